@@ -1,0 +1,54 @@
+"""SceneError and the small checks that raise it (shared by materials.py and scene.py)."""
+
+import json
+import math
+import numbers
+import re
+
+
+class SceneError(ValueError):
+    """Invalid scene input. The message is one line: ``<scene>: <dotted.key> = <value>: <what is allowed>``."""
+
+
+def show_key(key: str) -> str:
+    """A TOML key as written in a file: bare when possible, else quoted."""
+    return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else show(key)
+
+
+def show(value) -> str:
+    """One-line TOML rendering of a value (valid TOML for strings, numbers, booleans, lists, tables)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False).replace("\x7f", "\\u007f")
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return repr(float(value))
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(map(show, value)) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{show_key(str(k))} = {show(v)}" for k, v in value.items()) + "}"
+    return show(str(value))
+
+
+def number(key: str, value, *, integer: bool = False):
+    """``value`` as a finite float (or an int when ``integer``); bool is not a number."""
+    kind = numbers.Integral if integer else numbers.Real
+    if isinstance(value, bool) or not isinstance(value, kind):
+        raise SceneError(f"{key} = {show(value)}: must be {'an integer' if integer else 'a number'}")
+    if integer:
+        return int(value)
+    if not math.isfinite(value):
+        raise SceneError(f"{key} = {show(value)}: must be finite")
+    return float(value)
+
+
+def table(key: str, value, allowed: tuple[str, ...]) -> dict:
+    """``value`` checked to be a table whose keys are all in ``allowed``."""
+    if not isinstance(value, dict):
+        raise SceneError(f"{key} = {show(value)}: must be a table")
+    for k, v in value.items():
+        if k not in allowed:
+            raise SceneError(f"{key}.{show_key(k)} = {show(v)}: unknown key; allowed keys: {', '.join(allowed)}")
+    return value

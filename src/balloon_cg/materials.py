@@ -1,0 +1,101 @@
+"""Incompressible Ogden materials.
+
+Φ = Σ_i (μ_i/α_i)(λ1^α_i + λ2^α_i + λ3^α_i − 3) with moduli in units of μ/2, so that Σ μ_i α_i = 4
+(initial shear modulus 2). The presets are the paper's Table 1 plus two classical special cases.
+"""
+
+from dataclasses import dataclass, replace
+
+from .errors import SceneError, number, show, table
+
+MAX_TERMS = 6
+
+
+@dataclass(frozen=True)
+class Material:
+    """An Ogden material: terms (μ_i, α_i), i = 1..len(mu)."""
+
+    name: str
+    mu: tuple[float, ...]
+    alpha: tuple[float, ...]
+
+    @property
+    def shear_modulus_sum(self) -> float:
+        """Σ μ_i α_i: twice the initial shear modulus (4 for every preset)."""
+        return sum(m * a for m, a in zip(self.mu, self.alpha))
+
+
+# Named materials (SPOM/FPOM/TPOM: six-, four-, two-parameter Ogden fits, the paper's Table 1).
+PRESETS: dict[str, Material] = {
+    m.name: m
+    for m in (
+        Material("SPOM1", (3.00508, 0.0145, -0.0177), (1.3, 4.0, -2.0)),
+        Material("SPOM2", (2.25815, 0.0145, -0.0177), (1.73, 4.0, -2.0)),
+        Material("FPOM1", (3.04969, -0.0177), (1.3, -2.0)),
+        Material("FPOM2", (2.29168, -0.0177), (1.73, -2.0)),
+        Material("TPOM1", (3.07692,), (1.3,)),
+        Material("TPOM2", (2.0202,), (1.98,)),
+        # Φ = C1 (I1 − 3) with C1 = μ/2 = 1.
+        Material("neo-Hookean", (2.0,), (2.0,)),
+        # Φ = C1 (I1 − 3) + C2 (I2 − 3) with C1 = μ1/2, C2 = −μ2/2 and C2/C1 = 0.1:
+        # μ1 α1 = 4/1.1, μ2 α2 = 0.4/1.1, i.e. μ1 = 1.8181818181818181, μ2 = −0.18181818181818182.
+        Material("Mooney-Rivlin", (2 / 1.1, -0.2 / 1.1), (2.0, -2.0)),
+    )
+}
+
+_KEYS = ("preset", "mu", "alpha", "name")
+
+
+def get_preset(name: str) -> Material:
+    """The preset called ``name``, matched case-insensitively; KeyError if there is none."""
+    for key, material in PRESETS.items():
+        if key.lower() == name.lower():
+            return material
+    raise KeyError(name)
+
+
+def material_from_table(data: dict) -> Material:
+    """The Material described by a ``[material]`` table: ``preset = "NAME"`` or ``mu``/``alpha`` (+ ``name``)."""
+    data = table("material", data, _KEYS)
+    name = data.get("name")
+    if name is not None and (not isinstance(name, str) or not name.strip()):
+        raise SceneError(f"material.name = {show(name)}: must be a non-empty string")
+    if "preset" in data:
+        preset = data["preset"]
+        if "mu" in data or "alpha" in data:
+            raise SceneError(f"material.preset = {show(preset)}: give either preset or mu and alpha, not both")
+        try:
+            material = get_preset(preset) if isinstance(preset, str) else None
+        except KeyError:
+            material = None
+        if material is None:
+            raise SceneError(f"material.preset = {show(preset)}: unknown preset; allowed: {', '.join(PRESETS)}")
+        return replace(material, name=name) if name else material
+    for key in ("mu", "alpha"):
+        if key not in data:
+            raise SceneError(f'material.{key} is missing: give preset = "NAME", or both mu = [...] and alpha = [...]')
+    mu, alpha = _terms("material.mu", data["mu"]), _terms("material.alpha", data["alpha"])
+    if len(mu) != len(alpha):
+        raise SceneError(
+            f"material.alpha = {show(data['alpha'])}: has length {len(alpha)} but material.mu has length {len(mu)}; "
+            "they must match"
+        )
+    for i, a in enumerate(alpha):
+        if a == 0:
+            raise SceneError(f"material.alpha[{i}] = {show(data['alpha'][i])}: exponents must be nonzero")
+    material = Material(name or "custom", mu, alpha)
+    if material.shear_modulus_sum <= 0:
+        raise SceneError(
+            f"material.mu = {show(data['mu'])}: with material.alpha = {show(data['alpha'])}, "
+            f"Σ μ_i α_i = {material.shear_modulus_sum:g} must be > 0 (initial shear modulus must be positive)"
+        )
+    return material
+
+
+def _terms(key: str, values) -> tuple[float, ...]:
+    """A non-empty list of at most MAX_TERMS finite numbers."""
+    if not isinstance(values, (list, tuple)) or not values:
+        raise SceneError(f"{key} = {show(values)}: must be a non-empty list of numbers")
+    if len(values) > MAX_TERMS:
+        raise SceneError(f"{key} = {show(values)}: at most {MAX_TERMS} Ogden terms (got {len(values)})")
+    return tuple(number(f"{key}[{i}]", v) for i, v in enumerate(values))

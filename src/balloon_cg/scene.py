@@ -1,0 +1,346 @@
+"""Scenes: a balloon described in a TOML file (material, applied field, continuation and numerical settings).
+
+Every table but ``[material]`` may be omitted (defaults apply). Invalid input raises one SceneError whose
+one-line message names the file (or scene), the dotted key, the value and what is allowed.
+"""
+
+import math
+import re
+import tomllib
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+
+from .errors import SceneError, number, show, show_key, table
+from .materials import Material, material_from_table
+
+__all__ = [
+    "Coil", "Field", "Continuation", "Solver", "Stability", "Output", "Scene", "SceneError",
+    "parse_scene", "load_scene",
+]
+
+
+@dataclass(frozen=True)
+class Coil:
+    """A circular current loop coaxial with the balloon: radius a, height h of its plane, signed current s."""
+
+    radius: float
+    height: float
+    current: float
+
+
+@dataclass(frozen=True)
+class Field:
+    """The applied field: coupling χ, intensity M (section 2 of MODEL.md) and the coils producing it."""
+
+    chi: float = 1.0
+    M: float = 0.0
+    coils: tuple[Coil, ...] = ()
+
+    @property
+    def is_equator_symmetric(self) -> bool:
+        """True when the coils are mirror-symmetric about z = 0, so that H² is even in z.
+
+        Every coil (a, h, s) needs a partner (a, −h, ±s); the sign must be + for all pairs (h_z even)
+        or − for all pairs (h_ρ even). A coil at h = 0 is its own partner, with sign +.
+        """
+        same_sign = set()
+        for c in self.coils:
+            partner = next(
+                (d for d in self.coils
+                 if d.radius == c.radius and d.height == -c.height and abs(d.current) == abs(c.current)),
+                None,
+            )
+            if partner is None:
+                return False
+            same_sign.add(partner.current == c.current)
+        return len(same_sign) <= 1
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """Branch following, parameterised by the pole stretch λ2(0).
+
+    The branch starts at the sphere inflated to ``start_stretch`` and stops when the stretch passes
+    ``stop_stretch``, falls below ``min_stretch``, P passes ``stop_pressure`` (None: no limit), after
+    ``max_points`` points, or when the membrane comes within ``wire_gap`` of a coil wire. Arclength steps
+    start at ``step`` and stay in [step_min, step_max]. ``symmetry``: "equator" imposes η(π − θ) = −η(θ)
+    (needs equator-symmetric coils), "none" never does, "auto" does when the field allows it.
+    """
+
+    start_stretch: float = 1.01
+    stop_stretch: float = 5.0
+    min_stretch: float = 1.001
+    stop_pressure: float | None = None
+    step: float = 0.05
+    step_min: float = 1e-7
+    step_max: float = 0.25
+    max_points: int = 2000
+    symmetry: str = "auto"
+    wire_gap: float = 0.02
+
+
+@dataclass(frozen=True)
+class Solver:
+    """Discretisation: Legendre ``degree``, Gauss points (``quadrature``, 0 = automatic), Newton settings."""
+
+    degree: int = 40
+    quadrature: int = 0
+    tol: float = 1e-11
+    max_newton: int = 25
+
+
+@dataclass(frozen=True)
+class Stability:
+    """Second variation: Legendre ``degree`` of the perturbations and the largest azimuthal number ``m_max``."""
+
+    degree: int = 20
+    m_max: int = 1
+
+
+@dataclass(frozen=True)
+class Output:
+    """Sampling of the reported shapes and fields: ``theta_points`` values of θ on [0, π]."""
+
+    theta_points: int = 181
+
+
+_TABLES = ("material", "field", "continuation", "solver", "stability", "output")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene; ``text`` is the TOML it was parsed from (provenance)."""
+
+    name: str
+    material: Material
+    field: Field
+    continuation: Continuation
+    solver: Solver
+    stability: Stability
+    output: Output
+    text: str
+
+    def to_dict(self) -> dict:
+        """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded)."""
+        m, f = self.material, self.field
+        return {
+            "material": {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
+            "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
+            **{t: asdict(getattr(self, t)) for t in _TABLES[2:]},
+        }
+
+    def to_toml(self) -> str:
+        """TOML text of ``to_dict()``; parsing it gives back this scene (apart from ``text``)."""
+        return _to_toml(self.to_dict())
+
+    def with_overrides(self, overrides: dict[str, object]) -> "Scene":
+        """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``.
+
+        ``material.preset`` replaces the whole material; a value None restores the default.
+        """
+        data = self.to_dict()
+        try:
+            for key, value in overrides.items():
+                _assign(data, key, value)
+            scene = _build(data, self.name, "")
+        except SceneError as e:
+            raise SceneError(f"{self.name}: {e}") from None
+        return replace(scene, text=scene.to_toml())
+
+
+def parse_scene(text: str, name: str = "scene") -> Scene:
+    """Parse and validate a scene from TOML text."""
+    return _parse(text, name, name)
+
+
+def load_scene(path) -> Scene:
+    """Read a scene file; the scene is named after the file stem, error messages after the file name."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise SceneError(f"{path.name}: not UTF-8 text ({e})") from None
+    return _parse(text, path.stem, path.name)
+
+
+def _parse(text: str, name: str, source: str) -> Scene:
+    try:
+        return _build(tomllib.loads(text), name, text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"{source}: invalid TOML: {e}") from None
+    except SceneError as e:
+        raise SceneError(f"{source}: {e}") from None
+
+
+def _build(data: dict, name: str, text: str) -> Scene:
+    for key, value in data.items():
+        if key not in _TABLES:
+            where = f"[{show_key(key)}]: unknown table" if isinstance(value, dict) else \
+                f"{show_key(key)} = {show(value)}: unknown top-level key"
+            raise SceneError(f"{where}; allowed tables: {', '.join(_TABLES)}")
+    if "material" not in data:
+        raise SceneError('material: the [material] table is missing (give preset = "NAME", or mu and alpha)')
+    material = material_from_table(data["material"])
+    field = _field(data.get("field", {}))
+    return Scene(
+        name=name,
+        material=material,
+        field=field,
+        continuation=_continuation(data.get("continuation", {}), field),
+        solver=_solver(data.get("solver", {})),
+        stability=_stability(data.get("stability", {})),
+        output=_output(data.get("output", {})),
+        text=text,
+    )
+
+
+def _getter(data: dict, prefix: str, cls):
+    """get(key, ok, allowed, integer=False): the checked number at ``prefix.key``; missing or None: cls's default."""
+
+    def get(key, ok, allowed, integer=False):
+        raw = data.get(key)
+        raw = getattr(cls, key) if raw is None else raw
+        if raw is None:
+            return None
+        x = number(f"{prefix}.{key}", raw, integer=integer)
+        if not ok(x):
+            raise SceneError(f"{prefix}.{key} = {show(raw)}: must be {allowed}")
+        return x
+
+    return get
+
+
+def _keys(cls) -> tuple[str, ...]:
+    return tuple(f.name for f in fields(cls))
+
+
+def _field(data) -> Field:
+    data = table("field", data, _keys(Field))
+    get = _getter(data, "field", Field)
+    chi = get("chi", lambda x: x >= 0, ">= 0")
+    M = get("M", lambda x: x >= 0, ">= 0")
+    coils = data.get("coils")
+    coils = [] if coils is None else coils
+    if not isinstance(coils, list):
+        raise SceneError(f"field.coils = {show(coils)}: must be an array of tables [[field.coils]]")
+    coils = tuple(_coil(f"field.coils[{i}]", c) for i, c in enumerate(coils))
+    if M > 0 and not coils:
+        raise SceneError(f"field.M = {show(data['M'])} needs at least one [[field.coils]]")
+    seen = {}
+    for i, c in enumerate(coils):
+        j = seen.setdefault((c.radius, c.height), i)
+        if j != i:
+            raise SceneError(
+                f"field.coils[{i}]: same radius = {show(c.radius)} and height = {show(c.height)} as field.coils[{j}]: "
+                "coils must be distinct (merge their currents)"
+            )
+    return Field(chi, M, coils)
+
+
+def _coil(key: str, data) -> Coil:
+    data = table(key, data, _keys(Coil))
+    for k in _keys(Coil):
+        if data.get(k) is None:
+            raise SceneError(f"{key}.{k} is missing: each coil needs radius, height and current")
+    a = number(f"{key}.radius", data["radius"])
+    h = number(f"{key}.height", data["height"])
+    s = number(f"{key}.current", data["current"])
+    if a <= 0:
+        raise SceneError(f"{key}.radius = {show(data['radius'])}: must be > 0")
+    if s == 0:
+        raise SceneError(f"{key}.current = {show(data['current'])}: must be nonzero")
+    d2 = a * a + h * h
+    if d2 <= 1 + 1e-9:
+        where = "on" if d2 >= 1 - 1e-9 else "inside"
+        raise SceneError(
+            f"{key}: wire at distance {math.sqrt(d2):.6g} from the centre lies {where} the undeformed membrane "
+            "(a² + h² must be > 1)"
+        )
+    return Coil(a, h, s)
+
+
+def _continuation(data, field: Field) -> Continuation:
+    data = table("continuation", data, _keys(Continuation))
+    get = _getter(data, "continuation", Continuation)
+    start = get("start_stretch", lambda x: x > 1, "> 1")
+    stop = get("stop_stretch", lambda x: x > start, f"> continuation.start_stretch = {show(start)}")
+    low = get("min_stretch", lambda x: 1 < x < start, f"in (1, continuation.start_stretch = {show(start)})")
+    pressure = get("stop_pressure", lambda x: x > 0, "> 0")
+    step_min = get("step_min", lambda x: x > 0, "> 0")
+    step_max = get("step_max", lambda x: x >= step_min, f">= continuation.step_min = {show(step_min)}")
+    step = get(
+        "step", lambda x: step_min <= x <= step_max, f"in [step_min, step_max] = [{show(step_min)}, {show(step_max)}]"
+    )
+    points = get("max_points", lambda n: 1 <= n <= 100_000, "an integer in [1, 100000]", integer=True)
+    gap = get("wire_gap", lambda x: x > 0, "> 0")
+    symmetry = data.get("symmetry")
+    symmetry = Continuation.symmetry if symmetry is None else symmetry
+    if symmetry not in ("auto", "equator", "none"):
+        raise SceneError(f'continuation.symmetry = {show(symmetry)}: must be one of "auto", "equator", "none"')
+    if symmetry == "equator" and not field.is_equator_symmetric:
+        raise SceneError(
+            'continuation.symmetry = "equator": the coils are not mirror-symmetric about z = 0 (use "auto" or "none")'
+        )
+    return Continuation(start, stop, low, pressure, step, step_min, step_max, points, symmetry, gap)
+
+
+def _solver(data) -> Solver:
+    data = table("solver", data, _keys(Solver))
+    get = _getter(data, "solver", Solver)
+    degree = get("degree", lambda n: 8 <= n <= 400, "an integer in [8, 400]", integer=True)
+    quadrature = get(
+        "quadrature", lambda n: n == 0 or n >= degree + 1,
+        f"0 (automatic) or >= solver.degree + 1 = {degree + 1}", integer=True,
+    )
+    tol = get("tol", lambda x: 0 < x <= 1e-3, "in (0, 1e-3]")
+    max_newton = get("max_newton", lambda n: 1 <= n <= 200, "an integer in [1, 200]", integer=True)
+    return Solver(degree, quadrature, tol, max_newton)
+
+
+def _stability(data) -> Stability:
+    get = _getter(table("stability", data, _keys(Stability)), "stability", Stability)
+    return Stability(
+        get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
+        get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
+    )
+
+
+def _output(data) -> Output:
+    get = _getter(table("output", data, _keys(Output)), "output", Output)
+    return Output(get("theta_points", lambda n: 3 <= n <= 100_001, "an integer in [3, 100001]", integer=True))
+
+
+def _to_toml(data: dict) -> str:
+    """TOML for a dict of tables holding scalars, lists and arrays of tables; None values are left out."""
+    lines = []
+    for name, content in data.items():
+        arrays = {k: v for k, v in content.items() if isinstance(v, list) and v and isinstance(v[0], dict)}
+        lines.append(f"[{name}]")
+        lines += [f"{k} = {show(v)}" for k, v in content.items() if v is not None and k not in arrays]
+        for k, items in arrays.items():
+            for item in items:
+                lines += ["", f"[[{name}.{k}]]"] + [f"{kk} = {show(vv)}" for kk, vv in item.items()]
+        lines.append("")
+    return "\n".join(lines)
+
+
+_OVERRIDE_KEY = re.compile(r"(\w+)\.(\w+)(?:\[(\d+)\]\.(\w+))?")
+
+
+def _assign(data: dict, key: str, value) -> None:
+    """Set the dotted override ``key`` in a scene dict (numpy values become plain Python ones)."""
+    value = value.tolist() if hasattr(value, "tolist") else value
+    match = _OVERRIDE_KEY.fullmatch(key)
+    if match is None:
+        raise SceneError(f"{key} = {show(value)}: not a scene key (e.g. field.M or field.coils[0].current)")
+    tab, k, index, sub = match.groups()
+    if index is None:
+        if (tab, k) == ("material", "preset"):
+            data[tab] = {"preset": value}
+        else:
+            data.setdefault(tab, {})[k] = value
+        return
+    items = data.get(tab, {}).get(k)
+    if not isinstance(items, list) or int(index) >= len(items):
+        raise SceneError(f"{key} = {show(value)}: there is no {tab}.{k}[{index}]")
+    items[int(index)][sub] = value
