@@ -1,0 +1,69 @@
+"""Stage driver: scene classes -> kernels -> lowered IR -> module text -> files in generated/."""
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from . import equations, poles
+from .classes import scene_classes
+from .emit import module_text
+from .functional import GENERAL_TERMS, SceneClass
+from .kernels import lower
+
+GENERATOR = "codegen/build.py"
+
+
+def class_module(cls: SceneClass) -> str:
+    """Module text of one scene class: Galerkin energy kernels, first-order system, pole series."""
+    kernels = equations.energy_kernels(cls) + equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
+    title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
+    return module_text(title, cls.inputs(), [lower(k) for k in kernels], GENERATOR)
+
+
+def field_module_text() -> str:
+    from . import field
+
+    title, inputs, kernels, constants = field.field_module()
+    return module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants)
+
+
+def _class_job(cls):
+    return cls.name, class_module(cls)
+
+
+def all_modules(workers: int = 2):
+    """{module name: text}, generated in parallel; output does not depend on the worker count."""
+    classes = scene_classes()
+    with ProcessPoolExecutor(workers) as pool:
+        texts = dict(pool.map(_class_job, classes))
+    texts["coil_field"] = field_module_text()
+    return dict(sorted(texts.items()))
+
+
+def registry_text() -> str:
+    """``generated/__init__.py``: the index the runtime uses to pick a module for a scene."""
+    rows = []
+    for cls in scene_classes():
+        alphas = None if cls.alphas is None else tuple(float(a) for a in cls.alphas)
+        rows.append(f"    {cls.name!r}: ({alphas!r}, {cls.field!r}),\n")
+    return (
+        '"""Kernels emitted by codegen/ (make regenerate). Never edit by hand.\n\n'
+        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field).\n"""\n'
+        f"GENERAL_TERMS = {GENERAL_TERMS}\n"
+        "CLASSES = {\n" + "".join(rows) + "}\n"
+    )
+
+
+def write_all(outdir: Path, log=print) -> list[Path]:
+    outdir.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    modules = all_modules()
+    log(f"codegen: derived and printed {len(modules)} modules in {time.perf_counter() - start:.1f} s")
+    written = []
+    init = outdir / "__init__.py"
+    init.write_text(registry_text())
+    written.append(init)
+    for name, text in modules.items():
+        path = outdir / f"{name}.py"
+        path.write_text(text)
+        written.append(path)
+    return written

@@ -1,0 +1,98 @@
+"""Equations from the functional: energy gradient/Hessian (Ritz–Galerkin) and the first-order EL system.
+
+Galerkin form: E = ∫_{-1}^{1} π̂ d(cos θ); its first variation needs ∂π̂/∂(λ2, v, η, w) at a node, its Jacobian
+(= the axisymmetric second variation) the 4×4 Hessian of π̂, and continuation ∂/∂P and ∂/∂M of the gradient.
+
+First-order form (MODEL.md §4): with L(θ, λ2, λ2', η, η') = Π(θ, λ2, λ2' sin θ, η, η'), the EL equations
+d/dθ(Π_v sin θ) = Π_λ2 and d/dθ Π_w = Π_η are linear in (v', w'):
+    [Π_vv Π_vw; Π_wv Π_ww] (v', w') = b,
+    b1 = Π_λ2/s − c Π_v/s − ∂_θΠ_v − Π_vλ2 v/s − Π_vη w,
+    b2 = Π_η − ∂_θΠ_w − Π_wλ2 v/s − Π_wη w,
+(∂_θ the explicit θ-derivative) so y = (λ2, v, η, w) obeys y' = f = (v/s, F1, w, F2). The 2×2 matrix is
+singular when the membrane is unstretched (its determinant is proportional to the tension Φ_1).
+"""
+import sympy as sp
+
+from . import functional as fn
+from .functional import FIELD, STATE, M, P, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, w
+from .kernels import Arg, Kernel
+
+HESSIAN_PAIRS = tuple((i, j) for i in range(4) for j in range(i, 4))
+
+
+def _args(cls: SceneClass, node_symbols):
+    args = [Arg.node(s) for s in node_symbols]
+    args += [Arg.param(p) for p in fn.runtime_args(cls)]
+    args.append(Arg.param_array("mu", fn.moduli(cls)))
+    if cls.alphas is None:
+        args.append(Arg.param_array("alpha", fn.exponents(cls)))
+    if cls.field:
+        args.append(Arg.node_rows("field", FIELD))
+    return tuple(args)
+
+
+def energy_kernels(cls: SceneClass) -> list[Kernel]:
+    density = fn.energy_density(cls)
+    rho = lam2 * sin_theta
+    gradient = [sp.diff(density, x) for x in STATE]
+    hessian = [sp.diff(gradient[i], STATE[j]) for i, j in HESSIAN_PAIRS]
+    at_node = lambda exprs: tuple(fn.field_values(e, rho) for e in exprs)  # noqa: E731
+    args = _args(cls, (cos_theta, sin_theta) + STATE)
+    kernels = [
+        Kernel("energy_density", "π̂ = Π/sin θ at a node (MODEL.md §2).", args, at_node([density])),
+        Kernel("energy_gradient", "∂π̂/∂(λ2, v, η, w).", args, at_node(gradient)),
+        Kernel(
+            "energy_hessian",
+            "∂²π̂/∂(λ2, v, η, w)², upper triangle row by row (the axisymmetric second variation).",
+            args,
+            at_node(hessian),
+        ),
+        Kernel("pressure_gradient", "∂²π̂/∂P∂(λ2, v, η, w).", args, at_node([sp.diff(g, P) for g in gradient])),
+    ]
+    if cls.field:
+        kernels.append(
+            Kernel("field_gradient", "∂²π̂/∂M∂(λ2, v, η, w).", args, at_node([sp.diff(g, M) for g in gradient]))
+        )
+    return kernels
+
+
+def linear_system(cls: SceneClass):
+    """(A, b) of A (v', w') = b with node symbols for sin θ, cos θ; the H² proxy is left unevaluated."""
+    Pi = fn.lagrangian(cls)
+    s, c = sp.sin(theta), sp.cos(theta)
+    Pi_v, Pi_w = sp.diff(Pi, v), sp.diff(Pi, w)
+    A = [[sp.diff(Pi_v, v), sp.diff(Pi_v, w)], [sp.diff(Pi_w, v), sp.diff(Pi_w, w)]]
+    b1 = (sp.diff(Pi, lam2) - c * Pi_v) / s - sp.diff(Pi_v, theta) - sp.diff(Pi_v, lam2) * v / s - sp.diff(Pi_v, eta) * w
+    b2 = sp.diff(Pi, eta) - sp.diff(Pi_w, theta) - sp.diff(Pi_w, lam2) * v / s - sp.diff(Pi_w, eta) * w
+    node = {s: sin_theta, c: cos_theta}
+    return [[a.subs(node) for a in row] for row in A], [b1.subs(node), b2.subs(node)]
+
+
+def first_order_kernels(cls: SceneClass) -> list[Kernel]:
+    """f, ∂f/∂y, ∂f/∂P (and ∂f/∂M with a field), with F = A⁻¹ b and ∂F/∂x = A⁻¹(∂b/∂x − ∂A/∂x F)."""
+    A, b = linear_system(cls)
+    at_node = lambda e: fn.field_values(e, lam2 * sin_theta)  # noqa: E731
+    a11, a12, a21, a22, b1, b2, det, F1, F2 = sp.symbols("a11 a12 a21 a22 b1 b2 det F1 F2")
+    base = tuple(zip((a11, a12, a21, a22, b1, b2), map(at_node, (A[0][0], A[0][1], A[1][0], A[1][1], b[0], b[1]))))
+    solve = ((det, a11 * a22 - a12 * a21), (F1, (a22 * b1 - a12 * b2) / det), (F2, (a11 * b2 - a21 * b1) / det))
+    stages = (base, solve)
+
+    def dF(x):
+        r1 = at_node(sp.diff(b[0], x) - sp.diff(A[0][0], x) * F1 - sp.diff(A[0][1], x) * F2)
+        r2 = at_node(sp.diff(b[1], x) - sp.diff(A[1][0], x) * F1 - sp.diff(A[1][1], x) * F2)
+        return (a22 * r1 - a12 * r2) / det, (a11 * r2 - a21 * r1) / det
+
+    args = _args(cls, (theta, cos_theta, sin_theta) + STATE)
+    columns = [dF(x) for x in STATE]
+    jacobian = [0, 1 / sin_theta, 0, 0] + [col[0] for col in columns] + [0, 0, 0, 1] + [col[1] for col in columns]
+    dP = dF(P)
+    kernels = [
+        Kernel("rhs", "y' = f(θ, y): (λ2', v', η', w') of the EL equations (MODEL.md §4).", args,
+               (v / sin_theta, F1, w, F2), stages),
+        Kernel("rhs_jacobian", "∂f/∂(λ2, v, η, w), row-major 4×4.", args, tuple(map(sp.sympify, jacobian)), stages),
+        Kernel("rhs_pressure", "∂f/∂P.", args, (sp.S.Zero, dP[0], sp.S.Zero, dP[1]), stages),
+    ]
+    if cls.field:
+        dM = dF(M)
+        kernels.append(Kernel("rhs_field", "∂f/∂M.", args, (sp.S.Zero, dM[0], sp.S.Zero, dM[1]), stages))
+    return kernels

@@ -1,0 +1,71 @@
+"""Kernel IR: a named list of outputs over typed arguments, lowered to CSE'd assignments.
+
+A kernel is pointwise: it maps scalars at one quadrature node (``node`` arguments, or rows of a ``node_rows``
+matrix) and branch parameters (``param`` scalars, ``param_array`` vectors) to a tuple of outputs. ``stages``
+are earlier definitions (symbol = expression) that later stages and the outputs may use; each stage is CSE'd
+on its own so that a definition never appears after its first use.
+"""
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+
+@dataclass(frozen=True)
+class Arg:
+    """One argument: kind is 'node', 'param', 'node_rows' (matrix, one row per symbol) or 'param_array'."""
+
+    kind: str
+    name: str
+    symbols: tuple
+
+    @staticmethod
+    def node(symbol):
+        return Arg("node", str(symbol), (symbol,))
+
+    @staticmethod
+    def param(symbol):
+        return Arg("param", str(symbol), (symbol,))
+
+    @staticmethod
+    def node_rows(name, symbols):
+        return Arg("node_rows", name, tuple(symbols))
+
+    @staticmethod
+    def param_array(name, symbols):
+        return Arg("param_array", name, tuple(symbols))
+
+
+@dataclass(frozen=True)
+class Kernel:
+    name: str
+    doc: str
+    args: tuple
+    outputs: tuple
+    stages: tuple = field(default=())  # tuple of tuples of (symbol, expr)
+    vectorise: bool = True
+
+
+@dataclass(frozen=True)
+class LoweredKernel:
+    kernel: Kernel
+    assignments: tuple  # ((symbol, expr), ...) in evaluation order
+    results: tuple
+
+
+def lower(kernel: Kernel) -> LoweredKernel:
+    """Common-subexpression elimination, stage by stage (definitions before uses)."""
+    assignments = []
+    for index, stage in enumerate(kernel.stages):
+        names = [sym for sym, _ in stage]
+        replacements, reduced = sp.cse([expr for _, expr in stage], symbols=sp.numbered_symbols(f"s{index}_"))
+        assignments.extend(replacements)
+        assignments.extend(zip(names, reduced))
+    replacements, results = sp.cse(list(kernel.outputs), symbols=sp.numbered_symbols("t"))
+    assignments.extend(replacements)
+    return LoweredKernel(kernel, tuple(assignments), tuple(results))
+
+
+def operation_count(lowered: LoweredKernel) -> int:
+    """Arithmetic operations after CSE (the size that drives numba compile time)."""
+    exprs = [e for _, e in lowered.assignments] + list(lowered.results)
+    return int(sum(sp.count_ops(e) for e in exprs))

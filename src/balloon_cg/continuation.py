@@ -1,0 +1,143 @@
+"""Pseudo-arclength continuation of R(X) = 0, R: R^{n+1} -> R^n, with adaptive steps and fold location.
+
+Knows nothing about balloons: a *system* has ``residual(X)`` and ``jacobian(X)`` (n × (n+1)). From a point X
+with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector solves R = 0 with τ·(X − X_pred) = 0
+(Keller). Steps grow after easy corrections and shrink on failure or on a sharp turn (τ_i·τ_{i+1} small).
+*Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
+for a limit point); folds are then located by secant iteration in the arclength to |c·τ| ≤ 1e-12.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .newton import newton
+
+
+@dataclass
+class Settings:
+    step: float
+    step_min: float
+    step_max: float
+    max_points: int
+    tol: float
+    max_newton: int
+    max_turn: float = 0.3  # radians between successive tangents
+
+
+@dataclass
+class Point:
+    X: np.ndarray
+    tangent: np.ndarray
+    iterations: int
+    residual: float
+
+
+@dataclass
+class Fold:
+    label: str
+    point: Point
+    index: int  # the fold lies between points[index] and points[index + 1]
+
+
+@dataclass
+class Path:
+    points: list = field(default_factory=list)
+    folds: list = field(default_factory=list)
+    stop_reason: str = ""
+    overshoot: Point | None = None  # the first point past a stop condition (not part of the branch)
+
+
+def tangent(system, X, reference) -> np.ndarray:
+    """Unit null vector of J(X) oriented along ``reference``."""
+    J = system.jacobian(X)
+    matrix = np.vstack([J, reference])
+    rhs = np.zeros(J.shape[0] + 1)
+    rhs[-1] = 1.0
+    t = np.linalg.solve(matrix, rhs)
+    return t / np.linalg.norm(t)
+
+
+def correct(system, predictor, direction, settings: Settings):
+    """Keller's corrector: R(X) = 0 on the hyperplane through the predictor normal to ``direction``."""
+    return newton(system.residual, system.jacobian, predictor, direction, direction @ predictor,
+                  settings.tol, settings.max_newton)
+
+
+def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Settings):
+    """Secant/bisection (Illinois) on s ↦ c·τ(s) in (0, σ); returns the fold point or None."""
+    lo, hi = 0.0, sigma
+    f_lo, f_hi = float(c @ start.tangent), None
+    best = None
+    for _ in range(60):
+        s = 0.5 * (lo + hi) if f_hi is None else hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        if not lo < s < hi:
+            s = 0.5 * (lo + hi)
+        result = correct(system, start.X + s * start.tangent, start.tangent, settings)
+        if not result.converged:
+            return best
+        t = tangent(system, result.x, start.tangent)
+        value = float(c @ t)
+        best = Point(result.x, t, result.iterations, result.residual)
+        if abs(value) <= 1e-12 or hi - lo <= 1e-14 * max(1.0, sigma):
+            return best
+        if f_hi is None:
+            f_hi = float(c @ tangent(system, correct(system, start.X + hi * start.tangent, start.tangent,
+                                                       settings).x, start.tangent))
+        if (value > 0) == (f_lo > 0):
+            lo, f_lo = s, value
+            f_hi *= 0.5
+        else:
+            hi, f_hi = s, value
+            f_lo *= 0.5
+    return best
+
+
+def trace(system, start: Point, settings: Settings, stop, monitors: dict, progress=None) -> Path:
+    """Follow the branch from ``start`` along its tangent until ``stop(point)`` returns a reason.
+
+    The point that triggers the stop is not appended (it is kept as ``path.overshoot``, for the caller to
+    land exactly on the limit).
+
+    ``monitors``: label -> vector c for fold detection. ``progress``: optional callable(point).
+    """
+    path = Path(points=[start])
+    sigma = settings.step
+    current = start
+    while len(path.points) < settings.max_points:
+        predictor = current.X + sigma * current.tangent
+        result = correct(system, predictor, current.tangent, settings)
+        new_tangent = None
+        if result.converged:
+            try:
+                new_tangent = tangent(system, result.x, current.tangent)
+            except np.linalg.LinAlgError:
+                new_tangent = None
+        if new_tangent is None or float(new_tangent @ current.tangent) < np.cos(settings.max_turn):
+            sigma *= 0.5
+            if sigma < settings.step_min:
+                path.stop_reason = (
+                    f"corrector failed at the minimum step {settings.step_min:g}: {result.message}"
+                )
+                return path
+            continue
+        point = Point(result.x, new_tangent, result.iterations, result.residual)
+        for label, c in monitors.items():
+            if (c @ current.tangent) * (c @ point.tangent) < 0:
+                fold = _locate_fold(system, current, sigma, c, settings)
+                if fold is not None:
+                    path.folds.append(Fold(label, fold, len(path.points) - 1))
+        reason = stop(point)
+        if reason:
+            path.stop_reason = reason
+            path.overshoot = point
+            return path
+        path.points.append(point)
+        if progress is not None:
+            progress(point)
+        current = point
+        if result.iterations <= 3:
+            sigma = min(sigma * 1.5, settings.step_max)
+        elif result.iterations >= 6:
+            sigma = max(sigma * 0.7, settings.step_min)
+    path.stop_reason = f"maximum number of points ({settings.max_points}) reached"
+    return path

@@ -1,0 +1,122 @@
+"""Ritz–Galerkin discretisation in x = cos θ with Legendre polynomials.
+
+λ2(θ) = Σ_k a_k P_k(cos θ), η(θ) = Σ_k b_k P_k(cos θ), k = 0..N. Every such pair is smooth at the poles
+(λ2 and η are even in the distance from a pole), so the 0/0 pole terms never have to be evaluated: with
+dθ sin θ = −dx the energy E = ∫_0^π Π dθ = ∫_{-1}^{1} π̂ dx (π̂ = Π/sin θ) is a smooth integral, computed by
+Gauss–Legendre quadrature at interior nodes. At a node
+    v = λ2' sin θ = −(1 − x²) dλ2/dx,      w = η' = −sin θ dη/dx.
+Equator symmetry (λ2 even, η odd in x) keeps a_even and b_odd; without a field the translation η → η + c is
+removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import legendre
+
+
+def legendre_table(x: np.ndarray, degree: int):
+    """(P_k(x), P_k'(x)) for k = 0..degree, each of shape (len(x), degree + 1), by the three-term recurrence."""
+    p = np.zeros((x.size, degree + 1))
+    dp = np.zeros_like(p)
+    p[:, 0] = 1.0
+    if degree >= 1:
+        p[:, 1] = x
+        dp[:, 1] = 1.0
+    for k in range(1, degree):
+        p[:, k + 1] = ((2 * k + 1) * x * p[:, k] - k * p[:, k - 1]) / (k + 1)
+        dp[:, k + 1] = dp[:, k - 1] + (2 * k + 1) * p[:, k]
+    return p, dp
+
+
+@dataclass(frozen=True)
+class Discretisation:
+    """Basis, quadrature and the unknown-coefficient layout u = (a[kept], b[kept])."""
+
+    degree: int
+    symmetric: bool
+    pin_translation: bool
+    quadrature: int = 0
+
+    def __post_init__(self):
+        n_q = self.quadrature or (3 * self.degree) // 2 + 8
+        x, weights = legendre.leggauss(n_q)
+        p, dp = legendre_table(x, self.degree)
+        s = np.sqrt(1.0 - x * x)
+        k = np.arange(self.degree + 1)
+        a_keep = k[k % 2 == 0] if self.symmetric else k
+        b_keep = k[k % 2 == 1] if self.symmetric else (k[1:] if self.pin_translation else k)
+        put = object.__setattr__
+        put(self, "x", x)
+        put(self, "weights", weights)
+        put(self, "cos_theta", x)
+        put(self, "sin_theta", s)
+        put(self, "a_index", a_keep)
+        put(self, "b_index", b_keep)
+        na = a_keep.size
+        put(self, "size", na + b_keep.size)
+        # state at the nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
+        zeros_a = np.zeros((x.size, na))
+        zeros_b = np.zeros((x.size, b_keep.size))
+        ops = np.stack([
+            np.hstack([p[:, a_keep], zeros_b]),
+            np.hstack([-(1 - x * x)[:, None] * dp[:, a_keep], zeros_b]),
+            np.hstack([zeros_a, p[:, b_keep]]),
+            np.hstack([zeros_a, -s[:, None] * dp[:, b_keep]]),
+        ])
+        put(self, "ops", ops)
+
+    def split(self, u: np.ndarray):
+        """Full Legendre coefficient vectors (a, b) of length degree + 1 from the unknowns u."""
+        a = np.zeros(self.degree + 1)
+        b = np.zeros(self.degree + 1)
+        a[self.a_index] = u[: self.a_index.size]
+        b[self.b_index] = u[self.a_index.size:]
+        return a, b
+
+    def join(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[self.a_index], b[self.b_index]])
+
+    def node_state(self, u: np.ndarray) -> np.ndarray:
+        """(λ2, v, η, w) at the quadrature nodes, shape (4, n_q)."""
+        return self.ops @ u
+
+    def gradient(self, pointwise: np.ndarray) -> np.ndarray:
+        """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q)."""
+        return np.einsum("kqi,kq->i", self.ops, pointwise * self.weights)
+
+    def hessian(self, pointwise: np.ndarray) -> np.ndarray:
+        """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is the upper triangle (10, n_q)."""
+        weighted = pointwise * self.weights
+        out = np.zeros((self.size, self.size))
+        row = 0
+        for k in range(4):
+            for l in range(k, 4):
+                block = self.ops[k].T @ (weighted[row][:, None] * self.ops[l])
+                out += block if k == l else block + block.T
+                row += 1
+        return out
+
+    def pole_rows(self):
+        """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south)."""
+        sign = (-1.0) ** np.arange(self.degree + 1)
+        ones = np.ones(self.degree + 1)
+        zero = np.zeros(self.degree + 1)
+        return {
+            "lam2_north": self.join(ones, zero),
+            "lam2_south": self.join(sign, zero),
+            "eta_north": self.join(zero, ones),
+            "eta_south": self.join(zero, sign),
+        }
+
+    def evaluate(self, u: np.ndarray, theta: np.ndarray):
+        """(λ2, λ2', η, η') on an arbitrary θ grid (poles included), from the Legendre series."""
+        a, b = self.split(u)
+        x = np.cos(theta)
+        p, dp = legendre_table(x, self.degree)
+        s = np.sin(theta)
+        return p @ a, -s * (dp @ a), p @ b, -s * (dp @ b)
+
+    def tail(self, u: np.ndarray) -> float:
+        """Spectral error estimate: size of the two highest-degree coefficients of λ2 and η."""
+        a, b = self.split(u)
+        return float(max(np.abs(a[-2:]).max(), np.abs(b[-2:]).max()))

@@ -1,0 +1,82 @@
+"""The discrete equilibrium problem: gradient and Hessian of the Ritz energy E(u; P, M).
+
+R(u; P, M) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (λ2, v, η, w) at node q, MODEL.md §2),
+J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M for
+continuation. A point is an equilibrium when R = 0 at fixed (P, M).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .discretisation import Discretisation
+from .kernels import KernelSet
+
+
+class NonFiniteState(ArithmeticError):
+    """The kernels returned NaN/inf: the state left the physical domain (λ ≤ 0, a wire reached, …)."""
+
+
+@dataclass
+class Parameters:
+    P: float
+    M: float = 0.0
+    chi: float = 1.0
+
+    def with_value(self, name: str, value: float) -> "Parameters":
+        return Parameters(**{**self.__dict__, name: float(value)})
+
+
+class Equilibrium:
+    """Residual, Jacobian and parameter derivatives of the Ritz–Galerkin system for one scene."""
+
+    def __init__(self, scene, discretisation: Discretisation):
+        self.scene = scene
+        self.disc = discretisation
+        self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
+        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0)
+        self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
+
+    def _state(self, u):
+        state = self.disc.node_state(u)
+        field = None
+        if self.kernels.field_class:
+            from .field import field_squared_nodes
+
+            field = np.zeros((6, state.shape[1]))
+            if self.coils.shape[0]:
+                field_squared_nodes(state[0] * self.disc.sin_theta, state[2], self.coils, field)
+        return tuple(state), field
+
+    def _pointwise(self, kernel, u, params: Parameters, rows):
+        state, field = self._state(u)
+        out = self.kernels.nodes(kernel, self.geometry, state, self.kernels.params(params.P, params.M, params.chi),
+                                 field, rows)
+        if not np.all(np.isfinite(out)):
+            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+        return out
+
+    def energy(self, u, params: Parameters) -> float:
+        """E/(2π) (MODEL.md §2)."""
+        return float(self.disc.weights @ self._pointwise("energy_density", u, params, 1)[0])
+
+    def residual(self, u, params: Parameters) -> np.ndarray:
+        return self.disc.gradient(self._pointwise("energy_gradient", u, params, 4))
+
+    def jacobian(self, u, params: Parameters) -> np.ndarray:
+        return self.disc.hessian(self._pointwise("energy_hessian", u, params, 10))
+
+    def parameter_derivative(self, u, params: Parameters, name: str) -> np.ndarray:
+        """∂R/∂P or ∂R/∂M (the latter is zero without coils)."""
+        if name == "P":
+            return self.disc.gradient(self._pointwise("pressure_gradient", u, params, 4))
+        if name == "M":
+            if not self.coils.shape[0]:
+                return np.zeros(self.disc.size)
+            return self.disc.gradient(self._pointwise("field_gradient", u, params, 4))
+        raise ValueError(f"unknown continuation parameter {name!r}: expected 'P' or 'M'")
+
+    def volume(self, u) -> float:
+        """Enclosed volume / (2π) = −∂E/∂P (MODEL.md §2: the pressure term is −P V/(2π))."""
+        state, _ = self._state(u)
+        lam2, _, _, w = state
+        return float(-self.disc.weights @ (0.5 * lam2**2 * w * self.disc.sin_theta))

@@ -1,0 +1,24 @@
+"""The exact M = 0 solution (MODEL.md §4): a sphere of radius λ under pressure
+
+    P(λ) = 2 Σ_i μ_i (λ^(α_i − 3) − λ^(−2α_i − 3)),
+
+i.e. λ2 ≡ λ, η = λ cos θ (Legendre coefficients a_0 = λ, b_1 = λ), membrane stress σ = Σ μ_i (λ^α_i − λ^(−2α_i)).
+"""
+import numpy as np
+
+
+def sphere_pressure(material, stretch):
+    mu = np.asarray(material.mu)[:, None]
+    alpha = np.asarray(material.alpha)[:, None]
+    lam = np.atleast_1d(np.asarray(stretch, dtype=float))[None, :]
+    value = 2.0 * np.sum(mu * (lam ** (alpha - 3) - lam ** (-2 * alpha - 3)), axis=0)
+    return value if np.ndim(stretch) else float(value[0])
+
+
+def sphere_stress(material, stretch):
+    """Equal principal Cauchy membrane stresses of the inflated sphere (elastic part, MODEL.md §6)."""
+    mu = np.asarray(material.mu)[:, None]
+    alpha = np.asarray(material.alpha)[:, None]
+    lam = np.atleast_1d(np.asarray(stretch, dtype=float))[None, :]
+    value = np.sum(mu * (lam**alpha - lam ** (-2 * alpha)), axis=0)
+    return value if np.ndim(stretch) else float(value[0])
