@@ -74,8 +74,7 @@ def first_order_kernels(cls: SceneClass) -> list[Kernel]:
     at_node = lambda e: fn.field_values(e, lam2 * sin_theta)  # noqa: E731
     a11, a12, a21, a22, b1, b2, det, F1, F2 = sp.symbols("a11 a12 a21 a22 b1 b2 det F1 F2")
     base = tuple(zip((a11, a12, a21, a22, b1, b2), map(at_node, (A[0][0], A[0][1], A[1][0], A[1][1], b[0], b[1]))))
-    solve = ((det, a11 * a22 - a12 * a21), (F1, (a22 * b1 - a12 * b2) / det), (F2, (a11 * b2 - a21 * b1) / det))
-    stages = (base, solve)
+    stages = (base, ((det, a11 * a22 - a12 * a21),), ((F1, (a22 * b1 - a12 * b2) / det), (F2, (a11 * b2 - a21 * b1) / det)))
 
     def dF(x):
         r1 = at_node(sp.diff(b[0], x) - sp.diff(A[0][0], x) * F1 - sp.diff(A[0][1], x) * F2)

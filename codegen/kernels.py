@@ -3,7 +3,8 @@
 A kernel is pointwise: it maps scalars at one quadrature node (``node`` arguments, or rows of a ``node_rows``
 matrix) and branch parameters (``param`` scalars, ``param_array`` vectors) to a tuple of outputs. ``stages``
 are earlier definitions (symbol = expression) that later stages and the outputs may use; each stage is CSE'd
-on its own so that a definition never appears after its first use.
+on its own so that a definition never appears after its first use (a stage's definitions may only use
+symbols defined in earlier stages).
 """
 from dataclasses import dataclass, field
 

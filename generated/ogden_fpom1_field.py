@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "ce25bddc934c76f371398b674ddc668a3089beaf1ba70bcbfc929982349cf07b"
+SIGNATURE = "8bb0eafa21c25652f9b49b4aa0cc7b2e07cbf8b07c605ddf62b73998ff9ebb6c"
 INPUTS = [('alphas', ('1.3', '-2')), ('class', 'ogden_fpom1_field'), ('field', True)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series')
 
@@ -277,10 +277,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, field):
     a22 = sin_theta*(-s0_13*(s0_12 + s0_3*s0_35) + s0_29*((1.3)*s0_14 + (4.29)*s0_16*s0_26*s0_3 - s0_19 - s0_3*s0_36))
     b1 = -s0_37 - sin_theta*(-s0_13*(-2.0*s0_38*sin_theta + s0_39*s0_9 + s0_40*s0_41) + s0_29*(-s0_15*s0_39 + (1.3)*s0_17*s0_43 + (3.3)*s0_25*s0_44 + s0_32*s0_41)) - v*(-s0_13*(s0_1*s0_46 - s0_40*s0_48 + s0_45 - s0_47) + s0_29*((1.3)*cos_theta*s0_14 - s0_17*s0_25*s0_51 - s0_32*s0_48 - s0_33*s0_48 - s0_49)) + (-s0_37*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_52 + (0.7692307692307693)*mu0*(cos_theta*s0_15*s0_4 - s0_4*s0_49 + (1.3)*s0_42 - s0_51/s0_5**(0.65)) - s0_13*(s0_4*s0_45 - s0_4*s0_47 + s0_46*s0_5 - 2.0/s0_38)))/sin_theta
     b2 = -Q_z*s0_52 - cos_theta*(-s0_13*(s0_11*w - s0_9*w) + s0_29*(s0_15*w - s0_19*w) + s0_53*s0_54) - sin_theta*(P*cos_theta*s0_54 + mu1*s0_56*s0_57*s0_6 + s0_29*(s0_36*s0_55*s0_57 - 4.29*s0_44*w)) - v*(lam2*s0_53 - s0_13*(s0_35*s0_58 + s0_56) + s0_29*((1.69)*s0_17*s0_50*w + (4.29)*s0_27*s0_58 - s0_36*s0_58))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -371,10 +371,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, fi
     a22 = sin_theta*(-s0_13*(s0_12 + s0_3*s0_35) + s0_29*((1.3)*s0_14 + (4.29)*s0_16*s0_26*s0_3 - s0_19 - s0_3*s0_36))
     b1 = -s0_37 - sin_theta*(-s0_13*(-2.0*s0_38*sin_theta + s0_39*s0_9 + s0_40*s0_41) + s0_29*(-s0_15*s0_39 + (1.3)*s0_17*s0_43 + (3.3)*s0_25*s0_44 + s0_32*s0_41)) - v*(-s0_13*(s0_1*s0_46 - s0_40*s0_48 + s0_45 - s0_47) + s0_29*((1.3)*cos_theta*s0_14 - s0_17*s0_25*s0_51 - s0_32*s0_48 - s0_33*s0_48 - s0_49)) + (-s0_37*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_52 + (0.7692307692307693)*mu0*(cos_theta*s0_15*s0_4 - s0_4*s0_49 + (1.3)*s0_42 - s0_51/s0_5**(0.65)) - s0_13*(s0_4*s0_45 - s0_4*s0_47 + s0_46*s0_5 - 2.0/s0_38)))/sin_theta
     b2 = -Q_z*s0_52 - cos_theta*(-s0_13*(s0_11*w - s0_9*w) + s0_29*(s0_15*w - s0_19*w) + s0_53*s0_54) - sin_theta*(P*cos_theta*s0_54 + mu1*s0_56*s0_57*s0_6 + s0_29*(s0_36*s0_55*s0_57 - 4.29*s0_44*w)) - v*(lam2*s0_53 - s0_13*(s0_35*s0_58 + s0_56) + s0_29*((1.69)*s0_17*s0_50*w + (4.29)*s0_27*s0_58 - s0_36*s0_58))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = (0.5)*M*chi
@@ -652,10 +652,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, fi
     a22 = sin_theta*(-s0_13*(s0_12 + s0_3*s0_35) + s0_29*((1.3)*s0_14 + (4.29)*s0_16*s0_26*s0_3 - s0_19 - s0_3*s0_36))
     b1 = -s0_37 - sin_theta*(-s0_13*(-2.0*s0_38*sin_theta + s0_39*s0_9 + s0_40*s0_41) + s0_29*(-s0_15*s0_39 + (1.3)*s0_17*s0_43 + (3.3)*s0_25*s0_44 + s0_32*s0_41)) - v*(-s0_13*(s0_1*s0_46 - s0_40*s0_48 + s0_45 - s0_47) + s0_29*((1.3)*cos_theta*s0_14 - s0_17*s0_25*s0_51 - s0_32*s0_48 - s0_33*s0_48 - s0_49)) + (-s0_37*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_52 + (0.7692307692307693)*mu0*(cos_theta*s0_15*s0_4 - s0_4*s0_49 + (1.3)*s0_42 - s0_51/s0_5**(0.65)) - s0_13*(s0_4*s0_45 - s0_4*s0_47 + s0_46*s0_5 - 2.0/s0_38)))/sin_theta
     b2 = -Q_z*s0_52 - cos_theta*(-s0_13*(s0_11*w - s0_9*w) + s0_29*(s0_15*w - s0_19*w) + s0_53*s0_54) - sin_theta*(P*cos_theta*s0_54 + mu1*s0_56*s0_57*s0_6 + s0_29*(s0_36*s0_55*s0_57 - 4.29*s0_44*w)) - v*(lam2*s0_53 - s0_13*(s0_35*s0_58 + s0_56) + s0_29*((1.69)*s0_17*s0_50*w + (4.29)*s0_27*s0_58 - s0_36*s0_58))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v
@@ -749,10 +749,10 @@ def rhs_field(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, field
     a22 = sin_theta*(-s0_13*(s0_12 + s0_3*s0_35) + s0_29*((1.3)*s0_14 + (4.29)*s0_16*s0_26*s0_3 - s0_19 - s0_3*s0_36))
     b1 = -s0_37 - sin_theta*(-s0_13*(-2.0*s0_38*sin_theta + s0_39*s0_9 + s0_40*s0_41) + s0_29*(-s0_15*s0_39 + (1.3)*s0_17*s0_43 + (3.3)*s0_25*s0_44 + s0_32*s0_41)) - v*(-s0_13*(s0_1*s0_46 - s0_40*s0_48 + s0_45 - s0_47) + s0_29*((1.3)*cos_theta*s0_14 - s0_17*s0_25*s0_51 - s0_32*s0_48 - s0_33*s0_48 - s0_49)) + (-s0_37*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_52 + (0.7692307692307693)*mu0*(cos_theta*s0_15*s0_4 - s0_4*s0_49 + (1.3)*s0_42 - s0_51/s0_5**(0.65)) - s0_13*(s0_4*s0_45 - s0_4*s0_47 + s0_46*s0_5 - 2.0/s0_38)))/sin_theta
     b2 = -Q_z*s0_52 - cos_theta*(-s0_13*(s0_11*w - s0_9*w) + s0_29*(s0_15*w - s0_19*w) + s0_53*s0_54) - sin_theta*(P*cos_theta*s0_54 + mu1*s0_56*s0_57*s0_6 + s0_29*(s0_36*s0_55*s0_57 - 4.29*s0_44*w)) - v*(lam2*s0_53 - s0_13*(s0_35*s0_58 + s0_56) + s0_29*((1.69)*s0_17*s0_50*w + (4.29)*s0_27*s0_58 - s0_36*s0_58))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = (0.5)*chi*sin_theta
     t2 = Q_r*t1

@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "88d92338cc46bbe4e385e43fbecf18199795aba302d0712307f9efa14b6351da"
+SIGNATURE = "f2c33a884c30bed0347634632d45a1397f28814cec2c87b358bcfa2d8bcdbde4"
 INPUTS = [('alphas', 'runtime'), ('class', 'ogden_general_field'), ('field', True)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series')
 
@@ -439,10 +439,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, alpha, fiel
     a22 = sin_theta*(s0_30*(s0_11*s0_80 + s0_15*s0_80 + s0_22*s0_81 + s0_29 - s0_60*s0_81) + s0_45*(s0_33*s0_80 + s0_37*s0_80 + s0_40*s0_81 + s0_44 - s0_70*s0_81) + s0_59*(s0_48*s0_80 + s0_52*s0_80 + s0_54*s0_81 + s0_58 - s0_75*s0_81))
     b1 = -s0_83 - sin_theta*(s0_30*(alpha0*lam2*s0_1*s0_14*s0_17*s0_5*sin_theta + alpha0*lam2*s0_25*s0_9*sin_theta - s0_1*s0_101*s0_16*s0_17 - s0_100*s0_22 - s0_12*s0_98 - s0_27*s0_98) + s0_45*(alpha1*lam2*s0_1*s0_17*s0_36*s0_5*sin_theta + alpha1*lam2*s0_25*s0_31*sin_theta - s0_100*s0_40 - s0_103*s0_37 - s0_34*s0_98 - s0_42*s0_98) + s0_59*(alpha2*lam2*s0_1*s0_17*s0_5*s0_51*sin_theta + alpha2*lam2*s0_25*s0_46*sin_theta - s0_100*s0_54 - s0_103*s0_52 - s0_49*s0_98 - s0_56*s0_98)) - v*(s0_30*(-cos_theta*s0_28 - s0_102*s0_105 + s0_104*s0_22 + s0_106*s0_16*s0_68 + s0_108*s0_11 + s0_90) + s0_45*(-cos_theta*s0_43 + s0_104*s0_40 + s0_108*s0_33 - s0_109*s0_70 + s0_110*s0_37 + s0_95) + s0_59*(-cos_theta*s0_57 + s0_104*s0_54 + s0_108*s0_48 - s0_109*s0_75 + s0_110*s0_52 + s0_97)) + (-s0_83*sin_theta + sin_theta*(-Q_r*s0_87 + s0_30*(lam2**alpha0*s0_89 + s0_1*s0_90 - s0_89*s0_9*s0_93) + s0_45*(lam2**alpha1*s0_94 + s0_1*s0_95 - s0_31*s0_93*s0_94) + s0_59*(lam2**alpha2*s0_96 + s0_1*s0_97 - s0_46*s0_93*s0_96) + s0_85*w))/sin_theta
     b2 = -Q_z*s0_87 - cos_theta*(s0_111*s0_84 + s0_30*(s0_27*w - s0_28*w) + s0_45*(s0_42*w - s0_43*w) + s0_59*(s0_56*w - s0_57*w)) - sin_theta*(P*cos_theta*s0_111 + s0_30*(2.0*alpha0*lam2*s0_1*s0_14*s0_5*sin_theta*w - s0_1*s0_67*s0_98 - s0_65*s0_98 - s0_66*s0_98) + s0_45*(2.0*alpha1*lam2*s0_1*s0_36*s0_5*sin_theta*w - s0_112*s0_37 - s0_71*s0_98 - s0_72*s0_98) + s0_59*(2.0*alpha2*lam2*s0_1*s0_5*s0_51*sin_theta*w - s0_112*s0_52 - s0_76*s0_98 - s0_77*s0_98)) - v*(s0_30*(cos_theta*s0_65 - s0_105*s0_64 + s0_106*s0_67 + s0_11*s0_113) + s0_45*(cos_theta*s0_71 + s0_113*s0_33 - s0_114*s0_70 + s0_115*s0_37) + s0_59*(cos_theta*s0_76 + s0_113*s0_48 - s0_114*s0_75 + s0_115*s0_52) + s0_85)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -594,10 +594,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, al
     a22 = sin_theta*(s0_30*(s0_11*s0_80 + s0_15*s0_80 + s0_22*s0_81 + s0_29 - s0_60*s0_81) + s0_45*(s0_33*s0_80 + s0_37*s0_80 + s0_40*s0_81 + s0_44 - s0_70*s0_81) + s0_59*(s0_48*s0_80 + s0_52*s0_80 + s0_54*s0_81 + s0_58 - s0_75*s0_81))
     b1 = -s0_83 - sin_theta*(s0_30*(alpha0*lam2*s0_1*s0_14*s0_17*s0_5*sin_theta + alpha0*lam2*s0_25*s0_9*sin_theta - s0_1*s0_101*s0_16*s0_17 - s0_100*s0_22 - s0_12*s0_98 - s0_27*s0_98) + s0_45*(alpha1*lam2*s0_1*s0_17*s0_36*s0_5*sin_theta + alpha1*lam2*s0_25*s0_31*sin_theta - s0_100*s0_40 - s0_103*s0_37 - s0_34*s0_98 - s0_42*s0_98) + s0_59*(alpha2*lam2*s0_1*s0_17*s0_5*s0_51*sin_theta + alpha2*lam2*s0_25*s0_46*sin_theta - s0_100*s0_54 - s0_103*s0_52 - s0_49*s0_98 - s0_56*s0_98)) - v*(s0_30*(-cos_theta*s0_28 - s0_102*s0_105 + s0_104*s0_22 + s0_106*s0_16*s0_68 + s0_108*s0_11 + s0_90) + s0_45*(-cos_theta*s0_43 + s0_104*s0_40 + s0_108*s0_33 - s0_109*s0_70 + s0_110*s0_37 + s0_95) + s0_59*(-cos_theta*s0_57 + s0_104*s0_54 + s0_108*s0_48 - s0_109*s0_75 + s0_110*s0_52 + s0_97)) + (-s0_83*sin_theta + sin_theta*(-Q_r*s0_87 + s0_30*(lam2**alpha0*s0_89 + s0_1*s0_90 - s0_89*s0_9*s0_93) + s0_45*(lam2**alpha1*s0_94 + s0_1*s0_95 - s0_31*s0_93*s0_94) + s0_59*(lam2**alpha2*s0_96 + s0_1*s0_97 - s0_46*s0_93*s0_96) + s0_85*w))/sin_theta
     b2 = -Q_z*s0_87 - cos_theta*(s0_111*s0_84 + s0_30*(s0_27*w - s0_28*w) + s0_45*(s0_42*w - s0_43*w) + s0_59*(s0_56*w - s0_57*w)) - sin_theta*(P*cos_theta*s0_111 + s0_30*(2.0*alpha0*lam2*s0_1*s0_14*s0_5*sin_theta*w - s0_1*s0_67*s0_98 - s0_65*s0_98 - s0_66*s0_98) + s0_45*(2.0*alpha1*lam2*s0_1*s0_36*s0_5*sin_theta*w - s0_112*s0_37 - s0_71*s0_98 - s0_72*s0_98) + s0_59*(2.0*alpha2*lam2*s0_1*s0_5*s0_51*sin_theta*w - s0_112*s0_52 - s0_76*s0_98 - s0_77*s0_98)) - v*(s0_30*(cos_theta*s0_65 - s0_105*s0_64 + s0_106*s0_67 + s0_11*s0_113) + s0_45*(cos_theta*s0_71 + s0_113*s0_33 - s0_114*s0_70 + s0_115*s0_37) + s0_59*(cos_theta*s0_76 + s0_113*s0_48 - s0_114*s0_75 + s0_115*s0_52) + s0_85)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = (0.5)*M*chi
@@ -1247,10 +1247,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, al
     a22 = sin_theta*(s0_30*(s0_11*s0_80 + s0_15*s0_80 + s0_22*s0_81 + s0_29 - s0_60*s0_81) + s0_45*(s0_33*s0_80 + s0_37*s0_80 + s0_40*s0_81 + s0_44 - s0_70*s0_81) + s0_59*(s0_48*s0_80 + s0_52*s0_80 + s0_54*s0_81 + s0_58 - s0_75*s0_81))
     b1 = -s0_83 - sin_theta*(s0_30*(alpha0*lam2*s0_1*s0_14*s0_17*s0_5*sin_theta + alpha0*lam2*s0_25*s0_9*sin_theta - s0_1*s0_101*s0_16*s0_17 - s0_100*s0_22 - s0_12*s0_98 - s0_27*s0_98) + s0_45*(alpha1*lam2*s0_1*s0_17*s0_36*s0_5*sin_theta + alpha1*lam2*s0_25*s0_31*sin_theta - s0_100*s0_40 - s0_103*s0_37 - s0_34*s0_98 - s0_42*s0_98) + s0_59*(alpha2*lam2*s0_1*s0_17*s0_5*s0_51*sin_theta + alpha2*lam2*s0_25*s0_46*sin_theta - s0_100*s0_54 - s0_103*s0_52 - s0_49*s0_98 - s0_56*s0_98)) - v*(s0_30*(-cos_theta*s0_28 - s0_102*s0_105 + s0_104*s0_22 + s0_106*s0_16*s0_68 + s0_108*s0_11 + s0_90) + s0_45*(-cos_theta*s0_43 + s0_104*s0_40 + s0_108*s0_33 - s0_109*s0_70 + s0_110*s0_37 + s0_95) + s0_59*(-cos_theta*s0_57 + s0_104*s0_54 + s0_108*s0_48 - s0_109*s0_75 + s0_110*s0_52 + s0_97)) + (-s0_83*sin_theta + sin_theta*(-Q_r*s0_87 + s0_30*(lam2**alpha0*s0_89 + s0_1*s0_90 - s0_89*s0_9*s0_93) + s0_45*(lam2**alpha1*s0_94 + s0_1*s0_95 - s0_31*s0_93*s0_94) + s0_59*(lam2**alpha2*s0_96 + s0_1*s0_97 - s0_46*s0_93*s0_96) + s0_85*w))/sin_theta
     b2 = -Q_z*s0_87 - cos_theta*(s0_111*s0_84 + s0_30*(s0_27*w - s0_28*w) + s0_45*(s0_42*w - s0_43*w) + s0_59*(s0_56*w - s0_57*w)) - sin_theta*(P*cos_theta*s0_111 + s0_30*(2.0*alpha0*lam2*s0_1*s0_14*s0_5*sin_theta*w - s0_1*s0_67*s0_98 - s0_65*s0_98 - s0_66*s0_98) + s0_45*(2.0*alpha1*lam2*s0_1*s0_36*s0_5*sin_theta*w - s0_112*s0_37 - s0_71*s0_98 - s0_72*s0_98) + s0_59*(2.0*alpha2*lam2*s0_1*s0_5*s0_51*sin_theta*w - s0_112*s0_52 - s0_76*s0_98 - s0_77*s0_98)) - v*(s0_30*(cos_theta*s0_65 - s0_105*s0_64 + s0_106*s0_67 + s0_11*s0_113) + s0_45*(cos_theta*s0_71 + s0_113*s0_33 - s0_114*s0_70 + s0_115*s0_37) + s0_59*(cos_theta*s0_76 + s0_113*s0_48 - s0_114*s0_75 + s0_115*s0_52) + s0_85)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v
@@ -1405,10 +1405,10 @@ def rhs_field(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, alpha
     a22 = sin_theta*(s0_30*(s0_11*s0_80 + s0_15*s0_80 + s0_22*s0_81 + s0_29 - s0_60*s0_81) + s0_45*(s0_33*s0_80 + s0_37*s0_80 + s0_40*s0_81 + s0_44 - s0_70*s0_81) + s0_59*(s0_48*s0_80 + s0_52*s0_80 + s0_54*s0_81 + s0_58 - s0_75*s0_81))
     b1 = -s0_83 - sin_theta*(s0_30*(alpha0*lam2*s0_1*s0_14*s0_17*s0_5*sin_theta + alpha0*lam2*s0_25*s0_9*sin_theta - s0_1*s0_101*s0_16*s0_17 - s0_100*s0_22 - s0_12*s0_98 - s0_27*s0_98) + s0_45*(alpha1*lam2*s0_1*s0_17*s0_36*s0_5*sin_theta + alpha1*lam2*s0_25*s0_31*sin_theta - s0_100*s0_40 - s0_103*s0_37 - s0_34*s0_98 - s0_42*s0_98) + s0_59*(alpha2*lam2*s0_1*s0_17*s0_5*s0_51*sin_theta + alpha2*lam2*s0_25*s0_46*sin_theta - s0_100*s0_54 - s0_103*s0_52 - s0_49*s0_98 - s0_56*s0_98)) - v*(s0_30*(-cos_theta*s0_28 - s0_102*s0_105 + s0_104*s0_22 + s0_106*s0_16*s0_68 + s0_108*s0_11 + s0_90) + s0_45*(-cos_theta*s0_43 + s0_104*s0_40 + s0_108*s0_33 - s0_109*s0_70 + s0_110*s0_37 + s0_95) + s0_59*(-cos_theta*s0_57 + s0_104*s0_54 + s0_108*s0_48 - s0_109*s0_75 + s0_110*s0_52 + s0_97)) + (-s0_83*sin_theta + sin_theta*(-Q_r*s0_87 + s0_30*(lam2**alpha0*s0_89 + s0_1*s0_90 - s0_89*s0_9*s0_93) + s0_45*(lam2**alpha1*s0_94 + s0_1*s0_95 - s0_31*s0_93*s0_94) + s0_59*(lam2**alpha2*s0_96 + s0_1*s0_97 - s0_46*s0_93*s0_96) + s0_85*w))/sin_theta
     b2 = -Q_z*s0_87 - cos_theta*(s0_111*s0_84 + s0_30*(s0_27*w - s0_28*w) + s0_45*(s0_42*w - s0_43*w) + s0_59*(s0_56*w - s0_57*w)) - sin_theta*(P*cos_theta*s0_111 + s0_30*(2.0*alpha0*lam2*s0_1*s0_14*s0_5*sin_theta*w - s0_1*s0_67*s0_98 - s0_65*s0_98 - s0_66*s0_98) + s0_45*(2.0*alpha1*lam2*s0_1*s0_36*s0_5*sin_theta*w - s0_112*s0_37 - s0_71*s0_98 - s0_72*s0_98) + s0_59*(2.0*alpha2*lam2*s0_1*s0_5*s0_51*sin_theta*w - s0_112*s0_52 - s0_76*s0_98 - s0_77*s0_98)) - v*(s0_30*(cos_theta*s0_65 - s0_105*s0_64 + s0_106*s0_67 + s0_11*s0_113) + s0_45*(cos_theta*s0_71 + s0_113*s0_33 - s0_114*s0_70 + s0_115*s0_37) + s0_59*(cos_theta*s0_76 + s0_113*s0_48 - s0_114*s0_75 + s0_115*s0_52) + s0_85)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = (0.5)*chi*sin_theta
     t2 = Q_r*t1

@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "2979faa9dd886eb142258226ea885446c155eaea37a4edc90984d28e43ea275b"
+SIGNATURE = "5f893e3d36be48270b47f94b34134d9e1c8a795451ea2119212bb9089259c10f"
 INPUTS = [('alphas', ('2', '-2')), ('class', 'ogden_mooney_rivlin_field'), ('field', True)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series')
 
@@ -262,10 +262,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, field):
     a22 = sin_theta*(-s0_14*(s0_13 + s0_25) + s0_18*(s0_15*s0_25 + s0_17))
     b1 = -s0_27 - sin_theta*(-s0_14*(lam2*s0_29 + lam2*s0_32 - 2.0*s0_28*sin_theta) + s0_18*(s0_29*s0_34 + s0_32*s0_34 - s0_33*sin_theta)) - v*(-s0_14*(s0_1*s0_33 + s0_35 - s0_36 - s0_38) + s0_18*(2.0*cos_theta - s0_10*s0_2*s0_40 - s0_15*s0_38 - s0_39)) + (-s0_27*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_41 + (0.5)*mu0*(2.0*cos_theta*s0_4 + s0_33 - s0_39*s0_4 - s0_42/s0_5) - s0_14*(s0_33*s0_5 + s0_35*s0_4 - s0_36*s0_4 - s0_42)))/sin_theta
     b2 = -Q_z*s0_41 - cos_theta*(-s0_14*(-s0_10*w + s0_12*w) + s0_18*(-s0_16*w + s0_19) + s0_43*s0_47) - sin_theta*(P*cos_theta*s0_43 - mu0*s0_34*s0_45*s0_46 + mu1*s0_44*s0_45) - v*(lam2*s0_47 - s0_14*(s0_44 + s0_48) + s0_18*(s0_15*s0_48 + s0_40*s0_46*s0_9))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -346,10 +346,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, fi
     a22 = sin_theta*(-s0_14*(s0_13 + s0_25) + s0_18*(s0_15*s0_25 + s0_17))
     b1 = -s0_27 - sin_theta*(-s0_14*(lam2*s0_29 + lam2*s0_32 - 2.0*s0_28*sin_theta) + s0_18*(s0_29*s0_34 + s0_32*s0_34 - s0_33*sin_theta)) - v*(-s0_14*(s0_1*s0_33 + s0_35 - s0_36 - s0_38) + s0_18*(2.0*cos_theta - s0_10*s0_2*s0_40 - s0_15*s0_38 - s0_39)) + (-s0_27*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_41 + (0.5)*mu0*(2.0*cos_theta*s0_4 + s0_33 - s0_39*s0_4 - s0_42/s0_5) - s0_14*(s0_33*s0_5 + s0_35*s0_4 - s0_36*s0_4 - s0_42)))/sin_theta
     b2 = -Q_z*s0_41 - cos_theta*(-s0_14*(-s0_10*w + s0_12*w) + s0_18*(-s0_16*w + s0_19) + s0_43*s0_47) - sin_theta*(P*cos_theta*s0_43 - mu0*s0_34*s0_45*s0_46 + mu1*s0_44*s0_45) - v*(lam2*s0_47 - s0_14*(s0_44 + s0_48) + s0_18*(s0_15*s0_48 + s0_40*s0_46*s0_9))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = (0.5)*M*chi
@@ -582,10 +582,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, fi
     a22 = sin_theta*(-s0_14*(s0_13 + s0_25) + s0_18*(s0_15*s0_25 + s0_17))
     b1 = -s0_27 - sin_theta*(-s0_14*(lam2*s0_29 + lam2*s0_32 - 2.0*s0_28*sin_theta) + s0_18*(s0_29*s0_34 + s0_32*s0_34 - s0_33*sin_theta)) - v*(-s0_14*(s0_1*s0_33 + s0_35 - s0_36 - s0_38) + s0_18*(2.0*cos_theta - s0_10*s0_2*s0_40 - s0_15*s0_38 - s0_39)) + (-s0_27*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_41 + (0.5)*mu0*(2.0*cos_theta*s0_4 + s0_33 - s0_39*s0_4 - s0_42/s0_5) - s0_14*(s0_33*s0_5 + s0_35*s0_4 - s0_36*s0_4 - s0_42)))/sin_theta
     b2 = -Q_z*s0_41 - cos_theta*(-s0_14*(-s0_10*w + s0_12*w) + s0_18*(-s0_16*w + s0_19) + s0_43*s0_47) - sin_theta*(P*cos_theta*s0_43 - mu0*s0_34*s0_45*s0_46 + mu1*s0_44*s0_45) - v*(lam2*s0_47 - s0_14*(s0_44 + s0_48) + s0_18*(s0_15*s0_48 + s0_40*s0_46*s0_9))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v
@@ -669,10 +669,10 @@ def rhs_field(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, field
     a22 = sin_theta*(-s0_14*(s0_13 + s0_25) + s0_18*(s0_15*s0_25 + s0_17))
     b1 = -s0_27 - sin_theta*(-s0_14*(lam2*s0_29 + lam2*s0_32 - 2.0*s0_28*sin_theta) + s0_18*(s0_29*s0_34 + s0_32*s0_34 - s0_33*sin_theta)) - v*(-s0_14*(s0_1*s0_33 + s0_35 - s0_36 - s0_38) + s0_18*(2.0*cos_theta - s0_10*s0_2*s0_40 - s0_15*s0_38 - s0_39)) + (-s0_27*sin_theta + sin_theta*(P*lam2*sin_theta*w - Q_r*s0_41 + (0.5)*mu0*(2.0*cos_theta*s0_4 + s0_33 - s0_39*s0_4 - s0_42/s0_5) - s0_14*(s0_33*s0_5 + s0_35*s0_4 - s0_36*s0_4 - s0_42)))/sin_theta
     b2 = -Q_z*s0_41 - cos_theta*(-s0_14*(-s0_10*w + s0_12*w) + s0_18*(-s0_16*w + s0_19) + s0_43*s0_47) - sin_theta*(P*cos_theta*s0_43 - mu0*s0_34*s0_45*s0_46 + mu1*s0_44*s0_45) - v*(lam2*s0_47 - s0_14*(s0_44 + s0_48) + s0_18*(s0_15*s0_48 + s0_40*s0_46*s0_9))
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = (0.5)*chi*sin_theta
     t2 = Q_r*t1

@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "577530c64648ef4c7d79dd92b5e378775537a0ccd4e08bd2e6ee0e7d59d28866"
+SIGNATURE = "d65f6774bf3b0249c48d03377864aace332c112cd006b9a7a90b8141b7aac2d9"
 INPUTS = [('alphas', ('2',)), ('class', 'ogden_neo_hookean'), ('field', False)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'pole_series')
 
@@ -162,10 +162,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = s0_15*(s0_13 + s0_18*s0_5)
     b1 = -s0_14*s0_19 - s0_14*v*(-cos_theta*s0_22*s0_9 + 2.0*cos_theta - s0_11*s0_2*s0_26 - s0_12*s0_24) - s0_15*(2.0*s0_11*s0_21 - s0_20*sin_theta + s0_22*s0_23) + (-s0_15*s0_19 + sin_theta*(s0_14*(-s0_12*s0_29 + s0_20 - s0_26/s0_7 + s0_29) + s0_28*w))/sin_theta
     b2 = -cos_theta*(s0_14*(-s0_12*s0_16 + s0_16) + s0_27*s0_30) - sin_theta*(P*cos_theta*s0_30 - mu0*s0_23*s0_31*s0_6) - v*(s0_14*(cos_theta*s0_18*s0_6*w + s0_11*s0_25*s0_31) + s0_28)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -222,10 +222,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = s0_15*(s0_13 + s0_18*s0_5)
     b1 = -s0_14*s0_19 - s0_14*v*(-cos_theta*s0_22*s0_9 + 2.0*cos_theta - s0_11*s0_2*s0_26 - s0_12*s0_24) - s0_15*(2.0*s0_11*s0_21 - s0_20*sin_theta + s0_22*s0_23) + (-s0_15*s0_19 + sin_theta*(s0_14*(-s0_12*s0_29 + s0_20 - s0_26/s0_7 + s0_29) + s0_28*w))/sin_theta
     b2 = -cos_theta*(s0_14*(-s0_12*s0_16 + s0_16) + s0_27*s0_30) - sin_theta*(P*cos_theta*s0_30 - mu0*s0_23*s0_31*s0_6) - v*(s0_14*(cos_theta*s0_18*s0_6*w + s0_11*s0_25*s0_31) + s0_28)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = P*sin_theta
@@ -396,10 +396,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = s0_15*(s0_13 + s0_18*s0_5)
     b1 = -s0_14*s0_19 - s0_14*v*(-cos_theta*s0_22*s0_9 + 2.0*cos_theta - s0_11*s0_2*s0_26 - s0_12*s0_24) - s0_15*(2.0*s0_11*s0_21 - s0_20*sin_theta + s0_22*s0_23) + (-s0_15*s0_19 + sin_theta*(s0_14*(-s0_12*s0_29 + s0_20 - s0_26/s0_7 + s0_29) + s0_28*w))/sin_theta
     b2 = -cos_theta*(s0_14*(-s0_12*s0_16 + s0_16) + s0_27*s0_30) - sin_theta*(P*cos_theta*s0_30 - mu0*s0_23*s0_31*s0_6) - v*(s0_14*(cos_theta*s0_18*s0_6*w + s0_11*s0_25*s0_31) + s0_28)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v

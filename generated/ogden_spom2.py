@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "486e43214b310034b8cd69a12970fd52995d77cd0c33c0655f882188340c47a1"
+SIGNATURE = "084e4c34df16b5e2bc3f40b5e72f077ece1035fd93ebde11b5a62bddadddc755"
 INPUTS = [('alphas', ('1.73', '4', '-2')), ('class', 'ogden_spom2'), ('field', False)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'pole_series')
 
@@ -269,10 +269,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = sin_theta*(-s0_16*(s0_15 + s0_3*s0_49) + s0_25*(s0_24 + s0_3*s0_50 + 12.0*s0_3) + s0_41*((1.73)*s0_26 + (6.4529)*s0_28*s0_3*s0_38 - s0_3*s0_51 - s0_31))
     b1 = -s0_52 - sin_theta*(-s0_16*(s0_12*s0_54 - 2.0*s0_53*sin_theta + s0_55*s0_56) + s0_25*(6.0*s0_19*s0_4*s0_58*s0_9*sin_theta - s0_43*s0_55 - s0_54*s0_57 + 4.0*s0_58*s0_7*sin_theta) + s0_41*(-s0_27*s0_54 + (1.73)*s0_29*s0_60 + (3.73)*s0_37*s0_61 + s0_45*s0_55)) - v*(-s0_16*(s0_1*s0_63 - s0_56*s0_65 + s0_62 - s0_64) + s0_25*(2.0*cos_theta*s0_4*s0_8 + 4.0*cos_theta*s0_6 - s0_10*s0_68 - s0_44*s0_65 - s0_66) + s0_41*((1.73)*cos_theta*s0_26 - cos_theta*s0_31 - s0_29*s0_37*s0_70 - s0_45*s0_65 - s0_46*s0_65)) + (-s0_52*sin_theta + sin_theta*(-s0_16*(s0_4*s0_62 - s0_4*s0_64 - 2.0*s0_58 + s0_6*s0_63) + s0_25*(cos_theta*s0_4*s0_57 - s0_11*s0_68 - s0_4*s0_66 + 4.0*s0_53) + s0_41*(cos_theta*s0_27*s0_4 - s0_31*s0_65 + (1.73)*s0_59 - s0_70/s0_6**(0.865)) + s0_71*w))/sin_theta
     b2 = -cos_theta*(-s0_16*(-s0_12*w + s0_14*w) + s0_25*(-s0_23*w + s0_47*s0_6) + s0_41*(s0_27*w - s0_31*w) + s0_72*sin_theta) - sin_theta*(cos_theta*s0_72 + s0_22*s0_42*s0_55 + s0_25*(-24.0*s0_19*s0_4*s0_58*sin_theta*w - s0_55*s0_73) + s0_41*(s0_51*s0_55*w - 6.4529*s0_61*w)) - v*(-s0_16*(lam2*s0_47 + s0_49*s0_74) + s0_25*(s0_50*s0_74 + s0_65*s0_73 + 16.0*s0_67*s0_7*w) + s0_41*((2.9929)*s0_29*s0_69*w + (6.4529)*s0_39*s0_74 - s0_51*s0_74) + s0_71)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -374,10 +374,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = sin_theta*(-s0_16*(s0_15 + s0_3*s0_49) + s0_25*(s0_24 + s0_3*s0_50 + 12.0*s0_3) + s0_41*((1.73)*s0_26 + (6.4529)*s0_28*s0_3*s0_38 - s0_3*s0_51 - s0_31))
     b1 = -s0_52 - sin_theta*(-s0_16*(s0_12*s0_54 - 2.0*s0_53*sin_theta + s0_55*s0_56) + s0_25*(6.0*s0_19*s0_4*s0_58*s0_9*sin_theta - s0_43*s0_55 - s0_54*s0_57 + 4.0*s0_58*s0_7*sin_theta) + s0_41*(-s0_27*s0_54 + (1.73)*s0_29*s0_60 + (3.73)*s0_37*s0_61 + s0_45*s0_55)) - v*(-s0_16*(s0_1*s0_63 - s0_56*s0_65 + s0_62 - s0_64) + s0_25*(2.0*cos_theta*s0_4*s0_8 + 4.0*cos_theta*s0_6 - s0_10*s0_68 - s0_44*s0_65 - s0_66) + s0_41*((1.73)*cos_theta*s0_26 - cos_theta*s0_31 - s0_29*s0_37*s0_70 - s0_45*s0_65 - s0_46*s0_65)) + (-s0_52*sin_theta + sin_theta*(-s0_16*(s0_4*s0_62 - s0_4*s0_64 - 2.0*s0_58 + s0_6*s0_63) + s0_25*(cos_theta*s0_4*s0_57 - s0_11*s0_68 - s0_4*s0_66 + 4.0*s0_53) + s0_41*(cos_theta*s0_27*s0_4 - s0_31*s0_65 + (1.73)*s0_59 - s0_70/s0_6**(0.865)) + s0_71*w))/sin_theta
     b2 = -cos_theta*(-s0_16*(-s0_12*w + s0_14*w) + s0_25*(-s0_23*w + s0_47*s0_6) + s0_41*(s0_27*w - s0_31*w) + s0_72*sin_theta) - sin_theta*(cos_theta*s0_72 + s0_22*s0_42*s0_55 + s0_25*(-24.0*s0_19*s0_4*s0_58*sin_theta*w - s0_55*s0_73) + s0_41*(s0_51*s0_55*w - 6.4529*s0_61*w)) - v*(-s0_16*(lam2*s0_47 + s0_49*s0_74) + s0_25*(s0_50*s0_74 + s0_65*s0_73 + 16.0*s0_67*s0_7*w) + s0_41*((2.9929)*s0_29*s0_69*w + (6.4529)*s0_39*s0_74 - s0_51*s0_74) + s0_71)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = P*sin_theta
@@ -730,10 +730,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = sin_theta*(-s0_16*(s0_15 + s0_3*s0_49) + s0_25*(s0_24 + s0_3*s0_50 + 12.0*s0_3) + s0_41*((1.73)*s0_26 + (6.4529)*s0_28*s0_3*s0_38 - s0_3*s0_51 - s0_31))
     b1 = -s0_52 - sin_theta*(-s0_16*(s0_12*s0_54 - 2.0*s0_53*sin_theta + s0_55*s0_56) + s0_25*(6.0*s0_19*s0_4*s0_58*s0_9*sin_theta - s0_43*s0_55 - s0_54*s0_57 + 4.0*s0_58*s0_7*sin_theta) + s0_41*(-s0_27*s0_54 + (1.73)*s0_29*s0_60 + (3.73)*s0_37*s0_61 + s0_45*s0_55)) - v*(-s0_16*(s0_1*s0_63 - s0_56*s0_65 + s0_62 - s0_64) + s0_25*(2.0*cos_theta*s0_4*s0_8 + 4.0*cos_theta*s0_6 - s0_10*s0_68 - s0_44*s0_65 - s0_66) + s0_41*((1.73)*cos_theta*s0_26 - cos_theta*s0_31 - s0_29*s0_37*s0_70 - s0_45*s0_65 - s0_46*s0_65)) + (-s0_52*sin_theta + sin_theta*(-s0_16*(s0_4*s0_62 - s0_4*s0_64 - 2.0*s0_58 + s0_6*s0_63) + s0_25*(cos_theta*s0_4*s0_57 - s0_11*s0_68 - s0_4*s0_66 + 4.0*s0_53) + s0_41*(cos_theta*s0_27*s0_4 - s0_31*s0_65 + (1.73)*s0_59 - s0_70/s0_6**(0.865)) + s0_71*w))/sin_theta
     b2 = -cos_theta*(-s0_16*(-s0_12*w + s0_14*w) + s0_25*(-s0_23*w + s0_47*s0_6) + s0_41*(s0_27*w - s0_31*w) + s0_72*sin_theta) - sin_theta*(cos_theta*s0_72 + s0_22*s0_42*s0_55 + s0_25*(-24.0*s0_19*s0_4*s0_58*sin_theta*w - s0_55*s0_73) + s0_41*(s0_51*s0_55*w - 6.4529*s0_61*w)) - v*(-s0_16*(lam2*s0_47 + s0_49*s0_74) + s0_25*(s0_50*s0_74 + s0_65*s0_73 + 16.0*s0_67*s0_7*w) + s0_41*((2.9929)*s0_29*s0_69*w + (6.4529)*s0_39*s0_74 - s0_51*s0_74) + s0_71)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v

@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "dd8d9a8abc9163c59dcbfecd3307a55a8d32a2f3852b6ffe5eb7680eba715330"
+SIGNATURE = "017c508c1ee7f769aab1b7dabbe60d17f3c8dd25e91ba423183964e5206e1c15"
 INPUTS = [('alphas', ('1.3',)), ('class', 'ogden_tpom1'), ('field', False)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'pole_series')
 
@@ -178,10 +178,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = s0_20*((4.29)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.3)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.3)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.3)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.3)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.3)*s0_27 - s0_33/s0_3**(0.65)) + s0_35*w))/sin_theta
     b2 = -cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*sin_theta) - sin_theta*(cos_theta*s0_36 + s0_19*(s0_29*s0_37 - 4.29*s0_30*w)) - v*(s0_19*((4.29)*s0_17*s0_34*w + (1.69)*s0_32*s0_7*w - s0_34*s0_37) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -244,10 +244,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = s0_20*((4.29)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.3)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.3)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.3)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.3)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.3)*s0_27 - s0_33/s0_3**(0.65)) + s0_35*w))/sin_theta
     b2 = -cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*sin_theta) - sin_theta*(cos_theta*s0_36 + s0_19*(s0_29*s0_37 - 4.29*s0_30*w)) - v*(s0_19*((4.29)*s0_17*s0_34*w + (1.69)*s0_32*s0_7*w - s0_34*s0_37) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = P*sin_theta
@@ -442,10 +442,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, mu):
     a22 = s0_20*((4.29)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.3)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.3)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.3)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.3)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.3)*s0_27 - s0_33/s0_3**(0.65)) + s0_35*w))/sin_theta
     b2 = -cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*sin_theta) - sin_theta*(cos_theta*s0_36 + s0_19*(s0_29*s0_37 - 4.29*s0_30*w)) - v*(s0_19*((4.29)*s0_17*s0_34*w + (1.69)*s0_32*s0_7*w - s0_34*s0_37) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v

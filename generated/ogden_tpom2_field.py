@@ -7,7 +7,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "54d2ebfac8840157717174e5c14813e3158633939f5b6207c96770706c9a544f"
+SIGNATURE = "e602a0e434aef7bb64437b9dd81017afececb95e3318c3d3f995ebe52b68102d"
 INPUTS = [('alphas', ('1.98',)), ('class', 'ogden_tpom2_field'), ('field', True)]
 KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series')
 
@@ -237,10 +237,10 @@ def rhs(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, field):
     a22 = s0_20*((7.8804)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.98)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.98)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.98)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.98)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(-Q_r*s0_37 + s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.98)*s0_27 - s0_33/s0_3**(0.99)) + s0_35*w))/sin_theta
     b2 = -Q_z*s0_37 - cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*s0_38) - sin_theta*((0.5)*cos_theta*s0_38 + s0_19*(s0_29*s0_39 - 7.8804*s0_30*w)) - v*(s0_19*((7.8804)*s0_17*s0_34*w + (3.9204)*s0_32*s0_7*w - s0_34*s0_39) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     return (v/sin_theta, F1, w, F2,)
 
 
@@ -311,10 +311,10 @@ def rhs_jacobian(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, fi
     a22 = s0_20*((7.8804)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.98)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.98)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.98)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.98)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(-Q_r*s0_37 + s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.98)*s0_27 - s0_33/s0_3**(0.99)) + s0_35*w))/sin_theta
     b2 = -Q_z*s0_37 - cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*s0_38) - sin_theta*((0.5)*cos_theta*s0_38 + s0_19*(s0_29*s0_39 - 7.8804*s0_30*w)) - v*(s0_19*((7.8804)*s0_17*s0_34*w + (3.9204)*s0_32*s0_7*w - s0_34*s0_39) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(sin_theta))
     t1 = (1.0/(det))
     t2 = (0.5)*M*chi
@@ -521,10 +521,10 @@ def rhs_pressure(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, fi
     a22 = s0_20*((7.8804)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.98)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.98)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.98)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.98)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(-Q_r*s0_37 + s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.98)*s0_27 - s0_33/s0_3**(0.99)) + s0_35*w))/sin_theta
     b2 = -Q_z*s0_37 - cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*s0_38) - sin_theta*((0.5)*cos_theta*s0_38 + s0_19*(s0_29*s0_39 - 7.8804*s0_30*w)) - v*(s0_19*((7.8804)*s0_17*s0_34*w + (3.9204)*s0_32*s0_7*w - s0_34*s0_39) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = lam2*sin_theta
     t2 = -cos_theta*(lam2*lam2)*sin_theta - t1*v
@@ -598,10 +598,10 @@ def rhs_field(theta, cos_theta, sin_theta, lam2, v, eta, w, P, M, chi, mu, field
     a22 = s0_20*((7.8804)*s0_0*s0_16*s0_6 - s0_0*s0_24 + (1.98)*s0_4 - s0_9)
     b1 = -s0_19*s0_25 - s0_19*v*((1.98)*cos_theta*s0_4 - s0_15*s0_33*s0_7 - s0_21*s0_34 - s0_22*s0_34 - s0_31) - s0_20*((3.98)*s0_15*s0_30 + s0_21*s0_29 - s0_26*s0_5 + (1.98)*s0_28*s0_7) + (-s0_20*s0_25 + sin_theta*(-Q_r*s0_37 + s0_19*(cos_theta*s0_2*s0_5 - s0_2*s0_31 + (1.98)*s0_27 - s0_33/s0_3**(0.99)) + s0_35*w))/sin_theta
     b2 = -Q_z*s0_37 - cos_theta*(s0_19*(s0_5*w - s0_9*w) + s0_36*s0_38) - sin_theta*((0.5)*cos_theta*s0_38 + s0_19*(s0_29*s0_39 - 7.8804*s0_30*w)) - v*(s0_19*((7.8804)*s0_17*s0_34*w + (3.9204)*s0_32*s0_7*w - s0_34*s0_39) + s0_35)
-    s1_0 = (1.0/(det))
     det = a11*a22 - a12*a21
-    F1 = s1_0*(-a12*b2 + a22*b1)
-    F2 = s1_0*(a11*b2 - a21*b1)
+    s2_0 = (1.0/(det))
+    F1 = s2_0*(-a12*b2 + a22*b1)
+    F2 = s2_0*(a11*b2 - a21*b1)
     t0 = (1.0/(det))
     t1 = (0.5)*chi*sin_theta
     t2 = Q_r*t1

@@ -2,7 +2,9 @@
 
 Knows nothing about balloons: a *system* has ``residual(X)`` and ``jacobian(X)`` (n × (n+1)). From a point X
 with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector solves R = 0 with τ·(X − X_pred) = 0
-(Keller). Steps grow after easy corrections and shrink on failure or on a sharp turn (τ_i·τ_{i+1} small).
+(Keller). Steps grow after easy corrections and shrink on failure, on a sharp turn (τ_i·τ_{i+1} small) or
+on a slow correction (linear Newton convergence means a nearly singular Jacobian: landing close to a branch
+point, where the corrector may pick the crossing branch).
 *Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
 for a limit point); folds are then located by secant iteration in the arclength to |c·τ| ≤ 1e-12.
 """
@@ -22,6 +24,7 @@ class Settings:
     tol: float
     max_newton: int
     max_turn: float = 0.3  # radians between successive tangents
+    slow_newton: int = 6  # a correction needing more iterations is rejected (near-singular: e.g. a branch point)
 
 
 @dataclass
@@ -107,7 +110,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         predictor = current.X + sigma * current.tangent
         result = correct(system, predictor, current.tangent, settings)
         new_tangent = None
-        if result.converged:
+        if result.converged and result.iterations <= settings.slow_newton:
             try:
                 new_tangent = tangent(system, result.x, current.tangent)
             except np.linalg.LinAlgError:

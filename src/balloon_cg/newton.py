@@ -22,6 +22,9 @@ class NewtonResult:
 def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> NewtonResult:
     """Solve R(x) = 0, rows @ x = targets; converged when the correction is below tol·max(1, |x|∞).
 
+    Near a singular point Newton converges only linearly (ratio ρ = |dx_k|/|dx_{k−1}|) and the remaining
+    error is about |dx| ρ/(1 − ρ), which may exceed |dx|: that bound must be below the tolerance too.
+
     ``residual(x)`` returns R (n), ``jacobian(x)`` returns ∂R/∂x (n × (n + k)); rows is (k, n + k).
     """
     x = np.array(x0, dtype=float)
@@ -44,7 +47,8 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
             return NewtonResult(x, False, iteration, float(np.abs(r).max()), np.inf, "non-finite Newton step")
         x = x + dx
         step = float(np.abs(dx).max())
-        if step <= tol * max(1.0, float(np.abs(x).max())):
+        ratio = min(step / previous, 0.99) if np.isfinite(previous) and previous > 0 else 0.0
+        if max(step, step * ratio / (1.0 - ratio)) <= tol * max(1.0, float(np.abs(x).max())):
             try:
                 final = float(np.abs(residual(x)).max())
             except ArithmeticError as error:

@@ -1,0 +1,26 @@
+# balloon-cg developer targets. `make run` and `make test` each install first, so a fresh clone needs nothing else.
+PYTHON ?= python3
+OUT ?= out
+
+.PHONY: install install-dev regenerate test run bench clean
+
+install:
+	$(PYTHON) -m pip install --quiet .
+
+install-dev:
+	$(PYTHON) -m pip install --quiet -e ".[test,codegen]"
+
+regenerate:
+	$(PYTHON) -m codegen generated
+
+test: install-dev
+	$(PYTHON) -m pytest -q
+
+run: install
+	$(PYTHON) -m balloon_cg.default_run $(OUT)
+
+bench: install-dev
+	$(PYTHON) benchmarks/primary_branch.py
+
+clean:
+	rm -rf build dist *.egg-info $(OUT)

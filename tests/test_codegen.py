@@ -1,0 +1,100 @@
+"""The symbolic layer: printer text, kernels against SymPy, and generated/ up to date."""
+import filecmp
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from codegen import functional as fn, poles
+from codegen.printer import print_expr
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.parametrize(
+    "expr",
+    ["4*y/x**5", "x**2 + y**-3", "1/sqrt(x + y)", "y/x**(3/2)", "x**(13/10)*y**(-2)", "(x*y)**(-173/100) - 3/x"],
+)
+def test_printed_expression_evaluates_like_sympy(expr):
+    import math  # noqa: F401  (used by the printed text)
+
+    x, y = sp.symbols("x y")
+    e = sp.sympify(expr)
+    value = eval(print_expr(e), {"math": math, "x": 1.37, "y": 0.61})
+    assert value == pytest.approx(float(e.subs({x: 1.37, y: 0.61})), rel=1e-14)
+
+
+def test_integer_powers_print_as_products():
+    x = sp.Symbol("x")
+    assert print_expr(x**3) == "(x*x*x)"
+    assert print_expr(x**-2) == "(1.0/(x*x))"
+
+
+@pytest.mark.parametrize("name", ["ogden_spom1", "ogden_tpom2_field", "ogden_general_field"])
+def test_generated_gradient_matches_sympy(name):
+    """The emitted energy_gradient equals SymPy's derivative of the functional at a random state."""
+    import importlib
+
+    from codegen.classes import scene_classes
+
+    cls = next(c for c in scene_classes() if c.name == name)
+    module = importlib.import_module(f"balloon_cg.generated.{name}")
+    rng = np.random.default_rng(3)
+    state = dict(zip((fn.cos_theta, fn.lam2, fn.v, fn.eta, fn.w), (0.3, 1.6, 0.2, 0.4, -1.1)))
+    state[fn.sin_theta] = np.sqrt(1 - 0.3**2)
+    mus = rng.uniform(0.5, 2.0, cls.n_terms)
+    alphas = np.array([1.7, 3.0, -2.5])
+    values = {**state, fn.P: 0.9, **dict(zip(fn.moduli(cls), mus))}
+    if cls.alphas is None:
+        values.update(dict(zip(fn.exponents(cls), alphas)))
+    field = rng.uniform(-1, 1, 6)
+    if cls.field:
+        values.update({fn.M: 0.01, fn.chi: 1.3, **dict(zip(fn.FIELD, field))})
+    density = fn.energy_density(cls)
+    expected = [float(fn.field_values(sp.diff(density, s), fn.lam2 * fn.sin_theta).subs(values)) for s in fn.STATE]
+    args = [float(values[s]) for s in (fn.cos_theta, fn.sin_theta) + fn.STATE] + [0.9]
+    if cls.field:
+        args += [0.01, 1.3]
+    args.append(mus)
+    if cls.alphas is None:
+        args.append(alphas)
+    if cls.field:
+        args.append(field)
+    assert np.allclose(module.energy_gradient(*args), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_pole_series_of_the_sphere():
+    """At M = 0 the pole coefficients reduce to the sphere's: e2 = −c0/2 iff P = 2 φ_01 / c0² (MODEL.md §4)."""
+    _, e2, _, _ = poles.pole_coefficients("north")
+    phi01 = sp.Symbol("phi01")
+    sphere_P = 2 * phi01 / poles.c0**2
+    assert sp.simplify(e2.subs({fn.M: 0, fn.P: sphere_P}) + poles.c0 / 2) == 0
+
+
+@pytest.mark.parametrize("preset", ["SPOM1", "FPOM2", "TPOM2"])
+def test_first_order_system_holds_on_the_exact_sphere(preset):
+    """On the sphere λ2 = λ, η = λ cos θ at the exact pressure, f = (0, 0, −λ sin θ, −λ cos θ)."""
+    from balloon_cg.kernels import KernelSet
+    from balloon_cg.materials import get_preset
+    from balloon_cg.sphere import sphere_pressure
+
+    material = get_preset(preset)
+    kernels = KernelSet(material, has_field=False)
+    lam = 2.3
+    for theta in (0.2, 1.1, 2.9):
+        c, s = np.cos(theta), np.sin(theta)
+        f = kernels.module.rhs(theta, c, s, lam, 0.0, lam * c, -lam * s, *kernels.params(sphere_pressure(material, lam), 0, 1))
+        assert np.allclose(f, (0.0, 0.0, -lam * s, -lam * c), atol=1e-12)
+
+
+def test_generated_is_up_to_date(tmp_path):
+    """`make regenerate` reproduces generated/ byte for byte (fails when generated/ is stale)."""
+    subprocess.run([sys.executable, "-m", "codegen", str(tmp_path)], cwd=ROOT, check=True, capture_output=True)
+    fresh = sorted(p.name for p in tmp_path.glob("*.py"))
+    committed = sorted(p.name for p in (ROOT / "generated").glob("*.py"))
+    assert fresh == committed
+    _, mismatch, errors = filecmp.cmpfiles(tmp_path, ROOT / "generated", fresh, shallow=False)
+    assert not mismatch and not errors, f"stale generated modules: {mismatch + errors}; run `make regenerate`"
