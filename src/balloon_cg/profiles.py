@@ -1,0 +1,63 @@
+"""Deformed shapes and stretches of branch points, vectorised over points (MODEL.md §1, §6).
+
+From the Legendre series λ2(θ), η(θ) of every point:
+    λ2' = −sin θ dλ2/dx,   η' = −sin θ dη/dx   (x = cos θ),
+    ρ = λ2 sin θ,          λ1 = sqrt((λ2 cos θ + λ2' sin θ)² + η'²)   (= sqrt(ρ'² + η'²)).
+At the poles λ2' = η' = 0, so λ1 = λ2 there. η is measured from the centre of the undeformed sphere.
+"""
+import numpy as np
+
+from .discretisation import legendre_table
+
+EQUATOR = np.array([0.5 * np.pi])
+
+
+def theta_grid(points: int) -> np.ndarray:
+    """The stored θ grid: ``points`` values linspace(0, π)."""
+    return np.linspace(0.0, np.pi, points)
+
+
+def fields(disc, U: np.ndarray, theta: np.ndarray):
+    """(λ2, λ2', η, η') for unknowns U (n_points × disc.size), each of shape (n_points, len(theta)).
+
+    The same values as ``disc.evaluate(u, theta)`` for every row u, with one Legendre table for all rows.
+    """
+    p, dp = legendre_table(np.cos(theta), disc.degree)
+    s = np.sin(theta)
+    na = disc.a_index.size
+    a, b = U[:, :na], U[:, na:]
+    pa, dpa = p[:, disc.a_index].T, dp[:, disc.a_index].T
+    pb, dpb = p[:, disc.b_index].T, dp[:, disc.b_index].T
+    return a @ pa, -s * (a @ dpa), b @ pb, -s * (b @ dpb)
+
+
+def meridional_stretch(theta, lam2, dlam2, deta):
+    """λ1 = sqrt((λ2 cos θ + λ2' sin θ)² + η'²)."""
+    return np.hypot(lam2 * np.cos(theta) + dlam2 * np.sin(theta), deta)
+
+
+def _unknowns(branch, X):
+    return (branch.X if X is None else np.atleast_2d(X))[:, :-1]
+
+
+def profiles(branch, theta: np.ndarray, X=None) -> dict:
+    """λ1, λ2, ρ = λ2 sin θ and η on ``theta`` for every point of the branch (or for the rows of X = (u, P)).
+
+    Each array has shape (n_points, len(theta)).
+    """
+    lam2, dlam2, eta, deta = fields(branch.disc, _unknowns(branch, X), theta)
+    return {
+        "lam1": meridional_stretch(theta, lam2, dlam2, deta),
+        "lam2": lam2,
+        "rho": lam2 * np.sin(theta),
+        "eta": eta,
+    }
+
+
+def equator_values(branch, X=None) -> dict:
+    """λ1(π/2) = sqrt(λ2'² + η'²) and λ2(π/2) for every point (or row of X): arrays 'lam1_equator', 'lam2_equator'."""
+    lam2, dlam2, _, deta = fields(branch.disc, _unknowns(branch, X), EQUATOR)
+    return {
+        "lam1_equator": meridional_stretch(EQUATOR, lam2, dlam2, deta)[:, 0],
+        "lam2_equator": lam2[:, 0],
+    }
