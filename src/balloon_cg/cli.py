@@ -1,0 +1,239 @@
+"""Command line: ``balloon-cg run | solve | inspect`` (``balloon-cg SUBCOMMAND -h`` for help).
+
+Exit codes: 0 success, 1 the computation did not give what was asked (branch could not start or did not
+reach the requested stretch), 2 bad input (invalid scene, missing or unreadable file, existing output
+without --force). Errors are one line on stderr, ``balloon-cg: error: ...``.
+"""
+import argparse
+import json
+import shlex
+import sys
+
+import numpy as np
+from tqdm import tqdm
+
+from .branch import ContinuationError, trace_primary
+from .profiles import equator_values
+from .scene import SceneError, load_scene
+from .storage import RunFileError, check_output, read_run, write_run
+
+PROG = "balloon-cg"
+
+
+class UsageError(ValueError):
+    """A bad command-line value (exit code 2)."""
+
+
+class Failure(Exception):
+    """A computation that ran but did not give what was asked (exit code 1)."""
+
+
+def main(argv=None) -> int:
+    """Run one subcommand; returns the exit code."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser().parse_args(argv)
+    args.command_line = shlex.join([PROG, *argv])
+    try:
+        return args.handler(args)
+    except (SceneError, RunFileError, UsageError) as e:
+        return _error(str(e), 2)
+    except OSError as e:
+        return _error(_os_message(e), 2)
+    except (ContinuationError, Failure) as e:
+        return _error(str(e), 1)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for add in (_add_run, _add_solve, _add_inspect):
+        add(commands)
+    return parser
+
+
+def _error(message: str, code: int) -> int:
+    print(f"{PROG}: error: {message}", file=sys.stderr)
+    return code
+
+
+def _os_message(e: OSError) -> str:
+    if e.filename is None:
+        return str(e)
+    return f"{e.filename}: {e.strerror or e}"
+
+
+# --- run ---------------------------------------------------------------------------------------------------
+
+def _add_run(commands):
+    p = commands.add_parser("run", help="trace the primary branch of a scene and write a run file")
+    p.add_argument("scene", help="scene TOML file")
+    p.add_argument("-o", "--output", required=True, help="run file to write (HDF5)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
+    p.set_defaults(handler=run)
+
+
+def run(args) -> int:
+    """Trace, write, read back and summarise."""
+    scene = load_scene(args.scene)
+    check_output(args.output, args.force)  # before the trace, which may take long
+    with tqdm(desc=scene.name, unit=" points", disable=args.quiet, file=sys.stderr) as bar:
+        branch = trace_primary(scene, progress=lambda point: bar.update())
+    write_run(args.output, scene, [branch], force=args.force, extra_attrs={"command": args.command_line})
+    if not args.quiet:
+        print(format_run(read_run(args.output)))
+    return 0
+
+
+# --- solve -------------------------------------------------------------------------------------------------
+
+def _add_solve(commands):
+    p = commands.add_parser("solve", help="one equilibrium on the primary branch at a given north pole stretch")
+    p.add_argument("scene", help="scene TOML file")
+    p.add_argument("--pole-stretch", type=float, required=True, metavar="X", help="north pole stretch λ2(0)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=solve)
+
+
+def solve(args) -> int:
+    """Trace the primary branch up to the requested north pole stretch and report its end point."""
+    scene = load_scene(args.scene)
+    x, start = args.pole_stretch, scene.continuation.start_stretch
+    if not np.isfinite(x) or x <= start:
+        raise UsageError(f"--pole-stretch = {x:g}: must be > continuation.start_stretch = {start:g}")
+    branch = trace_primary(scene, stop_stretch=x)
+    end = branch.special[-1] if branch.special else None
+    if end is None or end.kind != "EP" or end.index != len(branch.X) - 1:
+        reached = branch.pole_values()["lam2_north"].max()
+        raise Failure(
+            f"the primary branch did not reach north pole stretch {x:g} ({branch.stop_reason}); "
+            f"largest stretch reached: {reached:.10g}"
+        )
+    result = solution(branch, -1)
+    print(json.dumps(result) if args.json else format_table(result | {"wall_time": f"{result['wall_time']:.3f} s"}))
+    return 0
+
+
+def solution(branch, i: int) -> dict:
+    """The reported quantities of point i of a branch."""
+    X = branch.X[i]
+    values = {"pressure": X[-1], **branch.pole_values(X), **equator_values(branch, X)}
+    return {
+        **{k: float(np.squeeze(v)) for k, v in values.items()},
+        "residual": float(branch.residual[i]),
+        "error_estimate": float(branch.error_estimate[i]),
+        "converged": True,  # a Branch holds converged points only
+        "wall_time": branch.wall_time,
+    }
+
+
+# --- inspect -----------------------------------------------------------------------------------------------
+
+def _add_inspect(commands):
+    p = commands.add_parser("inspect", help="summary of the branches in a run file")
+    p.add_argument("file", help="run file (HDF5)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=inspect)
+
+
+def inspect(args) -> int:
+    """Print the summary of a run file."""
+    run = read_run(args.file)
+    if args.json:
+        print(json.dumps(summarise_run(run)))
+    else:
+        print(format_run(run))
+    return 0
+
+
+# --- summaries ---------------------------------------------------------------------------------------------
+
+def summarise_run(run: dict) -> dict:
+    """JSON-ready summary of read_run() output: provenance and one summary per branch."""
+    return {
+        "file": run["path"],
+        "scene_name": run["scene_name"],
+        "provenance": run["attrs"],
+        "branches": {name: summarise_branch(b) for name, b in run["branches"].items()},
+    }
+
+
+def summarise_branch(b: dict) -> dict:
+    """Points, ranges, special points, accuracy and run time of one stored branch."""
+    n, attrs = len(b["pressure"]), b["attrs"]
+    wall = float(attrs["wall_time"])
+    return {
+        "points": n,
+        "pressure": _range(b["pressure"]),
+        "lam2_north": _range(b["lam2_north"]),
+        "lam2_south": _range(b["lam2_south"]),
+        "special_points": b["special_points"],
+        "stop_reason": attrs["stop_reason"],
+        "max_residual": float(b["residual"].max()),
+        "max_error_estimate": float(b["error_estimate"].max()),
+        "wall_time": wall,
+        "wall_time_per_point": wall / n,
+        "degree": int(attrs["degree"]),
+        "symmetric": bool(attrs["symmetric"]),
+        "kernel_class": attrs["kernel_class"],
+        "M": float(attrs["M"]),
+        "chi": float(attrs["chi"]),
+    }
+
+
+def _range(values) -> list:
+    return [float(np.min(values)), float(np.max(values))]
+
+
+def format_run(run: dict) -> str:
+    """Readable summary of read_run() output."""
+    summary = summarise_run(run)
+    p = summary["provenance"]
+    lines = [
+        f"file           {summary['file']}",
+        f"scene          {summary['scene_name']}",
+        f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
+        f"command        {p['command']}",
+        f"tolerance      {p['tolerance']:g}",
+        f"kernels        digest {p['generated_digest'][:16]}…",
+    ]
+    for name, b in summary["branches"].items():
+        lines += ["", *_format_branch(name, b)]
+    return "\n".join(lines)
+
+
+def _format_branch(name: str, b: dict) -> list[str]:
+    lines = [
+        f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
+        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
+        f"  points               {b['points']}",
+        "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
+        "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
+        "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
+        f"  stop reason          {b['stop_reason']}",
+        f"  max residual         {b['max_residual']:.3e}",
+        f"  max error estimate   {b['max_error_estimate']:.3e}",
+        f"  wall time            {b['wall_time']:.3f} s",
+        f"  error estimate vs run time: {b['max_error_estimate']:.3e} max, "
+        f"{1e3 * b['wall_time_per_point']:.2f} ms per point",
+        f"  special points       {len(b['special_points']) or 'none'}",
+    ]
+    for s in b["special_points"]:
+        note = f"  {s['note']}" if s["note"] else ""
+        lines.append(
+            f"    {s['kind']:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
+            f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
+        )
+    return lines
+
+
+def format_table(values: dict) -> str:
+    """Two aligned columns: name, value."""
+    width = max(map(len, values))
+    return "\n".join(f"{k:<{width}}  {_show(v)}" for k, v in values.items())
+
+
+def _show(v) -> str:
+    if isinstance(v, bool):
+        return str(v).lower()
+    return f"{v:.12g}" if isinstance(v, float) else str(v)

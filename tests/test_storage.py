@@ -1,0 +1,166 @@
+"""Run files: round trip, profiles of the M = 0 sphere, atomic and non-clobbering writes."""
+import datetime
+from dataclasses import replace
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import balloon_cg
+from balloon_cg import storage
+from balloon_cg.branch import trace_primary
+from balloon_cg.kernels import generated_digest
+from balloon_cg.profiles import equator_values, fields, profiles, theta_grid
+from balloon_cg.scene import load_scene
+from balloon_cg.storage import RunFileError, read_run, write_run
+
+SPOM1 = Path(__file__).resolve().parents[1] / "scenes" / "spom1.toml"
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene(SPOM1).with_overrides({"continuation.stop_stretch": 2.0})
+
+
+@pytest.fixture(scope="module")
+def branch(scene):
+    return trace_primary(scene)
+
+
+@pytest.fixture(scope="module")
+def free_branch(scene):
+    """The same sphere without the equator-symmetric subspace (every Legendre degree kept but b_0)."""
+    return trace_primary(scene, symmetric=False)
+
+
+@pytest.fixture
+def run_file(tmp_path, scene, branch):
+    return write_run(tmp_path / "run.h5", scene, [branch], extra_attrs={"note": "test"})
+
+
+def test_round_trip(run_file, scene, branch):
+    run = read_run(run_file)
+    attrs = run["attrs"]
+    assert run["scene_name"] == scene.name == attrs["scene_name"]
+    assert attrs["format"] == "balloon-cg/1"
+    assert attrs["scene_toml"] == scene.text
+    assert attrs["package_version"] == balloon_cg.__version__
+    assert attrs["generated_digest"] == generated_digest()
+    assert attrs["tolerance"] == scene.solver.tol
+    assert attrs["note"] == "test" and isinstance(attrs["command"], str)
+    created = datetime.datetime.fromisoformat(attrs["created"])
+    assert created.utcoffset() == datetime.timedelta(0)
+
+    b = run["branches"]["primary"]
+    n, n_theta = len(branch.X), scene.output.theta_points
+    np.testing.assert_array_equal(b["unknowns"], branch.X)
+    np.testing.assert_array_equal(b["pressure"], branch.pressure)
+    for name, values in branch.pole_values().items():
+        np.testing.assert_array_equal(b[name], values)
+    for name, values in equator_values(branch).items():
+        np.testing.assert_array_equal(b[name], values)
+    np.testing.assert_array_equal(b["residual"], branch.residual)
+    np.testing.assert_array_equal(b["error_estimate"], branch.error_estimate)
+    np.testing.assert_array_equal(b["newton_iterations"], branch.iterations)
+    assert b["converged"].dtype == bool and b["converged"].all() and b["converged"].shape == (n,)
+    np.testing.assert_array_equal(b["theta"], np.linspace(0, np.pi, n_theta))
+    assert set(b["profiles"]) == {"lam1", "lam2", "rho", "eta"}
+    assert all(p.shape == (n, n_theta) for p in b["profiles"].values())
+
+    a = b["attrs"]
+    assert a["stop_reason"] == branch.stop_reason and a["wall_time"] == branch.wall_time
+    assert (a["degree"], a["symmetric"], a["pin_translation"]) == (scene.solver.degree, True, True)
+    assert a["kernel_class"] == "ogden_spom1" == branch.equilibrium.kernels.name
+    assert a["kernel_signature"] == branch.equilibrium.kernels.signature
+    assert (a["M"], a["chi"]) == (0.0, 1.0)
+
+    assert [s["kind"] for s in b["special_points"]] == [s.kind for s in branch.special] == ["LP", "EP"]
+    for stored, sp in zip(b["special_points"], branch.special):
+        assert stored["index"] == sp.index and stored["note"] == sp.note
+        assert stored["pressure"] == sp.X[-1]
+        assert stored["lam2_north"] == pytest.approx(branch.pole_values(sp.X)["lam2_north"][0], rel=1e-15)
+    np.testing.assert_array_equal(b["special_unknowns"], [sp.X for sp in branch.special])
+
+
+@pytest.mark.parametrize("which", ["branch", "free_branch"])
+def test_sphere_profiles(request, scene, which):
+    """M = 0: a centred sphere, ρ² + η² = λ², λ1 = λ2 = λ, η = ±λ at the poles."""
+    branch = request.getfixturevalue(which)
+    theta = theta_grid(scene.output.theta_points)
+    shape = profiles(branch, theta)
+    lam = branch.pole_values()["lam2_north"][:, None]
+    np.testing.assert_allclose(shape["rho"] ** 2 + shape["eta"] ** 2, lam**2 * np.ones_like(theta), rtol=0, atol=1e-10)
+    np.testing.assert_allclose(shape["lam1"], lam * np.ones_like(theta), rtol=0, atol=1e-10)
+    np.testing.assert_allclose(shape["lam2"], lam * np.ones_like(theta), rtol=0, atol=1e-10)
+    np.testing.assert_allclose(shape["eta"][:, 0], lam[:, 0], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(shape["eta"][:, -1], -lam[:, 0], rtol=0, atol=1e-10)
+    equator = equator_values(branch)
+    middle = len(theta) // 2  # θ = π/2 for an odd number of points
+    np.testing.assert_allclose(equator["lam1_equator"], shape["lam1"][:, middle], rtol=1e-14)
+    np.testing.assert_allclose(equator["lam2_equator"], shape["lam2"][:, middle], rtol=1e-14)
+
+
+@pytest.mark.parametrize("which", ["branch", "free_branch"])
+def test_fields_match_evaluate(request, which):
+    branch = request.getfixturevalue(which)
+    theta = np.linspace(0, np.pi, 13)
+    rng = np.random.default_rng(0)
+    U = rng.normal(size=(3, branch.disc.size))
+    batched = fields(branch.disc, U, theta)
+    for i, u in enumerate(U):
+        for got, want in zip(batched, branch.disc.evaluate(u, theta)):
+            np.testing.assert_allclose(got[i], want, rtol=1e-13, atol=1e-13)
+
+
+def _temp_files(directory):
+    return sorted(p.name for p in Path(directory).iterdir() if p.name.endswith(".tmp"))
+
+
+def test_existing_file_kept_without_force(tmp_path, scene, branch):
+    path = tmp_path / "run.h5"
+    path.write_bytes(b"keep me")
+    with pytest.raises(FileExistsError, match="--force"):
+        write_run(path, scene, [branch])
+    assert path.read_bytes() == b"keep me"
+    write_run(path, scene, [branch], force=True)
+    assert read_run(path)["branches"]["primary"]["pressure"].size == len(branch.X)
+
+
+def test_unconverged_point_is_not_written(tmp_path, scene, branch):
+    path = tmp_path / "run.h5"
+    path.write_bytes(b"keep me")
+    residual = branch.residual.copy()
+    residual[3] = np.nan
+    with pytest.raises(ValueError, match=r"points \[3\] are not converged"):
+        write_run(path, scene, [replace(branch, residual=residual)], force=True)
+    assert path.read_bytes() == b"keep me"
+    assert _temp_files(tmp_path) == []
+
+
+def test_failure_mid_write_leaves_file_untouched(tmp_path, scene, branch, monkeypatch):
+    path = tmp_path / "run.h5"
+    path.write_bytes(b"keep me")
+
+    def fail(group, branch):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(storage, "_write_special", fail)
+    with pytest.raises(RuntimeError, match="disk full"):
+        write_run(path, scene, [branch], force=True)
+    assert path.read_bytes() == b"keep me"
+    assert _temp_files(tmp_path) == []
+
+
+def test_read_run_rejects_other_files(tmp_path):
+    junk = tmp_path / "junk.h5"
+    junk.write_text("not hdf5")
+    with pytest.raises(RunFileError, match="not a readable HDF5 file"):
+        read_run(junk)
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f.attrs["format"] = "something/2"
+    with pytest.raises(RunFileError, match="not a balloon-cg run file"):
+        read_run(other)
+    with pytest.raises(FileNotFoundError):
+        read_run(tmp_path / "missing.h5")
