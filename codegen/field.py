@@ -15,8 +15,11 @@ every output a polynomial in ρ, ζ, a, 1/S, 1/S², G0..G3: no division by ρ an
 Kernels:
 - ``coil_field(rho, zeta, a, G0, G1, G2, G3)``: h_ρ, h_z and their first and second (ρ, ζ) derivatives,
   with G0..G3 = G, G', G'', G''' at m supplied by the runtime.
-- ``stream_shape_closed(m, m1, K, E)``: G, G', G'', G''' in closed form with m1 = 1 − m supplied separately
-  (full precision near a wire, where m → 1); cancellation ~ eps/m^(2+k) makes it the m > 1/2 branch only.
+- ``stream_shape_closed(m, m1, K, N)``: G, G', G'', G''' in closed form. SymPy differentiates elliptic_k and
+  elliptic_e; then E = (1 − m/2) K − N, with N = (1 − m/2) K − E supplied cancellation-free by the AGM
+  (balloon_cg.elliptic.loop_elliptic), and every factor m − 1 becomes −m1, m1 = 1 − m also supplied exactly
+  (m → 1 near a wire). In the (K, E) basis the numerator of G''' cancels ~850-fold at m = 1/2 (~2e-12 error
+  from a few-ulp E); in the (K, N) basis at most 26-fold for m ≥ 1/2, the branch this kernel serves.
 - ``STREAM_SERIES``: Maclaurin coefficients of G from K = π/2 ₂F₁(½,½;1;m), E = π/2 ₂F₁(−½,½;1;m).
 """
 import sympy as sp
@@ -28,7 +31,7 @@ SERIES_TERMS = 70
 
 rho, zeta = sp.symbols("rho zeta", real=True)
 a = sp.Symbol("a", positive=True)
-m, m1, K, E = sp.symbols("m m1 K E", positive=True)
+m, m1, K, N = sp.symbols("m m1 K N", positive=True)
 G = sp.symbols("G0:4", real=True)
 inv_s2, inv_s = sp.symbols("inv_s2 inv_s", positive=True)  # 1/S², 1/S: kernel stages
 _half_ds2 = {rho: a + rho, zeta: zeta}  # ½ ∂(S²)/∂var
@@ -61,14 +64,15 @@ def field_expressions():
 
 
 def stream_shape_expressions():
-    """G, G', G'', G''' from m, m1 = 1 − m, K(m), E(m): numerator collected on K, E over a factored denominator,
-    each factor m − 1 written −m1 so that the caller can supply 1 − m without cancellation near a wire."""
+    """G, G', G'', G''' from m, m1 = 1 − m, K(m) and N = (1 − m/2) K − E: numerator collected on K, N over a
+    factored denominator, each factor m − 1 written −m1."""
     g = ((1 - m / 2) * sp.elliptic_k(m) - sp.elliptic_e(m)) / m**2
+    elliptic = {sp.elliptic_k(m): K, sp.elliptic_e(m): (1 - m / 2) * K - N}
     complement = {m - 1: -m1, 1 - m: m1}
     out = []
     for _ in range(4):
-        numerator, denominator = sp.fraction(sp.together(g.subs({sp.elliptic_k(m): K, sp.elliptic_e(m): E})))
-        expr = sp.collect(sp.expand(numerator), [K, E], sp.factor) / sp.factor(denominator)
+        numerator, denominator = sp.fraction(sp.together(g.subs(elliptic)))
+        expr = sp.collect(sp.expand(numerator), [K, N], sp.factor) / sp.factor(denominator)
         out.append(expr.replace(lambda e: e in complement, lambda e: complement[e]))
         g = sp.diff(g, m)
     return tuple(out)
@@ -97,8 +101,9 @@ def field_module():
     )
     stream_shape_closed = Kernel(
         name="stream_shape_closed",
-        doc="G, G', G'', G''' of G(m) = ((1 - m/2) K - E)/m^2 from m, m1 = 1 - m, K(m), E(m); for m > 1/2.",
-        args=tuple(Arg.node(s) for s in (m, m1, K, E)),
+        doc="G, G', G'', G''' of G(m) = ((1 - m/2) K - E)/m^2 from m, m1 = 1 - m, K(m), N = (1 - m/2) K - E "
+        "(for m > 1/2).",
+        args=tuple(Arg.node(s) for s in (m, m1, K, N)),
         outputs=stream_shape_expressions(),
         vectorise=False,
     )
