@@ -50,7 +50,7 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert summary["provenance"]["command"] == f"balloon-cg run {scene_file} -o {out}"
     assert summary["provenance"]["format"] == "balloon-cg/1"
     branch = summary["branches"]["primary"]
-    assert [s["kind"] for s in branch["special_points"]] == ["LP", "EP"]
+    assert [s["kind"] for s in branch["special_points"]] == ["EP", "LP", "EP"]
     assert branch["lam2_north"][1] == pytest.approx(2.0, abs=1e-12)
     assert branch["max_residual"] < 1e-10 and branch["max_error_estimate"] < 1e-10
     assert branch["points"] > 10 and branch["wall_time"] > 0

@@ -6,6 +6,9 @@
 3. Pressure: pseudo-arclength in (u, P) downwards to ``min_stretch`` and upwards to ``stop_stretch`` (landing
    exactly on it), ``stop_pressure``, a wire gap or ``max_points``; folds in P (LP) and in the north pole
    stretch (TP) are located and recorded.
+4. Resolution: when a point's spectral error estimate exceeds ``solver.max_error`` the Legendre degree grows
+   by half (up to ``solver.max_degree``) and the point is recomputed; past that the branch stops, saying so.
+   Stored points are prolonged to the finest degree used (exact: higher coefficients are zero).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
 removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
@@ -21,6 +24,8 @@ from .discretisation import Discretisation
 from .equilibrium import Equilibrium, Parameters
 from .newton import newton
 from .sphere import sphere_pressure
+
+RESOLUTION = "resolution"
 
 
 class ContinuationError(RuntimeError):
@@ -46,24 +51,28 @@ class ParameterSystem:
 
 @dataclass
 class SpecialPoint:
-    kind: str  # 'LP' fold in P, 'TP' turning point of the north pole stretch, 'EP' end point
-    index: int  # position in the branch (the special point lies between index and index + 1 for folds)
+    """'LP' fold in P, 'TP' turning point of the north pole stretch (both lie between points ``index`` and
+    ``index + 1``, X is the located point), 'EP' end point (X is point ``index``, ``note`` the stop reason)."""
+
+    kind: str
+    index: int
     X: np.ndarray
     note: str = ""
 
 
 @dataclass
 class Branch:
-    """A traced branch: unknowns u and pressure P per point, solver records, special points."""
+    """A traced branch: unknowns u and pressure P per point (all converged), solver records, special points."""
 
     name: str
     equilibrium: Equilibrium
     disc: Discretisation
-    params: Parameters
-    X: np.ndarray  # (n_points, n + 1): (u, P)
+    params: Parameters  # M and χ of the branch (P varies along it)
+    X: np.ndarray  # (n_points, n + 1): (u, P), u at the finest degree used
     iterations: np.ndarray
     residual: np.ndarray
     error_estimate: np.ndarray
+    degree: np.ndarray  # Legendre degree each point was solved at
     special: list = field(default_factory=list)
     stop_reason: str = ""
     wall_time: float = 0.0
@@ -72,6 +81,11 @@ class Branch:
     def pressure(self):
         return self.X[:, -1]
 
+    @property
+    def converged(self):
+        """Every stored point is a converged solution (unconverged corrections are never stored)."""
+        return np.ones(len(self.X), dtype=bool)
+
     def pole_values(self, X=None):
         """dict of λ2 and η at both poles for every point (or for one X)."""
         rows = self.disc.pole_rows()
@@ -79,15 +93,10 @@ class Branch:
         return {name: U @ row for name, row in rows.items()}
 
 
-def settings_from(scene) -> continuation.Settings:
-    c, s = scene.continuation, scene.solver
-    return continuation.Settings(c.step, c.step_min, c.step_max, c.max_points, s.tol, s.max_newton)
-
-
-def make_discretisation(scene, symmetric: bool) -> Discretisation:
-    held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
-    return Discretisation(scene.solver.degree, symmetric, pin_translation=(not scene.field.coils) or held,
-                          quadrature=scene.solver.quadrature)
+def _unit(size, index):
+    e = np.zeros(size)
+    e[index] = 1.0
+    return e
 
 
 def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float, int]:
@@ -101,59 +110,101 @@ def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float,
     return float(min(gaps)), int(np.argmin(gaps))
 
 
-def start_point(scene, equilibrium: Equilibrium) -> tuple[np.ndarray, Parameters]:
-    """The inflated M = 0 sphere, then the field switched on by natural continuation in M (bounded halving)."""
-    disc, material = equilibrium.disc, scene.material
-    lam = scene.continuation.start_stretch
-    a = np.zeros(disc.degree + 1)
-    b = np.zeros(disc.degree + 1)
-    a[0], b[1] = lam, lam
-    u = disc.join(a, b)
-    params = Parameters(sphere_pressure(material, lam), 0.0, scene.field.chi)
-    target_M, M, dM = scene.field.M, 0.0, scene.field.M
-    tol, max_newton = scene.solver.tol, scene.solver.max_newton
-    while M < target_M:
-        trial = min(M + dM, target_M)
-        system = ParameterSystem(equilibrium, params, "M")
-        result = newton(system.residual, system.jacobian, np.append(u, trial), _unit(u.size + 1, -1), trial,
-                        tol, max_newton)
-        if result.converged:
-            u, M = result.x[:-1], trial
-            dM *= 2
-        else:
-            dM *= 0.5
-            if dM < 1e-6 * max(target_M, 1e-12):
-                raise ContinuationError(
-                    f"could not switch the field on at start stretch {lam}: Newton failed at M = {trial:.6g} "
-                    f"({result.message}); try a smaller [continuation].start_stretch or a smaller M"
+class PrimaryTracer:
+    """Discretisations of growing degree for one scene, and the legs of the primary branch traced on them."""
+
+    def __init__(self, scene, symmetric: bool | None = None):
+        self.scene = scene
+        if symmetric is None:
+            symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
+        self.symmetric = symmetric
+        held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
+        self.pin = (not scene.field.coils) or held
+        c, s = scene.continuation, scene.solver
+        self.settings = continuation.Settings(c.step, c.step_min, c.step_max, c.max_points, s.tol, s.max_newton)
+        self._systems = {}
+
+    def system(self, degree: int, params: Parameters) -> ParameterSystem:
+        if degree not in self._systems:
+            quadrature = self.scene.solver.quadrature if degree == self.scene.solver.degree else 0
+            disc = Discretisation(degree, self.symmetric, self.pin, quadrature)
+            self._systems[degree] = Equilibrium(self.scene, disc)
+        return ParameterSystem(self._systems[degree], params, "P")
+
+    def start(self) -> tuple[np.ndarray, Parameters]:
+        """The inflated M = 0 sphere, then the field switched on by natural continuation in M (bounded halving)."""
+        scene = self.scene
+        eq = self.system(scene.solver.degree, Parameters(0.0)).eq
+        disc = eq.disc
+        lam = scene.continuation.start_stretch
+        a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
+        a[0], b[1] = lam, lam
+        u = disc.join(a, b)
+        params = Parameters(sphere_pressure(scene.material, lam), 0.0, scene.field.chi)
+        target, M, dM = scene.field.M, 0.0, scene.field.M
+        while M < target:
+            trial = min(M + dM, target)
+            system = ParameterSystem(eq, params, "M")
+            result = newton(system.residual, system.jacobian, np.append(u, trial), _unit(u.size + 1, -1), trial,
+                            scene.solver.tol, scene.solver.max_newton)
+            if result.converged:
+                u, M = result.x[:-1], trial
+                dM *= 2
+            else:
+                dM *= 0.5
+                if dM < 1e-6 * target:
+                    raise ContinuationError(
+                        f"could not switch the field on at start stretch {lam}: Newton failed at M = {trial:.6g} "
+                        f"({result.message}); try a smaller continuation.start_stretch or a smaller field.M"
+                    )
+        return np.append(u, params.P), params.with_value("M", target)
+
+    def leg(self, X0, direction: float, params: Parameters, stop, progress=None):
+        """Trace one direction from X0; returns [(degree, points, folds)], stop reason, last path."""
+        degree = self.scene.solver.degree
+        max_error, max_degree = self.scene.solver.max_error, self.scene.solver.max_degree
+        system = self.system(degree, params)
+        north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
+        start = continuation.Point(X0, direction * continuation.tangent(system, X0, north), 0, 0.0)
+        segments = []
+        while True:
+            disc = system.eq.disc
+            north = np.append(disc.pole_rows()["lam2_north"], 0.0)
+            monitors = {"LP": _unit(start.X.size, -1), "TP": north}
+
+            def checked_stop(point, disc=disc):
+                if disc.tail(point.X[:-1]) > max_error:
+                    return RESOLUTION
+                return stop(disc, point)
+
+            path = continuation.trace(system, start, self.settings, checked_stop, monitors, progress)
+            segments.append((degree, path))
+            if path.stop_reason != RESOLUTION:
+                return segments, path.stop_reason
+            if degree >= max_degree:
+                return segments, (
+                    f"resolution: spectral error estimate above solver.max_error = {max_error:g} at "
+                    f"solver.max_degree = {max_degree}; raise max_degree or shorten the branch"
                 )
-    return u, params.with_value("M", target_M)
+            finer = min(int(degree * 1.5), max_degree)
+            last = path.points.pop()  # recomputed at the finer degree as the next segment's first point
+            path.folds = [f for f in path.folds if f.index < len(path.points)]  # later ones are found again
+            system = self.system(finer, params)
+            X = disc.prolong(last.X, system.eq.disc)
+            t = disc.prolong(last.tangent, system.eq.disc)
+            result = newton(system.residual, system.jacobian, X, t, t @ X, self.settings.tol, self.settings.max_newton)
+            if not result.converged:
+                return segments, f"could not refine to degree {finer}: {result.message}"
+            start = continuation.Point(result.x, continuation.tangent(system, result.x, t), result.iterations,
+                                       result.residual)
+            degree = finer
 
 
-def _unit(size, index):
-    e = np.zeros(size)
-    e[index] = 1.0
-    return e
-
-
-def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | None = None, progress=None) -> Branch:
-    """Trace the primary branch of a scene; see the module docstring for the stages and stop rules."""
-    t0 = time.perf_counter()
-    if symmetric is None:
-        symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
-    disc = make_discretisation(scene, symmetric)
-    eq = Equilibrium(scene, disc)
-    u, params = start_point(scene, eq)
-    settings = settings_from(scene)
-    system = ParameterSystem(eq, params, "P")
-    X0 = np.append(u, params.P)
-    north = np.append(disc.pole_rows()["lam2_north"], 0.0)
-    monitors = {"LP": _unit(X0.size, -1), "TP": north}
+def _stop_rule(scene, upper: float):
     cont = scene.continuation
-    upper = cont.stop_stretch if stop_stretch is None else stop_stretch
 
-    def stop(point):
-        stretch = float(north @ point.X)
+    def stop(disc, point):
+        stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
         if stretch >= upper:
             return f"reached stop_stretch {upper:g}"
         if stretch <= cont.min_stretch:
@@ -165,44 +216,77 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
             return f"membrane within wire_gap {cont.wire_gap:g} of coil {coil} (gap {gap:.3g})"
         return None
 
-    t_up = continuation.tangent(system, X0, north)
-    start = continuation.Point(X0, t_up, 0, float(np.abs(system.residual(X0)).max()))
+    return stop
+
+
+def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | None = None, down: bool = True,
+                  progress=None) -> Branch:
+    """Trace the primary branch of a scene (module docstring). ``down=False`` skips the leg below the start."""
+    t0 = time.perf_counter()
+    tracer = PrimaryTracer(scene, symmetric)
+    X0, params = tracer.start()
+    upper = scene.continuation.stop_stretch if stop_stretch is None else stop_stretch
+    stop = _stop_rule(scene, upper)
     legs = {}
-    for direction, t in (("down", -t_up), ("up", t_up)):
-        legs[direction] = continuation.trace(system, continuation.Point(X0, t, 0, start.residual), settings,
-                                             stop, monitors, progress)
-    up, down = legs["up"], legs["down"]
-    points = down.points[:0:-1] + up.points
-    offset = len(down.points) - 1
-    special = [SpecialPoint(f.label, offset - f.index - 1, f.point.X) for f in down.folds[::-1]]
-    special += [SpecialPoint(f.label, offset + f.index, f.point.X) for f in up.folds]
-    if up.stop_reason.startswith("reached stop_stretch") and up.overshoot is not None:
-        end = _land(system, up.points[-1], up.overshoot, north, upper, settings)
-        if end is not None:
-            points.append(end)
-            special.append(SpecialPoint("EP", len(points) - 1, end.X, "stop_stretch"))
-    X = np.array([p.X for p in points])
+    for name, direction in (("down", -1.0), ("up", 1.0)):
+        if name == "down" and not down:
+            legs[name] = ([], "not traced")
+            continue
+        legs[name] = tracer.leg(X0, direction, params, stop, progress)
+    finest = max([scene.solver.degree] + [deg for segs, _ in legs.values() for deg, _ in segs])
+    final = tracer.system(finest, params)
+    disc = final.eq.disc
+
+    def collect(segments):
+        points, folds = [], []
+        for degree, path in segments:
+            coarse = tracer.system(degree, params).eq.disc
+            base = len(points)
+            for p in path.points:
+                points.append((coarse.prolong(p.X, disc), p, degree, coarse.tail(p.X[:-1])))
+            folds += [(f.label, base + f.index, coarse.prolong(f.point.X, disc)) for f in path.folds]
+        return points, folds
+
+    down_points, down_folds = collect(legs["down"][0])
+    up_points, up_folds = collect(legs["up"][0])
+    points = down_points[:0:-1] + up_points
+    offset = max(len(down_points) - 1, 0)
+    special = [SpecialPoint(kind, offset - index - 1, X) for kind, index, X in down_folds[::-1]]
+    special += [SpecialPoint(kind, offset + index, X) for kind, index, X in up_folds]
+    up_reason = legs["up"][1]
+    if up_reason.startswith("reached stop_stretch"):
+        last_degree, last_path = legs["up"][0][-1]
+        overshoot = tracer.system(last_degree, params).eq.disc.prolong(last_path.overshoot.X, disc)
+        north = np.append(disc.pole_rows()["lam2_north"], 0.0)
+        end = _land(final, points[-1][0], overshoot, north, upper, tracer.settings)
+        if end is None:
+            up_reason = f"could not land on stop_stretch {upper:g} (Newton failed); stopped just below it"
+        else:
+            points.append((end.X, end, finest, disc.tail(end.X[:-1])))
+    special.append(SpecialPoint("EP", len(points) - 1, points[-1][0], up_reason))
+    if down and down_points:
+        special.insert(0, SpecialPoint("EP", 0, points[0][0], legs["down"][1]))
     return Branch(
         name="primary",
-        equilibrium=eq,
+        equilibrium=final.eq,
         disc=disc,
         params=params,
-        X=X,
-        iterations=np.array([p.iterations for p in points]),
-        residual=np.array([p.residual for p in points]),
-        error_estimate=np.array([disc.tail(x[:-1]) for x in X]),
+        X=np.array([p[0] for p in points]),
+        iterations=np.array([p[1].iterations for p in points]),
+        residual=np.array([p[1].residual for p in points]),
+        error_estimate=np.array([p[3] for p in points]),
+        degree=np.array([p[2] for p in points]),
         special=special,
-        stop_reason=f"up: {up.stop_reason}; down: {down.stop_reason}",
+        stop_reason=f"up: {up_reason}; down: {legs['down'][1]}",
         wall_time=time.perf_counter() - t0,
     )
 
 
 def _land(system, before, after, row, target, settings):
     """The point with row·X = target between two branch points (Newton from the linear interpolant)."""
-    f0, f1 = row @ before.X, row @ after.X
-    guess = before.X + (target - f0) / (f1 - f0) * (after.X - before.X)
+    f0, f1 = row @ before, row @ after
+    guess = before + (target - f0) / (f1 - f0) * (after - before)
     result = newton(system.residual, system.jacobian, guess, row, target, settings.tol, settings.max_newton)
     if not result.converged:
         return None
-    return continuation.Point(result.x, continuation.tangent(system, result.x, before.tangent), result.iterations,
-                              result.residual)
+    return continuation.Point(result.x, np.zeros_like(result.x), result.iterations, result.residual)

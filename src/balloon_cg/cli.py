@@ -101,9 +101,9 @@ def solve(args) -> int:
     x, start = args.pole_stretch, scene.continuation.start_stretch
     if not np.isfinite(x) or x <= start:
         raise UsageError(f"--pole-stretch = {x:g}: must be > continuation.start_stretch = {start:g}")
-    branch = trace_primary(scene, stop_stretch=x)
-    end = branch.special[-1] if branch.special else None
-    if end is None or end.kind != "EP" or end.index != len(branch.X) - 1:
+    branch = trace_primary(scene, stop_stretch=x, down=False)
+    end = branch.special[-1]
+    if not end.note.startswith("reached stop_stretch"):
         reached = branch.pole_values()["lam2_north"].max()
         raise Failure(
             f"the primary branch did not reach north pole stretch {x:g} ({branch.stop_reason}); "
@@ -122,7 +122,7 @@ def solution(branch, i: int) -> dict:
         **{k: float(np.squeeze(v)) for k, v in values.items()},
         "residual": float(branch.residual[i]),
         "error_estimate": float(branch.error_estimate[i]),
-        "converged": True,  # a Branch holds converged points only
+        "converged": bool(branch.converged[i]),
         "wall_time": branch.wall_time,
     }
 

@@ -28,6 +28,9 @@ def legendre_table(x: np.ndarray, degree: int):
     return p, dp
 
 
+_UPPER = tuple((k, l) for k in range(4) for l in range(k, 4))
+
+
 @dataclass(frozen=True)
 class Discretisation:
     """Basis, quadrature and the unknown-coefficient layout u = (a[kept], b[kept])."""
@@ -82,19 +85,23 @@ class Discretisation:
 
     def gradient(self, pointwise: np.ndarray) -> np.ndarray:
         """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q)."""
-        return np.einsum("kqi,kq->i", self.ops, pointwise * self.weights)
+        return self.ops.reshape(-1, self.size).T @ (pointwise * self.weights).ravel()
 
     def hessian(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is the upper triangle (10, n_q)."""
+        """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is the upper triangle (10, n_q).
+
+        One BLAS product Opsᵀ (D Ops) with D the node-wise 4×4 blocks.
+        """
         weighted = pointwise * self.weights
-        out = np.zeros((self.size, self.size))
-        row = 0
+        blocks = np.empty((4, 4, weighted.shape[1]))
+        for row, (k, l) in enumerate(_UPPER):
+            blocks[k, l] = blocks[l, k] = weighted[row]
+        scaled = np.zeros_like(self.ops)
         for k in range(4):
-            for l in range(k, 4):
-                block = self.ops[k].T @ (weighted[row][:, None] * self.ops[l])
-                out += block if k == l else block + block.T
-                row += 1
-        return out
+            for l in range(4):
+                scaled[k] += blocks[k, l][:, None] * self.ops[l]
+        n = self.size
+        return self.ops.reshape(-1, n).T @ scaled.reshape(-1, n)
 
     def pole_rows(self):
         """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south)."""
@@ -109,14 +116,29 @@ class Discretisation:
         }
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
-        """(λ2, λ2', η, η') on an arbitrary θ grid (poles included), from the Legendre series."""
-        a, b = self.split(u)
-        x = np.cos(theta)
-        p, dp = legendre_table(x, self.degree)
+        """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
+        p, dp = legendre_table(np.cos(theta), self.degree)
         s = np.sin(theta)
-        return p @ a, -s * (dp @ a), p @ b, -s * (dp @ b)
+        U = np.atleast_2d(u)
+        na = self.a_index.size
+        a, b = U[:, :na], U[:, na:]
+        values = (a @ p[:, self.a_index].T, -s * (a @ dp[:, self.a_index].T),
+                  b @ p[:, self.b_index].T, -s * (b @ dp[:, self.b_index].T))
+        return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
+
+    def prolong(self, u: np.ndarray, finer: "Discretisation") -> np.ndarray:
+        """The same functions in a basis of higher degree (zero coefficients appended); u may be (.., size + 1)."""
+        U = np.atleast_2d(u)
+        rest = U[:, self.size:]
+        out = []
+        for row in U[:, : self.size]:
+            a, b = self.split(row)
+            pad = finer.degree - self.degree
+            out.append(finer.join(np.pad(a, (0, pad)), np.pad(b, (0, pad))))
+        result = np.hstack([np.array(out), rest])
+        return result if np.ndim(u) == 2 else result[0]
 
     def tail(self, u: np.ndarray) -> float:
-        """Spectral error estimate: size of the two highest-degree coefficients of λ2 and η."""
+        """Spectral error estimate: the two highest-degree coefficients of λ2 and η relative to the mean λ2 (a_0)."""
         a, b = self.split(u)
-        return float(max(np.abs(a[-2:]).max(), np.abs(b[-2:]).max()))
+        return float(max(np.abs(a[-2:]).max(), np.abs(b[-2:]).max()) / abs(a[0]))

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .discretisation import Discretisation
+from .field import field_squared_nodes
 from .kernels import KernelSet
 
 
@@ -40,8 +41,6 @@ class Equilibrium:
         state = self.disc.node_state(u)
         field = None
         if self.kernels.field_class:
-            from .field import field_squared_nodes
-
             field = np.zeros((6, state.shape[1]))
             if self.coils.shape[0]:
                 field_squared_nodes(state[0] * self.disc.sin_theta, state[2], self.coils, field)

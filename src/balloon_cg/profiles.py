@@ -7,7 +7,6 @@ At the poles λ2' = η' = 0, so λ1 = λ2 there. η is measured from the centre 
 """
 import numpy as np
 
-from .discretisation import legendre_table
 
 EQUATOR = np.array([0.5 * np.pi])
 
@@ -18,17 +17,8 @@ def theta_grid(points: int) -> np.ndarray:
 
 
 def fields(disc, U: np.ndarray, theta: np.ndarray):
-    """(λ2, λ2', η, η') for unknowns U (n_points × disc.size), each of shape (n_points, len(theta)).
-
-    The same values as ``disc.evaluate(u, theta)`` for every row u, with one Legendre table for all rows.
-    """
-    p, dp = legendre_table(np.cos(theta), disc.degree)
-    s = np.sin(theta)
-    na = disc.a_index.size
-    a, b = U[:, :na], U[:, na:]
-    pa, dpa = p[:, disc.a_index].T, dp[:, disc.a_index].T
-    pb, dpb = p[:, disc.b_index].T, dp[:, disc.b_index].T
-    return a @ pa, -s * (a @ dpa), b @ pb, -s * (b @ dpb)
+    """(λ2, λ2', η, η') for unknowns U (n_points × disc.size), each of shape (n_points, len(theta))."""
+    return disc.evaluate(np.atleast_2d(U), theta)
 
 
 def meridional_stretch(theta, lam2, dlam2, deta):

@@ -81,12 +81,18 @@ class Continuation:
 
 @dataclass(frozen=True)
 class Solver:
-    """Discretisation: Legendre ``degree``, Gauss points (``quadrature``, 0 = automatic), Newton settings."""
+    """Discretisation: Legendre ``degree``, Gauss points (``quadrature``, 0 = automatic), Newton settings.
+
+    The degree grows by half (up to ``max_degree``) whenever the spectral error estimate of a point exceeds
+    ``max_error``; a branch that would need more stops there, saying so.
+    """
 
     degree: int = 40
     quadrature: int = 0
     tol: float = 1e-11
     max_newton: int = 25
+    max_degree: int = 320
+    max_error: float = 1e-9
 
 
 @dataclass(frozen=True)
@@ -294,7 +300,10 @@ def _solver(data) -> Solver:
     )
     tol = get("tol", lambda x: 0 < x <= 1e-3, "in (0, 1e-3]")
     max_newton = get("max_newton", lambda n: 1 <= n <= 200, "an integer in [1, 200]", integer=True)
-    return Solver(degree, quadrature, tol, max_newton)
+    max_degree = get("max_degree", lambda n: degree <= n <= 400, f"an integer in [solver.degree = {degree}, 400]",
+                     integer=True)
+    max_error = get("max_error", lambda x: 0 < x <= 1e-2, "in (0, 1e-2]")
+    return Solver(degree, quadrature, tol, max_newton, max_degree, max_error)
 
 
 def _stability(data) -> Stability:

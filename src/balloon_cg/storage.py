@@ -8,7 +8,7 @@ Layout::
                                   kernel_class, kernel_signature, M, chi
         pressure, lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
-        newton_iterations                                  (n_points,)
+        newton_iterations, solved_degree                   (n_points,)
         unknowns                                           (n_points, n + 1): Legendre unknowns u, then P
         theta                                              (n_theta,): linspace(0, π)
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (n_points, n_theta)
@@ -86,8 +86,8 @@ def check_output(path, force: bool) -> Path:
 
 
 def converged(branch) -> np.ndarray:
-    """Per point: finite unknowns and a finite residual (a Branch holds only Newton-converged points)."""
-    return np.isfinite(branch.X).all(axis=1) & np.isfinite(branch.residual)
+    """Per point: Newton converged (the branch's flag), with finite unknowns and residual."""
+    return branch.converged & np.isfinite(branch.X).all(axis=1) & np.isfinite(branch.residual)
 
 
 def _check_converged(branch):
@@ -130,6 +130,7 @@ def _write_branch(group, branch, theta):
         "residual": branch.residual,
         "error_estimate": branch.error_estimate,
         "newton_iterations": branch.iterations,
+        "solved_degree": branch.degree,
         "unknowns": branch.X,
         "theta": theta,
     }
