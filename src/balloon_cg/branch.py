@@ -113,12 +113,15 @@ def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float,
 class PrimaryTracer:
     """Discretisations of growing degree for one scene, and the legs of the primary branch traced on them."""
 
-    def __init__(self, scene, symmetric: bool | None = None):
+    def __init__(self, scene, symmetric: bool | None = None, held: bool | None = None):
+        """``held``: constrain the axial translation b_0 = 0 (default: with coils that are not equator-symmetric;
+        without coils b_0 is always removed, being a zero mode)."""
         self.scene = scene
         if symmetric is None:
             symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
         self.symmetric = symmetric
-        held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
+        if held is None:
+            held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
         self.pin = (not scene.field.coils) or held
         c, s = scene.continuation, scene.solver
         self.settings = continuation.Settings(c.step, c.step_min, c.step_max, c.max_points, s.tol, s.max_newton)
@@ -159,13 +162,20 @@ class PrimaryTracer:
                     )
         return np.append(u, params.P), params.with_value("M", target)
 
-    def leg(self, X0, direction: float, params: Parameters, stop, progress=None):
-        """Trace one direction from X0; returns [(degree, points, folds)], stop reason, last path."""
-        degree = self.scene.solver.degree
+    def initial_point(self, X0, direction: float, params: Parameters) -> continuation.Point:
+        """X0 with its unit tangent oriented so that the north pole stretch moves in ``direction``."""
+        system = self.system(self.scene.solver.degree, params)
+        north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
+        return continuation.Point(X0, direction * continuation.tangent(system, X0, north), 0, 0.0)
+
+    def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None):
+        """Trace from ``start`` (at ``degree``, default the scene's) along its tangent, refining as needed.
+
+        Returns ([(degree, path), ...], stop reason).
+        """
+        degree = degree or self.scene.solver.degree
         max_error, max_degree = self.scene.solver.max_error, self.scene.solver.max_degree
         system = self.system(degree, params)
-        north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
-        start = continuation.Point(X0, direction * continuation.tangent(system, X0, north), 0, 0.0)
         segments = []
         while True:
             disc = system.eq.disc
@@ -227,13 +237,20 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
     X0, params = tracer.start()
     upper = scene.continuation.stop_stretch if stop_stretch is None else stop_stretch
     stop = _stop_rule(scene, upper)
-    legs = {}
-    for name, direction in (("down", -1.0), ("up", 1.0)):
-        if name == "down" and not down:
-            legs[name] = ([], "not traced")
-            continue
-        legs[name] = tracer.leg(X0, direction, params, stop, progress)
-    finest = max([scene.solver.degree] + [deg for segs, _ in legs.values() for deg, _ in segs])
+    up = tracer.leg(tracer.initial_point(X0, 1.0, params), params, stop, progress)
+    below = tracer.leg(tracer.initial_point(X0, -1.0, params), params, stop, progress) if down else None
+    return assemble(tracer, params, "primary", up, below, t0, land_on=upper, labels=("up", "down"))
+
+
+def assemble(tracer, params, name, forward, backward=None, t0=None, land_on=None,
+             labels=("forward", "backward")) -> Branch:
+    """One Branch from the legs of a trace: reversed ``backward`` (without its first point), then ``forward``.
+
+    Points are prolonged to the finest degree used. With ``land_on``, a forward leg that stopped on reaching
+    that north pole stretch gets its exact end point.
+    """
+    legs = [leg for leg in (backward, forward) if leg is not None]
+    finest = max([tracer.scene.solver.degree] + [deg for segments, _ in legs for deg, _ in segments])
     final = tracer.system(finest, params)
     disc = final.eq.disc
 
@@ -247,27 +264,28 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
             folds += [(f.label, base + f.index, coarse.prolong(f.point.X, disc)) for f in path.folds]
         return points, folds
 
-    down_points, down_folds = collect(legs["down"][0])
-    up_points, up_folds = collect(legs["up"][0])
-    points = down_points[:0:-1] + up_points
-    offset = max(len(down_points) - 1, 0)
-    special = [SpecialPoint(kind, offset - index - 1, X) for kind, index, X in down_folds[::-1]]
-    special += [SpecialPoint(kind, offset + index, X) for kind, index, X in up_folds]
-    up_reason = legs["up"][1]
-    if up_reason.startswith("reached stop_stretch"):
-        last_degree, last_path = legs["up"][0][-1]
+    forward_points, forward_folds = collect(forward[0])
+    backward_points, backward_folds = collect(backward[0]) if backward else ([], [])
+    points = backward_points[:0:-1] + forward_points
+    offset = max(len(backward_points) - 1, 0)
+    special = [SpecialPoint(kind, offset - index - 1, X) for kind, index, X in backward_folds[::-1]]
+    special += [SpecialPoint(kind, offset + index, X) for kind, index, X in forward_folds]
+    reason = forward[1]
+    if land_on is not None and reason.startswith("reached stop_stretch"):
+        last_degree, last_path = forward[0][-1]
         overshoot = tracer.system(last_degree, params).eq.disc.prolong(last_path.overshoot.X, disc)
         north = np.append(disc.pole_rows()["lam2_north"], 0.0)
-        end = _land(final, points[-1][0], overshoot, north, upper, tracer.settings)
+        end = _land(final, points[-1][0], overshoot, north, land_on, tracer.settings)
         if end is None:
-            up_reason = f"could not land on stop_stretch {upper:g} (Newton failed); stopped just below it"
+            reason = f"could not land on stop_stretch {land_on:g} (Newton failed); stopped just below it"
         else:
             points.append((end.X, end, finest, disc.tail(end.X[:-1])))
-    special.append(SpecialPoint("EP", len(points) - 1, points[-1][0], up_reason))
-    if down and down_points:
-        special.insert(0, SpecialPoint("EP", 0, points[0][0], legs["down"][1]))
+    special.append(SpecialPoint("EP", len(points) - 1, points[-1][0], reason))
+    if backward and backward_points:
+        special.insert(0, SpecialPoint("EP", 0, points[0][0], backward[1]))
+    stop_reason = f"{labels[0]}: {reason}" + (f"; {labels[1]}: {backward[1]}" if backward else "")
     return Branch(
-        name="primary",
+        name=name,
         equilibrium=final.eq,
         disc=disc,
         params=params,
@@ -277,8 +295,8 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
         error_estimate=np.array([p[3] for p in points]),
         degree=np.array([p[2] for p in points]),
         special=special,
-        stop_reason=f"up: {up_reason}; down: {legs['down'][1]}",
-        wall_time=time.perf_counter() - t0,
+        stop_reason=stop_reason,
+        wall_time=time.perf_counter() - (t0 or time.perf_counter()),
     )
 
 

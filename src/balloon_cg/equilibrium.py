@@ -37,22 +37,31 @@ class Equilibrium:
         self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
 
-    def _state(self, u):
-        state = self.disc.node_state(u)
-        field = None
-        if self.kernels.field_class:
-            field = np.zeros((6, state.shape[1]))
-            if self.coils.shape[0]:
-                field_squared_nodes(state[0] * self.disc.sin_theta, state[2], self.coils, field)
-        return tuple(state), field
+    def _field(self, lam2, sin_theta, eta):
+        """H² and its derivatives at the nodes (zeros for a field class without coils)."""
+        if not self.kernels.field_class:
+            return None
+        field = np.zeros((6, lam2.shape[0]))
+        if self.coils.shape[0]:
+            field_squared_nodes(lam2 * sin_theta, eta, self.coils, field)
+        return field
 
-    def _pointwise(self, kernel, u, params: Parameters, rows):
-        state, field = self._state(u)
-        out = self.kernels.nodes(kernel, self.geometry, state, self.kernels.params(params.P, params.M, params.chi),
+    def pointwise(self, kernel: str, geometry: tuple, state: tuple, params: Parameters, rows: int) -> np.ndarray:
+        """A generated kernel at nodes with (cos θ, sin θ) = geometry and (λ2, v, η, w) = state."""
+        field = self._field(state[0], geometry[1], state[2])
+        out = self.kernels.nodes(kernel, geometry, state, self.kernels.params(params.P, params.M, params.chi),
                                  field, rows)
         if not np.all(np.isfinite(out)):
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
+
+    def _pointwise(self, kernel, u, params: Parameters, rows):
+        return self.pointwise(kernel, self.geometry, tuple(self.disc.node_state(u)), params, rows)
+
+    def state_at(self, u, theta: np.ndarray) -> tuple:
+        """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
+        lam2, dlam2, eta, deta = self.disc.evaluate(u, theta)
+        return lam2, dlam2 * np.sin(theta), eta, deta
 
     def energy(self, u, params: Parameters) -> float:
         """E/(2π) (MODEL.md §2)."""
@@ -76,6 +85,5 @@ class Equilibrium:
 
     def volume(self, u) -> float:
         """Enclosed volume / (2π) = −∂E/∂P (MODEL.md §2: the pressure term is −P V/(2π))."""
-        state, _ = self._state(u)
-        lam2, _, _, w = state
+        lam2, _, _, w = self.disc.node_state(u)
         return float(-self.disc.weights @ (0.5 * lam2**2 * w * self.disc.sin_theta))

@@ -1,0 +1,120 @@
+"""Stability of equilibria from the second variation (MODEL.md §5), axisymmetric modes.
+
+Perturbations δλ2 = Σ a_k P_k(cos θ), δη = Σ b_k P_k(cos θ), k = 0..N (the paper's basis drops a_0, which
+carries the limit-point instability, and b_0, the rigid axial translation: both are kept here). The Hessian
+H = Σ_q W_q Bᵀ ∂²π̂ B is assembled at the equilibrium state, and eigenvalues are taken relative to the L2 Gram
+matrix G = ∫(δλ2² + δη²) d(cos θ), so that they do not depend on the basis normalisation.
+
+Blocks of an equator-symmetric state: 'even' (a_even, b_odd: shape-symmetric modes, carries the volume change)
+and 'odd' (a_odd, b_even: pear-shaped modes). b_0 is the rigid translation: a zero mode without a field
+(always left out); with a field it is kept for a *free* balloon and left out for one *held* at its centre.
+
+Control modes: under pressure control the test is H > 0; under volume control H restricted to the
+perturbations that keep the volume, gᵀδ = 0 with g = ∂V/∂(a, b) = −∂²E/∂P∂(a, b).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from .discretisation import Discretisation
+from .equilibrium import Parameters
+
+LOWEST = 3  # eigenvalues reported per block
+
+
+@dataclass
+class Assessment:
+    """Lowest eigenvalues per block and the stability flags of one equilibrium."""
+
+    blocks: dict  # name -> lowest eigenvalues (ascending); names: even, odd_held, odd_free, all_held, all_free,
+    #                even_volume, all_volume_held, all_volume_free
+    stable_pressure: bool  # held at the centre (the translation excluded), pressure control
+    stable_volume: bool  # held, volume control
+    stable_pressure_free: bool  # free balloon (translation included; equal to held without a field)
+    stable_volume_free: bool
+
+
+class SecondVariation:
+    """Galerkin Hessians of the energy on a Legendre perturbation basis of degree N, at equilibria of ``eq``."""
+
+    def __init__(self, equilibrium, degree: int):
+        self.eq = equilibrium
+        quadrature = max(equilibrium.disc.x.size, (3 * degree) // 2 + 8)
+        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature)
+        self.theta = np.arccos(self.basis.x)
+        k = np.arange(degree + 1)
+        na = degree + 1
+        self.index = {
+            "a_even": k[k % 2 == 0], "a_odd": k[k % 2 == 1],
+            "b_even": na + k[k % 2 == 0], "b_odd": na + k[k % 2 == 1],
+        }
+        self.translation = na  # b_0
+        ops, w = self.basis.ops, self.basis.weights
+        self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+
+    def matrices(self, u, params: Parameters):
+        """(H, g): the Hessian of E and the volume gradient on the perturbation basis."""
+        state = self.eq.state_at(u, self.theta)
+        geometry = (self.basis.cos_theta, self.basis.sin_theta)
+        hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params, 10))
+        volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params, 4))
+        return hessian, volume
+
+    def _lowest(self, H, idx, constraint=None):
+        Hb, Gb = H[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)]
+        if constraint is not None:
+            Z = scipy.linalg.null_space(constraint[idx][None, :])
+            Hb, Gb = Z.T @ Hb @ Z, Z.T @ Gb @ Z
+        return scipy.linalg.eigh(Hb, Gb, eigvals_only=True, subset_by_index=[0, min(LOWEST, len(Hb)) - 1])
+
+    def assess(self, u, params: Parameters, symmetric: bool) -> Assessment:
+        H, g = self.matrices(u, params)
+        field_on = self.eq.coils.shape[0] > 0 and params.M > 0
+        i = self.index
+        t = self.translation
+        blocks = {}
+        if symmetric:
+            even = np.concatenate([i["a_even"], i["b_odd"]])
+            odd_held = np.concatenate([i["a_odd"], i["b_even"][1:]])
+            blocks["even"] = self._lowest(H, even)
+            blocks["even_volume"] = self._lowest(H, even, g)
+            blocks["odd_held"] = self._lowest(H, odd_held)
+            if field_on:
+                blocks["odd_free"] = self._lowest(H, np.append(odd_held, t))
+            held = min(blocks["even"][0], blocks["odd_held"][0])
+            held_volume = min(blocks["even_volume"][0], blocks["odd_held"][0])
+            free = min(held, blocks["odd_free"][0]) if field_on else held
+            free_volume = min(held_volume, blocks["odd_free"][0]) if field_on else held_volume
+        else:
+            everything = np.arange(H.shape[0])
+            held_idx = everything[everything != t]
+            blocks["all_held"] = self._lowest(H, held_idx)
+            blocks["all_volume_held"] = self._lowest(H, held_idx, g)
+            held, held_volume = blocks["all_held"][0], blocks["all_volume_held"][0]
+            free, free_volume = held, held_volume
+            if field_on:
+                blocks["all_free"] = self._lowest(H, everything)
+                blocks["all_volume_free"] = self._lowest(H, everything, g)
+                free, free_volume = blocks["all_free"][0], blocks["all_volume_free"][0]
+        return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0)
+
+
+def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degree: int | None = None):
+    """Assessments of every point (and, with ``check_degree``, the points whose flags change at that degree)."""
+    symmetric = branch.disc.symmetric if symmetric is None else symmetric
+    variation = SecondVariation(branch.equilibrium, degree)
+    params = branch.params
+    results = [variation.assess(X[:-1], params.with_value("P", X[-1]), symmetric) for X in branch.X]
+    unsettled = []
+    if check_degree:
+        finer = SecondVariation(branch.equilibrium, check_degree)
+        for n, (X, coarse) in enumerate(zip(branch.X, results)):
+            fine = finer.assess(X[:-1], params.with_value("P", X[-1]), symmetric)
+            if _flags(fine) != _flags(coarse):
+                unsettled.append(n)
+    return results, unsettled
+
+
+def _flags(a: Assessment):
+    return (a.stable_pressure, a.stable_volume, a.stable_pressure_free, a.stable_volume_free)
