@@ -26,6 +26,7 @@ def _assess(branch, scene, symmetric):
     results, unsettled = assess_branch(branch, scene.stability.degree, symmetric,
                                        check_degree=2 * scene.stability.degree)
     branch.stability = results
+    branch.unsettled = unsettled
     return unsettled
 
 
@@ -39,8 +40,8 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     for n, (index, block) in enumerate(events):
         bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block))
         picture.branch_points.append(bp)
-        primary.special.append(SpecialPoint(bp.kind, index, bp.X, f"{block} mode; E2, E3, E4 = "
-                                            f"{bp.E[0]:.3e}, {bp.E[1]:.3e}, {bp.E[2]:.3e}"))
+        mode = "pear (odd)" if block == "odd_held" else "equator-symmetric (even)"
+        primary.special.append(SpecialPoint(bp.kind, index, bp.X, f"{mode} mode, branch point {n}", bp.E))
     primary.special.sort(key=lambda s: s.index)
     if pear:
         _trace_pears(scene, primary, picture, progress)

@@ -51,13 +51,15 @@ class ParameterSystem:
 
 @dataclass
 class SpecialPoint:
-    """'LP' fold in P, 'TP' turning point of the north pole stretch (both lie between points ``index`` and
-    ``index + 1``, X is the located point), 'EP' end point (X is point ``index``, ``note`` the stop reason)."""
+    """'LP' fold in P, 'TP' turning point of the north pole stretch, branch points 'pitchfork-super',
+    'pitchfork-sub', 'transcritical' (all lie between points ``index`` and ``index + 1``, X is the located
+    point), 'EP' end point (X is point ``index``, ``note`` the stop reason)."""
 
     kind: str
     index: int
     X: np.ndarray
     note: str = ""
+    E: tuple = (np.nan, np.nan, np.nan)  # normal-form coefficients E2, E3, E4 at branch points
 
 
 @dataclass

@@ -36,14 +36,15 @@ from .profiles import equator_values, profiles, theta_grid
 
 FORMAT = "balloon-cg/1"
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
-SPECIAL_NUMBERS = ("pressure",) + POLES
+SPECIAL_NUMBERS = ("pressure", "E2", "E3", "E4") + POLES
 
 
 class RunFileError(ValueError):
     """A file that is not a readable balloon-cg run file."""
 
 
-def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | None = None) -> Path:
+def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | None = None,
+              snaps: list | None = None) -> Path:
     """Write the branches traced for ``scene`` to ``path`` atomically; returns the path.
 
     An existing file is kept unless ``force`` (FileExistsError); on any failure the existing file is
@@ -66,6 +67,8 @@ def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | No
             group = f.create_group("branches")
             for branch in branches:
                 _write_branch(group.create_group(branch.name), branch, theta_grid(scene.output.theta_points))
+            if snaps is not None:
+                _write_snaps(f.create_group("snap_throughs"), snaps)
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -140,6 +143,40 @@ def _write_branch(group, branch, theta):
     for name, data in profiles(branch, theta).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
     _write_special(group.create_group("special_points"), branch)
+    if getattr(branch, "stability", None):
+        _write_stability(group.create_group("stability"), branch)
+    if getattr(branch, "parent", None):
+        group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
+
+
+STABILITY_FLAGS = {
+    "stable_pressure": "held at the centre (axial translation excluded), pressure control",
+    "stable_volume": "held at the centre, volume control (volume-preserving perturbations)",
+    "stable_pressure_free": "free balloon (axial translation included), pressure control",
+    "stable_volume_free": "free balloon, volume control",
+}
+
+
+def _write_stability(group, branch):
+    """Flags per point (what each means is in the dataset's 'meaning' attribute) and lowest eigenvalues."""
+    results = branch.stability
+    for name, meaning in STABILITY_FLAGS.items():
+        group.create_dataset(name, data=np.array([getattr(a, name) for a in results], dtype=bool))
+        group[name].attrs["meaning"] = meaning
+    for block in results[0].blocks:
+        values = np.array([a.blocks[block] for a in results])
+        group.create_dataset(f"lowest_{block}", data=values)
+    group.attrs["unsettled_points"] = np.asarray(getattr(branch, "unsettled", []), dtype=np.int64)
+
+
+def _write_snaps(group, snaps):
+    """Snap-throughs under pressure control: from (branch, index) at pressure P to (branch, index) or none."""
+    text = h5py.string_dtype()
+    for key in ("from_branch", "to_branch"):
+        group.create_dataset(key, data=np.array([s[key] for s in snaps], dtype=object), dtype=text)
+    for key in ("from_index", "to_index"):
+        group.create_dataset(key, data=np.array([s[key] for s in snaps], dtype=np.int64))
+    group.create_dataset("pressure", data=np.array([s["pressure"] for s in snaps], dtype=float))
 
 
 def _write_special(group, branch):
@@ -150,6 +187,8 @@ def _write_special(group, branch):
     group.create_dataset("index", data=np.array([s.index for s in special], dtype=np.int64))
     group.create_dataset("note", data=np.array([s.note for s in special], dtype=object), dtype=text)
     group.create_dataset("pressure", data=X[:, -1])
+    for n, name in enumerate(("E2", "E3", "E4")):
+        group.create_dataset(name, data=np.array([s.E[n] for s in special], dtype=float))
     for name, values in branch.pole_values(X).items():
         group.create_dataset(name, data=values)
     group.create_dataset("unknowns", data=X)
