@@ -1,0 +1,177 @@
+"""What users look at (MODEL.md §6): stresses, wrinkling, the applied field on the surface, Gaussian curvature.
+
+Every quantity is evaluated from the stored Legendre unknowns of a point (λ2 = Σ a_k P_k(x), η = Σ b_k P_k(x),
+x = cos θ) on a θ grid, poles included. θ-derivatives by the chain rule, regular at the poles:
+
+    d/dθ = −sin θ d/dx,    d²/dθ² = sin²θ d²/dx² − cos θ d/dx,
+    ρ = λ2 sin θ,   ρ' = λ2' sin θ + λ2 cos θ,   ρ'' = λ2'' sin θ + 2 λ2' cos θ − λ2 sin θ,
+    λ1 = sqrt(ρ'² + η'²).
+
+Geometry (t, n unit tangent along increasing θ and outward normal in the (e_ρ, e_z) plane):
+
+    t = (ρ', η')/λ1,   n = (−η', ρ')/λ1          (on a sphere n = (sin θ, cos θ), away from the centre),
+    k_m = −(ρ'η'' − ρ''η')/λ1³                   meridian curvature,
+    k_p = −η'/(ρ λ1) = (dη/dx)/(λ2 λ1)            parallel curvature (η'/ρ = −(dη/dx)/λ2 exactly: no 0/0),
+    κ = k_m k_p = η'(ρ'η'' − ρ''η')/(ρ (ρ'² + η'²)²)  Gaussian curvature (κ R0²);
+
+both principal curvatures are 1/λ on a sphere of radius λ, and at a pole k_p = k_m, so κ there is the square of
+the meridian curvature. Stresses are Cauchy stresses in units of μ/2 (the moduli's units, MODEL.md §2); the
+applied field h is in units of I/(4π R0) (MODEL.md §3), so that M H² is the nondimensional magnetic energy scale.
+"""
+import numpy as np
+from numpy.polynomial import legendre
+
+from .discretisation import Discretisation
+from .field import coil_table, field_components, field_squared_nodes
+from .profiles import meridional_stretch
+from .scene import parse_scene
+
+WRINKLING_STATES = ("taut", "wrinkled", "slack")
+
+
+def stored_scene(run: dict):
+    """The Scene a run file was computed for, rebuilt from its ``scene_toml`` attribute."""
+    return parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
+
+
+def branch_discretisation(branch: dict) -> Discretisation:
+    """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric and
+    pin_translation: it evaluates the branch's unknowns."""
+    attrs = branch["attrs"]
+    return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]))
+
+
+def surface(disc: Discretisation, X, theta) -> dict:
+    """Shape, stretches and principal curvatures (module docstring) for the rows X = (u, P) on ``theta``.
+
+    Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), k_meridian, k_parallel, gaussian_curvature (κ);
+    each array has shape (n_points, len(theta)).
+    """
+    U = np.atleast_2d(X)[:, : disc.size]
+    a = np.zeros((disc.degree + 1, len(U)))
+    b = np.zeros_like(a)
+    a[disc.a_index] = U[:, : disc.a_index.size].T
+    b[disc.b_index] = U[:, disc.a_index.size:].T
+    c, s = np.cos(theta), np.sin(theta)
+
+    def series(coefficients):
+        """(f, f', f'') in θ of f = Σ c_k P_k(cos θ), and df/dx."""
+        f, fx, fxx = (legendre.legval(c, legendre.legder(coefficients, m)) for m in range(3))
+        return f, -s * fx, s * s * fxx - c * fx, fx
+
+    lam2, dlam2, d2lam2, _ = series(a)
+    eta, deta, d2eta, deta_dx = series(b)
+    rho = lam2 * s
+    drho = dlam2 * s + lam2 * c
+    d2rho = d2lam2 * s + 2 * dlam2 * c - lam2 * s
+    lam1 = meridional_stretch(theta, lam2, dlam2, deta)
+    k_meridian = -(drho * d2eta - d2rho * deta) / lam1**3
+    k_parallel = deta_dx / (lam2 * lam1)
+    return {
+        "lam1": lam1, "lam2": lam2, "rho": rho, "eta": eta, "drho": drho, "deta": deta,
+        "k_meridian": k_meridian, "k_parallel": k_parallel,
+        "gaussian_curvature": k_meridian * k_parallel,
+    }
+
+
+def elastic_stresses(material, lam1, lam2):
+    """Elastic Cauchy membrane stresses (σ_θ, σ_φ) = (λ1 ∂Φ/∂λ1, λ2 ∂Φ/∂λ2), λ3 = 1/(λ1λ2) eliminated:
+
+    σ_θ = Σ μ_i (λ1^α_i − (λ1λ2)^(−α_i)),   σ_φ = Σ μ_i (λ2^α_i − (λ1λ2)^(−α_i))   (units of μ/2).
+    """
+    lam3 = 1.0 / (lam1 * lam2)
+    terms = list(zip(material.mu, material.alpha))
+    sigma_theta = sum(mu * (lam1**alpha - lam3**alpha) for mu, alpha in terms)
+    sigma_phi = sum(mu * (lam2**alpha - lam3**alpha) for mu, alpha in terms)
+    return sigma_theta, sigma_phi
+
+
+def surface_field(coils, geometry: dict) -> dict:
+    """Applied field on the deformed surface (units of I/(4π R0)); coils are rows (radius, height, current).
+
+    h_rho, h_z: h at (ρ, η); H_theta = h·t, H_zeta = h·n (meridional tangent, outward normal, so that
+    H_θ² + H_ζ² = H²); H2 = H²; dH2_drho = ∂(H²)/∂ρ at fixed η. Raises FieldError where the surface reaches
+    a wire.
+    """
+    table = coil_table(np.reshape(coils, (-1, 3)))
+    rho, eta = geometry["rho"], geometry["eta"]
+    h_rho, h_z = field_components(rho, eta, table)
+    derivatives = np.empty((6, rho.size))
+    field_squared_nodes(np.ascontiguousarray(rho.ravel()), np.ascontiguousarray(eta.ravel()), table, derivatives)
+    t_rho, t_z = geometry["drho"] / geometry["lam1"], geometry["deta"] / geometry["lam1"]
+    return {
+        "h_rho": h_rho, "h_z": h_z,
+        "H_theta": h_rho * t_rho + h_z * t_z,
+        "H_zeta": -h_rho * t_z + h_z * t_rho,
+        "H2": h_rho**2 + h_z**2,
+        "dH2_drho": derivatives[1].reshape(rho.shape),
+    }
+
+
+def paper_magnetic_stresses(M: float, chi: float, theta, lam2, field: dict):
+    """The paper's magnetic additions to (σ_θ, σ_φ) (its Cauchy stress section), taken as written:
+
+    Δσ_θ = (1 + χ) M H_θ² − ½ M H²,    Δσ_φ = ½ λ2 χ M ∂(H²)/∂λ2 − ½ M H²,    ∂(H²)/∂λ2 = sin θ ∂(H²)/∂ρ
+    (at fixed θ, ρ = λ2 sin θ). Its factors are not consistent with the energy of MODEL.md §2 (the paper
+    switches between ½ χ M H² and χ M H², and calls these stresses nondimensional "with shear modulus μ" while
+    its moduli are in units of μ/2), so the terms are reported on their own, next to the elastic stresses,
+    never added to them.
+    """
+    half = 0.5 * M * field["H2"]
+    return (
+        (1.0 + chi) * M * field["H_theta"] ** 2 - half,
+        0.5 * lam2 * chi * M * np.sin(theta) * field["dH2_drho"] - half,
+    )
+
+
+def wrinkling(sigma_theta, sigma_phi) -> np.ndarray:
+    """Tension-field state per entry: 'taut' (both principal stresses > 0), 'wrinkled' (one ≤ 0), 'slack'
+    (both ≤ 0)."""
+    compressed = (np.asarray(sigma_theta) <= 0).astype(int) + (np.asarray(sigma_phi) <= 0)
+    return np.array(WRINKLING_STATES)[compressed]
+
+
+def quantities(scene, disc: Discretisation, X, theta, M: float | None = None, chi: float | None = None) -> dict:
+    """Everything of MODEL.md §6 for the rows X = (u, P) of a branch of ``scene`` on ``theta``.
+
+    The keys of surface() and surface_field(), plus (arrays of shape (n_points, len(theta))):
+    sigma_theta, sigma_phi: elastic stresses; sigma_theta_paper, sigma_phi_paper: the paper's magnetic additions
+    alone (paper_magnetic_stresses); wrinkling: state from the elastic stresses; wrinkling_paper: from elastic
+    plus the paper's additions; lam1_below_one: the paper's wrinkling sign λ1 < 1. Also theta and pressure.
+    M and χ default to the scene's.
+    """
+    theta = np.asarray(theta, dtype=float)
+    X = np.atleast_2d(X)
+    M = scene.field.M if M is None else M
+    chi = scene.field.chi if chi is None else chi
+    geometry = surface(disc, X, theta)
+    field = surface_field([(c.radius, c.height, c.current) for c in scene.field.coils], geometry)
+    sigma_theta, sigma_phi = elastic_stresses(scene.material, geometry["lam1"], geometry["lam2"])
+    extra_theta, extra_phi = paper_magnetic_stresses(M, chi, theta, geometry["lam2"], field)
+    return {
+        "theta": theta,
+        "pressure": X[:, -1],
+        **geometry,
+        **field,
+        "sigma_theta": sigma_theta,
+        "sigma_phi": sigma_phi,
+        "sigma_theta_paper": extra_theta,
+        "sigma_phi_paper": extra_phi,
+        "wrinkling": wrinkling(sigma_theta, sigma_phi),
+        "wrinkling_paper": wrinkling(sigma_theta + extra_theta, sigma_phi + extra_phi),
+        "lam1_below_one": geometry["lam1"] < 1.0,
+    }
+
+
+def postprocess(run: dict, branch: str = "primary", points=None, theta=None) -> dict:
+    """quantities() for stored points of a run (read_run() output): all points, or the indices ``points``.
+
+    θ defaults to the branch's stored grid; M and χ come from the branch attrs. Adds 'points' (the indices).
+    """
+    data = run["branches"][branch]
+    index = np.arange(len(data["pressure"])) if points is None else np.asarray(points, dtype=int)
+    result = quantities(
+        stored_scene(run), branch_discretisation(data), data["unknowns"][index],
+        data["theta"] if theta is None else theta, float(data["attrs"]["M"]), float(data["attrs"]["chi"]),
+    )
+    return result | {"points": index}
