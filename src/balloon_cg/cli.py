@@ -1,4 +1,4 @@
-"""Command line: ``balloon-cg run | solve | inspect`` (``balloon-cg SUBCOMMAND -h`` for help).
+"""Command line: ``balloon-cg run | solve | inspect | plot`` (``balloon-cg SUBCOMMAND -h`` for help).
 
 Exit codes: 0 success, 1 the computation did not give what was asked (branch could not start or did not
 reach the requested stretch), 2 bad input (invalid scene, missing or unreadable file, existing output
@@ -8,11 +8,14 @@ import argparse
 import json
 import shlex
 import sys
+from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from .branch import ContinuationError, trace_primary
+from .field import FieldError
+from .plotting import KINDS, PlotError, plot as draw_plot
 from .profiles import equator_values
 from .scene import SceneError, load_scene
 from .storage import RunFileError, check_output, read_run, write_run
@@ -35,7 +38,7 @@ def main(argv=None) -> int:
     args.command_line = shlex.join([PROG, *argv])
     try:
         return args.handler(args)
-    except (SceneError, RunFileError, UsageError) as e:
+    except (SceneError, RunFileError, UsageError, PlotError, FieldError) as e:
         return _error(str(e), 2)
     except OSError as e:
         return _error(_os_message(e), 2)
@@ -46,7 +49,7 @@ def main(argv=None) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot):
         add(commands)
     return parser
 
@@ -76,13 +79,23 @@ def _add_run(commands):
 def run(args) -> int:
     """Trace, write, read back and summarise."""
     scene = load_scene(args.scene)
-    check_output(args.output, args.force)  # before the trace, which may take long
-    with tqdm(desc=scene.name, unit=" points", disable=args.quiet, file=sys.stderr) as bar:
-        branch = trace_primary(scene, progress=lambda point: bar.update())
-    write_run(args.output, scene, [branch], force=args.force, extra_attrs={"command": args.command_line})
+    run_scene(scene, args.output, args.force, progress=not args.quiet, command=args.command_line)
     if not args.quiet:
         print(format_run(read_run(args.output)))
     return 0
+
+
+def run_scene(scene, out_path, force: bool = False, progress: bool = False, command: str | None = None) -> Path:
+    """Trace the primary branch of ``scene`` and write it to the run file ``out_path``; returns the path.
+
+    The output is checked before the trace (which may take long); ``progress`` shows a bar on stderr;
+    ``command`` overrides the provenance attribute (default: sys.argv).
+    """
+    check_output(out_path, force)
+    with tqdm(desc=scene.name, unit=" points", disable=not progress, file=sys.stderr) as bar:
+        branch = trace_primary(scene, progress=lambda point: bar.update())
+    extra = {} if command is None else {"command": command}
+    return write_run(out_path, scene, [branch], force=force, extra_attrs=extra)
 
 
 # --- solve -------------------------------------------------------------------------------------------------
@@ -143,6 +156,44 @@ def inspect(args) -> int:
         print(json.dumps(summarise_run(run)))
     else:
         print(format_run(run))
+    return 0
+
+
+# --- plot --------------------------------------------------------------------------------------------------
+
+IMAGE_FORMATS = (".png", ".pdf", ".svg")
+
+
+def _add_plot(commands):
+    p = commands.add_parser("plot", help="draw a figure from one or more run files (docs/plots.md)")
+    p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
+    p.add_argument("--what", required=True, choices=list(KINDS), metavar="KIND",
+                   help=f"what to draw: {', '.join(KINDS)}")
+    p.add_argument("-o", "--output", help="image file, .png, .pdf or .svg (default: FIRST_FILE_STEM_KIND.png "
+                                          "next to the first file; an existing image is overwritten)")
+    p.add_argument("--points", type=_indices, metavar="I,J,K",
+                   help="point indices for shapes, stresses, field, curvature (negative: from the end)")
+    p.add_argument("--branch", metavar="NAME",
+                   help="branch to draw (default: every branch for pressure-* and energy, primary for the others)")
+    p.set_defaults(handler=plot)
+
+
+def _indices(text: str) -> list[int]:
+    try:
+        return [int(item) for item in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated integers, e.g. 0,10,-1") from None
+
+
+def plot(args) -> int:
+    """Draw one figure and save it; prints the image path."""
+    first = Path(args.files[0])
+    output = Path(args.output) if args.output else first.with_name(f"{first.stem}_{args.what}.png")
+    if output.suffix.lower() not in IMAGE_FORMATS:
+        raise UsageError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
+    check_output(output, force=True)
+    draw_plot(args.files, args.what, args.points, args.branch).savefig(output, dpi=150)
+    print(output)
     return 0
 
 

@@ -1,0 +1,106 @@
+"""The default run (``make run``): ``python -m balloon_cg.default_run OUTDIR [--quick]``.
+
+For each default scene (SPOM1 at M = 0, and SPOM1 between the paper's two opposed coils at M = 0.002: the
+files scenes/spom1.toml and scenes/spom1_two_coils_M0.002.toml, shipped inside the package as
+default_scenes/ so that an installed package runs them too) the primary branch is traced and written to
+OUTDIR/<scene>.h5, and every plot kind that applies is drawn as OUTDIR/<scene>_<kind>.png. The pressure
+curves of all scenes together (several M in one figure) go to OUTDIR/all_<kind>.png. Existing files of these
+names are overwritten. A summary table closes the run; the exit code is 1 if a scene failed, else 0.
+``--quick`` limits every leg of the continuation to QUICK_POINTS points (for tests).
+"""
+import argparse
+import sys
+import time
+from importlib import resources
+from pathlib import Path
+
+from .branch import ContinuationError
+from .cli import run_scene, summarise_branch
+from .plotting import applicable_kinds, load_branches, plot
+from .scene import parse_scene
+from .storage import read_run
+
+SCENES = ("spom1", "spom1_two_coils_M0.002")
+COMBINED = ("pressure-pole", "pressure-equator")
+QUICK_POINTS = 8
+
+
+def default_scenes(max_points: int | None = None) -> list:
+    """The default scenes from the package data (``continuation.max_points`` overridden if given)."""
+    folder = resources.files("balloon_cg") / "default_scenes"
+    scenes = [parse_scene((folder / f"{name}.toml").read_text(encoding="utf-8"), name) for name in SCENES]
+    if max_points is not None:
+        scenes = [s.with_overrides({"continuation.max_points": max_points}) for s in scenes]
+    return scenes
+
+
+def draw_figures(paths, outdir: Path, stem: str, kinds=None) -> list[Path]:
+    """Save every applicable plot kind (or those of ``kinds``) for the run files ``paths`` as <stem>_<kind>.png."""
+    applicable = applicable_kinds([b for p in paths for b in load_branches(p)])
+    images = []
+    for kind in applicable if kinds is None else [k for k in kinds if k in applicable]:
+        image = outdir / f"{stem}_{kind}.png"
+        plot(paths, kind).savefig(image, dpi=150)
+        images.append(image)
+    return images
+
+
+def summary_row(path) -> dict:
+    """Scene, points, P range, special points, max error estimate and trace wall time of a run file."""
+    run = read_run(path)
+    b = summarise_branch(run["branches"]["primary"])
+    return {
+        "scene": run["scene_name"],
+        "points": str(b["points"]),
+        "P range": "{:.4f} .. {:.4f}".format(*b["pressure"]),
+        "special points": " ".join(s["kind"] for s in b["special_points"]),
+        "max error est.": f"{b['max_error_estimate']:.1e}",
+        "wall time": f"{b['wall_time']:.1f} s",
+    }
+
+
+def format_summary(rows: list[dict]) -> str:
+    """Rows of equal keys as an aligned text table."""
+    keys = list(rows[0])
+    widths = [max(len(k), *(len(r[k]) for r in rows)) for k in keys]
+
+    def line(values):
+        return "  ".join(f"{v:<{w}}" for v, w in zip(values, widths)).rstrip()
+
+    return "\n".join([line(keys), line("-" * w for w in widths)] + [line(r[k] for k in keys) for r in rows])
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m balloon_cg.default_run", description=__doc__.split("\n")[0])
+    parser.add_argument("outdir", help="folder for the run files and figures (created if missing)")
+    parser.add_argument("--quick", action="store_true", help=f"at most {QUICK_POINTS} points per leg (for tests)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    args = parser.parse_args(argv)
+    outdir = Path(args.outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    rows, paths, failed = [], [], []
+    for scene in default_scenes(QUICK_POINTS if args.quick else None):
+        try:
+            path = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=not args.quiet)
+        except ContinuationError as e:
+            failed.append(f"{scene.name}: {e}")
+            continue
+        paths.append(path)
+        for image in draw_figures([path], outdir, scene.name):
+            print(image)
+        rows.append(summary_row(path))
+    if len(paths) > 1:
+        for image in draw_figures(paths, outdir, "all", COMBINED):
+            print(image)
+    if rows:
+        print()
+        print(format_summary(rows))
+    print(f"\ntotal wall time {time.perf_counter() - start:.1f} s (traces, run files and figures)")
+    for message in failed:
+        print(f"failed: {message}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

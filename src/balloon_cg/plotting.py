@@ -1,0 +1,416 @@
+"""Figures from run files (docs/plots.md). Every plot function returns a matplotlib Figure drawn on the Agg
+canvas (no pyplot, no global backend state); save it with ``figure.savefig(path)``.
+
+Curves of branches (pressure-pole, pressure-equator) and the energy landscape draw every branch of every file
+(or the one named); the per-point kinds (shapes, stresses, field, curvature) draw chosen points of one branch
+per file (default: primary). One colour per drawn branch, labelled by M (branch attrs), plus the branch name
+when a file holds several. Branch curves are solid where stable and dashed where unstable when the file has
+``branches/<name>/stability/stable_pressure`` (pressure control, balloon held at its centre); otherwise all
+solid, and the legend title says so. Special points are marked and labelled with their kind (LP, TP, EP,
+branch points, …). Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), lengths in R0, stresses in μ/2,
+field in I/(4π R0).
+"""
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from .postprocess import branch_discretisation, postprocess, stored_scene, surface
+from .profiles import EQUATOR
+from .storage import read_run
+
+NORMAL_FORM = ("E2", "E3", "E4")
+DEFAULT_POINTS = 5
+THETA_SAMPLES = 721  # θ values of the per-point curves, evaluated from the Legendre series (finer than stored)
+MARKERS = {"LP": "o", "TP": "s", "EP": "X"}  # branch points and other kinds: "D"
+
+P_LABEL = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
+THETA_LABEL = r"material coordinate $\theta$ (rad)"
+
+
+class PlotError(ValueError):
+    """A figure that cannot be drawn from the given files (missing branch, data or point)."""
+
+
+@dataclass
+class StoredBranch:
+    """One branch of a run file (``run``: read_run() output) with its optional per-point stability flag
+    stability/stable_pressure (None if the file has none) and a label for legends."""
+
+    path: Path
+    run: dict
+    name: str
+    stable: np.ndarray | None
+    label: str = ""
+
+    @property
+    def data(self) -> dict:
+        return self.run["branches"][self.name]
+
+    @property
+    def M(self) -> float:
+        return float(self.data["attrs"]["M"])
+
+    @property
+    def coils(self):
+        return stored_scene(self.run).field.coils
+
+    @property
+    def bifurcations(self) -> list:
+        """Special points with finite normal-form coefficients E2, E3, E4."""
+        return [s for s in self.data["special_points"]
+                if all(np.isfinite(s.get(k, np.nan)) for k in NORMAL_FORM)]
+
+
+def load_branches(path, branch: str | None = None) -> list[StoredBranch]:
+    """The branches of a run file (all, primary first, or the one named), with their stability flags."""
+    run = read_run(path)
+    names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
+    if branch is not None and branch not in run["branches"]:
+        raise PlotError(f"{path}: no branch {branch!r} (branches: {', '.join(run['branches'])})")
+    loaded = []
+    with h5py.File(path, "r") as f:
+        for name in names:
+            group = f["branches"][name]
+            stable = group["stability/stable_pressure"][()].astype(bool) if "stability/stable_pressure" in group \
+                else None
+            n = len(run["branches"][name]["pressure"])
+            if stable is not None and stable.shape != (n,):
+                raise PlotError(f"{path}: branch {name}: stability/stable_pressure has shape {stable.shape}, "
+                                f"expected ({n},)")
+            loaded.append(StoredBranch(Path(path), run, name, stable))
+    return loaded
+
+
+def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
+    """Set each branch's legend label: 'M = …', with the scene name where two files share an M, and the branch
+    name where a file contributes several branches."""
+    files = {}
+    for b in branches:
+        files.setdefault(b.path, []).append(b)
+    by_M = {}
+    for path, members in files.items():
+        by_M.setdefault(f"M = {members[0].M:g}", []).append(path)
+    for b in branches:
+        label = f"M = {b.M:g}"
+        if len(by_M[label]) > 1:
+            label += f" ({b.run['scene_name']})"
+        if len(files[b.path]) > 1:
+            label += f", {b.name}"
+        b.label = label
+    return branches
+
+
+def applicable_kinds(branches) -> list[str]:
+    """The KINDS that can be drawn for these branches (field needs coils, energy needs normal-form data)."""
+    return [kind for kind in KINDS
+            if (kind != "field" or any(b.coils for b in branches))
+            and (kind != "energy" or any(b.bifurcations for b in branches))]
+
+
+def plot(paths, what: str, points=None, branch: str | None = None) -> Figure:
+    """The figure of kind ``what`` (one of KINDS) for the run files ``paths``.
+
+    ``branch``: the branch to draw (default: all branches for the branch curves and the energy, 'primary' for
+    the per-point kinds). ``points``: indices (negative count from the end) of the configurations drawn by the
+    per-point kinds (default: DEFAULT_POINTS spread along the branch).
+    """
+    if what not in KINDS:
+        raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
+    draw, per_point = KINDS[what]
+    if per_point and branch is None:
+        branch = "primary"
+    branches = _label([b for p in paths for b in load_branches(p, branch)])
+    return draw(branches, points) if per_point else draw(branches)
+
+
+# --- branch curves -----------------------------------------------------------------------------------------
+
+def _title(branches) -> str:
+    return ", ".join(dict.fromkeys(b.run["scene_name"] for b in branches))
+
+
+def _curve(ax, x, y, stable, color, linestyle="-"):
+    """A branch curve: solid where stable, dashed where unstable (stable None: the given linestyle throughout)."""
+    if stable is None:
+        ax.plot(x, y, color=color, linestyle=linestyle, linewidth=1.4)
+        return
+    edges = np.flatnonzero(np.diff(stable.astype(int))) + 1
+    for start, end in zip(np.r_[0, edges], np.r_[edges, len(x)]):
+        piece = slice(start, min(end + 1, len(x)))  # one shared point joins the pieces
+        ax.plot(x[piece], y[piece], color=color, linestyle="-" if stable[start] else "--", linewidth=1.4)
+
+
+def _special(ax, branch: StoredBranch, x, y, color) -> list:
+    """Mark the special points at (x, y) (one entry per special point); returns their labels for _label_special."""
+    marks = []
+    for s, xs, ys in zip(branch.data["special_points"], x, y):
+        ax.plot(xs, ys, MARKERS.get(s["kind"], "D"), color=color, markersize=6, markeredgecolor="k",
+                markeredgewidth=0.5)
+        marks.append((ax, s["kind"], xs, ys, color))
+    return marks
+
+
+CHAR_WIDTH, LINE_HEIGHT = 5.0, 9.0  # points, for fontsize 8
+
+
+def _label_special(fig, marks):
+    """Label the marked special points with their kind, each at the first of a few offsets around its marker
+    whose text box (estimated, in points) lies inside the axes and clear of the labels already placed there
+    (if none does, the first one clear of the others). Call after all data are drawn."""
+    placed = {}
+    for ax, kind, x, y, color in marks:
+        ax.margins(x=0.06)
+        ax.autoscale_view()
+        scale = 72.0 / fig.dpi
+        frame = ax.get_window_extent()
+        anchor = ax.transData.transform((x, y)) * scale
+        width = CHAR_WIDTH * len(kind)
+        boxes = placed.setdefault(ax, [])
+
+        def clear(x0, y0):
+            return all(x0 + width <= bx or bx + bw <= x0 or y0 + LINE_HEIGHT <= by or by + LINE_HEIGHT <= y0
+                       for bx, by, bw in boxes)
+
+        def inside(x0, y0):
+            return (frame.x0 * scale <= x0 and x0 + width <= frame.x1 * scale
+                    and frame.y0 * scale <= y0 and y0 + LINE_HEIGHT <= frame.y1 * scale)
+
+        candidates = [(dx, dy) for dy in (4, -12, 14, -22, 24, -32) for dx in (5, -5 - width)]
+        fits = [c for c in candidates if clear(*(anchor + c))]
+        dx, dy = next((c for c in fits if inside(*(anchor + c))), fits[0] if fits else candidates[0])
+        boxes.append((*(anchor + (dx, dy)), width))
+        ax.annotate(kind, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=8, color=color)
+
+
+def _branch_legend(fig, branches, extra=()):
+    """Legend right of the axes: one line per drawn branch plus ``extra`` handles; the title tells what the
+    line styles mean."""
+    with_stability = [b.stable is not None for b in branches]
+    if all(with_stability):
+        title = "solid: stable, dashed: unstable\n(pressure control, held at centre)"
+    elif any(with_stability):
+        title = "solid: stable or not computed,\ndashed: unstable (pressure control)"
+    else:
+        title = "stability not computed (all solid)"
+    handles = [Line2D([], [], color=f"C{i % 10}", label=b.label) for i, b in enumerate(branches)]
+    fig.legend(handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8, loc="outside right upper")
+
+
+def plot_pressure_pole(branches) -> Figure:
+    """P against the north pole stretch λ2(0); the south pole λ2(π) dotted where it differs."""
+    fig = Figure(figsize=(8.4, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    extra, marks = [], []
+    for i, b in enumerate(branches):
+        d, color = b.data, f"C{i % 10}"
+        _curve(ax, d["lam2_north"], d["pressure"], b.stable, color)
+        scale = np.abs(d["lam2_north"]).max()
+        if np.abs(d["lam2_south"] - d["lam2_north"]).max() > 1e-8 * scale:
+            _curve(ax, d["lam2_south"], d["pressure"], None, color, linestyle=":")
+            extra = [Line2D([], [], color="k", linestyle=":", label=r"south pole $\lambda_2(\pi)$")]
+        special = d["special_points"]
+        marks += _special(ax, b, [s["lam2_north"] for s in special], [s["pressure"] for s in special], color)
+    ax.set_xlabel(r"pole stretch $\lambda_2(0)$ (north)")
+    ax.set_ylabel(P_LABEL)
+    ax.set_title(_title(branches), fontsize=10)
+    _branch_legend(fig, branches, extra)
+    _label_special(fig, marks)
+    return fig
+
+
+def plot_pressure_equator(branches) -> Figure:
+    """P against λ2(π/2) and against λ1(π/2) at the equator (two panels)."""
+    fig = Figure(figsize=(12, 4.5), layout="constrained")
+    axes = fig.subplots(1, 2, sharey=True)
+    marks = []
+    for i, b in enumerate(branches):
+        d, color = b.data, f"C{i % 10}"
+        at_equator = surface(branch_discretisation(d), d["special_unknowns"], EQUATOR)
+        special_p = [s["pressure"] for s in d["special_points"]]
+        for ax, key in zip(axes, ("lam2", "lam1")):
+            _curve(ax, d[f"{key}_equator"], d["pressure"], b.stable, color)
+            marks += _special(ax, b, at_equator[key][:, 0], special_p, color)
+    axes[0].set_xlabel(r"equator stretch $\lambda_2(\pi/2)$ (circumferential)")
+    axes[1].set_xlabel(r"equator stretch $\lambda_1(\pi/2)$ (meridional)")
+    axes[0].set_ylabel(P_LABEL)
+    fig.suptitle(_title(branches), fontsize=10)
+    _branch_legend(fig, branches)
+    _label_special(fig, marks)
+    return fig
+
+
+# --- configurations (per point) ----------------------------------------------------------------------------
+
+def select_points(data: dict, points=None) -> np.ndarray:
+    """Indices of the points of a stored branch to draw: ``points`` checked (negative count from the end), or
+    DEFAULT_POINTS spread evenly in arclength along the (λ2(0), P) curve, each scaled by its range."""
+    n = len(data["pressure"])
+    if points is None:
+        path = np.stack([data["lam2_north"], data["pressure"]])
+        span = np.ptp(path, axis=1, keepdims=True)
+        step = np.hypot(*(np.diff(path, axis=1) / np.where(span > 0, span, 1.0)))
+        length = np.r_[0.0, np.cumsum(step)]
+        targets = np.linspace(0.0, length[-1], min(n, DEFAULT_POINTS))
+        return np.unique(np.abs(length[:, None] - targets).argmin(axis=0))
+    bad = [p for p in points if not -n <= p < n]
+    if bad:
+        raise PlotError(f"point {bad[0]} does not exist: the branch has {n} points (indices 0..{n - 1})")
+    return np.array([p % n for p in points], dtype=int)
+
+
+def _configurations(branches, points):
+    """[(label, colour, quantities row dict, branch)] for the chosen points of every branch."""
+    several = len(branches) > 1
+    rows = []
+    for b in branches:
+        q = postprocess(b.run, b.name, select_points(b.data, points), np.linspace(0.0, np.pi, THETA_SAMPLES))
+        for j, index in enumerate(q["points"]):
+            label = (f"{b.label}: " if several else "") + (
+                f"#{index}  P = {q['pressure'][j]:.4g}, $\\lambda_2(0)$ = {q['lam2'][j, 0]:.4g}")
+            row = {k: v[j] for k, v in q.items() if k not in ("theta", "points")}
+            rows.append((label, f"C{len(rows) % 10}", row | {"theta": q["theta"]}, b))
+    return rows
+
+
+def _per_point_title(branches) -> str:
+    if len(branches) == 1:
+        return f"{_title(branches)}, M = {branches[0].M:g}"
+    return _title(branches)
+
+
+def _point_legend(fig, handles):
+    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=2)
+
+
+def _theta_axes(branches, ylabels, height=5.0):
+    fig = Figure(figsize=(7.5, height), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(len(ylabels), 1, sharex=True, squeeze=False)[:, 0])
+    for ax, label in zip(axes, ylabels):
+        ax.set_ylabel(label)
+        ax.axhline(0.0, color="0.6", linewidth=0.6)
+    axes[-1].set_xlabel(THETA_LABEL)
+    axes[-1].set_xlim(0.0, np.pi)
+    axes[-1].set_xticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
+    fig.suptitle(_per_point_title(branches), fontsize=10)
+    return fig, axes
+
+
+def plot_shapes(branches, points=None) -> Figure:
+    """Deformed meridian sections (ρ, η) and their mirror (−ρ, η), equal aspect, coils at (±a, h)."""
+    fig = Figure(figsize=(6.4, 7.6), layout="constrained")
+    ax = fig.add_subplot()
+    ax.set_aspect("equal")
+    psi = np.linspace(0, 2 * np.pi, 200)
+    ax.plot(np.cos(psi), np.sin(psi), color="0.6", linewidth=0.8, linestyle=":")
+    handles = [Line2D([], [], color="0.6", linewidth=0.8, linestyle=":", label="undeformed ($R_0$ = 1)")]
+    for label, color, q, _ in _configurations(branches, points):
+        ax.fill(np.r_[q["rho"], -q["rho"][::-1]], np.r_[q["eta"], q["eta"][::-1]], fill=False, edgecolor=color,
+                linewidth=1.4)  # one closed outline: no seam at the poles
+        handles.append(Line2D([], [], color=color, label=label))
+    coils = {(c.radius, c.height, np.sign(c.current)) for b in branches for c in b.coils}
+    for a, h, sign in coils:
+        ax.plot([a, -a], [h, h], linestyle="none", marker="o", markersize=9, markerfacecolor="w", color="k")
+        for x in (a, -a):  # a positive current flows along +e_φ: into the (x, z) plane at x = a, out at x = −a
+            ax.plot(x, h, linestyle="none", color="k", markersize=4, marker="x" if x * sign > 0 else ".")
+    if coils:
+        handles.append(Line2D([], [], linestyle="none", marker="o", markerfacecolor="w", color="k",
+                              label="coil wire (· current out of, × into the plane)"))
+    ax.set_xlabel(r"$\pm\rho/R_0$ (distance from the axis)")
+    ax.set_ylabel(r"$\eta/R_0$ (height)")
+    ax.set_title(_per_point_title(branches), fontsize=10)
+    _point_legend(fig, handles)
+    return fig
+
+
+def plot_stresses(branches, points=None) -> Figure:
+    """σ_θ and σ_φ against θ: elastic stresses solid; with the paper's magnetic additions dashed (M > 0)."""
+    fig, axes = _theta_axes(branches, [r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"], height=7.2)
+    handles = []
+    for label, color, q, b in _configurations(branches, points):
+        for ax, key in zip(axes, ("sigma_theta", "sigma_phi")):
+            ax.plot(q["theta"], q[key], color=color, linewidth=1.4)
+            if b.M > 0:
+                ax.plot(q["theta"], q[key] + q[f"{key}_paper"], color=color, linewidth=1.0, linestyle="--")
+        handles.append(Line2D([], [], color=color, label=label))
+    handles.append(Line2D([], [], color="k", label="elastic"))
+    if any(b.M > 0 for b in branches):
+        handles.append(Line2D([], [], color="k", linestyle="--", label="elastic + paper's magnetic terms"))
+    _point_legend(fig, handles)
+    return fig
+
+
+def plot_field(branches, points=None) -> Figure:
+    """Applied field on the deformed surface: H_θ (meridional tangent) and H_ζ (outward normal) against θ."""
+    if not any(b.coils for b in branches):
+        raise PlotError("no coils in these run files: the applied field is zero everywhere")
+    fig, axes = _theta_axes(branches, [r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"], height=7.2)
+    handles = []
+    for label, color, q, _ in _configurations([b for b in branches if b.coils], points):
+        axes[0].plot(q["theta"], q["H_theta"], color=color, linewidth=1.4)
+        axes[1].plot(q["theta"], q["H_zeta"], color=color, linewidth=1.4)
+        handles.append(Line2D([], [], color=color, label=label))
+    _point_legend(fig, handles)
+    return fig
+
+
+def plot_curvature(branches, points=None) -> Figure:
+    """Gaussian curvature κ R0² of the deformed surface against θ."""
+    fig, (ax,) = _theta_axes(branches, [r"Gaussian curvature $\kappa R_0^2$"])
+    handles = []
+    for label, color, q, _ in _configurations(branches, points):
+        ax.plot(q["theta"], q["gaussian_curvature"], color=color, linewidth=1.4)
+        handles.append(Line2D([], [], color=color, label=label))
+    _point_legend(fig, handles)
+    return fig
+
+
+# --- bifurcations ------------------------------------------------------------------------------------------
+
+def _amplitude_range(e2, e3, e4) -> float:
+    """Half-range of Λ: 1.5 × the quartic's own scale max(√|E2/E4|, |E3/E4|), clipped to [0.04, 0.5]
+    (the coefficients are a local fit; bifurcation.classify samples |Λ| ≤ 0.04)."""
+    scale = max(np.sqrt(abs(e2 / e4)), abs(e3 / e4)) if e4 != 0 else np.inf
+    return float(np.clip(1.5 * scale, 0.04, 0.5))
+
+
+def plot_energy(branches) -> Figure:
+    """Energy landscape E(Λ) − E0 = E2Λ² + E3Λ³ + E4Λ⁴ along the critical mode at each branch point (the
+    special points with finite E2, E3, E4, written by the stability analysis)."""
+    if not any(b.bifurcations for b in branches):
+        files = ", ".join(dict.fromkeys(str(b.path) for b in branches))
+        raise PlotError(f"{files}: no bifurcation data (no special point with finite special_points/E2, E3, E4, "
+                        "which the stability analysis writes); the energy landscape cannot be drawn")
+    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    ax.axhline(0.0, color="0.6", linewidth=0.6)
+    styles = ["-", "--", "-.", ":"]
+    drawn = 0
+    for i, b in enumerate(branches):
+        for s in b.bifurcations:
+            e2, e3, e4 = (s[k] for k in NORMAL_FORM)
+            amplitude = np.linspace(-1, 1, 401) * _amplitude_range(e2, e3, e4)
+            energy = e2 * amplitude**2 + e3 * amplitude**3 + e4 * amplitude**4
+            ax.plot(amplitude, energy, color=f"C{i % 10}", linestyle=styles[drawn % len(styles)], linewidth=1.4,
+                    label=f"{b.label}: {s['kind']} at P = {s['pressure']:.6g}\n"
+                          f"E2 = {e2:.3g}, E3 = {e3:.3g}, E4 = {e4:.3g}")
+            drawn += 1
+    ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
+    ax.set_ylabel(r"$E(\Lambda) - E_0$ (per $2\pi$, units of $T_0 R_0^2 \mu/2$)")
+    ax.set_title(_title(branches), fontsize=10)
+    ax.legend(fontsize=8)
+    return fig
+
+
+KINDS = {
+    "pressure-pole": (plot_pressure_pole, False),
+    "pressure-equator": (plot_pressure_equator, False),
+    "shapes": (plot_shapes, True),
+    "stresses": (plot_stresses, True),
+    "field": (plot_field, True),
+    "curvature": (plot_curvature, True),
+    "energy": (plot_energy, False),
+}

@@ -1,0 +1,157 @@
+"""Figures, the plot subcommand and the default run (reduced with --quick)."""
+import contextlib
+import io
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from balloon_cg import default_run
+from balloon_cg.cli import main
+from balloon_cg.plotting import KINDS, PlotError, plot
+from balloon_cg.postprocess import postprocess
+from balloon_cg.storage import read_run
+
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
+PER_POINT_KINDS = ("shapes", "stresses", "field", "curvature")
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    """The default run with --quick: (output folder, printed text)."""
+    out = tmp_path_factory.mktemp("default")
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert default_run.main([str(out), "--quick", "--quiet"]) == 0
+    return out, printed.getvalue()
+
+
+@pytest.fixture(scope="module")
+def files(quick_run):
+    out, _ = quick_run
+    return {name: out / f"{name}.h5" for name in default_run.SCENES}
+
+
+@pytest.fixture(scope="module")
+def bifurcation_file(files, tmp_path_factory):
+    """The two-coil file with what the stability analysis adds: a stability flag per point, a branch point
+    with normal-form coefficients, and a second branch (here a copy of the primary one)."""
+    path = tmp_path_factory.mktemp("bp") / "with_bp.h5"
+    shutil.copy(files["spom1_two_coils_M0.002"], path)
+    with h5py.File(path, "r+") as f:
+        group = f["branches/primary"]
+        n = group["pressure"].shape[0]
+        group.create_dataset("stability/stable_pressure", data=np.arange(n) < n // 2)
+        special = group["special_points"]
+        special["kind"][1] = "pitchfork-super"
+        for name, value in (("E2", -0.02), ("E3", 0.0), ("E4", 0.5)):
+            special[name][1] = value
+        f.copy(group, "branches/pear_0")
+    return path
+
+
+def test_default_run_writes_the_promised_files(quick_run):
+    out, text = quick_run
+    for scene in default_run.SCENES:
+        assert read_run(out / f"{scene}.h5")["scene_name"] == scene
+        for kind in ("pressure-pole", "pressure-equator", "shapes", "stresses", "curvature"):
+            assert (out / f"{scene}_{kind}.png").stat().st_size > 0
+        assert not (out / f"{scene}_energy.png").exists()  # no bifurcation data
+    assert (out / "spom1_two_coils_M0.002_field.png").stat().st_size > 0
+    assert not (out / "spom1_field.png").exists()  # no coils
+    for kind in default_run.COMBINED:
+        assert (out / f"all_{kind}.png").stat().st_size > 0
+    for word in ("scene", "points", "P range", "special points", "max error est.", "wall time", *default_run.SCENES):
+        assert word in text
+
+
+def test_packaged_default_scenes_match_the_scene_files():
+    for scene in default_run.default_scenes():
+        assert scene.text == (SCENES / f"{scene.name}.toml").read_text(encoding="utf-8")
+
+
+PRESSURE = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
+LABELS = {
+    "pressure-pole": (r"pole stretch $\lambda_2(0)$ (north)", PRESSURE),
+    "pressure-equator": (r"equator stretch $\lambda_2(\pi/2)$ (circumferential)", PRESSURE),
+    "shapes": (r"$\pm\rho/R_0$ (distance from the axis)", r"$\eta/R_0$ (height)"),
+    "stresses": (r"material coordinate $\theta$ (rad)", r"$\sigma_\phi$ / ($\mu$/2)"),
+    "field": (r"material coordinate $\theta$ (rad)", r"$H_\zeta$ / ($I/4\pi R_0$)"),
+    "curvature": (r"material coordinate $\theta$ (rad)", r"Gaussian curvature $\kappa R_0^2$"),
+    "energy": (r"amplitude $\Lambda$ along the critical mode",
+               r"$E(\Lambda) - E_0$ (per $2\pi$, units of $T_0 R_0^2 \mu/2$)"),
+}
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_every_kind_draws_with_labels(kind, files, bifurcation_file, tmp_path):
+    paths = [bifurcation_file] if kind == "energy" else list(files.values())
+    fig = plot(paths, kind, points=[0, -1] if kind in PER_POINT_KINDS else None)
+    labelled = [ax for ax in fig.axes if ax.get_xlabel()]
+    assert LABELS[kind][0] in [ax.get_xlabel() for ax in labelled]
+    assert LABELS[kind][1] in [ax.get_ylabel() for ax in fig.axes]
+    image = tmp_path / f"{kind}.png"
+    fig.savefig(image)
+    assert image.read_bytes().startswith(b"\x89PNG") and image.stat().st_size > 1000
+
+
+def legend_texts(fig):
+    return [t.get_text() for legend in [*fig.legends, *(ax.get_legend() for ax in fig.axes)] if legend
+            for t in legend.get_texts()]
+
+
+def test_several_files_are_labelled_by_M(files):
+    fig = plot(list(files.values()), "pressure-pole")
+    legend = fig.legends[0]
+    assert [t.get_text() for t in legend.get_texts()] == ["M = 0", "M = 0.002"]
+    assert "stability not computed" in legend.get_title().get_text()
+    assert {t.get_text() for t in fig.axes[0].texts} >= {"EP"}  # special points labelled with their kind
+    shapes = plot(list(files.values()), "shapes", points=[-1])
+    assert any(text.startswith("M = 0.002: #") for text in legend_texts(shapes))
+
+
+def test_stability_and_special_points(bifurcation_file):
+    fig = plot([bifurcation_file], "pressure-pole")
+    ax = fig.axes[0]
+    assert "dashed: unstable" in fig.legends[0].get_title().get_text()
+    styles = {line.get_linestyle() for line in ax.get_lines() if len(line.get_xdata()) > 1}
+    assert {"-", "--"} <= styles
+    assert "pitchfork-super" in {t.get_text() for t in ax.texts}
+    assert legend_texts(fig) == ["M = 0.002, primary", "M = 0.002, pear_0"]
+    assert legend_texts(plot([bifurcation_file], "pressure-pole", branch="pear_0")) == ["M = 0.002"]
+
+
+def test_missing_data_is_a_clear_error(files):
+    with pytest.raises(PlotError, match="no bifurcation data"):
+        plot([files["spom1"]], "energy")
+    with pytest.raises(PlotError, match="no coils"):
+        plot([files["spom1"]], "field")
+    with pytest.raises(PlotError, match="does not exist"):
+        plot([files["spom1"]], "shapes", points=[10**6])
+    with pytest.raises(PlotError, match="no branch 'pear'"):
+        plot([files["spom1"]], "pressure-pole", branch="pear")
+
+
+def test_field_identity_on_a_stored_two_coil_point(files):
+    q = postprocess(read_run(files["spom1_two_coils_M0.002"]), points=[-1])
+    np.testing.assert_allclose(q["H_theta"] ** 2 + q["H_zeta"] ** 2, q["H2"], rtol=1e-12)
+
+
+def test_plot_subcommand(files, tmp_path, capsys):
+    out = tmp_path / "both.pdf"
+    assert main(["plot", *map(str, files.values()), "--what", "pressure-equator", "-o", str(out)]) == 0
+    assert out.read_bytes().startswith(b"%PDF") and capsys.readouterr().out.strip() == str(out)
+    assert main(["plot", str(files["spom1"]), "--what", "stresses", "--points", "0,-1", "-o",
+                 str(tmp_path / "s.png")]) == 0
+    capsys.readouterr()
+    for argv, words in (
+        (["--what", "energy"], ["no bifurcation data"]),
+        (["--what", "shapes", "--points", "999"], ["point 999 does not exist"]),
+        (["--what", "shapes", "-o", str(tmp_path / "x.gif")], ["suffix"]),
+    ):
+        assert main(["plot", str(files["spom1"]), *argv]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("balloon-cg: error: ")
+        assert all(word in err for word in words)
