@@ -37,8 +37,8 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     if not primary.disc.symmetric:
         return picture
     events = bifurcation.detect(primary, primary.stability)
-    for n, (index, block) in enumerate(events):
-        bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block))
+    for n, (index, block, k) in enumerate(events):
+        bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
         picture.branch_points.append(bp)
         mode = "pear (odd)" if block == "odd_held" else "equator-symmetric (even)"
         primary.special.append(SpecialPoint(bp.kind, index, bp.X, f"{mode} mode, branch point {n}", bp.E))

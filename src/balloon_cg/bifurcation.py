@@ -34,10 +34,11 @@ class BranchPoint:
     E: tuple = (np.nan, np.nan, np.nan)  # E2, E3, E4
 
 
-def _lowest_eigenpair(variation, u, params, idx):
+def _eigenpair(variation, u, params, idx, k):
+    """The k-th lowest eigenvalue (from 0) of a block and its eigenvector on the full perturbation basis."""
     H, _ = variation.matrices(u, params)
     Hb, Gb = H[np.ix_(idx, idx)], variation.gram[np.ix_(idx, idx)]
-    values, vectors = scipy.linalg.eigh(Hb, Gb, subset_by_index=[0, 0])
+    values, vectors = scipy.linalg.eigh(Hb, Gb, subset_by_index=[k, k])
     mode = np.zeros(H.shape[0])
     mode[idx] = vectors[:, 0]
     return values[0], mode
@@ -52,18 +53,21 @@ def block_indices(variation, block: str, field_on: bool):
 
 
 def detect(branch, assessments):
-    """(index, block) of every sign change of the lowest pear / even eigenvalue between neighbouring points."""
+    """(index, block, k) of every change of the number of negative eigenvalues of the pear or even block
+    between neighbouring points; k is the eigenvalue (from the lowest, 0) that crosses zero. Changes of the
+    even block at a fold in P are the fold itself, not a branch point."""
     folds = {s.index for s in branch.special if s.kind == "LP"}
     events = []
     for n in range(len(assessments) - 1):
         for block in ("odd_held", "even"):
-            a, b = assessments[n].blocks[block][0], assessments[n + 1].blocks[block][0]
-            if a * b < 0 and not (block == "even" and n in folds):
-                events.append((n, block))
+            a = int(np.sum(assessments[n].blocks[block] < 0))
+            b = int(np.sum(assessments[n + 1].blocks[block] < 0))
+            if a != b and not (block == "even" and n in folds):
+                events.append((n, block, min(a, b)))
     return events
 
 
-def locate(branch, index: int, block: str) -> BranchPoint:
+def locate(branch, index: int, block: str, k: int = 0) -> BranchPoint:
     """The branch point between points index and index + 1 (see module docstring)."""
     eq, params = branch.equilibrium, branch.params
     variation = SecondVariation(eq, branch.disc.degree)
@@ -77,7 +81,7 @@ def locate(branch, index: int, block: str) -> BranchPoint:
     def mu(s):
         result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s,
                         eq.scene.solver.tol, eq.scene.solver.max_newton)
-        value, mode = _lowest_eigenpair(variation, result.x[:-1], params.with_value("P", result.x[-1]), idx)
+        value, mode = _eigenpair(variation, result.x[:-1], params.with_value("P", result.x[-1]), idx, k)
         return value, result.x, mode
 
     lo, hi = 0.0, length

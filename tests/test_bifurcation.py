@@ -1,0 +1,90 @@
+"""Branch points, pear-shaped branches and isolas at M = 0 and with the paper's coils (MODEL.md §5)."""
+import numpy as np
+import pytest
+
+from balloon_cg.analysis import analyse
+from balloon_cg.materials import get_preset
+from balloon_cg.scene import load_scene, parse_scene
+from balloon_cg.sphere import sphere_pressure
+from balloon_cg.sphere_modes import bifurcation_stretches
+
+ISOLA = ["SPOM1", "SPOM2", "FPOM1", "FPOM2"]
+SINGLE = ["TPOM1", "TPOM2"]
+
+
+def scene_for(preset, stop=6.0):
+    return parse_scene(f'[material]\npreset = "{preset}"\n[continuation]\nstop_stretch = {stop}\n', name=preset)
+
+
+@pytest.fixture(scope="module", params=ISOLA + SINGLE)
+def picture(request):
+    return request.param, analyse(scene_for(request.param, stop=10.0 if request.param in ISOLA else 6.0))
+
+
+def pear_points(picture):
+    name, pic = picture
+    primary = pic.branches[0]
+    bps = [bp for bp in pic.branch_points if bp.block == "odd_held"]
+    return name, pic, primary, bps
+
+
+def test_pear_bifurcations_match_the_independent_sphere_condition(picture):
+    """Stretches to 1e-8 (relative) against the closed-form mode-1 condition of sphere_modes; P against the
+    exact sphere pressure."""
+    name, pic, primary, bps = pear_points(picture)
+    expected = bifurcation_stretches(get_preset(name), 1, lam_max=primary.pole_values()["lam2_north"].max())
+    found = np.array([primary.pole_values(bp.X)["lam2_north"][0] for bp in bps])
+    assert found.size == expected.size
+    np.testing.assert_allclose(found, expected, rtol=1e-8)
+    for bp, lam in zip(bps, found):
+        assert bp.X[-1] == pytest.approx(sphere_pressure(get_preset(name), lam), rel=1e-10)
+        assert bp.kind.startswith("pitchfork")
+
+
+def test_isola_or_single_pitchfork(picture):
+    """SPOM/FPOM: two pear branch points joined by a closed loop; TPOM: one, its branch leaves the range."""
+    name, pic, primary, bps = pear_points(picture)
+    pears = {b.name: b for b in pic.branches if b.name.startswith("pear")}
+    if name in ISOLA:
+        assert len(bps) == 2
+        assert set(pears) == {"pear_0", "pear_0_mirror"}
+        for branch in pears.values():
+            assert "rejoined the primary branch at branch point 1" in branch.stop_reason
+            assert branch.pressure[-1] == pytest.approx(bps[1].X[-1], rel=1e-2)
+    else:
+        assert len(bps) == 1
+        for branch in pears.values():
+            assert "rejoined" not in branch.stop_reason
+
+
+def test_mirror_branch_swaps_the_poles(picture):
+    _, pic, _, _ = pear_points(picture)
+    branches = {b.name: b for b in pic.branches}
+    pear, mirror = branches["pear_0"].pole_values(), branches["pear_0_mirror"].pole_values()
+    n = min(len(pear["lam2_north"]), len(mirror["lam2_north"]), 8)
+    np.testing.assert_allclose(mirror["lam2_north"][:n], pear["lam2_south"][:n], rtol=1e-6)
+    assert np.abs(pear["lam2_north"] - pear["lam2_south"]).max() > 0.5
+
+
+def test_every_point_has_stability(picture):
+    _, pic, _, _ = pear_points(picture)
+    for branch in pic.branches:
+        assert len(branch.stability) == len(branch.X)
+
+
+def test_tpom_bifurcation_pressure_decreases_with_alpha():
+    pressures = []
+    for name in SINGLE:
+        lam = bifurcation_stretches(get_preset(name), 1, lam_max=6.0)[0]
+        pressures.append(sphere_pressure(get_preset(name), lam))
+    assert get_preset("TPOM2").alpha[0] > get_preset("TPOM1").alpha[0]
+    assert pressures[1] < pressures[0]
+
+
+def test_two_coils_have_one_pear_branch_point_and_no_isola():
+    scene = load_scene(__file__.replace("tests/test_bifurcation.py", "scenes/spom1_two_coils_M0.002.toml"))
+    scene = scene.with_overrides({"solver.max_degree": 120, "solver.max_error": 1e-8})
+    pic = analyse(scene)
+    bps = [bp for bp in pic.branch_points if bp.block == "odd_held"]
+    assert len(bps) == 1
+    assert all("rejoined" not in b.stop_reason for b in pic.branches if b.name.startswith("pear"))
