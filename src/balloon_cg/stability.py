@@ -62,11 +62,22 @@ class SecondVariation:
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):
-        Hb, Gb = H[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)]
-        if constraint is not None:
+        """Lowest generalized eigenvalues of (H, G) on the block ``idx`` (optionally with gᵀδ = 0)."""
+        Hb = H[np.ix_(idx, idx)]
+        if constraint is None:
+            inverse = self._inverse_cholesky(tuple(idx))
+        else:
             Z = scipy.linalg.null_space(constraint[idx][None, :])
-            Hb, Gb = Z.T @ Hb @ Z, Z.T @ Gb @ Z
-        return scipy.linalg.eigh(Hb, Gb, eigvals_only=True, subset_by_index=[0, min(LOWEST, len(Hb)) - 1])
+            Hb = Z.T @ Hb @ Z
+            inverse = np.linalg.inv(np.linalg.cholesky(Z.T @ self.gram[np.ix_(idx, idx)] @ Z))
+        return np.linalg.eigvalsh(inverse @ Hb @ inverse.T)[:LOWEST]
+
+    def _inverse_cholesky(self, idx: tuple):
+        """L⁻¹ with G_block = L Lᵀ (the Gram blocks do not change along a branch: cached)."""
+        cache = self.__dict__.setdefault("_cholesky", {})
+        if idx not in cache:
+            cache[idx] = np.linalg.inv(np.linalg.cholesky(self.gram[np.ix_(idx, idx)]))
+        return cache[idx]
 
     def assess(self, u, params: Parameters, symmetric: bool) -> Assessment:
         H, g = self.matrices(u, params)
@@ -100,8 +111,14 @@ class SecondVariation:
         return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0)
 
 
-def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degree: int | None = None):
-    """Assessments of every point (and, with ``check_degree``, the points whose flags change at that degree)."""
+def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degree: int | None = None,
+                  near_zero: float = 0.1):
+    """Assessments of every point and, with ``check_degree``, the points whose flags change at that degree.
+
+    The check is made where a sign could change: points with a lowest eigenvalue of magnitude below
+    ``near_zero`` (eigenvalues are O(1) in the L2 normalisation), points next to a change of a flag, and every
+    tenth point.
+    """
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     variation = SecondVariation(branch.equilibrium, degree)
     params = branch.params
@@ -109,9 +126,14 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degr
     unsettled = []
     if check_degree:
         finer = SecondVariation(branch.equilibrium, check_degree)
+        flags = [_flags(a) for a in results]
         for n, (X, coarse) in enumerate(zip(branch.X, results)):
+            changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])
+            small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
+            if not (changes or small or n % 10 == 0):
+                continue
             fine = finer.assess(X[:-1], params.with_value("P", X[-1]), symmetric)
-            if _flags(fine) != _flags(coarse):
+            if _flags(fine) != flags[n]:
                 unsettled.append(n)
     return results, unsettled
 
