@@ -288,7 +288,7 @@ def _point_legend(fig, handles):
 
 def _theta_axes(branches, ylabels, height=5.0):
     fig = Figure(figsize=(7.5, height), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(len(ylabels), 1, sharex=True, squeeze=False)[:, 0])
+    axes = fig.subplots(len(ylabels), 1, sharex=True, squeeze=False)[:, 0]
     for ax, label in zip(axes, ylabels):
         ax.set_ylabel(label)
         ax.axhline(0.0, color="0.6", linewidth=0.6)
