@@ -17,8 +17,8 @@ preset = "SPOM1"
 start_stretch = 1.01
 min_stretch = 1.001
 stop_stretch = 5.0
-step = 0.01
-step_max = 0.02
+step = 0.02
+step_max = 0.035
 """
 
 CHILD = """

@@ -46,9 +46,11 @@ class Equilibrium:
             field_squared_nodes(lam2 * sin_theta, eta, self.coils, field)
         return field
 
-    def pointwise(self, kernel: str, geometry: tuple, state: tuple, params: Parameters, rows: int) -> np.ndarray:
+    def pointwise(self, kernel: str, geometry: tuple, state: tuple, params: Parameters, rows: int,
+                  field=None) -> np.ndarray:
         """A generated kernel at nodes with (cos θ, sin θ) = geometry and (λ2, v, η, w) = state."""
-        field = self._field(state[0], geometry[1], state[2])
+        if field is None:
+            field = self._field(state[0], geometry[1], state[2])
         out = self.kernels.nodes(kernel, geometry, state, self.kernels.params(params.P, params.M, params.chi),
                                  field, rows)
         if not np.all(np.isfinite(out)):
@@ -56,7 +58,12 @@ class Equilibrium:
         return out
 
     def _pointwise(self, kernel, u, params: Parameters, rows):
-        return self.pointwise(kernel, self.geometry, tuple(self.disc.node_state(u)), params, rows)
+        """Kernel at the own nodes; the state and field of the last u are reused (Newton asks for R, then J)."""
+        last = getattr(self, "_last", None)
+        if last is None or not np.array_equal(last[0], u):
+            state = tuple(self.disc.node_state(u))
+            last = self._last = (np.array(u), state, self._field(state[0], self.disc.sin_theta, state[2]))
+        return self.pointwise(kernel, self.geometry, last[1], params, rows, last[2])
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
