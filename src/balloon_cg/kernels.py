@@ -30,11 +30,24 @@ def class_name(alpha, has_field: bool) -> str:
 
 
 class KernelSet:
-    """The kernels of one scene: module, packed material parameters and the call conventions."""
+    """The kernels of one scene: module, packed material parameters and the call conventions.
 
-    def __init__(self, material, has_field: bool):
+    ``kernel_class`` forces a generated class by name (benchmarks: the general class on a preset material);
+    it must be the general class or one whose exponents match the material, and a field class when
+    ``has_field``.
+    """
+
+    def __init__(self, material, has_field: bool, kernel_class: str | None = None):
         self.has_field = has_field
-        self.name = class_name(material.alpha, has_field)
+        self.name = class_name(material.alpha, has_field) if kernel_class is None else kernel_class
+        if kernel_class is not None:
+            if kernel_class not in generated.CLASSES:
+                known = ", ".join(generated.CLASSES)
+                raise SceneError(f"kernel class {kernel_class!r}: not generated; known: {known}")
+            alphas, field = generated.CLASSES[kernel_class]
+            if (has_field and not field) or (alphas is not None and class_name(material.alpha, field) != kernel_class):
+                raise SceneError(f"kernel class {kernel_class!r} does not fit material exponents "
+                                 f"{tuple(material.alpha)} (field {has_field})")
         self.module = importlib.import_module(f"{generated.__name__}.{self.name}")
         self.general = generated.CLASSES[self.name][0] is None
         if self.general:
