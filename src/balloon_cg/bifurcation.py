@@ -13,6 +13,7 @@ Branch switching: from u* + δφ, corrected on the hyperplane normal to φ, then
 (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch point)
 or a stop rule applies.
 """
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -160,6 +161,7 @@ def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
 
 def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, delta: float = 1e-3):
     """The bifurcating branch leaving ``bp`` along ±φ, in the general space, until it rejoins or stops."""
+    t0 = time.perf_counter()
     scene = branch.equilibrium.scene
     tracer = general_tracer(scene)
     degree = branch.disc.degree
@@ -190,7 +192,7 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
             return f"south pole stretch reached stop_stretch {scene.continuation.stop_stretch:g}"
         return base(disc, point)
 
-    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree))
+    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0)
 
 
 def _prolong_to(coarse: Discretisation, u, fine: Discretisation):

@@ -244,7 +244,7 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
     return assemble(tracer, params, "primary", up, below, t0, land_on=upper, labels=("up", "down"))
 
 
-def assemble(tracer, params, name, forward, backward=None, t0=None, land_on=None,
+def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
              labels=("forward", "backward")) -> Branch:
     """One Branch from the legs of a trace: reversed ``backward`` (without its first point), then ``forward``.
 
@@ -298,7 +298,7 @@ def assemble(tracer, params, name, forward, backward=None, t0=None, land_on=None
         degree=np.array([p[2] for p in points]),
         special=special,
         stop_reason=stop_reason,
-        wall_time=time.perf_counter() - (t0 or time.perf_counter()),
+        wall_time=time.perf_counter() - t0,
     )
 
 

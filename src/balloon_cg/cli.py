@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from .analysis import analyse
 from .branch import ContinuationError, trace_primary
 from .field import FieldError
 from .plotting import KINDS, PlotError, plot as draw_plot
@@ -73,29 +74,39 @@ def _add_run(commands):
     p.add_argument("-o", "--output", required=True, help="run file to write (HDF5)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--primary-only", action="store_true",
+                   help="trace the primary branch only (no stability, branch points or pear branches)")
     p.set_defaults(handler=run)
 
 
 def run(args) -> int:
     """Trace, write, read back and summarise."""
     scene = load_scene(args.scene)
-    run_scene(scene, args.output, args.force, progress=not args.quiet, command=args.command_line)
+    run_scene(scene, args.output, args.force, progress=not args.quiet, command=args.command_line,
+              primary_only=args.primary_only)
     if not args.quiet:
         print(format_run(read_run(args.output)))
     return 0
 
 
-def run_scene(scene, out_path, force: bool = False, progress: bool = False, command: str | None = None) -> Path:
-    """Trace the primary branch of ``scene`` and write it to the run file ``out_path``; returns the path.
+def run_scene(scene, out_path, force: bool = False, progress: bool = False, command: str | None = None,
+              primary_only: bool = False) -> Path:
+    """Analyse ``scene`` (primary branch, stability, branch points, pear branches, snap-throughs; or only the
+    primary branch) and write the run file ``out_path``; returns the path.
 
     The output is checked before the trace (which may take long); ``progress`` shows a bar on stderr;
     ``command`` overrides the provenance attribute (default: sys.argv).
     """
     check_output(out_path, force)
     with tqdm(desc=scene.name, unit=" points", disable=not progress, file=sys.stderr) as bar:
-        branch = trace_primary(scene, progress=lambda point: bar.update())
+        tick = lambda point: bar.update()  # noqa: E731
+        if primary_only:
+            branches, snaps = [trace_primary(scene, progress=tick)], None
+        else:
+            picture = analyse(scene, progress=tick)
+            branches, snaps = picture.branches, picture.snaps
     extra = {} if command is None else {"command": command}
-    return write_run(out_path, scene, [branch], force=force, extra_attrs=extra)
+    return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps)
 
 
 # --- solve -------------------------------------------------------------------------------------------------
@@ -206,6 +217,7 @@ def summarise_run(run: dict) -> dict:
         "scene_name": run["scene_name"],
         "provenance": run["attrs"],
         "branches": {name: summarise_branch(b) for name, b in run["branches"].items()},
+        "snap_throughs": run.get("snap_throughs", []),
     }
 
 
@@ -229,6 +241,8 @@ def summarise_branch(b: dict) -> dict:
         "kernel_class": attrs["kernel_class"],
         "M": float(attrs["M"]),
         "chi": float(attrs["chi"]),
+        "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
+        "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
 
 
@@ -250,6 +264,9 @@ def format_run(run: dict) -> str:
     ]
     for name, b in summary["branches"].items():
         lines += ["", *_format_branch(name, b)]
+    for s in summary["snap_throughs"]:
+        target = f"{s['to_branch']} point {s['to_index']}" if s["to_branch"] else "no stable state on the traced branches"
+        lines.append(f"snap-through at P = {s['pressure']:.10g}: {s['from_branch']} point {s['from_index']} -> {target}")
     return "\n".join(lines)
 
 
@@ -267,6 +284,7 @@ def _format_branch(name: str, b: dict) -> list[str]:
         f"  wall time            {b['wall_time']:.3f} s",
         f"  error estimate vs run time: {b['max_error_estimate']:.3e} max, "
         f"{1e3 * b['wall_time_per_point']:.2f} ms per point",
+        f"  stable points        {b['stable_points'] or 'not assessed'}",
         f"  special points       {len(b['special_points']) or 'none'}",
     ]
     for s in b["special_points"]:

@@ -65,8 +65,9 @@ def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | No
         with h5py.File(tmp, "x") as f:
             f.attrs.update(attrs)
             group = f.create_group("branches")
-            for branch in branches:
+            for order, branch in enumerate(branches):
                 _write_branch(group.create_group(branch.name), branch, theta_grid(scene.output.theta_points))
+                group[branch.name].attrs["order"] = order
             if snaps is not None:
                 _write_snaps(f.create_group("snap_throughs"), snaps)
         os.replace(tmp, path)
@@ -222,7 +223,8 @@ def read_run(path) -> dict:
                 "path": str(path),
                 "scene_name": attrs["scene_name"],
                 "attrs": attrs,
-                "branches": {name: _read_branch(group) for name, group in f["branches"].items()},
+                "branches": {name: _read_branch(f["branches"][name]) for name in _branch_order(f["branches"])},
+                "snap_throughs": _read_snaps(f.get("snap_throughs")),
             }
         except KeyError as e:
             raise RunFileError(f"{path}: damaged balloon-cg run file (missing {e})") from None
@@ -241,7 +243,22 @@ def _read_branch(group) -> dict:
     }
     data["special_points"] = [{k: _plain(v[i]) for k, v in columns.items()} for i in range(sp["kind"].shape[0])]
     data["special_unknowns"] = sp["unknowns"][()]
+    if "stability" in group:
+        data["stability"] = {name: item[()] for name, item in group["stability"].items()}
     return data
+
+
+def _branch_order(group) -> list:
+    """Branch names in the order they were written (the primary branch first)."""
+    return sorted(group, key=lambda name: group[name].attrs.get("order", 0))
+
+
+def _read_snaps(group) -> list:
+    if group is None:
+        return []
+    columns = {k: (group[k].asstr()[()] if k.endswith("branch") else group[k][()]) for k in group}
+    n = len(columns.get("pressure", []))
+    return [{k: _plain(v[i]) for k, v in columns.items()} for i in range(n)]
 
 
 def _plain(value):
