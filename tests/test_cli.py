@@ -50,7 +50,11 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert summary["provenance"]["command"] == f"balloon-cg run {scene_file} -o {out}"
     assert summary["provenance"]["format"] == "balloon-cg/1"
     branch = summary["branches"]["primary"]
-    assert [s["kind"] for s in branch["special_points"]] == ["EP", "LP", "EP"]
+    # SPOM1 up to stretch 2: the fold in P and the first pear pitchfork (λ = 1.6799), its pear branches
+    assert [s["kind"] for s in branch["special_points"]] == ["EP", "LP", "pitchfork-super", "EP"]
+    assert {"pear_0", "pear_0_mirror"} <= set(summary["branches"])
+    assert summary["branches"]["pear_0"]["parent"] == ["primary", 0]
+    assert summary["snap_throughs"][0]["from_branch"] == "primary"
     assert branch["lam2_north"][1] == pytest.approx(2.0, abs=1e-12)
     assert branch["max_residual"] < 1e-10 and branch["max_error_estimate"] < 1e-10
     assert branch["points"] > 10 and branch["wall_time"] > 0

@@ -43,11 +43,15 @@ def bifurcation_file(files, tmp_path_factory):
     with h5py.File(path, "r+") as f:
         group = f["branches/primary"]
         n = group["pressure"].shape[0]
+        if "stability" in group:
+            del group["stability"]
         group.create_dataset("stability/stable_pressure", data=np.arange(n) < n // 2)
         special = group["special_points"]
         special["kind"][1] = "pitchfork-super"
         for name, value in (("E2", -0.02), ("E3", 0.0), ("E4", 0.5)):
             special[name][1] = value
+        for name in [b for b in f["branches"] if b != "primary"]:
+            del f["branches"][name]
         f.copy(group, "branches/pear_0")
     return path
 
@@ -106,7 +110,7 @@ def test_several_files_are_labelled_by_M(files):
     fig = plot(list(files.values()), "pressure-pole")
     legend = fig.legends[0]
     assert [t.get_text() for t in legend.get_texts()] == ["M = 0", "M = 0.002"]
-    assert "stability not computed" in legend.get_title().get_text()
+    assert "dashed: unstable" in legend.get_title().get_text()  # the default run assesses stability
     assert {t.get_text() for t in fig.axes[0].texts} >= {"EP"}  # special points labelled with their kind
     shapes = plot(list(files.values()), "shapes", points=[-1])
     assert any(text.startswith("M = 0.002: #") for text in legend_texts(shapes))
