@@ -1,0 +1,374 @@
+"""Work–precision: error of P at fixed north pole stretches against the wall time of one point solve.
+
+For each scene and each target pole stretch λ*, and for a range of Legendre degrees (fixed: no adaptivity) and
+Newton tolerances, one point is solved by the pole-stretch-constrained Newton (R(u; P) = 0, λ2(0) = λ*, the
+same bordered Newton ``branch._land`` uses), warm-started from the converged neighbour at λ* − H on the same
+discretisation: what one continuation step costs, without the step control. Only that Newton call is timed
+(best of REPEAT, repeats interleaved over all settings so that load from other processes hits them alike);
+building the discretisation (once per degree on a branch) is not. Two clocks: process CPU time (the plotted
+and compared one) and wall time. BLAS/LAPACK run single-threaded (OPENBLAS_NUM_THREADS=1, set here) for every
+method: on a shared 2-core machine with a load average of ~7, a solve of a few ms is preempted in most
+repeats, so wall times of ms-scale solves mostly measure the scheduler; the CPU time of a single-threaded
+process does not.
+
+References: SPOM1 M = 0: the exact sphere pressure. Two coils and the single equatorial coil (both
+equator-symmetric): ``shooting.shoot_symmetric`` at rtol = atol = 1e-13 (DOP853 on the first-order system, an
+independent discretisation), cross-checked against shooting started at the pole and against the Galerkin
+solution at the finest degree the adaptive trace used.
+
+Run: python benchmarks/work_precision.py   (writes benchmarks/results/work_precision.{txt,png})
+"""
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")  # single-threaded BLAS/LAPACK for every method (set before numpy loads)
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "benchmarks" / "results"
+
+SPOM1_M0 = """
+[material]
+preset = "SPOM1"
+[continuation]
+stop_stretch = 5.0
+"""
+DEGREES = (8, 12, 16, 24, 32, 48, 64, 96, 128, 192)
+TOLS = (1e-6, 1e-9, 1e-12)
+H = 0.02  # pole stretch distance of the warm-start neighbour
+REPEAT = 5
+
+
+@dataclass
+class Case:
+    label: str
+    scene: object
+    stretches: tuple
+    reference: str  # "sphere" or "shooting"
+
+
+def cases():
+    from balloon_cg.scene import load_scene, parse_scene
+
+    return [
+        Case("SPOM1, M = 0", parse_scene(SPOM1_M0, name="spom1"), (1.3, 1.5, 2.0, 3.0), "sphere"),
+        Case("SPOM1, two coils, M = 0.002", load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml"),
+             (1.3, 1.5, 1.7, 1.8), "shooting"),
+        Case("SPOM1, single coil, M = 0.002", load_scene(ROOT / "scenes" / "spom1_single_coil.toml"),
+             (1.3, 1.5, 2.0, 3.0), "shooting"),
+    ]
+
+
+class PointSolver:
+    """The pole-stretch-constrained Newton of one scene on fixed-degree discretisations (as PrimaryTracer)."""
+
+    def __init__(self, scene, params):
+        self.scene, self.params = scene, params
+        self.symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
+        held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
+        self.pin = (not scene.field.coils) or held
+        self._eq = {}
+
+    def equilibrium(self, degree):
+        from balloon_cg.discretisation import Discretisation
+        from balloon_cg.equilibrium import Equilibrium
+
+        if degree not in self._eq:
+            self._eq[degree] = Equilibrium(self.scene, Discretisation(degree, self.symmetric, self.pin))
+        return self._eq[degree]
+
+    def functions(self, eq):
+        params = self.params
+
+        def residual(X):
+            return eq.residual(X[:-1], params.with_value("P", X[-1]))
+
+        def jacobian(X):
+            p = params.with_value("P", X[-1])
+            return np.hstack([eq.jacobian(X[:-1], p), eq.parameter_derivative(X[:-1], p, "P")[:, None]])
+
+        return residual, jacobian
+
+    def convert(self, X, source, degree):
+        """X (u, P) from discretisation ``source`` to ``degree`` (truncating or padding Legendre coefficients)."""
+        disc = self.equilibrium(degree).disc
+        a, b = source.split(X[:-1])
+        n = min(source.degree, degree) + 1
+        a2, b2 = np.zeros(degree + 1), np.zeros(degree + 1)
+        a2[:n], b2[:n] = a[:n], b[:n]
+        return np.append(disc.join(a2, b2), X[-1])
+
+    def solve(self, degree, X0, stretch, tol, max_newton=None):
+        """Constrained Newton at ``degree`` from X0 (already on that degree): (NewtonResult, CPU seconds);
+        the wall time of the same call is left in ``self.last_wall``."""
+        from balloon_cg.newton import newton
+
+        eq = self.equilibrium(degree)
+        residual, jacobian = self.functions(eq)
+        row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
+        t0, c0 = time.perf_counter(), time.process_time()
+        result = newton(residual, jacobian, X0, row, stretch, tol, max_newton or self.scene.solver.max_newton)
+        self.last_wall = time.perf_counter() - t0
+        return result, time.process_time() - c0
+
+
+@dataclass
+class Target:
+    """One target pole stretch: fine solutions there and at λ* − H, the reference P and how it was obtained."""
+
+    stretch: float
+    fine_degree: int
+    X_fine: np.ndarray
+    X_neighbour_fine: np.ndarray
+    P_ref: float
+    eta0: float
+    note: str = ""
+    checks: dict = field(default_factory=dict)
+
+
+def prepare(case: Case):
+    """Trace the primary branch (adaptive degree) to the largest target; fine solutions at every λ* and λ* − H."""
+    from balloon_cg.branch import trace_primary
+    from balloon_cg.shooting import shoot_symmetric
+    from balloon_cg.sphere import sphere_pressure
+
+    top = max(case.stretches)
+    branch = trace_primary(case.scene, stop_stretch=top, down=False)
+    solver = PointSolver(case.scene, branch.params)
+    disc = branch.disc
+    lam = branch.pole_values()["lam2_north"]
+    eta_row = disc.pole_rows()["eta_north"]
+    targets = []
+    for s in case.stretches:
+        if s > lam.max() + 1e-12:
+            targets.append(None)
+            continue
+        out = []
+        for goal in (s - H, s):
+            i = max(int(np.searchsorted(lam, goal)) - 1, 0)  # last branch point below the goal (first crossing)
+            X = solver.convert(branch.X[i], disc, disc.degree)
+            result, _ = solver.solve(disc.degree, X, goal, 1e-13)
+            if not result.converged:
+                raise RuntimeError(f"{case.label}: fine solve at λ = {goal} failed: {result.message}")
+            out.append(result.x)
+        X_nb, X_fine = out
+        P_gal, eta0 = X_fine[-1], float(eta_row @ X_fine[:-1])
+        checks = {f"Galerkin degree {disc.degree}": P_gal}
+        if case.reference == "sphere":
+            P_ref, note = sphere_pressure(case.scene.material, s), "exact sphere"
+        else:
+            shot = shoot_symmetric(case.scene, s, P_gal, eta0)
+            pole = shoot_symmetric(case.scene, s, P_gal, eta0, start="pole")
+            if not (shot.converged and pole.converged):
+                raise RuntimeError(f"{case.label}: shooting at λ = {s} failed: {shot.message} / {pole.message}")
+            P_ref, note = shot.P, "shooting (Taylor start, rtol 1e-13)"
+            checks["shooting from the pole"] = pole.P
+        targets.append(Target(s, disc.degree, X_fine, X_nb, P_ref, eta0, note, checks))
+    return branch, solver, targets
+
+
+def neighbour(solver, target: Target, degree: int, source_disc):
+    """The converged point at λ* − H on ``degree`` (untimed), or None."""
+    X = solver.convert(target.X_neighbour_fine, source_disc, degree)
+    result, _ = solver.solve(degree, X, target.stretch - H, 1e-13)
+    return result.x if result.converged else None
+
+
+def sweep(case, branch, solver, targets, degrees=DEGREES, tols=TOLS, repeat=REPEAT):
+    """rows: dict per (stretch, degree, tol) with error, best time, iterations, residual, tail."""
+    starts = {}
+    for t in targets:
+        if t is None:
+            continue
+        for d in degrees:
+            starts[(t.stretch, d)] = neighbour(solver, t, d, branch.disc)
+    rows = {}
+    for _ in range(repeat):
+        for t in targets:
+            if t is None:
+                continue
+            for d in degrees:
+                X0 = starts[(t.stretch, d)]
+                for tol in tols:
+                    key = (t.stretch, d, tol)
+                    if X0 is None:
+                        rows[key] = dict(converged=False, message="no neighbour at λ* − H", time=np.nan)
+                        continue
+                    result, seconds = solver.solve(d, X0, t.stretch, tol)
+                    row = rows.setdefault(key, dict(time=np.inf, wall=np.inf))
+                    row["time"] = min(row["time"], seconds)
+                    row["wall"] = min(row["wall"], solver.last_wall)
+                    row.update(converged=result.converged, message=result.message, iterations=result.iterations,
+                               residual=result.residual, P=result.x[-1],
+                               error=abs(result.x[-1] / t.P_ref - 1) if result.converged else np.nan,
+                               tail=solver.equilibrium(d).disc.tail(result.x[:-1]))
+    return rows
+
+
+def bifurcation_hook(case: Case):
+    """(b) the bifurcation pressure: uses balloon_cg.stability / balloon_cg.bifurcation when they exist.
+
+    Returns a line for the report. The error of the bifurcation pressure against degree is the natural
+    extension of this table once the detection is in place (a located branch point per degree).
+    """
+    try:
+        from balloon_cg import bifurcation, stability  # noqa: F401
+    except ImportError as error:
+        return f"(b) bifurcation pressure: not available ({error})"
+    return bifurcation_rows(case, stability, bifurcation)
+
+
+def bifurcation_rows(case, stability, bifurcation):
+    """First detected branch point of the primary branch traced at fixed Legendre degrees (adaptivity off):
+    its pressure per degree, against the finest, and the wall time of trace + detection + location.
+
+    ``bifurcation.locate`` takes the eigenvalue with the branch's own discretisation, so the primary branch
+    degree is the resolution parameter here; the stability basis degree N = 20 only serves detection.
+    """
+    from balloon_cg.branch import trace_primary
+
+    try:
+        found_P = {}
+        lines = []
+        for degree in (16, 24, 40, 64):
+            scene = case.scene.with_overrides({"solver.degree": degree, "solver.max_degree": degree,
+                                               "solver.max_error": 1e-2})
+            t0 = time.perf_counter()
+            branch = trace_primary(scene, stop_stretch=min(max(case.stretches), 3.0), down=False)
+            assessments, _ = stability.assess_branch(branch, 20)
+            events = bifurcation.detect(branch, assessments)
+            if not events:
+                lines.append(f"degree {degree}: none detected")
+                continue
+            bp = bifurcation.locate(branch, *events[0])
+            found_P[degree] = bp.X[-1]
+            lines.append(f"degree {degree}: P_b = {bp.X[-1]:.12f} ({events[0][1]}, {time.perf_counter() - t0:.1f} s)")
+        if len(found_P) > 1:
+            best = found_P[max(found_P)]
+            lines.append("relative to degree {}: {}".format(max(found_P), ", ".join(
+                f"{d}: {abs(P / best - 1):.1e}" for d, P in found_P.items() if d != max(found_P))))
+        return "(b) bifurcation pressure (balloon_cg.bifurcation, first branch point, N = 20): " + "; ".join(lines)
+    except Exception as error:  # the API is someone else's work in progress: report, don't fail
+        return f"(b) bifurcation pressure: hook failed ({type(error).__name__}: {error})"
+
+
+def format_case(case, branch, targets, rows, degrees=DEGREES, tols=TOLS):
+    lines = [f"== {case.label}: reference {targets[0].note if targets[0] else '-'}; branch traced to "
+             f"λ = {branch.pole_values()['lam2_north'].max():.4g} (adaptive degree up to {branch.disc.degree})"]
+    for t in targets:
+        if t is None:
+            continue
+        checks = ", ".join(f"{k}: {v / t.P_ref - 1:+.1e}" for k, v in t.checks.items())
+        lines.append(f"  λ* = {t.stretch}: P_ref = {t.P_ref:.15g}   cross-checks (relative): {checks}")
+    header = f"  {'λ*':>5} {'degree':>6} " + " ".join(f"{'tol ' + format(tol, '.0e'):>31}" for tol in tols)
+    lines += [header, f"  {'':>5} {'':>6} " + " ".join(f"{'rel. error  cpu ms wall ms its':>31}" for _ in tols)]
+    for t in targets:
+        if t is None:
+            continue
+        for d in degrees:
+            cells = []
+            for tol in tols:
+                r = rows[(t.stretch, d, tol)]
+                if not r.get("converged"):
+                    cells.append(f"{'failed: ' + r['message'][:22]:>31}")
+                else:
+                    cells.append(f"{r['error']:10.1e} {r['time'] * 1e3:7.2f} {r['wall'] * 1e3:7.2f} "
+                                 f"{r['iterations']:3d}")
+            lines.append(f"  {t.stretch:5.2f} {d:6d} " + " ".join(f"{c:>31}" for c in cells))
+    return lines
+
+
+def cheapest(rows, stretch, level, degrees=DEGREES, tols=TOLS):
+    """The fastest (degree, tol, time, error) with error ≤ level at ``stretch``, or None."""
+    good = [(r["time"], d, tol, r["error"]) for (s, d, tol), r in rows.items()
+            if s == stretch and r.get("converged") and r["error"] <= level]
+    if not good:
+        return None
+    t, d, tol, e = min(good)
+    return d, tol, t, e
+
+
+def plot(results, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(results), figsize=(5.2 * len(results), 4.4), sharey=True)
+    markers = {TOLS[0]: "s", TOLS[1]: "^", TOLS[2]: "o"}
+    for ax, (case, branch, targets, rows) in zip(np.atleast_1d(axes), results):
+        for k, t in enumerate(x for x in targets if x is not None):
+            color = f"C{k}"
+            for tol in TOLS:
+                pts = [(rows[(t.stretch, d, tol)]["time"] * 1e3, max(rows[(t.stretch, d, tol)]["error"], 1e-16))
+                       for d in DEGREES if rows[(t.stretch, d, tol)].get("converged")]
+                if not pts:
+                    continue
+                x, y = zip(*pts)
+                ax.loglog(x, y, marker=markers[tol], color=color, ls="-" if tol == TOLS[-1] else "none",
+                          mfc="none" if tol != TOLS[-1] else color, ms=5, lw=1,
+                          label=f"λ* = {t.stretch}" if tol == TOLS[-1] else None)
+        ax.axhline(1e-8, color="0.6", lw=0.8, ls="--")
+        ax.set_title(case.label, fontsize=10)
+        ax.set_xlabel("CPU time per point solve [ms] (single-threaded)")
+        ax.grid(True, which="major", alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
+    np.atleast_1d(axes)[0].set_ylabel("|P / P_ref − 1|  (floored at 1e-16)")
+    fig.suptitle("Work–precision: constrained Newton from the neighbour at λ* − 0.02, degrees "
+                 f"{DEGREES[0]}–{DEGREES[-1]}; ● tol 1e-12 (lines, by degree), ▲ 1e-9, ■ 1e-6", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+
+
+def main():
+    results, lines = [], []
+    t_start = time.perf_counter()
+    for case in cases():
+        t0 = time.perf_counter()
+        branch, solver, targets = prepare(case)
+        rows = sweep(case, branch, solver, targets)
+        results.append((case, branch, targets, rows))
+        block = format_case(case, branch, targets, rows)
+        block.append("  cheapest setting per λ* with error ≤ 1e-8 / ≤ 1e-11:")
+        for t in targets:
+            if t is None:
+                continue
+            parts = []
+            for level in (1e-8, 1e-11):
+                best = cheapest(rows, t.stretch, level)
+                parts.append("none" if best is None else
+                             f"degree {best[0]}, tol {best[1]:.0e}: {best[2] * 1e3:.2f} ms CPU (error {best[3]:.1e})")
+            lines_ = f"    λ* = {t.stretch}: {parts[0]}  |  {parts[1]}"
+            block.append(lines_)
+        missing = [s for s, t in zip(case.stretches, targets) if t is None]
+        if missing:
+            block.append(f"  not reached by the branch: λ* = {missing} ({branch.stop_reason})")
+        block.append("  " + bifurcation_hook(case))
+        block.append(f"  (case wall time {time.perf_counter() - t0:.0f} s)")
+        print("\n".join(block), flush=True)
+        lines += block + [""]
+    head = [
+        "Work–precision of the primary branch solver: P at fixed north pole stretch λ*",
+        "time = one pole-stretch-constrained Newton solve from the converged neighbour at λ* − 0.02 on the same",
+        f"fixed-degree discretisation (best of {REPEAT}, interleaved): process CPU time and wall time, BLAS single-",
+        "threaded (shared 2-core machine under load: the CPU time is the reliable one, see the module docstring);",
+        "error = |P/P_ref − 1|; its = Newton iterations.",
+        "Symmetric (equator) subspace in all three scenes: about degree + 1 unknowns.",
+        "",
+    ]
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / "work_precision.txt").write_text("\n".join(head + lines) +
+                                                f"\ntotal wall time {time.perf_counter() - t_start:.0f} s\n")
+    plot(results, RESULTS / "work_precision.png")
+    print(f"wrote {RESULTS / 'work_precision.txt'} and work_precision.png")
+    return results
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT / "src"))
+    main()
