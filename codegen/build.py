@@ -4,6 +4,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from . import equations, poles
+from . import second_variation
 from .classes import scene_classes
 from .emit import module_text
 from .functional import GENERAL_TERMS, SceneClass
@@ -15,6 +16,8 @@ GENERATOR = "codegen/build.py"
 def class_module(cls: SceneClass) -> str:
     """Module text of one scene class: Galerkin energy kernels, first-order system, pole series."""
     kernels = equations.energy_kernels(cls) + equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
+    # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient (codegen/second_variation.py)
+    kernels += second_variation.second_variation_kernels(cls)
     title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
     return module_text(title, cls.inputs(), [lower(k) for k in kernels], GENERATOR)
 

@@ -8,9 +8,9 @@ import math
 
 from numba import njit
 
-SIGNATURE = "0610a17c502e2ef641555ddb9821e706eef5c033c2a6895cc0ef61dcda2086c8"
+SIGNATURE = "e6c84c4cb7bcc5da4c63a437f92cde1563f73f076c1740a73f61d236323f99b9"
 INPUTS = [('alphas', ('1.73', '-2')), ('class', 'ogden_fpom2_field'), ('field', True)]
-KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series')
+KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series', 'azimuthal_hessian', 'shear_coefficient')
 
 
 @njit(cache=True, inline='always')
@@ -810,3 +810,132 @@ def pole_series(lam0, P, M, chi, mu, pole_field):
     t27 = (t26*t26)
     t28 = 3.0*t27
     return (t23*(-t11*t8 - t15*(t1*t19 + t18 - t8) + t17 + t22*(-Q_rr_N*t20 - t21) + t6*t7), -t24*t5, t23*(-t11*t28 + t15*(-t18 + t19*t25 + t28) + t17 + t22*(-Q_rr_S*t20 - t21) + t27*t7), -t24*t26,)
+
+
+@njit(cache=True, inline='always')
+def azimuthal_hessian(cos_theta, sin_theta, lam2, v, eta, w, m, P, M, chi, mu, field):
+    """Second variation for perturbations cos(mφ), m ≥ 1 (MODEL.md §5): the 6×6 matrix h with d²E/dε² = ∫ yᵀ h y d(cos θ), y = (R, R', Z, Z', T, T'), R, Z the radial/axial displacement amplitudes (cos mφ), T the azimuthal one (sin mφ); upper triangle row by row (codegen/second_variation.py)."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    Q = field[0]
+    Q_r = field[1]
+    Q_z = field[2]
+    Q_rr = field[3]
+    Q_rz = field[4]
+    Q_zz = field[5]
+    lam1 = math.sqrt((w*w) + ((cos_theta*lam2 + v)*(cos_theta*lam2 + v)))
+    s1_0 = (lam2*lam2)
+    s1_1 = (1.0/(lam1*lam1*lam1*lam1))
+    s1_2 = (0.5)*mu1
+    s1_3 = lam1**(-3.73)
+    s1_4 = lam2**(-1.73)
+    s1_5 = (0.5780346820809249)*mu0
+    s1_6 = (lam1*lam1)
+    s1_7 = (1.0/(lam2*lam2*lam2*lam2))
+    s1_8 = lam1**(-1.73)
+    s1_9 = lam2**(-3.73)
+    s1_10 = (0.0025)*mu0
+    s1_11 = lam2**(-2.27)
+    s1_12 = (1.0/(lam2))
+    s1_13 = lam1 - lam2
+    s1_14 = (lam2 < 100.0*abs(s1_13))
+    s1_15 = math.log1p(((s1_12*s1_13) if s1_14 else (1.0)))
+    s1_16 = (0.5)*mu0*s1_11
+    s1_17 = lam1*s1_12 - 1.0
+    p1 = -s1_2*(s1_0 - s1_1) + s1_5*(-0.865*s1_3*s1_4 + (0.865)/lam1**(0.27))
+    p2 = -s1_2*(s1_6 - s1_7) + s1_5*(-0.865*s1_8*s1_9 + (0.865)/lam2**(0.27))
+    p11 = -mu1/(lam1*lam1*lam1*lam1*lam1*lam1) - s1_10*(27.0 - 373.0*s1_4/lam1**(3.46))/lam1**(2.27)
+    p12 = (0.4325)*mu0*s1_3*s1_9 - s1_2
+    p22 = -s1_10*s1_11*(27.0 - 373.0*s1_8/lam2**(3.46)) - mu1/(lam2*lam2*lam2*lam2*lam2*lam2)
+    K = (0.5)*mu0*s1_3*s1_9 + s1_1*s1_2*s1_7*(-s1_0 - s1_6) + s1_2 + ((s1_16*math.expm1(-0.27*s1_15)/math.expm1(2.0*s1_15)) if s1_14 else (s1_16*((0.153225)*lam1*s1_12 - 0.06651565775565164*(s1_17*s1_17*s1_17*s1_17*s1_17*s1_17*s1_17*s1_17) + (0.07353034992212003)*(s1_17*s1_17*s1_17*s1_17*s1_17*s1_17*s1_17) - 0.08230753293944569*(s1_17*s1_17*s1_17*s1_17*s1_17*s1_17) + (0.09335986158200625)*(s1_17*s1_17*s1_17*s1_17*s1_17) - 0.10716845839875*(s1_17*s1_17*s1_17*s1_17) + (0.123766216875)*(s1_17*s1_17*s1_17) - 0.14147775*(s1_17*s1_17) - 0.288225)))
+    t0 = (1.0/(sin_theta*sin_theta))
+    t1 = p2*t0
+    t2 = (0.25)*M*chi
+    t3 = (1.0/(sin_theta))
+    t4 = (0.3333333333333333)*P
+    t5 = t4*w
+    t6 = (m*m)
+    t7 = t1*t6
+    t8 = (lam2*lam2)
+    t9 = 2.0*t8
+    t10 = p22*t9
+    t11 = (v*v)
+    t12 = t0*t6
+    t13 = K*t12
+    t14 = cos_theta*lam2
+    t15 = t14*v
+    t16 = 2.0*t15
+    t17 = (cos_theta*cos_theta)
+    t18 = K*t8
+    t19 = t17*t18
+    t20 = (0.16666666666666666)*P
+    t21 = eta*t20
+    t22 = lam2*v
+    t23 = 2.0*p12
+    t24 = t3*(cos_theta*p12*t9 - t21 + t22*t23)
+    t25 = t13*w
+    t26 = t14 + v
+    t27 = t23*t3*w
+    t28 = p2*t3
+    t29 = t10*t3
+    t30 = K*t3
+    t31 = t11*t30 + t16*t30 + t19*t3 + t5
+    t32 = m*t3
+    t33 = t3*(K*t22 + cos_theta*t18 + t21)
+    t34 = 2.0*p11
+    t35 = (w*w)
+    t36 = t30*w
+    t37 = lam2*m
+    return (-Q_rr*t2 + t0*t10 + t1 + t11*t13 + t12*t19 + t13*t16 + t3*t5 + t7, t24, -Q_rz*t2 + t14*t25 - t20*t26*t3 + t25*v, lam2*(t27 + t4), t32*(2.0*t28 + t29 + t31), -m*t33, p1 + 4.0*p11*t15 + t11*t34 + t17*t34*t8, -lam2*t20, t26*t34*w, m*t24, 0.0, -Q_zz*t2 + t13*t35 + t7, 0.0, t32*(t14*t36 - t26*t4 + t36*v), t37*((0.16666666666666666)*P - t36), p1 + t34*t35, t37*(t20 + t27), 0.0, t3*(-Q_r*t2/lam2 + t28*t6 + t28 + t29*t6 + t31), -t33, p1 + t18,)
+
+
+@njit(cache=True)
+def azimuthal_hessian_nodes(cos_theta, sin_theta, lam2, v, eta, w, m, P, M, chi, mu, field, out):
+    """azimuthal_hessian at every node i; output k goes to out[k, i]."""
+    for i in range(cos_theta.shape[0]):
+        r = azimuthal_hessian(cos_theta[i], sin_theta[i], lam2[i], v[i], eta[i], w[i], m, P, M, chi, mu, field[:, i])
+        out[0, i] = r[0]
+        out[1, i] = r[1]
+        out[2, i] = r[2]
+        out[3, i] = r[3]
+        out[4, i] = r[4]
+        out[5, i] = r[5]
+        out[6, i] = r[6]
+        out[7, i] = r[7]
+        out[8, i] = r[8]
+        out[9, i] = r[9]
+        out[10, i] = r[10]
+        out[11, i] = r[11]
+        out[12, i] = r[12]
+        out[13, i] = r[13]
+        out[14, i] = r[14]
+        out[15, i] = r[15]
+        out[16, i] = r[16]
+        out[17, i] = r[17]
+        out[18, i] = r[18]
+        out[19, i] = r[19]
+        out[20, i] = r[20]
+
+
+@njit(cache=True, inline='always')
+def shear_coefficient(lam1, lam2, mu):
+    """K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12)."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    t0 = (0.5)*mu1
+    t1 = (0.5)*mu0
+    t2 = (1.0/(lam2))
+    t3 = lam1 - lam2
+    t4 = (lam2 < 100.0*abs(t3))
+    t5 = math.log1p(((t2*t3) if t4 else (1.0)))
+    t6 = t1/lam2**(2.27)
+    t7 = lam1*t2 - 1.0
+    return (t0 + ((t6*math.expm1(-0.27*t5)/math.expm1(2.0*t5)) if t4 else (t6*((0.153225)*lam1*t2 - 0.06651565775565164*(t7*t7*t7*t7*t7*t7*t7*t7) + (0.07353034992212003)*(t7*t7*t7*t7*t7*t7*t7) - 0.08230753293944569*(t7*t7*t7*t7*t7*t7) + (0.09335986158200625)*(t7*t7*t7*t7*t7) - 0.10716845839875*(t7*t7*t7*t7) + (0.123766216875)*(t7*t7*t7) - 0.14147775*(t7*t7) - 0.288225))) + t0*(-(lam1*lam1) - (lam2*lam2))/((lam1*lam1*lam1*lam1)*(lam2*lam2*lam2*lam2)) + t1/(lam1**(3.73)*lam2**(3.73)),)
+
+
+@njit(cache=True)
+def shear_coefficient_nodes(lam1, lam2, mu, out):
+    """shear_coefficient at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = shear_coefficient(lam1[i], lam2[i], mu)
+        out[0, i] = r[0]

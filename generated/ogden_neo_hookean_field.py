@@ -8,9 +8,9 @@ import math
 
 from numba import njit
 
-SIGNATURE = "84bc71a0479412bd76c6dbe29abbf789a0747d552ee9a7484472bfd0ae94d7a2"
+SIGNATURE = "66891e738761a4cddfd20d8e0193f4457d7e9e0788aad24eecb3b000b6662da4"
 INPUTS = [('alphas', ('2',)), ('class', 'ogden_neo_hookean_field'), ('field', True)]
-KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series')
+KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'field_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'rhs_field', 'pole_series', 'azimuthal_hessian', 'shear_coefficient')
 
 
 @njit(cache=True, inline='always')
@@ -601,3 +601,110 @@ def pole_series(lam0, P, M, chi, mu, pole_field):
     t26 = (t25*t25)
     t27 = 3.0*t26
     return (t22*(-t11*t8 + t15 + t18*(-Q_rr_N*t16 - t17) - t21*(t1*t20 + t19 - t8) + t5*t7), -t23*t4, t22*(-t11*t27 + t15 + t18*(-Q_rr_S*t16 - t17) + t21*(-t19 + t20*t24 + t27) + t26*t7), -t23*t25,)
+
+
+@njit(cache=True, inline='always')
+def azimuthal_hessian(cos_theta, sin_theta, lam2, v, eta, w, m, P, M, chi, mu, field):
+    """Second variation for perturbations cos(mφ), m ≥ 1 (MODEL.md §5): the 6×6 matrix h with d²E/dε² = ∫ yᵀ h y d(cos θ), y = (R, R', Z, Z', T, T'), R, Z the radial/axial displacement amplitudes (cos mφ), T the azimuthal one (sin mφ); upper triangle row by row (codegen/second_variation.py)."""
+    mu0 = mu[0]
+    Q = field[0]
+    Q_r = field[1]
+    Q_z = field[2]
+    Q_rr = field[3]
+    Q_rz = field[4]
+    Q_zz = field[5]
+    lam1 = math.sqrt((w*w) + ((cos_theta*lam2 + v)*(cos_theta*lam2 + v)))
+    s1_0 = (1.0/(lam1*lam1*lam1*lam1))
+    s1_1 = (1.0/(lam2*lam2))
+    s1_2 = (0.5)*mu0
+    s1_3 = (1.0/(lam1*lam1))
+    s1_4 = (1.0/(lam2*lam2*lam2*lam2))
+    s1_5 = s1_0*s1_2*s1_4
+    p1 = s1_2*(-s1_0*s1_1 + 1.0)
+    p2 = s1_2*(-s1_3*s1_4 + 1.0)
+    p11 = mu0*s1_1/(lam1*lam1*lam1*lam1*lam1*lam1)
+    p12 = s1_5
+    p22 = mu0*s1_3/(lam2*lam2*lam2*lam2*lam2*lam2)
+    K = s1_5
+    t0 = (1.0/(sin_theta*sin_theta))
+    t1 = p2*t0
+    t2 = (0.25)*M*chi
+    t3 = (1.0/(sin_theta))
+    t4 = (0.3333333333333333)*P
+    t5 = t4*w
+    t6 = (m*m)
+    t7 = t1*t6
+    t8 = (lam2*lam2)
+    t9 = 2.0*t8
+    t10 = p22*t9
+    t11 = (v*v)
+    t12 = t0*t6
+    t13 = K*t12
+    t14 = cos_theta*lam2
+    t15 = t14*v
+    t16 = 2.0*t15
+    t17 = (cos_theta*cos_theta)
+    t18 = K*t8
+    t19 = t17*t18
+    t20 = (0.16666666666666666)*P
+    t21 = eta*t20
+    t22 = lam2*v
+    t23 = 2.0*p12
+    t24 = t3*(cos_theta*p12*t9 - t21 + t22*t23)
+    t25 = t13*w
+    t26 = t14 + v
+    t27 = t23*t3*w
+    t28 = p2*t3
+    t29 = t10*t3
+    t30 = K*t3
+    t31 = t11*t30 + t16*t30 + t19*t3 + t5
+    t32 = m*t3
+    t33 = t3*(K*t22 + cos_theta*t18 + t21)
+    t34 = 2.0*p11
+    t35 = (w*w)
+    t36 = t30*w
+    t37 = lam2*m
+    return (-Q_rr*t2 + t0*t10 + t1 + t11*t13 + t12*t19 + t13*t16 + t3*t5 + t7, t24, -Q_rz*t2 + t14*t25 - t20*t26*t3 + t25*v, lam2*(t27 + t4), t32*(2.0*t28 + t29 + t31), -m*t33, p1 + 4.0*p11*t15 + t11*t34 + t17*t34*t8, -lam2*t20, t26*t34*w, m*t24, 0.0, -Q_zz*t2 + t13*t35 + t7, 0.0, t32*(t14*t36 - t26*t4 + t36*v), t37*((0.16666666666666666)*P - t36), p1 + t34*t35, t37*(t20 + t27), 0.0, t3*(-Q_r*t2/lam2 + t28*t6 + t28 + t29*t6 + t31), -t33, p1 + t18,)
+
+
+@njit(cache=True)
+def azimuthal_hessian_nodes(cos_theta, sin_theta, lam2, v, eta, w, m, P, M, chi, mu, field, out):
+    """azimuthal_hessian at every node i; output k goes to out[k, i]."""
+    for i in range(cos_theta.shape[0]):
+        r = azimuthal_hessian(cos_theta[i], sin_theta[i], lam2[i], v[i], eta[i], w[i], m, P, M, chi, mu, field[:, i])
+        out[0, i] = r[0]
+        out[1, i] = r[1]
+        out[2, i] = r[2]
+        out[3, i] = r[3]
+        out[4, i] = r[4]
+        out[5, i] = r[5]
+        out[6, i] = r[6]
+        out[7, i] = r[7]
+        out[8, i] = r[8]
+        out[9, i] = r[9]
+        out[10, i] = r[10]
+        out[11, i] = r[11]
+        out[12, i] = r[12]
+        out[13, i] = r[13]
+        out[14, i] = r[14]
+        out[15, i] = r[15]
+        out[16, i] = r[16]
+        out[17, i] = r[17]
+        out[18, i] = r[18]
+        out[19, i] = r[19]
+        out[20, i] = r[20]
+
+
+@njit(cache=True, inline='always')
+def shear_coefficient(lam1, lam2, mu):
+    """K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12)."""
+    mu0 = mu[0]
+    return ((0.5)*mu0/((lam1*lam1*lam1*lam1)*(lam2*lam2*lam2*lam2)),)
+
+
+@njit(cache=True)
+def shear_coefficient_nodes(lam1, lam2, mu, out):
+    """shear_coefficient at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = shear_coefficient(lam1[i], lam2[i], mu)
+        out[0, i] = r[0]

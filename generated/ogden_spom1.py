@@ -8,9 +8,9 @@ import math
 
 from numba import njit
 
-SIGNATURE = "14b6779f69f0876a0e509e4eb8fd535ee6fed4547618f04fd78055552d7df771"
+SIGNATURE = "c55ef90233c8cc15245d6469be94de89db5bf6a329608333d520267f5c09f926"
 INPUTS = [('alphas', ('1.3', '4', '-2')), ('class', 'ogden_spom1'), ('field', False)]
-KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'pole_series')
+KERNELS = ('energy_density', 'energy_gradient', 'energy_hessian', 'pressure_gradient', 'rhs', 'rhs_jacobian', 'rhs_pressure', 'pole_series', 'azimuthal_hessian', 'shear_coefficient')
 
 
 @njit(cache=True, inline='always')
@@ -774,3 +774,132 @@ def pole_series(lam0, P, mu):
     t13 = (0.00390625)*(48.0*lam0*t3*t9 - 4.0*t1*t11*t8 + 4.0*t10*t12 - 12.0*t12*t3 + 16.0*t9*(-lam0*t10 + (0.7692307692307693)*mu0*t4 + (0.25)*mu1*t6 - t7))/(t3*t9)
     t14 = (0.25)*P*t5/t8
     return (t13, -t14, t13, t14,)
+
+
+@njit(cache=True, inline='always')
+def azimuthal_hessian(cos_theta, sin_theta, lam2, v, eta, w, m, P, mu):
+    """Second variation for perturbations cos(mφ), m ≥ 1 (MODEL.md §5): the 6×6 matrix h with d²E/dε² = ∫ yᵀ h y d(cos θ), y = (R, R', Z, Z', T, T'), R, Z the radial/axial displacement amplitudes (cos mφ), T the azimuthal one (sin mφ); upper triangle row by row (codegen/second_variation.py)."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    lam1 = math.sqrt((w*w) + ((cos_theta*lam2 + v)*(cos_theta*lam2 + v)))
+    s1_0 = (lam2*lam2)
+    s1_1 = (1.0/(lam1*lam1*lam1*lam1))
+    s1_2 = (0.5)*mu2
+    s1_3 = lam1**(-3.3)
+    s1_4 = lam2**(-1.3)
+    s1_5 = (0.7692307692307693)*mu0
+    s1_6 = (lam1*lam1)
+    s1_7 = (1.0/(lam1*lam1*lam1*lam1*lam1*lam1))
+    s1_8 = (1.0/(lam2*lam2*lam2*lam2))
+    s1_9 = (0.25)*mu1
+    s1_10 = lam1**(-1.3)
+    s1_11 = lam2**(-3.3)
+    s1_12 = (1.0/(lam2*lam2*lam2*lam2*lam2*lam2))
+    s1_13 = (0.025)*mu0
+    s1_14 = s1_12*s1_7
+    s1_15 = mu0*s1_11*s1_3
+    s1_16 = lam2**(-2.7)
+    s1_17 = (0.5)*mu1
+    s1_18 = (1.0/(lam2))
+    s1_19 = lam1 - lam2
+    s1_20 = (lam2 < 100.0*abs(s1_19))
+    s1_21 = math.log1p(((s1_18*s1_19) if s1_20 else (1.0)))
+    s1_22 = (0.5)*mu0*s1_16
+    s1_23 = lam1*s1_18 - 1.0
+    p1 = -s1_2*(s1_0 - s1_1) + s1_5*(-0.65*s1_3*s1_4 + (0.65)/lam1**(0.7)) + s1_9*(2.0*s1_6 - 2.0*s1_7*s1_8)
+    p2 = -s1_2*(s1_6 - s1_8) + s1_5*(-0.65*s1_10*s1_11 + (0.65)/lam2**(0.7)) + s1_9*(2.0*s1_0 - 2.0*s1_1*s1_12)
+    p11 = (0.5)*mu1*(1.0 + 3.0*s1_8/(lam1*lam1*lam1*lam1*lam1*lam1*lam1*lam1)) - mu2*s1_7 - s1_13*(7.0 - 33.0*s1_4/lam1**(2.6))/lam1**(2.7)
+    p12 = mu1*s1_14 + (0.325)*s1_15 - s1_2
+    p22 = (0.5)*mu1*(1.0 + 3.0*s1_1/(lam2*lam2*lam2*lam2*lam2*lam2*lam2*lam2)) - mu2*s1_12 - s1_13*s1_16*(7.0 - 33.0*s1_10/lam2**(2.6))
+    K = s1_1*s1_2*s1_8*(-s1_0 - s1_6) + s1_14*s1_17 + (0.5)*s1_15 + s1_17 + s1_2 + ((s1_22*math.expm1(-0.7*s1_21)/math.expm1(2.0*s1_21)) if s1_20 else (s1_22*((0.4725)*lam1*s1_18 - 0.409568692059375*(s1_23*s1_23*s1_23*s1_23*s1_23*s1_23*s1_23*s1_23) + (0.4252184003671875)*(s1_23*s1_23*s1_23*s1_23*s1_23*s1_23*s1_23) - 0.44293440375*(s1_23*s1_23*s1_23*s1_23*s1_23*s1_23) + (0.46248969375)*(s1_23*s1_23*s1_23*s1_23*s1_23) - 0.482643*(s1_23*s1_23*s1_23*s1_23) + (0.49966875)*(s1_23*s1_23*s1_23) - 0.504*(s1_23*s1_23) - 0.8225)))
+    t0 = (1.0/(sin_theta))
+    t1 = (m*m)
+    t2 = (v*v)
+    t3 = K*t0
+    t4 = t2*t3
+    t5 = (cos_theta*cos_theta)
+    t6 = (lam2*lam2)
+    t7 = K*t6
+    t8 = t0*t5*t7
+    t9 = cos_theta*lam2
+    t10 = t9*v
+    t11 = 2.0*t10*t3
+    t12 = (0.3333333333333333)*P
+    t13 = t12*w
+    t14 = 2.0*t6
+    t15 = p22*t0*t14
+    t16 = t13 + t15
+    t17 = p2*t0
+    t18 = t1*t17 + t17
+    t19 = (0.16666666666666666)*P
+    t20 = eta*t19
+    t21 = lam2*v
+    t22 = 2.0*p12
+    t23 = t0*(cos_theta*p12*t14 - t20 + t21*t22)
+    t24 = t9 + v
+    t25 = t3*w
+    t26 = t25*v
+    t27 = t25*t9
+    t28 = t0*t22*w
+    t29 = t11 + t4 + t8
+    t30 = m*t0
+    t31 = t0*(K*t21 + cos_theta*t7 + t20)
+    t32 = 2.0*p11
+    t33 = (w*w)
+    t34 = lam2*m
+    return (t0*(t1*t11 + t1*t4 + t1*t8 + t16 + t18), t23, t0*(t1*t26 + t1*t27 - t19*t24), lam2*(t12 + t28), t30*(t16 + 2.0*t17 + t29), -m*t31, p1 + 4.0*p11*t10 + t2*t32 + t32*t5*t6, -lam2*t19, t24*t32*w, m*t23, 0.0, t1*(K*t33 + p2)/(sin_theta*sin_theta), 0.0, t30*(-t12*t24 + t26 + t27), t34*((0.16666666666666666)*P - t25), p1 + t32*t33, t34*(t19 + t28), 0.0, t0*(t1*t15 + t13 + t18 + t29), -t31, p1 + t7,)
+
+
+@njit(cache=True)
+def azimuthal_hessian_nodes(cos_theta, sin_theta, lam2, v, eta, w, m, P, mu, out):
+    """azimuthal_hessian at every node i; output k goes to out[k, i]."""
+    for i in range(cos_theta.shape[0]):
+        r = azimuthal_hessian(cos_theta[i], sin_theta[i], lam2[i], v[i], eta[i], w[i], m, P, mu)
+        out[0, i] = r[0]
+        out[1, i] = r[1]
+        out[2, i] = r[2]
+        out[3, i] = r[3]
+        out[4, i] = r[4]
+        out[5, i] = r[5]
+        out[6, i] = r[6]
+        out[7, i] = r[7]
+        out[8, i] = r[8]
+        out[9, i] = r[9]
+        out[10, i] = r[10]
+        out[11, i] = r[11]
+        out[12, i] = r[12]
+        out[13, i] = r[13]
+        out[14, i] = r[14]
+        out[15, i] = r[15]
+        out[16, i] = r[16]
+        out[17, i] = r[17]
+        out[18, i] = r[18]
+        out[19, i] = r[19]
+        out[20, i] = r[20]
+
+
+@njit(cache=True, inline='always')
+def shear_coefficient(lam1, lam2, mu):
+    """K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12)."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    t0 = (0.5)*mu1
+    t1 = (0.5)*mu2
+    t2 = (0.5)*mu0
+    t3 = (1.0/(lam2))
+    t4 = lam1 - lam2
+    t5 = (lam2 < 100.0*abs(t4))
+    t6 = math.log1p(((t3*t4) if t5 else (1.0)))
+    t7 = t2/lam2**(2.7)
+    t8 = lam1*t3 - 1.0
+    return (t0 + t1 + ((t7*math.expm1(-0.7*t6)/math.expm1(2.0*t6)) if t5 else (t7*((0.4725)*lam1*t3 - 0.409568692059375*(t8*t8*t8*t8*t8*t8*t8*t8) + (0.4252184003671875)*(t8*t8*t8*t8*t8*t8*t8) - 0.44293440375*(t8*t8*t8*t8*t8*t8) + (0.46248969375)*(t8*t8*t8*t8*t8) - 0.482643*(t8*t8*t8*t8) + (0.49966875)*(t8*t8*t8) - 0.504*(t8*t8) - 0.8225))) + t1*(-(lam1*lam1) - (lam2*lam2))/((lam1*lam1*lam1*lam1)*(lam2*lam2*lam2*lam2)) + t0/((lam1*lam1*lam1*lam1*lam1*lam1)*(lam2*lam2*lam2*lam2*lam2*lam2)) + t2/(lam1**(3.3)*lam2**(3.3)),)
+
+
+@njit(cache=True)
+def shear_coefficient_nodes(lam1, lam2, mu, out):
+    """shear_coefficient at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = shear_coefficient(lam1[i], lam2[i], mu)
+        out[0, i] = r[0]

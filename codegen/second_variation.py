@@ -1,0 +1,251 @@
+"""Second variation of the energy for non-axisymmetric perturbations cos(mφ)/sin(mφ), m ≥ 1 (MODEL.md §5).
+
+Derivation (docs/second_variation.md has the full account). In the local frame (e_ρ(φ), e_φ(φ), e_z) the
+perturbed mid-surface is the straight line in Cartesian space
+
+    x = (ρ0 + ε R cos mφ) e_ρ + ε T sin mφ e_φ + (η0 + ε Z cos mφ) e_z,
+
+R = a sin θ (a: the λ2 perturbation), T the azimuthal displacement (T = ρ0 B to first order in the angle form
+β = φ + ε B sin mφ), Z the axial one. With ' = d/dθ, ∂_φ e_ρ = e_φ, ∂_φ e_φ = −e_ρ:
+
+    x_θ = (ρ0' + ε R' c, ε T' s, η0' + ε Z' c),
+    x_φ = (−ε (mR + T) s, ρ0 + ε (R + mT) c, −ε m Z s),      c = cos mφ, s = sin mφ,
+
+and C = G⁻¹g, G = diag(1, sin²θ), in the orthonormal reference frame: c11 = |x_θ|², c22 = |x_φ|²/sin²θ,
+c12 = x_θ·x_φ / sin θ (c12 = O(ε)). The principal stretches squared are the eigenvalues e1, e2 of that matrix;
+with φ̂(e1, e2) = Φ(√e1, √e2) and c12 = O(ε), to second order
+
+    Φ(Λ1, Λ2) = φ̂(c11, c22) + K c12²,      K = (φ̂_1 − φ̂_2)/(λ1² − λ2²)   (the shear coefficient),
+
+where λ1² = c11|0, λ2² = c22|0. K has a removable singularity at λ1 = λ2; its limit is φ̂_11 − φ̂_12.
+The field enters through H²(|x_h|, z) with |x_h| = ρ0 + ε R c + ε² T² s²/(2ρ0) + …, the pressure through
+−P V, V = (1/3) ∮ x·(x_θ × x_φ) dθ dφ. Averaging the ε² coefficient over φ (⟨c²⟩ = ⟨s²⟩ = ½, ⟨cs⟩ = 0 for
+m ≥ 1) and dividing by sin θ (integration in x = cos θ) gives E₂(θ), a quadratic form in
+y = (R, R', Z, Z', T, T'); the kernel returns h = ∂²E₂/∂y², so that with E per 2π (MODEL.md §2)
+
+    d²E/dε² = ∫_{-1}^{1} yᵀ h y d(cos θ).
+
+Why (R, T) and a straight Cartesian line rather than (a, B) and the angle β: for m = 1 a regular perturbation
+(the rigid translation, R = 1, T = −1 at the poles) has a = R/sin θ and B = T/ρ0 unbounded at the poles, and the
+angle form's second-order displacement ~ T²/ρ0 is singular there, which adds a spurious pole term to the
+second variation (the translation is then not a zero mode). Along the straight line d²E/dε² is the Hessian
+E''[x1, x1] itself, at any state. The kernel is written per scene class; m is a runtime argument.
+"""
+import functools
+
+import sympy as sp
+from sympy.codegen.cfunctions import expm1, log1p
+
+from . import functional as fn
+from .functional import FIELD, SceneClass, cos_theta, eta, lam2, sin_theta, v, w
+from .kernels import Arg, Kernel
+
+m = sp.Symbol("m", real=True)
+R, R1, Z, Z1, T, T1 = sp.symbols("R R1 Z Z1 T T1", real=True)
+PERTURBATION = (R, R1, Z, Z1, T, T1)
+PAIRS = tuple((i, j) for i in range(6) for j in range(i, 6))
+
+_eps, _c, _s = sp.symbols("epsilon cm sm", real=True)
+_l2 = sp.Symbol("l2", positive=True)
+_h = sp.Symbol("h", real=True)
+# material stage symbols: φ̂ derivatives in e = λ² and the shear coefficient, at (λ1, λ2) of the state
+p1, p2, p11, p12, p22, shear = sp.symbols("p1 p2 p11 p12 p22 K", real=True)
+l1 = sp.Symbol("lam1", positive=True)
+
+# removable-singularity switch: closed form when |λ1 − λ2| > SWITCH·λ2, else Taylor in h = λ1/λ2 − 1 of this order
+SWITCH = sp.Rational(1, 100)
+TAYLOR_ORDER = 8
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot(a, b):
+    return sum(x * y for x, y in zip(a, b))
+
+
+def surface(kinematics: str = "cartesian"):
+    """(x, x_θ, x_φ) in the local frame (e_ρ, e_φ, e_z), polynomial in ε, cm, sm (see module docstring).
+
+    ``kinematics="angle"`` is the angle form ρ(cos β, sin β) with β = φ + ε B sin mφ, B = T/ρ0 (for comparison
+    only: its ε² term differs from the Hessian by a first-variation term that is singular at the poles, m = 1).
+    """
+    rho0, drho0 = lam2 * sin_theta, lam2 * cos_theta + v
+    if kinematics == "cartesian":
+        x = (rho0 + _eps * R * _c, _eps * T * _s, eta + _eps * Z * _c)
+        x_t = (drho0 + _eps * R1 * _c, _eps * T1 * _s, w + _eps * Z1 * _c)
+        x_p = (-_eps * (m * R + T) * _s, rho0 + _eps * (R + m * T) * _c, -_eps * m * Z * _s)
+        return x, x_t, x_p
+    if kinematics == "angle":
+        # x = ρ (cos(β − φ), sin(β − φ)) in the local frame; β − φ = ε B s, expanded to O(ε²)
+        B, B1 = T / rho0, (T1 - drho0 * T / rho0) / rho0
+        rho, drho = rho0 + _eps * R * _c, drho0 + _eps * R1 * _c
+        ang, dang_t, dang_p = _eps * B * _s, _eps * B1 * _s, _eps * m * B * _c  # β − φ, its θ and φ derivatives
+        cos_a, sin_a = 1 - ang**2 / 2, ang
+        x = (rho * cos_a, rho * sin_a, eta + _eps * Z * _c)
+        # ∂(ρ e_β) = ∂ρ e_β + ρ ∂β e_β⊥, e_β = (cos_a, sin_a), e_β⊥ = (−sin_a, cos_a) in the local frame;
+        # ∂_φ of the local frame itself adds e_φ-rotation: handled by ∂_φβ = 1 + dang_p
+        x_t = (drho * cos_a - rho * dang_t * sin_a, drho * sin_a + rho * dang_t * cos_a, w + _eps * Z1 * _c)
+        drho_p, beta_p = -_eps * m * R * _s, 1 + dang_p
+        x_p = (drho_p * cos_a - rho * beta_p * sin_a, drho_p * sin_a + rho * beta_p * cos_a, -_eps * m * Z * _s)
+        return x, x_t, x_p
+    raise ValueError(kinematics)
+
+
+def _order(expr, k):
+    """Coefficient of ε^k."""
+    return sp.expand(expr).coeff(_eps, k)
+
+
+def _phi_average(expr):
+    """(1/2π)∫ dφ of a polynomial in cm = cos mφ, sm = sin mφ of degree ≤ 2 (m ≥ 1)."""
+    poly = sp.Poly(sp.expand(expr), _c, _s)
+    mean = {(0, 0): sp.S.One, (2, 0): sp.S.Half, (0, 2): sp.S.Half, (1, 0): 0, (0, 1): 0, (1, 1): 0}
+    out = sp.S.Zero
+    for (i, j), coeff in poly.terms():
+        if (i, j) not in mean:
+            raise ValueError(f"unexpected φ dependence cm^{i} sm^{j}")
+        out += coeff * mean[(i, j)]
+    return sp.expand(out)
+
+
+def volume_density(x, x_t, x_p, form: str = "cone"):
+    """Enclosed-volume density per dθ dφ: 'cone' (1/3) x·(x_θ × x_φ), or 'cylinder' ½ρ² dβ∧dz, i.e.
+    ½ e_z·(x × x_θ) z_φ − ½ e_z·(x × x_φ) z_θ (the form of the axisymmetric code, ½ ρ² (−η') there)."""
+    if form == "cone":
+        return _dot(x, _cross(x_t, x_p)) / 3
+    if form == "cylinder":
+        zx_t = x[0] * x_t[1] - x[1] * x_t[0]
+        zx_p = x[0] * x_p[1] - x[1] * x_p[0]
+        return (zx_t * x_p[2] - zx_p * x_t[2]) / 2
+    raise ValueError(form)
+
+
+def second_order_density(cls: SceneClass, kinematics: str = "cartesian", volume: str = "cone"):
+    """E₂: the φ-averaged ε² coefficient of the energy per d(cos θ), per 2π, in the stage symbols
+    (λ1 = lam1, p1, p2, p11, p12, p22, K) and the node/state/field symbols; quadratic in PERTURBATION."""
+    x, x_t, x_p = surface(kinematics)
+    c11 = _dot(x_t, x_t)
+    c22 = _dot(x_p, x_p) / sin_theta**2
+    c12 = _dot(x_t, x_p) / sin_theta
+    a1, a2 = _order(c11, 1), _order(c22, 1)
+    elastic = p1 * _order(c11, 2) + p2 * _order(c22, 2) + p11 * a1**2 / 2 + p12 * a1 * a2 + p22 * a2**2 / 2
+    elastic += shear * _order(c12, 1) ** 2
+    density = _phi_average(elastic)
+    pressure = _phi_average(_order(volume_density(x, x_t, x_p, volume), 2))
+    density -= fn.P * pressure / sin_theta
+    if cls.field:
+        rho_sq = x[0] ** 2 + x[1] ** 2
+        # |x_h| = sqrt(rho_sq) to O(ε²) about ρ0 = lam2 sinθ: ρ0 + δ1 + δ2 with rho_sq = ρ0² + ε q1 + ε² q2
+        rho0 = lam2 * sin_theta
+        q1, q2 = _order(rho_sq, 1), _order(rho_sq, 2)
+        radius = rho0 + _eps * q1 / (2 * rho0) + _eps**2 * (q2 / (2 * rho0) - q1**2 / (8 * rho0**3))
+        H2 = fn._field_proxy(radius, x[2])
+        magnetic = _phi_average(_order(fn.field_values(sp.expand(H2), rho0), 2))
+        density -= fn.chi * fn.M * magnetic / 2
+    return density
+
+
+def material_stage(cls: SceneClass):
+    """(p1, p2, p11, p12, p22) = derivatives of φ̂(e1, e2) = Φ(√e1, √e2) at (λ1², λ2²), as functions of (λ1, λ2)."""
+    e1, e2 = sp.symbols("e1 e2", positive=True)
+    phi = fn.ogden(cls, sp.sqrt(e1), sp.sqrt(e2))
+    at = {e1: l1**2, e2: _l2**2}  # positive λ2 while deriving (no |λ2|), the state's lam2 afterwards
+    d = lambda *xs: sp.diff(phi, *xs).subs(at).subs(_l2, lam2)  # noqa: E731
+    return d(e1), d(e2), d(e1, e1), d(e1, e2), d(e2, e2)
+
+
+def _divided_difference_terms(cls: SceneClass, a, b):
+    """K(λ1 = a, λ2 = b) term by term: (μ/2)[(e1^p − e2^p)/(e1 − e2) + (e1 e2)^(−α/2−1)], p = α/2 − 1.
+
+    Returns (regular part, list of (μ, p) for the divided differences that are not polynomial)."""
+    e1, e2 = a**2, b**2
+    regular, singular = sp.S.Zero, []
+    for mu, alpha in zip(fn.moduli(cls), fn.exponents(cls)):
+        p = alpha / 2 - 1
+        regular += mu / 2 * (e1 * e2) ** (-alpha / 2 - 1)
+        if p.is_Integer:  # (e1^p − e2^p)/(e1 − e2) is a polynomial in e1, e2, 1/e1, 1/e2: regular form
+            regular += mu / 2 * sp.cancel((e1**p - e2**p) / (e1 - e2))
+        else:
+            singular.append((mu, p))
+    return regular, singular
+
+
+@functools.cache
+def shear_coefficient(cls: SceneClass):
+    """K(λ1, λ2) in a form finite at λ1 = λ2: (expression in lam1, lam2 with a Piecewise switch, its limit at
+    λ1 = λ2, the plain closed form (φ̂_1 − φ̂_2)/(λ1² − λ2²)).
+
+    Per Ogden term K = (μ/2)[(e1^p − e2^p)/(e1 − e2) + (e1 e2)^(−α/2−1)], e = λ², p = α/2 − 1. Where p is an
+    integer the divided difference is cancelled exactly (a polynomial in e1^±1, e2^±1: regular). Otherwise: the
+    Taylor series in h = λ1/λ2 − 1 (order TAYLOR_ORDER, truncation ~|h|^9) where |λ1 − λ2| ≤ SWITCH·λ2, and the
+    expm1/log1p form (no cancellation) elsewhere."""
+    p1_, p2_, p11_, p12_, _ = material_stage(cls)
+    closed = (p1_ - p2_) / (l1**2 - lam2**2)
+    limit = sp.simplify((p11_ - p12_).subs(l1, lam2))
+    regular, singular = _divided_difference_terms(cls, l1, _l2)
+    regular = regular.subs(_l2, lam2)
+    if not singular:
+        return regular, limit, closed
+    far = sp.Abs(l1 - lam2) > SWITCH * lam2
+    # closed form without cancellation: (e1^p − e2^p)/(e1 − e2) = e2^(p−1) expm1(p L)/expm1(L), L = 2 log1p(h),
+    # h = (λ1 − λ2)/λ2 (exact difference); h is guarded (= 1 in the Taylor range) so that no branch divides by 0
+    h_far = sp.Piecewise(((l1 - lam2) / lam2, far), (1, True))
+    L = 2 * log1p(h_far)
+    closed_part = sum(mu / 2 * lam2 ** (2 * p - 2) * expm1(p * L) / expm1(L) for mu, p in singular)
+    # Taylor of (e1^p − e2^p)/(e1 − e2) with e1 = e2 (1+h)²: e2^(p−1) ((1+h)^(2p) − 1)/((1+h)² − 1)
+    taylor_part = sp.S.Zero
+    for mu, p in singular:
+        g = ((1 + _h) ** (2 * p) - 1) / (_h * (2 + _h))
+        series = sp.series(g, _h, 0, TAYLOR_ORDER + 1).removeO()
+        taylor_part += mu / 2 * lam2 ** (2 * p - 2) * series
+    taylor_part = taylor_part.subs(_h, l1 / lam2 - 1)
+    expr = regular + sp.Piecewise((closed_part, far), (taylor_part, True))
+    return expr, limit, closed
+
+
+def _kernel_args(cls: SceneClass):
+    args = [Arg.node(s) for s in (cos_theta, sin_theta, lam2, v, eta, w)]
+    args += [Arg.param(m)] + [Arg.param(p) for p in fn.runtime_args(cls)]
+    args.append(Arg.param_array("mu", fn.moduli(cls)))
+    if cls.alphas is None:
+        args.append(Arg.param_array("alpha", fn.exponents(cls)))
+    if cls.field:
+        args.append(Arg.node_rows("field", FIELD))
+    return tuple(args)
+
+
+def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
+    density = second_order_density(cls)
+    outputs = tuple(sp.diff(density, PERTURBATION[i], PERTURBATION[j]) for i, j in PAIRS)
+    material = material_stage(cls)
+    stages = (
+        ((l1, fn.meridional_stretch(cos_theta, v, w)),),
+        tuple(zip((p1, p2, p11, p12, p22), material)) + ((shear, shear_coefficient(cls)[0]),),
+    )
+    return Kernel(
+        "azimuthal_hessian",
+        "Second variation for perturbations cos(mφ), m ≥ 1 (MODEL.md §5): the 6×6 matrix h with "
+        "d²E/dε² = ∫ yᵀ h y d(cos θ), y = (R, R', Z, Z', T, T'), R, Z the radial/axial displacement amplitudes "
+        "(cos mφ), T the azimuthal one (sin mφ); upper triangle row by row (codegen/second_variation.py).",
+        _kernel_args(cls),
+        outputs,
+        stages,
+    )
+
+
+def shear_kernel(cls: SceneClass) -> Kernel:
+    args = [Arg.node(l1), Arg.node(lam2), Arg.param_array("mu", fn.moduli(cls))]
+    if cls.alphas is None:
+        args.append(Arg.param_array("alpha", fn.exponents(cls)))
+    return Kernel(
+        "shear_coefficient",
+        "K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12).",
+        tuple(args),
+        (shear_coefficient(cls)[0],),
+    )
+
+
+def second_variation_kernels(cls: SceneClass) -> list[Kernel]:
+    return [azimuthal_hessian_kernel(cls), shear_kernel(cls)]
