@@ -24,7 +24,7 @@ class Picture:
 
 def _assess(branch, scene, symmetric):
     results, unsettled = assess_branch(branch, scene.stability.degree, symmetric,
-                                       check_degree=2 * scene.stability.degree)
+                                       check_degree=2 * scene.stability.degree, m_max=scene.stability.m_max)
     branch.stability = results
     branch.unsettled = unsettled
     return unsettled

@@ -11,12 +11,16 @@ and 'odd' (a_odd, b_even: pear-shaped modes). b_0 is the rigid translation: a ze
 
 Control modes: under pressure control the test is H > 0; under volume control H restricted to the
 perturbations that keep the volume, gᵀδ = 0 with g = ∂V/∂(a, b) = −∂²E/∂P∂(a, b).
+
+Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) form blocks 'm<m>_held' and
+'m<m>_free' with the symmetry zero modes removed; they enter every flag.
 """
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
+from .azimuthal import spectrum
 from .discretisation import Discretisation
 from .equilibrium import Parameters
 
@@ -79,7 +83,9 @@ class SecondVariation:
             cache[idx] = np.linalg.inv(np.linalg.cholesky(self.gram[np.ix_(idx, idx)]))
         return cache[idx]
 
-    def assess(self, u, params: Parameters, symmetric: bool) -> Assessment:
+    def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> Assessment:
+        """Blocks and flags at one equilibrium; azimuthal blocks m = 1..m_max are included in every flag
+        (their modes keep the volume to first order, so both control modes see the same m ≥ 1 spectrum)."""
         H, g = self.matrices(u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         i = self.index
@@ -108,11 +114,18 @@ class SecondVariation:
                 blocks["all_free"] = self._lowest(H, everything)
                 blocks["all_volume_free"] = self._lowest(H, everything, g)
                 free, free_volume = blocks["all_free"][0], blocks["all_volume_free"][0]
+        for m in range(1, m_max + 1):
+            blocks[f"m{m}_held"] = spectrum(self.eq, u, params, m, self.basis.degree, LOWEST, held=True)
+            held, held_volume = min(held, blocks[f"m{m}_held"][0]), min(held_volume, blocks[f"m{m}_held"][0])
+            if field_on:
+                blocks[f"m{m}_free"] = spectrum(self.eq, u, params, m, self.basis.degree, LOWEST, held=False)
+            lowest_free = blocks[f"m{m}_free" if field_on else f"m{m}_held"][0]
+            free, free_volume = min(free, lowest_free), min(free_volume, lowest_free)
         return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0)
 
 
 def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degree: int | None = None,
-                  near_zero: float = 0.1):
+                  near_zero: float = 0.1, m_max: int = 0):
     """Assessments of every point and, with ``check_degree``, the points whose flags change at that degree.
 
     The check is made where a sign could change: points with a lowest eigenvalue of magnitude below
@@ -122,7 +135,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degr
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     variation = SecondVariation(branch.equilibrium, degree)
     params = branch.params
-    results = [variation.assess(X[:-1], params.with_value("P", X[-1]), symmetric) for X in branch.X]
+    results = [variation.assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max) for X in branch.X]
     unsettled = []
     if check_degree:
         finer = SecondVariation(branch.equilibrium, check_degree)
@@ -132,7 +145,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degr
             small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
             if not (changes or small or n % 10 == 0):
                 continue
-            fine = finer.assess(X[:-1], params.with_value("P", X[-1]), symmetric)
+            fine = finer.assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max)
             if _flags(fine) != flags[n]:
                 unsettled.append(n)
     return results, unsettled
