@@ -90,18 +90,26 @@ class Discretisation:
     def hessian(self, pointwise: np.ndarray) -> np.ndarray:
         """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is the upper triangle (10, n_q).
 
-        One BLAS product Opsᵀ (D Ops) with D the node-wise 4×4 blocks.
+        (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three
+        blocks aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner.
         """
         weighted = pointwise * self.weights
-        blocks = np.empty((4, 4, weighted.shape[1]))
+        d = np.empty((4, 4, weighted.shape[1]))
         for row, (k, l) in enumerate(_UPPER):
-            blocks[k, l] = blocks[l, k] = weighted[row]
-        scaled = np.zeros_like(self.ops)
-        for k in range(4):
-            for l in range(4):
-                scaled[k] += blocks[k, l][:, None] * self.ops[l]
-        n = self.size
-        return self.ops.reshape(-1, n).T @ scaled.reshape(-1, n)
+            d[k, l] = d[l, k] = weighted[row]
+        na = self.a_index.size
+        A = self.ops[0:2, :, :na]
+        B = self.ops[2:4, :, na:]
+        stacked_a, stacked_b = A.reshape(-1, na), B.reshape(-1, self.size - na)
+
+        def weighted_basis(rows, basis, first):
+            return np.concatenate([d[k, first, :, None] * basis[0] + d[k, first + 1, :, None] * basis[1]
+                                   for k in rows])
+
+        aa = stacked_a.T @ weighted_basis((0, 1), A, 0)
+        ab = stacked_a.T @ weighted_basis((0, 1), B, 2)
+        bb = stacked_b.T @ weighted_basis((2, 3), B, 2)
+        return np.block([[aa, ab], [ab.T, bb]])
 
     def pole_rows(self):
         """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south)."""
