@@ -73,7 +73,8 @@ def test_galerkin_converges_to_the_shooting_solution(two_coils, magnetic):
     """
     errors = []
     for degree in (40, 60, 80):
-        branch = trace_primary(two_coils.with_overrides({"solver.degree": degree}), stop_stretch=1.5)
+        fixed = {"solver.degree": degree, "solver.max_degree": degree, "solver.max_error": 1e-2}
+        branch = trace_primary(two_coils.with_overrides(fixed), stop_stretch=1.5)
         poles = branch.pole_values()
         assert poles["lam2_north"][-1] == pytest.approx(1.5, abs=1e-12)
         errors.append(abs(branch.pressure[-1] / magnetic.P - 1))
@@ -82,6 +83,17 @@ def test_galerkin_converges_to_the_shooting_solution(two_coils, magnetic):
     assert poles["eta_north"][-1] == pytest.approx(magnetic.eta_north, rel=1e-9)
     lam2, _, _, _ = branch.disc.evaluate(branch.X[-1, :-1], np.array([np.pi / 2]))
     assert lam2[0] == pytest.approx(magnetic.lam2_equator, rel=1e-9)
+
+
+def test_default_settings_are_converged_under_refinement(two_coils, magnetic):
+    """Issue acceptance: the default (adaptive) settings and a 4× finer/tighter run differ by < 1e-9 in P, and
+    both agree with the independent shooting solution to 1e-9."""
+    default = trace_primary(two_coils, stop_stretch=1.5, down=False)
+    finer = trace_primary(two_coils.with_overrides({"solver.degree": 160, "solver.max_degree": 400,
+                                                    "solver.tol": 2.5e-12, "solver.max_error": 2.5e-10}),
+                          stop_stretch=1.5, down=False)
+    assert abs(default.pressure[-1] / finer.pressure[-1] - 1) < 1e-9
+    assert abs(default.pressure[-1] / magnetic.P - 1) < 1e-9
 
 
 def test_general_shooting_matches_the_symmetric_one(two_coils, magnetic):
