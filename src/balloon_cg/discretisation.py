@@ -106,10 +106,12 @@ class Discretisation:
             return np.concatenate([d[k, first, :, None] * basis[0] + d[k, first + 1, :, None] * basis[1]
                                    for k in rows])
 
-        aa = stacked_a.T @ weighted_basis((0, 1), A, 0)
-        ab = stacked_a.T @ weighted_basis((0, 1), B, 2)
-        bb = stacked_b.T @ weighted_basis((2, 3), B, 2)
-        return np.block([[aa, ab], [ab.T, bb]])
+        out = np.empty((self.size, self.size))
+        out[:na, :na] = stacked_a.T @ weighted_basis((0, 1), A, 0)
+        out[:na, na:] = stacked_a.T @ weighted_basis((0, 1), B, 2)
+        out[na:, :na] = out[:na, na:].T
+        out[na:, na:] = stacked_b.T @ weighted_basis((2, 3), B, 2)
+        return out
 
     def pole_rows(self):
         """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south)."""

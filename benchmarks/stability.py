@@ -1,0 +1,48 @@
+"""Benchmark: stability per branch point (N = 20, m = 0 and 1) and the whole SPOM1 M = 0 picture.
+
+The picture is the primary branch 1 -> 6, stability of every point, the two pear branch points located and
+classified, and the isola (pear branch and its mirror) traced with stability on every point.
+Run: python benchmarks/stability.py
+"""
+import time
+
+from balloon_cg.analysis import analyse
+from balloon_cg.branch import trace_primary
+from balloon_cg.scene import parse_scene
+from balloon_cg.stability import SecondVariation
+
+SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 6.0\n'
+
+
+def best(f, repeat=3):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        value = f()
+        times.append(time.perf_counter() - t0)
+    return min(times), value
+
+
+def main():
+    scene = parse_scene(SCENE, name="spom1")
+    analyse(scene)  # compile / load kernels
+    branch = trace_primary(scene)
+    variation = SecondVariation(branch.equilibrium, 20)
+    params = branch.params
+
+    def assess_all(m_max):
+        return [variation.assess(X[:-1], params.with_value("P", X[-1]), True, m_max) for X in branch.X]
+
+    t_m0, _ = best(lambda: assess_all(0))
+    t_m1, _ = best(lambda: assess_all(1))
+    t_picture, picture = best(lambda: analyse(scene))
+    points = sum(len(b.X) for b in picture.branches)
+    print(f"SPOM1, M = 0, N = 20, {len(branch.X)} primary points")
+    print(f"  stability per point, m = 0 blocks          {t_m0 / len(branch.X) * 1e3:7.2f} ms")
+    print(f"  stability per point, m = 0 and m = 1       {t_m1 / len(branch.X) * 1e3:7.2f} ms")
+    print(f"  whole picture (primary + isola, stability on {points} points, 2N checks, classification) "
+          f"{t_picture:.2f} s   floor < 3 s: {'met' if t_picture < 3 else 'NOT met'}")
+
+
+if __name__ == "__main__":
+    main()
