@@ -1,0 +1,397 @@
+"""Two-parameter continuation of a pear-shaped pitchfork: the curve of branch points in (q, P).
+
+A pear branch point of the equator-symmetric primary branch (``bifurcation``) is an equilibrium where the odd
+(pear) block of the Hessian is singular. Following it in a second parameter q (the field intensity ``"M"``, or
+the Ogden exponent ``"alpha1"`` with μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 so that Σ μ_i α_i = 4 stays true) is a
+Moore–Spence type extended system in the equator-symmetric space at the branch's Legendre degree N:
+
+    unknowns  X = (u, P, φ, q)              u: symmetric-layout coefficients, φ: the odd block (a_odd, b_even
+                                             without b_0) of the general-layout perturbation basis of degree N
+    equations R(u; P, q)            = 0     (n)      equilibrium
+              H_odd(u; P, q) φ      = 0     (m)      the pear block is singular, φ its null vector
+              ℓ·φ − 1               = 0     (1)      normalisation (ℓ = the located critical mode)
+
+— one equation fewer than unknowns: a curve, traced by the generic pseudo-arclength ``continuation.trace``.
+
+Jacobian. ∂R/∂u is the generated Hessian (``Equilibrium.jacobian``), ∂R/∂P and ∂R/∂M come from
+``Equilibrium.parameter_derivative``; H_odd is the generated Hessian on the perturbation basis
+(as ``SecondVariation.matrices``). The third-derivative terms are **central differences of the generated
+Hessian along directions**: because the third derivative of E is symmetric, ∂(H_odd φ)/∂u is the directional
+derivative of the full perturbation-basis Hessian along φ (one pair of Hessian evaluations, at the
+non-symmetric states u ± hφ), restricted to the odd rows and the symmetric-layout columns; ∂(H_odd φ)/∂P and
+∂(H_odd φ)/∂q are central differences of H in P and q. ∂R/∂α1 is a central difference of the gradient through
+the general kernel class (``ogden_general_field``, exponents as runtime arguments). Difference steps are
+``H_STEP`` (relative): the Jacobian is then accurate to ~1e-9, which only affects Newton's rate, not the
+converged points (the residual itself is exact).
+
+The two pitchforks of an isola lie on one such curve; where the curve turns back in q (a sign change of the
+q-component of the tangent, located by the continuation's fold locator, label 'merge') they merge: that q is
+the critical value (critical M, critical α1) — obtained directly, without bracketing in q.
+"""
+import os
+import secrets
+import time
+from dataclasses import dataclass, field, replace
+
+import h5py
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from . import continuation
+from .branch import SpecialPoint
+from .bifurcation import block_indices
+from .equilibrium import Equilibrium
+from .kernels import KernelSet
+from .newton import newton
+from .sphere_modes import bifurcation_condition, bifurcation_stretches
+from .stability import SecondVariation
+from .storage import _root_attrs, _write_special, check_output
+
+PARAMETERS = ("M", "alpha1")
+H_STEP = 1e-6
+GENERAL_CLASS = "ogden_general_field"
+
+
+class TwoParameterError(RuntimeError):
+    """The extended system could not be set up or started; the message says why."""
+
+
+class ExtendedSystem:
+    """R(u; P, q) = 0, H_odd φ = 0, ℓ·φ = 1 as a map of X = (u, P, φ, q) (module docstring)."""
+
+    def __init__(self, equilibrium: Equilibrium, params, parameter: str, ell: np.ndarray):
+        if parameter not in PARAMETERS:
+            raise ValueError(f"unknown second parameter {parameter!r}: expected one of {PARAMETERS}")
+        self.eq, self.params, self.parameter = equilibrium, params, parameter
+        disc = equilibrium.disc
+        if not disc.symmetric:
+            raise TwoParameterError("the extended system needs the equator-symmetric layout of the primary branch")
+        if parameter == "alpha1":
+            material = equilibrium.scene.material
+            if len(material.alpha) < 1:
+                raise TwoParameterError("alpha1: the material has no Ogden term")
+            # runtime exponents: the general class (same energy, μ and α as arguments)
+            equilibrium.kernels = KernelSet(material, has_field=equilibrium.coils.shape[0] > 0,
+                                            kernel_class=GENERAL_CLASS)
+            self._rest = float(np.dot(equilibrium.kernels.mu[1:], equilibrium.kernels.alpha[1:]))
+        self.variation = SecondVariation(equilibrium, disc.degree)
+        self.odd = block_indices(self.variation, "odd_held", field_on=False)
+        self.basis = self.variation.basis
+        # embedding of symmetric-layout u in the full (a_0..a_N, b_0..b_N) coefficients
+        N = disc.degree
+        self.embed = np.zeros((2 * (N + 1), disc.size))
+        self.embed[disc.a_index, np.arange(disc.a_index.size)] = 1.0
+        self.embed[N + 1 + disc.b_index, disc.a_index.size + np.arange(disc.b_index.size)] = 1.0
+        self.n, self.m = disc.size, self.odd.size
+        self.ell = np.asarray(ell, dtype=float)
+
+    # -- parameters ------------------------------------------------------------------------------------
+    def set_q(self, q: float):
+        """Parameters at q (for α1 the kernels' μ1, α1 are set, keeping Σ μ_i α_i = 4)."""
+        if self.parameter == "M":
+            return self.params.with_value("M", q)
+        kernels = self.eq.kernels
+        kernels.alpha[0] = q
+        kernels.mu[0] = (4.0 - self._rest) / q
+        return self.params
+
+    def q_value(self, X):
+        return float(X[-1])
+
+    def split(self, X):
+        n, m = self.n, self.m
+        return X[:n], float(X[n]), X[n + 1:n + 1 + m], float(X[-1])
+
+    # -- pieces ----------------------------------------------------------------------------------------
+    def full_hessian(self, c, params):
+        """Generated Hessian on the perturbation basis at the (general) coefficient vector c."""
+        b = self.basis
+        state = tuple(b.node_state(c))
+        return b.hessian(self.eq.pointwise("energy_hessian", (b.cos_theta, b.sin_theta), state, params, 10))
+
+    def odd_hessian(self, u, params):
+        return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]
+
+    def residual(self, X):
+        u, P, phi, q = self.split(X)
+        params = self.set_q(q).with_value("P", P)
+        return np.concatenate([self.eq.residual(u, params), self.odd_hessian(u, params) @ phi,
+                               [self.ell @ phi - 1.0]])
+
+    def jacobian(self, X):
+        u, P, phi, q = self.split(X)
+        n, m = self.n, self.m
+        params = self.set_q(q).with_value("P", P)
+        J = np.zeros((n + m + 1, n + m + 2))
+        J[:n, :n] = self.eq.jacobian(u, params)
+        J[:n, n] = self.eq.parameter_derivative(u, params, "P")
+        c = self.embed @ u
+        H = self.full_hessian(c, params)
+        J[n:n + m, n + 1:n + 1 + m] = H[np.ix_(self.odd, self.odd)]
+        # ∂(H_odd φ)/∂u = D_c H[φ_full] restricted (symmetry of the third derivative)
+        phi_full = np.zeros(c.size)
+        phi_full[self.odd] = phi
+        h = H_STEP * max(1.0, np.abs(c).max()) / max(np.abs(phi_full).max(), 1e-300)
+        dH = (self.full_hessian(c + h * phi_full, params) - self.full_hessian(c - h * phi_full, params)) / (2 * h)
+        J[n:n + m, :n] = dH[self.odd] @ self.embed
+        # ∂(H_odd φ)/∂P
+        hP = H_STEP * max(1.0, abs(P))
+        J[n:n + m, n] = (self.odd_hessian(u, params.with_value("P", P + hP))
+                         - self.odd_hessian(u, params.with_value("P", P - hP))) @ phi / (2 * hP)
+        # q column
+        hq = H_STEP * max(1.0, abs(q))
+        plus = self.set_q(q + hq).with_value("P", P)
+        H_plus, R_plus = self.odd_hessian(u, plus), self.eq.residual(u, plus)
+        minus = self.set_q(q - hq).with_value("P", P)
+        H_minus, R_minus = self.odd_hessian(u, minus), self.eq.residual(u, minus)
+        params = self.set_q(q).with_value("P", P)
+        if self.parameter == "M":
+            J[:n, -1] = self.eq.parameter_derivative(u, params, "M")
+        else:
+            J[:n, -1] = (R_plus - R_minus) / (2 * hq)
+        J[n:n + m, -1] = (H_plus - H_minus) @ phi / (2 * hq)
+        J[-1, n + 1:n + 1 + m] = self.ell
+        return J
+
+    def initial(self, bp, q0: float):
+        """X0 = (u*, P*, φ*, q0) from a located branch point; φ* normalised so that ℓ·φ* = 1."""
+        phi = bp.mode[self.odd]
+        return np.concatenate([bp.X[:-1], [bp.X[-1]], phi / (self.ell @ phi), [q0]])
+
+
+@dataclass
+class TwoParameterCurve:
+    """A traced curve of pear branch points: X = (u, P, φ, q) per point, the merge points (folds in q)."""
+
+    parameter: str
+    system: ExtendedSystem
+    X: np.ndarray
+    iterations: np.ndarray
+    residual: np.ndarray
+    merges: list = field(default_factory=list)  # continuation.Fold, label 'merge'
+    stop_reason: str = ""
+    wall_time: float = 0.0
+
+    def _parts(self, X):
+        X = np.atleast_2d(X)
+        n = self.system.n
+        return X[:, :n], X[:, n], X[:, -1]
+
+    @property
+    def q(self):
+        return self._parts(self.X)[2]
+
+    @property
+    def pressure(self):
+        return self._parts(self.X)[1]
+
+    def branch_X(self, X=None):
+        """(u, P) rows in the primary branch's layout."""
+        u, P, _ = self._parts(self.X if X is None else X)
+        return np.hstack([u, P[:, None]])
+
+    def pole_values(self, X=None):
+        rows = self.system.eq.disc.pole_rows()
+        u = self._parts(self.X if X is None else X)[0]
+        return {name: u @ row for name, row in rows.items()}
+
+    @property
+    def pole_stretch(self):
+        return self.pole_values()["lam2_north"]
+
+    @property
+    def critical(self):
+        """(q, P, north pole stretch) of the first merge point, or None."""
+        if not self.merges:
+            return None
+        X = self.merges[0].point.X
+        return float(X[-1]), float(self._parts(X)[1][0]), float(self.pole_values(X)["lam2_north"][0])
+
+
+def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0: float | None = None,
+                          settings: continuation.Settings | None = None, stop=None, progress=None,
+                          max_points: int = 400) -> TwoParameterCurve:
+    """Trace the curve of pear branch points through ``bp`` (located on the symmetric ``branch``) in q.
+
+    ``direction``: +1 starts with q increasing, −1 decreasing. ``q0``: the branch's value of q (default: its M,
+    or its material's α1). The trace stops when ``stop(point)`` (a continuation.Point) returns a reason, by default when q
+    returns past q0 after a merge (the curve has reached the partner pitchfork) or at ``max_points``.
+    Returns a TwoParameterCurve whose ``merges`` are the located folds in q (the critical values).
+    """
+    t0 = time.perf_counter()
+    scene = branch.equilibrium.scene
+    eq = Equilibrium(scene, branch.disc)  # own object: the α1 continuation swaps in runtime-exponent kernels
+    if q0 is None:
+        q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
+    if bp.block != "odd_held":
+        raise TwoParameterError(f"branch point of block {bp.block!r}: only pear (odd_held) points are continued")
+    variation = SecondVariation(eq, branch.disc.degree)
+    odd = block_indices(variation, "odd_held", field_on=False)
+    ell = bp.mode[odd] / np.linalg.norm(bp.mode[odd])
+    system = ExtendedSystem(eq, branch.params.with_value("P", bp.X[-1]), parameter, ell)
+    X0 = system.initial(bp, q0)
+    if settings is None:
+        c, s = scene.continuation, scene.solver
+        settings = continuation.Settings(c.step, c.step_min, c.step_max, max_points, s.tol, s.max_newton)
+    e_q = np.zeros(X0.size)
+    e_q[-1] = 1.0
+    # corrected at fixed q0: for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 may differ from the material's
+    # rounded μ1 (SPOM1: Σ μ_i α_i = 4.000004), and the located point carries the locator's tolerance
+    first = newton(system.residual, system.jacobian, X0, e_q, q0, settings.tol, settings.max_newton)
+    if not first.converged:
+        raise TwoParameterError(f"the extended system did not converge at the branch point: {first.message}")
+    X0 = first.x
+    t = continuation.tangent(system, X0, direction * e_q)
+    if abs(t[-1]) < 1e-8:
+        raise TwoParameterError("the branch point is already a fold in q: no direction to start in")
+    start = continuation.Point(X0, t, first.iterations, first.residual)
+
+    def default_stop(point):
+        if (point.X[-1] - q0) * direction < 0:
+            return f"q returned past its start value {q0:g} (reached the partner branch point)"
+        return None
+
+    rule = stop or default_stop
+
+    def stop_point(point):
+        if point.X[-1] <= 0 and parameter == "alpha1":
+            return "alpha1 reached 0"
+        return rule(point)
+
+    path = continuation.trace(system, start, settings, stop_point, {"merge": e_q}, progress)
+    merged = [f for f in path.folds if f.label == "merge"]
+    points = path.points
+    curve = TwoParameterCurve(parameter, system, np.array([p.X for p in points]),
+                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
+                              merged, path.stop_reason, 0.0)
+    curve.overshoot = path.overshoot
+    curve.wall_time = time.perf_counter() - t0
+    return curve
+
+
+def land_on_q(curve: TwoParameterCurve, q: float, near: int):
+    """The curve point with q exactly (Newton from curve point ``near`` with the row e_q), or None."""
+    system = curve.system
+    X = curve.X[near]
+    row = np.zeros(X.size)
+    row[-1] = 1.0
+    guess = X.copy()
+    guess[-1] = q
+    settings = system.eq.scene.solver
+    result = newton(system.residual, system.jacobian, guess, row, q, settings.tol, settings.max_newton)
+    return result.x if result.converged else None
+
+
+# -- the α1 family and its closed form at M = 0 (independent check: sphere_modes) ---------------------------
+def alpha1_material(material, alpha1: float):
+    """``material`` with α1 replaced and μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 (Σ μ_i α_i = 4 kept)."""
+    rest = sum(m * a for m, a in zip(material.mu[1:], material.alpha[1:]))
+    return replace(material, name=f"{material.name}(alpha1={alpha1:g})",
+                   mu=((4.0 - rest) / alpha1,) + tuple(material.mu[1:]), alpha=(alpha1,) + tuple(material.alpha[1:]))
+
+
+def sphere_pear_minimum(material, lam_max: float = 10.0):
+    """(λ, value) of the minimum over λ ∈ (1, lam_max) of the closed-form pear condition 4(S − t) (sphere_modes)."""
+    grid = np.geomspace(1.0, lam_max, 4000)
+    values = bifurcation_condition(material, grid, 1)
+    i = int(np.clip(np.argmin(values), 1, grid.size - 2))
+    res = minimize_scalar(lambda lam: float(bifurcation_condition(material, lam, 1)), bounds=(grid[i - 1], grid[i + 1]),
+                          method="bounded", options={"xatol": 1e-13})
+    return float(res.x), float(res.fun)
+
+
+def sphere_critical_alpha1(material, lo: float, hi: float, lam_max: float = 10.0) -> tuple[float, float]:
+    """Closed-form critical α1 at M = 0: where the minimum over λ of the pear condition touches zero (the two
+    pear points merge), root-found in α1 ∈ [lo, hi] (brentq, xtol 1e-14). Returns (α1, λ at the merge)."""
+    def g(a1):
+        return sphere_pear_minimum(alpha1_material(material, a1), lam_max)[1]
+
+    a1 = brentq(g, lo, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+    return a1, sphere_pear_minimum(alpha1_material(material, a1), lam_max)[0]
+
+
+def sphere_pear_stretches(material, alpha1: float, lam_max: float = 10.0):
+    """Closed-form pear branch-point stretches of the α1 family member (sphere_modes.bifurcation_stretches)."""
+    return bifurcation_stretches(alpha1_material(material, alpha1), 1, lam_max=lam_max)
+
+
+# -- storage --------------------------------------------------------------------------------------------------
+def write_curve(path, scene, curve: TwoParameterCurve, name: str = "pear", force: bool = False,
+                extra_attrs: dict | None = None):
+    """Write a two-parameter curve to an HDF5 file (atomically; root attributes as run files, ``storage``).
+
+    Layout::
+
+        /                            attrs: as a run file (format, scene, provenance) + extra_attrs
+        /branches/                   (empty: the file is also a readable run file)
+        /two_parameter/<name>/       attrs: parameter, stop_reason, wall_time, degree, kernel_class, M, chi,
+                                            critical_q (NaN if no merge was found)
+            q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
+            unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block
+            special_points/ kind ('merge'), index, note, pressure, E2..E4, pole values, unknowns (storage
+                            layout of branch special points), q
+    """
+    path = check_output(path, force)
+    attrs = _root_attrs(scene) | dict(extra_attrs or {})
+    system = curve.system
+    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        with h5py.File(tmp, "x") as f:
+            f.attrs.update(attrs)
+            f.create_group("branches")
+            group = f.create_group("two_parameter").create_group(name)
+            critical = curve.critical
+            group.attrs.update({
+                "parameter": curve.parameter,
+                "stop_reason": curve.stop_reason,
+                "wall_time": curve.wall_time,
+                "degree": system.eq.disc.degree,
+                "kernel_class": system.eq.kernels.name,
+                "M": system.params.M,
+                "chi": system.params.chi,
+                "critical_q": np.nan if critical is None else critical[0],
+            })
+            n, m = system.n, system.m
+            columns = {"q": curve.q, "pressure": curve.pressure, **curve.pole_values(),
+                       "newton_iterations": curve.iterations, "residual": curve.residual,
+                       "unknowns": curve.branch_X(), "mode": curve.X[:, n + 1:n + 1 + m]}
+            for key, data in columns.items():
+                group.create_dataset(key, data=data)
+            merges = [SpecialPoint("merge", fold.index, curve.branch_X(fold.point.X)[0],
+                                   f"fold of the curve in {curve.parameter}: the two pitchforks merge")
+                      for fold in curve.merges]
+            view = _SpecialView(merges, curve.branch_X(), system.eq.disc)
+            special = group.create_group("special_points")
+            _write_special(special, view)
+            special.create_dataset("q", data=np.array([fold.point.X[-1] for fold in curve.merges], dtype=float))
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+@dataclass
+class _SpecialView:
+    """What storage._write_special reads from a branch: special points, X rows and pole values."""
+
+    special: list
+    X: np.ndarray
+    disc: object
+
+    def pole_values(self, X=None):
+        rows = self.disc.pole_rows()
+        U = (self.X if X is None else np.atleast_2d(X))[:, :-1]
+        return {key: U @ row for key, row in rows.items()}
+
+
+def read_curve(path, name: str = "pear") -> dict:
+    """The datasets and attributes of a stored curve: {'attrs', datasets…, 'special_points': {…}}."""
+    with h5py.File(path, "r") as f:
+        group = f["two_parameter"][name]
+        data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
+        data["attrs"] = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in group.attrs.items()}
+        sp = group["special_points"]
+        data["special_points"] = {key: (sp[key].asstr()[()] if key in ("kind", "note") else sp[key][()])
+                                  for key in sp}
+    return data

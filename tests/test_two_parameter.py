@@ -1,0 +1,105 @@
+"""Two-parameter continuation of pear pitchforks (two_parameter): the SPOM1 isola at M = 0 followed in α1
+(Σ μ_i α_i = 4 kept through μ1) against the closed-form sphere condition of sphere_modes."""
+import numpy as np
+import pytest
+
+from balloon_cg import bifurcation
+from balloon_cg.branch import trace_primary
+from balloon_cg.equilibrium import Equilibrium
+from balloon_cg.materials import get_preset
+from balloon_cg.scene import parse_scene
+from balloon_cg.stability import SecondVariation, assess_branch
+from balloon_cg.storage import read_run
+from balloon_cg.two_parameter import (ExtendedSystem, alpha1_material, continue_branch_point, read_curve,
+                                      sphere_critical_alpha1, sphere_pear_stretches, write_curve)
+
+SPOM1 = get_preset("SPOM1")
+
+
+@pytest.fixture(scope="module")
+def located():
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n', name="SPOM1")
+    branch = trace_primary(scene, down=False)
+    assessments, _ = assess_branch(branch, branch.disc.degree, True)
+    events = [e for e in bifurcation.detect(branch, assessments) if e[1] == "odd_held"]
+    assert len(events) == 2  # the isola's two pitchforks
+    return scene, branch, [bifurcation.locate(branch, *e) for e in events]
+
+
+@pytest.fixture(scope="module")
+def curve(located):
+    _, branch, bps = located
+    return continue_branch_point(branch, bps[0], "alpha1")
+
+
+def test_jacobian_matches_differences_of_the_residual(located):
+    """The assembled Jacobian (generated Hessians + central differences for the third-derivative and α1 terms)
+    against central differences of the exact extended residual."""
+    _, branch, bps = located
+    for parameter, q0 in (("alpha1", 1.3), ("M", 0.0)):
+        eq = Equilibrium(branch.equilibrium.scene, branch.disc)
+        odd = bifurcation.block_indices(SecondVariation(eq, branch.disc.degree), "odd_held", False)
+        ell = bps[0].mode[odd] / np.linalg.norm(bps[0].mode[odd])
+        system = ExtendedSystem(eq, branch.params.with_value("P", bps[0].X[-1]), parameter, ell)
+        X0 = system.initial(bps[0], q0)
+        direction = np.random.default_rng(1).standard_normal(X0.size) * 1e-2
+        h = 1e-4
+        fd = (system.residual(X0 + h * direction) - system.residual(X0 - h * direction)) / (2 * h)
+        assert np.abs(fd - system.jacobian(X0) @ direction).max() < 1e-8
+
+
+def test_critical_alpha1_matches_closed_form(curve):
+    """The fold of the curve in α1 (the two pear points merge) against the closed form: α1 where the minimum
+    over λ of the sphere pear condition Φ11 + Φ12 − Φ1/λ touches zero."""
+    assert len(curve.merges) == 1
+    q, P, stretch = curve.critical
+    expected, lam = sphere_critical_alpha1(SPOM1, 1.3, 2.5)
+    assert q == pytest.approx(expected, rel=1e-6)
+    assert stretch == pytest.approx(lam, rel=1e-4)  # λ is flat (a double root) at the merge
+
+
+def test_curve_joins_the_two_pitchforks(curve, located):
+    """Started at the lower SPOM1 pitchfork, the curve comes back to α1 = 1.3 at the upper one."""
+    _, branch, bps = located
+    assert "partner" in curve.stop_reason
+    upper = branch.pole_values(bps[1].X)["lam2_north"][0]
+    assert curve.pole_stretch[-1] > 0.9 * upper and curve.q[-1] < 1.5
+
+
+def test_intermediate_pear_points_match_sphere_modes(curve):
+    """Points of the curve away from the merge: the pole stretch is a root of the closed-form pear condition
+    of that α1 (sphere_modes.bifurcation_stretches) to 1e-8."""
+    critical = curve.critical[0]
+    checked = 0
+    for q, stretch in zip(curve.q, curve.pole_stretch):
+        if critical - q < 0.02:  # the roots are ill-conditioned in α1 next to the double root
+            continue
+        roots = sphere_pear_stretches(SPOM1, q)
+        assert len(roots) == 2
+        nearest = roots[np.argmin(np.abs(roots - stretch))]
+        assert stretch == pytest.approx(nearest, rel=1e-8)
+        checked += 1
+    assert checked >= 6
+
+
+def test_material_family_keeps_the_modulus_sum():
+    material = alpha1_material(SPOM1, 1.7)
+    assert material.shear_modulus_sum == pytest.approx(4.0, abs=1e-14)
+    assert material.alpha[0] == 1.7 and material.mu[1:] == SPOM1.mu[1:]
+
+
+def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
+    scene = located[0]
+    path = write_curve(tmp_path / "curve.h5", scene, curve)
+    data = read_curve(path)
+    np.testing.assert_array_equal(data["q"], curve.q)
+    np.testing.assert_array_equal(data["pressure"], curve.pressure)
+    np.testing.assert_array_equal(data["lam2_north"], curve.pole_stretch)
+    special = data["special_points"]
+    assert list(special["kind"]) == ["merge"]
+    assert special["q"][0] == curve.critical[0] == data["attrs"]["critical_q"]
+    assert special["lam2_north"][0] == pytest.approx(curve.critical[2], rel=1e-14)
+    assert data["attrs"]["parameter"] == "alpha1"
+    assert read_run(path)["branches"] == {}  # also a readable run file (provenance attributes)
+    with pytest.raises(FileExistsError):
+        write_curve(path, scene, curve)
