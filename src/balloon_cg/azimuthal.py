@@ -237,10 +237,13 @@ def lowest_eigenvalues(H, G, count: int = 6, exclude=None, vectors: bool = False
         null = linalg.null_space(np.atleast_2d(exclude) @ G, rcond=1e-9)
         H, G = null.T @ H @ null, null.T @ G @ null
     count = min(count, H.shape[0])
+    if not vectors:  # Cholesky reduction + LAPACK syevd: several times faster than the subset driver here
+        inverse = np.linalg.inv(np.linalg.cholesky(G))
+        return np.linalg.eigvalsh(inverse @ H @ inverse.T)[:count]
     values, vecs = linalg.eigh(H, G, subset_by_index=(0, count - 1))
     if null is not None:
         vecs = null @ vecs
-    return (values, vecs) if vectors else values
+    return values, vecs
 
 
 def spectrum(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, count: int = 6,

@@ -6,7 +6,7 @@ with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector so
 on a slow correction (linear Newton convergence means a nearly singular Jacobian: landing close to a branch
 point, where the corrector may pick the crossing branch).
 *Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
-for a limit point); folds are then located by secant iteration in the arclength to |c·τ| ≤ 1e-12.
+for a limit point); folds are then located by secant iteration in the arclength to |c·τ| ≤ 1e-10.
 """
 from dataclasses import dataclass, field
 
@@ -81,7 +81,7 @@ def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Se
         t = tangent(system, result.x, start.tangent)
         value = float(c @ t)
         best = Point(result.x, t, result.iterations, result.residual)
-        if abs(value) <= 1e-12 or hi - lo <= 1e-14 * max(1.0, sigma):
+        if abs(value) <= 1e-10 or hi - lo <= 1e-14 * max(1.0, sigma):
             return best
         if f_hi is None:
             f_hi = float(c @ tangent(system, correct(system, start.X + hi * start.tangent, start.tangent,

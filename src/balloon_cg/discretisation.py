@@ -8,6 +8,7 @@ Gauss–Legendre quadrature at interior nodes. At a node
 Equator symmetry (λ2 even, η odd in x) keeps a_even and b_odd; without a field the translation η → η + c is
 removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
 """
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,12 @@ def legendre_table(x: np.ndarray, degree: int):
 
 
 _UPPER = tuple((k, l) for k in range(4) for l in range(k, 4))
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_table(theta_bytes: bytes, degree: int):
+    """Legendre tables at cos θ for a θ grid met again and again (stability nodes, stored profiles)."""
+    return legendre_table(np.cos(np.frombuffer(theta_bytes)), degree)
 
 
 @dataclass(frozen=True)
@@ -127,7 +134,7 @@ class Discretisation:
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
-        p, dp = legendre_table(np.cos(theta), self.degree)
+        p, dp = _cached_table(theta.tobytes(), self.degree)
         s = np.sin(theta)
         U = np.atleast_2d(u)
         na = self.a_index.size
