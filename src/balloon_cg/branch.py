@@ -206,6 +206,7 @@ class PrimaryTracer:
             t = disc.prolong(last.tangent, system.eq.disc)
             result = newton(system.residual, system.jacobian, X, t, t @ X, self.settings.tol, self.settings.max_newton)
             if not result.converged:
+                path.points.append(last)
                 return segments, f"could not refine to degree {finer}: {result.message}"
             start = continuation.Point(result.x, continuation.tangent(system, result.x, t), result.iterations,
                                        result.residual)
@@ -269,6 +270,8 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     forward_points, forward_folds = collect(forward[0])
     backward_points, backward_folds = collect(backward[0]) if backward else ([], [])
     points = backward_points[:0:-1] + forward_points
+    if not points:
+        raise ContinuationError(f"{name}: no converged point ({forward[1]})")
     offset = max(len(backward_points) - 1, 0)
     special = [SpecialPoint(kind, offset - index - 1, X) for kind, index, X in backward_folds[::-1]]
     special += [SpecialPoint(kind, offset + index, X) for kind, index, X in forward_folds]
