@@ -1,4 +1,4 @@
-"""Command line: ``balloon-cg run | solve | inspect | plot`` (``balloon-cg SUBCOMMAND -h`` for help).
+"""Command line: ``balloon-cg run | solve | inspect | plot | sweep`` (``balloon-cg SUBCOMMAND -h`` for help).
 
 Exit codes: 0 success, 1 the computation did not give what was asked (branch could not start or did not
 reach the requested stretch), 2 bad input (invalid scene, missing or unreadable file, existing output
@@ -50,7 +50,7 @@ def main(argv=None) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep):
         add(commands)
     return parser
 
@@ -205,6 +205,49 @@ def plot(args) -> int:
     check_output(output, force=True)
     draw_plot(args.files, args.what, args.points, args.branch).savefig(output, dpi=150)
     print(output)
+    return 0
+
+
+# --- sweep -------------------------------------------------------------------------------------------------
+
+def _add_sweep(commands):
+    p = commands.add_parser("sweep", help="run a scene over a grid of parameter values into one sweep file")
+    p.add_argument("scene", help="scene TOML file (the base scene)")
+    p.add_argument("--vary", action="append", required=True, metavar="KEY=SPEC",
+                   help="KEY=START:STOP:COUNT or KEY=v1,v2,...; KEY a dotted scene key (field.M, "
+                        "field.coils[0].radius, material.alpha[0]) or a bare name of one table (M = field.M); "
+                        "repeat for a cartesian product")
+    p.add_argument("-o", "--output", required=True, help="sweep file (HDF5) to write or resume")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="send the members to this dask.distributed scheduler")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="local worker processes (default: all cores; 1: compute in this process)")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--primary-only", action="store_true", help="trace the primary branch only")
+    mode.add_argument("--no-pear", action="store_true",
+                      help="primary branch, stability and branch points, but no pear branches")
+    p.add_argument("--force", action="store_true", help="replace an existing file holding a different sweep")
+    p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
+    p.set_defaults(handler=sweep)
+
+
+def sweep(args) -> int:
+    """Expand, compute the members not yet in the file, append them, summarise."""
+    from .sweep import SweepError, format_summary, run_sweep
+
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: must be >= 1")
+    mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"
+    scene = load_scene(args.scene)
+    try:
+        result = run_sweep(scene, args.vary, args.output, mode=mode, workers=args.workers, scheduler=args.scheduler,
+                           force=args.force, progress=not args.quiet, command=args.command_line)
+    except SweepError as e:
+        raise UsageError(str(e)) from None
+    if not args.quiet:
+        print(format_summary(result))
+    if result.failed:
+        raise Failure(f"{len(result.failed)} of {len(result.members)} sweep members failed (members "
+                      f"{', '.join(map(str, sorted(result.failed)))}); re-run the same command to retry them")
     return 0
 
 

@@ -1,0 +1,205 @@
+"""Sweeps: member expansion, local pool = serial = dask cluster, one writer, resume after an interruption."""
+import json
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from balloon_cg import sweep as sweep_module
+from balloon_cg.cli import main
+from balloon_cg.scene import SceneError, load_scene
+from balloon_cg.sweep import SweepError, expand, read_sweep, run_sweep, scene_hash
+
+SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "spom1_single_coil.toml"
+SPECS = ["M=0:0.004:3"]
+MODE = "primary-only"
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene(SCENE_FILE).with_overrides({"continuation.stop_stretch": 2.0})
+
+
+@pytest.fixture(scope="module")
+def serial(scene, tmp_path_factory):
+    path = tmp_path_factory.mktemp("serial") / "serial.h5"
+    result = run_sweep(scene, SPECS, path, mode=MODE, workers=1)
+    assert result.computed == [0, 1, 2] and not result.failed
+    return read_sweep(path)
+
+
+def assert_same_members(a: dict, b: dict):
+    assert sorted(a["members"]) == sorted(b["members"])
+    for index, ma in a["members"].items():
+        mb = b["members"][index]
+        assert ma["overrides"] == mb["overrides"] and ma["scene_hash"] == mb["scene_hash"]
+        assert list(ma["branches"]) == list(mb["branches"])
+        for name, ba in ma["branches"].items():
+            bb = mb["branches"][name]
+            for key in ("unknowns", "pressure", "lam2_north", "residual", "error_estimate"):
+                np.testing.assert_allclose(ba[key], bb[key], rtol=1e-12, atol=1e-14, err_msg=f"{index}/{name}/{key}")
+            np.testing.assert_allclose(ba["profiles"]["rho"], bb["profiles"]["rho"], rtol=1e-12, atol=1e-14)
+            assert [s["kind"] for s in ba["special_points"]] == [s["kind"] for s in bb["special_points"]]
+
+
+# --- expansion ---------------------------------------------------------------------------------------------
+
+def test_expand_bare_name_range_and_product(scene):
+    members = expand(scene, ["M=0:0.004:3", "field.coils[0].radius=4,5"])
+    assert len(members) == 6
+    assert [m.overrides for m in members[:2]] == [{"field.M": 0.0, "field.coils[0].radius": 4},
+                                                  {"field.M": 0.0, "field.coils[0].radius": 5}]
+    assert members[-1].scene.field.M == pytest.approx(0.004) and members[-1].scene.field.coils[0].radius == 5
+    assert [m.index for m in members] == list(range(6))
+    assert members[2].scene_hash == scene_hash(scene.with_overrides({"field.M": 0.002}))
+
+
+def test_expand_list_entry_key(scene):
+    (m,) = expand(scene, ["material.alpha[0]=1.4"])
+    assert m.scene.material.alpha[0] == 1.4
+    assert m.scene.material.alpha[1:] == scene.material.alpha[1:]
+
+
+@pytest.mark.parametrize("specs, message", [
+    (["M"], "expected KEY=START:STOP:COUNT"),
+    (["M=0:1"], "three fields"),
+    (["degree=20,30"], "exactly one scene table"),
+    (["M=0,1", "field.M=2"], "varied twice"),
+])
+def test_bad_specs(scene, specs, message):
+    with pytest.raises(SweepError, match=message):
+        expand(scene, specs)
+
+
+def test_invalid_members_reported_once_before_any_work(scene, tmp_path):
+    with pytest.raises(SceneError) as info:
+        run_sweep(scene, ["M=-0.002:0.002:5"], tmp_path / "s.h5", mode=MODE, workers=1)
+    message = str(info.value)
+    assert message.startswith("2 of 5 sweep members are invalid")
+    assert message.count("must be >= 0") == 2 and "(member 0)" in message and "(member 1)" in message
+    assert not (tmp_path / "s.h5").exists()
+
+
+# --- parallel backends -------------------------------------------------------------------------------------
+
+def test_local_pool_equals_serial(scene, serial, tmp_path):
+    path = tmp_path / "pool.h5"
+    result = run_sweep(scene, SPECS, path, mode=MODE, workers=2)
+    assert sorted(result.computed) == [0, 1, 2]
+    pool = read_sweep(path)
+    assert_same_members(serial, pool)
+    assert len({m["attrs"]["worker_pid"] for m in pool["members"].values()}) >= 1
+    with h5py.File(path) as f:
+        assert sorted(f["members"]) == ["0", "1", "2"]
+        assert json.loads(f["members/1"].attrs["overrides"]) == {"field.M": 0.002}
+        assert f.attrs["mode"] == MODE and f.attrs["members"] == 3
+
+
+def test_dask_cluster_equals_local_pool(scene, serial, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        result = run_sweep(scene, SPECS, tmp_path / "dask.h5", mode=MODE, scheduler=cluster.scheduler_address)
+    assert sorted(result.computed) == [0, 1, 2] and not result.failed
+    assert_same_members(serial, read_sweep(tmp_path / "dask.h5"))
+
+
+# --- interruption and resume -------------------------------------------------------------------------------
+
+def test_interrupted_sweep_resumes_without_recomputing(scene, serial, tmp_path, monkeypatch):
+    path, written = tmp_path / "resume.h5", []
+    append = sweep_module._append_member
+
+    def append_then_interrupt(f, member, result):
+        append(f, member, result)
+        written.append(member.index)
+        raise KeyboardInterrupt  # the user presses Ctrl-C after the first member is written
+
+    monkeypatch.setattr(sweep_module, "_append_member", append_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(scene, SPECS, path, mode=MODE, workers=2)
+    monkeypatch.setattr(sweep_module, "_append_member", append)
+    assert len(written) == 1
+    with h5py.File(path, "a") as f:
+        assert list(f["members"]) == [str(written[0])]
+        first = dict(f["members"][str(written[0])].attrs)
+        f["members"].create_group(".tmp-2-deadbeef")  # a member whose write was cut before its rename
+
+    result = run_sweep(scene, SPECS, path, mode=MODE, workers=2)
+    assert result.skipped == written
+    assert sorted(result.computed) == sorted({0, 1, 2} - set(written))
+    with h5py.File(path) as f:
+        assert sorted(f["members"]) == ["0", "1", "2"]  # the leftover temporary group is gone
+        again = f["members"][str(written[0])].attrs
+        assert again["created"] == first["created"] and again["worker_pid"] == first["worker_pid"]
+    assert_same_members(serial, read_sweep(path))
+
+    done = run_sweep(scene, SPECS, path, mode=MODE, workers=2)
+    assert done.computed == [] and done.skipped == [0, 1, 2]
+
+
+def test_resume_refuses_changed_scene(scene, tmp_path):
+    path = tmp_path / "s.h5"
+    run_sweep(scene, ["M=0,0.002"], path, mode=MODE, workers=1)
+    moved = scene.with_overrides({"field.coils[0].radius": 4.5})
+    with pytest.raises(SweepError, match=r"base scene differs \(field.coils"):
+        run_sweep(moved, ["M=0,0.002"], path, mode=MODE, workers=1)
+    with pytest.raises(SweepError, match="--vary differs"):
+        run_sweep(scene, ["M=0,0.003"], path, mode=MODE, workers=1)
+    with pytest.raises(SweepError, match="mode differs"):
+        run_sweep(scene, ["M=0,0.002"], path, mode="no-pear", workers=1)
+    with h5py.File(path, "a") as f:  # a member stored for another scene than the one it should hold
+        f["members/1"].attrs["scene_hash"] = scene_hash(moved)
+    with pytest.raises(SweepError, match=r"member 1 \(field.M=0.002\) was computed for another scene"):
+        run_sweep(scene, ["M=0,0.002"], path, mode=MODE, workers=1)
+    result = run_sweep(moved, ["M=0,0.002"], path, mode=MODE, workers=1, force=True)
+    assert result.computed == [0, 1]
+    assert read_sweep(path)["members"][0]["scene_hash"] == scene_hash(moved.with_overrides({"field.M": 0.0}))
+
+
+def test_failed_member_is_reported_and_retried(scene, tmp_path, monkeypatch):
+    path = tmp_path / "s.h5"
+    compute = sweep_module.compute_member
+
+    def flaky(index, *args):
+        if index == 1:
+            raise RuntimeError("boom")
+        return compute(index, *args)
+
+    monkeypatch.setattr(sweep_module, "compute_member", flaky)
+    result = run_sweep(scene, ["M=0,0.002"], path, mode=MODE, workers=1)
+    assert result.computed == [0] and result.failed == {1: "RuntimeError: boom"}
+    monkeypatch.setattr(sweep_module, "compute_member", compute)
+    again = run_sweep(scene, ["M=0,0.002"], path, mode=MODE, workers=1)
+    assert again.skipped == [0] and again.computed == [1]
+
+
+# --- command line ------------------------------------------------------------------------------------------
+
+def test_cli_sweep_and_resume(tmp_path, capsys):
+    out = tmp_path / "cli.h5"
+    argv = ["sweep", str(SCENE_FILE), "--vary", "M=0,0.004", "--vary", "stop_stretch=2", "-o", str(out),
+            "--primary-only", "--workers", "2"]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "2 computed, 0 already in the file" in text and "field.M=0.004, continuation.stop_stretch=2" in text
+    assert main(argv) == 0
+    assert "0 computed, 2 already in the file" in capsys.readouterr().out
+    assert main(argv[:3] + ["M=0,0.003"] + argv[4:]) == 2
+    assert "holds a different sweep: --vary differs" in capsys.readouterr().err
+    assert main(["sweep", str(SCENE_FILE), "--vary", "M=-1", "-o", str(tmp_path / "x.h5")]) == 2
+    assert "must be >= 0" in capsys.readouterr().err
+
+
+def test_cli_no_pear_reports_branch_points(tmp_path, capsys):
+    out = tmp_path / "np.h5"
+    argv = ["sweep", str(SCENE_FILE), "--vary", "M=0", "--vary", "stop_stretch=3", "-o", str(out), "--no-pear",
+            "--workers", "1"]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    member = read_sweep(out)["members"][0]
+    pears = [p for p, b in zip(member["attrs"]["branch_point_pressures"], member["attrs"]["branch_point_blocks"])
+             if b == "odd_held"]
+    assert len(pears) == 1 and f"{pears[0]:.6g}" in text
+    assert list(member["branches"]) == ["primary"] and "stability" in member["branches"]["primary"]
