@@ -1,5 +1,8 @@
 """Two-parameter continuation of pear pitchforks (two_parameter): the SPOM1 isola at M = 0 followed in α1
-(Σ μ_i α_i = 4 kept through μ1) against the closed-form sphere condition of sphere_modes."""
+(Σ μ_i α_i = 4 kept through μ1) against the closed-form sphere condition of sphere_modes; the single-coil isola
+followed in M, its critical M bracketed by plain primary-branch sweeps."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -7,11 +10,11 @@ from balloon_cg import bifurcation
 from balloon_cg.branch import trace_primary
 from balloon_cg.equilibrium import Equilibrium
 from balloon_cg.materials import get_preset
-from balloon_cg.scene import parse_scene
+from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.stability import SecondVariation, assess_branch
 from balloon_cg.storage import read_run
-from balloon_cg.two_parameter import (ExtendedSystem, alpha1_material, continue_branch_point, read_curve,
-                                      sphere_critical_alpha1, sphere_pear_stretches, write_curve)
+from balloon_cg.two_parameter import (ExtendedSystem, alpha1_material, continue_branch_point, land_on_q,
+                                      read_curve, sphere_critical_alpha1, sphere_pear_stretches, write_curve)
 
 SPOM1 = get_preset("SPOM1")
 
@@ -103,3 +106,52 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     assert read_run(path)["branches"] == {}  # also a readable run file (provenance attributes)
     with pytest.raises(FileExistsError):
         write_curve(path, scene, curve)
+
+
+SINGLE_COIL = Path(__file__).resolve().parent.parent / "scenes" / "spom1_single_coil.toml"
+
+
+def _pear_points(branch):
+    """Located pear points of a primary branch from the odd block alone (cheaper than the full assessment)."""
+    variation = SecondVariation(branch.equilibrium, branch.disc.degree)
+    odd = bifurcation.block_indices(variation, "odd_held", False)
+    lowest = np.array([variation._lowest(variation.matrices(X[:-1], branch.params.with_value("P", X[-1]))[0],
+                                         odd)[0] for X in branch.X])
+    changes = np.flatnonzero(np.sign(lowest[:-1]) != np.sign(lowest[1:]))
+    return [bifurcation.locate(branch, int(i), "odd_held", 0) for i in changes]
+
+
+def _probe(M):
+    """Primary branch of the single-coil scene at M over pole stretches [1.5, 2.8] (started at 2: the field
+    cannot be switched on at the default start stretch 1.01 for M ≈ 4)."""
+    scene = load_scene(SINGLE_COIL).with_overrides({
+        "field.M": M, "continuation.start_stretch": 2.0, "continuation.min_stretch": 1.5,
+        "continuation.stop_stretch": 2.8, "continuation.step_max": 0.05, "solver.max_degree": 80})
+    return trace_primary(scene)
+
+
+@pytest.fixture(scope="module")
+def field_curve():
+    scene = load_scene(SINGLE_COIL).with_overrides({"continuation.stop_stretch": 2.0, "solver.degree": 60})
+    branch = trace_primary(scene, down=False)
+    return branch, continue_branch_point(branch, _pear_points(branch)[0], "M")
+
+
+def test_critical_field_of_the_single_coil_isola(field_curve):
+    """Continued in M, the lower pitchfork of the single-coil scene merges with the upper one at M* ≈ 4.1877 (this
+    coil, a = 4 at h = 0, is far from the balloon: the paper's ≈ 0.004 is for its unstated coil). A plain sweep
+    brackets it: the primary branch has two pear points at M = 4.17 (where they lie on the curve) and none at
+    4.20."""
+    branch, curve = field_curve
+    assert len(curve.merges) == 1 and "partner" in curve.stop_reason
+    q, P, stretch = curve.critical
+    assert 4.17 < q < 4.20
+    merge = curve.merges[0].point.X
+    assert branch.disc.tail(merge[:branch.disc.size]) < 1e-9
+    below, above = _pear_points(_probe(4.17)), _pear_points(_probe(4.20))
+    assert len(below) == 2 and len(above) == 0
+    upward = int(np.argmax(curve.q))  # the curve's two crossings of M = 4.17, on either side of the merge
+    for near, bp in zip((upward - 1, upward + 1), below):
+        X = land_on_q(curve, 4.17, near)
+        assert X is not None
+        assert X[branch.disc.size] == pytest.approx(bp.X[-1], rel=1e-7)
