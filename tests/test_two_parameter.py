@@ -13,8 +13,9 @@ from balloon_cg.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.stability import SecondVariation, assess_branch
 from balloon_cg.storage import read_run
-from balloon_cg.two_parameter import (ExtendedSystem, alpha1_material, continue_branch_point, land_on_q,
-                                      read_curve, sphere_critical_alpha1, sphere_pear_stretches, write_curve)
+from balloon_cg.two_parameter import (ExtendedSystem, TwoParameterError, alpha1_material, continue_branch_point,
+                                      land_on_q, read_curve, sphere_critical_alpha1, sphere_pear_stretches,
+                                      write_curve)
 
 SPOM1 = get_preset("SPOM1")
 
@@ -39,7 +40,7 @@ def test_jacobian_matches_differences_of_the_residual(located):
     """The assembled Jacobian (generated Hessians + central differences for the third-derivative and α1 terms)
     against central differences of the exact extended residual."""
     _, branch, bps = located
-    for parameter, q0 in (("alpha1", 1.3), ("M", 0.0)):
+    for parameter, q0 in (("alpha1", 1.3), ("M", 0.0)):  # (no coils: the M column is zero, still consistent)
         eq = Equilibrium(branch.equilibrium.scene, branch.disc)
         odd = bifurcation.block_indices(SecondVariation(eq, branch.disc.degree), "odd_held", False)
         ell = bps[0].mode[odd] / np.linalg.norm(bps[0].mode[odd])
@@ -155,3 +156,9 @@ def test_critical_field_of_the_single_coil_isola(field_curve):
         X = land_on_q(curve, 4.17, near)
         assert X is not None
         assert X[branch.disc.size] == pytest.approx(bp.X[-1], rel=1e-7)
+
+
+def test_continuation_in_M_without_coils_is_refused(located):
+    _, branch, bps = located
+    with pytest.raises(TwoParameterError, match="needs coils"):
+        continue_branch_point(branch, bps[0], "M")

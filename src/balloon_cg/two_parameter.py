@@ -87,16 +87,14 @@ class ExtendedSystem:
 
     # -- parameters ------------------------------------------------------------------------------------
     def set_q(self, q: float):
-        """Parameters at q (for α1 the kernels' μ1, α1 are set, keeping Σ μ_i α_i = 4)."""
+        """Parameters at q (for α1 the kernels' μ1, α1 are set in place, keeping Σ μ_i α_i = 4: the system's
+        kernels are those of the last q evaluated; every stored point carries its own q)."""
         if self.parameter == "M":
             return self.params.with_value("M", q)
         kernels = self.eq.kernels
         kernels.alpha[0] = q
         kernels.mu[0] = (4.0 - self._rest) / q
         return self.params
-
-    def q_value(self, X):
-        return float(X[-1])
 
     def split(self, X):
         n, m = self.n, self.m
@@ -223,6 +221,8 @@ def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0
     eq = Equilibrium(scene, branch.disc)  # own object: the α1 continuation swaps in runtime-exponent kernels
     if q0 is None:
         q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
+    if parameter == "M" and not branch.equilibrium.coils.shape[0]:
+        raise TwoParameterError("continuation in M needs coils: without a field R does not depend on M")
     if bp.block != "odd_held":
         raise TwoParameterError(f"branch point of block {bp.block!r}: only pear (odd_held) points are continued")
     variation = SecondVariation(eq, branch.disc.degree)
