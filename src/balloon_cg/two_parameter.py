@@ -212,8 +212,8 @@ def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0
     """Trace the curve of pear branch points through ``bp`` (located on the symmetric ``branch``) in q.
 
     ``direction``: +1 starts with q increasing, −1 decreasing. ``q0``: the branch's value of q (default: its M,
-    or its material's α1). The trace stops when ``stop(point)`` (a continuation.Point) returns a reason, by default when q
-    returns past q0 after a merge (the curve has reached the partner pitchfork) or at ``max_points``.
+    or its material's α1). The trace stops when ``stop(point)`` (a continuation.Point) returns a reason, by
+    default when q returns past q0 after a merge (the curve has reached the partner pitchfork) or at ``max_points``.
     Returns a TwoParameterCurve whose ``merges`` are the located folds in q (the critical values).
     """
     t0 = time.perf_counter()
@@ -291,7 +291,8 @@ def alpha1_material(material, alpha1: float):
 
 
 def sphere_pear_minimum(material, lam_max: float = 10.0):
-    """(λ, value) of the minimum over λ ∈ (1, lam_max) of the closed-form pear condition 4(S − t) (sphere_modes)."""
+    """(λ, value) of the minimum over λ ∈ (1, lam_max) of the closed-form pear condition 4(S − t)
+    (sphere_modes.bifurcation_condition, n = 1)."""
     grid = np.geomspace(1.0, lam_max, 4000)
     values = bifurcation_condition(material, grid, 1)
     i = int(np.clip(np.argmin(values), 1, grid.size - 2))
