@@ -50,16 +50,9 @@ def equilibrium(scene, degree, name):
 
 
 def point_system(eq):
-    params = Parameters(0.0)
-
-    def residual(X):
-        return eq.residual(X[:-1], params.with_value("P", X[-1]))
-
-    def jacobian(X):
-        p = params.with_value("P", X[-1])
-        return np.hstack([eq.jacobian(X[:-1], p), eq.parameter_derivative(X[:-1], p, "P")[:, None]])
-
-    return residual, jacobian
+    """(residual, jacobian) of X = (u, P) for the constrained point solve."""
+    system = ParameterSystem(eq, Parameters(0.0), "P")
+    return system.residual, system.jacobian
 
 
 def sphere_X(eq, lam, material):

@@ -83,16 +83,10 @@ class PointSolver:
         return self._eq[degree]
 
     def functions(self, eq):
-        params = self.params
+        from balloon_cg.branch import ParameterSystem
 
-        def residual(X):
-            return eq.residual(X[:-1], params.with_value("P", X[-1]))
-
-        def jacobian(X):
-            p = params.with_value("P", X[-1])
-            return np.hstack([eq.jacobian(X[:-1], p), eq.parameter_derivative(X[:-1], p, "P")[:, None]])
-
-        return residual, jacobian
+        system = ParameterSystem(eq, self.params, "P")
+        return system.residual, system.jacobian
 
     def convert(self, X, source, degree):
         """X (u, P) from discretisation ``source`` to ``degree`` (truncating or padding Legendre coefficients)."""

@@ -20,9 +20,10 @@ from .kernels import Arg, Kernel
 HESSIAN_PAIRS = tuple((i, j) for i in range(4) for j in range(i, 4))
 
 
-def _args(cls: SceneClass, node_symbols):
+def kernel_args(cls: SceneClass, node_symbols, leading_params=()):
+    """Arguments of a pointwise kernel: node values, then (leading_params, P, [M, χ]), μ, [α], [field rows]."""
     args = [Arg.node(s) for s in node_symbols]
-    args += [Arg.param(p) for p in fn.runtime_args(cls)]
+    args += [Arg.param(p) for p in (*leading_params, *fn.runtime_args(cls))]
     args.append(Arg.param_array("mu", fn.moduli(cls)))
     if cls.alphas is None:
         args.append(Arg.param_array("alpha", fn.exponents(cls)))
@@ -37,7 +38,7 @@ def energy_kernels(cls: SceneClass) -> list[Kernel]:
     gradient = [sp.diff(density, x) for x in STATE]
     hessian = [sp.diff(gradient[i], STATE[j]) for i, j in HESSIAN_PAIRS]
     at_node = lambda exprs: tuple(fn.field_values(e, rho) for e in exprs)  # noqa: E731
-    args = _args(cls, (cos_theta, sin_theta) + STATE)
+    args = kernel_args(cls, (cos_theta, sin_theta) + STATE)
     kernels = [
         Kernel("energy_density", "π̂ = Π/sin θ at a node (MODEL.md §2).", args, at_node([density])),
         Kernel("energy_gradient", "∂π̂/∂(λ2, v, η, w).", args, at_node(gradient)),
@@ -81,7 +82,7 @@ def first_order_kernels(cls: SceneClass) -> list[Kernel]:
         r2 = at_node(sp.diff(b[1], x) - sp.diff(A[1][0], x) * F1 - sp.diff(A[1][1], x) * F2)
         return (a22 * r1 - a12 * r2) / det, (a11 * r2 - a21 * r1) / det
 
-    args = _args(cls, (theta, cos_theta, sin_theta) + STATE)
+    args = kernel_args(cls, (theta, cos_theta, sin_theta) + STATE)
     columns = [dF(x) for x in STATE]
     jacobian = [0, 1 / sin_theta, 0, 0] + [col[0] for col in columns] + [0, 0, 0, 1] + [col[1] for col in columns]
     dP = dF(P)

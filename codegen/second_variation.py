@@ -37,7 +37,8 @@ import sympy as sp
 from sympy.codegen.cfunctions import expm1, log1p
 
 from . import functional as fn
-from .functional import FIELD, SceneClass, cos_theta, eta, lam2, sin_theta, v, w
+from .functional import SceneClass, cos_theta, eta, lam2, sin_theta, v, w
+from .equations import kernel_args
 from .kernels import Arg, Kernel
 
 m = sp.Symbol("m", real=True)
@@ -206,14 +207,7 @@ def shear_coefficient(cls: SceneClass):
 
 
 def _kernel_args(cls: SceneClass):
-    args = [Arg.node(s) for s in (cos_theta, sin_theta, lam2, v, eta, w)]
-    args += [Arg.param(m)] + [Arg.param(p) for p in fn.runtime_args(cls)]
-    args.append(Arg.param_array("mu", fn.moduli(cls)))
-    if cls.alphas is None:
-        args.append(Arg.param_array("alpha", fn.exponents(cls)))
-    if cls.field:
-        args.append(Arg.node_rows("field", FIELD))
-    return tuple(args)
+    return kernel_args(cls, (cos_theta, sin_theta, lam2, v, eta, w), leading_params=(m,))
 
 
 def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:

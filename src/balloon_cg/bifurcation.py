@@ -3,8 +3,8 @@
 Detection: a sign change, between neighbouring points, of the lowest eigenvalue of a block of the second
 variation (``stability``): the pear block (odd) gives symmetry-breaking pitchforks 'BP'; the even block gives
 equator-symmetric (prolate/oblate) branch points 'BP-even' unless the change coincides with a fold in P.
-Location: Illinois iteration on μ(s), the lowest eigenvalue at the branch point X(s) corrected on the chord
-hyperplane, to |Δs| ≤ 1e-13 (the eigenvalue is taken with the discretisation of the branch itself).
+Location: Brent's method (``continuation.locate_root``) on μ(s), the crossing eigenvalue at the point X(s)
+corrected on the chord hyperplane, to |Δs| ≤ 1e-13 (with the discretisation of the branch itself).
 Classification: the reduced energy at the bifurcation pressure along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
 E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical.
@@ -79,28 +79,18 @@ def locate(branch, index: int, block: str, k: int = 0) -> BranchPoint:
     length = np.linalg.norm(chord)
     d = chord / length
 
-    def mu(s):
+    def value_at(s):
         result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s,
                         eq.scene.solver.tol, eq.scene.solver.max_newton)
+        if not result.converged:
+            raise ArithmeticError(result.message)
         value, mode = _eigenpair(variation, result.x[:-1], params.with_value("P", result.x[-1]), idx, k)
-        return value, result.x, mode
+        return value, (result.x, mode)
 
-    lo, hi = 0.0, length
-    f_lo, f_hi = mu(lo)[0], mu(hi)[0]
-    X, mode = X0, None
-    for _ in range(80):
-        s = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        if not lo < s < hi:
-            s = 0.5 * (lo + hi)
-        value, X, mode = mu(s)
-        if abs(value) < 1e-14 or hi - lo < 1e-13:
-            break
-        if (value > 0) == (f_lo > 0):
-            lo, f_lo = s, value
-            f_hi *= 0.5
-        else:
-            hi, f_hi = s, value
-            f_lo *= 0.5
+    found = continuation.locate_root(value_at, length)
+    if found is None:
+        raise RuntimeError(f"branch point between points {index} and {index + 1} could not be located")
+    X, mode = found
     return BranchPoint(index, block, X, mode)
 
 

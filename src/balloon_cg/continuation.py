@@ -6,11 +6,12 @@ with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector so
 on a slow correction (linear Newton convergence means a nearly singular Jacobian: landing close to a branch
 point, where the corrector may pick the crossing branch).
 *Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
-for a limit point); folds are then located by secant iteration in the arclength to |c·τ| ≤ 1e-10.
+for a limit point); folds are then located by Brent's method in the arclength (``locate_root``, to 1e-13 in s).
 """
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.optimize
 
 from .newton import newton
 
@@ -66,33 +67,34 @@ def correct(system, predictor, direction, settings: Settings):
                   settings.tol, settings.max_newton)
 
 
+def locate_root(value_at, length: float, xtol: float = 1e-13):
+    """Root in (0, length) of s ↦ value_at(s)[0] (value_at returns (value, payload)) by Brent's method, and the
+    payload there. If an evaluation fails (ArithmeticError: e.g. Newton at a singular point) the evaluated point
+    with the smallest |value| is returned; None if there is none."""
+    cache = {}
+
+    def f(s):
+        cache[s] = value_at(s)
+        return cache[s][0]
+
+    try:
+        s = scipy.optimize.brentq(f, 0.0, length, xtol=xtol * max(1.0, length), maxiter=100)
+        return (cache[s] if s in cache else value_at(s))[1]
+    except (ArithmeticError, ValueError):
+        return min(cache.values(), key=lambda item: abs(item[0]))[1] if cache else None
+
+
 def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Settings):
-    """Secant/bisection (Illinois) on s ↦ c·τ(s) in (0, σ); returns the fold point or None."""
-    lo, hi = 0.0, sigma
-    f_lo, f_hi = float(c @ start.tangent), None
-    best = None
-    for _ in range(60):
-        s = 0.5 * (lo + hi) if f_hi is None else hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        if not lo < s < hi:
-            s = 0.5 * (lo + hi)
+    """The point where c·τ vanishes between start and start + σ along the arclength (Brent), or None."""
+
+    def value_at(s):
         result = correct(system, start.X + s * start.tangent, start.tangent, settings)
         if not result.converged:
-            return best
+            raise ArithmeticError(result.message)
         t = tangent(system, result.x, start.tangent)
-        value = float(c @ t)
-        best = Point(result.x, t, result.iterations, result.residual)
-        if abs(value) <= 1e-10 or hi - lo <= 1e-14 * max(1.0, sigma):
-            return best
-        if f_hi is None:
-            f_hi = float(c @ tangent(system, correct(system, start.X + hi * start.tangent, start.tangent,
-                                                       settings).x, start.tangent))
-        if (value > 0) == (f_lo > 0):
-            lo, f_lo = s, value
-            f_hi *= 0.5
-        else:
-            hi, f_hi = s, value
-            f_lo *= 0.5
-    return best
+        return float(c @ t), Point(result.x, t, result.iterations, result.residual)
+
+    return locate_root(value_at, sigma)
 
 
 def trace(system, start: Point, settings: Settings, stop, monitors: dict, progress=None) -> Path:
