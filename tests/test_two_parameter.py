@@ -162,3 +162,16 @@ def test_continuation_in_M_without_coils_is_refused(located):
     _, branch, bps = located
     with pytest.raises(TwoParameterError, match="needs coils"):
         continue_branch_point(branch, bps[0], "M")
+
+
+def test_phase_diagram_plot(curve, tmp_path):
+    from balloon_cg.plotting import plot
+    from balloon_cg.scene import parse_scene
+
+    path = write_curve(tmp_path / "phase.h5", parse_scene('[material]\npreset = "SPOM1"\n'), curve)
+    fig = plot([path], "phase")
+    ax = fig.axes[0]
+    assert "alpha_1" in ax.get_xlabel() and "bifurcation pressure" in ax.get_ylabel()
+    assert any("critical alpha1 = 1.73962" in t.get_text() for t in ax.texts)
+    fig.savefig(tmp_path / "phase.png")
+    assert (tmp_path / "phase.png").stat().st_size > 1000

@@ -107,7 +107,8 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
 def applicable_kinds(branches) -> list[str]:
     """The KINDS that can be drawn for these branches (field needs coils, energy needs normal-form data)."""
     return [kind for kind in KINDS
-            if (kind != "field" or any(b.coils for b in branches))
+            if kind != "phase"
+            and (kind != "field" or any(b.coils for b in branches))
             and (kind != "energy" or any(b.bifurcations for b in branches))]
 
 
@@ -120,6 +121,8 @@ def plot(paths, what: str, points=None, branch: str | None = None) -> Figure:
     """
     if what not in KINDS:
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
+    if what == "phase":
+        return plot_phase(paths)
     draw, per_point = KINDS[what]
     if per_point and branch is None:
         branch = "primary"
@@ -405,6 +408,49 @@ def plot_energy(branches) -> Figure:
     return fig
 
 
+PARAMETER_LABELS = {"M": r"field intensity $M$", "alpha1": r"Ogden exponent $\alpha_1$ ($\sum\mu_i\alpha_i = 4$)"}
+
+
+def plot_phase(paths) -> Figure:
+    """Phase diagram from two-parameter curves (files written by ``two_parameter.write_curve``): the pear
+    bifurcation pressure against the second parameter q; the two pitchforks of an isola meet where q turns
+    back (the critical q, marked); the region where the isola exists (q between its start and the critical
+    value, P between the two pitchfork pressures) is shaded."""
+    fig = Figure(figsize=(6.4, 4.6), constrained_layout=True)
+    ax = fig.add_subplot()
+    parameters = set()
+    for path in paths:
+        with h5py.File(path, "r") as f:
+            names = list(f.get("two_parameter", {}))
+        if not names:
+            raise PlotError(f"{path}: no two-parameter curve in this file (write one with two_parameter.write_curve)")
+        for name in names:
+            curve = _read_curve(path, name)
+            q, P = curve["q"], curve["pressure"]
+            parameters.add(curve["attrs"]["parameter"])
+            line, = ax.plot(q, P, label=f"{Path(path).stem}: {name}")
+            critical = curve["attrs"].get("critical_q", np.nan)
+            merges = np.flatnonzero(np.asarray(curve["special_points"]["kind"]) == "merge")
+            if np.isfinite(critical) and merges.size:
+                P_merge = curve["special_points"]["pressure"][merges[0]]
+                ax.fill(q, P, alpha=0.15, color=line.get_color(), label="isola exists")
+                ax.plot(critical, P_merge, "o", color=line.get_color())
+                ax.annotate(f"critical {curve['attrs']['parameter']} = {critical:.6g}", (critical, P_merge),
+                            textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
+    parameter = parameters.pop() if len(parameters) == 1 else "q"
+    ax.set_xlabel(PARAMETER_LABELS.get(parameter, parameter))
+    ax.set_ylabel(r"bifurcation pressure $P = \bar P R_0/(T_0\mu/2)$")
+    ax.set_title("pear-shaped pitchforks (the isola lies between the two)", fontsize=10)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def _read_curve(path, name):
+    from .two_parameter import read_curve
+
+    return read_curve(path, name)
+
+
 KINDS = {
     "pressure-pole": (plot_pressure_pole, False),
     "pressure-equator": (plot_pressure_equator, False),
@@ -413,4 +459,5 @@ KINDS = {
     "field": (plot_field, True),
     "curvature": (plot_curvature, True),
     "energy": (plot_energy, False),
+    "phase": (plot_phase, False),
 }
