@@ -1,0 +1,101 @@
+"""Benchmark: a 21-member sweep, M = 0 .. 0.005 on the single-coil SPOM1 scene (stop_stretch 3), each member the
+full analysis (primary branch, stability, branch points, pear branches; about 0.5-1 s per member).
+
+Runs the command ``balloon-cg sweep`` in a fresh interpreter each time (worker start-up and numba cache loading
+included; the time of importing balloon_cg in the parent is shown separately) serially (--workers 1) and on 2
+local worker processes, then the same members on a dask LocalCluster of 2 single-threaded worker processes
+(cluster start-up excluded). Prints a table with the speed-up
+over serial (floor: >= 1.7x for 2 workers on an otherwise idle 2-core machine) and checks that every run stored
+the same members. Run: python benchmarks/sweep.py  (output also in benchmarks/results/sweep.txt)
+"""
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from balloon_cg.scene import load_scene
+from balloon_cg.sweep import read_sweep, run_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "scenes" / "spom1_single_coil.toml"
+VARY = ["M=0:0.005:21", "stop_stretch=3"]
+MODE_FLAG = None  # full analysis
+CHILD = "import sys, time; from balloon_cg.cli import main; t = time.perf_counter(); main(sys.argv[1:]); print(time.perf_counter() - t)"
+
+
+def cli_run(out: Path, workers: int) -> tuple[float, float]:
+    """(wall time of the sweep command after import, wall time of the whole process)."""
+    argv = [sys.executable, "-c", CHILD, "sweep", str(SCENE), *sum((["--vary", v] for v in VARY), []),
+            "-o", str(out), *([MODE_FLAG] if MODE_FLAG else []), "--workers", str(workers), "--quiet"]
+    start = time.perf_counter()
+    done = subprocess.run(argv, check=True, capture_output=True, text=True)
+    return float(done.stdout.split()[-1]), time.perf_counter() - start
+
+
+def dask_run(out: Path) -> float | None:
+    try:
+        from distributed import LocalCluster
+    except ImportError:
+        return None
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        start = time.perf_counter()
+        run_sweep(load_scene(SCENE), VARY, out, mode="analysis", scheduler=cluster.scheduler_address)
+        t = time.perf_counter() - start
+        return t, t
+
+
+def same(a: Path, b: Path) -> bool:
+    ra, rb = read_sweep(a)["members"], read_sweep(b)["members"]
+    return sorted(ra) == sorted(rb) and all(
+        np.allclose(ra[i]["branches"]["primary"]["unknowns"], rb[i]["branches"]["primary"]["unknowns"],
+                    rtol=1e-12, atol=1e-14) for i in ra)
+
+
+def member_sum(path: Path) -> float:
+    return sum(m["attrs"]["wall_time"] for m in read_sweep(path)["members"].values())
+
+
+def main():
+    load = os.getloadavg()
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        cli_run(tmp / "warm.h5", 1)  # numba cache warm for every run below
+        rows = [("serial (--workers 1)", cli_run(tmp / "serial.h5", 1), tmp / "serial.h5"),
+                ("local pool, 2 workers", cli_run(tmp / "pool.h5", 2), tmp / "pool.h5")]
+        t = dask_run(tmp / "dask.h5")
+        if t is not None:
+            rows.append(("dask LocalCluster, 2 workers", t, tmp / "dask.h5"))
+        members = read_sweep(tmp / "serial.h5")["members"]
+        member_time = [m["attrs"]["wall_time"] for m in members.values()]
+        serial = rows[0][1][0]
+        lines = [
+            f"sweep benchmark: {SCENE.name}, --vary {' --vary '.join(VARY)}, {MODE_FLAG or 'full analysis'}: "
+            f"{len(members)} members",
+            f"per-member compute time (serial run): mean {np.mean(member_time):.2f} s, "
+            f"min {min(member_time):.2f} s, max {max(member_time):.2f} s",
+            f"cores: {os.cpu_count()}; load average before: {load[0]:.2f}, after: {os.getloadavg()[0]:.2f} "
+            "(other processes share the cores)",
+            "",
+            f"{'run':<30} {'sweep [s]':>10} {'speed-up':>9} {'process [s]':>12} {'speed-up':>9} {'Σ member [s]':>13}  same as serial",
+        ]
+        for name, (wall, total), path in rows:
+            lines.append(f"{name:<30} {wall:>10.2f} {serial / wall:>8.2f}x {total:>12.2f} "
+                         f"{rows[0][1][1] / total:>8.2f}x {member_sum(path):>13.2f}  {same(rows[0][2], path)}")
+        lines += ["", "sweep: the sweep command after `import balloon_cg` (includes starting the local workers and "
+                  "their numba cache loading); process: the whole `python -c ...` run including imports. The dask "
+                  "row excludes the cluster start-up (the cluster exists before the sweep).",
+                  "Σ member: the members' own compute times added up; larger than the serial one means the workers "
+                  "competed for the cores with other processes."]
+    text = "\n".join(lines)
+    print(text)
+    out = ROOT / "benchmarks" / "results" / "sweep.txt"
+    out.write_text(text + "\n")
+
+
+if __name__ == "__main__":
+    main()
