@@ -7,6 +7,8 @@ BALLOON_CG_BLAS_THREADS to another number to change that.
 """
 import os
 
+import numpy  # noqa: F401  (load numpy's and scipy's BLAS first: threadpoolctl limits loaded libraries only)
+import scipy.linalg  # noqa: F401
 from threadpoolctl import threadpool_limits
 
 __version__ = "0.1.0"
