@@ -127,3 +127,15 @@ def test_missing_and_unreadable_files(tmp_path, capsys):
     assert main(["inspect", str(junk)]) == 2
     one_error_line(capsys, "junk.h5", "HDF5")
     assert list(tmp_path.iterdir()) == [junk]
+
+
+def test_critical_alpha1_from_the_command_line(tmp_path, capsys):
+    """`critical` continues the pear pitchfork in alpha1 and reports where the isola closes (closed form:
+    1.739619649392, tests/test_two_parameter.py); `plot --what phase` draws the curve."""
+    scene = tmp_path / "spom1.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n')
+    out = tmp_path / "curve.h5"
+    assert main(["critical", str(scene), "--parameter", "alpha1", "-o", str(out)]) == 0
+    assert "critical alpha1 = 1.73961964939" in capsys.readouterr().out
+    assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0
+    assert (tmp_path / "phase.png").stat().st_size > 1000

@@ -50,7 +50,7 @@ def main(argv=None) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical):
         add(commands)
     return parser
 
@@ -205,6 +205,42 @@ def plot(args) -> int:
     check_output(output, force=True)
     draw_plot(args.files, args.what, args.points, args.branch).savefig(output, dpi=150)
     print(output)
+    return 0
+
+
+# --- critical ----------------------------------------------------------------------------------------------
+
+def _add_critical(commands):
+    p = commands.add_parser("critical", help="continue the first pear pitchfork in M or alpha1 (two-parameter "
+                                             "continuation) and report where the isola closes")
+    p.add_argument("scene", help="scene TOML file")
+    p.add_argument("--parameter", required=True, choices=("M", "alpha1"), help="the second parameter")
+    p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(handler=critical)
+
+
+def critical(args) -> int:
+    """Primary branch, its first pear pitchfork, the curve of pitchforks in the parameter, the merge point."""
+    from .bifurcation import detect, locate
+    from .stability import assess_branch
+    from .two_parameter import continue_branch_point, write_curve
+
+    scene = load_scene(args.scene)
+    check_output(args.output, args.force)
+    branch = trace_primary(scene)
+    assessments, _ = assess_branch(branch, scene.stability.degree)
+    pear = [event for event in detect(branch, assessments) if event[1] == "odd_held"]
+    if not pear:
+        raise Failure(f"no pear-shaped branch point on the primary branch ({branch.stop_reason})")
+    curve = continue_branch_point(branch, locate(branch, *pear[0]), args.parameter)
+    write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
+    if curve.critical is None:
+        print(f"no merge of the pitchforks found ({curve.stop_reason}); curve written to {args.output}")
+        return 0
+    q, P, stretch = curve.critical
+    print(f"critical {args.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
+          f"curve written to {args.output}")
     return 0
 
 
