@@ -203,3 +203,20 @@ def test_cli_no_pear_reports_branch_points(tmp_path, capsys):
              if b == "odd_held"]
     assert len(pears) == 1 and f"{pears[0]:.6g}" in text
     assert list(member["branches"]) == ["primary"] and "stability" in member["branches"]["primary"]
+
+
+def test_phase_diagram_from_a_sweep_file(tmp_path):
+    """`plot SWEEP.h5 --what phase`: the pear pitchfork pressures of every member against the varied key."""
+    from balloon_cg.cli import main as cli_main
+    from balloon_cg.plotting import plot
+
+    scene = tmp_path / "spom1.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n')
+    out = tmp_path / "sweep.h5"
+    assert cli_main(["sweep", str(scene), "--vary", "material.alpha[0]=1.3,1.5", "-o", str(out), "--quiet",
+                     "--no-pear", "--workers", "1"]) == 0
+    fig = plot([out], "phase")
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "material.alpha[0]" and "bifurcation pressure" in ax.get_ylabel()
+    lines = [line for line in ax.get_lines() if "pear pitchfork" in line.get_label()]
+    assert len(lines) == 2 and all(len(line.get_xdata()) == 2 for line in lines)

@@ -422,8 +422,13 @@ def plot_phase(paths) -> Figure:
     for path in paths:
         with h5py.File(path, "r") as f:
             names = list(f.get("two_parameter", {}))
+            is_sweep = "members" in f
+        if is_sweep:
+            parameters.add(_sweep_phase(ax, path))
+            continue
         if not names:
-            raise PlotError(f"{path}: no two-parameter curve in this file (write one with two_parameter.write_curve)")
+            raise PlotError(f"{path}: no two-parameter curve and no sweep members in this file (write one with "
+                            "`balloon-cg critical` or `balloon-cg sweep`)")
         for name in names:
             curve = _read_curve(path, name)
             q, P = curve["q"], curve["pressure"]
@@ -443,6 +448,30 @@ def plot_phase(paths) -> Figure:
     ax.set_title("pear-shaped pitchforks (the isola lies between the two)", fontsize=10)
     ax.legend(fontsize=8)
     return fig
+
+
+def _sweep_phase(ax, path) -> str:
+    """Pear pitchfork pressures of every sweep member against the first varied key; the isola region (two
+    pitchforks) shaded between them. Returns the parameter name."""
+    from .sweep import read_sweep
+
+    sweep = read_sweep(path)
+    rows = []
+    for member in sweep["members"].values():
+        key, value = next(iter(member["overrides"].items()))
+        primary = member["branches"]["primary"]
+        pressures = sorted(s["pressure"] for s in primary["special_points"] if "pear" in s["note"])
+        rows.append((float(value), pressures))
+    rows.sort()
+    q = np.array([r[0] for r in rows])
+    for n in range(max((len(r[1]) for r in rows), default=0)):
+        ax.plot([r[0] for r in rows if len(r[1]) > n], [r[1][n] for r in rows if len(r[1]) > n], "o-", ms=3,
+                label=f"{Path(path).stem}: pear pitchfork {n + 1}")
+    two = np.array([len(r[1]) >= 2 for r in rows])
+    if two.any():
+        ax.fill_between(q, [r[1][0] if len(r[1]) >= 2 else np.nan for r in rows],
+                        [r[1][-1] if len(r[1]) >= 2 else np.nan for r in rows], alpha=0.15, label="isola exists")
+    return "M" if key == "field.M" else key
 
 
 def _read_curve(path, name):
