@@ -4,8 +4,11 @@ OUT ?= out
 
 .PHONY: install install-dev regenerate test run bench clean
 
+# Editable like install-dev, so that `make run` and `make test` never leave two installs of different kinds (a
+# regular install leaves numba cache files in site-packages that would shadow a later editable one).
+# `pip install .` ships the generated kernels too (tests/test_packaging.py builds and inspects the wheel).
 install:
-	$(PYTHON) -m pip install --quiet .
+	$(PYTHON) -m pip install --quiet -e .
 
 install-dev:
 	$(PYTHON) -m pip install --quiet -e ".[test,codegen]"
