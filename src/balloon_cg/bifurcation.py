@@ -172,8 +172,7 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
     def stop(disc, point):
         if disc.degree not in anchors:
             coarse = system.eq.disc
-            anchors[disc.degree] = (np.append(_prolong_to(coarse, phi[:-1], disc), 0.0),
-                                    np.append(_prolong_to(coarse, X_star[:-1], disc), X_star[-1]))
+            anchors[disc.degree] = (coarse.prolong(phi, disc), coarse.prolong(X_star, disc))
         direction, star = anchors[disc.degree]
         if direction @ (point.X - star) < 0:
             return "rejoined the primary branch"
@@ -183,7 +182,3 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
         return base(disc, point)
 
     return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0)
-
-
-def _prolong_to(coarse: Discretisation, u, fine: Discretisation):
-    return u if coarse.degree == fine.degree else coarse.prolong(u, fine)

@@ -216,19 +216,15 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> d
     from .analysis import analyse
     from .branch import trace_primary
 
-    import scipy.linalg  # noqa: F401 - load scipy's BLAS before limiting its threads
-    from threadpoolctl import threadpool_limits
-
+    # BLAS runs single-threaded in every member: importing balloon_cg limits it (balloon_cg/__init__); with
+    # 2 BLAS threads per member on busy cores a member ran 35x slower (benchmarks/sweep.py).
     scene = parse_scene(scene_toml, scene_name)
     start = time.perf_counter()
-    # Parallel members must not each run a multi-threaded BLAS: with 2 BLAS threads per member on busy cores
-    # a member ran 35x slower than single-threaded (benchmarks/sweep.py).
-    with threadpool_limits(limits=int(os.environ.get("BALLOON_CG_BLAS_THREADS", "1"))):
-        if mode == "primary-only":
-            branches, snaps, points = [trace_primary(scene)], None, []
-        else:
-            picture = analyse(scene, pear=(mode == "analysis"))
-            branches, snaps, points = picture.branches, picture.snaps, picture.branch_points
+    if mode == "primary-only":
+        branches, snaps, points = [trace_primary(scene)], None, []
+    else:
+        picture = analyse(scene, pear=(mode == "analysis"))
+        branches, snaps, points = picture.branches, picture.snaps, picture.branch_points
     wall = time.perf_counter() - start
     with tempfile.TemporaryDirectory(prefix="balloon-cg-sweep-") as tmp:
         path = write_run(Path(tmp) / "member.h5", scene, branches, snaps=snaps,
