@@ -12,6 +12,7 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.polynomial import legendre
 
 
@@ -29,7 +30,28 @@ def legendre_table(x: np.ndarray, degree: int):
     return p, dp
 
 
-_UPPER = tuple((k, l) for k in range(4) for l in range(k, 4))
+_UPPER_ROW = np.array([[0, 1, 2, 3], [1, 4, 5, 6], [2, 5, 7, 8], [3, 6, 8, 9]])  # (k, l) -> row of the upper triangle
+
+
+@njit(cache=True)
+def _weighted_bases(pointwise, weights, A, B):
+    """W_q Σ_l h_kl(q) ∂state_l/∂u at every node: against the a-basis A = (∂λ2, ∂v) for k ∈ {λ2, v}
+    (2, n_q, n_a) and against the b-basis B = (∂η, ∂w) for every k (4, n_q, n_b)."""
+    n_q, n_a, n_b = weights.shape[0], A.shape[2], B.shape[2]
+    against_a = np.empty((2, n_q, n_a))
+    against_b = np.empty((4, n_q, n_b))
+    for k in range(4):
+        for q in range(n_q):
+            if k < 2:
+                c0 = pointwise[_UPPER_ROW[k, 0], q] * weights[q]
+                c1 = pointwise[_UPPER_ROW[k, 1], q] * weights[q]
+                for i in range(n_a):
+                    against_a[k, q, i] = c0 * A[0, q, i] + c1 * A[1, q, i]
+            c2 = pointwise[_UPPER_ROW[k, 2], q] * weights[q]
+            c3 = pointwise[_UPPER_ROW[k, 3], q] * weights[q]
+            for i in range(n_b):
+                against_b[k, q, i] = c2 * B[0, q, i] + c3 * B[1, q, i]
+    return against_a, against_b
 
 
 @functools.lru_cache(maxsize=64)
@@ -74,6 +96,9 @@ class Discretisation:
             np.hstack([zeros_a, -s[:, None] * dp[:, b_keep]]),
         ])
         put(self, "ops", ops)
+        # the blocks of ops that are not identically zero: (∂λ2, ∂v)/∂a and (∂η, ∂w)/∂b, contiguous for BLAS
+        put(self, "basis_a", np.ascontiguousarray(ops[0:2, :, :na]))
+        put(self, "basis_b", np.ascontiguousarray(ops[2:4, :, na:]))
 
     def split(self, u: np.ndarray):
         """Full Legendre coefficient vectors (a, b) of length degree + 1 from the unknowns u."""
@@ -100,24 +125,15 @@ class Discretisation:
         (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three
         blocks aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner.
         """
-        weighted = pointwise * self.weights
-        d = np.empty((4, 4, weighted.shape[1]))
-        for row, (k, l) in enumerate(_UPPER):
-            d[k, l] = d[l, k] = weighted[row]
         na = self.a_index.size
-        A = self.ops[0:2, :, :na]
-        B = self.ops[2:4, :, na:]
+        A, B = self.basis_a, self.basis_b
+        weighted_a, weighted_b = _weighted_bases(np.ascontiguousarray(pointwise), self.weights, A, B)
         stacked_a, stacked_b = A.reshape(-1, na), B.reshape(-1, self.size - na)
-
-        def weighted_basis(rows, basis, first):
-            return np.concatenate([d[k, first, :, None] * basis[0] + d[k, first + 1, :, None] * basis[1]
-                                   for k in rows])
-
         out = np.empty((self.size, self.size))
-        out[:na, :na] = stacked_a.T @ weighted_basis((0, 1), A, 0)
-        out[:na, na:] = stacked_a.T @ weighted_basis((0, 1), B, 2)
+        out[:na, :na] = stacked_a.T @ weighted_a.reshape(-1, na)
+        out[:na, na:] = stacked_a.T @ weighted_b[:2].reshape(-1, self.size - na)
         out[na:, :na] = out[:na, na:].T
-        out[na:, na:] = stacked_b.T @ weighted_basis((2, 3), B, 2)
+        out[na:, na:] = stacked_b.T @ weighted_b[2:].reshape(-1, self.size - na)
         return out
 
     def pole_rows(self):

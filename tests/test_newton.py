@@ -1,0 +1,71 @@
+"""Newton with Jacobian reuse (simplified Newton): converges to the root within the tolerance, factors the
+Jacobian only when the corrections stop contracting fast, and reports failures instead of returning garbage."""
+import numpy as np
+import pytest
+
+from balloon_cg.newton import REFRESH_RATIO, newton
+
+
+def circle_and_line():
+    """x² + y² = 4 with the bordering row x − y = 0: root (√2, √2)."""
+    calls = {"jacobian": 0}
+
+    def residual(z):
+        return np.array([z[0] ** 2 + z[1] ** 2 - 4.0])
+
+    def jacobian(z):
+        calls["jacobian"] += 1
+        return np.array([[2 * z[0], 2 * z[1]]])
+
+    return residual, jacobian, np.array([[1.0, -1.0]]), calls
+
+
+@pytest.mark.parametrize("start", [(1.5, 1.5), (1.0, 1.0), (3.0, 3.0)])
+def test_converges_to_root_within_tolerance(start):
+    residual, jacobian, rows, calls = circle_and_line()
+    result = newton(residual, jacobian, start, rows, 0.0, 1e-12, 50)
+    assert result.converged and result.message == "converged"
+    assert np.abs(result.x - np.sqrt(2.0)).max() < 1e-12
+    assert result.residual < 1e-12
+    assert result.jacobians == calls["jacobian"] <= result.iterations
+
+
+def test_good_start_factors_once():
+    """From 1e-3 of the root one Jacobian serves every correction (chord contraction ~1e-3 < REFRESH_RATIO)."""
+    residual, jacobian, rows, _ = circle_and_line()
+    result = newton(residual, jacobian, (np.sqrt(2.0) + 1e-3,) * 2, rows, 0.0, 1e-13, 50)
+    assert result.converged and result.jacobians == 1 and result.iterations >= 3
+
+
+def test_poor_start_refreshes_the_jacobian():
+    """From far away the chord steps contract slower than REFRESH_RATIO: the Jacobian is refreshed."""
+    residual, jacobian, rows, _ = circle_and_line()
+    result = newton(residual, jacobian, (10.0, 10.0), rows, 0.0, 1e-13, 50)
+    assert result.converged and result.jacobians >= 3
+    assert REFRESH_RATIO < 1.0
+
+
+def test_double_root_converges_linearly_and_error_estimate_holds():
+    """x² = 0: Newton halves the error each step (ρ = 1/2); the stop must account for ρ/(1 − ρ)|dx| = |dx|."""
+    result = newton(lambda z: np.array([z[0] ** 2]), lambda z: np.array([[2 * z[0], 0.0]]), (1.0, 0.0),
+                    np.array([[0.0, 1.0]]), 0.0, 1e-6, 200)
+    assert result.converged
+    assert abs(result.x[0]) <= 2e-6  # the true error, not only the last correction, is near the tolerance
+
+
+def test_iteration_bound_reports_failure():
+    result = newton(lambda z: np.array([z[0] ** 2 + 1.0]), lambda z: np.array([[2 * z[0], 0.0]]), (1.0, 0.0),
+                    np.array([[0.0, 1.0]]), 0.0, 1e-12, 30)
+    assert not result.converged and result.iterations <= 30 and result.message
+
+
+def test_singular_matrix_and_domain_errors_are_reported():
+    singular = newton(lambda z: np.array([z[0] - 1.0]), lambda z: np.array([[0.0, 0.0]]), (0.0, 0.0),
+                      np.array([[0.0, 1.0]]), 0.0, 1e-12, 10)
+    assert not singular.converged and "singular" in singular.message
+
+    def leaves(z):
+        raise ArithmeticError("stretch ≤ 0")
+
+    left = newton(leaves, lambda z: np.eye(1, 2), (0.0, 0.0), np.array([[0.0, 1.0]]), 0.0, 1e-12, 10)
+    assert not left.converged and "left the domain" in left.message
