@@ -5,20 +5,26 @@ equations leave free: a pseudo-arclength condition, a prescribed pole stretch or
 Every loop is bounded; the result says whether it converged and why not.
 
 The Jacobian is evaluated and LU-factored only when it is needed (simplified Newton, Hairer & Wanner, *Solving
-ODEs II*, §IV.8): it is reused while the corrections contract by at least ``REFRESH_RATIO`` per iteration, and
-refreshed at the current iterate as soon as they do not (the slow step is dropped, so every accepted step is
-a Newton step or a chord step that contracted fast, and the observed ratios estimate the contraction). With a fresh Jacobian every iteration this is plain
-Newton; from a good start (a continuation predictor, a neighbouring solution) one factorisation usually serves
-the whole solve, and the remaining iterations cost one residual each. Converged when both the last correction
-and the error estimate ρ/(1 − ρ)·|dx| (observed contraction ρ = |dx_k|/|dx_{k−1}|, Hairer & Wanner IV.8.10)
-are below the tolerance.
+ODEs II*, §IV.8): it is reused while the corrections contract fast enough (``REFRESH_RATIO``) and refreshed at
+the current iterate as soon as they do not. The slow step is then dropped, so every accepted step is a Newton
+step or a chord step that contracted fast, and the observed ratios estimate the contraction. With a fresh
+Jacobian every iteration this is plain Newton; from a good start (a continuation predictor, a neighbouring
+solution) one or two factorisations serve the whole solve, and the other iterations cost one residual each.
+Converged when both the last correction and the error estimate ρ/(1 − ρ)·|dx| (observed contraction
+ρ = |dx_k|/|dx_{k−1}|, Hairer & Wanner IV.8.10) are below the tolerance.
 """
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
-REFRESH_RATIO = 0.1  # a stale Jacobian is kept while |dx_k| ≤ REFRESH_RATIO |dx_{k−1}|
+# A stale Jacobian is kept while |dx_k| ≤ ratio·|dx_{k−1}|. A Jacobian (assembly and LU) costs about two
+# residuals below ~100 unknowns, where call overhead dominates, and about eight at 200 (O(n_q n²) assembly):
+# small systems refresh early, large ones ride the chord longer (Hairer & Wanner's advice for costly Jacobians).
+# Measured on the baseline points (benchmarks/baselines.py): best of {1e-3, 1e-2, 1e-1} at each size.
+REFRESH_RATIO = 0.01
+REFRESH_RATIO_LARGE = 0.1
+LARGE_SYSTEM = 100
 
 
 @dataclass
@@ -41,6 +47,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
     ``residual(x)`` returns R (n), ``jacobian(x)`` returns ∂R/∂x (n × (n + k)); rows is (k, n + k).
     """
     x = np.array(x0, dtype=float)
+    refresh_ratio = REFRESH_RATIO_LARGE if x.size >= LARGE_SYSTEM else REFRESH_RATIO
     rows = np.atleast_2d(rows)
     targets = np.atleast_1d(np.asarray(targets, dtype=float))
     previous = np.inf
@@ -64,7 +71,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
             return _failed(x, iteration, r, np.inf, "non-finite Newton step", jacobians)
         step = float(np.abs(dx).max())
         ratio = step / previous if np.isfinite(previous) and previous > 0 else None
-        if ratio is not None and ratio > REFRESH_RATIO and not fresh:
+        if ratio is not None and ratio > refresh_ratio and not fresh:
             factors = None  # a stale Jacobian contracts too slowly: drop its step, redo it with a fresh one here
             continue
         fresh = False
