@@ -49,8 +49,8 @@ import work_precision as wp  # noqa: E402
 LEVEL = 1e-8
 EPS_IVP = 1e-4
 EPS_BVP = 1e-3
-REPEAT_OURS = 5
-REPEAT_BASELINE = 2
+REPEAT_OURS = 9
+REPEAT_BASELINE = 5
 # (solve_ivp rtol = atol, Nelder–Mead xatol); fatol is 1e-30 throughout (termination by xatol)
 PAPER_SETTINGS = ((1e-9, 1e-9), (1e-10, 1e-10), (1e-11, 1e-11), (1e-12, 1e-12))
 BVP_TOLS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 1e-8, 1e-10)  # both ladders ~√10 / ~1.2x apart
