@@ -18,7 +18,7 @@ start_stretch = 1.01
 min_stretch = 1.001
 stop_stretch = 5.0
 step = 0.02
-step_max = 0.035
+step_max = 0.028
 """
 
 CHILD = """

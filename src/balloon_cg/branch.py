@@ -242,15 +242,17 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
     stop = _stop_rule(scene, upper)
     up = tracer.leg(tracer.initial_point(X0, 1.0, params), params, stop, progress)
     below = tracer.leg(tracer.initial_point(X0, -1.0, params), params, stop, progress) if down else None
-    return assemble(tracer, params, "primary", up, below, t0, land_on=upper, labels=("up", "down"))
+    return assemble(tracer, params, "primary", up, below, t0, land_on=(upper, scene.continuation.min_stretch),
+                    labels=("up", "down"))
 
 
 def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
              labels=("forward", "backward")) -> Branch:
     """One Branch from the legs of a trace: reversed ``backward`` (without its first point), then ``forward``.
 
-    Points are prolonged to the finest degree used. With ``land_on``, a forward leg that stopped on reaching
-    that north pole stretch gets its exact end point.
+    Points are prolonged to the finest degree used. With ``land_on`` = (upper, lower) north pole stretches, a
+    forward leg that stopped on passing ``upper`` and a backward leg that stopped on passing ``lower`` get their
+    exact end points.
     """
     legs = [leg for leg in (backward, forward) if leg is not None]
     finest = max([tracer.scene.solver.degree] + [deg for segments, _ in legs for deg, _ in segments])
@@ -267,28 +269,39 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
             folds += [(f.label, base + f.index, coarse.prolong(f.point.X, disc)) for f in path.folds]
         return points, folds
 
+    north = np.append(disc.pole_rows()["lam2_north"], 0.0)
+
+    targets = dict(zip(("reached stop_stretch", "reached min_stretch"), land_on or (None, None)))
+
+    def landed(leg, leg_points):
+        """(points, reason) of a leg, with its exact end point when it stopped on passing a ``land_on`` stretch."""
+        segments, reason = leg
+        target = next((t for key, t in targets.items() if reason.startswith(key)), None)
+        if target is None or not leg_points:
+            return leg_points, reason
+        last_degree, last_path = segments[-1]
+        overshoot = tracer.system(last_degree, params).eq.disc.prolong(last_path.overshoot.X, disc)
+        end = _land(final, leg_points[-1][0], overshoot, north, target, tracer.settings)
+        if end is None:
+            return leg_points, f"could not land on {reason.removeprefix('reached ')} (Newton failed); stopped before it"
+        return leg_points + [(end.X, end, finest, disc.tail(end.X[:-1]))], reason
+
     forward_points, forward_folds = collect(forward[0])
-    backward_points, backward_folds = collect(backward[0]) if backward else ([], [])
+    forward_points, reason = landed(forward, forward_points)
+    backward_points, backward_folds, backward_reason = [], [], None
+    if backward:
+        backward_points, backward_folds = collect(backward[0])
+        backward_points, backward_reason = landed(backward, backward_points)
     points = backward_points[:0:-1] + forward_points
     if not points:
         raise ContinuationError(f"{name}: no converged point ({forward[1]})")
     offset = max(len(backward_points) - 1, 0)
     special = [SpecialPoint(kind, offset - index - 1, X) for kind, index, X in backward_folds[::-1]]
     special += [SpecialPoint(kind, offset + index, X) for kind, index, X in forward_folds]
-    reason = forward[1]
-    if land_on is not None and reason.startswith("reached stop_stretch"):
-        last_degree, last_path = forward[0][-1]
-        overshoot = tracer.system(last_degree, params).eq.disc.prolong(last_path.overshoot.X, disc)
-        north = np.append(disc.pole_rows()["lam2_north"], 0.0)
-        end = _land(final, points[-1][0], overshoot, north, land_on, tracer.settings)
-        if end is None:
-            reason = f"could not land on stop_stretch {land_on:g} (Newton failed); stopped just below it"
-        else:
-            points.append((end.X, end, finest, disc.tail(end.X[:-1])))
     special.append(SpecialPoint("EP", len(points) - 1, points[-1][0], reason))
     if backward and backward_points:
-        special.insert(0, SpecialPoint("EP", 0, points[0][0], backward[1]))
-    stop_reason = f"{labels[0]}: {reason}" + (f"; {labels[1]}: {backward[1]}" if backward else "")
+        special.insert(0, SpecialPoint("EP", 0, points[0][0], backward_reason))
+    stop_reason = f"{labels[0]}: {reason}" + (f"; {labels[1]}: {backward_reason}" if backward else "")
     return Branch(
         name=name,
         equilibrium=final.eq,

@@ -5,6 +5,9 @@ with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector so
 (Keller). Steps grow after easy corrections and shrink on failure, on a sharp turn (τ_i·τ_{i+1} small) or
 on a slow correction (linear Newton convergence means a nearly singular Jacobian: landing close to a branch
 point, where the corrector may pick the crossing branch).
+``step_max`` bounds the change of the state X[:-1] in one step, not of the parameter X[-1]: where the branch
+is steep in the parameter (a stiff material's pressure grows like λ^(α−1)) the arclength may grow until the
+state moves step_max, instead of crawling at a fixed arclength that the parameter alone uses up.
 *Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
 for a limit point); folds are then located by Brent's method in the arclength (``locate_root``, to 1e-13 in s).
 """
@@ -141,7 +144,8 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
             progress(point)
         current = point
         if result.iterations <= 3:
-            sigma = min(sigma * 1.5, settings.step_max)
+            state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
+            sigma = min(sigma * 1.5, settings.step_max / state_share)
         elif result.iterations >= 6:
             sigma = max(sigma * 0.7, settings.step_min)
     path.stop_reason = f"maximum number of points ({settings.max_points}) reached"

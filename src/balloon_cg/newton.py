@@ -33,13 +33,15 @@ class NewtonResult:
     converged: bool
     iterations: int  # corrections computed (a dropped stale-Jacobian correction counts too)
     residual: float  # max-norm of R at the returned x
-    step: float  # max-norm of the last correction
+    step: float  # the last correction in the scaled max-norm max_i |dx_i|/(1 + |x_i|)
     message: str
     jacobians: int = 0  # Jacobian evaluations and factorisations
 
 
 def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> NewtonResult:
-    """Solve R(x) = 0, rows @ x = targets; converged when |dx| and the estimated error are below tol·max(1, |x|∞).
+    """Solve R(x) = 0, rows @ x = targets; converged when the correction and the estimated error are below tol in
+    the scaled max-norm max_i |dx_i|/(1 + |x_i|) (absolute for small components, relative for large ones: a
+    pressure of 10³ does not loosen the tolerance on the shape coefficients).
 
     Near a singular point Newton converges only linearly (ratio ρ) even with a fresh Jacobian, and the
     remaining error ρ/(1 − ρ)|dx| may exceed |dx|: the estimate accounts for that.
@@ -69,7 +71,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
         dx = scipy.linalg.lu_solve(factors, -np.concatenate([r, rows @ x - targets]), check_finite=False)
         if not np.all(np.isfinite(dx)):
             return _failed(x, iteration, r, np.inf, "non-finite Newton step", jacobians)
-        step = float(np.abs(dx).max())
+        step = float((np.abs(dx) / (1.0 + np.abs(x))).max())
         ratio = step / previous if np.isfinite(previous) and previous > 0 else None
         if ratio is not None and ratio > refresh_ratio and not fresh:
             factors = None  # a stale Jacobian contracts too slowly: drop its step, redo it with a fresh one here
@@ -78,7 +80,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
         x = x + dx
         r = None
         error = step if ratio is None else max(step, step * min(ratio, 0.99) / (1.0 - min(ratio, 0.99)))
-        if error <= tol * max(1.0, float(np.abs(x).max())):
+        if error <= tol:
             try:
                 final = float(np.abs(residual(x)).max())
             except ArithmeticError as failure:
