@@ -32,9 +32,8 @@ def landed():
 def test_tail_estimate_tracks_the_true_error(landed, degree):
     scene, branch, X, P_ref = landed
     fine = branch.disc
-    disc = Discretisation(degree, fine.symmetric, fine.pin_translation)
-    a, b = fine.split(X[:-1])
-    X0 = np.append(disc.join(a[: degree + 1], b[: degree + 1]), X[-1])
+    disc = Discretisation(degree, fine.symmetric, fine.pin_translation)  # Legendre in x, no map
+    X0 = fine.transfer(X, disc)
     eq = Equilibrium(scene, disc)
     system = ParameterSystem(eq, branch.params, "P")
     row = np.append(disc.pole_rows()["lam2_north"], 0.0)

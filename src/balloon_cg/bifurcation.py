@@ -106,7 +106,7 @@ def general_tracer(scene) -> PrimaryTracer:
 
 def to_general(branch, tracer, degree, u):
     """Coefficients of a (symmetric-layout) solution in the general layout of ``tracer`` at ``degree``."""
-    disc = tracer.system(degree, branch.params).eq.disc
+    disc = tracer.system(degree, branch.params, branch.disc.mapping).eq.disc
     a, b = branch.disc.split(u)
     return disc.join(a, b)
 
@@ -123,7 +123,7 @@ def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
     scene = branch.equilibrium.scene
     tracer = general_tracer(scene)
     degree = branch.disc.degree
-    eq = tracer.system(degree, branch.params).eq
+    eq = tracer.system(degree, branch.params, branch.disc.mapping).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])
     params = branch.params.with_value("P", bp.X[-1])
     phi = mode_direction(bp, eq.disc)[:-1]
@@ -156,7 +156,7 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
     tracer = general_tracer(scene)
     degree = branch.disc.degree
     params = branch.params
-    system = tracer.system(degree, params)
+    system = tracer.system(degree, params, branch.disc.mapping)
     X_star = np.append(to_general(branch, tracer, degree, bp.X[:-1]), bp.X[-1])
     phi = sign * mode_direction(bp, system.eq.disc)
     guess = X_star + delta * phi
@@ -170,10 +170,10 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
     anchors = {}
 
     def stop(disc, point):
-        if disc.degree not in anchors:
+        if disc not in anchors:
             coarse = system.eq.disc
-            anchors[disc.degree] = (coarse.prolong(phi, disc), coarse.prolong(X_star, disc))
-        direction, star = anchors[disc.degree]
+            anchors[disc] = (coarse.transfer(phi, disc), coarse.transfer(X_star, disc))
+        direction, star = anchors[disc]
         if direction @ (point.X - star) < 0:
             return "rejoined the primary branch"
         south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
@@ -181,4 +181,5 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
             return f"south pole stretch reached stop_stretch {scene.continuation.stop_stretch:g}"
         return base(disc, point)
 
-    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0)
+    return assemble(tracer, params, name,
+                    tracer.leg(start, params, stop, progress, degree=degree, mapping=branch.disc.mapping), t0=t0)

@@ -8,7 +8,9 @@
    stretch (TP) are located and recorded.
 4. Resolution: when a point's spectral error estimate exceeds ``solver.max_error`` the Legendre degree grows
    by half (up to ``solver.max_degree``) and the point is recomputed; past that the branch stops, saying so.
-   Stored points are prolonged to the finest degree used (exact: higher coefficients are zero).
+   With coils the refinement also tries a mapped basis (``wire_map``) whose nodes cluster where the membrane
+   is closest to each wire, and keeps whichever basis gives the smaller error estimate. Stored points are transferred to the last, finest
+   discretisation (exact for the same map: higher coefficients are zero; a projection otherwise).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
 removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
@@ -20,12 +22,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import continuation
+from .coordinate_map import WireMap
 from .discretisation import Discretisation
 from .equilibrium import Equilibrium, Parameters
 from .newton import newton
 from .sphere import sphere_pressure
 
 RESOLUTION = "resolution"
+MAP_WIDTH = 0.3  # map width ε_j per unit gap to wire j (x units); measured best 0.15–0.5 (docs/numerics.md)
+MAP_GAP = 0.5  # wires farther than this from the membrane get no map centre (their field is smooth there)
 
 
 class ContinuationError(RuntimeError):
@@ -112,6 +117,41 @@ def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float,
     return float(min(gaps)), int(np.argmin(gaps))
 
 
+def wire_map(disc: Discretisation, u, coils, symmetric: bool, n_theta: int = 2001) -> WireMap | None:
+    """The map clustering a basis at the membrane's closest approach to each wire within MAP_GAP (x_j = cos θ_j,
+    width MAP_WIDTH·gap_j; mirrored centres for an equator-symmetric basis); None if there is no such wire."""
+    if not len(coils):
+        return None
+    theta = np.linspace(0.0, np.pi, n_theta)
+    lam2, _, eta, _ = disc.evaluate(u, theta)
+    rho = lam2 * np.sin(theta)
+    centres, widths = [], []
+    for c in coils:
+        distance = np.hypot(rho - c.radius, eta - c.height)
+        j = int(np.argmin(distance))
+        if distance[j] >= MAP_GAP:
+            continue
+        x = float(np.clip(np.cos(theta[j]), -0.999, 0.999))
+        for centre in ((x, -x) if symmetric and abs(x) > 1e-3 else (x,)):
+            if all(abs(centre - other) > 1e-6 for other in centres):
+                centres.append(centre)
+                widths.append(MAP_WIDTH * float(distance[j]))
+    return WireMap(tuple(centres), tuple(widths)) if centres else None
+
+
+def transfer_error(source: Discretisation, X, target: Discretisation, moved, n_theta: int = 721) -> np.ndarray:
+    """Per row: max |Δλ2|, |Δη| / |a_0| on a θ grid between X in ``source`` and ``moved`` = its transfer to
+    ``target`` (zero when the transfer is exact: same map, no lower degree)."""
+    X, moved = np.atleast_2d(X), np.atleast_2d(moved)
+    if target.mapping == source.mapping and target.degree >= source.degree:
+        return np.zeros(len(X))
+    theta = np.linspace(0.0, np.pi, n_theta)
+    before = source.evaluate(X[:, : source.size], theta)
+    after = target.evaluate(moved[:, : target.size], theta)
+    difference = np.maximum(np.abs(before[0] - after[0]).max(axis=1), np.abs(before[2] - after[2]).max(axis=1))
+    return difference / np.abs(before[0][:, 0])
+
+
 class PrimaryTracer:
     """Discretisations of growing degree for one scene, and the legs of the primary branch traced on them."""
 
@@ -129,12 +169,12 @@ class PrimaryTracer:
         self.settings = continuation.Settings(c.step, c.step_min, c.step_max, c.max_points, s.tol, s.max_newton)
         self._systems = {}
 
-    def system(self, degree: int, params: Parameters) -> ParameterSystem:
-        if degree not in self._systems:
+    def system(self, degree: int, params: Parameters, mapping: WireMap | None = None) -> ParameterSystem:
+        if (degree, mapping) not in self._systems:
             quadrature = self.scene.solver.quadrature if degree == self.scene.solver.degree else 0
-            disc = Discretisation(degree, self.symmetric, self.pin, quadrature)
-            self._systems[degree] = Equilibrium(self.scene, disc)
-        return ParameterSystem(self._systems[degree], params, "P")
+            disc = Discretisation(degree, self.symmetric, self.pin, quadrature, mapping)
+            self._systems[degree, mapping] = Equilibrium(self.scene, disc)
+        return ParameterSystem(self._systems[degree, mapping], params, "P")
 
     def start(self) -> tuple[np.ndarray, Parameters]:
         """The inflated M = 0 sphere, then the field switched on by natural continuation in M (bounded halving)."""
@@ -170,14 +210,15 @@ class PrimaryTracer:
         north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
         return continuation.Point(X0, direction * continuation.tangent(system, X0, north), 0, 0.0)
 
-    def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None):
-        """Trace from ``start`` (at ``degree``, default the scene's) along its tangent, refining as needed.
+    def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None, mapping=None):
+        """Trace from ``start`` (at ``degree``, default the scene's, and ``mapping``) along its tangent, refining
+        as needed.
 
-        Returns ([(degree, path), ...], stop reason).
+        Returns ([(discretisation, path), ...], stop reason).
         """
         degree = degree or self.scene.solver.degree
         max_error, max_degree = self.scene.solver.max_error, self.scene.solver.max_degree
-        system = self.system(degree, params)
+        system = self.system(degree, params, mapping)
         segments = []
         while True:
             disc = system.eq.disc
@@ -190,7 +231,7 @@ class PrimaryTracer:
                 return stop(disc, point)
 
             path = continuation.trace(system, start, self.settings, checked_stop, monitors, progress)
-            segments.append((degree, path))
+            segments.append((disc, path))
             if path.stop_reason != RESOLUTION:
                 return segments, path.stop_reason
             if degree >= max_degree:
@@ -201,16 +242,36 @@ class PrimaryTracer:
             finer = min(int(degree * 1.5), max_degree)
             last = path.points.pop()  # recomputed at the finer degree as the next segment's first point
             path.folds = [f for f in path.folds if f.index < len(path.points)]  # later ones are found again
-            system = self.system(finer, params)
-            X = disc.prolong(last.X, system.eq.disc)
-            t = disc.prolong(last.tangent, system.eq.disc)
-            result = newton(system.residual, system.jacobian, X, t, t @ X, self.settings.tol, self.settings.max_newton)
-            if not result.converged:
+            refined = self._refine(disc, last, finer, params)
+            if isinstance(refined, str):
                 path.points.append(last)
-                return segments, f"could not refine to degree {finer}: {result.message}"
+                return segments, f"could not refine to degree {finer}: {refined}"
+            system, result, t = refined
             start = continuation.Point(result.x, continuation.tangent(system, result.x, t), result.iterations,
                                        result.residual)
             degree = finer
+
+
+    def _refine(self, disc: Discretisation, last: continuation.Point, degree: int, params: Parameters):
+        """``last`` recomputed at ``degree``, on the current map and (with coils) on one re-centred at the closest
+        approach to the wires (``wire_map``): (system, Newton result, tangent reference) of the candidate with
+        the smaller error estimate, or the last Newton message when none converges."""
+        candidates = [disc.mapping]
+        recentred = wire_map(disc, last.X[:-1], self.scene.field.coils, self.symmetric)
+        if recentred is not None and recentred != disc.mapping:
+            candidates.append(recentred)
+        best, message = None, ""
+        for mapping in candidates:
+            system = self.system(degree, params, mapping)
+            X = disc.transfer(last.X, system.eq.disc)
+            t = disc.transfer(last.tangent, system.eq.disc)
+            result = newton(system.residual, system.jacobian, X, t, t @ X, self.settings.tol, self.settings.max_newton)
+            message = result.message
+            if result.converged:
+                estimate = system.eq.disc.tail(result.x[:-1])
+                if best is None or estimate < best[0]:
+                    best = (estimate, system, result, t)
+        return message if best is None else best[1:]
 
 
 def _stop_rule(scene, upper: float):
@@ -250,23 +311,28 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
              labels=("forward", "backward")) -> Branch:
     """One Branch from the legs of a trace: reversed ``backward`` (without its first point), then ``forward``.
 
-    Points are prolonged to the finest degree used. With ``land_on`` = (upper, lower) north pole stretches, a
+    Points are transferred to the finest discretisation used. With ``land_on`` = (upper, lower) north pole stretches, a
     forward leg that stopped on passing ``upper`` and a backward leg that stopped on passing ``lower`` get their
     exact end points.
     """
     legs = [leg for leg in (backward, forward) if leg is not None]
-    finest = max([tracer.scene.solver.degree] + [deg for segments, _ in legs for deg, _ in segments])
-    final = tracer.system(finest, params)
-    disc = final.eq.disc
+    # the finest discretisation used (the last one of the most refined leg: its map is the latest)
+    disc = max((d for segments, _ in legs for d, _ in segments), key=lambda d: d.degree)
+    final = tracer.system(disc.degree, params, disc.mapping)
+    finest = disc.degree
 
     def collect(segments):
         points, folds = [], []
-        for degree, path in segments:
-            coarse = tracer.system(degree, params).eq.disc
+        for coarse, path in segments:
             base = len(points)
-            for p in path.points:
-                points.append((coarse.prolong(p.X, disc), p, degree, coarse.tail(p.X[:-1])))
-            folds += [(f.label, base + f.index, coarse.prolong(f.point.X, disc)) for f in path.folds]
+            if not path.points:
+                continue
+            own = np.array([p.X for p in path.points])
+            moved = coarse.transfer(own, disc)
+            loss = transfer_error(coarse, own, disc, moved)
+            for p, X, lost in zip(path.points, moved, loss):
+                points.append((X, p, coarse.degree, coarse.tail(p.X[:-1]) + lost))
+            folds += [(f.label, base + f.index, coarse.transfer(f.point.X, disc)) for f in path.folds]
         return points, folds
 
     north = np.append(disc.pole_rows()["lam2_north"], 0.0)
@@ -279,8 +345,8 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
         target = next((t for key, t in targets.items() if reason.startswith(key)), None)
         if target is None or not leg_points:
             return leg_points, reason
-        last_degree, last_path = segments[-1]
-        overshoot = tracer.system(last_degree, params).eq.disc.prolong(last_path.overshoot.X, disc)
+        last_disc, last_path = segments[-1]
+        overshoot = last_disc.transfer(last_path.overshoot.X, disc)
         end = _land(final, leg_points[-1][0], overshoot, north, target, tracer.settings)
         if end is None:
             return leg_points, f"could not land on {reason.removeprefix('reached ')} (Newton failed); stopped before it"

@@ -15,6 +15,8 @@ import numpy as np
 from numba import njit
 from numpy.polynomial import legendre
 
+from .coordinate_map import WireMap
+
 
 def legendre_table(x: np.ndarray, degree: int):
     """(P_k(x), P_k'(x)) for k = 0..degree, each of shape (len(x), degree + 1), by the three-term recurrence."""
@@ -55,29 +57,45 @@ def _weighted_bases(pointwise, weights, A, B):
 
 
 @functools.lru_cache(maxsize=64)
-def _cached_table(theta_bytes: bytes, degree: int):
-    """Legendre tables at cos θ for a θ grid met again and again (stability nodes, stored profiles)."""
-    return legendre_table(np.cos(np.frombuffer(theta_bytes)), degree)
+def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None):
+    """(P_k(s), dP_k/dx) at x = cos θ, s = h(x), for a θ grid met again and again (stability nodes, profiles)."""
+    x = np.cos(np.frombuffer(theta_bytes))
+    if mapping is None:
+        return legendre_table(x, degree)
+    p, dp = legendre_table(np.clip(mapping.s(x), -1.0, 1.0), degree)
+    return p, dp * mapping.ds_dx(x)[:, None]
 
 
 @dataclass(frozen=True)
 class Discretisation:
-    """Basis, quadrature and the unknown-coefficient layout u = (a[kept], b[kept])."""
+    """Basis, quadrature and the unknown-coefficient layout u = (a[kept], b[kept]).
+
+    With a ``mapping`` (coordinate_map.WireMap) the basis is P_k(s), s = h(x): Gauss nodes s_q in s, x_q = g(s_q),
+    weights w_q/h'(x_q) (dx = ds/h'), and d/dx = h'(x) d/ds; everything else is unchanged.
+    """
 
     degree: int
     symmetric: bool
     pin_translation: bool
     quadrature: int = 0
+    mapping: WireMap | None = None
 
     def __post_init__(self):
         n_q = self.quadrature or (3 * self.degree) // 2 + 8
-        x, weights = legendre.leggauss(n_q)
-        p, dp = legendre_table(x, self.degree)
+        nodes, s_weights = legendre.leggauss(n_q)
+        p, dp = legendre_table(nodes, self.degree)
+        if self.mapping is None:
+            x, weights = nodes, s_weights
+        else:
+            x = self.mapping.x(nodes)
+            jacobian = self.mapping.ds_dx(x)
+            weights, dp = s_weights / jacobian, dp * jacobian[:, None]
         s = np.sqrt(1.0 - x * x)
         k = np.arange(self.degree + 1)
         a_keep = k[k % 2 == 0] if self.symmetric else k
         b_keep = k[k % 2 == 1] if self.symmetric else (k[1:] if self.pin_translation else k)
         put = object.__setattr__
+        put(self, "projection", (p * s_weights[:, None] * (k + 0.5)).T)  # values at the nodes -> coefficients
         put(self, "x", x)
         put(self, "weights", weights)
         put(self, "cos_theta", x)
@@ -150,7 +168,7 @@ class Discretisation:
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
-        p, dp = _cached_table(theta.tobytes(), self.degree)
+        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping)
         s = np.sin(theta)
         U = np.atleast_2d(u)
         na = self.a_index.size
@@ -159,16 +177,26 @@ class Discretisation:
                   b @ p[:, self.b_index].T, -s * (b @ dp[:, self.b_index].T))
         return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
 
-    def prolong(self, u: np.ndarray, finer: "Discretisation") -> np.ndarray:
-        """The same functions in a basis of higher degree (zero coefficients appended); u may be (.., size + 1)."""
+    def transfer(self, u: np.ndarray, other: "Discretisation") -> np.ndarray:
+        """The same functions in the basis of ``other``; u may be (.., size + 1), trailing entries (P, ...) kept.
+
+        Same map and a degree at least as high: zero coefficients appended (exact). Otherwise λ2 and η are
+        evaluated at ``other``'s nodes and projected (Gauss quadrature in s: exact up to the truncation).
+        """
         U = np.atleast_2d(u)
         rest = U[:, self.size:]
-        out = []
-        for row in U[:, : self.size]:
-            a, b = self.split(row)
-            pad = finer.degree - self.degree
-            out.append(finer.join(np.pad(a, (0, pad)), np.pad(b, (0, pad))))
-        result = np.hstack([np.array(out), rest])
+        if other.mapping == self.mapping and other.degree >= self.degree:
+            out = []
+            for row in U[:, : self.size]:
+                a, b = self.split(row)
+                pad = other.degree - self.degree
+                out.append(other.join(np.pad(a, (0, pad)), np.pad(b, (0, pad))))
+            coefficients = np.array(out)
+        else:
+            lam2, _, eta, _ = self.evaluate(U[:, : self.size], np.arccos(other.x))
+            a, b = lam2 @ other.projection.T, eta @ other.projection.T
+            coefficients = np.hstack([a[:, other.a_index], b[:, other.b_index]])
+        result = np.hstack([coefficients, rest])
         return result if np.ndim(u) == 2 else result[0]
 
     def tail(self, u: np.ndarray) -> float:

@@ -1,7 +1,7 @@
 """What users look at (MODEL.md §6): stresses, wrinkling, the applied field on the surface, Gaussian curvature.
 
-Every quantity is evaluated from the stored Legendre unknowns of a point (λ2 = Σ a_k P_k(x), η = Σ b_k P_k(x),
-x = cos θ) on a θ grid, poles included. θ-derivatives by the chain rule, regular at the poles:
+Every quantity is evaluated from the stored Legendre unknowns of a point (λ2 = Σ a_k P_k(s), η = Σ b_k P_k(s),
+s = x = cos θ, or s = h(x) for a branch stored with a coordinate map) on a θ grid, poles included. θ-derivatives by the chain rule, regular at the poles:
 
     d/dθ = −sin θ d/dx,    d²/dθ² = sin²θ d²/dx² − cos θ d/dx,
     ρ = λ2 sin θ,   ρ' = λ2' sin θ + λ2 cos θ,   ρ'' = λ2'' sin θ + 2 λ2' cos θ − λ2 sin θ,
@@ -21,6 +21,7 @@ applied field h is in units of I/(4π R0) (MODEL.md §3), so that M H² is the n
 import numpy as np
 from numpy.polynomial import legendre
 
+from .coordinate_map import WireMap
 from .discretisation import Discretisation
 from .field import coil_table, field_components, field_squared_nodes
 from .profiles import meridional_stretch
@@ -35,10 +36,13 @@ def stored_scene(run: dict):
 
 
 def branch_discretisation(branch: dict) -> Discretisation:
-    """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric and
-    pin_translation: it evaluates the branch's unknowns."""
+    """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric,
+    pin_translation and the coordinate map (map_centres, map_widths; empty: none): it evaluates the unknowns."""
     attrs = branch["attrs"]
-    return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]))
+    centres = tuple(float(c) for c in attrs.get("map_centres", ()))
+    mapping = WireMap(centres, tuple(float(w) for w in attrs["map_widths"])) if centres else None
+    return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]),
+                          mapping=mapping)
 
 
 def surface(disc: Discretisation, X, theta) -> dict:
@@ -54,9 +58,15 @@ def surface(disc: Discretisation, X, theta) -> dict:
     b[disc.b_index] = U[:, disc.a_index.size:].T
     c, s = np.cos(theta), np.sin(theta)
 
+    mapping = disc.mapping
+    arg = c if mapping is None else np.clip(mapping.s(c), -1.0, 1.0)
+    ds = 1.0 if mapping is None else mapping.ds_dx(c)
+    d2s = 0.0 if mapping is None else mapping.d2s_dx2(c)
+
     def series(coefficients):
-        """(f, f', f'') in θ of f = Σ c_k P_k(cos θ), and df/dx."""
-        f, fx, fxx = (legendre.legval(c, legendre.legder(coefficients, m)) for m in range(3))
+        """(f, f', f'') in θ of f = Σ c_k P_k(s), s = h(cos θ), and df/dx (f_x = f_s h', f_xx = f_ss h'² + f_s h'')."""
+        f, fs, fss = (legendre.legval(arg, legendre.legder(coefficients, m)) for m in range(3))
+        fx, fxx = fs * ds, fss * ds * ds + fs * d2s
         return f, -s * fx, s * s * fxx - c * fx, fx
 
     lam2, dlam2, d2lam2, _ = series(a)

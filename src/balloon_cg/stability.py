@@ -45,7 +45,8 @@ class SecondVariation:
     def __init__(self, equilibrium, degree: int):
         self.eq = equilibrium
         quadrature = max(equilibrium.disc.x.size, (3 * degree) // 2 + 8)
-        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature)
+        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature,
+                                    mapping=equilibrium.disc.mapping)  # the equilibrium's map: same coefficients
         self.theta = np.arccos(self.basis.x)
         k = np.arange(degree + 1)
         na = degree + 1
