@@ -74,13 +74,14 @@ class PointSolver:
         self.pin = (not scene.field.coils) or held
         self._eq = {}
 
-    def equilibrium(self, degree):
+    def equilibrium(self, degree, mapping=None):
         from balloon_cg.discretisation import Discretisation
         from balloon_cg.equilibrium import Equilibrium
 
-        if degree not in self._eq:
-            self._eq[degree] = Equilibrium(self.scene, Discretisation(degree, self.symmetric, self.pin))
-        return self._eq[degree]
+        if (degree, mapping) not in self._eq:
+            disc = Discretisation(degree, self.symmetric, self.pin, mapping=mapping)
+            self._eq[degree, mapping] = Equilibrium(self.scene, disc)
+        return self._eq[degree, mapping]
 
     def functions(self, eq):
         from balloon_cg.branch import ParameterSystem
@@ -88,21 +89,16 @@ class PointSolver:
         system = ParameterSystem(eq, self.params, "P")
         return system.residual, system.jacobian
 
-    def convert(self, X, source, degree):
-        """X (u, P) from discretisation ``source`` to ``degree`` (truncating or padding Legendre coefficients)."""
-        disc = self.equilibrium(degree).disc
-        a, b = source.split(X[:-1])
-        n = min(source.degree, degree) + 1
-        a2, b2 = np.zeros(degree + 1), np.zeros(degree + 1)
-        a2[:n], b2[:n] = a[:n], b[:n]
-        return np.append(disc.join(a2, b2), X[-1])
+    def convert(self, X, source, degree, mapping=None):
+        """X (u, P) from discretisation ``source`` to ``degree`` and ``mapping`` (Discretisation.transfer)."""
+        return source.transfer(X, self.equilibrium(degree, mapping).disc)
 
-    def solve(self, degree, X0, stretch, tol, max_newton=None):
+    def solve(self, degree, X0, stretch, tol, max_newton=None, mapping=None):
         """Constrained Newton at ``degree`` from X0 (already on that degree): (NewtonResult, CPU seconds);
         the wall time of the same call is left in ``self.last_wall``."""
         from balloon_cg.newton import newton
 
-        eq = self.equilibrium(degree)
+        eq = self.equilibrium(degree, mapping)
         residual, jacobian = self.functions(eq)
         row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
         t0, c0 = time.perf_counter(), time.process_time()
@@ -145,8 +141,8 @@ def prepare(case: Case):
         out = []
         for goal in (s - H, s):
             i = max(int(np.searchsorted(lam, goal)) - 1, 0)  # last branch point below the goal (first crossing)
-            X = solver.convert(branch.X[i], disc, disc.degree)
-            result, _ = solver.solve(disc.degree, X, goal, 1e-13)
+            X = solver.convert(branch.X[i], disc, disc.degree, disc.mapping)
+            result, _ = solver.solve(disc.degree, X, goal, 1e-13, mapping=disc.mapping)
             if not result.converged:
                 raise RuntimeError(f"{case.label}: fine solve at λ = {goal} failed: {result.message}")
             out.append(result.x)
@@ -166,10 +162,10 @@ def prepare(case: Case):
     return branch, solver, targets
 
 
-def neighbour(solver, target: Target, degree: int, source_disc):
-    """The converged point at λ* − H on ``degree`` (untimed), or None."""
-    X = solver.convert(target.X_neighbour_fine, source_disc, degree)
-    result, _ = solver.solve(degree, X, target.stretch - H, 1e-13)
+def neighbour(solver, target: Target, degree: int, source_disc, mapping=None):
+    """The converged point at λ* − H on ``degree`` and ``mapping`` (untimed), or None."""
+    X = solver.convert(target.X_neighbour_fine, source_disc, degree, mapping)
+    result, _ = solver.solve(degree, X, target.stretch - H, 1e-13, mapping=mapping)
     return result.x if result.converged else None
 
 

@@ -8,8 +8,10 @@
    stretch (TP) are located and recorded.
 4. Resolution: when a point's spectral error estimate exceeds ``solver.max_error`` the Legendre degree grows
    by half (up to ``solver.max_degree``) and the point is recomputed; past that the branch stops, saying so.
-   With coils the refinement also tries a mapped basis (``wire_map``) whose nodes cluster where the membrane
-   is closest to each wire, and keeps whichever basis gives the smaller error estimate. Stored points are transferred to the last, finest
+   With coils a mapped basis (``wire_map``) clusters the nodes where the membrane is closest to each wire:
+   on a resolution stop the map is first re-centred at the same degree (kept if the estimate is below
+   max_error/4, at most MAX_RECENTRES times per degree); otherwise the degree grows and the better of the
+   current and the re-centred map is kept. Stored points are transferred to the last, finest
    discretisation (exact for the same map: higher coefficients are zero; a projection otherwise).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
@@ -29,7 +31,8 @@ from .newton import newton
 from .sphere import sphere_pressure
 
 RESOLUTION = "resolution"
-MAP_WIDTH = 0.3  # map width ε_j per unit gap to wire j (x units); measured best 0.15–0.5 (docs/numerics.md)
+MAP_WIDTH = 0.4  # map width ε_j per unit gap to wire j (x units); measured best 0.15–0.5 (docs/numerics.md)
+MAX_RECENTRES = 6  # re-centrings of the map at one degree before the degree grows
 MAP_GAP = 0.5  # wires farther than this from the membrane get no map centre (their field is smooth there)
 
 
@@ -219,7 +222,7 @@ class PrimaryTracer:
         degree = degree or self.scene.solver.degree
         max_error, max_degree = self.scene.solver.max_error, self.scene.solver.max_degree
         system = self.system(degree, params, mapping)
-        segments = []
+        segments, recentres = [], 0
         while True:
             disc = system.eq.disc
             north = np.append(disc.pole_rows()["lam2_north"], 0.0)
@@ -234,34 +237,37 @@ class PrimaryTracer:
             segments.append((disc, path))
             if path.stop_reason != RESOLUTION:
                 return segments, path.stop_reason
-            if degree >= max_degree:
-                return segments, (
-                    f"resolution: spectral error estimate above solver.max_error = {max_error:g} at "
-                    f"solver.max_degree = {max_degree}; raise max_degree or shorten the branch"
-                )
-            finer = min(int(degree * 1.5), max_degree)
-            last = path.points.pop()  # recomputed at the finer degree as the next segment's first point
+            last = path.points.pop()  # recomputed on the new basis as the next segment's first point
             path.folds = [f for f in path.folds if f.index < len(path.points)]  # later ones are found again
-            refined = self._refine(disc, last, finer, params)
-            if isinstance(refined, str):
-                path.points.append(last)
-                return segments, f"could not refine to degree {finer}: {refined}"
+            recentred = wire_map(disc, last.X[:-1], self.scene.field.coils, self.symmetric)
+            refined = None
+            if recentred is not None and recentred != disc.mapping and recentres < MAX_RECENTRES:
+                # first the map re-centred on the closer wire, at the same degree, if it leaves headroom
+                refined = self._refine(disc, last, degree, [recentred], params, 0.25 * max_error)
+                recentres += not isinstance(refined, str)
+            if refined is None or isinstance(refined, str):
+                if degree >= max_degree:
+                    path.points.append(last)
+                    return segments, (
+                        f"resolution: spectral error estimate above solver.max_error = {max_error:g} at "
+                        f"solver.max_degree = {max_degree}; raise max_degree or shorten the branch"
+                    )
+                degree, recentres = min(int(degree * 1.5), max_degree), 0
+                candidates = [disc.mapping] + ([recentred] if recentred not in (None, disc.mapping) else [])
+                refined = self._refine(disc, last, degree, candidates, params, np.inf)
+                if isinstance(refined, str):
+                    path.points.append(last)
+                    return segments, f"could not refine to degree {degree}: {refined}"
             system, result, t = refined
             start = continuation.Point(result.x, continuation.tangent(system, result.x, t), result.iterations,
                                        result.residual)
-            degree = finer
 
-
-    def _refine(self, disc: Discretisation, last: continuation.Point, degree: int, params: Parameters):
-        """``last`` recomputed at ``degree``, on the current map and (with coils) on one re-centred at the closest
-        approach to the wires (``wire_map``): (system, Newton result, tangent reference) of the candidate with
-        the smaller error estimate, or the last Newton message when none converges."""
-        candidates = [disc.mapping]
-        recentred = wire_map(disc, last.X[:-1], self.scene.field.coils, self.symmetric)
-        if recentred is not None and recentred != disc.mapping:
-            candidates.append(recentred)
-        best, message = None, ""
-        for mapping in candidates:
+    def _refine(self, disc: Discretisation, last: continuation.Point, degree: int, mappings, params: Parameters,
+                accept: float):
+        """``last`` recomputed at ``degree`` on each basis map of ``mappings``: (system, Newton result, tangent
+        reference) of the one with the smallest error estimate, if that is ≤ ``accept``; else a message."""
+        best, message = None, "no candidate basis"
+        for mapping in mappings:
             system = self.system(degree, params, mapping)
             X = disc.transfer(last.X, system.eq.disc)
             t = disc.transfer(last.tangent, system.eq.disc)
@@ -269,8 +275,9 @@ class PrimaryTracer:
             message = result.message
             if result.converged:
                 estimate = system.eq.disc.tail(result.x[:-1])
-                if best is None or estimate < best[0]:
+                if estimate <= accept and (best is None or estimate < best[0]):
                     best = (estimate, system, result, t)
+                message = f"error estimate {estimate:.2g} above {accept:.2g}"
         return message if best is None else best[1:]
 
 
@@ -317,7 +324,8 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     """
     legs = [leg for leg in (backward, forward) if leg is not None]
     # the finest discretisation used (the last one of the most refined leg: its map is the latest)
-    disc = max((d for segments, _ in legs for d, _ in segments), key=lambda d: d.degree)
+    used = [d for segments, _ in legs for d, _ in segments]
+    disc = [d for d in used if d.degree == max(u.degree for u in used)][-1]
     final = tracer.system(disc.degree, params, disc.mapping)
     finest = disc.degree
 

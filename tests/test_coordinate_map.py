@@ -1,0 +1,111 @@
+"""The mapped Legendre basis (coordinate_map.WireMap, Discretisation(mapping=...)): map properties, exact
+quadrature and transfer, accuracy near a wire against shooting, and a branch that reaches its wire gap."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balloon_cg.branch import ParameterSystem, trace_primary, wire_gap, wire_map
+from balloon_cg.coordinate_map import WireMap
+from balloon_cg.discretisation import Discretisation
+from balloon_cg.equilibrium import Equilibrium
+from balloon_cg.newton import newton
+from balloon_cg.postprocess import surface
+from balloon_cg.scene import load_scene
+from balloon_cg.shooting import shoot_symmetric
+
+SCENE = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
+MAP = WireMap((0.5, -0.5), (0.06, 0.06))
+
+
+def test_map_is_monotone_onto_and_odd_for_mirrored_centres():
+    x = np.linspace(-1, 1, 2001)
+    s = MAP.s(x)
+    assert s[0] == pytest.approx(-1, abs=1e-15) and s[-1] == pytest.approx(1, abs=1e-15)
+    assert np.all(np.diff(s) > 0) and np.all(MAP.ds_dx(x) > 0)
+    np.testing.assert_allclose(MAP.s(-x), -s, atol=1e-15)
+    np.testing.assert_allclose(MAP.x(s), x, atol=1e-13)
+    h = 1e-6  # derivatives against central differences
+    np.testing.assert_allclose(MAP.ds_dx(x[1:-1]), (MAP.s(x[1:-1] + h) - MAP.s(x[1:-1] - h)) / (2 * h), rtol=1e-6)
+    np.testing.assert_allclose(MAP.d2s_dx2(x[1:-1]), (MAP.ds_dx(x[1:-1] + h) - MAP.ds_dx(x[1:-1] - h)) / (2 * h),
+                               rtol=1e-5, atol=1e-6)
+    with pytest.raises(ValueError, match="widths"):
+        WireMap((0.5,), (0.0,))
+
+
+def test_mapped_quadrature_and_transfer():
+    disc = Discretisation(64, True, False, mapping=MAP)
+    assert disc.weights.sum() == pytest.approx(2.0, abs=1e-13)  # ∫ dx over [−1, 1]
+    assert disc.weights @ np.exp(disc.x) == pytest.approx(np.e - 1 / np.e, rel=1e-12)
+    plain = Discretisation(20, True, False)
+    a, b = np.zeros(21), np.zeros(21)
+    a[0], a[2], b[1], b[3] = 1.5, 0.1, 1.5, 0.05
+    u = plain.join(a, b)
+    theta = np.linspace(0, np.pi, 91)
+    moved = plain.transfer(u, disc)
+    for before, after in zip(plain.evaluate(u, theta), disc.evaluate(moved, theta)):
+        assert np.abs(before - after).max() < 1e-10
+    np.testing.assert_allclose(disc.transfer(moved, plain), u, atol=1e-10)
+    # the pole rows of the mapped basis are those of Legendre (h(±1) = ±1)
+    assert disc.pole_rows()["lam2_north"] @ moved == pytest.approx(plain.pole_rows()["lam2_north"] @ u, abs=1e-12)
+
+
+def test_curvature_of_a_mapped_profile_matches_the_plain_one():
+    plain = Discretisation(20, True, False)
+    a, b = np.zeros(21), np.zeros(21)
+    a[0], a[2], b[1], b[3] = 1.5, 0.1, 1.5, 0.05
+    X = np.append(plain.join(a, b), 1.0)
+    disc = Discretisation(64, True, False, mapping=MAP)
+    theta = np.linspace(0, np.pi, 61)
+    expected, got = surface(plain, X, theta), surface(disc, plain.transfer(X, disc), theta)
+    for key in ("lam1", "rho", "k_meridian", "k_parallel", "gaussian_curvature"):
+        np.testing.assert_allclose(got[key], expected[key], atol=1e-8, err_msg=key)
+
+
+@pytest.fixture(scope="module")
+def near_wire():
+    """The two-coil primary branch landed at pole stretch 1.8 (gap ≈ 0.17) and its shooting pressure."""
+    scene = load_scene(SCENE).with_overrides({"continuation.stop_stretch": 1.8})
+    branch = trace_primary(scene, down=False)
+    X = branch.X[-1]
+    eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
+    shot = shoot_symmetric(scene, 1.8, X[-1], eta0, tol=1e-13)
+    assert shot.converged
+    return scene, branch, X, shot.P
+
+
+def _solve_at(scene, branch, X, disc, stretch):
+    system = ParameterSystem(Equilibrium(scene, disc), branch.params, "P")
+    row = np.append(disc.pole_rows()["lam2_north"], 0.0)
+    result = newton(system.residual, system.jacobian, branch.disc.transfer(X, disc), row, stretch, 1e-13, 30)
+    assert result.converged
+    return result.x
+
+
+def test_mapped_basis_resolves_the_wire_with_a_third_of_the_degree(near_wire):
+    """Degree 64: relative P error < 3e-9 against shooting with the wire map, > 1e-5 in plain Legendre."""
+    scene, branch, X, P_ref = near_wire
+    mapping = wire_map(branch.disc, X[:-1], scene.field.coils, True)
+    assert mapping is not None and len(mapping.centres) == 2
+    errors = {}
+    for name, m in (("plain", None), ("mapped", mapping)):
+        disc = Discretisation(64, True, False, mapping=m)
+        errors[name] = abs(_solve_at(scene, branch, X, disc, 1.8)[-1] / P_ref - 1)
+    assert errors["mapped"] < 3e-9 and errors["plain"] > 1e-5
+
+
+def test_branch_reaches_the_wire_gap_and_its_end_matches_shooting():
+    """The default two-coil scene now ends on its wire_gap (0.1), not on resolution, and the last point's pressure
+    agrees with shooting at its pole stretch."""
+    scene = load_scene(SCENE)
+    branch = trace_primary(scene, down=False)
+    assert "wire_gap" in branch.stop_reason and branch.disc.mapping is not None
+    # each point passed max_error on its own basis; the stored estimate adds the (measured) loss of its transfer
+    # to the final mapped basis
+    assert np.all(branch.error_estimate <= scene.solver.max_error + 1e-11)
+    X = branch.X[-1]
+    assert wire_gap(branch.disc, X[:-1], scene.field.coils)[0] < 0.11
+    stretch = float(branch.disc.pole_rows()["lam2_north"] @ X[:-1])
+    eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
+    shot = shoot_symmetric(scene, stretch, X[-1], eta0, tol=1e-13)
+    assert shot.converged and abs(shot.P / X[-1] - 1) < 1e-8
