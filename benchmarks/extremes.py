@@ -22,6 +22,7 @@ from balloon_cg.branch import trace_primary, wire_gap  # noqa: E402
 from balloon_cg.discretisation import Discretisation  # noqa: E402
 from balloon_cg.equilibrium import Parameters  # noqa: E402
 from balloon_cg.scene import load_scene, parse_scene  # noqa: E402
+from balloon_cg.shooting import shoot_symmetric  # noqa: E402
 from balloon_cg.sphere import sphere_pressure  # noqa: E402
 from test_extremes import constrained_newton  # noqa: E402
 
@@ -143,7 +144,14 @@ def wire_approach():
         branch = trace_primary(scene, down=False)
         gaps = [wire_gap(branch.disc, X[:-1], scene.field.coils)[0] for X in branch.X]
         say(f"  {name}: {summary(branch, t0)}")
-        say(f"    smallest gap reached {min(gaps):.3g} (last point {gaps[-1]:.3g}) at degree {branch.degree[-1]}")
+        say(f"    smallest gap reached {min(gaps):.3g} (last point {gaps[-1]:.3g}) at degree {branch.degree[-1]}, "
+            f"basis map {branch.disc.mapping}")
+        X = branch.X[-1]
+        rows = branch.disc.pole_rows()
+        shot = shoot_symmetric(scene, float(rows["lam2_north"] @ X[:-1]), X[-1], float(rows["eta_north"] @ X[:-1]),
+                               tol=1e-13)
+        say(f"    last point against shooting at its pole stretch: |P/P_shoot − 1| = {abs(X[-1] / shot.P - 1):.1e} "
+            f"({shot.message})")
 
 
 def stability_basis():
