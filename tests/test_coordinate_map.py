@@ -109,3 +109,31 @@ def test_branch_reaches_the_wire_gap_and_its_end_matches_shooting():
     eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
     shot = shoot_symmetric(scene, stretch, X[-1], eta0, tol=1e-13)
     assert shot.converged and abs(shot.P / X[-1] - 1) < 1e-8
+
+
+def _pear_point(branch):
+    from balloon_cg import bifurcation
+    from balloon_cg.stability import SecondVariation
+
+    variation = SecondVariation(branch.equilibrium, branch.disc.degree)
+    odd = bifurcation.block_indices(variation, "odd_held", False)
+    lowest = np.array([variation._lowest(variation.matrices(X[:-1], branch.params.with_value("P", X[-1]))[0],
+                                         odd)[0] for X in branch.X])
+    i = int(np.flatnonzero(np.sign(lowest[:-1]) != np.sign(lowest[1:]))[0])
+    return bifurcation.classify(branch, bifurcation.locate(branch, i, "odd_held", 0))
+
+
+def test_pear_point_does_not_depend_on_the_basis_map():
+    """The pear pitchfork located on the two-coil branch as stored (wire-mapped basis) and on the same branch
+    projected to Legendre in x (degree 96) agree: the stability basis stays in x, where the held constraint
+    b_0 = 0 means ∫η dx = 0 (in a mapped basis it would mean ∫η ds = 0, a different constraint)."""
+    from dataclasses import replace
+
+    scene = load_scene(SCENE)
+    mapped = trace_primary(scene, down=False)
+    assert mapped.disc.mapping is not None
+    disc = Discretisation(96, True, False)
+    plain = replace(mapped, disc=disc, X=mapped.disc.transfer(mapped.X, disc), equilibrium=Equilibrium(scene, disc))
+    bp_mapped, bp_plain = _pear_point(mapped), _pear_point(plain)
+    assert bp_mapped.X[-1] == pytest.approx(bp_plain.X[-1], rel=1e-9)
+    assert bp_mapped.kind == bp_plain.kind == "pitchfork-super"

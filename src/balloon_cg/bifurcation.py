@@ -105,10 +105,9 @@ def general_tracer(scene) -> PrimaryTracer:
 
 
 def to_general(branch, tracer, degree, u):
-    """Coefficients of a (symmetric-layout) solution in the general layout of ``tracer`` at ``degree``."""
-    disc = tracer.system(degree, branch.params, branch.disc.mapping).eq.disc
-    a, b = branch.disc.split(u)
-    return disc.join(a, b)
+    """Coefficients of a (symmetric-layout) solution in the general layout of ``tracer`` at ``degree`` (in x:
+    a branch stored on a mapped basis is projected)."""
+    return branch.disc.transfer(u, tracer.system(degree, branch.params).eq.disc)
 
 
 def mode_direction(bp: BranchPoint, disc: Discretisation):
@@ -123,7 +122,7 @@ def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
     scene = branch.equilibrium.scene
     tracer = general_tracer(scene)
     degree = branch.disc.degree
-    eq = tracer.system(degree, branch.params, branch.disc.mapping).eq
+    eq = tracer.system(degree, branch.params).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])
     params = branch.params.with_value("P", bp.X[-1])
     phi = mode_direction(bp, eq.disc)[:-1]
@@ -156,7 +155,7 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
     tracer = general_tracer(scene)
     degree = branch.disc.degree
     params = branch.params
-    system = tracer.system(degree, params, branch.disc.mapping)
+    system = tracer.system(degree, params)
     X_star = np.append(to_general(branch, tracer, degree, bp.X[:-1]), bp.X[-1])
     phi = sign * mode_direction(bp, system.eq.disc)
     guess = X_star + delta * phi
@@ -182,4 +181,4 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
         return base(disc, point)
 
     return assemble(tracer, params, name,
-                    tracer.leg(start, params, stop, progress, degree=degree, mapping=branch.disc.mapping), t0=t0)
+                    tracer.leg(start, params, stop, progress, degree=degree), t0=t0)

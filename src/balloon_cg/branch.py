@@ -121,9 +121,11 @@ def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float,
 
 
 def wire_map(disc: Discretisation, u, coils, symmetric: bool, n_theta: int = 2001) -> WireMap | None:
-    """The map clustering a basis at the membrane's closest approach to each wire within MAP_GAP (x_j = cos θ_j,
-    width MAP_WIDTH·gap_j; mirrored centres for an equator-symmetric basis); None if there is no such wire."""
-    if not len(coils):
+    """The map clustering an equator-symmetric basis at the membrane's closest approach to each wire within
+    MAP_GAP (centres ±x_j, x_j = cos θ_j, widths MAP_WIDTH·gap_j); None if there is no such wire, and for a
+    general basis: there b_0 = 0 holds the balloon (∫η dx = 0 in x, but ∫η ds = 0 in s: not the same constraint),
+    so a general basis stays in x."""
+    if not len(coils) or not symmetric:
         return None
     theta = np.linspace(0.0, np.pi, n_theta)
     lam2, _, eta, _ = disc.evaluate(u, theta)
@@ -135,7 +137,7 @@ def wire_map(disc: Discretisation, u, coils, symmetric: bool, n_theta: int = 200
         if distance[j] >= MAP_GAP:
             continue
         x = float(np.clip(np.cos(theta[j]), -0.999, 0.999))
-        for centre in ((x, -x) if symmetric and abs(x) > 1e-3 else (x,)):
+        for centre in ((x, -x) if abs(x) > 1e-3 else (x,)):
             if all(abs(centre - other) > 1e-6 for other in centres):
                 centres.append(centre)
                 widths.append(MAP_WIDTH * float(distance[j]))

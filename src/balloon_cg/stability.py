@@ -45,8 +45,9 @@ class SecondVariation:
     def __init__(self, equilibrium, degree: int):
         self.eq = equilibrium
         quadrature = max(equilibrium.disc.x.size, (3 * degree) // 2 + 8)
-        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature,
-                                    mapping=equilibrium.disc.mapping)  # the equilibrium's map: same coefficients
+        # Legendre in x even when the equilibrium's basis is mapped: the held blocks drop b_0, i.e. ∫η dx = 0,
+        # which is the same physical constraint only in this basis
+        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature)
         self.theta = np.arccos(self.basis.x)
         k = np.arange(degree + 1)
         na = degree + 1

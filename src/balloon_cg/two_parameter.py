@@ -40,6 +40,7 @@ from scipy.optimize import brentq, minimize_scalar
 from . import continuation
 from .branch import SpecialPoint
 from .bifurcation import block_indices
+from .discretisation import Discretisation
 from .equilibrium import Equilibrium
 from .kernels import KernelSet
 from .newton import newton
@@ -218,6 +219,11 @@ def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0
     """
     t0 = time.perf_counter()
     scene = branch.equilibrium.scene
+    if branch.disc.mapping is not None:  # the extended system shares coefficients with the stability basis (in x)
+        mapped = branch.disc
+        plain = Discretisation(mapped.degree, mapped.symmetric, mapped.pin_translation)
+        branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain), equilibrium=Equilibrium(scene, plain))
+        bp = replace(bp, X=mapped.transfer(bp.X, plain))
     eq = Equilibrium(scene, branch.disc)  # own object: the α1 continuation swaps in runtime-exponent kernels
     if q0 is None:
         q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
