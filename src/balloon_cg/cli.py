@@ -317,6 +317,8 @@ def summarise_branch(b: dict) -> dict:
         "wall_time_per_point": wall / n,
         "degree": int(attrs["degree"]),
         "symmetric": bool(attrs["symmetric"]),
+        "basis_map": {"centres": [float(c) for c in attrs.get("map_centres", [])],
+                      "widths": [float(w) for w in attrs.get("map_widths", [])]},
         "kernel_class": attrs["kernel_class"],
         "M": float(attrs["M"]),
         "chi": float(attrs["chi"]),
@@ -353,6 +355,9 @@ def _format_branch(name: str, b: dict) -> list[str]:
     lines = [
         f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
         f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
+        *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
+           f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]
+          if b["basis_map"]["centres"] else []),
         f"  points               {b['points']}",
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
         "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
