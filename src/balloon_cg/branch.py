@@ -121,11 +121,10 @@ def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float,
 
 
 def wire_map(disc: Discretisation, u, coils, symmetric: bool, n_theta: int = 2001) -> WireMap | None:
-    """The map clustering an equator-symmetric basis at the membrane's closest approach to each wire within
-    MAP_GAP (centres ±x_j, x_j = cos θ_j, widths MAP_WIDTH·gap_j); None if there is no such wire, and for a
-    general basis: there b_0 = 0 holds the balloon (∫η dx = 0 in x, but ∫η ds = 0 in s: not the same constraint),
-    so a general basis stays in x."""
-    if not len(coils) or not symmetric:
+    """The map clustering a basis at the membrane's closest approach to each wire within MAP_GAP (centres
+    x_j = cos θ_j, mirrored ±x_j for an equator-symmetric basis; widths MAP_WIDTH·gap_j); None if there is no
+    such wire."""
+    if not len(coils):
         return None
     theta = np.linspace(0.0, np.pi, n_theta)
     lam2, _, eta, _ = disc.evaluate(u, theta)
@@ -137,7 +136,7 @@ def wire_map(disc: Discretisation, u, coils, symmetric: bool, n_theta: int = 200
         if distance[j] >= MAP_GAP:
             continue
         x = float(np.clip(np.cos(theta[j]), -0.999, 0.999))
-        for centre in ((x, -x) if abs(x) > 1e-3 else (x,)):
+        for centre in ((x, -x) if symmetric and abs(x) > 1e-3 else (x,)):
             if all(abs(centre - other) > 1e-6 for other in centres):
                 centres.append(centre)
                 widths.append(MAP_WIDTH * float(distance[j]))
@@ -320,7 +319,8 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
              labels=("forward", "backward")) -> Branch:
     """One Branch from the legs of a trace: reversed ``backward`` (without its first point), then ``forward``.
 
-    Points are transferred to the finest discretisation used. With ``land_on`` = (upper, lower) north pole stretches, a
+    Points are transferred to the finest discretisation used (its degree raised, up to max_degree, while the
+    projection would lose more than max_error/2 of any point). With ``land_on`` = (upper, lower) north pole stretches, a
     forward leg that stopped on passing ``upper`` and a backward leg that stopped on passing ``lower`` get their
     exact end points.
     """
@@ -328,6 +328,13 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     # the finest discretisation used (the last one of the most refined leg: its map is the latest)
     used = [d for segments, _ in legs for d, _ in segments]
     disc = [d for d in used if d.degree == max(u.degree for u in used)][-1]
+    solved = [(coarse, np.array([p.X for p in path.points])) for segments, _ in legs for coarse, path in segments
+              if path.points]
+    solver = tracer.scene.solver
+    while disc.degree < solver.max_degree and max(
+            transfer_error(coarse, own, disc, coarse.transfer(own, disc)).max() for coarse, own in solved) > \
+            0.5 * solver.max_error:  # a narrow final map may not hold the early points: store at a higher degree
+        disc = tracer.system(min(int(disc.degree * 1.5), solver.max_degree), params, disc.mapping).eq.disc
     final = tracer.system(disc.degree, params, disc.mapping)
     finest = disc.degree
 

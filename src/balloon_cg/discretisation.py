@@ -102,6 +102,10 @@ class Discretisation:
         put(self, "sin_theta", s)
         put(self, "a_index", a_keep)
         put(self, "b_index", b_keep)
+        # held (b_0 = 0 means ∫η dx = 0) on a mapped general basis: η = Σ b_k (P_k(s) − m_k), m_k = ½∫P_k(s(x)) dx,
+        # so that the hold is the same physical constraint in every basis (m = 0 without a map)
+        held_mapped = self.mapping is not None and self.pin_translation and not self.symmetric
+        put(self, "eta_mean", 0.5 * weights @ p[:, b_keep] if held_mapped else np.zeros(b_keep.size))
         na = a_keep.size
         put(self, "size", na + b_keep.size)
         # state at the nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
@@ -110,7 +114,7 @@ class Discretisation:
         ops = np.stack([
             np.hstack([p[:, a_keep], zeros_b]),
             np.hstack([-(1 - x * x)[:, None] * dp[:, a_keep], zeros_b]),
-            np.hstack([zeros_a, p[:, b_keep]]),
+            np.hstack([zeros_a, p[:, b_keep] - self.eta_mean]),
             np.hstack([zeros_a, -s[:, None] * dp[:, b_keep]]),
         ])
         put(self, "ops", ops)
@@ -119,11 +123,13 @@ class Discretisation:
         put(self, "basis_b", np.ascontiguousarray(ops[2:4, :, na:]))
 
     def split(self, u: np.ndarray):
-        """Full Legendre coefficient vectors (a, b) of length degree + 1 from the unknowns u."""
+        """Full Legendre coefficient vectors (a, b) of length degree + 1 from the unknowns u (for a held mapped
+        basis b_0 = −Σ m_k b_k, so that η = Σ b_k P_k(s))."""
         a = np.zeros(self.degree + 1)
         b = np.zeros(self.degree + 1)
         a[self.a_index] = u[: self.a_index.size]
         b[self.b_index] = u[self.a_index.size:]
+        b[0] -= self.eta_mean @ u[self.a_index.size:]
         return a, b
 
     def join(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -162,8 +168,8 @@ class Discretisation:
         return {
             "lam2_north": self.join(ones, zero),
             "lam2_south": self.join(sign, zero),
-            "eta_north": self.join(zero, ones),
-            "eta_south": self.join(zero, sign),
+            "eta_north": self.join(zero, ones) - np.append(np.zeros(self.a_index.size), self.eta_mean),
+            "eta_south": self.join(zero, sign) - np.append(np.zeros(self.a_index.size), self.eta_mean),
         }
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
@@ -174,7 +180,7 @@ class Discretisation:
         na = self.a_index.size
         a, b = U[:, :na], U[:, na:]
         values = (a @ p[:, self.a_index].T, -s * (a @ dp[:, self.a_index].T),
-                  b @ p[:, self.b_index].T, -s * (b @ dp[:, self.b_index].T))
+                  b @ (p[:, self.b_index] - self.eta_mean).T, -s * (b @ dp[:, self.b_index].T))
         return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
 
     def transfer(self, u: np.ndarray, other: "Discretisation") -> np.ndarray:

@@ -51,11 +51,7 @@ def surface(disc: Discretisation, X, theta) -> dict:
     Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), k_meridian, k_parallel, gaussian_curvature (κ);
     each array has shape (n_points, len(theta)).
     """
-    U = np.atleast_2d(X)[:, : disc.size]
-    a = np.zeros((disc.degree + 1, len(U)))
-    b = np.zeros_like(a)
-    a[disc.a_index] = U[:, : disc.a_index.size].T
-    b[disc.b_index] = U[:, disc.a_index.size:].T
+    a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
     c, s = np.cos(theta), np.sin(theta)
 
     mapping = disc.mapping
