@@ -187,3 +187,32 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire()
     row = np.append(plain.pole_rows()["lam2_north"], 0.0)
     result = newton(system.residual, system.jacobian, pear.disc.transfer(X, plain), row, stretch, 1e-13, 30)
     assert result.converged and abs(result.x[-1] / X[-1] - 1) < 1e-8
+
+
+def test_projection_is_accurate_at_high_degree():
+    """transfer() projects by least squares: a quadratic moved onto a narrow map at degree 320 is exact to 1e-12
+    (the Gauss-weight formula lost ~1e-9 there: numpy's end weights carry ~3e-14, amplified by (k + ½)P_k(±1))."""
+    plain = Discretisation(40, False, True)
+    a, b = np.zeros(41), np.zeros(41)
+    a[0], a[2], b[1], b[2] = 1.5, 0.1, 1.5, 0.05
+    u = plain.join(a, b)
+    theta = np.linspace(0, np.pi, 721)
+    for degree in (135, 320):
+        disc = Discretisation(degree, False, True, mapping=WireMap((0.1,), (0.03,)))
+        moved = plain.transfer(u, disc)
+        for before, after in zip(plain.evaluate(u, theta)[::2], disc.evaluate(moved, theta)[::2]):
+            assert np.abs(before - after).max() < 1e-12
+
+
+def test_bifurcation_work_on_a_mapped_branch_uses_a_degree_that_holds_it(near_wire):
+    """Branch points of a mapped branch are classified and continued in x at a degree whose projection and tail
+    are within max_error, which near a wire is above the mapped degree."""
+    from balloon_cg.bifurcation import plain_degree
+
+    scene, branch, X, _ = near_wire
+    assert branch.disc.mapping is not None
+    degree = plain_degree(branch, X)
+    assert degree > branch.disc.degree
+    plain = Discretisation(degree, True, False)
+    moved = branch.disc.transfer(X, plain)
+    assert plain.tail(moved[:-1]) <= scene.solver.max_error

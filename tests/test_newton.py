@@ -68,3 +68,14 @@ def test_singular_matrix_and_domain_errors_are_reported():
 
     left = newton(leaves, lambda z: np.eye(1, 2), (0.0, 0.0), np.array([[0.0, 1.0]]), 0.0, 1e-12, 10)
     assert not left.converged and "left the domain" in left.message
+
+
+def test_non_finite_residual_at_the_end_is_not_convergence():
+    calls = {"n": 0}
+
+    def residual(z):
+        calls["n"] += 1
+        return np.array([z[0] - 1.0]) if calls["n"] < 3 else np.array([np.nan])
+
+    result = newton(residual, lambda z: np.array([[1.0, 0.0]]), (0.0, 0.0), np.array([[0.0, 1.0]]), 0.0, 1e-12, 10)
+    assert not result.converged and "non-finite" in result.message

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.linalg
 
 from . import continuation
-from .branch import ParameterSystem, PrimaryTracer, _stop_rule, assemble
+from .branch import ParameterSystem, PrimaryTracer, _stop_rule, assemble, transfer_error
 from .discretisation import Discretisation
 from .newton import newton
 from .stability import SecondVariation
@@ -104,6 +104,21 @@ def general_tracer(scene) -> PrimaryTracer:
     return PrimaryTracer(scene, symmetric=False, held=True)
 
 
+def plain_degree(branch, X) -> int:
+    """The Legendre degree in x that holds the point X of ``branch``: the branch's own degree if its basis is not
+    mapped, else grown by half (up to solver.max_degree) until the projection loses at most max_error and its
+    spectral tail is within max_error (the mapped degree is far below what x needs near a wire)."""
+    disc, solver = branch.disc, branch.equilibrium.scene.solver
+    degree = disc.degree
+    while disc.mapping is not None and degree < solver.max_degree:
+        plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
+        moved = disc.transfer(X, plain)
+        if max(transfer_error(disc, X, plain, moved)[0], plain.tail(moved[: plain.size])) <= solver.max_error:
+            break
+        degree = min(int(degree * 1.5), solver.max_degree)
+    return degree
+
+
 def to_general(branch, tracer, degree, u):
     """Coefficients of a (symmetric-layout) solution in the general layout of ``tracer`` at ``degree`` (in x:
     a branch stored on a mapped basis is projected)."""
@@ -111,9 +126,11 @@ def to_general(branch, tracer, degree, u):
 
 
 def mode_direction(bp: BranchPoint, disc: Discretisation):
-    """The critical eigenvector as a unit direction in X = (u, P) of the general discretisation."""
+    """The critical eigenvector as a unit direction in X = (u, P) of the general discretisation (its Legendre
+    coefficients in x padded to that degree)."""
     n = bp.mode.size // 2
-    direction = np.append(disc.join(bp.mode[:n], bp.mode[n:]), 0.0)
+    pad = disc.degree + 1 - n
+    direction = np.append(disc.join(np.pad(bp.mode[:n], (0, pad)), np.pad(bp.mode[n:], (0, pad))), 0.0)
     return direction / np.linalg.norm(direction)
 
 
@@ -121,7 +138,7 @@ def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
     """E2, E3, E4 of the reduced energy at fixed P* and the kind (module docstring)."""
     scene = branch.equilibrium.scene
     tracer = general_tracer(scene)
-    degree = branch.disc.degree
+    degree = plain_degree(branch, bp.X)
     eq = tracer.system(degree, branch.params).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])
     params = branch.params.with_value("P", bp.X[-1])
@@ -153,7 +170,7 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
     t0 = time.perf_counter()
     scene = branch.equilibrium.scene
     tracer = general_tracer(scene)
-    degree = branch.disc.degree
+    degree = plain_degree(branch, bp.X)
     params = branch.params
     system = tracer.system(degree, params)
     X_star = np.append(to_general(branch, tracer, degree, bp.X[:-1]), bp.X[-1])

@@ -242,7 +242,7 @@ class PrimaryTracer:
             path.folds = [f for f in path.folds if f.index < len(path.points)]  # later ones are found again
             recentred = wire_map(disc, last.X[:-1], self.scene.field.coils, self.symmetric)
             refined = None
-            if recentred is not None and recentred != disc.mapping and recentres < MAX_RECENTRES:
+            if recentred is not None and not recentred.close_to(disc.mapping) and recentres < MAX_RECENTRES:
                 # first the map re-centred on the closer wire, at the same degree, if it leaves headroom
                 refined = self._refine(disc, last, degree, [recentred], params, 0.25 * max_error)
                 recentres += not isinstance(refined, str)
@@ -331,14 +331,25 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     solved = [(coarse, np.array([p.X for p in path.points])) for segments, _ in legs for coarse, path in segments
               if path.points]
     solver = tracer.scene.solver
-    while disc.degree < solver.max_degree and max(
-            transfer_error(coarse, own, disc, coarse.transfer(own, disc)).max() for coarse, own in solved) > \
-            0.5 * solver.max_error:  # a narrow final map may not hold the early points: store at a higher degree
-        disc = tracer.system(min(int(disc.degree * 1.5), solver.max_degree), params, disc.mapping).eq.disc
+
+    def worst_loss(target):
+        return max(transfer_error(coarse, own, target, coarse.transfer(own, target)).max() for coarse, own in solved)
+
+    loss = worst_loss(disc)
+    while loss > 0.5 * solver.max_error and disc.degree < solver.max_degree:
+        # a narrow final map may not hold the early points: store at a higher degree while that helps
+        finer = tracer.system(min(int(disc.degree * 1.5), solver.max_degree), params, disc.mapping).eq.disc
+        finer_loss = worst_loss(finer)
+        if finer_loss >= loss:
+            break
+        disc, loss = finer, finer_loss
     final = tracer.system(disc.degree, params, disc.mapping)
     finest = disc.degree
+    uncorrected = []  # projection losses above max_error/2
 
     def collect(segments):
+        """Points and folds in ``disc``; a point's error estimate adds its measured projection loss. Losses above
+        max_error/2 (a narrow final map at max_degree) are counted for the stop reason."""
         points, folds = [], []
         for coarse, path in segments:
             base = len(points)
@@ -347,6 +358,7 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
             own = np.array([p.X for p in path.points])
             moved = coarse.transfer(own, disc)
             loss = transfer_error(coarse, own, disc, moved)
+            uncorrected.extend(float(lost) for lost in loss if lost > 0.5 * solver.max_error)
             for p, X, lost in zip(path.points, moved, loss):
                 points.append((X, p, coarse.degree, coarse.tail(p.X[:-1]) + lost))
             folds += [(f.label, base + f.index, coarse.transfer(f.point.X, disc)) for f in path.folds]
@@ -385,6 +397,9 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     if backward and backward_points:
         special.insert(0, SpecialPoint("EP", 0, points[0][0], backward_reason))
     stop_reason = f"{labels[0]}: {reason}" + (f"; {labels[1]}: {backward_reason}" if backward else "")
+    if uncorrected:
+        stop_reason += (f"; {len(uncorrected)} points stored on the final basis with a projection loss up to "
+                        f"{max(uncorrected):.1g} (in their error estimate)")
     return Branch(
         name=name,
         equilibrium=final.eq,

@@ -40,6 +40,12 @@ class WireMap:
     def _sum(self, x):
         return np.arcsinh((np.asarray(x, dtype=float) - self._c) / self._e).sum(axis=0)
 
+    def close_to(self, other: "WireMap | None", rtol: float = 0.05) -> bool:
+        """Same centres and widths to within rtol of the widths (re-centring on such a map gains nothing)."""
+        return (other is not None and len(other.centres) == len(self.centres)
+                and all(abs(c - d) <= rtol * e and abs(e - f) <= rtol * e
+                        for c, d, e, f in zip(self.centres, other.centres, self.widths, other.widths)))
+
     def s(self, x):
         """h(x)."""
         return -1.0 + self._scale * (self._sum(x) - self._low)

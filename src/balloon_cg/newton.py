@@ -85,6 +85,8 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
             except ArithmeticError as failure:
                 return NewtonResult(x, False, iteration, np.inf, step, f"state left the domain: {failure}",
                                     jacobians)
+            if not np.isfinite(final):
+                return NewtonResult(x, False, iteration, final, step, "non-finite residual at the solution", jacobians)
             return NewtonResult(x, True, iteration, final, step, "converged", jacobians)
         growth = growth + 1 if step > previous else 0
         if growth >= 3:

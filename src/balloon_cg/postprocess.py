@@ -37,12 +37,13 @@ def stored_scene(run: dict):
 
 def branch_discretisation(branch: dict) -> Discretisation:
     """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric,
-    pin_translation and the coordinate map (map_centres, map_widths; empty: none): it evaluates the unknowns."""
+    pin_translation, quadrature (0: automatic) and the coordinate map (map_centres, map_widths; empty: none): it
+    evaluates the unknowns."""
     attrs = branch["attrs"]
     centres = tuple(float(c) for c in attrs.get("map_centres", ()))
     mapping = WireMap(centres, tuple(float(w) for w in attrs["map_widths"])) if centres else None
     return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]),
-                          mapping=mapping)
+                          int(attrs.get("quadrature", 0)), mapping)
 
 
 def surface(disc: Discretisation, X, theta) -> dict:

@@ -121,6 +121,7 @@ def _write_branch(group, branch, theta):
         "degree": disc.degree,
         "symmetric": disc.symmetric,
         "pin_translation": disc.pin_translation,
+        "quadrature": disc.quadrature,
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
         "kernel_class": kernels.name,
