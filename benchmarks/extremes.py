@@ -148,8 +148,7 @@ def wire_approach():
             f"basis map {branch.disc.mapping}")
         X = branch.X[-1]
         rows = branch.disc.pole_rows()
-        shot = shoot_symmetric(scene, float(rows["lam2_north"] @ X[:-1]), X[-1], float(rows["eta_north"] @ X[:-1]),
-                               tol=1e-13)
+        shot = shoot_symmetric(scene, float(rows["lam2_north"] @ X[:-1]), X[-1], float(rows["eta_north"] @ X[:-1]))
         say(f"    last point against shooting at its pole stretch: |P/P_shoot − 1| = {abs(X[-1] / shot.P - 1):.1e} "
             f"({shot.message})")
 
