@@ -338,7 +338,8 @@ def plot(results, path):
         ax.legend(fontsize=8, loc="upper right")
     np.atleast_1d(axes)[0].set_ylabel("|P / P_ref − 1|  (floored at 1e-16)")
     fig.suptitle("Work–precision: constrained Newton from the neighbour at λ* − 0.02, degrees "
-                 f"{DEGREES[0]}–{DEGREES[-1]}; ● tol 1e-12 (lines, by degree), ▲ 1e-9, ■ 1e-6; ◇ dashed: wire-mapped basis",
+                 f"{DEGREES[0]}–{DEGREES[-1]}; ● tol 1e-12 (lines, by degree), ▲ 1e-9, ■ 1e-6; "
+                 "◇ dashed: wire-mapped basis",
                  fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=130)

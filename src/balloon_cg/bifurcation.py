@@ -125,12 +125,17 @@ def to_general(branch, tracer, degree, u):
     return branch.disc.transfer(u, tracer.system(degree, branch.params).eq.disc)
 
 
+def padded_mode(mode: np.ndarray, degree: int) -> np.ndarray:
+    """A mode (a_0..a_N, b_0..b_N) of the stability basis in x, the same function at a degree ≥ N."""
+    n = mode.size // 2
+    return np.concatenate([np.pad(mode[:n], (0, degree + 1 - n)), np.pad(mode[n:], (0, degree + 1 - n))])
+
+
 def mode_direction(bp: BranchPoint, disc: Discretisation):
     """The critical eigenvector as a unit direction in X = (u, P) of the general discretisation (its Legendre
     coefficients in x padded to that degree)."""
-    n = bp.mode.size // 2
-    pad = disc.degree + 1 - n
-    direction = np.append(disc.join(np.pad(bp.mode[:n], (0, pad)), np.pad(bp.mode[n:], (0, pad))), 0.0)
+    mode = padded_mode(bp.mode, disc.degree)
+    direction = np.append(disc.join(mode[: disc.degree + 1], mode[disc.degree + 1:]), 0.0)
     return direction / np.linalg.norm(direction)
 
 
@@ -197,5 +202,4 @@ def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, d
             return f"south pole stretch reached stop_stretch {scene.continuation.stop_stretch:g}"
         return base(disc, point)
 
-    return assemble(tracer, params, name,
-                    tracer.leg(start, params, stop, progress, degree=degree), t0=t0)
+    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0)

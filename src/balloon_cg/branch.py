@@ -147,7 +147,7 @@ def transfer_error(source: Discretisation, X, target: Discretisation, moved, n_t
     """Per row: max |Δλ2|, |Δη| / |a_0| on a θ grid between X in ``source`` and ``moved`` = its transfer to
     ``target`` (zero when the transfer is exact: same map, no lower degree)."""
     X, moved = np.atleast_2d(X), np.atleast_2d(moved)
-    if target.mapping == source.mapping and target.degree >= source.degree:
+    if source.nests_in(target):
         return np.zeros(len(X))
     theta = np.linspace(0.0, np.pi, n_theta)
     before = source.evaluate(X[:, : source.size], theta)
@@ -320,32 +320,41 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     """One Branch from the legs of a trace: reversed ``backward`` (without its first point), then ``forward``.
 
     Points are transferred to the finest discretisation used (its degree raised, up to max_degree, while the
-    projection would lose more than max_error/2 of any point). With ``land_on`` = (upper, lower) north pole stretches, a
-    forward leg that stopped on passing ``upper`` and a backward leg that stopped on passing ``lower`` get their
-    exact end points.
+    projection would lose more than max_error/2 of any point and raising it helps). With ``land_on`` = (upper,
+    lower) north pole stretches, a forward leg that stopped on passing ``upper`` and a backward leg that stopped
+    on passing ``lower`` get their exact end points.
     """
     legs = [leg for leg in (backward, forward) if leg is not None]
     # the finest discretisation used (the last one of the most refined leg: its map is the latest)
     used = [d for segments, _ in legs for d, _ in segments]
     disc = [d for d in used if d.degree == max(u.degree for u in used)][-1]
-    solved = [(coarse, np.array([p.X for p in path.points])) for segments, _ in legs for coarse, path in segments
-              if path.points]
     solver = tracer.scene.solver
 
-    def worst_loss(target):
-        return max(transfer_error(coarse, own, target, coarse.transfer(own, target)).max() for coarse, own in solved)
+    def transferred(target):
+        """Per path with points (by id): its points in ``target`` and their projection losses."""
+        out = {}
+        for segments, _ in legs:
+            for coarse, path in segments:
+                if path.points:
+                    own = np.array([p.X for p in path.points])
+                    moved = coarse.transfer(own, target)
+                    out[id(path)] = moved, transfer_error(coarse, own, target, moved)
+        return out
 
-    loss = worst_loss(disc)
-    while loss > 0.5 * solver.max_error and disc.degree < solver.max_degree:
+    def worst(moves):
+        return max(loss.max() for _, loss in moves.values())
+
+    moves = transferred(disc)
+    while worst(moves) > 0.5 * solver.max_error and disc.degree < solver.max_degree:
         # a narrow final map may not hold the early points: store at a higher degree while that helps
         finer = tracer.system(min(int(disc.degree * 1.5), solver.max_degree), params, disc.mapping).eq.disc
-        finer_loss = worst_loss(finer)
-        if finer_loss >= loss:
+        finer_moves = transferred(finer)
+        if worst(finer_moves) >= worst(moves):
             break
-        disc, loss = finer, finer_loss
+        disc, moves = finer, finer_moves
     final = tracer.system(disc.degree, params, disc.mapping)
     finest = disc.degree
-    uncorrected = []  # projection losses above max_error/2
+    lossy = []  # projection losses above max_error/2
 
     def collect(segments):
         """Points and folds in ``disc``; a point's error estimate adds its measured projection loss. Losses above
@@ -355,10 +364,8 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
             base = len(points)
             if not path.points:
                 continue
-            own = np.array([p.X for p in path.points])
-            moved = coarse.transfer(own, disc)
-            loss = transfer_error(coarse, own, disc, moved)
-            uncorrected.extend(float(lost) for lost in loss if lost > 0.5 * solver.max_error)
+            moved, loss = moves[id(path)]
+            lossy.extend(float(lost) for lost in loss if lost > 0.5 * solver.max_error)
             for p, X, lost in zip(path.points, moved, loss):
                 points.append((X, p, coarse.degree, coarse.tail(p.X[:-1]) + lost))
             folds += [(f.label, base + f.index, coarse.transfer(f.point.X, disc)) for f in path.folds]
@@ -397,9 +404,9 @@ def assemble(tracer, params, name, forward, backward=None, t0=0.0, land_on=None,
     if backward and backward_points:
         special.insert(0, SpecialPoint("EP", 0, points[0][0], backward_reason))
     stop_reason = f"{labels[0]}: {reason}" + (f"; {labels[1]}: {backward_reason}" if backward else "")
-    if uncorrected:
-        stop_reason += (f"; {len(uncorrected)} points stored on the final basis with a projection loss up to "
-                        f"{max(uncorrected):.1g} (in their error estimate)")
+    if lossy:
+        stop_reason += (f"; {len(lossy)} points stored on the final basis with a projection loss up to "
+                        f"{max(lossy):.1g} (in their error estimate)")
     return Branch(
         name=name,
         equilibrium=final.eq,

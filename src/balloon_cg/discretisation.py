@@ -189,15 +189,19 @@ class Discretisation:
                   b @ (p[:, self.b_index] - self.eta_mean).T, -s * (b @ dp[:, self.b_index].T))
         return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
 
+    def nests_in(self, other: "Discretisation") -> bool:
+        """Every function of this basis lies in ``other``'s (same map, degree no higher): transfers are exact."""
+        return other.mapping == self.mapping and other.degree >= self.degree
+
     def transfer(self, u: np.ndarray, other: "Discretisation") -> np.ndarray:
         """The same functions in the basis of ``other``; u may be (.., size + 1), trailing entries (P, ...) kept.
 
-        Same map and a degree at least as high: zero coefficients appended (exact). Otherwise λ2 and η are
-        evaluated at ``other``'s nodes and projected (Gauss quadrature in s: exact up to the truncation).
+        When this basis nests in ``other``, zero coefficients are appended (exact). Otherwise λ2 and η are
+        evaluated at ``other``'s nodes and fitted by least squares (``projection``).
         """
         U = np.atleast_2d(u)
         rest = U[:, self.size:]
-        if other.mapping == self.mapping and other.degree >= self.degree:
+        if self.nests_in(other):
             out = []
             for row in U[:, : self.size]:
                 a, b = self.split(row)

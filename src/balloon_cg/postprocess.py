@@ -1,7 +1,8 @@
 """What users look at (MODEL.md §6): stresses, wrinkling, the applied field on the surface, Gaussian curvature.
 
 Every quantity is evaluated from the stored Legendre unknowns of a point (λ2 = Σ a_k P_k(s), η = Σ b_k P_k(s),
-s = x = cos θ, or s = h(x) for a branch stored with a coordinate map) on a θ grid, poles included. θ-derivatives by the chain rule, regular at the poles:
+s = x = cos θ, or s = h(x) for a branch stored with a coordinate map) on a θ grid, poles included.
+θ-derivatives by the chain rule, regular at the poles:
 
     d/dθ = −sin θ d/dx,    d²/dθ² = sin²θ d²/dx² − cos θ d/dx,
     ρ = λ2 sin θ,   ρ' = λ2' sin θ + λ2 cos θ,   ρ'' = λ2'' sin θ + 2 λ2' cos θ − λ2 sin θ,

@@ -39,7 +39,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from . import continuation
 from .branch import SpecialPoint
-from .bifurcation import block_indices, plain_degree
+from .bifurcation import block_indices, padded_mode, plain_degree
 from .discretisation import Discretisation
 from .equilibrium import Equilibrium
 from .kernels import KernelSet
@@ -223,9 +223,7 @@ def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0
         mapped = branch.disc
         plain = Discretisation(plain_degree(branch, bp.X), mapped.symmetric, mapped.pin_translation)
         branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain), equilibrium=Equilibrium(scene, plain))
-        n, pad = bp.mode.size // 2, plain.degree + 1 - bp.mode.size // 2  # the mode: stability basis in x
-        bp = replace(bp, X=mapped.transfer(bp.X, plain),
-                     mode=np.concatenate([np.pad(bp.mode[:n], (0, pad)), np.pad(bp.mode[n:], (0, pad))]))
+        bp = replace(bp, X=mapped.transfer(bp.X, plain), mode=padded_mode(bp.mode, plain.degree))
     eq = Equilibrium(scene, branch.disc)  # own object: the α1 continuation swaps in runtime-exponent kernels
     if q0 is None:
         q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
