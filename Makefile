@@ -20,7 +20,7 @@ test: install-dev
 	$(PYTHON) -m pytest -q
 
 run: install
-	$(PYTHON) -m balloon_cg.default_run $(OUT)
+	$(PYTHON) -m balloon_cg.app.default_run $(OUT)
 
 bench: install-dev
 	$(PYTHON) benchmarks/primary_branch.py

@@ -67,7 +67,7 @@ class FirstOrderSystem:
     """The generated first-order EL system of a scene: jitted scalar calls (i) and numpy-vectorised (ii)."""
 
     def __init__(self, scene):
-        from balloon_cg.shooting import Shooter
+        from balloon_cg.model.shooting import Shooter
 
         self.shooter = Shooter(scene)
         self.module = self.shooter.module
@@ -107,7 +107,7 @@ class FirstOrderSystem:
 
     # -- (ii): vectorised over the nodes
     def field_nodes(self, lam2, sin_theta, eta):
-        from balloon_cg.field import field_squared_nodes
+        from balloon_cg.model.field import field_squared_nodes
 
         field = np.zeros((6, lam2.size))
         if self.coils.shape[0]:
@@ -198,7 +198,7 @@ def main():
             # (iii) ours: plain Legendre and, with coils, the tracer's wire-mapped basis (centred from the neighbour)
             mappings = [None]
             if case.scene.field.coils:
-                from balloon_cg.branch import wire_map
+                from balloon_cg.analysis.branch import wire_map
 
                 mapped = wire_map(branch.disc, X_nb[:-1], case.scene.field.coils, solver.symmetric)
                 mappings += [mapped] if mapped is not None else []

@@ -18,12 +18,12 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT / "src"))
 
 import work_precision as wp  # noqa: E402
-from balloon_cg.branch import trace_primary, wire_gap  # noqa: E402
-from balloon_cg.discretisation import Discretisation  # noqa: E402
-from balloon_cg.equilibrium import Parameters  # noqa: E402
+from balloon_cg.analysis.branch import trace_primary, wire_gap  # noqa: E402
+from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
+from balloon_cg.galerkin.equilibrium import Parameters  # noqa: E402
 from balloon_cg.scene import load_scene, parse_scene  # noqa: E402
-from balloon_cg.shooting import shoot_symmetric  # noqa: E402
-from balloon_cg.sphere import sphere_pressure  # noqa: E402
+from balloon_cg.model.shooting import shoot_symmetric  # noqa: E402
+from balloon_cg.model.sphere import sphere_pressure  # noqa: E402
 from test_extremes import constrained_newton  # noqa: E402
 
 LINES = []
@@ -156,7 +156,7 @@ def wire_approach():
 def stability_basis():
     say("7. Stability basis degree N up to 60 (second variation, two coils M = 0.002, primary branch to λ = 1.8)")
     try:
-        from balloon_cg import stability
+        from balloon_cg.analysis import stability
     except ImportError as error:
         say(f"  skipped: {error}")
         return

@@ -28,14 +28,14 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT / "src"))
 
 import work_precision as wp  # noqa: E402
-from balloon_cg import continuation  # noqa: E402
-from balloon_cg.branch import ParameterSystem  # noqa: E402
-from balloon_cg.discretisation import Discretisation  # noqa: E402
-from balloon_cg.equilibrium import Equilibrium, Parameters  # noqa: E402
-from balloon_cg.kernels import KernelSet  # noqa: E402
-from balloon_cg.newton import newton  # noqa: E402
+from balloon_cg.numerics import continuation  # noqa: E402
+from balloon_cg.analysis.branch import ParameterSystem  # noqa: E402
+from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters  # noqa: E402
+from balloon_cg.model.kernels import KernelSet  # noqa: E402
+from balloon_cg.numerics.newton import newton  # noqa: E402
 from balloon_cg.scene import parse_scene  # noqa: E402
-from balloon_cg.sphere import sphere_pressure  # noqa: E402
+from balloon_cg.model.sphere import sphere_pressure  # noqa: E402
 
 CLASSES = ("ogden_spom1", "ogden_spom1_field", "ogden_general_field")
 DEGREES = (24, 40, 64)

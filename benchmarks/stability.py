@@ -6,10 +6,10 @@ Run: python benchmarks/stability.py
 """
 import time
 
-from balloon_cg.analysis import analyse
-from balloon_cg.branch import trace_primary
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.branch import trace_primary
 from balloon_cg.scene import parse_scene
-from balloon_cg.stability import SecondVariation
+from balloon_cg.analysis.stability import SecondVariation
 
 SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 6.0\n'
 

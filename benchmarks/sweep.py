@@ -18,13 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from balloon_cg.scene import load_scene
-from balloon_cg.sweep import read_sweep, run_sweep
+from balloon_cg.app.sweep import read_sweep, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "spom1_single_coil.toml"
 VARY = ["M=0:0.005:21", "stop_stretch=3"]
 MODE_FLAG = None  # full analysis
-CHILD = "import sys, time; from balloon_cg.cli import main; t = time.perf_counter(); main(sys.argv[1:]); print(time.perf_counter() - t)"
+CHILD = "import sys, time; from balloon_cg.app.cli import main; t = time.perf_counter(); main(sys.argv[1:]); print(time.perf_counter() - t)"
 
 
 def cli_run(out: Path, workers: int) -> tuple[float, float]:

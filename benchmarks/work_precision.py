@@ -76,8 +76,8 @@ class PointSolver:
         self._eq = {}
 
     def equilibrium(self, degree, mapping=None):
-        from balloon_cg.discretisation import Discretisation
-        from balloon_cg.equilibrium import Equilibrium
+        from balloon_cg.galerkin.discretisation import Discretisation
+        from balloon_cg.galerkin.equilibrium import Equilibrium
 
         if (degree, mapping) not in self._eq:
             disc = Discretisation(degree, self.symmetric, self.pin, mapping=mapping)
@@ -85,7 +85,7 @@ class PointSolver:
         return self._eq[degree, mapping]
 
     def functions(self, eq):
-        from balloon_cg.branch import ParameterSystem
+        from balloon_cg.analysis.branch import ParameterSystem
 
         system = ParameterSystem(eq, self.params, "P")
         return system.residual, system.jacobian
@@ -97,7 +97,7 @@ class PointSolver:
     def solve(self, degree, X0, stretch, tol, max_newton=None, mapping=None):
         """Constrained Newton at ``degree`` from X0 (already on that degree): (NewtonResult, CPU seconds);
         the wall time of the same call is left in ``self.last_wall``."""
-        from balloon_cg.newton import newton
+        from balloon_cg.numerics.newton import newton
 
         eq = self.equilibrium(degree, mapping)
         residual, jacobian = self.functions(eq)
@@ -124,9 +124,9 @@ class Target:
 
 def prepare(case: Case):
     """Trace the primary branch (adaptive degree) to the largest target; fine solutions at every λ* and λ* − H."""
-    from balloon_cg.branch import trace_primary
-    from balloon_cg.shooting import shoot_symmetric
-    from balloon_cg.sphere import sphere_pressure
+    from balloon_cg.analysis.branch import trace_primary
+    from balloon_cg.model.shooting import shoot_symmetric
+    from balloon_cg.model.sphere import sphere_pressure
 
     top = max(case.stretches)
     branch = trace_primary(case.scene, stop_stretch=top, down=False)
@@ -172,7 +172,7 @@ def neighbour(solver, target: Target, degree: int, source_disc, mapping=None):
 
 def wire_maps(case, branch, targets):
     """Per target stretch: the tracer's wire-mapped basis centred from the neighbour's profile (coil scenes)."""
-    from balloon_cg.branch import wire_map
+    from balloon_cg.analysis.branch import wire_map
 
     return {t.stretch: wire_map(branch.disc, t.X_neighbour_fine[:-1], case.scene.field.coils, branch.disc.symmetric)
             for t in targets if t is not None}
@@ -218,13 +218,14 @@ def sweep(case, branch, solver, targets, degrees=DEGREES, tols=TOLS, repeat=REPE
 
 
 def bifurcation_hook(case: Case):
-    """(b) the bifurcation pressure: uses balloon_cg.stability / balloon_cg.bifurcation when they exist.
+    """(b) the bifurcation pressure: uses balloon_cg.analysis.stability / balloon_cg.analysis.bifurcation when they exist.
 
     Returns a line for the report. The error of the bifurcation pressure against degree is the natural
     extension of this table once the detection is in place (a located branch point per degree).
     """
     try:
-        from balloon_cg import bifurcation, stability  # noqa: F401
+        from balloon_cg.analysis import bifurcation  # noqa: F401
+        from balloon_cg.analysis import stability  # noqa: F401
     except ImportError as error:
         return f"(b) bifurcation pressure: not available ({error})"
     return bifurcation_rows(case, stability, bifurcation)
@@ -237,7 +238,7 @@ def bifurcation_rows(case, stability, bifurcation):
     ``bifurcation.locate`` takes the eigenvalue with the branch's own discretisation, so the primary branch
     degree is the resolution parameter here; the stability basis degree N = 20 only serves detection.
     """
-    from balloon_cg.branch import trace_primary
+    from balloon_cg.analysis.branch import trace_primary
 
     try:
         found_P = {}
@@ -259,7 +260,7 @@ def bifurcation_rows(case, stability, bifurcation):
             best = found_P[max(found_P)]
             lines.append("relative to degree {}: {}".format(max(found_P), ", ".join(
                 f"{d}: {abs(P / best - 1):.1e}" for d, P in found_P.items() if d != max(found_P))))
-        return "(b) bifurcation pressure (balloon_cg.bifurcation, first branch point, N = 20): " + "; ".join(lines)
+        return "(b) bifurcation pressure (balloon_cg.analysis.bifurcation, first branch point, N = 20): " + "; ".join(lines)
     except Exception as error:  # the API is someone else's work in progress: report, don't fail
         return f"(b) bifurcation pressure: hook failed ({type(error).__name__}: {error})"
 
@@ -379,7 +380,7 @@ def main():
         "threaded (shared 2-core machine under load: the CPU time is the reliable one, see the module docstring);",
         "error = |P/P_ref − 1|; its = Newton iterations.",
         "Symmetric (equator) subspace in all three scenes: about degree + 1 unknowns. With coils, a last column:",
-        "the same solve on the wire-mapped basis the tracer uses near a wire (balloon_cg.branch.wire_map, centred",
+        "the same solve on the wire-mapped basis the tracer uses near a wire (balloon_cg.analysis.branch.wire_map, centred",
         "from the neighbour's profile), tol 1e-12.",
         "",
     ]

@@ -17,7 +17,7 @@ Kernels:
   with G0..G3 = G, G', G'', G''' at m supplied by the runtime.
 - ``stream_shape_closed(m, m1, K, N)``: G, G', G'', G''' in closed form. SymPy differentiates elliptic_k and
   elliptic_e; then E = (1 − m/2) K − N, with N = (1 − m/2) K − E supplied cancellation-free by the AGM
-  (balloon_cg.elliptic.loop_elliptic), and every factor m − 1 becomes −m1, m1 = 1 − m also supplied exactly
+  (balloon_cg.model.elliptic.loop_elliptic), and every factor m − 1 becomes −m1, m1 = 1 − m also supplied exactly
   (m → 1 near a wire). In the (K, E) basis the numerator of G''' cancels ~850-fold at m = 1/2 (~2e-12 error
   from a few-ulp E); in the (K, N) basis at most 26-fold for m ≥ 1/2, the branch this kernel serves.
 - ``STREAM_SERIES``: Maclaurin coefficients of G from K = π/2 ₂F₁(½,½;1;m), E = π/2 ₂F₁(−½,½;1;m).

@@ -1,4 +1,4 @@
-"""Non-axisymmetric (m ≥ 1) second variation (balloon_cg.azimuthal, codegen/second_variation.py).
+"""Non-axisymmetric (m ≥ 1) second variation (balloon_cg.analysis.azimuthal, codegen/second_variation.py).
 
 Independent checks: the exact sphere's spectrum (spherical symmetry: m = 1 = axisymmetric n ≥ 1 + toroidal modes
 with the closed form below), rigid-body null vectors, the removable singularity of the shear coefficient against
@@ -13,13 +13,13 @@ import pytest
 from numpy.polynomial import legendre
 from scipy import linalg
 
-from balloon_cg import azimuthal as az
-from balloon_cg.branch import trace_primary
-from balloon_cg.discretisation import Discretisation
-from balloon_cg.equilibrium import Equilibrium, Parameters
-from balloon_cg.field import field_squared
+from balloon_cg.analysis import azimuthal as az
+from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.model.field import field_squared
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.sphere import sphere_pressure
+from balloon_cg.model.sphere import sphere_pressure
 
 ROOT = Path(__file__).resolve().parent.parent
 SPOM1 = (3.00508, 0.0145, -0.0177), (1.3, 4.0, -2.0)

@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import analyse
-from balloon_cg.materials import get_preset
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.sphere import sphere_pressure
-from balloon_cg.sphere_modes import bifurcation_stretches
+from balloon_cg.model.sphere import sphere_pressure
+from balloon_cg.model.sphere_modes import bifurcation_stretches
 
 ISOLA = ["SPOM1", "SPOM2", "FPOM1", "FPOM2"]
 SINGLE = ["TPOM1", "TPOM2"]

@@ -4,8 +4,8 @@ from pathlib import Path
 
 import pytest
 
-from balloon_cg.cli import main
-from balloon_cg.materials import PRESETS
+from balloon_cg.app.cli import main
+from balloon_cg.scene.materials import PRESETS
 
 SPOM1 = Path(__file__).resolve().parents[1] / "scenes" / "spom1.toml"
 

@@ -77,9 +77,9 @@ def test_pole_series_of_the_sphere():
 @pytest.mark.parametrize("preset", ["SPOM1", "FPOM2", "TPOM2"])
 def test_first_order_system_holds_on_the_exact_sphere(preset):
     """On the sphere λ2 = λ, η = λ cos θ at the exact pressure, f = (0, 0, −λ sin θ, −λ cos θ)."""
-    from balloon_cg.kernels import KernelSet
-    from balloon_cg.materials import get_preset
-    from balloon_cg.sphere import sphere_pressure
+    from balloon_cg.model.kernels import KernelSet
+    from balloon_cg.scene.materials import get_preset
+    from balloon_cg.model.sphere import sphere_pressure
 
     material = get_preset(preset)
     kernels = KernelSet(material, has_field=False)

@@ -5,14 +5,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.branch import ParameterSystem, trace_primary, wire_gap, wire_map
-from balloon_cg.coordinate_map import WireMap
-from balloon_cg.discretisation import Discretisation
-from balloon_cg.equilibrium import Equilibrium
-from balloon_cg.newton import newton
-from balloon_cg.postprocess import surface
+from balloon_cg.analysis.branch import ParameterSystem, trace_primary, wire_gap, wire_map
+from balloon_cg.galerkin.coordinate_map import WireMap
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.numerics.newton import newton
+from balloon_cg.post.quantities import surface
 from balloon_cg.scene import load_scene
-from balloon_cg.shooting import shoot_symmetric
+from balloon_cg.model.shooting import shoot_symmetric
 
 SCENE = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
 MAP = WireMap((0.5, -0.5), (0.06, 0.06))
@@ -112,8 +112,8 @@ def test_branch_reaches_the_wire_gap_and_its_end_matches_shooting():
 
 
 def _pear_point(branch):
-    from balloon_cg import bifurcation
-    from balloon_cg.stability import SecondVariation
+    from balloon_cg.analysis import bifurcation
+    from balloon_cg.analysis.stability import SecondVariation
 
     variation = SecondVariation(branch.equilibrium, branch.disc.degree)
     odd = bifurcation.block_indices(variation, "odd_held", False)
@@ -142,8 +142,8 @@ def test_pear_point_does_not_depend_on_the_basis_map():
 def test_mapped_branch_round_trips_through_hdf5(tmp_path):
     """A branch stored on a mapped basis is rebuilt from the file (map_centres, map_widths) and evaluates to the
     same profile and curvature as in memory."""
-    from balloon_cg.postprocess import branch_discretisation
-    from balloon_cg.storage import read_run, write_run
+    from balloon_cg.post.quantities import branch_discretisation
+    from balloon_cg.io.run_file import read_run, write_run
 
     scene = load_scene(SCENE)
     branch = trace_primary(scene, down=False)
@@ -162,7 +162,7 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire()
     """On a general (held) basis the map keeps b_0 = 0 meaning ∫η dx = 0 (η = Σ b_k (P_k(s) − m_k)); the pear branch
     of the two-coil scene then reaches its wire gap 0.1 on a mapped basis (before: degree 320 and a resolution
     stop), every stored point within max_error, and its last point matches a plain Legendre solve at degree 320."""
-    from balloon_cg.analysis import analyse
+    from balloon_cg.analysis.picture import analyse
 
     held = Discretisation(80, False, True, mapping=WireMap((0.6,), (0.06,)))
     rng = np.random.default_rng(0)
@@ -207,7 +207,7 @@ def test_projection_is_accurate_at_high_degree():
 def test_bifurcation_work_on_a_mapped_branch_uses_a_degree_that_holds_it(near_wire):
     """Branch points of a mapped branch are classified and continued in x at a degree whose projection and tail
     are within max_error, which near a wire is above the mapped degree."""
-    from balloon_cg.bifurcation import plain_degree
+    from balloon_cg.analysis.bifurcation import plain_degree
 
     scene, branch, X, _ = near_wire
     assert branch.disc.mapping is not None

@@ -7,12 +7,12 @@ bounded (max_points, max_degree, Newton iterations).
 import numpy as np
 import pytest
 
-from balloon_cg.branch import trace_primary, wire_gap
-from balloon_cg.discretisation import Discretisation
-from balloon_cg.equilibrium import Equilibrium, Parameters
-from balloon_cg.newton import newton
+from balloon_cg.analysis.branch import trace_primary, wire_gap
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.sphere import sphere_pressure
+from balloon_cg.model.sphere import sphere_pressure
 
 from pathlib import Path
 
@@ -188,8 +188,8 @@ def test_wire_gap_stop_names_the_coil():
 
 def test_stability_basis_degree_60():
     """N = 60 in the second variation: finite lowest eigenvalues, the same flags as N = 40 (skipped while
-    balloon_cg.stability does not exist)."""
-    stability = pytest.importorskip("balloon_cg.stability")
+    balloon_cg.analysis.stability does not exist)."""
+    stability = pytest.importorskip("balloon_cg.analysis.stability")
     branch = trace_primary(spom1("[continuation]\nstop_stretch = 2.0\n"), down=False)
     params = branch.params
     coarse, fine = stability.SecondVariation(branch.equilibrium, 40), stability.SecondVariation(branch.equilibrium, 60)

@@ -13,8 +13,8 @@ import pytest
 import scipy.special
 import sympy as sp
 
-from balloon_cg.elliptic import complete_elliptic, loop_elliptic
-from balloon_cg.field import (
+from balloon_cg.model.elliptic import complete_elliptic, loop_elliptic
+from balloon_cg.model.field import (
     WIRE_TOLERANCE,
     FieldError,
     coil_field_unit,

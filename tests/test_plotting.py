@@ -8,11 +8,11 @@ import h5py
 import numpy as np
 import pytest
 
-from balloon_cg import default_run
-from balloon_cg.cli import main
-from balloon_cg.plotting import KINDS, PlotError, plot
-from balloon_cg.postprocess import postprocess
-from balloon_cg.storage import read_run
+from balloon_cg.app import default_run
+from balloon_cg.app.cli import main
+from balloon_cg.post.plotting import KINDS, PlotError, plot
+from balloon_cg.post.quantities import postprocess
+from balloon_cg.io.run_file import read_run
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 PER_POINT_KINDS = ("shapes", "stresses", "field", "curvature")

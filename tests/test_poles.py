@@ -7,10 +7,10 @@ f ≈ (2σ c2 t, 4 c2 t, 2σ e2 t, 2 e2) with relative error O(t²).
 import numpy as np
 import pytest
 
-from balloon_cg.field import field_squared
-from balloon_cg.kernels import KernelSet
-from balloon_cg.materials import PRESETS, Material, get_preset
-from balloon_cg.sphere import sphere_pressure
+from balloon_cg.model.field import field_squared
+from balloon_cg.model.kernels import KernelSet
+from balloon_cg.scene.materials import PRESETS, Material, get_preset
+from balloon_cg.model.sphere import sphere_pressure
 
 TWO_COILS = np.array([[1.7321, 1.0, 1.0], [1.7321, -1.0, -1.0]])
 CUSTOM = Material("custom", (1.5, 0.2, -0.05), (1.8, -1.0, 3.0))  # runtime exponents: ogden_general_field

@@ -5,16 +5,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.branch import trace_primary
-from balloon_cg.discretisation import Discretisation
-from balloon_cg.field import field_components
-from balloon_cg.postprocess import (
+from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.model.field import field_components
+from balloon_cg.post.quantities import (
     paper_magnetic_stresses, postprocess, quantities, surface, wrinkling,
 )
-from balloon_cg.profiles import profiles
+from balloon_cg.galerkin.profiles import profiles
 from balloon_cg.scene import load_scene
-from balloon_cg.sphere import sphere_stress
-from balloon_cg.storage import read_run, write_run
+from balloon_cg.model.sphere import sphere_stress
+from balloon_cg.io.run_file import read_run, write_run
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 THETA = np.linspace(0.0, np.pi, 37)  # both poles exactly

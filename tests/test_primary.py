@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from balloon_cg.branch import trace_primary
-from balloon_cg.equilibrium import Parameters
-from balloon_cg.materials import PRESETS
+from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.galerkin.equilibrium import Parameters
+from balloon_cg.scene.materials import PRESETS
 from balloon_cg.scene import parse_scene
-from balloon_cg.sphere import sphere_pressure
+from balloon_cg.model.sphere import sphere_pressure
 
 PRESET_NAMES = ["SPOM1", "SPOM2", "FPOM1", "FPOM2", "TPOM1", "TPOM2", "neo-Hookean", "Mooney-Rivlin"]
 

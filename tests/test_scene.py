@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.materials import PRESETS, Material, get_preset, material_from_table
+from balloon_cg.scene.materials import PRESETS, Material, get_preset, material_from_table
 from balloon_cg.scene import (
     Coil, Continuation, Field, Output, Scene, SceneError, Solver, Stability, load_scene, parse_scene,
 )

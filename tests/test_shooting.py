@@ -4,11 +4,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.branch import trace_primary
-from balloon_cg.materials import PRESETS
+from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.scene.materials import PRESETS
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.shooting import shoot_general, shoot_symmetric
-from balloon_cg.sphere import sphere_pressure
+from balloon_cg.model.shooting import shoot_general, shoot_symmetric
+from balloon_cg.model.sphere import sphere_pressure
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 STRETCHES = (1.05, 1.5, 3.0)

@@ -1,4 +1,4 @@
-"""Axisymmetric bifurcations of the M = 0 sphere from the continuum second variation (balloon_cg.sphere_modes),
+"""Axisymmetric bifurcations of the M = 0 sphere from the continuum second variation (balloon_cg.model.sphere_modes),
 checked against a brute-force second variation: E of MODEL.md §2 evaluated by Gauss–Legendre quadrature for the
 sphere perturbed by one Legendre mode, differentiated twice by finite differences."""
 import subprocess
@@ -11,9 +11,9 @@ from numpy.polynomial import legendre
 from scipy.optimize import brentq
 from scipy.special import roots_legendre
 
-from balloon_cg.materials import Material, get_preset
-from balloon_cg.sphere import sphere_pressure
-from balloon_cg.sphere_modes import (
+from balloon_cg.scene.materials import Material, get_preset
+from balloon_cg.model.sphere import sphere_pressure
+from balloon_cg.model.sphere_modes import (
     bifurcation_condition,
     bifurcation_pressures,
     bifurcation_stretches,
@@ -185,7 +185,7 @@ def test_mode_matrix_structure():
 def test_close_root_pair_is_not_lost(monkeypatch):
     """A condition that dips through zero between two grid points still gives both roots: SPOM2's pear pair
     (λ ≈ 2.115, 2.435) on a 6-point grid, where the condition is positive at every grid point."""
-    import balloon_cg.sphere_modes as sphere_modes
+    import balloon_cg.model.sphere_modes as sphere_modes
 
     m = get_preset("SPOM2")
     roots = bifurcation_stretches(m, 1)

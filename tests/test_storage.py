@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 import balloon_cg
-from balloon_cg import storage
-from balloon_cg.branch import trace_primary
-from balloon_cg.kernels import generated_digest
-from balloon_cg.profiles import equator_values, fields, profiles, theta_grid
+from balloon_cg.io import run_file as storage
+from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.model.kernels import generated_digest
+from balloon_cg.galerkin.profiles import equator_values, fields, profiles, theta_grid
 from balloon_cg.scene import load_scene
-from balloon_cg.storage import RunFileError, read_run, write_run
+from balloon_cg.io.run_file import RunFileError, read_run, write_run
 
 SPOM1 = Path(__file__).resolve().parents[1] / "scenes" / "spom1.toml"
 

@@ -6,10 +6,10 @@ import h5py
 import numpy as np
 import pytest
 
-from balloon_cg import sweep as sweep_module
-from balloon_cg.cli import main
+from balloon_cg.app import sweep as sweep_module
+from balloon_cg.app.cli import main
 from balloon_cg.scene import SceneError, load_scene
-from balloon_cg.sweep import SweepError, expand, read_sweep, run_sweep, scene_hash
+from balloon_cg.app.sweep import SweepError, expand, read_sweep, run_sweep, scene_hash
 
 SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "spom1_single_coil.toml"
 SPECS = ["M=0:0.004:3"]
@@ -207,8 +207,8 @@ def test_cli_no_pear_reports_branch_points(tmp_path, capsys):
 
 def test_phase_diagram_from_a_sweep_file(tmp_path):
     """`plot SWEEP.h5 --what phase`: the pear pitchfork pressures of every member against the varied key."""
-    from balloon_cg.cli import main as cli_main
-    from balloon_cg.plotting import plot
+    from balloon_cg.app.cli import main as cli_main
+    from balloon_cg.post.plotting import plot
 
     scene = tmp_path / "spom1.toml"
     scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n')

@@ -6,12 +6,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.branch import ParameterSystem, trace_primary
-from balloon_cg.discretisation import Discretisation
-from balloon_cg.equilibrium import Equilibrium
-from balloon_cg.newton import newton
+from balloon_cg.analysis.branch import ParameterSystem, trace_primary
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import load_scene
-from balloon_cg.shooting import shoot_symmetric
+from balloon_cg.model.shooting import shoot_symmetric
 
 SCENE = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
 STRETCH = 1.7

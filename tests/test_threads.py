@@ -5,7 +5,7 @@ import sys
 
 def test_blas_is_single_threaded_after_import():
     code = (
-        "import balloon_cg, balloon_cg.analysis\n"
+        "import balloon_cg, balloon_cg.analysis.picture\n"
         "from threadpoolctl import threadpool_info\n"
         "blas = [i for i in threadpool_info() if i['user_api'] == 'blas']\n"
         "assert blas and all(i['num_threads'] == 1 for i in blas), blas\n"

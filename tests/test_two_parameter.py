@@ -6,14 +6,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg import bifurcation
-from balloon_cg.branch import trace_primary
-from balloon_cg.equilibrium import Equilibrium
-from balloon_cg.materials import get_preset
+from balloon_cg.analysis import bifurcation
+from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.stability import SecondVariation, assess_branch
-from balloon_cg.storage import read_run
-from balloon_cg.two_parameter import (ExtendedSystem, TwoParameterError, alpha1_material, continue_branch_point,
+from balloon_cg.analysis.stability import SecondVariation, assess_branch
+from balloon_cg.io.run_file import read_run
+from balloon_cg.analysis.codim2 import (ExtendedSystem, TwoParameterError, alpha1_material, continue_branch_point,
                                       land_on_q, read_curve, sphere_critical_alpha1, sphere_pear_stretches,
                                       write_curve)
 
@@ -165,7 +165,7 @@ def test_continuation_in_M_without_coils_is_refused(located):
 
 
 def test_phase_diagram_plot(curve, tmp_path):
-    from balloon_cg.plotting import plot
+    from balloon_cg.post.plotting import plot
     from balloon_cg.scene import parse_scene
 
     path = write_curve(tmp_path / "phase.h5", parse_scene('[material]\npreset = "SPOM1"\n'), curve)

@@ -14,11 +14,11 @@ import time
 from importlib import resources
 from pathlib import Path
 
-from .branch import ContinuationError
+from ..analysis.branch import ContinuationError
 from .cli import run_scene, summarise_branch
-from .plotting import applicable_kinds, load_branches, plot
-from .scene import parse_scene
-from .storage import read_run
+from ..post.plotting import applicable_kinds, load_branches, plot
+from ..scene import parse_scene
+from ..io.run_file import read_run
 
 SCENES = ("spom1", "spom1_two_coils_M0.002")
 COMBINED = ("pressure-pole", "pressure-equator")

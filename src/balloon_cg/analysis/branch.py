@@ -23,12 +23,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import continuation
-from .coordinate_map import WireMap
-from .discretisation import Discretisation
-from .equilibrium import Equilibrium, Parameters
-from .newton import newton
-from .sphere import sphere_pressure
+from ..numerics import continuation
+from ..galerkin.coordinate_map import WireMap
+from ..galerkin.discretisation import Discretisation
+from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..numerics.newton import newton
+from ..model.sphere import sphere_pressure
 
 RESOLUTION = "resolution"
 MAP_WIDTH = 0.4  # map width ε_j per unit gap to wire j (x units); measured best 0.15–0.5 (docs/numerics.md)

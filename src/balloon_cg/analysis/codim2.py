@@ -37,16 +37,16 @@ import h5py
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from . import continuation
+from ..numerics import continuation
 from .branch import SpecialPoint
 from .bifurcation import block_indices, padded_mode, plain_degree
-from .discretisation import Discretisation
-from .equilibrium import Equilibrium
-from .kernels import KernelSet
-from .newton import newton
-from .sphere_modes import bifurcation_condition, bifurcation_stretches
+from ..galerkin.discretisation import Discretisation
+from ..galerkin.equilibrium import Equilibrium
+from ..model.kernels import KernelSet
+from ..numerics.newton import newton
+from ..model.sphere_modes import bifurcation_condition, bifurcation_stretches
 from .stability import SecondVariation
-from .storage import _root_attrs, _write_special, check_output
+from ..io.run_file import _root_attrs, _write_special, check_output
 
 PARAMETERS = ("M", "alpha1")
 H_STEP = 1e-6

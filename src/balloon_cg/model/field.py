@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from .elliptic import loop_elliptic
-from .generated.coil_field import STREAM_SERIES, coil_field, stream_shape_closed
+from ..generated.coil_field import STREAM_SERIES, coil_field, stream_shape_closed
 
 SERIES_SWITCH = 0.5
 WIRE_TOLERANCE = 1e-12

@@ -40,8 +40,8 @@ import numpy as np
 from numpy.polynomial import legendre
 from scipy import linalg
 
-from .equilibrium import Equilibrium, NonFiniteState, Parameters
-from .field import field_squared_nodes
+from ..galerkin.equilibrium import Equilibrium, NonFiniteState, Parameters
+from ..model.field import field_squared_nodes
 
 # y = (R, R', Z, Z', T, T'): upper triangle row by row, as the kernel returns it
 _PAIRS = tuple((i, j) for i in range(6) for j in range(i, 6))

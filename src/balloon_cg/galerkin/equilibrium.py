@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .discretisation import Discretisation
-from .field import field_squared_nodes
-from .kernels import KernelSet
+from ..model.field import field_squared_nodes
+from ..model.kernels import KernelSet
 
 
 class NonFiniteState(ArithmeticError):

@@ -44,9 +44,9 @@ from tqdm import tqdm
 
 import balloon_cg
 
-from .kernels import generated_digest
-from .scene import Scene, SceneError, parse_scene
-from .storage import _branch_order, _plain, _read_branch, _read_snaps, check_output, write_run
+from ..model.kernels import generated_digest
+from ..scene import Scene, SceneError, parse_scene
+from ..io.run_file import _branch_order, _plain, _read_branch, _read_snaps, check_output, write_run
 
 FORMAT = "balloon-cg-sweep/1"
 MODES = ("analysis", "no-pear", "primary-only")
@@ -213,8 +213,8 @@ def _ranges(indices: list[int]) -> str:
 def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> dict:
     """Worker side: compute one member and return its run file as bytes (written by storage.write_run) with a
     short summary. Runs in a worker process (local pool or dask worker); picklable in and out."""
-    from .analysis import analyse
-    from .branch import trace_primary
+    from ..analysis.picture import analyse
+    from ..analysis.branch import trace_primary
 
     # BLAS runs single-threaded in every member: importing balloon_cg limits it (balloon_cg/__init__); with
     # 2 BLAS threads per member on busy cores a member ran 35x slower (benchmarks/sweep.py).

@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from . import continuation
+from ..numerics import continuation
 from .branch import ParameterSystem, PrimaryTracer, _stop_rule, assemble, transfer_error
-from .discretisation import Discretisation
-from .newton import newton
+from ..galerkin.discretisation import Discretisation
+from ..numerics.newton import newton
 from .stability import SecondVariation
 
 @dataclass

@@ -18,9 +18,9 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .postprocess import branch_discretisation, postprocess, stored_scene, surface
-from .profiles import EQUATOR
-from .storage import read_run
+from .quantities import branch_discretisation, postprocess, stored_scene, surface
+from ..galerkin.profiles import EQUATOR
+from ..io.run_file import read_run
 
 NORMAL_FORM = ("E2", "E3", "E4")
 DEFAULT_POINTS = 5
@@ -453,7 +453,7 @@ def plot_phase(paths) -> Figure:
 def _sweep_phase(ax, path) -> str:
     """Pear pitchfork pressures of every sweep member against the first varied key; the isola region (two
     pitchforks) shaded between them. Returns the parameter name."""
-    from .sweep import read_sweep
+    from ..app.sweep import read_sweep
 
     sweep = read_sweep(path)
     rows = []
@@ -475,7 +475,7 @@ def _sweep_phase(ax, path) -> str:
 
 
 def _read_curve(path, name):
-    from .two_parameter import read_curve
+    from ..analysis.codim2 import read_curve
 
     return read_curve(path, name)
 

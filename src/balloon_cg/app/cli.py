@@ -13,13 +13,13 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .analysis import analyse
-from .branch import ContinuationError, trace_primary
-from .field import FieldError
-from .plotting import KINDS, PlotError, plot as draw_plot
-from .profiles import equator_values
-from .scene import SceneError, load_scene
-from .storage import RunFileError, check_output, read_run, write_run
+from ..analysis.picture import analyse
+from ..analysis.branch import ContinuationError, trace_primary
+from ..model.field import FieldError
+from ..post.plotting import KINDS, PlotError, plot as draw_plot
+from ..galerkin.profiles import equator_values
+from ..scene import SceneError, load_scene
+from ..io.run_file import RunFileError, check_output, read_run, write_run
 
 PROG = "balloon-cg"
 
@@ -222,9 +222,9 @@ def _add_critical(commands):
 
 def critical(args) -> int:
     """Primary branch, its first pear pitchfork, the curve of pitchforks in the parameter, the merge point."""
-    from .bifurcation import detect, locate
-    from .stability import assess_branch
-    from .two_parameter import continue_branch_point, write_curve
+    from ..analysis.bifurcation import detect, locate
+    from ..analysis.stability import assess_branch
+    from ..analysis.codim2 import continue_branch_point, write_curve
 
     scene = load_scene(args.scene)
     check_output(args.output, args.force)

@@ -21,8 +21,8 @@ import numpy as np
 import scipy.linalg
 
 from .azimuthal import spectrum
-from .discretisation import Discretisation
-from .equilibrium import Parameters
+from ..galerkin.discretisation import Discretisation
+from ..galerkin.equilibrium import Parameters
 
 LOWEST = 3  # eigenvalues reported per block
 

@@ -31,8 +31,8 @@ import numpy as np
 
 import balloon_cg
 
-from .kernels import generated_digest
-from .profiles import equator_values, profiles, theta_grid
+from ..model.kernels import generated_digest
+from ..galerkin.profiles import equator_values, profiles, theta_grid
 
 FORMAT = "balloon-cg/1"
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")

@@ -22,11 +22,11 @@ applied field h is in units of I/(4π R0) (MODEL.md §3), so that M H² is the n
 import numpy as np
 from numpy.polynomial import legendre
 
-from .coordinate_map import WireMap
-from .discretisation import Discretisation
-from .field import coil_table, field_components, field_squared_nodes
-from .profiles import meridional_stretch
-from .scene import parse_scene
+from ..galerkin.coordinate_map import WireMap
+from ..galerkin.discretisation import Discretisation
+from ..model.field import coil_table, field_components, field_squared_nodes
+from ..galerkin.profiles import meridional_stretch
+from ..scene import parse_scene
 
 WRINKLING_STATES = ("taut", "wrinkled", "slack")
 

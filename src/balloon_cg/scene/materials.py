@@ -6,7 +6,7 @@
 
 from dataclasses import dataclass, replace
 
-from .errors import SceneError, number, show, table
+from .validation import SceneError, number, show, table
 
 MAX_TERMS = 6
 

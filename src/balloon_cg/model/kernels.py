@@ -9,8 +9,8 @@ from functools import cached_property
 
 import numpy as np
 
-from . import generated
-from .errors import SceneError
+from .. import generated
+from ..scene.validation import SceneError
 
 
 def class_name(alpha, has_field: bool) -> str:

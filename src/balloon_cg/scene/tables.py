@@ -10,7 +10,7 @@ import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
-from .errors import SceneError, number, show, show_key, table
+from .validation import SceneError, number, show, show_key, table
 from .materials import Material, material_from_table
 
 __all__ = [

@@ -1,0 +1,1 @@
+"""Applications: the command line, the sweep runner, the default run."""

@@ -1,0 +1,1 @@
+"""HDF5 files (run, sweep, curve): one atomic writer, provenance, readers."""

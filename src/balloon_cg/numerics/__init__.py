@@ -1,0 +1,1 @@
+"""Balloon-free numerics: Newton with a bordering row, pseudo-arclength continuation, fold location."""

@@ -1,0 +1,1 @@
+"""What users look at: quantities evaluated from stored unknowns, and plots."""
