@@ -18,7 +18,9 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT / "src"))
 
 import work_precision as wp  # noqa: E402
-from balloon_cg.analysis.branch import trace_primary, wire_gap  # noqa: E402
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.primary import trace_primary  # noqa: E402
+from balloon_cg.analysis.wires import wire_gap  # noqa: E402
 from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
 from balloon_cg.galerkin.equilibrium import Parameters  # noqa: E402
 from balloon_cg.scene import load_scene, parse_scene  # noqa: E402
@@ -50,14 +52,14 @@ def summary(branch, t0):
 def refined(branch, factor=1.5):
     X = branch.X[-1]
     lam = branch.pole_values()["lam2_north"][-1]
-    result, _ = constrained_newton(branch.equilibrium.scene, int(branch.disc.degree * factor), X, branch.disc, lam,
+    result, _ = constrained_newton(branch.scene, int(branch.disc.degree * factor), X, branch.disc, lam,
                                    branch.params)
     return f"refinement × {factor}: P changes by {abs(result.x[-1] / X[-1] - 1):.1e} ({result.message})"
 
 
 def sphere_error(branch):
     lam = branch.pole_values()["lam2_north"]
-    return np.abs(branch.pressure / sphere_pressure(branch.equilibrium.scene.material, lam) - 1).max()
+    return np.abs(branch.pressure / sphere_pressure(branch.scene.material, lam) - 1).max()
 
 
 def pole_stretch_10():
@@ -165,7 +167,7 @@ def stability_basis():
     picks = list(range(0, len(branch.X), max(1, len(branch.X) // 5)))
     lowest = {}
     for N in (20, 40, 60):
-        variation = stability.SecondVariation(branch.equilibrium, N)
+        variation = stability.SecondVariation(equilibrium_of(branch), N)
         t0 = time.perf_counter()
         results = [variation.assess(branch.X[i][:-1], params.with_value("P", branch.X[i][-1]), True) for i in picks]
         seconds = (time.perf_counter() - t0) / len(picks)

@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT / "src"))
 
 import work_precision as wp  # noqa: E402
 from balloon_cg.numerics import continuation  # noqa: E402
-from balloon_cg.analysis.branch import ParameterSystem  # noqa: E402
+from balloon_cg.analysis.problem import ParameterSystem  # noqa: E402
 from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters  # noqa: E402
 from balloon_cg.model.kernels import KernelSet  # noqa: E402

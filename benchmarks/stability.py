@@ -6,8 +6,9 @@ Run: python benchmarks/stability.py
 """
 import time
 
+from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.scene import parse_scene
 from balloon_cg.analysis.stability import SecondVariation
 
@@ -27,7 +28,7 @@ def main():
     scene = parse_scene(SCENE, name="spom1")
     analyse(scene)  # compile / load kernels
     branch = trace_primary(scene)
-    variation = SecondVariation(branch.equilibrium, 20)
+    variation = SecondVariation(equilibrium_of(branch), 20)
     params = branch.params
 
     def assess_all(m_max):

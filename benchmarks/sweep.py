@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from balloon_cg.scene import load_scene
-from balloon_cg.app.sweep import read_sweep, run_sweep
+from balloon_cg.app.sweep import run_sweep
+from balloon_cg.io.sweep_file import read_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "spom1_single_coil.toml"

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
+from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.analysis.stability import SecondVariation
@@ -29,7 +30,7 @@ SINGLE_COIL = ROOT / "scenes" / "spom1_single_coil.toml"
 def pear_points(branch):
     """Located pear branch points of a symmetric primary branch: sign changes of the lowest eigenvalue of the
     odd (pear) block only (the full assessment with azimuthal blocks is not needed here)."""
-    variation = SecondVariation(branch.equilibrium, branch.disc.degree)
+    variation = SecondVariation(equilibrium_of(branch), branch.disc.degree)
     odd = bifurcation.block_indices(variation, "odd_held", False)
     lowest = np.array([variation._lowest(variation.matrices(X[:-1], branch.params.with_value("P", X[-1]))[0],
                                          odd)[0] for X in branch.X])

@@ -85,7 +85,7 @@ class PointSolver:
         return self._eq[degree, mapping]
 
     def functions(self, eq):
-        from balloon_cg.analysis.branch import ParameterSystem
+        from balloon_cg.analysis.problem import ParameterSystem
 
         system = ParameterSystem(eq, self.params, "P")
         return system.residual, system.jacobian
@@ -124,7 +124,7 @@ class Target:
 
 def prepare(case: Case):
     """Trace the primary branch (adaptive degree) to the largest target; fine solutions at every λ* and λ* − H."""
-    from balloon_cg.analysis.branch import trace_primary
+    from balloon_cg.analysis.primary import trace_primary
     from balloon_cg.model.shooting import shoot_symmetric
     from balloon_cg.model.sphere import sphere_pressure
 
@@ -172,7 +172,7 @@ def neighbour(solver, target: Target, degree: int, source_disc, mapping=None):
 
 def wire_maps(case, branch, targets):
     """Per target stretch: the tracer's wire-mapped basis centred from the neighbour's profile (coil scenes)."""
-    from balloon_cg.analysis.branch import wire_map
+    from balloon_cg.analysis.wires import wire_map
 
     return {t.stretch: wire_map(branch.disc, t.X_neighbour_fine[:-1], case.scene.field.coils, branch.disc.symmetric)
             for t in targets if t is not None}
@@ -238,7 +238,7 @@ def bifurcation_rows(case, stability, bifurcation):
     ``bifurcation.locate`` takes the eigenvalue with the branch's own discretisation, so the primary branch
     degree is the resolution parameter here; the stability basis degree N = 20 only serves detection.
     """
-    from balloon_cg.analysis.branch import trace_primary
+    from balloon_cg.analysis.primary import trace_primary
 
     try:
         found_P = {}

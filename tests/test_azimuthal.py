@@ -13,8 +13,9 @@ import pytest
 from numpy.polynomial import legendre
 from scipy import linalg
 
+from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis import azimuthal as az
-from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model.field import field_squared
@@ -310,7 +311,7 @@ def two_coil_state():
     scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml")
     branch = trace_primary(scene, stop_stretch=1.5, down=False)
     X = branch.X[-1]
-    return branch.equilibrium, X[:-1], branch.params.with_value("P", X[-1])
+    return equilibrium_of(branch), X[:-1], branch.params.with_value("P", X[-1])
 
 
 def test_relabelling_mode_is_null_at_a_magnetic_equilibrium(two_coil_state):

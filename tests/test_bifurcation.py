@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.results import Block, Classification, Kind, RootStatus, StopCode
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.sphere import sphere_pressure
@@ -24,7 +25,7 @@ def picture(request):
 def pear_points(picture):
     name, pic = picture
     primary = pic.branches[0]
-    bps = [bp for bp in pic.branch_points if bp.block == "odd_held"]
+    bps = [bp for bp in pic.branch_points if bp.block == Block.ODD_HELD]
     return name, pic, primary, bps
 
 
@@ -38,7 +39,8 @@ def test_pear_bifurcations_match_the_independent_sphere_condition(picture):
     np.testing.assert_allclose(found, expected, rtol=1e-8)
     for bp, lam in zip(bps, found):
         assert bp.X[-1] == pytest.approx(sphere_pressure(get_preset(name), lam), rel=1e-10)
-        assert bp.kind.startswith("pitchfork")
+        assert bp.kind == Kind.BP and bp.status == RootStatus.LOCATED
+        assert bp.classification in (Classification.PITCHFORK_SUPER, Classification.PITCHFORK_SUB)
 
 
 def test_isola_or_single_pitchfork(picture):
@@ -49,12 +51,12 @@ def test_isola_or_single_pitchfork(picture):
         assert len(bps) == 2
         assert set(pears) == {"pear_0", "pear_0_mirror"}
         for branch in pears.values():
-            assert "rejoined the primary branch at branch point 1" in branch.stop_reason
+            assert branch.stopped(StopCode.REJOINED) and branch.rejoins == 1
             assert branch.pressure[-1] == pytest.approx(bps[1].X[-1], rel=1e-2)
     else:
         assert len(bps) == 1
         for branch in pears.values():
-            assert "rejoined" not in branch.stop_reason
+            assert not branch.stopped(StopCode.REJOINED) and branch.rejoins is None
 
 
 def test_mirror_branch_swaps_the_poles(picture):
@@ -85,6 +87,6 @@ def test_two_coils_have_one_pear_branch_point_and_no_isola():
     scene = load_scene(__file__.replace("tests/test_bifurcation.py", "scenes/spom1_two_coils_M0.002.toml"))
     scene = scene.with_overrides({"solver.max_degree": 120, "solver.max_error": 1e-8})
     pic = analyse(scene)
-    bps = [bp for bp in pic.branch_points if bp.block == "odd_held"]
+    bps = [bp for bp in pic.branch_points if bp.block == Block.ODD_HELD]
     assert len(bps) == 1
-    assert all("rejoined" not in b.stop_reason for b in pic.branches if b.name.startswith("pear"))
+    assert not any(b.stopped(StopCode.REJOINED) for b in pic.branches if b.name.startswith("pear"))

@@ -5,7 +5,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.branch import ParameterSystem, trace_primary, wire_gap, wire_map
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.problem import ParameterSystem
+
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.results import Classification, StopCode
+
+from balloon_cg.analysis.wires import wire_gap, wire_map
 from balloon_cg.galerkin.coordinate_map import WireMap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
@@ -99,7 +105,7 @@ def test_branch_reaches_the_wire_gap_and_its_end_matches_shooting():
     agrees with shooting at its pole stretch."""
     scene = load_scene(SCENE)
     branch = trace_primary(scene, down=False)
-    assert "wire_gap" in branch.stop_reason and branch.disc.mapping is not None
+    assert branch.stopped(StopCode.WIRE_GAP) and branch.disc.mapping is not None
     # each point passed max_error on its own basis; the stored estimate adds the (measured) loss of its transfer
     # to the final mapped basis
     assert np.all(branch.error_estimate <= scene.solver.max_error + 1e-11)
@@ -115,7 +121,7 @@ def _pear_point(branch):
     from balloon_cg.analysis import bifurcation
     from balloon_cg.analysis.stability import SecondVariation
 
-    variation = SecondVariation(branch.equilibrium, branch.disc.degree)
+    variation = SecondVariation(equilibrium_of(branch), branch.disc.degree)
     odd = bifurcation.block_indices(variation, "odd_held", False)
     lowest = np.array([variation._lowest(variation.matrices(X[:-1], branch.params.with_value("P", X[-1]))[0],
                                          odd)[0] for X in branch.X])
@@ -133,10 +139,10 @@ def test_pear_point_does_not_depend_on_the_basis_map():
     mapped = trace_primary(scene, down=False)
     assert mapped.disc.mapping is not None
     disc = Discretisation(96, True, False)
-    plain = replace(mapped, disc=disc, X=mapped.disc.transfer(mapped.X, disc), equilibrium=Equilibrium(scene, disc))
+    plain = replace(mapped, disc=disc, X=mapped.disc.transfer(mapped.X, disc))
     bp_mapped, bp_plain = _pear_point(mapped), _pear_point(plain)
     assert bp_mapped.X[-1] == pytest.approx(bp_plain.X[-1], rel=1e-9)
-    assert bp_mapped.kind == bp_plain.kind == "pitchfork-super"
+    assert bp_mapped.classification == bp_plain.classification == Classification.PITCHFORK_SUPER
 
 
 def test_mapped_branch_round_trips_through_hdf5(tmp_path):
@@ -176,7 +182,7 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire()
     scene = load_scene(SCENE)
     picture = analyse(scene)
     pear = next(b for b in picture.branches if b.name == "pear_0")
-    assert "wire_gap" in pear.stop_reason and pear.disc.mapping is not None and not pear.disc.symmetric
+    assert pear.stopped(StopCode.WIRE_GAP) and pear.disc.mapping is not None and not pear.disc.symmetric
     assert np.all(pear.error_estimate <= scene.solver.max_error)
     # independent check: the last point re-solved in plain Legendre (degree 320, the same held constraint), at
     # the same north pole stretch (shooting solves the free balloon, not the held one)

@@ -7,7 +7,11 @@ bounded (max_points, max_degree, Newton iterations).
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.branch import trace_primary, wire_gap
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.results import StopCode, TraceStop
+
+from balloon_cg.analysis.wires import wire_gap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.numerics.newton import newton
@@ -51,7 +55,7 @@ def assert_clean(branch):
     """Every stored point finite and converged (residual at the Newton tolerance's level)."""
     assert np.all(np.isfinite(branch.X))
     assert np.all(branch.residual < 1e-9)
-    assert branch.stop_reason
+    assert branch.legs and all(leg.stop is not None for leg in branch.legs)
 
 
 def refinement_check(branch, factor=1.5, rel=1e-10):
@@ -59,7 +63,7 @@ def refinement_check(branch, factor=1.5, rel=1e-10):
     X = branch.X[-1]
     stretch = branch.pole_values()["lam2_north"][-1]
     degree = int(branch.disc.degree * factor)
-    scene = branch.equilibrium.scene
+    scene = branch.scene
     result, _ = constrained_newton(scene, degree, X, branch.disc, stretch, branch.params)
     assert result.converged, result.message
     assert result.x[-1] == pytest.approx(X[-1], rel=rel)
@@ -71,8 +75,8 @@ def test_pole_stretch_10_is_the_exact_sphere():
     assert_clean(branch)
     lam = branch.pole_values()["lam2_north"]
     assert lam[-1] == pytest.approx(10.0, abs=1e-12)
-    assert branch.stop_reason.startswith("up: reached stop_stretch 10")
-    exact = sphere_pressure(branch.equilibrium.scene.material, lam)
+    assert branch.legs[0].label == "up" and branch.stopped(StopCode.STOP_STRETCH)
+    exact = sphere_pressure(branch.scene.material, lam)
     assert np.abs(branch.pressure / exact - 1).max() < 1e-10
     refinement_check(branch)
 
@@ -84,7 +88,7 @@ def test_one_term_ogden_with_extreme_exponents(mu, alpha):
                         name=f"alpha{alpha}")
     branch = trace_primary(scene, down=False)
     assert_clean(branch)
-    assert branch.stop_reason.startswith("up: reached stop_stretch 2")
+    assert branch.legs[0].label == "up" and branch.stopped(StopCode.STOP_STRETCH)
     lam = branch.pole_values()["lam2_north"]
     assert np.abs(branch.pressure / sphere_pressure(scene.material, lam) - 1).max() < 1e-10
     refinement_check(branch)
@@ -96,7 +100,7 @@ def test_stiff_material_runs_out_of_points_with_a_clear_stop():
     scene = parse_scene("[material]\nmu = [0.5]\nalpha = [8.0]\n[continuation]\nstop_stretch = 10.0\nmax_points = 60\n")
     branch = trace_primary(scene, down=False)
     assert_clean(branch)
-    assert "maximum number of points (60)" in branch.stop_reason
+    assert branch.stopped(TraceStop.MAX_POINTS) and len(branch.X) <= 60
     assert len(branch.X) <= 61
 
 
@@ -138,7 +142,7 @@ def test_nearly_undeformed_start(start, low):
     assert lam[0] == lam.min() == pytest.approx(low, abs=1e-15)  # the down leg lands on min_stretch
     assert start in lam
     assert np.abs(branch.pressure - sphere_pressure(scene.material, lam)).max() < 1e-11
-    assert "min_stretch" in branch.stop_reason
+    assert branch.legs[1].stop.code == StopCode.MIN_STRETCH
 
 
 def test_constrained_newton_at_pole_stretch_one_plus_1e8():
@@ -170,7 +174,7 @@ def test_approaching_a_wire_stops_for_resolution():
     scene = two_coils(**{"continuation.wire_gap": 1e-3, "solver.max_degree": 60})
     branch = trace_primary(scene, down=False)
     assert_clean(branch)
-    assert branch.stop_reason.startswith("up: resolution") and "max_degree = 60" in branch.stop_reason
+    assert branch.legs[0].stop.code == StopCode.RESOLUTION_LIMIT
     assert branch.degree.max() == 60
     gaps = [wire_gap(branch.disc, X[:-1], scene.field.coils)[0] for X in branch.X]
     assert min(gaps) > 1e-3
@@ -181,7 +185,7 @@ def test_wire_gap_stop_names_the_coil():
     scene = two_coils(**{"continuation.wire_gap": 0.3})
     branch = trace_primary(scene, down=False)
     assert_clean(branch)
-    assert "within wire_gap 0.3 of coil" in branch.stop_reason
+    assert branch.stopped(StopCode.WIRE_GAP)
     gaps = [wire_gap(branch.disc, X[:-1], scene.field.coils)[0] for X in branch.X]
     assert min(gaps) >= 0.3
 
@@ -192,7 +196,7 @@ def test_stability_basis_degree_60():
     stability = pytest.importorskip("balloon_cg.analysis.stability")
     branch = trace_primary(spom1("[continuation]\nstop_stretch = 2.0\n"), down=False)
     params = branch.params
-    coarse, fine = stability.SecondVariation(branch.equilibrium, 40), stability.SecondVariation(branch.equilibrium, 60)
+    coarse, fine = stability.SecondVariation(equilibrium_of(branch), 40), stability.SecondVariation(equilibrium_of(branch), 60)
     for X in branch.X[:: max(1, len(branch.X) // 6)]:
         p = params.with_value("P", X[-1])
         a40, a60 = coarse.assess(X[:-1], p, True), fine.assess(X[:-1], p, True)

@@ -3,7 +3,7 @@ Jacobian only when the corrections stop contracting fast, and reports failures i
 import numpy as np
 import pytest
 
-from balloon_cg.numerics.newton import REFRESH_RATIO, newton
+from balloon_cg.numerics.newton import newton
 
 
 def circle_and_line():

@@ -47,7 +47,8 @@ def bifurcation_file(files, tmp_path_factory):
             del group["stability"]
         group.create_dataset("stability/stable_pressure", data=np.arange(n) < n // 2)
         special = group["special_points"]
-        special["kind"][1] = "pitchfork-super"
+        special["kind"][1] = "BP"
+        special["classification"][1] = "pitchfork-super"
         for name, value in (("E2", -0.02), ("E3", 0.0), ("E4", 0.5)):
             special[name][1] = value
         for name in [b for b in f["branches"] if b != "primary"]:

@@ -9,7 +9,7 @@ import pytest
 
 import balloon_cg
 from balloon_cg.io import run_file as storage
-from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.model.kernels import generated_digest
 from balloon_cg.galerkin.profiles import equator_values, fields, profiles, theta_grid
 from balloon_cg.scene import load_scene
@@ -43,7 +43,7 @@ def test_round_trip(run_file, scene, branch):
     run = read_run(run_file)
     attrs = run["attrs"]
     assert run["scene_name"] == scene.name == attrs["scene_name"]
-    assert attrs["format"] == "balloon-cg/1"
+    assert attrs["format"] == "balloon-cg/2"
     assert attrs["scene_toml"] == scene.text
     assert attrs["package_version"] == balloon_cg.__version__
     assert attrs["generated_digest"] == generated_digest()
@@ -71,13 +71,14 @@ def test_round_trip(run_file, scene, branch):
     a = b["attrs"]
     assert a["stop_reason"] == branch.stop_reason and a["wall_time"] == branch.wall_time
     assert (a["degree"], a["symmetric"], a["pin_translation"]) == (scene.solver.degree, True, True)
-    assert a["kernel_class"] == "ogden_spom1" == branch.equilibrium.kernels.name
-    assert a["kernel_signature"] == branch.equilibrium.kernels.signature
+    assert a["kernel_class"] == "ogden_spom1" == branch.kernel_class
+    assert a["kernel_signature"] == branch.kernel_signature
     assert (a["M"], a["chi"]) == (0.0, 1.0)
 
     assert [s["kind"] for s in b["special_points"]] == [s.kind for s in branch.special] == ["EP", "LP", "EP"]
     for stored, sp in zip(b["special_points"], branch.special):
-        assert stored["index"] == sp.index and stored["note"] == sp.note
+        assert stored["index"] == sp.index and stored["stop_code"] == (sp.stop.code.value if sp.stop else "")
+        assert stored["note"] == (sp.stop.message if sp.stop else sp.note)
         assert stored["pressure"] == sp.X[-1]
         assert stored["lam2_north"] == pytest.approx(branch.pole_values(sp.X)["lam2_north"][0], rel=1e-15)
     np.testing.assert_array_equal(b["special_unknowns"], [sp.X for sp in branch.special])
@@ -142,10 +143,10 @@ def test_failure_mid_write_leaves_file_untouched(tmp_path, scene, branch, monkey
     path = tmp_path / "run.h5"
     path.write_bytes(b"keep me")
 
-    def fail(group, branch):
+    def fail(group, special, width, disc):
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(storage, "_write_special", fail)
+    monkeypatch.setattr(storage, "write_special", fail)
     with pytest.raises(RuntimeError, match="disk full"):
         write_run(path, scene, [branch], force=True)
     assert path.read_bytes() == b"keep me"

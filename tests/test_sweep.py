@@ -9,7 +9,8 @@ import pytest
 from balloon_cg.app import sweep as sweep_module
 from balloon_cg.app.cli import main
 from balloon_cg.scene import SceneError, load_scene
-from balloon_cg.app.sweep import SweepError, expand, read_sweep, run_sweep, scene_hash
+from balloon_cg.app.sweep import expand, run_sweep, scene_hash
+from balloon_cg.io.sweep_file import SweepError, read_sweep
 
 SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "spom1_single_coil.toml"
 SPECS = ["M=0:0.004:3"]
@@ -109,17 +110,17 @@ def test_dask_cluster_equals_local_pool(scene, serial, tmp_path):
 
 def test_interrupted_sweep_resumes_without_recomputing(scene, serial, tmp_path, monkeypatch):
     path, written = tmp_path / "resume.h5", []
-    append = sweep_module._append_member
+    append = sweep_module.append_member
 
     def append_then_interrupt(f, member, result):
         append(f, member, result)
         written.append(member.index)
         raise KeyboardInterrupt  # the user presses Ctrl-C after the first member is written
 
-    monkeypatch.setattr(sweep_module, "_append_member", append_then_interrupt)
+    monkeypatch.setattr(sweep_module, "append_member", append_then_interrupt)
     with pytest.raises(KeyboardInterrupt):
         run_sweep(scene, SPECS, path, mode=MODE, workers=2)
-    monkeypatch.setattr(sweep_module, "_append_member", append)
+    monkeypatch.setattr(sweep_module, "append_member", append)
     assert len(written) == 1
     with h5py.File(path, "a") as f:
         assert list(f["members"]) == [str(written[0])]

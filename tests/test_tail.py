@@ -6,7 +6,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.branch import ParameterSystem, trace_primary
+from balloon_cg.analysis.problem import ParameterSystem
+
+from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.numerics.newton import newton

@@ -6,16 +6,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.branch import trace_primary
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.results import StopCode
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.analysis.stability import SecondVariation, assess_branch
 from balloon_cg.io.run_file import read_run
 from balloon_cg.analysis.codim2 import (ExtendedSystem, TwoParameterError, alpha1_material, continue_branch_point,
-                                      land_on_q, read_curve, sphere_critical_alpha1, sphere_pear_stretches,
-                                      write_curve)
+                                       land_on_q, sphere_critical_alpha1, sphere_pear_stretches)
+from balloon_cg.io.curve_file import read_curve, write_curve
 
 SPOM1 = get_preset("SPOM1")
 
@@ -41,7 +43,7 @@ def test_jacobian_matches_differences_of_the_residual(located):
     against central differences of the exact extended residual."""
     _, branch, bps = located
     for parameter, q0 in (("alpha1", 1.3), ("M", 0.0)):  # (no coils: the M column is zero, still consistent)
-        eq = Equilibrium(branch.equilibrium.scene, branch.disc)
+        eq = Equilibrium(branch.scene, branch.disc)
         odd = bifurcation.block_indices(SecondVariation(eq, branch.disc.degree), "odd_held", False)
         ell = bps[0].mode[odd] / np.linalg.norm(bps[0].mode[odd])
         system = ExtendedSystem(eq, branch.params.with_value("P", bps[0].X[-1]), parameter, ell)
@@ -65,7 +67,7 @@ def test_critical_alpha1_matches_closed_form(curve):
 def test_curve_joins_the_two_pitchforks(curve, located):
     """Started at the lower SPOM1 pitchfork, the curve comes back to α1 = 1.3 at the upper one."""
     _, branch, bps = located
-    assert "partner" in curve.stop_reason
+    assert curve.stop.code == StopCode.PARTNER
     upper = branch.pole_values(bps[1].X)["lam2_north"][0]
     assert curve.pole_stretch[-1] > 0.9 * upper and curve.q[-1] < 1.5
 
@@ -100,9 +102,9 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     np.testing.assert_array_equal(data["pressure"], curve.pressure)
     np.testing.assert_array_equal(data["lam2_north"], curve.pole_stretch)
     special = data["special_points"]
-    assert list(special["kind"]) == ["merge"]
-    assert special["q"][0] == curve.critical[0] == data["attrs"]["critical_q"]
-    assert special["lam2_north"][0] == pytest.approx(curve.critical[2], rel=1e-14)
+    assert [s["kind"] for s in special] == ["LP"] and data["attrs"]["stop_code"] == "partner"
+    assert data["special_q"][0] == curve.critical[0] == data["attrs"]["critical_q"]
+    assert special[0]["lam2_north"] == pytest.approx(curve.critical[2], rel=1e-14)
     assert data["attrs"]["parameter"] == "alpha1"
     assert read_run(path)["branches"] == {}  # also a readable run file (provenance attributes)
     with pytest.raises(FileExistsError):
@@ -114,7 +116,7 @@ SINGLE_COIL = Path(__file__).resolve().parent.parent / "scenes" / "spom1_single_
 
 def _pear_points(branch):
     """Located pear points of a primary branch from the odd block alone (cheaper than the full assessment)."""
-    variation = SecondVariation(branch.equilibrium, branch.disc.degree)
+    variation = SecondVariation(equilibrium_of(branch), branch.disc.degree)
     odd = bifurcation.block_indices(variation, "odd_held", False)
     lowest = np.array([variation._lowest(variation.matrices(X[:-1], branch.params.with_value("P", X[-1]))[0],
                                          odd)[0] for X in branch.X])
@@ -144,10 +146,10 @@ def test_critical_field_of_the_single_coil_isola(field_curve):
     brackets it: the primary branch has two pear points at M = 4.17 (where they lie on the curve) and none at
     4.20."""
     branch, curve = field_curve
-    assert len(curve.merges) == 1 and "partner" in curve.stop_reason
+    assert len(curve.merges) == 1 and curve.stop.code == StopCode.PARTNER
     q, P, stretch = curve.critical
     assert 4.17 < q < 4.20
-    merge = curve.merges[0].point.X
+    merge = curve.merges[0].X
     assert branch.disc.tail(merge[:branch.disc.size]) < 1e-9
     below, above = _pear_points(_probe(4.17)), _pear_points(_probe(4.20))
     assert len(below) == 2 and len(above) == 0

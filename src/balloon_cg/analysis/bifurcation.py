@@ -1,38 +1,30 @@
 """Branch points of the primary branch, their classification, the pear-shaped branches and snap-through.
 
 Detection: a sign change, between neighbouring points, of the lowest eigenvalue of a block of the second
-variation (``stability``): the pear block (odd) gives symmetry-breaking pitchforks 'BP'; the even block gives
-equator-symmetric (prolate/oblate) branch points 'BP-even' unless the change coincides with a fold in P.
+variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks; the even block gives
+equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. Both are BP
+special points; their ``block`` says which.
 Location: Brent's method (``continuation.locate_root``) on μ(s), the crossing eigenvalue at the point X(s)
-corrected on the chord hyperplane, to |Δs| ≤ 1e-13 (with the discretisation of the branch itself).
+corrected on the chord hyperplane, to |Δs| ≤ 1e-13 (with the discretisation of the branch itself); the point's
+``status`` says whether the root was located or only the nearest evaluated point is known.
 Classification: the reduced energy at the bifurcation pressure along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
-E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical.
-Branch switching: from u* + δφ, corrected on the hyperplane normal to φ, then pseudo-arclength in the general
-(non-symmetric) space, both ways (the pear branch and its mirror image), until it rejoins the primary branch
-(the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch point)
-or a stop rule applies.
+E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical (``classification``).
+Branch switching is in ``switching``.
 """
-import time
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 import scipy.linalg
 
-from ..numerics import continuation
-from .branch import ParameterSystem, PrimaryTracer, _stop_rule, assemble, transfer_error
 from ..galerkin.discretisation import Discretisation
+from ..numerics import continuation
 from ..numerics.newton import newton
+from .problem import equilibrium_of, pressure_system
+from .resolution import Resolution
+from .results import Block, Branch, Classification, Kind, SpecialPoint
 from .stability import SecondVariation
-
-@dataclass
-class BranchPoint:
-    index: int  # between branch points index and index + 1
-    block: str  # 'odd_held' (pear) or 'even'
-    X: np.ndarray  # located point (u in the branch's layout, P)
-    mode: np.ndarray  # critical eigenvector on the perturbation basis (a_0..a_N, b_0..b_N)
-    kind: str = "BP"
-    E: tuple = (np.nan, np.nan, np.nan)  # E2, E3, E4
+from .tracer import Tracer
 
 
 def _eigenpair(variation, u, params, idx, k):
@@ -45,43 +37,44 @@ def _eigenpair(variation, u, params, idx, k):
     return values[0], mode
 
 
-def block_indices(variation, block: str, field_on: bool):
+def block_indices(variation, block: Block, field_on: bool):
+    """Indices of a block on the perturbation basis (odd_held plus b_0 for a free balloon in a field)."""
     i = variation.index
-    if block == "even":
+    if block == Block.EVEN:
         return np.concatenate([i["a_even"], i["b_odd"]])
     odd = np.concatenate([i["a_odd"], i["b_even"][1:]])
     return np.append(odd, variation.translation) if (block == "odd_free" and field_on) else odd
 
 
-def detect(branch, assessments):
+def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
     """(index, block, k) of every change of the number of negative eigenvalues of the pear or even block
     between neighbouring points; k is the eigenvalue (from the lowest, 0) that crosses zero. Changes of the
     even block at a fold in P are the fold itself, not a branch point."""
-    folds = {s.index for s in branch.special if s.kind == "LP"}
+    folds = {s.index for s in branch.special if s.kind == Kind.LP}
     events = []
     for n in range(len(assessments) - 1):
-        for block in ("odd_held", "even"):
+        for block in (Block.ODD_HELD, Block.EVEN):
             a = int(np.sum(assessments[n].blocks[block] < 0))
             b = int(np.sum(assessments[n + 1].blocks[block] < 0))
-            if a != b and not (block == "even" and n in folds):
+            if a != b and not (block == Block.EVEN and n in folds):
                 events.append((n, block, min(a, b)))
     return events
 
 
-def locate(branch, index: int, block: str, k: int = 0) -> BranchPoint:
-    """The branch point between points index and index + 1 (see module docstring)."""
-    eq, params = branch.equilibrium, branch.params
+def locate(branch: Branch, index: int, block: Block, k: int = 0) -> SpecialPoint:
+    """The branch point between points index and index + 1 (module docstring): a BP special point with its
+    block, critical mode and location status."""
+    eq, params, solver = equilibrium_of(branch), branch.params, branch.scene.solver
     variation = SecondVariation(eq, branch.disc.degree)
     idx = block_indices(variation, block, field_on=False)
-    system = _system(branch)
+    system = pressure_system(branch)
     X0, X1 = branch.X[index], branch.X[index + 1]
     chord = X1 - X0
     length = np.linalg.norm(chord)
     d = chord / length
 
     def value_at(s):
-        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s,
-                        eq.scene.solver.tol, eq.scene.solver.max_newton)
+        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
         if not result.converged:
             raise ArithmeticError(result.message)
         value, mode = _eigenpair(variation, result.x[:-1], params.with_value("P", result.x[-1]), idx, k)
@@ -90,36 +83,22 @@ def locate(branch, index: int, block: str, k: int = 0) -> BranchPoint:
     found = continuation.locate_root(value_at, length)
     if found is None:
         raise RuntimeError(f"branch point between points {index} and {index + 1} could not be located")
-    X, mode = found
-    return BranchPoint(index, block, X, mode)
+    X, mode = found.payload
+    return SpecialPoint(Kind.BP, index, X, block=Block(block), status=found.status, mode=mode)
 
 
-def _system(branch):
-    return ParameterSystem(branch.equilibrium, branch.params, "P")
-
-
-def general_tracer(scene) -> PrimaryTracer:
+def general_tracer(scene) -> Tracer:
     """The general (non-symmetric) space, balloon held at its centre: the branch points are those of the held
     reading (the 'odd_held' block), so the branches leaving them are traced with b_0 = 0 too."""
-    return PrimaryTracer(scene, symmetric=False, held=True)
+    return Tracer(scene, symmetric=False, held=True)
 
 
-def plain_degree(branch, X) -> int:
-    """The Legendre degree in x that holds the point X of ``branch``: the branch's own degree if its basis is not
-    mapped, else grown by half (up to solver.max_degree) until the projection loses at most max_error and its
-    spectral tail is within max_error (the mapped degree is far below what x needs near a wire)."""
-    disc, solver = branch.disc, branch.equilibrium.scene.solver
-    degree = disc.degree
-    while disc.mapping is not None and degree < solver.max_degree:
-        plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
-        moved = disc.transfer(X, plain)
-        if max(transfer_error(disc, X, plain, moved)[0], plain.tail(moved[: plain.size])) <= solver.max_error:
-            break
-        degree = min(int(degree * 1.5), solver.max_degree)
-    return degree
+def plain_degree(branch: Branch, X) -> int:
+    """The Legendre degree in x that holds the point X of ``branch`` (``Resolution.plain_degree``)."""
+    return Resolution.of(branch.scene.solver).plain_degree(branch.disc, X)
 
 
-def to_general(branch, tracer, degree, u):
+def to_general(branch: Branch, tracer: Tracer, degree: int, u):
     """Coefficients of a (symmetric-layout) solution in the general layout of ``tracer`` at ``degree`` (in x:
     a branch stored on a mapped basis is projected)."""
     return branch.disc.transfer(u, tracer.system(degree, branch.params).eq.disc)
@@ -131,7 +110,7 @@ def padded_mode(mode: np.ndarray, degree: int) -> np.ndarray:
     return np.concatenate([np.pad(mode[:n], (0, degree + 1 - n)), np.pad(mode[n:], (0, degree + 1 - n))])
 
 
-def mode_direction(bp: BranchPoint, disc: Discretisation):
+def mode_direction(bp: SpecialPoint, disc: Discretisation):
     """The critical eigenvector as a unit direction in X = (u, P) of the general discretisation (its Legendre
     coefficients in x padded to that degree)."""
     mode = padded_mode(bp.mode, disc.degree)
@@ -139,10 +118,11 @@ def mode_direction(bp: BranchPoint, disc: Discretisation):
     return direction / np.linalg.norm(direction)
 
 
-def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
-    """E2, E3, E4 of the reduced energy at fixed P* and the kind (module docstring)."""
-    scene = branch.equilibrium.scene
-    tracer = general_tracer(scene)
+def classify(branch: Branch, bp: SpecialPoint, delta: float = 2e-2) -> SpecialPoint:
+    """``bp`` with E2, E3, E4 of the reduced energy at fixed P* and its classification (module docstring);
+    unclassified (Classification.NONE) when fewer than three constrained minimisations converge."""
+    solver = branch.scene.solver
+    tracer = general_tracer(branch.scene)
     degree = plain_degree(branch, bp.X)
     eq = tracer.system(degree, branch.params).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])
@@ -154,7 +134,7 @@ def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
         result = newton(lambda x: eq.residual(x[:-1], params) + x[-1] * phi,
                         lambda x: np.hstack([eq.jacobian(x[:-1], params), phi[:, None]]),
                         np.append(u_star + lam * phi, 0.0), np.append(phi, 0.0), phi @ u_star + lam,
-                        scene.solver.tol, scene.solver.max_newton)
+                        solver.tol, solver.max_newton)
         if result.converged:
             lams.append(lam)
             energies.append(eq.energy(result.x[:-1], params) - E0)
@@ -162,44 +142,8 @@ def classify(branch, bp: BranchPoint, delta: float = 2e-2) -> BranchPoint:
         return bp
     L = np.array(lams)
     E2, E3, E4 = np.linalg.lstsq(np.stack([L**2, L**3, L**4], axis=1), np.array(energies), rcond=None)[0]
-    bp.E = (float(E2), float(E3), float(E4))
     if abs(E3) * delta > abs(E4) * delta**2:
-        bp.kind = "transcritical"
+        kind = Classification.TRANSCRITICAL
     else:
-        bp.kind = "pitchfork-super" if E4 > 0 else "pitchfork-sub"
-    return bp
-
-
-def trace_pear(branch, bp: BranchPoint, sign: float, name: str, progress=None, delta: float = 1e-3):
-    """The bifurcating branch leaving ``bp`` along ±φ, in the general space, until it rejoins or stops."""
-    t0 = time.perf_counter()
-    scene = branch.equilibrium.scene
-    tracer = general_tracer(scene)
-    degree = plain_degree(branch, bp.X)
-    params = branch.params
-    system = tracer.system(degree, params)
-    X_star = np.append(to_general(branch, tracer, degree, bp.X[:-1]), bp.X[-1])
-    phi = sign * mode_direction(bp, system.eq.disc)
-    guess = X_star + delta * phi
-    result = newton(system.residual, system.jacobian, guess, phi, phi @ guess, scene.solver.tol,
-                    scene.solver.max_newton)
-    if not result.converged:
-        return None
-    start = continuation.Point(result.x, continuation.tangent(system, result.x, phi), result.iterations,
-                               result.residual)
-    base = _stop_rule(scene, scene.continuation.stop_stretch)
-    anchors = {}
-
-    def stop(disc, point):
-        if disc not in anchors:
-            coarse = system.eq.disc
-            anchors[disc] = (coarse.transfer(phi, disc), coarse.transfer(X_star, disc))
-        direction, star = anchors[disc]
-        if direction @ (point.X - star) < 0:
-            return "rejoined the primary branch"
-        south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
-        if south >= scene.continuation.stop_stretch:
-            return f"south pole stretch reached stop_stretch {scene.continuation.stop_stretch:g}"
-        return base(disc, point)
-
-    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0)
+        kind = Classification.PITCHFORK_SUPER if E4 > 0 else Classification.PITCHFORK_SUB
+    return replace(bp, E=(float(E2), float(E3), float(E4)), classification=kind)

@@ -25,28 +25,27 @@ the general kernel class (``ogden_general_field``, exponents as runtime argument
 converged points (the residual itself is exact).
 
 The two pitchforks of an isola lie on one such curve; where the curve turns back in q (a sign change of the
-q-component of the tangent, located by the continuation's fold locator, label 'merge') they merge: that q is
+q-component of the tangent, located by the continuation's fold locator: an LP of the curve) they merge: that q is
 the critical value (critical M, critical α1) — obtained directly, without bracketing in q.
 """
-import os
-import secrets
 import time
 from dataclasses import dataclass, field, replace
 
-import h5py
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from ..numerics import continuation
-from .branch import SpecialPoint
-from .bifurcation import block_indices, padded_mode, plain_degree
 from ..galerkin.discretisation import Discretisation
-from ..galerkin.equilibrium import Equilibrium
+from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model.kernels import KernelSet
-from ..numerics.newton import newton
 from ..model.sphere_modes import bifurcation_condition, bifurcation_stretches
+from ..numerics import continuation
+from ..numerics.continuation import Stop
+from ..numerics.newton import newton
+from ..scene import Scene
+from .bifurcation import block_indices, padded_mode, plain_degree
+from .problem import equilibrium_of
+from .results import Block, Branch, Kind, SpecialPoint, StopCode
 from .stability import SecondVariation
-from ..io.run_file import _root_attrs, _write_special, check_output
 
 PARAMETERS = ("M", "alpha1")
 H_STEP = 1e-6
@@ -160,21 +159,32 @@ class ExtendedSystem:
 
 @dataclass
 class TwoParameterCurve:
-    """A traced curve of pear branch points: X = (u, P, φ, q) per point, the merge points (folds in q)."""
+    """A traced curve of pear branch points (plain data): X = (u, P, φ, q) per point on the symmetric layout
+    ``disc``, and the merge points (LP special points: folds in q, X in the same layout)."""
 
     parameter: str
-    system: ExtendedSystem
+    scene: Scene
+    disc: Discretisation
+    params: Parameters  # the branch's parameters (q replaces M or α1 along the curve)
+    ell: np.ndarray  # normalisation row of φ
     X: np.ndarray
     iterations: np.ndarray
     residual: np.ndarray
-    merges: list = field(default_factory=list)  # continuation.Fold, label 'merge'
-    stop_reason: str = ""
+    merges: list = field(default_factory=list)
+    stop: Stop | None = None
     wall_time: float = 0.0
+
+    @property
+    def n(self) -> int:
+        return self.disc.size
+
+    def system(self) -> "ExtendedSystem":
+        """The extended system the curve solves (rebuilt)."""
+        return ExtendedSystem(Equilibrium(self.scene, self.disc), self.params, self.parameter, self.ell)
 
     def _parts(self, X):
         X = np.atleast_2d(X)
-        n = self.system.n
-        return X[:, :n], X[:, n], X[:, -1]
+        return X[:, :self.n], X[:, self.n], X[:, -1]
 
     @property
     def q(self):
@@ -184,13 +194,22 @@ class TwoParameterCurve:
     def pressure(self):
         return self._parts(self.X)[1]
 
+    @property
+    def mode(self):
+        """φ per point, on the odd perturbation block."""
+        return self.X[:, self.n + 1:-1]
+
+    @property
+    def stop_reason(self) -> str:
+        return self.stop.message if self.stop else ""
+
     def branch_X(self, X=None):
         """(u, P) rows in the primary branch's layout."""
         u, P, _ = self._parts(self.X if X is None else X)
         return np.hstack([u, P[:, None]])
 
     def pole_values(self, X=None):
-        rows = self.system.eq.disc.pole_rows()
+        rows = self.disc.pole_rows()
         u = self._parts(self.X if X is None else X)[0]
         return {name: u @ row for name, row in rows.items()}
 
@@ -203,38 +222,39 @@ class TwoParameterCurve:
         """(q, P, north pole stretch) of the first merge point, or None."""
         if not self.merges:
             return None
-        X = self.merges[0].point.X
+        X = self.merges[0].X
         return float(X[-1]), float(self._parts(X)[1][0]), float(self.pole_values(X)["lam2_north"][0])
 
 
-def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0: float | None = None,
-                          settings: continuation.Settings | None = None, stop=None, progress=None,
-                          max_points: int = 400) -> TwoParameterCurve:
+def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, direction: float = 1.0,
+                          q0: float | None = None, settings: continuation.Settings | None = None, stop=None,
+                          progress=None, max_points: int = 400) -> TwoParameterCurve:
     """Trace the curve of pear branch points through ``bp`` (located on the symmetric ``branch``) in q.
 
     ``direction``: +1 starts with q increasing, −1 decreasing. ``q0``: the branch's value of q (default: its M,
-    or its material's α1). The trace stops when ``stop(point)`` (a continuation.Point) returns a reason, by
+    or its material's α1). The trace stops when ``stop(point)`` (a continuation.Point) returns a Stop, by
     default when q returns past q0 after a merge (the curve has reached the partner pitchfork) or at ``max_points``.
     Returns a TwoParameterCurve whose ``merges`` are the located folds in q (the critical values).
     """
     t0 = time.perf_counter()
-    scene = branch.equilibrium.scene
+    scene = branch.scene
     if branch.disc.mapping is not None:  # the extended system shares coefficients with the stability basis (in x)
         mapped = branch.disc
         plain = Discretisation(plain_degree(branch, bp.X), mapped.symmetric, mapped.pin_translation)
-        branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain), equilibrium=Equilibrium(scene, plain))
+        branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
         bp = replace(bp, X=mapped.transfer(bp.X, plain), mode=padded_mode(bp.mode, plain.degree))
-    eq = Equilibrium(scene, branch.disc)  # own object: the α1 continuation swaps in runtime-exponent kernels
+    eq = equilibrium_of(branch)  # own object: the α1 continuation swaps in runtime-exponent kernels
     if q0 is None:
         q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
-    if parameter == "M" and not branch.equilibrium.coils.shape[0]:
+    if parameter == "M" and not scene.field.coils:
         raise TwoParameterError("continuation in M needs coils: without a field R does not depend on M")
-    if bp.block != "odd_held":
-        raise TwoParameterError(f"branch point of block {bp.block!r}: only pear (odd_held) points are continued")
+    if bp.block != Block.ODD_HELD:
+        raise TwoParameterError(f"branch point of block {bp.block.value!r}: only pear (odd_held) points are continued")
     variation = SecondVariation(eq, branch.disc.degree)
-    odd = block_indices(variation, "odd_held", field_on=False)
+    odd = block_indices(variation, Block.ODD_HELD, field_on=False)
     ell = bp.mode[odd] / np.linalg.norm(bp.mode[odd])
-    system = ExtendedSystem(eq, branch.params.with_value("P", bp.X[-1]), parameter, ell)
+    params = branch.params.with_value("P", bp.X[-1])
+    system = ExtendedSystem(eq, params, parameter, ell)
     X0 = system.initial(bp, q0)
     if settings is None:
         c, s = scene.continuation, scene.solver
@@ -254,37 +274,35 @@ def continue_branch_point(branch, bp, parameter: str, direction: float = 1.0, q0
 
     def default_stop(point):
         if (point.X[-1] - q0) * direction < 0:
-            return f"q returned past its start value {q0:g} (reached the partner branch point)"
+            return Stop(StopCode.PARTNER, f"q returned past its start value {q0:g} (reached the partner branch point)")
         return None
 
     rule = stop or default_stop
 
     def stop_point(point):
         if point.X[-1] <= 0 and parameter == "alpha1":
-            return "alpha1 reached 0"
+            return Stop(StopCode.ALPHA1_ZERO, "alpha1 reached 0")
         return rule(point)
 
-    path = continuation.trace(system, start, settings, stop_point, {"merge": e_q}, progress)
-    merged = [f for f in path.folds if f.label == "merge"]
+    path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
+    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, status=fold.status,
+                           note=f"fold of the curve in {parameter}: the two pitchforks merge") for fold in path.folds]
     points = path.points
-    curve = TwoParameterCurve(parameter, system, np.array([p.X for p in points]),
-                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
-                              merged, path.stop_reason, 0.0)
-    curve.overshoot = path.overshoot
-    curve.wall_time = time.perf_counter() - t0
-    return curve
+    return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
+                             np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
+                             merges, path.stop, time.perf_counter() - t0)
 
 
 def land_on_q(curve: TwoParameterCurve, q: float, near: int):
     """The curve point with q exactly (Newton from curve point ``near`` with the row e_q), or None."""
-    system = curve.system
+    system = curve.system()
     X = curve.X[near]
     row = np.zeros(X.size)
     row[-1] = 1.0
     guess = X.copy()
     guess[-1] = q
-    settings = system.eq.scene.solver
-    result = newton(system.residual, system.jacobian, guess, row, q, settings.tol, settings.max_newton)
+    solver = curve.scene.solver
+    result = newton(system.residual, system.jacobian, guess, row, q, solver.tol, solver.max_newton)
     return result.x if result.converged else None
 
 
@@ -320,85 +338,3 @@ def sphere_critical_alpha1(material, lo: float, hi: float, lam_max: float = 10.0
 def sphere_pear_stretches(material, alpha1: float, lam_max: float = 10.0):
     """Closed-form pear branch-point stretches of the α1 family member (sphere_modes.bifurcation_stretches)."""
     return bifurcation_stretches(alpha1_material(material, alpha1), 1, lam_max=lam_max)
-
-
-# -- storage --------------------------------------------------------------------------------------------------
-def write_curve(path, scene, curve: TwoParameterCurve, name: str = "pear", force: bool = False,
-                extra_attrs: dict | None = None):
-    """Write a two-parameter curve to an HDF5 file (atomically; root attributes as run files, ``storage``).
-
-    Layout::
-
-        /                            attrs: as a run file (format, scene, provenance) + extra_attrs
-        /branches/                   (empty: the file is also a readable run file)
-        /two_parameter/<name>/       attrs: parameter, stop_reason, wall_time, degree, kernel_class, M, chi,
-                                            critical_q (NaN if no merge was found)
-            q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
-            unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block
-            special_points/ kind ('merge'), index, note, pressure, E2..E4, pole values, unknowns (storage
-                            layout of branch special points), q
-    """
-    path = check_output(path, force)
-    attrs = _root_attrs(scene) | dict(extra_attrs or {})
-    system = curve.system
-    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        with h5py.File(tmp, "x") as f:
-            f.attrs.update(attrs)
-            f.create_group("branches")
-            group = f.create_group("two_parameter").create_group(name)
-            critical = curve.critical
-            group.attrs.update({
-                "parameter": curve.parameter,
-                "stop_reason": curve.stop_reason,
-                "wall_time": curve.wall_time,
-                "degree": system.eq.disc.degree,
-                "kernel_class": system.eq.kernels.name,
-                "M": system.params.M,
-                "chi": system.params.chi,
-                "critical_q": np.nan if critical is None else critical[0],
-            })
-            n, m = system.n, system.m
-            columns = {"q": curve.q, "pressure": curve.pressure, **curve.pole_values(),
-                       "newton_iterations": curve.iterations, "residual": curve.residual,
-                       "unknowns": curve.branch_X(), "mode": curve.X[:, n + 1:n + 1 + m]}
-            for key, data in columns.items():
-                group.create_dataset(key, data=data)
-            merges = [SpecialPoint("merge", fold.index, curve.branch_X(fold.point.X)[0],
-                                   f"fold of the curve in {curve.parameter}: the two pitchforks merge")
-                      for fold in curve.merges]
-            view = _SpecialView(merges, curve.branch_X(), system.eq.disc)
-            special = group.create_group("special_points")
-            _write_special(special, view)
-            special.create_dataset("q", data=np.array([fold.point.X[-1] for fold in curve.merges], dtype=float))
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path
-
-
-@dataclass
-class _SpecialView:
-    """What storage._write_special reads from a branch: special points, X rows and pole values."""
-
-    special: list
-    X: np.ndarray
-    disc: object
-
-    def pole_values(self, X=None):
-        rows = self.disc.pole_rows()
-        U = (self.X if X is None else np.atleast_2d(X))[:, :-1]
-        return {key: U @ row for key, row in rows.items()}
-
-
-def read_curve(path, name: str = "pear") -> dict:
-    """The datasets and attributes of a stored curve: {'attrs', datasets…, 'special_points': {…}}."""
-    with h5py.File(path, "r") as f:
-        group = f["two_parameter"][name]
-        data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
-        data["attrs"] = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in group.attrs.items()}
-        sp = group["special_points"]
-        data["special_points"] = {key: (sp[key].asstr()[()] if key in ("kind", "note") else sp[key][()])
-                                  for key in sp}
-    return data

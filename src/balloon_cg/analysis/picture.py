@@ -2,46 +2,64 @@
 
 ``analyse(scene)`` traces the primary branch, assesses every point (``stability``), locates and classifies its
 branch points (``bifurcation``), follows each pear-shaped branch both ways (the branch and its mirror image,
-north and south poles swapped) until it rejoins the primary branch or stops, assesses those too, and lists the
-snap-throughs under pressure control. Every branch carries its assessments in ``branch.stability``.
+north and south poles swapped: ``switching``) until it rejoins the primary branch or stops, assesses those
+too, and lists the snap-throughs under pressure control. Every branch carries its assessments in
+``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import bifurcation
-from .branch import SpecialPoint, trace_primary
+from .primary import trace_primary
+from .problem import equilibrium_of
+from .results import Block, Branch, StopCode
 from .stability import assess_branch
+from .switching import trace_pear
+
+
+@dataclass
+class SnapThrough:
+    """Under pressure control: a stable stretch of ``from_branch`` ends after point ``from_index`` at ``pressure``;
+    the lowest-energy stable point at that pressure is on ``to_branch`` near ``to_index`` ("" and −1: none)."""
+
+    from_branch: str
+    from_index: int
+    pressure: float
+    to_branch: str = ""
+    to_index: int = -1
 
 
 @dataclass
 class Picture:
     branches: list
-    branch_points: list = field(default_factory=list)
-    snaps: list = field(default_factory=list)  # dicts: from (branch, index, P) to (branch, index)
-    unsettled: dict = field(default_factory=dict)  # branch name -> point indices whose flags change at 2N
+    branch_points: list = field(default_factory=list)  # the primary branch's BP special points, in order
+    snaps: list = field(default_factory=list)  # SnapThrough
+
+    @property
+    def primary(self) -> Branch:
+        return self.branches[0]
 
 
-def _assess(branch, scene, symmetric):
-    results, unsettled = assess_branch(branch, scene.stability.degree, symmetric,
-                                       check_degree=2 * scene.stability.degree, m_max=scene.stability.m_max)
-    branch.stability = results
-    branch.unsettled = unsettled
-    return unsettled
+def _assess(branch: Branch, scene, symmetric: bool) -> None:
+    branch.stability, branch.unsettled = assess_branch(
+        branch, scene.stability.degree, symmetric, check_degree=2 * scene.stability.degree,
+        m_max=scene.stability.m_max)
 
 
 def analyse(scene, progress=None, pear: bool = True) -> Picture:
+    """The picture of a scene (module docstring); ``pear=False`` skips the pear branches."""
     primary = trace_primary(scene, progress=progress)
     picture = Picture([primary])
-    picture.unsettled["primary"] = _assess(primary, scene, primary.disc.symmetric)
+    _assess(primary, scene, primary.disc.symmetric)
     if not primary.disc.symmetric:
         return picture
-    events = bifurcation.detect(primary, primary.stability)
-    for n, (index, block, k) in enumerate(events):
+    for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
         bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
+        mode = "pear (odd)" if block == Block.ODD_HELD else "equator-symmetric (even)"
+        bp.note = f"{mode} mode, branch point {n}"
         picture.branch_points.append(bp)
-        mode = "pear (odd)" if block == "odd_held" else "equator-symmetric (even)"
-        primary.special.append(SpecialPoint(bp.kind, index, bp.X, f"{mode} mode, branch point {n}", bp.E))
+        primary.special.append(bp)
     primary.special.sort(key=lambda s: s.index)
     if pear:
         _trace_pears(scene, primary, picture, progress)
@@ -49,37 +67,36 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     return picture
 
 
-def _trace_pears(scene, primary, picture, progress):
+def _trace_pears(scene, primary: Branch, picture: Picture, progress):
     """Pear branches from the pear branch points; a branch that rejoins at an already traced point is not repeated."""
     reached = set()
     for n, bp in enumerate(picture.branch_points):
-        if bp.block != "odd_held" or n in reached:
+        if bp.block != Block.ODD_HELD or n in reached:
             continue
         for sign, suffix in ((1.0, ""), (-1.0, "_mirror")):
             name = f"pear_{n}{suffix}"
-            branch = bifurcation.trace_pear(primary, bp, sign, name, progress)
+            branch = trace_pear(primary, bp, sign, name, progress)
             if branch is None:
                 continue
             branch.parent = ("primary", n)
-            end = _rejoin_point(primary, branch, picture.branch_points, n)
-            if end is not None:
-                reached.add(end)
-                branch.stop_reason += f" at branch point {end}"
-            picture.unsettled[name] = _assess(branch, scene, symmetric=False)
+            branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
+            if branch.rejoins is not None:
+                reached.add(branch.rejoins)
+            _assess(branch, scene, symmetric=False)
             picture.branches.append(branch)
 
 
-def _rejoin_point(primary, branch, branch_points, origin):
+def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:
     """The pear branch point where ``branch`` rejoined the primary branch (nearest in P), if any."""
-    if "rejoined" not in branch.stop_reason:
+    if not branch.stopped(StopCode.REJOINED):
         return None
     P_end = branch.pressure[-1]
     candidates = [(abs(bp.X[-1] - P_end), n) for n, bp in enumerate(branch_points)
-                  if n != origin and bp.block == "odd_held"]
+                  if n != origin and bp.block == Block.ODD_HELD]
     return min(candidates)[1] if candidates else None
 
 
-def snap_throughs(branches):
+def snap_throughs(branches: list) -> list:
     """Under pressure control: where a stable stretch of a branch ends (fold or loss of stability) with P
     increasing, the jump to the lowest-energy stable point at the same P on any branch (or none found)."""
     snaps = []
@@ -89,21 +106,21 @@ def snap_throughs(branches):
             if stable[i] and not stable[i + 1]:
                 P = branch.pressure[i]
                 target = _stable_at(branches, P, exclude=(branch.name, i))
-                snaps.append({"from_branch": branch.name, "from_index": i, "pressure": float(P),
-                              "to_branch": target[0] if target else "", "to_index": target[1] if target else -1})
+                snaps.append(SnapThrough(branch.name, i, float(P), *(target or ())))
     return snaps
 
 
-def _stable_at(branches, P, exclude):
+def _stable_at(branches: list, P: float, exclude):
     best = None
     for branch in branches:
         stable = np.array([a.stable_pressure for a in branch.stability])
         p = branch.pressure
+        eq = equilibrium_of(branch)
         for i in range(len(p) - 1):
             if (branch.name, i) == exclude or abs(i - exclude[1]) <= 1 and branch.name == exclude[0]:
                 continue
             if stable[i] and stable[i + 1] and (p[i] - P) * (p[i + 1] - P) <= 0:
-                volume = branch.equilibrium.volume(branch.X[i, :-1])
+                volume = eq.volume(branch.X[i, :-1])
                 if best is None or volume > best[0]:
                     best = (volume, branch.name, i)
     return best[1:] if best else None

@@ -23,6 +23,7 @@ import scipy.linalg
 from .azimuthal import spectrum
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
+from .problem import equilibrium_of
 
 LOWEST = 3  # eigenvalues reported per block
 
@@ -135,12 +136,13 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degr
     tenth point.
     """
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
-    variation = SecondVariation(branch.equilibrium, degree)
+    eq = equilibrium_of(branch)
+    variation = SecondVariation(eq, degree)
     params = branch.params
     results = [variation.assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max) for X in branch.X]
     unsettled = []
     if check_degree:
-        finer = SecondVariation(branch.equilibrium, check_degree)
+        finer = SecondVariation(eq, check_degree)
         flags = [_flags(a) for a in results]
         for n, (X, coarse) in enumerate(zip(branch.X, results)):
             changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])

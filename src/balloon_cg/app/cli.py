@@ -14,12 +14,15 @@ import numpy as np
 from tqdm import tqdm
 
 from ..analysis.picture import analyse
-from ..analysis.branch import ContinuationError, trace_primary
+from ..analysis.primary import trace_primary
+from ..analysis.results import StopCode
+from ..analysis.tracer import ContinuationError
 from ..model.field import FieldError
 from ..post.plotting import KINDS, PlotError, plot as draw_plot
 from ..galerkin.profiles import equator_values
 from ..scene import SceneError, load_scene
-from ..io.run_file import RunFileError, check_output, read_run, write_run
+from ..io.hdf5 import check_output
+from ..io.run_file import RunFileError, read_run, write_run
 
 PROG = "balloon-cg"
 
@@ -126,8 +129,7 @@ def solve(args) -> int:
     if not np.isfinite(x) or x <= start:
         raise UsageError(f"--pole-stretch = {x:g}: must be > continuation.start_stretch = {start:g}")
     branch = trace_primary(scene, stop_stretch=x, down=False)
-    end = branch.special[-1]
-    if not end.note.startswith("reached stop_stretch"):
+    if branch.special[-1].stop.code != StopCode.STOP_STRETCH:
         reached = branch.pole_values()["lam2_north"].max()
         raise Failure(
             f"the primary branch did not reach north pole stretch {x:g} ({branch.stop_reason}); "
@@ -146,7 +148,6 @@ def solution(branch, i: int) -> dict:
         **{k: float(np.squeeze(v)) for k, v in values.items()},
         "residual": float(branch.residual[i]),
         "error_estimate": float(branch.error_estimate[i]),
-        "converged": bool(branch.converged[i]),
         "wall_time": branch.wall_time,
     }
 
@@ -224,13 +225,15 @@ def critical(args) -> int:
     """Primary branch, its first pear pitchfork, the curve of pitchforks in the parameter, the merge point."""
     from ..analysis.bifurcation import detect, locate
     from ..analysis.stability import assess_branch
-    from ..analysis.codim2 import continue_branch_point, write_curve
+    from ..analysis.codim2 import continue_branch_point
+    from ..analysis.results import Block
+    from ..io.curve_file import write_curve
 
     scene = load_scene(args.scene)
     check_output(args.output, args.force)
     branch = trace_primary(scene)
     assessments, _ = assess_branch(branch, scene.stability.degree)
-    pear = [event for event in detect(branch, assessments) if event[1] == "odd_held"]
+    pear = [event for event in detect(branch, assessments) if event[1] == Block.ODD_HELD]
     if not pear:
         raise Failure(f"no pear-shaped branch point on the primary branch ({branch.stop_reason})")
     curve = continue_branch_point(branch, locate(branch, *pear[0]), args.parameter)
@@ -311,6 +314,7 @@ def summarise_branch(b: dict) -> dict:
         "lam2_south": _range(b["lam2_south"]),
         "special_points": b["special_points"],
         "stop_reason": attrs["stop_reason"],
+        "stop_codes": dict(zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", []))),
         "max_residual": float(b["residual"].max()),
         "max_error_estimate": float(b["error_estimate"].max()),
         "wall_time": wall,
@@ -373,8 +377,10 @@ def _format_branch(name: str, b: dict) -> list[str]:
     ]
     for s in b["special_points"]:
         note = f"  {s['note']}" if s["note"] else ""
+        status = "" if s["status"] == "located" else f" ({s['status']})"
+        label = f"{s['kind']} {s['classification']}".strip() + status
         lines.append(
-            f"    {s['kind']:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
+            f"    {label:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
             f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
         )
     return lines

@@ -14,7 +14,7 @@ import time
 from importlib import resources
 from pathlib import Path
 
-from ..analysis.branch import ContinuationError
+from ..analysis.tracer import ContinuationError
 from .cli import run_scene, summarise_branch
 from ..post.plotting import applicable_kinds, load_branches, plot
 from ..scene import parse_scene

@@ -2,63 +2,31 @@
 
 ``balloon-cg sweep SCENE.toml --vary M=0:0.005:21 -o SWEEP.h5`` expands the specs into members (each a Scene
 made by ``Scene.with_overrides``), computes them in worker processes (a local ProcessPoolExecutor, or an
-existing dask.distributed cluster with ``--scheduler``) and appends each member to one HDF5 file as it finishes.
-Only the parent process writes the sweep file.
-
-Sweep file layout (format "balloon-cg-sweep/1")::
-
-    /                   attrs: format, scene_name, scene_toml (base scene, normalised), vary (JSON list of
-                               [key, values]), mode, members (total count), package_version, generated_digest,
-                               created, command
-    /members/<index>/   attrs: overrides (JSON object, dotted key -> value), scene_hash (sha256 of the member
-                               scene's normalised TOML), scene_toml, created, worker_pid, wall_time,
-                               branch_point_kinds, branch_point_blocks, branch_point_pressures, + the member
-                               run file's provenance (package_version, generated_digest, tolerance)
-        branches/<name>/          exactly as storage.write_run writes /branches (storage.py)
-        snap_throughs/            as in a run file (full analysis only)
-
-A member is first written under a temporary name in /members and then renamed, so an interrupted sweep leaves
-only whole members; the file is flushed after each. Re-running the same sweep skips the members whose group
-holds the same scene_hash; a different sweep into an existing file needs --force.
+existing dask.distributed cluster with ``--scheduler``) and appends each member to one sweep file as it
+finishes (layout: ``io.sweep_file``). Workers return their results as plain data (``MemberResult``); only the
+parent process writes the sweep file. Re-running the same sweep skips the members whose group holds the same
+scene_hash; a different sweep into an existing file needs --force.
 """
 import contextlib
-import datetime
 import hashlib
-import io
 import itertools
-import json
 import os
 import re
-import secrets
-import shlex
 import sys
-import tempfile
 import time
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 from tqdm import tqdm
 
-import balloon_cg
 
-from ..model.kernels import generated_digest
+from ..analysis.picture import analyse
+from ..analysis.primary import trace_primary
+from ..io.sweep_file import SweepError, append_member, open_sweep, read_sweep, root_attrs
 from ..scene import Scene, SceneError, parse_scene
-from ..io.run_file import _branch_order, _plain, _read_branch, _read_snaps, check_output, write_run
 
-FORMAT = "balloon-cg-sweep/1"
 MODES = ("analysis", "no-pear", "primary-only")
-_TMP_PREFIX = ".tmp-"
-
-
-class SweepError(ValueError):
-    """A sweep that cannot be run as asked (bad --vary spec, conflicting existing file)."""
-
-
-class MemberFailure(RuntimeError):
-    """Some members raised; the others were written."""
 
 
 # --- specs and members -------------------------------------------------------------------------------------
@@ -210,12 +178,21 @@ def _ranges(indices: list[int]) -> str:
 
 # --- the worker --------------------------------------------------------------------------------------------
 
-def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> dict:
-    """Worker side: compute one member and return its run file as bytes (written by storage.write_run) with a
-    short summary. Runs in a worker process (local pool or dask worker); picklable in and out."""
-    from ..analysis.picture import analyse
-    from ..analysis.branch import trace_primary
+@dataclass
+class MemberResult:
+    """What a worker returns (plain data, pickled back to the parent): the branches, snap-throughs and branch
+    points of one member."""
 
+    index: int
+    branches: list
+    snaps: list | None
+    branch_points: list
+    wall_time: float
+    pid: int
+
+
+def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> MemberResult:
+    """Worker side: compute one member (local pool or dask worker); picklable in and out."""
     # BLAS runs single-threaded in every member: importing balloon_cg limits it (balloon_cg/__init__); with
     # 2 BLAS threads per member on busy cores a member ran 35x slower (benchmarks/sweep.py).
     scene = parse_scene(scene_toml, scene_name)
@@ -225,20 +202,7 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> d
     else:
         picture = analyse(scene, pear=(mode == "analysis"))
         branches, snaps, points = picture.branches, picture.snaps, picture.branch_points
-    wall = time.perf_counter() - start
-    with tempfile.TemporaryDirectory(prefix="balloon-cg-sweep-") as tmp:
-        path = write_run(Path(tmp) / "member.h5", scene, branches, snaps=snaps,
-                         extra_attrs={"command": f"sweep member {index}"})
-        data = path.read_bytes()
-    return {
-        "index": index,
-        "run_file": data,
-        "wall_time": wall,
-        "pid": os.getpid(),
-        "branch_point_kinds": [bp.kind for bp in points],
-        "branch_point_blocks": [bp.block for bp in points],
-        "branch_point_pressures": [float(bp.X[-1]) for bp in points],
-    }
+    return MemberResult(index, branches, snaps, points, time.perf_counter() - start, os.getpid())
 
 
 # --- the writer (parent process only) ----------------------------------------------------------------------
@@ -251,121 +215,6 @@ class SweepResult:
     skipped: list = field(default_factory=list)  # indices already in the file (same scene_hash)
     failed: dict = field(default_factory=dict)  # index -> error message
     wall_time: float = 0.0
-
-
-def _root_attrs(scene: Scene, axes: list, mode: str, n: int, command: str | None) -> dict:
-    return {
-        "format": FORMAT,
-        "scene_name": scene.name,
-        "scene_toml": scene.to_toml(),
-        "vary": json.dumps(axes),
-        "mode": mode,
-        "members": n,
-        "package_version": balloon_cg.__version__,
-        "generated_digest": generated_digest(),
-        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "command": command if command is not None else shlex.join(sys.argv),
-    }
-
-
-def _open_sweep(path: Path, attrs: dict, members: list[Member], force: bool) -> tuple[h5py.File, set]:
-    """Open (or create) the sweep file; returns it and the indices already done. A file holding another sweep is
-    an error unless ``force`` (then it is replaced)."""
-    if path.exists() and force:
-        path.unlink()
-    if path.exists():
-        try:
-            f = h5py.File(path, "a")
-        except OSError:
-            raise SweepError(f"{path}: exists and is not a readable HDF5 file (use --force to replace it)") from None
-        try:
-            done = _check_existing(f, path, attrs, members)
-        except BaseException:
-            f.close()
-            raise
-        return f, done
-    check_output(path, force=False)
-    f = h5py.File(path, "w-")
-    f.attrs.update(attrs)
-    f.create_group("members")
-    f.flush()
-    return f, set()
-
-
-def _check_existing(f: h5py.File, path: Path, attrs: dict, members: list[Member]) -> set:
-    if f.attrs.get("format") != FORMAT:
-        raise SweepError(f"{path}: exists and is not a balloon-cg sweep file (use --force to replace it)")
-    for key in ("scene_toml", "vary", "mode", "members"):
-        old, new = _plain(f.attrs.get(key)), attrs[key]
-        if old != new:
-            what = {"scene_toml": f"the base scene differs ({_scene_diff(old, new)})", "vary": f"--vary differs (file: {old}, now: {new})",
-                    "mode": f"the mode differs (file: {old}, now: {new})",
-                    "members": f"the member count differs (file: {old}, now: {new})"}[key]
-            raise SweepError(f"{path}: holds a different sweep: {what}; use --force to replace it")
-    group = f.require_group("members")
-    for name in [n for n in group if n.startswith(_TMP_PREFIX)]:
-        del group[name]  # a member whose write was interrupted before its rename
-    expected = {str(m.index): m for m in members}
-    done = set()
-    for name in group:
-        m = expected.get(name)
-        if m is None:
-            raise SweepError(f"{path}: member {name} is not a member of this sweep; use --force to replace the file")
-        stored = _plain(group[name].attrs.get("scene_hash"))
-        if stored != m.scene_hash:
-            raise SweepError(f"{path}: member {name} ({m.label}) was computed for another scene "
-                             f"(scene_hash {str(stored)[:12]}… in the file, {m.scene_hash[:12]}… now); "
-                             "use --force to replace the file")
-        done.add(m.index)
-    return done
-
-
-def _scene_diff(old: str, new: str) -> str:
-    """The dotted keys whose values differ between two normalised scene TOML texts."""
-    def flat(data, prefix=""):
-        out = {}
-        for k, v in data.items():
-            if isinstance(v, dict):
-                out |= flat(v, f"{prefix}{k}.")
-            else:
-                out[f"{prefix}{k}"] = v
-        return out
-
-    try:
-        a, b = flat(tomllib.loads(old)), flat(tomllib.loads(new))
-    except (tomllib.TOMLDecodeError, TypeError):
-        return "unreadable scene in the file"
-    keys = [k for k in dict.fromkeys([*a, *b]) if a.get(k) != b.get(k)]
-    return ", ".join(f"{k}: {a.get(k)} in the file, {b.get(k)} now" for k in keys) or "formatting only"
-
-
-def _append_member(f: h5py.File, member: Member, result: dict) -> None:
-    """Write one member under a temporary name, rename it to /members/<index>, flush."""
-    group = f["members"]
-    tmp = f"{_TMP_PREFIX}{member.index}-{secrets.token_hex(4)}"
-    with h5py.File(io.BytesIO(result["run_file"]), "r") as run:
-        g = group.create_group(tmp)
-        try:
-            for key in ("package_version", "generated_digest", "tolerance", "created"):
-                g.attrs[key] = run.attrs[key]
-            g.attrs.update({
-                "overrides": json.dumps(member.overrides),
-                "scene_hash": member.scene_hash,
-                "scene_toml": member.scene.to_toml(),
-                "worker_pid": result["pid"],
-                "wall_time": result["wall_time"],
-                "branch_point_pressures": np.array(result["branch_point_pressures"], dtype=float),
-            })
-            for key in ("branch_point_kinds", "branch_point_blocks"):
-                g.attrs.create(key, np.array(result[key], dtype=object), dtype=h5py.string_dtype())
-            run.copy(run["branches"], g, "branches")
-            if "snap_throughs" in run:
-                run.copy(run["snap_throughs"], g, "snap_throughs")
-        except BaseException:
-            del group[tmp]
-            raise
-    group.move(tmp, str(member.index))
-    f.flush()
 
 
 def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis", workers: int | None = None,
@@ -383,7 +232,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
     members = expand(scene, specs) if members is None else members
     axes = [list(parse_vary(s, scene)) for s in specs]
     path = Path(out_path)
-    f, done = _open_sweep(path, _root_attrs(scene, axes, mode, len(members), command), members, force)
+    f, done = open_sweep(path, root_attrs(scene, axes, mode, len(members), command), members, force)
     result = SweepResult(path, members, skipped=sorted(done))
     todo = [m for m in members if m.index not in done]
     by_index = {m.index: m for m in members}
@@ -395,7 +244,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
                     if isinstance(outcome, BaseException):
                         result.failed[index] = f"{type(outcome).__name__}: {outcome}"
                     else:
-                        _append_member(f, by_index[index], outcome)
+                        append_member(f, by_index[index], outcome)
                         result.computed.append(index)
                     bar.update()
     finally:
@@ -455,29 +304,6 @@ def _compute_dask(jobs, scheduler: str):
 
 
 # --- reading and summary -----------------------------------------------------------------------------------
-
-def read_sweep(path) -> dict:
-    """{'path', 'attrs', 'members': {index: {'overrides', 'scene_hash', 'attrs', 'branches': {name: branch}}}}.
-
-    Branches are dicts as read by storage.read_run.
-    """
-    path = Path(path)
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != FORMAT:
-            raise SweepError(f"{path}: not a balloon-cg sweep file")
-        out = {"path": str(path), "attrs": {k: _plain(v) for k, v in f.attrs.items()}, "members": {}}
-        for name in sorted((n for n in f["members"] if not n.startswith(_TMP_PREFIX)), key=int):
-            g = f["members"][name]
-            attrs = {k: (v.tolist() if isinstance(v, np.ndarray) else _plain(v)) for k, v in g.attrs.items()}
-            out["members"][int(name)] = {
-                "overrides": json.loads(attrs["overrides"]),
-                "scene_hash": attrs["scene_hash"],
-                "attrs": attrs,
-                "branches": {b: _read_branch(g["branches"][b]) for b in _branch_order(g["branches"])},
-                "snap_throughs": _read_snaps(g.get("snap_throughs")),
-            }
-    return out
-
 
 def format_summary(result: SweepResult) -> str:
     """Members, time, and per member the pear branch points (pressures) read back from the sweep file."""

@@ -80,6 +80,10 @@ class Discretisation:
     quadrature: int = 0
     mapping: WireMap | None = None
 
+    def __reduce__(self):
+        """Pickled as its five defining fields (the tables are rebuilt): results holding one stay small."""
+        return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping)
+
     def __post_init__(self):
         n_q = self.quadrature or (3 * self.degree) // 2 + 8
         nodes, s_weights = legendre.leggauss(n_q)

@@ -1,42 +1,42 @@
-"""Run files (HDF5, format "balloon-cg/1"): traced branches with their provenance.
+"""Run files (HDF5, format "balloon-cg/2"): traced branches with their provenance.
 
 Layout::
 
-    /                      attrs: format, scene_name, scene_toml, package_version, generated_digest,
-                                  tolerance, created (UTC ISO 8601), command, + extra_attrs
-    /branches/<name>/      attrs: stop_reason, wall_time, degree, symmetric, pin_translation,
-                                  kernel_class, kernel_signature, M, chi
+    /                      attrs: format, scene_name, scene_toml, tolerance, + provenance (io.hdf5: package_version,
+                                  generated_digest, created (UTC ISO 8601), command) + extra_attrs
+    /branches/<name>/      attrs: order, stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
+                                  'up'/'down'/'forward' and a StopCode/TraceStop value), wall_time, degree,
+                                  symmetric, pin_translation, quadrature, map_centres, map_widths,
+                                  kernel_class, kernel_signature, M, chi, [parent_branch, parent_branch_point,
+                                  rejoins_branch_point]
         pressure, lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
         newton_iterations, solved_degree                   (n_points,)
         unknowns                                           (n_points, n + 1): Legendre unknowns u, then P
         theta                                              (n_theta,): linspace(0, π)
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (n_points, n_theta)
-        special_points/kind, index, note, pressure, lam2_north, lam2_south, eta_north, eta_south   (n_special,)
+        special_points/kind (LP, TP, BP, EP, UZ), classification, block, status, stop_code, note, index,
+                       pressure, E2, E3, E4, lam2_north, lam2_south, eta_north, eta_south   (n_special,)
         special_points/unknowns                            (n_special, n + 1)
+        stability/...                                      (analysed branches: flags and lowest eigenvalues)
+    /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
 
-A fold (LP, TP) lies between points ``index`` and ``index + 1``; its own X is in special_points/unknowns.
-Files are written atomically (temporary file in the same directory, then os.replace).
+A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index + 1``; its own X is in
+special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``).
 """
-import datetime
 import errno
-import os
-import secrets
-import shlex
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 
-import balloon_cg
-
-from ..model.kernels import generated_digest
 from ..galerkin.profiles import equator_values, profiles, theta_grid
+from .hdf5 import atomic_file, plain, provenance, write_strings
 
-FORMAT = "balloon-cg/1"
+FORMAT = "balloon-cg/2"
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
 SPECIAL_NUMBERS = ("pressure", "E2", "E3", "E4") + POLES
+SPECIAL_TEXT = ("kind", "classification", "block", "status", "stop_code", "note")
 
 
 class RunFileError(ValueError):
@@ -49,72 +49,53 @@ def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | No
 
     An existing file is kept unless ``force`` (FileExistsError); on any failure the existing file is
     untouched and the temporary file removed. ``extra_attrs`` are added to (or override, except ``format``)
-    the root attributes. Raises ValueError if a branch holds a point that is not a converged solution.
+    the root attributes. Raises ValueError if a branch holds a point that is not a finite solution.
     """
-    path = check_output(path, force)
+    attrs = root_attrs(scene) | dict(extra_attrs or {})
+    if attrs["format"] != FORMAT:
+        raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
+    check_branches(branches)
+    with atomic_file(path, force) as f:
+        f.attrs.update(attrs)
+        write_branches(f, scene, branches, snaps)
+    return Path(path)
+
+
+def root_attrs(scene, command: str | None = None) -> dict:
+    """The root attributes of a run file: format, the scene and the provenance."""
+    return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.text, "tolerance": scene.solver.tol,
+            **provenance(command)}
+
+
+def check_branches(branches) -> None:
+    """Distinct names and only finite points (ValueError otherwise: nothing is written)."""
     names = [b.name for b in branches]
     if len(set(names)) != len(names):
         raise ValueError(f"branch names must be distinct, got {names}")
     for branch in branches:
-        _check_converged(branch)
-    attrs = _root_attrs(scene) | dict(extra_attrs or {})
-    if attrs["format"] != FORMAT:
-        raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
-    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        with h5py.File(tmp, "x") as f:
-            f.attrs.update(attrs)
-            group = f.create_group("branches")
-            for order, branch in enumerate(branches):
-                _write_branch(group.create_group(branch.name), branch, theta_grid(scene.output.theta_points))
-                group[branch.name].attrs["order"] = order
-            if snaps is not None:
-                _write_snaps(f.create_group("snap_throughs"), snaps)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path
+        bad = np.flatnonzero(~finite(branch))
+        if bad.size:
+            raise ValueError(f"branch {branch.name!r}: points {bad.tolist()} are not converged solutions; not written")
 
 
-def check_output(path, force: bool) -> Path:
-    """``path`` as a Path, if a run file may be written there (else FileExistsError, FileNotFoundError, …)."""
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    if not path.parent.is_dir():
-        raise FileNotFoundError(errno.ENOENT, "no such directory", str(path.parent))
-    if path.exists() and not force:
-        raise FileExistsError(errno.EEXIST, "already exists (use --force to overwrite it)", str(path))
-    return path
+def finite(branch) -> np.ndarray:
+    """Per point: finite unknowns and residual (every traced point is a converged Newton solution)."""
+    return np.isfinite(branch.X).all(axis=1) & np.isfinite(branch.residual)
 
 
-def converged(branch) -> np.ndarray:
-    """Per point: Newton converged (the branch's flag), with finite unknowns and residual."""
-    return branch.converged & np.isfinite(branch.X).all(axis=1) & np.isfinite(branch.residual)
-
-
-def _check_converged(branch):
-    bad = np.flatnonzero(~converged(branch))
-    if bad.size:
-        raise ValueError(f"branch {branch.name!r}: points {bad.tolist()} are not converged solutions; not written")
-
-
-def _root_attrs(scene) -> dict:
-    return {
-        "format": FORMAT,
-        "scene_name": scene.name,
-        "scene_toml": scene.text,
-        "package_version": balloon_cg.__version__,
-        "generated_digest": generated_digest(),
-        "tolerance": scene.solver.tol,
-        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "command": shlex.join(sys.argv),
-    }
+def write_branches(parent, scene, branches, snaps=None) -> None:
+    """/branches (and /snap_throughs when ``snaps`` is given) of a run file into the h5py group ``parent``."""
+    group = parent.create_group("branches")
+    theta = theta_grid(scene.output.theta_points)
+    for order, branch in enumerate(branches):
+        _write_branch(group.create_group(branch.name), branch, theta)
+        group[branch.name].attrs["order"] = order
+    if snaps is not None:
+        _write_snaps(parent.create_group("snap_throughs"), snaps)
 
 
 def _write_branch(group, branch, theta):
-    disc, kernels = branch.disc, branch.equilibrium.kernels
+    disc = branch.disc
     group.attrs.update({
         "stop_reason": branch.stop_reason,
         "wall_time": branch.wall_time,
@@ -124,16 +105,24 @@ def _write_branch(group, branch, theta):
         "quadrature": disc.quadrature,
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
-        "kernel_class": kernels.name,
-        "kernel_signature": kernels.signature,
+        "kernel_class": branch.kernel_class,
+        "kernel_signature": branch.kernel_signature,
         "M": branch.params.M,
         "chi": branch.params.chi,
     })
+    text = h5py.string_dtype()
+    group.attrs.create("leg_labels", np.array([leg.label for leg in branch.legs], dtype=object), dtype=text)
+    group.attrs.create("leg_stop_codes", np.array([leg.stop.code.value for leg in branch.legs], dtype=object),
+                       dtype=text)
+    if branch.parent is not None:
+        group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
+    if branch.rejoins is not None:
+        group.attrs["rejoins_branch_point"] = branch.rejoins
     columns = {
         "pressure": branch.pressure,
         **branch.pole_values(),
         **equator_values(branch),
-        "converged": converged(branch),
+        "converged": finite(branch),
         "residual": branch.residual,
         "error_estimate": branch.error_estimate,
         "newton_iterations": branch.iterations,
@@ -146,11 +135,9 @@ def _write_branch(group, branch, theta):
     shapes = group.create_group("profiles")
     for name, data in profiles(branch, theta).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
-    _write_special(group.create_group("special_points"), branch)
-    if getattr(branch, "stability", None):
+    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc)
+    if branch.stability:
         _write_stability(group.create_group("stability"), branch)
-    if getattr(branch, "parent", None):
-        group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
 
 
 STABILITY_FLAGS = {
@@ -170,31 +157,35 @@ def _write_stability(group, branch):
     for block in results[0].blocks:
         values = np.array([a.blocks[block] for a in results])
         group.create_dataset(f"lowest_{block}", data=values)
-    group.attrs["unsettled_points"] = np.asarray(getattr(branch, "unsettled", []), dtype=np.int64)
+    group.attrs["unsettled_points"] = np.asarray(branch.unsettled, dtype=np.int64)
 
 
 def _write_snaps(group, snaps):
     """Snap-throughs under pressure control: from (branch, index) at pressure P to (branch, index) or none."""
-    text = h5py.string_dtype()
-    for key in ("from_branch", "to_branch"):
-        group.create_dataset(key, data=np.array([s[key] for s in snaps], dtype=object), dtype=text)
+    write_strings(group, "from_branch", [s.from_branch for s in snaps])
+    write_strings(group, "to_branch", [s.to_branch for s in snaps])
     for key in ("from_index", "to_index"):
-        group.create_dataset(key, data=np.array([s[key] for s in snaps], dtype=np.int64))
-    group.create_dataset("pressure", data=np.array([s["pressure"] for s in snaps], dtype=float))
+        group.create_dataset(key, data=np.array([getattr(s, key) for s in snaps], dtype=np.int64))
+    group.create_dataset("pressure", data=np.array([s.pressure for s in snaps], dtype=float))
 
 
-def _write_special(group, branch):
-    special = branch.special
-    X = np.array([s.X for s in special]).reshape(len(special), branch.X.shape[1])
-    text = h5py.string_dtype()
-    group.create_dataset("kind", data=np.array([s.kind for s in special], dtype=object), dtype=text)
+def write_special(group, special: list, width: int, disc) -> None:
+    """Special points (results.SpecialPoint) as columns; ``width`` = n + 1, the length of their X rows, and
+    ``disc`` the discretisation of their u (for the pole values)."""
+    X = np.array([s.X for s in special]).reshape(len(special), width)
+    write_strings(group, "kind", [s.kind.value for s in special])
+    write_strings(group, "classification", [s.classification.value for s in special])
+    write_strings(group, "block", [s.block.value for s in special])
+    write_strings(group, "status", [s.status.value for s in special])
+    write_strings(group, "stop_code", [s.stop.code.value if s.stop else "" for s in special])
+    write_strings(group, "note", [s.stop.message if s.stop else s.note for s in special])
     group.create_dataset("index", data=np.array([s.index for s in special], dtype=np.int64))
-    group.create_dataset("note", data=np.array([s.note for s in special], dtype=object), dtype=text)
     group.create_dataset("pressure", data=X[:, -1])
     for n, name in enumerate(("E2", "E3", "E4")):
         group.create_dataset(name, data=np.array([s.E[n] for s in special], dtype=float))
-    for name, values in branch.pole_values(X).items():
-        group.create_dataset(name, data=values)
+    rows = disc.pole_rows()
+    for name in POLES:
+        group.create_dataset(name, data=X[:, :-1] @ rows[name])
     group.create_dataset("unknowns", data=X)
 
 
@@ -202,9 +193,9 @@ def read_run(path) -> dict:
     """Summary of a run file: {'path', 'scene_name', 'attrs', 'branches': {name: branch}}.
 
     Each branch is a dict of its attrs ('attrs'), its per-point arrays and 'theta', 'profiles' (dict of
-    arrays), 'special_points' (list of dicts: kind, index, note, pressure, pole values) and 'special_unknowns'
+    arrays), 'special_points' (list of dicts: the special_points columns) and 'special_unknowns'
     (their X rows).
-    Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a balloon-cg/1 run file.
+    Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a balloon-cg/2 run file.
     """
     path = Path(path)
     if path.is_dir():
@@ -221,30 +212,31 @@ def read_run(path) -> dict:
             found = "no format attribute" if fmt is None else f"format {fmt!r}"
             raise RunFileError(f"{path}: not a balloon-cg run file ({found}, expected {FORMAT!r})")
         try:
-            attrs = {k: _plain(v) for k, v in f.attrs.items()}
-            return {
-                "path": str(path),
-                "scene_name": attrs["scene_name"],
-                "attrs": attrs,
-                "branches": {name: _read_branch(f["branches"][name]) for name in _branch_order(f["branches"])},
-                "snap_throughs": _read_snaps(f.get("snap_throughs")),
-            }
+            attrs = {k: plain(v) for k, v in f.attrs.items()}
+            return {"path": str(path), "scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
         except KeyError as e:
             raise RunFileError(f"{path}: damaged balloon-cg run file (missing {e})") from None
 
 
+def read_branches(parent) -> dict:
+    """{'branches': {name: branch dict}, 'snap_throughs': [...]} of an h5py group written by write_branches."""
+    group = parent["branches"]
+    return {"branches": {name: _read_branch(group[name]) for name in _branch_order(group)},
+            "snap_throughs": _read_snaps(parent.get("snap_throughs"))}
+
+
+def _attr(value):
+    if isinstance(value, np.ndarray) and value.dtype == object:
+        return [v.decode() if isinstance(v, bytes) else v for v in value.tolist()]
+    return plain(value)
+
+
 def _read_branch(group) -> dict:
     data = {name: group[name][()] for name, item in group.items() if isinstance(item, h5py.Dataset)}
-    data["attrs"] = {k: _plain(v) for k, v in group.attrs.items()}
+    data["attrs"] = {k: _attr(v) for k, v in group.attrs.items()}
     data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]
-    columns = {
-        "kind": sp["kind"].asstr()[()],
-        "index": sp["index"][()],
-        "note": sp["note"].asstr()[()],
-        **{name: sp[name][()] for name in SPECIAL_NUMBERS},
-    }
-    data["special_points"] = [{k: _plain(v[i]) for k, v in columns.items()} for i in range(sp["kind"].shape[0])]
+    data["special_points"] = read_special(sp)
     data["special_unknowns"] = sp["unknowns"][()]
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
@@ -261,9 +253,11 @@ def _read_snaps(group) -> list:
         return []
     columns = {k: (group[k].asstr()[()] if k.endswith("branch") else group[k][()]) for k in group}
     n = len(columns.get("pressure", []))
-    return [{k: _plain(v[i]) for k, v in columns.items()} for i in range(n)]
+    return [{k: plain(v[i]) for k, v in columns.items()} for i in range(n)]
 
 
-def _plain(value):
-    """numpy scalars as Python numbers/bools, for printing and JSON."""
-    return value.item() if isinstance(value, np.generic) else value
+def read_special(group) -> list:
+    """Special points written by write_special, as a list of dicts (text columns as str)."""
+    columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT}
+    columns |= {name: group[name][()] for name in ("index",) + SPECIAL_NUMBERS}
+    return [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]

@@ -11,6 +11,7 @@ state moves step_max, instead of crawling at a fixed arclength that the paramete
 *Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
 for a limit point); folds are then located by Brent's method in the arclength (``locate_root``, to 1e-13 in s).
 """
+import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,6 +32,24 @@ class Settings:
     slow_newton: int = 6  # a correction needing more iterations is rejected (near-singular: e.g. a branch point)
 
 
+class TraceStop(enum.StrEnum):
+    """Why ``trace`` itself stopped (the caller's stop rule has its own codes)."""
+
+    MAX_POINTS = "max_points"  # settings.max_points reached
+    STEP_MIN = "step_min"  # the corrector failed at the minimum step
+
+
+@dataclass(frozen=True)
+class Stop:
+    """A stop: ``code`` (a member of an enum: TraceStop or the caller's) decides, ``message`` explains."""
+
+    code: enum.Enum
+    message: str
+
+    def __str__(self):
+        return self.message
+
+
 @dataclass
 class Point:
     X: np.ndarray
@@ -44,13 +63,14 @@ class Fold:
     label: str
     point: Point
     index: int  # the fold lies between points[index] and points[index + 1]
+    status: "RootStatus"
 
 
 @dataclass
 class Path:
     points: list = field(default_factory=list)
     folds: list = field(default_factory=list)
-    stop_reason: str = ""
+    stop: Stop | None = None
     overshoot: Point | None = None  # the first point past a stop condition (not part of the branch)
 
 
@@ -70,10 +90,24 @@ def correct(system, predictor, direction, settings: Settings):
                   settings.tol, settings.max_newton)
 
 
-def locate_root(value_at, length: float, xtol: float = 1e-13):
+class RootStatus(enum.StrEnum):
+    """How ``locate_root`` found its point."""
+
+    LOCATED = "located"  # Brent's method converged to xtol
+    NEAREST = "nearest"  # an evaluation failed: the evaluated point with the smallest |value| (not a root)
+
+
+@dataclass(frozen=True)
+class Root:
+    payload: object
+    status: RootStatus
+    value: float  # the function's value there
+
+
+def locate_root(value_at, length: float, xtol: float = 1e-13) -> Root | None:
     """Root in (0, length) of s ↦ value_at(s)[0] (value_at returns (value, payload)) by Brent's method, and the
     payload there. If an evaluation fails (ArithmeticError: e.g. Newton at a singular point) the evaluated point
-    with the smallest |value| is returned; None if there is none."""
+    with the smallest |value| is returned with status NEAREST; None if there is none."""
     cache = {}
 
     def f(s):
@@ -82,9 +116,13 @@ def locate_root(value_at, length: float, xtol: float = 1e-13):
 
     try:
         s = scipy.optimize.brentq(f, 0.0, length, xtol=xtol * max(1.0, length), maxiter=100)
-        return (cache[s] if s in cache else value_at(s))[1]
+        value, payload = cache[s] if s in cache else value_at(s)
+        return Root(payload, RootStatus.LOCATED, float(value))
     except (ArithmeticError, ValueError):
-        return min(cache.values(), key=lambda item: abs(item[0]))[1] if cache else None
+        if not cache:
+            return None
+        value, payload = min(cache.values(), key=lambda item: abs(item[0]))
+        return Root(payload, RootStatus.NEAREST, float(value))
 
 
 def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Settings):
@@ -101,7 +139,7 @@ def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Se
 
 
 def trace(system, start: Point, settings: Settings, stop, monitors: dict, progress=None) -> Path:
-    """Follow the branch from ``start`` along its tangent until ``stop(point)`` returns a reason.
+    """Follow the branch from ``start`` along its tangent until ``stop(point)`` returns a ``Stop``.
 
     The point that triggers the stop is not appended (it is kept as ``path.overshoot``, for the caller to
     land exactly on the limit).
@@ -123,9 +161,8 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         if new_tangent is None or float(new_tangent @ current.tangent) < np.cos(settings.max_turn):
             sigma *= 0.5
             if sigma < settings.step_min:
-                path.stop_reason = (
-                    f"corrector failed at the minimum step {settings.step_min:g}: {result.message}"
-                )
+                path.stop = Stop(TraceStop.STEP_MIN,
+                                 f"corrector failed at the minimum step {settings.step_min:g}: {result.message}")
                 return path
             continue
         point = Point(result.x, new_tangent, result.iterations, result.residual)
@@ -133,10 +170,10 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
             if (c @ current.tangent) * (c @ point.tangent) < 0:
                 fold = _locate_fold(system, current, sigma, c, settings)
                 if fold is not None:
-                    path.folds.append(Fold(label, fold, len(path.points) - 1))
+                    path.folds.append(Fold(label, fold.payload, len(path.points) - 1, fold.status))
         reason = stop(point)
-        if reason:
-            path.stop_reason = reason
+        if reason is not None:
+            path.stop = reason
             path.overshoot = point
             return path
         path.points.append(point)
@@ -148,5 +185,5 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
             sigma = min(sigma * 1.5, settings.step_max / state_share)
         elif result.iterations >= 6:
             sigma = max(sigma * 0.7, settings.step_min)
-    path.stop_reason = f"maximum number of points ({settings.max_points}) reached"
+    path.stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({settings.max_points}) reached")
     return path

@@ -20,7 +20,9 @@ from matplotlib.lines import Line2D
 
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
 from ..galerkin.profiles import EQUATOR
+from ..io.curve_file import read_curve
 from ..io.run_file import read_run
+from ..io.sweep_file import read_sweep
 
 NORMAL_FORM = ("E2", "E3", "E4")
 DEFAULT_POINTS = 5
@@ -147,13 +149,18 @@ def _curve(ax, x, y, stable, color, linestyle="-"):
         ax.plot(x[piece], y[piece], color=color, linestyle="-" if stable[start] else "--", linewidth=1.4)
 
 
+def special_label(s: dict) -> str:
+    """A stored special point's label: its classification (pitchfork-super, …) if it has one, else its kind."""
+    return s["classification"] or s["kind"]
+
+
 def _special(ax, branch: StoredBranch, x, y, color) -> list:
     """Mark the special points at (x, y) (one entry per special point); returns their labels for _label_special."""
     marks = []
     for s, xs, ys in zip(branch.data["special_points"], x, y):
         ax.plot(xs, ys, MARKERS.get(s["kind"], "D"), color=color, markersize=6, markeredgecolor="k",
                 markeredgewidth=0.5)
-        marks.append((ax, s["kind"], xs, ys, color))
+        marks.append((ax, special_label(s), xs, ys, color))
     return marks
 
 
@@ -398,7 +405,7 @@ def plot_energy(branches) -> Figure:
             amplitude = np.linspace(-1, 1, 401) * _amplitude_range(e2, e3, e4)
             energy = e2 * amplitude**2 + e3 * amplitude**3 + e4 * amplitude**4
             ax.plot(amplitude, energy, color=f"C{i % 10}", linestyle=styles[drawn % len(styles)], linewidth=1.4,
-                    label=f"{b.label}: {s['kind']} at P = {s['pressure']:.6g}\n"
+                    label=f"{b.label}: {special_label(s)} at P = {s['pressure']:.6g}\n"
                           f"E2 = {e2:.3g}, E3 = {e3:.3g}, E4 = {e4:.3g}")
             drawn += 1
     ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
@@ -412,7 +419,7 @@ PARAMETER_LABELS = {"M": r"field intensity $M$", "alpha1": r"Ogden exponent $\al
 
 
 def plot_phase(paths) -> Figure:
-    """Phase diagram from two-parameter curves (files written by ``two_parameter.write_curve``): the pear
+    """Phase diagram from two-parameter curves (files written by ``io.curve_file.write_curve``): the pear
     bifurcation pressure against the second parameter q; the two pitchforks of an isola meet where q turns
     back (the critical q, marked); the region where the isola exists (q between its start and the critical
     value, P between the two pitchfork pressures) is shaded."""
@@ -430,14 +437,14 @@ def plot_phase(paths) -> Figure:
             raise PlotError(f"{path}: no two-parameter curve and no sweep members in this file (write one with "
                             "`balloon-cg critical` or `balloon-cg sweep`)")
         for name in names:
-            curve = _read_curve(path, name)
+            curve = read_curve(path, name)
             q, P = curve["q"], curve["pressure"]
             parameters.add(curve["attrs"]["parameter"])
             line, = ax.plot(q, P, label=f"{Path(path).stem}: {name}")
             critical = curve["attrs"].get("critical_q", np.nan)
-            merges = np.flatnonzero(np.asarray(curve["special_points"]["kind"]) == "merge")
-            if np.isfinite(critical) and merges.size:
-                P_merge = curve["special_points"]["pressure"][merges[0]]
+            merges = [s for s in curve["special_points"] if s["kind"] == "LP"]
+            if np.isfinite(critical) and merges:
+                P_merge = merges[0]["pressure"]
                 ax.fill(q, P, alpha=0.15, color=line.get_color(), label="isola exists")
                 ax.plot(critical, P_merge, "o", color=line.get_color())
                 ax.annotate(f"critical {curve['attrs']['parameter']} = {critical:.6g}", (critical, P_merge),
@@ -453,14 +460,12 @@ def plot_phase(paths) -> Figure:
 def _sweep_phase(ax, path) -> str:
     """Pear pitchfork pressures of every sweep member against the first varied key; the isola region (two
     pitchforks) shaded between them. Returns the parameter name."""
-    from ..app.sweep import read_sweep
-
     sweep = read_sweep(path)
     rows = []
     for member in sweep["members"].values():
         key, value = next(iter(member["overrides"].items()))
         primary = member["branches"]["primary"]
-        pressures = sorted(s["pressure"] for s in primary["special_points"] if "pear" in s["note"])
+        pressures = sorted(s["pressure"] for s in primary["special_points"] if s["block"] == "odd_held")
         rows.append((float(value), pressures))
     rows.sort()
     q = np.array([r[0] for r in rows])
@@ -473,11 +478,6 @@ def _sweep_phase(ax, path) -> str:
                         [r[1][-1] if len(r[1]) >= 2 else np.nan for r in rows], alpha=0.15, label="isola exists")
     return "M" if key == "field.M" else key
 
-
-def _read_curve(path, name):
-    from ..analysis.codim2 import read_curve
-
-    return read_curve(path, name)
 
 
 KINDS = {

@@ -1,0 +1,140 @@
+"""One Branch from the legs of a trace: the storage basis, the points moved onto it, exact end points.
+
+Points are stored on the finest discretisation used (the last one of the most refined leg: its map is the
+latest), its degree raised by the resolution policy while the projection would lose more than the policy's
+loss limit of any point and raising it helps. A point's stored error estimate adds its measured projection
+loss. A leg that stopped on passing a north pole stretch given in ``land_on`` (STOP_STRETCH, MIN_STRETCH) gets
+its exact end point there (Newton on the row e_λ2(0)·X = target from the linear interpolant).
+"""
+import time
+
+import numpy as np
+
+from ..numerics import continuation
+from ..numerics.continuation import Stop
+from ..numerics.newton import newton
+from .resolution import transfer_error
+from .results import Branch, Kind, Leg, SpecialPoint, StopCode
+from .tracer import ContinuationError, LegTrace
+
+
+def _moved(legs: list[LegTrace], target) -> dict:
+    """Per path with points (by id): its points transferred to ``target`` and their projection losses."""
+    out = {}
+    for leg in legs:
+        for coarse, path in leg.segments:
+            if path.points:
+                own = np.array([p.X for p in path.points])
+                moved = coarse.transfer(own, target)
+                out[id(path)] = moved, transfer_error(coarse, own, target, moved)
+    return out
+
+
+def _worst(moves: dict) -> float:
+    return max(loss.max() for _, loss in moves.values())
+
+
+def storage_basis(tracer, params, legs: list[LegTrace]):
+    """(discretisation, moves) for storing ``legs``: the finest one used, raised while that lowers the worst
+    projection loss below the policy's limit (a narrow final map may not hold the early points)."""
+    policy = tracer.resolution
+    used = [d for leg in legs for d, _ in leg.segments]
+    disc = [d for d in used if d.degree == max(u.degree for u in used)][-1]
+    moves = _moved(legs, disc)
+    while _worst(moves) > policy.loss_limit and disc.degree < policy.max_degree:
+        finer = tracer.system(policy.grow(disc.degree), params, disc.mapping).eq.disc
+        finer_moves = _moved(legs, finer)
+        if _worst(finer_moves) >= _worst(moves):
+            break
+        disc, moves = finer, finer_moves
+    return disc, moves
+
+
+def _collect(leg: LegTrace, disc, moves):
+    """Points (X on disc, continuation point, solved degree, error estimate + loss) and folds (kind, index, X,
+    status) of one leg, in order."""
+    points, folds = [], []
+    for coarse, path in leg.segments:
+        if not path.points:
+            continue
+        base = len(points)
+        moved, loss = moves[id(path)]
+        for p, X, lost in zip(path.points, moved, loss):
+            points.append((X, p, coarse.degree, coarse.tail(p.X[:-1]) + lost))
+        folds += [(f.label, base + f.index, coarse.transfer(f.point.X, disc), f.status) for f in path.folds]
+    return points, folds
+
+
+def _land(system, before, after, row, target, settings):
+    """The point with row·X = target between two branch points (Newton from the linear interpolant)."""
+    f0, f1 = row @ before, row @ after
+    guess = before + (target - f0) / (f1 - f0) * (after - before)
+    result = newton(system.residual, system.jacobian, guess, row, target, settings.tol, settings.max_newton)
+    if not result.converged:
+        return None
+    return continuation.Point(result.x, np.zeros_like(result.x), result.iterations, result.residual)
+
+
+def _landed(tracer, final, leg: LegTrace, points: list, land_on: dict):
+    """(points, stop) of a leg, with its exact end point when it stopped on passing a ``land_on`` stretch."""
+    target = land_on.get(leg.stop.code)
+    if target is None or not points:
+        return points, leg.stop
+    disc = final.eq.disc
+    last_disc, last_path = leg.segments[-1]
+    overshoot = last_disc.transfer(last_path.overshoot.X, disc)
+    north = np.append(disc.pole_rows()["lam2_north"], 0.0)
+    end = _land(final, points[-1][0], overshoot, north, target, tracer.settings)
+    if end is None:
+        reached = leg.stop.message.removeprefix("reached ")
+        return points, Stop(StopCode.LANDING_FAILED, f"could not land on {reached} (Newton failed); stopped before it")
+    return points + [(end.X, end, disc.degree, disc.tail(end.X[:-1]))], leg.stop
+
+
+def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | None = None, t0: float = 0.0,
+             land_on: dict | None = None, labels=("forward", "backward")) -> Branch:
+    """One Branch (module docstring): reversed ``backward`` (without its first point), then ``forward``.
+    ``land_on``: StopCode -> north pole stretch to land exactly on for legs stopped with that code."""
+    legs = [leg for leg in (backward, forward) if leg is not None]
+    disc, moves = storage_basis(tracer, params, legs)
+    final = tracer.system(disc.degree, params, disc.mapping)
+    land_on = land_on or {}
+    forward_points, forward_folds = _collect(forward, disc, moves)
+    forward_points, forward_stop = _landed(tracer, final, forward, forward_points, land_on)
+    backward_points, backward_folds = [], []
+    if backward:
+        backward_points, backward_folds = _collect(backward, disc, moves)
+        backward_points, backward_stop = _landed(tracer, final, backward, backward_points, land_on)
+    points = backward_points[:0:-1] + forward_points
+    if not points:
+        raise ContinuationError(f"{name}: no converged point ({forward.stop.message})")
+    offset = max(len(backward_points) - 1, 0)
+    special = [SpecialPoint(kind, offset - index - 1, X, status=status)
+               for kind, index, X, status in backward_folds[::-1]]
+    special += [SpecialPoint(kind, offset + index, X, status=status) for kind, index, X, status in forward_folds]
+    special.append(SpecialPoint(Kind.EP, len(points) - 1, points[-1][0], stop=forward_stop))
+    traced = (Leg(labels[0], forward_stop),)
+    if backward:
+        traced += (Leg(labels[1], backward_stop),)
+        if backward_points:
+            special.insert(0, SpecialPoint(Kind.EP, 0, points[0][0], stop=backward_stop))
+    loss_limit = tracer.resolution.loss_limit
+    lossy = tuple(float(lost) for _, loss in moves.values() for lost in loss if lost > loss_limit)
+    kernels = final.eq.kernels
+    return Branch(
+        name=name,
+        scene=tracer.scene,
+        disc=disc,
+        kernel_class=kernels.name,
+        kernel_signature=kernels.signature,
+        params=params,
+        X=np.array([p[0] for p in points]),
+        iterations=np.array([p[1].iterations for p in points]),
+        residual=np.array([p[1].residual for p in points]),
+        error_estimate=np.array([p[3] for p in points]),
+        degree=np.array([p[2] for p in points]),
+        special=special,
+        legs=traced,
+        lossy=lossy,
+        wall_time=time.perf_counter() - t0,
+    )

@@ -1,0 +1,31 @@
+"""The discrete problem of a branch as a continuation system, and the solver objects rebuilt from a result."""
+import numpy as np
+
+from ..galerkin.equilibrium import Equilibrium, Parameters
+
+
+class ParameterSystem:
+    """R(u; p) as a map of X = (u, p) for one continuation parameter p ∈ {P, M}."""
+
+    def __init__(self, equilibrium: Equilibrium, params: Parameters, name: str):
+        self.eq, self.params, self.name = equilibrium, params, name
+
+    def _params(self, X):
+        return self.params.with_value(self.name, X[-1])
+
+    def residual(self, X):
+        return self.eq.residual(X[:-1], self._params(X))
+
+    def jacobian(self, X):
+        p = self._params(X)
+        return np.hstack([self.eq.jacobian(X[:-1], p), self.eq.parameter_derivative(X[:-1], p, self.name)[:, None]])
+
+
+def equilibrium_of(branch) -> Equilibrium:
+    """The Ritz–Galerkin problem a branch was stored on (its scene on its discretisation)."""
+    return Equilibrium(branch.scene, branch.disc)
+
+
+def pressure_system(branch) -> ParameterSystem:
+    """R(u; P) of a branch as a map of X = (u, P)."""
+    return ParameterSystem(equilibrium_of(branch), branch.params, "P")

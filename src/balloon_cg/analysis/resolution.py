@@ -1,0 +1,73 @@
+"""The resolution policy: one object deciding when a discretisation holds a solution and how it grows.
+
+A point is resolved on a discretisation when its spectral error estimate (``Discretisation.tail``: the
+neglected geometric tail of the Legendre coefficients) is at most ``max_error``. Otherwise the degree grows by
+``growth`` (up to ``max_degree``). With a wire map, a re-centred map at the same degree is preferred when it
+leaves ``headroom`` · max_error (at most ``max_recentres`` times per degree). Points moved to another basis
+(storage on the final basis, a branch point projected to the stability basis in x) may lose at most
+``storage_loss`` · max_error to the projection (``transfer_error``) before the target degree is raised.
+The tracer, the storage-basis rule, bifurcation and two-parameter code all ask this object.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..galerkin.discretisation import Discretisation
+
+
+@dataclass(frozen=True)
+class Resolution:
+    max_error: float
+    max_degree: int
+    growth: float = 1.5
+    headroom: float = 0.25
+    storage_loss: float = 0.5
+    max_recentres: int = 6
+
+    @classmethod
+    def of(cls, solver) -> "Resolution":
+        """The policy of a scene's [solver] table."""
+        return cls(solver.max_error, solver.max_degree)
+
+    def resolved(self, disc: Discretisation, u) -> bool:
+        return disc.tail(u) <= self.max_error
+
+    def grow(self, degree: int) -> int:
+        """The next degree: ``growth`` times larger, at most max_degree."""
+        return min(int(degree * self.growth), self.max_degree)
+
+    @property
+    def recentre_accept(self) -> float:
+        """Largest error estimate for which a re-centred map at the same degree is kept."""
+        return self.headroom * self.max_error
+
+    @property
+    def loss_limit(self) -> float:
+        """Largest projection loss of a point moved to a storage basis."""
+        return self.storage_loss * self.max_error
+
+    def plain_degree(self, disc: Discretisation, X) -> int:
+        """The Legendre degree in x that holds the point X = (u, P) of a branch on ``disc``: its own degree if the
+        basis is not mapped, else grown until the projection loses at most max_error and the projected tail is
+        within max_error (the mapped degree is far below what x needs near a wire)."""
+        degree = disc.degree
+        while disc.mapping is not None and degree < self.max_degree:
+            plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
+            moved = disc.transfer(X, plain)
+            if max(transfer_error(disc, X, plain, moved)[0], plain.tail(moved[: plain.size])) <= self.max_error:
+                break
+            degree = self.grow(degree)
+        return degree
+
+
+def transfer_error(source: Discretisation, X, target: Discretisation, moved, n_theta: int = 721) -> np.ndarray:
+    """Per row: max |Δλ2|, |Δη| / |a_0| on a θ grid between X in ``source`` and ``moved`` = its transfer to
+    ``target`` (zero when the transfer is exact: same map, no lower degree)."""
+    X, moved = np.atleast_2d(X), np.atleast_2d(moved)
+    if source.nests_in(target):
+        return np.zeros(len(X))
+    theta = np.linspace(0.0, np.pi, n_theta)
+    before = source.evaluate(X[:, : source.size], theta)
+    after = target.evaluate(moved[:, : target.size], theta)
+    difference = np.maximum(np.abs(before[0] - after[0]).max(axis=1), np.abs(before[2] - after[2]).max(axis=1))
+    return difference / np.abs(before[0][:, 0])

@@ -1,0 +1,143 @@
+"""Results as plain data: branches, special points and stops, with typed decisions (no solver inside).
+
+A ``Branch`` is arrays and metadata (its scene, discretisation, kernel class, parameters, stability, parent):
+it pickles cheaply and the solver objects are rebuilt from it where needed (``analysis.problem``).
+Special points carry AUTO's labels where they exist (LP fold in the parameter, BP branch point, EP end point,
+UZ user point) plus TP, the turning point of the north pole stretch; a branch point's classification,
+block and the status of its location are separate fields. Stops are a code from ``StopCode`` (or the
+continuation engine's ``TraceStop``) plus a message for people; code decides, never the message.
+"""
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..galerkin.discretisation import Discretisation
+from ..galerkin.equilibrium import Parameters
+from ..numerics.continuation import RootStatus, Stop, TraceStop  # noqa: F401  (re-exported: one vocabulary)
+from ..scene import Scene
+
+
+class Kind(enum.StrEnum):
+    LP = "LP"  # fold in the continuation parameter (P on a branch, q on a two-parameter curve)
+    TP = "TP"  # turning point of the north pole stretch
+    BP = "BP"  # branch point (a block of the second variation is singular)
+    EP = "EP"  # end point of a branch (``stop`` says why)
+    UZ = "UZ"  # user point
+
+
+class Classification(enum.StrEnum):
+    NONE = ""  # not a branch point, or the reduced energy could not be fitted
+    PITCHFORK_SUPER = "pitchfork-super"
+    PITCHFORK_SUB = "pitchfork-sub"
+    TRANSCRITICAL = "transcritical"
+
+
+class Block(enum.StrEnum):
+    """The block of the second variation whose eigenvalue crosses zero at a branch point."""
+
+    NONE = ""
+    ODD_HELD = "odd_held"  # pear-shaped (symmetry-breaking) modes, balloon held at its centre
+    EVEN = "even"  # equator-symmetric modes
+
+
+class StopCode(enum.StrEnum):
+    """Why a leg of a branch (or a two-parameter curve) stopped, besides the engine's ``TraceStop``."""
+
+    STOP_STRETCH = "stop_stretch"  # the north pole stretch reached continuation.stop_stretch
+    MIN_STRETCH = "min_stretch"  # the north pole stretch reached continuation.min_stretch
+    STOP_PRESSURE = "stop_pressure"  # P reached continuation.stop_pressure
+    WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
+    SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch
+    REJOINED = "rejoined"  # a pear branch crossed back through the primary branch
+    RESOLUTION = "resolution"  # the spectral error estimate exceeds max_error (the tracer refines)
+    RESOLUTION_LIMIT = "resolution_limit"  # ... and the degree is at solver.max_degree
+    REFINE_FAILED = "refine_failed"  # Newton failed on the refined basis
+    LANDING_FAILED = "landing_failed"  # Newton failed landing exactly on stop/min_stretch
+    PARTNER = "partner"  # a two-parameter curve returned past its start value (reached the partner point)
+    ALPHA1_ZERO = "alpha1_zero"  # the α1 continuation reached α1 = 0
+
+
+@dataclass
+class SpecialPoint:
+    """A labelled point of a branch. LP, TP and BP lie between points ``index`` and ``index + 1`` (X is the
+    located point); EP is point ``index`` (``stop`` says why the branch ended there)."""
+
+    kind: Kind
+    index: int
+    X: np.ndarray
+    classification: Classification = Classification.NONE
+    block: Block = Block.NONE
+    status: RootStatus = RootStatus.LOCATED
+    E: tuple = (np.nan, np.nan, np.nan)  # normal-form coefficients E2, E3, E4 of a branch point
+    mode: np.ndarray | None = None  # critical eigenvector of a branch point (a_0..a_N, b_0..b_N, in x)
+    stop: Stop | None = None  # an end point's stop
+    note: str = ""  # for people only
+
+
+@dataclass(frozen=True)
+class Leg:
+    """One direction of a trace: its label ('up', 'down', 'forward') and why it stopped."""
+
+    label: str
+    stop: Stop
+
+
+@dataclass
+class Branch:
+    """A traced branch: unknowns u and pressure P per point (all converged), solver records, special points,
+    and what was read off it (stability per point, the points whose stability flags change at degree 2N)."""
+
+    name: str
+    scene: Scene
+    disc: Discretisation  # the storage discretisation (pickles as its five defining fields)
+    kernel_class: str
+    kernel_signature: str
+    params: Parameters  # M and χ of the branch (P varies along it)
+    X: np.ndarray  # (n_points, n + 1): (u, P), u on ``disc``
+    iterations: np.ndarray
+    residual: np.ndarray
+    error_estimate: np.ndarray
+    degree: np.ndarray  # Legendre degree each point was solved at
+    special: list = field(default_factory=list)
+    legs: tuple = ()  # Leg per traced direction
+    lossy: tuple = ()  # projection losses above max_error/2 of points moved to the final basis
+    wall_time: float = 0.0
+    stability: list | None = None  # stability.Assessment per point
+    unsettled: list = field(default_factory=list)  # point indices whose flags change at the check degree
+    parent: tuple | None = None  # (branch name, branch point number) a bifurcating branch leaves from
+    rejoins: int | None = None  # the parent's branch point number where a bifurcating branch rejoins it
+
+    @property
+    def pressure(self):
+        return self.X[:, -1]
+
+    @property
+    def stop_reason(self) -> str:
+        """Why the branch ended, for people (``legs`` hold the codes)."""
+        text = "; ".join(f"{leg.label}: {leg.stop.message}" for leg in self.legs)
+        if self.rejoins is not None:
+            text += f" at branch point {self.rejoins}"
+        if self.lossy:
+            text += (f"; {len(self.lossy)} points stored on the final basis with a projection loss up to "
+                     f"{max(self.lossy):.1g} (in their error estimate)")
+        return text
+
+    def stopped(self, code) -> bool:
+        """Whether a leg stopped with ``code``."""
+        return any(leg.stop.code == code for leg in self.legs)
+
+    def pole_values(self, X=None):
+        """dict of λ2 and η at both poles for every point (or for one X)."""
+        rows = self.disc.pole_rows()
+        U = (self.X if X is None else np.atleast_2d(X))[:, :-1]
+        return {name: U @ row for name, row in rows.items()}
+
+    def branch_points(self, block: Block | None = None) -> list:
+        """The BP special points (of one block), in order along the branch."""
+        return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]
+
+    def __repr__(self):
+        return (f"Branch({self.name!r}, {len(self.X)} points, degree {self.disc.degree}, "
+                f"P {self.pressure.min():.4g}..{self.pressure.max():.4g}, "
+                f"special {' '.join(s.kind.value for s in self.special)}, stop {self.stop_reason!r})")

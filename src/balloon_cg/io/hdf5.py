@@ -1,0 +1,66 @@
+"""What every balloon-cg HDF5 file shares: the checked output path, the atomic write and the provenance.
+
+A file is written to a temporary file in the same directory and renamed over the target (``os.replace``) only
+when complete: an existing file is never left half-written, and on any failure the temporary file is removed.
+"""
+import contextlib
+import datetime
+import errno
+import os
+import secrets
+import shlex
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+import balloon_cg
+
+from ..model.kernels import generated_digest
+
+
+def check_output(path, force: bool) -> Path:
+    """``path`` as a Path, if a file may be written there (else FileExistsError, FileNotFoundError, …)."""
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if not path.parent.is_dir():
+        raise FileNotFoundError(errno.ENOENT, "no such directory", str(path.parent))
+    if path.exists() and not force:
+        raise FileExistsError(errno.EEXIST, "already exists (use --force to overwrite it)", str(path))
+    return path
+
+
+@contextlib.contextmanager
+def atomic_file(path, force: bool = False):
+    """``with atomic_file(path) as f:`` a new h5py.File that replaces ``path`` when the block completes."""
+    path = check_output(path, force)
+    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        with h5py.File(tmp, "x") as f:
+            yield f
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def provenance(command: str | None = None) -> dict:
+    """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command."""
+    return {
+        "package_version": balloon_cg.__version__,
+        "generated_digest": generated_digest(),
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "command": command if command is not None else shlex.join(sys.argv),
+    }
+
+
+def write_strings(group, name: str, values) -> None:
+    """A dataset of variable-length UTF-8 strings."""
+    group.create_dataset(name, data=np.array(list(values), dtype=object), dtype=h5py.string_dtype())
+
+
+def plain(value):
+    """numpy scalars as Python numbers/bools, for printing and JSON."""
+    return value.item() if isinstance(value, np.generic) else value
