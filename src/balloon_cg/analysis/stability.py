@@ -39,6 +39,11 @@ class Assessment:
     stable_pressure_free: bool  # free balloon (translation included; equal to held without a field)
     stable_volume_free: bool
 
+    def flags(self) -> dict:
+        """The four stability flags by name."""
+        return {"stable_pressure": self.stable_pressure, "stable_volume": self.stable_volume,
+                "stable_pressure_free": self.stable_pressure_free, "stable_volume_free": self.stable_volume_free}
+
 
 class SecondVariation:
     """Galerkin Hessians of the energy on a Legendre perturbation basis of degree N, at equilibria of ``eq``."""
@@ -156,4 +161,4 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degr
 
 
 def _flags(a: Assessment):
-    return (a.stable_pressure, a.stable_volume, a.stable_pressure_free, a.stable_volume_free)
+    return tuple(a.flags().values())

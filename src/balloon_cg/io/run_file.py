@@ -152,7 +152,7 @@ def _write_stability(group, branch):
     """Flags per point (what each means is in the dataset's 'meaning' attribute) and lowest eigenvalues."""
     results = branch.stability
     for name, meaning in STABILITY_FLAGS.items():
-        group.create_dataset(name, data=np.array([getattr(a, name) for a in results], dtype=bool))
+        group.create_dataset(name, data=np.array([a.flags()[name] for a in results], dtype=bool))
         group[name].attrs["meaning"] = meaning
     for block in results[0].blocks:
         values = np.array([a.blocks[block] for a in results])
@@ -164,8 +164,8 @@ def _write_snaps(group, snaps):
     """Snap-throughs under pressure control: from (branch, index) at pressure P to (branch, index) or none."""
     write_strings(group, "from_branch", [s.from_branch for s in snaps])
     write_strings(group, "to_branch", [s.to_branch for s in snaps])
-    for key in ("from_index", "to_index"):
-        group.create_dataset(key, data=np.array([getattr(s, key) for s in snaps], dtype=np.int64))
+    group.create_dataset("from_index", data=np.array([s.from_index for s in snaps], dtype=np.int64))
+    group.create_dataset("to_index", data=np.array([s.to_index for s in snaps], dtype=np.int64))
     group.create_dataset("pressure", data=np.array([s.pressure for s in snaps], dtype=float))
 
 

@@ -1,0 +1,60 @@
+"""The runtime's layers import only downward (README "How it is built"), numerics knows nothing of balloons and
+the runtime never imports SymPy or codegen."""
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "src" / "balloon_cg"
+LAYERS = ("scene", "model", "galerkin", "numerics", "analysis", "io", "post", "app")
+ALLOWED = {layer: set(LAYERS[: i + 1]) | {"generated"} for i, layer in enumerate(LAYERS)}
+ALLOWED["numerics"] = {"numerics"}  # balloon-free
+
+
+def imported_layers(path: Path) -> set:
+    """The balloon_cg subpackages a module imports (relative or absolute)."""
+    module = path.relative_to(PACKAGE).with_suffix("").parts
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = list(module[: len(module) - node.level])
+                target = base + (node.module.split(".") if node.module else [])
+                names = [target + [alias.name] for alias in node.names] if not target else [target]
+            elif node.module and node.module.split(".")[0] == "balloon_cg":
+                names = [node.module.split(".")[1:] or [alias.name for alias in node.names][:1]]
+            else:
+                names = []
+            found |= {name[0] for name in names if name}
+        elif isinstance(node, ast.Import):
+            found |= {alias.name.split(".")[1] for alias in node.names
+                      if alias.name.startswith("balloon_cg.") and alias.name.count(".") >= 1}
+    return found
+
+
+def third_party(path: Path) -> set:
+    roots = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            roots |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            roots.add(node.module.split(".")[0])
+    return roots
+
+
+@pytest.mark.parametrize("layer", LAYERS)
+def test_layer_imports_only_downward(layer):
+    for path in sorted((PACKAGE / layer).glob("*.py")):
+        wrong = imported_layers(path) - ALLOWED[layer] - {"__init__", "__version__"}
+        assert not wrong, f"{path.relative_to(PACKAGE)} imports {sorted(wrong)} (allowed: {sorted(ALLOWED[layer])})"
+
+
+def test_every_module_is_in_a_layer():
+    loose = [p.name for p in PACKAGE.glob("*.py") if p.name != "__init__.py"]
+    assert loose == [], f"modules outside the layer subpackages: {loose}"
+    assert {p.name for p in PACKAGE.iterdir() if p.is_dir() and p.name != "__pycache__"} <= set(LAYERS) | {"scenes"}
+
+
+def test_runtime_never_imports_sympy_or_codegen():
+    for path in PACKAGE.rglob("*.py"):
+        assert not third_party(path) & {"sympy", "codegen"}, path
