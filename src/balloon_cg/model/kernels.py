@@ -89,10 +89,6 @@ class KernelSet:
         pad = generated.GENERAL_TERMS - len(mu)
         return {"mu": _frozen(mu + (0.0,) * pad), "alpha": _frozen(alpha + (1.0,) * pad)}
 
-    def outputs(self, kernel: str) -> tuple:
-        """The labels of ``kernel``'s outputs, in order (the rows of ``nodes``)."""
-        return self.module.KERNELS[kernel]["outputs"]
-
     def arguments(self, kernel: str, values: dict) -> tuple:
         """The argument tuple of ``kernel`` from named values (module docstring); missing names raise KeyError."""
         material = self.material(values.get("mu"), values.get("alpha"))
@@ -122,7 +118,7 @@ class KernelSet:
         return getattr(self.module, kernel)(*self.arguments(kernel, values))
 
     def nodes(self, kernel: str, values: dict) -> np.ndarray:
-        """``kernel`` at every node (node values are arrays): output k (``outputs``) in row k."""
+        """``kernel`` at every node (node values are arrays): output k (KERNELS[kernel]['outputs']) in row k."""
         spec = self.module.KERNELS[kernel]
         first_node = next(name for name, kind, _ in spec["args"] if kind == "node")
         out = np.empty((len(spec["outputs"]), values[first_node].shape[0]))
@@ -135,9 +131,11 @@ class KernelSet:
 
 
 def _frozen(values) -> np.ndarray:
+    """A read-only float array: the kernels' material arguments are never changed in place."""
     array = np.array(values, dtype=float)
     array.flags.writeable = False
     return array
+
 
 def generated_digest() -> str:
     """SHA-256 over the signatures of every generated module (stored as provenance)."""
