@@ -70,10 +70,9 @@ class FirstOrderSystem:
         from balloon_cg.model.shooting import Shooter
 
         self.shooter = Shooter(scene)
-        self.module = self.shooter.module
+        self.kernels = self.shooter.kernels
         self.coils = self.shooter.coils
-        self.field_class = self.shooter.kernels.field_class
-        self.vectorised = {name: self._numpy(getattr(self.module, name).py_func)
+        self.vectorised = {name: self._numpy(getattr(self.kernels.module, name).py_func)
                            for name in ("rhs", "rhs_jacobian", "rhs_pressure")}
 
     @staticmethod
@@ -83,8 +82,10 @@ class FirstOrderSystem:
         namespace["math"] = np
         return types.FunctionType(function.__code__, namespace, function.__name__, function.__defaults__)
 
-    def params(self, P):
-        return self.shooter.params(P)
+    def values(self, theta, c, s, y, P, field):
+        """The kernels' named values at (θ, y) (scalars, or arrays over nodes)."""
+        return {"theta": theta, "cos_theta": c, "sin_theta": s, **self.kernels.state(y), **self.shooter.params(P),
+                "field": field}
 
     def taylor(self, lam, eta, P, eps):
         c2, e2 = self.shooter.pole_coefficients(1.0, lam, eta, P)
@@ -92,13 +93,12 @@ class FirstOrderSystem:
 
     # -- (i): scalar jitted calls inside solve_ivp
     def north_half(self, lam, eta0, P, rtol):
-        module, params, shooter = self.module, self.params(P), self.shooter
+        kernels, shooter = self.kernels, self.shooter
         _, _, y0 = self.taylor(lam, eta0, P, EPS_IVP)
 
         def rhs(t, y):
             c, s = np.cos(t), np.sin(t)
-            extra = (shooter.field(y[0] * s, y[2]),) if self.field_class else ()
-            return module.rhs(t, c, s, *y, *params, *extra)
+            return kernels.call("rhs", self.values(t, c, s, y, P, shooter.field(y[0] * s, y[2])))
 
         sol = solve_ivp(rhs, (EPS_IVP, 0.5 * np.pi), y0, method="DOP853", rtol=rtol, atol=rtol)
         if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
@@ -112,18 +112,22 @@ class FirstOrderSystem:
         field = np.zeros((6, lam2.size))
         if self.coils.shape[0]:
             field_squared_nodes(np.ascontiguousarray(lam2 * sin_theta), np.ascontiguousarray(eta), self.coils, field)
-        return (field,) if self.field_class else ()
+        return field
+
+    def node_values(self, theta, y, P):
+        c, s = np.cos(theta), np.sin(theta)
+        return self.values(theta, c, s, y, P, self.field_nodes(y[0], s, y[2]))
+
+    def _vectorised(self, kernel, values):
+        out = self.vectorised[kernel](*self.kernels.arguments(kernel, values))
+        return np.array([np.broadcast_to(v, values["theta"].shape) for v in out])
 
     def f(self, theta, y, P):
-        c, s = np.cos(theta), np.sin(theta)
-        out = self.vectorised["rhs"](theta, c, s, *y, *self.params(P), *self.field_nodes(y[0], s, y[2]))
-        return np.array([np.broadcast_to(v, theta.shape) for v in out])
+        return self._vectorised("rhs", self.node_values(theta, y, P))
 
     def f_jac(self, theta, y, P):
-        c, s = np.cos(theta), np.sin(theta)
-        args = (theta, c, s, *y, *self.params(P), *self.field_nodes(y[0], s, y[2]))
-        J = np.array([np.broadcast_to(v, theta.shape) for v in self.vectorised["rhs_jacobian"](*args)])
-        dP = np.array([np.broadcast_to(v, theta.shape) for v in self.vectorised["rhs_pressure"](*args)])
+        values = self.node_values(theta, y, P)
+        J, dP = self._vectorised("rhs_jacobian", values), self._vectorised("rhs_pressure", values)
         return J.reshape(4, 4, -1), dP.reshape(4, 1, -1)
 
 

@@ -1,6 +1,6 @@
 """Specialised kernels against the most general class, same scene (SPOM1, M = 0), same points, one run.
 
-Classes (all generated, selected with ``KernelSet(..., kernel_class=...)`` and put on an Equilibrium):
+Classes (all generated, selected with ``Equilibrium(..., kernel_class=...)``):
   ogden_spom1          exponents (1.3, 4, −2) baked in, no field terms (what the scene uses by default)
   ogden_spom1_field    exponents baked in, field terms on (zero field: M = 0, no coils)
   ogden_general_field  the most general class: 3 Ogden terms with runtime exponents, field terms on, M = 0
@@ -32,7 +32,6 @@ from balloon_cg.numerics import continuation  # noqa: E402
 from balloon_cg.analysis.problem import ParameterSystem  # noqa: E402
 from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters  # noqa: E402
-from balloon_cg.model.kernels import KernelSet  # noqa: E402
 from balloon_cg.numerics.newton import newton  # noqa: E402
 from balloon_cg.scene import parse_scene  # noqa: E402
 from balloon_cg.model.sphere import sphere_pressure  # noqa: E402
@@ -44,9 +43,7 @@ REPEAT = 7
 
 
 def equilibrium(scene, degree, name):
-    eq = Equilibrium(scene, Discretisation(degree, True, True))
-    eq.kernels = KernelSet(scene.material, has_field=False, kernel_class=name)
-    return eq
+    return Equilibrium(scene, Discretisation(degree, True, True), kernel_class=name)
 
 
 def point_system(eq):
@@ -64,8 +61,8 @@ def sphere_X(eq, lam, material):
 def kernels_only(eq, X):
     p = Parameters(X[-1])
     t0 = time.process_time()
-    eq._pointwise("energy_gradient", X[:-1], p, 4)
-    eq._pointwise("energy_hessian", X[:-1], p, 10)
+    eq._pointwise("energy_gradient", X[:-1], p)
+    eq._pointwise("energy_hessian", X[:-1], p)
     return time.process_time() - t0
 
 
@@ -75,12 +72,12 @@ def throughput(eq, X, nodes=20000, repeat=REPEAT):
     reps = nodes // state.shape[1] + 1
     state = tuple(np.ascontiguousarray(np.tile(s, reps)[:nodes]) for s in state)
     geometry = tuple(np.ascontiguousarray(np.tile(g, reps)[:nodes]) for g in (eq.disc.cos_theta, eq.disc.sin_theta))
-    field = np.zeros((6, nodes)) if eq.kernels.field_class else None
-    params = eq.kernels.params(X[-1], 0.0, 1.0)
+    values = {"cos_theta": geometry[0], "sin_theta": geometry[1], **eq.kernels.state(state), "P": X[-1], "M": 0.0,
+              "chi": 1.0, "field": np.zeros((6, nodes))}
     best = np.inf
     for _ in range(repeat):
         t0 = time.process_time()
-        eq.kernels.nodes("energy_hessian", geometry, state, params, field, 10)
+        eq.kernels.nodes("energy_hessian", values)
         best = min(best, time.process_time() - t0)
     return best / nodes
 

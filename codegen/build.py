@@ -7,10 +7,23 @@ from . import equations, poles
 from . import second_variation
 from .classes import scene_classes
 from .emit import module_text
-from .functional import GENERAL_TERMS, SceneClass
+from .functional import FIELD, GENERAL_TERMS, SceneClass
 from .kernels import lower
 
 GENERATOR = "codegen/build.py"
+
+
+def layout() -> dict:
+    """Row layouts of the class modules (the same for every class, so also in the registry): the state
+    (λ2, v, η, w), the energy_hessian rows as (i, j) state pairs, the perturbation (R, R', Z, Z', T, T') and the
+    azimuthal_hessian rows as its pairs, and the rows of the field argument (H² and its (ρ, η) derivatives)."""
+    return {
+        "STATE": equations.STATE_LABELS,
+        "HESSIAN_PAIRS": equations.HESSIAN_PAIRS,
+        "PERTURBATION": tuple(map(str, second_variation.PERTURBATION)),
+        "AZIMUTHAL_PAIRS": second_variation.PAIRS,
+        "FIELD_ROWS": tuple(map(str, FIELD)),
+    }
 
 
 def class_module(cls: SceneClass) -> str:
@@ -19,7 +32,7 @@ def class_module(cls: SceneClass) -> str:
     # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient (codegen/second_variation.py)
     kernels += second_variation.second_variation_kernels(cls)
     title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
-    return module_text(title, cls.inputs(), [lower(k) for k in kernels], GENERATOR)
+    return module_text(title, cls.inputs(), [lower(k) for k in kernels], GENERATOR, layout=layout())
 
 
 def field_module_text() -> str:
@@ -50,9 +63,11 @@ def registry_text() -> str:
         rows.append(f"    {cls.name!r}: ({alphas!r}, {cls.field!r}),\n")
     return (
         '"""Kernels emitted by codegen/ (make regenerate). Never edit by hand.\n\n'
-        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field).\n"""\n'
+        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field); the layout\n'
+        'constants are those of every class module (codegen/build.py: layout).\n"""\n'
         f"GENERAL_TERMS = {GENERAL_TERMS}\n"
-        "CLASSES = {\n" + "".join(rows) + "}\n"
+        + "".join(f"{name} = {value!r}\n" for name, value in layout().items())
+        + "CLASSES = {\n" + "".join(rows) + "}\n"
     )
 
 

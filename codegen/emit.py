@@ -1,11 +1,16 @@
-"""Print lowered kernels as one numba module with a content-keyed header."""
+"""Print lowered kernels as one numba module with a content-keyed header.
+
+Besides the jitted functions a module holds its calling convention as plain data: ``KERNELS`` maps each kernel
+name to ``kernels.convention`` (argument names, kinds and rows; output labels; whether ``NAME_nodes`` exists),
+and ``layout`` constants (e.g. ``HESSIAN_PAIRS``) name the row layouts the runtime reads instead of copying.
+"""
 import hashlib
 import textwrap
 
-from .kernels import LoweredKernel
+from .kernels import LoweredKernel, convention
 from .printer import print_expr
 
-GENERATOR_VERSION = "1"
+GENERATOR_VERSION = "2"
 
 
 def _signature_line(lowered: LoweredKernel) -> str:
@@ -53,17 +58,36 @@ def _node_loop(lowered: LoweredKernel) -> str:
     return "\n".join(body)
 
 
+def _conventions(lowered_kernels: list[LoweredKernel]) -> str:
+    """``KERNELS = {name: convention, ...}``, one key per line."""
+    lines = ["KERNELS = {"]
+    for lowered in lowered_kernels:
+        lines.append(f"    {lowered.kernel.name!r}: {{")
+        lines += [f"        {key!r}: {value!r}," for key, value in convention(lowered.kernel).items()]
+        lines.append("    },")
+    return "\n".join(lines + ["}"])
+
+
 def module_text(
-    title: str, inputs: dict, lowered_kernels: list[LoweredKernel], generator: str, constants: dict | None = None
+    title: str,
+    inputs: dict,
+    lowered_kernels: list[LoweredKernel],
+    generator: str,
+    constants: dict | None = None,
+    layout: dict | None = None,
 ) -> str:
     """The whole module; the signature hashes the generator version, the inputs and the printed body.
 
-    ``constants`` maps names to tuples of floats, printed as module-level numba-readable tuples.
+    ``constants`` maps names to tuples of floats, printed as module-level numba-readable tuples; ``layout`` maps
+    names to plain tuples (row layouts), printed with repr after them, then ``KERNELS``.
     """
     parts = [
         f"{name} = (\n" + "".join(f"    {float(x)!r},\n" for x in values) + ")"
         for name, values in sorted((constants or {}).items())
     ]
+    if layout:
+        parts.append("\n".join(f"{name} = {value!r}" for name, value in layout.items()))
+    parts.append(_conventions(lowered_kernels))
     for lowered in lowered_kernels:
         parts.append(_scalar_function(lowered))
         if lowered.kernel.vectorise:
@@ -85,7 +109,6 @@ def module_text(
 
         SIGNATURE = "{signature}"
         INPUTS = {inputs_text}
-        KERNELS = {tuple(lk.kernel.name for lk in lowered_kernels)!r}
         '''
     )
     return header + "\n\n" + body

@@ -17,18 +17,31 @@ from . import functional as fn
 from .functional import FIELD, STATE, M, P, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, w
 from .kernels import Arg, Kernel
 
-HESSIAN_PAIRS = tuple((i, j) for i in range(4) for j in range(i, 4))
+HESSIAN_PAIRS = tuple((i, j) for i in range(4) for j in range(i, 4))  # upper triangle row by row
+STATE_LABELS = tuple(map(str, STATE))
 
 
-def kernel_args(cls: SceneClass, node_symbols, leading_params=()):
-    """Arguments of a pointwise kernel: node values, then (leading_params, P, [M, χ]), μ, [α], [field rows]."""
-    args = [Arg.node(s) for s in node_symbols]
-    args += [Arg.param(p) for p in (*leading_params, *fn.runtime_args(cls))]
-    args.append(Arg.param_array("mu", fn.moduli(cls)))
+def pair_labels(symbols, pairs) -> tuple:
+    """'a_b' for each (i, j) of ``pairs``: the output labels of a matrix stored as the listed entries."""
+    return tuple(f"{symbols[i]}_{symbols[j]}" for i, j in pairs)
+
+
+def material_args(cls: SceneClass) -> list:
+    """μ, and α for the general class (runtime exponents)."""
+    args = [Arg.param_array("mu", fn.moduli(cls))]
     if cls.alphas is None:
         args.append(Arg.param_array("alpha", fn.exponents(cls)))
+    return args
+
+
+def kernel_args(cls: SceneClass, node_symbols, leading_params=(), field_arg=None):
+    """The calling convention of a pointwise kernel: node values, then (leading_params, P, [M, χ]), μ, [α],
+    [field_arg] (a field class; default the node rows FIELD of H² and its derivatives)."""
+    args = [Arg.node(s) for s in node_symbols]
+    args += [Arg.param(p) for p in (*leading_params, *fn.runtime_args(cls))]
+    args += material_args(cls)
     if cls.field:
-        args.append(Arg.node_rows("field", FIELD))
+        args.append(field_arg or Arg.node_rows("field", FIELD))
     return tuple(args)
 
 
@@ -40,19 +53,22 @@ def energy_kernels(cls: SceneClass) -> list[Kernel]:
     at_node = lambda exprs: tuple(fn.field_values(e, rho) for e in exprs)  # noqa: E731
     args = kernel_args(cls, (cos_theta, sin_theta) + STATE)
     kernels = [
-        Kernel("energy_density", "π̂ = Π/sin θ at a node (MODEL.md §2).", args, at_node([density])),
-        Kernel("energy_gradient", "∂π̂/∂(λ2, v, η, w).", args, at_node(gradient)),
+        Kernel("energy_density", "π̂ = Π/sin θ at a node (MODEL.md §2).", args, at_node([density]), ("pi_hat",)),
+        Kernel("energy_gradient", "∂π̂/∂(λ2, v, η, w).", args, at_node(gradient), STATE_LABELS),
         Kernel(
             "energy_hessian",
             "∂²π̂/∂(λ2, v, η, w)², upper triangle row by row (the axisymmetric second variation).",
             args,
             at_node(hessian),
+            pair_labels(STATE, HESSIAN_PAIRS),
         ),
-        Kernel("pressure_gradient", "∂²π̂/∂P∂(λ2, v, η, w).", args, at_node([sp.diff(g, P) for g in gradient])),
+        Kernel("pressure_gradient", "∂²π̂/∂P∂(λ2, v, η, w).", args, at_node([sp.diff(g, P) for g in gradient]),
+               STATE_LABELS),
     ]
     if cls.field:
         kernels.append(
-            Kernel("field_gradient", "∂²π̂/∂M∂(λ2, v, η, w).", args, at_node([sp.diff(g, M) for g in gradient]))
+            Kernel("field_gradient", "∂²π̂/∂M∂(λ2, v, η, w).", args, at_node([sp.diff(g, M) for g in gradient]),
+                   STATE_LABELS)
         )
     return kernels
 
@@ -86,13 +102,16 @@ def first_order_kernels(cls: SceneClass) -> list[Kernel]:
     columns = [dF(x) for x in STATE]
     jacobian = [0, 1 / sin_theta, 0, 0] + [col[0] for col in columns] + [0, 0, 0, 1] + [col[1] for col in columns]
     dP = dF(P)
+    row_major = pair_labels(STATE, [(i, j) for i in range(4) for j in range(4)])
     kernels = [
         Kernel("rhs", "y' = f(θ, y): (λ2', v', η', w') of the EL equations (MODEL.md §4).", args,
-               (v / sin_theta, F1, w, F2), stages),
-        Kernel("rhs_jacobian", "∂f/∂(λ2, v, η, w), row-major 4×4.", args, tuple(map(sp.sympify, jacobian)), stages),
-        Kernel("rhs_pressure", "∂f/∂P.", args, (sp.S.Zero, dP[0], sp.S.Zero, dP[1]), stages),
+               (v / sin_theta, F1, w, F2), STATE_LABELS, stages),
+        Kernel("rhs_jacobian", "∂f/∂(λ2, v, η, w), row-major 4×4.", args, tuple(map(sp.sympify, jacobian)),
+               row_major, stages),
+        Kernel("rhs_pressure", "∂f/∂P.", args, (sp.S.Zero, dP[0], sp.S.Zero, dP[1]), STATE_LABELS, stages),
     ]
     if cls.field:
         dM = dF(M)
-        kernels.append(Kernel("rhs_field", "∂f/∂M.", args, (sp.S.Zero, dM[0], sp.S.Zero, dM[1]), stages))
+        kernels.append(Kernel("rhs_field", "∂f/∂M.", args, (sp.S.Zero, dM[0], sp.S.Zero, dM[1]), STATE_LABELS,
+                              stages))
     return kernels

@@ -96,6 +96,7 @@ def field_module():
         + ".",
         args=tuple(Arg.node(s) for s in (rho, zeta, a, *G)),
         outputs=field_expressions(),
+        labels=FIELD_NAMES,
         stages=(((inv_s2, 1 / ((a + rho) ** 2 + zeta**2)),), ((inv_s, sp.sqrt(inv_s2)),)),
         vectorise=False,
     )
@@ -105,6 +106,7 @@ def field_module():
         "(for m > 1/2).",
         args=tuple(Arg.node(s) for s in (m, m1, K, N)),
         outputs=stream_shape_expressions(),
+        labels=tuple(map(str, G)),
         vectorise=False,
     )
     constants = {"STREAM_SERIES": tuple(float(sp.N(sp.pi * g, 40)) for g in stream_series())}

@@ -5,6 +5,9 @@ matrix) and branch parameters (``param`` scalars, ``param_array`` vectors) to a 
 are earlier definitions (symbol = expression) that later stages and the outputs may use; each stage is CSE'd
 on its own so that a definition never appears after its first use (a stage's definitions may only use
 symbols defined in earlier stages).
+
+``convention`` is the calling convention as plain data, emitted into every module (``KERNELS``) so that the
+runtime binds arguments by name and reads output layouts instead of keeping copies of them.
 """
 from dataclasses import dataclass, field
 
@@ -38,12 +41,29 @@ class Arg:
 
 @dataclass(frozen=True)
 class Kernel:
+    """``labels`` name the outputs in order (the row layout of ``NAME_nodes``' out)."""
+
     name: str
     doc: str
     args: tuple
     outputs: tuple
+    labels: tuple
     stages: tuple = field(default=())  # tuple of tuples of (symbol, expr)
     vectorise: bool = True
+
+    def __post_init__(self):
+        if len(self.labels) != len(self.outputs):
+            raise ValueError(f"{self.name}: {len(self.labels)} labels for {len(self.outputs)} outputs")
+
+
+def convention(kernel: Kernel) -> dict:
+    """{'args': ((name, kind, rows), ...), 'outputs': labels, 'nodes': has NAME_nodes} of one kernel; rows name
+    the entries of a 'param_array' or the rows of a 'node_rows' argument (empty for scalars)."""
+    args = tuple(
+        (arg.name, arg.kind, tuple(map(str, arg.symbols)) if arg.kind in ("param_array", "node_rows") else ())
+        for arg in kernel.args
+    )
+    return {"args": args, "outputs": tuple(kernel.labels), "nodes": kernel.vectorise}
 
 
 @dataclass(frozen=True)
@@ -65,8 +85,3 @@ def lower(kernel: Kernel) -> LoweredKernel:
     assignments.extend(replacements)
     return LoweredKernel(kernel, tuple(assignments), tuple(results))
 
-
-def operation_count(lowered: LoweredKernel) -> int:
-    """Arithmetic operations after CSE (the size that drives numba compile time)."""
-    exprs = [e for _, e in lowered.assignments] + list(lowered.results)
-    return int(sum(sp.count_ops(e) for e in exprs))

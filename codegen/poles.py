@@ -18,6 +18,7 @@ import functools
 import sympy as sp
 
 from . import functional as fn
+from .equations import kernel_args
 from .functional import SceneClass
 from .kernels import Arg, Kernel
 from .series import derivative, truncated_series
@@ -67,7 +68,8 @@ def pole_coefficients(pole: str):
 
 
 def pole_kernel(cls: SceneClass) -> Kernel:
-    """``pole_series(lam0, P, [M, chi], mu, [alpha], [Q_z_N, Q_rr_N, Q_z_S, Q_rr_S]) -> (c2_N, e2_N, c2_S, e2_S)``."""
+    """``pole_series(lam0, P, [M, chi], mu, [alpha], [pole_field]) -> (c2_N, e2_N, c2_S, e2_S)``, pole_field =
+    (Q_z_N, Q_rr_N, Q_z_S, Q_rr_S): H²_z and H²_ρρ on the axis at each pole (rows 'NAME_N' / 'NAME_S' of FIELD)."""
     l1, l2 = sp.symbols("l1 l2", positive=True)
     energy = fn.ogden(cls, l1, l2)
     lam0 = sp.Symbol("lam0", positive=True)
@@ -82,16 +84,12 @@ def pole_kernel(cls: SceneClass) -> Kernel:
         outputs += [c2_value.subs(subs), e2_value.subs(subs)]
     if not cls.field:
         outputs = [o.subs(fn.M, 0) for o in outputs]
-    args = [Arg.node(lam0)] + [Arg.param(p) for p in fn.runtime_args(cls)]
-    args.append(Arg.param_array("mu", fn.moduli(cls)))
-    if cls.alphas is None:
-        args.append(Arg.param_array("alpha", fn.exponents(cls)))
-    if cls.field:
-        args.append(Arg.param_array("pole_field", field_symbols))
+    args = kernel_args(cls, (lam0,), field_arg=Arg.param_array("pole_field", field_symbols))
     return Kernel(
         "pole_series",
         "Taylor coefficients (c2, e2) of λ2 = λ0 + c2 t², η = η0 + e2 t² at the north and south poles.",
-        tuple(args),
+        args,
         tuple(outputs),
+        ("c2_N", "e2_N", "c2_S", "e2_S"),
         vectorise=False,
     )

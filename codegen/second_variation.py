@@ -38,13 +38,13 @@ from sympy.codegen.cfunctions import expm1, log1p
 
 from . import functional as fn
 from .functional import SceneClass, cos_theta, eta, lam2, sin_theta, v, w
-from .equations import kernel_args
+from .equations import kernel_args, material_args, pair_labels
 from .kernels import Arg, Kernel
 
 m = sp.Symbol("m", real=True)
 R, R1, Z, Z1, T, T1 = sp.symbols("R R1 Z Z1 T T1", real=True)
 PERTURBATION = (R, R1, Z, Z1, T, T1)
-PAIRS = tuple((i, j) for i in range(6) for j in range(i, 6))
+PAIRS = tuple((i, j) for i in range(6) for j in range(i, 6))  # upper triangle row by row
 
 _eps, _c, _s = sp.symbols("epsilon cm sm", real=True)
 _l2 = sp.Symbol("l2", positive=True)
@@ -66,32 +66,13 @@ def _dot(a, b):
     return sum(x * y for x, y in zip(a, b))
 
 
-def surface(kinematics: str = "cartesian"):
-    """(x, x_θ, x_φ) in the local frame (e_ρ, e_φ, e_z), polynomial in ε, cm, sm (see module docstring).
-
-    ``kinematics="angle"`` is the angle form ρ(cos β, sin β) with β = φ + ε B sin mφ, B = T/ρ0 (for comparison
-    only: its ε² term differs from the Hessian by a first-variation term that is singular at the poles, m = 1).
-    """
+def surface():
+    """(x, x_θ, x_φ) in the local frame (e_ρ, e_φ, e_z), polynomial in ε, cm, sm (see module docstring)."""
     rho0, drho0 = lam2 * sin_theta, lam2 * cos_theta + v
-    if kinematics == "cartesian":
-        x = (rho0 + _eps * R * _c, _eps * T * _s, eta + _eps * Z * _c)
-        x_t = (drho0 + _eps * R1 * _c, _eps * T1 * _s, w + _eps * Z1 * _c)
-        x_p = (-_eps * (m * R + T) * _s, rho0 + _eps * (R + m * T) * _c, -_eps * m * Z * _s)
-        return x, x_t, x_p
-    if kinematics == "angle":
-        # x = ρ (cos(β − φ), sin(β − φ)) in the local frame; β − φ = ε B s, expanded to O(ε²)
-        B, B1 = T / rho0, (T1 - drho0 * T / rho0) / rho0
-        rho, drho = rho0 + _eps * R * _c, drho0 + _eps * R1 * _c
-        ang, dang_t, dang_p = _eps * B * _s, _eps * B1 * _s, _eps * m * B * _c  # β − φ, its θ and φ derivatives
-        cos_a, sin_a = 1 - ang**2 / 2, ang
-        x = (rho * cos_a, rho * sin_a, eta + _eps * Z * _c)
-        # ∂(ρ e_β) = ∂ρ e_β + ρ ∂β e_β⊥, e_β = (cos_a, sin_a), e_β⊥ = (−sin_a, cos_a) in the local frame;
-        # ∂_φ of the local frame itself adds e_φ-rotation: handled by ∂_φβ = 1 + dang_p
-        x_t = (drho * cos_a - rho * dang_t * sin_a, drho * sin_a + rho * dang_t * cos_a, w + _eps * Z1 * _c)
-        drho_p, beta_p = -_eps * m * R * _s, 1 + dang_p
-        x_p = (drho_p * cos_a - rho * beta_p * sin_a, drho_p * sin_a + rho * beta_p * cos_a, -_eps * m * Z * _s)
-        return x, x_t, x_p
-    raise ValueError(kinematics)
+    x = (rho0 + _eps * R * _c, _eps * T * _s, eta + _eps * Z * _c)
+    x_t = (drho0 + _eps * R1 * _c, _eps * T1 * _s, w + _eps * Z1 * _c)
+    x_p = (-_eps * (m * R + T) * _s, rho0 + _eps * (R + m * T) * _c, -_eps * m * Z * _s)
+    return x, x_t, x_p
 
 
 def _order(expr, k):
@@ -123,10 +104,10 @@ def volume_density(x, x_t, x_p, form: str = "cone"):
     raise ValueError(form)
 
 
-def second_order_density(cls: SceneClass, kinematics: str = "cartesian", volume: str = "cone"):
+def second_order_density(cls: SceneClass, volume: str = "cone"):
     """E₂: the φ-averaged ε² coefficient of the energy per d(cos θ), per 2π, in the stage symbols
     (λ1 = lam1, p1, p2, p11, p12, p22, K) and the node/state/field symbols; quadratic in PERTURBATION."""
-    x, x_t, x_p = surface(kinematics)
+    x, x_t, x_p = surface()
     c11 = _dot(x_t, x_t)
     c22 = _dot(x_p, x_p) / sin_theta**2
     c12 = _dot(x_t, x_p) / sin_theta
@@ -225,19 +206,18 @@ def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
         "(cos mφ), T the azimuthal one (sin mφ); upper triangle row by row (codegen/second_variation.py).",
         _kernel_args(cls),
         outputs,
+        pair_labels(PERTURBATION, PAIRS),
         stages,
     )
 
 
 def shear_kernel(cls: SceneClass) -> Kernel:
-    args = [Arg.node(l1), Arg.node(lam2), Arg.param_array("mu", fn.moduli(cls))]
-    if cls.alphas is None:
-        args.append(Arg.param_array("alpha", fn.exponents(cls)))
     return Kernel(
         "shear_coefficient",
         "K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12).",
-        tuple(args),
+        (Arg.node(l1), Arg.node(lam2), *material_args(cls)),
         (shear_coefficient(cls)[0],),
+        ("K",),
     )
 
 

@@ -205,7 +205,7 @@ def test_nodes_match_scalar():
     out = np.empty((6, rho.size))
     field_squared_nodes(rho, z, MIXED_COILS, out)
     for i in range(rho.size):
-        assert tuple(out[:, i]) == field_squared(rho[i], z[i], MIXED_COILS)
+        assert np.array_equal(out[:, i], field_squared(rho[i], z[i], MIXED_COILS))
 
 
 def _hypergeometric_shape(m, k):

@@ -21,26 +21,24 @@ class System:
 
     def __init__(self, material, coils, M):
         self.kernels = KernelSet(material, has_field=len(coils) > 0)
-        self.module, self.coils, self.M = self.kernels.module, coils, M
+        self.coils, self.M = coils, M
 
-    def args(self, theta, c, s, y, P, M=None):
-        extra = ()
-        if self.kernels.field_class:
-            q = field_squared(y[0] * s, y[2], self.coils) if len(self.coils) else (0.0,) * 6
-            extra = (np.array(q),)
-        return (theta, c, s, *y, *self.kernels.params(P, self.M if M is None else M, 1.0), *extra)
+    def field(self, rho, z):
+        return field_squared(rho, z, self.coils) if len(self.coils) else np.zeros(6)
+
+    def values(self, theta, c, s, y, P, M=None):
+        return {"theta": theta, "cos_theta": c, "sin_theta": s, **self.kernels.state(y), "P": P,
+                "M": self.M if M is None else M, "chi": 1.0, "field": self.field(y[0] * s, y[2])}
 
     def call(self, kernel, theta, y, P, M=None, c=None, s=None):
         c = np.cos(theta) if c is None else c
         s = np.sin(theta) if s is None else s
-        return np.array(getattr(self.module, kernel)(*self.args(theta, c, s, y, P, M)))
+        return np.array(self.kernels.call(kernel, self.values(theta, c, s, y, P, M)))
 
     def pole_series(self, lam0, eta0, P):
-        extra = ()
-        if self.kernels.field_class:
-            q = field_squared(0.0, eta0, self.coils)
-            extra = (np.array([q[2], q[3], q[2], q[3]]),)
-        return self.module.pole_series(lam0, *self.kernels.params(P, self.M, 1.0), *extra)
+        q = self.field(0.0, eta0)
+        values = {"lam0": lam0, "P": P, "M": self.M, "chi": 1.0, "field_north": q, "field_south": q}
+        return self.kernels.call("pole_series", values)
 
 
 SYSTEMS = {
@@ -128,10 +126,17 @@ def test_pole_series_changes_sign_with_the_field_gradient_between_poles():
     """Mirror symmetry z → −z: the south coefficients equal the north ones of the mirrored field,
     c2_S(H²_z) = c2_N(−H²_z), e2_S(H²_z) = −e2_N(−H²_z)."""
     system = SYSTEMS["spom1_field"]()
-    module, params = system.module, system.kernels.params(2.2, 0.01, 1.0)
     qz, qrr = 3.7, -1.3
-    c2n, e2n, _, _ = module.pole_series(1.4, *params, np.array([-qz, qrr, 0.0, 0.0]))
-    _, _, c2s, e2s = module.pole_series(1.4, *params, np.array([0.0, 0.0, qz, qrr]))
+
+    def pole_series(north, south):
+        """pole_series with H²_z, H²_ρρ on the axis at the north and south pole (rows FIELD_ROWS)."""
+        rows = system.kernels.module.FIELD_ROWS
+        at = lambda z, rr: np.array([{"Q_z": z, "Q_rr": rr}.get(row, 0.0) for row in rows])  # noqa: E731
+        values = {"lam0": 1.4, "P": 2.2, "M": 0.01, "chi": 1.0, "field_north": at(*north), "field_south": at(*south)}
+        return system.kernels.call("pole_series", values)
+
+    c2n, e2n, _, _ = pole_series((-qz, qrr), (0.0, 0.0))
+    _, _, c2s, e2s = pole_series((0.0, 0.0), (qz, qrr))
     assert c2s == pytest.approx(c2n, rel=1e-13)
     assert e2s == pytest.approx(-e2n, rel=1e-13)
 

@@ -40,11 +40,7 @@ import numpy as np
 from numpy.polynomial import legendre
 from scipy import linalg
 
-from ..galerkin.equilibrium import Equilibrium, NonFiniteState, Parameters
-from ..model.field import field_squared_nodes
-
-# y = (R, R', Z, Z', T, T'): upper triangle row by row, as the kernel returns it
-_PAIRS = tuple((i, j) for i in range(6) for j in range(i, 6))
+from ..galerkin.equilibrium import Equilibrium, Parameters
 
 
 def legendre_values(x: np.ndarray, degree: int, order: int) -> np.ndarray:
@@ -166,21 +162,10 @@ def basis(m: int, degree: int, quadrature: int) -> AzimuthalBasis:
 
 
 def _node_matrix(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> np.ndarray:
-    """The kernel's 21 entries of h at every node, shape (21, n_q)."""
+    """The kernel's entries of h at every node (the AZIMUTHAL_PAIRS of y = PERTURBATION), shape (21, n_q)."""
     lam2, dlam2, eta, deta = equilibrium.disc.evaluate(np.asarray(u, dtype=float), b.theta)
-    s = b.sin_theta
-    state = (lam2, dlam2 * s, eta, deta)
-    kernels = equilibrium.kernels
-    field = None
-    if kernels.field_class:
-        field = np.zeros((6, b.x.size))
-        if equilibrium.coils.shape[0]:
-            field_squared_nodes(lam2 * s, eta, equilibrium.coils, field)
-    out = kernels.nodes("azimuthal_hessian", (b.x, s), state,
-                        (float(m),) + kernels.params(params.P, params.M, params.chi), field, len(_PAIRS))
-    if not np.all(np.isfinite(out)):
-        raise NonFiniteState("azimuthal_hessian: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
-    return out
+    state = (lam2, dlam2 * b.sin_theta, eta, deta)
+    return equilibrium.pointwise("azimuthal_hessian", (b.x, b.sin_theta), state, params, m=float(m))
 
 
 def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, quadrature: int = 0):
@@ -190,7 +175,7 @@ def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     b = perturbation_basis(equilibrium, m, degree, quadrature)
     h = _node_matrix(equilibrium, u, params, m, b) * b.weights
     blocks = np.empty((6, 6, b.x.size))
-    for row, (k, l) in enumerate(_PAIRS):
+    for row, (k, l) in enumerate(equilibrium.kernels.module.AZIMUTHAL_PAIRS):
         blocks[k, l] = blocks[l, k] = h[row]
     scaled = np.einsum("kln,lni->kni", blocks, b.ops)
     n = b.size

@@ -36,7 +36,6 @@ from scipy.optimize import brentq, minimize_scalar
 
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Equilibrium, Parameters
-from ..model.kernels import KernelSet
 from ..model.sphere_modes import bifurcation_condition, bifurcation_stretches
 from ..numerics import continuation
 from ..numerics.continuation import Stop
@@ -62,7 +61,6 @@ class ExtendedSystem:
     def __init__(self, equilibrium: Equilibrium, params, parameter: str, ell: np.ndarray):
         if parameter not in PARAMETERS:
             raise ValueError(f"unknown second parameter {parameter!r}: expected one of {PARAMETERS}")
-        self.eq, self.params, self.parameter = equilibrium, params, parameter
         disc = equilibrium.disc
         if not disc.symmetric:
             raise TwoParameterError("the extended system needs the equator-symmetric layout of the primary branch")
@@ -70,10 +68,10 @@ class ExtendedSystem:
             material = equilibrium.scene.material
             if len(material.alpha) < 1:
                 raise TwoParameterError("alpha1: the material has no Ogden term")
-            # runtime exponents: the general class (same energy, μ and α as arguments)
-            equilibrium.kernels = KernelSet(material, has_field=equilibrium.coils.shape[0] > 0,
-                                            kernel_class=GENERAL_CLASS)
-            self._rest = float(np.dot(equilibrium.kernels.mu[1:], equilibrium.kernels.alpha[1:]))
+            # runtime exponents: an own equilibrium of the general class (same energy, μ and α as arguments)
+            equilibrium = Equilibrium(equilibrium.scene, disc, kernel_class=GENERAL_CLASS)
+            self._rest = float(np.dot(material.mu[1:], material.alpha[1:]))
+        self.eq, self.params, self.parameter = equilibrium, params, parameter
         self.variation = SecondVariation(equilibrium, disc.degree)
         self.odd = block_indices(self.variation, "odd_held", field_on=False)
         self.basis = self.variation.basis
@@ -87,14 +85,13 @@ class ExtendedSystem:
 
     # -- parameters ------------------------------------------------------------------------------------
     def set_q(self, q: float):
-        """Parameters at q (for α1 the kernels' μ1, α1 are set in place, keeping Σ μ_i α_i = 4: the system's
-        kernels are those of the last q evaluated; every stored point carries its own q)."""
+        """Parameters at q: M = q, or α1 = q with μ1 = (4 − Σ_{i≥2} μ_i α_i)/q (Σ μ_i α_i = 4 kept), the other
+        terms the material's."""
         if self.parameter == "M":
             return self.params.with_value("M", q)
-        kernels = self.eq.kernels
-        kernels.alpha[0] = q
-        kernels.mu[0] = (4.0 - self._rest) / q
-        return self.params
+        material = self.eq.scene.material
+        mu = ((4.0 - self._rest) / q,) + tuple(material.mu[1:])
+        return replace(self.params, mu=mu, alpha=(float(q),) + tuple(material.alpha[1:]))
 
     def split(self, X):
         n, m = self.n, self.m
@@ -105,7 +102,7 @@ class ExtendedSystem:
         """Generated Hessian on the perturbation basis at the (general) coefficient vector c."""
         b = self.basis
         state = tuple(b.node_state(c))
-        return b.hessian(self.eq.pointwise("energy_hessian", (b.cos_theta, b.sin_theta), state, params, 10))
+        return b.hessian(self.eq.pointwise("energy_hessian", (b.cos_theta, b.sin_theta), state, params))
 
     def odd_hessian(self, u, params):
         return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]
@@ -142,7 +139,6 @@ class ExtendedSystem:
         H_plus, R_plus = self.odd_hessian(u, plus), self.eq.residual(u, plus)
         minus = self.set_q(q - hq).with_value("P", P)
         H_minus, R_minus = self.odd_hessian(u, minus), self.eq.residual(u, minus)
-        params = self.set_q(q).with_value("P", P)
         if self.parameter == "M":
             J[:n, -1] = self.eq.parameter_derivative(u, params, "M")
         else:
@@ -243,7 +239,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
         plain = Discretisation(plain_degree(branch, bp.X), mapped.symmetric, mapped.pin_translation)
         branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
         bp = replace(bp, X=mapped.transfer(bp.X, plain), mode=padded_mode(bp.mode, plain.degree))
-    eq = equilibrium_of(branch)  # own object: the α1 continuation swaps in runtime-exponent kernels
+    eq = equilibrium_of(branch)
     if q0 is None:
         q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
     if parameter == "M" and not scene.field.coils:

@@ -69,8 +69,8 @@ class SecondVariation:
         """(H, g): the Hessian of E and the volume gradient on the perturbation basis."""
         state = self.eq.state_at(u, self.theta)
         geometry = (self.basis.cos_theta, self.basis.sin_theta)
-        hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params, 10))
-        volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params, 4))
+        hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params))
+        volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params))
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):

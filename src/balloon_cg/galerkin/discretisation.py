@@ -16,6 +16,7 @@ from numba import njit
 from numpy.polynomial import legendre
 
 from .coordinate_map import WireMap
+from ..generated import HESSIAN_PAIRS
 
 
 def legendre_table(x: np.ndarray, degree: int):
@@ -32,7 +33,17 @@ def legendre_table(x: np.ndarray, degree: int):
     return p, dp
 
 
-_UPPER_ROW = np.array([[0, 1, 2, 3], [1, 4, 5, 6], [2, 5, 7, 8], [3, 6, 8, 9]])  # (k, l) -> row of the upper triangle
+def symmetric_rows(pairs) -> np.ndarray:
+    """rows[k, l] = rows[l, k] = r for the r-th (k, l) of ``pairs``: where a symmetric matrix stored as the listed
+    entries (the generated HESSIAN_PAIRS) keeps h_kl."""
+    n = 1 + max(max(pair) for pair in pairs)
+    rows = np.full((n, n), -1)
+    for r, (k, l) in enumerate(pairs):
+        rows[k, l] = rows[l, k] = r
+    return rows
+
+
+_HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
 
 
 @njit(cache=True)
@@ -45,12 +56,12 @@ def _weighted_bases(pointwise, weights, A, B):
     for k in range(4):
         for q in range(n_q):
             if k < 2:
-                c0 = pointwise[_UPPER_ROW[k, 0], q] * weights[q]
-                c1 = pointwise[_UPPER_ROW[k, 1], q] * weights[q]
+                c0 = pointwise[_HESSIAN_ROW[k, 0], q] * weights[q]
+                c1 = pointwise[_HESSIAN_ROW[k, 1], q] * weights[q]
                 for i in range(n_a):
                     against_a[k, q, i] = c0 * A[0, q, i] + c1 * A[1, q, i]
-            c2 = pointwise[_UPPER_ROW[k, 2], q] * weights[q]
-            c3 = pointwise[_UPPER_ROW[k, 3], q] * weights[q]
+            c2 = pointwise[_HESSIAN_ROW[k, 2], q] * weights[q]
+            c3 = pointwise[_HESSIAN_ROW[k, 3], q] * weights[q]
             for i in range(n_b):
                 against_b[k, q, i] = c2 * B[0, q, i] + c3 * B[1, q, i]
     return against_a, against_b
@@ -154,7 +165,8 @@ class Discretisation:
         return self.ops.reshape(-1, self.size).T @ (pointwise * self.weights).ravel()
 
     def hessian(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is the upper triangle (10, n_q).
+        """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is energy_hessian's output (10, n_q), the
+        entries (k, l) of HESSIAN_PAIRS.
 
         (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three
         blocks aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner.

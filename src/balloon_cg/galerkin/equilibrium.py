@@ -19,9 +19,14 @@ class NonFiniteState(ArithmeticError):
 
 @dataclass
 class Parameters:
+    """Branch parameters P, M, χ and the material moduli μ and exponents α (None: the scene material's); the
+    field names are the generated kernels' argument names (model/kernels.py binds them by name)."""
+
     P: float
     M: float = 0.0
     chi: float = 1.0
+    mu: tuple | None = None
+    alpha: tuple | None = None
 
     def with_value(self, name: str, value: float) -> "Parameters":
         return Parameters(**{**self.__dict__, name: float(value)})
@@ -30,11 +35,13 @@ class Parameters:
 class Equilibrium:
     """Residual, Jacobian and parameter derivatives of the Ritz–Galerkin system for one scene."""
 
-    def __init__(self, scene, discretisation: Discretisation):
+    def __init__(self, scene, discretisation: Discretisation, kernel_class: str | None = None):
+        """``kernel_class``: a generated class by name instead of the material's (model/kernels.KernelSet), e.g.
+        the general class, whose exponents are runtime arguments (Parameters.alpha)."""
         self.scene = scene
         self.disc = discretisation
         self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
-        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0)
+        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0, kernel_class=kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
 
     def _field(self, lam2, sin_theta, eta):
@@ -46,24 +53,26 @@ class Equilibrium:
             field_squared_nodes(lam2 * sin_theta, eta, self.coils, field)
         return field
 
-    def pointwise(self, kernel: str, geometry: tuple, state: tuple, params: Parameters, rows: int,
-                  field=None) -> np.ndarray:
-        """A generated kernel at nodes with (cos θ, sin θ) = geometry and (λ2, v, η, w) = state."""
+    def pointwise(self, kernel: str, geometry: tuple, state: tuple, params: Parameters, field=None,
+                  **values) -> np.ndarray:
+        """A generated kernel at nodes with (cos θ, sin θ) = geometry and (λ2, v, η, w) = state, one row per
+        output; ``values`` are further named arguments (the azimuthal number m)."""
         if field is None:
             field = self._field(state[0], geometry[1], state[2])
-        out = self.kernels.nodes(kernel, geometry, state, self.kernels.params(params.P, params.M, params.chi),
-                                 field, rows)
+        named = {"cos_theta": geometry[0], "sin_theta": geometry[1], **self.kernels.state(state), **vars(params),
+                 "field": field, **values}
+        out = self.kernels.nodes(kernel, named)
         if not np.all(np.isfinite(out)):
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 
-    def _pointwise(self, kernel, u, params: Parameters, rows):
+    def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u are reused (Newton asks for R, then J)."""
         last = getattr(self, "_last", None)
         if last is None or not np.array_equal(last[0], u):
             state = tuple(self.disc.node_state(u))
             last = self._last = (np.array(u), state, self._field(state[0], self.disc.sin_theta, state[2]))
-        return self.pointwise(kernel, self.geometry, last[1], params, rows, last[2])
+        return self.pointwise(kernel, self.geometry, last[1], params, last[2])
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
@@ -72,22 +81,22 @@ class Equilibrium:
 
     def energy(self, u, params: Parameters) -> float:
         """E/(2π) (MODEL.md §2)."""
-        return float(self.disc.weights @ self._pointwise("energy_density", u, params, 1)[0])
+        return float(self.disc.weights @ self._pointwise("energy_density", u, params)[0])
 
     def residual(self, u, params: Parameters) -> np.ndarray:
-        return self.disc.gradient(self._pointwise("energy_gradient", u, params, 4))
+        return self.disc.gradient(self._pointwise("energy_gradient", u, params))
 
     def jacobian(self, u, params: Parameters) -> np.ndarray:
-        return self.disc.hessian(self._pointwise("energy_hessian", u, params, 10))
+        return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
     def parameter_derivative(self, u, params: Parameters, name: str) -> np.ndarray:
         """∂R/∂P or ∂R/∂M (the latter is zero without coils)."""
         if name == "P":
-            return self.disc.gradient(self._pointwise("pressure_gradient", u, params, 4))
+            return self.disc.gradient(self._pointwise("pressure_gradient", u, params))
         if name == "M":
             if not self.coils.shape[0]:
                 return np.zeros(self.disc.size)
-            return self.disc.gradient(self._pointwise("field_gradient", u, params, 4))
+            return self.disc.gradient(self._pointwise("field_gradient", u, params))
         raise ValueError(f"unknown continuation parameter {name!r}: expected 'P' or 'M'")
 
     def volume(self, u) -> float:

@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 
 from .elliptic import loop_elliptic
+from ..generated import FIELD_ROWS
 from ..generated.coil_field import STREAM_SERIES, coil_field, stream_shape_closed
 
 SERIES_SWITCH = 0.5
@@ -81,9 +82,13 @@ def coil_sum(rho, z, coils):
     return t
 
 
+SQUARED = ("Q", "Q_r", "Q_z", "Q_rr", "Q_rz", "Q_zz")  # what _squared returns: H² and its (ρ, z) derivatives
+_ROW_SOURCE = np.array([SQUARED.index(name) for name in FIELD_ROWS])  # field row k <- entry _ROW_SOURCE[k]
+
+
 @njit(cache=True)
-def field_squared(rho, z, coils):
-    """(Q, Q_ρ, Q_z, Q_ρρ, Q_ρz, Q_zz) for Q = H² = h_ρ² + h_z² at (ρ, z), coils a checked coil_table; chain rule:
+def _squared(rho, z, coils):
+    """SQUARED for Q = H² = h_ρ² + h_z² at (ρ, z), coils a checked coil_table; chain rule:
     Q_ρ = 2(h_ρ ∂_ρh_ρ + h_z ∂_ρh_z), Q_ρz = 2(∂_ρh_ρ ∂_zh_ρ + h_ρ ∂_ρzh_ρ + ∂_ρh_z ∂_zh_z + h_z ∂_ρzh_z)."""
     f, g, f_r, f_z, g_r, g_z, f_rr, f_rz, f_zz, g_rr, g_rz, g_zz = coil_sum(rho, z, coils)
     return (
@@ -97,12 +102,23 @@ def field_squared(rho, z, coils):
 
 
 @njit(cache=True)
+def field_squared(rho, z, coils):
+    """H² and its derivatives at (ρ, z) in the rows the kernels' field argument takes (generated FIELD_ROWS:
+    Q, Q_ρ, Q_z, Q_ρρ, Q_ρz, Q_zz), bound by name to SQUARED; coils a checked coil_table."""
+    q = _squared(rho, z, coils)
+    out = np.empty(_ROW_SOURCE.shape[0])
+    for k in range(_ROW_SOURCE.shape[0]):
+        out[k] = q[_ROW_SOURCE[k]]
+    return out
+
+
+@njit(cache=True)
 def field_squared_nodes(rho, z, coils, out):
-    """field_squared at every node i of the arrays rho, z; output k goes to out[k, i]."""
+    """field_squared at every node i of the arrays rho, z; row k (FIELD_ROWS) goes to out[k, i]."""
     for i in range(rho.shape[0]):
-        q = field_squared(rho[i], z[i], coils)
-        for k in range(6):
-            out[k, i] = q[k]
+        q = _squared(rho[i], z[i], coils)
+        for k in range(_ROW_SOURCE.shape[0]):
+            out[k, i] = q[_ROW_SOURCE[k]]
 
 
 @njit(cache=True)

@@ -2,6 +2,15 @@
 
 A material whose exponents match a generated class uses it (exponents baked in); any other material uses the
 general class with runtime exponents, its unused terms padded with μ = 0.
+
+Calling convention: every generated module lists, in ``KERNELS``, each kernel's arguments as (name, kind,
+rows) and its output labels (codegen/kernels.py: convention). ``KernelSet.arguments`` is the one place that
+turns named values into an argument tuple, so no caller knows the argument order:
+
+- 'node' and 'node_rows' arguments (cos_theta, lam2, …; field) and 'param' scalars (P, M, chi, m) are the
+  values of the same name;
+- μ and α are the material's (padded for the general class), or the overrides ``mu``/``alpha`` when given;
+- ``pole_field`` rows 'NAME_N' / 'NAME_S' are the FIELD_ROWS entry NAME of ``field_north`` / ``field_south``.
 """
 import hashlib
 import importlib
@@ -50,32 +59,82 @@ class KernelSet:
                                  f"{tuple(material.alpha)} (field {has_field})")
         self.module = importlib.import_module(f"{generated.__name__}.{self.name}")
         self.general = generated.CLASSES[self.name][0] is None
-        if self.general:
-            pad = generated.GENERAL_TERMS - len(material.mu)
-            self.mu = np.array(list(material.mu) + [0.0] * pad)
-            self.alpha = np.array(list(material.alpha) + [1.0] * pad)
-        else:
-            self.mu = np.array(material.mu, dtype=float)
         # a field class evaluated at M = 0 is the "field on, M = 0" general setting of the benchmarks
         self.field_class = generated.CLASSES[self.name][1]
+        self.scene_material = material
+        self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
 
     @cached_property
     def signature(self) -> str:
         """Hash of the generated module text (provenance)."""
         return self.module.SIGNATURE
 
-    def params(self, P: float, M: float, chi: float) -> tuple:
-        """Branch parameters in the order the generated kernels take them."""
-        args = (float(P),) + ((float(M), float(chi)) if self.field_class else ())
-        args += (self.mu,) + ((self.alpha,) if self.general else ())
-        return args
+    def material(self, mu=None, alpha=None) -> dict:
+        """{'mu': μ, 'alpha': α} as the kernels take them (read-only arrays); None: the scene material's.
 
-    def nodes(self, kernel: str, geometry: tuple, state: tuple, params: tuple, field, rows: int) -> np.ndarray:
-        """Run ``kernel`` at every node: geometry (θ-dependent arrays), state (λ2, v, η, w), field rows."""
-        out = np.empty((rows, state[0].shape[0]))
-        extra = (field,) if self.field_class else ()
-        getattr(self.module, f"{kernel}_nodes")(*geometry, *state, *params, *extra, out)
+        The general class takes GENERAL_TERMS terms, the unused ones padded with μ = 0, α = 1; a class with
+        baked-in exponents takes μ only, and accepts an α override only if it is its own exponents."""
+        if mu is None and alpha is None:
+            return self._scene_arrays
+        return self._pack(tuple(self.scene_material.mu if mu is None else mu),
+                          tuple(self.scene_material.alpha if alpha is None else alpha))
+
+    def _pack(self, mu: tuple, alpha: tuple) -> dict:
+        if len(mu) != len(alpha):
+            raise ValueError(f"{len(mu)} moduli for {len(alpha)} exponents")
+        if not self.general:
+            if class_name(alpha, self.field_class) != self.name:
+                raise ValueError(f"exponents {alpha} need the general kernel class, not {self.name}")
+            return {"mu": _frozen(mu)}
+        pad = generated.GENERAL_TERMS - len(mu)
+        return {"mu": _frozen(mu + (0.0,) * pad), "alpha": _frozen(alpha + (1.0,) * pad)}
+
+    def arguments(self, kernel: str, values: dict) -> tuple:
+        """The argument tuple of ``kernel`` from named values (module docstring); missing names raise KeyError."""
+        material = self.material(values.get("mu"), values.get("alpha"))
+        args = []
+        for name, kind, rows in self.module.KERNELS[kernel]["args"]:
+            if name in material:
+                args.append(material[name])
+            elif name == "pole_field":
+                args.append(self._pole_field(values, rows))
+            elif name not in values:
+                raise KeyError(f"{kernel}: no value for its argument {name!r}")
+            else:
+                args.append(float(values[name]) if kind == "param" else values[name])
+        return tuple(args)
+
+    def _pole_field(self, values: dict, rows: tuple) -> np.ndarray:
+        """Rows 'NAME_N' / 'NAME_S': entry NAME (of FIELD_ROWS) of values['field_north'] / values['field_south']."""
+        at_pole = {"N": values["field_north"], "S": values["field_south"]}
+        out = np.empty(len(rows))
+        for k, row in enumerate(rows):
+            quantity, pole = row.rsplit("_", 1)
+            out[k] = at_pole[pole][self.module.FIELD_ROWS.index(quantity)]
         return out
+
+    def call(self, kernel: str, values: dict) -> tuple:
+        """``kernel`` at one point (scalar node values)."""
+        return getattr(self.module, kernel)(*self.arguments(kernel, values))
+
+    def nodes(self, kernel: str, values: dict) -> np.ndarray:
+        """``kernel`` at every node (node values are arrays): output k (KERNELS[kernel]['outputs']) in row k."""
+        spec = self.module.KERNELS[kernel]
+        first_node = next(name for name, kind, _ in spec["args"] if kind == "node")
+        out = np.empty((len(spec["outputs"]), values[first_node].shape[0]))
+        getattr(self.module, f"{kernel}_nodes")(*self.arguments(kernel, values), out)
+        return out
+
+    def state(self, state) -> dict:
+        """Named values of the state (λ2, v, η, w) in the generated order STATE."""
+        return dict(zip(self.module.STATE, state))
+
+
+def _frozen(values) -> np.ndarray:
+    """A read-only float array: the kernels' material arguments are never changed in place."""
+    array = np.array(values, dtype=float)
+    array.flags.writeable = False
+    return array
 
 
 def generated_digest() -> str:

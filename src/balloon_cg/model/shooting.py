@@ -36,6 +36,7 @@ from scipy.integrate import solve_ivp
 
 from .field import field_squared
 from .kernels import KernelSet
+from ..generated import FIELD_ROWS
 
 NORTH, SOUTH = 1.0, -1.0
 EQUATOR = 0.5 * np.pi
@@ -77,30 +78,26 @@ class Shooter:
         f = scene.field
         self.coils = np.array([[c.radius, c.height, c.current] for c in f.coils], dtype=float).reshape(-1, 3)
         self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0)
-        self.module = self.kernels.module
         self.M, self.chi = (f.M, f.chi) if self.coils.shape[0] else (0.0, f.chi)
         self.equator_symmetric = f.is_equator_symmetric
         self.rtol, self.atol = rtol, atol
 
-    def params(self, P):
-        return self.kernels.params(P, self.M, self.chi)
+    def params(self, P) -> dict:
+        """The branch parameters as the kernels' named values (the material's μ, α)."""
+        return {"P": P, "M": self.M, "chi": self.chi}
 
     def field(self, rho, z):
-        """(H², ∂ρH², ∂zH², ∂ρρH², ∂ρzH², ∂zzH²) at (ρ, z) for the field kernels (zeros without coils)."""
+        """H² and its derivatives at (ρ, z) in the generated FIELD_ROWS (zeros without coils)."""
         if not self.coils.shape[0]:
-            return np.zeros(6)
-        return np.array(field_squared(rho, z, self.coils))
-
-    def _extra(self, rho, z):
-        return (self.field(rho, z),) if self.kernels.field_class else ()
+            return np.zeros(len(FIELD_ROWS))
+        return field_squared(rho, z, self.coils)
 
     def pole_coefficients(self, pole, lam, eta, P):
-        """(c2, e2) of the Taylor series at the pole (σ = NORTH or SOUTH) with stretch λ_p and height η_p."""
-        extra = ()
-        if self.kernels.field_class:
-            q = self.field(0.0, eta)
-            extra = (np.array([q[2], q[3], q[2], q[3]]),)
-        c2n, e2n, c2s, e2s = self.module.pole_series(lam, *self.params(P), *extra)
+        """(c2, e2) of the Taylor series at the pole (σ = NORTH or SOUTH) with stretch λ_p and height η_p (the
+        field on the axis at η_p)."""
+        q = self.field(0.0, eta)
+        values = {"lam0": lam, **self.params(P), "field_north": q, "field_south": q}
+        c2n, e2n, c2s, e2s = self.kernels.call("pole_series", values)
         return (c2n, e2n) if pole == NORTH else (c2s, e2s)
 
     def pole_derivatives(self, pole, lam, eta, P):
@@ -136,7 +133,7 @@ class Shooter:
         Z0[0, 2] += 1.0
         pole_limit = np.zeros(16)
         pole_limit[3], pole_limit[4 + 9:4 + 12] = 2 * sigma * e2, 2 * sigma * de2
-        module, params = self.module, self.params(P)
+        kernels, params = self.kernels, self.params(P)
 
         def rhs(t, Y):
             if t == 0.0:
@@ -144,11 +141,12 @@ class Shooter:
             y = Y[:4]
             c, s = sigma * np.cos(t), np.sin(t)
             theta = t if sigma > 0 else np.pi - t
-            args = (theta, c, s, *y, *params, *self._extra(y[0] * s, y[2]))
-            J = np.array(module.rhs_jacobian(*args)).reshape(4, 4)
+            values = {"theta": theta, "cos_theta": c, "sin_theta": s, **kernels.state(y), **params,
+                      "field": self.field(y[0] * s, y[2])}
+            J = np.array(kernels.call("rhs_jacobian", values)).reshape(4, 4)
             dZ = J @ Y[4:].reshape(4, 3)
-            dZ[:, 0] += module.rhs_pressure(*args)
-            return sigma * np.concatenate([module.rhs(*args), dZ.ravel()])
+            dZ[:, 0] += kernels.call("rhs_pressure", values)
+            return sigma * np.concatenate([kernels.call("rhs", values), dZ.ravel()])
 
         solution = solve_ivp(rhs, (t0, EQUATOR), np.concatenate([y0, Z0.ravel()]), method="DOP853",
                              rtol=self.rtol, atol=self.atol)
