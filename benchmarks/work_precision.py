@@ -19,7 +19,6 @@ solution at the finest degree the adaptive trace used.
 Run: python benchmarks/work_precision.py   (writes benchmarks/results/work_precision.{txt,png})
 """
 import os
-import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -393,5 +392,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, str(ROOT / "src"))
     main()
