@@ -20,6 +20,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")  # single-threaded BLAS (before numpy loads), as the other benchmarks
 
 import numpy as np  # noqa: E402
+
 import work_precision as wp  # noqa: E402
 from balloon_cg.numerics import continuation  # noqa: E402
 from balloon_cg.analysis.branch import ParameterSystem  # noqa: E402
