@@ -1,5 +1,6 @@
 """Installing: the wheel ships exactly the source tree (generated kernels and scenes included), and the README's
-sequence `pip install .`, `make run`, `make test` on a fresh venv leaves a working package after each step.
+sequence `pip install .`, `make run`, `make test` on a fresh venv leaves a working package after each step
+(numba's cache outside site-packages, so pip leaves nothing behind), and kernels of another tree are refused.
 
 Offline and fast: builds without isolation from the current environment's setuptools, and the fresh venv has
 no pip or dependencies of its own: a .pth file puts the current environment's site folders on its path.
@@ -118,3 +119,16 @@ def test_generated_kernels_of_another_tree_are_refused(tmp_path):
     assert done.returncode != 0
     message = done.stderr.strip().splitlines()[-1]
     assert message.startswith("ImportError") and str(other) in message and "expected" in message
+
+
+@pytest.mark.parametrize("first, user_dir", [("", False), ("import numba; ", False), ("", True)])
+def test_numba_cache_folder(tmp_path, first, user_dir):
+    """${XDG_CACHE_HOME}/balloon-cg/numba (also when numba was imported first), or the user's NUMBA_CACHE_DIR."""
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "xdg")
+    if user_dir:
+        env["NUMBA_CACHE_DIR"] = str(tmp_path / "mine")
+    code = f"{first}from balloon_cg.model.elliptic import _agm; _agm(0.5, 0.5); print(_agm.stats.cache_path)"
+    folder = run([sys.executable, "-c", code], env, tmp_path).strip()
+    assert Path(folder).parent == (tmp_path / "mine" if user_dir else tmp_path / "xdg" / "balloon-cg" / "numba")
+    assert any(Path(folder).glob("*.nbi"))
