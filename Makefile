@@ -1,12 +1,13 @@
 # balloon-cg developer targets. `make run` and `make test` each install first, so a fresh clone needs nothing else.
 PYTHON ?= python3
 OUT ?= out
+RUN_FLAGS ?=
 
 .PHONY: install install-dev regenerate test run bench clean
 
-# Editable like install-dev, so that `make run` and `make test` never leave two installs of different kinds (a
-# regular install leaves numba cache files in site-packages that would shadow a later editable one).
-# `pip install .` ships the generated kernels too (tests/test_packaging.py builds and inspects the wheel).
+# Editable like install-dev. A regular `pip install .` before or after is fine too: it ships the generated kernels
+# and the scenes, and numba's cache goes to ~/.cache/balloon-cg/numba, never into site-packages
+# (tests/test_packaging.py builds and inspects the wheel and runs install, run and test installs in a fresh venv).
 install:
 	$(PYTHON) -m pip install --quiet -e .
 
@@ -20,7 +21,7 @@ test: install-dev
 	$(PYTHON) -m pytest -q
 
 run: install
-	$(PYTHON) -m balloon_cg.app.default_run $(OUT)
+	$(PYTHON) -m balloon_cg.app.default_run $(OUT) $(RUN_FLAGS)
 
 bench: install-dev
 	$(PYTHON) benchmarks/primary_branch.py

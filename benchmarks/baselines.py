@@ -32,10 +32,8 @@ benchmarks/work_precision.py on the loaded machine).
 Run: python benchmarks/baselines.py   (writes benchmarks/results/baselines.txt)
 """
 import os
-import sys
 import time
 import types
-from pathlib import Path
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")  # single-threaded BLAS/LAPACK for every method (before numpy loads)
@@ -43,10 +41,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 from scipy.integrate import solve_bvp, solve_ivp  # noqa: E402
 from scipy.optimize import minimize  # noqa: E402
-
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "benchmarks"))
-sys.path.insert(0, str(ROOT / "src"))
 
 import work_precision as wp  # noqa: E402
 

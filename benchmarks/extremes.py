@@ -6,27 +6,24 @@ Newton iterations).
 
 Run: python benchmarks/extremes.py   (writes benchmarks/results/extremes.txt)
 """
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
-sys.path.insert(0, str(ROOT / "benchmarks"))
-sys.path.insert(0, str(ROOT / "src"))
-
-import work_precision as wp  # noqa: E402
+from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.primary import trace_primary  # noqa: E402
-from balloon_cg.analysis.wires import wire_gap  # noqa: E402
-from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
-from balloon_cg.galerkin.equilibrium import Parameters  # noqa: E402
-from balloon_cg.scene import load_scene, parse_scene  # noqa: E402
-from balloon_cg.model.shooting import shoot_symmetric  # noqa: E402
-from balloon_cg.model.sphere import sphere_pressure  # noqa: E402
-from test_extremes import constrained_newton  # noqa: E402
+from balloon_cg.analysis.wires import wire_gap
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Parameters
+from balloon_cg.galerkin.point_solve import constrained_newton
+from balloon_cg.scene import load_scene, parse_scene
+from balloon_cg.model.shooting import shoot_symmetric
+from balloon_cg.model.sphere import sphere_pressure
+
+import work_precision as wp
+
+ROOT = Path(__file__).resolve().parent.parent
 
 LINES = []
 

@@ -14,18 +14,12 @@ benchmarks/work_precision.py).
 Run: python benchmarks/specialisation.py   (writes benchmarks/results/specialisation.txt)
 """
 import os
-import sys
 import time
-from pathlib import Path
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")  # single-threaded BLAS (before numpy loads), as the other benchmarks
 
 import numpy as np  # noqa: E402
-
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "benchmarks"))
-sys.path.insert(0, str(ROOT / "src"))
 
 import work_precision as wp  # noqa: E402
 from balloon_cg.numerics import continuation  # noqa: E402

@@ -19,7 +19,6 @@ solution at the finest degree the adaptive trace used.
 Run: python benchmarks/work_precision.py   (writes benchmarks/results/work_precision.{txt,png})
 """
 import os
-import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -380,7 +379,7 @@ def main():
         "threaded (shared 2-core machine under load: the CPU time is the reliable one, see the module docstring);",
         "error = |P/P_ref − 1|; its = Newton iterations.",
         "Symmetric (equator) subspace in all three scenes: about degree + 1 unknowns. With coils, a last column:",
-        "the same solve on the wire-mapped basis the tracer uses near a wire (balloon_cg.analysis.branch.wire_map, centred",
+        "the same solve on the wire-mapped basis the tracer uses near a wire (balloon_cg.analysis.wires.wire_map, centred",
         "from the neighbour's profile), tol 1e-12.",
         "",
     ]
@@ -393,5 +392,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, str(ROOT / "src"))
     main()

@@ -13,8 +13,8 @@ from balloon_cg.analysis.results import StopCode, TraceStop
 
 from balloon_cg.analysis.wires import wire_gap
 from balloon_cg.galerkin.discretisation import Discretisation
-from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
-from balloon_cg.numerics.newton import newton
+from balloon_cg.galerkin.equilibrium import Parameters
+from balloon_cg.galerkin.point_solve import constrained_newton
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.sphere import sphere_pressure
 
@@ -29,26 +29,6 @@ def spom1(extra=""):
 
 def two_coils(**overrides):
     return load_scene(SCENES / "spom1_two_coils_M0.002.toml").with_overrides(overrides)
-
-
-def constrained_newton(scene, degree, X0, source, stretch, params, tol=1e-12):
-    """Solve R = 0 with λ2(0) = stretch on ``degree`` from X0 given on ``source`` (padded/truncated)."""
-    eq = Equilibrium(scene, Discretisation(degree, source.symmetric, source.pin_translation))
-    a, b = source.split(X0[:-1])
-    n = min(degree, source.degree) + 1
-    a2, b2 = np.zeros(degree + 1), np.zeros(degree + 1)
-    a2[:n], b2[:n] = a[:n], b[:n]
-    X = np.append(eq.disc.join(a2, b2), X0[-1])
-
-    def residual(X):
-        return eq.residual(X[:-1], params.with_value("P", X[-1]))
-
-    def jacobian(X):
-        p = params.with_value("P", X[-1])
-        return np.hstack([eq.jacobian(X[:-1], p), eq.parameter_derivative(X[:-1], p, "P")[:, None]])
-
-    row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
-    return newton(residual, jacobian, X, row, stretch, tol, 25), eq
 
 
 def assert_clean(branch):

@@ -1,17 +1,134 @@
-"""`pip install .` (a regular, non-editable install) ships the generated kernels and the default scenes."""
+"""Installing: the wheel ships exactly the source tree (generated kernels and scenes included), and the README's
+sequence `pip install .`, `make run`, `make test` on a fresh venv leaves a working package after each step
+(numba's cache outside site-packages, so pip leaves nothing behind), and kernels of another tree are refused.
+
+Offline and fast: builds without isolation from the current environment's setuptools, and the fresh venv has
+no pip or dependencies of its own: a .pth file puts the current environment's site folders on its path.
+"""
+import importlib.metadata
+import json
+import os
+import shutil
 import subprocess
 import sys
 import zipfile
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
+LEFT_OUT = shutil.ignore_patterns("build", "dist", "*.egg-info", "__pycache__", ".git", ".pytest_cache", "out")
+CHECK = """
+import json, sys
+from importlib import resources
+import balloon_cg, balloon_cg.generated as generated
+from balloon_cg.model.elliptic import _agm
+_agm(0.5, 0.5)  # a cache=True kernel: loaded from or written to numba's cache
+print(json.dumps({"package": balloon_cg.__file__, "generated": generated.__file__, "classes": len(generated.CLASSES),
+                  "scene": (resources.files("balloon_cg.scenes") / "spom1.toml").is_file(),
+                  "cache_hits": sum(_agm.stats.cache_hits.values())}))
+"""
 
 
-def test_wheel_contains_generated_kernels_and_default_scenes(tmp_path):
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps",
-                    "-w", str(tmp_path), str(ROOT)], check=True, capture_output=True)
+def clean_copy(tmp_path) -> Path:
+    """The source tree without build products (a stale build/lib would leak into a wheel built in place)."""
+    return Path(shutil.copytree(ROOT, tmp_path / "tree", ignore=LEFT_OUT))
+
+
+def shipped(tree: Path) -> set:
+    """Wheel paths of every file the package must ship (package-dir of pyproject.toml)."""
+    folders = {"balloon_cg": tree / "src" / "balloon_cg", "balloon_cg/generated": tree / "generated",
+               "balloon_cg/scenes": tree / "scenes"}
+    return {f"{prefix}/{path.relative_to(folder).as_posix()}" for prefix, folder in folders.items()
+            for path in folder.rglob("*") if path.suffix in (".py", ".toml")}
+
+
+def test_wheel_ships_exactly_the_source_tree(tmp_path):
+    tree = clean_copy(tmp_path)
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "--no-build-isolation",
+                    "-w", str(tmp_path), str(tree)], check=True, capture_output=True)
     wheel = next(tmp_path.glob("balloon_cg-*.whl"))
-    names = set(zipfile.ZipFile(wheel).namelist())
-    generated = {p.name for p in (ROOT / "generated").glob("*.py")}
-    assert {f"balloon_cg/generated/{name}" for name in generated} <= names
-    assert "balloon_cg/default_scenes/spom1.toml" in names
+    names = {n for n in zipfile.ZipFile(wheel).namelist() if ".dist-info/" not in n}
+    assert names == shipped(tree)
+    assert {"balloon_cg/scenes/spom1.toml", "balloon_cg/generated/__init__.py"} <= names
+
+
+def fresh_venv(tmp_path) -> tuple[Path, Path]:
+    """(python, site-packages) of a new venv without pip that sees the current environment's distributions."""
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
+    python = venv / "bin" / "python"
+    site = Path(subprocess.run([python, "-c", "import sysconfig; print(sysconfig.get_path('purelib'))"],
+                               check=True, capture_output=True, text=True).stdout.strip())
+    folders = dict.fromkeys(str(d.locate_file("")) for d in importlib.metadata.distributions())
+    (site / "environment.pth").write_text("".join(f"{f}\n" for f in folders if not f.startswith(str(ROOT))))
+    return python, site
+
+
+def run(args, env, cwd):
+    done = subprocess.run([str(a) for a in args], env=env, cwd=cwd, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout
+
+
+def check(python, env, cwd) -> dict:
+    return json.loads(run([python, "-c", CHECK], env, cwd).splitlines()[-1])
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="needs make")
+def test_install_then_make_run_then_make_test_on_a_fresh_venv(tmp_path):
+    tree = clean_copy(tmp_path)
+    python, site = fresh_venv(tmp_path)
+    cache = tmp_path / "cache"
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH")}
+    # PIP_NO_BUILD_ISOLATION=0 means --no-build-isolation (pip reads the variable as "isolation off")
+    env.update(XDG_CACHE_HOME=str(cache), PIP_NO_INDEX="1", PIP_NO_BUILD_ISOLATION="0",
+               PIP_DISABLE_PIP_VERSION_CHECK="1")
+
+    run([python, "-m", "pip", "install", "--quiet", "--no-deps", tree], env, tmp_path)  # README: pip install .
+    first, second = check(python, env, tmp_path), check(python, env, tmp_path)
+    assert first["package"] == str(site / "balloon_cg" / "__init__.py")
+    assert first["generated"] == str(site / "balloon_cg" / "generated" / "__init__.py")
+    assert first["classes"] > 0 and first["scene"]
+    record = (next(site.glob("balloon_cg-*.dist-info")) / "RECORD").read_text().splitlines()
+    installed = {line.split(",")[0] for line in record}
+    on_disk = {p.relative_to(site).as_posix() for p in (site / "balloon_cg").rglob("*") if p.is_file()}
+    assert on_disk - installed == set()  # nothing pip would leave behind on uninstall
+    assert first["cache_hits"] == 0 and second["cache_hits"] > 0  # compiled once, then loaded from the cache
+    assert any((cache / "balloon-cg" / "numba").rglob("*.nbi"))
+
+    out = tmp_path / "out"
+    run(["make", "-C", tree, "run", f"PYTHON={python}", f"OUT={out}", "RUN_FLAGS=--quick --quiet"], env, tmp_path)
+    assert (out / "spom1.h5").is_file() and (out / "spom1_two_coils_M0.002.h5").is_file()
+    editable = check(python, env, tmp_path)
+    assert editable["package"] == str(tree / "src" / "balloon_cg" / "__init__.py")
+    assert editable["generated"] == str(tree / "generated" / "__init__.py")
+    assert editable["scene"] and editable["cache_hits"] > 0
+
+    run(["make", "-C", tree, "install-dev", f"PYTHON={python}"], env, tmp_path)  # the install step of make test
+    assert check(python, env, tmp_path) == editable
+
+
+def test_generated_kernels_of_another_tree_are_refused(tmp_path):
+    """balloon_cg from a copy of src/ on PYTHONPATH, the kernels from the installed tree (or none): ImportError."""
+    other = tmp_path / "other" / "src" / "balloon_cg"
+    shutil.copytree(ROOT / "src" / "balloon_cg", other, ignore=LEFT_OUT)
+    env = {**os.environ, "PYTHONPATH": str(other.parent)}
+    done = subprocess.run([sys.executable, "-c", "import balloon_cg"], env=env, cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    message = done.stderr.strip().splitlines()[-1]
+    assert message.startswith("ImportError") and str(other) in message and "expected" in message
+
+
+@pytest.mark.parametrize("first, user_dir", [("", False), ("import numba; ", False), ("", True)])
+def test_numba_cache_folder(tmp_path, first, user_dir):
+    """${XDG_CACHE_HOME}/balloon-cg/numba (also when numba was imported first), or the user's NUMBA_CACHE_DIR."""
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "xdg")
+    if user_dir:
+        env["NUMBA_CACHE_DIR"] = str(tmp_path / "mine")
+    code = f"{first}from balloon_cg.model.elliptic import _agm; _agm(0.5, 0.5); print(_agm.stats.cache_path)"
+    folder = run([sys.executable, "-c", code], env, tmp_path).strip()
+    assert Path(folder).parent == (tmp_path / "mine" if user_dir else tmp_path / "xdg" / "balloon-cg" / "numba")
+    assert any(Path(folder).glob("*.nbi"))

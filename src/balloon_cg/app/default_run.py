@@ -1,12 +1,13 @@
-"""The default run (``make run``): ``python -m balloon_cg.default_run OUTDIR [--quick]``.
+"""The default run (``make run``): ``python -m balloon_cg.app.default_run OUTDIR [--quick]``.
 
 For each default scene (SPOM1 at M = 0, and SPOM1 between the paper's two opposed coils at M = 0.002: the
-files scenes/spom1.toml and scenes/spom1_two_coils_M0.002.toml, shipped inside the package as
-default_scenes/ so that an installed package runs them too) the primary branch is traced and written to
-OUTDIR/<scene>.h5, and every plot kind that applies is drawn as OUTDIR/<scene>_<kind>.png. The pressure
-curves of all scenes together (several M in one figure) go to OUTDIR/all_<kind>.png. Existing files of these
-names are overwritten. A summary table closes the run; the exit code is 1 if a scene failed, else 0.
-``--quick`` limits every leg of the continuation to QUICK_POINTS points (for tests).
+files scenes/spom1.toml and scenes/spom1_two_coils_M0.002.toml, read as the package data balloon_cg.scenes,
+which pyproject.toml maps to the top-level scenes/, so that an installed package runs them too) the primary
+branch is traced and written to OUTDIR/<scene>.h5, and every plot kind that applies is drawn as
+OUTDIR/<scene>_<kind>.png. The pressure curves of all scenes together (several M in one figure) go to
+OUTDIR/all_<kind>.png. Existing files of these names are overwritten. A summary table closes the run; the
+exit code is 1 if a scene failed, else 0. ``--quick`` limits every leg of the continuation to QUICK_POINTS
+points (for tests).
 """
 import argparse
 import sys
@@ -27,7 +28,7 @@ QUICK_POINTS = 8
 
 def default_scenes(max_points: int | None = None) -> list:
     """The default scenes from the package data (``continuation.max_points`` overridden if given)."""
-    folder = resources.files("balloon_cg") / "default_scenes"
+    folder = resources.files("balloon_cg.scenes")
     scenes = [parse_scene((folder / f"{name}.toml").read_text(encoding="utf-8"), name) for name in SCENES]
     if max_points is not None:
         scenes = [s.with_overrides({"continuation.max_points": max_points}) for s in scenes]
@@ -71,7 +72,8 @@ def format_summary(rows: list[dict]) -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m balloon_cg.default_run", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m balloon_cg.app.default_run",
+                                     description=__doc__.split("\n")[0])
     parser.add_argument("outdir", help="folder for the run files and figures (created if missing)")
     parser.add_argument("--quick", action="store_true", help=f"at most {QUICK_POINTS} points per leg (for tests)")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")

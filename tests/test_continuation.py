@@ -1,0 +1,95 @@
+"""The generic engine (balloon_cg.numerics.continuation) on scalar toy systems with closed-form answers.
+
+S-curve R(u, λ) = u³ − u − (λ − 1): λ = 1 + u³ − u has limit points where dλ/du = 3u² − 1 = 0,
+    u = ±1/√3,  λ = 1 ∓ 2/(3√3),
+found by the fold monitor c = e_λ (sign change of c·τ = dλ/ds) and located by Brent in the arclength.
+Pitchfork normal form R(u, λ) = λu − u³: on the trivial branch u = 0 the test function ∂R/∂u = λ − 3u²
+changes sign at λ = 0, where the branches u = ±√λ cross; the engine locates that root with ``locate_root``
+(it has no branch-point detection or classification of its own: those are balloon-specific, in
+analysis/bifurcation.py).
+"""
+import math
+
+import numpy as np
+import pytest
+
+from balloon_cg.numerics import continuation
+
+SETTINGS = continuation.Settings(step=0.05, step_min=1e-8, step_max=0.2, max_points=500, tol=1e-13, max_newton=20)
+LAMBDA = np.array([0.0, 1.0])  # c with c·X = λ: the fold monitor of limit points
+STATE = np.array([1.0, 0.0])  # c·X = u: u is monotonic on the S-curve, so this monitor never fires
+
+
+class Scalar:
+    """R(X), X = (u, λ), with its Jacobian [∂R/∂u, ∂R/∂λ] (1 × 2), as the engine expects."""
+
+    def __init__(self, residual, r_u, r_lambda):
+        self.f, self.r_u, self.r_lambda = residual, r_u, r_lambda
+
+    def residual(self, X):
+        return np.array([self.f(*X)])
+
+    def jacobian(self, X):
+        return np.array([[self.r_u(*X), self.r_lambda(*X)]])
+
+
+S_CURVE = Scalar(lambda u, lam: u**3 - u - (lam - 1), lambda u, lam: 3 * u**2 - 1, lambda u, lam: -1.0)
+PITCHFORK = Scalar(lambda u, lam: lam * u - u**3, lambda u, lam: lam - 3 * u**2, lambda u, lam: u)
+
+
+def start(system, X, reference):
+    X = np.asarray(X, dtype=float)
+    return continuation.Point(X, continuation.tangent(system, X, np.asarray(reference, dtype=float)), 0, 0.0)
+
+
+def test_s_curve_folds_located_by_the_fold_monitor():
+    u0 = -2.0
+    path = continuation.trace(S_CURVE, start(S_CURVE, [u0, 1 + u0**3 - u0], [1.0, 0.0]), SETTINGS,
+                              lambda p: "u > 2" if p.X[0] > 2 else "", {"lambda": LAMBDA, "u": STATE})
+    assert path.stop_reason == "u > 2"
+    assert [f.label for f in path.folds] == ["lambda", "lambda"]
+    expected = [(-1 / math.sqrt(3), 1 + 2 / (3 * math.sqrt(3))), (1 / math.sqrt(3), 1 - 2 / (3 * math.sqrt(3)))]
+    for fold, (u, lam) in zip(path.folds, expected):
+        assert abs(fold.point.X[0] - u) < 1e-10 and abs(fold.point.X[1] - lam) < 1e-12
+        assert abs(fold.point.tangent @ LAMBDA) < 1e-10  # dλ/ds = 0 there
+        assert abs(S_CURVE.residual(fold.point.X)[0]) < 1e-13
+        before, after = path.points[fold.index], path.points[fold.index + 1]
+        assert before.X[0] < fold.point.X[0] < after.X[0]  # between the points it is reported between
+    assert np.all(np.diff([p.X[0] for p in path.points]) > 0)
+    assert all(abs(S_CURVE.residual(p.X)[0]) < 1e-12 for p in path.points)
+
+
+def test_pitchfork_located_by_the_test_function_on_the_trivial_branch():
+    path = continuation.trace(PITCHFORK, start(PITCHFORK, [0.0, -1.0], [0.0, 1.0]), SETTINGS,
+                              lambda p: "λ > 1" if p.X[1] > 1 else "", {"lambda": LAMBDA})
+    assert path.stop_reason == "λ > 1" and path.folds == []
+    assert all(p.X[0] == 0.0 for p in path.points)  # the corrector stays on u = 0 across the branch point
+
+    def test_function(X):
+        return PITCHFORK.r_u(*X)
+
+    values = [test_function(p.X) for p in path.points]
+    crossings = [i for i in range(len(values) - 1) if values[i] * values[i + 1] < 0]
+    assert len(crossings) == 1
+    first = path.points[crossings[0]]
+    length = float(np.linalg.norm(path.points[crossings[0] + 1].X - first.X))
+
+    def value_at(s):
+        result = continuation.correct(PITCHFORK, first.X + s * first.tangent, first.tangent, SETTINGS)
+        return test_function(result.x), result.x
+
+    X = continuation.locate_root(value_at, length)
+    assert abs(X[1]) < 1e-13 and X[0] == 0.0
+
+
+def test_locate_root_falls_back_to_the_best_evaluated_point():
+    """No sign change (brentq refuses) or a failed evaluation: the evaluated point of smallest |value|."""
+    assert continuation.locate_root(lambda s: (s - 0.3, s), 1.0) == pytest.approx(0.3, abs=1e-13)
+    assert continuation.locate_root(lambda s: (s + 1.0, s), 1.0) == 0.0
+
+    def failing(s):
+        if s > 0.9:
+            raise ArithmeticError("singular")
+        return s - 0.3, s
+
+    assert continuation.locate_root(failing, 1.0) == 0.0  # brentq's first two evaluations are the ends
