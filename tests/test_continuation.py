@@ -8,12 +8,14 @@ changes sign at λ = 0, where the branches u = ±√λ cross; the engine locates
 (it has no branch-point detection or classification of its own: those are balloon-specific, in
 analysis/bifurcation.py).
 """
+import enum
 import math
 
 import numpy as np
 import pytest
 
 from balloon_cg.numerics import continuation
+from balloon_cg.numerics.continuation import RootStatus, Stop
 
 SETTINGS = continuation.Settings(step=0.05, step_min=1e-8, step_max=0.2, max_points=500, tol=1e-13, max_newton=20)
 LAMBDA = np.array([0.0, 1.0])  # c with c·X = λ: the fold monitor of limit points
@@ -33,6 +35,12 @@ class Scalar:
         return np.array([[self.r_u(*X), self.r_lambda(*X)]])
 
 
+class Done(enum.Enum):
+    """The caller's stop codes (the engine takes any enum)."""
+
+    REACHED = "reached"
+
+
 S_CURVE = Scalar(lambda u, lam: u**3 - u - (lam - 1), lambda u, lam: 3 * u**2 - 1, lambda u, lam: -1.0)
 PITCHFORK = Scalar(lambda u, lam: lam * u - u**3, lambda u, lam: lam - 3 * u**2, lambda u, lam: u)
 
@@ -45,8 +53,9 @@ def start(system, X, reference):
 def test_s_curve_folds_located_by_the_fold_monitor():
     u0 = -2.0
     path = continuation.trace(S_CURVE, start(S_CURVE, [u0, 1 + u0**3 - u0], [1.0, 0.0]), SETTINGS,
-                              lambda p: "u > 2" if p.X[0] > 2 else "", {"lambda": LAMBDA, "u": STATE})
-    assert path.stop_reason == "u > 2"
+                              lambda p: Stop(Done.REACHED, "u > 2") if p.X[0] > 2 else None,
+                              {"lambda": LAMBDA, "u": STATE})
+    assert path.stop.code == Done.REACHED
     assert [f.label for f in path.folds] == ["lambda", "lambda"]
     expected = [(-1 / math.sqrt(3), 1 + 2 / (3 * math.sqrt(3))), (1 / math.sqrt(3), 1 - 2 / (3 * math.sqrt(3)))]
     for fold, (u, lam) in zip(path.folds, expected):
@@ -61,8 +70,8 @@ def test_s_curve_folds_located_by_the_fold_monitor():
 
 def test_pitchfork_located_by_the_test_function_on_the_trivial_branch():
     path = continuation.trace(PITCHFORK, start(PITCHFORK, [0.0, -1.0], [0.0, 1.0]), SETTINGS,
-                              lambda p: "λ > 1" if p.X[1] > 1 else "", {"lambda": LAMBDA})
-    assert path.stop_reason == "λ > 1" and path.folds == []
+                              lambda p: Stop(Done.REACHED, "λ > 1") if p.X[1] > 1 else None, {"lambda": LAMBDA})
+    assert path.stop.code == Done.REACHED and path.folds == []
     assert all(p.X[0] == 0.0 for p in path.points)  # the corrector stays on u = 0 across the branch point
 
     def test_function(X):
@@ -78,18 +87,22 @@ def test_pitchfork_located_by_the_test_function_on_the_trivial_branch():
         result = continuation.correct(PITCHFORK, first.X + s * first.tangent, first.tangent, SETTINGS)
         return test_function(result.x), result.x
 
-    X = continuation.locate_root(value_at, length)
-    assert abs(X[1]) < 1e-13 and X[0] == 0.0
+    root = continuation.locate_root(value_at, length)
+    assert root.status == RootStatus.LOCATED and abs(root.payload[1]) < 1e-13 and root.payload[0] == 0.0
 
 
 def test_locate_root_falls_back_to_the_best_evaluated_point():
-    """No sign change (brentq refuses) or a failed evaluation: the evaluated point of smallest |value|."""
-    assert continuation.locate_root(lambda s: (s - 0.3, s), 1.0) == pytest.approx(0.3, abs=1e-13)
-    assert continuation.locate_root(lambda s: (s + 1.0, s), 1.0) == 0.0
+    """No sign change (brentq refuses) or a failed evaluation: the evaluated point of smallest |value|, with
+    status NEAREST (a root it is not)."""
+    root = continuation.locate_root(lambda s: (s - 0.3, s), 1.0)
+    assert root.status == RootStatus.LOCATED and root.payload == pytest.approx(0.3, abs=1e-13)
+    root = continuation.locate_root(lambda s: (s + 1.0, s), 1.0)
+    assert root.status == RootStatus.NEAREST and root.payload == 0.0 and root.value == 1.0
 
     def failing(s):
         if s > 0.9:
             raise ArithmeticError("singular")
         return s - 0.3, s
 
-    assert continuation.locate_root(failing, 1.0) == 0.0  # brentq's first two evaluations are the ends
+    root = continuation.locate_root(failing, 1.0)
+    assert root.status == RootStatus.NEAREST and root.payload == 0.0  # brentq's first evaluations are the ends

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "balloon_cg"
-LAYERS = ("scene", "model", "galerkin", "numerics", "analysis", "io", "post", "app")
+LAYERS = ("scene", "model", "numerics", "galerkin", "analysis", "io", "post", "app")
 ALLOWED = {layer: set(LAYERS[: i + 1]) | {"generated"} for i, layer in enumerate(LAYERS)}
 ALLOWED["numerics"] = {"numerics"}  # balloon-free
 
