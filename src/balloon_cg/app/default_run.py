@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..analysis.tracer import ContinuationError
 from .cli import run_scene, summarise_branch
-from ..post.plotting import applicable_kinds, load_branches, plot
+from ..post.plotting import applicable_kinds, load_branches, plot, special_label
 from ..scene import parse_scene
 from ..io.run_file import read_run
 
@@ -54,7 +54,7 @@ def summary_row(path) -> dict:
         "scene": run["scene_name"],
         "points": str(b["points"]),
         "P range": "{:.4f} .. {:.4f}".format(*b["pressure"]),
-        "special points": " ".join(s["kind"] for s in b["special_points"]),
+        "special points": " ".join(special_label(s) for s in b["special_points"]),
         "max error est.": f"{b['max_error_estimate']:.1e}",
         "wall time": f"{b['wall_time']:.1f} s",
     }
