@@ -59,9 +59,14 @@ class Equilibrium:
         output; ``values`` are further named arguments (the azimuthal number m)."""
         if field is None:
             field = self._field(state[0], geometry[1], state[2])
-        named = {"cos_theta": geometry[0], "sin_theta": geometry[1], **self.kernels.state(state), **vars(params),
-                 "field": field, **values}
-        out = self.kernels.nodes(kernel, named)
+        return self._evaluate(kernel, self._node_values(geometry, state, field) | values, params)
+
+    def _node_values(self, geometry: tuple, state: tuple, field) -> dict:
+        """The kernels' node arguments by name."""
+        return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
+
+    def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
+        out = self.kernels.nodes(kernel, named, params)
         if not np.all(np.isfinite(out)):
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
@@ -71,8 +76,9 @@ class Equilibrium:
         last = getattr(self, "_last", None)
         if last is None or not np.array_equal(last[0], u):
             state = tuple(self.disc.node_state(u))
-            last = self._last = (np.array(u), state, self._field(state[0], self.disc.sin_theta, state[2]))
-        return self.pointwise(kernel, self.geometry, last[1], params, last[2])
+            field = self._field(state[0], self.disc.sin_theta, state[2])
+            last = self._last = (np.array(u), self._node_values(self.geometry, state, field))
+        return self._evaluate(kernel, last[1], params)
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""

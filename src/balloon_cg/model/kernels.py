@@ -38,6 +38,9 @@ def class_name(alpha, has_field: bool) -> str:
     return "ogden_general_field"
 
 
+_MATERIAL, _VALUE, _PARAM, _POLE = "material", "value", "param", "pole"  # how an argument is bound
+
+
 class KernelSet:
     """The kernels of one scene: module, packed material parameters and the call conventions.
 
@@ -63,6 +66,7 @@ class KernelSet:
         self.field_class = generated.CLASSES[self.name][1]
         self.scene_material = material
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
+        self._plans, self._node_kernels = {}, {}
 
     @cached_property
     def signature(self) -> str:
@@ -89,20 +93,33 @@ class KernelSet:
         pad = generated.GENERAL_TERMS - len(mu)
         return {"mu": _frozen(mu + (0.0,) * pad), "alpha": _frozen(alpha + (1.0,) * pad)}
 
-    def arguments(self, kernel: str, values: dict) -> tuple:
-        """The argument tuple of ``kernel`` from named values (module docstring); missing names raise KeyError."""
-        material = self.material(values.get("mu"), values.get("alpha"))
-        args = []
+    def arguments(self, kernel: str, values: dict, params=None) -> tuple:
+        """The argument tuple of ``kernel`` from named values (module docstring) and, if given, the branch
+        parameters ``params`` (galerkin.equilibrium.Parameters: P, M, χ, μ, α); missing names raise KeyError."""
+        plan = self._plans.get(kernel) or self._plan(kernel)
+        source = values if params is None else {"P": params.P, "M": params.M, "chi": params.chi, "mu": params.mu,
+                                                "alpha": params.alpha, **values}
+        mu, alpha = source.get("mu"), source.get("alpha")
+        material = self._scene_arrays if mu is None and alpha is None else self.material(mu, alpha)
+        try:
+            return tuple([material[name] if how is _MATERIAL else source[name] if how is _VALUE
+                          else float(source[name]) if how is _PARAM else self._pole_field(source, name)
+                          for how, name in plan])
+        except KeyError as e:
+            raise KeyError(f"{kernel}: no value for its argument {e.args[0]!r}") from None
+
+    def _plan(self, kernel: str) -> tuple:
+        """(how, name) per argument of ``kernel``, read once from KERNELS (the binding is then a single pass)."""
+        plan = []
         for name, kind, rows in self.module.KERNELS[kernel]["args"]:
-            if name in material:
-                args.append(material[name])
+            if name in self._scene_arrays:
+                plan.append((_MATERIAL, name))
             elif name == "pole_field":
-                args.append(self._pole_field(values, rows))
-            elif name not in values:
-                raise KeyError(f"{kernel}: no value for its argument {name!r}")
+                plan.append((_POLE, rows))
             else:
-                args.append(float(values[name]) if kind == "param" else values[name])
-        return tuple(args)
+                plan.append((_PARAM if kind == "param" else _VALUE, name))
+        self._plans[kernel] = plan = tuple(plan)
+        return plan
 
     def _pole_field(self, values: dict, rows: tuple) -> np.ndarray:
         """Rows 'NAME_N' / 'NAME_S': entry NAME (of FIELD_ROWS) of values['field_north'] / values['field_south']."""
@@ -117,13 +134,20 @@ class KernelSet:
         """``kernel`` at one point (scalar node values)."""
         return getattr(self.module, kernel)(*self.arguments(kernel, values))
 
-    def nodes(self, kernel: str, values: dict) -> np.ndarray:
+    def nodes(self, kernel: str, values: dict, params=None) -> np.ndarray:
         """``kernel`` at every node (node values are arrays): output k (KERNELS[kernel]['outputs']) in row k."""
+        function, rows, first_node = self._node_kernels.get(kernel) or self._node_kernel(kernel)
+        out = np.empty((rows, values[first_node].shape[0]))
+        function(*self.arguments(kernel, values, params), out)
+        return out
+
+    def _node_kernel(self, kernel: str) -> tuple:
+        """(the kernel's node loop, its output count, the name of its first node argument), read once."""
         spec = self.module.KERNELS[kernel]
         first_node = next(name for name, kind, _ in spec["args"] if kind == "node")
-        out = np.empty((len(spec["outputs"]), values[first_node].shape[0]))
-        getattr(self.module, f"{kernel}_nodes")(*self.arguments(kernel, values), out)
-        return out
+        entry = (getattr(self.module, f"{kernel}_nodes"), len(spec["outputs"]), first_node)
+        self._node_kernels[kernel] = entry
+        return entry
 
     def state(self, state) -> dict:
         """Named values of the state (λ2, v, η, w) in the generated order STATE."""
