@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.results import Block, Classification, Kind, RootStatus, StopCode
+from balloon_cg.analysis.results import Block, Classification, Kind, Status, StopCode
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.sphere import sphere_pressure
@@ -39,7 +39,7 @@ def test_pear_bifurcations_match_the_independent_sphere_condition(picture):
     np.testing.assert_allclose(found, expected, rtol=1e-8)
     for bp, lam in zip(bps, found):
         assert bp.X[-1] == pytest.approx(sphere_pressure(get_preset(name), lam), rel=1e-10)
-        assert bp.kind == Kind.BP and bp.status == RootStatus.LOCATED
+        assert bp.kind == Kind.BP and bp.status == Status.LOCATED
         assert bp.classification in (Classification.PITCHFORK_SUPER, Classification.PITCHFORK_SUB)
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.results import Block, Classification, Kind, RootStatus, StopCode
+from balloon_cg.analysis.results import Block, Classification, Kind, Status, StopCode
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene import parse_scene
 
@@ -48,7 +48,7 @@ def test_special_points_and_stops_are_typed(picture):
     assert [s.kind for s in branch.special] == [Kind.EP, Kind.LP, Kind.BP, Kind.EP]
     bp = branch.branch_points()[0]
     assert (bp.classification, bp.block, bp.status) == (Classification.PITCHFORK_SUPER, Block.ODD_HELD,
-                                                         RootStatus.LOCATED)
+                                                         Status.LOCATED)
     assert bp.mode is not None and np.isfinite(bp.E).all()
     assert [leg.label for leg in branch.legs] == ["up", "down"]
     assert [leg.stop.code for leg in branch.legs] == [StopCode.STOP_STRETCH, StopCode.MIN_STRETCH]

@@ -14,7 +14,7 @@ from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .resolution import transfer_error
-from .results import Branch, Kind, Leg, SpecialPoint, StopCode
+from .results import Branch, Kind, Leg, SpecialPoint, StopCode, located_or_bracketed
 from .tracer import ContinuationError, LegTrace
 
 
@@ -52,7 +52,7 @@ def storage_basis(tracer, params, legs: list[LegTrace]):
 
 def _collect(leg: LegTrace, disc, moves):
     """Points (X on disc, continuation point, solved degree, error estimate + loss) and folds (kind, index, X,
-    status) of one leg, in order."""
+    status fields) of one leg, in order."""
     points, folds = [], []
     for coarse, path in leg.segments:
         if not path.points:
@@ -61,7 +61,10 @@ def _collect(leg: LegTrace, disc, moves):
         moved, loss = moves[id(path)]
         for p, X, lost in zip(path.points, moved, loss):
             points.append((X, p, coarse.degree, coarse.tail(p.X[:-1]) + lost))
-        folds += [(f.label, base + f.index, coarse.transfer(f.point.X, disc), f.status) for f in path.folds]
+        for f in path.folds:
+            after = path.points[f.index + 1].X if f.index + 1 < len(path.points) else path.overshoot.X
+            found = located_or_bracketed(f.status, coarse, path.points[f.index].X, after, f"fold {f.label.value}")
+            folds.append((f.label, base + f.index, coarse.transfer(f.point.X, disc), found))
     return points, folds
 
 
@@ -109,9 +112,8 @@ def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | 
     if not points:
         raise ContinuationError(f"{name}: no converged point ({forward.stop.message})")
     offset = max(len(backward_points) - 1, 0)
-    special = [SpecialPoint(kind, offset - index - 1, X, status=status)
-               for kind, index, X, status in backward_folds[::-1]]
-    special += [SpecialPoint(kind, offset + index, X, status=status) for kind, index, X, status in forward_folds]
+    special = [SpecialPoint(kind, offset - index - 1, X, **found) for kind, index, X, found in backward_folds[::-1]]
+    special += [SpecialPoint(kind, offset + index, X, **found) for kind, index, X, found in forward_folds]
     special.append(SpecialPoint(Kind.EP, len(points) - 1, points[-1][0], stop=forward_stop))
     traced = (Leg(labels[0], forward_stop),)
     if backward:

@@ -22,7 +22,7 @@ from ..numerics import continuation
 from ..numerics.newton import newton
 from .problem import equilibrium_of, pressure_system
 from .resolution import Resolution
-from .results import Block, Branch, Classification, Kind, SpecialPoint
+from .results import Block, Branch, Classification, Kind, SpecialPoint, located_or_bracketed
 from .stability import SecondVariation
 from .tracer import Tracer
 
@@ -84,7 +84,8 @@ def locate(branch: Branch, index: int, block: Block, k: int = 0) -> SpecialPoint
     if found is None:
         raise RuntimeError(f"branch point between points {index} and {index + 1} could not be located")
     X, mode = found.payload
-    return SpecialPoint(Kind.BP, index, X, block=Block(block), status=found.status, mode=mode)
+    found_fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({Block(block).value} block)")
+    return SpecialPoint(Kind.BP, index, X, block=Block(block), mode=mode, **found_fields)
 
 
 def general_tracer(scene) -> Tracer:

@@ -43,7 +43,7 @@ from ..numerics.newton import newton
 from ..scene import Scene
 from .bifurcation import block_indices, padded_mode, plain_degree
 from .problem import equilibrium_of
-from .results import Block, Branch, Kind, SpecialPoint, StopCode
+from .results import Block, Branch, Kind, SpecialPoint, StopCode, located_or_bracketed
 from .stability import SecondVariation
 
 PARAMETERS = ("M", "alpha1")
@@ -281,12 +281,21 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
         return rule(point)
 
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
-    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, status=fold.status,
+    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc),
                            note=f"fold of the curve in {parameter}: the two pitchforks merge") for fold in path.folds]
     points = path.points
     return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
                              merges, path.stop, time.perf_counter() - t0)
+
+
+def _merge_status(fold, path, disc) -> dict:
+    """Status fields of a merge (a fold of the curve in q), bracketed by the curve points around it."""
+    after = path.points[fold.index + 1].X if fold.index + 1 < len(path.points) else path.overshoot.X
+    before = path.points[fold.index].X
+    n = disc.size
+    return located_or_bracketed(fold.status, disc, np.append(before[:n], before[n]), np.append(after[:n], after[n]),
+                                "merge of the pitchforks")
 
 
 def land_on_q(curve: TwoParameterCurve, q: float, near: int):

@@ -41,6 +41,14 @@ class Block(enum.StrEnum):
     EVEN = "even"  # equator-symmetric modes
 
 
+class Status(enum.StrEnum):
+    """How well a special point is known (the contract of docs/numerics.md)."""
+
+    LOCATED = "located"  # its test function vanishes to tolerance at a converged point, found by a method that
+    #                      converges there
+    APPROXIMATE = "approximate"  # known only to lie in a bracket: ``uncertainty`` says how wide, ``reason`` why
+
+
 class StopCode(enum.StrEnum):
     """Why a leg of a branch (or a two-parameter curve) stopped, besides the engine's ``TraceStop``."""
 
@@ -68,11 +76,29 @@ class SpecialPoint:
     X: np.ndarray
     classification: Classification = Classification.NONE
     block: Block = Block.NONE
-    status: RootStatus = RootStatus.LOCATED
+    status: Status = Status.LOCATED
+    uncertainty: float = 0.0  # APPROXIMATE: half-width of its bracket in (P, λ2(0)), max norm (bracket_uncertainty)
+    reason: str = ""  # APPROXIMATE: why, for people
     E: tuple = (np.nan, np.nan, np.nan)  # normal-form coefficients E2, E3, E4 of a branch point
     mode: np.ndarray | None = None  # critical eigenvector of a branch point (a_0..a_N, b_0..b_N, in x)
     stop: Stop | None = None  # an end point's stop
     note: str = ""  # for people only
+
+
+def bracket_uncertainty(disc, before, after) -> float:
+    """Half the max-norm distance in (P, north pole stretch λ2(0)) between two points X = (u, P) bracketing a
+    special point on ``disc``."""
+    north = disc.pole_rows()["lam2_north"]
+    return 0.5 * max(abs(after[-1] - before[-1]), abs(north @ (after[:-1] - before[:-1])))
+
+
+def located_or_bracketed(status: RootStatus, disc, before, after, what: str) -> dict:
+    """SpecialPoint fields for a point found by ``numerics.continuation.locate_root`` between ``before`` and
+    ``after``: LOCATED, or APPROXIMATE with the bracket's uncertainty when the root search fell back."""
+    if status == RootStatus.LOCATED:
+        return {"status": Status.LOCATED}
+    return {"status": Status.APPROXIMATE, "uncertainty": bracket_uncertainty(disc, before, after),
+            "reason": f"{what}: the root search failed inside its bracket; the nearest evaluated point is stored"}
 
 
 @dataclass(frozen=True)

@@ -377,7 +377,7 @@ def _format_branch(name: str, b: dict) -> list[str]:
     ]
     for s in b["special_points"]:
         note = f"  {s['note']}" if s["note"] else ""
-        status = "" if s["status"] == "located" else f" ({s['status']})"
+        status = "" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})"
         label = f"{s['kind']} {s['classification']}".strip() + status
         lines.append(
             f"    {label:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "

@@ -15,8 +15,9 @@ Layout::
         unknowns                                           (n_points, n + 1): Legendre unknowns u, then P
         theta                                              (n_theta,): linspace(0, π)
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (n_points, n_theta)
-        special_points/kind (LP, TP, BP, EP, UZ), classification, block, status, stop_code, note, index,
-                       pressure, E2, E3, E4, lam2_north, lam2_south, eta_north, eta_south   (n_special,)
+        special_points/kind (LP, TP, BP, EP, UZ), classification, block, status (located, approximate), reason,
+                       stop_code, note, index, pressure, uncertainty, E2, E3, E4, lam2_north, lam2_south,
+                       eta_north, eta_south                                                  (n_special,)
         special_points/unknowns                            (n_special, n + 1)
         stability/...                                      (analysed branches: flags and lowest eigenvalues)
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
@@ -35,8 +36,8 @@ from .hdf5 import atomic_file, plain, provenance, write_strings
 
 FORMAT = "balloon-cg/2"
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
-SPECIAL_NUMBERS = ("pressure", "E2", "E3", "E4") + POLES
-SPECIAL_TEXT = ("kind", "classification", "block", "status", "stop_code", "note")
+SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
+SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
 
 
 class RunFileError(ValueError):
@@ -177,6 +178,8 @@ def write_special(group, special: list, width: int, disc) -> None:
     write_strings(group, "classification", [s.classification.value for s in special])
     write_strings(group, "block", [s.block.value for s in special])
     write_strings(group, "status", [s.status.value for s in special])
+    write_strings(group, "reason", [s.reason for s in special])
+    group.create_dataset("uncertainty", data=np.array([s.uncertainty for s in special], dtype=float))
     write_strings(group, "stop_code", [s.stop.code.value if s.stop else "" for s in special])
     write_strings(group, "note", [s.stop.message if s.stop else s.note for s in special])
     group.create_dataset("index", data=np.array([s.index for s in special], dtype=np.int64))
