@@ -14,6 +14,7 @@ turns named values into an argument tuple, so no caller knows the argument order
 """
 import hashlib
 import importlib
+import operator
 from functools import cached_property
 
 import numpy as np
@@ -36,9 +37,6 @@ def class_name(alpha, has_field: bool) -> str:
             "run `make regenerate`"
         )
     return "ogden_general_field"
-
-
-_MATERIAL, _VALUE, _PARAM, _POLE = "material", "value", "param", "pole"  # how an argument is bound
 
 
 class KernelSet:
@@ -66,7 +64,7 @@ class KernelSet:
         self.field_class = generated.CLASSES[self.name][1]
         self.scene_material = material
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
-        self._plans, self._node_kernels = {}, {}
+        self._binders, self._node_kernels = {}, {}
 
     @cached_property
     def signature(self) -> str:
@@ -96,30 +94,34 @@ class KernelSet:
     def arguments(self, kernel: str, values: dict, params=None) -> tuple:
         """The argument tuple of ``kernel`` from named values (module docstring) and, if given, the branch
         parameters ``params`` (galerkin.equilibrium.Parameters: P, M, χ, μ, α); missing names raise KeyError."""
-        plan = self._plans.get(kernel) or self._plan(kernel)
-        source = values if params is None else {"P": params.P, "M": params.M, "chi": params.chi, "mu": params.mu,
-                                                "alpha": params.alpha, **values}
-        mu, alpha = source.get("mu"), source.get("alpha")
-        material = self._scene_arrays if mu is None and alpha is None else self.material(mu, alpha)
+        pick, scalars, pole_rows = self._binders.get(kernel) or self._binder(kernel)
+        if params is None:
+            mu, alpha = values.get("mu"), values.get("alpha")
+            source = {**values}
+        else:
+            mu, alpha = params.mu, params.alpha
+            source = {"P": params.P, "M": params.M, "chi": params.chi, **values}
+        source.update(self._scene_arrays if mu is None and alpha is None else self.material(mu, alpha))
         try:
-            return tuple([material[name] if how is _MATERIAL else source[name] if how is _VALUE
-                          else float(source[name]) if how is _PARAM else self._pole_field(source, name)
-                          for how, name in plan])
+            for name in scalars:
+                source[name] = float(source[name])
+            if pole_rows:
+                source["pole_field"] = self._pole_field(source, pole_rows)
+            return pick(source)
         except KeyError as e:
             raise KeyError(f"{kernel}: no value for its argument {e.args[0]!r}") from None
 
-    def _plan(self, kernel: str) -> tuple:
-        """(how, name) per argument of ``kernel``, read once from KERNELS (the binding is then a single pass)."""
-        plan = []
-        for name, kind, rows in self.module.KERNELS[kernel]["args"]:
-            if name in self._scene_arrays:
-                plan.append((_MATERIAL, name))
-            elif name == "pole_field":
-                plan.append((_POLE, rows))
-            else:
-                plan.append((_PARAM if kind == "param" else _VALUE, name))
-        self._plans[kernel] = plan = tuple(plan)
-        return plan
+    def _binder(self, kernel: str) -> tuple:
+        """(a getter of the argument tuple from a dict of named values, the scalar parameter names, the
+        pole-field rows or None) of ``kernel``, read once from KERNELS."""
+        spec = self.module.KERNELS[kernel]["args"]
+        names = [name for name, _, _ in spec]
+        getter = operator.itemgetter(*names)
+        pick = getter if len(names) > 1 else (lambda source: (getter(source),))
+        scalars = tuple(name for name, kind, _ in spec if kind == "param")
+        pole_rows = next((rows for name, _, rows in spec if name == "pole_field"), None)
+        self._binders[kernel] = binder = (pick, scalars, pole_rows)
+        return binder
 
     def _pole_field(self, values: dict, rows: tuple) -> np.ndarray:
         """Rows 'NAME_N' / 'NAME_S': entry NAME (of FIELD_ROWS) of values['field_north'] / values['field_south']."""
