@@ -3,8 +3,9 @@
 Points are stored on the finest discretisation used (the last one of the most refined leg: its map is the
 latest), its degree raised by the resolution policy while the projection would lose more than the policy's
 loss limit of any point and raising it helps. A point's stored error estimate adds its measured projection
-loss. A leg that stopped on passing a north pole stretch given in ``land_on`` (STOP_STRETCH, MIN_STRETCH) gets
-its exact end point there (Newton on the row e_λ2(0)·X = target from the linear interpolant).
+loss. A leg that stopped on passing a pole stretch given in ``land_on`` (STOP_STRETCH, MIN_STRETCH,
+SOUTH_STOP_STRETCH) gets its exact end point there (Newton on the pole row r·X = target from the linear
+interpolant); a fold found between the last point and the overshoot is kept only if it lies before that end.
 """
 import time
 
@@ -78,36 +79,46 @@ def _land(system, before, after, row, target, settings):
     return continuation.Point(result.x, np.zeros_like(result.x), result.iterations, result.residual)
 
 
-def _landed(tracer, final, leg: LegTrace, points: list, land_on: dict):
-    """(points, stop) of a leg, with its exact end point when it stopped on passing a ``land_on`` stretch."""
-    target = land_on.get(leg.stop.code)
-    if target is None or not points:
-        return points, leg.stop
+def _landed(tracer, final, leg: LegTrace, points: list, folds: list, land_on: dict):
+    """(points, folds, stop) of a leg: with its exact end point when it stopped on passing a ``land_on`` pole
+    stretch; folds found past the last stored point (between it and the overshoot) are kept only if they lie
+    before that end point, i.e. on the stored branch."""
+    beyond = [f for f in folds if f[1] >= len(points) - 1]
+    kept = [f for f in folds if f[1] < len(points) - 1]
+    land = land_on.get(leg.stop.code)
+    if land is None or not points:
+        return points, kept, leg.stop
+    pole, target = land
     disc = final.eq.disc
     last_disc, last_path = leg.segments[-1]
     overshoot = last_disc.transfer(last_path.overshoot.X, disc)
-    north = np.append(disc.pole_rows()["lam2_north"], 0.0)
-    end = _land(final, points[-1][0], overshoot, north, target, tracer.settings)
+    row = np.append(disc.pole_rows()[pole], 0.0)
+    end = _land(final, points[-1][0], overshoot, row, target, tracer.settings)
     if end is None:
         reached = leg.stop.message.removeprefix("reached ")
-        return points, Stop(StopCode.LANDING_FAILED, f"could not land on {reached} (Newton failed); stopped before it")
-    return points + [(end.X, end, disc.degree, disc.tail(end.X[:-1]))], leg.stop
+        return points, kept, Stop(StopCode.LANDING_FAILED,
+                                  f"could not land on {reached} (Newton failed); stopped before it")
+    last = row @ points[-1][0]
+    kept += [f for f in beyond if (row @ f[2] - last) * (target - row @ f[2]) >= 0]
+    return points + [(end.X, end, disc.degree, disc.tail(end.X[:-1]))], kept, leg.stop
 
 
 def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | None = None, t0: float = 0.0,
              land_on: dict | None = None, labels=("forward", "backward")) -> Branch:
     """One Branch (module docstring): reversed ``backward`` (without its first point), then ``forward``.
-    ``land_on``: StopCode -> north pole stretch to land exactly on for legs stopped with that code."""
+    ``land_on``: StopCode -> (pole row name, stretch) to land exactly on for legs stopped with that code."""
     legs = [leg for leg in (backward, forward) if leg is not None]
     disc, moves = storage_basis(tracer, params, legs)
     final = tracer.system(disc.degree, params, disc.mapping)
     land_on = land_on or {}
     forward_points, forward_folds = _collect(forward, disc, moves)
-    forward_points, forward_stop = _landed(tracer, final, forward, forward_points, land_on)
+    forward_points, forward_folds, forward_stop = _landed(tracer, final, forward, forward_points, forward_folds,
+                                                          land_on)
     backward_points, backward_folds = [], []
     if backward:
         backward_points, backward_folds = _collect(backward, disc, moves)
-        backward_points, backward_stop = _landed(tracer, final, backward, backward_points, land_on)
+        backward_points, backward_folds, backward_stop = _landed(tracer, final, backward, backward_points,
+                                                                 backward_folds, land_on)
     points = backward_points[:0:-1] + forward_points
     if not points:
         raise ContinuationError(f"{name}: no converged point ({forward.stop.message})")

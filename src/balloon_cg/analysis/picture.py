@@ -16,6 +16,7 @@ from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
 from .stability import assess_branch
 from .switching import trace_pear
+from .verdict import Incomplete, incomplete
 
 
 @dataclass
@@ -35,10 +36,16 @@ class Picture:
     branches: list
     branch_points: list = field(default_factory=list)  # the primary branch's BP special points, in order
     snaps: list = field(default_factory=list)  # SnapThrough
+    not_searched: str = ""  # why branch points were not searched, if they were not
 
     @property
     def primary(self) -> Branch:
         return self.branches[0]
+
+    @property
+    def incomplete(self) -> list[Incomplete]:
+        """What the picture lacks against the contract (``verdict``); empty when it is complete."""
+        return incomplete(self.branches, self.not_searched)
 
 
 def _assess(branch: Branch, scene, symmetric: bool) -> None:
@@ -53,6 +60,8 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     picture = Picture([primary])
     _assess(primary, scene, primary.disc.symmetric)
     if not primary.disc.symmetric:
+        picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
+                                "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
         return picture
     for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
         bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))

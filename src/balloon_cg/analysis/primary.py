@@ -27,10 +27,13 @@ from .tracer import ContinuationError, Tracer, unit
 from .wires import wire_gap
 
 
-def start(tracer: Tracer) -> tuple[np.ndarray, Parameters]:
-    """The inflated M = 0 sphere, then the field switched on by natural continuation in M (bounded halving)."""
+def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
+    """The inflated M = 0 sphere, then the field switched on by natural continuation in M (bounded halving), on
+    a degree that resolves it: (the start point, its parameters, its degree). Raises ContinuationError when the
+    field cannot be switched on or the start is not resolved up to solver.max_degree (never a guess)."""
     scene = tracer.scene
-    eq = tracer.system(scene.solver.degree, Parameters(0.0)).eq
+    degree = scene.solver.degree
+    eq = tracer.system(degree, Parameters(0.0)).eq
     disc = eq.disc
     lam = scene.continuation.start_stretch
     a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
@@ -53,14 +56,50 @@ def start(tracer: Tracer) -> tuple[np.ndarray, Parameters]:
                     f"could not switch the field on at start stretch {lam}: Newton failed at M = {trial:.6g} "
                     f"({result.message}); try a smaller continuation.start_stretch or a smaller field.M"
                 )
-    return np.append(u, params.P), params.with_value("M", target)
+    params = params.with_value("M", target)
+    X, degree = _resolved_start(tracer, np.append(u, params.P), degree, params)
+    residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
+    return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
 
 
-def initial_point(tracer: Tracer, X0, direction: float, params: Parameters) -> continuation.Point:
-    """X0 with its unit tangent oriented so that the north pole stretch moves in ``direction``."""
-    system = tracer.system(tracer.scene.solver.degree, params)
+def _resolved_start(tracer: Tracer, X, degree: int, params: Parameters) -> tuple[np.ndarray, int]:
+    """X = (u, P) of the start recomputed (at fixed P and M) on degrees grown by the resolution policy until its
+    spectral error estimate is within max_error; ContinuationError past max_degree or when Newton fails."""
+    policy, scene = tracer.resolution, tracer.scene
+    disc = tracer.system(degree, params).eq.disc
+    while not policy.resolved(disc, X[:-1]):
+        if degree >= policy.max_degree:
+            lam2 = disc.evaluate(X[:-1], np.linspace(0.0, np.pi, 181))[0]
+            slack = (f"; the membrane is compressed (smallest λ2 = {lam2.min():.4g} < 1: a membrane carries no "
+                     "compression): start at a larger continuation.start_stretch") if lam2.min() < 1 else ""
+            raise ContinuationError(
+                f"the start at continuation.start_stretch = {scene.continuation.start_stretch:g}, field.M = "
+                f"{params.M:g} is not resolved: spectral error estimate {disc.tail(X[:-1]):.2g} above "
+                f"solver.max_error = {policy.max_error:g} at solver.max_degree = {policy.max_degree}{slack}")
+        degree = policy.grow(degree)
+        system = tracer.system(degree, params)
+        guess = disc.transfer(X, system.eq.disc)
+        result = newton(system.residual, system.jacobian, guess, unit(guess.size, -1), guess[-1],
+                        scene.solver.tol, scene.solver.max_newton)
+        if not result.converged:
+            lam2 = disc.evaluate(X[:-1], np.linspace(0.0, np.pi, 181))[0]
+            slack = (f"; the membrane is compressed (smallest λ2 = {lam2.min():.4g} < 1: a membrane carries no "
+                     "compression)") if lam2.min() < 1 else ""
+            raise ContinuationError(
+                f"the start at field.M = {params.M:g} is not resolved at degree {disc.degree} (error estimate "
+                f"{disc.tail(X[:-1]):.2g}) and could not be refined to degree {degree} ({result.message}){slack}; "
+                "try a larger continuation.start_stretch or a smaller field.M")
+        X, disc = result.x, system.eq.disc
+    return X, degree
+
+
+def initial_point(tracer: Tracer, start: continuation.Point, direction: float, params: Parameters,
+                  degree: int) -> continuation.Point:
+    """The start with its unit tangent oriented so that the north pole stretch moves in ``direction``."""
+    system = tracer.system(degree, params)
     north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
-    return continuation.Point(X0, direction * continuation.tangent(system, X0, north), 0, 0.0)
+    tangent = direction * continuation.tangent(system, start.X, north)
+    return continuation.Point(start.X, tangent, start.iterations, start.residual)
 
 
 def stop_rule(scene, upper: float):
@@ -89,10 +128,12 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
     """Trace the primary branch of a scene (module docstring). ``down=False`` skips the leg below the start."""
     t0 = time.perf_counter()
     tracer = Tracer(scene, symmetric)
-    X0, params = start(tracer)
+    first, params, degree = start(tracer)
     upper = scene.continuation.stop_stretch if stop_stretch is None else stop_stretch
     stop = stop_rule(scene, upper)
-    up = tracer.leg(initial_point(tracer, X0, 1.0, params), params, stop, progress)
-    below = tracer.leg(initial_point(tracer, X0, -1.0, params), params, stop, progress) if down else None
-    land_on = {StopCode.STOP_STRETCH: upper, StopCode.MIN_STRETCH: scene.continuation.min_stretch}
+    up = tracer.leg(initial_point(tracer, first, 1.0, params, degree), params, stop, progress, degree=degree)
+    below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree)
+             if down else None)
+    land_on = {StopCode.STOP_STRETCH: ("lam2_north", upper),
+               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)}
     return assemble(tracer, params, "primary", up, below, t0, land_on=land_on, labels=("up", "down"))

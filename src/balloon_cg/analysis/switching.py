@@ -3,7 +3,8 @@
 From u* + δφ (φ the critical mode, ±), corrected on the hyperplane normal to φ, then pseudo-arclength in the
 general (non-symmetric) space, balloon held (``bifurcation.general_tracer``), until it rejoins the primary
 branch (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch
-point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch).
+point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch);
+it ends exactly on stop_stretch (north or south) when it stops there.
 """
 import time
 
@@ -53,4 +54,7 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
                         f"south pole stretch reached stop_stretch {scene.continuation.stop_stretch:g}")
         return base(disc, point)
 
-    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0)
+    stretch = scene.continuation.stop_stretch
+    land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch)}
+    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0,
+                    land_on=land_on)

@@ -1,8 +1,10 @@
 """Command line: ``balloon-cg run | solve | inspect | plot | sweep`` (``balloon-cg SUBCOMMAND -h`` for help).
 
-Exit codes: 0 success, 1 the computation did not give what was asked (branch could not start or did not
-reach the requested stretch), 2 bad input (invalid scene, missing or unreadable file, existing output
-without --force). Errors are one line on stderr, ``balloon-cg: error: ...``.
+Exit codes: 0 success: the result is complete (analysis.verdict: every branch reached its requested end, every
+special point is located, stability settled); 1 the computation did not give what was asked (a branch could
+not start, or the result is incomplete: the file is still written, flagged, and the incomplete parts are named
+on stderr; ``--allow-partial`` makes an incomplete result exit 0); 2 bad input (invalid scene, missing or
+unreadable file, existing output without --force). Errors are one line on stderr, ``balloon-cg: error: ...``.
 """
 import argparse
 import json
@@ -17,6 +19,7 @@ from ..analysis.picture import analyse
 from ..analysis.primary import trace_primary
 from ..analysis.results import StopCode
 from ..analysis.tracer import ContinuationError
+from ..analysis.verdict import failing, incomplete, summary_line
 from ..model.field import FieldError
 from ..post.plotting import KINDS, PlotError, plot as draw_plot
 from ..galerkin.profiles import equator_values
@@ -79,23 +82,35 @@ def _add_run(commands):
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--primary-only", action="store_true",
                    help="trace the primary branch only (no stability, branch points or pear branches)")
+    p.add_argument("--allow-partial", action="store_true",
+                   help="exit 0 also when the result is incomplete (it is still flagged in the file and on stderr)")
     p.set_defaults(handler=run)
 
 
 def run(args) -> int:
     """Trace, write, read back and summarise."""
     scene = load_scene(args.scene)
-    run_scene(scene, args.output, args.force, progress=not args.quiet, command=args.command_line,
-              primary_only=args.primary_only)
+    _, found = run_scene(scene, args.output, args.force, progress=not args.quiet, command=args.command_line,
+                         primary_only=args.primary_only)
     if not args.quiet:
         print(format_run(read_run(args.output)))
-    return 0
+    return verdict_status(found, args.allow_partial)
+
+
+def verdict_status(found: list, allow_partial: bool) -> int:
+    """Exit status of a written result: 0 when complete (or ``allow_partial``), else 1 with the incomplete
+    parts on stderr (one line)."""
+    if not failing(found):
+        return 0
+    print(f"{PROG}: {summary_line(found)}", file=sys.stderr)
+    return 0 if allow_partial else 1
 
 
 def run_scene(scene, out_path, force: bool = False, progress: bool = False, command: str | None = None,
-              primary_only: bool = False) -> Path:
+              primary_only: bool = False) -> tuple[Path, list]:
     """Analyse ``scene`` (primary branch, stability, branch points, pear branches, snap-throughs; or only the
-    primary branch) and write the run file ``out_path``; returns the path.
+    primary branch) and write the run file ``out_path``; returns the path and what is incomplete
+    (analysis.verdict.Incomplete entries, empty when the result is complete).
 
     The output is checked before the trace (which may take long); ``progress`` shows a bar on stderr;
     ``command`` overrides the provenance attribute (default: sys.argv).
@@ -105,11 +120,12 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
         tick = lambda point: bar.update()  # noqa: E731
         if primary_only:
             branches, snaps = [trace_primary(scene, progress=tick)], None
+            found = incomplete(branches)
         else:
             picture = analyse(scene, progress=tick)
-            branches, snaps = picture.branches, picture.snaps
+            branches, snaps, found = picture.branches, picture.snaps, picture.incomplete
     extra = {} if command is None else {"command": command}
-    return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps)
+    return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found), found
 
 
 # --- solve -------------------------------------------------------------------------------------------------
@@ -266,6 +282,8 @@ def _add_sweep(commands):
                       help="primary branch, stability and branch points, but no pear branches")
     p.add_argument("--force", action="store_true", help="replace an existing file holding a different sweep")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--allow-partial", action="store_true",
+                   help="exit 0 also when some members are incomplete (they are flagged in the file)")
     p.set_defaults(handler=sweep)
 
 
@@ -287,7 +305,19 @@ def sweep(args) -> int:
     if result.failed:
         raise Failure(f"{len(result.failed)} of {len(result.members)} sweep members failed (members "
                       f"{', '.join(map(str, sorted(result.failed)))}); re-run the same command to retry them")
+    partial = incomplete_members(result.path)
+    if partial:
+        print(f"{PROG}: incomplete: sweep members {', '.join(map(str, partial))} (their results are flagged in the "
+              "file: members/<index> attributes complete, incomplete_*)", file=sys.stderr)
+        return 0 if args.allow_partial else 1
     return 0
+
+
+def incomplete_members(path) -> list[int]:
+    """Indices of the members of a sweep file whose results are incomplete."""
+    from ..io.sweep_file import read_sweep
+
+    return [index for index, member in read_sweep(path)["members"].items() if not member["attrs"].get("complete")]
 
 
 # --- summaries ---------------------------------------------------------------------------------------------
@@ -346,6 +376,7 @@ def format_run(run: dict) -> str:
         f"command        {p['command']}",
         f"tolerance      {p['tolerance']:g}",
         f"kernels        digest {p['generated_digest'][:16]}…",
+        f"result         {_verdict(p)}",
     ]
     for name, b in summary["branches"].items():
         lines += ["", *_format_branch(name, b)]
@@ -353,6 +384,17 @@ def format_run(run: dict) -> str:
         target = f"{s['to_branch']} point {s['to_index']}" if s["to_branch"] else "no stable state on the traced branches"
         lines.append(f"snap-through at P = {s['pressure']:.10g}: {s['from_branch']} point {s['from_index']} -> {target}")
     return "\n".join(lines)
+
+
+def _verdict(attrs: dict) -> str:
+    """'complete', or the incomplete parts stored in a run file's root attributes."""
+    if "complete" not in attrs:
+        return "not assessed"
+    if attrs["complete"]:
+        return "complete"
+    parts = [f"{gap} ({branch}: {message})" for gap, branch, message in
+             zip(attrs["incomplete_gaps"], attrs["incomplete_branches"], attrs["incomplete_messages"])]
+    return "incomplete: " + "; ".join(parts)
 
 
 def _format_branch(name: str, b: dict) -> list[str]:

@@ -6,8 +6,9 @@ which pyproject.toml maps to the top-level scenes/, so that an installed package
 branch is traced and written to OUTDIR/<scene>.h5, and every plot kind that applies is drawn as
 OUTDIR/<scene>_<kind>.png. The pressure curves of all scenes together (several M in one figure) go to
 OUTDIR/all_<kind>.png. Existing files of these names are overwritten. A summary table closes the run; the
-exit code is 1 if a scene failed, else 0. ``--quick`` limits every leg of the continuation to QUICK_POINTS
-points (for tests).
+exit code is 1 if a scene failed or its result is incomplete (analysis.verdict), else 0. ``--quick`` limits
+every leg of the continuation to QUICK_POINTS points (for tests: the results are then partial by design and
+do not change the exit code).
 """
 import argparse
 import sys
@@ -16,6 +17,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..analysis.tracer import ContinuationError
+from ..analysis.verdict import failing, summary_line
 from .cli import run_scene, summarise_branch
 from ..post.plotting import applicable_kinds, load_branches, plot, special_label
 from ..scene import parse_scene
@@ -57,6 +59,7 @@ def summary_row(path) -> dict:
         "special points": " ".join(special_label(s) for s in b["special_points"]),
         "max error est.": f"{b['max_error_estimate']:.1e}",
         "wall time": f"{b['wall_time']:.1f} s",
+        "result": "complete" if run["attrs"].get("complete") else "incomplete",
     }
 
 
@@ -84,10 +87,12 @@ def main(argv=None) -> int:
     rows, paths, failed = [], [], []
     for scene in default_scenes(QUICK_POINTS if args.quick else None):
         try:
-            path = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=not args.quiet)
+            path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=not args.quiet)
         except ContinuationError as e:
             failed.append(f"{scene.name}: {e}")
             continue
+        if failing(found) and not args.quick:
+            failed.append(f"{scene.name}: {summary_line(found)}")
         paths.append(path)
         for image in draw_figures([path], outdir, scene.name):
             print(image)

@@ -23,6 +23,7 @@ from tqdm import tqdm
 
 from ..analysis.picture import analyse
 from ..analysis.primary import trace_primary
+from ..analysis.verdict import incomplete
 from ..io.sweep_file import SweepError, append_member, open_sweep, read_sweep, root_attrs
 from ..scene import Scene, SceneError, parse_scene
 
@@ -180,13 +181,14 @@ def _ranges(indices: list[int]) -> str:
 
 @dataclass
 class MemberResult:
-    """What a worker returns (plain data, pickled back to the parent): the branches, snap-throughs and branch
-    points of one member."""
+    """What a worker returns (plain data, pickled back to the parent): the branches, snap-throughs, branch
+    points and what is incomplete (analysis.verdict) of one member."""
 
     index: int
     branches: list
     snaps: list | None
     branch_points: list
+    incomplete: list
     wall_time: float
     pid: int
 
@@ -199,10 +201,11 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
     start = time.perf_counter()
     if mode == "primary-only":
         branches, snaps, points = [trace_primary(scene)], None, []
+        found = incomplete(branches)
     else:
         picture = analyse(scene, pear=(mode == "analysis"))
-        branches, snaps, points = picture.branches, picture.snaps, picture.branch_points
-    return MemberResult(index, branches, snaps, points, time.perf_counter() - start, os.getpid())
+        branches, snaps, points, found = picture.branches, picture.snaps, picture.branch_points, picture.incomplete
+    return MemberResult(index, branches, snaps, points, found, time.perf_counter() - start, os.getpid())
 
 
 # --- the writer (parent process only) ----------------------------------------------------------------------
@@ -318,7 +321,8 @@ def format_summary(result: SweepResult) -> str:
         "",
     ]
     w = max([len("overrides")] + [len(m.label) for m in result.members])
-    header = f"{'member':>6}  {'overrides':<{w}}  {'points':>6}  {'pear BPs':>8}  pear branch point pressures"
+    header = (f"{'member':>6}  {'overrides':<{w}}  {'result':<10}  {'points':>6}  {'pear BPs':>8}  "
+              "pear branch point pressures")
     lines.append(header)
     for m in result.members:
         if m.index in result.failed:
@@ -334,5 +338,6 @@ def format_summary(result: SweepResult) -> str:
                  if block == "odd_held"]
         count = "n/a" if mode == "primary-only" else str(len(pears))
         pressures = ", ".join(f"{p:.6g}" for p in pears) if pears else ("-" if mode != "primary-only" else "")
-        lines.append(f"{m.index:>6}  {m.label:<{w}}  {n_points:>6}  {count:>8}  {pressures}")
+        verdict = "complete" if a.get("complete") else "incomplete"
+        lines.append(f"{m.index:>6}  {m.label:<{w}}  {verdict:<10}  {n_points:>6}  {count:>8}  {pressures}")
     return "\n".join(lines)

@@ -3,7 +3,9 @@
 Layout::
 
     /                      attrs: format, scene_name, scene_toml, tolerance, + provenance (io.hdf5: package_version,
-                                  generated_digest, created (UTC ISO 8601), command) + extra_attrs
+                                  generated_digest, created (UTC ISO 8601), command), complete (bool),
+                                  incomplete_gaps, incomplete_branches, incomplete_messages (analysis.verdict),
+                                  + extra_attrs
     /branches/<name>/      attrs: order, stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
                                   'up'/'down'/'forward' and a StopCode/TraceStop value), wall_time, degree,
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
@@ -31,6 +33,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..analysis.verdict import failing, incomplete
 from ..galerkin.profiles import equator_values, profiles, theta_grid
 from .hdf5 import atomic_file, plain, provenance, write_strings
 
@@ -45,14 +48,15 @@ class RunFileError(ValueError):
 
 
 def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | None = None,
-              snaps: list | None = None) -> Path:
+              snaps: list | None = None, found: list | None = None) -> Path:
     """Write the branches traced for ``scene`` to ``path`` atomically; returns the path.
 
     An existing file is kept unless ``force`` (FileExistsError); on any failure the existing file is
     untouched and the temporary file removed. ``extra_attrs`` are added to (or override, except ``format``)
-    the root attributes. Raises ValueError if a branch holds a point that is not a finite solution.
+    the root attributes. ``found``: analysis.verdict.Incomplete entries (default: those of ``branches``).
+    Raises ValueError if a branch holds a point that is not a finite solution.
     """
-    attrs = root_attrs(scene) | dict(extra_attrs or {})
+    attrs = root_attrs(scene) | verdict_attrs(branches, found) | dict(extra_attrs or {})
     if attrs["format"] != FORMAT:
         raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
     check_branches(branches)
@@ -66,6 +70,17 @@ def root_attrs(scene, command: str | None = None) -> dict:
     """The root attributes of a run file: format, the scene and the provenance."""
     return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.text, "tolerance": scene.solver.tol,
             **provenance(command)}
+
+
+def verdict_attrs(branches=None, found=None) -> dict:
+    """complete and incomplete_* attributes from Incomplete entries (or computed from ``branches``)."""
+    if found is None:
+        found = incomplete(branches)
+    text = h5py.string_dtype()
+    return {"complete": not failing(found),
+            "incomplete_gaps": np.array([item.gap.value for item in found], dtype=text),
+            "incomplete_branches": np.array([item.branch for item in found], dtype=text),
+            "incomplete_messages": np.array([item.message for item in found], dtype=text)}
 
 
 def check_branches(branches) -> None:
@@ -215,7 +230,7 @@ def read_run(path) -> dict:
             found = "no format attribute" if fmt is None else f"format {fmt!r}"
             raise RunFileError(f"{path}: not a balloon-cg run file ({found}, expected {FORMAT!r})")
         try:
-            attrs = {k: plain(v) for k, v in f.attrs.items()}
+            attrs = {k: _attr(v) for k, v in f.attrs.items()}
             return {"path": str(path), "scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
         except KeyError as e:
             raise RunFileError(f"{path}: damaged balloon-cg run file (missing {e})") from None

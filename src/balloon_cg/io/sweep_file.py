@@ -7,7 +7,9 @@ Layout::
     /members/<index>/   attrs: overrides (JSON object, dotted key -> value), scene_hash (sha256 of the member
                                scene's normalised TOML), scene_toml, tolerance, created, package_version,
                                generated_digest, worker_pid, wall_time, branch_point_kinds,
-                               branch_point_classifications, branch_point_blocks, branch_point_pressures
+                               branch_point_classifications, branch_point_blocks, branch_point_pressures,
+                               complete, incomplete_gaps, incomplete_branches, incomplete_messages (as a run
+                               file's root: analysis.verdict)
         branches/<name>/          exactly as a run file's /branches (io.run_file)
         snap_throughs/            as in a run file (full analysis only)
 
@@ -23,7 +25,7 @@ import h5py
 import numpy as np
 
 from .hdf5 import check_output, plain, provenance
-from .run_file import read_branches, write_branches
+from .run_file import read_branches, verdict_attrs, write_branches
 
 FORMAT = "balloon-cg-sweep/1"
 _TMP_PREFIX = ".tmp-"
@@ -133,6 +135,7 @@ def append_member(f: h5py.File, member, result) -> None:
                             ("branch_point_classifications", [bp.classification.value for bp in result.branch_points]),
                             ("branch_point_blocks", [bp.block.value for bp in result.branch_points])):
             g.attrs.create(key, np.array(values, dtype=object), dtype=text)
+        g.attrs.update(verdict_attrs(found=result.incomplete))
         write_branches(g, member.scene, result.branches, result.snaps)
     except BaseException:
         del group[tmp]

@@ -1,0 +1,74 @@
+"""Is a result complete? The contract of docs/numerics.md: every stored result is verified or flagged.
+
+A result is *complete* when every leg of every branch ended where the scene asked (a requested stop: the pole
+stretch limits, stop_pressure, the wire gap, a pear branch rejoining the primary branch), every special point
+is LOCATED, the stability flags of every assessed point are settled between the stability degree and the
+check degree. Everything else is an ``Incomplete`` entry: typed, named, explained. A limitation of the method
+that is not a failure of the computation (branch points not searched on a scene without equator symmetry) is
+an entry too, but does not make the result incomplete (``Gap.fails``). The CLI turns failing entries into exit
+status 1 (unless ``--allow-partial``); the run file stores every entry (``io.run_file``: root attributes
+complete, incomplete_*).
+"""
+import enum
+from dataclasses import dataclass
+
+from .results import Status, StopCode
+
+REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCode.STOP_PRESSURE,
+                             StopCode.WIRE_GAP, StopCode.SOUTH_STOP_STRETCH, StopCode.REJOINED})
+
+
+class Gap(enum.StrEnum):
+    STOPPED_SHORT = "stopped_short"  # a leg stopped before what the scene asked (budget, resolution, Newton)
+    APPROXIMATE = "approximate"  # a special point is known only to a bracket
+    UNSETTLED = "unsettled"  # stability flags change between the stability and the check degree at some points
+    NOT_SEARCHED = "not_searched"  # branch points were not searched (a limitation, stated; not a failure)
+
+    @property
+    def fails(self) -> bool:
+        """Whether an entry of this kind makes the result incomplete."""
+        return self is not Gap.NOT_SEARCHED
+
+
+@dataclass(frozen=True)
+class Incomplete:
+    gap: Gap
+    branch: str
+    message: str  # for people
+
+
+def incomplete(branches: list, not_searched: str = "") -> list[Incomplete]:
+    """What the traced ``branches`` lack against the contract (module docstring); ``not_searched``: why branch
+    points were not searched on the primary branch, if they were asked for and not searched."""
+    found = []
+    for branch in branches:
+        for leg in branch.legs:
+            if leg.stop.code not in REQUESTED_STOPS:
+                found.append(Incomplete(Gap.STOPPED_SHORT, branch.name, f"{leg.label} leg: {leg.stop.message}"))
+        for s in branch.special:
+            if s.status != Status.LOCATED:
+                found.append(Incomplete(Gap.APPROXIMATE, branch.name,
+                                        f"{s.kind.value} near point {s.index} (±{s.uncertainty:.1g}): {s.reason}"))
+        if branch.unsettled:
+            found.append(Incomplete(Gap.UNSETTLED, branch.name,
+                                    f"stability flags change at the check degree at points {branch.unsettled}"))
+    if not_searched:
+        found.append(Incomplete(Gap.NOT_SEARCHED, branches[0].name, not_searched))
+    return found
+
+
+def failing(found: list[Incomplete]) -> list[Incomplete]:
+    """The entries that make a result incomplete."""
+    return [item for item in found if item.gap.fails]
+
+
+def summary_line(found: list[Incomplete]) -> str:
+    """One line: 'complete' or what is incomplete, counted by kind."""
+    if not failing(found):
+        return "complete: every branch reached its requested end and every special point is located"
+    counts = {}
+    for item in found:
+        counts[item.gap] = counts.get(item.gap, 0) + 1
+    return "incomplete: " + ", ".join(f"{n} {gap.value}" for gap, n in counts.items()) + \
+        " (" + "; ".join(f"{item.branch}: {item.message}" for item in found[:3]) + \
+        ("; …" if len(found) > 3 else "") + ")"
