@@ -211,7 +211,7 @@ def _path(code, fold_pressures, n=2):
     (StopCode.REJOINED, [], CurveEnd.OTHER),  # a caller's stop rule
 ])
 def test_curve_end_classification(code, folds, end):
-    assert codim2._classify(_path(code, folds), 2, 1.0) == end
+    assert codim2._classify(_path(code, folds), 2) == end
 
 
 TWO_COILS = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"

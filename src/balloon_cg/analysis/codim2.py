@@ -369,7 +369,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
     if path.stop.code == CurveStop.NONPOSITIVE_PRESSURE:
         path.stop = _pressure_zero_stop(system, path, parameter, settings)
-    end = _classify(path, n, direction)
+    end = _classify(path, n)
     merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
                            note=f"fold of the curve in {parameter}"
                                 + (": the two pitchforks merge" if end == CurveEnd.ISOLA_MERGE else
@@ -380,7 +380,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
                              merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction))
 
 
-def _classify(path, n: int, direction: float) -> CurveEnd:
+def _classify(path, n: int) -> CurveEnd:
     """How a traced curve ended (module docstring)."""
     code = path.stop.code
     if path.folds:
