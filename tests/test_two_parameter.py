@@ -217,14 +217,42 @@ def test_curve_end_classification(code, folds, end):
 TWO_COILS = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
 
 
-def test_two_coil_curve_reaches_zero_pressure_without_a_merge():
+@pytest.fixture(scope="module")
+def two_coils():
+    branch = trace_primary(load_scene(TWO_COILS))
+    return branch, _pear_points(branch)[0]
+
+
+def test_two_coil_curve_reaches_zero_pressure_without_a_merge(two_coils):
     """Issue 11: the two-coil pitchfork continued in M turns back only at P ≈ −1.8 (M ≈ 0.416); the curve now
     stops where P reaches 0 (M ≈ 0.28) and gives no critical M."""
-    scene = load_scene(TWO_COILS)
-    branch = trace_primary(scene)
-    curve = continue_branch_point(branch, _pear_points(branch)[0], "M")
+    curve = continue_branch_point(*two_coils, "M")
     assert curve.stop.code == CurveStop.NONPOSITIVE_PRESSURE and curve.end == CurveEnd.NONPOSITIVE_PRESSURE
     assert curve.critical is None and curve.merge is None and curve.merges == []
     assert np.all(curve.pressure > 0) and np.all(np.diff(curve.q) > 0)
     assert 0.25 < curve.q[-1] < 0.3 and len(curve.q) < 100
     assert "P reached 0 at M = 0.27" in curve.stop.message and "before the curve turned back" in curve.describe()
+
+
+def test_two_coil_curve_in_alpha1_reaches_the_wire(two_coils):
+    """Continued in α1, the two-coil pitchfork moves up in pressure and pole stretch until the membrane comes
+    within continuation.wire_gap (0.1) of a coil: end WIRE, no critical α1."""
+    curve = continue_branch_point(*two_coils, "alpha1")
+    assert curve.stop.code == StopCode.WIRE_GAP and curve.end == CurveEnd.WIRE and curve.critical is None
+    assert curve.merges == [] and np.all(curve.pressure > 0) and curve.q[-1] > 3
+
+
+def test_fold_without_the_partner_is_not_a_merge():
+    """A coil of radius 2.2 in the equatorial plane: the curve turns back in M at P > 0 (M ≈ 0.030) but reaches the
+    wire gap before it comes back to the scene's M: end FOLD, the fold APPROXIMATE, no critical M."""
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[field]\nM = 0.002\n[[field.coils]]\nradius = 2.2\n'
+                        'height = 0.0\ncurrent = 1.0\n[continuation]\nstop_stretch = 2.0\nwire_gap = 0.1\n',
+                        name="coil_2.2")
+    branch = trace_primary(scene, down=False)
+    curve = continue_branch_point(branch, _pear_points(branch)[0], "M")
+    assert curve.stop.code == StopCode.WIRE_GAP and curve.end == CurveEnd.FOLD
+    assert curve.critical is None and curve.merge is None
+    assert len(curve.merges) == 1 and curve.merges[0].status == Status.APPROXIMATE
+    assert "not verified" in curve.merges[0].reason and curve.merges[0].X[curve.n] > 0
+    assert 0.02 < curve.merges[0].X[-1] < 0.04 and curve.q[-1] > curve.q0
+    assert "turns back in M" in curve.describe()
