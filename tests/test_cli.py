@@ -1,13 +1,16 @@
-"""Command line: run, solve, inspect and the one-line errors for bad input."""
+"""Command line: run, solve, inspect, critical and the one-line errors for bad input."""
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from balloon_cg.app.cli import main
+from balloon_cg.io.curve_file import read_curve
 from balloon_cg.scene.materials import PRESETS
 
-SPOM1 = Path(__file__).resolve().parents[1] / "scenes" / "spom1.toml"
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
+SPOM1 = SCENES / "spom1.toml"
 
 SMALL = """
 [material]
@@ -138,6 +141,65 @@ def test_critical_alpha1_from_the_command_line(tmp_path, capsys):
     scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n')
     out = tmp_path / "curve.h5"
     assert main(["critical", str(scene), "--parameter", "alpha1", "-o", str(out)]) == 0
-    assert "critical alpha1 = 1.73961964939" in capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert "critical alpha1 = 1.73961964939" in captured.out
+    assert "continuing it in alpha1" in captured.err and "ended: isola_merge" in captured.err  # progress
+    assert read_curve(out)["attrs"]["end"] == "isola_merge"
     assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0
     assert (tmp_path / "phase.png").stat().st_size > 1000
+
+
+def test_critical_M_of_the_single_coil_scene(tmp_path, capsys):
+    """The shipped single-coil scene (coil radius 4): the pitchforks merge at M = 4.1876946802 (as
+    tests/test_two_parameter.py), at P > 0, and the curve returns to the partner; --quiet: nothing on stderr."""
+    out = tmp_path / "single.h5"
+    assert main(["critical", str(SCENES / "spom1_single_coil.toml"), "--parameter", "M", "-o", str(out),
+                 "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("critical M = 4.187694680") and captured.err == ""
+    attrs = read_curve(out)["attrs"]
+    assert attrs["end"] == "isola_merge" and attrs["stop_code"] == "partner"
+    assert attrs["critical_q"] == pytest.approx(4.1876946802, abs=1e-9)
+
+
+@pytest.mark.parametrize("M", ["0.001", "0.002"])
+def test_critical_M_between_two_coils_is_not_claimed(M, tmp_path, capsys):
+    """Issue 11: between the two opposed coils the pitchfork curve reaches P = 0 (near M = 0.28) before it turns
+    back in M (at P ≈ −1.8): no isola closes, so no critical M: one line saying how the curve ended, exit 1, and
+    the curve file is still written."""
+    out = tmp_path / "curve.h5"
+    assert main(["critical", str(SCENES / f"spom1_two_coils_M{M}.toml"), "--parameter", "M", "-o", str(out),
+                 "--quiet"]) == 1
+    err = one_error_line(capsys, "no critical M", "P reached 0 at M = 0.2", "before the curve turned back in M",
+                         "nonpositive_pressure", "written to", str(out))
+    assert "critical M =" not in err
+    data = read_curve(out)
+    assert data["attrs"]["end"] == "nonpositive_pressure" and data["attrs"]["stop_code"] == "nonpositive_pressure"
+    assert np.isnan(data["attrs"]["critical_q"]) and (data["pressure"] > 0).all()
+
+
+def test_critical_refuses_a_scene_without_equator_symmetry(tmp_path, capsys):
+    scene = tmp_path / "offset.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[field]\nM = 0.002\n'
+                     '[[field.coils]]\nradius = 4.0\nheight = 0.5\ncurrent = 1.0\n')
+    out = tmp_path / "curve.h5"
+    for parameter in ("M", "alpha1"):
+        assert main(["critical", str(scene), "--parameter", parameter, "-o", str(out)]) == 2
+        one_error_line(capsys, "critical needs an equator-symmetric scene", "offset.toml", "coil 0", "height 0.5")
+    assert not out.exists()
+
+
+def test_critical_in_M_needs_coils(tmp_path, capsys):
+    out = tmp_path / "curve.h5"
+    assert main(["critical", str(SPOM1), "--parameter", "M", "-o", str(out)]) == 2
+    one_error_line(capsys, "--parameter M needs coils", "spom1.toml")
+    assert not out.exists()
+
+
+def test_critical_without_a_pear_pitchfork(tmp_path, capsys):
+    scene = tmp_path / "short.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 1.5\n')  # first pear: 1.68
+    out = tmp_path / "curve.h5"
+    assert main(["critical", str(scene), "--parameter", "alpha1", "-o", str(out), "--quiet"]) == 1
+    one_error_line(capsys, "no pear-shaped pitchfork on the primary branch", "short.toml")
+    assert not out.exists()

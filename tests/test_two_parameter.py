@@ -9,14 +9,17 @@ import pytest
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis import bifurcation
 from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.results import StopCode
+from balloon_cg.analysis.results import Status, StopCode
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.analysis.stability import SecondVariation, assess_branch
 from balloon_cg.io.run_file import read_run
-from balloon_cg.analysis.codim2 import (ExtendedSystem, TwoParameterError, alpha1_material, continue_branch_point,
-                                       land_on_q, sphere_critical_alpha1, sphere_pear_stretches)
+from balloon_cg.analysis.codim2 import (CurveEnd, CurveStop, ExtendedSystem, TwoParameterError, alpha1_material,
+                                       continue_branch_point, land_on_q, sphere_critical_alpha1,
+                                       sphere_pear_stretches)
+from balloon_cg.analysis import codim2
+from balloon_cg.numerics.continuation import Fold, Path as TracePath, Point, RootStatus, Stop, TraceStop
 from balloon_cg.io.curve_file import read_curve, write_curve
 
 SPOM1 = get_preset("SPOM1")
@@ -67,7 +70,9 @@ def test_critical_alpha1_matches_closed_form(curve):
 def test_curve_joins_the_two_pitchforks(curve, located):
     """Started at the lower SPOM1 pitchfork, the curve comes back to α1 = 1.3 at the upper one."""
     _, branch, bps = located
-    assert curve.stop.code == StopCode.PARTNER
+    assert curve.stop.code == StopCode.PARTNER and curve.end == CurveEnd.ISOLA_MERGE
+    assert curve.merge is curve.merges[0] and curve.merges[0].status == Status.LOCATED
+    assert np.all(curve.pressure > 0)
     upper = branch.pole_values(bps[1].X)["lam2_north"][0]
     assert curve.pole_stretch[-1] > 0.9 * upper and curve.q[-1] < 1.5
 
@@ -105,7 +110,8 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     assert [s["kind"] for s in special] == ["LP"] and data["attrs"]["stop_code"] == "partner"
     assert data["special_q"][0] == curve.critical[0] == data["attrs"]["critical_q"]
     assert special[0]["lam2_north"] == pytest.approx(curve.critical[2], rel=1e-14)
-    assert data["attrs"]["parameter"] == "alpha1"
+    assert data["attrs"]["parameter"] == "alpha1" and data["attrs"]["end"] == "isola_merge"
+    assert special[0]["status"] == "located" and "merge" in data["attrs"]["end_description"]
     assert read_run(path)["branches"] == {}  # also a readable run file (provenance attributes)
     with pytest.raises(FileExistsError):
         write_curve(path, scene, curve)
@@ -146,9 +152,11 @@ def test_critical_field_of_the_single_coil_isola(field_curve):
     brackets it: the primary branch has two pear points at M = 4.17 (where they lie on the curve) and none at
     4.20."""
     branch, curve = field_curve
-    assert len(curve.merges) == 1 and curve.stop.code == StopCode.PARTNER
+    assert len(curve.merges) == 1 and curve.stop.code == StopCode.PARTNER and curve.end == CurveEnd.ISOLA_MERGE
+    assert curve.merges[0].status == Status.LOCATED and np.all(curve.pressure > 0)
     q, P, stretch = curve.critical
     assert 4.17 < q < 4.20
+    assert q == pytest.approx(4.1876946802, abs=1e-9)
     merge = curve.merges[0].X
     assert branch.disc.tail(merge[:branch.disc.size]) < 1e-9
     below, above = _pear_points(_probe(4.17)), _pear_points(_probe(4.20))
@@ -177,3 +185,74 @@ def test_phase_diagram_plot(curve, tmp_path):
     assert any("critical alpha1 = 1.73962" in t.get_text() for t in ax.texts)
     fig.savefig(tmp_path / "phase.png")
     assert (tmp_path / "phase.png").stat().st_size > 1000
+
+
+# -- how a curve ends (CurveEnd) ------------------------------------------------------------------------------
+def _path(code, fold_pressures, n=2):
+    """A stand-in trace: points with (u, P, φ, q), folds at the given pressures, a stop with ``code``."""
+    def point(P, q):
+        return Point(np.array([1.0] * n + [P, 0.5, q]), np.zeros(n + 3), 1, 0.0)
+    points = [point(1.0, 0.1 * i) for i in range(5)]
+    folds = [Fold("LP", point(P, 0.45), 2, RootStatus.LOCATED) for P in fold_pressures]
+    return TracePath(points, folds, Stop(code, "test stop"), point(0.5, 0.0))
+
+
+@pytest.mark.parametrize("code, folds, end", [
+    (StopCode.PARTNER, [1.5], CurveEnd.ISOLA_MERGE),
+    (StopCode.PARTNER, [-1.8], CurveEnd.FOLD),  # the two-coil turn: at negative pressure
+    (StopCode.PARTNER, [], CurveEnd.FOLD),  # back at q0 but no located fold
+    (TraceStop.MAX_POINTS, [1.5], CurveEnd.FOLD),  # turned but never came back to the partner
+    (CurveStop.NONPOSITIVE_PRESSURE, [0.2], CurveEnd.FOLD),
+    (CurveStop.NONPOSITIVE_PRESSURE, [], CurveEnd.NONPOSITIVE_PRESSURE),
+    (StopCode.WIRE_GAP, [], CurveEnd.WIRE),
+    (TraceStop.MAX_POINTS, [], CurveEnd.BUDGET),
+    (TraceStop.STEP_MIN, [], CurveEnd.STEP_MIN),
+    (StopCode.ALPHA1_ZERO, [], CurveEnd.ALPHA1_ZERO),
+    (StopCode.REJOINED, [], CurveEnd.OTHER),  # a caller's stop rule
+])
+def test_curve_end_classification(code, folds, end):
+    assert codim2._classify(_path(code, folds), 2) == end
+
+
+TWO_COILS = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
+
+
+@pytest.fixture(scope="module")
+def two_coils():
+    branch = trace_primary(load_scene(TWO_COILS))
+    return branch, _pear_points(branch)[0]
+
+
+def test_two_coil_curve_reaches_zero_pressure_without_a_merge(two_coils):
+    """Issue 11: the two-coil pitchfork continued in M turns back only at P ≈ −1.8 (M ≈ 0.416); the curve now
+    stops where P reaches 0 (M ≈ 0.28) and gives no critical M."""
+    curve = continue_branch_point(*two_coils, "M")
+    assert curve.stop.code == CurveStop.NONPOSITIVE_PRESSURE and curve.end == CurveEnd.NONPOSITIVE_PRESSURE
+    assert curve.critical is None and curve.merge is None and curve.merges == []
+    assert np.all(curve.pressure > 0) and np.all(np.diff(curve.q) > 0)
+    assert 0.25 < curve.q[-1] < 0.3 and len(curve.q) < 100
+    assert "P reached 0 at M = 0.27" in curve.stop.message and "before the curve turned back" in curve.describe()
+
+
+def test_two_coil_curve_in_alpha1_reaches_the_wire(two_coils):
+    """Continued in α1, the two-coil pitchfork moves up in pressure and pole stretch until the membrane comes
+    within continuation.wire_gap (0.1) of a coil: end WIRE, no critical α1."""
+    curve = continue_branch_point(*two_coils, "alpha1")
+    assert curve.stop.code == StopCode.WIRE_GAP and curve.end == CurveEnd.WIRE and curve.critical is None
+    assert curve.merges == [] and np.all(curve.pressure > 0) and curve.q[-1] > 3
+
+
+def test_fold_without_the_partner_is_not_a_merge():
+    """A coil of radius 2.2 in the equatorial plane: the curve turns back in M at P > 0 (M ≈ 0.030) but reaches the
+    wire gap before it comes back to the scene's M: end FOLD, the fold APPROXIMATE, no critical M."""
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[field]\nM = 0.002\n[[field.coils]]\nradius = 2.2\n'
+                        'height = 0.0\ncurrent = 1.0\n[continuation]\nstop_stretch = 2.0\nwire_gap = 0.1\n',
+                        name="coil_2.2")
+    branch = trace_primary(scene, down=False)
+    curve = continue_branch_point(branch, _pear_points(branch)[0], "M")
+    assert curve.stop.code == StopCode.WIRE_GAP and curve.end == CurveEnd.FOLD
+    assert curve.critical is None and curve.merge is None
+    assert len(curve.merges) == 1 and curve.merges[0].status == Status.APPROXIMATE
+    assert "not verified" in curve.merges[0].reason and curve.merges[0].X[curve.n] > 0
+    assert 0.02 < curve.merges[0].X[-1] < 0.04 and curve.q[-1] > curve.q0
+    assert "turns back in M" in curve.describe()

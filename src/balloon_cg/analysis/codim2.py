@@ -27,7 +27,30 @@ converged points (the residual itself is exact).
 The two pitchforks of an isola lie on one such curve; where the curve turns back in q (a sign change of the
 q-component of the tangent, located by the continuation's fold locator: an LP of the curve) they merge: that q is
 the critical value (critical M, critical α1) — obtained directly, without bracketing in q.
+
+How the curve ends (``CurveEnd``, the curve's ``end``). A fold in q is a merge of the isola's two pitchforks only
+if the curve, after it, comes back to q0 at the partner pitchfork with P > 0 all the way. The trace stops when q
+returns past q0 (stop ``PARTNER``), when P ≤ 0 (``CurveStop.NONPOSITIVE_PRESSURE``: the pitchforks leave the
+physical range of an inflated balloon; the message gives q where the curve crosses P = 0), when the membrane
+comes within ``continuation.wire_gap`` of a coil (``WIRE_GAP``), when α1 reaches 0, at ``max_points`` or at the
+minimum step. The end is then, in this order of precedence:
+
+    ISOLA_MERGE            a fold in q at P > 0, then the partner pitchfork (stop PARTNER): the isola is born or
+                           dies there; ``critical`` is that fold (the fold of extreme q if there are several)
+    FOLD                   folds in q, none verified as such a merge (P ≤ 0 at the fold, or the curve did not
+                           come back to the partner; PARTNER without a located fold is also FOLD)
+    NONPOSITIVE_PRESSURE   no fold, and P reached 0
+    WIRE                   no fold, and the membrane reached continuation.wire_gap of a coil
+    BUDGET                 no fold, and max_points were traced
+    STEP_MIN               no fold, and the corrector failed at the minimum step
+    ALPHA1_ZERO            no fold, and α1 reached 0
+    OTHER                  a caller's own stop rule stopped the curve
+
+The merge points (``merges``: every fold in q, LP special points) carry ``Status.LOCATED`` only for the merge of
+an ISOLA_MERGE curve found by a converged root search; every other fold is ``Status.APPROXIMATE`` with the
+reason (not verified as a merge, or the root search fell back) and the half-width of its bracket.
 """
+import enum
 import time
 from dataclasses import dataclass, field, replace
 
@@ -38,13 +61,15 @@ from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model.sphere_modes import bifurcation_condition, bifurcation_stretches
 from ..numerics import continuation
-from ..numerics.continuation import Stop
+from ..numerics.continuation import Stop, TraceStop
 from ..numerics.newton import newton
 from ..scene import Scene
 from .bifurcation import block_indices, padded_mode, plain_degree
 from .problem import equilibrium_of
-from .results import Block, Branch, Kind, SpecialPoint, StopCode, located_or_bracketed
+from .results import (Block, Branch, Kind, SpecialPoint, Status, StopCode, bracket_uncertainty,
+                      located_or_bracketed)
 from .stability import SecondVariation
+from .wires import wire_gap
 
 PARAMETERS = ("M", "alpha1")
 H_STEP = 1e-6
@@ -53,6 +78,30 @@ GENERAL_CLASS = "ogden_general_field"
 
 class TwoParameterError(RuntimeError):
     """The extended system could not be set up or started; the message says why."""
+
+
+class CurveStop(enum.StrEnum):
+    """Stop codes of a two-parameter curve besides ``StopCode`` and the engine's ``TraceStop``."""
+
+    NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # the branch-point pressure P reached 0
+
+
+class CurveEnd(enum.StrEnum):
+    """How a two-parameter curve ended (module docstring): only ISOLA_MERGE gives a critical value."""
+
+    ISOLA_MERGE = "isola_merge"  # a fold in q at P > 0, then back to q0 at the partner pitchfork
+    FOLD = "fold"  # a fold in q not verified as a merge (P <= 0 there, or no return to the partner)
+    NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # P reached 0 (no fold before)
+    WIRE = "wire"  # the membrane reached continuation.wire_gap of a coil (no fold before)
+    BUDGET = "budget"  # max_points traced (no fold before)
+    STEP_MIN = "step_min"  # the corrector failed at the minimum step (no fold before)
+    ALPHA1_ZERO = "alpha1_zero"  # α1 reached 0 (no fold before)
+    OTHER = "other"  # a caller's stop rule
+
+
+_END_OF_STOP = {CurveStop.NONPOSITIVE_PRESSURE: CurveEnd.NONPOSITIVE_PRESSURE, StopCode.WIRE_GAP: CurveEnd.WIRE,
+                TraceStop.MAX_POINTS: CurveEnd.BUDGET, TraceStop.STEP_MIN: CurveEnd.STEP_MIN,
+                StopCode.ALPHA1_ZERO: CurveEnd.ALPHA1_ZERO}
 
 
 class ExtendedSystem:
@@ -166,9 +215,12 @@ class TwoParameterCurve:
     X: np.ndarray
     iterations: np.ndarray
     residual: np.ndarray
-    merges: list = field(default_factory=list)
+    merges: list = field(default_factory=list)  # every fold in q (LP); LOCATED only for a verified merge
     stop: Stop | None = None
     wall_time: float = 0.0
+    end: CurveEnd | None = None  # how the curve ended (module docstring); None: not classified
+    q0: float = np.nan  # the start value of q
+    direction: float = 1.0  # +1: q increased from q0, −1: decreased
 
     @property
     def n(self) -> int:
@@ -214,12 +266,36 @@ class TwoParameterCurve:
         return self.pole_values()["lam2_north"]
 
     @property
-    def critical(self):
-        """(q, P, north pole stretch) of the first merge point, or None."""
-        if not self.merges:
+    def merge(self) -> SpecialPoint | None:
+        """The verified merge of the two pitchforks (ISOLA_MERGE only: the fold of extreme q), or None."""
+        if self.end != CurveEnd.ISOLA_MERGE or not self.merges:
             return None
-        X = self.merges[0].X
+        return max(self.merges, key=lambda s: self.direction * s.X[-1])
+
+    @property
+    def critical(self):
+        """(q, P, north pole stretch) of the verified merge point (``end`` is ISOLA_MERGE), or None: a fold in q
+        that is not such a merge is no critical value."""
+        merge = self.merge
+        if merge is None:
+            return None
+        X = merge.X
         return float(X[-1]), float(self._parts(X)[1][0]), float(self.pole_values(X)["lam2_north"][0])
+
+    def describe(self) -> str:
+        """One line for people: how the curve ended and where (q, P, pole stretch of its last point or fold)."""
+        name = self.parameter
+        q, P, stretch = self.q[-1], self.pressure[-1], self.pole_stretch[-1]
+        at = f"last point {name} = {q:.6g}, P = {P:.6g}, pole stretch {stretch:.6g}"
+        if self.end == CurveEnd.ISOLA_MERGE:
+            qc, Pc, sc = self.critical
+            return (f"the pitchforks merge at {name} = {qc:.12g} (P = {Pc:.10g}, pole stretch {sc:.10g}) and the "
+                    f"curve returns to {name} = {self.q0:g} at the partner pitchfork")
+        if self.end == CurveEnd.FOLD:
+            folds = ", ".join(f"{name} = {s.X[-1]:.6g} at P = {s.X[self.n]:.4g}" for s in self.merges) or "not located"
+            return (f"the curve turns back in {name} ({folds}) but is not verified as a merge of the isola's two "
+                    f"pitchforks: it ended by {self.stop_reason} ({at})")
+        return f"{self.stop_reason or 'the curve stopped'} before the curve turned back in {name} ({at})"
 
 
 def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, direction: float = 1.0,
@@ -228,9 +304,11 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
     """Trace the curve of pear branch points through ``bp`` (located on the symmetric ``branch``) in q.
 
     ``direction``: +1 starts with q increasing, −1 decreasing. ``q0``: the branch's value of q (default: its M,
-    or its material's α1). The trace stops when ``stop(point)`` (a continuation.Point) returns a Stop, by
-    default when q returns past q0 after a merge (the curve has reached the partner pitchfork) or at ``max_points``.
-    Returns a TwoParameterCurve whose ``merges`` are the located folds in q (the critical values).
+    or its material's α1). The trace stops when P ≤ 0, when the membrane comes within continuation.wire_gap of a
+    coil, when α1 reaches 0, or when ``stop(point)`` (a continuation.Point) returns a Stop, by default when q
+    returns past q0 after a fold (the curve has reached the partner pitchfork); or at ``max_points``.
+    Returns a TwoParameterCurve whose ``end`` says how it ended (``CurveEnd``) and whose ``merges`` are the folds
+    in q; only an ISOLA_MERGE curve has a ``critical`` value (its merge, Status.LOCATED).
     """
     t0 = time.perf_counter()
     scene = branch.scene
@@ -275,27 +353,70 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
 
     rule = stop or default_stop
 
+    n, coils, gap_limit = branch.disc.size, scene.field.coils, scene.continuation.wire_gap
+
     def stop_point(point):
         if point.X[-1] <= 0 and parameter == "alpha1":
             return Stop(StopCode.ALPHA1_ZERO, "alpha1 reached 0")
+        if point.X[n] <= 0:
+            return Stop(CurveStop.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 (P = {point.X[n]:.4g} "
+                                                        f"at {parameter} = {point.X[-1]:.6g})")
+        gap, coil = wire_gap(branch.disc, point.X[:n], coils)
+        if gap < gap_limit:
+            return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap_limit:g} of coil {coil} (gap {gap:.3g})")
         return rule(point)
 
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
-    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc),
-                           note=f"fold of the curve in {parameter}: the two pitchforks merge") for fold in path.folds]
+    if path.stop.code == CurveStop.NONPOSITIVE_PRESSURE:
+        path.stop = _pressure_zero_stop(system, path, parameter, settings)
+    end = _classify(path, n)
+    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
+                           note=f"fold of the curve in {parameter}"
+                                + (": the two pitchforks merge" if end == CurveEnd.ISOLA_MERGE else
+                                   " (not verified as a merge of the pitchforks)")) for fold in path.folds]
     points = path.points
     return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
-                             merges, path.stop, time.perf_counter() - t0)
+                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction))
 
 
-def _merge_status(fold, path, disc) -> dict:
-    """Status fields of a merge (a fold of the curve in q), bracketed by the curve points around it."""
+def _classify(path, n: int) -> CurveEnd:
+    """How a traced curve ended (module docstring)."""
+    code = path.stop.code
+    if path.folds:
+        if code == StopCode.PARTNER and all(fold.point.X[n] > 0 for fold in path.folds):
+            return CurveEnd.ISOLA_MERGE
+        return CurveEnd.FOLD
+    if code == StopCode.PARTNER:
+        return CurveEnd.FOLD  # q came back without a located fold: no critical value to report
+    return _END_OF_STOP.get(code, CurveEnd.OTHER)
+
+
+def _pressure_zero_stop(system, path, parameter: str, settings) -> Stop:
+    """The P ≤ 0 stop, its message naming q where the curve crosses P = 0 (Newton from the overshoot point with
+    the row e_P; the crossing is only reported, not added to the curve)."""
+    X = path.overshoot.X
+    row = np.zeros(X.size)
+    row[system.n] = 1.0
+    result = newton(system.residual, system.jacobian, X, row, 0.0, settings.tol, settings.max_newton)
+    if not result.converged:
+        return path.stop
+    return Stop(CurveStop.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 at {parameter} = "
+                                                f"{result.x[-1]:.10g}")
+
+
+def _merge_status(fold, path, disc, end: CurveEnd) -> dict:
+    """Status fields of a fold of the curve in q, bracketed by the curve points around it: LOCATED only for a
+    verified merge (ISOLA_MERGE) whose root search converged."""
     after = path.points[fold.index + 1].X if fold.index + 1 < len(path.points) else path.overshoot.X
     before = path.points[fold.index].X
     n = disc.size
-    return located_or_bracketed(fold.status, disc, np.append(before[:n], before[n]), np.append(after[:n], after[n]),
-                                "merge of the pitchforks")
+    before, after = np.append(before[:n], before[n]), np.append(after[:n], after[n])
+    if end == CurveEnd.ISOLA_MERGE:
+        return located_or_bracketed(fold.status, disc, before, after, "merge of the pitchforks")
+    return {"status": Status.APPROXIMATE, "uncertainty": bracket_uncertainty(disc, before, after),
+            "reason": f"fold in q not verified as a merge of the pitchforks (curve end: {end.value}: "
+                      f"{path.stop.message})"}
 
 
 def land_on_q(curve: TwoParameterCurve, q: float, near: int):

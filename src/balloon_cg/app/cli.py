@@ -228,39 +228,94 @@ def plot(args) -> int:
 # --- critical ----------------------------------------------------------------------------------------------
 
 def _add_critical(commands):
-    p = commands.add_parser("critical", help="continue the first pear pitchfork in M or alpha1 (two-parameter "
-                                             "continuation) and report where the isola closes")
-    p.add_argument("scene", help="scene TOML file")
+    p = commands.add_parser(
+        "critical", help="continue the first pear pitchfork in M or alpha1 (two-parameter continuation) and report "
+                         "the critical value where the isola's two pitchforks merge",
+        description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in M or alpha1. "
+                    "Exit 0: the two pitchforks merge at P > 0 and the curve returns to the partner pitchfork "
+                    "(critical value printed). Exit 1: the computation gave no critical value (no pear pitchfork, "
+                    "or the curve ended otherwise: one line says how and where; the curve file is still written). "
+                    "Exit 2: a scene this command cannot handle (not equator-symmetric; --parameter M without "
+                    "coils) or bad input.")
+    p.add_argument("scene", help="scene TOML file (equator-symmetric: coils mirror-symmetric about z = 0)")
     p.add_argument("--parameter", required=True, choices=("M", "alpha1"), help="the second parameter")
     p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(handler=critical)
 
 
 def critical(args) -> int:
-    """Primary branch, its first pear pitchfork, the curve of pitchforks in the parameter, the merge point."""
+    """Primary branch, its first pear pitchfork, the curve of pitchforks in the parameter, the merge point.
+
+    Exit codes: 0 a verified merge (``CurveEnd.ISOLA_MERGE``: a fold in q at P > 0 after which the curve returns
+    to q0 at the partner pitchfork), ``critical q = ...`` on stdout. 1 (``Failure``) the computation ran but gave
+    no critical value: no pear pitchfork on the primary branch, the extended system did not start, or the curve
+    ended otherwise (P reached 0, a fold not verified as a merge, a coil wire, the point budget, the minimum
+    step): one line on stderr says how and where, and the curve file is still written. 2 (``UsageError``) a
+    scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
+    the equator-symmetric layout), or ``--parameter M`` without coils. Progress goes to stderr (``--quiet``: none).
+    """
     from ..analysis.bifurcation import detect, locate
     from ..analysis.stability import assess_branch
-    from ..analysis.codim2 import continue_branch_point
-    from ..analysis.results import Block
+    from ..analysis.codim2 import CurveEnd, TwoParameterError, continue_branch_point
+    from ..analysis.results import Block, Status
     from ..io.curve_file import write_curve
 
     scene = load_scene(args.scene)
+    asymmetry = _asymmetry(scene)
+    if asymmetry:
+        raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
+    if args.parameter == "M" and not scene.field.coils:
+        raise UsageError(f"critical --parameter M needs coils: {args.scene} has no [[field.coils]], so the "
+                         "equilibrium does not depend on M")
     check_output(args.output, args.force)
-    branch = trace_primary(scene)
+
+    def say(text):
+        if not args.quiet:
+            print(f"{PROG} critical: {text}", file=sys.stderr)
+
+    with tqdm(desc="primary branch", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
+        branch = trace_primary(scene, progress=lambda point: bar.update())
+    say(f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
     assessments, _ = assess_branch(branch, scene.stability.degree)
     pear = [event for event in detect(branch, assessments) if event[1] == Block.ODD_HELD]
     if not pear:
-        raise Failure(f"no pear-shaped branch point on the primary branch ({branch.stop_reason})")
-    curve = continue_branch_point(branch, locate(branch, *pear[0]), args.parameter)
+        raise Failure(f"no pear-shaped pitchfork on the primary branch of {args.scene} ({branch.stop_reason}): "
+                      f"nothing to continue in {args.parameter}")
+    say(f"locating the first pear pitchfork (of {len(pear)})")
+    bp = locate(branch, *pear[0])
+    say(f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
+    try:
+        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
+            curve = continue_branch_point(branch, bp, args.parameter, progress=lambda point: bar.update())
+    except TwoParameterError as e:
+        raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
     write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
-    if curve.critical is None:
-        print(f"no merge of the pitchforks found ({curve.stop_reason}); curve written to {args.output}")
-        return 0
+    say(f"curve: {len(curve.q)} points, ended: {curve.end.value}")
+    if curve.end != CurveEnd.ISOLA_MERGE:
+        raise Failure(f"no critical {args.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
+                      f"written to {args.output}")
     q, P, stretch = curve.critical
-    print(f"critical {args.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
+    merge = curve.merge
+    note = "" if merge.status == Status.LOCATED else f" (approximate, ±{merge.uncertainty:.1g}: {merge.reason})"
+    print(f"critical {args.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}){note}; "
           f"curve written to {args.output}")
     return 0
+
+
+def _asymmetry(scene) -> str:
+    """Why the primary branch of ``scene`` is not traced in the equator-symmetric layout ('' if it is)."""
+    if scene.continuation.symmetry == "none":
+        return 'continuation.symmetry = "none"'
+    if scene.field.is_equator_symmetric:
+        return ""
+    coils = scene.field.coils
+    for i, c in enumerate(coils):
+        if not any(d.radius == c.radius and d.height == -c.height and abs(d.current) == abs(c.current) for d in coils):
+            return (f"coil {i} (radius {c.radius:g}, height {c.height:g}) has no mirror image about z = 0 "
+                    "(radius, height −h, current ±)")
+    return "the coil pairs mix equal and opposite currents (all pairs must be one or the other)"
 
 
 # --- sweep -------------------------------------------------------------------------------------------------

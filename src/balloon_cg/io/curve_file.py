@@ -4,12 +4,15 @@ Layout::
 
     /                            attrs: as a run file (format, scene, provenance) + extra_attrs
     /branches/                   (empty: the file is also a readable run file)
-    /two_parameter/<name>/       attrs: parameter, stop_reason, stop_code, wall_time, degree, kernel_class, M,
-                                        chi, critical_q (NaN if no merge was found)
+    /two_parameter/<name>/       attrs: parameter, stop_reason, stop_code, end, end_description, q0, wall_time,
+                                        degree, kernel_class, M, chi, critical_q (NaN unless end = isola_merge)
         q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block
-        special_points/ the run file's special-point columns (kind LP: the fold in q where the two pitchforks
-                        merge), unknowns in the branch layout (u, P), and q
+        special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
+                        the verified merge of the two pitchforks), unknowns in the branch layout (u, P), and q
+
+``end`` is the curve's ``analysis.codim2.CurveEnd`` (how it ended: isola_merge, fold, nonpositive_pressure, wire,
+budget, step_min, alpha1_zero, other); ``end_description`` says the same for people, with where.
 """
 from dataclasses import replace
 
@@ -32,6 +35,9 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
             "parameter": curve.parameter,
             "stop_reason": curve.stop_reason,
             "stop_code": curve.stop.code.value if curve.stop else "",
+            "end": curve.end.value if curve.end else "",
+            "end_description": curve.describe() if curve.end else "",
+            "q0": curve.q0,
             "wall_time": curve.wall_time,
             "degree": curve.disc.degree,
             "kernel_class": curve.system().eq.kernels.name,
