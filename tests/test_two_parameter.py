@@ -15,7 +15,7 @@ from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.analysis.stability import SecondVariation, assess_branch
 from balloon_cg.io.run_file import read_run
-from balloon_cg.analysis.codim2 import (CurveEnd, CurveStop, ExtendedSystem, TwoParameterError, alpha1_material,
+from balloon_cg.analysis.codim2 import (CurveEnd, ExtendedSystem, TwoParameterError, alpha1_material,
                                        continue_branch_point, land_on_q, sphere_critical_alpha1,
                                        sphere_pear_stretches)
 from balloon_cg.analysis import codim2
@@ -202,8 +202,8 @@ def _path(code, fold_pressures, n=2):
     (StopCode.PARTNER, [-1.8], CurveEnd.FOLD),  # the two-coil turn: at negative pressure
     (StopCode.PARTNER, [], CurveEnd.FOLD),  # back at q0 but no located fold
     (TraceStop.MAX_POINTS, [1.5], CurveEnd.FOLD),  # turned but never came back to the partner
-    (CurveStop.NONPOSITIVE_PRESSURE, [0.2], CurveEnd.FOLD),
-    (CurveStop.NONPOSITIVE_PRESSURE, [], CurveEnd.NONPOSITIVE_PRESSURE),
+    (StopCode.NONPOSITIVE_PRESSURE, [0.2], CurveEnd.FOLD),
+    (StopCode.NONPOSITIVE_PRESSURE, [], CurveEnd.NONPOSITIVE_PRESSURE),
     (StopCode.WIRE_GAP, [], CurveEnd.WIRE),
     (TraceStop.MAX_POINTS, [], CurveEnd.BUDGET),
     (TraceStop.STEP_MIN, [], CurveEnd.STEP_MIN),
@@ -227,7 +227,7 @@ def test_two_coil_curve_reaches_zero_pressure_without_a_merge(two_coils):
     """Issue 11: the two-coil pitchfork continued in M turns back only at P ≈ −1.8 (M ≈ 0.416); the curve now
     stops where P reaches 0 (M ≈ 0.28) and gives no critical M."""
     curve = continue_branch_point(*two_coils, "M")
-    assert curve.stop.code == CurveStop.NONPOSITIVE_PRESSURE and curve.end == CurveEnd.NONPOSITIVE_PRESSURE
+    assert curve.stop.code == StopCode.NONPOSITIVE_PRESSURE and curve.end == CurveEnd.NONPOSITIVE_PRESSURE
     assert curve.critical is None and curve.merge is None and curve.merges == []
     assert np.all(curve.pressure > 0) and np.all(np.diff(curve.q) > 0)
     assert 0.25 < curve.q[-1] < 0.3 and len(curve.q) < 100

@@ -30,7 +30,7 @@ the critical value (critical M, critical α1) — obtained directly, without bra
 
 How the curve ends (``CurveEnd``, the curve's ``end``). A fold in q is a merge of the isola's two pitchforks only
 if the curve, after it, comes back to q0 at the partner pitchfork with P > 0 all the way. The trace stops when q
-returns past q0 (stop ``PARTNER``), when P ≤ 0 (``CurveStop.NONPOSITIVE_PRESSURE``: the pitchforks leave the
+returns past q0 (stop ``PARTNER``), when P ≤ 0 (``StopCode.NONPOSITIVE_PRESSURE``: the pitchforks leave the
 physical range of an inflated balloon; the message gives q where the curve crosses P = 0), when the membrane
 comes within ``continuation.wire_gap`` of a coil (``WIRE_GAP``), when α1 reaches 0, at ``max_points`` or at the
 minimum step. The end is then, in this order of precedence:
@@ -80,12 +80,6 @@ class TwoParameterError(RuntimeError):
     """The extended system could not be set up or started; the message says why."""
 
 
-class CurveStop(enum.StrEnum):
-    """Stop codes of a two-parameter curve besides ``StopCode`` and the engine's ``TraceStop``."""
-
-    NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # the branch-point pressure P reached 0
-
-
 class CurveEnd(enum.StrEnum):
     """How a two-parameter curve ended (module docstring): only ISOLA_MERGE gives a critical value."""
 
@@ -99,7 +93,7 @@ class CurveEnd(enum.StrEnum):
     OTHER = "other"  # a caller's stop rule
 
 
-_END_OF_STOP = {CurveStop.NONPOSITIVE_PRESSURE: CurveEnd.NONPOSITIVE_PRESSURE, StopCode.WIRE_GAP: CurveEnd.WIRE,
+_END_OF_STOP = {StopCode.NONPOSITIVE_PRESSURE: CurveEnd.NONPOSITIVE_PRESSURE, StopCode.WIRE_GAP: CurveEnd.WIRE,
                 TraceStop.MAX_POINTS: CurveEnd.BUDGET, TraceStop.STEP_MIN: CurveEnd.STEP_MIN,
                 StopCode.ALPHA1_ZERO: CurveEnd.ALPHA1_ZERO}
 
@@ -359,7 +353,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
         if point.X[-1] <= 0 and parameter == "alpha1":
             return Stop(StopCode.ALPHA1_ZERO, "alpha1 reached 0")
         if point.X[n] <= 0:
-            return Stop(CurveStop.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 (P = {point.X[n]:.4g} "
+            return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 (P = {point.X[n]:.4g} "
                                                         f"at {parameter} = {point.X[-1]:.6g})")
         gap, coil = wire_gap(branch.disc, point.X[:n], coils)
         if gap < gap_limit:
@@ -367,7 +361,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
         return rule(point)
 
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
-    if path.stop.code == CurveStop.NONPOSITIVE_PRESSURE:
+    if path.stop.code == StopCode.NONPOSITIVE_PRESSURE:
         path.stop = _pressure_zero_stop(system, path, parameter, settings)
     end = _classify(path, n)
     merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
@@ -401,7 +395,7 @@ def _pressure_zero_stop(system, path, parameter: str, settings) -> Stop:
     result = newton(system.residual, system.jacobian, X, row, 0.0, settings.tol, settings.max_newton)
     if not result.converged:
         return path.stop
-    return Stop(CurveStop.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 at {parameter} = "
+    return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 at {parameter} = "
                                                 f"{result.x[-1]:.10g}")
 
 

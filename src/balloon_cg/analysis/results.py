@@ -63,6 +63,7 @@ class StopCode(enum.StrEnum):
     REFINE_FAILED = "refine_failed"  # Newton failed on the refined basis
     LANDING_FAILED = "landing_failed"  # Newton failed landing exactly on stop/min_stretch
     PARTNER = "partner"  # a two-parameter curve returned past its start value (reached the partner point)
+    NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # a two-parameter curve's branch-point pressure reached 0
     ALPHA1_ZERO = "alpha1_zero"  # the α1 continuation reached α1 = 0
 
 

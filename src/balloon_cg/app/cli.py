@@ -1,10 +1,11 @@
-"""Command line: ``balloon-cg run | solve | inspect | plot | sweep`` (``balloon-cg SUBCOMMAND -h`` for help).
+"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical`` (``balloon-cg SUBCOMMAND -h``).
 
 Exit codes: 0 success: the result is complete (analysis.verdict: every branch reached its requested end, every
 special point is located, stability settled); 1 the computation did not give what was asked (a branch could
 not start, or the result is incomplete: the file is still written, flagged, and the incomplete parts are named
-on stderr; ``--allow-partial`` makes an incomplete result exit 0); 2 bad input (invalid scene, missing or
-unreadable file, existing output without --force). Errors are one line on stderr, ``balloon-cg: error: ...``.
+on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: the two-parameter curve did not
+end in a verified merge of the pitchforks); 2 bad input (invalid scene, missing or unreadable file, existing
+output without --force, a scene ``critical`` cannot handle). Errors are one line on stderr, ``balloon-cg: error: ...``.
 """
 import argparse
 import json
