@@ -119,3 +119,21 @@ def test_edge_scene_is_complete_or_flagged(name, tmp_path, capsys):
         if code == 0:
             assert all(s["status"] == "located" for s in branch["special_points"])
     assert stored["attrs"]["complete"] is (code == 0)
+
+
+def test_near_undeformed_leg_with_a_field_reaches_min_stretch():
+    """The shipped M = 0.003 two-coil scene: its lower leg ends on min_stretch like M = 0.002. It used to stop on
+    resolution at degree 320: the point past min_stretch = 1.001 lies in compression (λ < 1), which no degree
+    resolves, and the resolution check came before the range check."""
+    from pathlib import Path
+
+    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.results import StopCode
+    from balloon_cg.scene import load_scene
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "spom1_two_coils_M0.003.toml")
+    branch = trace_primary(scene)
+    assert [leg.stop.code for leg in branch.legs] == [StopCode.WIRE_GAP, StopCode.MIN_STRETCH]
+    assert branch.pole_values()["lam2_north"][0] == pytest.approx(scene.continuation.min_stretch, abs=1e-12)
+    assert branch.degree.max() < scene.solver.max_degree and branch.disc.mapping is not None
+    assert branch.error_estimate.max() <= scene.solver.max_error

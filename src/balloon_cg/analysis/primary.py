@@ -102,12 +102,12 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
     return continuation.Point(start.X, tangent, start.iterations, start.residual)
 
 
-def stop_rule(scene, upper: float):
-    """stop(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper], P reaches
-    stop_pressure, or the membrane comes within wire_gap of a coil."""
+def range_limits(scene, upper: float):
+    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper] or P reaches
+    stop_pressure (the range the scene asks for)."""
     cont = scene.continuation
 
-    def stop(disc, point):
+    def limits(disc, point):
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
         if stretch >= upper:
             return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
@@ -115,6 +115,20 @@ def stop_rule(scene, upper: float):
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure:
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
+        return None
+
+    return limits
+
+
+def stop_rule(scene, upper: float):
+    """stop(disc, point) -> Stop or None: ``range_limits``, or the membrane comes within wire_gap of a coil."""
+    cont = scene.continuation
+    limits = range_limits(scene, upper)
+
+    def stop(disc, point):
+        beyond = limits(disc, point)
+        if beyond is not None:
+            return beyond
         gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils)
         if gap < cont.wire_gap:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {cont.wire_gap:g} of coil {coil} (gap {gap:.3g})")
@@ -130,10 +144,11 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
     tracer = Tracer(scene, symmetric)
     first, params, degree = start(tracer)
     upper = scene.continuation.stop_stretch if stop_stretch is None else stop_stretch
-    stop = stop_rule(scene, upper)
-    up = tracer.leg(initial_point(tracer, first, 1.0, params, degree), params, stop, progress, degree=degree)
-    below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree)
-             if down else None)
+    stop, limits = stop_rule(scene, upper), range_limits(scene, upper)
+    up = tracer.leg(initial_point(tracer, first, 1.0, params, degree), params, stop, progress, degree=degree,
+                    limits=limits)
+    below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree,
+                        limits=limits) if down else None)
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", upper),
                StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)}
     return assemble(tracer, params, "primary", up, below, t0, land_on=land_on, labels=("up", "down"))

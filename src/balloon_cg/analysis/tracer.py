@@ -70,9 +70,12 @@ class Tracer:
         return ParameterSystem(self._systems[degree, mapping], params, "P")
 
     def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None,
-            mapping=None) -> LegTrace:
+            mapping=None, limits=None) -> LegTrace:
         """Trace from ``start`` (at ``degree``, default the scene's, and ``mapping``) along its tangent, refining
-        as needed (module docstring). ``stop(disc, point)`` returns a Stop or None."""
+        as needed (module docstring). ``stop(disc, point)`` returns a Stop or None; ``limits(disc, point)`` (the
+        requested range of the branch) is asked first, before the resolution check: a point past the range ends
+        the leg (it is landed on exactly afterwards), however unresolved it is (past min_stretch = 1.001 a
+        predictor lands in compression, λ < 1, which no degree resolves)."""
         policy = self.resolution
         degree = degree or self.scene.solver.degree
         system = self.system(degree, params, mapping)
@@ -83,6 +86,9 @@ class Tracer:
             monitors = {Kind.LP: unit(start.X.size, -1), Kind.TP: north}
 
             def checked_stop(point, disc=disc):
+                beyond = limits(disc, point) if limits is not None else None
+                if beyond is not None:
+                    return beyond
                 if not policy.resolved(disc, point.X[:-1]):
                     return Stop(StopCode.RESOLUTION, "spectral error estimate above solver.max_error")
                 return stop(disc, point)
