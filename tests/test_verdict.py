@@ -42,13 +42,13 @@ def test_point_budget_is_a_flagged_partial_result(tmp_path, capsys):
     assert code == 0
 
 
-def test_unresolved_start_is_never_stored(tmp_path, capsys):
-    """One coil of radius 4 at M = 1: the start stretch 1.05 cannot carry the field (the membrane is compressed);
-    no file, exit 1, one line saying so."""
+def test_failed_start_is_never_stored(tmp_path, capsys):
+    """One coil of radius 4 at M = 1: the start stretch 1.01 cannot carry the field (the membrane wrinkles); no
+    file, exit 1, one line saying so."""
     code, out = run(tmp_path, SPOM1 + ONE_COIL.format(M=1.0, a=4.0, h=0.0))
     err = capsys.readouterr().err
     assert code == 1 and not out.exists()
-    assert err.count("\n") == 1 and "start" in err and "compressed" in err
+    assert err.count("\n") == 1 and "start" in err
 
 
 def test_stored_points_are_resolved(tmp_path):
@@ -137,3 +137,22 @@ def test_near_undeformed_leg_with_a_field_reaches_min_stretch():
     assert branch.pole_values()["lam2_north"][0] == pytest.approx(scene.continuation.min_stretch, abs=1e-12)
     assert branch.degree.max() < scene.solver.max_degree and branch.disc.mapping is not None
     assert branch.error_estimate.max() <= scene.solver.max_error
+
+
+def test_wrinkling_while_the_field_is_switched_on_is_located(tmp_path, capsys):
+    """Single coil of radius 4 at h = 0, start stretch 1.01: the start wrinkles (an elastic principal stress reaches
+    0) at M ≈ 0.6047 while the field is switched on; M = 1 stops there with that M named, and M = 0.6 (just below)
+    starts taut."""
+    from balloon_cg.analysis.primary import start
+    from balloon_cg.analysis.tracer import ContinuationError, Tracer
+
+    code, out = run(tmp_path, SPOM1 + ONE_COIL.format(M=1.0, a=4.0, h=0.0))
+    err = capsys.readouterr().err
+    assert code == 1 and not out.exists() and "wrinkles" in err
+    limit = float(err.split(" at M = ")[1].split()[0])
+    assert 0.59 < limit < 0.62
+    below = parse_scene(SPOM1 + ONE_COIL.format(M=round(limit * 0.999, 6), a=4.0, h=0.0))
+    start(Tracer(below))  # taut: no error
+    above = parse_scene(SPOM1 + ONE_COIL.format(M=round(limit * 1.001, 6), a=4.0, h=0.0))
+    with pytest.raises(ContinuationError, match="wrinkles"):
+        start(Tracer(above))

@@ -16,7 +16,9 @@ import time
 import numpy as np
 
 from ..galerkin.equilibrium import Parameters
+from ..galerkin.profiles import meridional_stretch
 from ..model.sphere import sphere_pressure
+from ..model.stresses import smallest_stress
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
@@ -41,25 +43,55 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     u = disc.join(a, b)
     params = Parameters(sphere_pressure(scene.material, lam), 0.0, scene.field.chi)
     target, M, dM = scene.field.M, 0.0, scene.field.M
+    system = ParameterSystem(eq, params, "M")
     while M < target:
         trial = min(M + dM, target)
-        system = ParameterSystem(eq, params, "M")
         result = newton(system.residual, system.jacobian, np.append(u, trial), unit(u.size + 1, -1), trial,
                         scene.solver.tol, scene.solver.max_newton)
-        if result.converged:
+        if result.converged and _taut(disc, result.x[:-1], scene.material):
             u, M = result.x[:-1], trial
             dM *= 2
+        elif result.converged:
+            raise ContinuationError(_wrinkling_limit(system, u, M, trial, scene))
         else:
             dM *= 0.5
             if dM < 1e-6 * target:
                 raise ContinuationError(
-                    f"could not switch the field on at start stretch {lam}: Newton failed at M = {trial:.6g} "
-                    f"({result.message}); try a smaller continuation.start_stretch or a smaller field.M"
+                    f"could not switch the field on at continuation.start_stretch = {lam:g} beyond M = {M:.6g} "
+                    f"(Newton failed at M = {trial:.6g}: {result.message}; at fixed pressure the equilibrium may "
+                    "turn back in M there); try another continuation.start_stretch or a smaller field.M"
                 )
     params = params.with_value("M", target)
     X, degree = _resolved_start(tracer, np.append(u, params.P), degree, params)
     residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
     return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
+
+
+def _taut(disc, u, material, n_theta: int = 361) -> bool:
+    """Both elastic principal stresses positive everywhere (MODEL.md §6: tension-field theory)."""
+    theta = np.linspace(0.0, np.pi, n_theta)
+    lam2, dlam2, _, deta = disc.evaluate(u, theta)
+    return smallest_stress(material, meridional_stretch(theta, lam2, dlam2, deta), lam2) > 0.0
+
+
+def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: float, scene, rtol: float = 1e-8) -> str:
+    """The message for a start that wrinkles while the field is switched on: the field intensity where the
+    smallest elastic principal stress reaches zero, located by bisection between a taut and a wrinkled M."""
+    disc, solver = system.eq.disc, scene.solver
+    while wrinkled_M - taut_M > rtol * wrinkled_M:
+        middle = 0.5 * (taut_M + wrinkled_M)
+        result = newton(system.residual, system.jacobian, np.append(u, middle), unit(u.size + 1, -1), middle,
+                        solver.tol, solver.max_newton)
+        if not result.converged:
+            break
+        if _taut(disc, result.x[:-1], scene.material):
+            u, taut_M = result.x[:-1], middle
+        else:
+            wrinkled_M = middle
+    return (f"cannot start at field.M = {scene.field.M:g}: switched on at continuation.start_stretch = "
+            f"{scene.continuation.start_stretch:g}, the membrane wrinkles (its smallest elastic principal stress "
+            f"reaches 0) at M = {taut_M:.8g} (tension-field theory is not modelled); start at a larger "
+            "continuation.start_stretch, where the inflation keeps it taut")
 
 
 def _resolved_start(tracer: Tracer, X, degree: int, params: Parameters) -> tuple[np.ndarray, int]:

@@ -25,6 +25,7 @@ from numpy.polynomial import legendre
 from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import Discretisation
 from ..model.field import coil_table, field_components, field_squared_nodes
+from ..model.stresses import elastic_stresses
 from ..galerkin.profiles import meridional_stretch
 from ..scene import parse_scene
 
@@ -80,18 +81,6 @@ def surface(disc: Discretisation, X, theta) -> dict:
         "k_meridian": k_meridian, "k_parallel": k_parallel,
         "gaussian_curvature": k_meridian * k_parallel,
     }
-
-
-def elastic_stresses(material, lam1, lam2):
-    """Elastic Cauchy membrane stresses (σ_θ, σ_φ) = (λ1 ∂Φ/∂λ1, λ2 ∂Φ/∂λ2), λ3 = 1/(λ1λ2) eliminated:
-
-    σ_θ = Σ μ_i (λ1^α_i − (λ1λ2)^(−α_i)),   σ_φ = Σ μ_i (λ2^α_i − (λ1λ2)^(−α_i))   (units of μ/2).
-    """
-    lam3 = 1.0 / (lam1 * lam2)
-    terms = list(zip(material.mu, material.alpha))
-    sigma_theta = sum(mu * (lam1**alpha - lam3**alpha) for mu, alpha in terms)
-    sigma_phi = sum(mu * (lam2**alpha - lam3**alpha) for mu, alpha in terms)
-    return sigma_theta, sigma_phi
 
 
 def surface_field(coils, geometry: dict) -> dict:

@@ -1,0 +1,20 @@
+"""Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6) and the tension-field test on them."""
+import numpy as np
+
+
+def elastic_stresses(material, lam1, lam2):
+    """Elastic Cauchy membrane stresses (σ_θ, σ_φ) = (λ1 ∂Φ/∂λ1, λ2 ∂Φ/∂λ2), λ3 = 1/(λ1λ2) eliminated:
+
+    σ_θ = Σ μ_i (λ1^α_i − (λ1λ2)^(−α_i)),   σ_φ = Σ μ_i (λ2^α_i − (λ1λ2)^(−α_i))   (units of μ/2).
+    """
+    lam3 = 1.0 / (lam1 * lam2)
+    terms = list(zip(material.mu, material.alpha))
+    sigma_theta = sum(mu * (lam1**alpha - lam3**alpha) for mu, alpha in terms)
+    sigma_phi = sum(mu * (lam2**alpha - lam3**alpha) for mu, alpha in terms)
+    return sigma_theta, sigma_phi
+
+
+def smallest_stress(material, lam1, lam2) -> float:
+    """The smallest elastic principal stress over the given stretches: ≤ 0 where the membrane wrinkles."""
+    sigma_theta, sigma_phi = elastic_stresses(material, np.asarray(lam1), np.asarray(lam2))
+    return float(min(np.min(sigma_theta), np.min(sigma_phi)))
