@@ -10,4 +10,5 @@
 - ``bifurcation``: detection, location and classification of branch points
 - ``codim2``: two-parameter continuation of pear pitchforks (critical M, critical α1)
 - ``picture``: all of it for one scene (``analyse``)
+- ``verdict``: is a result complete, and if not, what it lacks (the contract of docs/numerics.md §4a)
 """
