@@ -14,10 +14,11 @@ Location: Brent's method (``continuation.locate_root``) on μ_k(s), the eigenval
 (the corrector on the chord hyperplane, as ``bifurcation.locate`` for m = 0), with the branch's own
 discretisation and the perturbation degree of its assessments; LOCATED when Brent converged (|Δs| ≤ 1e-13),
 else APPROXIMATE with the bracket (``results.located_or_bracketed``).
-A crossing in the interval of an m = 0 branch point of the branch at which μ_k vanishes too
-(|μ_k| ≤ ``DEGENERATE``) is that point, not another one: on a spherical state (no field) a mode of spherical
-degree n has copies for every m ≤ n, the m = 0 mode seen about a tilted axis, and the m = 0 point stands
-for all of them. Every other crossing is a BP special point with its ``m`` and ``block``.
+Without a field (M = 0 or no coils) the energy is invariant under every rotation and the primary branch is a
+sphere, on which a mode of spherical degree n has copies for every m ≤ n: the m = 0 mode about a tilted axis
+(the tilted pear, n = 1; the tilted n = 2 mode). So without a field a crossing in the interval of an m = 0
+branch point of the branch is that point, and the m = 0 point stands for it (``is_copy``); every other crossing
+is a BP special point with its ``m`` and ``block``.
 Not classified (``Classification.NONE``): the reduced energy along a non-axisymmetric mode needs the
 three-dimensional problem; the critical mode is not stored (``SpecialPoint.mode`` is an axisymmetric layout).
 """
@@ -28,8 +29,6 @@ from ..numerics.newton import newton
 from .azimuthal import spectrum
 from .problem import equilibrium_of, pressure_system
 from .results import Block, Branch, Kind, SpecialPoint, located_or_bracketed
-
-DEGENERATE = 1e-8  # |μ_k| at an m = 0 branch point below which the m ≥ 1 crossing is that point
 
 
 def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]]:
@@ -80,17 +79,16 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
                         note=f"non-axisymmetric m = {m} mode, balloon {reading}", **fields)
 
 
-def is_degenerate(branch: Branch, index: int, m: int, held: bool, k: int, degree: int) -> bool:
-    """Whether μ_k vanishes (≤ DEGENERATE) at an m = 0 branch point between points index and index + 1."""
-    eq = equilibrium_of(branch)
-    return any(abs(eigenvalue(eq, branch.params, bp.X, m, held, k, degree)) <= DEGENERATE
-               for bp in branch.branch_points() if bp.m == 0 and bp.index == index)
+def is_copy(branch: Branch, index: int) -> bool:
+    """Whether an m ≥ 1 crossing between points index and index + 1 is a copy of an m = 0 branch point there:
+    no field, and an m = 0 branch point in that interval (module docstring)."""
+    field_free = branch.params.M == 0 or not branch.scene.field.coils
+    return field_free and any(bp.m == 0 and bp.index == index for bp in branch.branch_points())
 
 
 def find(branch: Branch, degree: int, m_max: int) -> list[SpecialPoint]:
     """The m ≥ 1 branch points, m ≤ m_max, of a branch assessed at perturbation degree ``degree``
-    (``branch.stability``), in order along it; crossings that are an m = 0 branch point of the branch are left
-    to it (module docstring)."""
+    (``branch.stability``), in order along it; without a field, the copies of its m = 0 branch points are left
+    to them (module docstring)."""
     return [locate(branch, index, m, held, block, k, degree)
-            for index, m, held, block, k in crossings(branch.stability, m_max)
-            if not is_degenerate(branch, index, m, held, k, degree)]
+            for index, m, held, block, k in crossings(branch.stability, m_max) if not is_copy(branch, index)]
