@@ -4,8 +4,9 @@
 branch points (``bifurcation``), follows each pear-shaped branch both ways (the branch and its mirror image,
 north and south poles swapped: ``switching``) until it rejoins the primary branch or stops, assesses those
 too, locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored
-with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under pressure control. Every branch carries its assessments in
-``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
+with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under pressure control. Every
+branch carries its assessments in ``branch.stability`` and the points whose flags change at the check degree in
+``branch.unsettled``.
 """
 from dataclasses import dataclass, field
 
