@@ -3,14 +3,16 @@
 ``analyse(scene)`` traces the primary branch, assesses every point (``stability``), locates and classifies its
 branch points (``bifurcation``), follows each pear-shaped branch both ways (the branch and its mirror image,
 north and south poles swapped: ``switching``) until it rejoins the primary branch or stops, assesses those
-too, and lists the snap-throughs under pressure control. Every branch carries its assessments in
-``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
+too, locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored
+with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under pressure control. Every
+branch carries its assessments in ``branch.stability`` and the points whose flags change at the check degree in
+``branch.unsettled``.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bifurcation
+from . import azimuthal_points, bifurcation
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
@@ -72,6 +74,9 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     primary.special.sort(key=lambda s: s.index)
     if pear:
         _trace_pears(scene, primary, picture, progress)
+    for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
+        branch.special += azimuthal_points.find(branch, scene.stability.degree, scene.stability.m_max)
+        branch.special.sort(key=lambda s: s.index)
     picture.snaps = snap_throughs(picture.branches)
     return picture
 

@@ -39,6 +39,28 @@ class Block(enum.StrEnum):
     NONE = ""
     ODD_HELD = "odd_held"  # pear-shaped (symmetry-breaking) modes, balloon held at its centre
     EVEN = "even"  # equator-symmetric modes
+    # non-axisymmetric cos mφ modes, m = 1..8 (stability.m_max ≤ 8): held at the centre, or free (with a field)
+    M1_HELD = "m1_held"
+    M1_FREE = "m1_free"
+    M2_HELD = "m2_held"
+    M2_FREE = "m2_free"
+    M3_HELD = "m3_held"
+    M3_FREE = "m3_free"
+    M4_HELD = "m4_held"
+    M4_FREE = "m4_free"
+    M5_HELD = "m5_held"
+    M5_FREE = "m5_free"
+    M6_HELD = "m6_held"
+    M6_FREE = "m6_free"
+    M7_HELD = "m7_held"
+    M7_FREE = "m7_free"
+    M8_HELD = "m8_held"
+    M8_FREE = "m8_free"
+
+    @classmethod
+    def azimuthal(cls, m: int, held: bool) -> "Block":
+        """The block of the cos mφ modes (m ≥ 1), balloon held at its centre or free."""
+        return cls(f"m{m}_{'held' if held else 'free'}")
 
 
 class Status(enum.StrEnum):
@@ -77,6 +99,7 @@ class SpecialPoint:
     X: np.ndarray
     classification: Classification = Classification.NONE
     block: Block = Block.NONE
+    m: int = 0  # BP: azimuthal number of the singular block (0: axisymmetric, ``azimuthal_points`` for m ≥ 1)
     status: Status = Status.LOCATED
     uncertainty: float = 0.0  # APPROXIMATE: half-width of its bracket in (P, λ2(0)), max norm (bracket_uncertainty)
     reason: str = ""  # APPROXIMATE: why, for people

@@ -476,7 +476,7 @@ def _format_branch(name: str, b: dict) -> list[str]:
     for s in b["special_points"]:
         note = f"  {s['note']}" if s["note"] else ""
         status = "" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})"
-        label = f"{s['kind']} {s['classification']}".strip() + status
+        label = f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "") + status
         lines.append(
             f"    {label:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
             f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"

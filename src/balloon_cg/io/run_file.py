@@ -18,7 +18,7 @@ Layout::
         theta                                              (n_theta,): linspace(0, π)
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (n_points, n_theta)
         special_points/kind (LP, TP, BP, EP, UZ), classification, block, status (located, approximate), reason,
-                       stop_code, note, index, pressure, uncertainty, E2, E3, E4, lam2_north, lam2_south,
+                       stop_code, note, index, m, pressure, uncertainty, E2, E3, E4, lam2_north, lam2_south,
                        eta_north, eta_south                                                  (n_special,)
         special_points/unknowns                            (n_special, n + 1)
         stability/...                                      (analysed branches: flags and lowest eigenvalues)
@@ -198,6 +198,7 @@ def write_special(group, special: list, width: int, disc) -> None:
     write_strings(group, "stop_code", [s.stop.code.value if s.stop else "" for s in special])
     write_strings(group, "note", [s.stop.message if s.stop else s.note for s in special])
     group.create_dataset("index", data=np.array([s.index for s in special], dtype=np.int64))
+    group.create_dataset("m", data=np.array([s.m for s in special], dtype=np.int64))
     group.create_dataset("pressure", data=X[:, -1])
     for n, name in enumerate(("E2", "E3", "E4")):
         group.create_dataset(name, data=np.array([s.E[n] for s in special], dtype=float))
@@ -277,5 +278,5 @@ def _read_snaps(group) -> list:
 def read_special(group) -> list:
     """Special points written by write_special, as a list of dicts (text columns as str)."""
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT}
-    columns |= {name: group[name][()] for name in ("index",) + SPECIAL_NUMBERS}
+    columns |= {name: group[name][()] for name in ("index", "m") + SPECIAL_NUMBERS}
     return [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]

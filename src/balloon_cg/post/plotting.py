@@ -150,8 +150,9 @@ def _curve(ax, x, y, stable, color, linestyle="-"):
 
 
 def special_label(s: dict) -> str:
-    """A stored special point's label: its classification (pitchfork-super, …) if it has one, else its kind."""
-    return s["classification"] or s["kind"]
+    """A stored special point's label: its classification (pitchfork-super, …) if it has one, else its kind;
+    with its azimuthal number for m ≥ 1 ("BP m=1")."""
+    return (s["classification"] or s["kind"]) + (f" m={s['m']}" if s["m"] else "")
 
 
 def _special(ax, branch: StoredBranch, x, y, color) -> list:

@@ -1,0 +1,94 @@
+"""Branch points of the non-axisymmetric blocks m = 1..m_max (``azimuthal``, docs/second_variation.md).
+
+Detection: between neighbouring points i and i + 1 of an assessed branch, the number of negative eigenvalues
+among the lowest ones of a block 'm<m>_held' (and 'm<m>_free' with a field, ``stability.Assessment.blocks``)
+changes from a to b: the eigenvalues μ_k, k = min(a, b) .. max(a, b) − 1, of
+
+    H_m c = μ G_m c   (cos mφ perturbations, symmetry zero modes removed: ``azimuthal.spectrum``)
+
+cross zero there.
+Location: Brent's method (``continuation.locate_root``) on μ_k(s), the eigenvalue at the point X(s) with
+
+    R(X(s)) = 0,   d·X(s) = d·X_i + s,   d = (X_{i+1} − X_i)/|X_{i+1} − X_i|
+
+(the corrector on the chord hyperplane, as ``bifurcation.locate`` for m = 0), with the branch's own
+discretisation and the perturbation degree of its assessments; LOCATED when Brent converged (|Δs| ≤ 1e-13),
+else APPROXIMATE with the bracket (``results.located_or_bracketed``).
+Without a field (M = 0 or no coils) the energy is invariant under every rotation and the primary branch is a
+sphere, on which a mode of spherical degree n has copies for every m ≤ n: the m = 0 mode about a tilted axis
+(the tilted pear, n = 1; the tilted n = 2 mode). So without a field a crossing in the interval of an m = 0
+branch point of the branch is that point, and the m = 0 point stands for it (``is_copy``); every other crossing
+is a BP special point with its ``m`` and ``block``.
+Not classified (``Classification.NONE``): the reduced energy along a non-axisymmetric mode needs the
+three-dimensional problem; the critical mode is not stored (``SpecialPoint.mode`` is an axisymmetric layout).
+"""
+import numpy as np
+
+from ..numerics import continuation
+from ..numerics.newton import newton
+from .azimuthal import spectrum
+from .problem import equilibrium_of, pressure_system
+from .results import Block, Branch, Kind, SpecialPoint, located_or_bracketed
+
+
+def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]]:
+    """(index, m, held, block, k) of every eigenvalue μ_k of an azimuthal block m ≤ m_max that changes sign
+    between points index and index + 1 (module docstring); the free blocks are those the assessments hold
+    (with a field)."""
+    events = []
+    for m in range(1, m_max + 1):
+        for held in (True, False):
+            block = Block.azimuthal(m, held)
+            if block not in assessments[0].blocks:
+                continue
+            negative = [int(np.sum(a.blocks[block] < 0)) for a in assessments]
+            for n in range(len(assessments) - 1):
+                low, high = sorted((negative[n], negative[n + 1]))
+                events += [(n, m, held, block, k) for k in range(low, high)]
+    return sorted(events, key=lambda event: event[0])
+
+
+def eigenvalue(eq, params, X, m: int, held: bool, k: int, degree: int) -> float:
+    """μ_k of block m (held or free) at the point X = (u, P) of the problem ``eq``, perturbation degree
+    ``degree`` (``azimuthal.spectrum``)."""
+    return float(spectrum(eq, X[:-1], params.with_value("P", X[-1]), m, degree, k + 1, held=held)[k])
+
+
+def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int, degree: int) -> SpecialPoint:
+    """The zero of μ_k of block m between points index and index + 1 (module docstring), a BP special point."""
+    system = pressure_system(branch)
+    eq, params, solver = system.eq, branch.params, branch.scene.solver
+    X0, X1 = branch.X[index], branch.X[index + 1]
+    chord = X1 - X0
+    length = np.linalg.norm(chord)
+    d = chord / length
+
+    def value_at(s):
+        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
+        if not result.converged:
+            raise ArithmeticError(result.message)
+        return eigenvalue(eq, params, result.x, m, held, k, degree), result.x
+
+    found = continuation.locate_root(value_at, length)
+    if found is None:
+        raise RuntimeError(f"m = {m} branch point ({block.value}) between points {index} and {index + 1} could "
+                           "not be located")
+    fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({block.value} block)")
+    reading = "held at its centre" if held else "free"
+    return SpecialPoint(Kind.BP, index, found.payload, block=block, m=m,
+                        note=f"non-axisymmetric m = {m} mode, balloon {reading}", **fields)
+
+
+def is_copy(branch: Branch, index: int) -> bool:
+    """Whether an m ≥ 1 crossing between points index and index + 1 is a copy of an m = 0 branch point there:
+    no field, and an m = 0 branch point in that interval (module docstring)."""
+    field_free = branch.params.M == 0 or not branch.scene.field.coils
+    return field_free and any(bp.m == 0 and bp.index == index for bp in branch.branch_points())
+
+
+def find(branch: Branch, degree: int, m_max: int) -> list[SpecialPoint]:
+    """The m ≥ 1 branch points, m ≤ m_max, of a branch assessed at perturbation degree ``degree``
+    (``branch.stability``), in order along it; without a field, the copies of its m = 0 branch points are left
+    to them (module docstring)."""
+    return [locate(branch, index, m, held, block, k, degree)
+            for index, m, held, block, k in crossings(branch.stability, m_max) if not is_copy(branch, index)]

@@ -1,0 +1,94 @@
+"""Branch points of the non-axisymmetric blocks (m ≥ 1): located on a field scene, stored with their m, none of
+their own at M = 0 (there the m = 1 crossing is the tilted copy of the pear point)."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balloon_cg.analysis import azimuthal_points
+from balloon_cg.analysis.azimuthal import spectrum
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.results import Block, Classification, Kind, Status
+from balloon_cg.app.cli import main
+from balloon_cg.io.run_file import read_run, write_run
+from balloon_cg.scene import load_scene, parse_scene
+
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
+
+
+@pytest.fixture(scope="module")
+def field_scene():
+    return load_scene(SCENES / "spom1_two_coils_M0.002.toml").with_overrides({"continuation.stop_stretch": 2.0})
+
+
+@pytest.fixture(scope="module")
+def field_picture(field_scene):
+    return analyse(field_scene, pear=False)
+
+
+def azimuthal(branch) -> list:
+    return [s for s in branch.special if s.m >= 1]
+
+
+def test_held_m1_crossing_is_located(field_scene, field_picture):
+    branch = field_picture.primary
+    held = [s for s in azimuthal(branch) if s.block == Block.M1_HELD]
+    assert held, "the held m = 1 eigenvalue crosses zero on this branch"
+    s = held[0]
+    assert (s.kind, s.m, s.status, s.classification) == (Kind.BP, 1, Status.LOCATED, Classification.NONE)
+    mu = spectrum(equilibrium_of(branch), s.X[:-1], branch.params.with_value("P", s.X[-1]), 1,
+                  field_scene.stability.degree, 3, held=True)
+    assert abs(mu[0]) <= 1e-8
+    P0, P1 = branch.X[s.index, -1], branch.X[s.index + 1, -1]
+    assert min(P0, P1) < s.X[-1] < max(P0, P1)
+    north = branch.pole_values()["lam2_north"][s.index: s.index + 2]
+    assert north.min() < branch.pole_values(s.X)["lam2_north"][0] < north.max()
+    assert s.X[-1] == pytest.approx(2.2642245, abs=1e-6)  # before the pear pitchfork (P = 2.2527) along the branch
+
+
+def test_every_m1_point_is_a_zero_of_its_block(field_scene, field_picture):
+    branch = field_picture.primary
+    eq = equilibrium_of(branch)
+    for s in azimuthal(branch):
+        held = s.block == Block.azimuthal(s.m, held=True)
+        mu = spectrum(eq, s.X[:-1], branch.params.with_value("P", s.X[-1]), s.m, field_scene.stability.degree, 3,
+                      held=held)
+        assert np.abs(mu).min() <= 1e-8 and s.status == Status.LOCATED
+
+
+def test_m1_points_stay_on_the_branch_only(field_picture):
+    branch = field_picture.primary
+    assert not any(bp.m for bp in field_picture.branch_points)
+    assert [s.index for s in branch.special] == sorted(s.index for s in branch.special)
+
+
+def test_run_file_round_trips_m(tmp_path, field_scene, field_picture):
+    branch = field_picture.primary
+    stored = read_run(write_run(tmp_path / "run.h5", field_scene, [branch]))["branches"]["primary"]
+    assert [s["m"] for s in stored["special_points"]] == [s.m for s in branch.special]
+    assert [s["block"] for s in stored["special_points"]] == [s.block.value for s in branch.special]
+    assert any(s["m"] == 1 for s in stored["special_points"])
+
+
+def test_inspect_shows_m(tmp_path, field_scene, field_picture, capsys):
+    path = write_run(tmp_path / "run.h5", field_scene, [field_picture.primary])
+    assert main(["inspect", str(path)]) == 0
+    assert "BP m=1" in capsys.readouterr().out
+
+
+def test_no_m1_point_of_its_own_at_zero_field():
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n', "sphere")
+    picture = analyse(scene, pear=False)
+    branch = picture.primary
+    assert not azimuthal(branch)
+    # the m = 1 eigenvalue does cross, at the pear point: its tilted copy on the sphere (the zero modes are
+    # removed), an exact zero there
+    crossings = azimuthal_points.crossings(branch.stability, scene.stability.m_max)
+    assert crossings and {c[0] for c in crossings} == {bp.index for bp in picture.branch_points}
+    assert all(azimuthal_points.is_copy(branch, c[0]) for c in crossings)
+    eq = equilibrium_of(branch)
+    for bp in picture.branch_points:
+        mu = spectrum(eq, bp.X[:-1], branch.params.with_value("P", bp.X[-1]), 1, scene.stability.degree, 3,
+                      held=True)
+        assert np.abs(mu).min() <= 1e-8
