@@ -42,9 +42,8 @@ class Picture:
 
 
 def _assess(branch: Branch, scene, symmetric: bool) -> None:
-    branch.stability, branch.unsettled = assess_branch(
-        branch, scene.stability.degree, symmetric, check_degree=2 * scene.stability.degree,
-        m_max=scene.stability.m_max)
+    branch.stability, branch.unsettled = assess_branch(branch, scene.stability.degree, symmetric, check=True,
+                                                       m_max=scene.stability.m_max)
 
 
 def analyse(scene, progress=None, pear: bool = True) -> Picture:
