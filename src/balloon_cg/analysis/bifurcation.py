@@ -4,9 +4,13 @@ Detection: a sign change, between neighbouring points, of the lowest eigenvalue 
 variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks; the even block gives
 equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. Both are BP
 special points; their ``block`` says which.
-Location: Brent's method (``continuation.locate_root``) on μ(s), the crossing eigenvalue at the point X(s)
-corrected on the chord hyperplane, to |Δs| ≤ 1e-13 (with the discretisation of the branch itself); the point's
-``status`` says whether the root was located or only the nearest evaluated point is known.
+Location: Newton on an extended system that is regular at the branch point (``branch_point``: Werner–Spence
+for a pear point, Moore's system for an even-block point), from the detection bracket, on the plain degree in
+x that holds it (``plain_degree``). The point is LOCATED when Newton converged, the crossing eigenvalue there is
+below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at the bracketing points (signs and
+values agree at each point's stability degree and its check degree, ``stability.point_degrees`` and
+``check_degree``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP ``index`` is the
+interval that contains the located point.
 Classification: the reduced energy at the bifurcation pressure along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
 E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical (``classification``).
@@ -200,9 +204,11 @@ def to_general(branch: Branch, tracer: Tracer, degree: int, u):
 
 
 def padded_mode(mode: np.ndarray, degree: int) -> np.ndarray:
-    """A mode (a_0..a_N, b_0..b_N) of the stability basis in x, the same function at a degree ≥ N."""
+    """A mode (a_0..a_N, b_0..b_N) of the perturbation basis in x at another degree: the same function at a
+    degree ≥ N, its L2 projection (the Legendre coefficients up to ``degree``) at a lower one."""
     n = mode.size // 2
-    return np.concatenate([np.pad(mode[:n], (0, degree + 1 - n)), np.pad(mode[n:], (0, degree + 1 - n))])
+    a, b = mode[:n][: degree + 1], mode[n:][: degree + 1]
+    return np.concatenate([np.pad(a, (0, degree + 1 - a.size)), np.pad(b, (0, degree + 1 - b.size))])
 
 
 def mode_direction(bp: SpecialPoint, disc: Discretisation):

@@ -74,7 +74,7 @@ class WernerSpence:
     def odd_hessian(self, u, params):
         return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]
 
-    def equations(self, u, P, phi, params):
+    def equations(self, u, phi, params):
         """(R, H_odd φ, ℓ·φ − 1) at parameters ``params`` (P among them)."""
         return np.concatenate([self.eq.residual(u, params), self.odd_hessian(u, params) @ phi,
                                [self.ell @ phi - 1.0]])
@@ -101,7 +101,7 @@ class WernerSpence:
 
     def residual(self, X):
         u, P, phi = self.split(X)
-        return self.equations(u, P, phi, self.params.with_value("P", P))
+        return self.equations(u, phi, self.params.with_value("P", P))
 
     def jacobian(self, X):
         u, P, phi = self.split(X)

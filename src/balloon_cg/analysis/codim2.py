@@ -91,7 +91,7 @@ class ExtendedSystem(WernerSpence):
 
     def residual(self, X):
         u, P, phi, q = self.split(X)
-        return self.equations(u, P, phi, self.set_q(q).with_value("P", P))
+        return self.equations(u, phi, self.set_q(q).with_value("P", P))
 
     def jacobian(self, X):
         u, P, phi, q = self.split(X)

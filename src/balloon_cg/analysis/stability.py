@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from .azimuthal import spectrum
+from .azimuthal import LARGE_BLOCK, restrict, spectrum
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
 from .problem import equilibrium_of
@@ -76,14 +76,14 @@ class SecondVariation:
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):
-        """Lowest generalized eigenvalues of (H, G) on the block ``idx`` (optionally with gᵀδ = 0)."""
-        Hb = H[np.ix_(idx, idx)]
-        if constraint is None:
-            inverse = self._inverse_cholesky(tuple(idx))
-        else:
-            Z = scipy.linalg.null_space(constraint[idx][None, :])
-            Hb = Z.T @ Hb @ Z
-            inverse = np.linalg.inv(np.linalg.cholesky(Z.T @ self.gram[np.ix_(idx, idx)] @ Z))
+        """Lowest generalized eigenvalues of (H, G) on the block ``idx``, optionally restricted to gᵀδ = 0
+        (``azimuthal.restrict``: a Householder reflection, no null-space basis)."""
+        Hb, Gb = H[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)]
+        if constraint is not None:
+            Hb, Gb = restrict(Hb, Gb, constraint[idx])
+        if len(Hb) >= LARGE_BLOCK:
+            return scipy.linalg.eigh(Hb, Gb, eigvals_only=True, subset_by_index=[0, LOWEST - 1])
+        inverse = self._inverse_cholesky(tuple(idx)) if constraint is None else np.linalg.inv(np.linalg.cholesky(Gb))
         return np.linalg.eigvalsh(inverse @ Hb @ inverse.T)[:LOWEST]
 
     def _inverse_cholesky(self, idx: tuple):
