@@ -126,3 +126,59 @@ def test_traced_pear_branch_rejoins_at_the_located_pitchfork():
     disc = tracer.system(bifurcation.plain_degree(primary, second.X), primary.params).eq.disc
     last = pear.disc.transfer(pear.X[-1], disc)
     assert abs(pear_branch_limit(primary, second, start=last) - second.X[-1]) <= 1e-8
+
+
+@pytest.fixture(scope="module")
+def tpom1():
+    scene = parse_scene('[material]\npreset = "TPOM1"\n[continuation]\nstop_stretch = 3.0\n', name="TPOM1")
+    return analyse(scene, pear=False).primary
+
+
+@pytest.mark.parametrize("block", [Block.ODD_HELD, Block.EVEN])
+def test_extended_jacobians_match_differences_of_the_residual(tpom1, block):
+    """Werner–Spence and Moore: the Jacobian (third-derivative terms by differences of the generated Hessian)
+    against central differences of the exact residual, at the located point; β = 0 there."""
+    from balloon_cg.analysis.branch_point import MooreSystem, WernerSpence
+    from balloon_cg.analysis.problem import equilibrium_of
+
+    bp = tpom1.branch_points(block)[0]
+    eq, params = equilibrium_of(tpom1), tpom1.params
+    if block == Block.ODD_HELD:
+        system = WernerSpence(eq, params, np.zeros(0))
+        phi = bp.mode[system.odd]
+        system.ell = phi / (phi @ phi)
+        X = np.concatenate([bp.X, phi])
+    else:
+        system = MooreSystem(eq, params, np.zeros(0))
+        psi = bp.mode @ system.embed
+        system.ell = psi / (psi @ psi)
+        X = np.concatenate([bp.X, psi, [0.0]])
+    assert np.abs(system.residual(X)).max() < 1e-8
+    J = system.jacobian(X)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        d = rng.normal(size=X.size)
+        h = 1e-6 / np.abs(d).max()
+        numeric = (system.residual(X + h * d) - system.residual(X - h * d)) / (2 * h)
+        assert np.abs(J @ d - numeric).max() <= 1e-6 * max(1.0, np.abs(numeric).max())
+
+
+def test_failed_extended_newton_is_approximate_not_located(tpom1):
+    """With one Newton iteration the extended system cannot converge: the point is APPROXIMATE, with the
+    bracket's uncertainty and the reason, never LOCATED."""
+    from dataclasses import replace
+
+    bp = tpom1.branch_points(Block.EVEN)[0]
+    starved = replace(tpom1, scene=tpom1.scene.with_overrides({"solver.max_newton": 1}))
+    failed = bifurcation.locate(starved, bp.index, Block.EVEN, 0)
+    assert failed.status == Status.APPROXIMATE and "Newton on the extended system failed" in failed.reason
+    assert 0 < failed.uncertainty and abs(failed.X[-1] - bp.X[-1]) <= 2 * failed.uncertainty
+
+
+def test_crossing_must_change_sign_and_converge_at_the_bracketing_points(tpom1):
+    """The bracket check behind LOCATED: nothing to report at the located point's interval; an interval without
+    a sign change of the crossing eigenvalue is reported."""
+    bp = tpom1.branch_points(Block.ODD_HELD)[0]
+    assert bifurcation.crossing_problems(tpom1, bp.index, Block.ODD_HELD, 0) == []
+    problems = bifurcation.crossing_problems(tpom1, bp.index + 2, Block.ODD_HELD, 0)
+    assert any("does not change sign" in p for p in problems)

@@ -242,21 +242,21 @@ def lowest_eigenvalues(H, G, count: int = 6, exclude=None, vectors: bool = False
     restricts the problem to {c : E G c = 0}, the G-orthogonal complement of their span (linearly dependent rows
     are fine): an exact null vector is then removed from the spectrum and nothing else changes, and excluding
     the translation is the constraint that the material centroid stays put (∫ δx dA = 0). Returned vectors are
-    in the full basis (then through a null-space basis; eigenvalues alone through ``restrict``)."""
+    in the full basis. Blocks of size ≥ LARGE_BLOCK (eigenvalues only) go through ``restrict`` and the subset driver."""
     excluding = exclude is not None and len(exclude)
-    if not vectors:
+    if not vectors and H.shape[0] >= LARGE_BLOCK:
         if excluding:
             H, G = restrict(H, G, (np.atleast_2d(exclude) @ G).T)
-        count = min(count, H.shape[0])
-        if H.shape[0] < LARGE_BLOCK:  # Cholesky reduction + LAPACK syevd: several times faster than the subset
-            inverse = np.linalg.inv(np.linalg.cholesky(G))  # driver on small blocks
-            return np.linalg.eigvalsh(inverse @ H @ inverse.T)[:count]
-        return linalg.eigh(H, G, eigvals_only=True, subset_by_index=(0, count - 1))
+        return linalg.eigh(H, G, eigvals_only=True, subset_by_index=(0, min(count, H.shape[0]) - 1))
     null = None
     if excluding:
         null = linalg.null_space(np.atleast_2d(exclude) @ G, rcond=1e-9)
         H, G = null.T @ H @ null, null.T @ G @ null
-    values, vecs = linalg.eigh(H, G, subset_by_index=(0, min(count, H.shape[0]) - 1))
+    count = min(count, H.shape[0])
+    if not vectors:  # Cholesky reduction + LAPACK syevd: several times faster than the subset driver on small blocks
+        inverse = np.linalg.inv(np.linalg.cholesky(G))
+        return np.linalg.eigvalsh(inverse @ H @ inverse.T)[:count]
+    values, vecs = linalg.eigh(H, G, subset_by_index=(0, count - 1))
     if null is not None:
         vecs = null @ vecs
     return values, vecs

@@ -12,6 +12,10 @@ and 'odd' (a_odd, b_even: pear-shaped modes). b_0 is the rigid translation: a ze
 Control modes: under pressure control the test is H > 0; under volume control H restricted to the
 perturbations that keep the volume, gᵀδ = 0 with g = ∂V/∂(a, b) = −∂²E/∂P∂(a, b).
 
+Resolution: along a branch each point is assessed at the degree N = max(stability.degree, the Legendre degree
+in x that holds the equilibrium) (``point_degrees``: raised near a wire, where the equilibrium lives on a mapped
+basis), and checked at ``check_degree`` (2N, at solver.max_degree against N/1.5) where a sign could change.
+
 Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) form blocks 'm<m>_held' and
 'm<m>_free' with the symmetry zero modes removed; they enter every flag.
 """
