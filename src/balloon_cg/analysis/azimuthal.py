@@ -271,13 +271,22 @@ def spectrum(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: in
     sideways (a negative eigenvalue). At M = 0 both readings coincide. Negative values: unstable under pressure
     control (P fixed); the m ≥ 1 modes leave the enclosed volume unchanged to first order, so volume control
     gives the same m ≥ 1 spectrum."""
+    return spectra(equilibrium, u, params, m, degree, count, (held,), quadrature)[held]
+
+
+def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, count: int = 6,
+            readings=(True, False), quadrature: int = 0) -> dict:
+    """``spectrum`` for several readings (held: True, free: False) from one assembly of the m-th block."""
     H, G = azimuthal_hessian(equilibrium, u, params, m, degree, quadrature)
-    exclude = []
-    if m == 1:
-        modes = special_modes(equilibrium, u, degree, quadrature)
-        exclude.append(modes["relabelling"])
-        if params.M == 0 or not equilibrium.coils.shape[0]:
-            exclude += [modes["translation"], modes["rotation"]]
-        elif held:
-            exclude.append(modes["translation"])
-    return lowest_eigenvalues(H, G, count, exclude)
+    modes = special_modes(equilibrium, u, degree, quadrature) if m == 1 else None
+    out = {}
+    for held in readings:
+        exclude = []
+        if m == 1:
+            exclude.append(modes["relabelling"])
+            if params.M == 0 or not equilibrium.coils.shape[0]:
+                exclude += [modes["translation"], modes["rotation"]]
+            elif held:
+                exclude.append(modes["translation"])
+        out[held] = lowest_eigenvalues(H, G, count, exclude)
+    return out

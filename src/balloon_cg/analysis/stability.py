@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from .azimuthal import LARGE_BLOCK, restrict, spectrum
+from .azimuthal import LARGE_BLOCK, restrict, spectra
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
 from .problem import equilibrium_of
@@ -129,10 +129,11 @@ class SecondVariation:
                 blocks["all_volume_free"] = self._lowest(H, everything, g)
                 free, free_volume = blocks["all_free"][0], blocks["all_volume_free"][0]
         for m in range(1, m_max + 1):
-            blocks[f"m{m}_held"] = spectrum(self.eq, u, params, m, self.basis.degree, LOWEST, held=True)
+            readings = spectra(self.eq, u, params, m, self.basis.degree, LOWEST, (True, False) if field_on else (True,))
+            blocks[f"m{m}_held"] = readings[True]
             held, held_volume = min(held, blocks[f"m{m}_held"][0]), min(held_volume, blocks[f"m{m}_held"][0])
             if field_on:
-                blocks[f"m{m}_free"] = spectrum(self.eq, u, params, m, self.basis.degree, LOWEST, held=False)
+                blocks[f"m{m}_free"] = readings[False]
             lowest_free = blocks[f"m{m}_free" if field_on else f"m{m}_held"][0]
             free, free_volume = min(free, lowest_free), min(free_volume, lowest_free)
         return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0)
