@@ -10,6 +10,7 @@ from balloon_cg.analysis.azimuthal import spectrum
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.results import Block, Classification, Kind, Status
+from balloon_cg.analysis.stability import point_degrees
 from balloon_cg.app.cli import main
 from balloon_cg.io.run_file import read_run, write_run
 from balloon_cg.scene import load_scene, parse_scene
@@ -31,6 +32,12 @@ def azimuthal(branch) -> list:
     return [s for s in branch.special if s.m >= 1]
 
 
+def location_degree(branch, s, scene) -> int:
+    """The perturbation degree a point was located at: the larger of its bracketing points' assessment degrees."""
+    degrees = point_degrees(branch, scene.stability.degree)
+    return max(degrees[s.index], degrees[s.index + 1])
+
+
 def test_held_m1_crossing_is_located(field_scene, field_picture):
     branch = field_picture.primary
     held = [s for s in azimuthal(branch) if s.block == Block.M1_HELD]
@@ -38,13 +45,15 @@ def test_held_m1_crossing_is_located(field_scene, field_picture):
     s = held[0]
     assert (s.kind, s.m, s.status, s.classification) == (Kind.BP, 1, Status.LOCATED, Classification.NONE)
     mu = spectrum(equilibrium_of(branch), s.X[:-1], branch.params.with_value("P", s.X[-1]), 1,
-                  field_scene.stability.degree, 3, held=True)
+                  location_degree(branch, s, field_scene), 3, held=True)
     assert abs(mu[0]) <= 1e-8
     P0, P1 = branch.X[s.index, -1], branch.X[s.index + 1, -1]
     assert min(P0, P1) < s.X[-1] < max(P0, P1)
     north = branch.pole_values()["lam2_north"][s.index: s.index + 2]
     assert north.min() < branch.pole_values(s.X)["lam2_north"][0] < north.max()
-    assert s.X[-1] == pytest.approx(2.2642245, abs=1e-6)  # before the pear pitchfork (P = 2.2527) along the branch
+    # before the pear pitchfork (P = 2.2527) along the branch; located at the degree that holds the branch there
+    # (100): 2.2642302776 at perturbation degrees 60, 90 and 135 alike, 2.2642244744 at the old fixed degree 20
+    assert s.X[-1] == pytest.approx(2.2642302776, abs=1e-9)
 
 
 def test_every_m1_point_is_a_zero_of_its_block(field_scene, field_picture):
@@ -52,8 +61,8 @@ def test_every_m1_point_is_a_zero_of_its_block(field_scene, field_picture):
     eq = equilibrium_of(branch)
     for s in azimuthal(branch):
         held = s.block == Block.azimuthal(s.m, held=True)
-        mu = spectrum(eq, s.X[:-1], branch.params.with_value("P", s.X[-1]), s.m, field_scene.stability.degree, 3,
-                      held=held)
+        mu = spectrum(eq, s.X[:-1], branch.params.with_value("P", s.X[-1]), s.m,
+                      location_degree(branch, s, field_scene), 3, held=held)
         assert np.abs(mu).min() <= 1e-8 and s.status == Status.LOCATED
 
 

@@ -27,7 +27,7 @@ import numpy as np
 from ..numerics import continuation
 from ..numerics.newton import newton
 from .azimuthal import spectrum
-from .problem import equilibrium_of, pressure_system
+from .problem import pressure_system
 from .results import Block, Branch, Kind, SpecialPoint, located_or_bracketed
 
 
@@ -86,9 +86,10 @@ def is_copy(branch: Branch, index: int) -> bool:
     return field_free and any(bp.m == 0 and bp.index == index for bp in branch.branch_points())
 
 
-def find(branch: Branch, degree: int, m_max: int) -> list[SpecialPoint]:
-    """The m ≥ 1 branch points, m ≤ m_max, of a branch assessed at perturbation degree ``degree``
-    (``branch.stability``), in order along it; without a field, the copies of its m = 0 branch points are left
-    to them (module docstring)."""
-    return [locate(branch, index, m, held, block, k, degree)
+def find(branch: Branch, degrees, m_max: int) -> list[SpecialPoint]:
+    """The m ≥ 1 branch points, m ≤ m_max, of a branch assessed at the perturbation degrees ``degrees`` (one per
+    point, ``stability.point_degrees``; ``branch.stability``), in order along it, each located at the larger
+    degree of its two bracketing points; without a field, the copies of its m = 0 branch points are left to
+    them (module docstring)."""
+    return [locate(branch, index, m, held, block, k, max(degrees[index], degrees[index + 1]))
             for index, m, held, block, k in crossings(branch.stability, m_max) if not is_copy(branch, index)]

@@ -4,27 +4,34 @@ Detection: a sign change, between neighbouring points, of the lowest eigenvalue 
 variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks; the even block gives
 equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. Both are BP
 special points; their ``block`` says which.
-Location: Brent's method (``continuation.locate_root``) on μ(s), the crossing eigenvalue at the point X(s)
-corrected on the chord hyperplane, to |Δs| ≤ 1e-13 (with the discretisation of the branch itself); the point's
-``status`` says whether the root was located or only the nearest evaluated point is known.
+Location: Newton on an extended system that is regular at the branch point (``branch_point``: Werner–Spence
+for a pear point, Moore's system for an even-block point), from the detection bracket, on the plain degree in
+x that holds it (``plain_degree``). The point is LOCATED when Newton converged, the crossing eigenvalue there is
+below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at the bracketing points (signs and
+values agree at each point's stability degree and its check degree, ``stability.point_degrees`` and
+``check_degree``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP ``index`` is the
+interval that contains the located point.
 Classification: the reduced energy at the bifurcation pressure along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
 E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical (``classification``).
 Branch switching is in ``switching``.
 """
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg
 
 from ..galerkin.discretisation import Discretisation
-from ..numerics import continuation
+from ..galerkin.equilibrium import Equilibrium
 from ..numerics.newton import newton
-from .problem import equilibrium_of, pressure_system
+from .branch_point import MooreSystem, WernerSpence
+from .problem import equilibrium_of
 from .resolution import Resolution
-from .results import Block, Branch, Classification, Kind, SpecialPoint, located_or_bracketed
-from .stability import SecondVariation
+from .results import Block, Branch, Classification, Kind, SpecialPoint, Status, approximate
+from .stability import SecondVariation, Variations, block_indices, check_degree, point_degrees
 from .tracer import Tracer
+
+EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
 
 
 def _eigenpair(variation, u, params, idx, k):
@@ -35,15 +42,6 @@ def _eigenpair(variation, u, params, idx, k):
     mode = np.zeros(H.shape[0])
     mode[idx] = vectors[:, 0]
     return values[0], mode
-
-
-def block_indices(variation, block: Block, field_on: bool):
-    """Indices of a block on the perturbation basis (odd_held plus b_0 for a free balloon in a field)."""
-    i = variation.index
-    if block == Block.EVEN:
-        return np.concatenate([i["a_even"], i["b_odd"]])
-    odd = np.concatenate([i["a_odd"], i["b_even"][1:]])
-    return np.append(odd, variation.translation) if (block == "odd_free" and field_on) else odd
 
 
 def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
@@ -62,30 +60,130 @@ def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
 
 
 def locate(branch: Branch, index: int, block: Block, k: int = 0) -> SpecialPoint:
-    """The branch point between points index and index + 1 (module docstring): a BP special point with its
-    block, critical mode and location status."""
-    eq, params, solver = equilibrium_of(branch), branch.params, branch.scene.solver
-    variation = SecondVariation(eq, branch.disc.degree)
+    """The branch point detected between points index and index + 1 (module docstring): a BP special point
+    with its block, critical mode (on the perturbation basis of the extended system) and location status; its
+    ``index`` is the interval that contains the located point."""
+    block = Block(block)
+    found = _solve_extended(branch, index, block, k)
+    if found.converged:
+        index = containing_interval(branch, found.X)
+        # the located point may lie in an interval of finer degree than the detection interval: solve there
+        if found.degree < max(extended_degrees(branch, index)):
+            found = _solve_extended(branch, index, block, k, start=found)
+            index = containing_interval(branch, found.X) if found.converged else index
+    before, after = branch.X[index], branch.X[index + 1]
+    problems = found.problems()
+    if found.converged:
+        problems += crossing_problems(branch, index, block, k)
+    fields = {"status": Status.LOCATED} if not problems else approximate(
+        branch.disc, before, after, f"branch point ({block.value} block): " + "; ".join(problems))
+    return SpecialPoint(Kind.BP, index, found.X, block=block, mode=found.mode, **fields)
+
+
+@dataclass
+class ExtendedSolution:
+    """The outcome of Newton on an extended system: X in the branch's layout, the critical mode on the
+    perturbation basis of ``degree``, the crossing eigenvalue there and, for Moore's system, β."""
+
+    X: np.ndarray
+    mode: np.ndarray
+    degree: int
+    converged: bool
+    message: str
+    eigenvalue: float
+    beta: float = 0.0
+
+    def problems(self) -> list[str]:
+        """Why the point is not a located branch point ([] if it is)."""
+        if not self.converged:
+            return [f"Newton on the extended system failed ({self.message}); the interpolated detection point is "
+                    "stored"]
+        out = []
+        if abs(self.eigenvalue) > EIGENVALUE_TOL:
+            out.append(f"crossing eigenvalue {self.eigenvalue:.2g} at the solution")
+        if abs(self.beta) > EIGENVALUE_TOL:
+            out.append(f"Moore's β = {self.beta:.2g}: not a branch point of the unperturbed problem")
+        return out
+
+
+def extended_degrees(branch: Branch, index: int) -> tuple[int, int]:
+    """The plain degrees that hold points index and index + 1 (``plain_degree``)."""
+    return tuple(int(d) for d in Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X[index:index + 2]))
+
+
+def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "ExtendedSolution | None" = None):
+    """Newton on the extended system of ``block`` (branch_point) on the plain degree that holds the bracket,
+    from the point of the bracket where the crossing eigenvalue interpolates to zero (or from ``start``)."""
+    degree = max(extended_degrees(branch, index))
+    plain = Discretisation(degree, True, branch.disc.pin_translation)
+    eq = Equilibrium(branch.scene, plain)
+    variation = SecondVariation(eq, degree)
     idx = block_indices(variation, block, field_on=False)
-    system = pressure_system(branch)
-    X0, X1 = branch.X[index], branch.X[index + 1]
-    chord = X1 - X0
-    length = np.linalg.norm(chord)
-    d = chord / length
+    params = branch.params
+    if start is None:
+        ends = branch.disc.transfer(branch.X[index:index + 2], plain)
+        values = [_eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)[0] for X in ends]
+        s = float(np.clip(values[0] / (values[0] - values[1]), 0.0, 1.0))
+        guess = ends[0] + s * (ends[1] - ends[0])
+    else:
+        guess = branch.disc.transfer(start.X, plain)
+    _, mode = _eigenpair(variation, guess[:-1], params.with_value("P", guess[-1]), idx, k)
+    if block == Block.ODD_HELD:
+        ell = mode[idx] / np.linalg.norm(mode[idx])
+        system = WernerSpence(eq, params, ell)
+        X0 = np.concatenate([guess, ell])
+    else:
+        psi = plain.join(mode[: degree + 1], mode[degree + 1:])
+        ell = psi / np.linalg.norm(psi)
+        system = MooreSystem(eq, params, ell)
+        X0 = np.concatenate([guess, ell, [0.0]])
+    solver = branch.scene.solver
+    result = newton(system.residual, system.jacobian, X0, np.zeros((0, X0.size)), [], solver.tol, solver.max_newton)
+    solution = result.x if result.converged else X0  # a failed Newton keeps its starting point (it says so)
+    X = solution[:plain.size + 1]
+    eigenvalue, _ = _eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)
+    beta = system.beta(solution) if block == Block.EVEN else 0.0
+    return ExtendedSolution(plain.transfer(X, branch.disc), system.mode(solution), degree, result.converged,
+                            result.message, float(eigenvalue), float(beta))
 
-    def value_at(s):
-        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
-        if not result.converged:
-            raise ArithmeticError(result.message)
-        value, mode = _eigenpair(variation, result.x[:-1], params.with_value("P", result.x[-1]), idx, k)
-        return value, (result.x, mode)
 
-    found = continuation.locate_root(value_at, length)
-    if found is None:
-        raise RuntimeError(f"branch point between points {index} and {index + 1} could not be located")
-    X, mode = found.payload
-    found_fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({Block(block).value} block)")
-    return SpecialPoint(Kind.BP, index, X, block=Block(block), mode=mode, **found_fields)
+def containing_interval(branch: Branch, X) -> int:
+    """The interval i (between points i and i + 1) nearest to X in (P, north pole stretch): the one that
+    contains a point of the branch."""
+    north = branch.disc.pole_rows()["lam2_north"]
+    path = np.stack([branch.X[:, -1], branch.X[:, :-1] @ north], axis=1)
+    target = np.array([X[-1], X[:-1] @ north])
+    a, d = path[:-1], np.diff(path, axis=0)
+    t = np.clip(np.einsum("ij,ij->i", target - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    return int(np.argmin(np.linalg.norm(a + t[:, None] * d - target, axis=1)))
+
+
+def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[str]:
+    """Whether the crossing eigenvalue changes sign between points index and index + 1 and is converged there:
+    at each point's stability degree N (``stability.point_degrees``) and at its ``stability.check_degree`` the
+    signs agree and the values differ by less than half the value at N ([] if so, else what is wrong)."""
+    eq, params = equilibrium_of(branch), branch.params
+    variations = Variations(eq)
+    degrees = point_degrees(branch, branch.scene.stability.degree)
+    problems = []
+    signs = []
+    for n in (index, index + 1):
+        X = branch.X[n]
+        N, finer = int(degrees[n]), check_degree(branch, int(degrees[n]))
+        at = {}
+        for degree in (N, finer):
+            variation = variations[degree]
+            idx = block_indices(variation, block, field_on=False)
+            at[degree] = _eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)[0]
+        coarse, fine = at[N], at[finer]  # ``fine``: the check degree's (coarser at solver.max_degree)
+        signs.append(np.sign(coarse))
+        if np.sign(coarse) != np.sign(fine) or abs(coarse - fine) >= 0.5 * abs(coarse):
+            problems.append(f"point {n}: crossing eigenvalue not converged ({coarse:.3g} at N = {N}, "
+                            f"{fine:.3g} at {finer})")
+    if signs[0] == signs[1]:
+        problems.append(f"the crossing eigenvalue does not change sign between points {index} and {index + 1} "
+                        "at the stability degree")
+    return problems
 
 
 def general_tracer(scene) -> Tracer:
@@ -106,9 +204,11 @@ def to_general(branch: Branch, tracer: Tracer, degree: int, u):
 
 
 def padded_mode(mode: np.ndarray, degree: int) -> np.ndarray:
-    """A mode (a_0..a_N, b_0..b_N) of the stability basis in x, the same function at a degree ≥ N."""
+    """A mode (a_0..a_N, b_0..b_N) of the perturbation basis in x at another degree: the same function at a
+    degree ≥ N, its L2 projection (the Legendre coefficients up to ``degree``) at a lower one."""
     n = mode.size // 2
-    return np.concatenate([np.pad(mode[:n], (0, degree + 1 - n)), np.pad(mode[n:], (0, degree + 1 - n))])
+    a, b = mode[:n][: degree + 1], mode[n:][: degree + 1]
+    return np.concatenate([np.pad(a, (0, degree + 1 - a.size)), np.pad(b, (0, degree + 1 - b.size))])
 
 
 def mode_direction(bp: SpecialPoint, disc: Discretisation):

@@ -64,15 +64,15 @@ from ..numerics import continuation
 from ..numerics.continuation import Stop, TraceStop
 from ..numerics.newton import newton
 from ..scene import Scene
-from .bifurcation import block_indices, padded_mode, plain_degree
+from .bifurcation import padded_mode, plain_degree
+from .branch_point import H_STEP, WernerSpence
 from .problem import equilibrium_of
 from .results import (Block, Branch, Kind, SpecialPoint, Status, StopCode, bracket_uncertainty,
                       located_or_bracketed)
-from .stability import SecondVariation
+from .stability import SecondVariation, block_indices
 from .wires import wire_gap
 
 PARAMETERS = ("M", "alpha1")
-H_STEP = 1e-6
 GENERAL_CLASS = "ogden_general_field"
 
 
@@ -98,8 +98,9 @@ _END_OF_STOP = {StopCode.NONPOSITIVE_PRESSURE: CurveEnd.NONPOSITIVE_PRESSURE, St
                 StopCode.ALPHA1_ZERO: CurveEnd.ALPHA1_ZERO}
 
 
-class ExtendedSystem:
-    """R(u; P, q) = 0, H_odd φ = 0, ℓ·φ = 1 as a map of X = (u, P, φ, q) (module docstring)."""
+class ExtendedSystem(WernerSpence):
+    """R(u; P, q) = 0, H_odd φ = 0, ℓ·φ = 1 as a map of X = (u, P, φ, q) (module docstring): the pear system of
+    ``branch_point`` with q as one more unknown."""
 
     def __init__(self, equilibrium: Equilibrium, params, parameter: str, ell: np.ndarray):
         if parameter not in PARAMETERS:
@@ -114,17 +115,8 @@ class ExtendedSystem:
             # runtime exponents: an own equilibrium of the general class (same energy, μ and α as arguments)
             equilibrium = Equilibrium(equilibrium.scene, disc, kernel_class=GENERAL_CLASS)
             self._rest = float(np.dot(material.mu[1:], material.alpha[1:]))
-        self.eq, self.params, self.parameter = equilibrium, params, parameter
-        self.variation = SecondVariation(equilibrium, disc.degree)
-        self.odd = block_indices(self.variation, "odd_held", field_on=False)
-        self.basis = self.variation.basis
-        # embedding of symmetric-layout u in the full (a_0..a_N, b_0..b_N) coefficients
-        N = disc.degree
-        self.embed = np.zeros((2 * (N + 1), disc.size))
-        self.embed[disc.a_index, np.arange(disc.a_index.size)] = 1.0
-        self.embed[N + 1 + disc.b_index, disc.a_index.size + np.arange(disc.b_index.size)] = 1.0
-        self.n, self.m = disc.size, self.odd.size
-        self.ell = np.asarray(ell, dtype=float)
+        super().__init__(equilibrium, params, ell)
+        self.parameter = parameter
 
     # -- parameters ------------------------------------------------------------------------------------
     def set_q(self, q: float):
@@ -140,43 +132,16 @@ class ExtendedSystem:
         n, m = self.n, self.m
         return X[:n], float(X[n]), X[n + 1:n + 1 + m], float(X[-1])
 
-    # -- pieces ----------------------------------------------------------------------------------------
-    def full_hessian(self, c, params):
-        """Generated Hessian on the perturbation basis at the (general) coefficient vector c."""
-        b = self.basis
-        state = tuple(b.node_state(c))
-        return b.hessian(self.eq.pointwise("energy_hessian", (b.cos_theta, b.sin_theta), state, params))
-
-    def odd_hessian(self, u, params):
-        return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]
-
     def residual(self, X):
         u, P, phi, q = self.split(X)
-        params = self.set_q(q).with_value("P", P)
-        return np.concatenate([self.eq.residual(u, params), self.odd_hessian(u, params) @ phi,
-                               [self.ell @ phi - 1.0]])
+        return self.equations(u, phi, self.set_q(q).with_value("P", P))
 
     def jacobian(self, X):
         u, P, phi, q = self.split(X)
         n, m = self.n, self.m
         params = self.set_q(q).with_value("P", P)
         J = np.zeros((n + m + 1, n + m + 2))
-        J[:n, :n] = self.eq.jacobian(u, params)
-        J[:n, n] = self.eq.parameter_derivative(u, params, "P")
-        c = self.embed @ u
-        H = self.full_hessian(c, params)
-        J[n:n + m, n + 1:n + 1 + m] = H[np.ix_(self.odd, self.odd)]
-        # ∂(H_odd φ)/∂u = D_c H[φ_full] restricted (symmetry of the third derivative)
-        phi_full = np.zeros(c.size)
-        phi_full[self.odd] = phi
-        h = H_STEP * max(1.0, np.abs(c).max()) / max(np.abs(phi_full).max(), 1e-300)
-        dH = (self.full_hessian(c + h * phi_full, params) - self.full_hessian(c - h * phi_full, params)) / (2 * h)
-        J[n:n + m, :n] = dH[self.odd] @ self.embed
-        # ∂(H_odd φ)/∂P
-        hP = H_STEP * max(1.0, abs(P))
-        J[n:n + m, n] = (self.odd_hessian(u, params.with_value("P", P + hP))
-                         - self.odd_hessian(u, params.with_value("P", P - hP))) @ phi / (2 * hP)
-        # q column
+        J[:, :-1] = self.derivatives(u, P, phi, params)
         hq = H_STEP * max(1.0, abs(q))
         plus = self.set_q(q + hq).with_value("P", P)
         H_plus, R_plus = self.odd_hessian(u, plus), self.eq.residual(u, plus)
@@ -187,7 +152,6 @@ class ExtendedSystem:
         else:
             J[:n, -1] = (R_plus - R_minus) / (2 * hq)
         J[n:n + m, -1] = (H_plus - H_minus) @ phi / (2 * hq)
-        J[-1, n + 1:n + 1 + m] = self.ell
         return J
 
     def initial(self, bp, q0: float):

@@ -16,7 +16,7 @@ from . import azimuthal_points, bifurcation
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
-from .stability import assess_branch
+from .stability import assess_branch, point_degrees
 from .switching import trace_pear
 from .verdict import Incomplete, incomplete
 
@@ -51,9 +51,8 @@ class Picture:
 
 
 def _assess(branch: Branch, scene, symmetric: bool) -> None:
-    branch.stability, branch.unsettled = assess_branch(
-        branch, scene.stability.degree, symmetric, check_degree=2 * scene.stability.degree,
-        m_max=scene.stability.m_max)
+    branch.stability, branch.unsettled = assess_branch(branch, scene.stability.degree, symmetric, check=True,
+                                                       m_max=scene.stability.m_max)
 
 
 def analyse(scene, progress=None, pear: bool = True) -> Picture:
@@ -75,7 +74,8 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     if pear:
         _trace_pears(scene, primary, picture, progress)
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
-        branch.special += azimuthal_points.find(branch, scene.stability.degree, scene.stability.m_max)
+        degrees = point_degrees(branch, scene.stability.degree)
+        branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
     picture.snaps = snap_throughs(picture.branches)
     return picture

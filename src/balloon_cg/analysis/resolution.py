@@ -46,18 +46,28 @@ class Resolution:
         """Largest projection loss of a point moved to a storage basis."""
         return self.storage_loss * self.max_error
 
-    def plain_degree(self, disc: Discretisation, X) -> int:
-        """The Legendre degree in x that holds the point X = (u, P) of a branch on ``disc``: its own degree if the
-        basis is not mapped, else grown until the projection loses at most max_error and the projected tail is
-        within max_error (the mapped degree is far below what x needs near a wire)."""
-        degree = disc.degree
-        while disc.mapping is not None and degree < self.max_degree:
+    def plain_degree(self, disc: Discretisation, X, start: int | None = None) -> int:
+        """The Legendre degree in x that holds the point X = (u, P) of a branch on ``disc`` (``plain_degrees``)."""
+        return int(self.plain_degrees(disc, X, start)[0])
+
+    def plain_degrees(self, disc: Discretisation, X, start: int | None = None) -> np.ndarray:
+        """Per row X = (u, P): the Legendre degree in x that holds it. Its own degree if the basis is not mapped;
+        else grown from ``start`` (default: the mapped degree) until the projection loses at most max_error and
+        the projected tail is within max_error (the mapped degree is far below what x needs near a wire), at
+        most max_degree."""
+        X = np.atleast_2d(X)
+        degree = disc.degree if start is None else start
+        degrees = np.full(len(X), disc.degree if disc.mapping is None else degree)
+        open_rows = np.arange(len(X)) if disc.mapping is not None else np.arange(0)
+        while open_rows.size and degree < self.max_degree:
             plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
-            moved = disc.transfer(X, plain)
-            if max(transfer_error(disc, X, plain, moved)[0], plain.tail(moved[: plain.size])) <= self.max_error:
-                break
+            moved = disc.transfer(X[open_rows], plain)
+            loss = transfer_error(disc, X[open_rows], plain, moved)
+            tails = np.array([plain.tail(row[: plain.size]) for row in moved])
+            open_rows = open_rows[np.maximum(loss, tails) > self.max_error]
             degree = self.grow(degree)
-        return degree
+            degrees[open_rows] = degree
+        return degrees
 
 
 def transfer_error(source: Discretisation, X, target: Discretisation, moved, n_theta: int = 721) -> np.ndarray:

@@ -121,8 +121,13 @@ def located_or_bracketed(status: RootStatus, disc, before, after, what: str) -> 
     ``after``: LOCATED, or APPROXIMATE with the bracket's uncertainty when the root search fell back."""
     if status == RootStatus.LOCATED:
         return {"status": Status.LOCATED}
-    return {"status": Status.APPROXIMATE, "uncertainty": bracket_uncertainty(disc, before, after),
-            "reason": f"{what}: the root search failed inside its bracket; the nearest evaluated point is stored"}
+    return approximate(disc, before, after,
+                       f"{what}: the root search failed inside its bracket; the nearest evaluated point is stored")
+
+
+def approximate(disc, before, after, reason: str) -> dict:
+    """SpecialPoint fields of a point known only to lie between ``before`` and ``after``, and why."""
+    return {"status": Status.APPROXIMATE, "uncertainty": bracket_uncertainty(disc, before, after), "reason": reason}
 
 
 @dataclass(frozen=True)

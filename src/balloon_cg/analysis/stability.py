@@ -12,6 +12,10 @@ and 'odd' (a_odd, b_even: pear-shaped modes). b_0 is the rigid translation: a ze
 Control modes: under pressure control the test is H > 0; under volume control H restricted to the
 perturbations that keep the volume, gᵀδ = 0 with g = ∂V/∂(a, b) = −∂²E/∂P∂(a, b).
 
+Resolution: along a branch each point is assessed at the degree N = max(stability.degree, the Legendre degree
+in x that holds the equilibrium) (``point_degrees``: raised near a wire, where the equilibrium lives on a mapped
+basis), and checked at ``check_degree`` (2N, at solver.max_degree against N/1.5) where a sign could change.
+
 Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) form blocks 'm<m>_held' and
 'm<m>_free' with the symmetry zero modes removed; they enter every flag.
 """
@@ -20,12 +24,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from .azimuthal import spectrum
+from .azimuthal import LARGE_BLOCK, restrict, spectra
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
 from .problem import equilibrium_of
+from .resolution import Resolution
 
 LOWEST = 3  # eigenvalues reported per block
+CHECK_FACTOR = 2.0  # N-convergence is checked at CHECK_FACTOR·N
 
 
 @dataclass
@@ -74,14 +80,14 @@ class SecondVariation:
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):
-        """Lowest generalized eigenvalues of (H, G) on the block ``idx`` (optionally with gᵀδ = 0)."""
-        Hb = H[np.ix_(idx, idx)]
-        if constraint is None:
-            inverse = self._inverse_cholesky(tuple(idx))
-        else:
-            Z = scipy.linalg.null_space(constraint[idx][None, :])
-            Hb = Z.T @ Hb @ Z
-            inverse = np.linalg.inv(np.linalg.cholesky(Z.T @ self.gram[np.ix_(idx, idx)] @ Z))
+        """Lowest generalized eigenvalues of (H, G) on the block ``idx``, optionally restricted to gᵀδ = 0
+        (``azimuthal.restrict``: a Householder reflection, no null-space basis)."""
+        Hb, Gb = H[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)]
+        if constraint is not None:
+            Hb, Gb = restrict(Hb, Gb, constraint[idx])
+        if len(Hb) >= LARGE_BLOCK:
+            return scipy.linalg.eigh(Hb, Gb, eigvals_only=True, subset_by_index=[0, LOWEST - 1])
+        inverse = self._inverse_cholesky(tuple(idx)) if constraint is None else np.linalg.inv(np.linalg.cholesky(Gb))
         return np.linalg.eigvalsh(inverse @ Hb @ inverse.T)[:LOWEST]
 
     def _inverse_cholesky(self, idx: tuple):
@@ -123,38 +129,80 @@ class SecondVariation:
                 blocks["all_volume_free"] = self._lowest(H, everything, g)
                 free, free_volume = blocks["all_free"][0], blocks["all_volume_free"][0]
         for m in range(1, m_max + 1):
-            blocks[f"m{m}_held"] = spectrum(self.eq, u, params, m, self.basis.degree, LOWEST, held=True)
+            readings = spectra(self.eq, u, params, m, self.basis.degree, LOWEST, (True, False) if field_on else (True,))
+            blocks[f"m{m}_held"] = readings[True]
             held, held_volume = min(held, blocks[f"m{m}_held"][0]), min(held_volume, blocks[f"m{m}_held"][0])
             if field_on:
-                blocks[f"m{m}_free"] = spectrum(self.eq, u, params, m, self.basis.degree, LOWEST, held=False)
+                blocks[f"m{m}_free"] = readings[False]
             lowest_free = blocks[f"m{m}_free" if field_on else f"m{m}_held"][0]
             free, free_volume = min(free, lowest_free), min(free_volume, lowest_free)
         return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0)
 
 
-def assess_branch(branch, degree: int, symmetric: bool | None = None, check_degree: int | None = None,
-                  near_zero: float = 0.1, m_max: int = 0):
-    """Assessments of every point and, with ``check_degree``, the points whose flags change at that degree.
+def block_indices(variation, block: str, field_on: bool):
+    """Indices of a block on the perturbation basis (odd_held plus b_0 for a free balloon in a field)."""
+    i = variation.index
+    if block == "even":
+        return np.concatenate([i["a_even"], i["b_odd"]])
+    odd = np.concatenate([i["a_odd"], i["b_even"][1:]])
+    return np.append(odd, variation.translation) if (block == "odd_free" and field_on) else odd
 
-    The check is made where a sign could change: points with a lowest eigenvalue of magnitude below
-    ``near_zero`` (eigenvalues are O(1) in the L2 normalisation), points next to a change of a flag, and every
-    tenth point.
+
+def point_degrees(branch, degree: int) -> np.ndarray:
+    """The perturbation degree per point of ``branch``: at least ``degree`` (the scene's stability.degree) and at
+    least the Legendre degree in x that holds the equilibrium (``Resolution.plain_degrees`` from ``degree`` up:
+    near a wire, on a mapped basis); on an unmapped branch ``degree``."""
+    if branch.disc.mapping is None:
+        return np.full(len(branch.X), degree)
+    return np.maximum(degree, Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X, start=degree))
+
+
+def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:
+    """The degree a result at perturbation degree N is checked against: ``factor``·N, at most solver.max_degree;
+    at max_degree itself the coarser N/growth (then the check says whether N lies in the converged range)."""
+    resolution = Resolution.of(branch.scene.solver)
+    if degree < resolution.max_degree:
+        return min(int(factor * degree), resolution.max_degree)
+    return int(degree / resolution.growth)
+
+
+class Variations(dict):
+    """SecondVariation of one equilibrium by perturbation degree, built when first asked for."""
+
+    def __init__(self, equilibrium):
+        super().__init__()
+        self.eq = equilibrium
+
+    def __missing__(self, degree):
+        self[degree] = SecondVariation(self.eq, int(degree))
+        return self[degree]
+
+
+def assess_branch(branch, degree: int, symmetric: bool | None = None, check: bool = False,
+                  near_zero: float = 0.1, m_max: int = 0):
+    """Assessments of every point and, with ``check``, the points whose flags change at the check degree.
+
+    Each point is assessed at its ``point_degrees`` (``degree`` far from wires, the degree in x that holds the
+    equilibrium near one) and checked at ``check_degree`` of that where a sign could change: points with a
+    lowest eigenvalue of magnitude below ``near_zero`` (eigenvalues are O(1) in the L2 normalisation), points
+    next to a change of a flag, and every tenth point.
     """
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
-    eq = equilibrium_of(branch)
-    variation = SecondVariation(eq, degree)
+    variations = Variations(equilibrium_of(branch))
+    degrees = point_degrees(branch, degree)
     params = branch.params
-    results = [variation.assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max) for X in branch.X]
+    results = [variations[N].assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max)
+               for N, X in zip(degrees, branch.X)]
     unsettled = []
-    if check_degree:
-        finer = SecondVariation(eq, check_degree)
+    if check:
         flags = [_flags(a) for a in results]
         for n, (X, coarse) in enumerate(zip(branch.X, results)):
             changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])
             small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
             if not (changes or small or n % 10 == 0):
                 continue
-            fine = finer.assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max)
+            fine = variations[check_degree(branch, degrees[n])].assess(X[:-1], params.with_value("P", X[-1]),
+                                                                      symmetric, m_max)
             if _flags(fine) != flags[n]:
                 unsettled.append(n)
     return results, unsettled
