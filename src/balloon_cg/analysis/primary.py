@@ -101,28 +101,31 @@ def _resolved_start(tracer: Tracer, X, degree: int, params: Parameters) -> tuple
     disc = tracer.system(degree, params).eq.disc
     while not policy.resolved(disc, X[:-1]):
         if degree >= policy.max_degree:
-            lam2 = disc.evaluate(X[:-1], np.linspace(0.0, np.pi, 181))[0]
-            slack = (f"; the membrane is compressed (smallest λ2 = {lam2.min():.4g} < 1: a membrane carries no "
-                     "compression): start at a larger continuation.start_stretch") if lam2.min() < 1 else ""
             raise ContinuationError(
                 f"the start at continuation.start_stretch = {scene.continuation.start_stretch:g}, field.M = "
                 f"{params.M:g} is not resolved: spectral error estimate {disc.tail(X[:-1]):.2g} above "
-                f"solver.max_error = {policy.max_error:g} at solver.max_degree = {policy.max_degree}{slack}")
+                f"solver.max_error = {policy.max_error:g} at solver.max_degree = {policy.max_degree}"
+                f"{_compression(disc, X)}; try a larger continuation.start_stretch or a smaller field.M")
         degree = policy.grow(degree)
         system = tracer.system(degree, params)
         guess = disc.transfer(X, system.eq.disc)
         result = newton(system.residual, system.jacobian, guess, unit(guess.size, -1), guess[-1],
                         scene.solver.tol, scene.solver.max_newton)
         if not result.converged:
-            lam2 = disc.evaluate(X[:-1], np.linspace(0.0, np.pi, 181))[0]
-            slack = (f"; the membrane is compressed (smallest λ2 = {lam2.min():.4g} < 1: a membrane carries no "
-                     "compression)") if lam2.min() < 1 else ""
             raise ContinuationError(
                 f"the start at field.M = {params.M:g} is not resolved at degree {disc.degree} (error estimate "
-                f"{disc.tail(X[:-1]):.2g}) and could not be refined to degree {degree} ({result.message}){slack}; "
-                "try a larger continuation.start_stretch or a smaller field.M")
+                f"{disc.tail(X[:-1]):.2g}) and could not be refined to degree {degree} ({result.message})"
+                f"{_compression(disc, X)}; try a larger continuation.start_stretch or a smaller field.M")
         X, disc = result.x, system.eq.disc
     return X, degree
+
+
+def _compression(disc, X) -> str:
+    """'; the membrane is compressed …' when the hoop stretch λ2 falls below 1 somewhere, else ''."""
+    lam2 = disc.evaluate(X[:-1], np.linspace(0.0, np.pi, 181))[0]
+    if lam2.min() >= 1:
+        return ""
+    return f"; the membrane is compressed (smallest λ2 = {lam2.min():.4g} < 1: a membrane carries no compression)"
 
 
 def initial_point(tracer: Tracer, start: continuation.Point, direction: float, params: Parameters,
