@@ -96,6 +96,8 @@ EDGE_SCENES = {
     "mooney_rivlin_at_the_wire": '[material]\npreset = "Mooney-Rivlin"\n' + ONE_COIL.format(M=0.01, a=3.0, h=0.5)
                                  + "[continuation]\nstop_stretch = 4.0\nwire_gap = 0.01\n[solver]\nmax_degree = 90\n",
     "strong_field_start": SPOM1 + ONE_COIL.format(M=1.0, a=4.0, h=0.0),
+    "near_critical_M": SPOM1 + ONE_COIL.format(M=4.185, a=4.0, h=0.0)
+                       + "[continuation]\nstart_stretch = 2.0\nmin_stretch = 1.5\nstop_stretch = 2.3\n",
 }
 
 
