@@ -158,3 +158,31 @@ def test_wrinkling_while_the_field_is_switched_on_is_located(tmp_path, capsys):
     above = parse_scene(SPOM1 + ONE_COIL.format(M=round(limit * 1.001, 6), a=4.0, h=0.0))
     with pytest.raises(ContinuationError, match="wrinkles"):
         start(Tracer(above))
+
+
+def test_every_crossing_eigenvalue_is_an_event():
+    """Two eigenvalues of one block crossing in the same interval are two branch points, not one."""
+    from types import SimpleNamespace
+
+    from balloon_cg.analysis.bifurcation import detect
+    from balloon_cg.analysis.results import Block
+
+    def assessment(odd, even):
+        return SimpleNamespace(blocks={Block.ODD_HELD: np.array(odd), Block.EVEN: np.array(even)})
+
+    branch = SimpleNamespace(special=[])
+    events = detect(branch, [assessment([0.5, 1.0, 2.0], [1.0, 2.0, 3.0]),
+                             assessment([-0.5, -0.1, 2.0], [1.0, 2.0, 3.0])])
+    assert events == [(0, Block.ODD_HELD, 0), (0, Block.ODD_HELD, 1)]
+
+
+def test_unclassified_branch_point_and_unstarted_branch_are_incomplete():
+    from types import SimpleNamespace
+
+    from balloon_cg.analysis.results import Block, Kind, SpecialPoint
+    from balloon_cg.analysis.verdict import failing, incomplete
+
+    bp = SpecialPoint(Kind.BP, 3, np.zeros(3), block=Block.ODD_HELD)
+    branch = SimpleNamespace(name="primary", legs=(), special=[bp], unsettled=[])
+    found = incomplete([branch], not_started=(("pear_0", "the first correction did not converge"),))
+    assert {item.gap for item in failing(found)} == {Gap.UNCLASSIFIED, Gap.NOT_STARTED}

@@ -95,9 +95,8 @@ def _landed(tracer, final, leg: LegTrace, points: list, folds: list, land_on: di
     row = np.append(disc.pole_rows()[pole], 0.0)
     end = _land(final, points[-1][0], overshoot, row, target, tracer.settings)
     if end is None:
-        reached = leg.stop.message.removeprefix("reached ")
-        return points, kept, Stop(StopCode.LANDING_FAILED,
-                                  f"could not land on {reached} (Newton failed); stopped before it")
+        return points, kept, Stop(StopCode.LANDING_FAILED, f"could not land on {pole} = {target:g} (Newton "
+                                                           "failed); stopped before it")
     last = row @ points[-1][0]
     kept += [f for f in beyond if (row @ f[2] - last) * (target - row @ f[2]) >= 0]
     return points + [(end.X, end, disc.degree, disc.tail(end.X[:-1]))], kept, leg.stop

@@ -28,7 +28,7 @@ from ..numerics import continuation
 from ..numerics.newton import newton
 from .azimuthal import spectrum
 from .problem import pressure_system
-from .results import Block, Branch, Kind, SpecialPoint, located_or_bracketed
+from .results import Block, Branch, Kind, SpecialPoint, approximate, located_or_bracketed
 
 
 def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]]:
@@ -70,13 +70,14 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
         return eigenvalue(eq, params, result.x, m, held, k, degree), result.x
 
     found = continuation.locate_root(value_at, length)
-    if found is None:
-        raise RuntimeError(f"m = {m} branch point ({block.value}) between points {index} and {index + 1} could "
-                           "not be located")
-    fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({block.value} block)")
     reading = "held at its centre" if held else "free"
-    return SpecialPoint(Kind.BP, index, found.payload, block=block, m=m,
-                        note=f"non-axisymmetric m = {m} mode, balloon {reading}", **fields)
+    note = f"non-axisymmetric m = {m} mode, balloon {reading}"
+    if found is None:  # not one evaluation converged: the bracket is all that is known
+        fields = approximate(branch.disc, X0, X1, f"branch point ({block.value} block): the corrector failed at "
+                                                  "every evaluation inside its bracket; its start is stored")
+        return SpecialPoint(Kind.BP, index, X0, block=block, m=m, note=note, **fields)
+    fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({block.value} block)")
+    return SpecialPoint(Kind.BP, index, found.payload, block=block, m=m, note=note, **fields)
 
 
 def is_copy(branch: Branch, index: int) -> bool:

@@ -46,7 +46,7 @@ def _eigenpair(variation, u, params, idx, k):
 
 def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
     """(index, block, k) of every change of the number of negative eigenvalues of the pear or even block
-    between neighbouring points; k is the eigenvalue (from the lowest, 0) that crosses zero. Changes of the
+    between neighbouring points, one per eigenvalue k (from the lowest, 0) that crosses zero. Changes of the
     even block at a fold in P are the fold itself, not a branch point."""
     folds = {s.index for s in branch.special if s.kind == Kind.LP}
     events = []
@@ -55,7 +55,7 @@ def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
             a = int(np.sum(assessments[n].blocks[block] < 0))
             b = int(np.sum(assessments[n + 1].blocks[block] < 0))
             if a != b and not (block == Block.EVEN and n in folds):
-                events.append((n, block, min(a, b)))
+                events += [(n, block, k) for k in range(min(a, b), max(a, b))]
     return events
 
 

@@ -25,7 +25,7 @@ F(x) = R(u; P), x = (u, P) (n equations, n + 1 unknowns), F_x = [J_u, R_P]:
               ℓ·ψ − 1      = 0    (1)
 
 regular at a simple (transcritical or pitchfork) bifurcation point, where β = 0 (a solution with β ≠ 0 is a
-point of the perturbed problem F + βψ, not a branch point: ``MooreSystem.genuine`` checks it).
+point of the perturbed problem F + βψ, not a branch point: ``MooreSystem.beta`` is checked to vanish).
 Jacobian rows of F_xᵀψ: ∂(J_u ψ)/∂u = D_u J_u[ψ] (the third derivative of E is symmetric), a central
 difference of the generated Hessian along ψ; ∂(J_u ψ)/∂P = ∂(R_P·ψ)/∂u = D_u R_P[ψ] (R_P = ∂²E/∂u∂P is a
 gradient: its Jacobian is symmetric), a central difference of the pressure gradient (exact: R_P is quadratic

@@ -67,8 +67,7 @@ from ..scene import Scene
 from .bifurcation import padded_mode, plain_degree
 from .branch_point import H_STEP, WernerSpence
 from .problem import equilibrium_of
-from .results import (Block, Branch, Kind, SpecialPoint, Status, StopCode, bracket_uncertainty,
-                      located_or_bracketed)
+from .results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
 from .stability import SecondVariation, block_indices
 from .wires import wire_gap
 
@@ -372,9 +371,8 @@ def _merge_status(fold, path, disc, end: CurveEnd) -> dict:
     before, after = np.append(before[:n], before[n]), np.append(after[:n], after[n])
     if end == CurveEnd.ISOLA_MERGE:
         return located_or_bracketed(fold.status, disc, before, after, "merge of the pitchforks")
-    return {"status": Status.APPROXIMATE, "uncertainty": bracket_uncertainty(disc, before, after),
-            "reason": f"fold in q not verified as a merge of the pitchforks (curve end: {end.value}: "
-                      f"{path.stop.message})"}
+    return approximate(disc, before, after, f"fold in q not verified as a merge of the pitchforks (curve end: "
+                                            f"{end.value}: {path.stop.message})")
 
 
 def land_on_q(curve: TwoParameterCurve, q: float, near: int):

@@ -39,6 +39,7 @@ class Picture:
     branch_points: list = field(default_factory=list)  # the primary branch's BP special points, in order
     snaps: list = field(default_factory=list)  # SnapThrough
     not_searched: str = ""  # why branch points were not searched, if they were not
+    not_started: list = field(default_factory=list)  # (name, reason) of pear branches that could not start
 
     @property
     def primary(self) -> Branch:
@@ -47,7 +48,7 @@ class Picture:
     @property
     def incomplete(self) -> list[Incomplete]:
         """What the picture lacks against the contract (``verdict``); empty when it is complete."""
-        return incomplete(self.branches, self.not_searched)
+        return incomplete(self.branches, self.not_searched, tuple(self.not_started))
 
 
 def _assess(branch: Branch, scene, symmetric: bool) -> None:
@@ -91,6 +92,8 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress):
             name = f"pear_{n}{suffix}"
             branch = trace_pear(primary, bp, sign, name, progress)
             if branch is None:
+                picture.not_started.append((name, f"the first correction from branch point {n} along its mode "
+                                                  "did not converge"))
                 continue
             branch.parent = ("primary", n)
             branch.rejoins = _rejoin_point(branch, picture.branch_points, n)

@@ -55,6 +55,7 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
         return base(disc, point)
 
     stretch = scene.continuation.stop_stretch
-    land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch)}
+    land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
+               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)}
     return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0,
                     land_on=land_on)

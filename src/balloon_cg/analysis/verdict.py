@@ -2,7 +2,8 @@
 
 A result is *complete* when every leg of every branch ended where the scene asked (a requested stop: the pole
 stretch limits, stop_pressure, the wire gap, a pear branch rejoining the primary branch), every special point
-is LOCATED, the stability flags of every assessed point are settled between the stability degree and the
+is LOCATED (and every axisymmetric branch point classified), every bifurcating branch asked for could be
+started, and the stability flags of every assessed point are settled between the stability degree and the
 check degree. Everything else is an ``Incomplete`` entry: typed, named, explained. A limitation of the method
 that is not a failure of the computation (branch points not searched on a scene without equator symmetry) is
 an entry too, but does not make the result incomplete (``Gap.fails``). The CLI turns failing entries into exit
@@ -12,7 +13,7 @@ complete, incomplete_*).
 import enum
 from dataclasses import dataclass
 
-from .results import Status, StopCode
+from .results import Classification, Kind, Status, StopCode
 
 REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCode.STOP_PRESSURE,
                              StopCode.WIRE_GAP, StopCode.SOUTH_STOP_STRETCH, StopCode.REJOINED})
@@ -22,6 +23,8 @@ class Gap(enum.StrEnum):
     STOPPED_SHORT = "stopped_short"  # a leg stopped before what the scene asked (budget, resolution, Newton)
     APPROXIMATE = "approximate"  # a special point is known only to a bracket
     UNSETTLED = "unsettled"  # stability flags change between the stability and the check degree at some points
+    UNCLASSIFIED = "unclassified"  # an axisymmetric branch point whose reduced energy could not be fitted
+    NOT_STARTED = "not_started"  # a bifurcating branch the analysis asked for could not be started
     NOT_SEARCHED = "not_searched"  # branch points were not searched (a limitation, stated; not a failure)
 
     @property
@@ -37,10 +40,11 @@ class Incomplete:
     message: str  # for people
 
 
-def incomplete(branches: list, not_searched: str = "") -> list[Incomplete]:
+def incomplete(branches: list, not_searched: str = "", not_started: tuple = ()) -> list[Incomplete]:
     """What the traced ``branches`` lack against the contract (module docstring); ``not_searched``: why branch
-    points were not searched on the primary branch, if they were asked for and not searched."""
-    found = []
+    points were not searched on the primary branch, if they were asked for and not searched; ``not_started``:
+    (name, reason) of the bifurcating branches that could not be started."""
+    found = [Incomplete(Gap.NOT_STARTED, name, reason) for name, reason in not_started]
     for branch in branches:
         for leg in branch.legs:
             if leg.stop.code not in REQUESTED_STOPS:
@@ -49,6 +53,9 @@ def incomplete(branches: list, not_searched: str = "") -> list[Incomplete]:
             if s.status != Status.LOCATED:
                 found.append(Incomplete(Gap.APPROXIMATE, branch.name,
                                         f"{s.kind.value} near point {s.index} (±{s.uncertainty:.1g}): {s.reason}"))
+            if s.kind == Kind.BP and s.m == 0 and s.classification == Classification.NONE:
+                found.append(Incomplete(Gap.UNCLASSIFIED, branch.name, f"BP near point {s.index}: fewer than three "
+                                        "constrained minimisations along its mode converged"))
         if branch.unsettled:
             found.append(Incomplete(Gap.UNSETTLED, branch.name,
                                     f"stability flags change at the check degree at points {branch.unsettled}"))
@@ -66,6 +73,7 @@ def summary_line(found: list[Incomplete]) -> str:
     """One line: 'complete' or what is incomplete, counted by kind."""
     if not failing(found):
         return "complete: every branch reached its requested end and every special point is located"
+    found = failing(found)
     counts = {}
     for item in found:
         counts[item.gap] = counts.get(item.gap, 0) + 1

@@ -146,7 +146,7 @@ def solve(args) -> int:
     if not np.isfinite(x) or x <= start:
         raise UsageError(f"--pole-stretch = {x:g}: must be > continuation.start_stretch = {start:g}")
     branch = trace_primary(scene, stop_stretch=x, down=False)
-    if branch.special[-1].stop.code != StopCode.STOP_STRETCH:
+    if branch.legs[0].stop.code != StopCode.STOP_STRETCH:
         reached = branch.pole_values()["lam2_north"].max()
         raise Failure(
             f"the primary branch did not reach north pole stretch {x:g} ({branch.stop_reason}); "
@@ -250,8 +250,9 @@ def critical(args) -> int:
     """Primary branch, its first pear pitchfork, the curve of pitchforks in the parameter, the merge point.
 
     Exit codes: 0 a verified merge (``CurveEnd.ISOLA_MERGE``: a fold in q at P > 0 after which the curve returns
-    to q0 at the partner pitchfork), ``critical q = ...`` on stdout. 1 (``Failure``) the computation ran but gave
-    no critical value: no pear pitchfork on the primary branch, the extended system did not start, or the curve
+    to q0 at the partner pitchfork) located, ``critical q = ...`` on stdout. 1 (``Failure``) the computation ran
+    but gave no verified critical value: no pear pitchfork on the primary branch, the extended system did not
+    start, the merge is only approximately located, or the curve
     ended otherwise (P reached 0, a fold not verified as a merge, a coil wire, the point budget, the minimum
     step): one line on stderr says how and where, and the curve file is still written. 2 (``UsageError``) a
     scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
@@ -286,6 +287,8 @@ def critical(args) -> int:
                       f"nothing to continue in {args.parameter}")
     say(f"locating the first pear pitchfork (of {len(pear)})")
     bp = locate(branch, *pear[0])
+    if bp.status != Status.LOCATED:
+        say(f"the pear pitchfork is only approximately located (±{bp.uncertainty:.1g}: {bp.reason})")
     say(f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
     try:
         with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
@@ -299,8 +302,10 @@ def critical(args) -> int:
                       f"written to {args.output}")
     q, P, stretch = curve.critical
     merge = curve.merge
-    note = "" if merge.status == Status.LOCATED else f" (approximate, ±{merge.uncertainty:.1g}: {merge.reason})"
-    print(f"critical {args.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}){note}; "
+    if merge.status != Status.LOCATED:
+        raise Failure(f"the merge of the pitchforks near {args.parameter} = {q:.8g} is only approximately located "
+                      f"(±{merge.uncertainty:.1g}: {merge.reason}); curve written to {args.output}")
+    print(f"critical {args.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
           f"curve written to {args.output}")
     return 0
 

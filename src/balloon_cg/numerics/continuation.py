@@ -169,7 +169,9 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         for label, c in monitors.items():
             if (c @ current.tangent) * (c @ point.tangent) < 0:
                 fold = _locate_fold(system, current, sigma, c, settings)
-                if fold is not None:
+                if fold is None:  # no evaluation converged: the fold is known to lie in the step, no better
+                    path.folds.append(Fold(label, current, len(path.points) - 1, RootStatus.NEAREST))
+                else:
                     path.folds.append(Fold(label, fold.payload, len(path.points) - 1, fold.status))
         reason = stop(point)
         if reason is not None:
