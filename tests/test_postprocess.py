@@ -150,7 +150,7 @@ def test_postprocess_of_a_stored_run(tmp_path, spom1):
     for key in ("lam1", "lam2", "rho", "eta"):
         np.testing.assert_allclose(q[key], stored["profiles"][key][[0, -1]], atol=1e-12)
     np.testing.assert_allclose(q["pressure"], stored["pressure"][[0, -1]])
-    reference = profiles(branch, stored["theta"])
+    reference = profiles(branch.disc, branch.X, stored["theta"])
     np.testing.assert_allclose(postprocess(run)["lam1"], reference["lam1"], atol=1e-12)
     # M = 0 branch of spheres: κ = 1/λ2² everywhere, poles included
     np.testing.assert_allclose(q["gaussian_curvature"], 1 / q["lam2"] ** 2, rtol=1e-9)

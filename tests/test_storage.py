@@ -58,7 +58,7 @@ def test_round_trip(run_file, scene, branch):
     np.testing.assert_array_equal(b["pressure"], branch.pressure)
     for name, values in branch.pole_values().items():
         np.testing.assert_array_equal(b[name], values)
-    for name, values in equator_values(branch).items():
+    for name, values in equator_values(branch.disc, branch.X).items():
         np.testing.assert_array_equal(b[name], values)
     np.testing.assert_array_equal(b["residual"], branch.residual)
     np.testing.assert_array_equal(b["error_estimate"], branch.error_estimate)
@@ -89,14 +89,14 @@ def test_sphere_profiles(request, scene, which):
     """M = 0: a centred sphere, ρ² + η² = λ², λ1 = λ2 = λ, η = ±λ at the poles."""
     branch = request.getfixturevalue(which)
     theta = theta_grid(scene.output.theta_points)
-    shape = profiles(branch, theta)
+    shape = profiles(branch.disc, branch.X, theta)
     lam = branch.pole_values()["lam2_north"][:, None]
     np.testing.assert_allclose(shape["rho"] ** 2 + shape["eta"] ** 2, lam**2 * np.ones_like(theta), rtol=0, atol=1e-10)
     np.testing.assert_allclose(shape["lam1"], lam * np.ones_like(theta), rtol=0, atol=1e-10)
     np.testing.assert_allclose(shape["lam2"], lam * np.ones_like(theta), rtol=0, atol=1e-10)
     np.testing.assert_allclose(shape["eta"][:, 0], lam[:, 0], rtol=0, atol=1e-10)
     np.testing.assert_allclose(shape["eta"][:, -1], -lam[:, 0], rtol=0, atol=1e-10)
-    equator = equator_values(branch)
+    equator = equator_values(branch.disc, branch.X)
     middle = len(theta) // 2  # θ = π/2 for an odd number of points
     np.testing.assert_allclose(equator["lam1_equator"], shape["lam1"][:, middle], rtol=1e-14)
     np.testing.assert_allclose(equator["lam2_equator"], shape["lam2"][:, middle], rtol=1e-14)

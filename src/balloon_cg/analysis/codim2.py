@@ -66,7 +66,7 @@ from ..numerics.newton import newton
 from ..scene import Scene
 from .bifurcation import padded_mode, plain_degree
 from .branch_point import H_STEP, WernerSpence
-from .problem import equilibrium_of
+from .problem import continuation_settings, equilibrium_of
 from .results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
 from .stability import SecondVariation, block_indices
 from .wires import wire_gap
@@ -288,8 +288,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
     system = ExtendedSystem(eq, params, parameter, ell)
     X0 = system.initial(bp, q0)
     if settings is None:
-        c, s = scene.continuation, scene.solver
-        settings = continuation.Settings(c.step, c.step_min, c.step_max, max_points, s.tol, s.max_newton)
+        settings = continuation_settings(scene, max_points)
     e_q = np.zeros(X0.size)
     e_q[-1] = 1.0
     # corrected at fixed q0: for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 may differ from the material's

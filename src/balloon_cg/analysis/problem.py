@@ -2,6 +2,7 @@
 import numpy as np
 
 from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..numerics import continuation
 
 
 class ParameterSystem:
@@ -19,6 +20,13 @@ class ParameterSystem:
     def jacobian(self, X):
         p = self._params(X)
         return np.hstack([self.eq.jacobian(X[:-1], p), self.eq.parameter_derivative(X[:-1], p, self.name)[:, None]])
+
+
+def continuation_settings(scene, max_points: int | None = None) -> continuation.Settings:
+    """The continuation settings of a scene's [continuation] and [solver] tables (``max_points`` overridden)."""
+    c, s = scene.continuation, scene.solver
+    return continuation.Settings(c.step, c.step_min, c.step_max, c.max_points if max_points is None else max_points,
+                                 s.tol, s.max_newton)
 
 
 def equilibrium_of(branch) -> Equilibrium:

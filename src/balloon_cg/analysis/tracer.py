@@ -19,7 +19,7 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
-from .problem import ParameterSystem
+from .problem import ParameterSystem, continuation_settings
 from .resolution import Resolution
 from .results import Kind, StopCode
 from .wires import wire_map
@@ -57,9 +57,8 @@ class Tracer:
         if held is None:
             held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
         self.pin = (not scene.field.coils) or held
-        c, s = scene.continuation, scene.solver
-        self.settings = continuation.Settings(c.step, c.step_min, c.step_max, c.max_points, s.tol, s.max_newton)
-        self.resolution = Resolution.of(s)
+        self.settings = continuation_settings(scene)
+        self.resolution = Resolution.of(scene.solver)
         self._systems = {}
 
     def system(self, degree: int, params: Parameters, mapping=None) -> ParameterSystem:

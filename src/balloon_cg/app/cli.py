@@ -160,7 +160,7 @@ def solve(args) -> int:
 def solution(branch, i: int) -> dict:
     """The reported quantities of point i of a branch."""
     X = branch.X[i]
-    values = {"pressure": X[-1], **branch.pole_values(X), **equator_values(branch, X)}
+    values = {"pressure": X[-1], **branch.pole_values(X), **equator_values(branch.disc, X)}
     return {
         **{k: float(np.squeeze(v)) for k, v in values.items()},
         "residual": float(branch.residual[i]),

@@ -1,4 +1,4 @@
-"""Deformed shapes and stretches of branch points, vectorised over points (MODEL.md §1, §6).
+"""Deformed shapes and stretches of points X = (u, P) on a discretisation, vectorised over points (MODEL.md §1, §6).
 
 From the Legendre series λ2(θ), η(θ) of every point:
     λ2' = −sin θ dλ2/dx,   η' = −sin θ dη/dx   (x = cos θ),
@@ -26,16 +26,12 @@ def meridional_stretch(theta, lam2, dlam2, deta):
     return np.hypot(lam2 * np.cos(theta) + dlam2 * np.sin(theta), deta)
 
 
-def _unknowns(branch, X):
-    return (branch.X if X is None else np.atleast_2d(X))[:, :-1]
-
-
-def profiles(branch, theta: np.ndarray, X=None) -> dict:
-    """λ1, λ2, ρ = λ2 sin θ and η on ``theta`` for every point of the branch (or for the rows of X = (u, P)).
+def profiles(disc, X: np.ndarray, theta: np.ndarray) -> dict:
+    """λ1, λ2, ρ = λ2 sin θ and η on ``theta`` for the rows X = (u, P) of points on ``disc``.
 
     Each array has shape (n_points, len(theta)).
     """
-    lam2, dlam2, eta, deta = fields(branch.disc, _unknowns(branch, X), theta)
+    lam2, dlam2, eta, deta = fields(disc, np.atleast_2d(X)[:, :-1], theta)
     return {
         "lam1": meridional_stretch(theta, lam2, dlam2, deta),
         "lam2": lam2,
@@ -44,9 +40,10 @@ def profiles(branch, theta: np.ndarray, X=None) -> dict:
     }
 
 
-def equator_values(branch, X=None) -> dict:
-    """λ1(π/2) = sqrt(λ2'² + η'²) and λ2(π/2) for every point (or row of X): arrays 'lam1_equator', 'lam2_equator'."""
-    lam2, dlam2, _, deta = fields(branch.disc, _unknowns(branch, X), EQUATOR)
+def equator_values(disc, X: np.ndarray) -> dict:
+    """λ1(π/2) = sqrt(λ2'² + η'²) and λ2(π/2) for the rows X = (u, P) of points on ``disc``: arrays
+    'lam1_equator', 'lam2_equator'."""
+    lam2, dlam2, _, deta = fields(disc, np.atleast_2d(X)[:, :-1], EQUATOR)
     return {
         "lam1_equator": meridional_stretch(EQUATOR, lam2, dlam2, deta)[:, 0],
         "lam2_equator": lam2[:, 0],

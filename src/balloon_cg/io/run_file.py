@@ -137,7 +137,7 @@ def _write_branch(group, branch, theta):
     columns = {
         "pressure": branch.pressure,
         **branch.pole_values(),
-        **equator_values(branch),
+        **equator_values(branch.disc, branch.X),
         "converged": finite(branch),
         "residual": branch.residual,
         "error_estimate": branch.error_estimate,
@@ -149,7 +149,7 @@ def _write_branch(group, branch, theta):
     for name, data in columns.items():
         group.create_dataset(name, data=data)
     shapes = group.create_group("profiles")
-    for name, data in profiles(branch, theta).items():
+    for name, data in profiles(branch.disc, branch.X, theta).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
     write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc)
     if branch.stability:
