@@ -82,9 +82,10 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
 
 def is_copy(branch: Branch, index: int) -> bool:
     """Whether an m ≥ 1 crossing between points index and index + 1 is a copy of an m = 0 branch point there:
-    no field, and an m = 0 branch point in that interval (module docstring)."""
+    no field, and an m = 0 branch point in that interval or a neighbouring one (its located point may lie just
+    outside the interval where the m ≥ 1 eigenvalue changed sign; module docstring)."""
     field_free = branch.params.M == 0 or not branch.scene.field.coils
-    return field_free and any(bp.m == 0 and bp.index == index for bp in branch.branch_points())
+    return field_free and any(bp.m == 0 and abs(bp.index - index) <= 1 for bp in branch.branch_points())
 
 
 def find(branch: Branch, degrees, m_max: int) -> list[SpecialPoint]:
