@@ -12,8 +12,9 @@ Location: Brent's method (``continuation.locate_root``) on μ_k(s), the eigenval
     R(X(s)) = 0,   d·X(s) = d·X_i + s,   d = (X_{i+1} − X_i)/|X_{i+1} − X_i|
 
 (the corrector on the chord hyperplane, as ``bifurcation.locate`` for m = 0), with the branch's own
-discretisation and the perturbation degree of its assessments; LOCATED when Brent converged (|Δs| ≤ 1e-13),
-else APPROXIMATE with the bracket (``results.located_or_bracketed``).
+discretisation and the perturbation degree of its assessments; LOCATED when Brent converged (|Δs| ≤ 1e-13) and
+the crossing eigenvalue is converged at the bracketing points between that degree and the check degree
+(``crossing_problems``, as for m = 0), else APPROXIMATE with the bracket and the reason.
 Without a field (M = 0 or no coils) the energy is invariant under every rotation and the primary branch is a
 sphere, on which a mode of spherical degree n has copies for every m ≤ n: the m = 0 mode about a tilted axis
 (the tilted pear, n = 1; the tilted n = 2 mode). So without a field a crossing in the interval of an m = 0
@@ -29,6 +30,7 @@ from ..numerics.newton import newton
 from .azimuthal import spectrum
 from .problem import pressure_system
 from .results import Block, Branch, Kind, SpecialPoint, approximate, located_or_bracketed
+from .stability import check_degree
 
 
 def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]]:
@@ -77,7 +79,28 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
                                                   "every evaluation inside its bracket; its start is stored")
         return SpecialPoint(Kind.BP, index, X0, block=block, m=m, note=note, **fields)
     fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({block.value} block)")
+    problems = crossing_problems(branch, index, m, held, k, degree)
+    if problems and not fields.get("reason"):
+        fields = approximate(branch.disc, X0, X1, f"branch point ({block.value} block): " + "; ".join(problems))
     return SpecialPoint(Kind.BP, index, found.payload, block=block, m=m, note=note, **fields)
+
+
+def crossing_problems(branch: Branch, index: int, m: int, held: bool, k: int, degree: int) -> list[str]:
+    """Whether μ_k of block m is converged at the bracketing points: at ``degree`` N and at its
+    ``stability.check_degree`` the signs agree and the values differ by less than half the value at N, and the
+    sign changes between the points ([] if so, else what is wrong; as ``bifurcation.crossing_problems``)."""
+    eq, params = pressure_system(branch).eq, branch.params
+    finer = check_degree(branch, degree)
+    problems, signs = [], []
+    for n in (index, index + 1):
+        coarse, fine = (eigenvalue(eq, params, branch.X[n], m, held, k, N) for N in (degree, finer))
+        signs.append(np.sign(coarse))
+        if np.sign(coarse) != np.sign(fine) or abs(coarse - fine) >= 0.5 * abs(coarse):
+            problems.append(f"point {n}: crossing eigenvalue not converged ({coarse:.3g} at N = {degree}, "
+                            f"{fine:.3g} at {finer})")
+    if signs[0] == signs[1]:
+        problems.append(f"the crossing eigenvalue does not change sign between points {index} and {index + 1}")
+    return problems
 
 
 def is_copy(branch: Branch, index: int) -> bool:
