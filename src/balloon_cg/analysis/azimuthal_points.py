@@ -30,7 +30,7 @@ from ..numerics.newton import newton
 from .azimuthal import spectrum
 from .problem import pressure_system
 from .results import Block, Branch, Kind, SpecialPoint, approximate, located_or_bracketed
-from .stability import check_degree
+from .stability import convergence_problems
 
 
 def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]]:
@@ -86,21 +86,11 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
 
 
 def crossing_problems(branch: Branch, index: int, m: int, held: bool, k: int, degree: int) -> list[str]:
-    """Whether μ_k of block m is converged at the bracketing points: at ``degree`` N and at its
-    ``stability.check_degree`` the signs agree and the values differ by less than half the value at N, and the
-    sign changes between the points ([] if so, else what is wrong; as ``bifurcation.crossing_problems``)."""
+    """Whether μ_k of block m is converged at the bracketing points, both at ``degree``
+    (``stability.convergence_problems``, as for m = 0)."""
     eq, params = pressure_system(branch).eq, branch.params
-    finer = check_degree(branch, degree)
-    problems, signs = [], []
-    for n in (index, index + 1):
-        coarse, fine = (eigenvalue(eq, params, branch.X[n], m, held, k, N) for N in (degree, finer))
-        signs.append(np.sign(coarse))
-        if np.sign(coarse) != np.sign(fine) or abs(coarse - fine) >= 0.5 * abs(coarse):
-            problems.append(f"point {n}: crossing eigenvalue not converged ({coarse:.3g} at N = {degree}, "
-                            f"{fine:.3g} at {finer})")
-    if signs[0] == signs[1]:
-        problems.append(f"the crossing eigenvalue does not change sign between points {index} and {index + 1}")
-    return problems
+    return convergence_problems(branch, index,
+                                lambda n, N: eigenvalue(eq, params, branch.X[n], m, held, k, N), (degree, degree))
 
 
 def is_copy(branch: Branch, index: int) -> bool:
@@ -113,7 +103,7 @@ def is_copy(branch: Branch, index: int) -> bool:
 
 def find(branch: Branch, degrees, m_max: int) -> list[SpecialPoint]:
     """The m ≥ 1 branch points, m ≤ m_max, of a branch assessed at the perturbation degrees ``degrees`` (one per
-    point, ``stability.point_degrees``; ``branch.stability``), in order along it, each located at the larger
+    point, ``Assessment.degree`` of ``branch.stability``), in order along it, each located at the larger
     degree of its two bracketing points; without a field, the copies of its m = 0 branch points are left to
     them (module docstring)."""
     return [locate(branch, index, m, held, block, k, max(degrees[index], degrees[index + 1]))

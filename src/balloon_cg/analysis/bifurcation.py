@@ -28,7 +28,7 @@ from .branch_point import MooreSystem, WernerSpence
 from .problem import equilibrium_of
 from .resolution import Resolution
 from .results import Block, Branch, Classification, Kind, SpecialPoint, Status, approximate
-from .stability import SecondVariation, Variations, block_indices, check_degree, point_degrees
+from .stability import SecondVariation, Variations, block_indices, convergence_problems, point_degrees
 from .tracer import Tracer
 
 EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
@@ -159,31 +159,18 @@ def containing_interval(branch: Branch, X) -> int:
 
 
 def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[str]:
-    """Whether the crossing eigenvalue changes sign between points index and index + 1 and is converged there:
-    at each point's stability degree N (``stability.point_degrees``) and at its ``stability.check_degree`` the
-    signs agree and the values differ by less than half the value at N ([] if so, else what is wrong)."""
+    """Whether the crossing eigenvalue of ``block`` is converged at the bracketing points, at their
+    ``stability.point_degrees`` (``stability.convergence_problems``)."""
     eq, params = equilibrium_of(branch), branch.params
     variations = Variations(eq)
+
+    def eigenvalue(n, degree):
+        variation, X = variations[degree], branch.X[n]
+        idx = block_indices(variation, block, field_on=False)
+        return _eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)[0]
+
     degrees = point_degrees(branch, branch.scene.stability.degree)
-    problems = []
-    signs = []
-    for n in (index, index + 1):
-        X = branch.X[n]
-        N, finer = int(degrees[n]), check_degree(branch, int(degrees[n]))
-        at = {}
-        for degree in (N, finer):
-            variation = variations[degree]
-            idx = block_indices(variation, block, field_on=False)
-            at[degree] = _eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)[0]
-        coarse, fine = at[N], at[finer]  # ``fine``: the check degree's (coarser at solver.max_degree)
-        signs.append(np.sign(coarse))
-        if np.sign(coarse) != np.sign(fine) or abs(coarse - fine) >= 0.5 * abs(coarse):
-            problems.append(f"point {n}: crossing eigenvalue not converged ({coarse:.3g} at N = {N}, "
-                            f"{fine:.3g} at {finer})")
-    if signs[0] == signs[1]:
-        problems.append(f"the crossing eigenvalue does not change sign between points {index} and {index + 1} "
-                        "at the stability degree")
-    return problems
+    return convergence_problems(branch, index, eigenvalue, degrees[index:index + 2])
 
 
 def general_tracer(scene) -> Tracer:

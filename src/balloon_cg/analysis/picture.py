@@ -16,7 +16,7 @@ from . import azimuthal_points, bifurcation
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
-from .stability import assess_branch, point_degrees
+from .stability import assess_branch
 from .switching import trace_pear
 from .verdict import Incomplete, incomplete
 
@@ -75,7 +75,7 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     if pear:
         _trace_pears(scene, primary, picture, progress)
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
-        degrees = point_degrees(branch, scene.stability.degree)
+        degrees = [a.degree for a in branch.stability]
         branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
     picture.snaps = snap_throughs(picture.branches)

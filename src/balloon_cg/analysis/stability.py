@@ -44,6 +44,7 @@ class Assessment:
     stable_volume: bool  # held, volume control
     stable_pressure_free: bool  # free balloon (translation included; equal to held without a field)
     stable_volume_free: bool
+    degree: int  # the perturbation degree N it was computed at
 
     def flags(self) -> dict:
         """The four stability flags by name."""
@@ -136,7 +137,7 @@ class SecondVariation:
                 blocks[f"m{m}_free"] = readings[False]
             lowest_free = blocks[f"m{m}_free" if field_on else f"m{m}_held"][0]
             free, free_volume = min(free, lowest_free), min(free_volume, lowest_free)
-        return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0)
+        return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0, self.basis.degree)
 
 
 def block_indices(variation, block: str, field_on: bool):
@@ -164,6 +165,25 @@ def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:
     if degree < resolution.max_degree:
         return min(int(factor * degree), resolution.max_degree)
     return int(degree / resolution.growth)
+
+
+def convergence_problems(branch, index: int, eigenvalue, degrees) -> list[str]:
+    """Whether a crossing eigenvalue changes sign between points index and index + 1 and is converged there: at
+    each point's degree N (``degrees``: one per bracketing point) and at its ``check_degree`` the signs agree and
+    the values differ by less than half the value at N ([] if so, else what is wrong). ``eigenvalue(n, N)`` is the
+    eigenvalue at point n on the perturbation basis of degree N."""
+    problems, signs = [], []
+    for n, N in zip((index, index + 1), degrees):
+        finer = check_degree(branch, int(N))
+        coarse, fine = eigenvalue(n, int(N)), eigenvalue(n, finer)  # ``fine``: coarser at solver.max_degree
+        signs.append(np.sign(coarse))
+        if np.sign(coarse) != np.sign(fine) or abs(coarse - fine) >= 0.5 * abs(coarse):
+            problems.append(f"point {n}: crossing eigenvalue not converged ({coarse:.3g} at N = {int(N)}, "
+                            f"{fine:.3g} at {finer})")
+    if signs[0] == signs[1]:
+        problems.append(f"the crossing eigenvalue does not change sign between points {index} and {index + 1} "
+                        "at the stability degree")
+    return problems
 
 
 class Variations(dict):

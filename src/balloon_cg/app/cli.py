@@ -350,6 +350,7 @@ def _add_sweep(commands):
 
 def sweep(args) -> int:
     """Expand, compute the members not yet in the file, append them, summarise."""
+    from ..io.sweep_file import incomplete_members
     from .sweep import SweepError, format_summary, run_sweep
 
     if args.workers is not None and args.workers < 1:
@@ -366,19 +367,13 @@ def sweep(args) -> int:
     if result.failed:
         raise Failure(f"{len(result.failed)} of {len(result.members)} sweep members failed (members "
                       f"{', '.join(map(str, sorted(result.failed)))}); re-run the same command to retry them")
-    partial = incomplete_members(result.path)
+    partial = incomplete_members(result.path)  # the verdicts stored with the members (attributes only)
     if partial:
         print(f"{PROG}: incomplete: sweep members {', '.join(map(str, partial))} (their results are flagged in the "
               "file: members/<index> attributes complete, incomplete_*)", file=sys.stderr)
         return 0 if args.allow_partial else 1
     return 0
 
-
-def incomplete_members(path) -> list[int]:
-    """Indices of the members of a sweep file whose results are incomplete."""
-    from ..io.sweep_file import read_sweep
-
-    return [index for index, member in read_sweep(path)["members"].items() if not member["attrs"].get("complete")]
 
 
 # --- summaries ---------------------------------------------------------------------------------------------

@@ -160,3 +160,11 @@ def read_sweep(path) -> dict:
             out["members"][int(name)] = {"overrides": json.loads(attrs["overrides"]), "scene_hash": attrs["scene_hash"],
                                          "attrs": attrs, **read_branches(g)}
     return out
+
+
+def incomplete_members(path) -> list[int]:
+    """Indices of the whole members of a sweep file whose results are incomplete (from their ``complete``
+    attribute; nothing else is read)."""
+    with h5py.File(path, "r") as f:
+        return sorted(int(name) for name, g in f["members"].items()
+                      if not name.startswith(_TMP_PREFIX) and not bool(g.attrs.get("complete", False)))
