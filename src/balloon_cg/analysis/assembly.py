@@ -63,8 +63,7 @@ def _collect(leg: LegTrace, disc, moves):
         for p, X, lost in zip(path.points, moved, loss):
             points.append((X, p, coarse.degree, coarse.tail(p.X[:-1]) + lost))
         for f in path.folds:
-            after = path.points[f.index + 1].X if f.index + 1 < len(path.points) else path.overshoot.X
-            found = located_or_bracketed(f.status, coarse, path.points[f.index].X, after, f"fold {f.label.value}")
+            found = located_or_bracketed(f.status, coarse, *path.bracket(f), f"fold {f.label.value}")
             folds.append((f.label, base + f.index, coarse.transfer(f.point.X, disc), found))
     return points, folds
 

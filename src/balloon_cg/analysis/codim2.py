@@ -364,8 +364,7 @@ def _pressure_zero_stop(system, path, parameter: str, settings) -> Stop:
 def _merge_status(fold, path, disc, end: CurveEnd) -> dict:
     """Status fields of a fold of the curve in q, bracketed by the curve points around it: LOCATED only for a
     verified merge (ISOLA_MERGE) whose root search converged."""
-    after = path.points[fold.index + 1].X if fold.index + 1 < len(path.points) else path.overshoot.X
-    before = path.points[fold.index].X
+    before, after = path.bracket(fold)
     n = disc.size
     before, after = np.append(before[:n], before[n]), np.append(after[:n], after[n])
     if end == CurveEnd.ISOLA_MERGE:

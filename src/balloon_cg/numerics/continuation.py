@@ -73,6 +73,12 @@ class Path:
     stop: Stop | None = None
     overshoot: Point | None = None  # the first point past a stop condition (not part of the branch)
 
+    def bracket(self, fold: Fold) -> tuple[np.ndarray, np.ndarray]:
+        """X of the two points a fold lies between: points[index] and the next one (the overshoot, for a fold
+        found on the step that ended the trace)."""
+        after = self.points[fold.index + 1] if fold.index + 1 < len(self.points) else self.overshoot
+        return self.points[fold.index].X, after.X
+
 
 def tangent(system, X, reference) -> np.ndarray:
     """Unit null vector of J(X) oriented along ``reference``."""
