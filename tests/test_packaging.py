@@ -61,7 +61,10 @@ def fresh_venv(tmp_path) -> tuple[Path, Path]:
     site = Path(subprocess.run([python, "-c", "import sysconfig; print(sysconfig.get_path('purelib'))"],
                                check=True, capture_output=True, text=True).stdout.strip())
     folders = dict.fromkeys(str(d.locate_file("")) for d in importlib.metadata.distributions())
-    (site / "environment.pth").write_text("".join(f"{f}\n" for f in folders if not f.startswith(str(ROOT))))
+    # the source tree itself is left out (it must come from the installs under test), not an environment that
+    # happens to live inside it (a venv in the clone)
+    inside = [f for f in folders if f.startswith(str(ROOT)) and "site-packages" not in Path(f).parts]
+    (site / "environment.pth").write_text("".join(f"{f}\n" for f in folders if f not in inside))
     return python, site
 
 
