@@ -10,7 +10,7 @@ from balloon_cg.app import sweep as sweep_module
 from balloon_cg.app.cli import main
 from balloon_cg.scene import SceneError, load_scene
 from balloon_cg.app.sweep import expand, run_sweep, scene_hash
-from balloon_cg.io.sweep_file import SweepError, read_sweep
+from balloon_cg.io.sweep_file import Store, SweepError, read_sweep, store_path
 
 SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "spom1_single_coil.toml"
 SPECS = ["M=0:0.004:3"]
@@ -110,28 +110,30 @@ def test_dask_cluster_equals_local_pool(scene, serial, tmp_path):
 
 def test_interrupted_sweep_resumes_without_recomputing(scene, serial, tmp_path, monkeypatch):
     path, written = tmp_path / "resume.h5", []
-    append = sweep_module.append_member
+    write = Store.write_member
 
-    def append_then_interrupt(f, member, result):
-        append(f, member, result)
+    def write_then_interrupt(store, member, result):
+        write(store, member, result)
         written.append(member.index)
         raise KeyboardInterrupt  # the user presses Ctrl-C after the first member is written
 
-    monkeypatch.setattr(sweep_module, "append_member", append_then_interrupt)
+    monkeypatch.setattr(Store, "write_member", write_then_interrupt)
     with pytest.raises(KeyboardInterrupt):
         run_sweep(scene, SPECS, path, mode=MODE, workers=2)
-    monkeypatch.setattr(sweep_module, "append_member", append)
+    monkeypatch.setattr(Store, "write_member", write)
     assert len(written) == 1
-    with h5py.File(path, "a") as f:
+    with h5py.File(path) as f:  # the view was rebuilt on the way out
         assert list(f["members"]) == [str(written[0])]
         first = dict(f["members"][str(written[0])].attrs)
-        f["members"].create_group(".tmp-2-deadbeef")  # a member whose write was cut before its rename
+    debris = store_path(path) / ".000002.h5.0123abcd.tmp"
+    debris.write_bytes(b"half a member")  # a member file whose write was cut before its rename
 
     result = run_sweep(scene, SPECS, path, mode=MODE, workers=2)
     assert result.skipped == written
     assert sorted(result.computed) == sorted({0, 1, 2} - set(written))
+    assert not debris.exists()
     with h5py.File(path) as f:
-        assert sorted(f["members"]) == ["0", "1", "2"]  # the leftover temporary group is gone
+        assert sorted(f["members"]) == ["0", "1", "2"]
         again = f["members"][str(written[0])].attrs
         assert again["created"] == first["created"] and again["worker_pid"] == first["worker_pid"]
     assert_same_members(serial, read_sweep(path))
@@ -150,8 +152,8 @@ def test_resume_refuses_changed_scene(scene, tmp_path):
         run_sweep(scene, ["M=0,0.003"], path, mode=MODE, workers=1)
     with pytest.raises(SweepError, match="mode differs"):
         run_sweep(scene, ["M=0,0.002"], path, mode="no-pear", workers=1)
-    with h5py.File(path, "a") as f:  # a member stored for another scene than the one it should hold
-        f["members/1"].attrs["scene_hash"] = scene_hash(moved)
+    with h5py.File(store_path(path) / "000001.h5", "a") as f:  # a member stored for another scene
+        f.attrs["scene_hash"] = scene_hash(moved)
     with pytest.raises(SweepError, match=r"member 1 \(field.M=0.002\) was computed for another scene"):
         run_sweep(scene, ["M=0,0.002"], path, mode=MODE, workers=1)
     result = run_sweep(moved, ["M=0,0.002"], path, mode=MODE, workers=1, force=True)

@@ -5,7 +5,9 @@ special point is located, stability settled); 1 the computation did not give wha
 not start, or the result is incomplete: the file is still written, flagged, and the incomplete parts are named
 on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: the two-parameter curve did not
 end in a verified merge of the pitchforks); 2 bad input (invalid scene, missing or unreadable file, existing
-output without --force, a scene ``critical`` cannot handle). Errors are one line on stderr, ``balloon-cg: error: ...``.
+output without --force or in use by another process, a damaged file, a scene ``critical`` cannot handle); 3 an
+internal error (a bug: one line asking to report it; ``--debug`` shows the traceback). Errors are one line on
+stderr, ``balloon-cg: error: ...``.
 """
 import argparse
 import json
@@ -26,7 +28,9 @@ from ..post.plotting import KINDS, PlotError, plot as draw_plot
 from ..galerkin.profiles import equator_values
 from ..scene import SceneError, load_scene
 from ..io.hdf5 import check_output
-from ..io.run_file import RunFileError, read_run, write_run
+from ..io.lock import claim
+from ..io.run_file import read_run, write_run
+from ..io.schema import FileError
 
 PROG = "balloon-cg"
 
@@ -46,16 +50,26 @@ def main(argv=None) -> int:
     args.command_line = shlex.join([PROG, *argv])
     try:
         return args.handler(args)
-    except (SceneError, RunFileError, UsageError, PlotError, FieldError) as e:
-        return _error(str(e), 2)
+    except (SceneError, FileError, UsageError, PlotError, FieldError) as e:
+        return _debug(args) or _error(str(e), 2)
     except OSError as e:
-        return _error(_os_message(e), 2)
+        return _debug(args) or _error(_os_message(e), 2)
     except (ContinuationError, Failure) as e:
-        return _error(str(e), 1)
+        return _debug(args) or _error(str(e), 1)
+    except Exception as e:  # noqa: BLE001 - a bug: one line and exit 3 (the traceback with --debug)
+        return _debug(args) or _error(f"internal error ({type(e).__name__}: {e}); please report it with the "
+                                      f"command and the output of `{PROG} --debug ...`", 3)
+
+
+def _debug(args) -> None:
+    """With --debug, re-raise the exception being handled (the traceback instead of one line)."""
+    if args.debug:
+        raise
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical):
         add(commands)
@@ -116,17 +130,18 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
     The output is checked before the trace (which may take long); ``progress`` shows a bar on stderr;
     ``command`` overrides the provenance attribute (default: sys.argv).
     """
-    check_output(out_path, force)
-    with tqdm(desc=scene.name, unit=" points", disable=not progress, file=sys.stderr) as bar:
-        tick = lambda point: bar.update()  # noqa: E731
-        if primary_only:
-            branches, snaps = [trace_primary(scene, progress=tick)], None
-            found = incomplete(branches)
-        else:
-            picture = analyse(scene, progress=tick)
-            branches, snaps, found = picture.branches, picture.snaps, picture.incomplete
-    extra = {} if command is None else {"command": command}
-    return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found), found
+    with claim(out_path, "run"):
+        check_output(out_path, force)
+        with tqdm(desc=scene.name, unit=" points", disable=not progress, file=sys.stderr) as bar:
+            tick = lambda point: bar.update()  # noqa: E731
+            if primary_only:
+                branches, snaps = [trace_primary(scene, progress=tick)], None
+                found = incomplete(branches)
+            else:
+                picture = analyse(scene, progress=tick)
+                branches, snaps, found = picture.branches, picture.snaps, picture.incomplete
+        extra = {} if command is None else {"command": command}
+        return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found), found
 
 
 # --- solve -------------------------------------------------------------------------------------------------

@@ -3,9 +3,12 @@
 ``balloon-cg sweep SCENE.toml --vary M=0:0.005:21 -o SWEEP.h5`` expands the specs into members (each a Scene
 made by ``Scene.with_overrides``), computes them in worker processes (a local ProcessPoolExecutor, or an
 existing dask.distributed cluster with ``--scheduler``) and appends each member to one sweep file as it
-finishes (layout: ``io.sweep_file``). Workers return their results as plain data (``MemberResult``); only the
-parent process writes the sweep file. Re-running the same sweep skips the members whose group holds the same
-scene_hash; a different sweep into an existing file needs --force.
+finishes, each to its own file (``io.sweep_file``: a store folder beside the sweep file, and the sweep file a
+view rebuilt from it). The output is owned (``io.lock.claim``) from before the expansion until the view is
+written. Workers return their results as plain data (``MemberResult``); only the parent process writes, and the
+pool's workers die with it (``worker_hygiene``). Re-running the same sweep skips the members whose file holds
+the same scene_hash; a different sweep into an existing file needs --force, which replaces the old sweep only
+once every member of the new one is written.
 """
 import contextlib
 import hashlib
@@ -24,10 +27,14 @@ from tqdm import tqdm
 from ..analysis.picture import analyse
 from ..analysis.primary import trace_primary
 from ..analysis.verdict import incomplete
-from ..io.sweep_file import SweepError, append_member, open_sweep, read_sweep, root_attrs
+from ..io.lock import claim
+from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
+                             store_path)
+from .hygiene import worker_hygiene
 from ..scene import Scene, SceneError, parse_scene
 
 MODES = ("analysis", "no-pear", "primary-only")
+MAX_MEMBERS = 10_000  # docs/scenes.md, Bounds: a sweep's member count (the product of the --vary counts)
 
 
 # --- specs and members -------------------------------------------------------------------------------------
@@ -77,6 +84,8 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
             raise SweepError(f"--vary {spec!r}: START and STOP must be numbers and COUNT an integer") from None
         if count < 1 or (count == 1 and start != stop):
             raise SweepError(f"--vary {spec!r}: COUNT must be >= 2 (or 1 with START = STOP)")
+        if count > MAX_MEMBERS:
+            raise SweepError(f"--vary {spec!r}: COUNT = {count}: at most {MAX_MEMBERS} members per sweep")
         values = np.linspace(start, stop, count).tolist()
         if isinstance(start, int) and isinstance(stop, int) and all(float(v).is_integer() for v in values):
             values = [int(v) for v in values]
@@ -113,6 +122,9 @@ def expand(scene: Scene, specs: list[str]) -> list[Member]:
     keys = [k for k, _ in axes]
     if len(set(keys)) != len(keys):
         raise SweepError(f"--vary: the same key is varied twice ({', '.join(keys)})")
+    total = int(np.prod([len(v) for _, v in axes], dtype=object))
+    if total > MAX_MEMBERS:
+        raise SweepError(f"--vary {' '.join(specs)}: {total} members; at most {MAX_MEMBERS} per sweep")
     members, errors = [], {}
     for index, values in enumerate(itertools.product(*(v for _, v in axes))):
         overrides = dict(zip(keys, values))
@@ -214,44 +226,57 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
 class SweepResult:
     path: Path
     members: list
+    mode: str = "analysis"
+    store: Path = None  # the folder of the member files (io.sweep_file.store_path, or staging_path for --force)
     computed: list = field(default_factory=list)  # indices computed by this call
-    skipped: list = field(default_factory=list)  # indices already in the file (same scene_hash)
+    skipped: list = field(default_factory=list)  # indices already in the store (same scene_hash)
     failed: dict = field(default_factory=dict)  # index -> error message
+    replaced: bool = True  # False: a --force sweep left incomplete; the old sweep file is kept
     wall_time: float = 0.0
 
 
 def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis", workers: int | None = None,
               scheduler: str | None = None, force: bool = False, progress: bool = False,
               command: str | None = None, members: list[Member] | None = None) -> SweepResult:
-    """Expand ``specs`` over ``scene``, compute the members not yet in ``out_path`` and append them.
+    """Expand ``specs`` over ``scene``, compute the members not yet stored for ``out_path`` and write them.
 
     ``workers``: local processes (default: all cores; 1 computes in this process); ``scheduler``: address of a
     dask.distributed scheduler to send the members to instead. Failed members are reported in the result (the
-    others are written); an interrupted sweep keeps the members written so far.
+    others are written); an interrupted sweep keeps the members written so far. The sweep file is rebuilt from
+    the store when the call ends; with ``force`` only once every member is written (else ``replaced`` is
+    False and the old file is untouched; the same --force call resumes the replacement).
+    Raises io.lock.OutputInUse at once if another process owns ``out_path``.
     """
     if mode not in MODES:
         raise SweepError(f"mode {mode!r}: must be one of {', '.join(MODES)}")
     start = time.perf_counter()
-    members = expand(scene, specs) if members is None else members
-    axes = [list(parse_vary(s, scene)) for s in specs]
     path = Path(out_path)
-    f, done = open_sweep(path, root_attrs(scene, axes, mode, len(members), command), members, force)
-    result = SweepResult(path, members, skipped=sorted(done))
-    todo = [m for m in members if m.index not in done]
-    by_index = {m.index: m for m in members}
-    try:
-        with tqdm(total=len(members), initial=len(done), desc="sweep", unit=" members",
-                  disable=not progress, file=sys.stderr) as bar:
-            with contextlib.closing(_compute(todo, mode, workers, scheduler)) as outcomes:
-                for index, outcome in outcomes:
-                    if isinstance(outcome, BaseException):
-                        result.failed[index] = f"{type(outcome).__name__}: {outcome}"
-                    else:
-                        append_member(f, by_index[index], outcome)
-                        result.computed.append(index)
-                    bar.update()
-    finally:
-        f.close()
+    with claim(path, "sweep"):
+        members = expand(scene, specs) if members is None else members
+        axes = [list(parse_vary(s, scene)) for s in specs]
+        store = open_store(path, root_attrs(scene, axes, mode, len(members), command), members, force)
+        result = SweepResult(path, members, mode, store.directory, skipped=sorted(store.done))
+        todo = [m for m in members if m.index not in store.done]
+        by_index = {m.index: m for m in members}
+        try:
+            with tqdm(total=len(members), initial=len(store.done), desc="sweep", unit=" members",
+                      disable=not progress, file=sys.stderr) as bar:
+                with contextlib.closing(_compute(todo, mode, workers, scheduler)) as outcomes:
+                    for index, outcome in outcomes:
+                        if isinstance(outcome, BaseException):
+                            result.failed[index] = f"{type(outcome).__name__}: {outcome}"
+                        else:
+                            store.write_member(by_index[index], outcome)
+                            result.computed.append(index)
+                        bar.update()
+        finally:
+            if not force:
+                consolidate(path, store.directory)
+            elif len(store.done) == len(members):
+                commit_replacement(path)
+                result.store = store_path(path)
+            else:
+                result.replaced = False
     result.wall_time = time.perf_counter() - start
     return result
 
@@ -274,7 +299,8 @@ def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str 
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)))
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), initializer=worker_hygiene,
+                               initargs=(os.getpid(),))
     try:
         futures = {pool.submit(compute_member, *job): job[0] for job in jobs}
         for future in as_completed(futures):
@@ -309,9 +335,9 @@ def _compute_dask(jobs, scheduler: str):
 # --- reading and summary -----------------------------------------------------------------------------------
 
 def format_summary(result: SweepResult) -> str:
-    """Members, time, and per member the pear branch points (pressures) read back from the sweep file."""
-    sweep = read_sweep(result.path)
-    mode = sweep["attrs"]["mode"]
+    """Members, time, and per member the pear branch points (pressures) read back from the store."""
+    stored_members = read_store(result.store)
+    mode = result.mode
     lines = [
         f"sweep file     {result.path}",
         f"members        {len(result.members)}: {len(result.computed)} computed, {len(result.skipped)} already in "
@@ -328,7 +354,7 @@ def format_summary(result: SweepResult) -> str:
         if m.index in result.failed:
             lines.append(f"{m.index:>6}  {m.label:<{w}}  failed: {result.failed[m.index]}")
             continue
-        stored = sweep["members"].get(m.index)
+        stored = stored_members.get(m.index)
         if stored is None:
             lines.append(f"{m.index:>6}  {m.label:<{w}}  not computed")
             continue

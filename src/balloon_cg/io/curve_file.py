@@ -20,7 +20,8 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain
-from .run_file import read_special, root_attrs, write_special
+from .run_file import SPECIAL_COLUMNS, read_run, read_special, root_attrs, write_special
+from .schema import FileError, check_columns, require_attrs, require_group
 
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):
@@ -57,13 +58,29 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
     return path
 
 
+CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_north", "lam2_south", "residual")},
+                 "newton_iterations": ("int", 1), "unknowns": ("float", 2), "mode": ("float", 2)}
+CURVE_KINDS = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float"}
+
+
 def read_curve(path, name: str = "pear") -> dict:
-    """The datasets and attributes of a stored curve: {'attrs', datasets…, 'special_points': [dicts], 'q'}."""
+    """The datasets and attributes of a stored curve: {'attrs', datasets…, 'special_points': [dicts], 'q'}.
+    Raises CurveFileError naming the file and what is missing (the file must also be a readable run file)."""
+    read_run(path)  # the root attributes and /branches, checked
     with h5py.File(path, "r") as f:
-        group = f["two_parameter"][name]
+        curves = require_group(f, "two_parameter", path, CurveFileError)
+        group = require_group(curves, name, f"{path}: two_parameter", CurveFileError)
+        where = f"{path}: two_parameter/{name}"
+        require_attrs(group.attrs, where, CURVE_KINDS, CURVE_KINDS, CurveFileError)
+        check_columns(group, where, CURVE_COLUMNS, CurveFileError)
+        special = require_group(group, "special_points", where, CurveFileError)
+        check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS | {"q": ("float", 1)}, CurveFileError)
         data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}
-        special = group["special_points"]
         data["special_points"] = read_special(special)
         data["special_q"] = special["q"][()]
     return data
+
+
+class CurveFileError(FileError):
+    """A file that is not a readable two-parameter curve file (names the file and what is missing)."""

@@ -36,6 +36,7 @@ import numpy as np
 from ..analysis.verdict import failing, incomplete
 from ..galerkin.profiles import equator_values, profiles, theta_grid
 from .hdf5 import atomic_file, plain, provenance, write_strings
+from .schema import FileError, check_columns, require_attrs, require_group
 
 FORMAT = "balloon-cg/2"
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
@@ -43,8 +44,8 @@ SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
 SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
 
 
-class RunFileError(ValueError):
-    """A file that is not a readable balloon-cg run file."""
+class RunFileError(FileError):
+    """A file that is not a readable balloon-cg run file (names the file and what is missing or wrong)."""
 
 
 def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | None = None,
@@ -213,8 +214,8 @@ def read_run(path) -> dict:
 
     Each branch is a dict of its attrs ('attrs'), its per-point arrays and 'theta', 'profiles' (dict of
     arrays), 'special_points' (list of dicts: the special_points columns) and 'special_unknowns'
-    (their X rows).
-    Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a balloon-cg/2 run file.
+    (their X rows). The layout is checked first (``io.schema``).
+    Raises FileNotFoundError, IsADirectoryError, or RunFileError naming the file and what is missing or wrong.
     """
     path = Path(path)
     if path.is_dir():
@@ -224,24 +225,76 @@ def read_run(path) -> dict:
     try:
         f = h5py.File(path, "r")
     except OSError:
-        raise RunFileError(f"{path}: not a readable HDF5 file") from None
+        raise RunFileError(path, "not a readable HDF5 file") from None
     with f:
         fmt = f.attrs.get("format")
         if fmt != FORMAT:
-            found = "no format attribute" if fmt is None else f"format {fmt!r}"
-            raise RunFileError(f"{path}: not a balloon-cg run file ({found}, expected {FORMAT!r})")
-        try:
-            attrs = {k: _attr(v) for k, v in f.attrs.items()}
-            return {"path": str(path), "scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
-        except KeyError as e:
-            raise RunFileError(f"{path}: damaged balloon-cg run file (missing {e})") from None
+            found = "no format attribute" if fmt is None else f"format {plain(fmt)!r}"
+            raise RunFileError(path, f"not a balloon-cg run file ({found}, expected {FORMAT!r})")
+        require_attrs(f.attrs, path, ROOT_KINDS, ROOT_KINDS, error=RunFileError)
+        if "complete" in f.attrs:
+            require_attrs(f.attrs, path, VERDICT_KINDS, VERDICT_KINDS, error=RunFileError)
+        attrs = {k: _attr(v) for k, v in f.attrs.items()}
+        return {"path": str(path), "scene_name": attrs["scene_name"], "attrs": attrs,
+                **read_branches(f, path, RunFileError)}
 
 
-def read_branches(parent) -> dict:
-    """{'branches': {name: branch dict}, 'snap_throughs': [...]} of an h5py group written by write_branches."""
-    group = parent["branches"]
+ROOT_KINDS = {"scene_name": "str", "scene_toml": "str", "tolerance": "float", "package_version": "str",
+              "generated_digest": "str", "created": "str", "command": "str"}
+VERDICT_KINDS = {"complete": "bool", "incomplete_gaps": "str[]", "incomplete_branches": "str[]",
+                 "incomplete_messages": "str[]"}
+BRANCH_KINDS = {"stop_reason": "str", "wall_time": "float", "degree": "int", "symmetric": "bool",
+                "pin_translation": "bool", "quadrature": "int", "kernel_class": "str", "kernel_signature": "str",
+                "M": "float", "chi": "float", "leg_labels": "str[]", "leg_stop_codes": "str[]",
+                "map_centres": "float[]", "map_widths": "float[]"}
+BRANCH_COLUMNS = {**{name: ("float", 1) for name in ("pressure", *POLES, "lam1_equator", "lam2_equator", "residual",
+                                                      "error_estimate")},
+                  "converged": ("bool", 1), "newton_iterations": ("int", 1), "solved_degree": ("int", 1),
+                  "unknowns": ("float", 2)}
+PROFILES = {name: ("float", 2) for name in ("lam1", "lam2", "rho", "eta")}
+SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int", 1), "m": ("int", 1),
+                   **{name: ("float", 1) for name in SPECIAL_NUMBERS}, "unknowns": ("float", 2)}
+SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
+                "to_index": ("int", 1), "pressure": ("float", 1)}
+
+
+def read_branches(parent, where, error=None) -> dict:
+    """{'branches': {name: branch dict}, 'snap_throughs': [...]} of an h5py group written by write_branches,
+    checked first (``error``, default RunFileError, names ``where`` and what is missing)."""
+    error = error or RunFileError
+    group = require_group(parent, "branches", where, error)
+    for name, branch in group.items():
+        check_branch(branch, f"{where}: branch {name}", error)
+    snaps = parent.get("snap_throughs")
+    if snaps is not None:
+        check_columns(snaps, f"{where}: snap_throughs", SNAP_COLUMNS, error)
     return {"branches": {name: _read_branch(group[name]) for name in _branch_order(group)},
-            "snap_throughs": _read_snaps(parent.get("snap_throughs"))}
+            "snap_throughs": _read_snaps(snaps)}
+
+
+def check_branch(group, where, error) -> None:
+    """The attributes and columns of one stored branch (at least one point; unknowns, profiles and special
+    points of consistent shapes)."""
+    if not isinstance(group, h5py.Group):
+        raise error(where, "is not a group")
+    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS, error)
+    n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
+    width = group["unknowns"].shape[1]
+    t = check_columns(group, where, {"theta": ("float", 1)}, error)
+    check_columns(require_group(group, "profiles", where, error), f"{where}: profiles", PROFILES, error, rows=n)
+    for name, item in group["profiles"].items():
+        if item.shape[1:] != (t,):
+            raise error(f"{where}: profiles", f"dataset {name} has shape {item.shape}, expected ({n}, {t})")
+    special = require_group(group, "special_points", where, error)
+    check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
+    if special["unknowns"].shape[1:] != (width,) and special["unknowns"].shape[0]:
+        raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
+                                                f"expected {width}")
+    if "stability" in group:
+        stability = require_group(group, "stability", where, error)
+        flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
+        lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
+        check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
 
 
 def _attr(value):

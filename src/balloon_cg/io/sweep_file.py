@@ -1,96 +1,223 @@
-"""Sweep files (HDF5, format "balloon-cg-sweep/1"): one member group per computed scene of a sweep.
+"""Sweeps on disk: a store of one file per member, and one consolidated sweep file rebuilt from it.
 
-Layout::
+``-o SWEEP.h5`` keeps the sweep in two places (docs/hdf5.md, *Sweep files*)::
+
+    SWEEP.h5.members/              the store (the authority)
+        sweep.h5                   attrs: the sweep's root attributes (below), written once, atomically
+        000003.h5                  member 3: attrs as /members/3 below, groups branches/, snap_throughs/
+    SWEEP.h5                       the consolidated view (format "balloon-cg-sweep/2"): a copy of the store
 
     /                   attrs: format, scene_name, scene_toml (base scene, normalised), vary (JSON list of
-                               [key, values]), mode, members (total count), + provenance (io.hdf5)
-    /members/<index>/   attrs: overrides (JSON object, dotted key -> value), scene_hash (sha256 of the member
-                               scene's normalised TOML), scene_toml, tolerance, created, package_version,
-                               generated_digest, worker_pid, wall_time, branch_point_kinds,
-                               branch_point_classifications, branch_point_blocks, branch_point_pressures,
-                               complete, incomplete_gaps, incomplete_branches, incomplete_messages (as a run
-                               file's root: analysis.verdict)
+                               [key, values]), mode, members (total count), store (the store folder's name),
+                               + provenance (io.hdf5)
+    /members/<index>/   attrs: format ("balloon-cg-sweep-member/1"), overrides (JSON object, dotted key -> value),
+                               scene_hash (sha256 of the member scene's normalised TOML), scene_toml, tolerance,
+                               created, package_version, generated_digest, worker_pid, wall_time,
+                               branch_point_kinds, branch_point_classifications, branch_point_blocks,
+                               branch_point_pressures, complete, incomplete_gaps, incomplete_branches,
+                               incomplete_messages (as a run file's root: analysis.verdict)
         branches/<name>/          exactly as a run file's /branches (io.run_file)
         snap_throughs/            as in a run file (full analysis only)
 
-A member is first written under a temporary name in /members and then renamed, so an interrupted sweep leaves
-only whole members; the file is flushed after each. Only the parent process of a sweep writes its file.
+Every file is written by io.hdf5.atomic_file (a temporary file renamed over the target), so a SIGKILL at any
+instant leaves whole files and ``.NAME.<hex>.tmp`` debris, which the next owner (io.lock) removes. A member
+file exists only once its member is complete; the view is rebuilt from the store when a sweep call ends and is
+never the only copy (a view without a store is imported back into one). ``--force`` computes into
+``SWEEP.h5.members-new/`` and swaps it in (``commit_replacement``) only once every member is there; a swap cut
+short is rolled forward by the next call. Format ``balloon-cg-sweep/1`` files (one HDF5 file, members appended
+in place) are read as before, and a resumed sweep imports their members into a store.
 """
+import contextlib
 import json
-import secrets
+import re
+import shutil
 import tomllib
 from pathlib import Path
 
 import h5py
 import numpy as np
 
-from .hdf5 import check_output, plain, provenance
+from .hdf5 import atomic_file, plain, provenance
+from .lock import remove_debris
 from .run_file import read_branches, verdict_attrs, write_branches
+from .schema import FileError, require_attrs
 
-FORMAT = "balloon-cg-sweep/1"
-_TMP_PREFIX = ".tmp-"
+FORMAT = "balloon-cg-sweep/2"
+FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
+MEMBER_FORMAT = "balloon-cg-sweep-member/1"
+MANIFEST = "sweep.h5"
+ROOT_KEYS = ("scene_name", "scene_toml", "vary", "mode", "members")
+MEMBER_KEYS = ("overrides", "scene_hash", "scene_toml")
+_MEMBER = re.compile(r"(\d{6})\.h5")
+_OLD_TMP_PREFIX = ".tmp-"  # /1 files: a member group whose write was cut before its rename
 
 
 class SweepError(ValueError):
-    """A sweep that cannot be run as asked (bad --vary spec, conflicting existing file)."""
+    """A sweep that cannot be run as asked (bad --vary spec, conflicting existing sweep)."""
+
+
+class SweepFileError(FileError):
+    """A sweep file or store that cannot be read (not a sweep, damaged: names the file and what is missing)."""
+
+
+def store_path(path) -> Path:
+    path = Path(path)
+    return path.with_name(f"{path.name}.members")
+
+
+def staging_path(path) -> Path:
+    path = Path(path)
+    return path.with_name(f"{path.name}.members-new")
+
+
+def _retired_path(path) -> Path:
+    path = Path(path)
+    return path.with_name(f"{path.name}.members-old")
 
 
 def root_attrs(scene, axes: list, mode: str, n: int, command: str | None) -> dict:
-    """Root attributes of a sweep file: the base scene, the varied keys and values, the mode, provenance."""
+    """Root attributes of a sweep: the base scene, the varied keys and values, the mode, provenance."""
     return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.to_toml(), "vary": json.dumps(axes),
             "mode": mode, "members": n, **provenance(command)}
 
 
-def open_sweep(path: Path, attrs: dict, members: list, force: bool) -> tuple[h5py.File, set]:
-    """Open (or create) the sweep file; returns it and the indices already done. A file holding another sweep is
-    an error unless ``force`` (then it is replaced)."""
-    if path.exists() and force:
-        path.unlink()
+# --- the store ---------------------------------------------------------------------------------------------
+
+class Store:
+    """The member files of one sweep in one folder; ``done`` maps member index -> its file."""
+
+    def __init__(self, directory: Path, done: dict):
+        self.directory = directory
+        self.done = done
+
+    def member_file(self, index: int) -> Path:
+        return self.directory / f"{index:06d}.h5"
+
+    def write_member(self, member, result) -> None:
+        """Write one computed member (app.sweep.MemberResult) to its own file, atomically."""
+        path = self.member_file(member.index)
+        with atomic_file(path, force=True) as f:
+            attrs = provenance()
+            del attrs["command"]
+            f.attrs.update(attrs | {
+                "format": MEMBER_FORMAT,
+                "tolerance": member.scene.solver.tol,
+                "overrides": json.dumps(member.overrides),
+                "scene_hash": member.scene_hash,
+                "scene_toml": member.scene.to_toml(),
+                "worker_pid": result.pid,
+                "wall_time": result.wall_time,
+                "branch_point_pressures": np.array([float(bp.X[-1]) for bp in result.branch_points], dtype=float),
+            })
+            text = h5py.string_dtype()
+            for key, values in (("branch_point_kinds", [bp.kind.value for bp in result.branch_points]),
+                                ("branch_point_classifications",
+                                 [bp.classification.value for bp in result.branch_points]),
+                                ("branch_point_blocks", [bp.block.value for bp in result.branch_points])):
+                f.attrs.create(key, np.array(values, dtype=object), dtype=text)
+            f.attrs.update(verdict_attrs(found=result.incomplete))
+            write_branches(f, member.scene, result.branches, result.snaps)
+        self.done[member.index] = path
+
+
+def open_store(path, attrs: dict, members: list, force: bool) -> Store:
+    """The store to compute ``members`` into (call while owning ``path``, io.lock.claim), with the members
+    already complete in it. Rolls forward a replacement cut short, imports a store-less sweep file, removes
+    debris. ``force``: the staging store of a replacement (a new one, or the one an earlier --force left).
+    A different sweep in the way is a SweepError (naming what differs) unless ``force``."""
+    path = Path(path)
+    _finish_replacement(path)
+    if force:
+        directory = staging_path(path)
+        if (directory / MANIFEST).is_file():
+            with contextlib.suppress(SweepError, SweepFileError):
+                return _open_existing(directory, attrs, members)
+        shutil.rmtree(directory, ignore_errors=True)  # another replacement's leftovers: start again
+        return _create(directory, attrs)
+    directory = store_path(path)
+    if directory.is_dir() and (directory / MANIFEST).is_file():
+        return _open_existing(directory, attrs, members)
     if path.exists():
-        try:
-            f = h5py.File(path, "a")
-        except OSError:
-            raise SweepError(f"{path}: exists and is not a readable HDF5 file (use --force to replace it)") from None
-        try:
-            done = _check_existing(f, path, attrs, members)
-        except BaseException:
-            f.close()
-            raise
-        return f, done
-    check_output(path, force=False)
-    f = h5py.File(path, "w-")
-    f.attrs.update(attrs)
-    f.create_group("members")
-    f.flush()
-    return f, set()
+        return _import(path, directory, attrs, members)
+    shutil.rmtree(directory, ignore_errors=True)  # a store cut short before its manifest: nothing in it
+    return _create(directory, attrs)
 
 
-def _check_existing(f: h5py.File, path: Path, attrs: dict, members: list) -> set:
-    if f.attrs.get("format") != FORMAT:
-        raise SweepError(f"{path}: exists and is not a balloon-cg sweep file (use --force to replace it)")
+def _create(directory: Path, attrs: dict) -> Store:
+    directory.mkdir()
+    with atomic_file(directory / MANIFEST) as f:
+        f.attrs.update({k: v for k, v in attrs.items() if k != "format"} | {"format": FORMAT})
+    return Store(directory, {})
+
+
+def _open_existing(directory: Path, attrs: dict, members: list) -> Store:
+    manifest = directory / MANIFEST
+    with _open(manifest) as f:
+        _check_same_sweep(f.attrs, manifest, attrs)
+    expected = {m.index: m for m in members}
+    done = {}
+    for item in sorted(directory.iterdir()):
+        if item.name == MANIFEST:
+            continue
+        match = _MEMBER.fullmatch(item.name)
+        if match is None:
+            continue
+        index = int(match.group(1))
+        m = expected.get(index)
+        if m is None:
+            raise SweepError(f"{item}: member {index} is not a member of this sweep; use --force to replace it")
+        try:
+            with _open(item) as f:
+                require_attrs(f.attrs, item, MEMBER_KEYS)
+                stored = plain(f.attrs["scene_hash"])
+        except SweepFileError:
+            item.unlink()  # not a whole member (atomic writes leave none such): computed again
+            continue
+        if stored != m.scene_hash:
+            raise SweepError(f"{item}: member {index} ({m.label}) was computed for another scene "
+                             f"(scene_hash {str(stored)[:12]}… in the file, {m.scene_hash[:12]}… now); "
+                             "use --force to replace it")
+        done[index] = item
+    for name in [MANIFEST, *(f"{i:06d}.h5" for i in expected)]:
+        remove_debris(directory / name)
+    return Store(directory, done)
+
+
+def _import(path: Path, directory: Path, attrs: dict, members: list) -> Store:
+    """A sweep file without its store (format /1, or a view whose store was removed): its whole members are
+    copied into a new store."""
+    with _open(path) as f:
+        fmt = plain(f.attrs.get("format"))
+        if fmt not in FORMATS:
+            raise SweepError(f"{path}: exists and is not a balloon-cg sweep file (use --force to replace it)")
+        _check_same_sweep(f.attrs, path, attrs)
+        store = _create(directory, attrs)
+        expected = {str(m.index): m for m in members}
+        for name, group in f["members"].items():
+            m = expected.get(name)
+            if name.startswith(_OLD_TMP_PREFIX) or m is None:
+                continue
+            if plain(group.attrs.get("scene_hash")) != m.scene_hash:
+                raise SweepError(f"{path}: member {name} ({m.label}) was computed for another scene; "
+                                 "use --force to replace the file")
+            target = store.member_file(m.index)
+            with atomic_file(target, force=True) as out:
+                _copy_group(group, out)
+                out.attrs["format"] = MEMBER_FORMAT
+            store.done[m.index] = target
+    return store
+
+
+def _check_same_sweep(stored, path: Path, attrs: dict) -> None:
+    require_attrs(stored, path, ROOT_KEYS, error=SweepFileError)
     for key in ("scene_toml", "vary", "mode", "members"):
-        old, new = plain(f.attrs.get(key)), attrs[key]
+        old, new = plain(stored.get(key)), attrs[key]
         if old != new:
-            what = {"scene_toml": f"the base scene differs ({_scene_diff(old, new)})", "vary": f"--vary differs (file: {old}, now: {new})",
+            what = {"scene_toml": f"the base scene differs ({_scene_diff(old, new)})",
+                    "vary": f"--vary differs (file: {old}, now: {new})",
                     "mode": f"the mode differs (file: {old}, now: {new})",
                     "members": f"the member count differs (file: {old}, now: {new})"}[key]
             raise SweepError(f"{path}: holds a different sweep: {what}; use --force to replace it")
-    group = f.require_group("members")
-    for name in [n for n in group if n.startswith(_TMP_PREFIX)]:
-        del group[name]  # a member whose write was interrupted before its rename
-    expected = {str(m.index): m for m in members}
-    done = set()
-    for name in group:
-        m = expected.get(name)
-        if m is None:
-            raise SweepError(f"{path}: member {name} is not a member of this sweep; use --force to replace the file")
-        stored = plain(group[name].attrs.get("scene_hash"))
-        if stored != m.scene_hash:
-            raise SweepError(f"{path}: member {name} ({m.label}) was computed for another scene "
-                             f"(scene_hash {str(stored)[:12]}… in the file, {m.scene_hash[:12]}… now); "
-                             "use --force to replace the file")
-        done.add(m.index)
-    return done
 
 
 def _scene_diff(old: str, new: str) -> str:
@@ -112,59 +239,120 @@ def _scene_diff(old: str, new: str) -> str:
     return ", ".join(f"{k}: {a.get(k)} in the file, {b.get(k)} now" for k in keys) or "formatting only"
 
 
-def append_member(f: h5py.File, member, result) -> None:
-    """Write one computed member (app.sweep.MemberResult) under a temporary name, rename it to
-    /members/<index>, flush."""
-    group = f["members"]
-    tmp = f"{_TMP_PREFIX}{member.index}-{secrets.token_hex(4)}"
-    g = group.create_group(tmp)
+# --- the consolidated view ---------------------------------------------------------------------------------
+
+def consolidate(path, directory: Path) -> None:
+    """Rebuild the sweep file ``path`` from the store ``directory`` (atomically replacing it)."""
+    path = Path(path)
+    with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True) as f:
+        _copy_attrs(manifest, f)
+        f.attrs["format"] = FORMAT
+        f.attrs["store"] = store_path(path).name
+        group = f.create_group("members")
+        for item in sorted(directory.iterdir()):
+            match = _MEMBER.fullmatch(item.name)
+            if match is not None:
+                with _open(item) as member:
+                    _copy_group(member, group.create_group(str(int(match.group(1)))))
+
+
+def commit_replacement(path) -> None:
+    """Swap the complete staging store of a --force sweep in for the old store, then rebuild the view. Cut short
+    at any instant, the next open_store rolls it forward (the old sweep stays readable until the view moves)."""
+    path = Path(path)
+    old, new, retired = store_path(path), staging_path(path), _retired_path(path)
+    shutil.rmtree(retired, ignore_errors=True)
+    if old.exists():
+        old.rename(retired)
+    new.rename(old)
+    consolidate(path, old)
+    shutil.rmtree(retired, ignore_errors=True)
+
+
+def _finish_replacement(path: Path) -> None:
+    retired = _retired_path(path)
+    if not retired.exists():
+        return
+    if not store_path(path).exists():
+        staging_path(path).rename(store_path(path))  # cut between the two renames of commit_replacement
+        consolidate(path, store_path(path))
+    shutil.rmtree(retired)
+
+
+def _copy_attrs(src, dst) -> None:
+    for name in src.attrs:
+        dst.attrs.create(name, src.attrs[name], dtype=src.attrs.get_id(name).dtype)
+
+
+def _copy_group(src, dst) -> None:
+    _copy_attrs(src, dst)
+    for name in src:
+        src.copy(src[name], dst, name)
+
+
+# --- reading -----------------------------------------------------------------------------------------------
+
+@contextlib.contextmanager
+def _open(path):
     try:
-        attrs = provenance()
-        del attrs["command"]
-        g.attrs.update(attrs | {
-            "tolerance": member.scene.solver.tol,
-            "overrides": json.dumps(member.overrides),
-            "scene_hash": member.scene_hash,
-            "scene_toml": member.scene.to_toml(),
-            "worker_pid": result.pid,
-            "wall_time": result.wall_time,
-            "branch_point_pressures": np.array([float(bp.X[-1]) for bp in result.branch_points], dtype=float),
-        })
-        text = h5py.string_dtype()
-        for key, values in (("branch_point_kinds", [bp.kind.value for bp in result.branch_points]),
-                            ("branch_point_classifications", [bp.classification.value for bp in result.branch_points]),
-                            ("branch_point_blocks", [bp.block.value for bp in result.branch_points])):
-            g.attrs.create(key, np.array(values, dtype=object), dtype=text)
-        g.attrs.update(verdict_attrs(found=result.incomplete))
-        write_branches(g, member.scene, result.branches, result.snaps)
-    except BaseException:
-        del group[tmp]
+        f = h5py.File(path, "r")
+    except FileNotFoundError:
         raise
-    group.move(tmp, str(member.index))
-    f.flush()
+    except OSError:
+        raise SweepFileError(path, "not a readable HDF5 file (damaged or not HDF5)") from None
+    with f:
+        yield f
 
 
 def read_sweep(path) -> dict:
-    """{'path', 'attrs', 'members': {index: {'overrides', 'scene_hash', 'attrs', 'branches': {name: branch}}}}.
-
-    Branches are dicts as read by io.run_file.read_run.
-    """
+    """{'path', 'attrs', 'members': {index: {'overrides', 'scene_hash', 'attrs', 'branches': {name: branch}}}}
+    from a sweep file (the view, or a format /1 file). Branches are dicts as read by io.run_file.read_run.
+    Raises SweepFileError naming the file and what is missing."""
     path = Path(path)
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != FORMAT:
-            raise SweepError(f"{path}: not a balloon-cg sweep file")
+    if not path.exists():
+        raise FileNotFoundError(2, "no such file", str(path))
+    with _open(path) as f:
+        if plain(f.attrs.get("format")) not in FORMATS:
+            raise SweepFileError(path, f"not a balloon-cg sweep file (format {plain(f.attrs.get('format'))!r}, "
+                                       f"expected one of {', '.join(FORMATS)})")
+        require_attrs(f.attrs, path, ROOT_KEYS, error=SweepFileError)
+        if not isinstance(f.get("members"), h5py.Group):
+            raise SweepFileError(path, "no /members group")
         out = {"path": str(path), "attrs": {k: plain(v) for k, v in f.attrs.items()}, "members": {}}
-        for name in sorted((n for n in f["members"] if not n.startswith(_TMP_PREFIX)), key=int):
-            g = f["members"][name]
-            attrs = {k: (v.tolist() if isinstance(v, np.ndarray) else plain(v)) for k, v in g.attrs.items()}
-            out["members"][int(name)] = {"overrides": json.loads(attrs["overrides"]), "scene_hash": attrs["scene_hash"],
-                                         "attrs": attrs, **read_branches(g)}
+        names = [n for n in f["members"] if not n.startswith(_OLD_TMP_PREFIX)]
+        for name in sorted(names, key=lambda n: int(n) if n.isdigit() else -1):
+            if not name.isdigit():
+                raise SweepFileError(path, f"member group /members/{name} is not named by an index")
+            out["members"][int(name)] = _read_member(f["members"][name], f"{path}: /members/{name}")
     return out
 
 
+def read_store(directory) -> dict:
+    """The members of a store folder, as read_sweep's 'members'."""
+    directory = Path(directory)
+    out = {}
+    for item in sorted(directory.iterdir()):
+        match = _MEMBER.fullmatch(item.name)
+        if match is not None:
+            with _open(item) as f:
+                out[int(match.group(1))] = _read_member(f, str(item))
+    return out
+
+
+def _read_member(group, where: str) -> dict:
+    require_attrs(group.attrs, where, MEMBER_KEYS, error=SweepFileError)
+    attrs = {k: (v.tolist() if isinstance(v, np.ndarray) else plain(v)) for k, v in group.attrs.items()}
+    try:
+        overrides = json.loads(attrs["overrides"])
+    except (TypeError, json.JSONDecodeError):
+        raise SweepFileError(where, "attribute overrides is not a JSON object") from None
+    return {"overrides": overrides, "scene_hash": attrs["scene_hash"], "attrs": attrs,
+            **read_branches(group, where, SweepFileError)}
+
+
 def incomplete_members(path) -> list[int]:
-    """Indices of the whole members of a sweep file whose results are incomplete (from their ``complete``
+    """Indices of the members of a sweep file whose results are incomplete (from their ``complete``
     attribute; nothing else is read)."""
-    with h5py.File(path, "r") as f:
+    with _open(path) as f:
         return sorted(int(name) for name, g in f["members"].items()
-                      if not name.startswith(_TMP_PREFIX) and not bool(g.attrs.get("complete", False)))
+                      if not name.startswith(_OLD_TMP_PREFIX) and not bool(g.attrs.get("complete", False)))
