@@ -6,9 +6,10 @@
 
 from dataclasses import dataclass, replace
 
+from ..generated import CLASSES, GENERAL_TERMS
 from .validation import SceneError, number, show, table
 
-MAX_TERMS = 6
+MAX_TERMS = max([GENERAL_TERMS] + [len(a) for a, _ in CLASSES.values() if a is not None])  # generated kernels
 
 
 @dataclass(frozen=True)

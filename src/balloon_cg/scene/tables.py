@@ -111,6 +111,8 @@ class Output:
 
 
 _TABLES = ("material", "field", "continuation", "solver", "stability", "output")
+MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
+MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 
 
 @dataclass(frozen=True)
@@ -171,11 +173,29 @@ def load_scene(path) -> Scene:
 
 def _parse(text: str, name: str, source: str) -> Scene:
     try:
-        return _build(tomllib.loads(text), name, text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{source}: invalid TOML: {e}") from None
+    except RecursionError:
+        raise SceneError(f"{source}: invalid TOML: arrays or tables nested deeper than {MAX_NESTING} levels") from None
+    try:
+        _check_nesting(data)
+        return _build(data, name, text)
     except SceneError as e:
         raise SceneError(f"{source}: {e}") from None
+
+
+def _check_nesting(data) -> None:
+    """SceneError when arrays/tables nest deeper than MAX_NESTING (a scene needs 3: [[field.coils]] keys)."""
+    stack = [(data, 1, "")]
+    while stack:
+        value, depth, key = stack.pop()
+        if depth > MAX_NESTING:
+            raise SceneError(f"{key or 'the scene'}: arrays or tables nested deeper than {MAX_NESTING} levels")
+        items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+        for k, v in items:
+            if isinstance(v, (dict, list)):
+                stack.append((v, depth + 1, key or str(k)))
 
 
 def _build(data: dict, name: str, text: str) -> Scene:
@@ -270,6 +290,9 @@ def _continuation(data, field: Field) -> Continuation:
     get = _getter(data, "continuation", Continuation)
     start = get("start_stretch", lambda x: x > 1, "> 1")
     stop = get("stop_stretch", lambda x: x > start, f"> continuation.start_stretch = {show(start)}")
+    if data.get("min_stretch") is None and start <= Continuation.min_stretch:
+        data = {**data, "min_stretch": (1 + start) / 2}  # the default lies below any allowed start_stretch
+        get = _getter(data, "continuation", Continuation)
     low = get("min_stretch", lambda x: 1 < x < start, f"in (1, continuation.start_stretch = {show(start)})")
     pressure = get("stop_pressure", lambda x: x > 0, "> 0")
     step_min = get("step_min", lambda x: x > 0, "> 0")
@@ -295,11 +318,14 @@ def _solver(data) -> Solver:
     get = _getter(data, "solver", Solver)
     degree = get("degree", lambda n: 8 <= n <= 400, "an integer in [8, 400]", integer=True)
     quadrature = get(
-        "quadrature", lambda n: n == 0 or n >= degree + 1,
-        f"0 (automatic) or >= solver.degree + 1 = {degree + 1}", integer=True,
+        "quadrature", lambda n: n == 0 or degree + 1 <= n <= MAX_QUADRATURE,
+        f"0 (automatic) or an integer in [solver.degree + 1 = {degree + 1}, {MAX_QUADRATURE}]", integer=True,
     )
     tol = get("tol", lambda x: 0 < x <= 1e-3, "in (0, 1e-3]")
     max_newton = get("max_newton", lambda n: 1 <= n <= 200, "an integer in [1, 200]", integer=True)
+    if data.get("max_degree") is None and degree > Solver.max_degree:
+        data = {**data, "max_degree": degree}  # the default never lies below the starting degree
+        get = _getter(data, "solver", Solver)
     max_degree = get("max_degree", lambda n: degree <= n <= 400, f"an integer in [solver.degree = {degree}, 400]",
                      integer=True)
     max_error = get("max_error", lambda x: 0 < x <= 1e-2, "in (0, 1e-2]")
