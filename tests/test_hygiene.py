@@ -1,0 +1,53 @@
+"""Pool workers die with their parent (app.hygiene): killing only the sweep's parent, as the OOM killer does,
+leaves no worker running."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+CLI = "import sys; from balloon_cg.app.cli import main; sys.exit(main(sys.argv[1:]))"
+SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4\n'
+
+
+def children(pid: int) -> list[int]:
+    found = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        found += [int(c) for c in (task / "children").read_text().split()]
+    return found
+
+
+def alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_workers_exit_when_the_parent_is_killed(tmp_path):
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE)
+    parent = subprocess.Popen([sys.executable, "-c", CLI, "sweep", str(scene), "--vary", "material.alpha[0]=1.3:1.4:8",
+                               "-o", str(tmp_path / "s.h5"), "--primary-only", "--workers", "2", "--quiet"],
+                              start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        workers = []
+        while len(workers) < 2 and time.monotonic() < deadline and parent.poll() is None:
+            time.sleep(0.05)
+            workers = children(parent.pid)
+        assert len(workers) == 2, "the pool did not start"
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+        deadline = time.monotonic() + 10
+        while any(map(alive, workers)) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(map(alive, workers)), f"workers {workers} outlived their parent"
+    finally:
+        for pid in [parent.pid]:
+            try:
+                os.killpg(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
