@@ -1,4 +1,4 @@
-"""Damaged files: every read path checks the layout first (io.schema) and the CLI prints one line naming the file
+"""Damaged files: every read path checks the layout first (io.layout) and the CLI prints one line naming the file
 and what is wrong (exit 2); a bug is exit 3 with a pointer to report it, the traceback only with --debug."""
 import shutil
 from pathlib import Path

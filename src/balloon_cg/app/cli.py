@@ -30,7 +30,7 @@ from ..scene import SceneError, load_scene
 from ..io.hdf5 import check_output
 from ..io.lock import claim
 from ..io.run_file import read_run, write_run
-from ..io.schema import FileError
+from ..io.layout import FileError
 
 PROG = "balloon-cg"
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, plain
 from .run_file import SPECIAL_COLUMNS, read_run, read_special, root_attrs, write_special
-from .schema import FileError, check_columns, require_attrs, require_group
+from .layout import FileError, check_columns, require_attrs, require_group
 
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):

@@ -36,7 +36,7 @@ import numpy as np
 from ..analysis.verdict import failing, incomplete
 from ..galerkin.profiles import equator_values, profiles, theta_grid
 from .hdf5 import atomic_file, plain, provenance, write_strings
-from .schema import FileError, check_columns, require_attrs, require_group
+from .layout import FileError, check_columns, require_attrs, require_group
 
 FORMAT = "balloon-cg/2"
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
@@ -214,7 +214,7 @@ def read_run(path) -> dict:
 
     Each branch is a dict of its attrs ('attrs'), its per-point arrays and 'theta', 'profiles' (dict of
     arrays), 'special_points' (list of dicts: the special_points columns) and 'special_unknowns'
-    (their X rows). The layout is checked first (``io.schema``).
+    (their X rows). The layout is checked first (``io.layout``).
     Raises FileNotFoundError, IsADirectoryError, or RunFileError naming the file and what is missing or wrong.
     """
     path = Path(path)

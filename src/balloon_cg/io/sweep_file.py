@@ -40,7 +40,7 @@ import numpy as np
 from .hdf5 import atomic_file, plain, provenance
 from .lock import remove_debris
 from .run_file import read_branches, verdict_attrs, write_branches
-from .schema import FileError, require_attrs
+from .layout import FileError, require_attrs
 
 FORMAT = "balloon-cg-sweep/2"
 FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
