@@ -19,6 +19,7 @@ from .results import Block, Branch, StopCode
 from .stability import assess_branch
 from .switching import trace_pear
 from .verdict import Incomplete, incomplete
+from ..numerics.threads import limited_blas
 
 
 @dataclass
@@ -56,6 +57,7 @@ def _assess(branch: Branch, scene, symmetric: bool) -> None:
                                                        m_max=scene.stability.m_max)
 
 
+@limited_blas
 def analyse(scene, progress=None, pear: bool = True) -> Picture:
     """The picture of a scene (module docstring); ``pear=False`` skips the pear branches."""
     primary = trace_primary(scene, progress=progress)
