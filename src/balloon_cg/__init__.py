@@ -34,7 +34,7 @@ __version__ = "0.1.0"
 _API = {
     "Scene": "balloon_cg.scene", "SceneError": "balloon_cg.scene", "load_scene": "balloon_cg.scene",
     "parse_scene": "balloon_cg.scene",
-    "Result": "balloon_cg.app.api", "StoredBranch": "balloon_cg.app.api", "trace": "balloon_cg.app.api",
+    "Result": "balloon_cg.app.api", "BranchData": "balloon_cg.app.api", "trace": "balloon_cg.app.api",
     "analyse": "balloon_cg.app.api", "load": "balloon_cg.app.api", "plot": "balloon_cg.app.api",
 }
 __all__ = ["__version__", *_API]
@@ -50,7 +50,7 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(__all__))
+    return sorted(__all__)
 
 
 def _numba_cache_dir() -> Path:

@@ -33,6 +33,7 @@ special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``).
 "balloon-cg/2" (no volume, no dimension scales) still read.
 """
 import errno
+import io
 from pathlib import Path
 
 import h5py
@@ -61,14 +62,31 @@ def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | No
     the root attributes. ``found``: analysis.verdict.Incomplete entries (default: those of ``branches``).
     Raises ValueError if a branch holds a point that is not a finite solution.
     """
-    attrs = root_attrs(scene) | verdict_attrs(branches, found) | dict(extra_attrs or {})
-    if attrs["format"] != FORMAT:
-        raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
-    check_branches(branches)
+    attrs = _run_attrs(scene, branches, extra_attrs, found)
     with atomic_file(path, force) as f:
         f.attrs.update(attrs)
         write_branches(f, scene, branches, snaps)
     return Path(path)
+
+
+def run_image(scene, branches, extra_attrs: dict | None = None, snaps: list | None = None,
+              found: list | None = None) -> bytes:
+    """The bytes of the file ``write_run`` writes, made in memory (an HDF5 file image; nothing on disk)."""
+    attrs = _run_attrs(scene, branches, extra_attrs, found)
+    with h5py.File(f"{scene.name}.h5", "w", driver="core", backing_store=False) as f:
+        f.attrs.update(attrs)
+        write_branches(f, scene, branches, snaps)
+        f.flush()
+        return f.id.get_file_image()
+
+
+def _run_attrs(scene, branches, extra_attrs, found) -> dict:
+    """The root attributes of a run file, after checking the branches (ValueError: nothing is written)."""
+    attrs = root_attrs(scene) | verdict_attrs(branches, found) | dict(extra_attrs or {})
+    if attrs["format"] != FORMAT:
+        raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
+    check_branches(branches)
+    return attrs
 
 
 def root_attrs(scene, command: str | None = None) -> dict:
@@ -251,15 +269,25 @@ def read_run(path) -> dict:
     except OSError:
         raise RunFileError(f"{path}: not a readable HDF5 file") from None
     with f:
-        fmt = f.attrs.get("format")
-        if fmt not in READABLE:
-            found = "no format attribute" if fmt is None else f"format {fmt!r}"
-            raise RunFileError(f"{path}: not a balloon-cg run file ({found}, expected one of {', '.join(READABLE)})")
-        try:
-            attrs = {k: _attr(v) for k, v in f.attrs.items()}
-            return {"path": str(path), "scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
-        except KeyError as e:
-            raise RunFileError(f"{path}: damaged balloon-cg run file (missing {e})") from None
+        return _read_open(f, path) | {"path": str(path)}
+
+
+def read_run_image(image: bytes, label: str = "run") -> dict:
+    """``read_run`` of a file image (``run_image``); 'path' is None and errors name ``label``."""
+    with h5py.File(io.BytesIO(image), "r") as f:
+        return _read_open(f, label) | {"path": None}
+
+
+def _read_open(f, label) -> dict:
+    fmt = f.attrs.get("format")
+    if fmt not in READABLE:
+        found = "no format attribute" if fmt is None else f"format {fmt!r}"
+        raise RunFileError(f"{label}: not a balloon-cg run file ({found}, expected one of {', '.join(READABLE)})")
+    try:
+        attrs = {k: _attr(v) for k, v in f.attrs.items()}
+        return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
+    except KeyError as e:
+        raise RunFileError(f"{label}: damaged balloon-cg run file (missing {e})") from None
 
 
 def read_branches(parent) -> dict:
