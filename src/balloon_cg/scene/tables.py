@@ -8,6 +8,7 @@ import math
 import re
 import tomllib
 from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import field as dataclass_field
 from pathlib import Path
 
 from .validation import SceneError, number, show, show_key, table
@@ -126,7 +127,12 @@ class Scene:
     solver: Solver
     stability: Stability
     output: Output
-    text: str
+    text: str = dataclass_field(repr=False)
+
+    @classmethod
+    def from_toml(cls, path) -> "Scene":
+        """The scene of a TOML file (``load_scene``)."""
+        return load_scene(path)
 
     def to_dict(self) -> dict:
         """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded)."""
@@ -141,19 +147,40 @@ class Scene:
         """TOML text of ``to_dict()``; parsing it gives back this scene (apart from ``text``)."""
         return _to_toml(self.to_dict())
 
-    def with_overrides(self, overrides: dict[str, object]) -> "Scene":
+    def with_overrides(self, overrides: dict[str, object], name: str | None = None) -> "Scene":
         """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``.
 
-        ``material.preset`` replaces the whole material; a value None restores the default.
+        ``material.preset`` replaces the whole material; a value None restores the default. The copy is named
+        ``name``, or after what changed physically: each field or material key's token in the name
+        (``_M0.002``, ``_radius4``) takes the new value, or is appended (numerical keys keep the name).
         """
         data = self.to_dict()
         try:
             for key, value in overrides.items():
                 _assign(data, key, value)
-            scene = _build(data, self.name, "")
+            scene = _build(data, name or renamed(self.name, overrides), "")
         except SceneError as e:
             raise SceneError(f"{self.name}: {e}") from None
         return replace(scene, text=scene.to_toml())
+
+
+def renamed(name: str, overrides: dict[str, object]) -> str:
+    """``name`` with a ``_<key><value>`` token per field or material override (key: the last part of the dotted
+    key, without indices; a preset: its name): an existing token of that key is updated, else one is appended."""
+    for key, value in overrides.items():
+        if key.split(".")[0] not in ("field", "material") or value is None:
+            continue
+        if isinstance(value, str):  # a preset: its name
+            name = f"{name}_{value.lower()}"
+            continue
+        short = re.sub(r"\[\d+\]", "", key.split(".")[-1])
+        values = value if isinstance(value, (list, tuple)) else [value]
+        text = "-".join(f"{v:g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+                        for v in values)
+        token = re.compile(rf"(^|_){re.escape(short)}-?[0-9][0-9.eE+-]*(?=_|$)")
+        name = token.sub(lambda m: f"{m.group(1)}{short}{text}", name, count=1) if token.search(name) \
+            else f"{name}_{short}{text}"
+    return name
 
 
 def parse_scene(text: str, name: str = "scene") -> Scene:
