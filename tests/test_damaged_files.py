@@ -7,7 +7,7 @@ import h5py
 import numpy as np
 import pytest
 
-from balloon_cg.app import cli
+from balloon_cg.app import summaries
 from balloon_cg.app.cli import main
 
 SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'
@@ -104,7 +104,7 @@ def test_internal_error_is_exit_3_with_a_pointer_and_traceback_only_with_debug(g
     def bug(path):
         raise ZeroDivisionError("division by zero")
 
-    monkeypatch.setattr(cli, "read_run", bug)
+    monkeypatch.setattr(summaries, "summarise_file", bug)
     assert main(["inspect", str(good)]) == 3
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "internal error (ZeroDivisionError: division by zero)" in err
