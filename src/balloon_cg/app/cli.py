@@ -500,8 +500,9 @@ def sweep(args) -> int:
     if not args.quiet:
         print(format_summary(result))
     if result.failed:
+        kept = "" if result.replaced else f"; {result.path} is kept until every member of the new sweep is written"
         raise Failure(f"{len(result.failed)} of {len(result.members)} sweep members failed (members "
-                      f"{', '.join(map(str, sorted(result.failed)))}); re-run the same command to retry them")
+                      f"{', '.join(map(str, sorted(result.failed)))}); re-run the same command to retry them{kept}")
     partial = incomplete_members(result.path)  # the verdicts stored with the members (attributes only)
     if partial:
         print(f"{PROG}: incomplete: sweep members {', '.join(map(str, partial))} (their results are flagged in the "
