@@ -2,8 +2,8 @@
 and check that nothing is lost or corrupted; then start pairs of `balloon-cg run` on one output at once.
 
 Kills: each `sweep` (6 short primary-only members, 2 workers) is killed after a random delay drawn uniformly from
-a window that covers a whole uninterrupted sweep (imports, members, the view rebuild); a sweep that finishes first
-ends its round and the next round starts on a new output. After every kill, what is on disk must be readable
+a window 1.5 times as long as an uninterrupted sweep, measured first (imports, members, the view rebuild); a
+sweep that finishes first ends its round and the next round starts on a new output. After every kill, what is on disk must be readable
 (the sweep file if present, every member file of the store); every round ends with an uninterrupted resume that
 must exit 0 with every member bitwise equal (all datasets, and the members' results attributes) to an
 uninterrupted serial sweep and leave no debris (temporary files, lock files, staging folders).
@@ -76,6 +76,14 @@ def debris(out: Path) -> list[str]:
     return leftovers
 
 
+def temporary_files(out: Path) -> list[Path]:
+    """The temporary files of writes in progress (or cut short) of a sweep: beside the output and in its store."""
+    from balloon_cg.io.sweep_file import store_path
+
+    found = list(out.parent.glob(f".{out.name}.*.tmp"))
+    return found + (list(store_path(out).glob(".*.tmp")) if store_path(out).is_dir() else [])
+
+
 def readable(out: Path) -> str:
     """'' if what a killed sweep left is readable (the sweep file if present, each stored member), else why not."""
     from balloon_cg.io.sweep_file import read_store, read_sweep, store_path
@@ -90,17 +98,23 @@ def readable(out: Path) -> str:
     return ""
 
 
-def soak(kills: int, workdir: Path, seed: int = 0, window: tuple = (0.05, 2.0), log=None) -> dict:
-    """Kill sweeps ``kills`` times; returns the figures (kills, rounds, recovered, unrecoverable, lost, debris)."""
+def soak(kills: int, workdir: Path, seed: int = 0, log=None) -> dict:
+    """Kill sweeps ``kills`` times; returns the figures (kills, rounds, recovered, unrecoverable, lost, debris).
+
+    The kill instants are uniform in (0.05 s, 1.5 T), T the wall time of an uninterrupted sweep on 2 workers
+    measured first (so on a loaded machine the instants still cover the whole sweep, not only the imports)."""
     workdir = Path(workdir)
     scene = workdir / "scene.toml"
     scene.write_text(SCENE)
     reference = workdir / "reference.h5"
     subprocess.run(sweep_argv(scene, reference, workers=1), check=True, capture_output=True)
     expected = member_digests(reference)
+    start = time.perf_counter()
+    subprocess.run(sweep_argv(scene, workdir / "timing.h5"), check=True, capture_output=True)
+    window = (0.05, 1.5 * (time.perf_counter() - start))
     rng = random.Random(seed)
     figures = {"kills": 0, "rounds": 0, "recovered": 0, "unrecoverable": [], "lost": 0, "debris": [],
-               "failed_resumes": []}
+               "failed_resumes": [], "window": window, "cut_writes": 0}
     start = time.perf_counter()
     out, killed_in_round = None, 0
     while figures["kills"] < kills or killed_in_round:
@@ -119,6 +133,7 @@ def soak(kills: int, workdir: Path, seed: int = 0, window: tuple = (0.05, 2.0), 
             _wait_group_gone(process.pid)
             figures["kills"] += 1
             killed_in_round += 1
+            figures["cut_writes"] += bool(temporary_files(out))
             problem = readable(out)
             if problem:
                 figures["unrecoverable"].append(problem)
@@ -205,11 +220,13 @@ def main(argv) -> int:
         clash = collide(count, Path(tmp))
     rows = [("kills tried (SIGKILL to the sweep's process group)", figures["kills"]),
             ("rounds (each ends with an uninterrupted resume)", figures["rounds"]),
+            ("kills that cut a file write (temporary file left)", figures["cut_writes"]),
             ("rounds with kills recovered by the resume", figures["recovered"]),
             ("states left unreadable by a kill", len(figures["unrecoverable"])),
             ("resumes that failed", len(figures["failed_resumes"])),
             ("members lost or not bitwise equal", figures["lost"]),
             ("debris after the resumes", len(figures["debris"])),
+            ("kill instants drawn in (s)", "({:.2f}, {:.2f})".format(*figures["window"])),
             ("soak time (s)", f"{figures['seconds']:.0f}"),
             ("concurrent-run collisions tried", clash["collisions"]),
             ("collisions with a lost result (both exit 0)", clash["lost"]),
