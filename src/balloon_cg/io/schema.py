@@ -16,6 +16,7 @@ VARIABLES = {
     "theta": ("rad", "material polar angle θ", "material coordinate of the undeformed sphere, 0 at the north pole"),
     "unknown": (NONDIMENSIONAL, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last"),
     "special": (NONDIMENSIONAL, "special point index", "index of the special point on its branch"),
+    "mode_unknown": (NONDIMENSIONAL, "mode unknown index", "index into the odd perturbation block of the mode"),
     "eigenvalue": (NONDIMENSIONAL, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
     "pressure": (NONDIMENSIONAL, "pressure P", "P = P̄ R0 / (T0 μ/2)"),
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
@@ -78,10 +79,10 @@ def scale(group, name: str, length: int):
 
 
 def attach_dimensions(group, axes: dict) -> None:
-    """Attach to every dataset in ``group`` the scales of its axes (``axes``: {ndim: (scale, …)}) and describe
-    it; the scales themselves are left alone."""
-    for item in group.values():
+    """Attach to every dataset in ``group`` the scales of its axes (``axes``: {dataset name or ndim: (scale, …)},
+    the name first) and describe it; the scales themselves are left alone."""
+    for name, item in group.items():
         if isinstance(item, h5py.Dataset) and not item.is_scale:
-            for axis, dimension in enumerate(axes[item.ndim]):
+            for axis, dimension in enumerate(axes.get(name) or axes[item.ndim]):
                 item.dims[axis].attach_scale(dimension)
             describe(item)
