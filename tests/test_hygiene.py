@@ -51,3 +51,35 @@ def test_workers_exit_when_the_parent_is_killed(tmp_path):
                 os.killpg(pid, signal.SIGKILL)
             except ProcessLookupError:
                 pass
+
+
+def test_the_watchdog_fallback_exits_when_the_parent_dies(tmp_path):
+    """The path taken where prctl is not available: a thread polling os.getppid()."""
+    pid_file = tmp_path / "child.pid"
+    script = ("import os, sys, threading, time\n"
+              "from balloon_cg.app import hygiene\n"
+              "pid = os.fork()\n"
+              "if pid == 0:\n"
+              "    threading.Thread(target=hygiene._watch, args=(os.getppid(),), daemon=True).start()\n"
+              f"    open({str(pid_file)!r}, 'w').write(str(os.getpid()))\n"
+              "    time.sleep(60)\n"
+              "    os._exit(0)\n"
+              "time.sleep(60)\n")
+    parent = subprocess.Popen([sys.executable, "-c", script], start_new_session=True)
+    try:
+        deadline = time.monotonic() + 30
+        while not (pid_file.exists() and pid_file.read_text()) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        child = int(pid_file.read_text())
+        assert alive(child)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+        deadline = time.monotonic() + 5
+        while alive(child) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not alive(child), "the watchdog did not end the orphaned child"
+    finally:
+        try:
+            os.killpg(parent.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass

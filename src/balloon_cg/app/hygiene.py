@@ -1,9 +1,10 @@
 """Pool workers that die with their parent: ``ProcessPoolExecutor(initializer=worker_hygiene, initargs=(pid,))``.
 
 A worker whose parent is killed (SIGKILL, the OOM killer) would otherwise keep computing, blocked on the result
-pipe. On Linux the worker asks the kernel for SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``);
-elsewhere a daemon thread polls ``os.getppid()`` once a second. Either way the worker then checks that the parent
-it was started by is still its parent (it may have died before the request was made).
+pipe. On Linux the worker asks the kernel for SIGKILL when the process that started it dies
+(``prctl(PR_SET_PDEATHSIG)``: the sweep's process with the fork start method, or the forkserver, which exits
+with it); elsewhere a daemon thread polls ``os.getppid()`` once a second. Either way the worker then exits at
+once if the sweep's process ``pid`` died before the request was made.
 """
 import ctypes
 import ctypes.util
@@ -17,11 +18,11 @@ PR_SET_PDEATHSIG = 1
 POLL_SECONDS = 1.0
 
 
-def worker_hygiene(parent_pid: int) -> None:
-    """Initializer of a pool worker: exit when the process ``parent_pid`` stops being the parent."""
+def worker_hygiene(sweep_pid: int) -> None:
+    """Initializer of a pool worker: exit when its parent dies, or now if the process ``sweep_pid`` is gone."""
     if not (sys.platform.startswith("linux") and _pdeathsig()):
-        threading.Thread(target=_watch, args=(parent_pid,), daemon=True, name="parent-watchdog").start()
-    if os.getppid() != parent_pid:
+        threading.Thread(target=_watch, args=(os.getppid(),), daemon=True, name="parent-watchdog").start()
+    if not _alive(sweep_pid):
         os._exit(1)
 
 
@@ -33,7 +34,17 @@ def _pdeathsig() -> bool:
         return False
 
 
-def _watch(parent_pid: int) -> None:
-    while os.getppid() == parent_pid:
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _watch(parent: int) -> None:
+    while os.getppid() == parent:
         time.sleep(POLL_SECONDS)
     os._exit(1)
