@@ -21,8 +21,9 @@ def example() -> str:
     return blocks[0]
 
 
-def test_the_documented_example_runs(tmp_path, capsys):
-    namespace = {"SCENES": SCENES, "OUT": tmp_path}
+def test_the_documented_example_runs(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    namespace = {}
     exec(compile(example(), "docs/api.md", "exec"), namespace)  # our own documentation, not user input
     result, fig = namespace["result"], namespace["fig"]
     assert (tmp_path / "spom1.png").stat().st_size > 10_000 and (tmp_path / "spom1.h5").exists()
@@ -68,6 +69,14 @@ def test_reprs_are_short(result):
     assert len(repr(result)) < 300 and len(repr(result.picture)) < 300 and len(repr(result.scene)) < 1000
     assert all(len(repr(b)) < 200 for b in result.branches.values())
     assert all(len(repr(s)) < 200 for b in result.picture.branches for s in b.special)
+
+
+def test_bad_plot_arguments_are_plot_errors(result):
+    for points in ([], 5, ["a"]):
+        with pytest.raises(bc.PlotError, match="points"):
+            bc.plot(result, "shapes", points=points)
+    with pytest.raises(bc.PlotError, match="not matplotlib Axes"):
+        bc.plot(result, "shapes", ax=42)
 
 
 def test_plot_panels_must_match(result):

@@ -54,6 +54,8 @@ def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
     ("nope=1", ("--set nope", "no table")),
     ("M=0:1:3", ("--set M=0:1:3", "one value")),
     ("continuation.max_points=abc", ("max_points", "abc")),
+    ("field.M", ("--set field.M", "KEY=VALUE")),
+    ("=3", ("KEY=VALUE",)),
 ])
 def test_bad_set_is_one_line(tmp_path, capsys, setting, words):
     out = tmp_path / "x.h5"
@@ -61,6 +63,12 @@ def test_bad_set_is_one_line(tmp_path, capsys, setting, words):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("balloon-cg: error: ") and all(w in err for w in words), err
     assert not out.exists()
+
+
+def test_shorthand_and_set_of_the_same_key_conflict(tmp_path, capsys):
+    assert main(["run", "spom1", "--set", "continuation.max_points=4", "--max-points", "3",
+                 "-o", str(tmp_path / "x.h5")]) == 2
+    assert "both given" in capsys.readouterr().err and not (tmp_path / "x.h5").exists()
 
 
 def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):

@@ -4,7 +4,7 @@ The public API (docs/api.md) is importable from here and loaded on first use, so
 light (no numpy, numba or matplotlib until a name needs them)::
 
     import balloon_cg as bc
-    scene = bc.Scene.from_toml("scenes/spom1.toml").with_overrides({"field.M": 0.001})
+    scene = bc.Scene.from_toml("spom1_two_coils_M0.002").with_overrides({"field.M": 0.001})  # a shipped scene
     result = bc.analyse(scene)          # or bc.trace(scene): the primary branch only
     result.to_dataframe(); result.save("spom1.h5"); bc.plot(result, "pressure-pole")
 
@@ -33,7 +33,7 @@ __version__ = "0.1.0"
 
 _API = {
     "Scene": "balloon_cg.scene", "SceneError": "balloon_cg.scene", "load_scene": "balloon_cg.scene",
-    "parse_scene": "balloon_cg.scene",
+    "parse_scene": "balloon_cg.scene", "shipped_scenes": "balloon_cg.scene", "PlotError": "balloon_cg.post.plotting",
     "Result": "balloon_cg.app.api", "BranchData": "balloon_cg.app.api", "trace": "balloon_cg.app.api",
     "analyse": "balloon_cg.app.api", "load": "balloon_cg.app.api", "plot": "balloon_cg.app.api",
 }

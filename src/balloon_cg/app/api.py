@@ -77,7 +77,10 @@ class BranchData:
 
 @dataclass(frozen=True, repr=False)
 class Result:
-    """A computed or loaded run (module docstring)."""
+    """A computed or loaded run: ``scene``; ``image``, the bytes of its run file (what ``save`` writes);
+    ``run``, the same content as arrays (io.run_file.read_run's layout); ``picture``, the analysis objects when
+    computed in this process (else None). Tables: ``branches``, ``special_points``, ``to_dataframe``,
+    ``to_xarray``; verdict: ``complete``, ``incomplete``."""
 
     scene: Scene
     image: bytes
@@ -148,11 +151,15 @@ class Result:
 
     def save(self, path, force: bool = False) -> Path:
         """Write the run file (atomically; an existing file only with ``force``)."""
-        return atomic_bytes(path, self.image, force)
+        try:
+            return atomic_bytes(path, self.image, force)
+        except FileExistsError as e:
+            raise FileExistsError(e.errno, "already exists (save(..., force=True) replaces it)", e.filename) from None
 
     def __repr__(self):
         branches = ", ".join(f"{name} ({len(b['pressure'])} points)" for name, b in self.run["branches"].items())
-        state = "complete" if self.complete else f"incomplete: {len(self.incomplete)} parts"
+        n = len(self.incomplete)
+        state = "complete" if self.complete else f"incomplete: {n} part{'s' * (n != 1)}"
         return (f"Result({self.scene.name!r}: {branches}; {len(self.special_points)} special points, "
                 f"{len(self.snap_throughs)} snap-throughs; {state})")
 

@@ -47,6 +47,8 @@ def main(argv=None) -> int:
     args.command_line = shlex.join([PROG, *argv])
     try:
         return args.handler(args)
+    except KeyboardInterrupt:  # before the computation installed its own handler (imports), or a second Ctrl-C
+        return _error("interrupted", INTERRUPTED)
     except (UsageError, *_loaded(BAD_INPUT)) as e:
         return _debug(args) or _error(str(e), 2)
     except OSError as e:
@@ -131,14 +133,21 @@ def scene_of(args):
     from .sweep import SweepError, overridden, parse_vary
 
     scene = load_scene(args.scene)
-    settings = list(args.settings) + [f"continuation.{key}={getattr(args, key)}"
-                                      for key in ("max_points", "stop_stretch", "stop_pressure")
-                                      if getattr(args, key, None) is not None]
+    shorthands = [f"continuation.{key}={getattr(args, key)}" for key in ("max_points", "stop_stretch", "stop_pressure")
+                  if getattr(args, key, None) is not None]
+    settings = list(args.settings) + shorthands
     if not settings:
         return scene
     for text in settings:
-        if "," in text.partition("=")[2] or ":" in text.partition("=")[2]:
+        key, sep, value = (part.strip() for part in text.partition("="))
+        if not sep or not key or not value:
+            raise UsageError(f"--set {text}: expected KEY=VALUE, e.g. --set field.M=0.003")
+        if "," in value or ":" in value:
             raise UsageError(f"--set {text}: one value per key (sweep --vary takes lists and ranges)")
+    given = [text.partition("=")[0].strip() for text in args.settings]
+    for text in shorthands:
+        if text.partition("=")[0] in given or text.partition("=")[0].split(".")[1] in given:
+            raise UsageError(f"--set {text.partition('=')[0]} and its shorthand flag both given: use one")
     try:
         overrides = dict(parse_vary(text, scene) for text in settings)
     except SweepError as e:

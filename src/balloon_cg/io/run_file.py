@@ -223,6 +223,7 @@ def _write_snaps(group, snaps):
     group.create_dataset("from_index", data=np.array([s.from_index for s in snaps], dtype=np.int64))
     group.create_dataset("to_index", data=np.array([s.to_index for s in snaps], dtype=np.int64))
     group.create_dataset("pressure", data=np.array([s.pressure for s in snaps], dtype=float))
+    attach_dimensions(group, {1: (scale(group, "snap", len(snaps)),)})
 
 
 def write_special(group, special: list, width: int, disc, unknown=None) -> None:

@@ -154,8 +154,10 @@ def _panels(axes, count: int, figsize, **subplots):
         return fig, np.atleast_1d(fig.subplots(**subplots) if subplots else fig.add_subplot()), True
     given = list(np.ravel(np.asarray(axes, dtype=object)))
     if len(given) != count:
-        raise PlotError(f"this figure has {count} panel{'s' * (count > 1)}: pass axes= a sequence of {count} "
-                        f"matplotlib Axes (got {len(given)})")
+        raise PlotError(f"this figure has {count} panel{'s' * (count > 1)}: give a sequence of {count} matplotlib "
+                        f"Axes (got {len(given)})")
+    if not all(hasattr(a, "plot") and hasattr(a, "figure") for a in given):
+        raise PlotError(f"not matplotlib Axes: {', '.join(type(a).__name__ for a in given)}")
     return given[0].figure, np.array(given, dtype=object), False
 
 
@@ -302,6 +304,9 @@ def select_points(data: dict, points=None) -> np.ndarray:
     """Indices of the points of a stored branch to draw: ``points`` checked (negative count from the end), or
     DEFAULT_POINTS spread evenly in arclength along the (λ2(0), P) curve, each scaled by its range."""
     n = len(data["pressure"])
+    if points is not None and (np.ndim(points) != 1 or len(points) == 0
+                               or not all(isinstance(p, (int, np.integer)) for p in points)):
+        raise PlotError(f"points = {points!r}: expected a non-empty list of point indices, e.g. [0, 10, -1]")
     if points is None:
         path = np.stack([data["lam2_north"], data["pressure"]])
         span = np.ptp(path, axis=1, keepdims=True)
@@ -346,9 +351,10 @@ def _theta_axes(branches, ylabels, height=5.0, axes=None):
     for ax, label in zip(axes, ylabels):
         ax.set_ylabel(label)
         ax.axhline(0.0, color="0.6", linewidth=0.6)
-    axes[-1].set_xlabel(THETA_LABEL)
-    axes[-1].set_xlim(0.0, np.pi)
-    axes[-1].set_xticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
+    for ax in axes[-1:] if own else axes:  # the caller's Axes need not share x
+        ax.set_xlabel(THETA_LABEL)
+        ax.set_xlim(0.0, np.pi)
+        ax.set_xticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
     _suptitle(fig, axes, own, _per_point_title(branches))
     return fig, axes, own
 

@@ -165,18 +165,19 @@ class Scene:
 
 
 def renamed(name: str, overrides: dict[str, object]) -> str:
-    """``name`` with a ``_<key><value>`` token per field or material override (key: the last part of the dotted
-    key, without indices; a preset: its name): an existing token of that key is updated, else one is appended."""
+    """``name`` with a ``_<key><value>`` token per scalar field or material override (key: the last part of
+    the dotted key, with its list index past 0: ``radius3.5``, ``radius1=3.5``; a string: itself, reduced to
+    filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
+    (``field.coils``, ``material.mu``) leave the name alone."""
     for key, value in overrides.items():
-        if key.split(".")[0] not in ("field", "material") or value is None:
+        if key.split(".")[0] not in ("field", "material") or value is None or isinstance(value, (list, tuple, dict)):
             continue
-        if isinstance(value, str):  # a preset: its name
-            name = f"{name}_{value.lower()}"
+        if isinstance(value, str):  # a preset or a material name
+            name = f"{name}_{re.sub(r'[^A-Za-z0-9.+-]+', '-', value).strip('-').lower()}"
             continue
-        short = re.sub(r"\[\d+\]", "", key.split(".")[-1])
-        values = value if isinstance(value, (list, tuple)) else [value]
-        text = "-".join(f"{v:g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
-                        for v in values)
+        indices = "".join(i for i in re.findall(r"\[(\d+)\]", key) if i != "0")
+        short = re.sub(r"\[\d+\]", "", key.split(".")[-1]) + (f"{indices}=" if indices else "")
+        text = f"{value:g}" if isinstance(value, (int, float)) and not isinstance(value, bool) else str(value)
         token = re.compile(rf"(^|_){re.escape(short)}-?[0-9][0-9.eE+-]*(?=_|$)")
         name = token.sub(lambda m: f"{m.group(1)}{short}{text}", name, count=1) if token.search(name) \
             else f"{name}_{short}{text}"
@@ -189,13 +190,26 @@ def parse_scene(text: str, name: str = "scene") -> Scene:
 
 
 def load_scene(path) -> Scene:
-    """Read a scene file; the scene is named after the file stem, error messages after the file name."""
+    """Read a scene file; the scene is named after the file stem, error messages after the file name. A bare
+    name that is not a file (``"spom1"``, ``"spom1.toml"``) names a scene shipped with the package
+    (``shipped_scenes()``)."""
     path = Path(path)
+    shipped = path.name.removesuffix(".toml")
+    if not path.exists() and path.parent == Path(".") and shipped in shipped_scenes():
+        path = shipped_scenes()[shipped]
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as e:
         raise SceneError(f"{path.name}: not UTF-8 text ({e})") from None
     return _parse(text, path.stem, path.name)
+
+
+def shipped_scenes() -> dict[str, Path]:
+    """The scenes shipped with the package (the repository's scenes/ folder): {name: path}."""
+    from importlib import resources
+
+    folder = resources.files("balloon_cg.scenes")
+    return {item.name.removesuffix(".toml"): Path(str(item)) for item in folder.iterdir() if item.name.endswith(".toml")}
 
 
 def _parse(text: str, name: str, source: str) -> Scene:
