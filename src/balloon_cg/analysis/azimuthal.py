@@ -168,9 +168,31 @@ def basis(m: int, degree: int, quadrature: int) -> AzimuthalBasis:
     return AzimuthalBasis(m, degree, quadrature)
 
 
+@dataclass(frozen=True)
+class StateMaps:
+    """The linear maps of the unknowns u of a discretisation onto the nodes of an azimuthal basis: ``state``
+    (size, 4 n_q), u @ state = (λ2, λ2', η, η') at the nodes; ``modes`` (size, 2 size_b) and ``translation``
+    (size_b), the special modes' rows G c (``_mode_moments``): (rotation, relabelling) = u @ modes, and the
+    translation's, which does not depend on u."""
+
+    state: np.ndarray
+    modes: np.ndarray
+    translation: np.ndarray
+
+
+@lru_cache(maxsize=32)
+def state_maps(disc, b: AzimuthalBasis) -> StateMaps:
+    """``StateMaps`` of ``disc`` (a galerkin Discretisation) on the nodes of ``b``: columns of unit unknowns."""
+    unit = tuple(np.atleast_2d(v) for v in disc.evaluate(np.eye(disc.size), b.theta))  # each (size, n_q)
+    moments = _mode_moments(b, unit)  # (3, size, size_b): G c of each mode for each unit u
+    zero = _mode_moments(b, tuple(np.zeros((1, b.x.size)) for _ in range(4)))[0, 0]
+    return StateMaps(np.ascontiguousarray(np.concatenate(unit, axis=1)),
+                     np.ascontiguousarray(np.concatenate([moments[1], moments[2]], axis=1)), zero)
+
+
 def _node_state(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> tuple:
     """(λ2, λ2', η, η') of the axisymmetric state u at the nodes of ``b``."""
-    return equilibrium.disc.evaluate(np.asarray(u, dtype=float), b.theta)
+    return tuple((np.asarray(u, dtype=float) @ state_maps(equilibrium.disc, b).state).reshape(4, -1))
 
 
 def _hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis) -> np.ndarray:
@@ -239,13 +261,20 @@ MODES = ("translation", "rotation", "relabelling")
 
 
 def _mode_moments(b: AzimuthalBasis, state: tuple) -> np.ndarray:
-    """G c for the special modes (``special_modes``, rows in the order MODES) from the node state: the L2
-    projection's right-hand sides ½ ∫ (R δR + T δT + Z δZ) dx, shape (3, size)."""
+    """G c for the special modes (``special_modes``, in the order MODES) from node states (λ2, λ2', η, η'), each
+    (k, n_q) for k states: the L2 projection's right-hand sides ½ ∫ (R δR + T δT + Z δZ) dx, shape (3, k, size);
+    the translation's is the same for every state."""
     lam2, dlam2, eta, deta = state
     s, c = b.sin_theta, b.x
     one = np.ones_like(eta)
     values = np.array([[one, -one, 0.0 * one], [eta, -eta, -lam2 * s], [lam2 * c + dlam2 * s, -lam2 * c, deta]])
-    return values.reshape(3, -1) @ b.moments
+    return np.einsum("mjkq,jqi->mki", values, b.moments.reshape(3, -1, b.size))
+
+
+def mode_moments(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> np.ndarray:
+    """G c of the special modes (rows in the order MODES) of the state u, by the linear maps ``state_maps``."""
+    maps = state_maps(equilibrium.disc, b)
+    return np.vstack([maps.translation, (np.asarray(u, dtype=float) @ maps.modes).reshape(2, -1)])
 
 
 def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0) -> dict:
@@ -261,7 +290,7 @@ def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0)
     All are regular (D = R − T ≠ 0 at the poles) and exact in the basis when degree ≥ the equilibrium's Legendre
     degree + 1 (the translation for any degree)."""
     b = perturbation_basis(equilibrium, 1, degree, quadrature)
-    moments = _mode_moments(b, _node_state(equilibrium, u, b))
+    moments = mode_moments(equilibrium, u, b)
     coefficients = b.inverse_factor.T @ (b.inverse_factor @ moments.T)  # G⁻¹ (G c)
     return dict(zip(MODES, coefficients.T))
 
@@ -314,7 +343,7 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     b = perturbation_basis(equilibrium, m, degree, quadrature)
     state = _node_state(equilibrium, u, b)
     H = _hessian(equilibrium, state, params, m, b)
-    moments = _mode_moments(b, state) if m == 1 else None
+    moments = mode_moments(equilibrium, u, b) if m == 1 else None
     return {held: eigen.restricted(H, b.inverse_factor, moments[list(excluded_modes(equilibrium, params, held))]
                                    if m == 1 else eigen.NO_CONSTRAINT) for held in readings}
 

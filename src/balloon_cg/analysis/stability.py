@@ -74,10 +74,13 @@ class SecondVariation:
         self.translation = na  # b_0
         ops, w = self.basis.ops, self.basis.weights
         self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+        # the state at the nodes is linear in the equilibrium's unknowns: (λ2, v, η, w) = u @ state_map
+        unit = self.eq.state_at(np.eye(self.eq.disc.size), self.theta)
+        self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
 
     def matrices(self, u, params: Parameters):
         """(H, g): the Hessian of E and the volume gradient on the perturbation basis."""
-        state = self.eq.state_at(u, self.theta)
+        state = tuple((np.asarray(u, dtype=float) @ self.state_map).reshape(4, -1))
         geometry = (self.basis.cos_theta, self.basis.sin_theta)
         hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params))
         volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params))
