@@ -136,6 +136,12 @@ class AzimuthalBasis:
         # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
         moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
         put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
+        # reflection classes z → −z of an equator-symmetric state (P̄_k^j(−x) = (−1)^{k+j} P̄_k^j(x)): k + m odd is
+        # (R, T even in x, Z odd), k + m even the opposite; H and G have no entries between them
+        parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
+        classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
+        put(self, "classes", classes)
+        put(self, "class_factors", tuple(np.linalg.inv(np.linalg.cholesky(self.gram[np.ix_(c, c)])) for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
@@ -213,25 +219,24 @@ _UD_ROWS = np.array([0, 1, 4, 5])  # R, R', T, T'
 _Z_ROWS = np.array([2, 3])  # Z, Z'
 
 
-@njit(cache=True)
 def _assemble(h, weights, row, ops_ud, ops_z):
     """H = Σ_q w_q Σ_kl h_kl(q) ∂y_k/∂c ∂y_l/∂c, h_kl in row ``row[k, l]`` of h, on the column groups (Z | U, D):
     (R, R', T, T') depend on the U, D coefficients only (``ops_ud``, (4, n_q, n_ud)), (Z, Z') on the Z ones only
-    (``ops_z``, (2, n_q, n_z)); symmetrised."""
+    (``ops_z``, (2, n_q, n_z)); each group pair is one BLAS product of the stacked ops of one group with the
+    node-wise weighted combinations of the other's (``_weighted``); symmetrised."""
     nz, nud = ops_z.shape[2], ops_ud.shape[2]
+    stacked_ud, stacked_z = ops_ud.reshape(-1, nud), ops_z.reshape(-1, nz)
     H = np.empty((nz + nud, nz + nud))
-    H[nz:, nz:] = _group_block(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud, ops_ud)
-    H[:nz, :nz] = _group_block(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z, ops_z)
-    cross = _group_block(h, weights, row, _Z_ROWS, _UD_ROWS, ops_z, ops_ud)
-    H[:nz, nz:] = cross
-    H[nz:, :nz] = cross.T
+    H[nz:, nz:] = stacked_ud.T @ _weighted(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
+    H[:nz, :nz] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z).reshape(-1, nz)
+    H[:nz, nz:] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
+    H[nz:, :nz] = H[:nz, nz:].T
     return 0.5 * (H + H.T)
 
 
 @njit(cache=True)
-def _group_block(h, weights, row, rows_i, rows_j, ops_i, ops_j):
-    """Σ_q Σ_{k ∈ rows_i, l ∈ rows_j} w_q h_kl(q) ops_i[k]ᵀ ops_j[l]: one BLAS product of the stacked ops_i with
-    the node-wise weighted combinations of ops_j."""
+def _weighted(h, weights, row, rows_i, rows_j, ops_j):
+    """Σ_{l ∈ rows_j} w_q h_kl(q) ops_j[l] at every node q for each k ∈ rows_i, shape (len(rows_i), n_q, n_j)."""
     ni, nq, nj = rows_i.size, weights.size, ops_j.shape[2]
     scaled = np.zeros((ni, nq, nj))
     for a in range(ni):
@@ -241,7 +246,7 @@ def _group_block(h, weights, row, rows_i, rows_j, ops_i, ops_j):
                 c = weights[q] * h[r, q]
                 for j in range(nj):
                     scaled[a, q, j] += c * ops_j[b, q, j]
-    return ops_i.reshape(ni * nq, ops_i.shape[2]).T @ scaled.reshape(ni * nq, nj)
+    return scaled
 
 
 def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, quadrature: int = 0):
@@ -258,6 +263,7 @@ def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature
 
 
 MODES = ("translation", "rotation", "relabelling")
+MODE_CLASS = (0, 1, 1)  # the reflection class (AzimuthalBasis.classes) of each mode: R, T even / odd in x
 
 
 def _mode_moments(b: AzimuthalBasis, state: tuple) -> np.ndarray:
@@ -332,20 +338,43 @@ def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int
             readings=(True, False), quadrature: int = 0) -> dict:
     """``spectrum`` for several readings (held: True, free: False) from one assembly of the m-th block."""
     matrices = restricted_blocks(equilibrium, u, params, m, degree, readings, quadrature)
-    return {held: eigen.lowest_of(A, count) for held, A in matrices.items()}
+    return {held: merged_lowest(parts, count) for held, parts in matrices.items()}
+
+
+def merged_lowest(parts, count: int) -> np.ndarray:
+    """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
+    return np.sort(np.concatenate([eigen.lowest_of(A, count) for A in parts]))[:count]
 
 
 def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, readings=(True, False),
                       quadrature: int = 0) -> dict:
-    """The m-th block for each reading (held: True, free: False) as a standard symmetric matrix with the special
-    modes removed (``numerics.eigen.restricted``): its eigenvalues are ``spectrum``'s, its inertia the block's.
-    One assembly and, for m = 1, one evaluation of the modes' constraint rows G c serve every reading."""
+    """The m-th block for each reading (held: True, free: False) as standard symmetric matrices with the special
+    modes removed (``numerics.eigen.restricted``): their eigenvalues together are ``spectrum``'s, and the block is
+    positive when each is. On an equator-symmetric discretisation the state is symmetric and the block splits
+    into its two reflection classes (``AzimuthalBasis.classes``, each mode in its own: MODE_CLASS), two matrices
+    of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
+    serve every reading."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    state = _node_state(equilibrium, u, b)
-    H = _hessian(equilibrium, state, params, m, b)
-    moments = mode_moments(equilibrium, u, b) if m == 1 else None
-    return {held: eigen.restricted(H, b.inverse_factor, moments[list(excluded_modes(equilibrium, params, held))]
-                                   if m == 1 else eigen.NO_CONSTRAINT) for held in readings}
+    H = _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b)
+    moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
+    split = equilibrium.disc.symmetric
+    parts = tuple(zip(b.classes, b.class_factors, (0, 1))) if split else ((None, b.inverse_factor, None),)
+    out = {}
+    for held in readings:
+        modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []
+        out[held] = tuple(
+            eigen.restricted(H, factor, _class_rows(moments, modes, cls, index), index)
+            for index, factor, cls in parts)
+    return out
+
+
+def _class_rows(moments, modes: list, cls, index):
+    """The constraint rows of ``modes`` on the part ``index`` (all of them for the whole block, cls None; else
+    those of the modes in reflection class cls)."""
+    if cls is None:
+        return moments[modes]
+    kept = [k for k in modes if MODE_CLASS[k] == cls]
+    return moments[np.ix_(kept, index)] if kept else eigen.NO_CONSTRAINT
 
 
 def excluded_modes(equilibrium: Equilibrium, params: Parameters, held: bool) -> tuple:

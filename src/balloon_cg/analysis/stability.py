@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .azimuthal import restricted_blocks
+from .azimuthal import merged_lowest, restricted_blocks
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
@@ -105,8 +105,9 @@ class SecondVariation:
         return cache[key]
 
     def blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> list:
-        """(name, standard matrix, flags) per block at one equilibrium: the block's pencil restricted to its
-        constraints (``_restricted``, ``azimuthal.restricted_blocks``) and the flags it enters (positions in
+        """(name, standard matrices, flags) per block at one equilibrium: the block's pencil restricted to its
+        constraints, as one matrix or the matrices of its uncoupled parts (``_restricted``,
+        ``azimuthal.restricted_blocks``), and the flags it enters (positions in
         FLAGS). Azimuthal blocks m = 1..m_max enter every flag (their modes keep the volume to first order, so
         both control modes see the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
         translation is no zero mode to remove (no field)."""
@@ -127,7 +128,7 @@ class SecondVariation:
                     ("all_volume_held", held_idx, g, (HELD_VOLUME,) if field_on else (HELD_VOLUME, FREE_VOLUME))]
             if field_on:
                 plan += [("all_free", everything, None, (FREE,)), ("all_volume_free", everything, g, (FREE_VOLUME,))]
-        out = [(name, self._restricted(H, idx, constraint), flags) for name, idx, constraint, flags in plan]
+        out = [(name, (self._restricted(H, idx, constraint),), flags) for name, idx, constraint, flags in plan]
         for m in range(1, m_max + 1):
             readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,))
             out.append((f"m{m}_held", readings[True], (HELD, HELD_VOLUME) if field_on else EVERY_FLAG))
@@ -139,8 +140,8 @@ class SecondVariation:
         """Blocks (their LOWEST eigenvalues) and flags (a flag holds when every block it takes is positive) at one
         equilibrium (``blocks``)."""
         blocks, lowest = {}, [np.inf] * len(FLAGS)
-        for name, A, flags in self.blocks(u, params, symmetric, m_max):
-            blocks[name] = eigen.lowest_of(A, LOWEST)
+        for name, parts, flags in self.blocks(u, params, symmetric, m_max):
+            blocks[name] = merged_lowest(parts, LOWEST)
             for flag in flags:
                 lowest[flag] = min(lowest[flag], blocks[name][0])
         return Assessment(blocks, *(value > 0 for value in lowest), self.basis.degree)
@@ -150,8 +151,8 @@ class SecondVariation:
         factorisation exists (``eigen.positive_definite``), no eigenvalues; a block is skipped once every flag
         it enters has failed."""
         stable = [True] * len(FLAGS)
-        for _, A, flags in self.blocks(u, params, symmetric, m_max):
-            if any(stable[flag] for flag in flags) and not eigen.positive_definite(A):
+        for _, parts, flags in self.blocks(u, params, symmetric, m_max):
+            if any(stable[flag] for flag in flags) and not all(eigen.positive_definite(A) for A in parts):
                 for flag in flags:
                     stable[flag] = False
         return tuple(stable)

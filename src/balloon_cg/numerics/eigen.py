@@ -1,12 +1,12 @@
 """Lowest eigenvalues of a symmetric pencil (H, G), G = L Lᵀ > 0, on the hyperplanes nᵢᵀc = 0.
 
 With y = Lᵀc the pencil becomes the standard problem A y = μ y, A = L⁻¹ H L⁻ᵀ, and a constraint nᵀc = 0 becomes
-(L⁻¹n)ᵀ y = 0. The constraint directions are orthonormalised by an SVD (directions below rcond times the largest
-singular value are dropped: linearly dependent normals are fine) and each is removed by a Householder
-reflection Q (Q d ∥ e₁, then the first row and column dropped): a rank-two update, no null-space basis. The
-spectrum of the result is that of the Rayleigh quotient cᵀHc / cᵀGc on {c : Nᵀc = 0}. The reduction is one
-jitted call (``restricted_matrix``); the eigenvalues come from LAPACK's dsyevr for the lowest ``count`` only
-(tridiagonalisation and bisection, no full spectrum).
+(L⁻¹n)ᵀ y = 0. The constraint directions are orthonormalised by Gram–Schmidt with pivoting (a direction whose
+remainder is below rcond times the largest is dropped: linearly dependent normals are fine) and each is removed
+by a Householder reflection Q (Q d ∥ e₁, then the first row and column dropped): a rank-two update, no
+null-space basis. The spectrum of the result is that of the Rayleigh quotient cᵀHc / cᵀGc on {c : Nᵀc = 0}.
+The products L⁻¹ H L⁻ᵀ are BLAS calls, the gathering and the reflections plain jitted loops (quick to compile);
+the eigenvalues come from LAPACK's dsyevr for the lowest ``count`` only (tridiagonalisation and bisection).
 """
 import numpy as np
 from numba import njit
@@ -20,9 +20,11 @@ def restricted(H, inverse_factor, normals=NO_CONSTRAINT, index=None, rcond: floa
     """The standard symmetric matrix A of the pencil (H, G) on the block ``index`` of H (None: all of it) with
     Nᵀc = 0 (module docstring); ``inverse_factor`` is L⁻¹ of the block of G (G = LLᵀ), ``normals`` the rows nᵢ on
     the block (k × n). Its eigenvalues are the pencil's on the constrained block, its inertia the block's."""
-    index = np.arange(H.shape[0]) if index is None else np.asarray(index, dtype=np.int64)
-    normals = np.ascontiguousarray(np.atleast_2d(normals), dtype=float)
-    return restricted_matrix(np.ascontiguousarray(H, dtype=float), index, inverse_factor, normals, rcond)
+    block = H if index is None else _gather(np.ascontiguousarray(H, dtype=float), np.asarray(index, dtype=np.int64))
+    A = inverse_factor @ block @ inverse_factor.T
+    normals = np.atleast_2d(normals)
+    directions = normals @ inverse_factor.T if normals.shape[0] else np.zeros((0, A.shape[0]))
+    return _reflect_out(A, directions, rcond)
 
 
 def lowest_of(A, count: int) -> np.ndarray:
@@ -46,46 +48,98 @@ def lowest(H, inverse_factor, count: int, normals=NO_CONSTRAINT, index=None, rco
 
 
 @njit(cache=True)
-def restricted_matrix(H, index, inverse_factor, normals, rcond):
-    """L⁻¹ H[index, index] L⁻ᵀ on the orthogonal complement of the directions L⁻¹nᵢ (module docstring)."""
+def _gather(H, index):
+    """H[index][:, index]."""
     n = index.size
     block = np.empty((n, n))
     for i in range(n):
         for j in range(n):
             block[i, j] = H[index[i], index[j]]
-    A = inverse_factor @ block @ inverse_factor.T
-    A = 0.5 * (A + A.T)
-    if normals.shape[0]:
-        directions = normals @ inverse_factor.T  # rows L⁻¹nᵢ
-        _, s, vt = np.linalg.svd(directions, full_matrices=False)
-        kept = 0
-        while kept < s.size and s[kept] > rcond * s[0]:
-            kept += 1
-        D = np.ascontiguousarray(vt[:kept].T)  # orthonormal columns
-        while D.shape[1]:
-            A, D = _reflect_out(A, D)
-    return A
+    return block
 
 
 @njit(cache=True)
-def _reflect_out(A, D):
-    """(Q A Q, Q D) without their first rows (and A's first column), Q = I − w v vᵀ the Householder reflection
-    that maps the first column d of D (unit length) to ∓e₁."""
+def _orthonormal_rows(D, rcond):
+    """Orthonormal rows spanning the rows of D (k × n): Gram–Schmidt with pivoting on the largest remaining norm
+    and a second pass; a row whose remainder is below rcond times the largest norm is dependent and dropped."""
+    k, n = D.shape
+    Q = D.copy()
+    norms = np.empty(k)
+    for i in range(k):
+        norms[i] = np.sqrt(_dot(Q[i], Q[i]))
+    largest = norms.max() if k else 0.0
+    done = np.zeros(k, dtype=np.bool_)
+    out = np.empty((k, n))
+    count = 0
+    for _ in range(k):
+        pick, best = -1, rcond * largest
+        for i in range(k):
+            if not done[i] and norms[i] > best:
+                pick, best = i, norms[i]
+        if pick < 0:
+            break
+        done[pick] = True
+        for j in range(n):
+            out[count, j] = Q[pick, j]
+        for r in range(count):  # second pass against the accepted rows
+            _subtract_projection(out, count, r)
+        scale = 1.0 / np.sqrt(_dot(out[count], out[count]))
+        for j in range(n):
+            out[count, j] *= scale
+        for i in range(k):
+            if not done[i]:
+                projection = _dot(Q[i], out[count])
+                for j in range(n):
+                    Q[i, j] -= projection * out[count, j]
+                norms[i] = np.sqrt(_dot(Q[i], Q[i]))
+        count += 1
+    return out[:count].copy()
+
+
+@njit(cache=True)
+def _subtract_projection(rows, i, r):
+    """rows[i] −= (rows[i]·rows[r]) rows[r]."""
+    projection = _dot(rows[i], rows[r])
+    for j in range(rows.shape[1]):
+        rows[i, j] -= projection * rows[r, j]
+
+
+@njit(cache=True)
+def _reflect_out(A, directions, rcond):
+    """The symmetric part of A on the orthogonal complement of the rows of ``directions``: each orthonormal
+    direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two update of A),
+    then the first row and column dropped (and the first coordinate of the remaining directions)."""
     n = A.shape[0]
-    v = D[:, 0].copy()
-    v[0] += 1.0 if v[0] >= 0.0 else -1.0
-    w = 2.0 / (v @ v)
-    Av = A @ v
-    c = w * w * (v @ Av)
-    B = np.empty((n - 1, n - 1))
-    for i in range(1, n):
-        for j in range(1, n):
-            B[i - 1, j - 1] = A[i, j] - w * (v[i] * Av[j] + Av[i] * v[j]) + c * v[i] * v[j]
-    E = np.empty((n - 1, D.shape[1] - 1))
-    for j in range(1, D.shape[1]):
-        projected = 0.0
+    B = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            B[i, j] = 0.5 * (A[i, j] + A[j, i])
+    D = _orthonormal_rows(directions, rcond)
+    for r in range(D.shape[0]):
+        v = D[r].copy()
+        v[0] += 1.0 if v[0] >= 0.0 else -1.0
+        w = 2.0 / _dot(v, v)
+        Bv = np.zeros(n)
         for i in range(n):
-            projected += v[i] * D[i, j]
+            for j in range(n):
+                Bv[i] += B[i, j] * v[j]
+        c = w * w * _dot(v, Bv)
+        C = np.empty((n - 1, n - 1))
         for i in range(1, n):
-            E[i - 1, j - 1] = D[i, j] - w * v[i] * projected
-    return B, E
+            for j in range(1, n):
+                C[i - 1, j - 1] = B[i, j] - w * (v[i] * Bv[j] + Bv[i] * v[j]) + c * v[i] * v[j]
+        rest = np.empty((D.shape[0], n - 1))
+        for s in range(r + 1, D.shape[0]):
+            projected = _dot(D[s], v)
+            for i in range(1, n):
+                rest[s, i - 1] = D[s, i] - w * v[i] * projected
+        B, D, n = C, rest, n - 1
+    return B
+
+
+@njit(cache=True)
+def _dot(a, b):
+    total = 0.0
+    for i in range(a.size):
+        total += a[i] * b[i]
+    return total
