@@ -132,7 +132,7 @@ class AzimuthalBasis:
         w = weights[:, None]
         gram = 0.5 * sum(ops[k].T @ (w * ops[k]) for k in (0, 2, 4))
         put(self, "gram", 0.5 * (gram + gram.T))
-        put(self, "inverse_factor", np.linalg.inv(np.linalg.cholesky(self.gram)))  # L⁻¹, G = LLᵀ
+        put(self, "factor", eigen.GramFactor(self.gram))
         # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
         moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
         put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
@@ -141,7 +141,7 @@ class AzimuthalBasis:
         parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
         classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
         put(self, "classes", classes)
-        put(self, "class_factors", tuple(np.linalg.inv(np.linalg.cholesky(self.gram[np.ix_(c, c)])) for c in classes))
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)]) for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
@@ -297,7 +297,7 @@ def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0)
     degree + 1 (the translation for any degree)."""
     b = perturbation_basis(equilibrium, 1, degree, quadrature)
     moments = mode_moments(equilibrium, u, b)
-    coefficients = b.inverse_factor.T @ (b.inverse_factor @ moments.T)  # G⁻¹ (G c)
+    coefficients = b.factor.inverse.T @ (b.factor.inverse @ moments.T)  # G⁻¹ (G c)
     return dict(zip(MODES, coefficients.T))
 
 
@@ -311,7 +311,7 @@ def lowest_eigenvalues(H, G, count: int = 6, exclude=None, vectors: bool = False
     count = min(count, H.shape[0])
     if not vectors:
         normals = np.atleast_2d(exclude) @ G if excluding else eigen.NO_CONSTRAINT
-        return eigen.lowest(H, np.linalg.inv(np.linalg.cholesky(G)), count, normals)
+        return eigen.lowest(H, eigen.GramFactor(G), count, normals)
     null = None
     if excluding:
         null = linalg.null_space(np.atleast_2d(exclude) @ G, rcond=eigen.RCOND)
@@ -358,7 +358,7 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     H = _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b)
     moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
     split = equilibrium.disc.symmetric
-    parts = tuple(zip(b.classes, b.class_factors, (0, 1))) if split else ((None, b.inverse_factor, None),)
+    parts = tuple(zip(b.classes, b.class_factors, (0, 1))) if split else ((None, b.factor, None),)
     out = {}
     for held in readings:
         modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []

@@ -94,14 +94,14 @@ class SecondVariation:
     def _restricted(self, H, idx, constraint=None):
         """The block ``idx`` of (H, G) as a standard symmetric matrix, optionally on gᵀδ = 0 (``eigen.restricted``)."""
         normals = eigen.NO_CONSTRAINT if constraint is None else constraint[idx]
-        return eigen.restricted(H, self._inverse_cholesky(idx), normals, idx)
+        return eigen.restricted(H, self._gram_factor(idx), normals, idx)
 
-    def _inverse_cholesky(self, idx: np.ndarray):
-        """L⁻¹ with G_block = L Lᵀ (the Gram blocks do not change along a branch: cached)."""
+    def _gram_factor(self, idx: np.ndarray) -> eigen.GramFactor:
+        """G_block = L Lᵀ (the Gram blocks do not change along a branch: cached)."""
         cache = self.__dict__.setdefault("_cholesky", {})
         key = idx.tobytes()
         if key not in cache:
-            cache[key] = np.linalg.inv(np.linalg.cholesky(self.gram[np.ix_(idx, idx)]))
+            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)])
         return cache[key]
 
     def blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> list:
