@@ -185,16 +185,24 @@ class Discretisation:
         return out
 
     def pole_rows(self):
-        """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south)."""
+        """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south) (read-only, built once: every
+        continuation step's stop test reads them)."""
+        return dict(self._pole_rows)
+
+    @functools.cached_property
+    def _pole_rows(self) -> dict:
         sign = (-1.0) ** np.arange(self.degree + 1)
         ones = np.ones(self.degree + 1)
         zero = np.zeros(self.degree + 1)
-        return {
+        rows = {
             "lam2_north": self.join(ones, zero),
             "lam2_south": self.join(sign, zero),
             "eta_north": self.join(zero, ones) - np.append(np.zeros(self.a_index.size), self.eta_mean),
             "eta_south": self.join(zero, sign) - np.append(np.zeros(self.a_index.size), self.eta_mean),
         }
+        for row in rows.values():
+            row.flags.writeable = False
+        return rows
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
