@@ -4,6 +4,7 @@ R(u; P, M) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (λ2, v,
 J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M for
 continuation. A point is an equilibrium when R = 0 at fixed (P, M).
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,17 +68,17 @@ class Equilibrium:
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
         out = self.kernels.nodes(kernel, named, params)
-        if not np.all(np.isfinite(out)):
+        if not math.isfinite(out.sum()):  # a NaN or ±inf anywhere makes the sum NaN or ±inf
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 
     def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u are reused (Newton asks for R, then J)."""
         last = getattr(self, "_last", None)
-        if last is None or not np.array_equal(last[0], u):
+        if last is None or last[0].shape != u.shape or (last[0] != u).any():
             state = tuple(self.disc.node_state(u))
             field = self._field(state[0], self.disc.sin_theta, state[2])
-            last = self._last = (np.array(u), self._node_values(self.geometry, state, field))
+            last = self._last = (np.array(u, dtype=float), self._node_values(self.geometry, state, field))
         return self._evaluate(kernel, last[1], params)
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
@@ -95,15 +96,26 @@ class Equilibrium:
     def jacobian(self, u, params: Parameters) -> np.ndarray:
         return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
-    def parameter_derivative(self, u, params: Parameters, name: str) -> np.ndarray:
-        """∂R/∂P or ∂R/∂M (the latter is zero without coils)."""
+    def parameter_derivative(self, u, params: Parameters, name: str, out: np.ndarray | None = None) -> np.ndarray:
+        """∂R/∂P or ∂R/∂M (the latter is zero without coils), into ``out`` if given."""
         if name == "P":
-            return self.disc.gradient(self._pointwise("pressure_gradient", u, params))
+            return self.disc.gradient(self._pointwise("pressure_gradient", u, params), out)
         if name == "M":
             if not self.coils.shape[0]:
-                return np.zeros(self.disc.size)
-            return self.disc.gradient(self._pointwise("field_gradient", u, params))
+                out = np.empty(self.disc.size) if out is None else out
+                out[:] = 0.0
+                return out
+            return self.disc.gradient(self._pointwise("field_gradient", u, params), out)
         raise ValueError(f"unknown continuation parameter {name!r}: expected 'P' or 'M'")
+
+    def bordered_jacobian(self, u, params: Parameters, name: str) -> np.ndarray:
+        """[∂R/∂u  ∂R/∂name] (n × (n + 1)) for the map X = (u, name) of a continuation or a constrained solve,
+        assembled in place (one state evaluation serves both parts)."""
+        n = self.disc.size
+        out = np.empty((n, n + 1))
+        self.disc.hessian(self._pointwise("energy_hessian", u, params), out[:, :n])
+        self.parameter_derivative(u, params, name, out[:, n])
+        return out
 
     def volume(self, u) -> float:
         """Enclosed volume / (2π) = −∂E/∂P (MODEL.md §2: the pressure term is −P V/(2π))."""
