@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
 from .validation import SceneError, number, show, show_key, table
+from .energies import StrainEnergy
 from .materials import Material, material_from_table
 
 __all__ = [
@@ -118,7 +119,7 @@ class Scene:
     """A validated scene; ``text`` is the TOML it was parsed from (provenance)."""
 
     name: str
-    material: Material
+    material: Material | StrainEnergy
     field: Field
     continuation: Continuation
     solver: Solver
@@ -130,7 +131,8 @@ class Scene:
         """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded)."""
         m, f = self.material, self.field
         return {
-            "material": {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
+            "material": m.to_table() if isinstance(m, StrainEnergy) else
+            {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
             **{t: asdict(getattr(self, t)) for t in _TABLES[2:]},
         }
