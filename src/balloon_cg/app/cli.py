@@ -27,6 +27,7 @@ from ..galerkin.profiles import equator_values
 from ..scene import SceneError, load_scene
 from ..io.hdf5 import check_output
 from ..io.run_file import RunFileError, read_run, write_run
+from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
 
@@ -57,7 +58,7 @@ def main(argv=None) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels):
         add(commands)
     return parser
 
