@@ -89,3 +89,4 @@ def test_gent_pressure_has_a_maximum_and_a_minimum_then_stiffens():
     after = np.linspace(minimum, 7.0, 50)  # Gent's limit: I1 − 3 = Jm at λ ≈ 7.07 on the sphere
     assert pressure(maximum) > pressure(minimum) and np.all(np.diff(pressure(after)) > 0)
     assert pressure(7.0) > pressure(maximum)
+

@@ -15,14 +15,12 @@ from .validation import SceneError, show
 
 @dataclass(frozen=True)
 class Family:
-    """A named energy: its formula, parameter names (in kernel order), the parameters that must be > 0, and
-    its admissible domain as a condition on the state (``None``: every stretch)."""
+    """A named energy: its formula, parameter names (in kernel order) and the parameters that must be > 0."""
 
     key: str
     formula: str
     parameters: tuple[str, ...]
     positive: tuple[str, ...]
-    domain: str | None = None
 
 
 FAMILIES = {
@@ -33,14 +31,13 @@ FAMILIES = {
                          " + C02*(I2 - 3)**2 + C30*(I1 - 3)**3",
                ("C10", "C01", "C20", "C11", "C02", "C30"), ()),
         # Gent (1996): limiting chain extensibility I1 − 3 < Jm
-        Family("gent", "-(mu*Jm/2)*log(1 - (I1 - 3)/Jm)", ("mu", "Jm"), ("mu", "Jm"), "I1 - 3 < Jm"),
+        Family("gent", "-(mu*Jm/2)*log(1 - (I1 - 3)/Jm)", ("mu", "Jm"), ("mu", "Jm")),
         # Gent–Gent (Pucci & Saccomandi 2002): Gent plus C2 ln(I2/3)
         Family("gent_gent", "-(mu*Jm/2)*log(1 - (I1 - 3)/Jm) + C2*log(I2/3)", ("mu", "Jm", "C2"),
-               ("mu", "Jm"), "I1 - 3 < Jm"),
+               ("mu", "Jm")),
         # Arruda–Boyce 8-chain, inverse Langevin by Cohen's rounded Padé L⁻¹(x) ≈ x(3 − x²)/(1 − x²):
         # Φ = μN ∫ L⁻¹(x) dx = μN (x²/2 − ln(1 − x²)) + const with x² = I1/(3N) (chain stretch²/N)
-        Family("arruda_boyce", "mu*(I1 - 3)/6 - mu*N*log((3*N - I1)/(3*N - 3))", ("mu", "N"), ("mu",),
-               "I1 < 3 N"),
+        Family("arruda_boyce", "mu*(I1 - 3)/6 - mu*N*log((3*N - I1)/(3*N - 3))", ("mu", "N"), ("mu",)),
     )
 }
 
