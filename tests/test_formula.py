@@ -146,20 +146,21 @@ def test_cached_module_has_the_committed_header(tmp_path, monkeypatch):
     assert f"('energy', {energy.formula.text!r})" in text
 
 
-@pytest.fixture(scope="module")
-def spom1_pair():
-    """The SPOM1 preset and a user formula of its three Ogden terms (runtime exponents, another code path)."""
+# (preset, the same energy as a user formula (another code path: runtime exponents, the kernel cache), pear points)
+PAIRS = {"SPOM1": (f'energy = "{SPOM1_TERMS}"\n[material.parameters]\n{SPOM1_PARAMETERS}', 2),
+         "neo-Hookean": ('energy = "I1 - 3"', 0)}
+
+
+@pytest.mark.parametrize("preset", list(PAIRS))
+def test_user_formula_reproduces_the_preset(preset):
+    formula_material, pears = PAIRS[preset]
     scenes = [parse_scene(f'[material]\n{m}\n[continuation]\nstop_stretch = 6.0\n', name="s")
-              for m in ('preset = "SPOM1"', f'energy = "{SPOM1_TERMS}"\n[material.parameters]\n{SPOM1_PARAMETERS}')]
-    return [analyse(s, pear=False).primary for s in scenes]
-
-
-def test_user_formula_for_spom1_reproduces_the_preset(spom1_pair):
-    preset, formula = spom1_pair
-    lam_p, lam_f = (b.pole_values()["lam2_north"] for b in spom1_pair)
+              for m in (f'preset = "{preset}"', formula_material)]
+    pair = [analyse(s, pear=False).primary for s in scenes]
+    lam_p, lam_f = (b.pole_values()["lam2_north"] for b in pair)
     assert lam_p.shape == lam_f.shape
-    assert np.abs(lam_f - lam_p).max() < 1e-12 and np.abs(formula.pressure / preset.pressure - 1).max() < 1e-12
+    assert np.abs(lam_f - lam_p).max() < 1e-12 and np.abs(pair[1].pressure / pair[0].pressure - 1).max() < 1e-12
     for block in (Block.ODD_HELD, Block.EVEN):
-        points = [[b.pole_values(bp.X)["lam2_north"][0] for bp in b.branch_points(block)] for b in spom1_pair]
-        assert len(points[0]) == len(points[1]) and (block != Block.ODD_HELD or len(points[0]) == 2)
+        points = [[b.pole_values(bp.X)["lam2_north"][0] for bp in b.branch_points(block)] for b in pair]
+        assert len(points[0]) == len(points[1]) and (block != Block.ODD_HELD or len(points[0]) == pears)
         assert np.abs(np.subtract(*points)).max(initial=0) < 1e-12
