@@ -90,3 +90,21 @@ def test_gent_pressure_has_a_maximum_and_a_minimum_then_stiffens():
     assert pressure(maximum) > pressure(minimum) and np.all(np.diff(pressure(after)) > 0)
     assert pressure(7.0) > pressure(maximum)
 
+
+
+def test_leaving_gent_domain_is_an_error_naming_the_point_and_stretch():
+    """A sphere beyond Gent's limit (I1 − 3 ≥ Jm, where the kernels would stay finite): NonFiniteState naming
+    the node, the failing log argument and the stretches; Newton reports it as the state leaving the domain."""
+    from balloon_cg.analysis.problem import equilibrium_of
+    from balloon_cg.galerkin.equilibrium import NonFiniteState, Parameters
+
+    scene = parse_scene('[material]\nfamily = "gent"\n[material.parameters]\nmu = 2.0\nJm = 10.0\n'
+                        "[continuation]\nstop_stretch = 2.0\n")
+    primary = analyse(scene, pear=False).primary
+    X = primary.X[-1]
+    beyond = X[:-1] * 3.0 / primary.pole_values(X)["lam2_north"][0]  # the sphere λ = 3: I1 − 3 = 15 > Jm
+    equilibrium = equilibrium_of(primary)
+    with pytest.raises(NonFiniteState, match=r"left the domain of gent at the node cos θ = -?[0-9.]+: log argument "
+                                             r"1 - \(I1 - 3\) / Jm = -0\.501235 \(λ1 = 3, λ2 = 3\)"):
+        equilibrium.residual(beyond, Parameters(X[-1]))
+    equilibrium.residual(X[:-1], Parameters(X[-1]))  # inside: no error

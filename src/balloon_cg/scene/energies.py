@@ -9,7 +9,9 @@ generated/; a user formula (``[material] energy = "..."``) gets its kernels gene
 import cmath
 from dataclasses import dataclass
 
-from .formula import Formula, evaluate, parse_formula
+import numpy as np
+
+from .formula import Formula, domain_conditions, evaluate, parse_formula
 from .validation import SceneError, show
 
 
@@ -61,6 +63,18 @@ class StrainEnergy:
         """μ0 = (Φ11 − Φ12)/2 at λ1 = λ2 = 1 (2 for neo-Hookean), by central differences of complex-step Φ1."""
         step = 1e-4
         return (_phi1(self, 1 + step, 1 - step) - _phi1(self, 1 - step, 1 + step)) / (4 * step)
+
+    def domain_violation(self, lam1: np.ndarray, lam2: np.ndarray) -> tuple[int, str] | None:
+        """None if every state (λ1[i], λ2[i]) is in the energy's domain (formula.domain_conditions), else the first
+        failing state i and what fails there ('log argument <text> = <value> (λ1 = …, λ2 = …)')."""
+        for function, tree, text in domain_conditions(self.formula):
+            with np.errstate(all="ignore"):
+                argument = evaluate(self.formula, self.parameters, lam1, lam2, tree)
+            bad = ~(argument > 0) if function == "log" else ~(argument >= 0)
+            if np.any(bad):
+                i = int(np.argmax(bad))
+                return i, f"{function} argument {text} = {argument[i]:.6g} (λ1 = {lam1[i]:.6g}, λ2 = {lam2[i]:.6g})"
+        return None
 
     def to_table(self) -> dict:
         """The ``[material]`` table that gives this energy back (family or formula, with its parameters)."""

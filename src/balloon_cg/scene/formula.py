@@ -15,6 +15,8 @@ import cmath
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from .validation import SceneError, show
 
 MAX_LENGTH = 2000
@@ -133,15 +135,29 @@ def fold(tree, leaf, number, binary, unary, call):
     return call(tree.func.id, fold(tree.args[0], *args))
 
 
+def domain_conditions(formula: Formula) -> tuple:
+    """(function, argument tree, argument text) of every ``log`` (argument > 0) and ``sqrt`` (argument ≥ 0) in
+    the formula: its admissible domain (Gent's I1 − 3 < Jm, Arruda–Boyce's I1 < 3N)."""
+    return tuple((node.func.id, node.args[0], ast.unparse(node.args[0])) for node in ast.walk(formula.tree())
+                 if isinstance(node, ast.Call) and node.func.id in ("log", "sqrt"))
+
+
 _OPS = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b, "/": lambda a, b: a / b,
         "**": lambda a, b: a**b}
 
 
-def evaluate(formula: Formula, values: dict, lam1, lam2):
-    """Φ(λ1, λ2) of the formula with parameter ``values``, in complex arithmetic (``cmath``; for the complex-step
-    derivatives of ``check_reference_state``)."""
+_NUMPY = {"exp": np.exp, "log": np.log, "sqrt": np.sqrt, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh,
+          "atan": np.arctan}
+
+
+def evaluate(formula: Formula, values: dict, lam1, lam2, tree=None):
+    """Φ(λ1, λ2) of the formula (or of its subtree ``tree``) with parameter ``values``: in complex arithmetic
+    (``cmath``) for scalars, for the complex-step derivatives of the reference-state checks; elementwise (numpy)
+    for arrays."""
     lam3 = 1 / (lam1 * lam2)
     symbols = {"lambda1": lam1, "lambda2": lam2, "lambda3": lam3, "I1": lam1**2 + lam2**2 + lam3**2,
                "I2": lam1**-2 + lam2**-2 + lam3**-2, **values}
-    return fold(formula.tree(), symbols.__getitem__, complex, lambda op, a, b: _OPS[op](a, b),
-                lambda op, a: -a if op == "-" else a, lambda name, a: getattr(cmath, name)(a))
+    arrays = isinstance(lam1, np.ndarray)
+    call = (lambda name, a: _NUMPY[name](a)) if arrays else (lambda name, a: getattr(cmath, name)(a))
+    return fold(formula.tree() if tree is None else tree, symbols.__getitem__, float if arrays else complex,
+                lambda op, a, b: _OPS[op](a, b), lambda op, a: -a if op == "-" else a, call)
