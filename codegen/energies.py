@@ -22,7 +22,7 @@ from balloon_cg.scene.formula import SYMBOLS, fold, parse_formula
 
 I1, I2 = sp.symbols("I1 I2", positive=True)
 SWITCH = sp.Rational(1, 100)
-SERIES_TERMS = 3
+SERIES_TERMS = 4
 
 _FUNCTIONS = {"exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt, "sinh": sp.sinh, "cosh": sp.cosh, "tanh": sp.tanh,
               "atan": sp.atan}

@@ -104,13 +104,16 @@ def test_arruda_boyce_pade_error():
     assert error[0] < 1e-5 and error[-1] < 2e-3
 
 
-def test_cache_key_changes_with_formula_field_and_generator_version(monkeypatch):
+def test_cache_key_changes_with_formula_field_generator_source_and_version(monkeypatch):
     energy = material_from_table({"energy": "I1 - 3"})
     other = material_from_table({"energy": "(I1 - 3)"})  # the same canonical text
     key = kernel_cache.class_key(energy.formula, False)
     assert kernel_cache.class_key(other.formula, False) == key
     assert kernel_cache.class_key(energy.formula, True) != key
     assert kernel_cache.class_key(material_from_table({"energy": "I1 - 3 + 0*I2"}).formula, False) != key
+    monkeypatch.setattr(kernel_cache, "generator_digest", lambda: "an edited generator")
+    assert kernel_cache.class_key(energy.formula, False) != key
+    monkeypatch.undo()
     monkeypatch.setattr(codegen, "GENERATOR_VERSION", codegen.GENERATOR_VERSION + "-changed")
     assert kernel_cache.class_key(energy.formula, False) != key
 
@@ -164,3 +167,55 @@ def test_user_formula_reproduces_the_preset(preset):
         points = [[b.pole_values(bp.X)["lam2_north"][0] for bp in b.branch_points(block)] for b in pair]
         assert len(points[0]) == len(points[1]) and (block != Block.ODD_HELD or len(points[0]) == pears)
         assert np.abs(np.subtract(*points)).max(initial=0) < 1e-12
+
+
+def spom1_formula_kernels():
+    from balloon_cg.model.kernels import KernelSet
+
+    values = dict(zip(("mu1", "a1", "mu2", "a2", "mu3", "a3"), (3.00508, 1.3, 0.0145, 4.0, -0.0177, -2.0)))
+    return KernelSet(material_from_table({"energy": SPOM1_TERMS, "parameters": values}), False)
+
+
+def test_shear_coefficient_of_a_stretch_formula_is_exact_through_lambda1_eq_lambda2():
+    """The generic removable-singularity form (closed form, even Taylor series within 1 %) for SPOM1 written as
+    a formula, against the exact Ogden divided difference of test_azimuthal (the preset's test, same bound)."""
+    from test_azimuthal import SPOM1, exact_shear
+
+    kernels = spom1_formula_kernels()
+    worst = 0.0
+    for l2 in (1.0, 1.7, 3.0, 6.0):
+        for h in np.concatenate([-np.logspace(-15, -0.5, 80), [0.0], np.logspace(-15, -0.5, 80)]):
+            l1 = l2 * (1 + h)
+            K = kernels.call("shear_coefficient", {"lam1": l1, "lam2": l2})[0]
+            worst = max(worst, abs(K / exact_shear(*SPOM1, l1, l2) - 1))
+    assert worst < 1e-13
+
+
+def test_azimuthal_hessian_of_the_spom1_formula_is_the_presets():
+    from balloon_cg.model.kernels import KernelSet
+    from balloon_cg.scene.materials import get_preset
+
+    formula, preset = spom1_formula_kernels(), KernelSet(get_preset("SPOM1"), False)
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        c = rng.uniform(-1, 1)
+        values = {"cos_theta": c, "sin_theta": np.sqrt(1 - c * c), "lam2": rng.uniform(1, 4), "v": rng.uniform(-.3, .3),
+                  "eta": rng.uniform(-2, 2), "w": rng.uniform(-3, -0.5), "P": rng.uniform(0, 3), "m": 1.0 + _ % 3}
+        a, b = (np.array(k.call("azimuthal_hessian", values)) for k in (formula, preset))
+        assert np.abs(a - b).max() <= 1e-12 * np.abs(b).max()
+
+
+def test_shear_coefficient_of_an_invariant_energy_is_its_divided_difference():
+    """Gent (K = W_1/(e1e2)² + W_2((e1+e2)/(e1e2)² − 1)) against (φ̂_1 − φ̂_2)/(e1 − e2) in 40-digit arithmetic."""
+    import sympy as sp
+
+    from balloon_cg.model.kernels import KernelSet
+
+    e1, e2 = sp.symbols("e1 e2", positive=True)
+    i1 = e1 + e2 + 1 / (e1 * e2)
+    phi = -97.2 * sp.log(1 - (i1 - 3) / sp.Rational("97.2"))
+    divided = (sp.diff(phi, e1) - sp.diff(phi, e2)) / (e1 - e2)
+    kernels = KernelSet(ENERGY_PRESETS["Gent"], False)
+    for l1, l2 in ((1.9, 1.4), (1.3, 2.6), (3.0, 3.2), (2.0, 2.0 * (1 + 1e-7))):
+        exact = float(divided.subs({e1: sp.Float(l1, 40) ** 2, e2: sp.Float(l2, 40) ** 2}).evalf(40))
+        assert kernels.call("shear_coefficient", {"lam1": l1, "lam2": l2})[0] == pytest.approx(exact, rel=1e-13)

@@ -4,7 +4,8 @@ The module is generated at first use by the same generator as generated/ (codege
 balloon_cg.codegen; it needs SymPy, the ``codegen`` extra) into a content-keyed cache folder, and imported from
 there by every later run. The key is the SHA-256 of
 
-    (canonical formula, parameter names, field or not, codegen.GENERATOR_VERSION, SymPy version),
+    (canonical formula, parameter names, field or not, codegen.GENERATOR_VERSION, the generator's source digest,
+     SymPy version),
 
 so an edited formula, a new generator or another SymPy gives a new module; parameter values are kernel
 arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
@@ -13,6 +14,7 @@ succeed, each finds either no module or a complete one, and the deterministic te
 
 This is the only runtime module that imports SymPy or codegen (tests/test_layers.py).
 """
+import functools
 import hashlib
 import importlib.metadata
 import importlib.util
@@ -23,6 +25,7 @@ import time
 from pathlib import Path
 
 from .. import codegen
+from ..scene import formula as formula_module
 from ..scene.validation import SceneError
 
 CACHE_ENV = "BALLOON_CG_KERNEL_CACHE"
@@ -43,9 +46,18 @@ def _sympy_version() -> str:
                          "pip install 'balloon-cg[codegen]'") from None
 
 
+@functools.cache
+def generator_digest() -> str:
+    """SHA-256 of the generator's source (codegen/*.py and the formula parser it walks): an edit to the generator
+    invalidates cached modules even where GENERATOR_VERSION was not raised."""
+    files = sorted(Path(codegen.__file__).parent.glob("*.py")) + [Path(formula_module.__file__)]
+    return hashlib.sha256(b"".join(f.name.encode() + f.read_bytes() for f in files)).hexdigest()
+
+
 def class_key(formula, field: bool) -> str:
     """The cache key of the class of ``formula`` (scene/formula.Formula) with or without a field."""
-    text = repr((formula.text, tuple(formula.parameters), bool(field), codegen.GENERATOR_VERSION, _sympy_version()))
+    text = repr((formula.text, tuple(formula.parameters), bool(field), codegen.GENERATOR_VERSION, generator_digest(),
+                 _sympy_version()))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
