@@ -156,13 +156,19 @@ PAIRS = {"SPOM1": (f'energy = "{SPOM1_TERMS}"\n[material.parameters]\n{SPOM1_PAR
 
 @pytest.mark.parametrize("preset", list(PAIRS))
 def test_user_formula_reproduces_the_preset(preset):
+    """Primary branch, branch points and pear branches (SPOM1's isola) of the whole picture, to 1e-12."""
     formula_material, pears = PAIRS[preset]
     scenes = [parse_scene(f'[material]\n{m}\n[continuation]\nstop_stretch = 6.0\n', name="s")
               for m in (f'preset = "{preset}"', formula_material)]
-    pair = [analyse(s, pear=False).primary for s in scenes]
-    lam_p, lam_f = (b.pole_values()["lam2_north"] for b in pair)
-    assert lam_p.shape == lam_f.shape
-    assert np.abs(lam_f - lam_p).max() < 1e-12 and np.abs(pair[1].pressure / pair[0].pressure - 1).max() < 1e-12
+    pictures = [analyse(s) for s in scenes]
+    assert [b.name for b in pictures[0].branches] == [b.name for b in pictures[1].branches]
+    assert (len(pictures[0].branches) > 1) == bool(pears)  # SPOM1: the primary branch and the isola
+    for preset_branch, formula_branch in zip(*(p.branches for p in pictures)):
+        lam_p, lam_f = (b.pole_values()["lam2_north"] for b in (preset_branch, formula_branch))
+        assert lam_p.shape == lam_f.shape
+        assert np.abs(lam_f - lam_p).max() < 1e-12
+        assert np.abs(formula_branch.pressure / preset_branch.pressure - 1).max() < 1e-12
+    pair = [p.primary for p in pictures]
     for block in (Block.ODD_HELD, Block.EVEN):
         points = [[b.pole_values(bp.X)["lam2_north"][0] for bp in b.branch_points(block)] for b in pair]
         assert len(points[0]) == len(points[1]) and (block != Block.ODD_HELD or len(points[0]) == pears)
