@@ -108,3 +108,17 @@ def test_leaving_gent_domain_is_an_error_naming_the_point_and_stretch():
                                              r"1 - \(I1 - 3\) / Jm = -0\.501235 \(λ1 = 3, λ2 = 3\)"):
         equilibrium.residual(beyond, Parameters(X[-1]))
     equilibrium.residual(X[:-1], Parameters(X[-1]))  # inside: no error
+
+
+def test_a_family_parameter_is_an_override_and_a_sweep_key():
+    from balloon_cg.app.sweep import expand
+    from balloon_cg.scene.validation import SceneError
+
+    scene = parse_scene('[material]\npreset = "Gent"\n')
+    assert scene.with_overrides({"material.parameters.Jm": 20.0}).material.parameters == {"mu": 2.0, "Jm": 20.0}
+    members = expand(scene, ["material.parameters.Jm=20:60:3"])
+    assert [m.scene.material.parameters["Jm"] for m in members] == [20.0, 40.0, 60.0]
+    with pytest.raises(SceneError, match="no parameter 'N'"):
+        scene.with_overrides({"material.parameters.N": 3.0})
+    with pytest.raises(SceneError, match=r"parameters.Jm = -1.0: must be > 0"):
+        scene.with_overrides({"material.parameters.Jm": -1.0})

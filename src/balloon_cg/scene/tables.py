@@ -335,12 +335,21 @@ def _to_toml(data: dict) -> str:
     return "\n".join(lines)
 
 
+_PARAMETER_KEY = re.compile(r"material\.parameters\.(\w+)")
 _OVERRIDE_KEY = re.compile(r"(\w+)\.(\w+)(?:\[(\d+)\]\.(\w+))?")
 
 
 def _assign(data: dict, key: str, value) -> None:
     """Set the dotted override ``key`` in a scene dict (numpy values become plain Python ones)."""
     value = value.tolist() if hasattr(value, "tolist") else value
+    parameter = _PARAMETER_KEY.fullmatch(key)
+    if parameter is not None:  # a strain energy's parameter (scene/energies.py)
+        parameters = data.get("material", {}).get("parameters", {})
+        if parameter.group(1) not in parameters:
+            raise SceneError(f"{key} = {show(value)}: the material has no parameter {parameter.group(1)!r} "
+                             f"(it has: {', '.join(parameters) or 'none'})")
+        parameters[parameter.group(1)] = value
+        return
     match = _OVERRIDE_KEY.fullmatch(key)
     if match is None:
         raise SceneError(f"{key} = {show(value)}: not a scene key (e.g. field.M or field.coils[0].current)")
