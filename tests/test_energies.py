@@ -122,3 +122,19 @@ def test_a_family_parameter_is_an_override_and_a_sweep_key():
         scene.with_overrides({"material.parameters.N": 3.0})
     with pytest.raises(SceneError, match=r"parameters.Jm = -1.0: must be > 0"):
         scene.with_overrides({"material.parameters.Jm": -1.0})
+
+
+def test_gent_pressure_extrema_merge_at_the_critical_jm():
+    """The two extrema of the Gent sphere's P(λ) merge at Jm* (a double root of dP/dλ, solved by SymPy from the
+    closed form); the kernels' sphere_modes find none just below Jm* and two about λ* just above."""
+    from balloon_cg.scene.energies import family_energy
+
+    lam, J = sp.symbols("lam J", positive=True)
+    i1 = 2 * lam**2 + lam**-4
+    slope = sp.numer(sp.together(sp.diff(sp.diff(-J * sp.log(1 - (i1 - 3) / J), lam) / lam**2, lam)))
+    lam_c, jm_c = (float(x) for x in sp.nsolve([slope, sp.diff(slope, lam)], [lam, J], [1.6, 18]))
+    assert jm_c == pytest.approx(17.638, abs=1e-3) and lam_c == pytest.approx(1.6426, abs=1e-4)
+    gent = lambda jm: family_energy("gent", {"mu": 2.0, "Jm": jm}, "gent")  # noqa: E731
+    assert bifurcation_stretches(gent(jm_c * (1 - 1e-4)), 0, lam_max=2.5).size == 0
+    below, above = bifurcation_stretches(gent(jm_c * (1 + 1e-4)), 0, lam_max=2.5)
+    assert below < lam_c < above and above - below < 0.02
