@@ -20,6 +20,8 @@ import sympy as sp
 
 from balloon_cg.scene.formula import SYMBOLS, fold, parse_formula
 
+from .series import truncated_series
+
 I1, I2 = sp.symbols("I1 I2", positive=True)
 SWITCH = sp.Rational(1, 100)
 SERIES_TERMS = 4
@@ -80,11 +82,9 @@ def shear_coefficient(energy, lam1, lam2):
     a, b, d, mean = sp.symbols("a b d mean", positive=True)
     phi = membrane_energy(energy, sp.sqrt(a), sp.sqrt(b))
     numerator = (sp.diff(phi, a) - sp.diff(phi, b)).subs({a: mean + d, b: mean - d}, simultaneous=True)
-    # K = numerator/(2d) = Σ_j c_j d^(2j), c_j = numerator^(2j+1)(0)/((2j+1)! 2)
-    series, derivative = sp.S.Zero, numerator
-    for j in range(SERIES_TERMS):
-        derivative = sp.diff(derivative, d) if j == 0 else sp.diff(derivative, d, 2)
-        series += derivative.subs(d, 0) / (2 * sp.factorial(2 * j + 1)) * d ** (2 * j)
+    # K = numerator/(2d) = Σ_j c_j d^(2j), c_j = (coefficient of d^(2j+1) in the numerator)/2
+    odd = _odd_coefficients(numerator, d)
+    series = sum(c / 2 * d ** (2 * j) for j, c in enumerate(odd))
     far = sp.Abs(lam1 - lam2) > SWITCH * lam2
     # the closed form at guarded e1 (2 e2 in the series range): no branch divides by zero after CSE
     guarded = sp.Piecewise((e1, far), (2 * e2, True))
@@ -92,3 +92,21 @@ def shear_coefficient(energy, lam1, lam2):
     at = {mean: (e1 + e2) / 2, d: (e1 - e2) / 2}
     K = sp.Piecewise((closed, far), (series.subs(at, simultaneous=True), True))
     return K, series.subs({d: 0, mean: e2}).subs(e2, lam2**2)
+
+
+def _odd_coefficients(numerator, d) -> list:
+    """Coefficients of d, d³, …, d^(2·SERIES_TERMS − 1) in the numerator: by the truncated-series engine of the
+    pole limits (codegen/series.py: powers with symbolic exponents by the binomial series, seconds), or, for a
+    formula with other functions of the stretches (exp, log, …) that it does not expand, by repeated
+    differentiation at d = 0 (minutes for long formulas)."""
+    order = 2 * SERIES_TERMS - 1
+    try:
+        # binomial(a, k) of a symbolic exponent as the product a(a − 1)…(a − k + 1)/k! (SymPy would print it as a
+        # gamma ratio, 0/0 at the integer exponents a runtime parameter may take)
+        coefficients = [sp.expand_func(c) for c in truncated_series(numerator, d, {}, order)]
+    except NotImplementedError:
+        coefficients, derivative = [], numerator
+        for k in range(order + 1):
+            coefficients.append(derivative.subs(d, 0) / sp.factorial(k))
+            derivative = sp.diff(derivative, d)
+    return coefficients[1::2]

@@ -225,3 +225,24 @@ def test_shear_coefficient_of_an_invariant_energy_is_its_divided_difference():
     for l1, l2 in ((1.9, 1.4), (1.3, 2.6), (3.0, 3.2), (2.0, 2.0 * (1 + 1e-7))):
         exact = float(divided.subs({e1: sp.Float(l1, 40) ** 2, e2: sp.Float(l2, 40) ** 2}).evalf(40))
         assert kernels.call("shear_coefficient", {"lam1": l1, "lam2": l2})[0] == pytest.approx(exact, rel=1e-13)
+
+
+def test_shear_coefficient_of_a_formula_with_logarithms():
+    """A Hencky-type stretch formula (the series engine does not expand log: repeated differentiation) against
+    (φ̂_1 − φ̂_2)/(e1 − e2) in 40-digit arithmetic, far from and through λ1 = λ2."""
+    import sympy as sp
+
+    from balloon_cg.model.kernels import KernelSet
+
+    text = "I1 - 3 + k*(log(lambda1)**2 + log(lambda2)**2 + log(lambda3)**2)"
+    kernels = KernelSet(material_from_table({"energy": text, "parameters": {"k": 0.3}}), False)
+    e1, e2 = sp.symbols("e1 e2", positive=True)
+    logs = sp.log(e1) ** 2 / 4 + sp.log(e2) ** 2 / 4 + sp.log(e1 * e2) ** 2 / 4
+    phi = e1 + e2 + 1 / (e1 * e2) - 3 + sp.Rational("0.3") * logs
+    divided = (sp.diff(phi, e1) - sp.diff(phi, e2)) / (e1 - e2)
+    for l1, l2 in ((1.9, 1.4), (1.3, 2.6), (2.0 * (1 + 3e-3), 2.0), (2.0 * (1 - 1e-6), 2.0), (1.5, 1.5)):
+        if l1 == l2:
+            exact = float(sp.limit(divided.subs(e2, sp.Rational(9, 4)), e1, sp.Rational(9, 4)))
+        else:
+            exact = float(divided.subs({e1: sp.Float(l1, 40) ** 2, e2: sp.Float(l2, 40) ** 2}).evalf(40))
+        assert kernels.call("shear_coefficient", {"lam1": l1, "lam2": l2})[0] == pytest.approx(exact, rel=1e-13)

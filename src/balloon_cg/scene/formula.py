@@ -12,7 +12,7 @@ of MODEL.md §2, moduli in units of μ/2 (``"I1 - 3"`` is the neo-Hookean preset
 """
 import ast
 import cmath
-import math
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,8 +45,13 @@ class Formula:
         return not self.symbols & set(STRETCHES)
 
     def tree(self) -> ast.expr:
-        """The checked expression tree of the canonical text."""
-        return _check(self.text, self.parameters, "energy").body
+        """The checked expression tree of the canonical text (parsed once per text)."""
+        return _checked_tree(self.text, self.parameters)
+
+
+@functools.cache
+def _checked_tree(text: str, parameters: tuple) -> ast.expr:
+    return _check(text, parameters, "energy").body
 
 
 def parse_formula(text, parameters=(), key: str = "material.energy") -> Formula:
@@ -135,6 +140,7 @@ def fold(tree, leaf, number, binary, unary, call):
     return call(tree.func.id, fold(tree.args[0], *args))
 
 
+@functools.cache
 def domain_conditions(formula: Formula) -> tuple:
     """(function, argument tree, argument text) of every ``log`` (argument > 0) and ``sqrt`` (argument ≥ 0) in
     the formula: its admissible domain (Gent's I1 − 3 < Jm, Arruda–Boyce's I1 < 3N)."""
