@@ -6,6 +6,8 @@ cached class against the committed class of the same material (one run, classes 
     family's codegen time is measured in this process (what ``make regenerate`` spends on it).
 (2) trace_primary at M = 0 to λ = 5, warm (compiled), best of REPEAT process-CPU times, preset and user formula
     alternating; the pressures must agree to 1e-12.
+(3) The cost of the domain check (Equilibrium: every log argument > 0 at every node of every Newton iterate) on
+    the Gent preset's trace: with and without it, alternating, best of REPEAT.
 
 Run: python benchmarks/materials.py   (writes benchmarks/results/materials.txt)
 """
@@ -19,6 +21,7 @@ from pathlib import Path
 
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.codegen import build, classes
+from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene import parse_scene
 
 REPEAT = 5
@@ -60,6 +63,28 @@ def solve_times(pair) -> tuple:
     return best[0], best[1], len(branches[0].pressure)
 
 
+def domain_check_times() -> tuple:
+    scene = parse_scene(scene_text('preset = "Gent"'))
+    trace_primary(scene)
+    original = Equilibrium.__init__
+
+    def unchecked(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        self._domain_check = False
+
+    best = {True: float("inf"), False: float("inf")}
+    try:
+        for _ in range(REPEAT):
+            for check in (True, False):
+                Equilibrium.__init__ = original if check else unchecked
+                start = time.process_time()
+                trace_primary(scene)
+                best[check] = min(best[check], time.process_time() - start)
+    finally:
+        Equilibrium.__init__ = original
+    return best[True], best[False]
+
+
 def main():
     lines = ["(1) first use (fresh caches)", f"{'class':<18}{'codegen s':>10}{'first JIT s':>12}  kernel class"]
     for name, material in CLASSES.items():
@@ -75,6 +100,10 @@ def main():
     for name, pair in PAIRS.items():
         committed, user, points = solve_times(pair)
         lines.append(f"{name:<10}{points:>7}{committed:>11.3f}{user:>14.3f}{user / committed:>8.2f}")
+    with_check, without_check = domain_check_times()
+    lines += ["", "(3) Gent trace_primary, domain check on/off, best of %d CPU s" % REPEAT,
+              f"{'on':>8}{'off':>8}{'ratio':>8}", f"{with_check:>8.3f}{without_check:>8.3f}"
+                                                  f"{with_check / without_check:>8.2f}"]
     text = "\n".join(lines)
     print(text)
     out = Path(__file__).parent / "results" / "materials.txt"

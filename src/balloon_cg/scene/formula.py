@@ -161,9 +161,16 @@ def evaluate(formula: Formula, values: dict, lam1, lam2, tree=None):
     (``cmath``) for scalars, for the complex-step derivatives of the reference-state checks; elementwise (numpy)
     for arrays."""
     lam3 = 1 / (lam1 * lam2)
-    symbols = {"lambda1": lam1, "lambda2": lam2, "lambda3": lam3, "I1": lam1**2 + lam2**2 + lam3**2,
-               "I2": lam1**-2 + lam2**-2 + lam3**-2, **values}
+    invariants = {"I1": lambda: lam1 * lam1 + lam2 * lam2 + lam3 * lam3,
+                  "I2": lambda: 1 / (lam1 * lam1) + 1 / (lam2 * lam2) + 1 / (lam3 * lam3)}
+    symbols = {"lambda1": lam1, "lambda2": lam2, "lambda3": lam3, **values}
+
+    def leaf(name):  # the invariants only when used, once
+        if name not in symbols:
+            symbols[name] = invariants[name]()
+        return symbols[name]
+
     arrays = isinstance(lam1, np.ndarray)
     call = (lambda name, a: _NUMPY[name](a)) if arrays else (lambda name, a: getattr(cmath, name)(a))
-    return fold(formula.tree() if tree is None else tree, symbols.__getitem__, float if arrays else complex,
+    return fold(formula.tree() if tree is None else tree, leaf, float if arrays else complex,
                 lambda op, a, b: _OPS[op](a, b), lambda op, a: -a if op == "-" else a, call)
