@@ -37,7 +37,7 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     if cls.energy is None:
         title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
     else:
-        kernels.append(stretch_derivatives.derivatives_kernel(cls))
+        kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
         title = f"Kernels for scene class {cls.name}: strain energy {cls.energy[0]}, field {cls.field}."
     derived = time.perf_counter()
     lowered = [lower(k) for k in kernels]

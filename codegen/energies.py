@@ -18,7 +18,7 @@ import functools
 
 import sympy as sp
 
-from balloon_cg.scene.formula import SYMBOLS, fold, parse_formula
+from balloon_cg.scene.formula import SYMBOLS, domain_conditions, fold, parse_formula
 
 from .series import truncated_series
 
@@ -43,12 +43,19 @@ def _formula(energy):
     return parse_formula(text, names)
 
 
-def _expression(energy, symbols: dict):
+def _expression(energy, symbols: dict, tree=None):
+    """The SymPy form of the formula (or of its subtree ``tree``) with the given symbol values."""
     formula = _formula(energy)
     leaves = dict(zip(formula.parameters, parameter_symbols(energy))) | symbols
     number = lambda value: sp.Integer(value) if isinstance(value, int) else sp.Rational(repr(value))  # noqa: E731
-    return fold(formula.tree(), leaves.__getitem__, number, lambda op, a, b: _BINARY[op](a, b),
-                lambda op, a: -a if op == "-" else a, lambda name, a: _FUNCTIONS[name](a))
+    return fold(formula.tree() if tree is None else tree, leaves.__getitem__, number,
+                lambda op, a, b: _BINARY[op](a, b), lambda op, a: -a if op == "-" else a,
+                lambda name, a: _FUNCTIONS[name](a))
+
+
+def _stretch_symbols(l1, l2) -> dict:
+    i1, i2 = invariants(l1, l2)
+    return dict(zip(SYMBOLS, (l1, l2, 1 / (l1 * l2), i1, i2)))
 
 
 def invariants(l1, l2):
@@ -65,9 +72,14 @@ def energy_in_invariants(energy):
 
 def membrane_energy(energy, l1, l2):
     """Φ(λ1, λ2) with λ3 = 1/(λ1 λ2) and the invariants eliminated."""
-    i1, i2 = invariants(l1, l2)
-    values = dict(zip(SYMBOLS, (l1, l2, 1 / (l1 * l2), i1, i2)))
-    return _expression(energy, values)
+    return _expression(energy, _stretch_symbols(l1, l2))
+
+
+def domain_margins(energy, l1, l2) -> tuple:
+    """The arguments of the formula's log (must be > 0) and sqrt (≥ 0) calls as functions of (λ1, λ2), in the
+    order of scene/formula.domain_conditions."""
+    return tuple(_expression(energy, _stretch_symbols(l1, l2), tree)
+                 for _, tree, _ in domain_conditions(_formula(energy)))
 
 
 def shear_coefficient(energy, lam1, lam2):

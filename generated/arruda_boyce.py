@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "34fc72f7f5419e42766977da7643a5d0de4a7f44a9d514b960c45b9072d4160b"
+SIGNATURE = "6a541f574b676ae418124831f248d1cf06122310bbe78f1630824bd27176c991"
 INPUTS = [('class', 'arruda_boyce'), ('energy', 'mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))'), ('field', False), ('parameters', ('mu', 'N'))]
 
 
@@ -73,6 +73,11 @@ KERNELS = {
     'membrane_derivatives': {
         'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_N'))),
         'outputs': ('phi', 'phi_1', 'phi_2', 'phi_11', 'phi_12', 'phi_22'),
+        'nodes': True,
+    },
+    'domain_margins': {
+        'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_N'))),
+        'outputs': ('margin0',),
         'nodes': True,
     },
 }
@@ -846,3 +851,21 @@ def membrane_derivatives_nodes(lam1, lam2, material, out):
         out[3, i] = r[3]
         out[4, i] = r[4]
         out[5, i] = r[5]
+
+
+@njit(cache=True, inline='always')
+def domain_margins(lam1, lam2, material):
+    """Arguments of the energy's log (> 0) and sqrt (≥ 0) calls at (λ1, λ2)."""
+    par_mu = material[0]
+    par_N = material[1]
+    t0 = (lam1*lam1)
+    t1 = (lam2*lam2)
+    return ((3.0*par_N - t0 - t1 - 1.0/(t0*t1))/(3.0*par_N - 3.0),)
+
+
+@njit(cache=True)
+def domain_margins_nodes(lam1, lam2, material, out):
+    """domain_margins at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = domain_margins(lam1[i], lam2[i], material)
+        out[0, i] = r[0]

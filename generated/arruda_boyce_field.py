@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "46790e57790436bab5ae79247b747f49d54a3f2c7ebf36c5904d6bdd400320c5"
+SIGNATURE = "e482d08456fc21cd202cd6a83099db52af7697b4d4b941b98cb05039f4e85d09"
 INPUTS = [('class', 'arruda_boyce_field'), ('energy', 'mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))'), ('field', True), ('parameters', ('mu', 'N'))]
 
 
@@ -83,6 +83,11 @@ KERNELS = {
     'membrane_derivatives': {
         'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_N'))),
         'outputs': ('phi', 'phi_1', 'phi_2', 'phi_11', 'phi_12', 'phi_22'),
+        'nodes': True,
+    },
+    'domain_margins': {
+        'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_N'))),
+        'outputs': ('margin0',),
         'nodes': True,
     },
 }
@@ -1044,3 +1049,21 @@ def membrane_derivatives_nodes(lam1, lam2, material, out):
         out[3, i] = r[3]
         out[4, i] = r[4]
         out[5, i] = r[5]
+
+
+@njit(cache=True, inline='always')
+def domain_margins(lam1, lam2, material):
+    """Arguments of the energy's log (> 0) and sqrt (≥ 0) calls at (λ1, λ2)."""
+    par_mu = material[0]
+    par_N = material[1]
+    t0 = (lam1*lam1)
+    t1 = (lam2*lam2)
+    return ((3.0*par_N - t0 - t1 - 1.0/(t0*t1))/(3.0*par_N - 3.0),)
+
+
+@njit(cache=True)
+def domain_margins_nodes(lam1, lam2, material, out):
+    """domain_margins at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = domain_margins(lam1[i], lam2[i], material)
+        out[0, i] = r[0]

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "6c96a0a0a2110f47c468b2ba7324407343650fc315fb5692df764360716ebe14"
+SIGNATURE = "948994f4d63faaa7c5dfd204cd12501876b33b9731c639444b55f9b8819a5242"
 INPUTS = [('class', 'gent'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)'), ('field', False), ('parameters', ('mu', 'Jm'))]
 
 
@@ -73,6 +73,11 @@ KERNELS = {
     'membrane_derivatives': {
         'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_Jm'))),
         'outputs': ('phi', 'phi_1', 'phi_2', 'phi_11', 'phi_12', 'phi_22'),
+        'nodes': True,
+    },
+    'domain_margins': {
+        'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_Jm'))),
+        'outputs': ('margin0',),
         'nodes': True,
     },
 }
@@ -813,3 +818,21 @@ def membrane_derivatives_nodes(lam1, lam2, material, out):
         out[3, i] = r[3]
         out[4, i] = r[4]
         out[5, i] = r[5]
+
+
+@njit(cache=True, inline='always')
+def domain_margins(lam1, lam2, material):
+    """Arguments of the energy's log (> 0) and sqrt (≥ 0) calls at (λ1, λ2)."""
+    par_mu = material[0]
+    par_Jm = material[1]
+    t0 = (lam1*lam1)
+    t1 = (lam2*lam2)
+    return (1.0 - (t0 + t1 - 3.0 + 1.0/(t0*t1))/par_Jm,)
+
+
+@njit(cache=True)
+def domain_margins_nodes(lam1, lam2, material, out):
+    """domain_margins at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = domain_margins(lam1[i], lam2[i], material)
+        out[0, i] = r[0]

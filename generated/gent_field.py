@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "864d3a10a3c0f9261e6c236af244b38a20015be57985f9862927306ca3d5248b"
+SIGNATURE = "8ca2393d4f154f03409c993443b1df2581106e5a9a5a6b729f8bd3f9f2706e44"
 INPUTS = [('class', 'gent_field'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)'), ('field', True), ('parameters', ('mu', 'Jm'))]
 
 
@@ -83,6 +83,11 @@ KERNELS = {
     'membrane_derivatives': {
         'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_Jm'))),
         'outputs': ('phi', 'phi_1', 'phi_2', 'phi_11', 'phi_12', 'phi_22'),
+        'nodes': True,
+    },
+    'domain_margins': {
+        'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_Jm'))),
+        'outputs': ('margin0',),
         'nodes': True,
     },
 }
@@ -1019,3 +1024,21 @@ def membrane_derivatives_nodes(lam1, lam2, material, out):
         out[3, i] = r[3]
         out[4, i] = r[4]
         out[5, i] = r[5]
+
+
+@njit(cache=True, inline='always')
+def domain_margins(lam1, lam2, material):
+    """Arguments of the energy's log (> 0) and sqrt (≥ 0) calls at (λ1, λ2)."""
+    par_mu = material[0]
+    par_Jm = material[1]
+    t0 = (lam1*lam1)
+    t1 = (lam2*lam2)
+    return (1.0 - (t0 + t1 - 3.0 + 1.0/(t0*t1))/par_Jm,)
+
+
+@njit(cache=True)
+def domain_margins_nodes(lam1, lam2, material, out):
+    """domain_margins at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = domain_margins(lam1[i], lam2[i], material)
+        out[0, i] = r[0]

@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "ebb2980d4080c34e2f41c3de5c88be8847eef1f2228423c4d7cb7a2858ce441d"
+SIGNATURE = "9003d878ea2c56c8e3b65c9e448a8d600775d5abcdb812cb4dc4d813590dfe43"
 INPUTS = [('class', 'gent_gent_field'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)'), ('field', True), ('parameters', ('mu', 'Jm', 'C2'))]
 
 
@@ -83,6 +83,11 @@ KERNELS = {
     'membrane_derivatives': {
         'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_Jm', 'par_C2'))),
         'outputs': ('phi', 'phi_1', 'phi_2', 'phi_11', 'phi_12', 'phi_22'),
+        'nodes': True,
+    },
+    'domain_margins': {
+        'args': (('lam1', 'node', ()), ('lam2', 'node', ()), ('material', 'param_array', ('par_mu', 'par_Jm', 'par_C2'))),
+        'outputs': ('margin0', 'margin1'),
         'nodes': True,
     },
 }
@@ -1327,3 +1332,25 @@ def membrane_derivatives_nodes(lam1, lam2, material, out):
         out[3, i] = r[3]
         out[4, i] = r[4]
         out[5, i] = r[5]
+
+
+@njit(cache=True, inline='always')
+def domain_margins(lam1, lam2, material):
+    """Arguments of the energy's log (> 0) and sqrt (≥ 0) calls at (λ1, λ2)."""
+    par_mu = material[0]
+    par_Jm = material[1]
+    par_C2 = material[2]
+    t0 = (lam1*lam1)
+    t1 = (lam2*lam2)
+    t2 = (1.0/(t0))
+    t3 = (1.0/(t1))
+    return (1.0 - (t0 + t1 + t2*t3 - 3.0)/par_Jm, (0.3333333333333333)*t0*t1 + (0.3333333333333333)*t2 + (0.3333333333333333)*t3,)
+
+
+@njit(cache=True)
+def domain_margins_nodes(lam1, lam2, material, out):
+    """domain_margins at every node i; output k goes to out[k, i]."""
+    for i in range(lam1.shape[0]):
+        r = domain_margins(lam1[i], lam2[i], material)
+        out[0, i] = r[0]
+        out[1, i] = r[1]

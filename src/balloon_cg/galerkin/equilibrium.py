@@ -70,7 +70,8 @@ class Equilibrium:
         if self._domain_check:
             lam2, v, _, w = state
             lam1 = np.hypot(lam2 * geometry[0] + v, w)
-            violation = self.scene.material.domain_violation(lam1, lam2)
+            margins = self.kernels.nodes("domain_margins", {"lam1": lam1, "lam2": lam2})
+            violation = self.scene.material.domain_violation(margins, lam1, lam2)
             if violation is not None:
                 node, what = violation
                 raise NonFiniteState(f"the membrane left the domain of {self.scene.material.name} at the node "

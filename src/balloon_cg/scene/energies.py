@@ -64,12 +64,11 @@ class StrainEnergy:
         step = 1e-4
         return (_phi1(self, 1 + step, 1 - step) - _phi1(self, 1 - step, 1 + step)) / (4 * step)
 
-    def domain_violation(self, lam1: np.ndarray, lam2: np.ndarray) -> tuple[int, str] | None:
-        """None if every state (λ1[i], λ2[i]) is in the energy's domain (formula.domain_conditions), else the first
-        failing state i and what fails there ('log argument <text> = <value> (λ1 = …, λ2 = …)')."""
-        for function, tree, text in domain_conditions(self.formula):
-            with np.errstate(all="ignore"):
-                argument = evaluate(self.formula, self.parameters, lam1, lam2, tree)
+    def domain_violation(self, margins: np.ndarray, lam1: np.ndarray, lam2: np.ndarray) -> tuple[int, str] | None:
+        """None if every state is in the energy's domain, else the first failing state i and what fails there
+        ('log argument <text> = <value> (λ1 = …, λ2 = …)'); ``margins`` row k is the argument of
+        formula.domain_conditions entry k at the states (λ1[i], λ2[i]) (the class's domain_margins kernel)."""
+        for (function, _, text), argument in zip(domain_conditions(self.formula), margins):
             bad = ~(argument > 0) if function == "log" else ~(argument >= 0)
             if np.any(bad):
                 i = int(np.argmax(bad))

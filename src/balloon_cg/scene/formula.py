@@ -15,8 +15,6 @@ import cmath
 import functools
 from dataclasses import dataclass
 
-import numpy as np
-
 from .validation import SceneError, show
 
 MAX_LENGTH = 2000
@@ -152,25 +150,11 @@ _OPS = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * 
         "**": lambda a, b: a**b}
 
 
-_NUMPY = {"exp": np.exp, "log": np.log, "sqrt": np.sqrt, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh,
-          "atan": np.arctan}
-
-
-def evaluate(formula: Formula, values: dict, lam1, lam2, tree=None):
-    """Φ(λ1, λ2) of the formula (or of its subtree ``tree``) with parameter ``values``: in complex arithmetic
-    (``cmath``) for scalars, for the complex-step derivatives of the reference-state checks; elementwise (numpy)
-    for arrays."""
+def evaluate(formula: Formula, values: dict, lam1, lam2):
+    """Φ(λ1, λ2) of the formula with parameter ``values``, in complex arithmetic (``cmath``; for the complex-step
+    derivatives of the reference-state checks)."""
     lam3 = 1 / (lam1 * lam2)
-    invariants = {"I1": lambda: lam1 * lam1 + lam2 * lam2 + lam3 * lam3,
-                  "I2": lambda: 1 / (lam1 * lam1) + 1 / (lam2 * lam2) + 1 / (lam3 * lam3)}
-    symbols = {"lambda1": lam1, "lambda2": lam2, "lambda3": lam3, **values}
-
-    def leaf(name):  # the invariants only when used, once
-        if name not in symbols:
-            symbols[name] = invariants[name]()
-        return symbols[name]
-
-    arrays = isinstance(lam1, np.ndarray)
-    call = (lambda name, a: _NUMPY[name](a)) if arrays else (lambda name, a: getattr(cmath, name)(a))
-    return fold(formula.tree() if tree is None else tree, leaf, float if arrays else complex,
-                lambda op, a, b: _OPS[op](a, b), lambda op, a: -a if op == "-" else a, call)
+    symbols = {"lambda1": lam1, "lambda2": lam2, "lambda3": lam3, "I1": lam1**2 + lam2**2 + lam3**2,
+               "I2": lam1**-2 + lam2**-2 + lam3**-2, **values}
+    return fold(formula.tree(), symbols.__getitem__, complex, lambda op, a, b: _OPS[op](a, b),
+                lambda op, a: -a if op == "-" else a, lambda name, a: getattr(cmath, name)(a))
