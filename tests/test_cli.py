@@ -51,7 +51,7 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["scene_name"] == "small"
     assert summary["provenance"]["command"] == f"balloon-cg run {scene_file} -o {out}"
-    assert summary["provenance"]["format"] == "balloon-cg/2"
+    assert summary["provenance"]["format"] == "balloon-cg/3"
     branch = summary["branches"]["primary"]
     # SPOM1 up to stretch 2: the fold in P and the first pear pitchfork (λ = 1.6799), its pear branches
     assert [s["kind"] for s in branch["special_points"]] == ["EP", "LP", "BP", "EP"]
@@ -147,6 +147,13 @@ def test_critical_alpha1_from_the_command_line(tmp_path, capsys):
     assert read_curve(out)["attrs"]["end"] == "isola_merge"
     assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0
     assert (tmp_path / "phase.png").stat().st_size > 1000
+    capsys.readouterr()
+    assert main(["inspect", str(out), "--json"]) == 0  # inspect reads curve files; strict JSON (NaN -> null)
+    summary = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(c))
+    assert summary["kind"] == "curve" and summary["curves"]["pear"]["critical_q"] == pytest.approx(1.739619649392)
+    xr = pytest.importorskip("xarray")
+    with xr.open_dataset(out, engine="h5netcdf", group="two_parameter/pear") as ds:
+        assert ds.mode.dims == ("point", "mode_unknown") and all("units" in v.attrs for v in ds.variables.values())
 
 
 def test_critical_M_of_the_single_coil_scene(tmp_path, capsys):

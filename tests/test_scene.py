@@ -114,7 +114,9 @@ def test_with_overrides():
     swept = scene.with_overrides({"field.M": np.float64(0.003), "solver.degree": np.int64(60),
                                   "field.coils[1].current": -2.0})
     assert swept.field.M == 0.003 and swept.solver.degree == 60 and swept.field.coils[1].current == -2.0
-    assert swept.name == "two" and parse_scene(swept.text, name="two") == swept
+    assert swept.name == "two_M0.003_current1=-2" and parse_scene(swept.text, name=swept.name) == swept
+
+
     assert scene.field.M == 0.002  # the original is untouched
     assert swept.with_overrides({"material.preset": "tpom2"}).material == PRESETS["TPOM2"]
     custom = swept.with_overrides({"material.alpha": np.array([1.3, 4.0, -2.5])})
@@ -130,6 +132,30 @@ def test_with_overrides():
         with pytest.raises(SceneError) as err:
             scene.with_overrides(overrides)
         assert str(err.value).startswith(f"two: {key}")
+
+
+def test_with_overrides_renames_after_physical_keys():
+    scene = parse_scene(TWO_COILS, name="spom1_two_coils_M0.002")
+    assert scene.with_overrides({"field.M": 0.0025}).name == "spom1_two_coils_M0.0025"  # the token updated
+    assert scene.with_overrides({"field.coils[0].radius": 2.5}).name == "spom1_two_coils_M0.002_radius2.5"
+    assert scene.with_overrides({"material.preset": "TPOM1"}).name == "spom1_two_coils_M0.002_tpom1"
+    assert scene.with_overrides({"continuation.max_points": 10}).name == scene.name  # numerics keep the name
+    assert scene.with_overrides({"field.M": 0.001}, name="mine").name == "mine"
+    both = scene.with_overrides({"field.coils[0].radius": 3.5, "field.coils[1].radius": 3.0})
+    assert both.name == "spom1_two_coils_M0.002_radius3.5_radius1=3"  # index past 0 kept, no ambiguity
+    coils = [{"radius": 3.0, "height": 0.0, "current": 1.0}]
+    assert scene.with_overrides({"field.coils": coils}).name == scene.name  # tables and lists: no token
+    assert scene.with_overrides({"material.name": "my balloon/v2"}).name == "spom1_two_coils_M0.002_my-balloon-v2"
+
+
+def test_shipped_scenes_by_name(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert load_scene("spom1").name == "spom1" and load_scene("spom1_two_coils_M0.002.toml").field.M == 0.002
+    (tmp_path / "spom1.toml").write_text('[material]\npreset = "TPOM1"\n')
+    assert load_scene("spom1.toml").material.name == "TPOM1"  # a file of that name comes first
+    with pytest.raises(FileNotFoundError):
+        load_scene("no_such_scene")
+
 
 
 def test_file_error_names_file(tmp_path):

@@ -43,7 +43,7 @@ def test_round_trip(run_file, scene, branch):
     run = read_run(run_file)
     attrs = run["attrs"]
     assert run["scene_name"] == scene.name == attrs["scene_name"]
-    assert attrs["format"] == "balloon-cg/2"
+    assert attrs["format"] == "balloon-cg/3"
     assert attrs["scene_toml"] == scene.text
     assert attrs["package_version"] == balloon_cg.__version__
     assert attrs["generated_digest"] == generated_digest()
@@ -143,7 +143,7 @@ def test_failure_mid_write_leaves_file_untouched(tmp_path, scene, branch, monkey
     path = tmp_path / "run.h5"
     path.write_bytes(b"keep me")
 
-    def fail(group, special, width, disc):
+    def fail(*args):
         raise RuntimeError("disk full")
 
     monkeypatch.setattr(storage, "write_special", fail)

@@ -1,9 +1,15 @@
 """balloon-cg: nonlinear mechanics of inflatable magnetoelastic membranes.
 
-The dense systems here are small (a few hundred unknowns at most), where multi-threaded BLAS only adds
-synchronisation cost (measured: the SPOM1 M = 0 stability picture took 4.4 s with one BLAS thread and 83 s
-with two on a loaded 2-core machine). Importing balloon_cg therefore limits BLAS to one thread; set
-BALLOON_CG_BLAS_THREADS to another number to change that.
+The public API (docs/api.md) is importable from here and loaded on first use, so ``import balloon_cg`` stays
+light (no numpy, numba or matplotlib until a name needs them)::
+
+    import balloon_cg as bc
+    scene = bc.Scene.from_toml("spom1_two_coils_M0.002").with_overrides({"field.M": 0.001})  # a shipped scene
+    result = bc.analyse(scene)          # or bc.trace(scene): the primary branch only
+    result.to_dataframe(); result.save("spom1.h5"); bc.plot(result, "pressure-pole")
+
+Importing balloon_cg leaves the process's BLAS threads alone: the computation limits them inside its own
+entry points (``numerics.threads``).
 
 numba's on-disk cache of compiled kernels (``cache=True``) goes to NUMBA_CACHE_DIR, which importing balloon_cg
 sets, unless it is set already, to ``$XDG_CACHE_HOME/balloon-cg/numba`` (``~/.cache/balloon-cg/numba``):
@@ -17,16 +23,34 @@ Importing balloon_cg also checks that balloon_cg.generated (the kernels of codeg
 <site-packages>/balloon_cg/generated when installed, <root>/generated next to <root>/src/balloon_cg in a
 checkout (editable install). Anything else mixes two versions of the code and raises ImportError.
 """
+import importlib
 import importlib.util
 import os
 import sys
 from pathlib import Path
 
-import numpy  # noqa: F401  (load numpy's and scipy's BLAS first: threadpoolctl limits loaded libraries only)
-import scipy.linalg  # noqa: F401
-from threadpoolctl import threadpool_limits
-
 __version__ = "0.1.0"
+
+_API = {
+    "Scene": "balloon_cg.scene", "SceneError": "balloon_cg.scene", "load_scene": "balloon_cg.scene",
+    "parse_scene": "balloon_cg.scene", "shipped_scenes": "balloon_cg.scene", "PlotError": "balloon_cg.post.plotting",
+    "Result": "balloon_cg.app.api", "BranchData": "balloon_cg.app.api", "trace": "balloon_cg.app.api",
+    "analyse": "balloon_cg.app.api", "load": "balloon_cg.app.api", "plot": "balloon_cg.app.api",
+}
+__all__ = ["__version__", *_API]
+
+
+def __getattr__(name: str):
+    """The public API on first use (PEP 562)."""
+    if name not in _API:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_API[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(__all__)
 
 
 def _numba_cache_dir() -> Path:
@@ -60,4 +84,3 @@ def _check_generated_tree() -> None:
 
 
 _check_generated_tree()
-threadpool_limits(int(os.environ.get("BALLOON_CG_BLAS_THREADS", "1")), user_api="blas")

@@ -30,6 +30,7 @@ from .resolution import Resolution
 from .results import Block, Branch, Classification, Kind, SpecialPoint, Status, approximate
 from .stability import SecondVariation, Variations, block_indices, convergence_problems, point_degrees
 from .tracer import Tracer
+from ..numerics.threads import limited_blas
 
 EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
 
@@ -59,6 +60,7 @@ def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
     return events
 
 
+@limited_blas
 def locate(branch: Branch, index: int, block: Block, k: int = 0) -> SpecialPoint:
     """The branch point detected between points index and index + 1 (module docstring): a BP special point
     with its block, critical mode (on the perturbation basis of the extended system) and location status; its

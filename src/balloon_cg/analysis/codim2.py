@@ -70,6 +70,7 @@ from .problem import continuation_settings, equilibrium_of
 from .results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
 from .stability import SecondVariation, block_indices
 from .wires import wire_gap
+from ..numerics.threads import limited_blas
 
 PARAMETERS = ("M", "alpha1")
 GENERAL_CLASS = "ogden_general_field"
@@ -255,6 +256,7 @@ class TwoParameterCurve:
         return f"{self.stop_reason or 'the curve stopped'} before the curve turned back in {name} ({at})"
 
 
+@limited_blas
 def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, direction: float = 1.0,
                           q0: float | None = None, settings: continuation.Settings | None = None, stop=None,
                           progress=None, max_points: int = 400) -> TwoParameterCurve:

@@ -8,6 +8,7 @@ with the branch, not in ``Picture.branch_points``) and lists the snap-throughs u
 branch carries its assessments in ``branch.stability`` and the points whose flags change at the check degree in
 ``branch.unsettled``.
 """
+import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,7 +19,34 @@ from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
 from .stability import assess_branch
 from .switching import trace_pear
-from .verdict import Incomplete, incomplete
+from .verdict import Gap, Incomplete, incomplete
+from ..numerics import interrupt
+from ..numerics.threads import limited_blas
+
+
+class Phase(enum.StrEnum):
+    """The phases of ``analyse``, for progress reports."""
+
+    PRIMARY = "primary branch"
+    STABILITY = "stability"
+    PEAR = "pear branches"
+
+
+class Progress:
+    """What ``analyse`` reports: ``tick(phase)`` per traced or assessed point, ``finish(phase, count)`` with the
+    number of points the phase stored (the tracer may compute a few points it does not keep). This base class
+    reports nothing; the CLI draws one bar per phase."""
+
+    def tick(self, phase: Phase) -> None:
+        pass
+
+    def finish(self, phase: Phase, count: int) -> None:
+        pass
+
+    def ticker(self, phase: Phase):
+        """A per-point callable for the tracers."""
+        return lambda point: self.tick(phase)
+
 
 
 @dataclass
@@ -40,28 +68,49 @@ class Picture:
     snaps: list = field(default_factory=list)  # SnapThrough
     not_searched: str = ""  # why branch points were not searched, if they were not
     not_started: list = field(default_factory=list)  # (name, reason) of pear branches that could not start
+    interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
 
     @property
     def primary(self) -> Branch:
         return self.branches[0]
 
+    def __repr__(self):
+        branches = ", ".join(f"{b.name} ({len(b.X)} points)" for b in self.branches)
+        return (f"Picture({branches}; {len(self.branch_points)} branch points, {len(self.snaps)} snap-throughs, "
+                f"{'complete' if not self.incomplete else f'{len(self.incomplete)} incomplete parts'})")
+
     @property
     def incomplete(self) -> list[Incomplete]:
         """What the picture lacks against the contract (``verdict``); empty when it is complete."""
-        return incomplete(self.branches, self.not_searched, tuple(self.not_started))
+        found = incomplete(self.branches, self.not_searched, tuple(self.not_started))
+        if self.interrupted:
+            found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, "interrupted by a signal: the branches "
+                                    "and phases after the stored points were not computed"))
+        return found
 
 
-def _assess(branch: Branch, scene, symmetric: bool) -> None:
+def _assess(branch: Branch, scene, symmetric: bool, progress: Progress) -> None:
     branch.stability, branch.unsettled = assess_branch(branch, scene.stability.degree, symmetric, check=True,
                                                        m_max=scene.stability.m_max)
+    for _ in branch.X:
+        progress.tick(Phase.STABILITY)
 
 
-def analyse(scene, progress=None, pear: bool = True) -> Picture:
-    """The picture of a scene (module docstring); ``pear=False`` skips the pear branches."""
-    primary = trace_primary(scene, progress=progress)
+@limited_blas
+def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Picture:
+    """The picture of a scene (module docstring); ``pear=False`` skips the pear branches. ``progress``: a
+    ``Progress`` told of every point. A signal (``numerics.interrupt``) stops it at the next point: the picture
+    then holds what is finished (``interrupted``; the branches after it are not traced, nor assessed)."""
+    progress = progress or Progress()
+    primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
+    progress.finish(Phase.PRIMARY, len(primary.X))
     picture = Picture([primary])
-    _assess(primary, scene, primary.disc.symmetric)
+    if interrupt.requested():
+        picture.interrupted = True
+        return picture
+    _assess(primary, scene, primary.disc.symmetric, progress)
     if not primary.disc.symmetric:
+        progress.finish(Phase.STABILITY, len(primary.X))
         picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
                                 "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
         return picture
@@ -74,6 +123,11 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     primary.special.sort(key=lambda s: s.index)
     if pear:
         _trace_pears(scene, primary, picture, progress)
+        progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
+    progress.finish(Phase.STABILITY, sum(len(b.stability) for b in picture.branches))
+    if interrupt.requested():
+        picture.interrupted = True
+        return picture
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
         degrees = [a.degree for a in branch.stability]
         branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
@@ -82,15 +136,18 @@ def analyse(scene, progress=None, pear: bool = True) -> Picture:
     return picture
 
 
-def _trace_pears(scene, primary: Branch, picture: Picture, progress):
-    """Pear branches from the pear branch points; a branch that rejoins at an already traced point is not repeated."""
+def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
+    """Pear branches from the pear branch points; a branch that rejoins at an already traced point is not
+    repeated. An interrupt ends the search after the branch being traced (which is kept, assessed)."""
     reached = set()
     for n, bp in enumerate(picture.branch_points):
         if bp.block != Block.ODD_HELD or n in reached:
             continue
         for sign, suffix in ((1.0, ""), (-1.0, "_mirror")):
+            if interrupt.requested():
+                return
             name = f"pear_{n}{suffix}"
-            branch = trace_pear(primary, bp, sign, name, progress)
+            branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR))
             if branch is None:
                 picture.not_started.append((name, f"the first correction from branch point {n} along its mode "
                                                   "did not converge"))
@@ -99,8 +156,10 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress):
             branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
             if branch.rejoins is not None:
                 reached.add(branch.rejoins)
-            _assess(branch, scene, symmetric=False)
             picture.branches.append(branch)
+            if interrupt.requested():  # kept as traced, not assessed
+                return
+            _assess(branch, scene, False, progress)
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

@@ -27,6 +27,7 @@ from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
 from .wires import wire_gap
+from ..numerics.threads import limited_blas
 
 
 def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
@@ -172,6 +173,7 @@ def stop_rule(scene, upper: float):
     return stop
 
 
+@limited_blas
 def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | None = None, down: bool = True,
                   progress=None) -> Branch:
     """Trace the primary branch of a scene (module docstring). ``down=False`` skips the leg below the start."""

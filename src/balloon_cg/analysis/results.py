@@ -87,6 +87,7 @@ class StopCode(enum.StrEnum):
     PARTNER = "partner"  # a two-parameter curve returned past its start value (reached the partner point)
     NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # a two-parameter curve's branch-point pressure reached 0
     ALPHA1_ZERO = "alpha1_zero"  # the α1 continuation reached α1 = 0
+    INTERRUPTED = "interrupted"  # SIGINT/SIGTERM asked the computation to stop (numerics.interrupt)
 
 
 @dataclass
@@ -107,6 +108,12 @@ class SpecialPoint:
     mode: np.ndarray | None = None  # critical eigenvector of a branch point (a_0..a_N, b_0..b_N, in x)
     stop: Stop | None = None  # an end point's stop
     note: str = ""  # for people only
+
+    def __repr__(self):
+        label = " ".join(v for v in (self.kind.value, self.classification.value, self.block.value) if v)
+        status = "" if self.status == Status.LOCATED else f", {self.status.value} ±{self.uncertainty:.1g}"
+        return (f"SpecialPoint({label}{f' m={self.m}' if self.m else ''} after point {self.index}, "
+                f"P = {self.X[-1]:.10g}{status})")
 
 
 def bracket_uncertainty(disc, before, after) -> float:

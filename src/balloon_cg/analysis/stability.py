@@ -29,6 +29,7 @@ from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
 from .problem import equilibrium_of
 from .resolution import Resolution
+from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
 CHECK_FACTOR = 2.0  # N-convergence is checked at CHECK_FACTOR·N
@@ -198,6 +199,7 @@ class Variations(dict):
         return self[degree]
 
 
+@limited_blas
 def assess_branch(branch, degree: int, symmetric: bool | None = None, check: bool = False,
                   near_zero: float = 0.1, m_max: int = 0):
     """Assessments of every point and, with ``check``, the points whose flags change at the check degree.

@@ -17,8 +17,10 @@ from .assembly import assemble
 from .bifurcation import general_tracer, mode_direction, plain_degree, to_general
 from .primary import stop_rule
 from .results import Branch, SpecialPoint, StopCode
+from ..numerics.threads import limited_blas
 
 
+@limited_blas
 def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progress=None,
                delta: float = 1e-3) -> Branch | None:
     """The bifurcating branch leaving ``bp`` along sign·φ until it rejoins or stops; None if the first

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Equilibrium, Parameters
-from ..numerics import continuation
+from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .problem import ParameterSystem, continuation_settings
@@ -85,6 +85,8 @@ class Tracer:
             monitors = {Kind.LP: unit(start.X.size, -1), Kind.TP: north}
 
             def checked_stop(point, disc=disc):
+                if interrupt.requested():
+                    return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
                 beyond = limits(disc, point) if limits is not None else None
                 if beyond is not None:
                     return beyond

@@ -26,6 +26,7 @@ class Gap(enum.StrEnum):
     UNCLASSIFIED = "unclassified"  # an axisymmetric branch point whose reduced energy could not be fitted
     NOT_STARTED = "not_started"  # a bifurcating branch the analysis asked for could not be started
     NOT_SEARCHED = "not_searched"  # branch points were not searched (a limitation, stated; not a failure)
+    INTERRUPTED = "interrupted"  # a signal stopped the computation: what follows the stored points is missing
 
     @property
     def fails(self) -> bool:

@@ -1,35 +1,35 @@
-"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical`` (``balloon-cg SUBCOMMAND -h``).
+"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical`` (``balloon-cg SUBCOMMAND -h``;
+also ``python -m balloon_cg``). The computing layers are imported by the subcommand that needs them, so
+``--help``, ``--version`` and ``inspect`` start fast.
 
 Exit codes: 0 success: the result is complete (analysis.verdict: every branch reached its requested end, every
 special point is located, stability settled); 1 the computation did not give what was asked (a branch could
 not start, or the result is incomplete: the file is still written, flagged, and the incomplete parts are named
 on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: the two-parameter curve did not
 end in a verified merge of the pitchforks); 2 bad input (invalid scene, missing or unreadable file, existing
-output without --force, a scene ``critical`` cannot handle). Errors are one line on stderr, ``balloon-cg: error: ...``.
+output without --force, a scene ``critical`` cannot handle); 130 interrupted (SIGINT or SIGTERM: ``run`` stops at
+the next point and writes what is finished, flagged incomplete). Errors are one line on stderr,
+``balloon-cg: error: ...``.
 """
 import argparse
 import json
+import math
 import shlex
 import sys
+from importlib import resources
 from pathlib import Path
 
-import numpy as np
-from tqdm import tqdm
-
-from ..analysis.picture import analyse
-from ..analysis.primary import trace_primary
-from ..analysis.results import StopCode
-from ..analysis.tracer import ContinuationError
-from ..analysis.verdict import failing, incomplete, summary_line
-from ..model.field import FieldError
-from ..post.plotting import KINDS, PlotError, plot as draw_plot
-from ..galerkin.profiles import equator_values
-from ..scene import SceneError, load_scene
-from ..io.hdf5 import check_output
-from ..io.run_file import RunFileError, read_run, write_run
+from .. import __version__
 from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
+INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
+PLOT_KINDS = ("pressure-pole", "pressure-equator", "shapes", "stresses", "field", "curvature", "energy", "phase")
+# the exceptions that mean bad input (exit 2) or a computation that did not give what was asked (exit 1), by
+# module: a module that is not loaded cannot have raised its exception, so none is imported to catch it
+BAD_INPUT = {"balloon_cg.scene.validation": "SceneError", "balloon_cg.io.run_file": "RunFileError",
+             "balloon_cg.post.plotting": "PlotError", "balloon_cg.model.field": "FieldError"}
+FAILED = {"balloon_cg.analysis.tracer": "ContinuationError"}
 
 
 class UsageError(ValueError):
@@ -47,16 +47,31 @@ def main(argv=None) -> int:
     args.command_line = shlex.join([PROG, *argv])
     try:
         return args.handler(args)
-    except (SceneError, RunFileError, UsageError, PlotError, FieldError) as e:
+    except KeyboardInterrupt:  # before the computation installed its own handler (imports), or a second Ctrl-C
+        return _error("interrupted", INTERRUPTED)
+    except (UsageError, *_loaded(BAD_INPUT)) as e:
         return _error(str(e), 2)
     except OSError as e:
         return _error(_os_message(e), 2)
-    except (ContinuationError, Failure) as e:
+    except (Failure, *_loaded(FAILED)) as e:
         return _error(str(e), 1)
 
 
+def _loaded(classes: dict) -> tuple:
+    """The exception classes of ``classes`` ({module: name}) whose modules are loaded."""
+    return tuple(getattr(sys.modules[module], name) for module, name in classes.items() if module in sys.modules)
+
+
+def docs_path(name: str) -> str:
+    """Where the installed documentation page docs/``name`` is."""
+    return str(resources.files("balloon_cg.docs") / name)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=PROG, description="Inflated magnetoelastic membranes.")
+    parser = argparse.ArgumentParser(
+        prog=PROG, description="Inflated magnetoelastic membranes: equilibrium branches, their bifurcations and "
+                               f"stability. Documentation: {docs_path('')}")
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels):
         add(commands)
@@ -77,9 +92,12 @@ def _os_message(e: OSError) -> str:
 # --- run ---------------------------------------------------------------------------------------------------
 
 def _add_run(commands):
-    p = commands.add_parser("run", help="trace the primary branch of a scene and write a run file")
+    p = commands.add_parser("run", help="analyse a scene (primary branch, stability, branch points, pear branches) "
+                                        "and write a run file")
     p.add_argument("scene", help="scene TOML file")
-    p.add_argument("-o", "--output", required=True, help="run file to write (HDF5)")
+    p.add_argument("-o", "--output", help="run file to write (HDF5; default: SCENE_NAME.h5 in the current folder, "
+                                          "the name after --set changes)")
+    _add_settings(p)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--primary-only", action="store_true",
@@ -89,19 +107,70 @@ def _add_run(commands):
     p.set_defaults(handler=run)
 
 
-def run(args) -> int:
-    """Trace, write, read back and summarise."""
+def _add_settings(p):
+    """--set and the continuation limits AUTO users expect on the command line (both validated like the TOML)."""
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
+                   help="override a scene key (dotted, e.g. field.M=0.003, field.coils[0].radius=2.5, "
+                        "material.preset=TPOM1; a bare name of one table: M=0.003); repeatable")
+    for flag, key, metavar in (("--max-points", "max_points", "N"), ("--stop-stretch", "stop_stretch", "X"),
+                               ("--stop-pressure", "stop_pressure", "P")):
+        p.add_argument(flag, dest=key, metavar=metavar, help=f"continuation.{key} (as --set continuation.{key}=…)")
+
+
+def scene_of(args):
+    """The scene file with the command line's --set and continuation limits applied (renamed after them)."""
+    from ..scene import load_scene
+    from .sweep import SweepError, overridden, parse_vary
+
     scene = load_scene(args.scene)
-    _, found = run_scene(scene, args.output, args.force, progress=not args.quiet, command=args.command_line,
-                         primary_only=args.primary_only)
+    shorthands = [f"continuation.{key}={getattr(args, key)}" for key in ("max_points", "stop_stretch", "stop_pressure")
+                  if getattr(args, key, None) is not None]
+    settings = list(args.settings) + shorthands
+    if not settings:
+        return scene
+    for text in settings:
+        key, sep, value = (part.strip() for part in text.partition("="))
+        if not sep or not key or not value:
+            raise UsageError(f"--set {text}: expected KEY=VALUE, e.g. --set field.M=0.003")
+        if "," in value or ":" in value:
+            raise UsageError(f"--set {text}: one value per key (sweep --vary takes lists and ranges)")
+    given = [text.partition("=")[0].strip() for text in args.settings]
+    for text in shorthands:
+        if text.partition("=")[0] in given or text.partition("=")[0].split(".")[1] in given:
+            raise UsageError(f"--set {text.partition('=')[0]} and its shorthand flag both given: use one")
+    try:
+        overrides = dict(parse_vary(text, scene) for text in settings)
+    except SweepError as e:
+        raise UsageError(str(e).replace("--vary", "--set")) from None
+    return overridden(scene, {key: values[0] for key, values in overrides.items()})
+
+
+def run(args) -> int:
+    """Analyse, write, read back and summarise; exit 130 after an interrupt (what is finished is written)."""
+    from ..io.run_file import read_run
+    from ..numerics.interrupt import requested, stop_on_signals
+
+    scene = scene_of(args)
+    output = args.output or f"{scene.name}.h5"
+    with stop_on_signals():
+        _, found = run_scene(scene, output, args.force, progress=not args.quiet, command=args.command_line,
+                             primary_only=args.primary_only)
+        interrupted = requested()
+    if interrupted:
+        print(f"{PROG}: interrupted: what was finished is written to {output} (flagged incomplete)", file=sys.stderr)
+        return INTERRUPTED
     if not args.quiet:
-        print(format_run(read_run(args.output)))
+        from .summaries import format_run
+
+        print(format_run(read_run(output)))
     return verdict_status(found, args.allow_partial)
 
 
 def verdict_status(found: list, allow_partial: bool) -> int:
     """Exit status of a written result: 0 when complete (or ``allow_partial``), else 1 with the incomplete
     parts on stderr (one line)."""
+    from ..analysis.verdict import failing, summary_line
+
     if not failing(found):
         return 0
     print(f"{PROG}: {summary_line(found)}", file=sys.stderr)
@@ -114,17 +183,24 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
     primary branch) and write the run file ``out_path``; returns the path and what is incomplete
     (analysis.verdict.Incomplete entries, empty when the result is complete).
 
-    The output is checked before the trace (which may take long); ``progress`` shows a bar on stderr;
-    ``command`` overrides the provenance attribute (default: sys.argv).
+    The output is checked before the trace (which may take long); ``progress`` shows one bar per phase on
+    stderr; ``command`` overrides the provenance attribute (default: sys.argv).
     """
+    from ..analysis.picture import Phase, analyse
+    from ..analysis.primary import trace_primary
+    from ..analysis.verdict import incomplete
+    from ..io.hdf5 import check_output
+    from ..io.run_file import write_run
+    from .progress import PhaseBars
+
     check_output(out_path, force)
-    with tqdm(desc=scene.name, unit=" points", disable=not progress, file=sys.stderr) as bar:
-        tick = lambda point: bar.update()  # noqa: E731
+    with PhaseBars(scene.name, progress) as bars:
         if primary_only:
-            branches, snaps = [trace_primary(scene, progress=tick)], None
+            branches, snaps = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))], None
+            bars.finish(Phase.PRIMARY, len(branches[0].X))
             found = incomplete(branches)
         else:
-            picture = analyse(scene, progress=tick)
+            picture = analyse(scene, progress=bars)
             branches, snaps, found = picture.branches, picture.snaps, picture.incomplete
     extra = {} if command is None else {"command": command}
     return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found), found
@@ -137,12 +213,20 @@ def _add_solve(commands):
     p.add_argument("scene", help="scene TOML file")
     p.add_argument("--pole-stretch", type=float, required=True, metavar="X", help="north pole stretch λ2(0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
+                   help="override a scene key, as for run; repeatable")
     p.set_defaults(handler=solve)
 
 
 def solve(args) -> int:
     """Trace the primary branch up to the requested north pole stretch and report its end point."""
-    scene = load_scene(args.scene)
+    import numpy as np
+
+    from ..analysis.primary import trace_primary
+    from ..analysis.results import StopCode
+    from .summaries import format_table
+
+    scene = scene_of(args)
     x, start = args.pole_stretch, scene.continuation.start_stretch
     if not np.isfinite(x) or x <= start:
         raise UsageError(f"--pole-stretch = {x:g}: must be > continuation.start_stretch = {start:g}")
@@ -154,12 +238,16 @@ def solve(args) -> int:
             f"largest stretch reached: {reached:.10g}"
         )
     result = solution(branch, -1)
-    print(json.dumps(result) if args.json else format_table(result | {"wall_time": f"{result['wall_time']:.3f} s"}))
+    print(strict_json(result) if args.json else format_table(result | {"wall_time": f"{result['wall_time']:.3f} s"}))
     return 0
 
 
 def solution(branch, i: int) -> dict:
     """The reported quantities of point i of a branch."""
+    import numpy as np
+
+    from ..galerkin.profiles import equator_values
+
     X = branch.X[i]
     values = {"pressure": X[-1], **branch.pole_values(X), **equator_values(branch.disc, X)}
     return {
@@ -173,20 +261,36 @@ def solution(branch, i: int) -> dict:
 # --- inspect -----------------------------------------------------------------------------------------------
 
 def _add_inspect(commands):
-    p = commands.add_parser("inspect", help="summary of the branches in a run file")
-    p.add_argument("file", help="run file (HDF5)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p = commands.add_parser("inspect", help="summary of a run, sweep or curve file")
+    p.add_argument("file", help="run, sweep or two-parameter curve file (HDF5)")
+    p.add_argument("--json", action="store_true", help="print one JSON object (strict: null for NaN)")
     p.set_defaults(handler=inspect)
 
 
 def inspect(args) -> int:
-    """Print the summary of a run file."""
-    run = read_run(args.file)
-    if args.json:
-        print(json.dumps(summarise_run(run)))
-    else:
-        print(format_run(run))
+    """Print the summary of a run, sweep or curve file."""
+    from .summaries import summarise_file
+
+    summary, text = summarise_file(args.file)
+    print(strict_json(summary) if args.json else text)
     return 0
+
+
+def strict_json(value) -> str:
+    """JSON that strict parsers accept: NaN and ±inf as null, numpy scalars and arrays as numbers and lists."""
+    return json.dumps(_finite(value), allow_nan=False)
+
+
+def _finite(value):
+    if isinstance(value, dict):
+        return {str(k): _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    if hasattr(value, "tolist"):  # numpy scalar or array
+        return _finite(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 # --- plot --------------------------------------------------------------------------------------------------
@@ -195,17 +299,26 @@ IMAGE_FORMATS = (".png", ".pdf", ".svg")
 
 
 def _add_plot(commands):
-    p = commands.add_parser("plot", help="draw a figure from one or more run files (docs/plots.md)")
+    p = commands.add_parser("plot", help=f"draw figures from one or more run files ({docs_path('plots.md')})")
     p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
-    p.add_argument("--what", required=True, choices=list(KINDS), metavar="KIND",
-                   help=f"what to draw: {', '.join(KINDS)}")
+    p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
+                   help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}")
     p.add_argument("-o", "--output", help="image file, .png, .pdf or .svg (default: FIRST_FILE_STEM_KIND.png "
-                                          "next to the first file; an existing image is overwritten)")
+                                          "next to the first file; with several kinds: OUTPUT_STEM_KIND.SUFFIX; "
+                                          "an existing image is overwritten)")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
                    help="point indices for shapes, stresses, field, curvature (negative: from the end)")
     p.add_argument("--branch", metavar="NAME",
                    help="branch to draw (default: every branch for pressure-* and energy, primary for the others)")
     p.set_defaults(handler=plot)
+
+
+def _kinds(text: str) -> list[str]:
+    kinds = [k.strip() for k in text.split(",")]
+    unknown = [k for k in kinds if k not in PLOT_KINDS]
+    if unknown:
+        raise argparse.ArgumentTypeError(f"{unknown[0]!r}: not a plot kind (choose from {', '.join(PLOT_KINDS)})")
+    return kinds
 
 
 def _indices(text: str) -> list[int]:
@@ -216,14 +329,26 @@ def _indices(text: str) -> list[int]:
 
 
 def plot(args) -> int:
-    """Draw one figure and save it; prints the image path."""
+    """Draw one figure per kind and save it; prints the image paths."""
+    from ..io.hdf5 import check_output
+    from ..post.plotting import as_run, plot as draw
+
     first = Path(args.files[0])
-    output = Path(args.output) if args.output else first.with_name(f"{first.stem}_{args.what}.png")
-    if output.suffix.lower() not in IMAGE_FORMATS:
-        raise UsageError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
-    check_output(output, force=True)
-    draw_plot(args.files, args.what, args.points, args.branch).savefig(output, dpi=150)
-    print(output)
+    outputs = {}
+    for kind in args.what:
+        if args.output is None:
+            outputs[kind] = first.with_name(f"{first.stem}_{kind}.png")
+        else:
+            given = Path(args.output)
+            outputs[kind] = given if len(args.what) == 1 else given.with_name(f"{given.stem}_{kind}{given.suffix}")
+    for output in outputs.values():
+        if output.suffix.lower() not in IMAGE_FORMATS:
+            raise UsageError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
+        check_output(output, force=True)
+    runs = [as_run(f) for f in args.files] if any(kind != "phase" for kind in args.what) else []
+    for kind, output in outputs.items():
+        draw(args.files if kind == "phase" else runs, kind, args.points, args.branch).savefig(output, dpi=150)
+        print(output)
     return 0
 
 
@@ -259,11 +384,16 @@ def critical(args) -> int:
     scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
     the equator-symmetric layout), or ``--parameter M`` without coils. Progress goes to stderr (``--quiet``: none).
     """
+    from tqdm import tqdm
+
     from ..analysis.bifurcation import detect, locate
-    from ..analysis.stability import assess_branch
     from ..analysis.codim2 import CurveEnd, TwoParameterError, continue_branch_point
+    from ..analysis.primary import trace_primary
     from ..analysis.results import Block, Status
+    from ..analysis.stability import assess_branch
     from ..io.curve_file import write_curve
+    from ..io.hdf5 import check_output
+    from ..scene import load_scene
 
     scene = load_scene(args.scene)
     asymmetry = _asymmetry(scene)
@@ -352,6 +482,7 @@ def _add_sweep(commands):
 def sweep(args) -> int:
     """Expand, compute the members not yet in the file, append them, summarise."""
     from ..io.sweep_file import incomplete_members
+    from ..scene import load_scene
     from .sweep import SweepError, format_summary, run_sweep
 
     if args.workers is not None and args.workers < 1:
@@ -374,124 +505,3 @@ def sweep(args) -> int:
               "file: members/<index> attributes complete, incomplete_*)", file=sys.stderr)
         return 0 if args.allow_partial else 1
     return 0
-
-
-
-# --- summaries ---------------------------------------------------------------------------------------------
-
-def summarise_run(run: dict) -> dict:
-    """JSON-ready summary of read_run() output: provenance and one summary per branch."""
-    return {
-        "file": run["path"],
-        "scene_name": run["scene_name"],
-        "provenance": run["attrs"],
-        "branches": {name: summarise_branch(b) for name, b in run["branches"].items()},
-        "snap_throughs": run.get("snap_throughs", []),
-    }
-
-
-def summarise_branch(b: dict) -> dict:
-    """Points, ranges, special points, accuracy and run time of one stored branch."""
-    n, attrs = len(b["pressure"]), b["attrs"]
-    wall = float(attrs["wall_time"])
-    return {
-        "points": n,
-        "pressure": _range(b["pressure"]),
-        "lam2_north": _range(b["lam2_north"]),
-        "lam2_south": _range(b["lam2_south"]),
-        "special_points": b["special_points"],
-        "stop_reason": attrs["stop_reason"],
-        "stop_codes": dict(zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", []))),
-        "max_residual": float(b["residual"].max()),
-        "max_error_estimate": float(b["error_estimate"].max()),
-        "wall_time": wall,
-        "wall_time_per_point": wall / n,
-        "degree": int(attrs["degree"]),
-        "symmetric": bool(attrs["symmetric"]),
-        "basis_map": {"centres": [float(c) for c in attrs.get("map_centres", [])],
-                      "widths": [float(w) for w in attrs.get("map_widths", [])]},
-        "kernel_class": attrs["kernel_class"],
-        "M": float(attrs["M"]),
-        "chi": float(attrs["chi"]),
-        "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
-        "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
-    }
-
-
-def _range(values) -> list:
-    return [float(np.min(values)), float(np.max(values))]
-
-
-def format_run(run: dict) -> str:
-    """Readable summary of read_run() output."""
-    summary = summarise_run(run)
-    p = summary["provenance"]
-    lines = [
-        f"file           {summary['file']}",
-        f"scene          {summary['scene_name']}",
-        f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
-        f"command        {p['command']}",
-        f"tolerance      {p['tolerance']:g}",
-        f"kernels        digest {p['generated_digest'][:16]}…",
-        f"result         {_verdict(p)}",
-    ]
-    for name, b in summary["branches"].items():
-        lines += ["", *_format_branch(name, b)]
-    for s in summary["snap_throughs"]:
-        target = f"{s['to_branch']} point {s['to_index']}" if s["to_branch"] else "no stable state on the traced branches"
-        lines.append(f"snap-through at P = {s['pressure']:.10g}: {s['from_branch']} point {s['from_index']} -> {target}")
-    return "\n".join(lines)
-
-
-def _verdict(attrs: dict) -> str:
-    """'complete', or the incomplete parts stored in a run file's root attributes."""
-    if "complete" not in attrs:
-        return "not assessed"
-    if attrs["complete"]:
-        return "complete"
-    parts = [f"{gap} ({branch}: {message})" for gap, branch, message in
-             zip(attrs["incomplete_gaps"], attrs["incomplete_branches"], attrs["incomplete_messages"])]
-    return "incomplete: " + "; ".join(parts)
-
-
-def _format_branch(name: str, b: dict) -> list[str]:
-    lines = [
-        f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
-        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
-        *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
-           f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]
-          if b["basis_map"]["centres"] else []),
-        f"  points               {b['points']}",
-        "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
-        "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
-        "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
-        f"  stop reason          {b['stop_reason']}",
-        f"  max residual         {b['max_residual']:.3e}",
-        f"  max error estimate   {b['max_error_estimate']:.3e}",
-        f"  wall time            {b['wall_time']:.3f} s",
-        f"  error estimate vs run time: {b['max_error_estimate']:.3e} max, "
-        f"{1e3 * b['wall_time_per_point']:.2f} ms per point",
-        f"  stable points        {b['stable_points'] or 'not assessed'}",
-        f"  special points       {len(b['special_points']) or 'none'}",
-    ]
-    for s in b["special_points"]:
-        note = f"  {s['note']}" if s["note"] else ""
-        status = "" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})"
-        label = f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "") + status
-        lines.append(
-            f"    {label:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
-            f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
-        )
-    return lines
-
-
-def format_table(values: dict) -> str:
-    """Two aligned columns: name, value."""
-    width = max(map(len, values))
-    return "\n".join(f"{k:<{width}}  {_show(v)}" for k, v in values.items())
-
-
-def _show(v) -> str:
-    if isinstance(v, bool):
-        return str(v).lower()
-    return f"{v:.12g}" if isinstance(v, float) else str(v)

@@ -18,7 +18,8 @@ from pathlib import Path
 
 from ..analysis.tracer import ContinuationError
 from ..analysis.verdict import failing, summary_line
-from .cli import run_scene, summarise_branch
+from .cli import run_scene
+from .summaries import summarise_branch
 from ..post.plotting import applicable_kinds, load_branches, plot, special_label
 from ..scene import parse_scene
 from ..io.run_file import read_run

@@ -6,16 +6,10 @@ cache) and 'import'; for every class 'jit' per kernel: its first call, compiled 
 numba's on-disk cache ('cache' column: hits).
 """
 import json
+import math
 import time
 
-import numpy as np
-
-from ..model import kernel_cache
-from ..model.kernels import KernelSet
-from ..scene import load_scene
-from ..scene.energies import StrainEnergy
-
-_SAMPLE = {"theta": 1.0, "cos_theta": np.cos(1.0), "sin_theta": np.sin(1.0), "lam2": 1.2, "v": 0.01,
+_SAMPLE = {"theta": 1.0, "cos_theta": math.cos(1.0), "sin_theta": math.sin(1.0), "lam2": 1.2, "v": 0.01,
            "eta": 0.5, "w": 0.3, "lam0": 1.2, "lam1": 1.3, "P": 0.5, "M": 0.001, "chi": 1.0, "m": 1.0}
 _NODES = 4
 
@@ -28,6 +22,8 @@ def add_kernels(commands):
 
 
 def kernels(args) -> int:
+    from ..scene import load_scene  # the CLI imports what a subcommand needs when it runs (app/cli.py)
+
     report = kernel_report(load_scene(args.scene))
     if args.json:
         print(json.dumps(report))
@@ -42,6 +38,10 @@ def kernels(args) -> int:
 
 def kernel_report(scene) -> dict:
     """{'class', 'source' (committed | cached | generated), 'key', 'stages' {stage: s}, 'jit' {kernel: (s, hits)}}."""
+    from ..model import kernel_cache
+    from ..model.kernels import KernelSet
+    from ..scene.energies import StrainEnergy
+
     material, has_field = scene.material, bool(scene.field.coils)
     stages, key, source = {}, None, "committed"
     if isinstance(material, StrainEnergy) and material.family is None:
@@ -56,6 +56,8 @@ def kernel_report(scene) -> dict:
 
 def _first_calls(kernel_set) -> dict:
     """{kernel: (seconds of its first call, numba cache hits)} for every kernel of the module."""
+    import numpy as np
+
     out = {}
     for name, spec in kernel_set.module.KERNELS.items():
         values = {**_SAMPLE, "field_north": np.zeros(6), "field_south": np.zeros(6)}

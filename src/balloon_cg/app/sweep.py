@@ -117,7 +117,7 @@ def expand(scene: Scene, specs: list[str]) -> list[Member]:
     for index, values in enumerate(itertools.product(*(v for _, v in axes))):
         overrides = dict(zip(keys, values))
         try:
-            member_scene = scene.with_overrides(_expand_indexed(overrides, scene))
+            member_scene = overridden(scene, overrides)
         except SceneError as e:
             errors.setdefault(str(e), []).append(index)
             continue
@@ -127,6 +127,11 @@ def expand(scene: Scene, specs: list[str]) -> list[Member]:
         lines = [f"{msg} (member{'s' if len(idx) > 1 else ''} {_ranges(idx)})" for msg, idx in errors.items()]
         raise SceneError(f"{total} of {total + len(members)} sweep members are invalid: " + "; ".join(lines))
     return members
+
+
+def overridden(scene: Scene, overrides: dict) -> Scene:
+    """``scene`` with ``overrides`` (canonical keys, indexed ones included) applied and validated."""
+    return scene.with_overrides(_expand_indexed(overrides, scene))
 
 
 def _expand_indexed(overrides: dict, scene: Scene) -> dict:

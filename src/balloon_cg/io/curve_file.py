@@ -21,6 +21,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, plain
 from .run_file import read_special, root_attrs, write_special
+from .schema import attach_dimensions, describe, scale
 
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):
@@ -50,10 +51,15 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
                    "unknowns": curve.branch_X(), "mode": curve.mode}
         for key, data in columns.items():
             group.create_dataset(key, data=data)
+        point, unknown = scale(group, "point", len(curve.q)), scale(group, "unknown", columns["unknowns"].shape[1])
+        attach_dimensions(group, {1: (point,), "unknowns": (point, unknown),
+                                  "mode": (point, scale(group, "mode_unknown", columns["mode"].shape[1]))})
         merges = [replace(s, X=curve.branch_X(s.X)[0]) for s in curve.merges]
         special = group.create_group("special_points")
-        write_special(special, merges, curve.n + 1, curve.disc)
-        special.create_dataset("q", data=np.array([s.X[-1] for s in curve.merges], dtype=float))
+        write_special(special, merges, curve.n + 1, curve.disc, unknown)
+        q = special.create_dataset("q", data=np.array([s.X[-1] for s in curve.merges], dtype=float))
+        q.dims[0].attach_scale(special["special"])
+        describe(q)
     return path
 
 

@@ -33,17 +33,31 @@ def check_output(path, force: bool) -> Path:
 
 
 @contextlib.contextmanager
-def atomic_file(path, force: bool = False):
-    """``with atomic_file(path) as f:`` a new h5py.File that replaces ``path`` when the block completes."""
+def _replacing(path, force: bool):
+    """``with _replacing(path, force) as tmp:`` a temporary path next to ``path``, renamed over it when the block
+    completes, removed on any failure."""
     path = check_output(path, force)
     tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
     try:
-        with h5py.File(tmp, "x") as f:
-            yield f
+        yield tmp
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def atomic_file(path, force: bool = False):
+    """``with atomic_file(path) as f:`` a new h5py.File that replaces ``path`` when the block completes."""
+    with _replacing(path, force) as tmp, h5py.File(tmp, "x") as f:
+        yield f
+
+
+def atomic_bytes(path, data: bytes, force: bool = False) -> Path:
+    """Write ``data`` (a file image) to ``path`` as atomically as ``atomic_file``."""
+    with _replacing(path, force) as tmp, open(tmp, "xb") as f:
+        f.write(data)
+    return Path(path)
 
 
 def provenance(command: str | None = None) -> dict:
@@ -52,8 +66,15 @@ def provenance(command: str | None = None) -> dict:
         "package_version": balloon_cg.__version__,
         "generated_digest": generated_digest(),
         "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "command": command if command is not None else shlex.join(sys.argv),
+        "command": command if command is not None else command_line(),
     }
+
+
+def command_line() -> str:
+    """What was typed: ``python -m module args`` for a module run with -m (sys.argv[0] is then its file)."""
+    spec = getattr(sys.modules.get("__main__"), "__spec__", None)
+    argv = ["python", "-m", spec.name.removesuffix(".__main__"), *sys.argv[1:]] if spec is not None and spec.name else sys.argv
+    return shlex.join(argv)
 
 
 def write_strings(group, name: str, values) -> None:

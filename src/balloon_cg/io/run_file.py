@@ -1,4 +1,4 @@
-"""Run files (HDF5, format "balloon-cg/2"): traced branches with their provenance.
+"""Run files (HDF5, format "balloon-cg/3"): traced branches with their provenance.
 
 Layout::
 
@@ -11,33 +11,39 @@ Layout::
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
                                   kernel_class, kernel_signature, M, chi, [parent_branch, parent_branch_point,
                                   rejoins_branch_point]
-        pressure, lam2_north, lam2_south, eta_north, eta_south,
+        point, unknown                                     dimension scales (0, 1, …)
+        pressure, volume, lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
-        newton_iterations, solved_degree                   (n_points,)
-        unknowns                                           (n_points, n + 1): Legendre unknowns u, then P
-        theta                                              (n_theta,): linspace(0, π)
-        profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (n_points, n_theta)
+        newton_iterations, solved_degree                   (point,)
+        unknowns                                           (point, unknown): Legendre unknowns u, then P
+        theta                                              (theta,): linspace(0, π), a dimension scale
+        profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
         special_points/kind (LP, TP, BP, EP, UZ), classification, block, status (located, approximate), reason,
                        stop_code, note, index, m, pressure, uncertainty, E2, E3, E4, lam2_north, lam2_south,
-                       eta_north, eta_south                                                  (n_special,)
-        special_points/unknowns                            (n_special, n + 1)
-        stability/...                                      (analysed branches: flags and lowest eigenvalues)
+                       eta_north, eta_south                                                  (special,)
+        special_points/unknowns                            (special, unknown)
+        stability/stable_*                                 (point,) flags
+        stability/lowest_<block>                           (point, eigenvalue): lowest eigenvalues
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
 
+Every dataset carries ``units``, ``long_name`` and ``description`` (``io.schema``), and its axes are netCDF-4
+dimensions (HDF5 dimension scales), so ``xarray.open_dataset(path, engine="h5netcdf", group=...)`` names them.
 A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index + 1``; its own X is in
-special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``).
+special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous format
+"balloon-cg/2" (no volume, no dimension scales) still read.
 """
 import errno
+import io
 from pathlib import Path
 
 import h5py
 import numpy as np
 
-from ..analysis.verdict import failing, incomplete
-from ..galerkin.profiles import equator_values, profiles, theta_grid
 from .hdf5 import atomic_file, plain, provenance, write_strings
+from .schema import attach_dimensions, describe, scale
 
-FORMAT = "balloon-cg/2"
+FORMAT = "balloon-cg/3"
+READABLE = (FORMAT, "balloon-cg/2")
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
 SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
 SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
@@ -56,14 +62,31 @@ def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | No
     the root attributes. ``found``: analysis.verdict.Incomplete entries (default: those of ``branches``).
     Raises ValueError if a branch holds a point that is not a finite solution.
     """
-    attrs = root_attrs(scene) | verdict_attrs(branches, found) | dict(extra_attrs or {})
-    if attrs["format"] != FORMAT:
-        raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
-    check_branches(branches)
+    attrs = _run_attrs(scene, branches, extra_attrs, found)
     with atomic_file(path, force) as f:
         f.attrs.update(attrs)
         write_branches(f, scene, branches, snaps)
     return Path(path)
+
+
+def run_image(scene, branches, extra_attrs: dict | None = None, snaps: list | None = None,
+              found: list | None = None) -> bytes:
+    """The bytes of the file ``write_run`` writes, made in memory (an HDF5 file image; nothing on disk)."""
+    attrs = _run_attrs(scene, branches, extra_attrs, found)
+    with h5py.File(f"{scene.name}.h5", "w", driver="core", backing_store=False) as f:
+        f.attrs.update(attrs)
+        write_branches(f, scene, branches, snaps)
+        f.flush()
+        return f.id.get_file_image()
+
+
+def _run_attrs(scene, branches, extra_attrs, found) -> dict:
+    """The root attributes of a run file, after checking the branches (ValueError: nothing is written)."""
+    attrs = root_attrs(scene) | verdict_attrs(branches, found) | dict(extra_attrs or {})
+    if attrs["format"] != FORMAT:
+        raise ValueError(f"extra_attrs may not change format (= {FORMAT!r})")
+    check_branches(branches)
+    return attrs
 
 
 def root_attrs(scene, command: str | None = None) -> dict:
@@ -74,6 +97,8 @@ def root_attrs(scene, command: str | None = None) -> dict:
 
 def verdict_attrs(branches=None, found=None) -> dict:
     """complete and incomplete_* attributes from Incomplete entries (or computed from ``branches``)."""
+    from ..analysis.verdict import failing, incomplete
+
     if found is None:
         found = incomplete(branches)
     text = h5py.string_dtype()
@@ -101,6 +126,8 @@ def finite(branch) -> np.ndarray:
 
 def write_branches(parent, scene, branches, snaps=None) -> None:
     """/branches (and /snap_throughs when ``snaps`` is given) of a run file into the h5py group ``parent``."""
+    from ..galerkin.profiles import theta_grid
+
     group = parent.create_group("branches")
     theta = theta_grid(scene.output.theta_points)
     for order, branch in enumerate(branches):
@@ -111,6 +138,9 @@ def write_branches(parent, scene, branches, snaps=None) -> None:
 
 
 def _write_branch(group, branch, theta):
+    from ..analysis.problem import equilibrium_of
+    from ..galerkin.profiles import equator_values, profiles
+
     disc = branch.disc
     group.attrs.update({
         "stop_reason": branch.stop_reason,
@@ -134,8 +164,10 @@ def _write_branch(group, branch, theta):
         group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
     if branch.rejoins is not None:
         group.attrs["rejoins_branch_point"] = branch.rejoins
+    volume = equilibrium_of(branch).volume
     columns = {
         "pressure": branch.pressure,
+        "volume": 2 * np.pi * np.array([volume(u) for u in branch.X[:, :-1]]),
         **branch.pole_values(),
         **equator_values(branch.disc, branch.X),
         "converged": finite(branch),
@@ -144,16 +176,21 @@ def _write_branch(group, branch, theta):
         "newton_iterations": branch.iterations,
         "solved_degree": branch.degree,
         "unknowns": branch.X,
-        "theta": theta,
     }
+    point, unknown = scale(group, "point", len(branch.X)), scale(group, "unknown", branch.X.shape[1])
+    theta_scale = group.create_dataset("theta", data=theta)
+    theta_scale.make_scale("theta")
+    describe(theta_scale)
     for name, data in columns.items():
         group.create_dataset(name, data=data)
+    attach_dimensions(group, {1: (point,), 2: (point, unknown)})
     shapes = group.create_group("profiles")
     for name, data in profiles(branch.disc, branch.X, theta).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
-    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc)
+    attach_dimensions(shapes, {2: (point, theta_scale)})
+    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc, unknown)
     if branch.stability:
-        _write_stability(group.create_group("stability"), branch)
+        _write_stability(group.create_group("stability"), branch, point)
 
 
 STABILITY_FLAGS = {
@@ -164,15 +201,17 @@ STABILITY_FLAGS = {
 }
 
 
-def _write_stability(group, branch):
+def _write_stability(group, branch, point):
     """Flags per point (what each means is in the dataset's 'meaning' attribute) and lowest eigenvalues."""
     results = branch.stability
     for name, meaning in STABILITY_FLAGS.items():
         group.create_dataset(name, data=np.array([a.flags()[name] for a in results], dtype=bool))
         group[name].attrs["meaning"] = meaning
-    for block in results[0].blocks:
-        values = np.array([a.blocks[block] for a in results])
-        group.create_dataset(f"lowest_{block}", data=values)
+    lowest = {f"lowest_{block}": np.array([a.blocks[block] for a in results]) for block in results[0].blocks}
+    eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in lowest.values()))
+    for name, values in lowest.items():
+        group.create_dataset(name, data=values)
+    attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
     group.attrs["unsettled_points"] = np.asarray(branch.unsettled, dtype=np.int64)
 
 
@@ -183,11 +222,13 @@ def _write_snaps(group, snaps):
     group.create_dataset("from_index", data=np.array([s.from_index for s in snaps], dtype=np.int64))
     group.create_dataset("to_index", data=np.array([s.to_index for s in snaps], dtype=np.int64))
     group.create_dataset("pressure", data=np.array([s.pressure for s in snaps], dtype=float))
+    attach_dimensions(group, {1: (scale(group, "snap", len(snaps)),)})
 
 
-def write_special(group, special: list, width: int, disc) -> None:
+def write_special(group, special: list, width: int, disc, unknown=None) -> None:
     """Special points (results.SpecialPoint) as columns; ``width`` = n + 1, the length of their X rows, and
-    ``disc`` the discretisation of their u (for the pole values)."""
+    ``disc`` the discretisation of their u (for the pole values); ``unknown``: the dimension scale of the X
+    rows (default: a new one in ``group``)."""
     X = np.array([s.X for s in special]).reshape(len(special), width)
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
@@ -206,6 +247,8 @@ def write_special(group, special: list, width: int, disc) -> None:
     for name in POLES:
         group.create_dataset(name, data=X[:, :-1] @ rows[name])
     group.create_dataset("unknowns", data=X)
+    special_scale = scale(group, "special", len(special))
+    attach_dimensions(group, {1: (special_scale,), 2: (special_scale, unknown or scale(group, "unknown", width))})
 
 
 def read_run(path) -> dict:
@@ -214,7 +257,8 @@ def read_run(path) -> dict:
     Each branch is a dict of its attrs ('attrs'), its per-point arrays and 'theta', 'profiles' (dict of
     arrays), 'special_points' (list of dicts: the special_points columns) and 'special_unknowns'
     (their X rows).
-    Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a balloon-cg/2 run file.
+    Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a readable run file
+    (format balloon-cg/3 or /2).
     """
     path = Path(path)
     if path.is_dir():
@@ -226,15 +270,25 @@ def read_run(path) -> dict:
     except OSError:
         raise RunFileError(f"{path}: not a readable HDF5 file") from None
     with f:
-        fmt = f.attrs.get("format")
-        if fmt != FORMAT:
-            found = "no format attribute" if fmt is None else f"format {fmt!r}"
-            raise RunFileError(f"{path}: not a balloon-cg run file ({found}, expected {FORMAT!r})")
-        try:
-            attrs = {k: _attr(v) for k, v in f.attrs.items()}
-            return {"path": str(path), "scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
-        except KeyError as e:
-            raise RunFileError(f"{path}: damaged balloon-cg run file (missing {e})") from None
+        return _read_open(f, path) | {"path": str(path)}
+
+
+def read_run_image(image: bytes, label: str = "run") -> dict:
+    """``read_run`` of a file image (``run_image``); 'path' is None and errors name ``label``."""
+    with h5py.File(io.BytesIO(image), "r") as f:
+        return _read_open(f, label) | {"path": None}
+
+
+def _read_open(f, label) -> dict:
+    fmt = f.attrs.get("format")
+    if fmt not in READABLE:
+        found = "no format attribute" if fmt is None else f"format {fmt!r}"
+        raise RunFileError(f"{label}: not a balloon-cg run file ({found}, expected one of {', '.join(READABLE)})")
+    try:
+        attrs = {k: _attr(v) for k, v in f.attrs.items()}
+        return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f)}
+    except KeyError as e:
+        raise RunFileError(f"{label}: damaged balloon-cg run file (missing {e})") from None
 
 
 def read_branches(parent) -> dict:

@@ -15,7 +15,6 @@ import enum
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
 
 from .newton import newton
 
@@ -121,7 +120,9 @@ def locate_root(value_at, length: float, xtol: float = 1e-13) -> Root | None:
         return cache[s][0]
 
     try:
-        s = scipy.optimize.brentq(f, 0.0, length, xtol=xtol * max(1.0, length), maxiter=100)
+        from scipy.optimize import brentq  # here: importing scipy.optimize costs 0.2 s at start-up
+
+        s = brentq(f, 0.0, length, xtol=xtol * max(1.0, length), maxiter=100)
         value, payload = cache[s] if s in cache else value_at(s)
         return Root(payload, RootStatus.LOCATED, float(value))
     except (ArithmeticError, ValueError):

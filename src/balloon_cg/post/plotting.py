@@ -1,5 +1,7 @@
-"""Figures from run files (docs/plots.md). Every plot function returns a matplotlib Figure drawn on the Agg
-canvas (no pyplot, no global backend state); save it with ``figure.savefig(path)``.
+"""Figures from run files or results in memory (docs/plots.md). Every plot function returns a matplotlib Figure:
+a new one on the Agg canvas (no pyplot, no global backend state; save it with ``figure.savefig(path)``), or,
+given ``axes``, the figure of the caller's Axes (one Axes, or a sequence for the kinds with several panels),
+drawn into them with the legend inside the first.
 
 Curves of branches (pressure-pole, pressure-equator) and the energy landscape draw every branch of every file
 (or the one named); the per-point kinds (shapes, stresses, field, curvature) draw chosen points of one branch
@@ -39,10 +41,9 @@ class PlotError(ValueError):
 
 @dataclass
 class StoredBranch:
-    """One branch of a run file (``run``: read_run() output) with its optional per-point stability flag
-    stability/stable_pressure (None if the file has none) and a label for legends."""
+    """One branch of a run (``run``: read_run() output, from a file or from memory) with its optional per-point
+    stability flag stability/stable_pressure (None if the run has none) and a label for legends."""
 
-    path: Path
     run: dict
     name: str
     stable: np.ndarray | None
@@ -67,23 +68,33 @@ class StoredBranch:
                 if all(np.isfinite(s.get(k, np.nan)) for k in NORMAL_FORM)]
 
 
-def load_branches(path, branch: str | None = None) -> list[StoredBranch]:
-    """The branches of a run file (all, primary first, or the one named), with their stability flags."""
-    run = read_run(path)
+    @property
+    def source(self) -> str:
+        """The run's file, or its scene name for a run in memory."""
+        return self.run["path"] or self.run["scene_name"]
+
+
+def as_run(source) -> dict:
+    """A run (read_run() output): ``source`` itself if it is one, else read from the file it names."""
+    return source if isinstance(source, dict) else read_run(source)
+
+
+def load_branches(source, branch: str | None = None) -> list[StoredBranch]:
+    """The branches of a run or run file (all, primary first, or the one named), with their stability flags."""
+    run = as_run(source)
     names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
     if branch is not None and branch not in run["branches"]:
-        raise PlotError(f"{path}: no branch {branch!r} (branches: {', '.join(run['branches'])})")
+        raise PlotError(f"{run['path'] or run['scene_name']}: no branch {branch!r} "
+                        f"(branches: {', '.join(run['branches'])})")
     loaded = []
-    with h5py.File(path, "r") as f:
-        for name in names:
-            group = f["branches"][name]
-            stable = group["stability/stable_pressure"][()].astype(bool) if "stability/stable_pressure" in group \
-                else None
-            n = len(run["branches"][name]["pressure"])
-            if stable is not None and stable.shape != (n,):
-                raise PlotError(f"{path}: branch {name}: stability/stable_pressure has shape {stable.shape}, "
-                                f"expected ({n},)")
-            loaded.append(StoredBranch(Path(path), run, name, stable))
+    for name in names:
+        data = run["branches"][name]
+        stable = data.get("stability", {}).get("stable_pressure")
+        n = len(data["pressure"])
+        if stable is not None and stable.shape != (n,):
+            raise PlotError(f"{run['path']}: branch {name}: stability/stable_pressure has shape {stable.shape}, "
+                            f"expected ({n},)")
+        loaded.append(StoredBranch(run, name, None if stable is None else stable.astype(bool)))
     return loaded
 
 
@@ -92,7 +103,7 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     name where a file contributes several branches."""
     files = {}
     for b in branches:
-        files.setdefault(b.path, []).append(b)
+        files.setdefault(id(b.run), []).append(b)
     by_M = {}
     for path, members in files.items():
         by_M.setdefault(f"M = {members[0].M:g}", []).append(path)
@@ -100,7 +111,7 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         label = f"M = {b.M:g}"
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
-        if len(files[b.path]) > 1:
+        if len(files[id(b.run)]) > 1:
             label += f", {b.name}"
         b.label = label
     return branches
@@ -114,22 +125,56 @@ def applicable_kinds(branches) -> list[str]:
             and (kind != "energy" or any(b.bifurcations for b in branches))]
 
 
-def plot(paths, what: str, points=None, branch: str | None = None) -> Figure:
-    """The figure of kind ``what`` (one of KINDS) for the run files ``paths``.
+def plot(sources, what: str, points=None, branch: str | None = None, axes=None) -> Figure:
+    """The figure of kind ``what`` (one of KINDS) for ``sources``: runs (read_run() output) or run files, one
+    or a list (``phase``: curve or sweep files).
 
     ``branch``: the branch to draw (default: all branches for the branch curves and the energy, 'primary' for
     the per-point kinds). ``points``: indices (negative count from the end) of the configurations drawn by the
-    per-point kinds (default: DEFAULT_POINTS spread along the branch).
+    per-point kinds (default: DEFAULT_POINTS spread along the branch). ``axes``: draw into these matplotlib
+    Axes (one, or as many as the kind has panels: PANELS) instead of a new figure.
     """
     if what not in KINDS:
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
+    sources = [sources] if isinstance(sources, (str, Path, dict)) else list(sources)
     if what == "phase":
-        return plot_phase(paths)
+        return plot_phase(sources, axes)
     draw, per_point = KINDS[what]
     if per_point and branch is None:
         branch = "primary"
-    branches = _label([b for p in paths for b in load_branches(p, branch)])
-    return draw(branches, points) if per_point else draw(branches)
+    branches = _label([b for source in sources for b in load_branches(source, branch)])
+    return draw(branches, points, axes=axes) if per_point else draw(branches, axes=axes)
+
+
+def _panels(axes, count: int, figsize, **subplots):
+    """(figure, ``count`` Axes, own): a new constrained-layout Figure with ``count`` panels (own = True), or
+    the caller's ``axes`` (one Axes or a sequence of ``count``) and their figure."""
+    if axes is None:
+        fig = Figure(figsize=figsize, layout="constrained")
+        return fig, np.atleast_1d(fig.subplots(**subplots) if subplots else fig.add_subplot()), True
+    given = list(np.ravel(np.asarray(axes, dtype=object)))
+    if len(given) != count:
+        raise PlotError(f"this figure has {count} panel{'s' * (count > 1)}: give a sequence of {count} matplotlib "
+                        f"Axes (got {len(given)})")
+    if not all(hasattr(a, "plot") and hasattr(a, "figure") for a in given):
+        raise PlotError(f"not matplotlib Axes: {', '.join(type(a).__name__ for a in given)}")
+    return given[0].figure, np.array(given, dtype=object), False
+
+
+def _legend(fig, axes, own: bool, loc: str, **options):
+    """The legend: outside the axes of an own figure, inside the first Axes of the caller's."""
+    if own:
+        fig.legend(loc=f"outside {loc}", **options)
+    else:
+        options.pop("ncols", None)
+        axes[0].legend(**options)
+
+
+def _suptitle(fig, axes, own: bool, text: str):
+    if own:
+        fig.suptitle(text, fontsize=10)
+    else:
+        axes[0].set_title(text, fontsize=10)
 
 
 # --- branch curves -----------------------------------------------------------------------------------------
@@ -197,7 +242,7 @@ def _label_special(fig, marks):
         ax.annotate(kind, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=8, color=color)
 
 
-def _branch_legend(fig, branches, extra=()):
+def _branch_legend(fig, axes, own, branches, extra=()):
     """Legend right of the axes: one line per drawn branch plus ``extra`` handles; the title tells what the
     line styles mean."""
     with_stability = [b.stable is not None for b in branches]
@@ -208,13 +253,13 @@ def _branch_legend(fig, branches, extra=()):
     else:
         title = "stability not computed (all solid)"
     handles = [Line2D([], [], color=f"C{i % 10}", label=b.label) for i, b in enumerate(branches)]
-    fig.legend(handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8, loc="outside right upper")
+    _legend(fig, axes, own, "right upper", handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8)
 
 
-def plot_pressure_pole(branches) -> Figure:
+def plot_pressure_pole(branches, axes=None) -> Figure:
     """P against the north pole stretch λ2(0); the south pole λ2(π) dotted where it differs."""
-    fig = Figure(figsize=(8.4, 4.8), layout="constrained")
-    ax = fig.add_subplot()
+    fig, panels, own = _panels(axes, 1, (8.4, 4.8))
+    ax = panels[0]
     extra, marks = [], []
     for i, b in enumerate(branches):
         d, color = b.data, f"C{i % 10}"
@@ -228,15 +273,14 @@ def plot_pressure_pole(branches) -> Figure:
     ax.set_xlabel(r"pole stretch $\lambda_2(0)$ (north)")
     ax.set_ylabel(P_LABEL)
     ax.set_title(_title(branches), fontsize=10)
-    _branch_legend(fig, branches, extra)
+    _branch_legend(fig, panels, own, branches, extra)
     _label_special(fig, marks)
     return fig
 
 
-def plot_pressure_equator(branches) -> Figure:
+def plot_pressure_equator(branches, axes=None) -> Figure:
     """P against λ2(π/2) and against λ1(π/2) at the equator (two panels)."""
-    fig = Figure(figsize=(12, 4.5), layout="constrained")
-    axes = fig.subplots(1, 2, sharey=True)
+    fig, axes, own = _panels(axes, 2, (12, 4.5), nrows=1, ncols=2, sharey=True)
     marks = []
     for i, b in enumerate(branches):
         d, color = b.data, f"C{i % 10}"
@@ -248,8 +292,8 @@ def plot_pressure_equator(branches) -> Figure:
     axes[0].set_xlabel(r"equator stretch $\lambda_2(\pi/2)$ (circumferential)")
     axes[1].set_xlabel(r"equator stretch $\lambda_1(\pi/2)$ (meridional)")
     axes[0].set_ylabel(P_LABEL)
-    fig.suptitle(_title(branches), fontsize=10)
-    _branch_legend(fig, branches)
+    _suptitle(fig, axes, own, _title(branches))
+    _branch_legend(fig, axes, own, branches)
     _label_special(fig, marks)
     return fig
 
@@ -260,6 +304,9 @@ def select_points(data: dict, points=None) -> np.ndarray:
     """Indices of the points of a stored branch to draw: ``points`` checked (negative count from the end), or
     DEFAULT_POINTS spread evenly in arclength along the (λ2(0), P) curve, each scaled by its range."""
     n = len(data["pressure"])
+    if points is not None and (np.ndim(points) != 1 or len(points) == 0
+                               or not all(isinstance(p, (int, np.integer)) for p in points)):
+        raise PlotError(f"points = {points!r}: expected a non-empty list of point indices, e.g. [0, 10, -1]")
     if points is None:
         path = np.stack([data["lam2_north"], data["pressure"]])
         span = np.ptp(path, axis=1, keepdims=True)
@@ -293,27 +340,29 @@ def _per_point_title(branches) -> str:
     return _title(branches)
 
 
-def _point_legend(fig, handles):
-    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=2)
+def _point_legend(fig, axes, own, handles):
+    _legend(fig, axes, own, "lower center", handles=handles, fontsize=8, ncols=2)
 
 
-def _theta_axes(branches, ylabels, height=5.0):
-    fig = Figure(figsize=(7.5, height), layout="constrained")
-    axes = fig.subplots(len(ylabels), 1, sharex=True, squeeze=False)[:, 0]
+def _theta_axes(branches, ylabels, height=5.0, axes=None):
+    fig, axes, own = _panels(axes, len(ylabels), (7.5, height), nrows=len(ylabels), ncols=1, sharex=True,
+                             squeeze=False)
+    axes = axes.ravel()
     for ax, label in zip(axes, ylabels):
         ax.set_ylabel(label)
         ax.axhline(0.0, color="0.6", linewidth=0.6)
-    axes[-1].set_xlabel(THETA_LABEL)
-    axes[-1].set_xlim(0.0, np.pi)
-    axes[-1].set_xticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
-    fig.suptitle(_per_point_title(branches), fontsize=10)
-    return fig, axes
+    for ax in axes[-1:] if own else axes:  # the caller's Axes need not share x
+        ax.set_xlabel(THETA_LABEL)
+        ax.set_xlim(0.0, np.pi)
+        ax.set_xticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
+    _suptitle(fig, axes, own, _per_point_title(branches))
+    return fig, axes, own
 
 
-def plot_shapes(branches, points=None) -> Figure:
+def plot_shapes(branches, points=None, axes=None) -> Figure:
     """Deformed meridian sections (ρ, η) and their mirror (−ρ, η), equal aspect, coils at (±a, h)."""
-    fig = Figure(figsize=(6.4, 7.6), layout="constrained")
-    ax = fig.add_subplot()
+    fig, panels, own = _panels(axes, 1, (6.4, 7.6))
+    ax = panels[0]
     ax.set_aspect("equal")
     psi = np.linspace(0, 2 * np.pi, 200)
     ax.plot(np.cos(psi), np.sin(psi), color="0.6", linewidth=0.8, linestyle=":")
@@ -333,13 +382,13 @@ def plot_shapes(branches, points=None) -> Figure:
     ax.set_xlabel(r"$\pm\rho/R_0$ (distance from the axis)")
     ax.set_ylabel(r"$\eta/R_0$ (height)")
     ax.set_title(_per_point_title(branches), fontsize=10)
-    _point_legend(fig, handles)
+    _point_legend(fig, panels, own, handles)
     return fig
 
 
-def plot_stresses(branches, points=None) -> Figure:
+def plot_stresses(branches, points=None, axes=None) -> Figure:
     """σ_θ and σ_φ against θ: elastic stresses solid; with the paper's magnetic additions dashed (M > 0)."""
-    fig, axes = _theta_axes(branches, [r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"], height=7.2)
+    fig, axes, own = _theta_axes(branches, [r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"], 7.2, axes)
     handles = []
     for label, color, q, b in _configurations(branches, points):
         for ax, key in zip(axes, ("sigma_theta", "sigma_phi")):
@@ -350,32 +399,34 @@ def plot_stresses(branches, points=None) -> Figure:
     handles.append(Line2D([], [], color="k", label="elastic"))
     if any(b.M > 0 for b in branches):
         handles.append(Line2D([], [], color="k", linestyle="--", label="elastic + paper's magnetic terms"))
-    _point_legend(fig, handles)
+    _point_legend(fig, axes, own, handles)
     return fig
 
 
-def plot_field(branches, points=None) -> Figure:
+def plot_field(branches, points=None, axes=None) -> Figure:
     """Applied field on the deformed surface: H_θ (meridional tangent) and H_ζ (outward normal) against θ."""
     if not any(b.coils for b in branches):
         raise PlotError("no coils in these run files: the applied field is zero everywhere")
-    fig, axes = _theta_axes(branches, [r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"], height=7.2)
+    fig, axes, own = _theta_axes(branches, [r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"], 7.2,
+                                 axes)
     handles = []
     for label, color, q, _ in _configurations([b for b in branches if b.coils], points):
         axes[0].plot(q["theta"], q["H_theta"], color=color, linewidth=1.4)
         axes[1].plot(q["theta"], q["H_zeta"], color=color, linewidth=1.4)
         handles.append(Line2D([], [], color=color, label=label))
-    _point_legend(fig, handles)
+    _point_legend(fig, axes, own, handles)
     return fig
 
 
-def plot_curvature(branches, points=None) -> Figure:
+def plot_curvature(branches, points=None, axes=None) -> Figure:
     """Gaussian curvature κ R0² of the deformed surface against θ."""
-    fig, (ax,) = _theta_axes(branches, [r"Gaussian curvature $\kappa R_0^2$"])
+    fig, axes, own = _theta_axes(branches, [r"Gaussian curvature $\kappa R_0^2$"], axes=axes)
+    ax = axes[0]
     handles = []
     for label, color, q, _ in _configurations(branches, points):
         ax.plot(q["theta"], q["gaussian_curvature"], color=color, linewidth=1.4)
         handles.append(Line2D([], [], color=color, label=label))
-    _point_legend(fig, handles)
+    _point_legend(fig, axes, own, handles)
     return fig
 
 
@@ -388,15 +439,14 @@ def _amplitude_range(e2, e3, e4) -> float:
     return float(np.clip(1.5 * scale, 0.04, 0.5))
 
 
-def plot_energy(branches) -> Figure:
+def plot_energy(branches, axes=None) -> Figure:
     """Energy landscape E(Λ) − E0 = E2Λ² + E3Λ³ + E4Λ⁴ along the critical mode at each branch point (the
     special points with finite E2, E3, E4, written by the stability analysis)."""
     if not any(b.bifurcations for b in branches):
-        files = ", ".join(dict.fromkeys(str(b.path) for b in branches))
+        files = ", ".join(dict.fromkeys(str(b.source) for b in branches))
         raise PlotError(f"{files}: no bifurcation data (no special point with finite special_points/E2, E3, E4, "
                         "which the stability analysis writes); the energy landscape cannot be drawn")
-    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
-    ax = fig.add_subplot()
+    fig, (ax,), _ = _panels(axes, 1, (6.4, 4.8))
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     styles = ["-", "--", "-.", ":"]
     drawn = 0
@@ -419,14 +469,15 @@ def plot_energy(branches) -> Figure:
 PARAMETER_LABELS = {"M": r"field intensity $M$", "alpha1": r"Ogden exponent $\alpha_1$ ($\sum\mu_i\alpha_i = 4$)"}
 
 
-def plot_phase(paths) -> Figure:
+def plot_phase(paths, axes=None) -> Figure:
     """Phase diagram from two-parameter curves (files written by ``io.curve_file.write_curve``): the pear
     bifurcation pressure against the second parameter q; the two pitchforks of an isola meet where q turns
     back (the critical q, marked); the region where the isola exists (q between its start and the critical
     value, P between the two pitchfork pressures) is shaded."""
-    fig = Figure(figsize=(6.4, 4.6), constrained_layout=True)
-    ax = fig.add_subplot()
+    fig, (ax,), _ = _panels(axes, 1, (6.4, 4.6))
     parameters = set()
+    if any(isinstance(path, dict) for path in paths):
+        raise PlotError("phase draws curve files (balloon-cg critical) or sweep files, not runs")
     for path in paths:
         with h5py.File(path, "r") as f:
             names = list(f.get("two_parameter", {}))

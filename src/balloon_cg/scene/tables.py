@@ -8,6 +8,7 @@ import math
 import re
 import tomllib
 from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import field as dataclass_field
 from pathlib import Path
 
 from .validation import SceneError, number, show, show_key, table
@@ -125,7 +126,12 @@ class Scene:
     solver: Solver
     stability: Stability
     output: Output
-    text: str
+    text: str = dataclass_field(repr=False)
+
+    @classmethod
+    def from_toml(cls, path) -> "Scene":
+        """The scene of a TOML file (``load_scene``)."""
+        return load_scene(path)
 
     def to_dict(self) -> dict:
         """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded)."""
@@ -141,19 +147,41 @@ class Scene:
         """TOML text of ``to_dict()``; parsing it gives back this scene (apart from ``text``)."""
         return _to_toml(self.to_dict())
 
-    def with_overrides(self, overrides: dict[str, object]) -> "Scene":
+    def with_overrides(self, overrides: dict[str, object], name: str | None = None) -> "Scene":
         """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``.
 
-        ``material.preset`` replaces the whole material; a value None restores the default.
+        ``material.preset`` replaces the whole material; a value None restores the default. The copy is named
+        ``name``, or after what changed physically: each field or material key's token in the name
+        (``_M0.002``, ``_radius4``) takes the new value, or is appended (numerical keys keep the name).
         """
         data = self.to_dict()
         try:
             for key, value in overrides.items():
                 _assign(data, key, value)
-            scene = _build(data, self.name, "")
+            scene = _build(data, name or renamed(self.name, overrides), "")
         except SceneError as e:
             raise SceneError(f"{self.name}: {e}") from None
         return replace(scene, text=scene.to_toml())
+
+
+def renamed(name: str, overrides: dict[str, object]) -> str:
+    """``name`` with a ``_<key><value>`` token per scalar field or material override (key: the last part of
+    the dotted key, with its list index past 0: ``radius3.5``, ``radius1=3.5``; a string: itself, reduced to
+    filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
+    (``field.coils``, ``material.mu``) leave the name alone."""
+    for key, value in overrides.items():
+        if key.split(".")[0] not in ("field", "material") or value is None or isinstance(value, (list, tuple, dict)):
+            continue
+        if isinstance(value, str):  # a preset or a material name
+            name = f"{name}_{re.sub(r'[^A-Za-z0-9.+-]+', '-', value).strip('-').lower()}"
+            continue
+        indices = "".join(i for i in re.findall(r"\[(\d+)\]", key) if i != "0")
+        short = re.sub(r"\[\d+\]", "", key.split(".")[-1]) + (f"{indices}=" if indices else "")
+        text = f"{value:g}" if isinstance(value, (int, float)) and not isinstance(value, bool) else str(value)
+        token = re.compile(rf"(^|_){re.escape(short)}-?[0-9][0-9.eE+-]*(?=_|$)")
+        name = token.sub(lambda m: f"{m.group(1)}{short}{text}", name, count=1) if token.search(name) \
+            else f"{name}_{short}{text}"
+    return name
 
 
 def parse_scene(text: str, name: str = "scene") -> Scene:
@@ -162,13 +190,26 @@ def parse_scene(text: str, name: str = "scene") -> Scene:
 
 
 def load_scene(path) -> Scene:
-    """Read a scene file; the scene is named after the file stem, error messages after the file name."""
+    """Read a scene file; the scene is named after the file stem, error messages after the file name. A bare
+    name that is not a file (``"spom1"``, ``"spom1.toml"``) names a scene shipped with the package
+    (``shipped_scenes()``)."""
     path = Path(path)
+    shipped = path.name.removesuffix(".toml")
+    if not path.exists() and path.parent == Path(".") and shipped in shipped_scenes():
+        path = shipped_scenes()[shipped]
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as e:
         raise SceneError(f"{path.name}: not UTF-8 text ({e})") from None
     return _parse(text, path.stem, path.name)
+
+
+def shipped_scenes() -> dict[str, Path]:
+    """The scenes shipped with the package (the repository's scenes/ folder): {name: path}."""
+    from importlib import resources
+
+    folder = resources.files("balloon_cg.scenes")
+    return {item.name.removesuffix(".toml"): Path(str(item)) for item in folder.iterdir() if item.name.endswith(".toml")}
 
 
 def _parse(text: str, name: str, source: str) -> Scene:

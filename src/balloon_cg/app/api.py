@@ -1,0 +1,210 @@
+"""The Python API (docs/api.md): a scene in, a ``Result`` out.
+
+    trace(scene) -> Result             the primary branch
+    analyse(scene) -> Result           the whole picture: stability, branch points, pear branches, snap-throughs
+    load(path) -> Result               a run file
+    plot(source, what, ax=None) -> matplotlib Figure, from Results or run files
+
+A ``Result`` is plain data: the content of its run file (``image``, the bytes of the HDF5 file that ``save``
+writes, and the same content read into arrays, ``run``, laid out as ``io.run_file.read_run`` returns it) and,
+when it was computed in this process, the analysis objects (``picture``: branches with their assessments).
+Tables come from the same content: ``to_dataframe`` (pandas) and ``to_xarray`` (xarray; named dimensions and
+units, read from the file image through h5netcdf), both from the optional extra ``balloon-cg[analysis]``.
+"""
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.picture import Phase
+from ..io.hdf5 import atomic_bytes, command_line
+from ..io.run_file import read_run, read_run_image, run_image
+from ..numerics.interrupt import stop_on_signals
+from ..scene import Scene, load_scene, parse_scene
+from .progress import PhaseBars
+
+EXTRA = "pip install 'balloon-cg[analysis]'"
+
+
+def _optional(module: str, what: str):
+    try:
+        return __import__(module)
+    except ImportError:
+        raise ImportError(f"{what} needs {module}, which is not installed: {EXTRA}") from None
+
+
+@dataclass(frozen=True, repr=False)
+class BranchData:
+    """One stored branch: ``data`` is its read_run() dict (per-point arrays, 'attrs', 'profiles',
+    'special_points', 'stability'); ``branch['pressure']`` indexes it."""
+
+    name: str
+    data: dict
+
+    def __getitem__(self, key: str):
+        return self.data[key]
+
+    def __len__(self) -> int:
+        return len(self.data["pressure"])
+
+    @property
+    def attrs(self) -> dict:
+        return self.data["attrs"]
+
+    @property
+    def special_points(self) -> list[dict]:
+        return self.data["special_points"]
+
+    def columns(self) -> dict:
+        """The per-point columns: every 1-D per-point dataset and the stability flags."""
+        n = len(self)
+        flat = {k: v for k, v in self.data.items()
+                if isinstance(v, np.ndarray) and v.shape == (n,) and k != "point"}
+        flags = {k: v for k, v in self.data.get("stability", {}).items() if k.startswith("stable")}
+        return flat | flags
+
+    def to_dataframe(self):
+        """A pandas DataFrame, one row per point (index ``point``)."""
+        pd = _optional("pandas", "to_dataframe")
+        return pd.DataFrame(self.columns()).rename_axis("point")
+
+    def __repr__(self):
+        P, north = self.data["pressure"], self.data["lam2_north"]
+        return (f"BranchData({self.name!r}, {len(self)} points, P {P.min():.4g}..{P.max():.4g}, "
+                f"λ2(0) {north.min():.4g}..{north.max():.4g}, {len(self.special_points)} special points)")
+
+
+@dataclass(frozen=True, repr=False)
+class Result:
+    """A computed or loaded run: ``scene``; ``image``, the bytes of its run file (what ``save`` writes);
+    ``run``, the same content as arrays (io.run_file.read_run's layout); ``picture``, the analysis objects when
+    computed in this process (else None). Tables: ``branches``, ``special_points``, ``to_dataframe``,
+    ``to_xarray``; verdict: ``complete``, ``incomplete``."""
+
+    scene: Scene
+    image: bytes
+    run: dict
+    picture: object = None
+
+    @classmethod
+    def of(cls, scene: Scene, branches, snaps=None, found=None, picture=None, command: str = "") -> "Result":
+        image = run_image(scene, branches, {"command": command or command_line()}, snaps, found)
+        return cls(scene, image, read_run_image(image, scene.name), picture)
+
+    @property
+    def branches(self) -> dict[str, BranchData]:
+        """The stored branches by name, the primary branch first."""
+        return {name: BranchData(name, data) for name, data in self.run["branches"].items()}
+
+    @property
+    def special_points(self) -> list[dict]:
+        """Every special point of every branch (dicts of the stored columns, with 'branch')."""
+        return [{"branch": name, **s} for name, b in self.run["branches"].items() for s in b["special_points"]]
+
+    @property
+    def snap_throughs(self) -> list[dict]:
+        return self.run["snap_throughs"]
+
+    @property
+    def complete(self) -> bool:
+        """Every branch reached its requested end, every special point is located, stability is settled."""
+        return bool(self.run["attrs"].get("complete", False))
+
+    @property
+    def incomplete(self) -> list[str]:
+        """What is incomplete, one line each ('gap (branch: message)')."""
+        a = self.run["attrs"]
+        return [f"{gap} ({branch}: {message})" for gap, branch, message in
+                zip(a.get("incomplete_gaps", []), a.get("incomplete_branches", []), a.get("incomplete_messages", []))]
+
+    def to_dataframe(self, table: str = "points"):
+        """A pandas DataFrame: ``"points"``, one row per point of every branch (columns branch, point, then the
+        per-point columns), or ``"special"``, one row per special point."""
+        pd = _optional("pandas", "to_dataframe")
+        if table == "special":
+            return pd.DataFrame(self.special_points)
+        if table != "points":
+            raise ValueError(f"table = {table!r}: must be 'points' or 'special'")
+        frames = [b.to_dataframe().reset_index().assign(branch=name) for name, b in self.branches.items()]
+        frame = pd.concat(frames, ignore_index=True)
+        return frame[["branch", *[c for c in frame.columns if c != "branch"]]]
+
+    def to_xarray(self, branch: str = "primary", part: str = "points"):
+        """An xarray Dataset of one branch, read from the file image with named dimensions and units:
+        ``"points"`` (dims point, unknown, theta: the per-point columns, profiles and stability) or
+        ``"special"`` (dim special)."""
+        _optional("h5netcdf", "to_xarray")
+        xr = _optional("xarray", "to_xarray")
+        if branch not in self.run["branches"]:
+            raise KeyError(f"no branch {branch!r} (branches: {', '.join(self.run['branches'])})")
+        groups = {"points": ["", "/profiles"] + (["/stability"] if "stability" in self.run["branches"][branch]
+                                                  else []),
+                  "special": ["/special_points"]}
+        if part not in groups:
+            raise ValueError(f"part = {part!r}: must be 'points' or 'special'")
+        parts = []
+        for group in groups[part]:
+            with xr.open_dataset(io.BytesIO(self.image), engine="h5netcdf", group=f"branches/{branch}{group}") as ds:
+                parts.append(ds.load())
+        return xr.merge(parts, combine_attrs="override")
+
+    def save(self, path, force: bool = False) -> Path:
+        """Write the run file (atomically; an existing file only with ``force``)."""
+        try:
+            return atomic_bytes(path, self.image, force)
+        except FileExistsError as e:
+            raise FileExistsError(e.errno, "already exists (save(..., force=True) replaces it)", e.filename) from None
+
+    def __repr__(self):
+        branches = ", ".join(f"{name} ({len(b['pressure'])} points)" for name, b in self.run["branches"].items())
+        n = len(self.incomplete)
+        state = "complete" if self.complete else f"incomplete: {n} part{'s' * (n != 1)}"
+        return (f"Result({self.scene.name!r}: {branches}; {len(self.special_points)} special points, "
+                f"{len(self.snap_throughs)} snap-throughs; {state})")
+
+
+def _scene(scene) -> Scene:
+    return scene if isinstance(scene, Scene) else load_scene(scene)
+
+
+def trace(scene, progress: bool = False) -> Result:
+    """The primary branch of ``scene`` (a Scene or a TOML path). Ctrl-C (SIGINT) stops it at the next point
+    and returns what is finished, flagged incomplete."""
+    from ..analysis.primary import trace_primary
+    from ..analysis.verdict import incomplete
+
+    scene = _scene(scene)
+    with PhaseBars(scene.name, progress) as bars, stop_on_signals():
+        branch = trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))
+        bars.finish(Phase.PRIMARY, len(branch.X))
+    return Result.of(scene, [branch], found=incomplete([branch]), command=f"balloon_cg.trace({scene.name!r})")
+
+
+def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
+    """The whole picture of ``scene`` (a Scene or a TOML path): primary branch, stability of every point,
+    branch points located and classified, pear branches (``pear=False``: not traced), snap-throughs
+    (analysis.picture). Ctrl-C (SIGINT) stops at the next point and returns what is finished, flagged."""
+    from ..analysis.picture import analyse as analyse_picture
+
+    scene = _scene(scene)
+    with PhaseBars(scene.name, progress) as bars, stop_on_signals():
+        picture = analyse_picture(scene, bars, pear=pear)
+    return Result.of(scene, picture.branches, picture.snaps, picture.incomplete, picture,
+                     command=f"balloon_cg.analyse({scene.name!r})")
+
+
+def load(path) -> Result:
+    """The Result stored in a run file."""
+    run = read_run(path)
+    scene = parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
+    return Result(scene, Path(path).read_bytes(), run)
+
+
+def plot(source, what: str = "pressure-pole", ax=None, points=None, branch: str | None = None):
+    """A matplotlib Figure of kind ``what`` (docs/plots.md) from Results or run files (one or a list); drawn
+    into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given."""
+    from ..post.plotting import plot as draw
+
+    sources = source if isinstance(source, (list, tuple)) else [source]
+    return draw([s.run if isinstance(s, Result) else s for s in sources], what, points, branch, axes=ax)

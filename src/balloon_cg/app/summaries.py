@@ -1,0 +1,216 @@
+"""Summaries of stored files for people and for JSON: run files, sweep files and two-parameter curve files."""
+from pathlib import Path
+
+import numpy as np
+
+
+def summarise_file(path) -> tuple[dict, str]:
+    """(JSON-ready summary, readable text) of a run, sweep or curve file, told apart by their format and
+    content (raises the readers' errors for anything else)."""
+    import h5py
+
+    from ..io.run_file import RunFileError, read_run
+
+    path = Path(path)
+    kind = None
+    if path.is_file():
+        try:
+            with h5py.File(path, "r") as f:
+                kind = "sweep" if str(f.attrs.get("format", "")).startswith("balloon-cg-sweep") else \
+                    "curve" if len(f.get("two_parameter", {})) else "run"
+        except OSError:
+            raise RunFileError(f"{path}: not a readable HDF5 file") from None
+    if kind == "sweep":
+        summary = summarise_sweep(path)
+        return summary, format_sweep(summary)
+    if kind == "curve":
+        summary = summarise_curves(path)
+        return summary, format_curves(summary)
+    run = read_run(path)
+    return summarise_run(run), format_run(run)
+
+
+def summarise_sweep(path) -> dict:
+    """Provenance and, per member, its overrides, verdict and the primary branch's summary."""
+    from ..io.sweep_file import read_sweep
+
+    sweep = read_sweep(path)
+    members = {}
+    for index, member in sweep["members"].items():
+        primary = member["branches"].get("primary")
+        members[index] = {"overrides": member["overrides"],
+                          "complete": bool(member["attrs"].get("complete", False)),
+                          "branches": {name: len(b["pressure"]) for name, b in member["branches"].items()},
+                          "primary": summarise_branch(primary) if primary is not None else None}
+    return {"file": str(path), "kind": "sweep", "provenance": sweep["attrs"], "members": members}
+
+
+def format_sweep(summary: dict) -> str:
+    p = summary["provenance"]
+    lines = [f"file           {summary['file']}", f"sweep of      {p.get('scene_name', '?')}",
+             f"created        {p.get('created', '?')}  (balloon-cg {p.get('package_version', '?')}, "
+             f"format {p.get('format')})", f"command        {p.get('command', '?')}",
+             f"members        {len(summary['members'])}", ""]
+    for index, m in summary["members"].items():
+        settings = ", ".join(f"{k} = {v}" for k, v in m["overrides"].items())
+        branches = ", ".join(f"{name} ({n} points)" for name, n in m["branches"].items())
+        specials = len(m["primary"]["special_points"]) if m["primary"] else 0
+        lines.append(f"  member {index:<4} {settings}: {'complete' if m['complete'] else 'INCOMPLETE'}; "
+                     f"{branches}; {specials} special points on the primary branch")
+    return "\n".join(lines)
+
+
+def summarise_curves(path) -> dict:
+    """Provenance and, per two-parameter curve, its parameter, end, critical value and ranges."""
+    import h5py
+
+    from ..io.curve_file import read_curve
+    from ..io.hdf5 import plain
+
+    with h5py.File(path, "r") as f:
+        attrs = {k: plain(v) for k, v in f.attrs.items()}
+        names = list(f["two_parameter"])
+    curves = {}
+    for name in names:
+        c = read_curve(path, name)
+        curves[name] = {**{k: c["attrs"][k] for k in ("parameter", "end", "end_description", "q0", "critical_q",
+                                                      "degree", "wall_time")},
+                        "points": len(c["q"]), "q": _range(c["q"]), "pressure": _range(c["pressure"]),
+                        "special_points": c["special_points"]}
+    return {"file": str(path), "kind": "curve", "provenance": attrs, "curves": curves}
+
+
+def format_curves(summary: dict) -> str:
+    p = summary["provenance"]
+    lines = [f"file           {summary['file']}", f"scene          {p.get('scene_name')}",
+             f"created        {p.get('created')}  (balloon-cg {p.get('package_version')}, format {p.get('format')})",
+             f"command        {p.get('command')}"]
+    for name, c in summary["curves"].items():
+        critical = c["critical_q"]
+        lines += ["", f"two-parameter curve {name}   (in {c['parameter']}, degree {c['degree']})",
+                  f"  points               {c['points']}",
+                  "  {:<20} {:.10g} .. {:.10g}".format(c["parameter"], *c["q"]),
+                  "  pressure             {:.10g} .. {:.10g}".format(*c["pressure"]),
+                  f"  ended                {c['end']}: {c['end_description']}",
+                  f"  critical value       {critical:.12g}" if np.isfinite(critical) else
+                  "  critical value       none (the curve did not end in a verified merge)",
+                  f"  wall time            {c['wall_time']:.3f} s"]
+    return "\n".join(lines)
+
+
+def summarise_run(run: dict) -> dict:
+    """JSON-ready summary of read_run() output: provenance and one summary per branch."""
+    return {
+        "file": run["path"],
+        "scene_name": run["scene_name"],
+        "provenance": run["attrs"],
+        "branches": {name: summarise_branch(b) for name, b in run["branches"].items()},
+        "snap_throughs": run.get("snap_throughs", []),
+    }
+
+
+def summarise_branch(b: dict) -> dict:
+    """Points, ranges, special points, accuracy and run time of one stored branch."""
+    n, attrs = len(b["pressure"]), b["attrs"]
+    wall = float(attrs["wall_time"])
+    return {
+        "points": n,
+        "pressure": _range(b["pressure"]),
+        "lam2_north": _range(b["lam2_north"]),
+        "lam2_south": _range(b["lam2_south"]),
+        "special_points": b["special_points"],
+        "stop_reason": attrs["stop_reason"],
+        "stop_codes": dict(zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", []))),
+        "max_residual": float(b["residual"].max()),
+        "max_error_estimate": float(b["error_estimate"].max()),
+        "wall_time": wall,
+        "wall_time_per_point": wall / n,
+        "degree": int(attrs["degree"]),
+        "symmetric": bool(attrs["symmetric"]),
+        "basis_map": {"centres": [float(c) for c in attrs.get("map_centres", [])],
+                      "widths": [float(w) for w in attrs.get("map_widths", [])]},
+        "kernel_class": attrs["kernel_class"],
+        "M": float(attrs["M"]),
+        "chi": float(attrs["chi"]),
+        "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
+        "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
+    }
+
+
+def _range(values) -> list:
+    return [float(np.min(values)), float(np.max(values))]
+
+
+def format_run(run: dict) -> str:
+    """Readable summary of read_run() output."""
+    summary = summarise_run(run)
+    p = summary["provenance"]
+    lines = [
+        f"file           {summary['file']}",
+        f"scene          {summary['scene_name']}",
+        f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
+        f"command        {p['command']}",
+        f"tolerance      {p['tolerance']:g}",
+        f"kernels        digest {p['generated_digest'][:16]}…",
+        f"result         {_verdict(p)}",
+    ]
+    for name, b in summary["branches"].items():
+        lines += ["", *_format_branch(name, b)]
+    for s in summary["snap_throughs"]:
+        target = f"{s['to_branch']} point {s['to_index']}" if s["to_branch"] else "no stable state on the traced branches"
+        lines.append(f"snap-through at P = {s['pressure']:.10g}: {s['from_branch']} point {s['from_index']} -> {target}")
+    return "\n".join(lines)
+
+
+def _verdict(attrs: dict) -> str:
+    """'complete', or the incomplete parts stored in a run file's root attributes."""
+    if "complete" not in attrs:
+        return "not assessed"
+    if attrs["complete"]:
+        return "complete"
+    parts = [f"{gap} ({branch}: {message})" for gap, branch, message in
+             zip(attrs["incomplete_gaps"], attrs["incomplete_branches"], attrs["incomplete_messages"])]
+    return "incomplete: " + "; ".join(parts)
+
+
+def _format_branch(name: str, b: dict) -> list[str]:
+    lines = [
+        f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
+        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
+        *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
+           f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]
+          if b["basis_map"]["centres"] else []),
+        f"  points               {b['points']}",
+        "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
+        "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
+        "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
+        f"  stop reason          {b['stop_reason']}",
+        f"  max residual         {b['max_residual']:.3e}",
+        f"  max error estimate   {b['max_error_estimate']:.3e}",
+        f"  wall time            {b['wall_time']:.3f} s",
+        f"  error estimate vs run time: {b['max_error_estimate']:.3e} max, "
+        f"{1e3 * b['wall_time_per_point']:.2f} ms per point",
+        f"  stable points        {b['stable_points'] or 'not assessed'}",
+        f"  special points       {len(b['special_points']) or 'none'}",
+    ]
+    for s in b["special_points"]:
+        note = f"  {s['note']}" if s["note"] else ""
+        status = "" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})"
+        label = f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "") + status
+        lines.append(
+            f"    {label:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
+            f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
+        )
+    return lines
+
+
+def format_table(values: dict) -> str:
+    """Two aligned columns: name, value."""
+    width = max(map(len, values))
+    return "\n".join(f"{k:<{width}}  {_show(v)}" for k, v in values.items())
+
+
+def _show(v) -> str:
+    if isinstance(v, bool):
+        return str(v).lower()
+    return f"{v:.12g}" if isinstance(v, float) else str(v)

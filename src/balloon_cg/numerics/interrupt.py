@@ -1,0 +1,43 @@
+"""Cooperative interrupts: SIGINT or SIGTERM asks the computation to stop at its next point.
+
+``with stop_on_signals():`` installs handlers that only set a flag; the continuation driver's callers check
+``requested()`` at every point and end their work there (``StopCode.INTERRUPTED``), so what is finished can
+still be written. A second signal while the first is pending raises KeyboardInterrupt at once. On exit the
+previous handlers are restored and the flag cleared.
+"""
+import signal
+import threading
+from contextlib import contextmanager
+
+_flag = threading.Event()
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def requested() -> bool:
+    """Whether a stop was asked for (by a signal or ``request``)."""
+    return _flag.is_set()
+
+
+def request() -> None:
+    _flag.set()
+
+
+def _handler(signum, frame):
+    if _flag.is_set():
+        raise KeyboardInterrupt
+    _flag.set()
+
+
+@contextmanager
+def stop_on_signals():
+    """Turn SIGINT/SIGTERM into ``requested()`` for the duration (main thread only; elsewhere a no-op)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.signal(s, _handler) for s in SIGNALS}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        _flag.clear()

@@ -1,0 +1,107 @@
+"""The public API: docs/api.md's example runs end to end; Results are short to print, save and load exactly,
+and tabulate what the run file holds."""
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import balloon_cg as bc
+from balloon_cg.io.run_file import read_run
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "scenes"
+
+
+def example() -> str:
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "api.md").read_text(encoding="utf-8"), re.S)
+    assert len(blocks) == 1
+    return blocks[0]
+
+
+def test_the_documented_example_runs(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    namespace = {}
+    exec(compile(example(), "docs/api.md", "exec"), namespace)  # our own documentation, not user input
+    result, fig = namespace["result"], namespace["fig"]
+    assert (tmp_path / "spom1.png").stat().st_size > 10_000 and (tmp_path / "spom1.h5").exists()
+    left, right = fig.axes[:2]
+    assert "pole stretch" in left.get_xlabel() and "pressure" in left.get_ylabel()
+    assert "rho" in right.get_xlabel()
+    assert len(left.get_lines()) >= len(result.branches)  # every branch drawn into the caller's Axes
+    printed = capsys.readouterr().out
+    assert printed.startswith("Result('spom1'") and "long_name" not in printed
+
+
+@pytest.fixture(scope="module")
+def result():
+    scene = bc.Scene.from_toml(SCENES / "spom1.toml").with_overrides({"continuation.stop_stretch": 3.0})
+    return bc.analyse(scene)
+
+
+def test_result_tables_match_the_run_file(result, tmp_path):
+    path = result.save(tmp_path / "r.h5")
+    stored = read_run(path)
+    table = result.to_dataframe()
+    assert set(table.branch) == set(stored["branches"])
+    for name, data in stored["branches"].items():
+        rows = table[table.branch == name]
+        assert np.array_equal(rows.pressure.to_numpy(), data["pressure"])
+        assert np.array_equal(rows.stable_pressure.to_numpy(), data["stability"]["stable_pressure"])
+    special = result.to_dataframe("special")
+    assert len(special) == sum(len(b["special_points"]) for b in stored["branches"].values())
+    assert set(special.kind) <= {"LP", "TP", "BP", "EP", "UZ"} and all(isinstance(k, str) for k in special.kind)
+
+
+def test_save_load_round_trip_is_exact(result, tmp_path):
+    path = result.save(tmp_path / "r.h5")
+    assert path.read_bytes() == result.image
+    again = bc.load(path)
+    assert again.scene == result.scene and again.complete == result.complete
+    assert again.to_dataframe().equals(result.to_dataframe())
+    with pytest.raises(FileExistsError):
+        result.save(path)
+
+
+def test_reprs_are_short(result):
+    assert len(repr(result)) < 300 and len(repr(result.picture)) < 300 and len(repr(result.scene)) < 1000
+    assert all(len(repr(b)) < 200 for b in result.branches.values())
+    assert all(len(repr(s)) < 200 for b in result.picture.branches for s in b.special)
+
+
+def test_bad_plot_arguments_are_plot_errors(result):
+    for points in ([], 5, ["a"]):
+        with pytest.raises(bc.PlotError, match="points"):
+            bc.plot(result, "shapes", points=points)
+    with pytest.raises(bc.PlotError, match="not matplotlib Axes"):
+        bc.plot(result, "shapes", ax=42)
+
+
+def test_plot_panels_must_match(result):
+    import matplotlib.figure
+
+    fig = matplotlib.figure.Figure()
+    ax = fig.add_subplot()
+    with pytest.raises(bc_plot_error(), match="2 panels"):
+        bc.plot(result, "pressure-equator", ax=ax)
+    assert bc.plot(result, "pressure-equator", ax=fig.subplots(1, 2)) is fig
+
+
+def bc_plot_error():
+    from balloon_cg.post.plotting import PlotError
+    return PlotError
+
+
+def test_trace_and_load_from_paths(tmp_path):
+    traced = bc.trace(SCENES / "spom1.toml")
+    assert list(traced.branches) == ["primary"] and traced.complete
+    assert bc.plot(traced.save(tmp_path / "t.h5"), "pressure-pole").axes
+
+
+def test_import_is_light():
+    code = "import sys, balloon_cg; print(sorted(m for m in ('numpy', 'numba', 'matplotlib', 'h5py') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+    assert "numpy" not in dir(bc) and {"analyse", "trace", "load", "plot", "Scene"} <= set(dir(bc))

@@ -1,0 +1,141 @@
+"""CLI conventions: --version, python -m balloon_cg, run --set and the default output name, plot --what a,b,
+strict JSON from inspect (run, sweep and curve files), SIGINT on a running run."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import pytest
+
+import balloon_cg
+from balloon_cg.app.cli import main, strict_json
+from balloon_cg.io.run_file import read_run
+
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
+SMALL = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'
+
+
+def cli(*args, cwd=None, **kw):
+    return subprocess.run([sys.executable, "-m", "balloon_cg", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, **kw)
+
+
+def test_version_and_module_entry_point():
+    done = cli("--version")
+    assert done.returncode == 0 and done.stdout.strip() == f"balloon-cg {balloon_cg.__version__}"
+    done = cli("--help")
+    assert done.returncode == 0 and "run" in done.stdout and "Documentation:" in done.stdout
+    docs = done.stdout.split("Documentation:")[1].split()[0]
+    assert (Path(docs) / "plots.md").is_file()  # the help names installed documentation
+
+
+def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
+    scene = tmp_path / "small_M0.toml"
+    scene.write_text(SMALL)
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(scene), "--set", "continuation.stop_stretch=1.5", "--set", "solver.degree=30",
+                 "--primary-only", "--quiet"]) == 0
+    run = read_run(tmp_path / "small_M0.h5")  # numerical keys keep the name
+    assert run["branches"]["primary"]["lam2_north"].max() == pytest.approx(1.5, abs=1e-12)
+    assert "stop_stretch = 1.5" in run["attrs"]["scene_toml"] and "degree = 30" in run["attrs"]["scene_toml"]
+    # --max-points 15 stops the up leg short: written, flagged, exit 1
+    assert main(["run", str(scene), "--set", "M=0", "--set", "material.preset=TPOM1", "--max-points", "15",
+                 "--primary-only", "--quiet"]) == 1
+    run = read_run(tmp_path / "small_M0_tpom1.h5")  # renamed after the material
+    assert len(run["branches"]["primary"]["pressure"]) <= 2 * 15 + 1 and not run["attrs"]["complete"]
+
+
+@pytest.mark.parametrize("setting, words", [
+    ("field.M=-1", ("field.M = -1", ">= 0")),
+    ("nope=1", ("--set nope", "no table")),
+    ("M=0:1:3", ("--set M=0:1:3", "one value")),
+    ("continuation.max_points=abc", ("max_points", "abc")),
+    ("field.M", ("--set field.M", "KEY=VALUE")),
+    ("=3", ("KEY=VALUE",)),
+])
+def test_bad_set_is_one_line(tmp_path, capsys, setting, words):
+    out = tmp_path / "x.h5"
+    assert main(["run", str(SCENES / "spom1.toml"), "--set", setting, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("balloon-cg: error: ") and all(w in err for w in words), err
+    assert not out.exists()
+
+
+def test_shorthand_and_set_of_the_same_key_conflict(tmp_path, capsys):
+    assert main(["run", "spom1", "--set", "continuation.max_points=4", "--max-points", "3",
+                 "-o", str(tmp_path / "x.h5")]) == 2
+    assert "both given" in capsys.readouterr().err and not (tmp_path / "x.h5").exists()
+
+
+def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):
+    scene = tmp_path / "small.toml"
+    scene.write_text(SMALL)
+    run, sweep = tmp_path / "run.h5", tmp_path / "sweep.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    assert main(["sweep", str(scene), "--vary", "continuation.stop_stretch=1.5,1.6", "--primary-only",
+                 "--workers", "1", "-o", str(sweep), "--quiet"]) == 0
+    capsys.readouterr()
+    for path, kind in ((run, None), (sweep, "sweep")):
+        assert main(["inspect", str(path), "--json"]) == 0
+        text = capsys.readouterr().out
+        summary = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON constant {c}"))
+        assert summary.get("kind") == kind
+        assert main(["inspect", str(path)]) == 0
+        assert "file" in capsys.readouterr().out
+    assert len(summary["members"]) == 2
+    assert strict_json({"a": float("nan"), "b": [float("inf"), 1.0]}) == '{"a": null, "b": [null, 1.0]}'
+
+
+def test_plot_several_kinds_at_once(tmp_path, capsys):
+    scene = tmp_path / "small.toml"
+    scene.write_text(SMALL)
+    run = tmp_path / "run.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["plot", str(run), "--what", "pressure-pole,shapes", "-o", str(tmp_path / "fig.pdf")]) == 0
+    assert capsys.readouterr().out.split() == [str(tmp_path / "fig_pressure-pole.pdf"), str(tmp_path / "fig_shapes.pdf")]
+    with pytest.raises(SystemExit) as bad:
+        main(["plot", str(run), "--what", "pressure-pole,nonsense"])
+    assert bad.value.code == 2
+    assert "not a plot kind" in capsys.readouterr().err
+
+
+def test_sigint_writes_a_readable_partial_file_and_exits_130(tmp_path):
+    """A two-coil analysis takes ~20 s; interrupted after its primary branch started, it writes what is finished."""
+    out = tmp_path / "int.h5"
+    process = subprocess.Popen([sys.executable, "-m", "balloon_cg", "run", str(SCENES / "spom1_two_coils_M0.002.toml"),
+                                "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    deadline = time.monotonic() + 60
+    while b"primary branch" not in _peek(process) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(1.0)
+    started = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert time.monotonic() - started < 30
+    assert "Traceback" not in err and err.strip().splitlines()[-1].startswith("balloon-cg: interrupted")
+    run = read_run(out)
+    assert not run["attrs"]["complete"] and "interrupted" in run["attrs"]["incomplete_gaps"]
+    assert len(run["branches"]["primary"]["pressure"]) > 0
+    with h5py.File(out, "r") as f:
+        assert f.attrs["format"].startswith("balloon-cg/")
+
+
+def _peek(process) -> bytes:
+    """Whatever the process has written to stderr so far (non-blocking)."""
+    import fcntl
+
+    fd = process.stderr.fileno()
+    fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_NONBLOCK)
+    try:
+        chunk = os.read(fd, 1 << 16)
+    except BlockingIOError:
+        chunk = b""
+    process._peeked = getattr(process, "_peeked", b"") + chunk
+    return process._peeked
