@@ -1,5 +1,6 @@
 """User strain-energy formulas: the whitelist parser (nothing in the text runs), the reference-state checks,
 the on-demand kernel cache, and a formula for SPOM1's Ogden terms against the SPOM1 preset."""
+import ast
 import subprocess
 import sys
 import textwrap
@@ -53,7 +54,7 @@ def test_hostile_formulas_are_rejected_with_the_token_named_and_nothing_runs(cas
         print(repr((message, events)))
     """)
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
-    message, events = eval(out)  # our own script's repr of (str, list)
+    message, events = ast.literal_eval(out)
     assert token in message and "\n" not in message
     assert events == [] and not marker.exists()
 
