@@ -20,6 +20,7 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
+from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
@@ -72,7 +73,7 @@ def build_parser() -> argparse.ArgumentParser:
                                f"stability. Documentation: {docs_path('')}")
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels):
         add(commands)
     return parser
 

@@ -12,6 +12,8 @@ import numpy as np
 from .discretisation import Discretisation
 from ..model.field import field_squared_nodes
 from ..model.kernels import KernelSet
+from ..scene.energies import StrainEnergy
+from ..scene.formula import domain_conditions
 
 
 class NonFiniteState(ArithmeticError):
@@ -44,6 +46,7 @@ class Equilibrium:
         self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
         self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0, kernel_class=kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
+        self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
 
     def _field(self, lam2, sin_theta, eta):
         """H² and its derivatives at the nodes (zeros for a field class without coils)."""
@@ -63,7 +66,17 @@ class Equilibrium:
         return self._evaluate(kernel, self._node_values(geometry, state, field) | values, params)
 
     def _node_values(self, geometry: tuple, state: tuple, field) -> dict:
-        """The kernels' node arguments by name."""
+        """The kernels' node arguments by name; NonFiniteState if a node's stretches leave the material's domain
+        (a strain energy with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
+        if self._domain_check:
+            lam2, v, _, w = state
+            lam1 = np.hypot(lam2 * geometry[0] + v, w)
+            margins = self.kernels.nodes("domain_margins", {"lam1": lam1, "lam2": lam2})
+            violation = self.scene.material.domain_violation(margins, lam1, lam2)
+            if violation is not None:
+                node, what = violation
+                raise NonFiniteState(f"the membrane left the domain of {self.scene.material.name} at the node "
+                                     f"cos θ = {geometry[0][node]:.6g}: {what}")
         return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
