@@ -11,3 +11,5 @@ Stages (each a pure function, testable on its own):
 
 This package imports SymPy and never numba; the runtime (``balloon_cg``) never imports SymPy.
 """
+
+GENERATOR_VERSION = "2"  # part of every module's signature and of the on-demand cache key (no SymPy needed here)

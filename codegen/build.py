@@ -4,7 +4,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from . import equations, poles
-from . import second_variation
+from . import second_variation, stretch_derivatives
 from .classes import scene_classes
 from .emit import module_text
 from .functional import FIELD, GENERAL_TERMS, SceneClass
@@ -26,13 +26,26 @@ def layout() -> dict:
     }
 
 
-def class_module(cls: SceneClass) -> str:
-    """Module text of one scene class: Galerkin energy kernels, first-order system, pole series."""
+def class_module(cls: SceneClass, timings: dict | None = None) -> str:
+    """Module text of one scene class: Galerkin energy kernels, first-order system, pole series. ``timings``
+    (if given) receives the seconds spent per stage: 'derive' (equations, poles, second variation), 'lower'
+    (CSE), 'print'."""
+    start = time.perf_counter()
     kernels = equations.energy_kernels(cls) + equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
     # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient (codegen/second_variation.py)
     kernels += second_variation.second_variation_kernels(cls)
-    title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
-    return module_text(title, cls.inputs(), [lower(k) for k in kernels], GENERATOR, layout=layout())
+    if cls.energy is None:
+        title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
+    else:
+        kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
+        title = f"Kernels for scene class {cls.name}: strain energy {cls.energy[0]}, field {cls.field}."
+    derived = time.perf_counter()
+    lowered = [lower(k) for k in kernels]
+    cse = time.perf_counter()
+    text = module_text(title, cls.inputs(), lowered, GENERATOR, layout=layout())
+    if timings is not None:
+        timings.update(derive=derived - start, lower=cse - derived, print=time.perf_counter() - cse)
+    return text
 
 
 def field_module_text() -> str:
@@ -57,17 +70,22 @@ def all_modules(workers: int = 2):
 
 def registry_text() -> str:
     """``generated/__init__.py``: the index the runtime uses to pick a module for a scene."""
-    rows = []
+    rows, energy_rows = [], []
     for cls in scene_classes():
+        if cls.energy is not None:
+            energy_rows.append(f"    {cls.name!r}: ({cls.energy[0]!r}, {cls.field!r}),\n")
+            continue
         alphas = None if cls.alphas is None else tuple(float(a) for a in cls.alphas)
         rows.append(f"    {cls.name!r}: ({alphas!r}, {cls.field!r}),\n")
     return (
         '"""Kernels emitted by codegen/ (make regenerate). Never edit by hand.\n\n'
-        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field); the layout\n'
-        'constants are those of every class module (codegen/build.py: layout).\n"""\n'
+        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field), ENERGY_CLASSES\n'
+        'module name -> (canonical strain-energy formula, has field); the layout constants are those of every\n'
+        'class module (codegen/build.py: layout).\n"""\n'
         f"GENERAL_TERMS = {GENERAL_TERMS}\n"
         + "".join(f"{name} = {value!r}\n" for name, value in layout().items())
         + "CLASSES = {\n" + "".join(rows) + "}\n"
+        + "ENERGY_CLASSES = {\n" + "".join(energy_rows) + "}\n"
     )
 
 

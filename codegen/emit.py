@@ -7,10 +7,9 @@ and ``layout`` constants (e.g. ``HESSIAN_PAIRS``) name the row layouts the runti
 import hashlib
 import textwrap
 
+from . import GENERATOR_VERSION
 from .kernels import LoweredKernel, convention
 from .printer import print_expr
-
-GENERATOR_VERSION = "2"
 
 
 def _signature_line(lowered: LoweredKernel) -> str:

@@ -13,7 +13,7 @@ singular when the membrane is unstretched (its determinant is proportional to th
 """
 import sympy as sp
 
-from . import functional as fn
+from . import energies, functional as fn
 from .functional import FIELD, STATE, M, P, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, w
 from .kernels import Arg, Kernel
 
@@ -27,7 +27,9 @@ def pair_labels(symbols, pairs) -> tuple:
 
 
 def material_args(cls: SceneClass) -> list:
-    """μ, and α for the general class (runtime exponents)."""
+    """μ, and α for the general class (runtime exponents); a strain energy's parameters as ``material``."""
+    if cls.energy is not None:
+        return [Arg.param_array("material", energies.parameter_symbols(cls.energy))]
     args = [Arg.param_array("mu", fn.moduli(cls))]
     if cls.alphas is None:
         args.append(Arg.param_array("alpha", fn.exponents(cls)))

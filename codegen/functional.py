@@ -2,7 +2,7 @@
 
 Π(θ, λ2, v, η, w) = Φ(λ1, λ2) sin θ − ½ χ M H²(ρ, η) sin θ + ½ P λ2² w sin² θ,
 λ1 = sqrt((λ2 cos θ + v)² + w²), ρ = λ2 sin θ,
-Φ = Σ_i (μ_i/α_i)(λ1^α_i + λ2^α_i + (λ1 λ2)^(−α_i) − 3).
+Φ = Σ_i (μ_i/α_i)(λ1^α_i + λ2^α_i + (λ1 λ2)^(−α_i) − 3), or another strain energy (codegen/energies.py).
 
 H² is not symbolic: the field kernels supply its value and derivatives at the node, so Π carries a second-order
 Taylor proxy of H² about (ρ0, η0) and ``field_values`` puts ρ0 = ρ, η0 = η back after differentiation. This is
@@ -11,6 +11,8 @@ exact for every derivative of order ≤ 2, which is all the equations and Hessia
 from dataclasses import dataclass
 
 import sympy as sp
+
+from . import energies
 
 theta = sp.Symbol("theta", real=True)
 cos_theta, sin_theta = sp.symbols("cos_theta sin_theta", real=True)
@@ -28,17 +30,23 @@ GENERAL_TERMS = 3
 
 @dataclass(frozen=True)
 class SceneClass:
-    """What a kernel module is specialised to: Ogden exponents (None: runtime exponents) and field presence."""
+    """What a kernel module is specialised to: Ogden exponents (None: runtime exponents) and field presence,
+    or instead of Ogden a strain energy ``energy`` = (canonical formula, parameter names) (codegen/energies.py)
+    whose parameters the kernels take at run time."""
 
     name: str
     alphas: tuple | None
     field: bool
+    energy: tuple | None = None
 
     @property
     def n_terms(self) -> int:
         return GENERAL_TERMS if self.alphas is None else len(self.alphas)
 
     def inputs(self) -> dict:
+        if self.energy is not None:
+            return {"class": self.name, "energy": self.energy[0], "parameters": tuple(self.energy[1]),
+                    "field": self.field}
         alphas = "runtime" if self.alphas is None else tuple(str(a) for a in self.alphas)
         return {"class": self.name, "alphas": alphas, "field": self.field}
 
@@ -60,6 +68,13 @@ def ogden(cls: SceneClass, l1, l2):
     )
 
 
+def membrane_energy(cls: SceneClass, l1, l2):
+    """Φ(λ1, λ2) of the class: Ogden, or its strain energy formula."""
+    if cls.energy is not None:
+        return energies.membrane_energy(cls.energy, l1, l2)
+    return ogden(cls, l1, l2)
+
+
 def meridional_stretch(c, vv, ww, l2=lam2):
     return sp.sqrt((l2 * c + vv) ** 2 + ww**2)
 
@@ -77,7 +92,7 @@ def field_values(expr, rho):
 def energy_density(cls: SceneClass, c=cos_theta, s=sin_theta):
     """π̂ = Π / sin θ (the integrand per d(cos θ)), as a function of the node's (cos θ, sin θ) and state."""
     l1 = meridional_stretch(c, v, w)
-    density = ogden(cls, l1, lam2) + P * lam2**2 * w * s / 2
+    density = membrane_energy(cls, l1, lam2) + P * lam2**2 * w * s / 2
     if cls.field:
         density -= chi * M * _field_proxy(lam2 * s, eta) / 2
     return density

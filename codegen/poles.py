@@ -71,7 +71,7 @@ def pole_kernel(cls: SceneClass) -> Kernel:
     """``pole_series(lam0, P, [M, chi], mu, [alpha], [pole_field]) -> (c2_N, e2_N, c2_S, e2_S)``, pole_field =
     (Q_z_N, Q_rr_N, Q_z_S, Q_rr_S): H²_z and H²_ρρ on the axis at each pole (rows 'NAME_N' / 'NAME_S' of FIELD)."""
     l1, l2 = sp.symbols("l1 l2", positive=True)
-    energy = fn.ogden(cls, l1, l2)
+    energy = fn.membrane_energy(cls, l1, l2)
     lam0 = sp.Symbol("lam0", positive=True)
     outputs, field_symbols = [], []
     for pole in ("north", "south"):

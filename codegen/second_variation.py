@@ -36,7 +36,7 @@ import functools
 import sympy as sp
 from sympy.codegen.cfunctions import expm1, log1p
 
-from . import functional as fn
+from . import energies, functional as fn
 from .functional import SceneClass, cos_theta, eta, lam2, sin_theta, v, w
 from .equations import kernel_args, material_args, pair_labels
 from .kernels import Arg, Kernel
@@ -132,7 +132,7 @@ def second_order_density(cls: SceneClass, volume: str = "cone"):
 def material_stage(cls: SceneClass):
     """(p1, p2, p11, p12, p22) = derivatives of φ̂(e1, e2) = Φ(√e1, √e2) at (λ1², λ2²), as functions of (λ1, λ2)."""
     e1, e2 = sp.symbols("e1 e2", positive=True)
-    phi = fn.ogden(cls, sp.sqrt(e1), sp.sqrt(e2))
+    phi = fn.membrane_energy(cls, sp.sqrt(e1), sp.sqrt(e2))
     at = {e1: l1**2, e2: _l2**2}  # positive λ2 while deriving (no |λ2|), the state's lam2 afterwards
     d = lambda *xs: sp.diff(phi, *xs).subs(at).subs(_l2, lam2)  # noqa: E731
     return d(e1), d(e2), d(e1, e1), d(e1, e2), d(e2, e2)
@@ -165,6 +165,9 @@ def shear_coefficient(cls: SceneClass):
     expm1/log1p form (no cancellation) elsewhere."""
     p1_, p2_, p11_, p12_, _ = material_stage(cls)
     closed = (p1_ - p2_) / (l1**2 - lam2**2)
+    if cls.energy is not None:
+        expr, limit = energies.shear_coefficient(cls.energy, l1, lam2)
+        return expr, limit, closed
     limit = sp.simplify((p11_ - p12_).subs(l1, lam2))
     regular, singular = _divided_difference_terms(cls, l1, _l2)
     regular = regular.subs(_l2, lam2)

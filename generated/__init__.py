@@ -1,7 +1,8 @@
 """Kernels emitted by codegen/ (make regenerate). Never edit by hand.
 
-CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field); the layout
-constants are those of every class module (codegen/build.py: layout).
+CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field), ENERGY_CLASSES
+module name -> (canonical strain-energy formula, has field); the layout constants are those of every
+class module (codegen/build.py: layout).
 """
 GENERAL_TERMS = 3
 STATE = ('lam2', 'v', 'eta', 'w')
@@ -27,4 +28,14 @@ CLASSES = {
     'ogden_mooney_rivlin': ((2.0, -2.0), False),
     'ogden_mooney_rivlin_field': ((2.0, -2.0), True),
     'ogden_general_field': (None, True),
+}
+ENERGY_CLASSES = {
+    'rivlin': ('C10 * (I1 - 3) + C01 * (I2 - 3) + C20 * (I1 - 3) ** 2 + C11 * (I1 - 3) * (I2 - 3) + C02 * (I2 - 3) ** 2 + C30 * (I1 - 3) ** 3', False),
+    'rivlin_field': ('C10 * (I1 - 3) + C01 * (I2 - 3) + C20 * (I1 - 3) ** 2 + C11 * (I1 - 3) * (I2 - 3) + C02 * (I2 - 3) ** 2 + C30 * (I1 - 3) ** 3', True),
+    'gent': ('-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)', False),
+    'gent_field': ('-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)', True),
+    'gent_gent': ('-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)', False),
+    'gent_gent_field': ('-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)', True),
+    'arruda_boyce': ('mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))', False),
+    'arruda_boyce_field': ('mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))', True),
 }

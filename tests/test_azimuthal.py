@@ -359,3 +359,33 @@ def test_lowest_eigenvalue_converges_in_the_degree_on_a_magnetic_state(two_coil_
         if m == 1:
             assert (fine[0] < -1e-2) != held
             assert fine[1] > 1.0
+
+
+@pytest.mark.parametrize("m", [1, 2])
+def test_reflection_classes_split_the_block_of_a_symmetric_state(m):
+    """An equator-symmetric state (two opposed coils, a field): H and G have no entries between the reflection
+    classes (rounding only), and the two class blocks together give the whole block's spectrum, held and free,
+    with every special mode in the class MODE_CLASS names."""
+    scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml")
+    branch = trace_primary(scene, stop_stretch=1.6, down=False)
+    assert branch.disc.symmetric
+    eq, X = equilibrium_of(branch), branch.X[-1]
+    u, params = X[:-1], branch.params.with_value("P", X[-1])
+    H, G = az.azimuthal_hessian(eq, u, params, m, 20)
+    b = az.perturbation_basis(eq, m, 20)
+    even, odd = b.classes
+    assert even.size + odd.size == b.size and min(even.size, odd.size) > 0
+    for M in (H, G):
+        assert np.abs(M[np.ix_(even, odd)]).max() < 1e-13 * np.abs(M).max()
+    if m == 1:
+        moments = az.mode_moments(eq, u, b)
+        for k, cls in enumerate(az.MODE_CLASS):
+            other = b.classes[1 - cls]
+            assert np.abs(moments[k, other]).max() < 1e-13 * np.abs(moments[k]).max()
+    for held in (True, False):
+        split = az.spectrum(eq, u, params, m, 20, 5, held=held)
+        exclude = [] if m > 1 else [az.special_modes(eq, u, 20)[az.MODES[k]]
+                                    for k in az.excluded_modes(eq, params, held)]
+        null = linalg.null_space(np.atleast_2d(exclude) @ G) if exclude else np.eye(b.size)
+        whole = linalg.eigh(null.T @ H @ null, null.T @ G @ null, eigvals_only=True)[:5]
+        assert np.abs(split - whole).max() < 1e-10 * np.abs(whole).max()

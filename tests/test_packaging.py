@@ -38,7 +38,7 @@ def clean_copy(tmp_path) -> Path:
 def shipped(tree: Path) -> set:
     """Wheel paths of every file the package must ship (package-dir of pyproject.toml)."""
     folders = {"balloon_cg": tree / "src" / "balloon_cg", "balloon_cg/generated": tree / "generated",
-               "balloon_cg/scenes": tree / "scenes"}
+               "balloon_cg/scenes": tree / "scenes", "balloon_cg/codegen": tree / "codegen"}
     code = {f"{prefix}/{path.relative_to(folder).as_posix()}" for prefix, folder in folders.items()
             for path in folder.rglob("*") if path.suffix in (".py", ".toml")}
     docs = {f"balloon_cg/docs/{path.name}" for path in (tree / "docs").glob("*")  # the pages, not derivations/

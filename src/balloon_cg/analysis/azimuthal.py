@@ -40,11 +40,11 @@ import numpy as np
 from numpy.polynomial import legendre
 from scipy import linalg
 
-from ..galerkin.equilibrium import Equilibrium, Parameters
+from numba import njit
 
-# blocks of at least this size use LAPACK's subset driver (n = 960: 0.06 s against 0.19 s for the Cholesky
-# reduction and a full syevd, which wins on small blocks)
-LARGE_BLOCK = 200
+from ..galerkin.discretisation import symmetric_rows
+from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..numerics import eigen
 
 
 def legendre_values(x: np.ndarray, degree: int, order: int) -> np.ndarray:
@@ -127,23 +127,25 @@ class AzimuthalBasis:
         # R, R', T, T' involve only the U and D coefficients, Z, Z' only the Z ones: the assembly works on these
         # column groups (about half the work of the full products)
         z = blocks["Z"][0]
-        ud = slice(z.stop, offset)
-        put(self, "groups", tuple((rows, cols, np.ascontiguousarray(ops[np.ix_(rows, np.arange(x.size),
-                                                                                np.arange(offset)[cols])]))
-                                  for rows, cols in (((0, 1, 4, 5), ud), ((2, 3), z))))
+        put(self, "ops_z", np.ascontiguousarray(ops[2:4, :, z]))
+        put(self, "ops_ud", np.ascontiguousarray(ops[[0, 1, 4, 5], :, z.stop:]))
         w = weights[:, None]
         gram = 0.5 * sum(ops[k].T @ (w * ops[k]) for k in (0, 2, 4))
         put(self, "gram", 0.5 * (gram + gram.T))
+        put(self, "factor", eigen.GramFactor(self.gram))
+        # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
+        moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
+        put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
+        # reflection classes z → −z of an equator-symmetric state (P̄_k^j(−x) = (−1)^{k+j} P̄_k^j(x)): k + m odd is
+        # (R, T even in x, Z odd), k + m even the opposite; H and G have no entries between them
+        parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
+        classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
+        put(self, "classes", classes)
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)]) for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
         return self.ops @ c
-
-    def project(self, R: np.ndarray, T: np.ndarray, Z: np.ndarray) -> np.ndarray:
-        """L2 (‖δx‖) projection of node values of (R, T, Z) onto the basis: the coefficients c."""
-        w = self.weights
-        rhs = 0.5 * (self.ops[0].T @ (w * R) + self.ops[4].T @ (w * T) + self.ops[2].T @ (w * Z))
-        return linalg.solve(self.gram, rhs, assume_a="pos")
 
     def cartesian(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
         """Cartesian displacement δx (3, len(theta)) at points (θ, φ), θ anywhere in [0, π] (poles included)."""
@@ -172,11 +174,79 @@ def basis(m: int, degree: int, quadrature: int) -> AzimuthalBasis:
     return AzimuthalBasis(m, degree, quadrature)
 
 
-def _node_matrix(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> np.ndarray:
-    """The kernel's entries of h at every node (the AZIMUTHAL_PAIRS of y = PERTURBATION), shape (21, n_q)."""
-    lam2, dlam2, eta, deta = equilibrium.disc.evaluate(np.asarray(u, dtype=float), b.theta)
-    state = (lam2, dlam2 * b.sin_theta, eta, deta)
-    return equilibrium.pointwise("azimuthal_hessian", (b.x, b.sin_theta), state, params, m=float(m))
+@dataclass(frozen=True)
+class StateMaps:
+    """The linear maps of the unknowns u of a discretisation onto the nodes of an azimuthal basis: ``state``
+    (size, 4 n_q), u @ state = (λ2, λ2', η, η') at the nodes; ``modes`` (size, 2 size_b) and ``translation``
+    (size_b), the special modes' rows G c (``_mode_moments``): (rotation, relabelling) = u @ modes, and the
+    translation's, which does not depend on u."""
+
+    state: np.ndarray
+    modes: np.ndarray
+    translation: np.ndarray
+
+
+@lru_cache(maxsize=32)
+def state_maps(disc, b: AzimuthalBasis) -> StateMaps:
+    """``StateMaps`` of ``disc`` (a galerkin Discretisation) on the nodes of ``b``: columns of unit unknowns."""
+    unit = tuple(np.atleast_2d(v) for v in disc.evaluate(np.eye(disc.size), b.theta))  # each (size, n_q)
+    moments = _mode_moments(b, unit)  # (3, size, size_b): G c of each mode for each unit u
+    zero = _mode_moments(b, tuple(np.zeros((1, b.x.size)) for _ in range(4)))[0, 0]
+    return StateMaps(np.ascontiguousarray(np.concatenate(unit, axis=1)),
+                     np.ascontiguousarray(np.concatenate([moments[1], moments[2]], axis=1)), zero)
+
+
+def _node_state(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> tuple:
+    """(λ2, λ2', η, η') of the axisymmetric state u at the nodes of ``b``."""
+    return tuple((np.asarray(u, dtype=float) @ state_maps(equilibrium.disc, b).state).reshape(4, -1))
+
+
+def _hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis) -> np.ndarray:
+    """H from the node state (``_node_state``): the kernel's entries of h at every node (the AZIMUTHAL_PAIRS of
+    y = PERTURBATION, (21, n_q)), assembled by ``_assemble``."""
+    lam2, dlam2, eta, deta = state
+    h = equilibrium.pointwise("azimuthal_hessian", (b.x, b.sin_theta), (lam2, dlam2 * b.sin_theta, eta, deta), params,
+                              m=float(m))
+    return _assemble(h, b.weights, _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS), b.ops_ud, b.ops_z)
+
+
+@lru_cache(maxsize=4)
+def _pair_rows(pairs: tuple) -> np.ndarray:
+    return symmetric_rows(pairs)
+
+
+_UD_ROWS = np.array([0, 1, 4, 5])  # R, R', T, T'
+_Z_ROWS = np.array([2, 3])  # Z, Z'
+
+
+def _assemble(h, weights, row, ops_ud, ops_z):
+    """H = Σ_q w_q Σ_kl h_kl(q) ∂y_k/∂c ∂y_l/∂c, h_kl in row ``row[k, l]`` of h, on the column groups (Z | U, D):
+    (R, R', T, T') depend on the U, D coefficients only (``ops_ud``, (4, n_q, n_ud)), (Z, Z') on the Z ones only
+    (``ops_z``, (2, n_q, n_z)); each group pair is one BLAS product of the stacked ops of one group with the
+    node-wise weighted combinations of the other's (``_weighted``); symmetrised."""
+    nz, nud = ops_z.shape[2], ops_ud.shape[2]
+    stacked_ud, stacked_z = ops_ud.reshape(-1, nud), ops_z.reshape(-1, nz)
+    H = np.empty((nz + nud, nz + nud))
+    H[nz:, nz:] = stacked_ud.T @ _weighted(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
+    H[:nz, :nz] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z).reshape(-1, nz)
+    H[:nz, nz:] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
+    H[nz:, :nz] = H[:nz, nz:].T
+    return 0.5 * (H + H.T)
+
+
+@njit(cache=True)
+def _weighted(h, weights, row, rows_i, rows_j, ops_j):
+    """Σ_{l ∈ rows_j} w_q h_kl(q) ops_j[l] at every node q for each k ∈ rows_i, shape (len(rows_i), n_q, n_j)."""
+    ni, nq, nj = rows_i.size, weights.size, ops_j.shape[2]
+    scaled = np.zeros((ni, nq, nj))
+    for a in range(ni):
+        for b in range(rows_j.size):
+            r = row[rows_i[a], rows_j[b]]
+            for q in range(nq):
+                c = weights[q] * h[r, q]
+                for j in range(nj):
+                    scaled[a, q, j] += c * ops_j[b, q, j]
+    return scaled
 
 
 def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, quadrature: int = 0):
@@ -184,22 +254,33 @@ def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     axisymmetric state u (unknowns of ``equilibrium.disc``) at parameters ``params``, basis of ``degree`` N
     (module docstring; see ``perturbation_basis`` for the layout). Both are symmetric, of size 3(N − m + 1)."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    h = _node_matrix(equilibrium, u, params, m, b) * b.weights
-    blocks = np.empty((6, 6, b.x.size))
-    for row, (k, l) in enumerate(equilibrium.kernels.module.AZIMUTHAL_PAIRS):
-        blocks[k, l] = blocks[l, k] = h[row]
-    H = np.empty((b.size, b.size))
-    for i, (rows_i, cols_i, ops_i) in enumerate(b.groups):
-        for rows_j, cols_j, ops_j in b.groups[i:]:
-            scaled = np.einsum("kln,lni->kni", blocks[np.ix_(rows_i, rows_j)], ops_j)
-            H[cols_i, cols_j] = ops_i.reshape(-1, ops_i.shape[2]).T @ scaled.reshape(-1, ops_j.shape[2])
-            H[cols_j, cols_i] = H[cols_i, cols_j].T
-    return 0.5 * (H + H.T), b.gram
+    return _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b), b.gram
 
 
 def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature: int = 0) -> AzimuthalBasis:
     """The basis ``azimuthal_hessian`` uses for this equilibrium's discretisation (cached)."""
     return basis(int(m), int(degree), int(quadrature or default_quadrature(degree, equilibrium.disc.degree)))
+
+
+MODES = ("translation", "rotation", "relabelling")
+MODE_CLASS = (0, 1, 1)  # the reflection class (AzimuthalBasis.classes) of each mode: R, T even / odd in x
+
+
+def _mode_moments(b: AzimuthalBasis, state: tuple) -> np.ndarray:
+    """G c for the special modes (``special_modes``, in the order MODES) from node states (λ2, λ2', η, η'), each
+    (k, n_q) for k states: the L2 projection's right-hand sides ½ ∫ (R δR + T δT + Z δZ) dx, shape (3, k, size);
+    the translation's is the same for every state."""
+    lam2, dlam2, eta, deta = state
+    s, c = b.sin_theta, b.x
+    one = np.ones_like(eta)
+    values = np.array([[one, -one, 0.0 * one], [eta, -eta, -lam2 * s], [lam2 * c + dlam2 * s, -lam2 * c, deta]])
+    return np.einsum("mjkq,jqi->mki", values, b.moments.reshape(3, -1, b.size))
+
+
+def mode_moments(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> np.ndarray:
+    """G c of the special modes (rows in the order MODES) of the state u, by the linear maps ``state_maps``."""
+    maps = state_maps(equilibrium.disc, b)
+    return np.vstack([maps.translation, (np.asarray(u, dtype=float) @ maps.modes).reshape(2, -1)])
 
 
 def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0) -> dict:
@@ -215,36 +296,9 @@ def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0)
     All are regular (D = R − T ≠ 0 at the poles) and exact in the basis when degree ≥ the equilibrium's Legendre
     degree + 1 (the translation for any degree)."""
     b = perturbation_basis(equilibrium, 1, degree, quadrature)
-    lam2, dlam2, eta, deta = equilibrium.disc.evaluate(np.asarray(u, dtype=float), b.theta)
-    s, c = b.sin_theta, b.x
-    one = np.ones_like(eta)
-    return {
-        "translation": b.project(one, -one, 0 * one),
-        "rotation": b.project(eta, -eta, -lam2 * s),
-        "relabelling": b.project(lam2 * c + dlam2 * s, -lam2 * c, deta),
-    }
-
-
-def restrict(H, G, normals, rcond: float = 1e-9):
-    """(H, G) on the hyperplanes n·c = 0 of the columns n of ``normals`` (linearly dependent columns are fine:
-    directions below rcond times the largest singular value are dropped): one Householder reflection Q per
-    direction (Qn ∥ e_1, then the first coordinate dropped), each a rank-two update of H and G (O(n²), no
-    null-space basis); the result is the restriction in an orthonormal basis of the intersection."""
-    U, s, _ = np.linalg.svd(np.reshape(normals, (len(H), -1)), full_matrices=False)
-    U = U[:, s > rcond * s[0]]
-    while U.shape[1]:
-        v = U[:, 0].copy()
-        v[0] += np.copysign(1.0, v[0])
-        w = 2.0 / (v @ v)
-        H, G = _reflect(H, v, w)[1:, 1:], _reflect(G, v, w)[1:, 1:]
-        U = (U[:, 1:] - w * np.outer(v, v @ U[:, 1:]))[1:]
-    return H, G
-
-
-def _reflect(A, v, w):
-    """Q A Q for symmetric A and Q = I − w v vᵀ (w = 2/(vᵀv))."""
-    Av = A @ v
-    return A - w * (np.outer(v, Av) + np.outer(Av, v)) + w * w * (v @ Av) * np.outer(v, v)
+    moments = mode_moments(equilibrium, u, b)
+    coefficients = b.factor.inverse.T @ (b.factor.inverse @ moments.T)  # G⁻¹ (G c)
+    return dict(zip(MODES, coefficients.T))
 
 
 def lowest_eigenvalues(H, G, count: int = 6, exclude=None, vectors: bool = False):
@@ -252,20 +306,16 @@ def lowest_eigenvalues(H, G, count: int = 6, exclude=None, vectors: bool = False
     restricts the problem to {c : E G c = 0}, the G-orthogonal complement of their span (linearly dependent rows
     are fine): an exact null vector is then removed from the spectrum and nothing else changes, and excluding
     the translation is the constraint that the material centroid stays put (∫ δx dA = 0). Returned vectors are
-    in the full basis. Blocks of size ≥ LARGE_BLOCK (eigenvalues only) go through ``restrict`` and the subset driver."""
+    in the full basis. Eigenvalues only: ``numerics.eigen.lowest`` (the constraint rows are E G)."""
     excluding = exclude is not None and len(exclude)
-    if not vectors and H.shape[0] >= LARGE_BLOCK:
-        if excluding:
-            H, G = restrict(H, G, (np.atleast_2d(exclude) @ G).T)
-        return linalg.eigh(H, G, eigvals_only=True, subset_by_index=(0, min(count, H.shape[0]) - 1))
+    count = min(count, H.shape[0])
+    if not vectors:
+        normals = np.atleast_2d(exclude) @ G if excluding else eigen.NO_CONSTRAINT
+        return eigen.lowest(H, eigen.GramFactor(G), count, normals)
     null = None
     if excluding:
-        null = linalg.null_space(np.atleast_2d(exclude) @ G, rcond=1e-9)
+        null = linalg.null_space(np.atleast_2d(exclude) @ G, rcond=eigen.RCOND)
         H, G = null.T @ H @ null, null.T @ G @ null
-    count = min(count, H.shape[0])
-    if not vectors:  # Cholesky reduction + LAPACK syevd: several times faster than the subset driver on small blocks
-        inverse = np.linalg.inv(np.linalg.cholesky(G))
-        return np.linalg.eigvalsh(inverse @ H @ inverse.T)[:count]
     values, vecs = linalg.eigh(H, G, subset_by_index=(0, count - 1))
     if null is not None:
         vecs = null @ vecs
@@ -287,16 +337,49 @@ def spectrum(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: in
 def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, count: int = 6,
             readings=(True, False), quadrature: int = 0) -> dict:
     """``spectrum`` for several readings (held: True, free: False) from one assembly of the m-th block."""
-    H, G = azimuthal_hessian(equilibrium, u, params, m, degree, quadrature)
-    modes = special_modes(equilibrium, u, degree, quadrature) if m == 1 else None
+    matrices = restricted_blocks(equilibrium, u, params, m, degree, readings, quadrature)
+    return {held: merged_lowest(parts, count) for held, parts in matrices.items()}
+
+
+def merged_lowest(parts, count: int) -> np.ndarray:
+    """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
+    return np.sort(np.concatenate([eigen.lowest_of(A, count) for A in parts]))[:count]
+
+
+def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, readings=(True, False),
+                      quadrature: int = 0) -> dict:
+    """The m-th block for each reading (held: True, free: False) as standard symmetric matrices with the special
+    modes removed (``numerics.eigen.restricted``): their eigenvalues together are ``spectrum``'s, and the block is
+    positive when each is. On an equator-symmetric discretisation the state is symmetric and the block splits
+    into its two reflection classes (``AzimuthalBasis.classes``, each mode in its own: MODE_CLASS), two matrices
+    of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
+    serve every reading."""
+    b = perturbation_basis(equilibrium, m, degree, quadrature)
+    H = _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b)
+    moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
+    split = equilibrium.disc.symmetric
+    parts = tuple(zip(b.classes, b.class_factors, (0, 1))) if split else ((None, b.factor, None),)
     out = {}
     for held in readings:
-        exclude = []
-        if m == 1:
-            exclude.append(modes["relabelling"])
-            if params.M == 0 or not equilibrium.coils.shape[0]:
-                exclude += [modes["translation"], modes["rotation"]]
-            elif held:
-                exclude.append(modes["translation"])
-        out[held] = lowest_eigenvalues(H, G, count, exclude)
+        modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []
+        out[held] = tuple(
+            eigen.restricted(H, factor, _class_rows(moments, modes, cls, index), index)
+            for index, factor, cls in parts)
     return out
+
+
+def _class_rows(moments, modes: list, cls, index):
+    """The constraint rows of ``modes`` on the part ``index`` (all of them for the whole block, cls None; else
+    those of the modes in reflection class cls)."""
+    if cls is None:
+        return moments[modes]
+    kept = [k for k in modes if MODE_CLASS[k] == cls]
+    return moments[np.ix_(kept, index)] if kept else eigen.NO_CONSTRAINT
+
+
+def excluded_modes(equilibrium: Equilibrium, params: Parameters, held: bool) -> tuple:
+    """Indices into MODES of the m = 1 modes ``spectrum`` removes: always the relabelling; at M = 0 (or without
+    coils) also the translation and the rotation; with a field the translation for a held balloon."""
+    if params.M == 0 or not equilibrium.coils.shape[0]:
+        return 0, 1, 2
+    return (0, 2) if held else (2,)

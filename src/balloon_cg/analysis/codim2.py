@@ -110,7 +110,7 @@ class ExtendedSystem(WernerSpence):
             raise TwoParameterError("the extended system needs the equator-symmetric layout of the primary branch")
         if parameter == "alpha1":
             material = equilibrium.scene.material
-            if len(material.alpha) < 1:
+            if not hasattr(material, "alpha") or len(material.alpha) < 1:
                 raise TwoParameterError("alpha1: the material has no Ogden term")
             # runtime exponents: an own equilibrium of the general class (same energy, μ and α as arguments)
             equilibrium = Equilibrium(equilibrium.scene, disc, kernel_class=GENERAL_CLASS)

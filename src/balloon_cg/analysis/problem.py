@@ -1,6 +1,4 @@
 """The discrete problem of a branch as a continuation system, and the solver objects rebuilt from a result."""
-import numpy as np
-
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..numerics import continuation
 
@@ -18,8 +16,7 @@ class ParameterSystem:
         return self.eq.residual(X[:-1], self._params(X))
 
     def jacobian(self, X):
-        p = self._params(X)
-        return np.hstack([self.eq.jacobian(X[:-1], p), self.eq.parameter_derivative(X[:-1], p, self.name)[:, None]])
+        return self.eq.bordered_jacobian(X[:-1], self._params(X), self.name)
 
 
 def continuation_settings(scene, max_points: int | None = None) -> continuation.Settings:

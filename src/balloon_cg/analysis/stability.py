@@ -22,16 +22,19 @@ Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) fo
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
-from .azimuthal import LARGE_BLOCK, restrict, spectra
+from .azimuthal import merged_lowest, restricted_blocks
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
+from ..numerics import eigen
 from .problem import equilibrium_of
 from .resolution import Resolution
 from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
+FLAGS = ("stable_pressure", "stable_volume", "stable_pressure_free", "stable_volume_free")  # Assessment's order
+HELD, HELD_VOLUME, FREE, FREE_VOLUME = range(len(FLAGS))
+EVERY_FLAG = (HELD, HELD_VOLUME, FREE, FREE_VOLUME)
 CHECK_FACTOR = 2.0  # N-convergence is checked at CHECK_FACTOR·N
 
 
@@ -48,9 +51,8 @@ class Assessment:
     degree: int  # the perturbation degree N it was computed at
 
     def flags(self) -> dict:
-        """The four stability flags by name."""
-        return {"stable_pressure": self.stable_pressure, "stable_volume": self.stable_volume,
-                "stable_pressure_free": self.stable_pressure_free, "stable_volume_free": self.stable_volume_free}
+        """The four stability flags by name (FLAGS)."""
+        return {name: getattr(self, name) for name in FLAGS}
 
 
 class SecondVariation:
@@ -72,10 +74,13 @@ class SecondVariation:
         self.translation = na  # b_0
         ops, w = self.basis.ops, self.basis.weights
         self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+        # the state at the nodes is linear in the equilibrium's unknowns: (λ2, v, η, w) = u @ state_map
+        unit = self.eq.state_at(np.eye(self.eq.disc.size), self.theta)
+        self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
 
     def matrices(self, u, params: Parameters):
         """(H, g): the Hessian of E and the volume gradient on the perturbation basis."""
-        state = self.eq.state_at(u, self.theta)
+        state = tuple((np.asarray(u, dtype=float) @ self.state_map).reshape(4, -1))
         geometry = (self.basis.cos_theta, self.basis.sin_theta)
         hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params))
         volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params))
@@ -83,62 +88,74 @@ class SecondVariation:
 
     def _lowest(self, H, idx, constraint=None):
         """Lowest generalized eigenvalues of (H, G) on the block ``idx``, optionally restricted to gᵀδ = 0
-        (``azimuthal.restrict``: a Householder reflection, no null-space basis)."""
-        Hb, Gb = H[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)]
-        if constraint is not None:
-            Hb, Gb = restrict(Hb, Gb, constraint[idx])
-        if len(Hb) >= LARGE_BLOCK:
-            return scipy.linalg.eigh(Hb, Gb, eigvals_only=True, subset_by_index=[0, LOWEST - 1])
-        inverse = self._inverse_cholesky(tuple(idx)) if constraint is None else np.linalg.inv(np.linalg.cholesky(Gb))
-        return np.linalg.eigvalsh(inverse @ Hb @ inverse.T)[:LOWEST]
+        (``numerics.eigen.lowest``)."""
+        return eigen.lowest_of(self._restricted(H, idx, constraint), LOWEST)
 
-    def _inverse_cholesky(self, idx: tuple):
-        """L⁻¹ with G_block = L Lᵀ (the Gram blocks do not change along a branch: cached)."""
+    def _restricted(self, H, idx, constraint=None):
+        """The block ``idx`` of (H, G) as a standard symmetric matrix, optionally on gᵀδ = 0 (``eigen.restricted``)."""
+        normals = eigen.NO_CONSTRAINT if constraint is None else constraint[idx]
+        return eigen.restricted(H, self._gram_factor(idx), normals, idx)
+
+    def _gram_factor(self, idx: np.ndarray) -> eigen.GramFactor:
+        """G_block = L Lᵀ (the Gram blocks do not change along a branch: cached)."""
         cache = self.__dict__.setdefault("_cholesky", {})
-        if idx not in cache:
-            cache[idx] = np.linalg.inv(np.linalg.cholesky(self.gram[np.ix_(idx, idx)]))
-        return cache[idx]
+        key = idx.tobytes()
+        if key not in cache:
+            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)])
+        return cache[key]
 
-    def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> Assessment:
-        """Blocks and flags at one equilibrium; azimuthal blocks m = 1..m_max are included in every flag
-        (their modes keep the volume to first order, so both control modes see the same m ≥ 1 spectrum)."""
+    def blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> list:
+        """(name, standard matrices, flags) per block at one equilibrium: the block's pencil restricted to its
+        constraints, as one matrix or the matrices of its uncoupled parts (``_restricted``,
+        ``azimuthal.restricted_blocks``), and the flags it enters (positions in
+        FLAGS). Azimuthal blocks m = 1..m_max enter every flag (their modes keep the volume to first order, so
+        both control modes see the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
+        translation is no zero mode to remove (no field)."""
         H, g = self.matrices(u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
-        i = self.index
-        t = self.translation
-        blocks = {}
+        i, t = self.index, self.translation
         if symmetric:
             even = np.concatenate([i["a_even"], i["b_odd"]])
             odd_held = np.concatenate([i["a_odd"], i["b_even"][1:]])
-            blocks["even"] = self._lowest(H, even)
-            blocks["even_volume"] = self._lowest(H, even, g)
-            blocks["odd_held"] = self._lowest(H, odd_held)
+            plan = [("even", even, None, (HELD, FREE)), ("even_volume", even, g, (HELD_VOLUME, FREE_VOLUME)),
+                    ("odd_held", odd_held, None, EVERY_FLAG)]
             if field_on:
-                blocks["odd_free"] = self._lowest(H, np.append(odd_held, t))
-            held = min(blocks["even"][0], blocks["odd_held"][0])
-            held_volume = min(blocks["even_volume"][0], blocks["odd_held"][0])
-            free = min(held, blocks["odd_free"][0]) if field_on else held
-            free_volume = min(held_volume, blocks["odd_free"][0]) if field_on else held_volume
+                plan.append(("odd_free", np.append(odd_held, t), None, (FREE, FREE_VOLUME)))
         else:
             everything = np.arange(H.shape[0])
             held_idx = everything[everything != t]
-            blocks["all_held"] = self._lowest(H, held_idx)
-            blocks["all_volume_held"] = self._lowest(H, held_idx, g)
-            held, held_volume = blocks["all_held"][0], blocks["all_volume_held"][0]
-            free, free_volume = held, held_volume
+            plan = [("all_held", held_idx, None, (HELD,) if field_on else (HELD, FREE)),
+                    ("all_volume_held", held_idx, g, (HELD_VOLUME,) if field_on else (HELD_VOLUME, FREE_VOLUME))]
             if field_on:
-                blocks["all_free"] = self._lowest(H, everything)
-                blocks["all_volume_free"] = self._lowest(H, everything, g)
-                free, free_volume = blocks["all_free"][0], blocks["all_volume_free"][0]
+                plan += [("all_free", everything, None, (FREE,)), ("all_volume_free", everything, g, (FREE_VOLUME,))]
+        out = [(name, (self._restricted(H, idx, constraint),), flags) for name, idx, constraint, flags in plan]
         for m in range(1, m_max + 1):
-            readings = spectra(self.eq, u, params, m, self.basis.degree, LOWEST, (True, False) if field_on else (True,))
-            blocks[f"m{m}_held"] = readings[True]
-            held, held_volume = min(held, blocks[f"m{m}_held"][0]), min(held_volume, blocks[f"m{m}_held"][0])
+            readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,))
+            out.append((f"m{m}_held", readings[True], (HELD, HELD_VOLUME) if field_on else EVERY_FLAG))
             if field_on:
-                blocks[f"m{m}_free"] = readings[False]
-            lowest_free = blocks[f"m{m}_free" if field_on else f"m{m}_held"][0]
-            free, free_volume = min(free, lowest_free), min(free_volume, lowest_free)
-        return Assessment(blocks, held > 0, held_volume > 0, free > 0, free_volume > 0, self.basis.degree)
+                out.append((f"m{m}_free", readings[False], (FREE, FREE_VOLUME)))
+        return out
+
+    def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> Assessment:
+        """Blocks (their LOWEST eigenvalues) and flags (a flag holds when every block it takes is positive) at one
+        equilibrium (``blocks``)."""
+        blocks, lowest = {}, [np.inf] * len(FLAGS)
+        for name, parts, flags in self.blocks(u, params, symmetric, m_max):
+            blocks[name] = merged_lowest(parts, LOWEST)
+            for flag in flags:
+                lowest[flag] = min(lowest[flag], blocks[name][0])
+        return Assessment(blocks, *(value > 0 for value in lowest), self.basis.degree)
+
+    def flags(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> tuple:
+        """The flags of ``assess`` (in FLAGS order) from the inertia alone: a block is positive when its Cholesky
+        factorisation exists (``eigen.positive_definite``), no eigenvalues; a block is skipped once every flag
+        it enters has failed."""
+        stable = [True] * len(FLAGS)
+        for _, parts, flags in self.blocks(u, params, symmetric, m_max):
+            if any(stable[flag] for flag in flags) and not all(eigen.positive_definite(A) for A in parts):
+                for flag in flags:
+                    stable[flag] = False
+        return tuple(stable)
 
 
 def block_indices(variation, block: str, field_on: bool):
@@ -223,9 +240,9 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
             small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
             if not (changes or small or n % 10 == 0):
                 continue
-            fine = variations[check_degree(branch, degrees[n])].assess(X[:-1], params.with_value("P", X[-1]),
-                                                                      symmetric, m_max)
-            if _flags(fine) != flags[n]:
+            fine = variations[check_degree(branch, degrees[n])].flags(X[:-1], params.with_value("P", X[-1]),
+                                                                     symmetric, m_max)
+            if fine != flags[n]:
                 unsettled.append(n)
     return results, unsettled
 

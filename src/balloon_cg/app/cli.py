@@ -21,6 +21,7 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
+from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
@@ -83,7 +84,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels):
         add(commands)
     return parser
 

@@ -136,6 +136,7 @@ class Discretisation:
         # the blocks of ops that are not identically zero: (∂λ2, ∂v)/∂a and (∂η, ∂w)/∂b, contiguous for BLAS
         put(self, "basis_a", np.ascontiguousarray(ops[0:2, :, :na]))
         put(self, "basis_b", np.ascontiguousarray(ops[2:4, :, na:]))
+        put(self, "_gradient_ops", np.ascontiguousarray(ops.reshape(-1, self.size).T))  # (size, 4 n_q) for gemv
 
     @functools.cached_property
     def projection(self) -> np.ndarray:
@@ -160,39 +161,48 @@ class Discretisation:
         """(λ2, v, η, w) at the quadrature nodes, shape (4, n_q)."""
         return self.ops @ u
 
-    def gradient(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q)."""
-        return self.ops.reshape(-1, self.size).T @ (pointwise * self.weights).ravel()
+    def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q) (into ``out`` if given)."""
+        return np.matmul(self._gradient_ops, (pointwise * self.weights).ravel(), out=out)
 
-    def hessian(self, pointwise: np.ndarray) -> np.ndarray:
+    def hessian(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is energy_hessian's output (10, n_q), the
         entries (k, l) of HESSIAN_PAIRS.
 
         (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three
-        blocks aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner.
+        blocks aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner, written
+        into ``out`` (size × size, e.g. the leading columns of a bordered Jacobian) if given.
         """
         na = self.a_index.size
         A, B = self.basis_a, self.basis_b
         weighted_a, weighted_b = _weighted_bases(np.ascontiguousarray(pointwise), self.weights, A, B)
         stacked_a, stacked_b = A.reshape(-1, na), B.reshape(-1, self.size - na)
-        out = np.empty((self.size, self.size))
-        out[:na, :na] = stacked_a.T @ weighted_a.reshape(-1, na)
-        out[:na, na:] = stacked_a.T @ weighted_b[:2].reshape(-1, self.size - na)
+        out = np.empty((self.size, self.size)) if out is None else out
+        np.matmul(stacked_a.T, weighted_a.reshape(-1, na), out=out[:na, :na])
+        np.matmul(stacked_a.T, weighted_b[:2].reshape(-1, self.size - na), out=out[:na, na:])
         out[na:, :na] = out[:na, na:].T
-        out[na:, na:] = stacked_b.T @ weighted_b[2:].reshape(-1, self.size - na)
+        np.matmul(stacked_b.T, weighted_b[2:].reshape(-1, self.size - na), out=out[na:, na:])
         return out
 
     def pole_rows(self):
-        """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south)."""
+        """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south) (read-only, built once: every
+        continuation step's stop test reads them)."""
+        return dict(self._pole_rows)
+
+    @functools.cached_property
+    def _pole_rows(self) -> dict:
         sign = (-1.0) ** np.arange(self.degree + 1)
         ones = np.ones(self.degree + 1)
         zero = np.zeros(self.degree + 1)
-        return {
+        rows = {
             "lam2_north": self.join(ones, zero),
             "lam2_south": self.join(sign, zero),
             "eta_north": self.join(zero, ones) - np.append(np.zeros(self.a_index.size), self.eta_mean),
             "eta_south": self.join(zero, sign) - np.append(np.zeros(self.a_index.size), self.eta_mean),
         }
+        for row in rows.values():
+            row.flags.writeable = False
+        return rows
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""

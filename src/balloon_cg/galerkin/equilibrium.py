@@ -4,6 +4,7 @@ R(u; P, M) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (λ2, v,
 J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M for
 continuation. A point is an equilibrium when R = 0 at fixed (P, M).
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -11,6 +12,8 @@ import numpy as np
 from .discretisation import Discretisation
 from ..model.field import field_squared_nodes
 from ..model.kernels import KernelSet
+from ..scene.energies import StrainEnergy
+from ..scene.formula import domain_conditions
 
 
 class NonFiniteState(ArithmeticError):
@@ -43,6 +46,7 @@ class Equilibrium:
         self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
         self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0, kernel_class=kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
+        self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
 
     def _field(self, lam2, sin_theta, eta):
         """H² and its derivatives at the nodes (zeros for a field class without coils)."""
@@ -62,22 +66,32 @@ class Equilibrium:
         return self._evaluate(kernel, self._node_values(geometry, state, field) | values, params)
 
     def _node_values(self, geometry: tuple, state: tuple, field) -> dict:
-        """The kernels' node arguments by name."""
+        """The kernels' node arguments by name; NonFiniteState if a node's stretches leave the material's domain
+        (a strain energy with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
+        if self._domain_check:
+            lam2, v, _, w = state
+            lam1 = np.hypot(lam2 * geometry[0] + v, w)
+            margins = self.kernels.nodes("domain_margins", {"lam1": lam1, "lam2": lam2})
+            violation = self.scene.material.domain_violation(margins, lam1, lam2)
+            if violation is not None:
+                node, what = violation
+                raise NonFiniteState(f"the membrane left the domain of {self.scene.material.name} at the node "
+                                     f"cos θ = {geometry[0][node]:.6g}: {what}")
         return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
         out = self.kernels.nodes(kernel, named, params)
-        if not np.all(np.isfinite(out)):
+        if not math.isfinite(out.sum()):  # a NaN or ±inf anywhere makes the sum NaN or ±inf
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 
     def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u are reused (Newton asks for R, then J)."""
         last = getattr(self, "_last", None)
-        if last is None or not np.array_equal(last[0], u):
+        if last is None or last[0].shape != u.shape or (last[0] != u).any():
             state = tuple(self.disc.node_state(u))
             field = self._field(state[0], self.disc.sin_theta, state[2])
-            last = self._last = (np.array(u), self._node_values(self.geometry, state, field))
+            last = self._last = (np.array(u, dtype=float), self._node_values(self.geometry, state, field))
         return self._evaluate(kernel, last[1], params)
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
@@ -95,15 +109,26 @@ class Equilibrium:
     def jacobian(self, u, params: Parameters) -> np.ndarray:
         return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
-    def parameter_derivative(self, u, params: Parameters, name: str) -> np.ndarray:
-        """∂R/∂P or ∂R/∂M (the latter is zero without coils)."""
+    def parameter_derivative(self, u, params: Parameters, name: str, out: np.ndarray | None = None) -> np.ndarray:
+        """∂R/∂P or ∂R/∂M (the latter is zero without coils), into ``out`` if given."""
         if name == "P":
-            return self.disc.gradient(self._pointwise("pressure_gradient", u, params))
+            return self.disc.gradient(self._pointwise("pressure_gradient", u, params), out)
         if name == "M":
             if not self.coils.shape[0]:
-                return np.zeros(self.disc.size)
-            return self.disc.gradient(self._pointwise("field_gradient", u, params))
+                out = np.empty(self.disc.size) if out is None else out
+                out[:] = 0.0
+                return out
+            return self.disc.gradient(self._pointwise("field_gradient", u, params), out)
         raise ValueError(f"unknown continuation parameter {name!r}: expected 'P' or 'M'")
+
+    def bordered_jacobian(self, u, params: Parameters, name: str) -> np.ndarray:
+        """[∂R/∂u  ∂R/∂name] (n × (n + 1)) for the map X = (u, name) of a continuation or a constrained solve,
+        assembled in place (one state evaluation serves both parts)."""
+        n = self.disc.size
+        out = np.empty((n, n + 1))
+        self.disc.hessian(self._pointwise("energy_hessian", u, params), out[:, :n])
+        self.parameter_derivative(u, params, name, out[:, n])
+        return out
 
     def volume(self, u) -> float:
         """Enclosed volume / (2π) = −∂E/∂P (MODEL.md §2: the pressure term is −P V/(2π))."""

@@ -35,8 +35,7 @@ def constrained_newton(scene, degree, X0, source, stretch, params, tol=1e-12, ma
         return eq.residual(X[:-1], params.with_value("P", X[-1]))
 
     def jacobian(X):
-        p = params.with_value("P", X[-1])
-        return np.hstack([eq.jacobian(X[:-1], p), eq.parameter_derivative(X[:-1], p, "P")[:, None]])
+        return eq.bordered_jacobian(X[:-1], params.with_value("P", X[-1]), "P")
 
     row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
     return newton(residual, jacobian, X, row, stretch, tol, max_iter), eq

@@ -1,7 +1,9 @@
 """Pick and call the generated kernel module for a scene class (Ogden exponents, field or not).
 
 A material whose exponents match a generated class uses it (exponents baked in); any other material uses the
-general class with runtime exponents, its unused terms padded with μ = 0.
+general class with runtime exponents, its unused terms padded with μ = 0. A strain energy (scene/energies.py)
+uses its family's committed class or, for a user formula, the on-demand cache; its parameters are the
+``material`` argument.
 
 Calling convention: every generated module lists, in ``KERNELS``, each kernel's arguments as (name, kind,
 rows) and its output labels (codegen/kernels.py: convention). ``KernelSet.arguments`` is the one place that
@@ -19,7 +21,9 @@ from functools import cached_property
 
 import numpy as np
 
+from . import kernel_cache
 from .. import generated
+from ..scene.energies import StrainEnergy
 from ..scene.validation import SceneError
 
 
@@ -49,6 +53,15 @@ class KernelSet:
 
     def __init__(self, material, has_field: bool, kernel_class: str | None = None):
         self.has_field = has_field
+        self.scene_material = material
+        self._binders, self._node_kernels = {}, {}
+        if isinstance(material, StrainEnergy):
+            if kernel_class is not None:
+                raise SceneError(f"kernel class {kernel_class!r}: only Ogden materials choose a kernel class")
+            self.module = energy_module(material, has_field)
+            self.name, self.general, self.field_class = dict(self.module.INPUTS)["class"], False, has_field
+            self._scene_arrays = {"material": _frozen(material.values)}
+            return
         self.name = class_name(material.alpha, has_field) if kernel_class is None else kernel_class
         if kernel_class is not None:
             if kernel_class not in generated.CLASSES:
@@ -62,9 +75,7 @@ class KernelSet:
         self.general = generated.CLASSES[self.name][0] is None
         # a field class evaluated at M = 0 is the "field on, M = 0" general setting of the benchmarks
         self.field_class = generated.CLASSES[self.name][1]
-        self.scene_material = material
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
-        self._binders, self._node_kernels = {}, {}
 
     @cached_property
     def signature(self) -> str:
@@ -78,6 +89,8 @@ class KernelSet:
         baked-in exponents takes μ only, and accepts an α override only if it is its own exponents."""
         if mu is None and alpha is None:
             return self._scene_arrays
+        if isinstance(self.scene_material, StrainEnergy):
+            raise ValueError(f"moduli/exponents overrides apply to Ogden materials, not {self.scene_material.name}")
         return self._pack(tuple(self.scene_material.mu if mu is None else mu),
                           tuple(self.scene_material.alpha if alpha is None else alpha))
 
@@ -154,6 +167,19 @@ class KernelSet:
     def state(self, state) -> dict:
         """Named values of the state (λ2, v, η, w) in the generated order STATE."""
         return dict(zip(self.module.STATE, state))
+
+
+def energy_module(material: StrainEnergy, has_field: bool):
+    """The kernel module of a strain energy: a family's committed one (its formula must be the one generated),
+    or a user formula's from the on-demand cache (model/kernel_cache.py)."""
+    if material.family is None:
+        return kernel_cache.load(material.formula, has_field)
+    name = f"{material.family}_field" if has_field else material.family
+    formula, _ = generated.ENERGY_CLASSES[name]
+    if formula != material.formula.text:
+        raise ImportError(f"generated/{name}.py is for the formula {formula!r}, the scene layer's family "
+                          f"{material.family} is {material.formula.text!r}: run `make regenerate`")
+    return importlib.import_module(f"{generated.__name__}.{name}")
 
 
 def _frozen(values) -> np.ndarray:

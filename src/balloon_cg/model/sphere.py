@@ -3,11 +3,17 @@
     P(λ) = 2 Σ_i μ_i (λ^(α_i − 3) − λ^(−2α_i − 3)),
 
 i.e. λ2 ≡ λ, η = λ cos θ (Legendre coefficients a_0 = λ, b_1 = λ), membrane stress σ = Σ μ_i (λ^α_i − λ^(−2α_i)).
+For any other strain energy P = 2 Φ_1(λ, λ)/λ² and σ = λ Φ_1(λ, λ) (Φ_1 from model/membrane.py).
 """
 import numpy as np
 
+from .membrane import stretch_derivatives
+from ..scene.energies import StrainEnergy
+
 
 def sphere_pressure(material, stretch):
+    if isinstance(material, StrainEnergy):
+        return _scalar_or_array(2 * _phi1(material, stretch) / np.asarray(stretch, dtype=float) ** 2, stretch)
     mu = np.asarray(material.mu)[:, None]
     alpha = np.asarray(material.alpha)[:, None]
     lam = np.atleast_1d(np.asarray(stretch, dtype=float))[None, :]
@@ -17,8 +23,18 @@ def sphere_pressure(material, stretch):
 
 def sphere_stress(material, stretch):
     """Equal principal Cauchy membrane stresses of the inflated sphere (elastic part, MODEL.md §6)."""
+    if isinstance(material, StrainEnergy):
+        return _scalar_or_array(np.asarray(stretch, dtype=float) * _phi1(material, stretch), stretch)
     mu = np.asarray(material.mu)[:, None]
     alpha = np.asarray(material.alpha)[:, None]
     lam = np.atleast_1d(np.asarray(stretch, dtype=float))[None, :]
     value = np.sum(mu * (lam**alpha - lam ** (-2 * alpha)), axis=0)
     return value if np.ndim(stretch) else float(value[0])
+
+
+def _phi1(material, stretch):
+    return stretch_derivatives(material, stretch, stretch)["phi_1"]
+
+
+def _scalar_or_array(value, stretch):
+    return value if np.ndim(stretch) else float(value)

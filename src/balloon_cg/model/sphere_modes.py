@@ -1,4 +1,4 @@
-"""Axisymmetric bifurcations of the pressurised Ogden sphere at M = 0, from the continuum second variation.
+"""Axisymmetric bifurcations of the pressurised sphere (any isotropic energy) at M = 0, from the continuum second variation.
 
 An independent check on the Galerkin/Newton branch-point detection (derivation: docs/sphere_bifurcation.md,
 SymPy verification: docs/derivations/sphere_second_variation.py). The sphere of radius λ under
@@ -22,13 +22,20 @@ Runtime module: numpy/scipy only.
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from .membrane import stretch_derivatives
 from .sphere import sphere_pressure
+from ..scene.energies import StrainEnergy
 
 _GRID_POINTS = 4000
 
 
 def sphere_derivatives(material, stretch):
-    """(Φ1, Φ11, Φ12) of the Ogden Φ(λ1, λ2) at λ1 = λ2 = stretch (scalar or array; Φ2 = Φ1, Φ22 = Φ11)."""
+    """(Φ1, Φ11, Φ12) of Φ(λ1, λ2) at λ1 = λ2 = stretch (scalar or array; Φ2 = Φ1, Φ22 = Φ11): Ogden in closed
+    form, any other strain energy from its kernels (model/membrane.py)."""
+    if isinstance(material, StrainEnergy):
+        d = stretch_derivatives(material, stretch, stretch)
+        values = d["phi_1"], d["phi_11"], d["phi_12"]
+        return tuple(map(float, values)) if np.ndim(stretch) == 0 else values
     mu = np.asarray(material.mu, dtype=float)[:, None]
     alpha = np.asarray(material.alpha, dtype=float)[:, None]
     lam = np.atleast_1d(np.asarray(stretch, dtype=float))[None, :]

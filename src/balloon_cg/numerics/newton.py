@@ -13,6 +13,7 @@ solution) one or two factorisations serve the whole solve, and the other iterati
 Converged when both the last correction and the error estimate ρ/(1 − ρ)·|dx| (observed contraction
 ρ = |dx_k|/|dx_{k−1}|, Hairer & Wanner IV.8.10) are below the tolerance.
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,20 +56,27 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
     previous = np.inf
     factors, fresh, jacobians, growth = None, False, 0, 0
     r, step = None, np.inf
+    n = x.size - rows.shape[0]  # equations R
+    matrix = np.empty((x.size, x.size), order="F")  # [∂R/∂x; rows], factored in place (LAPACK's column order)
+    rhs = np.empty(x.size)
     for iteration in range(1, max_iter + 1):
         try:
             if r is None:
                 r = residual(x)
             if factors is None:
-                lu, pivots, info = dgetrf(np.vstack([jacobian(x), rows]), overwrite_a=True)
+                matrix[:n] = jacobian(x)
+                matrix[n:] = rows
+                lu, pivots, info = dgetrf(matrix, overwrite_a=True)
                 factors, fresh, jacobians = (lu, pivots), True, jacobians + 1
                 if info != 0:
                     message = "singular Newton matrix" if info > 0 else "invalid Newton matrix"
                     return _failed(x, iteration, r, np.inf, message, jacobians)
         except ArithmeticError as error:
             return NewtonResult(x, False, iteration, np.inf, np.inf, f"state left the domain: {error}", jacobians)
-        dx, _ = dgetrs(*factors, -np.concatenate([r, rows @ x - targets]))
-        if not np.all(np.isfinite(dx)):
+        np.negative(r, out=rhs[:n])
+        np.subtract(targets, rows @ x, out=rhs[n:])
+        dx, _ = dgetrs(*factors, rhs)
+        if not math.isfinite(dx.sum()):  # a NaN or ±inf anywhere makes the sum NaN or ±inf
             return _failed(x, iteration, r, np.inf, "non-finite Newton step", jacobians)
         step = float((np.abs(dx) / (1.0 + np.abs(x))).max())
         ratio = step / previous if np.isfinite(previous) and previous > 0 else None

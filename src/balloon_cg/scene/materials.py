@@ -7,6 +7,7 @@
 from dataclasses import dataclass, replace
 
 from ..generated import CLASSES, GENERAL_TERMS
+from .energies import FAMILIES, PRESET_VALUES, StrainEnergy, family_energy, formula_energy, preset_energy
 from .validation import SceneError, number, show, table
 
 MAX_TERMS = max([GENERAL_TERMS] + [len(a) for a, _ in CLASSES.values() if a is not None])  # generated kernels
@@ -44,33 +45,45 @@ PRESETS: dict[str, Material] = {
     )
 }
 
-_KEYS = ("preset", "mu", "alpha", "name")
+# Named non-Ogden materials (scene/energies.py: families and their preset parameters).
+ENERGY_PRESETS: dict[str, StrainEnergy] = {name: preset_energy(name) for name in PRESET_VALUES}
+
+_KEYS = ("preset", "mu", "alpha", "name", "family", "energy", "parameters")
 
 
-def get_preset(name: str) -> Material:
-    """The preset called ``name``, matched case-insensitively; KeyError if there is none."""
-    for key, material in PRESETS.items():
+def get_preset(name: str) -> Material | StrainEnergy:
+    """The preset called ``name`` (Ogden or another family), matched case-insensitively; KeyError if none."""
+    for key, material in (PRESETS | ENERGY_PRESETS).items():
         if key.lower() == name.lower():
             return material
     raise KeyError(name)
 
 
-def material_from_table(data: dict) -> Material:
-    """The Material described by a ``[material]`` table: ``preset = "NAME"`` or ``mu``/``alpha`` (+ ``name``)."""
+def material_from_table(data: dict) -> Material | StrainEnergy:
+    """The material of a ``[material]`` table (+ ``name``): ``preset = "NAME"``; Ogden ``mu``/``alpha``;
+    ``family = "KEY"`` or ``energy = "FORMULA"``, each with a ``[material.parameters]`` table."""
     data = table("material", data, _KEYS)
     name = data.get("name")
     if name is not None and (not isinstance(name, str) or not name.strip()):
         raise SceneError(f"material.name = {show(name)}: must be a non-empty string")
+    given = [k for k in ("preset", "family", "energy") if k in data] + (["mu/alpha"] if {"mu", "alpha"} & set(data)
+                                                                       else [])
+    if len(given) > 1:
+        raise SceneError(f"material.{given[0]} = {show(data.get(given[0]))}: give one of preset, family, energy "
+                         f"or mu and alpha (got {', '.join(given)})")
+    if "parameters" in data and not {"family", "energy"} & set(data):
+        raise SceneError("material.parameters: only with family = \"KEY\" or energy = \"FORMULA\"")
+    if "family" in data or "energy" in data:
+        return _energy_from_table(data, name)
     if "preset" in data:
         preset = data["preset"]
-        if "mu" in data or "alpha" in data:
-            raise SceneError(f"material.preset = {show(preset)}: give either preset or mu and alpha, not both")
         try:
             material = get_preset(preset) if isinstance(preset, str) else None
         except KeyError:
             material = None
         if material is None:
-            raise SceneError(f"material.preset = {show(preset)}: unknown preset; allowed: {', '.join(PRESETS)}")
+            raise SceneError(f"material.preset = {show(preset)}: unknown preset; allowed: "
+                             f"{', '.join(PRESETS | ENERGY_PRESETS)}")
         return replace(material, name=name) if name else material
     for key in ("mu", "alpha"):
         if key not in data:
@@ -91,6 +104,24 @@ def material_from_table(data: dict) -> Material:
             f"Σ μ_i α_i = {material.shear_modulus_sum:g} must be > 0 (initial shear modulus must be positive)"
         )
     return material
+
+
+def _energy_from_table(data: dict, name: str | None) -> StrainEnergy:
+    """``family = "KEY"`` or ``energy = "FORMULA"`` with ``[material.parameters]`` (name = number)."""
+    parameters = data.get("parameters", {})
+    if not isinstance(parameters, dict):
+        raise SceneError(f"material.parameters = {show(parameters)}: must be a table of name = number")
+    values = {k: number(f"material.parameters.{k}", v) for k, v in parameters.items()}
+    if "family" in data:
+        family = data["family"]
+        if family not in FAMILIES:
+            raise SceneError(f"material.family = {show(family)}: unknown family; allowed: {', '.join(FAMILIES)}")
+        extra = [k for k in values if k not in FAMILIES[family].parameters]
+        if extra:
+            raise SceneError(f"material.parameters.{extra[0]} = {show(values[extra[0]])}: not a parameter of "
+                             f"family {family} ({', '.join(FAMILIES[family].parameters)})")
+        return family_energy(family, values, name or family)
+    return formula_energy(data["energy"], values, name or "formula")
 
 
 def _terms(key: str, values) -> tuple[float, ...]:

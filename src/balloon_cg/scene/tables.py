@@ -12,6 +12,7 @@ from dataclasses import field as dataclass_field
 from pathlib import Path
 
 from .validation import SceneError, number, show, show_key, table
+from .energies import StrainEnergy
 from .materials import Material, material_from_table
 
 __all__ = [
@@ -121,7 +122,7 @@ class Scene:
     """A validated scene; ``text`` is the TOML it was parsed from (provenance)."""
 
     name: str
-    material: Material
+    material: Material | StrainEnergy
     field: Field
     continuation: Continuation
     solver: Solver
@@ -138,7 +139,8 @@ class Scene:
         """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded)."""
         m, f = self.material, self.field
         return {
-            "material": {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
+            "material": m.to_table() if isinstance(m, StrainEnergy) else
+            {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
             **{t: asdict(getattr(self, t)) for t in _TABLES[2:]},
         }
@@ -400,12 +402,21 @@ def _to_toml(data: dict) -> str:
     return "\n".join(lines)
 
 
+_PARAMETER_KEY = re.compile(r"material\.parameters\.(\w+)")
 _OVERRIDE_KEY = re.compile(r"(\w+)\.(\w+)(?:\[(\d+)\]\.(\w+))?")
 
 
 def _assign(data: dict, key: str, value) -> None:
     """Set the dotted override ``key`` in a scene dict (numpy values become plain Python ones)."""
     value = value.tolist() if hasattr(value, "tolist") else value
+    parameter = _PARAMETER_KEY.fullmatch(key)
+    if parameter is not None:  # a strain energy's parameter (scene/energies.py)
+        parameters = data.get("material", {}).get("parameters", {})
+        if parameter.group(1) not in parameters:
+            raise SceneError(f"{key} = {show(value)}: the material has no parameter {parameter.group(1)!r} "
+                             f"(it has: {', '.join(parameters) or 'none'})")
+        parameters[parameter.group(1)] = value
+        return
     match = _OVERRIDE_KEY.fullmatch(key)
     if match is None:
         raise SceneError(f"{key} = {show(value)}: not a scene key (e.g. field.M or field.coils[0].current)")

@@ -1,0 +1,90 @@
+"""Constrained lowest eigenvalues (balloon_cg.numerics.eigen) and the stability flags from the inertia alone.
+
+Independent checks: the restricted pencil against an explicit null-space basis (scipy.linalg.null_space) and
+scipy's generalized eigensolver; positive definiteness against the sign of the lowest eigenvalue; and, on
+branches with and without a field, the flags of ``SecondVariation.flags`` (Cholesky) against those of
+``SecondVariation.assess`` (eigenvalues) at every point and both degrees the check uses.
+"""
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import linalg
+
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.stability import SecondVariation
+from balloon_cg.numerics import eigen
+from balloon_cg.scene import load_scene, parse_scene
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def pencil(n, seed):
+    rng = np.random.default_rng(seed)
+    B = rng.normal(size=(n, n))
+    G = B @ B.T + n * np.eye(n)
+    H = rng.normal(size=(n, n))
+    return 0.5 * (H + H.T), G, rng
+
+
+@pytest.mark.parametrize("n, k", [(12, 0), (30, 1), (41, 3), (60, 3), (eigen.LARGE_BLOCK + 40, 3)])
+def test_restricted_lowest_matches_an_explicit_null_space(n, k):
+    H, G, rng = pencil(n, n + k)
+    normals = rng.normal(size=(k, n))
+    if k == 3:
+        normals[2] = 2.0 * normals[0] - normals[1]  # linearly dependent: one direction fewer
+    values = eigen.lowest(H, eigen.GramFactor(G), 4, normals)
+    null = linalg.null_space(normals) if k else np.eye(n)
+    assert null.shape[1] == n - min(k, 2)
+    expected = linalg.eigh(null.T @ H @ null, null.T @ G @ null, eigvals_only=True)[:4]
+    assert np.abs(values - expected).max() < 1e-12 * np.abs(expected).max()
+
+
+def test_restricted_block_of_a_larger_matrix():
+    H, G, rng = pencil(20, 3)
+    index = np.array([1, 4, 5, 9, 12, 17])
+    g = rng.normal(size=20)
+    values = eigen.lowest(H, eigen.GramFactor(G[np.ix_(index, index)]), 3, g[index], index)
+    null = linalg.null_space(g[index][None])
+    Hb, Gb = H[np.ix_(index, index)], G[np.ix_(index, index)]
+    expected = linalg.eigh(null.T @ Hb @ null, null.T @ Gb @ null, eigvals_only=True)[:3]
+    assert np.abs(values - expected).max() < 1e-12 * np.abs(expected).max()
+
+
+def test_positive_definite_is_the_sign_of_the_lowest_eigenvalue():
+    H, G, _ = pencil(25, 11)
+    factor = eigen.GramFactor(G)
+    lowest = eigen.lowest(H, factor, 1)[0]
+    for shift in (lowest - 1e-3, lowest + 1e-3):
+        A = eigen.restricted(H - shift * G, factor)
+        assert eigen.positive_definite(A) == (lowest - shift > 0)
+
+
+def flag_pairs(branch, symmetric, m_max, degrees):
+    eq = equilibrium_of(branch)
+    for degree in degrees:
+        variation = SecondVariation(eq, degree)
+        for X in branch.X:
+            params = branch.params.with_value("P", X[-1])
+            yield (tuple(variation.assess(X[:-1], params, symmetric, m_max).flags().values()),
+                   variation.flags(X[:-1], params, symmetric, m_max))
+
+
+@pytest.mark.parametrize("scene, stop", [("spom1", 4.0), ("spom1_two_coils_M0.002", 1.8)])
+def test_inertia_flags_agree_with_the_eigenvalue_flags(scene, stop):
+    """Both symmetry readings (the equator-symmetric blocks and the general ones), m = 0 and 1, held and free in
+    a field; the flags must change along the branch for the comparison to mean something."""
+    branch = trace_primary(load_scene(ROOT / "scenes" / f"{scene}.toml"), stop_stretch=stop, down=False)
+    for symmetric in (True, False):
+        pairs = list(flag_pairs(branch, symmetric, 1, (20, 40)))
+        assert all(eigenvalues == inertia for eigenvalues, inertia in pairs)
+        assert len({eigenvalues for eigenvalues, _ in pairs}) > 1
+
+
+def test_inertia_flags_without_m1_blocks():
+    branch = trace_primary(parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 3.0\n',
+                                       name="spom1"), down=False)
+    pairs = list(flag_pairs(branch, True, 0, (20,)))
+    assert all(eigenvalues == inertia for eigenvalues, inertia in pairs)
+    assert len({eigenvalues for eigenvalues, _ in pairs}) > 1
