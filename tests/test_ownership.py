@@ -87,3 +87,11 @@ def test_debris_of_killed_writers_is_removed_on_start_and_none_left_on_exit(tmp_
     assert main(["run", str(scene), "-o", str(out), "--primary-only", "--quiet"]) == 0
     assert not any(p.exists() for p in old) and unrelated.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([".other.h5.0123456789ab.tmp", "run.h5", scene.name])
+
+
+def test_critical_on_an_output_in_use_fails_at_once(tmp_path, capsys):
+    out = tmp_path / "curve.h5"
+    with claim(out):
+        assert main(["critical", str(scene_file(tmp_path)), "--parameter", "alpha1", "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"in use by PID {os.getpid()}" in err and "--force" not in err

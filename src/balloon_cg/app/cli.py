@@ -21,6 +21,7 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
+from ..io.lock import owned
 from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
@@ -382,7 +383,7 @@ def _add_critical(commands):
     p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.set_defaults(handler=critical)
+    p.set_defaults(handler=owned(critical, "critical"))
 
 
 def critical(args) -> int:
