@@ -11,8 +11,9 @@ uninterrupted serial sweep and leave no debris (temporary files, lock files, sta
 Collisions: two `run`s on one output, the second started 0-20 ms after the first, no --force: exactly one may
 write it; the other must exit 2 with "in use by PID"; a "lost result" is both exiting 0.
 
-Run: python benchmarks/crash_soak.py [KILLS [COLLISIONS]]  (default 200 and 20; figures in the note; the test
-suite runs the same code with 20 kills and 3 collisions: tests/test_crash.py)
+Run: python benchmarks/crash_soak.py [KILLS [COLLISIONS]]  (default 200 and 20; output also in
+benchmarks/results/crash_soak.txt; the test suite runs the same code with 20 kills and 3 collisions:
+tests/test_crash.py)
 """
 import hashlib
 import os
@@ -235,9 +236,11 @@ def main(argv) -> int:
             ("collisions refused at once with 'in use by PID'", clash["refused_in_use"]),
             ("pairs that did not overlap (second found the file written)", clash["sequential"])]
     width = max(len(r[0]) for r in rows)
-    print("\n".join(f"{name:<{width}}  {value}" for name, value in rows))
-    for problem in figures["unrecoverable"] + figures["failed_resumes"] + figures["debris"] + clash["other"]:
-        print("  ", problem)
+    text = "\n".join([f"{name:<{width}}  {value}" for name, value in rows]
+                     + [f"   {problem}" for problem in figures["unrecoverable"] + figures["failed_resumes"]
+                        + figures["debris"] + clash["other"]])
+    print(text)
+    (Path(__file__).resolve().parent / "results" / "crash_soak.txt").write_text(text + "\n")
     bad = (figures["unrecoverable"] or figures["failed_resumes"] or figures["lost"] or figures["debris"]
            or clash["lost"] or clash["other"])
     return 1 if bad else 0
