@@ -66,6 +66,15 @@ class Reading(enum.StrEnum):
     def meaning(self) -> str:
         return READING_MEANINGS[self]
 
+    @classmethod
+    def parse(cls, text: str) -> "Reading":
+        """The reading named ``text`` (PlotError naming the allowed ones otherwise)."""
+        try:
+            return cls(text)
+        except ValueError:
+            raise PlotError(f"--stability {text!r}: not a stability reading (choose one of "
+                            f"{', '.join(r.value for r in cls)})") from None
+
 
 READING_MEANINGS = {
     Reading.PRESSURE: "pressure control, held at centre",
@@ -152,7 +161,7 @@ def as_run(source) -> dict:
 def load_branches(source, branch: str | None = None, reading: Reading = Reading.PRESSURE) -> list[StoredBranch]:
     """The branches of a run or run file (all, primary first, or the one named), with their stability under
     ``reading``."""
-    reading = Reading(reading)
+    reading = Reading.parse(reading)
     run = as_run(source)
     names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
     if branch is not None and branch not in run["branches"]:
