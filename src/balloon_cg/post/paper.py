@@ -14,8 +14,9 @@ from importlib import resources
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
-from .plotting import Configuration, Reading, describe_scene, plot
+from .plotting import P_LABEL, Configuration, Reading, describe_scene, plot
 from .quantities import stored_scene
 from ..scene import parse_scene
 
@@ -73,9 +74,10 @@ def primary_only(run: dict) -> dict:
     return run | {"branches": {"primary": run["branches"]["primary"]}}
 
 
-def shared_legend(fig, axes, ncols: int = 3):
+def shared_legend(fig, axes, ncols: int = 4):
     """Replace the legends drawn inside ``axes`` by one legend below the figure (entries deduplicated by
-    label; the title of the first)."""
+    label; the title of the first), with the key of the special-point markers."""
+    markers_only(axes)
     handles, title = {}, None
     for ax in axes:
         legend = ax.get_legend()
@@ -85,9 +87,23 @@ def shared_legend(fig, axes, ncols: int = 3):
         for handle, text in zip(legend.legend_handles, legend.get_texts()):
             handles.setdefault(text.get_text(), handle)
         legend.remove()
-    if handles:
-        fig.legend(list(handles.values()), list(handles), title=title, loc="outside lower center",
-                   ncols=min(ncols, len(handles)))
+    handles |= {h.get_label(): h for h in MARKER_KEY}
+    fig.legend(list(handles.values()), list(handles), title=title, loc="outside lower center",
+               ncols=min(ncols, len(handles)))
+
+
+def markers_only(axes):
+    """Remove the kind labels of the special points (their markers stay; the key is in the legend)."""
+    for ax in axes:
+        for text in list(ax.texts):
+            if text.get_text() in SPECIAL_TEXTS or text.get_text().startswith(("BP", "pitchfork", "transcritical")):
+                text.remove()
+
+
+SPECIAL_TEXTS = {"LP", "TP", "EP", "UZ"}
+MARKER_KEY = [Line2D([], [], linestyle="none", marker=m, markerfacecolor="0.7", markeredgecolor="k",
+                     markeredgewidth=0.5, label=text)
+              for m, text in (("o", "LP fold"), ("s", "TP turn in λ2(0)"), ("D", "BP branch point"), ("X", "EP end"))]
 
 
 def _scratch_axes():
@@ -123,6 +139,7 @@ def curve_panels(kind: str, panel: int | None) -> Callable:
                 pair = [_scratch_axes(), _scratch_axes()]
                 pair[panel or 0] = ax
                 plot(sources, kind, axes=ax if panel is None else pair, stability=reading)
+                ax.set_ylabel(P_LABEL)  # pressure-equator labels only its first panel
                 targets += [ax] if panel is None else pair
                 which = ("primary", "pear-shaped")[col] if columns else ""
                 _letter(ax, 2 * row + col if columns else row, f"{material} {which}".strip())
@@ -267,7 +284,7 @@ def draw_energy(runs, fig, reading):
         ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
         ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)")
         if k >= len(points):
-            ax.text(0.5, 0.5, "no classified branch point", transform=ax.transAxes, ha="center")
+            _letter(ax, k, f"$P_{{cr{k + 1}}}$: no classified branch point on the traced branch")
             continue
         s = points[k]
         plot(run | {"branches": {"primary": run["branches"]["primary"] | {"special_points": [s]}}}, "energy",
@@ -286,6 +303,9 @@ def draw_energy(runs, fig, reading):
 
 # --- the figures -------------------------------------------------------------------------------------------
 
+SINGLE_COIL_REACH = (("continuation.stop_stretch", 6.0),)  # the isola reaches λ2(0) = 5.4 (spom1.toml)
+
+
 def _family(single_coil: bool, quick: bool) -> tuple[Case, ...]:
     """SPOM1 then TPOM1: M = 0 (field-free scenes; not in quick runs) and the M values with one coil
     (spom1_single_coil, its material replaced for TPOM1) or the paper's two coils (the shipped scenes)."""
@@ -295,13 +315,13 @@ def _family(single_coil: bool, quick: bool) -> tuple[Case, ...]:
         cases += [] if quick else [Case(material)]
         if single_coil:
             preset = () if material == "spom1" else (("material.preset", "TPOM1"),)
-            cases += [Case("spom1_single_coil", preset + (("field.M", M),)) for M in values]
+            cases += [Case("spom1_single_coil", preset + (("field.M", M),) + SINGLE_COIL_REACH) for M in values]
         else:
             cases += [Case(f"{material}_two_coils_M{M:g}") for M in values]
     return tuple(cases)
 
 
-SINGLE_COIL_M0001 = Case("spom1_single_coil", (("field.M", 0.001),))
+SINGLE_COIL_M0001 = Case("spom1_single_coil", (("field.M", 0.001),) + SINGLE_COIL_REACH)
 TWO_COILS_M0001 = Case("spom1_two_coils_M0.001")
 
 

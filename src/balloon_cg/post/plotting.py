@@ -180,9 +180,10 @@ def load_branches(source, branch: str | None = None, reading: Reading = Reading.
 
 
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
-    """Set each branch's legend label: 'M = …', with the scene name where two files share an M, and the branch
-    name where a file contributes several branches; and its colour: one per branch, a mirror image sharing
-    its partner's."""
+    """Set each branch's legend label and colour. One file: a colour per branch (a mirror image sharing its
+    partner's), labelled 'M = …, <branch name>' when there are several. Several files: a colour per file,
+    labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
+    curves)."""
     files = {}
     for b in branches:
         files.setdefault(id(b.run), []).append(b)
@@ -193,13 +194,13 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         label = f"M = {b.M:g}"
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
-        if len(files[id(b.run)]) > 1:
+        if len(files) == 1 and len(files[id(b.run)]) > 1:
             label += f", {b.name}"
         b.label = label
     colors = {}
     for b in branches:
-        partner = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX))
-        b.color = colors.setdefault(partner, f"C{len(colors) % 10}")
+        key = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX)) if len(files) == 1 else id(b.run)
+        b.color = colors.setdefault(key, f"C{len(colors) % 10}")
     return branches
 
 
@@ -357,8 +358,13 @@ def _branch_legend(fig, axes, own, branches, extra=()):
         title = f"solid: stable or not computed,\ndashed: unstable ({meaning})"
     else:
         title = "stability not computed (all solid)"
-    handles = [Line2D([], [], color=b.color, label=b.label, linewidth=0.9 if b.mirror else 1.4,
-                      alpha=0.55 if b.mirror else 1.0) for b in branches]
+    handles = {}
+    for b in branches:  # several files: one entry per file (its label)
+        handles.setdefault(b.label, Line2D([], [], color=b.color, label=b.label, linewidth=0.9 if b.mirror else 1.4,
+                                           alpha=0.55 if b.mirror else 1.0))
+    handles = list(handles.values())
+    if any(b.mirror for b in branches) and len({id(b.run) for b in branches}) > 1:
+        handles.append(Line2D([], [], color="0.4", linewidth=0.9, alpha=0.55, label="mirror-image branch"))
     _legend(fig, axes, own, "right upper", handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8)
 
 
