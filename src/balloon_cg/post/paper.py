@@ -186,7 +186,11 @@ def numbered_configurations(run: dict, first: int = 1, snaps: bool = True) -> di
     for k, (source, i, target_branch, j) in enumerate(pairs):
         chosen[first + 3 + 2 * k] = (source, int(i))
         chosen[first + 4 + 2 * k] = (target_branch, int(j))
-    return {n: Configuration(branch, index, str(n)) for n, (branch, index) in sorted(chosen.items())}
+    return {n: Configuration(branch, index, str(n), CONFIGURATION_COLORS[(n - 1) % len(CONFIGURATION_COLORS)])
+            for n, (branch, index) in sorted(chosen.items())}
+
+
+CONFIGURATION_COLORS = ("C0", "C1", "C2", "C3", "C4", "C5", "C6", "C8", "C9")  # one per number; no grey (C7)
 
 
 def pick(configurations: dict, *numbers) -> list[Configuration]:
@@ -199,7 +203,7 @@ def mark_configurations(ax, run: dict, configurations):
     for c in configurations:
         data = run["branches"][c.branch]
         x, y = data["lam2_north"][c.index], data["pressure"][c.index]
-        ax.plot(x, y, "o", markersize=3.5, markerfacecolor="w", markeredgecolor="k", markeredgewidth=0.6)
+        ax.plot(x, y, "o", markersize=3.5, markerfacecolor=c.color or "w", markeredgecolor="k", markeredgewidth=0.6)
         ax.annotate(c.label, (x, y), xytext=(3, 3), textcoords="offset points", fontsize="small", weight="bold")
 
 

@@ -104,11 +104,13 @@ def stable_points(data: dict, reading: Reading) -> np.ndarray | None:
 @dataclass(frozen=True)
 class Configuration:
     """A point to draw in the per-point kinds: point ``index`` (negative: from the end) of branch ``branch``,
-    named ``label`` in the legend (e.g. the paper's configuration numbers)."""
+    named ``label`` in the legend (e.g. the paper's configuration numbers), drawn in ``color`` (default: the
+    next colour of the cycle), so that one configuration keeps its colour across figures."""
 
     branch: str
     index: int
     label: str
+    color: str = ""
 
 
 @dataclass
@@ -450,8 +452,11 @@ def _configurations(branches, points):
             label = (f"{b.label}: " if several else "") + (
                 f"{name}  P = {q['pressure'][j]:.4g}, $\\lambda_2(0)$ = {q['lam2'][j, 0]:.4g}")
             row = {k: v[j] for k, v in q.items() if k not in ("theta", "points")}
-            rows.append((label, f"C{len(rows) % 10}", row | {"theta": q["theta"]}, b))
-    return rows
+            color = (chosen[j].color if named else "") or f"C{len(rows) % 10}"
+            rows.append((label, color, row | {"theta": q["theta"]}, b, chosen[j] if named else None))
+    if named:  # in the order given
+        rows.sort(key=lambda row: points.index(row[4]))
+    return [row[:4] for row in rows]
 
 
 def _per_point_title(branches) -> str:
