@@ -165,6 +165,7 @@ def test_landscape_equilibria_closed_form():
     e2, e3, e4 = -0.3, 0.2, 0.5
     found = landscape_equilibria(e2, e3, e4)
     assert 2 * e2 * found + 3 * e3 * found**2 + 4 * e4 * found**3 == pytest.approx(np.zeros(3), abs=1e-12)
+    assert landscape_equilibria(-1e-8, 0.0, 1.0, resolution=1e-3) == pytest.approx([0.0])  # at a branch point
 
 
 def test_make_figure_output_folder_default(runs, tmp_path):

@@ -74,9 +74,9 @@ def primary_only(run: dict) -> dict:
     return run | {"branches": {"primary": run["branches"]["primary"]}}
 
 
-def shared_legend(fig, axes, ncols: int = 4):
+def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
     """Replace the legends drawn inside ``axes`` by one legend below the figure (entries deduplicated by
-    label; the title of the first), with the key of the special-point markers."""
+    label; the title of the first), with the key of the special-point markers (``markers``)."""
     markers_only(axes)
     handles, title = {}, None
     for ax in axes:
@@ -87,7 +87,7 @@ def shared_legend(fig, axes, ncols: int = 4):
         for handle, text in zip(legend.legend_handles, legend.get_texts()):
             handles.setdefault(text.get_text(), handle)
         legend.remove()
-    handles |= {h.get_label(): h for h in MARKER_KEY}
+    handles |= {h.get_label(): h for h in MARKER_KEY} if markers else {}
     fig.legend(list(handles.values()), list(handles), title=title, loc="outside lower center",
                ncols=min(ncols, len(handles)))
 
@@ -218,7 +218,7 @@ def configurations_figure(two_coils: bool) -> Callable:
         groups = [pick(numbered, 8), pick(numbered, 9)] if two_coils else [pick(numbered, 1, 2), pick(numbered, 3)]
         panels = fig.subplot_mosaic([["a", "b"], ["c0", "d0"], ["c1", "d1"]], height_ratios=[1.4, 1, 1])
         plot(run, "pressure-pole", axes=panels["a"], stability=reading)
-        mark_configurations(panels["a"], run, numbered.values())
+        mark_configurations(panels["a"], run, pick(numbered, 8, 9) if two_coils else numbered.values())
         _letter(panels["a"], 0, "equilibrium curves")
         plot(run, "shapes", points=shapes, axes=panels["b"])
         _letter(panels["b"], 1, "shapes")
@@ -259,6 +259,7 @@ def per_point_columns(kind: str, rows: int) -> Callable:
             else:
                 _absent(axes[:, k], "configuration not traced")
             _letter(axes[0, k], k, f"configuration {', '.join(c.label for c in group) or '–'}")
+        shared_legend(fig, axes.ravel(), ncols=3, markers=False)
         fig.suptitle(f"{describe_scene(stored_scene(single))}; {_coils_line([double])}", fontsize="small")
 
     return draw
@@ -270,11 +271,16 @@ AMPLITUDE_NORMALISATION = (r"$\Lambda = \varphi\cdot(u - u^*)$, $\varphi$ the cr
                            "Euclidean norm of its Legendre coefficients")
 
 
-def landscape_equilibria(e2: float, e3: float, e4: float) -> np.ndarray:
-    """The real critical points Λ* of E(Λ) = E2Λ² + E3Λ³ + E4Λ⁴: 0 and the roots of 4E4Λ² + 3E3Λ + 2E2 = 0."""
+def landscape_equilibria(e2: float, e3: float, e4: float, resolution: float = 0.0) -> np.ndarray:
+    """The real critical points Λ* of E(Λ) = E2Λ² + E3Λ³ + E4Λ⁴: 0 and the roots of 4E4Λ² + 3E3Λ + 2E2 = 0;
+    roots within ``resolution`` of 0 are 0 (at a branch point E2 vanishes up to the fit's error, and the
+    pitchfork's equilibria coincide there)."""
     roots = np.roots([4 * e4, 3 * e3, 2 * e2]) if e4 != 0 else np.array([])
     real = roots[np.abs(roots.imag) <= 1e-12 * max(1.0, np.abs(roots).max(initial=0.0))].real
-    return np.sort(np.r_[0.0, real])
+    return np.sort(np.r_[0.0, real[np.abs(real) > resolution]])
+
+
+LANDSCAPE_RESOLUTION = 0.02  # Λ* closer to 0 than this fraction of the drawn Λ range are drawn as 0
 
 
 def draw_energy(runs, fig, reading):
@@ -293,13 +299,16 @@ def draw_energy(runs, fig, reading):
         s = points[k]
         plot(run | {"branches": {"primary": run["branches"]["primary"] | {"special_points": [s]}}}, "energy",
              branch="primary", axes=ax)
-        for lam in landscape_equilibria(s["E2"], s["E3"], s["E4"]):
+        span = np.ptp(ax.get_lines()[-1].get_xdata())
+        for lam in landscape_equilibria(s["E2"], s["E3"], s["E4"], LANDSCAPE_RESOLUTION * span):
             energy = s["E2"] * lam**2 + s["E3"] * lam**3 + s["E4"] * lam**4
             ax.plot(lam, energy, "o", markersize=3.5, markerfacecolor="w", markeredgecolor="k")
             ax.annotate(rf"$\Lambda^*$ = {lam:.3g}", (lam, energy), xytext=(0, 5), textcoords="offset points",
                         ha="center", fontsize="x-small")
         _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g}, {s['classification']}")
-        ax.get_legend().remove()  # the title names the point; the coefficients are in docs/paper.md
+        ax.get_legend().remove()  # the title names the point, the coefficients follow
+        ax.text(0.5, 0.95, f"E2 = {s['E2']:.3g}, E3 = {s['E3']:.3g}, E4 = {s['E4']:.3g}", transform=ax.transAxes,
+                ha="center", va="top", fontsize="x-small")
         ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)")
     fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}; at the "
                  "branch points; " + AMPLITUDE_NORMALISATION, fontsize="x-small")
