@@ -26,7 +26,8 @@ run: install
 	$(PYTHON) -m balloon_cg.app.default_run $(OUT) $(RUN_FLAGS)
 
 # every figure of the paper (docs/paper.md) into $(PAPER_OUT)/figN.pdf; the runs are kept in $(PAPER_OUT)/runs and
-# reused while their scenes are unchanged. PAPER_FLAGS: e.g. "--width 3.5 --stability axisymmetric" or "--quick".
+# reused while their scenes are unchanged. PAPER_FLAGS: e.g. "--width 3.5 --stability axisymmetric", "--quick", or
+# "--allow-partial" (exit 0 although a run drawn is flagged incomplete; they are named on stderr either way).
 paper: install
 	$(PYTHON) -m balloon_cg figure all -o $(PAPER_OUT) $(PAPER_FLAGS)
 

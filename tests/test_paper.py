@@ -70,8 +70,11 @@ def test_figure_command_one_column(runs, tmp_path, capsys):
     """One column wide, the paper's reading; the paper style does not leak into matplotlib's global state."""
     output = tmp_path / "fig2.pdf"
     before = dict(matplotlib.rcParams)
-    assert main(["figure", "fig2", "-o", str(output), "--runs", str(runs), "--quick", "--quiet",
-                 "--width", str(ONE_COLUMN), "--stability", "axisymmetric"]) == 0
+    command = ["figure", "fig2", "-o", str(output), "--runs", str(runs), "--quick", "--quiet", "--width",
+               str(ONE_COLUMN), "--stability", "axisymmetric"]
+    assert main(command) == 1  # the reduced runs stop short: incomplete, named on stderr
+    assert "incomplete runs drawn" in capsys.readouterr().err
+    assert main(command + ["--allow-partial"]) == 0
     assert output.read_bytes().startswith(b"%PDF") and str(output) in capsys.readouterr().out
     assert dict(matplotlib.rcParams) == before
 

@@ -369,6 +369,7 @@ def _add_figure(commands):
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")
     p.add_argument("--quick", action="store_true", help="reduced runs (few points, low degree, one M): for tests")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.add_argument("--allow-partial", action="store_true", help="exit 0 also when a run drawn is incomplete")
 
     def figure(args) -> int:
         from .figures import FigureError, command
