@@ -174,3 +174,13 @@ def test_landscape_equilibria_closed_form():
 def test_make_figure_output_folder_default(runs, tmp_path):
     path = make_figure("fig12", tmp_path / "out" / "fig12.svg", runs=runs, quick=True)
     assert path.read_text().lstrip().startswith("<?xml")
+
+
+def test_one_column_uses_the_symbols(runs):
+    figure = figures(quick=True)["fig2"]
+    loaded = [run_for(case, runs, quick=True) for case in figure.cases]
+    with matplotlib.rc_context(PAPER_STYLE):
+        fig = draw_figure(figure, loaded, ONE_COLUMN)
+    assert {ax.get_xlabel() for ax in fig.axes} == {r"$\lambda_2(0)$"}
+    assert {ax.get_ylabel() for ax in fig.axes} == {"$P$"}
+    assert fig.get_size_inches()[0] == pytest.approx(ONE_COLUMN)

@@ -88,6 +88,7 @@ def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
             handles.setdefault(text.get_text(), handle)
         legend.remove()
     handles |= {h.get_label(): h for h in MARKER_KEY} if markers else {}
+    ncols = 2 if fig.get_size_inches()[0] < COMPACT_WIDTH else ncols
     fig.legend(list(handles.values()), list(handles), title=title, loc="outside lower center",
                ncols=min(ncols, len(handles)))
 
@@ -229,7 +230,7 @@ def configurations_figure(two_coils: bool) -> Callable:
             else:
                 _absent(pair, "configuration not traced")
             _letter(pair[0], 2 + k, f"stresses, configuration {', '.join(c.label for c in group) or '–'}")
-        shared_legend(fig, [panels["a"]], ncols=2)
+        shared_legend(fig, list(panels.values()), ncols=3)
         fig.suptitle(describe_scene(stored_scene(run)) + f", M = {run['branches']['primary']['attrs']['M']:g}",
                      fontsize="small")
 
@@ -365,12 +366,40 @@ def figures(quick: bool = False) -> dict[str, PaperFigure]:
     )}
 
 
+COMPACT_WIDTH = 5.0  # inches: narrower figures (one column) get the symbols as axis labels, smaller markers
+SHORT_LABELS = {  # the kinds' axis labels -> their symbols (units: docs/plots.md, stated in the caption)
+    P_LABEL: r"$P$", r"pole stretch $\lambda_2(0)$ (north)": r"$\lambda_2(0)$",
+    r"equator stretch $\lambda_2(\pi/2)$ (circumferential)": r"$\lambda_2(\pi/2)$",
+    r"equator stretch $\lambda_1(\pi/2)$ (meridional)": r"$\lambda_1(\pi/2)$",
+    r"material coordinate $\theta$ (rad)": r"$\theta$", r"$\pm\rho/R_0$ (distance from the axis)": r"$\pm\rho/R_0$",
+    r"$\eta/R_0$ (height)": r"$\eta/R_0$", r"$\sigma_\theta$ / ($\mu$/2)": r"$\sigma_\theta$",
+    r"$\sigma_\phi$ / ($\mu$/2)": r"$\sigma_\phi$", r"$H_\theta$ / ($I/4\pi R_0$)": r"$H_\theta$",
+    r"$H_\zeta$ / ($I/4\pi R_0$)": r"$H_\zeta$", r"Gaussian curvature $\kappa R_0^2$": r"$\kappa R_0^2$",
+    r"amplitude $\Lambda$ along the critical mode": r"$\Lambda$",
+    r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)": r"$\Delta\Pi$",
+}
+COMPACT_MARKER = 3.0  # points
+
+
+def compact(fig):
+    """Fit a narrow figure: axis labels by their symbols (SHORT_LABELS), special-point markers COMPACT_MARKER
+    points (``shared_legend`` uses two columns there)."""
+    for ax in fig.axes:
+        ax.set_xlabel(SHORT_LABELS.get(ax.get_xlabel(), ax.get_xlabel()))
+        ax.set_ylabel(SHORT_LABELS.get(ax.get_ylabel(), ax.get_ylabel()))
+        for line in ax.get_lines():
+            if line.get_marker() not in ("None", "", None):
+                line.set_markersize(min(line.get_markersize(), COMPACT_MARKER))
+
+
 def draw_figure(figure: PaperFigure, runs: list[dict], width: float = TWO_COLUMNS,
                 reading: Reading = Reading.PRESSURE) -> Figure:
-    """The Figure of ``figure`` from its runs, ``width`` inches wide, in PAPER_STYLE (applied by the caller
-    around drawing and saving: matplotlib.rc_context(PAPER_STYLE))."""
+    """The Figure of ``figure`` from its runs, ``width`` inches wide (below COMPACT_WIDTH: ``compact``), in
+    PAPER_STYLE (applied by the caller around drawing and saving: matplotlib.rc_context(PAPER_STYLE))."""
     fig = Figure(figsize=(width, figure.height * width), layout="constrained")
     figure.draw(runs, fig, Reading(reading))
+    if width < COMPACT_WIDTH:
+        compact(fig)
     return fig
 
 
