@@ -113,6 +113,11 @@ class Configuration:
     color: str = ""
 
 
+def named_points(points) -> bool:
+    """Whether ``points`` is a non-empty sequence of Configurations (not indices)."""
+    return isinstance(points, (list, tuple)) and len(points) > 0 and all(isinstance(p, Configuration) for p in points)
+
+
 @dataclass
 class StoredBranch:
     """One branch of a run (``run``: read_run() output, from a file or from memory) with its per-point
@@ -231,7 +236,7 @@ def plot(sources, what: str, points=None, branch: str | None = None, axes=None,
     if what == "phase":
         return plot_phase(sources, axes)
     draw, per_point = KINDS[what]
-    configurations = per_point and points is not None and all(isinstance(p, Configuration) for p in points)
+    configurations = per_point and named_points(points)
     names = list(dict.fromkeys(p.branch for p in points)) if configurations else [
         "primary" if per_point and branch is None else branch]
     branches = _label([b for source in sources for name in names for b in load_branches(source, name, stability)])
@@ -440,7 +445,7 @@ def select_points(data: dict, points=None) -> np.ndarray:
 def _configurations(branches, points):
     """[(label, colour, quantities row dict, branch)] for the chosen points of every branch (``points``:
     indices, or Configurations naming their branches and labels)."""
-    named = points is not None and all(isinstance(p, Configuration) for p in points)
+    named = named_points(points)
     several = len(branches) > 1 and not named
     rows = []
     for b in branches:
