@@ -2,8 +2,10 @@
 PYTHON ?= python3
 OUT ?= out
 RUN_FLAGS ?=
+PAPER_OUT ?= paper-figures
+PAPER_FLAGS ?=
 
-.PHONY: install install-dev regenerate test run bench clean
+.PHONY: install install-dev regenerate test run paper bench clean
 
 # Editable like install-dev. A regular `pip install .` before or after is fine too: it ships the generated kernels
 # and the scenes, and numba's cache goes to ~/.cache/balloon-cg/numba, never into site-packages
@@ -23,8 +25,14 @@ test: install-dev
 run: install
 	$(PYTHON) -m balloon_cg.app.default_run $(OUT) $(RUN_FLAGS)
 
+# every figure of the paper (docs/paper.md) into $(PAPER_OUT)/figN.pdf; the runs are kept in $(PAPER_OUT)/runs and
+# reused while their scenes are unchanged. PAPER_FLAGS: e.g. "--width 3.5 --stability axisymmetric", "--quick", or
+# "--allow-partial" (exit 0 although a run drawn is flagged incomplete; they are named on stderr either way).
+paper: install
+	$(PYTHON) -m balloon_cg figure all -o $(PAPER_OUT) $(PAPER_FLAGS)
+
 bench: install-dev
 	$(PYTHON) benchmarks/primary_branch.py
 
 clean:
-	rm -rf build dist *.egg-info $(OUT)
+	rm -rf build dist *.egg-info $(OUT) $(PAPER_OUT)

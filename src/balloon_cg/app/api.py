@@ -201,10 +201,13 @@ def load(path) -> Result:
     return Result(scene, Path(path).read_bytes(), run)
 
 
-def plot(source, what: str = "pressure-pole", ax=None, points=None, branch: str | None = None):
+def plot(source, what: str = "pressure-pole", ax=None, points=None, branch: str | None = None,
+         stability: str = "pressure"):
     """A matplotlib Figure of kind ``what`` (docs/plots.md) from Results or run files (one or a list); drawn
-    into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given."""
+    into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given; ``stability`` the
+    reading that draws curves solid or dashed (post.plotting.Reading)."""
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]
-    return draw([s.run if isinstance(s, Result) else s for s in sources], what, points, branch, axes=ax)
+    return draw([s.run if isinstance(s, Result) else s for s in sources], what, points, branch, axes=ax,
+                stability=stability)

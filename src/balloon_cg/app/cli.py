@@ -85,7 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels,
+                _add_figure):
         add(commands)
     return parser
 
@@ -324,6 +325,9 @@ def _add_plot(commands):
                    help="point indices for shapes, stresses, field, curvature (negative: from the end)")
     p.add_argument("--branch", metavar="NAME",
                    help="branch to draw (default: every branch for pressure-* and energy, primary for the others)")
+    p.add_argument("--stability", default="pressure", metavar="READING",
+                   help="what solid (stable) and dashed (unstable) mean: pressure (default; held at the centre, "
+                        "pressure control), volume, free, free-volume, or axisymmetric (the paper's: m = 0 modes only)")
     p.set_defaults(handler=plot)
 
 
@@ -361,9 +365,35 @@ def plot(args) -> int:
         check_output(output, force=True)
     runs = [as_run(f) for f in args.files] if any(kind != "phase" for kind in args.what) else []
     for kind, output in outputs.items():
-        draw(args.files if kind == "phase" else runs, kind, args.points, args.branch).savefig(output, dpi=150)
+        draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
+             stability=args.stability).savefig(output, dpi=150)
         print(output)
     return 0
+
+
+# --- figure ------------------------------------------------------------------------------------------------
+
+def _add_figure(commands):
+    """``figure``: one figure of the paper, or all of them (app.figures, docs/paper.md)."""
+    p = commands.add_parser("figure", help=f"draw a figure of the paper, computing its runs ({docs_path('paper.md')})")
+    p.add_argument("name", help="fig2 .. fig13, or all (then --output is a folder)")
+    p.add_argument("-o", "--output", required=True, help="image file (.png, .pdf, .svg), or the folder for all")
+    p.add_argument("--runs", metavar="FOLDER", help="where run files are kept and reused (default: OUTPUT's folder/runs)")
+    p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
+    p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")
+    p.add_argument("--quick", action="store_true", help="reduced runs (few points, low degree, one M): for tests")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.add_argument("--allow-partial", action="store_true", help="exit 0 also when a run drawn is incomplete")
+
+    def figure(args) -> int:
+        from .figures import FigureError, command
+
+        try:
+            return command(args)
+        except FigureError as e:
+            raise UsageError(str(e)) from None
+
+    p.set_defaults(handler=figure)
 
 
 # --- critical ----------------------------------------------------------------------------------------------

@@ -5,13 +5,17 @@ drawn into them with the legend inside the first.
 
 Curves of branches (pressure-pole, pressure-equator) and the energy landscape draw every branch of every file
 (or the one named); the per-point kinds (shapes, stresses, field, curvature) draw chosen points of one branch
-per file (default: primary). One colour per drawn branch, labelled by M (branch attrs), plus the branch name
-when a file holds several. Branch curves are solid where stable and dashed where unstable when the file has
-``branches/<name>/stability/stable_pressure`` (pressure control, balloon held at its centre); otherwise all
-solid, and the legend title says so. Special points are marked and labelled with their kind (LP, TP, EP,
-branch points, …). Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), lengths in R0, stresses in μ/2,
-field in I/(4π R0).
+per file (default: primary), or chosen ``Configuration`` s of several branches. One colour per drawn branch,
+labelled by M (branch attrs), plus the branch name when a file holds several; a mirror-image branch
+(``<name>_mirror``) takes its partner's colour, drawn thinner and lighter. Branch curves are solid where stable
+and dashed where unstable under the chosen stability ``Reading`` (default: pressure control, balloon held at
+its centre), named in the legend title; without stability data all solid, and the legend title says so. Titles
+name the material and the coils. Special points are marked and labelled with their kind (LP, TP, EP, branch
+points, …). The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest
+(``robust_limits``). Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), lengths in R0, stresses in
+μ/2, field in I/(4π R0).
 """
+import enum
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,19 +39,101 @@ P_LABEL = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
 THETA_LABEL = r"material coordinate $\theta$ (rad)"
 
 
+MIRROR_SUFFIX = "_mirror"  # analysis.picture names the mirror image of pear branch <name> <name>_mirror
+
+
 class PlotError(ValueError):
     """A figure that cannot be drawn from the given files (missing branch, data or point)."""
 
 
+class Reading(enum.StrEnum):
+    """Which stability flag draws a branch solid (stable) or dashed (docs/hdf5.md, stability/).
+
+    The stored flags: ``pressure`` stable_pressure (balloon held at its centre, pressure control), ``volume``
+    stable_volume (held, volume control: the gas enclosed), ``free`` stable_pressure_free (axial translation
+    included, pressure control), ``free-volume`` stable_volume_free. ``axisymmetric`` is the paper's reading:
+    held, pressure control, the axisymmetric blocks only (lowest_even and lowest_odd_held, or lowest_all_held
+    off the equator-symmetric layout), i.e. the m ≥ 1 blocks ignored.
+    """
+
+    PRESSURE = "pressure"
+    VOLUME = "volume"
+    FREE = "free"
+    FREE_VOLUME = "free-volume"
+    AXISYMMETRIC = "axisymmetric"
+
+    @property
+    def meaning(self) -> str:
+        return READING_MEANINGS[self]
+
+    @classmethod
+    def parse(cls, text: str) -> "Reading":
+        """The reading named ``text`` (PlotError naming the allowed ones otherwise)."""
+        try:
+            return cls(text)
+        except ValueError:
+            raise PlotError(f"--stability {text!r}: not a stability reading (choose one of "
+                            f"{', '.join(r.value for r in cls)})") from None
+
+
+READING_MEANINGS = {
+    Reading.PRESSURE: "pressure control, held at centre",
+    Reading.VOLUME: "volume control, held at centre",
+    Reading.FREE: "pressure control, free balloon",
+    Reading.FREE_VOLUME: "volume control, free balloon",
+    Reading.AXISYMMETRIC: "axisymmetric modes only (paper)",
+}
+FLAGS = {Reading.PRESSURE: "stable_pressure", Reading.VOLUME: "stable_volume",
+         Reading.FREE: "stable_pressure_free", Reading.FREE_VOLUME: "stable_volume_free"}
+AXISYMMETRIC_BLOCKS = (("lowest_even", "lowest_odd_held"), ("lowest_all_held",))
+
+
+def stable_points(data: dict, reading: Reading) -> np.ndarray | None:
+    """The per-point stability of a stored branch under ``reading`` (None when the branch has no such data):
+    a stored flag, or for ``axisymmetric`` the lowest eigenvalue of every axisymmetric block > 0."""
+    stability = data.get("stability", {})
+    if reading != Reading.AXISYMMETRIC:
+        flag = stability.get(FLAGS[reading])
+        return None if flag is None else np.asarray(flag, dtype=bool)
+    for blocks in AXISYMMETRIC_BLOCKS:
+        if all(block in stability for block in blocks):
+            return np.all([stability[block][:, 0] > 0 for block in blocks], axis=0)
+    return None
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """A point to draw in the per-point kinds: point ``index`` (negative: from the end) of branch ``branch``,
+    named ``label`` in the legend (e.g. the paper's configuration numbers), drawn in ``color`` (default: the
+    next colour of the cycle), so that one configuration keeps its colour across figures."""
+
+    branch: str
+    index: int
+    label: str
+    color: str = ""
+
+
+def named_points(points) -> bool:
+    """Whether ``points`` is a non-empty sequence of Configurations (not indices)."""
+    return isinstance(points, (list, tuple)) and len(points) > 0 and all(isinstance(p, Configuration) for p in points)
+
+
 @dataclass
 class StoredBranch:
-    """One branch of a run (``run``: read_run() output, from a file or from memory) with its optional per-point
-    stability flag stability/stable_pressure (None if the run has none) and a label for legends."""
+    """One branch of a run (``run``: read_run() output, from a file or from memory) with its per-point
+    stability under the chosen reading (None if the run has none), a label and a colour for legends."""
 
     run: dict
     name: str
     stable: np.ndarray | None
     label: str = ""
+    color: str = "C0"
+    reading: Reading = Reading.PRESSURE
+
+    @property
+    def mirror(self) -> bool:
+        """Whether this is the mirror image (about the equator) of another pear branch."""
+        return self.name.endswith(MIRROR_SUFFIX)
 
     @property
     def data(self) -> dict:
@@ -79,8 +165,10 @@ def as_run(source) -> dict:
     return source if isinstance(source, dict) else read_run(source)
 
 
-def load_branches(source, branch: str | None = None) -> list[StoredBranch]:
-    """The branches of a run or run file (all, primary first, or the one named), with their stability flags."""
+def load_branches(source, branch: str | None = None, reading: Reading = Reading.PRESSURE) -> list[StoredBranch]:
+    """The branches of a run or run file (all, primary first, or the one named), with their stability under
+    ``reading``."""
+    reading = Reading.parse(reading)
     run = as_run(source)
     names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
     if branch is not None and branch not in run["branches"]:
@@ -89,18 +177,20 @@ def load_branches(source, branch: str | None = None) -> list[StoredBranch]:
     loaded = []
     for name in names:
         data = run["branches"][name]
-        stable = data.get("stability", {}).get("stable_pressure")
+        stable = stable_points(data, reading)
         n = len(data["pressure"])
         if stable is not None and stable.shape != (n,):
-            raise PlotError(f"{run['path']}: branch {name}: stability/stable_pressure has shape {stable.shape}, "
+            raise PlotError(f"{run['path']}: branch {name}: the {reading.value} stability has shape {stable.shape}, "
                             f"expected ({n},)")
-        loaded.append(StoredBranch(run, name, None if stable is None else stable.astype(bool)))
+        loaded.append(StoredBranch(run, name, stable, reading=reading))
     return loaded
 
 
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
-    """Set each branch's legend label: 'M = …', with the scene name where two files share an M, and the branch
-    name where a file contributes several branches."""
+    """Set each branch's legend label and colour. One file: a colour per branch (a mirror image sharing its
+    partner's), labelled 'M = …, <branch name>' when there are several. Several files: a colour per file,
+    labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
+    curves)."""
     files = {}
     for b in branches:
         files.setdefault(id(b.run), []).append(b)
@@ -111,9 +201,13 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         label = f"M = {b.M:g}"
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
-        if len(files[id(b.run)]) > 1:
+        if len(files) == 1 and len(files[id(b.run)]) > 1:
             label += f", {b.name}"
         b.label = label
+    colors = {}
+    for b in branches:
+        key = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX)) if len(files) == 1 else id(b.run)
+        b.color = colors.setdefault(key, f"C{len(colors) % 10}")
     return branches
 
 
@@ -125,14 +219,16 @@ def applicable_kinds(branches) -> list[str]:
             and (kind != "energy" or any(b.bifurcations for b in branches))]
 
 
-def plot(sources, what: str, points=None, branch: str | None = None, axes=None) -> Figure:
+def plot(sources, what: str, points=None, branch: str | None = None, axes=None,
+         stability: Reading = Reading.PRESSURE) -> Figure:
     """The figure of kind ``what`` (one of KINDS) for ``sources``: runs (read_run() output) or run files, one
     or a list (``phase``: curve or sweep files).
 
     ``branch``: the branch to draw (default: all branches for the branch curves and the energy, 'primary' for
     the per-point kinds). ``points``: indices (negative count from the end) of the configurations drawn by the
-    per-point kinds (default: DEFAULT_POINTS spread along the branch). ``axes``: draw into these matplotlib
-    Axes (one, or as many as the kind has panels: PANELS) instead of a new figure.
+    per-point kinds (default: DEFAULT_POINTS spread along the branch), or ``Configuration`` s (each names its
+    branch; ``branch`` is then ignored). ``axes``: draw into these matplotlib Axes (one, or as many as the kind
+    has panels) instead of a new figure. ``stability``: the Reading that draws curves solid or dashed.
     """
     if what not in KINDS:
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
@@ -140,9 +236,10 @@ def plot(sources, what: str, points=None, branch: str | None = None, axes=None) 
     if what == "phase":
         return plot_phase(sources, axes)
     draw, per_point = KINDS[what]
-    if per_point and branch is None:
-        branch = "primary"
-    branches = _label([b for source in sources for b in load_branches(source, branch)])
+    configurations = per_point and named_points(points)
+    names = list(dict.fromkeys(p.branch for p in points)) if configurations else [
+        "primary" if per_point and branch is None else branch]
+    branches = _label([b for source in sources for name in names for b in load_branches(source, name, stability)])
     return draw(branches, points, axes=axes) if per_point else draw(branches, axes=axes)
 
 
@@ -179,19 +276,34 @@ def _suptitle(fig, axes, own: bool, text: str):
 
 # --- branch curves -----------------------------------------------------------------------------------------
 
+def describe_scene(scene) -> str:
+    """The material and the coils of a scene, for titles: 'SPOM1, no field', 'TPOM1, one coil a = 4, h = 0',
+    'SPOM1, two coils a = 1.732, h = ±1' (M is in the legend)."""
+    coils = scene.field.coils
+    if not coils:
+        return f"{scene.material.name}, no field"
+    heights = sorted({abs(c.height) for c in coils})
+    radii = sorted({c.radius for c in coils})
+    count = {1: "one coil", 2: "two coils"}.get(len(coils), f"{len(coils)} coils")
+    height = "±" * (len(coils) == 2 * len(heights) and heights[0] > 0) + "/".join(f"{h:.4g}" for h in heights)
+    return f"{scene.material.name}, {count} a = {'/'.join(f'{a:.4g}' for a in radii)}, h = {height}"
+
+
 def _title(branches) -> str:
-    return ", ".join(dict.fromkeys(b.run["scene_name"] for b in branches))
+    return "; ".join(dict.fromkeys(describe_scene(stored_scene(b.run)) for b in branches))
 
 
-def _curve(ax, x, y, stable, color, linestyle="-"):
-    """A branch curve: solid where stable, dashed where unstable (stable None: the given linestyle throughout)."""
+def _curve(ax, x, y, stable, color, linestyle="-", mirror=False):
+    """A branch curve: solid where stable, dashed where unstable (stable None: the given linestyle throughout);
+    a mirror image thinner and lighter."""
+    style = {"color": color, "linewidth": 0.9 if mirror else 1.4, "alpha": 0.55 if mirror else 1.0}
     if stable is None:
-        ax.plot(x, y, color=color, linestyle=linestyle, linewidth=1.4)
+        ax.plot(x, y, linestyle=linestyle, **style)
         return
     edges = np.flatnonzero(np.diff(stable.astype(int))) + 1
     for start, end in zip(np.r_[0, edges], np.r_[edges, len(x)]):
         piece = slice(start, min(end + 1, len(x)))  # one shared point joins the pieces
-        ax.plot(x[piece], y[piece], color=color, linestyle="-" if stable[start] else "--", linewidth=1.4)
+        ax.plot(x[piece], y[piece], linestyle="-" if stable[start] else "--", **style)
 
 
 def special_label(s: dict) -> str:
@@ -243,16 +355,23 @@ def _label_special(fig, marks):
 
 
 def _branch_legend(fig, axes, own, branches, extra=()):
-    """Legend right of the axes: one line per drawn branch plus ``extra`` handles; the title tells what the
-    line styles mean."""
+    """Legend right of the axes: one line per drawn branch (a mirror image as its partner's 'mirror') plus
+    ``extra`` handles; the title tells what the line styles mean under which stability reading."""
     with_stability = [b.stable is not None for b in branches]
+    meaning = branches[0].reading.meaning if branches else Reading.PRESSURE.meaning
     if all(with_stability):
-        title = "solid: stable, dashed: unstable\n(pressure control, held at centre)"
+        title = f"solid: stable, dashed: unstable\n({meaning})"
     elif any(with_stability):
-        title = "solid: stable or not computed,\ndashed: unstable (pressure control)"
+        title = f"solid: stable or not computed,\ndashed: unstable ({meaning})"
     else:
         title = "stability not computed (all solid)"
-    handles = [Line2D([], [], color=f"C{i % 10}", label=b.label) for i, b in enumerate(branches)]
+    handles = {}
+    for b in branches:  # several files: one entry per file (its label)
+        handles.setdefault(b.label, Line2D([], [], color=b.color, label=b.label, linewidth=0.9 if b.mirror else 1.4,
+                                           alpha=0.55 if b.mirror else 1.0))
+    handles = list(handles.values())
+    if any(b.mirror for b in branches) and len({id(b.run) for b in branches}) > 1:
+        handles.append(Line2D([], [], color="0.4", linewidth=0.9, alpha=0.55, label="mirror-image branch"))
     _legend(fig, axes, own, "right upper", handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8)
 
 
@@ -261,11 +380,14 @@ def plot_pressure_pole(branches, axes=None) -> Figure:
     fig, panels, own = _panels(axes, 1, (8.4, 4.8))
     ax = panels[0]
     extra, marks = [], []
-    for i, b in enumerate(branches):
-        d, color = b.data, f"C{i % 10}"
-        _curve(ax, d["lam2_north"], d["pressure"], b.stable, color)
+    drawn = {(id(b.run), b.name) for b in branches}
+    for b in branches:
+        d, color = b.data, b.color
+        _curve(ax, d["lam2_north"], d["pressure"], b.stable, color, mirror=b.mirror)
         scale = np.abs(d["lam2_north"]).max()
-        if np.abs(d["lam2_south"] - d["lam2_north"]).max() > 1e-8 * scale:
+        partner = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX) if b.mirror else b.name + MIRROR_SUFFIX)
+        # a pear branch's south pole is its mirror image's north pole: drawn already when that one is
+        if partner not in drawn and np.abs(d["lam2_south"] - d["lam2_north"]).max() > 1e-8 * scale:
             _curve(ax, d["lam2_south"], d["pressure"], None, color, linestyle=":")
             extra = [Line2D([], [], color="k", linestyle=":", label=r"south pole $\lambda_2(\pi)$")]
         special = d["special_points"]
@@ -282,12 +404,12 @@ def plot_pressure_equator(branches, axes=None) -> Figure:
     """P against λ2(π/2) and against λ1(π/2) at the equator (two panels)."""
     fig, axes, own = _panels(axes, 2, (12, 4.5), nrows=1, ncols=2, sharey=True)
     marks = []
-    for i, b in enumerate(branches):
-        d, color = b.data, f"C{i % 10}"
+    for b in branches:
+        d, color = b.data, b.color
         at_equator = surface(branch_discretisation(d), d["special_unknowns"], EQUATOR)
         special_p = [s["pressure"] for s in d["special_points"]]
         for ax, key in zip(axes, ("lam2", "lam1")):
-            _curve(ax, d[f"{key}_equator"], d["pressure"], b.stable, color)
+            _curve(ax, d[f"{key}_equator"], d["pressure"], b.stable, color, mirror=b.mirror)
             marks += _special(ax, b, at_equator[key][:, 0], special_p, color)
     axes[0].set_xlabel(r"equator stretch $\lambda_2(\pi/2)$ (circumferential)")
     axes[1].set_xlabel(r"equator stretch $\lambda_1(\pi/2)$ (meridional)")
@@ -321,17 +443,25 @@ def select_points(data: dict, points=None) -> np.ndarray:
 
 
 def _configurations(branches, points):
-    """[(label, colour, quantities row dict, branch)] for the chosen points of every branch."""
-    several = len(branches) > 1
+    """[(label, colour, quantities row dict, branch)] for the chosen points of every branch (``points``:
+    indices, or Configurations naming their branches and labels)."""
+    named = named_points(points)
+    several = len(branches) > 1 and not named
     rows = []
     for b in branches:
-        q = postprocess(b.run, b.name, select_points(b.data, points), np.linspace(0.0, np.pi, THETA_SAMPLES))
+        chosen = [p for p in points if p.branch == b.name] if named else []
+        indices = select_points(b.data, [p.index for p in chosen] if named else points)
+        q = postprocess(b.run, b.name, indices, np.linspace(0.0, np.pi, THETA_SAMPLES))
         for j, index in enumerate(q["points"]):
+            name = f"{chosen[j].label}:" if named else f"#{index}"
             label = (f"{b.label}: " if several else "") + (
-                f"#{index}  P = {q['pressure'][j]:.4g}, $\\lambda_2(0)$ = {q['lam2'][j, 0]:.4g}")
+                f"{name}  P = {q['pressure'][j]:.4g}, $\\lambda_2(0)$ = {q['lam2'][j, 0]:.4g}")
             row = {k: v[j] for k, v in q.items() if k not in ("theta", "points")}
-            rows.append((label, f"C{len(rows) % 10}", row | {"theta": q["theta"]}, b))
-    return rows
+            color = (chosen[j].color if named else "") or f"C{len(rows) % 10}"
+            rows.append((label, color, row | {"theta": q["theta"]}, b, chosen[j] if named else None))
+    if named:  # in the order given
+        rows.sort(key=lambda row: points.index(row[4]))
+    return [row[:4] for row in rows]
 
 
 def _per_point_title(branches) -> str:
@@ -357,6 +487,29 @@ def _theta_axes(branches, ylabels, height=5.0, axes=None):
         ax.set_xticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
     _suptitle(fig, axes, own, _per_point_title(branches))
     return fig, axes, own
+
+
+ROBUST_PERCENTILES = (1.0, 99.0)  # the bulk of the values of a θ plot
+ROBUST_SPREAD = 5.0  # the full range must exceed the bulk's range this many times before y is limited
+
+
+def robust_limits(ax, curves) -> bool:
+    """Limit ax's y range to the bulk of ``curves`` (arrays of values) when a spike, e.g. a stress
+    concentration next to a coil wire, would flatten the rest: when max − min of all values exceeds ROBUST_SPREAD
+    times the ROBUST_PERCENTILES range, y spans that range widened by a quarter each side (and 0), and a note in
+    the axes names the clipped extremes. Returns whether it limited."""
+    values = np.concatenate([np.ravel(c) for c in curves])
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return False
+    low, high = np.percentile(values, ROBUST_PERCENTILES)
+    if np.ptp(values) <= ROBUST_SPREAD * max(high - low, 1e-300):
+        return False
+    margin = 0.25 * (high - low)
+    ax.set_ylim(min(low - margin, 0.0), max(high + margin, 0.0))
+    ax.text(0.99, 0.97, f"clipped: range {values.min():.3g} .. {values.max():.3g}", transform=ax.transAxes,
+            ha="right", va="top", fontsize="x-small", color="0.35")
+    return True
 
 
 def plot_shapes(branches, points=None, axes=None) -> Figure:
@@ -389,13 +542,17 @@ def plot_shapes(branches, points=None, axes=None) -> Figure:
 def plot_stresses(branches, points=None, axes=None) -> Figure:
     """σ_θ and σ_φ against θ: elastic stresses solid; with the paper's magnetic additions dashed (M > 0)."""
     fig, axes, own = _theta_axes(branches, [r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"], 7.2, axes)
-    handles = []
+    handles, curves = [], {ax: [] for ax in axes}
     for label, color, q, b in _configurations(branches, points):
         for ax, key in zip(axes, ("sigma_theta", "sigma_phi")):
             ax.plot(q["theta"], q[key], color=color, linewidth=1.4)
+            curves[ax].append(q[key])
             if b.M > 0:
                 ax.plot(q["theta"], q[key] + q[f"{key}_paper"], color=color, linewidth=1.0, linestyle="--")
+                curves[ax].append(q[key] + q[f"{key}_paper"])
         handles.append(Line2D([], [], color=color, label=label))
+    for ax, values in curves.items():
+        robust_limits(ax, values)
     handles.append(Line2D([], [], color="k", label="elastic"))
     if any(b.M > 0 for b in branches):
         handles.append(Line2D([], [], color="k", linestyle="--", label="elastic + paper's magnetic terms"))
@@ -409,11 +566,14 @@ def plot_field(branches, points=None, axes=None) -> Figure:
         raise PlotError("no coils in these run files: the applied field is zero everywhere")
     fig, axes, own = _theta_axes(branches, [r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"], 7.2,
                                  axes)
-    handles = []
+    handles, curves = [], ([], [])
     for label, color, q, _ in _configurations([b for b in branches if b.coils], points):
-        axes[0].plot(q["theta"], q["H_theta"], color=color, linewidth=1.4)
-        axes[1].plot(q["theta"], q["H_zeta"], color=color, linewidth=1.4)
+        for ax, values, key in zip(axes, curves, ("H_theta", "H_zeta")):
+            ax.plot(q["theta"], q[key], color=color, linewidth=1.4)
+            values.append(q[key])
         handles.append(Line2D([], [], color=color, label=label))
+    for ax, values in zip(axes, curves):
+        robust_limits(ax, values)
     _point_legend(fig, axes, own, handles)
     return fig
 
@@ -422,10 +582,12 @@ def plot_curvature(branches, points=None, axes=None) -> Figure:
     """Gaussian curvature κ R0² of the deformed surface against θ."""
     fig, axes, own = _theta_axes(branches, [r"Gaussian curvature $\kappa R_0^2$"], axes=axes)
     ax = axes[0]
-    handles = []
+    handles, curves = [], []
     for label, color, q, _ in _configurations(branches, points):
         ax.plot(q["theta"], q["gaussian_curvature"], color=color, linewidth=1.4)
+        curves.append(q["gaussian_curvature"])
         handles.append(Line2D([], [], color=color, label=label))
+    robust_limits(ax, curves)
     _point_legend(fig, axes, own, handles)
     return fig
 
@@ -450,12 +612,12 @@ def plot_energy(branches, axes=None) -> Figure:
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     styles = ["-", "--", "-.", ":"]
     drawn = 0
-    for i, b in enumerate(branches):
+    for b in branches:
         for s in b.bifurcations:
             e2, e3, e4 = (s[k] for k in NORMAL_FORM)
             amplitude = np.linspace(-1, 1, 401) * _amplitude_range(e2, e3, e4)
             energy = e2 * amplitude**2 + e3 * amplitude**3 + e4 * amplitude**4
-            ax.plot(amplitude, energy, color=f"C{i % 10}", linestyle=styles[drawn % len(styles)], linewidth=1.4,
+            ax.plot(amplitude, energy, color=b.color, linestyle=styles[drawn % len(styles)], linewidth=1.4,
                     label=f"{b.label}: {special_label(s)} at P = {s['pressure']:.6g}\n"
                           f"E2 = {e2:.3g}, E3 = {e3:.3g}, E4 = {e4:.3g}")
             drawn += 1

@@ -1,0 +1,103 @@
+"""The paper's figures from the command line: ``balloon-cg figure NAME -o FILE`` and ``make paper``
+(``balloon-cg figure all -o FOLDER``), docs/paper.md.
+
+Each figure's runs (post.paper: shipped scenes with overrides) are computed with ``analyse`` (the whole
+picture) and kept as run files in a runs folder, ``<name of the scene>.h5``; a run file there is reused when
+the scene it was computed for (its normalised TOML) is the one asked for, and recomputed otherwise.
+Figures are drawn and saved inside ``matplotlib.rc_context(PAPER_STYLE)``: no global matplotlib state changes.
+"""
+import sys
+from pathlib import Path
+
+import matplotlib
+
+from ..io.run_file import read_run
+from ..post.paper import PAPER_STYLE, TWO_COLUMNS, draw_figure, figures
+from ..post.plotting import Reading
+from ..scene import parse_scene
+from .api import analyse
+
+IMAGE_FORMATS = (".png", ".pdf", ".svg")
+
+
+class FigureError(ValueError):
+    """Bad input to ``figure``: an unknown figure name, image suffix or width (exit code 2)."""
+
+
+def run_path(scene, runs: Path, quick: bool = False) -> Path:
+    """Where the run of ``scene`` is kept: ``runs``/<scene name>.h5 (``_quick`` before the suffix for reduced
+    runs)."""
+    return Path(runs) / f"{scene.name}{'_quick' * quick}.h5"
+
+
+def incomplete_runs(names, runs: Path, quick: bool = False) -> list[Path]:
+    """The run files of the figures ``names`` in ``runs`` that are flagged incomplete."""
+    cases = dict.fromkeys(case for name in names for case in figures(quick)[name].cases)
+    paths = [run_path(case.load(quick), runs, quick) for case in cases]
+    return [path for path in paths if not read_run(path)["attrs"].get("complete", False)]
+
+
+def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> dict:
+    """The run of ``case`` (read_run() output): the file in ``runs`` if it holds this scene, else computed and
+    written there (incomplete or not: ``incomplete_runs``)."""
+    scene = case.load(quick)
+    path = run_path(scene, runs, quick)
+    run = read_run(path) if path.exists() else None
+    if run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml():
+        runs.mkdir(parents=True, exist_ok=True)
+        analyse(scene, progress=progress).save(path, force=True)
+        run = read_run(path)
+    return run
+
+
+def make_figure(name: str, output, runs=None, width: float = TWO_COLUMNS, reading: Reading = Reading.PRESSURE,
+                quick: bool = False, progress: bool = False) -> Path:
+    """Draw the paper's figure ``name`` (post.paper.figures) into the image ``output`` (.png, .pdf or .svg),
+    ``width`` inches wide; runs kept in ``runs`` (default: a folder ``runs`` next to the image)."""
+    catalogue = figures(quick)
+    if name not in catalogue:
+        raise FigureError(f"figure {name!r}: not a figure of the paper (choose one of {', '.join(catalogue)}, or all)")
+    output = Path(output)
+    if output.suffix.lower() not in IMAGE_FORMATS:
+        raise FigureError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
+    if not width > 0:
+        raise FigureError(f"--width {width}: must be > 0 inches (3.5 one column, 7.2 two)")
+    figure = catalogue[name]
+    runs = output.parent / "runs" if runs is None else Path(runs)
+    loaded = [run_for(case, runs, quick, progress) for case in figure.cases]
+    output.parent.mkdir(parents=True, exist_ok=True)
+    with matplotlib.rc_context(PAPER_STYLE):
+        draw_figure(figure, loaded, width, reading).savefig(output)
+    return output
+
+
+def make_all(folder, runs=None, width: float = TWO_COLUMNS, reading: Reading = Reading.PRESSURE,
+             quick: bool = False, suffix: str = ".pdf", progress: bool = False) -> list[Path]:
+    """Every figure of the paper into ``folder`` as ``<name><suffix>``; the runs shared through ``runs``
+    (default: ``folder``/runs)."""
+    folder = Path(folder)
+    runs = folder / "runs" if runs is None else runs
+    return [make_figure(name, folder / f"{name}{suffix}", runs, width, reading, quick, progress)
+            for name in figures(quick)]
+
+
+def command(args) -> int:
+    """``balloon-cg figure NAME|all -o FILE|FOLDER [--width IN] [--stability READING] [--runs FOLDER] [--quick]
+    [--allow-partial]``: prints the image paths. Exit 1 when a run drawn is incomplete (the figures are still
+    written; ``--allow-partial``: 0), as for ``run``."""
+    reading = Reading.parse(args.stability)
+    progress = not args.quiet
+    if args.name == "all":
+        names = list(figures(args.quick))
+        paths = make_all(args.output, args.runs, args.width, reading, args.quick, progress=progress)
+        runs = Path(args.output) / "runs" if args.runs is None else Path(args.runs)
+    else:
+        names = [args.name]
+        paths = [make_figure(args.name, args.output, args.runs, args.width, reading, args.quick, progress)]
+        runs = Path(args.output).parent / "runs" if args.runs is None else Path(args.runs)
+    for path in paths:
+        print(path)
+    partial = incomplete_runs(names, runs, args.quick)
+    if partial:
+        print(f"balloon-cg: incomplete runs drawn: {', '.join(map(str, partial))}", file=sys.stderr)
+    return 1 if partial and not args.allow_partial else 0

@@ -1,0 +1,186 @@
+"""The paper's figures (reduced: post.paper.QUICK, one M), the stability readings, and the journal conventions."""
+import matplotlib
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from balloon_cg.app import figures as app_figures
+from balloon_cg.app.cli import main
+from balloon_cg.app.figures import make_figure, run_for
+from balloon_cg.post.paper import (PAPER_STYLE, ONE_COLUMN, TWO_COLUMNS, Case, draw_figure, figures,
+                                   landscape_equilibria, numbered_configurations)
+from balloon_cg.post.plotting import Reading, load_branches, plot, robust_limits, stable_points
+
+POLE = r"pole stretch $\lambda_2(0)$ (north)"
+PRESSURE = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
+THETA = r"material coordinate $\theta$ (rad)"
+EQUATOR_2 = r"equator stretch $\lambda_2(\pi/2)$ (circumferential)"
+EQUATOR_1 = r"equator stretch $\lambda_1(\pi/2)$ (meridional)"
+ENERGY = r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)"
+LABELS = {  # (x labels, y labels) the figure's axes must carry
+    "fig2": ({POLE}, {PRESSURE}),
+    "fig3": ({POLE}, {PRESSURE}), "fig6": ({POLE}, {PRESSURE}),
+    "fig4": ({EQUATOR_2}, {PRESSURE}), "fig7": ({EQUATOR_2}, {PRESSURE}),
+    "fig5": ({EQUATOR_1}, {PRESSURE}), "fig8": ({EQUATOR_1}, {PRESSURE}),
+    "fig9": ({POLE, r"$\pm\rho/R_0$ (distance from the axis)", THETA},
+             {PRESSURE, r"$\eta/R_0$ (height)", r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"}),
+    "fig11": ({THETA}, {r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"}),
+    "fig12": ({THETA}, {r"Gaussian curvature $\kappa R_0^2$"}),
+    "fig13": ({r"amplitude $\Lambda$ along the critical mode"}, {ENERGY}),
+}
+LABELS["fig10"] = LABELS["fig9"]
+PANELS = {"fig2": 4, "fig3": 4, "fig4": 4, "fig5": 4, "fig6": 4, "fig7": 4, "fig8": 4, "fig9": 6, "fig10": 6,
+          "fig11": 6, "fig12": 3, "fig13": 2}
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """The reduced runs of every figure, computed once into one runs folder."""
+    folder = tmp_path_factory.mktemp("runs")
+    catalogue = figures(quick=True)
+    for figure in catalogue.values():
+        for case in figure.cases:
+            run_for(case, folder, quick=True)
+    return folder
+
+
+def test_every_paper_figure_is_listed():
+    assert list(figures()) == [f"fig{n}" for n in range(2, 14)]
+    assert set(LABELS) == set(figures(quick=True))
+
+
+@pytest.mark.parametrize("name", list(LABELS))
+def test_each_figure_is_written_with_its_labels(name, runs, tmp_path):
+    figure = figures(quick=True)[name]
+    loaded = [run_for(case, runs, quick=True) for case in figure.cases]
+    with matplotlib.rc_context(PAPER_STYLE):
+        fig = draw_figure(figure, loaded, TWO_COLUMNS)
+        image = tmp_path / f"{name}.png"
+        fig.savefig(image, dpi=60)
+    assert image.read_bytes().startswith(b"\x89PNG")
+    assert len(fig.axes) == PANELS[name]
+    xlabels, ylabels = ({ax.get_xlabel() for ax in fig.axes}, {ax.get_ylabel() for ax in fig.axes})
+    assert LABELS[name][0] <= xlabels and LABELS[name][1] <= ylabels
+    assert fig.get_size_inches()[0] == pytest.approx(TWO_COLUMNS)
+    titles = [ax.get_title(loc="left") for ax in fig.axes if ax.get_title(loc="left")]
+    assert titles and all(t.startswith("(") for t in titles)  # panel letters
+
+
+def test_figure_command_one_column(runs, tmp_path, capsys):
+    """One column wide, the paper's reading; the paper style does not leak into matplotlib's global state."""
+    output = tmp_path / "fig2.pdf"
+    before = dict(matplotlib.rcParams)
+    command = ["figure", "fig2", "-o", str(output), "--runs", str(runs), "--quick", "--quiet", "--width",
+               str(ONE_COLUMN), "--stability", "axisymmetric"]
+    assert main(command) == 1  # the reduced runs stop short: incomplete, named on stderr
+    assert "incomplete runs drawn" in capsys.readouterr().err
+    assert main(command + ["--allow-partial"]) == 0
+    assert output.read_bytes().startswith(b"%PDF") and str(output) in capsys.readouterr().out
+    assert dict(matplotlib.rcParams) == before
+
+
+def test_figure_command_bad_input(tmp_path, capsys):
+    assert main(["figure", "fig99", "-o", str(tmp_path / "x.png"), "--quick"]) == 2
+    assert "fig99" in capsys.readouterr().err
+    assert main(["figure", "fig2", "-o", str(tmp_path / "x.txt"), "--quick"]) == 2
+    assert main(["figure", "fig2", "-o", str(tmp_path / "x.png"), "--quick", "--stability", "gas"]) == 2
+    assert "pressure, volume, free, free-volume, axisymmetric" in capsys.readouterr().err
+
+
+def test_runs_are_reused_only_for_the_same_scene(runs, monkeypatch):
+    def refuse(*args, **kwargs):
+        raise AssertionError("recomputed a run that is in the runs folder")
+
+    monkeypatch.setattr(app_figures, "analyse", refuse)
+    case = figures(quick=True)["fig2"].cases[0]
+    assert run_for(case, runs, quick=True)["scene_name"] == "spom1"
+    changed = Case(case.scene, (("continuation.stop_stretch", 1.2),))
+    with pytest.raises(AssertionError, match="recomputed"):
+        run_for(changed, runs, quick=True)
+
+
+def test_numbered_configurations_by_rule(runs):
+    run = run_for(figures(quick=True)["fig9"].cases[0], runs, quick=True)
+    numbered = numbered_configurations(run)
+    primary = run["branches"]["primary"]
+    assert numbered[1].branch == "primary" and numbered[3].index == len(primary["pressure"]) - 1
+    if 2 in numbered:  # 1 and 2 at the same pressure, the middle of the pear branch's range
+        pear = run["branches"][numbered[2].branch]["pressure"]
+        middle = 0.5 * (pear.min() + pear.max())
+        assert abs(primary["pressure"][numbered[1].index] - middle) <= np.ptp(primary["pressure"])
+
+
+def _data(n, **blocks):
+    return {"pressure": np.zeros(n), "stability": blocks}
+
+
+def test_stability_readings():
+    """Each reading is its stored flag; axisymmetric is every m = 0 block's lowest eigenvalue > 0 (an m = 1
+    instability does not count in the paper's reading)."""
+    even = np.array([[1.0, 2, 3], [1.0, 2, 3], [-1.0, 2, 3]])
+    odd = np.array([[0.5, 2, 3], [-0.5, 2, 3], [0.5, 2, 3]])
+    m1 = np.full((3, 3), -1.0)
+    flags = {name: np.array([True, False, True]) for name in
+             ("stable_pressure", "stable_volume", "stable_pressure_free", "stable_volume_free")}
+    flags["stable_volume"] = np.array([False, False, True])
+    data = _data(3, lowest_even=even, lowest_odd_held=odd, lowest_m1_held=m1, **flags)
+    assert stable_points(data, Reading.AXISYMMETRIC).tolist() == [True, False, False]
+    assert stable_points(data, Reading.VOLUME).tolist() == [False, False, True]
+    general = _data(3, lowest_all_held=np.array([[1.0, 2, 3], [-1.0, 2, 3], [1.0, 2, 3]]))
+    assert stable_points(general, Reading.AXISYMMETRIC).tolist() == [True, False, True]
+    assert stable_points(_data(3), Reading.PRESSURE) is None
+
+
+def test_plot_stability_reading_in_the_legend(runs):
+    run = run_for(figures(quick=True)["fig2"].cases[0], runs, quick=True)
+    for reading in Reading:
+        fig = plot(run, "pressure-pole", stability=reading)
+        assert reading.meaning in fig.legends[0].get_title().get_text()
+        assert load_branches(run, reading=reading)[0].reading == reading
+
+
+def test_mirror_branches_share_their_partners_colour(runs):
+    run = run_for(figures(quick=True)["fig2"].cases[0], runs, quick=True)
+    pear = run["branches"]["primary"]
+    fake = run | {"branches": {"primary": pear, "pear_0": pear, "pear_0_mirror": pear, "pear_1": pear}}
+    fig = plot(fake, "pressure-pole")
+    handles = {t.get_text(): h for t, h in zip(fig.legends[0].get_texts(), fig.legends[0].legend_handles)}
+    first, mirror, other = (handles[f"M = 0, {name}"] for name in ("pear_0", "pear_0_mirror", "pear_1"))
+    assert first.get_color() == mirror.get_color() != other.get_color()
+    assert mirror.get_alpha() < 1 and mirror.get_linewidth() < first.get_linewidth()
+
+
+def test_robust_limits_clip_a_spike_only():
+    theta = np.linspace(0, np.pi, 721)
+    smooth = np.sin(theta)
+    ax = Figure().add_subplot()
+    assert not robust_limits(ax, [smooth])
+    spike = smooth + 1e3 * np.exp(-((theta - np.pi / 2) / 0.005) ** 2)
+    assert robust_limits(ax, [spike])
+    low, high = ax.get_ylim()
+    assert low <= 0 and 1.0 < high < 10  # the bulk (0..1) fills the axes, the spike (1000) is clipped
+
+
+def test_landscape_equilibria_closed_form():
+    """E = E2Λ² + E4Λ⁴ with E2 < 0 < E4: minima at ±√(−E2/(2E4)); with E3: the roots of 4E4Λ² + 3E3Λ + 2E2."""
+    assert landscape_equilibria(-1.0, 0.0, 1.0) == pytest.approx([-np.sqrt(0.5), 0.0, np.sqrt(0.5)])
+    assert landscape_equilibria(1.0, 0.0, 1.0) == pytest.approx([0.0])
+    e2, e3, e4 = -0.3, 0.2, 0.5
+    found = landscape_equilibria(e2, e3, e4)
+    assert 2 * e2 * found + 3 * e3 * found**2 + 4 * e4 * found**3 == pytest.approx(np.zeros(3), abs=1e-12)
+    assert landscape_equilibria(-1e-8, 0.0, 1.0, resolution=1e-3) == pytest.approx([0.0])  # at a branch point
+
+
+def test_make_figure_output_folder_default(runs, tmp_path):
+    path = make_figure("fig12", tmp_path / "out" / "fig12.svg", runs=runs, quick=True)
+    assert path.read_text().lstrip().startswith("<?xml")
+
+
+def test_one_column_uses_the_symbols(runs):
+    figure = figures(quick=True)["fig2"]
+    loaded = [run_for(case, runs, quick=True) for case in figure.cases]
+    with matplotlib.rc_context(PAPER_STYLE):
+        fig = draw_figure(figure, loaded, ONE_COLUMN)
+    assert {ax.get_xlabel() for ax in fig.axes} == {r"$\lambda_2(0)$"}
+    assert {ax.get_ylabel() for ax in fig.axes} == {"$P$"}
+    assert fig.get_size_inches()[0] == pytest.approx(ONE_COLUMN)
