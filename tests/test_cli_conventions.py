@@ -139,3 +139,29 @@ def _peek(process) -> bytes:
         chunk = b""
     process._peeked = getattr(process, "_peeked", b"") + chunk
     return process._peeked
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
+    """Members of a few seconds each on 2 workers: the signal comes once the first member is stored; the
+    running members are abandoned (workers terminated), the stored ones kept, and the same command resumes."""
+    out = tmp_path / "sweep.h5"
+    command = [sys.executable, "-m", "balloon_cg", "sweep", "spom1_two_coils_M0.002", "--vary",
+               "M=0.001,0.0012,0.0014,0.0016,0.0018,0.002", "--no-pear", "--workers", "2", "-o", str(out), "--quiet"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    store = Path(f"{out}.members")
+    deadline = time.monotonic() + 120
+    while not any(store.glob("0*.h5")) and time.monotonic() < deadline and process.poll() is None:
+        time.sleep(0.1)
+    assert process.poll() is None, "the sweep ended before it could be interrupted"
+    started = time.monotonic()
+    process.send_signal(sig)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130 and time.monotonic() - started < 2.0, err
+    assert "interrupted" in err and "Traceback" not in err
+    stored = len(list(store.glob("0*.h5")))
+    assert 1 <= stored < 6
+    assert subprocess.run(["pgrep", "-f", "--", str(out)], capture_output=True).returncode == 1  # no worker left
+    resumed = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    assert len(list(store.glob("0*.h5"))) == 6

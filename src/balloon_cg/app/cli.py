@@ -531,13 +531,21 @@ def sweep(args) -> int:
 
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: must be >= 1")
+    from ..numerics.interrupt import sigterm_raises
+
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"
     scene = load_scene(args.scene)
     try:
-        result = run_sweep(scene, args.vary, args.output, mode=mode, workers=args.workers, scheduler=args.scheduler,
-                           force=args.force, progress=not args.quiet, command=args.command_line)
+        with sigterm_raises():
+            result = run_sweep(scene, args.vary, args.output, mode=mode, workers=args.workers,
+                               scheduler=args.scheduler, force=args.force, progress=not args.quiet,
+                               command=args.command_line)
     except SweepError as e:
         raise UsageError(str(e)) from None
+    except KeyboardInterrupt:  # SIGINT or SIGTERM: the workers are stopped, the finished members are stored
+        print(f"{PROG}: interrupted: the finished members are stored; re-run the same command to resume",
+              file=sys.stderr)
+        return INTERRUPTED
     if not args.quiet:
         print(format_summary(result))
     if result.failed:

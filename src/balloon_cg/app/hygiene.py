@@ -19,7 +19,11 @@ POLL_SECONDS = 1.0
 
 
 def worker_hygiene(sweep_pid: int) -> None:
-    """Initializer of a pool worker: exit when its parent dies, or now if the process ``sweep_pid`` is gone."""
+    """Initializer of a pool worker: exit when its parent dies, or now if the process ``sweep_pid`` is gone;
+    Ctrl-C (SIGINT to the terminal's process group) is left to the parent, which stops the workers itself with
+    SIGTERM, whose default (die) is restored here (a forked worker inherits the parent's handlers)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if not (sys.platform.startswith("linux") and _pdeathsig()):
         threading.Thread(target=_watch, args=(os.getppid(),), daemon=True, name="parent-watchdog").start()
     if not _alive(sweep_pid):

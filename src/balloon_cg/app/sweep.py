@@ -311,8 +311,17 @@ def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str 
         for future in as_completed(futures):
             error = future.exception()
             yield futures[future], error if error is not None else future.result()
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:  # an interrupt (or the caller closing early): the running members are abandoned
+        _terminate(pool)
+        raise
+    pool.shutdown(wait=True)
+
+
+def _terminate(pool) -> None:
+    """Stop a process pool now: its workers are terminated (their members are recomputed on resume)."""
+    for process in list(pool._processes.values()):  # no public API before Python 3.14's terminate_workers()
+        process.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _compute_dask(jobs, scheduler: str):

@@ -29,6 +29,20 @@ def _handler(signum, frame):
 
 
 @contextmanager
+def sigterm_raises():
+    """SIGTERM raises KeyboardInterrupt, as SIGINT does, for the duration (main thread only): for work that
+    stops at once and cleans up in ``finally`` blocks rather than at its next point."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextmanager
 def stop_on_signals():
     """Turn SIGINT/SIGTERM into ``requested()`` for the duration (main thread only; elsewhere a no-op)."""
     if threading.current_thread() is not threading.main_thread():
