@@ -106,3 +106,53 @@ def test_locate_root_falls_back_to_the_best_evaluated_point():
 
     root = continuation.locate_root(failing, 1.0)
     assert root.status == RootStatus.NEAREST and root.payload == 0.0  # brentq's first evaluations are the ends
+
+
+def test_known_values_spare_evaluations_and_change_nothing():
+    """``known`` (the bracket end the caller has computed) is used when Brent asks for it: the same root and
+    payload, one evaluation fewer; a failed first evaluation still gives None (the known end is never offered
+    as the fallback before Brent asked for it)."""
+    calls = []
+
+    def value_at(s):
+        calls.append(s)
+        return (s - 0.3) ** 3 + 0.1 * (s - 0.3), s
+
+    plain = continuation.locate_root(value_at, 1.0)
+    evaluations, end = len(calls), value_at(1.0)
+    calls.clear()
+    seeded = continuation.locate_root(value_at, 1.0, known={1.0: end})
+    assert 1.0 not in calls and len(calls) == evaluations - 1
+    assert (seeded.status, seeded.payload, seeded.value) == (plain.status, plain.payload, plain.value)
+
+    def failing_at_zero(s):
+        if s == 0.0:
+            raise ArithmeticError("singular")
+        return s - 0.3, s
+
+    assert continuation.locate_root(failing_at_zero, 1.0, known={1.0: (0.7, 1.0)}) is None
+
+
+def test_traced_folds_equal_brent_from_scratch(monkeypatch):
+    """The fold trace() reports (its Brent run takes the step's end point as the bracket end) is bit for bit the
+    one of a Brent run that evaluates both ends itself."""
+    steps = []
+    original = continuation._locate_fold
+
+    def recording(system, start, sigma, c, settings, end):
+        steps.append((start, sigma))
+        return original(system, start, sigma, c, settings, end)
+
+    monkeypatch.setattr(continuation, "_locate_fold", recording)
+    u0 = -2.0
+    path = continuation.trace(S_CURVE, start(S_CURVE, [u0, 1 + u0**3 - u0], [1.0, 0.0]), SETTINGS,
+                              lambda p: Stop(Done.REACHED, "u > 2") if p.X[0] > 2 else None, {"lambda": LAMBDA})
+    assert len(path.folds) == len(steps) == 2
+    for fold, (before, sigma) in zip(path.folds, steps):
+        def value_at(s):
+            result = continuation.correct(S_CURVE, before.X + s * before.tangent, before.tangent, SETTINGS)
+            t = continuation.tangent(S_CURVE, result.x, before.tangent)
+            return float(LAMBDA @ t), (result.x, t)
+
+        root = continuation.locate_root(value_at, sigma)
+        assert np.array_equal(root.payload[0], fold.point.X) and np.array_equal(root.payload[1], fold.point.tangent)

@@ -222,3 +222,16 @@ def test_bifurcation_work_on_a_mapped_branch_uses_a_degree_that_holds_it(near_wi
     plain = Discretisation(degree, True, False)
     moved = branch.disc.transfer(X, plain)
     assert plain.tail(moved[:-1]) <= scene.solver.max_error
+
+
+def test_equal_discretisations_share_read_only_tables():
+    """Discretisations with the same five fields share their tables (built once), which nobody can change; a
+    different field gives other tables."""
+    mapping = WireMap((0.3,), (0.05,))
+    first, second = Discretisation(24, False, True, 0, mapping), Discretisation(24, False, True, 0, mapping)
+    assert first.ops is second.ops and first.weights is second.weights and first.eta_mean is second.eta_mean
+    assert not first.ops.flags.writeable and not first.x.flags.writeable
+    with pytest.raises(ValueError):
+        first.weights[0] = 1.0
+    other = Discretisation(24, False, True, 0, WireMap((0.3,), (0.06,)))
+    assert other.ops is not first.ops and not np.array_equal(other.x, first.x)

@@ -96,47 +96,9 @@ class Discretisation:
         return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping)
 
     def __post_init__(self):
-        n_q = self.quadrature or (3 * self.degree) // 2 + 8
-        nodes, s_weights = legendre.leggauss(n_q)
-        p, dp = legendre_table(nodes, self.degree)
-        if self.mapping is None:
-            x, weights = nodes, s_weights
-        else:
-            x = self.mapping.x(nodes)
-            jacobian = self.mapping.ds_dx(x)
-            weights, dp = s_weights / jacobian, dp * jacobian[:, None]
-        s = np.sqrt(1.0 - x * x)
-        k = np.arange(self.degree + 1)
-        a_keep = k[k % 2 == 0] if self.symmetric else k
-        b_keep = k[k % 2 == 1] if self.symmetric else (k[1:] if self.pin_translation else k)
-        put = object.__setattr__
-        put(self, "_node_table", p)
-        put(self, "x", x)
-        put(self, "weights", weights)
-        put(self, "cos_theta", x)
-        put(self, "sin_theta", s)
-        put(self, "a_index", a_keep)
-        put(self, "b_index", b_keep)
-        # held (b_0 = 0 means ∫η dx = 0) on a mapped general basis: η = Σ b_k (P_k(s) − m_k), m_k = ½∫P_k(s(x)) dx,
-        # so that the hold is the same physical constraint in every basis (m = 0 without a map)
-        held_mapped = self.mapping is not None and self.pin_translation and not self.symmetric
-        put(self, "eta_mean", 0.5 * weights @ p[:, b_keep] if held_mapped else np.zeros(b_keep.size))
-        na = a_keep.size
-        put(self, "size", na + b_keep.size)
-        # state at the nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
-        zeros_a = np.zeros((x.size, na))
-        zeros_b = np.zeros((x.size, b_keep.size))
-        ops = np.stack([
-            np.hstack([p[:, a_keep], zeros_b]),
-            np.hstack([-(1 - x * x)[:, None] * dp[:, a_keep], zeros_b]),
-            np.hstack([zeros_a, p[:, b_keep] - self.eta_mean]),
-            np.hstack([zeros_a, -s[:, None] * dp[:, b_keep]]),
-        ])
-        put(self, "ops", ops)
-        # the blocks of ops that are not identically zero: (∂λ2, ∂v)/∂a and (∂η, ∂w)/∂b, contiguous for BLAS
-        put(self, "basis_a", np.ascontiguousarray(ops[0:2, :, :na]))
-        put(self, "basis_b", np.ascontiguousarray(ops[2:4, :, na:]))
-        put(self, "_gradient_ops", np.ascontiguousarray(ops.reshape(-1, self.size).T))  # (size, 4 n_q) for gemv
+        """Basis and quadrature tables from ``_tables`` (built once per set of fields, shared, read-only)."""
+        for name, value in _tables(self).items():
+            object.__setattr__(self, name, value)
 
     @functools.cached_property
     def projection(self) -> np.ndarray:
@@ -257,3 +219,48 @@ class Discretisation:
         earlier = float(envelope[max(n - 3 * window + 1, 0): n - 2 * window + 1].max())
         rate = min((last / earlier) ** (1.0 / (2 * window)), 0.999) if earlier > 0.0 else 0.999
         return last * rate / (1.0 - rate)
+
+
+@functools.lru_cache(maxsize=16)
+def _tables(disc: Discretisation) -> dict:
+    """The node, weight and basis tables of a Discretisation (keyed by its five fields: equal discretisations
+    share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
+    n_q = disc.quadrature or (3 * disc.degree) // 2 + 8
+    nodes, s_weights = legendre.leggauss(n_q)
+    p, dp = legendre_table(nodes, disc.degree)
+    if disc.mapping is None:
+        x, weights = nodes, s_weights
+    else:
+        x = disc.mapping.x(nodes)
+        jacobian = disc.mapping.ds_dx(x)
+        weights, dp = s_weights / jacobian, dp * jacobian[:, None]
+    s = np.sqrt(1.0 - x * x)
+    k = np.arange(disc.degree + 1)
+    a_keep = k[k % 2 == 0] if disc.symmetric else k
+    b_keep = k[k % 2 == 1] if disc.symmetric else (k[1:] if disc.pin_translation else k)
+    # held (b_0 = 0 means ∫η dx = 0) on a mapped general basis: η = Σ b_k (P_k(s) − m_k), m_k = ½∫P_k(s(x)) dx,
+    # so that the hold is the same physical constraint in every basis (m = 0 without a map)
+    held_mapped = disc.mapping is not None and disc.pin_translation and not disc.symmetric
+    eta_mean = 0.5 * weights @ p[:, b_keep] if held_mapped else np.zeros(b_keep.size)
+    na = a_keep.size
+    size = na + b_keep.size
+    # state at the nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
+    zeros_a = np.zeros((x.size, na))
+    zeros_b = np.zeros((x.size, b_keep.size))
+    ops = np.stack([
+        np.hstack([p[:, a_keep], zeros_b]),
+        np.hstack([-(1 - x * x)[:, None] * dp[:, a_keep], zeros_b]),
+        np.hstack([zeros_a, p[:, b_keep] - eta_mean]),
+        np.hstack([zeros_a, -s[:, None] * dp[:, b_keep]]),
+    ])
+    tables = {
+        "_node_table": p, "x": x, "weights": weights, "cos_theta": x, "sin_theta": s, "a_index": a_keep,
+        "b_index": b_keep, "eta_mean": eta_mean, "ops": ops,
+        # the blocks of ops that are not identically zero: (∂λ2, ∂v)/∂a and (∂η, ∂w)/∂b, contiguous for BLAS
+        "basis_a": np.ascontiguousarray(ops[0:2, :, :na]),
+        "basis_b": np.ascontiguousarray(ops[2:4, :, na:]),
+        "_gradient_ops": np.ascontiguousarray(ops.reshape(-1, size).T),  # (size, 4 n_q) for gemv
+    }
+    for array in tables.values():
+        array.flags.writeable = False
+    return tables | {"size": size}

@@ -109,14 +109,15 @@ class Root:
     value: float  # the function's value there
 
 
-def locate_root(value_at, length: float, xtol: float = 1e-13) -> Root | None:
+def locate_root(value_at, length: float, xtol: float = 1e-13, known: dict | None = None) -> Root | None:
     """Root in (0, length) of s ↦ value_at(s)[0] (value_at returns (value, payload)) by Brent's method, and the
     payload there. If an evaluation fails (ArithmeticError: e.g. Newton at a singular point) the evaluated point
-    with the smallest |value| is returned with status NEAREST; None if there is none."""
-    cache = {}
+    with the smallest |value| is returned with status NEAREST; None if there is none. ``known``: s -> value_at(s)
+    already computed by the caller (e.g. the bracket's end), used when Brent asks for that s."""
+    cache, known = {}, known or {}
 
     def f(s):
-        cache[s] = value_at(s)
+        cache[s] = known[s] if s in known else value_at(s)
         return cache[s][0]
 
     try:
@@ -132,8 +133,9 @@ def locate_root(value_at, length: float, xtol: float = 1e-13) -> Root | None:
         return Root(payload, RootStatus.NEAREST, float(value))
 
 
-def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Settings):
-    """The point where c·τ vanishes between start and start + σ along the arclength (Brent), or None."""
+def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Settings, end: Point):
+    """The point where c·τ vanishes between start and start + σ along the arclength (Brent), or None; ``end`` is
+    the point the step from start reached (``value_at(σ)``: the same corrector and tangent, not recomputed)."""
 
     def value_at(s):
         result = correct(system, start.X + s * start.tangent, start.tangent, settings)
@@ -142,7 +144,8 @@ def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Se
         t = tangent(system, result.x, start.tangent)
         return float(c @ t), Point(result.x, t, result.iterations, result.residual)
 
-    return locate_root(value_at, sigma)
+    reached = Point(end.X.copy(), end.tangent.copy(), end.iterations, end.residual)  # a fold's own arrays
+    return locate_root(value_at, sigma, known={sigma: (float(c @ end.tangent), reached)})
 
 
 def trace(system, start: Point, settings: Settings, stop, monitors: dict, progress=None) -> Path:
@@ -175,7 +178,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         point = Point(result.x, new_tangent, result.iterations, result.residual)
         for label, c in monitors.items():
             if (c @ current.tangent) * (c @ point.tangent) < 0:
-                fold = _locate_fold(system, current, sigma, c, settings)
+                fold = _locate_fold(system, current, sigma, c, settings, point)
                 if fold is None:  # no evaluation converged: the fold is known to lie in the step, no better
                     path.folds.append(Fold(label, current, len(path.points) - 1, RootStatus.NEAREST))
                 else:
