@@ -120,13 +120,14 @@ def main():
             table[radius] = row
             print(f"{radius:>6.3g} | {cell(row['SPOM1'])} | {cell(row['TPOM1'])}", flush=True)
         verified = [(a, row["SPOM1"]["critical"]) for a, row in table.items() if row["SPOM1"]["end"] == "isola_merge"]
-        bracket = [(a, b) for (a, ma), (b, mb) in zip(verified, verified[1:]) if (ma - TARGET_M) * (mb - TARGET_M) <= 0]
+        bracket = [(a, ma, b) for (a, ma), (b, mb) in zip(verified, verified[1:])
+                   if (ma - TARGET_M) * (mb - TARGET_M) <= 0]
         if bracket:
-            (lo, m_lo), (hi, _) = bracket[0]
+            lo, m_lo, hi = bracket[0]
             radius = bisect(lo, hi, m_lo, "critical", work, runs)
             spom, tpom = (critical(radius, preset, work) for preset in ("SPOM1", "TPOM1"))
             runs += [(radius, "SPOM1", spom), (radius, "TPOM1", tpom)]
-            print(f"inferred a = {radius:.4g} (bracket [{lo:g}, {hi:g}], bisection to |da| < {A_TOL:g})")
+            print(f"inferred a = {radius:.6g} (bracket [{lo:g}, {hi:g}], bisection to |da| < {A_TOL:g})")
             print(f"{radius:>6.4g} | {cell(spom)} | {cell(tpom)}   (paper: 0.004, 0.0078)")
             for preset, result in (("SPOM1", spom), ("TPOM1", tpom)):
                 fine = critical(radius, preset, work, solver=f"max_error = {FINE_ERROR!r}")
