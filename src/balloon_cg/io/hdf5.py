@@ -73,8 +73,9 @@ def provenance(command: str | None = None) -> dict:
 def command_line() -> str:
     """What was typed: ``python -m module args`` for a module run with -m (sys.argv[0] is then its file)."""
     spec = getattr(sys.modules.get("__main__"), "__spec__", None)
-    argv = ["python", "-m", spec.name.removesuffix(".__main__"), *sys.argv[1:]] if spec is not None and spec.name else sys.argv
-    return shlex.join(argv)
+    if spec is None or not spec.name:
+        return shlex.join(sys.argv)
+    return shlex.join(["python", "-m", spec.name.removesuffix(".__main__"), *sys.argv[1:]])
 
 
 def write_strings(group, name: str, values) -> None:

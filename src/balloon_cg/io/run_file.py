@@ -41,7 +41,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, plain, provenance, write_strings
 from .layout import FileError, check_columns, require_attrs, require_group
-from .schema import attach_dimensions, describe, scale
+from .schema import attach_dimensions, scale
 
 FORMAT = "balloon-cg/3"
 READABLE = (FORMAT, "balloon-cg/2")
@@ -179,9 +179,7 @@ def _write_branch(group, branch, theta):
         "unknowns": branch.X,
     }
     point, unknown = scale(group, "point", len(branch.X)), scale(group, "unknown", branch.X.shape[1])
-    theta_scale = group.create_dataset("theta", data=theta)
-    theta_scale.make_scale("theta")
-    describe(theta_scale)
+    theta_scale = scale(group, "theta", values=theta)
     for name, data in columns.items():
         group.create_dataset(name, data=data)
     attach_dimensions(group, {1: (point,), 2: (point, unknown)})

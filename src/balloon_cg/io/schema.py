@@ -75,9 +75,9 @@ def describe(dataset, name: str | None = None) -> None:
     dataset.attrs.update({"units": units, "long_name": long_name, "description": description})
 
 
-def scale(group, name: str, length: int):
-    """An index dimension scale ``name`` = 0 … length − 1 in ``group`` (described)."""
-    dataset = group.create_dataset(name, data=np.arange(length, dtype=np.int64))
+def scale(group, name: str, length: int = 0, values=None):
+    """A dimension scale ``name`` in ``group`` (described): ``values``, or the index 0 … length − 1."""
+    dataset = group.create_dataset(name, data=np.arange(length, dtype=np.int64) if values is None else values)
     dataset.make_scale(name)
     describe(dataset)
     return dataset
