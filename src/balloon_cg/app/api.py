@@ -11,6 +11,7 @@ when it was computed in this process, the analysis objects (``picture``: branche
 Tables come from the same content: ``to_dataframe`` (pandas) and ``to_xarray`` (xarray; named dimensions and
 units, read from the file image through h5netcdf), both from the optional extra ``balloon-cg[analysis]``.
 """
+import importlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,7 +30,7 @@ EXTRA = "pip install 'balloon-cg[analysis]'"
 
 def _optional(module: str, what: str):
     try:
-        return __import__(module)
+        return importlib.import_module(module)
     except ImportError:
         raise ImportError(f"{what} needs {module}, which is not installed: {EXTRA}") from None
 
@@ -168,30 +169,39 @@ def _scene(scene) -> Scene:
     return scene if isinstance(scene, Scene) else load_scene(scene)
 
 
-def trace(scene, progress: bool = False) -> Result:
-    """The primary branch of ``scene`` (a Scene or a TOML path). Ctrl-C (SIGINT) stops it at the next point
-    and returns what is finished, flagged incomplete."""
+def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progress: bool = False):
+    """(branches, snap-throughs, incomplete entries, picture) of ``scene``, one progress bar per phase: the
+    primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse)."""
+    from ..analysis.picture import analyse as analyse_picture
     from ..analysis.primary import trace_primary
     from ..analysis.verdict import incomplete
 
+    with PhaseBars(scene.name, progress) as bars:
+        if primary_only:
+            branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
+            bars.finish(Phase.PRIMARY, len(branches[0].X))
+            return branches, None, incomplete(branches), None
+        picture = analyse_picture(scene, bars, pear=pear)
+        return picture.branches, picture.snaps, picture.incomplete, picture
+
+
+def trace(scene, progress: bool = False) -> Result:
+    """The primary branch of ``scene`` (a Scene or a TOML path). Ctrl-C (SIGINT) stops it at the next point
+    and returns what is finished, flagged incomplete."""
     scene = _scene(scene)
-    with PhaseBars(scene.name, progress) as bars, stop_on_signals():
-        branch = trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))
-        bars.finish(Phase.PRIMARY, len(branch.X))
-    return Result.of(scene, [branch], found=incomplete([branch]), command=f"balloon_cg.trace({scene.name!r})")
+    with stop_on_signals():
+        branches, snaps, found, _ = computed(scene, primary_only=True, progress=progress)
+    return Result.of(scene, branches, snaps, found, command=f"balloon_cg.trace({scene.name!r})")
 
 
 def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
     """The whole picture of ``scene`` (a Scene or a TOML path): primary branch, stability of every point,
     branch points located and classified, pear branches (``pear=False``: not traced), snap-throughs
     (analysis.picture). Ctrl-C (SIGINT) stops at the next point and returns what is finished, flagged."""
-    from ..analysis.picture import analyse as analyse_picture
-
     scene = _scene(scene)
-    with PhaseBars(scene.name, progress) as bars, stop_on_signals():
-        picture = analyse_picture(scene, bars, pear=pear)
-    return Result.of(scene, picture.branches, picture.snaps, picture.incomplete, picture,
-                     command=f"balloon_cg.analyse({scene.name!r})")
+    with stop_on_signals():
+        branches, snaps, found, picture = computed(scene, pear=pear, progress=progress)
+    return Result.of(scene, branches, snaps, found, picture, command=f"balloon_cg.analyse({scene.name!r})")
 
 
 def load(path) -> Result:

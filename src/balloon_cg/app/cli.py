@@ -199,24 +199,14 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
     The output is checked before the trace (which may take long); ``progress`` shows one bar per phase on
     stderr; ``command`` overrides the provenance attribute (default: sys.argv).
     """
-    from ..analysis.picture import Phase, analyse
-    from ..analysis.primary import trace_primary
-    from ..analysis.verdict import incomplete
     from ..io.hdf5 import check_output
     from ..io.lock import claim
     from ..io.run_file import write_run
-    from .progress import PhaseBars
+    from .api import computed
 
     with claim(out_path, "run"):
         check_output(out_path, force)
-        with PhaseBars(scene.name, progress) as bars:
-            if primary_only:
-                branches, snaps = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))], None
-                bars.finish(Phase.PRIMARY, len(branches[0].X))
-                found = incomplete(branches)
-            else:
-                picture = analyse(scene, progress=bars)
-                branches, snaps, found = picture.branches, picture.snaps, picture.incomplete
+        branches, snaps, found, _ = computed(scene, primary_only, progress=progress)
         extra = {} if command is None else {"command": command}
         return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found), found
 
