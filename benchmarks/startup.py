@@ -1,67 +1,126 @@
-"""Benchmark: what the command line costs beyond its computation (warm numba cache).
+"""Benchmark: what a command costs beyond its computation (warm numba cache). Issue 12's targets: ``--help`` and
+``--version`` ≤ 0.3 s, ``inspect`` ≤ 0.8 s, a warm ``run scenes/spom1.toml`` ≤ 2× its compute time.
 
-For each command, the wall time of the whole process (best of REPEATS, in alternating rounds) against the time of
-its computation alone, measured inside a warm process on the same input (the part a faster start-up cannot
-remove). Prints the table and the ratios. Run: python benchmarks/startup.py
+For each command: the wall time and the CPU time (user + system) of the whole process, the median of REPEATS
+runs in alternating rounds (a noisy moment hits every command alike), against its **compute time**: the
+median time of the command's computation alone, repeated in one process that has run it once already (imports
+done, numba kernels loaded), writing nothing. That is the part a faster start-up cannot remove:
+
+    inspect: summarise_file(run file)    solve: trace_primary to λ2(0) = 3    run: the whole picture (api.computed)
+
+The ratios are wall / compute and CPU / compute (the CPU ratio is the steadier one on a loaded machine). Then,
+for ``run``, where the rest goes, measured inside one fresh process doing what the CLI does: imports, the first
+computation (numba loads its cached kernels on first call), the write. The load average is printed before and
+after: on a loaded machine every number grows, the ratios less so.
+
+    python benchmarks/startup.py                       # the installed balloon-cg of this interpreter
+    python benchmarks/startup.py --python A --python B # several installs, interleaved in the same rounds
 """
+import argparse
+import json
+import os
+import resource
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-REPEATS = 3
+REPEATS = 5
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "spom1.toml"
+TARGETS = {"--help": "<= 0.3 s", "--version": "<= 0.3 s", "inspect": "<= 0.8 s", "run": "<= 2x compute",
+           "run (quiet)": "<= 2x compute"}
 
-
-def wall(args) -> float:
-    start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "balloon_cg", *map(str, args)], check=True, capture_output=True)
-    return time.perf_counter() - start
-
-
-COMPUTE = """
-import sys, time
-from balloon_cg.analysis.picture import analyse
+# imports, first computation and write of one fresh process, then the steady compute of every command
+MEASURE = """
+import json, statistics, sys, time
+t0 = time.perf_counter()
 from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.app.api import computed
 from balloon_cg.app.summaries import summarise_file
+from balloon_cg.io.run_file import write_run
 from balloon_cg.scene import load_scene
 scene = load_scene(sys.argv[1])
-analyse(scene); trace_primary(scene, stop_stretch=3.0, down=False); summarise_file(sys.argv[2])  # warm
-def best(f):
+t1 = time.perf_counter()
+branches, snaps, found, _ = computed(scene)
+t2 = time.perf_counter()
+write_run(sys.argv[2], scene, branches, force=True, snaps=snaps, found=found)
+t3 = time.perf_counter()
+work = {"inspect": lambda: summarise_file(sys.argv[2]), "solve": lambda: trace_primary(scene, stop_stretch=3.0,
+        down=False), "run": lambda: computed(scene)}
+steady = {}
+for name, f in work.items():
+    f()
     times = []
-    for _ in range(3):
+    for _ in range(int(sys.argv[3])):
         t = time.perf_counter(); f(); times.append(time.perf_counter() - t)
-    return min(times)
-print(best(lambda: analyse(scene)), best(lambda: trace_primary(scene, stop_stretch=3.0, down=False)),
-      best(lambda: summarise_file(sys.argv[2])))
+    steady[name] = statistics.median(times)
+print(json.dumps({"steady": steady, "imports": t1 - t0, "first": t2 - t1, "write": t3 - t2}))
 """
 
 
+def timed(args) -> tuple[float, float]:
+    """(wall, CPU) seconds of one child process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run(args, check=True, capture_output=True)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def load() -> str:
+    one, five, _ = os.getloadavg()
+    return f"load average {one:.2f} (1 min), {five:.2f} (5 min) on {os.cpu_count()} CPUs"
+
+
 def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--python", action="append", help="an interpreter with balloon-cg installed (repeatable; "
+                                                          "default: this one)")
+    parser.add_argument("--repeats", type=int, default=REPEATS)
+    options = parser.parse_args()
+    pythons = options.python or [sys.executable]
+    print(f"start: {load()}; {options.repeats} repetitions, medians\n")
     with tempfile.TemporaryDirectory() as tmp:
-        run_file = Path(tmp) / "run.h5"
-        wall(["run", SCENE, "-o", run_file, "--quiet"])  # warms the numba cache
-        out = subprocess.run([sys.executable, "-c", COMPUTE, str(SCENE), str(run_file)], check=True,
-                             capture_output=True, text=True).stdout.split()
-        compute = dict(zip(("run", "solve", "inspect"), map(float, out)))
-        compute["--help"] = compute["--version"] = 0.0
-        commands = {"--help": ["--help"], "--version": ["--version"], "inspect": ["inspect", run_file],
-                    "solve": ["solve", SCENE, "--pole-stretch", "3.0"],
-                    "run": ["run", SCENE, "-o", run_file, "--quiet", "--force"]}
-        walls = {name: [] for name in commands}
-        for _ in range(REPEATS):  # alternating rounds: a noisy moment hits every command alike
-            for name, args in commands.items():
-                walls[name].append(wall(args))
-    print(f"{'command':<28} {'wall (s)':>9} {'compute (s)':>12} {'wall/compute':>13}")
-    for name, args in commands.items():
-        w, c = min(walls[name]), compute[name]
-        label = " ".join(str(a) if not isinstance(a, Path) else a.name for a in args)[:28]
-        print(f"{label:<28} {w:9.3f} {c:12.3f} {w / c if c else float('nan'):13.2f}")
-    print("\ncompute: the same work in a warm process (run: analyse; solve: the trace to λ2(0) = 3; inspect: the "
-          "summary of the run file). Targets (issue 12): --help, --version <= 0.3 s, inspect <= 0.8 s, "
-          "run <= 2x compute.")
+        runs = {py: Path(tmp) / f"run{i}.h5" for i, py in enumerate(pythons)}
+        commands = {py: {"--help": ["--help"], "--version": ["--version"], "inspect": ["inspect", runs[py]],
+                         "solve": ["solve", SCENE, "--pole-stretch", "3.0"],
+                         "run": ["run", SCENE, "-o", runs[py], "--force"],
+                         "run (quiet)": ["run", SCENE, "-o", runs[py], "--quiet", "--force"]} for py in pythons}
+        cli = {py: [py, "-m", "balloon_cg"] for py in pythons}
+        for py in pythons:  # warms numba's cache and writes the file inspect reads
+            timed([*cli[py], "run", SCENE, "-o", runs[py], "--quiet", "--force"])
+        measured = {py: [] for py in pythons}
+        walls = {py: {name: [] for name in commands[py]} for py in pythons}
+        for _ in range(options.repeats):
+            for py in pythons:
+                for name, args in commands[py].items():
+                    walls[py][name].append(timed([*cli[py], *map(str, args)]))
+            for py in pythons:
+                out = subprocess.run([py, "-c", MEASURE, str(SCENE), str(Path(tmp) / "measure.h5"), "3"],
+                                     check=True, capture_output=True, text=True).stdout
+                measured[py].append(json.loads(out))
+    for py in pythons:
+        steady = {name: statistics.median(m["steady"][name] for m in measured[py]) for name in ("inspect", "solve",
+                                                                                               "run")}
+        steady["run (quiet)"] = steady["run"]
+        print(f"{py}\n{'command':<34} {'wall (s)':>9} {'CPU (s)':>8} {'compute (s)':>12} {'wall/comp':>10} "
+              f"{'CPU/comp':>9}  target")
+        for name, args in commands[py].items():
+            wall = statistics.median(w for w, _ in walls[py][name])
+            cpu = statistics.median(c for _, c in walls[py][name])
+            label = " ".join(a.name if isinstance(a, Path) else str(a) for a in args)[:34]
+            compute = steady.get(name, 0.0)
+            ratios = f"{wall / compute:10.2f} {cpu / compute:9.2f}" if compute else f"{'-':>10} {'-':>9}"
+            print(f"{label:<34} {wall:9.3f} {cpu:8.3f} {compute:12.3f} {ratios}  {TARGETS.get(name, '')}")
+        parts = {k: statistics.median(m[k] for m in measured[py]) for k in ("imports", "first", "write")}
+        print(f"run, inside one fresh process: imports {parts['imports']:.3f} s, first computation "
+              f"{parts['first']:.3f} s (compute {steady['run']:.3f} s + {parts['first'] - steady['run']:.3f} s "
+              f"of numba loading its kernels and first-call work), write {parts['write']:.3f} s\n")
+    print(f"end: {load()}")
 
 
 if __name__ == "__main__":

@@ -66,7 +66,16 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert branch["points"] > 10 and branch["wall_time"] > 0
 
     assert main(["inspect", str(out)]) == 0
-    assert "branch primary" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "branch primary" in text
+    # an EP is a stored point, an LP or BP lies between two (docs/hdf5.md: index); counts named by control
+    primary = text.split("branch primary")[1].split("branch ")[0]
+    lp, bp = (branch["special_points"][k]["index"] for k in (1, 2))
+    assert "EP                  point 0 " in primary and f"LP                  points {lp}-{lp + 1} " in primary
+    assert f"BP pitchfork-super  points {bp}-{bp + 1} " in primary
+    stable = branch["stable_points"]
+    assert (f"stable points        pressure control {stable['stable_pressure']}, volume control "
+            f"{stable['stable_volume']} (of {branch['points']}") in primary
 
 
 def test_run_keeps_existing_output(tmp_path, scene_file, capsys):
@@ -80,7 +89,7 @@ def test_run_keeps_existing_output(tmp_path, scene_file, capsys):
     assert main(["inspect", str(out), "--json"]) == 0
 
 
-@pytest.mark.parametrize("stretch", [1.5, 3.0])
+@pytest.mark.parametrize("stretch", [1.005, 1.5, 3.0])  # 1.005: below the scene's start_stretch 1.01
 def test_solve_json_matches_sphere(stretch, capsys):
     assert main(["solve", str(SPOM1), "--pole-stretch", str(stretch), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
@@ -109,8 +118,9 @@ def test_solve_not_reached(tmp_path, capsys):
 
 
 def test_solve_bad_stretch(scene_file, capsys):
-    assert main(["solve", str(scene_file), "--pole-stretch", "0.5"]) == 2
-    one_error_line(capsys, "--pole-stretch")
+    for stretch in ("0.5", "1", "nan"):
+        assert main(["solve", str(scene_file), "--pole-stretch", stretch]) == 2
+        one_error_line(capsys, "--pole-stretch", "must be > 1")
 
 
 def test_bad_scene(tmp_path, capsys):

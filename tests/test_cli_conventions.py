@@ -12,8 +12,9 @@ import h5py
 import pytest
 
 import balloon_cg
-from balloon_cg.app.cli import main, strict_json
+from balloon_cg.app.cli import build_parser, main, scene_of, strict_json
 from balloon_cg.io.run_file import read_run
+from balloon_cg.scene import load_scene, parse_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SMALL = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'
@@ -68,7 +69,25 @@ def test_bad_set_is_one_line(tmp_path, capsys, setting, words):
 def test_shorthand_and_set_of_the_same_key_conflict(tmp_path, capsys):
     assert main(["run", "spom1", "--set", "continuation.max_points=4", "--max-points", "3",
                  "-o", str(tmp_path / "x.h5")]) == 2
-    assert "both given" in capsys.readouterr().err and not (tmp_path / "x.h5").exists()
+    assert "given twice" in capsys.readouterr().err and not (tmp_path / "x.h5").exists()
+
+
+def test_unset_restores_the_default_and_a_key_is_given_once(tmp_path, capsys):
+    """--unset KEY gives the value a scene without that key parses to; a key given twice, in any spelling, or
+    set and unset, is one line and exit 2 before any computation."""
+    args = build_parser().parse_args(["run", "spom1", "--unset", "stop_stretch", "--set", "solver.degree=12"])
+    scene = scene_of(args)
+    default = parse_scene('[material]\npreset = "SPOM1"\n').continuation.stop_stretch
+    assert scene.continuation.stop_stretch == default != load_scene("spom1").continuation.stop_stretch
+    assert scene.solver.degree == 12
+    out = tmp_path / "x.h5"
+    for flags, words in ((["--set", "M=0", "--set", "field.M=0"], "given twice"),
+                         (["--unset", "continuation.stop_stretch", "--stop-stretch", "3"], "also given a value"),
+                         (["--unset", "nope"], "--unset nope: a bare name")):
+        assert main(["run", "spom1", *flags, "-o", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and words in err, err
+    assert not out.exists()
 
 
 def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):

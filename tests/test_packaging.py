@@ -53,7 +53,16 @@ def test_wheel_ships_exactly_the_source_tree(tmp_path):
     wheel = next(tmp_path.glob("balloon_cg-*.whl"))
     names = {n for n in zipfile.ZipFile(wheel).namelist() if ".dist-info/" not in n}
     assert names == shipped(tree)
-    assert {"balloon_cg/scenes/spom1.toml", "balloon_cg/generated/__init__.py"} <= names
+    assert {"balloon_cg/scenes/spom1.toml", "balloon_cg/generated/__init__.py", "balloon_cg/docs/MODEL.md"} <= names
+
+
+def test_the_shipped_model_page_is_the_shared_one():
+    """docs/MODEL.md, which docstrings, docs pages and help texts cite, ships with the package; it is a copy of the
+    project's shared MODEL.md (beside the clone in CI and in the work folders), so the two cannot drift."""
+    shared = ROOT.parent / "shared" / "MODEL.md"
+    if not shared.is_file():
+        pytest.skip(f"no shared folder beside the clone ({shared})")
+    assert (ROOT / "docs" / "MODEL.md").read_bytes() == shared.read_bytes()
 
 
 def fresh_venv(tmp_path) -> tuple[Path, Path]:

@@ -134,6 +134,20 @@ def test_with_overrides():
         assert str(err.value).startswith(f"two: {key}")
 
 
+def test_with_overrides_takes_the_bare_names_of_the_command_line():
+    """{"M": x} is {"field.M": x} (the one table with that key), as `--set M=x`; an ambiguous or unknown bare
+    name is refused naming the tables."""
+    scene = parse_scene(TWO_COILS, name="spom1_two_coils_M0.002")
+    bare = scene.with_overrides({"M": 0.0025, "stop_stretch": 3.0, "preset": "TPOM1"})
+    dotted = scene.with_overrides({"field.M": 0.0025, "continuation.stop_stretch": 3.0, "material.preset": "TPOM1"})
+    assert bare == dotted and bare.name == "spom1_two_coils_M0.0025_tpom1"
+    assert scene.canonical_key("M") == "field.M" and scene.canonical_key("solver.degree") == "solver.degree"
+    for key, words in (("degree", "in tables solver, stability"), ("nope", "in no table")):
+        with pytest.raises(SceneError) as err:
+            scene.with_overrides({key: 3})
+        assert str(err.value).startswith(f"spom1_two_coils_M0.002: {key}: a bare name") and words in str(err.value)
+
+
 def test_with_overrides_renames_after_physical_keys():
     scene = parse_scene(TWO_COILS, name="spom1_two_coils_M0.002")
     assert scene.with_overrides({"field.M": 0.0025}).name == "spom1_two_coils_M0.0025"  # the token updated

@@ -10,7 +10,7 @@ import pytest
 import balloon_cg
 from balloon_cg.io import run_file as storage
 from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.model.kernels import generated_digest
+from balloon_cg.model.kernels import generated_digest, module_signature
 from balloon_cg.galerkin.profiles import equator_values, fields, profiles, theta_grid
 from balloon_cg.scene import load_scene
 from balloon_cg.io.run_file import RunFileError, read_run, write_run
@@ -37,6 +37,20 @@ def free_branch(scene):
 @pytest.fixture
 def run_file(tmp_path, scene, branch):
     return write_run(tmp_path / "run.h5", scene, [branch], extra_attrs={"note": "test"})
+
+
+def test_generated_digest_reads_the_signatures_the_modules_hold():
+    """The provenance digest reads each module's SIGNATURE line from its text (no import); it must be the
+    constant the imported module holds, for every class and the coil field."""
+    import hashlib
+    import importlib
+
+    from balloon_cg import generated
+
+    names = sorted(generated.CLASSES) + ["coil_field"]
+    signatures = [importlib.import_module(f"balloon_cg.generated.{n}").SIGNATURE for n in names]
+    assert [module_signature(n) for n in names] == signatures
+    assert generated_digest() == hashlib.sha256("".join(signatures).encode()).hexdigest()
 
 
 def test_round_trip(run_file, scene, branch):

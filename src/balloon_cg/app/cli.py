@@ -120,42 +120,58 @@ def _add_run(commands):
     p.set_defaults(handler=run)
 
 
-def _add_settings(p):
-    """--set and the continuation limits AUTO users expect on the command line (both validated like the TOML)."""
+def _add_settings(p, shorthands: bool = True):
+    """--set, --unset and (``shorthands``) the continuation limits AUTO users expect on the command line, all
+    validated like the TOML."""
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
                    help="override a scene key (dotted, e.g. field.M=0.003, field.coils[0].radius=2.5, "
                         "material.preset=TPOM1; a bare name of one table: M=0.003); repeatable")
+    p.add_argument("--unset", action="append", default=[], metavar="KEY",
+                   help="restore a scene key to its default (e.g. continuation.stop_stretch); repeatable")
+    if not shorthands:
+        return
     for flag, key, metavar in (("--max-points", "max_points", "N"), ("--stop-stretch", "stop_stretch", "X"),
                                ("--stop-pressure", "stop_pressure", "P")):
         p.add_argument(flag, dest=key, metavar=metavar, help=f"continuation.{key} (as --set continuation.{key}=…)")
 
 
 def scene_of(args):
-    """The scene file with the command line's --set and continuation limits applied (renamed after them)."""
-    from ..scene import load_scene
-    from .sweep import SweepError, overridden, parse_vary
+    """The scene file with the command line's --set, --unset and continuation limits applied (renamed after them).
+    A key given twice (also as a bare name and dotted, or by --set and its shorthand flag) is refused."""
+    from ..scene import SceneError, load_scene
 
     scene = load_scene(args.scene)
     shorthands = [f"continuation.{key}={getattr(args, key)}" for key in ("max_points", "stop_stretch", "stop_pressure")
                   if getattr(args, key, None) is not None]
     settings = list(args.settings) + shorthands
-    if not settings:
+    if not settings and not args.unset:
         return scene
+    from .sweep import SweepError, overridden, parse_vary
+
     for text in settings:
         key, sep, value = (part.strip() for part in text.partition("="))
         if not sep or not key or not value:
-            raise UsageError(f"--set {text}: expected KEY=VALUE, e.g. --set field.M=0.003")
+            raise UsageError(f"--set {text}: expected KEY=VALUE, e.g. --set field.M=0.003 (--unset KEY restores "
+                             "the default)")
         if "," in value or ":" in value:
             raise UsageError(f"--set {text}: one value per key (sweep --vary takes lists and ranges)")
-    given = [text.partition("=")[0].strip() for text in args.settings]
-    for text in shorthands:
-        if text.partition("=")[0] in given or text.partition("=")[0].split(".")[1] in given:
-            raise UsageError(f"--set {text.partition('=')[0]} and its shorthand flag both given: use one")
     try:
-        overrides = dict(parse_vary(text, scene) for text in settings)
+        overrides = {}
+        for text in settings:
+            key, values = parse_vary(text, scene)
+            if key in overrides:
+                raise UsageError(f"--set {text}: {key} is given twice (by --set or a shorthand flag): give it once")
+            overrides[key] = values[0]
+        for text in args.unset:
+            key = scene.canonical_key(text.strip())
+            if key in overrides:
+                raise UsageError(f"--unset {text}: {key} is also given a value: give one of the two")
+            overrides[key] = None
     except SweepError as e:
         raise UsageError(str(e).replace("--vary", "--set")) from None
-    return overridden(scene, {key: values[0] for key, values in overrides.items()})
+    except SceneError as e:
+        raise UsageError(f"--unset {e}") from None
+    return overridden(scene, overrides)
 
 
 def run(args) -> int:
@@ -216,10 +232,9 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
 def _add_solve(commands):
     p = commands.add_parser("solve", help="one equilibrium on the primary branch at a given north pole stretch")
     p.add_argument("scene", help="scene TOML file")
-    p.add_argument("--pole-stretch", type=float, required=True, metavar="X", help="north pole stretch λ2(0)")
+    p.add_argument("--pole-stretch", type=float, required=True, metavar="X", help="north pole stretch λ2(0) (> 1)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
-                   help="override a scene key, as for run; repeatable")
+    _add_settings(p, shorthands=False)
     p.set_defaults(handler=solve)
 
 
@@ -232,9 +247,11 @@ def solve(args) -> int:
     from .summaries import format_table
 
     scene = scene_of(args)
-    x, start = args.pole_stretch, scene.continuation.start_stretch
-    if not np.isfinite(x) or x <= start:
-        raise UsageError(f"--pole-stretch = {x:g}: must be > continuation.start_stretch = {start:g}")
+    x = args.pole_stretch
+    if not np.isfinite(x) or x <= 1:
+        raise UsageError(f"--pole-stretch = {x:g}: must be > 1 (λ2(0) = 1 is the undeformed sphere)")
+    if x <= scene.continuation.start_stretch:  # traced upwards from a start below x, halfway from the sphere
+        scene = scene.with_overrides({"continuation.start_stretch": (1 + x) / 2, "continuation.min_stretch": None})
     branch = trace_primary(scene, stop_stretch=x, down=False)
     if branch.legs[0].stop.code != StopCode.STOP_STRETCH:
         reached = branch.pole_values()["lam2_north"].max()

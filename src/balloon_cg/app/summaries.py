@@ -190,18 +190,35 @@ def _format_branch(name: str, b: dict) -> list[str]:
         f"  wall time            {b['wall_time']:.3f} s",
         f"  error estimate vs run time: {b['max_error_estimate']:.3e} max, "
         f"{1e3 * b['wall_time_per_point']:.2f} ms per point",
-        f"  stable points        {b['stable_points'] or 'not assessed'}",
+        f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
     ]
-    for s in b["special_points"]:
+    labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
+              + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
+              for s in b["special_points"]]
+    places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"
+              for s in b["special_points"]]  # EP is a stored point; LP, TP, BP lie between two (docs/hdf5.md)
+    width, place_width = max(map(len, labels), default=0), max(map(len, places), default=0)
+    for s, label, place in zip(b["special_points"], labels, places):
         note = f"  {s['note']}" if s["note"] else ""
-        status = "" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})"
-        label = f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "") + status
         lines.append(
-            f"    {label:<3} at point {s['index']:<5} P = {s['pressure']:.10g}  "
+            f"    {label:<{width}}  {place:<{place_width}}  P = {s['pressure']:.10g}  "
             f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
         )
     return lines
+
+
+def _stable_counts(counts: dict, points: int) -> str:
+    """'pressure control 23, volume control 51 (of 72; the same with the centre free)' from the counts of the
+    stored flags stable_READING and stable_READING_free (balloon held at its centre, or free)."""
+    if not counts:
+        return "not assessed"
+    held = {k.removeprefix("stable_"): n for k, n in counts.items() if not k.endswith("_free")}
+    free = {k.removeprefix("stable_").removesuffix("_free"): n for k, n in counts.items() if k.endswith("_free")}
+    text = ", ".join(f"{reading} control {n}" for reading, n in held.items()) + f" (of {points}"
+    if free == held:
+        return text + "; the same with the centre free)"
+    return text + "; centre free: " + ", ".join(f"{reading} control {n}" for reading, n in free.items()) + ")"
 
 
 def format_table(values: dict) -> str:

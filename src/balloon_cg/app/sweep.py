@@ -72,7 +72,10 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
     key, text = key.strip(), text.strip()
     if not sep or not key or not text:
         raise SweepError(f"--vary {spec!r}: expected KEY=START:STOP:COUNT or KEY=v1,v2,...")
-    key = canonical_key(key, scene)
+    try:
+        key = scene.canonical_key(key)
+    except SceneError as e:
+        raise SweepError(f"--vary {e}") from None
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3:
@@ -94,21 +97,6 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
         if any(v == "" for v in values):
             raise SweepError(f"--vary {spec!r}: empty value in the list")
     return key, values
-
-
-def canonical_key(key: str, scene: Scene) -> str:
-    """The dotted key for ``key``: bare names are looked up in the scene's tables (must be unique)."""
-    if "." in key:
-        return key
-    data = scene.to_dict()
-    tables = [t for t, content in data.items() if key in content]
-    if key == "preset":
-        tables = ["material"]
-    if len(tables) != 1:
-        found = f"in tables {', '.join(tables)}" if tables else "in no table"
-        raise SweepError(f"--vary {key}: a bare name must name a key of exactly one scene table; "
-                         f"{key!r} is {found} (write TABLE.{key})")
-    return f"{tables[0]}.{key}"
 
 
 def expand(scene: Scene, specs: list[str]) -> list[Member]:

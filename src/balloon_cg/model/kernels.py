@@ -17,7 +17,9 @@ turns named values into an argument tuple, so no caller knows the argument order
 import hashlib
 import importlib
 import operator
-from functools import cached_property
+import re
+from functools import cache, cached_property
+from importlib import resources
 
 import numpy as np
 
@@ -189,8 +191,21 @@ def _frozen(values) -> np.ndarray:
     return array
 
 
+@cache
 def generated_digest() -> str:
-    """SHA-256 over the signatures of every generated module (stored as provenance)."""
+    """SHA-256 over the signatures of every generated module (stored as provenance), read from the modules' text:
+    importing all of them would build every numba dispatcher of every class (~0.2 s at start-up)."""
     names = sorted(generated.CLASSES) + ["coil_field"]
-    text = "".join(importlib.import_module(f"{generated.__name__}.{n}").SIGNATURE for n in names)
-    return hashlib.sha256(text.encode()).hexdigest()
+    return hashlib.sha256("".join(map(module_signature, names)).encode()).hexdigest()
+
+
+def module_signature(name: str) -> str:
+    """The ``SIGNATURE = "…"`` line of generated module ``name`` (codegen/emit.py prints it), without importing it."""
+    text = resources.files(generated).joinpath(f"{name}.py").read_text(encoding="utf-8")
+    found = _SIGNATURE.search(text)
+    if found is None:
+        raise ImportError(f"{generated.__name__}.{name} has no SIGNATURE line: run `make regenerate`")
+    return found[1]
+
+
+_SIGNATURE = re.compile(r'^SIGNATURE = "([0-9a-f]{64})"$', re.MULTILINE)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .newton import newton
+from .roots import brent
 
 
 @dataclass
@@ -121,9 +122,7 @@ def locate_root(value_at, length: float, xtol: float = 1e-13, known: dict | None
         return cache[s][0]
 
     try:
-        from scipy.optimize import brentq  # here: importing scipy.optimize costs 0.2 s at start-up
-
-        s = brentq(f, 0.0, length, xtol=xtol * max(1.0, length), maxiter=100)
+        s = brent(f, 0.0, length, xtol=xtol * max(1.0, length), maxiter=100)
         value, payload = cache[s] if s in cache else value_at(s)
         return Root(payload, RootStatus.LOCATED, float(value))
     except (ArithmeticError, ValueError):

@@ -149,8 +149,21 @@ class Scene:
         """TOML text of ``to_dict()``; parsing it gives back this scene (apart from ``text``)."""
         return _to_toml(self.to_dict())
 
+    def canonical_key(self, key: str) -> str:
+        """The dotted key for ``key``: a dotted key itself; a bare name, the key of that name in the one table
+        that has it (``M`` -> ``field.M``; ``preset`` -> ``material.preset``). SceneError if none or several do."""
+        if "." in key:
+            return key
+        tables = ["material"] if key == "preset" else [t for t, content in self.to_dict().items() if key in content]
+        if len(tables) != 1:
+            found = f"in tables {', '.join(tables)}" if tables else "in no table"
+            raise SceneError(f"{key}: a bare name must name a key of exactly one scene table; {key!r} is {found} "
+                             f"(write TABLE.{key})")
+        return f"{tables[0]}.{key}"
+
     def with_overrides(self, overrides: dict[str, object], name: str | None = None) -> "Scene":
-        """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``.
+        """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``,
+        or bare names of one table as on the command line (``{"M": 0.003}``: ``canonical_key``).
 
         ``material.preset`` replaces the whole material; a value None restores the default. The copy is named
         ``name``, or after what changed physically: each field or material key's token in the name
@@ -158,6 +171,7 @@ class Scene:
         """
         data = self.to_dict()
         try:
+            overrides = {self.canonical_key(key): value for key, value in overrides.items()}
             for key, value in overrides.items():
                 _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
