@@ -8,7 +8,8 @@ done, numba kernels loaded), writing nothing. That is the part a faster start-up
 
     inspect: summarise_file(run file)    solve: trace_primary to λ2(0) = 3    run: the whole picture (api.computed)
 
-The ratios are wall / compute and CPU / compute (the CPU ratio is the steadier one on a loaded machine). Then,
+The ratios are wall / compute wall and CPU / compute CPU (the CPU ratio is the steadier one on a loaded
+machine: another process's share of the cores stretches wall times, not CPU times). Then,
 for ``run``, where the rest goes, measured inside one fresh process doing what the CLI does: imports, the first
 computation (numba loads its cached kernels on first call), the write. The load average is printed before and
 after: on a loaded machine every number grows, the ratios less so.
@@ -36,18 +37,19 @@ TARGETS = {"--help": "<= 0.3 s", "--version": "<= 0.3 s", "inspect": "<= 0.8 s",
 # imports, first computation and write of one fresh process, then the steady compute of every command
 MEASURE = """
 import json, statistics, sys, time
-t0 = time.perf_counter()
+clocks = (time.perf_counter, time.process_time)
+t0 = [c() for c in clocks]
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.app.api import computed
 from balloon_cg.app.summaries import summarise_file
 from balloon_cg.io.run_file import write_run
 from balloon_cg.scene import load_scene
 scene = load_scene(sys.argv[1])
-t1 = time.perf_counter()
+t1 = [c() for c in clocks]
 branches, snaps, found, _ = computed(scene)
-t2 = time.perf_counter()
+t2 = [c() for c in clocks]
 write_run(sys.argv[2], scene, branches, force=True, snaps=snaps, found=found)
-t3 = time.perf_counter()
+t3 = [c() for c in clocks]
 work = {"inspect": lambda: summarise_file(sys.argv[2]), "solve": lambda: trace_primary(scene, stop_stretch=3.0,
         down=False), "run": lambda: computed(scene)}
 steady = {}
@@ -55,9 +57,10 @@ for name, f in work.items():
     f()
     times = []
     for _ in range(int(sys.argv[3])):
-        t = time.perf_counter(); f(); times.append(time.perf_counter() - t)
-    steady[name] = statistics.median(times)
-print(json.dumps({"steady": steady, "imports": t1 - t0, "first": t2 - t1, "write": t3 - t2}))
+        t = [c() for c in clocks]; f(); times.append([c() - s for c, s in zip(clocks, t)])
+    steady[name] = [statistics.median(column) for column in zip(*times)]
+print(json.dumps({"steady": steady, "imports": [b - a for a, b in zip(t0, t1)],
+                  "first": [b - a for a, b in zip(t1, t2)], "write": [b - a for a, b in zip(t2, t3)]}))
 """
 
 
@@ -104,22 +107,28 @@ def main():
                                      check=True, capture_output=True, text=True).stdout
                 measured[py].append(json.loads(out))
     for py in pythons:
-        steady = {name: statistics.median(m["steady"][name] for m in measured[py]) for name in ("inspect", "solve",
-                                                                                               "run")}
+        steady = {name: [statistics.median(m["steady"][name][k] for m in measured[py]) for k in (0, 1)]
+                  for name in ("inspect", "solve", "run")}
         steady["run (quiet)"] = steady["run"]
-        print(f"{py}\n{'command':<34} {'wall (s)':>9} {'CPU (s)':>8} {'compute (s)':>12} {'wall/comp':>10} "
-              f"{'CPU/comp':>9}  target")
+        print(f"{py}\n{'command':<34} {'wall (s)':>9} {'CPU (s)':>8} {'compute wall':>13} {'compute CPU':>12} "
+              f"{'wall ratio':>11} {'CPU ratio':>10}  target")
         for name, args in commands[py].items():
             wall = statistics.median(w for w, _ in walls[py][name])
             cpu = statistics.median(c for _, c in walls[py][name])
             label = " ".join(a.name if isinstance(a, Path) else str(a) for a in args)[:34]
-            compute = steady.get(name, 0.0)
-            ratios = f"{wall / compute:10.2f} {cpu / compute:9.2f}" if compute else f"{'-':>10} {'-':>9}"
-            print(f"{label:<34} {wall:9.3f} {cpu:8.3f} {compute:12.3f} {ratios}  {TARGETS.get(name, '')}")
-        parts = {k: statistics.median(m[k] for m in measured[py]) for k in ("imports", "first", "write")}
-        print(f"run, inside one fresh process: imports {parts['imports']:.3f} s, first computation "
-              f"{parts['first']:.3f} s (compute {steady['run']:.3f} s + {parts['first'] - steady['run']:.3f} s "
-              f"of numba loading its kernels and first-call work), write {parts['write']:.3f} s\n")
+            if name in steady:
+                c_wall, c_cpu = steady[name]
+                numbers = f"{c_wall:13.3f} {c_cpu:12.3f} {wall / c_wall:11.2f} {cpu / c_cpu:10.2f}"
+            else:
+                numbers = f"{'-':>13} {'-':>12} {'-':>11} {'-':>10}"
+            print(f"{label:<34} {wall:9.3f} {cpu:8.3f} {numbers}  {TARGETS.get(name, '')}")
+        parts = {k: [statistics.median(m[k][i] for m in measured[py]) for i in (0, 1)]
+                 for k in ("imports", "first", "write")}
+        print("run, inside one fresh process (wall / CPU s): imports {:.3f} / {:.3f}, first computation {:.3f} / "
+              "{:.3f} (of which beyond the steady compute, numba loading its kernels and first-call work: {:.3f} / "
+              "{:.3f}), write {:.3f} / {:.3f}\n".format(
+                  *parts["imports"], *parts["first"], parts["first"][0] - steady["run"][0],
+                  parts["first"][1] - steady["run"][1], *parts["write"]))
     print(f"end: {load()}")
 
 

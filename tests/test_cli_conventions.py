@@ -109,6 +109,16 @@ def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):
     assert strict_json({"a": float("nan"), "b": [float("inf"), 1.0]}) == '{"a": null, "b": [null, 1.0]}'
 
 
+def test_a_closed_stdout_ends_quietly():
+    """`balloon-cg inspect FILE | head`: the reader goes away; no error line, the SIGPIPE status 141."""
+    fixture = Path(__file__).parent / "data" / "spom1_format2.h5"
+    process = subprocess.Popen([sys.executable, "-m", "balloon_cg", "inspect", str(fixture), "--json"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process.stdout.close()
+    assert process.wait(timeout=60) == 141
+    assert process.stderr.read() == b""
+
+
 def test_plot_several_kinds_at_once(tmp_path, capsys):
     scene = tmp_path / "small.toml"
     scene.write_text(SMALL)

@@ -15,6 +15,7 @@ stderr, ``balloon-cg: error: ...``.
 import argparse
 import json
 import math
+import os
 import shlex
 import sys
 from importlib import resources
@@ -26,6 +27,7 @@ from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
+BROKEN_PIPE = 141  # 128 + SIGPIPE: what a tool killed by SIGPIPE reports
 PLOT_KINDS = ("pressure-pole", "pressure-equator", "shapes", "stresses", "field", "curvature", "energy", "phase")
 # the exceptions that mean bad input (exit 2) or a computation that did not give what was asked (exit 1), by
 # module: a module that is not loaded cannot have raised its exception, so none is imported to catch it
@@ -51,6 +53,9 @@ def main(argv=None) -> int:
         return args.handler(args)
     except KeyboardInterrupt:  # before the computation installed its own handler (imports), or a second Ctrl-C
         return _error("interrupted", INTERRUPTED)
+    except BrokenPipeError:  # the reader of stdout went away (`| head`): stop quietly, as other Unix tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # the exit's flush must not fail again
+        return BROKEN_PIPE
     except (UsageError, *_loaded(BAD_INPUT)) as e:
         return _debug(args) or _error(str(e), 2)
     except OSError as e:
@@ -76,6 +81,10 @@ def _loaded(classes: dict) -> tuple:
 def docs_path(name: str) -> str:
     """Where the installed documentation page docs/``name`` is."""
     return str(resources.files("balloon_cg.docs") / name)
+
+
+SCENE_HELP = ("scene TOML file, or the name of a scene shipped with the package (spom1, tpom1_two_coils_M0.002, …: "
+              f"the files in {resources.files('balloon_cg.scenes')})")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -107,7 +116,7 @@ def _os_message(e: OSError) -> str:
 def _add_run(commands):
     p = commands.add_parser("run", help="analyse a scene (primary branch, stability, branch points, pear branches) "
                                         "and write a run file")
-    p.add_argument("scene", help="scene TOML file")
+    p.add_argument("scene", help=SCENE_HELP)
     p.add_argument("-o", "--output", help="run file to write (HDF5; default: SCENE_NAME.h5 in the current folder, "
                                           "the name after --set changes)")
     _add_settings(p)
@@ -231,7 +240,7 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
 
 def _add_solve(commands):
     p = commands.add_parser("solve", help="one equilibrium on the primary branch at a given north pole stretch")
-    p.add_argument("scene", help="scene TOML file")
+    p.add_argument("scene", help=SCENE_HELP)
     p.add_argument("--pole-stretch", type=float, required=True, metavar="X", help="north pole stretch λ2(0) (> 1)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_settings(p, shorthands=False)
@@ -415,7 +424,7 @@ def _add_critical(commands):
                     "or the curve ended otherwise: one line says how and where; the curve file is still written). "
                     "Exit 2: a scene this command cannot handle (not equator-symmetric; --parameter M without "
                     "coils) or bad input.")
-    p.add_argument("scene", help="scene TOML file (equator-symmetric: coils mirror-symmetric about z = 0)")
+    p.add_argument("scene", help=f"{SCENE_HELP}; equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, choices=("M", "alpha1"), help="the second parameter")
     p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -510,7 +519,7 @@ def _asymmetry(scene) -> str:
 
 def _add_sweep(commands):
     p = commands.add_parser("sweep", help="run a scene over a grid of parameter values into one sweep file")
-    p.add_argument("scene", help="scene TOML file (the base scene)")
+    p.add_argument("scene", help=f"{SCENE_HELP}; the base scene")
     p.add_argument("--vary", action="append", required=True, metavar="KEY=SPEC",
                    help="KEY=START:STOP:COUNT or KEY=v1,v2,...; KEY a dotted scene key (field.M, "
                         "field.coils[0].radius, material.alpha[0]) or a bare name of one table (M = field.M); "
