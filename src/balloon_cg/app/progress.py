@@ -16,15 +16,15 @@ class PhaseBars(Progress):
             from tqdm import tqdm
 
             desc = f"{self.label}: {phase.value}" if self.label else phase.value
-            self.bars[phase] = tqdm(desc=desc, unit=" points", disable=not self.enabled, file=sys.stderr,
-                                    leave=True)
+            self.bars[phase] = tqdm(desc=desc, unit=" points", file=sys.stderr, leave=True)
         return self.bars[phase]
 
     def tick(self, phase: Phase) -> None:
-        self._bar(phase).update()
+        if self.enabled:  # disabled: no tqdm at all (not even its multiprocessing lock)
+            self._bar(phase).update()
 
     def finish(self, phase: Phase, count: int) -> None:
-        if phase not in self.bars and count == 0:
+        if not self.enabled or (phase not in self.bars and count == 0):
             return
         bar = self._bar(phase)
         bar.n = count
