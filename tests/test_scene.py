@@ -146,6 +146,8 @@ def test_with_overrides_takes_the_bare_names_of_the_command_line():
         with pytest.raises(SceneError) as err:
             scene.with_overrides({key: 3})
         assert str(err.value).startswith(f"spom1_two_coils_M0.002: {key}: a bare name") and words in str(err.value)
+    with pytest.raises(SceneError, match="field.M is given twice"):
+        scene.with_overrides({"M": 0.001, "field.M": 0.003})
 
 
 def test_with_overrides_renames_after_physical_keys():

@@ -171,7 +171,12 @@ class Scene:
         """
         data = self.to_dict()
         try:
-            overrides = {self.canonical_key(key): value for key, value in overrides.items()}
+            canonical = {}
+            for key, value in overrides.items():
+                if self.canonical_key(key) in canonical:
+                    raise SceneError(f"{key}: {self.canonical_key(key)} is given twice")
+                canonical[self.canonical_key(key)] = value
+            overrides = canonical
             for key, value in overrides.items():
                 _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
