@@ -4,8 +4,9 @@
    first-order system is singular at the undeformed state, MODEL.md §4).
 2. Field on: natural continuation in M at that pressure from 0 to the scene's M.
 3. Pressure: pseudo-arclength in (u, P) downwards to ``min_stretch`` and upwards to ``stop_stretch`` (landing
-   exactly on it), ``stop_pressure``, a wire gap or ``max_points``; folds in P (LP) and in the north pole
-   stretch (TP) are located and recorded; the degree and basis map adapt (``tracer``).
+   exactly on it), ``stop_pressure``, ``loading.stop_volume``/``stop_amount``, a wire gap or ``max_points``;
+   folds in P (LP), in the north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and
+   recorded; the degree and basis map adapt (``tracer``).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
 removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
@@ -22,7 +23,9 @@ from ..model.stresses import smallest_stress
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
+from ..scene import Control
 from .assembly import assemble
+from .control import control_value
 from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
@@ -139,9 +142,12 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
 
 
 def range_limits(scene, upper: float):
-    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper] or P reaches
-    stop_pressure (the range the scene asks for)."""
-    cont = scene.continuation
+    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper], P reaches
+    stop_pressure, or the control parameter reaches loading.stop_volume or stop_amount (the range the scene asks
+    for)."""
+    cont, loading = scene.continuation, scene.loading
+    control_stop = {Control.VOLUME: (loading.stop_volume, StopCode.STOP_VOLUME, "stop_volume"),
+                    Control.GAS: (loading.stop_amount, StopCode.STOP_AMOUNT, "stop_amount")}.get(loading.control)
 
     def limits(disc, point):
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
@@ -151,6 +157,10 @@ def range_limits(scene, upper: float):
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure:
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
+        if control_stop is not None and control_stop[0] is not None:
+            limit, code, key = control_stop
+            if control_value(disc, point.X, loading.control) >= limit:
+                return Stop(code, f"reached {key} {limit:g}")
         return None
 
     return limits
