@@ -196,6 +196,9 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
                     limits=limits)
     below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree,
                         limits=limits) if down else None)
+    loading = scene.loading
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", upper),
-               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)}
+               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch),
+               StopCode.STOP_VOLUME: (Control.VOLUME, loading.stop_volume),
+               StopCode.STOP_AMOUNT: (Control.GAS, loading.stop_amount)}
     return assemble(tracer, params, "primary", up, below, t0, land_on=land_on, labels=("up", "down"))
