@@ -4,8 +4,8 @@ A ``Branch`` is arrays and metadata (its scene, discretisation, kernel class, pa
 it pickles cheaply and the solver objects are rebuilt from it where needed (``analysis.problem``).
 Special points carry AUTO's labels where they exist (LP fold in the parameter, BP branch point, EP end point,
 UZ user point) plus TP, the turning point of the north pole stretch, and LV, LN, the folds in the volume and in
-the gas amount (the control parameters of volume and gas control, ``analysis.control``); a branch point's classification,
-block and the status of its location are separate fields. Stops are a code from ``StopCode`` (or the
+the gas amount (the control parameters of volume and gas control, ``analysis.control``); a branch point's
+classification, block and the status of its location are separate fields. Stops are a code from ``StopCode`` (or the
 continuation engine's ``TraceStop``) plus a message for people; code decides, never the message.
 """
 import enum

@@ -221,7 +221,7 @@ def _write_stability(group, branch, point):
 
 
 def _write_snaps(group, snaps):
-    """Snap-throughs under pressure control: from (branch, index) at pressure P to (branch, index) or none."""
+    """Snap-throughs under the loading control: from (branch, index) at pressure P to (branch, index) or none."""
     write_strings(group, "from_branch", [s.from_branch for s in snaps])
     write_strings(group, "to_branch", [s.to_branch for s in snaps])
     group.create_dataset("from_index", data=np.array([s.from_index for s in snaps], dtype=np.int64))

@@ -17,7 +17,7 @@ VARIABLES = {
     "unknown": (NONDIMENSIONAL, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last"),
     "special": (NONDIMENSIONAL, "special point index", "index of the special point on its branch"),
     "mode_unknown": (NONDIMENSIONAL, "mode unknown index", "index into the odd perturbation block of the mode"),
-    "snap": (NONDIMENSIONAL, "snap-through index", "one row per snap-through under pressure control"),
+    "snap": (NONDIMENSIONAL, "snap-through index", "one row per snap-through under the loading control"),
     "from_branch": ("", "from branch", "the branch whose stable stretch ends"),
     "from_index": (NONDIMENSIONAL, "from point", "the last stable point of from_branch"),
     "to_branch": ("", "to branch", "the branch of the lowest-energy stable state at that P (empty: none)"),

@@ -8,5 +8,5 @@ from .tables import (Coil, Continuation, Field, Output, Scene, Solver, Stability
                      shipped_scenes)
 from .validation import SceneError
 
-__all__ = ["Coil", "Continuation", "Control", "Field", "Loading", "Output", "Scene", "SceneError", "Solver", "Stability", "load_scene",
-           "parse_scene"]
+__all__ = ["Coil", "Continuation", "Control", "Field", "Loading", "Output", "Scene", "SceneError", "Solver",
+           "Stability", "load_scene", "parse_scene"]

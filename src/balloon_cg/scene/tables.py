@@ -172,12 +172,13 @@ class Scene:
 
 
 def renamed(name: str, overrides: dict[str, object]) -> str:
-    """``name`` with a ``_<key><value>`` token per scalar field or material override (key: the last part of
-    the dotted key, with its list index past 0: ``radius3.5``, ``radius1=3.5``; a string: itself, reduced to
+    """``name`` with a ``_<key><value>`` token per scalar field, material or loading override (key: the last part
+    of the dotted key, with its list index past 0: ``radius3.5``, ``radius1=3.5``; a string: itself, reduced to
     filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
     (``field.coils``, ``material.mu``) leave the name alone."""
     for key, value in overrides.items():
-        if key.split(".")[0] not in ("field", "material", "loading") or value is None or isinstance(value, (list, tuple, dict)):
+        physical = key.split(".")[0] in ("field", "material", "loading")
+        if not physical or value is None or isinstance(value, (list, tuple, dict)):
             continue
         if isinstance(value, str):  # a preset or a material name
             name = f"{name}_{re.sub(r'[^A-Za-z0-9.+-]+', '-', value).strip('-').lower()}"
