@@ -17,6 +17,7 @@ from balloon_cg.analysis.results import Kind, Status, StopCode
 from balloon_cg.analysis.stability import FLAGS, SecondVariation, assess_branch
 from balloon_cg.app.cli import main
 from balloon_cg.model.sphere import sphere_pressure
+from balloon_cg.post.plotting import Reading, load_branches
 from balloon_cg.scene import Control, SceneError, load_scene, parse_scene
 
 # SPOM1's exponents (its committed kernels) with a stronger α = −2 term: μ3 α3 < 0 softens Pλ³ at large λ,
@@ -130,6 +131,24 @@ def test_fold_in_n_matches_the_extremum_of_P_lambda3(soft_gas, spom1_gas):
     assert not [s for s in spom1_gas[0].special if s.kind == Kind.LN]  # SPOM1: Pλ³ monotone, no fold in n
 
 
+def test_gas_jacobian_is_singular_at_the_fold_in_n(soft_gas):
+    """At a fold of n the Jacobian of the gas problem, J + (P/Ṽ) ∇Ṽ ∇Ṽᵀ (the Hessian of E/2π − (n/2π) ln V in
+    the unknowns), is singular (J du = ∇Ṽ dP with dn = 0 gives it a null vector); at the neighbours it is not."""
+    branch, _ = soft_gas
+    fold = next(s for s in branch.special if s.kind == Kind.LN)
+    eq = equilibrium_of(branch)
+
+    def smallest_singular_value(X):
+        params = branch.params.with_value("P", X[-1])
+        gradient = -eq.parameter_derivative(X[:-1], params, "P")  # ∇Ṽ
+        J = eq.jacobian(X[:-1], params) + X[-1] / eq.volume(X[:-1]) * np.outer(gradient, gradient)
+        return np.linalg.svd(J, compute_uv=False)[-1]
+
+    at_fold = smallest_singular_value(fold.X)
+    neighbours = [smallest_singular_value(branch.X[i]) for i in (fold.index, fold.index + 1)]
+    assert at_fold < 1e-8 < min(neighbours)
+
+
 @pytest.mark.parametrize("control, key, target", [("gas", "stop_amount", 40.0), ("volume", "stop_volume", 20.0)])
 def test_branch_lands_on_the_control_stop(control, key, target):
     scene = load_scene("spom1").with_overrides({"loading.control": control, f"loading.{key}": target})
@@ -181,6 +200,7 @@ def test_run_and_inspect_each_control(control, tmp_path, capsys):
     capsys.readouterr()
     assert main(["inspect", str(out)]) == 0
     assert f"control        {control.value} (loading.control)" in capsys.readouterr().out
+    assert load_branches(str(out))[0].reading == Reading(control.value)  # plot's default reading
     with h5py.File(out) as f:
         assert f.attrs["control"] == control.value
         b = f["branches/primary"]
