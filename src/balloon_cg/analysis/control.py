@@ -9,9 +9,26 @@ import numpy as np
 
 from ..galerkin.equilibrium import enclosed_volume
 from ..scene import Control
-from .results import Kind
+from .results import Kind, StopCode
 
 FOLD_KIND = {Control.PRESSURE: Kind.LP, Control.VOLUME: Kind.LV, Control.GAS: Kind.LN}
+STOP_KEY = {Control.VOLUME: ("stop_volume", StopCode.STOP_VOLUME), Control.GAS: ("stop_amount", StopCode.STOP_AMOUNT)}
+
+
+def control_stop(loading) -> tuple | None:
+    """(loading key, StopCode, limit) of a scene's stop in its control parameter (loading.stop_volume or
+    stop_amount), or None when it has none."""
+    if loading.control not in STOP_KEY:
+        return None
+    key, code = STOP_KEY[loading.control]
+    limit = getattr(loading, key)
+    return None if limit is None else (key, code, limit)
+
+
+def landing(loading) -> dict:
+    """The ``assembly.assemble`` land_on entry of a scene's control stop: {StopCode: (Control, limit)} or {}."""
+    stop = control_stop(loading)
+    return {} if stop is None else {stop[1]: (loading.control, stop[2])}
 
 
 def control_value(disc, X, control: Control) -> float:

@@ -23,9 +23,8 @@ from ..model.stresses import smallest_stress
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
-from ..scene import Control
 from .assembly import assemble
-from .control import control_value
+from .control import control_stop, control_value, landing
 from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
@@ -145,9 +144,8 @@ def range_limits(scene, upper: float):
     """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper], P reaches
     stop_pressure, or the control parameter reaches loading.stop_volume or stop_amount (the range the scene asks
     for)."""
-    cont, loading = scene.continuation, scene.loading
-    control_stop = {Control.VOLUME: (loading.stop_volume, StopCode.STOP_VOLUME, "stop_volume"),
-                    Control.GAS: (loading.stop_amount, StopCode.STOP_AMOUNT, "stop_amount")}.get(loading.control)
+    cont, control = scene.continuation, scene.loading.control
+    by_control = control_stop(scene.loading)
 
     def limits(disc, point):
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
@@ -157,10 +155,9 @@ def range_limits(scene, upper: float):
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure:
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
-        if control_stop is not None and control_stop[0] is not None:
-            limit, code, key = control_stop
-            if control_value(disc, point.X, loading.control) >= limit:
-                return Stop(code, f"reached {key} {limit:g}")
+        if by_control is not None and control_value(disc, point.X, control) >= by_control[2]:
+            key, code, limit = by_control
+            return Stop(code, f"reached {key} {limit:g}")
         return None
 
     return limits
@@ -196,9 +193,6 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
                     limits=limits)
     below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree,
                         limits=limits) if down else None)
-    loading = scene.loading
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", upper),
-               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch),
-               StopCode.STOP_VOLUME: (Control.VOLUME, loading.stop_volume),
-               StopCode.STOP_AMOUNT: (Control.GAS, loading.stop_amount)}
+               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
     return assemble(tracer, params, "primary", up, below, t0, land_on=land_on, labels=("up", "down"))

@@ -1,8 +1,8 @@
 """The adaptive tracer: pseudo-arclength legs on discretisations of growing degree and, near wires, mapped bases.
 
 A leg follows a branch from a point along its tangent (``numerics.continuation.trace``), locating the folds
-in P (LP), in the north pole stretch (TP) and in the loading's control parameter (LV, LN: ``control``). When a point's
-spectral error estimate exceeds the resolution policy's max_error (``resolution.Resolution``), the leg stops
+in P (LP), in the north pole stretch (TP) and in the loading's control parameter (LV, LN: ``control``). When a
+point's spectral error estimate exceeds the resolution policy's max_error (``resolution.Resolution``), the leg stops
 with RESOLUTION and the last point is recomputed on a finer basis: with coils, first the wire map re-centred
 at the same degree (kept if the estimate leaves the policy's headroom, at most max_recentres times per degree);
 otherwise the degree grows and the better of the current and the re-centred map is kept. Past max_degree the
