@@ -167,6 +167,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
     path = Path(points=[start])
     sigma = settings.step
     current = start
+    rates = {label: rate(c, start.X, start.tangent) for label, c in monitors.items()}  # at ``current``
     while len(path.points) < settings.max_points:
         predictor = current.X + sigma * current.tangent
         result = correct(system, predictor, current.tangent, settings)
@@ -184,8 +185,9 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
                 return path
             continue
         point = Point(result.x, new_tangent, result.iterations, result.residual)
+        new_rates = {label: rate(c, point.X, point.tangent) for label, c in monitors.items()}
         for label, c in monitors.items():
-            if rate(c, current.X, current.tangent) * rate(c, point.X, point.tangent) < 0:
+            if rates[label] * new_rates[label] < 0:
                 fold = _locate_fold(system, current, sigma, c, settings, point)
                 if fold is None:  # no evaluation converged: the fold is known to lie in the step, no better
                     path.folds.append(Fold(label, current, len(path.points) - 1, RootStatus.NEAREST))
@@ -199,7 +201,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         path.points.append(point)
         if progress is not None:
             progress(point)
-        current = point
+        current, rates = point, new_rates
         if result.iterations <= 3:
             state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
             sigma = min(sigma * 1.5, settings.step_max / state_share)
