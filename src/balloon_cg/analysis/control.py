@@ -40,11 +40,8 @@ def control_value(disc, X, control: Control) -> float:
 
 
 def control_gradient(system, X, control: Control) -> np.ndarray:
-    """∇q(X) = ∂q/∂(u, P) for the continuation system ``system`` (an ``analysis.problem.ParameterSystem`` in P)."""
-    if control == Control.PRESSURE:
-        gradient = np.zeros(X.size)
-        gradient[-1] = 1.0
-        return gradient
+    """∇q(X) = ∂q/∂(u, P) of volume or gas control for the continuation system ``system`` (an
+    ``analysis.problem.ParameterSystem`` in P; under pressure control q = P is linear: its monitor is e_P)."""
     eq = system.eq
     dV = -2 * np.pi * eq.parameter_derivative(X[:-1], system.params.with_value("P", X[-1]), "P")
     if control == Control.VOLUME:
