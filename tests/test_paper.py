@@ -83,8 +83,8 @@ def test_figure_command_bad_input(tmp_path, capsys):
     assert main(["figure", "fig99", "-o", str(tmp_path / "x.png"), "--quick"]) == 2
     assert "fig99" in capsys.readouterr().err
     assert main(["figure", "fig2", "-o", str(tmp_path / "x.txt"), "--quick"]) == 2
-    assert main(["figure", "fig2", "-o", str(tmp_path / "x.png"), "--quick", "--stability", "gas"]) == 2
-    assert "pressure, volume, free, free-volume, axisymmetric" in capsys.readouterr().err
+    assert main(["figure", "fig2", "-o", str(tmp_path / "x.png"), "--quick", "--stability", "mass"]) == 2
+    assert "pressure, volume, free, free-volume, gas, free-gas, axisymmetric" in capsys.readouterr().err
 
 
 def test_runs_are_reused_only_for_the_same_scene(runs, monkeypatch):

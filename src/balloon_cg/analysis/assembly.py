@@ -5,7 +5,10 @@ latest), its degree raised by the resolution policy while the projection would l
 loss limit of any point and raising it helps. A point's stored error estimate adds its measured projection
 loss. A leg that stopped on passing a pole stretch given in ``land_on`` (STOP_STRETCH, MIN_STRETCH,
 SOUTH_STOP_STRETCH) gets its exact end point there (Newton on the pole row r·X = target from the linear
-interpolant); a fold found between the last point and the overshoot is kept only if it lies before that end.
+interpolant); one that stopped on a value of the control parameter q (STOP_VOLUME, STOP_AMOUNT: q = V or n,
+nonlinear in X) lands by Newton on the linearised constraint ∇q(X_k)·(X − X_k) = target − q(X_k), repeated
+until |q − target| ≤ LANDING_RTOL·max(1, |target|); a fold found between the last point and the overshoot is
+kept only if it lies before that end.
 """
 import time
 
@@ -14,6 +17,8 @@ import numpy as np
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
+from ..scene import Control
+from .control import control_gradient, control_value
 from .resolution import transfer_error
 from .results import Branch, Kind, Leg, SpecialPoint, StopCode, located_or_bracketed
 from .tracer import ContinuationError, LegTrace
@@ -68,14 +73,34 @@ def _collect(leg: LegTrace, disc, moves):
     return points, folds
 
 
-def _land(system, before, after, row, target, settings):
-    """The point with row·X = target between two branch points (Newton from the linear interpolant)."""
-    f0, f1 = row @ before, row @ after
-    guess = before + (target - f0) / (f1 - f0) * (after - before)
-    result = newton(system.residual, system.jacobian, guess, row, target, settings.tol, settings.max_newton)
-    if not result.converged:
-        return None
-    return continuation.Point(result.x, np.zeros_like(result.x), result.iterations, result.residual)
+LANDING_RTOL = 1e-12
+LANDING_ROUNDS = 8
+
+
+def _quantity(system, name):
+    """(q, ∇q) of a landing target: the pole row ``name`` (linear) or the control parameter of a Control."""
+    if isinstance(name, Control):
+        return (lambda X: control_value(system.eq.disc, X, name)), (lambda X: control_gradient(system, X, name))
+    row = np.append(system.eq.disc.pole_rows()[name], 0.0)
+    return (lambda X: float(row @ X)), (lambda X: row)
+
+
+def _land(system, before, after, quantity, target, settings):
+    """The point with q(X) = target between two branch points (Newton from the linear interpolant, on the
+    linearised constraint while q is not met: module docstring)."""
+    q, gradient = quantity
+    f0, f1 = q(before), q(after)
+    X = before + (target - f0) / (f1 - f0) * (after - before)
+    for _ in range(LANDING_ROUNDS):
+        row = gradient(X)
+        result = newton(system.residual, system.jacobian, X, row, row @ X + target - q(X), settings.tol,
+                        settings.max_newton)
+        if not result.converged:
+            return None
+        X = result.x
+        if abs(q(X) - target) <= LANDING_RTOL * max(1.0, abs(target)):
+            return continuation.Point(X, np.zeros_like(X), result.iterations, result.residual)
+    return None
 
 
 def _landed(tracer, final, leg: LegTrace, points: list, folds: list, land_on: dict):
@@ -91,20 +116,21 @@ def _landed(tracer, final, leg: LegTrace, points: list, folds: list, land_on: di
     disc = final.eq.disc
     last_disc, last_path = leg.segments[-1]
     overshoot = last_disc.transfer(last_path.overshoot.X, disc)
-    row = np.append(disc.pole_rows()[pole], 0.0)
-    end = _land(final, points[-1][0], overshoot, row, target, tracer.settings)
+    quantity = _quantity(final, pole)
+    end = _land(final, points[-1][0], overshoot, quantity, target, tracer.settings)
     if end is None:
         return points, kept, Stop(StopCode.LANDING_FAILED, f"could not land on {pole} = {target:g} (Newton "
                                                            "failed); stopped before it")
-    last = row @ points[-1][0]
-    kept += [f for f in beyond if (row @ f[2] - last) * (target - row @ f[2]) >= 0]
+    q, last = quantity[0], quantity[0](points[-1][0])
+    kept += [f for f in beyond if (q(f[2]) - last) * (target - q(f[2])) >= 0]
     return points + [(end.X, end, disc.degree, disc.tail(end.X[:-1]))], kept, leg.stop
 
 
 def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | None = None, t0: float = 0.0,
              land_on: dict | None = None, labels=("forward", "backward")) -> Branch:
     """One Branch (module docstring): reversed ``backward`` (without its first point), then ``forward``.
-    ``land_on``: StopCode -> (pole row name, stretch) to land exactly on for legs stopped with that code."""
+    ``land_on``: StopCode -> (pole row name or Control, target) to land exactly on for legs stopped with that
+    code (a pole stretch, or the control parameter V or n)."""
     legs = [leg for leg in (backward, forward) if leg is not None]
     disc, moves = storage_basis(tracer, params, legs)
     final = tracer.system(disc.degree, params, disc.mapping)

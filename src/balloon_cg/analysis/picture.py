@@ -4,7 +4,8 @@
 branch points (``bifurcation``), follows each pear-shaped branch both ways (the branch and its mirror image,
 north and south poles swapped: ``switching``) until it rejoins the primary branch or stops, assesses those
 too, locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored
-with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under pressure control. Every
+with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under the scene's loading control
+(pressure, volume or gas: its held stability flag). Every
 branch carries its assessments in ``branch.stability`` and the points whose flags change at the check degree in
 ``branch.unsettled``.
 """
@@ -14,6 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import azimuthal_points, bifurcation
+from ..scene import Control
+from .control import control_value
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
@@ -51,8 +54,9 @@ class Progress:
 
 @dataclass
 class SnapThrough:
-    """Under pressure control: a stable stretch of ``from_branch`` ends after point ``from_index`` at ``pressure``;
-    the lowest-energy stable point at that pressure is on ``to_branch`` near ``to_index`` ("" and −1: none)."""
+    """Under the scene's loading control: a stable stretch of ``from_branch`` ends after point ``from_index`` at
+    ``pressure``; the stable point of largest volume at the same value of the control parameter is on
+    ``to_branch`` near ``to_index`` ("" and −1: none)."""
 
     from_branch: str
     from_index: int
@@ -132,7 +136,7 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
         degrees = [a.degree for a in branch.stability]
         branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
-    picture.snaps = snap_throughs(picture.branches)
+    picture.snaps = snap_throughs(picture.branches, scene.loading.control)
     return picture
 
 
@@ -172,30 +176,39 @@ def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | Non
     return min(candidates)[1] if candidates else None
 
 
-def snap_throughs(branches: list) -> list:
-    """Under pressure control: where a stable stretch of a branch ends (fold or loss of stability) with P
-    increasing, the jump to the lowest-energy stable point at the same P on any branch (or none found)."""
+HELD_FLAG = {Control.PRESSURE: "stable_pressure", Control.VOLUME: "stable_volume", Control.GAS: "stable_gas"}
+
+
+def snap_throughs(branches: list, control: Control = Control.PRESSURE) -> list:
+    """Under the loading ``control`` (its held flag, HELD_FLAG): where a stable stretch of a branch ends (fold or
+    loss of stability), the jump to the stable point of largest volume at the same value of the control
+    parameter q (P, V or n: ``control.control_value``) on any branch (or none found); ``pressure`` is P at the
+    last stable point."""
     snaps = []
     for branch in branches:
-        stable = np.array([a.stable_pressure for a in branch.stability])
+        stable = np.array([a.flags()[HELD_FLAG[control]] for a in branch.stability])
+        q = _control_values(branch, control)
         for i in range(len(stable) - 1):
             if stable[i] and not stable[i + 1]:
-                P = branch.pressure[i]
-                target = _stable_at(branches, P, exclude=(branch.name, i))
-                snaps.append(SnapThrough(branch.name, i, float(P), *(target or ())))
+                target = _stable_at(branches, q[i], control, exclude=(branch.name, i))
+                snaps.append(SnapThrough(branch.name, i, float(branch.pressure[i]), *(target or ())))
     return snaps
 
 
-def _stable_at(branches: list, P: float, exclude):
+def _control_values(branch: Branch, control: Control) -> np.ndarray:
+    return np.array([control_value(branch.disc, X, control) for X in branch.X])
+
+
+def _stable_at(branches: list, value: float, control: Control, exclude):
     best = None
     for branch in branches:
-        stable = np.array([a.stable_pressure for a in branch.stability])
-        p = branch.pressure
+        stable = np.array([a.flags()[HELD_FLAG[control]] for a in branch.stability])
+        p = _control_values(branch, control)
         eq = equilibrium_of(branch)
         for i in range(len(p) - 1):
             if (branch.name, i) == exclude or abs(i - exclude[1]) <= 1 and branch.name == exclude[0]:
                 continue
-            if stable[i] and stable[i + 1] and (p[i] - P) * (p[i + 1] - P) <= 0:
+            if stable[i] and stable[i + 1] and (p[i] - value) * (p[i + 1] - value) <= 0:
                 volume = eq.volume(branch.X[i, :-1])
                 if best is None or volume > best[0]:
                     best = (volume, branch.name, i)

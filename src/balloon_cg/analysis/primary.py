@@ -4,8 +4,9 @@
    first-order system is singular at the undeformed state, MODEL.md §4).
 2. Field on: natural continuation in M at that pressure from 0 to the scene's M.
 3. Pressure: pseudo-arclength in (u, P) downwards to ``min_stretch`` and upwards to ``stop_stretch`` (landing
-   exactly on it), ``stop_pressure``, a wire gap or ``max_points``; folds in P (LP) and in the north pole
-   stretch (TP) are located and recorded; the degree and basis map adapt (``tracer``).
+   exactly on it), ``stop_pressure``, ``loading.stop_volume``/``stop_amount``, a wire gap or ``max_points``;
+   folds in P (LP), in the north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and
+   recorded; the degree and basis map adapt (``tracer``).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
 removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
@@ -23,6 +24,7 @@ from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .assembly import assemble
+from .control import control_stop, control_value, landing
 from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
@@ -139,9 +141,11 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
 
 
 def range_limits(scene, upper: float):
-    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper] or P reaches
-    stop_pressure (the range the scene asks for)."""
-    cont = scene.continuation
+    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper], P reaches
+    stop_pressure, or the control parameter reaches loading.stop_volume or stop_amount (the range the scene asks
+    for)."""
+    cont, control = scene.continuation, scene.loading.control
+    by_control = control_stop(scene.loading)
 
     def limits(disc, point):
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
@@ -151,6 +155,9 @@ def range_limits(scene, upper: float):
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure:
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
+        if by_control is not None and control_value(disc, point.X, control) >= by_control[2]:
+            key, code, limit = by_control
+            return Stop(code, f"reached {key} {limit:g}")
         return None
 
     return limits
@@ -187,5 +194,5 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
     below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree,
                         limits=limits) if down else None)
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", upper),
-               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)}
+               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
     return assemble(tracer, params, "primary", up, below, t0, land_on=land_on, labels=("up", "down"))

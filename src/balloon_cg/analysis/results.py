@@ -3,8 +3,9 @@
 A ``Branch`` is arrays and metadata (its scene, discretisation, kernel class, parameters, stability, parent):
 it pickles cheaply and the solver objects are rebuilt from it where needed (``analysis.problem``).
 Special points carry AUTO's labels where they exist (LP fold in the parameter, BP branch point, EP end point,
-UZ user point) plus TP, the turning point of the north pole stretch; a branch point's classification,
-block and the status of its location are separate fields. Stops are a code from ``StopCode`` (or the
+UZ user point) plus TP, the turning point of the north pole stretch, and LV, LN, the folds in the volume and in
+the gas amount (the control parameters of volume and gas control, ``analysis.control``); a branch point's
+classification, block and the status of its location are separate fields. Stops are a code from ``StopCode`` (or the
 continuation engine's ``TraceStop``) plus a message for people; code decides, never the message.
 """
 import enum
@@ -21,6 +22,8 @@ from ..scene import Scene
 class Kind(enum.StrEnum):
     LP = "LP"  # fold in the continuation parameter (P on a branch, q on a two-parameter curve)
     TP = "TP"  # turning point of the north pole stretch
+    LV = "LV"  # fold in the enclosed volume V (volume control: its control parameter)
+    LN = "LN"  # fold in the gas amount n = P V (gas control: its control parameter)
     BP = "BP"  # branch point (a block of the second variation is singular)
     EP = "EP"  # end point of a branch (``stop`` says why)
     UZ = "UZ"  # user point
@@ -77,6 +80,8 @@ class StopCode(enum.StrEnum):
     STOP_STRETCH = "stop_stretch"  # the north pole stretch reached continuation.stop_stretch
     MIN_STRETCH = "min_stretch"  # the north pole stretch reached continuation.min_stretch
     STOP_PRESSURE = "stop_pressure"  # P reached continuation.stop_pressure
+    STOP_VOLUME = "stop_volume"  # V reached loading.stop_volume (volume control)
+    STOP_AMOUNT = "stop_amount"  # the gas amount n = P V reached loading.stop_amount (gas control)
     WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
     SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch
     REJOINED = "rejoined"  # a pear branch crossed back through the primary branch

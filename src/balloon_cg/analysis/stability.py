@@ -10,7 +10,10 @@ and 'odd' (a_odd, b_even: pear-shaped modes). b_0 is the rigid translation: a ze
 (always left out); with a field it is kept for a *free* balloon and left out for one *held* at its centre.
 
 Control modes: under pressure control the test is H > 0; under volume control H restricted to the
-perturbations that keep the volume, gᵀδ = 0 with g = ∂V/∂(a, b) = −∂²E/∂P∂(a, b).
+perturbations that keep the volume, gᵀδ = 0 with g = ∂Ṽ/∂(a, b) = −∂²(E/2π)/∂P∂(a, b) (Ṽ = V/2π); under gas
+control (isothermal ideal gas, P V = n fixed: energy E − n ln V in place of E − P V) the Hessian of
+E/2π − (n/2π) ln V, H + (n/2π)(2π)² g gᵀ/V² = H + (P/Ṽ) g gᵀ > 0. As H ≤ H_gas and H_gas = H on gᵀδ = 0,
+stable under pressure ⇒ stable under gas ⇒ stable under volume control.
 
 Resolution: along a branch each point is assessed at the degree N = max(stability.degree, the Legendre degree
 in x that holds the equilibrium) (``point_degrees``: raised near a wire, where the equilibrium lives on a mapped
@@ -32,9 +35,11 @@ from .resolution import Resolution
 from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
-FLAGS = ("stable_pressure", "stable_volume", "stable_pressure_free", "stable_volume_free")  # Assessment's order
-HELD, HELD_VOLUME, FREE, FREE_VOLUME = range(len(FLAGS))
-EVERY_FLAG = (HELD, HELD_VOLUME, FREE, FREE_VOLUME)
+FLAGS = ("stable_pressure", "stable_volume", "stable_pressure_free", "stable_volume_free", "stable_gas",
+         "stable_gas_free")  # Assessment's order
+HELD, HELD_VOLUME, FREE, FREE_VOLUME, HELD_GAS, FREE_GAS = range(len(FLAGS))
+EVERY_FLAG = tuple(range(len(FLAGS)))
+HELD_FLAGS, FREE_FLAGS = (HELD, HELD_VOLUME, HELD_GAS), (FREE, FREE_VOLUME, FREE_GAS)
 CHECK_FACTOR = 2.0  # N-convergence is checked at CHECK_FACTOR·N
 
 
@@ -43,15 +48,17 @@ class Assessment:
     """Lowest eigenvalues per block and the stability flags of one equilibrium."""
 
     blocks: dict  # name -> lowest eigenvalues (ascending); names: even, odd_held, odd_free, all_held, all_free,
-    #                even_volume, all_volume_held, all_volume_free
+    #                even_volume, all_volume_held, all_volume_free, even_gas, all_gas_held, all_gas_free
     stable_pressure: bool  # held at the centre (the translation excluded), pressure control
     stable_volume: bool  # held, volume control
     stable_pressure_free: bool  # free balloon (translation included; equal to held without a field)
     stable_volume_free: bool
+    stable_gas: bool  # held, gas control (fixed amount of isothermal ideal gas)
+    stable_gas_free: bool
     degree: int  # the perturbation degree N it was computed at
 
     def flags(self) -> dict:
-        """The four stability flags by name (FLAGS)."""
+        """The six stability flags by name (FLAGS)."""
         return {name: getattr(self, name) for name in FLAGS}
 
 
@@ -79,7 +86,7 @@ class SecondVariation:
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
 
     def matrices(self, u, params: Parameters):
-        """(H, g): the Hessian of E and the volume gradient on the perturbation basis."""
+        """(H, g): the Hessian of E/2π and the gradient of Ṽ = V/2π on the perturbation basis."""
         state = tuple((np.asarray(u, dtype=float) @ self.state_map).reshape(4, -1))
         geometry = (self.basis.cos_theta, self.basis.sin_theta)
         hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params))
@@ -109,31 +116,36 @@ class SecondVariation:
         constraints, as one matrix or the matrices of its uncoupled parts (``_restricted``,
         ``azimuthal.restricted_blocks``), and the flags it enters (positions in
         FLAGS). Azimuthal blocks m = 1..m_max enter every flag (their modes keep the volume to first order, so
-        both control modes see the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
+        every control mode sees the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
         translation is no zero mode to remove (no field)."""
         H, g = self.matrices(u, params)
+        H_gas = H + (params.P / self.eq.volume(u)) * np.outer(g, g)  # module docstring
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         i, t = self.index, self.translation
-        if symmetric:
+        if symmetric:  # the odd modes keep the volume to first order (g = 0 there): one odd block for all controls
             even = np.concatenate([i["a_even"], i["b_odd"]])
             odd_held = np.concatenate([i["a_odd"], i["b_even"][1:]])
-            plan = [("even", even, None, (HELD, FREE)), ("even_volume", even, g, (HELD_VOLUME, FREE_VOLUME)),
-                    ("odd_held", odd_held, None, EVERY_FLAG)]
+            plan = [("even", H, even, None, (HELD, FREE)), ("even_volume", H, even, g, (HELD_VOLUME, FREE_VOLUME)),
+                    ("even_gas", H_gas, even, None, (HELD_GAS, FREE_GAS)), ("odd_held", H, odd_held, None, EVERY_FLAG)]
             if field_on:
-                plan.append(("odd_free", np.append(odd_held, t), None, (FREE, FREE_VOLUME)))
+                plan.append(("odd_free", H, np.append(odd_held, t), None, FREE_FLAGS))
         else:
             everything = np.arange(H.shape[0])
             held_idx = everything[everything != t]
-            plan = [("all_held", held_idx, None, (HELD,) if field_on else (HELD, FREE)),
-                    ("all_volume_held", held_idx, g, (HELD_VOLUME,) if field_on else (HELD_VOLUME, FREE_VOLUME))]
+            plan = [("all_held", H, held_idx, None, (HELD,) if field_on else (HELD, FREE)),
+                    ("all_volume_held", H, held_idx, g, (HELD_VOLUME,) if field_on else (HELD_VOLUME, FREE_VOLUME)),
+                    ("all_gas_held", H_gas, held_idx, None, (HELD_GAS,) if field_on else (HELD_GAS, FREE_GAS))]
             if field_on:
-                plan += [("all_free", everything, None, (FREE,)), ("all_volume_free", everything, g, (FREE_VOLUME,))]
-        out = [(name, (self._restricted(H, idx, constraint),), flags) for name, idx, constraint, flags in plan]
+                plan += [("all_free", H, everything, None, (FREE,)),
+                         ("all_volume_free", H, everything, g, (FREE_VOLUME,)),
+                         ("all_gas_free", H_gas, everything, None, (FREE_GAS,))]
+        out = [(name, (self._restricted(matrix, idx, constraint),), flags)
+               for name, matrix, idx, constraint, flags in plan]
         for m in range(1, m_max + 1):
             readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,))
-            out.append((f"m{m}_held", readings[True], (HELD, HELD_VOLUME) if field_on else EVERY_FLAG))
+            out.append((f"m{m}_held", readings[True], HELD_FLAGS if field_on else EVERY_FLAG))
             if field_on:
-                out.append((f"m{m}_free", readings[False], (FREE, FREE_VOLUME)))
+                out.append((f"m{m}_free", readings[False], FREE_FLAGS))
         return out
 
     def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> Assessment:

@@ -4,7 +4,8 @@ From u* + δφ (φ the critical mode, ±), corrected on the hyperplane normal to
 general (non-symmetric) space, balloon held (``bifurcation.general_tracer``), until it rejoins the primary
 branch (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch
 point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch);
-it ends exactly on stop_stretch (north or south) when it stops there.
+it ends exactly on stop_stretch (north or south), or on the loading's stop_volume/stop_amount, when it stops
+there.
 """
 import time
 
@@ -15,6 +16,7 @@ from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .assembly import assemble
 from .bifurcation import general_tracer, mode_direction, plain_degree, to_general
+from .control import landing
 from .primary import stop_rule
 from .results import Branch, SpecialPoint, StopCode
 from ..numerics.threads import limited_blas
@@ -58,6 +60,6 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
 
     stretch = scene.continuation.stop_stretch
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
-               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)}
+               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
     return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0,
                     land_on=land_on)

@@ -1,7 +1,8 @@
 """The adaptive tracer: pseudo-arclength legs on discretisations of growing degree and, near wires, mapped bases.
 
-A leg follows a branch from a point along its tangent (``numerics.continuation.trace``). When a point's
-spectral error estimate exceeds the resolution policy's max_error (``resolution.Resolution``), the leg stops
+A leg follows a branch from a point along its tangent (``numerics.continuation.trace``), locating the folds
+in P (LP), in the north pole stretch (TP) and in the loading's control parameter (LV, LN: ``control``). When a
+point's spectral error estimate exceeds the resolution policy's max_error (``resolution.Resolution``), the leg stops
 with RESOLUTION and the last point is recomputed on a finer basis: with coils, first the wire map re-centred
 at the same degree (kept if the estimate leaves the policy's headroom, at most max_recentres times per degree);
 otherwise the degree grows and the better of the current and the re-centred map is kept. Past max_degree the
@@ -19,6 +20,7 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
+from .control import fold_monitors
 from .problem import ParameterSystem, continuation_settings
 from .resolution import Resolution
 from .results import Kind, StopCode
@@ -82,7 +84,8 @@ class Tracer:
         while True:
             disc = system.eq.disc
             north = np.append(disc.pole_rows()["lam2_north"], 0.0)
-            monitors = {Kind.LP: unit(start.X.size, -1), Kind.TP: north}
+            monitors = {Kind.LP: unit(start.X.size, -1), Kind.TP: north} | fold_monitors(system,
+                                                                                         self.scene.loading.control)
 
             def checked_stop(point, disc=disc):
                 if interrupt.requested():

@@ -212,10 +212,10 @@ def load(path) -> Result:
 
 
 def plot(source, what: str = "pressure-pole", ax=None, points=None, branch: str | None = None,
-         stability: str = "pressure"):
+         stability: str | None = None):
     """A matplotlib Figure of kind ``what`` (docs/plots.md) from Results or run files (one or a list); drawn
     into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given; ``stability`` the
-    reading that draws curves solid or dashed (post.plotting.Reading)."""
+    reading that draws curves solid or dashed (post.plotting.Reading; None: each run's loading control)."""
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]

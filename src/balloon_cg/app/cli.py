@@ -341,9 +341,10 @@ def _add_plot(commands):
                    help="point indices for shapes, stresses, field, curvature (negative: from the end)")
     p.add_argument("--branch", metavar="NAME",
                    help="branch to draw (default: every branch for pressure-* and energy, primary for the others)")
-    p.add_argument("--stability", default="pressure", metavar="READING",
-                   help="what solid (stable) and dashed (unstable) mean: pressure (default; held at the centre, "
-                        "pressure control), volume, free, free-volume, or axisymmetric (the paper's: m = 0 modes only)")
+    p.add_argument("--stability", default=None, metavar="READING",
+                   help="what solid (stable) and dashed (unstable) mean: pressure (held at the centre, pressure "
+                        "control), volume, gas, free, free-volume, free-gas, or axisymmetric (the paper's: m = 0 "
+                        "modes only); default: the run's loading.control, held")
     p.set_defaults(handler=plot)
 
 

@@ -151,6 +151,7 @@ def format_run(run: dict) -> str:
         f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
         f"command        {p['command']}",
         f"tolerance      {p['tolerance']:g}",
+        f"control        {p.get('control', 'pressure')} (loading.control)",
         f"kernels        digest {p['generated_digest'][:16]}…",
         f"result         {_verdict(p)}",
     ]

@@ -131,6 +131,11 @@ class Equilibrium:
         return out
 
     def volume(self, u) -> float:
-        """Enclosed volume / (2π) = −∂E/∂P (MODEL.md §2: the pressure term is −P V/(2π))."""
-        lam2, _, _, w = self.disc.node_state(u)
-        return float(-self.disc.weights @ (0.5 * lam2**2 * w * self.disc.sin_theta))
+        """Enclosed volume / (2π) (``enclosed_volume``)."""
+        return enclosed_volume(self.disc, u)
+
+
+def enclosed_volume(disc: Discretisation, u) -> float:
+    """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ λ2² η' sin²θ dθ (MODEL.md §2: the pressure term is −P V/(2π))."""
+    lam2, _, _, w = disc.node_state(u)
+    return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))

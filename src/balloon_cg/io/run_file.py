@@ -2,7 +2,8 @@
 
 Layout::
 
-    /                      attrs: format, scene_name, scene_toml, tolerance, + provenance (io.hdf5: package_version,
+    /                      attrs: format, scene_name, scene_toml, tolerance, control (loading.control),
+                                  + provenance (io.hdf5: package_version,
                                   generated_digest, created (UTC ISO 8601), command), complete (bool),
                                   incomplete_gaps, incomplete_branches, incomplete_messages (analysis.verdict),
                                   + extra_attrs
@@ -12,13 +13,13 @@ Layout::
                                   kernel_class, kernel_signature, M, chi, [parent_branch, parent_branch_point,
                                   rejoins_branch_point]
         point, unknown                                     dimension scales (0, 1, …)
-        pressure, volume, lam2_north, lam2_south, eta_north, eta_south,
+        pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
         newton_iterations, solved_degree                   (point,)
         unknowns                                           (point, unknown): Legendre unknowns u, then P
         theta                                              (theta,): linspace(0, π), a dimension scale
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
-        special_points/kind (LP, TP, BP, EP, UZ), classification, block, status (located, approximate), reason,
+        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, status (located, approximate), reason,
                        stop_code, note, index, m, pressure, uncertainty, E2, E3, E4, lam2_north, lam2_south,
                        eta_north, eta_south                                                  (special,)
         special_points/unknowns                            (special, unknown)
@@ -30,7 +31,8 @@ Every dataset carries ``units``, ``long_name`` and ``description`` (``io.schema`
 dimensions (HDF5 dimension scales), so ``xarray.open_dataset(path, engine="h5netcdf", group=...)`` names them.
 A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index + 1``; its own X is in
 special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous format
-"balloon-cg/2" (no volume, no dimension scales) still read.
+"balloon-cg/2" (no volume, no dimension scales) still read, and so do files without amount, control or the
+gas stability flags (written before gas control).
 """
 import errno
 import io
@@ -93,7 +95,7 @@ def _run_attrs(scene, branches, extra_attrs, found) -> dict:
 def root_attrs(scene, command: str | None = None) -> dict:
     """The root attributes of a run file: format, the scene and the provenance."""
     return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.text, "tolerance": scene.solver.tol,
-            **provenance(command)}
+            "control": scene.loading.control.value, **provenance(command)}
 
 
 def verdict_attrs(branches=None, found=None) -> dict:
@@ -166,9 +168,11 @@ def _write_branch(group, branch, theta):
     if branch.rejoins is not None:
         group.attrs["rejoins_branch_point"] = branch.rejoins
     volume = equilibrium_of(branch).volume
+    volumes = 2 * np.pi * np.array([volume(u) for u in branch.X[:, :-1]])
     columns = {
         "pressure": branch.pressure,
-        "volume": 2 * np.pi * np.array([volume(u) for u in branch.X[:, :-1]]),
+        "volume": volumes,
+        "amount": branch.pressure * volumes,
         **branch.pole_values(),
         **equator_values(branch.disc, branch.X),
         "converged": finite(branch),
@@ -197,6 +201,8 @@ STABILITY_FLAGS = {
     "stable_volume": "held at the centre, volume control (volume-preserving perturbations)",
     "stable_pressure_free": "free balloon (axial translation included), pressure control",
     "stable_volume_free": "free balloon, volume control",
+    "stable_gas": "held at the centre, gas control (fixed amount of isothermal ideal gas, P V = n)",
+    "stable_gas_free": "free balloon, gas control",
 }
 
 
@@ -215,7 +221,7 @@ def _write_stability(group, branch, point):
 
 
 def _write_snaps(group, snaps):
-    """Snap-throughs under pressure control: from (branch, index) at pressure P to (branch, index) or none."""
+    """Snap-throughs under the loading control: from (branch, index) at pressure P to (branch, index) or none."""
     write_strings(group, "from_branch", [s.from_branch for s in snaps])
     write_strings(group, "to_branch", [s.to_branch for s in snaps])
     group.create_dataset("from_index", data=np.array([s.from_index for s in snaps], dtype=np.int64))

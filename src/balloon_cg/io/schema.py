@@ -17,7 +17,7 @@ VARIABLES = {
     "unknown": (NONDIMENSIONAL, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last"),
     "special": (NONDIMENSIONAL, "special point index", "index of the special point on its branch"),
     "mode_unknown": (NONDIMENSIONAL, "mode unknown index", "index into the odd perturbation block of the mode"),
-    "snap": (NONDIMENSIONAL, "snap-through index", "one row per snap-through under pressure control"),
+    "snap": (NONDIMENSIONAL, "snap-through index", "one row per snap-through under the loading control"),
     "from_branch": ("", "from branch", "the branch whose stable stretch ends"),
     "from_index": (NONDIMENSIONAL, "from point", "the last stable point of from_branch"),
     "to_branch": ("", "to branch", "the branch of the lowest-energy stable state at that P (empty: none)"),
@@ -25,6 +25,8 @@ VARIABLES = {
     "eigenvalue": (NONDIMENSIONAL, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
     "pressure": (NONDIMENSIONAL, "pressure P", "P = P̄ R0 / (T0 μ/2)"),
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
+    "amount": (NONDIMENSIONAL, "gas amount n", "n = P V, the isothermal ideal gas P V = n in these units: "
+                                               "n = N R T / (T0 μ R0² / 2) for N moles at temperature T"),
     "lam2_north": (NONDIMENSIONAL, "λ2 at the north pole", "hoop stretch λ2(θ = 0)"),
     "lam2_south": (NONDIMENSIONAL, "λ2 at the south pole", "hoop stretch λ2(θ = π)"),
     "eta_north": (NONDIMENSIONAL, "η at the north pole", "axial position η(0) / R0"),
@@ -42,8 +44,8 @@ VARIABLES = {
     "lam2": (NONDIMENSIONAL, "hoop stretch λ2(θ)", "λ2 = ρ / sin θ"),
     "rho": (NONDIMENSIONAL, "radius ρ(θ)", "distance from the axis / R0"),
     "eta": (NONDIMENSIONAL, "axial position η(θ)", "z / R0"),
-    "kind": ("", "special point kind", "AUTO label: LP fold in P, TP fold in the pole stretch, BP branch point, "
-                                       "EP end point, UZ user point"),
+    "kind": ("", "special point kind", "AUTO label: LP fold in P, TP fold in the pole stretch, LV fold in V, "
+                                       "LN fold in n, BP branch point, EP end point, UZ user point"),
     "classification": ("", "classification", "pitchfork, transcritical, ... (docs/hdf5.md); empty if none"),
     "block": ("", "stability block", "the second-variation block whose eigenvalue crosses zero"),
     "status": ("", "location status", "located (converged extended system) or approximate"),
@@ -62,6 +64,8 @@ VARIABLES = {
     "stable_volume": (NONDIMENSIONAL, "stable, volume control", "held at the centre, volume-preserving"),
     "stable_pressure_free": (NONDIMENSIONAL, "stable, free, pressure control", "axial translation included"),
     "stable_volume_free": (NONDIMENSIONAL, "stable, free, volume control", "axial translation included"),
+    "stable_gas": (NONDIMENSIONAL, "stable, gas control", "held at the centre, fixed amount of isothermal gas"),
+    "stable_gas_free": (NONDIMENSIONAL, "stable, free, gas control", "axial translation included"),
 }
 LOWEST = (NONDIMENSIONAL, "lowest eigenvalue", "smallest eigenvalue of the second-variation block")
 

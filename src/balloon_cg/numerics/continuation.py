@@ -9,7 +9,8 @@ point, where the corrector may pick the crossing branch).
 is steep in the parameter (a stiff material's pressure grows like λ^(α−1)) the arclength may grow until the
 state moves step_max, instead of crawling at a fixed arclength that the parameter alone uses up.
 *Fold monitors* are vectors c whose sign change in c·τ marks a fold of the quantity c·X (the parameter itself
-for a limit point); folds are then located by Brent's method in the arclength (``locate_root``, to 1e-13 in s).
+for a limit point), or callables X ↦ ∇q(X) for a fold of a nonlinear quantity q (dq/ds = ∇q·τ); folds are then
+located by Brent's method in the arclength (``locate_root``, to 1e-13 in s).
 """
 import enum
 from dataclasses import dataclass, field
@@ -132,19 +133,25 @@ def locate_root(value_at, length: float, xtol: float = 1e-13, known: dict | None
         return Root(payload, RootStatus.NEAREST, float(value))
 
 
-def _locate_fold(system, start: Point, sigma: float, c: np.ndarray, settings: Settings, end: Point):
-    """The point where c·τ vanishes between start and start + σ along the arclength (Brent), or None; ``end`` is
-    the point the step from start reached (``value_at(σ)``: the same corrector and tangent, not recomputed)."""
+def rate(monitor, X: np.ndarray, t: np.ndarray) -> float:
+    """dq/ds = ∇q(X)·τ of a fold monitor: a vector c (q = c·X) or a callable X ↦ ∇q(X)."""
+    return float((monitor(X) if callable(monitor) else monitor) @ t)
+
+
+def _locate_fold(system, start: Point, sigma: float, c, settings: Settings, end: Point):
+    """The point where the monitor's rate (``rate``) vanishes between start and start + σ along the arclength
+    (Brent), or None; ``end`` is the point the step from start reached (``value_at(σ)``: the same corrector and
+    tangent, not recomputed)."""
 
     def value_at(s):
         result = correct(system, start.X + s * start.tangent, start.tangent, settings)
         if not result.converged:
             raise ArithmeticError(result.message)
         t = tangent(system, result.x, start.tangent)
-        return float(c @ t), Point(result.x, t, result.iterations, result.residual)
+        return rate(c, result.x, t), Point(result.x, t, result.iterations, result.residual)
 
     reached = Point(end.X.copy(), end.tangent.copy(), end.iterations, end.residual)  # a fold's own arrays
-    return locate_root(value_at, sigma, known={sigma: (float(c @ end.tangent), reached)})
+    return locate_root(value_at, sigma, known={sigma: (rate(c, end.X, end.tangent), reached)})
 
 
 def trace(system, start: Point, settings: Settings, stop, monitors: dict, progress=None) -> Path:
@@ -153,11 +160,13 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
     The point that triggers the stop is not appended (it is kept as ``path.overshoot``, for the caller to
     land exactly on the limit).
 
-    ``monitors``: label -> vector c for fold detection. ``progress``: optional callable(point).
+    ``monitors``: label -> vector c or callable X ↦ ∇q(X) for fold detection (``rate``). ``progress``: optional
+    callable(point).
     """
     path = Path(points=[start])
     sigma = settings.step
     current = start
+    rates = {label: rate(c, start.X, start.tangent) for label, c in monitors.items()}  # at ``current``
     while len(path.points) < settings.max_points:
         predictor = current.X + sigma * current.tangent
         result = correct(system, predictor, current.tangent, settings)
@@ -175,8 +184,9 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
                 return path
             continue
         point = Point(result.x, new_tangent, result.iterations, result.residual)
+        new_rates = {label: rate(c, point.X, point.tangent) for label, c in monitors.items()}
         for label, c in monitors.items():
-            if (c @ current.tangent) * (c @ point.tangent) < 0:
+            if rates[label] * new_rates[label] < 0:
                 fold = _locate_fold(system, current, sigma, c, settings, point)
                 if fold is None:  # no evaluation converged: the fold is known to lie in the step, no better
                     path.folds.append(Fold(label, current, len(path.points) - 1, RootStatus.NEAREST))
@@ -190,7 +200,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         path.points.append(point)
         if progress is not None:
             progress(point)
-        current = point
+        current, rates = point, new_rates
         if result.iterations <= 3:
             state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
             sigma = min(sigma * 1.5, settings.step_max / state_share)

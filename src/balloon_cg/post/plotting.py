@@ -8,8 +8,8 @@ Curves of branches (pressure-pole, pressure-equator) and the energy landscape dr
 per file (default: primary), or chosen ``Configuration`` s of several branches. One colour per drawn branch,
 labelled by M (branch attrs), plus the branch name when a file holds several; a mirror-image branch
 (``<name>_mirror``) takes its partner's colour, drawn thinner and lighter. Branch curves are solid where stable
-and dashed where unstable under the chosen stability ``Reading`` (default: pressure control, balloon held at
-its centre), named in the legend title; without stability data all solid, and the legend title says so. Titles
+and dashed where unstable under the chosen stability ``Reading`` (default: the run's loading control, balloon
+held at its centre), named in the legend title; without stability data all solid, and the legend title says so. Titles
 name the material and the coils. Special points are marked and labelled with their kind (LP, TP, EP, branch
 points, …). The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest
 (``robust_limits``). Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), lengths in R0, stresses in
@@ -51,7 +51,8 @@ class Reading(enum.StrEnum):
 
     The stored flags: ``pressure`` stable_pressure (balloon held at its centre, pressure control), ``volume``
     stable_volume (held, volume control: the gas enclosed), ``free`` stable_pressure_free (axial translation
-    included, pressure control), ``free-volume`` stable_volume_free. ``axisymmetric`` is the paper's reading:
+    included, pressure control), ``free-volume`` stable_volume_free, ``gas`` stable_gas (held, gas control: a
+    fixed amount of isothermal gas), ``free-gas`` stable_gas_free. ``axisymmetric`` is the paper's reading:
     held, pressure control, the axisymmetric blocks only (lowest_even and lowest_odd_held, or lowest_all_held
     off the equator-symmetric layout), i.e. the m ≥ 1 blocks ignored.
     """
@@ -60,6 +61,8 @@ class Reading(enum.StrEnum):
     VOLUME = "volume"
     FREE = "free"
     FREE_VOLUME = "free-volume"
+    GAS = "gas"
+    FREE_GAS = "free-gas"
     AXISYMMETRIC = "axisymmetric"
 
     @property
@@ -75,16 +78,24 @@ class Reading(enum.StrEnum):
             raise PlotError(f"--stability {text!r}: not a stability reading (choose one of "
                             f"{', '.join(r.value for r in cls)})") from None
 
+    @classmethod
+    def of_run(cls, run: dict) -> "Reading":
+        """The held reading of a run's loading control (root attribute ``control``; pressure when absent)."""
+        return cls(run["attrs"].get("control", cls.PRESSURE.value))
+
 
 READING_MEANINGS = {
     Reading.PRESSURE: "pressure control, held at centre",
     Reading.VOLUME: "volume control, held at centre",
     Reading.FREE: "pressure control, free balloon",
     Reading.FREE_VOLUME: "volume control, free balloon",
+    Reading.GAS: "gas control, held at centre",
+    Reading.FREE_GAS: "gas control, free balloon",
     Reading.AXISYMMETRIC: "axisymmetric modes only (paper)",
 }
 FLAGS = {Reading.PRESSURE: "stable_pressure", Reading.VOLUME: "stable_volume",
-         Reading.FREE: "stable_pressure_free", Reading.FREE_VOLUME: "stable_volume_free"}
+         Reading.FREE: "stable_pressure_free", Reading.FREE_VOLUME: "stable_volume_free", Reading.GAS: "stable_gas",
+         Reading.FREE_GAS: "stable_gas_free"}
 AXISYMMETRIC_BLOCKS = (("lowest_even", "lowest_odd_held"), ("lowest_all_held",))
 
 
@@ -165,11 +176,11 @@ def as_run(source) -> dict:
     return source if isinstance(source, dict) else read_run(source)
 
 
-def load_branches(source, branch: str | None = None, reading: Reading = Reading.PRESSURE) -> list[StoredBranch]:
+def load_branches(source, branch: str | None = None, reading: Reading | None = None) -> list[StoredBranch]:
     """The branches of a run or run file (all, primary first, or the one named), with their stability under
-    ``reading``."""
-    reading = Reading.parse(reading)
+    ``reading`` (None: the run's control, ``Reading.of_run``)."""
     run = as_run(source)
+    reading = Reading.of_run(run) if reading is None else Reading.parse(reading)
     names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
     if branch is not None and branch not in run["branches"]:
         raise PlotError(f"{run['path'] or run['scene_name']}: no branch {branch!r} "
@@ -220,7 +231,7 @@ def applicable_kinds(branches) -> list[str]:
 
 
 def plot(sources, what: str, points=None, branch: str | None = None, axes=None,
-         stability: Reading = Reading.PRESSURE) -> Figure:
+         stability: Reading | None = None) -> Figure:
     """The figure of kind ``what`` (one of KINDS) for ``sources``: runs (read_run() output) or run files, one
     or a list (``phase``: curve or sweep files).
 
@@ -228,7 +239,8 @@ def plot(sources, what: str, points=None, branch: str | None = None, axes=None,
     the per-point kinds). ``points``: indices (negative count from the end) of the configurations drawn by the
     per-point kinds (default: DEFAULT_POINTS spread along the branch), or ``Configuration`` s (each names its
     branch; ``branch`` is then ignored). ``axes``: draw into these matplotlib Axes (one, or as many as the kind
-    has panels) instead of a new figure. ``stability``: the Reading that draws curves solid or dashed.
+    has panels) instead of a new figure. ``stability``: the Reading that draws curves solid or dashed (None: each
+    run's loading control).
     """
     if what not in KINDS:
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")

@@ -13,10 +13,11 @@ from pathlib import Path
 
 from .validation import SceneError, number, show, show_key, table
 from .energies import StrainEnergy
+from .loading import Control, Loading, loading_from_table
 from .materials import Material, material_from_table
 
 __all__ = [
-    "Coil", "Field", "Continuation", "Solver", "Stability", "Output", "Scene", "SceneError",
+    "Coil", "Field", "Continuation", "Solver", "Stability", "Output", "Loading", "Control", "Scene", "SceneError",
     "parse_scene", "load_scene",
 ]
 
@@ -112,7 +113,7 @@ class Output:
     theta_points: int = 181
 
 
-_TABLES = ("material", "field", "continuation", "solver", "stability", "output")
+_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 
@@ -129,6 +130,7 @@ class Scene:
     stability: Stability
     output: Output
     text: str = dataclass_field(repr=False)
+    loading: Loading = Loading()
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
@@ -136,13 +138,16 @@ class Scene:
         return load_scene(path)
 
     def to_dict(self) -> dict:
-        """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded)."""
+        """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded); the
+        [loading] table only when it is not the default (pressure control), so older scenes keep their text."""
         m, f = self.material, self.field
         return {
             "material": m.to_table() if isinstance(m, StrainEnergy) else
             {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
-            **{t: asdict(getattr(self, t)) for t in _TABLES[2:]},
+            **{t: asdict(getattr(self, t)) for t in _TABLES[2:-1]},
+            **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
+                                                                  "control": self.loading.control.value}}),
         }
 
     def to_toml(self) -> str:
@@ -166,7 +171,7 @@ class Scene:
         or bare names of one table as on the command line (``{"M": 0.003}``: ``canonical_key``).
 
         ``material.preset`` replaces the whole material; a value None restores the default. The copy is named
-        ``name``, or after what changed physically: each field or material key's token in the name
+        ``name``, or after what changed physically: each field, material or loading key's token in the name
         (``_M0.002``, ``_radius4``) takes the new value, or is appended (numerical keys keep the name).
         """
         data = self.to_dict()
@@ -186,12 +191,13 @@ class Scene:
 
 
 def renamed(name: str, overrides: dict[str, object]) -> str:
-    """``name`` with a ``_<key><value>`` token per scalar field or material override (key: the last part of
-    the dotted key, with its list index past 0: ``radius3.5``, ``radius1=3.5``; a string: itself, reduced to
+    """``name`` with a ``_<key><value>`` token per scalar field, material or loading override (key: the last part
+    of the dotted key, with its list index past 0: ``radius3.5``, ``radius1=3.5``; a string: itself, reduced to
     filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
     (``field.coils``, ``material.mu``) leave the name alone."""
     for key, value in overrides.items():
-        if key.split(".")[0] not in ("field", "material") or value is None or isinstance(value, (list, tuple, dict)):
+        physical = key.split(".")[0] in ("field", "material", "loading")
+        if not physical or value is None or isinstance(value, (list, tuple, dict)):
             continue
         if isinstance(value, str):  # a preset or a material name
             name = f"{name}_{re.sub(r'[^A-Za-z0-9.+-]+', '-', value).strip('-').lower()}"
@@ -279,6 +285,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         stability=_stability(data.get("stability", {})),
         output=_output(data.get("output", {})),
         text=text,
+        loading=loading_from_table(data.get("loading", {})),
     )
 
 

@@ -1,0 +1,56 @@
+"""The control parameter of a loading (scene/loading.py) at a branch point X = (u, P), and its folds.
+
+q = P (pressure control), q = V = 2π Ṽ(u) (volume control; Ṽ = ``enclosed_volume``, per 2π), q = n = P V (gas
+control, isothermal ideal gas P V = n). Branches are traced in P (the equilibria are the same for every
+control); a fold of q is where dq/ds = ∇q·τ = 0 along the arclength, located by the continuation engine from
+∇q (``fold_monitors``): ∇_u V = −2π ∂R/∂P (R = ∂(E/2π)/∂u holds −P Ṽ), ∂V/∂P = 0; ∇n = (P ∇_u V, V).
+"""
+import numpy as np
+
+from ..galerkin.equilibrium import enclosed_volume
+from ..scene import Control
+from .results import Kind, StopCode
+
+FOLD_KIND = {Control.PRESSURE: Kind.LP, Control.VOLUME: Kind.LV, Control.GAS: Kind.LN}
+STOP_KEY = {Control.VOLUME: ("stop_volume", StopCode.STOP_VOLUME), Control.GAS: ("stop_amount", StopCode.STOP_AMOUNT)}
+
+
+def control_stop(loading) -> tuple | None:
+    """(loading key, StopCode, limit) of a scene's stop in its control parameter (loading.stop_volume or
+    stop_amount), or None when it has none."""
+    if loading.control not in STOP_KEY:
+        return None
+    key, code = STOP_KEY[loading.control]
+    limit = getattr(loading, key)
+    return None if limit is None else (key, code, limit)
+
+
+def landing(loading) -> dict:
+    """The ``assembly.assemble`` land_on entry of a scene's control stop: {StopCode: (Control, limit)} or {}."""
+    stop = control_stop(loading)
+    return {} if stop is None else {stop[1]: (loading.control, stop[2])}
+
+
+def control_value(disc, X, control: Control) -> float:
+    """q(X) on the discretisation ``disc`` (module docstring)."""
+    if control == Control.PRESSURE:
+        return float(X[-1])
+    volume = 2 * np.pi * enclosed_volume(disc, X[:-1])
+    return volume if control == Control.VOLUME else float(X[-1]) * volume
+
+
+def control_gradient(system, X, control: Control) -> np.ndarray:
+    """∇q(X) = ∂q/∂(u, P) of volume or gas control for the continuation system ``system`` (an
+    ``analysis.problem.ParameterSystem`` in P; under pressure control q = P is linear: its monitor is e_P)."""
+    eq = system.eq
+    dV = -2 * np.pi * eq.parameter_derivative(X[:-1], system.params.with_value("P", X[-1]), "P")
+    if control == Control.VOLUME:
+        return np.append(dV, 0.0)
+    return np.append(X[-1] * dV, 2 * np.pi * eq.volume(X[:-1]))
+
+
+def fold_monitors(system, control: Control) -> dict:
+    """The continuation monitor of the folds of q besides those of P (none under pressure control)."""
+    if control == Control.PRESSURE:
+        return {}
+    return {FOLD_KIND[control]: lambda X: control_gradient(system, X, control)}
