@@ -1,11 +1,13 @@
-"""The primary (axisymmetric) branch: start at the inflated M = 0 sphere, switch the field on, trace in P.
+"""The primary (axisymmetric) branch: start at the inflated M = 0 sphere, switch the field on, trace in P (or Φ̄).
 
 1. Start: the exact sphere (``model.sphere``) at the scene's start stretch, where the membrane is taut (the
-   first-order system is singular at the undeformed state, MODEL.md §4).
-2. Field on: natural continuation in M at that pressure from 0 to the scene's M.
-3. Pressure: pseudo-arclength in (u, P) downwards to ``min_stretch`` and upwards to ``stop_stretch`` (landing
-   exactly on it), ``stop_pressure``, a wire gap or ``max_points``; folds in P (LP) and in the north pole
-   stretch (TP) are located and recorded; the degree and basis map adapt (``tracer``).
+   first-order system is singular at the undeformed state, MODEL.md §4): its pressure at the scene's voltage,
+   or, for continuation.parameter = "voltage", its voltage at the scene's fixed pressure.
+2. Field on: natural continuation in M at that pressure (and voltage) from 0 to the scene's M.
+3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards
+   to ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``), a wire gap or
+   ``max_points``; folds in the parameter (LP) and in the north pole stretch (TP) are located and recorded; the
+   degree and basis map adapt (``tracer``).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
 removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
@@ -17,7 +19,7 @@ import numpy as np
 
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.profiles import meridional_stretch
-from ..model.sphere import sphere_pressure
+from ..model.sphere import sphere_pressure, sphere_voltage
 from ..model.stresses import smallest_stress
 from ..numerics import continuation
 from ..numerics.continuation import Stop
@@ -27,6 +29,7 @@ from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
 from .wires import wire_gap
+from ..scene import ContinuationParameter
 from ..numerics.threads import limited_blas
 
 
@@ -42,7 +45,7 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
     a[0], b[1] = lam, lam
     u = disc.join(a, b)
-    params = Parameters(sphere_pressure(scene.material, lam), 0.0, scene.field.chi)
+    params = start_parameters(scene, tracer.parameter)
     target, M, dM = scene.field.M, 0.0, scene.field.M
     system = ParameterSystem(eq, params, "M")
     while M < target:
@@ -63,9 +66,24 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
                     "turn back in M there); try another continuation.start_stretch or a smaller field.M"
                 )
     params = params.with_value("M", target)
-    X, degree = _resolved_start(tracer, np.append(u, params.P), degree, params)
+    X, degree = _resolved_start(tracer, np.append(u, getattr(params, tracer.parameter)), degree, params)
     residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
     return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
+
+
+def start_parameters(scene, parameter: str) -> Parameters:
+    """The start sphere's parameters at M = 0: its pressure at electric.voltage (parameter "P"), or its voltage
+    at continuation.pressure (parameter "voltage"; ContinuationError where no voltage holds it)."""
+    lam, chi = scene.continuation.start_stretch, scene.field.chi
+    if parameter == "P":
+        voltage = 0.0 if scene.electric is None else scene.electric.voltage
+        return Parameters(sphere_pressure(scene.material, lam, voltage), 0.0, chi, voltage)
+    P = scene.continuation.pressure
+    try:
+        return Parameters(P, 0.0, chi, sphere_voltage(scene.material, lam, P))
+    except ValueError as e:
+        raise ContinuationError(f"cannot start the voltage continuation at continuation.start_stretch = {lam:g}: "
+                                f"{e}; lower continuation.pressure or choose another start_stretch") from None
 
 
 def _taut(disc, u, material, n_theta: int = 361) -> bool:
@@ -140,8 +158,9 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
 
 def range_limits(scene, upper: float):
     """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper] or P reaches
-    stop_pressure (the range the scene asks for)."""
+    stop_pressure (Φ̄ reaches stop_voltage in a voltage continuation): the range the scene asks for."""
     cont = scene.continuation
+    in_voltage = cont.parameter == ContinuationParameter.VOLTAGE
 
     def limits(disc, point):
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
@@ -149,8 +168,10 @@ def range_limits(scene, upper: float):
             return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
         if stretch <= cont.min_stretch:
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
-        if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure:
+        if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and not in_voltage:
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
+        if in_voltage and cont.stop_voltage is not None and point.X[-1] >= cont.stop_voltage:
+            return Stop(StopCode.STOP_VOLTAGE, f"reached stop_voltage {cont.stop_voltage:g}")
         return None
 
     return limits

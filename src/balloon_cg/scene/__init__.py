@@ -3,9 +3,9 @@
 ``load_scene(path)`` / ``parse_scene(text, name)`` give a ``Scene``; invalid input raises ``SceneError`` with one
 line naming the key, the value and what is allowed.
 """
-from .tables import (Coil, Continuation, Field, Output, Scene, Solver, Stability, load_scene, parse_scene,
-                     shipped_scenes)
+from .tables import (Coil, Continuation, ContinuationParameter, Electric, Field, Output, Scene, Solver, Stability,
+                     load_scene, parse_scene, shipped_scenes)
 from .validation import SceneError
 
-__all__ = ["Coil", "Continuation", "Field", "Output", "Scene", "SceneError", "Solver", "Stability", "load_scene",
+__all__ = ["Coil", "Continuation", "ContinuationParameter", "Electric", "Field", "Output", "Scene", "SceneError", "Solver", "Stability", "load_scene",
            "parse_scene"]
