@@ -46,13 +46,17 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     a[0], b[1] = lam, lam
     u = disc.join(a, b)
     params = start_parameters(scene, tracer.parameter)
+    if compressed(disc, u, scene.material, params.voltage):
+        raise ContinuationError(f"the sphere at continuation.start_stretch = {lam:g} is compressed at the voltage "
+                                f"{params.voltage:.6g} (its dielectric stress exceeds the elastic tension); "
+                                "start at another continuation.start_stretch")
     target, M, dM = scene.field.M, 0.0, scene.field.M
     system = ParameterSystem(eq, params, "M")
     while M < target:
         trial = min(M + dM, target)
         result = newton(system.residual, system.jacobian, np.append(u, trial), unit(u.size + 1, -1), trial,
                         scene.solver.tol, scene.solver.max_newton)
-        if result.converged and _taut(disc, result.x[:-1], scene.material):
+        if result.converged and _taut(disc, result.x[:-1], scene.material, params.voltage):
             u, M = result.x[:-1], trial
             dM *= 2
         elif result.converged:
@@ -86,11 +90,30 @@ def start_parameters(scene, parameter: str) -> Parameters:
                                 f"{e}; lower continuation.pressure or choose another start_stretch") from None
 
 
-def _taut(disc, u, material, n_theta: int = 361) -> bool:
-    """Both elastic principal stresses positive everywhere (MODEL.md §6: tension-field theory)."""
+SLACK_TOLERANCE = 1e-8  # compression beyond rounding, relative to the elastic stress; zero stress (P = 0) is traced
+
+
+def _smallest_stress(disc, u, material, voltage: float = 0.0, n_theta: int = 361) -> tuple[float, float]:
+    """(smallest principal stress, elastic plus dielectric; smallest elastic one) of the state u on a θ grid."""
     theta = np.linspace(0.0, np.pi, n_theta)
     lam2, dlam2, _, deta = disc.evaluate(u, theta)
-    return smallest_stress(material, meridional_stretch(theta, lam2, dlam2, deta), lam2) > 0.0
+    lam1 = meridional_stretch(theta, lam2, dlam2, deta)
+    return smallest_stress(material, lam1, lam2, voltage), smallest_stress(material, lam1, lam2)
+
+
+def _taut(disc, u, material, voltage: float = 0.0) -> bool:
+    """Both elastic principal stresses positive everywhere (MODEL.md §6: tension-field theory) and, with the
+    dielectric term, not ``compressed``."""
+    total, elastic = _smallest_stress(disc, u, material, voltage)
+    return elastic > 0.0 and total >= -SLACK_TOLERANCE * elastic
+
+
+def compressed(disc, u, material, voltage: float) -> bool:
+    """A principal stress (elastic + dielectric) below −SLACK_TOLERANCE × the smallest elastic one: the membrane
+    would carry compression, which it cannot (the voltage's Maxwell stress exceeds the elastic tension)."""
+    total, elastic = _smallest_stress(disc, u, material, voltage)
+    return total < -SLACK_TOLERANCE * abs(elastic)
+
 
 
 def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: float, scene, rtol: float = 1e-8) -> str:
@@ -103,7 +126,7 @@ def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: floa
                         solver.tol, solver.max_newton)
         if not result.converged:
             break
-        if _taut(disc, result.x[:-1], scene.material):
+        if _taut(disc, result.x[:-1], scene.material, system.params.voltage):
             u, taut_M = result.x[:-1], middle
         else:
             wrinkled_M = middle
@@ -178,7 +201,8 @@ def range_limits(scene, upper: float):
 
 
 def stop_rule(scene, upper: float):
-    """stop(disc, point) -> Stop or None: ``range_limits``, or the membrane comes within wire_gap of a coil."""
+    """stop(disc, point) -> Stop or None: ``range_limits``, the membrane is compressed (a dielectric scene) or
+    comes within wire_gap of a coil."""
     cont = scene.continuation
     limits = range_limits(scene, upper)
 
@@ -186,6 +210,11 @@ def stop_rule(scene, upper: float):
         beyond = limits(disc, point)
         if beyond is not None:
             return beyond
+        if scene.electric is not None:
+            voltage = point.X[-1] if cont.parameter == ContinuationParameter.VOLTAGE else scene.electric.voltage
+            if compressed(disc, point.X[:-1], scene.material, voltage):
+                return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
+                                                 "tension: tension-field theory is not modelled)")
         gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils)
         if gap < cont.wire_gap:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {cont.wire_gap:g} of coil {coil} (gap {gap:.3g})")
