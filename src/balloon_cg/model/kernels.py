@@ -78,9 +78,7 @@ class KernelSet:
         # a field class evaluated at M = 0 is the "field on, M = 0" general setting of the benchmarks
         self.field_class = generated.CLASSES[self.exponent_class][1]
         if electric:
-            alphas = dict(self.module.INPUTS)["alphas"]
-            self.module = kernel_cache.load(kernel_cache.Exponents(None if alphas == "runtime" else alphas),
-                                            self.field_class, electric=True)
+            self.module = kernel_cache.load(exponents_of(self.module), self.field_class, electric=True)
         self.name = dict(self.module.INPUTS)["class"]
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
 
@@ -174,6 +172,20 @@ class KernelSet:
     def state(self, state) -> dict:
         """Named values of the state (λ2, v, η, w) in the generated order STATE."""
         return dict(zip(self.module.STATE, state))
+
+
+def exponents_of(module) -> kernel_cache.Exponents:
+    """The exponents a committed Ogden class module was generated from (its INPUTS), as the cache describes them."""
+    alphas = dict(module.INPUTS)["alphas"]
+    return kernel_cache.Exponents(None if alphas == "runtime" else alphas)
+
+
+def dielectric_source(material, has_field: bool):
+    """What a material's dielectric class is generated from (model/kernel_cache.py): a strain energy's formula,
+    or the exponents of the committed Ogden class the material's exponents select."""
+    if isinstance(material, StrainEnergy):
+        return material.formula
+    return exponents_of(importlib.import_module(f"{generated.__name__}.{class_name(material.alpha, has_field)}"))
 
 
 def energy_module(material: StrainEnergy, has_field: bool, electric: bool = False):
