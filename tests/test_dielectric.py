@@ -262,3 +262,19 @@ def test_galerkin_matches_shooting_with_voltage_and_two_coils():
     assert shot.converged
     assert abs(shot.P / P - 1) < 1e-10 and abs(shot.eta_north / eta - 1) < 1e-10
     assert abs(P / neo_hookean_pressure(1.5, 0.25) - 1) > 0.01
+
+
+def test_voltage_fold_at_a_positive_pressure_and_the_zero_voltage_end():
+    """At P = 0.5 the sphere is held by Φ̄² = (4(λ⁻¹ − λ⁻⁷) − P)/(4λ) = λ⁻² − λ⁻⁸ − P/(4λ): its maximum,
+    −2λ⁻³ + 8λ⁻⁹ + P/(4λ²) = 0 (solved by brentq), is the located fold; the lower leg ends where Φ̄ reaches 0 (the
+    voltage-free sphere)."""
+    scene = parse_scene(NEO + '[electric]\n[continuation]\nparameter = "voltage"\npressure = 0.5\n'
+                        "start_stretch = 1.2\nstop_stretch = 2.0\n", name="voltage_P0.5")
+    branch = trace_primary(scene)
+    square = lambda lam: (neo_hookean_pressure(lam, 0.0) - 0.5) / (4 * lam)  # noqa: E731
+    peak = brentq(lambda lam: -2 * lam**-3 + 8 * lam**-9 + 0.5 / (4 * lam**2), 1.1, 1.6, xtol=1e-14)
+    fold = next(s for s in branch.special if s.kind == Kind.LP)
+    assert abs(branch.pole_values(fold.X)["lam2_north"][0] - peak) < 1e-10
+    assert abs(fold.X[-1] ** 2 - square(peak)) < 1e-12
+    assert np.all(branch.pressure == 0.5) and branch.voltage.min() > 0
+    assert branch.stopped(StopCode.ZERO_VOLTAGE) and branch.stopped(StopCode.STOP_STRETCH)

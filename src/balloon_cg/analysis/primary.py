@@ -181,7 +181,8 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
 
 def range_limits(scene, upper: float):
     """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper] or P reaches
-    stop_pressure (Φ̄ reaches stop_voltage in a voltage continuation): the range the scene asks for."""
+    stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage continuation): the range the scene asks
+    for."""
     cont = scene.continuation
     in_voltage = cont.parameter == ContinuationParameter.VOLTAGE
 
@@ -195,6 +196,8 @@ def range_limits(scene, upper: float):
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
         if in_voltage and cont.stop_voltage is not None and point.X[-1] >= cont.stop_voltage:
             return Stop(StopCode.STOP_VOLTAGE, f"reached stop_voltage {cont.stop_voltage:g}")
+        if in_voltage and point.X[-1] < 0:  # Φ̄ → −Φ̄ is the same balloon: the branch ends at the voltage-free sphere
+            return Stop(StopCode.ZERO_VOLTAGE, "reached voltage 0 (the sphere without voltage)")
         return None
 
     return limits

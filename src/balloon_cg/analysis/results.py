@@ -78,6 +78,7 @@ class StopCode(enum.StrEnum):
     MIN_STRETCH = "min_stretch"  # the north pole stretch reached continuation.min_stretch
     STOP_PRESSURE = "stop_pressure"  # P reached continuation.stop_pressure
     STOP_VOLTAGE = "stop_voltage"  # Φ̄ reached continuation.stop_voltage (a voltage continuation)
+    ZERO_VOLTAGE = "zero_voltage"  # Φ̄ fell to 0 (a voltage continuation reached the voltage-free sphere)
     COMPRESSED = "compressed"  # a principal stress (elastic + dielectric) became negative
     WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
     SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch

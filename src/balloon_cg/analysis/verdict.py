@@ -1,7 +1,7 @@
 """Is a result complete? The contract of docs/numerics.md: every stored result is verified or flagged.
 
 A result is *complete* when every leg of every branch ended where the scene asked (a requested stop: the pole
-stretch limits, stop_pressure, stop_voltage, the wire gap, a pear branch rejoining the primary branch), every special point
+stretch limits, stop_pressure, stop_voltage, zero voltage, the wire gap, a pear branch rejoining the primary branch), every special point
 is LOCATED (and every axisymmetric branch point classified), every bifurcating branch asked for could be
 started, and the stability flags of every assessed point are settled between the stability degree and the
 check degree. Everything else is an ``Incomplete`` entry: typed, named, explained. A limitation of the method
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from .results import Classification, Kind, Status, StopCode
 
 REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCode.STOP_PRESSURE,
-                             StopCode.STOP_VOLTAGE, StopCode.WIRE_GAP, StopCode.SOUTH_STOP_STRETCH,
+                             StopCode.STOP_VOLTAGE, StopCode.ZERO_VOLTAGE, StopCode.WIRE_GAP, StopCode.SOUTH_STOP_STRETCH,
                              StopCode.REJOINED})
 
 

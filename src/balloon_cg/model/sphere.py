@@ -31,8 +31,8 @@ def sphere_voltage(material, stretch: float, pressure: float) -> float:
     """Φ̄ ≥ 0 holding the sphere of radius ``stretch`` at ``pressure``; ValueError where none does (P(λ; 0) < P)."""
     excess = sphere_pressure(material, stretch) - pressure
     if excess < 0:
-        raise ValueError(f"the sphere of stretch {stretch:g} needs P = {excess + pressure:.6g} < {pressure:g} "
-                         "without a voltage: no voltage holds it at that pressure")
+        raise ValueError(f"the sphere of stretch {stretch:g} holds P = {excess + pressure:.6g} without a voltage, "
+                         f"less than P = {pressure:g}, and a voltage only lowers it")
     return float(np.sqrt(excess / (4 * stretch)))
 
 
