@@ -20,7 +20,7 @@ import numpy as np
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.profiles import meridional_stretch
 from ..model.sphere import sphere_pressure, sphere_voltage
-from ..model.stresses import smallest_stress
+from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
@@ -46,7 +46,7 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     a[0], b[1] = lam, lam
     u = disc.join(a, b)
     params = start_parameters(scene, tracer.parameter)
-    if compressed(disc, u, scene.material, params.voltage):
+    if scene.electric is not None and not _taut(disc, u, scene.material, params.voltage):
         raise ContinuationError(f"the sphere at continuation.start_stretch = {lam:g} is compressed at the voltage "
                                 f"{params.voltage:.6g} (its dielectric stress exceeds the elastic tension); "
                                 "start at another continuation.start_stretch")
@@ -91,29 +91,30 @@ def start_parameters(scene, parameter: str) -> Parameters:
 
 
 SLACK_TOLERANCE = 1e-8  # compression beyond rounding, relative to the elastic stress; zero stress (P = 0) is traced
+_STRESS_GRID = np.linspace(0.0, np.pi, 361)  # θ where a start's stresses are checked
 
 
-def _smallest_stress(disc, u, material, voltage: float = 0.0, n_theta: int = 361) -> tuple[float, float]:
-    """(smallest principal stress, elastic plus dielectric; smallest elastic one) of the state u on a θ grid."""
-    theta = np.linspace(0.0, np.pi, n_theta)
-    lam2, dlam2, _, deta = disc.evaluate(u, theta)
-    lam1 = meridional_stretch(theta, lam2, dlam2, deta)
-    return smallest_stress(material, lam1, lam2, voltage), smallest_stress(material, lam1, lam2)
+def _smallest_stress(material, lam1, lam2, voltage: float) -> tuple[float, float]:
+    """(smallest principal stress, elastic plus dielectric; smallest elastic one) over the given stretches."""
+    elastic = np.minimum(*elastic_stresses(material, lam1, lam2))
+    return float(np.min(elastic + dielectric_stress(voltage, lam1, lam2))), float(np.min(elastic))
 
 
 def _taut(disc, u, material, voltage: float = 0.0) -> bool:
-    """Both elastic principal stresses positive everywhere (MODEL.md §6: tension-field theory) and, with the
-    dielectric term, not ``compressed``."""
-    total, elastic = _smallest_stress(disc, u, material, voltage)
+    """Both elastic principal stresses positive on a fine θ grid (MODEL.md §6: tension-field theory) and the
+    dielectric stress not above them (within SLACK_TOLERANCE)."""
+    lam2, dlam2, _, deta = disc.evaluate(u, _STRESS_GRID)
+    total, elastic = _smallest_stress(material, meridional_stretch(_STRESS_GRID, lam2, dlam2, deta), lam2, voltage)
     return elastic > 0.0 and total >= -SLACK_TOLERANCE * elastic
 
 
 def compressed(disc, u, material, voltage: float) -> bool:
-    """A principal stress (elastic + dielectric) below −SLACK_TOLERANCE × the smallest elastic one: the membrane
-    would carry compression, which it cannot (the voltage's Maxwell stress exceeds the elastic tension)."""
-    total, elastic = _smallest_stress(disc, u, material, voltage)
+    """At a quadrature node a principal stress (elastic + dielectric) below −SLACK_TOLERANCE × the smallest elastic
+    one: the membrane would carry compression, which it cannot (the voltage's Maxwell stress exceeds the elastic
+    tension). Checked at every point of a dielectric branch, so on the nodes the solver has (no new grid)."""
+    lam2, v, _, w = disc.node_state(u)
+    total, elastic = _smallest_stress(material, np.hypot(lam2 * disc.cos_theta + v, w), lam2, voltage)
     return total < -SLACK_TOLERANCE * abs(elastic)
-
 
 
 def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: float, scene, rtol: float = 1e-8) -> str:

@@ -1,5 +1,5 @@
-"""Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6), the dielectric part, and the
-tension-field test on them."""
+"""Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6) and the dielectric part (the taut test on
+them: analysis/primary.py)."""
 import numpy as np
 
 from .membrane import stretch_derivatives
@@ -27,10 +27,3 @@ def dielectric_stress(voltage: float, lam1, lam2):
     the Maxwell stress −ε E² of the true field E = (Φ/H) λ1 λ2 across the thickness."""
     return -2.0 * voltage**2 * (lam1 * lam2) ** 2
 
-
-def smallest_stress(material, lam1, lam2, voltage: float = 0.0) -> float:
-    """The smallest principal stress (elastic, plus the dielectric part at ``voltage``) over the given stretches:
-    ≤ 0 where the membrane wrinkles."""
-    lam1, lam2 = np.asarray(lam1), np.asarray(lam2)
-    sigma_theta, sigma_phi = elastic_stresses(material, lam1, lam2)
-    return float(np.min(np.minimum(sigma_theta, sigma_phi) + dielectric_stress(voltage, lam1, lam2)))
