@@ -181,13 +181,18 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
 
 
 def range_limits(scene, upper: float):
-    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper] or P reaches
-    stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage continuation): the range the scene asks
-    for."""
+    """limits(disc, point) -> Stop or None: a dielectric membrane is compressed, the north pole stretch leaves
+    [min_stretch, upper] or P reaches stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage
+    continuation): the range the scene asks for, and the model's."""
     cont = scene.continuation
     in_voltage = cont.parameter == ContinuationParameter.VOLTAGE
 
     def limits(disc, point):
+        if scene.electric is not None:  # first: a compressed point is not landed on, whatever its stretch
+            voltage = point.X[-1] if in_voltage else scene.electric.voltage
+            if compressed(disc, point.X[:-1], scene.material, voltage):
+                return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
+                                                 "tension: tension-field theory is not modelled)")
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
         if stretch >= upper:
             return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
@@ -205,8 +210,7 @@ def range_limits(scene, upper: float):
 
 
 def stop_rule(scene, upper: float):
-    """stop(disc, point) -> Stop or None: ``range_limits``, the membrane is compressed (a dielectric scene) or
-    comes within wire_gap of a coil."""
+    """stop(disc, point) -> Stop or None: ``range_limits``, or the membrane comes within wire_gap of a coil."""
     cont = scene.continuation
     limits = range_limits(scene, upper)
 
@@ -214,11 +218,6 @@ def stop_rule(scene, upper: float):
         beyond = limits(disc, point)
         if beyond is not None:
             return beyond
-        if scene.electric is not None:
-            voltage = point.X[-1] if cont.parameter == ContinuationParameter.VOLTAGE else scene.electric.voltage
-            if compressed(disc, point.X[:-1], scene.material, voltage):
-                return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
-                                                 "tension: tension-field theory is not modelled)")
         gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils)
         if gap < cont.wire_gap:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {cont.wire_gap:g} of coil {coil} (gap {gap:.3g})")
