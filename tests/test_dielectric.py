@@ -278,3 +278,15 @@ def test_voltage_fold_at_a_positive_pressure_and_the_zero_voltage_end():
     assert abs(fold.X[-1] ** 2 - square(peak)) < 1e-12
     assert np.all(branch.pressure == 0.5) and branch.voltage.min() > 0
     assert branch.stopped(StopCode.ZERO_VOLTAGE) and branch.stopped(StopCode.STOP_STRETCH)
+
+
+def test_a_compressed_point_is_never_landed_on():
+    """Φ̄ = 0.085: the tension vanishes at λ = 1.0012, just above min_stretch = 1.001, and the step that passes it
+    also passes min_stretch: the leg stops as compressed instead of landing on min_stretch (a compressed sphere,
+    P < 0), and every stored point is taut (P > 0)."""
+    scene = parse_scene(NEO + "[electric]\nvoltage = 0.085\n[continuation]\nstart_stretch = 1.1\nstop_stretch = 1.2\n")
+    branch = trace_primary(scene)
+    slack = brentq(lambda lam: neo_hookean_derivatives(lam, 0.085)[0], 1.0001, 1.1)
+    assert 1.001 < slack < 1.002
+    assert branch.stopped(StopCode.COMPRESSED) and not branch.stopped(StopCode.MIN_STRETCH)
+    assert branch.pressure.min() > 0 and branch.pole_values()["lam2_north"].min() > slack
