@@ -4,7 +4,7 @@
     each branch ends where the membrane would be compressed); (b) Φ̄ against the stretch at P = 0 (a voltage
     continuation) with the located pull-in fold, and the closed form Φ̄² = λ⁻² − λ⁻⁸.
 
-Run: python docs/dielectric_figure.py   (about 30 s)
+Run: python docs/figures/dielectric.py   (about 30 s)
 """
 from pathlib import Path
 
@@ -22,7 +22,7 @@ VOLTAGES = (0.0, 0.1, 0.2, 0.3, 0.4)
 NEO = '[material]\npreset = "neo-Hookean"\n'
 
 
-def main(out=Path(__file__).with_name("dielectric.png")):
+def main(out=Path(__file__).parent.parent / "dielectric.png"):
     fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.6), constrained_layout=True)
     for voltage in VOLTAGES:
         scene = parse_scene(NEO + f"[electric]\nvoltage = {voltage}\n[continuation]\nstart_stretch = 1.15\n"
