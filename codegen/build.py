@@ -39,6 +39,8 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     else:
         kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
         title = f"Kernels for scene class {cls.name}: strain energy {cls.energy[0]}, field {cls.field}."
+    if cls.electric:
+        title = f"{title[:-1]}, dielectric term -voltage^2 lam1^2 lam2^2."
     derived = time.perf_counter()
     lowered = [lower(k) for k in kernels]
     cse = time.perf_counter()

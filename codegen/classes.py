@@ -26,9 +26,11 @@ def scene_classes() -> list[SceneClass]:
     return classes + energy_classes()
 
 
-def energy_class(name: str, formula: str, parameters: tuple, field: bool) -> SceneClass:
-    """The class of a strain energy: its canonical formula text and parameter names."""
-    return SceneClass(name, None, field, energy=(parse_formula(formula, parameters).text, tuple(parameters)))
+def energy_class(name: str, formula: str, parameters: tuple, field: bool, electric: bool = False) -> SceneClass:
+    """The class of a strain energy: its canonical formula text and parameter names (``electric``: with the
+    dielectric term)."""
+    return SceneClass(name, None, field, energy=(parse_formula(formula, parameters).text, tuple(parameters)),
+                      electric=electric)
 
 
 def energy_classes() -> list[SceneClass]:

@@ -1,7 +1,8 @@
 """Equations from the functional: energy gradient/Hessian (Ritz–Galerkin) and the first-order EL system.
 
 Galerkin form: E = ∫_{-1}^{1} π̂ d(cos θ); its first variation needs ∂π̂/∂(λ2, v, η, w) at a node, its Jacobian
-(= the axisymmetric second variation) the 4×4 Hessian of π̂, and continuation ∂/∂P and ∂/∂M of the gradient.
+(= the axisymmetric second variation) the 4×4 Hessian of π̂, and continuation ∂/∂P, ∂/∂M (with a field) and
+∂/∂Φ̄ (a dielectric class: the voltage) of the gradient.
 
 First-order form (MODEL.md §4): with L(θ, λ2, λ2', η, η') = Π(θ, λ2, λ2' sin θ, η, η'), the EL equations
 d/dθ(Π_v sin θ) = Π_λ2 and d/dθ Π_w = Π_η are linear in (v', w'):
@@ -14,7 +15,7 @@ singular when the membrane is unstretched (its determinant is proportional to th
 import sympy as sp
 
 from . import energies, functional as fn
-from .functional import FIELD, STATE, M, P, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, w
+from .functional import FIELD, STATE, M, P, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, voltage, w
 from .kernels import Arg, Kernel
 
 HESSIAN_PAIRS = tuple((i, j) for i in range(4) for j in range(i, 4))  # upper triangle row by row
@@ -72,6 +73,9 @@ def energy_kernels(cls: SceneClass) -> list[Kernel]:
             Kernel("field_gradient", "∂²π̂/∂M∂(λ2, v, η, w).", args, at_node([sp.diff(g, M) for g in gradient]),
                    STATE_LABELS)
         )
+    if cls.electric:
+        kernels.append(Kernel("voltage_gradient", "∂²π̂/∂Φ̄∂(λ2, v, η, w).", args,
+                              at_node([sp.diff(g, voltage) for g in gradient]), STATE_LABELS))
     return kernels
 
 
@@ -88,7 +92,7 @@ def linear_system(cls: SceneClass):
 
 
 def first_order_kernels(cls: SceneClass) -> list[Kernel]:
-    """f, ∂f/∂y, ∂f/∂P (and ∂f/∂M with a field), with F = A⁻¹ b and ∂F/∂x = A⁻¹(∂b/∂x − ∂A/∂x F)."""
+    """f, ∂f/∂y, ∂f/∂P (and ∂f/∂M with a field, ∂f/∂Φ̄ for a dielectric class), with F = A⁻¹ b and ∂F/∂x = A⁻¹(∂b/∂x − ∂A/∂x F)."""
     A, b = linear_system(cls)
     at_node = lambda e: fn.field_values(e, lam2 * sin_theta)  # noqa: E731
     a11, a12, a21, a22, b1, b2, det, F1, F2 = sp.symbols("a11 a12 a21 a22 b1 b2 det F1 F2")
@@ -115,5 +119,9 @@ def first_order_kernels(cls: SceneClass) -> list[Kernel]:
     if cls.field:
         dM = dF(M)
         kernels.append(Kernel("rhs_field", "∂f/∂M.", args, (sp.S.Zero, dM[0], sp.S.Zero, dM[1]), STATE_LABELS,
+                              stages))
+    if cls.electric:
+        dV = dF(voltage)
+        kernels.append(Kernel("rhs_voltage", "∂f/∂Φ̄.", args, (sp.S.Zero, dV[0], sp.S.Zero, dV[1]), STATE_LABELS,
                               stages))
     return kernels

@@ -2,7 +2,10 @@
 
 Π(θ, λ2, v, η, w) = Φ(λ1, λ2) sin θ − ½ χ M H²(ρ, η) sin θ + ½ P λ2² w sin² θ,
 λ1 = sqrt((λ2 cos θ + v)² + w²), ρ = λ2 sin θ,
-Φ = Σ_i (μ_i/α_i)(λ1^α_i + λ2^α_i + (λ1 λ2)^(−α_i) − 3), or another strain energy (codegen/energies.py).
+Φ = Σ_i (μ_i/α_i)(λ1^α_i + λ2^α_i + (λ1 λ2)^(−α_i) − 3), or another strain energy (codegen/energies.py),
+and for a dielectric class (an ideal dielectric elastomer under the voltage Φ_e across its thickness H)
+Φ = Φ_elastic − Φ̄² λ1² λ2²: the free energy W − (ε/2)(Φ_e/H)² λ1² λ2² per reference volume in units of μ/2,
+with the nondimensional voltage Φ̄ = (Φ_e/H) √(ε/μ) (the runtime parameter ``voltage``; docs/scenes.md).
 
 H² is not symbolic: the field kernels supply its value and derivatives at the node, so Π carries a second-order
 Taylor proxy of H² about (ρ0, η0) and ``field_values`` puts ρ0 = ρ, η0 = η back after differentiation. This is
@@ -18,6 +21,7 @@ theta = sp.Symbol("theta", real=True)
 cos_theta, sin_theta = sp.symbols("cos_theta sin_theta", real=True)
 lam2, v, eta, w = sp.symbols("lam2 v eta w", real=True)
 P, M, chi = sp.symbols("P M chi", real=True)
+voltage = sp.Symbol("voltage", real=True)
 STATE = (lam2, v, eta, w)
 
 # H² and its derivatives in (ρ, η) at the node
@@ -32,23 +36,26 @@ GENERAL_TERMS = 3
 class SceneClass:
     """What a kernel module is specialised to: Ogden exponents (None: runtime exponents) and field presence,
     or instead of Ogden a strain energy ``energy`` = (canonical formula, parameter names) (codegen/energies.py)
-    whose parameters the kernels take at run time."""
+    whose parameters the kernels take at run time; ``electric``: the dielectric term (module docstring)."""
 
     name: str
     alphas: tuple | None
     field: bool
     energy: tuple | None = None
+    electric: bool = False
 
     @property
     def n_terms(self) -> int:
         return GENERAL_TERMS if self.alphas is None else len(self.alphas)
 
     def inputs(self) -> dict:
+        """What the module is generated from (its header); 'electric' only where the term is present."""
+        electric = {"electric": True} if self.electric else {}
         if self.energy is not None:
             return {"class": self.name, "energy": self.energy[0], "parameters": tuple(self.energy[1]),
-                    "field": self.field}
+                    "field": self.field, **electric}
         alphas = "runtime" if self.alphas is None else tuple(str(a) for a in self.alphas)
-        return {"class": self.name, "alphas": alphas, "field": self.field}
+        return {"class": self.name, "alphas": alphas, "field": self.field, **electric}
 
 
 def moduli(cls: SceneClass):
@@ -68,11 +75,26 @@ def ogden(cls: SceneClass, l1, l2):
     )
 
 
-def membrane_energy(cls: SceneClass, l1, l2):
-    """Φ(λ1, λ2) of the class: Ogden, or its strain energy formula."""
+def elastic_energy(cls: SceneClass, l1, l2):
+    """Φ_elastic(λ1, λ2) of the class: Ogden, or its strain energy formula."""
     if cls.energy is not None:
         return energies.membrane_energy(cls.energy, l1, l2)
     return ogden(cls, l1, l2)
+
+
+def electric_energy(cls: SceneClass, l1, l2):
+    """−Φ̄² λ1² λ2² for a dielectric class, else 0 (module docstring)."""
+    return -voltage**2 * l1**2 * l2**2 if cls.electric else sp.S.Zero
+
+
+def membrane_energy(cls: SceneClass, l1, l2):
+    """Φ(λ1, λ2) = Φ_elastic + the dielectric term: what the equations, pole limits and second variation use."""
+    return elastic_energy(cls, l1, l2) + electric_energy(cls, l1, l2)
+
+
+def electric_args(cls: SceneClass) -> list:
+    """[Φ̄] for a dielectric class, else []: the runtime parameters of the membrane energy."""
+    return [voltage] if cls.electric else []
 
 
 def meridional_stretch(c, vv, ww, l2=lam2):
@@ -108,4 +130,4 @@ def runtime_args(cls: SceneClass):
     params = [P]
     if cls.field:
         params += [M, chi]
-    return params
+    return params + electric_args(cls)

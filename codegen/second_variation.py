@@ -165,12 +165,14 @@ def shear_coefficient(cls: SceneClass):
     expm1/log1p form (no cancellation) elsewhere."""
     p1_, p2_, p11_, p12_, _ = material_stage(cls)
     closed = (p1_ - p2_) / (l1**2 - lam2**2)
+    # the dielectric term −Φ̄² e1 e2 adds the constant Φ̄² (its φ̂_1 − φ̂_2 = Φ̄² (e1 − e2))
+    electric = sum(v**2 for v in fn.electric_args(cls))
     if cls.energy is not None:
         expr, limit = energies.shear_coefficient(cls.energy, l1, lam2)
-        return expr, limit, closed
+        return expr + electric, limit + electric, closed
     limit = sp.simplify((p11_ - p12_).subs(l1, lam2))
     regular, singular = _divided_difference_terms(cls, l1, _l2)
-    regular = regular.subs(_l2, lam2)
+    regular = regular.subs(_l2, lam2) + electric
     if not singular:
         return regular, limit, closed
     far = sp.Abs(l1 - lam2) > SWITCH * lam2
@@ -218,7 +220,7 @@ def shear_kernel(cls: SceneClass) -> Kernel:
     return Kernel(
         "shear_coefficient",
         "K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12).",
-        (Arg.node(l1), Arg.node(lam2), *material_args(cls)),
+        (Arg.node(l1), Arg.node(lam2), *map(Arg.param, fn.electric_args(cls)), *material_args(cls)),
         (shear_coefficient(cls)[0],),
         ("K",),
     )

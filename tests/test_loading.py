@@ -183,6 +183,10 @@ def test_bad_control_is_one_line():
     assert str(error.value) == 'bad: loading.control = "mass": must be one of "pressure", "volume", "gas"'
     with pytest.raises(SceneError, match=r'loading.stop_amount = 3.0: only with loading.control = "gas"'):
         parse_scene('[material]\npreset = "SPOM1"\n[loading]\nstop_amount = 3.0\n', "bad")
+    voltage = '[material]\npreset = "neo-Hookean"\n[electric]\n[continuation]\nparameter = "voltage"\n'
+    assert parse_scene(voltage, "ok").loading.control == Control.PRESSURE
+    with pytest.raises(SceneError, match=r'loading.control = "gas": a voltage continuation .* allowed: "pressure"'):
+        parse_scene(voltage + '[loading]\ncontrol = "gas"\n', "bad")
 
 
 def test_default_scene_text_is_unchanged():

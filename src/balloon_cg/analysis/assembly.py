@@ -174,4 +174,5 @@ def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | 
         legs=traced,
         lossy=lossy,
         wall_time=time.perf_counter() - t0,
+        parameter=tracer.parameter,
     )

@@ -113,6 +113,12 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
         picture.interrupted = True
         return picture
     _assess(primary, scene, primary.disc.symmetric, progress)
+    if primary.parameter != "P":
+        progress.finish(Phase.STABILITY, len(primary.X))
+        picture.not_searched = ("branch points, pear branches and snap-throughs are searched on pressure "
+                                "continuations only; continuation.parameter = 'voltage' gives the primary branch, its "
+                                "folds and its stability")
+        return picture
     if not primary.disc.symmetric:
         progress.finish(Phase.STABILITY, len(primary.X))
         picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "

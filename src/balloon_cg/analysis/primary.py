@@ -1,12 +1,14 @@
-"""The primary (axisymmetric) branch: start at the inflated M = 0 sphere, switch the field on, trace in P.
+"""The primary (axisymmetric) branch: start at the inflated M = 0 sphere, switch the field on, trace in P (or Φ̄).
 
 1. Start: the exact sphere (``model.sphere``) at the scene's start stretch, where the membrane is taut (the
-   first-order system is singular at the undeformed state, MODEL.md §4).
-2. Field on: natural continuation in M at that pressure from 0 to the scene's M.
-3. Pressure: pseudo-arclength in (u, P) downwards to ``min_stretch`` and upwards to ``stop_stretch`` (landing
-   exactly on it), ``stop_pressure``, ``loading.stop_volume``/``stop_amount``, a wire gap or ``max_points``;
-   folds in P (LP), in the north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and
-   recorded; the degree and basis map adapt (``tracer``).
+   first-order system is singular at the undeformed state, MODEL.md §4): its pressure at the scene's voltage,
+   or, for continuation.parameter = "voltage", its voltage at the scene's fixed pressure.
+2. Field on: natural continuation in M at that pressure (and voltage) from 0 to the scene's M.
+3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards
+   to ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``),
+   ``loading.stop_volume``/``stop_amount``, a wire gap or ``max_points``; folds in the parameter (LP), in the
+   north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and recorded; the degree and
+   basis map adapt (``tracer``).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
 removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
@@ -18,8 +20,8 @@ import numpy as np
 
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.profiles import meridional_stretch
-from ..model.sphere import sphere_pressure
-from ..model.stresses import smallest_stress
+from ..model.sphere import sphere_pressure, sphere_voltage
+from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
@@ -29,6 +31,7 @@ from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
 from .wires import wire_gap
+from ..scene import ContinuationParameter
 from ..numerics.threads import limited_blas
 
 
@@ -44,14 +47,18 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
     a[0], b[1] = lam, lam
     u = disc.join(a, b)
-    params = Parameters(sphere_pressure(scene.material, lam), 0.0, scene.field.chi)
+    params = start_parameters(scene, tracer.parameter)
+    if scene.electric is not None and not _taut(disc, u, scene.material, params.voltage):
+        raise ContinuationError(f"the sphere at continuation.start_stretch = {lam:g} is compressed at the voltage "
+                                f"{params.voltage:.6g} (its dielectric stress exceeds the elastic tension); "
+                                "start at another continuation.start_stretch")
     target, M, dM = scene.field.M, 0.0, scene.field.M
     system = ParameterSystem(eq, params, "M")
     while M < target:
         trial = min(M + dM, target)
         result = newton(system.residual, system.jacobian, np.append(u, trial), unit(u.size + 1, -1), trial,
                         scene.solver.tol, scene.solver.max_newton)
-        if result.converged and _taut(disc, result.x[:-1], scene.material):
+        if result.converged and _taut(disc, result.x[:-1], scene.material, params.voltage):
             u, M = result.x[:-1], trial
             dM *= 2
         elif result.converged:
@@ -65,16 +72,51 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
                     "turn back in M there); try another continuation.start_stretch or a smaller field.M"
                 )
     params = params.with_value("M", target)
-    X, degree = _resolved_start(tracer, np.append(u, params.P), degree, params)
+    X, degree = _resolved_start(tracer, np.append(u, getattr(params, tracer.parameter)), degree, params)
     residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
     return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
 
 
-def _taut(disc, u, material, n_theta: int = 361) -> bool:
-    """Both elastic principal stresses positive everywhere (MODEL.md §6: tension-field theory)."""
-    theta = np.linspace(0.0, np.pi, n_theta)
-    lam2, dlam2, _, deta = disc.evaluate(u, theta)
-    return smallest_stress(material, meridional_stretch(theta, lam2, dlam2, deta), lam2) > 0.0
+def start_parameters(scene, parameter: str) -> Parameters:
+    """The start sphere's parameters at M = 0: its pressure at electric.voltage (parameter "P"), or its voltage
+    at continuation.pressure (parameter "voltage"; ContinuationError where no voltage holds it)."""
+    lam, chi = scene.continuation.start_stretch, scene.field.chi
+    if parameter == "P":
+        voltage = 0.0 if scene.electric is None else scene.electric.voltage
+        return Parameters(sphere_pressure(scene.material, lam, voltage), 0.0, chi, voltage)
+    P = scene.continuation.pressure
+    try:
+        return Parameters(P, 0.0, chi, sphere_voltage(scene.material, lam, P))
+    except ValueError as e:
+        raise ContinuationError(f"cannot start the voltage continuation at continuation.start_stretch = {lam:g}: "
+                                f"{e}; lower continuation.pressure or choose another start_stretch") from None
+
+
+SLACK_TOLERANCE = 1e-8  # compression beyond rounding, relative to the elastic stress; zero stress (P = 0) is traced
+_STRESS_GRID = np.linspace(0.0, np.pi, 361)  # θ where a start's stresses are checked
+
+
+def _smallest_stress(material, lam1, lam2, voltage: float) -> tuple[float, float]:
+    """(smallest principal stress, elastic plus dielectric; smallest elastic one) over the given stretches."""
+    elastic = np.minimum(*elastic_stresses(material, lam1, lam2))
+    return float(np.min(elastic + dielectric_stress(voltage, lam1, lam2))), float(np.min(elastic))
+
+
+def _taut(disc, u, material, voltage: float = 0.0) -> bool:
+    """Both elastic principal stresses positive on a fine θ grid (MODEL.md §6: tension-field theory) and the
+    dielectric stress not above them (within SLACK_TOLERANCE)."""
+    lam2, dlam2, _, deta = disc.evaluate(u, _STRESS_GRID)
+    total, elastic = _smallest_stress(material, meridional_stretch(_STRESS_GRID, lam2, dlam2, deta), lam2, voltage)
+    return elastic > 0.0 and total >= -SLACK_TOLERANCE * elastic
+
+
+def compressed(disc, u, material, voltage: float) -> bool:
+    """At a quadrature node a principal stress (elastic + dielectric) below −SLACK_TOLERANCE × the smallest elastic
+    one: the membrane would carry compression, which it cannot (the voltage's Maxwell stress exceeds the elastic
+    tension). Checked at every point of a dielectric branch, so on the nodes the solver has (no new grid)."""
+    lam2, v, _, w = disc.node_state(u)
+    total, elastic = _smallest_stress(material, np.hypot(lam2 * disc.cos_theta + v, w), lam2, voltage)
+    return total < -SLACK_TOLERANCE * abs(elastic)
 
 
 def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: float, scene, rtol: float = 1e-8) -> str:
@@ -87,7 +129,7 @@ def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: floa
                         solver.tol, solver.max_newton)
         if not result.converged:
             break
-        if _taut(disc, result.x[:-1], scene.material):
+        if _taut(disc, result.x[:-1], scene.material, system.params.voltage):
             u, taut_M = result.x[:-1], middle
         else:
             wrinkled_M = middle
@@ -141,23 +183,34 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
 
 
 def range_limits(scene, upper: float):
-    """limits(disc, point) -> Stop or None: the north pole stretch leaves [min_stretch, upper], P reaches
-    stop_pressure, or the control parameter reaches loading.stop_volume or stop_amount (the range the scene asks
-    for)."""
+    """limits(disc, point) -> Stop or None: a dielectric membrane is compressed, the north pole stretch leaves
+    [min_stretch, upper], P reaches stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage
+    continuation), or the control parameter reaches loading.stop_volume or stop_amount: the range the scene asks
+    for, and the model's."""
     cont, control = scene.continuation, scene.loading.control
     by_control = control_stop(scene.loading)
+    in_voltage = cont.parameter == ContinuationParameter.VOLTAGE
 
     def limits(disc, point):
+        if scene.electric is not None:  # first: a compressed point is not landed on, whatever its stretch
+            voltage = point.X[-1] if in_voltage else scene.electric.voltage
+            if compressed(disc, point.X[:-1], scene.material, voltage):
+                return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
+                                                 "tension: tension-field theory is not modelled)")
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
         if stretch >= upper:
             return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
         if stretch <= cont.min_stretch:
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
-        if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure:
+        if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and not in_voltage:
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
         if by_control is not None and control_value(disc, point.X, control) >= by_control[2]:
             key, code, limit = by_control
             return Stop(code, f"reached {key} {limit:g}")
+        if in_voltage and cont.stop_voltage is not None and point.X[-1] >= cont.stop_voltage:
+            return Stop(StopCode.STOP_VOLTAGE, f"reached stop_voltage {cont.stop_voltage:g}")
+        if in_voltage and point.X[-1] < 0:  # Φ̄ → −Φ̄ is the same balloon: the branch ends at the voltage-free sphere
+            return Stop(StopCode.ZERO_VOLTAGE, "reached voltage 0 (the sphere without voltage)")
         return None
 
     return limits

@@ -4,7 +4,7 @@ from ..numerics import continuation
 
 
 class ParameterSystem:
-    """R(u; p) as a map of X = (u, p) for one continuation parameter p ∈ {P, M}."""
+    """R(u; p) as a map of X = (u, p) for one continuation parameter p ∈ {P, M, voltage}."""
 
     def __init__(self, equilibrium: Equilibrium, params: Parameters, name: str):
         self.eq, self.params, self.name = equilibrium, params, name

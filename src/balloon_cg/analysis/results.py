@@ -82,6 +82,9 @@ class StopCode(enum.StrEnum):
     STOP_PRESSURE = "stop_pressure"  # P reached continuation.stop_pressure
     STOP_VOLUME = "stop_volume"  # V reached loading.stop_volume (volume control)
     STOP_AMOUNT = "stop_amount"  # the gas amount n = P V reached loading.stop_amount (gas control)
+    STOP_VOLTAGE = "stop_voltage"  # Φ̄ reached continuation.stop_voltage (a voltage continuation)
+    ZERO_VOLTAGE = "zero_voltage"  # Φ̄ fell to 0 (a voltage continuation reached the voltage-free sphere)
+    COMPRESSED = "compressed"  # a principal stress (elastic + dielectric) became negative
     WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
     SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch
     REJOINED = "rejoined"  # a pear branch crossed back through the primary branch
@@ -160,8 +163,8 @@ class Branch:
     disc: Discretisation  # the storage discretisation (pickles as its five defining fields)
     kernel_class: str
     kernel_signature: str
-    params: Parameters  # M and χ of the branch (P varies along it)
-    X: np.ndarray  # (n_points, n + 1): (u, P), u on ``disc``
+    params: Parameters  # M, χ, Φ̄ or P of the branch (``parameter`` varies along it)
+    X: np.ndarray  # (n_points, n + 1): (u, p), u on ``disc``, p the value of ``parameter``
     iterations: np.ndarray
     residual: np.ndarray
     error_estimate: np.ndarray
@@ -174,10 +177,23 @@ class Branch:
     unsettled: list = field(default_factory=list)  # point indices whose flags change at the check degree
     parent: tuple | None = None  # (branch name, branch point number) a bifurcating branch leaves from
     rejoins: int | None = None  # the parent's branch point number where a bifurcating branch rejoins it
+    parameter: str = "P"  # the continuation parameter: the Parameters field X[:, -1] holds ("P" or "voltage")
 
     @property
     def pressure(self):
-        return self.X[:, -1]
+        return self._column("P")
+
+    @property
+    def voltage(self):
+        return self._column("voltage")
+
+    def _column(self, name: str) -> np.ndarray:
+        """The value of parameter ``name`` at every point (constant unless it is the continuation parameter)."""
+        return self.X[:, -1] if self.parameter == name else np.full(len(self.X), getattr(self.params, name))
+
+    def params_at(self, X) -> Parameters:
+        """The parameters of the point X = (u, p)."""
+        return self.params.with_value(self.parameter, X[-1])
 
     @property
     def stop_reason(self) -> str:

@@ -241,8 +241,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     variations = Variations(equilibrium_of(branch))
     degrees = point_degrees(branch, degree)
-    params = branch.params
-    results = [variations[N].assess(X[:-1], params.with_value("P", X[-1]), symmetric, m_max)
+    results = [variations[N].assess(X[:-1], branch.params_at(X), symmetric, m_max)
                for N, X in zip(degrees, branch.X)]
     unsettled = []
     if check:
@@ -252,8 +251,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
             small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
             if not (changes or small or n % 10 == 0):
                 continue
-            fine = variations[check_degree(branch, degrees[n])].flags(X[:-1], params.with_value("P", X[-1]),
-                                                                     symmetric, m_max)
+            fine = variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max)
             if fine != flags[n]:
                 unsettled.append(n)
     return results, unsettled

@@ -21,6 +21,7 @@ from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .control import fold_monitors
+from ..scene import ContinuationParameter
 from .problem import ParameterSystem, continuation_settings
 from .resolution import Resolution
 from .results import Kind, StopCode
@@ -59,6 +60,8 @@ class Tracer:
         if held is None:
             held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
         self.pin = (not scene.field.coils) or held
+        # the continuation parameter (Parameters field): P, or Φ̄ for continuation.parameter = "voltage"
+        self.parameter = "voltage" if scene.continuation.parameter == ContinuationParameter.VOLTAGE else "P"
         self.settings = continuation_settings(scene)
         self.resolution = Resolution.of(scene.solver)
         self._systems = {}
@@ -68,7 +71,7 @@ class Tracer:
             quadrature = self.scene.solver.quadrature if degree == self.scene.solver.degree else 0
             disc = Discretisation(degree, self.symmetric, self.pin, quadrature, mapping)
             self._systems[degree, mapping] = Equilibrium(self.scene, disc)
-        return ParameterSystem(self._systems[degree, mapping], params, "P")
+        return ParameterSystem(self._systems[degree, mapping], params, self.parameter)
 
     def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None,
             mapping=None, limits=None) -> LegTrace:

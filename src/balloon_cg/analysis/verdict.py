@@ -1,10 +1,12 @@
 """Is a result complete? The contract of docs/numerics.md: every stored result is verified or flagged.
 
 A result is *complete* when every leg of every branch ended where the scene asked (a requested stop: the pole
-stretch limits, stop_pressure, stop_volume, stop_amount, the wire gap, a pear branch rejoining the primary
-branch), every special point is LOCATED (and every axisymmetric branch point classified), every bifurcating branch asked for could be
-started, and the stability flags of every assessed point are settled between the stability degree and the
-check degree. Everything else is an ``Incomplete`` entry: typed, named, explained. A limitation of the method
+stretch limits, stop_pressure, stop_volume, stop_amount, stop_voltage, zero voltage, the wire gap, a dielectric
+membrane's compression (the end of the membrane model: tension-field theory is not modelled), a pear branch
+rejoining the primary branch), every special point is LOCATED (and every axisymmetric branch point classified),
+every bifurcating branch asked for could be started, and the stability flags of every assessed point are settled
+between the stability degree and the check degree. Everything else is an ``Incomplete`` entry: typed, named,
+explained. A limitation of the method
 that is not a failure of the computation (branch points not searched on a scene without equator symmetry) is
 an entry too, but does not make the result incomplete (``Gap.fails``). The CLI turns failing entries into exit
 status 1 (unless ``--allow-partial``); the run file stores every entry (``io.run_file``: root attributes
@@ -16,7 +18,8 @@ from dataclasses import dataclass
 from .results import Classification, Kind, Status, StopCode
 
 REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCode.STOP_PRESSURE,
-                             StopCode.STOP_VOLUME, StopCode.STOP_AMOUNT, StopCode.WIRE_GAP,
+                             StopCode.STOP_VOLUME, StopCode.STOP_AMOUNT, StopCode.STOP_VOLTAGE, StopCode.ZERO_VOLTAGE,
+                             StopCode.COMPRESSED, StopCode.WIRE_GAP,
                              StopCode.SOUTH_STOP_STRETCH, StopCode.REJOINED})
 
 

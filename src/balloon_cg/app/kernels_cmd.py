@@ -1,6 +1,7 @@
 """``balloon-cg kernels SCENE``: which kernel class a scene uses, generated on demand if needed, with timings.
 
-Stages reported (seconds): for a class not committed in generated/ (a user formula) the codegen stages
+Stages reported (seconds): for a class not committed in generated/ (a user formula, any class with the
+dielectric term) the codegen stages
 'derive' (equations, pole series, second variation), 'lower' (CSE), 'print', then 'write' (atomic, into the
 cache) and 'import'; for every class 'jit' per kernel: its first call, compiled by numba or loaded from
 numba's on-disk cache ('cache' column: hits).
@@ -10,7 +11,8 @@ import math
 import time
 
 _SAMPLE = {"theta": 1.0, "cos_theta": math.cos(1.0), "sin_theta": math.sin(1.0), "lam2": 1.2, "v": 0.01,
-           "eta": 0.5, "w": 0.3, "lam0": 1.2, "lam1": 1.3, "P": 0.5, "M": 0.001, "chi": 1.0, "m": 1.0}
+           "eta": 0.5, "w": 0.3, "lam0": 1.2, "lam1": 1.3, "P": 0.5, "M": 0.001, "chi": 1.0, "m": 1.0,
+           "voltage": 0.3}
 _NODES = 4
 
 
@@ -39,17 +41,19 @@ def kernels(args) -> int:
 def kernel_report(scene) -> dict:
     """{'class', 'source' (committed | cached | generated), 'key', 'stages' {stage: s}, 'jit' {kernel: (s, hits)}}."""
     from ..model import kernel_cache
-    from ..model.kernels import KernelSet
+    from ..model.kernels import KernelSet, dielectric_source
     from ..scene.energies import StrainEnergy
 
-    material, has_field = scene.material, bool(scene.field.coils)
+    material, has_field, electric = scene.material, bool(scene.field.coils), scene.electric is not None
     stages, key, source = {}, None, "committed"
-    if isinstance(material, StrainEnergy) and material.family is None:
-        key = kernel_cache.class_key(material.formula, has_field)
-        source = "cached" if kernel_cache.module_path(material.formula, has_field).is_file() else "generated"
-        kernel_cache.load(material.formula, has_field, stages)
+    cached = dielectric_source(material, has_field) if electric else \
+        material.formula if isinstance(material, StrainEnergy) and material.family is None else None
+    if cached is not None:
+        key = kernel_cache.class_key(cached, has_field, electric)
+        source = "cached" if kernel_cache.module_path(cached, has_field, electric).is_file() else "generated"
+        kernel_cache.load(cached, has_field, stages, electric)
     start = time.perf_counter()
-    kernel_set = KernelSet(material, has_field)
+    kernel_set = KernelSet(material, has_field, electric=electric)
     stages["bind"] = time.perf_counter() - start
     return {"class": kernel_set.name, "source": source, "key": key, "stages": stages, "jit": _first_calls(kernel_set)}
 

@@ -132,6 +132,7 @@ def summarise_branch(b: dict) -> dict:
         "kernel_class": attrs["kernel_class"],
         "M": float(attrs["M"]),
         "chi": float(attrs["chi"]),
+        **({"voltage": _range(b["voltage"]), "parameter": attrs["parameter"]} if "voltage" in b else {}),
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
@@ -183,6 +184,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
           if b["basis_map"]["centres"] else []),
         f"  points               {b['points']}",
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
+        *(["  voltage              {:.10g} .. {:.10g}".format(*b["voltage"]) + f"  (continued in {b['parameter']})"]
+          if "voltage" in b else []),
         "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
         "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
         f"  stop reason          {b['stop_reason']}",
@@ -204,6 +207,7 @@ def _format_branch(name: str, b: dict) -> list[str]:
         note = f"  {s['note']}" if s["note"] else ""
         lines.append(
             f"    {label:<{width}}  {place:<{place_width}}  P = {s['pressure']:.10g}  "
+            + (f"voltage = {s['voltage']:.10g}  " if "voltage" in s else "") +
             f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
         )
     return lines

@@ -1,8 +1,8 @@
 """The discrete equilibrium problem: gradient and Hessian of the Ritz energy E(u; P, M).
 
-R(u; P, M) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (λ2, v, η, w) at node q, MODEL.md §2),
-J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M for
-continuation. A point is an equilibrium when R = 0 at fixed (P, M).
+R(u; P, M, Φ̄) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (λ2, v, η, w) at node q, MODEL.md §2),
+J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M, ∂R/∂Φ̄ for
+continuation. A point is an equilibrium when R = 0 at fixed (P, M, Φ̄).
 """
 import math
 from dataclasses import dataclass
@@ -22,12 +22,14 @@ class NonFiniteState(ArithmeticError):
 
 @dataclass
 class Parameters:
-    """Branch parameters P, M, χ and the material moduli μ and exponents α (None: the scene material's); the
-    field names are the generated kernels' argument names (model/kernels.py binds them by name)."""
+    """Branch parameters P, M, χ, the voltage Φ̄ (a dielectric class) and the material moduli μ and exponents α
+    (None: the scene material's); the field names are the generated kernels' argument names (model/kernels.py
+    binds them by name)."""
 
     P: float
     M: float = 0.0
     chi: float = 1.0
+    voltage: float = 0.0
     mu: tuple | None = None
     alpha: tuple | None = None
 
@@ -44,7 +46,8 @@ class Equilibrium:
         self.scene = scene
         self.disc = discretisation
         self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
-        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0, kernel_class=kernel_class)
+        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0, kernel_class=kernel_class,
+                                 electric=scene.electric is not None)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
 
@@ -110,16 +113,17 @@ class Equilibrium:
         return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
     def parameter_derivative(self, u, params: Parameters, name: str, out: np.ndarray | None = None) -> np.ndarray:
-        """∂R/∂P or ∂R/∂M (the latter is zero without coils), into ``out`` if given."""
-        if name == "P":
-            return self.disc.gradient(self._pointwise("pressure_gradient", u, params), out)
-        if name == "M":
-            if not self.coils.shape[0]:
-                out = np.empty(self.disc.size) if out is None else out
-                out[:] = 0.0
-                return out
-            return self.disc.gradient(self._pointwise("field_gradient", u, params), out)
-        raise ValueError(f"unknown continuation parameter {name!r}: expected 'P' or 'M'")
+        """∂R/∂P, ∂R/∂M or ∂R/∂voltage (zero without coils or without the dielectric term), into ``out`` if
+        given."""
+        kernel, present = {"P": ("pressure_gradient", True), "M": ("field_gradient", self.coils.shape[0] > 0),
+                           "voltage": ("voltage_gradient", self.kernels.electric)}.get(name, (None, False))
+        if kernel is None:
+            raise ValueError(f"unknown continuation parameter {name!r}: expected 'P', 'M' or 'voltage'")
+        if not present:
+            out = np.empty(self.disc.size) if out is None else out
+            out[:] = 0.0
+            return out
+        return self.disc.gradient(self._pointwise(kernel, u, params), out)
 
     def bordered_jacobian(self, u, params: Parameters, name: str) -> np.ndarray:
         """[∂R/∂u  ∂R/∂name] (n × (n + 1)) for the map X = (u, name) of a continuation or a constrained solve,

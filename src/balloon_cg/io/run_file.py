@@ -10,18 +10,20 @@ Layout::
     /branches/<name>/      attrs: order, stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
                                   'up'/'down'/'forward' and a StopCode/TraceStop value), wall_time, degree,
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
-                                  kernel_class, kernel_signature, M, chi, [parent_branch, parent_branch_point,
-                                  rejoins_branch_point]
+                                  kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
+                                  the kernels), voltage (Φ̄, fixed unless it is the parameter), parameter
+                                  ("P" or "voltage": what the last unknown is), [parent_branch,
+                                  parent_branch_point, rejoins_branch_point]
         point, unknown                                     dimension scales (0, 1, …)
         pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
-        newton_iterations, solved_degree                   (point,)
-        unknowns                                           (point, unknown): Legendre unknowns u, then P
+        newton_iterations, solved_degree, [voltage]        (point,) (voltage: where electric)
+        unknowns                                           (point, unknown): Legendre unknowns u, then P (or Φ̄)
         theta                                              (theta,): linspace(0, π), a dimension scale
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
-        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, status (located, approximate), reason,
-                       stop_code, note, index, m, pressure, uncertainty, E2, E3, E4, lam2_north, lam2_south,
-                       eta_north, eta_south                                                  (special,)
+        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, status (located, approximate),
+                       reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
+                       lam2_north, lam2_south, eta_north, eta_south                          (special,)
         special_points/unknowns                            (special, unknown)
         stability/stable_*                                 (point,) flags
         stability/lowest_<block>                           (point, eigenvalue): lowest eigenvalues
@@ -158,6 +160,9 @@ def _write_branch(group, branch, theta):
         "kernel_signature": branch.kernel_signature,
         "M": branch.params.M,
         "chi": branch.params.chi,
+        "electric": branch.scene.electric is not None,
+        "voltage": branch.params.voltage,
+        "parameter": branch.parameter,
     })
     text = h5py.string_dtype()
     group.attrs.create("leg_labels", np.array([leg.label for leg in branch.legs], dtype=object), dtype=text)
@@ -169,10 +174,11 @@ def _write_branch(group, branch, theta):
         group.attrs["rejoins_branch_point"] = branch.rejoins
     volume = equilibrium_of(branch).volume
     volumes = 2 * np.pi * np.array([volume(u) for u in branch.X[:, :-1]])
+    parameters = parameter_columns(branch, branch.X)
     columns = {
-        "pressure": branch.pressure,
+        **parameters,
         "volume": volumes,
-        "amount": branch.pressure * volumes,
+        "amount": parameters["pressure"] * volumes,
         **branch.pole_values(),
         **equator_values(branch.disc, branch.X),
         "converged": finite(branch),
@@ -191,7 +197,8 @@ def _write_branch(group, branch, theta):
     for name, data in profiles(branch.disc, branch.X, theta).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
     attach_dimensions(shapes, {2: (point, theta_scale)})
-    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc, unknown)
+    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc, unknown,
+                  lambda X: parameter_columns(branch, X))
     if branch.stability:
         _write_stability(group.create_group("stability"), branch, point)
 
@@ -230,10 +237,19 @@ def _write_snaps(group, snaps):
     attach_dimensions(group, {1: (scale(group, "snap", len(snaps)),)})
 
 
-def write_special(group, special: list, width: int, disc, unknown=None) -> None:
+def parameter_columns(branch, X) -> dict:
+    """{'pressure': P, and 'voltage': Φ̄ where the dielectric term is present} of the rows X = (u, p) of a branch
+    (p is its continuation parameter; the other one is fixed)."""
+    last = X[:, -1]
+    fixed = lambda name: last if branch.parameter == name else np.full(len(X), getattr(branch.params, name))  # noqa: E731
+    return {"pressure": fixed("P"), **({"voltage": fixed("voltage")} if branch.scene.electric is not None else {})}
+
+
+def write_special(group, special: list, width: int, disc, unknown=None, parameters=None) -> None:
     """Special points (results.SpecialPoint) as columns; ``width`` = n + 1, the length of their X rows, and
     ``disc`` the discretisation of their u (for the pole values); ``unknown``: the dimension scale of the X
-    rows (default: a new one in ``group``)."""
+    rows (default: a new one in ``group``); ``parameters(X)``: the parameter columns of the rows (default
+    pressure = the last unknown)."""
     X = np.array([s.X for s in special]).reshape(len(special), width)
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
@@ -245,7 +261,8 @@ def write_special(group, special: list, width: int, disc, unknown=None) -> None:
     write_strings(group, "note", [s.stop.message if s.stop else s.note for s in special])
     group.create_dataset("index", data=np.array([s.index for s in special], dtype=np.int64))
     group.create_dataset("m", data=np.array([s.m for s in special], dtype=np.int64))
-    group.create_dataset("pressure", data=X[:, -1])
+    for name, values in (parameters or (lambda X: {"pressure": X[:, -1]}))(X).items():
+        group.create_dataset(name, data=values)
     for n, name in enumerate(("E2", "E3", "E4")):
         group.create_dataset(name, data=np.array([s.E[n] for s in special], dtype=float))
     rows = disc.pole_rows()
@@ -388,5 +405,5 @@ def _read_snaps(group) -> list:
 def read_special(group) -> list:
     """Special points written by write_special, as a list of dicts (text columns as str)."""
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT}
-    columns |= {name: group[name][()] for name in ("index", "m") + SPECIAL_NUMBERS}
+    columns |= {name: group[name][()] for name in ("index", "m") + SPECIAL_NUMBERS + ("voltage",) if name in group}
     return [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]

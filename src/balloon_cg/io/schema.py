@@ -14,7 +14,8 @@ NONDIMENSIONAL = "1"
 VARIABLES = {
     "point": (NONDIMENSIONAL, "point index", "index of the point along the branch, in continuation order"),
     "theta": ("rad", "material polar angle θ", "material coordinate of the undeformed sphere, 0 at the north pole"),
-    "unknown": (NONDIMENSIONAL, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last"),
+    "unknown": (NONDIMENSIONAL, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last "
+                                                 "(Φ̄ on a voltage continuation)"),
     "special": (NONDIMENSIONAL, "special point index", "index of the special point on its branch"),
     "mode_unknown": (NONDIMENSIONAL, "mode unknown index", "index into the odd perturbation block of the mode"),
     "snap": (NONDIMENSIONAL, "snap-through index", "one row per snap-through under the loading control"),
@@ -24,6 +25,7 @@ VARIABLES = {
     "to_index": (NONDIMENSIONAL, "to point", "its point near the same P (-1: none)"),
     "eigenvalue": (NONDIMENSIONAL, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
     "pressure": (NONDIMENSIONAL, "pressure P", "P = P̄ R0 / (T0 μ/2)"),
+    "voltage": (NONDIMENSIONAL, "voltage Φ̄", "Φ̄ = (Φ/H) √(ε/μ): voltage across the thickness (docs/scenes.md)"),
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
     "amount": (NONDIMENSIONAL, "gas amount n", "n = P V, the isothermal ideal gas P V = n in these units: "
                                                "n = N R T / (T0 μ R0² / 2) for N moles at temperature T"),

@@ -1,14 +1,15 @@
-"""On-demand kernels for a strain-energy class that is not committed in generated/ (a user formula).
+"""On-demand kernels for a scene class that is not committed in generated/: a user formula, or any material with
+the dielectric term (a committed class's Ogden exponents or a strain energy, with or without a field).
 
 The module is generated at first use by the same generator as generated/ (codegen/, shipped as
 balloon_cg.codegen; it needs SymPy, the ``codegen`` extra) into a content-keyed cache folder, and imported from
 there by every later run. The key is the SHA-256 of
 
-    (canonical formula, parameter names, field or not, codegen.GENERATOR_VERSION, the generator's source digest,
-     SymPy version),
+    (canonical formula and parameter names, or 'ogden' and the exponents (None: runtime exponents), field or not,
+     dielectric term or not, codegen.GENERATOR_VERSION, the generator's source digest, SymPy version),
 
-so an edited formula, a new generator or another SymPy gives a new module; parameter values are kernel
-arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
+so an edited formula, a new generator or another SymPy gives a new module; parameter values (material
+parameters, the voltage) are kernel arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
 place with ``os.replace`` (atomic on one file system): concurrent sweep workers generating the same class all
 succeed, each finds either no module or a complete one, and the deterministic text makes the winner irrelevant.
 
@@ -22,6 +23,7 @@ import os
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 from .. import codegen
@@ -42,8 +44,8 @@ def _sympy_version() -> str:
     try:
         return importlib.metadata.version("sympy")
     except importlib.metadata.PackageNotFoundError:
-        raise SceneError("material.energy: a user formula needs its kernels generated once, which needs SymPy: "
-                         "pip install 'balloon-cg[codegen]'") from None
+        raise SceneError("kernels: a user formula or the [electric] term needs its kernels generated once, which "
+                         "needs SymPy: pip install 'balloon-cg[codegen]'") from None
 
 
 @functools.cache
@@ -54,38 +56,60 @@ def generator_digest() -> str:
     return hashlib.sha256(b"".join(f.name.encode() + f.read_bytes() for f in files)).hexdigest()
 
 
-def class_key(formula, field: bool) -> str:
-    """The cache key of the class of ``formula`` (scene/formula.Formula) with or without a field."""
-    text = repr((formula.text, tuple(formula.parameters), bool(field), codegen.GENERATOR_VERSION, generator_digest(),
+@dataclass(frozen=True)
+class Exponents:
+    """An Ogden material's class as plain data: the exponents of a committed class as the strings it was generated
+    from (its INPUTS 'alphas'), or None for the general class (runtime exponents)."""
+
+    alphas: tuple | None
+
+
+def _identity(material) -> tuple:
+    """What the class is generated from: a scene/formula.Formula or Exponents."""
+    if isinstance(material, Exponents):
+        return ("ogden", material.alphas)
+    return (material.text, tuple(material.parameters))
+
+
+def class_key(material, field: bool, electric: bool = False) -> str:
+    """The cache key of the class of ``material`` (scene/formula.Formula or Exponents) with or without a field
+    and the dielectric term."""
+    text = repr((*_identity(material), bool(field), bool(electric), codegen.GENERATOR_VERSION, generator_digest(),
                  _sympy_version()))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def module_name(formula, field: bool) -> str:
-    return f"energy_{class_key(formula, field)[:32]}"
+def module_name(material, field: bool, electric: bool = False) -> str:
+    kind = "ogden" if isinstance(material, Exponents) else "energy"
+    return f"{kind}{'_dielectric' if electric else ''}_{class_key(material, field, electric)[:32]}"
 
 
-def module_path(formula, field: bool) -> Path:
-    return cache_dir() / f"{module_name(formula, field)}.py"
+def module_path(material, field: bool, electric: bool = False) -> Path:
+    return cache_dir() / f"{module_name(material, field, electric)}.py"
 
 
-def generate(formula, field: bool, timings: dict | None = None) -> str:
+def generate(material, field: bool, timings: dict | None = None, electric: bool = False) -> str:
     """The module text of the class (stage timings in seconds into ``timings``: see codegen/build.py)."""
     _sympy_version()
     from ..codegen import build, classes
+    from ..codegen.functional import SceneClass
 
-    cls = classes.energy_class(module_name(formula, field), formula.text, formula.parameters, field)
+    name = module_name(material, field, electric)
+    if isinstance(material, Exponents):
+        cls = SceneClass(name, material.alphas, field, electric=electric)
+    else:
+        cls = classes.energy_class(name, material.text, material.parameters, field, electric)
     return build.class_module(cls, timings)
 
 
-def load(formula, field: bool, timings: dict | None = None):
+def load(material, field: bool, timings: dict | None = None, electric: bool = False):
     """The kernel module of the class, generated and written atomically into the cache first if missing; imported
     once per process (as ``sys.modules[module_name]``)."""
-    path = module_path(formula, field)
+    path = module_path(material, field, electric)
     if path.stem in sys.modules:
         return sys.modules[path.stem]
     if not path.is_file():
-        text = generate(formula, field, timings)
+        text = generate(material, field, timings, electric)
         start = time.perf_counter()
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",

@@ -9,8 +9,8 @@ Calling convention: every generated module lists, in ``KERNELS``, each kernel's 
 rows) and its output labels (codegen/kernels.py: convention). ``KernelSet.arguments`` is the one place that
 turns named values into an argument tuple, so no caller knows the argument order:
 
-- 'node' and 'node_rows' arguments (cos_theta, lam2, …; field) and 'param' scalars (P, M, chi, m) are the
-  values of the same name;
+- 'node' and 'node_rows' arguments (cos_theta, lam2, …; field) and 'param' scalars (P, M, chi, voltage, m) are
+  the values of the same name;
 - μ and α are the material's (padded for the general class), or the overrides ``mu``/``alpha`` when given;
 - ``pole_field`` rows 'NAME_N' / 'NAME_S' are the FIELD_ROWS entry NAME of ``field_north`` / ``field_south``.
 """
@@ -53,18 +53,20 @@ class KernelSet:
     ``has_field``.
     """
 
-    def __init__(self, material, has_field: bool, kernel_class: str | None = None):
-        self.has_field = has_field
+    def __init__(self, material, has_field: bool, kernel_class: str | None = None, electric: bool = False):
+        """``electric``: the class with the dielectric term (generated on demand, model/kernel_cache.py)."""
+        self.has_field, self.electric = has_field, electric
         self.scene_material = material
         self._binders, self._node_kernels = {}, {}
         if isinstance(material, StrainEnergy):
             if kernel_class is not None:
                 raise SceneError(f"kernel class {kernel_class!r}: only Ogden materials choose a kernel class")
-            self.module = energy_module(material, has_field)
+            self.module = energy_module(material, has_field, electric)
             self.name, self.general, self.field_class = dict(self.module.INPUTS)["class"], False, has_field
             self._scene_arrays = {"material": _frozen(material.values)}
             return
-        self.name = class_name(material.alpha, has_field) if kernel_class is None else kernel_class
+        # the committed class of these exponents (its dielectric twin, if asked for, is generated from it)
+        self.exponent_class = class_name(material.alpha, has_field) if kernel_class is None else kernel_class
         if kernel_class is not None:
             if kernel_class not in generated.CLASSES:
                 known = ", ".join(generated.CLASSES)
@@ -73,10 +75,13 @@ class KernelSet:
             if (has_field and not field) or (alphas is not None and class_name(material.alpha, field) != kernel_class):
                 raise SceneError(f"kernel class {kernel_class!r} does not fit material exponents "
                                  f"{tuple(material.alpha)} (field {has_field})")
-        self.module = importlib.import_module(f"{generated.__name__}.{self.name}")
-        self.general = generated.CLASSES[self.name][0] is None
+        self.module = importlib.import_module(f"{generated.__name__}.{self.exponent_class}")
+        self.general = generated.CLASSES[self.exponent_class][0] is None
         # a field class evaluated at M = 0 is the "field on, M = 0" general setting of the benchmarks
-        self.field_class = generated.CLASSES[self.name][1]
+        self.field_class = generated.CLASSES[self.exponent_class][1]
+        if electric:
+            self.module = kernel_cache.load(exponents_of(self.module), self.field_class, electric=True)
+        self.name = dict(self.module.INPUTS)["class"]
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
 
     @cached_property
@@ -100,7 +105,7 @@ class KernelSet:
         if len(mu) != len(alpha):
             raise ValueError(f"{len(mu)} moduli for {len(alpha)} exponents")
         if not self.general:
-            if class_name(alpha, self.field_class) != self.name:
+            if class_name(alpha, self.field_class) != self.exponent_class:
                 raise ValueError(f"exponents {alpha} need the general kernel class, not {self.name}")
             return {"mu": _frozen(mu)}
         pad = generated.GENERAL_TERMS - len(mu)
@@ -108,14 +113,14 @@ class KernelSet:
 
     def arguments(self, kernel: str, values: dict, params=None) -> tuple:
         """The argument tuple of ``kernel`` from named values (module docstring) and, if given, the branch
-        parameters ``params`` (galerkin.equilibrium.Parameters: P, M, χ, μ, α); missing names raise KeyError."""
+        parameters ``params`` (galerkin.equilibrium.Parameters: P, M, χ, Φ̄, μ, α); missing names raise KeyError."""
         pick, scalars, pole_rows = self._binders.get(kernel) or self._binder(kernel)
         if params is None:
             mu, alpha = values.get("mu"), values.get("alpha")
             source = {**values}
         else:
             mu, alpha = params.mu, params.alpha
-            source = {"P": params.P, "M": params.M, "chi": params.chi, **values}
+            source = {"P": params.P, "M": params.M, "chi": params.chi, "voltage": params.voltage, **values}
         source.update(self._scene_arrays if mu is None and alpha is None else self.material(mu, alpha))
         try:
             for name in scalars:
@@ -171,11 +176,25 @@ class KernelSet:
         return dict(zip(self.module.STATE, state))
 
 
-def energy_module(material: StrainEnergy, has_field: bool):
+def exponents_of(module) -> kernel_cache.Exponents:
+    """The exponents a committed Ogden class module was generated from (its INPUTS), as the cache describes them."""
+    alphas = dict(module.INPUTS)["alphas"]
+    return kernel_cache.Exponents(None if alphas == "runtime" else alphas)
+
+
+def dielectric_source(material, has_field: bool):
+    """What a material's dielectric class is generated from (model/kernel_cache.py): a strain energy's formula,
+    or the exponents of the committed Ogden class the material's exponents select."""
+    if isinstance(material, StrainEnergy):
+        return material.formula
+    return exponents_of(importlib.import_module(f"{generated.__name__}.{class_name(material.alpha, has_field)}"))
+
+
+def energy_module(material: StrainEnergy, has_field: bool, electric: bool = False):
     """The kernel module of a strain energy: a family's committed one (its formula must be the one generated),
-    or a user formula's from the on-demand cache (model/kernel_cache.py)."""
-    if material.family is None:
-        return kernel_cache.load(material.formula, has_field)
+    or a user formula's or any dielectric class's from the on-demand cache (model/kernel_cache.py)."""
+    if material.family is None or electric:
+        return kernel_cache.load(material.formula, has_field, electric=electric)
     name = f"{material.family}_field" if has_field else material.family
     formula, _ = generated.ENERGY_CLASSES[name]
     if formula != material.formula.text:

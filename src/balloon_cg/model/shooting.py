@@ -77,14 +77,16 @@ class Shooter:
     def __init__(self, scene, rtol: float = 1e-13, atol: float = 1e-13):
         f = scene.field
         self.coils = np.array([[c.radius, c.height, c.current] for c in f.coils], dtype=float).reshape(-1, 3)
-        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0)
+        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0,
+                                 electric=scene.electric is not None)
         self.M, self.chi = (f.M, f.chi) if self.coils.shape[0] else (0.0, f.chi)
+        self.voltage = 0.0 if scene.electric is None else scene.electric.voltage
         self.equator_symmetric = f.is_equator_symmetric
         self.rtol, self.atol = rtol, atol
 
     def params(self, P) -> dict:
         """The branch parameters as the kernels' named values (the material's μ, α)."""
-        return {"P": P, "M": self.M, "chi": self.chi}
+        return {"P": P, "M": self.M, "chi": self.chi, "voltage": self.voltage}
 
     def field(self, rho, z):
         """H² and its derivatives at (ρ, z) in the generated FIELD_ROWS (zeros without coils)."""

@@ -1,4 +1,5 @@
-"""Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6) and the tension-field test on them."""
+"""Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6) and the dielectric part (the taut test on
+them: analysis/primary.py)."""
 import numpy as np
 
 from .membrane import stretch_derivatives
@@ -21,7 +22,8 @@ def elastic_stresses(material, lam1, lam2):
     return sigma_theta, sigma_phi
 
 
-def smallest_stress(material, lam1, lam2) -> float:
-    """The smallest elastic principal stress over the given stretches: ≤ 0 where the membrane wrinkles."""
-    sigma_theta, sigma_phi = elastic_stresses(material, np.asarray(lam1), np.asarray(lam2))
-    return float(min(np.min(sigma_theta), np.min(sigma_phi)))
+def dielectric_stress(voltage: float, lam1, lam2):
+    """The dielectric part of both principal stresses, λ_i ∂(−Φ̄² λ1² λ2²)/∂λ_i = −2 Φ̄² λ1² λ2² (units of μ/2):
+    the Maxwell stress −ε E² of the true field E = (Φ/H) λ1 λ2 across the thickness."""
+    return -2.0 * voltage**2 * (lam1 * lam2) ** 2
+

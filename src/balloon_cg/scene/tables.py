@@ -4,6 +4,7 @@ Every table but ``[material]`` may be omitted (defaults apply). Invalid input ra
 one-line message names the file (or scene), the dotted key, the value and what is allowed.
 """
 
+import enum
 import math
 import re
 import tomllib
@@ -17,7 +18,8 @@ from .loading import Control, Loading, loading_from_table
 from .materials import Material, material_from_table
 
 __all__ = [
-    "Coil", "Field", "Continuation", "Solver", "Stability", "Output", "Loading", "Control", "Scene", "SceneError",
+    "Coil", "Field", "Electric", "ContinuationParameter", "Continuation", "Solver", "Stability", "Output", "Loading",
+    "Control", "Scene", "SceneError",
     "parse_scene", "load_scene",
 ]
 
@@ -60,6 +62,22 @@ class Field:
 
 
 @dataclass(frozen=True)
+class Electric:
+    """An ideal dielectric elastomer membrane under the nondimensional voltage Φ̄ = (Φ/H)√(ε/μ) across its
+    thickness: the energy gains −Φ̄² λ1² λ2² (units μ/2, MODEL.md §2; docs/scenes.md). ``voltage`` is held fixed
+    along a pressure continuation; a voltage continuation starts from the sphere's voltage instead."""
+
+    voltage: float = 0.0
+
+
+class ContinuationParameter(enum.StrEnum):
+    """The parameter a primary branch is continued in: P at fixed Φ̄, or Φ̄ at fixed P."""
+
+    PRESSURE = "pressure"
+    VOLTAGE = "voltage"
+
+
+@dataclass(frozen=True)
 class Continuation:
     """Branch following, parameterised by the pole stretch λ2(0).
 
@@ -68,6 +86,8 @@ class Continuation:
     ``max_points`` points, or when the membrane comes within ``wire_gap`` of a coil wire. Arclength steps
     start at ``step`` and stay in [step_min, step_max]. ``symmetry``: "equator" imposes η(π − θ) = −η(θ)
     (needs equator-symmetric coils), "none" never does, "auto" does when the field allows it.
+    ``parameter``: "pressure" (P varies), or "voltage" (Φ̄ varies at the fixed P = ``pressure``, needs
+    [electric]; it stops when Φ̄ passes ``stop_voltage``, None: no limit).
     """
 
     start_stretch: float = 1.01
@@ -80,6 +100,9 @@ class Continuation:
     max_points: int = 2000
     symmetry: str = "auto"
     wire_gap: float = 0.02
+    parameter: ContinuationParameter = ContinuationParameter.PRESSURE
+    pressure: float | None = None
+    stop_voltage: float | None = None
 
 
 @dataclass(frozen=True)
@@ -113,7 +136,7 @@ class Output:
     theta_points: int = 181
 
 
-_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading")
+_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 
@@ -129,6 +152,7 @@ class Scene:
     solver: Solver
     stability: Stability
     output: Output
+    electric: Electric | None  # None: no dielectric term in the kernels
     text: str = dataclass_field(repr=False)
     loading: Loading = Loading()
 
@@ -145,9 +169,10 @@ class Scene:
             "material": m.to_table() if isinstance(m, StrainEnergy) else
             {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
-            **{t: asdict(getattr(self, t)) for t in _TABLES[2:-1]},
+            **{t: asdict(getattr(self, t)) for t in _TABLES[2:6]},
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
                                                                   "control": self.loading.control.value}}),
+            **({} if self.electric is None else {"electric": asdict(self.electric)}),
         }
 
     def to_toml(self) -> str:
@@ -196,7 +221,7 @@ def renamed(name: str, overrides: dict[str, object]) -> str:
     filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
     (``field.coils``, ``material.mu``) leave the name alone."""
     for key, value in overrides.items():
-        physical = key.split(".")[0] in ("field", "material", "loading")
+        physical = key.split(".")[0] in ("field", "material", "loading", "electric")
         if not physical or value is None or isinstance(value, (list, tuple, dict)):
             continue
         if isinstance(value, str):  # a preset or a material name
@@ -276,16 +301,22 @@ def _build(data: dict, name: str, text: str) -> Scene:
         raise SceneError('material: the [material] table is missing (give preset = "NAME", or mu and alpha)')
     material = material_from_table(data["material"])
     field = _field(data.get("field", {}))
+    electric = None if "electric" not in data else _electric(data["electric"])
+    loading = loading_from_table(data.get("loading", {}))
+    if loading.control != Control.PRESSURE and data.get("continuation", {}).get("parameter") == "voltage":
+        raise SceneError(f'loading.control = "{loading.control.value}": a voltage continuation '
+                         '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     return Scene(
         name=name,
         material=material,
         field=field,
-        continuation=_continuation(data.get("continuation", {}), field),
+        continuation=_continuation(data.get("continuation", {}), field, electric),
         solver=_solver(data.get("solver", {})),
         stability=_stability(data.get("stability", {})),
         output=_output(data.get("output", {})),
+        electric=electric,
         text=text,
-        loading=loading_from_table(data.get("loading", {})),
+        loading=loading,
     )
 
 
@@ -354,7 +385,35 @@ def _coil(key: str, data) -> Coil:
     return Coil(a, h, s)
 
 
-def _continuation(data, field: Field) -> Continuation:
+def _electric(data) -> Electric:
+    get = _getter(table("electric", data, _keys(Electric)), "electric", Electric)
+    return Electric(get("voltage", lambda x: x >= 0, ">= 0"))
+
+
+def _parameter(data, electric: Electric | None):
+    """(parameter, fixed pressure, stop_voltage) of [continuation], checked against [electric]."""
+    raw = data.get("parameter")
+    raw = ContinuationParameter.PRESSURE.value if raw is None else raw
+    allowed = ", ".join(f'"{p.value}"' for p in ContinuationParameter)
+    if raw not in tuple(ContinuationParameter):
+        raise SceneError(f"continuation.parameter = {show(raw)}: must be one of {allowed}")
+    parameter = ContinuationParameter(raw)
+    get = _getter(data, "continuation", Continuation)
+    if parameter == ContinuationParameter.PRESSURE:
+        for key in ("pressure", "stop_voltage"):
+            if data.get(key) is not None:
+                raise SceneError(f'continuation.{key} = {show(data[key])}: only for continuation.parameter = "voltage"')
+        return parameter, None, None
+    if electric is None:
+        raise SceneError('continuation.parameter = "voltage": needs an [electric] table (the dielectric term)')
+    if electric.voltage != 0:
+        raise SceneError(f"electric.voltage = {show(electric.voltage)}: a voltage continuation starts at the "
+                         "sphere's voltage at continuation.start_stretch; leave electric.voltage out")
+    pressure = get("pressure", lambda x: x >= 0, ">= 0")
+    return parameter, 0.0 if pressure is None else pressure, get("stop_voltage", lambda x: x > 0, "> 0")
+
+
+def _continuation(data, field: Field, electric: Electric | None = None) -> Continuation:
     data = table("continuation", data, _keys(Continuation))
     get = _getter(data, "continuation", Continuation)
     start = get("start_stretch", lambda x: x > 1, "> 1")
@@ -379,7 +438,9 @@ def _continuation(data, field: Field) -> Continuation:
         raise SceneError(
             'continuation.symmetry = "equator": the coils are not mirror-symmetric about z = 0 (use "auto" or "none")'
         )
-    return Continuation(start, stop, low, pressure, step, step_min, step_max, points, symmetry, gap)
+    parameter, fixed_pressure, stop_voltage = _parameter(data, electric)
+    return Continuation(start, stop, low, pressure, step, step_min, step_max, points, symmetry, gap, parameter,
+                        fixed_pressure, stop_voltage)
 
 
 def _solver(data) -> Solver:
