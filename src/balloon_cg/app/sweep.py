@@ -306,10 +306,20 @@ def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str 
 
 
 def _terminate(pool) -> None:
-    """Stop a process pool now: its workers are terminated (their members are recomputed on resume)."""
-    for process in list(pool._processes.values()):  # no public API before Python 3.14's terminate_workers()
+    """Stop a process pool now: its workers are terminated (their members are recomputed on resume).
+
+    The order of Python 3.14's ``terminate_workers`` (no public API before): shut the pool without waiting (no
+    queued member starts), terminate, then wait for each worker itself; waiting on the pool's manager thread
+    after killing its workers can hang when a worker died holding the call queue's lock."""
+    processes = list((pool._processes or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
         process.terminate()
-    pool.shutdown(wait=True, cancel_futures=True)
+    for process in processes:
+        process.join(timeout=5)
+        if process.exitcode is None:
+            process.kill()
+            process.join()
 
 
 def _compute_dask(jobs, scheduler: str):
