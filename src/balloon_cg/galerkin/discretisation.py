@@ -234,7 +234,6 @@ def _tables(disc: Discretisation) -> dict:
         x = disc.mapping.x(nodes)
         jacobian = disc.mapping.ds_dx(x)
         weights, dp = s_weights / jacobian, dp * jacobian[:, None]
-    s = np.sqrt(1.0 - x * x)
     k = np.arange(disc.degree + 1)
     a_keep = k[k % 2 == 0] if disc.symmetric else k
     b_keep = k[k % 2 == 1] if disc.symmetric else (k[1:] if disc.pin_translation else k)
@@ -244,7 +243,16 @@ def _tables(disc: Discretisation) -> dict:
     eta_mean = 0.5 * weights @ p[:, b_keep] if held_mapped else np.zeros(b_keep.size)
     na = a_keep.size
     size = na + b_keep.size
-    # state at the nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
+    fitting = {"_node_table": p, "x": x}  # every node: least-squares fits (projection, transfer) need them all
+    if disc.symmetric:
+        # equator-symmetric subspace (λ2 even, η odd in x; the field even in z): every integrand of E, R, J and
+        # ∂R/∂(P, M) is even in x, and the nodes are mirror-symmetric (s_{n−1−q} = −s_q), so the Gauss sum is
+        # Σ_{x_q > 0} 2 W_q f_q (+ W_q f_q at x_q = 0): half the nodes for the field, the kernels and the assembly
+        keep = nodes >= 0.0
+        weights = np.where(nodes[keep] > 0.0, 2.0, 1.0) * weights[keep]
+        x, p, dp = x[keep], p[keep], dp[keep]
+    s = np.sqrt(1.0 - x * x)
+    # state at the (quadrature) nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
     zeros_a = np.zeros((x.size, na))
     zeros_b = np.zeros((x.size, b_keep.size))
     ops = np.stack([
@@ -254,7 +262,7 @@ def _tables(disc: Discretisation) -> dict:
         np.hstack([zeros_a, -s[:, None] * dp[:, b_keep]]),
     ])
     tables = {
-        "_node_table": p, "x": x, "weights": weights, "cos_theta": x, "sin_theta": s, "a_index": a_keep,
+        **fitting, "weights": weights, "cos_theta": x, "sin_theta": s, "a_index": a_keep,
         "b_index": b_keep, "eta_mean": eta_mean, "ops": ops,
         # the blocks of ops that are not identically zero: (∂λ2, ∂v)/∂a and (∂η, ∂w)/∂b, contiguous for BLAS
         "basis_a": np.ascontiguousarray(ops[0:2, :, :na]),
