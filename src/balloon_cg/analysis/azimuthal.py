@@ -132,7 +132,7 @@ class AzimuthalBasis:
         w = weights[:, None]
         gram = 0.5 * sum(ops[k].T @ (w * ops[k]) for k in (0, 2, 4))
         put(self, "gram", 0.5 * (gram + gram.T))
-        put(self, "factor", eigen.GramFactor(self.gram))
+        put(self, "factor", eigen.GramFactor(self.gram, orthogonal=True))  # orthonormal P̄: G = diag(½ | ¼, ¼)
         # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
         moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
         put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
@@ -141,7 +141,7 @@ class AzimuthalBasis:
         parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
         classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
         put(self, "classes", classes)
-        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)]) for c in classes))
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)], orthogonal=True) for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""

@@ -101,7 +101,7 @@ class SecondVariation:
         cache = self.__dict__.setdefault("_cholesky", {})
         key = idx.tobytes()
         if key not in cache:
-            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)])
+            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)], orthogonal=True)  # Legendre in x
         return cache[key]
 
     def blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> list:

@@ -26,30 +26,41 @@ SMALL_EIGEN = 40
 
 
 class GramFactor:
-    """G = L Lᵀ of a Gram matrix (or block) that serves many pencils: L (column order, for dsygst) and L⁻¹."""
+    """G = L Lᵀ of a Gram matrix (or block) that serves many pencils: L (column order, for dsygst) and L⁻¹.
 
-    def __init__(self, G):
-        lower = np.linalg.cholesky(G)
+    ``orthogonal``: the basis is orthogonal, G diagonal in exact arithmetic (its off-diagonal entries are
+    quadrature rounding): L = diag(√G_ii), and L⁻¹ H L⁻ᵀ is the scaling H_ij/√(G_ii G_jj) (``scale`` = 1/√G_ii;
+    None for a general G)."""
+
+    def __init__(self, G, orthogonal: bool = False):
+        if orthogonal:
+            root = np.sqrt(np.diag(G))
+            lower, self.scale = np.diag(root), 1.0 / root
+        else:
+            lower, self.scale = np.linalg.cholesky(G), None
         self.lower = np.asfortranarray(lower)
-        self.inverse = np.linalg.inv(lower)
+        self.inverse = np.diag(self.scale) if orthogonal else np.linalg.inv(lower)
 
     def directions(self, normals) -> np.ndarray:
         """The rows L⁻¹nᵢ of the constraint rows nᵢ (k × n)."""
-        return normals @ self.inverse.T
+        return normals * self.scale if self.scale is not None else normals @ self.inverse.T
 
 
 def restricted(H, factor: GramFactor, normals=NO_CONSTRAINT, index=None, rcond: float = RCOND) -> np.ndarray:
     """The standard symmetric matrix A of the pencil (H, G) on the block ``index`` of H (None: all of it) with
     Nᵀc = 0 (module docstring); ``factor`` is the GramFactor of the block of G, ``normals`` the rows nᵢ on the
     block (k × n). Its eigenvalues are the pencil's on the constrained block, its inertia the block's."""
-    block = H if index is None else _gather(np.ascontiguousarray(H, dtype=float), np.asarray(index, dtype=np.int64))
-    if block.shape[0] >= LARGE_BLOCK:
-        A, info = dsygst(block, factor.lower, itype=1, lower=1)  # the lower triangle of L⁻¹ H L⁻ᵀ
+    H = np.ascontiguousarray(H, dtype=float)
+    index = np.arange(H.shape[0]) if index is None else np.asarray(index, dtype=np.int64)
+    if factor.scale is not None:  # orthogonal basis: L⁻¹ H L⁻ᵀ is a scaling
+        A = _gather(H, index, factor.scale)
+    elif index.size >= LARGE_BLOCK:
+        A, info = dsygst(_gather(H, index, np.ones(index.size)), factor.lower, itype=1, lower=1)  # lower triangle
         if info != 0:
             raise np.linalg.LinAlgError(f"dsygst failed (info = {info})")
         A = np.ascontiguousarray(A)
     else:
-        A = factor.inverse @ block @ factor.inverse.T
+        A = factor.inverse @ _gather(H, index, np.ones(index.size)) @ factor.inverse.T
     normals = np.atleast_2d(normals)
     directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, A.shape[0]))
     return _reflect_out(A, directions, rcond)
@@ -79,13 +90,13 @@ def lowest(H, factor: GramFactor, count: int, normals=NO_CONSTRAINT, index=None,
 
 
 @njit(cache=True)
-def _gather(H, index):
-    """H[index][:, index]."""
+def _gather(H, index, scale):
+    """H[index][:, index] scaled: scale_i H_ij scale_j."""
     n = index.size
     block = np.empty((n, n))
     for i in range(n):
         for j in range(n):
-            block[i, j] = H[index[i], index[j]]
+            block[i, j] = scale[i] * H[index[i], index[j]] * scale[j]
     return block
 
 
