@@ -71,6 +71,44 @@ def _weighted_bases(pointwise, weights, A, B):
     return against_a, against_b
 
 
+def even_half(x: np.ndarray, weights: np.ndarray):
+    """(the nodes kept, their weights) of a mirror-symmetric node set (x_{n−1−q} = −x_q) for integrands even in x:
+    the nodes x ≥ 0, weights doubled where x > 0 (the node x = 0 of an odd rule counts once)."""
+    keep = np.flatnonzero(x >= 0.0)
+    return keep, np.where(x[keep] > 0.0, 2.0, 1.0) * weights[keep]
+
+
+def assemble_gradient(pointwise, weights, ops, gradient_ops, out=None) -> np.ndarray:
+    """Σ_q W_q Σ_k g_k(q) ops[k, q, :] for g (4, n_q); ``gradient_ops`` is ops as a contiguous (size, 4 n_q)."""
+    size = ops.shape[2]
+    if size < SMALL_SYSTEM:
+        out = np.empty(size) if out is None else out
+        _gradient_loops(np.ascontiguousarray(pointwise), weights, ops, out)
+        return out
+    return np.matmul(gradient_ops, (pointwise * weights).ravel(), out=out)
+
+
+def assemble_hessian(pointwise, weights, A, B, out=None) -> np.ndarray:
+    """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u from energy_hessian's output (10, n_q) and the bases
+    A = (∂λ2, ∂v)/∂a (2, n_q, n_a), B = (∂η, ∂w)/∂b (2, n_q, n_b) at the nodes.
+
+    (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three blocks
+    aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner; below SMALL_SYSTEM
+    unknowns the same sums are one jitted pass (``_hessian_loops``)."""
+    na, nb = A.shape[2], B.shape[2]
+    out = np.empty((na + nb, na + nb)) if out is None else out
+    if na + nb < SMALL_SYSTEM:
+        _hessian_loops(np.ascontiguousarray(pointwise), weights, A, B, out)
+        return out
+    weighted_a, weighted_b = _weighted_bases(np.ascontiguousarray(pointwise), weights, A, B)
+    stacked_a, stacked_b = A.reshape(-1, na), B.reshape(-1, nb)
+    np.matmul(stacked_a.T, weighted_a.reshape(-1, na), out=out[:na, :na])
+    np.matmul(stacked_a.T, weighted_b[:2].reshape(-1, nb), out=out[:na, na:])
+    out[na:, :na] = out[:na, na:].T
+    np.matmul(stacked_b.T, weighted_b[2:].reshape(-1, nb), out=out[na:, na:])
+    return out
+
+
 @njit(cache=True)
 def _hessian_loops(pointwise, weights, A, B, out):
     """Discretisation.hessian's blocks aa, ab (and ba = abᵀ), bb as sums of node-wise outer products of the
@@ -164,34 +202,13 @@ class Discretisation:
 
     def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q) (into ``out`` if given)."""
-        if self.size < SMALL_SYSTEM:
-            out = np.empty(self.size) if out is None else out
-            _gradient_loops(np.ascontiguousarray(pointwise), self.weights, self.ops, out)
-            return out
-        return np.matmul(self._gradient_ops, (pointwise * self.weights).ravel(), out=out)
+        return assemble_gradient(pointwise, self.weights, self.ops, self._gradient_ops, out)
 
     def hessian(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is energy_hessian's output (10, n_q), the
-        entries (k, l) of HESSIAN_PAIRS.
-
-        (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three
-        blocks aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner, written
-        into ``out`` (size × size, e.g. the leading columns of a bordered Jacobian) if given. Below SMALL_SYSTEM
-        unknowns the same sums are one jitted pass (``_hessian_loops``).
-        """
-        na = self.a_index.size
-        A, B = self.basis_a, self.basis_b
-        out = np.empty((self.size, self.size)) if out is None else out
-        if self.size < SMALL_SYSTEM:
-            _hessian_loops(np.ascontiguousarray(pointwise), self.weights, A, B, out)
-            return out
-        weighted_a, weighted_b = _weighted_bases(np.ascontiguousarray(pointwise), self.weights, A, B)
-        stacked_a, stacked_b = A.reshape(-1, na), B.reshape(-1, self.size - na)
-        np.matmul(stacked_a.T, weighted_a.reshape(-1, na), out=out[:na, :na])
-        np.matmul(stacked_a.T, weighted_b[:2].reshape(-1, self.size - na), out=out[:na, na:])
-        out[na:, :na] = out[:na, na:].T
-        np.matmul(stacked_b.T, weighted_b[2:].reshape(-1, self.size - na), out=out[na:, na:])
-        return out
+        entries (k, l) of HESSIAN_PAIRS (``assemble_hessian``), into ``out`` (size × size, e.g. the leading columns
+        of a bordered Jacobian) if given."""
+        return assemble_hessian(pointwise, self.weights, self.basis_a, self.basis_b, out)
 
     def pole_rows(self):
         """Rows r with λ2(north) = r_n·u, λ2(south) = r_s·u, η(north), η(south) (read-only, built once: every
@@ -293,10 +310,9 @@ def _tables(disc: Discretisation) -> dict:
     fitting = {"_node_table": p, "x": x}  # every node: least-squares fits (projection, transfer) need them all
     if disc.symmetric:
         # equator-symmetric subspace (λ2 even, η odd in x; the field even in z): every integrand of E, R, J and
-        # ∂R/∂(P, M) is even in x, and the nodes are mirror-symmetric (s_{n−1−q} = −s_q), so the Gauss sum is
-        # Σ_{x_q > 0} 2 W_q f_q (+ W_q f_q at x_q = 0): half the nodes for the field, the kernels and the assembly
-        keep = nodes >= 0.0
-        weights = np.where(nodes[keep] > 0.0, 2.0, 1.0) * weights[keep]
+        # ∂R/∂(P, M) is even in x and the Gauss nodes in s are mirror-symmetric, so the quadrature needs only the
+        # nodes s ≥ 0 (``even_half``): half the work for the field, the kernels and the assembly
+        keep, weights = even_half(nodes, weights)
         x, p, dp = x[keep], p[keep], dp[keep]
     s = np.sqrt(1.0 - x * x)
     # state at the (quadrature) nodes is linear in u: state_k = ops[k] @ u, for (λ2, v, η, w)
