@@ -5,8 +5,9 @@
 dθ sin θ = −dx the energy E = ∫_0^π Π dθ = ∫_{-1}^{1} π̂ dx (π̂ = Π/sin θ) is a smooth integral, computed by
 Gauss–Legendre quadrature at interior nodes. At a node
     v = λ2' sin θ = −(1 − x²) dλ2/dx,      w = η' = −sin θ dη/dx.
-Equator symmetry (λ2 even, η odd in x) keeps a_even and b_odd; without a field the translation η → η + c is
-removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
+Equator symmetry (λ2 even, η odd in x) keeps a_even and b_odd, and then every integrand is even in x: the
+quadrature runs over the nodes x ≥ 0 with doubled weights (``even_half``). Without a field the translation
+η → η + c is removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
 """
 import functools
 from dataclasses import dataclass
@@ -160,6 +161,9 @@ class Discretisation:
 
     With a ``mapping`` (coordinate_map.WireMap) the basis is P_k(s), s = h(x): Gauss nodes s_q in s, x_q = g(s_q),
     weights w_q/h'(x_q) (dx = ds/h'), and d/dx = h'(x) d/ds; everything else is unchanged.
+
+    ``x`` holds every Gauss node (least-squares fits: ``projection``, ``transfer``); ``cos_theta``, ``sin_theta``,
+    ``weights`` and ``ops`` are the quadrature's nodes, all of them or, on the symmetric layout, those with x ≥ 0.
     """
 
     degree: int
