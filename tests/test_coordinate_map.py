@@ -40,9 +40,12 @@ def test_map_is_monotone_onto_and_odd_for_mirrored_centres():
 
 
 def test_mapped_quadrature_and_transfer():
-    disc = Discretisation(64, True, False, mapping=MAP)
-    assert disc.weights.sum() == pytest.approx(2.0, abs=1e-13)  # ∫ dx over [−1, 1]
-    assert disc.weights @ np.exp(disc.x) == pytest.approx(np.e - 1 / np.e, rel=1e-12)
+    general = Discretisation(64, False, False, mapping=MAP)
+    assert general.weights.sum() == pytest.approx(2.0, abs=1e-13)  # ∫ dx over [−1, 1]
+    assert general.weights @ np.exp(general.cos_theta) == pytest.approx(np.e - 1 / np.e, rel=1e-12)
+    disc = Discretisation(64, True, False, mapping=MAP)  # integrands even in x, on the nodes x ≥ 0
+    assert disc.weights.sum() == pytest.approx(2.0, abs=1e-13)
+    assert disc.weights @ np.cosh(disc.cos_theta) == pytest.approx(2.0 * np.sinh(1.0), rel=1e-12)
     plain = Discretisation(20, True, False)
     a, b = np.zeros(21), np.zeros(21)
     a[0], a[2], b[1], b[3] = 1.5, 0.1, 1.5, 0.05

@@ -42,7 +42,7 @@ from scipy import linalg
 
 from numba import njit
 
-from ..galerkin.discretisation import symmetric_rows
+from ..galerkin.discretisation import even_half, symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..numerics import eigen
 
@@ -132,7 +132,7 @@ class AzimuthalBasis:
         w = weights[:, None]
         gram = 0.5 * sum(ops[k].T @ (w * ops[k]) for k in (0, 2, 4))
         put(self, "gram", 0.5 * (gram + gram.T))
-        put(self, "factor", eigen.GramFactor(self.gram))
+        put(self, "factor", eigen.GramFactor(self.gram, orthogonal=True))  # orthonormal P̄: G = diag(½ | ¼, ¼)
         # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
         moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
         put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
@@ -141,7 +141,11 @@ class AzimuthalBasis:
         parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
         classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
         put(self, "classes", classes)
-        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)]) for c in classes))
+        # within a class every integrand is even in x: its blocks need only the nodes x ≥ 0 (``even_half``)
+        keep, even_weights = even_half(x, weights)
+        put(self, "even", (keep, even_weights, np.ascontiguousarray(self.ops_ud[:, keep]),
+                           np.ascontiguousarray(self.ops_z[:, keep])))
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)], orthogonal=True) for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
@@ -201,13 +205,19 @@ def _node_state(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> tuple:
     return tuple((np.asarray(u, dtype=float) @ state_maps(equilibrium.disc, b).state).reshape(4, -1))
 
 
-def _hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis) -> np.ndarray:
+def _hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis,
+             even: bool = False) -> np.ndarray:
     """H from the node state (``_node_state``): the kernel's entries of h at every node (the AZIMUTHAL_PAIRS of
-    y = PERTURBATION, (21, n_q)), assembled by ``_assemble``."""
+    y = PERTURBATION, (21, n_q)), assembled by ``_assemble``. ``even``: an equator-symmetric state, on the nodes
+    x ≥ 0 (AzimuthalBasis.even): exact within each reflection class, the entries between classes not (never read)."""
+    row = _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS)
+    x, s, weights, ops_ud, ops_z = b.x, b.sin_theta, b.weights, b.ops_ud, b.ops_z
+    if even:
+        keep, weights, ops_ud, ops_z = b.even
+        x, s, state = x[keep], s[keep], tuple(value[keep] for value in state)
     lam2, dlam2, eta, deta = state
-    h = equilibrium.pointwise("azimuthal_hessian", (b.x, b.sin_theta), (lam2, dlam2 * b.sin_theta, eta, deta), params,
-                              m=float(m))
-    return _assemble(h, b.weights, _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS), b.ops_ud, b.ops_z)
+    h = equilibrium.pointwise("azimuthal_hessian", (x, s), (lam2, dlam2 * s, eta, deta), params, m=float(m))
+    return _assemble(h, weights, row, ops_ud, ops_z)
 
 
 @lru_cache(maxsize=4)
@@ -355,9 +365,9 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
     serve every reading."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    H = _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b)
-    moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
     split = equilibrium.disc.symmetric
+    H = _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b, even=split)
+    moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
     parts = tuple(zip(b.classes, b.class_factors, (0, 1))) if split else ((None, b.factor, None),)
     out = {}
     for held in readings:

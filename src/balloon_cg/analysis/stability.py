@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .azimuthal import merged_lowest, restricted_blocks
-from ..galerkin.discretisation import Discretisation
+from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
 from .problem import equilibrium_of
@@ -84,6 +84,29 @@ class SecondVariation:
         # the state at the nodes is linear in the equilibrium's unknowns: (λ2, v, η, w) = u @ state_map
         unit = self.eq.state_at(np.eye(self.eq.disc.size), self.theta)
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
+        # an equator-symmetric state's blocks (even, odd) take only integrands even in x: the nodes x ≥ 0 serve
+        self._even = self._even_tables() if self.eq.disc.symmetric else None
+
+    def _even_tables(self) -> tuple:
+        """(state map, geometry, weights, basis_a, basis_b, ops, gradient ops) on the nodes x ≥ 0 (``even_half``)."""
+        b = self.basis
+        keep, weights = even_half(b.x, b.weights)
+        n_q = b.x.size
+        state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])
+        ops = np.ascontiguousarray(b.ops[:, keep])
+        return (state_map, (b.cos_theta[keep], b.sin_theta[keep]), weights, np.ascontiguousarray(b.basis_a[:, keep]),
+                np.ascontiguousarray(b.basis_b[:, keep]), ops, np.ascontiguousarray(ops.reshape(-1, b.size).T))
+
+    def _even_matrices(self, u, params: Parameters):
+        """``matrices`` of an equator-symmetric state, exact on the blocks even and odd only (entries between them,
+        odd integrands, are not zero here and must not be read)."""
+        state_map, geometry, weights, basis_a, basis_b, ops, gradient_ops = self._even
+        state = tuple((np.asarray(u, dtype=float) @ state_map).reshape(4, -1))
+        hessian = assemble_hessian(self.eq.pointwise("energy_hessian", geometry, state, params), weights, basis_a,
+                                   basis_b)
+        volume = -assemble_gradient(self.eq.pointwise("pressure_gradient", geometry, state, params), weights, ops,
+                                    gradient_ops)
+        return hessian, volume
 
     def matrices(self, u, params: Parameters):
         """(H, g): the Hessian of E/2π and the gradient of Ṽ = V/2π on the perturbation basis."""
@@ -108,7 +131,7 @@ class SecondVariation:
         cache = self.__dict__.setdefault("_cholesky", {})
         key = idx.tobytes()
         if key not in cache:
-            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)])
+            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)], orthogonal=True)  # Legendre in x
         return cache[key]
 
     def blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> list:
@@ -118,7 +141,8 @@ class SecondVariation:
         FLAGS). Azimuthal blocks m = 1..m_max enter every flag (their modes keep the volume to first order, so
         every control mode sees the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
         translation is no zero mode to remove (no field)."""
-        H, g = self.matrices(u, params)
+        half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
+        H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
         H_gas = H + (params.P / self.eq.volume(u)) * np.outer(g, g)  # module docstring
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         i, t = self.index, self.translation

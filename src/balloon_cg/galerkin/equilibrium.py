@@ -4,7 +4,6 @@ R(u; P, M, Φ̄) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (�
 J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M, ∂R/∂Φ̄ for
 continuation. A point is an equilibrium when R = 0 at fixed (P, M, Φ̄).
 """
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -12,6 +11,7 @@ import numpy as np
 from .discretisation import Discretisation
 from ..model.field import field_squared_nodes
 from ..model.kernels import KernelSet
+from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
 
@@ -84,7 +84,7 @@ class Equilibrium:
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
         out = self.kernels.nodes(kernel, named, params)
-        if not math.isfinite(out.sum()):  # a NaN or ±inf anywhere makes the sum NaN or ±inf
+        if not finite(out):
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 

@@ -9,6 +9,8 @@ The reduction L⁻¹ H L⁻ᵀ is BLAS or LAPACK (``LARGE_BLOCK``), the gatherin
 (quick to compile);
 the eigenvalues come from LAPACK's dsyevr for the lowest ``count`` only (tridiagonalisation and bisection).
 """
+import math
+
 import numpy as np
 from numba import njit
 from scipy.linalg.lapack import dpotrf, dsyevr, dsygst
@@ -18,41 +20,58 @@ NO_CONSTRAINT = np.zeros((0, 1))
 # from this size on L⁻¹ H L⁻ᵀ is LAPACK's dsygst (n³ flops; n = 960: 43 ms) instead of two products with a stored
 # L⁻¹ (4n³ flops, but BLAS-3: faster on small blocks; n = 960: 119 ms, n = 60: 19 µs against 38 µs)
 LARGE_BLOCK = 200
+# below this size the lowest eigenvalues come from jitted loops (LAPACK's dsyevr costs ~30 µs at n = 20 and ~56 µs
+# at n = 30, mostly in its O(n) calls of level-2 BLAS and in the tridiagonal solver; the loops take ~11 and ~21 µs)
+SMALL_EIGEN = 40
 
 
 class GramFactor:
-    """G = L Lᵀ of a Gram matrix (or block) that serves many pencils: L (column order, for dsygst) and L⁻¹."""
+    """G = L Lᵀ of a Gram matrix (or block) that serves many pencils: L (column order, for dsygst) and L⁻¹.
 
-    def __init__(self, G):
-        lower = np.linalg.cholesky(G)
+    ``orthogonal``: the basis is orthogonal, G diagonal in exact arithmetic (its off-diagonal entries are
+    quadrature rounding): L = diag(√G_ii), and L⁻¹ H L⁻ᵀ is the scaling H_ij/√(G_ii G_jj) (``scale`` = 1/√G_ii;
+    None for a general G)."""
+
+    def __init__(self, G, orthogonal: bool = False):
+        if orthogonal:
+            root = np.sqrt(np.diag(G))
+            lower, self.scale = np.diag(root), 1.0 / root
+        else:
+            lower, self.scale = np.linalg.cholesky(G), None
         self.lower = np.asfortranarray(lower)
-        self.inverse = np.linalg.inv(lower)
+        self.inverse = np.diag(self.scale) if orthogonal else np.linalg.inv(lower)
 
     def directions(self, normals) -> np.ndarray:
         """The rows L⁻¹nᵢ of the constraint rows nᵢ (k × n)."""
-        return normals @ self.inverse.T
+        return normals * self.scale if self.scale is not None else normals @ self.inverse.T
 
 
 def restricted(H, factor: GramFactor, normals=NO_CONSTRAINT, index=None, rcond: float = RCOND) -> np.ndarray:
     """The standard symmetric matrix A of the pencil (H, G) on the block ``index`` of H (None: all of it) with
     Nᵀc = 0 (module docstring); ``factor`` is the GramFactor of the block of G, ``normals`` the rows nᵢ on the
     block (k × n). Its eigenvalues are the pencil's on the constrained block, its inertia the block's."""
-    block = H if index is None else _gather(np.ascontiguousarray(H, dtype=float), np.asarray(index, dtype=np.int64))
-    if block.shape[0] >= LARGE_BLOCK:
-        A, info = dsygst(block, factor.lower, itype=1, lower=1)  # the lower triangle of L⁻¹ H L⁻ᵀ
+    H = np.ascontiguousarray(H, dtype=float)
+    index = np.arange(H.shape[0]) if index is None else np.asarray(index, dtype=np.int64)
+    if factor.scale is not None:  # orthogonal basis: L⁻¹ H L⁻ᵀ is a scaling
+        A = _gather(H, index, factor.scale)
+    elif index.size >= LARGE_BLOCK:
+        A, info = dsygst(_gather(H, index, np.ones(index.size)), factor.lower, itype=1, lower=1)  # lower triangle
         if info != 0:
             raise np.linalg.LinAlgError(f"dsygst failed (info = {info})")
         A = np.ascontiguousarray(A)
     else:
-        A = factor.inverse @ block @ factor.inverse.T
+        A = factor.inverse @ _gather(H, index, np.ones(index.size)) @ factor.inverse.T
     normals = np.atleast_2d(normals)
     directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, A.shape[0]))
     return _reflect_out(A, directions, rcond)
 
 
 def lowest_of(A, count: int) -> np.ndarray:
-    """The ``count`` lowest eigenvalues (ascending) of the symmetric A (LAPACK dsyevr, range 'I'; A is passed as
-    its F-ordered transpose, no copy, and overwritten)."""
+    """The ``count`` lowest eigenvalues (ascending) of the symmetric A, overwritten: below SMALL_EIGEN rows by
+    the jitted Householder tridiagonalisation and bisection (``_lowest_small``), else LAPACK dsyevr, range 'I' (A
+    passed as its F-ordered transpose, no copy). Both are backward stable: eigenvalues to O(ε‖A‖)."""
+    if A.shape[0] < SMALL_EIGEN:
+        return _lowest_small(A, min(count, A.shape[0]))
     values, _, found, _, info = dsyevr(A.T, compute_v=0, range="I", il=1, iu=min(count, A.shape[0]), overwrite_a=1)
     if info != 0:
         raise np.linalg.LinAlgError(f"dsyevr failed (info = {info})")
@@ -71,13 +90,13 @@ def lowest(H, factor: GramFactor, count: int, normals=NO_CONSTRAINT, index=None,
 
 
 @njit(cache=True)
-def _gather(H, index):
-    """H[index][:, index]."""
+def _gather(H, index, scale):
+    """H[index][:, index] scaled: scale_i H_ij scale_j."""
     n = index.size
     block = np.empty((n, n))
     for i in range(n):
         for j in range(n):
-            block[i, j] = H[index[i], index[j]]
+            block[i, j] = scale[i] * H[index[i], index[j]] * scale[j]
     return block
 
 
@@ -166,3 +185,127 @@ def _dot(a, b):
     for i in range(a.size):
         total += a[i] * b[i]
     return total
+
+
+@njit(cache=True)
+def _lowest_small(A, count):
+    """The ``count`` ≤ n lowest eigenvalues of the symmetric A (its lower triangle; overwritten), ascending."""
+    d, e = _tridiagonal(A)
+    return _lowest_tridiagonal(d, e, count)
+
+
+@njit(cache=True)
+def _tridiagonal(A):
+    """(d, e), the diagonal and subdiagonal of Qᵀ A Q = T for the symmetric A (lower triangle read and overwritten):
+    Householder reflections H = I − τ v vᵀ from both sides, A₂₂ ← A₂₂ − v wᵀ − w vᵀ with p = τ A₂₂ v,
+    w = p − ½ τ (pᵀv) v (Golub & Van Loan, Matrix Computations, §8.3.1)."""
+    n = A.shape[0]
+    d = np.empty(n)
+    e = np.zeros(max(n - 1, 0))
+    v = np.empty(n)
+    p = np.empty(n)
+    for k in range(n - 2):
+        alpha = A[k + 1, k]
+        sigma = 0.0
+        for i in range(k + 2, n):
+            sigma += A[i, k] * A[i, k]
+        d[k] = A[k, k]
+        if sigma == 0.0:  # already tridiagonal in this column
+            e[k] = alpha
+            continue
+        norm = math.sqrt(alpha * alpha + sigma)
+        beta = -norm if alpha >= 0.0 else norm
+        tau = (beta - alpha) / beta
+        scale = 1.0 / (alpha - beta)
+        e[k] = beta
+        v[k + 1] = 1.0
+        for i in range(k + 2, n):
+            v[i] = A[i, k] * scale
+        for i in range(k + 1, n):
+            p[i] = 0.0
+        for i in range(k + 1, n):  # p = A₂₂ v from the lower triangle, row by row
+            total = A[i, i] * v[i]
+            vi = v[i]
+            for j in range(k + 1, i):
+                total += A[i, j] * v[j]
+                p[j] += A[i, j] * vi
+            p[i] += total
+        pv = 0.0
+        for i in range(k + 1, n):
+            p[i] *= tau
+            pv += p[i] * v[i]
+        half = 0.5 * tau * pv
+        for i in range(k + 1, n):
+            p[i] -= half * v[i]
+        for i in range(k + 1, n):
+            vi, wi = v[i], p[i]
+            for j in range(k + 1, i + 1):
+                A[i, j] -= vi * p[j] + wi * v[j]
+    if n >= 2:
+        d[n - 2] = A[n - 2, n - 2]
+        e[n - 2] = A[n - 1, n - 2]
+    d[n - 1] = A[n - 1, n - 1]
+    return d, e
+
+
+@njit(cache=True)
+def _sturm_counts(d, e2, x0, x1, x2, pivot):
+    """The number of eigenvalues below x of the tridiagonal (d, e² shifted: e2[i] = e[i−1]²) at three points x,
+    from the signs of the LDLᵀ pivots q_i = d_i − x − e²_i/q_{i−1} (a pivot below ``pivot`` in magnitude taken
+    as −pivot, as LAPACK's dstebz); the three recurrences interleaved (independent divisions overlap)."""
+    q0 = q1 = q2 = 1.0
+    c0 = c1 = c2 = 0
+    for i in range(d.shape[0]):
+        q0 = d[i] - x0 - e2[i] / q0
+        q1 = d[i] - x1 - e2[i] / q1
+        q2 = d[i] - x2 - e2[i] / q2
+        if abs(q0) < pivot:
+            q0 = -pivot
+        if abs(q1) < pivot:
+            q1 = -pivot
+        if abs(q2) < pivot:
+            q2 = -pivot
+        c0 += q0 < 0.0
+        c1 += q1 < 0.0
+        c2 += q2 < 0.0
+    return c0, c1, c2
+
+
+@njit(cache=True)
+def _lowest_tridiagonal(d, e, count):
+    """The ``count`` lowest eigenvalues (ascending) of the symmetric tridiagonal (d, e): bisection of Gershgorin's
+    interval on Sturm counts, three eigenvalues at a time, every count narrowing every interval, until each is
+    narrower than 4 ε ‖T‖ (the accuracy of any backward-stable method)."""
+    n = d.shape[0]
+    e2 = np.zeros(n)
+    low, high = math.inf, -math.inf
+    for i in range(n):
+        radius = (abs(e[i - 1]) if i > 0 else 0.0) + (abs(e[i]) if i < n - 1 else 0.0)
+        low, high = min(low, d[i] - radius), max(high, d[i] + radius)
+        if i > 0:
+            e2[i] = e[i - 1] * e[i - 1]
+    pivot = 2.2250738585072014e-308 * max(1.0, e2.max())
+    width = 4.0 * 2.220446049250313e-16 * max(abs(low), abs(high)) + 2.0 * pivot
+    lower = np.full(count, low - width)
+    upper = np.full(count, high + width)
+    x = np.empty(3)
+    out = np.empty(count)
+    for start in range(0, count, 3):
+        while True:
+            settled = True
+            for j in range(3):
+                k = min(start + j, count - 1)
+                x[j] = 0.5 * (lower[k] + upper[k])
+                settled = settled and upper[k] - lower[k] <= width
+            if settled:
+                break
+            counts = _sturm_counts(d, e2, x[0], x[1], x[2], pivot)
+            for j in range(3):
+                for k in range(count):
+                    if counts[j] > k:
+                        upper[k] = min(upper[k], x[j])
+                    else:
+                        lower[k] = max(lower[k], x[j])
+        for j in range(min(3, count - start)):
+            out[start + j] = x[j]
+    return out

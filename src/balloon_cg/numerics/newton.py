@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from scipy.linalg.lapack import dgetrf, dgetrs  # LAPACK directly: scipy.linalg's wrappers cost ~10-20 µs a call
 
 # A stale Jacobian is kept while |dx_k| ≤ ratio·|dx_{k−1}|. A Jacobian (assembly and LU) costs about two
@@ -73,12 +74,11 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
                     return _failed(x, iteration, r, np.inf, message, jacobians)
         except ArithmeticError as error:
             return NewtonResult(x, False, iteration, np.inf, np.inf, f"state left the domain: {error}", jacobians)
-        np.negative(r, out=rhs[:n])
-        np.subtract(targets, rows @ x, out=rhs[n:])
+        _right_hand_side(r, rows, targets, x, rhs)
         dx, _ = dgetrs(*factors, rhs)
-        if not math.isfinite(dx.sum()):  # a NaN or ±inf anywhere makes the sum NaN or ±inf
+        step = _scaled_size(dx, x)
+        if not math.isfinite(step):
             return _failed(x, iteration, r, np.inf, "non-finite Newton step", jacobians)
-        step = float((np.abs(dx) / (1.0 + np.abs(x))).max())
         ratio = step / previous if np.isfinite(previous) and previous > 0 else None
         if ratio is not None and ratio > refresh_ratio and not fresh:
             factors = None  # a stale Jacobian contracts too slowly: drop its step, redo it with a fresh one here
@@ -101,6 +101,40 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
             return NewtonResult(x, False, iteration, np.inf, step, "Newton corrections grow", jacobians)
         previous = step
     return NewtonResult(x, False, max_iter, np.inf, step, f"no convergence in {max_iter} iterations", jacobians)
+
+
+@njit(cache=True)
+def finite(a) -> bool:
+    """Whether every entry of the array ``a`` is finite."""
+    for value in a.ravel():
+        if not math.isfinite(value):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _right_hand_side(r, rows, targets, x, rhs):
+    """rhs = (−R, targets − rows·x)."""
+    n = r.shape[0]
+    for i in range(n):
+        rhs[i] = -r[i]
+    for k in range(rows.shape[0]):
+        total = 0.0
+        for j in range(x.shape[0]):
+            total += rows[k, j] * x[j]
+        rhs[n + k] = targets[k] - total
+    return rhs
+
+
+@njit(cache=True)
+def _scaled_size(dx, x) -> float:
+    """max_i |dx_i|/(1 + |x_i|); inf when an entry of dx is not finite."""
+    size = 0.0
+    for i in range(dx.shape[0]):
+        if not math.isfinite(dx[i]):
+            return math.inf
+        size = max(size, abs(dx[i]) / (1.0 + abs(x[i])))
+    return size
 
 
 def _failed(x, iteration, r, step, message, jacobians) -> NewtonResult:
