@@ -143,3 +143,14 @@ def test_unknown_parameter_is_one_line_listing_the_scene_parameters(tmp_path, ca
     for word in ("'Jm'", "field.M", "field.chi", "material.parameters.mu", "material.parameters.Jm"):
         assert word in err
     assert not out.exists()
+
+
+def test_critical_C20_from_the_command_line(c20_curve, tmp_path, capsys):
+    """`critical` with --set on a shipped scene (the Yeoh preset is the fixture's material) and a strain-energy
+    parameter: the same merge as the library call, recorded in the curve file."""
+    out = tmp_path / "c20.h5"
+    assert main(["critical", "spom1", "--set", "material.preset=Yeoh", "--stop-stretch", "3",
+                 "--parameter", "material.parameters.C20", "-o", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith(f"critical C20 = {c20_curve.critical[0]:.12g} ")
+    attrs = read_curve(out)["attrs"]
+    assert attrs["parameter_key"] == "material.parameters.C20" and attrs["end"] == "isola_merge"

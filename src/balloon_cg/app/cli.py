@@ -408,6 +408,7 @@ def _add_critical(commands):
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="start with the parameter increasing (1, default) or decreasing (-1)")
     p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
+    _add_settings(p)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(handler=owned(critical, "critical"))
@@ -436,9 +437,8 @@ def critical(args) -> int:
     from ..analysis.stability import assess_branch
     from ..io.curve_file import write_curve
     from ..io.hdf5 import check_output
-    from ..scene import load_scene
 
-    scene = load_scene(args.scene)
+    scene = scene_of(args)
     asymmetry = _asymmetry(scene)
     if asymmetry:
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
