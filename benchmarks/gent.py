@@ -3,9 +3,10 @@ parameter, with the default single coil and with the two coils.
 
 1. M = 0, closed form: the sphere's pressure extrema (λ(Φ11 + Φ12) = 2Φ1) and its pear condition
    λ(Φ11 + Φ12) = Φ1 (model/sphere_modes.py); the traced primary branch against them.
-2. The single coil (scenes/spom1_single_coil.toml, a = 4, h = 0, M = 0.002) and the two coils
-   (scenes/spom1_two_coils_M0.002.toml) with material.preset = "Gent": the whole picture (balloon_cg.analyse:
-   primary branch, pear pitchforks, pear branches).
+2. The single coil (scenes/spom1_single_coil.toml, a = 4, h = 0, M = 0.002), the coil inferred for the paper
+   (scenes/spom1_paper_coil.toml, a = 1.961) and the two coils (scenes/spom1_two_coils_M0.002.toml) with
+   material.preset = "Gent": the whole picture (balloon_cg.analyse: primary branch, pear pitchforks, pear
+   branches).
 3. Where there is a pear pitchfork: its curve in M and in J_m, both ways (analysis.codim2: the critical value is
    a fold of the curve at P > 0 followed by the partner pitchfork); checks: plain primary branches at a few J_m
    (their pear point must lie on the curve), and the J_m → ∞ end against the neo-Hookean preset (Ogden class,
@@ -33,6 +34,7 @@ from two_parameter import pear_points  # benchmarks/two_parameter.py (this scrip
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = {"single coil (a = 4, M = 0.002)": "spom1_single_coil.toml",
+          "inferred paper coil (a = 1.961, M = 0.002)": "spom1_paper_coil.toml",
           "two coils (M = 0.002)": "spom1_two_coils_M0.002.toml"}
 GENT = {"material.preset": "Gent"}
 FIGURE = ROOT / "docs" / "gent.png"
@@ -80,8 +82,9 @@ def whole_picture(label, file, out: Path):
     bps = [s for s in result.special_points if s["kind"] == "BP" and s["block"] == "odd_held"
            and s["branch"] == "primary"]
     primary = result.branches["primary"]
-    print(f"{label}: whole picture {elapsed:.1f} s; primary branch {len(primary)} points, ended "
-          f"{primary.attrs['stop_reason']}")
+    stretch = primary["lam2_north"]
+    print(f"{label}: whole picture {elapsed:.1f} s; primary branch {len(primary)} points, lambda2(0) "
+          f"{stretch.min():.4f}..{stretch.max():.4f}, ended {primary.attrs['stop_reason']}")
     print(f"  pear pitchforks on the primary branch: {len(bps)}" + "".join(
         f"; lambda2(0) {s['lam2_north']:.8f}, P {s['pressure']:.8f} ({s['classification']}, {s['status']})"
         for s in bps))
@@ -137,12 +140,12 @@ def check_jm(scene, rows):
     print(f"  check Jm -> infinity: neo-Hookean preset (Ogden kernels) pitchfork P = {P_neo:.10f}, lambda2(0) = "
           f"{neo.pole_values(bp.X)['lam2_north'][0]:.8f}; on the curve (Gent kernels):")
     P = {}
-    for Jm in (1e4, 2e4):
+    for Jm in (1e5, 2e5):
         X = land_on_q(up, Jm, int(np.argmin(np.abs(up.q - Jm))))
         P[Jm] = X[up.n]
         print(f"    Jm = {Jm:g}: P = {P[Jm]:.10f} (minus neo-Hookean: {P[Jm] - P_neo:.3e}; times Jm: "
               f"{(P[Jm] - P_neo) * Jm:.5f})")
-    extrapolated = 2 * P[2e4] - P[1e4]  # P(Jm) = P_inf + c/Jm + O(1/Jm^2)
+    extrapolated = 2 * P[2e5] - P[1e5]  # P(Jm) = P_inf + c/Jm + O(1/Jm^2)
     print(f"    Richardson in 1/Jm: P_inf = {extrapolated:.10f}, minus neo-Hookean {extrapolated - P_neo:.1e}")
 
 
@@ -156,7 +159,8 @@ def figure(runs: dict, files: dict, rows: list):
     fig, axes = plt.subplots(2, 2, figsize=(13, 10))
     (whole, zoom), (in_M, in_Jm) = axes
     draw(list(runs.values()), "pressure-pole", axes=whole)
-    whole.set_title("(a) Gent (Jm = 97.2): primary branches (M = 0, one coil, two coils)", fontsize=10)
+    whole.set_title("(a) Gent (Jm = 97.2): primary branches (M = 0, one coil a = 4 or 1.961, two coils)",
+                    fontsize=10)
     draw([runs["two coils (M = 0.002)"]], "pressure-pole", axes=zoom)
     zoom.set_xlim(1.55, 1.95)
     zoom.set_ylim(2.0, 2.3)
@@ -170,8 +174,8 @@ def figure(runs: dict, files: dict, rows: list):
     in_Jm.set_xscale("log")
     in_Jm.set_xlabel(r"Gent $J_m$ (log scale)")
     down = ends["material.parameters.Jm", -1.0]
-    in_Jm.set_title(f"(d) two coils: the pitchfork continued in Jm (down: {down.end.value} at Jm = "
-                    f"{down.q[-1]:.3g}; up: toward neo-Hookean)", fontsize=10)
+    in_Jm.set_title(f"(d) two coils: the pitchfork in Jm (down: {down.end.value} at Jm = {down.q[-1]:.3g}; "
+                    "up: to neo-Hookean)", fontsize=10)
     fig.tight_layout()
     fig.savefig(FIGURE, dpi=130)
     print(f"figure: {FIGURE.relative_to(ROOT)}")
