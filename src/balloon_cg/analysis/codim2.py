@@ -29,7 +29,7 @@ converged points (the residual itself is exact).
 
 The two pitchforks of an isola lie on one such curve; where the curve turns back in q (a sign change of the
 q-component of the tangent, located by the continuation's fold locator: an LP of the curve) they merge: that q is
-the critical value (critical M, critical α1) — obtained directly, without bracketing in q.
+the critical value (critical M, α1, Jm, …) — obtained directly, without bracketing in q.
 
 How the curve ends (``CurveEnd``, the curve's ``end``). A fold in q is a merge of the isola's two pitchforks only
 if the curve, after it, comes back to q0 at the partner pitchfork with P > 0 all the way. The trace stops when q
