@@ -154,3 +154,21 @@ def test_critical_C20_from_the_command_line(c20_curve, tmp_path, capsys):
     assert capsys.readouterr().out.startswith(f"critical C20 = {c20_curve.critical[0]:.12g} ")
     attrs = read_curve(out)["attrs"]
     assert attrs["parameter_key"] == "material.parameters.C20" and attrs["end"] == "isola_merge"
+
+
+def test_domain_check_uses_the_parameters_of_the_call():
+    """A Gent state with I1 − 3 ≈ 15 (sphere λ = 3) is inside the domain at the scene's Jm = 97.2 and outside it
+    at Jm = 10 given through Parameters.material, also right after a call at the scene's Jm at the same u (the
+    state cache must not keep the old check)."""
+    from dataclasses import replace
+
+    from balloon_cg.galerkin.equilibrium import NonFiniteState
+
+    scene = parse_scene('[material]\npreset = "Gent"\n[continuation]\nstop_stretch = 3.0\n', name="gent")
+    branch = trace_primary(scene, down=False)
+    eq = equilibrium_of(branch)
+    u, P = branch.X[-1, :-1], branch.X[-1, -1]
+    params = branch.params.with_value("P", P)
+    assert np.abs(eq.residual(u, params)).max() < 1e-8
+    with pytest.raises(NonFiniteState, match="left the domain"):
+        eq.residual(u, replace(params, material=(2.0, 10.0)))
