@@ -8,7 +8,8 @@
 - ``primary``: the primary branch; ``switching``: the pear branches leaving a branch point
 - ``stability``, ``azimuthal``: the second variation (axisymmetric and m ≥ 1 modes)
 - ``bifurcation``: detection, location and classification of branch points
-- ``codim2``: two-parameter continuation of pear pitchforks (critical M, critical α1)
+- ``second_parameter``: a second parameter by its scene key (M, a material parameter, α1, …);
+  ``codim2``: two-parameter continuation of pear pitchforks in it (critical M, critical α1, critical Jm)
 - ``picture``: all of it for one scene (``analyse``)
 - ``verdict``: is a result complete, and if not, what it lacks (the contract of docs/numerics.md §4a)
 """

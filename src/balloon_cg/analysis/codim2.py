@@ -1,9 +1,11 @@
 """Two-parameter continuation of a pear-shaped pitchfork: the curve of branch points in (q, P).
 
 A pear branch point of the equator-symmetric primary branch (``bifurcation``) is an equilibrium where the odd
-(pear) block of the Hessian is singular. Following it in a second parameter q (the field intensity ``"M"``, or
-the Ogden exponent ``"alpha1"`` with μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 so that Σ μ_i α_i = 4 stays true) is a
-Moore–Spence type extended system in the equator-symmetric space at the branch's Legendre degree N:
+(pear) block of the Hessian is singular. Following it in a second parameter q — any runtime parameter of the
+scene's kernels, named by its scene key (``second_parameter``: the field intensity ``M``, a strain energy's
+``material.parameters.Jm``, an Ogden ``material.mu[i]``, or ``alpha1`` with μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 so
+that Σ μ_i α_i = 4 stays true) — is a Moore–Spence type extended system in the equator-symmetric space at the
+branch's Legendre degree N:
 
     unknowns  X = (u, P, φ, q)              u: symmetric-layout coefficients, φ: the odd block (a_odd, b_even
                                              without b_0) of the general-layout perturbation basis of degree N
@@ -13,27 +15,29 @@ Moore–Spence type extended system in the equator-symmetric space at the branch
 
 — one equation fewer than unknowns: a curve, traced by the generic pseudo-arclength ``continuation.trace``.
 
-Jacobian. ∂R/∂u is the generated Hessian (``Equilibrium.jacobian``), ∂R/∂P and ∂R/∂M come from
-``Equilibrium.parameter_derivative``; H_odd is the generated Hessian on the perturbation basis
-(as ``SecondVariation.matrices``). The third-derivative terms are **central differences of the generated
-Hessian along directions**: because the third derivative of E is symmetric, ∂(H_odd φ)/∂u is the directional
-derivative of the full perturbation-basis Hessian along φ (one pair of Hessian evaluations, at the
+Jacobian. ∂R/∂u is the generated Hessian (``Equilibrium.jacobian``), ∂R/∂P comes from
+``Equilibrium.parameter_derivative``, and so does ∂R/∂q where a generated kernel gives it (``Derivative.EXACT``:
+M), else it is a central difference of the residual in q (``Derivative.CENTRAL``; exponents through the general
+kernel class ``ogden_general_field``, exponents as runtime arguments); H_odd is the generated Hessian on the
+perturbation basis (as ``SecondVariation.matrices``). The third-derivative terms are **central differences of
+the generated Hessian along directions**: because the third derivative of E is symmetric, ∂(H_odd φ)/∂u is the
+directional derivative of the full perturbation-basis Hessian along φ (one pair of Hessian evaluations, at the
 non-symmetric states u ± hφ), restricted to the odd rows and the symmetric-layout columns; ∂(H_odd φ)/∂P and
-∂(H_odd φ)/∂q are central differences of H in P and q. ∂R/∂α1 is a central difference of the gradient through
-the general kernel class (``ogden_general_field``, exponents as runtime arguments). Difference steps are
-``H_STEP`` (relative): the Jacobian is then accurate to ~1e-9, which only affects Newton's rate, not the
+∂(H_odd φ)/∂q are central differences of H in P and q. Difference steps are ``H_STEP`` (relative,
+h = H_STEP·max(1, |q|) in q): the Jacobian is then accurate to ~1e-9, which only affects Newton's rate, not the
 converged points (the residual itself is exact).
 
 The two pitchforks of an isola lie on one such curve; where the curve turns back in q (a sign change of the
 q-component of the tangent, located by the continuation's fold locator: an LP of the curve) they merge: that q is
-the critical value (critical M, critical α1) — obtained directly, without bracketing in q.
+the critical value (critical M, α1, Jm, …) — obtained directly, without bracketing in q.
 
 How the curve ends (``CurveEnd``, the curve's ``end``). A fold in q is a merge of the isola's two pitchforks only
 if the curve, after it, comes back to q0 at the partner pitchfork with P > 0 all the way. The trace stops when q
 returns past q0 (stop ``PARTNER``), when P ≤ 0 (``StopCode.NONPOSITIVE_PRESSURE``: the pitchforks leave the
 physical range of an inflated balloon; the message gives q where the curve crosses P = 0), when the membrane
-comes within ``continuation.wire_gap`` of a coil (``WIRE_GAP``), when α1 reaches 0, at ``max_points`` or at the
-minimum step. The end is then, in this order of precedence:
+comes within ``continuation.wire_gap`` of a coil (``WIRE_GAP``), when q reaches 0 for a parameter that must
+not (α1, an exponent, a family's positive parameter: ``ALPHA1_ZERO``), at ``max_points`` or at the minimum step.
+The end is then, in this order of precedence:
 
     ISOLA_MERGE            a fold in q at P > 0, then the partner pitchfork (stop PARTNER): the isola is born or
                            dies there; ``critical`` is that fold (the fold of extreme q if there are several)
@@ -43,7 +47,7 @@ minimum step. The end is then, in this order of precedence:
     WIRE                   no fold, and the membrane reached continuation.wire_gap of a coil
     BUDGET                 no fold, and max_points were traced
     STEP_MIN               no fold, and the corrector failed at the minimum step
-    ALPHA1_ZERO            no fold, and α1 reached 0
+    ALPHA1_ZERO            no fold, and q reached 0 (α1, an exponent or a positive parameter)
     OTHER                  a caller's own stop rule stopped the curve
 
 The merge points (``merges``: every fold in q, LP special points) carry ``Status.LOCATED`` only for the merge of
@@ -68,12 +72,10 @@ from .bifurcation import padded_mode, plain_degree
 from .branch_point import H_STEP, WernerSpence
 from .problem import continuation_settings, equilibrium_of
 from .results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
+from .second_parameter import Derivative, SecondParameter, alpha1_material, second_parameter
 from .stability import SecondVariation, block_indices
 from .wires import wire_gap
 from ..numerics.threads import limited_blas
-
-PARAMETERS = ("M", "alpha1")
-GENERAL_CLASS = "ogden_general_field"
 
 
 class TwoParameterError(RuntimeError):
@@ -89,7 +91,7 @@ class CurveEnd(enum.StrEnum):
     WIRE = "wire"  # the membrane reached continuation.wire_gap of a coil (no fold before)
     BUDGET = "budget"  # max_points traced (no fold before)
     STEP_MIN = "step_min"  # the corrector failed at the minimum step (no fold before)
-    ALPHA1_ZERO = "alpha1_zero"  # α1 reached 0 (no fold before)
+    ALPHA1_ZERO = "alpha1_zero"  # q (α1, an exponent, a positive parameter) reached 0 (no fold before)
     OTHER = "other"  # a caller's stop rule
 
 
@@ -100,33 +102,24 @@ _END_OF_STOP = {StopCode.NONPOSITIVE_PRESSURE: CurveEnd.NONPOSITIVE_PRESSURE, St
 
 class ExtendedSystem(WernerSpence):
     """R(u; P, q) = 0, H_odd φ = 0, ℓ·φ = 1 as a map of X = (u, P, φ, q) (module docstring): the pear system of
-    ``branch_point`` with q as one more unknown."""
+    ``branch_point`` with q as one more unknown. ``parameter``: a key of ``second_parameter`` or the looked-up
+    SecondParameter (UnknownParameter, a ValueError, for a key the scene's kernels do not take)."""
 
-    def __init__(self, equilibrium: Equilibrium, params, parameter: str, ell: np.ndarray):
-        if parameter not in PARAMETERS:
-            raise ValueError(f"unknown second parameter {parameter!r}: expected one of {PARAMETERS}")
+    def __init__(self, equilibrium: Equilibrium, params, parameter: str | SecondParameter, ell: np.ndarray):
         disc = equilibrium.disc
         if not disc.symmetric:
             raise TwoParameterError("the extended system needs the equator-symmetric layout of the primary branch")
-        if parameter == "alpha1":
-            material = equilibrium.scene.material
-            if not hasattr(material, "alpha") or len(material.alpha) < 1:
-                raise TwoParameterError("alpha1: the material has no Ogden term")
+        if not isinstance(parameter, SecondParameter):
+            parameter = second_parameter(equilibrium.scene, equilibrium, params, parameter)
+        if parameter.kernel_class is not None and equilibrium.kernels.name != parameter.kernel_class:
             # runtime exponents: an own equilibrium of the general class (same energy, μ and α as arguments)
-            equilibrium = Equilibrium(equilibrium.scene, disc, kernel_class=GENERAL_CLASS)
-            self._rest = float(np.dot(material.mu[1:], material.alpha[1:]))
+            equilibrium = Equilibrium(equilibrium.scene, disc, kernel_class=parameter.kernel_class)
         super().__init__(equilibrium, params, ell)
         self.parameter = parameter
 
-    # -- parameters ------------------------------------------------------------------------------------
     def set_q(self, q: float):
-        """Parameters at q: M = q, or α1 = q with μ1 = (4 − Σ_{i≥2} μ_i α_i)/q (Σ μ_i α_i = 4 kept), the other
-        terms the material's."""
-        if self.parameter == "M":
-            return self.params.with_value("M", q)
-        material = self.eq.scene.material
-        mu = ((4.0 - self._rest) / q,) + tuple(material.mu[1:])
-        return replace(self.params, mu=mu, alpha=(float(q),) + tuple(material.alpha[1:]))
+        """Parameters at q (``SecondParameter.at``: the other values the branch's or the material's)."""
+        return self.parameter.at(self.params, self.eq.scene.material, q)
 
     def split(self, X):
         n, m = self.n, self.m
@@ -143,15 +136,12 @@ class ExtendedSystem(WernerSpence):
         J = np.zeros((n + m + 1, n + m + 2))
         J[:, :-1] = self.derivatives(u, P, phi, params)
         hq = H_STEP * max(1.0, abs(q))
-        plus = self.set_q(q + hq).with_value("P", P)
-        H_plus, R_plus = self.odd_hessian(u, plus), self.eq.residual(u, plus)
-        minus = self.set_q(q - hq).with_value("P", P)
-        H_minus, R_minus = self.odd_hessian(u, minus), self.eq.residual(u, minus)
-        if self.parameter == "M":
-            J[:n, -1] = self.eq.parameter_derivative(u, params, "M")
+        plus, minus = self.set_q(q + hq).with_value("P", P), self.set_q(q - hq).with_value("P", P)
+        if self.parameter.derivative == Derivative.EXACT:
+            J[:n, -1] = self.eq.parameter_derivative(u, params, self.parameter.name)
         else:
-            J[:n, -1] = (R_plus - R_minus) / (2 * hq)
-        J[n:n + m, -1] = (H_plus - H_minus) @ phi / (2 * hq)
+            J[:n, -1] = (self.eq.residual(u, plus) - self.eq.residual(u, minus)) / (2 * hq)
+        J[n:n + m, -1] = (self.odd_hessian(u, plus) - self.odd_hessian(u, minus)) @ phi / (2 * hq)
         return J
 
     def initial(self, bp, q0: float):
@@ -165,10 +155,10 @@ class TwoParameterCurve:
     """A traced curve of pear branch points (plain data): X = (u, P, φ, q) per point on the symmetric layout
     ``disc``, and the merge points (LP special points: folds in q, X in the same layout)."""
 
-    parameter: str
+    second: SecondParameter  # q: its key, short name, how ∂R/∂q is computed
     scene: Scene
     disc: Discretisation
-    params: Parameters  # the branch's parameters (q replaces M or α1 along the curve)
+    params: Parameters  # the branch's parameters (q replaces one of them along the curve)
     ell: np.ndarray  # normalisation row of φ
     X: np.ndarray
     iterations: np.ndarray
@@ -184,9 +174,14 @@ class TwoParameterCurve:
     def n(self) -> int:
         return self.disc.size
 
+    @property
+    def parameter(self) -> str:
+        """q's short name (M, alpha1, Jm, mu[0], …): labels and messages; ``second.key`` is its scene key."""
+        return self.second.name
+
     def system(self) -> "ExtendedSystem":
         """The extended system the curve solves (rebuilt)."""
-        return ExtendedSystem(Equilibrium(self.scene, self.disc), self.params, self.parameter, self.ell)
+        return ExtendedSystem(Equilibrium(self.scene, self.disc), self.params, self.second, self.ell)
 
     def _parts(self, X):
         X = np.atleast_2d(X)
@@ -257,15 +252,19 @@ class TwoParameterCurve:
 
 
 @limited_blas
-def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, direction: float = 1.0,
+def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | SecondParameter,
+                          direction: float = 1.0,
                           q0: float | None = None, settings: continuation.Settings | None = None, stop=None,
                           progress=None, max_points: int = 400) -> TwoParameterCurve:
     """Trace the curve of pear branch points through ``bp`` (located on the symmetric ``branch``) in q.
 
-    ``direction``: +1 starts with q increasing, −1 decreasing. ``q0``: the branch's value of q (default: its M,
-    or its material's α1). The trace stops when P ≤ 0, when the membrane comes within continuation.wire_gap of a
-    coil, when α1 reaches 0, or when ``stop(point)`` (a continuation.Point) returns a Stop, by default when q
-    returns past q0 after a fold (the curve has reached the partner pitchfork); or at ``max_points``.
+    ``parameter``: a key of ``second_parameter.second_parameter`` (``M``, ``material.parameters.Jm``, ``alpha1``,
+    …; UnknownParameter lists the scene's) or a SecondParameter. ``direction``: +1 starts with q increasing, −1
+    decreasing. ``q0``: the branch's value of q (default: the branch's or its material's). The trace stops when
+    P ≤ 0, when the membrane comes within continuation.wire_gap of a coil, when q reaches 0 for a parameter that
+    must not (α1, exponents, positive parameters), or when ``stop(point)`` (a continuation.Point) returns a Stop,
+    by default when q returns past q0 after a fold (the curve has reached the partner pitchfork); or at
+    ``max_points``.
     Returns a TwoParameterCurve whose ``end`` says how it ended (``CurveEnd``) and whose ``merges`` are the folds
     in q; only an ISOLA_MERGE curve has a ``critical`` value (its merge, Status.LOCATED).
     """
@@ -277,10 +276,12 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
         branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
         bp = replace(bp, X=mapped.transfer(bp.X, plain), mode=padded_mode(bp.mode, plain.degree))
     eq = equilibrium_of(branch)
-    if q0 is None:
-        q0 = branch.params.M if parameter == "M" else float(scene.material.alpha[0])
-    if parameter == "M" and not scene.field.coils:
+    if parameter in ("M", "field.M") and not scene.field.coils:
         raise TwoParameterError("continuation in M needs coils: without a field R does not depend on M")
+    if not isinstance(parameter, SecondParameter):
+        parameter = second_parameter(scene, eq, branch.params, parameter)
+    if q0 is None:
+        q0 = parameter.q0
     if bp.block != Block.ODD_HELD:
         raise TwoParameterError(f"branch point of block {bp.block.value!r}: only pear (odd_held) points are continued")
     variation = SecondVariation(eq, branch.disc.degree)
@@ -293,8 +294,9 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
         settings = continuation_settings(scene, max_points)
     e_q = np.zeros(X0.size)
     e_q[-1] = 1.0
-    # corrected at fixed q0: for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 may differ from the material's
-    # rounded μ1 (SPOM1: Σ μ_i α_i = 4.000004), and the located point carries the locator's tolerance
+    # corrected at fixed q0 (it may differ from the branch's): for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1
+    # may differ from the material's rounded μ1 (SPOM1: Σ μ_i α_i = 4.000004), and the located point carries the
+    # locator's tolerance
     first = newton(system.residual, system.jacobian, X0, e_q, q0, settings.tol, settings.max_newton)
     if not first.converged:
         raise TwoParameterError(f"the extended system did not converge at the branch point: {first.message}")
@@ -313,12 +315,14 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
 
     n, coils, gap_limit = branch.disc.size, scene.field.coils, scene.continuation.wire_gap
 
+    name = parameter.name
+
     def stop_point(point):
-        if point.X[-1] <= 0 and parameter == "alpha1":
-            return Stop(StopCode.ALPHA1_ZERO, "alpha1 reached 0")
+        if parameter.bound and point.X[-1] * q0 <= 0:
+            return Stop(StopCode.ALPHA1_ZERO, f"{name} reached 0")
         if point.X[n] <= 0:
             return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 (P = {point.X[n]:.4g} "
-                                                        f"at {parameter} = {point.X[-1]:.6g})")
+                                                        f"at {name} = {point.X[-1]:.6g})")
         gap, coil = wire_gap(branch.disc, point.X[:n], coils)
         if gap < gap_limit:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap_limit:g} of coil {coil} (gap {gap:.3g})")
@@ -326,10 +330,10 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str, dire
 
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
     if path.stop.code == StopCode.NONPOSITIVE_PRESSURE:
-        path.stop = _pressure_zero_stop(system, path, parameter, settings)
+        path.stop = _pressure_zero_stop(system, path, name, settings)
     end = _classify(path, n)
     merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
-                           note=f"fold of the curve in {parameter}"
+                           note=f"fold of the curve in {name}"
                                 + (": the two pitchforks merge" if end == CurveEnd.ISOLA_MERGE else
                                    " (not verified as a merge of the pitchforks)")) for fold in path.folds]
     points = path.points
@@ -389,13 +393,6 @@ def land_on_q(curve: TwoParameterCurve, q: float, near: int):
 
 
 # -- the α1 family and its closed form at M = 0 (independent check: sphere_modes) ---------------------------
-def alpha1_material(material, alpha1: float):
-    """``material`` with α1 replaced and μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 (Σ μ_i α_i = 4 kept)."""
-    rest = sum(m * a for m, a in zip(material.mu[1:], material.alpha[1:]))
-    return replace(material, name=f"{material.name}(alpha1={alpha1:g})",
-                   mu=((4.0 - rest) / alpha1,) + tuple(material.mu[1:]), alpha=(alpha1,) + tuple(material.alpha[1:]))
-
-
 def sphere_pear_minimum(material, lam_max: float = 10.0):
     """(λ, value) of the minimum over λ ∈ (1, lam_max) of the closed-form pear condition 4(S − t)
     (sphere_modes.bifurcation_condition, n = 1)."""

@@ -417,17 +417,25 @@ def _add_figure(commands):
 
 def _add_critical(commands):
     p = commands.add_parser(
-        "critical", help="continue the first pear pitchfork in M or alpha1 (two-parameter continuation) and report "
-                         "the critical value where the isola's two pitchforks merge",
-        description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in M or alpha1. "
+        "critical", help="continue the first pear pitchfork in a second parameter (M, alpha1, a material parameter; "
+                         "two-parameter continuation) and report the critical value where the isola's two "
+                         "pitchforks merge",
+        description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in the second "
+                    "parameter: any runtime parameter of the scene's kernels, named by its scene key (field.M or M, "
+                    "field.chi, material.parameters.Jm, material.mu[0], material.alpha[0]) or alpha1 (with mu1 "
+                    "keeping sum mu_i alpha_i = 4); an unknown name lists the scene's. "
                     "Exit 0: the two pitchforks merge at P > 0 and the curve returns to the partner pitchfork "
                     "(critical value printed). Exit 1: the computation gave no critical value (no pear pitchfork, "
                     "or the curve ended otherwise: one line says how and where; the curve file is still written). "
                     "Exit 2: a scene this command cannot handle (not equator-symmetric; --parameter M without "
-                    "coils) or bad input.")
+                    "coils), a parameter the scene does not have, or bad input.")
     p.add_argument("scene", help=f"{SCENE_HELP}; equator-symmetric: coils mirror-symmetric about z = 0")
-    p.add_argument("--parameter", required=True, choices=("M", "alpha1"), help="the second parameter")
+    p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
+                                                       "material.parameters.Jm, voltage)")
+    p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
+                   help="start with the parameter increasing (1, default) or decreasing (-1)")
     p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
+    _add_settings(p)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(handler=owned(critical, "critical"))
@@ -443,7 +451,8 @@ def critical(args) -> int:
     ended otherwise (P reached 0, a fold not verified as a merge, a coil wire, the point budget, the minimum
     step): one line on stderr says how and where, and the curve file is still written. 2 (``UsageError``) a
     scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
-    the equator-symmetric layout), or ``--parameter M`` without coils. Progress goes to stderr (``--quiet``: none).
+    the equator-symmetric layout), ``--parameter M`` without coils, or a parameter the scene's kernels do not take
+    (one line listing those they do: ``analysis.second_parameter``). Progress goes to stderr (``--quiet``: none).
     """
     from tqdm import tqdm
 
@@ -451,18 +460,22 @@ def critical(args) -> int:
     from ..analysis.codim2 import CurveEnd, TwoParameterError, continue_branch_point
     from ..analysis.primary import trace_primary
     from ..analysis.results import Block, Status
+    from ..analysis.second_parameter import UnknownParameter, resolve
     from ..analysis.stability import assess_branch
     from ..io.curve_file import write_curve
     from ..io.hdf5 import check_output
-    from ..scene import load_scene
 
-    scene = load_scene(args.scene)
+    scene = scene_of(args)
     asymmetry = _asymmetry(scene)
     if asymmetry:
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
-    if args.parameter == "M" and not scene.field.coils:
+    if args.parameter in ("M", "field.M") and not scene.field.coils:
         raise UsageError(f"critical --parameter M needs coils: {args.scene} has no [[field.coils]], so the "
                          "equilibrium does not depend on M")
+    try:
+        resolve(scene, args.parameter)
+    except UnknownParameter as e:
+        raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
     check_output(args.output, args.force)
 
     def say(text):
@@ -484,20 +497,21 @@ def critical(args) -> int:
     say(f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
     try:
         with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
-            curve = continue_branch_point(branch, bp, args.parameter, progress=lambda point: bar.update())
+            curve = continue_branch_point(branch, bp, args.parameter, args.direction,
+                                          progress=lambda point: bar.update())
     except TwoParameterError as e:
         raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
     write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
     say(f"curve: {len(curve.q)} points, ended: {curve.end.value}")
     if curve.end != CurveEnd.ISOLA_MERGE:
-        raise Failure(f"no critical {args.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
+        raise Failure(f"no critical {curve.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
                       f"written to {args.output}")
     q, P, stretch = curve.critical
     merge = curve.merge
     if merge.status != Status.LOCATED:
-        raise Failure(f"the merge of the pitchforks near {args.parameter} = {q:.8g} is only approximately located "
+        raise Failure(f"the merge of the pitchforks near {curve.parameter} = {q:.8g} is only approximately located "
                       f"(±{merge.uncertainty:.1g}: {merge.reason}); curve written to {args.output}")
-    print(f"critical {args.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
+    print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
           f"curve written to {args.output}")
     return 0
 

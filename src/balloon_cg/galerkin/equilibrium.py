@@ -16,15 +16,19 @@ from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
 
 
+# the kernel of ∂R/∂name for a runtime scalar name; any other name: "NAME_gradient" if the class has one
+DERIVATIVE_KERNELS = {"P": "pressure_gradient", "M": "field_gradient"}
+
+
 class NonFiniteState(ArithmeticError):
     """The kernels returned NaN/inf: the state left the physical domain (λ ≤ 0, a wire reached, …)."""
 
 
 @dataclass
 class Parameters:
-    """Branch parameters P, M, χ, the voltage Φ̄ (a dielectric class) and the material moduli μ and exponents α
-    (None: the scene material's); the field names are the generated kernels' argument names (model/kernels.py
-    binds them by name)."""
+    """Branch parameters P, M, χ, the voltage Φ̄ (a dielectric class), the Ogden moduli μ and exponents α, and a
+    strain energy's parameter values ``material`` (in the order of its formula's parameters); None: the scene
+    material's. The field names are the generated kernels' argument names (model/kernels.py binds them by name)."""
 
     P: float
     M: float = 0.0
@@ -32,6 +36,7 @@ class Parameters:
     voltage: float = 0.0
     mu: tuple | None = None
     alpha: tuple | None = None
+    material: tuple | None = None
 
     def with_value(self, name: str, value: float) -> "Parameters":
         return Parameters(**{**self.__dict__, name: float(value)})
@@ -66,15 +71,16 @@ class Equilibrium:
         output; ``values`` are further named arguments (the azimuthal number m)."""
         if field is None:
             field = self._field(state[0], geometry[1], state[2])
-        return self._evaluate(kernel, self._node_values(geometry, state, field) | values, params)
+        return self._evaluate(kernel, self._node_values(geometry, state, field, params) | values, params)
 
-    def _node_values(self, geometry: tuple, state: tuple, field) -> dict:
-        """The kernels' node arguments by name; NonFiniteState if a node's stretches leave the material's domain
-        (a strain energy with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
+    def _node_values(self, geometry: tuple, state: tuple, field, params: Parameters) -> dict:
+        """The kernels' node arguments by name; NonFiniteState if a node's stretches leave the domain of the
+        material at ``params`` (a strain energy with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay
+        finite beyond it)."""
         if self._domain_check:
             lam2, v, _, w = state
             lam1 = np.hypot(lam2 * geometry[0] + v, w)
-            margins = self.kernels.nodes("domain_margins", {"lam1": lam1, "lam2": lam2})
+            margins = self.kernels.nodes("domain_margins", {"lam1": lam1, "lam2": lam2}, params)
             violation = self.scene.material.domain_violation(margins, lam1, lam2)
             if violation is not None:
                 node, what = violation
@@ -89,13 +95,15 @@ class Equilibrium:
         return out
 
     def _pointwise(self, kernel, u, params: Parameters):
-        """Kernel at the own nodes; the state and field of the last u are reused (Newton asks for R, then J)."""
+        """Kernel at the own nodes; the state and field of the last u (and material values: its domain check)
+        are reused (Newton asks for R, then J)."""
         last = getattr(self, "_last", None)
-        if last is None or last[0].shape != u.shape or (last[0] != u).any():
+        if last is None or last[0].shape != u.shape or (last[0] != u).any() or last[1] != params.material:
             state = tuple(self.disc.node_state(u))
             field = self._field(state[0], self.disc.sin_theta, state[2])
-            last = self._last = (np.array(u, dtype=float), self._node_values(self.geometry, state, field))
-        return self._evaluate(kernel, last[1], params)
+            last = self._last = (np.array(u, dtype=float), params.material,
+                                 self._node_values(self.geometry, state, field, params))
+        return self._evaluate(kernel, last[2], params)
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
@@ -112,17 +120,23 @@ class Equilibrium:
     def jacobian(self, u, params: Parameters) -> np.ndarray:
         return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
+    def derivative_kernel(self, name: str) -> str | None:
+        """The generated kernel of ∂π̂/∂s_k∂name for the runtime scalar ``name`` (``DERIVATIVE_KERNELS``, else
+        ``NAME_gradient``), or None if the scene's class has none."""
+        kernel = DERIVATIVE_KERNELS.get(name, f"{name}_gradient")
+        return kernel if kernel in self.kernels.module.KERNELS else None
+
     def parameter_derivative(self, u, params: Parameters, name: str, out: np.ndarray | None = None) -> np.ndarray:
-        """∂R/∂P, ∂R/∂M or ∂R/∂voltage (zero without coils or without the dielectric term), into ``out`` if
-        given."""
-        kernel, present = {"P": ("pressure_gradient", True), "M": ("field_gradient", self.coils.shape[0] > 0),
-                           "voltage": ("voltage_gradient", self.kernels.electric)}.get(name, (None, False))
-        if kernel is None:
-            raise ValueError(f"unknown continuation parameter {name!r}: expected 'P', 'M' or 'voltage'")
-        if not present:
+        """∂R/∂name from its generated kernel (``derivative_kernel``: P, M, voltage, …; ∂R/∂M is zero without coils,
+        ∂R/∂voltage without the dielectric term), into ``out`` if given."""
+        if (name == "M" and not self.coils.shape[0]) or (name == "voltage" and not self.kernels.electric):
             out = np.empty(self.disc.size) if out is None else out
             out[:] = 0.0
             return out
+        kernel = self.derivative_kernel(name)
+        if kernel is None:
+            raise ValueError(f"no generated derivative of the residual in {name!r} for kernel class "
+                             f"{self.kernels.name}")
         return self.disc.gradient(self._pointwise(kernel, u, params), out)
 
     def bordered_jacobian(self, u, params: Parameters, name: str) -> np.ndarray:

@@ -4,15 +4,20 @@ Layout::
 
     /                            attrs: as a run file (format, scene, provenance) + extra_attrs
     /branches/                   (empty: the file is also a readable run file)
-    /two_parameter/<name>/       attrs: parameter, stop_reason, stop_code, end, end_description, q0, wall_time,
-                                        degree, kernel_class, M, chi, critical_q (NaN unless end = isola_merge)
+    /two_parameter/<name>/       attrs: parameter, parameter_key, parameter_derivative, stop_reason, stop_code,
+                                        end, end_description, q0, wall_time, degree, kernel_class, M, chi,
+                                        critical_q (NaN unless end = isola_merge)
         q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
                         the verified merge of the two pitchforks), unknowns in the branch layout (u, P), and q
 
 ``end`` is the curve's ``analysis.codim2.CurveEnd`` (how it ended: isola_merge, fold, nonpositive_pressure, wire,
-budget, step_min, alpha1_zero, other); ``end_description`` says the same for people, with where.
+budget, step_min, alpha1_zero, other); ``end_description`` says the same for people, with where. ``parameter``
+is q's short name (M, alpha1, Jm, mu[0]), ``parameter_key`` its scene key (field.M, material.parameters.Jm,
+material.mu[0]; alpha1: itself), ``parameter_derivative`` how ∂R/∂q was computed (exact: a generated kernel;
+central: central differences): ``analysis.second_parameter``. Files written before these two existed have
+``parameter`` M or alpha1 and are read all the same.
 """
 from dataclasses import replace
 
@@ -35,6 +40,8 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         group = f.create_group("two_parameter").create_group(name)
         group.attrs.update({
             "parameter": curve.parameter,
+            "parameter_key": curve.second.key,
+            "parameter_derivative": curve.second.derivative.value,
             "stop_reason": curve.stop_reason,
             "stop_code": curve.stop.code.value if curve.stop else "",
             "end": curve.end.value if curve.end else "",
@@ -66,7 +73,8 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
 
 CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_north", "lam2_south", "residual")},
                  "newton_iterations": ("int", 1), "unknowns": ("float", 2), "mode": ("float", 2)}
-CURVE_KINDS = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float"}
+CURVE_REQUIRED = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float"}
+CURVE_KINDS = CURVE_REQUIRED | {"parameter_key": "str", "parameter_derivative": "str"}
 
 
 def read_curve(path, name: str = "pear") -> dict:
@@ -77,7 +85,7 @@ def read_curve(path, name: str = "pear") -> dict:
         curves = require_group(f, "two_parameter", path, CurveFileError)
         group = require_group(curves, name, f"{path}: two_parameter", CurveFileError)
         where = f"{path}: two_parameter/{name}"
-        require_attrs(group.attrs, where, CURVE_KINDS, CURVE_KINDS, CurveFileError)
+        require_attrs(group.attrs, where, CURVE_REQUIRED, CURVE_KINDS, CurveFileError)
         check_columns(group, where, CURVE_COLUMNS, CurveFileError)
         special = require_group(group, "special_points", where, CurveFileError)
         check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS | {"q": ("float", 1)}, CurveFileError)

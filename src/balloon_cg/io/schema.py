@@ -60,7 +60,7 @@ VARIABLES = {
     "E2": (NONDIMENSIONAL, "normal-form E2", "energy expansion coefficient along the mode (docs/second_variation.md)"),
     "E3": (NONDIMENSIONAL, "normal-form E3", "cubic coefficient"),
     "E4": (NONDIMENSIONAL, "normal-form E4", "quartic coefficient"),
-    "q": (NONDIMENSIONAL, "second parameter q", "the continued parameter (M or alpha1)"),
+    "q": (NONDIMENSIONAL, "second parameter q", "the continued parameter (its name: the parameter attribute)"),
     "mode": (NONDIMENSIONAL, "critical mode", "null vector φ on the odd perturbation block"),
     "stable_pressure": (NONDIMENSIONAL, "stable, pressure control", "held at the centre, pressure control"),
     "stable_volume": (NONDIMENSIONAL, "stable, volume control", "held at the centre, volume-preserving"),

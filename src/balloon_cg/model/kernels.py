@@ -11,7 +11,8 @@ turns named values into an argument tuple, so no caller knows the argument order
 
 - 'node' and 'node_rows' arguments (cos_theta, lam2, …; field) and 'param' scalars (P, M, chi, voltage, m) are
   the values of the same name;
-- μ and α are the material's (padded for the general class), or the overrides ``mu``/``alpha`` when given;
+- μ and α are the material's (padded for the general class), or the overrides ``mu``/``alpha`` when given; a
+  strain energy's ``material`` array is its parameter values, or the override ``Parameters.material``;
 - ``pole_field`` rows 'NAME_N' / 'NAME_S' are the FIELD_ROWS entry NAME of ``field_north`` / ``field_south``.
 """
 import hashlib
@@ -89,15 +90,24 @@ class KernelSet:
         """Hash of the generated module text (provenance)."""
         return self.module.SIGNATURE
 
-    def material(self, mu=None, alpha=None) -> dict:
-        """{'mu': μ, 'alpha': α} as the kernels take them (read-only arrays); None: the scene material's.
+    def material(self, mu=None, alpha=None, values=None) -> dict:
+        """{'mu': μ, 'alpha': α} or a strain energy's {'material': values} as the kernels take them (read-only
+        arrays); None: the scene material's.
 
         The general class takes GENERAL_TERMS terms, the unused ones padded with μ = 0, α = 1; a class with
         baked-in exponents takes μ only, and accepts an α override only if it is its own exponents."""
-        if mu is None and alpha is None:
+        if mu is None and alpha is None and values is None:
             return self._scene_arrays
-        if isinstance(self.scene_material, StrainEnergy):
-            raise ValueError(f"moduli/exponents overrides apply to Ogden materials, not {self.scene_material.name}")
+        energy = isinstance(self.scene_material, StrainEnergy)
+        if energy and mu is None and alpha is None:
+            names = self.scene_material.formula.parameters
+            if len(values) != len(names):
+                raise ValueError(f"{len(values)} parameter values for {self.scene_material.name}'s {len(names)} "
+                                 f"({', '.join(names)})")
+            return {"material": _frozen(values)}
+        if energy or values is not None:
+            kind = "moduli/exponents" if energy else "strain-energy parameter"
+            raise ValueError(f"{kind} overrides do not apply to the material {self.scene_material.name}")
         return self._pack(tuple(self.scene_material.mu if mu is None else mu),
                           tuple(self.scene_material.alpha if alpha is None else alpha))
 
@@ -113,15 +123,16 @@ class KernelSet:
 
     def arguments(self, kernel: str, values: dict, params=None) -> tuple:
         """The argument tuple of ``kernel`` from named values (module docstring) and, if given, the branch
-        parameters ``params`` (galerkin.equilibrium.Parameters: P, M, χ, Φ̄, μ, α); missing names raise KeyError."""
+        parameters ``params`` (galerkin.equilibrium.Parameters: P, M, χ, Φ̄, μ, α, material); missing names raise
+        KeyError."""
         pick, scalars, pole_rows = self._binders.get(kernel) or self._binder(kernel)
         if params is None:
-            mu, alpha = values.get("mu"), values.get("alpha")
+            mu, alpha, energy = values.get("mu"), values.get("alpha"), None
             source = {**values}
         else:
-            mu, alpha = params.mu, params.alpha
+            mu, alpha, energy = params.mu, params.alpha, params.material
             source = {"P": params.P, "M": params.M, "chi": params.chi, "voltage": params.voltage, **values}
-        source.update(self._scene_arrays if mu is None and alpha is None else self.material(mu, alpha))
+        source.update(self.material(mu, alpha, energy))
         try:
             for name in scalars:
                 source[name] = float(source[name])
