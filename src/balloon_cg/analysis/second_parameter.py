@@ -112,7 +112,7 @@ def _scene_key(scene, name: str) -> str:
 
 
 def _kernels(scene) -> KernelSet:
-    return KernelSet(scene.material, has_field=bool(scene.field.coils))  # as Equilibrium loads them
+    return KernelSet.of_scene(scene)  # as Equilibrium loads them
 
 
 def parameter_keys(scene, kernels: KernelSet | None = None) -> dict[str, str]:

@@ -51,8 +51,7 @@ class Equilibrium:
         self.scene = scene
         self.disc = discretisation
         self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
-        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0, kernel_class=kernel_class,
-                                 electric=scene.electric is not None)
+        self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
 

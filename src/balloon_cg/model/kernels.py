@@ -54,6 +54,13 @@ class KernelSet:
     ``has_field``.
     """
 
+    @classmethod
+    def of_scene(cls, scene, kernel_class: str | None = None) -> "KernelSet":
+        """The kernels of a scene's class: its material, with the field terms if it has coils, with the dielectric
+        term if it has an [electric] table."""
+        return cls(scene.material, has_field=bool(scene.field.coils), kernel_class=kernel_class,
+                   electric=scene.electric is not None)
+
     def __init__(self, material, has_field: bool, kernel_class: str | None = None, electric: bool = False):
         """``electric``: the class with the dielectric term (generated on demand, model/kernel_cache.py)."""
         self.has_field, self.electric = has_field, electric

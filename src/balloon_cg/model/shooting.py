@@ -77,8 +77,7 @@ class Shooter:
     def __init__(self, scene, rtol: float = 1e-13, atol: float = 1e-13):
         f = scene.field
         self.coils = np.array([[c.radius, c.height, c.current] for c in f.coils], dtype=float).reshape(-1, 3)
-        self.kernels = KernelSet(scene.material, has_field=self.coils.shape[0] > 0,
-                                 electric=scene.electric is not None)
+        self.kernels = KernelSet.of_scene(scene)
         self.M, self.chi = (f.M, f.chi) if self.coils.shape[0] else (0.0, f.chi)
         self.voltage = 0.0 if scene.electric is None else scene.electric.voltage
         self.equator_symmetric = f.is_equator_symmetric
