@@ -290,3 +290,12 @@ def test_a_compressed_point_is_never_landed_on():
     assert 1.001 < slack < 1.002
     assert branch.stopped(StopCode.COMPRESSED) and not branch.stopped(StopCode.MIN_STRETCH)
     assert branch.pressure.min() > 0 and branch.pole_values()["lam2_north"].min() > slack
+
+
+def test_voltage_is_a_second_parameter():
+    """critical --parameter voltage: the dielectric class's runtime voltage is found (KernelSet.of_scene)."""
+    from balloon_cg.analysis.second_parameter import resolve
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[electric]\nvoltage = 0.05\n', "d")
+    assert resolve(scene, "voltage") == "electric.voltage"
+    with pytest.raises(ValueError, match="not a runtime parameter"):
+        resolve(parse_scene('[material]\npreset = "SPOM1"\n', "plain"), "voltage")
