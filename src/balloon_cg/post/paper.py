@@ -317,25 +317,26 @@ def draw_energy(runs, fig, reading):
 
 # --- the figures -------------------------------------------------------------------------------------------
 
+SINGLE_COIL = "spom1_paper_coil"  # the coil inferred from the paper's critical M (a = 1.961 at height 0: docs/paper.md)
 SINGLE_COIL_REACH = (("continuation.stop_stretch", 6.0),)  # the isola reaches λ2(0) = 5.4 (spom1.toml)
 
 
 def _family(single_coil: bool, quick: bool) -> tuple[Case, ...]:
     """SPOM1 then TPOM1: M = 0 (field-free scenes; not in quick runs) and the M values with one coil
-    (spom1_single_coil, its material replaced for TPOM1) or the paper's two coils (the shipped scenes)."""
+    (SINGLE_COIL, its material replaced for TPOM1) or the paper's two coils (the shipped scenes)."""
     values = QUICK_M_VALUES if quick else M_VALUES
     cases = []
     for material in ("spom1", "tpom1"):
         cases += [] if quick else [Case(material)]
         if single_coil:
             preset = () if material == "spom1" else (("material.preset", "TPOM1"),)
-            cases += [Case("spom1_single_coil", preset + (("field.M", M),) + SINGLE_COIL_REACH) for M in values]
+            cases += [Case(SINGLE_COIL, preset + (("field.M", M),) + SINGLE_COIL_REACH) for M in values]
         else:
             cases += [Case(f"{material}_two_coils_M{M:g}") for M in values]
     return tuple(cases)
 
 
-SINGLE_COIL_M0001 = Case("spom1_single_coil", (("field.M", 0.001),) + SINGLE_COIL_REACH)
+SINGLE_COIL_M0001 = Case(SINGLE_COIL, (("field.M", 0.001),) + SINGLE_COIL_REACH)
 TWO_COILS_M0001 = Case("spom1_two_coils_M0.001")
 
 
