@@ -24,6 +24,9 @@ from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 
 
+MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
+
+
 class Phase(enum.StrEnum):
     """The phases of ``analyse``, for progress reports."""
 
@@ -51,8 +54,9 @@ class Progress:
 
 @dataclass
 class SnapThrough:
-    """Under pressure control: a stable stretch of ``from_branch`` ends after point ``from_index`` at ``pressure``;
-    the lowest-energy stable point at that pressure is on ``to_branch`` near ``to_index`` ("" and −1: none)."""
+    """A stable stretch of ``from_branch`` ends at point ``from_index`` (its last stable point) at ``pressure`` (the
+    control value: the volume under volume control); the lowest-energy stable point there is on ``to_branch``
+    near ``to_index`` ("" and −1: none) (``find_snaps``; stored runs: pressure control)."""
 
     from_branch: str
     from_index: int
@@ -143,7 +147,7 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
     for n, bp in enumerate(picture.branch_points):
         if bp.block != Block.ODD_HELD or n in reached:
             continue
-        for sign, suffix in ((1.0, ""), (-1.0, "_mirror")):
+        for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
             if interrupt.requested():
                 return
             name = f"pear_{n}{suffix}"
@@ -173,30 +177,58 @@ def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | Non
 
 
 def snap_throughs(branches: list) -> list:
-    """Under pressure control: where a stable stretch of a branch ends (fold or loss of stability) with P
-    increasing, the jump to the lowest-energy stable point at the same P on any branch (or none found)."""
+    """The snap-throughs under pressure control (``find_snaps``: the stable_pressure flags, P the control, the
+    energy E(u; P) of the Galerkin problem ranking the targets)."""
+    curves = []
+    for b in branches:
+        eq = equilibrium_of(b)
+        energy = np.array([eq.energy(x[:-1], b.params.with_value("P", x[-1])) for x in b.X])
+        curves.append(Curve(b.name, b.pressure, np.array([a.stable_pressure for a in b.stability], dtype=bool), energy))
+    return find_snaps(curves)
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A branch as ``find_snaps`` sees it, per point: the control value (P under pressure control, the volume
+    under volume control), whether it is stable under that control, and the energy that control minimises."""
+
+    name: str
+    control: np.ndarray
+    stable: np.ndarray
+    energy: np.ndarray
+
+
+def find_snaps(curves: list[Curve]) -> list[SnapThrough]:
+    """Where a stable stretch of a branch ends next to an unstable point (a fold or a loss of stability, reached
+    by raising or lowering the control along the stretch: both ends of every stretch), the jump at that control
+    value to the stable point of lowest energy on any branch (an interval of two stable points strictly bracketing
+    it, not within one point of the start on its branch or on the branch's mirror image: the same state
+    reflected; none: to_branch ""). ``pressure`` of the result is the control value."""
     snaps = []
-    for branch in branches:
-        stable = np.array([a.stable_pressure for a in branch.stability])
+    for curve in curves:
+        stable = curve.stable
         for i in range(len(stable) - 1):
-            if stable[i] and not stable[i + 1]:
-                P = branch.pressure[i]
-                target = _stable_at(branches, P, exclude=(branch.name, i))
-                snaps.append(SnapThrough(branch.name, i, float(P), *(target or ())))
+            if stable[i] != stable[i + 1]:
+                end = i if stable[i] else i + 1
+                value = float(curve.control[end])
+                target = _stable_at(curves, value, exclude=(curve.name, end))
+                snaps.append(SnapThrough(curve.name, end, value, *(target or ())))
     return snaps
 
 
-def _stable_at(branches: list, P: float, exclude):
+def _family(name: str) -> str:
+    """A pear branch and its mirror image (``_trace_pears`` names it <name>_mirror) share a family."""
+    return name.removesuffix(MIRROR)
+
+
+def _stable_at(curves: list[Curve], value: float, exclude):
     best = None
-    for branch in branches:
-        stable = np.array([a.stable_pressure for a in branch.stability])
-        p = branch.pressure
-        eq = equilibrium_of(branch)
-        for i in range(len(p) - 1):
-            if (branch.name, i) == exclude or abs(i - exclude[1]) <= 1 and branch.name == exclude[0]:
+    for curve in curves:
+        stable, c = curve.stable, curve.control
+        for i in range(len(c) - 1):
+            if _family(curve.name) == _family(exclude[0]) and abs(i - exclude[1]) <= 1:
                 continue
-            if stable[i] and stable[i + 1] and (p[i] - P) * (p[i + 1] - P) <= 0:
-                volume = eq.volume(branch.X[i, :-1])
-                if best is None or volume > best[0]:
-                    best = (volume, branch.name, i)
+            if stable[i] and stable[i + 1] and (c[i] - value) * (c[i + 1] - value) < 0:
+                if best is None or curve.energy[i] < best[0]:
+                    best = (curve.energy[i], curve.name, i)
     return best[1:] if best else None

@@ -5,8 +5,8 @@ computed or reused by ``app.figures``.
 Numbered configurations (Figs. 9–12): ``numbered_configurations`` picks them by rule from a run: 1 primary and
 2 pear-shaped at the common pressure P* = the middle of the first pear branch's pressure range (1 on the
 primary branch before its turning point TP, if it has one), 3 the last point of the primary branch (after the TP
-where there is one, next to the wire), then the snap-throughs under pressure control stored with the run, each
-as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number the two-coil pair 8 (primary) and 9 (pear) at P*.
+where there is one, next to the wire), then the snap-throughs under the figure's stability reading
+(``snap_throughs``: default pressure control), each as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number the two-coil pair 8 (primary) and 9 (pear) at P*.
 """
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -16,8 +16,10 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .plotting import P_LABEL, Configuration, Reading, describe_scene, plot
-from .quantities import stored_scene
+from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
+from .quantities import branch_discretisation, stored_scene
+from ..analysis.picture import Curve, find_snaps
+from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..scene import parse_scene
 
 ONE_COLUMN, TWO_COLUMNS = 3.5, 7.2  # journal widths, inches
@@ -168,10 +170,41 @@ def _x_label(kind, panel):
 
 # --- numbered configurations -------------------------------------------------------------------------------
 
-def numbered_configurations(run: dict, first: int = 1, snaps: bool = True) -> dict[int, Configuration]:
+VOLUME_CONTROL = (Reading.VOLUME, Reading.FREE_VOLUME)  # readings whose control is the volume; the others: P
+SNAP_READINGS = (Reading.PRESSURE, Reading.VOLUME, Reading.FREE, Reading.FREE_VOLUME, Reading.AXISYMMETRIC)
+
+
+def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
+    """The snap-throughs of a stored run with stability read as ``reading`` (``analysis.picture.find_snaps`` on
+    the stored flags or blocks, ``plotting.stable_points``): under pressure control at equal P to the stable
+    point of lowest E(u; P), under volume control at equal volume to the one of lowest E + P V/2π (the energy
+    without the pressure work), E the Galerkin energy of the stored unknowns. Branches without stability data
+    are left out; ``pressure`` of each result is the control value."""
+    if reading not in SNAP_READINGS:
+        raise PlotError(f"--stability {reading.value}: no snap-through search for this reading (one of "
+                        f"{', '.join(r.value for r in SNAP_READINGS)})")
+    scene = stored_scene(run)
+    volume_control = reading in VOLUME_CONTROL
+    curves = []
+    for name, data in run["branches"].items():
+        stable = stable_points(data, reading)
+        if stable is None:
+            continue
+        disc = branch_discretisation(data)
+        eq, M, chi = Equilibrium(scene, disc), data["attrs"]["M"], data["attrs"]["chi"]
+        P, V = data["pressure"], data["volume"]
+        E = np.array([eq.energy(X[:disc.size], Parameters(p, M, chi)) for X, p in zip(data["unknowns"], P)])
+        curves.append(Curve(name, V if volume_control else P, stable, E + P * V / (2 * np.pi) if volume_control
+                            else E))
+    return find_snaps(curves)
+
+
+def numbered_configurations(run: dict, first: int = 1, snaps: bool = True,
+                            reading: Reading = Reading.PRESSURE) -> dict[int, Configuration]:
     """The paper's numbered configurations of a run by number (module docstring): ``first`` primary and
     ``first`` + 1 pear-shaped at P*, ``first`` + 2 the last primary point, then each snap-through's (from, to)
-    pair. Without a pear branch there is no ``first`` + 1, and P* is the middle of the primary pressure range."""
+    pair under ``reading`` (``snap_throughs``). Without a pear branch there is no ``first`` + 1, and P* is the
+    middle of the primary pressure range."""
     branches = run["branches"]
     primary = branches["primary"]
     pear = next((name for name in branches if name.startswith("pear") and not name.endswith("_mirror")), None)
@@ -182,8 +215,8 @@ def numbered_configurations(run: dict, first: int = 1, snaps: bool = True) -> di
     chosen = {first: ("primary", int(np.abs(P[before] - target).argmin())), first + 2: ("primary", len(P) - 1)}
     if pear:
         chosen[first + 1] = (pear, int(np.abs(branches[pear]["pressure"] - target).argmin()))
-    pairs = [(s["from_branch"], s["from_index"], s["to_branch"], s["to_index"])
-             for s in run["snap_throughs"] if snaps and s["to_branch"]]
+    pairs = [(s.from_branch, s.from_index, s.to_branch, s.to_index)
+             for s in (snap_throughs(run, reading) if snaps else ()) if s.to_branch]
     for k, (source, i, target_branch, j) in enumerate(pairs):
         chosen[first + 3 + 2 * k] = (source, int(i))
         chosen[first + 4 + 2 * k] = (target_branch, int(j))
@@ -214,7 +247,7 @@ def configurations_figure(two_coils: bool) -> Callable:
 
     def draw(runs, fig, reading):
         run = runs[0]
-        numbered = numbered_configurations(run, first=8 if two_coils else 1, snaps=not two_coils)
+        numbered = numbered_configurations(run, first=8 if two_coils else 1, snaps=not two_coils, reading=reading)
         shapes = pick(numbered, 8, 9) if two_coils else pick(numbered, 1, 2, 3)
         groups = [pick(numbered, 8), pick(numbered, 9)] if two_coils else [pick(numbered, 1, 2), pick(numbered, 3)]
         panels = fig.subplot_mosaic([["a", "b"], ["c0", "d0"], ["c1", "d1"]], height_ratios=[1.4, 1, 1])
