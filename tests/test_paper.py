@@ -13,7 +13,7 @@ from balloon_cg.app.cli import main
 from balloon_cg.app.figures import make_figure, run_for
 from balloon_cg.analysis.picture import Curve, find_snaps
 from balloon_cg.post.paper import (PAPER_STYLE, ONE_COLUMN, SNAP_READINGS, TWO_COLUMNS, Case, draw_figure, figures,
-                                   landscape_equilibria, numbered_configurations, snap_throughs)
+                                   numbered_configurations, snap_throughs)
 from balloon_cg.post.plotting import Reading, load_branches, plot, robust_limits, stable_points
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -22,7 +22,7 @@ PRESSURE = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
 THETA = r"material coordinate $\theta$ (rad)"
 EQUATOR_2 = r"equator stretch $\lambda_2(\pi/2)$ (circumferential)"
 EQUATOR_1 = r"equator stretch $\lambda_1(\pi/2)$ (meridional)"
-ENERGY = r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)"
+ENERGY = r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)"
 LABELS = {  # (x labels, y labels) the figure's axes must carry
     "fig2": ({POLE}, {PRESSURE}),
     "fig3": ({POLE}, {PRESSURE}), "fig6": ({POLE}, {PRESSURE}),
@@ -32,7 +32,7 @@ LABELS = {  # (x labels, y labels) the figure's axes must carry
              {PRESSURE, r"$\eta/R_0$ (height)", r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"}),
     "fig11": ({THETA}, {r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"}),
     "fig12": ({THETA}, {r"Gaussian curvature $\kappa R_0^2$"}),
-    "fig13": ({r"amplitude $\Lambda$ along the critical mode"}, {ENERGY}),
+    "fig13": ({r"amplitude $\Lambda$ along the pear direction"}, {ENERGY}),
 }
 LABELS["fig10"] = LABELS["fig9"]
 PANELS = {"fig2": 4, "fig3": 4, "fig4": 4, "fig5": 4, "fig6": 4, "fig7": 4, "fig8": 4, "fig9": 6, "fig10": 6,
@@ -197,16 +197,6 @@ def test_robust_limits_clip_a_spike_only():
     assert robust_limits(ax, [spike])
     low, high = ax.get_ylim()
     assert low <= 0 and 1.0 < high < 10  # the bulk (0..1) fills the axes, the spike (1000) is clipped
-
-
-def test_landscape_equilibria_closed_form():
-    """E = E2Λ² + E4Λ⁴ with E2 < 0 < E4: minima at ±√(−E2/(2E4)); with E3: the roots of 4E4Λ² + 3E3Λ + 2E2."""
-    assert landscape_equilibria(-1.0, 0.0, 1.0) == pytest.approx([-np.sqrt(0.5), 0.0, np.sqrt(0.5)])
-    assert landscape_equilibria(1.0, 0.0, 1.0) == pytest.approx([0.0])
-    e2, e3, e4 = -0.3, 0.2, 0.5
-    found = landscape_equilibria(e2, e3, e4)
-    assert 2 * e2 * found + 3 * e3 * found**2 + 4 * e4 * found**3 == pytest.approx(np.zeros(3), abs=1e-12)
-    assert landscape_equilibria(-1e-8, 0.0, 1.0, resolution=1e-3) == pytest.approx([0.0])  # at a branch point
 
 
 def test_make_figure_output_folder_default(runs, tmp_path):

@@ -18,7 +18,8 @@ from matplotlib.lines import Line2D
 
 from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
 from .quantities import branch_discretisation, stored_scene
-from ..analysis.picture import Curve, find_snaps
+from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
+from ..analysis.picture import MIRROR, Curve, find_snaps
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..scene import parse_scene
 
@@ -301,51 +302,69 @@ def per_point_columns(kind: str, rows: int) -> Callable:
 
 # --- energy landscape --------------------------------------------------------------------------------------
 
-AMPLITUDE_NORMALISATION = (r"$\Lambda = \varphi\cdot(u - u^*)$, $\varphi$ the critical mode scaled to unit "
-                           "Euclidean norm of its Legendre coefficients")
+LANDSCAPE_OFFSET = 0.01  # |P − P_cr| of Fig. 13, toward the side of the pear branch
+AMPLITUDE_NORMALISATION = (r"$\Lambda = \varphi\cdot(u - u_s)$, $\varphi$ the unit vector (Euclidean norm of the "
+                           r"Legendre coefficients) from the symmetric state $u_s$ to the pear state at that $P$")
 
 
-def landscape_equilibria(e2: float, e3: float, e4: float, resolution: float = 0.0) -> np.ndarray:
-    """The real critical points Λ* of E(Λ) = E2Λ² + E3Λ³ + E4Λ⁴: 0 and the roots of 4E4Λ² + 3E3Λ + 2E2 = 0;
-    roots within ``resolution`` of 0 are 0 (at a branch point E2 vanishes up to the fit's error, and the
-    pitchfork's equilibria coincide there)."""
-    roots = np.roots([4 * e4, 3 * e3, 2 * e2]) if e4 != 0 else np.array([])
-    real = roots[np.abs(roots.imag) <= 1e-12 * max(1.0, np.abs(roots).max(initial=0.0))].real
-    return np.sort(np.r_[0.0, real[np.abs(real) > resolution]])
-
-
-LANDSCAPE_RESOLUTION = 0.02  # Λ* closer to 0 than this fraction of the drawn Λ range are drawn as 0
+def offset_landscape(run: dict, bp: dict, offset: float = LANDSCAPE_OFFSET) -> Landscape:
+    """``analysis.landscape`` at P = P_bp ± ``offset`` next to the pear branch point ``bp`` of the primary branch:
+    on the side of the pear branch whose end lies nearest the point (its first or last 15 points), the pear state
+    and the symmetric state at that P solved from the nearest stored points (the primary's within 5 of the
+    point's index), on the pear branch's discretisation. LandscapeError if there is no pear branch or a solve
+    fails."""
+    scene, primary = stored_scene(run), run["branches"]["primary"]
+    ends = [(abs(data["pressure"][end] - bp["pressure"]), name, end) for name, data in run["branches"].items()
+            if name != "primary" and not name.endswith(MIRROR) for end in (0, len(data["pressure"]) - 1)]
+    if not ends:
+        raise LandscapeError("no pear branch traced")
+    _, name, end = min(ends)
+    pear = run["branches"][name]
+    near = np.arange(len(pear["pressure"]))[:15] if end == 0 else np.arange(len(pear["pressure"]))[-15:]
+    P = bp["pressure"] + np.sign(np.mean(pear["pressure"][near]) - bp["pressure"]) * offset
+    disc, primary_disc = branch_discretisation(pear), branch_discretisation(primary)
+    eq, params = Equilibrium(scene, disc), Parameters(P, primary["attrs"]["M"], primary["attrs"]["chi"])
+    guess = near[np.argmin(np.abs(pear["pressure"][near] - P))]
+    u_pear = state_at(eq, params, pear["unknowns"][guess][:disc.size], P, scene.solver)
+    around = np.arange(max(0, bp["index"] - 4), min(len(primary["pressure"]), bp["index"] + 6))
+    start = around[np.argmin(np.abs(primary["pressure"][around] - P))]
+    u_sym = state_at(eq, params, primary_disc.transfer(primary["unknowns"][start][:primary_disc.size], disc), P,
+                     scene.solver)
+    return landscape(eq, params, u_sym, u_pear, scene.solver)
 
 
 def draw_energy(runs, fig, reading):
-    """Fig. 13: E(Λ) − E0 along the critical mode at each pear pitchfork of the single-coil run (one panel
-    each, by decreasing pressure: P_cr1 then P_cr2), the critical points Λ* marked."""
+    """Fig. 13: ΔΠ(Λ) at LANDSCAPE_OFFSET from each pear pitchfork of the single-coil run (one panel each, by
+    decreasing pressure: P_cr1 then P_cr2; ``offset_landscape``), its equilibria Λ* marked."""
     run = runs[0]
     points = sorted((s for s in run["branches"]["primary"]["special_points"]
-                     if s["kind"] == "BP" and np.isfinite(s["E4"])), key=lambda s: -s["pressure"])
+                     if s["kind"] == "BP" and s["block"] == "odd_held" and np.isfinite(s["E4"])),
+                    key=lambda s: -s["pressure"])
     axes = fig.subplots(1, max(2, len(points)), squeeze=False)[0]
     for k, ax in enumerate(axes):
-        ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
-        ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)")
+        ax.set_xlabel(r"amplitude $\Lambda$ along the pear direction")
+        ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)")
         if k >= len(points):
             _letter(ax, k, f"$P_{{cr{k + 1}}}$: no classified branch point on the traced branch")
             continue
         s = points[k]
-        plot(run | {"branches": {"primary": run["branches"]["primary"] | {"special_points": [s]}}}, "energy",
-             branch="primary", axes=ax)
-        span = np.ptp(ax.get_lines()[-1].get_xdata())
-        for lam in landscape_equilibria(s["E2"], s["E3"], s["E4"], LANDSCAPE_RESOLUTION * span):
-            energy = s["E2"] * lam**2 + s["E3"] * lam**3 + s["E4"] * lam**4
+        _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g} ({s['classification']})")
+        try:
+            land = offset_landscape(run, s)
+        except LandscapeError as e:
+            ax.text(0.5, 0.5, f"not drawn: {e}", transform=ax.transAxes, ha="center", fontsize="x-small")
+            continue
+        ax.axhline(0.0, color="0.6", linewidth=0.6)
+        ax.plot(land.amplitude, land.energy, color="C0")
+        for lam in land.equilibria:
+            energy = np.interp(lam, land.amplitude, land.energy)
             ax.plot(lam, energy, "o", markersize=3.5, markerfacecolor="w", markeredgecolor="k")
             ax.annotate(rf"$\Lambda^*$ = {lam:.3g}", (lam, energy), xytext=(0, 5), textcoords="offset points",
                         ha="center", fontsize="x-small")
-        _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g}, {s['classification']}")
-        ax.get_legend().remove()  # the title names the point, the coefficients follow
-        ax.text(0.5, 0.95, f"E2 = {s['E2']:.3g}, E3 = {s['E3']:.3g}, E4 = {s['E4']:.3g}", transform=ax.transAxes,
-                ha="center", va="top", fontsize="x-small")
-        ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)")
-    fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}; at the "
-                 "branch points; " + AMPLITUDE_NORMALISATION, fontsize="x-small")
+        ax.text(0.5, 0.95, f"at P = P_cr {land.pressure - s['pressure']:+.3g} = {land.pressure:.5g}",
+                transform=ax.transAxes, ha="center", va="top", fontsize="x-small")
+    fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}\n"
+                 + AMPLITUDE_NORMALISATION, fontsize="x-small")
 
 
 # --- the figures -------------------------------------------------------------------------------------------
@@ -395,7 +414,7 @@ def figures(quick: bool = False) -> dict[str, PaperFigure]:
                     (SINGLE_COIL_M0001, TWO_COILS_M0001), per_point_columns("field", 2), 0.65),
         PaperFigure("fig12", "Gaussian curvature κ of configurations 1, 2 | 3 | 8, 9",
                     (SINGLE_COIL_M0001, TWO_COILS_M0001), per_point_columns("curvature", 1), 0.45),
-        PaperFigure("fig13", "energy landscape at the pear pitchforks, one coil, SPOM1, M = 0.001",
+        PaperFigure("fig13", f"energy landscape {LANDSCAPE_OFFSET:g} off the pear pitchforks, one coil, SPOM1, M = 0.001",
                     (SINGLE_COIL_M0001,), draw_energy, 0.5),
     )}
 
@@ -409,8 +428,8 @@ SHORT_LABELS = {  # the kinds' axis labels -> their symbols (units: docs/plots.m
     r"$\eta/R_0$ (height)": r"$\eta/R_0$", r"$\sigma_\theta$ / ($\mu$/2)": r"$\sigma_\theta$",
     r"$\sigma_\phi$ / ($\mu$/2)": r"$\sigma_\phi$", r"$H_\theta$ / ($I/4\pi R_0$)": r"$H_\theta$",
     r"$H_\zeta$ / ($I/4\pi R_0$)": r"$H_\zeta$", r"Gaussian curvature $\kappa R_0^2$": r"$\kappa R_0^2$",
-    r"amplitude $\Lambda$ along the critical mode": r"$\Lambda$",
-    r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)": r"$\Delta\Pi$",
+    r"amplitude $\Lambda$ along the pear direction": r"$\Lambda$",
+    r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)": r"$\Delta\Pi$",
 }
 COMPACT_MARKER = 3.0  # points
 

@@ -1,8 +1,8 @@
-"""The m = 1 claim of docs/paper.md checked by a second method (balloon_cg.analysis.brute_force): the held m = 1
-block from the directly integrated 3D energy on a (θ, φ) grid, differenced numerically, against
-analysis.azimuthal's generated second variation, on pear-shaped equilibria in a field (one coil of radius 2 and
-the paper's two coils, M = 0.001). The longer study over whole traced pear branches is
-benchmarks/m1_brute_force.py."""
+"""Pear-shaped equilibria in a field (one coil of radius 2 and the paper's two coils, M = 0.001): the m = 1 claim
+of docs/paper.md checked by a second method (balloon_cg.analysis.brute_force: the held m = 1 block from the
+directly integrated 3D energy on a (θ, φ) grid, differenced numerically, against analysis.azimuthal's generated
+second variation; the longer study over whole traced pear branches is benchmarks/m1_brute_force.py), and the
+energy landscape off the branch point (analysis.landscape, Fig. 13)."""
 import dataclasses
 from pathlib import Path
 
@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis import azimuthal as az, bifurcation, brute_force as bf
+from balloon_cg.analysis.landscape import landscape, state_at
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.results import Block
@@ -94,3 +95,22 @@ def test_brute_force_eigenvalue_is_converged_in_the_grid_and_the_step(one_coil):
     smaller = bf.m1_block(pear.disc, pear.scene, u, params, N, grid(pear), step=bf.STEP / 2).lowest(1)[0]
     assert abs(finer - base) < 1e-7 * max(1.0, abs(base))
     assert abs(smaller - base) < 1e-7 * max(1.0, abs(base))
+
+
+def test_landscape_off_the_branch_point(two_coils):
+    """At the last pear point's pressure: the symmetric state (solved from the primary side) and the pear state
+    are stationary points of ΔΠ at Λ = 0 and Λ = |u_p − u_s|; μ = −dΔΠ/dΛ (the derivative of a degree-8 fit
+    of the samples); past a supercritical pitchfork the pear state lies below the symmetric one."""
+    pear = two_coils
+    u_pear, params = state(pear, len(pear.X) - 1)
+    eq = equilibrium_of(pear)
+    u_sym = state_at(eq, params, u_pear - 0.9 * (u_pear - pear.X[0, :-1]), params.P, pear.scene.solver)
+    assert np.linalg.norm(u_pear - u_sym) > 1e-3
+    land = landscape(eq, params, u_sym, u_pear, pear.scene.solver, samples=11)
+    found = land.equilibria
+    assert np.abs(found).min() < 1e-12 and np.abs(found - land.pear_amplitude).min() < 5e-3 * land.pear_amplitude
+    fit = np.polynomial.Polynomial.fit(land.amplitude, land.energy, 8)
+    slope = fit.deriv()(land.amplitude)
+    assert -land.multiplier == pytest.approx(slope, abs=1e-4 * np.abs(slope).max())
+    lowest = land.amplitude[np.argmin(land.energy)]  # a double well: the pear state is the minimum on its side
+    assert abs(abs(lowest) - land.pear_amplitude) <= np.diff(land.amplitude)[0] and land.energy.min() < 0
