@@ -202,11 +202,6 @@ class BruteForceBlock:
         projected = linalg.solve(self.G, self.rotation, assume_a="pos")
         return abs(c @ self.rotation) / np.sqrt((c @ self.G @ c) * (projected @ self.rotation))
 
-    def rotation_quotient(self) -> float:
-        """Rayleigh quotient of the rigid tilt (its projection on the basis)."""
-        c = linalg.solve(self.G, self.rotation, assume_a="pos")
-        return (c @ self.H @ c) / (c @ self.G @ c)
-
 
 def coil_rows(scene) -> np.ndarray:
     """The scene's coils as rows (radius, height, current)."""
