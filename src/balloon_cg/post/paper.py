@@ -371,9 +371,10 @@ def draw_energy(runs, fig, reading):
 
 SINGLE_COIL = "spom1_paper_coil"  # the coil inferred from the paper's critical M (a = 1.961 at height 0: docs/paper.md)
 SINGLE_COIL_REACH = (("continuation.stop_stretch", 6.0),)  # the isola reaches λ2(0) = 5.4 (spom1.toml)
-# TPOM1's pear branches with one coil reach λ2(0) = 6 on an unmapped basis, where the held m = 1 eigenvalue at the
-# default perturbation degree 20 is not converged (it changes sign between N = 20 and 40: flagged, approximate m = 1
-# points); from N = 40 on it is converged (−0.012945 at N = 40 … 120 at λ2(0) = 3.54, M = 0.001: docs/paper.md)
+# TPOM1's pear branches with one coil reach λ2(0) = 6 on an unmapped basis, where the held m = 1 eigenvalue is not
+# converged at the default perturbation degree 20 from λ2(0) ≈ 3.5 on, nor at 40 from ≈ 5 on (a spurious sign change:
+# flagged, approximate m = 1 points; converged and negative from N = 80: docs/paper.md). 40 moves the spurious points
+# out to λ2(0) ≈ 5.3 at twice the cost; 80 everywhere would be about eight times the cost.
 TPOM1_SINGLE_COIL_STABILITY = (("stability.degree", 40),)
 
 
