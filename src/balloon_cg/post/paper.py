@@ -8,6 +8,7 @@ primary branch before its turning point TP, if it has one), 3 the last point of 
 where there is one, next to the wire), then the snap-throughs under the figure's stability reading
 (``snap_throughs``: default pressure control), each as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number the two-coil pair 8 (primary) and 9 (pear) at P*.
 """
+import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import resources
@@ -303,8 +304,9 @@ def per_point_columns(kind: str, rows: int) -> Callable:
 # --- energy landscape --------------------------------------------------------------------------------------
 
 LANDSCAPE_OFFSET = 0.01  # |P − P_cr| of Fig. 13, toward the side of the pear branch
-AMPLITUDE_NORMALISATION = (r"$\Lambda = \varphi\cdot(u - u_s)$, $\varphi$ the unit vector (Euclidean norm of the "
+AMPLITUDE_NORMALISATION = (r"$\Lambda=\varphi\cdot(u-u_s)$, $\varphi$ the unit vector (Euclidean norm of the "
                            r"Legendre coefficients) from the symmetric state $u_s$ to the pear state at that $P$")
+# (no spaces inside the math: draw_energy wraps it at spaces)
 
 
 def offset_landscape(run: dict, bp: dict, offset: float = LANDSCAPE_OFFSET) -> Landscape:
@@ -348,23 +350,30 @@ def draw_energy(runs, fig, reading):
             _letter(ax, k, f"$P_{{cr{k + 1}}}$: no classified branch point on the traced branch")
             continue
         s = points[k]
-        _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g} ({s['classification']})")
+        kind = s["classification"].removeprefix("pitchfork-")
         try:
             land = offset_landscape(run, s)
         except LandscapeError as e:
+            _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g}, {kind}")
             ax.text(0.5, 0.5, f"not drawn: {e}", transform=ax.transAxes, ha="center", fontsize="x-small")
             continue
+        _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.4g}, {kind}\n"
+                       f"at P = {land.pressure:.4g} ({land.pressure - s['pressure']:+.2g})")
         ax.axhline(0.0, color="0.6", linewidth=0.6)
         ax.plot(land.amplitude, land.energy, color="C0")
         for lam in land.equilibria:
             energy = np.interp(lam, land.amplitude, land.energy)
             ax.plot(lam, energy, "o", markersize=3.5, markerfacecolor="w", markeredgecolor="k")
-            ax.annotate(rf"$\Lambda^*$ = {lam:.3g}", (lam, energy), xytext=(0, 5), textcoords="offset points",
-                        ha="center", fontsize="x-small")
-        ax.text(0.5, 0.95, f"at P = P_cr {land.pressure - s['pressure']:+.3g} = {land.pressure:.5g}",
-                transform=ax.transAxes, ha="center", va="top", fontsize="x-small")
-    fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}\n"
-                 + AMPLITUDE_NORMALISATION, fontsize="x-small")
+            ax.annotate(f"{lam:.3g}", (lam, energy), xytext=(0, 4), textcoords="offset points", ha="center",
+                        fontsize="x-small")
+        ax.margins(y=0.12)  # room for the labels of Λ* at the extremes
+    width = fig.get_size_inches()[0]
+    fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}; "
+                 r"$\Lambda^*$ marked" + "\n" + textwrap.fill(AMPLITUDE_NORMALISATION, int(SUPTITLE_CHARS * width)),
+                 fontsize="x-small")
+
+
+SUPTITLE_CHARS = 22  # characters of the x-small suptitle per inch of width (wrapping)
 
 
 # --- the figures -------------------------------------------------------------------------------------------
