@@ -6,7 +6,8 @@ The energy of a general mid-surface x(θ, φ) (MODEL.md §2 without the axisymme
     E = (1/2π) ∫∫ [Φ(Λ1, Λ2) − ½ χ M H²(x)] sin θ dθ dφ − P V/(2π),   V = (1/3) ∫∫ x·(x_θ × x_φ) dθ dφ,
 
 Λ1², Λ2² the eigenvalues ½(c11 + c22) ± √(¼(c11 − c22)² + c12²) of C = G⁻¹g in the orthonormal reference
-frame, c11 = |x_θ|², c22 = |q|², c12 = x_θ·q with q = x_φ / sin θ; H² = h_ρ² + h_z² from ``model.field.field_components``
+frame, c11 = |x_θ|², c22 = |q|², c12 = x_θ·q with q = x_φ / sin θ; H² = h_ρ² + h_z² from
+``model.field.field_components``
 at the 3D point. With Gauss nodes in cos θ (dθ sin θ = −d cos θ) and the trapezoid in φ, E = Σ_n w_n g(y_n), where
 the density g = Φ − ½χMH²(x) − (P/3) x·(x_θ × q) at node n depends on the nine numbers y = (x, x_θ, q) there only.
 So the Hessian of E in the coefficients c of x = x0 + Σ c_i δx_i is

@@ -39,8 +39,8 @@ class Landscape:
     @property
     def equilibria(self) -> np.ndarray:
         """Λ where μ changes sign between samples (the root in that interval of the cubic through the four
-        samples around it: it interpolates them, so it has one there) and the samples where μ vanishes (below ZERO_MULTIPLIER of its largest magnitude:
-        Λ = 0 on the symmetric state)."""
+        samples around it: it interpolates them, so it has one there) and the samples where μ vanishes (below
+        ZERO_MULTIPLIER of its largest magnitude: Λ = 0 on the symmetric state)."""
         L, mu = self.amplitude, self.multiplier
         zero = np.abs(mu) <= ZERO_MULTIPLIER * np.abs(mu).max()
         found = list(L[zero])

@@ -6,7 +6,8 @@ Numbered configurations (Figs. 9–12): ``numbered_configurations`` picks them b
 2 pear-shaped at the common pressure P* = the middle of the first pear branch's pressure range (1 on the
 primary branch before its turning point TP, if it has one), 3 the last point of the primary branch (after the TP
 where there is one, next to the wire), then the snap-throughs under the figure's stability reading
-(``snap_throughs``: default pressure control), each as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number the two-coil pair 8 (primary) and 9 (pear) at P*.
+(``snap_throughs``: default pressure control), each as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number
+the two-coil pair 8 (primary) and 9 (pear) at P*.
 """
 import textwrap
 from collections.abc import Callable
@@ -428,7 +429,8 @@ def figures(quick: bool = False) -> dict[str, PaperFigure]:
                     (SINGLE_COIL_M0001, TWO_COILS_M0001), per_point_columns("field", 2), 0.65),
         PaperFigure("fig12", "Gaussian curvature κ of configurations 1, 2 | 3 | 8, 9",
                     (SINGLE_COIL_M0001, TWO_COILS_M0001), per_point_columns("curvature", 1), 0.45),
-        PaperFigure("fig13", f"energy landscape {LANDSCAPE_OFFSET:g} off the pear pitchforks, one coil, SPOM1, M = 0.001",
+        PaperFigure("fig13", f"energy landscape {LANDSCAPE_OFFSET:g} off the pear pitchforks, one coil, SPOM1, "
+                    "M = 0.001",
                     (SINGLE_COIL_M0001,), draw_energy, 0.5),
     )}
 
