@@ -1,22 +1,28 @@
 """The paper's figures (reduced: post.paper.QUICK, one M), the stability readings, and the journal conventions."""
+from pathlib import Path
+
 import matplotlib
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
+from balloon_cg import Scene
 from balloon_cg.app import figures as app_figures
+from balloon_cg.app.api import analyse
 from balloon_cg.app.cli import main
 from balloon_cg.app.figures import make_figure, run_for
-from balloon_cg.post.paper import (PAPER_STYLE, ONE_COLUMN, TWO_COLUMNS, Case, draw_figure, figures,
-                                   landscape_equilibria, numbered_configurations)
+from balloon_cg.analysis.picture import Curve, find_snaps
+from balloon_cg.post.paper import (PAPER_STYLE, ONE_COLUMN, SNAP_READINGS, TWO_COLUMNS, Case, draw_figure, figures,
+                                   numbered_configurations, snap_throughs)
 from balloon_cg.post.plotting import Reading, load_branches, plot, robust_limits, stable_points
 
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
 POLE = r"pole stretch $\lambda_2(0)$ (north)"
 PRESSURE = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
 THETA = r"material coordinate $\theta$ (rad)"
 EQUATOR_2 = r"equator stretch $\lambda_2(\pi/2)$ (circumferential)"
 EQUATOR_1 = r"equator stretch $\lambda_1(\pi/2)$ (meridional)"
-ENERGY = r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)"
+ENERGY = r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)"
 LABELS = {  # (x labels, y labels) the figure's axes must carry
     "fig2": ({POLE}, {PRESSURE}),
     "fig3": ({POLE}, {PRESSURE}), "fig6": ({POLE}, {PRESSURE}),
@@ -26,7 +32,7 @@ LABELS = {  # (x labels, y labels) the figure's axes must carry
              {PRESSURE, r"$\eta/R_0$ (height)", r"$\sigma_\theta$ / ($\mu$/2)", r"$\sigma_\phi$ / ($\mu$/2)"}),
     "fig11": ({THETA}, {r"$H_\theta$ / ($I/4\pi R_0$)", r"$H_\zeta$ / ($I/4\pi R_0$)"}),
     "fig12": ({THETA}, {r"Gaussian curvature $\kappa R_0^2$"}),
-    "fig13": ({r"amplitude $\Lambda$ along the critical mode"}, {ENERGY}),
+    "fig13": ({r"amplitude $\Lambda$ along the pear direction"}, {ENERGY}),
 }
 LABELS["fig10"] = LABELS["fig9"]
 PANELS = {"fig2": 4, "fig3": 4, "fig4": 4, "fig5": 4, "fig6": 4, "fig7": 4, "fig8": 4, "fig9": 6, "fig10": 6,
@@ -110,6 +116,38 @@ def test_numbered_configurations_by_rule(runs):
         assert abs(primary["pressure"][numbered[1].index] - middle) <= np.ptp(primary["pressure"])
 
 
+def test_snap_throughs_at_both_ends_of_a_stable_stretch_to_the_lowest_energy():
+    """A stretch stable between points 2 and 4 ends at both (raising and lowering the control); each jumps to the
+    stable interval of lowest energy that strictly brackets its control value, never to its mirror image."""
+    a = Curve("pear_0", np.array([0.0, 1, 2, 3, 4, 5]), np.array([0, 0, 1, 1, 1, 0], dtype=bool), np.zeros(6))
+    mirror = Curve("pear_0_mirror", a.control, a.stable, a.energy)
+    low = Curve("primary", np.array([1.5, 4.5]), np.array([1, 1], dtype=bool), np.array([-1.0, -1.0]))
+    high = Curve("other", np.array([1.5, 4.5]), np.array([1, 1], dtype=bool), np.array([5.0, 5.0]))
+    snaps = [(s.from_branch, s.from_index, s.pressure, s.to_branch) for s in find_snaps([a, mirror, low, high])]
+    assert snaps[:2] == [("pear_0", 2, 2.0, "primary"), ("pear_0", 4, 4.0, "primary")]
+    assert ("pear_0_mirror", 2, 2.0, "primary") in snaps
+    assert not any(s[0] != "pear_0" and s[3] == "pear_0" for s in snaps)  # the mirror is no target
+
+
+def test_snap_throughs_from_stored_data_equal_the_analysis():
+    """Under pressure control the search on a stored run (stored flags, energies from the stored unknowns) finds
+    the snap-throughs the analysis stored (SPOM1, M = 0: the limit point, no stable target); under volume control
+    the primary branch loses stability at the pitchfork P_cr1 instead (controls: volumes)."""
+    scene = Scene.from_toml(SCENES / "spom1.toml").with_overrides({"continuation.stop_stretch": 2.0,
+                                                                   "stability.m_max": 0})
+    run = analyse(scene, pear=False).run
+    stored = [(s["from_branch"], s["from_index"], s["to_branch"], s["to_index"]) for s in run["snap_throughs"]]
+    found = [(s.from_branch, s.from_index, s.to_branch, s.to_index) for s in snap_throughs(run, Reading.PRESSURE)]
+    assert found == stored and len(stored) == 1
+    P = run["branches"]["primary"]["pressure"]
+    between = lambda i, value: (P[i] - value) * (P[i + 1] - value) <= 0  # noqa: E731
+    assert P[stored[0][1]] == pytest.approx(2.568464, abs=5e-3)  # the last stable point before the fold
+    [volume] = snap_throughs(run, Reading.VOLUME)
+    assert between(volume.from_index, 2.26473)  # P_cr1 lies between the last stable point and the next
+    assert volume.pressure == pytest.approx(run["branches"]["primary"]["volume"][volume.from_index])
+    assert [s.from_index for s in snap_throughs(run, Reading.AXISYMMETRIC)] == [stored[0][1]]
+
+
 def _data(n, **blocks):
     return {"pressure": np.zeros(n), "stability": blocks}
 
@@ -159,16 +197,6 @@ def test_robust_limits_clip_a_spike_only():
     assert robust_limits(ax, [spike])
     low, high = ax.get_ylim()
     assert low <= 0 and 1.0 < high < 10  # the bulk (0..1) fills the axes, the spike (1000) is clipped
-
-
-def test_landscape_equilibria_closed_form():
-    """E = E2Λ² + E4Λ⁴ with E2 < 0 < E4: minima at ±√(−E2/(2E4)); with E3: the roots of 4E4Λ² + 3E3Λ + 2E2."""
-    assert landscape_equilibria(-1.0, 0.0, 1.0) == pytest.approx([-np.sqrt(0.5), 0.0, np.sqrt(0.5)])
-    assert landscape_equilibria(1.0, 0.0, 1.0) == pytest.approx([0.0])
-    e2, e3, e4 = -0.3, 0.2, 0.5
-    found = landscape_equilibria(e2, e3, e4)
-    assert 2 * e2 * found + 3 * e3 * found**2 + 4 * e4 * found**3 == pytest.approx(np.zeros(3), abs=1e-12)
-    assert landscape_equilibria(-1e-8, 0.0, 1.0, resolution=1e-3) == pytest.approx([0.0])  # at a branch point
 
 
 def test_make_figure_output_folder_default(runs, tmp_path):

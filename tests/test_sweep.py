@@ -223,3 +223,5 @@ def test_phase_diagram_from_a_sweep_file(tmp_path):
     assert ax.get_xlabel() == "material.alpha[0]" and "bifurcation pressure" in ax.get_ylabel()
     lines = [line for line in ax.get_lines() if "pear pitchfork" in line.get_label()]
     assert len(lines) == 2 and all(len(line.get_xdata()) == 2 for line in lines)
+    [fold] = [line for line in ax.get_lines() if "fold (LP)" in line.get_label()]
+    assert len(fold.get_xdata()) == 2 and np.all(np.asarray(fold.get_ydata()) > 2.5)  # P_max ≈ 2.57 (α1 = 1.3)

@@ -183,8 +183,24 @@ def test_phase_diagram_plot(curve, tmp_path):
     ax = fig.axes[0]
     assert "alpha_1" in ax.get_xlabel() and "bifurcation pressure" in ax.get_ylabel()
     assert any("critical alpha1 = 1.73962" in t.get_text() for t in ax.texts)
+    [shaded] = ax.patches  # the isola region, bounded by the smoothed curve (not the chords of its points)
+    assert len(shaded.get_xy()) >= 400 > len(read_curve(path)["q"])
     fig.savefig(tmp_path / "phase.png")
     assert (tmp_path / "phase.png").stat().st_size > 1000
+
+
+def test_smooth_curve_follows_a_sparse_arc():
+    """Nine points on a half circle (its apex among them, as the located fold is on a curve): the curve through
+    them stays within 6e-3 of the circle where the chords between the points sag by 1 − cos(π/16) ≈ 0.019,
+    passes through every point and never leaves the points' range (no overshoot)."""
+    from balloon_cg.post.plotting import smooth_curve
+
+    t = np.linspace(0.0, np.pi, 9)
+    q0, P0 = 1e-3 * (1 + np.cos(t)), 2.0 + np.sin(t)
+    q, P = smooth_curve(q0, P0)
+    assert np.abs(np.hypot(q / 1e-3 - 1, P - 2.0) - 1).max() < 6e-3
+    assert all(np.hypot((q - a) / 1e-3, P - b).min() < 1e-2 for a, b in zip(q0, P0))
+    assert q.min() >= q0.min() and q.max() <= q0.max() and P.max() <= P0.max()
 
 
 # -- how a curve ends (CurveEnd) ------------------------------------------------------------------------------

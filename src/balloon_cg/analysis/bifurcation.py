@@ -208,6 +208,14 @@ def mode_direction(bp: SpecialPoint, disc: Discretisation):
     return direction / np.linalg.norm(direction)
 
 
+def constrained_minimum(eq: Equilibrium, params, phi: np.ndarray, target: float, guess: np.ndarray, solver):
+    """The stationary point of E(u) on the hyperplane φ·u = target (the other modes relax): Newton on
+    R(u) + μφ = 0, φ·u = target in x = (u, μ) from (guess, 0); x[-1] = μ = −dE/dΛ along the constraint."""
+    return newton(lambda x: eq.residual(x[:-1], params) + x[-1] * phi,
+                  lambda x: np.hstack([eq.jacobian(x[:-1], params), phi[:, None]]),
+                  np.append(guess, 0.0), np.append(phi, 0.0), target, solver.tol, solver.max_newton)
+
+
 def classify(branch: Branch, bp: SpecialPoint, delta: float = 2e-2) -> SpecialPoint:
     """``bp`` with E2, E3, E4 of the reduced energy at fixed P* and its classification (module docstring);
     unclassified (Classification.NONE) when fewer than three constrained minimisations converge."""
@@ -221,10 +229,7 @@ def classify(branch: Branch, bp: SpecialPoint, delta: float = 2e-2) -> SpecialPo
     E0 = eq.energy(u_star, params)
     lams, energies = [], []
     for lam in (-2 * delta, -delta, delta, 2 * delta):
-        result = newton(lambda x: eq.residual(x[:-1], params) + x[-1] * phi,
-                        lambda x: np.hstack([eq.jacobian(x[:-1], params), phi[:, None]]),
-                        np.append(u_star + lam * phi, 0.0), np.append(phi, 0.0), phi @ u_star + lam,
-                        solver.tol, solver.max_newton)
+        result = constrained_minimum(eq, params, phi, phi @ u_star + lam, u_star + lam * phi, solver)
         if result.converged:
             lams.append(lam)
             energies.append(eq.energy(result.x[:-1], params) - E0)

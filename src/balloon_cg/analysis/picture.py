@@ -27,6 +27,9 @@ from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 
 
+MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
+
+
 class Phase(enum.StrEnum):
     """The phases of ``analyse``, for progress reports."""
 
@@ -54,9 +57,9 @@ class Progress:
 
 @dataclass
 class SnapThrough:
-    """Under the scene's loading control: a stable stretch of ``from_branch`` ends after point ``from_index`` at
-    ``pressure``; the stable point of largest volume at the same value of the control parameter is on
-    ``to_branch`` near ``to_index`` ("" and −1: none)."""
+    """Under the scene's loading control: a stable stretch of ``from_branch`` ends at point ``from_index`` (its
+    last stable point) at ``pressure`` (the control value there: P, V or n); the lowest-energy stable point at
+    that control value is on ``to_branch`` near ``to_index`` ("" and −1: none) (``find_snaps``)."""
 
     from_branch: str
     from_index: int
@@ -153,7 +156,7 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
     for n, bp in enumerate(picture.branch_points):
         if bp.block != Block.ODD_HELD or n in reached:
             continue
-        for sign, suffix in ((1.0, ""), (-1.0, "_mirror")):
+        for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
             if interrupt.requested():
                 return
             name = f"pear_{n}{suffix}"
@@ -186,36 +189,68 @@ HELD_FLAG = {Control.PRESSURE: "stable_pressure", Control.VOLUME: "stable_volume
 
 
 def snap_throughs(branches: list, control: Control = Control.PRESSURE) -> list:
-    """Under the loading ``control`` (its held flag, HELD_FLAG): where a stable stretch of a branch ends (fold or
-    loss of stability), the jump to the stable point of largest volume at the same value of the control
-    parameter q (P, V or n: ``control.control_value``) on any branch (or none found); ``pressure`` is P at the
-    last stable point."""
+    """The snap-throughs under the loading ``control`` (``find_snaps``): its held flag (HELD_FLAG), its control
+    value q (P, V or n: ``control.control_value``) and the energy it minimises ranking the targets (per 2π, with
+    Ṽ = V/2π: E(u; P) under pressure control, the stored energy E + PṼ at fixed volume, and E + PṼ − (n/2π) ln V
+    for an isothermal ideal gas of amount n)."""
+    curves = []
+    for b in branches:
+        eq = equilibrium_of(b)
+        energy, q = np.empty(len(b.X)), np.empty(len(b.X))
+        for k, x in enumerate(b.X):
+            params = b.params.with_value(b.parameter, x[-1])  # a voltage branch: q = Φ̄ at fixed P
+            energy[k] = eq.energy(x[:-1], params)
+            if control != Control.PRESSURE:
+                P, volume = x[-1], eq.volume(x[:-1])
+                energy[k] += P * volume - (P * volume * np.log(2 * np.pi * volume) if control == Control.GAS else 0)
+            q[k] = x[-1] if b.parameter != "P" else control_value(b.disc, x, control)
+        stable = np.array([a.flags()[HELD_FLAG[control]] for a in b.stability], dtype=bool)
+        curves.append(Curve(b.name, q, stable, energy))
+    return find_snaps(curves)
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A branch as ``find_snaps`` sees it, per point: the control value (P under pressure control, the volume
+    under volume control), whether it is stable under that control, and the energy that control minimises."""
+
+    name: str
+    control: np.ndarray
+    stable: np.ndarray
+    energy: np.ndarray
+
+
+def find_snaps(curves: list[Curve]) -> list[SnapThrough]:
+    """Where a stable stretch of a branch ends next to an unstable point (a fold or a loss of stability, reached
+    by raising or lowering the control along the stretch: both ends of every stretch), the jump at that control
+    value to the stable point of lowest energy on any branch (an interval of two stable points strictly bracketing
+    it, not within one point of the start on its branch or on the branch's mirror image: the same state
+    reflected; none: to_branch ""). ``pressure`` of the result is the control value."""
     snaps = []
-    for branch in branches:
-        stable = np.array([a.flags()[HELD_FLAG[control]] for a in branch.stability])
-        q = _control_values(branch, control)
+    for curve in curves:
+        stable = curve.stable
         for i in range(len(stable) - 1):
-            if stable[i] and not stable[i + 1]:
-                target = _stable_at(branches, q[i], control, exclude=(branch.name, i))
-                snaps.append(SnapThrough(branch.name, i, float(branch.pressure[i]), *(target or ())))
+            if stable[i] != stable[i + 1]:
+                end = i if stable[i] else i + 1
+                value = float(curve.control[end])
+                target = _stable_at(curves, value, exclude=(curve.name, end))
+                snaps.append(SnapThrough(curve.name, end, value, *(target or ())))
     return snaps
 
 
-def _control_values(branch: Branch, control: Control) -> np.ndarray:
-    return np.array([control_value(branch.disc, X, control) for X in branch.X])
+def _family(name: str) -> str:
+    """A pear branch and its mirror image (``_trace_pears`` names it <name>_mirror) share a family."""
+    return name.removesuffix(MIRROR)
 
 
-def _stable_at(branches: list, value: float, control: Control, exclude):
+def _stable_at(curves: list[Curve], value: float, exclude):
     best = None
-    for branch in branches:
-        stable = np.array([a.flags()[HELD_FLAG[control]] for a in branch.stability])
-        p = _control_values(branch, control)
-        eq = equilibrium_of(branch)
-        for i in range(len(p) - 1):
-            if (branch.name, i) == exclude or abs(i - exclude[1]) <= 1 and branch.name == exclude[0]:
+    for curve in curves:
+        stable, c = curve.stable, curve.control
+        for i in range(len(c) - 1):
+            if _family(curve.name) == _family(exclude[0]) and abs(i - exclude[1]) <= 1:
                 continue
-            if stable[i] and stable[i + 1] and (p[i] - value) * (p[i + 1] - value) <= 0:
-                volume = eq.volume(branch.X[i, :-1])
-                if best is None or volume > best[0]:
-                    best = (volume, branch.name, i)
+            if stable[i] and stable[i + 1] and (c[i] - value) * (c[i + 1] - value) < 0:
+                if best is None or curve.energy[i] < best[0]:
+                    best = (curve.energy[i], curve.name, i)
     return best[1:] if best else None

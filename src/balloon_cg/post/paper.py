@@ -5,9 +5,11 @@ computed or reused by ``app.figures``.
 Numbered configurations (Figs. 9–12): ``numbered_configurations`` picks them by rule from a run: 1 primary and
 2 pear-shaped at the common pressure P* = the middle of the first pear branch's pressure range (1 on the
 primary branch before its turning point TP, if it has one), 3 the last point of the primary branch (after the TP
-where there is one, next to the wire), then the snap-throughs under pressure control stored with the run, each
-as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number the two-coil pair 8 (primary) and 9 (pear) at P*.
+where there is one, next to the wire), then the snap-throughs under the figure's stability reading
+(``snap_throughs``: default pressure control), each as its pair (from, to): 4 → 5, 6 → 7. Figs. 10–12 number
+the two-coil pair 8 (primary) and 9 (pear) at P*.
 """
+import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import resources
@@ -16,8 +18,11 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .plotting import P_LABEL, Configuration, Reading, describe_scene, plot
-from .quantities import stored_scene
+from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
+from .quantities import branch_discretisation, stored_scene
+from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
+from ..analysis.picture import MIRROR, Curve, find_snaps
+from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..scene import parse_scene
 
 ONE_COLUMN, TWO_COLUMNS = 3.5, 7.2  # journal widths, inches
@@ -168,10 +173,41 @@ def _x_label(kind, panel):
 
 # --- numbered configurations -------------------------------------------------------------------------------
 
-def numbered_configurations(run: dict, first: int = 1, snaps: bool = True) -> dict[int, Configuration]:
+VOLUME_CONTROL = (Reading.VOLUME, Reading.FREE_VOLUME)  # readings whose control is the volume; the others: P
+SNAP_READINGS = (Reading.PRESSURE, Reading.VOLUME, Reading.FREE, Reading.FREE_VOLUME, Reading.AXISYMMETRIC)
+
+
+def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
+    """The snap-throughs of a stored run with stability read as ``reading`` (``analysis.picture.find_snaps`` on
+    the stored flags or blocks, ``plotting.stable_points``): under pressure control at equal P to the stable
+    point of lowest E(u; P), under volume control at equal volume to the one of lowest E + P V/2π (the energy
+    without the pressure work), E the Galerkin energy of the stored unknowns. Branches without stability data
+    are left out; ``pressure`` of each result is the control value."""
+    if reading not in SNAP_READINGS:
+        raise PlotError(f"--stability {reading.value}: no snap-through search for this reading (one of "
+                        f"{', '.join(r.value for r in SNAP_READINGS)})")
+    scene = stored_scene(run)
+    volume_control = reading in VOLUME_CONTROL
+    curves = []
+    for name, data in run["branches"].items():
+        stable = stable_points(data, reading)
+        if stable is None:
+            continue
+        disc = branch_discretisation(data)
+        eq, M, chi = Equilibrium(scene, disc), data["attrs"]["M"], data["attrs"]["chi"]
+        P, V = data["pressure"], data["volume"]
+        E = np.array([eq.energy(X[:disc.size], Parameters(p, M, chi)) for X, p in zip(data["unknowns"], P)])
+        curves.append(Curve(name, V if volume_control else P, stable, E + P * V / (2 * np.pi) if volume_control
+                            else E))
+    return find_snaps(curves)
+
+
+def numbered_configurations(run: dict, first: int = 1, snaps: bool = True,
+                            reading: Reading = Reading.PRESSURE) -> dict[int, Configuration]:
     """The paper's numbered configurations of a run by number (module docstring): ``first`` primary and
     ``first`` + 1 pear-shaped at P*, ``first`` + 2 the last primary point, then each snap-through's (from, to)
-    pair. Without a pear branch there is no ``first`` + 1, and P* is the middle of the primary pressure range."""
+    pair under ``reading`` (``snap_throughs``). Without a pear branch there is no ``first`` + 1, and P* is the
+    middle of the primary pressure range."""
     branches = run["branches"]
     primary = branches["primary"]
     pear = next((name for name in branches if name.startswith("pear") and not name.endswith("_mirror")), None)
@@ -182,8 +218,8 @@ def numbered_configurations(run: dict, first: int = 1, snaps: bool = True) -> di
     chosen = {first: ("primary", int(np.abs(P[before] - target).argmin())), first + 2: ("primary", len(P) - 1)}
     if pear:
         chosen[first + 1] = (pear, int(np.abs(branches[pear]["pressure"] - target).argmin()))
-    pairs = [(s["from_branch"], s["from_index"], s["to_branch"], s["to_index"])
-             for s in run["snap_throughs"] if snaps and s["to_branch"]]
+    pairs = [(s.from_branch, s.from_index, s.to_branch, s.to_index)
+             for s in (snap_throughs(run, reading) if snaps else ()) if s.to_branch]
     for k, (source, i, target_branch, j) in enumerate(pairs):
         chosen[first + 3 + 2 * k] = (source, int(i))
         chosen[first + 4 + 2 * k] = (target_branch, int(j))
@@ -214,7 +250,7 @@ def configurations_figure(two_coils: bool) -> Callable:
 
     def draw(runs, fig, reading):
         run = runs[0]
-        numbered = numbered_configurations(run, first=8 if two_coils else 1, snaps=not two_coils)
+        numbered = numbered_configurations(run, first=8 if two_coils else 1, snaps=not two_coils, reading=reading)
         shapes = pick(numbered, 8, 9) if two_coils else pick(numbered, 1, 2, 3)
         groups = [pick(numbered, 8), pick(numbered, 9)] if two_coils else [pick(numbered, 1, 2), pick(numbered, 3)]
         panels = fig.subplot_mosaic([["a", "b"], ["c0", "d0"], ["c1", "d1"]], height_ratios=[1.4, 1, 1])
@@ -268,74 +304,106 @@ def per_point_columns(kind: str, rows: int) -> Callable:
 
 # --- energy landscape --------------------------------------------------------------------------------------
 
-AMPLITUDE_NORMALISATION = (r"$\Lambda = \varphi\cdot(u - u^*)$, $\varphi$ the critical mode scaled to unit "
-                           "Euclidean norm of its Legendre coefficients")
+LANDSCAPE_OFFSET = 0.01  # |P − P_cr| of Fig. 13, toward the side of the pear branch
+AMPLITUDE_NORMALISATION = (r"$\Lambda=\varphi\cdot(u-u_s)$, $\varphi$ the unit vector (Euclidean norm of the "
+                           r"Legendre coefficients) from the symmetric state $u_s$ to the pear state at that $P$")
+# (no spaces inside the math: draw_energy wraps it at spaces)
 
 
-def landscape_equilibria(e2: float, e3: float, e4: float, resolution: float = 0.0) -> np.ndarray:
-    """The real critical points Λ* of E(Λ) = E2Λ² + E3Λ³ + E4Λ⁴: 0 and the roots of 4E4Λ² + 3E3Λ + 2E2 = 0;
-    roots within ``resolution`` of 0 are 0 (at a branch point E2 vanishes up to the fit's error, and the
-    pitchfork's equilibria coincide there)."""
-    roots = np.roots([4 * e4, 3 * e3, 2 * e2]) if e4 != 0 else np.array([])
-    real = roots[np.abs(roots.imag) <= 1e-12 * max(1.0, np.abs(roots).max(initial=0.0))].real
-    return np.sort(np.r_[0.0, real[np.abs(real) > resolution]])
-
-
-LANDSCAPE_RESOLUTION = 0.02  # Λ* closer to 0 than this fraction of the drawn Λ range are drawn as 0
+def offset_landscape(run: dict, bp: dict, offset: float = LANDSCAPE_OFFSET) -> Landscape:
+    """``analysis.landscape`` at P = P_bp ± ``offset`` next to the pear branch point ``bp`` of the primary branch:
+    on the side of the pear branch whose end lies nearest the point (its first or last 15 points), the pear state
+    and the symmetric state at that P solved from the nearest stored points (the primary's within 5 of the
+    point's index), on the pear branch's discretisation. LandscapeError if there is no pear branch or a solve
+    fails."""
+    scene, primary = stored_scene(run), run["branches"]["primary"]
+    ends = [(abs(data["pressure"][end] - bp["pressure"]), name, end) for name, data in run["branches"].items()
+            if name != "primary" and not name.endswith(MIRROR) for end in (0, len(data["pressure"]) - 1)]
+    if not ends:
+        raise LandscapeError("no pear branch traced")
+    _, name, end = min(ends)
+    pear = run["branches"][name]
+    near = np.arange(len(pear["pressure"]))[:15] if end == 0 else np.arange(len(pear["pressure"]))[-15:]
+    P = bp["pressure"] + np.sign(np.mean(pear["pressure"][near]) - bp["pressure"]) * offset
+    disc, primary_disc = branch_discretisation(pear), branch_discretisation(primary)
+    eq, params = Equilibrium(scene, disc), Parameters(P, primary["attrs"]["M"], primary["attrs"]["chi"])
+    guess = near[np.argmin(np.abs(pear["pressure"][near] - P))]
+    u_pear = state_at(eq, params, pear["unknowns"][guess][:disc.size], P, scene.solver)
+    around = np.arange(max(0, bp["index"] - 4), min(len(primary["pressure"]), bp["index"] + 6))
+    start = around[np.argmin(np.abs(primary["pressure"][around] - P))]
+    u_sym = state_at(eq, params, primary_disc.transfer(primary["unknowns"][start][:primary_disc.size], disc), P,
+                     scene.solver)
+    return landscape(eq, params, u_sym, u_pear, scene.solver)
 
 
 def draw_energy(runs, fig, reading):
-    """Fig. 13: E(Λ) − E0 along the critical mode at each pear pitchfork of the single-coil run (one panel
-    each, by decreasing pressure: P_cr1 then P_cr2), the critical points Λ* marked."""
+    """Fig. 13: ΔΠ(Λ) at LANDSCAPE_OFFSET from each pear pitchfork of the single-coil run (one panel each, by
+    decreasing pressure: P_cr1 then P_cr2; ``offset_landscape``), its equilibria Λ* marked."""
     run = runs[0]
     points = sorted((s for s in run["branches"]["primary"]["special_points"]
-                     if s["kind"] == "BP" and np.isfinite(s["E4"])), key=lambda s: -s["pressure"])
+                     if s["kind"] == "BP" and s["block"] == "odd_held" and np.isfinite(s["E4"])),
+                    key=lambda s: -s["pressure"])
     axes = fig.subplots(1, max(2, len(points)), squeeze=False)[0]
     for k, ax in enumerate(axes):
-        ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
-        ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)")
+        ax.set_xlabel(r"amplitude $\Lambda$ along the pear direction")
+        ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)")
         if k >= len(points):
             _letter(ax, k, f"$P_{{cr{k + 1}}}$: no classified branch point on the traced branch")
             continue
         s = points[k]
-        plot(run | {"branches": {"primary": run["branches"]["primary"] | {"special_points": [s]}}}, "energy",
-             branch="primary", axes=ax)
-        span = np.ptp(ax.get_lines()[-1].get_xdata())
-        for lam in landscape_equilibria(s["E2"], s["E3"], s["E4"], LANDSCAPE_RESOLUTION * span):
-            energy = s["E2"] * lam**2 + s["E3"] * lam**3 + s["E4"] * lam**4
+        kind = s["classification"].removeprefix("pitchfork-")
+        try:
+            land = offset_landscape(run, s)
+        except LandscapeError as e:
+            _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g}, {kind}")
+            ax.text(0.5, 0.5, f"not drawn: {e}", transform=ax.transAxes, ha="center", fontsize="x-small")
+            continue
+        _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.4g}, {kind}\n"
+                       f"at P = {land.pressure:.4g} ({land.pressure - s['pressure']:+.2g})")
+        ax.axhline(0.0, color="0.6", linewidth=0.6)
+        ax.plot(land.amplitude, land.energy, color="C0")
+        for lam in land.equilibria:
+            energy = np.interp(lam, land.amplitude, land.energy)
             ax.plot(lam, energy, "o", markersize=3.5, markerfacecolor="w", markeredgecolor="k")
-            ax.annotate(rf"$\Lambda^*$ = {lam:.3g}", (lam, energy), xytext=(0, 5), textcoords="offset points",
-                        ha="center", fontsize="x-small")
-        _letter(ax, k, f"$P_{{cr{k + 1}}}$ = {s['pressure']:.5g}, {s['classification']}")
-        ax.get_legend().remove()  # the title names the point, the coefficients follow
-        ax.text(0.5, 0.95, f"E2 = {s['E2']:.3g}, E3 = {s['E3']:.3g}, E4 = {s['E4']:.3g}", transform=ax.transAxes,
-                ha="center", va="top", fontsize="x-small")
-        ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)")
-    fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}; at the "
-                 "branch points; " + AMPLITUDE_NORMALISATION, fontsize="x-small")
+            ax.annotate(f"{lam:.3g}", (lam, energy), xytext=(0, 4), textcoords="offset points", ha="center",
+                        fontsize="x-small")
+        ax.margins(y=0.12)  # room for the labels of Λ* at the extremes
+    width = fig.get_size_inches()[0]
+    fig.suptitle(f"{describe_scene(stored_scene(run))}, M = {run['branches']['primary']['attrs']['M']:g}; "
+                 r"$\Lambda^*$ marked" + "\n" + textwrap.fill(AMPLITUDE_NORMALISATION, int(SUPTITLE_CHARS * width)),
+                 fontsize="x-small")
+
+
+SUPTITLE_CHARS = 22  # characters of the x-small suptitle per inch of width (wrapping)
 
 
 # --- the figures -------------------------------------------------------------------------------------------
 
+SINGLE_COIL = "spom1_paper_coil"  # the coil inferred from the paper's critical M (a = 1.961 at height 0: docs/paper.md)
 SINGLE_COIL_REACH = (("continuation.stop_stretch", 6.0),)  # the isola reaches λ2(0) = 5.4 (spom1.toml)
+# TPOM1's pear branches with one coil reach λ2(0) = 6 on an unmapped basis, where the held m = 1 eigenvalue is not
+# converged at the default perturbation degree 20 from λ2(0) ≈ 3.5 on, nor at 40 from ≈ 5 on (a spurious sign change:
+# flagged, approximate m = 1 points; converged and negative from N = 80: docs/paper.md). 40 moves the spurious points
+# out to λ2(0) ≈ 5.3 at twice the cost; 80 everywhere would be about eight times the cost.
+TPOM1_SINGLE_COIL_STABILITY = (("stability.degree", 40),)
 
 
 def _family(single_coil: bool, quick: bool) -> tuple[Case, ...]:
     """SPOM1 then TPOM1: M = 0 (field-free scenes; not in quick runs) and the M values with one coil
-    (spom1_single_coil, its material replaced for TPOM1) or the paper's two coils (the shipped scenes)."""
+    (SINGLE_COIL, its material replaced for TPOM1) or the paper's two coils (the shipped scenes)."""
     values = QUICK_M_VALUES if quick else M_VALUES
     cases = []
     for material in ("spom1", "tpom1"):
         cases += [] if quick else [Case(material)]
         if single_coil:
-            preset = () if material == "spom1" else (("material.preset", "TPOM1"),)
-            cases += [Case("spom1_single_coil", preset + (("field.M", M),) + SINGLE_COIL_REACH) for M in values]
+            preset = () if material == "spom1" else (("material.preset", "TPOM1"),) + TPOM1_SINGLE_COIL_STABILITY
+            cases += [Case(SINGLE_COIL, preset + (("field.M", M),) + SINGLE_COIL_REACH) for M in values]
         else:
             cases += [Case(f"{material}_two_coils_M{M:g}") for M in values]
     return tuple(cases)
 
 
-SINGLE_COIL_M0001 = Case("spom1_single_coil", (("field.M", 0.001),) + SINGLE_COIL_REACH)
+SINGLE_COIL_M0001 = Case(SINGLE_COIL, (("field.M", 0.001),) + SINGLE_COIL_REACH)
 TWO_COILS_M0001 = Case("spom1_two_coils_M0.001")
 
 
@@ -361,7 +429,8 @@ def figures(quick: bool = False) -> dict[str, PaperFigure]:
                     (SINGLE_COIL_M0001, TWO_COILS_M0001), per_point_columns("field", 2), 0.65),
         PaperFigure("fig12", "Gaussian curvature κ of configurations 1, 2 | 3 | 8, 9",
                     (SINGLE_COIL_M0001, TWO_COILS_M0001), per_point_columns("curvature", 1), 0.45),
-        PaperFigure("fig13", "energy landscape at the pear pitchforks, one coil, SPOM1, M = 0.001",
+        PaperFigure("fig13", f"energy landscape {LANDSCAPE_OFFSET:g} off the pear pitchforks, one coil, SPOM1, "
+                    "M = 0.001",
                     (SINGLE_COIL_M0001,), draw_energy, 0.5),
     )}
 
@@ -375,8 +444,8 @@ SHORT_LABELS = {  # the kinds' axis labels -> their symbols (units: docs/plots.m
     r"$\eta/R_0$ (height)": r"$\eta/R_0$", r"$\sigma_\theta$ / ($\mu$/2)": r"$\sigma_\theta$",
     r"$\sigma_\phi$ / ($\mu$/2)": r"$\sigma_\phi$", r"$H_\theta$ / ($I/4\pi R_0$)": r"$H_\theta$",
     r"$H_\zeta$ / ($I/4\pi R_0$)": r"$H_\zeta$", r"Gaussian curvature $\kappa R_0^2$": r"$\kappa R_0^2$",
-    r"amplitude $\Lambda$ along the critical mode": r"$\Lambda$",
-    r"$\Delta\Pi = E(\Lambda) - E_0$ (per $2\pi$)": r"$\Delta\Pi$",
+    r"amplitude $\Lambda$ along the pear direction": r"$\Lambda$",
+    r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)": r"$\Delta\Pi$",
 }
 COMPACT_MARKER = 3.0  # points
 

@@ -23,6 +23,7 @@ import h5py
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from scipy.interpolate import PchipInterpolator
 
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
 from ..galerkin.profiles import EQUATOR
@@ -666,12 +667,17 @@ def plot_phase(paths, axes=None) -> Figure:
             curve = read_curve(path, name)
             q, P = curve["q"], curve["pressure"]
             parameters.add(curve["attrs"]["parameter"])
-            line, = ax.plot(q, P, label=f"{Path(path).stem}: {name}")
+            folds = [(s["index"], q_s, s["pressure"]) for s, q_s in zip(curve["special_points"], curve["special_q"])
+                     if s["kind"] == "LP"]
+            dense_q, dense_P = smooth_curve(*_with_points(q, P, folds))
+            line, = ax.plot(dense_q, dense_P, label=f"{Path(path).stem}: {name}")
+            ax.plot(q, P, "o", markersize=2, color=line.get_color())
             critical = curve["attrs"].get("critical_q", np.nan)
             merges = [s for s in curve["special_points"] if s["kind"] == "LP"]
             if np.isfinite(critical) and merges:
                 P_merge = merges[0]["pressure"]
-                ax.fill(q, P, alpha=0.15, color=line.get_color(), label="isola exists")
+                ax.fill(dense_q, dense_P, alpha=0.15, color=line.get_color(),  # closed at the start value q0
+                        label=f"isola exists ({curve['attrs']['parameter']} ≥ {curve['attrs']['q0']:g} traced)")
                 ax.plot(critical, P_merge, "o", color=line.get_color())
                 ax.annotate(f"critical {curve['attrs']['parameter']} = {critical:.6g}", (critical, P_merge),
                             textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
@@ -683,27 +689,57 @@ def plot_phase(paths, axes=None) -> Figure:
     return fig
 
 
+def _with_points(q, P, extra):
+    """(q, P) with the points (index, q, P) of ``extra`` inserted after their ``index`` (located special points
+    between two stored points: the fold of the curve in q, its apex)."""
+    q, P = list(q), list(P)
+    for index, q_s, P_s in sorted(extra, reverse=True):
+        q.insert(index + 1, q_s)
+        P.insert(index + 1, P_s)
+    return np.array(q), np.array(P)
+
+
+def smooth_curve(q, P, samples: int = 400):
+    """The two-parameter curve through its points (q, P): q and P each interpolated in the cumulative chord
+    length (both scaled by their ranges) by PCHIP, so that lines and shading follow the curve between its points
+    rather than chords, without overshooting them (no spurious hooks where the points are sparse); fewer than 3
+    points are returned as they are."""
+    q, P = np.asarray(q, dtype=float), np.asarray(P, dtype=float)
+    if q.size < 3:
+        return q, P
+    steps = np.hypot(np.diff(q) / (np.ptp(q) or 1.0), np.diff(P) / (np.ptp(P) or 1.0))
+    keep = np.r_[True, steps > 0]  # repeated points (a located special point stored twice) once
+    s = np.r_[0.0, np.cumsum(steps)][keep]
+    dense = PchipInterpolator(s, np.column_stack([q, P])[keep])(np.linspace(0.0, s[-1], samples))
+    return dense[:, 0], dense[:, 1]
+
+
 def _sweep_phase(ax, path) -> str:
-    """Pear pitchfork pressures of every sweep member against the first varied key; the isola region (two
-    pitchforks) shaded between them. Returns the parameter name."""
+    """Pear pitchfork pressures of every sweep member against the first varied key, and the primary branch's
+    fold (LP, the pressure maximum); the isola region (two pitchforks) shaded between them, its edges
+    interpolated between the members monotonically (PCHIP: no overshoot). Returns the parameter name."""
     sweep = read_sweep(path)
     rows = []
     for member in sweep["members"].values():
         key, value = next(iter(member["overrides"].items()))
-        primary = member["branches"]["primary"]
-        pressures = sorted(s["pressure"] for s in primary["special_points"] if s["block"] == "odd_held")
-        rows.append((float(value), pressures))
-    rows.sort()
-    q = np.array([r[0] for r in rows])
+        specials = member["branches"]["primary"]["special_points"]
+        pressures = sorted(s["pressure"] for s in specials if s["block"] == "odd_held")
+        folds = [s["pressure"] for s in specials if s["kind"] == "LP"]
+        rows.append((float(value), pressures, folds[0] if folds else np.nan))
+    rows.sort(key=lambda r: r[0])
     for n in range(max((len(r[1]) for r in rows), default=0)):
         ax.plot([r[0] for r in rows if len(r[1]) > n], [r[1][n] for r in rows if len(r[1]) > n], "o-", ms=3,
                 label=f"{Path(path).stem}: pear pitchfork {n + 1}")
-    two = np.array([len(r[1]) >= 2 for r in rows])
-    if two.any():
-        ax.fill_between(q, [r[1][0] if len(r[1]) >= 2 else np.nan for r in rows],
-                        [r[1][-1] if len(r[1]) >= 2 else np.nan for r in rows], alpha=0.15, label="isola exists")
+    if any(np.isfinite(r[2]) for r in rows):
+        ax.plot([r[0] for r in rows], [r[2] for r in rows], "s--", ms=3, color="0.3",
+                label=f"{Path(path).stem}: fold (LP) of the primary branch")
+    two = [r for r in rows if len(r[1]) >= 2]
+    if len(two) >= 2:
+        q = np.array([r[0] for r in two])
+        dense = np.linspace(q[0], q[-1], 200)
+        low, high = (PchipInterpolator(q, [r[1][k] for r in two])(dense) for k in (0, -1))
+        ax.fill_between(dense, low, high, alpha=0.15, label="isola exists")
     return "M" if key == "field.M" else key
-
 
 
 KINDS = {
