@@ -74,8 +74,8 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert "EP                  point 0 " in primary and f"LP                  points {lp}-{lp + 1} " in primary
     assert f"BP pitchfork-super  points {bp}-{bp + 1} " in primary
     stable = branch["stable_points"]
-    assert (f"stable points        pressure control {stable['stable_pressure']}, volume control "
-            f"{stable['stable_volume']} (of {branch['points']}") in primary
+    assert (f"stable points        pressure control {stable['stable_pressure']}, gas control "
+            f"{stable['stable_gas']}, volume control {stable['stable_volume']} (of {branch['points']}") in primary
 
 
 def test_run_keeps_existing_output(tmp_path, scene_file, capsys):

@@ -212,3 +212,22 @@ def test_one_column_uses_the_symbols(runs):
     assert {ax.get_xlabel() for ax in fig.axes} == {r"$\lambda_2(0)$"}
     assert {ax.get_ylabel() for ax in fig.axes} == {"$P$"}
     assert fig.get_size_inches()[0] == pytest.approx(ONE_COLUMN)
+
+
+def test_an_interrupted_run_is_kept_and_stops_the_figures(tmp_path, monkeypatch):
+    """SIGINT/SIGTERM during a figure's run: the partial run is written (flagged interrupted) and no further run
+    starts (KeyboardInterrupt: the CLI exits 130)."""
+    from balloon_cg.io.run_file import read_run
+    from balloon_cg.numerics import interrupt
+
+    def signalled(scene, **kwargs):
+        interrupt.request()  # as the signal handler does, before the first point
+        return analyse(scene, **kwargs)
+
+    monkeypatch.setattr(app_figures, "analyse", signalled)
+    case = figures(quick=True)["fig2"].cases[0]
+    with pytest.raises(KeyboardInterrupt):
+        run_for(case, tmp_path, quick=True)
+    assert not interrupt.requested()
+    (path,) = tmp_path.glob("*.h5")
+    assert "interrupted" in list(read_run(path)["attrs"]["incomplete_gaps"])

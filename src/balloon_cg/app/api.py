@@ -119,6 +119,11 @@ class Result:
         return [f"{gap} ({branch}: {message})" for gap, branch, message in
                 zip(a.get("incomplete_gaps", []), a.get("incomplete_branches", []), a.get("incomplete_messages", []))]
 
+    @property
+    def interrupted(self) -> bool:
+        """A signal (SIGINT/SIGTERM) stopped the computation: what is stored ends early."""
+        return "interrupted" in self.run["attrs"].get("incomplete_gaps", [])
+
     def to_dataframe(self, table: str = "points"):
         """A pandas DataFrame: ``"points"``, one row per point of every branch (columns branch, point, then the
         per-point columns), or ``"special"``, one row per special point."""

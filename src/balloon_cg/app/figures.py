@@ -39,13 +39,17 @@ def incomplete_runs(names, runs: Path, quick: bool = False) -> list[Path]:
 
 def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> dict:
     """The run of ``case`` (read_run() output): the file in ``runs`` if it holds this scene, else computed and
-    written there (incomplete or not: ``incomplete_runs``)."""
+    written there (incomplete or not: ``incomplete_runs``); KeyboardInterrupt after writing a run a signal
+    stopped (the CLI exits 130)."""
     scene = case.load(quick)
     path = run_path(scene, runs, quick)
     run = read_run(path) if path.exists() else None
     if run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml():
         runs.mkdir(parents=True, exist_ok=True)
-        analyse(scene, progress=progress).save(path, force=True)
+        result = analyse(scene, progress=progress)
+        result.save(path, force=True)
+        if result.interrupted:  # the partial run is kept (flagged); no further run or figure is started
+            raise KeyboardInterrupt
         run = read_run(path)
     return run
 

@@ -214,12 +214,14 @@ def _format_branch(name: str, b: dict) -> list[str]:
 
 
 def _stable_counts(counts: dict, points: int) -> str:
-    """'pressure control 23, volume control 51 (of 72; the same with the centre free)' from the counts of the
-    stored flags stable_READING and stable_READING_free (balloon held at its centre, or free)."""
+    """'pressure control 23, gas control 40, volume control 51 (of 72; the same with the centre free)' from the
+    counts of the stored flags stable_READING and stable_READING_free (balloon held at its centre, or free)."""
     if not counts:
         return "not assessed"
+    order = {"pressure": 0, "gas": 1, "volume": 2}  # the readings nest in this order (pressure ⊆ gas ⊆ volume)
     held = {k.removeprefix("stable_"): n for k, n in counts.items() if not k.endswith("_free")}
     free = {k.removeprefix("stable_").removesuffix("_free"): n for k, n in counts.items() if k.endswith("_free")}
+    held, free = ({k: d[k] for k in sorted(d, key=lambda r: (order.get(r, len(order)), r))} for d in (held, free))
     text = ", ".join(f"{reading} control {n}" for reading, n in held.items()) + f" (of {points}"
     if free == held:
         return text + "; the same with the centre free)"
