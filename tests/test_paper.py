@@ -146,6 +146,14 @@ def test_snap_throughs_from_stored_data_equal_the_analysis():
     assert between(volume.from_index, 2.26473)  # P_cr1 lies between the last stable point and the next
     assert volume.pressure == pytest.approx(run["branches"]["primary"]["volume"][volume.from_index])
     assert [s.from_index for s in snap_throughs(run, Reading.AXISYMMETRIC)] == [stored[0][1]]
+    # gas: SPOM1 is stable to uniform inflation under gas control everywhere ((Pλ³)′ > 0), so it too loses
+    # stability at P_cr1; the control value is n = P V, and a run under gas control stores the same snap
+    [gas] = snap_throughs(run, Reading.GAS)
+    V = run["branches"]["primary"]["volume"]
+    assert gas.from_index == volume.from_index and gas.pressure == pytest.approx(P[gas.from_index] * V[gas.from_index])
+    gas_run = analyse(scene.with_overrides({"loading.control": "gas"}), pear=False).run
+    assert [(s["from_branch"], s["from_index"], s["pressure"]) for s in gas_run["snap_throughs"]] == \
+        [(gas.from_branch, gas.from_index, pytest.approx(gas.pressure))]
 
 
 def _data(n, **blocks):

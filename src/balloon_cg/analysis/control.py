@@ -39,6 +39,21 @@ def control_value(disc, X, control: Control) -> float:
     return volume if control == Control.VOLUME else float(X[-1]) * volume
 
 
+def control_values(pressure, volume, control: Control):
+    """q of points with pressure P and enclosed volume V (arrays): P, V, or n = P V."""
+    return {Control.PRESSURE: pressure, Control.VOLUME: volume, Control.GAS: pressure * volume}[control]
+
+
+def minimised_energy(energy, pressure, volume, control: Control):
+    """The energy per 2π that ``control`` minimises, from E/2π = W/2π − P V/2π (``Equilibrium.energy``) at P and
+    the volume V: E under pressure control, W/2π = E + P V/2π at fixed volume, W/2π − (n/2π) ln V with n = P V
+    for an isothermal ideal gas (the ranking of snap-through targets)."""
+    if control == Control.PRESSURE:
+        return energy
+    work = pressure * volume / (2 * np.pi)
+    return energy + work - (work * np.log(volume) if control == Control.GAS else 0.0)
+
+
 def control_gradient(system, X, control: Control) -> np.ndarray:
     """∇q(X) = ∂q/∂(u, P) of volume or gas control for the continuation system ``system`` (an
     ``analysis.problem.ParameterSystem`` in P; under pressure control q = P is linear: its monitor is e_P)."""

@@ -16,7 +16,7 @@ import numpy as np
 
 from . import azimuthal_points, bifurcation
 from ..scene import Control
-from .control import control_value
+from .control import control_values, minimised_energy
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
@@ -190,20 +190,15 @@ HELD_FLAG = {Control.PRESSURE: "stable_pressure", Control.VOLUME: "stable_volume
 
 def snap_throughs(branches: list, control: Control = Control.PRESSURE) -> list:
     """The snap-throughs under the loading ``control`` (``find_snaps``): its held flag (HELD_FLAG), its control
-    value q (P, V or n: ``control.control_value``) and the energy it minimises ranking the targets (per 2π, with
-    Ṽ = V/2π: E(u; P) under pressure control, the stored energy E + PṼ at fixed volume, and E + PṼ − (n/2π) ln V
-    for an isothermal ideal gas of amount n)."""
+    value q (P, V or n) and the energy it minimises ranking the targets (``control.minimised_energy``)."""
     curves = []
     for b in branches:
         eq = equilibrium_of(b)
-        energy, q = np.empty(len(b.X)), np.empty(len(b.X))
-        for k, x in enumerate(b.X):
-            params = b.params.with_value(b.parameter, x[-1])  # a voltage branch: q = Φ̄ at fixed P
-            energy[k] = eq.energy(x[:-1], params)
-            if control != Control.PRESSURE:
-                P, volume = x[-1], eq.volume(x[:-1])
-                energy[k] += P * volume - (P * volume * np.log(2 * np.pi * volume) if control == Control.GAS else 0)
-            q[k] = x[-1] if b.parameter != "P" else control_value(b.disc, x, control)
+        energy = np.array([eq.energy(x[:-1], b.params_at(x)) for x in b.X])
+        P, volume = b.pressure, 2 * np.pi * np.array([eq.volume(x[:-1]) for x in b.X])
+        # a voltage branch (pressure control only): q = Φ̄ at fixed P
+        q = b.X[:, -1] if b.parameter != "P" else control_values(P, volume, control)
+        energy = minimised_energy(energy, P, volume, control)
         stable = np.array([a.flags()[HELD_FLAG[control]] for a in b.stability], dtype=bool)
         curves.append(Curve(b.name, q, stable, energy))
     return find_snaps(curves)

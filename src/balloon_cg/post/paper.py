@@ -21,9 +21,10 @@ from matplotlib.lines import Line2D
 from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
 from .quantities import branch_discretisation, stored_scene
 from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
+from ..analysis.control import control_values, minimised_energy
 from ..analysis.picture import MIRROR, Curve, find_snaps
 from ..galerkin.equilibrium import Equilibrium, Parameters
-from ..scene import parse_scene
+from ..scene import Control, parse_scene
 
 ONE_COLUMN, TWO_COLUMNS = 3.5, 7.2  # journal widths, inches
 M_VALUES = (0.001, 0.002, 0.003)  # the several M of Figs. 3–8 (with M = 0 from the field-free scenes)
@@ -173,21 +174,23 @@ def _x_label(kind, panel):
 
 # --- numbered configurations -------------------------------------------------------------------------------
 
-VOLUME_CONTROL = (Reading.VOLUME, Reading.FREE_VOLUME)  # readings whose control is the volume; the others: P
-SNAP_READINGS = (Reading.PRESSURE, Reading.VOLUME, Reading.FREE, Reading.FREE_VOLUME, Reading.AXISYMMETRIC)
+CONTROL = {Reading.VOLUME: Control.VOLUME, Reading.FREE_VOLUME: Control.VOLUME, Reading.GAS: Control.GAS,
+           Reading.FREE_GAS: Control.GAS}  # the control of a reading; the others: pressure
+SNAP_READINGS = (Reading.PRESSURE, Reading.VOLUME, Reading.GAS, Reading.FREE, Reading.FREE_VOLUME, Reading.FREE_GAS,
+                 Reading.AXISYMMETRIC)
 
 
 def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
     """The snap-throughs of a stored run with stability read as ``reading`` (``analysis.picture.find_snaps`` on
-    the stored flags or blocks, ``plotting.stable_points``): under pressure control at equal P to the stable
-    point of lowest E(u; P), under volume control at equal volume to the one of lowest E + P V/2π (the energy
-    without the pressure work), E the Galerkin energy of the stored unknowns. Branches without stability data
-    are left out; ``pressure`` of each result is the control value."""
+    the stored flags or blocks, ``plotting.stable_points``): at equal value of the reading's control (P, V or
+    n = P V) to the stable point of lowest energy that control minimises (``analysis.control.minimised_energy``),
+    E the Galerkin energy of the stored unknowns. Branches without stability data are left out; ``pressure`` of
+    each result is the control value."""
     if reading not in SNAP_READINGS:
         raise PlotError(f"--stability {reading.value}: no snap-through search for this reading (one of "
                         f"{', '.join(r.value for r in SNAP_READINGS)})")
     scene = stored_scene(run)
-    volume_control = reading in VOLUME_CONTROL
+    control = CONTROL.get(reading, Control.PRESSURE)
     curves = []
     for name, data in run["branches"].items():
         stable = stable_points(data, reading)
@@ -196,9 +199,11 @@ def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
         disc = branch_discretisation(data)
         eq, M, chi = Equilibrium(scene, disc), data["attrs"]["M"], data["attrs"]["chi"]
         P, V = data["pressure"], data["volume"]
-        E = np.array([eq.energy(X[:disc.size], Parameters(p, M, chi)) for X, p in zip(data["unknowns"], P)])
-        curves.append(Curve(name, V if volume_control else P, stable, E + P * V / (2 * np.pi) if volume_control
-                            else E))
+        voltage = data.get("voltage", np.zeros_like(P))
+        E = np.array([eq.energy(X[:disc.size], Parameters(p, M, chi, phi)) for X, p, phi in
+                      zip(data["unknowns"], P, voltage)])
+        q = voltage if data["attrs"].get("parameter") == "voltage" else control_values(P, V, control)
+        curves.append(Curve(name, q, stable, minimised_energy(E, P, V, control)))
     return find_snaps(curves)
 
 
