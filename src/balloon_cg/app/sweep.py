@@ -31,6 +31,7 @@ from ..io.lock import claim
 from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
                              store_path)
 from .hygiene import worker_hygiene
+from ..numerics import interrupt
 from ..scene import Scene, SceneError, parse_scene
 
 MODES = ("analysis", "no-pear", "primary-only")
@@ -289,20 +290,35 @@ def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str 
                 yield job[0], compute_member(*job)
             except Exception as e:  # noqa: BLE001 - reported per member
                 yield job[0], e
+            _check_interrupt()
         return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), initializer=worker_hygiene,
                                initargs=(os.getpid(),))
     try:
         futures = {pool.submit(compute_member, *job): job[0] for job in jobs}
-        for future in as_completed(futures):
-            error = future.exception()
-            yield futures[future], error if error is not None else future.result()
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, timeout=INTERRUPT_POLL, return_when=FIRST_COMPLETED)
+            _check_interrupt()
+            for future in done:
+                error = future.exception()
+                yield futures[future], error if error is not None else future.result()
     except BaseException:  # an interrupt (or the caller closing early): the running members are abandoned
         _terminate(pool)
         raise
     pool.shutdown(wait=True)
+
+
+INTERRUPT_POLL = 0.2  # s: how often the pool loop looks at the interrupt flag
+
+
+def _check_interrupt() -> None:
+    """Raise KeyboardInterrupt if a signal asked to stop (``interrupt.sigterm_raises`` sets the flag too: its
+    exception can be swallowed when the signal lands in a callback, as once in CI)."""
+    if interrupt.requested():
+        raise KeyboardInterrupt
 
 
 def _terminate(pool) -> None:

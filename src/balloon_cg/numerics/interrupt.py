@@ -28,18 +28,27 @@ def _handler(signum, frame):
     _flag.set()
 
 
+def _raise(signum, frame):
+    _flag.set()  # kept: a KeyboardInterrupt raised inside a callback (a weakref's, a __del__) is only printed
+    raise KeyboardInterrupt
+
+
 @contextmanager
 def sigterm_raises():
-    """SIGTERM raises KeyboardInterrupt, as SIGINT does, for the duration (main thread only): for work that
-    stops at once and cleans up in ``finally`` blocks rather than at its next point."""
+    """SIGINT and SIGTERM raise KeyboardInterrupt for the duration (main thread only): for work that stops at
+    once and cleans up in ``finally`` blocks rather than at its next point. The signal also sets ``requested()``,
+    for loops to check where the exception could have been swallowed. On exit the previous handlers are restored
+    and the flag cleared."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    previous = {s: signal.signal(s, _raise) for s in SIGNALS}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        _flag.clear()
 
 
 @contextmanager
