@@ -34,33 +34,28 @@ def _raise(signum, frame):
 
 
 @contextmanager
+def _handled_by(handler):
+    """SIGINT and SIGTERM go to ``handler`` for the duration (main thread only; elsewhere a no-op); on exit the
+    previous handlers are restored and the flag cleared."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.signal(s, handler) for s in SIGNALS}
+    try:
+        yield
+    finally:
+        for s, old in previous.items():
+            signal.signal(s, old)
+        _flag.clear()
+
+
 def sigterm_raises():
-    """SIGINT and SIGTERM raise KeyboardInterrupt for the duration (main thread only): for work that stops at
-    once and cleans up in ``finally`` blocks rather than at its next point. The signal also sets ``requested()``,
-    for loops to check where the exception could have been swallowed. On exit the previous handlers are restored
-    and the flag cleared."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {s: signal.signal(s, _raise) for s in SIGNALS}
-    try:
-        yield
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        _flag.clear()
+    """SIGINT and SIGTERM raise KeyboardInterrupt for the duration: for work that stops at once and cleans up in
+    ``finally`` blocks rather than at its next point. The signal also sets ``requested()``, for loops to check
+    where the exception could have been swallowed."""
+    return _handled_by(_raise)
 
 
-@contextmanager
 def stop_on_signals():
-    """Turn SIGINT/SIGTERM into ``requested()`` for the duration (main thread only; elsewhere a no-op)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {s: signal.signal(s, _handler) for s in SIGNALS}
-    try:
-        yield
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        _flag.clear()
+    """Turn SIGINT/SIGTERM into ``requested()`` for the duration."""
+    return _handled_by(_handler)
