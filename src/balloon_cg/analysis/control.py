@@ -35,8 +35,7 @@ def control_value(disc, X, control: Control) -> float:
     """q(X) on the discretisation ``disc`` (module docstring)."""
     if control == Control.PRESSURE:
         return float(X[-1])
-    volume = 2 * np.pi * enclosed_volume(disc, X[:-1])
-    return volume if control == Control.VOLUME else float(X[-1]) * volume
+    return float(control_values(X[-1], 2 * np.pi * enclosed_volume(disc, X[:-1]), control))
 
 
 def control_values(pressure, volume, control: Control):

@@ -303,14 +303,15 @@ def _build(data: dict, name: str, text: str) -> Scene:
     field = _field(data.get("field", {}))
     electric = None if "electric" not in data else _electric(data["electric"])
     loading = loading_from_table(data.get("loading", {}))
-    if loading.control != Control.PRESSURE and data.get("continuation", {}).get("parameter") == "voltage":
+    continuation = _continuation(data.get("continuation", {}), field, electric)
+    if loading.control != Control.PRESSURE and continuation.parameter == ContinuationParameter.VOLTAGE:
         raise SceneError(f'loading.control = "{loading.control.value}": a voltage continuation '
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     return Scene(
         name=name,
         material=material,
         field=field,
-        continuation=_continuation(data.get("continuation", {}), field, electric),
+        continuation=continuation,
         solver=_solver(data.get("solver", {})),
         stability=_stability(data.get("stability", {})),
         output=_output(data.get("output", {})),
