@@ -111,15 +111,11 @@ def _scene_key(scene, name: str) -> str:
     return name
 
 
-def _kernels(scene) -> KernelSet:
-    return KernelSet.of_scene(scene)  # as Equilibrium loads them
-
-
 def parameter_keys(scene, kernels: KernelSet | None = None) -> dict[str, str]:
     """{accepted name: canonical key} of the scene's second parameters (module docstring): the canonical keys in
     a fixed order, then the bare names of the runtime scalars; ``kernels``: the scene's (default: loaded as
     ``Equilibrium`` does)."""
-    scalars = runtime_scalars(_kernels(scene) if kernels is None else kernels)
+    scalars = runtime_scalars(KernelSet.of_scene(scene) if kernels is None else kernels)
     material = scene.material
     if isinstance(material, StrainEnergy):
         own = [f"material.parameters.{name}" for name in material.formula.parameters]
