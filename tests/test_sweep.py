@@ -160,7 +160,7 @@ def test_a_swallowed_interrupt_still_stops_the_sweep(scene, tmp_path, monkeypatc
             run_sweep(scene, SPECS, tmp_path / "s.h5", mode=MODE, workers=workers)
     finally:
         interrupt._flag.clear()
-    assert len(list(store_path(tmp_path / "s.h5").glob("*.h5"))) < 3
+    assert 1 <= len(list(store_path(tmp_path / "s.h5").glob("0*.h5"))) < 3  # member files; not all 3 computed
 
 
 def test_resume_refuses_changed_scene(scene, tmp_path):
