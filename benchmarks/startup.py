@@ -11,8 +11,11 @@ done, numba kernels loaded), writing nothing. That is the part a faster start-up
 The ratios are wall / compute wall and CPU / compute CPU (the CPU ratio is the steadier one on a loaded
 machine: another process's share of the cores stretches wall times, not CPU times). Then,
 for ``run``, where the rest goes, measured inside one fresh process doing what the CLI does: imports, the first
-computation (numba loads its cached kernels on first call), the write. The load average is printed before and
-after: on a loaded machine every number grows, the ratios less so.
+computation (numba loads its cached kernels on first call), the write. Last, the **floor** no package that calls
+numba kernels from a fresh process can go below: a bare interpreter that imports numpy and numba and calls one
+trivial cached kernel (and the same with scipy.linalg and h5py, the rest of a run's third-party stack), against
+the 2x-compute budget of ``run``. The load average is printed before and after: on a loaded machine every number
+grows, the ratios less so.
 
     python benchmarks/startup.py                       # the installed balloon-cg of this interpreter
     python benchmarks/startup.py --python A --python B # several installs, interleaved in the same rounds
@@ -63,12 +66,29 @@ print(json.dumps({"steady": steady, "imports": [b - a for a, b in zip(t0, t1)],
                   "first": [b - a for a, b in zip(t1, t2)], "write": [b - a for a, b in zip(t2, t3)]}))
 """
 
+# a trivial cached numba kernel, called once from a fresh interpreter (the floor of any numba-calling process)
+FLOOR_KERNEL = """
+from numba import njit
 
-def timed(args) -> tuple[float, float]:
+
+@njit(cache=True)
+def total(x):
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += x[i]
+    return s
+"""
+FLOOR = {"python + numpy + numba + one cached kernel": "import numpy, numba, floor_kernel; "
+                                                       "floor_kernel.total(numpy.ones(3))",
+         "the same + scipy.linalg + h5py": "import numpy, numba, scipy.linalg, h5py, floor_kernel; "
+                                           "floor_kernel.total(numpy.ones(3))"}
+
+
+def timed(args, **options) -> tuple[float, float]:
     """(wall, CPU) seconds of one child process."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run(args, check=True, capture_output=True)
+    subprocess.run(args, check=True, capture_output=True, **options)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -96,6 +116,12 @@ def main():
         cli = {py: [py, "-m", "balloon_cg"] for py in pythons}
         for py in pythons:  # warms numba's cache and writes the file inspect reads
             timed([*cli[py], "run", SCENE, "-o", runs[py], "--quiet", "--force"])
+        (Path(tmp) / "floor_kernel.py").write_text(FLOOR_KERNEL)
+        floor_env = {**os.environ, "NUMBA_CACHE_DIR": str(Path(tmp) / "numba")}
+        floor_run = {name: [pythons[0], "-c", code] for name, code in FLOOR.items()}
+        for args in floor_run.values():  # compiles the kernel into its cache
+            timed(args, cwd=tmp, env=floor_env)
+        floors = {name: [] for name in FLOOR}
         measured = {py: [] for py in pythons}
         walls = {py: {name: [] for name in commands[py]} for py in pythons}
         for _ in range(options.repeats):
@@ -106,6 +132,8 @@ def main():
                 out = subprocess.run([py, "-c", MEASURE, str(SCENE), str(Path(tmp) / "measure.h5"), "3"],
                                      check=True, capture_output=True, text=True).stdout
                 measured[py].append(json.loads(out))
+            for name, args in floor_run.items():
+                floors[name].append(timed(args, cwd=tmp, env=floor_env))
     for py in pythons:
         steady = {name: [statistics.median(m["steady"][name][k] for m in measured[py]) for k in (0, 1)]
                   for name in ("inspect", "solve", "run")}
@@ -129,7 +157,14 @@ def main():
               "{:.3f}), write {:.3f} / {:.3f}\n".format(
                   *parts["imports"], *parts["first"], parts["first"][0] - steady["run"][0],
                   parts["first"][1] - steady["run"][1], *parts["write"]))
-    print(f"end: {load()}")
+    run = [statistics.median(m["steady"]["run"][k] for m in measured[pythons[0]]) for k in (0, 1)]
+    print(f"floor of a fresh process (warm numba cache; {pythons[0]}), against run's budget 2x compute = "
+          f"{2 * run[0]:.3f} s wall, {2 * run[1]:.3f} s CPU; 'floor + compute' is the smallest ratio a run can reach"
+          f"\n{'process':<44} {'wall (s)':>9} {'CPU (s)':>8} {'floor+compute wall ratio':>25} {'CPU ratio':>10}")
+    for name, times in floors.items():
+        wall, cpu = (statistics.median(t[k] for t in times) for k in (0, 1))
+        print(f"{name:<44} {wall:9.3f} {cpu:8.3f} {(wall + run[0]) / run[0]:25.2f} {(cpu + run[1]) / run[1]:10.2f}")
+    print(f"\nend: {load()}")
 
 
 if __name__ == "__main__":
