@@ -12,7 +12,7 @@ import h5py
 import pytest
 
 import balloon_cg
-from balloon_cg.app.cli import build_parser, main, scene_of, strict_json
+from balloon_cg.app.cli import SCENE_HELP, build_parser, main, scene_of, strict_json
 from balloon_cg.io.run_file import read_run
 from balloon_cg.scene import load_scene, parse_scene
 
@@ -32,6 +32,17 @@ def test_version_and_module_entry_point():
     assert done.returncode == 0 and "run" in done.stdout and "Documentation:" in done.stdout
     docs = done.stdout.split("Documentation:")[1].split()[0]
     assert (Path(docs) / "plots.md").is_file()  # the help names installed documentation
+
+
+def test_every_scene_argument_says_what_it_takes():
+    """Each subcommand's SCENE goes to scene.load_scene (a file, or the name of a shipped scene): its help says
+    so (kernels' said "scene TOML file" only)."""
+    import argparse
+
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    helps = {name: a.help for name, p in commands.items() for a in p._actions if a.dest == "scene"}
+    assert set(helps) == {"run", "solve", "critical", "sweep", "kernels"}
+    assert all(text.startswith(SCENE_HELP) for text in helps.values()), helps
 
 
 def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
