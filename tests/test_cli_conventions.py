@@ -1,10 +1,14 @@
 """CLI conventions: --version, python -m balloon_cg, run --set and the default output name, plot --what a,b,
 strict JSON from inspect (run, sweep and curve files), SIGINT on a running run."""
+import fcntl
 import json
 import os
+import select
 import signal
+import struct
 import subprocess
 import sys
+import termios
 import time
 from pathlib import Path
 
@@ -144,19 +148,80 @@ def test_plot_several_kinds_at_once(tmp_path, capsys):
     assert "not a plot kind" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("command", [
+    ["run", "SCENE", "--primary-only", "-o", "run.h5"],
+    ["sweep", "SCENE", "--vary", "continuation.stop_stretch=1.3,1.4", "--primary-only", "--workers", "1",
+     "-o", "sweep.h5"],
+])
+def test_progress_is_drawn_on_a_terminal_only(tmp_path, command):
+    """stderr to a file or a pipe: no carriage returns or cursor codes (tqdm's disable=None: no bar on a
+    non-TTY); the same command with stderr on a terminal (a pty) draws its bars."""
+    scene = tmp_path / "small.toml"
+    scene.write_text(SMALL.replace("2.0", "1.5"))
+    args = [str(scene) if a == "SCENE" else a for a in command]
+    piped = subprocess.run([sys.executable, "-m", "balloon_cg", *args], capture_output=True, cwd=tmp_path)  # bytes:
+    assert piped.returncode == 0, piped.stderr  # text mode would turn a carriage return into a newline
+    assert b"\r" not in piped.stderr + piped.stdout and b"\x1b" not in piped.stderr + piped.stdout, piped.stderr
+    terminal = Terminal()
+    process = terminal.start([sys.executable, "-m", "balloon_cg", *args, "--force"], cwd=tmp_path)
+    shown = terminal.finish(process, 300)
+    assert process.returncode == 0
+    bar = "primary branch: " if command[0] == "run" else "sweep: "
+    assert f"\r{bar}" in shown or f"\rsmall: {bar}" in shown, repr(shown)
+
+
+class Terminal:
+    """A pseudo-terminal of 100 columns for a child's stderr (a new pty has 0 columns: tqdm would draw empty
+    bars); what the child writes there is read as it comes, so that the terminal's buffer never fills."""
+
+    def __init__(self):
+        import pty
+
+        self.master, self.slave = pty.openpty()
+        fcntl.ioctl(self.slave, termios.TIOCSWINSZ, struct.pack("HHHH", 30, 100, 0, 0))
+        self.data = b""
+
+    def start(self, command, **kw) -> subprocess.Popen:
+        process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self.slave,
+                                   **kw)
+        os.close(self.slave)
+        return process
+
+    def read(self, wait: float = 0.2) -> bytes:
+        """All written so far, after waiting up to ``wait`` s for more."""
+        if select.select([self.master], [], [], wait)[0]:
+            try:
+                self.data += os.read(self.master, 1 << 16)
+            except OSError:  # EIO: the child closed its end
+                pass
+        return self.data
+
+    def finish(self, process, timeout: float) -> str:
+        """Read until ``process`` has ended and written all; its exit code is checked by the caller."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            before = len(self.data)
+            if len(self.read()) == before and process.poll() is not None:
+                break
+        os.close(self.master)
+        process.wait(timeout=10)
+        return self.data.decode(errors="replace")
+
+
 def test_sigint_writes_a_readable_partial_file_and_exits_130(tmp_path):
-    """A two-coil analysis takes ~20 s; interrupted after its primary branch started, it writes what is finished."""
+    """A two-coil analysis takes ~20 s; interrupted after its primary branch started (its bar is drawn on the
+    terminal), it writes what is finished."""
     out = tmp_path / "int.h5"
-    process = subprocess.Popen([sys.executable, "-m", "balloon_cg", "run", str(SCENES / "spom1_two_coils_M0.002.toml"),
-                                "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(1.0)
+    terminal = Terminal()
+    process = terminal.start([sys.executable, "-m", "balloon_cg", "run",
+                              str(SCENES / "spom1_two_coils_M0.002.toml"), "-o", str(out)])
     deadline = time.monotonic() + 60
-    while b"primary branch" not in _peek(process) and time.monotonic() < deadline:
-        time.sleep(0.2)
+    while b"primary branch" not in terminal.read() and time.monotonic() < deadline:
+        pass
     time.sleep(1.0)
     started = time.monotonic()
     process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=120)
+    err = terminal.finish(process, 120)
     assert process.returncode == 130, err
     assert time.monotonic() - started < 30
     assert "Traceback" not in err and err.strip().splitlines()[-1].startswith("balloon-cg: interrupted")
@@ -165,20 +230,6 @@ def test_sigint_writes_a_readable_partial_file_and_exits_130(tmp_path):
     assert len(run["branches"]["primary"]["pressure"]) > 0
     with h5py.File(out, "r") as f:
         assert f.attrs["format"].startswith("balloon-cg/")
-
-
-def _peek(process) -> bytes:
-    """Whatever the process has written to stderr so far (non-blocking)."""
-    import fcntl
-
-    fd = process.stderr.fileno()
-    fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_NONBLOCK)
-    try:
-        chunk = os.read(fd, 1 << 16)
-    except BlockingIOError:
-        chunk = b""
-    process._peeked = getattr(process, "_peeked", b"") + chunk
-    return process._peeked
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])

@@ -187,11 +187,12 @@ def run(args) -> int:
     """Analyse, write, read back and summarise; exit 130 after an interrupt (what is finished is written)."""
     from ..io.run_file import read_run
     from ..numerics.interrupt import requested, stop_on_signals
+    from .progress import shown
 
     scene = scene_of(args)
     output = args.output or f"{scene.name}.h5"
     with stop_on_signals():
-        _, found = run_scene(scene, output, args.force, progress=not args.quiet, command=args.command_line,
+        _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
         interrupted = requested()
     if interrupted:
@@ -464,6 +465,7 @@ def critical(args) -> int:
     from ..analysis.stability import assess_branch
     from ..io.curve_file import write_curve
     from ..io.hdf5 import check_output
+    from .progress import shown, tqdm_disable
 
     scene = scene_of(args)
     asymmetry = _asymmetry(scene)
@@ -482,7 +484,8 @@ def critical(args) -> int:
         if not args.quiet:
             print(f"{PROG} critical: {text}", file=sys.stderr)
 
-    with tqdm(desc="primary branch", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
+    disable = tqdm_disable(shown(args.quiet))
+    with tqdm(desc="primary branch", unit=" points", disable=disable, file=sys.stderr) as bar:
         branch = trace_primary(scene, progress=lambda point: bar.update())
     say(f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
     assessments, _ = assess_branch(branch, scene.stability.degree)
@@ -496,7 +499,7 @@ def critical(args) -> int:
         say(f"the pear pitchfork is only approximately located (±{bp.uncertainty:.1g}: {bp.reason})")
     say(f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
     try:
-        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
+        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=disable, file=sys.stderr) as bar:
             curve = continue_branch_point(branch, bp, args.parameter, args.direction,
                                           progress=lambda point: bar.update())
     except TwoParameterError as e:
@@ -558,6 +561,7 @@ def sweep(args) -> int:
     """Expand, compute the members not yet in the file, append them, summarise."""
     from ..io.sweep_file import incomplete_members
     from ..scene import load_scene
+    from .progress import shown
     from .sweep import SweepError, format_summary, run_sweep
 
     if args.workers is not None and args.workers < 1:
@@ -569,7 +573,7 @@ def sweep(args) -> int:
     try:
         with sigterm_raises():
             result = run_sweep(scene, args.vary, args.output, mode=mode, workers=args.workers,
-                               scheduler=args.scheduler, force=args.force, progress=not args.quiet,
+                               scheduler=args.scheduler, force=args.force, progress=shown(args.quiet),
                                command=args.command_line)
     except SweepError as e:
         raise UsageError(str(e)) from None
