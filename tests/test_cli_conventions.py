@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 
 import balloon_cg
@@ -230,6 +231,65 @@ def test_sigint_writes_a_readable_partial_file_and_exits_130(tmp_path):
     assert len(run["branches"]["primary"]["pressure"]) > 0
     with h5py.File(out, "r") as f:
         assert f.attrs["format"].startswith("balloon-cg/")
+
+
+def _peek(process) -> bytes:
+    """Whatever the process has written to its stderr pipe so far (non-blocking; kept in ``process._peeked``)."""
+    fd = process.stderr.fileno()
+    fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_NONBLOCK)
+    try:
+        chunk = os.read(fd, 1 << 16)
+    except BlockingIOError:
+        chunk = b""
+    process._peeked = getattr(process, "_peeked", b"") + chunk
+    return process._peeked
+
+
+def test_sigterm_on_critical_writes_the_partial_curve_and_exits_130(tmp_path):
+    """`critical` as `run`: a signal during the curve of pitchforks (~100 points, a few seconds) ends it at its
+    next point; the curve so far is written (atomically, end interrupted), one line says so, exit 130."""
+    from balloon_cg.io.curve_file import read_curve
+
+    out = tmp_path / "curve.h5"
+    process = subprocess.Popen([sys.executable, "-m", "balloon_cg", "critical", "spom1_single_coil", "--parameter",
+                                "M", "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while b"continuing it in M" not in _peek(process) and time.monotonic() < deadline and process.poll() is None:
+        time.sleep(0.1)
+    time.sleep(0.5)
+    assert process.poll() is None, "critical ended before it could be interrupted"
+    process.send_signal(signal.SIGTERM)
+    out_text, err = process.communicate(timeout=60)
+    err = (process._peeked + err).decode()
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "\r" not in err and out_text == b""
+    last = err.splitlines()[-1]
+    assert last.startswith(f"balloon-cg: interrupted: the curve is written to {out} (end: interrupted"), err
+    curve = read_curve(out)
+    assert curve["attrs"]["end"] == curve["attrs"]["stop_code"] == "interrupted"
+    assert 1 <= len(curve["q"]) < 100 and np.isnan(curve["attrs"]["critical_q"])
+    assert main(["inspect", str(out)]) == 0
+
+
+def test_critical_interrupted_before_its_curve_leaves_the_output_alone(tmp_path, monkeypatch, capsys):
+    """A signal during the primary branch: nothing to write; an existing output (--force) is left as it was."""
+    from balloon_cg.analysis import primary
+    from balloon_cg.numerics import interrupt
+
+    trace = primary.trace_primary
+
+    def interrupted_trace(*args, **kw):
+        interrupt.request()  # as the handler does: the trace stops at its first point
+        return trace(*args, **kw)
+
+    monkeypatch.setattr(primary, "trace_primary", interrupted_trace)
+    out = tmp_path / "curve.h5"
+    out.write_bytes(b"an earlier result")
+    assert main(["critical", "spom1", "--parameter", "alpha1", "-o", str(out), "--force", "--quiet"]) == 130
+    err = capsys.readouterr().err
+    assert err == f"balloon-cg: interrupted: nothing is written to {out} (the curve had not started)\n"
+    assert out.read_bytes() == b"an earlier result" and not interrupt.requested()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.h5"]  # no temporary file left
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
