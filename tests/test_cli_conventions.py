@@ -120,7 +120,8 @@ def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):
         summary = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON constant {c}"))
         assert summary.get("kind") == kind
         assert main(["inspect", str(path)]) == 0
-        assert "file" in capsys.readouterr().out
+        header = capsys.readouterr().out.split("\n\n")[0].splitlines()
+        assert header[0].startswith("file ") and all(line[14] == " " != line[15] for line in header), header
     assert len(summary["members"]) == 2
     assert strict_json({"a": float("nan"), "b": [float("inf"), 1.0]}) == '{"a": null, "b": [null, 1.0]}'
 
