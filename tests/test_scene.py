@@ -169,8 +169,8 @@ def test_shipped_scenes_by_name(tmp_path, monkeypatch):
     assert load_scene("spom1").name == "spom1" and load_scene("spom1_two_coils_M0.002.toml").field.M == 0.002
     (tmp_path / "spom1.toml").write_text('[material]\npreset = "TPOM1"\n')
     assert load_scene("spom1.toml").material.name == "TPOM1"  # a file of that name comes first
-    with pytest.raises(FileNotFoundError):
-        load_scene("no_such_scene")
+    with pytest.raises(FileNotFoundError, match=r"nor the name of a scene shipped .*\(fpom1, fpom2, spom1, "):
+        load_scene("no_such_scene")  # a typo of a shipped name is told which names there are
 
 
 

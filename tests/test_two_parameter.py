@@ -162,7 +162,7 @@ def test_continuation_in_M_without_coils_is_refused(located):
 
 
 def test_phase_diagram_plot(curve, tmp_path):
-    from balloon_cg.post.plotting import plot
+    from balloon_cg.post.plotting import PlotError, plot
     from balloon_cg.scene import parse_scene
 
     path = write_curve(tmp_path / "phase.h5", parse_scene('[material]\npreset = "SPOM1"\n'), curve)
@@ -174,6 +174,9 @@ def test_phase_diagram_plot(curve, tmp_path):
     assert len(shaded.get_xy()) >= 400 > len(read_curve(path)["q"])
     fig.savefig(tmp_path / "phase.png")
     assert (tmp_path / "phase.png").stat().st_size > 1000
+    for kind in ("pressure-pole", "shapes", "energy"):  # a curve file has no branches: no empty figure
+        with pytest.raises(PlotError, match="no branches to draw .* its kind is phase"):
+            plot([path], kind)
 
 
 def test_smooth_curve_follows_a_sparse_arc():

@@ -181,6 +181,9 @@ def load_branches(source, branch: str | None = None, reading: Reading | None = N
     """The branches of a run or run file (all, primary first, or the one named), with their stability under
     ``reading`` (None: the run's control, ``Reading.of_run``)."""
     run = as_run(source)
+    if not run["branches"]:  # a two-parameter curve file is a run file without branches
+        raise PlotError(f"{run['path'] or run['scene_name']}: no branches to draw (a two-parameter curve file: its "
+                        "kind is phase)")
     reading = Reading.of_run(run) if reading is None else Reading.parse(reading)
     names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
     if branch is not None and branch not in run["branches"]:

@@ -5,6 +5,7 @@ one-line message names the file (or scene), the dotted key, the value and what i
 """
 
 import enum
+import errno
 import math
 import re
 import tomllib
@@ -247,7 +248,10 @@ def load_scene(path) -> Scene:
     (``shipped_scenes()``)."""
     path = Path(path)
     shipped = path.name.removesuffix(".toml")
-    if not path.exists() and path.parent == Path(".") and shipped in shipped_scenes():
+    if not path.exists() and path.parent == Path("."):
+        if shipped not in shipped_scenes():
+            raise FileNotFoundError(errno.ENOENT, "no such file, nor the name of a scene shipped with the package "
+                                    f"({', '.join(sorted(shipped_scenes()))})", str(path))
         path = shipped_scenes()[shipped]
     try:
         text = path.read_text(encoding="utf-8")
