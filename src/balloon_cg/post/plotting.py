@@ -722,6 +722,8 @@ def _sweep_phase(ax, path) -> str:
     fold (LP, the pressure maximum); the isola region (two pitchforks) shaded between them, its edges
     interpolated between the members monotonically (PCHIP: no overshoot). Returns the parameter name."""
     sweep = read_sweep(path)
+    if sweep["attrs"].get("mode") == "primary-only":  # no stability, so no branch points: an empty diagram
+        raise PlotError(f"{path}: a primary-only sweep has no branch points to draw (sweep without --primary-only)")
     rows = []
     for member in sweep["members"].values():
         key, value = next(iter(member["overrides"].items()))
