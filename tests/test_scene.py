@@ -134,6 +134,19 @@ def test_with_overrides():
         assert str(err.value).startswith(f"two: {key}")
 
 
+def test_a_new_preset_and_its_parameters_in_one_override():
+    """`--set material.preset=Gent --set material.parameters.Jm=50` on an Ogden scene: the parameter is the new
+    preset's (it was checked against the old material, which has none), in either order."""
+    scene = parse_scene(TWO_COILS, name="two")
+    for overrides in ({"material.preset": "Gent", "material.parameters.Jm": 50.0},
+                      {"material.parameters.Jm": 50.0, "material.preset": "Gent"}):
+        gent = scene.with_overrides(overrides)
+        assert gent.material.family == "gent" and gent.material.parameters == {"mu": 2.0, "Jm": 50.0}
+        assert parse_scene(gent.text, name=gent.name) == gent
+    with pytest.raises(SceneError, match="no parameter 'Jm'"):
+        scene.with_overrides({"material.preset": "Yeoh", "material.parameters.Jm": 50.0})
+
+
 def test_with_overrides_takes_the_bare_names_of_the_command_line():
     """{"M": x} is {"field.M": x} (the one table with that key), as `--set M=x`; an ambiguous or unknown bare
     name is refused naming the tables."""

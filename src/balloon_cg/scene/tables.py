@@ -208,8 +208,14 @@ class Scene:
                     raise SceneError(f"{key}: {self.canonical_key(key)} is given twice")
                 canonical[self.canonical_key(key)] = value
             overrides = canonical
+            preset = overrides.get("material.preset")
+            expand = preset is not None and any(_PARAMETER_KEY.fullmatch(key) for key in overrides)
+            if expand:  # the new preset's material written out first, so that its family's parameters can be set
+                _assign(data, "material.preset", preset)
+                data = _build(data, self.name, "").to_dict()
             for key, value in overrides.items():
-                _assign(data, key, value)
+                if not (expand and key == "material.preset"):
+                    _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
         except SceneError as e:
             raise SceneError(f"{self.name}: {e}") from None
