@@ -136,7 +136,8 @@ def test_with_overrides():
 
 def test_a_new_preset_and_its_parameters_in_one_override():
     """`--set material.preset=Gent --set material.parameters.Jm=50` on an Ogden scene: the parameter is the new
-    preset's (it was checked against the old material, which has none), in either order."""
+    preset's (it was checked against the old material, which has none), in either order; every other material
+    key applies to the new preset too."""
     scene = parse_scene(TWO_COILS, name="two")
     for overrides in ({"material.preset": "Gent", "material.parameters.Jm": 50.0},
                       {"material.parameters.Jm": 50.0, "material.preset": "Gent"}):
@@ -145,6 +146,12 @@ def test_a_new_preset_and_its_parameters_in_one_override():
         assert parse_scene(gent.text, name=gent.name) == gent
     with pytest.raises(SceneError, match="no parameter 'Jm'"):
         scene.with_overrides({"material.preset": "Yeoh", "material.parameters.Jm": 50.0})
+    # the preset first in any order: a material key given before it was silently dropped
+    assert scene.with_overrides({"material.name": "mine", "material.preset": "TPOM1"}).material.name == "mine"
+    for overrides in ({"material.alpha": [1.5, 4.0, -2.0], "material.preset": "TPOM1"},
+                      {"material.preset": "TPOM1", "material.alpha": [1.5, 4.0, -2.0]}):
+        with pytest.raises(SceneError, match="give one of preset"):
+            scene.with_overrides(overrides)
 
 
 def test_with_overrides_takes_the_bare_names_of_the_command_line():

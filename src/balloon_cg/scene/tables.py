@@ -196,7 +196,8 @@ class Scene:
         """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``,
         or bare names of one table as on the command line (``{"M": 0.003}``: ``canonical_key``).
 
-        ``material.preset`` replaces the whole material; a value None restores the default. The copy is named
+        ``material.preset`` replaces the whole material (applied first, whatever the order: the other material
+        keys change the new one); a value None restores the default. The copy is named
         ``name``, or after what changed physically: each field, material or loading key's token in the name
         (``_M0.002``, ``_radius4``) takes the new value, or is appended (numerical keys keep the name).
         """
@@ -209,12 +210,12 @@ class Scene:
                 canonical[self.canonical_key(key)] = value
             overrides = canonical
             preset = overrides.get("material.preset")
-            expand = preset is not None and any(_PARAMETER_KEY.fullmatch(key) for key in overrides)
-            if expand:  # the new preset's material written out first, so that its family's parameters can be set
+            if preset is not None:  # first, in any order: it replaces the material the other material keys change
                 _assign(data, "material.preset", preset)
-                data = _build(data, self.name, "").to_dict()
+                if any(_PARAMETER_KEY.fullmatch(key) for key in overrides):  # its family's parameters, written out
+                    data = _build(data, self.name, "").to_dict()
             for key, value in overrides.items():
-                if not (expand and key == "material.preset"):
+                if key != "material.preset" or preset is None:
                     _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
         except SceneError as e:
