@@ -211,7 +211,7 @@ def test_cli_sweep_and_resume(tmp_path, capsys):
     assert main(argv) == 0
     assert "0 computed, 2 already in the file" in capsys.readouterr().out
     assert main(argv[:3] + ["M=0,0.003"] + argv[4:]) == 2
-    assert "holds a different sweep: --vary differs" in capsys.readouterr().err
+    assert f"{out}: holds a different sweep: --vary differs" in capsys.readouterr().err  # not its store's manifest
     assert main(["sweep", str(SCENE_FILE), "--vary", "M=-1", "-o", str(tmp_path / "x.h5")]) == 2
     assert "must be >= 0" in capsys.readouterr().err
 
