@@ -36,6 +36,7 @@ class PhaseBars(Progress):
             desc = f"{self.label}: {phase.value}" if self.label else phase.value
             self.bars[phase] = tqdm(desc=desc, unit=" points", file=sys.stderr, leave=True, disable=self.disable)
         return self.bars[phase]
+
     def tick(self, phase: Phase) -> None:
         if self.enabled:  # disabled: no tqdm at all (not even its multiprocessing lock)
             self._bar(phase).update()
