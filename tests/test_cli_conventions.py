@@ -1,18 +1,23 @@
 """CLI conventions: --version, python -m balloon_cg, run --set and the default output name, plot --what a,b,
 strict JSON from inspect (run, sweep and curve files), SIGINT on a running run."""
+import fcntl
 import json
 import os
+import select
 import signal
+import struct
 import subprocess
 import sys
+import termios
 import time
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 
 import balloon_cg
-from balloon_cg.app.cli import build_parser, main, scene_of, strict_json
+from balloon_cg.app.cli import SCENE_HELP, build_parser, main, scene_of, strict_json
 from balloon_cg.io.run_file import read_run
 from balloon_cg.scene import load_scene, parse_scene
 
@@ -32,6 +37,17 @@ def test_version_and_module_entry_point():
     assert done.returncode == 0 and "run" in done.stdout and "Documentation:" in done.stdout
     docs = done.stdout.split("Documentation:")[1].split()[0]
     assert (Path(docs) / "plots.md").is_file()  # the help names installed documentation
+
+
+def test_every_scene_argument_says_what_it_takes():
+    """Each subcommand's SCENE goes to scene.load_scene (a file, or the name of a shipped scene): its help says
+    so (kernels' said "scene TOML file" only)."""
+    import argparse
+
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    helps = {name: a.help for name, p in commands.items() for a in p._actions if a.dest == "scene"}
+    assert set(helps) == {"run", "solve", "critical", "sweep", "kernels"}
+    assert all(text.startswith(SCENE_HELP) for text in helps.values()), helps
 
 
 def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
@@ -104,7 +120,8 @@ def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):
         summary = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON constant {c}"))
         assert summary.get("kind") == kind
         assert main(["inspect", str(path)]) == 0
-        assert "file" in capsys.readouterr().out
+        header = capsys.readouterr().out.split("\n\n")[0].splitlines()
+        assert header[0].startswith("file ") and all(line[14] == " " != line[15] for line in header), header
     assert len(summary["members"]) == 2
     assert strict_json({"a": float("nan"), "b": [float("inf"), 1.0]}) == '{"a": null, "b": [null, 1.0]}'
 
@@ -133,19 +150,80 @@ def test_plot_several_kinds_at_once(tmp_path, capsys):
     assert "not a plot kind" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("command", [
+    ["run", "SCENE", "--primary-only", "-o", "run.h5"],
+    ["sweep", "SCENE", "--vary", "continuation.stop_stretch=1.3,1.4", "--primary-only", "--workers", "1",
+     "-o", "sweep.h5"],
+])
+def test_progress_is_drawn_on_a_terminal_only(tmp_path, command):
+    """stderr to a file or a pipe: no carriage returns or cursor codes (tqdm's disable=None: no bar on a
+    non-TTY); the same command with stderr on a terminal (a pty) draws its bars."""
+    scene = tmp_path / "small.toml"
+    scene.write_text(SMALL.replace("2.0", "1.5"))
+    args = [str(scene) if a == "SCENE" else a for a in command]
+    piped = subprocess.run([sys.executable, "-m", "balloon_cg", *args], capture_output=True, cwd=tmp_path)  # bytes:
+    assert piped.returncode == 0, piped.stderr  # text mode would turn a carriage return into a newline
+    assert b"\r" not in piped.stderr + piped.stdout and b"\x1b" not in piped.stderr + piped.stdout, piped.stderr
+    terminal = Terminal()
+    process = terminal.start([sys.executable, "-m", "balloon_cg", *args, "--force"], cwd=tmp_path)
+    shown = terminal.finish(process, 300)
+    assert process.returncode == 0
+    bar = "primary branch: " if command[0] == "run" else "sweep: "
+    assert f"\r{bar}" in shown or f"\rsmall: {bar}" in shown, repr(shown)
+
+
+class Terminal:
+    """A pseudo-terminal of 100 columns for a child's stderr (a new pty has 0 columns: tqdm would draw empty
+    bars); what the child writes there is read as it comes, so that the terminal's buffer never fills."""
+
+    def __init__(self):
+        import pty
+
+        self.master, self.slave = pty.openpty()
+        fcntl.ioctl(self.slave, termios.TIOCSWINSZ, struct.pack("HHHH", 30, 100, 0, 0))
+        self.data = b""
+
+    def start(self, command, **kw) -> subprocess.Popen:
+        process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self.slave,
+                                   **kw)
+        os.close(self.slave)
+        return process
+
+    def read(self, wait: float = 0.2) -> bytes:
+        """All written so far, after waiting up to ``wait`` s for more."""
+        if select.select([self.master], [], [], wait)[0]:
+            try:
+                self.data += os.read(self.master, 1 << 16)
+            except OSError:  # EIO: the child closed its end
+                pass
+        return self.data
+
+    def finish(self, process, timeout: float) -> str:
+        """Read until ``process`` has ended and written all; its exit code is checked by the caller."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            before = len(self.data)
+            if len(self.read()) == before and process.poll() is not None:
+                break
+        os.close(self.master)
+        process.wait(timeout=10)
+        return self.data.decode(errors="replace")
+
+
 def test_sigint_writes_a_readable_partial_file_and_exits_130(tmp_path):
-    """A two-coil analysis takes ~20 s; interrupted after its primary branch started, it writes what is finished."""
+    """A two-coil analysis takes ~20 s; interrupted after its primary branch started (its bar is drawn on the
+    terminal), it writes what is finished."""
     out = tmp_path / "int.h5"
-    process = subprocess.Popen([sys.executable, "-m", "balloon_cg", "run", str(SCENES / "spom1_two_coils_M0.002.toml"),
-                                "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(1.0)
+    terminal = Terminal()
+    process = terminal.start([sys.executable, "-m", "balloon_cg", "run",
+                              str(SCENES / "spom1_two_coils_M0.002.toml"), "-o", str(out)])
     deadline = time.monotonic() + 60
-    while b"primary branch" not in _peek(process) and time.monotonic() < deadline:
-        time.sleep(0.2)
+    while b"primary branch" not in terminal.read() and time.monotonic() < deadline:
+        pass
     time.sleep(1.0)
     started = time.monotonic()
     process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=120)
+    err = terminal.finish(process, 120)
     assert process.returncode == 130, err
     assert time.monotonic() - started < 30
     assert "Traceback" not in err and err.strip().splitlines()[-1].startswith("balloon-cg: interrupted")
@@ -157,9 +235,7 @@ def test_sigint_writes_a_readable_partial_file_and_exits_130(tmp_path):
 
 
 def _peek(process) -> bytes:
-    """Whatever the process has written to stderr so far (non-blocking)."""
-    import fcntl
-
+    """Whatever the process has written to its stderr pipe so far (non-blocking; kept in ``process._peeked``)."""
     fd = process.stderr.fileno()
     fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_NONBLOCK)
     try:
@@ -168,6 +244,53 @@ def _peek(process) -> bytes:
         chunk = b""
     process._peeked = getattr(process, "_peeked", b"") + chunk
     return process._peeked
+
+
+def test_sigterm_on_critical_writes_the_partial_curve_and_exits_130(tmp_path):
+    """`critical` as `run`: a signal during the curve of pitchforks (~100 points, a few seconds) ends it at its
+    next point; the curve so far is written (atomically, end interrupted), one line says so, exit 130."""
+    from balloon_cg.io.curve_file import read_curve
+
+    out = tmp_path / "curve.h5"
+    process = subprocess.Popen([sys.executable, "-m", "balloon_cg", "critical", "spom1_single_coil", "--parameter",
+                                "M", "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while b"continuing it in M" not in _peek(process) and time.monotonic() < deadline and process.poll() is None:
+        time.sleep(0.1)
+    time.sleep(0.5)
+    assert process.poll() is None, "critical ended before it could be interrupted"
+    process.send_signal(signal.SIGTERM)
+    out_text, err = process.communicate(timeout=60)
+    err = (process._peeked + err).decode()
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "\r" not in err and out_text == b""
+    last = err.splitlines()[-1]
+    assert last.startswith(f"balloon-cg: interrupted: the curve is written to {out} (end: interrupted"), err
+    curve = read_curve(out)
+    assert curve["attrs"]["end"] == curve["attrs"]["stop_code"] == "interrupted"
+    assert 1 <= len(curve["q"]) < 100 and np.isnan(curve["attrs"]["critical_q"])
+    assert main(["inspect", str(out)]) == 0
+
+
+def test_critical_interrupted_before_its_curve_leaves_the_output_alone(tmp_path, monkeypatch, capsys):
+    """A signal during the primary branch: nothing to write; an existing output (--force) is left as it was."""
+    from balloon_cg.analysis import primary
+    from balloon_cg.numerics import interrupt
+
+    trace = primary.trace_primary
+
+    def interrupted_trace(*args, **kw):
+        interrupt.request()  # as the handler does: the trace stops at its first point
+        return trace(*args, **kw)
+
+    monkeypatch.setattr(primary, "trace_primary", interrupted_trace)
+    out = tmp_path / "curve.h5"
+    out.write_bytes(b"an earlier result")
+    assert main(["critical", "spom1", "--parameter", "alpha1", "-o", str(out), "--force", "--quiet"]) == 130
+    err = capsys.readouterr().err
+    assert err == f"balloon-cg: interrupted: nothing is written to {out} (the curve had not started)\n"
+    assert out.read_bytes() == b"an earlier result" and not interrupt.requested()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.h5"]  # no temporary file left
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])

@@ -134,6 +134,26 @@ def test_with_overrides():
         assert str(err.value).startswith(f"two: {key}")
 
 
+def test_a_new_preset_and_its_parameters_in_one_override():
+    """`--set material.preset=Gent --set material.parameters.Jm=50` on an Ogden scene: the parameter is the new
+    preset's (it was checked against the old material, which has none), in either order; every other material
+    key applies to the new preset too."""
+    scene = parse_scene(TWO_COILS, name="two")
+    for overrides in ({"material.preset": "Gent", "material.parameters.Jm": 50.0},
+                      {"material.parameters.Jm": 50.0, "material.preset": "Gent"}):
+        gent = scene.with_overrides(overrides)
+        assert gent.material.family == "gent" and gent.material.parameters == {"mu": 2.0, "Jm": 50.0}
+        assert parse_scene(gent.text, name=gent.name) == gent
+    with pytest.raises(SceneError, match="no parameter 'Jm'"):
+        scene.with_overrides({"material.preset": "Yeoh", "material.parameters.Jm": 50.0})
+    # the preset first in any order: a material key given before it was silently dropped
+    assert scene.with_overrides({"material.name": "mine", "material.preset": "TPOM1"}).material.name == "mine"
+    for overrides in ({"material.alpha": [1.5, 4.0, -2.0], "material.preset": "TPOM1"},
+                      {"material.preset": "TPOM1", "material.alpha": [1.5, 4.0, -2.0]}):
+        with pytest.raises(SceneError, match="give one of preset"):
+            scene.with_overrides(overrides)
+
+
 def test_with_overrides_takes_the_bare_names_of_the_command_line():
     """{"M": x} is {"field.M": x} (the one table with that key), as `--set M=x`; an ambiguous or unknown bare
     name is refused naming the tables."""
@@ -169,8 +189,8 @@ def test_shipped_scenes_by_name(tmp_path, monkeypatch):
     assert load_scene("spom1").name == "spom1" and load_scene("spom1_two_coils_M0.002.toml").field.M == 0.002
     (tmp_path / "spom1.toml").write_text('[material]\npreset = "TPOM1"\n')
     assert load_scene("spom1.toml").material.name == "TPOM1"  # a file of that name comes first
-    with pytest.raises(FileNotFoundError):
-        load_scene("no_such_scene")
+    with pytest.raises(FileNotFoundError, match=r"nor the name of a scene shipped .*\(fpom1, fpom2, spom1, "):
+        load_scene("no_such_scene")  # a typo of a shipped name is told which names there are
 
 
 

@@ -8,15 +8,15 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.codim2 import CurveEnd, ExtendedSystem, continue_branch_point
+from balloon_cg.analysis.codim2 import CurveEnd, continue_branch_point
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.results import Status, StopCode
 from balloon_cg.analysis.second_parameter import Derivative, UnknownParameter, parameter_keys, resolve
-from balloon_cg.analysis.stability import SecondVariation, assess_branch
 from balloon_cg.app.cli import main
 from balloon_cg.io.curve_file import read_curve, write_curve
 from balloon_cg.scene import load_scene, parse_scene
+from pitchforks import isola, jacobian_error, pear_events
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 YEOH = ('[material]\nfamily = "rivlin"\n[material.parameters]\nC10 = 1.0\nC01 = 0.0\nC20 = -0.01\nC11 = 0.0\n'
@@ -36,12 +36,7 @@ def yeoh_sphere(lam, C20, C10=1.0, C30=3e-4):
 
 @pytest.fixture(scope="module")
 def yeoh():
-    scene = parse_scene(YEOH, name="yeoh")
-    branch = trace_primary(scene, down=False)
-    assessments, _ = assess_branch(branch, branch.disc.degree, True)
-    events = [e for e in bifurcation.detect(branch, assessments) if e[1] == "odd_held"]
-    assert len(events) == 2  # Yeoh's softening then stiffening: an isola at M = 0
-    return scene, branch, [bifurcation.locate(branch, *e) for e in events]
+    return isola(parse_scene(YEOH, name="yeoh"))  # Yeoh's softening then stiffening: an isola at M = 0
 
 
 @pytest.fixture(scope="module")
@@ -84,22 +79,10 @@ def test_curve_file_records_the_parameter(c20_curve, yeoh, tmp_path):
     assert data["attrs"]["critical_q"] == c20_curve.critical[0]
 
 
-def _jacobian_error(branch, bp, key):
-    eq = equilibrium_of(branch)
-    odd = bifurcation.block_indices(SecondVariation(eq, branch.disc.degree), "odd_held", False)
-    ell = bp.mode[odd] / np.linalg.norm(bp.mode[odd])
-    system = ExtendedSystem(eq, branch.params.with_value("P", bp.X[-1]), key, ell)
-    X0 = system.initial(bp, system.parameter.q0)
-    direction = np.random.default_rng(2).standard_normal(X0.size) * 1e-2
-    h = 1e-4
-    fd = (system.residual(X0 + h * direction) - system.residual(X0 - h * direction)) / (2 * h)
-    return np.abs(fd - system.jacobian(X0) @ direction).max()
-
-
 def test_jacobian_in_an_energy_parameter_matches_differences(yeoh):
     _, branch, bps = yeoh
     for key in ("material.parameters.C20", "material.parameters.C10"):
-        assert _jacobian_error(branch, bps[0], key) < 1e-8
+        assert jacobian_error(branch, bps[0], key, seed=2) < 1e-8
 
 
 SINGLE_COIL = SCENES / "spom1_single_coil.toml"
@@ -112,10 +95,8 @@ def test_a_scalar_without_derivative_kernel_follows_the_same_curve_as_M():
     scene = load_scene(SINGLE_COIL).with_overrides({"continuation.stop_stretch": 2.0, "solver.degree": 60,
                                                     "field.M": 1.0, "field.chi": 0.002})
     branch = trace_primary(scene, down=False)
-    assessments, _ = assess_branch(branch, branch.disc.degree, True)
-    event = next(e for e in bifurcation.detect(branch, assessments) if e[1] == "odd_held")
-    bp = bifurcation.locate(branch, *event)
-    assert _jacobian_error(branch, bp, "chi") < 1e-8
+    bp = bifurcation.locate(branch, *pear_events(branch)[0])
+    assert jacobian_error(branch, bp, "chi", seed=2) < 1e-8
     curve = continue_branch_point(branch, bp, "field.chi")
     assert curve.second.derivative == Derivative.CENTRAL and curve.second.key == "field.chi"
     assert curve.end == CurveEnd.ISOLA_MERGE

@@ -211,7 +211,7 @@ def test_cli_sweep_and_resume(tmp_path, capsys):
     assert main(argv) == 0
     assert "0 computed, 2 already in the file" in capsys.readouterr().out
     assert main(argv[:3] + ["M=0,0.003"] + argv[4:]) == 2
-    assert "holds a different sweep: --vary differs" in capsys.readouterr().err
+    assert f"{out}: holds a different sweep: --vary differs" in capsys.readouterr().err  # not its store's manifest
     assert main(["sweep", str(SCENE_FILE), "--vary", "M=-1", "-o", str(tmp_path / "x.h5")]) == 2
     assert "must be >= 0" in capsys.readouterr().err
 
@@ -246,3 +246,15 @@ def test_phase_diagram_from_a_sweep_file(tmp_path):
     assert len(lines) == 2 and all(len(line.get_xdata()) == 2 for line in lines)
     [fold] = [line for line in ax.get_lines() if "fold (LP)" in line.get_label()]
     assert len(fold.get_xdata()) == 2 and np.all(np.asarray(fold.get_ydata()) > 2.5)  # P_max ≈ 2.57 (α1 = 1.3)
+
+
+def test_phase_diagram_of_a_primary_only_sweep_is_refused(tmp_path):
+    """A primary-only sweep has no stability, so no branch points: one clear line, not a diagram that shows no
+    pitchforks (as if there were none)."""
+    from balloon_cg.post.plotting import PlotError, plot
+
+    scene = load_scene("spom1").with_overrides({"continuation.stop_stretch": 1.5})
+    out = tmp_path / "primary.h5"
+    run_sweep(scene, ["material.alpha[0]=1.3,1.5"], out, mode="primary-only", workers=1)
+    with pytest.raises(PlotError, match="primary-only sweep has no branch points"):
+        plot([out], "phase")

@@ -10,29 +10,24 @@ from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis import bifurcation
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.results import Status, StopCode
-from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.analysis.stability import SecondVariation, assess_branch
+from balloon_cg.analysis.stability import SecondVariation
 from balloon_cg.io.run_file import read_run
-from balloon_cg.analysis.codim2 import (CurveEnd, ExtendedSystem, TwoParameterError, alpha1_material,
+from balloon_cg.analysis.codim2 import (CurveEnd, TwoParameterError, alpha1_material,
                                        continue_branch_point, land_on_q, sphere_critical_alpha1,
                                        sphere_pear_stretches)
 from balloon_cg.analysis import codim2
 from balloon_cg.numerics.continuation import Fold, Path as TracePath, Point, RootStatus, Stop, TraceStop
 from balloon_cg.io.curve_file import read_curve, write_curve
+from pitchforks import isola, jacobian_error
 
 SPOM1 = get_preset("SPOM1")
 
 
 @pytest.fixture(scope="module")
 def located():
-    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n', name="SPOM1")
-    branch = trace_primary(scene, down=False)
-    assessments, _ = assess_branch(branch, branch.disc.degree, True)
-    events = [e for e in bifurcation.detect(branch, assessments) if e[1] == "odd_held"]
-    assert len(events) == 2  # the isola's two pitchforks
-    return scene, branch, [bifurcation.locate(branch, *e) for e in events]
+    return isola(parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n', name="SPOM1"))
 
 
 @pytest.fixture(scope="module")
@@ -46,15 +41,7 @@ def test_jacobian_matches_differences_of_the_residual(located):
     against central differences of the exact extended residual."""
     _, branch, bps = located
     for parameter, q0 in (("alpha1", 1.3), ("M", 0.0)):  # (no coils: the M column is zero, still consistent)
-        eq = Equilibrium(branch.scene, branch.disc)
-        odd = bifurcation.block_indices(SecondVariation(eq, branch.disc.degree), "odd_held", False)
-        ell = bps[0].mode[odd] / np.linalg.norm(bps[0].mode[odd])
-        system = ExtendedSystem(eq, branch.params.with_value("P", bps[0].X[-1]), parameter, ell)
-        X0 = system.initial(bps[0], q0)
-        direction = np.random.default_rng(1).standard_normal(X0.size) * 1e-2
-        h = 1e-4
-        fd = (system.residual(X0 + h * direction) - system.residual(X0 - h * direction)) / (2 * h)
-        assert np.abs(fd - system.jacobian(X0) @ direction).max() < 1e-8
+        assert jacobian_error(branch, bps[0], parameter, q0) < 1e-8
 
 
 def test_critical_alpha1_matches_closed_form(curve):
@@ -175,7 +162,7 @@ def test_continuation_in_M_without_coils_is_refused(located):
 
 
 def test_phase_diagram_plot(curve, tmp_path):
-    from balloon_cg.post.plotting import plot
+    from balloon_cg.post.plotting import PlotError, plot
     from balloon_cg.scene import parse_scene
 
     path = write_curve(tmp_path / "phase.h5", parse_scene('[material]\npreset = "SPOM1"\n'), curve)
@@ -187,6 +174,9 @@ def test_phase_diagram_plot(curve, tmp_path):
     assert len(shaded.get_xy()) >= 400 > len(read_curve(path)["q"])
     fig.savefig(tmp_path / "phase.png")
     assert (tmp_path / "phase.png").stat().st_size > 1000
+    for kind in ("pressure-pole", "shapes", "energy"):  # a curve file has no branches: no empty figure
+        with pytest.raises(PlotError, match="no branches to draw .* its kind is phase"):
+            plot([path], kind)
 
 
 def test_smooth_curve_follows_a_sparse_arc():

@@ -36,9 +36,11 @@ if the curve, after it, comes back to q0 at the partner pitchfork with P > 0 all
 returns past q0 (stop ``PARTNER``), when P ≤ 0 (``StopCode.NONPOSITIVE_PRESSURE``: the pitchforks leave the
 physical range of an inflated balloon; the message gives q where the curve crosses P = 0), when the membrane
 comes within ``continuation.wire_gap`` of a coil (``WIRE_GAP``), when q reaches 0 for a parameter that must
-not (α1, an exponent, a family's positive parameter: ``ALPHA1_ZERO``), at ``max_points`` or at the minimum step.
-The end is then, in this order of precedence:
+not (α1, an exponent, a family's positive parameter: ``ALPHA1_ZERO``), at ``max_points``, at the minimum step,
+or at the next point after SIGINT/SIGTERM (``numerics.interrupt``: ``StopCode.INTERRUPTED``). The end is then, in
+this order of precedence:
 
+    INTERRUPTED            a signal stopped the trace: the curve is partial (folds so far are not verified)
     ISOLA_MERGE            a fold in q at P > 0, then the partner pitchfork (stop PARTNER): the isola is born or
                            dies there; ``critical`` is that fold (the fold of extreme q if there are several)
     FOLD                   folds in q, none verified as such a merge (P ≤ 0 at the fold, or the curve did not
@@ -64,7 +66,7 @@ from scipy.optimize import brentq, minimize_scalar
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model.sphere_modes import bifurcation_condition, bifurcation_stretches
-from ..numerics import continuation
+from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop, TraceStop
 from ..numerics.newton import newton
 from ..scene import Scene
@@ -85,6 +87,7 @@ class TwoParameterError(RuntimeError):
 class CurveEnd(enum.StrEnum):
     """How a two-parameter curve ended (module docstring): only ISOLA_MERGE gives a critical value."""
 
+    INTERRUPTED = "interrupted"  # SIGINT/SIGTERM stopped the trace (numerics.interrupt): the curve is partial
     ISOLA_MERGE = "isola_merge"  # a fold in q at P > 0, then back to q0 at the partner pitchfork
     FOLD = "fold"  # a fold in q not verified as a merge (P <= 0 there, or no return to the partner)
     NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # P reached 0 (no fold before)
@@ -244,6 +247,8 @@ class TwoParameterCurve:
             qc, Pc, sc = self.critical
             return (f"the pitchforks merge at {name} = {qc:.12g} (P = {Pc:.10g}, pole stretch {sc:.10g}) and the "
                     f"curve returns to {name} = {self.q0:g} at the partner pitchfork")
+        if self.end == CurveEnd.INTERRUPTED:
+            return f"a signal stopped the curve: it is partial ({len(self.q)} points, {at})"
         if self.end == CurveEnd.FOLD:
             folds = ", ".join(f"{name} = {s.X[-1]:.6g} at P = {s.X[self.n]:.4g}" for s in self.merges) or "not located"
             return (f"the curve turns back in {name} ({folds}) but is not verified as a merge of the isola's two "
@@ -264,7 +269,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     P ≤ 0, when the membrane comes within continuation.wire_gap of a coil, when q reaches 0 for a parameter that
     must not (α1, exponents, positive parameters), or when ``stop(point)`` (a continuation.Point) returns a Stop,
     by default when q returns past q0 after a fold (the curve has reached the partner pitchfork); or at
-    ``max_points``.
+    ``max_points``; or at the next point after SIGINT/SIGTERM under ``numerics.interrupt.stop_on_signals``.
     Returns a TwoParameterCurve whose ``end`` says how it ended (``CurveEnd``) and whose ``merges`` are the folds
     in q; only an ISOLA_MERGE curve has a ``critical`` value (its merge, Status.LOCATED).
     """
@@ -318,6 +323,8 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     name = parameter.name
 
     def stop_point(point):
+        if interrupt.requested():
+            return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
         if parameter.bound and point.X[-1] * q0 <= 0:
             return Stop(StopCode.ALPHA1_ZERO, f"{name} reached 0")
         if point.X[n] <= 0:
@@ -345,6 +352,8 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
 def _classify(path, n: int) -> CurveEnd:
     """How a traced curve ended (module docstring)."""
     code = path.stop.code
+    if code == StopCode.INTERRUPTED:
+        return CurveEnd.INTERRUPTED
     if path.folds:
         if code == StopCode.PARTNER and all(fold.point.X[n] > 0 for fold in path.folds):
             return CurveEnd.ISOLA_MERGE

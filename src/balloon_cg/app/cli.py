@@ -9,8 +9,8 @@ on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: 
 end in a verified merge of the pitchforks); 2 bad input (invalid scene, missing or unreadable file, existing
 output without --force or in use by another process, a damaged file, a scene ``critical`` cannot handle); 3 an
 internal error (a bug: one line asking to report it; ``--debug`` shows the traceback); 130 interrupted (SIGINT or
-SIGTERM: ``run`` stops at the next point and writes what is finished, flagged incomplete). Errors are one line on
-stderr, ``balloon-cg: error: ...``.
+SIGTERM: ``run`` and ``critical`` stop at the next point and write what is finished, flagged incomplete). Errors
+are one line on stderr, ``balloon-cg: error: ...``.
 """
 import argparse
 import json
@@ -187,11 +187,12 @@ def run(args) -> int:
     """Analyse, write, read back and summarise; exit 130 after an interrupt (what is finished is written)."""
     from ..io.run_file import read_run
     from ..numerics.interrupt import requested, stop_on_signals
+    from .progress import shown
 
     scene = scene_of(args)
     output = args.output or f"{scene.name}.h5"
     with stop_on_signals():
-        _, found = run_scene(scene, output, args.force, progress=not args.quiet, command=args.command_line,
+        _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
         interrupted = requested()
     if interrupted:
@@ -452,18 +453,16 @@ def critical(args) -> int:
     step): one line on stderr says how and where, and the curve file is still written. 2 (``UsageError``) a
     scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
     the equator-symmetric layout), ``--parameter M`` without coils, or a parameter the scene's kernels do not take
-    (one line listing those they do: ``analysis.second_parameter``). Progress goes to stderr (``--quiet``: none).
+    (one line listing those they do: ``analysis.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as
+    ``run``): the work stops at its next point (or phase); a curve already started is written (atomically, end
+    ``interrupted``), before it nothing is. Progress goes to stderr (``--quiet``: none).
     """
-    from tqdm import tqdm
-
-    from ..analysis.bifurcation import detect, locate
-    from ..analysis.codim2 import CurveEnd, TwoParameterError, continue_branch_point
-    from ..analysis.primary import trace_primary
-    from ..analysis.results import Block, Status
+    from ..analysis.codim2 import CurveEnd
+    from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
-    from ..analysis.stability import assess_branch
     from ..io.curve_file import write_curve
     from ..io.hdf5 import check_output
+    from ..numerics.interrupt import requested, stop_on_signals
 
     scene = scene_of(args)
     asymmetry = _asymmetry(scene)
@@ -477,32 +476,17 @@ def critical(args) -> int:
     except UnknownParameter as e:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
     check_output(args.output, args.force)
-
-    def say(text):
-        if not args.quiet:
-            print(f"{PROG} critical: {text}", file=sys.stderr)
-
-    with tqdm(desc="primary branch", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
-        branch = trace_primary(scene, progress=lambda point: bar.update())
-    say(f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
-    assessments, _ = assess_branch(branch, scene.stability.degree)
-    pear = [event for event in detect(branch, assessments) if event[1] == Block.ODD_HELD]
-    if not pear:
-        raise Failure(f"no pear-shaped pitchfork on the primary branch of {args.scene} ({branch.stop_reason}): "
-                      f"nothing to continue in {args.parameter}")
-    say(f"locating the first pear pitchfork (of {len(pear)})")
-    bp = locate(branch, *pear[0])
-    if bp.status != Status.LOCATED:
-        say(f"the pear pitchfork is only approximately located (±{bp.uncertainty:.1g}: {bp.reason})")
-    say(f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
-    try:
-        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=args.quiet, file=sys.stderr) as bar:
-            curve = continue_branch_point(branch, bp, args.parameter, args.direction,
-                                          progress=lambda point: bar.update())
-    except TwoParameterError as e:
-        raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
-    write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
-    say(f"curve: {len(curve.q)} points, ended: {curve.end.value}")
+    with stop_on_signals():
+        curve = _pitchfork_curve(scene, args)
+        if curve is not None:
+            write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
+        interrupted = requested()
+    if interrupted:
+        written = (f"nothing is written to {args.output} (the curve had not started)" if curve is None else
+                   f"the curve is written to {args.output} (end: {curve.end.value}, {len(curve.q)} points)")
+        print(f"{PROG}: interrupted: {written}", file=sys.stderr)
+        return INTERRUPTED
+    _say(args, f"curve: {len(curve.q)} points, ended: {curve.end.value}")
     if curve.end != CurveEnd.ISOLA_MERGE:
         raise Failure(f"no critical {curve.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
                       f"written to {args.output}")
@@ -514,6 +498,54 @@ def critical(args) -> int:
     print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
           f"curve written to {args.output}")
     return 0
+
+
+def _say(args, text: str) -> None:
+    """A progress line of ``critical`` on stderr (none with --quiet)."""
+    if not args.quiet:
+        print(f"{PROG} critical: {text}", file=sys.stderr)
+
+
+def _pitchfork_curve(scene, args):
+    """``critical``'s computation: the primary branch, its first pear pitchfork located, the curve of pitchforks
+    in ``args.parameter`` (analysis.codim2). None when a signal (numerics.interrupt) stopped the work before the
+    curve started; a signal during the curve ends it at its next point (end ``interrupted``)."""
+    from tqdm import tqdm
+
+    from ..analysis.bifurcation import detect, locate
+    from ..analysis.codim2 import TwoParameterError, continue_branch_point
+    from ..analysis.primary import trace_primary
+    from ..analysis.results import Block, Status
+    from ..analysis.stability import assess_branch
+    from ..numerics.interrupt import requested
+    from .progress import shown, tqdm_disable
+
+    disable = tqdm_disable(shown(args.quiet))
+    with tqdm(desc="primary branch", unit=" points", disable=disable, file=sys.stderr) as bar:
+        branch = trace_primary(scene, progress=lambda point: bar.update())
+    if requested():
+        return None
+    _say(args, f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
+    assessments, _ = assess_branch(branch, scene.stability.degree)
+    if requested():
+        return None
+    pear = [event for event in detect(branch, assessments) if event[1] == Block.ODD_HELD]
+    if not pear:
+        raise Failure(f"no pear-shaped pitchfork on the primary branch of {args.scene} ({branch.stop_reason}): "
+                      f"nothing to continue in {args.parameter}")
+    _say(args, f"locating the first pear pitchfork (of {len(pear)})")
+    bp = locate(branch, *pear[0])
+    if requested():
+        return None
+    if bp.status != Status.LOCATED:
+        _say(args, f"the pear pitchfork is only approximately located (±{bp.uncertainty:.1g}: {bp.reason})")
+    _say(args, f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
+    try:
+        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=disable, file=sys.stderr) as bar:
+            return continue_branch_point(branch, bp, args.parameter, args.direction,
+                                         progress=lambda point: bar.update())
+    except TwoParameterError as e:
+        raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
 
 
 def _asymmetry(scene) -> str:
@@ -558,6 +590,7 @@ def sweep(args) -> int:
     """Expand, compute the members not yet in the file, append them, summarise."""
     from ..io.sweep_file import incomplete_members
     from ..scene import load_scene
+    from .progress import shown
     from .sweep import SweepError, format_summary, run_sweep
 
     if args.workers is not None and args.workers < 1:
@@ -569,7 +602,7 @@ def sweep(args) -> int:
     try:
         with sigterm_raises():
             result = run_sweep(scene, args.vary, args.output, mode=mode, workers=args.workers,
-                               scheduler=args.scheduler, force=args.force, progress=not args.quiet,
+                               scheduler=args.scheduler, force=args.force, progress=shown(args.quiet),
                                command=args.command_line)
     except SweepError as e:
         raise UsageError(str(e)) from None

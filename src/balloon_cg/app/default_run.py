@@ -19,6 +19,7 @@ from pathlib import Path
 from ..analysis.tracer import ContinuationError
 from ..analysis.verdict import failing, summary_line
 from .cli import run_scene
+from .progress import shown
 from .summaries import summarise_branch
 from ..post.plotting import applicable_kinds, load_branches, plot, special_label
 from ..scene import parse_scene
@@ -88,7 +89,7 @@ def main(argv=None) -> int:
     rows, paths, failed = [], [], []
     for scene in default_scenes(QUICK_POINTS if args.quick else None):
         try:
-            path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=not args.quiet)
+            path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=shown(args.quiet))
         except ContinuationError as e:
             failed.append(f"{scene.name}: {e}")
             continue

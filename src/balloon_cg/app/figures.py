@@ -16,6 +16,7 @@ from ..post.paper import PAPER_STYLE, TWO_COLUMNS, draw_figure, figures
 from ..post.plotting import Reading
 from ..scene import parse_scene
 from .api import analyse
+from .progress import shown
 
 IMAGE_FORMATS = (".png", ".pdf", ".svg")
 
@@ -90,7 +91,7 @@ def command(args) -> int:
     [--allow-partial]``: prints the image paths. Exit 1 when a run drawn is incomplete (the figures are still
     written; ``--allow-partial``: 0), as for ``run``."""
     reading = Reading.parse(args.stability)
-    progress = not args.quiet
+    progress = shown(args.quiet)
     if args.name == "all":
         names = list(figures(args.quick))
         paths = make_all(args.output, args.runs, args.width, reading, args.quick, progress=progress)

@@ -17,8 +17,10 @@ _NODES = 4
 
 
 def add_kernels(commands):
+    from .cli import SCENE_HELP  # the CLI's parser calls this: cli is loaded
+
     p = commands.add_parser("kernels", help="the kernel class of a scene, generated on demand, with timings")
-    p.add_argument("scene", help="scene TOML file")
+    p.add_argument("scene", help=SCENE_HELP)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=kernels)
 

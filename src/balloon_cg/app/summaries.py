@@ -47,7 +47,7 @@ def summarise_sweep(path) -> dict:
 
 def format_sweep(summary: dict) -> str:
     p = summary["provenance"]
-    lines = [f"file           {summary['file']}", f"sweep of      {p.get('scene_name', '?')}",
+    lines = [f"file           {summary['file']}", f"sweep of       {p.get('scene_name', '?')}",
              f"created        {p.get('created', '?')}  (balloon-cg {p.get('package_version', '?')}, "
              f"format {p.get('format')})", f"command        {p.get('command', '?')}",
              f"members        {len(summary['members'])}", ""]

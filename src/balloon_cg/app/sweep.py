@@ -31,6 +31,7 @@ from ..io.lock import claim
 from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
                              store_path)
 from .hygiene import worker_hygiene
+from .progress import tqdm_disable
 from ..numerics import interrupt
 from ..scene import Scene, SceneError, parse_scene
 
@@ -254,7 +255,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
         by_index = {m.index: m for m in members}
         try:
             with tqdm(total=len(members), initial=len(store.done), desc="sweep", unit=" members",
-                      disable=not progress, file=sys.stderr) as bar:
+                      disable=tqdm_disable(progress), file=sys.stderr) as bar:
                 with contextlib.closing(_compute(todo, mode, workers, scheduler)) as outcomes:
                     for index, outcome in outcomes:
                         if isinstance(outcome, BaseException):

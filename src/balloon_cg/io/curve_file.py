@@ -13,11 +13,11 @@ Layout::
                         the verified merge of the two pitchforks), unknowns in the branch layout (u, P), and q
 
 ``end`` is the curve's ``analysis.codim2.CurveEnd`` (how it ended: isola_merge, fold, nonpositive_pressure, wire,
-budget, step_min, alpha1_zero, other); ``end_description`` says the same for people, with where. ``parameter``
-is q's short name (M, alpha1, Jm, mu[0]), ``parameter_key`` its scene key (field.M, material.parameters.Jm,
-material.mu[0]; alpha1: itself), ``parameter_derivative`` how ∂R/∂q was computed (exact: a generated kernel;
-central: central differences): ``analysis.second_parameter``. Files written before these two existed have
-``parameter`` M or alpha1 and are read all the same.
+budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is partial); ``end_description``
+says the same for people, with where. ``parameter`` is q's short name (M, alpha1, Jm, mu[0]), ``parameter_key`` its
+scene key (field.M, material.parameters.Jm, material.mu[0]; alpha1: itself), ``parameter_derivative`` how ∂R/∂q was
+computed (exact: a generated kernel; central: central differences): ``analysis.second_parameter``. Files written
+before these two existed have ``parameter`` M or alpha1 and are read all the same.
 """
 from dataclasses import replace
 

@@ -131,12 +131,12 @@ def open_store(path, attrs: dict, members: list, force: bool) -> Store:
         directory = staging_path(path)
         if (directory / MANIFEST).is_file():
             with contextlib.suppress(SweepError, SweepFileError):
-                return _open_existing(directory, attrs, members)
+                return _open_existing(directory, attrs, members, path)
         shutil.rmtree(directory, ignore_errors=True)  # another replacement's leftovers: start again
         return _create(directory, attrs)
     directory = store_path(path)
     if directory.is_dir() and (directory / MANIFEST).is_file():
-        return _open_existing(directory, attrs, members)
+        return _open_existing(directory, attrs, members, path)
     if path.exists():
         return _import(path, directory, attrs, members)
     shutil.rmtree(directory, ignore_errors=True)  # a store cut short before its manifest: nothing in it
@@ -150,10 +150,11 @@ def _create(directory: Path, attrs: dict) -> Store:
     return Store(directory, {})
 
 
-def _open_existing(directory: Path, attrs: dict, members: list) -> Store:
+def _open_existing(directory: Path, attrs: dict, members: list, path: Path) -> Store:
+    """The store ``directory`` of the sweep file ``path`` (named in the error when it holds another sweep)."""
     manifest = directory / MANIFEST
     with _open(manifest) as f:
-        _check_same_sweep(f.attrs, manifest, attrs)
+        _check_same_sweep(f.attrs, manifest, attrs, path)
     expected = {m.index: m for m in members}
     done = {}
     for item in sorted(directory.iterdir()):
@@ -208,7 +209,9 @@ def _import(path: Path, directory: Path, attrs: dict, members: list) -> Store:
     return store
 
 
-def _check_same_sweep(stored, path: Path, attrs: dict) -> None:
+def _check_same_sweep(stored, path: Path, attrs: dict, sweep: Path | None = None) -> None:
+    """SweepError unless the attributes ``stored`` (read from ``path``) are those of the sweep ``attrs``; the
+    message names ``sweep`` (the user's sweep file; default ``path``)."""
     require_attrs(stored, path, ROOT_KEYS, error=SweepFileError)
     for key in ("scene_toml", "vary", "mode", "members"):
         old, new = plain(stored.get(key)), attrs[key]
@@ -217,7 +220,7 @@ def _check_same_sweep(stored, path: Path, attrs: dict) -> None:
                     "vary": f"--vary differs (file: {old}, now: {new})",
                     "mode": f"the mode differs (file: {old}, now: {new})",
                     "members": f"the member count differs (file: {old}, now: {new})"}[key]
-            raise SweepError(f"{path}: holds a different sweep: {what}; use --force to replace it")
+            raise SweepError(f"{sweep or path}: holds a different sweep: {what}; use --force to replace it")
 
 
 def _scene_diff(old: str, new: str) -> str:

@@ -4,8 +4,13 @@
 ``requested()`` at every point and end their work there (``StopCode.INTERRUPTED``), so what is finished can
 still be written. A second signal while the first is pending raises KeyboardInterrupt at once. On exit the
 previous handlers are restored and the flag cleared.
+
+A KeyboardInterrupt raised where Python cannot propagate it (inside a weakref callback or a ``__del__``) would be
+printed as "Exception ignored in ..." with a traceback; while the handlers are installed it is dropped instead
+(``sys.unraisablehook``): its signal has set the flag, which the loops check.
 """
 import signal
+import sys
 import threading
 from contextlib import contextmanager
 
@@ -41,12 +46,23 @@ def _handled_by(handler):
         yield
         return
     previous = {s: signal.signal(s, handler) for s in SIGNALS}
+    hook = sys.unraisablehook
+    sys.unraisablehook = _dropping_interrupts(hook)
     try:
         yield
     finally:
         for s, old in previous.items():
             signal.signal(s, old)
+        sys.unraisablehook = hook
         _flag.clear()
+
+
+def _dropping_interrupts(hook):
+    """An unraisable hook that drops KeyboardInterrupt (the flag is set) and passes everything else to ``hook``."""
+    def unraisable(info):
+        if not isinstance(info.exc_value, KeyboardInterrupt):
+            hook(info)
+    return unraisable
 
 
 def sigterm_raises():

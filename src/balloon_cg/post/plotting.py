@@ -181,6 +181,9 @@ def load_branches(source, branch: str | None = None, reading: Reading | None = N
     """The branches of a run or run file (all, primary first, or the one named), with their stability under
     ``reading`` (None: the run's control, ``Reading.of_run``)."""
     run = as_run(source)
+    if not run["branches"]:  # a two-parameter curve file is a run file without branches
+        raise PlotError(f"{run['path'] or run['scene_name']}: no branches to draw (a two-parameter curve file: its "
+                        "kind is phase)")
     reading = Reading.of_run(run) if reading is None else Reading.parse(reading)
     names = sorted(run["branches"], key=lambda name: name != "primary") if branch is None else [branch]
     if branch is not None and branch not in run["branches"]:
@@ -719,6 +722,8 @@ def _sweep_phase(ax, path) -> str:
     fold (LP, the pressure maximum); the isola region (two pitchforks) shaded between them, its edges
     interpolated between the members monotonically (PCHIP: no overshoot). Returns the parameter name."""
     sweep = read_sweep(path)
+    if sweep["attrs"].get("mode") == "primary-only":  # no stability, so no branch points: an empty diagram
+        raise PlotError(f"{path}: a primary-only sweep has no branch points to draw (sweep without --primary-only)")
     rows = []
     for member in sweep["members"].values():
         key, value = next(iter(member["overrides"].items()))

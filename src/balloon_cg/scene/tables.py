@@ -5,6 +5,7 @@ one-line message names the file (or scene), the dotted key, the value and what i
 """
 
 import enum
+import errno
 import math
 import re
 import tomllib
@@ -195,7 +196,8 @@ class Scene:
         """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``,
         or bare names of one table as on the command line (``{"M": 0.003}``: ``canonical_key``).
 
-        ``material.preset`` replaces the whole material; a value None restores the default. The copy is named
+        ``material.preset`` replaces the whole material (applied first, whatever the order: the other material
+        keys change the new one); a value None restores the default. The copy is named
         ``name``, or after what changed physically: each field, material or loading key's token in the name
         (``_M0.002``, ``_radius4``) takes the new value, or is appended (numerical keys keep the name).
         """
@@ -207,8 +209,14 @@ class Scene:
                     raise SceneError(f"{key}: {self.canonical_key(key)} is given twice")
                 canonical[self.canonical_key(key)] = value
             overrides = canonical
+            preset = overrides.get("material.preset")
+            if preset is not None:  # first, in any order: it replaces the material the other material keys change
+                _assign(data, "material.preset", preset)
+                if any(_PARAMETER_KEY.fullmatch(key) for key in overrides):  # its family's parameters, written out
+                    data = _build(data, self.name, "").to_dict()
             for key, value in overrides.items():
-                _assign(data, key, value)
+                if key != "material.preset" or preset is None:
+                    _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
         except SceneError as e:
             raise SceneError(f"{self.name}: {e}") from None
@@ -247,7 +255,10 @@ def load_scene(path) -> Scene:
     (``shipped_scenes()``)."""
     path = Path(path)
     shipped = path.name.removesuffix(".toml")
-    if not path.exists() and path.parent == Path(".") and shipped in shipped_scenes():
+    if not path.exists() and path.parent == Path("."):
+        if shipped not in shipped_scenes():
+            raise FileNotFoundError(errno.ENOENT, "no such file, nor the name of a scene shipped with the package "
+                                    f"({', '.join(sorted(shipped_scenes()))})", str(path))
         path = shipped_scenes()[shipped]
     try:
         text = path.read_text(encoding="utf-8")
