@@ -190,3 +190,29 @@ def test_inspect_names_the_voltage_of_a_snap_through(voltage_file):
     run = read_run(voltage_file)
     assert run["snap_throughs"]  # the pull-in: the stable stretch ends at the fold in Φ̄
     assert "snap-through at voltage = " in format_run(run) and "snap-through at P" not in format_run(run)
+
+
+def test_critical_refuses_a_voltage_continuation(tmp_path, capsys):
+    """The curve of pitchforks lives in (q, P): a voltage branch's Φ̄ must not be read as P."""
+    scene = tmp_path / "voltage.toml"
+    scene.write_text(VOLTAGE_SCENE, encoding="utf-8")
+    assert main(["critical", str(scene), "--parameter", "material.mu[0]", "-o", str(tmp_path / "c.h5")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "continuation.parameter = 'voltage'" in err
+    assert not (tmp_path / "c.h5").exists()
+
+
+def test_two_parameter_curves_refuse_a_voltage_branch(voltage_picture):
+    from balloon_cg.analysis.codim2 import TwoParameterError, continue_branch_point
+    with pytest.raises(TwoParameterError, match="continued in voltage, not in P"):
+        continue_branch_point(voltage_picture.primary, voltage_picture.branch_points[0], "material.mu[0]")
+
+
+def test_a_sweep_of_voltage_runs_has_no_pressure_phase_diagram(tmp_path, capsys):
+    scene = tmp_path / "voltage.toml"
+    scene.write_text(VOLTAGE_SCENE.replace("stop_stretch = 1.45", "stop_stretch = 1.2"), encoding="utf-8")
+    sweep = tmp_path / "sweep.h5"
+    assert main(["sweep", str(scene), "--vary", "continuation.pressure=0.4,0.5", "-o", str(sweep), "--primary-only",
+                 "--workers", "1", "--quiet"]) == 0
+    with pytest.raises(PlotError, match="member 0 is continued in voltage: phase draws the pitchfork pressures"):
+        plot(sweep, "phase")

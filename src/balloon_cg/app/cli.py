@@ -451,8 +451,8 @@ def critical(args) -> int:
     start, the merge is only approximately located, or the curve
     ended otherwise (P reached 0, a fold not verified as a merge, a coil wire, the point budget, the minimum
     step): one line on stderr says how and where, and the curve file is still written. 2 (``UsageError``) a
-    scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
-    the equator-symmetric layout), ``--parameter M`` without coils, or a parameter the scene's kernels do not take
+    scene the command cannot handle, checked before any computation: a voltage continuation (the curve lives in
+    (q, P)), not equator-symmetric (the pear block needs the equator-symmetric layout), ``--parameter M`` without coils, or a parameter the scene's kernels do not take
     (one line listing those they do: ``analysis.second_parameter``). Progress goes to stderr (``--quiet``: none).
     """
     from tqdm import tqdm
@@ -465,11 +465,16 @@ def critical(args) -> int:
     from ..analysis.stability import assess_branch
     from ..io.curve_file import write_curve
     from ..io.hdf5 import check_output
+    from ..scene import ContinuationParameter
 
     scene = scene_of(args)
     asymmetry = _asymmetry(scene)
     if asymmetry:
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
+    if scene.continuation.parameter != ContinuationParameter.PRESSURE:
+        raise UsageError(f"critical needs a pressure continuation: {args.scene}: continuation.parameter = "
+                         f"{scene.continuation.parameter.value!r} (the curve of pitchforks is traced in (q, P); "
+                         "continue P at a fixed electric.voltage instead)")
     if args.parameter in ("M", "field.M") and not scene.field.coils:
         raise UsageError(f"critical --parameter M needs coils: {args.scene} has no [[field.coils]], so the "
                          "equilibrium does not depend on M")

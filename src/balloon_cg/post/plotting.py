@@ -819,9 +819,13 @@ def _sweep_phase(ax, path) -> str:
     interpolated between the members monotonically (PCHIP: no overshoot). Returns the parameter name."""
     sweep = read_sweep(path)
     rows = []
-    for member in sweep["members"].values():
+    for name, member in sweep["members"].items():
         key, value = next(iter(member["overrides"].items()))
-        specials = member["branches"]["primary"]["special_points"]
+        primary = member["branches"]["primary"]
+        if ordinate_of(primary) != PRESSURE_ORDINATE:
+            raise PlotError(f"{path}: member {name} is continued in {ordinate_of(primary).column}: phase draws the "
+                            "pitchfork pressures of pressure continuations")
+        specials = primary["special_points"]
         pressures = sorted(s["pressure"] for s in specials if s["block"] == "odd_held")
         folds = [s["pressure"] for s in specials if s["kind"] == "LP"]
         rows.append((float(value), pressures, folds[0] if folds else np.nan))
