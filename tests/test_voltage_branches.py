@@ -64,7 +64,11 @@ def voltage_file(voltage_picture, tmp_path_factory):
 
 
 def test_the_pear_formula_meets_the_pull_in_at_zero_pressure():
-    assert pear_stretch(0.0) == pytest.approx(2 ** (1 / 3), abs=1e-12)
+    """At P = 0 the pear point is the pull-in, where the tension vanishes and every mode n crosses at once."""
+    pull_in = 2 ** (1 / 3)
+    assert pear_stretch(0.0) == pytest.approx(pull_in, abs=1e-12)
+    for n in range(1, 6):
+        assert sphere_mode_condition(pull_in, sphere_voltage(pull_in, 0.0), n) == pytest.approx(0.0, abs=1e-12)
     lam = pear_stretch(PRESSURE)
     assert sphere_mode_condition(lam, sphere_voltage(lam), 1) == pytest.approx(0.0, abs=1e-12)
 
