@@ -165,14 +165,14 @@ def format_run(run: dict) -> str:
     return "\n".join(lines)
 
 
-SNAP_SYMBOLS = {"pressure": "P", "volume": "V", "gas": "n"}  # the control value of a snap-through, by loading.control
-
-
 def _snap_symbol(run: dict, branch: str) -> str:
     """What a snap-through's stored value is: Φ̄ on a voltage branch, else the control value P, V or n."""
+    from ..scene import Control
+
     if run["branches"][branch]["attrs"].get("parameter") == "voltage":
         return "voltage"
-    return SNAP_SYMBOLS[run["attrs"].get("control", "pressure")]
+    control = Control(run["attrs"].get("control", Control.PRESSURE))
+    return {Control.PRESSURE: "P", Control.VOLUME: "V", Control.GAS: "n"}[control]
 
 
 def _verdict(attrs: dict) -> str:
