@@ -220,3 +220,11 @@ def test_a_sweep_of_voltage_runs_has_no_pressure_phase_diagram(tmp_path, capsys)
                  "--workers", "1", "--quiet"]) == 0
     with pytest.raises(PlotError, match="member 0 is continued in voltage: phase draws the pitchfork pressures"):
         plot(sweep, "phase")
+
+
+@pytest.mark.parametrize("control, parameter, symbol", [("pressure", "P", "P"), ("volume", "P", "V"), ("gas", "P", "n"),
+                                                        ("pressure", "voltage", "voltage")])
+def test_a_snap_through_value_is_named_by_what_it_is(control, parameter, symbol):
+    from balloon_cg.app.summaries import _snap_symbol
+    run = {"attrs": {"control": control}, "branches": {"primary": {"attrs": {"parameter": parameter}}}}
+    assert _snap_symbol(run, "primary") == symbol
