@@ -212,12 +212,19 @@ def test_two_parameter_curves_refuse_a_voltage_branch(voltage_picture):
         continue_branch_point(voltage_picture.primary, voltage_picture.branch_points[0], "material.mu[0]")
 
 
-def test_a_sweep_of_voltage_runs_has_no_pressure_phase_diagram(tmp_path, capsys):
+def test_a_sweep_of_voltage_runs_stores_the_pear_voltages_and_has_no_pressure_phase_diagram(tmp_path, capsys):
+    from balloon_cg.io.sweep_file import read_sweep
     scene = tmp_path / "voltage.toml"
-    scene.write_text(VOLTAGE_SCENE.replace("stop_stretch = 1.45", "stop_stretch = 1.2"), encoding="utf-8")
+    scene.write_text(VOLTAGE_SCENE.replace("stop_stretch = 1.45", "stop_stretch = 1.32"), encoding="utf-8")
     sweep = tmp_path / "sweep.h5"
-    assert main(["sweep", str(scene), "--vary", "continuation.pressure=0.4,0.5", "-o", str(sweep), "--primary-only",
-                 "--workers", "1", "--quiet"]) == 0
+    assert main(["sweep", str(scene), "--vary", "continuation.pressure=0.5,0.6", "-o", str(sweep), "--no-pear",
+                 "--workers", "1"]) == 0
+    summary = capsys.readouterr().out
+    for member in read_sweep(sweep)["members"].values():
+        P = member["overrides"]["continuation.pressure"]
+        assert list(member["attrs"]["branch_point_pressures"]) == [P]
+        voltage = member["attrs"]["branch_point_voltages"][0]
+        assert abs(voltage - sphere_voltage(pear_stretch(P), P)) < 1e-9 and f"{voltage:.6g}" in summary
     with pytest.raises(PlotError, match="member 0 is continued in voltage: phase draws the pitchfork pressures"):
         plot(sweep, "phase")
 
