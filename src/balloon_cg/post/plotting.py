@@ -113,7 +113,7 @@ VOLTAGE_MEANINGS = {  # the pressure readings on a voltage branch: P is fixed, Î
 class Ordinate:
     """The y quantity of a branch curve: the continuation ``parameter`` it must be (the stored branch attribute
     ``parameter``: "P" or "voltage"), its per-point and special-point ``column``, its axis ``label``, its
-    ``symbol`` in legends and the ``kinds`` ("<prefix>-pole", "<prefix>-equator") that draw it."""
+    ``symbol`` in legends and the ``prefix`` of the kinds that draw it ("<prefix>-pole", "<prefix>-equator")."""
 
     parameter: str
     column: str
