@@ -41,9 +41,13 @@ def pear_stretch(P):
     return brentq(lambda lam: 4 / lam - 16 / lam**7 - P, 1.2, 1.7, xtol=1e-15)
 
 
-def fixed_voltage_scene(voltage, name="fixed"):
+TWO_COILS = ("[field]\nM = 0.003\n[[field.coils]]\nradius = 1.7321\nheight = 1.0\ncurrent = 1.0\n"
+             "[[field.coils]]\nradius = 1.7321\nheight = -1.0\ncurrent = -1.0\n")  # the paper's opposed coils
+
+
+def fixed_voltage_scene(voltage, name="fixed", field=""):
     return parse_scene(NEO + f"[electric]\nvoltage = {voltage!r}\n[continuation]\nstart_stretch = 1.2\n"
-                       "stop_stretch = 1.45\n", name=name)
+                       "stop_stretch = 1.45\n" + field, name=name)
 
 
 def stretch(branch, X) -> float:
@@ -92,11 +96,18 @@ def test_branch_points_of_a_voltage_continuation_are_the_sphere_modes(voltage_pi
                                                   Classification.PITCHFORK_SUB]
 
 
-def test_the_pear_point_is_the_same_from_a_pressure_continuation(voltage_picture):
+@pytest.mark.parametrize("field", ["", TWO_COILS], ids=["no field", "two coils"])
+def test_the_pear_point_is_the_same_from_a_pressure_continuation(voltage_picture, field):
     """Continuing P at the located Φ̄* finds the branch point at P = 0.5 and the same stretch, with the same
-    reduced energy (the energy at fixed P and Φ̄ does not know which parameter was continued)."""
+    reduced energy (the energy at fixed P and Φ̄ does not know which parameter was continued); also between the
+    paper's two coils (no closed form there)."""
+    if field:
+        voltage_picture = analyse(parse_scene(VOLTAGE_SCENE + field, name="voltage_coils"), pear=False)
     from_voltage = voltage_picture.branch_points[0]
-    picture = analyse(fixed_voltage_scene(float(from_voltage.X[-1])), pear=False)
+    assert from_voltage.block == Block.ODD_HELD and from_voltage.status == Status.LOCATED
+    moved = abs(stretch(voltage_picture.primary, from_voltage.X) - pear_stretch(PRESSURE))
+    assert (moved > 1e-3) if field else (moved < 1e-9)  # the field moves the pear point off the sphere's
+    picture = analyse(fixed_voltage_scene(float(from_voltage.X[-1]), field=field), pear=False)
     from_pressure = picture.primary.branch_points(Block.ODD_HELD)[0]
     assert from_pressure.status == Status.LOCATED
     assert abs(from_pressure.X[-1] - PRESSURE) < 1e-9
