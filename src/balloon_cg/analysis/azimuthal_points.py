@@ -28,7 +28,7 @@ import numpy as np
 from ..numerics import continuation
 from ..numerics.newton import newton
 from .azimuthal import spectrum
-from .problem import pressure_system
+from .problem import branch_system
 from .results import Block, Branch, Kind, SpecialPoint, approximate, located_or_bracketed
 from .stability import convergence_problems
 
@@ -50,16 +50,15 @@ def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]
     return sorted(events, key=lambda event: event[0])
 
 
-def eigenvalue(eq, params, X, m: int, held: bool, k: int, degree: int) -> float:
-    """μ_k of block m (held or free) at the point X = (u, P) of the problem ``eq``, perturbation degree
-    ``degree`` (``azimuthal.spectrum``)."""
-    return float(spectrum(eq, X[:-1], params.with_value("P", X[-1]), m, degree, k + 1, held=held)[k])
+def eigenvalue(system, X, m: int, held: bool, k: int, degree: int) -> float:
+    """μ_k of block m (held or free) at the point X = (u, p) of the branch's ``problem.ParameterSystem``,
+    perturbation degree ``degree`` (``azimuthal.spectrum``)."""
+    return float(spectrum(system.eq, X[:-1], system.params_at(X), m, degree, k + 1, held=held)[k])
 
 
 def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int, degree: int) -> SpecialPoint:
     """The zero of μ_k of block m between points index and index + 1 (module docstring), a BP special point."""
-    system = pressure_system(branch)
-    eq, params, solver = system.eq, branch.params, branch.scene.solver
+    system, solver = branch_system(branch), branch.scene.solver
     X0, X1 = branch.X[index], branch.X[index + 1]
     chord = X1 - X0
     length = np.linalg.norm(chord)
@@ -69,7 +68,7 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
         result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
         if not result.converged:
             raise ArithmeticError(result.message)
-        return eigenvalue(eq, params, result.x, m, held, k, degree), result.x
+        return eigenvalue(system, result.x, m, held, k, degree), result.x
 
     found = continuation.locate_root(value_at, length)
     reading = "held at its centre" if held else "free"
@@ -88,9 +87,9 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
 def crossing_problems(branch: Branch, index: int, m: int, held: bool, k: int, degree: int) -> list[str]:
     """Whether μ_k of block m is converged at the bracketing points, both at ``degree``
     (``stability.convergence_problems``, as for m = 0)."""
-    eq, params = pressure_system(branch).eq, branch.params
+    system = branch_system(branch)
     return convergence_problems(branch, index,
-                                lambda n, N: eigenvalue(eq, params, branch.X[n], m, held, k, N), (degree, degree))
+                                lambda n, N: eigenvalue(system, branch.X[n], m, held, k, N), (degree, degree))
 
 
 def is_copy(branch: Branch, index: int) -> bool:

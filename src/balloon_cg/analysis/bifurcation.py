@@ -11,7 +11,8 @@ below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at t
 values agree at each point's stability degree and its check degree, ``stability.point_degrees`` and
 ``check_degree``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP ``index`` is the
 interval that contains the located point.
-Classification: the reduced energy at the bifurcation pressure along the critical eigenvector φ,
+Classification: the reduced energy at the bifurcation parameter (P, or Φ̄ on a voltage continuation at fixed P)
+along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
 E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical (``classification``).
 Branch switching is in ``switching``.
@@ -48,7 +49,7 @@ def _eigenpair(variation, u, params, idx, k):
 def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
     """(index, block, k) of every change of the number of negative eigenvalues of the pear or even block
     between neighbouring points, one per eigenvalue k (from the lowest, 0) that crosses zero. Changes of the
-    even block at a fold in P are the fold itself, not a branch point."""
+    even block at a fold in the continuation parameter (P or Φ̄) are the fold itself, not a branch point."""
     folds = {s.index for s in branch.special if s.kind == Kind.LP}
     events = []
     for n in range(len(assessments) - 1):
@@ -124,34 +125,34 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     params = branch.params
     if start is None:
         ends = branch.disc.transfer(branch.X[index:index + 2], plain)
-        values = [_eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)[0] for X in ends]
+        values = [_eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0] for X in ends]
         s = float(np.clip(values[0] / (values[0] - values[1]), 0.0, 1.0))
         guess = ends[0] + s * (ends[1] - ends[0])
     else:
         guess = branch.disc.transfer(start.X, plain)
-    _, mode = _eigenpair(variation, guess[:-1], params.with_value("P", guess[-1]), idx, k)
+    _, mode = _eigenpair(variation, guess[:-1], branch.params_at(guess), idx, k)
     if block == Block.ODD_HELD:
         ell = mode[idx] / np.linalg.norm(mode[idx])
-        system = WernerSpence(eq, params, ell)
+        system = WernerSpence(eq, params, ell, branch.parameter)
         X0 = np.concatenate([guess, ell])
     else:
         psi = plain.join(mode[: degree + 1], mode[degree + 1:])
         ell = psi / np.linalg.norm(psi)
-        system = MooreSystem(eq, params, ell)
+        system = MooreSystem(eq, params, ell, branch.parameter)
         X0 = np.concatenate([guess, ell, [0.0]])
     solver = branch.scene.solver
     result = newton(system.residual, system.jacobian, X0, np.zeros((0, X0.size)), [], solver.tol, solver.max_newton)
     solution = result.x if result.converged else X0  # a failed Newton keeps its starting point (it says so)
     X = solution[:plain.size + 1]
-    eigenvalue, _ = _eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)
+    eigenvalue, _ = _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)
     beta = system.beta(solution) if block == Block.EVEN else 0.0
     return ExtendedSolution(plain.transfer(X, branch.disc), system.mode(solution), degree, result.converged,
                             result.message, float(eigenvalue), float(beta))
 
 
 def containing_interval(branch: Branch, X) -> int:
-    """The interval i (between points i and i + 1) nearest to X in (P, north pole stretch): the one that
-    contains a point of the branch."""
+    """The interval i (between points i and i + 1) nearest to X in (p, north pole stretch), p the continuation
+    parameter: the one that contains a point of the branch."""
     north = branch.disc.pole_rows()["lam2_north"]
     path = np.stack([branch.X[:, -1], branch.X[:, :-1] @ north], axis=1)
     target = np.array([X[-1], X[:-1] @ north])
@@ -163,13 +164,12 @@ def containing_interval(branch: Branch, X) -> int:
 def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[str]:
     """Whether the crossing eigenvalue of ``block`` is converged at the bracketing points, at their
     ``stability.point_degrees`` (``stability.convergence_problems``)."""
-    eq, params = equilibrium_of(branch), branch.params
-    variations = Variations(eq)
+    variations = Variations(equilibrium_of(branch))
 
     def eigenvalue(n, degree):
         variation, X = variations[degree], branch.X[n]
         idx = block_indices(variation, block, field_on=False)
-        return _eigenpair(variation, X[:-1], params.with_value("P", X[-1]), idx, k)[0]
+        return _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0]
 
     degrees = point_degrees(branch, branch.scene.stability.degree)
     return convergence_problems(branch, index, eigenvalue, degrees[index:index + 2])
@@ -217,14 +217,14 @@ def constrained_minimum(eq: Equilibrium, params, phi: np.ndarray, target: float,
 
 
 def classify(branch: Branch, bp: SpecialPoint, delta: float = 2e-2) -> SpecialPoint:
-    """``bp`` with E2, E3, E4 of the reduced energy at fixed P* and its classification (module docstring);
-    unclassified (Classification.NONE) when fewer than three constrained minimisations converge."""
+    """``bp`` with E2, E3, E4 of the reduced energy at its parameters (P, and Φ̄) and its classification (module
+    docstring); unclassified (Classification.NONE) when fewer than three constrained minimisations converge."""
     solver = branch.scene.solver
     tracer = general_tracer(branch.scene)
     degree = plain_degree(branch, bp.X)
     eq = tracer.system(degree, branch.params).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])
-    params = branch.params.with_value("P", bp.X[-1])
+    params = branch.params_at(bp.X)
     phi = mode_direction(bp, eq.disc)[:-1]
     E0 = eq.energy(u_star, params)
     lams, energies = [], []

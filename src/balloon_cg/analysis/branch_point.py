@@ -5,31 +5,35 @@ basis of the second variation (``stability.SecondVariation``, Legendre in x) has
 its even block *is* the Jacobian J_u of the symmetric layout and its odd block that of the pear directions
 of the general layout: a singular block is a branch point of the discrete problem itself.
 
+The parameter p is the branch's continuation parameter: the pressure P, or the voltage Φ̄ of a voltage
+continuation at fixed P (``parameter`` = "voltage"; R_p = ∂R/∂Φ̄ is the generated ``voltage_gradient``).
+
 Pear (odd_held block; a symmetry-breaking pitchfork), Werner–Spence:
 
-    unknowns  (u, P, φ)           u: symmetric-layout coefficients, φ: the odd block (a_odd, b_even without
+    unknowns  (u, p, φ)           u: symmetric-layout coefficients, φ: the odd block (a_odd, b_even without
                                    b_0) of the perturbation basis
-    equations R(u; P)       = 0   (n)    equilibrium
-              H_odd(u; P) φ = 0   (m)    the pear block is singular, φ its null vector
+    equations R(u; p)       = 0   (n)    equilibrium
+              H_odd(u; p) φ = 0   (m)    the pear block is singular, φ its null vector
               ℓ·φ − 1       = 0   (1)    normalisation
 
 J_u is regular at a symmetry-breaking pitchfork (the singular direction is not in the symmetric space), and
 the system is regular there when the pear eigenvalue crosses zero transversally along the branch.
 
 Even block (a branch point inside the symmetric space), Moore's system for a simple bifurcation point of
-F(x) = R(u; P), x = (u, P) (n equations, n + 1 unknowns), F_x = [J_u, R_P]:
+F(x) = R(u; p), x = (u, p) (n equations, n + 1 unknowns), F_x = [J_u, R_p]:
 
     unknowns  (x, ψ, β)
     equations F(x) + β ψ   = 0    (n)
-              F_x(x)ᵀ ψ    = 0    (n + 1)   i.e. J_u ψ = 0 (J_u is symmetric) and R_P·ψ = 0
+              F_x(x)ᵀ ψ    = 0    (n + 1)   i.e. J_u ψ = 0 (J_u is symmetric) and R_p·ψ = 0
               ℓ·ψ − 1      = 0    (1)
 
 regular at a simple (transcritical or pitchfork) bifurcation point, where β = 0 (a solution with β ≠ 0 is a
 point of the perturbed problem F + βψ, not a branch point: ``MooreSystem.beta`` is checked to vanish).
 Jacobian rows of F_xᵀψ: ∂(J_u ψ)/∂u = D_u J_u[ψ] (the third derivative of E is symmetric), a central
-difference of the generated Hessian along ψ; ∂(J_u ψ)/∂P = ∂(R_P·ψ)/∂u = D_u R_P[ψ] (R_P = ∂²E/∂u∂P is a
-gradient: its Jacobian is symmetric), a central difference of the pressure gradient (exact: R_P is quadratic
-in u); ∂(R_P·ψ)/∂P = 0 (R is linear in P).
+difference of the generated Hessian along ψ; ∂(J_u ψ)/∂p = ∂(R_p·ψ)/∂u = D_u R_p[ψ] (R_p = ∂²E/∂u∂p is a
+gradient: its Jacobian is symmetric), a central difference of R_p along ψ (exact for P: R_P is quadratic in u);
+∂(R_p·ψ)/∂p, a central difference of R_p in p (exact: R is linear in P and quadratic in Φ̄, so R_p is at most
+linear in p; zero for P).
 Difference steps are ``H_STEP`` (relative): the Jacobian is accurate to ~1e-9, which affects only Newton's
 rate, not the converged point (the residuals are exact).
 """
@@ -46,14 +50,19 @@ def _step(c, direction) -> float:
     return H_STEP * max(1.0, np.abs(c).max()) / max(np.abs(direction).max(), 1e-300)
 
 
-class WernerSpence:
-    """R(u; P) = 0, H_odd(u; P) φ = 0, ℓ·φ = 1 as a map of X = (u, P, φ) (module docstring): square, n + m + 1."""
+def _parameter_step(p: float) -> float:
+    return H_STEP * max(1.0, abs(p))
 
-    def __init__(self, equilibrium: Equilibrium, params, ell: np.ndarray):
+
+class WernerSpence:
+    """R(u; p) = 0, H_odd(u; p) φ = 0, ℓ·φ = 1 as a map of X = (u, p, φ) (module docstring): square, n + m + 1;
+    p the Parameters field ``parameter`` ("P" or "voltage")."""
+
+    def __init__(self, equilibrium: Equilibrium, params, ell: np.ndarray, parameter: str = "P"):
         disc = equilibrium.disc
         if not disc.symmetric or disc.mapping is not None:
             raise ValueError("the pear system needs a plain equator-symmetric discretisation")
-        self.eq, self.params = equilibrium, params
+        self.eq, self.params, self.continuation_parameter = equilibrium, params, parameter
         self.variation = SecondVariation(equilibrium, disc.degree)
         self.odd = block_indices(self.variation, "odd_held", field_on=False)
         self.basis = self.variation.basis
@@ -75,16 +84,16 @@ class WernerSpence:
         return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]
 
     def equations(self, u, phi, params):
-        """(R, H_odd φ, ℓ·φ − 1) at parameters ``params`` (P among them)."""
+        """(R, H_odd φ, ℓ·φ − 1) at parameters ``params`` (p among them)."""
         return np.concatenate([self.eq.residual(u, params), self.odd_hessian(u, params) @ phi,
                                [self.ell @ phi - 1.0]])
 
-    def derivatives(self, u, P, phi, params):
-        """∂(equations)/∂(u, P, φ), (n + m + 1) square (module docstring)."""
+    def derivatives(self, u, p, phi, params):
+        """∂(equations)/∂(u, p, φ), (n + m + 1) square (module docstring)."""
         n, m = self.n, self.m
         J = np.zeros((n + m + 1, n + m + 1))
         J[:n, :n] = self.eq.jacobian(u, params)
-        J[:n, n] = self.eq.parameter_derivative(u, params, "P")
+        J[:n, n] = self.eq.parameter_derivative(u, params, self.continuation_parameter)
         c = self.embed @ u
         J[n:n + m, n + 1:] = self.full_hessian(c, params)[np.ix_(self.odd, self.odd)]
         # ∂(H_odd φ)/∂u = D_c H[φ_full] restricted (symmetry of the third derivative)
@@ -93,19 +102,19 @@ class WernerSpence:
         h = _step(c, phi_full)
         dH = (self.full_hessian(c + h * phi_full, params) - self.full_hessian(c - h * phi_full, params)) / (2 * h)
         J[n:n + m, :n] = dH[self.odd] @ self.embed
-        hP = H_STEP * max(1.0, abs(P))
-        J[n:n + m, n] = (self.odd_hessian(u, params.with_value("P", P + hP))
-                         - self.odd_hessian(u, params.with_value("P", P - hP))) @ phi / (2 * hP)
+        hp, name = _parameter_step(p), self.continuation_parameter
+        J[n:n + m, n] = (self.odd_hessian(u, params.with_value(name, p + hp))
+                         - self.odd_hessian(u, params.with_value(name, p - hp))) @ phi / (2 * hp)
         J[-1, n + 1:] = self.ell
         return J
 
     def residual(self, X):
-        u, P, phi = self.split(X)
-        return self.equations(u, phi, self.params.with_value("P", P))
+        u, p, phi = self.split(X)
+        return self.equations(u, phi, self.params.with_value(self.continuation_parameter, p))
 
     def jacobian(self, X):
-        u, P, phi = self.split(X)
-        return self.derivatives(u, P, phi, self.params.with_value("P", P))
+        u, p, phi = self.split(X)
+        return self.derivatives(u, p, phi, self.params.with_value(self.continuation_parameter, p))
 
     def mode(self, X) -> np.ndarray:
         """φ on the full perturbation basis (a_0..a_N, b_0..b_N)."""
@@ -115,13 +124,14 @@ class WernerSpence:
 
 
 class MooreSystem:
-    """F(x) + βψ = 0, F_x(x)ᵀψ = 0, ℓ·ψ = 1 as a map of X = (u, P, ψ, β) (module docstring): square, 2n + 2."""
+    """F(x) + βψ = 0, F_x(x)ᵀψ = 0, ℓ·ψ = 1 as a map of X = (u, p, ψ, β) (module docstring): square, 2n + 2;
+    p the Parameters field ``parameter`` ("P" or "voltage")."""
 
-    def __init__(self, equilibrium: Equilibrium, params, ell: np.ndarray):
+    def __init__(self, equilibrium: Equilibrium, params, ell: np.ndarray, parameter: str = "P"):
         disc = equilibrium.disc
         if not disc.symmetric or disc.mapping is not None:
             raise ValueError("Moore's system here needs a plain equator-symmetric discretisation")
-        self.eq, self.params, self.n = equilibrium, params, disc.size
+        self.eq, self.params, self.n, self.continuation_parameter = equilibrium, params, disc.size, parameter
         self.embed = symmetric_embedding(disc)
         self.ell = np.asarray(ell, dtype=float)
 
@@ -129,25 +139,31 @@ class MooreSystem:
         n = self.n
         return X[:n], float(X[n]), X[n + 1:2 * n + 1], float(X[-1])
 
+    def _gradient(self, u, params):
+        """R_p = ∂R/∂p at (u, params)."""
+        return self.eq.parameter_derivative(u, params, self.continuation_parameter)
+
     def residual(self, X):
-        u, P, psi, beta = self.split(X)
-        params = self.params.with_value("P", P)
-        R, J, R_P = self.eq.residual(u, params), self.eq.jacobian(u, params), self.eq.parameter_derivative(u, params, "P")
-        return np.concatenate([R + beta * psi, J @ psi, [R_P @ psi, self.ell @ psi - 1.0]])
+        u, p, psi, beta = self.split(X)
+        params = self.params.with_value(self.continuation_parameter, p)
+        R, J, R_p = self.eq.residual(u, params), self.eq.jacobian(u, params), self._gradient(u, params)
+        return np.concatenate([R + beta * psi, J @ psi, [R_p @ psi, self.ell @ psi - 1.0]])
 
     def jacobian(self, X):
-        u, P, psi, beta = self.split(X)
+        u, p, psi, beta = self.split(X)
         n = self.n
-        params = self.params.with_value("P", P)
-        J, R_P = self.eq.jacobian(u, params), self.eq.parameter_derivative(u, params, "P")
+        params = self.params.with_value(self.continuation_parameter, p)
+        J, R_p = self.eq.jacobian(u, params), self._gradient(u, params)
         h = _step(u, psi)
         dJ = (self.eq.jacobian(u + h * psi, params) - self.eq.jacobian(u - h * psi, params)) / (2 * h)
-        dR_P = (self.eq.parameter_derivative(u + h * psi, params, "P")
-                - self.eq.parameter_derivative(u - h * psi, params, "P")) / (2 * h)
+        dR_p = (self._gradient(u + h * psi, params) - self._gradient(u - h * psi, params)) / (2 * h)
+        hp = _parameter_step(p)
+        dR_pp = (self._gradient(u, params.with_value(self.continuation_parameter, p + hp))
+                 - self._gradient(u, params.with_value(self.continuation_parameter, p - hp))) / (2 * hp)
         out = np.zeros((2 * n + 2, 2 * n + 2))
-        out[:n, :n], out[:n, n], out[:n, n + 1:2 * n + 1], out[:n, -1] = J, R_P, beta * np.eye(n), psi
-        out[n:2 * n, :n], out[n:2 * n, n], out[n:2 * n, n + 1:2 * n + 1] = dJ, dR_P, J
-        out[2 * n, :n], out[2 * n, n + 1:2 * n + 1] = dR_P, R_P
+        out[:n, :n], out[:n, n], out[:n, n + 1:2 * n + 1], out[:n, -1] = J, R_p, beta * np.eye(n), psi
+        out[n:2 * n, :n], out[n:2 * n, n], out[n:2 * n, n + 1:2 * n + 1] = dJ, dR_p, J
+        out[2 * n, :n], out[2 * n, n], out[2 * n, n + 1:2 * n + 1] = dR_p, dR_pp @ psi, R_p
         out[-1, n + 1:2 * n + 1] = self.ell
         return out
 

@@ -275,6 +275,9 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     """
     t0 = time.perf_counter()
     scene = branch.scene
+    if branch.parameter != "P":  # the extended system's unknowns are (u, P, φ, q)
+        raise TwoParameterError(f"the curve of pear points is traced in (q, P): the branch is continued in "
+                                f"{branch.parameter}, not in P")
     if branch.disc.mapping is not None:  # the extended system shares coefficients with the stability basis (in x)
         mapped = branch.disc
         plain = Discretisation(plain_degree(branch, bp.X), mapped.symmetric, mapped.pin_translation)

@@ -5,9 +5,9 @@ branch points (``bifurcation``), follows each pear-shaped branch both ways (the 
 north and south poles swapped: ``switching``) until it rejoins the primary branch or stops, assesses those
 too, locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored
 with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under the scene's loading control
-(pressure, volume or gas: its held stability flag). Every
-branch carries its assessments in ``branch.stability`` and the points whose flags change at the check degree in
-``branch.unsettled``.
+(pressure, volume or gas: its held stability flag). A voltage continuation (at fixed P) gets the same, with
+Φ̄ as the parameter of every branch and of its branch points. Every branch carries its assessments in
+``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
 from dataclasses import dataclass, field
@@ -116,12 +116,6 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
         picture.interrupted = True
         return picture
     _assess(primary, scene, primary.disc.symmetric, progress)
-    if primary.parameter != "P":
-        progress.finish(Phase.STABILITY, len(primary.X))
-        picture.not_searched = ("branch points, pear branches and snap-throughs are searched on pressure "
-                                "continuations only; continuation.parameter = 'voltage' gives the primary branch, its "
-                                "folds and its stability")
-        return picture
     if not primary.disc.symmetric:
         progress.finish(Phase.STABILITY, len(primary.X))
         picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
@@ -176,11 +170,12 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:
-    """The pear branch point where ``branch`` rejoined the primary branch (nearest in P), if any."""
+    """The pear branch point where ``branch`` rejoined the primary branch (nearest in the continuation parameter,
+    P or Φ̄), if any."""
     if not branch.stopped(StopCode.REJOINED):
         return None
-    P_end = branch.pressure[-1]
-    candidates = [(abs(bp.X[-1] - P_end), n) for n, bp in enumerate(branch_points)
+    p_end = branch.X[-1, -1]
+    candidates = [(abs(bp.X[-1] - p_end), n) for n, bp in enumerate(branch_points)
                   if n != origin and bp.block == Block.ODD_HELD]
     return min(candidates)[1] if candidates else None
 

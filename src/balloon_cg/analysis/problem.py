@@ -9,14 +9,15 @@ class ParameterSystem:
     def __init__(self, equilibrium: Equilibrium, params: Parameters, name: str):
         self.eq, self.params, self.name = equilibrium, params, name
 
-    def _params(self, X):
+    def params_at(self, X) -> Parameters:
+        """The parameters of the point X = (u, p)."""
         return self.params.with_value(self.name, X[-1])
 
     def residual(self, X):
-        return self.eq.residual(X[:-1], self._params(X))
+        return self.eq.residual(X[:-1], self.params_at(X))
 
     def jacobian(self, X):
-        return self.eq.bordered_jacobian(X[:-1], self._params(X), self.name)
+        return self.eq.bordered_jacobian(X[:-1], self.params_at(X), self.name)
 
 
 def continuation_settings(scene, max_points: int | None = None) -> continuation.Settings:
@@ -31,6 +32,6 @@ def equilibrium_of(branch) -> Equilibrium:
     return Equilibrium(branch.scene, branch.disc)
 
 
-def pressure_system(branch) -> ParameterSystem:
-    """R(u; P) of a branch as a map of X = (u, P)."""
-    return ParameterSystem(equilibrium_of(branch), branch.params, "P")
+def branch_system(branch) -> ParameterSystem:
+    """R(u; p) of a branch as a map of X = (u, p), p its continuation parameter (P or Φ̄)."""
+    return ParameterSystem(equilibrium_of(branch), branch.params, branch.parameter)

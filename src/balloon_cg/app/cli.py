@@ -28,7 +28,8 @@ from .kernels_cmd import add_kernels
 PROG = "balloon-cg"
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
 BROKEN_PIPE = 141  # 128 + SIGPIPE: what a tool killed by SIGPIPE reports
-PLOT_KINDS = ("pressure-pole", "pressure-equator", "shapes", "stresses", "field", "curvature", "energy", "phase")
+PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equator", "shapes", "stresses", "field",
+              "curvature", "energy", "phase")
 # the exceptions that mean bad input (exit 2) or a computation that did not give what was asked (exit 1), by
 # module: a module that is not loaded cannot have raised its exception, so none is imported to catch it
 BAD_INPUT = {"balloon_cg.scene.validation": "SceneError", "balloon_cg.io.layout": "FileError",
@@ -451,11 +452,12 @@ def critical(args) -> int:
     start, the merge is only approximately located, or the curve
     ended otherwise (P reached 0, a fold not verified as a merge, a coil wire, the point budget, the minimum
     step): one line on stderr says how and where, and the curve file is still written. 2 (``UsageError``) a
-    scene the command cannot handle, checked before any computation: not equator-symmetric (the pear block needs
-    the equator-symmetric layout), ``--parameter M`` without coils, or a parameter the scene's kernels do not take
-    (one line listing those they do: ``analysis.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as
-    ``run``): the work stops at its next point (or phase); a curve already started is written (atomically, end
-    ``interrupted``), before it nothing is. Progress goes to stderr (``--quiet``: none).
+    scene the command cannot handle, checked before any computation: a voltage continuation (the curve lives in
+    (q, P)), not equator-symmetric (the pear block needs the equator-symmetric layout), ``--parameter M`` without
+    coils, or a parameter the scene's kernels do not take (one line listing those they do:
+    ``analysis.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as ``run``): the work stops at its next
+    point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is.
+    Progress goes to stderr (``--quiet``: none).
     """
     from ..analysis.codim2 import CurveEnd
     from ..analysis.results import Status
@@ -463,11 +465,16 @@ def critical(args) -> int:
     from ..io.curve_file import write_curve
     from ..io.hdf5 import check_output
     from ..numerics.interrupt import requested, stop_on_signals
+    from ..scene import ContinuationParameter
 
     scene = scene_of(args)
     asymmetry = _asymmetry(scene)
     if asymmetry:
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
+    if scene.continuation.parameter != ContinuationParameter.PRESSURE:
+        raise UsageError(f"critical needs a pressure continuation: {args.scene}: continuation.parameter = "
+                         f"{scene.continuation.parameter.value!r} (the curve of pitchforks is traced in (q, P); "
+                         "continue P at a fixed electric.voltage instead)")
     if args.parameter in ("M", "field.M") and not scene.field.coils:
         raise UsageError(f"critical --parameter M needs coils: {args.scene} has no [[field.coils]], so the "
                          "equilibrium does not depend on M")

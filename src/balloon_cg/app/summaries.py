@@ -160,8 +160,19 @@ def format_run(run: dict) -> str:
         lines += ["", *_format_branch(name, b)]
     for s in summary["snap_throughs"]:
         target = f"{s['to_branch']} point {s['to_index']}" if s["to_branch"] else "no stable state on the traced branches"
-        lines.append(f"snap-through at P = {s['pressure']:.10g}: {s['from_branch']} point {s['from_index']} -> {target}")
+        value = f"{_snap_symbol(run, s['from_branch'])} = {s['pressure']:.10g}"
+        lines.append(f"snap-through at {value}: {s['from_branch']} point {s['from_index']} -> {target}")
     return "\n".join(lines)
+
+
+def _snap_symbol(run: dict, branch: str) -> str:
+    """What a snap-through's stored value is: Φ̄ on a voltage branch, else the control value P, V or n."""
+    from ..scene import Control
+
+    if run["branches"][branch]["attrs"].get("parameter") == "voltage":
+        return "voltage"
+    control = Control(run["attrs"].get("control", Control.PRESSURE))
+    return {Control.PRESSURE: "P", Control.VOLUME: "V", Control.GAS: "n"}[control]
 
 
 def _verdict(attrs: dict) -> str:

@@ -377,7 +377,7 @@ def format_summary(result: SweepResult) -> str:
     ]
     w = max([len("overrides")] + [len(m.label) for m in result.members])
     header = (f"{'member':>6}  {'overrides':<{w}}  {'result':<10}  {'points':>6}  {'pear BPs':>8}  "
-              "pear branch point pressures")
+              "pear branch point pressures (voltages on a voltage continuation)")
     lines.append(header)
     for m in result.members:
         if m.index in result.failed:
@@ -389,8 +389,8 @@ def format_summary(result: SweepResult) -> str:
             continue
         a = stored["attrs"]
         n_points = len(stored["branches"]["primary"]["pressure"])
-        pears = [p for p, block in zip(a.get("branch_point_pressures", []), a.get("branch_point_blocks", []))
-                 if block == "odd_held"]
+        values = a.get("branch_point_voltages", a.get("branch_point_pressures", []))
+        pears = [p for p, block in zip(values, a.get("branch_point_blocks", [])) if block == "odd_held"]
         count = "n/a" if mode == "primary-only" else str(len(pears))
         pressures = ", ".join(f"{p:.6g}" for p in pears) if pears else ("-" if mode != "primary-only" else "")
         verdict = "complete" if a.get("complete") else "incomplete"

@@ -14,7 +14,8 @@
                                scene_hash (sha256 of the member scene's normalised TOML), scene_toml, tolerance,
                                created, package_version, generated_digest, worker_pid, wall_time,
                                branch_point_kinds, branch_point_classifications, branch_point_blocks,
-                               branch_point_pressures, complete, incomplete_gaps, incomplete_branches,
+                               branch_point_pressures, [branch_point_voltages: a voltage continuation], complete,
+                               incomplete_gaps, incomplete_branches,
                                incomplete_messages (as a run file's root: analysis.verdict)
         branches/<name>/          exactly as a run file's /branches (io.run_file)
         snap_throughs/            as in a run file (full analysis only)
@@ -96,6 +97,8 @@ class Store:
     def write_member(self, member, result) -> None:
         """Write one computed member (app.sweep.MemberResult) to its own file, atomically."""
         path = self.member_file(member.index)
+        primary = result.branches[0]
+        points = [primary.params_at(bp.X) for bp in result.branch_points]
         with atomic_file(path, force=True) as f:
             attrs = provenance()
             del attrs["command"]
@@ -107,8 +110,10 @@ class Store:
                 "scene_toml": member.scene.to_toml(),
                 "worker_pid": result.pid,
                 "wall_time": result.wall_time,
-                "branch_point_pressures": np.array([float(bp.X[-1]) for bp in result.branch_points], dtype=float),
+                "branch_point_pressures": np.array([p.P for p in points], dtype=float),
             })
+            if primary.parameter == "voltage":
+                f.attrs["branch_point_voltages"] = np.array([p.voltage for p in points], dtype=float)
             text = h5py.string_dtype()
             for key, values in (("branch_point_kinds", [bp.kind.value for bp in result.branch_points]),
                                 ("branch_point_classifications",

@@ -3,17 +3,19 @@ a new one on the Agg canvas (no pyplot, no global backend state; save it with ``
 given ``axes``, the figure of the caller's Axes (one Axes, or a sequence for the kinds with several panels),
 drawn into them with the legend inside the first.
 
-Curves of branches (pressure-pole, pressure-equator) and the energy landscape draw every branch of every file
-(or the one named); the per-point kinds (shapes, stresses, field, curvature) draw chosen points of one branch
-per file (default: primary), or chosen ``Configuration`` s of several branches. One colour per drawn branch,
-labelled by M (branch attrs), plus the branch name when a file holds several; a mirror-image branch
-(``<name>_mirror``) takes its partner's colour, drawn thinner and lighter. Branch curves are solid where stable
-and dashed where unstable under the chosen stability ``Reading`` (default: the run's loading control, balloon
-held at its centre), named in the legend title; without stability data all solid, and the legend title says so. Titles
-name the material and the coils. Special points are marked and labelled with their kind (LP, TP, EP, branch
-points, …). The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest
-(``robust_limits``). Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), lengths in R0, stresses in
-μ/2, field in I/(4π R0).
+Curves of branches (pressure-pole, pressure-equator: P against a stretch; voltage-pole, voltage-equator: the
+voltage Φ̄ against a stretch, for runs continued in the voltage at fixed P) and the energy landscape draw every
+branch of every file (or the one named); a branch curve whose ordinate is not the branch's continuation parameter
+(a constant) is refused (``check_ordinate``); the per-point kinds (shapes, stresses, field, curvature) draw chosen
+points of one branch per file (default: primary), or chosen ``Configuration`` s of several branches. One colour
+per drawn branch, labelled by M (branch attrs; a dielectric branch also by its fixed Φ̄ or P), plus the branch
+name when a file holds several; a mirror-image branch (``<name>_mirror``) takes its partner's colour, drawn
+thinner and lighter. Branch curves are solid where stable and dashed where unstable under the chosen stability
+``Reading`` (default: the run's loading control, balloon held at its centre), named in the legend title; without
+stability data all solid, and the legend title says so. Titles name the material and the coils. Special points
+are marked and labelled with their kind (LP, TP, EP, branch points, …). The θ plots limit y to the bulk of the
+data when a near-wire spike would flatten the rest (``robust_limits``). Units are nondimensional (MODEL.md §2):
+P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2, field in I/(4π R0).
 """
 import enum
 from dataclasses import dataclass
@@ -37,6 +39,7 @@ THETA_SAMPLES = 721  # θ values of the per-point curves, evaluated from the Leg
 MARKERS = {"LP": "o", "TP": "s", "EP": "X"}  # branch points and other kinds: "D"
 
 P_LABEL = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
+VOLTAGE_LABEL = r"voltage $\bar\Phi = (\Phi/H)\sqrt{\varepsilon/\mu}$"
 THETA_LABEL = r"material coordinate $\theta$ (rad)"
 
 
@@ -100,6 +103,35 @@ FLAGS = {Reading.PRESSURE: "stable_pressure", Reading.VOLUME: "stable_volume",
 AXISYMMETRIC_BLOCKS = (("lowest_even", "lowest_odd_held"), ("lowest_all_held",))
 
 
+VOLTAGE_MEANINGS = {  # the pressure readings on a voltage branch: P is fixed, Φ̄ the control
+    Reading.PRESSURE: "voltage control at fixed P, held at centre",
+    Reading.FREE: "voltage control at fixed P, free balloon",
+}
+
+
+@dataclass(frozen=True)
+class Ordinate:
+    """The y quantity of a branch curve: the continuation ``parameter`` it must be (the stored branch attribute
+    ``parameter``: "P" or "voltage"), its per-point and special-point ``column``, its axis ``label``, its
+    ``symbol`` in legends and the ``prefix`` of the kinds that draw it ("<prefix>-pole", "<prefix>-equator")."""
+
+    parameter: str
+    column: str
+    label: str
+    symbol: str
+    prefix: str
+
+
+PRESSURE_ORDINATE = Ordinate("P", "pressure", P_LABEL, "P", "pressure")
+VOLTAGE_ORDINATE = Ordinate("voltage", "voltage", VOLTAGE_LABEL, r"$\bar\Phi$", "voltage")
+ORDINATES = {o.parameter: o for o in (PRESSURE_ORDINATE, VOLTAGE_ORDINATE)}
+
+
+def ordinate_of(data: dict) -> Ordinate:
+    """A stored branch's continuation parameter as an Ordinate (P for files without the attribute)."""
+    return ORDINATES[data["attrs"].get("parameter", "P")]
+
+
 def stable_points(data: dict, reading: Reading) -> np.ndarray | None:
     """The per-point stability of a stored branch under ``reading`` (None when the branch has no such data):
     a stored flag, or for ``axisymmetric`` the lowest eigenvalue of every axisymmetric block > 0."""
@@ -156,6 +188,32 @@ class StoredBranch:
         return float(self.data["attrs"]["M"])
 
     @property
+    def ordinate(self) -> Ordinate:
+        return ordinate_of(self.data)
+
+    @property
+    def parameter_values(self) -> np.ndarray:
+        """The continuation parameter at every point (P, or Φ̄ on a voltage branch)."""
+        return self.data[self.ordinate.column]
+
+    @property
+    def fixed(self) -> str:
+        """The parameter held fixed on a dielectric branch, for legends ('Φ̄ = 0.3' on a pressure branch,
+        'P = 0.5' on a voltage branch); '' without the dielectric term."""
+        if not self.data["attrs"].get("electric", False):
+            return ""
+        if self.ordinate == VOLTAGE_ORDINATE:
+            return f"P = {self.data['pressure'][0]:g}"
+        return f"{VOLTAGE_ORDINATE.symbol} = {self.data['voltage'][0]:g}"
+
+    @property
+    def meaning(self) -> str:
+        """What the stability reading means on this branch (VOLTAGE_MEANINGS on a voltage branch)."""
+        if self.ordinate == VOLTAGE_ORDINATE:
+            return VOLTAGE_MEANINGS.get(self.reading, self.reading.meaning)
+        return self.reading.meaning
+
+    @property
     def coils(self):
         return stored_scene(self.run).field.coils
 
@@ -205,15 +263,19 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     """Set each branch's legend label and colour. One file: a colour per branch (a mirror image sharing its
     partner's), labelled 'M = …, <branch name>' when there are several. Several files: a colour per file,
     labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
-    curves)."""
+    curves). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+
+    def key(b):
+        return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
+
     files = {}
     for b in branches:
         files.setdefault(id(b.run), []).append(b)
     by_M = {}
     for path, members in files.items():
-        by_M.setdefault(f"M = {members[0].M:g}", []).append(path)
+        by_M.setdefault(key(members[0]), []).append(path)
     for b in branches:
-        label = f"M = {b.M:g}"
+        label = key(b)
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
         if len(files) == 1 and len(files[id(b.run)]) > 1:
@@ -227,9 +289,11 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
 
 
 def applicable_kinds(branches) -> list[str]:
-    """The KINDS that can be drawn for these branches (field needs coils, energy needs normal-form data)."""
+    """The KINDS that can be drawn for these branches (the branch curves of their continuation parameter, field
+    needs coils, energy needs normal-form data)."""
+    prefixes, curves = {b.ordinate.prefix for b in branches}, {o.prefix for o in ORDINATES.values()}
     return [kind for kind in KINDS
-            if kind != "phase"
+            if kind != "phase" and (kind.split("-")[0] not in curves or prefixes == {kind.split("-")[0]})
             and (kind != "field" or any(b.coils for b in branches))
             and (kind != "energy" or any(b.bifurcations for b in branches))]
 
@@ -374,7 +438,7 @@ def _branch_legend(fig, axes, own, branches, extra=()):
     """Legend right of the axes: one line per drawn branch (a mirror image as its partner's 'mirror') plus
     ``extra`` handles; the title tells what the line styles mean under which stability reading."""
     with_stability = [b.stable is not None for b in branches]
-    meaning = branches[0].reading.meaning if branches else Reading.PRESSURE.meaning
+    meaning = branches[0].meaning if branches else Reading.PRESSURE.meaning
     if all(with_stability):
         title = f"solid: stable, dashed: unstable\n({meaning})"
     elif any(with_stability):
@@ -391,62 +455,97 @@ def _branch_legend(fig, axes, own, branches, extra=()):
     _legend(fig, axes, own, "right upper", handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8)
 
 
-def plot_pressure_pole(branches, axes=None) -> Figure:
-    """P against the north pole stretch λ2(0); the south pole λ2(π) dotted where it differs."""
+def check_ordinate(branches, ordinate: Ordinate, kind: str) -> None:
+    """Refuse a branch curve whose y quantity is not the continuation parameter of every drawn branch (it would
+    be a constant: P on a voltage branch, Φ̄ on a pressure branch), in one line naming the kind to draw."""
+    for b in branches:
+        if b.ordinate != ordinate:
+            held = b.fixed or "no voltage"
+            raise PlotError(f"{b.source}: branch {b.name} is continued in {b.ordinate.column} ({held}): {kind} "
+                            f"draws branches continued in {ordinate.column}; draw {b.ordinate.prefix}-"
+                            f"{kind.split('-', 1)[1]}")
+
+
+def _pole_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
+    """The parameter (P or Φ̄, ``ordinate``) against the north pole stretch λ2(0); the south pole λ2(π) dotted
+    where it differs."""
+    check_ordinate(branches, ordinate, f"{ordinate.prefix}-pole")
     fig, panels, own = _panels(axes, 1, (8.4, 4.8))
     ax = panels[0]
     extra, marks = [], []
     drawn = {(id(b.run), b.name) for b in branches}
     for b in branches:
-        d, color = b.data, b.color
-        _curve(ax, d["lam2_north"], d["pressure"], b.stable, color, mirror=b.mirror)
+        d, color, y = b.data, b.color, b.parameter_values
+        _curve(ax, d["lam2_north"], y, b.stable, color, mirror=b.mirror)
         scale = np.abs(d["lam2_north"]).max()
         partner = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX) if b.mirror else b.name + MIRROR_SUFFIX)
         # a pear branch's south pole is its mirror image's north pole: drawn already when that one is
         if partner not in drawn and np.abs(d["lam2_south"] - d["lam2_north"]).max() > 1e-8 * scale:
-            _curve(ax, d["lam2_south"], d["pressure"], None, color, linestyle=":")
+            _curve(ax, d["lam2_south"], y, None, color, linestyle=":")
             extra = [Line2D([], [], color="k", linestyle=":", label=r"south pole $\lambda_2(\pi)$")]
         special = d["special_points"]
-        marks += _special(ax, b, [s["lam2_north"] for s in special], [s["pressure"] for s in special], color)
+        marks += _special(ax, b, [s["lam2_north"] for s in special], [s[ordinate.column] for s in special], color)
     ax.set_xlabel(r"pole stretch $\lambda_2(0)$ (north)")
-    ax.set_ylabel(P_LABEL)
+    ax.set_ylabel(ordinate.label)
     ax.set_title(_title(branches), fontsize=10)
     _branch_legend(fig, panels, own, branches, extra)
     _label_special(fig, marks)
     return fig
 
 
-def plot_pressure_equator(branches, axes=None) -> Figure:
-    """P against λ2(π/2) and against λ1(π/2) at the equator (two panels)."""
+def _equator_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
+    """The parameter (P or Φ̄, ``ordinate``) against λ2(π/2) and against λ1(π/2) at the equator (two panels)."""
+    check_ordinate(branches, ordinate, f"{ordinate.prefix}-equator")
     fig, axes, own = _panels(axes, 2, (12, 4.5), nrows=1, ncols=2, sharey=True)
     marks = []
     for b in branches:
         d, color = b.data, b.color
         at_equator = surface(branch_discretisation(d), d["special_unknowns"], EQUATOR)
-        special_p = [s["pressure"] for s in d["special_points"]]
+        special_y = [s[ordinate.column] for s in d["special_points"]]
         for ax, key in zip(axes, ("lam2", "lam1")):
-            _curve(ax, d[f"{key}_equator"], d["pressure"], b.stable, color, mirror=b.mirror)
-            marks += _special(ax, b, at_equator[key][:, 0], special_p, color)
+            _curve(ax, d[f"{key}_equator"], b.parameter_values, b.stable, color, mirror=b.mirror)
+            marks += _special(ax, b, at_equator[key][:, 0], special_y, color)
     axes[0].set_xlabel(r"equator stretch $\lambda_2(\pi/2)$ (circumferential)")
     axes[1].set_xlabel(r"equator stretch $\lambda_1(\pi/2)$ (meridional)")
-    axes[0].set_ylabel(P_LABEL)
+    axes[0].set_ylabel(ordinate.label)
     _suptitle(fig, axes, own, _title(branches))
     _branch_legend(fig, axes, own, branches)
     _label_special(fig, marks)
     return fig
 
 
+def plot_pressure_pole(branches, axes=None) -> Figure:
+    """P against the north pole stretch λ2(0) (``_pole_curves``)."""
+    return _pole_curves(branches, PRESSURE_ORDINATE, axes)
+
+
+def plot_voltage_pole(branches, axes=None) -> Figure:
+    """Φ̄ against the north pole stretch λ2(0) of branches continued in the voltage (``_pole_curves``)."""
+    return _pole_curves(branches, VOLTAGE_ORDINATE, axes)
+
+
+def plot_pressure_equator(branches, axes=None) -> Figure:
+    """P against λ2(π/2) and λ1(π/2) (``_equator_curves``)."""
+    return _equator_curves(branches, PRESSURE_ORDINATE, axes)
+
+
+def plot_voltage_equator(branches, axes=None) -> Figure:
+    """Φ̄ against λ2(π/2) and λ1(π/2) of branches continued in the voltage (``_equator_curves``)."""
+    return _equator_curves(branches, VOLTAGE_ORDINATE, axes)
+
+
 # --- configurations (per point) ----------------------------------------------------------------------------
 
 def select_points(data: dict, points=None) -> np.ndarray:
     """Indices of the points of a stored branch to draw: ``points`` checked (negative count from the end), or
-    DEFAULT_POINTS spread evenly in arclength along the (λ2(0), P) curve, each scaled by its range."""
+    DEFAULT_POINTS spread evenly in arclength along the (λ2(0), p) curve (p the continuation parameter, P or Φ̄),
+    each scaled by its range."""
     n = len(data["pressure"])
     if points is not None and (np.ndim(points) != 1 or len(points) == 0
                                or not all(isinstance(p, (int, np.integer)) for p in points)):
         raise PlotError(f"points = {points!r}: expected a non-empty list of point indices, e.g. [0, 10, -1]")
     if points is None:
-        path = np.stack([data["lam2_north"], data["pressure"]])
+        path = np.stack([data["lam2_north"], data[ordinate_of(data).column]])
         span = np.ptp(path, axis=1, keepdims=True)
         step = np.hypot(*(np.diff(path, axis=1) / np.where(span > 0, span, 1.0)))
         length = np.r_[0.0, np.cumsum(step)]
@@ -470,8 +569,8 @@ def _configurations(branches, points):
         q = postprocess(b.run, b.name, indices, np.linspace(0.0, np.pi, THETA_SAMPLES))
         for j, index in enumerate(q["points"]):
             name = f"{chosen[j].label}:" if named else f"#{index}"
-            label = (f"{b.label}: " if several else "") + (
-                f"{name}  P = {q['pressure'][j]:.4g}, $\\lambda_2(0)$ = {q['lam2'][j, 0]:.4g}")
+            value = f"{b.ordinate.symbol} = {q[b.ordinate.column][j]:.4g}"
+            label = (f"{b.label}: " if several else "") + f"{name}  {value}, $\\lambda_2(0)$ = {q['lam2'][j, 0]:.4g}"
             row = {k: v[j] for k, v in q.items() if k not in ("theta", "points")}
             color = (chosen[j].color if named else "") or f"C{len(rows) % 10}"
             rows.append((label, color, row | {"theta": q["theta"]}, b, chosen[j] if named else None))
@@ -634,7 +733,7 @@ def plot_energy(branches, axes=None) -> Figure:
             amplitude = np.linspace(-1, 1, 401) * _amplitude_range(e2, e3, e4)
             energy = e2 * amplitude**2 + e3 * amplitude**3 + e4 * amplitude**4
             ax.plot(amplitude, energy, color=b.color, linestyle=styles[drawn % len(styles)], linewidth=1.4,
-                    label=f"{b.label}: {special_label(s)} at P = {s['pressure']:.6g}\n"
+                    label=f"{b.label}: {special_label(s)} at {b.ordinate.symbol} = {s[b.ordinate.column]:.6g}\n"
                           f"E2 = {e2:.3g}, E3 = {e3:.3g}, E4 = {e4:.3g}")
             drawn += 1
     ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
@@ -725,9 +824,13 @@ def _sweep_phase(ax, path) -> str:
     if sweep["attrs"].get("mode") == "primary-only":  # no stability, so no branch points: an empty diagram
         raise PlotError(f"{path}: a primary-only sweep has no branch points to draw (sweep without --primary-only)")
     rows = []
-    for member in sweep["members"].values():
+    for name, member in sweep["members"].items():
         key, value = next(iter(member["overrides"].items()))
-        specials = member["branches"]["primary"]["special_points"]
+        primary = member["branches"]["primary"]
+        if ordinate_of(primary) != PRESSURE_ORDINATE:
+            raise PlotError(f"{path}: member {name} is continued in {ordinate_of(primary).column}: phase draws the "
+                            "pitchfork pressures of pressure continuations")
+        specials = primary["special_points"]
         pressures = sorted(s["pressure"] for s in specials if s["block"] == "odd_held")
         folds = [s["pressure"] for s in specials if s["kind"] == "LP"]
         rows.append((float(value), pressures, folds[0] if folds else np.nan))
@@ -750,6 +853,8 @@ def _sweep_phase(ax, path) -> str:
 KINDS = {
     "pressure-pole": (plot_pressure_pole, False),
     "pressure-equator": (plot_pressure_equator, False),
+    "voltage-pole": (plot_voltage_pole, False),
+    "voltage-equator": (plot_voltage_equator, False),
     "shapes": (plot_shapes, True),
     "stresses": (plot_stresses, True),
     "field": (plot_field, True),

@@ -163,7 +163,9 @@ def quantities(scene, disc: Discretisation, X, theta, M: float | None = None, ch
 def postprocess(run: dict, branch: str = "primary", points=None, theta=None) -> dict:
     """quantities() for stored points of a run (read_run() output): all points, or the indices ``points``.
 
-    θ defaults to the branch's stored grid; M and χ come from the branch attrs. Adds 'points' (the indices).
+    θ defaults to the branch's stored grid; M and χ come from the branch attrs. Adds 'points' (the indices);
+    'pressure' (and 'voltage' where the dielectric term is present) are the stored columns (the last unknown is
+    Φ̄ on a voltage branch).
     """
     data = run["branches"][branch]
     index = np.arange(len(data["pressure"])) if points is None else np.asarray(points, dtype=int)
@@ -171,4 +173,5 @@ def postprocess(run: dict, branch: str = "primary", points=None, theta=None) -> 
         stored_scene(run), branch_discretisation(data), data["unknowns"][index],
         data["theta"] if theta is None else theta, float(data["attrs"]["M"]), float(data["attrs"]["chi"]),
     )
-    return result | {"points": index}
+    stored = {name: data[name][index] for name in ("pressure", "voltage") if name in data}
+    return result | stored | {"points": index}
