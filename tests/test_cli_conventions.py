@@ -305,7 +305,9 @@ def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
     deadline = time.monotonic() + 120
     while not any(store.glob("0*.h5")) and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.1)
-    assert process.poll() is None, "the sweep ended before it could be interrupted"
+    if process.poll() is not None:  # say how it ended (seen once under load: no diagnosis was printed)
+        pytest.fail(f"the sweep ended (exit {process.returncode}) before it could be interrupted; stored "
+                    f"{sorted(p.name for p in store.glob('*'))}; stderr: {process.communicate()[1][-3000:]}")
     started = time.monotonic()
     process.send_signal(sig)
     _, err = process.communicate(timeout=60)
