@@ -1,20 +1,16 @@
 """The perturbation degree follows the mode (analysis/crossings.py): every sign change a branch-point search reads
 is confirmed at raised degrees before it is located.
 
-(a) On model spectra μ(n, N) = c(n) + a(n)·(20/N)³ (converged value c, an under-resolution error that decays
+On model spectra μ(n, N) = c(n) + a(n)·(20/N)³ (converged value c, an under-resolution error that decays
 with the degree N): a spurious crossing disappears and the raised points carry the converged sign; a real
 crossing is kept in its interval, at the degree it was found when it is resolved there, moved to its true
 interval when the coarse degree displaced it; one that cannot be resolved below the maximum degree is kept (and
-then reported). (b) On a traced branch (the two coils, TPOM1, M = 0.003, stability degree 20, where the held
-m = 1 eigenvalue is under-resolved on the pear branches): the crossings left are resolved, their eigenvalues at
-the raised degrees agree with a computation at twice that degree, and the special points are those of the run
-at degree 40.
+then reported). On a traced branch (TPOM1 between two coils, M = 0.003, stability degree 20):
+tests/test_azimuthal_points.py::test_under_resolved_m1_crossings_are_refined_away.
 """
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
-import pytest
 
 from balloon_cg.analysis.crossings import branch_point_crossings, follow_modes, resolved, sign_changes
 from balloon_cg.analysis.results import Block
@@ -100,7 +96,7 @@ def test_unresolvable_crossing_is_kept_for_the_report():
     n = np.arange(8)
     model = Model(np.full(8, -0.01), np.where(n >= 4, 0.3, 0.0), max_degree=40)
     followed = model.follow()
-    (index, block, k), = branch_point_crossings(followed.assessments, 1)
+    ((index, _, _),) = branch_point_crossings(followed.assessments, 1)
     assert followed.degrees[index + 1] == 40
     point = followed.assessments[index + 1]
     assert not resolved(point.blocks[BLOCK][0], model.assess(index + 1, 80).blocks[BLOCK][0])

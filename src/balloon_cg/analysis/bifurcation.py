@@ -9,8 +9,8 @@ for a pear point, Moore's system for an even-block point), from the detection br
 x that holds it (``plain_degree``). The point is LOCATED when Newton converged, the crossing eigenvalue there is
 below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at the bracketing points (signs and
 values agree at each point's assessment degree and its check degree, ``stability.assessed_degrees`` and
-``check_degree``: ``crossings``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP ``index`` is the
-interval that contains the located point.
+``check_degree``: ``crossings``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP
+``index`` is the interval that contains the located point.
 Classification: the reduced energy at the bifurcation pressure along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
 E3 ≠ 0: transcritical; else E4 > 0: supercritical pitchfork, E4 < 0: subcritical (``classification``).
