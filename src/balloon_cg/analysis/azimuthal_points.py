@@ -30,6 +30,7 @@ from ..numerics.newton import newton
 from .azimuthal import spectrum
 from .problem import branch_system
 from .results import Block, Branch, Kind, SpecialPoint, approximate, located_or_bracketed
+from .crossings import branch_point_crossings
 from .stability import convergence_problems
 
 
@@ -37,17 +38,8 @@ def crossings(assessments, m_max: int) -> list[tuple[int, int, bool, Block, int]
     """(index, m, held, block, k) of every eigenvalue μ_k of an azimuthal block m ≤ m_max that changes sign
     between points index and index + 1 (module docstring); the free blocks are those the assessments hold
     (with a field)."""
-    events = []
-    for m in range(1, m_max + 1):
-        for held in (True, False):
-            block = Block.azimuthal(m, held)
-            if block not in assessments[0].blocks:
-                continue
-            negative = [int(np.sum(a.blocks[block] < 0)) for a in assessments]
-            for n in range(len(assessments) - 1):
-                low, high = sorted((negative[n], negative[n + 1]))
-                events += [(n, m, held, block, k) for k in range(low, high)]
-    return sorted(events, key=lambda event: event[0])
+    return [(n, block.m, block.held, block, k) for n, block, k in branch_point_crossings(assessments, m_max)
+            if block.m]
 
 
 def eigenvalue(system, X, m: int, held: bool, k: int, degree: int) -> float:

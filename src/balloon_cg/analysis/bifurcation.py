@@ -8,9 +8,9 @@ Location: Newton on an extended system that is regular at the branch point (``br
 for a pear point, Moore's system for an even-block point), from the detection bracket, on the plain degree in
 x that holds it (``plain_degree``). The point is LOCATED when Newton converged, the crossing eigenvalue there is
 below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at the bracketing points (signs and
-values agree at each point's stability degree and its check degree, ``stability.point_degrees`` and
-``check_degree``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP ``index`` is the
-interval that contains the located point.
+values agree at each point's assessment degree and its check degree, ``stability.assessed_degrees`` and
+``check_degree``: ``crossings``); otherwise APPROXIMATE, with the bracket's uncertainty and the reason. The BP
+``index`` is the interval that contains the located point.
 Classification: the reduced energy at the bifurcation parameter (P, or Φ̄ on a voltage continuation at fixed P)
 along the critical eigenvector φ,
 E(Λ) − E* = E2 Λ² + E3 Λ³ + E4 Λ⁴, from constrained minimisations φ·(u − u*) = Λ (the other modes relax);
@@ -29,7 +29,8 @@ from .branch_point import MooreSystem, WernerSpence
 from .problem import equilibrium_of
 from .resolution import Resolution
 from .results import Block, Branch, Classification, Kind, SpecialPoint, Status, approximate
-from .stability import SecondVariation, Variations, block_indices, convergence_problems, point_degrees
+from .crossings import branch_point_crossings
+from .stability import SecondVariation, Variations, assessed_degrees, block_indices, convergence_problems
 from .tracer import Tracer
 from ..numerics.threads import limited_blas
 
@@ -50,15 +51,8 @@ def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
     """(index, block, k) of every change of the number of negative eigenvalues of the pear or even block
     between neighbouring points, one per eigenvalue k (from the lowest, 0) that crosses zero. Changes of the
     even block at a fold in the continuation parameter (P or Φ̄) are the fold itself, not a branch point."""
-    folds = {s.index for s in branch.special if s.kind == Kind.LP}
-    events = []
-    for n in range(len(assessments) - 1):
-        for block in (Block.ODD_HELD, Block.EVEN):
-            a = int(np.sum(assessments[n].blocks[block] < 0))
-            b = int(np.sum(assessments[n + 1].blocks[block] < 0))
-            if a != b and not (block == Block.EVEN and n in folds):
-                events += [(n, block, k) for k in range(min(a, b), max(a, b))]
-    return events
+    folds = frozenset(s.index for s in branch.special if s.kind == Kind.LP)
+    return branch_point_crossings(assessments, 0, folds)
 
 
 @limited_blas
@@ -163,7 +157,7 @@ def containing_interval(branch: Branch, X) -> int:
 
 def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[str]:
     """Whether the crossing eigenvalue of ``block`` is converged at the bracketing points, at their
-    ``stability.point_degrees`` (``stability.convergence_problems``)."""
+    assessment degrees (``stability.assessed_degrees``, ``stability.convergence_problems``)."""
     variations = Variations(equilibrium_of(branch))
 
     def eigenvalue(n, degree):
@@ -171,8 +165,7 @@ def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[
         idx = block_indices(variation, block, field_on=False)
         return _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0]
 
-    degrees = point_degrees(branch, branch.scene.stability.degree)
-    return convergence_problems(branch, index, eigenvalue, degrees[index:index + 2])
+    return convergence_problems(branch, index, eigenvalue, assessed_degrees(branch)[index:index + 2])
 
 
 def general_tracer(scene) -> Tracer:

@@ -2,7 +2,8 @@
 
 ``analyse(scene)`` traces the primary branch, assesses every point (``stability``), locates and classifies its
 branch points (``bifurcation``), follows each pear-shaped branch both ways (the branch and its mirror image,
-north and south poles swapped: ``switching``) until it rejoins the primary branch or stops, assesses those
+north and south poles swapped: ``switching``) until it rejoins the primary branch (a fold candidate there is
+the rejoin's branch point: ``switching.mark_rejoin``) or stops, assesses those
 too, locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored
 with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag). A voltage continuation (at fixed P) gets the same, with
@@ -21,7 +22,7 @@ from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
 from .stability import assess_branch
-from .switching import trace_pear
+from .switching import mark_rejoin, trace_pear
 from .verdict import Gap, Incomplete, incomplete
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
@@ -163,6 +164,7 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
             branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
             if branch.rejoins is not None:
                 reached.add(branch.rejoins)
+                mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
             picture.branches.append(branch)
             if interrupt.requested():  # kept as traced, not assessed
                 return

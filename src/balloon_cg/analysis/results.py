@@ -65,6 +65,16 @@ class Block(enum.StrEnum):
         """The block of the cos mφ modes (m ≥ 1), balloon held at its centre or free."""
         return cls(f"m{m}_{'held' if held else 'free'}")
 
+    @property
+    def m(self) -> int:
+        """The azimuthal number of a block made by ``azimuthal`` (m<m>_held, m<m>_free); 0 for the others."""
+        return int(self.value[1:].partition("_")[0]) if self.value[:1] == "m" else 0
+
+    @property
+    def held(self) -> bool:
+        """Whether the block is the held reading (the balloon held at its centre)."""
+        return self.value.endswith("_held")
+
 
 class Status(enum.StrEnum):
     """How well a special point is known (the contract of docs/numerics.md)."""

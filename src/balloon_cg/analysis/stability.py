@@ -17,7 +17,10 @@ stable under pressure ⇒ stable under gas ⇒ stable under volume control.
 
 Resolution: along a branch each point is assessed at the degree N = max(stability.degree, the Legendre degree
 in x that holds the equilibrium) (``point_degrees``: raised near a wire, where the equilibrium lives on a mapped
-basis), and checked at ``check_degree`` (2N, at solver.max_degree against N/1.5) where a sign could change.
+basis), and checked at ``check_degree`` (2N, at solver.max_degree against N/1.5) where a sign could change. The
+bracketing points of a crossing (a sign change a branch-point search reads) are raised until the crossing
+eigenvalue is resolved there (``crossings.follow_modes``): the degree follows the mode, not only the
+equilibrium.
 
 Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) form blocks 'm<m>_held' and
 'm<m>_free' with the symmetry zero modes removed; they enter every flag.
@@ -27,11 +30,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .azimuthal import merged_lowest, restricted_blocks
+from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
 from .problem import equilibrium_of
 from .resolution import Resolution
+from .results import Kind
 from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
@@ -223,15 +228,15 @@ def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:
 
 def convergence_problems(branch, index: int, eigenvalue, degrees) -> list[str]:
     """Whether a crossing eigenvalue changes sign between points index and index + 1 and is converged there: at
-    each point's degree N (``degrees``: one per bracketing point) and at its ``check_degree`` the signs agree and
-    the values differ by less than half the value at N ([] if so, else what is wrong). ``eigenvalue(n, N)`` is the
+    each point's degree N (``degrees``: one per bracketing point) it is resolved against its ``check_degree``
+    (``crossings.resolved``) ([] if so, else what is wrong). ``eigenvalue(n, N)`` is the
     eigenvalue at point n on the perturbation basis of degree N."""
     problems, signs = [], []
     for n, N in zip((index, index + 1), degrees):
         finer = check_degree(branch, int(N))
         coarse, fine = eigenvalue(n, int(N)), eigenvalue(n, finer)  # ``fine``: coarser at solver.max_degree
         signs.append(np.sign(coarse))
-        if np.sign(coarse) != np.sign(fine) or abs(coarse - fine) >= 0.5 * abs(coarse):
+        if not resolved(coarse, fine):
             problems.append(f"point {n}: crossing eigenvalue not converged ({coarse:.3g} at N = {int(N)}, "
                             f"{fine:.3g} at {finer})")
     if signs[0] == signs[1]:
@@ -258,27 +263,45 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
     """Assessments of every point and, with ``check``, the points whose flags change at the check degree.
 
     Each point is assessed at its ``point_degrees`` (``degree`` far from wires, the degree in x that holds the
-    equilibrium near one) and checked at ``check_degree`` of that where a sign could change: points with a
+    equilibrium near one). With ``check``, the degree then follows the modes: the bracketing points of every
+    crossing a branch-point search reads are raised until its eigenvalue is resolved (``crossings.follow_modes``),
+    and flags are checked at ``check_degree`` of each point's degree where a sign could change: points with a
     lowest eigenvalue of magnitude below ``near_zero`` (eigenvalues are O(1) in the L2 normalisation), points
     next to a change of a flag, and every tenth point.
     """
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     variations = Variations(equilibrium_of(branch))
+
+    def assess(n, N):
+        return variations[N].assess(branch.X[n][:-1], branch.params_at(branch.X[n]), symmetric, m_max)
+
     degrees = point_degrees(branch, degree)
-    results = [variations[N].assess(X[:-1], branch.params_at(X), symmetric, m_max)
-               for N, X in zip(degrees, branch.X)]
+    results = [assess(n, N) for n, N in enumerate(degrees)]
     unsettled = []
     if check:
+        folds = frozenset(s.index for s in branch.special if s.kind == Kind.LP)
+        followed = follow_modes(results, degrees, assess, lambda N: check_degree(branch, N),
+                                lambda found: branch_point_crossings(found, m_max, folds))
+        results, degrees = followed.assessments, followed.degrees
         flags = [_flags(a) for a in results]
         for n, (X, coarse) in enumerate(zip(branch.X, results)):
             changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])
             small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
             if not (changes or small or n % 10 == 0):
                 continue
-            fine = variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max)
+            fine = (_flags(followed.checked[n]) if n in followed.checked else
+                    variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max))
             if fine != flags[n]:
                 unsettled.append(n)
     return results, unsettled
+
+
+def assessed_degrees(branch) -> list[int]:
+    """The perturbation degree of each point's stored assessment (``Assessment.degree``: ``point_degrees``, raised
+    where a crossing needed it); ``point_degrees`` at stability.degree for a branch not assessed."""
+    if branch.stability is None:
+        return [int(N) for N in point_degrees(branch, branch.scene.stability.degree)]
+    return [a.degree for a in branch.stability]
 
 
 def _flags(a: Assessment):

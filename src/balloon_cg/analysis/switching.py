@@ -6,8 +6,16 @@ branch (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, whe
 point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch);
 it ends exactly on stop_stretch (north or south), or on the loading's stop_volume/stop_amount, when it stops
 there.
+
+The rejoin is an extremum of P, not a fold: near a pitchfork P = P* + c A² + O(A⁴) on the pear branch (P is
+even in the pear amplitude A), so dP/ds vanishes where the branch crosses the primary branch and the fold
+search sees a sign change there, which it cannot locate as a regular fold (the corrector is singular at the
+branch point). A fold candidate of a branch that rejoined at a branch point is that branch point
+(``rejoin_fold``) when the amplitude A = λ2(0) − λ2(π) changes sign (or vanishes) across its bracket and the
+branch point lies within the bracket's width of it; ``mark_rejoin`` stores the branch point there in its place.
 """
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -18,7 +26,7 @@ from .assembly import assemble
 from .bifurcation import general_tracer, mode_direction, plain_degree, to_general
 from .control import landing
 from .primary import stop_rule
-from .results import Branch, SpecialPoint, StopCode
+from .results import Branch, Kind, SpecialPoint, StopCode
 from ..numerics.threads import limited_blas
 
 
@@ -63,3 +71,31 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
                StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
     return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0,
                     land_on=land_on)
+
+
+def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:
+    """Whether the fold candidate ``fold`` of ``branch`` is its rejoin at the branch point X = ``bp_X`` (on
+    ``branch.disc``): the pear amplitude λ2(0) − λ2(π) changes sign or vanishes between the bracketing points,
+    and the branch point is within the bracket's max-norm width in (P, λ2(0), λ2(π)) of the nearer of them
+    (module docstring)."""
+    i = fold.index
+    if fold.kind != Kind.LP or i + 1 >= len(branch.X):
+        return False
+    poles = branch.pole_values(branch.X[i:i + 2])
+    amplitude = poles["lam2_north"] - poles["lam2_south"]
+    if amplitude[0] * amplitude[1] > 0:
+        return False
+    at = branch.pole_values(bp_X)
+    point = np.array([bp_X[-1], at["lam2_north"][0], at["lam2_south"][0]])
+    ends = np.stack([branch.X[i:i + 2, -1], poles["lam2_north"], poles["lam2_south"]], axis=1)
+    return float(np.abs(ends - point).max(axis=1).min()) <= float(np.abs(ends[1] - ends[0]).max())
+
+
+def mark_rejoin(branch: Branch, primary: Branch, number: int, bp: SpecialPoint) -> None:
+    """Replace each fold candidate of ``branch`` that is its rejoin at the primary branch's branch point ``bp``
+    (number ``number``; ``rejoin_fold``) by that branch point on the branch's basis (its location status,
+    classification and mode; ``index`` the fold's interval)."""
+    X = primary.disc.transfer(bp.X, branch.disc)
+    branch.special = [replace(bp, index=s.index, X=X, note=f"the rejoin: branch point {number} of the primary "
+                                                           "branch (P is even in the pear amplitude there)")
+                      if rejoin_fold(branch, s, X) else s for s in branch.special]

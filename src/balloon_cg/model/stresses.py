@@ -1,6 +1,5 @@
 """Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6) and the dielectric part (the taut test on
 them: analysis/primary.py)."""
-import numpy as np
 
 from .membrane import stretch_derivatives
 from ..scene.energies import StrainEnergy

@@ -386,11 +386,6 @@ SUPTITLE_CHARS = 22  # characters of the x-small suptitle per inch of width (wra
 
 SINGLE_COIL = "spom1_paper_coil"  # the coil inferred from the paper's critical M (a = 1.961 at height 0: docs/paper.md)
 SINGLE_COIL_REACH = (("continuation.stop_stretch", 6.0),)  # the isola reaches λ2(0) = 5.4 (spom1.toml)
-# TPOM1's pear branches with one coil reach λ2(0) = 6 on an unmapped basis, where the held m = 1 eigenvalue is not
-# converged at the default perturbation degree 20 from λ2(0) ≈ 3.5 on, nor at 40 from ≈ 5 on (a spurious sign change:
-# flagged, approximate m = 1 points; converged and negative from N = 80: docs/paper.md). 40 moves the spurious points
-# out to λ2(0) ≈ 5.3 at twice the cost; 80 everywhere would be about eight times the cost.
-TPOM1_SINGLE_COIL_STABILITY = (("stability.degree", 40),)
 
 
 def _family(single_coil: bool, quick: bool) -> tuple[Case, ...]:
@@ -401,7 +396,7 @@ def _family(single_coil: bool, quick: bool) -> tuple[Case, ...]:
     for material in ("spom1", "tpom1"):
         cases += [] if quick else [Case(material)]
         if single_coil:
-            preset = () if material == "spom1" else (("material.preset", "TPOM1"),) + TPOM1_SINGLE_COIL_STABILITY
+            preset = () if material == "spom1" else (("material.preset", "TPOM1"),)
             cases += [Case(SINGLE_COIL, preset + (("field.M", M),) + SINGLE_COIL_REACH) for M in values]
         else:
             cases += [Case(f"{material}_two_coils_M{M:g}") for M in values]
