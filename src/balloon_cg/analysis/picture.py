@@ -97,11 +97,16 @@ class Picture:
         return found
 
 
-def _assess(branch: Branch, scene, symmetric: bool, progress: Progress) -> None:
-    branch.stability, branch.unsettled = assess_branch(branch, scene.stability.degree, symmetric, check=True,
-                                                       m_max=scene.stability.m_max)
-    for _ in branch.X:
-        progress.tick(Phase.STABILITY)
+def _assess(branch: Branch, scene, symmetric: bool, progress: Progress) -> bool:
+    """Assess ``branch`` (one STABILITY tick per point); False when a signal stopped it (the branch is kept as
+    traced, not assessed)."""
+    try:
+        branch.stability, branch.unsettled = assess_branch(
+            branch, scene.stability.degree, symmetric, check=True, m_max=scene.stability.m_max,
+            on_point=lambda: progress.tick(Phase.STABILITY))
+    except interrupt.Interrupted:
+        return False
+    return True
 
 
 @limited_blas
@@ -116,13 +121,18 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
     if interrupt.requested():
         picture.interrupted = True
         return picture
-    _assess(primary, scene, primary.disc.symmetric, progress)
+    if not _assess(primary, scene, primary.disc.symmetric, progress):
+        picture.interrupted = True
+        return picture
     if not primary.disc.symmetric:
         progress.finish(Phase.STABILITY, len(primary.X))
         picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
                                 "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
         return picture
     for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
+        if interrupt.requested():
+            picture.interrupted = True
+            return picture
         bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
         mode = "pear (odd)" if block == Block.ODD_HELD else "equator-symmetric (even)"
         bp.note = f"{mode} mode, branch point {n}"
@@ -132,11 +142,14 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
     if pear:
         _trace_pears(scene, primary, picture, progress)
         progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
-    progress.finish(Phase.STABILITY, sum(len(b.stability) for b in picture.branches))
+    progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
     if interrupt.requested():
         picture.interrupted = True
         return picture
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
+        if interrupt.requested():
+            picture.interrupted = True
+            return picture
         degrees = [a.degree for a in branch.stability]
         branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
@@ -146,7 +159,8 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
 
 def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
     """Pear branches from the pear branch points; a branch that rejoins at an already traced point is not
-    repeated. An interrupt ends the search after the branch being traced (which is kept, assessed)."""
+    repeated. An interrupt ends the search after the branch being traced (which is kept; assessed unless the
+    signal came before or during its assessment)."""
     reached = set()
     for n, bp in enumerate(picture.branch_points):
         if bp.block != Block.ODD_HELD or n in reached:
@@ -166,9 +180,8 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
                 reached.add(branch.rejoins)
                 mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
             picture.branches.append(branch)
-            if interrupt.requested():  # kept as traced, not assessed
+            if interrupt.requested() or not _assess(branch, scene, False, progress):  # kept as traced, not assessed
                 return
-            _assess(branch, scene, False, progress)
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

@@ -33,7 +33,7 @@ from .azimuthal import merged_lowest, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half
 from ..galerkin.equilibrium import Parameters
-from ..numerics import eigen
+from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
 from .resolution import Resolution
 from .results import Kind
@@ -259,8 +259,10 @@ class Variations(dict):
 
 @limited_blas
 def assess_branch(branch, degree: int, symmetric: bool | None = None, check: bool = False,
-                  near_zero: float = 0.1, m_max: int = 0):
+                  near_zero: float = 0.1, m_max: int = 0, on_point=None):
     """Assessments of every point and, with ``check``, the points whose flags change at the check degree.
+    ``on_point()`` is called after each point's first assessment. A stop asked for by a signal
+    (``numerics.interrupt``) raises ``interrupt.Interrupted`` at the next point: the assessment is abandoned.
 
     Each point is assessed at its ``point_degrees`` (``degree`` far from wires, the degree in x that holds the
     equilibrium near one). With ``check``, the degree then follows the modes: the bracketing points of every
@@ -273,10 +275,17 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
     variations = Variations(equilibrium_of(branch))
 
     def assess(n, N):
+        interrupt.check()
         return variations[N].assess(branch.X[n][:-1], branch.params_at(branch.X[n]), symmetric, m_max)
 
+    def first(n, N):
+        assessment = assess(n, N)
+        if on_point is not None:
+            on_point()
+        return assessment
+
     degrees = point_degrees(branch, degree)
-    results = [assess(n, N) for n, N in enumerate(degrees)]
+    results = [first(n, N) for n, N in enumerate(degrees)]
     unsettled = []
     if check:
         folds = frozenset(s.index for s in branch.special if s.kind == Kind.LP)

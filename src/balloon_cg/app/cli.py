@@ -524,7 +524,7 @@ def _pitchfork_curve(scene, args):
     from ..analysis.primary import trace_primary
     from ..analysis.results import Block, Status
     from ..analysis.stability import assess_branch
-    from ..numerics.interrupt import requested
+    from ..numerics.interrupt import Interrupted, requested
     from .progress import shown, tqdm_disable
 
     disable = tqdm_disable(shown(args.quiet))
@@ -533,8 +533,9 @@ def _pitchfork_curve(scene, args):
     if requested():
         return None
     _say(args, f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
-    assessments, _ = assess_branch(branch, scene.stability.degree)
-    if requested():
+    try:
+        assessments, _ = assess_branch(branch, scene.stability.degree)
+    except Interrupted:
         return None
     pear = [event for event in detect(branch, assessments) if event[1] == Block.ODD_HELD]
     if not pear:

@@ -27,6 +27,17 @@ def request() -> None:
     _flag.set()
 
 
+class Interrupted(Exception):
+    """Raised by ``check`` where a stop was asked for in the middle of a unit of work (a branch's assessment):
+    the unit is abandoned, what was finished before it is kept."""
+
+
+def check() -> None:
+    """Raise ``Interrupted`` if a stop was asked for (``requested()``)."""
+    if _flag.is_set():
+        raise Interrupted
+
+
 def _handler(signum, frame):
     if _flag.is_set():
         raise KeyboardInterrupt
