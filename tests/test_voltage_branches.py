@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block, Classification, Status
 from balloon_cg.analysis.switching import trace_pear
-from balloon_cg.app.api import Result
+from balloon_cg.app.api import Result, plot as api_plot
 from balloon_cg.app.cli import main
 from balloon_cg.app.summaries import format_run
 from balloon_cg.io.run_file import read_run
@@ -246,3 +246,20 @@ def test_a_snap_through_value_is_named_by_what_it_is(control, parameter, symbol)
     from balloon_cg.app.summaries import _snap_symbol
     run = {"attrs": {"control": control}, "branches": {"primary": {"attrs": {"parameter": parameter}}}}
     assert _snap_symbol(run, "primary") == symbol
+
+
+def test_the_default_kind_is_the_pole_curve_of_the_runs_own_parameter(voltage_file, tmp_path):
+    """plot(source) with no kind: voltage-pole for a voltage run, pressure-pole for a pressure run."""
+    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.io.run_file import write_run
+
+    ax = Figure().add_subplot()
+    api_plot(voltage_file, ax=ax)
+    assert ax.get_ylabel() == plot(voltage_file, "voltage-pole").axes[0].get_ylabel()
+    scene = fixed_voltage_scene(0.3).with_overrides({"continuation.parameter": "pressure",
+                                                     "continuation.stop_stretch": 1.3})
+    pressure_file = tmp_path / "pressure.h5"
+    write_run(pressure_file, scene, [trace_primary(scene)])
+    ax = Figure().add_subplot()
+    api_plot(pressure_file, ax=ax)
+    assert ax.get_ylabel() == plot(pressure_file, "pressure-pole").axes[0].get_ylabel() != ""

@@ -216,11 +216,13 @@ def load(path) -> Result:
     return Result(scene, Path(path).read_bytes(), run)
 
 
-def plot(source, what: str = "pressure-pole", ax=None, points=None, branch: str | None = None,
+def plot(source, what: str | None = None, ax=None, points=None, branch: str | None = None,
          stability: str | None = None):
-    """A matplotlib Figure of kind ``what`` (docs/plots.md) from Results or run files (one or a list); drawn
-    into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given; ``stability`` the
-    reading that draws curves solid or dashed (post.plotting.Reading; None: each run's loading control)."""
+    """A matplotlib Figure of kind ``what`` (docs/plots.md; None: the pole curve of the continuation parameter,
+    ``pressure-pole`` or, for a run continued in the voltage, ``voltage-pole``) from Results or run files (one or
+    a list); drawn into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given;
+    ``stability`` the reading that draws curves solid or dashed (post.plotting.Reading; None: each run's loading
+    control)."""
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]

@@ -298,10 +298,11 @@ def applicable_kinds(branches) -> list[str]:
             and (kind != "energy" or any(b.bifurcations for b in branches))]
 
 
-def plot(sources, what: str, points=None, branch: str | None = None, axes=None,
+def plot(sources, what: str | None, points=None, branch: str | None = None, axes=None,
          stability: Reading | None = None) -> Figure:
     """The figure of kind ``what`` (one of KINDS) for ``sources``: runs (read_run() output) or run files, one
-    or a list (``phase``: curve or sweep files).
+    or a list (``phase``: curve or sweep files). ``what`` None: the pole curve of the first run's continuation
+    parameter (``pressure-pole``, or ``voltage-pole`` for a run continued in the voltage).
 
     ``branch``: the branch to draw (default: all branches for the branch curves and the energy, 'primary' for
     the per-point kinds). ``points``: indices (negative count from the end) of the configurations drawn by the
@@ -310,9 +311,12 @@ def plot(sources, what: str, points=None, branch: str | None = None, axes=None,
     has panels) instead of a new figure. ``stability``: the Reading that draws curves solid or dashed (None: each
     run's loading control).
     """
+    sources = [sources] if isinstance(sources, (str, Path, dict)) else list(sources)
+    if what is None:
+        sources = [as_run(s) for s in sources]
+        what = f"{ordinate_of(sources[0]['branches']['primary']).prefix}-pole"
     if what not in KINDS:
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
-    sources = [sources] if isinstance(sources, (str, Path, dict)) else list(sources)
     if what == "phase":
         return plot_phase(sources, axes)
     draw, per_point = KINDS[what]
