@@ -7,6 +7,7 @@ continuation. A point is an equilibrium when R = 0 at fixed (P, M, Φ̄).
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .discretisation import Discretisation
 from ..model.field import field_squared_nodes
@@ -39,7 +40,12 @@ class Parameters:
     material: tuple | None = None
 
     def with_value(self, name: str, value: float) -> "Parameters":
-        return Parameters(**{**self.__dict__, name: float(value)})
+        other = object.__new__(Parameters)  # a copy with one field replaced (no __init__: called every Newton step)
+        other.__dict__.update(self.__dict__)
+        if name not in other.__dict__:
+            raise TypeError(f"Parameters has no field {name!r}")
+        other.__dict__[name] = float(value)
+        return other
 
 
 class Equilibrium:
@@ -54,6 +60,15 @@ class Equilibrium:
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
+        # the node state and field of the last u (``_pointwise``), in arrays owned here and refilled in place
+        n_q = discretisation.weights.size
+        self._held = np.empty(discretisation.size)
+        self._held_for = None  # (the material values the held state was checked for,) or None: nothing held
+        self._flat = np.empty(4 * n_q)
+        self._rho = np.empty(n_q)
+        self._field_rows = np.zeros((6, n_q)) if self.kernels.field_class else np.zeros((6, 0))
+        self._values = dict(zip(self.kernels.module.STATE, self._flat.reshape(4, n_q)), cos_theta=self.geometry[0],
+                            sin_theta=self.geometry[1], field=self._field_rows if self.kernels.field_class else None)
 
     def _field(self, lam2, sin_theta, eta):
         """H² and its derivatives at the nodes (zeros for a field class without coils)."""
@@ -73,9 +88,13 @@ class Equilibrium:
         return self._evaluate(kernel, self._node_values(geometry, state, field, params) | values, params)
 
     def _node_values(self, geometry: tuple, state: tuple, field, params: Parameters) -> dict:
-        """The kernels' node arguments by name; NonFiniteState if a node's stretches leave the domain of the
-        material at ``params`` (a strain energy with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay
-        finite beyond it)."""
+        """The kernels' node arguments by name (``_check_domain`` first)."""
+        self._check_domain(geometry, state, params)
+        return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
+
+    def _check_domain(self, geometry: tuple, state: tuple, params: Parameters):
+        """NonFiniteState if a node's stretches leave the domain of the material at ``params`` (a strain energy
+        with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
         if self._domain_check:
             lam2, v, _, w = state
             lam1 = np.hypot(lam2 * geometry[0] + v, w)
@@ -85,7 +104,6 @@ class Equilibrium:
                 node, what = violation
                 raise NonFiniteState(f"the membrane left the domain of {self.scene.material.name} at the node "
                                      f"cos θ = {geometry[0][node]:.6g}: {what}")
-        return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
         out = self.kernels.nodes(kernel, named, params)
@@ -95,14 +113,17 @@ class Equilibrium:
 
     def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u (and material values: its domain check)
-        are reused (Newton asks for R, then J)."""
-        last = getattr(self, "_last", None)
-        if last is None or last[0].shape != u.shape or (last[0] != u).any() or last[1] != params.material:
-            state = tuple(self.disc.node_state(u))
-            field = self._field(state[0], self.disc.sin_theta, state[2])
-            last = self._last = (np.array(u, dtype=float), params.material,
-                                 self._node_values(self.geometry, state, field, params))
-        return self._evaluate(kernel, last[2], params)
+        are reused (Newton asks for R, then J). State and field are one jitted pass (``node_pass``) into arrays
+        owned by this object."""
+        if self._held_for != (params.material,) or not same_values(self._held, u):
+            self._held_for = None
+            node_pass(self.disc._gradient_ops, u, self.disc.sin_theta, self.coils, self._flat, self._rho,
+                      self._field_rows)
+            if self._domain_check:
+                self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
+            self._held[:] = u
+            self._held_for = (params.material,)
+        return self._evaluate(kernel, self._values, params)
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
@@ -156,3 +177,31 @@ def enclosed_volume(disc: Discretisation, u) -> float:
     """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ λ2² η' sin²θ dθ (MODEL.md §2: the pressure term is −P V/(2π))."""
     lam2, _, _, w = disc.node_state(u)
     return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
+
+
+@njit(cache=True)
+def node_pass(state_ops, u, sin_theta, coils, flat, rho, field):
+    """The node state and the field of u in one pass: flat = state_opsᵀ u, the (λ2, v, η, w) rows (4, n_q) of
+    Discretisation.node_state flattened (state_ops = Discretisation._gradient_ops, (size, 4 n_q)); with coils
+    also ρ = λ2 sin θ and H² with its derivatives at (ρ, η) (field_squared_nodes) into field (6, n_q)."""
+    flat[:] = 0.0
+    for i in range(u.shape[0]):
+        c = u[i]
+        for j in range(flat.shape[0]):
+            flat[j] += c * state_ops[i, j]
+    if coils.shape[0]:
+        n_q = sin_theta.shape[0]
+        for q in range(n_q):
+            rho[q] = flat[q] * sin_theta[q]
+        field_squared_nodes(rho, flat[2 * n_q:3 * n_q], coils, field)
+
+
+@njit(cache=True)
+def same_values(a, b) -> bool:
+    """Whether the 1-D arrays a and b are equal entry by entry."""
+    if a.shape[0] != b.shape[0]:
+        return False
+    for i in range(a.shape[0]):
+        if a[i] != b[i]:
+            return False
+    return True
