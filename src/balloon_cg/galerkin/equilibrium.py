@@ -69,6 +69,7 @@ class Equilibrium:
         self._field_rows = np.zeros((6, n_q)) if self.kernels.field_class else np.zeros((6, 0))
         self._values = dict(zip(self.kernels.module.STATE, self._flat.reshape(4, n_q)), cos_theta=self.geometry[0],
                             sin_theta=self.geometry[1], field=self._field_rows if self.kernels.field_class else None)
+        self._templates = {}  # kernel -> its argument list on the held arrays and the slots of its scalar parameters
 
     def _field(self, lam2, sin_theta, eta):
         """H² and its derivatives at the nodes (zeros for a field class without coils)."""
@@ -123,7 +124,27 @@ class Equilibrium:
                 self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
             self._held[:] = u
             self._held_for = (params.material,)
-        return self._evaluate(kernel, self._values, params)
+        if params.mu is not None or params.alpha is not None or params.material is not None:
+            return self._evaluate(kernel, self._values, params)  # material overrides: bound by name each time
+        function, rows, args, slots = self._templates.get(kernel) or self._template(kernel, params)
+        for slot, name in slots:
+            args[slot] = float(getattr(params, name))
+        out = np.empty((rows, self._rho.shape[0]))
+        function(*args, out)
+        if not finite(out):
+            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+        return out
+
+    def _template(self, kernel: str, params: Parameters) -> tuple:
+        """(the kernel's node loop, its output count, its arguments on the held node arrays and the scene material
+        as a list, the (position, Parameters field) of each scalar parameter): ``_pointwise`` only refills the
+        scalars. Bound once by name (KernelSet.arguments)."""
+        spec = self.kernels.module.KERNELS[kernel]
+        slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"]) if kind == "param")
+        entry = (getattr(self.kernels.module, f"{kernel}_nodes"), len(spec["outputs"]),
+                 list(self.kernels.arguments(kernel, self._values, params)), slots)
+        self._templates[kernel] = entry
+        return entry
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
