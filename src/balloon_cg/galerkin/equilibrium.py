@@ -114,12 +114,14 @@ class Equilibrium:
 
     def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u (and material values: its domain check)
-        are reused (Newton asks for R, then J). State and field are one jitted pass (``node_pass``) into arrays
-        owned by this object."""
+        are reused (Newton asks for R, then J). The state is one jitted pass (``node_pass``), into arrays owned by
+        this object, as is the field."""
         if self._held_for != (params.material,) or not same_values(self._held, u):
             self._held_for = None
-            node_pass(self.disc._gradient_ops, u, self.disc.sin_theta, self.coils, self._flat, self._rho,
-                      self._field_rows)
+            node_pass(self.disc._gradient_ops, u, self.disc.sin_theta, self._flat, self._rho)
+            if self.coils.shape[0]:
+                field_squared_nodes(self._rho, self._flat[2 * self._rho.shape[0]:3 * self._rho.shape[0]], self.coils,
+                                    self._field_rows)  # at (ρ, η)
             if self._domain_check:
                 self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
             self._held[:] = u
@@ -201,20 +203,17 @@ def enclosed_volume(disc: Discretisation, u) -> float:
 
 
 @njit(cache=True)
-def node_pass(state_ops, u, sin_theta, coils, flat, rho, field):
-    """The node state and the field of u in one pass: flat = state_opsᵀ u, the (λ2, v, η, w) rows (4, n_q) of
-    Discretisation.node_state flattened (state_ops = Discretisation._gradient_ops, (size, 4 n_q)); with coils
-    also ρ = λ2 sin θ and H² with its derivatives at (ρ, η) (field_squared_nodes) into field (6, n_q)."""
+def node_pass(state_ops, u, sin_theta, flat, rho):
+    """The node state of u in one pass: flat = state_opsᵀ u, the (λ2, v, η, w) rows (4, n_q) of
+    Discretisation.node_state flattened (state_ops = Discretisation._gradient_ops, (size, 4 n_q)), and
+    ρ = λ2 sin θ (where the coil field is evaluated)."""
     flat[:] = 0.0
     for i in range(u.shape[0]):
         c = u[i]
         for j in range(flat.shape[0]):
             flat[j] += c * state_ops[i, j]
-    if coils.shape[0]:
-        n_q = sin_theta.shape[0]
-        for q in range(n_q):
-            rho[q] = flat[q] * sin_theta[q]
-        field_squared_nodes(rho, flat[2 * n_q:3 * n_q], coils, field)
+    for q in range(sin_theta.shape[0]):
+        rho[q] = flat[q] * sin_theta[q]
 
 
 @njit(cache=True)
