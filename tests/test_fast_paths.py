@@ -6,8 +6,8 @@
 - Below SMALL_SYSTEM unknowns the gradient and Hessian are jitted loops: against an einsum of the node tables.
 - The lowest eigenvalues below SMALL_EIGEN rows (tridiagonalisation and bisection) against LAPACK's full
   spectrum, with clustered, repeated and tiny eigenvalues; orthogonal Gram factors against Cholesky.
-- The node state of an iterate in one jitted pass (``equilibrium.node_pass``) and the held field against
-  Discretisation.node_state and field_squared_nodes; the kernels on the held arrays with the scalars refilled in a
+- The node state and coil field the Equilibrium holds (in arrays of its own) against Discretisation.node_state
+  and field_squared_nodes; the kernels on the held arrays with the scalars refilled in a
   bound argument list against binding by name; the held state against a fresh Equilibrium after other iterates.
 - The coil field's Maclaurin series summed only as far as m needs (``field.series_lengths``) against all its
   terms; Parameters.with_value against the dataclass constructor.
@@ -23,7 +23,7 @@ from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.stability import SecondVariation
 from balloon_cg.galerkin.discretisation import SMALL_SYSTEM, Discretisation, _HESSIAN_ROW
-from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters, node_pass
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import field
 from balloon_cg.numerics import eigen
 from balloon_cg.scene import load_scene
@@ -132,20 +132,16 @@ def test_orthogonal_gram_factor_is_the_cholesky_one():
     assert np.abs(eigen.lowest(H, b.factor, 3, normals) - general).max() <= 1e-12 * np.abs(H).max()
 
 
-def test_node_pass_and_held_field_match_node_state_and_field(two_coils):
+def test_held_state_and_field_are_node_state_and_field(two_coils):
     _, branch = two_coils
     eq = equilibrium_of(branch)
-    u = branch.X[-1][:-1]
-    n_q = eq.disc.weights.size
-    flat, rho = np.empty(4 * n_q), np.empty(n_q)
-    node_pass(eq.disc._gradient_ops, u, eq.disc.sin_theta, flat, rho)
-    state = eq.disc.node_state(u)
-    assert np.abs(flat.reshape(4, n_q) - state).max() <= 1e-14 * np.abs(state).max()
-    assert np.abs(rho - state[0] * eq.disc.sin_theta).max() <= 1e-14 * np.abs(rho).max()
-    eq._pointwise("energy_gradient", u, branch.params.with_value("P", branch.X[-1][-1]))
-    expected = np.empty((6, n_q))
+    X = branch.X[-1]
+    eq._pointwise("energy_gradient", X[:-1], branch.params.with_value("P", X[-1]))
+    state = eq.disc.node_state(X[:-1])
+    assert np.array_equal(eq._state, state)
+    expected = np.empty((6, state.shape[1]))
     field.field_squared_nodes(state[0] * eq.disc.sin_theta, state[2], eq.coils, expected)
-    assert (np.abs(eq._field_rows - expected).max(axis=1) <= 1e-13 * np.abs(expected).max(axis=1)).all()
+    assert np.array_equal(eq._field_rows, expected)
 
 
 @pytest.mark.parametrize("kernel", ["energy_gradient", "energy_hessian", "pressure_gradient", "field_gradient"])

@@ -64,10 +64,10 @@ class Equilibrium:
         n_q = discretisation.weights.size
         self._held = np.empty(discretisation.size)
         self._held_for = None  # (the material values the held state was checked for,) or None: nothing held
-        self._flat = np.empty(4 * n_q)
+        self._state = np.empty((4, n_q))
         self._rho = np.empty(n_q)
         self._field_rows = np.zeros((6, n_q)) if self.kernels.field_class else np.zeros((6, 0))
-        self._values = dict(zip(self.kernels.module.STATE, self._flat.reshape(4, n_q)), cos_theta=self.geometry[0],
+        self._values = dict(zip(self.kernels.module.STATE, self._state), cos_theta=self.geometry[0],
                             sin_theta=self.geometry[1], field=self._field_rows if self.kernels.field_class else None)
         self._templates = {}  # kernel -> its argument list on the held arrays and the slots of its scalar parameters
 
@@ -114,14 +114,13 @@ class Equilibrium:
 
     def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u (and material values: its domain check)
-        are reused (Newton asks for R, then J). The state is one jitted pass (``node_pass``), into arrays owned by
-        this object, as is the field."""
+        are reused (Newton asks for R, then J). State and field are computed into arrays owned by this object."""
         if self._held_for != (params.material,) or not same_values(self._held, u):
             self._held_for = None
-            node_pass(self.disc._gradient_ops, u, self.disc.sin_theta, self._flat, self._rho)
+            np.matmul(self.disc.ops, u, out=self._state)  # Discretisation.node_state, into the held rows
             if self.coils.shape[0]:
-                field_squared_nodes(self._rho, self._flat[2 * self._rho.shape[0]:3 * self._rho.shape[0]], self.coils,
-                                    self._field_rows)  # at (ρ, η)
+                np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
+                field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
             if self._domain_check:
                 self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
             self._held[:] = u
@@ -200,20 +199,6 @@ def enclosed_volume(disc: Discretisation, u) -> float:
     """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ λ2² η' sin²θ dθ (MODEL.md §2: the pressure term is −P V/(2π))."""
     lam2, _, _, w = disc.node_state(u)
     return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
-
-
-@njit(cache=True)
-def node_pass(state_ops, u, sin_theta, flat, rho):
-    """The node state of u in one pass: flat = state_opsᵀ u, the (λ2, v, η, w) rows (4, n_q) of
-    Discretisation.node_state flattened (state_ops = Discretisation._gradient_ops, (size, 4 n_q)), and
-    ρ = λ2 sin θ (where the coil field is evaluated)."""
-    flat[:] = 0.0
-    for i in range(u.shape[0]):
-        c = u[i]
-        for j in range(flat.shape[0]):
-            flat[j] += c * state_ops[i, j]
-    for q in range(sin_theta.shape[0]):
-        rho[q] = flat[q] * sin_theta[q]
 
 
 @njit(cache=True)
