@@ -267,7 +267,9 @@ def main():
         f"floors at error ≤ {LEVEL:g} (CPU time): ours ≥ 100x faster than (i): "
         f"{'met' if np.nanmin(r[:, 0]) >= 100 else 'NOT met'} at every point "
         f"({int(np.sum(r[:, 0] >= 100))}/{len(r)}); ours ≥ 10x faster than (ii): "
-        f"{'met' if np.nanmin(r[:, 1]) >= 10 else 'NOT met'} at every point ({int(np.sum(r[:, 1] >= 10))}/{len(r)})",
+        f"{'met' if np.nanmin(r[:, 1]) >= 10 else 'NOT met'} at every point ({int(np.sum(r[:, 1] >= 10))}/{len(r)}); "
+        f"ours ≥ 50x faster than (ii) (issue 14): {'met' if np.nanmin(r[:, 1]) >= 50 else 'NOT met'} at every point "
+        f"({int(np.sum(r[:, 1] >= 50))}/{len(r)})",
         f"total wall time {time.perf_counter() - t_start:.0f} s",
     ]
     head = [

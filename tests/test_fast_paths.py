@@ -6,6 +6,11 @@
 - Below SMALL_SYSTEM unknowns the gradient and Hessian are jitted loops: against an einsum of the node tables.
 - The lowest eigenvalues below SMALL_EIGEN rows (tridiagonalisation and bisection) against LAPACK's full
   spectrum, with clustered, repeated and tiny eigenvalues; orthogonal Gram factors against Cholesky.
+- The node state and coil field the Equilibrium holds (in arrays of its own) against Discretisation.node_state
+  and field_squared_nodes; the kernels on the held arrays with the scalars refilled in a
+  bound argument list against binding by name; the held state against a fresh Equilibrium after other iterates.
+- The coil field's Maclaurin series summed only as far as m needs (``field.series_lengths``) against all its
+  terms; Parameters.with_value against the dataclass constructor.
 """
 from pathlib import Path
 
@@ -19,6 +24,7 @@ from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.stability import SecondVariation
 from balloon_cg.galerkin.discretisation import SMALL_SYSTEM, Discretisation, _HESSIAN_ROW
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.model import field
 from balloon_cg.numerics import eigen
 from balloon_cg.scene import load_scene
 
@@ -124,3 +130,66 @@ def test_orthogonal_gram_factor_is_the_cholesky_one():
     normals = rng.normal(size=(2, b.size))
     general = eigen.lowest(H, eigen.GramFactor(b.gram), 3, normals)
     assert np.abs(eigen.lowest(H, b.factor, 3, normals) - general).max() <= 1e-12 * np.abs(H).max()
+
+
+def test_held_state_and_field_are_node_state_and_field(two_coils):
+    _, branch = two_coils
+    eq = equilibrium_of(branch)
+    X = branch.X[-1]
+    eq._pointwise("energy_gradient", X[:-1], branch.params.with_value("P", X[-1]))
+    state = eq.disc.node_state(X[:-1])
+    assert np.array_equal(eq._state, state)
+    expected = np.empty((6, state.shape[1]))
+    field.field_squared_nodes(state[0] * eq.disc.sin_theta, state[2], eq.coils, expected)
+    assert np.array_equal(eq._field_rows, expected)
+
+
+@pytest.mark.parametrize("kernel", ["energy_gradient", "energy_hessian", "pressure_gradient", "field_gradient"])
+def test_kernels_on_held_arrays_match_binding_by_name(two_coils, kernel):
+    _, branch = two_coils
+    eq = equilibrium_of(branch)
+    X = branch.X[-1]
+    u, params = X[:-1], branch.params.with_value("P", X[-1])
+    fast = eq._pointwise(kernel, u, params)
+    assert np.array_equal(fast, eq.kernels.nodes(kernel, eq._values, params))
+    other = branch.params.with_value("P", 1.5 * X[-1])  # only the scalars of the bound list change
+    assert np.array_equal(eq._pointwise(kernel, u, other), eq.kernels.nodes(kernel, eq._values, other))
+
+
+def test_held_state_follows_the_iterate(two_coils):
+    scene, branch = two_coils
+    eq = equilibrium_of(branch)
+    (u1, P1), (u2, P2) = (branch.X[-1][:-1], branch.X[-1][-1]), (branch.X[1][:-1], branch.X[1][-1])
+    p1, p2 = branch.params.with_value("P", P1), branch.params.with_value("P", P2)
+    eq.residual(u1, p1)
+    eq.jacobian(u2, p2)
+    for u, p in ((u1, p1), (u2, p2)):
+        fresh = Equilibrium(scene, eq.disc)
+        assert np.array_equal(eq.residual(u, p), fresh.residual(u, p))
+        assert np.array_equal(eq.bordered_jacobian(u, p, "P"), fresh.bordered_jacobian(u, p, "P"))
+
+
+def _full_series(m):
+    """G and its first three derivatives from every generated Maclaurin term (Horner, as before the shortening)."""
+    g0 = g1 = g2 = g3 = np.zeros_like(m)
+    for c in field._SERIES[::-1]:
+        g3, g2, g1, g0 = g3 * m + g2, g2 * m + g1, g1 * m + g0, g0 * m + c
+    return np.array([g0, g1, 2.0 * g2, 6.0 * g3])
+
+
+def test_shortened_series_match_every_term():
+    lengths = field._LENGTHS
+    assert lengths[-1] == field._SERIES.size and (np.diff(lengths) >= 0).all() and lengths[0] < 20
+    m = np.concatenate([np.linspace(0.0, field.SERIES_SWITCH, 20001), np.array(field.SERIES_BOUNDS),
+                        np.nextafter(np.array(field.SERIES_BOUNDS[:-1]), 1.0)])
+    expected = _full_series(m)
+    got = np.array([field.stream_shape(value, 1.0 - value) for value in m]).T
+    assert np.abs(got / expected - 1.0).max() <= 2.5 * np.finfo(float).eps
+
+
+def test_with_value_is_the_constructor():
+    params = Parameters(P=1.0, M=0.002, chi=0.5, mu=(1.0, 2.0), alpha=(1.3, 5.0))
+    assert params.with_value("M", 3) == Parameters(P=1.0, M=3.0, chi=0.5, mu=(1.0, 2.0), alpha=(1.3, 5.0))
+    assert params.P == 1.0
+    with pytest.raises(TypeError, match="no field 'Q'"):
+        params.with_value("Q", 1.0)

@@ -112,26 +112,44 @@ def assemble_hessian(pointwise, weights, A, B, out=None) -> np.ndarray:
 
 @njit(cache=True)
 def _hessian_loops(pointwise, weights, A, B, out):
-    """Discretisation.hessian's blocks aa, ab (and ba = abᵀ), bb as sums of node-wise outer products of the
-    basis (A, B) with its weighted partner (``_weighted_bases``), into ``out``."""
-    weighted_a, weighted_b = _weighted_bases(pointwise, weights, A, B)
+    """Discretisation.hessian's blocks aa, ab, bb (ba = abᵀ) in one pass over the nodes, into ``out``: at node q the
+    bases' weighted partners W_q Σ_l h_kl ∂state_l/∂u (as ``_weighted_bases``), then their outer products with the
+    basis; the symmetric blocks aa and bb only on and above the diagonal, mirrored at the end."""
     n_q, na, nb = weights.shape[0], A.shape[2], B.shape[2]
     out[:, :] = 0.0
-    for k in range(2):
-        for q in range(n_q):
-            for i in range(na):
-                a = A[k, q, i]
-                for j in range(na):
-                    out[i, j] += a * weighted_a[k, q, j]
-                for j in range(nb):
-                    out[i, na + j] += a * weighted_b[k, q, j]
-            for i in range(nb):
-                b = B[k, q, i]
-                for j in range(nb):
-                    out[na + i, na + j] += b * weighted_b[2 + k, q, j]
-    for i in range(na):
-        for j in range(nb):
-            out[na + j, i] = out[i, na + j]
+    partner_a = np.empty((2, na))
+    partner_b = np.empty((4, nb))
+    for q in range(n_q):
+        w = weights[q]
+        h00, h01, h11 = (pointwise[_HESSIAN_ROW[0, 0], q] * w, pointwise[_HESSIAN_ROW[0, 1], q] * w,
+                         pointwise[_HESSIAN_ROW[1, 1], q] * w)
+        h02, h03, h12, h13 = (pointwise[_HESSIAN_ROW[0, 2], q] * w, pointwise[_HESSIAN_ROW[0, 3], q] * w,
+                              pointwise[_HESSIAN_ROW[1, 2], q] * w, pointwise[_HESSIAN_ROW[1, 3], q] * w)
+        h22, h23, h33 = (pointwise[_HESSIAN_ROW[2, 2], q] * w, pointwise[_HESSIAN_ROW[2, 3], q] * w,
+                         pointwise[_HESSIAN_ROW[3, 3], q] * w)
+        for i in range(na):
+            a0, a1 = A[0, q, i], A[1, q, i]
+            partner_a[0, i] = h00 * a0 + h01 * a1
+            partner_a[1, i] = h01 * a0 + h11 * a1
+        for i in range(nb):
+            b0, b1 = B[0, q, i], B[1, q, i]
+            partner_b[0, i] = h02 * b0 + h03 * b1
+            partner_b[1, i] = h12 * b0 + h13 * b1
+            partner_b[2, i] = h22 * b0 + h23 * b1
+            partner_b[3, i] = h23 * b0 + h33 * b1
+        for i in range(na):
+            a0, a1 = A[0, q, i], A[1, q, i]
+            for j in range(i, na):
+                out[i, j] += a0 * partner_a[0, j] + a1 * partner_a[1, j]
+            for j in range(nb):
+                out[i, na + j] += a0 * partner_b[0, j] + a1 * partner_b[1, j]
+        for i in range(nb):
+            b0, b1 = B[0, q, i], B[1, q, i]
+            for j in range(i, nb):
+                out[na + i, na + j] += b0 * partner_b[2, j] + b1 * partner_b[3, j]
+    for i in range(na + nb):
+        for j in range(i):
+            out[i, j] = out[j, i]
 
 
 @njit(cache=True)

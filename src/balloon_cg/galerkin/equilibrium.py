@@ -7,6 +7,7 @@ continuation. A point is an equilibrium when R = 0 at fixed (P, M, Φ̄).
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .discretisation import Discretisation
 from ..model.field import field_squared_nodes
@@ -39,7 +40,12 @@ class Parameters:
     material: tuple | None = None
 
     def with_value(self, name: str, value: float) -> "Parameters":
-        return Parameters(**{**self.__dict__, name: float(value)})
+        other = object.__new__(Parameters)  # a copy with one field replaced (no __init__: called every Newton step)
+        other.__dict__.update(self.__dict__)
+        if name not in other.__dict__:
+            raise TypeError(f"Parameters has no field {name!r}")
+        other.__dict__[name] = float(value)
+        return other
 
 
 class Equilibrium:
@@ -54,6 +60,16 @@ class Equilibrium:
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
+        # the node state and field of the last u (``_pointwise``), in arrays owned here and refilled in place
+        n_q = discretisation.weights.size
+        self._held = np.empty(discretisation.size)
+        self._held_for = None  # (the material values the held state was checked for,) or None: nothing held
+        self._state = np.empty((4, n_q))
+        self._rho = np.empty(n_q)
+        self._field_rows = np.zeros((6, n_q)) if self.kernels.field_class else np.zeros((6, 0))
+        self._values = dict(zip(self.kernels.module.STATE, self._state), cos_theta=self.geometry[0],
+                            sin_theta=self.geometry[1], field=self._field_rows if self.kernels.field_class else None)
+        self._templates = {}  # kernel -> its argument list on the held arrays and the slots of its scalar parameters
 
     def _field(self, lam2, sin_theta, eta):
         """H² and its derivatives at the nodes (zeros for a field class without coils)."""
@@ -73,9 +89,13 @@ class Equilibrium:
         return self._evaluate(kernel, self._node_values(geometry, state, field, params) | values, params)
 
     def _node_values(self, geometry: tuple, state: tuple, field, params: Parameters) -> dict:
-        """The kernels' node arguments by name; NonFiniteState if a node's stretches leave the domain of the
-        material at ``params`` (a strain energy with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay
-        finite beyond it)."""
+        """The kernels' node arguments by name (``_check_domain`` first)."""
+        self._check_domain(geometry, state, params)
+        return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
+
+    def _check_domain(self, geometry: tuple, state: tuple, params: Parameters):
+        """NonFiniteState if a node's stretches leave the domain of the material at ``params`` (a strain energy
+        with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
         if self._domain_check:
             lam2, v, _, w = state
             lam1 = np.hypot(lam2 * geometry[0] + v, w)
@@ -85,7 +105,6 @@ class Equilibrium:
                 node, what = violation
                 raise NonFiniteState(f"the membrane left the domain of {self.scene.material.name} at the node "
                                      f"cos θ = {geometry[0][node]:.6g}: {what}")
-        return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
         out = self.kernels.nodes(kernel, named, params)
@@ -95,14 +114,38 @@ class Equilibrium:
 
     def _pointwise(self, kernel, u, params: Parameters):
         """Kernel at the own nodes; the state and field of the last u (and material values: its domain check)
-        are reused (Newton asks for R, then J)."""
-        last = getattr(self, "_last", None)
-        if last is None or last[0].shape != u.shape or (last[0] != u).any() or last[1] != params.material:
-            state = tuple(self.disc.node_state(u))
-            field = self._field(state[0], self.disc.sin_theta, state[2])
-            last = self._last = (np.array(u, dtype=float), params.material,
-                                 self._node_values(self.geometry, state, field, params))
-        return self._evaluate(kernel, last[2], params)
+        are reused (Newton asks for R, then J). State and field are computed into arrays owned by this object."""
+        if self._held_for != (params.material,) or not same_values(self._held, u):
+            self._held_for = None
+            np.matmul(self.disc.ops, u, out=self._state)  # Discretisation.node_state, into the held rows
+            if self.coils.shape[0]:
+                np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
+                field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
+            if self._domain_check:
+                self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
+            self._held[:] = u
+            self._held_for = (params.material,)
+        if params.mu is not None or params.alpha is not None or params.material is not None:
+            return self._evaluate(kernel, self._values, params)  # material overrides: bound by name each time
+        function, rows, args, slots = self._templates.get(kernel) or self._template(kernel, params)
+        for slot, name in slots:
+            args[slot] = float(getattr(params, name))
+        out = np.empty((rows, self._rho.shape[0]))
+        function(*args, out)
+        if not finite(out):
+            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+        return out
+
+    def _template(self, kernel: str, params: Parameters) -> tuple:
+        """(the kernel's node loop, its output count, its arguments on the held node arrays and the scene material
+        as a list, the (position, Parameters field) of each scalar parameter): ``_pointwise`` only refills the
+        scalars. Bound once by name (KernelSet.arguments)."""
+        spec = self.kernels.module.KERNELS[kernel]
+        slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"]) if kind == "param")
+        entry = (getattr(self.kernels.module, f"{kernel}_nodes"), len(spec["outputs"]),
+                 list(self.kernels.arguments(kernel, self._values, params)), slots)
+        self._templates[kernel] = entry
+        return entry
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""
@@ -139,11 +182,11 @@ class Equilibrium:
         return self.disc.gradient(self._pointwise(kernel, u, params), out)
 
     def bordered_jacobian(self, u, params: Parameters, name: str) -> np.ndarray:
-        """[∂R/∂u  ∂R/∂name] (n × (n + 1)) for the map X = (u, name) of a continuation or a constrained solve,
-        assembled in place (one state evaluation serves both parts)."""
+        """[∂R/∂u  ∂R/∂name] (n × (n + 1)) for the map X = (u, name) of a continuation or a constrained solve (one
+        state evaluation serves both parts; the Hessian is assembled contiguous, faster than into the columns)."""
         n = self.disc.size
         out = np.empty((n, n + 1))
-        self.disc.hessian(self._pointwise("energy_hessian", u, params), out[:, :n])
+        out[:, :n] = self.disc.hessian(self._pointwise("energy_hessian", u, params))
         self.parameter_derivative(u, params, name, out[:, n])
         return out
 
@@ -156,3 +199,14 @@ def enclosed_volume(disc: Discretisation, u) -> float:
     """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ λ2² η' sin²θ dθ (MODEL.md §2: the pressure term is −P V/(2π))."""
     lam2, _, _, w = disc.node_state(u)
     return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
+
+
+@njit(cache=True)
+def same_values(a, b) -> bool:
+    """Whether the 1-D arrays a and b are equal entry by entry."""
+    if a.shape[0] != b.shape[0]:
+        return False
+    for i in range(a.shape[0]):
+        if a[i] != b[i]:
+            return False
+    return True

@@ -8,7 +8,8 @@ H = 2π/a.
 
 G and its m-derivatives come from the Maclaurin series for m ≤ 1/2 and above from the closed form in K and
 N = (1 − m/2) K − E, both from the AGM (N without cancellation); 1 − m = ((a − ρ)² + ζ²)/S² is formed exactly,
-so points near a wire keep their digits.
+so points near a wire keep their digits. The series is summed only as far as m needs (``series_lengths``: the
+dropped tail of each of G, G', G'', G''' at most 2^-60 of it; all 70 generated terms for 3/8 < m ≤ 1/2).
 The jitted functions return NaN within WIRE_TOLERANCE·a of a wire (the solver treats non-finite values as
 failures); the Python-level functions raise FieldError there instead.
 
@@ -27,6 +28,40 @@ from ..generated.coil_field import STREAM_SERIES, coil_field, stream_shape_close
 SERIES_SWITCH = 0.5
 WIRE_TOLERANCE = 1e-12
 _SERIES = np.array(STREAM_SERIES)
+SERIES_TAIL = 2.0**-60  # the largest dropped tail of a shortened series, relative to the series' value
+SERIES_BOUNDS = (1 / 64, 1 / 32, 1 / 16, 1 / 8, 3 / 16, 1 / 4, 3 / 8, SERIES_SWITCH)  # m-intervals of one length
+
+
+def series_lengths(series, bounds, tail: float = SERIES_TAIL) -> np.ndarray:
+    """For each bound m_b: the fewest leading terms K of G = Σ c_k m^k such that for every m ≤ m_b and j ≤ 3 the
+    dropped terms of G^(j) = Σ_k c_k k!/(k − j)! m^(k−j) sum to at most ``tail`` · c_j j!.
+
+    All c_k are positive, so c_j j! (the first term) is a lower bound of G^(j)(m), and the dropped sum grows with
+    m: checking it at m = m_b covers the interval. (The generated series' own truncation after its last term is
+    the same for every length and not counted.)"""
+    c = np.asarray(series, dtype=float)
+    if not (c > 0.0).all():
+        raise ValueError("series_lengths: the tail bound needs positive coefficients")
+    k = np.arange(c.size, dtype=float)
+    lengths = []
+    for bound in bounds:
+        length = c.size
+        for terms in range(4, c.size):
+            dropped = k[terms:]
+            falling = np.ones_like(dropped)  # k!/(k − j)!
+            for j in range(4):
+                if (c[terms:] * falling * bound ** (dropped - j)).sum() > tail * c[j] * math.factorial(j):
+                    break
+                falling = falling * (dropped - j)
+            else:
+                length = terms
+                break
+        lengths.append(length)
+    return np.array(lengths, dtype=np.int64)
+
+
+_BOUNDS = np.array(SERIES_BOUNDS)
+_LENGTHS = series_lengths(_SERIES, SERIES_BOUNDS)
 
 
 class FieldError(ValueError):
@@ -38,7 +73,12 @@ def stream_shape(m, m1):
     """(G, G', G'', G''') at m, with m1 = 1 − m (pass 1.0 - m unless 1 − m is known more accurately)."""
     if m <= SERIES_SWITCH:
         g0 = g1 = g2 = g3 = 0.0
-        for k in range(_SERIES.shape[0] - 1, -1, -1):  # Horner for the series and its derivatives / k!
+        terms = _SERIES.shape[0]
+        for b in range(_BOUNDS.shape[0]):  # as many terms as m needs (series_lengths)
+            if m <= _BOUNDS[b]:
+                terms = _LENGTHS[b]
+                break
+        for k in range(terms - 1, -1, -1):  # Horner for the series and its derivatives / k!
             g3 = g3 * m + g2
             g2 = g2 * m + g1
             g1 = g1 * m + g0

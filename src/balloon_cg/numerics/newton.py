@@ -79,7 +79,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
         step = _scaled_size(dx, x)
         if not math.isfinite(step):
             return _failed(x, iteration, r, np.inf, "non-finite Newton step", jacobians)
-        ratio = step / previous if np.isfinite(previous) and previous > 0 else None
+        ratio = step / previous if math.isfinite(previous) and previous > 0 else None
         if ratio is not None and ratio > refresh_ratio and not fresh:
             factors = None  # a stale Jacobian contracts too slowly: drop its step, redo it with a fresh one here
             continue
@@ -89,11 +89,11 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
         error = step if ratio is None else max(step, step * min(ratio, 0.99) / (1.0 - min(ratio, 0.99)))
         if error <= tol:
             try:
-                final = float(np.abs(residual(x)).max())
+                final = max_abs(residual(x))
             except ArithmeticError as failure:
                 return NewtonResult(x, False, iteration, np.inf, step, f"state left the domain: {failure}",
                                     jacobians)
-            if not np.isfinite(final):
+            if not math.isfinite(final):
                 return NewtonResult(x, False, iteration, final, step, "non-finite residual at the solution", jacobians)
             return NewtonResult(x, True, iteration, final, step, "converged", jacobians)
         growth = growth + 1 if step > previous else 0
@@ -110,6 +110,17 @@ def finite(a) -> bool:
         if not math.isfinite(value):
             return False
     return True
+
+
+@njit(cache=True)
+def max_abs(a) -> float:
+    """max_i |a_i| of a 1-D array, NaN if an entry is NaN (as np.abs(a).max())."""
+    size = 0.0
+    for value in a:
+        if math.isnan(value):
+            return math.nan
+        size = max(size, abs(value))
+    return size
 
 
 @njit(cache=True)
