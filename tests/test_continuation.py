@@ -108,6 +108,28 @@ def test_locate_root_falls_back_to_the_best_evaluated_point():
     assert root.status == RootStatus.NEAREST and root.payload == 0.0  # brentq's first evaluations are the ends
 
 
+def test_a_failed_evaluation_near_the_root_keeps_the_narrowest_bracket():
+    """An evaluation that fails close to the root (Newton at a singular point): the root is known to lie between
+    the two evaluated neighbours of opposite sign that are closest together (``bracket``), and the end of it
+    with the smaller |value| is returned, not the whole interval's best guess."""
+    root_at, evaluated = 0.3, {}
+
+    def value_at(s):
+        if 0 < abs(s - root_at) < 1e-10:
+            raise ArithmeticError("singular")
+        evaluated[s] = (s - root_at) ** 3 + 0.1 * (s - root_at)
+        return evaluated[s], s
+
+    root = continuation.locate_root(value_at, 1.0)
+    assert root.status == RootStatus.NEAREST and root.bracket is not None
+    low, high = sorted(root.bracket)
+    assert low < root_at < high and evaluated[low] * evaluated[high] < 0
+    ordered = sorted(evaluated)
+    widths = [b - a for a, b in zip(ordered, ordered[1:]) if evaluated[a] * evaluated[b] <= 0]
+    assert high - low == min(widths) < 1.0  # Brent's own bracket (its steps here all fall on one side)
+    assert root.payload == min((low, high), key=lambda x: abs(evaluated[x]))
+
+
 def test_known_values_spare_evaluations_and_change_nothing():
     """``known`` (the bracket end the caller has computed) is used when Brent asks for it: the same root and
     payload, one evaluation fewer; a failed first evaluation still gives None (the known end is never offered

@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.results import Block, Kind, StopCode
+from balloon_cg.analysis.results import Block, Kind, Status, StopCode
 from balloon_cg.analysis.stability import assess_branch
 from balloon_cg.app.api import Result
 from balloon_cg.galerkin.equilibrium import Parameters
@@ -70,6 +70,16 @@ def test_pull_in_is_located_at_the_closed_form(pull_in_branch):
     stretch = pull_in_branch.pole_values(fold.X)["lam2_north"][0]
     assert abs(stretch - PULL_IN_STRETCH) < 1e-10
     assert abs(fold.X[-1] ** 2 - PULL_IN_VOLTAGE_SQ) < 1e-10
+
+
+def test_the_pull_in_fold_reports_the_bracket_its_search_narrowed(pull_in_branch):
+    """At the zero-tension pull-in every sphere mode is singular at once: the corrector fails ~1e-13 from the
+    fold, so the fold may be stored approximate; then its uncertainty is the narrowest sign change the root
+    search evaluated (~2e-8), not the whole continuation step (it was 3.4e-3), and it covers the closed form."""
+    fold = next(s for s in pull_in_branch.special if s.kind == Kind.LP)
+    assert fold.status == Status.LOCATED or fold.uncertainty < 1e-6
+    stretch = pull_in_branch.pole_values(fold.X)["lam2_north"][0]
+    assert abs(stretch - PULL_IN_STRETCH) <= max(fold.uncertainty, 1e-10)
 
 
 def test_voltage_branch_is_the_zero_pressure_sphere(pull_in_branch):

@@ -65,6 +65,7 @@ class Fold:
     point: Point
     index: int  # the fold lies between points[index] and points[index + 1]
     status: "RootStatus"
+    bracket: tuple | None = None  # NEAREST: the two evaluated Points of the narrowest sign change, if any
 
 
 @dataclass
@@ -75,8 +76,10 @@ class Path:
     overshoot: Point | None = None  # the first point past a stop condition (not part of the branch)
 
     def bracket(self, fold: Fold) -> tuple[np.ndarray, np.ndarray]:
-        """X of the two points a fold lies between: points[index] and the next one (the overshoot, for a fold
-        found on the step that ended the trace)."""
+        """X of the two points a fold lies between: the narrowest sign change its root search evaluated, else
+        points[index] and the next one (the overshoot, for a fold found on the step that ended the trace)."""
+        if fold.bracket is not None:
+            return fold.bracket[0].X, fold.bracket[1].X
         after = self.points[fold.index + 1] if fold.index + 1 < len(self.points) else self.overshoot
         return self.points[fold.index].X, after.X
 
@@ -109,13 +112,16 @@ class Root:
     payload: object
     status: RootStatus
     value: float  # the function's value there
+    bracket: tuple | None = None  # NEAREST: the payloads at the ends of the narrowest evaluated sign change
 
 
 def locate_root(value_at, length: float, xtol: float = 1e-13, known: dict | None = None) -> Root | None:
     """Root in (0, length) of s ↦ value_at(s)[0] (value_at returns (value, payload)) by Brent's method, and the
-    payload there. If an evaluation fails (ArithmeticError: e.g. Newton at a singular point) the evaluated point
-    with the smallest |value| is returned with status NEAREST; None if there is none. ``known``: s -> value_at(s)
-    already computed by the caller (e.g. the bracket's end), used when Brent asks for that s."""
+    payload there. If an evaluation fails (ArithmeticError: e.g. Newton at a singular point), the search stops
+    with status NEAREST: the root lies in the narrowest interval between evaluated neighbours whose values differ in
+    sign (``bracket``: their payloads), and the end of it with the smaller |value| is returned (without such an
+    interval: the evaluated point with the smallest |value|); None if nothing was evaluated. ``known``:
+    s -> value_at(s) already computed by the caller (e.g. the bracket's end), used when Brent asks for that s."""
     cache, known = {}, known or {}
 
     def f(s):
@@ -129,8 +135,14 @@ def locate_root(value_at, length: float, xtol: float = 1e-13, known: dict | None
     except (ArithmeticError, ValueError):
         if not cache:
             return None
-        value, payload = min(cache.values(), key=lambda item: abs(item[0]))
-        return Root(payload, RootStatus.NEAREST, float(value))
+        evaluated = sorted(cache.items(), key=lambda item: item[0])
+        changes = [(b[0] - a[0], a[1], b[1]) for a, b in zip(evaluated, evaluated[1:]) if a[1][0] * b[1][0] <= 0]
+        if not changes:
+            value, payload = min(cache.values(), key=lambda item: abs(item[0]))
+            return Root(payload, RootStatus.NEAREST, float(value))
+        _, low, high = min(changes, key=lambda change: change[0])
+        value, payload = min((low, high), key=lambda item: abs(item[0]))
+        return Root(payload, RootStatus.NEAREST, float(value), (low[1], high[1]))
 
 
 def rate(monitor, X: np.ndarray, t: np.ndarray) -> float:
@@ -191,7 +203,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
                 if fold is None:  # no evaluation converged: the fold is known to lie in the step, no better
                     path.folds.append(Fold(label, current, len(path.points) - 1, RootStatus.NEAREST))
                 else:
-                    path.folds.append(Fold(label, fold.payload, len(path.points) - 1, fold.status))
+                    path.folds.append(Fold(label, fold.payload, len(path.points) - 1, fold.status, fold.bracket))
         reason = stop(point)
         if reason is not None:
             path.stop = reason
