@@ -238,21 +238,3 @@ def test_equal_discretisations_share_read_only_tables():
         first.weights[0] = 1.0
     other = Discretisation(24, False, True, 0, WireMap((0.3,), (0.06,)))
     assert other.ops is not first.ops and not np.array_equal(other.x, first.x)
-
-
-def test_map_width_in_arc_length_resolves_a_gap_of_one_with_less_than_half_the_degree():
-    """Single equatorial coil, pole stretch 3 (gap ≈ 1.0, |dx/ds| ≈ 0.34 at the equator): the map of width
-    MAP_WIDTH · gap · |dx/ds| meets a relative P error of 1e-8 against shooting at degree 16, plain Legendre in x
-    needs degree 40 (3.8e-6 at 16)."""
-    scene = load_scene(SCENE.parent / "spom1_single_coil.toml").with_overrides({"continuation.stop_stretch": 3.0})
-    branch = trace_primary(scene, down=False)
-    X = branch.X[-1]
-    eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
-    shot = shoot_symmetric(scene, 3.0, X[-1], eta0, tol=1e-13)
-    assert shot.converged
-    mapping = wire_map(branch.disc, X[:-1], scene.field.coils, True)
-    assert mapping is not None and len(mapping.centres) == 1 and 0.6 < wire_gap(branch.disc, X[:-1],
-                                                                                    scene.field.coils)[0] < 1.5
-    errors = {name: abs(_solve_at(scene, branch, X, Discretisation(16, True, False, mapping=m), 3.0)[-1] / shot.P - 1)
-              for name, m in (("plain", None), ("mapped", mapping))}
-    assert errors["mapped"] < 1e-8 and errors["plain"] > 1e-6
