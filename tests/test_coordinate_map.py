@@ -132,6 +132,19 @@ def _pear_point(branch):
     return bifurcation.classify(branch, bifurcation.locate(branch, i, "odd_held", 0))
 
 
+@pytest.mark.parametrize("preset", [None, "TPOM1"])
+def test_the_paper_coil_branch_at_its_largest_field_reaches_the_wire(preset):
+    """The paper's single coil at M = 0.003 (Figs. 3–5): the primary branch reaches the wire gap within the
+    solver's resolution (main's map rule: degree 202 of 320). A map rule that widened the maps far from the wire
+    ended these branches at the resolution limit instead (found by `make paper`, not by a test)."""
+    from balloon_cg.post.paper import SINGLE_COIL, SINGLE_COIL_REACH, Case
+
+    overrides = ((("material.preset", preset),) if preset else ()) + (("field.M", 0.003),) + SINGLE_COIL_REACH
+    branch = trace_primary(Case(SINGLE_COIL, overrides).load())
+    assert branch.stopped(StopCode.WIRE_GAP), branch.stop_reason
+    assert branch.disc.degree < branch.scene.solver.max_degree
+
+
 def test_pear_point_does_not_depend_on_the_basis_map():
     """The pear pitchfork located on the two-coil branch as stored (wire-mapped basis) and on the same branch
     projected to Legendre in x (degree 96) agree: the stability basis stays in x, where the held constraint
