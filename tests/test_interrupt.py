@@ -71,3 +71,22 @@ def test_a_stop_during_stability_ends_the_analysis_at_the_next_point(tmp_path, p
     write_run(tmp_path / "partial.h5", scene, picture.branches, found=picture.incomplete)
     run = read_run(tmp_path / "partial.h5")
     assert not run["attrs"]["complete"] and "interrupted" in run["attrs"]["incomplete_gaps"]
+
+
+def test_a_stop_while_branch_points_are_located_keeps_those_located(monkeypatch):
+    """A stop asked for during the location of the first branch point: that one is kept (located and
+    classified), no other is started, no pear branch is traced, the special points stay in order."""
+    from balloon_cg.analysis import bifurcation
+
+    locate = bifurcation.locate
+
+    def interrupted_locate(*args, **kw):
+        interrupt.request()  # as the handler does, in the middle of the location
+        return locate(*args, **kw)
+
+    monkeypatch.setattr(bifurcation, "locate", interrupted_locate)
+    with interrupt.stop_on_signals():
+        picture = analyse(load_scene("spom1"))
+    assert picture.interrupted and len(picture.branch_points) == 1 and len(picture.branches) == 1
+    indices = [s.index for s in picture.primary.special]
+    assert indices == sorted(indices)

@@ -118,8 +118,7 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
     primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
     progress.finish(Phase.PRIMARY, len(primary.X))
     picture = Picture([primary])
-    if interrupt.requested():
-        picture.interrupted = True
+    if _stopped(picture):
         return picture
     if not _assess(primary, scene, primary.disc.symmetric, progress):
         picture.interrupted = True
@@ -130,31 +129,35 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
                                 "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
         return picture
     for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
-        if interrupt.requested():
-            picture.interrupted = True
-            return picture
+        if _stopped(picture):
+            break
         bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
         mode = "pear (odd)" if block == Block.ODD_HELD else "equator-symmetric (even)"
         bp.note = f"{mode} mode, branch point {n}"
         picture.branch_points.append(bp)
         primary.special.append(bp)
     primary.special.sort(key=lambda s: s.index)
+    if _stopped(picture):
+        return picture
     if pear:
         _trace_pears(scene, primary, picture, progress)
         progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
     progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
-    if interrupt.requested():
-        picture.interrupted = True
-        return picture
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
-        if interrupt.requested():
-            picture.interrupted = True
+        if _stopped(picture):
             return picture
         degrees = [a.degree for a in branch.stability]
         branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
     picture.snaps = snap_throughs(picture.branches, scene.loading.control)
     return picture
+
+
+def _stopped(picture: Picture) -> bool:
+    """Whether a signal asked the analysis to stop (``numerics.interrupt``); the picture is then ``interrupted``."""
+    if interrupt.requested():
+        picture.interrupted = True
+    return picture.interrupted
 
 
 def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
