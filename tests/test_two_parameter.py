@@ -174,7 +174,7 @@ def test_phase_diagram_plot(curve, tmp_path):
     assert len(shaded.get_xy()) >= 400 > len(read_curve(path)["q"])
     fig.savefig(tmp_path / "phase.png")
     assert (tmp_path / "phase.png").stat().st_size > 1000
-    for kind in ("pressure-pole", "shapes", "energy"):  # a curve file has no branches: no empty figure
+    for kind in ("pressure-pole", "shapes", "energy", None):  # a curve file has no branches: no empty figure
         with pytest.raises(PlotError, match="no branches to draw .* its kind is phase"):
             plot([path], kind)
 

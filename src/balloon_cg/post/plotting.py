@@ -314,7 +314,8 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
     sources = [sources] if isinstance(sources, (str, Path, dict)) else list(sources)
     if what is None:
         sources = [as_run(s) for s in sources]
-        what = f"{ordinate_of(sources[0]['branches']['primary']).prefix}-pole"
+        stored = list(sources[0]["branches"].values())  # none in a curve file: load_branches says so in one line
+        what = f"{ordinate_of(stored[0]).prefix}-pole" if stored else "pressure-pole"
     if what not in KINDS:
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
     if what == "phase":
