@@ -51,8 +51,7 @@ def detect(branch: Branch, assessments) -> list[tuple[int, Block, int]]:
     """(index, block, k) of every change of the number of negative eigenvalues of the pear or even block
     between neighbouring points, one per eigenvalue k (from the lowest, 0) that crosses zero. Changes of the
     even block at a fold in the continuation parameter (P or Φ̄) are the fold itself, not a branch point."""
-    folds = frozenset(s.index for s in branch.special if s.kind == Kind.LP)
-    return branch_point_crossings(assessments, 0, folds)
+    return branch_point_crossings(assessments, 0, branch.fold_intervals)
 
 
 @limited_blas

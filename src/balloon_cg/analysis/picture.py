@@ -21,7 +21,7 @@ from .control import control_values, minimised_energy
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, StopCode
-from .stability import assess_branch
+from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
 from .verdict import Gap, Incomplete, incomplete
 from ..numerics import interrupt
@@ -146,8 +146,7 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
         if _stopped(picture):
             return picture
-        degrees = [a.degree for a in branch.stability]
-        branch.special += azimuthal_points.find(branch, degrees, scene.stability.m_max)
+        branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
     picture.snaps = snap_throughs(picture.branches, scene.loading.control)
     return picture

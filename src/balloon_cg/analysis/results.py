@@ -206,6 +206,11 @@ class Branch:
         return self.params.with_value(self.parameter, X[-1])
 
     @property
+    def fold_intervals(self) -> frozenset:
+        """The intervals (between points i and i + 1) that hold a fold in the continuation parameter (LP)."""
+        return frozenset(s.index for s in self.special if s.kind == Kind.LP)
+
+    @property
     def stop_reason(self) -> str:
         """Why the branch ended, for people (``legs`` hold the codes)."""
         text = "; ".join(f"{leg.label}: {leg.stop.message}" for leg in self.legs)

@@ -36,7 +36,6 @@ from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
 from .resolution import Resolution
-from .results import Kind
 from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
@@ -288,7 +287,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
     results = [first(n, N) for n, N in enumerate(degrees)]
     unsettled = []
     if check:
-        folds = frozenset(s.index for s in branch.special if s.kind == Kind.LP)
+        folds = branch.fold_intervals
         followed = follow_modes(results, degrees, assess, lambda N: check_degree(branch, N),
                                 lambda found: branch_point_crossings(found, m_max, folds))
         results, degrees = followed.assessments, followed.degrees
