@@ -170,7 +170,7 @@ def test_every_crossing_eigenvalue_is_an_event():
     def assessment(odd, even):
         return SimpleNamespace(blocks={Block.ODD_HELD: np.array(odd), Block.EVEN: np.array(even)})
 
-    branch = SimpleNamespace(special=[])
+    branch = SimpleNamespace(fold_intervals=frozenset())  # no fold (Branch.fold_intervals)
     events = detect(branch, [assessment([0.5, 1.0, 2.0], [1.0, 2.0, 3.0]),
                              assessment([-0.5, -0.1, 2.0], [1.0, 2.0, 3.0])])
     assert events == [(0, Block.ODD_HELD, 0), (0, Block.ODD_HELD, 1)]
