@@ -133,8 +133,7 @@ def _right_hand_side(r, rows, targets, x, rhs):
         total = 0.0
         for j in range(x.shape[0]):
             total += rows[k, j] * x[j]
-        rhs[n + k] = targets[k] - total
-    return rhs
+        rhs[n + k] = targets[k] - total  # returns nothing: boxing a returned array costs ~0.4 µs a call
 
 
 @njit(cache=True)
