@@ -45,9 +45,10 @@ def symmetric_rows(pairs) -> np.ndarray:
 
 
 _HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
-# below this many unknowns the gradient and the Hessian are assembled in jitted loops, from it by BLAS (the loops
-# win while call overhead dominates: Hessian at 9 unknowns 1.3 µs against 6.7 µs, at 25 5.9 against 8.1, at 33
-# 18 against 9.6; measured single-threaded)
+# below this many unknowns the node state, the gradient and the Hessian are computed in jitted loops, from it by
+# BLAS (the loops win while call overhead dominates: Hessian at 9 unknowns 1.3 µs against 6.7 µs, at 25 5.9 against
+# 8.1, at 33 18 against 9.6; node state at 9 0.4 against 1.2, at 29 0.8 against 1.5, at 49 1.8 against 2.0, at 97
+# 10 against 5; measured single-threaded)
 SMALL_SYSTEM = 30
 
 
@@ -163,6 +164,22 @@ def _gradient_loops(pointwise, weights, ops, out):
                 out[i] += c * ops[k, q, i]
 
 
+@njit(cache=True)
+def _state_loops(A, B, u, out):
+    """Discretisation.node_state: (λ2, v) = A·a and (η, w) = B·b at every node, u = (a, b)."""
+    na = A.shape[2]
+    for q in range(A.shape[1]):
+        for k in range(2):
+            total = 0.0
+            for i in range(na):
+                total += A[k, q, i] * u[i]
+            out[k, q] = total
+            total = 0.0
+            for i in range(B.shape[2]):
+                total += B[k, q, i] * u[na + i]
+            out[2 + k, q] = total
+
+
 @functools.lru_cache(maxsize=64)
 def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None):
     """(P_k(s), dP_k/dx) at x = cos θ, s = h(x), for a θ grid met again and again (stability nodes, profiles)."""
@@ -218,9 +235,14 @@ class Discretisation:
     def join(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.concatenate([a[self.a_index], b[self.b_index]])
 
-    def node_state(self, u: np.ndarray) -> np.ndarray:
-        """(λ2, v, η, w) at the quadrature nodes, shape (4, n_q)."""
-        return self.ops @ u
+    def node_state(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """(λ2, v, η, w) = ops @ u at the quadrature nodes, shape (4, n_q) (into ``out`` if given); below
+        SMALL_SYSTEM unknowns a jitted loop over the blocks of ops that are not zero (``_state_loops``)."""
+        out = np.empty((4, self.weights.size)) if out is None else out
+        if self.size < SMALL_SYSTEM:
+            _state_loops(self.basis_a, self.basis_b, u, out)
+            return out
+        return np.matmul(self.ops, u, out=out)
 
     def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q) (into ``out`` if given)."""

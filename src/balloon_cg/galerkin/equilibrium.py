@@ -134,7 +134,7 @@ class Equilibrium:
         """The node state (Discretisation.node_state) and field of u into the held arrays; u and the material
         values held once the domain check passed."""
         self._holding = False
-        np.matmul(self.disc.ops, u, out=self._state)
+        self.disc.node_state(u, self._state)
         if self.coils.shape[0]:
             np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
             field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
