@@ -8,8 +8,9 @@ is judged by what it changes:
 (b) the lowest eigenvalues of every stability block (``SecondVariation.assess``, perturbation degree 20 and
     the equilibrium's own degree, the one ``bifurcation.locate`` uses) at those solutions;
 (c) located branch points with the rule as the default of every discretisation (equilibria, stability bases,
-    extended systems): SPOM1 at M = 0 against the closed-form pear stretches (``sphere_modes``), and the
-    two-coil (M = 0.001) first pear pitchfork against the default rule;
+    extended systems): SPOM1 at M = 0 against the closed-form pear stretches (``sphere_modes``), the two-coil
+    (M = 0.001) first pear pitchfork and both pear pitchforks of one coil of radius 2 (M = 0.001, the near-wire
+    scene of tests/test_branch_points.py) against the rule 2N + 16;
 (d) the CPU time of one constrained Newton solve, best of REPEAT, the rules interleaved in every repeat, as a
     ratio to the default rule (BLAS single-threaded, as in work_precision).
 
@@ -35,6 +36,8 @@ RULES = {
     "5N/4 + 8": lambda n: (5 * n) // 4 + 8,
     DEFAULT: discretisation.gauss_nodes,
 }
+FINE = "2N + 16"  # a rule converged in the node count at the branch points (3N + 16 agrees to 1e-10): their reference
+FINE_NODES = lambda n: 2 * n + 16  # noqa: E731
 DEGREES = (8, 12, 16, 20, 24, 28, 32, 40, 48, 64, 96)
 STABILITY_AT = (16, 28, 48)  # equilibrium degrees whose solutions are assessed
 STABILITY_DEGREE = 20
@@ -151,6 +154,28 @@ def format_points(case, targets, settings, rows):
     return lines
 
 
+def summary(settings, rows) -> list:
+    """Per rule: the CPU time ratio to the default at degrees 20–48 (median, range) and the largest ratio of its
+    P error to the default's where the default's lies in (1e-11, 1e-6] (above the rounding floor, at degrees a
+    tolerance of the order of solver.max_error would choose)."""
+    lines = []
+    for name in list(RULES)[:-1]:
+        ratios, worse = [], []
+        for t, d, basis in settings:
+            r, r0 = rows.get((name, t.stretch, d, basis)), rows.get((DEFAULT, t.stretch, d, basis))
+            if not (r and r0 and r["converged"] and r0["converged"]):
+                continue
+            if 20 <= d <= 48:
+                ratios.append(r["time"] / r0["time"])
+            if 1e-11 < r0["error"] <= 1e-6:
+                worse.append((r["error"] / r0["error"], t.stretch, d, basis or "x"))
+        top = max(worse) if worse else (np.nan, np.nan, 0, "-")
+        lines.append(f"  {name:>9}: CPU time / default at N = 20–48: median {np.median(ratios):.2f} "
+                     f"(range {min(ratios):.2f}–{max(ratios):.2f}); largest P error / default's error (default's "
+                     f"in (1e-11, 1e-6]): {top[0]:.2f} (λ* = {top[1]}, N = {top[2]}, {top[3]})")
+    return lines
+
+
 def format_spectra(found):
     names = list(RULES)
     lines = [f"  stability (b): the {3} lowest eigenvalues of every block (perturbation degree N_s) at the degree-N "
@@ -225,17 +250,17 @@ def branch_points():
              "extended systems)"]
     exact = bifurcation_stretches(get_preset("SPOM1"), 1, lam_max=8.0)
     found = {}
-    for name, nodes in RULES.items():
+    for name, nodes in {**RULES, FINE: FINE_NODES}.items():
         with default_rule(nodes):
             found[name] = {}
             for label, locate in (("sphere", sphere_pear_points), ("two coils", two_coil_pear_point),
                                   ("near wire", near_wire_pitchforks)):
                 t0 = time.perf_counter()
                 found[name][label] = (locate(), time.perf_counter() - t0)
-    reference = found[DEFAULT]
+    reference = found[FINE]
     lines.append(f"  SPOM1, M = 0, pear points: closed-form λ = {', '.join(f'{x:.12f}' for x in exact)}; two coils "
                  f"M = 0.001, first pear pitchfork, and one coil of radius 2 at M = 0.001, both pear pitchforks: "
-                 "P − P(default rule); wall time of trace + assessment + location")
+                 f"P − P({FINE}); wall time of trace + assessment + location")
     for name, points in found.items():
         sphere, t_sphere = points["sphere"]
         lam = np.array([s[0] for s in sphere])
@@ -259,7 +284,8 @@ def main():
     for case in wp.cases():
         branch, _, targets = wp.prepare(case)
         solvers, settings, rows, maps = point_rows(case, branch, targets)
-        block = format_points(case, targets, settings, rows) + format_spectra(spectra(solvers, targets, rows, maps))
+        block = (format_points(case, targets, settings, rows) + summary(settings, rows)
+                 + format_spectra(spectra(solvers, targets, rows, maps)))
         print("\n".join(block), flush=True)
         lines += block + [""]
     block = branch_points()
