@@ -182,7 +182,8 @@ def format_spectra(found):
              "solution of each rule, against the same at the best-resolved solution (default rule, degree "
              f"{max(DEGREES)}, wire-mapped where there is one): max relative error per rule; the reference's lowest "
              "even and odd_held eigenvalues"]
-    lines.append(f"  {'λ*':>5} {'N':>4} {'N_s':>4} {'even':>12} {'odd_held':>12} " + " ".join(f"{n:>10}" for n in names))
+    lines.append(f"  {'λ*':>5} {'N':>4} {'N_s':>4} {'even':>12} {'odd_held':>12} "
+                 + " ".join(f"{n:>10}" for n in names))
     for key in sorted(k for k in found if k[0] == REFERENCE):
         _, stretch, d, n_s = key
         ref = found[key]
