@@ -1,13 +1,17 @@
-"""Benchmark: a 21-member sweep, M = 0 .. 0.005 on the single-coil SPOM1 scene (stop_stretch 3), each member the
-full analysis (primary branch, stability, branch points, pear branches; about 0.5-1 s per member).
+"""Benchmark: a 21-member sweep over M, each member the full analysis (primary branch, stability, branch points,
+pear branches). Two studies (``--study``): ``single-coil`` (default), M = 0 .. 0.005 on the single-coil SPOM1
+scene (stop_stretch 3, about 0.5-1 s per member); ``two-coils``, M = 0 .. 0.003 on the paper's two-coil SPOM1
+scene (issue 14's sweep; the largest fields bring the membrane close to the wires).
 
 Runs the command ``balloon-cg sweep`` in a fresh interpreter each time (worker start-up and numba cache loading
 included; the time of importing balloon_cg in the parent is shown separately) serially (--workers 1) and on 2
 local worker processes, then the same members on a dask LocalCluster of 2 single-threaded worker processes
 (cluster start-up excluded). Prints a table with the speed-up
 over serial (floor: >= 1.7x for 2 workers on an otherwise idle 2-core machine) and checks that every run stored
-the same members. Run: python benchmarks/sweep.py  (output also in benchmarks/results/sweep.txt)
+the same members. Run: python benchmarks/sweep.py [--study two-coils]
+(output also in benchmarks/results/sweep.txt, or sweep_two_coils.txt)
 """
+import argparse
 import os
 import subprocess
 import sys
@@ -22,22 +26,25 @@ from balloon_cg.app.sweep import run_sweep
 from balloon_cg.io.sweep_file import read_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENE = ROOT / "scenes" / "spom1_single_coil.toml"
-VARY = ["M=0:0.005:21", "stop_stretch=3"]
+# study -> (scene, --vary arguments, results file)
+STUDIES = {
+    "single-coil": (ROOT / "scenes" / "spom1_single_coil.toml", ["M=0:0.005:21", "stop_stretch=3"], "sweep.txt"),
+    "two-coils": (ROOT / "scenes" / "spom1_two_coils_M0.002.toml", ["M=0:0.003:21"], "sweep_two_coils.txt"),
+}
 MODE_FLAG = None  # full analysis
 CHILD = "import sys, time; from balloon_cg.app.cli import main; t = time.perf_counter(); main(sys.argv[1:]); print(time.perf_counter() - t)"
 
 
-def cli_run(out: Path, workers: int) -> tuple[float, float]:
+def cli_run(scene: Path, vary: list, out: Path, workers: int) -> tuple[float, float]:
     """(wall time of the sweep command after import, wall time of the whole process)."""
-    argv = [sys.executable, "-c", CHILD, "sweep", str(SCENE), *sum((["--vary", v] for v in VARY), []),
+    argv = [sys.executable, "-c", CHILD, "sweep", str(scene), *sum((["--vary", v] for v in vary), []),
             "-o", str(out), *([MODE_FLAG] if MODE_FLAG else []), "--workers", str(workers), "--quiet"]
     start = time.perf_counter()
     done = subprocess.run(argv, check=True, capture_output=True, text=True)
     return float(done.stdout.split()[-1]), time.perf_counter() - start
 
 
-def dask_run(out: Path) -> float | None:
+def dask_run(scene: Path, vary: list, out: Path) -> float | None:
     try:
         from distributed import LocalCluster
     except ImportError:
@@ -45,7 +52,7 @@ def dask_run(out: Path) -> float | None:
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster:
         start = time.perf_counter()
-        run_sweep(load_scene(SCENE), VARY, out, mode="analysis", scheduler=cluster.scheduler_address)
+        run_sweep(load_scene(scene), vary, out, mode="analysis", scheduler=cluster.scheduler_address)
         t = time.perf_counter() - start
         return t, t
 
@@ -62,20 +69,23 @@ def member_sum(path: Path) -> float:
 
 
 def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--study", choices=sorted(STUDIES), default="single-coil")
+    scene, vary, result_name = STUDIES[parser.parse_args().study]
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        cli_run(tmp / "warm.h5", 1)  # numba cache warm for every run below
-        rows = [("serial (--workers 1)", cli_run(tmp / "serial.h5", 1), tmp / "serial.h5"),
-                ("local pool, 2 workers", cli_run(tmp / "pool.h5", 2), tmp / "pool.h5")]
-        t = dask_run(tmp / "dask.h5")
+        cli_run(scene, vary, tmp / "warm.h5", 1)  # numba cache warm for every run below
+        rows = [("serial (--workers 1)", cli_run(scene, vary, tmp / "serial.h5", 1), tmp / "serial.h5"),
+                ("local pool, 2 workers", cli_run(scene, vary, tmp / "pool.h5", 2), tmp / "pool.h5")]
+        t = dask_run(scene, vary, tmp / "dask.h5")
         if t is not None:
             rows.append(("dask LocalCluster, 2 workers", t, tmp / "dask.h5"))
         members = read_sweep(tmp / "serial.h5")["members"]
         member_time = [m["attrs"]["wall_time"] for m in members.values()]
         serial = rows[0][1][0]
         lines = [
-            f"sweep benchmark: {SCENE.name}, --vary {' --vary '.join(VARY)}, {MODE_FLAG or 'full analysis'}: "
+            f"sweep benchmark: {scene.name}, --vary {' --vary '.join(vary)}, {MODE_FLAG or 'full analysis'}: "
             f"{len(members)} members",
             f"per-member compute time (serial run): mean {np.mean(member_time):.2f} s, "
             f"min {min(member_time):.2f} s, max {max(member_time):.2f} s",
@@ -94,7 +104,7 @@ def main():
                   "competed for the cores with other processes."]
     text = "\n".join(lines)
     print(text)
-    out = ROOT / "benchmarks" / "results" / "sweep.txt"
+    out = ROOT / "benchmarks" / "results" / result_name
     out.write_text(text + "\n")
 
 

@@ -65,10 +65,11 @@ def cases():
 
 
 class PointSolver:
-    """The pole-stretch-constrained Newton of one scene on fixed-degree discretisations (as PrimaryTracer)."""
+    """The pole-stretch-constrained Newton of one scene on fixed-degree discretisations (as PrimaryTracer);
+    ``nodes(degree)``: the Gauss nodes of its quadrature (None: the default rule)."""
 
-    def __init__(self, scene, params):
-        self.scene, self.params = scene, params
+    def __init__(self, scene, params, nodes=None):
+        self.scene, self.params, self.nodes = scene, params, nodes
         self.symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
         held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
         self.pin = (not scene.field.coils) or held
@@ -79,7 +80,7 @@ class PointSolver:
         from balloon_cg.galerkin.equilibrium import Equilibrium
 
         if (degree, mapping) not in self._eq:
-            disc = Discretisation(degree, self.symmetric, self.pin, mapping=mapping)
+            disc = Discretisation(degree, self.symmetric, self.pin, self.nodes(degree) if self.nodes else 0, mapping)
             self._eq[degree, mapping] = Equilibrium(self.scene, disc)
         return self._eq[degree, mapping]
 

@@ -23,7 +23,7 @@ from balloon_cg.analysis import azimuthal
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.stability import SecondVariation
-from balloon_cg.galerkin.discretisation import SMALL_GRADIENT, SMALL_SYSTEM, Discretisation, _HESSIAN_ROW
+from balloon_cg.galerkin.discretisation import SMALL_GRADIENT, SMALL_SYSTEM, Discretisation, _HESSIAN_ROW, gauss_nodes
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import field
 from balloon_cg.numerics import eigen
@@ -49,7 +49,7 @@ def _embed(symmetric: Discretisation, general: Discretisation, u):
 def test_symmetric_half_nodes_match_every_node(two_coils, degree):
     scene, branch = two_coils
     sym = Discretisation(degree, True, False)
-    full = Discretisation(degree, False, False, quadrature=(3 * degree) // 2 + 8)
+    full = Discretisation(degree, False, False, quadrature=gauss_nodes(degree))
     assert sym.cos_theta.size < full.cos_theta.size and sym.x.size == full.x.size
     X = branch.disc.transfer(branch.X[len(branch.X) // 2], sym)
     u, params = X[:-1], branch.params.with_value("P", X[-1])

@@ -31,7 +31,7 @@ import numpy as np
 
 from .azimuthal import merged_lowest, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
-from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half
+from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
@@ -71,7 +71,7 @@ class SecondVariation:
 
     def __init__(self, equilibrium, degree: int):
         self.eq = equilibrium
-        quadrature = max(equilibrium.disc.x.size, (3 * degree) // 2 + 8)
+        quadrature = max(equilibrium.disc.x.size, gauss_nodes(degree))
         # Legendre in x even when the equilibrium's basis is mapped: the held blocks drop b_0, i.e. ∫η dx = 0,
         # which is the same physical constraint only in this basis
         self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature)

@@ -339,11 +339,16 @@ class Discretisation:
         return last * rate / (1.0 - rate)
 
 
+def gauss_nodes(degree: int) -> int:
+    """Gauss–Legendre nodes of the default rule at Legendre degree N (``Discretisation.quadrature`` = 0)."""
+    return (3 * degree) // 2 + 8
+
+
 @functools.lru_cache(maxsize=16)
 def _tables(disc: Discretisation) -> dict:
     """The node, weight and basis tables of a Discretisation (keyed by its five fields: equal discretisations
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
-    n_q = disc.quadrature or (3 * disc.degree) // 2 + 8
+    n_q = disc.quadrature or gauss_nodes(disc.degree)
     nodes, s_weights = legendre.leggauss(n_q)
     p, dp = legendre_table(nodes, disc.degree)
     if disc.mapping is None:
