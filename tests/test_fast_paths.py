@@ -3,7 +3,8 @@
 - Equator-symmetric states integrate on the Gauss nodes x ≥ 0 with doubled weights (``even_half``): the
   residual, Hessian, ∂R/∂M, energy and volume of a symmetric discretisation against the general one (every
   node) at the same state, with two coils; the stability blocks (m = 0 and m = 1) against the full assembly.
-- Below SMALL_SYSTEM unknowns the gradient and Hessian are jitted loops: against an einsum of the node tables.
+- Below SMALL_SYSTEM unknowns the node state and the Hessian, below SMALL_GRADIENT the gradient, are jitted loops:
+  against an einsum of the node tables.
 - The lowest eigenvalues below SMALL_EIGEN rows (tridiagonalisation and bisection) against LAPACK's full
   spectrum, with clustered, repeated and tiny eigenvalues; orthogonal Gram factors against Cholesky.
 - The node state and coil field the Equilibrium holds (in arrays of its own) against Discretisation.node_state
@@ -22,7 +23,7 @@ from balloon_cg.analysis import azimuthal
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.stability import SecondVariation
-from balloon_cg.galerkin.discretisation import SMALL_SYSTEM, Discretisation, _HESSIAN_ROW, gauss_nodes
+from balloon_cg.galerkin.discretisation import SMALL_GRADIENT, SMALL_SYSTEM, Discretisation, _HESSIAN_ROW, gauss_nodes
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import field
 from balloon_cg.numerics import eigen
@@ -77,6 +78,17 @@ def test_small_system_loops_match_the_node_sums():
     assert np.abs(disc.hessian(hessian_rows) - expected).max() <= 1e-13 * np.abs(expected).max()
     gradient = np.einsum("kqi,kq,q->i", ops, gradient_rows, disc.weights)
     assert np.abs(disc.gradient(gradient_rows) - gradient).max() <= 1e-13 * np.abs(gradient).max()
+    u = rng.normal(size=disc.size)
+    state = np.einsum("kqi,i->kq", ops, u)
+    assert np.abs(disc.node_state(u) - state).max() <= 1e-13 * np.abs(state).max()
+
+
+def test_gradient_loops_up_to_small_gradient_match_the_node_sums():
+    disc = Discretisation(40, False, True)
+    assert SMALL_SYSTEM <= disc.size < SMALL_GRADIENT
+    rows = np.random.default_rng(4).normal(size=(4, disc.weights.size))
+    gradient = np.einsum("kqi,kq,q->i", disc.ops, rows, disc.weights)
+    assert np.abs(disc.gradient(rows) - gradient).max() <= 1e-13 * np.abs(gradient).max()
 
 
 def test_stability_blocks_on_half_nodes_match_the_full_assembly(two_coils):

@@ -2,8 +2,9 @@
 Jacobian only when the corrections stop contracting fast, and reports failures instead of returning garbage."""
 import numpy as np
 import pytest
+from scipy.linalg.lapack import dgetrf, dgetrs
 
-from balloon_cg.numerics.newton import newton
+from balloon_cg.numerics.newton import SMALL_SOLVE, _correction, newton
 
 
 def circle_and_line():
@@ -79,3 +80,21 @@ def test_non_finite_residual_at_the_end_is_not_convergence():
 
     result = newton(residual, lambda z: np.array([[1.0, 0.0]]), (0.0, 0.0), np.array([[0.0, 1.0]]), 0.0, 1e-12, 10)
     assert not result.converged and "non-finite" in result.message
+
+
+@pytest.mark.parametrize("size", [2, 9, 30, SMALL_SOLVE - 1])
+def test_jitted_correction_is_the_lapack_solve(size):
+    """Below SMALL_SOLVE unknowns the correction comes from _correction's substitutions on dgetrf's factors: against
+    scipy's dgetrs on the same factors (a matrix whose rows need interchanging) and the scaled size."""
+    rng = np.random.default_rng(size)
+    A = rng.normal(size=(size, size)) + np.diag(np.full(size, 0.1))
+    A = A[rng.permutation(size)]
+    k = 1  # one bordering row
+    r, rows, targets, x = rng.normal(size=size - k), A[size - k:], rng.normal(size=k), rng.normal(size=size)
+    lu, pivots, info = dgetrf(np.asfortranarray(A))
+    assert info == 0 and (pivots != np.arange(size)).any()
+    expected, _ = dgetrs(lu, pivots, np.concatenate([-r, targets - rows @ x]))
+    dx = np.empty(size)
+    step = _correction(lu, pivots, r, rows, targets, x, dx)
+    assert np.abs(dx - expected).max() <= 1e-12 * np.abs(expected).max()
+    assert step == pytest.approx(np.max(np.abs(dx) / (1.0 + np.abs(x))), rel=1e-15)

@@ -92,24 +92,24 @@ class SecondVariation:
         self._even = self._even_tables() if self.eq.disc.symmetric else None
 
     def _even_tables(self) -> tuple:
-        """(state map, geometry, weights, basis_a, basis_b, ops, gradient ops) on the nodes x ≥ 0 (``even_half``)."""
+        """(state map, geometry, weights, basis_a, basis_b, gradient ops) on the nodes x ≥ 0 (``even_half``)."""
         b = self.basis
         keep, weights = even_half(b.x, b.weights)
         n_q = b.x.size
         state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])
         ops = np.ascontiguousarray(b.ops[:, keep])
         return (state_map, (b.cos_theta[keep], b.sin_theta[keep]), weights, np.ascontiguousarray(b.basis_a[:, keep]),
-                np.ascontiguousarray(b.basis_b[:, keep]), ops, np.ascontiguousarray(ops.reshape(-1, b.size).T))
+                np.ascontiguousarray(b.basis_b[:, keep]), np.ascontiguousarray(ops.reshape(-1, b.size).T))
 
     def _even_matrices(self, u, params: Parameters):
         """``matrices`` of an equator-symmetric state, exact on the blocks even and odd only (entries between them,
         odd integrands, are not zero here and must not be read)."""
-        state_map, geometry, weights, basis_a, basis_b, ops, gradient_ops = self._even
+        state_map, geometry, weights, basis_a, basis_b, gradient_ops = self._even
         state = tuple((np.asarray(u, dtype=float) @ state_map).reshape(4, -1))
         hessian = assemble_hessian(self.eq.pointwise("energy_hessian", geometry, state, params), weights, basis_a,
                                    basis_b)
-        volume = -assemble_gradient(self.eq.pointwise("pressure_gradient", geometry, state, params), weights, ops,
-                                    gradient_ops)
+        volume = -assemble_gradient(self.eq.pointwise("pressure_gradient", geometry, state, params), weights,
+                                    basis_a, basis_b, gradient_ops)
         return hessian, volume
 
     def matrices(self, u, params: Parameters):

@@ -45,10 +45,14 @@ def symmetric_rows(pairs) -> np.ndarray:
 
 
 _HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
-# below this many unknowns the gradient and the Hessian are assembled in jitted loops, from it by BLAS (the loops
-# win while call overhead dominates: Hessian at 9 unknowns 1.3 µs against 6.7 µs, at 25 5.9 against 8.1, at 33
-# 18 against 9.6; measured single-threaded)
+# below this many unknowns the node state and the Hessian are computed in jitted loops, from it by BLAS
+# (the loops win while call overhead dominates: Hessian at 9 unknowns 1.3 µs against 6.7 µs, at 25 5.9 against
+# 8.1, at 33 18 against 9.6; node state at 9 0.4 against 1.2, at 29 0.8 against 1.5, at 49 1.8 against 2.0, at 97
+# 10 against 5; measured single-threaded)
 SMALL_SYSTEM = 30
+# the gradient's loops (over the blocks of ops that are not zero) win longer: 1.0 µs against 2.3 at 29 unknowns,
+# 1.8 against 3.0 at 49, 3.1 against 3.5 at 65, 4.5 against 4.6 at 97, 8.0 against 6.3 at 129
+SMALL_GRADIENT = 100
 
 
 @njit(cache=True)
@@ -79,12 +83,13 @@ def even_half(x: np.ndarray, weights: np.ndarray):
     return keep, np.where(x[keep] > 0.0, 2.0, 1.0) * weights[keep]
 
 
-def assemble_gradient(pointwise, weights, ops, gradient_ops, out=None) -> np.ndarray:
-    """Σ_q W_q Σ_k g_k(q) ops[k, q, :] for g (4, n_q); ``gradient_ops`` is ops as a contiguous (size, 4 n_q)."""
-    size = ops.shape[2]
-    if size < SMALL_SYSTEM:
+def assemble_gradient(pointwise, weights, A, B, gradient_ops, out=None) -> np.ndarray:
+    """Σ_q W_q Σ_k g_k(q) ops[k, q, :] for g (4, n_q), ops' blocks that are not zero A = (∂λ2, ∂v)/∂a (2, n_q, n_a)
+    and B = (∂η, ∂w)/∂b (2, n_q, n_b); ``gradient_ops`` is ops as a contiguous (size, 4 n_q)."""
+    size = A.shape[2] + B.shape[2]
+    if size < SMALL_GRADIENT:
         out = np.empty(size) if out is None else out
-        _gradient_loops(np.ascontiguousarray(pointwise), weights, ops, out)
+        _gradient_loops(np.ascontiguousarray(pointwise), weights, A, B, out)
         return out
     return np.matmul(gradient_ops, (pointwise * weights).ravel(), out=out)
 
@@ -153,14 +158,36 @@ def _hessian_loops(pointwise, weights, A, B, out):
 
 
 @njit(cache=True)
-def _gradient_loops(pointwise, weights, ops, out):
-    """Discretisation.gradient: out_i = Σ_k Σ_q W_q g_k(q) ops[k, q, i]."""
+def _gradient_loops(pointwise, weights, A, B, out):
+    """Discretisation.gradient: out_i = Σ_k Σ_q W_q g_k(q) ∂state_k(q)/∂u_i over the blocks of ops that are not zero
+    (A = (∂λ2, ∂v)/∂a, B = (∂η, ∂w)/∂b), in the order of the sum over all of ops (the zeros add nothing)."""
+    na = A.shape[2]
     out[:] = 0.0
     for k in range(4):
         for q in range(weights.shape[0]):
             c = weights[q] * pointwise[k, q]
-            for i in range(out.shape[0]):
-                out[i] += c * ops[k, q, i]
+            if k < 2:
+                for i in range(na):
+                    out[i] += c * A[k, q, i]
+            else:
+                for i in range(B.shape[2]):
+                    out[na + i] += c * B[k - 2, q, i]
+
+
+@njit(cache=True)
+def _state_loops(A, B, u, out):
+    """Discretisation.node_state: (λ2, v) = A·a and (η, w) = B·b at every node, u = (a, b)."""
+    na = A.shape[2]
+    for q in range(A.shape[1]):
+        for k in range(2):
+            total = 0.0
+            for i in range(na):
+                total += A[k, q, i] * u[i]
+            out[k, q] = total
+            total = 0.0
+            for i in range(B.shape[2]):
+                total += B[k, q, i] * u[na + i]
+            out[2 + k, q] = total
 
 
 @functools.lru_cache(maxsize=64)
@@ -218,13 +245,18 @@ class Discretisation:
     def join(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.concatenate([a[self.a_index], b[self.b_index]])
 
-    def node_state(self, u: np.ndarray) -> np.ndarray:
-        """(λ2, v, η, w) at the quadrature nodes, shape (4, n_q)."""
-        return self.ops @ u
+    def node_state(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """(λ2, v, η, w) = ops @ u at the quadrature nodes, shape (4, n_q) (into ``out`` if given); below
+        SMALL_SYSTEM unknowns a jitted loop over the blocks of ops that are not zero (``_state_loops``)."""
+        out = np.empty((4, self.weights.size)) if out is None else out
+        if self.size < SMALL_SYSTEM:
+            _state_loops(self.basis_a, self.basis_b, u, out)
+            return out
+        return np.matmul(self.ops, u, out=out)
 
     def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_k g_k(q) ∂state_k(q)/∂u for pointwise derivatives g (4, n_q) (into ``out`` if given)."""
-        return assemble_gradient(pointwise, self.weights, self.ops, self._gradient_ops, out)
+        return assemble_gradient(pointwise, self.weights, self.basis_a, self.basis_b, self._gradient_ops, out)
 
     def hessian(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is energy_hessian's output (10, n_q), the

@@ -63,13 +63,15 @@ class Equilibrium:
         # the node state and field of the last u (``_pointwise``), in arrays owned here and refilled in place
         n_q = discretisation.weights.size
         self._held = np.empty(discretisation.size)
-        self._held_for = None  # (the material values the held state was checked for,) or None: nothing held
+        self._holding = False  # whether _held, _state and _field_rows are those of a u (and _held_material's)
+        self._held_material = None  # the material values the held state was checked for (its domain check)
         self._state = np.empty((4, n_q))
         self._rho = np.empty(n_q)
         self._field_rows = np.zeros((6, n_q)) if self.kernels.field_class else np.zeros((6, 0))
         self._values = dict(zip(self.kernels.module.STATE, self._state), cos_theta=self.geometry[0],
                             sin_theta=self.geometry[1], field=self._field_rows if self.kernels.field_class else None)
-        self._templates = {}  # kernel -> its argument list on the held arrays and the slots of its scalar parameters
+        self._templates = {}  # kernel -> its node loop, arguments on the held arrays, scalar slots and output array
+        self._hessian = np.empty((discretisation.size, discretisation.size))  # bordered_jacobian's assembly
 
     def _field(self, lam2, sin_theta, eta):
         """H² and its derivatives at the nodes (zeros for a field class without coils)."""
@@ -113,37 +115,43 @@ class Equilibrium:
         return out
 
     def _pointwise(self, kernel, u, params: Parameters):
-        """Kernel at the own nodes; the state and field of the last u (and material values: its domain check)
-        are reused (Newton asks for R, then J). State and field are computed into arrays owned by this object."""
-        if self._held_for != (params.material,) or not same_values(self._held, u):
-            self._held_for = None
-            np.matmul(self.disc.ops, u, out=self._state)  # Discretisation.node_state, into the held rows
-            if self.coils.shape[0]:
-                np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
-                field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
-            if self._domain_check:
-                self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
-            self._held[:] = u
-            self._held_for = (params.material,)
+        """Kernel at the own nodes, into an array owned here (valid until the next call of the same kernel). The
+        state and field of the last u (and material values: its domain check) are reused (Newton asks for R, then
+        J); they are computed into arrays owned by this object."""
+        if not (self._holding and params.material == self._held_material and same_values(self._held, u)):
+            self._hold(u, params)
         if params.mu is not None or params.alpha is not None or params.material is not None:
             return self._evaluate(kernel, self._values, params)  # material overrides: bound by name each time
-        function, rows, args, slots = self._templates.get(kernel) or self._template(kernel, params)
+        function, args, slots, out = self._templates.get(kernel) or self._template(kernel, params)
         for slot, name in slots:
             args[slot] = float(getattr(params, name))
-        out = np.empty((rows, self._rho.shape[0]))
         function(*args, out)
         if not finite(out):
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 
+    def _hold(self, u, params: Parameters):
+        """The node state (Discretisation.node_state) and field of u into the held arrays; u and the material
+        values held once the domain check passed."""
+        self._holding = False
+        self.disc.node_state(u, self._state)
+        if self.coils.shape[0]:
+            np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
+            field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
+        if self._domain_check:
+            self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
+        self._held[:] = u
+        self._holding, self._held_material = True, params.material
+
     def _template(self, kernel: str, params: Parameters) -> tuple:
-        """(the kernel's node loop, its output count, its arguments on the held node arrays and the scene material
-        as a list, the (position, Parameters field) of each scalar parameter): ``_pointwise`` only refills the
+        """(the kernel's node loop, its arguments on the held node arrays and the scene material as a list, the
+        (position, Parameters field) of each scalar parameter, its output array): ``_pointwise`` only refills the
         scalars. Bound once by name (KernelSet.arguments)."""
         spec = self.kernels.module.KERNELS[kernel]
         slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"]) if kind == "param")
-        entry = (getattr(self.kernels.module, f"{kernel}_nodes"), len(spec["outputs"]),
-                 list(self.kernels.arguments(kernel, self._values, params)), slots)
+        entry = (getattr(self.kernels.module, f"{kernel}_nodes"),
+                 list(self.kernels.arguments(kernel, self._values, params)), slots,
+                 np.empty((len(spec["outputs"]), self.disc.weights.size)))
         self._templates[kernel] = entry
         return entry
 
@@ -186,7 +194,7 @@ class Equilibrium:
         state evaluation serves both parts; the Hessian is assembled contiguous, faster than into the columns)."""
         n = self.disc.size
         out = np.empty((n, n + 1))
-        out[:, :n] = self.disc.hessian(self._pointwise("energy_hessian", u, params))
+        out[:, :n] = self.disc.hessian(self._pointwise("energy_hessian", u, params), self._hessian)
         self.parameter_derivative(u, params, name, out[:, n])
         return out
 
