@@ -11,7 +11,7 @@ from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.profiles import meridional_stretch
 
-# Map width ε_j = gap_j · min(MAP_ARC_WIDTH · |dx/ds|_j, MAP_WIDTH) (x units) for each wire within MAP_GAP of the
+# Map width ε_j = gap_j · clip(MAP_ARC_WIDTH · |dx/ds|_j, MAP_MIN_WIDTH, MAP_WIDTH) (x units) for each wire within MAP_GAP of the
 # membrane. benchmarks/results/wire_map_widths.txt (cheapest degree for P to 1e-8, gaps 0.05–2, three coil scenes):
 # the best width is ~0.8 × the gap measured along the membrane (ε = 0.8·gap·|dx/ds|) wherever the membrane is
 # stretched (|dx/ds| ≤ 0.5: the a = 4 coil, 0.2–0.3 × gap in x: degree 32 against 64 for 0.4·gap at gap 0.17),
@@ -19,6 +19,7 @@ from ..galerkin.profiles import meridional_stretch
 # gap 0.05) the layer is narrower than the gap (0.8·gap·|dx/ds| needs degree 320, 0.4·gap 160, 0.15·gap 64).
 MAP_ARC_WIDTH = 0.8  # map width per unit gap along the membrane, |dx/ds|·gap
 MAP_WIDTH = 0.4  # largest map width per unit gap in x
+MAP_MIN_WIDTH = 0.1  # smallest (the narrowest studied): |dx/ds| → 0 at a pole, where x = cos θ is quadratic in s
 MAP_GAP = 2.0  # wires farther than this get no map centre (up to 2 no point needs a higher degree mapped than plain)
 
 
@@ -62,7 +63,7 @@ def map_width(approach: Approach) -> float | None:
     """The map width ε_j (x units) for one closest approach, None if the wire gets no map centre."""
     if approach.gap >= MAP_GAP:
         return None
-    return approach.gap * min(MAP_ARC_WIDTH * approach.dx_ds, MAP_WIDTH)
+    return approach.gap * float(np.clip(MAP_ARC_WIDTH * approach.dx_ds, MAP_MIN_WIDTH, MAP_WIDTH))
 
 
 def centred_map(found: list[Approach], widths, symmetric: bool) -> WireMap | None:
