@@ -18,7 +18,7 @@ points past it (pole stretch falling again) are taken at the traced branch's own
 ``shooting.shoot_symmetric`` (Taylor start, rtol 1e-12), cross-checked against shooting started at the pole and
 the Galerkin solution on the tracer's own (mapped) basis; the largest cross-check difference is printed.
 
-Run: python benchmarks/wire_map_widths.py   (writes benchmarks/results/wire_map_widths.txt; ~17 min on the loaded 2-core machine)
+Run: python benchmarks/wire_map_widths.py   (writes benchmarks/results/wire_map_widths.txt; ~17 min, loaded)
 """
 import sys
 import time
