@@ -12,11 +12,12 @@ from ..galerkin.discretisation import Discretisation
 from ..galerkin.profiles import meridional_stretch
 
 # Map width ε_j = gap_j · clip(MAP_ARC_WIDTH · |dx/ds|_j, MAP_MIN_WIDTH, MAP_WIDTH) (x units) for each wire
-# within MAP_GAP of the membrane. benchmarks/results/wire_map_widths.txt (cheapest degree for P to 1e-8, gaps 0.05–2, three coil scenes):
-# the best width is ~0.8 × the gap measured along the membrane (ε = 0.8·gap·|dx/ds|) wherever the membrane is
-# stretched (|dx/ds| ≤ 0.5: the a = 4 coil, 0.2–0.3 × gap in x: degree 32 against 64 for 0.4·gap at gap 0.17),
-# and never wider than 0.4·gap in x: where λ1 drops next to the wire (|dx/ds| up to 1.15, the paper coil at
-# gap 0.05) the layer is narrower than the gap (0.8·gap·|dx/ds| needs degree 320, 0.4·gap 160, 0.15·gap 64).
+# within MAP_GAP of the membrane. benchmarks/results/wire_map_widths.txt (cheapest degree for P to 1e-8, gaps
+# 0.05–2, three coil scenes): the best width is ~0.8 × the gap measured along the membrane (0.8·gap·|dx/ds|)
+# where the membrane is stretched (|dx/ds| ≤ 0.5: the a = 4 coil, 0.21–0.27 × gap in x: degree 28 against 64
+# for 0.4·gap at gap 0.17), and never wider than 0.4·gap in x: where λ1 drops next to the wire (|dx/ds| up to
+# 1.15, the paper coil at gap 0.05) the layer is narrower than the gap (0.8·gap·|dx/ds| needs degree 320,
+# 0.4·gap 160, 0.15·gap 64).
 MAP_ARC_WIDTH = 0.8  # map width per unit gap along the membrane, |dx/ds|·gap
 MAP_WIDTH = 0.4  # largest map width per unit gap in x
 MAP_MIN_WIDTH = 0.1  # smallest (the narrowest studied): |dx/ds| → 0 at a pole, where x = cos θ is quadratic in s
