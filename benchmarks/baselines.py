@@ -22,7 +22,9 @@ point the cheapest of its settings that reaches the error level is taken (the sa
 (iii) Ours: the pole-stretch-constrained Newton of the Ritz–Galerkin system (generated exact Hessian) at the
      cheapest fixed Legendre degree of 8..256 (steps of ~1.2) that meets the error, in x = cos θ and, with coils,
      also in the wire-mapped basis the tracer uses near a wire (``branch.wire_map`` centred from the
-     neighbour's profile; the cheaper of the two), from the neighbour on the same discretisation.
+     neighbour's profile; the cheaper of the two), from the neighbour on the same discretisation. Like (i) and
+     (ii), its tolerance is a setting: the cheapest of OUR_TOLS (Newton's scaled step and error estimate) that
+     meets the error at that degree; its achieved error is checked against the reference like theirs.
 
 Timing: process CPU time (compared) and wall time, best of the repeats (a run longer than 2 s is not
 repeated); (ii) and (iii) at their chosen settings are then timed again in alternating rounds (best of all),
@@ -54,7 +56,7 @@ ALTERNATIONS = 3  # extra alternating timing rounds of (ii) and (iii) at their c
 PAPER_SETTINGS = ((1e-9, 1e-9), (1e-10, 1e-10), (1e-11, 1e-11), (1e-12, 1e-12))
 BVP_TOLS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 1e-8, 1e-10)  # both ladders ~√10 / ~1.2x apart
 OUR_DEGREES = (8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48, 56, 64, 80, 96, 112, 128, 160, 176, 192, 224, 256)
-OUR_TOL = 1e-10
+OUR_TOLS = (1e-10, 1e-9, 1e-8)  # Newton tolerances offered to (iii), as BVP_TOLS to (ii) and PAPER_SETTINGS to (i)
 
 
 class FirstOrderSystem:
@@ -205,13 +207,15 @@ def main():
                     X0 = wp.neighbour(solver, t, d, branch.disc, mapping)
                     if X0 is None:
                         continue
-                    cpu, wall, (result, _) = timed(solver.solve, REPEAT_OURS, d, X0, t.stretch, OUR_TOL, None,
-                                                   mapping)
-                    err = abs(result.x[-1] / t.P_ref - 1)
-                    if result.converged and err <= LEVEL and cpu < best.get("ours", (np.inf,))[0]:
-                        basis = "mapped " if mapping else ""
-                        best["ours"] = (cpu, wall, err, f"{basis}degree {d}, {result.iterations} its")
-                        chosen_ours = (solver.solve, d, X0, t.stretch, OUR_TOL, None, mapping)
+                    for tol in OUR_TOLS:
+                        cpu, wall, (result, _) = timed(solver.solve, REPEAT_OURS, d, X0, t.stretch, tol, None,
+                                                       mapping)
+                        err = abs(result.x[-1] / t.P_ref - 1)
+                        if result.converged and err <= LEVEL and cpu < best.get("ours", (np.inf,))[0]:
+                            basis = "mapped " if mapping else ""
+                            setting = f"{basis}degree {d}, tol {tol:.0e}, {result.iterations} its"
+                            best["ours"] = (cpu, wall, err, setting)
+                            chosen_ours = (solver.solve, d, X0, t.stretch, tol, None, mapping)
                 if "ours" in best:
                     break
             # (i) the paper's method

@@ -45,7 +45,6 @@ class StudyCase:
 
 def study_cases():
     from balloon_cg.post.paper import SINGLE_COIL, SINGLE_COIL_REACH, Case
-    from balloon_cg.scene import load_scene
 
     two, single = wp.cases()[1:]
     paper = Case(SINGLE_COIL, (("field.M", 0.003),) + SINGLE_COIL_REACH).load()

@@ -73,7 +73,7 @@ class PointSolver:
         self.symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
         held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
         self.pin = (not scene.field.coils) or held
-        self._eq = {}
+        self._eq, self._system = {}, {}
 
     def equilibrium(self, degree, mapping=None):
         from balloon_cg.galerkin.discretisation import Discretisation
@@ -84,11 +84,17 @@ class PointSolver:
             self._eq[degree, mapping] = Equilibrium(self.scene, disc)
         return self._eq[degree, mapping]
 
-    def functions(self, eq):
+    def system(self, degree, mapping=None):
+        """(R, its Jacobian, the pole row) of the constrained system at ``degree`` and ``mapping``, built once (as
+        a tracer holds them along a branch: building them is no part of a solve's time)."""
         from balloon_cg.analysis.problem import ParameterSystem
 
-        system = ParameterSystem(eq, self.params, "P")
-        return system.residual, system.jacobian
+        if (degree, mapping) not in self._system:
+            eq = self.equilibrium(degree, mapping)
+            system = ParameterSystem(eq, self.params, "P")
+            self._system[degree, mapping] = (system.residual, system.jacobian,
+                                             np.append(eq.disc.pole_rows()["lam2_north"], 0.0))
+        return self._system[degree, mapping]
 
     def convert(self, X, source, degree, mapping=None):
         """X (u, P) from discretisation ``source`` to ``degree`` and ``mapping`` (Discretisation.transfer)."""
@@ -99,9 +105,7 @@ class PointSolver:
         the wall time of the same call is left in ``self.last_wall``."""
         from balloon_cg.numerics.newton import newton
 
-        eq = self.equilibrium(degree, mapping)
-        residual, jacobian = self.functions(eq)
-        row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
+        residual, jacobian, row = self.system(degree, mapping)
         t0, c0 = time.perf_counter(), time.process_time()
         result = newton(residual, jacobian, X0, row, stretch, tol, max_newton or self.scene.solver.max_newton)
         self.last_wall = time.perf_counter() - t0
