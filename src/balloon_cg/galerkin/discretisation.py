@@ -88,8 +88,12 @@ def assemble_gradient(pointwise, weights, A, B, gradient_ops, out=None) -> np.nd
     and B = (∂η, ∂w)/∂b (2, n_q, n_b); ``gradient_ops`` is ops as a contiguous (size, 4 n_q)."""
     size = A.shape[2] + B.shape[2]
     if size < SMALL_GRADIENT:
-        out = np.empty(size) if out is None else out
-        _gradient_loops(np.ascontiguousarray(pointwise), weights, A, B, out)
+        # into a contiguous array: a column of a matrix as ``out`` would compile a second layout of the loops
+        target = out if out is not None and out.flags.c_contiguous else np.empty(size)
+        _gradient_loops(np.ascontiguousarray(pointwise), weights, A, B, target)
+        if out is None or out is target:
+            return target
+        out[:] = target
         return out
     return np.matmul(gradient_ops, (pointwise * weights).ravel(), out=out)
 
