@@ -194,52 +194,41 @@ def format_spectra(found):
     return lines
 
 
-def sphere_pear_points():
-    """SPOM1, M = 0: the located pear points of the primary branch (λ at the north pole, P, status)."""
+def _pear_points(scene, first_only=False):
+    """The located odd-held (pear) branch points of the primary branch of ``scene`` (all, or the first):
+    (λ at the north pole, P, status) each."""
     from balloon_cg.analysis import bifurcation
     from balloon_cg.analysis.primary import trace_primary
     from balloon_cg.analysis.stability import assess_branch
 
-    scene = wp.cases()[0].scene.with_overrides({"continuation.stop_stretch": 8.0})
     primary = trace_primary(scene)
     primary.stability, _ = assess_branch(primary, scene.stability.degree, True)
     events = [e for e in bifurcation.detect(primary, primary.stability) if e[1] == "odd_held"]
-    points = [bifurcation.locate(primary, *e) for e in events]
+    points = [bifurcation.locate(primary, *e) for e in events[:1 if first_only else None]]
     return [(primary.pole_values(bp.X)["lam2_north"][0], bp.X[-1], bp.status.value) for bp in points]
+
+
+def sphere_pear_points():
+    """SPOM1, M = 0: the located pear points of the primary branch."""
+    return _pear_points(wp.cases()[0].scene.with_overrides({"continuation.stop_stretch": 8.0}))
 
 
 def two_coil_pear_point():
     """Two coils, M = 0.001 (tests/test_pear_points.py's scene, stop_stretch 1.75): the first pear pitchfork."""
-    from balloon_cg.analysis import bifurcation
-    from balloon_cg.analysis.primary import trace_primary
-    from balloon_cg.analysis.stability import assess_branch
     from balloon_cg.scene import load_scene
 
-    scene = load_scene(wp.ROOT / "scenes" / "spom1_two_coils_M0.001.toml").with_overrides(
-        {"continuation.stop_stretch": 1.75, "stability.m_max": 0})
-    primary = trace_primary(scene)
-    primary.stability, _ = assess_branch(primary, scene.stability.degree, True)
-    event = next(e for e in bifurcation.detect(primary, primary.stability) if e[1] == "odd_held")
-    bp = bifurcation.locate(primary, *event)
-    return [(primary.pole_values(bp.X)["lam2_north"][0], bp.X[-1], bp.status.value)]
+    return _pear_points(load_scene(wp.ROOT / "scenes" / "spom1_two_coils_M0.001.toml").with_overrides(
+        {"continuation.stop_stretch": 1.75, "stability.m_max": 0}), first_only=True)
 
 
 def near_wire_pitchforks():
     """One coil of radius 2, M = 0.001 (tests/test_branch_points.py's near-wire scene, wire gap 0.02): both pear
     pitchforks; the second (P ≈ 1.92839) was once mislocated by an under-resolved stability basis."""
-    from balloon_cg.analysis import bifurcation
-    from balloon_cg.analysis.primary import trace_primary
-    from balloon_cg.analysis.stability import assess_branch
     from balloon_cg.scene import parse_scene
 
-    scene = parse_scene('[material]\npreset = "SPOM1"\n[field]\nM = 0.001\n[[field.coils]]\nradius = 2.0\n'
-                        'height = 0.0\ncurrent = 1.0\n[continuation]\nstop_stretch = 6.0\nwire_gap = 0.02\n',
-                        name="SPOM1-coil")
-    primary = trace_primary(scene)
-    primary.stability, _ = assess_branch(primary, scene.stability.degree, True)
-    events = [e for e in bifurcation.detect(primary, primary.stability) if e[1] == "odd_held"]
-    points = [bifurcation.locate(primary, *e) for e in events]
-    return [(primary.pole_values(bp.X)["lam2_north"][0], bp.X[-1], bp.status.value) for bp in points]
+    return _pear_points(parse_scene('[material]\npreset = "SPOM1"\n[field]\nM = 0.001\n[[field.coils]]\n'
+                                    'radius = 2.0\nheight = 0.0\ncurrent = 1.0\n[continuation]\n'
+                                    'stop_stretch = 6.0\nwire_gap = 0.02\n', name="SPOM1-coil"))
 
 
 def branch_points():
