@@ -35,9 +35,11 @@ class Approach:
 
 
 def _profile(disc: Discretisation, u, n_theta: int):
+    """θ on n_theta points, ρ = λ2 sin θ and η there, and (λ2, λ2', η') there for the stretch λ1 (``approaches``
+    only: ``wire_gap`` runs at every continuation step and needs no λ1)."""
     theta = np.linspace(0.0, np.pi, n_theta)
     lam2, dlam2, eta, deta = disc.evaluate(u, theta)
-    return theta, lam2 * np.sin(theta), eta, meridional_stretch(theta, lam2, dlam2, deta)
+    return theta, lam2 * np.sin(theta), eta, (lam2, dlam2, deta)
 
 
 def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float, int]:
@@ -51,7 +53,8 @@ def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float,
 
 def approaches(disc: Discretisation, u, coils, n_theta: int = 2001) -> list[Approach]:
     """The closest approach of the membrane profile to each wire of ``coils``, in their order."""
-    theta, rho, eta, lam1 = _profile(disc, u, n_theta)
+    theta, rho, eta, fields = _profile(disc, u, n_theta)
+    lam1 = meridional_stretch(theta, *fields)
     out = []
     for c in coils:
         j = int(np.argmin(np.hypot(rho - c.radius, eta - c.height)))

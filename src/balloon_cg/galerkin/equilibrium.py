@@ -139,7 +139,7 @@ class Equilibrium:
             np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
             field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
         if self._domain_check:
-            self._check_domain(self.geometry, tuple(self._values[k] for k in self.kernels.module.STATE), params)
+            self._check_domain(self.geometry, tuple(self._state), params)  # rows in STATE order
         self._held[:] = u
         self._holding, self._held_material = True, params.material
 
