@@ -15,12 +15,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation
+from . import azimuthal_points, bifurcation, mirror
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
 from .problem import equilibrium_of
-from .results import Block, Branch, StopCode
+from .results import Block, Branch, Origin, StopCode
 from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
 from .verdict import Gap, Incomplete, incomplete
@@ -160,22 +160,34 @@ def _stopped(picture: Picture) -> bool:
 
 
 def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
-    """Pear branches from the pear branch points; a branch that rejoins at an already traced point is not
-    repeated. An interrupt ends the search after the branch being traced (which is kept; assessed unless the
-    signal came before or during its assessment)."""
+    """Pear branches from the pear branch points, each with its mirror image: the reflection of the pear branch
+    in a scene invariant under z → −z (``mirror``: its Origin says how it was obtained), else traced; a branch
+    that rejoins at an already traced point is not repeated. An interrupt ends the search after the branch being
+    traced (which is kept; assessed unless the signal came before or during its assessment)."""
     reached = set()
+    reflect = mirror.reflectable(scene)
     for n, bp in enumerate(picture.branch_points):
         if bp.block != Block.ODD_HELD or n in reached:
             continue
+        pear, south_turns = None, []
         for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
             if interrupt.requested():
                 return
             name = f"pear_{n}{suffix}"
-            branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR))
+            origin = Origin.TRACED
+            if sign < 0 and pear is not None:
+                reflected = mirror.reflection(pear, south_turns, name)
+                if isinstance(reflected, Branch):  # parent, rejoin and assessments are the pear's, reflected
+                    picture.branches.append(reflected)
+                    continue
+                origin = reflected
+            branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR), south_turns=reflect)
             if branch is None:
                 picture.not_started.append((name, f"the first correction from branch point {n} along its mode "
                                                   "did not converge"))
                 continue
+            south_turns = mirror.take_south_turns(branch)
+            branch.origin = origin
             branch.parent = ("primary", n)
             branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
             if branch.rejoins is not None:
@@ -184,6 +196,7 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
             picture.branches.append(branch)
             if interrupt.requested() or not _assess(branch, scene, False, progress):  # kept as traced, not assessed
                 return
+            pear = branch if sign > 0 and reflect else None
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

@@ -182,6 +182,11 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
     return continuation.Point(start.X, tangent, start.iterations, start.residual)
 
 
+def north_stop_stretch(upper: float) -> Stop:
+    """The stop of a branch whose north pole stretch reached ``upper`` (continuation.stop_stretch)."""
+    return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
+
+
 def range_limits(scene, upper: float):
     """limits(disc, point) -> Stop or None: a dielectric membrane is compressed, the north pole stretch leaves
     [min_stretch, upper], P reaches stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage
@@ -199,7 +204,7 @@ def range_limits(scene, upper: float):
                                                  "tension: tension-field theory is not modelled)")
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
         if stretch >= upper:
-            return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
+            return north_stop_stretch(upper)
         if stretch <= cont.min_stretch:
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and not in_voltage:

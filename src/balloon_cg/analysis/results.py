@@ -108,6 +108,17 @@ class StopCode(enum.StrEnum):
     INTERRUPTED = "interrupted"  # SIGINT/SIGTERM asked the computation to stop (numerics.interrupt)
 
 
+class Origin(enum.StrEnum):
+    """How a branch's points were obtained (``analysis.mirror`` for the mirror image of a pear branch)."""
+
+    TRACED = "traced"  # by continuation
+    REFLECTED = "reflected"  # the reflection z → −z of branch ``reflection_of``, every point's residual checked
+    TRACED_NOT_REFLECTABLE = "traced_not_reflectable"  # a mirror image traced: its partner's trace met a rule of
+    #                                                    the north pole only (min_stretch), which is not reflected
+    TRACED_REFLECTION_FAILED = "traced_reflection_failed"  # a mirror image traced: a reflected point's residual
+    #                                                        was above solver.tol
+
+
 @dataclass
 class SpecialPoint:
     """A labelled point of a branch. LP, TP and BP lie between points ``index`` and ``index + 1`` (X is the
@@ -188,6 +199,8 @@ class Branch:
     parent: tuple | None = None  # (branch name, branch point number) a bifurcating branch leaves from
     rejoins: int | None = None  # the parent's branch point number where a bifurcating branch rejoins it
     parameter: str = "P"  # the continuation parameter: the Parameters field X[:, -1] holds ("P" or "voltage")
+    origin: Origin = Origin.TRACED
+    reflection_of: str = ""  # REFLECTED: the name of the branch this one is the reflection of
 
     @property
     def pressure(self):

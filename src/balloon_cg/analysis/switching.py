@@ -14,6 +14,7 @@ branch point). A fold candidate of a branch that rejoined at a branch point is t
 (``rejoin_fold``) when the amplitude A = λ2(0) − λ2(π) changes sign (or vanishes) across its bracket and the
 branch point lies within the bracket's width of it; ``mark_rejoin`` stores the branch point there in its place.
 """
+import enum
 import time
 from dataclasses import replace
 
@@ -27,14 +28,23 @@ from .bifurcation import general_tracer, mode_direction, plain_degree, to_genera
 from .control import landing
 from .primary import stop_rule
 from .results import Branch, Kind, SpecialPoint, StopCode
+from .tracer import NORTH_TURNING
 from ..numerics.threads import limited_blas
+
+
+class Turn(enum.StrEnum):
+    """A fold label of a pear trace that is no ``Kind``: the turning point of the south pole stretch, located when
+    ``trace_pear`` is asked for ``south_turns`` (the mirror image's TP: ``mirror``); never stored as such."""
+
+    SOUTH = "TP_south"
 
 
 @limited_blas
 def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progress=None,
-               delta: float = 1e-3) -> Branch | None:
+               delta: float = 1e-3, south_turns: bool = False) -> Branch | None:
     """The bifurcating branch leaving ``bp`` along sign·φ until it rejoins or stops; None if the first
-    correction fails."""
+    correction fails. ``south_turns``: its special points include the turning points of the south pole stretch
+    too, labelled ``Turn.SOUTH`` (located as TP is for the north pole)."""
     t0 = time.perf_counter()
     scene = branch.scene
     tracer = general_tracer(scene)
@@ -62,15 +72,20 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
             return Stop(StopCode.REJOINED, "rejoined the primary branch")
         south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
         if south >= scene.continuation.stop_stretch:
-            return Stop(StopCode.SOUTH_STOP_STRETCH,
-                        f"south pole stretch reached stop_stretch {scene.continuation.stop_stretch:g}")
+            return south_stop_stretch(scene.continuation.stop_stretch)
         return base(disc, point)
 
     stretch = scene.continuation.stop_stretch
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
                StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
-    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree), t0=t0,
-                    land_on=land_on)
+    turning = NORTH_TURNING | ({Turn.SOUTH: "lam2_south"} if south_turns else {})
+    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree, turning=turning),
+                    t0=t0, land_on=land_on)
+
+
+def south_stop_stretch(upper: float) -> Stop:
+    """The stop of a pear branch whose south pole stretch reached ``upper`` (continuation.stop_stretch)."""
+    return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
 
 
 def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:

@@ -12,6 +12,7 @@ The tracer is the same for the primary branch (``primary``) and the bifurcating 
 differ in the layout (equator-symmetric or general, held or free) and the stop rule.
 """
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
@@ -46,6 +47,9 @@ def unit(size: int, index: int) -> np.ndarray:
     return e
 
 
+NORTH_TURNING = MappingProxyType({Kind.TP: "lam2_north"})  # the pole stretch folds a leg locates by default
+
+
 class Tracer:
     """Discretisations of growing degree for one scene and one layout, and the legs traced on them."""
 
@@ -74,21 +78,21 @@ class Tracer:
         return ParameterSystem(self._systems[degree, mapping], params, self.parameter)
 
     def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None,
-            mapping=None, limits=None) -> LegTrace:
+            mapping=None, limits=None, turning=NORTH_TURNING) -> LegTrace:
         """Trace from ``start`` (at ``degree``, default the scene's, and ``mapping``) along its tangent, refining
         as needed (module docstring). ``stop(disc, point)`` returns a Stop or None; ``limits(disc, point)`` (the
         requested range of the branch) is asked first, before the resolution check: a point past the range ends
         the leg (it is landed on exactly afterwards), however unresolved it is (past min_stretch = 1.001 a
-        predictor lands in compression, λ < 1, which no degree resolves)."""
+        predictor lands in compression, λ < 1, which no degree resolves). ``turning``: fold label -> pole row
+        (``Discretisation.pole_rows``) whose turning points are located (default: TP, the north pole stretch)."""
         policy = self.resolution
         degree = degree or self.scene.solver.degree
         system = self.system(degree, params, mapping)
         segments, recentres = [], 0
         while True:
             disc = system.eq.disc
-            north = np.append(disc.pole_rows()["lam2_north"], 0.0)
-            monitors = {Kind.LP: unit(start.X.size, -1), Kind.TP: north} | fold_monitors(system,
-                                                                                         self.scene.loading.control)
+            poles = {label: np.append(disc.pole_rows()[row], 0.0) for label, row in turning.items()}
+            monitors = {Kind.LP: unit(start.X.size, -1)} | poles | fold_monitors(system, self.scene.loading.control)
 
             def checked_stop(point, disc=disc):
                 if interrupt.requested():

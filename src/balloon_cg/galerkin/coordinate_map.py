@@ -46,6 +46,13 @@ class WireMap:
                 and all(abs(c - d) <= rtol * e and abs(e - f) <= rtol * e
                         for c, d, e, f in zip(self.centres, other.centres, self.widths, other.widths)))
 
+    def mirrored(self) -> "WireMap":
+        """The map of the reflection x → −x: centres −c_j (in reversed order, so that sorted centres stay sorted),
+        the same widths. Its h̃ is exactly h̃(x) = −h(−x) (H̃(x) = −H(−x) in the module docstring's H), so
+        P_k(h̃(x)) = (−1)^k P_k(h(−x)): a function of this map's basis, reflected, has the coefficients times (−1)^k
+        on the mirrored map (``Discretisation.reflect``)."""
+        return WireMap(tuple(-c for c in reversed(self.centres)), tuple(reversed(self.widths)))
+
     def s(self, x):
         """h(x)."""
         return -1.0 + self._scale * (self._sum(x) - self._low)

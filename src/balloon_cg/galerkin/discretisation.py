@@ -10,7 +10,7 @@ quadrature runs over the nodes x ≥ 0 with doubled weights (``even_half``). Wit
 η → η + c is removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
 """
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -324,6 +324,27 @@ class Discretisation:
             coefficients = np.hstack([a[:, other.a_index], b[:, other.b_index]])
         result = np.hstack([coefficients, rest])
         return result if np.ndim(u) == 2 else result[0]
+
+    def reflected(self) -> "Discretisation":
+        """The basis holding this one's functions reflected z → −z (x → −x, ``reflect``): itself without a map, the
+        same fields on the mirrored map otherwise (``WireMap.mirrored``)."""
+        return self if self.mapping is None else replace(self, mapping=self.mapping.mirrored())
+
+    @functools.cached_property
+    def _reflection_signs(self) -> np.ndarray:
+        signs = self.join((-1.0) ** np.arange(self.degree + 1), -(-1.0) ** np.arange(self.degree + 1))
+        signs.flags.writeable = False
+        return signs
+
+    def reflect(self, u: np.ndarray) -> np.ndarray:
+        """The reflection z → −z of u (one unknown vector or rows, (.., size + k): trailing entries P, ... kept), on
+        ``reflected()``: θ → π − θ, i.e. x → −x, with λ2̃(x) = λ2(−x) and η̃(x) = −η(−x) (η is the axial
+        coordinate z), so a_k → (−1)^k a_k and b_k → (−1)^(k+1) b_k, exactly. On a map the mirrored map has
+        P_k(h̃(x)) = (−1)^k P_k(h(−x)) and hold means m̃_k = (−1)^k m_k, so the same signs hold. An
+        equator-symmetric state (a_even, b_odd) is its own reflection."""
+        U = np.array(u, dtype=float, ndmin=2)
+        U[:, : self.size] *= self._reflection_signs
+        return U if np.ndim(u) == 2 else U[0]
 
     def tail(self, u: np.ndarray) -> float:
         """Spectral error estimate: the neglected tail Σ_{k>N} of a geometric series, E·r/(1 − r).
