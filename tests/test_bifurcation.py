@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.results import Block, Classification, Kind, Status, StopCode
+from balloon_cg.analysis.results import Block, Classification, Kind, Origin, Status, StopCode
+from balloon_cg.analysis.switching import mark_rejoin, trace_pear
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.sphere import sphere_pressure
@@ -60,12 +61,29 @@ def test_isola_or_single_pitchfork(picture):
 
 
 def test_mirror_branch_swaps_the_poles(picture):
-    _, pic, _, _ = pear_points(picture)
+    """The traced mirror image (−φ: an independent continuation) has the pear branch's south pole stretch at its
+    north pole, and the stored mirror (the pear branch reflected, analysis.mirror) agrees with it point by point
+    in P and both pole stretches, in its stops and in its special points."""
+    _, pic, primary, bps = pear_points(picture)
     branches = {b.name: b for b in pic.branches}
-    pear, mirror = branches["pear_0"].pole_values(), branches["pear_0_mirror"].pole_values()
-    n = min(len(pear["lam2_north"]), len(mirror["lam2_north"]), 8)
-    np.testing.assert_allclose(mirror["lam2_north"][:n], pear["lam2_south"][:n], rtol=1e-6)
-    assert np.abs(pear["lam2_north"] - pear["lam2_south"]).max() > 0.5
+    pear, mirror = branches["pear_0"], branches["pear_0_mirror"]
+    traced = trace_pear(primary, bps[0], -1.0, "traced")
+    if pear.rejoins is not None:
+        mark_rejoin(traced, primary, pear.rejoins, bps[pear.rejoins])
+    assert mirror.origin == Origin.REFLECTED and mirror.reflection_of == "pear_0"
+    assert traced.origin == Origin.TRACED and len(traced.X) == len(mirror.X) == len(pear.X)
+    np.testing.assert_allclose(traced.pole_values()["lam2_north"], pear.pole_values()["lam2_south"], rtol=1e-9)
+    assert np.abs(pear.pole_values()["lam2_north"] - pear.pole_values()["lam2_south"]).max() > 0.5
+    np.testing.assert_allclose(mirror.X[:, -1], traced.X[:, -1], rtol=1e-9)
+    for pole in ("lam2_north", "lam2_south", "eta_north", "eta_south"):
+        np.testing.assert_allclose(mirror.pole_values()[pole], traced.pole_values()[pole], rtol=1e-9, atol=1e-9)
+    assert [leg.stop.code for leg in mirror.legs] == [leg.stop.code for leg in traced.legs]
+    own = [s for s in mirror.special if s.m == 0]  # the m ≥ 1 points are found on each stored branch (analyse)
+    assert [(s.kind, s.index) for s in own] == [(s.kind, s.index) for s in traced.special]
+    for s, t in zip(own, traced.special):
+        assert s.X[-1] == pytest.approx(t.X[-1], rel=1e-9)
+        assert mirror.pole_values(s.X)["lam2_north"][0] == pytest.approx(traced.pole_values(t.X)["lam2_north"][0],
+                                                                         rel=1e-9)
 
 
 def test_every_point_has_stability(picture):

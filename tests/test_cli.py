@@ -60,6 +60,10 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert branch["stop_codes"] == {"up": "stop_stretch", "down": "min_stretch"}
     assert {"pear_0", "pear_0_mirror"} <= set(summary["branches"])
     assert summary["branches"]["pear_0"]["parent"] == ["primary", 0]
+    pear, mirror = summary["branches"]["pear_0"], summary["branches"]["pear_0_mirror"]
+    assert (pear["origin"], pear["reflection_of"]) == ("traced", "")
+    assert (mirror["origin"], mirror["reflection_of"]) == ("reflected", "pear_0") and mirror["parent"] == ["primary", 0]
+    assert mirror["lam2_north"] == pytest.approx(pear["lam2_south"], rel=1e-12)
     assert summary["snap_throughs"][0]["from_branch"] == "primary"
     assert branch["lam2_north"][1] == pytest.approx(2.0, abs=1e-12)
     assert branch["max_residual"] < 1e-10 and branch["max_error_estimate"] < 1e-10
@@ -68,6 +72,7 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert main(["inspect", str(out)]) == 0
     text = capsys.readouterr().out
     assert "branch primary" in text
+    assert "the reflection z → −z of pear_0" in text.split("branch pear_0_mirror")[1]
     # an EP is a stored point, an LP or BP lies between two (docs/hdf5.md: index); counts named by control
     primary = text.split("branch primary")[1].split("branch ")[0]
     lp, bp = (branch["special_points"][k]["index"] for k in (1, 2))

@@ -200,12 +200,17 @@ def test_mapped_branch_round_trips_through_hdf5(tmp_path):
         np.testing.assert_array_equal(got[key], expected[key])
 
 
-def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire():
+@pytest.fixture(scope="module")
+def two_coil_picture():
+    from balloon_cg.analysis.picture import analyse
+
+    return analyse(load_scene(SCENE))
+
+
+def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire(two_coil_picture):
     """On a general (held) basis the map keeps b_0 = 0 meaning ∫η dx = 0 (η = Σ b_k (P_k(s) − m_k)); the pear branch
     of the two-coil scene then reaches its wire gap 0.1 on a mapped basis (before: degree 320 and a resolution
     stop), every stored point within max_error, and its last point matches a plain Legendre solve at degree 320."""
-    from balloon_cg.analysis.picture import analyse
-
     held = Discretisation(80, False, True, mapping=WireMap((0.6,), (0.06,)))
     rng = np.random.default_rng(0)
     u = rng.normal(size=held.size) / (1 + np.arange(held.size)) ** 2
@@ -216,7 +221,7 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire()
     assert held.pole_rows()["eta_south"] @ u == pytest.approx(eta[1], abs=1e-14)
 
     scene = load_scene(SCENE)
-    picture = analyse(scene)
+    picture = two_coil_picture
     pear = next(b for b in picture.branches if b.name == "pear_0")
     assert pear.stopped(StopCode.WIRE_GAP) and pear.disc.mapping is not None and not pear.disc.symmetric
     assert np.all(pear.error_estimate <= scene.solver.max_error)
@@ -232,6 +237,35 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire()
     north = np.append(plain.pole_rows()["lam2_north"], 0.0)
     stretch = float(pear.disc.pole_rows()["lam2_north"] @ X[:-1])
     assert result.converged and abs(north @ result.x / stretch - 1) < 2 * scene.solver.max_error
+
+
+def test_mirror_on_the_mirrored_map_matches_the_traced_mirror(two_coil_picture):
+    """Two coils, M = 0.002: the stored mirror (the pear branch reflected, on the mirrored two-centre wire map)
+    against the mirror traced by its own continuation, which chooses its maps itself: the same map to 1e-9, the
+    same points (P, both pole stretches, solved degrees), the same stop; and the m ≥ 1 branch points found on the
+    stored mirror (``azimuthal_points``, on its own points) lie where the pear branch's do."""
+    from balloon_cg.analysis.results import Origin
+    from balloon_cg.analysis.switching import trace_pear
+
+    picture = two_coil_picture
+    branches = {b.name: b for b in picture.branches}
+    pear, mirror = branches["pear_0"], branches["pear_0_mirror"]
+    assert mirror.origin == Origin.REFLECTED and pear.disc.mapping is not None
+    traced = trace_pear(picture.primary, picture.branch_points[0], -1.0, "traced")
+    assert traced.disc.degree == mirror.disc.degree and len(traced.disc.mapping.centres) == 2
+    for ours, theirs in ((mirror.disc.mapping.centres, traced.disc.mapping.centres),
+                         (mirror.disc.mapping.widths, traced.disc.mapping.widths)):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-12)
+    assert mirror.disc.mapping.centres != pear.disc.mapping.centres
+    assert len(traced.X) == len(mirror.X) and np.array_equal(traced.degree, mirror.degree)
+    np.testing.assert_allclose(mirror.X[:, -1], traced.X[:, -1], rtol=1e-9)
+    for pole in ("lam2_north", "lam2_south"):
+        np.testing.assert_allclose(mirror.pole_values()[pole], traced.pole_values()[pole], rtol=1e-9)
+    assert [leg.stop.code for leg in mirror.legs] == [leg.stop.code for leg in traced.legs] == [StopCode.WIRE_GAP]
+    assert [(s.kind, s.index) for s in mirror.special if s.m == 0] == [(s.kind, s.index) for s in traced.special]
+    azimuthal = [[(s.index, s.block, s.X[-1]) for s in b.special if s.m > 0] for b in (pear, mirror)]
+    assert azimuthal[0] and [p[:2] for p in azimuthal[0]] == [p[:2] for p in azimuthal[1]]
+    np.testing.assert_allclose([p[2] for p in azimuthal[1]], [p[2] for p in azimuthal[0]], rtol=1e-9)
 
 
 def test_projection_is_accurate_at_high_degree():

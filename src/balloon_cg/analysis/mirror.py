@@ -63,8 +63,10 @@ def reflection(pear: Branch, south_turns: list[SpecialPoint], name: str) -> Bran
     swapped = {StopCode.STOP_STRETCH: south_stop_stretch(cont.stop_stretch),
                StopCode.SOUTH_STOP_STRETCH: north_stop_stretch(cont.stop_stretch)}
 
-    def stop(s: Stop) -> Stop:
-        return swapped.get(s.code, Stop(s.code, f"{s.message} (on {pear.name}, reflected z → −z)"))
+    def stop(s: Stop) -> Stop:  # the stops that name a pole or a coil are reflected; the others are the same
+        if s.code == StopCode.WIRE_GAP:
+            return Stop(s.code, f"{s.message} on {pear.name}; here the mirror image of that coil")
+        return swapped.get(s.code, s)
 
     special = [_reflected(s, pear.disc, stop) for s in pear.special + south_turns if s.kind != Kind.TP]
     return replace(mirror, special=sorted(special, key=lambda s: s.index),

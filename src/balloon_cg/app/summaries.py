@@ -134,6 +134,8 @@ def summarise_branch(b: dict) -> dict:
         "chi": float(attrs["chi"]),
         **({"voltage": _range(b["voltage"]), "parameter": attrs["parameter"]} if "voltage" in b else {}),
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
+        "origin": attrs.get("origin", "traced"),  # files written before reflected mirrors: every branch traced
+        "reflection_of": attrs.get("reflection_of", ""),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
 
@@ -193,7 +195,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
         *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
            f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]
           if b["basis_map"]["centres"] else []),
-        f"  points               {b['points']}",
+        f"  points               {b['points']}"
+        + (f"  (the reflection z → −z of {b['reflection_of']}, residuals checked)" if b["reflection_of"] else ""),
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
         *(["  voltage              {:.10g} .. {:.10g}".format(*b["voltage"]) + f"  (continued in {b['parameter']})"]
           if "voltage" in b else []),

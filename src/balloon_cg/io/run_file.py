@@ -12,8 +12,9 @@ Layout::
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
                                   kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
                                   the kernels), voltage (Φ̄, fixed unless it is the parameter), parameter
-                                  ("P" or "voltage": what the last unknown is), [parent_branch,
-                                  parent_branch_point, rejoins_branch_point]
+                                  ("P" or "voltage": what the last unknown is), origin (traced,
+                                  reflected, ...: analysis.results.Origin), [parent_branch,
+                                  parent_branch_point, rejoins_branch_point, reflection_of]
         point, unknown                                     dimension scales (0, 1, …)
         pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
@@ -163,6 +164,7 @@ def _write_branch(group, branch, theta):
         "electric": branch.scene.electric is not None,
         "voltage": branch.params.voltage,
         "parameter": branch.parameter,
+        "origin": branch.origin.value,
     })
     text = h5py.string_dtype()
     group.attrs.create("leg_labels", np.array([leg.label for leg in branch.legs], dtype=object), dtype=text)
@@ -172,6 +174,8 @@ def _write_branch(group, branch, theta):
         group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
     if branch.rejoins is not None:
         group.attrs["rejoins_branch_point"] = branch.rejoins
+    if branch.reflection_of:
+        group.attrs["reflection_of"] = branch.reflection_of
     volume = equilibrium_of(branch).volume
     volumes = 2 * np.pi * np.array([volume(u) for u in branch.X[:, :-1]])
     parameters = parameter_columns(branch, branch.X)
