@@ -1,7 +1,8 @@
 """Benchmark: stability per branch point (N = 20, m = 0 and 1) and the whole SPOM1 M = 0 picture.
 
 The picture is the primary branch 1 -> 6, stability of every point, the two pear branch points located and
-classified, and the isola (pear branch and its mirror) traced with stability on every point.
+classified, and the isola (the pear branch traced, its mirror image the reflection: analysis.mirror) with
+stability on every point (the mirror's copied).
 Times: best of 3, process CPU time (BLAS single-threaded, so on a shared machine the CPU time is the reliable one)
 and wall time in parentheses. Run: python benchmarks/stability.py
 """

@@ -1,11 +1,12 @@
 """The whole picture of a scene: primary branch, stability, branch points, pear branches, snap-through.
 
 ``analyse(scene)`` traces the primary branch, assesses every point (``stability``), locates and classifies its
-branch points (``bifurcation``), follows each pear-shaped branch both ways (the branch and its mirror image,
-north and south poles swapped: ``switching``) until it rejoins the primary branch (a fold candidate there is
-the rejoin's branch point: ``switching.mark_rejoin``) or stops, assesses those
-too, locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored
-with the branch, not in ``Picture.branch_points``) and lists the snap-throughs under the scene's loading control
+branch points (``bifurcation``), follows each pear-shaped branch (``switching``) until it rejoins the primary
+branch (a fold candidate there is the rejoin's branch point: ``switching.mark_rejoin``) or stops, assesses it,
+and adds its mirror image (north and south poles swapped: the reflection z → −z of the branch and its
+assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
+locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
+branch, not in ``Picture.branch_points``) and lists the snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. Every branch carries its assessments in
 ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
