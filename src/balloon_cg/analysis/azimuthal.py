@@ -375,6 +375,8 @@ def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int
 
 def merged_lowest(parts, count: int) -> np.ndarray:
     """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
+    if len(parts) == 1:
+        return eigen.lowest_of(parts[0], count)
     return np.sort(np.concatenate([eigen.lowest_of(A, count) for A in parts]))[:count]
 
 

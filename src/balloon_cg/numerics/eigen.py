@@ -53,16 +53,17 @@ def restricted(H, factor: GramFactor, normals=NO_CONSTRAINT, index=None, rcond: 
     block (k × n). Its eigenvalues are the pencil's on the constrained block, its inertia the block's."""
     H = np.ascontiguousarray(H, dtype=float)
     index = np.arange(H.shape[0]) if index is None else np.asarray(index, dtype=np.int64)
-    if factor.scale is not None:  # orthogonal basis: L⁻¹ H L⁻ᵀ is a scaling
-        A = _gather(H, index, factor.scale)
-    elif index.size >= LARGE_BLOCK:
-        A, info = dsygst(_gather(H, index, np.ones(index.size)), factor.lower, itype=1, lower=1)  # lower triangle
+    normals = np.atleast_2d(normals)
+    if factor.scale is not None:  # orthogonal basis: L⁻¹ H L⁻ᵀ is a scaling, gathered with the reflections
+        directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, index.size))
+        return _scaled_block(H, index, factor.scale, directions, rcond)
+    if index.size >= LARGE_BLOCK:
+        A, info = dsygst(_gather(H, index), factor.lower, itype=1, lower=1)  # lower triangle
         if info != 0:
             raise np.linalg.LinAlgError(f"dsygst failed (info = {info})")
         A = np.ascontiguousarray(A)
     else:
-        A = factor.inverse @ _gather(H, index, np.ones(index.size)) @ factor.inverse.T
-    normals = np.atleast_2d(normals)
+        A = factor.inverse @ _gather(H, index) @ factor.inverse.T
     directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, A.shape[0]))
     return _reflect_out(A, directions, rcond)
 
@@ -91,13 +92,13 @@ def lowest(H, factor: GramFactor, count: int, normals=NO_CONSTRAINT, index=None,
 
 
 @njit(cache=True)
-def _gather(H, index, scale):
-    """H[index][:, index] scaled: scale_i H_ij scale_j."""
+def _gather(H, index):
+    """H[index][:, index]."""
     n = index.size
     block = np.empty((n, n))
     for i in range(n):
         for j in range(n):
-            block[i, j] = scale[i] * H[index[i], index[j]] * scale[j]
+            block[i, j] = H[index[i], index[j]]
     return block
 
 
@@ -148,15 +149,34 @@ def _subtract_projection(rows, i, r):
 
 
 @njit(cache=True)
+def _scaled_block(H, index, scale, directions, rcond):
+    """``_reflect_out`` of the block H[index][:, index] scaled, scale_i H_ij scale_j (its lower triangle read)."""
+    n = index.size
+    B = np.empty((n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            B[i, j] = B[j, i] = scale[i] * H[index[i], index[j]] * scale[j]
+    return _reflect(B, directions, rcond)
+
+
+@njit(cache=True)
 def _reflect_out(A, directions, rcond):
-    """The symmetric matrix of A's lower triangle on the orthogonal complement of the rows of ``directions``: each
-    orthonormal direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two
-    update), then the first row and column dropped (and the first coordinate of the remaining directions)."""
+    """The symmetric matrix of A's lower triangle on the orthogonal complement of the rows of ``directions``
+    (``_reflect``)."""
     n = A.shape[0]
     B = np.empty((n, n))
     for i in range(n):
         for j in range(n):
             B[i, j] = A[i, j] if i >= j else A[j, i]
+    return _reflect(B, directions, rcond)
+
+
+@njit(cache=True)
+def _reflect(B, directions, rcond):
+    """The symmetric B (owned) on the orthogonal complement of the rows of ``directions``: each orthonormal
+    direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two update), then the
+    first row and column dropped (and the first coordinate of the remaining directions)."""
+    n = B.shape[0]
     D = _orthonormal_rows(directions, rcond)
     for r in range(D.shape[0]):
         v = D[r].copy()
