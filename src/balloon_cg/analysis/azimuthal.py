@@ -203,32 +203,42 @@ def state_maps(disc, b: AzimuthalBasis) -> StateMaps:
                      np.ascontiguousarray(np.concatenate([moments[1], moments[2]], axis=1)), zero)
 
 
-def _node_state(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> tuple:
-    """(λ2, λ2', η, η') of the axisymmetric state u at the nodes of ``b``."""
-    return tuple((np.asarray(u, dtype=float) @ state_maps(equilibrium.disc, b).state).reshape(4, -1))
+@lru_cache(maxsize=32)
+def kernel_state_map(disc, b: AzimuthalBasis, even: bool) -> np.ndarray:
+    """u @ map: the kernels' node state (λ2, v = λ2' sin θ, η, w = η') of the unknowns u of ``disc`` at the nodes
+    of ``b`` (only those x ≥ 0 if ``even``: AzimuthalBasis.even), its four rows one after the other."""
+    state = state_maps(disc, b).state.reshape(disc.size, 4, -1).copy()
+    state[:, 1] *= b.sin_theta
+    if even:
+        state = state[:, :, b.even[0]]
+    return np.ascontiguousarray(state.reshape(disc.size, -1))
 
 
-def _hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis):
-    """H from the node state (``_node_state``): the kernel's entries of h at every node (the AZIMUTHAL_PAIRS of
-    y = PERTURBATION, (21, n_q)), assembled by ``_assemble``."""
-    h = _node_hessian(equilibrium, state, params, m, b.x, b.sin_theta)
+def _node_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis, even: bool):
+    """The kernel's 21 entries of h (the AZIMUTHAL_PAIRS of y = PERTURBATION) at the nodes of ``b`` (x ≥ 0 only if
+    ``even``) for the axisymmetric state u, on the equilibrium's kernels held at those nodes."""
+    x, s = (b.x[b.even[0]], b.sin_theta[b.even[0]]) if even else (b.x, b.sin_theta)
+    nodes = equilibrium.at_nodes(("azimuthal", b, even), (x, s))
+    np.dot(np.asarray(u, dtype=float), kernel_state_map(equilibrium.disc, b, even), out=nodes.state.reshape(-1))
+    nodes.hold(params)
+    return nodes("azimuthal_hessian", params, m=float(m))
+
+
+def _hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis):
+    """H for the axisymmetric state u: the kernel's h at every node (``_node_hessian``), assembled by
+    ``_assemble``."""
+    h = _node_hessian(equilibrium, u, params, m, b, even=False)
     return _assemble(h, b.weights, _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS), b.ops_ud, b.ops_z)
 
 
-def _class_hessians(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:
-    """The blocks H[c, c] of the reflection classes c (AzimuthalBasis.classes) of an equator-symmetric state: H has
-    no entries between them, and within one every integrand is even in x, so each is assembled on the nodes
+def _class_hessians(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:
+    """The blocks H[c, c] of the reflection classes c (AzimuthalBasis.classes) of an equator-symmetric state u: H
+    has no entries between them, and within one every integrand is even in x, so each is assembled on the nodes
     x ≥ 0 and on its own columns (AzimuthalBasis.even)."""
-    keep, weights, columns = b.even
-    h = _node_hessian(equilibrium, tuple(value[keep] for value in state), params, m, b.x[keep], b.sin_theta[keep])
+    _, weights, columns = b.even
+    h = _node_hessian(equilibrium, u, params, m, b, even=True)
     row = _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS)
     return tuple(_assemble(h, weights, row, ops_ud, ops_z) for ops_ud, ops_z in columns)
-
-
-def _node_hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, x, s) -> np.ndarray:
-    """The kernel's 21 entries of h at the nodes x = cos θ, s = sin θ from (λ2, λ2', η, η') there."""
-    lam2, dlam2, eta, deta = state
-    return equilibrium.pointwise("azimuthal_hessian", (x, s), (lam2, dlam2 * s, eta, deta), params, m=float(m))
 
 
 @lru_cache(maxsize=4)
@@ -286,7 +296,7 @@ def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     axisymmetric state u (unknowns of ``equilibrium.disc``) at parameters ``params``, basis of ``degree`` N
     (module docstring; see ``perturbation_basis`` for the layout). Both are symmetric, of size 3(N − m + 1)."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    return _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b), b.gram
+    return _hessian(equilibrium, u, params, m, b), b.gram
 
 
 def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature: int = 0) -> AzimuthalBasis:
@@ -389,12 +399,11 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
     serve every reading."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    state = _node_state(equilibrium, u, b)
     moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
     if equilibrium.disc.symmetric:
-        parts = tuple(zip(_class_hessians(equilibrium, state, params, m, b), b.classes, b.class_factors, (0, 1)))
+        parts = tuple(zip(_class_hessians(equilibrium, u, params, m, b), b.classes, b.class_factors, (0, 1)))
     else:
-        parts = ((_hessian(equilibrium, state, params, m, b), None, b.factor, None),)
+        parts = ((_hessian(equilibrium, u, params, m, b), None, b.factor, None),)
     out = {}
     for held in readings:
         modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []
@@ -409,7 +418,7 @@ def _class_rows(moments, modes: list, cls, index):
     if cls is None:
         return moments[modes]
     kept = [k for k in modes if MODE_CLASS[k] == cls]
-    return moments[np.ix_(kept, index)] if kept else eigen.NO_CONSTRAINT
+    return moments[kept][:, index] if kept else eigen.NO_CONSTRAINT
 
 
 def excluded_modes(equilibrium: Equilibrium, params: Parameters, held: bool) -> tuple:

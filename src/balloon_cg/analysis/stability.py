@@ -32,7 +32,7 @@ import numpy as np
 from .azimuthal import merged_lowest, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes
-from ..galerkin.equilibrium import Parameters
+from ..galerkin.equilibrium import NodeKernels, Parameters
 from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
 from .resolution import Resolution
@@ -90,34 +90,34 @@ class SecondVariation:
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
         # an equator-symmetric state's blocks (even, odd) take only integrands even in x: the nodes x ≥ 0 serve
         self._even = self._even_tables() if self.eq.disc.symmetric else None
+        self._nodes = NodeKernels(self.eq, (self.basis.cos_theta, self.basis.sin_theta))  # the kernels at the nodes
 
     def _even_tables(self) -> tuple:
-        """(state map, geometry, weights, basis_a, basis_b, gradient ops) on the nodes x ≥ 0 (``even_half``)."""
+        """(state map, the kernels at the nodes, weights, basis_a, basis_b, gradient ops) on the nodes x ≥ 0
+        (``even_half``)."""
         b = self.basis
         keep, weights = even_half(b.x, b.weights)
         n_q = b.x.size
         state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])
         ops = np.ascontiguousarray(b.ops[:, keep])
-        return (state_map, (b.cos_theta[keep], b.sin_theta[keep]), weights, np.ascontiguousarray(b.basis_a[:, keep]),
-                np.ascontiguousarray(b.basis_b[:, keep]), np.ascontiguousarray(ops.reshape(-1, b.size).T))
+        return (state_map, NodeKernels(self.eq, (b.cos_theta[keep], b.sin_theta[keep])), weights,
+                np.ascontiguousarray(b.basis_a[:, keep]), np.ascontiguousarray(b.basis_b[:, keep]),
+                np.ascontiguousarray(ops.reshape(-1, b.size).T))
 
     def _even_matrices(self, u, params: Parameters):
         """``matrices`` of an equator-symmetric state, exact on the blocks even and odd only (entries between them,
         odd integrands, are not zero here and must not be read)."""
-        state_map, geometry, weights, basis_a, basis_b, gradient_ops = self._even
-        state = tuple((np.asarray(u, dtype=float) @ state_map).reshape(4, -1))
-        hessian = assemble_hessian(self.eq.pointwise("energy_hessian", geometry, state, params), weights, basis_a,
-                                   basis_b)
-        volume = -assemble_gradient(self.eq.pointwise("pressure_gradient", geometry, state, params), weights,
-                                    basis_a, basis_b, gradient_ops)
+        state_map, nodes, weights, basis_a, basis_b, gradient_ops = self._even
+        _hold(nodes, u, state_map, params)
+        hessian = assemble_hessian(nodes("energy_hessian", params), weights, basis_a, basis_b)
+        volume = -assemble_gradient(nodes("pressure_gradient", params), weights, basis_a, basis_b, gradient_ops)
         return hessian, volume
 
     def matrices(self, u, params: Parameters):
         """(H, g): the Hessian of E/2π and the gradient of Ṽ = V/2π on the perturbation basis."""
-        state = tuple((np.asarray(u, dtype=float) @ self.state_map).reshape(4, -1))
-        geometry = (self.basis.cos_theta, self.basis.sin_theta)
-        hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params))
-        volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params))
+        _hold(self._nodes, u, self.state_map, params)
+        hessian = self.basis.hessian(self._nodes("energy_hessian", params))
+        volume = -self.basis.gradient(self._nodes("pressure_gradient", params))
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):
@@ -207,6 +207,12 @@ class SecondVariation:
                 for flag in flags:
                     stable[flag] = False
         return tuple(stable)
+
+
+def _hold(nodes: NodeKernels, u, state_map: np.ndarray, params: Parameters):
+    """The node state u @ state_map (rows λ2, v, η, w) of the unknowns u into ``nodes``, held at ``params``."""
+    np.dot(np.asarray(u, dtype=float), state_map, out=nodes.state.reshape(-1))
+    nodes.hold(params)
 
 
 def block_indices(variation, block: str, field_on: bool):
