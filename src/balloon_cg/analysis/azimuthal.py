@@ -141,10 +141,13 @@ class AzimuthalBasis:
         parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
         classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
         put(self, "classes", classes)
-        # within a class every integrand is even in x: its blocks need only the nodes x ≥ 0 (``even_half``)
+        # within a class every integrand is even in x: its blocks need only the nodes x ≥ 0 (``even_half``), and
+        # only the class's own columns (Z ones first, as in the class's index order)
         keep, even_weights = even_half(x, weights)
-        put(self, "even", (keep, even_weights, np.ascontiguousarray(self.ops_ud[:, keep]),
-                           np.ascontiguousarray(self.ops_z[:, keep])))
+        nz = z.stop
+        put(self, "even", (keep, even_weights, tuple(
+            (np.ascontiguousarray(self.ops_ud[:, keep][:, :, c[c >= nz] - nz]),
+             np.ascontiguousarray(self.ops_z[:, keep][:, :, c[c < nz]])) for c in classes)))
         put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)], orthogonal=True) for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
@@ -200,24 +203,42 @@ def state_maps(disc, b: AzimuthalBasis) -> StateMaps:
                      np.ascontiguousarray(np.concatenate([moments[1], moments[2]], axis=1)), zero)
 
 
-def _node_state(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> tuple:
-    """(λ2, λ2', η, η') of the axisymmetric state u at the nodes of ``b``."""
-    return tuple((np.asarray(u, dtype=float) @ state_maps(equilibrium.disc, b).state).reshape(4, -1))
-
-
-def _hessian(equilibrium: Equilibrium, state: tuple, params: Parameters, m: int, b: AzimuthalBasis,
-             even: bool = False) -> np.ndarray:
-    """H from the node state (``_node_state``): the kernel's entries of h at every node (the AZIMUTHAL_PAIRS of
-    y = PERTURBATION, (21, n_q)), assembled by ``_assemble``. ``even``: an equator-symmetric state, on the nodes
-    x ≥ 0 (AzimuthalBasis.even): exact within each reflection class, the entries between classes not (never read)."""
-    row = _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS)
-    x, s, weights, ops_ud, ops_z = b.x, b.sin_theta, b.weights, b.ops_ud, b.ops_z
+@lru_cache(maxsize=32)
+def kernel_state_map(disc, b: AzimuthalBasis, even: bool) -> np.ndarray:
+    """u @ map: the kernels' node state (λ2, v = λ2' sin θ, η, w = η') of the unknowns u of ``disc`` at the nodes
+    of ``b`` (only those x ≥ 0 if ``even``: AzimuthalBasis.even), its four rows one after the other."""
+    state = state_maps(disc, b).state.reshape(disc.size, 4, -1).copy()
+    state[:, 1] *= b.sin_theta
     if even:
-        keep, weights, ops_ud, ops_z = b.even
-        x, s, state = x[keep], s[keep], tuple(value[keep] for value in state)
-    lam2, dlam2, eta, deta = state
-    h = equilibrium.pointwise("azimuthal_hessian", (x, s), (lam2, dlam2 * s, eta, deta), params, m=float(m))
-    return _assemble(h, weights, row, ops_ud, ops_z)
+        state = state[:, :, b.even[0]]
+    return np.ascontiguousarray(state.reshape(disc.size, -1))
+
+
+def _node_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis, even: bool):
+    """The kernel's 21 entries of h (the AZIMUTHAL_PAIRS of y = PERTURBATION) at the nodes of ``b`` (x ≥ 0 only if
+    ``even``) for the axisymmetric state u, on the equilibrium's kernels held at those nodes."""
+    x, s = (b.x[b.even[0]], b.sin_theta[b.even[0]]) if even else (b.x, b.sin_theta)
+    nodes = equilibrium.at_nodes(("azimuthal", b, even), (x, s))
+    np.dot(np.asarray(u, dtype=float), kernel_state_map(equilibrium.disc, b, even), out=nodes.state.reshape(-1))
+    nodes.hold(params)
+    return nodes("azimuthal_hessian", params, m=float(m))
+
+
+def _hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis):
+    """H for the axisymmetric state u: the kernel's h at every node (``_node_hessian``), assembled by
+    ``_assemble``."""
+    h = _node_hessian(equilibrium, u, params, m, b, even=False)
+    return _assemble(h, b.weights, _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS), b.ops_ud, b.ops_z)
+
+
+def _class_hessians(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:
+    """The blocks H[c, c] of the reflection classes c (AzimuthalBasis.classes) of an equator-symmetric state u: H
+    has no entries between them, and within one every integrand is even in x, so each is assembled on the nodes
+    x ≥ 0 and on its own columns (AzimuthalBasis.even)."""
+    _, weights, columns = b.even
+    h = _node_hessian(equilibrium, u, params, m, b, even=True)
+    row = _pair_rows(equilibrium.kernels.module.AZIMUTHAL_PAIRS)
+    return tuple(_assemble(h, weights, row, ops_ud, ops_z) for ops_ud, ops_z in columns)
 
 
 @lru_cache(maxsize=4)
@@ -229,19 +250,30 @@ _UD_ROWS = np.array([0, 1, 4, 5])  # R, R', T, T'
 _Z_ROWS = np.array([2, 3])  # Z, Z'
 
 
+@njit(cache=True)
 def _assemble(h, weights, row, ops_ud, ops_z):
     """H = Σ_q w_q Σ_kl h_kl(q) ∂y_k/∂c ∂y_l/∂c, h_kl in row ``row[k, l]`` of h, on the column groups (Z | U, D):
     (R, R', T, T') depend on the U, D coefficients only (``ops_ud``, (4, n_q, n_ud)), (Z, Z') on the Z ones only
     (``ops_z``, (2, n_q, n_z)); each group pair is one BLAS product of the stacked ops of one group with the
-    node-wise weighted combinations of the other's (``_weighted``); symmetrised."""
-    nz, nud = ops_z.shape[2], ops_ud.shape[2]
-    stacked_ud, stacked_z = ops_ud.reshape(-1, nud), ops_z.reshape(-1, nz)
-    H = np.empty((nz + nud, nz + nud))
-    H[nz:, nz:] = stacked_ud.T @ _weighted(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
-    H[:nz, :nz] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z).reshape(-1, nz)
-    H[:nz, nz:] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
-    H[nz:, :nz] = H[:nz, nz:].T
-    return 0.5 * (H + H.T)
+    node-wise weighted combinations of the other's (``_weighted``); symmetrised. One jitted call."""
+    nq, nz, nud = weights.size, ops_z.shape[2], ops_ud.shape[2]
+    n = nz + nud
+    H = np.zeros((n, n))
+    if nud:
+        H[nz:, nz:] = np.dot(ops_ud.reshape(4 * nq, nud).T,
+                             _weighted(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud).reshape(4 * nq, nud))
+    if nz:
+        stacked_z = ops_z.reshape(2 * nq, nz).T
+        H[:nz, :nz] = np.dot(stacked_z, _weighted(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z).reshape(2 * nq, nz))
+        if nud:
+            H[:nz, nz:] = np.dot(stacked_z, _weighted(h, weights, row, _Z_ROWS, _UD_ROWS, ops_ud).reshape(2 * nq, nud))
+    for i in range(n):
+        for j in range(i):
+            if j < nz <= i:  # the (U, D)–Z block: the transpose of the one computed
+                H[i, j] = H[j, i]
+            else:
+                H[i, j] = H[j, i] = 0.5 * (H[i, j] + H[j, i])
+    return H
 
 
 @njit(cache=True)
@@ -264,7 +296,7 @@ def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     axisymmetric state u (unknowns of ``equilibrium.disc``) at parameters ``params``, basis of ``degree`` N
     (module docstring; see ``perturbation_basis`` for the layout). Both are symmetric, of size 3(N − m + 1)."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    return _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b), b.gram
+    return _hessian(equilibrium, u, params, m, b), b.gram
 
 
 def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature: int = 0) -> AzimuthalBasis:
@@ -353,6 +385,8 @@ def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int
 
 def merged_lowest(parts, count: int) -> np.ndarray:
     """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
+    if len(parts) == 1:
+        return eigen.lowest_of(parts[0], count)
     return np.sort(np.concatenate([eigen.lowest_of(A, count) for A in parts]))[:count]
 
 
@@ -365,16 +399,16 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
     serve every reading."""
     b = perturbation_basis(equilibrium, m, degree, quadrature)
-    split = equilibrium.disc.symmetric
-    H = _hessian(equilibrium, _node_state(equilibrium, u, b), params, m, b, even=split)
     moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
-    parts = tuple(zip(b.classes, b.class_factors, (0, 1))) if split else ((None, b.factor, None),)
+    if equilibrium.disc.symmetric:
+        parts = tuple(zip(_class_hessians(equilibrium, u, params, m, b), b.classes, b.class_factors, (0, 1)))
+    else:
+        parts = ((_hessian(equilibrium, u, params, m, b), None, b.factor, None),)
     out = {}
     for held in readings:
         modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []
-        out[held] = tuple(
-            eigen.restricted(H, factor, _class_rows(moments, modes, cls, index), index)
-            for index, factor, cls in parts)
+        out[held] = tuple(eigen.restricted(H, factor, _class_rows(moments, modes, cls, index))
+                          for H, index, factor, cls in parts)
     return out
 
 
@@ -384,7 +418,7 @@ def _class_rows(moments, modes: list, cls, index):
     if cls is None:
         return moments[modes]
     kept = [k for k in modes if MODE_CLASS[k] == cls]
-    return moments[np.ix_(kept, index)] if kept else eigen.NO_CONSTRAINT
+    return moments[kept][:, index] if kept else eigen.NO_CONSTRAINT
 
 
 def excluded_modes(equilibrium: Equilibrium, params: Parameters, held: bool) -> tuple:

@@ -32,7 +32,7 @@ import numpy as np
 from .azimuthal import merged_lowest, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes
-from ..galerkin.equilibrium import Parameters
+from ..galerkin.equilibrium import NodeKernels, Parameters
 from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
 from .resolution import Resolution
@@ -90,34 +90,34 @@ class SecondVariation:
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
         # an equator-symmetric state's blocks (even, odd) take only integrands even in x: the nodes x ≥ 0 serve
         self._even = self._even_tables() if self.eq.disc.symmetric else None
+        self._nodes = NodeKernels(self.eq, (self.basis.cos_theta, self.basis.sin_theta))  # the kernels at the nodes
 
     def _even_tables(self) -> tuple:
-        """(state map, geometry, weights, basis_a, basis_b, gradient ops) on the nodes x ≥ 0 (``even_half``)."""
+        """(state map, the kernels at the nodes, weights, basis_a, basis_b, gradient ops) on the nodes x ≥ 0
+        (``even_half``)."""
         b = self.basis
         keep, weights = even_half(b.x, b.weights)
         n_q = b.x.size
         state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])
         ops = np.ascontiguousarray(b.ops[:, keep])
-        return (state_map, (b.cos_theta[keep], b.sin_theta[keep]), weights, np.ascontiguousarray(b.basis_a[:, keep]),
-                np.ascontiguousarray(b.basis_b[:, keep]), np.ascontiguousarray(ops.reshape(-1, b.size).T))
+        return (state_map, NodeKernels(self.eq, (b.cos_theta[keep], b.sin_theta[keep])), weights,
+                np.ascontiguousarray(b.basis_a[:, keep]), np.ascontiguousarray(b.basis_b[:, keep]),
+                np.ascontiguousarray(ops.reshape(-1, b.size).T))
 
     def _even_matrices(self, u, params: Parameters):
         """``matrices`` of an equator-symmetric state, exact on the blocks even and odd only (entries between them,
         odd integrands, are not zero here and must not be read)."""
-        state_map, geometry, weights, basis_a, basis_b, gradient_ops = self._even
-        state = tuple((np.asarray(u, dtype=float) @ state_map).reshape(4, -1))
-        hessian = assemble_hessian(self.eq.pointwise("energy_hessian", geometry, state, params), weights, basis_a,
-                                   basis_b)
-        volume = -assemble_gradient(self.eq.pointwise("pressure_gradient", geometry, state, params), weights,
-                                    basis_a, basis_b, gradient_ops)
+        state_map, nodes, weights, basis_a, basis_b, gradient_ops = self._even
+        _hold(nodes, u, state_map, params)
+        hessian = assemble_hessian(nodes("energy_hessian", params), weights, basis_a, basis_b)
+        volume = -assemble_gradient(nodes("pressure_gradient", params), weights, basis_a, basis_b, gradient_ops)
         return hessian, volume
 
     def matrices(self, u, params: Parameters):
         """(H, g): the Hessian of E/2π and the gradient of Ṽ = V/2π on the perturbation basis."""
-        state = tuple((np.asarray(u, dtype=float) @ self.state_map).reshape(4, -1))
-        geometry = (self.basis.cos_theta, self.basis.sin_theta)
-        hessian = self.basis.hessian(self.eq.pointwise("energy_hessian", geometry, state, params))
-        volume = -self.basis.gradient(self.eq.pointwise("pressure_gradient", geometry, state, params))
+        _hold(self._nodes, u, self.state_map, params)
+        hessian = self.basis.hessian(self._nodes("energy_hessian", params))
+        volume = -self.basis.gradient(self._nodes("pressure_gradient", params))
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):
@@ -138,9 +138,37 @@ class SecondVariation:
             cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)], orthogonal=True)  # Legendre in x
         return cache[key]
 
+    def _plan(self, symmetric: bool, field_on: bool) -> tuple:
+        """The m = 0 blocks (``blocks``): (name, on H_gas, index, on gᵀδ = 0, Gram factor, flags) each; cached."""
+        plans = self.__dict__.setdefault("_plans", {})
+        if (symmetric, field_on) in plans:
+            return plans[symmetric, field_on]
+        i, t = self.index, self.translation
+        if symmetric:  # the odd modes keep the volume to first order (g = 0 there): one odd block for all controls
+            even = np.concatenate([i["a_even"], i["b_odd"]])
+            odd_held = np.concatenate([i["a_odd"], i["b_even"][1:]])
+            plan = [("even", False, even, False, (HELD, FREE)),
+                    ("even_volume", False, even, True, (HELD_VOLUME, FREE_VOLUME)),
+                    ("even_gas", True, even, False, (HELD_GAS, FREE_GAS)), ("odd_held", False, odd_held, False, EVERY_FLAG)]
+            if field_on:
+                plan.append(("odd_free", False, np.append(odd_held, t), False, FREE_FLAGS))
+        else:
+            everything = np.arange(self.basis.size)
+            held_idx = everything[everything != t]
+            plan = [("all_held", False, held_idx, False, (HELD,) if field_on else (HELD, FREE)),
+                    ("all_volume_held", False, held_idx, True, (HELD_VOLUME,) if field_on else (HELD_VOLUME, FREE_VOLUME)),
+                    ("all_gas_held", True, held_idx, False, (HELD_GAS,) if field_on else (HELD_GAS, FREE_GAS))]
+            if field_on:
+                plan += [("all_free", False, everything, False, (FREE,)),
+                         ("all_volume_free", False, everything, True, (FREE_VOLUME,)),
+                         ("all_gas_free", True, everything, False, (FREE_GAS,))]
+        plans[symmetric, field_on] = tuple((name, gas, idx, constrained, self._gram_factor(idx), flags)
+                                           for name, gas, idx, constrained, flags in plan)
+        return plans[symmetric, field_on]
+
     def blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> list:
         """(name, standard matrices, flags) per block at one equilibrium: the block's pencil restricted to its
-        constraints, as one matrix or the matrices of its uncoupled parts (``_restricted``,
+        constraints, as one matrix or the matrices of its uncoupled parts (``_plan``, ``eigen.restricted``,
         ``azimuthal.restricted_blocks``), and the flags it enters (positions in
         FLAGS). Azimuthal blocks m = 1..m_max enter every flag (their modes keep the volume to first order, so
         every control mode sees the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
@@ -149,26 +177,9 @@ class SecondVariation:
         H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
         H_gas = H + (params.P / self.eq.volume(u)) * np.outer(g, g)  # module docstring
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
-        i, t = self.index, self.translation
-        if symmetric:  # the odd modes keep the volume to first order (g = 0 there): one odd block for all controls
-            even = np.concatenate([i["a_even"], i["b_odd"]])
-            odd_held = np.concatenate([i["a_odd"], i["b_even"][1:]])
-            plan = [("even", H, even, None, (HELD, FREE)), ("even_volume", H, even, g, (HELD_VOLUME, FREE_VOLUME)),
-                    ("even_gas", H_gas, even, None, (HELD_GAS, FREE_GAS)), ("odd_held", H, odd_held, None, EVERY_FLAG)]
-            if field_on:
-                plan.append(("odd_free", H, np.append(odd_held, t), None, FREE_FLAGS))
-        else:
-            everything = np.arange(H.shape[0])
-            held_idx = everything[everything != t]
-            plan = [("all_held", H, held_idx, None, (HELD,) if field_on else (HELD, FREE)),
-                    ("all_volume_held", H, held_idx, g, (HELD_VOLUME,) if field_on else (HELD_VOLUME, FREE_VOLUME)),
-                    ("all_gas_held", H_gas, held_idx, None, (HELD_GAS,) if field_on else (HELD_GAS, FREE_GAS))]
-            if field_on:
-                plan += [("all_free", H, everything, None, (FREE,)),
-                         ("all_volume_free", H, everything, g, (FREE_VOLUME,)),
-                         ("all_gas_free", H_gas, everything, None, (FREE_GAS,))]
-        out = [(name, (self._restricted(matrix, idx, constraint),), flags)
-               for name, matrix, idx, constraint, flags in plan]
+        matrices = (H, H_gas)
+        out = [(name, (eigen.restricted(matrices[gas], factor, g[idx] if constrained else eigen.NO_CONSTRAINT, idx),),
+                flags) for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on)]
         for m in range(1, m_max + 1):
             readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,))
             out.append((f"m{m}_held", readings[True], HELD_FLAGS if field_on else EVERY_FLAG))
@@ -196,6 +207,12 @@ class SecondVariation:
                 for flag in flags:
                     stable[flag] = False
         return tuple(stable)
+
+
+def _hold(nodes: NodeKernels, u, state_map: np.ndarray, params: Parameters):
+    """The node state u @ state_map (rows λ2, v, η, w) of the unknowns u into ``nodes``, held at ``params``."""
+    np.dot(np.asarray(u, dtype=float), state_map, out=nodes.state.reshape(-1))
+    nodes.hold(params)
 
 
 def block_indices(variation, block: str, field_on: bool):

@@ -48,6 +48,65 @@ class Parameters:
         return other
 
 
+class NodeKernels:
+    """The generated kernels at fixed nodes (cos θ, sin θ) on a node state held in arrays owned here.
+
+    The owner fills ``state`` ((4, n): λ2, v, η, w in the generated STATE order) and calls ``hold(params)``, which
+    evaluates the coil field H² and its derivatives at (ρ, η) = (λ2 sin θ, η) into ``field`` and checks the
+    material's domain there; ``__call__(kernel, params, **fixed)`` then runs the kernel's node loop on the held
+    arrays, its arguments bound once by name with the extra named values ``fixed`` (the azimuthal number m) and
+    only the scalar branch parameters refilled, into an output array owned here (valid until the next call of
+    the same kernel and fixed values). Material overrides (Parameters.mu, alpha, material) are bound by name at
+    every call."""
+
+    def __init__(self, equilibrium: "Equilibrium", geometry: tuple):
+        self.eq = equilibrium
+        self.geometry = geometry
+        kernels = equilibrium.kernels
+        n = geometry[0].shape[0]
+        self.state = np.empty((4, n))
+        self._rho = np.empty(n)
+        self.field = np.zeros((6, n)) if kernels.field_class else np.zeros((6, 0))
+        self.values = dict(zip(kernels.module.STATE, self.state), cos_theta=geometry[0], sin_theta=geometry[1],
+                            field=self.field if kernels.field_class else None)
+        self._templates = {}  # (kernel, fixed values) -> node loop, bound arguments, scalar slots, output
+
+    def hold(self, params: Parameters):
+        """The field at the held state (if there are coils), then the domain check (``Equilibrium._check_domain``)."""
+        coils = self.eq.coils
+        if coils.shape[0]:
+            np.multiply(self.state[0], self.geometry[1], out=self._rho)
+            field_squared_nodes(self._rho, self.state[2], coils, self.field)
+        if self.eq._domain_check:
+            self.eq._check_domain(self.geometry, tuple(self.state), params)
+
+    def __call__(self, kernel: str, params: Parameters, **fixed) -> np.ndarray:
+        if params.mu is not None or params.alpha is not None or params.material is not None:
+            return self.eq._evaluate(kernel, self.values | fixed, params)
+        key = (kernel, tuple(fixed.items()))
+        function, args, slots, out = self._templates.get(key) or self._template(key, params)
+        for slot, name in slots:
+            args[slot] = float(getattr(params, name))
+        function(*args, out)
+        if not finite(out):
+            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+        return out
+
+    def _template(self, key: tuple, params: Parameters) -> tuple:
+        """(the kernel's node loop, its arguments on the held arrays, the fixed values and the scene material as a
+        list, the (position, Parameters field) of each scalar branch parameter, its output array)."""
+        kernel, fixed = key
+        kernels = self.eq.kernels
+        spec = kernels.module.KERNELS[kernel]
+        slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"])
+                      if kind == "param" and name not in dict(fixed))
+        entry = (getattr(kernels.module, f"{kernel}_nodes"),
+                 list(kernels.arguments(kernel, self.values | dict(fixed), params)), slots,
+                 np.empty((len(spec["outputs"]), self.geometry[0].shape[0])))
+        self._templates[key] = entry
+        return entry
+
+
 class Equilibrium:
     """Residual, Jacobian and parameter derivatives of the Ritz–Galerkin system for one scene."""
 
@@ -60,17 +119,12 @@ class Equilibrium:
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
-        # the node state and field of the last u (``_pointwise``), in arrays owned here and refilled in place
-        n_q = discretisation.weights.size
+        # the node state and field of the last u (``_pointwise``), in arrays owned by ``nodes``, refilled in place
+        self.nodes = NodeKernels(self, self.geometry)
         self._held = np.empty(discretisation.size)
-        self._holding = False  # whether _held, _state and _field_rows are those of a u (and _held_material's)
+        self._holding = False  # whether _held and the nodes' state and field are those of a u (and _held_material's)
         self._held_material = None  # the material values the held state was checked for (its domain check)
-        self._state = np.empty((4, n_q))
-        self._rho = np.empty(n_q)
-        self._field_rows = np.zeros((6, n_q)) if self.kernels.field_class else np.zeros((6, 0))
-        self._values = dict(zip(self.kernels.module.STATE, self._state), cos_theta=self.geometry[0],
-                            sin_theta=self.geometry[1], field=self._field_rows if self.kernels.field_class else None)
-        self._templates = {}  # kernel -> its node loop, arguments on the held arrays, scalar slots and output array
+        self._at_nodes = {}  # key -> NodeKernels at other nodes (``at_nodes``)
         self._hessian = np.empty((discretisation.size, discretisation.size))  # bordered_jacobian's assembly
 
     def _field(self, lam2, sin_theta, eta):
@@ -114,46 +168,28 @@ class Equilibrium:
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 
+    def at_nodes(self, key, geometry: tuple) -> NodeKernels:
+        """The kernels at other nodes (cos θ, sin θ) = ``geometry`` (a second variation's), by a key that names them."""
+        if key not in self._at_nodes:
+            self._at_nodes[key] = NodeKernels(self, geometry)
+        return self._at_nodes[key]
+
     def _pointwise(self, kernel, u, params: Parameters):
-        """Kernel at the own nodes, into an array owned here (valid until the next call of the same kernel). The
-        state and field of the last u (and material values: its domain check) are reused (Newton asks for R, then
-        J); they are computed into arrays owned by this object."""
+        """Kernel at the own nodes, into an array owned by ``nodes`` (valid until the next call of the same kernel).
+        The state and field of the last u (and material values: its domain check) are reused (Newton asks for R,
+        then J)."""
         if not (self._holding and params.material == self._held_material and same_values(self._held, u)):
             self._hold(u, params)
-        if params.mu is not None or params.alpha is not None or params.material is not None:
-            return self._evaluate(kernel, self._values, params)  # material overrides: bound by name each time
-        function, args, slots, out = self._templates.get(kernel) or self._template(kernel, params)
-        for slot, name in slots:
-            args[slot] = float(getattr(params, name))
-        function(*args, out)
-        if not finite(out):
-            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
-        return out
+        return self.nodes(kernel, params)
 
     def _hold(self, u, params: Parameters):
         """The node state (Discretisation.node_state) and field of u into the held arrays; u and the material
         values held once the domain check passed."""
         self._holding = False
-        self.disc.node_state(u, self._state)
-        if self.coils.shape[0]:
-            np.multiply(self._state[0], self.disc.sin_theta, out=self._rho)
-            field_squared_nodes(self._rho, self._state[2], self.coils, self._field_rows)  # at (ρ, η)
-        if self._domain_check:
-            self._check_domain(self.geometry, tuple(self._state), params)  # rows in STATE order
+        self.disc.node_state(u, self.nodes.state)
+        self.nodes.hold(params)
         self._held[:] = u
         self._holding, self._held_material = True, params.material
-
-    def _template(self, kernel: str, params: Parameters) -> tuple:
-        """(the kernel's node loop, its arguments on the held node arrays and the scene material as a list, the
-        (position, Parameters field) of each scalar parameter, its output array): ``_pointwise`` only refills the
-        scalars. Bound once by name (KernelSet.arguments)."""
-        spec = self.kernels.module.KERNELS[kernel]
-        slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"]) if kind == "param")
-        entry = (getattr(self.kernels.module, f"{kernel}_nodes"),
-                 list(self.kernels.arguments(kernel, self._values, params)), slots,
-                 np.empty((len(spec["outputs"]), self.disc.weights.size)))
-        self._templates[kernel] = entry
-        return entry
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
         """(λ2, v, η, w) of the solution u at arbitrary interior angles θ."""

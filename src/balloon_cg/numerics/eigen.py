@@ -20,9 +20,10 @@ NO_CONSTRAINT = np.zeros((0, 1))
 # from this size on L⁻¹ H L⁻ᵀ is LAPACK's dsygst (n³ flops; n = 960: 43 ms) instead of two products with a stored
 # L⁻¹ (4n³ flops, but BLAS-3: faster on small blocks; n = 960: 119 ms, n = 60: 19 µs against 38 µs)
 LARGE_BLOCK = 200
-# below this size the lowest eigenvalues come from jitted loops (LAPACK's dsyevr costs ~30 µs at n = 20 and ~56 µs
-# at n = 30, mostly in its O(n) calls of level-2 BLAS and in the tridiagonal solver; the loops take ~11 and ~21 µs)
-SMALL_EIGEN = 40
+# below this size the lowest eigenvalues come from jitted loops (LAPACK's dsyevr, three eigenvalues: ~17, 31, 55 and
+# 92 µs at n = 20, 30, 41 and 57, mostly in its O(n) calls of level-2 BLAS and in the tridiagonal solver; the loops
+# ~8, 14, 27 and 56 µs, even at n = 80: benchmarks/eigen_small.py)
+SMALL_EIGEN = 64
 
 
 class GramFactor:
@@ -52,16 +53,17 @@ def restricted(H, factor: GramFactor, normals=NO_CONSTRAINT, index=None, rcond: 
     block (k × n). Its eigenvalues are the pencil's on the constrained block, its inertia the block's."""
     H = np.ascontiguousarray(H, dtype=float)
     index = np.arange(H.shape[0]) if index is None else np.asarray(index, dtype=np.int64)
-    if factor.scale is not None:  # orthogonal basis: L⁻¹ H L⁻ᵀ is a scaling
-        A = _gather(H, index, factor.scale)
-    elif index.size >= LARGE_BLOCK:
-        A, info = dsygst(_gather(H, index, np.ones(index.size)), factor.lower, itype=1, lower=1)  # lower triangle
+    normals = np.atleast_2d(normals)
+    if factor.scale is not None:  # orthogonal basis: L⁻¹ H L⁻ᵀ is a scaling, gathered with the reflections
+        directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, index.size))
+        return _scaled_block(H, index, factor.scale, directions, rcond)
+    if index.size >= LARGE_BLOCK:
+        A, info = dsygst(_gather(H, index), factor.lower, itype=1, lower=1)  # lower triangle
         if info != 0:
             raise np.linalg.LinAlgError(f"dsygst failed (info = {info})")
         A = np.ascontiguousarray(A)
     else:
-        A = factor.inverse @ _gather(H, index, np.ones(index.size)) @ factor.inverse.T
-    normals = np.atleast_2d(normals)
+        A = factor.inverse @ _gather(H, index) @ factor.inverse.T
     directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, A.shape[0]))
     return _reflect_out(A, directions, rcond)
 
@@ -90,13 +92,13 @@ def lowest(H, factor: GramFactor, count: int, normals=NO_CONSTRAINT, index=None,
 
 
 @njit(cache=True)
-def _gather(H, index, scale):
-    """H[index][:, index] scaled: scale_i H_ij scale_j."""
+def _gather(H, index):
+    """H[index][:, index]."""
     n = index.size
     block = np.empty((n, n))
     for i in range(n):
         for j in range(n):
-            block[i, j] = scale[i] * H[index[i], index[j]] * scale[j]
+            block[i, j] = H[index[i], index[j]]
     return block
 
 
@@ -147,15 +149,34 @@ def _subtract_projection(rows, i, r):
 
 
 @njit(cache=True)
+def _scaled_block(H, index, scale, directions, rcond):
+    """``_reflect_out`` of the block H[index][:, index] scaled, scale_i H_ij scale_j (its lower triangle read)."""
+    n = index.size
+    B = np.empty((n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            B[i, j] = B[j, i] = scale[i] * H[index[i], index[j]] * scale[j]
+    return _reflect(B, directions, rcond)
+
+
+@njit(cache=True)
 def _reflect_out(A, directions, rcond):
-    """The symmetric matrix of A's lower triangle on the orthogonal complement of the rows of ``directions``: each
-    orthonormal direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two
-    update), then the first row and column dropped (and the first coordinate of the remaining directions)."""
+    """The symmetric matrix of A's lower triangle on the orthogonal complement of the rows of ``directions``
+    (``_reflect``)."""
     n = A.shape[0]
     B = np.empty((n, n))
     for i in range(n):
         for j in range(n):
             B[i, j] = A[i, j] if i >= j else A[j, i]
+    return _reflect(B, directions, rcond)
+
+
+@njit(cache=True)
+def _reflect(B, directions, rcond):
+    """The symmetric B (owned) on the orthogonal complement of the rows of ``directions``: each orthonormal
+    direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two update), then the
+    first row and column dropped (and the first coordinate of the remaining directions)."""
+    n = B.shape[0]
     D = _orthonormal_rows(directions, rcond)
     for r in range(D.shape[0]):
         v = D[r].copy()
@@ -224,12 +245,20 @@ def _tridiagonal(A):
         for i in range(k + 1, n):
             p[i] = 0.0
         for i in range(k + 1, n):  # p = A₂₂ v from the lower triangle, row by row
-            total = A[i, i] * v[i]
             vi = v[i]
-            for j in range(k + 1, i):
-                total += A[i, j] * v[j]
+            even, odd = A[i, i] * vi, 0.0  # two partial sums: half the latency of the dot product
+            j = k + 1
+            while j + 1 < i:
+                a0, a1 = A[i, j], A[i, j + 1]
+                even += a0 * v[j]
+                odd += a1 * v[j + 1]
+                p[j] += a0 * vi
+                p[j + 1] += a1 * vi
+                j += 2
+            if j < i:
+                even += A[i, j] * v[j]
                 p[j] += A[i, j] * vi
-            p[i] += total
+            p[i] += even + odd
         pv = 0.0
         for i in range(k + 1, n):
             p[i] *= tau
@@ -249,16 +278,25 @@ def _tridiagonal(A):
 
 
 @njit(cache=True)
-def _sturm_counts(d, e2, x0, x1, x2, pivot):
-    """The number of eigenvalues below x of the tridiagonal (d, e² shifted: e2[i] = e[i−1]²) at three points x,
-    from the signs of the LDLᵀ pivots q_i = d_i − x − e²_i/q_{i−1} (a pivot below ``pivot`` in magnitude taken
-    as −pivot, as LAPACK's dstebz); the three recurrences interleaved (independent divisions overlap)."""
-    q0 = q1 = q2 = 1.0
+def _sturm_newton(d, e2, x, pivot, counts, slopes):
+    """At each of the three points x[j]: the number of eigenvalues below x[j] of the tridiagonal (d, e² shifted:
+    e2[i] = e[i−1]²), from the signs of the LDLᵀ pivots q_i = d_i − x − e²_i/q_{i−1} (a pivot below ``pivot``
+    in magnitude taken as −pivot, as LAPACK's dstebz), into counts[j]; and Σ_i q_i'/q_i = d ln|det(T − x)|/dx,
+    q_i' = −1 + e²_i q_{i−1}'/q_{i−1}², into slopes[j] (the Newton step on det(T − x) is −1/slope). One
+    reciprocal per pivot; the three recurrences interleaved (independent divisions overlap)."""
+    x0, x1, x2 = x[0], x[1], x[2]
+    r0 = r1 = r2 = 1.0  # 1/q_{i−1}
+    p0 = p1 = p2 = 0.0  # q_{i−1}'
+    s0 = s1 = s2 = 0.0
     c0 = c1 = c2 = 0
     for i in range(d.shape[0]):
-        q0 = d[i] - x0 - e2[i] / q0
-        q1 = d[i] - x1 - e2[i] / q1
-        q2 = d[i] - x2 - e2[i] / q2
+        f = e2[i]
+        p0 = -1.0 + f * p0 * r0 * r0
+        p1 = -1.0 + f * p1 * r1 * r1
+        p2 = -1.0 + f * p2 * r2 * r2
+        q0 = d[i] - x0 - f * r0
+        q1 = d[i] - x1 - f * r1
+        q2 = d[i] - x2 - f * r2
         if abs(q0) < pivot:
             q0 = -pivot
         if abs(q1) < pivot:
@@ -268,14 +306,23 @@ def _sturm_counts(d, e2, x0, x1, x2, pivot):
         c0 += q0 < 0.0
         c1 += q1 < 0.0
         c2 += q2 < 0.0
-    return c0, c1, c2
+        r0, r1, r2 = 1.0 / q0, 1.0 / q1, 1.0 / q2
+        s0 += p0 * r0
+        s1 += p1 * r1
+        s2 += p2 * r2
+    counts[0], counts[1], counts[2] = c0, c1, c2
+    slopes[0], slopes[1], slopes[2] = s0, s1, s2
 
 
 @njit(cache=True)
 def _lowest_tridiagonal(d, e, count):
-    """The ``count`` lowest eigenvalues (ascending) of the symmetric tridiagonal (d, e): bisection of Gershgorin's
-    interval on Sturm counts, three eigenvalues at a time, every count narrowing every interval, until each is
-    narrower than 4 ε ‖T‖ (the accuracy of any backward-stable method)."""
+    """The ``count`` lowest eigenvalues (ascending) of the symmetric tridiagonal (d, e), each to an interval of
+    width 4 ε ‖T‖ (the accuracy of any backward-stable method) on whose ends the Sturm counts differ: three
+    eigenvalues at a time, every count narrowing every interval, from Gershgorin's interval. The next point of an
+    eigenvalue is its interval's midpoint (bisection) until the interval holds it alone; then the Newton step on
+    det(T − x) from the last point (``_sturm_newton``) while it lands inside the interval and at least halves
+    the previous step, and once the step is below half the width, the point half a width beyond the Newton
+    estimate, which closes the interval from the other side."""
     n = d.shape[0]
     e2 = np.zeros(n)
     low, high = math.inf, -math.inf
@@ -288,24 +335,49 @@ def _lowest_tridiagonal(d, e, count):
     width = 4.0 * 2.220446049250313e-16 * max(abs(low), abs(high)) + 2.0 * pivot
     lower = np.full(count, low - width)
     upper = np.full(count, high + width)
+    below_lower = np.zeros(count, dtype=np.int64)  # the Sturm counts at the interval ends
+    below_upper = np.full(count, n, dtype=np.int64)
     x = np.empty(3)
+    counts = np.zeros(3, dtype=np.int64)
+    slopes = np.zeros(3)
+    step = np.full(3, math.inf)  # the lanes' last Newton steps
     out = np.empty(count)
     for start in range(0, count, 3):
+        for j in range(3):
+            k = min(start + j, count - 1)
+            x[j] = 0.5 * (lower[k] + upper[k])
+            step[j] = math.inf
         while True:
             settled = True
             for j in range(3):
                 k = min(start + j, count - 1)
-                x[j] = 0.5 * (lower[k] + upper[k])
                 settled = settled and upper[k] - lower[k] <= width
             if settled:
                 break
-            counts = _sturm_counts(d, e2, x[0], x[1], x[2], pivot)
+            _sturm_newton(d, e2, x, pivot, counts, slopes)
             for j in range(3):
                 for k in range(count):
                     if counts[j] > k:
-                        upper[k] = min(upper[k], x[j])
-                    else:
-                        lower[k] = max(lower[k], x[j])
+                        if x[j] < upper[k]:
+                            upper[k], below_upper[k] = x[j], counts[j]
+                    elif x[j] > lower[k]:
+                        lower[k], below_lower[k] = x[j], counts[j]
+            for j in range(3):
+                k = min(start + j, count - 1)
+                mid = 0.5 * (lower[k] + upper[k])
+                alone = below_lower[k] == k and below_upper[k] == k + 1 and slopes[j] != 0.0
+                delta = -1.0 / slopes[j] if alone else math.inf
+                if not (alone and abs(delta) <= 0.5 * step[j]):  # not isolated, no slope, or no contraction
+                    x[j], step[j] = mid, math.inf
+                    continue
+                guess = x[j] + delta
+                if abs(delta) <= 0.5 * width:
+                    guess += 0.5 * width if delta > 0.0 else -0.5 * width
+                if lower[k] < guess < upper[k]:
+                    x[j], step[j] = guess, abs(delta)
+                else:
+                    x[j], step[j] = mid, math.inf
         for j in range(min(3, count - start)):
-            out[start + j] = x[j]
+            k = start + j
+            out[k] = 0.5 * (lower[k] + upper[k])
     return out
