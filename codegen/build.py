@@ -53,8 +53,8 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
 def field_module_text() -> str:
     from . import field
 
-    title, inputs, kernels, constants = field.field_module()
-    return module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants)
+    title, inputs, kernels, constants, layout = field.field_module()
+    return module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants, layout)
 
 
 def _class_job(cls):

@@ -19,15 +19,27 @@ Kernels:
   elliptic_e; then E = (1 − m/2) K − N, with N = (1 − m/2) K − E supplied cancellation-free by the AGM
   (balloon_cg.model.elliptic.loop_elliptic), and every factor m − 1 becomes −m1, m1 = 1 − m also supplied exactly
   (m → 1 near a wire). In the (K, E) basis the numerator of G''' cancels ~850-fold at m = 1/2 (~2e-12 error
-  from a few-ulp E); in the (K, N) basis at most 26-fold for m ≥ 1/2, the branch this kernel serves.
-- ``STREAM_SERIES``: Maclaurin coefficients of G from K = π/2 ₂F₁(½,½;1;m), E = π/2 ₂F₁(−½,½;1;m).
+  from a few-ulp E); in the (K, N) basis at most 26-fold for m ≥ 1/2, the branch this kernel serves near a wire.
+- ``STREAM_PIECES``: Taylor coefficients a_k = G^(k)(c)/k! of G about the centre c of each piece of
+  2^-PIECE_OCTAVES ≤ m1 = 1 − m ≤ 1: octave o (2^-(o+1) ≤ m1 ≤ 2^-o) cut into PIECES_PER_OCTAVE equal pieces,
+  centre c1 = 1 − c and half-width w, listed by (o, i), PIECE_TERMS + 3 coefficients each (each derivative
+  G^(j), j ≤ 3, summed to PIECE_TERMS terms); ``STREAM_PIECE_CENTRES`` the c1, exact dyadic numbers.
+  G = π/32 ₂F₁(3/2, 3/2; 3; m) is analytic but at m = 1, so about c the terms fall like (w/(1 − c))^k
+  ≤ (2·PIECES_PER_OCTAVE + 1)^-k in every octave alike; the dropped tail of each G^(j) on its piece is at most
+  PIECE_TAIL of min G^(j) there (``piece_tail``).
 """
+import mpmath
 import sympy as sp
 
 from .kernels import Arg, Kernel
 
 STREAM_CONSTANT = 32
-SERIES_TERMS = 70
+PIECES_PER_OCTAVE = 8
+PIECE_OCTAVES = 12  # pieces cover 2^-12 ≤ m1 ≤ 1 (m ≤ 0.99976); the AGM closer to a wire
+PIECE_TERMS = 20  # terms per derivative: 17 meet PIECE_TAIL; a multiple of 4 for the runtime's four Horner chains
+PIECE_TAIL = mpmath.mpf(2) ** -60
+_TAIL_TERMS = 60  # terms of the dropped tail summed (beyond them < 17^-60 of the first dropped one)
+_DIGITS = 40
 
 rho, zeta = sp.symbols("rho zeta", real=True)
 a = sp.Symbol("a", positive=True)
@@ -78,17 +90,68 @@ def stream_shape_expressions():
     return tuple(out)
 
 
-def stream_series(terms=SERIES_TERMS):
-    """Exact Maclaurin coefficients g_n/π of G(m) = π Σ g_n m^n (g_0 = 1/32)."""
-    half = sp.Rational(1, 2)
-    k = [sp.rf(half, n) ** 2 / sp.factorial(n) ** 2 for n in range(terms + 2)]
-    e = [sp.rf(-half, n) * sp.rf(half, n) / sp.factorial(n) ** 2 for n in range(terms + 2)]
-    # (1 − m/2) K − E = π/2 Σ_n (k_n − e_n − k_{n−1}/2) m^n; the n = 0, 1 terms vanish.
-    return tuple((k[n] - e[n] - k[n - 1] / 2) / 2 for n in range(2, terms + 2))
+def pieces():
+    """(c1, w) of every piece, by octave o and index i: c1 = 2^-(o+1) (1 + (i + ½)/P), w = 2^-(o+1)/(2P)."""
+    out = []
+    for octave in range(PIECE_OCTAVES):
+        low = sp.Rational(1, 2 ** (octave + 1))
+        out += [(low * (1 + sp.Rational(2 * i + 1, 2 * PIECES_PER_OCTAVE)), low / (2 * PIECES_PER_OCTAVE))
+                for i in range(PIECES_PER_OCTAVE)]
+    return out
+
+
+def _dyadic(x):
+    """The rational x = p/2^n as an mpf (exact)."""
+    return mpmath.mpf(x.p) / x.q
+
+
+def stream_taylor(c1, terms):
+    """a_k = G^(k)(c)/k!, k < terms, c = 1 − c1 (mpf, working precision _DIGITS), from the hypergeometric
+    equation of G = π/32 ₂F₁(3/2, 3/2; 3; m): m(1 − m) G'' + (3 − 4m) G' − 9/4 G = 0 at m = c + t gives
+    a_{k+2} = ((k + 3/2)² a_k − ((1 − 2c) k + 3 − 4c)(k + 1) a_{k+1}) / (c(1 − c)(k + 1)(k + 2)),
+    from a_0, a_1 by ₂F₁ (G' = 3π/128 ₂F₁(5/2, 5/2; 4; m)). G is the dominant solution about c > 1/2; below,
+    the recurrence amplifies the other one by up to ((1 − c)/c)^k, so it runs with that many more digits."""
+    c1 = _dyadic(c1)
+    c = 1 - c1
+    growth = max(0.0, float(mpmath.log10(c1 / c)))
+    with mpmath.workdps(_DIGITS + int(terms * growth) + 10):
+        q, p, r = c * c1, 1 - 2 * c, 3 - 4 * c
+        a = [mpmath.pi / 32 * mpmath.hyp2f1(1.5, 1.5, 3, c), 3 * mpmath.pi / 128 * mpmath.hyp2f1(2.5, 2.5, 4, c)]
+        for k in range(terms - 2):
+            a.append(((k + 1.5) ** 2 * a[k] - (p * k + r) * (k + 1) * a[k + 1]) / (q * (k + 1) * (k + 2)))
+    with mpmath.workdps(_DIGITS):
+        return [+x for x in a[:terms]]
+
+
+def piece_tail(c1, w, terms=PIECE_TERMS):
+    """max over j ≤ 3 of the dropped tail Σ_{k ≥ terms} a_{k+j} (k + j)!/k! w^k of G^(j) about the piece's centre,
+    relative to min G^(j) on the piece, G^(j)(c − w) (every a_k > 0, so G^(j) grows with m)."""
+    a = stream_taylor(c1, terms + _TAIL_TERMS + 3)
+    w = _dyadic(w)
+    worst = mpmath.mpf(0)
+    with mpmath.workdps(_DIGITS):
+        for j in range(4):
+            row = [a[k + j] * mpmath.ff(k + j, j) for k in range(terms + _TAIL_TERMS)]
+            low = mpmath.fsum(x * (-w) ** k for k, x in enumerate(row))
+            worst = max(worst, mpmath.fsum(x * w**k for k, x in enumerate(row) if k >= terms) / low)
+    return worst
+
+
+def stream_pieces():
+    """STREAM_PIECE_CENTRES and STREAM_PIECES (module docstring); ValueError unless every piece's tail is within
+    PIECE_TAIL at PIECE_TERMS terms."""
+    centres, coefficients = [], []
+    for c1, w in pieces():
+        tail = piece_tail(c1, w)
+        if not tail <= PIECE_TAIL:
+            raise ValueError(f"piece at 1 - m = {c1}: tail {mpmath.nstr(tail, 3)} > 2^-60 with {PIECE_TERMS} terms")
+        centres.append(float(c1))
+        coefficients += [float(x) for x in stream_taylor(c1, PIECE_TERMS + 3)]
+    return tuple(centres), tuple(coefficients)
 
 
 def field_module():
-    """(title, inputs, kernels, constants) for ``generated/coil_field.py``."""
+    """(title, inputs, kernels, constants, layout) for ``generated/coil_field.py``."""
     coil_field = Kernel(
         name="coil_field",
         doc="Per-unit-current field of the loop of radius a at (rho, zeta = z - h), G0..G3 = G^(k)(m): "
@@ -109,10 +172,13 @@ def field_module():
         labels=tuple(map(str, G)),
         vectorise=False,
     )
-    constants = {"STREAM_SERIES": tuple(float(sp.N(sp.pi * g, 40)) for g in stream_series())}
+    centres, coefficients = stream_pieces()
+    constants = {"STREAM_PIECE_CENTRES": centres, "STREAM_PIECES": coefficients}
+    layout = {"STREAM_PIECE_GRID": (PIECES_PER_OCTAVE, PIECE_OCTAVES, PIECE_TERMS)}  # per octave, octaves, terms
     inputs = {
         "stream_function": f"psi = {STREAM_CONSTANT} a^2 rho^2 G(m) / S^3, m = 4 a rho / S^2",
-        "series_terms": SERIES_TERMS,
+        "stream_pieces": f"{PIECES_PER_OCTAVE} per octave of 1 - m, {PIECE_OCTAVES} octaves, {PIECE_TERMS} terms, "
+        "tail 2^-60",
     }
     title = "Applied field of one coaxial current loop: stream-function field, derivatives and G(m) (MODEL.md §3)."
-    return title, inputs, [coil_field, stream_shape_closed], constants
+    return title, inputs, [coil_field, stream_shape_closed], constants, layout

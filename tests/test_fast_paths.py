@@ -10,8 +10,7 @@
 - The node state and coil field the Equilibrium holds (in arrays of its own) against Discretisation.node_state
   and field_squared_nodes; the kernels on the held arrays with the scalars refilled in a
   bound argument list against binding by name; the held state against a fresh Equilibrium after other iterates.
-- The coil field's Maclaurin series summed only as far as m needs (``field.series_lengths``) against all its
-  terms; Parameters.with_value against the dataclass constructor.
+- Parameters.with_value against the dataclass constructor.
 """
 from pathlib import Path
 
@@ -178,24 +177,6 @@ def test_held_state_follows_the_iterate(two_coils):
         fresh = Equilibrium(scene, eq.disc)
         assert np.array_equal(eq.residual(u, p), fresh.residual(u, p))
         assert np.array_equal(eq.bordered_jacobian(u, p, "P"), fresh.bordered_jacobian(u, p, "P"))
-
-
-def _full_series(m):
-    """G and its first three derivatives from every generated Maclaurin term (Horner, as before the shortening)."""
-    g0 = g1 = g2 = g3 = np.zeros_like(m)
-    for c in field._SERIES[::-1]:
-        g3, g2, g1, g0 = g3 * m + g2, g2 * m + g1, g1 * m + g0, g0 * m + c
-    return np.array([g0, g1, 2.0 * g2, 6.0 * g3])
-
-
-def test_shortened_series_match_every_term():
-    lengths = field._LENGTHS
-    assert lengths[-1] == field._SERIES.size and (np.diff(lengths) >= 0).all() and lengths[0] < 20
-    m = np.concatenate([np.linspace(0.0, field.SERIES_SWITCH, 20001), np.array(field.SERIES_BOUNDS),
-                        np.nextafter(np.array(field.SERIES_BOUNDS[:-1]), 1.0)])
-    expected = _full_series(m)
-    got = np.array([field.stream_shape(value, 1.0 - value) for value in m]).T
-    assert np.abs(got / expected - 1.0).max() <= 2.5 * np.finfo(float).eps
 
 
 def test_with_value_is_the_constructor():

@@ -24,6 +24,7 @@ from balloon_cg.model.field import (
     stream_shape,
     wire_distance,
 )
+from balloon_cg.model import field
 from balloon_cg.generated.coil_field import stream_shape_closed
 from codegen import field as field_codegen
 from codegen.emit import module_text
@@ -220,11 +221,48 @@ def test_stream_shape_accuracy_and_continuity_at_switch():
         got = stream_shape(m, 1.0 - m)
         want = [_hypergeometric_shape(mpmath.mpf(m), k) for k in range(4)]
         assert got == pytest.approx(want, rel=1e-13)
-    k, n = loop_elliptic(0.5, 0.5)
-    series, closed = np.array(stream_shape(0.5, 0.5)), np.array(stream_shape_closed(0.5, 0.5, k, n))
-    assert np.max(np.abs(closed / series - 1.0)) < 1e-14
-    above = np.array(stream_shape(np.nextafter(0.5, 1.0), 0.5))
-    assert np.max(np.abs(above / series - 1.0)) < 1e-13
+    m1 = field.PIECE_FLOOR  # the last piece's lower end against the closed form (the AGM just below it)
+    k, n = loop_elliptic(1.0 - m1, m1)
+    piece, closed = np.array(stream_shape(1.0 - m1, m1)), np.array(stream_shape_closed(1.0 - m1, m1, k, n))
+    assert np.max(np.abs(closed / piece - 1.0)) < 1e-14
+    below = np.array(stream_shape(1.0 - m1, np.nextafter(m1, 0.0)))
+    assert np.max(np.abs(below / piece - 1.0)) < 1e-13
+
+
+def _mpmath_shape(m1):
+    """G^(j)(m), j ≤ 3, at m = 1 − m1 (m1 a float, taken exactly): mpmath's K and E in the closed form
+    ((1 − m/2) K − E)/m², differentiated by mpmath.diff, at 90 digits (the closed form cancels ~m² of them)."""
+    def shape(m):
+        return ((1 - m / 2) * mpmath.ellipk(m) - mpmath.ellipe(m)) / m**2
+
+    with mpmath.workdps(90):
+        m = 1 - mpmath.mpf(m1)
+        if m == 0:  # G = π/32 ₂F₁(3/2, 3/2; 3; m): G^(j)(0) = π/32 (3/2)_j² / (3)_j
+            return [float(mpmath.pi / 32 * mpmath.rf(1.5, j) ** 2 / mpmath.rf(3, j)) for j in range(4)]
+        return [float(mpmath.diff(shape, m, j)) for j in range(4)]
+
+
+def test_stream_shape_pieces_against_mpmath():
+    """Every piece at its ends (and one ulp inside and outside them), its centre and random points, m1 = 1 − m
+    given exactly: G..G''' within 3 ulp of mpmath's K, E closed form (the input is exact: condition 1)."""
+    per_octave, octaves, _ = field.STREAM_PIECE_GRID
+    ends = np.concatenate([2.0 ** -(o + 1) * (1.0 + np.arange(per_octave + 1) / per_octave) for o in range(octaves)])
+    ends = np.unique(ends)
+    m1 = np.concatenate([ends, np.nextafter(ends, 0.0), np.nextafter(ends, 2.0)[:-1], field._CENTRES,
+                         2.0 ** np.random.default_rng(11).uniform(-octaves, 0.0, 200)])
+    m1 = m1[m1 >= field.PIECE_FLOOR]
+    got = np.array([stream_shape(1.0 - x, x) for x in m1])
+    want = np.array([_mpmath_shape(x) for x in m1])
+    assert np.abs(got / want - 1.0).max() <= 3 * np.finfo(float).eps
+
+
+def test_stream_shape_pieces_match_the_agm_closed_form():
+    """Above m = 1/2 the pieces against the AGM and the generated closed form they replace there (which the
+    test above does not use): agreement to the closed form's own error (it cancels ≤ 26-fold in G''')."""
+    m1 = np.concatenate([np.linspace(field.PIECE_FLOOR, 0.5, 2001), 2.0 ** np.linspace(-12.0, -1.0, 2001)])
+    got = np.array([stream_shape(1.0 - x, x) for x in m1])
+    closed = np.array([stream_shape_closed(1.0 - x, x, *loop_elliptic(1.0 - x, x)) for x in m1])
+    assert np.abs(got / closed - 1.0).max() < 5e-14
 
 
 def test_complete_elliptic_matches_scipy():
@@ -281,7 +319,7 @@ def module_parts():
 
 
 def test_field_expressions_never_divide_by_rho(module_parts):
-    _, _, kernels, _ = module_parts
+    _, _, kernels, _, _ = module_parts
     coil_field = next(k for k in kernels if k.name == "coil_field")
     assert len(coil_field.outputs) == len(field_codegen.FIELD_NAMES) == 12
     for expr in coil_field.outputs:
@@ -290,14 +328,39 @@ def test_field_expressions_never_divide_by_rho(module_parts):
     assert inv_s2 == field_codegen.inv_s2 and sp.denom(expr).subs(field_codegen.rho, 0) != 0
 
 
-def test_stream_series_is_the_hypergeometric_series():
-    coefficients = field_codegen.stream_series(6)
-    assert coefficients[:4] == tuple(sp.Rational(p, q) for p, q in [(1, 32), (3, 128), (75, 4096), (245, 16384)])
-    for n, c in enumerate(coefficients):
-        assert c == sp.Rational(1, 32) * sp.rf(sp.Rational(3, 2), n) ** 2 / (sp.rf(3, n) * sp.factorial(n))
+def test_piece_coefficients_are_the_taylor_coefficients():
+    """The recurrence's a_k = G^(k)(c)/k! against the Maclaurin series of G = π/32 ₂F₁(3/2, 3/2; 3; m) re-expanded
+    about c (c ≤ 1/2: a_k = Σ_n g_n C(n, k) c^(n−k)) and, near a wire, against mpmath.diff of the K, E closed form."""
+    pieces = field_codegen.pieces()
+    with mpmath.workdps(50):
+        g = [mpmath.pi / 32 * mpmath.rf(1.5, n) ** 2 / (mpmath.rf(3, n) * mpmath.factorial(n)) for n in range(400)]
+        for c1, _ in (pieces[0], pieces[7]):  # c = 15/32 and 1/32
+            c = 1 - field_codegen._dyadic(c1)
+            want = [mpmath.fsum(g[n] * mpmath.binomial(n, k) * c ** (n - k) for n in range(k, 400)) for k in range(12)]
+            got = field_codegen.stream_taylor(c1, 12)
+            assert max(abs(x / y - 1) for x, y in zip(got, want)) < 1e-30
+    with mpmath.workdps(60):
+        c1 = pieces[-1][0]
+        c = 1 - field_codegen._dyadic(c1)
+        got = field_codegen.stream_taylor(c1, 5)
+        want = [mpmath.diff(lambda m: ((1 - m / 2) * mpmath.ellipk(m) - mpmath.ellipe(m)) / m**2, c, k)
+                / mpmath.factorial(k) for k in range(5)]
+        assert max(abs(x / y - 1) for x, y in zip(got, want)) < 1e-30
+
+
+def test_piece_tails_meet_the_bound():
+    """The dropped tails (piece_tail) of the lowest piece of an octave (the largest w/(1 − c)) and of the top one
+    (m near 0): within 2^-60 at the generated length; 16 terms would not be (so the bound sets the length)."""
+    pieces = field_codegen.pieces()
+    per_octave = field_codegen.PIECES_PER_OCTAVE
+    assert field.STREAM_PIECE_GRID == (per_octave, field_codegen.PIECE_OCTAVES, field_codegen.PIECE_TERMS)
+    for c1, w in (pieces[0], pieces[per_octave - 1], pieces[-per_octave]):
+        assert field_codegen.piece_tail(c1, w) <= field_codegen.PIECE_TAIL
+    assert field_codegen.piece_tail(*pieces[0], terms=16) > field_codegen.PIECE_TAIL
+    assert len(field.STREAM_PIECES) == len(pieces) * (field_codegen.PIECE_TERMS + 3)
 
 
 def test_generated_module_is_up_to_date(module_parts):
-    title, inputs, kernels, constants = module_parts
-    text = module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants)
+    title, inputs, kernels, constants, layout = module_parts
+    text = module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants, layout)
     assert GENERATED.read_text() == text, "generated/coil_field.py is stale: regenerate it from codegen.field"

@@ -6,12 +6,13 @@ S² = (a + ρ)² + ζ², m = 4aρ/S², G(m) = ((1 − m/2) K(m) − E(m))/m², v
 (derived and emitted by codegen/field.py; no division by ρ, so exact on the axis). At a loop's centre
 H = 2π/a.
 
-G and its m-derivatives come from the Maclaurin series for m ≤ 1/2 and above from the closed form in K and
-N = (1 − m/2) K − E, both from the AGM (N without cancellation); 1 − m = ((a − ρ)² + ζ²)/S² is formed exactly,
-so points near a wire keep their digits. The series is summed only as far as m needs (``series_lengths``: the
-dropped tail of each of G, G', G'', G''' at most 2^-60 of it; all 70 generated terms for 3/8 < m ≤ 1/2).
-The jitted functions return NaN within WIRE_TOLERANCE·a of a wire (the solver treats non-finite values as
-failures); the Python-level functions raise FieldError there instead.
+G and its m-derivatives come from m1 = 1 − m = ((a − ρ)² + ζ²)/S², formed to full relative precision so that
+points near a wire keep their digits. For m1 ≥ PIECE_FLOOR: the generated Taylor polynomials of G^(j), j ≤ 3,
+about the centre c of m1's piece (codegen/field.py: 8 pieces to each octave of m1, PIECE_TERMS terms, every
+dropped tail at most 2^-60 of the value on its piece), at t = m − c = c1 − m1 (exact); closer to a wire: the
+closed form in K and N = (1 − m/2) K − E, both from the AGM (N without cancellation). The jitted functions return
+NaN within WIRE_TOLERANCE·a of a wire (the solver treats non-finite values as failures); the Python-level
+functions raise FieldError there instead.
 
 ρ < 0 is read as the mirror point across the axis (h_ρ odd in ρ, h_z even), so rounding at a pole is harmless;
 at ρ = 0 exactly the odd-in-ρ entries are returned as exact zeros, so Q_ρ(0, z) = 0.
@@ -23,45 +24,30 @@ from numba import njit
 
 from .elliptic import loop_elliptic
 from ..generated import FIELD_ROWS
-from ..generated.coil_field import STREAM_SERIES, coil_field, stream_shape_closed
+from ..generated.coil_field import (
+    STREAM_PIECE_CENTRES,
+    STREAM_PIECE_GRID,
+    STREAM_PIECES,
+    coil_field,
+    stream_shape_closed,
+)
 
-SERIES_SWITCH = 0.5
 WIRE_TOLERANCE = 1e-12
-_SERIES = np.array(STREAM_SERIES)
-SERIES_TAIL = 2.0**-60  # the largest dropped tail of a shortened series, relative to the series' value
-SERIES_BOUNDS = (1 / 64, 1 / 32, 1 / 16, 1 / 8, 3 / 16, 1 / 4, 3 / 8, SERIES_SWITCH)  # m-intervals of one length
+PIECES_PER_OCTAVE, PIECE_OCTAVES, PIECE_TERMS = STREAM_PIECE_GRID
+PIECE_FLOOR = 2.0**-PIECE_OCTAVES  # m1 below it (m > 1 − 2^-12): the AGM
+_CENTRES = np.array(STREAM_PIECE_CENTRES)
 
 
-def series_lengths(series, bounds, tail: float = SERIES_TAIL) -> np.ndarray:
-    """For each bound m_b: the fewest leading terms K of G = Σ c_k m^k such that for every m ≤ m_b and j ≤ 3 the
-    dropped terms of G^(j) = Σ_k c_k k!/(k − j)! m^(k−j) sum to at most ``tail`` · c_j j!.
-
-    All c_k are positive, so c_j j! (the first term) is a lower bound of G^(j)(m), and the dropped sum grows with
-    m: checking it at m = m_b covers the interval. (The generated series' own truncation after its last term is
-    the same for every length and not counted.)"""
-    c = np.asarray(series, dtype=float)
-    if not (c > 0.0).all():
-        raise ValueError("series_lengths: the tail bound needs positive coefficients")
-    k = np.arange(c.size, dtype=float)
-    lengths = []
-    for bound in bounds:
-        length = c.size
-        for terms in range(4, c.size):
-            dropped = k[terms:]
-            falling = np.ones_like(dropped)  # k!/(k − j)!
-            for j in range(4):
-                if (c[terms:] * falling * bound ** (dropped - j)).sum() > tail * c[j] * math.factorial(j):
-                    break
-                falling = falling * (dropped - j)
-            else:
-                length = terms
-                break
-        lengths.append(length)
-    return np.array(lengths, dtype=np.int64)
+def derivative_rows(coefficients, terms: int) -> np.ndarray:
+    """(pieces, 4, terms): row j of a piece holds the Taylor coefficients a_{k+j} (k + j)!/k!, k < terms, of G^(j),
+    from the generated a_k = G^(k)(c)/k! (terms + 3 of them per piece)."""
+    a = np.asarray(coefficients, dtype=float).reshape(-1, terms + 3)
+    k = np.arange(terms, dtype=float)
+    falling = (np.ones(terms), k + 1.0, (k + 1.0) * (k + 2.0), (k + 1.0) * (k + 2.0) * (k + 3.0))
+    return np.ascontiguousarray(np.stack([a[:, j:j + terms] * falling[j] for j in range(4)], axis=1))
 
 
-_BOUNDS = np.array(SERIES_BOUNDS)
-_LENGTHS = series_lengths(_SERIES, SERIES_BOUNDS)
+_ROWS = derivative_rows(STREAM_PIECES, PIECE_TERMS)
 
 
 class FieldError(ValueError):
@@ -69,21 +55,32 @@ class FieldError(ValueError):
 
 
 @njit(cache=True)
+def _polynomial(c, t, t2, t4):
+    """Σ_k c_k t^k, k < PIECE_TERMS (a multiple of 4), by four interleaved Horner chains in t⁴: a quarter of the
+    latency (the constant length lets the four calls of stream_shape unroll into one straight line)."""
+    p0 = p1 = p2 = p3 = 0.0
+    for k in range(PIECE_TERMS - 4, -1, -4):
+        p0 = p0 * t4 + c[k]
+        p1 = p1 * t4 + c[k + 1]
+        p2 = p2 * t4 + c[k + 2]
+        p3 = p3 * t4 + c[k + 3]
+    return p0 + t * p1 + t2 * (p2 + t * p3)
+
+
+@njit(cache=True)
 def stream_shape(m, m1):
     """(G, G', G'', G''') at m, with m1 = 1 − m (pass 1.0 - m unless 1 − m is known more accurately)."""
-    if m <= SERIES_SWITCH:
-        g0 = g1 = g2 = g3 = 0.0
-        terms = _SERIES.shape[0]
-        for b in range(_BOUNDS.shape[0]):  # as many terms as m needs (series_lengths)
-            if m <= _BOUNDS[b]:
-                terms = _LENGTHS[b]
-                break
-        for k in range(terms - 1, -1, -1):  # Horner for the series and its derivatives / k!
-            g3 = g3 * m + g2
-            g2 = g2 * m + g1
-            g1 = g1 * m + g0
-            g0 = g0 * m + _SERIES[k]
-        return g0, g1, 2.0 * g2, 6.0 * g3
+    if m1 >= PIECE_FLOOR:
+        fraction, exponent = math.frexp(m1)  # m1 = f·2^e, ½ ≤ f < 1: octave −e, piece by f
+        piece = -exponent * PIECES_PER_OCTAVE + int((fraction - 0.5) * (2 * PIECES_PER_OCTAVE))
+        if piece < 0:  # m1 = 1 (on the axis): the top piece of octave 0
+            piece = PIECES_PER_OCTAVE - 1
+        t = _CENTRES[piece] - m1  # = m − c, exact (Sterbenz)
+        t2 = t * t
+        t4 = t2 * t2
+        rows = _ROWS[piece]
+        return (_polynomial(rows[0], t, t2, t4), _polynomial(rows[1], t, t2, t4),
+                _polynomial(rows[2], t, t2, t4), _polynomial(rows[3], t, t2, t4))
     k, n = loop_elliptic(m, m1)
     return stream_shape_closed(m, m1, k, n)
 
