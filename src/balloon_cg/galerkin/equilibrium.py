@@ -81,21 +81,27 @@ class NodeKernels:
             self.eq._check_domain(self.geometry, tuple(self.state), params)
 
     def __call__(self, kernel: str, params: Parameters, **fixed) -> np.ndarray:
+        return self.evaluate((kernel, tuple(fixed.items())) if fixed else kernel, params)
+
+    def evaluate(self, key, params: Parameters) -> np.ndarray:
+        """``__call__`` by key: the kernel's name, or (name, its fixed values as items) (no keyword packing: the
+        Equilibrium's Newton iterations call this)."""
         if params.mu is not None or params.alpha is not None or params.material is not None:
-            return self.eq._evaluate(kernel, self.values | fixed, params)
-        key = (kernel, tuple(fixed.items()))
+            kernel, fixed = (key, ()) if isinstance(key, str) else key
+            return self.eq._evaluate(kernel, self.values | dict(fixed), params)
         function, args, slots, out = self._templates.get(key) or self._template(key, params)
         for slot, name in slots:
             args[slot] = float(getattr(params, name))
         function(*args, out)
         if not finite(out):
+            kernel = key if isinstance(key, str) else key[0]
             raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
         return out
 
-    def _template(self, key: tuple, params: Parameters) -> tuple:
+    def _template(self, key, params: Parameters) -> tuple:
         """(the kernel's node loop, its arguments on the held arrays, the fixed values and the scene material as a
         list, the (position, Parameters field) of each scalar branch parameter, its output array)."""
-        kernel, fixed = key
+        kernel, fixed = (key, ()) if isinstance(key, str) else key
         kernels = self.eq.kernels
         spec = kernels.module.KERNELS[kernel]
         slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"])
@@ -180,7 +186,7 @@ class Equilibrium:
         then J)."""
         if not (self._holding and params.material == self._held_material and same_values(self._held, u)):
             self._hold(u, params)
-        return self.nodes(kernel, params)
+        return self.nodes.evaluate(kernel, params)
 
     def _hold(self, u, params: Parameters):
         """The node state (Discretisation.node_state) and field of u into the held arrays; u and the material
