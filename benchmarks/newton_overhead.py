@@ -3,7 +3,7 @@ for one or several installs of balloon-cg timed in alternating rounds of one run
 of a Newton iteration).
 
 The points are the 12 of benchmarks/baselines.py at the setting it chose for ours (degree, plain or wire-mapped
-basis; results/baselines.txt of 2026-12-01), warm-started from the converged neighbour at λ* − 0.02 exactly as
+basis; results/baselines.txt of 2026-12-02: two coils λ* 1.3 and 1.5 on the wire map, degrees 20 and 28), warm-started from the converged neighbour at λ* − 0.02 exactly as
 there. They are prepared once by this interpreter (traces, neighbours, wire maps) and handed to one worker
 process per install; each round asks every worker in turn for the best of REPEAT solves of every point (wall
 clock, single-threaded BLAS), and a point's time is its best over the rounds. Printed per point: the time of each
@@ -32,7 +32,7 @@ REPEAT = 200
 TOL = 1e-10  # the tightest of baselines.OUR_TOLS
 # (case index in work_precision.cases(), λ*, degree, wire-mapped basis): the settings baselines.py chose for ours
 POINTS = [(0, 1.3, 8, False), (0, 1.5, 8, False), (0, 2.0, 8, False), (0, 3.0, 8, False),
-          (1, 1.3, 28, False), (1, 1.5, 48, False), (1, 1.7, 40, True), (1, 1.8, 56, True),
+          (1, 1.3, 20, True), (1, 1.5, 28, True), (1, 1.7, 40, True), (1, 1.8, 56, True),
           (2, 1.3, 8, False), (2, 1.5, 10, False), (2, 2.0, 16, False), (2, 3.0, 40, False)]
 
 
