@@ -26,8 +26,8 @@ point the cheapest of its settings that reaches the error level is taken (the sa
      (ii), its tolerance is a setting: the cheapest of OUR_TOLS (Newton's scaled step and error estimate) that
      meets the error at that degree; its achieved error is checked against the reference like theirs.
 
-Timing: process CPU time (compared) and wall time, best of the repeats (a run longer than 2 s is not
-repeated); (ii) and (iii) at their chosen settings are then timed again in alternating rounds (best of all),
+Timing: process CPU time (compared) and wall time, best of the repeats: at least REPEAT_* runs and as many
+as fit in BUDGET = 50 ms, the same for every method (a run longer than 2 s is not repeated); (ii) and (iii) at their chosen settings are then timed again in alternating rounds (best of all),
 so that a burst of load from other processes hits both alike. BLAS single-threaded for all methods (see
 benchmarks/work_precision.py on the loaded machine).
 
@@ -51,6 +51,7 @@ EPS_IVP = 1e-4
 EPS_BVP = 1e-3
 REPEAT_OURS = 9
 REPEAT_BASELINE = 5
+BUDGET = 0.05  # seconds of repeats per timing, at least REPEAT_* runs (``timed``)
 ALTERNATIONS = 3  # extra alternating timing rounds of (ii) and (iii) at their chosen settings
 # (solve_ivp rtol = atol, Nelder–Mead xatol); fatol is 1e-30 throughout (termination by xatol)
 PAPER_SETTINGS = ((1e-9, 1e-9), (1e-10, 1e-10), (1e-11, 1e-11), (1e-12, 1e-12))
@@ -164,12 +165,16 @@ def bvp_method(system, lam, X_neighbour, disc, P0, tol, nodes=60):
 
 
 def timed(function, repeat, *args):
-    """(best CPU seconds, best wall seconds, last output); runs longer than 2 s are not repeated."""
+    """(best CPU seconds, best wall seconds, last output) of at least ``repeat`` runs and as many more as fit in
+    BUDGET seconds (the same budget for every method: a 0.1 ms solve gets hundreds of samples, a 6 ms one about
+    eight, so a burst of load cannot cover all of either's); runs longer than 2 s are not repeated."""
     cpu, wall, out = np.inf, np.inf, None
-    for _ in range(repeat):
+    start, runs = time.perf_counter(), 0
+    while runs < repeat or time.perf_counter() - start < BUDGET:
         t0, c0 = time.perf_counter(), time.process_time()
         out = function(*args)
         cpu, wall = min(cpu, time.process_time() - c0), min(wall, time.perf_counter() - t0)
+        runs += 1
         if wall > 2.0:
             break
     return cpu, wall, out
@@ -277,8 +282,8 @@ def main():
         f"total wall time {time.perf_counter() - t_start:.0f} s",
     ]
     head = [
-        f"Baselines at matched error (|P/P_ref − 1| ≤ {LEVEL:g}), time per point (best of {REPEAT_BASELINE} "
-        f"for the baselines, {REPEAT_OURS} for ours; CPU and wall), warm starts from the neighbour at λ* − 0.02.",
+        f"Baselines at matched error (|P/P_ref − 1| ≤ {LEVEL:g}), time per point (best of the runs in "
+        f"{BUDGET * 1e3:.0f} ms, at least {REPEAT_BASELINE} for the baselines, {REPEAT_OURS} for ours; CPU and wall), warm starts from the neighbour at λ* − 0.02.",
         "Each cell: time, achieved error, the cheapest setting that met the level. See the module docstring.",
         "",
     ]
