@@ -250,30 +250,32 @@ _UD_ROWS = np.array([0, 1, 4, 5])  # R, R', T, T'
 _Z_ROWS = np.array([2, 3])  # Z, Z'
 
 
-@njit(cache=True)
 def _assemble(h, weights, row, ops_ud, ops_z):
     """H = Σ_q w_q Σ_kl h_kl(q) ∂y_k/∂c ∂y_l/∂c, h_kl in row ``row[k, l]`` of h, on the column groups (Z | U, D):
     (R, R', T, T') depend on the U, D coefficients only (``ops_ud``, (4, n_q, n_ud)), (Z, Z') on the Z ones only
     (``ops_z``, (2, n_q, n_z)); each group pair is one BLAS product of the stacked ops of one group with the
-    node-wise weighted combinations of the other's (``_weighted``); symmetrised. One jitted call."""
-    nq, nz, nud = weights.size, ops_z.shape[2], ops_ud.shape[2]
-    n = nz + nud
-    H = np.zeros((n, n))
-    if nud:
-        H[nz:, nz:] = np.dot(ops_ud.reshape(4 * nq, nud).T,
-                             _weighted(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud).reshape(4 * nq, nud))
-    if nz:
-        stacked_z = ops_z.reshape(2 * nq, nz).T
-        H[:nz, :nz] = np.dot(stacked_z, _weighted(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z).reshape(2 * nq, nz))
-        if nud:
-            H[:nz, nz:] = np.dot(stacked_z, _weighted(h, weights, row, _Z_ROWS, _UD_ROWS, ops_ud).reshape(2 * nq, nud))
+    node-wise weighted combinations of the other's (``_weighted``); symmetrised (``_symmetrise``). The products
+    stay in numpy: numba's np.dot would cost seconds of compilation at a cold start."""
+    nz, nud = ops_z.shape[2], ops_ud.shape[2]
+    stacked_ud, stacked_z = ops_ud.reshape(-1, nud), ops_z.reshape(-1, nz)
+    H = np.empty((nz + nud, nz + nud))
+    H[nz:, nz:] = stacked_ud.T @ _weighted(h, weights, row, _UD_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
+    H[:nz, :nz] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _Z_ROWS, ops_z).reshape(-1, nz)
+    H[:nz, nz:] = stacked_z.T @ _weighted(h, weights, row, _Z_ROWS, _UD_ROWS, ops_ud).reshape(-1, nud)
+    _symmetrise(H, nz)
+    return H
+
+
+@njit(cache=True)
+def _symmetrise(H, nz):
+    """H ← (H + Hᵀ)/2 on the diagonal group blocks; the lower (U, D)–Z block the transpose of the upper one."""
+    n = H.shape[0]
     for i in range(n):
         for j in range(i):
-            if j < nz <= i:  # the (U, D)–Z block: the transpose of the one computed
+            if j < nz <= i:
                 H[i, j] = H[j, i]
             else:
                 H[i, j] = H[j, i] = 0.5 * (H[i, j] + H[j, i])
-    return H
 
 
 @njit(cache=True)

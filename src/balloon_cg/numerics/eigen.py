@@ -43,8 +43,9 @@ class GramFactor:
         self.inverse = np.diag(self.scale) if orthogonal else np.linalg.inv(lower)
 
     def directions(self, normals) -> np.ndarray:
-        """The rows L⁻¹nᵢ of the constraint rows nᵢ (k × n)."""
-        return normals * self.scale if self.scale is not None else normals @ self.inverse.T
+        """The rows L⁻¹nᵢ of the constraint rows nᵢ (k × n), C-ordered whatever the normals' layout (the jitted
+        reflections then compile for one layout only)."""
+        return np.ascontiguousarray(normals * self.scale if self.scale is not None else normals @ self.inverse.T)
 
 
 def restricted(H, factor: GramFactor, normals=NO_CONSTRAINT, index=None, rcond: float = RCOND) -> np.ndarray:
