@@ -77,8 +77,10 @@ class WernerSpence:
     def full_hessian(self, c, params):
         """Generated Hessian on the perturbation basis at the (general) coefficient vector c."""
         b = self.basis
-        state = tuple(b.node_state(c))
-        return b.hessian(self.eq.pointwise("energy_hessian", (b.cos_theta, b.sin_theta), state, params))
+        nodes = self.eq.at_nodes(("branch_point", b), (b.cos_theta, b.sin_theta))
+        b.node_state(c, nodes.state)
+        nodes.hold(params)
+        return b.hessian(nodes("energy_hessian", params))
 
     def odd_hessian(self, u, params):
         return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]

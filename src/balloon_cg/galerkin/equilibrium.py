@@ -133,28 +133,6 @@ class Equilibrium:
         self._at_nodes = {}  # key -> NodeKernels at other nodes (``at_nodes``)
         self._hessian = np.empty((discretisation.size, discretisation.size))  # bordered_jacobian's assembly
 
-    def _field(self, lam2, sin_theta, eta):
-        """H² and its derivatives at the nodes (zeros for a field class without coils)."""
-        if not self.kernels.field_class:
-            return None
-        field = np.zeros((6, lam2.shape[0]))
-        if self.coils.shape[0]:
-            field_squared_nodes(lam2 * sin_theta, eta, self.coils, field)
-        return field
-
-    def pointwise(self, kernel: str, geometry: tuple, state: tuple, params: Parameters, field=None,
-                  **values) -> np.ndarray:
-        """A generated kernel at nodes with (cos θ, sin θ) = geometry and (λ2, v, η, w) = state, one row per
-        output; ``values`` are further named arguments (the azimuthal number m)."""
-        if field is None:
-            field = self._field(state[0], geometry[1], state[2])
-        return self._evaluate(kernel, self._node_values(geometry, state, field, params) | values, params)
-
-    def _node_values(self, geometry: tuple, state: tuple, field, params: Parameters) -> dict:
-        """The kernels' node arguments by name (``_check_domain`` first)."""
-        self._check_domain(geometry, state, params)
-        return dict(zip(self.kernels.module.STATE, state), cos_theta=geometry[0], sin_theta=geometry[1], field=field)
-
     def _check_domain(self, geometry: tuple, state: tuple, params: Parameters):
         """NonFiniteState if a node's stretches leave the domain of the material at ``params`` (a strain energy
         with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
