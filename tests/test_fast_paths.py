@@ -12,6 +12,8 @@
   bound argument list against binding by name; the held state against a fresh Equilibrium after other iterates.
 - Parameters.with_value against the dataclass constructor.
 """
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -185,3 +187,26 @@ def test_with_value_is_the_constructor():
     assert params.P == 1.0
     with pytest.raises(TypeError, match="no field 'Q'"):
         params.with_value("Q", 1.0)
+
+
+def test_a_default_run_compiles_every_jitted_loop_once(tmp_path):
+    """numba types a read-only array apart from a writable one: a second variation's node tables handed to the
+    loops as writable arrays compiled energy_hessian_nodes, its assembly and the gradient loops a second time
+    (~1.8 s of a cold start). After a default run (a fresh process) every dispatcher of balloon_cg holds one
+    signature."""
+    code = f"""
+import gc
+from numba.core.registry import CPUDispatcher
+from balloon_cg.app.cli import main
+try:
+    main(["run", {str(ROOT / "scenes" / "spom1.toml")!r}, "-o", {str(tmp_path / "run.h5")!r}, "--quiet"])
+except SystemExit as stop:
+    assert not stop.code, stop.code
+for obj in gc.get_objects():
+    if isinstance(obj, CPUDispatcher) and obj.py_func.__module__.startswith("balloon_cg"):
+        print(obj.py_func.__module__, obj.py_func.__name__, len(obj.signatures))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    counts = [line.rsplit(" ", 1) for line in out.splitlines()]
+    assert any(name.endswith("energy_hessian_nodes") for name, _ in counts)
+    assert [name for name, count in counts if int(count) > 1] == []

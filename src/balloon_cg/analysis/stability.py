@@ -31,7 +31,8 @@ import numpy as np
 
 from .azimuthal import merged_lowest, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
-from ..galerkin.discretisation import Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes
+from ..galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
+                                       read_only)
 from ..galerkin.equilibrium import NodeKernels, Parameters
 from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
@@ -100,9 +101,9 @@ class SecondVariation:
         n_q = b.x.size
         state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])
         ops = np.ascontiguousarray(b.ops[:, keep])
-        return (state_map, NodeKernels(self.eq, (b.cos_theta[keep], b.sin_theta[keep])), weights,
-                np.ascontiguousarray(b.basis_a[:, keep]), np.ascontiguousarray(b.basis_b[:, keep]),
-                np.ascontiguousarray(ops.reshape(-1, b.size).T))
+        tables = (read_only(weights), *(read_only(np.ascontiguousarray(t[:, keep])) for t in (b.basis_a, b.basis_b)),
+                  read_only(np.ascontiguousarray(ops.reshape(-1, b.size).T)))
+        return (state_map, NodeKernels(self.eq, (b.cos_theta[keep], b.sin_theta[keep])), *tables)
 
     def _even_matrices(self, u, params: Parameters):
         """``matrices`` of an equator-symmetric state, exact on the blocks even and odd only (entries between them,

@@ -34,6 +34,14 @@ def legendre_table(x: np.ndarray, degree: int):
     return p, dp
 
 
+def read_only(array: np.ndarray) -> np.ndarray:
+    """A read-only view of ``array``. Every table handed to the jitted node loops is read-only (as a
+    Discretisation's are), so that each loop compiles once: numba types a read-only array apart."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
 def symmetric_rows(pairs) -> np.ndarray:
     """rows[k, l] = rows[l, k] = r for the r-th (k, l) of ``pairs``: where a symmetric matrix stored as the listed
     entries (the generated HESSIAN_PAIRS) keeps h_kl."""

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .discretisation import Discretisation
+from .discretisation import Discretisation, read_only
 from ..model.field import field_squared_nodes
 from ..model.kernels import KernelSet
 from ..numerics.newton import finite
@@ -61,7 +61,7 @@ class NodeKernels:
 
     def __init__(self, equilibrium: "Equilibrium", geometry: tuple):
         self.eq = equilibrium
-        self.geometry = geometry
+        self.geometry = geometry = tuple(read_only(g) for g in geometry)  # one compile of every node loop
         kernels = equilibrium.kernels
         n = geometry[0].shape[0]
         self.state = np.empty((4, n))
