@@ -46,10 +46,11 @@ def _embed(symmetric: Discretisation, general: Discretisation, u):
     return general.join(a, b)
 
 
-@pytest.mark.parametrize("degree", [12, 40])  # jitted loops (< SMALL_SYSTEM unknowns) and BLAS
+@pytest.mark.parametrize("degree", [12, 64])  # jitted loops (< SMALL_SYSTEM unknowns) and BLAS
 def test_symmetric_half_nodes_match_every_node(two_coils, degree):
     scene, branch = two_coils
     sym = Discretisation(degree, True, False)
+    assert (sym.size < SMALL_SYSTEM) == (degree == 12)
     full = Discretisation(degree, False, False, quadrature=gauss_nodes(degree))
     assert sym.cos_theta.size < full.cos_theta.size and sym.x.size == full.x.size
     X = branch.disc.transfer(branch.X[len(branch.X) // 2], sym)
@@ -67,8 +68,9 @@ def test_symmetric_half_nodes_match_every_node(two_coils, degree):
     assert eq_sym.volume(u) == pytest.approx(eq_full.volume(v), rel=1e-13)
 
 
-def test_small_system_loops_match_the_node_sums():
-    disc = Discretisation(12, False, True)
+@pytest.mark.parametrize("degree", [12, 20])
+def test_small_system_loops_match_the_node_sums(degree):
+    disc = Discretisation(degree, False, True)
     assert disc.size < SMALL_SYSTEM
     rng = np.random.default_rng(3)
     n_q = disc.weights.size

@@ -54,10 +54,10 @@ def symmetric_rows(pairs) -> np.ndarray:
 
 _HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
 # below this many unknowns the node state and the Hessian are computed in jitted loops, from it by BLAS
-# (the loops win while call overhead dominates: Hessian at 9 unknowns 1.3 µs against 6.7 µs, at 25 5.9 against
-# 8.1, at 33 18 against 9.6; node state at 9 0.4 against 1.2, at 29 0.8 against 1.5, at 49 1.8 against 2.0, at 97
-# 10 against 5; measured single-threaded)
-SMALL_SYSTEM = 30
+# (the loops win while call overhead dominates: Hessian at 17 unknowns 2.0 µs against 7.3 µs, at 29 5.2 against
+# 9.0, at 41 10.6-11.5 against 11.4-12.0, at 49 16-18 against 14-15; node state at 9 0.4 against 1.2, at 29 0.8
+# against 1.5, at 49 1.8 against 2.0, at 97 10 against 5; measured single-threaded)
+SMALL_SYSTEM = 45
 # the gradient's loops (over the blocks of ops that are not zero) win longer: 1.0 µs against 2.3 at 29 unknowns,
 # 1.8 against 3.0 at 49, 3.1 against 3.5 at 65, 4.5 against 4.6 at 97, 8.0 against 6.3 at 129
 SMALL_GRADIENT = 100
@@ -112,12 +112,14 @@ def assemble_hessian(pointwise, weights, A, B, out=None) -> np.ndarray:
 
     (λ2, v) depend only on the a-coefficients and (η, w) only on the b-coefficients, so each of the three blocks
     aa, ab, bb is one BLAS product of the stacked basis with its node-wise weighted partner; below SMALL_SYSTEM
-    unknowns the same sums are one jitted pass (``_hessian_loops``)."""
+    unknowns the same sums are one jitted pass (``_hessian_loops``). ``out``: the leading na + nb columns of a
+    C-ordered array (a bordered Jacobian's rows) take the Hessian."""
     na, nb = A.shape[2], B.shape[2]
     out = np.empty((na + nb, na + nb)) if out is None else out
     if na + nb < SMALL_SYSTEM:
         _hessian_loops(np.ascontiguousarray(pointwise), weights, A, B, out)
-        return out
+        return out[:, :na + nb]
+    out = out[:, :na + nb]
     weighted_a, weighted_b = _weighted_bases(np.ascontiguousarray(pointwise), weights, A, B)
     stacked_a, stacked_b = A.reshape(-1, na), B.reshape(-1, nb)
     np.matmul(stacked_a.T, weighted_a.reshape(-1, na), out=out[:na, :na])
@@ -129,11 +131,13 @@ def assemble_hessian(pointwise, weights, A, B, out=None) -> np.ndarray:
 
 @njit(cache=True)
 def _hessian_loops(pointwise, weights, A, B, out):
-    """Discretisation.hessian's blocks aa, ab, bb (ba = abᵀ) in one pass over the nodes, into ``out``: at node q the
+    """Discretisation.hessian's blocks aa, ab, bb (ba = abᵀ) in one pass over the nodes, into the leading columns
+    of ``out``: at node q the
     bases' weighted partners W_q Σ_l h_kl ∂state_l/∂u (as ``_weighted_bases``), then their outer products with the
-    basis; the symmetric blocks aa and bb only on and above the diagonal, mirrored at the end."""
+    basis, each row's sums over whole contiguous rows (faster than over the upper triangle alone: 5.2 against 7.7 µs
+    at 29 unknowns), the lower triangle then overwritten by the upper's mirror (exactly symmetric)."""
     n_q, na, nb = weights.shape[0], A.shape[2], B.shape[2]
-    out[:, :] = 0.0
+    out[:, :na + nb] = 0.0
     partner_a = np.empty((2, na))
     partner_b = np.empty((4, nb))
     for q in range(n_q):
@@ -156,14 +160,16 @@ def _hessian_loops(pointwise, weights, A, B, out):
             partner_b[3, i] = h23 * b0 + h33 * b1
         for i in range(na):
             a0, a1 = A[0, q, i], A[1, q, i]
-            for j in range(i, na):
-                out[i, j] += a0 * partner_a[0, j] + a1 * partner_a[1, j]
+            row = out[i]
+            for j in range(na):
+                row[j] += a0 * partner_a[0, j] + a1 * partner_a[1, j]
             for j in range(nb):
-                out[i, na + j] += a0 * partner_b[0, j] + a1 * partner_b[1, j]
+                row[na + j] += a0 * partner_b[0, j] + a1 * partner_b[1, j]
         for i in range(nb):
             b0, b1 = B[0, q, i], B[1, q, i]
-            for j in range(i, nb):
-                out[na + i, na + j] += b0 * partner_b[2, j] + b1 * partner_b[3, j]
+            row = out[na + i]
+            for j in range(nb):
+                row[na + j] += b0 * partner_b[2, j] + b1 * partner_b[3, j]
     for i in range(na + nb):
         for j in range(i):
             out[i, j] = out[j, i]
@@ -272,8 +278,8 @@ class Discretisation:
 
     def hessian(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Σ_q W_q Σ_kl h_kl(q) ∂state_k/∂u ∂state_l/∂u; pointwise is energy_hessian's output (10, n_q), the
-        entries (k, l) of HESSIAN_PAIRS (``assemble_hessian``), into ``out`` (size × size, e.g. the leading columns
-        of a bordered Jacobian) if given."""
+        entries (k, l) of HESSIAN_PAIRS (``assemble_hessian``), into the leading size columns of ``out`` (C-ordered,
+        size × size or a bordered Jacobian's size × (size + k)) if given."""
         return assemble_hessian(pointwise, self.weights, self.basis_a, self.basis_b, out)
 
     def pole_rows(self):

@@ -75,8 +75,7 @@ class NodeKernels:
         """The field at the held state (if there are coils), then the domain check (``Equilibrium._check_domain``)."""
         coils = self.eq.coils
         if coils.shape[0]:
-            np.multiply(self.state[0], self.geometry[1], out=self._rho)
-            field_squared_nodes(self._rho, self.state[2], coils, self.field)
+            _field_of_state(self.state, self.geometry[1], coils, self._rho, self.field)
         if self.eq._domain_check:
             self.eq._check_domain(self.geometry, tuple(self.state), params)
 
@@ -128,10 +127,9 @@ class Equilibrium:
         # the node state and field of the last u (``_pointwise``), in arrays owned by ``nodes``, refilled in place
         self.nodes = NodeKernels(self, self.geometry)
         self._held = np.empty(discretisation.size)
-        self._holding = False  # whether _held and the nodes' state and field are those of a u (and _held_material's)
+        self._holding = False  # whether the nodes' state and field are those of _held (and _held_material's)
         self._held_material = None  # the material values the held state was checked for (its domain check)
         self._at_nodes = {}  # key -> NodeKernels at other nodes (``at_nodes``)
-        self._hessian = np.empty((discretisation.size, discretisation.size))  # bordered_jacobian's assembly
 
     def _check_domain(self, geometry: tuple, state: tuple, params: Parameters):
         """NonFiniteState if a node's stretches leave the domain of the material at ``params`` (a strain energy
@@ -162,17 +160,16 @@ class Equilibrium:
         """Kernel at the own nodes, into an array owned by ``nodes`` (valid until the next call of the same kernel).
         The state and field of the last u (and material values: its domain check) are reused (Newton asks for R,
         then J)."""
-        if not (self._holding and params.material == self._held_material and same_values(self._held, u)):
-            self._hold(u, params)
+        if take(self._held, u) or not self._holding or params.material != self._held_material:
+            self._hold(params)
         return self.nodes.evaluate(kernel, params)
 
-    def _hold(self, u, params: Parameters):
-        """The node state (Discretisation.node_state) and field of u into the held arrays; u and the material
-        values held once the domain check passed."""
+    def _hold(self, params: Parameters):
+        """The node state (Discretisation.node_state) and field of the u in ``_held`` into the held arrays, held
+        once the domain check passed (with the material values checked)."""
         self._holding = False
-        self.disc.node_state(u, self.nodes.state)
+        self.disc.node_state(self._held, self.nodes.state)
         self.nodes.hold(params)
-        self._held[:] = u
         self._holding, self._held_material = True, params.material
 
     def state_at(self, u, theta: np.ndarray) -> tuple:
@@ -211,10 +208,10 @@ class Equilibrium:
 
     def bordered_jacobian(self, u, params: Parameters, name: str) -> np.ndarray:
         """[∂R/∂u  ∂R/∂name] (n × (n + 1)) for the map X = (u, name) of a continuation or a constrained solve (one
-        state evaluation serves both parts; the Hessian is assembled contiguous, faster than into the columns)."""
+        state evaluation serves both parts; the Hessian is assembled into its leading columns)."""
         n = self.disc.size
         out = np.empty((n, n + 1))
-        out[:, :n] = self.disc.hessian(self._pointwise("energy_hessian", u, params), self._hessian)
+        self.disc.hessian(self._pointwise("energy_hessian", u, params), out)
         self.parameter_derivative(u, params, name, out[:, n])
         return out
 
@@ -230,11 +227,22 @@ def enclosed_volume(disc: Discretisation, u) -> float:
 
 
 @njit(cache=True)
-def same_values(a, b) -> bool:
-    """Whether the 1-D arrays a and b are equal entry by entry."""
-    if a.shape[0] != b.shape[0]:
-        return False
-    for i in range(a.shape[0]):
-        if a[i] != b[i]:
-            return False
-    return True
+def _field_of_state(state, sin_theta, coils, rho, out):
+    """field_squared_nodes at (ρ, z) = (λ2 sin θ, η) of the node state (λ2, v, η, w), ρ into ``rho``."""
+    for i in range(rho.shape[0]):
+        rho[i] = state[0, i] * sin_theta[i]
+    field_squared_nodes(rho, state[2], coils, out)
+
+
+@njit(cache=True)
+def take(held, u) -> bool:
+    """held ← u (1-D arrays of one size); whether an entry changed (one call: the Equilibrium's test for a new
+    state)."""
+    if held.shape[0] != u.shape[0]:
+        raise ValueError("the state has the wrong number of unknowns")
+    changed = False
+    for i in range(u.shape[0]):
+        if held[i] != u[i]:
+            held[i] = u[i]
+            changed = True
+    return changed

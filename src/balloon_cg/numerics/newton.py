@@ -56,8 +56,8 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
     """
     x = np.array(x0, dtype=float)
     refresh_ratio = REFRESH_RATIO_LARGE if x.size >= LARGE_SYSTEM else REFRESH_RATIO
-    rows = np.atleast_2d(rows)
-    targets = np.atleast_1d(np.asarray(targets, dtype=float))
+    rows = np.array(rows, dtype=float, ndmin=2, copy=None)  # as np.atleast_2d, np.atleast_1d: one C call each
+    targets = np.array(targets, dtype=float, ndmin=1)
     previous = np.inf
     factors, fresh, jacobians, growth = None, False, 0, 0
     r, step = None, np.inf
