@@ -46,7 +46,7 @@ def _embed(symmetric: Discretisation, general: Discretisation, u):
     return general.join(a, b)
 
 
-@pytest.mark.parametrize("degree", [12, 64])  # jitted loops (< SMALL_SYSTEM unknowns) and BLAS
+@pytest.mark.parametrize("degree", [12, 40])  # jitted loops (< SMALL_SYSTEM unknowns) and BLAS
 def test_symmetric_half_nodes_match_every_node(two_coils, degree):
     scene, branch = two_coils
     sym = Discretisation(degree, True, False)
@@ -68,7 +68,7 @@ def test_symmetric_half_nodes_match_every_node(two_coils, degree):
     assert eq_sym.volume(u) == pytest.approx(eq_full.volume(v), rel=1e-13)
 
 
-@pytest.mark.parametrize("degree", [12, 20])
+@pytest.mark.parametrize("degree", [8, 12])
 def test_small_system_loops_match_the_node_sums(degree):
     disc = Discretisation(degree, False, True)
     assert disc.size < SMALL_SYSTEM
