@@ -82,6 +82,21 @@ def test_bad_set_is_one_line(tmp_path, capsys, setting, words):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("command", [
+    ["run", str(SCENES / "spom1.toml")],
+    ["critical", str(SCENES / "spom1_two_coils_M0.002.toml"), "--parameter", "M"],
+    ["sweep", str(SCENES / "spom1.toml"), "--vary", "M=0:0.001:2"],
+])
+def test_an_hdf5_output_with_another_suffix_is_refused_and_left_alone(tmp_path, capsys, command):
+    """-o results.txt would write HDF5 under a text file's name (with --force: over the text file)."""
+    out = tmp_path / "results.txt"
+    out.write_text("my notes\n")
+    assert main([*command, "-o", str(out), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"--output {out}" in err and ".h5, .hdf5" in err, err
+    assert out.read_text() == "my notes\n"
+
+
 def test_shorthand_and_set_of_the_same_key_conflict(tmp_path, capsys):
     assert main(["run", "spom1", "--set", "continuation.max_points=4", "--max-points", "3",
                  "-o", str(tmp_path / "x.h5")]) == 2

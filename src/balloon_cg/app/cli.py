@@ -41,6 +41,18 @@ class UsageError(ValueError):
     """A bad command-line value (exit code 2)."""
 
 
+HDF5_SUFFIXES = (".h5", ".hdf5")
+
+
+def hdf5_output(path: str, kind: str) -> str:
+    """``path`` if its suffix names an HDF5 file (HDF5_SUFFIXES), else UsageError: ``-o results.txt`` would
+    write HDF5 under a text file's name (or, with --force, over a text file)."""
+    if Path(path).suffix.lower() not in HDF5_SUFFIXES:
+        raise UsageError(f"--output {path}: a {kind} file is HDF5: its suffix must be one of "
+                         f"{', '.join(HDF5_SUFFIXES)}")
+    return path
+
+
 class Failure(Exception):
     """A computation that ran but did not give what was asked (exit code 1)."""
 
@@ -191,7 +203,7 @@ def run(args) -> int:
     from .progress import shown
 
     scene = scene_of(args)
-    output = args.output or f"{scene.name}.h5"
+    output = hdf5_output(args.output, "run") if args.output else f"{scene.name}.h5"
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
@@ -482,7 +494,7 @@ def critical(args) -> int:
         resolve(scene, args.parameter)
     except UnknownParameter as e:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
-    check_output(args.output, args.force)
+    check_output(hdf5_output(args.output, "curve"), args.force)
     with stop_on_signals():
         curve = _pitchfork_curve(scene, args)
         if curve is not None:
@@ -606,6 +618,7 @@ def sweep(args) -> int:
     from ..numerics.interrupt import sigterm_raises
 
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"
+    hdf5_output(args.output, "sweep")
     scene = load_scene(args.scene)
     try:
         with sigterm_raises():
