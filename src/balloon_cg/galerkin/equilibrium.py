@@ -25,6 +25,11 @@ class NonFiniteState(ArithmeticError):
     """The kernels returned NaN/inf: the state left the physical domain (λ ≤ 0, a wire reached, …)."""
 
 
+def non_finite(kernel: str):
+    """Raise NonFiniteState for the output of ``kernel``."""
+    raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+
+
 @dataclass
 class Parameters:
     """Branch parameters P, M, χ, the voltage Φ̄ (a dielectric class), the Ogden moduli μ and exponents α, and a
@@ -92,10 +97,7 @@ class NodeKernels:
         for slot, name in slots:
             args[slot] = float(getattr(params, name))
         function(*args, out)
-        if not finite(out):
-            kernel = key if isinstance(key, str) else key[0]
-            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
-        return out
+        return out if finite(out) else non_finite(key if isinstance(key, str) else key[0])
 
     def _template(self, key, params: Parameters) -> tuple:
         """(the kernel's node loop, its arguments on the held arrays, the fixed values and the scene material as a
@@ -146,9 +148,7 @@ class Equilibrium:
 
     def _evaluate(self, kernel: str, named: dict, params: Parameters) -> np.ndarray:
         out = self.kernels.nodes(kernel, named, params)
-        if not finite(out):
-            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
-        return out
+        return out if finite(out) else non_finite(kernel)
 
     def at_nodes(self, key, geometry: tuple) -> NodeKernels:
         """The kernels at other nodes (cos θ, sin θ) = ``geometry`` (a second variation's), by a key that names them."""
