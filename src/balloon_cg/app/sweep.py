@@ -8,8 +8,8 @@ view rebuilt from it). The output is owned (``io.lock.claim``) from before the e
 written. Workers return their results as plain data (``MemberResult``); only the parent process writes, and the
 pool's workers die with it (``worker_hygiene``). dask workers need one setting (``DASK_WORKER_CONFIG``; a
 sweep warns, ``SlowWorkersWarning``, when a worker lacks it). Re-running the same sweep skips the members whose
-file holds the same scene_hash; a different sweep into an existing file needs --force, which replaces the old sweep only
-once every member of the new one is written.
+file holds the same scene_hash; a different sweep into an existing file needs --force, which replaces the old
+sweep only once every member of the new one is written.
 """
 import contextlib
 import hashlib
