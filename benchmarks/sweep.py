@@ -6,7 +6,8 @@ scene (issue 14's sweep; the largest fields bring the membrane close to the wire
 Runs the command ``balloon-cg sweep`` in a fresh interpreter each time (worker start-up and numba cache loading
 included; the time of importing balloon_cg in the parent is shown separately) serially (--workers 1) and on 2
 local worker processes, then the same members on a dask LocalCluster of 2 single-threaded worker processes
-(cluster start-up excluded). Prints a table with the speed-up
+started with balloon-cg's DASK_WORKER_CONFIG (cluster start-up excluded; dask's default malloc setting made its
+members 1.4x slower: benchmarks/dask_worker.py). Prints a table with the speed-up
 over serial (floor: >= 1.7x for 2 workers on an otherwise idle 2-core machine) and checks that every run stored
 the same members. Run: python benchmarks/sweep.py [--study two-coils]
 (output also in benchmarks/results/sweep.txt, or sweep_two_coils.txt)
@@ -22,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from balloon_cg.scene import load_scene
-from balloon_cg.app.sweep import run_sweep
+from balloon_cg.app.sweep import DASK_WORKER_CONFIG, run_sweep
 from balloon_cg.io.sweep_file import read_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -46,11 +47,12 @@ def cli_run(scene: Path, vary: list, out: Path, workers: int) -> tuple[float, fl
 
 def dask_run(scene: Path, vary: list, out: Path) -> float | None:
     try:
+        import dask
         from distributed import LocalCluster
     except ImportError:
         return None
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster:
+    with dask.config.set(DASK_WORKER_CONFIG), LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                                           host="127.0.0.1", dashboard_address=None) as cluster:
         start = time.perf_counter()
         run_sweep(load_scene(scene), vary, out, mode="analysis", scheduler=cluster.scheduler_address)
         t = time.perf_counter() - start
@@ -99,7 +101,8 @@ def main():
                          f"{rows[0][1][1] / total:>8.2f}x {member_sum(path):>13.2f}  {same(rows[0][2], path)}")
         lines += ["", "sweep: the sweep command after `import balloon_cg` (includes starting the local workers and "
                   "their numba cache loading); process: the whole `python -c ...` run including imports. The dask "
-                  "row excludes the cluster start-up (the cluster exists before the sweep).",
+                  "row excludes the cluster start-up (the cluster exists before the sweep); its workers run with "
+                  "DASK_WORKER_CONFIG.",
                   "Σ member: the members' own compute times added up; larger than the serial one means the workers "
                   "competed for the cores with other processes."]
     text = "\n".join(lines)

@@ -1,5 +1,6 @@
 """Sweeps: member expansion, local pool = serial = dask cluster, one writer, resume after an interruption."""
 import json
+import warnings
 from pathlib import Path
 
 import h5py
@@ -9,7 +10,7 @@ import pytest
 from balloon_cg.app import sweep as sweep_module
 from balloon_cg.app.cli import main
 from balloon_cg.scene import SceneError, load_scene
-from balloon_cg.app.sweep import expand, run_sweep, scene_hash
+from balloon_cg.app.sweep import DASK_WORKER_CONFIG, SlowWorkersWarning, expand, run_sweep, scene_hash
 from balloon_cg.io.sweep_file import Store, SweepError, read_sweep, store_path
 
 SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "spom1_single_coil.toml"
@@ -97,13 +98,30 @@ def test_local_pool_equals_serial(scene, serial, tmp_path):
         assert f.attrs["mode"] == MODE and f.attrs["members"] == 3
 
 
-def test_dask_cluster_equals_local_pool(scene, serial, tmp_path):
+def local_cluster(n_workers: int):
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
+    return distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                    dashboard_address=None)
+
+
+def test_dask_cluster_equals_local_pool(scene, serial, tmp_path, monkeypatch):
+    """Also: DASK_WORKER_CONFIG reaches the workers (their malloc variables unset: no SlowWorkersWarning)."""
+    import dask
+    for name in ("MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_"):  # inherited by the workers, else
+        monkeypatch.delenv(name, raising=False)
+    with dask.config.set(DASK_WORKER_CONFIG), local_cluster(2) as cluster, warnings.catch_warnings():
+        warnings.simplefilter("error", SlowWorkersWarning)
         result = run_sweep(scene, SPECS, tmp_path / "dask.h5", mode=MODE, scheduler=cluster.scheduler_address)
     assert sorted(result.computed) == [0, 1, 2] and not result.failed
     assert_same_members(serial, read_sweep(tmp_path / "dask.h5"))
+
+
+def test_dask_workers_with_a_frozen_mmap_threshold_are_reported(scene, tmp_path, monkeypatch):
+    monkeypatch.setenv("MALLOC_TRIM_THRESHOLD_", "65536")  # what dask's nanny sets by default
+    monkeypatch.delenv("MALLOC_MMAP_THRESHOLD_", raising=False)
+    with local_cluster(1) as cluster, pytest.warns(SlowWorkersWarning, match="1 dask worker"):
+        result = run_sweep(scene, ["M=0"], tmp_path / "dask.h5", mode=MODE, scheduler=cluster.scheduler_address)
+    assert result.computed == [0]
 
 
 # --- interruption and resume -------------------------------------------------------------------------------

@@ -6,9 +6,10 @@ existing dask.distributed cluster with ``--scheduler``) and appends each member 
 finishes, each to its own file (``io.sweep_file``: a store folder beside the sweep file, and the sweep file a
 view rebuilt from it). The output is owned (``io.lock.claim``) from before the expansion until the view is
 written. Workers return their results as plain data (``MemberResult``); only the parent process writes, and the
-pool's workers die with it (``worker_hygiene``). Re-running the same sweep skips the members whose file holds
-the same scene_hash; a different sweep into an existing file needs --force, which replaces the old sweep only
-once every member of the new one is written.
+pool's workers die with it (``worker_hygiene``). dask workers need one setting (``DASK_WORKER_CONFIG``; a
+sweep warns, ``SlowWorkersWarning``, when a worker lacks it). Re-running the same sweep skips the members whose
+file holds the same scene_hash; a different sweep into an existing file needs --force, which replaces the old
+sweep only once every member of the new one is written.
 """
 import contextlib
 import hashlib
@@ -17,6 +18,7 @@ import os
 import re
 import sys
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -339,6 +341,35 @@ def _terminate(pool) -> None:
             process.join()
 
 
+# The dask config of a sweep's workers: dask's nanny starts every worker with MALLOC_TRIM_THRESHOLD_=65536, and
+# any such glibc setting freezes its dynamic mmap threshold at 128 KiB (mallopt(3)), so each larger array (the
+# Galerkin matrices) is a fresh mmap, page-faulted in and unmapped again: ten times the page faults, a member
+# 1.4x slower (benchmarks/dask_worker.py). Set it around creating a LocalCluster (dask.config.set), or in the
+# dask YAML config of `dask worker` (README, a sweep); None makes the nanny leave the variable unset.
+DASK_WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+
+
+class SlowWorkersWarning(UserWarning):
+    """Some dask workers of a sweep run with glibc's mmap threshold frozen (``frozen_mmap_threshold``)."""
+
+
+def frozen_mmap_threshold() -> bool:
+    """Whether this process's glibc malloc has a fixed mmap threshold of 128 KiB: MALLOC_TRIM_THRESHOLD_ set
+    (dask's nanny default) and MALLOC_MMAP_THRESHOLD_ not (which would set the threshold itself); Linux only."""
+    return (sys.platform.startswith("linux") and "MALLOC_TRIM_THRESHOLD_" in os.environ
+            and "MALLOC_MMAP_THRESHOLD_" not in os.environ)
+
+
+def _warn_slow_workers(client) -> None:
+    """SlowWorkersWarning if a worker connected now has a frozen mmap threshold (``DASK_WORKER_CONFIG``)."""
+    frozen = [w for w, answer in client.run(frozen_mmap_threshold, on_error="return").items() if answer is True]
+    if frozen:
+        warnings.warn(f"{len(frozen)} dask worker(s) run with MALLOC_TRIM_THRESHOLD_ set (dask's nanny default), "
+                      "which makes each member about 1.4x slower; start the workers with the dask config "
+                      "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_ = null "
+                      "(balloon_cg.app.sweep.DASK_WORKER_CONFIG; README)", SlowWorkersWarning, stacklevel=2)
+
+
 def _compute_dask(jobs, scheduler: str):
     try:
         from distributed import Client, as_completed
@@ -349,6 +380,7 @@ def _compute_dask(jobs, scheduler: str):
     except (OSError, TimeoutError) as e:
         raise SweepError(f"--scheduler {scheduler}: cannot connect ({e})") from None
     try:
+        _warn_slow_workers(client)
         futures = {client.submit(compute_member, *job, pure=False): job[0] for job in jobs}
         for future in as_completed(futures):
             index = futures[future]
