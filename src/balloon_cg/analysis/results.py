@@ -252,3 +252,47 @@ class Branch:
         return (f"Branch({self.name!r}, {len(self.X)} points, degree {self.disc.degree}, "
                 f"P {self.pressure.min():.4g}..{self.pressure.max():.4g}, "
                 f"special {' '.join(s.kind.value for s in self.special)}, stop {self.stop_reason!r})")
+
+
+@dataclass
+class SurfaceBranch:
+    """A branch of non-axisymmetric states traced on the whole sphere (``surface``): per point the coefficients c
+    of the displacement in ``basis`` (a SphericalBasis: degree L and the reflections its states keep) and the value
+    of the continuation parameter, the solver records, the measures of ``surface.measures`` (pole stretches,
+    centroid offset, tilt of the long axis, volume) and the stability readings (lowest eigenvalues of the second
+    variation over every symmetry sector, balloon held at its centre or free; ``surface.stability``).
+
+    ``m`` is the azimuthal number of the mode it was born from, ``parent`` (branch name, branch point number)
+    the point of the axisymmetric branch it leaves from."""
+
+    name: str
+    scene: Scene
+    basis: object  # surface.basis.SphericalBasis
+    kernel_class: str
+    kernel_signature: str
+    params: Parameters
+    coefficients: np.ndarray  # (n_points, basis.size)
+    values: np.ndarray  # (n_points,): the parameter ``parameter`` at each point
+    iterations: np.ndarray
+    residual: np.ndarray
+    error_estimate: np.ndarray  # spectral tail of each point's coefficients (surface.measures.tail)
+    measures: dict  # name -> per-point array (surface.measures.MEASURES)
+    m: int
+    parent: tuple  # (branch name, branch point number)
+    legs: tuple = ()
+    special: list = field(default_factory=list)  # SpecialPoint, X = (c, p)
+    stability: dict | None = None  # {'held': (n_points, k), 'free': (n_points, k)} lowest eigenvalues, ascending
+    parameter: str = "P"
+    wall_time: float = 0.0
+
+    @property
+    def pressure(self):
+        return self.values if self.parameter == "P" else np.full(len(self.values), self.params.P)
+
+    @property
+    def stop_reason(self) -> str:
+        return "; ".join(f"{leg.label}: {leg.stop.message}" for leg in self.legs)
+
+    def __repr__(self):
+        return (f"SurfaceBranch({self.name!r}, m = {self.m}, {len(self.values)} points, degree {self.basis.degree}, "
+                f"P {self.pressure.min():.4g}..{self.pressure.max():.4g}, stop {self.stop_reason!r})")

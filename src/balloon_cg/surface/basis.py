@@ -1,0 +1,336 @@
+"""Real spherical harmonics for the Cartesian displacement of the whole sphere (MODEL.md §8), at Gauss–Legendre ×
+uniform nodes: the node values the surface kernels take, and the residual and Hessian assembled from theirs.
+
+    u_c(θ, φ) = Σ c_{c,l,m,t} Y_{l,m,t}(θ, φ),   Y_{l,m,t} = P̄_l^m(cos θ) τ_{m,t}(φ),
+    τ_{0,cos} = 1/√(2π),  τ_{m,cos} = cos mφ/√π,  τ_{m,sin} = sin mφ/√π,
+
+c = x, y, z, l ≤ L (orthonormal on the unit sphere, dA = d(cos θ) dφ). A smooth vector field has smooth Cartesian
+components, so every coefficient vector is a smooth surface: no pole condition to impose. At a node the kernels
+take x = X + u, a_θ = ∂x/∂θ and a_φ = ∂x/∂φ / sin θ (rows ``SURFACE_STATE``), and E = (1/2π) ∫∫ π dA becomes
+Σ_j Σ_k (w_j / N_φ) π(θ_j, φ_k).
+
+The unknowns come in *blocks* (component c, order m, type t; degrees l): inside a block every unknown has the same
+φ-dependence, so the Hessian is assembled by sum factorisation, not nodes × unknowns²:
+
+    H[(b, l), (b', l')] = Σ_{d, d'} Σ_j Θ^d_b[j, l] T^{dd'}_j[b, b'] Θ^{d'}_{b'}[j, l'],
+    T^{dd'}_j[b, b'] = Σ_k W_j D_{(c,d),(c',d')}(θ_j, φ_k) p^d_b(φ_k) p^{d'}_{b'}(φ_k),
+
+d ∈ (value, ∂θ, ∂φ/sin θ), Θ^d_b the θ-tables (P̄, dP̄/dθ, m P̄/sin θ) and p^d_b the φ-functions (τ, or ∂φτ/m).
+T comes from one FFT in φ per ring of each of the 45 node-Hessian entries D and the product-to-sum identities
+(cos a cos b = ½[cos(a − b) + cos(a + b)], …), exact for the discrete sums at any N_φ (frequencies alias mod N_φ).
+
+Symmetry subspaces: ``symmetry`` is a tuple of diagonal reflections S = diag(s_x, s_y, s_z) and ``characters``
+one sign χ_S each (default +1); the basis keeps the fields with u(S X) = χ_S S u(X), i.e. the e_c Y_{l,m,t} with
+s_c σ_S(l, m, t) = χ_S, σ the sign of Y under S: y → −y flips sin mφ, x → −x multiplies cos mφ by (−1)^m and
+sin mφ by −(−1)^m, z → −z multiplies by (−1)^(l+m). The states of a branch lie in the invariant subspace (every
+χ = +1); the Hessian at such a state maps each sector (a choice of the χ) to itself, so its spectrum is the union
+of the sectors' (``sectors``).
+"""
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+
+import numpy as np
+from numba import njit
+from numpy.polynomial import legendre as gauss
+
+from ..galerkin.discretisation import read_only
+from ..galerkin.legendre import assoc_legendre, legendre_values, theta_derivative
+
+COS, SIN = 0, 1
+MIRROR_Y = (1, -1, 1)  # the plane y = 0 through the axis (MODEL.md §8: x, z keep cos kφ, y keeps sin kφ)
+EQUATOR = (1, 1, -1)  # the equatorial plane z = 0
+INVERSION = (-1, -1, -1)  # the centre: x(−X) = −x(X)
+STATE_ROWS = 9  # x (3), a_θ (3), a_φ (3): row 3 d + c for derivative d and component c
+
+
+def _sign_under(reflection, l, m, t) -> int:
+    """σ_S(l, m, t): Y_{l,m,t}(S X) = σ Y_{l,m,t}(X) for the diagonal reflection S."""
+    sx, sy, sz = reflection
+    sign = 1
+    if sy < 0 and t == SIN:
+        sign = -sign
+    if sx < 0:
+        sign *= (-1) ** m * (1 if t == COS else -1)
+    if sz < 0:
+        sign *= (-1) ** (l + m)
+    return sign
+
+
+@dataclass(frozen=True)
+class Block:
+    """The unknowns of component ``component`` with φ-dependence τ_{m,t}: degrees ``degrees``, at ``offset``."""
+
+    component: int
+    m: int
+    t: int
+    degrees: tuple
+    offset: int
+
+    @property
+    def slice(self) -> slice:
+        return slice(self.offset, self.offset + len(self.degrees))
+
+
+def pair_rows(pairs) -> np.ndarray:
+    """rows[p, q] = rows[q, p] = r for the r-th (p, q) of ``pairs`` (a generated upper-triangle layout)."""
+    n = 1 + max(max(pair) for pair in pairs)
+    rows = np.full((n, n), -1, dtype=np.int64)
+    for r, (p, q) in enumerate(pairs):
+        rows[p, q] = rows[q, p] = r
+    return rows
+
+
+@dataclass(frozen=True)
+class SphericalBasis:
+    """Degree ``degree`` (L), the reflections ``symmetry`` the fields keep, n_theta × n_phi nodes (default
+    ⌈3(L + 1)/2⌉ + 2 Gauss nodes in cos θ and twice as many in φ: the products of two degree-L fields with a smooth
+    node function are integrated with aliasing below the truncation error of resolved states)."""
+
+    degree: int
+    symmetry: tuple = ()
+    characters: tuple = ()
+    n_theta: int = 0
+    n_phi: int = 0
+    blocks: tuple = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        if self.degree < 1:
+            raise ValueError(f"degree = {self.degree}: must be ≥ 1")
+        put = object.__setattr__
+        if not self.characters:
+            put(self, "characters", (1,) * len(self.symmetry))
+        if len(self.characters) != len(self.symmetry):
+            raise ValueError(f"{len(self.characters)} characters for {len(self.symmetry)} reflections")
+        if not self.n_theta:
+            put(self, "n_theta", (3 * (self.degree + 1) + 1) // 2 + 2)
+        if not self.n_phi:
+            put(self, "n_phi", 2 * self.n_theta)
+        blocks, offset = [], 0
+        for c in range(3):
+            for m in range(self.degree + 1):
+                for t in (COS,) if m == 0 else (COS, SIN):
+                    degrees = tuple(l for l in range(m, self.degree + 1)
+                                    if all(S[c] * _sign_under(S, l, m, t) == chi
+                                           for S, chi in zip(self.symmetry, self.characters)))
+                    if degrees:
+                        blocks.append(Block(c, m, t, degrees, offset))
+                        offset += len(degrees)
+        put(self, "blocks", tuple(blocks))
+
+    @property
+    def size(self) -> int:
+        return self.blocks[-1].offset + len(self.blocks[-1].degrees) if self.blocks else 0
+
+    def sectors(self) -> list:
+        """The bases of every choice of characters for this basis' reflections (same degree and nodes): their
+        spaces together are the whole space, and a Hessian at a state of the invariant subspace is block-diagonal
+        in them."""
+        if not self.symmetry:
+            return [self]
+        signs = np.array(np.meshgrid(*[(1, -1)] * len(self.symmetry), indexing="ij")).reshape(len(self.symmetry), -1)
+        return [replace(self, characters=tuple(int(s) for s in column)) for column in signs.T]
+
+    @cached_property
+    def nodes(self) -> dict:
+        """cos θ_j, sin θ_j, the weights W_j = w_j/N_φ (with E's 1/2π), φ_k, and X, a_θ(X), a_φ(X) at every
+        node (rows of the node state of u = 0), node index j N_φ + k."""
+        x, w = gauss.leggauss(self.n_theta)
+        x, w = x[::-1].copy(), w[::-1].copy()  # θ increasing: north to south
+        s = np.sqrt(1.0 - x * x)
+        phi = 2.0 * np.pi * np.arange(self.n_phi) / self.n_phi
+        C, S = np.meshgrid(x, np.cos(phi), indexing="ij")
+        s2, sp = np.meshgrid(s, np.sin(phi), indexing="ij")
+        reference = np.stack([s2 * S, s2 * sp, C, C * S, C * sp, -s2, -sp, S, np.zeros_like(C)])
+        return {"cos_theta": read_only(x), "sin_theta": read_only(s), "weights": read_only(w / self.n_phi),
+                "phi": read_only(phi), "reference": read_only(reference.reshape(STATE_ROWS, -1))}
+
+    @cached_property
+    def tables(self) -> dict:
+        """Per block: θ-tables Θ (3, n_theta, n_l) for value, ∂θ, ∂φ/(m sin θ)·m, and the φ-functions p (2, n_phi)
+        for value and ∂φ/m; per component the concatenated θ-tables and each column's block."""
+        nodes = self.nodes
+        x, s, phi = nodes["cos_theta"], nodes["sin_theta"], nodes["phi"]
+        legendre = {m: assoc_legendre(x, self.degree, m) for m in range(self.degree + 1)}
+        theta, phis = [], []
+        for b in self.blocks:
+            p, dp = legendre[b.m]
+            k = list(b.degrees)
+            theta.append(np.stack([p[:, k], dp[:, k], b.m * p[:, k] / s[:, None]]))
+            norm = _norm(b.m)
+            if b.t == COS:
+                phis.append(norm * np.stack([np.cos(b.m * phi), -np.sin(b.m * phi)]))
+            else:
+                phis.append(norm * np.stack([np.sin(b.m * phi), np.cos(b.m * phi)]))
+        components = []
+        for c in range(3):
+            index = [i for i, b in enumerate(self.blocks) if b.component == c]
+            columns = np.concatenate([[i] * len(self.blocks[i].degrees) for i in index]).astype(np.int64) \
+                if index else np.zeros(0, np.int64)
+            local = {i: n for n, i in enumerate(index)}
+            components.append({
+                "blocks": index,
+                "theta": read_only(np.ascontiguousarray(np.concatenate([theta[i] for i in index], axis=2)))
+                if index else None,
+                "column_block": read_only(np.array([local[i] for i in columns], dtype=np.int64)),
+                "sums": np.equal.outer(np.array([local[i] for i in columns], dtype=np.int64),
+                                       np.arange(len(index))).astype(float) if index else None,
+                "unknowns": np.concatenate([np.arange(self.blocks[i].offset,
+                                                      self.blocks[i].offset + len(self.blocks[i].degrees))
+                                            for i in index]) if index else np.zeros(0, np.int64),
+            })
+        return {"theta": theta, "phi": np.array(phis), "components": components}
+
+    @cached_property
+    def _products(self) -> dict:
+        """Gather plan of T from the φ-Fourier table of a node function: for component pair (c, c') and φ-types
+        (e, e'), T[j, b, b'] = α1 F[j, i1] + α2 F[j, i2] with F = [C_0 … C_{N−1}, S_0 … S_{N−1}],
+        C_q = Σ_k f_k cos qφ_k, S_q = Σ_k f_k sin qφ_k."""
+        n = self.n_phi
+        amplitude = np.array([[_norm(b.m), _norm(b.m) if b.m else 0.0] for b in self.blocks])
+        plans = {}
+        for c in range(3):
+            rows = self.tables["components"][c]["blocks"]
+            for c2 in range(3):
+                cols = self.tables["components"][c2]["blocks"]
+                for e in (0, 1):
+                    for e2 in (0, 1):
+                        plans[c, c2, e, e2] = self._plan(rows, cols, e, e2, amplitude, n)
+        return plans
+
+    def _plan(self, rows, cols, e, e2, amplitude, n):
+        """(i1, i2, α1, α2) of one (rows, cols, e, e') gather (see _products)."""
+        shape = (len(rows), len(cols))
+        i1, i2 = np.zeros(shape, np.int64), np.zeros(shape, np.int64)
+        a1, a2 = np.zeros(shape), np.zeros(shape)
+        for r, i in enumerate(rows):
+            bi = self.blocks[i]
+            kind_i, sign_i = self._kind(bi, e)
+            for q, k in enumerate(cols):
+                bk = self.blocks[k]
+                kind_k, sign_k = self._kind(bk, e2)
+                scale = 0.5 * amplitude[i, e] * amplitude[k, e2] * sign_i * sign_k
+                a, b = bi.m, bk.m
+                plus, minus = (a + b) % n, abs(a - b) % n
+                if kind_i == COS and kind_k == COS:
+                    i1[r, q], a1[r, q], i2[r, q], a2[r, q] = minus, scale, plus, scale
+                elif kind_i == SIN and kind_k == SIN:
+                    i1[r, q], a1[r, q], i2[r, q], a2[r, q] = minus, scale, plus, -scale
+                else:  # cos a sin b = ½[sin(a + b) − sin(a − b)], sin a cos b = ½[sin(a + b) + sin(a − b)]
+                    sign = np.sign(a - b) * (-1.0 if kind_i == COS else 1.0)
+                    i1[r, q], a1[r, q], i2[r, q], a2[r, q] = n + plus, scale, n + minus, scale * sign
+        return i1, i2, a1, a2
+
+    @staticmethod
+    def _kind(block: Block, e: int) -> tuple:
+        """(COS or SIN, sign) of the φ-function p^e of ``block``: τ for e = 0, ∂φτ/m for e = 1."""
+        if e == 0:
+            return block.t, 1.0
+        return (SIN, -1.0) if block.t == COS else (COS, 1.0)
+
+    # ---- fields ------------------------------------------------------------------------------------------------
+
+    def node_state(self, c: np.ndarray) -> np.ndarray:
+        """The 9 node rows (x, a_θ, a_φ) of x = X + u for coefficients ``c``, shape (9, n_theta n_phi)."""
+        tables, nodes = self.tables, self.nodes
+        out = np.array(nodes["reference"])
+        for comp in range(3):
+            info = tables["components"][comp]
+            if not info["blocks"]:
+                continue
+            coefficients = c[info["unknowns"]]
+            for d in range(3):
+                per_block = (info["theta"][d] * coefficients) @ info["sums"]  # (n_theta, n_b)
+                phis = tables["phi"][info["blocks"], 0 if d < 2 else 1]
+                out[3 * d + comp] += (per_block @ phis).ravel()
+        return out
+
+    def project(self, rows: np.ndarray) -> np.ndarray:
+        """Σ_{jk} W_j Σ_{d,c} rows[3d + c](θ_j, φ_k) ∂(node row 3d + c)/∂coefficient for every coefficient: the
+        residual from the node gradient, or ⟨f, Y⟩ (with 1/2π) from rows holding f in the value rows only."""
+        tables, nodes = self.tables, self.nodes
+        out = np.zeros(self.size)
+        weights = nodes["weights"][:, None]
+        for comp in range(3):
+            info = tables["components"][comp]
+            if not info["blocks"]:
+                continue
+            total = np.zeros(len(info["unknowns"]))
+            for d in range(3):
+                phis = tables["phi"][info["blocks"], 0 if d < 2 else 1]  # (n_b, n_phi)
+                rings = (rows[3 * d + comp].reshape(self.n_theta, self.n_phi) * weights) @ phis.T  # (n_theta, n_b)
+                total += np.einsum("jn,jn->n", info["theta"][d], rings[:, info["column_block"]])
+            out[info["unknowns"]] = total
+        return out
+
+    def hessian(self, pointwise: np.ndarray, pairs_rows: np.ndarray) -> np.ndarray:
+        """Σ_{jk} W_j D(θ_j, φ_k) contracted with the node rows' derivatives on both sides (module docstring), D the
+        45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (pair_rows of the kernels' pairs)."""
+        n, nodes, tables = self.n_phi, self.nodes, self.tables
+        spectra = np.fft.fft(pointwise.reshape(-1, self.n_theta, n) * nodes["weights"][None, :, None], axis=2)
+        fourier = np.concatenate([spectra.real, -spectra.imag], axis=2)  # (45, n_theta, 2n): C_q, S_q
+        H = np.zeros((self.size, self.size))
+        components = tables["components"]
+        for c in range(3):
+            if not components[c]["blocks"]:
+                continue
+            for c2 in range(c, 3):
+                if not components[c2]["blocks"]:
+                    continue
+                T = np.empty((3, 3, self.n_theta, len(components[c]["blocks"]), len(components[c2]["blocks"])))
+                for d in range(3):
+                    for d2 in range(3):
+                        i1, i2, a1, a2 = self._products[c, c2, d // 2, d2 // 2]
+                        f = fourier[pairs_rows[3 * d + c, 3 * d2 + c2]]
+                        T[d, d2] = a1 * f[:, i1] + a2 * f[:, i2]
+                theta_c, theta_c2 = components[c]["theta"], components[c2]["theta"]
+                rows_c, cols = components[c]["unknowns"], components[c2]["unknowns"]
+                block_of = components[c2]["column_block"]
+                start = 0
+                for r, i in enumerate(components[c]["blocks"]):
+                    width = len(self.blocks[i].degrees)
+                    Y = _weigh_columns(T, r, theta_c2, block_of)  # (3, n_theta, n_c2)
+                    left = theta_c[:, :, start:start + width].reshape(3 * self.n_theta, width)
+                    H[np.ix_(rows_c[start:start + width], cols)] = left.T @ Y.reshape(3 * self.n_theta, -1)
+                    start += width
+                if c2 != c:
+                    H[np.ix_(cols, rows_c)] = H[np.ix_(rows_c, cols)].T
+        return H
+
+    def point_values(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> tuple:
+        """(x, a_θ) of x = X + u at points (θ, φ) anywhere on the sphere, the poles included (each (3, n))."""
+        theta, phi = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(phi, float))
+        z = np.cos(theta)
+        x = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), z])
+        a_theta = np.array([z * np.cos(phi), z * np.sin(phi), -np.sin(theta)])
+        for m in range(self.degree + 1):
+            p, dp = legendre_values(z, self.degree, m), theta_derivative(z, self.degree, m)
+            for b in self.blocks:
+                if b.m != m:
+                    continue
+                trig = _norm(m) * (np.cos(m * phi) if b.t == COS else np.sin(m * phi))
+                k = list(b.degrees)
+                x[b.component] += trig * (p[:, k] @ c[b.slice])
+                a_theta[b.component] += trig * (dp[:, k] @ c[b.slice])
+        return x, a_theta
+
+    def gram(self) -> float:
+        """The displacement norm (1/2π)∫∫|δu|² dA in these coefficients: c·c/(2π) (the basis is orthonormal)."""
+        return 1.0 / (2.0 * np.pi)
+
+
+def _norm(m: int) -> float:
+    """The normalisation of τ_{m,t}: 1/√(2π) for m = 0, 1/√π otherwise."""
+    return 1.0 / np.sqrt(2.0 * np.pi) if m == 0 else 1.0 / np.sqrt(np.pi)
+
+
+@njit(cache=True)
+def _weigh_columns(T, r, theta, block_of):
+    """Y[d, j, col] = Σ_d' T[d, d', j, r, block_of[col]] Θ^{d'}[j, col]."""
+    n_theta, n_cols = theta.shape[1], theta.shape[2]
+    Y = np.zeros((3, n_theta, n_cols))
+    for d in range(3):
+        for d2 in range(3):
+            for j in range(n_theta):
+                for col in range(n_cols):
+                    Y[d, j, col] += T[d, d2, j, r, block_of[col]] * theta[d2, j, col]
+    return Y

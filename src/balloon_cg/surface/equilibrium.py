@@ -1,0 +1,92 @@
+"""The energy E(c) of a scene on the whole sphere (MODEL.md §8), its gradient (the residual) and Hessian in the
+spherical-harmonic coefficients c of the displacement (basis.py), and the residual's parameter derivatives.
+
+    E = Σ_nodes W π(x, a_θ, a_φ; P, M, …),   π = Φ(I, J) − ½ χ M H²(x) − (P/3) x · (a_θ × a_φ),
+
+π, its gradient and Hessian in the 9 node variables from the generated surface kernels of the scene's class
+(codegen: the same energy terms as the axisymmetric kernels), H² and its Cartesian derivatives from the coil field
+(model/field.field_squared_cartesian).
+"""
+import numpy as np
+
+from .basis import SphericalBasis, pair_rows
+from ..galerkin.equilibrium import NonFiniteState, Parameters
+from ..model.field import CARTESIAN, field_squared_cartesian
+from ..model.kernels import KernelSet
+from ..numerics.newton import finite
+
+# the kernel of ∂R/∂name for a runtime scalar name
+DERIVATIVE_KERNELS = {"P": "surface_pressure_gradient", "M": "surface_field_gradient",
+                      "voltage": "surface_voltage_gradient"}
+
+
+class SurfaceEquilibrium:
+    """E, ∇E and ∇²E of one scene in a SphericalBasis; ``kernels``: the surface KernelSet (default: the scene's)."""
+
+    def __init__(self, scene, basis: SphericalBasis, kernels=None):
+        self.scene, self.basis = scene, basis
+        self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils],
+                              dtype=float).reshape(-1, 3)
+        self.kernels = kernels if kernels is not None else KernelSet.of_scene(scene).surface()
+        self.has_field = self.coils.shape[0] > 0
+        self._pairs = pair_rows(self.kernels.module.SURFACE_PAIRS)
+        self._held = None  # the coefficients whose node state (and field) are in _named
+
+    def node_values(self, c: np.ndarray) -> dict:
+        """{'state': the 9 node rows of x = X + u, 'field': H² and its derivatives (field classes)} at ``c``;
+        NonFiniteState if the surface folds over (J ≤ 0 at a node) or reaches a wire."""
+        if self._held is not None and np.array_equal(self._held, c):
+            return self._named
+        state = self.basis.node_state(c)
+        named = {"state": state}
+        if self.has_field:
+            field = np.empty((len(CARTESIAN), state.shape[1]))
+            field_squared_cartesian(np.ascontiguousarray(state[:3]), self.coils, field)
+            if not finite(field):
+                raise NonFiniteState("the membrane reached a wire: the coil field is singular there")
+            named["field"] = field
+        if not _oriented(state, self.basis.nodes["reference"]):
+            raise NonFiniteState("the surface folds over: a_θ × a_φ is zero or turns against the reference normal "
+                                 "at a node")
+        self._held, self._named = np.array(c), named
+        return named
+
+    def _nodes(self, kernel: str, c: np.ndarray, params: Parameters) -> np.ndarray:
+        out = self.kernels.nodes(kernel, self.node_values(c), params)
+        if not finite(out):
+            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+        return out
+
+    def energy(self, c: np.ndarray, params: Parameters) -> float:
+        """E per 2π."""
+        pi = self._nodes("surface_energy", c, params)[0].reshape(self.basis.n_theta, self.basis.n_phi)
+        return float(self.basis.nodes["weights"] @ pi.sum(axis=1))
+
+    def residual(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """∂E/∂c."""
+        return self.basis.project(self._nodes("surface_gradient", c, params))
+
+    def hessian(self, c: np.ndarray, params: Parameters, basis: SphericalBasis | None = None) -> np.ndarray:
+        """∂²E/∂c² at the state c, in ``basis`` (default the state's own; another one on the same nodes, e.g. a
+        symmetry sector: the second variation against perturbations of that space)."""
+        return (basis or self.basis).hessian(self._nodes("surface_hessian", c, params), self._pairs)
+
+    def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str) -> np.ndarray:
+        """∂R/∂name for a continuation parameter (P; M with a field; the voltage of a dielectric class)."""
+        kernel = DERIVATIVE_KERNELS.get(name)
+        if kernel is None or kernel not in self.kernels.module.KERNELS:
+            raise ValueError(f"no generated derivative of the surface residual in {name!r} for this scene class")
+        return self.basis.project(self._nodes(kernel, c, params))
+
+    def volume(self, c: np.ndarray) -> float:
+        """V/(2π) = (1/2π) ∫∫ ⅓ x · (a_θ × a_φ) dA."""
+        state = self.node_values(c)["state"]
+        flux = np.einsum("in,in->n", state[:3], np.cross(state[3:6], state[6:9], axis=0)) / 3.0
+        return float(self.basis.nodes["weights"] @ flux.reshape(self.basis.n_theta, self.basis.n_phi).sum(axis=1))
+
+
+def _oriented(state: np.ndarray, reference: np.ndarray) -> bool:
+    """(a_θ × a_φ) · X > 0 at every node: the area element is positive and keeps the reference sphere's outward
+    orientation (the kernels see only J = |a_θ × a_φ|, blind to a fold-over)."""
+    normal = np.cross(state[3:6], state[6:9], axis=0)
+    return bool((np.einsum("in,in->n", normal, reference[:3]) > 0.0).all())

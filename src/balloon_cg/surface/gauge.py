@@ -1,0 +1,123 @@
+"""The gauge of the whole-sphere problem (MODEL.md §8): which exact zero modes are removed, and how.
+
+- Relabellings (a material rotation of the reference sphere) leave every surface unchanged: removed by the phase
+  conditions ∫∫ (e_k × X) · u dA = 0 (no rigid-rotation part of u in the reference frame), for each axis k whose
+  rotation field lies in the basis' symmetry subspace. They are linear, homogeneous and hold for every
+  axisymmetric state.
+- Translations: ∫∫ u dA = 0 (the l = 0 coefficients) along an axis where the balloon is held (``held``: the lateral
+  axes x, y; the multiplier is the reaction force) and where the field leaves the translation free (no field:
+  every axis; then held and free coincide). With a field the axial translation stays an unknown (net axial force
+  zero), as in the axisymmetric solver.
+- Rigid rotations of x are zero modes where the field allows them (every axis at M = 0, the coil axis for coaxial
+  loops). In a subspace that keeps one of them (other than on a sphere state, where it is a relabelling) the gauge
+  would need a phase condition on the current state: refused for now (``UnsupportedGauge``).
+
+The constraints G c = 0 touch only l ≤ 1 coefficients; the reduced coordinates are c = Z a with Z the identity on
+every other coefficient and an orthonormal null-space block on those.
+"""
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from .basis import COS, SphericalBasis
+
+
+class UnsupportedGauge(ValueError):
+    """A subspace with a rigid-rotation zero mode that this gauge does not remove."""
+
+
+@dataclass(frozen=True)
+class Gauge:
+    """Constraints of a SphericalBasis: ``held`` (the centre held laterally), ``in_field`` (coaxial coils:
+    the field fixes every translation and every rotation but the one about z; False: no field)."""
+
+    basis: SphericalBasis
+    held: bool = True
+    in_field: bool = False
+    constraints: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        rows = [self._translation(axis) for axis in range(3) if (axis < 2 and self.held) or not self.in_field]
+        rows = [row for row in rows if row is not None]
+        rotations = [self._rotation(axis) for axis in range(3)]
+        rows += [row for row in rotations if row is not None]
+        free_rotations = (0, 1, 2) if not self.in_field else (2,)
+        kept = [axis for axis in free_rotations if rotations[axis] is not None]
+        if kept:
+            raise UnsupportedGauge(
+                f"the rigid rotation about the {'xyz'[kept[0]]} axis is a zero mode of this subspace (symmetry "
+                f"{self.basis.symmetry}, field {self.in_field}) and no phase condition removes it: add a reflection "
+                "that excludes it")
+        object.__setattr__(self, "constraints", np.array(rows).reshape(-1, self.basis.size))
+
+    def _translation(self, axis: int):
+        """The unit row of the l = 0 coefficient of component ``axis``, or None (not in the subspace)."""
+        for b in self.basis.blocks:
+            if b.component == axis and b.m == 0 and b.t == COS and b.degrees[0] == 0:
+                row = np.zeros(self.basis.size)
+                row[b.offset] = 1.0
+                return row
+        return None
+
+    def _rotation(self, axis: int):
+        """The coefficients of e_axis × X (normalised), or None when the subspace excludes it."""
+        reference = self.basis.nodes["reference"]
+        rows = np.zeros_like(reference)
+        unit = np.eye(3)[axis]
+        rows[:3] = np.cross(unit[:, None], reference[:3], axis=0)
+        row = 2.0 * np.pi * self.basis.project(rows)
+        norm = np.linalg.norm(row)
+        return row / norm if norm > 1e-8 else None
+
+    @cached_property
+    def _split(self) -> tuple:
+        """(free coefficients, constrained ones, the orthonormal null-space block Z_S)."""
+        G = self.constraints
+        touched = np.flatnonzero(np.abs(G).max(axis=0, initial=0.0) > 1e-12)
+        free = np.setdiff1d(np.arange(self.basis.size), touched)
+        if touched.size == 0:
+            return free, touched, np.zeros((0, 0))
+        _, sigma, vt = np.linalg.svd(G[:, touched])
+        rank = int((sigma > 1e-10).sum())
+        return free, touched, vt[rank:].T.copy()
+
+    @property
+    def size(self) -> int:
+        free, _, block = self._split
+        return free.size + block.shape[1]
+
+    def expand(self, a: np.ndarray) -> np.ndarray:
+        """c = Z a."""
+        free, touched, block = self._split
+        c = np.zeros(self.basis.size)
+        c[free] = a[:free.size]
+        c[touched] = block @ a[free.size:]
+        return c
+
+    def reduce(self, r: np.ndarray) -> np.ndarray:
+        """Zᵀ r (a residual, or the coordinates a of a c that meets the constraints)."""
+        free, touched, block = self._split
+        return np.concatenate([r[free], block.T @ r[touched]])
+
+    def reduce_matrix(self, H: np.ndarray) -> np.ndarray:
+        """Zᵀ H Z."""
+        free, touched, block = self._split
+        out = np.empty((self.size, self.size))
+        n = free.size
+        out[:n, :n] = H[np.ix_(free, free)]
+        side = H[np.ix_(free, touched)] @ block
+        out[:n, n:], out[n:, :n] = side, side.T
+        out[n:, n:] = block.T @ H[np.ix_(touched, touched)] @ block
+        return out
+
+    def reaction(self, residual: np.ndarray) -> np.ndarray:
+        """The held translations' multipliers: the components of the full residual ∂E/∂c (zero in the reduced
+        space at an equilibrium) along the l = 0 coefficients of x, y, z, times √(4π) — the net force per 2π the hold
+        exerts, (1/2π)∫∫ ∂π/∂u dA (zero where the axis is free)."""
+        out = np.zeros(3)
+        for axis in range(3):
+            row = self._translation(axis)
+            if row is not None:
+                out[axis] = float(row @ residual) * np.sqrt(4.0 * np.pi)
+        return out

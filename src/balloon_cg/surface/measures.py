@@ -1,0 +1,49 @@
+"""What a non-axisymmetric state is measured by: the stretch at the material poles, the enclosed volume, the
+centroid of the enclosed body (offset from the held centre) and the tilt of its long axis, and the spectral tail.
+
+Volume integrals become surface integrals over the reference sphere with n dS = (a_θ × a_φ) dA (divergence theorem):
+V = ⅓ ∫ x·n dS, ∫_V x_i dV = ½ ∫ x_i² n_i dS, ∫_V x_i x_j dV = ⅕ ∫ x_i x_j (x·n) dS. Every value is per 2π like E
+(the centroid and the tilt are ratios, free of it).
+"""
+import numpy as np
+
+from .basis import SphericalBasis
+
+MEASURES = ("lam_north", "lam_south", "volume", "centroid", "tilt")  # centroid: (n, 3); tilt: degrees
+
+
+def pole_stretch(basis: SphericalBasis, c: np.ndarray, theta: float) -> float:
+    """√J = √(λ1 λ2) at the material point θ ∈ {0, π}: the tangent plane there is spanned by the θ-derivatives
+    along φ = 0 and φ = π/2 (the two orthogonal directions away from the pole), and J = |a(0) × a(π/2)|."""
+    _, a = basis.point_values(c, np.full(2, theta), np.array([0.0, np.pi / 2]))
+    return float(np.sqrt(np.linalg.norm(np.cross(a[:, 0], a[:, 1]))))
+
+
+def body_moments(basis: SphericalBasis, state: np.ndarray) -> tuple:
+    """(V, ∫_V x dV, ∫_V x xᵀ dV), per 2π, from the node state (9 rows)."""
+    x, normal = state[:3], np.cross(state[3:6], state[6:9], axis=0)
+    weights = np.repeat(basis.nodes["weights"], basis.n_phi)
+    flux = np.einsum("in,in->n", x, normal)
+    volume = weights @ flux / 3.0
+    first = (x * x * normal) @ weights / 2.0
+    second = np.einsum("in,jn,n->ij", x, x, flux * weights) / 5.0
+    return float(volume), first, second
+
+
+def measures(basis: SphericalBasis, c: np.ndarray) -> dict:
+    """The MEASURES of the state c: the pole stretches, V/(2π), the centroid x_c and the angle (degrees, 0..90)
+    between e_z and the principal axis of the largest second moment of the body about its centroid."""
+    volume, first, second = body_moments(basis, basis.node_state(c))
+    centroid = first / volume
+    central = second / volume - np.outer(centroid, centroid)
+    _, axes = np.linalg.eigh(central)
+    tilt = np.degrees(np.arccos(min(1.0, abs(float(axes[2, -1])))))
+    return {"lam_north": pole_stretch(basis, c, 0.0), "lam_south": pole_stretch(basis, c, np.pi),
+            "volume": volume, "centroid": centroid, "tilt": tilt}
+
+
+def tail(basis: SphericalBasis, c: np.ndarray) -> float:
+    """The spectral error estimate of the state: the largest coefficient of degree L − 1 or L (the Cartesian
+    displacement's harmonics decay geometrically on a resolved state; the last two degrees bound what is cut off)."""
+    top = [np.abs(c[b.slice][np.array(b.degrees) >= basis.degree - 1]).max(initial=0.0) for b in basis.blocks]
+    return float(max(top, default=0.0))

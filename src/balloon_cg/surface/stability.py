@@ -1,0 +1,79 @@
+"""Stability of a whole-sphere state under pressure control: the lowest eigenvalues μ of the second variation,
+H c = μ G c with G the displacement norm (1/2π)∫∫|δu|² dA (analysis/azimuthal.py uses the same, so the spectra
+compare), on the G-orthogonal complement of the state's exact zero modes, in each symmetry sector of the state's
+basis (SphericalBasis.sectors: together the whole space).
+
+Zero modes removed (MODEL.md §8), at the state x:
+- relabellings, δx = (w·e_θ) a_θ + (w·e_φ) a_φ for w = e_k × X: always (every axis);
+- rigid rotations δx = e_k × x where the field allows them: every axis at M = 0, the coil axis for coaxial loops;
+- translations δx = e_k: without a field always (then held and free coincide), with one for a balloon held at its
+  centre (``held``); the free balloon keeps them, so that a paramagnetic balloon can slide toward a coil.
+A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
+fine (numerics.eigen.restricted drops them).
+"""
+import numpy as np
+
+from .basis import SphericalBasis
+from .equilibrium import SurfaceEquilibrium
+from ..galerkin.equilibrium import Parameters
+from ..numerics import eigen
+
+
+def in_field(eq: SurfaceEquilibrium, params: Parameters) -> bool:
+    """Whether a field acts (coils and M ≠ 0): then only the rotation about the coil axis is free."""
+    return eq.has_field and params.M != 0.0
+
+
+def zero_mode_fields(state: np.ndarray, reference: np.ndarray, field: bool, held: bool) -> list:
+    """The displacement fields (3, nodes) of the exact zero modes removed (module docstring) at the node state."""
+    units = np.eye(3)[:, :, None]
+    modes = []
+    for k in range(3):
+        w = np.cross(units[k], reference[:3], axis=0)
+        modes.append(np.einsum("in,in->n", w, reference[3:6]) * state[3:6]
+                     + np.einsum("in,in->n", w, reference[6:9]) * state[6:9])
+    for k in (2,) if field else (0, 1, 2):
+        modes.append(np.cross(units[k], state[:3], axis=0))
+    if held or not field:
+        modes += [np.broadcast_to(units[k], state[:3].shape) for k in range(3)]
+    return modes
+
+
+def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
+    """The coefficients in ``basis`` of the displacement fields (rows; those outside its space dropped)."""
+    rows = np.zeros((9, fields[0].shape[1])) if fields else None
+    out = []
+    for f in fields:
+        rows[:3] = f
+        row = 2.0 * np.pi * basis.project(rows)
+        if np.linalg.norm(row) > 1e-10 * max(1.0, np.abs(f).max()):
+            out.append(row)
+    return np.array(out).reshape(-1, basis.size)
+
+
+def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True) -> dict:
+    """{characters: the standard symmetric matrix of the sector's pencil with the zero modes removed}
+    (numerics.eigen.restricted; its eigenvalues are the μ, its inertia the sector's)."""
+    state = eq.node_values(c)["state"]
+    fields = zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
+    out = {}
+    for sector in eq.basis.sectors():
+        if not sector.size:
+            continue
+        H = eq.hessian(c, params, sector)
+        gram = np.full(sector.size, sector.gram())
+        factor = eigen.GramFactor(np.diag(gram), orthogonal=True)
+        rows = mode_rows(sector, fields)
+        out[sector.characters] = eigen.restricted(H, factor, rows * gram if rows.size else eigen.NO_CONSTRAINT)
+    return out
+
+
+def spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True, count: int = 6) -> dict:
+    """{characters: the ``count`` lowest μ of the sector} (module docstring)."""
+    return {key: eigen.lowest_of(A, count) for key, A in restricted_sectors(eq, c, params, held).items()}
+
+
+def negative_count(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True) -> int:
+    """The number of negative μ over every sector: 0 is stable under pressure control (Sylvester: the inertia
+    of the restricted matrices is the constrained second variation's)."""
+    return sum(int((np.linalg.eigvalsh(A) < 0.0).sum()) for A in restricted_sectors(eq, c, params, held).values())
