@@ -36,10 +36,10 @@ from ..numerics.newton import newton
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
 from ..surface.basis import EQUATOR, INVERSION, MIRROR_Y, SphericalBasis
-from ..surface.embedding import axisymmetric_coefficients, mode_coefficients
+from ..surface.embedding import axisymmetric_coefficients, mode_coefficients, transfer
 from ..surface.equilibrium import SurfaceEquilibrium
 from ..surface.gauge import Gauge
-from ..surface.measures import MEASURES, measures, tail
+from ..surface.measures import MEASURES, measures, tail, tails
 from ..surface.system import SurfaceSystem
 from . import azimuthal
 from .problem import continuation_settings, equilibrium_of
@@ -78,9 +78,30 @@ def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
     raise ValueError("the critical mode has no definite parity under z → −z on an equator-symmetric branch")
 
 
+MAX_DEGREE = 128  # the finest polar degree the resolution policy raises to
+DEGREE_STEP, ORDER_STEP = 8, 2
+
+
+def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> SphericalBasis | None:
+    """The next finer basis when a tail of c exceeds ``max_error`` (degree + DEGREE_STEP for the polar tail, order +
+    ORDER_STEP for the azimuthal one; an isotropic basis stays isotropic), the same basis when both are below it,
+    None when the degree would pass MAX_DEGREE."""
+    theta, phi = tails(basis, c)
+    degree, order = basis.degree, basis.order
+    if theta > max_error:
+        degree += DEGREE_STEP
+        order = degree if basis.order == basis.degree else order
+    if phi > max_error:
+        order = min(order + ORDER_STEP, degree)
+    if degree > MAX_DEGREE:
+        return None
+    return replace(basis, degree=degree, order=order, n_theta=0, n_phi=0) if (degree, order) != (
+        basis.degree, basis.order) else basis
+
+
 class SurfaceTrace:
-    """The problem of one surface branch: the basis, equilibrium, gauge and continuation system at the branch's
-    parameters."""
+    """The problem of one surface branch on one basis: the equilibrium, gauge and continuation system at the
+    branch's parameters."""
 
     def __init__(self, scene, basis: SphericalBasis, params: Parameters):
         self.scene, self.basis = scene, basis
@@ -88,12 +109,41 @@ class SurfaceTrace:
         self.gauge = Gauge(basis, held=True, in_field=surface_stability.in_field(self.eq, params))
         self.system = SurfaceSystem(self.eq, self.gauge, params, "P")
 
+    def on(self, basis: SphericalBasis) -> "SurfaceTrace":
+        return SurfaceTrace(self.scene, basis, self.system.params)
+
+    def move(self, X: np.ndarray, to: "SurfaceTrace") -> np.ndarray:
+        """A point X = (a, p) of this trace's system on ``to``'s (its coefficients transferred)."""
+        return to.system.point(transfer(self.basis, self.system.coefficients(X), to.basis), X[-1])
+
+    def move_direction(self, t: np.ndarray, to: "SurfaceTrace") -> np.ndarray:
+        """A direction (δa, δp) on ``to``'s system (linear: the transfer of δc without the reference sphere)."""
+        zero = transfer(self.basis, np.zeros(self.basis.size), to.basis)
+        moved = transfer(self.basis, self.system.gauge.expand(t[:-1]), to.basis) - zero
+        return np.append(to.gauge.reduce(moved), t[-1])
+
+
+def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
+    """The basis of a branch's start: degree surface.degree on the axisymmetric state's wire map (isotropic without
+    one, order min(degree, 6) with one: a field's fine features are in θ), refined until the embedded state's
+    tails are below solver.max_error / 10 (``refined``); ValueError past MAX_DEGREE."""
+    degree = scene.surface.degree
+    order = degree if disc.mapping is None else min(degree, 6)
+    basis = SphericalBasis(degree, symmetry, order=order, mapping=disc.mapping)
+    while True:
+        finer = refined(basis, axisymmetric_coefficients(basis, disc, u), scene.solver.max_error / 10)
+        if finer is None:
+            raise ValueError(f"the branch point's state needs a whole-sphere degree above {MAX_DEGREE}")
+        if finer is basis:
+            return basis
+        basis = finer
+
 
 def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
-    """stop(point) -> Stop or None (module docstring)."""
+    """stop(point) -> Stop or None (module docstring); StopCode.RESOLUTION when a tail exceeds solver.max_error."""
     scene, basis = trace.scene, trace.basis
     upper, gap = scene.continuation.stop_stretch, scene.continuation.wire_gap
-    coils = scene.field.coils
+    coils = [[k.radius, k.height, k.current] for k in scene.field.coils]
 
     def stop(point):
         if direction @ (point.X - X_star) < 0:
@@ -106,14 +156,13 @@ def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
             return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
         if coils:
             x = trace.eq.node_values(c)["state"][:3]
-            distance = float(wire_distance(np.hypot(x[0], x[1]), x[2],
-                                           [[k.radius, k.height, k.current] for k in coils]).min())
+            distance = float(wire_distance(np.hypot(x[0], x[1]), x[2], coils).min())
             if distance < gap:
                 return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap:g} of a coil (gap {distance:.3g})")
         if tail(basis, c) > scene.solver.max_error:
-            return Stop(StopCode.RESOLUTION_LIMIT,
-                        f"spectral tail {tail(basis, c):.2g} above solver.max_error {scene.solver.max_error:g} at "
-                        f"degree {basis.degree} (raise surface.degree)")
+            return Stop(StopCode.RESOLUTION, f"spectral tail {tail(basis, c):.2g} above solver.max_error "
+                                             f"{scene.solver.max_error:g} at degree {basis.degree}, order "
+                                             f"{basis.order}")
         return None
 
     return stop
@@ -132,54 +181,78 @@ def switch(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, step: float
 
 
 @limited_blas
-def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, name: str, degree: int,
-                  max_points: int, progress=None) -> SurfaceBranch | None:
-    """The branch born at the primary branch's branch point ``bp`` (number ``number``) along sign·φ; None when the
-    switch fails."""
+def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, name: str, max_points: int,
+                  progress=None) -> SurfaceBranch | None:
+    """The branch born at the branch point ``bp`` (number ``number``) of ``branch`` along sign·φ (module docstring);
+    None when the switch fails."""
     t0 = time.perf_counter()
     scene = branch.scene
     az_basis, vector = critical_mode(branch, bp, scene.stability.degree)
-    symmetry = mode_symmetry(branch, az_basis, vector, degree)
+    symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
     params = branch.params_at(bp.X)
-    trace = SurfaceTrace(scene, SphericalBasis(degree, symmetry), params)
+    trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
     c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
     X_star = trace.system.point(c_star, bp.X[-1])
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
     E, kind = classify(trace, X_star, phi)
+    origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
+                     note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
     first = switch(trace, X_star, phi)
     if not isinstance(first, continuation.Point):
         return None
-    settings = continuation_settings(scene, max_points)
-    path = continuation.trace(trace.system, first, settings, _stop_rule(trace, phi, X_star),
-                              {Kind.LP: np.eye(X_star.size)[-1]}, progress)
     start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
-    path.points.insert(0, start)
-    path.folds = [replace(f, index=f.index + 1) for f in path.folds]
-    origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
-                     note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
-    return _branch(trace, branch, number, origin, name, path, t0)
+    segments, folds = [(trace, [start])], []
+    while True:
+        done = sum(len(points) for _, points in segments)
+        path = continuation.trace(trace.system, first, continuation_settings(scene, max(max_points - done, 1)),
+                                  _stop_rule(trace, phi, X_star), {Kind.LP: np.eye(X_star.size)[-1]}, progress)
+        folds += [(trace, replace(f, index=f.index + done)) for f in path.folds]
+        segments[-1][1].extend(path.points)
+        stop = path.stop
+        if stop.code != StopCode.RESOLUTION:
+            break
+        finer = refined(trace.basis, trace.system.coefficients(path.overshoot.X), scene.solver.max_error)
+        if finer is None:
+            stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the degree would pass {MAX_DEGREE})")
+            break
+        new = trace.on(finer)
+        X = newton(new.system.residual, new.system.jacobian, trace.move(path.points[-1].X, new), np.eye(
+            new.gauge.size + 1)[-1], path.points[-1].X[-1], scene.solver.tol, scene.solver.max_newton)
+        if not X.converged:
+            stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
+                                                f"{finer.order}): {X.message}")
+            break
+        reference = trace.move_direction(path.points[-1].tangent, new)
+        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference), X.iterations, X.residual)
+        phi, X_star = trace.move_direction(phi, new), trace.move(X_star, new)
+        trace = new
+        segments.append((trace, []))
+    return _branch(trace, segments, folds, stop, branch, number, origin, name, t0)
 
 
-def _branch(trace: SurfaceTrace, parent: Branch, number: int, bp: SpecialPoint, name: str, path, t0) -> SurfaceBranch:
-    """The SurfaceBranch of a traced path: measures, stability, folds, end point."""
-    system, basis = trace.system, trace.basis
-    X = np.array([p.X for p in path.points])
-    coefficients = np.array([system.coefficients(x) for x in X])
+def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: int, bp: SpecialPoint, name: str,
+            t0) -> SurfaceBranch:
+    """The SurfaceBranch of the traced segments, every point on the final basis: measures, stability, folds, end
+    point."""
+    basis = trace.basis
+    coefficients = np.array([transfer(t.basis, t.system.coefficients(p.X), basis) if t is not trace
+                             else t.system.coefficients(p.X) for t, points in segments for p in points])
+    values = np.array([p.X[-1] for _, points in segments for p in points])
     per_point = [measures(basis, c) for c in coefficients]
-    special = [SpecialPoint(Kind.LP, f.index, np.append(system.coefficients(f.point.X), f.point.X[-1]),
-                            status=Status.LOCATED if f.status == continuation.RootStatus.LOCATED else Status.APPROXIMATE)
-               for f in path.folds]
-    special.insert(0, bp)
-    special.append(SpecialPoint(Kind.EP, len(X) - 1, np.append(coefficients[-1], X[-1, -1]), stop=path.stop))
+    special = [bp] + [SpecialPoint(Kind.LP, f.index, np.append(transfer(t.basis, t.system.coefficients(f.point.X),
+                                                                        basis), f.point.X[-1]),
+                                   status=Status.LOCATED if f.status == continuation.RootStatus.LOCATED
+                                   else Status.APPROXIMATE) for t, f in folds]
+    special.append(SpecialPoint(Kind.EP, len(values) - 1, np.append(coefficients[-1], values[-1]), stop=stop))
     out = SurfaceBranch(
         name=name, scene=parent.scene, basis=basis, kernel_class=parent.kernel_class,
-        kernel_signature=trace.eq.kernels.signature, params=parent.params, coefficients=coefficients,
-        values=X[:, -1].copy(), iterations=np.array([p.iterations for p in path.points]),
-        residual=np.array([p.residual for p in path.points]),
+        kernel_signature=trace.eq.kernels.signature, params=parent.params, coefficients=coefficients, values=values,
+        iterations=np.array([p.iterations for _, points in segments for p in points]),
+        residual=np.array([p.residual for _, points in segments for p in points]),
         error_estimate=np.array([tail(basis, c) for c in coefficients]),
         measures={key: np.array([m[key] for m in per_point]) for key in MEASURES}, m=bp.m,
-        parent=(parent.name, number), legs=(Leg("forward", path.stop),), special=special)
+        parent=(parent.name, number), legs=(Leg("forward", stop),), special=special)
     assess(out, trace)
     out.wall_time = time.perf_counter() - t0
     return out
