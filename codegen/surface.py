@@ -20,12 +20,16 @@ cancellation, D ≥ 0; the principal stretches squared are m ± √D):
 - invariant energies (``energies.energy_in_invariants``): W(I1, I2), I1 = I + J⁻², I2 = J² + I J⁻², smooth;
 - Ogden terms (μ/α)(λ1^α + λ2^α + J^−α − 3) with S = λ1^α + λ2^α = (m + d)^a + (m − d)^a, a = α/2, d = √D:
   for integer a an exact polynomial in (m, D) (over J^(2|a|) for a < 0); otherwise the closed form with
-  m − d = J²/(m + d) where d > SWITCH·m, else the series 2 Σ_{j<SERIES_TERMS} C(a, 2j) m^(a−2j) D^j
+  m − d = J²/(m + d) where d > SWITCH·m, else the series 2 m^a Σ_{j<SERIES_TERMS} C(a, 2j) t^j, t = D/m²
   (the closed form's D is guarded so that the unused branch never divides by zero after CSE);
 - a formula in the stretches: not supported yet (NotImplementedError).
 
-Derivatives in (I, J) of a function F(I, J, D) with D = I²/4 − J² use the total derivatives
-∂_I = ∂/∂I + (I/2) ∂/∂D and ∂_J = ∂/∂J − 2J ∂/∂D.
+Derivatives in (I, J) of a function F(I, J, D, t) with D = I²/4 − J², t = 4D/I² use the total derivatives
+∂_I = ∂/∂I + (I/2) ∂/∂D + 2(1 − t)/I ∂/∂t and ∂_J = ∂/∂J − 2J ∂/∂D − 8J/I² ∂/∂t.
+
+Switch (measured, see the surface-kernels report): SWITCH = 0.3 and SERIES_TERMS = 20 keep both branches of
+S, S_I, …, S_JJ within ~6e-13 (closed form, cancellation ~ε (m/d)³) and ~2e-14 (series, truncation
+~t^(SERIES_TERMS − 2)) of the exact value at d/m = 0.3 for a = 0.65, 0.865, −1.25.
 """
 import functools
 
@@ -42,6 +46,7 @@ FIELD = sp.symbols("Q Q_x Q_y Q_z Q_xx Q_xy Q_xz Q_yy Q_yz Q_zz", real=True)
 
 # stage symbols: the node's invariants, then Φ and its derivatives in (I, J)
 inv_I, inv_J, inv_D = sp.symbols("inv_I inv_J inv_D", positive=True)
+inv_t = sp.Symbol("inv_t", nonnegative=True)  # t = D/m² = (d/m)², the series variable
 PHI = sp.symbols("phi phi_I phi_J phi_II phi_IJ phi_JJ", real=True)
 _I0, _J0 = sp.symbols("I0 J0", positive=True)
 _X0 = sp.symbols("x0 y0 z0", real=True)
@@ -99,10 +104,11 @@ def at_node(expr, normal_sq, invariant):
 
 
 def _total(expr, wrt):
-    """∂_I or ∂_J of F(I, J, D) with D = I²/4 − J² (module docstring)."""
+    """∂_I or ∂_J of F(I, J, D, t) with D = I²/4 − J², t = 4D/I² (module docstring): ∂_I t = 2(1 − t)/I,
+    ∂_J t = −8J/I²."""
     if wrt == "I":
-        return sp.diff(expr, inv_I) + sp.diff(expr, inv_D) * inv_I / 2
-    return sp.diff(expr, inv_J) - 2 * inv_J * sp.diff(expr, inv_D)
+        return sp.diff(expr, inv_I) + sp.diff(expr, inv_D) * inv_I / 2 + sp.diff(expr, inv_t) * 2 * (1 - inv_t) / inv_I
+    return sp.diff(expr, inv_J) - 2 * inv_J * sp.diff(expr, inv_D) - sp.diff(expr, inv_t) * 8 * inv_J / inv_I**2
 
 
 def _derivatives(expr) -> tuple:
@@ -121,8 +127,9 @@ def _stretch_power_sum(a):
         return (sp.expand(even) if a >= 0 else sp.expand(even) / inv_J ** (2 * k)), sp.S.Zero, sp.S.Zero
     root = sp.sqrt(inv_D)
     closed = (m + root) ** a + (inv_J**2 / (m + root)) ** a
-    # binomial(a, k) of a symbolic exponent as a product (codegen/energies.py: _odd_coefficients)
-    series = 2 * sum(sp.expand_func(sp.binomial(a, 2 * j)) * m ** (a - 2 * j) * inv_D**j for j in range(SERIES_TERMS))
+    # 2 m^a Σ_j C(a, 2j) t^j, t = D/m²: one power of m, a polynomial in t ≤ SWITCH² (binomial(a, k) of a symbolic
+    # exponent as a product, codegen/energies.py: _odd_coefficients)
+    series = 2 * m**a * sum(sp.expand_func(sp.binomial(a, 2 * j)) * inv_t**j for j in range(SERIES_TERMS))
     return sp.S.Zero, closed, series
 
 
@@ -168,7 +175,11 @@ def surface_kernels(cls: fn.SceneClass) -> list[Kernel]:
     node = lambda exprs: tuple(at_node(e, normal_sq, invariant) for e in exprs)  # noqa: E731
     geometry_stage = ((inv_I, invariant), (inv_J, sp.sqrt(normal_sq)), (inv_D, spread))
     material = dict(zip(PHI, material_stage(cls)))
-    stages = lambda *names: (geometry_stage, tuple((p, material[p]) for p in names))  # noqa: E731
+    # the series variable t = D/m² where an Ogden term needs it
+    earlier = (geometry_stage,)
+    if any(e.has(inv_t) for e in material.values()):
+        earlier += (((inv_t, 4 * inv_D / inv_I**2),),)
+    stages = lambda *names: (*earlier, tuple((p, material[p]) for p in names))  # noqa: E731
     phi, phi_I, phi_J, phi_II, phi_IJ, phi_JJ = PHI
     args = _args(cls)
     labels = tuple(map(str, STATE))
