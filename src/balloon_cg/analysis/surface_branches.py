@@ -44,7 +44,7 @@ from ..surface.system import SurfaceSystem
 from . import azimuthal
 from .problem import continuation_settings, equilibrium_of
 from .results import (Block, Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
-                      SurfaceBranch)
+                      SurfaceBranch, TraceStop)
 
 STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
@@ -84,24 +84,43 @@ def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
 
 
 MAX_DEGREE = 128  # the finest polar degree the resolution policy raises to
-DEGREE_STEP, ORDER_STEP = 8, 2
+MAX_ORDER = 16  # the finest azimuthal order (a state pressed against a wire on one side needs more: flagged)
+DEGREE_STEP, ORDER_STEP = 8, 2  # the smallest increments; larger ones where the decay asks for them
+
+
+def _increment(maxima: np.ndarray, target: float, step: int, most: int) -> int:
+    """How far to extend a spectrum whose largest coefficient per index is ``maxima`` (the last ones being the tail)
+    for its predicted tail to fall below ``target``: geometric decay fitted to the last four indices, rounded up to
+    a multiple of ``step``, at least ``step`` and at most ``most``."""
+    tail = np.maximum(maxima[-4:], 1e-300)
+    rate = np.polyfit(np.arange(tail.size), np.log(tail), 1)[0]
+    if rate >= 0.0:
+        return most
+    needed = np.log(target / tail[-1]) / rate
+    return int(min(most, max(step, step * np.ceil(needed / step))))
 
 
 def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> SphericalBasis | None:
-    """The next finer basis when a tail of c exceeds ``max_error`` (degree + DEGREE_STEP for the polar tail, order +
-    ORDER_STEP for the azimuthal one; an isotropic basis stays isotropic), the same basis when both are below it,
-    None when the degree would pass MAX_DEGREE."""
+    """The next finer basis when a tail of c exceeds ``max_error`` (``surface.measures.tails``): the degree and the
+    order extended as far as the fitted decay of the coefficients predicts is needed for a tail of max_error/4
+    (an isotropic basis stays isotropic); the same basis when both tails are below max_error, None when the degree
+    would pass MAX_DEGREE or a capped order MAX_ORDER."""
     theta, phi = tails(basis, c)
     degree, order = basis.degree, basis.order
     if theta > max_error:
-        degree += DEGREE_STEP
+        by_degree = np.array([max((abs(c[b.offset + i]) for b in basis.blocks for i, l in enumerate(b.degrees)
+                                   if l == degree_), default=0.0) for degree_ in range(basis.degree + 1)])
+        degree += _increment(by_degree, max_error / 4, DEGREE_STEP, 4 * DEGREE_STEP)
         order = degree if basis.order == basis.degree else order
     if phi > max_error:
-        order = min(order + ORDER_STEP, degree)
-    if degree > MAX_DEGREE:
+        by_order = np.array([max((np.abs(c[b.slice]).max() for b in basis.blocks if b.m == m), default=0.0)
+                             for m in range(basis.order + 1)])
+        order = min(order + _increment(by_order, max_error / 4, ORDER_STEP, 4 * ORDER_STEP), degree)
+    if degree > MAX_DEGREE or (order > MAX_ORDER and order > basis.order):
         return None
-    return replace(basis, degree=degree, order=order, n_theta=0, n_phi=0) if (degree, order) != (
-        basis.degree, basis.order) else basis
+    if (degree, order) == (basis.degree, basis.order):
+        return basis
+    return replace(basis, degree=degree, order=order, n_theta=0, n_phi=0)
 
 
 class SurfaceTrace:
@@ -212,25 +231,31 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     segments, folds = [(trace, [start])], []
     while True:
         done = sum(len(points) for _, points in segments)
-        path = continuation.trace(trace.system, first, continuation_settings(scene, max(max_points - done, 1)),
-                                  _stop_rule(trace, phi, X_star), {Kind.LP: np.eye(X_star.size)[-1]}, progress)
+        settings = continuation_settings(scene, max(max_points - done, 1))
+        path = continuation.trace(trace.system, first, settings, _stop_rule(trace, phi, X_star),
+                                  {Kind.LP: np.eye(X_star.size)[-1]}, progress)
         folds += [(trace, replace(f, index=f.index + done)) for f in path.folds]
         segments[-1][1].extend(path.points)
         stop = path.stop
+        if stop.code == TraceStop.MAX_POINTS:
+            stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
             break
         finer = refined(trace.basis, trace.system.coefficients(path.overshoot.X), scene.solver.max_error)
         if finer is None:
-            stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the degree would pass {MAX_DEGREE})")
+            stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
+                                                                  f"order {MAX_ORDER})")
             break
         new = trace.on(finer)
-        X = newton(new.system.residual, new.system.jacobian, trace.move(path.points[-1].X, new), np.eye(
-            new.gauge.size + 1)[-1], path.points[-1].X[-1], scene.solver.tol, scene.solver.max_newton)
+        last = segments[-1][1].pop()  # solved again on the finer basis: the first point of the next segment
+        X = newton(new.system.residual, new.system.jacobian, trace.move(last.X, new), np.eye(new.gauge.size + 1)[-1],
+                   last.X[-1], scene.solver.tol, scene.solver.max_newton)
         if not X.converged:
+            segments[-1][1].append(last)
             stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
                                                 f"{finer.order}): {X.message}")
             break
-        reference = trace.move_direction(path.points[-1].tangent, new)
+        reference = trace.move_direction(last.tangent, new)
         first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference), X.iterations, X.residual)
         phi, X_star = trace.move_direction(phi, new), trace.move(X_star, new)
         trace = new
@@ -247,6 +272,9 @@ def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: 
                              else t.system.coefficients(p.X) for t, points in segments for p in points])
     values = np.array([p.X[-1] for _, points in segments for p in points])
     per_point = [measures(basis, c) for c in coefficients]
+    first_basis = segments[0][0].basis
+    if first_basis is not basis:  # the origin was made on the first basis
+        bp = replace(bp, X=np.append(transfer(first_basis, bp.X[:-1], basis), bp.X[-1]))
     special = [bp] + [SpecialPoint(Kind.LP, f.index, np.append(transfer(t.basis, t.system.coefficients(f.point.X),
                                                                         basis), f.point.X[-1]),
                                    status=Status.LOCATED if f.status == continuation.RootStatus.LOCATED
@@ -274,7 +302,7 @@ def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
         readings["free"].append(spectra[False])
     sb.stability = {key: np.array(rows) for key, rows in readings.items()}
     negative = (sb.stability["held"] < 0).sum(axis=1)
-    for i in np.flatnonzero(np.diff(negative)):
+    for i in np.flatnonzero(np.diff(negative[1:])) + 1:  # point 0 is the parent branch point itself
         X0 = np.append(sb.coefficients[i], sb.values[i])
         sb.special.append(SpecialPoint(
             Kind.BP, int(i), X0, block=Block.NONE, m=sb.m, status=Status.APPROXIMATE,

@@ -187,7 +187,7 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
             bars.finish(Phase.PRIMARY, len(branches[0].X))
             return branches, None, incomplete(branches), None
         picture = analyse_picture(scene, bars, pear=pear)
-        return picture.branches, picture.snaps, picture.incomplete, picture
+        return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture
 
 
 def trace(scene, progress: bool = False) -> Result:

@@ -213,7 +213,8 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
         found = incomplete(branches)
     else:
         picture = analyse(scene, pear=(mode == "analysis"))
-        branches, snaps, points, found = picture.branches, picture.snaps, picture.branch_points, picture.incomplete
+        branches, snaps, points, found = (picture.branches + picture.surface_branches, picture.snaps,
+                                          picture.branch_points, picture.incomplete)
     return MemberResult(index, branches, snaps, points, found, time.perf_counter() - start, os.getpid())
 
 

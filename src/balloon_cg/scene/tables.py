@@ -98,7 +98,7 @@ class Continuation:
     step: float = 0.05
     step_min: float = 1e-7
     step_max: float = 0.25
-    max_points: int = 2000
+    max_points: int = 300
     symmetry: str = "auto"
     wire_gap: float = 0.02
     parameter: ContinuationParameter = ContinuationParameter.PRESSURE
@@ -138,7 +138,7 @@ class Surface:
 
     branches: str = "first"
     degree: int = 16
-    max_points: int = 200
+    max_points: int = 30
 
 
 SURFACE_BRANCHES = ("first", "all", "none")

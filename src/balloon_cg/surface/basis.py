@@ -26,6 +26,7 @@ sin mφ by −(−1)^m, z → −z multiplies by (−1)^(l+m). The states of a b
 χ = +1); the Hessian at such a state maps each sector (a choice of the χ) to itself, so its spectrum is the union
 of the sectors' (``sectors``).
 """
+import functools
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -138,11 +139,8 @@ class SphericalBasis:
     def sectors(self) -> list:
         """The bases of every choice of characters for this basis' reflections (same degree and nodes): their
         spaces together are the whole space, and a Hessian at a state of the invariant subspace is block-diagonal
-        in them."""
-        if not self.symmetry:
-            return [self]
-        signs = np.array(np.meshgrid(*[(1, -1)] * len(self.symmetry), indexing="ij")).reshape(len(self.symmetry), -1)
-        return [replace(self, characters=tuple(int(s) for s in column)) for column in signs.T]
+        in them. Built once per basis (their tables are reused)."""
+        return _sectors(self)
 
     @cached_property
     def nodes(self) -> dict:
@@ -350,6 +348,14 @@ class SphericalBasis:
     def gram(self) -> float:
         """The displacement norm (1/2π)∫∫|δu|² dA in these coefficients: c·c/(2π) (the basis is orthonormal)."""
         return 1.0 / (2.0 * np.pi)
+
+
+@functools.lru_cache(maxsize=16)
+def _sectors(basis: SphericalBasis) -> list:
+    if not basis.symmetry:
+        return [basis]
+    signs = np.array(np.meshgrid(*[(1, -1)] * len(basis.symmetry), indexing="ij")).reshape(len(basis.symmetry), -1)
+    return [replace(basis, characters=tuple(int(s) for s in column)) for column in signs.T]
 
 
 def _norm(m: int) -> float:
