@@ -84,7 +84,8 @@ def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
 
 
 MAX_DEGREE = 128  # the finest polar degree the resolution policy raises to
-MAX_ORDER = 16  # the finest azimuthal order (a state pressed against a wire on one side needs more: flagged)
+MAX_ORDER = 16  # the finest order of an anisotropic basis (a state pressed against a wire on one side needs more:
+#                 flagged); an isotropic basis (order = degree) is capped by MAX_DEGREE
 DEGREE_STEP, ORDER_STEP = 8, 2  # the smallest increments; larger ones where the decay asks for them
 
 
@@ -116,7 +117,7 @@ def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> Spherical
         by_order = np.array([max((np.abs(c[b.slice]).max() for b in basis.blocks if b.m == m), default=0.0)
                              for m in range(basis.order + 1)])
         order = min(order + _increment(by_order, max_error / 4, ORDER_STEP, 4 * ORDER_STEP), degree)
-    if degree > MAX_DEGREE or (order > MAX_ORDER and order > basis.order):
+    if degree > MAX_DEGREE or (order < degree and order > max(MAX_ORDER, basis.order)):
         return None
     if (degree, order) == (basis.degree, basis.order):
         return basis
