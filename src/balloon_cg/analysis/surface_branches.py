@@ -32,6 +32,7 @@ from ..galerkin.equilibrium import Parameters
 from ..model.field import wire_distance
 from ..numerics import continuation
 from ..numerics.continuation import Stop
+from ..numerics import eigen
 from ..numerics.newton import newton
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
@@ -295,22 +296,61 @@ def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: 
 
 
 def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
-    """The stability readings of every point and the secondary branch points (module docstring)."""
-    readings = {"held": [], "free": []}
+    """The stability readings of every point and the secondary branch points: where the number of negative held
+    eigenvalues of a sector changes between points i and i + 1 (i ≥ 1: point 0 is the parent point), the zero of
+    the crossing eigenvalue, located by Brent's method along the chord with the corrector on its hyperplane (as
+    azimuthal_points.locate); APPROXIMATE with the bracket when the search fails."""
+    readings, counts = {"held": [], "free": []}, []
     for c, value in zip(sb.coefficients, sb.values):
-        spectra = surface_stability.spectra(trace.eq, c, sb.params.with_value(sb.parameter, value), STABILITY_COUNT)
-        readings["held"].append(spectra[True])
-        readings["free"].append(spectra[False])
+        params = sb.params.with_value(sb.parameter, value)
+        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT)
+        for key, held in (("held", True), ("free", False)):
+            readings[key].append(np.sort(np.concatenate(list(spectra[held].values())))[:STABILITY_COUNT])
+        counts.append(_negative_counts(trace, c, params, spectra[True]))
     sb.stability = {key: np.array(rows) for key, rows in readings.items()}
-    negative = (sb.stability["held"] < 0).sum(axis=1)
-    for i in np.flatnonzero(np.diff(negative[1:])) + 1:  # point 0 is the parent branch point itself
-        X0 = np.append(sb.coefficients[i], sb.values[i])
-        sb.special.append(SpecialPoint(
-            Kind.BP, int(i), X0, block=Block.NONE, m=sb.m, status=Status.APPROXIMATE,
-            uncertainty=0.5 * float(abs(sb.values[i + 1] - sb.values[i])),
-            reason="secondary branch point of a non-axisymmetric branch: bracketed, not located",
-            note="a held eigenvalue of the whole-sphere second variation changes sign"))
+    for i in range(1, len(counts) - 1):
+        for key in counts[i]:
+            if counts[i][key] != counts[i + 1][key]:
+                sb.special.append(_secondary(sb, trace, i, key, min(counts[i][key], counts[i + 1][key])))
     sb.special.sort(key=lambda s: s.index)
+
+
+def _negative_counts(trace: SurfaceTrace, c, params, lowest: dict) -> dict:
+    """{characters: the number of negative held eigenvalues of the sector}: from its lowest STABILITY_COUNT, or,
+    when they are all negative, from its whole spectrum."""
+    counts = {}
+    for key, values in lowest.items():
+        counts[key] = int((values < 0).sum())
+        if counts[key] == values.size:
+            A = surface_stability.restricted_sectors(trace.eq, c, params, (True,), key)[True][key]
+            counts[key] = int((np.linalg.eigvalsh(A) < 0).sum())
+    return counts
+
+
+def _secondary(sb: SurfaceBranch, trace: SurfaceTrace, i: int, sector: tuple, k: int) -> SpecialPoint:
+    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero."""
+    system, solver = trace.system, trace.scene.solver
+    X0, X1 = (system.point(sb.coefficients[j], sb.values[j]) for j in (i, i + 1))
+    chord = X1 - X0
+    d = chord / np.linalg.norm(chord)
+
+    def value_at(s):
+        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
+        if not result.converged:
+            raise ArithmeticError(result.message)
+        c, params = system.coefficients(result.x), system.params_at(result.x)
+        A = surface_stability.restricted_sectors(trace.eq, c, params, (True,), sector)[True][sector]
+        return float(eigen.lowest_of(A, k + 1)[k]), np.append(c, result.x[-1])
+
+    found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
+    note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"
+    if found is not None and found.status == continuation.RootStatus.LOCATED:
+        return SpecialPoint(Kind.BP, i, found.payload, m=sb.m, note=note)
+    X = np.append(sb.coefficients[i], sb.values[i]) if found is None else found.payload
+    return SpecialPoint(Kind.BP, i, X, m=sb.m, status=Status.APPROXIMATE,
+                        uncertainty=0.5 * float(abs(sb.values[i + 1] - sb.values[i])),
+                        reason="the root search along the chord failed; the nearest evaluated point is stored",
+                        note=note)
 
 
 def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: float = 2e-2) -> tuple:

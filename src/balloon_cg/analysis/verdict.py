@@ -5,7 +5,9 @@ stretch limits, stop_pressure, stop_volume, stop_amount, stop_voltage, zero volt
 membrane's compression (the end of the membrane model: tension-field theory is not modelled), a pear branch
 rejoining the primary branch), every special point is LOCATED (and every axisymmetric branch point classified),
 every bifurcating branch asked for could be started, and the stability flags of every assessed point are settled
-between the stability degree and the check degree. Everything else is an ``Incomplete`` entry: typed, named,
+between the stability degree and the check degree. A non-axisymmetric branch (``surface_branches``) may end at the
+caps of its whole-sphere basis or at its ``[surface] max_points``: a stated limitation (Gap.LIMITED), since every
+point it stores is resolved. Everything else is an ``Incomplete`` entry: typed, named,
 explained. A limitation of the method
 that is not a failure of the computation (branch points not searched on a scene without equator symmetry) is
 an entry too, but does not make the result incomplete (``Gap.fails``). The CLI turns failing entries into exit
@@ -15,12 +17,17 @@ complete, incomplete_*).
 import enum
 from dataclasses import dataclass
 
-from .results import Classification, Kind, Status, StopCode
+from .results import Classification, Kind, Status, StopCode, SurfaceBranch, TraceStop
 
 REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCode.STOP_PRESSURE,
                              StopCode.STOP_VOLUME, StopCode.STOP_AMOUNT, StopCode.STOP_VOLTAGE, StopCode.ZERO_VOLTAGE,
                              StopCode.COMPRESSED, StopCode.WIRE_GAP,
                              StopCode.SOUTH_STOP_STRETCH, StopCode.REJOINED})
+
+
+# where a non-axisymmetric branch may end short without failing: the caps of the whole-sphere basis (its points up to
+# there are resolved) and the [surface] max_points budget
+SURFACE_LIMITS = frozenset({StopCode.RESOLUTION_LIMIT, TraceStop.MAX_POINTS})
 
 
 class Gap(enum.StrEnum):
@@ -30,12 +37,14 @@ class Gap(enum.StrEnum):
     UNCLASSIFIED = "unclassified"  # an axisymmetric branch point whose reduced energy could not be fitted
     NOT_STARTED = "not_started"  # a bifurcating branch the analysis asked for could not be started
     NOT_SEARCHED = "not_searched"  # branch points were not searched (a limitation, stated; not a failure)
+    LIMITED = "limited"  # a non-axisymmetric branch ended at the whole-sphere basis' cap or its [surface] max_points
+    #                      (a limitation of the method or the budget asked for, stated; every stored point resolved)
     INTERRUPTED = "interrupted"  # a signal stopped the computation: what follows the stored points is missing
 
     @property
     def fails(self) -> bool:
         """Whether an entry of this kind makes the result incomplete."""
-        return self is not Gap.NOT_SEARCHED
+        return self not in (Gap.NOT_SEARCHED, Gap.LIMITED)
 
 
 @dataclass(frozen=True)
@@ -52,7 +61,9 @@ def incomplete(branches: list, not_searched: str = "", not_started: tuple = ()) 
     found = [Incomplete(Gap.NOT_STARTED, name, reason) for name, reason in not_started]
     for branch in branches:
         for leg in branch.legs:
-            if leg.stop.code not in REQUESTED_STOPS:
+            if isinstance(branch, SurfaceBranch) and leg.stop.code in SURFACE_LIMITS:
+                found.append(Incomplete(Gap.LIMITED, branch.name, f"{leg.label} leg: {leg.stop.message}"))
+            elif leg.stop.code not in REQUESTED_STOPS:
                 found.append(Incomplete(Gap.STOPPED_SHORT, branch.name, f"{leg.label} leg: {leg.stop.message}"))
         for s in branch.special:
             if s.status != Status.LOCATED:

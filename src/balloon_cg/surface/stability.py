@@ -51,31 +51,47 @@ def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
     return np.array(out).reshape(-1, basis.size)
 
 
-def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=(True, False)) -> dict:
+def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=(True, False),
+                       only: tuple | None = None) -> dict:
     """{held: {characters: the standard symmetric matrix of the sector's pencil with the zero modes removed}} for
     each reading (held: True, free: False) from one assembly per sector (numerics.eigen.restricted; its eigenvalues
-    are the μ, its inertia the sector's)."""
+    are the μ, its inertia the sector's); ``only``: the characters of the one sector wanted."""
     state = eq.node_values(c)["state"]
-    sectors = [sector for sector in eq.basis.sectors() if sector.size]
+    sectors = [sector for sector in eq.basis.sectors() if sector.size and only in (None, sector.characters)]
     hessians = [eq.hessian(c, params, sector) for sector in sectors]
+    made = {}  # (sector, constraint rows) -> matrix: the readings share a sector without a translation
     out = {}
     for held in readings:
         fields = zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
         out[held] = {}
-        for sector, H in zip(sectors, hessians):
-            gram = np.full(sector.size, sector.gram())
-            factor = eigen.GramFactor(np.diag(gram), orthogonal=True)
+        for k, (sector, H) in enumerate(zip(sectors, hessians)):
             rows = mode_rows(sector, fields)
-            out[held][sector.characters] = eigen.restricted(H, factor,
-                                                            rows * gram if rows.size else eigen.NO_CONSTRAINT)
+            key = (k, rows.tobytes())
+            if key not in made:
+                gram = np.full(sector.size, sector.gram())
+                factor = eigen.GramFactor(np.diag(gram), orthogonal=True)
+                made[key] = eigen.restricted(H, factor, rows * gram if rows.size else eigen.NO_CONSTRAINT)
+            out[held][sector.characters] = made[key]
+    return out
+
+
+def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
+                   readings=(True, False)) -> dict:
+    """{held: {characters: the ``count`` lowest μ of the sector}}; a matrix both readings share is solved once."""
+    lowest, out = {}, {}
+    for held, sectors in restricted_sectors(eq, c, params, readings).items():
+        for A in sectors.values():
+            if id(A) not in lowest:
+                lowest[id(A)] = eigen.lowest_of(A.copy(), count)
+        out[held] = {key: lowest[id(A)] for key, A in sectors.items()}
     return out
 
 
 def spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
             readings=(True, False)) -> dict:
     """{held: the ``count`` lowest μ over every sector, ascending} (module docstring)."""
-    return {held: np.sort(np.concatenate([eigen.lowest_of(A, count) for A in sectors.values()]))[:count]
-            for held, sectors in restricted_sectors(eq, c, params, readings).items()}
+    return {held: np.sort(np.concatenate(list(sectors.values())))[:count]
+            for held, sectors in sector_spectra(eq, c, params, count, readings).items()}
 
 
 def spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True, count: int = 6) -> dict:
