@@ -11,7 +11,8 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 import balloon_cg as bc
 from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.results import Kind, Leg, SpecialPoint, Stop, StopCode, SurfaceBranch
+from balloon_cg.analysis.results import (Block, Classification, Kind, Leg, SpecialPoint, Stop, StopCode,
+                                         SurfaceBranch)
 from balloon_cg.app.api import Result
 from balloon_cg.app.cli import PLOT_KINDS, main
 from balloon_cg.galerkin.equilibrium import Parameters
@@ -57,7 +58,8 @@ def surface_branch(scene, basis):
         np.arange(n) + 2, np.full(n, 1e-12), np.full(n, 1e-10),
         {name: np.array([m[name] for m in per_point]) for name in MEASURES}, 1, ("primary", 0),
         legs=(Leg("forward", end),),
-        special=[SpecialPoint(Kind.BP, 0, rows[0].copy(), m=1, note="m = 1 branch point 0 of primary"),
+        special=[SpecialPoint(Kind.BP, 0, rows[0].copy(), Classification.PITCHFORK_SUB, Block.M1_HELD, m=1,
+                              E=(0.2, 0.0, -0.5), note="born here: branch point 0 of primary (m = 1)"),
                  SpecialPoint(Kind.EP, n - 1, rows[-1].copy(), stop=end)],
         stability=lowest, wall_time=0.25)
 
@@ -136,7 +138,7 @@ def test_inspect_text_and_json(run_path, capsys):
 
 
 @pytest.mark.parametrize("kind", [k for k in PLOT_KINDS if k not in ("phase", "voltage-pole", "voltage-equator",
-                                                                      "field", "energy")])
+                                                                      "field")])
 def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
     fig = plot([run_path], kind)
     axes = fig.axes
@@ -146,6 +148,9 @@ def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
         color = legend["m = 1 (parent BP 0)"].get_color()
         drawn = [line.get_xdata() for line in axes[0].lines if line.get_color() == color and len(line.get_xdata()) > 1]
         assert np.allclose(np.unique(np.concatenate(drawn).round(12)), STRETCHES)  # P against lam2_north
+    elif kind == "energy":  # the normal form at the branch point the surface branch is born at
+        labels = [t.get_text() for t in axes[0].get_legend().get_texts()]
+        assert len(labels) == 1 and labels[0].startswith("m = 1 (parent BP 0): pitchfork-sub m=1 at P = ")
     elif kind == "surface":
         assert axes[0].name == "3d"
         assert any(isinstance(c, Poly3DCollection) for c in axes[0].collections)

@@ -14,8 +14,8 @@ thinner and lighter. Branch curves are solid where stable and dashed where unsta
 ``Reading`` (default: the run's loading control, balloon held at its centre), named in the legend title; without
 stability data all solid, and the legend title says so. Titles name the material and the coils. Special points
 are marked and labelled with their kind (LP, TP, EP, branch points, …). Surface branches (m ≥ 1, states on the
-whole sphere) are drawn by the pole curves, labelled 'm = 1 (parent BP k)', and left out of the other branch
-and per-point kinds; ``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
+whole sphere) are drawn by the pole curves and the energy landscape, labelled 'm = 1 (parent BP k)', and left
+out of the other branch and per-point kinds; ``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
 The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest (``robust_limits``).
 Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2,
 field in I/(4π R0).
@@ -345,11 +345,11 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
     names = list(dict.fromkeys(p.branch for p in points)) if configurations else [
         "primary" if per_point and branch is None else branch]
     branches = [b for source in sources for name in names for b in load_branches(source, name, stability)]
-    if what not in POLE_KINDS:  # the axisymmetric kinds: surface branches have no profiles, equator or modes
+    if what not in SURFACE_DRAWN:  # the axisymmetric kinds: surface branches have no profiles or equator ring
         named = [b for b in branches if b.m and (branch is not None or configurations)]
         if named:
             raise PlotError(f"{named[0].source}: branch {named[0].name} is a surface branch (m = {named[0].m}): "
-                            f"{what} draws axisymmetric branches; draw it with {', '.join(POLE_KINDS)}, "
+                            f"{what} draws axisymmetric branches; draw it with {', '.join(SURFACE_DRAWN)}, "
                             f"{' or '.join(SURFACE_KINDS)}")
         branches = [b for b in branches if not b.m]
     branches = _label(branches)
@@ -1044,5 +1044,5 @@ KINDS = {
     "surface": (plot_surface, True),
     "stretch-map": (plot_stretch_map, True),
 }
-POLE_KINDS = ("pressure-pole", "voltage-pole")  # the branch curves that draw surface branches too
+SURFACE_DRAWN = ("pressure-pole", "voltage-pole", "energy")  # the branch kinds that draw surface branches too
 SURFACE_KINDS = ("surface", "stretch-map")  # one state of a surface branch
