@@ -4,7 +4,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from . import equations, poles
-from . import second_variation, stretch_derivatives
+from . import second_variation, stretch_derivatives, surface
 from .classes import scene_classes
 from .emit import module_text
 from .functional import FIELD, GENERAL_TERMS, SceneClass
@@ -50,6 +50,29 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     return text
 
 
+def surface_module(cls: SceneClass, timings: dict | None = None) -> str:
+    """Module text of the surface kernels of one scene class (codegen/surface.py), separate from its class
+    module; ``timings`` as for ``class_module``."""
+    start = time.perf_counter()
+    kernels = surface.surface_kernels(cls)
+    material = f"Ogden exponents {cls.inputs()['alphas']}" if cls.energy is None else f"strain energy {cls.energy[0]}"
+    title = f"Surface kernels (MODEL.md §8) for scene class {cls.name}: {material}, field {cls.field}."
+    if cls.electric:
+        title = f"{title[:-1]}, dielectric term -voltage^2 J^2."
+    derived = time.perf_counter()
+    lowered = [lower(k) for k in kernels]
+    cse = time.perf_counter()
+    text = module_text(title, {**cls.inputs(), "surface": True}, lowered, GENERATOR, layout=surface.layout())
+    if timings is not None:
+        timings.update(derive=derived - start, lower=cse - derived, print=time.perf_counter() - cse)
+    return text
+
+
+def surface_name(cls: SceneClass) -> str:
+    """The module name of a committed class's surface kernels."""
+    return f"surface_{cls.name}"
+
+
 def field_module_text() -> str:
     from . import field
 
@@ -57,15 +80,19 @@ def field_module_text() -> str:
     return module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants, layout)
 
 
-def _class_job(cls):
+def _class_job(job):
+    kind, cls = job
+    if kind == "surface":
+        return surface_name(cls), surface_module(cls)
     return cls.name, class_module(cls)
 
 
 def all_modules(workers: int = 2):
     """{module name: text}, generated in parallel; output does not depend on the worker count."""
     classes = scene_classes()
+    jobs = [("class", cls) for cls in classes] + [("surface", cls) for cls in classes]
     with ProcessPoolExecutor(workers) as pool:
-        texts = dict(pool.map(_class_job, classes))
+        texts = dict(pool.map(_class_job, jobs))
     texts["coil_field"] = field_module_text()
     return dict(sorted(texts.items()))
 
@@ -83,11 +110,15 @@ def registry_text() -> str:
         '"""Kernels emitted by codegen/ (make regenerate). Never edit by hand.\n\n'
         'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field), ENERGY_CLASSES\n'
         'module name -> (canonical strain-energy formula, has field); the layout constants are those of every\n'
-        'class module (codegen/build.py: layout).\n"""\n'
+        'class module (codegen/build.py: layout). SURFACE_CLASSES maps class name -> its surface module (MODEL.md §8,\n'
+        'codegen/surface.py), whose row layouts are the SURFACE_ constants.\n"""\n'
         f"GENERAL_TERMS = {GENERAL_TERMS}\n"
         + "".join(f"{name} = {value!r}\n" for name, value in layout().items())
         + "CLASSES = {\n" + "".join(rows) + "}\n"
         + "ENERGY_CLASSES = {\n" + "".join(energy_rows) + "}\n"
+        + "".join(f"{name} = {value!r}\n" for name, value in surface.layout().items())
+        + "SURFACE_CLASSES = {\n" + "".join(f"    {c.name!r}: {surface_name(c)!r},\n" for c in scene_classes())
+        + "}\n"
     )
 
 

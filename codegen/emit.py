@@ -33,6 +33,15 @@ def _scalar_function(lowered: LoweredKernel) -> str:
     return "\n".join(lines)
 
 
+def node_count(kernel) -> str:
+    """The loop bound of ``NAME_nodes``: the length of the first 'node' argument, or else the row length of the
+    first 'node_rows' argument (a kernel whose node values all come in one matrix, e.g. the surface kernels)."""
+    first = next((a.name for a in kernel.args if a.kind == "node"), None)
+    if first is not None:
+        return f"{first}.shape[0]"
+    return f"{next(a.name for a in kernel.args if a.kind == 'node_rows')}.shape[1]"
+
+
 def _node_loop(lowered: LoweredKernel) -> str:
     """``NAME_nodes``: the scalar kernel applied at every node, results in rows of ``out``."""
     kernel = lowered.kernel
@@ -45,12 +54,11 @@ def _node_loop(lowered: LoweredKernel) -> str:
             call.append(f"{arg.name}[:, i]")
         else:
             call.append(arg.name)
-    first_node = next(a.name for a in kernel.args if a.kind == "node")
     body = [
         "@njit(cache=True)",
         f"def {kernel.name}_nodes({', '.join(names + ['out'])}):",
         f'    """{kernel.name} at every node i; output k goes to out[k, i]."""',
-        f"    for i in range({first_node}.shape[0]):",
+        f"    for i in range({node_count(kernel)}):",
         f"        r = {kernel.name}({', '.join(call)})",
     ]
     body += [f"        out[{k}, i] = r[{k}]" for k in range(len(lowered.results))]

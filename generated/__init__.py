@@ -2,7 +2,8 @@
 
 CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field), ENERGY_CLASSES
 module name -> (canonical strain-energy formula, has field); the layout constants are those of every
-class module (codegen/build.py: layout).
+class module (codegen/build.py: layout). SURFACE_CLASSES maps class name -> its surface module (MODEL.md §8,
+codegen/surface.py), whose row layouts are the SURFACE_ constants.
 """
 GENERAL_TERMS = 3
 STATE = ('lam2', 'v', 'eta', 'w')
@@ -38,4 +39,34 @@ ENERGY_CLASSES = {
     'gent_gent_field': ('-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)', True),
     'arruda_boyce': ('mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))', False),
     'arruda_boyce_field': ('mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))', True),
+}
+SURFACE_STATE = ('x', 'y', 'z', 'xt', 'yt', 'zt', 'xp', 'yp', 'zp')
+SURFACE_PAIRS = ((0, 0), (0, 1), (0, 2), (0, 3), (0, 4), (0, 5), (0, 6), (0, 7), (0, 8), (1, 1), (1, 2), (1, 3), (1, 4), (1, 5), (1, 6), (1, 7), (1, 8), (2, 2), (2, 3), (2, 4), (2, 5), (2, 6), (2, 7), (2, 8), (3, 3), (3, 4), (3, 5), (3, 6), (3, 7), (3, 8), (4, 4), (4, 5), (4, 6), (4, 7), (4, 8), (5, 5), (5, 6), (5, 7), (5, 8), (6, 6), (6, 7), (6, 8), (7, 7), (7, 8), (8, 8))
+SURFACE_FIELD_ROWS = ('Q', 'Q_x', 'Q_y', 'Q_z', 'Q_xx', 'Q_xy', 'Q_xz', 'Q_yy', 'Q_yz', 'Q_zz')
+SURFACE_CLASSES = {
+    'ogden_spom1': 'surface_ogden_spom1',
+    'ogden_spom1_field': 'surface_ogden_spom1_field',
+    'ogden_spom2': 'surface_ogden_spom2',
+    'ogden_spom2_field': 'surface_ogden_spom2_field',
+    'ogden_fpom1': 'surface_ogden_fpom1',
+    'ogden_fpom1_field': 'surface_ogden_fpom1_field',
+    'ogden_fpom2': 'surface_ogden_fpom2',
+    'ogden_fpom2_field': 'surface_ogden_fpom2_field',
+    'ogden_tpom1': 'surface_ogden_tpom1',
+    'ogden_tpom1_field': 'surface_ogden_tpom1_field',
+    'ogden_tpom2': 'surface_ogden_tpom2',
+    'ogden_tpom2_field': 'surface_ogden_tpom2_field',
+    'ogden_neo_hookean': 'surface_ogden_neo_hookean',
+    'ogden_neo_hookean_field': 'surface_ogden_neo_hookean_field',
+    'ogden_mooney_rivlin': 'surface_ogden_mooney_rivlin',
+    'ogden_mooney_rivlin_field': 'surface_ogden_mooney_rivlin_field',
+    'ogden_general_field': 'surface_ogden_general_field',
+    'rivlin': 'surface_rivlin',
+    'rivlin_field': 'surface_rivlin_field',
+    'gent': 'surface_gent',
+    'gent_field': 'surface_gent_field',
+    'gent_gent': 'surface_gent_gent',
+    'gent_gent_field': 'surface_gent_gent_field',
+    'arruda_boyce': 'surface_arruda_boyce',
+    'arruda_boyce_field': 'surface_arruda_boyce_field',
 }

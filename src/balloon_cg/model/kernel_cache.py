@@ -71,45 +71,47 @@ def _identity(material) -> tuple:
     return (material.text, tuple(material.parameters))
 
 
-def class_key(material, field: bool, electric: bool = False) -> str:
+def class_key(material, field: bool, electric: bool = False, surface: bool = False) -> str:
     """The cache key of the class of ``material`` (scene/formula.Formula or Exponents) with or without a field
-    and the dielectric term."""
-    text = repr((*_identity(material), bool(field), bool(electric), codegen.GENERATOR_VERSION, generator_digest(),
-                 _sympy_version()))
+    and the dielectric term; ``surface``: its surface kernels (MODEL.md §8) instead of the axisymmetric ones."""
+    text = repr((*_identity(material), bool(field), bool(electric), bool(surface), codegen.GENERATOR_VERSION,
+                 generator_digest(), _sympy_version()))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def module_name(material, field: bool, electric: bool = False) -> str:
-    kind = "ogden" if isinstance(material, Exponents) else "energy"
-    return f"{kind}{'_dielectric' if electric else ''}_{class_key(material, field, electric)[:32]}"
+def module_name(material, field: bool, electric: bool = False, surface: bool = False) -> str:
+    kind = ("surface_" if surface else "") + ("ogden" if isinstance(material, Exponents) else "energy")
+    return f"{kind}{'_dielectric' if electric else ''}_{class_key(material, field, electric, surface)[:32]}"
 
 
-def module_path(material, field: bool, electric: bool = False) -> Path:
-    return cache_dir() / f"{module_name(material, field, electric)}.py"
+def module_path(material, field: bool, electric: bool = False, surface: bool = False) -> Path:
+    return cache_dir() / f"{module_name(material, field, electric, surface)}.py"
 
 
-def generate(material, field: bool, timings: dict | None = None, electric: bool = False) -> str:
-    """The module text of the class (stage timings in seconds into ``timings``: see codegen/build.py)."""
+def generate(material, field: bool, timings: dict | None = None, electric: bool = False,
+             surface: bool = False) -> str:
+    """The module text of the class, or of its surface kernels (stage timings in seconds into ``timings``: see
+    codegen/build.py)."""
     _sympy_version()
     from ..codegen import build, classes
     from ..codegen.functional import SceneClass
 
-    name = module_name(material, field, electric)
+    name = module_name(material, field, electric, surface)
     if isinstance(material, Exponents):
         cls = SceneClass(name, material.alphas, field, electric=electric)
     else:
         cls = classes.energy_class(name, material.text, material.parameters, field, electric)
-    return build.class_module(cls, timings)
+    return (build.surface_module if surface else build.class_module)(cls, timings)
 
 
-def load(material, field: bool, timings: dict | None = None, electric: bool = False):
-    """The kernel module of the class, generated and written atomically into the cache first if missing; imported
-    once per process (as ``sys.modules[module_name]``)."""
-    path = module_path(material, field, electric)
+def load(material, field: bool, timings: dict | None = None, electric: bool = False, surface: bool = False):
+    """The kernel module of the class (``surface``: its surface kernels), generated and written atomically into
+    the cache first if missing; imported once per process (as ``sys.modules[module_name]``)."""
+    path = module_path(material, field, electric, surface)
     if path.stem in sys.modules:
         return sys.modules[path.stem]
     if not path.is_file():
-        text = generate(material, field, timings, electric)
+        text = generate(material, field, timings, electric, surface)
         start = time.perf_counter()
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",

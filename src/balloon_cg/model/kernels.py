@@ -15,6 +15,7 @@ turns named values into an argument tuple, so no caller knows the argument order
   strain energy's ``material`` array is its parameter values, or the override ``Parameters.material``;
 - ``pole_field`` rows 'NAME_N' / 'NAME_S' are the FIELD_ROWS entry NAME of ``field_north`` / ``field_south``.
 """
+import copy
 import hashlib
 import importlib
 import operator
@@ -91,6 +92,16 @@ class KernelSet:
             self.module = kernel_cache.load(exponents_of(self.module), self.field_class, electric=True)
         self.name = dict(self.module.INPUTS)["class"]
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
+
+    def surface(self) -> "KernelSet":
+        """The surface kernels (MODEL.md §8; codegen/surface.py) of the same class and material packing: a committed
+        class's ``generated.surface_<class>``, or for a user formula and every dielectric class the on-demand
+        module (model/kernel_cache.py, ``surface=True``)."""
+        twin = copy.copy(self)
+        twin._binders, twin._node_kernels = {}, {}
+        twin.module = surface_module(self)
+        twin.__dict__.pop("signature", None)
+        return twin
 
     @cached_property
     def signature(self) -> str:
@@ -176,16 +187,19 @@ class KernelSet:
 
     def nodes(self, kernel: str, values: dict, params=None) -> np.ndarray:
         """``kernel`` at every node (node values are arrays): output k (KERNELS[kernel]['outputs']) in row k."""
-        function, rows, first_node = self._node_kernels.get(kernel) or self._node_kernel(kernel)
-        out = np.empty((rows, values[first_node].shape[0]))
+        function, rows, first_node, axis = self._node_kernels.get(kernel) or self._node_kernel(kernel)
+        out = np.empty((rows, values[first_node].shape[axis]))
         function(*self.arguments(kernel, values, params), out)
         return out
 
     def _node_kernel(self, kernel: str) -> tuple:
-        """(the kernel's node loop, its output count, the name of its first node argument), read once."""
+        """(the kernel's node loop, its output count, the name of the argument that counts the nodes, its node
+        axis), read once: the first 'node' argument, or else (the surface kernels) the columns of the first
+        'node_rows' argument, as the node loop counts them (codegen/emit.py: node_count)."""
         spec = self.module.KERNELS[kernel]
-        first_node = next(name for name, kind, _ in spec["args"] if kind == "node")
-        entry = (getattr(self.module, f"{kernel}_nodes"), len(spec["outputs"]), first_node)
+        nodes = [(name, 0) for name, kind, _ in spec["args"] if kind == "node"]
+        first_node, axis = (nodes or [(name, 1) for name, kind, _ in spec["args"] if kind == "node_rows"])[0]
+        entry = (getattr(self.module, f"{kernel}_nodes"), len(spec["outputs"]), first_node, axis)
         self._node_kernels[kernel] = entry
         return entry
 
@@ -219,6 +233,16 @@ def energy_module(material: StrainEnergy, has_field: bool, electric: bool = Fals
         raise ImportError(f"generated/{name}.py is for the formula {formula!r}, the scene layer's family "
                           f"{material.family} is {material.formula.text!r}: run `make regenerate`")
     return importlib.import_module(f"{generated.__name__}.{name}")
+
+
+def surface_module(kernels: KernelSet):
+    """The surface kernel module of a kernel set's class: committed (generated.SURFACE_CLASSES) unless the class
+    is generated on demand (a user formula, the dielectric term)."""
+    material = kernels.scene_material
+    if kernels.electric or (isinstance(material, StrainEnergy) and material.family is None):
+        source = material.formula if isinstance(material, StrainEnergy) else exponents_of(kernels.module)
+        return kernel_cache.load(source, kernels.field_class, electric=kernels.electric, surface=True)
+    return importlib.import_module(f"{generated.__name__}.{generated.SURFACE_CLASSES[kernels.name]}")
 
 
 def _frozen(values) -> np.ndarray:

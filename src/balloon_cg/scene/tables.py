@@ -131,13 +131,27 @@ class Stability:
 
 
 @dataclass(frozen=True)
+class Surface:
+    """The non-axisymmetric branches born at the m ≥ 1 branch points (MODEL.md §8): at the ``branches`` "first" one
+    of the primary branch, "all", or "none"; spherical-harmonic ``degree`` L of the whole-sphere basis;
+    ``max_points`` per branch."""
+
+    branches: str = "first"
+    degree: int = 16
+    max_points: int = 200
+
+
+SURFACE_BRANCHES = ("first", "all", "none")
+
+
+@dataclass(frozen=True)
 class Output:
     """Sampling of the reported shapes and fields: ``theta_points`` values of θ on [0, π]."""
 
     theta_points: int = 181
 
 
-_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric")
+_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric", "surface")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 
@@ -156,6 +170,7 @@ class Scene:
     electric: Electric | None  # None: no dielectric term in the kernels
     text: str = dataclass_field(repr=False)
     loading: Loading = Loading()
+    surface: Surface = Surface()
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
@@ -164,7 +179,7 @@ class Scene:
 
     def to_dict(self) -> dict:
         """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded); the
-        [loading] table only when it is not the default (pressure control), so older scenes keep their text."""
+        [loading] and [surface] tables only when they are not the default, so older scenes keep their text."""
         m, f = self.material, self.field
         return {
             "material": m.to_table() if isinstance(m, StrainEnergy) else
@@ -174,6 +189,7 @@ class Scene:
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
                                                                   "control": self.loading.control.value}}),
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
+            **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
         }
 
     def to_toml(self) -> str:
@@ -329,6 +345,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         electric=electric,
         text=text,
         loading=loading,
+        surface=_surface(data.get("surface", {})),
     )
 
 
@@ -480,6 +497,17 @@ def _stability(data) -> Stability:
         get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
         get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
     )
+
+
+def _surface(data) -> Surface:
+    data = table("surface", data, _keys(Surface))
+    get = _getter(data, "surface", Surface)
+    branches = data.get("branches", Surface.branches)
+    if branches not in SURFACE_BRANCHES:
+        raise SceneError(f"surface.branches = {show(branches)}: must be one of "
+                         + ", ".join(f'"{b}"' for b in SURFACE_BRANCHES))
+    return Surface(branches, get("degree", lambda n: 4 <= n <= 48, "an integer in [4, 48]", integer=True),
+                   get("max_points", lambda n: 1 <= n <= 10_000, "an integer in [1, 10000]", integer=True))
 
 
 def _output(data) -> Output:

@@ -32,9 +32,10 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 from numpy.polynomial import legendre as gauss
+from scipy import linalg
 
 from ..galerkin.discretisation import read_only
-from ..galerkin.legendre import assoc_legendre, legendre_values, theta_derivative
+from ..galerkin.legendre import legendre_values, theta_derivative
 
 COS, SIN = 0, 1
 MIRROR_Y = (1, -1, 1)  # the plane y = 0 through the axis (MODEL.md §8: x, z keep cos kφ, y keeps sin kφ)
@@ -82,15 +83,24 @@ def pair_rows(pairs) -> np.ndarray:
 
 @dataclass(frozen=True)
 class SphericalBasis:
-    """Degree ``degree`` (L), the reflections ``symmetry`` the fields keep, n_theta × n_phi nodes (default
-    ⌈3(L + 1)/2⌉ + 2 Gauss nodes in cos θ and twice as many in φ: the products of two degree-L fields with a smooth
-    node function are integrated with aliasing below the truncation error of resolved states)."""
+    """Degree ``degree`` (L), the largest azimuthal order ``order`` (M ≤ L, default L: every harmonic of degree
+    ≤ L), the reflections ``symmetry`` the fields keep, n_theta × n_phi nodes (default ⌈3(L + 1)/2⌉ + 2 Gauss nodes
+    and 2(⌈3(M + 1)/2⌉ + 2) in φ: the products of two fields with a smooth node function are integrated with
+    aliasing below the truncation error of resolved states).
+
+    ``mapping`` (a galerkin.coordinate_map.WireMap, as the axisymmetric solver picks near a coil wire): the
+    harmonics are those of the mapped polar coordinate s = h(cos θ), P̄_l^m(s) τ_{m,t}(φ), smooth on the sphere
+    since (1 − s²)/(1 − cos²θ) is smooth and positive (h' > 0 at the poles); Gauss nodes in s, weights
+    w_j / h'(x_j), and each block's functions orthonormalised in the quadrature's inner product (Cholesky of its
+    Gram matrix), so that the coefficients stay orthonormal and the spectral tail stays the last coefficients'."""
 
     degree: int
     symmetry: tuple = ()
     characters: tuple = ()
     n_theta: int = 0
     n_phi: int = 0
+    order: int = -1
+    mapping: object = None
     blocks: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -101,13 +111,17 @@ class SphericalBasis:
             put(self, "characters", (1,) * len(self.symmetry))
         if len(self.characters) != len(self.symmetry):
             raise ValueError(f"{len(self.characters)} characters for {len(self.symmetry)} reflections")
+        if self.order < 0:
+            put(self, "order", self.degree)
+        if not 0 <= self.order <= self.degree:
+            raise ValueError(f"order = {self.order}: must lie in [0, degree = {self.degree}]")
         if not self.n_theta:
             put(self, "n_theta", (3 * (self.degree + 1) + 1) // 2 + 2)
         if not self.n_phi:
-            put(self, "n_phi", 2 * self.n_theta)
+            put(self, "n_phi", 2 * ((3 * (self.order + 1) + 1) // 2 + 2))
         blocks, offset = [], 0
         for c in range(3):
-            for m in range(self.degree + 1):
+            for m in range(self.order + 1):
                 for t in (COS,) if m == 0 else (COS, SIN):
                     degrees = tuple(l for l in range(m, self.degree + 1)
                                     if all(S[c] * _sign_under(S, l, m, t) == chi
@@ -134,14 +148,20 @@ class SphericalBasis:
     def nodes(self) -> dict:
         """cos θ_j, sin θ_j, the weights W_j = w_j/N_φ (with E's 1/2π), φ_k, and X, a_θ(X), a_φ(X) at every
         node (rows of the node state of u = 0), node index j N_φ + k."""
-        x, w = gauss.leggauss(self.n_theta)
-        x, w = x[::-1].copy(), w[::-1].copy()  # θ increasing: north to south
+        mapped, w = gauss.leggauss(self.n_theta)
+        mapped, w = mapped[::-1].copy(), w[::-1].copy()  # θ increasing: north to south
+        if self.mapping is None:
+            x = mapped
+        else:
+            x = self.mapping.x(mapped)
+            w = w / self.mapping.ds_dx(x)
         s = np.sqrt(1.0 - x * x)
         phi = 2.0 * np.pi * np.arange(self.n_phi) / self.n_phi
         C, S = np.meshgrid(x, np.cos(phi), indexing="ij")
         s2, sp = np.meshgrid(s, np.sin(phi), indexing="ij")
         reference = np.stack([s2 * S, s2 * sp, C, C * S, C * sp, -s2, -sp, S, np.zeros_like(C)])
         return {"cos_theta": read_only(x), "sin_theta": read_only(s), "weights": read_only(w / self.n_phi),
+                "mapped": read_only(mapped),
                 "phi": read_only(phi), "reference": read_only(reference.reshape(STATE_ROWS, -1))}
 
     @cached_property
@@ -150,12 +170,12 @@ class SphericalBasis:
         for value and ∂φ/m; per component the concatenated θ-tables and each column's block."""
         nodes = self.nodes
         x, s, phi = nodes["cos_theta"], nodes["sin_theta"], nodes["phi"]
-        legendre = {m: assoc_legendre(x, self.degree, m) for m in range(self.degree + 1)}
-        theta, phis = [], []
+        theta, phis, transforms = [], [], []
         for b in self.blocks:
-            p, dp = legendre[b.m]
-            k = list(b.degrees)
-            theta.append(np.stack([p[:, k], dp[:, k], b.m * p[:, k] / s[:, None]]))
+            p, dp = self._polar(nodes["mapped"], x, b)
+            transform = self._orthonormaliser(p)
+            transforms.append(transform)
+            theta.append(np.stack([p, dp, b.m * p / s[:, None]]) @ transform)
             norm = _norm(b.m)
             if b.t == COS:
                 phis.append(norm * np.stack([np.cos(b.m * phi), -np.sin(b.m * phi)]))
@@ -164,27 +184,50 @@ class SphericalBasis:
         components = []
         for c in range(3):
             index = [i for i, b in enumerate(self.blocks) if b.component == c]
-            columns = np.concatenate([[i] * len(self.blocks[i].degrees) for i in index]).astype(np.int64) \
-                if index else np.zeros(0, np.int64)
-            local = {i: n for n, i in enumerate(index)}
+            if not index:
+                components.append({"blocks": []})
+                continue
+            widths = np.array([len(self.blocks[i].degrees) for i in index])
+            starts = np.concatenate([[0], np.cumsum(widths)]).astype(np.int64)
+            block_of = np.repeat(np.arange(len(index)), widths)
+            table = np.ascontiguousarray(np.concatenate([theta[i] for i in index], axis=2))  # (3, n_theta, n_c)
             components.append({
                 "blocks": index,
-                "theta": read_only(np.ascontiguousarray(np.concatenate([theta[i] for i in index], axis=2)))
-                if index else None,
-                "column_block": read_only(np.array([local[i] for i in columns], dtype=np.int64)),
-                "sums": np.equal.outer(np.array([local[i] for i in columns], dtype=np.int64),
-                                       np.arange(len(index))).astype(float) if index else None,
-                "unknowns": np.concatenate([np.arange(self.blocks[i].offset,
-                                                      self.blocks[i].offset + len(self.blocks[i].degrees))
-                                            for i in index]) if index else np.zeros(0, np.int64),
+                "theta": read_only(table),
+                "starts": read_only(starts),
+                "column_block": read_only(block_of),
+                "sums": np.equal.outer(block_of, np.arange(len(index))).astype(float),
+                "range": slice(self.blocks[index[0]].offset, self.blocks[index[-1]].slice.stop),
+                "unknowns": np.arange(self.blocks[index[0]].offset, self.blocks[index[-1]].slice.stop),
+                "row_ranges": list(zip(starts[:-1], starts[1:])),
+                "left": [np.ascontiguousarray(table[:, :, lo:hi]).reshape(3 * self.n_theta, hi - lo)
+                         for lo, hi in zip(starts[:-1], starts[1:])],
             })
-        return {"theta": theta, "phi": np.array(phis), "components": components}
+        return {"theta": theta, "phi": np.array(phis), "components": components, "transforms": transforms}
+
+    def _polar(self, mapped: np.ndarray, x: np.ndarray, block: Block) -> tuple:
+        """(P̄_l^m(s), dP̄_l^m/dθ) of the block's degrees at s = h(x) (s = x unmapped), valid at the poles."""
+        k = list(block.degrees)
+        p = legendre_values(mapped, self.degree, block.m)[:, k]
+        dp = theta_derivative(mapped, self.degree, block.m)[:, k]
+        if self.mapping is not None:  # dθ_s/dθ = h'(x) sin θ / sin θ_s, → √h'(±1) at the poles
+            ratio = np.sqrt(np.where(np.abs(mapped) < 1.0, (1.0 - x * x) / np.maximum(1.0 - mapped * mapped, 1e-300),
+                                     1.0 / self.mapping.ds_dx(x)))
+            dp = dp * (self.mapping.ds_dx(x) * ratio)[:, None]
+        return p, dp
+
+    def _orthonormaliser(self, p: np.ndarray) -> np.ndarray:
+        """L⁻ᵀ of the block's Gram matrix Σ_j N_φ W_j p_l p_l' (identity unmapped: Gauss–Legendre is exact there)."""
+        if self.mapping is None:
+            return np.eye(p.shape[1])
+        gram = (p.T * (self.nodes["weights"] * self.n_phi)) @ p
+        return linalg.solve_triangular(np.linalg.cholesky(gram), np.eye(p.shape[1]), lower=True).T
 
     @cached_property
     def _products(self) -> dict:
-        """Gather plan of T from the φ-Fourier table of a node function: for component pair (c, c') and φ-types
-        (e, e'), T[j, b, b'] = α1 F[j, i1] + α2 F[j, i2] with F = [C_0 … C_{N−1}, S_0 … S_{N−1}],
-        C_q = Σ_k f_k cos qφ_k, S_q = Σ_k f_k sin qφ_k."""
+        """Gather plan of T from the φ-Fourier table of a node function: for component pair (c, c') the arrays
+        (i1, i2, α1, α2), each (2, 2, n_b, n_b') by φ-types (e, e'), with T[j, b, b'] = α1 F[j, i1] + α2 F[j, i2],
+        F = [C_0 … C_{N−1}, S_0 … S_{N−1}], C_q = Σ_k f_k cos qφ_k, S_q = Σ_k f_k sin qφ_k."""
         n = self.n_phi
         amplitude = np.array([[_norm(b.m), _norm(b.m) if b.m else 0.0] for b in self.blocks])
         plans = {}
@@ -192,9 +235,9 @@ class SphericalBasis:
             rows = self.tables["components"][c]["blocks"]
             for c2 in range(3):
                 cols = self.tables["components"][c2]["blocks"]
-                for e in (0, 1):
-                    for e2 in (0, 1):
-                        plans[c, c2, e, e2] = self._plan(rows, cols, e, e2, amplitude, n)
+                parts = [[self._plan(rows, cols, e, e2, amplitude, n) for e2 in (0, 1)] for e in (0, 1)]
+                plans[c, c2] = tuple(read_only(np.ascontiguousarray(np.array([[p[k] for p in row] for row in parts])))
+                                     for k in range(4))
         return plans
 
     def _plan(self, rows, cols, e, e2, amplitude, n):
@@ -264,53 +307,44 @@ class SphericalBasis:
 
     def hessian(self, pointwise: np.ndarray, pairs_rows: np.ndarray) -> np.ndarray:
         """Σ_{jk} W_j D(θ_j, φ_k) contracted with the node rows' derivatives on both sides (module docstring), D the
-        45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (pair_rows of the kernels' pairs)."""
-        n, nodes, tables = self.n_phi, self.nodes, self.tables
+        45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (pair_rows of the kernels' pairs). Per
+        component pair (c, c'): the column weights Y_b = Σ_d' T^{dd'}[·, b, ·] Θ^{d'} of every row block b in one
+        jitted pass (``_weighted_columns``), then one product Θ_bᵀ Y_b per row block (BLAS)."""
+        n, nodes, components = self.n_phi, self.nodes, self.tables["components"]
         spectra = np.fft.fft(pointwise.reshape(-1, self.n_theta, n) * nodes["weights"][None, :, None], axis=2)
-        fourier = np.concatenate([spectra.real, -spectra.imag], axis=2)  # (45, n_theta, 2n): C_q, S_q
-        H = np.zeros((self.size, self.size))
-        components = tables["components"]
+        fourier = np.ascontiguousarray(np.concatenate([spectra.real, -spectra.imag], axis=2))  # C_q, S_q
+        H = np.empty((self.size, self.size))
         for c in range(3):
             if not components[c]["blocks"]:
                 continue
+            rows = components[c]["range"]
             for c2 in range(c, 3):
                 if not components[c2]["blocks"]:
                     continue
-                T = np.empty((3, 3, self.n_theta, len(components[c]["blocks"]), len(components[c2]["blocks"])))
-                for d in range(3):
-                    for d2 in range(3):
-                        i1, i2, a1, a2 = self._products[c, c2, d // 2, d2 // 2]
-                        f = fourier[pairs_rows[3 * d + c, 3 * d2 + c2]]
-                        T[d, d2] = a1 * f[:, i1] + a2 * f[:, i2]
-                theta_c, theta_c2 = components[c]["theta"], components[c2]["theta"]
-                rows_c, cols = components[c]["unknowns"], components[c2]["unknowns"]
-                block_of = components[c2]["column_block"]
-                start = 0
-                for r, i in enumerate(components[c]["blocks"]):
-                    width = len(self.blocks[i].degrees)
-                    Y = _weigh_columns(T, r, theta_c2, block_of)  # (3, n_theta, n_c2)
-                    left = theta_c[:, :, start:start + width].reshape(3 * self.n_theta, width)
-                    H[np.ix_(rows_c[start:start + width], cols)] = left.T @ Y.reshape(3 * self.n_theta, -1)
-                    start += width
+                cols = components[c2]["range"]
+                channels = np.array([[pairs_rows[3 * d + c, 3 * d2 + c2] for d2 in range(3)] for d in range(3)])
+                Y = _weighted_columns(fourier, channels, *self._products[c, c2], components[c2]["theta"],
+                                      components[c2]["column_block"])
+                left = components[c]["left"]
+                for r, (start, stop) in enumerate(components[c]["row_ranges"]):
+                    H[rows.start + start:rows.start + stop, cols] = left[r].T @ Y[r].reshape(3 * self.n_theta, -1)
                 if c2 != c:
-                    H[np.ix_(cols, rows_c)] = H[np.ix_(rows_c, cols)].T
+                    H[cols, rows] = H[rows, cols].T
         return H
 
     def point_values(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> tuple:
         """(x, a_θ) of x = X + u at points (θ, φ) anywhere on the sphere, the poles included (each (3, n))."""
         theta, phi = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(phi, float))
         z = np.cos(theta)
+        mapped = z if self.mapping is None else self.mapping.s(z)
         x = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), z])
         a_theta = np.array([z * np.cos(phi), z * np.sin(phi), -np.sin(theta)])
-        for m in range(self.degree + 1):
-            p, dp = legendre_values(z, self.degree, m), theta_derivative(z, self.degree, m)
-            for b in self.blocks:
-                if b.m != m:
-                    continue
-                trig = _norm(m) * (np.cos(m * phi) if b.t == COS else np.sin(m * phi))
-                k = list(b.degrees)
-                x[b.component] += trig * (p[:, k] @ c[b.slice])
-                a_theta[b.component] += trig * (dp[:, k] @ c[b.slice])
+        for b, transform in zip(self.blocks, self.tables["transforms"]):
+            p, dp = self._polar(mapped, z, b)
+            trig = _norm(b.m) * (np.cos(b.m * phi) if b.t == COS else np.sin(b.m * phi))
+            coefficients = transform @ c[b.slice]
+            x[b.component] += trig * (p @ coefficients)
+            a_theta[b.component] += trig * (dp @ coefficients)
         return x, a_theta
 
     def gram(self) -> float:
@@ -324,13 +358,25 @@ def _norm(m: int) -> float:
 
 
 @njit(cache=True)
-def _weigh_columns(T, r, theta, block_of):
-    """Y[d, j, col] = Σ_d' T[d, d', j, r, block_of[col]] Θ^{d'}[j, col]."""
+def _weighted_columns(fourier, channels, i1, i2, a1, a2, theta, block_of):
+    """Y[r, d, j, col] = Σ_d' T^{dd'}_j[r, b'] Θ^{d'}[j, col] for every row block r, b' = block_of[col] the block of
+    column col, T^{dd'}_j[r, b'] = α1 F_ch[j, i1] + α2 F_ch[j, i2] of the plan of φ-types (d // 2, d' // 2) and the
+    Fourier table F_ch of channel ch = channels[d, d']."""
+    n_r, n_b = i1.shape[2], i1.shape[3]
     n_theta, n_cols = theta.shape[1], theta.shape[2]
-    Y = np.zeros((3, n_theta, n_cols))
-    for d in range(3):
-        for d2 in range(3):
-            for j in range(n_theta):
-                for col in range(n_cols):
-                    Y[d, j, col] += T[d, d2, j, r, block_of[col]] * theta[d2, j, col]
+    Y = np.zeros((n_r, 3, n_theta, n_cols))
+    t = np.empty(n_b)
+    for r in range(n_r):
+        for d in range(3):
+            e = d // 2
+            for d2 in range(3):
+                e2 = d2 // 2
+                ch = channels[d, d2]
+                for j in range(n_theta):
+                    for b in range(n_b):
+                        t[b] = (a1[e, e2, r, b] * fourier[ch, j, i1[e, e2, r, b]]
+                                + a2[e, e2, r, b] * fourier[ch, j, i2[e, e2, r, b]])
+                    y, weights = Y[r, d, j], theta[d2, j]
+                    for col in range(n_cols):
+                        y[col] += t[block_of[col]] * weights[col]
     return Y

@@ -38,3 +38,12 @@ def mode_coefficients(basis: SphericalBasis, azimuthal_basis, vector: np.ndarray
     """c of an azimuthal mode (its coefficients ``vector`` in ``azimuthal_basis``, analysis.azimuthal)."""
     theta, phi = node_angles(basis)
     return displacement_coefficients(basis, azimuthal_basis.cartesian(vector, theta, phi))
+
+
+def transfer(source: SphericalBasis, c: np.ndarray, target: SphericalBasis) -> np.ndarray:
+    """The state c of ``source`` on ``target`` (a finer degree or order, or another map): its displacement at the
+    target's nodes, projected (exact when the target's space holds the source's, up to the quadrature of
+    non-polynomial mapped functions)."""
+    theta, phi = node_angles(target)
+    x, _ = source.point_values(c, theta, phi)
+    return displacement_coefficients(target, x - target.nodes["reference"][:3])

@@ -52,29 +52,27 @@ class Gauge:
         object.__setattr__(self, "constraints", np.array(rows).reshape(-1, self.basis.size))
 
     def _translation(self, axis: int):
-        """The unit row of the l = 0 coefficient of component ``axis``, or None (not in the subspace)."""
-        for b in self.basis.blocks:
-            if b.component == axis and b.m == 0 and b.t == COS and b.degrees[0] == 0:
-                row = np.zeros(self.basis.size)
-                row[b.offset] = 1.0
-                return row
-        return None
+        """The constraint row ∫∫ u_axis dA (its moments: ``basis.project``), normalised, or None (not in the
+        subspace)."""
+        return self._moments(np.eye(3)[axis][:, None] * np.ones(self.basis.n_theta * self.basis.n_phi))
 
     def _rotation(self, axis: int):
-        """The coefficients of e_axis × X (normalised), or None when the subspace excludes it."""
-        reference = self.basis.nodes["reference"]
-        rows = np.zeros_like(reference)
-        unit = np.eye(3)[axis]
-        rows[:3] = np.cross(unit[:, None], reference[:3], axis=0)
-        row = 2.0 * np.pi * self.basis.project(rows)
+        """The constraint row ∫∫ (e_axis × X) · u dA, normalised, or None when the subspace excludes it."""
+        reference = self.basis.nodes["reference"][:3]
+        return self._moments(np.cross(np.eye(3)[axis][:, None], reference, axis=0))
+
+    def _moments(self, field: np.ndarray):
+        rows = np.zeros((9, field.shape[1]))
+        rows[:3] = field
+        row = self.basis.project(rows)
         norm = np.linalg.norm(row)
-        return row / norm if norm > 1e-8 else None
+        return row / norm if norm > 1e-10 else None
 
     @cached_property
     def _split(self) -> tuple:
         """(free coefficients, constrained ones, the orthonormal null-space block Z_S)."""
         G = self.constraints
-        touched = np.flatnonzero(np.abs(G).max(axis=0, initial=0.0) > 1e-12)
+        touched = np.flatnonzero(np.abs(G).max(axis=0, initial=0.0) > 1e-14)
         free = np.setdiff1d(np.arange(self.basis.size), touched)
         if touched.size == 0:
             return free, touched, np.zeros((0, 0))
@@ -112,12 +110,12 @@ class Gauge:
         return out
 
     def reaction(self, residual: np.ndarray) -> np.ndarray:
-        """The held translations' multipliers: the components of the full residual ∂E/∂c (zero in the reduced
-        space at an equilibrium) along the l = 0 coefficients of x, y, z, times √(4π) — the net force per 2π the hold
-        exerts, (1/2π)∫∫ ∂π/∂u dA (zero where the axis is free)."""
+        """The net force per 2π the hold exerts, (1/2π)∫∫ ∂π/∂u dA: the residual ∂E/∂c (zero in the reduced space at
+        an equilibrium) applied to the constant displacement e_k (coefficients from the projection)."""
         out = np.zeros(3)
+        rows = np.zeros((9, self.basis.n_theta * self.basis.n_phi))
         for axis in range(3):
-            row = self._translation(axis)
-            if row is not None:
-                out[axis] = float(row @ residual) * np.sqrt(4.0 * np.pi)
+            rows[:3] = 0.0
+            rows[axis] = 1.0
+            out[axis] = float(2.0 * np.pi * self.basis.project(rows) @ residual)
         return out

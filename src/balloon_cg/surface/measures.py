@@ -42,8 +42,31 @@ def measures(basis: SphericalBasis, c: np.ndarray) -> dict:
             "volume": volume, "centroid": centroid, "tilt": tilt}
 
 
+def tails(basis: SphericalBasis, c: np.ndarray) -> tuple:
+    """(θ-tail, φ-tail): the largest coefficient of degree L − 1 or L, and of order M − 1 or M when the basis stops
+    at an order M < L (0 otherwise: the degree tail holds it). On a resolved state the coefficients decay
+    geometrically in both, and these bound what the truncation cuts off."""
+    theta = max((np.abs(c[b.slice][np.array(b.degrees) >= basis.degree - 1]).max(initial=0.0) for b in basis.blocks),
+                default=0.0)
+    phi = 0.0
+    if basis.order < basis.degree:
+        phi = max((np.abs(c[b.slice]).max(initial=0.0) for b in basis.blocks if b.m >= basis.order - 1), default=0.0)
+    return float(theta), float(phi)
+
+
 def tail(basis: SphericalBasis, c: np.ndarray) -> float:
-    """The spectral error estimate of the state: the largest coefficient of degree L − 1 or L (the Cartesian
-    displacement's harmonics decay geometrically on a resolved state; the last two degrees bound what is cut off)."""
-    top = [np.abs(c[b.slice][np.array(b.degrees) >= basis.degree - 1]).max(initial=0.0) for b in basis.blocks]
-    return float(max(top, default=0.0))
+    """The spectral error estimate of the state: the larger of its ``tails``."""
+    return max(tails(basis, c))
+
+
+def axial_stretch_row(basis: SphericalBasis) -> tuple:
+    """(r, r0) with e_x · a_θ(θ = 0, φ = 0) = r0 + r · c: the north pole stretch λ2(0) of an axisymmetric state (there
+    a_θ = λ2(0) e_x at φ = 0), a linear function of c: a bordering row that prescribes it (as the axisymmetric
+    solver's point_solve does)."""
+    r0 = float(basis.point_values(np.zeros(basis.size), 0.0, 0.0)[1][0, 0])
+    row = np.zeros(basis.size)
+    for b in basis.blocks:
+        if b.component == 0 and b.m == 1:
+            for k in range(b.offset, b.offset + len(b.degrees)):
+                row[k] = basis.point_values(np.eye(basis.size)[k], 0.0, 0.0)[1][0, 0] - r0
+    return row, r0

@@ -1,0 +1,312 @@
+"""Non-axisymmetric branches born at the m ≥ 1 branch points of an axisymmetric branch, traced on the whole sphere
+(``surface``; MODEL.md §8).
+
+At a located BP of block m<m>_held the critical mode is the lowest eigenvector of the held m-block
+(``azimuthal``, its zero modes removed), δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. The branch it starts
+keeps the symmetry of that mode: the mirror y → −y always, and on an equator-symmetric state the reflection
+z → −z (a mode even in z) or the inversion x → −x (a mode odd in z, which rotation by π about the axis maps to
+−itself); it is solved in that invariant subspace of degree L (``surface.degree``), with the balloon's centre
+held and the relabelling modes removed (``surface.gauge``).
+
+Switching: from (c*, P*) (the BP state embedded) the predictor c* + δφ (φ the embedded mode, unit) is corrected on
+the hyperplane normal to φ, then the branch is followed by pseudo-arclength continuation until it rejoins the
+axisymmetric branch (the amplitude φ·(c − c*) changes sign), a pole stretch reaches stop_stretch, the membrane
+comes within wire_gap of a coil, the spectral tail of the coefficients exceeds solver.max_error (flagged: the
+degree is not raised), or max_points. Both signs ±φ are traced. Folds in P are located (LP).
+
+Every point carries its measures (pole stretches, volume, centroid offset, tilt) and the lowest eigenvalues of
+its second variation over every symmetry sector, held and free (``surface.stability``); a change of the number
+of negative held eigenvalues between two points is a secondary branch point, stored with its bracket
+(APPROXIMATE: not located in this version).
+
+Classification of the parent point: the reduced energy E(Λ) − E* along φ at P* (the other coefficients relax on
+φ·(c − c*) = Λ, as ``bifurcation.classify`` for the pear points), fitted by E2 Λ² + E3 Λ³ + E4 Λ⁴.
+"""
+import time
+from dataclasses import replace
+
+import numpy as np
+from scipy import linalg
+
+from ..galerkin.equilibrium import Parameters
+from ..model.field import wire_distance
+from ..numerics import continuation
+from ..numerics.continuation import Stop
+from ..numerics.newton import newton
+from ..numerics.threads import limited_blas
+from ..surface import stability as surface_stability
+from ..surface.basis import EQUATOR, INVERSION, MIRROR_Y, SphericalBasis
+from ..surface.embedding import axisymmetric_coefficients, mode_coefficients, transfer
+from ..surface.equilibrium import SurfaceEquilibrium
+from ..surface.gauge import Gauge
+from ..surface.measures import MEASURES, measures, tail, tails
+from ..surface.system import SurfaceSystem
+from . import azimuthal
+from .problem import continuation_settings, equilibrium_of
+from .results import (Block, Branch, Classification, Kind, Leg, SpecialPoint, Status, StopCode, SurfaceBranch,
+                      TraceStop)
+
+STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
+SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
+
+
+def critical_mode(branch: Branch, bp: SpecialPoint, degree: int):
+    """(the azimuthal basis, the lowest held eigenvector of block m at the BP) (module docstring)."""
+    eq = equilibrium_of(branch)
+    u, params = bp.X[:-1], branch.params_at(bp.X)
+    b = azimuthal.perturbation_basis(eq, bp.m, degree)
+    H, G = azimuthal.azimuthal_hessian(eq, u, params, bp.m, degree)
+    exclude = None
+    if bp.m == 1:
+        modes = azimuthal.special_modes(eq, u, degree)
+        exclude = np.array([modes[azimuthal.MODES[k]] for k in azimuthal.excluded_modes(eq, params, True)])
+    _, vectors = azimuthal.lowest_eigenvalues(H, G, 1, exclude, vectors=True)
+    return b, vectors[:, 0]
+
+
+def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
+    """The reflections the branch born along the mode keeps (module docstring): MIRROR_Y, with EQUATOR or
+    INVERSION on an equator-symmetric branch when the mode is even or odd in z."""
+    if not branch.disc.symmetric:
+        return (MIRROR_Y,)
+    mirror = SphericalBasis(degree, (MIRROR_Y,))
+    whole = np.linalg.norm(mode_coefficients(mirror, az_basis, vector))
+    for reflection in (EQUATOR, INVERSION):
+        part = np.linalg.norm(mode_coefficients(SphericalBasis(degree, (MIRROR_Y, reflection)), az_basis, vector))
+        if abs(part - whole) <= 1e-8 * whole:
+            return (MIRROR_Y, reflection)
+    raise ValueError("the critical mode has no definite parity under z → −z on an equator-symmetric branch")
+
+
+MAX_DEGREE = 128  # the finest polar degree the resolution policy raises to
+DEGREE_STEP, ORDER_STEP = 8, 2
+
+
+def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> SphericalBasis | None:
+    """The next finer basis when a tail of c exceeds ``max_error`` (degree + DEGREE_STEP for the polar tail, order +
+    ORDER_STEP for the azimuthal one; an isotropic basis stays isotropic), the same basis when both are below it,
+    None when the degree would pass MAX_DEGREE."""
+    theta, phi = tails(basis, c)
+    degree, order = basis.degree, basis.order
+    if theta > max_error:
+        degree += DEGREE_STEP
+        order = degree if basis.order == basis.degree else order
+    if phi > max_error:
+        order = min(order + ORDER_STEP, degree)
+    if degree > MAX_DEGREE:
+        return None
+    return replace(basis, degree=degree, order=order, n_theta=0, n_phi=0) if (degree, order) != (
+        basis.degree, basis.order) else basis
+
+
+class SurfaceTrace:
+    """The problem of one surface branch on one basis: the equilibrium, gauge and continuation system at the
+    branch's parameters."""
+
+    def __init__(self, scene, basis: SphericalBasis, params: Parameters):
+        self.scene, self.basis = scene, basis
+        self.eq = SurfaceEquilibrium(scene, basis)
+        self.gauge = Gauge(basis, held=True, in_field=surface_stability.in_field(self.eq, params))
+        self.system = SurfaceSystem(self.eq, self.gauge, params, "P")
+
+    def on(self, basis: SphericalBasis) -> "SurfaceTrace":
+        return SurfaceTrace(self.scene, basis, self.system.params)
+
+    def move(self, X: np.ndarray, to: "SurfaceTrace") -> np.ndarray:
+        """A point X = (a, p) of this trace's system on ``to``'s (its coefficients transferred)."""
+        return to.system.point(transfer(self.basis, self.system.coefficients(X), to.basis), X[-1])
+
+    def move_direction(self, t: np.ndarray, to: "SurfaceTrace") -> np.ndarray:
+        """A direction (δa, δp) on ``to``'s system (linear: the transfer of δc without the reference sphere)."""
+        zero = transfer(self.basis, np.zeros(self.basis.size), to.basis)
+        moved = transfer(self.basis, self.system.gauge.expand(t[:-1]), to.basis) - zero
+        return np.append(to.gauge.reduce(moved), t[-1])
+
+
+def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
+    """The basis of a branch's start: degree surface.degree on the axisymmetric state's wire map (isotropic without
+    one, order min(degree, 6) with one: a field's fine features are in θ), refined until the embedded state's
+    tails are below solver.max_error / 10 (``refined``); ValueError past MAX_DEGREE."""
+    degree = scene.surface.degree
+    order = degree if disc.mapping is None else min(degree, 6)
+    basis = SphericalBasis(degree, symmetry, order=order, mapping=disc.mapping)
+    while True:
+        finer = refined(basis, axisymmetric_coefficients(basis, disc, u), scene.solver.max_error / 10)
+        if finer is None:
+            raise ValueError(f"the branch point's state needs a whole-sphere degree above {MAX_DEGREE}")
+        if finer is basis:
+            return basis
+        basis = finer
+
+
+def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
+    """stop(point) -> Stop or None (module docstring); StopCode.RESOLUTION when a tail exceeds solver.max_error."""
+    scene, basis = trace.scene, trace.basis
+    upper, gap = scene.continuation.stop_stretch, scene.continuation.wire_gap
+    coils = [[k.radius, k.height, k.current] for k in scene.field.coils]
+
+    def stop(point):
+        if direction @ (point.X - X_star) < 0:
+            return Stop(StopCode.REJOINED, "rejoined the axisymmetric branch")
+        c = trace.system.coefficients(point.X)
+        m = measures(basis, c)
+        if m["lam_north"] >= upper:
+            return Stop(StopCode.STOP_STRETCH, f"north pole stretch reached stop_stretch {upper:g}")
+        if m["lam_south"] >= upper:
+            return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
+        if coils:
+            x = trace.eq.node_values(c)["state"][:3]
+            distance = float(wire_distance(np.hypot(x[0], x[1]), x[2], coils).min())
+            if distance < gap:
+                return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap:g} of a coil (gap {distance:.3g})")
+        if tail(basis, c) > scene.solver.max_error:
+            return Stop(StopCode.RESOLUTION, f"spectral tail {tail(basis, c):.2g} above solver.max_error "
+                                             f"{scene.solver.max_error:g} at degree {basis.degree}, order "
+                                             f"{basis.order}")
+        return None
+
+    return stop
+
+
+def switch(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, step: float = SWITCH_STEP):
+    """The first point off the axisymmetric branch along φ (unit, in X = (a, P)), or the NewtonResult that failed."""
+    solver = trace.scene.solver
+    guess = X_star + step * phi
+    result = newton(trace.system.residual, trace.system.jacobian, guess, phi, phi @ guess, solver.tol,
+                    solver.max_newton)
+    if not result.converged:
+        return result
+    return continuation.Point(result.x, continuation.tangent(trace.system, result.x, phi), result.iterations,
+                              result.residual)
+
+
+@limited_blas
+def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, name: str, max_points: int,
+                  progress=None) -> SurfaceBranch | None:
+    """The branch born at the branch point ``bp`` (number ``number``) of ``branch`` along sign·φ (module docstring);
+    None when the switch fails."""
+    t0 = time.perf_counter()
+    scene = branch.scene
+    az_basis, vector = critical_mode(branch, bp, scene.stability.degree)
+    symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
+    params = branch.params_at(bp.X)
+    trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
+    c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
+    X_star = trace.system.point(c_star, bp.X[-1])
+    phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
+    phi = sign * phi / np.linalg.norm(phi)
+    E, kind = classify(trace, X_star, phi)
+    origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
+                     note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
+    first = switch(trace, X_star, phi)
+    if not isinstance(first, continuation.Point):
+        return None
+    start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
+    segments, folds = [(trace, [start])], []
+    while True:
+        done = sum(len(points) for _, points in segments)
+        path = continuation.trace(trace.system, first, continuation_settings(scene, max(max_points - done, 1)),
+                                  _stop_rule(trace, phi, X_star), {Kind.LP: np.eye(X_star.size)[-1]}, progress)
+        folds += [(trace, replace(f, index=f.index + done)) for f in path.folds]
+        segments[-1][1].extend(path.points)
+        stop = path.stop
+        if stop.code != StopCode.RESOLUTION:
+            break
+        finer = refined(trace.basis, trace.system.coefficients(path.overshoot.X), scene.solver.max_error)
+        if finer is None:
+            stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the degree would pass {MAX_DEGREE})")
+            break
+        new = trace.on(finer)
+        X = newton(new.system.residual, new.system.jacobian, trace.move(path.points[-1].X, new), np.eye(
+            new.gauge.size + 1)[-1], path.points[-1].X[-1], scene.solver.tol, scene.solver.max_newton)
+        if not X.converged:
+            stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
+                                                f"{finer.order}): {X.message}")
+            break
+        reference = trace.move_direction(path.points[-1].tangent, new)
+        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference), X.iterations, X.residual)
+        phi, X_star = trace.move_direction(phi, new), trace.move(X_star, new)
+        trace = new
+        segments.append((trace, []))
+    return _branch(trace, segments, folds, stop, branch, number, origin, name, t0)
+
+
+def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: int, bp: SpecialPoint, name: str,
+            t0) -> SurfaceBranch:
+    """The SurfaceBranch of the traced segments, every point on the final basis: measures, stability, folds, end
+    point."""
+    basis = trace.basis
+    coefficients = np.array([transfer(t.basis, t.system.coefficients(p.X), basis) if t is not trace
+                             else t.system.coefficients(p.X) for t, points in segments for p in points])
+    values = np.array([p.X[-1] for _, points in segments for p in points])
+    per_point = [measures(basis, c) for c in coefficients]
+    special = [bp] + [SpecialPoint(Kind.LP, f.index, np.append(transfer(t.basis, t.system.coefficients(f.point.X),
+                                                                        basis), f.point.X[-1]),
+                                   status=Status.LOCATED if f.status == continuation.RootStatus.LOCATED
+                                   else Status.APPROXIMATE) for t, f in folds]
+    special.append(SpecialPoint(Kind.EP, len(values) - 1, np.append(coefficients[-1], values[-1]), stop=stop))
+    out = SurfaceBranch(
+        name=name, scene=parent.scene, basis=basis, kernel_class=parent.kernel_class,
+        kernel_signature=trace.eq.kernels.signature, params=parent.params, coefficients=coefficients, values=values,
+        iterations=np.array([p.iterations for _, points in segments for p in points]),
+        residual=np.array([p.residual for _, points in segments for p in points]),
+        error_estimate=np.array([tail(basis, c) for c in coefficients]),
+        measures={key: np.array([m[key] for m in per_point]) for key in MEASURES}, m=bp.m,
+        parent=(parent.name, number), legs=(Leg("forward", stop),), special=special)
+    assess(out, trace)
+    out.wall_time = time.perf_counter() - t0
+    return out
+
+
+def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
+    """The stability readings of every point and the secondary branch points (module docstring)."""
+    readings = {"held": [], "free": []}
+    for c, value in zip(sb.coefficients, sb.values):
+        params = sb.params.with_value(sb.parameter, value)
+        for key, held in (("held", True), ("free", False)):
+            spectra = surface_stability.spectrum(trace.eq, c, params, held, STABILITY_COUNT)
+            readings[key].append(np.sort(np.concatenate(list(spectra.values())))[:STABILITY_COUNT])
+    sb.stability = {key: np.array(rows) for key, rows in readings.items()}
+    negative = (sb.stability["held"] < 0).sum(axis=1)
+    for i in np.flatnonzero(np.diff(negative)):
+        X0 = np.append(sb.coefficients[i], sb.values[i])
+        sb.special.append(SpecialPoint(
+            Kind.BP, int(i), X0, block=Block.NONE, m=sb.m, status=Status.APPROXIMATE,
+            uncertainty=0.5 * float(abs(sb.values[i + 1] - sb.values[i])),
+            reason="secondary branch point of a non-axisymmetric branch: bracketed, not located",
+            note="a held eigenvalue of the whole-sphere second variation changes sign"))
+    sb.special.sort(key=lambda s: s.index)
+
+
+def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: float = 2e-2) -> tuple:
+    """(E2, E3, E4, Classification) of the reduced energy along the unit mode φ (in a) at P* (module docstring);
+    Classification.NONE when fewer than three constrained minimisations converge."""
+    system, solver = trace.system, trace.scene.solver
+    params = system.params_at(X_star)
+    a_star, direction = X_star[:-1], phi[:-1]
+
+    def residual(x):
+        return system.gauge.reduce(trace.eq.residual(system.gauge.expand(x[:-1]), params)) + x[-1] * direction
+
+    def jacobian(x):
+        H = system.gauge.reduce_matrix(trace.eq.hessian(system.gauge.expand(x[:-1]), params))
+        return np.hstack([H, direction[:, None]])
+
+    E0 = trace.eq.energy(system.gauge.expand(a_star), params)
+    lams, energies = [], []
+    for lam in (-2 * delta, -delta, delta, 2 * delta):
+        guess = np.append(a_star + lam * direction, 0.0)
+        result = newton(residual, jacobian, guess, np.append(direction, 0.0), direction @ a_star + lam, solver.tol,
+                        solver.max_newton)
+        if result.converged:
+            lams.append(lam)
+            energies.append(trace.eq.energy(system.gauge.expand(result.x[:-1]), params) - E0)
+    if len(lams) < 3:
+        return (np.nan, np.nan, np.nan), Classification.NONE
+    L = np.array(lams)
+    E2, E3, E4 = linalg.lstsq(np.stack([L**2, L**3, L**4], axis=1), np.array(energies))[0]
+    if abs(E3) * delta > abs(E4) * delta**2:
+        kind = Classification.TRANSCRITICAL
+    else:
+        kind = Classification.PITCHFORK_SUPER if E4 > 0 else Classification.PITCHFORK_SUB
+    return (float(E2), float(E3), float(E4)), kind
