@@ -32,7 +32,8 @@ Layout::
     /branches/<name>/      a surface branch (analysis.results.SurfaceBranch, m ≥ 1): attrs order, m, parent_branch,
                            parent_branch_point, stop_reason, leg_labels, leg_stop_codes, wall_time, kernel_class,
                            kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
-                           surface_degree, symmetry (k × 3 int), characters (k int), n_theta, n_phi
+                           surface_degree, surface_order, symmetry (k × 3 int), characters (k int), n_theta,
+                           n_phi, map_centres, map_widths (the polar coordinate map; empty: none)
         point, coefficient, axis                           dimension scales (axis: x, y, z as 0, 1, 2)
         pressure, volume, amount, lam2_north, lam2_south (√J at the material poles), tilt (degrees),
         converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
@@ -252,10 +253,13 @@ def _write_surface_branch(group, branch) -> None:
         "parent_branch": branch.parent[0],
         "parent_branch_point": branch.parent[1],
         "surface_degree": basis.degree,
+        "surface_order": basis.order,
         "symmetry": np.array(basis.symmetry, dtype=np.int64).reshape(len(basis.symmetry), 3),
         "characters": np.array(basis.characters, dtype=np.int64),
         "n_theta": basis.n_theta,
         "n_phi": basis.n_phi,
+        "map_centres": np.array(basis.mapping.centres if basis.mapping else [], dtype=float),
+        "map_widths": np.array(basis.mapping.widths if basis.mapping else [], dtype=float),
     })
     rows = branch_rows(branch)
     parameters = parameter_columns(branch, rows)
@@ -437,7 +441,8 @@ COMMON_KINDS = {"stop_reason": "str", "wall_time": "float", "kernel_class": "str
 BRANCH_KINDS = COMMON_KINDS | {"degree": "int", "symmetric": "bool", "pin_translation": "bool", "quadrature": "int",
                                "map_centres": "float[]", "map_widths": "float[]"}
 SURFACE_KINDS = COMMON_KINDS | {"m": "int", "parent_branch": "str", "parent_branch_point": "int",
-                                "surface_degree": "int", "n_theta": "int", "n_phi": "int", "parameter": "str"}
+                                "surface_degree": "int", "surface_order": "int", "n_theta": "int", "n_phi": "int",
+                                "map_centres": "float[]", "map_widths": "float[]", "parameter": "str"}
 SURFACE_COLUMNS = {**{name: ("float", 1) for name in ("pressure", "volume", "lam2_north", "lam2_south", "tilt",
                                                        "residual", "error_estimate")},
                    "converged": ("bool", 1), "newton_iterations": ("int", 1), "centroid": ("float", 2),
@@ -534,8 +539,10 @@ def check_surface_branch(group, where, error) -> None:
 
 
 def stored_basis(attrs, where="", error=FileError):
-    """The surface.basis.SphericalBasis of a stored surface branch, from its attributes surface_degree, symmetry
-    (k × 3 signs), characters (k signs), n_theta, n_phi (``error`` naming ``where`` if they do not make one)."""
+    """The surface.basis.SphericalBasis of a stored surface branch, from its attributes surface_degree,
+    surface_order, symmetry (k × 3 signs), characters (k signs), n_theta, n_phi and the polar coordinate map
+    map_centres, map_widths (empty: none) (``error`` naming ``where`` if they do not make one)."""
+    from ..galerkin.coordinate_map import WireMap
     from ..surface.basis import SphericalBasis
 
     symmetry, characters = (np.asarray(attrs.get(key, np.zeros(0))) for key in ("symmetry", "characters"))
@@ -547,8 +554,10 @@ def stored_basis(attrs, where="", error=FileError):
     if characters.shape != (len(symmetry),) or not np.isin(characters, (-1, 1)).all():
         raise error(where, f"attribute characters is {characters.tolist()}, expected {len(symmetry)} signs ±1")
     try:
+        centres, widths = (tuple(float(v) for v in attrs.get(key, ())) for key in ("map_centres", "map_widths"))
         return SphericalBasis(int(attrs["surface_degree"]), tuple(tuple(int(s) for s in row) for row in symmetry),
-                              tuple(int(c) for c in characters), int(attrs["n_theta"]), int(attrs["n_phi"]))
+                              tuple(int(c) for c in characters), int(attrs["n_theta"]), int(attrs["n_phi"]),
+                              int(attrs["surface_order"]), WireMap(centres, widths) if centres or widths else None)
     except ValueError as e:
         raise error(where, f"the basis attributes do not make a basis: {e}") from None
 

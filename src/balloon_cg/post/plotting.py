@@ -21,7 +21,7 @@ Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(�
 field in I/(4π R0).
 """
 import enum
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -742,7 +742,7 @@ def plot_curvature(branches, points=None, axes=None) -> Figure:
 
 # --- surface branches (one state on the whole sphere) ------------------------------------------------------
 
-SURFACE_SAMPLES = (61, 121)  # (θ, φ) samples of the drawn surface: the stored coefficients on a finer node grid
+SURFACE_SAMPLES = (61, 121)  # (θ, φ) values of the drawn surface, poles and both ends of φ included
 
 
 def surface_state(sources, points, branch: str | None, what: str) -> tuple:
@@ -771,36 +771,31 @@ def surface_state(sources, points, branch: str | None, what: str) -> tuple:
     return stored, index
 
 
-def stored_state(branch: StoredBranch, index: int, samples: tuple | None = None) -> tuple:
-    """(basis, coefficients) of point ``index`` of a stored surface branch: the SphericalBasis rebuilt from its
-    attributes (io.run_file.stored_basis), on ``samples`` = (n_theta, n_phi) nodes instead of the stored ones
-    when given (the coefficients do not depend on the nodes)."""
-    basis = stored_basis(branch.data["attrs"], branch.source)
-    if samples is not None:
-        basis = replace(basis, n_theta=samples[0], n_phi=samples[1])
-    return basis, branch.data["coefficients"][index]
+def stored_state(branch: StoredBranch, index: int) -> tuple:
+    """(basis, coefficients) of point ``index`` of a stored surface branch, the SphericalBasis rebuilt from its
+    attributes (io.run_file.stored_basis)."""
+    return stored_basis(branch.data["attrs"], branch.source), branch.data["coefficients"][index]
 
 
 def _state_title(branch: StoredBranch, index: int) -> str:
     d = branch.data
     return (f"{_title([branch])}, M = {branch.M:g}\n{branch.label}: #{index}  "
             f"{branch.ordinate.symbol} = {d[branch.ordinate.column][index]:.4g}, "
-            f"$\\lambda_2(0)$ = {d['lam2_north'][index]:.4g}, tilt {d['tilt'][index]:.3g}°")
+            f"$\\lambda_2(0)$ = {d['lam2_north'][index]:.4g}, tilt {d['tilt'][index]:.1f}°")
 
 
-def surface_grid(basis, c) -> np.ndarray:
-    """x (3, n_theta + 2, n_phi + 1) of the state c on the basis' nodes, closed: the two material poles added
-    as first and last rows, the first meridian repeated at φ = 2π."""
-    rings = basis.node_state(c)[:3].reshape(3, basis.n_theta, basis.n_phi)
-    poles, _ = basis.point_values(c, np.array([0.0, np.pi]), np.zeros(2))
-    x = np.concatenate([np.repeat(poles[:, :1, None], basis.n_phi, axis=2), rings,
-                        np.repeat(poles[:, 1:, None], basis.n_phi, axis=2)], axis=1)
-    return np.concatenate([x, x[:, :, :1]], axis=2)
+def surface_grid(basis, c, samples: tuple = SURFACE_SAMPLES) -> np.ndarray:
+    """x (3, n_θ, n_φ) of the state c on a (θ, φ) grid of ``samples`` values from pole to pole and from φ = 0 to
+    2π (``SphericalBasis.point_values``: the series anywhere, the poles included)."""
+    theta, phi = np.meshgrid(np.linspace(0.0, np.pi, samples[0]), np.linspace(0.0, 2 * np.pi, samples[1]),
+                             indexing="ij")
+    x, _ = basis.point_values(c, theta.ravel(), phi.ravel())
+    return x.reshape(3, *samples)
 
 
 def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
-    """One state of a surface branch as a 3D surface (mplot3d), equal axis scales, the coils as circles of
-    radius a at height h (docs/plots.md)."""
+    """One state of a surface branch as a 3D surface (mplot3d) with its material lines θ, φ = multiples of 30°,
+    equal axis scales, the coils as circles of radius a at height h (docs/plots.md)."""
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
 
     if axes is None:
@@ -810,9 +805,11 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
         fig, (ax,), own = _panels(axes, 1, None)
         if getattr(ax, "name", "") != "3d":
             raise PlotError("surface draws into a 3D Axes: give one made with projection='3d'")
-    x = surface_grid(*stored_state(branch, index, SURFACE_SAMPLES))
-    ax.plot_surface(*x, color=branch.color, alpha=0.85, rstride=4, cstride=4, linewidth=0.3, edgecolor="0.3",
+    x = surface_grid(*stored_state(branch, index))
+    ax.plot_surface(*x, color=branch.color, alpha=0.85, rcount=x.shape[1], ccount=x.shape[2], linewidth=0,
                     shade=True)
+    step = (x.shape[1] - 1) // 6, (x.shape[2] - 1) // 12  # the material lines θ, φ = multiples of 30°
+    ax.plot_wireframe(*x, rstride=step[0], cstride=step[1], color="0.25", linewidth=0.3)
     handles = [Line2D([], [], color=branch.color, linewidth=6, alpha=0.85, label=f"#{index} of {branch.label}")]
     psi = np.linspace(0.0, 2 * np.pi, 200)
     extent = np.abs(x).max()
