@@ -124,6 +124,13 @@ def test_a_mapped_order_capped_basis_is_rebuilt(tmp_path, scene, surface_branch)
     assert np.array_equal(rebuilt.node_state(data["coefficients"][2]), basis.node_state(c[2]))
 
 
+def test_a_special_point_on_another_basis_is_not_written(tmp_path, scene, surface_branch):
+    stale = replace(surface_branch, special=[replace(surface_branch.special[0], X=np.zeros(7))])
+    with pytest.raises(ValueError, match="special points BP after point 0 .7. are not rows of its 41"):
+        write_run(tmp_path / "stale.h5", scene, [stale])
+    assert not (tmp_path / "stale.h5").exists()
+
+
 def test_files_without_m_read_as_axisymmetric(run_path, tmp_path):
     """A balloon-cg/3 file (no m attribute, no surface branch) still reads: every branch m = 0."""
     old = tmp_path / "old.h5"

@@ -129,7 +129,8 @@ def verdict_attrs(branches=None, found=None) -> dict:
 
 
 def check_branches(branches) -> None:
-    """Distinct names and only finite points (ValueError otherwise: nothing is written)."""
+    """Distinct names, only finite points, special points as wide as the points (ValueError otherwise: nothing
+    is written)."""
     names = [b.name for b in branches]
     if len(set(names)) != len(names):
         raise ValueError(f"branch names must be distinct, got {names}")
@@ -137,6 +138,12 @@ def check_branches(branches) -> None:
         bad = np.flatnonzero(~finite(branch))
         if bad.size:
             raise ValueError(f"branch {branch.name!r}: points {bad.tolist()} are not converged solutions; not written")
+        width = branch_rows(branch).shape[1]
+        wrong = [f"{s.kind.value} after point {s.index} ({np.size(s.X)})" for s in branch.special
+                 if np.size(s.X) != width]
+        if wrong:
+            raise ValueError(f"branch {branch.name!r}: special points {', '.join(wrong)} are not rows of its {width} "
+                             "unknowns and parameter (another basis?); not written")
 
 
 def finite(branch) -> np.ndarray:
