@@ -6,22 +6,24 @@ branch (a fold candidate there is the rejoin's branch point: ``switching.mark_re
 and adds its mirror image (north and south poles swapped: the reflection z → −z of the branch and its
 assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
 locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
-branch, not in ``Picture.branch_points``) and lists the snap-throughs under the scene's loading control
+branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
+whole sphere (``surface_branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
+snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. Every branch carries its assessments in
 ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation, mirror
+from . import azimuthal_points, bifurcation, mirror, surface_branches
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
 from .problem import equilibrium_of
-from .results import Block, Branch, Origin, StopCode
+from .results import Block, Branch, Origin, Status, StopCode
 from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
 from .verdict import Gap, Incomplete, incomplete
@@ -30,6 +32,7 @@ from ..numerics.threads import limited_blas
 
 
 MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
+ROTATED = "_rotated"  # the suffix of a non-axisymmetric branch's image under the rotation by π about the axis
 
 
 class Phase(enum.StrEnum):
@@ -38,6 +41,7 @@ class Phase(enum.StrEnum):
     PRIMARY = "primary branch"
     STABILITY = "stability"
     PEAR = "pear branches"
+    SURFACE = "non-axisymmetric branches"
 
 
 class Progress:
@@ -76,7 +80,8 @@ class Picture:
     branch_points: list = field(default_factory=list)  # the primary branch's BP special points, in order
     snaps: list = field(default_factory=list)  # SnapThrough
     not_searched: str = ""  # why branch points were not searched, if they were not
-    not_started: list = field(default_factory=list)  # (name, reason) of pear branches that could not start
+    not_started: list = field(default_factory=list)  # (name, reason) of bifurcating branches that could not start
+    surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
     interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
 
     @property
@@ -91,7 +96,7 @@ class Picture:
     @property
     def incomplete(self) -> list[Incomplete]:
         """What the picture lacks against the contract (``verdict``); empty when it is complete."""
-        found = incomplete(self.branches, self.not_searched, tuple(self.not_started))
+        found = incomplete(self.branches + self.surface_branches, self.not_searched, tuple(self.not_started))
         if self.interrupted:
             found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, "interrupted by a signal: the branches "
                                     "and phases after the stored points were not computed"))
@@ -112,7 +117,8 @@ def _assess(branch: Branch, scene, symmetric: bool, progress: Progress) -> bool:
 
 @limited_blas
 def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Picture:
-    """The picture of a scene (module docstring); ``pear=False`` skips the pear branches. ``progress``: a
+    """The picture of a scene (module docstring); ``pear=False`` skips the pear and the non-axisymmetric branches
+    (those follow ``[surface] branches``). ``progress``: a
     ``Progress`` told of every point. A signal (``numerics.interrupt``) stops it at the next point: the picture
     then holds what is finished (``interrupted``; the branches after it are not traced, nor assessed)."""
     progress = progress or Progress()
@@ -149,6 +155,9 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
             return picture
         branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
+    if pear and scene.surface.branches != "none":
+        _trace_surface(scene, primary, picture, progress)
+        progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
     picture.snaps = snap_throughs(picture.branches, scene.loading.control)
     return picture
 
@@ -198,6 +207,29 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
             if interrupt.requested() or not _assess(branch, scene, False, progress):  # kept as traced, not assessed
                 return
             pear = branch if sign > 0 and reflect else None
+
+
+def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress):
+    """The non-axisymmetric branches born at the located m ≥ 1 branch points of the held reading on the primary
+    branch (the first one, or all: ``[surface] branches``), each with its image under the rotation by π about the
+    axis (the other direction of the pitchfork: ``surface_branches.rotated``); the parent point gets the
+    classification from the reduced energy on the whole sphere."""
+    points = [(k, bp) for k, bp in enumerate(primary.branch_points())
+              if bp.m >= 1 and bp.block.held and bp.status == Status.LOCATED]
+    for k, bp in points[:1] if scene.surface.branches == "first" else points:
+        if _stopped(picture):
+            return
+        name = f"m{bp.m}_bp{k}"
+        try:
+            branch = surface_branches.trace_surface(primary, k, bp, 1.0, name, scene.surface.max_points,
+                                                    progress.ticker(Phase.SURFACE))
+        except surface_branches.SurfaceStartError as error:
+            picture.not_started.append((name, str(error)))
+            continue
+        picture.surface_branches += [branch, surface_branches.rotated(branch, f"{name}{ROTATED}")]
+        origin = branch.special[0]
+        primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
+                           for s in primary.special]
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

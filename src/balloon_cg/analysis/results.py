@@ -284,6 +284,9 @@ class SurfaceBranch:
     stability: dict | None = None  # {'held': (n_points, k), 'free': (n_points, k)} lowest eigenvalues, ascending
     parameter: str = "P"
     wall_time: float = 0.0
+    origin: Origin = Origin.TRACED
+    reflection_of: str = ""  # REFLECTED: the branch this one is the image of (rotation by π about the axis)
+    unsettled: list = field(default_factory=list)  # (verdict's interface: no check degree on the whole sphere)
 
     @property
     def pressure(self):

@@ -43,11 +43,16 @@ from ..surface.measures import MEASURES, measures, tail, tails
 from ..surface.system import SurfaceSystem
 from . import azimuthal
 from .problem import continuation_settings, equilibrium_of
-from .results import (Block, Branch, Classification, Kind, Leg, SpecialPoint, Status, StopCode, SurfaceBranch,
-                      TraceStop)
+from .results import (Block, Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
+                      SurfaceBranch)
 
 STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
+
+
+class SurfaceStartError(ArithmeticError):
+    """A branch could not be started: its start needs a degree above MAX_DEGREE, or the first correction off the
+    axisymmetric branch did not converge."""
 
 
 def critical_mode(branch: Branch, bp: SpecialPoint, degree: int):
@@ -133,7 +138,8 @@ def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
     while True:
         finer = refined(basis, axisymmetric_coefficients(basis, disc, u), scene.solver.max_error / 10)
         if finer is None:
-            raise ValueError(f"the branch point's state needs a whole-sphere degree above {MAX_DEGREE}")
+            raise SurfaceStartError(f"the branch point's state needs a whole-sphere degree above {MAX_DEGREE} "
+                                    f"(tails {tails(basis, axisymmetric_coefficients(basis, disc, u))})")
         if finer is basis:
             return basis
         basis = finer
@@ -182,9 +188,9 @@ def switch(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, step: float
 
 @limited_blas
 def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, name: str, max_points: int,
-                  progress=None) -> SurfaceBranch | None:
-    """The branch born at the branch point ``bp`` (number ``number``) of ``branch`` along sign·φ (module docstring);
-    None when the switch fails."""
+                  progress=None) -> SurfaceBranch:
+    """The branch born at the branch point ``bp`` (number ``number`` in ``branch.branch_points()``) of ``branch``
+    along sign·φ (module docstring); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     scene = branch.scene
     az_basis, vector = critical_mode(branch, bp, scene.stability.degree)
@@ -200,7 +206,8 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
                      note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
     first = switch(trace, X_star, phi)
     if not isinstance(first, continuation.Point):
-        return None
+        raise SurfaceStartError(f"the first correction from branch point {number} along its m = {bp.m} mode did "
+                                f"not converge: {first.message}")
     start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
     segments, folds = [(trace, [start])], []
     while True:
@@ -262,10 +269,9 @@ def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
     """The stability readings of every point and the secondary branch points (module docstring)."""
     readings = {"held": [], "free": []}
     for c, value in zip(sb.coefficients, sb.values):
-        params = sb.params.with_value(sb.parameter, value)
-        for key, held in (("held", True), ("free", False)):
-            spectra = surface_stability.spectrum(trace.eq, c, params, held, STABILITY_COUNT)
-            readings[key].append(np.sort(np.concatenate(list(spectra.values())))[:STABILITY_COUNT])
+        spectra = surface_stability.spectra(trace.eq, c, sb.params.with_value(sb.parameter, value), STABILITY_COUNT)
+        readings["held"].append(spectra[True])
+        readings["free"].append(spectra[False])
     sb.stability = {key: np.array(rows) for key, rows in readings.items()}
     negative = (sb.stability["held"] < 0).sum(axis=1)
     for i in np.flatnonzero(np.diff(negative)):
@@ -310,3 +316,17 @@ def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: fl
     else:
         kind = Classification.PITCHFORK_SUPER if E4 > 0 else Classification.PITCHFORK_SUB
     return (float(E2), float(E3), float(E4)), kind
+
+
+def rotated(branch: SurfaceBranch, name: str) -> SurfaceBranch:
+    """The image of ``branch`` under the rotation R by π about the axis, x ↦ R x(R⁻¹X): the other direction −φ of
+    its pitchfork (R maps the mode to −itself; coaxial loops and the held gauge are invariant under R). A
+    coefficient of e_c Y_{l,m,t} changes by the sign of e_c under R (−1 for x, y) times (−1)^m; P, the pole
+    stretches, volume, tilt and every eigenvalue are unchanged, the centroid turns with R."""
+    signs = np.concatenate([np.full(len(b.degrees), (-1.0 if b.component < 2 else 1.0) * (-1.0) ** b.m)
+                            for b in branch.basis.blocks])
+    turn = np.array([-1.0, -1.0, 1.0])
+    measures_ = {**branch.measures, "centroid": branch.measures["centroid"] * turn}
+    special = [replace(s, X=np.append(s.X[:-1] * signs, s.X[-1])) for s in branch.special]
+    return replace(branch, name=name, coefficients=branch.coefficients * signs, measures=measures_, special=special,
+                   origin=Origin.REFLECTED, reflection_of=branch.name)

@@ -30,13 +30,15 @@ class SurfaceEquilibrium:
         self.kernels = kernels if kernels is not None else KernelSet.of_scene(scene).surface()
         self.has_field = self.coils.shape[0] > 0
         self._pairs = pair_rows(self.kernels.module.SURFACE_PAIRS)
-        self._held = None  # the coefficients whose node state (and field) are in _named
+        self._held = None  # the coefficients whose node state (and field) are in _named, kernel outputs in _outputs
+        self._outputs = {}
 
     def node_values(self, c: np.ndarray) -> dict:
         """{'state': the 9 node rows of x = X + u, 'field': H² and its derivatives (field classes)} at ``c``;
         NonFiniteState if the surface folds over (J ≤ 0 at a node) or reaches a wire."""
         if self._held is not None and np.array_equal(self._held, c):
             return self._named
+        self._outputs = {}
         state = self.basis.node_state(c)
         named = {"state": state}
         if self.has_field:
@@ -52,10 +54,16 @@ class SurfaceEquilibrium:
         return named
 
     def _nodes(self, kernel: str, c: np.ndarray, params: Parameters) -> np.ndarray:
-        out = self.kernels.nodes(kernel, self.node_values(c), params)
-        if not finite(out):
-            raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
-        return out
+        """The kernel's node rows at c, kept for the held state and parameters (stability asks for the same
+        Hessian rows once per symmetry sector)."""
+        values = self.node_values(c)
+        key = (kernel, params.P, params.M, params.chi, params.voltage, params.mu, params.alpha, params.material)
+        if key not in self._outputs:
+            out = self.kernels.nodes(kernel, values, params)
+            if not finite(out):
+                raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
+            self._outputs[key] = out
+        return self._outputs[key]
 
     def energy(self, c: np.ndarray, params: Parameters) -> float:
         """E per 2π."""

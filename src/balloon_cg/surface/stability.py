@@ -13,7 +13,7 @@ fine (numerics.eigen.restricted drops them).
 """
 import numpy as np
 
-from .basis import SphericalBasis
+from .basis import COS, MIRROR_Y, SIN, SphericalBasis
 from .equilibrium import SurfaceEquilibrium
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
@@ -51,29 +51,84 @@ def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
     return np.array(out).reshape(-1, basis.size)
 
 
-def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True) -> dict:
-    """{characters: the standard symmetric matrix of the sector's pencil with the zero modes removed}
-    (numerics.eigen.restricted; its eigenvalues are the μ, its inertia the sector's)."""
+def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=(True, False)) -> dict:
+    """{held: {characters: the standard symmetric matrix of the sector's pencil with the zero modes removed}} for
+    each reading (held: True, free: False) from one assembly per sector (numerics.eigen.restricted; its eigenvalues
+    are the μ, its inertia the sector's)."""
     state = eq.node_values(c)["state"]
-    fields = zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
+    sectors = [sector for sector in eq.basis.sectors() if sector.size]
+    hessians = [eq.hessian(c, params, sector) for sector in sectors]
     out = {}
-    for sector in eq.basis.sectors():
-        if not sector.size:
-            continue
-        H = eq.hessian(c, params, sector)
-        gram = np.full(sector.size, sector.gram())
-        factor = eigen.GramFactor(np.diag(gram), orthogonal=True)
-        rows = mode_rows(sector, fields)
-        out[sector.characters] = eigen.restricted(H, factor, rows * gram if rows.size else eigen.NO_CONSTRAINT)
+    for held in readings:
+        fields = zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
+        out[held] = {}
+        for sector, H in zip(sectors, hessians):
+            gram = np.full(sector.size, sector.gram())
+            factor = eigen.GramFactor(np.diag(gram), orthogonal=True)
+            rows = mode_rows(sector, fields)
+            out[held][sector.characters] = eigen.restricted(H, factor,
+                                                            rows * gram if rows.size else eigen.NO_CONSTRAINT)
     return out
+
+
+def spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
+            readings=(True, False)) -> dict:
+    """{held: the ``count`` lowest μ over every sector, ascending} (module docstring)."""
+    return {held: np.sort(np.concatenate([eigen.lowest_of(A, count) for A in sectors.values()]))[:count]
+            for held, sectors in restricted_sectors(eq, c, params, readings).items()}
 
 
 def spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True, count: int = 6) -> dict:
     """{characters: the ``count`` lowest μ of the sector} (module docstring)."""
-    return {key: eigen.lowest_of(A, count) for key, A in restricted_sectors(eq, c, params, held).items()}
+    sectors = restricted_sectors(eq, c, params, (held,))[held]
+    return {key: eigen.lowest_of(A, count) for key, A in sectors.items()}
 
 
 def negative_count(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True) -> int:
     """The number of negative μ over every sector: 0 is stable under pressure control (Sylvester: the inertia
     of the restricted matrices is the constrained second variation's)."""
-    return sum(int((np.linalg.eigvalsh(A) < 0.0).sum()) for A in restricted_sectors(eq, c, params, held).values())
+    sectors = restricted_sectors(eq, c, params, (held,))[held]
+    return sum(int((np.linalg.eigvalsh(A) < 0.0).sum()) for A in sectors.values())
+
+
+def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
+    """E_m: orthonormal columns spanning the cos mφ family δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z in a basis
+    with the mirror y → −y and no other reflection (MODEL.md §5; analysis/azimuthal.py's space at the same degree):
+    Z in the z blocks of order m, U = R + T in the pairs (x cos, y sin) of order m + 1, D = R − T in the pairs
+    (x cos, −y sin) of order m − 1 (δx_x + i δx_y = ½ U e^{i(m+1)φ} + ½ D e^{−i(m−1)φ})."""
+    if basis.symmetry != (MIRROR_Y,) or basis.characters != (1,):
+        raise ValueError(f"azimuthal_family: needs the mirror-invariant basis, not symmetry {basis.symmetry} "
+                         f"with characters {basis.characters}")
+    find = {(b.component, b.m, b.t): b for b in basis.blocks}
+    columns = []
+    if (2, m, COS) in find:
+        b = find[2, m, COS]
+        columns += [{b.offset + i: 1.0} for i in range(len(b.degrees))]
+    for order, sign in ((m + 1, 1.0), (m - 1, -1.0)):
+        x, y = find.get((0, order, COS)), find.get((1, order, SIN))
+        if x is None:
+            continue
+        for i in range(len(x.degrees)):
+            columns.append({x.offset + i: 1.0} if y is None else
+                           {x.offset + i: np.sqrt(0.5), y.offset + i: sign * np.sqrt(0.5)})
+    E = np.zeros((basis.size, len(columns)))
+    for k, column in enumerate(columns):
+        for row, value in column.items():
+            E[row, k] = value
+    return E
+
+
+def azimuthal_spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, m: int, held: bool = True,
+                       count: int = 6) -> np.ndarray:
+    """The lowest μ of the whole-sphere Hessian restricted to the cos mφ family (``azimuthal_family``) at an
+    axisymmetric state c of a mirror-invariant basis, its zero modes removed as ``spectrum`` removes them: the
+    whole-sphere counterpart of analysis/azimuthal.spectrum."""
+    E = azimuthal_family(eq.basis, m)
+    H = E.T @ eq.hessian(c, params) @ E
+    fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"], in_field(eq, params), held)
+    rows = mode_rows(eq.basis, fields) @ E if m == 1 else np.zeros((0, E.shape[1]))
+    rows = rows[np.linalg.norm(rows, axis=1) > 1e-10] if rows.size else rows
+    gram = np.full(E.shape[1], eq.basis.gram())
+    A = eigen.restricted(H, eigen.GramFactor(np.diag(gram), orthogonal=True),
+                         rows * gram if rows.size else eigen.NO_CONSTRAINT)
+    return eigen.lowest_of(A, count)
