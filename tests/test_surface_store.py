@@ -12,6 +12,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 import balloon_cg as bc
 from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.surface_branches import rotated
 from balloon_cg.analysis.results import (Block, Classification, Kind, Leg, SpecialPoint, Stop, StopCode,
                                          SurfaceBranch)
 from balloon_cg.app.api import Result
@@ -129,6 +130,22 @@ def test_a_special_point_on_another_basis_is_not_written(tmp_path, scene, surfac
     with pytest.raises(ValueError, match="special points BP after point 0 .7. are not rows of its 41"):
         write_run(tmp_path / "stale.h5", scene, [stale])
     assert not (tmp_path / "stale.h5").exists()
+
+
+def test_a_rotated_image_shares_its_partners_entry(tmp_path, scene, primary, surface_branch, capsys):
+    """The other direction of the pitchfork (analysis.surface_branches.rotated): stored with origin reflected and
+    reflection_of, drawn in its partner's colour under the same legend entry, named in inspect."""
+    image = rotated(surface_branch, "m1_bp0_rotated")
+    path = write_run(tmp_path / "rotated.h5", scene, [primary, surface_branch, image])
+    attrs = read_run(path)["branches"]["m1_bp0_rotated"]["attrs"]
+    assert (attrs["origin"], attrs["reflection_of"]) == ("reflected", "m1_bp0")
+    fig = plot([path], "pressure-pole")
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert labels.count("m = 1 (parent BP 0)") == 1 and len(labels) == 2
+    colours = {line.get_color() for line in fig.axes[0].lines if len(line.get_xdata()) > 1}
+    assert len(colours) == 2  # the primary branch's and the pair's
+    assert main(["inspect", str(path)]) == 0
+    assert "(the rotation by π about the axis of m1_bp0)" in capsys.readouterr().out
 
 
 def test_files_without_m_read_as_axisymmetric(run_path, tmp_path):

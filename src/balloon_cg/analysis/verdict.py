@@ -61,10 +61,9 @@ def incomplete(branches: list, not_searched: str = "", not_started: tuple = ()) 
             if s.kind == Kind.BP and s.m == 0 and s.classification == Classification.NONE:
                 found.append(Incomplete(Gap.UNCLASSIFIED, branch.name, f"BP near point {s.index}: fewer than three "
                                         "constrained minimisations along its mode converged"))
-        unsettled = getattr(branch, "unsettled", ())  # a SurfaceBranch has no check degree
-        if unsettled:
+        if branch.unsettled:
             found.append(Incomplete(Gap.UNSETTLED, branch.name,
-                                    f"stability flags change at the check degree at points {unsettled}"))
+                                    f"stability flags change at the check degree at points {branch.unsettled}"))
     if not_searched:
         found.append(Incomplete(Gap.NOT_SEARCHED, branches[0].name, not_searched))
     return found

@@ -195,7 +195,8 @@ def _scene(scene) -> Scene:
 
 def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progress: bool = False):
     """(branches, snap-throughs, incomplete entries, picture) of ``scene``, one progress bar per phase: the
-    primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse)."""
+    primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse; its
+    axisymmetric branches, then its surface branches)."""
     from ..analysis.picture import analyse as analyse_picture
     from ..analysis.primary import trace_primary
     from ..analysis.verdict import incomplete
@@ -206,7 +207,7 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
             bars.finish(Phase.PRIMARY, len(branches[0].X))
             return branches, None, incomplete(branches), None
         picture = analyse_picture(scene, bars, pear=pear)
-        return picture.branches, picture.snaps, picture.incomplete, picture
+        return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture
 
 
 def trace(scene, progress: bool = False) -> Result:

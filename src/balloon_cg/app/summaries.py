@@ -152,6 +152,8 @@ def summarise_surface_branch(b: dict) -> dict:
     return {
         "m": int(attrs["m"]),
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])],
+        "origin": attrs.get("origin", "traced"),
+        "reflection_of": attrs.get("reflection_of", ""),
         "points": n,
         "pressure": _range(b["pressure"]),
         "pressures": [float(p) for p in b["pressure"]],
@@ -241,7 +243,8 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"surface branch {name}   (m = {b['m']}, from {parent} branch point {point}; {b['kernel_class']}, degree "
         f"{b['surface_degree']}, reflections {_reflections(b['symmetry'], b['characters'])}, nodes "
         f"{b['nodes'][0]} × {b['nodes'][1]}, M = {b['M']:g}, chi = {b['chi']:g})",
-        f"  points               {b['points']}",
+        f"  points               {b['points']}"
+        + (f"  (the rotation by π about the axis of {b['reflection_of']})" if b["reflection_of"] else ""),
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
         "  lam2 north pole      {:.10g} .. {:.10g}  (√(λ1 λ2) at the material pole)".format(*b["lam2_north"]),
         "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),

@@ -33,7 +33,8 @@ Layout::
                            parent_branch_point, stop_reason, leg_labels, leg_stop_codes, wall_time, kernel_class,
                            kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
                            surface_degree, surface_order, symmetry (k × 3 int), characters (k int), n_theta,
-                           n_phi, map_centres, map_widths (the polar coordinate map; empty: none)
+                           n_phi, map_centres, map_widths (the polar coordinate map; empty: none); origin,
+                           [reflection_of] (a branch's image under the rotation by π about the axis)
         point, coefficient, axis                           dimension scales (axis: x, y, z as 0, 1, 2)
         pressure, volume, amount, lam2_north, lam2_south (√J at the material poles), tilt (degrees),
         converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
@@ -267,7 +268,10 @@ def _write_surface_branch(group, branch) -> None:
         "n_phi": basis.n_phi,
         "map_centres": np.array(basis.mapping.centres if basis.mapping else [], dtype=float),
         "map_widths": np.array(basis.mapping.widths if basis.mapping else [], dtype=float),
+        "origin": branch.origin.value,
     })
+    if branch.reflection_of:
+        group.attrs["reflection_of"] = branch.reflection_of
     rows = branch_rows(branch)
     parameters = parameter_columns(branch, rows)
     measures = branch.measures
@@ -525,7 +529,7 @@ def check_surface_branch(group, where, error) -> None:
     """The attributes and columns of one stored surface branch: its basis (symmetry k × 3 of ±1, characters k of
     ±1) rebuilt, the coefficients as wide as its size, the centroid 3 wide, special points (c, p) rows and
     stability of consistent shapes."""
-    require_attrs(group.attrs, where, SURFACE_KINDS, SURFACE_KINDS, error)
+    require_attrs(group.attrs, where, (*SURFACE_KINDS, "symmetry", "characters"), SURFACE_KINDS, error)
     n = check_columns(group, where, SURFACE_COLUMNS, error, min_rows=1)
     size = stored_basis(group.attrs, where, error).size
     if group["coefficients"].shape[1] != size:
@@ -578,8 +582,6 @@ def _attr(value):
 def _read_branch(group) -> dict:
     data = {name: group[name][()] for name, item in group.items() if isinstance(item, h5py.Dataset)}
     data["attrs"] = {"m": 0} | {k: _attr(v) for k, v in group.attrs.items()}  # m: files before surface branches
-    if "symmetry" in group.attrs:  # k × 3 ints (k = 0: HDF5 keeps no shape for an empty attribute)
-        data["attrs"]["symmetry"] = np.asarray(group.attrs["symmetry"], dtype=np.int64).reshape(-1, 3)
     if "profiles" in group:
         data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]

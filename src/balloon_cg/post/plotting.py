@@ -275,10 +275,11 @@ def load_branches(source, branch: str | None = None, reading: Reading | None = N
 
 
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
-    """Set each branch's legend label and colour. One file: a colour per branch (a mirror image sharing its
-    partner's), labelled 'M = …, <branch name>' when there are several. Several files: a colour per file,
-    labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
-    curves). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+    """Set each branch's legend label and colour. One file: a colour per branch (a mirror image, or a surface
+    branch's rotation by π, sharing its partner's), labelled 'M = …, <branch name>' when there are several, a
+    surface branch 'm = 1 (parent BP k)'. Several files: a colour per file, labelled 'M = …', with the scene
+    name where two files share an M (its branches told apart by their curves). A dielectric branch adds its fixed
+    parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
 
     def key(b):
         return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
@@ -293,14 +294,15 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         label = key(b)
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
-        if b.m:  # a surface branch: by its mode and parent, never its internal name
-            label = b.surface_name if len(files) == 1 else f"{label}: {b.surface_name}"
+        if len(files) == 1 and b.m:  # a surface branch: by its mode and parent, never its internal name
+            label = b.surface_name
         elif len(files) == 1 and len(files[id(b.run)]) > 1:
             label += f", {b.name}"
         b.label = label
     colors = {}
     for b in branches:
-        key = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX)) if len(files) == 1 or b.m else id(b.run)
+        partner = b.data["attrs"].get("reflection_of") or b.name if b.m else b.name.removesuffix(MIRROR_SUFFIX)
+        key = (id(b.run), partner) if len(files) == 1 else id(b.run)
         b.color = colors.setdefault(key, f"C{len(colors) % 10}")
     return branches
 
