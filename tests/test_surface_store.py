@@ -268,3 +268,14 @@ def test_result_has_m_and_parent(run_path, scene, primary, surface_branch):
         assert np.array_equal(rows.pressure, surface_branch.values) and "centroid_x" in table
     points = bc.load(run_path).to_xarray("m1_bp0")
     assert points.coefficients.shape == (5, surface_branch.basis.size)
+
+
+def test_analyse_stores_the_pictures_surface_branches(monkeypatch, scene, primary, surface_branch):
+    """bc.analyse (and `balloon-cg run`, through api.computed) hands the writers the picture's axisymmetric
+    branches, then its surface branches."""
+    from balloon_cg.analysis import picture
+
+    monkeypatch.setattr(picture, "analyse", lambda *args, **kwargs: picture.Picture(
+        [primary], surface_branches=[surface_branch]))
+    result = bc.analyse(scene)
+    assert list(result.branches) == ["primary", "m1_bp0"] and result.branches["m1_bp0"].m == 1
