@@ -38,7 +38,9 @@ def _optional(module: str, what: str):
 @dataclass(frozen=True, repr=False)
 class BranchData:
     """One stored branch: ``data`` is its read_run() dict (per-point arrays, 'attrs', 'profiles',
-    'special_points', 'stability'); ``branch['pressure']`` indexes it."""
+    'special_points', 'stability'); ``branch['pressure']`` indexes it. A surface branch (``m`` ≥ 1,
+    analysis.results.SurfaceBranch) holds 'coefficients', 'volume', 'centroid', 'tilt' instead of the
+    Legendre unknowns and profiles (docs/hdf5.md)."""
 
     name: str
     data: dict
@@ -57,13 +59,28 @@ class BranchData:
     def special_points(self) -> list[dict]:
         return self.data["special_points"]
 
+    @property
+    def m(self) -> int:
+        """The azimuthal number: 0 for an axisymmetric branch, m ≥ 1 for a surface branch."""
+        return int(self.attrs.get("m", 0))
+
+    @property
+    def parent(self) -> tuple | None:
+        """(branch name, branch point number) the branch leaves from; None for the primary branch."""
+        if "parent_branch" not in self.attrs:
+            return None
+        return self.attrs["parent_branch"], int(self.attrs["parent_branch_point"])
+
     def columns(self) -> dict:
-        """The per-point columns: every 1-D per-point dataset and the stability flags."""
+        """The per-point columns: every 1-D per-point dataset, the centroid of a surface branch as centroid_x,
+        centroid_y, centroid_z, and the stability flags."""
         n = len(self)
         flat = {k: v for k, v in self.data.items()
                 if isinstance(v, np.ndarray) and v.shape == (n,) and k != "point"}
+        centroid = {f"centroid_{axis}": self.data["centroid"][:, k] for k, axis in enumerate("xyz")
+                    if "centroid" in self.data}
         flags = {k: v for k, v in self.data.get("stability", {}).items() if k.startswith("stable")}
-        return flat | flags
+        return flat | centroid | flags
 
     def to_dataframe(self):
         """A pandas DataFrame, one row per point (index ``point``)."""
@@ -125,27 +142,29 @@ class Result:
         return "interrupted" in self.run["attrs"].get("incomplete_gaps", [])
 
     def to_dataframe(self, table: str = "points"):
-        """A pandas DataFrame: ``"points"``, one row per point of every branch (columns branch, point, then the
-        per-point columns), or ``"special"``, one row per special point."""
+        """A pandas DataFrame: ``"points"``, one row per point of every branch (columns branch, m (0:
+        axisymmetric, m ≥ 1: a surface branch), point, then the per-point columns; a column a branch does not
+        have is NaN in its rows), or ``"special"``, one row per special point."""
         pd = _optional("pandas", "to_dataframe")
         if table == "special":
             return pd.DataFrame(self.special_points)
         if table != "points":
             raise ValueError(f"table = {table!r}: must be 'points' or 'special'")
-        frames = [b.to_dataframe().reset_index().assign(branch=name) for name, b in self.branches.items()]
+        frames = [b.to_dataframe().reset_index().assign(branch=name, m=b.m) for name, b in self.branches.items()]
         frame = pd.concat(frames, ignore_index=True)
-        return frame[["branch", *[c for c in frame.columns if c != "branch"]]]
+        return frame[["branch", "m", *[c for c in frame.columns if c not in ("branch", "m")]]]
 
     def to_xarray(self, branch: str = "primary", part: str = "points"):
         """An xarray Dataset of one branch, read from the file image with named dimensions and units:
-        ``"points"`` (dims point, unknown, theta: the per-point columns, profiles and stability) or
+        ``"points"`` (dims point, unknown, theta: the per-point columns, profiles and stability; a surface
+        branch: point, coefficient, axis, eigenvalue) or
         ``"special"`` (dim special)."""
         _optional("h5netcdf", "to_xarray")
         xr = _optional("xarray", "to_xarray")
         if branch not in self.run["branches"]:
             raise KeyError(f"no branch {branch!r} (branches: {', '.join(self.run['branches'])})")
-        groups = {"points": ["", "/profiles"] + (["/stability"] if "stability" in self.run["branches"][branch]
-                                                  else []),
+        data = self.run["branches"][branch]
+        groups = {"points": [""] + ["/profiles"] * ("profiles" in data) + ["/stability"] * ("stability" in data),
                   "special": ["/special_points"]}
         if part not in groups:
             raise ValueError(f"part = {part!r}: must be 'points' or 'special'")
@@ -176,7 +195,8 @@ def _scene(scene) -> Scene:
 
 def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progress: bool = False):
     """(branches, snap-throughs, incomplete entries, picture) of ``scene``, one progress bar per phase: the
-    primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse)."""
+    primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse; its
+    axisymmetric branches, then its surface branches)."""
     from ..analysis.picture import analyse as analyse_picture
     from ..analysis.primary import trace_primary
     from ..analysis.verdict import incomplete

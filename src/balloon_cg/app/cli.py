@@ -29,7 +29,7 @@ PROG = "balloon-cg"
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
 BROKEN_PIPE = 141  # 128 + SIGPIPE: what a tool killed by SIGPIPE reports
 PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equator", "shapes", "stresses", "field",
-              "curvature", "energy", "phase")
+              "curvature", "energy", "phase", "surface", "stretch-map")
 # the exceptions that mean bad input (exit 2) or a computation that did not give what was asked (exit 1), by
 # module: a module that is not loaded cannot have raised its exception, so none is imported to catch it
 BAD_INPUT = {"balloon_cg.scene.validation": "SceneError", "balloon_cg.io.layout": "FileError",
@@ -352,9 +352,11 @@ def _add_plot(commands):
                                           "next to the first file; with several kinds: OUTPUT_STEM_KIND.SUFFIX; "
                                           "an existing image is overwritten)")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
-                   help="point indices for shapes, stresses, field, curvature (negative: from the end)")
+                   help="point indices for shapes, stresses, field, curvature (negative: from the end); one "
+                        "index for surface and stretch-map (default: point 1 of the surface branch)")
     p.add_argument("--branch", metavar="NAME",
-                   help="branch to draw (default: every branch for pressure-* and energy, primary for the others)")
+                   help="branch to draw (default: every branch for pressure-* and energy, the first surface branch "
+                        "for surface and stretch-map, primary for the others)")
     p.add_argument("--stability", default=None, metavar="READING",
                    help="what solid (stable) and dashed (unstable) mean: pressure (held at the centre, pressure "
                         "control), volume, gas, free, free-volume, free-gas, or axisymmetric (the paper's: m = 0 "

@@ -110,10 +110,14 @@ def summarise_run(run: dict) -> dict:
 
 
 def summarise_branch(b: dict) -> dict:
-    """Points, ranges, special points, accuracy and run time of one stored branch."""
+    """Points, ranges, special points, accuracy and run time of one stored branch (``m`` = 0: axisymmetric;
+    a surface branch, m ≥ 1: ``summarise_surface_branch``)."""
+    if b["attrs"].get("m", 0):
+        return summarise_surface_branch(b)
     n, attrs = len(b["pressure"]), b["attrs"]
     wall = float(attrs["wall_time"])
     return {
+        "m": 0,
         "points": n,
         "pressure": _range(b["pressure"]),
         "lam2_north": _range(b["lam2_north"]),
@@ -136,6 +140,41 @@ def summarise_branch(b: dict) -> dict:
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
         "origin": attrs.get("origin", "traced"),  # files written before reflected mirrors: every branch traced
         "reflection_of": attrs.get("reflection_of", ""),
+        "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
+    }
+
+
+def summarise_surface_branch(b: dict) -> dict:
+    """The summary of a surface branch (docs/hdf5.md): m, its parent (branch, branch point number), every
+    point's P, the ranges of the pole stretches, volume and tilt, its basis, stop, accuracy, stability."""
+    n, attrs = len(b["pressure"]), b["attrs"]
+    wall = float(attrs["wall_time"])
+    return {
+        "m": int(attrs["m"]),
+        "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])],
+        "origin": attrs.get("origin", "traced"),
+        "reflection_of": attrs.get("reflection_of", ""),
+        "points": n,
+        "pressure": _range(b["pressure"]),
+        "pressures": [float(p) for p in b["pressure"]],
+        "lam2_north": _range(b["lam2_north"]),
+        "lam2_south": _range(b["lam2_south"]),
+        "volume": _range(b["volume"]),
+        "tilt": _range(b["tilt"]),
+        "special_points": b["special_points"],
+        "stop_reason": attrs["stop_reason"],
+        "stop_codes": dict(zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", []))),
+        "max_residual": float(b["residual"].max()),
+        "max_error_estimate": float(b["error_estimate"].max()),
+        "wall_time": wall,
+        "wall_time_per_point": wall / n,
+        "surface_degree": int(attrs["surface_degree"]),
+        "symmetry": np.asarray(attrs["symmetry"]).reshape(-1, 3).tolist(),
+        "characters": [int(c) for c in attrs["characters"]],
+        "nodes": [int(attrs["n_theta"]), int(attrs["n_phi"])],
+        "kernel_class": attrs["kernel_class"],
+        "M": float(attrs["M"]),
+        "chi": float(attrs["chi"]),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
 
@@ -188,7 +227,42 @@ def _verdict(attrs: dict) -> str:
     return "incomplete: " + "; ".join(parts)
 
 
+def _reflections(symmetry, characters) -> str:
+    """'y → −y, z → −z' for the reflections a surface basis keeps (a character −1 as 'odd under …')."""
+    axes = "xyz"
+    parts = []
+    for row, chi in zip(symmetry, characters):
+        flipped = ", ".join(f"{axes[k]} → −{axes[k]}" for k in range(3) if row[k] < 0)
+        parts.append(f"({flipped})" + (" odd" if chi < 0 else ""))
+    return "; ".join(parts) or "none"
+
+
+def _format_surface_branch(name: str, b: dict) -> list[str]:
+    parent, point = b["parent"]
+    return [
+        f"surface branch {name}   (m = {b['m']}, from {parent} branch point {point}; {b['kernel_class']}, degree "
+        f"{b['surface_degree']}, reflections {_reflections(b['symmetry'], b['characters'])}, nodes "
+        f"{b['nodes'][0]} × {b['nodes'][1]}, M = {b['M']:g}, chi = {b['chi']:g})",
+        f"  points               {b['points']}"
+        + (f"  (the rotation by π about the axis of {b['reflection_of']})" if b["reflection_of"] else ""),
+        "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
+        "  lam2 north pole      {:.10g} .. {:.10g}  (√(λ1 λ2) at the material pole)".format(*b["lam2_north"]),
+        "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
+        "  volume               {:.10g} .. {:.10g}".format(*b["volume"]),
+        "  tilt                 {:.4g} .. {:.4g} degrees".format(*b["tilt"]),
+        f"  stop reason          {b['stop_reason']}",
+        f"  max residual         {b['max_residual']:.3e}",
+        f"  max error estimate   {b['max_error_estimate']:.3e}",
+        f"  wall time            {b['wall_time']:.3f} s",
+        f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
+        f"  special points       {len(b['special_points']) or 'none'}",
+        *_special_lines(b["special_points"]),
+    ]
+
+
 def _format_branch(name: str, b: dict) -> list[str]:
+    if b["m"]:
+        return _format_surface_branch(name, b)
     lines = [
         f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
         f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
@@ -211,13 +285,19 @@ def _format_branch(name: str, b: dict) -> list[str]:
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
     ]
+    return lines + _special_lines(b["special_points"])
+
+
+def _special_lines(special: list) -> list[str]:
+    """One aligned line per stored special point: label, place, P (and Φ̄), the pole stretches, the note."""
     labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
-              for s in b["special_points"]]
+              for s in special]
     places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"
-              for s in b["special_points"]]  # EP is a stored point; LP, TP, BP lie between two (docs/hdf5.md)
+              for s in special]  # EP is a stored point; LP, TP, BP lie between two (docs/hdf5.md)
     width, place_width = max(map(len, labels), default=0), max(map(len, places), default=0)
-    for s, label, place in zip(b["special_points"], labels, places):
+    lines = []
+    for s, label, place in zip(special, labels, places):
         note = f"  {s['note']}" if s["note"] else ""
         lines.append(
             f"    {label:<{width}}  {place:<{place_width}}  P = {s['pressure']:.10g}  "

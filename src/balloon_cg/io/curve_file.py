@@ -26,7 +26,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, plain
 from .layout import FileError, check_columns, require_attrs, require_group
-from .run_file import SPECIAL_COLUMNS, read_run, read_special, root_attrs, write_special
+from .run_file import SPECIAL_COLUMNS, legendre_poles, read_run, read_special, root_attrs, write_special
 from .schema import attach_dimensions, describe, scale
 
 
@@ -64,7 +64,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
                                   "mode": (point, scale(group, "mode_unknown", columns["mode"].shape[1]))})
         merges = [replace(s, X=curve.branch_X(s.X)[0]) for s in curve.merges]
         special = group.create_group("special_points")
-        write_special(special, merges, curve.n + 1, curve.disc, unknown)
+        write_special(special, merges, curve.n + 1, lambda X: legendre_poles(curve.disc, X), unknown)
         q = special.create_dataset("q", data=np.array([s.X[-1] for s in curve.merges], dtype=float))
         q.dims[0].attach_scale(special["special"])
         describe(q)

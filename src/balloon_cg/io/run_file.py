@@ -1,4 +1,4 @@
-"""Run files (HDF5, format "balloon-cg/3"): traced branches with their provenance.
+"""Run files (HDF5, format "balloon-cg/4"): traced branches with their provenance.
 
 Layout::
 
@@ -7,7 +7,8 @@ Layout::
                                   generated_digest, created (UTC ISO 8601), command), complete (bool),
                                   incomplete_gaps, incomplete_branches, incomplete_messages (analysis.verdict),
                                   + extra_attrs
-    /branches/<name>/      attrs: order, stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
+    /branches/<name>/      attrs: order, m (0: axisymmetric, this layout; m ≥ 1: a surface branch, below),
+                                  stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
                                   'up'/'down'/'forward' and a StopCode/TraceStop value), wall_time, degree,
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
                                   kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
@@ -28,14 +29,28 @@ Layout::
         special_points/unknowns                            (special, unknown)
         stability/stable_*                                 (point,) flags
         stability/lowest_<block>                           (point, eigenvalue): lowest eigenvalues
+    /branches/<name>/      a surface branch (analysis.results.SurfaceBranch, m ≥ 1): attrs order, m, parent_branch,
+                           parent_branch_point, stop_reason, leg_labels, leg_stop_codes, wall_time, kernel_class,
+                           kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
+                           surface_degree, surface_order, symmetry (k × 3 int), characters (k int), n_theta,
+                           n_phi, map_centres, map_widths (the polar coordinate map; empty: none); origin,
+                           [reflection_of] (a branch's image under the rotation by π about the axis)
+        point, coefficient, axis                           dimension scales (axis: x, y, z as 0, 1, 2)
+        pressure, volume, amount, lam2_north, lam2_south (√J at the material poles), tilt (degrees),
+        converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
+        centroid                                           (point, axis)
+        coefficients                                       (point, coefficient)
+        special_points/ as above, unknowns (special, unknown): the coefficients c, then P (or Φ̄)
+        stability/lowest_held, lowest_free (point, eigenvalue); stable_pressure, stable_pressure_free (point,)
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
 
 Every dataset carries ``units``, ``long_name`` and ``description`` (``io.schema``), and its axes are netCDF-4
 dimensions (HDF5 dimension scales), so ``xarray.open_dataset(path, engine="h5netcdf", group=...)`` names them.
 A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index + 1``; its own X is in
-special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous format
-"balloon-cg/2" (no volume, no dimension scales) still read, and so do files without amount, control or the
-gas stability flags (written before gas control).
+special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous formats
+still read: "balloon-cg/3" (no ``m`` attribute, no surface branches: every branch reads as m = 0) and
+"balloon-cg/2" (no volume, no dimension scales), and so do files without amount, control or the gas stability
+flags (written before gas control).
 """
 import errno
 import io
@@ -48,8 +63,8 @@ from .hdf5 import atomic_file, plain, provenance, write_strings
 from .layout import FileError, check_columns, require_attrs, require_group
 from .schema import attach_dimensions, scale
 
-FORMAT = "balloon-cg/3"
-READABLE = (FORMAT, "balloon-cg/2")
+FORMAT = "balloon-cg/4"
+READABLE = (FORMAT, "balloon-cg/3", "balloon-cg/2")
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
 SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
 SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
@@ -115,7 +130,8 @@ def verdict_attrs(branches=None, found=None) -> dict:
 
 
 def check_branches(branches) -> None:
-    """Distinct names and only finite points (ValueError otherwise: nothing is written)."""
+    """Distinct names, only finite points, special points as wide as the points (ValueError otherwise: nothing
+    is written)."""
     names = [b.name for b in branches]
     if len(set(names)) != len(names):
         raise ValueError(f"branch names must be distinct, got {names}")
@@ -123,11 +139,28 @@ def check_branches(branches) -> None:
         bad = np.flatnonzero(~finite(branch))
         if bad.size:
             raise ValueError(f"branch {branch.name!r}: points {bad.tolist()} are not converged solutions; not written")
+        width = branch_rows(branch).shape[1]
+        wrong = [f"{s.kind.value} after point {s.index} ({np.size(s.X)})" for s in branch.special
+                 if np.size(s.X) != width]
+        if wrong:
+            raise ValueError(f"branch {branch.name!r}: special points {', '.join(wrong)} are not rows of its {width} "
+                             "unknowns and parameter (another basis?); not written")
 
 
 def finite(branch) -> np.ndarray:
     """Per point: finite unknowns and residual (every traced point is a converged Newton solution)."""
-    return np.isfinite(branch.X).all(axis=1) & np.isfinite(branch.residual)
+    return np.isfinite(branch_rows(branch)).all(axis=1) & np.isfinite(branch.residual)
+
+
+def is_surface(branch) -> bool:
+    """Whether ``branch`` is a surface branch (analysis.results.SurfaceBranch: coefficients in a SphericalBasis)
+    rather than an axisymmetric Branch (Legendre unknowns on a Discretisation)."""
+    return hasattr(branch, "coefficients")
+
+
+def branch_rows(branch) -> np.ndarray:
+    """The rows (unknowns, parameter) of every point: X of a Branch, (c, p) of a SurfaceBranch."""
+    return np.column_stack([branch.coefficients, branch.values]) if is_surface(branch) else branch.X
 
 
 def write_branches(parent, scene, branches, snaps=None) -> None:
@@ -137,7 +170,8 @@ def write_branches(parent, scene, branches, snaps=None) -> None:
     group = parent.create_group("branches")
     theta = theta_grid(scene.output.theta_points)
     for order, branch in enumerate(branches):
-        _write_branch(group.create_group(branch.name), branch, theta)
+        write = _write_surface_branch if is_surface(branch) else lambda g, b: _write_branch(g, b, theta)
+        write(group.create_group(branch.name), branch)
         group[branch.name].attrs["order"] = order
     if snaps is not None:
         _write_snaps(parent.create_group("snap_throughs"), snaps)
@@ -148,28 +182,17 @@ def _write_branch(group, branch, theta):
     from ..galerkin.profiles import equator_values, profiles
 
     disc = branch.disc
+    _write_common_attrs(group, branch)
     group.attrs.update({
-        "stop_reason": branch.stop_reason,
-        "wall_time": branch.wall_time,
+        "m": 0,
         "degree": disc.degree,
         "symmetric": disc.symmetric,
         "pin_translation": disc.pin_translation,
         "quadrature": disc.quadrature,
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
-        "kernel_class": branch.kernel_class,
-        "kernel_signature": branch.kernel_signature,
-        "M": branch.params.M,
-        "chi": branch.params.chi,
-        "electric": branch.scene.electric is not None,
-        "voltage": branch.params.voltage,
-        "parameter": branch.parameter,
         "origin": branch.origin.value,
     })
-    text = h5py.string_dtype()
-    group.attrs.create("leg_labels", np.array([leg.label for leg in branch.legs], dtype=object), dtype=text)
-    group.attrs.create("leg_stop_codes", np.array([leg.stop.code.value for leg in branch.legs], dtype=object),
-                       dtype=text)
     if branch.parent is not None:
         group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
     if branch.rejoins is not None:
@@ -201,10 +224,96 @@ def _write_branch(group, branch, theta):
     for name, data in profiles(branch.disc, branch.X, theta).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
     attach_dimensions(shapes, {2: (point, theta_scale)})
-    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1], branch.disc, unknown,
-                  lambda X: parameter_columns(branch, X))
+    write_special(group.create_group("special_points"), branch.special, branch.X.shape[1],
+                  lambda X: legendre_poles(branch.disc, X), unknown, lambda X: parameter_columns(branch, X))
     if branch.stability:
         _write_stability(group.create_group("stability"), branch, point)
+
+
+def _write_common_attrs(group, branch) -> None:
+    """The attributes every branch has: its stop, legs, run time, kernels and parameters."""
+    group.attrs.update({
+        "stop_reason": branch.stop_reason,
+        "wall_time": branch.wall_time,
+        "kernel_class": branch.kernel_class,
+        "kernel_signature": branch.kernel_signature,
+        "M": branch.params.M,
+        "chi": branch.params.chi,
+        "electric": branch.scene.electric is not None,
+        "voltage": branch.params.voltage,
+        "parameter": branch.parameter,
+    })
+    text = h5py.string_dtype()
+    group.attrs.create("leg_labels", np.array([leg.label for leg in branch.legs], dtype=object), dtype=text)
+    group.attrs.create("leg_stop_codes", np.array([leg.stop.code.value for leg in branch.legs], dtype=object),
+                       dtype=text)
+
+
+def _write_surface_branch(group, branch) -> None:
+    """A SurfaceBranch (module docstring): its basis as attributes, the per-point measures (the volume per 2π
+    of ``surface.measures`` times 2π, as the axisymmetric ``volume``), the coefficients, special points with
+    the pole values of their own states, and the lowest eigenvalues held and free with the pressure-control
+    flags they give (the lowest > 0, as ``analysis.stability.Assessment``)."""
+    basis = branch.basis
+    _write_common_attrs(group, branch)
+    group.attrs.update({
+        "m": branch.m,
+        "parent_branch": branch.parent[0],
+        "parent_branch_point": branch.parent[1],
+        "surface_degree": basis.degree,
+        "surface_order": basis.order,
+        "symmetry": np.array(basis.symmetry, dtype=np.int64).reshape(len(basis.symmetry), 3),
+        "characters": np.array(basis.characters, dtype=np.int64),
+        "n_theta": basis.n_theta,
+        "n_phi": basis.n_phi,
+        "map_centres": np.array(basis.mapping.centres if basis.mapping else [], dtype=float),
+        "map_widths": np.array(basis.mapping.widths if basis.mapping else [], dtype=float),
+        "origin": branch.origin.value,
+    })
+    if branch.reflection_of:
+        group.attrs["reflection_of"] = branch.reflection_of
+    rows = branch_rows(branch)
+    parameters = parameter_columns(branch, rows)
+    measures = branch.measures
+    volumes = 2 * np.pi * np.asarray(measures["volume"], dtype=float)
+    columns = {
+        **parameters,
+        "volume": volumes,
+        "amount": parameters["pressure"] * volumes,
+        "lam2_north": np.asarray(measures["lam_north"], dtype=float),
+        "lam2_south": np.asarray(measures["lam_south"], dtype=float),
+        "centroid": np.asarray(measures["centroid"], dtype=float).reshape(len(rows), 3),
+        "tilt": np.asarray(measures["tilt"], dtype=float),
+        "converged": finite(branch),
+        "residual": branch.residual,
+        "error_estimate": branch.error_estimate,
+        "newton_iterations": branch.iterations,
+        "coefficients": branch.coefficients,
+    }
+    point, coefficient = scale(group, "point", len(rows)), scale(group, "coefficient", basis.size)
+    axis = scale(group, "axis", 3)
+    for name, data in columns.items():
+        group.create_dataset(name, data=data)
+    attach_dimensions(group, {"centroid": (point, axis), 1: (point,), 2: (point, coefficient)})
+    write_special(group.create_group("special_points"), branch.special, rows.shape[1],
+                  lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X))
+    if branch.stability:
+        _write_surface_stability(group.create_group("stability"), branch.stability, point)
+
+
+def _write_surface_stability(group, lowest: dict, point) -> None:
+    """lowest_held, lowest_free (every symmetry sector, zero modes removed: surface.stability) and the flags of
+    pressure control they give, held and free."""
+    columns = {f"lowest_{reading}": np.asarray(values, dtype=float) for reading, values in lowest.items()}
+    for name, reading in (("stable_pressure", "held"), ("stable_pressure_free", "free")):
+        if reading in lowest:
+            group.create_dataset(name, data=np.asarray(lowest[reading])[:, 0] > 0)
+            group[name].attrs["meaning"] = STABILITY_FLAGS[name]
+    eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in columns.values()))
+    for name, values in columns.items():
+        group.create_dataset(name, data=values)
+    attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
+    group.attrs["unsettled_points"] = np.zeros(0, dtype=np.int64)
 
 
 STABILITY_FLAGS = {
@@ -249,11 +358,28 @@ def parameter_columns(branch, X) -> dict:
     return {"pressure": fixed("P"), **({"voltage": fixed("voltage")} if branch.scene.electric is not None else {})}
 
 
-def write_special(group, special: list, width: int, disc, unknown=None, parameters=None) -> None:
-    """Special points (results.SpecialPoint) as columns; ``width`` = n + 1, the length of their X rows, and
-    ``disc`` the discretisation of their u (for the pole values); ``unknown``: the dimension scale of the X
-    rows (default: a new one in ``group``); ``parameters(X)``: the parameter columns of the rows (default
-    pressure = the last unknown)."""
+def legendre_poles(disc, X) -> dict:
+    """The POLES columns of rows X = (u, p) on the Discretisation ``disc``."""
+    return {name: X[:, :-1] @ row for name, row in disc.pole_rows().items()}
+
+
+def surface_poles(basis, X) -> dict:
+    """The POLES columns of rows X = (c, p) in the SphericalBasis ``basis``: the stretch √J at the material poles
+    (surface.measures.pole_stretch, λ2 there on an axisymmetric state) and their height z."""
+    from ..surface.measures import pole_stretch
+
+    heights = np.array([basis.point_values(row[:-1], np.array([0.0, np.pi]), np.zeros(2))[0][2] for row in X])
+    return {"lam2_north": np.array([pole_stretch(basis, row[:-1], 0.0) for row in X]),
+            "lam2_south": np.array([pole_stretch(basis, row[:-1], np.pi) for row in X]),
+            "eta_north": heights[:, 0] if len(X) else np.zeros(0),
+            "eta_south": heights[:, 1] if len(X) else np.zeros(0)}
+
+
+def write_special(group, special: list, width: int, poles, unknown=None, parameters=None) -> None:
+    """Special points (results.SpecialPoint) as columns; ``width`` the length of their X rows (unknowns, then
+    the parameter), ``poles(X)`` the POLES columns of the rows (``legendre_poles``, ``surface_poles``);
+    ``unknown``: the dimension scale of the X rows (default: a new one in ``group``); ``parameters(X)``: the
+    parameter columns of the rows (default pressure = the last unknown)."""
     X = np.array([s.X for s in special]).reshape(len(special), width)
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
@@ -269,9 +395,9 @@ def write_special(group, special: list, width: int, disc, unknown=None, paramete
         group.create_dataset(name, data=values)
     for n, name in enumerate(("E2", "E3", "E4")):
         group.create_dataset(name, data=np.array([s.E[n] for s in special], dtype=float))
-    rows = disc.pole_rows()
+    pole_values = poles(X)
     for name in POLES:
-        group.create_dataset(name, data=X[:, :-1] @ rows[name])
+        group.create_dataset(name, data=pole_values[name])
     group.create_dataset("unknowns", data=X)
     special_scale = scale(group, "special", len(special))
     attach_dimensions(group, {1: (special_scale,), 2: (special_scale, unknown or scale(group, "unknown", width))})
@@ -321,10 +447,17 @@ ROOT_KINDS = {"scene_name": "str", "scene_toml": "str", "tolerance": "float", "p
               "generated_digest": "str", "created": "str", "command": "str"}
 VERDICT_KINDS = {"complete": "bool", "incomplete_gaps": "str[]", "incomplete_branches": "str[]",
                  "incomplete_messages": "str[]"}
-BRANCH_KINDS = {"stop_reason": "str", "wall_time": "float", "degree": "int", "symmetric": "bool",
-                "pin_translation": "bool", "quadrature": "int", "kernel_class": "str", "kernel_signature": "str",
-                "M": "float", "chi": "float", "leg_labels": "str[]", "leg_stop_codes": "str[]",
-                "map_centres": "float[]", "map_widths": "float[]"}
+COMMON_KINDS = {"stop_reason": "str", "wall_time": "float", "kernel_class": "str", "kernel_signature": "str",
+                "M": "float", "chi": "float", "leg_labels": "str[]", "leg_stop_codes": "str[]"}
+BRANCH_KINDS = COMMON_KINDS | {"degree": "int", "symmetric": "bool", "pin_translation": "bool", "quadrature": "int",
+                               "map_centres": "float[]", "map_widths": "float[]"}
+SURFACE_KINDS = COMMON_KINDS | {"m": "int", "parent_branch": "str", "parent_branch_point": "int",
+                                "surface_degree": "int", "surface_order": "int", "n_theta": "int", "n_phi": "int",
+                                "map_centres": "float[]", "map_widths": "float[]", "parameter": "str"}
+SURFACE_COLUMNS = {**{name: ("float", 1) for name in ("pressure", "volume", "lam2_north", "lam2_south", "tilt",
+                                                       "residual", "error_estimate")},
+                   "converged": ("bool", 1), "newton_iterations": ("int", 1), "centroid": ("float", 2),
+                   "coefficients": ("float", 2)}
 BRANCH_COLUMNS = {**{name: ("float", 1) for name in ("pressure", *POLES, "lam1_equator", "lam2_equator", "residual",
                                                       "error_estimate")},
                   "converged": ("bool", 1), "newton_iterations": ("int", 1), "solved_degree": ("int", 1),
@@ -342,7 +475,10 @@ def read_branches(parent, where, error=None) -> dict:
     error = error or RunFileError
     group = require_group(parent, "branches", where, error)
     for name, branch in group.items():
-        check_branch(branch, f"{where}: branch {name}", error)
+        if branch_m(branch, f"{where}: branch {name}", error):
+            check_surface_branch(branch, f"{where}: branch {name}", error)
+        else:
+            check_branch(branch, f"{where}: branch {name}", error)
     snaps = parent.get("snap_throughs")
     if snaps is not None:
         check_columns(snaps, f"{where}: snap_throughs", SNAP_COLUMNS, error)
@@ -375,6 +511,68 @@ def check_branch(group, where, error) -> None:
         check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
 
 
+def branch_m(group, where, error) -> int:
+    """The azimuthal number ``m`` of a stored branch: 0 (axisymmetric; also files written before surface
+    branches, which have no ``m``), or m ≥ 1 (a surface branch)."""
+    if not isinstance(group, h5py.Group):
+        raise error(where, "is not a group")
+    if "m" not in group.attrs:
+        return 0
+    require_attrs(group.attrs, where, ("m",), {"m": "int"}, error)
+    m = int(group.attrs["m"])
+    if m < 0:
+        raise error(where, f"attribute m = {m}: must be ≥ 0")
+    return m
+
+
+def check_surface_branch(group, where, error) -> None:
+    """The attributes and columns of one stored surface branch: its basis (symmetry k × 3 of ±1, characters k of
+    ±1) rebuilt, the coefficients as wide as its size, the centroid 3 wide, special points (c, p) rows and
+    stability of consistent shapes."""
+    require_attrs(group.attrs, where, (*SURFACE_KINDS, "symmetry", "characters"), SURFACE_KINDS, error)
+    n = check_columns(group, where, SURFACE_COLUMNS, error, min_rows=1)
+    size = stored_basis(group.attrs, where, error).size
+    if group["coefficients"].shape[1] != size:
+        raise error(where, f"coefficients has {group['coefficients'].shape[1]} columns, expected {size} (the size "
+                           "of the basis its attributes describe)")
+    if group["centroid"].shape[1] != 3:
+        raise error(where, f"centroid has shape {group['centroid'].shape}, expected ({n}, 3)")
+    special = require_group(group, "special_points", where, error)
+    check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
+    if special["unknowns"].shape[0] and special["unknowns"].shape[1] != size + 1:
+        raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
+                                                f"expected {size + 1}")
+    if "stability" in group:
+        stability = require_group(group, "stability", where, error)
+        flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
+        lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
+        check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
+
+
+def stored_basis(attrs, where="", error=FileError):
+    """The surface.basis.SphericalBasis of a stored surface branch, from its attributes surface_degree,
+    surface_order, symmetry (k × 3 signs), characters (k signs), n_theta, n_phi and the polar coordinate map
+    map_centres, map_widths (empty: none) (``error`` naming ``where`` if they do not make one)."""
+    from ..galerkin.coordinate_map import WireMap
+    from ..surface.basis import SphericalBasis
+
+    symmetry, characters = (np.asarray(attrs.get(key, np.zeros(0))) for key in ("symmetry", "characters"))
+    if symmetry.size == 0:
+        symmetry = symmetry.reshape(0, 3)
+    if symmetry.ndim != 2 or symmetry.shape[1] != 3 or not np.isin(symmetry, (-1, 1)).all():
+        raise error(where, f"attribute symmetry has shape {symmetry.shape} and values {symmetry.ravel().tolist()}, "
+                           "expected k × 3 signs ±1 (the reflections the states keep)")
+    if characters.shape != (len(symmetry),) or not np.isin(characters, (-1, 1)).all():
+        raise error(where, f"attribute characters is {characters.tolist()}, expected {len(symmetry)} signs ±1")
+    try:
+        centres, widths = (tuple(float(v) for v in attrs.get(key, ())) for key in ("map_centres", "map_widths"))
+        return SphericalBasis(int(attrs["surface_degree"]), tuple(tuple(int(s) for s in row) for row in symmetry),
+                              tuple(int(c) for c in characters), int(attrs["n_theta"]), int(attrs["n_phi"]),
+                              int(attrs["surface_order"]), WireMap(centres, widths) if centres or widths else None)
+    except ValueError as e:
+        raise error(where, f"the basis attributes do not make a basis: {e}") from None
+
+
 def _attr(value):
     if isinstance(value, np.ndarray) and value.dtype == object:
         return [v.decode() if isinstance(v, bytes) else v for v in value.tolist()]
@@ -383,8 +581,9 @@ def _attr(value):
 
 def _read_branch(group) -> dict:
     data = {name: group[name][()] for name, item in group.items() if isinstance(item, h5py.Dataset)}
-    data["attrs"] = {k: _attr(v) for k, v in group.attrs.items()}
-    data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
+    data["attrs"] = {"m": 0} | {k: _attr(v) for k, v in group.attrs.items()}  # m: files before surface branches
+    if "profiles" in group:
+        data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]
     data["special_points"] = read_special(sp)
     data["special_unknowns"] = sp["unknowns"][()]

@@ -2,8 +2,9 @@
 
 All quantities are nondimensional (MODEL.md §2): lengths in R0, the pressure P = P̄R0/(T0 μ/2), stresses in μ/2,
 field in I/(4π R0); their ``units`` attribute is "1" (dimensionless, CF convention) and ``description`` names the
-scale. ``describe`` writes the attributes; ``attach_dimensions`` makes ``point``, ``theta``, ``unknown`` and
-``special`` HDF5 dimension scales (netCDF-4 dimensions, so xarray with h5netcdf names the axes) and attaches them.
+scale (the tilt of a surface branch is in degrees). ``describe`` writes the attributes; ``attach_dimensions``
+makes ``point``, ``theta``, ``unknown``, ``coefficient``, ``axis`` and ``special`` HDF5 dimension scales
+(netCDF-4 dimensions, so xarray with h5netcdf names the axes) and attaches them.
 """
 import h5py
 import numpy as np
@@ -24,13 +25,23 @@ VARIABLES = {
     "to_branch": ("", "to branch", "the branch of the lowest-energy stable state at that P (empty: none)"),
     "to_index": (NONDIMENSIONAL, "to point", "its point near the same P (-1: none)"),
     "eigenvalue": (NONDIMENSIONAL, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
+    "coefficient": (NONDIMENSIONAL, "coefficient index", "coefficients c of the displacement in the branch's "
+                                                         "spherical harmonics, in block order (docs/hdf5.md)"),
+    "axis": (NONDIMENSIONAL, "Cartesian axis", "0: x, 1: y, 2: z (z the coil axis)"),
     "pressure": (NONDIMENSIONAL, "pressure P", "P = P̄ R0 / (T0 μ/2)"),
     "voltage": (NONDIMENSIONAL, "voltage Φ̄", "Φ̄ = (Φ/H) √(ε/μ): voltage across the thickness (docs/scenes.md)"),
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
     "amount": (NONDIMENSIONAL, "gas amount n", "n = P V, the isothermal ideal gas P V = n in these units: "
                                                "n = N R T / (T0 μ R0² / 2) for N moles at temperature T"),
-    "lam2_north": (NONDIMENSIONAL, "λ2 at the north pole", "hoop stretch λ2(θ = 0)"),
-    "lam2_south": (NONDIMENSIONAL, "λ2 at the south pole", "hoop stretch λ2(θ = π)"),
+    "lam2_north": (NONDIMENSIONAL, "λ2 at the north pole", "hoop stretch λ2(θ = 0); on a surface branch √(λ1 λ2) "
+                                                           "at the material pole (equal there when axisymmetric)"),
+    "lam2_south": (NONDIMENSIONAL, "λ2 at the south pole", "hoop stretch λ2(θ = π); on a surface branch √(λ1 λ2) "
+                                                           "at the material pole"),
+    "coefficients": (NONDIMENSIONAL, "displacement coefficients c", "u = x − X in real spherical harmonics of "
+                                                                    "degree ≤ surface_degree (docs/hdf5.md)"),
+    "centroid": (NONDIMENSIONAL, "centroid of the enclosed body", "x_c / R0, offset from the held centre"),
+    "tilt": ("degree", "tilt of the long axis", "angle between e_z and the principal axis of the largest second "
+                                                "moment of the enclosed body, 0 … 90"),
     "eta_north": (NONDIMENSIONAL, "η at the north pole", "axial position η(0) / R0"),
     "eta_south": (NONDIMENSIONAL, "η at the south pole", "axial position η(π) / R0"),
     "lam1_equator": (NONDIMENSIONAL, "λ1 at the equator", "meridional stretch λ1(π/2)"),

@@ -184,8 +184,8 @@ def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
     """The snap-throughs of a stored run with stability read as ``reading`` (``analysis.picture.find_snaps`` on
     the stored flags or blocks, ``plotting.stable_points``): at equal value of the reading's control (P, V or
     n = P V) to the stable point of lowest energy that control minimises (``analysis.control.minimised_energy``),
-    E the Galerkin energy of the stored unknowns. Branches without stability data are left out; ``pressure`` of
-    each result is the control value."""
+    E the Galerkin energy of the stored unknowns. Branches without stability data are left out, and so are
+    surface branches (m ≥ 1: no Galerkin unknowns); ``pressure`` of each result is the control value."""
     if reading not in SNAP_READINGS:
         raise PlotError(f"--stability {reading.value}: no snap-through search for this reading (one of "
                         f"{', '.join(r.value for r in SNAP_READINGS)})")
@@ -194,7 +194,7 @@ def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
     curves = []
     for name, data in run["branches"].items():
         stable = stable_points(data, reading)
-        if stable is None:
+        if stable is None or data["attrs"].get("m", 0):
             continue
         disc = branch_discretisation(data)
         eq, M, chi = Equilibrium(scene, disc), data["attrs"]["M"], data["attrs"]["chi"]
@@ -323,7 +323,8 @@ def offset_landscape(run: dict, bp: dict, offset: float = LANDSCAPE_OFFSET) -> L
     fails."""
     scene, primary = stored_scene(run), run["branches"]["primary"]
     ends = [(abs(data["pressure"][end] - bp["pressure"]), name, end) for name, data in run["branches"].items()
-            if name != "primary" and not name.endswith(MIRROR) for end in (0, len(data["pressure"]) - 1)]
+            if name != "primary" and not name.endswith(MIRROR) and not data["attrs"].get("m", 0)
+            for end in (0, len(data["pressure"]) - 1)]
     if not ends:
         raise LandscapeError("no pear branch traced")
     _, name, end = min(ends)

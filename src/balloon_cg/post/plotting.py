@@ -13,9 +13,12 @@ name when a file holds several; a mirror-image branch (``<name>_mirror``) takes 
 thinner and lighter. Branch curves are solid where stable and dashed where unstable under the chosen stability
 ``Reading`` (default: the run's loading control, balloon held at its centre), named in the legend title; without
 stability data all solid, and the legend title says so. Titles name the material and the coils. Special points
-are marked and labelled with their kind (LP, TP, EP, branch points, …). The θ plots limit y to the bulk of the
-data when a near-wire spike would flatten the rest (``robust_limits``). Units are nondimensional (MODEL.md §2):
-P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2, field in I/(4π R0).
+are marked and labelled with their kind (LP, TP, EP, branch points, …). Surface branches (m ≥ 1, states on the
+whole sphere) are drawn by the pole curves and the energy landscape, labelled 'm = 1 (parent BP k)', and left
+out of the other branch and per-point kinds; ``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
+The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest (``robust_limits``).
+Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2,
+field in I/(4π R0).
 """
 import enum
 from dataclasses import dataclass
@@ -30,7 +33,7 @@ from scipy.interpolate import PchipInterpolator
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import read_curve
-from ..io.run_file import read_run
+from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
 
 NORMAL_FORM = ("E2", "E3", "E4")
@@ -188,6 +191,18 @@ class StoredBranch:
         return float(self.data["attrs"]["M"])
 
     @property
+    def m(self) -> int:
+        """The azimuthal number: 0 for an axisymmetric branch, m ≥ 1 for a surface branch (docs/hdf5.md)."""
+        return int(self.data["attrs"].get("m", 0))
+
+    @property
+    def surface_name(self) -> str:
+        """The legend name of a surface branch: 'm = 1 (parent BP 2)' (its parent's name when not primary)."""
+        attrs = self.data["attrs"]
+        parent = "parent" if attrs["parent_branch"] == "primary" else f"parent {attrs['parent_branch']}"
+        return f"m = {self.m} ({parent} BP {int(attrs['parent_branch_point'])})"
+
+    @property
     def ordinate(self) -> Ordinate:
         return ordinate_of(self.data)
 
@@ -260,10 +275,11 @@ def load_branches(source, branch: str | None = None, reading: Reading | None = N
 
 
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
-    """Set each branch's legend label and colour. One file: a colour per branch (a mirror image sharing its
-    partner's), labelled 'M = …, <branch name>' when there are several. Several files: a colour per file,
-    labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
-    curves). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+    """Set each branch's legend label and colour. One file: a colour per branch (a mirror image, or a surface
+    branch's rotation by π, sharing its partner's), labelled 'M = …, <branch name>' when there are several, a
+    surface branch 'm = 1 (parent BP k)'. Several files: a colour per file, labelled 'M = …', with the scene
+    name where two files share an M (its branches told apart by their curves). A dielectric branch adds its fixed
+    parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
 
     def key(b):
         return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
@@ -278,12 +294,15 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         label = key(b)
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
-        if len(files) == 1 and len(files[id(b.run)]) > 1:
+        if len(files) == 1 and b.m:  # a surface branch: by its mode and parent, never its internal name
+            label = b.surface_name
+        elif len(files) == 1 and len(files[id(b.run)]) > 1:
             label += f", {b.name}"
         b.label = label
     colors = {}
     for b in branches:
-        key = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX)) if len(files) == 1 else id(b.run)
+        partner = b.data["attrs"].get("reflection_of") or b.name if b.m else b.name.removesuffix(MIRROR_SUFFIX)
+        key = (id(b.run), partner) if len(files) == 1 else id(b.run)
         b.color = colors.setdefault(key, f"C{len(colors) % 10}")
     return branches
 
@@ -295,7 +314,8 @@ def applicable_kinds(branches) -> list[str]:
     return [kind for kind in KINDS
             if kind != "phase" and (kind.split("-")[0] not in curves or prefixes == {kind.split("-")[0]})
             and (kind != "field" or any(b.coils for b in branches))
-            and (kind != "energy" or any(b.bifurcations for b in branches))]
+            and (kind != "energy" or any(b.bifurcations for b in branches))
+            and (kind not in SURFACE_KINDS or any(b.m for b in branches))]
 
 
 def plot(sources, what: str | None, points=None, branch: str | None = None, axes=None,
@@ -320,11 +340,21 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
         raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
     if what == "phase":
         return plot_phase(sources, axes)
+    if what in SURFACE_KINDS:
+        return KINDS[what][0](*surface_state(sources, points, branch, what), axes=axes)
     draw, per_point = KINDS[what]
     configurations = per_point and named_points(points)
     names = list(dict.fromkeys(p.branch for p in points)) if configurations else [
         "primary" if per_point and branch is None else branch]
-    branches = _label([b for source in sources for name in names for b in load_branches(source, name, stability)])
+    branches = [b for source in sources for name in names for b in load_branches(source, name, stability)]
+    if what not in SURFACE_DRAWN:  # the axisymmetric kinds: surface branches have no profiles or equator ring
+        named = [b for b in branches if b.m and (branch is not None or configurations)]
+        if named:
+            raise PlotError(f"{named[0].source}: branch {named[0].name} is a surface branch (m = {named[0].m}): "
+                            f"{what} draws axisymmetric branches; draw it with {', '.join(SURFACE_DRAWN)}, "
+                            f"{' or '.join(SURFACE_KINDS)}")
+        branches = [b for b in branches if not b.m]
+    branches = _label(branches)
     return draw(branches, points, axes=axes) if per_point else draw(branches, axes=axes)
 
 
@@ -712,6 +742,150 @@ def plot_curvature(branches, points=None, axes=None) -> Figure:
     return fig
 
 
+# --- surface branches (one state on the whole sphere) ------------------------------------------------------
+
+SURFACE_SAMPLES = (61, 121)  # (θ, φ) values of the drawn surface, poles and both ends of φ included
+
+
+def surface_state(sources, points, branch: str | None, what: str) -> tuple:
+    """(StoredBranch, point index) of the state the surface kinds draw: point ``points[0]`` (one index, or one
+    Configuration naming its branch) of the surface branch ``branch`` (default: the first surface branch of the
+    file), by default the first point past its start (point 1)."""
+    if len(sources) != 1:
+        raise PlotError(f"{what} draws one state of one run file (got {len(sources)} files)")
+    if named_points(points):
+        branch, points = points[0].branch, [p.index for p in points]
+    run = as_run(sources[0])
+    source = run["path"] or run["scene_name"]
+    if branch is None:
+        branch = next((name for name, d in run["branches"].items() if d["attrs"].get("m", 0)), None)
+        if branch is None:
+            raise PlotError(f"{source}: no surface branch (m ≥ 1) in this file: {what} draws a state of a "
+                            "non-axisymmetric branch (shapes draws axisymmetric ones)")
+    stored = _label(load_branches(run, branch))[0]
+    if not stored.m:
+        raise PlotError(f"{source}: branch {branch} is axisymmetric (m = 0): {what} draws surface branches "
+                        "(draw it with shapes)")
+    if points is not None and np.ndim(points) == 1 and len(points) > 1:
+        raise PlotError(f"{what} draws one state: give one point (got {len(points)})")
+    n = len(stored.data["pressure"])
+    index = int(select_points(stored.data, points)[0]) if points is not None else min(1, n - 1)
+    return stored, index
+
+
+def stored_state(branch: StoredBranch, index: int) -> tuple:
+    """(basis, coefficients) of point ``index`` of a stored surface branch, the SphericalBasis rebuilt from its
+    attributes (io.run_file.stored_basis)."""
+    return stored_basis(branch.data["attrs"], branch.source), branch.data["coefficients"][index]
+
+
+def _state_title(branch: StoredBranch, index: int) -> str:
+    d = branch.data
+    return (f"{_title([branch])}, M = {branch.M:g}\n{branch.label}: #{index}  "
+            f"{branch.ordinate.symbol} = {d[branch.ordinate.column][index]:.4g}, "
+            f"$\\lambda_2(0)$ = {d['lam2_north'][index]:.4g}, tilt {d['tilt'][index]:.1f}°")
+
+
+def surface_grid(basis, c, samples: tuple = SURFACE_SAMPLES) -> np.ndarray:
+    """x (3, n_θ, n_φ) of the state c on a (θ, φ) grid of ``samples`` values from pole to pole and from φ = 0 to
+    2π (``SphericalBasis.point_values``: the series anywhere, the poles included)."""
+    theta, phi = np.meshgrid(np.linspace(0.0, np.pi, samples[0]), np.linspace(0.0, 2 * np.pi, samples[1]),
+                             indexing="ij")
+    x, _ = basis.point_values(c, theta.ravel(), phi.ravel())
+    return x.reshape(3, *samples)
+
+
+def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
+    """One state of a surface branch as a 3D surface (mplot3d) with its material lines θ, φ = multiples of 30°,
+    equal axis scales, the coils as circles of radius a at height h (docs/plots.md)."""
+    from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
+
+    if axes is None:
+        fig = Figure(figsize=(6.4, 6.4), layout="constrained")
+        ax, own = fig.add_subplot(projection="3d"), True
+    else:
+        fig, (ax,), own = _panels(axes, 1, None)
+        if getattr(ax, "name", "") != "3d":
+            raise PlotError("surface draws into a 3D Axes: give one made with projection='3d'")
+    x = surface_grid(*stored_state(branch, index))
+    ax.plot_surface(*x, color=branch.color, alpha=0.85, rcount=x.shape[1], ccount=x.shape[2], linewidth=0,
+                    shade=True)
+    step = (x.shape[1] - 1) // 6, (x.shape[2] - 1) // 12  # the material lines θ, φ = multiples of 30°
+    ax.plot_wireframe(*x, rstride=step[0], cstride=step[1], color="0.25", linewidth=0.3)
+    handles = [Line2D([], [], color=branch.color, linewidth=6, alpha=0.85, label=f"#{index} of {branch.label}")]
+    psi = np.linspace(0.0, 2 * np.pi, 200)
+    extent = np.abs(x).max()
+    for coil in branch.coils:
+        ax.plot(coil.radius * np.cos(psi), coil.radius * np.sin(psi), np.full_like(psi, coil.height), color="k",
+                linewidth=1.4)
+        extent = max(extent, coil.radius, abs(coil.height))
+    if branch.coils:
+        handles.append(Line2D([], [], color="k", linewidth=1.4, label="coil wire"))
+    ax.set(xlim=(-extent, extent), ylim=(-extent, extent), zlim=(-extent, extent))
+    ax.set_box_aspect((1.0, 1.0, 1.0))
+    ax.set_xlabel(r"$x/R_0$")
+    ax.set_ylabel(r"$y/R_0$")
+    ax.set_zlabel(r"$z/R_0$")
+    ax.set_title(_state_title(branch, index), fontsize=10)
+    _point_legend(fig, [ax], own, handles)
+    return fig
+
+
+def principal_stretches(state: np.ndarray) -> tuple:
+    """(λ1, λ2) at every node of a node state (9 rows x, a_θ, a_φ; a_φ = ∂x/∂φ / sin θ, so that both are unit on
+    the reference sphere): the square roots of the eigenvalues of C = [[a_θ·a_θ, a_θ·a_φ], [a_θ·a_φ, a_φ·a_φ]],
+    λ1 the one whose principal direction is nearer the meridian (the larger when a_θ·a_θ ≥ a_φ·a_φ): on an
+    axisymmetric state the meridional and the hoop stretch."""
+    a_theta, a_phi = state[3:6], state[6:9]
+    a, b, d = (np.einsum("in,in->n", u, v) for u, v in ((a_theta, a_theta), (a_theta, a_phi), (a_phi, a_phi)))
+    mean, radius = (a + d) / 2, np.sqrt(((a - d) / 2) ** 2 + b * b)
+    larger, smaller = np.sqrt(mean + radius), np.sqrt(np.maximum(mean - radius, 0.0))
+    meridional = a >= d
+    return np.where(meridional, larger, smaller), np.where(meridional, smaller, larger)
+
+
+def _cell_edges(nodes: np.ndarray, low: float, high: float) -> np.ndarray:
+    """Edges of the cells around sorted ``nodes``: midway between neighbours, ``low`` and ``high`` at the ends."""
+    return np.r_[low, (nodes[1:] + nodes[:-1]) / 2, high]
+
+
+def _colour_range(values: np.ndarray) -> tuple:
+    """(vmin, vmax) of a map: its range, widened to ±0.5 % about its value when it is constant to rounding (a
+    sphere), so that the colour bar does not show rounding noise."""
+    low, high = float(values.min()), float(values.max())
+    if high - low <= 1e-9 * max(1.0, abs(high)):
+        middle = (low + high) / 2
+        return middle - 0.005 * abs(middle), middle + 0.005 * abs(middle)
+    return low, high
+
+
+def plot_stretch_map(branch: StoredBranch, index: int, axes=None) -> Figure:
+    """λ1 and λ2 (``principal_stretches``) of one state of a surface branch as maps over (φ, θ) at the nodes of
+    its basis (the stored ones: where the kernels evaluate the state), each node's value on the cell around it
+    (from the poles to the midpoints between nodes), north pole at the top, two panels."""
+    fig, axes, own = _panels(axes, 2, (10.5, 4.2), nrows=1, ncols=2, sharey=True)
+    basis, c = stored_state(branch, index)
+    lam1, lam2 = (v.reshape(basis.n_theta, basis.n_phi) for v in principal_stretches(basis.node_state(c)))
+    theta = _cell_edges(np.arccos(basis.nodes["cos_theta"]), 0.0, np.pi)
+    # uniform nodes φ_k = k 2π/N_φ: the cells (k ∓ ½) 2π/N_φ, node 0 again after the last, clipped to [0, 2π]
+    phi = (np.arange(basis.n_phi + 2) - 0.5) * 2 * np.pi / basis.n_phi
+    for ax, values, name in zip(axes, (lam1, lam2), (r"$\lambda_1$ (nearer the meridian)",
+                                                      r"$\lambda_2$ (nearer the hoop direction)")):
+        low, high = _colour_range(values)
+        mesh = ax.pcolormesh(phi, theta, np.c_[values, values[:, :1]], shading="flat", cmap="viridis", vmin=low,
+                             vmax=high)
+        fig.colorbar(mesh, ax=ax, shrink=0.9)
+        ax.set_title(name, fontsize=10)
+        ax.set_xlabel(r"material angle $\phi$ (rad)")
+        ax.set_xlim(0.0, 2 * np.pi)
+        ax.set_xticks(np.linspace(0, 2 * np.pi, 5), ["0", "π/2", "π", "3π/2", "2π"])
+    axes[0].set_ylabel(THETA_LABEL)
+    axes[0].set_ylim(np.pi, 0.0)  # the north pole at the top
+    axes[0].set_yticks(np.linspace(0, np.pi, 5), ["0", "π/4", "π/2", "3π/4", "π"])
+    _suptitle(fig, axes, own, _state_title(branch, index))
+    return fig
+
+
 # --- bifurcations ------------------------------------------------------------------------------------------
 
 def _amplitude_range(e2, e3, e4) -> float:
@@ -866,4 +1040,8 @@ KINDS = {
     "curvature": (plot_curvature, True),
     "energy": (plot_energy, False),
     "phase": (plot_phase, False),
+    "surface": (plot_surface, True),
+    "stretch-map": (plot_stretch_map, True),
 }
+SURFACE_DRAWN = ("pressure-pole", "voltage-pole", "energy")  # the branch kinds that draw surface branches too
+SURFACE_KINDS = ("surface", "stretch-map")  # one state of a surface branch
