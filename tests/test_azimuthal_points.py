@@ -115,7 +115,7 @@ def test_under_resolved_m1_crossings_are_refined_away():
     from balloon_cg.analysis.crossings import resolved
     from balloon_cg.analysis.verdict import failing
 
-    scene = load_scene(SCENES / "tpom1_two_coils_M0.003.toml")
+    scene = load_scene(SCENES / "tpom1_two_coils_M0.003.toml").with_overrides({"surface.branches": "none"})
     coarse = analyse(scene.with_overrides({"stability.degree": 20}))
     fine = analyse(scene)
     assert not failing(coarse.incomplete) and not failing(fine.incomplete)

@@ -191,7 +191,7 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
     from dataclasses import replace
 
     from balloon_cg.analysis.results import Block
-    from balloon_cg.analysis.surface_branches import trace_surface
+    from balloon_cg.analysis.surface_branches import SurfaceTrace, rotated, trace_surface
     from balloon_cg.galerkin.point_solve import constrained_newton
 
     primary = spom1_picture.primary
@@ -215,6 +215,11 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
         assert abs(south - minus) <= 1e-9
         checked += 1
     assert checked >= 8 and branch.measures["tilt"][1:].min() > 89.999
+    image = rotated(branch, "m1_rotated")  # the other direction of the pitchfork: exact, by symmetry
+    trace = SurfaceTrace(branch.scene, branch.basis, branch.params)
+    for c, P in zip(image.coefficients, image.values):
+        assert np.abs(trace.eq.residual(c, Parameters(P))).max() <= 1e-10
+    assert np.allclose(image.measures["centroid"][:, 0], -branch.measures["centroid"][:, 0])
 
 
 @pytest.fixture(scope="module")
@@ -256,3 +261,30 @@ def test_m1_eigenvalue_and_crossing_with_a_field(two_coil_picture):
     found = continuation.locate_root(value_at, float(np.linalg.norm(X1 - X0)))
     assert found.status == continuation.RootStatus.LOCATED
     assert abs(found.payload[-1] - bp.X[-1]) <= 1e-9 * bp.X[-1]
+
+
+def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
+    """`balloon-cg run` on the shipped two-coil scene stores the branch born at the first m = 1 point (a few points
+    here) and its image; `inspect --json` lists every branch with its m, the surface branches with their parent and
+    pressures; [surface] branches = "none" and --primary-only leave them out."""
+    import json
+
+    from balloon_cg.app.cli import main
+
+    scene = ROOT / "scenes" / "spom1_two_coils_M0.002.toml"
+    out = tmp_path / "run.h5"
+    assert main(["run", str(scene), "-o", str(out), "--quiet", "--set", "surface.max_points=3"]) == 0
+    capsys.readouterr()
+    assert main(["inspect", str(out), "--json"]) == 0
+    branches = json.loads(capsys.readouterr().out)["branches"]
+    surface = {name: b for name, b in branches.items() if b["m"] != 0}
+    assert set(surface) == {"m1_bp1", "m1_bp1_rotated"}
+    assert all(b["m"] == 0 for name, b in branches.items() if name not in surface)
+    first = surface["m1_bp1"]
+    assert first["m"] == 1 and first["parent"][0] == "primary" and len(first["pressures"]) == 3
+    none = tmp_path / "none.h5"
+    assert main(["run", str(scene), "-o", str(none), "--quiet", "--set", "surface.branches=none",
+                 "--set", "continuation.stop_stretch=1.7"]) == 0
+    capsys.readouterr()
+    assert main(["inspect", str(none), "--json"]) == 0
+    assert all(b["m"] == 0 for b in json.loads(capsys.readouterr().out)["branches"].values())

@@ -219,7 +219,12 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     params = branch.params_at(bp.X)
     trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
     c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
-    X_star = trace.system.point(c_star, bp.X[-1])
+    solved = trace.system.solve(trace.system.point(c_star, bp.X[-1]), scene.solver.tol, scene.solver.max_newton)
+    if not solved.converged:
+        raise SurfaceStartError(f"the state of branch point {number}, embedded on the whole sphere, did not converge "
+                                f"there: {solved.message}")
+    X_star = solved.x  # the axisymmetric state as the whole-sphere solution at P* (its truncation differs)
+    c_star = trace.system.coefficients(X_star)
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
     E, kind = classify(trace, X_star, phi)

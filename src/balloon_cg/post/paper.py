@@ -44,7 +44,7 @@ PAPER_STYLE = {  # readable at 3.5 in: 8 pt text, 7 pt ticks and legends, thin f
 @dataclass(frozen=True)
 class Case:
     """One run a figure draws: the shipped scene ``scene`` (balloon_cg.scenes, by file stem) with ``overrides``
-    (dotted keys, Scene.with_overrides)."""
+    (dotted keys, Scene.with_overrides), without the non-axisymmetric branches (``[surface] branches = "none"``)."""
 
     scene: str
     overrides: tuple[tuple[str, object], ...] = ()
@@ -53,8 +53,9 @@ class Case:
         """The Scene (``quick``: with the QUICK numerical settings, a reduced run for tests)."""
         text = (resources.files("balloon_cg.scenes") / f"{self.scene}.toml").read_text(encoding="utf-8")
         scene = parse_scene(text, self.scene)
-        overrides = dict(self.overrides) | (QUICK if quick else {})
-        return scene.with_overrides(overrides) if overrides else scene
+        # the paper draws axisymmetric branches only: its runs leave out the non-axisymmetric ones
+        overrides = {"surface.branches": "none"} | dict(self.overrides) | (QUICK if quick else {})
+        return scene.with_overrides(overrides)
 
 
 @dataclass(frozen=True)
