@@ -30,7 +30,9 @@ def sphere(scene, stretch, degree):
     disc = Discretisation(degree, symmetric=False, pin_translation=False)
     a, b = np.zeros(degree + 1), np.zeros(degree + 1)
     a[0], b[1] = stretch, stretch
-    return Equilibrium(scene, disc), disc.join(a, b), Parameters(sphere_pressure(scene.material, stretch))
+    voltage = 0.0 if scene.electric is None else scene.electric.voltage
+    return (Equilibrium(scene, disc), disc.join(a, b),
+            Parameters(sphere_pressure(scene.material, stretch, voltage), voltage=voltage))
 
 
 @pytest.fixture(scope="module")
@@ -89,6 +91,7 @@ def test_sphere_spectrum_is_the_union_of_the_azimuthal_blocks(spom1):
 @pytest.mark.parametrize("text, stretch", [
     ('[material]\npreset = "SPOM1"\n', 2.1),
     ('[material]\nfamily = "gent"\n[material.parameters]\nmu = 2.0\nJm = 30.0\n', 1.8),
+    ('[material]\npreset = "neo-Hookean"\n[electric]\nvoltage = 0.3\n', 1.6),
 ])
 def test_sphere_states_are_equilibria_and_the_solver_returns_them(text, stretch):
     """An exact sphere embedded: residual ≤ 1e-10; Newton at the prescribed north pole stretch (a bordering row)

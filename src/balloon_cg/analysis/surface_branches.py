@@ -217,14 +217,18 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     az_basis, vector = critical_mode(branch, bp, scene.stability.degree)
     symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
     params = branch.params_at(bp.X)
-    trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
+    try:
+        trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
+    except NotImplementedError as error:  # codegen: no whole-sphere kernels for a formula in the stretches yet
+        raise SurfaceStartError(f"no whole-sphere kernels for this material: {error}") from None
     c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
-    solved = trace.system.solve(trace.system.point(c_star, bp.X[-1]), scene.solver.tol, scene.solver.max_newton)
-    if not solved.converged:
-        raise SurfaceStartError(f"the state of branch point {number}, embedded on the whole sphere, did not converge "
-                                f"there: {solved.message}")
-    X_star = solved.x  # the axisymmetric state as the whole-sphere solution at P* (its truncation differs)
-    c_star = trace.system.coefficients(X_star)
+    # point 0: the axisymmetric state as the whole-sphere solution at P* (its truncation differs), or, where Newton
+    # does not converge at the branch point (its Jacobian is singular there), the embedded state itself; its
+    # residual is stored either way
+    X_star = trace.system.point(c_star, bp.X[-1])
+    solved = trace.system.solve(X_star, scene.solver.tol, scene.solver.max_newton)
+    if solved.converged:
+        X_star, c_star = solved.x, trace.system.coefficients(solved.x)
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
     E, kind = classify(trace, X_star, phi)
