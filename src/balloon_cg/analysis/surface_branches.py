@@ -11,13 +11,14 @@ held and the relabelling modes removed (``surface.gauge``).
 Switching: from (c*, P*) (the BP state embedded) the predictor c* + δφ (φ the embedded mode, unit) is corrected on
 the hyperplane normal to φ, then the branch is followed by pseudo-arclength continuation until it rejoins the
 axisymmetric branch (the amplitude φ·(c − c*) changes sign), a pole stretch reaches stop_stretch, the membrane
-comes within wire_gap of a coil, the spectral tail of the coefficients exceeds solver.max_error (flagged: the
-degree is not raised), or max_points. Both signs ±φ are traced. Folds in P are located (LP).
+comes within wire_gap of a coil, or max_points; a point whose spectral tail exceeds solver.max_error refines the
+basis (``refined``: up to MAX_DEGREE, MAX_ORDER; past them the branch stops, flagged). The sign −φ is the image
+of the +φ branch under the rotation by π about the axis (``rotated``). Folds in P are located (LP).
 
 Every point carries its measures (pole stretches, volume, centroid offset, tilt) and the lowest eigenvalues of
 its second variation over every symmetry sector, held and free (``surface.stability``); a change of the number
-of negative held eigenvalues between two points is a secondary branch point, stored with its bracket
-(APPROXIMATE: not located in this version).
+of negative held eigenvalues of a sector between two points is a secondary branch point, located by Brent's
+method on that eigenvalue (``assess``).
 
 Classification of the parent point: the reduced energy E(Λ) − E* along φ at P* (the other coefficients relax on
 φ·(c − c*) = Λ, as ``bifurcation.classify`` for the pear points), fitted by E2 Λ² + E3 Λ³ + E4 Λ⁴.
@@ -44,7 +45,7 @@ from ..surface.measures import MEASURES, measures, tail, tails
 from ..surface.system import SurfaceSystem
 from . import azimuthal
 from .problem import continuation_settings, equilibrium_of
-from .results import (Block, Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
+from .results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
 
 STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
@@ -152,7 +153,7 @@ class SurfaceTrace:
 def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
     """The basis of a branch's start: degree surface.degree on the axisymmetric state's wire map (isotropic without
     one, order min(degree, 6) with one: a field's fine features are in θ), refined until the embedded state's
-    tails are below solver.max_error / 10 (``refined``); ValueError past MAX_DEGREE."""
+    tails are below solver.max_error / 10 (``refined``); SurfaceStartError past MAX_DEGREE."""
     degree = scene.surface.degree
     order = degree if disc.mapping is None else min(degree, 6)
     basis = SphericalBasis(degree, symmetry, order=order, mapping=disc.mapping)
@@ -186,8 +187,9 @@ def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
             distance = float(wire_distance(np.hypot(x[0], x[1]), x[2], coils).min())
             if distance < gap:
                 return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap:g} of a coil (gap {distance:.3g})")
-        if tail(basis, c) > scene.solver.max_error:
-            return Stop(StopCode.RESOLUTION, f"spectral tail {tail(basis, c):.2g} above solver.max_error "
+        error = tail(basis, c)
+        if error > scene.solver.max_error:
+            return Stop(StopCode.RESOLUTION, f"spectral tail {error:.2g} above solver.max_error "
                                              f"{scene.solver.max_error:g} at degree {basis.degree}, order "
                                              f"{basis.order}")
         return None
@@ -314,7 +316,7 @@ def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
         params = sb.params.with_value(sb.parameter, value)
         spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT)
         for key, held in (("held", True), ("free", False)):
-            readings[key].append(np.sort(np.concatenate(list(spectra[held].values())))[:STABILITY_COUNT])
+            readings[key].append(surface_stability.lowest_over(spectra[held], STABILITY_COUNT))
         counts.append(_negative_counts(trace, c, params, spectra[True]))
     sb.stability = {key: np.array(rows) for key, rows in readings.items()}
     for i in range(1, len(counts) - 1):

@@ -73,15 +73,6 @@ class Block:
         return slice(self.offset, self.offset + len(self.degrees))
 
 
-def pair_rows(pairs) -> np.ndarray:
-    """rows[p, q] = rows[q, p] = r for the r-th (p, q) of ``pairs`` (a generated upper-triangle layout)."""
-    n = 1 + max(max(pair) for pair in pairs)
-    rows = np.full((n, n), -1, dtype=np.int64)
-    for r, (p, q) in enumerate(pairs):
-        rows[p, q] = rows[q, p] = r
-    return rows
-
-
 @dataclass(frozen=True)
 class SphericalBasis:
     """Degree ``degree`` (L), the largest azimuthal order ``order`` (M ≤ L, default L: every harmonic of degree
@@ -305,7 +296,7 @@ class SphericalBasis:
 
     def hessian(self, pointwise: np.ndarray, pairs_rows: np.ndarray) -> np.ndarray:
         """Σ_{jk} W_j D(θ_j, φ_k) contracted with the node rows' derivatives on both sides (module docstring), D the
-        45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (pair_rows of the kernels' pairs). Per
+        45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (galerkin.discretisation.symmetric_rows of the kernels' pairs). Per
         component pair (c, c'): the column weights Y_b = Σ_d' T^{dd'}[·, b, ·] Θ^{d'} of every row block b in one
         jitted pass (``_weighted_columns``), then one product Θ_bᵀ Y_b per row block (BLAS)."""
         n, nodes, components = self.n_phi, self.nodes, self.tables["components"]

@@ -9,7 +9,8 @@ spherical-harmonic coefficients c of the displacement (basis.py), and the residu
 """
 import numpy as np
 
-from .basis import SphericalBasis, pair_rows
+from .basis import SphericalBasis
+from ..galerkin.discretisation import symmetric_rows
 from ..galerkin.equilibrium import NonFiniteState, Parameters
 from ..model.field import CARTESIAN, field_squared_cartesian
 from ..model.kernels import KernelSet
@@ -29,7 +30,7 @@ class SurfaceEquilibrium:
                               dtype=float).reshape(-1, 3)
         self.kernels = kernels if kernels is not None else KernelSet.of_scene(scene).surface()
         self.has_field = self.coils.shape[0] > 0
-        self._pairs = pair_rows(self.kernels.module.SURFACE_PAIRS)
+        self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
         self._held = None  # the coefficients whose node state (and field) are in _named, kernel outputs in _outputs
         self._outputs = {}
 
@@ -85,12 +86,6 @@ class SurfaceEquilibrium:
         if kernel is None or kernel not in self.kernels.module.KERNELS:
             raise ValueError(f"no generated derivative of the surface residual in {name!r} for this scene class")
         return self.basis.project(self._nodes(kernel, c, params))
-
-    def volume(self, c: np.ndarray) -> float:
-        """V/(2π) = (1/2π) ∫∫ ⅓ x · (a_θ × a_φ) dA."""
-        state = self.node_values(c)["state"]
-        flux = np.einsum("in,in->n", state[:3], np.cross(state[3:6], state[6:9], axis=0)) / 3.0
-        return float(self.basis.nodes["weights"] @ flux.reshape(self.basis.n_theta, self.basis.n_phi).sum(axis=1))
 
 
 def _oriented(state: np.ndarray, reference: np.ndarray) -> bool:

@@ -20,7 +20,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .basis import COS, SphericalBasis
+from .basis import SphericalBasis
 
 
 class UnsupportedGauge(ValueError):
@@ -107,15 +107,4 @@ class Gauge:
         side = H[np.ix_(free, touched)] @ block
         out[:n, n:], out[n:, :n] = side, side.T
         out[n:, n:] = block.T @ H[np.ix_(touched, touched)] @ block
-        return out
-
-    def reaction(self, residual: np.ndarray) -> np.ndarray:
-        """The net force per 2π the hold exerts, (1/2π)∫∫ ∂π/∂u dA: the residual ∂E/∂c (zero in the reduced space at
-        an equilibrium) applied to the constant displacement e_k (coefficients from the projection)."""
-        out = np.zeros(3)
-        rows = np.zeros((9, self.basis.n_theta * self.basis.n_phi))
-        for axis in range(3):
-            rows[:3] = 0.0
-            rows[axis] = 1.0
-            out[axis] = float(2.0 * np.pi * self.basis.project(rows) @ residual)
         return out

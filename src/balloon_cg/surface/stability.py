@@ -68,9 +68,7 @@ def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
             rows = mode_rows(sector, fields)
             key = (k, rows.tobytes())
             if key not in made:
-                gram = np.full(sector.size, sector.gram())
-                factor = eigen.GramFactor(np.diag(gram), orthogonal=True)
-                made[key] = eigen.restricted(H, factor, rows * gram if rows.size else eigen.NO_CONSTRAINT)
+                made[key] = _restricted(H, sector.gram(), rows)
             out[held][sector.characters] = made[key]
     return out
 
@@ -90,21 +88,20 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
 def spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
             readings=(True, False)) -> dict:
     """{held: the ``count`` lowest μ over every sector, ascending} (module docstring)."""
-    return {held: np.sort(np.concatenate(list(sectors.values())))[:count]
-            for held, sectors in sector_spectra(eq, c, params, count, readings).items()}
+    return {held: lowest_over(sectors, count) for held, sectors in sector_spectra(eq, c, params, count, readings).items()}
 
 
-def spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True, count: int = 6) -> dict:
-    """{characters: the ``count`` lowest μ of the sector} (module docstring)."""
-    sectors = restricted_sectors(eq, c, params, (held,))[held]
-    return {key: eigen.lowest_of(A, count) for key, A in sectors.items()}
+def lowest_over(sectors: dict, count: int) -> np.ndarray:
+    """The ``count`` lowest of the sectors' lowest eigenvalues together, ascending."""
+    return np.sort(np.concatenate(list(sectors.values())))[:count]
 
 
-def negative_count(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, held: bool = True) -> int:
-    """The number of negative μ over every sector: 0 is stable under pressure control (Sylvester: the inertia
-    of the restricted matrices is the constrained second variation's)."""
-    sectors = restricted_sectors(eq, c, params, (held,))[held]
-    return sum(int((np.linalg.eigvalsh(A) < 0.0).sum()) for A in sectors.values())
+def _restricted(H: np.ndarray, gram: float, rows: np.ndarray) -> np.ndarray:
+    """The standard matrix of (H, gram·I) on the G-orthogonal complement of the coefficient vectors ``rows``
+    (numerics.eigen.restricted; the basis is orthonormal, so G = gram·I)."""
+    diagonal = np.full(H.shape[0], gram)
+    factor = eigen.GramFactor(np.diag(diagonal), orthogonal=True)
+    return eigen.restricted(H, factor, rows * diagonal if rows.size else eigen.NO_CONSTRAINT)
 
 
 def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
@@ -137,14 +134,11 @@ def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
 def azimuthal_spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, m: int, held: bool = True,
                        count: int = 6) -> np.ndarray:
     """The lowest μ of the whole-sphere Hessian restricted to the cos mφ family (``azimuthal_family``) at an
-    axisymmetric state c of a mirror-invariant basis, its zero modes removed as ``spectrum`` removes them: the
-    whole-sphere counterpart of analysis/azimuthal.spectrum."""
+    axisymmetric state c of a mirror-invariant basis, its zero modes removed as ``restricted_sectors`` removes them:
+    the whole-sphere counterpart of analysis/azimuthal.spectrum."""
     E = azimuthal_family(eq.basis, m)
     H = E.T @ eq.hessian(c, params) @ E
     fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"], in_field(eq, params), held)
     rows = mode_rows(eq.basis, fields) @ E if m == 1 else np.zeros((0, E.shape[1]))
     rows = rows[np.linalg.norm(rows, axis=1) > 1e-10] if rows.size else rows
-    gram = np.full(E.shape[1], eq.basis.gram())
-    A = eigen.restricted(H, eigen.GramFactor(np.diag(gram), orthogonal=True),
-                         rows * gram if rows.size else eigen.NO_CONSTRAINT)
-    return eigen.lowest_of(A, count)
+    return eigen.lowest_of(_restricted(H, eq.basis.gram(), rows), count)
