@@ -43,6 +43,7 @@ MIRROR_Y = (1, -1, 1)  # the plane y = 0 through the axis (MODEL.md §8: x, z ke
 EQUATOR = (1, 1, -1)  # the equatorial plane z = 0
 INVERSION = (-1, -1, -1)  # the centre: x(−X) = −x(X)
 STATE_ROWS = 9  # x (3), a_θ (3), a_φ (3): row 3 d + c for derivative d and component c
+POLE_ZONE = 1e-10  # sin²θ below which a mapped basis' dθ_s/dθ takes its pole limit (relative error ~ POLE_ZONE)
 
 
 def _sign_under(reflection, l, m, t) -> int:
@@ -200,8 +201,10 @@ class SphericalBasis:
         p = legendre_values(mapped, self.degree, block.m)[:, k]
         dp = theta_derivative(mapped, self.degree, block.m)[:, k]
         if self.mapping is not None:  # dθ_s/dθ = h'(x) sin θ / sin θ_s, → √h'(±1) at the poles
-            ratio = np.sqrt(np.where(np.abs(mapped) < 1.0, (1.0 - x * x) / np.maximum(1.0 - mapped * mapped, 1e-300),
-                                     1.0 / self.mapping.ds_dx(x)))
+            # the limit within POLE_ZONE of a pole, where h(±1) = ±1 may be off by an ulp (0/ε otherwise)
+            at_pole = np.minimum(1.0 - x * x, 1.0 - mapped * mapped) < POLE_ZONE
+            ratio = np.sqrt(np.where(at_pole, 1.0 / self.mapping.ds_dx(x),
+                                     (1.0 - x * x) / np.where(at_pole, 1.0, 1.0 - mapped * mapped)))
             dp = dp * (self.mapping.ds_dx(x) * ratio)[:, None]
         return p, dp
 
