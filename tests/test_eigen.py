@@ -61,6 +61,37 @@ def test_positive_definite_is_the_sign_of_the_lowest_eigenvalue():
         assert eigen.positive_definite(A) == (lowest - shift > 0)
 
 
+def stiff_matrix(n, lowest, seed):
+    """A symmetric matrix with the eigenvalues ``lowest`` and then n − len(lowest) spread over 1..1e6 (a membrane
+    Hessian's range), and its spectrum."""
+    rng = np.random.default_rng(seed)
+    Q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    spectrum = np.concatenate([lowest, np.geomspace(1.0, 1e6, n - len(lowest))])
+    A = (Q * spectrum) @ Q.T
+    return 0.5 * (A + A.T), np.sort(spectrum)
+
+
+@pytest.mark.parametrize("guess", [-3.0, -20.0, 0.5, 1e-9])
+def test_lowest_following_matches_the_dense_spectrum(guess):
+    """Lanczos on (A − σI)⁻¹ below the spectrum returns the lowest eigenvalues to 1e-10 whatever the guess (one far
+    above the lowest needs several shifts), near-zero and clustered ones included."""
+    A, spectrum = stiff_matrix(eigen.FOLLOWING_SIZE + 50, [-3.9, -1e-12, 0.3, 0.3 + 1e-7, 0.5], 5)
+    kept = A.copy()
+    values = eigen.lowest_following(A, 4, guess)
+    assert np.array_equal(A, kept)
+    assert np.abs(values - spectrum[:4]).max() < 1e-10
+
+
+def test_negative_count_is_the_inertia():
+    """The Bunch–Kaufman inertia counts the negative eigenvalues, with 2×2 pivots (zero diagonal blocks force them)."""
+    for negatives in (0, 1, 3, 7):
+        A, spectrum = stiff_matrix(120, -np.geomspace(1e-6, 5.0, negatives), negatives)
+        assert eigen.negative_count(A) == negatives == int((spectrum < 0).sum())
+    swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # eigenvalues ±1: a 2×2 pivot
+    assert eigen.negative_count(np.kron(np.eye(3), swap)) == 3
+    assert eigen.negative_count(-np.kron(np.eye(3), swap) - 2 * np.eye(6)) == 6
+
+
 def flag_pairs(branch, symmetric, m_max, degrees):
     eq = equilibrium_of(branch)
     for degree in degrees:

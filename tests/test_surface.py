@@ -150,7 +150,8 @@ def test_relabelling_and_rigid_modes_are_exact_null_vectors(spom1):
     assert len(rows) == 9
     for v in rows:
         assert np.abs(H @ v).max() <= 1e-10 * np.abs(H).max() * np.linalg.norm(v)
-    values = stability.sector_spectra(eq, c, params, readings=(True,))[True]
+    held = stability.Reading(True)
+    values = stability.sector_spectra(eq, c, params, readings=(held,))[held]
     assert min(v.min() for v in values.values()) > 0
 
 
@@ -305,3 +306,75 @@ def test_a_mapped_basis_reads_its_poles_as_the_limit():
             at = basis.point_values(c, np.full(2, pole), np.array([0.0, np.pi / 2]))
             by = basis.point_values(c, np.full(2, near), np.array([0.0, np.pi / 2]))
             assert np.abs(at[1] - by[1]).max() <= 1e-4 and np.abs(at[0] - by[0]).max() <= 1e-4
+
+
+def test_volume_and_gas_control_at_a_sphere_hold_the_axisymmetric_readings(spom1):
+    """Past the pressure maximum (λ = 1.5) a sphere's breathing mode is unstable under pressure control and held
+    under volume and gas control. The whole-sphere readings (``stability.READINGS``, held; mirror sector, L = 10)
+    hold the three lowest eigenvalues of the axisymmetric m = 0 pencil (H, G) in the same displacement norm, built
+    here from the axisymmetric solver (its Jacobian, ∂Ṽ/∂u = −∂R/∂P, the translation removed; with gᵀδ = 0 for
+    volume control, H + (P/Ṽ) g gᵀ for gas control) on an explicit null space, to 1e-9; the breathing eigenvalue is
+    in the pressure reading only."""
+    L = 10
+    eq1, u, params = sphere(spom1, 1.5, L + 4)
+    basis = SphericalBasis(L, (MIRROR_Y,))
+    eq = SurfaceEquilibrium(spom1, basis)
+    c = axisymmetric_coefficients(basis, eq1.disc, u)
+    readings = [stability.Reading(True, control) for control in stability.Control]
+    ours = stability.sector_spectra(eq, c, params, 40, readings)
+    ops, w, s = eq1.disc.ops, eq1.disc.weights, eq1.disc.sin_theta
+    G = (ops[0].T * (w * s * s)) @ ops[0] + (ops[2].T * w) @ ops[2]
+    H = eq1.jacobian(u, params)
+    g = -eq1.parameter_derivative(u, params, "P")
+    translation = eq1.disc.join(np.zeros(L + 5), np.eye(L + 5)[0])
+    references = []
+    for normals, matrix in (([G @ translation], H), ([G @ translation, g], H),
+                            ([G @ translation], H + (params.P / eq1.volume(u)) * np.outer(g, g))):
+        N = linalg.null_space(np.array(normals))
+        references.append(linalg.eigh(N.T @ matrix @ N, N.T @ G @ N, eigvals_only=True)[:3])
+    for reading, reference in zip(readings, references):
+        for value in reference:
+            assert np.abs(ours[reading][(1,)] - value).min() <= 1e-9 * max(1.0, abs(value))
+    breathing = references[0][0]
+    assert breathing < 0.0 < min(references[1][0], references[2][0])
+    for reading in readings[1:]:
+        assert ours[reading][(1,)].min() > 0.0 and np.abs(ours[reading][(1,)] - breathing).min() > 1e-3
+
+
+@pytest.mark.slow
+def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, monkeypatch):
+    """The M = 0 check along the whole branch: from the m = 1 copy of the first pear point to its rejoin of the
+    primary branch at the second, traced with solver.max_error = 1e-11 (the whole-sphere P error is about ten times
+    the spectral tail); at every point P and λ2(π) of the axisymmetric pear branch solved at λ2(0) = λ+ at twice its
+    run's degree agree to 1e-9. The stability of the points is not computed here (``assess`` skipped). A study of
+    several minutes: ``pytest -m slow``."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis import surface_branches
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.results import Block, StopCode
+    from balloon_cg.galerkin.point_solve import constrained_newton
+
+    monkeypatch.setattr(surface_branches, "assess", lambda sb, trace: None)
+    scene = spom1.with_overrides({"continuation.stop_stretch": 4.0, "surface.branches": "none",
+                                  "solver.max_error": 1e-11})
+    picture = analyse(scene)
+    primary = picture.primary
+    bp = primary.branch_points()[0]
+    branch = surface_branches.trace_surface(primary, 0, replace(bp, m=1, block=Block.M1_HELD), 1.0, "m1", 1000)
+    assert branch.special[-1].stop.code == StopCode.REJOINED
+    pears = [b for b in picture.branches[1:] if b.parent == ("primary", 0)]
+    errors = []
+    for c, P in zip(branch.coefficients[1:], branch.values[1:]):
+        _, a = branch.basis.point_values(c, np.full(2, np.pi / 2), np.array([0.0, np.pi]))
+        plus, minus = np.linalg.norm(a, axis=0)
+        pear = min(pears, key=lambda b: np.min(np.abs(b.pole_values()["lam2_north"] - plus)
+                                                + np.abs(b.pole_values()["lam2_south"] - minus)))
+        poles = pear.pole_values()
+        nearest = int(np.argmin(np.abs(poles["lam2_north"] - plus) + np.abs(poles["lam2_south"] - minus)))
+        result, eq = constrained_newton(pear.scene, 2 * pear.disc.degree, pear.X[nearest], pear.disc, plus,
+                                        pear.params, tol=1e-13)
+        assert result.converged
+        south = eq.disc.pole_rows()["lam2_south"] @ result.x[:-1]
+        errors.append(max(abs(result.x[-1] - P) / P, abs(south - minus)))
+    assert len(errors) > 100 and max(errors) <= 1e-9, (len(errors), np.median(errors), max(errors))

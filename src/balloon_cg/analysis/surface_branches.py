@@ -43,7 +43,7 @@ from ..surface.equilibrium import SurfaceEquilibrium
 from ..surface.gauge import Gauge
 from ..surface.measures import MEASURES, measures, tail, tails
 from ..surface.system import SurfaceSystem
-from . import azimuthal
+from . import azimuthal, wires
 from .problem import continuation_settings, equilibrium_of
 from .results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
@@ -86,7 +86,7 @@ def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
 
 
 MAX_DEGREE = 128  # the finest polar degree the resolution policy raises to
-MAX_ORDER = 16  # the finest order of an anisotropic basis (a state pressed against a wire on one side needs more:
+MAX_ORDER = 48  # the finest order of an anisotropic basis (a state pressed against a wire on one side needs more:
 #                 flagged); an isotropic basis (order = degree) is capped by MAX_DEGREE
 DEGREE_STEP, ORDER_STEP = 8, 2  # the smallest increments; larger ones where the decay asks for them
 
@@ -124,6 +124,21 @@ def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> Spherical
     if (degree, order) == (basis.degree, basis.order):
         return basis
     return replace(basis, degree=degree, order=order, n_theta=0, n_phi=0)
+
+
+def remapped(basis: SphericalBasis, c: np.ndarray, coils) -> SphericalBasis:
+    """``basis`` on the wire map of the state c's own closest approaches to the wires (analysis.wires: the
+    axisymmetric solver's widths, centres mirrored on a basis that keeps z → −z or the inversion) when that map is
+    not ``close_to`` the basis' own: a state that moves toward a wire on one side needs a narrower map than the
+    branch point's. ``basis`` itself without a map or without coils."""
+    if basis.mapping is None or not len(coils):
+        return basis
+    found = wires.surface_approaches(basis.node_state(c), np.repeat(basis.nodes["cos_theta"], basis.n_phi), coils)
+    mapping = wires.centred_map(found, [wires.map_width(a) for a in found],
+                                any(S[2] < 0 for S in basis.symmetry))
+    if mapping is None or mapping.close_to(basis.mapping):
+        return basis
+    return replace(basis, mapping=mapping)
 
 
 class SurfaceTrace:
@@ -254,7 +269,10 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
             stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
             break
-        finer = refined(trace.basis, trace.system.coefficients(path.overshoot.X), scene.solver.max_error)
+        c = trace.system.coefficients(path.overshoot.X)
+        target = remapped(trace.basis, c, scene.field.coils)
+        finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target),
+                        scene.solver.max_error)
         if finer is None:
             stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
                                                                   f"order {MAX_ORDER})")
@@ -307,39 +325,46 @@ def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: 
 
 
 def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
-    """The stability readings of every point and the secondary branch points: where the number of negative held
-    eigenvalues of a sector changes between points i and i + 1 (i ≥ 1: point 0 is the parent point), the zero of
-    the crossing eigenvalue, located by Brent's method along the chord with the corrector on its hyperplane (as
-    azimuthal_points.locate); APPROXIMATE with the bracket when the search fails."""
-    readings, counts = {"held": [], "free": []}, []
+    """The stability readings of every point (held and free, under pressure, volume and gas control:
+    ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
+    of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
+    the zero of the crossing eigenvalue, located by Brent's method along the chord with the corrector on its
+    hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails."""
+    held = surface_stability.Reading(True)
+    readings = {r: [] for r in surface_stability.READINGS}
+    counts, held_spectra, spectra = [], [], None
     for c, value in zip(sb.coefficients, sb.values):
         params = sb.params.with_value(sb.parameter, value)
-        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT)
-        for key, held in (("held", True), ("free", False)):
-            readings[key].append(surface_stability.lowest_over(spectra[held], STABILITY_COUNT))
-        counts.append(_negative_counts(trace, c, params, spectra[True]))
-    sb.stability = {key: np.array(rows) for key, rows in readings.items()}
+        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
+        for r in readings:
+            readings[r].append(surface_stability.lowest_over(spectra[r], STABILITY_COUNT))
+        counts.append(_negative_counts(trace, c, params, spectra[held]))
+        held_spectra.append(spectra[held])
+    sb.stability = {r.name: np.array(rows) for r, rows in readings.items()}
     for i in range(1, len(counts) - 1):
         for key in counts[i]:
             if counts[i][key] != counts[i + 1][key]:
-                sb.special.append(_secondary(sb, trace, i, key, min(counts[i][key], counts[i + 1][key])))
+                sb.special.append(_secondary(sb, trace, i, key, min(counts[i][key], counts[i + 1][key]),
+                                             float(held_spectra[i][key][0])))
     sb.special.sort(key=lambda s: s.index)
 
 
 def _negative_counts(trace: SurfaceTrace, c, params, lowest: dict) -> dict:
     """{characters: the number of negative held eigenvalues of the sector}: from its lowest STABILITY_COUNT, or,
-    when they are all negative, from its whole spectrum."""
+    when they are all negative, from the inertia of its matrix (numerics.eigen.negative_count)."""
     counts = {}
     for key, values in lowest.items():
         counts[key] = int((values < 0).sum())
         if counts[key] == values.size:
-            A = surface_stability.restricted_sectors(trace.eq, c, params, (True,), key)[True][key]
-            counts[key] = int((np.linalg.eigvalsh(A) < 0).sum())
+            held = surface_stability.Reading(True)
+            A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), key)[held][key]
+            counts[key] = eigen.negative_count(A)
     return counts
 
 
-def _secondary(sb: SurfaceBranch, trace: SurfaceTrace, i: int, sector: tuple, k: int) -> SpecialPoint:
-    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero."""
+def _secondary(sb: SurfaceBranch, trace: SurfaceTrace, i: int, sector: tuple, k: int, lowest: float) -> SpecialPoint:
+    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero
+    (``lowest``: the sector's lowest eigenvalue at point i, which the spectra follow)."""
     system, solver = trace.system, trace.scene.solver
     X0, X1 = (system.point(sb.coefficients[j], sb.values[j]) for j in (i, i + 1))
     chord = X1 - X0
@@ -350,8 +375,9 @@ def _secondary(sb: SurfaceBranch, trace: SurfaceTrace, i: int, sector: tuple, k:
         if not result.converged:
             raise ArithmeticError(result.message)
         c, params = system.coefficients(result.x), system.params_at(result.x)
-        A = surface_stability.restricted_sectors(trace.eq, c, params, (True,), sector)[True][sector]
-        return float(eigen.lowest_of(A, k + 1)[k]), np.append(c, result.x[-1])
+        held = surface_stability.Reading(True)
+        A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), sector)[held][sector]
+        return float(eigen.lowest_following(A, k + 1, lowest)[k]), np.append(c, result.x[-1])
 
     found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
     note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"

@@ -63,6 +63,20 @@ def approaches(disc: Discretisation, u, coils, n_theta: int = 2001) -> list[Appr
     return out
 
 
+def surface_approaches(state: np.ndarray, cos_theta: np.ndarray, coils) -> list[Approach]:
+    """The closest approach of a whole-sphere state to each wire of ``coils``, over its nodes: ``state`` the node
+    rows (x, a_θ, a_φ; surface.basis), ``cos_theta`` the material cos θ of each node; |dx/ds| = sin θ/|a_θ|
+    there (|a_θ| the meridional stretch)."""
+    x, a_theta = state[:3], state[3:6]
+    rho = np.hypot(x[0], x[1])
+    out = []
+    for c in coils:
+        j = int(np.argmin(np.hypot(rho - c.radius, x[2] - c.height)))
+        out.append(Approach(float(cos_theta[j]), float(np.hypot(rho[j] - c.radius, x[2, j] - c.height)),
+                            float(np.sqrt(1.0 - cos_theta[j] ** 2) / np.linalg.norm(a_theta[:, j]))))
+    return out
+
+
 def map_width(approach: Approach) -> float | None:
     """The map width ε_j (x units) for one closest approach, None if the wire gets no map centre."""
     if approach.gap >= MAP_GAP:

@@ -41,7 +41,8 @@ Layout::
         centroid                                           (point, axis)
         coefficients                                       (point, coefficient)
         special_points/ as above, unknowns (special, unknown): the coefficients c, then P (or Φ̄)
-        stability/lowest_held, lowest_free (point, eigenvalue); stable_pressure, stable_pressure_free (point,)
+        stability/lowest_<reading> (point, eigenvalue) for the readings held, free, held_volume, free_volume,
+                           held_gas, free_gas; stable_pressure, stable_pressure_free, stable_volume, … (point,)
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
 
 Every dataset carries ``units``, ``long_name`` and ``description`` (``io.schema``), and its axes are netCDF-4
@@ -302,10 +303,12 @@ def _write_surface_branch(group, branch) -> None:
 
 
 def _write_surface_stability(group, lowest: dict, point) -> None:
-    """lowest_held, lowest_free (every symmetry sector, zero modes removed: surface.stability) and the flags of
-    pressure control they give, held and free."""
+    """lowest_<reading> (held, free, held_volume, free_volume, held_gas, free_gas: every symmetry sector, zero
+    modes removed: surface.stability) and the flags they give."""
     columns = {f"lowest_{reading}": np.asarray(values, dtype=float) for reading, values in lowest.items()}
-    for name, reading in (("stable_pressure", "held"), ("stable_pressure_free", "free")):
+    for name, reading in (("stable_pressure", "held"), ("stable_pressure_free", "free"),
+                          ("stable_volume", "held_volume"), ("stable_volume_free", "free_volume"),
+                          ("stable_gas", "held_gas"), ("stable_gas_free", "free_gas")):
         if reading in lowest:
             group.create_dataset(name, data=np.asarray(lowest[reading])[:, 0] > 0)
             group[name].attrs["meaning"] = STABILITY_FLAGS[name]

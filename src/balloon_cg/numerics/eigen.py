@@ -8,12 +8,18 @@ null-space basis. The spectrum of the result is that of the Rayleigh quotient c�
 The reduction L⁻¹ H L⁻ᵀ is BLAS or LAPACK (``LARGE_BLOCK``), the gathering and the reflections plain jitted loops
 (quick to compile);
 the eigenvalues come from LAPACK's dsyevr for the lowest ``count`` only (tridiagonalisation and bisection).
+
+Large matrices along a branch (``lowest_following``): Lanczos (ARPACK) on (A − σI)⁻¹ with σ below the spectrum,
+proved so by a Cholesky factorisation of A − σI (n³/3 flops against dsyevr's 4n³/3 for the tridiagonal form): the
+eigenvalues of the inverse closest to its top are the lowest of A. The inertia of an indefinite matrix
+(``negative_count``) is the Bunch–Kaufman LDLᵀ's (Sylvester's law), again a factorisation, no eigensolve.
 """
 import math
 
 import numpy as np
 from numba import njit
-from scipy.linalg.lapack import dpotrf, dsyevr, dsygst
+from scipy.linalg.lapack import dpotrf, dpotrs, dsyevr, dsygst, dsytrf
+from scipy.sparse.linalg import LinearOperator, eigsh
 
 RCOND = 1e-9  # constraint directions below RCOND times the largest are dependent ones (dropped)
 NO_CONSTRAINT = np.zeros((0, 1))
@@ -79,6 +85,65 @@ def lowest_of(A, count: int) -> np.ndarray:
     if info != 0:
         raise np.linalg.LinAlgError(f"dsyevr failed (info = {info})")
     return values[:found]
+
+
+FOLLOWING_SIZE = 600  # from this size on ``lowest_following`` factors and iterates; below it dsyevr is as quick
+SHIFT_TRIES = 4  # shifts tried (each 4× farther below the guess) before the dense eigensolve
+
+
+def lowest_following(A, count: int, guess: float | None) -> np.ndarray:
+    """The ``count`` lowest eigenvalues (ascending) of the symmetric A (lower triangle read; kept), where ``guess``
+    estimates the lowest (the previous point's along a branch; None: unknown): σ = guess − δ, δ = max(|guess|,
+    1e-2), tried as a lower bound by Cholesky of A − σI (δ × 4 per failure, SHIFT_TRIES times); then the largest
+    eigenvalues ν = 1/(μ − σ) of (A − σI)⁻¹ by ARPACK to machine precision (module docstring). Falls back to
+    ``lowest_of`` (dsyevr) below FOLLOWING_SIZE, without a guess, or when no shift is a lower bound."""
+    n = A.shape[0]
+    if guess is None or n < FOLLOWING_SIZE or count >= n - 1:
+        return lowest_of(np.array(A), count)
+    delta = max(abs(guess), 1e-2)
+    for _ in range(SHIFT_TRIES):
+        sigma = guess - delta
+        shifted = np.array(A, order="F")
+        shifted[np.diag_indices(n)] -= sigma
+        factor, info = dpotrf(shifted, lower=1, clean=0, overwrite_a=1)
+        if info == 0:
+            break
+        delta *= 4.0
+    else:
+        return lowest_of(np.array(A), count)
+
+    def solve(v):
+        return dpotrs(factor, np.asarray(v, dtype=float).ravel(), lower=1)[0]
+
+    nu = eigsh(LinearOperator((n, n), matvec=solve, dtype=float), k=count, which="LA", tol=0.0,
+               return_eigenvectors=False)
+    return np.sort(sigma + 1.0 / nu)
+
+
+def negative_count(A) -> int:
+    """The number of negative eigenvalues of the symmetric A (lower triangle read; kept): the inertia of its
+    Bunch–Kaufman factorisation P A Pᵀ = L D Lᵀ (LAPACK dsytrf), D of 1×1 and 2×2 blocks."""
+    ldu, pivots, info = dsytrf(np.array(A, order="F"), lower=1)
+    if info < 0:
+        raise np.linalg.LinAlgError(f"dsytrf failed (info = {info})")
+    return _block_negatives(np.ascontiguousarray(np.diag(ldu)), np.ascontiguousarray(np.diag(ldu, -1)), pivots)
+
+
+@njit(cache=True)
+def _block_negatives(diagonal, sub, pivots):
+    """Negative eigenvalues of D: a 1×1 block where pivots[k] > 0, a 2×2 block [d_k, s_k; s_k, d_k+1] where
+    pivots[k] = pivots[k + 1] < 0 (lower storage)."""
+    count, k, n = 0, 0, diagonal.size
+    while k < n:
+        if pivots[k] > 0 or k == n - 1:
+            count += diagonal[k] < 0.0
+            k += 1
+        else:
+            det = diagonal[k] * diagonal[k + 1] - sub[k] * sub[k]
+            trace = diagonal[k] + diagonal[k + 1]
+            count += 1 if det < 0.0 else (2 if trace < 0.0 and det > 0.0 else 0)
+            k += 2
+    return count
 
 
 def positive_definite(A) -> bool:

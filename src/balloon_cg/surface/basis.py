@@ -33,7 +33,7 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 from numpy.polynomial import legendre as gauss
-from scipy import linalg
+from scipy.linalg import lapack
 
 from ..galerkin.discretisation import read_only
 from ..galerkin.legendre import legendre_values, theta_derivative
@@ -43,6 +43,7 @@ MIRROR_Y = (1, -1, 1)  # the plane y = 0 through the axis (MODEL.md §8: x, z ke
 EQUATOR = (1, 1, -1)  # the equatorial plane z = 0
 INVERSION = (-1, -1, -1)  # the centre: x(−X) = −x(X)
 STATE_ROWS = 9  # x (3), a_θ (3), a_φ (3): row 3 d + c for derivative d and component c
+SHARED_TABLE = 4096  # up to this many points the Legendre tables of an order are cached (the blocks share them)
 POLE_ZONE = 1e-10  # sin²θ below which a mapped basis' dθ_s/dθ takes its pole limit (relative error ~ POLE_ZONE)
 
 
@@ -198,8 +199,10 @@ class SphericalBasis:
     def _polar(self, mapped: np.ndarray, x: np.ndarray, block: Block) -> tuple:
         """(P̄_l^m(s), dP̄_l^m/dθ) of the block's degrees at s = h(x) (s = x unmapped), valid at the poles."""
         k = list(block.degrees)
-        p = legendre_values(mapped, self.degree, block.m)[:, k]
-        dp = theta_derivative(mapped, self.degree, block.m)[:, k]
+        points = np.ascontiguousarray(mapped, dtype=float)
+        p, dp = (_legendre_pair(points.tobytes(), self.degree, block.m) if points.size <= SHARED_TABLE else
+                 (legendre_values(points, self.degree, block.m), theta_derivative(points, self.degree, block.m)))
+        p, dp = p[:, k], dp[:, k]
         if self.mapping is not None:  # dθ_s/dθ = h'(x) sin θ / sin θ_s, → √h'(±1) at the poles
             # the limit within POLE_ZONE of a pole, where h(±1) = ±1 may be off by an ulp (0/ε otherwise)
             at_pole = np.minimum(1.0 - x * x, 1.0 - mapped * mapped) < POLE_ZONE
@@ -213,7 +216,10 @@ class SphericalBasis:
         if self.mapping is None:
             return np.eye(p.shape[1])
         gram = (p.T * (self.nodes["weights"] * self.n_phi)) @ p
-        return linalg.solve_triangular(np.linalg.cholesky(gram), np.eye(p.shape[1]), lower=True).T
+        inverse, info = lapack.dtrtri(np.linalg.cholesky(gram), lower=1)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"the Gram matrix of a mapped block is singular (dtrtri info = {info})")
+        return inverse.T
 
     @cached_property
     def _products(self) -> dict:
@@ -339,6 +345,19 @@ class SphericalBasis:
             a_theta[b.component] += trig * (dp @ coefficients)
         return x, a_theta
 
+    def grid_values(self, c: np.ndarray, cos_theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """x = X + u on the grid of rings cos θ_j × angles φ_k, shape (3, n_rings, n_φ): each block's θ-series once
+        per ring (``point_values`` evaluates it per point)."""
+        x = np.asarray(cos_theta, dtype=float)
+        s = np.sqrt(np.clip(1.0 - x * x, 0.0, None))
+        mapped = x if self.mapping is None else self.mapping.s(x)
+        out = np.array([np.outer(s, np.cos(phi)), np.outer(s, np.sin(phi)), np.outer(x, np.ones_like(phi))])
+        for b, transform in zip(self.blocks, self.tables["transforms"]):
+            p, _ = self._polar(mapped, x, b)
+            trig = _norm(b.m) * (np.cos(b.m * phi) if b.t == COS else np.sin(b.m * phi))
+            out[b.component] += np.outer(p @ (transform @ c[b.slice]), trig)
+        return out
+
     def gram(self) -> float:
         """The displacement norm (1/2π)∫∫|δu|² dA in these coefficients: c·c/(2π) (the basis is orthonormal)."""
         return 1.0 / (2.0 * np.pi)
@@ -350,6 +369,14 @@ def _sectors(basis: SphericalBasis) -> list:
         return [basis]
     signs = np.array(np.meshgrid(*[(1, -1)] * len(basis.symmetry), indexing="ij")).reshape(len(basis.symmetry), -1)
     return [replace(basis, characters=tuple(int(s) for s in column)) for column in signs.T]
+
+
+@functools.lru_cache(maxsize=256)
+def _legendre_pair(points: bytes, degree: int, m: int) -> tuple:
+    """(P̄_l^m, dP̄_l^m/dθ), l ≤ degree, at the points (a float64 array's bytes): the blocks of one order (three
+    components, two φ-types, every symmetry sector) share them."""
+    x = np.frombuffer(points)
+    return read_only(legendre_values(x, degree, m)), read_only(theta_derivative(x, degree, m))
 
 
 def _norm(m: int) -> float:

@@ -44,6 +44,5 @@ def transfer(source: SphericalBasis, c: np.ndarray, target: SphericalBasis) -> n
     """The state c of ``source`` on ``target`` (a finer degree or order, or another map): its displacement at the
     target's nodes, projected (exact when the target's space holds the source's, up to the quadrature of
     non-polynomial mapped functions)."""
-    theta, phi = node_angles(target)
-    x, _ = source.point_values(c, theta, phi)
+    x = source.grid_values(c, target.nodes["cos_theta"], target.nodes["phi"]).reshape(3, -1)
     return displacement_coefficients(target, x - target.nodes["reference"][:3])

@@ -80,12 +80,14 @@ class SurfaceEquilibrium:
         symmetry sector: the second variation against perturbations of that space)."""
         return (basis or self.basis).hessian(self._nodes("surface_hessian", c, params), self._pairs)
 
-    def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str) -> np.ndarray:
-        """∂R/∂name for a continuation parameter (P; M with a field; the voltage of a dielectric class)."""
+    def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str,
+                             basis: SphericalBasis | None = None) -> np.ndarray:
+        """∂R/∂name for a continuation parameter (P; M with a field; the voltage of a dielectric class), in
+        ``basis`` (default the state's own; another on the same nodes, as for ``hessian``)."""
         kernel = DERIVATIVE_KERNELS.get(name)
         if kernel is None or kernel not in self.kernels.module.KERNELS:
             raise ValueError(f"no generated derivative of the surface residual in {name!r} for this scene class")
-        return self.basis.project(self._nodes(kernel, c, params))
+        return (basis or self.basis).project(self._nodes(kernel, c, params))
 
 
 def _oriented(state: np.ndarray, reference: np.ndarray) -> bool:

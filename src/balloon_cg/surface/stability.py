@@ -1,7 +1,13 @@
-"""Stability of a whole-sphere state under pressure control: the lowest eigenvalues μ of the second variation,
-H c = μ G c with G the displacement norm (1/2π)∫∫|δu|² dA (analysis/azimuthal.py uses the same, so the spectra
-compare), on the G-orthogonal complement of the state's exact zero modes, in each symmetry sector of the state's
-basis (SphericalBasis.sectors: together the whole space).
+"""Stability of a whole-sphere state: the lowest eigenvalues μ of the second variation, H c = μ G c with G the
+displacement norm (1/2π)∫∫|δu|² dA (analysis/azimuthal.py uses the same, so the spectra compare), on the
+G-orthogonal complement of the state's exact zero modes, in each symmetry sector of the state's basis
+(SphericalBasis.sectors: together the whole space), for a balloon held at its centre or free, under each control
+(a ``Reading``), as analysis/stability.py for axisymmetric modes:
+- pressure control: H;
+- volume control: H on the perturbations that keep the volume, gᵀc = 0, g = ∂Ṽ/∂c = −∂²E/∂P∂c (Ṽ = V/2π);
+- gas control (isothermal ideal gas, P V fixed): H + (P/Ṽ) g gᵀ.
+The volume is invariant under the state's reflections, so g lies in its own sector (every character +1): the
+other sectors read the same under every control.
 
 Zero modes removed (MODEL.md §8), at the state x:
 - relabellings, δx = (w·e_θ) a_θ + (w·e_φ) a_φ for w = e_k × X: always (every axis);
@@ -11,12 +17,39 @@ Zero modes removed (MODEL.md §8), at the state x:
 A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
 fine (numerics.eigen.restricted drops them).
 """
+from enum import Enum
+from typing import NamedTuple
+
 import numpy as np
 
 from .basis import COS, MIRROR_Y, SIN, SphericalBasis
 from .equilibrium import SurfaceEquilibrium
+from .measures import body_moments
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
+
+
+class Control(Enum):
+    PRESSURE = "pressure"
+    VOLUME = "volume"
+    GAS = "gas"
+
+
+class Reading(NamedTuple):
+    """A balloon held at its centre or free, under a control."""
+
+    held: bool
+    control: Control = Control.PRESSURE
+
+    @property
+    def name(self) -> str:
+        """'held', 'free', 'held_volume', … (the keys of SurfaceBranch.stability)."""
+        base = "held" if self.held else "free"
+        return base if self.control == Control.PRESSURE else f"{base}_{self.control.value}"
+
+
+PRESSURE_READINGS = (Reading(True), Reading(False))
+READINGS = tuple(Reading(held, control) for control in Control for held in (True, False))
 
 
 def in_field(eq: SurfaceEquilibrium, params: Parameters) -> bool:
@@ -51,44 +84,65 @@ def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
     return np.array(out).reshape(-1, basis.size)
 
 
-def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=(True, False),
-                       only: tuple | None = None) -> dict:
-    """{held: {characters: the standard symmetric matrix of the sector's pencil with the zero modes removed}} for
-    each reading (held: True, free: False) from one assembly per sector (numerics.eigen.restricted; its eigenvalues
-    are the μ, its inertia the sector's); ``only``: the characters of the one sector wanted."""
+def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=PRESSURE_READINGS,
+                    only: tuple | None = None):
+    """Yields (characters, the readings, A) one matrix at a time: A the standard symmetric matrix of the sector's
+    pencil under those readings (module docstring), the zero modes removed (numerics.eigen.restricted: its
+    eigenvalues are the μ, its inertia the sector's), one assembly per sector and one matrix for the readings that
+    share it (a sector without a translation reads the same held and free; one without g the same under every
+    control); ``only``: the characters of the one sector wanted."""
     state = eq.node_values(c)["state"]
-    sectors = [sector for sector in eq.basis.sectors() if sector.size and only in (None, sector.characters)]
-    hessians = [eq.hessian(c, params, sector) for sector in sectors]
-    made = {}  # (sector, constraint rows) -> matrix: the readings share a sector without a translation
-    out = {}
-    for held in readings:
-        fields = zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
-        out[held] = {}
-        for k, (sector, H) in enumerate(zip(sectors, hessians)):
-            rows = mode_rows(sector, fields)
-            key = (k, rows.tobytes())
-            if key not in made:
-                made[key] = _restricted(H, sector.gram(), rows)
-            out[held][sector.characters] = made[key]
+    fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
+              for held in {r.held for r in readings}}
+    controlled = any(r.control != Control.PRESSURE for r in readings)
+    volume = body_moments(eq.basis, state)[0] if controlled else None
+    for sector in eq.basis.sectors():
+        if not sector.size or only not in (None, sector.characters):
+            continue
+        H = eq.hessian(c, params, sector)
+        g = -eq.parameter_derivative(c, params, "P", sector) if controlled and _own(sector, eq.basis) else None
+        groups = {}
+        for r in readings:
+            rows = mode_rows(sector, fields[r.held])
+            groups.setdefault((rows.tobytes(), r.control if g is not None else Control.PRESSURE), (rows, []))[1].append(r)
+        for (_, control), (rows, shared) in groups.items():
+            if control == Control.VOLUME:
+                A = _restricted(H, sector.gram(), rows, g)
+            elif control == Control.GAS:
+                A = _restricted(H + (params.P / volume) * np.outer(g, g), sector.gram(), rows)
+            else:
+                A = _restricted(H, sector.gram(), rows)
+            yield sector.characters, tuple(shared), A
+
+
+def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=PRESSURE_READINGS,
+                       only: tuple | None = None) -> dict:
+    """{reading: {characters: matrix}} of ``sector_matrices``, all at once."""
+    out = {r: {} for r in readings}
+    for key, shared, A in sector_matrices(eq, c, params, readings, only):
+        for r in shared:
+            out[r][key] = A
     return out
 
 
 def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
-                   readings=(True, False)) -> dict:
-    """{held: {characters: the ``count`` lowest μ of the sector}}; a matrix both readings share is solved once."""
-    lowest, out = {}, {}
-    for held, sectors in restricted_sectors(eq, c, params, readings).items():
-        for A in sectors.values():
-            if id(A) not in lowest:
-                lowest[id(A)] = eigen.lowest_of(A.copy(), count)
-        out[held] = {key: lowest[id(A)] for key, A in sectors.items()}
+                   readings=PRESSURE_READINGS, guesses: dict | None = None) -> dict:
+    """{reading: {characters: the ``count`` lowest μ of the sector}}, each matrix solved as it is made (one at a
+    time in memory). ``guesses`` (the same layout, the previous point's along a branch) let a large sector follow
+    its lowest eigenvalue (numerics.eigen.lowest_following) instead of a dense eigensolve."""
+    out = {r: {} for r in readings}
+    for key, shared, A in sector_matrices(eq, c, params, readings):
+        previous = (guesses or {}).get(shared[0], {}).get(key)
+        values = eigen.lowest_following(A, count, None if previous is None else float(previous[0]))
+        for r in shared:
+            out[r][key] = values
     return out
 
 
 def spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
-            readings=(True, False)) -> dict:
-    """{held: the ``count`` lowest μ over every sector, ascending} (module docstring)."""
-    return {held: lowest_over(sectors, count) for held, sectors in sector_spectra(eq, c, params, count, readings).items()}
+            readings=PRESSURE_READINGS) -> dict:
+    """{reading: the ``count`` lowest μ over every sector, ascending} (module docstring)."""
+    return {r: lowest_over(sectors, count) for r, sectors in sector_spectra(eq, c, params, count, readings).items()}
 
 
 def lowest_over(sectors: dict, count: int) -> np.ndarray:
@@ -96,12 +150,20 @@ def lowest_over(sectors: dict, count: int) -> np.ndarray:
     return np.sort(np.concatenate(list(sectors.values())))[:count]
 
 
-def _restricted(H: np.ndarray, gram: float, rows: np.ndarray) -> np.ndarray:
-    """The standard matrix of (H, gram·I) on the G-orthogonal complement of the coefficient vectors ``rows``
-    (numerics.eigen.restricted; the basis is orthonormal, so G = gram·I)."""
+def _restricted(H: np.ndarray, gram: float, rows: np.ndarray, normal: np.ndarray | None = None) -> np.ndarray:
+    """The standard matrix of (H, gram·I) on the G-orthogonal complement of the coefficient vectors ``rows`` and,
+    given, on normalᵀc = 0 (numerics.eigen.restricted; the basis is orthonormal, so G = gram·I)."""
     diagonal = np.full(H.shape[0], gram)
     factor = eigen.GramFactor(np.diag(diagonal), orthogonal=True)
-    return eigen.restricted(H, factor, rows * diagonal if rows.size else eigen.NO_CONSTRAINT)
+    normals = [rows * diagonal] if rows.size else []
+    if normal is not None:
+        normals.append(normal[None, :])
+    return eigen.restricted(H, factor, np.vstack(normals) if normals else eigen.NO_CONSTRAINT)
+
+
+def _own(sector: SphericalBasis, basis: SphericalBasis) -> bool:
+    """Whether ``sector`` is the state's own (its characters those of the state's basis)."""
+    return sector.characters == basis.characters
 
 
 def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
