@@ -355,7 +355,7 @@ def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, 
     from balloon_cg.analysis.results import Block, StopCode
     from balloon_cg.galerkin.point_solve import constrained_newton
 
-    monkeypatch.setattr(surface_branches, "assess", lambda sb, trace: None)
+    monkeypatch.setattr(surface_branches, "assess", lambda sb, traced: None)
     scene = spom1.with_overrides({"continuation.stop_stretch": 4.0, "surface.branches": "none",
                                   "solver.max_error": 1e-11})
     picture = analyse(scene)

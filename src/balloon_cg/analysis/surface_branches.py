@@ -296,8 +296,8 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
 
 def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: int, bp: SpecialPoint, name: str,
             t0) -> SurfaceBranch:
-    """The SurfaceBranch of the traced segments, every point on the final basis: measures, stability, folds, end
-    point."""
+    """The SurfaceBranch of the traced segments, every point on the final basis: measures, folds, end point; the
+    stability of each point read on the basis it was traced on (``assess``)."""
     basis = trace.basis
     coefficients = np.array([transfer(t.basis, t.system.coefficients(p.X), basis) if t is not trace
                              else t.system.coefficients(p.X) for t, points in segments for p in points])
@@ -319,21 +319,23 @@ def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: 
         error_estimate=np.array([tail(basis, c) for c in coefficients]),
         measures={key: np.array([m[key] for m in per_point]) for key in MEASURES}, m=bp.m,
         parent=(parent.name, number), legs=(Leg("forward", stop),), special=special)
-    assess(out, trace)
+    assess(out, [(t, t.system.coefficients(p.X)) for t, points in segments for p in points])
     out.wall_time = time.perf_counter() - t0
     return out
 
 
-def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
+def assess(sb: SurfaceBranch, traced: list) -> None:
     """The stability readings of every point (held and free, under pressure, volume and gas control:
     ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
     of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
     the zero of the crossing eigenvalue, located by Brent's method along the chord with the corrector on its
-    hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails."""
+    hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails. ``traced``: per
+    point, (the SurfaceTrace it was traced on, its coefficients there): a point is read on its own basis (resolved
+    there; the final basis of a branch that refined is several times larger than its first points need)."""
     held = surface_stability.Reading(True)
     readings = {r: [] for r in surface_stability.READINGS}
     counts, held_spectra, spectra = [], [], None
-    for c, value in zip(sb.coefficients, sb.values):
+    for (trace, c), value in zip(traced, sb.values):
         params = sb.params.with_value(sb.parameter, value)
         spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
         for r in readings:
@@ -344,7 +346,7 @@ def assess(sb: SurfaceBranch, trace: SurfaceTrace) -> None:
     for i in range(1, len(counts) - 1):
         for key in counts[i]:
             if counts[i][key] != counts[i + 1][key]:
-                sb.special.append(_secondary(sb, trace, i, key, min(counts[i][key], counts[i + 1][key]),
+                sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
                                              float(held_spectra[i][key][0])))
     sb.special.sort(key=lambda s: s.index)
 
@@ -362,22 +364,26 @@ def _negative_counts(trace: SurfaceTrace, c, params, lowest: dict) -> dict:
     return counts
 
 
-def _secondary(sb: SurfaceBranch, trace: SurfaceTrace, i: int, sector: tuple, k: int, lowest: float) -> SpecialPoint:
-    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero
-    (``lowest``: the sector's lowest eigenvalue at point i, which the spectra follow)."""
+def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, lowest: float) -> SpecialPoint:
+    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero, searched
+    on the basis of point i + 1 (``lowest``: the sector's lowest eigenvalue at point i, which the spectra follow)."""
+    (before, c0), (trace, c1) = traced[i], traced[i + 1]
+    if before is not trace:
+        c0 = transfer(before.basis, c0, trace.basis)
     system, solver = trace.system, trace.scene.solver
-    X0, X1 = (system.point(sb.coefficients[j], sb.values[j]) for j in (i, i + 1))
+    X0, X1 = system.point(c0, sb.values[i]), system.point(c1, sb.values[i + 1])
     chord = X1 - X0
     d = chord / np.linalg.norm(chord)
+    held = surface_stability.Reading(True)
 
     def value_at(s):
         result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
         if not result.converged:
             raise ArithmeticError(result.message)
         c, params = system.coefficients(result.x), system.params_at(result.x)
-        held = surface_stability.Reading(True)
         A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), sector)[held][sector]
-        return float(eigen.lowest_following(A, k + 1, lowest)[k]), np.append(c, result.x[-1])
+        final = c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis)
+        return float(eigen.lowest_following(A, k + 1, lowest)[k]), np.append(final, result.x[-1])
 
     found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
     note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"

@@ -15,6 +15,7 @@ eigenvalues of the inverse closest to its top are the lowest of A. The inertia o
 (``negative_count``) is the Bunch–Kaufman LDLᵀ's (Sylvester's law), again a factorisation, no eigensolve.
 """
 import math
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -36,17 +37,23 @@ class GramFactor:
     """G = L Lᵀ of a Gram matrix (or block) that serves many pencils: L (column order, for dsygst) and L⁻¹.
 
     ``orthogonal``: the basis is orthogonal, G diagonal in exact arithmetic (its off-diagonal entries are
-    quadrature rounding): L = diag(√G_ii), and L⁻¹ H L⁻ᵀ is the scaling H_ij/√(G_ii G_jj) (``scale`` = 1/√G_ii;
-    None for a general G)."""
+    quadrature rounding; G may be given as its diagonal): L = diag(√G_ii), and L⁻¹ H L⁻ᵀ is the scaling
+    H_ij/√(G_ii G_jj) (``scale`` = 1/√G_ii; None for a general G). L and L⁻¹ are made when asked for."""
 
     def __init__(self, G, orthogonal: bool = False):
+        G = np.asarray(G, dtype=float)
         if orthogonal:
-            root = np.sqrt(np.diag(G))
-            lower, self.scale = np.diag(root), 1.0 / root
+            self.scale, self._lower = 1.0 / np.sqrt(G if G.ndim == 1 else np.diag(G)), None
         else:
-            lower, self.scale = np.linalg.cholesky(G), None
-        self.lower = np.asfortranarray(lower)
-        self.inverse = np.diag(self.scale) if orthogonal else np.linalg.inv(lower)
+            self.scale, self._lower = None, np.asfortranarray(np.linalg.cholesky(G))
+
+    @cached_property
+    def lower(self) -> np.ndarray:
+        return self._lower if self.scale is None else np.asfortranarray(np.diag(1.0 / self.scale))
+
+    @cached_property
+    def inverse(self) -> np.ndarray:
+        return np.diag(self.scale) if self.scale is not None else np.linalg.inv(self._lower)
 
     def directions(self, normals) -> np.ndarray:
         """The rows L⁻¹nᵢ of the constraint rows nᵢ (k × n), C-ordered whatever the normals' layout (the jitted
@@ -88,6 +95,7 @@ def lowest_of(A, count: int) -> np.ndarray:
 
 
 FOLLOWING_SIZE = 600  # from this size on ``lowest_following`` factors and iterates; below it dsyevr is as quick
+LANCZOS_VECTORS = 20  # ARPACK's Lanczos basis (fewer restarts than its default 2k + 1)
 SHIFT_TRIES = 4  # shifts tried (each 4× farther below the guess) before the dense eigensolve
 
 
@@ -116,7 +124,7 @@ def lowest_following(A, count: int, guess: float | None) -> np.ndarray:
         return dpotrs(factor, np.asarray(v, dtype=float).ravel(), lower=1)[0]
 
     nu = eigsh(LinearOperator((n, n), matvec=solve, dtype=float), k=count, which="LA", tol=0.0,
-               return_eigenvectors=False)
+               ncv=min(n - 1, max(2 * count + 1, LANCZOS_VECTORS)), return_eigenvectors=False)
     return np.sort(sigma + 1.0 / nu)
 
 

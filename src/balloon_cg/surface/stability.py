@@ -154,7 +154,7 @@ def _restricted(H: np.ndarray, gram: float, rows: np.ndarray, normal: np.ndarray
     """The standard matrix of (H, gram·I) on the G-orthogonal complement of the coefficient vectors ``rows`` and,
     given, on normalᵀc = 0 (numerics.eigen.restricted; the basis is orthonormal, so G = gram·I)."""
     diagonal = np.full(H.shape[0], gram)
-    factor = eigen.GramFactor(np.diag(diagonal), orthogonal=True)
+    factor = eigen.GramFactor(diagonal, orthogonal=True)
     normals = [rows * diagonal] if rows.size else []
     if normal is not None:
         normals.append(normal[None, :])
