@@ -268,16 +268,19 @@ def test_m1_eigenvalue_and_crossing_with_a_field(two_coil_picture):
 
 
 def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
-    """`balloon-cg run` on the shipped two-coil scene stores the branch born at the first m = 1 point (a few points
-    here) and its image; `inspect --json` lists every branch with its m, the surface branches with their parent and
-    pressures; [surface] branches = "none" and --primary-only leave them out."""
+    """`balloon-cg run` on the shipped two-coil scene stores the branch born at the first m = 1 point and its image:
+    the branch reaches its stop (the membrane within wire_gap of the wires on one side, 14 points), every point
+    resolved (tail ≤ solver.max_error) and an equilibrium (point 0, the branch point, solved in the axisymmetric
+    family: residual ≤ 1e-10), the parent point classified, its secondary branch point located, every point read
+    held and free under pressure, volume and gas control; `inspect --json` lists every branch with its m, the surface
+    branches with their parent and pressures; [surface] branches = "none" leaves them out."""
     import json
 
     from balloon_cg.app.cli import main
 
     scene = ROOT / "scenes" / "spom1_two_coils_M0.002.toml"
     out = tmp_path / "run.h5"
-    assert main(["run", str(scene), "-o", str(out), "--quiet", "--set", "surface.max_points=3"]) == 0
+    assert main(["run", str(scene), "-o", str(out), "--quiet"]) == 0
     capsys.readouterr()
     assert main(["inspect", str(out), "--json"]) == 0
     branches = json.loads(capsys.readouterr().out)["branches"]
@@ -285,13 +288,40 @@ def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
     assert set(surface) == {"m1_bp1", "m1_bp1_rotated"}
     assert all(b["m"] == 0 for name, b in branches.items() if name not in surface)
     first = surface["m1_bp1"]
-    assert first["m"] == 1 and first["parent"][0] == "primary" and len(first["pressures"]) == 3
+    assert first["m"] == 1 and first["parent"][0] == "primary" and len(first["pressures"]) == first["points"] > 10
+    assert first["stop_codes"] == {"forward": "wire_gap"}
+    assert first["max_error_estimate"] <= load_scene(scene).solver.max_error and first["max_residual"] <= 1e-10
+    origin, *inner, end = first["special_points"]
+    assert origin["classification"] == "pitchfork-super" and end["kind"] == "EP"
+    assert [s["status"] for s in inner if s["kind"] == "BP"] == ["located"]
+    assert set(first["stable_points"]) == {f"stable_{control}{reading}" for control in ("pressure", "volume", "gas")
+                                           for reading in ("", "_free")}
     none = tmp_path / "none.h5"
     assert main(["run", str(scene), "-o", str(none), "--quiet", "--set", "surface.branches=none",
                  "--set", "continuation.stop_stretch=1.7"]) == 0
     capsys.readouterr()
     assert main(["inspect", str(none), "--json"]) == 0
     assert all(b["m"] == 0 for b in json.loads(capsys.readouterr().out)["branches"].values())
+
+
+@pytest.mark.slow
+def test_the_one_coil_m1_branch_reaches_the_wire_past_a_located_fold(tmp_path):
+    """One coil of radius 2 in the equatorial plane, M = 0.001: the branch born at the first m = 1 point starts
+    there (point 0 solved), turns at a located fold in P and reaches the wire gap; every point resolved, with
+    stability (about a minute: ``pytest -m slow``)."""
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.results import Kind, Status, StopCode
+    from balloon_cg.analysis.surface_branches import trace_surface
+
+    text = (ROOT / "scenes" / "spom1_single_coil.toml").read_text()
+    scene = parse_scene(text.replace("radius = 4.0", "radius = 2.0").replace("M = 0.002", "M = 0.001"))
+    primary = analyse(scene, pear=False).primary
+    bp = next(s for s in primary.branch_points() if s.m == 1 and s.block.held)
+    branch = trace_surface(primary, 0, bp, 1.0, "m1", scene.surface.max_points)
+    assert branch.special[-1].stop.code == StopCode.WIRE_GAP
+    assert [s.status for s in branch.special if s.kind == Kind.LP] == [Status.LOCATED]
+    assert branch.error_estimate.max() <= scene.solver.max_error and branch.residual.max() <= 1e-10
+    assert set(branch.stability) == {"held", "free", "held_volume", "free_volume", "held_gas", "free_gas"}
 
 
 def test_a_mapped_basis_reads_its_poles_as_the_limit():

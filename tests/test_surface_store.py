@@ -191,9 +191,12 @@ def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
         labels = [t.get_text() for t in axes[0].get_legend().get_texts()]
         assert len(labels) == 1 and labels[0].startswith("m = 1 (parent BP 0): pitchfork-sub m=1 at P = ")
     elif kind == "surface":
-        assert axes[0].name == "3d"
+        assert axes[0].name == "3d" and len(axes) == 2  # the surface and its section by y = 0
         assert any(isinstance(c, Poly3DCollection) for c in axes[0].collections)
-        assert "#1" in axes[0].get_title()  # the first point past the start
+        assert "#1" in fig.get_suptitle()  # the first point past the start
+        sections = [line for line in axes[1].lines if len(line.get_xdata()) > 1]  # point 0 and #1, round
+        assert len(sections) == 2 and all(np.allclose(np.hypot(line.get_xdata(), line.get_ydata()), 1.2)
+                                          for line in sections[1:])
     elif kind == "stretch-map":
         meshes = [c for ax in axes[:2] for c in ax.collections if isinstance(c, QuadMesh)]  # then colour bars
         assert len(meshes) == 2 and len(axes) == 4

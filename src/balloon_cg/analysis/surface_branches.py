@@ -8,17 +8,18 @@ z → −z (a mode even in z) or the inversion x → −x (a mode odd in z, whic
 −itself); it is solved in that invariant subspace of degree L (``surface.degree``), with the balloon's centre
 held and the relabelling modes removed (``surface.gauge``).
 
-Switching: from (c*, P*) (the BP state embedded) the predictor c* + δφ (φ the embedded mode, unit) is corrected on
-the hyperplane normal to φ, then the branch is followed by pseudo-arclength continuation until it rejoins the
-axisymmetric branch (the amplitude φ·(c − c*) changes sign), a pole stretch reaches stop_stretch, the membrane
-comes within wire_gap of a coil, or max_points; a point whose spectral tail exceeds solver.max_error refines the
-basis (``refined``: up to MAX_DEGREE, MAX_ORDER; past them the branch stops, flagged). The sign −φ is the image
-of the +φ branch under the rotation by π about the axis (``rotated``). Folds in P are located (LP).
+Point 0 is the BP state solved on the whole sphere at P* within its axisymmetric family (``axisymmetric_solve``:
+regular there, where the subspace's Jacobian is singular). Switching: from (c*, P*) the predictor c* + δφ (φ the
+embedded mode, unit) is corrected on the hyperplane normal to φ, then the branch is followed by pseudo-arclength
+continuation until it rejoins the axisymmetric branch (the amplitude φ·(c − c*) changes sign), a pole stretch
+reaches stop_stretch, the membrane comes within wire_gap of a coil, or max_points; a point whose spectral tail
+exceeds solver.max_error refines the basis (``surface_resolution``: the wire map re-centred on the state, the
+degree and order extended; past MAX_DEGREE or MAX_ORDER the branch stops, flagged). The sign −φ is the image of the
++φ branch under the rotation by π about the axis (``rotated``). Folds in P are located (LP).
 
 Every point carries its measures (pole stretches, volume, centroid offset, tilt) and the lowest eigenvalues of
-its second variation over every symmetry sector, held and free (``surface.stability``); a change of the number
-of negative held eigenvalues of a sector between two points is a secondary branch point, located by Brent's
-method on that eigenvalue (``assess``).
+its second variation over every symmetry sector, held and free, under pressure, volume and gas control, and the
+secondary branch points are located (``surface_assessment``).
 
 Classification of the parent point: the reduced energy E(Λ) − E* along φ at P* (the other coefficients relax on
 φ·(c − c*) = Λ, as ``bifurcation.classify`` for the pear points), fitted by E2 Λ² + E3 Λ³ + E4 Λ⁴.
@@ -33,7 +34,6 @@ from ..galerkin.equilibrium import Parameters
 from ..model.field import wire_distance
 from ..numerics import continuation
 from ..numerics.continuation import Stop
-from ..numerics import eigen
 from ..numerics.newton import newton
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
@@ -43,12 +43,13 @@ from ..surface.equilibrium import SurfaceEquilibrium
 from ..surface.gauge import Gauge
 from ..surface.measures import MEASURES, measures, tail, tails
 from ..surface.system import SurfaceSystem
-from . import azimuthal, wires
+from . import azimuthal
 from .problem import continuation_settings, equilibrium_of
 from .results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
+from .surface_assessment import assess
+from .surface_resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 
-STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
 
 
@@ -83,62 +84,6 @@ def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
         if abs(part - whole) <= 1e-8 * whole:
             return (MIRROR_Y, reflection)
     raise ValueError("the critical mode has no definite parity under z → −z on an equator-symmetric branch")
-
-
-MAX_DEGREE = 128  # the finest polar degree the resolution policy raises to
-MAX_ORDER = 48  # the finest order of an anisotropic basis (a state pressed against a wire on one side needs more:
-#                 flagged); an isotropic basis (order = degree) is capped by MAX_DEGREE
-DEGREE_STEP, ORDER_STEP = 8, 2  # the smallest increments; larger ones where the decay asks for them
-
-
-def _increment(maxima: np.ndarray, target: float, step: int, most: int) -> int:
-    """How far to extend a spectrum whose largest coefficient per index is ``maxima`` (the last ones being the tail)
-    for its predicted tail to fall below ``target``: geometric decay fitted to the last four indices, rounded up to
-    a multiple of ``step``, at least ``step`` and at most ``most``."""
-    tail = np.maximum(maxima[-4:], 1e-300)
-    rate = np.polyfit(np.arange(tail.size), np.log(tail), 1)[0]
-    if rate >= 0.0:
-        return most
-    needed = np.log(target / tail[-1]) / rate
-    return int(min(most, max(step, step * np.ceil(needed / step))))
-
-
-def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> SphericalBasis | None:
-    """The next finer basis when a tail of c exceeds ``max_error`` (``surface.measures.tails``): the degree and the
-    order extended as far as the fitted decay of the coefficients predicts is needed for a tail of max_error/4
-    (an isotropic basis stays isotropic); the same basis when both tails are below max_error, None when the degree
-    would pass MAX_DEGREE or a capped order MAX_ORDER."""
-    theta, phi = tails(basis, c)
-    degree, order = basis.degree, basis.order
-    if theta > max_error:
-        by_degree = np.array([max((abs(c[b.offset + i]) for b in basis.blocks for i, l in enumerate(b.degrees)
-                                   if l == degree_), default=0.0) for degree_ in range(basis.degree + 1)])
-        degree += _increment(by_degree, max_error / 4, DEGREE_STEP, 4 * DEGREE_STEP)
-        order = degree if basis.order == basis.degree else order
-    if phi > max_error:
-        by_order = np.array([max((np.abs(c[b.slice]).max() for b in basis.blocks if b.m == m), default=0.0)
-                             for m in range(basis.order + 1)])
-        order = min(order + _increment(by_order, max_error / 4, ORDER_STEP, 4 * ORDER_STEP), degree)
-    if degree > MAX_DEGREE or (order < degree and order > max(MAX_ORDER, basis.order)):
-        return None
-    if (degree, order) == (basis.degree, basis.order):
-        return basis
-    return replace(basis, degree=degree, order=order, n_theta=0, n_phi=0)
-
-
-def remapped(basis: SphericalBasis, c: np.ndarray, coils) -> SphericalBasis:
-    """``basis`` on the wire map of the state c's own closest approaches to the wires (analysis.wires: the
-    axisymmetric solver's widths, centres mirrored on a basis that keeps z → −z or the inversion) when that map is
-    not ``close_to`` the basis' own: a state that moves toward a wire on one side needs a narrower map than the
-    branch point's. ``basis`` itself without a map or without coils."""
-    if basis.mapping is None or not len(coils):
-        return basis
-    found = wires.surface_approaches(basis.node_state(c), np.repeat(basis.nodes["cos_theta"], basis.n_phi), coils)
-    mapping = wires.centred_map(found, [wires.map_width(a) for a in found],
-                                any(S[2] < 0 for S in basis.symmetry))
-    if mapping is None or mapping.close_to(basis.mapping):
-        return basis
-    return replace(basis, mapping=mapping)
 
 
 class SurfaceTrace:
@@ -180,6 +125,26 @@ def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
         if finer is basis:
             return basis
         basis = finer
+
+
+def axisymmetric_solve(trace: SurfaceTrace, c: np.ndarray, P: float) -> np.ndarray | None:
+    """The axisymmetric state near c at the pressure P solved on the whole sphere within its axisymmetric family
+    (c + E_0 a, ``surface.stability.azimuthal_family``): the Jacobian E_0ᵀ H E_0 is regular at an m ≥ 1 branch point,
+    where the whole subspace's is singular; None when Newton does not converge."""
+    E = surface_stability.azimuthal_family(trace.basis, 0)
+    params, solver = trace.system.params, trace.scene.solver
+
+    def residual(X):
+        return E.T @ trace.eq.residual(c + E @ X[:-1], params.with_value("P", X[-1]))
+
+    def jacobian(X):
+        state, at = c + E @ X[:-1], params.with_value("P", X[-1])
+        return np.hstack([E.T @ trace.eq.hessian(state, at) @ E,
+                          (E.T @ trace.eq.parameter_derivative(state, at, "P"))[:, None]])
+
+    start = np.append(np.zeros(E.shape[1]), P)
+    result = newton(residual, jacobian, start, np.eye(start.size)[-1], P, solver.tol, solver.max_newton)
+    return c + E @ result.x[:-1] if result.converged else None
 
 
 def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
@@ -239,13 +204,13 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     except NotImplementedError as error:  # codegen: no whole-sphere kernels for a formula in the stretches yet
         raise SurfaceStartError(f"no whole-sphere kernels for this material: {error}") from None
     c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
-    # point 0: the axisymmetric state as the whole-sphere solution at P* (its truncation differs), or, where Newton
-    # does not converge at the branch point (its Jacobian is singular there), the embedded state itself; its
-    # residual is stored either way
+    # point 0: the axisymmetric state as the whole-sphere solution at P* (its truncation differs), solved in the
+    # axisymmetric family, where the Jacobian is regular at an m ≥ 1 point; where that Newton fails, the embedded
+    # state itself; its residual is stored either way
+    solved = axisymmetric_solve(trace, c_star, bp.X[-1])
+    if solved is not None:
+        c_star = solved
     X_star = trace.system.point(c_star, bp.X[-1])
-    solved = trace.system.solve(X_star, scene.solver.tol, scene.solver.max_newton)
-    if solved.converged:
-        X_star, c_star = solved.x, trace.system.coefficients(solved.x)
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
     E, kind = classify(trace, X_star, phi)
@@ -322,78 +287,6 @@ def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: 
     assess(out, [(t, t.system.coefficients(p.X)) for t, points in segments for p in points])
     out.wall_time = time.perf_counter() - t0
     return out
-
-
-def assess(sb: SurfaceBranch, traced: list) -> None:
-    """The stability readings of every point (held and free, under pressure, volume and gas control:
-    ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
-    of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
-    the zero of the crossing eigenvalue, located by Brent's method along the chord with the corrector on its
-    hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails. ``traced``: per
-    point, (the SurfaceTrace it was traced on, its coefficients there): a point is read on its own basis (resolved
-    there; the final basis of a branch that refined is several times larger than its first points need)."""
-    held = surface_stability.Reading(True)
-    readings = {r: [] for r in surface_stability.READINGS}
-    counts, held_spectra, spectra = [], [], None
-    for (trace, c), value in zip(traced, sb.values):
-        params = sb.params.with_value(sb.parameter, value)
-        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
-        for r in readings:
-            readings[r].append(surface_stability.lowest_over(spectra[r], STABILITY_COUNT))
-        counts.append(_negative_counts(trace, c, params, spectra[held]))
-        held_spectra.append(spectra[held])
-    sb.stability = {r.name: np.array(rows) for r, rows in readings.items()}
-    for i in range(1, len(counts) - 1):
-        for key in counts[i]:
-            if counts[i][key] != counts[i + 1][key]:
-                sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
-                                             float(held_spectra[i][key][0])))
-    sb.special.sort(key=lambda s: s.index)
-
-
-def _negative_counts(trace: SurfaceTrace, c, params, lowest: dict) -> dict:
-    """{characters: the number of negative held eigenvalues of the sector}: from its lowest STABILITY_COUNT, or,
-    when they are all negative, from the inertia of its matrix (numerics.eigen.negative_count)."""
-    counts = {}
-    for key, values in lowest.items():
-        counts[key] = int((values < 0).sum())
-        if counts[key] == values.size:
-            held = surface_stability.Reading(True)
-            A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), key)[held][key]
-            counts[key] = eigen.negative_count(A)
-    return counts
-
-
-def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, lowest: float) -> SpecialPoint:
-    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero, searched
-    on the basis of point i + 1 (``lowest``: the sector's lowest eigenvalue at point i, which the spectra follow)."""
-    (before, c0), (trace, c1) = traced[i], traced[i + 1]
-    if before is not trace:
-        c0 = transfer(before.basis, c0, trace.basis)
-    system, solver = trace.system, trace.scene.solver
-    X0, X1 = system.point(c0, sb.values[i]), system.point(c1, sb.values[i + 1])
-    chord = X1 - X0
-    d = chord / np.linalg.norm(chord)
-    held = surface_stability.Reading(True)
-
-    def value_at(s):
-        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
-        if not result.converged:
-            raise ArithmeticError(result.message)
-        c, params = system.coefficients(result.x), system.params_at(result.x)
-        A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), sector)[held][sector]
-        final = c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis)
-        return float(eigen.lowest_following(A, k + 1, lowest)[k]), np.append(final, result.x[-1])
-
-    found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
-    note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"
-    if found is not None and found.status == continuation.RootStatus.LOCATED:
-        return SpecialPoint(Kind.BP, i, found.payload, m=sb.m, note=note)
-    X = np.append(sb.coefficients[i], sb.values[i]) if found is None else found.payload
-    return SpecialPoint(Kind.BP, i, X, m=sb.m, status=Status.APPROXIMATE,
-                        uncertainty=0.5 * float(abs(sb.values[i + 1] - sb.values[i])),
-                        reason="the root search along the chord failed; the nearest evaluated point is stored",
-                        note=note)
 
 
 def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: float = 2e-2) -> tuple:

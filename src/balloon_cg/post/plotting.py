@@ -797,12 +797,14 @@ def surface_grid(basis, c, samples: tuple = SURFACE_SAMPLES) -> np.ndarray:
 
 def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
     """One state of a surface branch as a 3D surface (mplot3d) with its material lines θ, φ = multiples of 30°,
-    equal axis scales, the coils as circles of radius a at height h (docs/plots.md)."""
+    equal axis scales, the coils as circles of radius a at height h; in a figure of its own also its section by the
+    mirror plane y = 0 beside it (``_mirror_section``) (docs/plots.md)."""
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
 
     if axes is None:
-        fig = Figure(figsize=(6.4, 6.4), layout="constrained")
-        ax, own = fig.add_subplot(projection="3d"), True
+        fig = Figure(figsize=(10.0, 5.4), layout="constrained")
+        ax, own = fig.add_subplot(1, 2, 1, projection="3d"), True
+        _mirror_section(fig.add_subplot(1, 2, 2), branch, index)
     else:
         fig, (ax,), own = _panels(axes, 1, None)
         if getattr(ax, "name", "") != "3d":
@@ -826,9 +828,33 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
     ax.set_xlabel(r"$x/R_0$")
     ax.set_ylabel(r"$y/R_0$")
     ax.set_zlabel(r"$z/R_0$")
-    ax.set_title(_state_title(branch, index), fontsize=10)
+    if own:  # the 3D Axes' own title is clipped by the constrained layout beside a second panel
+        fig.suptitle(_state_title(branch, index), fontsize=10)
+    else:
+        ax.set_title(_state_title(branch, index), fontsize=10)
     _point_legend(fig, [ax], own, handles)
     return fig
+
+
+def _mirror_section(ax, branch: StoredBranch, index: int) -> None:
+    """The section of the state by the plane y = 0 (the branches' mirror plane: it holds the axis and the sideways
+    displacement of an m = 1 state), the meridians φ = 0 and π, with that of point 0 (the branch point, dashed) and
+    the coil wires where they cross the plane (x = ±a, z = h)."""
+    theta = np.linspace(0.0, np.pi, 181)
+    for i, style, label in ((0, "--", "point 0 (branch point)"), (index, "-", f"#{index}")):
+        basis, c = stored_state(branch, i)
+        x = np.concatenate([basis.point_values(c, theta, np.full_like(theta, phi))[0] for phi in (0.0, np.pi)],
+                           axis=1)
+        order = np.r_[np.arange(theta.size), np.arange(2 * theta.size - 1, theta.size - 1, -1)]  # round the section
+        ax.plot(x[0, order], x[2, order], style, color=branch.color, linewidth=1.2, label=label)
+    for k, coil in enumerate(branch.coils):
+        ax.plot([-coil.radius, coil.radius], [coil.height] * 2, "o", color="k", markersize=4,
+                label="coil wire" if k == 0 else None)
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"$x/R_0$")
+    ax.set_ylabel(r"$z/R_0$")
+    ax.set_title("section y = 0", fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
 
 
 def principal_stretches(state: np.ndarray) -> tuple:

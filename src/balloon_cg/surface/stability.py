@@ -168,11 +168,12 @@ def _own(sector: SphericalBasis, basis: SphericalBasis) -> bool:
 
 def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
     """E_m: orthonormal columns spanning the cos mφ family δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z in a basis
-    with the mirror y → −y and no other reflection (MODEL.md §5; analysis/azimuthal.py's space at the same degree):
+    with the mirror y → −y (MODEL.md §5; analysis/azimuthal.py's space at the same degree; with more reflections,
+    the part of it they keep):
     Z in the z blocks of order m, U = R + T in the pairs (x cos, y sin) of order m + 1, D = R − T in the pairs
     (x cos, −y sin) of order m − 1 (δx_x + i δx_y = ½ U e^{i(m+1)φ} + ½ D e^{−i(m−1)φ})."""
-    if basis.symmetry != (MIRROR_Y,) or basis.characters != (1,):
-        raise ValueError(f"azimuthal_family: needs the mirror-invariant basis, not symmetry {basis.symmetry} "
+    if MIRROR_Y not in basis.symmetry or basis.characters[basis.symmetry.index(MIRROR_Y)] != 1:
+        raise ValueError(f"azimuthal_family: needs a mirror-invariant basis, not symmetry {basis.symmetry} "
                          f"with characters {basis.characters}")
     find = {(b.component, b.m, b.t): b for b in basis.blocks}
     columns = []
@@ -183,6 +184,9 @@ def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
         x, y = find.get((0, order, COS)), find.get((1, order, SIN))
         if x is None:
             continue
+        if y is not None and x.degrees != y.degrees:
+            raise ValueError(f"azimuthal_family: the reflections {basis.symmetry} split the pair (x cos, y sin) of "
+                             f"order {order}")
         for i in range(len(x.degrees)):
             columns.append({x.offset + i: 1.0} if y is None else
                            {x.offset + i: np.sqrt(0.5), y.offset + i: sign * np.sqrt(0.5)})

@@ -1,0 +1,86 @@
+"""The stability of a branch on the whole sphere (``surface_branches``) and its secondary branch points: every point
+read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
+change of the number of negative held eigenvalues of a sector under pressure control between two points is a
+secondary branch point, located by Brent's method on that eigenvalue.
+"""
+import numpy as np
+
+from ..numerics import continuation, eigen
+from ..numerics.newton import newton
+from ..surface import stability as surface_stability
+from ..surface.embedding import transfer
+from .results import Kind, SpecialPoint, Status, SurfaceBranch
+
+STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
+
+
+def assess(sb: SurfaceBranch, traced: list) -> None:
+    """The stability readings of every point (held and free, under pressure, volume and gas control:
+    ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
+    of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
+    the zero of the crossing eigenvalue, located by Brent's method along the chord with the corrector on its
+    hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails. ``traced``: per
+    point, (the SurfaceTrace it was traced on, its coefficients there): a point is read on its own basis (resolved
+    there; the final basis of a branch that refined is several times larger than its first points need)."""
+    held = surface_stability.Reading(True)
+    readings = {r: [] for r in surface_stability.READINGS}
+    counts, held_spectra, spectra = [], [], None
+    for (trace, c), value in zip(traced, sb.values):
+        params = sb.params.with_value(sb.parameter, value)
+        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
+        for r in readings:
+            readings[r].append(surface_stability.lowest_over(spectra[r], STABILITY_COUNT))
+        counts.append(_negative_counts(trace, c, params, spectra[held]))
+        held_spectra.append(spectra[held])
+    sb.stability = {r.name: np.array(rows) for r, rows in readings.items()}
+    for i in range(1, len(counts) - 1):
+        for key in counts[i]:
+            if counts[i][key] != counts[i + 1][key]:
+                sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
+                                             float(held_spectra[i][key][0])))
+    sb.special.sort(key=lambda s: s.index)
+
+
+def _negative_counts(trace, c, params, lowest: dict) -> dict:
+    """{characters: the number of negative held eigenvalues of the sector}: from its lowest STABILITY_COUNT, or,
+    when they are all negative, from the inertia of its matrix (numerics.eigen.negative_count)."""
+    counts = {}
+    for key, values in lowest.items():
+        counts[key] = int((values < 0).sum())
+        if counts[key] == values.size:
+            held = surface_stability.Reading(True)
+            A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), key)[held][key]
+            counts[key] = eigen.negative_count(A)
+    return counts
+
+
+def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, lowest: float) -> SpecialPoint:
+    """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero, searched
+    on the basis of point i + 1 (``lowest``: the sector's lowest eigenvalue at point i, which the spectra follow)."""
+    (before, c0), (trace, c1) = traced[i], traced[i + 1]
+    if before is not trace:
+        c0 = transfer(before.basis, c0, trace.basis)
+    system, solver = trace.system, trace.scene.solver
+    X0, X1 = system.point(c0, sb.values[i]), system.point(c1, sb.values[i + 1])
+    chord = X1 - X0
+    d = chord / np.linalg.norm(chord)
+    held = surface_stability.Reading(True)
+
+    def value_at(s):
+        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
+        if not result.converged:
+            raise ArithmeticError(result.message)
+        c, params = system.coefficients(result.x), system.params_at(result.x)
+        A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), sector)[held][sector]
+        final = c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis)
+        return float(eigen.lowest_following(A, k + 1, lowest)[k]), np.append(final, result.x[-1])
+
+    found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
+    note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"
+    if found is not None and found.status == continuation.RootStatus.LOCATED:
+        return SpecialPoint(Kind.BP, i, found.payload, m=sb.m, note=note)
+    X = np.append(sb.coefficients[i], sb.values[i]) if found is None else found.payload
+    return SpecialPoint(Kind.BP, i, X, m=sb.m, status=Status.APPROXIMATE,
+                        uncertainty=0.5 * float(abs(sb.values[i + 1] - sb.values[i])),
+                        reason="the root search along the chord failed; the nearest evaluated point is stored",
+                        note=note)
