@@ -7,8 +7,10 @@ from . import equations, poles
 from . import second_variation, stretch_derivatives, surface
 from .classes import scene_classes
 from .emit import module_text
-from .functional import FIELD, GENERAL_TERMS, SceneClass
+from .functional import SceneClass
 from .kernels import lower
+from .terms.elastic import GENERAL_TERMS
+from .terms.magnetic import FIELD
 
 GENERATOR = "codegen/build.py"
 
@@ -34,13 +36,9 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     kernels = equations.energy_kernels(cls) + equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
     # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient (codegen/second_variation.py)
     kernels += second_variation.second_variation_kernels(cls)
-    if cls.energy is None:
-        title = f"Kernels for scene class {cls.name}: Ogden exponents {cls.inputs()['alphas']}, field {cls.field}."
-    else:
+    if cls.elastic.energy is not None:
         kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
-        title = f"Kernels for scene class {cls.name}: strain energy {cls.energy[0]}, field {cls.field}."
-    if cls.electric:
-        title = f"{title[:-1]}, dielectric term -voltage^2 lam1^2 lam2^2."
+    title = cls.title("Kernels for scene class")
     derived = time.perf_counter()
     lowered = [lower(k) for k in kernels]
     cse = time.perf_counter()
@@ -55,10 +53,7 @@ def surface_module(cls: SceneClass, timings: dict | None = None) -> str:
     module; ``timings`` as for ``class_module``."""
     start = time.perf_counter()
     kernels = surface.surface_kernels(cls)
-    material = f"Ogden exponents {cls.inputs()['alphas']}" if cls.energy is None else f"strain energy {cls.energy[0]}"
-    title = f"Surface kernels (MODEL.md §8) for scene class {cls.name}: {material}, field {cls.field}."
-    if cls.electric:
-        title = f"{title[:-1]}, dielectric term -voltage^2 J^2."
+    title = cls.title("Surface kernels (MODEL.md §8) for scene class", surface=True)
     derived = time.perf_counter()
     lowered = [lower(k) for k in kernels]
     cse = time.perf_counter()
@@ -101,10 +96,11 @@ def registry_text() -> str:
     """``generated/__init__.py``: the index the runtime uses to pick a module for a scene."""
     rows, energy_rows = [], []
     for cls in scene_classes():
-        if cls.energy is not None:
-            energy_rows.append(f"    {cls.name!r}: ({cls.energy[0]!r}, {cls.field!r}),\n")
+        elastic = cls.elastic
+        if elastic.energy is not None:
+            energy_rows.append(f"    {cls.name!r}: ({elastic.energy[0]!r}, {cls.field!r}),\n")
             continue
-        alphas = None if cls.alphas is None else tuple(float(a) for a in cls.alphas)
+        alphas = None if elastic.alphas is None else tuple(float(a) for a in elastic.alphas)
         rows.append(f"    {cls.name!r}: ({alphas!r}, {cls.field!r}),\n")
     return (
         '"""Kernels emitted by codegen/ (make regenerate). Never edit by hand.\n\n'

@@ -1,9 +1,16 @@
-"""The scene classes kernels are generated for: preset exponent sets, named models, the general class, and the
-strain-energy families of scene/energies.py (parameters at run time)."""
+"""The scene table: the energy terms a class may have, and the classes kernels are committed for (preset exponent
+sets, named models, the general class, and the strain-energy families of scene/energies.py, parameters at run
+time)."""
 from balloon_cg.scene.energies import FAMILIES
 from balloon_cg.scene.formula import parse_formula
 
 from .functional import SceneClass
+from .terms.dielectric import DIELECTRIC
+from .terms.elastic import Elastic
+from .terms.magnetic import MAGNETIC
+from .terms.pressure import PRESSURE
+
+KNOWN_TERMS = (PRESSURE, MAGNETIC, DIELECTRIC)  # in kernel order
 
 EXPONENT_SETS = {
     "spom1": ("1.3", "4", "-2"),
@@ -17,23 +24,28 @@ EXPONENT_SETS = {
 }
 
 
+def terms(field: bool, electric: bool = False) -> tuple:
+    """The terms of a class beyond the elastic one, as the runtime names them (model/kernel_cache.py): the pressure
+    always, the magnetic term with coils (``field``), the dielectric term with an [electric] table."""
+    return tuple(t for t, present in zip(KNOWN_TERMS, (True, field, electric)) if present)
+
+
+def strain_energy(formula: str, parameters: tuple) -> Elastic:
+    """The elastic term of a strain energy: its canonical formula text and parameter names."""
+    return Elastic(energy=(parse_formula(formula, parameters).text, tuple(parameters)))
+
+
 def scene_classes() -> list[SceneClass]:
     classes = []
     for name, alphas in EXPONENT_SETS.items():
-        classes.append(SceneClass(f"ogden_{name}", alphas, field=False))
-        classes.append(SceneClass(f"ogden_{name}_field", alphas, field=True))
-    classes.append(SceneClass("ogden_general_field", None, field=True))
+        classes.append(SceneClass(f"ogden_{name}", Elastic(alphas), terms(field=False)))
+        classes.append(SceneClass(f"ogden_{name}_field", Elastic(alphas), terms(field=True)))
+    classes.append(SceneClass("ogden_general_field", Elastic(None), terms(field=True)))
     return classes + energy_classes()
-
-
-def energy_class(name: str, formula: str, parameters: tuple, field: bool, electric: bool = False) -> SceneClass:
-    """The class of a strain energy: its canonical formula text and parameter names (``electric``: with the
-    dielectric term)."""
-    return SceneClass(name, None, field, energy=(parse_formula(formula, parameters).text, tuple(parameters)),
-                      electric=electric)
 
 
 def energy_classes() -> list[SceneClass]:
     """``KEY`` and ``KEY_field`` for every family."""
-    return [energy_class(f"{key}{'_field' if field else ''}", family.formula, family.parameters, field)
+    return [SceneClass(f"{key}{'_field' if field else ''}", strain_energy(family.formula, family.parameters),
+                       terms(field))
             for key, family in FAMILIES.items() for field in (False, True)]

@@ -1,8 +1,8 @@
 """Equations from the functional: energy gradient/Hessian (Ritz–Galerkin) and the first-order EL system.
 
 Galerkin form: E = ∫_{-1}^{1} π̂ d(cos θ); its first variation needs ∂π̂/∂(λ2, v, η, w) at a node, its Jacobian
-(= the axisymmetric second variation) the 4×4 Hessian of π̂, and continuation ∂/∂P, ∂/∂M (with a field) and
-∂/∂Φ̄ (a dielectric class: the voltage) of the gradient.
+(= the axisymmetric second variation) the 4×4 Hessian of π̂, and continuation the derivative of the gradient in
+each parameter the class's terms are continued in (∂/∂P; ∂/∂M with the magnetic term, ∂/∂Φ̄ with the dielectric).
 
 First-order form (MODEL.md §4): with L(θ, λ2, λ2', η, η') = Π(θ, λ2, λ2' sin θ, η, η'), the EL equations
 d/dθ(Π_v sin θ) = Π_λ2 and d/dθ Π_w = Π_η are linear in (v', w'):
@@ -14,8 +14,8 @@ singular when the membrane is unstretched (its determinant is proportional to th
 """
 import sympy as sp
 
-from . import energies, functional as fn
-from .functional import FIELD, STATE, M, P, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, voltage, w
+from . import functional as fn
+from .functional import STATE, SceneClass, cos_theta, eta, lam2, sin_theta, theta, v, w
 from .kernels import Arg, Kernel
 
 HESSIAN_PAIRS = tuple((i, j) for i in range(4) for j in range(i, 4))  # upper triangle row by row
@@ -27,33 +27,22 @@ def pair_labels(symbols, pairs) -> tuple:
     return tuple(f"{symbols[i]}_{symbols[j]}" for i, j in pairs)
 
 
-def material_args(cls: SceneClass) -> list:
-    """μ, and α for the general class (runtime exponents); a strain energy's parameters as ``material``."""
-    if cls.energy is not None:
-        return [Arg.param_array("material", energies.parameter_symbols(cls.energy))]
-    args = [Arg.param_array("mu", fn.moduli(cls))]
-    if cls.alphas is None:
-        args.append(Arg.param_array("alpha", fn.exponents(cls)))
-    return args
-
-
-def kernel_args(cls: SceneClass, node_symbols, leading_params=(), field_arg=None):
-    """The calling convention of a pointwise kernel: node values, then (leading_params, P, [M, χ]), μ, [α],
-    [field_arg] (a field class; default the node rows FIELD of H² and its derivatives)."""
+def kernel_args(cls: SceneClass, node_symbols, leading_params=(), rows=lambda term: term.rows()):
+    """The calling convention of a pointwise kernel: node values, then (leading_params, the terms' runtime
+    scalars: P, [M, χ], [Φ̄]), the material's arrays (μ, [α] or ``material``), then ``rows(term)`` of every term
+    (default its node rows, e.g. the field's H² and derivatives)."""
     args = [Arg.node(s) for s in node_symbols]
     args += [Arg.param(p) for p in (*leading_params, *fn.runtime_args(cls))]
-    args += material_args(cls)
-    if cls.field:
-        args.append(field_arg or Arg.node_rows("field", FIELD))
+    args += cls.elastic.arguments()
+    args += [arg for term in cls.terms for arg in rows(term)]
     return tuple(args)
 
 
 def energy_kernels(cls: SceneClass) -> list[Kernel]:
     density = fn.energy_density(cls)
-    rho = lam2 * sin_theta
     gradient = [sp.diff(density, x) for x in STATE]
     hessian = [sp.diff(gradient[i], STATE[j]) for i, j in HESSIAN_PAIRS]
-    at_node = lambda exprs: tuple(fn.field_values(e, rho) for e in exprs)  # noqa: E731
+    at_node = lambda exprs: tuple(fn.at_node(cls, e) for e in exprs)  # noqa: E731
     args = kernel_args(cls, (cos_theta, sin_theta) + STATE)
     kernels = [
         Kernel("energy_density", "π̂ = Π/sin θ at a node (MODEL.md §2).", args, at_node([density]), ("pi_hat",)),
@@ -65,17 +54,10 @@ def energy_kernels(cls: SceneClass) -> list[Kernel]:
             at_node(hessian),
             pair_labels(STATE, HESSIAN_PAIRS),
         ),
-        Kernel("pressure_gradient", "∂²π̂/∂P∂(λ2, v, η, w).", args, at_node([sp.diff(g, P) for g in gradient]),
-               STATE_LABELS),
     ]
-    if cls.field:
-        kernels.append(
-            Kernel("field_gradient", "∂²π̂/∂M∂(λ2, v, η, w).", args, at_node([sp.diff(g, M) for g in gradient]),
-                   STATE_LABELS)
-        )
-    if cls.electric:
-        kernels.append(Kernel("voltage_gradient", "∂²π̂/∂Φ̄∂(λ2, v, η, w).", args,
-                              at_node([sp.diff(g, voltage) for g in gradient]), STATE_LABELS))
+    kernels += [Kernel(f"{word}_gradient", f"∂²π̂/∂{shown}∂(λ2, v, η, w).", args,
+                       at_node([sp.diff(g, symbol) for g in gradient]), STATE_LABELS)
+                for symbol, word, shown in fn.continuations(cls)]
     return kernels
 
 
@@ -92,9 +74,10 @@ def linear_system(cls: SceneClass):
 
 
 def first_order_kernels(cls: SceneClass) -> list[Kernel]:
-    """f, ∂f/∂y, ∂f/∂P (and ∂f/∂M with a field, ∂f/∂Φ̄ for a dielectric class), with F = A⁻¹ b and ∂F/∂x = A⁻¹(∂b/∂x − ∂A/∂x F)."""
+    """f, ∂f/∂y and ∂f/∂(each continuation parameter: P, [M], [Φ̄]), with F = A⁻¹ b and
+    ∂F/∂x = A⁻¹(∂b/∂x − ∂A/∂x F)."""
     A, b = linear_system(cls)
-    at_node = lambda e: fn.field_values(e, lam2 * sin_theta)  # noqa: E731
+    at_node = lambda e: fn.at_node(cls, e)  # noqa: E731
     a11, a12, a21, a22, b1, b2, det, F1, F2 = sp.symbols("a11 a12 a21 a22 b1 b2 det F1 F2")
     base = tuple(zip((a11, a12, a21, a22, b1, b2), map(at_node, (A[0][0], A[0][1], A[1][0], A[1][1], b[0], b[1]))))
     stages = (base, ((det, a11 * a22 - a12 * a21),), ((F1, (a22 * b1 - a12 * b2) / det), (F2, (a11 * b2 - a21 * b1) / det)))
@@ -107,21 +90,15 @@ def first_order_kernels(cls: SceneClass) -> list[Kernel]:
     args = kernel_args(cls, (theta, cos_theta, sin_theta) + STATE)
     columns = [dF(x) for x in STATE]
     jacobian = [0, 1 / sin_theta, 0, 0] + [col[0] for col in columns] + [0, 0, 0, 1] + [col[1] for col in columns]
-    dP = dF(P)
     row_major = pair_labels(STATE, [(i, j) for i in range(4) for j in range(4)])
     kernels = [
         Kernel("rhs", "y' = f(θ, y): (λ2', v', η', w') of the EL equations (MODEL.md §4).", args,
                (v / sin_theta, F1, w, F2), STATE_LABELS, stages),
         Kernel("rhs_jacobian", "∂f/∂(λ2, v, η, w), row-major 4×4.", args, tuple(map(sp.sympify, jacobian)),
                row_major, stages),
-        Kernel("rhs_pressure", "∂f/∂P.", args, (sp.S.Zero, dP[0], sp.S.Zero, dP[1]), STATE_LABELS, stages),
     ]
-    if cls.field:
-        dM = dF(M)
-        kernels.append(Kernel("rhs_field", "∂f/∂M.", args, (sp.S.Zero, dM[0], sp.S.Zero, dM[1]), STATE_LABELS,
-                              stages))
-    if cls.electric:
-        dV = dF(voltage)
-        kernels.append(Kernel("rhs_voltage", "∂f/∂Φ̄.", args, (sp.S.Zero, dV[0], sp.S.Zero, dV[1]), STATE_LABELS,
+    for symbol, word, shown in fn.continuations(cls):
+        d1, d2 = dF(symbol)
+        kernels.append(Kernel(f"rhs_{word}", f"∂f/∂{shown}.", args, (sp.S.Zero, d1, sp.S.Zero, d2), STATE_LABELS,
                               stages))
     return kernels

@@ -7,20 +7,23 @@ p = λ2', q = η') and expanding in t, the lowest non-trivial orders are linear 
 
     O(t)  of the η equation  ->  e2,        O(t³) of the λ2 equation  ->  c2.
 
-The energy enters through the derivatives φ_ij = ∂^{i+j}Φ/∂λ1^i∂λ2^j at λ1 = λ2 = c0 and the field through
-H²_η and H²_ρρ on the axis, so the series is derived once for an abstract symmetric Φ and specialised per
-class by differentiating the class's Φ. The limits of f at the pole follow: λ2' = v' = η' = 0 and
-w' = ±2 e2 (in θ; the sign is + at θ = 0 and, since d/dθ = −d/dt there, the Taylor start at θ = π − t is
-λ2 = c0 + c2 t², v = −2 c2 t sin t, η = e0 + e2 t², w = −2 e2 t).
+The energy enters through the derivatives φ_ij = ∂^{i+j}Φ/∂λ1^i∂λ2^j at λ1 = λ2 = c0 and the other terms
+through their pole Lagrangians (``Term.pole``: the pressure, the field's H²_η and H²_ρρ on the axis), so the
+series is derived once for an abstract symmetric Φ and every known term (``classes.KNOWN_TERMS``, plus any other
+term of the class), and specialised per class by differentiating the class's Φ and switching the absent terms
+off (``Term.off``; deriving without them would print the same limits differently). The limits of f at the
+pole follow: λ2' = v' = η' = 0 and w' = ±2 e2 (in θ; the sign is + at θ = 0 and, since d/dθ = −d/dt there, the
+Taylor start at θ = π − t is λ2 = c0 + c2 t², v = −2 c2 t sin t, η = e0 + e2 t², w = −2 e2 t).
 """
 import functools
 
 import sympy as sp
 
 from . import functional as fn
+from .classes import KNOWN_TERMS
 from .equations import kernel_args
 from .functional import SceneClass
-from .kernels import Arg, Kernel
+from .kernels import Kernel
 from .series import derivative, truncated_series
 
 c0, c2, e0, e2 = sp.symbols("c0 c2 e0 e2", positive=True)
@@ -43,14 +46,14 @@ def _abstract_energy(l1, l2):
 
 
 @functools.cache
-def pole_coefficients(pole: str):
-    """(c2, e2) at the 'north' (θ = t) or 'south' (θ = π − t) pole, for abstract Φ; field: H²_z, H²_rr."""
+def pole_coefficients(pole: str, terms: tuple = KNOWN_TERMS):
+    """(c2, e2) at the 'north' (θ = t) or 'south' (θ = π − t) pole, for abstract Φ and the pole Lagrangians of
+    ``terms``."""
     lam, p, z, q = sp.symbols("lam p z q", real=True)
     sign = 1 if pole == "north" else -1
     s, c = sp.sin(_t), sign * sp.cos(_t)
     l1 = sp.sqrt((lam * c + p * s) ** 2 + q**2)
-    H2 = fn.Q + fn.Q_z * (z - e0) + fn.Q_rr * (lam * s) ** 2 / 2
-    L = _abstract_energy(l1, lam) * s - fn.chi * fn.M * H2 * s / 2 + fn.P * lam**2 * q * s**2 / 2
+    L = _abstract_energy(l1, lam) * s + sum(term.pole(lam, z, q, s, e0) for term in terms)
     lam_t = [c0, 0, c2]
     eta_t = [e0, 0, e2]
     known = {lam: lam_t, z: eta_t, p: [sign * x for x in derivative(lam_t)], q: [sign * x for x in derivative(eta_t)]}
@@ -68,23 +71,27 @@ def pole_coefficients(pole: str):
 
 
 def pole_kernel(cls: SceneClass) -> Kernel:
-    """``pole_series(lam0, P, [M, chi], mu, [alpha], [pole_field]) -> (c2_N, e2_N, c2_S, e2_S)``, pole_field =
-    (Q_z_N, Q_rr_N, Q_z_S, Q_rr_S): H²_z and H²_ρρ on the axis at each pole (rows 'NAME_N' / 'NAME_S' of FIELD)."""
+    """``pole_series(lam0, P, [M, chi], [voltage], mu, [alpha], [pole_field]) -> (c2_N, e2_N, c2_S, e2_S)``, the
+    terms' pole arguments last (the field's pole_field = (Q_z_N, Q_rr_N, Q_z_S, Q_rr_S): H²_z and H²_ρρ on the
+    axis at each pole, rows 'NAME_N' / 'NAME_S' of FIELD)."""
     l1, l2 = sp.symbols("l1 l2", positive=True)
     energy = fn.membrane_energy(cls, l1, l2)
     lam0 = sp.Symbol("lam0", positive=True)
-    outputs, field_symbols = [], []
+    derived = KNOWN_TERMS + tuple(t for t in cls.terms if t not in KNOWN_TERMS)
+    off = {}
+    for term in derived:
+        if term not in cls.terms:
+            off.update(term.off())
+    outputs = []
     for pole in ("north", "south"):
-        c2_value, e2_value, _, _ = pole_coefficients(pole)
+        c2_value, e2_value, _, _ = pole_coefficients(pole, derived)
         phis = {_phi_symbol(i, j): sp.diff(energy, l1, i, l2, j).subs({l1: lam0, l2: lam0})
                 for i in range(_TAYLOR_ORDER + 1) for j in range(_TAYLOR_ORDER + 1 - i)}
-        qz, qrr = sp.symbols(f"Q_z_{pole[0].upper()} Q_rr_{pole[0].upper()}", real=True)
-        field_symbols += [qz, qrr]
-        subs = {**phis, c0: lam0, fn.Q_z: qz, fn.Q_rr: qrr}
-        outputs += [c2_value.subs(subs), e2_value.subs(subs)]
-    if not cls.field:
-        outputs = [o.subs(fn.M, 0) for o in outputs]
-    args = kernel_args(cls, (lam0,), field_arg=Arg.param_array("pole_field", field_symbols))
+        subs = {**phis, c0: lam0}
+        for term in cls.terms:
+            subs.update(term.pole_values(pole[0].upper()))
+        outputs += [c2_value.subs(subs).subs(off), e2_value.subs(subs).subs(off)]
+    args = kernel_args(cls, (lam0,), rows=lambda term: term.pole_rows())
     return Kernel(
         "pole_series",
         "Taylor coefficients (c2, e2) of λ2 = λ0 + c2 t², η = η0 + e2 t² at the north and south poles.",

@@ -38,7 +38,7 @@ from sympy.codegen.cfunctions import expm1, log1p
 
 from . import energies, functional as fn
 from .functional import SceneClass, cos_theta, eta, lam2, sin_theta, v, w
-from .equations import kernel_args, material_args, pair_labels
+from .equations import kernel_args, pair_labels
 from .kernels import Arg, Kernel
 
 m = sp.Symbol("m", real=True)
@@ -46,7 +46,7 @@ R, R1, Z, Z1, T, T1 = sp.symbols("R R1 Z Z1 T T1", real=True)
 PERTURBATION = (R, R1, Z, Z1, T, T1)
 PAIRS = tuple((i, j) for i in range(6) for j in range(i, 6))  # upper triangle row by row
 
-_eps, _c, _s = sp.symbols("epsilon cm sm", real=True)
+eps, _c, _s = sp.symbols("epsilon cm sm", real=True)
 _l2 = sp.Symbol("l2", positive=True)
 _h = sp.Symbol("h", real=True)
 # material stage symbols: φ̂ derivatives in e = λ² and the shear coefficient, at (λ1, λ2) of the state
@@ -58,29 +58,29 @@ SWITCH = sp.Rational(1, 100)
 TAYLOR_ORDER = 8
 
 
-def _cross(a, b):
+def cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-def _dot(a, b):
+def dot(a, b):
     return sum(x * y for x, y in zip(a, b))
 
 
 def surface():
     """(x, x_θ, x_φ) in the local frame (e_ρ, e_φ, e_z), polynomial in ε, cm, sm (see module docstring)."""
     rho0, drho0 = lam2 * sin_theta, lam2 * cos_theta + v
-    x = (rho0 + _eps * R * _c, _eps * T * _s, eta + _eps * Z * _c)
-    x_t = (drho0 + _eps * R1 * _c, _eps * T1 * _s, w + _eps * Z1 * _c)
-    x_p = (-_eps * (m * R + T) * _s, rho0 + _eps * (R + m * T) * _c, -_eps * m * Z * _s)
+    x = (rho0 + eps * R * _c, eps * T * _s, eta + eps * Z * _c)
+    x_t = (drho0 + eps * R1 * _c, eps * T1 * _s, w + eps * Z1 * _c)
+    x_p = (-eps * (m * R + T) * _s, rho0 + eps * (R + m * T) * _c, -eps * m * Z * _s)
     return x, x_t, x_p
 
 
-def _order(expr, k):
+def epsilon_order(expr, k):
     """Coefficient of ε^k."""
-    return sp.expand(expr).coeff(_eps, k)
+    return sp.expand(expr).coeff(eps, k)
 
 
-def _phi_average(expr):
+def phi_average(expr):
     """(1/2π)∫ dφ of a polynomial in cm = cos mφ, sm = sin mφ of degree ≤ 2 (m ≥ 1)."""
     poly = sp.Poly(sp.expand(expr), _c, _s)
     mean = {(0, 0): sp.S.One, (2, 0): sp.S.Half, (0, 2): sp.S.Half, (1, 0): 0, (0, 1): 0, (1, 1): 0}
@@ -92,41 +92,19 @@ def _phi_average(expr):
     return sp.expand(out)
 
 
-def volume_density(x, x_t, x_p, form: str = "cone"):
-    """Enclosed-volume density per dθ dφ: 'cone' (1/3) x·(x_θ × x_φ), or 'cylinder' ½ρ² dβ∧dz, i.e.
-    ½ e_z·(x × x_θ) z_φ − ½ e_z·(x × x_φ) z_θ (the form of the axisymmetric code, ½ ρ² (−η') there)."""
-    if form == "cone":
-        return _dot(x, _cross(x_t, x_p)) / 3
-    if form == "cylinder":
-        zx_t = x[0] * x_t[1] - x[1] * x_t[0]
-        zx_p = x[0] * x_p[1] - x[1] * x_p[0]
-        return (zx_t * x_p[2] - zx_p * x_t[2]) / 2
-    raise ValueError(form)
-
-
-def second_order_density(cls: SceneClass, volume: str = "cone"):
+def second_order_density(cls: SceneClass):
     """E₂: the φ-averaged ε² coefficient of the energy per d(cos θ), per 2π, in the stage symbols
-    (λ1 = lam1, p1, p2, p11, p12, p22, K) and the node/state/field symbols; quadratic in PERTURBATION."""
+    (λ1 = lam1, p1, p2, p11, p12, p22, K) and the node/state/field symbols; quadratic in PERTURBATION. The
+    material stage carries Φ (every term of the stretches); the other terms add their own (``Term.second_order``)."""
     x, x_t, x_p = surface()
-    c11 = _dot(x_t, x_t)
-    c22 = _dot(x_p, x_p) / sin_theta**2
-    c12 = _dot(x_t, x_p) / sin_theta
-    a1, a2 = _order(c11, 1), _order(c22, 1)
-    elastic = p1 * _order(c11, 2) + p2 * _order(c22, 2) + p11 * a1**2 / 2 + p12 * a1 * a2 + p22 * a2**2 / 2
-    elastic += shear * _order(c12, 1) ** 2
-    density = _phi_average(elastic)
-    pressure = _phi_average(_order(volume_density(x, x_t, x_p, volume), 2))
-    density -= fn.P * pressure / sin_theta
-    if cls.field:
-        rho_sq = x[0] ** 2 + x[1] ** 2
-        # |x_h| = sqrt(rho_sq) to O(ε²) about ρ0 = lam2 sinθ: ρ0 + δ1 + δ2 with rho_sq = ρ0² + ε q1 + ε² q2
-        rho0 = lam2 * sin_theta
-        q1, q2 = _order(rho_sq, 1), _order(rho_sq, 2)
-        radius = rho0 + _eps * q1 / (2 * rho0) + _eps**2 * (q2 / (2 * rho0) - q1**2 / (8 * rho0**3))
-        H2 = fn._field_proxy(radius, x[2])
-        magnetic = _phi_average(_order(fn.field_values(sp.expand(H2), rho0), 2))
-        density -= fn.chi * fn.M * magnetic / 2
-    return density
+    c11 = dot(x_t, x_t)
+    c22 = dot(x_p, x_p) / sin_theta**2
+    c12 = dot(x_t, x_p) / sin_theta
+    a1, a2 = epsilon_order(c11, 1), epsilon_order(c22, 1)
+    elastic = p1 * epsilon_order(c11, 2) + p2 * epsilon_order(c22, 2)
+    elastic += p11 * a1**2 / 2 + p12 * a1 * a2 + p22 * a2**2 / 2
+    elastic += shear * epsilon_order(c12, 1) ** 2
+    return phi_average(elastic) + sum(term.second_order(x, x_t, x_p) for term in cls.terms)
 
 
 def material_stage(cls: SceneClass):
@@ -144,7 +122,7 @@ def _divided_difference_terms(cls: SceneClass, a, b):
     Returns (regular part, list of (μ, p) for the divided differences that are not polynomial)."""
     e1, e2 = a**2, b**2
     regular, singular = sp.S.Zero, []
-    for mu, alpha in zip(fn.moduli(cls), fn.exponents(cls)):
+    for mu, alpha in zip(cls.elastic.moduli(), cls.elastic.exponents()):
         p = alpha / 2 - 1
         regular += mu / 2 * (e1 * e2) ** (-alpha / 2 - 1)
         if p.is_Integer:  # (e1^p − e2^p)/(e1 − e2) is a polynomial in e1, e2, 1/e1, 1/e2: regular form
@@ -165,14 +143,15 @@ def shear_coefficient(cls: SceneClass):
     expm1/log1p form (no cancellation) elsewhere."""
     p1_, p2_, p11_, p12_, _ = material_stage(cls)
     closed = (p1_ - p2_) / (l1**2 - lam2**2)
-    # the dielectric term −Φ̄² e1 e2 adds the constant Φ̄² (its φ̂_1 − φ̂_2 = Φ̄² (e1 − e2))
-    electric = sum(v**2 for v in fn.electric_args(cls))
-    if cls.energy is not None:
-        expr, limit = energies.shear_coefficient(cls.energy, l1, lam2)
-        return expr + electric, limit + electric, closed
+    # the other terms of the stretches add their divided differences, cancelled exactly (the dielectric −Φ̄² e1 e2:
+    # the constant Φ̄²)
+    others = sum(_divided_difference(term) for term in cls.terms)
+    if cls.elastic.energy is not None:
+        expr, limit = energies.shear_coefficient(cls.elastic.energy, l1, lam2)
+        return expr + others, limit + others, closed
     limit = sp.simplify((p11_ - p12_).subs(l1, lam2))
     regular, singular = _divided_difference_terms(cls, l1, _l2)
-    regular = regular.subs(_l2, lam2) + electric
+    regular = regular.subs(_l2, lam2) + others
     if not singular:
         return regular, limit, closed
     far = sp.Abs(l1 - lam2) > SWITCH * lam2
@@ -190,6 +169,13 @@ def shear_coefficient(cls: SceneClass):
     taylor_part = taylor_part.subs(_h, l1 / lam2 - 1)
     expr = regular + sp.Piecewise((closed_part, far), (taylor_part, True))
     return expr, limit, closed
+
+
+def _divided_difference(term):
+    """(φ̂_1 − φ̂_2)/(e1 − e2) of a term's part of Φ, φ̂(e1, e2) = Φ(√e1, √e2), cancelled (a term smooth at e1 = e2)."""
+    e1, e2 = sp.symbols("e1 e2", positive=True)
+    phi = term.membrane(sp.sqrt(e1), sp.sqrt(e2))
+    return sp.cancel((sp.diff(phi, e1) - sp.diff(phi, e2)) / (e1 - e2))
 
 
 def _kernel_args(cls: SceneClass):
@@ -217,11 +203,14 @@ def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
 
 
 def shear_kernel(cls: SceneClass) -> Kernel:
+    """K(λ1, λ2) of the class; its runtime scalars are those it depends on (the dielectric voltage)."""
+    coefficient = shear_coefficient(cls)[0]
+    parameters = [p for p in fn.runtime_args(cls) if coefficient.has(p)]
     return Kernel(
         "shear_coefficient",
         "K = (φ̂_1 − φ̂_2)/(λ1² − λ2²), φ̂(e1, e2) = Φ(√e1, √e2), finite at λ1 = λ2 (limit φ̂_11 − φ̂_12).",
-        (Arg.node(l1), Arg.node(lam2), *map(Arg.param, fn.electric_args(cls)), *material_args(cls)),
-        (shear_coefficient(cls)[0],),
+        (Arg.node(l1), Arg.node(lam2), *map(Arg.param, parameters), *cls.elastic.arguments()),
+        (coefficient,),
         ("K",),
     )
 

@@ -9,9 +9,8 @@ or ≥ 0 (sqrt) (galerkin/equilibrium.py checks them at every node).
 """
 import sympy as sp
 
-from .equations import material_args
 from .energies import domain_margins
-from .functional import SceneClass, elastic_energy
+from .functional import SceneClass
 from .kernels import Arg, Kernel
 
 lam1, lam2 = sp.symbols("lam1 lam2", positive=True)
@@ -19,17 +18,17 @@ LABELS = ("phi", "phi_1", "phi_2", "phi_11", "phi_12", "phi_22")
 
 
 def derivatives_kernel(cls: SceneClass) -> Kernel:
-    phi = elastic_energy(cls, lam1, lam2)
+    phi = cls.elastic.membrane(lam1, lam2)
     d1, d2 = sp.diff(phi, lam1), sp.diff(phi, lam2)
     outputs = (phi, d1, d2, sp.diff(d1, lam1), sp.diff(d1, lam2), sp.diff(d2, lam2))
     return Kernel("membrane_derivatives", "Φ, Φ_1, Φ_2, Φ_11, Φ_12, Φ_22 at (λ1, λ2) (Φ_i = ∂Φ/∂λ_i).",
-                  (Arg.node(lam1), Arg.node(lam2), *material_args(cls)), outputs, LABELS)
+                  (Arg.node(lam1), Arg.node(lam2), *cls.elastic.arguments()), outputs, LABELS)
 
 
 def domain_kernels(cls: SceneClass) -> list[Kernel]:
-    margins = domain_margins(cls.energy, lam1, lam2)
+    margins = domain_margins(cls.elastic.energy, lam1, lam2)
     if not margins:
         return []
     return [Kernel("domain_margins", "Arguments of the energy's log (> 0) and sqrt (≥ 0) calls at (λ1, λ2).",
-                   (Arg.node(lam1), Arg.node(lam2), *material_args(cls)), margins,
+                   (Arg.node(lam1), Arg.node(lam2), *cls.elastic.arguments()), margins,
                    tuple(f"margin{k}" for k in range(len(margins))))]

@@ -3,13 +3,11 @@
 Node variables q = (x, y, z, xt, yt, zt, xp, yp, zp): the deformed point x = X + u, a_θ = ∂x/∂θ and
 a_φ = (1/sin θ) ∂x/∂φ. Density per unit reference area (E per 2π = (1/2π) ∫∫ π sin θ dθ dφ):
 
-    π = Φ(I, J) − ½ χ M H²(x) − (P/3) x · (a_θ × a_φ)   (− Φ̄² J² for a dielectric class),
-    I = |a_θ|² + |a_φ|² = tr C,   J = |a_θ × a_φ| = λ1 λ2 = √det C,   λ3 = 1/J.
+    π = Φ(I, J) + (the terms' densities),   I = |a_θ|² + |a_φ|² = tr C,   J = |a_θ × a_φ| = λ1 λ2 = √det C,
 
-The pressure term is ``second_variation.volume_density`` (cone form): −P V/(2π) after integration; for an
-axisymmetric state it differs pointwise from the axisymmetric ½ P λ2² w sin θ by −(P/6)(ρ²η)'/sin θ, whose
-integral vanishes. H² is the second-order Taylor proxy in (x, y, z) of ``functional._field_proxy``, exact for
-all derivatives of order ≤ 2 (field rows Q, Q_x, …, Q_zz supplied by the runtime).
+λ3 = 1/J; for the full set of terms (codegen/terms/: ``Term.surface``) π = Φ(I, J) − ½ χ M H²(x) −
+(P/3) x · (a_θ × a_φ) − Φ̄² J², with H² the Taylor proxy in (x, y, z) of terms/magnetic.py (field rows Q, Q_x, …,
+Q_zz supplied by the runtime).
 
 Φ is abstract in the derivatives: π carries the Taylor proxy
 Φ + Φ_I δI + Φ_J δJ + ½(Φ_II δI² + Φ_JJ δJ²) + Φ_IJ δI δJ about (I, J) of the node, so SymPy's chain rule gives
@@ -36,71 +34,50 @@ import functools
 import sympy as sp
 
 from . import energies, functional as fn
-from .equations import material_args, pair_labels
+from .equations import pair_labels
 from .kernels import Arg, Kernel
-from .second_variation import volume_density
+from .second_variation import cross, dot
+from .terms.magnetic import SURFACE_FIELD
 
 x, y, z, xt, yt, zt, xp, yp, zp = STATE = sp.symbols("x y z xt yt zt xp yp zp", real=True)
 PAIRS = tuple((i, j) for i in range(9) for j in range(i, 9))  # upper triangle row by row
-FIELD = sp.symbols("Q Q_x Q_y Q_z Q_xx Q_xy Q_xz Q_yy Q_yz Q_zz", real=True)
 
 # stage symbols: the node's invariants, then Φ and its derivatives in (I, J)
 inv_I, inv_J, inv_D = sp.symbols("inv_I inv_J inv_D", positive=True)
 inv_t = sp.Symbol("inv_t", nonnegative=True)  # t = D/m² = (d/m)², the series variable
 PHI = sp.symbols("phi phi_I phi_J phi_II phi_IJ phi_JJ", real=True)
 _I0, _J0 = sp.symbols("I0 J0", positive=True)
-_X0 = sp.symbols("x0 y0 z0", real=True)
 
 # closed form where d/m > SWITCH, else SERIES_TERMS terms of the even series in d (measured: docs in report)
 SWITCH = sp.Rational(3, 10)
 SERIES_TERMS = 20
 
 
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _dot(a, b):
-    return sum(p * q for p, q in zip(a, b))
-
-
-def field_proxy(point):
-    """H² near (x0, y0, z0): Q + Σ Q_i δ_i + ½ Σ Q_ii δ_i² + Σ_{i<j} Q_ij δ_i δ_j (rows FIELD)."""
-    dx = [p - p0 for p, p0 in zip(point, _X0)]
-    Q, Qx, Qy, Qz, Qxx, Qxy, Qxz, Qyy, Qyz, Qzz = FIELD
-    first = Qx * dx[0] + Qy * dx[1] + Qz * dx[2]
-    second = (Qxx * dx[0] ** 2 + Qyy * dx[1] ** 2 + Qzz * dx[2] ** 2) / 2
-    mixed = Qxy * dx[0] * dx[1] + Qxz * dx[0] * dx[2] + Qyz * dx[1] * dx[2]
-    return Q + first + second + mixed
-
-
 def geometry():
-    """(I, J², D) of the node as polynomials (J² = |a_θ × a_φ|²) and the volume density (1/3) x·(a_θ × a_φ)."""
-    point, a_t, a_p = STATE[:3], STATE[3:6], STATE[6:]
-    c11, c22, c12 = _dot(a_t, a_t), _dot(a_p, a_p), _dot(a_t, a_p)
-    normal = _cross(a_t, a_p)
-    return c11 + c22, _dot(normal, normal), ((c11 - c22) / 2) ** 2 + c12**2, volume_density(point, a_t, a_p)
+    """(I, J², D) of the node as polynomials (J² = |a_θ × a_φ|²)."""
+    a_t, a_p = STATE[3:6], STATE[6:]
+    c11, c22, c12 = dot(a_t, a_t), dot(a_p, a_p), dot(a_t, a_p)
+    normal = cross(a_t, a_p)
+    return c11 + c22, dot(normal, normal), ((c11 - c22) / 2) ** 2 + c12**2
 
 
 def density(cls: fn.SceneClass):
-    """π at the node with the Φ proxy about (I0, J0) and the field proxy about (x0, y0, z0) left unevaluated."""
-    invariant, normal_sq, _, volume = geometry()
+    """π at the node with the Φ proxy about (I0, J0) and the terms' proxies left unevaluated; the dielectric term,
+    a function of J alone (smooth), is one of the terms, outside the Φ stage of the elastic energy."""
+    invariant, normal_sq, _ = geometry()
     areal = sp.sqrt(normal_sq)
     dI, dJ = invariant - _I0, areal - _J0
     phi, phi_I, phi_J, phi_II, phi_IJ, phi_JJ = PHI
     pi = phi + phi_I * dI + phi_J * dJ + (phi_II * dI**2 + phi_JJ * dJ**2) / 2 + phi_IJ * dI * dJ
-    # the dielectric term −Φ̄² λ1² λ2² is a function of J = λ1 λ2 alone (smooth): outside the Φ stage
-    pi += fn.electric_energy(cls, areal, sp.S.One)
-    pi -= fn.P * volume
-    if cls.field:
-        pi -= fn.chi * fn.M * field_proxy(STATE[:3]) / 2
-    return pi
+    return pi + sum(term.surface(STATE[:3], STATE[3:6], STATE[6:], areal) for term in cls.terms)
 
 
-def at_node(expr, normal_sq, invariant):
+def at_node(cls: fn.SceneClass, expr, normal_sq, invariant):
     """Put the proxies' expansion points back (after differentiation) and name J = inv_J."""
-    expr = expr.subs({_I0: invariant, _J0: sp.sqrt(normal_sq), **dict(zip(_X0, STATE[:3]))})
-    return expr.xreplace({normal_sq: inv_J**2})
+    expansion = {_I0: invariant, _J0: sp.sqrt(normal_sq)}
+    for term in cls.terms:
+        expansion.update(term.surface_expansion(STATE[:3]))
+    return expr.subs(expansion).xreplace({normal_sq: inv_J**2})
 
 
 def _total(expr, wrt):
@@ -136,16 +113,17 @@ def _stretch_power_sum(a):
 @functools.cache
 def material_stage(cls: fn.SceneClass) -> tuple:
     """(Φ, Φ_I, Φ_J, Φ_II, Φ_IJ, Φ_JJ) of the elastic energy as expressions in (inv_I, inv_J, inv_D)."""
-    if cls.energy is not None:
-        W = energies.energy_in_invariants(cls.energy)
+    energy = cls.elastic.energy
+    if energy is not None:
+        W = energies.energy_in_invariants(energy)
         if W is None:
             raise NotImplementedError(
-                f"surface kernels for the strain energy {cls.energy[0]!r}: a formula in the stretches needs the "
+                f"surface kernels for the strain energy {energy[0]!r}: a formula in the stretches needs the "
                 "even-in-d series of φ̂(m ± d), not implemented yet; write it in I1, I2 if it is invariant-based")
         at = {energies.I1: inv_I + inv_J**-2, energies.I2: inv_J**2 + inv_I * inv_J**-2}
         return _derivatives(W.subs(at, simultaneous=True))
     exact, closed, series = sp.S.Zero, sp.S.Zero, sp.S.Zero
-    for mu, alpha in zip(fn.moduli(cls), fn.exponents(cls)):
+    for mu, alpha in zip(cls.elastic.moduli(), cls.elastic.exponents()):
         e, c, s = _stretch_power_sum(alpha / 2)
         exact += mu / alpha * (e + inv_J**-alpha - 3)
         closed += mu / alpha * c
@@ -160,19 +138,17 @@ def material_stage(cls: fn.SceneClass) -> tuple:
 
 
 def _args(cls: fn.SceneClass) -> tuple:
-    args = [Arg.node_rows("state", STATE), *map(Arg.param, fn.runtime_args(cls)), *material_args(cls)]
-    if cls.field:
-        args.append(Arg.node_rows("field", FIELD))
-    return tuple(args)
+    args = [Arg.node_rows("state", STATE), *map(Arg.param, fn.runtime_args(cls)), *cls.elastic.arguments()]
+    return tuple(args + [arg for term in cls.terms for arg in term.surface_rows()])
 
 
 def surface_kernels(cls: fn.SceneClass) -> list[Kernel]:
-    """surface_energy, _gradient, _hessian, _pressure_gradient (and _field_gradient, _voltage_gradient)."""
-    invariant, normal_sq, spread, _ = geometry()
+    """surface_energy, _gradient, _hessian and surface_WORD_gradient per continuation parameter (P, [M], [Φ̄])."""
+    invariant, normal_sq, spread = geometry()
     pi = density(cls)
     gradient = [sp.diff(pi, q) for q in STATE]
     hessian = [sp.diff(gradient[i], STATE[j]) for i, j in PAIRS]
-    node = lambda exprs: tuple(at_node(e, normal_sq, invariant) for e in exprs)  # noqa: E731
+    node = lambda exprs: tuple(at_node(cls, e, normal_sq, invariant) for e in exprs)  # noqa: E731
     geometry_stage = ((inv_I, invariant), (inv_J, sp.sqrt(normal_sq)), (inv_D, spread))
     material = dict(zip(PHI, material_stage(cls)))
     # the series variable t = D/m² where an Ogden term needs it
@@ -190,19 +166,14 @@ def surface_kernels(cls: fn.SceneClass) -> list[Kernel]:
                stages(phi_I, phi_J)),
         Kernel("surface_hessian", "∂²π/∂(x, a_θ, a_φ)², upper triangle row by row (SURFACE_PAIRS).", args,
                node(hessian), pair_labels(STATE, PAIRS), stages(phi_I, phi_J, phi_II, phi_IJ, phi_JJ)),
-        Kernel("surface_pressure_gradient", "∂²π/∂P∂(x, a_θ, a_φ).", args,
-               node([sp.diff(g, fn.P) for g in gradient]), labels),
     ]
-    if cls.field:
-        kernels.append(Kernel("surface_field_gradient", "∂²π/∂M∂(x, a_θ, a_φ).", args,
-                              node([sp.diff(g, fn.M) for g in gradient]), labels))
-    if cls.electric:
-        kernels.append(Kernel("surface_voltage_gradient", "∂²π/∂Φ̄∂(x, a_θ, a_φ).", args,
-                              node([sp.diff(g, fn.voltage) for g in gradient]), labels))
+    kernels += [Kernel(f"surface_{word}_gradient", f"∂²π/∂{shown}∂(x, a_θ, a_φ).", args,
+                       node([sp.diff(g, symbol) for g in gradient]), labels)
+                for symbol, word, shown in fn.continuations(cls)]
     return kernels
 
 
 def layout() -> dict:
     """Row layouts of every surface module: the node variables, the Hessian pairs, the field rows."""
     return {"SURFACE_STATE": tuple(map(str, STATE)), "SURFACE_PAIRS": PAIRS,
-            "SURFACE_FIELD_ROWS": tuple(map(str, FIELD))}
+            "SURFACE_FIELD_ROWS": tuple(map(str, SURFACE_FIELD))}

@@ -218,8 +218,9 @@ def test_axisymmetric_states_give_the_axisymmetric_energy():
 
 def test_a_formula_in_the_stretches_is_refused_by_name():
     from codegen import surface
-    from codegen.classes import energy_class
+    from codegen.classes import strain_energy, terms
+    from codegen.functional import SceneClass
 
-    cls = energy_class("stretchy", "c*(lambda1**3 + lambda2**3 + lambda3**3 - 3)", ("c",), False)
+    cls = SceneClass("stretchy", strain_energy("c*(lambda1**3 + lambda2**3 + lambda3**3 - 3)", ("c",)), terms(False))
     with pytest.raises(NotImplementedError, match="lambda1"):
         surface.material_stage(cls)

@@ -50,9 +50,9 @@ def _sympy_version() -> str:
 
 @functools.cache
 def generator_digest() -> str:
-    """SHA-256 of the generator's source (codegen/*.py and the formula parser it walks): an edit to the generator
+    """SHA-256 of the generator's source (codegen/**/*.py and the formula parser it walks): an edit to the generator
     invalidates cached modules even where GENERATOR_VERSION was not raised."""
-    files = sorted(Path(codegen.__file__).parent.glob("*.py")) + [Path(formula_module.__file__)]
+    files = sorted(Path(codegen.__file__).parent.rglob("*.py")) + [Path(formula_module.__file__)]
     return hashlib.sha256(b"".join(f.name.encode() + f.read_bytes() for f in files)).hexdigest()
 
 
@@ -95,12 +95,13 @@ def generate(material, field: bool, timings: dict | None = None, electric: bool 
     _sympy_version()
     from ..codegen import build, classes
     from ..codegen.functional import SceneClass
+    from ..codegen.terms.elastic import Elastic
 
-    name = module_name(material, field, electric, surface)
     if isinstance(material, Exponents):
-        cls = SceneClass(name, material.alphas, field, electric=electric)
+        elastic = Elastic(material.alphas)
     else:
-        cls = classes.energy_class(name, material.text, material.parameters, field, electric)
+        elastic = classes.strain_energy(material.text, material.parameters)
+    cls = SceneClass(module_name(material, field, electric, surface), elastic, classes.terms(field, electric))
     return (build.surface_module if surface else build.class_module)(cls, timings)
 
 
