@@ -113,19 +113,26 @@ def test_sphere_states_are_equilibria_and_the_solver_returns_them(text, stretch)
 
 
 def test_primary_branch_states_are_equilibria_with_a_field(two_coil_picture):
-    """Points of the two-coil M = 0.002 primary branch (wire-mapped Legendre degree 90, field on), and its first m = 1
-    point, embedded on the whole sphere with the same wire map at degree 88, order 3: the residual is ≤ 1e-9
-    (measured 2e-11 to 4e-10: the embedded state's own truncation, times the stiffness ~ l² of the top modes;
-    docs/numerics.md tabulates it against the degree), and Newton at the prescribed north pole stretch returns P to
+    """Points of the two-coil M = 0.002 primary branch (field on) and its first m = 1 point, each solved again at
+    its P on the axisymmetric solver's wire map at degree 150 (the run's degree 90 leaves a truncation that the
+    whole sphere sees: residuals up to 4e-10), embedded on the whole sphere with the same map at degree 104, order 3:
+    the residual is ≤ 1e-10 (measured 4e-12 to 4e-11), and Newton at the prescribed north pole stretch returns P to
     1e-10."""
     branch = two_coil_picture.primary
-    basis = SphericalBasis(88, (MIRROR_Y, EQUATOR), order=3, mapping=branch.disc.mapping)
+    fine = Discretisation(150, branch.disc.symmetric, branch.disc.pin_translation, mapping=branch.disc.mapping)
+    eq1 = Equilibrium(branch.scene, fine)
+    basis = SphericalBasis(104, (MIRROR_Y, EQUATOR), order=3, mapping=branch.disc.mapping)
     eq = SurfaceEquilibrium(branch.scene, basis)
     bp = next(s for s in branch.branch_points() if s.m == 1)
     for X in (branch.X[len(branch.X) // 3], branch.X[2 * len(branch.X) // 3], bp.X):
         params = branch.params_at(X)
-        c = axisymmetric_coefficients(basis, branch.disc, X[:-1])
-        assert np.abs(eq.residual(c, params)).max() <= 1e-9
+        axisymmetric = newton(lambda x: eq1.residual(x[:-1], params.with_value("P", x[-1])),
+                              lambda x: eq1.bordered_jacobian(x[:-1], params.with_value("P", x[-1]), "P"),
+                              np.append(branch.disc.transfer(X[:-1], fine), params.P), np.eye(fine.size + 1)[-1],
+                              params.P, 1e-14, 30)
+        assert axisymmetric.converged and fine.tail(axisymmetric.x[:-1]) <= 1e-11
+        c = axisymmetric_coefficients(basis, fine, axisymmetric.x[:-1])
+        assert np.abs(eq.residual(c, params)).max() <= 1e-10
         system = SurfaceSystem(eq, Gauge(basis, held=True, in_field=True), params)
         row, offset = axial_stretch_row(basis)
         stretch = branch.pole_values(X)["lam2_north"][0]
