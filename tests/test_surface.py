@@ -231,6 +231,8 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
     for c, P in zip(image.coefficients, image.values):
         assert np.abs(trace.eq.residual(c, Parameters(P))).max() <= 1e-10
     assert np.allclose(image.measures["centroid"][:, 0], -branch.measures["centroid"][:, 0])
+    with pytest.raises(ValueError, match="maps the m = 2 mode"):  # an even mode is its own image: traced along −φ
+        rotated(replace(branch, m=2), "m2_rotated")
 
 
 @pytest.fixture(scope="module")

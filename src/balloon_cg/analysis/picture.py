@@ -33,6 +33,7 @@ from ..numerics.threads import limited_blas
 
 MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
 ROTATED = "_rotated"  # the suffix of a non-axisymmetric branch's image under the rotation by π about the axis
+OPPOSITE = "_opposite"  # the suffix of the branch traced along −φ (even m: the rotation by π maps the mode to itself)
 
 
 class Phase(enum.StrEnum):
@@ -211,9 +212,10 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
 
 def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress):
     """The non-axisymmetric branches born at the located m ≥ 1 branch points of the held reading on the primary
-    branch (the first one, or all: ``[surface] branches``), each with its image under the rotation by π about the
-    axis (the other direction of the pitchfork: ``surface_branches.rotated``); the parent point gets the
-    classification from the reduced energy on the whole sphere."""
+    branch (the first one, or all: ``[surface] branches``), each with the other direction of its pitchfork: for an
+    odd m its image under the rotation by π about the axis (``surface_branches.rotated``), for an even m (which
+    that rotation maps to itself) traced along −φ; the parent point gets the classification from the reduced energy
+    on the whole sphere."""
     points = [(k, bp) for k, bp in enumerate(primary.branch_points())
               if bp.m >= 1 and bp.block.held and bp.status == Status.LOCATED]
     for k, bp in points[:1] if scene.surface.branches == "first" else points:
@@ -223,10 +225,13 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
         try:
             branch = surface_branches.trace_surface(primary, k, bp, 1.0, name, scene.surface.max_points,
                                                     progress.ticker(Phase.SURFACE))
+            other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else
+                     surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}",
+                                                    scene.surface.max_points, progress.ticker(Phase.SURFACE)))
         except surface_branches.SurfaceStartError as error:
             picture.not_started.append((name, str(error)))
             continue
-        picture.surface_branches += [branch, surface_branches.rotated(branch, f"{name}{ROTATED}")]
+        picture.surface_branches += [branch, other]
         origin = branch.special[0]
         primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
                            for s in primary.special]

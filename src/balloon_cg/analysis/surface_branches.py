@@ -324,10 +324,14 @@ def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: fl
 
 
 def rotated(branch: SurfaceBranch, name: str) -> SurfaceBranch:
-    """The image of ``branch`` under the rotation R by π about the axis, x ↦ R x(R⁻¹X): the other direction −φ of
-    its pitchfork (R maps the mode to −itself; coaxial loops and the held gauge are invariant under R). A
+    """The image of ``branch`` under the rotation R by π about the axis, x ↦ R x(R⁻¹X): for an odd m the other
+    direction −φ of its pitchfork (R maps the mode to −itself; coaxial loops and the held gauge are invariant under
+    R; an even mode R maps to itself: ValueError). A
     coefficient of e_c Y_{l,m,t} changes by the sign of e_c under R (−1 for x, y) times (−1)^m; P, the pole
     stretches, volume, tilt and every eigenvalue are unchanged, the centroid turns with R."""
+    if branch.m % 2 == 0:
+        raise ValueError(f"rotated: the rotation by π maps the m = {branch.m} mode of {branch.name} to itself, not "
+                         "to the other direction of its pitchfork (trace that one along −φ)")
     signs = np.concatenate([np.full(len(b.degrees), (-1.0 if b.component < 2 else 1.0) * (-1.0) ** b.m)
                             for b in branch.basis.blocks])
     turn = np.array([-1.0, -1.0, 1.0])
