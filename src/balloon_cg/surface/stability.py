@@ -17,7 +17,6 @@ Zero modes removed (MODEL.md §8), at the state x:
 A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
 fine (numerics.eigen.restricted drops them).
 """
-from enum import Enum
 from typing import NamedTuple
 
 import numpy as np
@@ -27,12 +26,7 @@ from .equilibrium import SurfaceEquilibrium
 from .measures import body_moments
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
-
-
-class Control(Enum):
-    PRESSURE = "pressure"
-    VOLUME = "volume"
-    GAS = "gas"
+from ..scene.loading import Control
 
 
 class Reading(NamedTuple):
@@ -101,10 +95,11 @@ def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, r
             continue
         H = eq.hessian(c, params, sector)
         g = -eq.parameter_derivative(c, params, "P", sector) if controlled and _own(sector, eq.basis) else None
-        groups = {}
+        groups = {}  # (zero-mode rows, the control the sector sees) -> (rows, the readings sharing the matrix)
         for r in readings:
             rows = mode_rows(sector, fields[r.held])
-            groups.setdefault((rows.tobytes(), r.control if g is not None else Control.PRESSURE), (rows, []))[1].append(r)
+            control = r.control if g is not None else Control.PRESSURE
+            groups.setdefault((rows.tobytes(), control), (rows, []))[1].append(r)
         for (_, control), (rows, shared) in groups.items():
             if control == Control.VOLUME:
                 A = _restricted(H, sector.gram(), rows, g)
