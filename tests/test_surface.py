@@ -381,12 +381,13 @@ def test_volume_and_gas_control_at_a_sphere_hold_the_axisymmetric_readings(spom1
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(5400)
 def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, monkeypatch):
     """The M = 0 check along the whole branch: from the m = 1 copy of the first pear point to its rejoin of the
     primary branch at the second, traced with solver.max_error = 1e-11 (the whole-sphere P error is about ten times
     the spectral tail); at every point P and λ2(π) of the axisymmetric pear branch solved at λ2(0) = λ+ at twice its
     run's degree agree to 1e-9. The stability of the points is not computed here (``assess`` skipped). A study of
-    several minutes: ``pytest -m slow``."""
+    tens of minutes (degree up to ~64 on the whole sphere): ``pytest -m slow``."""
     from dataclasses import replace
 
     from balloon_cg.analysis import surface_branches

@@ -511,6 +511,8 @@ def _pole_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
     drawn = {(id(b.run), b.name) for b in branches}
     for b in branches:
         d, color, y = b.data, b.color, b.parameter_values
+        if b.m and (id(b.run), d["attrs"].get("reflection_of")) in drawn:
+            continue  # a surface branch's image under the rotation about the axis: its source's curve and points
         _curve(ax, d["lam2_north"], y, b.stable, color, mirror=b.mirror)
         scale = np.abs(d["lam2_north"]).max()
         partner = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX) if b.mirror else b.name + MIRROR_SUFFIX)
