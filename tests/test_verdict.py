@@ -189,3 +189,21 @@ def test_unclassified_branch_point_and_unstarted_branch_are_incomplete():
     branch = SimpleNamespace(name="primary", legs=(), special=[bp], unsettled=[])
     found = incomplete([branch], not_started=(("pear_0", "the first correction did not converge"),))
     assert {item.gap for item in failing(found)} == {Gap.UNCLASSIFIED, Gap.NOT_STARTED}
+
+
+def test_a_surface_branch_point_above_max_error_on_the_final_basis_is_flagged():
+    """Points of a non-axisymmetric branch are traced on the basis of their segment and stored on the last; one
+    whose tail there exceeds solver.max_error makes the result incomplete (Gap.UNRESOLVED), naming the points."""
+    from balloon_cg.analysis.results import SurfaceBranch
+    from balloon_cg.analysis.verdict import failing, incomplete
+    from balloon_cg.galerkin.equilibrium import Parameters
+
+    scene = parse_scene(SPOM1)
+    limit = scene.solver.max_error
+    branch = SurfaceBranch("m1_bp0", scene, None, "ogden_spom1", "", Parameters(1.0), np.zeros((3, 1)),
+                           np.ones(3), np.ones(3), np.zeros(3), np.array([0.1, 5.0, 0.5]) * limit, {}, 1,
+                           ("primary", 0))
+    assert failing(incomplete([branch])) == []
+    branch.error_estimate[0] = 2.0 * limit
+    (found,) = failing(incomplete([branch]))
+    assert found.gap == Gap.UNRESOLVED and "points [0, 1]" in found.message

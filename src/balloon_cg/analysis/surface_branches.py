@@ -51,6 +51,7 @@ from .surface_assessment import assess
 from .surface_resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
+SWITCH_REACH, SWITCH_TRIES = 4.0, 3  # how far from the branch point (in steps) the first point may land; tries
 
 
 class SurfaceStartError(ArithmeticError):
@@ -178,15 +179,23 @@ def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
 
 
 def switch(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, step: float = SWITCH_STEP):
-    """The first point off the axisymmetric branch along φ (unit, in X = (a, P)), or the NewtonResult that failed."""
+    """The first point off the axisymmetric branch along φ (unit, in X = (a, P)), or the NewtonResult that failed:
+    the corrector on the hyperplane φ·(X − X*) = δ, accepted when it lands within SWITCH_REACH·δ of X* (a
+    solution farther away lies on another branch that crosses the hyperplane: δ is quartered, SWITCH_TRIES times)."""
     solver = trace.scene.solver
-    guess = X_star + step * phi
-    result = newton(trace.system.residual, trace.system.jacobian, guess, phi, phi @ guess, solver.tol,
-                    solver.max_newton)
-    if not result.converged:
-        return result
-    return continuation.Point(result.x, continuation.tangent(trace.system, result.x, phi), result.iterations,
-                              result.residual)
+    for _ in range(SWITCH_TRIES):
+        guess = X_star + step * phi
+        result = newton(trace.system.residual, trace.system.jacobian, guess, phi, phi @ guess, solver.tol,
+                        solver.max_newton)
+        if result.converged and np.linalg.norm(result.x - X_star) <= SWITCH_REACH * step:
+            return continuation.Point(result.x, continuation.tangent(trace.system, result.x, phi),
+                                      result.iterations, result.residual)
+        if result.converged:
+            far = float(np.linalg.norm(result.x - X_star))
+            result = replace(result, converged=False, message=f"the corrector landed {far:.3g} from the branch point "
+                                                              f"for a step {step:.3g} (on another branch)")
+        step /= 4.0
+    return result
 
 
 @limited_blas

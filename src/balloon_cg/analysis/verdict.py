@@ -7,7 +7,8 @@ rejoining the primary branch), every special point is LOCATED (and every axisymm
 every bifurcating branch asked for could be started, and the stability flags of every assessed point are settled
 between the stability degree and the check degree. A non-axisymmetric branch (``surface_branches``) may end at the
 caps of its whole-sphere basis or at its ``[surface] max_points``: a stated limitation (Gap.LIMITED), since every
-point it stores is resolved. Everything else is an ``Incomplete`` entry: typed, named,
+point it stores is resolved; a point whose tail on the branch's final basis exceeds max_error (points are traced
+on the bases of their segment and stored on the last) is flagged (Gap.UNRESOLVED). Everything else is an ``Incomplete`` entry: typed, named,
 explained. A limitation of the method
 that is not a failure of the computation (branch points not searched on a scene without equator symmetry) is
 an entry too, but does not make the result incomplete (``Gap.fails``). The CLI turns failing entries into exit
@@ -16,6 +17,8 @@ complete, incomplete_*).
 """
 import enum
 from dataclasses import dataclass
+
+import numpy as np
 
 from .results import Classification, Kind, Status, StopCode, SurfaceBranch, TraceStop
 
@@ -40,6 +43,8 @@ class Gap(enum.StrEnum):
     LIMITED = "limited"  # a non-axisymmetric branch ended at the whole-sphere basis' cap or its [surface] max_points
     #                      (a limitation of the method or the budget asked for, stated; every stored point resolved)
     INTERRUPTED = "interrupted"  # a signal stopped the computation: what follows the stored points is missing
+    UNRESOLVED = "unresolved"  # stored points of a non-axisymmetric branch whose spectral tail on the branch's final
+    #                            basis (they were traced on earlier ones) exceeds solver.max_error
 
     @property
     def fails(self) -> bool:
@@ -72,6 +77,12 @@ def incomplete(branches: list, not_searched: str = "", not_started: tuple = ()) 
             if s.kind == Kind.BP and s.m == 0 and s.classification == Classification.NONE:
                 found.append(Incomplete(Gap.UNCLASSIFIED, branch.name, f"BP near point {s.index}: fewer than three "
                                         "constrained minimisations along its mode converged"))
+        if isinstance(branch, SurfaceBranch):
+            above = [int(i) for i in np.flatnonzero(branch.error_estimate > branch.scene.solver.max_error)]
+            if above:
+                found.append(Incomplete(Gap.UNRESOLVED, branch.name, f"points {above} exceed solver.max_error "
+                                        f"{branch.scene.solver.max_error:g} on the final basis (tail up to "
+                                        f"{branch.error_estimate.max():.2g})"))
         if branch.unsettled:
             found.append(Incomplete(Gap.UNSETTLED, branch.name,
                                     f"stability flags change at the check degree at points {branch.unsettled}"))
