@@ -201,9 +201,9 @@ def test_a_surface_branch_point_above_max_error_on_the_final_basis_is_flagged():
     scene = parse_scene(SPOM1)
     limit = scene.solver.max_error
     branch = SurfaceBranch("m1_bp0", scene, None, "ogden_spom1", "", Parameters(1.0), np.zeros((3, 1)),
-                           np.ones(3), np.ones(3), np.zeros(3), np.array([0.1, 5.0, 0.5]) * limit, {}, 1,
+                           np.ones(3), np.ones(3), np.zeros(3), np.array([0.1, 0.5, 0.5]) * limit, {}, 1,
                            ("primary", 0))
     assert failing(incomplete([branch])) == []
-    branch.error_estimate[0] = 2.0 * limit
+    branch.error_estimate[:2] = 2.0 * limit
     (found,) = failing(incomplete([branch]))
     assert found.gap == Gap.UNRESOLVED and "points [0, 1]" in found.message
