@@ -39,9 +39,12 @@ def _power(base, exponent, order):
     return [sp.expand(b0**exponent * c) for c in out]
 
 
-def _call(function, argument, order):
-    """f(a0 + h) = Σ_k f⁽ᵏ⁾(a0) h^k/k!, h the argument's series without its constant term."""
-    a0, h = argument[0], [sp.S.Zero] + argument[1:]
+def _call(function, argument, order, constants: list):
+    """f(a0 + h) = Σ_k f⁽ᵏ⁾(a0) h^k/k!, h the argument's series without its constant term; f⁽ᵏ⁾ is taken at a
+    symbol A standing for a0, appended to ``constants`` as (A, a0) (expanding 1/a0^k of a sum a0 would multiply
+    its terms out)."""
+    a0, h = sp.Dummy("a0"), [sp.S.Zero] + argument[1:]
+    constants.append((a0, argument[0]))
     x = sp.Dummy("x")
     derivative_at, power = function(x), [sp.S.One] + [sp.S.Zero] * order
     out = [function(a0)] + [sp.S.Zero] * order
@@ -81,10 +84,14 @@ def truncated_series(expr, t, known, order, calls=False):
             taylor = sp.series(e, t, 0, order + 1).removeO()
             return [taylor.coeff(t, k) for k in range(order + 1)]
         if calls and isinstance(e, sp.Function) and len(e.args) == 1:
-            return _call(e.func, walk(e.args[0]), order)
+            return _call(e.func, walk(e.args[0]), order, constants)
         raise NotImplementedError(f"truncated_series: cannot expand {e.func}")
 
-    return walk(sp.sympify(expr))
+    constants = []
+    coefficients = walk(sp.sympify(expr))
+    for symbol, value in reversed(constants):  # a call's constant term may hold those of the calls inside it
+        coefficients = [c.xreplace({symbol: value}) for c in coefficients]
+    return coefficients
 
 
 def derivative(coeffs):

@@ -39,7 +39,7 @@ converges faster: q/s² = ((λ1 − λ2)/(λ1 + λ2))² ≤ 0.0236 at d/m = SWIT
 kernels of neo-Hookean, Mooney–Rivlin, Gent, an exponential (Fung) energy and the SPOM1 sum written in the
 stretches within 3e-14 relative (value, gradient, Hessian) of the same energies in invariants or as Ogden terms, at
 d/m = 0, 1e-8, 1e-4, 0.1, 0.29, 0.3 ± 1e-7, 0.31, 0.5, 0.8 and λ2 = 0.7, 1.1, 2.5 (tests/test_surface_stretch.py);
-generating such a module takes 10–60 s (SymPy: series, chain rule, CSE).
+generating such a module takes 10–70 s on one core (SymPy: series, chain rule, CSE).
 """
 import functools
 
