@@ -12,7 +12,8 @@ The shear coefficient K = (φ̂_1 − φ̂_2)/(e1 − e2) of the m ≥ 1 second 
 since (∂I1/∂e1 − ∂I1/∂e2)/(e1 − e2) = 1/(e1e2)² and (∂I2/∂e1 − ∂I2/∂e2)/(e1 − e2) = (e1 + e2)/(e1e2)² − 1.
 A formula in the stretches gets the closed form away from λ1 = λ2 and, where |λ1 − λ2| ≤ SWITCH·λ2, the even
 Taylor series of K in d = (e1 − e2)/2 about the mean m = (e1 + e2)/2 (K(m + d, m − d) is even in d by the
-symmetry of φ̂), to order d^(2·SERIES_TERMS − 2).
+symmetry of φ̂), to order d^(2·SERIES_TERMS − 2). ``stretch_series``: the even series of Φ((s + r)/2, (s − r)/2)
+in r = λ1 − λ2, for the whole-sphere kernels of a formula in the stretches (codegen/surface.py).
 """
 import functools
 
@@ -80,6 +81,15 @@ def domain_margins(energy, l1, l2) -> tuple:
     order of scene/formula.domain_conditions."""
     return tuple(_expression(energy, _stretch_symbols(l1, l2), tree)
                  for _, tree, _ in domain_conditions(_formula(energy)))
+
+
+def stretch_series(energy, s, r, terms: int) -> list:
+    """c_0(s), …, c_{terms−1}(s) of Φ((s + r)/2, (s − r)/2) = Σ_j c_j(s) r^(2j) + O(r^(2·terms)): Φ at λ1,2 =
+    (s ± r)/2, even in r = λ1 − λ2 by the symmetry of Φ (its odd coefficients vanish and are dropped), by the
+    truncated-series engine with the formula's functions expanded about their arguments' constant terms
+    (codegen/series.py; binomial(a, k) of a symbolic exponent as a product, as in ``_odd_coefficients``)."""
+    phi = membrane_energy(energy, (s + r) / 2, (s - r) / 2)
+    return [sp.expand_func(c) for c in truncated_series(phi, r, {}, 2 * terms - 2, calls=True)[::2]]
 
 
 def shear_coefficient(energy, lam1, lam2):

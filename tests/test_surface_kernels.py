@@ -215,12 +215,3 @@ def test_axisymmetric_states_give_the_axisymmetric_energy():
     assert np.allclose(surf[0.0], axi[0.0], rtol=1e-13, atol=0)
     assert weights @ (surf[1.0] - surf[0.0]) == pytest.approx(weights @ (axi[1.0] - axi[0.0]), rel=1e-12)
 
-
-def test_a_formula_in_the_stretches_is_refused_by_name():
-    from codegen import surface
-    from codegen.classes import strain_energy, terms
-    from codegen.functional import SceneClass
-
-    cls = SceneClass("stretchy", strain_energy("c*(lambda1**3 + lambda2**3 + lambda3**3 - 3)", ("c",)), terms(False))
-    with pytest.raises(NotImplementedError, match="lambda1"):
-        surface.material_stage(cls)

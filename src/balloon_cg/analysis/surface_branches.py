@@ -208,10 +208,7 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     az_basis, vector = critical_mode(branch, bp, scene.stability.degree)
     symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
     params = branch.params_at(bp.X)
-    try:
-        trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
-    except NotImplementedError as error:  # codegen: no whole-sphere kernels for a formula in the stretches yet
-        raise SurfaceStartError(f"no whole-sphere kernels for this material: {error}") from None
+    trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
     c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
     # point 0: the axisymmetric state as the whole-sphere solution at P* (its truncation differs), solved in the
     # axisymmetric family, where the Jacobian is regular at an m ≥ 1 point; where that Newton fails, the embedded
