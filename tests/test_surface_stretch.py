@@ -69,10 +69,12 @@ def test_the_series_is_continuous_across_the_switch():
         assert_close(ours, theirs, 1e-12)
 
 
+@pytest.mark.slow
 def test_a_scene_in_the_stretches_traces_its_m1_branch():
     """SPOM1 written in the stretches at M = 0: the branch born at the m = 1 copy of the pear point starts and takes
     its points with the generated surface kernels, as the Ogden class's (tests/test_surface.py), at the same
-    pressures."""
+    pressures (slow: the axisymmetric and whole-sphere modules of the formula are generated and compiled cold, ~1 to
+    6 minutes)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block
     from balloon_cg.analysis.surface_branches import trace_surface
