@@ -47,6 +47,8 @@ HDF5_SUFFIXES = (".h5", ".hdf5")
 def hdf5_output(path: str, kind: str) -> str:
     """``path`` if its suffix names an HDF5 file (HDF5_SUFFIXES), else UsageError: ``-o results.txt`` would
     write HDF5 under a text file's name (or, with --force, over a text file)."""
+    if not path.strip():
+        raise UsageError(f"--output {path!r}: an empty path (give a file name ending in .h5)")
     if Path(path).suffix.lower() not in HDF5_SUFFIXES:
         raise UsageError(f"--output {path}: a {kind} file is HDF5: its suffix must be one of "
                          f"{', '.join(HDF5_SUFFIXES)}")
@@ -203,7 +205,7 @@ def run(args) -> int:
     from .progress import shown
 
     scene = scene_of(args)
-    output = hdf5_output(args.output, "run") if args.output else f"{scene.name}.h5"
+    output = hdf5_output(args.output, "run") if args.output is not None else f"{scene.name}.h5"
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
@@ -350,7 +352,8 @@ def _add_plot(commands):
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}")
     p.add_argument("-o", "--output", help="image file, .png, .pdf or .svg (default: FIRST_FILE_STEM_KIND.png "
                                           "next to the first file; with several kinds: OUTPUT_STEM_KIND.SUFFIX; "
-                                          "an existing image is overwritten)")
+                                          "an existing file is replaced only with --force)")
+    p.add_argument("--force", action="store_true", help="replace existing image files")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
                    help="point indices for shapes, stresses, field, curvature (negative: from the end); one "
                         "index for surface and stretch-map (default: point 1 of the surface branch)")
@@ -381,7 +384,7 @@ def _indices(text: str) -> list[int]:
 
 def plot(args) -> int:
     """Draw one figure per kind and save it; prints the image paths."""
-    from ..io.hdf5 import check_output
+    from ..io.output import check_output, replacing
     from ..post.plotting import as_run, plot as draw
 
     first = Path(args.files[0])
@@ -395,11 +398,13 @@ def plot(args) -> int:
     for output in outputs.values():
         if output.suffix.lower() not in IMAGE_FORMATS:
             raise UsageError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
-        check_output(output, force=True)
+        check_output(output, args.force)
     runs = [as_run(f) for f in args.files] if any(kind != "phase" for kind in args.what) else []
     for kind, output in outputs.items():
-        draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
-             stability=args.stability).savefig(output, dpi=150)
+        figure = draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
+                      stability=args.stability)
+        with replacing(output, args.force) as tmp:
+            figure.savefig(tmp, dpi=150, format=output.suffix.lower()[1:])
         print(output)
     return 0
 
@@ -415,6 +420,8 @@ def _add_figure(commands):
     p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")
     p.add_argument("--quick", action="store_true", help="reduced runs (few points, low degree, one M): for tests")
+    p.add_argument("--force", action="store_true", help="replace existing image files (the runs folder is a cache: "
+                                                        "its runs are reused or recomputed without it)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.add_argument("--allow-partial", action="store_true", help="exit 0 also when a run drawn is incomplete")
 

@@ -30,6 +30,7 @@ from ..analysis.picture import analyse
 from ..analysis.primary import trace_primary
 from ..analysis.verdict import incomplete
 from ..io.lock import claim
+from ..io.output import check_output
 from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
                              store_path)
 from .hygiene import worker_hygiene
@@ -250,6 +251,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
     start = time.perf_counter()
     path = Path(out_path)
     with claim(path, "sweep"):
+        check_output(path, force, sweep=True)  # another kind of file there only with --force (io.output)
         members = expand(scene, specs) if members is None else members
         axes = [list(parse_vary(s, scene)) for s in specs]
         store = open_store(path, root_attrs(scene, axes, mode, len(members), command), members, force)

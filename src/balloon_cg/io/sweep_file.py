@@ -39,6 +39,7 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain, provenance
+from .output import store_path
 from .lock import remove_debris
 from .run_file import read_branches, verdict_attrs, write_branches
 from .layout import FileError, require_attrs
@@ -59,11 +60,6 @@ class SweepError(ValueError):
 
 class SweepFileError(FileError):
     """A sweep file or store that cannot be read (not a sweep, damaged: names the file and what is missing)."""
-
-
-def store_path(path) -> Path:
-    path = Path(path)
-    return path.with_name(f"{path.name}.members")
 
 
 def staging_path(path) -> Path:
@@ -252,7 +248,7 @@ def _scene_diff(old: str, new: str) -> str:
 def consolidate(path, directory: Path) -> None:
     """Rebuild the sweep file ``path`` from the store ``directory`` (atomically replacing it)."""
     path = Path(path)
-    with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True) as f:
+    with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True, keep_store=True) as f:
         _copy_attrs(manifest, f)
         f.attrs["format"] = FORMAT
         f.attrs["store"] = store_path(path).name
