@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, Phase, given, seed, settings, strategies as 
 from balloon_cg.app.cli import main
 from balloon_cg.model import kernel_cache
 from balloon_cg.scene import SceneError
-from balloon_cg.scene.formula import MAX_CALL_DEPTH, MAX_EXPONENT, MAX_NODES, parse_formula
+from balloon_cg.scene.formula import MAX_EXPONENT, MAX_NODES, parse_formula
 
 HANGING = {  # the formulas, and others past each bound: refused in parsing, before any SymPy
     "I1 - 3 + 0*(1/3)**(10**9)": "exponent 10**9 is beyond",

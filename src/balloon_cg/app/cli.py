@@ -16,8 +16,11 @@ import argparse
 import json
 import math
 import os
+import re
 import shlex
+import signal
 import sys
+import threading
 from importlib import resources
 from pathlib import Path
 
@@ -60,7 +63,31 @@ class Failure(Exception):
 
 
 def main(argv=None) -> int:
-    """Run one subcommand; returns the exit code."""
+    """Run one subcommand; returns the exit code. SIGTERM raises KeyboardInterrupt from the start (exit 130, as
+    Ctrl-C; before, a SIGTERM during the imports ended the process with −15); the previous handler is restored
+    on return (main called in a process that has its own)."""
+    previous = _terminate_raises()
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # during argument parsing
+        return _error("interrupted", INTERRUPTED)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _terminate_raises():
+    """SIGTERM raises KeyboardInterrupt (main thread only); returns the previous handler (None: unchanged)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def terminate(signum, frame):
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, terminate)
+
+
+def _main(argv) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     args.command_line = shlex.join([PROG, *argv])
@@ -240,7 +267,7 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
     The output is checked before the trace (which may take long); ``progress`` shows one bar per phase on
     stderr; ``command`` overrides the provenance attribute (default: sys.argv).
     """
-    from ..io.hdf5 import check_output
+    from ..io.output import check_output
     from ..io.lock import claim
     from ..io.run_file import write_run
     from .api import computed
@@ -484,7 +511,7 @@ def critical(args) -> int:
     from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
-    from ..io.hdf5 import check_output
+    from ..io.output import check_output
     from ..numerics.interrupt import requested, stop_on_signals
     from ..scene import ContinuationParameter
 
@@ -603,7 +630,10 @@ def _add_sweep(commands):
     p.add_argument("-o", "--output", required=True, help="sweep file (HDF5) to write or resume")
     p.add_argument("--scheduler", metavar="ADDRESS", help="send the members to this dask.distributed scheduler")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="local worker processes (default: all cores; 1: compute in this process)")
+                   help="local worker processes (default: all cores; 1: compute in this process; at most the CPU "
+                        "count unless --oversubscribe)")
+    p.add_argument("--oversubscribe", action="store_true",
+                   help=f"allow --workers above the CPU count (up to {MAX_WORKERS})")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--primary-only", action="store_true", help="trace the primary branch only")
     mode.add_argument("--no-pear", action="store_true",
@@ -615,6 +645,34 @@ def _add_sweep(commands):
     p.set_defaults(handler=sweep)
 
 
+MAX_WORKERS = 256  # local worker processes, even with --oversubscribe
+
+
+def cpu_count() -> int:
+    """The CPUs this process may run on (its affinity mask where the system has one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def check_workers(workers: int | None, oversubscribe: bool, scheduler: str | None) -> None:
+    """UsageError unless ``workers`` is None or in [1, CPU count] ([1, MAX_WORKERS] with ``oversubscribe``), and
+    not given with ``scheduler`` (the cluster's workers compute; local ones would be ignored); ``scheduler`` must
+    look like an address ([PROTOCOL://]HOST:PORT)."""
+    if scheduler is not None and not re.fullmatch(r"([a-z]+://)?[\w.\-\[\]:]+:\d+", scheduler):
+        raise UsageError(f"--scheduler {scheduler!r}: not a scheduler address (e.g. tcp://HOST:8786)")
+    if workers is None:
+        return
+    if scheduler is not None:
+        raise UsageError(f"--workers {workers} with --scheduler {scheduler}: the cluster's workers compute the members; "
+                         "give one of the two")
+    limit = MAX_WORKERS if oversubscribe else cpu_count()
+    if not 1 <= workers <= limit:
+        more = "" if oversubscribe else f" (the CPU count; --oversubscribe allows up to {MAX_WORKERS})"
+        raise UsageError(f"--workers {workers}: must be in [1, {limit}]{more}")
+
+
 def sweep(args) -> int:
     """Expand, compute the members not yet in the file, append them, summarise."""
     from ..io.sweep_file import incomplete_members
@@ -622,8 +680,7 @@ def sweep(args) -> int:
     from .progress import shown
     from .sweep import SweepError, format_summary, run_sweep
 
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers {args.workers}: must be >= 1")
+    check_workers(args.workers, args.oversubscribe, args.scheduler)
     from ..numerics.interrupt import sigterm_raises
 
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"

@@ -90,6 +90,8 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
             count = int(parts[2])
         except ValueError:
             raise SweepError(f"--vary {spec!r}: START and STOP must be numbers and COUNT an integer") from None
+        if not (np.isfinite(start) and np.isfinite(stop)):
+            raise SweepError(f"--vary {spec!r}: START and STOP must be finite numbers")
         if count < 1 or (count == 1 and start != stop):
             raise SweepError(f"--vary {spec!r}: COUNT must be >= 2 (or 1 with START = STOP)")
         if count > MAX_MEMBERS:
@@ -380,7 +382,7 @@ def _compute_dask(jobs, scheduler: str):
         raise SweepError("--scheduler needs the 'distributed' package (pip install 'balloon-cg[sweep]')") from None
     try:
         client = Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError) as e:
+    except (OSError, TimeoutError, ValueError, TypeError) as e:
         raise SweepError(f"--scheduler {scheduler}: cannot connect ({e})") from None
     try:
         _warn_slow_workers(client)

@@ -79,7 +79,8 @@ def parse_formula(text, parameters=(), key: str = "material.energy") -> Formula:
     used = frozenset(n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and n.id in SYMBOLS)
     unused = [p for p in parameters if p not in {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}]
     if unused:
-        raise SceneError(f"{key}.parameters.{unused[0]}: not used by the formula {show(canonical)}")
+        table = key.removesuffix(".energy")  # material.energy's parameters are material.parameters
+        raise SceneError(f"{table}.parameters.{unused[0]}: not used by the formula {show(canonical)}")
     return Formula(canonical, parameters, used)
 
 
