@@ -122,3 +122,26 @@ def test_sweep_file_over_which_run_writes_with_force_loses_its_store(tmp_path):
     with pytest.raises(FileExistsError, match="a sweep file"):
         check_output(out, force=False)
     assert check_output(out, force=False, sweep=True) == out
+
+
+def test_an_immutable_output_is_refused_before_computing_even_with_force(scene, tmp_path, capsys):
+    import subprocess
+
+    out = tmp_path / "old.h5"
+    out.write_bytes(b"keep me")
+    if subprocess.run(["chattr", "+i", str(out)], capture_output=True).returncode != 0:
+        pytest.skip("chattr +i is not available here")
+    try:
+        assert main(["run", str(scene), "-o", str(out), "--force", "--quiet"]) == 2
+        line = one_error_line(capsys)
+        assert "old.h5: exists and is not writable" in line and ".tmp" not in line
+        assert out.read_bytes() == b"keep me" and not [p for p in tmp_path.iterdir() if p.suffix == ".tmp"]
+    finally:
+        subprocess.run(["chattr", "-i", str(out)], capture_output=True)
+
+
+def test_plot_points_are_bounded(tmp_path, capsys):
+    argv = ["plot", str(tmp_path / "r.h5"), "--what", "shapes", "--points", ",".join(["0"] * 20_000)]
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    assert exit_.value.code == 2 and "at most 100" in capsys.readouterr().err

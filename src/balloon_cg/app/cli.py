@@ -402,11 +402,17 @@ def _kinds(text: str) -> list[str]:
     return kinds
 
 
+MAX_DRAWN_POINTS = 100  # --points: shapes drawn in one figure (20,000 took over a minute to draw)
+
+
 def _indices(text: str) -> list[int]:
+    items = text.split(",")
+    if len(items) > MAX_DRAWN_POINTS:
+        raise argparse.ArgumentTypeError(f"{len(items)} point indices: at most {MAX_DRAWN_POINTS} in one figure")
     try:
-        return [int(item) for item in text.split(",")]
+        return [int(item) for item in items]
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated integers, e.g. 0,10,-1") from None
+        raise argparse.ArgumentTypeError(f"{text[:40]!r}: expected comma-separated integers, e.g. 0,10,-1") from None
 
 
 def plot(args) -> int:

@@ -16,7 +16,7 @@ import numpy as np
 import balloon_cg
 
 from ..model.kernels import generated_digest
-from .output import check_output, replacing  # noqa: F401 - check_output: the callers' one import
+from .output import replacing
 
 
 @contextlib.contextmanager
