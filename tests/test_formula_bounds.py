@@ -167,3 +167,10 @@ def test_a_damaged_cached_module_is_regenerated_with_a_warning(damage, tmp_path,
         warnings.simplefilter("error")  # a whole module loads without a word
         kernel_cache.load(formula, False)
     sys.modules.pop(path.stem, None)
+
+
+def test_a_generated_module_past_its_size_bound_is_one_line(monkeypatch):
+    monkeypatch.setattr(kernel_cache, "MAX_MODULE_CHARS", 1000)
+    assert kernel_cache.checked_size("x" * 1000, "f") == "x" * 1000
+    with pytest.raises(SceneError, match="material.energy = 'I1': its kernels would be 0.001 MB of code"):
+        kernel_cache.checked_size("x" * 1001, "material.energy = 'I1'")

@@ -11,8 +11,9 @@
    basis map adapt (``tracer``).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field (no coils, or M = 0) the
-axial translation is removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
-(the translation coefficient b_0 is constrained to zero, a reaction force balances the net magnetic pull).
+axial translation is removed from the unknowns; with a field that is not equator-symmetric the balloon is held at
+the centre (the translation coefficient b_0 is constrained to zero, a reaction force balances the net magnetic
+pull).
 """
 import time
 

@@ -15,9 +15,10 @@ succeed, each finds either no module or a complete one, and the deterministic te
 
 Generation runs in a child process (``python -m balloon_cg.model.kernel_cache``) under a time budget
 (GENERATION_TIMEOUT seconds, $BALLOON_CG_CODEGEN_TIMEOUT to change it) and a memory bound (GENERATION_MEMORY
-bytes of address space): a formula within scene/formula's bounds that still outgrows them is refused with one
-line naming it (SceneError, exit 2), and SIGINT or SIGTERM stops the generation at once (KeyboardInterrupt, exit
-130; the child is killed, and dies with its parent). The cached file ends with a line holding the SHA-256 of the
+bytes of address space), and the module it prints is at most MAX_MODULE_CHARS long: a formula within
+scene/formula's bounds that still outgrows them is refused with one line naming it (SceneError, exit 2), and
+SIGINT or SIGTERM stops the generation at once (KeyboardInterrupt, exit 130; the child is killed, and dies with
+its parent). The cached file ends with a line holding the SHA-256 of the
 module text above it (``# content-sha256 HEX``); a file whose digest does not match (truncated, empty, garbled)
 is regenerated with a KernelCacheWarning before it is imported.
 
@@ -49,6 +50,7 @@ CACHE_ENV = "BALLOON_CG_KERNEL_CACHE"
 TIMEOUT_ENV = "BALLOON_CG_CODEGEN_TIMEOUT"
 GENERATION_TIMEOUT = 600.0  # seconds (a user formula at the bounds of scene/formula takes about a minute)
 GENERATION_MEMORY = 2 * 1024**3  # bytes of address space of the generating process
+MAX_MODULE_CHARS = 2_000_000  # a generated module's text (the largest committed one: 85 kB)
 DIGEST_MARK = "# content-sha256 "
 
 
@@ -213,7 +215,17 @@ def bounded_generate(material, field: bool, timings: dict | None = None, electri
     reply = json.loads(out)
     if timings is not None:
         timings.update(reply["timings"])
-    return reply["text"]
+    return checked_size(reply["text"], what)
+
+
+def checked_size(text: str, what: str) -> str:
+    """``text`` if the module is at most MAX_MODULE_CHARS long (the size of the expanded derivatives, after CSE:
+    numba's compile time grows with it), else SceneError naming ``what``."""
+    if len(text) > MAX_MODULE_CHARS:
+        raise SceneError(f"{what}: its kernels would be {len(text) / 1e6:.3g} MB of code; at most "
+                         f"{MAX_MODULE_CHARS / 1e6:g} MB (the committed classes are below 0.1 MB); simplify the "
+                         "formula")
+    return text
 
 
 _OUT_OF_MEMORY = 75
