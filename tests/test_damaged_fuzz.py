@@ -157,7 +157,7 @@ def test_a_huge_declared_dataset_is_refused_without_allocating(good_files, tmp_p
 
 
 @pytest.mark.parametrize("change", ["long double pressure", "missing parent_branch_point", "no primary (its snap-throughs name it)",
-                                    "snap from nowhere", "volume as text", "special kind 2-d"])
+                                    "snap from nowhere", "volume as text", "missing amount", "special kind 2-d"])
 def test_the_issues_damaged_files(good_files, tmp_path, capsys, change):
     path = tmp_path / "run.h5"
     shutil.copy(good_files["run"], path)
@@ -183,6 +183,8 @@ def test_the_issues_damaged_files(good_files, tmp_path, capsys, change):
             snaps.create_dataset("from_index", data=np.array([0]))
             snaps.create_dataset("to_index", data=np.array([-1]))
             snaps.create_dataset("pressure", data=np.array([1.0]))
+        elif change == "missing amount":
+            del primary["amount"]
         elif change == "volume as text":
             n = primary["volume"].shape[0]
             del primary["volume"]

@@ -436,6 +436,11 @@ def _read_open(f, label) -> dict:
     if "complete" in f.attrs:
         require_attrs(f.attrs, label, VERDICT_KINDS, VERDICT_KINDS, error=RunFileError)
     attrs = {k: _attr(v) for k, v in f.attrs.items()}
+    if plain(fmt) == FORMAT:  # the current format always writes them (older ones may lack them: OPTIONAL_COLUMNS)
+        for name, branch in require_group(f, "branches", label, RunFileError).items():
+            missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
+            if missing:
+                raise RunFileError(f"{label}: branch {name}", f"missing dataset {missing[0]}")
     return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f, label, RunFileError)}
 
 
