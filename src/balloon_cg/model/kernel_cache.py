@@ -195,7 +195,7 @@ def bounded_generate(material, field: bool, timings: dict | None = None, electri
     what = (f"material.energy = {material.text!r}" if not isinstance(material, Exponents) else
             f"the Ogden class with exponents {material.alphas}")
     child = subprocess.Popen([sys.executable, "-m", __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True, preexec_fn=_child_limits)
+                             stderr=subprocess.PIPE, text=True)  # no preexec_fn: unsafe in a threaded worker
     try:
         with _signals_raise():
             out, err = child.communicate(json.dumps(request), timeout=budget)
@@ -245,7 +245,7 @@ def _budget() -> float:
 
 
 def _child_limits() -> None:
-    """In the generating child, before it runs: the memory bound, and death with its parent (Linux)."""
+    """In the generating child, first thing: the memory bound, and death with its parent (Linux)."""
     import resource
 
     resource.setrlimit(resource.RLIMIT_AS, (GENERATION_MEMORY, GENERATION_MEMORY))
@@ -273,6 +273,7 @@ def _signals_raise():
 
 def _child_main() -> int:
     """The generating child: the request (JSON) on stdin, {'text', 'timings'} (JSON) on stdout."""
+    _child_limits()
     request = json.loads(sys.stdin.read())
     if "alphas" in request:
         alphas = request["alphas"]
