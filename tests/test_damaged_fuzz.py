@@ -213,19 +213,27 @@ def curve_file(tmp_path_factory) -> Path:
 
 
 @pytest.mark.parametrize("change", ["nan q", "inf pressure", "missing degree", "missing end_description",
-                                    "missing wall_time"])
+                                    "missing wall_time", "long double root attribute"])
 def test_the_issues_damaged_curve_files(curve_file, tmp_path, capsys, change):
     path = tmp_path / "curve.h5"
     shutil.copy(curve_file, path)
     with h5py.File(path, "a") as f:
         curve = f["two_parameter/pear"]
-        if change.startswith("missing"):
+        if change == "long double root attribute":  # an undocumented attribute: shown, as a float
+            f.attrs["control"] = np.longdouble(1.5)
+            curve.attrs["extra"] = np.clongdouble(1 + 2j)
+        elif change.startswith("missing"):
             del curve.attrs[change.removeprefix("missing ")]
         else:
             name = "q" if change == "nan q" else "pressure"
             data = curve[name][()]
             data[len(data) // 2] = np.nan if change == "nan q" else np.inf
             curve[name][...] = data
+    if change == "long double root attribute":
+        for argv in (["inspect", str(path)], ["inspect", "--json", str(path)]):
+            assert main(argv) == 0  # a RecursionError in inspect --json before
+        assert '"control": 1.5' in capsys.readouterr().out
+        return
     for argv in (["inspect", str(path)], ["plot", str(path), "--what", "phase", "-o", str(tmp_path / "p.png")]):
         assert main(argv) == 2
         err = capsys.readouterr().err

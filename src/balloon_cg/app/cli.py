@@ -361,7 +361,8 @@ def _finite(value):
     if isinstance(value, (list, tuple)):
         return [_finite(v) for v in value]
     if hasattr(value, "tolist"):  # numpy scalar or array
-        return _finite(value.tolist())
+        listed = value.tolist()
+        return _finite(listed) if type(listed) is not type(value) else str(value)  # a long double lists itself
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value

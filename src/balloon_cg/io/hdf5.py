@@ -59,4 +59,7 @@ def write_strings(group, name: str, values) -> None:
 
 def plain(value):
     """numpy scalars as Python numbers/bools, for printing and JSON."""
-    return value.item() if isinstance(value, np.generic) else value
+    if not isinstance(value, np.generic):
+        return value
+    item = value.item()  # a long double stays a numpy scalar: its nearest Python number
+    return item if not isinstance(item, np.generic) else complex(item) if np.iscomplexobj(item) else float(item)
