@@ -213,7 +213,7 @@ def curve_file(tmp_path_factory) -> Path:
 
 
 @pytest.mark.parametrize("change", ["nan q", "inf pressure", "missing degree", "missing end_description",
-                                    "missing wall_time", "long double root attribute"])
+                                    "missing wall_time", "long double root attribute", "inf merge pressure"])
 def test_the_issues_damaged_curve_files(curve_file, tmp_path, capsys, change):
     path = tmp_path / "curve.h5"
     shutil.copy(curve_file, path)
@@ -222,6 +222,9 @@ def test_the_issues_damaged_curve_files(curve_file, tmp_path, capsys, change):
         if change == "long double root attribute":  # an undocumented attribute: shown, as a float
             f.attrs["control"] = np.longdouble(1.5)
             curve.attrs["extra"] = np.clongdouble(1 + 2j)
+        elif change == "inf merge pressure":
+            special = curve["special_points"]
+            special["pressure"][...] = np.full(special["pressure"].shape, np.inf)
         elif change.startswith("missing"):
             del curve.attrs[change.removeprefix("missing ")]
         else:

@@ -95,8 +95,9 @@ def read_curve(path, name: str = "pear") -> dict:
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}
         data["special_points"] = read_special(special)
         data["special_q"] = special["q"][()]
-    for key in ("q", "pressure"):
-        if not np.isfinite(data[key]).all():
+    for key, values in (("q", data["q"]), ("pressure", data["pressure"]), ("special_points/q", data["special_q"]),
+                        ("special_points/pressure", [s["pressure"] for s in data["special_points"]])):
+        if not np.isfinite(np.asarray(values, dtype=float)).all():
             raise CurveFileError(where, f"dataset {key} holds NaN or inf (a stored curve point is always finite)")
     return data
 
