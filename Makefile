@@ -29,7 +29,7 @@ run: install
 # reused while their scenes are unchanged. PAPER_FLAGS: e.g. "--width 3.5 --stability axisymmetric", "--quick", or
 # "--allow-partial" (exit 0 although a run drawn is flagged incomplete; they are named on stderr either way).
 paper: install
-	$(PYTHON) -m balloon_cg figure all -o $(PAPER_OUT) $(PAPER_FLAGS)
+	$(PYTHON) -m balloon_cg figure all -o $(PAPER_OUT) --force $(PAPER_FLAGS)
 
 bench: install-dev
 	$(PYTHON) benchmarks/primary_branch.py

@@ -67,7 +67,7 @@ def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("setting, words", [
-    ("field.M=-1", ("field.M = -1", ">= 0")),
+    ("field.M=-1", ("field.M = -1", "in [0, 1000]")),
     ("nope=1", ("--set nope", "no table")),
     ("M=0:1:3", ("--set M=0:1:3", "one value")),
     ("continuation.max_points=abc", ("max_points", "abc")),

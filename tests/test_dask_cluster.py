@@ -34,12 +34,21 @@ def dask_command() -> list[str]:
     return [found]
 
 
-def wait_for(predicate, what: str, timeout: float = 60):
+def wait_for(predicate, what: str, timeout: float = 300):  # generous: a loaded machine is slow, never wrong
     deadline = time.monotonic() + timeout
     while not predicate():
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out waiting for {what}")
         time.sleep(0.05)
+
+
+def scheduler_address(path: Path) -> str | None:
+    """The address in dask's scheduler file, once the file is complete (the scheduler writes it in place: it can
+    exist and be empty or half-written for a while on a loaded machine)."""
+    try:
+        return json.loads(path.read_text())["address"]
+    except (FileNotFoundError, json.JSONDecodeError, KeyError, TypeError):
+        return None
 
 
 def test_sweep_on_a_real_cluster_survives_a_lost_worker(tmp_path):
@@ -55,15 +64,15 @@ def test_sweep_on_a_real_cluster_survives_a_lost_worker(tmp_path):
         processes.append(subprocess.Popen([*dask, "scheduler", "--host", "127.0.0.1", "--port", "0",
                                            "--no-dashboard", "--scheduler-file", str(address_file)],
                                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        wait_for(address_file.exists, "the scheduler")
-        address = json.loads(address_file.read_text())["address"]
+        wait_for(lambda: scheduler_address(address_file) is not None, "the scheduler", timeout=300)
+        address = scheduler_address(address_file)
         assert address.startswith("tcp://127.0.0.1:")
         workers = [subprocess.Popen([*dask, "worker", address, "--host", "127.0.0.1", "--nworkers", "1",
                                      "--nthreads", "1", "--no-nanny", "--no-dashboard", "--name", f"w{i}"],
                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for i in range(2)]
         processes += workers
         with distributed.Client(address, timeout="30s") as client:
-            client.wait_for_workers(2, timeout=60)
+            client.wait_for_workers(2, timeout=300)
         out = tmp_path / "cluster.h5"
         sweep = subprocess.Popen(soak.cli("sweep", scene, "--vary", VARY, "-o", out, "--primary-only",
                                           "--scheduler", address, "--quiet"), stderr=subprocess.PIPE, text=True)

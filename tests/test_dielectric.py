@@ -224,7 +224,7 @@ def test_run_file_records_the_voltage_and_the_term(tmp_path, pull_in_branch):
 
 
 @pytest.mark.parametrize("text, message", [
-    ("[electric]\nvoltage = -0.1\n", "electric.voltage = -0.1: must be >= 0"),
+    ("[electric]\nvoltage = -0.1\n", "electric.voltage = -0.1: must be in [0, 10]"),
     ("[electric]\nvoltage = inf\n", "electric.voltage = inf: must be finite"),
     ('[electric]\nvoltage = "high"\n', 'electric.voltage = "high": must be a number'),
     ("[electric]\ncharge = 1\n", "electric.charge = 1: unknown key; allowed keys: voltage"),
@@ -237,7 +237,7 @@ def test_run_file_records_the_voltage_and_the_term(tmp_path, pull_in_branch):
     ('[electric]\nvoltage = 0.2\n[continuation]\nparameter = "voltage"\n', "electric.voltage = 0.2: a voltage "
      "continuation starts at the sphere's voltage"),
     ('[electric]\n[continuation]\nparameter = "voltage"\nstop_voltage = 0\n', "continuation.stop_voltage = 0: "
-     "must be > 0"),
+     "must be in (0, 10]"),
     ('[electric]\n[continuation]\nparameter = "voltage"\npressure = -1\n', "continuation.pressure = -1: must be "
      ">= 0"),
 ])

@@ -80,7 +80,9 @@ def test_figure_command_one_column(runs, tmp_path, capsys):
                str(ONE_COLUMN), "--stability", "axisymmetric"]
     assert main(command) == 1  # the reduced runs stop short: incomplete, named on stderr
     assert "incomplete runs drawn" in capsys.readouterr().err
-    assert main(command + ["--allow-partial"]) == 0
+    assert main(command + ["--allow-partial"]) == 2  # the figure exists: replaced only with --force
+    assert "already exists" in capsys.readouterr().err
+    assert main(command + ["--allow-partial", "--force"]) == 0
     assert output.read_bytes().startswith(b"%PDF") and str(output) in capsys.readouterr().out
     assert dict(matplotlib.rcParams) == before
 

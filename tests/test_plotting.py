@@ -155,8 +155,8 @@ def test_plot_subcommand(files, tmp_path, capsys):
                  str(tmp_path / "s.png")]) == 0
     capsys.readouterr()
     for argv, words in (
-        (["--what", "energy"], ["no bifurcation data"]),
-        (["--what", "shapes", "--points", "999"], ["point 999 does not exist"]),
+        (["--what", "energy", "-o", str(tmp_path / "e.png")], ["no bifurcation data"]),
+        (["--what", "shapes", "--points", "999", "-o", str(tmp_path / "p.png")], ["point 999 does not exist"]),
         (["--what", "shapes", "-o", str(tmp_path / "x.gif")], ["suffix"]),
     ):
         assert main(["plot", str(files["spom1"]), *argv]) == 2

@@ -199,7 +199,7 @@ def test_file_error_names_file(tmp_path):
     path.write_text('[material]\npreset = "SPOM1"\n[field]\nM = -0.1\n')
     with pytest.raises(SceneError) as err:
         load_scene(path)
-    assert str(err.value) == "spom1.toml: field.M = -0.1: must be >= 0"
+    assert str(err.value) == "spom1.toml: field.M = -0.1: must be in [0, 1000]"
 
 
 MAT = '[material]\npreset = "SPOM1"\n'
@@ -236,7 +236,7 @@ BAD = [
     ("too-many-terms", "[material]\nmu = [1, 1, 1, 1, 1, 1, 1]\nalpha = [1, 1, 1, 1, 1, 1, 1]", "material.mu"),
     ("name-not-string", "[material]\nname = 3\nmu = [2]\nalpha = [2]", "material.name"),
     ("M-string", MAT + '[field]\nM = "0.1"', "field.M"),
-    ("M-negative", MAT + "[field]\nM = -0.1", "field.M = -0.1: must be >= 0"),
+    ("M-negative", MAT + "[field]\nM = -0.1", "field.M = -0.1: must be in [0, 1000]"),
     ("M-inf", MAT + "[field]\nM = inf\n" + coil(), "field.M"),
     ("chi-negative", MAT + "[field]\nchi = -1", "field.chi"),
     ("chi-nan", MAT + "[field]\nchi = nan", "field.chi"),

@@ -10,9 +10,10 @@
    north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and recorded; the degree and
    basis map adapt (``tracer``).
 
-The equator-symmetric subspace is used whenever the field allows it; without a field the axial translation is
-removed from the unknowns; with a field that is not equator-symmetric the balloon is held at the centre
-(the translation coefficient b_0 is constrained to zero, a reaction force balances the net magnetic pull).
+The equator-symmetric subspace is used whenever the field allows it; without a field (no coils, or M = 0) the
+axial translation is removed from the unknowns; with a field that is not equator-symmetric the balloon is held at
+the centre (the translation coefficient b_0 is constrained to zero, a reaction force balances the net magnetic
+pull).
 """
 import time
 

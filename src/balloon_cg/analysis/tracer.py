@@ -55,15 +55,16 @@ class Tracer:
 
     def __init__(self, scene, symmetric: bool | None = None, held: bool | None = None):
         """``symmetric``: the equator-symmetric layout (default: when the field allows it); ``held``: constrain the
-        axial translation b_0 = 0 (default: with coils that are not equator-symmetric; without coils b_0 is always
-        removed, being a zero mode)."""
+        axial translation b_0 = 0 (default: with coils that are not equator-symmetric). Without a field acting (no
+        coils, or M = 0: the field energy is proportional to M) the energy does not depend on b_0, an exact zero
+        mode, and b_0 is always removed."""
         self.scene = scene
         if symmetric is None:
             symmetric = scene.continuation.symmetry != "none" and scene.field.is_equator_symmetric
         self.symmetric = symmetric
         if held is None:
             held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
-        self.pin = (not scene.field.coils) or held
+        self.pin = (not scene.field.coils) or scene.field.M == 0 or held
         # the continuation parameter (Parameters field): P, or Φ̄ for continuation.parameter = "voltage"
         self.parameter = "voltage" if scene.continuation.parameter == ContinuationParameter.VOLTAGE else "P"
         self.settings = continuation_settings(scene)

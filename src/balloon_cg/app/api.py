@@ -20,9 +20,9 @@ import numpy as np
 
 from ..analysis.picture import Phase
 from ..io.hdf5 import atomic_bytes, command_line
-from ..io.run_file import read_run, read_run_image, run_image
+from ..io.run_file import RunFileError, read_run, read_run_image, run_image
 from ..numerics.interrupt import stop_on_signals
-from ..scene import Scene, load_scene, parse_scene
+from ..scene import Scene, SceneError, load_scene, parse_scene
 from .progress import PhaseBars
 
 EXTRA = "pip install 'balloon-cg[analysis]'"
@@ -151,6 +151,8 @@ class Result:
         if table != "points":
             raise ValueError(f"table = {table!r}: must be 'points' or 'special'")
         frames = [b.to_dataframe().reset_index().assign(branch=name, m=b.m) for name, b in self.branches.items()]
+        if not frames:  # nothing stored (a file written before run files needed their primary branch)
+            return pd.DataFrame(columns=["branch", "m", "point"])
         frame = pd.concat(frames, ignore_index=True)
         return frame[["branch", "m", *[c for c in frame.columns if c not in ("branch", "m")]]]
 
@@ -230,9 +232,13 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
 
 
 def load(path) -> Result:
-    """The Result stored in a run file."""
+    """The Result stored in a run file. Raises FileNotFoundError or IsADirectoryError (no such file), or
+    io.run_file.RunFileError (a damaged or foreign file, a stored scene that does not parse: docs/api.md)."""
     run = read_run(path)
-    scene = parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
+    try:
+        scene = parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
+    except SceneError as e:
+        raise RunFileError(path, f"the stored scene_toml is not a valid scene ({e})") from None
     return Result(scene, Path(path).read_bytes(), run)
 
 

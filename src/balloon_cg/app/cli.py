@@ -16,8 +16,11 @@ import argparse
 import json
 import math
 import os
+import re
 import shlex
+import signal
 import sys
+import threading
 from importlib import resources
 from pathlib import Path
 
@@ -47,6 +50,8 @@ HDF5_SUFFIXES = (".h5", ".hdf5")
 def hdf5_output(path: str, kind: str) -> str:
     """``path`` if its suffix names an HDF5 file (HDF5_SUFFIXES), else UsageError: ``-o results.txt`` would
     write HDF5 under a text file's name (or, with --force, over a text file)."""
+    if not path.strip():
+        raise UsageError(f"--output {path!r}: an empty path (give a file name ending in .h5)")
     if Path(path).suffix.lower() not in HDF5_SUFFIXES:
         raise UsageError(f"--output {path}: a {kind} file is HDF5: its suffix must be one of "
                          f"{', '.join(HDF5_SUFFIXES)}")
@@ -58,7 +63,31 @@ class Failure(Exception):
 
 
 def main(argv=None) -> int:
-    """Run one subcommand; returns the exit code."""
+    """Run one subcommand; returns the exit code. SIGTERM raises KeyboardInterrupt from the start (exit 130, as
+    Ctrl-C; before, a SIGTERM during the imports ended the process with −15); the previous handler is restored
+    on return (main called in a process that has its own)."""
+    previous = _terminate_raises()
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # during argument parsing
+        return _error("interrupted", INTERRUPTED)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _terminate_raises():
+    """SIGTERM raises KeyboardInterrupt (main thread only); returns the previous handler (None: unchanged)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def terminate(signum, frame):
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, terminate)
+
+
+def _main(argv) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     args.command_line = shlex.join([PROG, *argv])
@@ -203,7 +232,7 @@ def run(args) -> int:
     from .progress import shown
 
     scene = scene_of(args)
-    output = hdf5_output(args.output, "run") if args.output else f"{scene.name}.h5"
+    output = hdf5_output(args.output, "run") if args.output is not None else f"{scene.name}.h5"
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
@@ -238,7 +267,7 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
     The output is checked before the trace (which may take long); ``progress`` shows one bar per phase on
     stderr; ``command`` overrides the provenance attribute (default: sys.argv).
     """
-    from ..io.hdf5 import check_output
+    from ..io.output import check_output
     from ..io.lock import claim
     from ..io.run_file import write_run
     from .api import computed
@@ -332,7 +361,8 @@ def _finite(value):
     if isinstance(value, (list, tuple)):
         return [_finite(v) for v in value]
     if hasattr(value, "tolist"):  # numpy scalar or array
-        return _finite(value.tolist())
+        listed = value.tolist()
+        return _finite(listed) if type(listed) is not type(value) else str(value)  # a long double lists itself
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
@@ -350,7 +380,8 @@ def _add_plot(commands):
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}")
     p.add_argument("-o", "--output", help="image file, .png, .pdf or .svg (default: FIRST_FILE_STEM_KIND.png "
                                           "next to the first file; with several kinds: OUTPUT_STEM_KIND.SUFFIX; "
-                                          "an existing image is overwritten)")
+                                          "an existing file is replaced only with --force)")
+    p.add_argument("--force", action="store_true", help="replace existing image files")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
                    help="point indices for shapes, stresses, field, curvature (negative: from the end); one "
                         "index for surface and stretch-map (default: point 1 of the surface branch)")
@@ -372,16 +403,22 @@ def _kinds(text: str) -> list[str]:
     return kinds
 
 
+MAX_DRAWN_POINTS = 100  # --points: shapes drawn in one figure (20,000 took over a minute to draw)
+
+
 def _indices(text: str) -> list[int]:
+    items = text.split(",")
+    if len(items) > MAX_DRAWN_POINTS:
+        raise argparse.ArgumentTypeError(f"{len(items)} point indices: at most {MAX_DRAWN_POINTS} in one figure")
     try:
-        return [int(item) for item in text.split(",")]
+        return [int(item) for item in items]
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated integers, e.g. 0,10,-1") from None
+        raise argparse.ArgumentTypeError(f"{text[:40]!r}: expected comma-separated integers, e.g. 0,10,-1") from None
 
 
 def plot(args) -> int:
     """Draw one figure per kind and save it; prints the image paths."""
-    from ..io.hdf5 import check_output
+    from ..io.output import check_output, replacing
     from ..post.plotting import as_run, plot as draw
 
     first = Path(args.files[0])
@@ -395,11 +432,13 @@ def plot(args) -> int:
     for output in outputs.values():
         if output.suffix.lower() not in IMAGE_FORMATS:
             raise UsageError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
-        check_output(output, force=True)
+        check_output(output, args.force)
     runs = [as_run(f) for f in args.files] if any(kind != "phase" for kind in args.what) else []
     for kind, output in outputs.items():
-        draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
-             stability=args.stability).savefig(output, dpi=150)
+        figure = draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
+                      stability=args.stability)
+        with replacing(output, args.force) as tmp:
+            figure.savefig(tmp, dpi=150, format=output.suffix.lower()[1:])
         print(output)
     return 0
 
@@ -415,6 +454,8 @@ def _add_figure(commands):
     p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")
     p.add_argument("--quick", action="store_true", help="reduced runs (few points, low degree, one M): for tests")
+    p.add_argument("--force", action="store_true", help="replace existing image files (the runs folder is a cache: "
+                                                        "its runs are reused or recomputed without it)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.add_argument("--allow-partial", action="store_true", help="exit 0 also when a run drawn is incomplete")
 
@@ -477,7 +518,7 @@ def critical(args) -> int:
     from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
-    from ..io.hdf5 import check_output
+    from ..io.output import check_output
     from ..numerics.interrupt import requested, stop_on_signals
     from ..scene import ContinuationParameter
 
@@ -596,7 +637,10 @@ def _add_sweep(commands):
     p.add_argument("-o", "--output", required=True, help="sweep file (HDF5) to write or resume")
     p.add_argument("--scheduler", metavar="ADDRESS", help="send the members to this dask.distributed scheduler")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="local worker processes (default: all cores; 1: compute in this process)")
+                   help="local worker processes (default: all cores; 1: compute in this process; at most the CPU "
+                        "count unless --oversubscribe)")
+    p.add_argument("--oversubscribe", action="store_true",
+                   help=f"allow --workers above the CPU count (up to {MAX_WORKERS})")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--primary-only", action="store_true", help="trace the primary branch only")
     mode.add_argument("--no-pear", action="store_true",
@@ -608,6 +652,34 @@ def _add_sweep(commands):
     p.set_defaults(handler=sweep)
 
 
+MAX_WORKERS = 256  # local worker processes, even with --oversubscribe
+
+
+def cpu_count() -> int:
+    """The CPUs this process may run on (its affinity mask where the system has one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def check_workers(workers: int | None, oversubscribe: bool, scheduler: str | None) -> None:
+    """UsageError unless ``workers`` is None or in [1, CPU count] ([1, MAX_WORKERS] with ``oversubscribe``), and
+    not given with ``scheduler`` (the cluster's workers compute; local ones would be ignored); ``scheduler`` must
+    look like an address ([PROTOCOL://]HOST:PORT)."""
+    if scheduler is not None and not re.fullmatch(r"([a-z]+://)?[\w.\-\[\]:]+:\d+", scheduler):
+        raise UsageError(f"--scheduler {scheduler!r}: not a scheduler address (e.g. tcp://HOST:8786)")
+    if workers is None:
+        return
+    if scheduler is not None:
+        raise UsageError(f"--workers {workers} with --scheduler {scheduler}: the cluster's workers compute the members; "
+                         "give one of the two")
+    limit = MAX_WORKERS if oversubscribe else cpu_count()
+    if not 1 <= workers <= limit:
+        more = "" if oversubscribe else f" (the CPU count; --oversubscribe allows up to {MAX_WORKERS})"
+        raise UsageError(f"--workers {workers}: must be in [1, {limit}]{more}")
+
+
 def sweep(args) -> int:
     """Expand, compute the members not yet in the file, append them, summarise."""
     from ..io.sweep_file import incomplete_members
@@ -615,8 +687,7 @@ def sweep(args) -> int:
     from .progress import shown
     from .sweep import SweepError, format_summary, run_sweep
 
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers {args.workers}: must be >= 1")
+    check_workers(args.workers, args.oversubscribe, args.scheduler)
     from ..numerics.interrupt import sigterm_raises
 
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"

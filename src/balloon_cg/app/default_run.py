@@ -18,6 +18,7 @@ from pathlib import Path
 
 from ..analysis.tracer import ContinuationError
 from ..analysis.verdict import failing, summary_line
+from ..io.output import replacing
 from .cli import run_scene
 from .progress import shown
 from .summaries import summarise_branch
@@ -45,7 +46,9 @@ def draw_figures(paths, outdir: Path, stem: str, kinds=None) -> list[Path]:
     images = []
     for kind in applicable if kinds is None else [k for k in kinds if k in applicable]:
         image = outdir / f"{stem}_{kind}.png"
-        plot(paths, kind).savefig(image, dpi=150)
+        figure = plot(paths, kind)
+        with replacing(image, force=True) as tmp:  # the default run owns out/ (its runs are replaced too)
+            figure.savefig(tmp, dpi=150, format="png")
         images.append(image)
     return images
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import matplotlib
 
+from ..io.output import check_output, replacing
 from ..io.run_file import read_run
 from ..post.paper import PAPER_STYLE, TWO_COLUMNS, draw_figure, figures
 from ..post.plotting import Reading
@@ -19,6 +20,7 @@ from .api import analyse
 from .progress import shown
 
 IMAGE_FORMATS = (".png", ".pdf", ".svg")
+MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (docs/cli.md)
 
 
 class FigureError(ValueError):
@@ -56,33 +58,39 @@ def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> di
 
 
 def make_figure(name: str, output, runs=None, width: float = TWO_COLUMNS, reading: Reading = Reading.PRESSURE,
-                quick: bool = False, progress: bool = False) -> Path:
+                quick: bool = False, progress: bool = False, force: bool = False) -> Path:
     """Draw the paper's figure ``name`` (post.paper.figures) into the image ``output`` (.png, .pdf or .svg),
-    ``width`` inches wide; runs kept in ``runs`` (default: a folder ``runs`` next to the image)."""
+    ``width`` inches wide; runs kept in ``runs`` (default: a folder ``runs`` next to the image). An existing
+    ``output`` is replaced only with ``force`` (io.output), checked before any run is computed."""
     catalogue = figures(quick)
     if name not in catalogue:
         raise FigureError(f"figure {name!r}: not a figure of the paper (choose one of {', '.join(catalogue)}, or all)")
     output = Path(output)
     if output.suffix.lower() not in IMAGE_FORMATS:
         raise FigureError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
-    if not width > 0:
-        raise FigureError(f"--width {width}: must be > 0 inches (3.5 one column, 7.2 two)")
+    if not MIN_WIDTH <= width <= MAX_WIDTH:
+        raise FigureError(f"--width {width:g}: must be in [{MIN_WIDTH:g}, {MAX_WIDTH:g}] inches (3.5 one column, "
+                          "7.2 two)")
     figure = catalogue[name]
     runs = output.parent / "runs" if runs is None else Path(runs)
-    loaded = [run_for(case, runs, quick, progress) for case in figure.cases]
     output.parent.mkdir(parents=True, exist_ok=True)
-    with matplotlib.rc_context(PAPER_STYLE):
-        draw_figure(figure, loaded, width, reading).savefig(output)
+    check_output(output, force)
+    loaded = [run_for(case, runs, quick, progress) for case in figure.cases]
+    with matplotlib.rc_context(PAPER_STYLE), replacing(output, force) as tmp:
+        draw_figure(figure, loaded, width, reading).savefig(tmp, format=output.suffix.lower()[1:])
     return output
 
 
 def make_all(folder, runs=None, width: float = TWO_COLUMNS, reading: Reading = Reading.PRESSURE,
-             quick: bool = False, suffix: str = ".pdf", progress: bool = False) -> list[Path]:
+             quick: bool = False, suffix: str = ".pdf", progress: bool = False, force: bool = False) -> list[Path]:
     """Every figure of the paper into ``folder`` as ``<name><suffix>``; the runs shared through ``runs``
     (default: ``folder``/runs)."""
     folder = Path(folder)
     runs = folder / "runs" if runs is None else runs
-    return [make_figure(name, folder / f"{name}{suffix}", runs, width, reading, quick, progress)
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in figures(quick):  # every image checked before the first run is computed
+        check_output(folder / f"{name}{suffix}", force)
+    return [make_figure(name, folder / f"{name}{suffix}", runs, width, reading, quick, progress, force)
             for name in figures(quick)]
 
 
@@ -94,11 +102,11 @@ def command(args) -> int:
     progress = shown(args.quiet)
     if args.name == "all":
         names = list(figures(args.quick))
-        paths = make_all(args.output, args.runs, args.width, reading, args.quick, progress=progress)
+        paths = make_all(args.output, args.runs, args.width, reading, args.quick, progress=progress, force=args.force)
         runs = Path(args.output) / "runs" if args.runs is None else Path(args.runs)
     else:
         names = [args.name]
-        paths = [make_figure(args.name, args.output, args.runs, args.width, reading, args.quick, progress)]
+        paths = [make_figure(args.name, args.output, args.runs, args.width, reading, args.quick, progress, args.force)]
         runs = Path(args.output).parent / "runs" if args.runs is None else Path(args.runs)
     for path in paths:
         print(path)

@@ -9,17 +9,19 @@ def summarise_file(path) -> tuple[dict, str]:
     content (raises the readers' errors for anything else)."""
     import h5py
 
+    from ..io.layout import reading
     from ..io.run_file import RunFileError, read_run
 
     path = Path(path)
     kind = None
     if path.is_file():
         try:
-            with h5py.File(path, "r") as f:
-                kind = "sweep" if str(f.attrs.get("format", "")).startswith("balloon-cg-sweep") else \
-                    "curve" if len(f.get("two_parameter", {})) else "run"
-        except OSError:
+            f = h5py.File(path, "r")
+        except (OSError, RuntimeError):
             raise RunFileError(path, "not a readable HDF5 file") from None
+        with f, reading(path, RunFileError):
+            kind = "sweep" if str(f.attrs.get("format", "")).startswith("balloon-cg-sweep") else \
+                "curve" if len(f.get("two_parameter", {})) else "run"
     if kind == "sweep":
         summary = summarise_sweep(path)
         return summary, format_sweep(summary)
@@ -64,10 +66,11 @@ def summarise_curves(path) -> dict:
     """Provenance and, per two-parameter curve, its parameter, end, critical value and ranges."""
     import h5py
 
-    from ..io.curve_file import read_curve
+    from ..io.curve_file import CurveFileError, read_curve
     from ..io.hdf5 import plain
+    from ..io.layout import reading
 
-    with h5py.File(path, "r") as f:
+    with h5py.File(path, "r") as f, reading(path, CurveFileError):
         attrs = {k: plain(v) for k, v in f.attrs.items()}
         names = list(f["two_parameter"])
     curves = {}

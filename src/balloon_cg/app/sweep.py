@@ -30,6 +30,7 @@ from ..analysis.picture import analyse
 from ..analysis.primary import trace_primary
 from ..analysis.verdict import incomplete
 from ..io.lock import claim
+from ..io.output import check_output
 from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
                              store_path)
 from .hygiene import worker_hygiene
@@ -89,6 +90,8 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
             count = int(parts[2])
         except ValueError:
             raise SweepError(f"--vary {spec!r}: START and STOP must be numbers and COUNT an integer") from None
+        if not (np.isfinite(start) and np.isfinite(stop)):
+            raise SweepError(f"--vary {spec!r}: START and STOP must be finite numbers")
         if count < 1 or (count == 1 and start != stop):
             raise SweepError(f"--vary {spec!r}: COUNT must be >= 2 (or 1 with START = STOP)")
         if count > MAX_MEMBERS:
@@ -250,6 +253,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
     start = time.perf_counter()
     path = Path(out_path)
     with claim(path, "sweep"):
+        check_output(path, force, sweep=True)  # another kind of file there only with --force (io.output)
         members = expand(scene, specs) if members is None else members
         axes = [list(parse_vary(s, scene)) for s in specs]
         store = open_store(path, root_attrs(scene, axes, mode, len(members), command), members, force)
@@ -378,7 +382,7 @@ def _compute_dask(jobs, scheduler: str):
         raise SweepError("--scheduler needs the 'distributed' package (pip install 'balloon-cg[sweep]')") from None
     try:
         client = Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError) as e:
+    except (OSError, TimeoutError, ValueError, TypeError) as e:
         raise SweepError(f"--scheduler {scheduler}: cannot connect ({e})") from None
     try:
         _warn_slow_workers(client)

@@ -25,7 +25,7 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain
-from .layout import FileError, check_columns, require_attrs, require_group
+from .layout import FileError, check_columns, check_sizes, reading, require_attrs, require_group
 from .run_file import SPECIAL_COLUMNS, legendre_poles, read_run, read_special, root_attrs, write_special
 from .schema import attach_dimensions, describe, scale
 
@@ -73,7 +73,8 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
 
 CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_north", "lam2_south", "residual")},
                  "newton_iterations": ("int", 1), "unknowns": ("float", 2), "mode": ("float", 2)}
-CURVE_REQUIRED = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float"}
+CURVE_REQUIRED = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float",
+                  "end_description": "str", "degree": "int", "wall_time": "float"}
 CURVE_KINDS = CURVE_REQUIRED | {"parameter_key": "str", "parameter_derivative": "str"}
 
 
@@ -81,18 +82,23 @@ def read_curve(path, name: str = "pear") -> dict:
     """The datasets and attributes of a stored curve: {'attrs', datasets…, 'special_points': [dicts], 'q'}.
     Raises CurveFileError naming the file and what is missing (the file must also be a readable run file)."""
     read_run(path)  # the root attributes and /branches, checked
-    with h5py.File(path, "r") as f:
+    with h5py.File(path, "r") as f, reading(path, CurveFileError):
         curves = require_group(f, "two_parameter", path, CurveFileError)
         group = require_group(curves, name, f"{path}: two_parameter", CurveFileError)
         where = f"{path}: two_parameter/{name}"
         require_attrs(group.attrs, where, CURVE_REQUIRED, CURVE_KINDS, CurveFileError)
         check_columns(group, where, CURVE_COLUMNS, CurveFileError)
+        check_sizes(group, where, CurveFileError)
         special = require_group(group, "special_points", where, CurveFileError)
         check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS | {"q": ("float", 1)}, CurveFileError)
         data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}
         data["special_points"] = read_special(special)
         data["special_q"] = special["q"][()]
+    for key, values in (("q", data["q"]), ("pressure", data["pressure"]), ("special_points/q", data["special_q"]),
+                        ("special_points/pressure", [s["pressure"] for s in data["special_points"]])):
+        if not np.isfinite(np.asarray(values, dtype=float)).all():
+            raise CurveFileError(where, f"dataset {key} holds NaN or inf (a stored curve point is always finite)")
     return data
 
 

@@ -2,12 +2,10 @@
 
 A file is written to a temporary file in the same directory and renamed over the target (``os.replace``) only
 when complete: an existing file is never left half-written, and on any failure the temporary file is removed.
+Which outputs may be written or replaced is io.output's one rule.
 """
 import contextlib
 import datetime
-import errno
-import os
-import secrets
 import shlex
 import sys
 from pathlib import Path
@@ -18,44 +16,20 @@ import numpy as np
 import balloon_cg
 
 from ..model.kernels import generated_digest
-
-
-def check_output(path, force: bool) -> Path:
-    """``path`` as a Path, if a file may be written there (else FileExistsError, FileNotFoundError, …)."""
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    if not path.parent.is_dir():
-        raise FileNotFoundError(errno.ENOENT, "no such directory", str(path.parent))
-    if path.exists() and not force:
-        raise FileExistsError(errno.EEXIST, "already exists (use --force to overwrite it)", str(path))
-    return path
+from .output import replacing
 
 
 @contextlib.contextmanager
-def _replacing(path, force: bool):
-    """``with _replacing(path, force) as tmp:`` a temporary path next to ``path``, renamed over it when the block
-    completes, removed on any failure."""
-    path = check_output(path, force)
-    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-@contextlib.contextmanager
-def atomic_file(path, force: bool = False):
-    """``with atomic_file(path) as f:`` a new h5py.File that replaces ``path`` when the block completes."""
-    with _replacing(path, force) as tmp, h5py.File(tmp, "x") as f:
+def atomic_file(path, force: bool = False, keep_store: bool = False):
+    """``with atomic_file(path) as f:`` a new h5py.File that replaces ``path`` when the block completes
+    (io.output.replacing: the one rule for outputs; ``keep_store`` only for a sweep's own view)."""
+    with replacing(path, force, keep_store=keep_store) as tmp, h5py.File(tmp, "x") as f:
         yield f
 
 
 def atomic_bytes(path, data: bytes, force: bool = False) -> Path:
     """Write ``data`` (a file image) to ``path`` as atomically as ``atomic_file``."""
-    with _replacing(path, force) as tmp, open(tmp, "xb") as f:
+    with replacing(path, force) as tmp, open(tmp, "xb") as f:
         f.write(data)
     return Path(path)
 
@@ -85,4 +59,7 @@ def write_strings(group, name: str, values) -> None:
 
 def plain(value):
     """numpy scalars as Python numbers/bools, for printing and JSON."""
-    return value.item() if isinstance(value, np.generic) else value
+    if not isinstance(value, np.generic):
+        return value
+    item = value.item()  # a long double stays a numpy scalar: its nearest Python number
+    return item if not isinstance(item, np.generic) else complex(item) if np.iscomplexobj(item) else float(item)

@@ -4,6 +4,11 @@ A column spec maps a dataset name to its kind (``float``, ``int``, ``bool``, ``s
 one spec has the same first dimension n (``check_columns`` returns it). Kinds are numpy dtype kinds:
 float 'f', int 'iu', bool 'b', str an HDF5 string type.
 """
+import contextlib
+import errno
+import os
+import stat
+
 import h5py
 import numpy as np
 
@@ -20,15 +25,74 @@ _KINDS = {"float": "f", "int": "iu", "bool": "b"}
 
 
 def _kind_ok(dtype, kind: str) -> bool:
+    """float: float64 exactly, or an integer of at most 8 bytes (exact floats); int: at most 8 bytes (a long double
+    or a 16-byte integer read as data gave wrong numbers and unbounded recursion in JSON)."""
     if kind == "str":
         return h5py.check_string_dtype(dtype) is not None
     if kind == "float":
-        return dtype.kind in "fiu"  # integers are exact floats
+        return dtype == np.float64 or (dtype.kind in "iu" and dtype.itemsize <= 8)
+    if kind == "int":
+        return dtype.kind in "iu" and dtype.itemsize <= 8
     return dtype.kind in _KINDS[kind]
+
+
+# A dataset may declare at most this many bytes per byte of its file, and always MIN_DECLARED (gzip'd profiles of
+# a smooth shape compress by 5-20; a damaged header declaring 1e11 doubles in 200 KB must not be allocated).
+DECLARED_PER_FILE_BYTE = 1000
+MIN_DECLARED = 64 * 1024**2
+
+
+def check_size(item, where, error=FileError) -> None:
+    """``error`` when the dataset ``item`` declares more bytes than its file can hold (the bound above)."""
+    declared = int(np.prod(item.shape, dtype=object) or 0) * item.dtype.itemsize
+    try:
+        size = item.file.id.get_filesize()
+    except (OSError, RuntimeError, ValueError):
+        size = 0
+    if declared > max(MIN_DECLARED, DECLARED_PER_FILE_BYTE * size):
+        raise error(where, f"dataset {item.name} declares {declared / 1024**2:.3g} MiB in a file of "
+                           f"{size / 1024:.3g} KiB (damaged)")
+
+
+def check_sizes(group, where, error=FileError) -> None:
+    """check_size for every dataset directly in ``group`` (those a reader loads wholesale)."""
+    for item in group.values():
+        if isinstance(item, h5py.Dataset):
+            check_size(item, where, error)
+
+
+def check_input(path, error=FileError) -> None:
+    """``path`` is a regular file (FileNotFoundError, IsADirectoryError, or ``error`` for a FIFO, a device, a
+    socket: opening one could block forever or never end)."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise FileNotFoundError(errno.ENOENT, "no such file", str(path)) from None
+    if stat.S_ISDIR(mode):
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if not stat.S_ISREG(mode):
+        raise error(path, "not a regular file (a FIFO, a device or a socket)")
+
+
+@contextlib.contextmanager
+def reading(path, error=FileError):
+    """Map what h5py raises on a damaged file while it is read (OSError, RuntimeError: bit flips, corrupted
+    chunks, a truncated file; RecursionError on absurd types; KeyError "Unable to open object" on a damaged
+    object header) to ``error(path, ...)``; a missing file or folder stays an OSError naming it."""
+    try:
+        yield
+    except (FileNotFoundError, IsADirectoryError, PermissionError):
+        raise
+    except (OSError, RuntimeError, KeyError) as e:
+        text = str(e).strip("'\"").splitlines()[0] if str(e) else type(e).__name__
+        if isinstance(e, KeyError) and not text.startswith("Unable to"):
+            raise  # a KeyError not from HDF5's error stack (h5py's "Unable to open object ...") is a bug
+        raise error(path, f"damaged: unreadable data ({text[:160]})") from None
 
 
 def require_attrs(attrs, where, keys, kinds: dict | None = None, error=FileError) -> None:
     """Every key of ``keys`` present in ``attrs`` (and of the kind ``kinds[key]`` where given)."""
+    keys = list(keys)
     missing = [k for k in keys if k not in attrs]
     if missing:
         raise error(where, f"missing attribute{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
@@ -41,7 +105,7 @@ def require_attrs(attrs, where, keys, kinds: dict | None = None, error=FileError
         elif kind == "str[]":
             ok = isinstance(value, np.ndarray) and value.ndim == 1 and (value.dtype == object or value.size == 0)
         elif kind == "float[]":
-            ok = isinstance(value, np.ndarray) and value.ndim == 1 and value.dtype.kind in "fiu"
+            ok = isinstance(value, np.ndarray) and value.ndim == 1 and _kind_ok(value.dtype, "float")
         else:
             ok = np.ndim(value) == 0 and _kind_ok(np.asarray(value).dtype, kind)
         if not ok:
@@ -58,9 +122,10 @@ def check_columns(group, where, spec: dict, error=FileError, rows: int | None = 
             raise error(where, f"missing dataset {name}")
         if not isinstance(item, h5py.Dataset):
             raise error(where, f"{name} is not a dataset")
-        if len(item.shape) != ndim or not _kind_ok(item.dtype, kind):
+        if item.shape is None or len(item.shape) != ndim or not _kind_ok(item.dtype, kind):
             raise error(where, f"dataset {name} has shape {item.shape} and type {item.dtype}, expected "
                                f"{ndim}-d {kind}")
+        check_size(item, where, error)
         if rows is None and ndim >= 1:
             rows = item.shape[0]
         elif ndim >= 1 and item.shape[0] != rows:

@@ -16,6 +16,8 @@ import os
 import re
 from pathlib import Path
 
+from .output import check_folder
+
 
 class OutputInUse(OSError):
     """Another live process owns this output (exit code 2: wait for it, or choose another output)."""
@@ -38,8 +40,7 @@ def claim(path, what: str = "balloon-cg"):
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    if not path.parent.is_dir():
-        raise FileNotFoundError(errno.ENOENT, "no such directory", str(path.parent))
+    check_folder(path)  # a folder we cannot write in names the output, not the lock file
     lock = lock_path(path)
     while True:
         fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)

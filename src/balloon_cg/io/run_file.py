@@ -53,7 +53,6 @@ still read: "balloon-cg/3" (no ``m`` attribute, no surface branches: every branc
 "balloon-cg/2" (no volume, no dimension scales), and so do files without amount, control or the gas stability
 flags (written before gas control).
 """
-import errno
 import io
 from pathlib import Path
 
@@ -61,7 +60,7 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain, provenance, write_strings
-from .layout import FileError, check_columns, require_attrs, require_group
+from .layout import FileError, check_columns, check_input, check_sizes, reading, require_attrs, require_group
 from .schema import attach_dimensions, scale
 
 FORMAT = "balloon-cg/4"
@@ -416,21 +415,18 @@ def read_run(path) -> dict:
     (format balloon-cg/3 or /2), naming the file and what is missing or wrong.
     """
     path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    if not path.exists():
-        raise FileNotFoundError(errno.ENOENT, "no such file", str(path))
+    check_input(path, RunFileError)
     try:
         f = h5py.File(path, "r")
-    except OSError:
+    except (OSError, RuntimeError):
         raise RunFileError(path, "not a readable HDF5 file") from None
-    with f:
+    with f, reading(path, RunFileError):
         return _read_open(f, path) | {"path": str(path)}
 
 
 def read_run_image(image: bytes, label: str = "run") -> dict:
     """``read_run`` of a file image (``run_image``); 'path' is None and errors name ``label``."""
-    with h5py.File(io.BytesIO(image), "r") as f:
+    with reading(label, RunFileError), h5py.File(io.BytesIO(image), "r") as f:
         return _read_open(f, label) | {"path": None}
 
 
@@ -443,6 +439,11 @@ def _read_open(f, label) -> dict:
     if "complete" in f.attrs:
         require_attrs(f.attrs, label, VERDICT_KINDS, VERDICT_KINDS, error=RunFileError)
     attrs = {k: _attr(v) for k, v in f.attrs.items()}
+    if plain(fmt) == FORMAT:  # the current format always writes them (older ones may lack them: OPTIONAL_COLUMNS)
+        for name, branch in require_group(f, "branches", label, RunFileError).items():
+            missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
+            if missing:
+                raise RunFileError(f"{label}: branch {name}", f"missing dataset {missing[0]}")
     return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f, label, RunFileError)}
 
 
@@ -468,6 +469,8 @@ BRANCH_COLUMNS = {**{name: ("float", 1) for name in ("pressure", *POLES, "lam1_e
 PROFILES = {name: ("float", 2) for name in ("lam1", "lam2", "rho", "eta")}
 SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int", 1), "m": ("int", 1),
                    **{name: ("float", 1) for name in SPECIAL_NUMBERS}, "unknowns": ("float", 2)}
+OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage")}  # absent in older formats
+PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
 
@@ -485,8 +488,23 @@ def read_branches(parent, where, error=None) -> dict:
     snaps = parent.get("snap_throughs")
     if snaps is not None:
         check_columns(snaps, f"{where}: snap_throughs", SNAP_COLUMNS, error)
+        _check_snaps(snaps, group, f"{where}: snap_throughs", error)
     return {"branches": {name: _read_branch(group[name]) for name in _branch_order(group)},
             "snap_throughs": _read_snaps(snaps)}
+
+
+def _check_snaps(snaps, branches, where, error) -> None:
+    """Every snap-through names stored branches and points on them (its target may be none: '' and −1)."""
+    for end in ("from", "to"):
+        names = snaps[f"{end}_branch"].asstr()[()]
+        indices = snaps[f"{end}_index"][()]
+        for name, index in zip(names, indices):
+            if end == "to" and name == "" and index == -1:
+                continue
+            if name not in branches:
+                raise error(where, f"{end}_branch {name!r} names no stored branch")
+            if not 0 <= index < branches[name]["pressure"].shape[0]:
+                raise error(where, f"{end}_index {index} is not a point of branch {name!r}")
 
 
 def check_branch(group, where, error) -> None:
@@ -495,15 +513,23 @@ def check_branch(group, where, error) -> None:
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
     require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS, error)
+    if "parent_branch" in group.attrs:
+        require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
+    check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items() if k in group}, error, rows=n)
+    check_sizes(group, where, error)
     width = group["unknowns"].shape[1]
     t = check_columns(group, where, {"theta": ("float", 1)}, error)
     check_columns(require_group(group, "profiles", where, error), f"{where}: profiles", PROFILES, error, rows=n)
+    check_sizes(group["profiles"], f"{where}: profiles", error)
     for name, item in group["profiles"].items():
         if item.shape[1:] != (t,):
             raise error(f"{where}: profiles", f"dataset {name} has shape {item.shape}, expected ({n}, {t})")
     special = require_group(group, "special_points", where, error)
     check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
+    check_columns(special, f"{where}: special_points", {k: ("float", 1) for k in ("voltage",) if k in special}, error,
+                  rows=special["kind"].shape[0])
+    check_sizes(special, f"{where}: special_points", error)
     if special["unknowns"].shape[1:] != (width,) and special["unknowns"].shape[0]:
         raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
                                                 f"expected {width}")
@@ -512,6 +538,7 @@ def check_branch(group, where, error) -> None:
         flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
         lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
         check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
+        check_sizes(stability, f"{where}: stability", error)
 
 
 def branch_m(group, where, error) -> int:
@@ -534,6 +561,8 @@ def check_surface_branch(group, where, error) -> None:
     stability of consistent shapes."""
     require_attrs(group.attrs, where, (*SURFACE_KINDS, "symmetry", "characters"), SURFACE_KINDS, error)
     n = check_columns(group, where, SURFACE_COLUMNS, error, min_rows=1)
+    check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items() if k in group}, error, rows=n)
+    check_sizes(group, where, error)
     size = stored_basis(group.attrs, where, error).size
     if group["coefficients"].shape[1] != size:
         raise error(where, f"coefficients has {group['coefficients'].shape[1]} columns, expected {size} (the size "
@@ -542,6 +571,9 @@ def check_surface_branch(group, where, error) -> None:
         raise error(where, f"centroid has shape {group['centroid'].shape}, expected ({n}, 3)")
     special = require_group(group, "special_points", where, error)
     check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
+    check_columns(special, f"{where}: special_points", {k: ("float", 1) for k in ("voltage",) if k in special}, error,
+                  rows=special["kind"].shape[0])
+    check_sizes(special, f"{where}: special_points", error)
     if special["unknowns"].shape[0] and special["unknowns"].shape[1] != size + 1:
         raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
                                                 f"expected {size + 1}")
@@ -550,6 +582,7 @@ def check_surface_branch(group, where, error) -> None:
         flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
         lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
         check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
+        check_sizes(stability, f"{where}: stability", error)
 
 
 def stored_basis(attrs, where="", error=FileError):

@@ -39,9 +39,10 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain, provenance
+from .output import store_path
 from .lock import remove_debris
 from .run_file import read_branches, verdict_attrs, write_branches
-from .layout import FileError, require_attrs
+from .layout import FileError, check_input, reading, require_attrs
 
 FORMAT = "balloon-cg-sweep/2"
 FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
@@ -59,11 +60,6 @@ class SweepError(ValueError):
 
 class SweepFileError(FileError):
     """A sweep file or store that cannot be read (not a sweep, damaged: names the file and what is missing)."""
-
-
-def store_path(path) -> Path:
-    path = Path(path)
-    return path.with_name(f"{path.name}.members")
 
 
 def staging_path(path) -> Path:
@@ -252,7 +248,7 @@ def _scene_diff(old: str, new: str) -> str:
 def consolidate(path, directory: Path) -> None:
     """Rebuild the sweep file ``path`` from the store ``directory`` (atomically replacing it)."""
     path = Path(path)
-    with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True) as f:
+    with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True, keep_store=True) as f:
         _copy_attrs(manifest, f)
         f.attrs["format"] = FORMAT
         f.attrs["store"] = store_path(path).name
@@ -302,13 +298,14 @@ def _copy_group(src, dst) -> None:
 
 @contextlib.contextmanager
 def _open(path):
+    check_input(path, SweepFileError)
     try:
         f = h5py.File(path, "r")
     except FileNotFoundError:
         raise
-    except OSError:
+    except (OSError, RuntimeError):
         raise SweepFileError(path, "not a readable HDF5 file (damaged or not HDF5)") from None
-    with f:
+    with f, reading(path, SweepFileError):
         yield f
 
 
@@ -317,8 +314,6 @@ def read_sweep(path) -> dict:
     from a sweep file (the view, or a format /1 file). Branches are dicts as read by io.run_file.read_run.
     Raises SweepFileError naming the file and what is missing."""
     path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(2, "no such file", str(path))
     with _open(path) as f:
         if plain(f.attrs.get("format")) not in FORMATS:
             raise SweepFileError(path, f"not a balloon-cg sweep file (format {plain(f.attrs.get('format'))!r}, "

@@ -13,16 +13,32 @@ parameters, the voltage) are kernel arguments and never enter the key. The text 
 place with ``os.replace`` (atomic on one file system): concurrent sweep workers generating the same class all
 succeed, each finds either no module or a complete one, and the deterministic text makes the winner irrelevant.
 
+Generation runs in a child process (``python -m balloon_cg.model.kernel_cache``) under a time budget
+(GENERATION_TIMEOUT seconds, $BALLOON_CG_CODEGEN_TIMEOUT to change it) and a memory bound (GENERATION_MEMORY
+bytes of address space), and the module it prints is at most MAX_MODULE_CHARS long: a formula within
+scene/formula's bounds that still outgrows them is refused with one line naming it (SceneError, exit 2), and
+SIGINT or SIGTERM stops the generation at once (KeyboardInterrupt, exit 130; the child is killed, and dies with
+its parent). The cached file ends with a line holding the SHA-256 of the
+module text above it (``# content-sha256 HEX``); a file whose digest does not match (truncated, empty, garbled)
+is regenerated with a KernelCacheWarning before it is imported.
+
 This is the only runtime module that imports SymPy or codegen (tests/test_layers.py).
 """
+import contextlib
+import ctypes
 import functools
 import hashlib
 import importlib.metadata
 import importlib.util
+import json
 import os
+import signal
+import subprocess
 import sys
 import tempfile
+import threading
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +47,15 @@ from ..scene import formula as formula_module
 from ..scene.validation import SceneError
 
 CACHE_ENV = "BALLOON_CG_KERNEL_CACHE"
+TIMEOUT_ENV = "BALLOON_CG_CODEGEN_TIMEOUT"
+GENERATION_TIMEOUT = 600.0  # seconds (a user formula at the bounds of scene/formula takes about a minute)
+GENERATION_MEMORY = 2 * 1024**3  # bytes of address space of the generating process
+MAX_MODULE_CHARS = 2_000_000  # a generated module's text (the largest committed one: 85 kB)
+DIGEST_MARK = "# content-sha256 "
+
+
+class KernelCacheWarning(UserWarning):
+    """A cached kernel module was damaged (its content digest does not match) and is generated again."""
 
 
 def cache_dir() -> Path:
@@ -106,18 +131,23 @@ def generate(material, field: bool, timings: dict | None = None, electric: bool 
 
 
 def load(material, field: bool, timings: dict | None = None, electric: bool = False, surface: bool = False):
-    """The kernel module of the class (``surface``: its surface kernels), generated and written atomically into
-    the cache first if missing; imported once per process (as ``sys.modules[module_name]``)."""
+    """The kernel module of the class (``surface``: its surface kernels), generated (bounded_generate) and written
+    atomically into the cache first if missing or damaged; imported once per process (as
+    ``sys.modules[module_name]``)."""
     path = module_path(material, field, electric, surface)
     if path.stem in sys.modules:
         return sys.modules[path.stem]
-    if not path.is_file():
-        text = generate(material, field, timings, electric, surface)
+    damage = _damage(path)
+    if damage is not None:
+        if damage != "missing":
+            warnings.warn(f"{path}: damaged cached kernel module ({damage}); generating it again", KernelCacheWarning,
+                          stacklevel=2)
+        text = bounded_generate(material, field, timings, electric, surface)
         start = time.perf_counter()
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",
                                          delete=False, encoding="utf-8") as handle:
-            handle.write(text)
+            handle.write(sealed(text))
         os.replace(handle.name, path)
         if timings is not None:
             timings["write"] = time.perf_counter() - start
@@ -129,3 +159,136 @@ def load(material, field: bool, timings: dict | None = None, electric: bool = Fa
     if timings is not None:
         timings["import"] = time.perf_counter() - start
     return module
+
+
+def sealed(text: str) -> str:
+    """The module text with its content digest as the last line (what the cache holds)."""
+    text = text if text.endswith("\n") else text + "\n"
+    return f"{text}{DIGEST_MARK}{hashlib.sha256(text.encode('utf-8')).hexdigest()}\n"
+
+
+def _damage(path: Path) -> str | None:
+    """None when ``path`` is a whole cached module (its last line is the digest of the text above it), else what
+    is wrong ('missing', 'no digest line', 'digest mismatch', …)."""
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return "missing"
+    except OSError as e:
+        return f"unreadable: {e.strerror or e}"
+    body, mark, tail = data.rpartition(DIGEST_MARK.encode())
+    if not mark or not body.endswith(b"\n") or not tail.endswith(b"\n"):
+        return "empty" if not data else "no digest line (truncated?)"
+    if hashlib.sha256(body).hexdigest().encode() != tail.strip():
+        return "digest mismatch (garbled?)"
+    return None
+
+
+def bounded_generate(material, field: bool, timings: dict | None = None, electric: bool = False,
+                     surface: bool = False) -> str:
+    """``generate`` in a child process under the time budget and memory bound (SceneError naming the formula
+    when one is hit); SIGINT or SIGTERM here raises KeyboardInterrupt after killing the child."""
+    _sympy_version()
+    request = {"field": bool(field), "electric": bool(electric), "surface": bool(surface),
+               **({"alphas": material.alphas} if isinstance(material, Exponents) else
+                  {"formula": material.text, "parameters": list(material.parameters)})}
+    budget = _budget()
+    what = (f"material.energy = {material.text!r}" if not isinstance(material, Exponents) else
+            f"the Ogden class with exponents {material.alphas}")
+    child = subprocess.Popen([sys.executable, "-m", __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)  # no preexec_fn: unsafe in a threaded worker
+    try:
+        with _signals_raise():
+            out, err = child.communicate(json.dumps(request), timeout=budget)
+    except subprocess.TimeoutExpired:
+        raise SceneError(f"{what}: its kernels were not generated within {budget:g} s (the time budget, "
+                         f"${TIMEOUT_ENV} raises it); simplify the formula") from None
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    if child.returncode == _OUT_OF_MEMORY:
+        raise SceneError(f"{what}: generating its kernels needs more than {GENERATION_MEMORY / 1024**3:g} GiB "
+                         "(the memory bound); simplify the formula")
+    if child.returncode != 0:
+        lines = err.strip().splitlines()
+        raise RuntimeError(f"kernel generation failed for {what}: {lines[-1] if lines else child.returncode}")
+    reply = json.loads(out)
+    if timings is not None:
+        timings.update(reply["timings"])
+    return checked_size(reply["text"], what)
+
+
+def checked_size(text: str, what: str) -> str:
+    """``text`` if the module is at most MAX_MODULE_CHARS long (the size of the expanded derivatives, after CSE:
+    numba's compile time grows with it), else SceneError naming ``what``."""
+    if len(text) > MAX_MODULE_CHARS:
+        raise SceneError(f"{what}: its kernels would be {len(text) / 1e6:.3g} MB of code; at most "
+                         f"{MAX_MODULE_CHARS / 1e6:g} MB (the committed classes are below 0.1 MB); simplify the "
+                         "formula")
+    return text
+
+
+_OUT_OF_MEMORY = 75
+
+
+def _budget() -> float:
+    text = os.environ.get(TIMEOUT_ENV)
+    if not text:
+        return GENERATION_TIMEOUT
+    try:
+        budget = float(text)
+    except ValueError:
+        budget = -1.0
+    if not 0 < budget < float("inf"):
+        raise SceneError(f"${TIMEOUT_ENV} = {text!r}: must be a number of seconds > 0")
+    return budget
+
+
+def _child_limits() -> None:
+    """In the generating child, first thing: the memory bound, and death with its parent (Linux)."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (GENERATION_MEMORY, GENERATION_MEMORY))
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+
+
+@contextlib.contextmanager
+def _signals_raise():
+    """SIGINT and SIGTERM raise KeyboardInterrupt for the duration (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+
+
+def _child_main() -> int:
+    """The generating child: the request (JSON) on stdin, {'text', 'timings'} (JSON) on stdout."""
+    _child_limits()
+    request = json.loads(sys.stdin.read())
+    if "alphas" in request:
+        alphas = request["alphas"]
+        material = Exponents(None if alphas is None else tuple(alphas))
+    else:
+        material = formula_module.parse_formula(request["formula"], tuple(request["parameters"]))
+    timings = {}
+    try:
+        text = generate(material, request["field"], timings, request["electric"], request["surface"])
+    except MemoryError:
+        return _OUT_OF_MEMORY
+    json.dump({"text": text, "timings": timings}, sys.stdout)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_child_main())

@@ -33,6 +33,7 @@ from scipy.interpolate import PchipInterpolator
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import read_curve
+from ..io.layout import FileError, check_input, reading
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
 
@@ -963,7 +964,12 @@ def plot_phase(paths, axes=None) -> Figure:
     if any(isinstance(path, dict) for path in paths):
         raise PlotError("phase draws curve files (balloon-cg critical) or sweep files, not runs")
     for path in paths:
-        with h5py.File(path, "r") as f:
+        check_input(path)
+        try:
+            f = h5py.File(path, "r")
+        except (OSError, RuntimeError):
+            raise FileError(path, "not a readable HDF5 file") from None
+        with f, reading(path):
             names = list(f.get("two_parameter", {}))
             is_sweep = "members" in f
         if is_sweep:

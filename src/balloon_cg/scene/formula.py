@@ -13,12 +13,20 @@ of MODEL.md §2, moduli in units of μ/2 (``"I1 - 3"`` is the neo-Hookean preset
 import ast
 import cmath
 import functools
+import math
 from dataclasses import dataclass
 
 from .validation import SceneError, show
 
 MAX_LENGTH = 2000
 MAX_DEPTH = 60
+# Bounds on what the kernels' derivation will face (docs/scenes.md, Bounds), checked on the tree before SymPy
+# sees it: SymPy evaluates a power of numbers eagerly ((1/3)**(10**9) never returns), and the derivatives of deeply
+# nested functions grow without bound (sinh nested 8 deep takes minutes).
+MAX_NODES = 300  # numbers, names, operators and calls in the tree
+MAX_CALL_DEPTH = 3  # functions nested in functions: exp(sinh(tanh(I1 - 3))) is 3
+MAX_EXPONENT = 32  # |a constant exponent|, and the product of nested ones: (I1**8)**4 is 32
+MAX_CONSTANT = 1e12  # |a number|, and |a subexpression of numbers only|
 STRETCHES = ("lambda1", "lambda2", "lambda3")
 INVARIANTS = ("I1", "I2")
 SYMBOLS = STRETCHES + INVARIANTS
@@ -64,12 +72,15 @@ def parse_formula(text, parameters=(), key: str = "material.energy") -> Formula:
         if not name.isidentifier() or name in SYMBOLS or name in _ALIASES or name in FUNCTIONS:
             raise SceneError(f"{key}: parameter name {show(name)} must be an identifier other than "
                              f"{', '.join(SYMBOLS + tuple(FUNCTIONS))}")
-    tree = _check(text.replace("^", "**"), parameters, key)
+    source = text.replace("^", "**")
+    tree = _check(source, parameters, key)
     canonical = ast.unparse(tree)
+    _bound(tree.body, source, key)
     used = frozenset(n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and n.id in SYMBOLS)
     unused = [p for p in parameters if p not in {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}]
     if unused:
-        raise SceneError(f"{key}.parameters.{unused[0]}: not used by the formula {show(canonical)}")
+        table = key.removesuffix(".energy")  # material.energy's parameters are material.parameters
+        raise SceneError(f"{table}.parameters.{unused[0]}: not used by the formula {show(canonical)}")
     return Formula(canonical, parameters, used)
 
 
@@ -116,6 +127,75 @@ def _check(text: str, parameters: tuple, key: str) -> ast.Expression:
 
     visit(tree, 0)
     return tree
+
+
+def _bound(tree: ast.expr, text: str, key: str) -> None:
+    """SceneError naming the formula when the checked tree exceeds a bound above (MAX_NODES, MAX_CALL_DEPTH,
+    MAX_EXPONENT, MAX_CONSTANT), or when a subexpression of numbers only has no finite value (1/0, exp(1e6)).
+    Numbers are combined in complex floating point, each exponent checked before its power is taken: nothing
+    here can be slow."""
+    def refuse(what: str):
+        raise SceneError(f"{key} = {show(text if len(text) <= 120 else text[:117] + '...')}: {what}")
+
+    nodes = sum(1 for n in ast.walk(tree) if isinstance(n, (ast.Constant, ast.Name, ast.BinOp, ast.UnaryOp,
+                                                              ast.Call)))
+    if nodes > MAX_NODES:
+        refuse(f"{nodes} terms (numbers, names, operations); at most {MAX_NODES}")
+
+    def value(node, calls: int, power: float):
+        """The number ``node`` stands for (complex), or None when it holds a symbol or parameter."""
+        if isinstance(node, ast.Constant):
+            try:
+                number = complex(node.value)
+            except OverflowError:
+                number = complex(math.inf)
+            if not abs(number) <= MAX_CONSTANT:
+                refuse(f"the number {_token(text, node)} is beyond ±{MAX_CONSTANT:g}")
+            return number
+        if isinstance(node, ast.Name):
+            return None
+        if isinstance(node, ast.UnaryOp):
+            inner = value(node.operand, calls, power)
+            return None if inner is None else (-inner if isinstance(node.op, ast.USub) else inner)
+        if isinstance(node, ast.Call):
+            if calls + 1 > MAX_CALL_DEPTH:
+                refuse(f"functions nested {calls + 1} deep; at most {MAX_CALL_DEPTH}")
+            inner = value(node.args[0], calls + 1, 1.0)
+            return None if inner is None else _constant(refuse, node, text,
+                                                        lambda: getattr(cmath, node.func.id)(inner))
+        if isinstance(node.op, ast.Pow):
+            exponent = value(node.right, calls, 1.0)
+            if exponent is not None:
+                if not abs(exponent) <= MAX_EXPONENT:
+                    refuse(f"the exponent {_token(text, node.right)} is beyond ±{MAX_EXPONENT}")
+                power *= max(abs(exponent), 1.0)
+                if power > MAX_EXPONENT:
+                    refuse(f"nested powers multiply to an exponent of {power:g}; at most {MAX_EXPONENT}")
+            base = value(node.left, calls, power)
+            if base is None or exponent is None:
+                return None
+            if base == 0 and exponent.real <= 0:
+                refuse(f"{_token(text, node)}: zero to a power ≤ 0")
+            return _constant(refuse, node, text, lambda: base**exponent)
+        left, right = value(node.left, calls, power), value(node.right, calls, power)
+        if left is None or right is None:
+            return None
+        if isinstance(node.op, ast.Div) and right == 0:
+            refuse(f"{_token(text, node)}: division by zero")
+        return _constant(refuse, node, text, lambda: _OPS[_BINARY[type(node.op)]](left, right))
+
+    value(tree, 0, 1.0)
+
+
+def _constant(refuse, node, text: str, compute) -> complex:
+    """``compute()``, a subexpression of numbers, if finite and within ±MAX_CONSTANT (else ``refuse``)."""
+    try:
+        number = complex(compute())
+    except (OverflowError, ZeroDivisionError, ValueError):
+        number = complex(math.inf)
+    if not (math.isfinite(number.real) and math.isfinite(number.imag) and abs(number) <= MAX_CONSTANT):
+        refuse(f"{_token(text, node)} is not a finite number within ±{MAX_CONSTANT:g}")
+    return number
 
 
 def _token(text: str, node) -> str:

@@ -59,6 +59,9 @@ def get_preset(name: str) -> Material | StrainEnergy:
     raise KeyError(name)
 
 
+MAX_EXPONENT = 100.0  # docs/scenes.md, Bounds: |an Ogden exponent| (λ^100 at λ = 5 is 8e69, still finite)
+
+
 def material_from_table(data: dict) -> Material | StrainEnergy:
     """The material of a ``[material]`` table (+ ``name``): ``preset = "NAME"``; Ogden ``mu``/``alpha``;
     ``family = "KEY"`` or ``energy = "FORMULA"``, each with a ``[material.parameters]`` table."""
@@ -95,8 +98,9 @@ def material_from_table(data: dict) -> Material | StrainEnergy:
             "they must match"
         )
     for i, a in enumerate(alpha):
-        if a == 0:
-            raise SceneError(f"material.alpha[{i}] = {show(data['alpha'][i])}: exponents must be nonzero")
+        if a == 0 or abs(a) > MAX_EXPONENT:
+            raise SceneError(f"material.alpha[{i}] = {show(data['alpha'][i])}: exponents must be nonzero and within "
+                             f"±{MAX_EXPONENT:g}")
     material = Material(name or "custom", mu, alpha)
     if material.shear_modulus_sum <= 0:
         raise SceneError(

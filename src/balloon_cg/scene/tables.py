@@ -7,7 +7,9 @@ one-line message names the file (or scene), the dotted key, the value and what i
 import enum
 import errno
 import math
+import os
 import re
+import stat
 import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from dataclasses import field as dataclass_field
@@ -149,11 +151,25 @@ class Output:
     """Sampling of the reported shapes and fields: ``theta_points`` values of θ on [0, π]."""
 
     theta_points: int = 181
+    memory_limit: float = 2.0  # GiB: the bound on products of keys (_check_products)
 
 
 _TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric", "surface")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
+# docs/scenes.md, Bounds: ranges that keep the computation finite (the paper's values are far inside them)
+MAX_COILS = 64
+MAX_COIL_DISTANCE = 1e3  # |radius|, |height| of a coil
+MAX_CURRENT = 1e3  # |current| of a coil (relative currents: only ratios and M matter)
+MAX_M = 1e3  # field.M (the paper's isolas close near M = 0.003; critical curves in M pass M = 4)
+MAX_CHI = 100.0
+MAX_VOLTAGE = 10.0  # electric.voltage, continuation.stop_voltage (a sphere's voltage peaks below 1)
+MAX_STRETCH = 100.0  # continuation.start_stretch, stop_stretch
+MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
+MAX_WIRE_GAP = 10.0
+MIN_TOLERANCE = 1e-15  # solver.tol, solver.max_error (below rounding no Newton step converges)
+PROFILE_ARRAYS = 8  # doubles per (point, θ) while a branch's profiles are computed (io.run_file, galerkin.profiles)
+MAX_SCENE_BYTES = 1 << 20  # a scene file (a scene needs a few hundred bytes)
 
 
 @dataclass(frozen=True)
@@ -185,7 +201,9 @@ class Scene:
             "material": m.to_table() if isinstance(m, StrainEnergy) else
             {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
-            **{t: asdict(getattr(self, t)) for t in _TABLES[2:6]},
+            **{t: asdict(getattr(self, t)) for t in _TABLES[2:5]},
+            "output": {k: v for k, v in asdict(self.output).items()  # memory_limit only when set: older texts stay
+                       if k != "memory_limit" or v != Output.memory_limit},
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
                                                                   "control": self.loading.control.value}}),
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
@@ -269,6 +287,9 @@ def load_scene(path) -> Scene:
     """Read a scene file; the scene is named after the file stem, error messages after the file name. A bare
     name that is not a file (``"spom1"``, ``"spom1.toml"``) names a scene shipped with the package
     (``shipped_scenes()``)."""
+    if str(path) == "":
+        raise FileNotFoundError(errno.ENOENT, "an empty scene path (give a scene file or a shipped scene's name)",
+                                "''")
     path = Path(path)
     shipped = path.name.removesuffix(".toml")
     if not path.exists() and path.parent == Path("."):
@@ -276,11 +297,22 @@ def load_scene(path) -> Scene:
             raise FileNotFoundError(errno.ENOENT, "no such file, nor the name of a scene shipped with the package "
                                     f"({', '.join(sorted(shipped_scenes()))})", str(path))
         path = shipped_scenes()[shipped]
+    return _parse(_read_text(path), path.stem, path.name)
+
+
+def _read_text(path: Path) -> str:
+    """The text of the scene file ``path``: a regular file (not a folder, FIFO or device, which could block or
+    never end) of at most MAX_SCENE_BYTES, in UTF-8."""
+    with open(path, "rb", opener=lambda name, flags: os.open(name, flags | os.O_NONBLOCK)) as handle:
+        if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+            raise SceneError(f"{path}: not a regular file (a scene is a TOML file)")
+        data = handle.read(MAX_SCENE_BYTES + 1)
+    if len(data) > MAX_SCENE_BYTES:
+        raise SceneError(f"{path.name}: larger than {MAX_SCENE_BYTES // 1024} KiB (a scene needs a few hundred bytes)")
     try:
-        text = path.read_text(encoding="utf-8")
+        return data.decode("utf-8")
     except UnicodeDecodeError as e:
         raise SceneError(f"{path.name}: not UTF-8 text ({e})") from None
-    return _parse(text, path.stem, path.name)
 
 
 def shipped_scenes() -> dict[str, Path]:
@@ -334,6 +366,8 @@ def _build(data: dict, name: str, text: str) -> Scene:
     if loading.control != Control.PRESSURE and continuation.parameter == ContinuationParameter.VOLTAGE:
         raise SceneError(f'loading.control = "{loading.control.value}": a voltage continuation '
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
+    output = _output(data.get("output", {}))
+    _check_products(continuation, output)
     return Scene(
         name=name,
         material=material,
@@ -341,7 +375,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         continuation=continuation,
         solver=_solver(data.get("solver", {})),
         stability=_stability(data.get("stability", {})),
-        output=_output(data.get("output", {})),
+        output=output,
         electric=electric,
         text=text,
         loading=loading,
@@ -372,12 +406,14 @@ def _keys(cls) -> tuple[str, ...]:
 def _field(data) -> Field:
     data = table("field", data, _keys(Field))
     get = _getter(data, "field", Field)
-    chi = get("chi", lambda x: x >= 0, ">= 0")
-    M = get("M", lambda x: x >= 0, ">= 0")
+    chi = get("chi", lambda x: 0 <= x <= MAX_CHI, f"in [0, {MAX_CHI:g}]")
+    M = get("M", lambda x: 0 <= x <= MAX_M, f"in [0, {MAX_M:g}]")
     coils = data.get("coils")
     coils = [] if coils is None else coils
     if not isinstance(coils, list):
         raise SceneError(f"field.coils = {show(coils)}: must be an array of tables [[field.coils]]")
+    if len(coils) > MAX_COILS:
+        raise SceneError(f"field.coils: {len(coils)} coils; at most {MAX_COILS}")
     coils = tuple(_coil(f"field.coils[{i}]", c) for i, c in enumerate(coils))
     if M > 0 and not coils:
         raise SceneError(f"field.M = {show(data['M'])} needs at least one [[field.coils]]")
@@ -400,10 +436,13 @@ def _coil(key: str, data) -> Coil:
     a = number(f"{key}.radius", data["radius"])
     h = number(f"{key}.height", data["height"])
     s = number(f"{key}.current", data["current"])
-    if a <= 0:
-        raise SceneError(f"{key}.radius = {show(data['radius'])}: must be > 0")
-    if s == 0:
-        raise SceneError(f"{key}.current = {show(data['current'])}: must be nonzero")
+    if not 0 < a <= MAX_COIL_DISTANCE:
+        raise SceneError(f"{key}.radius = {show(data['radius'])}: must be in (0, {MAX_COIL_DISTANCE:g}]")
+    if not abs(h) <= MAX_COIL_DISTANCE:
+        raise SceneError(f"{key}.height = {show(data['height'])}: must be in [-{MAX_COIL_DISTANCE:g}, "
+                         f"{MAX_COIL_DISTANCE:g}]")
+    if s == 0 or abs(s) > MAX_CURRENT:
+        raise SceneError(f"{key}.current = {show(data['current'])}: must be nonzero and within ±{MAX_CURRENT:g}")
     d2 = a * a + h * h
     if d2 <= 1 + 1e-9:
         where = "on" if d2 >= 1 - 1e-9 else "inside"
@@ -416,7 +455,7 @@ def _coil(key: str, data) -> Coil:
 
 def _electric(data) -> Electric:
     get = _getter(table("electric", data, _keys(Electric)), "electric", Electric)
-    return Electric(get("voltage", lambda x: x >= 0, ">= 0"))
+    return Electric(get("voltage", lambda x: 0 <= x <= MAX_VOLTAGE, f"in [0, {MAX_VOLTAGE:g}]"))
 
 
 def _parameter(data, electric: Electric | None):
@@ -439,26 +478,29 @@ def _parameter(data, electric: Electric | None):
         raise SceneError(f"electric.voltage = {show(electric.voltage)}: a voltage continuation starts at the "
                          "sphere's voltage at continuation.start_stretch; leave electric.voltage out")
     pressure = get("pressure", lambda x: x >= 0, ">= 0")
-    return parameter, 0.0 if pressure is None else pressure, get("stop_voltage", lambda x: x > 0, "> 0")
+    return parameter, 0.0 if pressure is None else pressure, get("stop_voltage", lambda x: 0 < x <= MAX_VOLTAGE,
+                                                                 f"in (0, {MAX_VOLTAGE:g}]")
 
 
 def _continuation(data, field: Field, electric: Electric | None = None) -> Continuation:
     data = table("continuation", data, _keys(Continuation))
     get = _getter(data, "continuation", Continuation)
-    start = get("start_stretch", lambda x: x > 1, "> 1")
-    stop = get("stop_stretch", lambda x: x > start, f"> continuation.start_stretch = {show(start)}")
+    start = get("start_stretch", lambda x: 1 < x < MAX_STRETCH, f"in (1, {MAX_STRETCH:g})")
+    stop = get("stop_stretch", lambda x: start < x <= MAX_STRETCH,
+               f"in (continuation.start_stretch = {show(start)}, {MAX_STRETCH:g}]")
     if data.get("min_stretch") is None and start <= Continuation.min_stretch:
         data = {**data, "min_stretch": (1 + start) / 2}  # the default lies below any allowed start_stretch
         get = _getter(data, "continuation", Continuation)
     low = get("min_stretch", lambda x: 1 < x < start, f"in (1, continuation.start_stretch = {show(start)})")
     pressure = get("stop_pressure", lambda x: x > 0, "> 0")
-    step_min = get("step_min", lambda x: x > 0, "> 0")
-    step_max = get("step_max", lambda x: x >= step_min, f">= continuation.step_min = {show(step_min)}")
+    step_min = get("step_min", lambda x: MIN_STEP <= x <= MAX_STEP, f"in [{MIN_STEP:g}, {MAX_STEP:g}]")
+    step_max = get("step_max", lambda x: step_min <= x <= MAX_STEP,
+                   f"in [continuation.step_min = {show(step_min)}, {MAX_STEP:g}]")
     step = get(
         "step", lambda x: step_min <= x <= step_max, f"in [step_min, step_max] = [{show(step_min)}, {show(step_max)}]"
     )
     points = get("max_points", lambda n: 1 <= n <= 100_000, "an integer in [1, 100000]", integer=True)
-    gap = get("wire_gap", lambda x: x > 0, "> 0")
+    gap = get("wire_gap", lambda x: 0 < x <= MAX_WIRE_GAP, f"in (0, {MAX_WIRE_GAP:g}]")
     symmetry = data.get("symmetry")
     symmetry = Continuation.symmetry if symmetry is None else symmetry
     if symmetry not in ("auto", "equator", "none"):
@@ -480,14 +522,14 @@ def _solver(data) -> Solver:
         "quadrature", lambda n: n == 0 or degree + 1 <= n <= MAX_QUADRATURE,
         f"0 (automatic) or an integer in [solver.degree + 1 = {degree + 1}, {MAX_QUADRATURE}]", integer=True,
     )
-    tol = get("tol", lambda x: 0 < x <= 1e-3, "in (0, 1e-3]")
+    tol = get("tol", lambda x: MIN_TOLERANCE <= x <= 1e-3, f"in [{MIN_TOLERANCE:g}, 1e-3]")
     max_newton = get("max_newton", lambda n: 1 <= n <= 200, "an integer in [1, 200]", integer=True)
     if data.get("max_degree") is None and degree > Solver.max_degree:
         data = {**data, "max_degree": degree}  # the default never lies below the starting degree
         get = _getter(data, "solver", Solver)
     max_degree = get("max_degree", lambda n: degree <= n <= 400, f"an integer in [solver.degree = {degree}, 400]",
                      integer=True)
-    max_error = get("max_error", lambda x: 0 < x <= 1e-2, "in (0, 1e-2]")
+    max_error = get("max_error", lambda x: MIN_TOLERANCE <= x <= 1e-2, f"in [{MIN_TOLERANCE:g}, 1e-2]")
     return Solver(degree, quadrature, tol, max_newton, max_degree, max_error)
 
 
@@ -512,7 +554,19 @@ def _surface(data) -> Surface:
 
 def _output(data) -> Output:
     get = _getter(table("output", data, _keys(Output)), "output", Output)
-    return Output(get("theta_points", lambda n: 3 <= n <= 100_001, "an integer in [3, 100001]", integer=True))
+    return Output(get("theta_points", lambda n: 3 <= n <= 100_001, "an integer in [3, 100001]", integer=True),
+                  get("memory_limit", lambda x: 0 < x <= 1024, "in (0, 1024] GiB"))
+
+
+def _check_products(continuation: Continuation, output: Output) -> None:
+    """SceneError when keys each within their range multiply into more memory than output.memory_limit (GiB):
+    a branch's stored profiles are about 2 legs × max_points × theta_points × PROFILE_ARRAYS doubles at once."""
+    need = 2 * continuation.max_points * output.theta_points * PROFILE_ARRAYS * 8 / 1024**3
+    if need > output.memory_limit:
+        raise SceneError(f"continuation.max_points = {continuation.max_points} × output.theta_points = "
+                         f"{output.theta_points}: the profiles of one branch would need about {need:.3g} GiB; at "
+                         f"most output.memory_limit = {show(output.memory_limit)} GiB (lower either key, or raise "
+                         "output.memory_limit if you mean it)")
 
 
 def _to_toml(data: dict) -> str:

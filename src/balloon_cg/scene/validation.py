@@ -32,8 +32,11 @@ def show(value) -> str:
     return show(str(value))
 
 
+MAX_MAGNITUDE = 1e6  # docs/scenes.md, Bounds: |any number of a scene| (most keys have a tighter range)
+
+
 def number(key: str, value, *, integer: bool = False):
-    """``value`` as a finite float (or an int when ``integer``); bool is not a number."""
+    """``value`` as a finite float within ±MAX_MAGNITUDE (or an int when ``integer``); bool is not a number."""
     kind = numbers.Integral if integer else numbers.Real
     if isinstance(value, bool) or not isinstance(value, kind):
         raise SceneError(f"{key} = {show(value)}: must be {'an integer' if integer else 'a number'}")
@@ -41,6 +44,9 @@ def number(key: str, value, *, integer: bool = False):
         return int(value)
     if not math.isfinite(value):
         raise SceneError(f"{key} = {show(value)}: must be finite")
+    if abs(value) > MAX_MAGNITUDE:
+        raise SceneError(f"{key} = {show(value)}: must be within ±{MAX_MAGNITUDE:g} (no balloon needs more: "
+                         "docs/scenes.md, Bounds)")
     return float(value)
 
 

@@ -1,0 +1,176 @@
+"""A scene's formula cannot hang or exhaust the machine (issue 30, item 2): bounds on the checked tree before
+SymPy sees it (scene/formula), kernel generation in a child under a time budget and a memory bound, stopped by
+Ctrl-C (model/kernel_cache); the kernel cache is verified on load."""
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, Phase, given, seed, settings, strategies as st
+
+from balloon_cg.app.cli import main
+from balloon_cg.model import kernel_cache
+from balloon_cg.scene import SceneError
+from balloon_cg.scene.formula import MAX_EXPONENT, MAX_NODES, parse_formula
+
+HANGING = {  # the issue's formulas, and others past each bound: refused in parsing, before any SymPy
+    "I1 - 3 + 0*(1/3)**(10**9)": "exponent 10**9 is beyond",
+    "I1 - 3 + (1/3)**(10**9)*(I1 - 3)**2": "exponent 10**9 is beyond",
+    "sinh(sinh(sinh(sinh(sinh(sinh(sinh(sinh(I1 - 3))))))))": "nested 4 deep",
+    "I1 - 3 + (I1 - 3)**1e308": "number 1e308 is beyond",
+    "((I1 - 3)**8)**8": "exponent of 64",
+    "I1 - 3 + 1/(2 - 2)": "division by zero",
+    "I1 - 3 + exp(10**3)": "not a finite number",
+    " + ".join(["(I1 + I2 + I1 + I2)"] * 45): "terms",
+}
+
+
+def one_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+@pytest.mark.parametrize("formula", list(HANGING))
+def test_formulas_past_a_bound_are_one_line_at_once(formula, tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv(kernel_cache.CACHE_ENV, str(tmp_path / "cache"))
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'[material]\nenergy = "{formula}"\n[continuation]\nstop_stretch = 1.5\n')
+    start = time.perf_counter()
+    assert main(["run", str(scene), "-o", str(tmp_path / "x.h5"), "--quiet"]) == 2
+    assert time.perf_counter() - start < 60  # refused in parsing: milliseconds (the bound is for a stuck machine)
+    line = one_line(capsys)
+    assert "material.energy" in line and HANGING[formula] in line
+    assert not (tmp_path / "cache").exists() and not (tmp_path / "x.h5").exists()
+
+
+def test_formulas_within_the_bounds_parse():
+    for formula in ("I1 - 3 + 0.1*(I1 - 3)**2", f"(I1 - 3)**{MAX_EXPONENT}", "log(1 - (I1 - 3)/30)",
+                    "exp(sinh(tanh(I1 - 3))) - 1", "(-8)**(1/3)*(I1 - 3)", "lambda1**1.3 + lambda2**1.3 - 2",
+                    " + ".join(["(I1 + I2 + I1 + I2)"] * (MAX_NODES // 8)) + f" - {MAX_NODES // 8}*12"):
+        parse_formula(formula)
+
+
+operands = st.sampled_from(["I1", "I2", "lambda1", "lambda2", "lambda3", "3", "0", "1/3", "10**9", "1e308", "2.5",
+                            "-1", "0.0"])
+
+
+def formulas(depth: int = 0):
+    if depth >= 4:
+        return operands
+    inner = st.deferred(lambda: formulas(depth + 1))
+    return st.one_of(
+        operands,
+        st.tuples(inner, st.sampled_from(["+", "-", "*", "/", "**", "^"]), inner).map(lambda t: f"({t[0]}{t[1]}{t[2]})"),
+        st.tuples(st.sampled_from(["exp", "log", "sqrt", "sinh", "cosh", "tanh", "atan"]), inner).map(
+            lambda t: f"{t[0]}({t[1]})"))
+
+
+def _parse_fuzzed(text: str) -> None:
+    start = time.perf_counter()
+    try:
+        parse_formula(text)
+    except SceneError as e:
+        assert "\n" not in str(e)
+    assert time.perf_counter() - start < 5  # a parse is milliseconds: seconds would mean work grows with the input
+
+
+@seed(30)
+@settings(max_examples=200, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate),
+          suppress_health_check=list(HealthCheck))
+@given(formulas())
+def test_fuzzed_formulas_parse_or_are_one_scene_error(text):
+    _parse_fuzzed(text)
+
+
+@pytest.mark.slow
+@seed(3030)
+@settings(max_examples=1000, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate),
+          suppress_health_check=list(HealthCheck))
+@given(formulas())
+def test_fuzzed_formulas_1000(text):
+    _parse_fuzzed(text)
+
+
+SCENE = '[material]\nenergy = "I1 - 3 + 0.2*(I1 - 3)**2 + 0.01*(I2 - 3)"\n[continuation]\nstop_stretch = 1.3\n'
+
+
+def test_generation_past_its_time_budget_is_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv(kernel_cache.CACHE_ENV, str(tmp_path / "cache"))
+    monkeypatch.setenv(kernel_cache.TIMEOUT_ENV, "0.001")  # no Python starts in a millisecond
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE)
+    assert main(["kernels", str(scene)]) == 2
+    line = one_line(capsys)
+    assert "material.energy" in line and "time budget" in line and kernel_cache.TIMEOUT_ENV in line
+    assert not list((tmp_path / "cache").glob("*.py"))
+    monkeypatch.setenv(kernel_cache.TIMEOUT_ENV, "soon")
+    assert main(["kernels", str(scene)]) == 2
+    assert kernel_cache.TIMEOUT_ENV in one_line(capsys)
+
+
+def _children(pid: int) -> list[int]:
+    path = Path(f"/proc/{pid}/task/{pid}/children")
+    return [int(p) for p in path.read_text().split()] if path.exists() else []
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs /proc")
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_ctrl_c_stops_kernel_generation(tmp_path, signum):
+    """The signal goes to balloon-cg only (not its process group): it kills the generating child and exits 130."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE.replace("0.01", "0.0125" if signum == signal.SIGINT else "0.015"))
+    env = {**os.environ, kernel_cache.CACHE_ENV: str(tmp_path / "cache")}
+    proc = subprocess.Popen([sys.executable, "-m", "balloon_cg", "run", str(scene), "-o", str(tmp_path / "x.h5"),
+                             "--quiet"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300
+        while not _children(proc.pid) and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        children = _children(proc.pid)
+        assert children, "the generating child never started"
+        proc.send_signal(signum)
+        _, err = proc.communicate(timeout=300)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130, err
+    assert "interrupted" in err and "Traceback" not in err
+    assert not list((tmp_path / "cache").glob("*.py")) and not (tmp_path / "x.h5").exists()
+    for child in children:
+        assert not Path(f"/proc/{child}").exists() or "zombie" in Path(f"/proc/{child}/status").read_text()
+
+
+@pytest.mark.parametrize("damage", ["empty", "truncated", "garbled", "null bytes"])
+def test_a_damaged_cached_module_is_regenerated_with_a_warning(damage, tmp_path, monkeypatch):
+    from balloon_cg.scene.formula import parse_formula as parse
+
+    monkeypatch.setenv(kernel_cache.CACHE_ENV, str(tmp_path))
+    formula = parse("I1 - 3 + 0.5*(I2 - 3)")
+    path = kernel_cache.module_path(formula, False)
+    text = kernel_cache.sealed("INPUTS = ()\nKERNELS = {}\n")
+    monkeypatch.setattr(kernel_cache, "bounded_generate", lambda *args, **kwargs: "INPUTS = ()\nKERNELS = {}\n")
+    damaged = {"empty": "", "truncated": text[: len(text) // 2], "garbled": text.replace("KERNELS", "KERNELZ"),
+               "null bytes": text.replace("INPUTS", "\0\0\0\0\0\0")}[damage]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(damaged)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        module = kernel_cache.load(formula, False)
+    sys.modules.pop(path.stem, None)
+    assert [w.category for w in caught] == [kernel_cache.KernelCacheWarning] and str(path) in str(caught[0].message)
+    assert module.KERNELS == {} and path.read_text() == text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a whole module loads without a word
+        kernel_cache.load(formula, False)
+    sys.modules.pop(path.stem, None)
+
+
+def test_a_generated_module_past_its_size_bound_is_one_line(monkeypatch):
+    monkeypatch.setattr(kernel_cache, "MAX_MODULE_CHARS", 1000)
+    assert kernel_cache.checked_size("x" * 1000, "f") == "x" * 1000
+    with pytest.raises(SceneError, match="material.energy = 'I1': its kernels would be 0.001 MB of code"):
+        kernel_cache.checked_size("x" * 1001, "material.energy = 'I1'")
