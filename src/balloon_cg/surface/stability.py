@@ -95,9 +95,10 @@ def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, r
             continue
         H = eq.hessian(c, params, sector)
         g = -eq.parameter_derivative(c, params, "P", sector) if controlled and _own(sector, eq.basis) else None
+        rows_of = {held: mode_rows(sector, modes) for held, modes in fields.items()}
         groups = {}  # (zero-mode rows, the control the sector sees) -> (rows, the readings sharing the matrix)
         for r in readings:
-            rows = mode_rows(sector, fields[r.held])
+            rows = rows_of[r.held]
             control = r.control if g is not None else Control.PRESSURE
             groups.setdefault((rows.tobytes(), control), (rows, []))[1].append(r)
         for (_, control), (rows, shared) in groups.items():
