@@ -382,6 +382,8 @@ def test_volume_and_gas_control_at_a_sphere_hold_the_axisymmetric_readings(spom1
 
 @pytest.mark.slow
 @pytest.mark.timeout(5400)
+@pytest.mark.xfail(strict=True, reason="measured 2026-12-02: 178 points to the rejoin, median 8.3e-10, worst 4.0e-8 "
+                                       "(not yet 1e-9 along the whole branch; docs/surface.md)")
 def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, monkeypatch):
     """The M = 0 check along the whole branch: from the m = 1 copy of the first pear point to its rejoin of the
     primary branch at the second, traced with solver.max_error = 1e-11 (the whole-sphere P error is about ten times
