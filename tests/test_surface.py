@@ -194,6 +194,27 @@ def spom1_picture(spom1):
     return analyse(spom1.with_overrides({"continuation.stop_stretch": 4.0, "surface.branches": "none"}))
 
 
+def turned_pear(basis, c, pears, degree_factor, tol):
+    """(P, λ2(π), λ−) of the whole-sphere state c read as a pear turned by 90° about y: its stretches λ+ and λ− at
+    the material points ±e_x are the pear's poles; P and λ2(π) are those of the axisymmetric pear branch (the
+    nearest stored point of ``pears``) solved at λ2(0) = λ+ at ``degree_factor`` times its degree (point_solve)."""
+    from balloon_cg.galerkin.point_solve import constrained_newton
+
+    _, a = basis.point_values(c, np.full(2, np.pi / 2), np.array([0.0, np.pi]))
+    plus, minus = np.linalg.norm(a, axis=0)
+
+    def distance(b):
+        poles = b.pole_values()
+        return np.abs(poles["lam2_north"] - plus) + np.abs(poles["lam2_south"] - minus)
+
+    pear = min(pears, key=lambda b: distance(b).min())
+    nearest = int(np.argmin(distance(pear)))
+    result, eq = constrained_newton(pear.scene, degree_factor * pear.disc.degree, pear.X[nearest], pear.disc, plus,
+                                    pear.params, tol=tol)
+    assert result.converged, (plus, minus, result.message)
+    return result.x[-1], eq.disc.pole_rows()["lam2_south"] @ result.x[:-1], minus
+
+
 def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
     """MODEL.md §8 check: at M = 0 the branch born at the m = 1 copy of the pear point is the axisymmetric pear
     branch rotated by 90° about y: its material points ±e_x are the pear's poles. At every traced point the stretches
@@ -203,7 +224,6 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
 
     from balloon_cg.analysis.results import Block
     from balloon_cg.analysis.surface_branches import SurfaceTrace, rotated, trace_surface
-    from balloon_cg.galerkin.point_solve import constrained_newton
 
     primary = spom1_picture.primary
     bp = primary.branch_points()[0]
@@ -212,17 +232,8 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
     pears = [b for b in spom1_picture.branches[1:] if b.parent == ("primary", 0)]
     checked = 0
     for c, P in zip(branch.coefficients[1:], branch.values[1:]):
-        _, a = branch.basis.point_values(c, np.full(2, np.pi / 2), np.array([0.0, np.pi]))
-        plus, minus = np.linalg.norm(a, axis=0)
-        pear = min(pears, key=lambda b: np.min(np.abs(b.pole_values()["lam2_north"] - plus)
-                                                + np.abs(b.pole_values()["lam2_south"] - minus)))
-        poles = pear.pole_values()
-        nearest = int(np.argmin(np.abs(poles["lam2_north"] - plus) + np.abs(poles["lam2_south"] - minus)))
-        result, eq = constrained_newton(pear.scene, pear.disc.degree, pear.X[nearest], pear.disc, plus,
-                                        pear.params, tol=1e-13)
-        assert result.converged
-        south = eq.disc.pole_rows()["lam2_south"] @ result.x[:-1]
-        assert abs(result.x[-1] - P) <= 1e-9 * P
+        reference, south, minus = turned_pear(branch.basis, c, pears, 1, 1e-13)
+        assert abs(reference - P) <= 1e-9 * P
         assert abs(south - minus) <= 1e-9
         checked += 1
     assert checked >= 8 and branch.measures["tilt"][1:].min() > 89.999
@@ -395,7 +406,6 @@ def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, 
     from balloon_cg.analysis import surface_branches
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block, StopCode
-    from balloon_cg.galerkin.point_solve import constrained_newton
 
     monkeypatch.setattr(surface_branches, "assess", lambda sb, traced: None)
     # stop_stretch 6: the axisymmetric pear branches (the reference) must reach the pear pole stretch the sideways
@@ -410,15 +420,6 @@ def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, 
     pears = [b for b in picture.branches[1:] if b.parent == ("primary", 0)]
     errors = []
     for c, P in zip(branch.coefficients[1:], branch.values[1:]):
-        _, a = branch.basis.point_values(c, np.full(2, np.pi / 2), np.array([0.0, np.pi]))
-        plus, minus = np.linalg.norm(a, axis=0)
-        pear = min(pears, key=lambda b: np.min(np.abs(b.pole_values()["lam2_north"] - plus)
-                                                + np.abs(b.pole_values()["lam2_south"] - minus)))
-        poles = pear.pole_values()
-        nearest = int(np.argmin(np.abs(poles["lam2_north"] - plus) + np.abs(poles["lam2_south"] - minus)))
-        result, eq = constrained_newton(pear.scene, 2 * pear.disc.degree, pear.X[nearest], pear.disc, plus,
-                                        pear.params, tol=1e-12)
-        assert result.converged, (P, plus, minus, result.message)
-        south = eq.disc.pole_rows()["lam2_south"] @ result.x[:-1]
-        errors.append(max(abs(result.x[-1] - P) / P, abs(south - minus)))
+        reference, south, minus = turned_pear(branch.basis, c, pears, 2, 1e-12)
+        errors.append(max(abs(reference - P) / P, abs(south - minus)))
     assert len(errors) > 100 and max(errors) <= 1e-9, (len(errors), np.median(errors), max(errors))
