@@ -15,8 +15,8 @@ from balloon_cg.model.sphere import sphere_pressure
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.surface import stability
-from balloon_cg.surface.basis import EQUATOR, INVERSION, MIRROR_Y, SphericalBasis
-from balloon_cg.surface.embedding import axisymmetric_coefficients, displacement_coefficients
+from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
+from balloon_cg.surface.embedding import axisymmetric_coefficients, displacement_coefficients, mode_coefficients
 from balloon_cg.surface.equilibrium import SurfaceEquilibrium
 from balloon_cg.surface.gauge import Gauge, UnsupportedGauge
 from balloon_cg.surface.measures import axial_stretch_row, measures
@@ -40,7 +40,8 @@ def spom1():
     return load_scene(ROOT / "scenes" / "spom1.toml")
 
 
-@pytest.mark.parametrize("symmetry", [(), (MIRROR_Y,), (MIRROR_Y, EQUATOR), (MIRROR_Y, INVERSION)])
+@pytest.mark.parametrize("symmetry", [(), (MIRROR_Y,), (MIRROR_Y, EQUATOR), (MIRROR_Y, INVERSION),
+                                      (MIRROR_Y, HALF_TURN, EQUATOR)])
 def test_hessian_is_the_derivative_of_the_residual_and_the_residual_of_the_energy(spom1, symmetry):
     """The sum-factorised Hessian (FFT in φ, product-to-sum) and the projected residual against central differences,
     at a random non-symmetric... state of the subspace (every block and sector present)."""
@@ -110,6 +111,43 @@ def test_sphere_states_are_equilibria_and_the_solver_returns_them(text, stretch)
     result = newton(system.residual, system.jacobian, X0, reduced_row, stretch - offset, 1e-13, 30)
     assert result.converged
     assert abs(result.x[-1] - params.P) <= 1e-10 * params.P
+
+
+def test_an_even_mode_keeps_the_half_turn(two_coil_picture, spom1):
+    """The branch of an m-mode keeps the rotation by π about the axis exactly when m is even (mode_symmetry on the
+    lowest held m-block eigenvector, a simple one, at the first m = 1 point of the two-coil scene, an equator-symmetric
+    branch: m = 1 even in z, m = 2 and 4 odd in z keep no z-reflection, m = 3 keeps the inversion); the embedded mode
+    lies wholly in the returned subspace and has no part in a smaller one. (At a sphere the
+    lowest eigenvalue of an m-block is double and its eigenvector of no definite parity.) At a sphere state the
+    sectors of (MIRROR_Y, HALF_TURN) hold the mirror subspace's spectrum to 1e-9."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis.surface_branches import critical_mode, mode_symmetry
+
+    primary = two_coil_picture.primary
+    bp = next(s for s in primary.branch_points() if s.m == 1 and s.block.held)
+    for m in (1, 2, 3, 4):
+        az_basis, vector = critical_mode(primary, replace(bp, m=m), 12)
+        symmetry = mode_symmetry(primary, az_basis, vector, 12)
+        assert (HALF_TURN in symmetry) == (m % 2 == 0) and symmetry[0] == MIRROR_Y, (m, symmetry)
+        whole = np.linalg.norm(mode_coefficients(SphericalBasis(12, (MIRROR_Y,)), az_basis, vector))
+        part = np.linalg.norm(mode_coefficients(SphericalBasis(12, symmetry), az_basis, vector))
+        assert abs(part - whole) <= 1e-10 * whole
+        for reflection in {EQUATOR, INVERSION} - set(symmetry):  # none other is kept (the largest group)
+            if not (HALF_TURN in symmetry and {EQUATOR, INVERSION} & set(symmetry)):
+                smaller = SphericalBasis(12, (*symmetry, reflection))
+                assert np.linalg.norm(mode_coefficients(smaller, az_basis, vector)) <= 1e-10 * whole
+    eq1, u, params = sphere(spom1, 1.5, 12)
+    mirror = SphericalBasis(8, (MIRROR_Y,))
+    eq = SurfaceEquilibrium(spom1, mirror)
+    c = axisymmetric_coefficients(mirror, eq1.disc, u)
+    ours = np.sort(linalg.eigvalsh(eq.hessian(c, params)))
+    halves = []
+    for sector in SphericalBasis(8, (MIRROR_Y, HALF_TURN)).sectors():
+        if sector.characters[0] == 1:
+            halves += list(linalg.eigvalsh(eq.hessian(c, params, sector)))
+    assert len(halves) == mirror.size
+    assert np.abs(np.sort(halves) - ours).max() <= 1e-9 * np.abs(ours).max()
 
 
 def test_primary_branch_states_are_equilibria_with_a_field(two_coil_picture):

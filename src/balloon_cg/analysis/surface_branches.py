@@ -3,9 +3,9 @@
 
 At a located BP of block m<m>_held the critical mode is the lowest eigenvector of the held m-block
 (``azimuthal``, its zero modes removed), δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. The branch it starts
-keeps the symmetry of that mode: the mirror y → −y always, and on an equator-symmetric state the reflection
-z → −z (a mode even in z) or the inversion x → −x (a mode odd in z, which rotation by π about the axis maps to
-−itself); it is solved in that invariant subspace of degree L (``surface.degree``), with the balloon's centre
+keeps the symmetry of that mode: the mirror y → −y always, the rotation by π about the axis for an even m, and on
+an equator-symmetric state the reflection z → −z (a mode even in z) or, for an odd m, the inversion x → −x (a mode
+odd in z, which rotation by π about the axis maps to −itself); it is solved in that invariant subspace of degree L (``surface.degree``), with the balloon's centre
 held and the relabelling modes removed (``surface.gauge``).
 
 Point 0 is the BP state solved on the whole sphere at P* within its axisymmetric family (``axisymmetric_solve``:
@@ -37,7 +37,7 @@ from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
-from ..surface.basis import EQUATOR, INVERSION, MIRROR_Y, SphericalBasis
+from ..surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 from ..surface.embedding import axisymmetric_coefficients, mode_coefficients, transfer
 from ..surface.equilibrium import SurfaceEquilibrium
 from ..surface.gauge import Gauge
@@ -74,17 +74,22 @@ def critical_mode(branch: Branch, bp: SpecialPoint, degree: int):
 
 
 def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
-    """The reflections the branch born along the mode keeps (module docstring): MIRROR_Y, with EQUATOR or
-    INVERSION on an equator-symmetric branch when the mode is even or odd in z."""
-    if not branch.disc.symmetric:
-        return (MIRROR_Y,)
-    mirror = SphericalBasis(degree, (MIRROR_Y,))
-    whole = np.linalg.norm(mode_coefficients(mirror, az_basis, vector))
-    for reflection in (EQUATOR, INVERSION):
-        part = np.linalg.norm(mode_coefficients(SphericalBasis(degree, (MIRROR_Y, reflection)), az_basis, vector))
+    """The reflections the branch born along the mode keeps (module docstring): MIRROR_Y; HALF_TURN when the mode is
+    invariant under the rotation by π about the axis (even m: cos m(φ + π) = cos mφ); on an equator-symmetric branch
+    EQUATOR or INVERSION when the mode is even or odd in z. Each is tested on the embedded mode (its part in the
+    smaller subspace is all of it); the tuple is independent (with HALF_TURN and EQUATOR, INVERSION is their product
+    and not listed). An even-m mode odd in z keeps neither EQUATOR nor INVERSION (only EQUATOR composed with the
+    rotation by π/m, which is not diagonal)."""
+    candidates = (HALF_TURN, EQUATOR, INVERSION) if branch.disc.symmetric else (HALF_TURN,)
+    whole = np.linalg.norm(mode_coefficients(SphericalBasis(degree, (MIRROR_Y,)), az_basis, vector))
+    symmetry = (MIRROR_Y,)
+    for reflection in candidates:
+        if INVERSION in symmetry or (reflection == INVERSION and EQUATOR in symmetry):
+            break
+        part = np.linalg.norm(mode_coefficients(SphericalBasis(degree, (*symmetry, reflection)), az_basis, vector))
         if abs(part - whole) <= 1e-8 * whole:
-            return (MIRROR_Y, reflection)
-    raise ValueError("the critical mode has no definite parity under z → −z on an equator-symmetric branch")
+            symmetry += (reflection,)
+    return symmetry
 
 
 class SurfaceTrace:

@@ -22,7 +22,8 @@ T comes from one FFT in φ per ring of each of the 45 node-Hessian entries D and
 Symmetry subspaces: ``symmetry`` is a tuple of diagonal reflections S = diag(s_x, s_y, s_z) and ``characters``
 one sign χ_S each (default +1); the basis keeps the fields with u(S X) = χ_S S u(X), i.e. the e_c Y_{l,m,t} with
 s_c σ_S(l, m, t) = χ_S, σ the sign of Y under S: y → −y flips sin mφ, x → −x multiplies cos mφ by (−1)^m and
-sin mφ by −(−1)^m, z → −z multiplies by (−1)^(l+m). The states of a branch lie in the invariant subspace (every
+sin mφ by −(−1)^m, z → −z multiplies by (−1)^(l+m) (the rotation by π about the axis, diag(−1, −1, 1), is
+diagonal too: it multiplies Y_{l,m,t} by (−1)^m). The states of a branch lie in the invariant subspace (every
 χ = +1); the Hessian at such a state maps each sector (a choice of the χ) to itself, so its spectrum is the union
 of the sectors' (``sectors``).
 """
@@ -42,6 +43,7 @@ COS, SIN = 0, 1
 MIRROR_Y = (1, -1, 1)  # the plane y = 0 through the axis (MODEL.md §8: x, z keep cos kφ, y keeps sin kφ)
 EQUATOR = (1, 1, -1)  # the equatorial plane z = 0
 INVERSION = (-1, -1, -1)  # the centre: x(−X) = −x(X)
+HALF_TURN = (-1, -1, 1)  # the rotation by π about the axis: C_2 ⊂ C_m, kept by the branches of an even-m mode
 STATE_ROWS = 9  # x (3), a_θ (3), a_φ (3): row 3 d + c for derivative d and component c
 SHARED_TABLE = 4096  # up to this many points the Legendre tables of an order are cached (the blocks share them)
 POLE_ZONE = 1e-10  # sin²θ below which a mapped basis' dθ_s/dθ takes its pole limit (relative error ~ POLE_ZONE)
