@@ -98,16 +98,17 @@ def registry_text() -> str:
     for cls in scene_classes():
         elastic = cls.elastic
         if elastic.energy is not None:
-            energy_rows.append(f"    {cls.name!r}: ({elastic.energy[0]!r}, {cls.field!r}),\n")
+            energy_rows.append(f"    {cls.name!r}: ({elastic.energy[0]!r}, {cls.term_names!r}),\n")
             continue
         alphas = None if elastic.alphas is None else tuple(float(a) for a in elastic.alphas)
-        rows.append(f"    {cls.name!r}: ({alphas!r}, {cls.field!r}),\n")
+        rows.append(f"    {cls.name!r}: ({alphas!r}, {cls.term_names!r}),\n")
     return (
         '"""Kernels emitted by codegen/ (make regenerate). Never edit by hand.\n\n'
-        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, has field), ENERGY_CLASSES\n'
-        'module name -> (canonical strain-energy formula, has field); the layout constants are those of every\n'
-        'class module (codegen/build.py: layout). SURFACE_CLASSES maps class name -> its surface module (MODEL.md §8,\n'
-        'codegen/surface.py), whose row layouts are the SURFACE_ constants.\n"""\n'
+        'CLASSES maps module name -> (Ogden exponents or None for runtime exponents, the names of its energy terms\n'
+        'beyond the elastic one), ENERGY_CLASSES module name -> (canonical strain-energy formula, its terms); a scene\n'
+        'class without a committed module is generated on demand (model/kernel_cache.py). The layout constants are\n'
+        'those of every class module (codegen/build.py: layout). SURFACE_CLASSES maps class name -> its surface module\n'
+        '(MODEL.md §8, codegen/surface.py), whose row layouts are the SURFACE_ constants.\n"""\n'
         f"GENERAL_TERMS = {GENERAL_TERMS}\n"
         + "".join(f"{name} = {value!r}\n" for name, value in layout().items())
         + "CLASSES = {\n" + "".join(rows) + "}\n"

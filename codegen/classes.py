@@ -24,10 +24,16 @@ EXPONENT_SETS = {
 }
 
 
-def terms(field: bool, electric: bool = False) -> tuple:
-    """The terms of a class beyond the elastic one, as the runtime names them (model/kernel_cache.py): the pressure
-    always, the magnetic term with coils (``field``), the dielectric term with an [electric] table."""
-    return tuple(t for t, present in zip(KNOWN_TERMS, (True, field, electric)) if present)
+PLAIN, FIELD = ("pressure",), ("pressure", "magnetic")  # the term sets classes are committed for
+
+
+def terms(names) -> tuple:
+    """The terms of a class beyond the elastic one from their names (the runtime's, model/kernels.py:
+    ``scene_terms``), in kernel order; ValueError for a name no term has."""
+    unknown = set(names) - {t.name for t in KNOWN_TERMS}
+    if unknown:
+        raise ValueError(f"unknown energy terms {sorted(unknown)}; known: {[t.name for t in KNOWN_TERMS]}")
+    return tuple(t for t in KNOWN_TERMS if t.name in names)
 
 
 def strain_energy(formula: str, parameters: tuple) -> Elastic:
@@ -38,14 +44,14 @@ def strain_energy(formula: str, parameters: tuple) -> Elastic:
 def scene_classes() -> list[SceneClass]:
     classes = []
     for name, alphas in EXPONENT_SETS.items():
-        classes.append(SceneClass(f"ogden_{name}", Elastic(alphas), terms(field=False)))
-        classes.append(SceneClass(f"ogden_{name}_field", Elastic(alphas), terms(field=True)))
-    classes.append(SceneClass("ogden_general_field", Elastic(None), terms(field=True)))
+        classes.append(SceneClass(f"ogden_{name}", Elastic(alphas), terms(PLAIN)))
+        classes.append(SceneClass(f"ogden_{name}_field", Elastic(alphas), terms(FIELD)))
+    classes.append(SceneClass("ogden_general_field", Elastic(None), terms(FIELD)))
     return classes + energy_classes()
 
 
 def energy_classes() -> list[SceneClass]:
     """``KEY`` and ``KEY_field`` for every family."""
     return [SceneClass(f"{key}{'_field' if field else ''}", strain_energy(family.formula, family.parameters),
-                       terms(field))
+                       terms(FIELD if field else PLAIN))
             for key, family in FAMILIES.items() for field in (False, True)]

@@ -36,8 +36,13 @@ class SceneClass:
         return inputs
 
     @property
+    def term_names(self) -> tuple:
+        """Its terms beyond the elastic one by name, in kernel order (the registry's and the runtime's key)."""
+        return tuple(t.name for t in self.terms)
+
+    @property
     def field(self) -> bool:
-        """Whether the class has the magnetic term (its header's 'field', the registry's 'has field')."""
+        """Whether the class has the magnetic term (its header's 'field')."""
         return self.inputs()["field"]
 
     def title(self, kind: str, surface: bool = False) -> str:

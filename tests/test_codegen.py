@@ -57,7 +57,7 @@ def test_generated_gradient_matches_sympy(name):
         values.update({M: 0.01, chi: 1.3, **dict(zip(FIELD, field))})
     density = fn.energy_density(cls)
     expected = [float(fn.at_node(cls, sp.diff(density, s)).subs(values)) for s in fn.STATE]
-    kernels = KernelSet(Material("random", tuple(mus), tuple(alphas)), cls.field, kernel_class=name)
+    kernels = KernelSet(Material("random", tuple(mus), tuple(alphas)), cls.term_names, kernel_class=name)
     named = {str(symbol): float(value) for symbol, value in values.items()} | {"field": field}
     assert np.allclose(kernels.call("energy_gradient", named), expected, rtol=1e-12, atol=1e-12)
 
@@ -78,7 +78,7 @@ def test_first_order_system_holds_on_the_exact_sphere(preset):
     from balloon_cg.model.sphere import sphere_pressure
 
     material = get_preset(preset)
-    kernels = KernelSet(material, has_field=False)
+    kernels = KernelSet(material)
     lam = 2.3
     for theta in (0.2, 1.1, 2.9):
         c, s = np.cos(theta), np.sin(theta)

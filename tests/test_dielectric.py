@@ -20,13 +20,14 @@ from balloon_cg.analysis.results import Block, Kind, Status, StopCode
 from balloon_cg.analysis.stability import assess_branch
 from balloon_cg.app.api import Result
 from balloon_cg.galerkin.equilibrium import Parameters
-from balloon_cg.model.kernels import KernelSet
+from balloon_cg.model.kernels import PLAIN, KernelSet
 from balloon_cg.model.shooting import shoot_symmetric
 from balloon_cg.scene import parse_scene
 from balloon_cg.scene.validation import SceneError
 
 NEO = '[material]\npreset = "neo-Hookean"\n'
 PULL_IN_STRETCH = 2 ** (1 / 3)
+DIELECTRIC = (*PLAIN, "dielectric")  # the terms of a dielectric class without coils
 PULL_IN_VOLTAGE_SQ = 2 ** (-2 / 3) - 2 ** (-8 / 3)
 
 
@@ -184,11 +185,11 @@ def test_voltage_is_a_runtime_parameter_of_one_module():
     """Scenes that differ only in Φ̄ use one kernel module; its kernels take Φ̄ as the named argument 'voltage'."""
     first = parse_scene(NEO + "[electric]\nvoltage = 0.1\n")
     second = first.with_overrides({"electric.voltage": 0.4})
-    a = KernelSet(first.material, False, electric=True)
-    b = KernelSet(second.material, False, electric=True)
+    a = KernelSet(first.material, DIELECTRIC)
+    b = KernelSet(second.material, DIELECTRIC)
     assert a.module is b.module and a.name == b.name
     assert ("voltage", "param", ()) in a.module.KERNELS["energy_gradient"]["args"]
-    plain = KernelSet(first.material, False)
+    plain = KernelSet(first.material)
     assert "voltage_gradient" not in plain.module.KERNELS and plain.name == "ogden_neo_hookean"
     values = {"cos_theta": np.array([0.3]), "sin_theta": np.array([0.95]), "lam2": np.array([1.3]),
               "v": np.array([0.0]), "eta": np.array([0.4]), "w": np.array([-1.2])}
@@ -201,7 +202,7 @@ def test_voltage_is_a_runtime_parameter_of_one_module():
 def test_shear_coefficient_gains_the_voltage_squared():
     """K = (φ̂_1 − φ̂_2)/(e1 − e2) of −Φ̄² e1 e2 is Φ̄²: the dielectric class's K minus the plain class's."""
     scene = parse_scene(NEO + "[electric]\n")
-    electric, plain = KernelSet(scene.material, False, electric=True), KernelSet(scene.material, False)
+    electric, plain = KernelSet(scene.material, DIELECTRIC), KernelSet(scene.material)
     for l1, l2 in ((1.3, 1.3), (1.2, 1.5)):
         K = electric.call("shear_coefficient", {"lam1": l1, "lam2": l2, "voltage": 0.35})[0]
         assert K - plain.call("shear_coefficient", {"lam1": l1, "lam2": l2})[0] == pytest.approx(0.35**2, rel=1e-12)

@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, Phase, given, seed, settings, strategies as 
 
 from balloon_cg.app.cli import main
 from balloon_cg.model import kernel_cache
+from balloon_cg.model.kernels import PLAIN
 from balloon_cg.scene import SceneError
 from balloon_cg.scene.formula import MAX_EXPONENT, MAX_NODES, parse_formula
 
@@ -114,29 +115,64 @@ def test_generation_past_its_time_budget_is_one_line(tmp_path, capsys, monkeypat
 
 
 def _children(pid: int) -> list[int]:
+    """The generating children of ``pid`` (python -m balloon_cg.model.kernel_cache), not other short-lived helpers
+    a library may spawn (ldconfig from ctypes.util)."""
     path = Path(f"/proc/{pid}/task/{pid}/children")
-    return [int(p) for p in path.read_text().split()] if path.exists() else []
+    found = []
+    for child in (path.read_text().split() if path.exists() else []):
+        try:
+            if b"balloon_cg.model.kernel_cache" in Path(f"/proc/{child}/cmdline").read_bytes():
+                found.append(int(child))
+        except FileNotFoundError:
+            pass
+    return found
+
+
+def _state(pid: int) -> str:
+    """The one-letter process state of /proc/PID/stat ('' when gone)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError, IndexError):
+        return ""
 
 
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs /proc")
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_ctrl_c_stops_kernel_generation(tmp_path, signum):
-    """The signal goes to balloon-cg only (not its process group): it kills the generating child and exits 130."""
+    """The signal goes to balloon-cg only (not its process group): it kills the generating child and exits 130.
+    The generating child (found by its command line) is frozen (SIGSTOP) before the signal, so the signal surely
+    arrives while it generates (on a busy machine the test could otherwise signal a child that has just finished); a
+    child that had finished before it was frozen makes the attempt void and it is repeated."""
     scene = tmp_path / "s.toml"
     scene.write_text(SCENE.replace("0.01", "0.0125" if signum == signal.SIGINT else "0.015"))
     env = {**os.environ, kernel_cache.CACHE_ENV: str(tmp_path / "cache")}
-    proc = subprocess.Popen([sys.executable, "-m", "balloon_cg", "run", str(scene), "-o", str(tmp_path / "x.h5"),
-                             "--quiet"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        deadline = time.monotonic() + 300
-        while not _children(proc.pid) and proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.05)
-        children = _children(proc.pid)
-        assert children, "the generating child never started"
-        proc.send_signal(signum)
-        _, err = proc.communicate(timeout=300)
-    finally:
-        proc.kill()
+    for _ in range(3):
+        proc = subprocess.Popen([sys.executable, "-m", "balloon_cg", "run", str(scene), "-o", str(tmp_path / "x.h5"),
+                                 "--quiet"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            deadline = time.monotonic() + 300
+            while not _children(proc.pid) and proc.poll() is None and time.monotonic() < deadline:
+                time.sleep(0.05)
+            children = _children(proc.pid)
+            assert children, "the generating child never started"
+            for child in children:
+                os.kill(child, signal.SIGSTOP)
+            settle = time.monotonic() + 30
+            while any(_state(c) not in ("T", "Z", "") for c in children) and time.monotonic() < settle:
+                time.sleep(0.01)  # a stop signal takes effect when the child is next scheduled
+            if any(_state(child) != "T" for child in children):  # finished before it was frozen: void
+                proc.kill()
+                proc.communicate()
+                for path in (tmp_path / "cache").glob("*.py"):
+                    path.unlink()
+                continue
+            proc.send_signal(signum)
+            _, err = proc.communicate(timeout=300)
+        finally:
+            proc.kill()
+        break
+    else:
+        pytest.fail("the generating child finished before it could be frozen, three times")
     assert proc.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err
     assert not list((tmp_path / "cache").glob("*.py")) and not (tmp_path / "x.h5").exists()
@@ -150,7 +186,7 @@ def test_a_damaged_cached_module_is_regenerated_with_a_warning(damage, tmp_path,
 
     monkeypatch.setenv(kernel_cache.CACHE_ENV, str(tmp_path))
     formula = parse("I1 - 3 + 0.5*(I2 - 3)")
-    path = kernel_cache.module_path(formula, False)
+    path = kernel_cache.module_path(formula, PLAIN)
     text = kernel_cache.sealed("INPUTS = ()\nKERNELS = {}\n")
     monkeypatch.setattr(kernel_cache, "bounded_generate", lambda *args, **kwargs: "INPUTS = ()\nKERNELS = {}\n")
     damaged = {"empty": "", "truncated": text[: len(text) // 2], "garbled": text.replace("KERNELS", "KERNELZ"),
@@ -159,13 +195,13 @@ def test_a_damaged_cached_module_is_regenerated_with_a_warning(damage, tmp_path,
     path.write_text(damaged)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        module = kernel_cache.load(formula, False)
+        module = kernel_cache.load(formula, PLAIN)
     sys.modules.pop(path.stem, None)
     assert [w.category for w in caught] == [kernel_cache.KernelCacheWarning] and str(path) in str(caught[0].message)
     assert module.KERNELS == {} and path.read_text() == text
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # a whole module loads without a word
-        kernel_cache.load(formula, False)
+        kernel_cache.load(formula, PLAIN)
     sys.modules.pop(path.stem, None)
 
 

@@ -4,6 +4,7 @@ import json
 
 from balloon_cg.app.cli import main
 from balloon_cg.model import kernel_cache
+from balloon_cg.model.kernels import PLAIN
 
 SCENE = '[material]\nenergy = "c*(I1 - 3) + d*(I1 - 3)*(I2 - 3)"\n[material.parameters]\nc = 1.0\nd = 0.002\n'
 
@@ -52,7 +53,7 @@ def test_run_and_inspect_name_the_user_class_and_its_key(tmp_path, monkeypatch, 
     scene.write_text(SCENE + "[continuation]\nstop_stretch = 1.5\n")
     out = tmp_path / "user.h5"
     assert main(["run", str(scene), "-o", str(out), "--primary-only"]) == 0
-    key = kernel_cache.class_key(load_scene(scene).material.formula, False)
+    key = kernel_cache.class_key(load_scene(scene).material.formula, PLAIN)
     capsys.readouterr()
     assert main(["inspect", str(out)]) == 0
     assert f"energy_{key[:32]}" in capsys.readouterr().out

@@ -20,7 +20,7 @@ class System:
     """rhs and friends of one kernel class at (M, χ = 1), with the field re-evaluated at each state."""
 
     def __init__(self, material, coils, M):
-        self.kernels = KernelSet(material, has_field=len(coils) > 0)
+        self.kernels = KernelSet(material, ("pressure", "magnetic") if len(coils) else ("pressure",))
         self.coils, self.M = coils, M
 
     def field(self, rho, z):

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from balloon_cg import generated
-from balloon_cg.model.kernels import KernelSet
+from balloon_cg.model.kernels import PLAIN, KernelSet
 from balloon_cg.scene.energies import StrainEnergy
 from balloon_cg.scene.formula import evaluate
 from balloon_cg.scene.materials import Material, get_preset
@@ -19,6 +19,13 @@ CASES = {  # name: (material, has field, dielectric)
     "SPOM1_dielectric": (get_preset("SPOM1"), False, True),
 }
 PARAMS = {"P": 0.7, "M": 0.3, "chi": 1.2, "voltage": 0.4}
+
+
+def terms(has_field: bool, electric: bool) -> tuple:
+    """The class's energy terms by name (model/kernels.py: scene_terms)."""
+    return PLAIN + (("magnetic",) if has_field else ()) + (("dielectric",) if electric else ())
+
+
 FIELD_CENTRE = np.array([0.2, -0.1, 0.5])
 FIELD_SLOPE = np.array([0.3, -0.2, 0.5])
 FIELD_CURVATURE = np.array([[1.0, 0.2, -0.3], [0.2, 0.6, 0.1], [-0.3, 0.1, 0.8]])
@@ -27,7 +34,7 @@ FIELD_CURVATURE = np.array([[1.0, 0.2, -0.3], [0.2, 0.6, 0.1], [-0.3, 0.1, 0.8]]
 @pytest.fixture(scope="module", params=list(CASES))
 def case(request):
     material, has_field, electric = CASES[request.param]
-    kernels = KernelSet(material, has_field, electric=electric).surface()
+    kernels = KernelSet(material, terms(has_field, electric)).surface()
     return material, has_field, electric, kernels
 
 
@@ -169,7 +176,7 @@ def test_sphere_states_and_the_series_switch(name):
     """d = 0 (a_θ ⊥ a_φ, |a_θ| = |a_φ|): finite, equal to the numpy density and to differences of the gradient;
     just below/above d/m = SWITCH: value, gradient and Hessian continuous to rounding."""
     material, has_field, electric = CASES[name]
-    kernels = KernelSet(material, has_field, electric=electric).surface()
+    kernels = KernelSet(material, terms(has_field, electric)).surface()
     gradient = lambda s: np.array(kernels.call("surface_gradient", values(s, has_field)))  # noqa: E731
     for r in (0.0, 1e-3):
         state = stretched_state(r)
@@ -196,7 +203,7 @@ def test_axisymmetric_states_give_the_axisymmetric_energy():
     """Φ(λ1, λ2) of generated/ogden_spom1 (its energy_density at P = 0) equals surface_energy at P = 0; with P the
     two pressure terms differ by a total θ-derivative, so their integrals over the sphere agree."""
     material = get_preset("SPOM1")
-    axisymmetric = KernelSet(material, has_field=False)
+    axisymmetric = KernelSet(material)
     surface = axisymmetric.surface()
     assert surface.module.__name__.endswith("surface_ogden_spom1")
     # a smooth axisymmetric state: λ2 = 1.3 + 0.2 cos θ, η = 1.1 cos θ + 0.3 cos² θ

@@ -8,7 +8,7 @@ import pytest
 import sympy as sp
 
 from codegen import equations, functional as fn, poles, surface
-from codegen.classes import scene_classes, terms
+from codegen.classes import PLAIN, scene_classes, terms
 from codegen.functional import SceneClass
 from codegen.terms import Term
 from codegen.terms.elastic import Elastic
@@ -34,8 +34,8 @@ class Weight(Term):
 
 
 NEO_HOOKEAN = Elastic(("2",))
-BASE = SceneClass("toy", NEO_HOOKEAN, terms(field=False))
-WEIGHTED = SceneClass("toy", NEO_HOOKEAN, terms(field=False) + (Weight(),))
+BASE = SceneClass("toy", NEO_HOOKEAN, terms(PLAIN))
+WEIGHTED = SceneClass("toy", NEO_HOOKEAN, terms(PLAIN) + (Weight(),))
 
 
 @pytest.mark.parametrize("cls", scene_classes(), ids=lambda c: c.name)

@@ -17,12 +17,15 @@ import sympy as sp
 class Term:
     """What one energy term contributes; the defaults contribute nothing.
 
+    ``name``: how the runtime and the registry (generated/__init__.py) name it: a class is the set of its terms'
+    names (model/kernels.py: ``scene_terms``).
     ``parameters``: its runtime scalars (kernel 'param' arguments, in this order after the class's earlier terms').
     ``continuation``: (symbol, word, shown) of the parameter the runtime continues in, or None: the term adds the
     kernels WORD_gradient (∂²π̂/∂SHOWN∂state), rhs_WORD (∂f/∂SHOWN) and surface_WORD_gradient.
     Subclasses are frozen dataclasses (hashable: the stages cache per class).
     """
 
+    name = ""
     parameters: tuple = ()
     continuation: tuple | None = None
 

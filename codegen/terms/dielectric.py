@@ -19,6 +19,7 @@ voltage = sp.Symbol("voltage", real=True)
 
 @dataclass(frozen=True)
 class Dielectric(Term):
+    name = "dielectric"
     parameters = (voltage,)
     continuation = (voltage, "voltage", "Φ̄")
 

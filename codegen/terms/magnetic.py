@@ -46,6 +46,7 @@ def surface_field_proxy(point):
 
 @dataclass(frozen=True)
 class MagneticField(Term):
+    name = "magnetic"
     parameters = (M, chi)
     continuation = (M, "field", "M")
 

@@ -23,6 +23,7 @@ def volume_density(x, x_t, x_p):
 
 @dataclass(frozen=True)
 class Pressure(Term):
+    name = "pressure"
     parameters = (P,)
     continuation = (P, "pressure", "P")
 

@@ -1,8 +1,9 @@
 """Non-axisymmetric branches born at the m ≥ 1 branch points of an axisymmetric branch, traced on the whole sphere
 (``surface``; MODEL.md §8).
 
-At a located BP of block m<m>_held the critical mode is the lowest eigenvector of the held m-block
-(``azimuthal``, its zero modes removed), δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. The branch it starts
+At a located BP of block m<m>_held the critical mode is the eigenvector of the held m-block whose eigenvalue is
+zero there (``azimuthal``, its zero modes removed; not always the lowest: at a later crossing of the block the
+lowest is already negative), δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. The branch it starts
 keeps the symmetry of that mode: the mirror y → −y always, the rotation by π about the axis for an even m, and on
 an equator-symmetric state the reflection z → −z (a mode even in z) or, for an odd m, the inversion x → −x (a mode
 odd in z, which rotation by π about the axis maps to −itself); it is solved in that invariant subspace of degree L (``surface.degree``), with the balloon's centre
@@ -51,7 +52,9 @@ from .surface_assessment import assess
 from .surface_resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
-SWITCH_REACH, SWITCH_TRIES = 4.0, 3  # how far from the branch point (in steps) the first point may land; tries
+CRITICAL_SEARCH = 4  # the eigenvalues of the BP's block among which the critical (nearest zero) one is taken
+SWITCH_REACH, SWITCH_TRIES = 4.0, 3
+CLASSIFY_TRIES = 3  # halvings of the classification's amplitude δ before it gives up  # how far from the branch point (in steps) the first point may land; tries
 
 
 class SurfaceStartError(ArithmeticError):
@@ -59,8 +62,20 @@ class SurfaceStartError(ArithmeticError):
     axisymmetric branch did not converge."""
 
 
-def critical_mode(branch: Branch, bp: SpecialPoint, degree: int):
-    """(the azimuthal basis, the lowest held eigenvector of block m at the BP) (module docstring)."""
+def located_degree(branch: Branch, bp: SpecialPoint) -> int:
+    """The perturbation degree a branch point was located at: the larger of its bracketing points' assessments
+    (``azimuthal_points.find``; near a wire it reaches hundreds), stability.degree on an unassessed branch."""
+    if not branch.stability:
+        return branch.scene.stability.degree
+    last = len(branch.stability) - 1
+    return max(branch.stability[min(bp.index, last)].degree, branch.stability[min(bp.index + 1, last)].degree)
+
+
+def critical_mode(branch: Branch, bp: SpecialPoint, degree: int, count: int = CRITICAL_SEARCH):
+    """(the azimuthal basis, the held eigenvector of block m at the BP whose eigenvalue is nearest zero, among the
+    ``count`` lowest) at perturbation degree ``degree`` (``located_degree``: a lower one may not resolve the mode):
+    at a later crossing of the block the lowest eigenvalue is already negative and the one that crosses is above it
+    (module docstring)."""
     eq = equilibrium_of(branch)
     u, params = bp.X[:-1], branch.params_at(bp.X)
     b = azimuthal.perturbation_basis(eq, bp.m, degree)
@@ -69,8 +84,8 @@ def critical_mode(branch: Branch, bp: SpecialPoint, degree: int):
     if bp.m == 1:
         modes = azimuthal.special_modes(eq, u, degree)
         exclude = np.array([modes[azimuthal.MODES[k]] for k in azimuthal.excluded_modes(eq, params, True)])
-    _, vectors = azimuthal.lowest_eigenvalues(H, G, 1, exclude, vectors=True)
-    return b, vectors[:, 0]
+    values, vectors = azimuthal.lowest_eigenvalues(H, G, count, exclude, vectors=True)
+    return b, vectors[:, int(np.argmin(np.abs(values)))]
 
 
 def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
@@ -210,7 +225,7 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     along sign·φ (module docstring); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     scene = branch.scene
-    az_basis, vector = critical_mode(branch, bp, scene.stability.degree)
+    az_basis, vector = critical_mode(branch, bp, located_degree(branch, bp))
     symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
     params = branch.params_at(bp.X)
     trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
@@ -301,8 +316,9 @@ def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: 
 
 
 def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: float = 2e-2) -> tuple:
-    """(E2, E3, E4, Classification) of the reduced energy along the unit mode φ (in a) at P* (module docstring);
-    Classification.NONE when fewer than three constrained minimisations converge."""
+    """(E2, E3, E4, Classification) of the reduced energy along the unit mode φ (in a) at P* (module docstring),
+    fitted to the constrained minimisations at Λ = ±δ, ±2δ; δ is halved (CLASSIFY_TRIES times) until all four
+    converge, else Classification.NONE."""
     system, solver = trace.system, trace.scene.solver
     params = system.params_at(X_star)
     a_star, direction = X_star[:-1], phi[:-1]
@@ -314,18 +330,26 @@ def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: fl
         H = system.gauge.reduce_matrix(trace.eq.hessian(system.gauge.expand(x[:-1]), params))
         return np.hstack([H, direction[:, None]])
 
-    E0 = trace.eq.energy(system.gauge.expand(a_star), params)
-    lams, energies = [], []
-    for lam in (-2 * delta, -delta, delta, 2 * delta):
+    def reduced_energy(lam):
         guess = np.append(a_star + lam * direction, 0.0)
         result = newton(residual, jacobian, guess, np.append(direction, 0.0), direction @ a_star + lam, solver.tol,
                         solver.max_newton)
-        if result.converged:
-            lams.append(lam)
-            energies.append(trace.eq.energy(system.gauge.expand(result.x[:-1]), params) - E0)
-    if len(lams) < 3:
+        return trace.eq.energy(system.gauge.expand(result.x[:-1]), params) - E0 if result.converged else None
+
+    E0 = trace.eq.energy(system.gauge.expand(a_star), params)
+    for _ in range(CLASSIFY_TRIES):
+        L = np.array([-2 * delta, -delta, delta, 2 * delta])
+        energies = []
+        for lam in L:
+            energy = reduced_energy(lam)
+            if energy is None:
+                break
+            energies.append(energy)
+        if len(energies) == len(L):
+            break
+        delta /= 2
+    else:
         return (np.nan, np.nan, np.nan), Classification.NONE
-    L = np.array(lams)
     E2, E3, E4 = linalg.lstsq(np.stack([L**2, L**3, L**4], axis=1), np.array(energies))[0]
     if abs(E3) * delta > abs(E4) * delta**2:
         kind = Classification.TRANSCRITICAL

@@ -43,19 +43,17 @@ def kernels(args) -> int:
 def kernel_report(scene) -> dict:
     """{'class', 'source' (committed | cached | generated), 'key', 'stages' {stage: s}, 'jit' {kernel: (s, hits)}}."""
     from ..model import kernel_cache
-    from ..model.kernels import KernelSet, dielectric_source
-    from ..scene.energies import StrainEnergy
+    from ..model.kernels import KernelSet, class_source, scene_terms
 
-    material, has_field, electric = scene.material, bool(scene.field.coils), scene.electric is not None
+    material, terms = scene.material, scene_terms(scene)
     stages, key, source = {}, None, "committed"
-    cached = dielectric_source(material, has_field) if electric else \
-        material.formula if isinstance(material, StrainEnergy) and material.family is None else None
+    _, cached = class_source(material, terms)
     if cached is not None:
-        key = kernel_cache.class_key(cached, has_field, electric)
-        source = "cached" if kernel_cache.module_path(cached, has_field, electric).is_file() else "generated"
-        kernel_cache.load(cached, has_field, stages, electric)
+        key = kernel_cache.class_key(cached, terms)
+        source = "cached" if kernel_cache.module_path(cached, terms).is_file() else "generated"
+        kernel_cache.load(cached, terms, stages)
     start = time.perf_counter()
-    kernel_set = KernelSet(material, has_field, electric=electric)
+    kernel_set = KernelSet(material, terms)
     stages["bind"] = time.perf_counter() - start
     return {"class": kernel_set.name, "source": source, "key": key, "stages": stages, "jit": _first_calls(kernel_set)}
 

@@ -5,8 +5,9 @@ The module is generated at first use by the same generator as generated/ (codege
 balloon_cg.codegen; it needs SymPy, the ``codegen`` extra) into a content-keyed cache folder, and imported from
 there by every later run. The key is the SHA-256 of
 
-    (canonical formula and parameter names, or 'ogden' and the exponents (None: runtime exponents), field or not,
-     dielectric term or not, codegen.GENERATOR_VERSION, the generator's source digest, SymPy version),
+    (canonical formula and parameter names, or 'ogden' and the exponents (None: runtime exponents), the names of
+     the energy terms beyond the elastic one, surface kernels or not, codegen.GENERATOR_VERSION, the generator's
+     source digest, SymPy version),
 
 so an edited formula, a new generator or another SymPy gives a new module; parameter values (material
 parameters, the voltage) are kernel arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
@@ -96,25 +97,27 @@ def _identity(material) -> tuple:
     return (material.text, tuple(material.parameters))
 
 
-def class_key(material, field: bool, electric: bool = False, surface: bool = False) -> str:
-    """The cache key of the class of ``material`` (scene/formula.Formula or Exponents) with or without a field
-    and the dielectric term; ``surface``: its surface kernels (MODEL.md §8) instead of the axisymmetric ones."""
-    text = repr((*_identity(material), bool(field), bool(electric), bool(surface), codegen.GENERATOR_VERSION,
+def class_key(material, terms: tuple, surface: bool = False) -> str:
+    """The cache key of the class of ``material`` (scene/formula.Formula or Exponents) with the energy terms
+    ``terms`` (names, model/kernels.py: scene_terms); ``surface``: its surface kernels (MODEL.md §8) instead of the
+    axisymmetric ones."""
+    text = repr((*_identity(material), tuple(terms), bool(surface), codegen.GENERATOR_VERSION,
                  generator_digest(), _sympy_version()))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def module_name(material, field: bool, electric: bool = False, surface: bool = False) -> str:
+def module_name(material, terms: tuple, surface: bool = False) -> str:
+    """kind (surface_, ogden or energy), the terms other than the pressure, the key's first 32 digits."""
     kind = ("surface_" if surface else "") + ("ogden" if isinstance(material, Exponents) else "energy")
-    return f"{kind}{'_dielectric' if electric else ''}_{class_key(material, field, electric, surface)[:32]}"
+    extra = "".join(f"_{name}" for name in terms if name != "pressure")
+    return f"{kind}{extra}_{class_key(material, terms, surface)[:32]}"
 
 
-def module_path(material, field: bool, electric: bool = False, surface: bool = False) -> Path:
-    return cache_dir() / f"{module_name(material, field, electric, surface)}.py"
+def module_path(material, terms: tuple, surface: bool = False) -> Path:
+    return cache_dir() / f"{module_name(material, terms, surface)}.py"
 
 
-def generate(material, field: bool, timings: dict | None = None, electric: bool = False,
-             surface: bool = False) -> str:
+def generate(material, terms: tuple, timings: dict | None = None, surface: bool = False) -> str:
     """The module text of the class, or of its surface kernels (stage timings in seconds into ``timings``: see
     codegen/build.py)."""
     _sympy_version()
@@ -126,15 +129,15 @@ def generate(material, field: bool, timings: dict | None = None, electric: bool 
         elastic = Elastic(material.alphas)
     else:
         elastic = classes.strain_energy(material.text, material.parameters)
-    cls = SceneClass(module_name(material, field, electric, surface), elastic, classes.terms(field, electric))
+    cls = SceneClass(module_name(material, terms, surface), elastic, classes.terms(terms))
     return (build.surface_module if surface else build.class_module)(cls, timings)
 
 
-def load(material, field: bool, timings: dict | None = None, electric: bool = False, surface: bool = False):
+def load(material, terms: tuple, timings: dict | None = None, surface: bool = False):
     """The kernel module of the class (``surface``: its surface kernels), generated (bounded_generate) and written
     atomically into the cache first if missing or damaged; imported once per process (as
     ``sys.modules[module_name]``)."""
-    path = module_path(material, field, electric, surface)
+    path = module_path(material, terms, surface)
     if path.stem in sys.modules:
         return sys.modules[path.stem]
     damage = _damage(path)
@@ -142,7 +145,7 @@ def load(material, field: bool, timings: dict | None = None, electric: bool = Fa
         if damage != "missing":
             warnings.warn(f"{path}: damaged cached kernel module ({damage}); generating it again", KernelCacheWarning,
                           stacklevel=2)
-        text = bounded_generate(material, field, timings, electric, surface)
+        text = bounded_generate(material, terms, timings, surface)
         start = time.perf_counter()
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",
@@ -184,12 +187,11 @@ def _damage(path: Path) -> str | None:
     return None
 
 
-def bounded_generate(material, field: bool, timings: dict | None = None, electric: bool = False,
-                     surface: bool = False) -> str:
+def bounded_generate(material, terms: tuple, timings: dict | None = None, surface: bool = False) -> str:
     """``generate`` in a child process under the time budget and memory bound (SceneError naming the formula
     when one is hit); SIGINT or SIGTERM here raises KeyboardInterrupt after killing the child."""
     _sympy_version()
-    request = {"field": bool(field), "electric": bool(electric), "surface": bool(surface),
+    request = {"terms": list(terms), "surface": bool(surface),
                **({"alphas": material.alphas} if isinstance(material, Exponents) else
                   {"formula": material.text, "parameters": list(material.parameters)})}
     budget = _budget()
@@ -283,7 +285,7 @@ def _child_main() -> int:
         material = formula_module.parse_formula(request["formula"], tuple(request["parameters"]))
     timings = {}
     try:
-        text = generate(material, request["field"], timings, request["electric"], request["surface"])
+        text = generate(material, tuple(request["terms"]), timings, request["surface"])
     except MemoryError:
         return _OUT_OF_MEMORY
     json.dump({"text": text, "timings": timings}, sys.stdout)

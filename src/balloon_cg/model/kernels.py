@@ -1,9 +1,12 @@
-"""Pick and call the generated kernel module for a scene class (Ogden exponents, field or not).
+"""Pick and call the generated kernel module for a scene class: its material and its energy terms by name
+(``scene_terms``: the pressure, the magnetic term with coils, the dielectric term with a voltage).
 
 A material whose exponents match a generated class uses it (exponents baked in); any other material uses the
 general class with runtime exponents, its unused terms padded with μ = 0. A strain energy (scene/energies.py)
 uses its family's committed class or, for a user formula, the on-demand cache; its parameters are the
-``material`` argument.
+``material`` argument. The committed module is the one with the fewest terms that include the scene's (the
+registry generated.CLASSES lists each module's terms); a term set no committed module covers (the dielectric
+term) is generated on demand from the same exponents or formula (model/kernel_cache.py).
 
 Calling convention: every generated module lists, in ``KERNELS``, each kernel's arguments as (name, kind,
 rows) and its output labels (codegen/kernels.py: convention). ``KernelSet.arguments`` is the one place that
@@ -31,67 +34,117 @@ from ..scene.energies import StrainEnergy
 from ..scene.validation import SceneError
 
 
-def class_name(alpha, has_field: bool) -> str:
-    """The generated module for these exponents: exact match first, else the general class."""
-    for name, (alphas, field) in generated.CLASSES.items():
-        if alphas is not None and field == has_field and len(alphas) == len(alpha) and all(
-            abs(a - b) <= 1e-12 * max(1.0, abs(a)) for a, b in zip(alphas, alpha)
-        ):
-            return name
+PLAIN = ("pressure",)  # the terms of a class without coils or voltage
+
+
+def scene_terms(scene) -> tuple:
+    """The energy terms of a scene's class beyond the elastic one, by name (codegen/terms/), in kernel order: the
+    pressure always, the magnetic term with coils, the dielectric term with an [electric] table."""
+    present = {"pressure": True, "magnetic": bool(scene.field.coils), "dielectric": scene.electric is not None}
+    return tuple(name for name, on in present.items() if on)
+
+
+def _same_exponents(alphas, alpha) -> bool:
+    return len(alphas) == len(alpha) and all(abs(a - b) <= 1e-12 * max(1.0, abs(a)) for a, b in zip(alphas, alpha))
+
+
+def committed_class(registry: dict, identity, terms: tuple) -> str | None:
+    """The committed module of ``registry`` (generated.CLASSES or ENERGY_CLASSES: name -> (identity, term names))
+    for ``identity`` (exponents, None for the general class, or a canonical formula) whose terms are the fewest
+    that include ``terms`` (a term a scene lacks is evaluated at zero: M = 0, no field rows); None: the class is
+    generated on demand (model/kernel_cache.py)."""
+    fits = [(len(names), name) for name, (ident, names) in registry.items()
+            if set(terms) <= set(names) and (ident == identity if identity is None or isinstance(identity, str)
+                                              else ident is not None and _same_exponents(ident, identity))]
+    return min(fits)[1] if fits else None
+
+
+def exponent_class(alpha) -> str:
+    """A committed Ogden module of these exponents (the one with the fewest terms), else the general class."""
+    name = committed_class(generated.CLASSES, tuple(alpha), PLAIN)
+    if name is not None:
+        return name
     if len(alpha) > generated.GENERAL_TERMS:
         raise SceneError(
             f"material.alpha: {len(alpha)} terms with exponents {tuple(alpha)} match no generated class and the "
             f"general class takes at most {generated.GENERAL_TERMS}; add the exponents to codegen/classes.py and "
             "run `make regenerate`"
         )
-    return "ogden_general_field"
+    return committed_class(generated.CLASSES, None, PLAIN)
+
+
+def class_source(material, terms: tuple = PLAIN, kernel_class: str | None = None):
+    """(committed module name or None, what an on-demand class is generated from: a scene/formula.Formula or
+    kernel_cache.Exponents, or None) of a material with ``terms``; ``kernel_class`` forces a committed Ogden class
+    (it must include the terms and fit the exponents)."""
+    if isinstance(material, StrainEnergy):
+        if kernel_class is not None:
+            raise SceneError(f"kernel class {kernel_class!r}: only Ogden materials choose a kernel class")
+        name = committed_class(generated.ENERGY_CLASSES, material.formula.text, terms) \
+            if material.family is not None else None
+        return (name, None) if name is not None else (None, material.formula)
+    if kernel_class is not None:
+        if kernel_class not in generated.CLASSES:
+            known = ", ".join(generated.CLASSES)
+            raise SceneError(f"kernel class {kernel_class!r}: not generated; known: {known}")
+        alphas, names = generated.CLASSES[kernel_class]
+        if not set(terms) <= set(names) or (alphas is not None and not _same_exponents(alphas, material.alpha)):
+            raise SceneError(f"kernel class {kernel_class!r} does not fit material exponents "
+                             f"{tuple(material.alpha)} (terms {', '.join(terms)})")
+        return kernel_class, None
+    own = exponent_class(material.alpha)
+    alphas = generated.CLASSES[own][0]
+    name = committed_class(generated.CLASSES, alphas, terms)
+    if name is not None:
+        return name, None
+    return None, exponents_of(importlib.import_module(f"{generated.__name__}.{own}"))
 
 
 class KernelSet:
     """The kernels of one scene: module, packed material parameters and the call conventions.
 
-    ``kernel_class`` forces a generated class by name (benchmarks: the general class on a preset material);
-    it must be the general class or one whose exponents match the material, and a field class when
-    ``has_field``.
+    ``terms``: the energy terms beyond the elastic one, by name (``scene_terms``); the module is the committed class
+    with the fewest terms that include them, or one generated on demand for them (model/kernel_cache.py: every
+    class with the dielectric term, every user formula). ``kernel_class`` forces a committed Ogden class by name
+    (benchmarks: the general class on a preset material).
     """
 
     @classmethod
     def of_scene(cls, scene, kernel_class: str | None = None) -> "KernelSet":
-        """The kernels of a scene's class: its material, with the field terms if it has coils, with the dielectric
-        term if it has an [electric] table."""
-        return cls(scene.material, has_field=bool(scene.field.coils), kernel_class=kernel_class,
-                   electric=scene.electric is not None)
+        """The kernels of a scene's class: its material and its terms (``scene_terms``)."""
+        return cls(scene.material, scene_terms(scene), kernel_class=kernel_class)
 
-    def __init__(self, material, has_field: bool, kernel_class: str | None = None, electric: bool = False):
-        """``electric``: the class with the dielectric term (generated on demand, model/kernel_cache.py)."""
-        self.has_field, self.electric = has_field, electric
+    def __init__(self, material, terms: tuple = PLAIN, kernel_class: str | None = None):
+        self.terms = tuple(terms)
         self.scene_material = material
         self._binders, self._node_kernels = {}, {}
+        name, self.source = class_source(material, self.terms, kernel_class)
+        if name is not None:
+            self.module = importlib.import_module(f"{generated.__name__}.{name}")
+            registry = generated.ENERGY_CLASSES if isinstance(material, StrainEnergy) else generated.CLASSES
+            self.class_terms = registry[name][1]
+        else:
+            self.module = kernel_cache.load(self.source, self.terms)
+            self.class_terms = self.terms
+        self.name = dict(self.module.INPUTS)["class"]
         if isinstance(material, StrainEnergy):
-            if kernel_class is not None:
-                raise SceneError(f"kernel class {kernel_class!r}: only Ogden materials choose a kernel class")
-            self.module = energy_module(material, has_field, electric)
-            self.name, self.general, self.field_class = dict(self.module.INPUTS)["class"], False, has_field
+            self.general = False
             self._scene_arrays = {"material": _frozen(material.values)}
             return
-        # the committed class of these exponents (its dielectric twin, if asked for, is generated from it)
-        self.exponent_class = class_name(material.alpha, has_field) if kernel_class is None else kernel_class
-        if kernel_class is not None:
-            if kernel_class not in generated.CLASSES:
-                known = ", ".join(generated.CLASSES)
-                raise SceneError(f"kernel class {kernel_class!r}: not generated; known: {known}")
-            alphas, field = generated.CLASSES[kernel_class]
-            if (has_field and not field) or (alphas is not None and class_name(material.alpha, field) != kernel_class):
-                raise SceneError(f"kernel class {kernel_class!r} does not fit material exponents "
-                                 f"{tuple(material.alpha)} (field {has_field})")
-        self.module = importlib.import_module(f"{generated.__name__}.{self.exponent_class}")
-        self.general = generated.CLASSES[self.exponent_class][0] is None
-        # a field class evaluated at M = 0 is the "field on, M = 0" general setting of the benchmarks
-        self.field_class = generated.CLASSES[self.exponent_class][1]
-        if electric:
-            self.module = kernel_cache.load(exponents_of(self.module), self.field_class, electric=True)
-        self.name = dict(self.module.INPUTS)["class"]
+        alphas = dict(self.module.INPUTS)["alphas"]
+        self.exponents = None if alphas == "runtime" else tuple(float(a) for a in alphas)
+        self.general = self.exponents is None
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
+
+    @property
+    def field_class(self) -> bool:
+        """Whether the module has the magnetic term (it takes field rows; zero without coils)."""
+        return "magnetic" in self.class_terms
+
+    @property
+    def electric(self) -> bool:
+        """Whether the module has the dielectric term (it takes the voltage)."""
+        return "dielectric" in self.class_terms
 
     def surface(self) -> "KernelSet":
         """The surface kernels (MODEL.md §8; codegen/surface.py) of the same class and material packing: a committed
@@ -133,7 +186,7 @@ class KernelSet:
         if len(mu) != len(alpha):
             raise ValueError(f"{len(mu)} moduli for {len(alpha)} exponents")
         if not self.general:
-            if class_name(alpha, self.field_class) != self.exponent_class:
+            if not _same_exponents(self.exponents, alpha):
                 raise ValueError(f"exponents {alpha} need the general kernel class, not {self.name}")
             return {"mu": _frozen(mu)}
         pad = generated.GENERAL_TERMS - len(mu)
@@ -214,35 +267,12 @@ def exponents_of(module) -> kernel_cache.Exponents:
     return kernel_cache.Exponents(None if alphas == "runtime" else alphas)
 
 
-def dielectric_source(material, has_field: bool):
-    """What a material's dielectric class is generated from (model/kernel_cache.py): a strain energy's formula,
-    or the exponents of the committed Ogden class the material's exponents select."""
-    if isinstance(material, StrainEnergy):
-        return material.formula
-    return exponents_of(importlib.import_module(f"{generated.__name__}.{class_name(material.alpha, has_field)}"))
-
-
-def energy_module(material: StrainEnergy, has_field: bool, electric: bool = False):
-    """The kernel module of a strain energy: a family's committed one (its formula must be the one generated),
-    or a user formula's or any dielectric class's from the on-demand cache (model/kernel_cache.py)."""
-    if material.family is None or electric:
-        return kernel_cache.load(material.formula, has_field, electric=electric)
-    name = f"{material.family}_field" if has_field else material.family
-    formula, _ = generated.ENERGY_CLASSES[name]
-    if formula != material.formula.text:
-        raise ImportError(f"generated/{name}.py is for the formula {formula!r}, the scene layer's family "
-                          f"{material.family} is {material.formula.text!r}: run `make regenerate`")
-    return importlib.import_module(f"{generated.__name__}.{name}")
-
-
 def surface_module(kernels: KernelSet):
-    """The surface kernel module of a kernel set's class: committed (generated.SURFACE_CLASSES) unless the class
-    is generated on demand (a user formula, the dielectric term)."""
-    material = kernels.scene_material
-    if kernels.electric or (isinstance(material, StrainEnergy) and material.family is None):
-        source = material.formula if isinstance(material, StrainEnergy) else exponents_of(kernels.module)
-        return kernel_cache.load(source, kernels.field_class, electric=kernels.electric, surface=True)
-    return importlib.import_module(f"{generated.__name__}.{generated.SURFACE_CLASSES[kernels.name]}")
+    """The surface kernel module of a kernel set's class: the committed one (generated.SURFACE_CLASSES) of a
+    committed class, else generated on demand from the same source and terms."""
+    if kernels.source is None:
+        return importlib.import_module(f"{generated.__name__}.{generated.SURFACE_CLASSES[kernels.name]}")
+    return kernel_cache.load(kernels.source, kernels.class_terms, surface=True)
 
 
 def _frozen(values) -> np.ndarray:

@@ -15,7 +15,7 @@ LABELS = ("phi", "phi_1", "phi_2", "phi_11", "phi_12", "phi_22")
 
 @functools.cache
 def _kernels(material) -> KernelSet:
-    return KernelSet(material, has_field=False)
+    return KernelSet(material)
 
 
 def stretch_derivatives(material, lam1, lam2) -> dict:
