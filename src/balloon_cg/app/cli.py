@@ -26,6 +26,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..io.lock import owned
+from ..io.output import IMAGE_FORMATS
 from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
@@ -370,17 +371,14 @@ def _finite(value):
 
 # --- plot --------------------------------------------------------------------------------------------------
 
-IMAGE_FORMATS = (".png", ".pdf", ".svg")
-
-
 def _add_plot(commands):
     p = commands.add_parser("plot", help=f"draw figures from one or more run files ({docs_path('plots.md')})")
     p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
     p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}")
-    p.add_argument("-o", "--output", help="image file, .png, .pdf or .svg (default: FIRST_FILE_STEM_KIND.png "
-                                          "next to the first file; with several kinds: OUTPUT_STEM_KIND.SUFFIX; "
-                                          "an existing file is replaced only with --force)")
+    p.add_argument("-o", "--output", help=f"image file, {', '.join(IMAGE_FORMATS)} (default: "
+                                          "FIRST_FILE_STEM_KIND.png next to the first file; with several kinds: "
+                                          "OUTPUT_STEM_KIND.SUFFIX; an existing file is replaced only with --force)")
     p.add_argument("--force", action="store_true", help="replace existing image files")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
                    help="point indices for shapes, stresses, field, curvature (negative: from the end); one "
@@ -449,7 +447,8 @@ def _add_figure(commands):
     """``figure``: one figure of the paper, or all of them (app.figures, docs/paper.md)."""
     p = commands.add_parser("figure", help=f"draw a figure of the paper, computing its runs ({docs_path('paper.md')})")
     p.add_argument("name", help="fig2 .. fig13, or all (then --output is a folder)")
-    p.add_argument("-o", "--output", required=True, help="image file (.png, .pdf, .svg), or the folder for all")
+    p.add_argument("-o", "--output", required=True, help=f"image file ({', '.join(IMAGE_FORMATS)}), or the folder for "
+                                                           "all")
     p.add_argument("--runs", metavar="FOLDER", help="where run files are kept and reused (default: OUTPUT's folder/runs)")
     p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")

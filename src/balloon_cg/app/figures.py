@@ -4,22 +4,19 @@
 Each figure's runs (post.paper: shipped scenes with overrides) are computed with ``analyse`` (the whole
 picture) and kept as run files in a runs folder, ``<name of the scene>.h5``; a run file there is reused when
 the scene it was computed for (its normalised TOML) is the one asked for, and recomputed otherwise.
-Figures are drawn and saved inside ``matplotlib.rc_context(PAPER_STYLE)``: no global matplotlib state changes.
+Figures are drawn and saved in the journal style (post.style): no global matplotlib state changes.
 """
 import sys
 from pathlib import Path
 
-import matplotlib
-
-from ..io.output import check_output, replacing
+from ..io.output import IMAGE_FORMATS, check_output, replacing
 from ..io.run_file import read_run
-from ..post.paper import PAPER_STYLE, TWO_COLUMNS, draw_figure, figures
+from ..post.paper import TWO_COLUMNS, draw_figure, figures
 from ..post.plotting import Reading
 from ..scene import parse_scene
 from .api import analyse
 from .progress import shown
 
-IMAGE_FORMATS = (".png", ".pdf", ".svg")
 MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (docs/cli.md)
 
 
@@ -59,7 +56,7 @@ def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> di
 
 def make_figure(name: str, output, runs=None, width: float = TWO_COLUMNS, reading: Reading = Reading.PRESSURE,
                 quick: bool = False, progress: bool = False, force: bool = False) -> Path:
-    """Draw the paper's figure ``name`` (post.paper.figures) into the image ``output`` (.png, .pdf or .svg),
+    """Draw the paper's figure ``name`` (post.paper.figures) into the image ``output`` (IMAGE_FORMATS),
     ``width`` inches wide; runs kept in ``runs`` (default: a folder ``runs`` next to the image). An existing
     ``output`` is replaced only with ``force`` (io.output), checked before any run is computed."""
     catalogue = figures(quick)
@@ -76,7 +73,7 @@ def make_figure(name: str, output, runs=None, width: float = TWO_COLUMNS, readin
     output.parent.mkdir(parents=True, exist_ok=True)
     check_output(output, force)
     loaded = [run_for(case, runs, quick, progress) for case in figure.cases]
-    with matplotlib.rc_context(PAPER_STYLE), replacing(output, force) as tmp:
+    with replacing(output, force) as tmp:
         draw_figure(figure, loaded, width, reading).savefig(tmp, format=output.suffix.lower()[1:])
     return output
 
