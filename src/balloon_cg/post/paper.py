@@ -20,6 +20,7 @@ from matplotlib.lines import Line2D
 
 from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
 from .quantities import branch_discretisation, stored_scene
+from . import labels
 from .fit import fit_titles, fitted_legend
 from .style import JournalFigure, journal_style
 from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
@@ -94,14 +95,13 @@ def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
 
 
 def markers_only(axes):
-    """Remove the kind labels of the special points (their markers stay; the key is in the legend)."""
+    """Remove the kind labels of the special points and their leaders (their markers stay; the key is in the
+    legend)."""
     for ax in axes:
-        for text in list(ax.texts):
-            if text.get_text() in SPECIAL_TEXTS or text.get_text().startswith(("BP", "pitchfork", "transcritical")):
-                text.remove()
+        for artist in ax.findobj(lambda a: a.get_gid() == labels.GID and a is not ax):
+            artist.remove()
 
 
-SPECIAL_TEXTS = {"LP", "TP", "EP", "UZ"}
 MARKER_KEY = [Line2D([], [], linestyle="none", marker=m, markerfacecolor="0.7", markeredgecolor="k",
                      markeredgewidth=0.5, label=text)
               for m, text in (("o", "LP fold"), ("s", "TP turn in λ2(0)"), ("D", "BP branch point"), ("X", "EP end"))]

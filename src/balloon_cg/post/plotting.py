@@ -33,6 +33,7 @@ from matplotlib.lines import Line2D
 from scipy.interpolate import PchipInterpolator
 
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
+from .labels import label_points
 from .style import JournalFigure, journal_style
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import read_curve
@@ -448,45 +449,13 @@ def special_label(s: dict) -> str:
 
 
 def _special(ax, branch: StoredBranch, x, y, color) -> list:
-    """Mark the special points at (x, y) (one entry per special point); returns their labels for _label_special."""
+    """Mark the special points at (x, y) (one entry per special point); returns them for labels.label_points."""
     marks = []
     for s, xs, ys in zip(branch.data["special_points"], x, y):
         ax.plot(xs, ys, MARKERS.get(s["kind"], "D"), color=color, markersize=6, markeredgecolor="k",
                 markeredgewidth=0.5)
         marks.append((ax, special_label(s), xs, ys, color))
     return marks
-
-
-CHAR_WIDTH, LINE_HEIGHT = 5.0, 9.0  # points, for fontsize 8
-
-
-def _label_special(fig, marks):
-    """Label the marked special points with their kind, each at the first of a few offsets around its marker
-    whose text box (estimated, in points) lies inside the axes and clear of the labels already placed there
-    (if none does, the first one clear of the others). Call after all data are drawn."""
-    placed = {}
-    for ax, kind, x, y, color in marks:
-        ax.margins(x=0.06)
-        ax.autoscale_view()
-        scale = 72.0 / fig.dpi
-        frame = ax.get_window_extent()
-        anchor = ax.transData.transform((x, y)) * scale
-        width = CHAR_WIDTH * len(kind)
-        boxes = placed.setdefault(ax, [])
-
-        def clear(x0, y0):
-            return all(x0 + width <= bx or bx + bw <= x0 or y0 + LINE_HEIGHT <= by or by + LINE_HEIGHT <= y0
-                       for bx, by, bw in boxes)
-
-        def inside(x0, y0):
-            return (frame.x0 * scale <= x0 and x0 + width <= frame.x1 * scale
-                    and frame.y0 * scale <= y0 and y0 + LINE_HEIGHT <= frame.y1 * scale)
-
-        candidates = [(dx, dy) for dy in (4, -12, 14, -22, 24, -32) for dx in (5, -5 - width)]
-        fits = [c for c in candidates if clear(*(anchor + c))]
-        dx, dy = next((c for c in fits if inside(*(anchor + c))), fits[0] if fits else candidates[0])
-        boxes.append((*(anchor + (dx, dy)), width))
-        ax.annotate(kind, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=8, color=color)
 
 
 def _branch_legend(fig, axes, own, branches, extra=()):
@@ -546,7 +515,7 @@ def _pole_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
     ax.set_ylabel(ordinate.label)
     ax.set_title(_title(branches))
     _branch_legend(fig, panels, own, branches, extra)
-    _label_special(fig, marks)
+    label_points(marks)
     return fig
 
 
@@ -567,7 +536,7 @@ def _equator_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
     axes[0].set_ylabel(ordinate.label)
     _suptitle(fig, axes, own, _title(branches))
     _branch_legend(fig, axes, own, branches)
-    _label_special(fig, marks)
+    label_points(marks)
     return fig
 
 
