@@ -60,7 +60,7 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain, provenance, write_strings
-from .layout import FileError, check_columns, check_input, check_sizes, reading, require_attrs, require_group
+from .layout import FileError, check_columns, check_sizes, opened, reading, require_attrs, require_group
 from .schema import attach_dimensions, scale
 
 FORMAT = "balloon-cg/4"
@@ -415,12 +415,7 @@ def read_run(path) -> dict:
     (format balloon-cg/3 or /2), naming the file and what is missing or wrong.
     """
     path = Path(path)
-    check_input(path, RunFileError)
-    try:
-        f = h5py.File(path, "r")
-    except (OSError, RuntimeError):
-        raise RunFileError(path, "not a readable HDF5 file") from None
-    with f, reading(path, RunFileError):
+    with opened(path, RunFileError) as f:
         return _read_open(f, path) | {"path": str(path)}
 
 
