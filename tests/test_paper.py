@@ -244,6 +244,33 @@ def test_an_interrupted_run_is_kept_and_stops_the_figures(tmp_path, monkeypatch)
     assert "interrupted" in list(read_run(path)["attrs"]["incomplete_gaps"])
 
 
+def test_an_interrupted_run_is_computed_again_and_says_so(tmp_path, monkeypatch, capsys):
+    """The next figure (``figure``, ``make paper``) recomputes a kept run that a signal stopped, saying so on
+    stderr; the run it writes then is reused."""
+    from balloon_cg.io.run_file import read_run
+    from balloon_cg.numerics import interrupt
+
+    calls = []
+
+    def counted(scene, **kwargs):
+        calls.append(scene.name)
+        if len(calls) == 1:
+            interrupt.request()
+        return analyse(scene, **kwargs)
+
+    monkeypatch.setattr(app_figures, "analyse", counted)
+    case = figures(quick=True)["fig2"].cases[0]
+    with pytest.raises(KeyboardInterrupt):
+        run_for(case, tmp_path, quick=True)
+    capsys.readouterr()
+    run = run_for(case, tmp_path, quick=True)
+    assert len(calls) == 2 and "interrupted" not in list(run["attrs"].get("incomplete_gaps", []))
+    assert "was interrupted; computing it again" in capsys.readouterr().err
+    run_for(case, tmp_path, quick=True)
+    assert len(calls) == 2 and capsys.readouterr().err == ""
+    assert read_run(next(tmp_path.glob("*.h5")))["scene_name"] == run["scene_name"]
+
+
 INTERNAL_NAME = re.compile(r"pear_\d|_mirror|_rotated|_opposite|m\d+_bp\d")  # analysis.picture's branch names
 
 

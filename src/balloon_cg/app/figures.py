@@ -3,7 +3,8 @@
 
 Each figure's runs (post.paper: shipped scenes with overrides) are computed with ``analyse`` (the whole
 picture) and kept as run files in a runs folder, ``<name of the scene>.h5``; a run file there is reused when
-the scene it was computed for (its normalised TOML) is the one asked for, and recomputed otherwise.
+the scene it was computed for (its normalised TOML) is the one asked for and it was not interrupted (a signal
+stopped it: recomputed, said on stderr), and recomputed otherwise.
 Figures are drawn and saved in the journal style (post.style): no global matplotlib state changes.
 """
 import sys
@@ -38,13 +39,18 @@ def incomplete_runs(names, runs: Path, quick: bool = False) -> list[Path]:
 
 
 def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> dict:
-    """The run of ``case`` (read_run() output): the file in ``runs`` if it holds this scene, else computed and
-    written there (incomplete or not: ``incomplete_runs``); KeyboardInterrupt after writing a run a signal
-    stopped (the CLI exits 130)."""
+    """The run of ``case`` (read_run() output): the file in ``runs`` if it holds this scene and was not
+    interrupted, else computed and written there (incomplete or not: ``incomplete_runs``; an interrupted one is
+    recomputed, saying so on stderr); KeyboardInterrupt after writing a run a signal stopped (the CLI exits
+    130)."""
     scene = case.load(quick)
     path = run_path(scene, runs, quick)
     run = read_run(path) if path.exists() else None
-    if run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml():
+    interrupted = run is not None and "interrupted" in list(run["attrs"].get("incomplete_gaps", []))
+    if interrupted:
+        print(f"balloon-cg: {path}: the run kept there was interrupted; computing it again", file=sys.stderr)
+    stale = run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml()
+    if stale or interrupted:
         runs.mkdir(parents=True, exist_ok=True)
         result = analyse(scene, progress=progress)
         result.save(path, force=True)
