@@ -447,8 +447,8 @@ def _add_figure(commands):
     """``figure``: one figure of the paper, or all of them (app.figures, docs/paper.md)."""
     p = commands.add_parser("figure", help=f"draw a figure of the paper, computing its runs ({docs_path('paper.md')})")
     p.add_argument("name", help="fig2 .. fig13, or all (then --output is a folder)")
-    p.add_argument("-o", "--output", required=True, help=f"image file ({', '.join(IMAGE_FORMATS)}), or the folder for "
-                                                           "all")
+    p.add_argument("-o", "--output", required=True,
+                   help=f"image file ({', '.join(IMAGE_FORMATS)}), or the folder for all")
     p.add_argument("--runs", metavar="FOLDER", help="where run files are kept and reused (default: OUTPUT's folder/runs)")
     p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")

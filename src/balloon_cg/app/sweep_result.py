@@ -4,9 +4,10 @@
 the members' overrides name them), ``complete``, the primary branch's fold (``P_LP``, ``lam2_LP``: its first LP),
 the critical pressures of the pear-shaped instability (``P_cr1`` ≥ ``P_cr2``: the branch points of the odd held
 block, as in the paper) and every branch point of the primary branch in stored order (``P_BP1``, ``block_BP1``,
-``classification_BP1``, ``m_BP1``, …); NaN where a member has none (a primary-only sweep has no branch points). ``to_xarray()`` is the
-same table as an xarray Dataset along ``member``. Members are ``SweepMember`` s: overrides, attributes and
-branches (``BranchData``), each group of the file readable with xarray (``to_xarray``).
+``classification_BP1``, ``m_BP1``, …); NaN where a member has none (a primary-only sweep has no branch
+points). ``to_xarray()`` is the same table as an xarray Dataset along ``member``. Members are
+``SweepMember`` s: overrides, attributes and branches (``BranchData``), each group of the file readable with
+xarray (``to_xarray``).
 """
 from dataclasses import dataclass
 from pathlib import Path
