@@ -32,7 +32,8 @@ from .schema import attach_dimensions, describe, scale
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):
     """Write a two-parameter curve (analysis.codim2.TwoParameterCurve) to ``path`` atomically."""
-    attrs = root_attrs(scene) | dict(extra_attrs or {})
+    attrs = root_attrs(scene) | {"title": f"balloon-cg two-parameter curve of scene {scene.name}"} | dict(
+        extra_attrs or {})
     critical = curve.critical
     with atomic_file(path, force) as f:
         f.attrs.update(attrs)

@@ -35,13 +35,21 @@ def atomic_bytes(path, data: bytes, force: bool = False) -> Path:
     return Path(path)
 
 
+CONVENTIONS = "CF-1.10"  # the netCDF conventions the files follow (units, long_name, dimensions, history)
+
+
 def provenance(command: str | None = None) -> dict:
-    """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command."""
+    """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command, and
+    the CF global attributes ``Conventions`` and ``history`` (time, command and version, one line)."""
+    created = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    command = command if command is not None else command_line()
     return {
         "package_version": balloon_cg.__version__,
         "generated_digest": generated_digest(),
-        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "command": command if command is not None else command_line(),
+        "created": created,
+        "command": command,
+        "Conventions": CONVENTIONS,
+        "history": f"{created}: {command} (balloon-cg {balloon_cg.__version__})",
     }
 
 

@@ -9,7 +9,7 @@
 
     /                   attrs: format, scene_name, scene_toml (base scene, normalised), vary (JSON list of
                                [key, values]), mode, members (total count), store (the store folder's name),
-                               + provenance (io.hdf5)
+                               title, + provenance (io.hdf5: with Conventions and history)
     /members/<index>/   attrs: format ("balloon-cg-sweep-member/1"), overrides (JSON object, dotted key -> value),
                                scene_hash (sha256 of the member scene's normalised TOML), scene_toml, tolerance,
                                created, package_version, generated_digest, worker_pid, wall_time,
@@ -75,7 +75,7 @@ def _retired_path(path) -> Path:
 def root_attrs(scene, axes: list, mode: str, n: int, command: str | None) -> dict:
     """Root attributes of a sweep: the base scene, the varied keys and values, the mode, provenance."""
     return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.to_toml(), "vary": json.dumps(axes),
-            "mode": mode, "members": n, **provenance(command)}
+            "mode": mode, "members": n, "title": f"balloon-cg sweep of scene {scene.name}", **provenance(command)}
 
 
 # --- the store ---------------------------------------------------------------------------------------------
