@@ -40,6 +40,7 @@ from ..io.curve_file import read_curve
 from ..io.layout import FileError, check_input, reading
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
+from ..scene.validation import did_you_mean
 
 NORMAL_FORM = ("E2", "E3", "E4")
 DEFAULT_POINTS = 5
@@ -358,7 +359,7 @@ def _draw(sources, what, points, branch, axes, stability) -> Figure:
         stored = list(sources[0]["branches"].values())  # none in a curve file: load_branches says so in one line
         what = f"{ordinate_of(stored[0]).prefix}-pole" if stored else "pressure-pole"
     if what not in KINDS:
-        raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
+        raise PlotError(f"unknown plot kind {what!r}{did_you_mean(what, KINDS)}; choose one of {', '.join(KINDS)}")
     if what == "phase":
         return plot_phase(sources, axes)
     if what in SURFACE_KINDS:
