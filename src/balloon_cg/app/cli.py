@@ -611,7 +611,7 @@ def _pitchfork_curve(scene, args):
     """``critical``'s computation: the primary branch, its first pear pitchfork located, the curve of pitchforks
     in ``args.parameter`` (analysis.codim2). None when a signal (numerics.interrupt) stopped the work before the
     curve started; a signal during the curve ends it at its next point (end ``interrupted``)."""
-    from tqdm import tqdm
+    from tqdm.auto import tqdm
 
     from ..analysis.bifurcation import detect, locate
     from ..analysis.codim2 import TwoParameterError, continue_branch_point

@@ -1,4 +1,5 @@
-"""Progress on stderr: one tqdm bar per phase of the analysis, whose final count is what the phase stored.
+"""Progress on stderr: one tqdm bar per phase of the analysis, whose final count is what the phase stored
+(``tqdm.auto``: a widget in a Jupyter notebook).
 
 A progress setting is True (drawn), False (nothing) or ``ON_TERMINAL`` (None: drawn only when stderr is a
 terminal; tqdm's documented ``disable=None``, off on a non-TTY, so a log file or a pipe gets no carriage
@@ -31,7 +32,7 @@ class PhaseBars(Progress):
 
     def _bar(self, phase: Phase):
         if phase not in self.bars:
-            from tqdm import tqdm
+            from tqdm.auto import tqdm
 
             desc = f"{self.label}: {phase.value}" if self.label else phase.value
             self.bars[phase] = tqdm(desc=desc, unit=" points", file=sys.stderr, leave=True, disable=self.disable)

@@ -26,6 +26,7 @@ from importlib import resources
 import numpy as np
 
 from . import kernel_cache
+from .compile_notice import announce_first_use
 from .. import generated
 from ..scene.energies import StrainEnergy
 from ..scene.validation import SceneError
@@ -73,6 +74,7 @@ class KernelSet:
             self.module = energy_module(material, has_field, electric)
             self.name, self.general, self.field_class = dict(self.module.INPUTS)["class"], False, has_field
             self._scene_arrays = {"material": _frozen(material.values)}
+            announce_first_use(self.module)
             return
         # the committed class of these exponents (its dielectric twin, if asked for, is generated from it)
         self.exponent_class = class_name(material.alpha, has_field) if kernel_class is None else kernel_class
@@ -92,6 +94,7 @@ class KernelSet:
             self.module = kernel_cache.load(exponents_of(self.module), self.field_class, electric=True)
         self.name = dict(self.module.INPUTS)["class"]
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
+        announce_first_use(self.module)
 
     def surface(self) -> "KernelSet":
         """The surface kernels (MODEL.md §8; codegen/surface.py) of the same class and material packing: a committed
@@ -101,6 +104,7 @@ class KernelSet:
         twin._binders, twin._node_kernels = {}, {}
         twin.module = surface_module(self)
         twin.__dict__.pop("signature", None)
+        announce_first_use(twin.module)
         return twin
 
     @cached_property
