@@ -13,7 +13,7 @@ JOURNAL_STYLE = Path(__file__).with_name("journal.mplstyle")
 
 
 def journal_style():
-    """A context manager applying the journal style (``matplotlib.style.context``; also
+    """A context manager applying the journal style (``matplotlib.style.context``; for good:
     ``plt.style.use(balloon_cg.JOURNAL_STYLE)``)."""
     return matplotlib.style.context(JOURNAL_STYLE)
 
