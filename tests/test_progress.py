@@ -51,3 +51,12 @@ def test_no_bars_into_a_pipe(monkeypatch):
         bars.tick(Phase.PRIMARY)
         bars.finish(Phase.PRIMARY, 1)
     assert pipe.getvalue() == ""
+
+
+def test_a_phase_with_a_known_total_shows_its_fraction_and_eta(monkeypatch):
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    with PhaseBars("spom1", ON_TERMINAL) as bars:
+        bars.expect(Phase.STABILITY, 40)
+        assert re.search(r"stability:\s+0%\|.*\| 0/40 \[00:00<", terminal.getvalue())  # <: the time left
+        bars.finish(Phase.STABILITY, 40)

@@ -48,6 +48,13 @@ class PhaseBars(Progress):
         if self.enabled and phase not in self.finished:  # disabled: no tqdm at all (not even its lock)
             self._bar(phase).update()
 
+    def expect(self, phase: Phase, count: int) -> None:
+        """A total for the phase's bar (its fraction and ETA), grown by ``count``."""
+        if self.enabled and phase not in self.finished:
+            bar = self._bar(phase)
+            bar.total = (bar.total or 0) + count
+            bar.refresh()
+
     def finish(self, phase: Phase, count: int) -> None:
         if not self.enabled or phase in self.finished or (phase not in self.bars and count == 0):
             return
