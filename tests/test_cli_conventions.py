@@ -329,3 +329,38 @@ def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
     resumed = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
     assert len(list(store.glob("0*.h5"))) == 6
+
+
+@pytest.mark.parametrize("argv, suggestion", [
+    (["rn", "spom1"], "'rn': not a command (did you mean run?)"),
+    (["--debug", "plt", "x.h5"], "'plt': not a command (did you mean plot?)"),
+    (["run", "spom1", "--set", "continuation.stop_strech=3"], "unknown key (did you mean stop_stretch?)"),
+    (["run", "spom1", "--set", "material.preset=SPOM3"], "unknown preset (did you mean SPOM2?)"),
+    (["run", "spom1_two_coil_M0.002"], "(did you mean spom1_two_coils_M0.002?)"),
+    (["run", str(SCENES / "spom1.tml")], f"No such file or directory (did you mean {SCENES / 'spom1.toml'}?)"),
+    (["plot", "x.h5", "--what", "presure-pole"], "not a plot kind (did you mean pressure-pole?)"),
+])
+def test_a_near_miss_gets_a_suggestion(argv, suggestion, tmp_path, monkeypatch, capsys):
+    """A mistyped subcommand, scene key, preset, shipped scene, file name or plot kind: the error line (exit 2)
+    names the nearest allowed name."""
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = main(argv + ["-o", str(tmp_path / "out.h5")] * (argv[0] == "run"))
+    except SystemExit as e:  # argparse's own errors (a bad --what)
+        code = e.code
+    err = capsys.readouterr().err
+    assert code == 2 and suggestion in err.strip().splitlines()[-1], err  # the error line (after argparse's usage)
+
+
+def test_every_subcommand_help_ends_with_examples_that_parse(capsys):
+    parser = build_parser()
+    for name in parser.commands:
+        with pytest.raises(SystemExit):
+            main([name, "--help"])
+        help_text = capsys.readouterr().out
+        examples = help_text.split("examples:\n", 1)[1].strip().splitlines()
+        assert examples, name
+        for example in examples:
+            words = example.split()
+            assert words[:2] == ["balloon-cg", name]
+            assert build_parser().parse_args(words[1:]).command == name

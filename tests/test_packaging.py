@@ -40,7 +40,7 @@ def shipped(tree: Path) -> set:
     folders = {"balloon_cg": tree / "src" / "balloon_cg", "balloon_cg/generated": tree / "generated",
                "balloon_cg/scenes": tree / "scenes", "balloon_cg/codegen": tree / "codegen"}
     code = {f"{prefix}/{path.relative_to(folder).as_posix()}" for prefix, folder in folders.items()
-            for path in folder.rglob("*") if path.suffix in (".py", ".toml")}
+            for path in folder.rglob("*") if path.suffix in (".py", ".toml", ".mplstyle")}
     docs = {f"balloon_cg/docs/{path.name}" for path in (tree / "docs").glob("*")  # the pages, not derivations/
             if path.suffix in (".md", ".png") or path.name == "__init__.py"}
     return code | docs

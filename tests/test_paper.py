@@ -1,7 +1,9 @@
 """The paper's figures (reduced: post.paper.QUICK, one M), the stability readings, and the journal conventions."""
+import re
 from pathlib import Path
 
 import matplotlib
+import matplotlib.text
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -12,7 +14,7 @@ from balloon_cg.app.api import analyse
 from balloon_cg.app.cli import main
 from balloon_cg.app.figures import make_figure, run_for
 from balloon_cg.analysis.picture import Curve, find_snaps
-from balloon_cg.post.paper import (PAPER_STYLE, ONE_COLUMN, SNAP_READINGS, TWO_COLUMNS, Case, draw_figure, figures,
+from balloon_cg.post.paper import (ONE_COLUMN, SNAP_READINGS, TWO_COLUMNS, Case, draw_figure, figures,
                                    numbered_configurations, snap_throughs)
 from balloon_cg.post.plotting import Reading, load_branches, plot, robust_limits, stable_points
 
@@ -59,10 +61,9 @@ def test_every_paper_figure_is_listed():
 def test_each_figure_is_written_with_its_labels(name, runs, tmp_path):
     figure = figures(quick=True)[name]
     loaded = [run_for(case, runs, quick=True) for case in figure.cases]
-    with matplotlib.rc_context(PAPER_STYLE):
-        fig = draw_figure(figure, loaded, TWO_COLUMNS)
-        image = tmp_path / f"{name}.png"
-        fig.savefig(image, dpi=60)
+    fig = draw_figure(figure, loaded, TWO_COLUMNS)
+    image = tmp_path / f"{name}.png"
+    fig.savefig(image, dpi=60)
     assert image.read_bytes().startswith(b"\x89PNG")
     assert len(fig.axes) == PANELS[name]
     xlabels, ylabels = ({ax.get_xlabel() for ax in fig.axes}, {ax.get_ylabel() for ax in fig.axes})
@@ -193,7 +194,8 @@ def test_mirror_branches_share_their_partners_colour(runs):
     fake = run | {"branches": {"primary": pear, "pear_0": pear, "pear_0_mirror": pear, "pear_1": pear}}
     fig = plot(fake, "pressure-pole")
     handles = {t.get_text(): h for t, h in zip(fig.legends[0].get_texts(), fig.legends[0].legend_handles)}
-    first, mirror, other = (handles[f"M = 0, {name}"] for name in ("pear_0", "pear_0_mirror", "pear_1"))
+    first, mirror, other = (handles[f"M = 0, {name}"] for name in ("pear (BP 0)", "pear (BP 0), mirror image",
+                                                                    "pear (BP 1)"))
     assert first.get_color() == mirror.get_color() != other.get_color()
     assert mirror.get_alpha() < 1 and mirror.get_linewidth() < first.get_linewidth()
 
@@ -217,8 +219,7 @@ def test_make_figure_output_folder_default(runs, tmp_path):
 def test_one_column_uses_the_symbols(runs):
     figure = figures(quick=True)["fig2"]
     loaded = [run_for(case, runs, quick=True) for case in figure.cases]
-    with matplotlib.rc_context(PAPER_STYLE):
-        fig = draw_figure(figure, loaded, ONE_COLUMN)
+    fig = draw_figure(figure, loaded, ONE_COLUMN)
     assert {ax.get_xlabel() for ax in fig.axes} == {r"$\lambda_2(0)$"}
     assert {ax.get_ylabel() for ax in fig.axes} == {"$P$"}
     assert fig.get_size_inches()[0] == pytest.approx(ONE_COLUMN)
@@ -241,3 +242,88 @@ def test_an_interrupted_run_is_kept_and_stops_the_figures(tmp_path, monkeypatch)
     assert not interrupt.requested()
     (path,) = tmp_path.glob("*.h5")
     assert "interrupted" in list(read_run(path)["attrs"]["incomplete_gaps"])
+
+
+def test_an_interrupted_run_is_computed_again_and_says_so(tmp_path, monkeypatch, capsys):
+    """The next figure (``figure``, ``make paper``) recomputes a kept run that a signal stopped, saying so on
+    stderr; the run it writes then is reused."""
+    from balloon_cg.io.run_file import read_run
+    from balloon_cg.numerics import interrupt
+
+    calls = []
+
+    def counted(scene, **kwargs):
+        calls.append(scene.name)
+        if len(calls) == 1:
+            interrupt.request()
+        return analyse(scene, **kwargs)
+
+    monkeypatch.setattr(app_figures, "analyse", counted)
+    case = figures(quick=True)["fig2"].cases[0]
+    with pytest.raises(KeyboardInterrupt):
+        run_for(case, tmp_path, quick=True)
+    capsys.readouterr()
+    run = run_for(case, tmp_path, quick=True)
+    assert len(calls) == 2 and "interrupted" not in list(run["attrs"].get("incomplete_gaps", []))
+    assert "was interrupted; computing it again" in capsys.readouterr().err
+    run_for(case, tmp_path, quick=True)
+    assert len(calls) == 2 and capsys.readouterr().err == ""
+    assert read_run(next(tmp_path.glob("*.h5")))["scene_name"] == run["scene_name"]
+
+
+INTERNAL_NAME = re.compile(r"pear_\d|_mirror|_rotated|_opposite|m\d+_bp\d")  # analysis.picture's branch names
+
+
+@pytest.fixture
+def drawn_texts(monkeypatch):
+    """Every matplotlib Text drawn while the test runs (tick labels of ticks outside the view are never drawn)."""
+    drawn = []
+    draw = matplotlib.text.Text.draw
+
+    def recording(text, renderer):
+        drawn.append(text)
+        return draw(text, renderer)
+
+    monkeypatch.setattr(matplotlib.text.Text, "draw", recording)
+    return drawn
+
+
+@pytest.mark.parametrize("width", [ONE_COLUMN, TWO_COLUMNS])
+def test_every_figure_keeps_its_text_inside_at_journal_widths(width, runs, drawn_texts):
+    """What ``figure all --width W --quick`` draws (the reduced runs): every text drawn (titles, tick and axis
+    labels, legends, special-point labels) lies inside the figure, and legends name branches readably."""
+    for name, figure in figures(quick=True).items():
+        fig = draw_figure(figure, [run_for(case, runs, quick=True) for case in figure.cases], width)
+        drawn_texts.clear()
+        fig.canvas.draw()
+        renderer, box = fig.canvas.get_renderer(), fig.bbox
+        texts = [t for t in drawn_texts if t.get_visible() and t.get_text().strip()]
+        assert texts
+        for text in texts:
+            extent = text.get_window_extent(renderer)
+            assert (extent.x0 >= box.x0 - 0.5 and extent.x1 <= box.x1 + 0.5 and extent.y0 >= box.y0 - 0.5
+                    and extent.y1 <= box.y1 + 0.5), f"{name} at {width} in: {text.get_text()!r} is cut off"
+        legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend())]
+        assert not [t.get_text() for legend in legends for t in legend.get_texts()
+                    if INTERNAL_NAME.search(t.get_text())]
+
+
+def test_figure_pdfs_embed_truetype_fonts_only(runs, tmp_path, capsys):
+    """``figure all`` into PDFs and one figure into EPS: the fonts are embedded as TrueType (Type 42), never as
+    Type 3 (which many journals reject); TIFF is written too."""
+    folder = tmp_path / "figures"
+    assert main(["figure", "all", "-o", str(folder), "--runs", str(runs), "--quick", "--quiet", "--width",
+                 str(ONE_COLUMN), "--allow-partial"]) == 0
+    pdfs = sorted(folder.glob("*.pdf"))
+    assert len(pdfs) == len(figures(quick=True))
+    for pdf in pdfs:
+        data = pdf.read_bytes()
+        assert b"/Type3" not in data and b"/FontFile2" in data, pdf.name  # FontFile2: an embedded TrueType font
+    for suffix, magic in ((".eps", b"%!PS-Adobe"), (".tiff", b"II*\x00")):
+        image = tmp_path / f"fig2{suffix}"
+        assert main(["figure", "fig2", "-o", str(image), "--runs", str(runs), "--quick", "--quiet",
+                     "--allow-partial"]) == 0
+        assert image.read_bytes().startswith(magic)
+    eps = (tmp_path / "fig2.eps").read_bytes()
+    assert b"FontType 3" not in eps and b"/FontType 42" in eps
+    capsys.readouterr()

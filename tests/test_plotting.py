@@ -127,7 +127,7 @@ def test_stability_and_special_points(bifurcation_file):
     styles = {line.get_linestyle() for line in ax.get_lines() if len(line.get_xdata()) > 1}
     assert {"-", "--"} <= styles
     assert "pitchfork-super" in {t.get_text() for t in ax.texts}
-    assert legend_texts(fig) == ["M = 0.002, primary", "M = 0.002, pear_0"]
+    assert legend_texts(fig) == ["M = 0.002, primary", "M = 0.002, pear (BP 0)"]  # never the stored name
     assert legend_texts(plot([bifurcation_file], "pressure-pole", branch="pear_0")) == ["M = 0.002"]
 
 
@@ -163,3 +163,29 @@ def test_plot_subcommand(files, tmp_path, capsys):
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith("balloon-cg: error: ")
         assert all(word in err for word in words)
+
+
+def test_plot_and_bc_plot_draw_in_the_journal_style(files, tmp_path, capsys):
+    """``plot`` (a new figure or the caller's Axes) draws in the journal style, a new figure saves in it (TrueType
+    fonts in PDF: no Type 3), and the plot subcommand writes EPS and TIFF; matplotlib's global state is kept."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    from balloon_cg import plot as bc_plot
+
+    before = dict(matplotlib.rcParams)
+    fig = plot([files["spom1"]], "pressure-pole")
+    assert fig.legends[0].get_texts()[0].get_fontsize() == 6.5  # journal.mplstyle's legend.fontsize
+    ax = Figure().add_subplot()
+    bc_plot(files["spom1"], "pressure-pole", ax=ax)
+    assert ax.title.get_fontsize() == 8 and ax.get_legend().get_texts()[0].get_fontsize() == 6.5  # the Axes' own
+    # tick and axis-label sizes are the caller's (set when the Axes was made)
+    pdf = tmp_path / "p.pdf"
+    fig.savefig(pdf)
+    assert b"/Type3" not in pdf.read_bytes() and b"/FontFile2" in pdf.read_bytes()
+    assert dict(matplotlib.rcParams) == before
+    for suffix, magic in ((".eps", b"%!PS-Adobe"), (".tif", b"II*\x00")):
+        image = tmp_path / f"p{suffix}"
+        assert main(["plot", str(files["spom1"]), "--what", "pressure-pole", "-o", str(image)]) == 0
+        assert image.read_bytes().startswith(magic)
+    capsys.readouterr()

@@ -40,7 +40,9 @@ def test_every_variable_has_named_dimensions_and_units(run_file):
         with xr.open_dataset(run_file, engine="h5netcdf", group=group) as ds:
             assert not [d for d in ds.dims if str(d).startswith("phony")], (group, ds.dims)
             for name, variable in ds.variables.items():
-                assert "units" in variable.attrs and variable.attrs["long_name"], (group, name)
+                assert variable.attrs["long_name"], (group, name)
+                quantity = variable.dtype.kind == "f" and name not in ("newton_iterations",)
+                assert ("units" in variable.attrs) == quantity, (group, name)  # indices, flags, labels: none
     with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary/profiles") as ds:
         assert ds.rho.dims == ("point", "theta")
     with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary") as ds:
@@ -78,3 +80,12 @@ def test_previous_format_still_reads_and_draws():
     run = read_run(old)
     assert "volume" not in run["branches"]["primary"] and len(run["branches"]["primary"]["pressure"]) > 10
     assert plot([old], "pressure-pole").axes
+
+
+def test_cf_global_attributes(run_file):
+    with xr.open_dataset(run_file, engine="h5netcdf") as ds:
+        assert ds.attrs["Conventions"] == "CF-1.10" and ds.attrs["title"] == "balloon-cg run of scene small"
+        assert ds.attrs["history"].startswith(ds.attrs["created"]) and "balloon-cg 0.1.0" in ds.attrs["history"]
+    with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary") as ds:
+        assert ds.pressure.attrs["units"] == "1" and "units" not in ds.point.attrs
+        assert "units" not in ds.converged.attrs and "units" not in ds.newton_iterations.attrs

@@ -282,3 +282,51 @@ def test_phase_diagram_of_a_primary_only_sweep_is_refused(tmp_path):
     run_sweep(scene, ["material.alpha[0]=1.3,1.5"], out, mode="primary-only", workers=1)
     with pytest.raises(PlotError, match="primary-only sweep has no branch points"):
         plot([out], "phase")
+
+
+def test_every_group_of_a_sweep_file_opens_with_xarray(serial):
+    """The members copied into the sweep file keep valid dimension scales: h5py follows them to the member's own
+    scales, and xarray (h5netcdf) opens every group with named dimensions."""
+    xr = pytest.importorskip("xarray")
+    path = serial["path"]
+    groups = []
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, item: groups.append(name) if isinstance(item, h5py.Group) else None)
+        pressure = f["members/1/branches/primary/pressure"]
+        assert pressure.dims[0][0].name == "/members/1/branches/primary/point"
+    assert "members/2/branches/primary/special_points" in groups
+    for group in groups:
+        with xr.open_dataset(path, engine="h5netcdf", group=group) as ds:
+            if group.endswith("branches/primary"):
+                assert ds.pressure.dims == ("point",) and ds.unknowns.dims == ("point", "unknown")
+
+
+@pytest.fixture(scope="module")
+def analysed_sweep(scene, tmp_path_factory):
+    """The whole analysis (no surface branches) of M = 0, 0.002, 0.004 to λ2(0) = 2.5: every member has its
+    fold and its pear pitchfork."""
+    path = tmp_path_factory.mktemp("analysed") / "sweep.h5"
+    member_scene = scene.with_overrides({"continuation.stop_stretch": 2.5, "surface.branches": "none"})
+    run_sweep(member_scene, SPECS, path, workers=1)
+    return path
+
+
+def test_a_loaded_sweep_is_a_table_of_members(analysed_sweep):
+    """bc.load(sweep): the members, and one row per member with the varied value, the fold and the critical
+    pressures (each equal to the member's stored branch point)."""
+    import balloon_cg as bc
+
+    sweep = bc.load(analysed_sweep)
+    assert isinstance(sweep, bc.SweepResult) and sorted(sweep.members) == [0, 1, 2]
+    table = sweep.to_dataframe()
+    assert list(table.index) == [0, 1, 2] and list(table["field.M"]) == [0.0, 0.002, 0.004]
+    for index, member in sweep.members.items():
+        special = member.branches["primary"].special_points
+        pear = max(s["pressure"] for s in special if s["block"] == "odd_held")
+        assert table.loc[index, "P_cr1"] == pear and table.loc[index, "P_BP1"] == special[
+            [s["kind"] for s in special].index("BP")]["pressure"]
+        assert table.loc[index, "P_LP"] == next(s["pressure"] for s in special if s["kind"] == "LP")
+        assert member.to_xarray(group="special_points").sizes["special"] == len(special)
+    assert table["complete"].all() and table["P_cr1"].is_monotonic_increasing  # 2.26473, 2.26480, 2.26487
+    ds = sweep.to_xarray()
+    assert ds.sizes["member"] == 3 and float(ds["P_cr1"][2]) == table.loc[2, "P_cr1"]

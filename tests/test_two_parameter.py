@@ -3,9 +3,11 @@
 followed in M, its critical M bracketed by plain primary-branch sweeps."""
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 
+import balloon_cg as bc
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis import bifurcation
 from balloon_cg.analysis.primary import trace_primary
@@ -102,6 +104,13 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     assert read_run(path)["branches"] == {}  # also a readable run file (provenance attributes)
     with pytest.raises(FileExistsError):
         write_curve(path, scene, curve)
+    loaded = bc.load(path)  # a curve object named after its parameter
+    assert isinstance(loaded, bc.CurveResult) and loaded.parameter == "alpha1"
+    assert loaded.critical == {"pear": curve.critical[0]} and "critical alpha1 = " in repr(loaded)
+    table = loaded.to_dataframe()
+    assert list(table.columns[:3]) == ["curve", "alpha1", "pressure"] and len(table) == len(curve.q)
+    with h5py.File(path, "r") as f:
+        assert f["two_parameter/pear/q"].attrs["long_name"] == "alpha1"
 
 
 SINGLE_COIL = Path(__file__).resolve().parent.parent / "scenes" / "spom1_single_coil.toml"

@@ -22,6 +22,7 @@ from balloon_cg.app.cli import main
 from balloon_cg.app.summaries import format_run
 from balloon_cg.io.run_file import read_run
 from balloon_cg.model.shooting import shoot_general
+from balloon_cg.post.labels import GID
 from balloon_cg.post.plotting import PlotError, applicable_kinds, load_branches, plot
 from balloon_cg.scene import parse_scene
 from test_dielectric import NEO, sphere_mode_condition
@@ -133,6 +134,11 @@ def test_the_pear_branch_is_traced_in_the_voltage_at_fixed_pressure(voltage_pict
     assert abs(shot.P - PRESSURE) < 1e-8 and abs(shot.lam2_south - poles["lam2_south"][k]) < 1e-8
 
 
+def curve_pieces(ax) -> list:
+    """The branch curves drawn in ``ax`` (not the special-point labels' leader lines)."""
+    return [line for line in ax.get_lines() if len(line.get_xdata()) > 1 and line.get_gid() != GID]
+
+
 def test_voltage_pole_draws_the_stored_voltage_and_stability(voltage_file):
     """On an Axes: the curve pieces are the file's (λ2(0), Φ̄), solid exactly on the stable points, and the
     markers sit at the special points' stored (λ2(0), Φ̄)."""
@@ -140,7 +146,7 @@ def test_voltage_pole_draws_the_stored_voltage_and_stability(voltage_file):
     ax = Figure().add_subplot()
     assert plot(voltage_file, "voltage-pole", axes=ax) is ax.figure
     assert ax.get_ylabel().startswith("voltage")
-    pieces = [line for line in ax.get_lines() if len(line.get_xdata()) > 1]
+    pieces = curve_pieces(ax)
     x = np.concatenate([pieces[0].get_xdata()] + [line.get_xdata()[1:] for line in pieces[1:]])
     y = np.concatenate([pieces[0].get_ydata()] + [line.get_ydata()[1:] for line in pieces[1:]])
     np.testing.assert_array_equal(x, data["lam2_north"])
@@ -162,7 +168,7 @@ def test_voltage_equator_and_energy_name_the_voltage(voltage_file):
     axes = Figure().subplots(1, 2)
     plot(voltage_file, "voltage-equator", axes=axes)
     for ax, key in zip(axes, ("lam2_equator", "lam1_equator")):
-        pieces = [line for line in ax.get_lines() if len(line.get_xdata()) > 1]
+        pieces = curve_pieces(ax)
         np.testing.assert_array_equal(np.concatenate([pieces[0].get_ydata()] + [p.get_ydata()[1:] for p in pieces[1:]]),
                                       data["voltage"])
         np.testing.assert_array_equal(np.concatenate([pieces[0].get_xdata()] + [p.get_xdata()[1:] for p in pieces[1:]]),

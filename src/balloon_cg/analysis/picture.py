@@ -56,6 +56,9 @@ class Progress:
     def finish(self, phase: Phase, count: int) -> None:
         pass
 
+    def expect(self, phase: Phase, count: int) -> None:
+        """``count`` more points are to come in ``phase`` (known ahead for the stability of a traced branch)."""
+
     def ticker(self, phase: Phase):
         """A per-point callable for the tracers."""
         return lambda point: self.tick(phase)
@@ -107,6 +110,7 @@ class Picture:
 def _assess(branch: Branch, scene, symmetric: bool, progress: Progress) -> bool:
     """Assess ``branch`` (one STABILITY tick per point); False when a signal stopped it (the branch is kept as
     traced, not assessed)."""
+    progress.expect(Phase.STABILITY, len(branch.X))
     try:
         branch.stability, branch.unsettled = assess_branch(
             branch, scene.stability.degree, symmetric, check=True, m_max=scene.stability.m_max,

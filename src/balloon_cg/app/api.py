@@ -2,7 +2,7 @@
 
     trace(scene) -> Result             the primary branch
     analyse(scene) -> Result           the whole picture: stability, branch points, pear branches, snap-throughs
-    load(path) -> Result               a run file
+    load(path) -> Result               a run file (a sweep file: SweepResult; a curve file: CurveResult)
     plot(source, what, ax=None) -> matplotlib Figure, from Results or run files
 
 A ``Result`` is plain data: the content of its run file (``image``, the bytes of the HDF5 file that ``save``
@@ -20,6 +20,7 @@ import numpy as np
 
 from ..analysis.picture import Phase
 from ..io.hdf5 import atomic_bytes, command_line
+from ..io.layout import file_kind
 from ..io.run_file import RunFileError, read_run, read_run_image, run_image
 from ..numerics.interrupt import stop_on_signals
 from ..scene import Scene, SceneError, load_scene, parse_scene
@@ -231,9 +232,18 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
     return Result.of(scene, branches, snaps, found, picture, command=f"balloon_cg.analyse({scene.name!r})")
 
 
-def load(path) -> Result:
-    """The Result stored in a run file. Raises FileNotFoundError or IsADirectoryError (no such file), or
-    io.run_file.RunFileError (a damaged or foreign file, a stored scene that does not parse: docs/api.md)."""
+def load(path):
+    """What a balloon-cg file holds: the Result of a run file, the ``SweepResult`` of a sweep file
+    (app.sweep_result: its members and a table of what each found), the ``CurveResult`` of a two-parameter curve
+    file (app.curve_result, named after its parameter). Raises FileNotFoundError or IsADirectoryError (no such
+    file), or an io FileError (a damaged or foreign file, a stored scene that does not parse: docs/api.md)."""
+    kind = file_kind(path, RunFileError)
+    if kind == "sweep":
+        from .sweep_result import SweepResult
+        return SweepResult.read(path)
+    if kind == "curve":
+        from .curve_result import CurveResult
+        return CurveResult.read(path)
     run = read_run(path)
     try:
         scene = parse_scene(run["attrs"]["scene_toml"], run["scene_name"])

@@ -26,6 +26,8 @@ from pathlib import Path
 
 from .. import __version__
 from ..io.lock import owned
+from ..io.output import IMAGE_FORMATS
+from ..scene.validation import did_you_mean
 from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
@@ -89,7 +91,12 @@ def _terminate_raises():
 
 def _main(argv) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    command = next((word for word in argv if not word.startswith("-")), None)
+    if command is not None and command not in parser.commands:  # argparse names no near miss before Python 3.14
+        return _error(f"{command!r}: not a command{did_you_mean(command, parser.commands)} (choose from "
+                      f"{', '.join(parser.commands)}; {PROG} COMMAND -h)", 2)
+    args = parser.parse_args(argv)
     args.command_line = shlex.join([PROG, *argv])
     try:
         return args.handler(args)
@@ -139,7 +146,35 @@ def build_parser() -> argparse.ArgumentParser:
     for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels,
                 _add_figure):
         add(commands)
+    parser.commands = tuple(commands.choices)
+    for name, subcommand in commands.choices.items():
+        subcommand.epilog = EXAMPLES_HEADING + "\n".join(f"  {line}" for line in EXAMPLES[name])
+        subcommand.formatter_class = ExamplesFormatter
     return parser
+
+
+EXAMPLES_HEADING = "examples:\n"
+EXAMPLES = {  # each subcommand's --help ends with these
+    "run": ("balloon-cg run spom1_two_coils_M0.002 -o two_coils.h5",
+            "balloon-cg run spom1 --set continuation.stop_stretch=3 --primary-only"),
+    "solve": ("balloon-cg solve spom1 --pole-stretch 2.5 --json",),
+    "inspect": ("balloon-cg inspect two_coils.h5", "balloon-cg inspect sweep.h5 --json"),
+    "plot": ("balloon-cg plot two_coils.h5 --what pressure-pole,shapes -o p.pdf",
+             "balloon-cg plot two_coils.h5 --what pressure-pole --stability volume"),
+    "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:21 -o sweep.h5",),
+    "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",),
+    "kernels": ("balloon-cg kernels spom1 --json",),
+    "figure": ("balloon-cg figure fig9 -o fig9.pdf --width 3.5", "balloon-cg figure all -o paper-figures"),
+}
+
+
+class ExamplesFormatter(argparse.HelpFormatter):
+    """argparse's help, the examples epilog kept one command a line (the other text wrapped as usual)."""
+
+    def _fill_text(self, text, width, indent):
+        if text.startswith(EXAMPLES_HEADING):
+            return "\n".join(indent + line for line in text.splitlines())
+        return super()._fill_text(text, width, indent)
 
 
 def _error(message: str, code: int) -> int:
@@ -148,9 +183,14 @@ def _error(message: str, code: int) -> int:
 
 
 def _os_message(e: OSError) -> str:
+    """'FILE: what is wrong', with the nearest name in its folder when the file does not exist."""
     if e.filename is None:
         return str(e)
-    return f"{e.filename}: {e.strerror or e}"
+    near = ""
+    if isinstance(e, FileNotFoundError) and Path(e.filename).parent.is_dir():
+        folder = Path(e.filename).parent
+        near = did_you_mean(e.filename, [str(folder / p.name) for p in folder.iterdir()])
+    return f"{e.filename}: {e.strerror or e}{near}"
 
 
 # --- run ---------------------------------------------------------------------------------------------------
@@ -370,17 +410,14 @@ def _finite(value):
 
 # --- plot --------------------------------------------------------------------------------------------------
 
-IMAGE_FORMATS = (".png", ".pdf", ".svg")
-
-
 def _add_plot(commands):
     p = commands.add_parser("plot", help=f"draw figures from one or more run files ({docs_path('plots.md')})")
     p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
     p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}")
-    p.add_argument("-o", "--output", help="image file, .png, .pdf or .svg (default: FIRST_FILE_STEM_KIND.png "
-                                          "next to the first file; with several kinds: OUTPUT_STEM_KIND.SUFFIX; "
-                                          "an existing file is replaced only with --force)")
+    p.add_argument("-o", "--output", help=f"image file, {', '.join(IMAGE_FORMATS)} (default: "
+                                          "FIRST_FILE_STEM_KIND.png next to the first file; with several kinds: "
+                                          "OUTPUT_STEM_KIND.SUFFIX; an existing file is replaced only with --force)")
     p.add_argument("--force", action="store_true", help="replace existing image files")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
                    help="point indices for shapes, stresses, field, curvature (negative: from the end); one "
@@ -399,7 +436,8 @@ def _kinds(text: str) -> list[str]:
     kinds = [k.strip() for k in text.split(",")]
     unknown = [k for k in kinds if k not in PLOT_KINDS]
     if unknown:
-        raise argparse.ArgumentTypeError(f"{unknown[0]!r}: not a plot kind (choose from {', '.join(PLOT_KINDS)})")
+        raise argparse.ArgumentTypeError(f"{unknown[0]!r}: not a plot kind{did_you_mean(unknown[0], PLOT_KINDS)} "
+                                         f"(choose from {', '.join(PLOT_KINDS)})")
     return kinds
 
 
@@ -449,7 +487,8 @@ def _add_figure(commands):
     """``figure``: one figure of the paper, or all of them (app.figures, docs/paper.md)."""
     p = commands.add_parser("figure", help=f"draw a figure of the paper, computing its runs ({docs_path('paper.md')})")
     p.add_argument("name", help="fig2 .. fig13, or all (then --output is a folder)")
-    p.add_argument("-o", "--output", required=True, help="image file (.png, .pdf, .svg), or the folder for all")
+    p.add_argument("-o", "--output", required=True,
+                   help=f"image file ({', '.join(IMAGE_FORMATS)}), or the folder for all")
     p.add_argument("--runs", metavar="FOLDER", help="where run files are kept and reused (default: OUTPUT's folder/runs)")
     p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")
@@ -572,7 +611,7 @@ def _pitchfork_curve(scene, args):
     """``critical``'s computation: the primary branch, its first pear pitchfork located, the curve of pitchforks
     in ``args.parameter`` (analysis.codim2). None when a signal (numerics.interrupt) stopped the work before the
     curve started; a signal during the curve ends it at its next point (end ``interrupted``)."""
-    from tqdm import tqdm
+    from tqdm.auto import tqdm
 
     from ..analysis.bifurcation import detect, locate
     from ..analysis.codim2 import TwoParameterError, continue_branch_point

@@ -3,23 +3,21 @@
 
 Each figure's runs (post.paper: shipped scenes with overrides) are computed with ``analyse`` (the whole
 picture) and kept as run files in a runs folder, ``<name of the scene>.h5``; a run file there is reused when
-the scene it was computed for (its normalised TOML) is the one asked for, and recomputed otherwise.
-Figures are drawn and saved inside ``matplotlib.rc_context(PAPER_STYLE)``: no global matplotlib state changes.
+the scene it was computed for (its normalised TOML) is the one asked for and it was not interrupted (a signal
+stopped it: recomputed, said on stderr), and recomputed otherwise.
+Figures are drawn and saved in the journal style (post.style): no global matplotlib state changes.
 """
 import sys
 from pathlib import Path
 
-import matplotlib
-
-from ..io.output import check_output, replacing
+from ..io.output import IMAGE_FORMATS, check_output, replacing
 from ..io.run_file import read_run
-from ..post.paper import PAPER_STYLE, TWO_COLUMNS, draw_figure, figures
+from ..post.paper import TWO_COLUMNS, draw_figure, figures
 from ..post.plotting import Reading
 from ..scene import parse_scene
 from .api import analyse
 from .progress import shown
 
-IMAGE_FORMATS = (".png", ".pdf", ".svg")
 MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (docs/cli.md)
 
 
@@ -41,13 +39,18 @@ def incomplete_runs(names, runs: Path, quick: bool = False) -> list[Path]:
 
 
 def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> dict:
-    """The run of ``case`` (read_run() output): the file in ``runs`` if it holds this scene, else computed and
-    written there (incomplete or not: ``incomplete_runs``); KeyboardInterrupt after writing a run a signal
-    stopped (the CLI exits 130)."""
+    """The run of ``case`` (read_run() output): the file in ``runs`` if it holds this scene and was not
+    interrupted, else computed and written there (incomplete or not: ``incomplete_runs``; an interrupted one is
+    recomputed, saying so on stderr); KeyboardInterrupt after writing a run a signal stopped (the CLI exits
+    130)."""
     scene = case.load(quick)
     path = run_path(scene, runs, quick)
     run = read_run(path) if path.exists() else None
-    if run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml():
+    interrupted = run is not None and "interrupted" in list(run["attrs"].get("incomplete_gaps", []))
+    if interrupted:
+        print(f"balloon-cg: {path}: the run kept there was interrupted; computing it again", file=sys.stderr)
+    stale = run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml()
+    if stale or interrupted:
         runs.mkdir(parents=True, exist_ok=True)
         result = analyse(scene, progress=progress)
         result.save(path, force=True)
@@ -59,7 +62,7 @@ def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> di
 
 def make_figure(name: str, output, runs=None, width: float = TWO_COLUMNS, reading: Reading = Reading.PRESSURE,
                 quick: bool = False, progress: bool = False, force: bool = False) -> Path:
-    """Draw the paper's figure ``name`` (post.paper.figures) into the image ``output`` (.png, .pdf or .svg),
+    """Draw the paper's figure ``name`` (post.paper.figures) into the image ``output`` (IMAGE_FORMATS),
     ``width`` inches wide; runs kept in ``runs`` (default: a folder ``runs`` next to the image). An existing
     ``output`` is replaced only with ``force`` (io.output), checked before any run is computed."""
     catalogue = figures(quick)
@@ -76,7 +79,7 @@ def make_figure(name: str, output, runs=None, width: float = TWO_COLUMNS, readin
     output.parent.mkdir(parents=True, exist_ok=True)
     check_output(output, force)
     loaded = [run_for(case, runs, quick, progress) for case in figure.cases]
-    with matplotlib.rc_context(PAPER_STYLE), replacing(output, force) as tmp:
+    with replacing(output, force) as tmp:
         draw_figure(figure, loaded, width, reading).savefig(tmp, format=output.suffix.lower()[1:])
     return output
 

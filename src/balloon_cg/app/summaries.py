@@ -7,21 +7,11 @@ import numpy as np
 def summarise_file(path) -> tuple[dict, str]:
     """(JSON-ready summary, readable text) of a run, sweep or curve file, told apart by their format and
     content (raises the readers' errors for anything else)."""
-    import h5py
-
-    from ..io.layout import reading
+    from ..io.layout import file_kind
     from ..io.run_file import RunFileError, read_run
 
     path = Path(path)
-    kind = None
-    if path.is_file():
-        try:
-            f = h5py.File(path, "r")
-        except (OSError, RuntimeError):
-            raise RunFileError(path, "not a readable HDF5 file") from None
-        with f, reading(path, RunFileError):
-            kind = "sweep" if str(f.attrs.get("format", "")).startswith("balloon-cg-sweep") else \
-                "curve" if len(f.get("two_parameter", {})) else "run"
+    kind = file_kind(path, RunFileError) if path.is_file() else None
     if kind == "sweep":
         summary = summarise_sweep(path)
         return summary, format_sweep(summary)

@@ -32,7 +32,8 @@ from .schema import attach_dimensions, describe, scale
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):
     """Write a two-parameter curve (analysis.codim2.TwoParameterCurve) to ``path`` atomically."""
-    attrs = root_attrs(scene) | dict(extra_attrs or {})
+    attrs = root_attrs(scene) | {"title": f"balloon-cg two-parameter curve of scene {scene.name}"} | dict(
+        extra_attrs or {})
     critical = curve.critical
     with atomic_file(path, force) as f:
         f.attrs.update(attrs)
@@ -62,6 +63,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         point, unknown = scale(group, "point", len(curve.q)), scale(group, "unknown", columns["unknowns"].shape[1])
         attach_dimensions(group, {1: (point,), "unknowns": (point, unknown),
                                   "mode": (point, scale(group, "mode_unknown", columns["mode"].shape[1]))})
+        group["q"].attrs["long_name"] = curve.parameter  # q by its name (M, alpha1, …)
         merges = [replace(s, X=curve.branch_X(s.X)[0]) for s in curve.merges]
         special = group.create_group("special_points")
         write_special(special, merges, curve.n + 1, lambda X: legendre_poles(curve.disc, X), unknown)

@@ -1,4 +1,5 @@
-"""What every balloon-cg HDF5 file shares: the checked output path, the atomic write and the provenance.
+"""What every balloon-cg HDF5 file shares: the checked output path, the atomic write, the provenance and the copy of
+a group into another file (``copy_tree``: dimension scales kept valid).
 
 A file is written to a temporary file in the same directory and renamed over the target (``os.replace``) only
 when complete: an existing file is never left half-written, and on any failure the temporary file is removed.
@@ -34,13 +35,21 @@ def atomic_bytes(path, data: bytes, force: bool = False) -> Path:
     return Path(path)
 
 
+CONVENTIONS = "CF-1.10"  # the netCDF conventions the files follow (units, long_name, dimensions, history)
+
+
 def provenance(command: str | None = None) -> dict:
-    """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command."""
+    """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command, and
+    the CF global attributes ``Conventions`` and ``history`` (time, command and version, one line)."""
+    created = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    command = command if command is not None else command_line()
     return {
         "package_version": balloon_cg.__version__,
         "generated_digest": generated_digest(),
-        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "command": command if command is not None else command_line(),
+        "created": created,
+        "command": command,
+        "Conventions": CONVENTIONS,
+        "history": f"{created}: {command} (balloon-cg {balloon_cg.__version__})",
     }
 
 
@@ -63,3 +72,40 @@ def plain(value):
         return value
     item = value.item()  # a long double stays a numpy scalar: its nearest Python number
     return item if not isinstance(item, np.generic) else complex(item) if np.iscomplexobj(item) else float(item)
+
+
+SCALE_BOOKKEEPING = ("DIMENSION_LIST", "REFERENCE_LIST")  # HDF5 dimension-scale attributes: object references
+
+
+def copy_attrs(src, dst) -> None:
+    """Every attribute of ``src`` onto ``dst``, with its stored type."""
+    for name in src.attrs:
+        dst.attrs.create(name, src.attrs[name], dtype=src.attrs.get_id(name).dtype)
+
+
+def copy_tree(src, dst) -> None:
+    """Copy the group ``src`` (its attributes and everything in it) into the group ``dst`` of another file, its
+    dimension scales attached again in ``dst``: HDF5's object copy across files keeps the scales' references as
+    addresses in the source file, which dangle in the copy (h5py, xarray and netCDF readers then fail)."""
+    copy_attrs(src, dst)
+    for name in src:
+        src.copy(src[name], dst, name)
+    datasets = []
+    src.visititems(lambda name, item: datasets.append(name) if isinstance(item, h5py.Dataset) else None)
+    for name in datasets:
+        for key in SCALE_BOOKKEEPING:
+            if key in dst[name].attrs:
+                del dst[name].attrs[key]
+    for name in datasets:
+        for axis, dimension in enumerate(src[name].dims):
+            for attached in _scales(dimension):
+                dst[name].dims[axis].attach_scale(dst[attached.name.removeprefix(src.name).lstrip("/")])
+
+
+def _scales(dimension) -> list:
+    """The scales attached to a dimension; none when its references dangle (a sweep file written by an earlier
+    version copied them so): the copy then has no scale on that axis."""
+    try:
+        return dimension.values()
+    except (KeyError, RuntimeError, ValueError):
+        return []

@@ -149,3 +149,25 @@ def _describe(value) -> str:
     if isinstance(value, np.ndarray):
         return f"{value.ndim}-d {value.dtype}"
     return type(value).__name__
+
+
+@contextlib.contextmanager
+def opened(path, error=FileError):
+    """``with opened(path) as f:`` the HDF5 file ``path`` open for reading (``check_input`` first), what h5py
+    raises while it is read mapped by ``reading``; ``error`` when it is not a readable HDF5 file."""
+    check_input(path, error)
+    try:
+        f = h5py.File(path, "r")
+    except (OSError, RuntimeError):
+        raise error(path, "not a readable HDF5 file") from None
+    with f, reading(path, error):
+        yield f
+
+
+def file_kind(path, error=FileError) -> str:
+    """'sweep', 'curve' or 'run': what a balloon-cg file holds, by its format and content (a curve file is a run
+    file with /two_parameter curves)."""
+    with opened(path, error) as f:
+        if str(f.attrs.get("format", "")).startswith("balloon-cg-sweep"):
+            return "sweep"
+        return "curve" if len(f.get("two_parameter", {})) else "run"

@@ -20,6 +20,7 @@ import shutil
 import stat
 from pathlib import Path
 
+IMAGE_FORMATS = (".png", ".pdf", ".svg", ".eps", ".tif", ".tiff")  # what plot and figure write
 STORE_SUFFIXES = (".members", ".members-new", ".members-old")  # the store, a --force sweep's staging, a retired one
 
 

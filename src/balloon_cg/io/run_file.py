@@ -2,9 +2,9 @@
 
 Layout::
 
-    /                      attrs: format, scene_name, scene_toml, tolerance, control (loading.control),
-                                  + provenance (io.hdf5: package_version,
-                                  generated_digest, created (UTC ISO 8601), command), complete (bool),
+    /                      attrs: format, scene_name, scene_toml, tolerance, control (loading.control), title,
+                                  + provenance (io.hdf5: package_version, generated_digest, created (UTC ISO
+                                  8601), command, Conventions, history: CF), complete (bool),
                                   incomplete_gaps, incomplete_branches, incomplete_messages (analysis.verdict),
                                   + extra_attrs
     /branches/<name>/      attrs: order, m (0: axisymmetric, this layout; m ≥ 1: a surface branch, below),
@@ -45,8 +45,9 @@ Layout::
                            held_gas, free_gas; stable_pressure, stable_pressure_free, stable_volume, … (point,)
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
 
-Every dataset carries ``units``, ``long_name`` and ``description`` (``io.schema``), and its axes are netCDF-4
-dimensions (HDF5 dimension scales), so ``xarray.open_dataset(path, engine="h5netcdf", group=...)`` names them.
+Every dataset carries ``long_name`` and ``description``, and a quantity its ``units`` (``io.schema``); its axes
+are netCDF-4 dimensions (HDF5 dimension scales), so ``xarray.open_dataset(path, engine="h5netcdf", group=...)``
+names them.
 A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index + 1``; its own X is in
 special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous formats
 still read: "balloon-cg/3" (no ``m`` attribute, no surface branches: every branch reads as m = 0) and
@@ -60,7 +61,7 @@ import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, plain, provenance, write_strings
-from .layout import FileError, check_columns, check_input, check_sizes, reading, require_attrs, require_group
+from .layout import FileError, check_columns, check_sizes, opened, reading, require_attrs, require_group
 from .schema import attach_dimensions, scale
 
 FORMAT = "balloon-cg/4"
@@ -111,9 +112,10 @@ def _run_attrs(scene, branches, extra_attrs, found) -> dict:
 
 
 def root_attrs(scene, command: str | None = None) -> dict:
-    """The root attributes of a run file: format, the scene and the provenance."""
+    """The root attributes of a run file: format, the scene, the provenance and a CF ``title``."""
     return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.text, "tolerance": scene.solver.tol,
-            "control": scene.loading.control.value, **provenance(command)}
+            "control": scene.loading.control.value, "title": f"balloon-cg run of scene {scene.name}",
+            **provenance(command)}
 
 
 def verdict_attrs(branches=None, found=None) -> dict:
@@ -415,12 +417,7 @@ def read_run(path) -> dict:
     (format balloon-cg/3 or /2), naming the file and what is missing or wrong.
     """
     path = Path(path)
-    check_input(path, RunFileError)
-    try:
-        f = h5py.File(path, "r")
-    except (OSError, RuntimeError):
-        raise RunFileError(path, "not a readable HDF5 file") from None
-    with f, reading(path, RunFileError):
+    with opened(path, RunFileError) as f:
         return _read_open(f, path) | {"path": str(path)}
 
 

@@ -2,7 +2,8 @@
 
 All quantities are nondimensional (MODEL.md §2): lengths in R0, the pressure P = P̄R0/(T0 μ/2), stresses in μ/2,
 field in I/(4π R0); their ``units`` attribute is "1" (dimensionless, CF convention) and ``description`` names the
-scale (the tilt of a surface branch is in degrees). ``describe`` writes the attributes; ``attach_dimensions``
+scale (the tilt of a surface branch is in degrees). Indices, counts, flags and labels are not quantities: they
+have no ``units`` (``COUNT``). ``describe`` writes the attributes; ``attach_dimensions``
 makes ``point``, ``theta``, ``unknown``, ``coefficient``, ``axis`` and ``special`` HDF5 dimension scales
 (netCDF-4 dimensions, so xarray with h5netcdf names the axes) and attaches them.
 """
@@ -10,24 +11,25 @@ import h5py
 import numpy as np
 
 NONDIMENSIONAL = "1"
+COUNT = ""  # an index, a count, a flag or a label: no units attribute
 
 #: name: (units, long_name, description)
 VARIABLES = {
-    "point": (NONDIMENSIONAL, "point index", "index of the point along the branch, in continuation order"),
+    "point": (COUNT, "point index", "index of the point along the branch, in continuation order"),
     "theta": ("rad", "material polar angle θ", "material coordinate of the undeformed sphere, 0 at the north pole"),
-    "unknown": (NONDIMENSIONAL, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last "
+    "unknown": (COUNT, "unknown index", "Legendre unknowns u (their order: docs/hdf5.md), then P last "
                                                  "(Φ̄ on a voltage continuation)"),
-    "special": (NONDIMENSIONAL, "special point index", "index of the special point on its branch"),
-    "mode_unknown": (NONDIMENSIONAL, "mode unknown index", "index into the odd perturbation block of the mode"),
-    "snap": (NONDIMENSIONAL, "snap-through index", "one row per snap-through under the loading control"),
+    "special": (COUNT, "special point index", "index of the special point on its branch"),
+    "mode_unknown": (COUNT, "mode unknown index", "index into the odd perturbation block of the mode"),
+    "snap": (COUNT, "snap-through index", "one row per snap-through under the loading control"),
     "from_branch": ("", "from branch", "the branch whose stable stretch ends"),
-    "from_index": (NONDIMENSIONAL, "from point", "the last stable point of from_branch"),
+    "from_index": (COUNT, "from point", "the last stable point of from_branch"),
     "to_branch": ("", "to branch", "the branch of the lowest-energy stable state at that P (empty: none)"),
-    "to_index": (NONDIMENSIONAL, "to point", "its point near the same P (-1: none)"),
-    "eigenvalue": (NONDIMENSIONAL, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
-    "coefficient": (NONDIMENSIONAL, "coefficient index", "coefficients c of the displacement in the branch's "
+    "to_index": (COUNT, "to point", "its point near the same P (-1: none)"),
+    "eigenvalue": (COUNT, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
+    "coefficient": (COUNT, "coefficient index", "coefficients c of the displacement in the branch's "
                                                          "spherical harmonics, in block order (docs/hdf5.md)"),
-    "axis": (NONDIMENSIONAL, "Cartesian axis", "0: x, 1: y, 2: z (z the coil axis)"),
+    "axis": (COUNT, "Cartesian axis", "0: x, 1: y, 2: z (z the coil axis)"),
     "pressure": (NONDIMENSIONAL, "pressure P", "P = P̄ R0 / (T0 μ/2)"),
     "voltage": (NONDIMENSIONAL, "voltage Φ̄", "Φ̄ = (Φ/H) √(ε/μ): voltage across the thickness (docs/scenes.md)"),
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
@@ -46,12 +48,12 @@ VARIABLES = {
     "eta_south": (NONDIMENSIONAL, "η at the south pole", "axial position η(π) / R0"),
     "lam1_equator": (NONDIMENSIONAL, "λ1 at the equator", "meridional stretch λ1(π/2)"),
     "lam2_equator": (NONDIMENSIONAL, "λ2 at the equator", "hoop stretch λ2(π/2)"),
-    "converged": (NONDIMENSIONAL, "converged", "true: a finite converged Newton solution"),
+    "converged": (COUNT, "converged", "true: a finite converged Newton solution"),
     "residual": (NONDIMENSIONAL, "residual norm", "max-norm of the Ritz residual at the solution"),
     "error_estimate": (NONDIMENSIONAL, "discretisation error estimate", "change of the pole stretch against a "
                                                                           "higher degree (docs/numerics.md)"),
-    "newton_iterations": (NONDIMENSIONAL, "Newton iterations", "iterations of the corrector at this point"),
-    "solved_degree": (NONDIMENSIONAL, "solved Legendre degree", "degree the point was solved at before storage"),
+    "newton_iterations": (COUNT, "Newton iterations", "iterations of the corrector at this point"),
+    "solved_degree": (COUNT, "solved Legendre degree", "degree the point was solved at before storage"),
     "unknowns": (NONDIMENSIONAL, "unknowns (u, P)", "Legendre unknowns u of λ2, η (docs/hdf5.md), then P"),
     "lam1": (NONDIMENSIONAL, "meridional stretch λ1(θ)", "λ1 = sqrt(λ2'² ... ) (MODEL.md §1)"),
     "lam2": (NONDIMENSIONAL, "hoop stretch λ2(θ)", "λ2 = ρ / sin θ"),
@@ -65,31 +67,33 @@ VARIABLES = {
     "reason": ("", "reason", "why a special point is approximate; empty when located"),
     "stop_code": ("", "stop code", "analysis.results.StopCode of an end point"),
     "note": ("", "note", "for people: the stop message or the mode"),
-    "index": (NONDIMENSIONAL, "point index", "the special point lies between points index and index + 1"),
-    "m": (NONDIMENSIONAL, "azimuthal wave number", "m of the crossing mode (0: axisymmetric)"),
+    "index": (COUNT, "point index", "the special point lies between points index and index + 1"),
+    "m": (COUNT, "azimuthal wave number", "m of the crossing mode (0: axisymmetric)"),
     "uncertainty": (NONDIMENSIONAL, "uncertainty in P", "bracket width in P of an approximate point; 0 if located"),
     "E2": (NONDIMENSIONAL, "normal-form E2", "energy expansion coefficient along the mode (docs/second_variation.md)"),
     "E3": (NONDIMENSIONAL, "normal-form E3", "cubic coefficient"),
     "E4": (NONDIMENSIONAL, "normal-form E4", "quartic coefficient"),
     "q": (NONDIMENSIONAL, "second parameter q", "the continued parameter (its name: the parameter attribute)"),
     "mode": (NONDIMENSIONAL, "critical mode", "null vector φ on the odd perturbation block"),
-    "stable_pressure": (NONDIMENSIONAL, "stable, pressure control", "held at the centre, pressure control"),
-    "stable_volume": (NONDIMENSIONAL, "stable, volume control", "held at the centre, volume-preserving"),
-    "stable_pressure_free": (NONDIMENSIONAL, "stable, free, pressure control", "axial translation included"),
-    "stable_volume_free": (NONDIMENSIONAL, "stable, free, volume control", "axial translation included"),
-    "stable_gas": (NONDIMENSIONAL, "stable, gas control", "held at the centre, fixed amount of isothermal gas"),
-    "stable_gas_free": (NONDIMENSIONAL, "stable, free, gas control", "axial translation included"),
+    "stable_pressure": (COUNT, "stable, pressure control", "held at the centre, pressure control"),
+    "stable_volume": (COUNT, "stable, volume control", "held at the centre, volume-preserving"),
+    "stable_pressure_free": (COUNT, "stable, free, pressure control", "axial translation included"),
+    "stable_volume_free": (COUNT, "stable, free, volume control", "axial translation included"),
+    "stable_gas": (COUNT, "stable, gas control", "held at the centre, fixed amount of isothermal gas"),
+    "stable_gas_free": (COUNT, "stable, free, gas control", "axial translation included"),
 }
 LOWEST = (NONDIMENSIONAL, "lowest eigenvalue", "smallest eigenvalue of the second-variation block")
 
 
 def describe(dataset, name: str | None = None) -> None:
-    """Set ``units``, ``long_name`` and ``description`` of an h5py dataset from VARIABLES (by its own name)."""
+    """Set ``units`` (a quantity's only), ``long_name`` and ``description`` of an h5py dataset from VARIABLES (by
+    its own name)."""
     name = name or dataset.name.rsplit("/", 1)[-1]
     units, long_name, description = LOWEST if name.startswith("lowest_") else VARIABLES[name]
     if name.startswith("lowest_"):
         long_name = f"{long_name}, block {name.removeprefix('lowest_')}"
-    dataset.attrs.update({"units": units, "long_name": long_name, "description": description})
+    dataset.attrs.update({"units": units} if units else {})
+    dataset.attrs.update({"long_name": long_name, "description": description})
 
 
 def scale(group, name: str, length: int = 0, values=None):

@@ -9,7 +9,7 @@
 
     /                   attrs: format, scene_name, scene_toml (base scene, normalised), vary (JSON list of
                                [key, values]), mode, members (total count), store (the store folder's name),
-                               + provenance (io.hdf5)
+                               title, + provenance (io.hdf5: with Conventions and history)
     /members/<index>/   attrs: format ("balloon-cg-sweep-member/1"), overrides (JSON object, dotted key -> value),
                                scene_hash (sha256 of the member scene's normalised TOML), scene_toml, tolerance,
                                created, package_version, generated_digest, worker_pid, wall_time,
@@ -38,7 +38,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .hdf5 import atomic_file, plain, provenance
+from .hdf5 import atomic_file, copy_attrs, copy_tree, plain, provenance
 from .output import store_path
 from .lock import remove_debris
 from .run_file import read_branches, verdict_attrs, write_branches
@@ -75,7 +75,7 @@ def _retired_path(path) -> Path:
 def root_attrs(scene, axes: list, mode: str, n: int, command: str | None) -> dict:
     """Root attributes of a sweep: the base scene, the varied keys and values, the mode, provenance."""
     return {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.to_toml(), "vary": json.dumps(axes),
-            "mode": mode, "members": n, **provenance(command)}
+            "mode": mode, "members": n, "title": f"balloon-cg sweep of scene {scene.name}", **provenance(command)}
 
 
 # --- the store ---------------------------------------------------------------------------------------------
@@ -204,7 +204,7 @@ def _import(path: Path, directory: Path, attrs: dict, members: list) -> Store:
                                  "use --force to replace the file")
             target = store.member_file(m.index)
             with atomic_file(target, force=True) as out:
-                _copy_group(group, out)
+                copy_tree(group, out)
                 out.attrs["format"] = MEMBER_FORMAT
             store.done[m.index] = target
     return store
@@ -249,7 +249,7 @@ def consolidate(path, directory: Path) -> None:
     """Rebuild the sweep file ``path`` from the store ``directory`` (atomically replacing it)."""
     path = Path(path)
     with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True, keep_store=True) as f:
-        _copy_attrs(manifest, f)
+        copy_attrs(manifest, f)
         f.attrs["format"] = FORMAT
         f.attrs["store"] = store_path(path).name
         group = f.create_group("members")
@@ -257,7 +257,7 @@ def consolidate(path, directory: Path) -> None:
             match = _MEMBER.fullmatch(item.name)
             if match is not None:
                 with _open(item) as member:
-                    _copy_group(member, group.create_group(str(int(match.group(1)))))
+                    copy_tree(member, group.create_group(str(int(match.group(1)))))
 
 
 def commit_replacement(path) -> None:
@@ -281,17 +281,6 @@ def _finish_replacement(path: Path) -> None:
         staging_path(path).rename(store_path(path))  # cut between the two renames of commit_replacement
         consolidate(path, store_path(path))
     shutil.rmtree(retired)
-
-
-def _copy_attrs(src, dst) -> None:
-    for name in src.attrs:
-        dst.attrs.create(name, src.attrs[name], dtype=src.attrs.get_id(name).dtype)
-
-
-def _copy_group(src, dst) -> None:
-    _copy_attrs(src, dst)
-    for name in src:
-        src.copy(src[name], dst, name)
 
 
 # --- reading -----------------------------------------------------------------------------------------------

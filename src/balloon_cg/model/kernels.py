@@ -29,6 +29,7 @@ from importlib import resources
 import numpy as np
 
 from . import kernel_cache
+from .compile_notice import announce_first_use
 from .. import generated
 from ..scene.energies import StrainEnergy
 from ..scene.validation import SceneError
@@ -130,11 +131,13 @@ class KernelSet:
         if isinstance(material, StrainEnergy):
             self.general = False
             self._scene_arrays = {"material": _frozen(material.values)}
+            announce_first_use(self.module)
             return
         alphas = dict(self.module.INPUTS)["alphas"]
         self.exponents = None if alphas == "runtime" else tuple(float(a) for a in alphas)
         self.general = self.exponents is None
         self._scene_arrays = self._pack(tuple(material.mu), tuple(material.alpha))
+        announce_first_use(self.module)
 
     @property
     def field_class(self) -> bool:
@@ -154,6 +157,7 @@ class KernelSet:
         twin._binders, twin._node_kernels = {}, {}
         twin.module = surface_module(self)
         twin.__dict__.pop("signature", None)
+        announce_first_use(twin.module)
         return twin
 
     @cached_property

@@ -20,6 +20,9 @@ from matplotlib.lines import Line2D
 
 from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
 from .quantities import branch_discretisation, stored_scene
+from . import labels
+from .fit import fit_titles, fitted_legend
+from .style import JournalFigure, journal_style
 from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
 from ..analysis.control import control_values, minimised_energy
 from ..analysis.picture import MIRROR, Curve, find_snaps
@@ -31,15 +34,6 @@ M_VALUES = (0.001, 0.002, 0.003)  # the several M of Figs. 3–8 (with M = 0 fro
 QUICK_M_VALUES = (0.001,)
 QUICK = {"solver.degree": 12, "solver.max_degree": 60, "stability.degree": 8, "stability.m_max": 0,
          "continuation.max_points": 12, "continuation.step": 0.2, "continuation.step_max": 0.8}
-
-PAPER_STYLE = {  # readable at 3.5 in: 8 pt text, 7 pt ticks and legends, thin frames
-    "font.size": 8, "axes.titlesize": 8, "axes.labelsize": 8, "xtick.labelsize": 7, "ytick.labelsize": 7,
-    "legend.fontsize": 6.5, "legend.title_fontsize": 6.5, "legend.frameon": False, "axes.linewidth": 0.6,
-    "lines.linewidth": 1.1, "lines.markersize": 4, "xtick.major.width": 0.6, "ytick.major.width": 0.6,
-    "xtick.direction": "in", "ytick.direction": "in", "savefig.dpi": 300, "mathtext.fontset": "dejavuserif",
-    "font.family": "serif",
-}
-
 
 @dataclass(frozen=True)
 class Case:
@@ -83,7 +77,8 @@ def primary_only(run: dict) -> dict:
 
 def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
     """Replace the legends drawn inside ``axes`` by one legend below the figure (entries deduplicated by
-    label; the title of the first), with the key of the special-point markers (``markers``)."""
+    label; the title of the first; at most ``ncols`` columns, as many as fit: ``fit.fitted_legend``), with the
+    key of the special-point markers (``markers``)."""
     markers_only(axes)
     handles, title = {}, None
     for ax in axes:
@@ -95,20 +90,18 @@ def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
             handles.setdefault(text.get_text(), handle)
         legend.remove()
     handles |= {h.get_label(): h for h in MARKER_KEY} if markers else {}
-    ncols = 2 if fig.get_size_inches()[0] < COMPACT_WIDTH else ncols
-    fig.legend(list(handles.values()), list(handles), title=title, loc="outside lower center",
-               ncols=min(ncols, len(handles)))
+    fitted_legend(fig, list(handles.values()), list(handles), min(ncols, len(handles)), title=title,
+                  loc="outside lower center")
 
 
 def markers_only(axes):
-    """Remove the kind labels of the special points (their markers stay; the key is in the legend)."""
+    """Remove the kind labels of the special points and their leaders (their markers stay; the key is in the
+    legend)."""
     for ax in axes:
-        for text in list(ax.texts):
-            if text.get_text() in SPECIAL_TEXTS or text.get_text().startswith(("BP", "pitchfork", "transcritical")):
-                text.remove()
+        for artist in ax.findobj(lambda a: a.get_gid() == labels.GID and a is not ax):
+            artist.remove()
 
 
-SPECIAL_TEXTS = {"LP", "TP", "EP", "UZ"}
 MARKER_KEY = [Line2D([], [], linestyle="none", marker=m, markerfacecolor="0.7", markeredgecolor="k",
                      markeredgewidth=0.5, label=text)
               for m, text in (("o", "LP fold"), ("s", "TP turn in λ2(0)"), ("D", "BP branch point"), ("X", "EP end"))]
@@ -152,7 +145,7 @@ def curve_panels(kind: str, panel: int | None) -> Callable:
                 which = ("primary", "pear-shaped")[col] if columns else ""
                 _letter(ax, 2 * row + col if columns else row, f"{material} {which}".strip())
         shared_legend(fig, targets)
-        fig.suptitle(_coils_line(runs), fontsize="small")
+        fig.suptitle(_coils_line(runs))
 
     return draw
 
@@ -301,9 +294,10 @@ def per_point_columns(kind: str, rows: int) -> Callable:
                 plot(run, kind, points=group, axes=list(axes[:, k]) if rows > 1 else axes[0, k])
             else:
                 _absent(axes[:, k], "configuration not traced")
-            _letter(axes[0, k], k, f"configuration {', '.join(c.label for c in group) or '–'}")
+            word = "config." if fig.get_size_inches()[0] < COMPACT_WIDTH else "configuration"
+            _letter(axes[0, k], k, f"{word} {', '.join(c.label for c in group) or '–'}")
         shared_legend(fig, axes.ravel(), ncols=3, markers=False)
-        fig.suptitle(f"{describe_scene(stored_scene(single))}; {_coils_line([double])}", fontsize="small")
+        fig.suptitle(f"{describe_scene(stored_scene(single))}; {_coils_line([double])}")
 
     return draw
 
@@ -355,7 +349,7 @@ def draw_energy(runs, fig, reading):
         ax.set_xlabel(r"amplitude $\Lambda$ along the pear direction")
         ax.set_ylabel(r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)")
         if k >= len(points):
-            _letter(ax, k, f"$P_{{cr{k + 1}}}$: no classified branch point on the traced branch")
+            _letter(ax, k, f"$P_{{cr{k + 1}}}$: no classified branch point")
             continue
         s = points[k]
         kind = s["classification"].removeprefix("pitchfork-")
@@ -450,11 +444,12 @@ SHORT_LABELS = {  # the kinds' axis labels -> their symbols (units: docs/plots.m
     r"$\Delta\Pi = E(\Lambda) - E(u_s)$ (per $2\pi$)": r"$\Delta\Pi$",
 }
 COMPACT_MARKER = 3.0  # points
+COMPACT_HEIGHT = 1.5  # a narrow figure's height in units of ``PaperFigure.height`` × width: its panels stacked
 
 
 def compact(fig):
     """Fit a narrow figure: axis labels by their symbols (SHORT_LABELS), special-point markers COMPACT_MARKER
-    points (``shared_legend`` uses two columns there)."""
+    points."""
     for ax in fig.axes:
         ax.set_xlabel(SHORT_LABELS.get(ax.get_xlabel(), ax.get_xlabel()))
         ax.set_ylabel(SHORT_LABELS.get(ax.get_ylabel(), ax.get_ylabel()))
@@ -465,12 +460,16 @@ def compact(fig):
 
 def draw_figure(figure: PaperFigure, runs: list[dict], width: float = TWO_COLUMNS,
                 reading: Reading = Reading.PRESSURE) -> Figure:
-    """The Figure of ``figure`` from its runs, ``width`` inches wide (below COMPACT_WIDTH: ``compact``), in
-    PAPER_STYLE (applied by the caller around drawing and saving: matplotlib.rc_context(PAPER_STYLE))."""
-    fig = Figure(figsize=(width, figure.height * width), layout="constrained")
-    figure.draw(runs, fig, Reading(reading))
+    """The Figure of ``figure`` from its runs, ``width`` inches wide (below COMPACT_WIDTH: ``compact``, and
+    COMPACT_HEIGHT times taller for its width; titles wrapped to fit: ``fit.fit_titles``), drawn and saved in the
+    journal style (``style``)."""
+    height = figure.height * width * (COMPACT_HEIGHT if width < COMPACT_WIDTH else 1.0)
+    fig = JournalFigure(figsize=(width, height), layout="constrained")
+    with journal_style():
+        figure.draw(runs, fig, Reading(reading))
     if width < COMPACT_WIDTH:
         compact(fig)
+    fit_titles(fig)
     return fig
 
 

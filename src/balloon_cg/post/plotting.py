@@ -1,5 +1,6 @@
 """Figures from run files or results in memory (docs/plots.md). Every plot function returns a matplotlib Figure:
-a new one on the Agg canvas (no pyplot, no global backend state; save it with ``figure.savefig(path)``), or,
+a new one on the Agg canvas (no pyplot, no global backend state; save it with ``figure.savefig(path)``: a
+``style.JournalFigure``, saved in the journal style), or,
 given ``axes``, the figure of the caller's Axes (one Axes, or a sequence for the kinds with several panels),
 drawn into them with the legend inside the first.
 
@@ -21,6 +22,7 @@ Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(�
 field in I/(4π R0).
 """
 import enum
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,11 +33,14 @@ from matplotlib.lines import Line2D
 from scipy.interpolate import PchipInterpolator
 
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
+from .labels import label_points
+from .style import JournalFigure, journal_style
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import read_curve
 from ..io.layout import FileError, check_input, reading
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
+from ..scene.validation import did_you_mean
 
 NORMAL_FORM = ("E2", "E3", "E4")
 DEFAULT_POINTS = 5
@@ -275,12 +280,22 @@ def load_branches(source, branch: str | None = None, reading: Reading | None = N
     return loaded
 
 
+def branch_title(name: str) -> str:
+    """A stored branch's name as legends show it: 'pear_2' → 'pear (BP 2)', 'pear_2_mirror' → 'pear (BP 2),
+    mirror image' (analysis.picture's names: the pear branch from branch point 2 and its mirror image), any other
+    name with spaces for underscores."""
+    pear = re.fullmatch(r"pear_(\d+)(_mirror)?", name)
+    if pear:
+        return f"pear (BP {pear[1]})" + ", mirror image" * bool(pear[2])
+    return name.replace("_", " ")
+
+
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     """Set each branch's legend label and colour. One file: a colour per branch (a mirror image, or a surface
-    branch's rotation by π, sharing its partner's), labelled 'M = …, <branch name>' when there are several, a
-    surface branch 'm = 1 (parent BP k)'. Several files: a colour per file, labelled 'M = …', with the scene
-    name where two files share an M (its branches told apart by their curves). A dielectric branch adds its fixed
-    parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+    branch's rotation by π, sharing its partner's), labelled 'M = …, <branch title>' (``branch_title``) when
+    there are several, a surface branch 'm = 1 (parent BP k)'. Several files: a colour per file, labelled
+    'M = …', with the scene name where two files share an M (its branches told apart by their curves). A
+    dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
 
     def key(b):
         return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
@@ -298,7 +313,7 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         if len(files) == 1 and b.m:  # a surface branch: by its mode and parent, never its internal name
             label = b.surface_name
         elif len(files) == 1 and len(files[id(b.run)]) > 1:
-            label += f", {b.name}"
+            label += f", {branch_title(b.name)}"
         b.label = label
     colors = {}
     for b in branches:
@@ -330,15 +345,21 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
     per-point kinds (default: DEFAULT_POINTS spread along the branch), or ``Configuration`` s (each names its
     branch; ``branch`` is then ignored). ``axes``: draw into these matplotlib Axes (one, or as many as the kind
     has panels) instead of a new figure. ``stability``: the Reading that draws curves solid or dashed (None: each
-    run's loading control).
+    run's loading control). Drawn in the journal style (``style``); a new figure is also saved in it.
     """
+    with journal_style():
+        return _draw(sources, what, points, branch, axes, stability)
+
+
+def _draw(sources, what, points, branch, axes, stability) -> Figure:
+    """``plot`` in the current matplotlib style."""
     sources = [sources] if isinstance(sources, (str, Path, dict)) else list(sources)
     if what is None:
         sources = [as_run(s) for s in sources]
         stored = list(sources[0]["branches"].values())  # none in a curve file: load_branches says so in one line
         what = f"{ordinate_of(stored[0]).prefix}-pole" if stored else "pressure-pole"
     if what not in KINDS:
-        raise PlotError(f"unknown plot kind {what!r}; choose one of {', '.join(KINDS)}")
+        raise PlotError(f"unknown plot kind {what!r}{did_you_mean(what, KINDS)}; choose one of {', '.join(KINDS)}")
     if what == "phase":
         return plot_phase(sources, axes)
     if what in SURFACE_KINDS:
@@ -363,7 +384,7 @@ def _panels(axes, count: int, figsize, **subplots):
     """(figure, ``count`` Axes, own): a new constrained-layout Figure with ``count`` panels (own = True), or
     the caller's ``axes`` (one Axes or a sequence of ``count``) and their figure."""
     if axes is None:
-        fig = Figure(figsize=figsize, layout="constrained")
+        fig = JournalFigure(figsize=figsize, layout="constrained")
         return fig, np.atleast_1d(fig.subplots(**subplots) if subplots else fig.add_subplot()), True
     given = list(np.ravel(np.asarray(axes, dtype=object)))
     if len(given) != count:
@@ -385,9 +406,9 @@ def _legend(fig, axes, own: bool, loc: str, **options):
 
 def _suptitle(fig, axes, own: bool, text: str):
     if own:
-        fig.suptitle(text, fontsize=10)
+        fig.suptitle(text)
     else:
-        axes[0].set_title(text, fontsize=10)
+        axes[0].set_title(text)
 
 
 # --- branch curves -----------------------------------------------------------------------------------------
@@ -429,45 +450,13 @@ def special_label(s: dict) -> str:
 
 
 def _special(ax, branch: StoredBranch, x, y, color) -> list:
-    """Mark the special points at (x, y) (one entry per special point); returns their labels for _label_special."""
+    """Mark the special points at (x, y) (one entry per special point); returns them for labels.label_points."""
     marks = []
     for s, xs, ys in zip(branch.data["special_points"], x, y):
         ax.plot(xs, ys, MARKERS.get(s["kind"], "D"), color=color, markersize=6, markeredgecolor="k",
                 markeredgewidth=0.5)
         marks.append((ax, special_label(s), xs, ys, color))
     return marks
-
-
-CHAR_WIDTH, LINE_HEIGHT = 5.0, 9.0  # points, for fontsize 8
-
-
-def _label_special(fig, marks):
-    """Label the marked special points with their kind, each at the first of a few offsets around its marker
-    whose text box (estimated, in points) lies inside the axes and clear of the labels already placed there
-    (if none does, the first one clear of the others). Call after all data are drawn."""
-    placed = {}
-    for ax, kind, x, y, color in marks:
-        ax.margins(x=0.06)
-        ax.autoscale_view()
-        scale = 72.0 / fig.dpi
-        frame = ax.get_window_extent()
-        anchor = ax.transData.transform((x, y)) * scale
-        width = CHAR_WIDTH * len(kind)
-        boxes = placed.setdefault(ax, [])
-
-        def clear(x0, y0):
-            return all(x0 + width <= bx or bx + bw <= x0 or y0 + LINE_HEIGHT <= by or by + LINE_HEIGHT <= y0
-                       for bx, by, bw in boxes)
-
-        def inside(x0, y0):
-            return (frame.x0 * scale <= x0 and x0 + width <= frame.x1 * scale
-                    and frame.y0 * scale <= y0 and y0 + LINE_HEIGHT <= frame.y1 * scale)
-
-        candidates = [(dx, dy) for dy in (4, -12, 14, -22, 24, -32) for dx in (5, -5 - width)]
-        fits = [c for c in candidates if clear(*(anchor + c))]
-        dx, dy = next((c for c in fits if inside(*(anchor + c))), fits[0] if fits else candidates[0])
-        boxes.append((*(anchor + (dx, dy)), width))
-        ax.annotate(kind, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=8, color=color)
 
 
 def _branch_legend(fig, axes, own, branches, extra=()):
@@ -488,7 +477,7 @@ def _branch_legend(fig, axes, own, branches, extra=()):
     handles = list(handles.values())
     if any(b.mirror for b in branches) and len({id(b.run) for b in branches}) > 1:
         handles.append(Line2D([], [], color="0.4", linewidth=0.9, alpha=0.55, label="mirror-image branch"))
-    _legend(fig, axes, own, "right upper", handles=handles + list(extra), title=title, fontsize=8, title_fontsize=8)
+    _legend(fig, axes, own, "right upper", handles=handles + list(extra), title=title)
 
 
 def check_ordinate(branches, ordinate: Ordinate, kind: str) -> None:
@@ -525,9 +514,9 @@ def _pole_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
         marks += _special(ax, b, [s["lam2_north"] for s in special], [s[ordinate.column] for s in special], color)
     ax.set_xlabel(r"pole stretch $\lambda_2(0)$ (north)")
     ax.set_ylabel(ordinate.label)
-    ax.set_title(_title(branches), fontsize=10)
+    ax.set_title(_title(branches))
     _branch_legend(fig, panels, own, branches, extra)
-    _label_special(fig, marks)
+    label_points(marks)
     return fig
 
 
@@ -548,7 +537,7 @@ def _equator_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
     axes[0].set_ylabel(ordinate.label)
     _suptitle(fig, axes, own, _title(branches))
     _branch_legend(fig, axes, own, branches)
-    _label_special(fig, marks)
+    label_points(marks)
     return fig
 
 
@@ -624,7 +613,7 @@ def _per_point_title(branches) -> str:
 
 
 def _point_legend(fig, axes, own, handles):
-    _legend(fig, axes, own, "lower center", handles=handles, fontsize=8, ncols=2)
+    _legend(fig, axes, own, "lower center", handles=handles, ncols=2)
 
 
 def _theta_axes(branches, ylabels, height=5.0, axes=None):
@@ -687,7 +676,7 @@ def plot_shapes(branches, points=None, axes=None) -> Figure:
                               label="coil wire (· current out of, × into the plane)"))
     ax.set_xlabel(r"$\pm\rho/R_0$ (distance from the axis)")
     ax.set_ylabel(r"$\eta/R_0$ (height)")
-    ax.set_title(_per_point_title(branches), fontsize=10)
+    ax.set_title(_per_point_title(branches))
     _point_legend(fig, panels, own, handles)
     return fig
 
@@ -805,7 +794,7 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
 
     if axes is None:
-        fig = Figure(figsize=(10.0, 5.4), layout="constrained")
+        fig = JournalFigure(figsize=(10.0, 5.4), layout="constrained")
         ax, own = fig.add_subplot(1, 2, 1, projection="3d"), True
         _mirror_section(fig.add_subplot(1, 2, 2), branch, index)
     else:
@@ -832,9 +821,9 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
     ax.set_ylabel(r"$y/R_0$")
     ax.set_zlabel(r"$z/R_0$")
     if own:  # the 3D Axes' own title is clipped by the constrained layout beside a second panel
-        fig.suptitle(_state_title(branch, index), fontsize=10)
+        fig.suptitle(_state_title(branch, index))
     else:
-        ax.set_title(_state_title(branch, index), fontsize=10)
+        ax.set_title(_state_title(branch, index))
     _point_legend(fig, [ax], own, handles)
     return fig
 
@@ -856,8 +845,8 @@ def _mirror_section(ax, branch: StoredBranch, index: int) -> None:
     ax.set_aspect("equal")
     ax.set_xlabel(r"$x/R_0$")
     ax.set_ylabel(r"$z/R_0$")
-    ax.set_title("section y = 0", fontsize=10)
-    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title("section y = 0")
+    ax.legend(loc="upper right")
 
 
 def principal_stretches(state: np.ndarray) -> tuple:
@@ -904,7 +893,7 @@ def plot_stretch_map(branch: StoredBranch, index: int, axes=None) -> Figure:
         mesh = ax.pcolormesh(phi, theta, np.c_[values, values[:, :1]], shading="flat", cmap="viridis", vmin=low,
                              vmax=high)
         fig.colorbar(mesh, ax=ax, shrink=0.9)
-        ax.set_title(name, fontsize=10)
+        ax.set_title(name)
         ax.set_xlabel(r"material angle $\phi$ (rad)")
         ax.set_xlim(0.0, 2 * np.pi)
         ax.set_xticks(np.linspace(0, 2 * np.pi, 5), ["0", "π/2", "π", "3π/2", "2π"])
@@ -946,8 +935,8 @@ def plot_energy(branches, axes=None) -> Figure:
             drawn += 1
     ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
     ax.set_ylabel(r"$E(\Lambda) - E_0$ (per $2\pi$, units of $T_0 R_0^2 \mu/2$)")
-    ax.set_title(_title(branches), fontsize=10)
-    ax.legend(fontsize=8)
+    ax.set_title(_title(branches))
+    ax.legend()
     return fig
 
 
@@ -999,8 +988,8 @@ def plot_phase(paths, axes=None) -> Figure:
     parameter = parameters.pop() if len(parameters) == 1 else "q"
     ax.set_xlabel(PARAMETER_LABELS.get(parameter, parameter))
     ax.set_ylabel(r"bifurcation pressure $P = \bar P R_0/(T_0\mu/2)$")
-    ax.set_title("pear-shaped pitchforks (the isola lies between the two)", fontsize=10)
-    ax.legend(fontsize=8)
+    ax.set_title("pear-shaped pitchforks (the isola lies between the two)")
+    ax.legend()
     return fig
 
 

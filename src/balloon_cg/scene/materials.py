@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 
 from ..generated import CLASSES, GENERAL_TERMS
 from .energies import FAMILIES, PRESET_VALUES, StrainEnergy, family_energy, formula_energy, preset_energy
-from .validation import SceneError, number, show, table
+from .validation import SceneError, did_you_mean, number, show, table
 
 MAX_TERMS = max([GENERAL_TERMS] + [len(a) for a, _ in CLASSES.values() if a is not None])  # generated kernels
 
@@ -85,7 +85,8 @@ def material_from_table(data: dict) -> Material | StrainEnergy:
         except KeyError:
             material = None
         if material is None:
-            raise SceneError(f"material.preset = {show(preset)}: unknown preset; allowed: "
+            raise SceneError(f"material.preset = {show(preset)}: unknown preset"
+                             f"{did_you_mean(preset, PRESETS | ENERGY_PRESETS)}; allowed: "
                              f"{', '.join(PRESETS | ENERGY_PRESETS)}")
         return replace(material, name=name) if name else material
     for key in ("mu", "alpha"):

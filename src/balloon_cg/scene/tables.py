@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass, fields, replace
 from dataclasses import field as dataclass_field
 from pathlib import Path
 
-from .validation import SceneError, number, show, show_key, table
+from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
 from .loading import Control, Loading, loading_from_table
 from .materials import Material, material_from_table
@@ -294,8 +294,9 @@ def load_scene(path) -> Scene:
     shipped = path.name.removesuffix(".toml")
     if not path.exists() and path.parent == Path("."):
         if shipped not in shipped_scenes():
-            raise FileNotFoundError(errno.ENOENT, "no such file, nor the name of a scene shipped with the package "
-                                    f"({', '.join(sorted(shipped_scenes()))})", str(path))
+            near = did_you_mean(shipped, [*shipped_scenes(), *(p.name for p in Path(".").glob("*.toml"))])
+            raise FileNotFoundError(errno.ENOENT, f"no such file, nor the name of a scene shipped with the package"
+                                    f"{near} ({', '.join(sorted(shipped_scenes()))})", str(path))
         path = shipped_scenes()[shipped]
     return _parse(_read_text(path), path.stem, path.name)
 

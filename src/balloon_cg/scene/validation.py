@@ -1,5 +1,7 @@
-"""SceneError and the small checks that raise it (shared by materials.py and scene.py)."""
+"""SceneError and the small checks that raise it (shared by materials.py and scene.py), and ``did_you_mean`` for
+every one-line error about a mistyped name (scene keys, presets, commands, plot kinds, files)."""
 
+import difflib
 import json
 import math
 import numbers
@@ -8,6 +10,12 @@ import re
 
 class SceneError(ValueError):
     """Invalid scene input. The message is one line: ``<scene>: <dotted.key> = <value>: <what is allowed>``."""
+
+
+def did_you_mean(word, allowed) -> str:
+    """' (did you mean X?)' naming the allowed name closest to ``word`` (difflib), or '' when none is close."""
+    close = difflib.get_close_matches(str(word), [str(a) for a in allowed], n=1)
+    return f" (did you mean {close[0]}?)" if close else ""
 
 
 def show_key(key: str) -> str:
@@ -56,5 +64,6 @@ def table(key: str, value, allowed: tuple[str, ...]) -> dict:
         raise SceneError(f"{key} = {show(value)}: must be a table")
     for k, v in value.items():
         if k not in allowed:
-            raise SceneError(f"{key}.{show_key(k)} = {show(v)}: unknown key; allowed keys: {', '.join(allowed)}")
+            raise SceneError(f"{key}.{show_key(k)} = {show(v)}: unknown key{did_you_mean(k, allowed)}; allowed keys: "
+                             f"{', '.join(allowed)}")
     return value

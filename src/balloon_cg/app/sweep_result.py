@@ -1,0 +1,102 @@
+"""A sweep file in Python (``balloon_cg.load(sweep)``): its members and one table of what each found.
+
+``SweepResult.to_dataframe()`` has one row per member (index ``member``): the varied scene keys (dotted, as
+the members' overrides name them), ``complete``, the primary branch's fold (``P_LP``, ``lam2_LP``: its first LP),
+the critical pressures of the pear-shaped instability (``P_cr1`` ≥ ``P_cr2``: the branch points of the odd held
+block, as in the paper) and every branch point of the primary branch in stored order (``P_BP1``, ``block_BP1``,
+``classification_BP1``, ``m_BP1``, …); NaN where a member has none (a primary-only sweep has no branch
+points). ``to_xarray()`` is the same table as an xarray Dataset along ``member``. Members are
+``SweepMember`` s: overrides, attributes and branches (``BranchData``), each group of the file readable with
+xarray (``to_xarray``).
+"""
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..io.sweep_file import read_sweep
+from .api import BranchData, _optional
+
+PEAR_BLOCK = "odd_held"  # the pear-shaped (m = 0, odd) instability of a held balloon
+
+
+@dataclass(frozen=True, repr=False)
+class SweepMember:
+    """One member of a sweep: ``index``, its ``overrides`` (dotted key -> value), ``attrs`` (verdict,
+    provenance), ``branches`` (name -> BranchData) and ``path``, the sweep file."""
+
+    index: int
+    overrides: dict
+    attrs: dict
+    branches: dict
+    path: str
+
+    @property
+    def complete(self) -> bool:
+        return bool(self.attrs.get("complete", False))
+
+    def to_xarray(self, branch: str = "primary", group: str = ""):
+        """The xarray Dataset of one stored group of a branch (``group``: '', 'profiles', 'stability',
+        'special_points'), with its named dimensions and units."""
+        _optional("h5netcdf", "to_xarray")
+        xr = _optional("xarray", "to_xarray")
+        if branch not in self.branches:
+            raise KeyError(f"member {self.index}: no branch {branch!r} (branches: {', '.join(self.branches)})")
+        where = "/".join(filter(None, ("members", str(self.index), "branches", branch, group)))
+        with xr.open_dataset(self.path, engine="h5netcdf", group=where) as ds:
+            return ds.load()
+
+    def row(self) -> dict:
+        """This member's line of ``SweepResult.to_dataframe``."""
+        primary = self.branches.get("primary")
+        special = primary.special_points if primary is not None else []
+        folds = [s for s in special if s["kind"] == "LP"]
+        branch_points = [s for s in special if s["kind"] == "BP"]
+        critical = sorted((s["pressure"] for s in branch_points if s["block"] == PEAR_BLOCK), reverse=True)
+        row = dict(self.overrides) | {"complete": self.complete,
+                                      "P_LP": folds[0]["pressure"] if folds else np.nan,
+                                      "lam2_LP": folds[0]["lam2_north"] if folds else np.nan}
+        row |= {f"P_cr{k}": critical[k - 1] if len(critical) >= k else np.nan for k in (1, 2)}
+        for k, s in enumerate(branch_points, 1):
+            row |= {f"P_BP{k}": s["pressure"], f"block_BP{k}": s["block"],
+                    f"classification_BP{k}": s["classification"], f"m_BP{k}": int(s["m"])}
+        return row
+
+    def __repr__(self):
+        state = "complete" if self.complete else "incomplete"
+        return f"SweepMember({self.index}, {self.overrides}, {len(self.branches)} branches, {state})"
+
+
+@dataclass(frozen=True, repr=False)
+class SweepResult:
+    """A loaded sweep file: ``path``, ``attrs`` (root attributes: scene, vary, mode), ``members`` (index ->
+    SweepMember)."""
+
+    path: str
+    attrs: dict
+    members: dict
+
+    @classmethod
+    def read(cls, path) -> "SweepResult":
+        sweep = read_sweep(path)
+        members = {index: SweepMember(index, m["overrides"], m["attrs"],
+                                      {name: BranchData(name, data) for name, data in m["branches"].items()},
+                                      str(path))
+                   for index, m in sweep["members"].items()}
+        return cls(str(path), sweep["attrs"], members)
+
+    def to_dataframe(self):
+        """A pandas DataFrame, one row per member (module docstring)."""
+        pd = _optional("pandas", "to_dataframe")
+        return pd.DataFrame([m.row() for m in self.members.values()],
+                            index=pd.Index(list(self.members), name="member"))
+
+    def to_xarray(self):
+        """``to_dataframe`` as an xarray Dataset along ``member``."""
+        _optional("xarray", "to_xarray")
+        return self.to_dataframe().to_xarray()
+
+    def __repr__(self):
+        done = sum(m.complete for m in self.members.values())
+        return (f"SweepResult({Path(self.path).name!r}: {self.attrs.get('scene_name')}, {len(self.members)} of "
+                f"{self.attrs.get('members')} members ({done} complete), mode {self.attrs.get('mode')})")

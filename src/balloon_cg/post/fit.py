@@ -1,0 +1,69 @@
+"""Text that stays inside a figure at a journal width (3.5 in one column, 7.2 in two), measured rather than
+guessed: ``fit_titles`` wraps each panel title to the room it has and the figure's title to the figure's width;
+``fitted_legend`` gives a figure legend as many columns as fit across the figure (one column: its labels
+wrapped). Both need a figure with a renderer (``style.JournalFigure``: the Agg canvas).
+"""
+import textwrap
+
+from matplotlib.text import Text
+
+MIN_CHARS = 12  # the narrowest wrap tried, characters per line
+
+
+def wrap_to(text: Text, width: float) -> None:
+    """Wrap ``text`` at spaces (each of its lines; none inside $…$ math) until it is at most ``width`` display
+    units wide, or its lines are MIN_CHARS characters."""
+    renderer = text.figure.canvas.get_renderer()
+    original = text.get_text()
+    chars = max(map(len, original.splitlines()), default=0)
+    while text.get_window_extent(renderer).width > width and chars > MIN_CHARS:
+        chars = max(MIN_CHARS, min(chars - 1, int(chars * width / text.get_window_extent(renderer).width)))
+        text.set_text("\n".join(textwrap.fill(line, chars, break_long_words=False)
+                                for line in original.splitlines()))
+
+
+def fit_titles(fig) -> None:
+    """Wrap every panel title to the room it has (``room``) and the figure's texts (its suptitle) to the
+    figure's width, after laying the figure out."""
+    fig.draw_without_rendering()
+    for ax in fig.axes:
+        for title in (c for c in ax.get_children() if isinstance(c, Text) and c not in ax.texts):
+            wrap_to(title, room(ax))
+    for text in fig.texts:
+        wrap_to(text, fig.bbox.width)
+    fig.draw_without_rendering()
+
+
+def room(ax) -> float:
+    """The width a panel's title may take: from the panel's left edge to the next panel on its right in the
+    same row, or to the figure's edge."""
+    box = ax.get_window_extent()
+    others = [other.get_window_extent() for other in ax.figure.axes if other is not ax]
+    right = [o.x0 for o in others if o.x0 >= box.x1 and o.y1 > box.y0 and o.y0 < box.y1]
+    return min(right, default=ax.figure.bbox.x1) - box.x0
+
+
+def fitted_legend(fig, handles, labels, ncols: int, **options):
+    """A figure legend of as many columns (at most ``ncols``) as fit across the figure with its labels wrapped to
+    no narrower than MIN_LABEL_SHARE of the widest (one column: wrapped as far as needed)."""
+    renderer = fig.canvas.get_renderer()
+    for n in range(ncols, 0, -1):
+        legend = fig.legend(handles, labels, ncols=n, **options)
+        texts = legend.get_texts()
+        widest = max(text.get_window_extent(renderer).width for text in texts)
+        for _ in range(3):  # the columns' widths follow their widest labels: measure again after wrapping
+            overflow = legend.get_window_extent(renderer).width - fig.bbox.width
+            if overflow <= 0:
+                return legend
+            width = max(text.get_window_extent(renderer).width for text in texts) - overflow / n
+            if width < MIN_LABEL_SHARE * widest and n > 1:
+                break
+            for text, label in zip(texts, labels):  # from the label: wrap_to keeps the lines it is given
+                text.set_text(label)
+                wrap_to(text, width)
+        if n == 1:
+            return legend
+        legend.remove()
+
+
+MIN_LABEL_SHARE = 0.5  # a legend label is wrapped to no less than this share of the widest before a column goes

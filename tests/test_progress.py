@@ -1,0 +1,62 @@
+"""Progress bars: overlapping phases end in clean finished lines, one per phase, on a terminal; none elsewhere."""
+import io
+import re
+
+from balloon_cg.analysis.picture import Phase
+from balloon_cg.app.progress import ON_TERMINAL, PhaseBars
+
+
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def screen(written: str) -> list[str]:
+    """The lines a terminal shows after ``written`` (carriage return, newline, cursor up), right-stripped."""
+    lines, row, col = [""], 0, 0
+    for token in re.split(r"(\r|\n|\x1b\[A)", written):
+        if token == "\r":
+            col = 0
+        elif token == "\n":
+            row, col = row + 1, 0
+            lines += [""] * (row + 1 - len(lines))
+        elif token == "\x1b[A":
+            row = max(0, row - 1)
+        elif token:
+            line = lines[row].ljust(col)
+            lines[row], col = line[:col] + token + line[col + len(token):], col + len(token)
+    return [line.rstrip() for line in lines if line.strip()]
+
+
+def test_overlapping_phases_end_in_clean_lines(monkeypatch):
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    with PhaseBars("spom1", ON_TERMINAL) as bars:
+        for _ in range(1000):
+            bars.tick(Phase.STABILITY)  # a long bar first, then a shorter one below it, finished first
+        for _ in range(3):
+            bars.tick(Phase.PEAR)
+        bars.finish(Phase.PEAR, 3)
+        bars.finish(Phase.STABILITY, 1000)
+        bars.tick(Phase.PRIMARY)  # an unfinished phase (an interrupt) gets its line at the end
+    assert screen(terminal.getvalue()) == ["spom1: pear branches: 3 points [00:00]",
+                                           "spom1: stability: 1000 points [00:00]",
+                                           "spom1: primary branch: 1 points [00:00]"]
+
+
+def test_no_bars_into_a_pipe(monkeypatch):
+    pipe = io.StringIO()
+    monkeypatch.setattr("sys.stderr", pipe)
+    with PhaseBars("spom1", ON_TERMINAL) as bars:
+        bars.tick(Phase.PRIMARY)
+        bars.finish(Phase.PRIMARY, 1)
+    assert pipe.getvalue() == ""
+
+
+def test_a_phase_with_a_known_total_shows_its_fraction_and_eta(monkeypatch):
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    with PhaseBars("spom1", ON_TERMINAL) as bars:
+        bars.expect(Phase.STABILITY, 40)
+        assert re.search(r"stability:\s+0%\|.*\| 0/40 \[00:00<", terminal.getvalue())  # <: the time left
+        bars.finish(Phase.STABILITY, 40)
