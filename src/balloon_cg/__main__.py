@@ -1,5 +1,6 @@
-"""``python -m balloon_cg``: the command line (app.cli). SIGTERM raises KeyboardInterrupt from the first line,
-so a signal during the imports exits 130 as later ones do (app.cli.main)."""
+"""``python -m balloon_cg`` and the ``balloon-cg`` script (``run``): the command line (app.cli). SIGTERM raises
+KeyboardInterrupt before anything heavy is imported, so a signal during the imports exits 130 as later ones do
+(app.cli.main)."""
 import signal
 import sys
 
@@ -8,11 +9,15 @@ def _terminate(signum, frame):
     raise KeyboardInterrupt
 
 
-signal.signal(signal.SIGTERM, _terminate)
-try:
-    from .app.cli import main
-except KeyboardInterrupt:
-    print("balloon-cg: error: interrupted", file=sys.stderr)
-    sys.exit(130)
+def run() -> int:
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        from .app.cli import main
+    except KeyboardInterrupt:
+        print("balloon-cg: error: interrupted", file=sys.stderr)
+        return 130
+    return main()
 
-sys.exit(main())
+
+if __name__ == "__main__":
+    sys.exit(run())
