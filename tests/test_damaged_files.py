@@ -50,6 +50,7 @@ DAMAGE = {
                                            np.array(["x"] * len(f["branches/primary/pressure"]), dtype=object)),
     "branches as a dataset": lambda f: _replace(f, "branches", np.arange(3)),
     "a branch as a dataset": lambda f: _replace(f["branches"], "primary", np.arange(3)),
+    "missing primary": lambda f: f["branches"].__delitem__("primary"),  # was read as an empty, complete run
     "missing special_points": lambda f: f["branches/primary"].__delitem__("special_points"),
     "missing special kind": lambda f: f["branches/primary/special_points"].__delitem__("kind"),
     "unknowns 1-d": lambda f: _replace(f["branches/primary"], "unknowns", f["branches/primary/unknowns"][:, 0]),

@@ -436,6 +436,10 @@ def _read_open(f, label) -> dict:
     if "complete" in f.attrs:
         require_attrs(f.attrs, label, VERDICT_KINDS, VERDICT_KINDS, error=RunFileError)
     attrs = {k: _attr(v) for k, v in f.attrs.items()}
+    # every run writes its primary branch (a curve file, a run file with /two_parameter curves, has none)
+    if "primary" not in require_group(f, "branches", label, RunFileError) and not len(f.get("two_parameter", {})):
+        raise RunFileError(label, "missing branch primary (branches: "
+                                  f"{', '.join(f['branches']) or 'none'}): not a whole run file")
     if plain(fmt) == FORMAT:  # the current format always writes them (older ones may lack them: OPTIONAL_COLUMNS)
         for name, branch in require_group(f, "branches", label, RunFileError).items():
             missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
