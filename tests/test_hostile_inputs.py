@@ -8,7 +8,8 @@ import pytest
 
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.results import Kind
-from balloon_cg.app.cli import cpu_count, main
+from balloon_cg.app.cli import main
+from balloon_cg.app.sweep import cpu_count
 from balloon_cg.scene import parse_scene
 
 SPOM1 = '[material]\npreset = "SPOM1"\n'
@@ -102,6 +103,16 @@ def test_workers_up_to_the_cpu_count_are_accepted():
 
     check_workers(cpu_count(), False, None)
     check_workers(cpu_count() + 1, True, None)
+
+
+def test_the_default_worker_count_is_the_affinity_not_the_machine(monkeypatch):
+    """A process allowed one CPU of 64 (a cluster job's cgroup, taskset) runs one worker by default, as --workers
+    is capped at (it forked os.cpu_count() workers before)."""
+    import os
+
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {3}, raising=False)
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)
+    assert cpu_count() == 1
 
 
 @pytest.mark.parametrize("kind", ["empty", "directory", "fifo", "device"])

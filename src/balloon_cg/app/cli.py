@@ -694,14 +694,6 @@ def _add_sweep(commands):
 MAX_WORKERS = 256  # local worker processes, even with --oversubscribe
 
 
-def cpu_count() -> int:
-    """The CPUs this process may run on (its affinity mask where the system has one)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
-
-
 def check_workers(workers: int | None, oversubscribe: bool, scheduler: str | None) -> None:
     """UsageError unless ``workers`` is None or in [1, CPU count] ([1, MAX_WORKERS] with ``oversubscribe``), and
     not given with ``scheduler`` (the cluster's workers compute; local ones would be ignored); ``scheduler`` must
@@ -713,6 +705,8 @@ def check_workers(workers: int | None, oversubscribe: bool, scheduler: str | Non
     if scheduler is not None:
         raise UsageError(f"--workers {workers} with --scheduler {scheduler}: the cluster's workers compute the members; "
                          "give one of the two")
+    from .sweep import cpu_count
+
     limit = MAX_WORKERS if oversubscribe else cpu_count()
     if not 1 <= workers <= limit:
         more = "" if oversubscribe else f" (the CPU count; --oversubscribe allows up to {MAX_WORKERS})"

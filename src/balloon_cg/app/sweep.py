@@ -283,6 +283,15 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
     return result
 
 
+def cpu_count() -> int:
+    """The CPUs this process may run on (its affinity mask where the system has one): the default and the cap of
+    --workers."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str | None):
     """Yield (index, result dict or exception) as members finish."""
     if not todo:
@@ -291,7 +300,7 @@ def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str 
     if scheduler is not None:
         yield from _compute_dask(jobs, scheduler)
         return
-    workers = (os.cpu_count() or 1) if workers is None else workers
+    workers = cpu_count() if workers is None else workers
     if workers <= 1 or len(jobs) == 1:
         for job in jobs:
             try:
