@@ -43,18 +43,19 @@ def loop_table(coils) -> np.ndarray:
 
 
 @njit(cache=True)
-def _add_loop(point, loop, h, J, K):
-    """Add one loop's h, ∂_b h_a (J[a, b]) and ∂_bc h_a (K[a, b, c]) at ``point`` (module docstring)."""
-    n = loop[3:6]
+def _add_loop(x, y, z, loop, h, J, K):
+    """Add one loop's h, ∂_b h_a (J[a, b]) and ∂_bc h_a (K[a, b, c], c ≥ b) at the point (x, y, z) (module
+    docstring)."""
+    n = (loop[3], loop[4], loop[5])
     a, s = loop[6], loop[7]
-    r = point - loop[0:3]
-    z = r[0] * n[0] + r[1] * n[1] + r[2] * n[2]
-    e = r - z * n
+    r = (x - loop[0], y - loop[1], z - loop[2])
+    axial = r[0] * n[0] + r[1] * n[1] + r[2] * n[2]
+    e = (r[0] - axial * n[0], r[1] - axial * n[1], r[2] - axial * n[2])
     rho = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-    f, g, f_r, f_z, g_r, g_z, f_rr, f_rz, f_zz, g_rr, g_rz, g_zz = coil_field_unit(rho, z, a)
+    f, g, f_r, f_z, g_r, g_z, f_rr, f_rz, f_zz, g_rr, g_rz, g_zz = coil_field_unit(rho, axial, a)
     if rho > 0.0:
-        e = e / rho
-    if 2.0 * a * rho < a * a + z * z:  # nearer the axis than the wire: the quotients by ρ' from the field equations
+        e = (e[0] / rho, e[1] / rho, e[2] / rho)
+    if 2.0 * a * rho < a * a + axial * axial:  # nearer the axis than the wire: the quotients from the field equations
         phi, beta, gamma, delta = -(f_r + g_z), -(f_rr + g_rz), -(f_rz + g_zz), -(g_rr + g_zz)
     else:
         phi = f / rho
@@ -77,13 +78,13 @@ def _add_loop(point, loop, h, J, K):
 
 
 @njit(cache=True)
-def _loops_at(point, loops, h, J, K):
-    """h, J and K (upper triangle in the last two indices) of the sum over ``loops`` at ``point``."""
+def _loops_at(points, i, loops, h, J, K):
+    """h, J and K (K[a, b, c] for c ≥ b) of the sum over ``loops`` at the point in column i of ``points``."""
     h[:] = 0.0
     J[:] = 0.0
     K[:] = 0.0
     for j in range(loops.shape[0]):
-        _add_loop(point, loops[j], h, J, K)
+        _add_loop(points[0, i], points[1, i], points[2, i], loops[j], h, J, K)
 
 
 @njit(cache=True)
@@ -91,7 +92,7 @@ def loop_field(points, loops, out):
     """h = Σ_j s_j h_j at every point (columns of ``points``: x, y, z) into out[0:3, i]; loops a loop_table."""
     h, J, K = np.empty(3), np.empty((3, 3)), np.empty((3, 3, 3))
     for i in range(points.shape[1]):
-        _loops_at(points[:, i].copy(), loops, h, J, K)
+        _loops_at(points, i, loops, h, J, K)
         out[:, i] = h
 
 
@@ -101,7 +102,7 @@ def field_squared_cartesian(points, loops, out):
     loop_table: Q = h·h, Q_b = 2 h_a ∂_b h_a, Q_bc = 2 (∂_b h_a ∂_c h_a + h_a ∂_bc h_a)."""
     h, J, K = np.empty(3), np.empty((3, 3)), np.empty((3, 3, 3))
     for i in range(points.shape[1]):
-        _loops_at(points[:, i].copy(), loops, h, J, K)
+        _loops_at(points, i, loops, h, J, K)
         out[0, i] = h[0] * h[0] + h[1] * h[1] + h[2] * h[2]
         for b in range(3):
             out[1 + b, i] = 2.0 * (h[0] * J[0, b] + h[1] * J[1, b] + h[2] * J[2, b])
