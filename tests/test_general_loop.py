@@ -160,9 +160,12 @@ def test_a_coaxial_loop_in_the_general_form_is_the_coaxial_form():
     q, q_r, q_z, q_rr, q_rz, q_zz = np.array([field_squared(r, zz, table) for r, zz in zip(x, z)]).T
     with np.errstate(invalid="ignore", divide="ignore"):
         q_yy = np.where(x > 0, q_r / x, q_rr)
-    expected = [q, q_r, 0 * q, q_z, q_rr, 0 * q, q_rz, q_yy, 0 * q, q_zz]
-    for name, row, value in zip(CARTESIAN, rows, expected):
-        assert np.abs(row - value).max() <= 1e-14 * np.abs(rows).max(), name
+    expected = np.array([q, q_r, 0 * q, q_z, q_rr, 0 * q, q_rz, q_yy, 0 * q, q_zz])
+    # at each point, relative to the largest entry of the same order; the (ρ, z) second derivatives are themselves
+    # accurate to ~4e-14 (docs/numerics.md §5), and the two routes to Q_yy (Q_ρ/ρ; the field equations) differ so
+    for order, tolerance in ((slice(0, 1), 1e-14), (slice(1, 4), 1e-14), (slice(4, 10), 1e-13)):
+        scale = np.abs(rows[order]).max(axis=0)
+        assert (np.abs(rows[order] - expected[order]).max(axis=0) <= tolerance * scale).all(), order
     # ... and turned about the axis: Q is invariant, its gradient turns with the point
     turn = 0.9
     turned = rows_at(np.array([x * math.cos(turn), x * math.sin(turn), z]), COAXIAL)
