@@ -13,7 +13,7 @@ from balloon_cg.scene import (
 
 SCENES = sorted((Path(__file__).resolve().parents[1] / "scenes").glob("*.toml"))
 
-PAIR = (Coil(1.7321, 1.0, 1.0), Coil(1.7321, -1.0, -1.0))
+PAIR = (Coil.coaxial(1.7321, 1.0, 1.0), Coil.coaxial(1.7321, -1.0, -1.0))
 
 TWO_COILS = """
 [material]
@@ -87,13 +87,13 @@ def test_defaults():
 
 def test_symmetry():
     assert Field(M=0.002, coils=PAIR).is_equator_symmetric
-    assert Field(coils=(Coil(1.7321, 1.0, 1.0), Coil(1.7321, -1.0, 1.0))).is_equator_symmetric
-    assert Field(coils=(Coil(4.0, 0.0, 1.0),)).is_equator_symmetric
+    assert Field(coils=(Coil.coaxial(1.7321, 1.0, 1.0), Coil.coaxial(1.7321, -1.0, 1.0))).is_equator_symmetric
+    assert Field(coils=(Coil.coaxial(4.0, 0.0, 1.0),)).is_equator_symmetric
     assert Field().is_equator_symmetric
-    assert not Field(coils=(Coil(4.0, 0.5, 1.0),)).is_equator_symmetric
-    assert not Field(coils=(Coil(1.7321, 1.0, 1.0), Coil(1.7321, -1.0, 2.0))).is_equator_symmetric
+    assert not Field(coils=(Coil.coaxial(4.0, 0.5, 1.0),)).is_equator_symmetric
+    assert not Field(coils=(Coil.coaxial(1.7321, 1.0, 1.0), Coil.coaxial(1.7321, -1.0, 2.0))).is_equator_symmetric
     # a coil at h = 0 pairs with itself (same sign): it breaks the opposite-sign pair's symmetry
-    assert not Field(coils=PAIR + (Coil(4.0, 0.0, 1.0),)).is_equator_symmetric
+    assert not Field(coils=PAIR + (Coil.coaxial(4.0, 0.0, 1.0),)).is_equator_symmetric
     assert parse_scene(TWO_COILS + '[continuation]\nsymmetry = "equator"').continuation.symmetry == "equator"
 
 

@@ -35,7 +35,7 @@ from numpy.polynomial import legendre
 from scipy import linalg, special
 
 from ..galerkin.equilibrium import Parameters
-from ..model.field import field_components
+from ..model.field import coaxial_table, field_components
 from ..numerics.threads import limited_blas
 
 STEP = 1e-3  # central-difference step in y (Richardson with STEP/2)
@@ -206,7 +206,7 @@ class BruteForceBlock:
 
 def coil_rows(scene) -> np.ndarray:
     """The scene's coils as rows (radius, height, current)."""
-    return np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
+    return coaxial_table(scene.field.coils)
 
 
 @limited_blas

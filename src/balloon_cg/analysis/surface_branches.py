@@ -32,7 +32,7 @@ import numpy as np
 from scipy import linalg
 
 from ..galerkin.equilibrium import Parameters
-from ..model.field import wire_distance
+from ..model.field import coaxial_table, wire_distance
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
@@ -172,7 +172,7 @@ def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
     """stop(point) -> Stop or None (module docstring); StopCode.RESOLUTION when a tail exceeds solver.max_error."""
     scene, basis = trace.scene, trace.basis
     upper, gap = scene.continuation.stop_stretch, scene.continuation.wire_gap
-    coils = [[k.radius, k.height, k.current] for k in scene.field.coils]
+    coils = coaxial_table(scene.field.coils)
 
     def stop(point):
         if direction @ (point.X - X_star) < 0:
@@ -183,7 +183,7 @@ def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
             return Stop(StopCode.STOP_STRETCH, f"north pole stretch reached stop_stretch {upper:g}")
         if m["lam_south"] >= upper:
             return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
-        if coils:
+        if coils.shape[0]:
             x = trace.eq.node_values(c)["state"][:3]
             distance = float(wire_distance(np.hypot(x[0], x[1]), x[2], coils).min())
             if distance < gap:

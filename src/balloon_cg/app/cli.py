@@ -265,13 +265,22 @@ def scene_of(args):
     return overridden(scene, overrides)
 
 
+def axisymmetric(scene):
+    """``scene``, refused (FieldError, exit 2) before any work when a coil is not coaxial: the primary branch is
+    traced by the axisymmetric solver, and a non-axisymmetric field is not."""
+    from ..model.field import coaxial_table
+
+    coaxial_table(scene.field.coils)
+    return scene
+
+
 def run(args) -> int:
     """Analyse, write, read back and summarise; exit 130 after an interrupt (what is finished is written)."""
     from ..io.run_file import read_run
     from ..numerics.interrupt import requested, stop_on_signals
     from .progress import shown
 
-    scene = scene_of(args)
+    scene = axisymmetric(scene_of(args))
     output = hdf5_output(args.output, "run") if args.output is not None else f"{scene.name}.h5"
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
@@ -338,7 +347,7 @@ def solve(args) -> int:
     from ..analysis.results import StopCode
     from .summaries import format_table
 
-    scene = scene_of(args)
+    scene = axisymmetric(scene_of(args))
     x = args.pole_stretch
     if not np.isfinite(x) or x <= 1:
         raise UsageError(f"--pole-stretch = {x:g}: must be > 1 (λ2(0) = 1 is the undeformed sphere)")

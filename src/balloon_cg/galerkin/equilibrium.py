@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 from .discretisation import Discretisation, read_only
-from ..model.field import field_squared_nodes
+from ..model.field import coaxial_table, field_squared_nodes
 from ..model.kernels import KernelSet
 from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
@@ -122,7 +122,7 @@ class Equilibrium:
         the general class, whose exponents are runtime arguments (Parameters.alpha)."""
         self.scene = scene
         self.disc = discretisation
-        self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils], dtype=float).reshape(-1, 3)
+        self.coils = coaxial_table(scene.field.coils)
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))

@@ -181,6 +181,16 @@ def coil_table(coils) -> np.ndarray:
     return table
 
 
+def coaxial_table(coils) -> np.ndarray:
+    """The coils (scene.Coil) as the coil_table rows (radius, height, current) of the axisymmetric solver; FieldError
+    naming the first coil that is not coaxial (its field is not axisymmetric)."""
+    for k, c in enumerate(coils):
+        if not c.is_coaxial:
+            raise FieldError(f"coil {k} is not coaxial (centre {list(c.centre)}, normal {list(c.normal)}): "
+                             "non-axisymmetric fields are traced on the whole sphere, not yet available")
+    return coil_table(np.array([[c.radius, c.height, c.current] for c in coils], dtype=float).reshape(-1, 3))
+
+
 def _coil_distances(rho, z, table):
     """Broadcast (ρ, z) and the distances to each wire, shape (..., n)."""
     r, zz = np.broadcast_arrays(np.asarray(rho, dtype=float), np.asarray(z, dtype=float))
@@ -208,31 +218,3 @@ def field_components(rho, z, coils):
     out = np.empty((2, r.size))
     _components_nodes(np.ascontiguousarray(r.ravel()), np.ascontiguousarray(zz.ravel()), table, out)
     return out[0].reshape(r.shape), out[1].reshape(r.shape)
-
-
-CARTESIAN = ("Q", "Q_x", "Q_y", "Q_z", "Q_xx", "Q_xy", "Q_xz", "Q_yy", "Q_yz", "Q_zz")  # field_squared_cartesian rows
-
-
-@njit(cache=True)
-def field_squared_cartesian(points, coils, out):
-    """H² and its Cartesian derivatives (rows CARTESIAN) at every point (columns of ``points``: x, y, z) from the
-    (ρ, z) ones, ρ = √(x² + y²), ρ̂ = (x, y)/ρ: Q_a = Q_ρ ρ̂_a, Q_ab = Q_ρρ ρ̂_a ρ̂_b + (Q_ρ/ρ)(δ_ab − ρ̂_a ρ̂_b),
-    Q_az = Q_ρz ρ̂_a. Q_ρ is odd in ρ, so Q_ρ/ρ → Q_ρρ on the axis (and exactly there: ρ̂ = 0 drops the rest)."""
-    for i in range(points.shape[1]):
-        x, y = points[0, i], points[1, i]
-        rho = math.sqrt(x * x + y * y)
-        q, q_r, q_z, q_rr, q_rz, q_zz = _squared(rho, points[2, i], coils)
-        if rho > 0.0:
-            ex, ey, q_r_rho = x / rho, y / rho, q_r / rho
-        else:
-            ex, ey, q_r_rho = 0.0, 0.0, q_rr
-        out[0, i] = q
-        out[1, i] = q_r * ex
-        out[2, i] = q_r * ey
-        out[3, i] = q_z
-        out[4, i] = q_rr * ex * ex + q_r_rho * (1.0 - ex * ex)
-        out[5, i] = (q_rr - q_r_rho) * ex * ey
-        out[6, i] = q_rz * ex
-        out[7, i] = q_rr * ey * ey + q_r_rho * (1.0 - ey * ey)
-        out[8, i] = q_rz * ey
-        out[9, i] = q_zz

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .field import field_squared
+from .field import coaxial_table, field_squared
 from .kernels import KernelSet
 from ..generated import FIELD_ROWS
 
@@ -76,7 +76,7 @@ class Shooter:
 
     def __init__(self, scene, rtol: float = 1e-13, atol: float = 1e-13):
         f = scene.field
-        self.coils = np.array([[c.radius, c.height, c.current] for c in f.coils], dtype=float).reshape(-1, 3)
+        self.coils = coaxial_table(f.coils)
         self.kernels = KernelSet.of_scene(scene)
         self.M, self.chi = (f.M, f.chi) if self.coils.shape[0] else (0.0, f.chi)
         self.voltage = 0.0 if scene.electric is None else scene.electric.voltage

@@ -24,7 +24,7 @@ from numpy.polynomial import legendre
 
 from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import Discretisation
-from ..model.field import coil_table, field_components, field_squared_nodes
+from ..model.field import coaxial_table, coil_table, field_components, field_squared_nodes
 from ..model.stresses import elastic_stresses
 from ..galerkin.profiles import meridional_stretch
 from ..scene import parse_scene
@@ -142,7 +142,7 @@ def quantities(scene, disc: Discretisation, X, theta, M: float | None = None, ch
     M = scene.field.M if M is None else M
     chi = scene.field.chi if chi is None else chi
     geometry = surface(disc, X, theta)
-    field = surface_field([(c.radius, c.height, c.current) for c in scene.field.coils], geometry)
+    field = surface_field(coaxial_table(scene.field.coils), geometry)
     sigma_theta, sigma_phi = elastic_stresses(scene.material, geometry["lam1"], geometry["lam2"])
     extra_theta, extra_phi = paper_magnetic_stresses(M, chi, theta, geometry["lam2"], field)
     return {

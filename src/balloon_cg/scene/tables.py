@@ -29,11 +29,37 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Coil:
-    """A circular current loop coaxial with the balloon: radius a, height h of its plane, signed current s."""
+    """A circular current loop (MODEL.md §9): radius a, signed current s (circulating positively about n), centre c
+    and unit normal n. Coaxial with the balloon when c = (0, 0, h) and n = e_z: the scene's ``height`` form (a loop
+    on the axis with normal −e_z is stored so, its current reversed: the same loop)."""
 
     radius: float
-    height: float
     current: float
+    centre: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+
+    @classmethod
+    def coaxial(cls, radius: float, height: float, current: float) -> "Coil":
+        """The loop of radius a coaxial with the balloon, its plane at height h."""
+        return cls(radius, current, (0.0, 0.0, height))
+
+    @property
+    def height(self) -> float:
+        """The height of the loop's centre (of its plane, for a coaxial loop)."""
+        return self.centre[2]
+
+    @property
+    def is_coaxial(self) -> bool:
+        """True when the loop's centre lies on the balloon's axis and its normal is e_z."""
+        return self.centre[:2] == (0.0, 0.0) and self.normal == (0.0, 0.0, 1.0)
+
+    def to_table(self) -> dict:
+        """The scene's [[field.coils]] table: {radius, height, current} for a coaxial loop (as written before
+        loops anywhere existed), else {radius, centre, normal, current}."""
+        if self.is_coaxial:
+            return {"radius": self.radius, "height": self.height, "current": self.current}
+        return {"radius": self.radius, "centre": list(self.centre), "normal": list(self.normal),
+                "current": self.current}
 
 
 @dataclass(frozen=True)
@@ -46,11 +72,13 @@ class Field:
 
     @property
     def is_equator_symmetric(self) -> bool:
-        """True when the coils are mirror-symmetric about z = 0, so that H² is even in z.
+        """True when the coils are coaxial and mirror-symmetric about z = 0, so that H² is even in z.
 
         Every coil (a, h, s) needs a partner (a, −h, ±s); the sign must be + for all pairs (h_z even)
         or − for all pairs (h_ρ even). A coil at h = 0 is its own partner, with sign +.
         """
+        if not all(c.is_coaxial for c in self.coils):
+            return False
         same_sign = set()
         for c in self.coils:
             partner = next(
@@ -200,7 +228,7 @@ class Scene:
         return {
             "material": m.to_table() if isinstance(m, StrainEnergy) else
             {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
-            "field": {"chi": f.chi, "M": f.M, "coils": [asdict(c) for c in f.coils]},
+            "field": {"chi": f.chi, "M": f.M, "coils": [c.to_table() for c in f.coils]},
             **{t: asdict(getattr(self, t)) for t in _TABLES[2:5]},
             "output": {k: v for k, v in asdict(self.output).items()  # memory_limit only when set: older texts stay
                        if k != "memory_limit" or v != Output.memory_limit},
@@ -420,38 +448,78 @@ def _field(data) -> Field:
         raise SceneError(f"field.M = {show(data['M'])} needs at least one [[field.coils]]")
     seen = {}
     for i, c in enumerate(coils):
-        j = seen.setdefault((c.radius, c.height), i)
+        j = seen.setdefault((c.radius, c.centre, max(c.normal, tuple(-x for x in c.normal))), i)
         if j != i:
-            raise SceneError(
-                f"field.coils[{i}]: same radius = {show(c.radius)} and height = {show(c.height)} as field.coils[{j}]: "
-                "coils must be distinct (merge their currents)"
-            )
+            same = f"radius = {show(c.radius)} and height = {show(c.height)}" if c.is_coaxial else \
+                f"radius = {show(c.radius)}, centre = {show(c.centre)} and normal = ±{show(c.normal)}"
+            raise SceneError(f"field.coils[{i}]: same {same} as field.coils[{j}]: coils must be distinct (merge "
+                             "their currents)")
     return Field(chi, M, coils)
 
 
+COIL_KEYS = ("radius", "height", "centre", "normal", "current")
+
+
 def _coil(key: str, data) -> Coil:
-    data = table(key, data, _keys(Coil))
-    for k in _keys(Coil):
+    """A [[field.coils]] table: radius, current and the loop's place, either ``height`` h (centre (0, 0, h)) or
+    ``centre`` = [x, y, z], with ``normal`` = [nx, ny, nz] (default e_z; normalised). The wire must lie outside
+    the undeformed unit sphere: its closest approach to the centre, √((|c − (c·n) n| − a)² + (c·n)²), exceeds 1."""
+    data = table(key, data, COIL_KEYS)
+    for k in ("radius", "current"):
         if data.get(k) is None:
-            raise SceneError(f"{key}.{k} is missing: each coil needs radius, height and current")
+            raise SceneError(f"{key}.{k} is missing: each coil needs radius, current, and height or centre")
+    if (data.get("height") is None) == (data.get("centre") is None):
+        given = "neither" if data.get("height") is None else \
+            f"both height = {show(data['height'])} and centre = {show(data['centre'])}"
+        raise SceneError(f"{key}: {given} given: place the loop by one of height (centre = [0, 0, height]) or "
+                         "centre = [x, y, z]")
     a = number(f"{key}.radius", data["radius"])
-    h = number(f"{key}.height", data["height"])
-    s = number(f"{key}.current", data["current"])
     if not 0 < a <= MAX_COIL_DISTANCE:
         raise SceneError(f"{key}.radius = {show(data['radius'])}: must be in (0, {MAX_COIL_DISTANCE:g}]")
-    if not abs(h) <= MAX_COIL_DISTANCE:
-        raise SceneError(f"{key}.height = {show(data['height'])}: must be in [-{MAX_COIL_DISTANCE:g}, "
-                         f"{MAX_COIL_DISTANCE:g}]")
+    if data.get("height") is not None:
+        h = number(f"{key}.height", data["height"])
+        if not abs(h) <= MAX_COIL_DISTANCE:
+            raise SceneError(f"{key}.height = {show(data['height'])}: must be in [-{MAX_COIL_DISTANCE:g}, "
+                             f"{MAX_COIL_DISTANCE:g}]")
+        centre = (0.0, 0.0, h)
+    else:
+        centre = _vector(f"{key}.centre", data["centre"])
+        if not max(map(abs, centre)) <= MAX_COIL_DISTANCE:
+            raise SceneError(f"{key}.centre = {show(data['centre'])}: each entry must be within "
+                             f"±{MAX_COIL_DISTANCE:g}")
+    normal = (0.0, 0.0, 1.0) if data.get("normal") is None else _unit(f"{key}.normal", data["normal"])
+    s = number(f"{key}.current", data["current"])
     if s == 0 or abs(s) > MAX_CURRENT:
         raise SceneError(f"{key}.current = {show(data['current'])}: must be nonzero and within ±{MAX_CURRENT:g}")
-    d2 = a * a + h * h
+    if centre[:2] == (0.0, 0.0) and normal == (0.0, 0.0, -1.0):  # the coaxial loop with the current reversed
+        normal, s = (0.0, 0.0, 1.0), -s
+    coil = Coil(a, s, centre, normal)
+    axial = sum(c * n for c, n in zip(centre, normal))
+    off_axis = math.dist(centre, [axial * n for n in normal])
+    d2 = (off_axis - a) ** 2 + axial**2
     if d2 <= 1 + 1e-9:
         where = "on" if d2 >= 1 - 1e-9 else "inside"
-        raise SceneError(
-            f"{key}: wire at distance {math.sqrt(d2):.6g} from the centre lies {where} the undeformed membrane "
-            "(a² + h² must be > 1)"
-        )
-    return Coil(a, h, s)
+        rule = "a² + h²" if coil.is_coaxial else "(|c − (c·n) n| − a)² + (c·n)²"
+        raise SceneError(f"{key}: wire at distance {math.sqrt(d2):.6g} from the centre lies {where} the undeformed "
+                         f"membrane ({rule} must be > 1)")
+    return coil
+
+
+def _vector(key: str, raw) -> tuple[float, float, float]:
+    """``raw`` as 3 checked numbers."""
+    if not isinstance(raw, list) or len(raw) != 3:
+        raise SceneError(f"{key} = {show(raw)}: must be 3 numbers [x, y, z]")
+    return tuple(number(f"{key}[{i}]", x) for i, x in enumerate(raw))
+
+
+def _unit(key: str, raw) -> tuple[float, float, float]:
+    """``raw`` as a unit vector: divided by its length (kept as written when that is 1 to rounding, so that a scene
+    written back reads the same); a zero length is refused."""
+    vector = _vector(key, raw)
+    length = math.hypot(*vector)
+    if length == 0:
+        raise SceneError(f"{key} = {show(raw)}: must have a nonzero length (the direction of the loop's axis)")
+    return vector if abs(length - 1.0) <= 1e-15 else tuple(x / length for x in vector)
 
 
 def _electric(data) -> Electric:

@@ -5,14 +5,14 @@ spherical-harmonic coefficients c of the displacement (basis.py), and the residu
 
 π, its gradient and Hessian in the 9 node variables from the generated surface kernels of the scene's class
 (codegen: the same energy terms as the axisymmetric kernels), H² and its Cartesian derivatives from the coil field
-(model/field.field_squared_cartesian).
+(model/loop.field_squared_cartesian: loops anywhere).
 """
 import numpy as np
 
 from .basis import SphericalBasis
 from ..galerkin.discretisation import symmetric_rows
 from ..galerkin.equilibrium import NonFiniteState, Parameters
-from ..model.field import CARTESIAN, field_squared_cartesian
+from ..model.loop import CARTESIAN, field_squared_cartesian, loop_table
 from ..model.kernels import KernelSet
 from ..numerics.newton import finite
 
@@ -26,8 +26,7 @@ class SurfaceEquilibrium:
 
     def __init__(self, scene, basis: SphericalBasis, kernels=None):
         self.scene, self.basis = scene, basis
-        self.coils = np.array([[c.radius, c.height, c.current] for c in scene.field.coils],
-                              dtype=float).reshape(-1, 3)
+        self.coils = loop_table(scene.field.coils)
         self.kernels = kernels if kernels is not None else KernelSet.of_scene(scene).surface()
         self.has_field = self.coils.shape[0] > 0
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
