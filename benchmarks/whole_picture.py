@@ -58,7 +58,7 @@ print(json.dumps({"total": total, "phases": seconds, "points": int(sum(len(b.X) 
 
 def measure(python: str, scene: str) -> dict:
     out = subprocess.run([python, "-c", MEASURE, str(ROOT / "scenes" / f"{scene}.toml")], capture_output=True,
-                         text=True, check=True, cwd=ROOT)
+                         text=True, check=True, cwd=ROOT.parent)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 

@@ -350,15 +350,11 @@ def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int
     return {held: merged_lowest(parts, count) for held, parts in matrices.items()}
 
 
-def merged_lowest(parts, count: int, guess: float | None = None) -> np.ndarray:
-    """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts;
-    ``guess`` estimates the block's lowest (the previous point's along a branch): a large part then follows it
-    (``numerics.eigen.lowest_following``: the guess less a margin is a lower bound of every part)."""
-    if guess is None:
-        found = [eigen.lowest_of(A, count) for A in parts]
-    else:
-        found = [eigen.lowest_following(A, count, guess) for A in parts]
-    return found[0] if len(parts) == 1 else np.sort(np.concatenate(found))[:count]
+def merged_lowest(parts, count: int) -> np.ndarray:
+    """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
+    if len(parts) == 1:
+        return eigen.lowest_of(parts[0], count)
+    return np.sort(np.concatenate([eigen.lowest_of(A, count) for A in parts]))[:count]
 
 
 def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, readings=(True, False),

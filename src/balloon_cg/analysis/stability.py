@@ -188,14 +188,12 @@ class SecondVariation:
                 out.append((f"m{m}_free", readings[False], FREE_FLAGS))
         return out
 
-    def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0, near: dict | None = None) -> Assessment:
+    def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> Assessment:
         """Blocks (their LOWEST eigenvalues) and flags (a flag holds when every block it takes is positive) at one
-        equilibrium (``blocks``); ``near``: the blocks of a neighbouring assessment (the previous point, or this
-        point at another degree), whose lowest eigenvalues the large blocks follow (``merged_lowest``)."""
+        equilibrium (``blocks``)."""
         blocks, lowest = {}, [np.inf] * len(FLAGS)
         for name, parts, flags in self.blocks(u, params, symmetric, m_max):
-            guess = None if near is None or name not in near else float(near[name][0])
-            blocks[name] = merged_lowest(parts, LOWEST, guess)
+            blocks[name] = merged_lowest(parts, LOWEST)
             for flag in flags:
                 lowest[flag] = min(lowest[flag], blocks[name][0])
         return Assessment(blocks, *(value > 0 for value in lowest), self.basis.degree)
@@ -289,28 +287,26 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
     and flags are checked at ``check_degree`` of each point's degree where a sign could change: points with a
     lowest eigenvalue of magnitude below ``near_zero`` (eigenvalues are O(1) in the L2 normalisation), points
     next to a change of a flag, and every tenth point.
-    The large blocks (``numerics.eigen.FOLLOWING_SIZE`` rows on) follow the lowest eigenvalues of the previous
-    point (of the point itself at its first degree, for a raised one) instead of a dense eigensolve
-    (``eigen.lowest_following``: the same eigenvalues to rounding).
     """
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     variations = Variations(equilibrium_of(branch))
 
-    def assess(n, N, near=None):
+    def assess(n, N):
         interrupt.check()
-        return variations[N].assess(branch.X[n][:-1], branch.params_at(branch.X[n]), symmetric, m_max, near)
+        return variations[N].assess(branch.X[n][:-1], branch.params_at(branch.X[n]), symmetric, m_max)
 
-    degrees = point_degrees(branch, degree)
-    results = []
-    for n, N in enumerate(degrees):  # each point's large blocks follow the previous point's lowest eigenvalues
-        results.append(assess(n, N, results[-1].blocks if results else None))
+    def first(n, N):
+        assessment = assess(n, N)
         if on_point is not None:
             on_point()
+        return assessment
+
+    degrees = point_degrees(branch, degree)
+    results = [first(n, N) for n, N in enumerate(degrees)]
     unsettled = []
     if check:
         folds = branch.fold_intervals
-        followed = follow_modes(results, degrees, lambda n, N: assess(n, N, results[n].blocks),
-                                lambda N: check_degree(branch, N),
+        followed = follow_modes(results, degrees, assess, lambda N: check_degree(branch, N),
                                 lambda found: branch_point_crossings(found, m_max, folds))
         results, degrees = followed.assessments, followed.degrees
         flags = [_flags(a) for a in results]
