@@ -12,11 +12,12 @@ Location: Brent's method (``continuation.locate_root``) on μ_k(s), the eigenval
     R(X(s)) = 0,   d·X(s) = d·X_i + s,   d = (X_{i+1} − X_i)/|X_{i+1} − X_i|
 
 (the corrector on the chord hyperplane, as ``bifurcation.locate`` for m = 0), with the branch's own
-discretisation and the perturbation degree of its assessments (every evaluation a dense eigensolve: the
-location is as sensitive to the eigenvalue's rounding as ε‖H‖ divided by its slope, ~5e-11 at degree 225 on the
-two-coil pear branch, so the function Brent sees is the one it always saw); LOCATED when Brent converged (|Δs| ≤ 1e-13) and
-the crossing eigenvalue is converged at the bracketing points between that degree and the check degree
-(``crossing_problems``, as for m = 0), else APPROXIMATE with the bracket and the reason.
+discretisation and the perturbation degree of its assessments. Every evaluation is a dense eigensolve: the
+location is only as certain as the eigenvalue's rounding ε‖H‖ over its slope (~5e-11 at degree 225 on the two-coil
+pear branch), and an eigenvalue rounded otherwise (a Lanczos follower) moves the point by as much
+(docs/numerics.md §6). LOCATED when Brent converged (|Δs| ≤ 1e-13) and the crossing eigenvalue is converged at
+the bracketing points between that degree and the check degree (``crossing_problems``, as for m = 0; it reads
+the stored eigenvalue where a point was assessed at that degree), else APPROXIMATE with the bracket and the reason.
 Without a field (M = 0 or no coils) the energy is invariant under every rotation and the primary branch is a
 sphere, on which a mode of spherical degree n has copies for every m ≤ n: the m = 0 mode about a tilted axis
 (the tilted pear, n = 1; the tilted n = 2 mode). So without a field a crossing in the interval of an m = 0

@@ -215,8 +215,8 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
                 reached.add(branch.rejoins)
                 mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
             picture.branches.append(branch)
-            if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):  # kept as traced, not assessed
-                return
+            if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):
+                return  # kept as traced, not assessed
             pear = branch if sign > 0 and reflect else None
 
 
