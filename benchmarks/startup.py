@@ -49,7 +49,7 @@ from balloon_cg.io.run_file import write_run
 from balloon_cg.scene import load_scene
 scene = load_scene(sys.argv[1])
 t1 = [c() for c in clocks]
-branches, snaps, found, _ = computed(scene)
+branches, snaps, found, _, _ = computed(scene)
 t2 = [c() for c in clocks]
 write_run(sys.argv[2], scene, branches, force=True, snaps=snaps, found=found)
 t3 = [c() for c in clocks]

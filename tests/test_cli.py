@@ -44,7 +44,8 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     out = tmp_path / "run.h5"
     assert main(["run", str(scene_file), "-o", str(out)]) == 0
     text = capsys.readouterr().out
-    for item in ("points", "pressure", "LP", "EP", "stop reason", "max residual", "error estimate vs run time"):
+    for item in ("points", "pressure", "LP", "EP", "stop reason", "max residual", "error estimate vs trace time",
+                 "run time"):
         assert item in text
 
     assert main(["inspect", str(out), "--json"]) == 0
@@ -68,6 +69,9 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     assert branch["lam2_north"][1] == pytest.approx(2.0, abs=1e-12)
     assert branch["max_residual"] < 1e-10 and branch["max_error_estimate"] < 1e-10
     assert branch["points"] > 10 and branch["wall_time"] > 0
+    timing = summary["run_time"]  # every phase that ran, writing included, within the whole run's time
+    assert {"trace", "stability", "branch points", "pear branches", "writing"} <= set(timing["phases"])
+    assert 0 < sum(timing["phases"].values()) <= timing["total"]
 
     assert main(["inspect", str(out)]) == 0
     text = capsys.readouterr().out

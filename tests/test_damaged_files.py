@@ -59,6 +59,9 @@ DAMAGE = {
     "snap_throughs column": lambda f: f["snap_throughs"].__delitem__("to_index"),
     "no format": lambda f: f.attrs.__delitem__("format"),
     "complete without incomplete_gaps": lambda f: f.attrs.__delitem__("incomplete_gaps"),
+    "phase_names without phase_seconds": lambda f: f.attrs.__delitem__("phase_seconds"),
+    "phase_seconds shorter than phase_names": lambda f: f.attrs.__setitem__("phase_seconds",
+                                                                            f.attrs["phase_seconds"][:-1]),
 }
 
 

@@ -68,7 +68,8 @@ def test_default_run_writes_the_promised_files(quick_run):
     assert not (out / "spom1_field.png").exists()  # no coils
     for kind in default_run.COMBINED:
         assert (out / f"all_{kind}.png").stat().st_size > 0
-    for word in ("scene", "points", "P range", "special points", "max error est.", "wall time", *default_run.SCENES):
+    for word in ("scene", "points", "P range", "special points", "max error est.", "trace time", "run time",
+                 *default_run.SCENES):
         assert word in text
 
 

@@ -12,9 +12,12 @@ Location: Brent's method (``continuation.locate_root``) on μ_k(s), the eigenval
     R(X(s)) = 0,   d·X(s) = d·X_i + s,   d = (X_{i+1} − X_i)/|X_{i+1} − X_i|
 
 (the corrector on the chord hyperplane, as ``bifurcation.locate`` for m = 0), with the branch's own
-discretisation and the perturbation degree of its assessments; LOCATED when Brent converged (|Δs| ≤ 1e-13) and
-the crossing eigenvalue is converged at the bracketing points between that degree and the check degree
-(``crossing_problems``, as for m = 0), else APPROXIMATE with the bracket and the reason.
+discretisation and the perturbation degree of its assessments. Every evaluation is a dense eigensolve: the
+location is only as certain as the eigenvalue's rounding ε‖H‖ over its slope (~5e-11 at degree 225 on the two-coil
+pear branch), and an eigenvalue rounded otherwise (a Lanczos follower) moves the point by as much
+(docs/numerics.md §6). LOCATED when Brent converged (|Δs| ≤ 1e-13) and the crossing eigenvalue is converged at
+the bracketing points between that degree and the check degree (``crossing_problems``, as for m = 0; it reads
+the stored eigenvalue where a point was assessed at that degree), else APPROXIMATE with the bracket and the reason.
 Without a field (M = 0 or no coils) the energy is invariant under every rotation and the primary branch is a
 sphere, on which a mode of spherical degree n has copies for every m ≤ n: the m = 0 mode about a tilted axis
 (the tilted pear, n = 1; the tilted n = 2 mode). So without a field a crossing in the interval of an m = 0
@@ -48,6 +51,12 @@ def eigenvalue(system, X, m: int, held: bool, k: int, degree: int) -> float:
     return float(spectrum(system.eq, X[:-1], system.params_at(X), m, degree, k + 1, held=held)[k])
 
 
+def assessed(branch: Branch, n: int, block: Block, k: int, degree: int) -> float | None:
+    """μ_k of ``block`` at point n as stored in its assessment, if it was assessed at ``degree`` (else None)."""
+    assessment = branch.stability[n]
+    return float(assessment.blocks[block][k]) if assessment.degree == degree else None
+
+
 def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int, degree: int) -> SpecialPoint:
     """The zero of μ_k of block m between points index and index + 1 (module docstring), a BP special point."""
     system, solver = branch_system(branch), branch.scene.solver
@@ -70,18 +79,23 @@ def locate(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
                                                   "every evaluation inside its bracket; its start is stored")
         return SpecialPoint(Kind.BP, index, X0, block=block, m=m, note=note, **fields)
     fields = located_or_bracketed(found.status, branch.disc, X0, X1, f"branch point ({block.value} block)")
-    problems = crossing_problems(branch, index, m, held, k, degree)
+    problems = crossing_problems(branch, index, m, held, block, k, degree)
     if problems and not fields.get("reason"):
         fields = approximate(branch.disc, X0, X1, f"branch point ({block.value} block): " + "; ".join(problems))
     return SpecialPoint(Kind.BP, index, found.payload, block=block, m=m, note=note, **fields)
 
 
-def crossing_problems(branch: Branch, index: int, m: int, held: bool, k: int, degree: int) -> list[str]:
+def crossing_problems(branch: Branch, index: int, m: int, held: bool, block: Block, k: int,
+                      degree: int) -> list[str]:
     """Whether μ_k of block m is converged at the bracketing points, both at ``degree``
-    (``stability.convergence_problems``, as for m = 0)."""
+    (``stability.convergence_problems``, as for m = 0; the stored μ_k where a point was assessed at that degree)."""
     system = branch_system(branch)
-    return convergence_problems(branch, index,
-                                lambda n, N: eigenvalue(system, branch.X[n], m, held, k, N), (degree, degree))
+
+    def value(n, N):
+        stored = assessed(branch, n, block, k, N)
+        return stored if stored is not None else eigenvalue(system, branch.X[n], m, held, k, N)
+
+    return convergence_problems(branch, index, value, (degree, degree))
 
 
 def is_copy(branch: Branch, index: int) -> bool:

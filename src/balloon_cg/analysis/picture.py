@@ -26,6 +26,7 @@ from .problem import equilibrium_of
 from .results import Block, Branch, Origin, Status, StopCode
 from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
+from .timing import Clock, Step
 from .verdict import Gap, Incomplete, incomplete
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
@@ -87,6 +88,7 @@ class Picture:
     not_started: list = field(default_factory=list)  # (name, reason) of bifurcating branches that could not start
     surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
     interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
+    clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
 
     @property
     def primary(self) -> Branch:
@@ -107,32 +109,35 @@ class Picture:
         return found
 
 
-def _assess(branch: Branch, scene, symmetric: bool, progress: Progress) -> bool:
+def _assess(branch: Branch, scene, symmetric: bool, progress: Progress, clock: Clock) -> bool:
     """Assess ``branch`` (one STABILITY tick per point); False when a signal stopped it (the branch is kept as
     traced, not assessed)."""
     progress.expect(Phase.STABILITY, len(branch.X))
     try:
-        branch.stability, branch.unsettled = assess_branch(
-            branch, scene.stability.degree, symmetric, check=True, m_max=scene.stability.m_max,
-            on_point=lambda: progress.tick(Phase.STABILITY))
+        with clock.step(Step.STABILITY):
+            branch.stability, branch.unsettled = assess_branch(
+                branch, scene.stability.degree, symmetric, check=True, m_max=scene.stability.m_max,
+                on_point=lambda: progress.tick(Phase.STABILITY))
     except interrupt.Interrupted:
         return False
     return True
 
 
 @limited_blas
-def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Picture:
+def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: Clock | None = None) -> Picture:
     """The picture of a scene (module docstring); ``pear=False`` skips the pear and the non-axisymmetric branches
     (those follow ``[surface] branches``). ``progress``: a
     ``Progress`` told of every point. A signal (``numerics.interrupt``) stops it at the next point: the picture
-    then holds what is finished (``interrupted``; the branches after it are not traced, nor assessed)."""
-    progress = progress or Progress()
-    primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
+    then holds what is finished (``interrupted``; the branches after it are not traced, nor assessed).
+    ``clock``: the Clock its phases are charged to (``Picture.clock``; default: one started here)."""
+    progress, clock = progress or Progress(), clock or Clock()
+    with clock.step(Step.TRACE):
+        primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
     progress.finish(Phase.PRIMARY, len(primary.X))
-    picture = Picture([primary])
+    picture = Picture([primary], clock=clock)
     if _stopped(picture):
         return picture
-    if not _assess(primary, scene, primary.disc.symmetric, progress):
+    if not _assess(primary, scene, primary.disc.symmetric, progress, clock):
         picture.interrupted = True
         return picture
     if not primary.disc.symmetric:
@@ -140,30 +145,35 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True) -> Pictu
         picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
                                 "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
         return picture
-    for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
-        if _stopped(picture):
-            break
-        bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
-        mode = "pear (odd)" if block == Block.ODD_HELD else "equator-symmetric (even)"
-        bp.note = f"{mode} mode, branch point {n}"
-        picture.branch_points.append(bp)
-        primary.special.append(bp)
+    with clock.step(Step.BRANCH_POINTS):
+        for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
+            if _stopped(picture):
+                break
+            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
+            mode = "pear (odd)" if block == Block.ODD_HELD else "equator-symmetric (even)"
+            bp.note = f"{mode} mode, branch point {n}"
+            picture.branch_points.append(bp)
+            primary.special.append(bp)
     primary.special.sort(key=lambda s: s.index)
     if _stopped(picture):
         return picture
     if pear:
-        _trace_pears(scene, primary, picture, progress)
+        with clock.step(Step.PEAR_BRANCHES):
+            _trace_pears(scene, primary, picture, progress)
         progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
     progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
     for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
         if _stopped(picture):
             return picture
-        branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
+        with clock.step(Step.CROSSINGS):
+            branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
         branch.special.sort(key=lambda s: s.index)
     if pear and scene.surface.branches != "none":
-        _trace_surface(scene, primary, picture, progress)
+        with clock.step(Step.SURFACE_BRANCHES):
+            _trace_surface(scene, primary, picture, progress)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
-    picture.snaps = snap_throughs(picture.branches, scene.loading.control)
+    with clock.step(Step.SNAP_THROUGHS):
+        picture.snaps = snap_throughs(picture.branches, scene.loading.control)
     return picture
 
 
@@ -209,8 +219,8 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
                 reached.add(branch.rejoins)
                 mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
             picture.branches.append(branch)
-            if interrupt.requested() or not _assess(branch, scene, False, progress):  # kept as traced, not assessed
-                return
+            if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):
+                return  # kept as traced, not assessed
             pear = branch if sign > 0 and reflect else None
 
 

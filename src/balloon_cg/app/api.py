@@ -107,8 +107,9 @@ class Result:
     picture: object = None
 
     @classmethod
-    def of(cls, scene: Scene, branches, snaps=None, found=None, picture=None, command: str = "") -> "Result":
-        image = run_image(scene, branches, {"command": command or command_line()}, snaps, found)
+    def of(cls, scene: Scene, branches, snaps=None, found=None, picture=None, command: str = "",
+           clock=None) -> "Result":
+        image = run_image(scene, branches, {"command": command or command_line()}, snaps, found, clock)
         return cls(scene, image, read_run_image(image, scene.name), picture)
 
     @property
@@ -197,20 +198,24 @@ def _scene(scene) -> Scene:
 
 
 def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progress: bool = False):
-    """(branches, snap-throughs, incomplete entries, picture) of ``scene``, one progress bar per phase: the
+    """(branches, snap-throughs, incomplete entries, picture, clock) of ``scene``, one progress bar per phase: the
     primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse; its
-    axisymmetric branches, then its surface branches)."""
+    axisymmetric branches, then its surface branches); ``clock`` the seconds of each phase (analysis.timing,
+    started here: the writer adds its own)."""
     from ..analysis.picture import analyse as analyse_picture
     from ..analysis.primary import trace_primary
+    from ..analysis.timing import Clock, Step
     from ..analysis.verdict import incomplete
 
+    clock = Clock()
     with PhaseBars(scene.name, progress) as bars:
         if primary_only:
-            branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
+            with clock.step(Step.TRACE):
+                branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
             bars.finish(Phase.PRIMARY, len(branches[0].X))
-            return branches, None, incomplete(branches), None
-        picture = analyse_picture(scene, bars, pear=pear)
-        return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture
+            return branches, None, incomplete(branches), None, clock
+        picture = analyse_picture(scene, bars, pear=pear, clock=clock)
+        return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture, clock
 
 
 def trace(scene, progress: bool = False) -> Result:
@@ -218,8 +223,8 @@ def trace(scene, progress: bool = False) -> Result:
     and returns what is finished, flagged incomplete."""
     scene = _scene(scene)
     with stop_on_signals():
-        branches, snaps, found, _ = computed(scene, primary_only=True, progress=progress)
-    return Result.of(scene, branches, snaps, found, command=f"balloon_cg.trace({scene.name!r})")
+        branches, snaps, found, _, clock = computed(scene, primary_only=True, progress=progress)
+    return Result.of(scene, branches, snaps, found, command=f"balloon_cg.trace({scene.name!r})", clock=clock)
 
 
 def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
@@ -228,8 +233,9 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
     (analysis.picture). Ctrl-C (SIGINT) stops at the next point and returns what is finished, flagged."""
     scene = _scene(scene)
     with stop_on_signals():
-        branches, snaps, found, picture = computed(scene, pear=pear, progress=progress)
-    return Result.of(scene, branches, snaps, found, picture, command=f"balloon_cg.analyse({scene.name!r})")
+        branches, snaps, found, picture, clock = computed(scene, pear=pear, progress=progress)
+    return Result.of(scene, branches, snaps, found, picture, command=f"balloon_cg.analyse({scene.name!r})",
+                     clock=clock)
 
 
 def load(path):

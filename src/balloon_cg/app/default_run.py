@@ -21,7 +21,7 @@ from ..analysis.verdict import failing, summary_line
 from ..io.output import replacing
 from .cli import run_scene
 from .progress import shown
-from .summaries import summarise_branch
+from .summaries import run_time, summarise_branch
 from ..post.plotting import applicable_kinds, load_branches, plot, special_label
 from ..scene import parse_scene
 from ..io.run_file import read_run
@@ -54,16 +54,19 @@ def draw_figures(paths, outdir: Path, stem: str, kinds=None) -> list[Path]:
 
 
 def summary_row(path) -> dict:
-    """Scene, points, P range, special points, max error estimate and trace wall time of a run file."""
+    """Scene, points, P range, special points, max error estimate, the primary trace's time and the whole run's
+    (every phase, writing included: ``summaries.run_time``) of a run file."""
     run = read_run(path)
     b = summarise_branch(run["branches"]["primary"])
+    timing = run_time(run["attrs"])
     return {
         "scene": run["scene_name"],
         "points": str(b["points"]),
         "P range": "{:.4f} .. {:.4f}".format(*b["pressure"]),
         "special points": " ".join(special_label(s) for s in b["special_points"]),
         "max error est.": f"{b['max_error_estimate']:.1e}",
-        "wall time": f"{b['wall_time']:.1f} s",
+        "trace time": f"{b['wall_time']:.1f} s",
+        "run time": f"{timing['total']:.1f} s" if timing else "-",
         "result": "complete" if run["attrs"].get("complete") else "incomplete",
     }
 

@@ -6,7 +6,8 @@ Layout::
                                   + provenance (io.hdf5: package_version, generated_digest, created (UTC ISO
                                   8601), command, Conventions, history: CF), complete (bool),
                                   incomplete_gaps, incomplete_branches, incomplete_messages (analysis.verdict),
-                                  + extra_attrs
+                                  [phase_names, phase_seconds, total_seconds] (analysis.timing: seconds per
+                                  phase and of the whole run, writing included), + extra_attrs
     /branches/<name>/      attrs: order, m (0: axisymmetric, this layout; m ≥ 1: a surface branch, below),
                                   stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
                                   'up'/'down'/'forward' and a StopCode/TraceStop value), wall_time, degree,
@@ -60,6 +61,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..analysis.timing import Clock, Step
 from .hdf5 import atomic_file, plain, provenance, write_strings
 from .layout import FileError, check_columns, check_sizes, opened, reading, require_attrs, require_group
 from .schema import attach_dimensions, scale
@@ -76,30 +78,50 @@ class RunFileError(FileError):
 
 
 def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | None = None,
-              snaps: list | None = None, found: list | None = None) -> Path:
+              snaps: list | None = None, found: list | None = None, clock: Clock | None = None) -> Path:
     """Write the branches traced for ``scene`` to ``path`` atomically; returns the path.
 
     An existing file is kept unless ``force`` (FileExistsError); on any failure the existing file is
     untouched and the temporary file removed. ``extra_attrs`` are added to (or override, except ``format``)
     the root attributes. ``found``: analysis.verdict.Incomplete entries (default: those of ``branches``).
-    Raises ValueError if a branch holds a point that is not a finite solution.
+    ``clock``: the run's analysis.timing.Clock (its phases and total stored with the write's own time:
+    ``timing_attrs``). Raises ValueError if a branch holds a point that is not a finite solution.
     """
     attrs = _run_attrs(scene, branches, extra_attrs, found)
     with atomic_file(path, force) as f:
-        f.attrs.update(attrs)
-        write_branches(f, scene, branches, snaps)
+        _write_timed(f, attrs, scene, branches, snaps, clock)
     return Path(path)
 
 
 def run_image(scene, branches, extra_attrs: dict | None = None, snaps: list | None = None,
-              found: list | None = None) -> bytes:
+              found: list | None = None, clock: Clock | None = None) -> bytes:
     """The bytes of the file ``write_run`` writes, made in memory (an HDF5 file image; nothing on disk)."""
     attrs = _run_attrs(scene, branches, extra_attrs, found)
     with h5py.File(f"{scene.name}.h5", "w", driver="core", backing_store=False) as f:
-        f.attrs.update(attrs)
-        write_branches(f, scene, branches, snaps)
+        _write_timed(f, attrs, scene, branches, snaps, clock)
         f.flush()
         return f.id.get_file_image()
+
+
+def _write_timed(f, attrs: dict, scene, branches, snaps, clock: Clock | None) -> None:
+    """The root attributes and the branches into the open file ``f``, then, with a ``clock``, the timing
+    (``timing_attrs``, the write charged to Step.WRITING)."""
+    if clock is None:
+        f.attrs.update(attrs)
+        write_branches(f, scene, branches, snaps)
+        return
+    with clock.step(Step.WRITING):
+        f.attrs.update(attrs)
+        write_branches(f, scene, branches, snaps)
+    f.attrs.update(timing_attrs(clock))
+
+
+def timing_attrs(clock: Clock) -> dict:
+    """phase_names and phase_seconds (the phases that ran, in Step order) and total_seconds (since the clock
+    started: the phases and what lies between them)."""
+    steps = [step for step in Step if step in clock.seconds]
+    return {"phase_names": np.array([step.value for step in steps], dtype=h5py.string_dtype()),
+            "phase_seconds": np.array([clock.seconds[step] for step in steps]), "total_seconds": clock.total()}
 
 
 def _run_attrs(scene, branches, extra_attrs, found) -> dict:
@@ -435,6 +457,11 @@ def _read_open(f, label) -> dict:
     require_attrs(f.attrs, label, ROOT_KINDS, ROOT_KINDS, error=RunFileError)
     if "complete" in f.attrs:
         require_attrs(f.attrs, label, VERDICT_KINDS, VERDICT_KINDS, error=RunFileError)
+    if any(k in f.attrs for k in TIMING_KINDS):  # written since issue 28
+        require_attrs(f.attrs, label, TIMING_KINDS, TIMING_KINDS, error=RunFileError)
+        if len(f.attrs["phase_names"]) != len(f.attrs["phase_seconds"]):
+            raise RunFileError(label, f"{len(f.attrs['phase_names'])} phase_names but "
+                                      f"{len(f.attrs['phase_seconds'])} phase_seconds")
     attrs = {k: _attr(v) for k, v in f.attrs.items()}
     # every run writes its primary branch (a curve file, a run file with /two_parameter curves, has none)
     if "primary" not in require_group(f, "branches", label, RunFileError) and not len(f.get("two_parameter", {})):
@@ -452,6 +479,7 @@ ROOT_KINDS = {"scene_name": "str", "scene_toml": "str", "tolerance": "float", "p
               "generated_digest": "str", "created": "str", "command": "str"}
 VERDICT_KINDS = {"complete": "bool", "incomplete_gaps": "str[]", "incomplete_branches": "str[]",
                  "incomplete_messages": "str[]"}
+TIMING_KINDS = {"phase_names": "str[]", "phase_seconds": "float[]", "total_seconds": "float"}
 COMMON_KINDS = {"stop_reason": "str", "wall_time": "float", "kernel_class": "str", "kernel_signature": "str",
                 "M": "float", "chi": "float", "leg_labels": "str[]", "leg_stop_codes": "str[]"}
 BRANCH_KINDS = COMMON_KINDS | {"degree": "int", "symmetric": "bool", "pin_translation": "bool", "quadrature": "int",
