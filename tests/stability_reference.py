@@ -1,6 +1,7 @@
 """The reference table of issue 28: every stored eigenvalue, flag and located point of the whole picture of the
 shipped scenes, as computed by the code this table was made with (main at 86f8543, before the stability work of
-issue 28). tests/test_stability_reference.py computes the same table with the code under test and compares it to
+issue 28; rewritten once since, when a surface branch's critical mode moved to the perturbation degree its point
+was located at: the two-coil m = 1 branch's points moved by ~2e-8, nothing else). tests/test_stability_reference.py computes the same table with the code under test and compares it to
 1e-10; ``python tests/stability_reference.py`` rewrites tests/data/stability_reference.npz (only to record a
 deliberate change of the numbers).
 

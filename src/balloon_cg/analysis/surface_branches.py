@@ -75,7 +75,8 @@ def critical_mode(branch: Branch, bp: SpecialPoint, degree: int, count: int = CR
     """(the azimuthal basis, the held eigenvector of block m at the BP whose eigenvalue is nearest zero, among the
     ``count`` lowest) at perturbation degree ``degree`` (``located_degree``: a lower one may not resolve the mode):
     at a later crossing of the block the lowest eigenvalue is already negative and the one that crosses is above it
-    (module docstring)."""
+    (module docstring). Its sign (which direction is +φ, which branch the rotated image) is fixed by its largest
+    entry, positive, not left to the eigensolver."""
     eq = equilibrium_of(branch)
     u, params = bp.X[:-1], branch.params_at(bp.X)
     b = azimuthal.perturbation_basis(eq, bp.m, degree)
@@ -85,7 +86,8 @@ def critical_mode(branch: Branch, bp: SpecialPoint, degree: int, count: int = CR
         modes = azimuthal.special_modes(eq, u, degree)
         exclude = np.array([modes[azimuthal.MODES[k]] for k in azimuthal.excluded_modes(eq, params, True)])
     values, vectors = azimuthal.lowest_eigenvalues(H, G, count, exclude, vectors=True)
-    return b, vectors[:, int(np.argmin(np.abs(values)))]
+    vector = vectors[:, int(np.argmin(np.abs(values)))]
+    return b, vector * np.sign(vector[np.argmax(np.abs(vector))])  # its largest entry positive: +φ is reproducible
 
 
 def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
