@@ -113,14 +113,14 @@ def test_round_trip_is_bit_exact(run_path, surface_branch, basis):
     assert np.allclose([s["eta_south"] for s in special], -STRETCHES[[0, -1]], rtol=1e-13)
 
 
-def test_a_mapped_order_capped_basis_is_rebuilt(tmp_path, scene, surface_branch):
+def test_a_mapped_order_capped_basis_is_rebuilt(tmp_path, scene, primary, surface_branch):
     """The attributes rebuild a basis with an azimuthal order cap and a polar coordinate map (whose functions are
     orthonormalised in its own quadrature) exactly: the same node states from the stored coefficients."""
     basis = SphericalBasis(6, (MIRROR_Y, EQUATOR), order=3, mapping=WireMap((0.4,), (0.2,)))
     c = np.array([displacement_coefficients(basis, (lam - 1.0) * basis.nodes["reference"][:3]) for lam in STRETCHES])
     mapped = replace(surface_branch, name="m1_mapped", basis=basis, coefficients=c,
                      special=[replace(s, X=np.append(c[s.index], s.X[-1])) for s in surface_branch.special])
-    data = read_run(write_run(tmp_path / "mapped.h5", scene, [mapped]))["branches"]["m1_mapped"]
+    data = read_run(write_run(tmp_path / "mapped.h5", scene, [primary, mapped]))["branches"]["m1_mapped"]
     rebuilt = stored_basis(data["attrs"])
     assert rebuilt == basis and (rebuilt.order, rebuilt.mapping) == (3, WireMap((0.4,), (0.2,)))
     assert np.array_equal(rebuilt.node_state(data["coefficients"][2]), basis.node_state(c[2]))
