@@ -63,8 +63,22 @@ def test_expand_list_entry_key(scene):
     assert m.scene.material.alpha[1:] == scene.material.alpha[1:]
 
 
+def test_the_range_spellings_agree(scene):
+    """START:STOP:num=COUNT and linspace(START, STOP, COUNT) (unambiguous to a MATLAB user, for whom a:b:c is
+    start:step:stop) give the short START:STOP:COUNT's values; a step where the count belongs is refused."""
+    from balloon_cg.app.sweep import parse_vary
+
+    short = parse_vary("M=0:0.003:4", scene)
+    assert short == ("field.M", [0.0, 0.001, 0.002, 0.003])
+    assert parse_vary("M=0:0.003:num=4", scene) == short == parse_vary("M=linspace(0, 0.003, 4)", scene)
+    with pytest.raises(SweepError, match="COUNT an integer .the number of values, not a step"):
+        parse_vary("M=0:0.001:0.003", scene)
+    with pytest.raises(SweepError, match="three fields"):
+        parse_vary("M=linspace(0, 0.003)", scene)
+
+
 @pytest.mark.parametrize("specs, message", [
-    (["M"], "expected KEY=START:STOP:COUNT"),
+    (["M"], "expected KEY=START:STOP:num=COUNT"),
     (["M=0:1"], "three fields"),
     (["degree=20,30"], "exactly one scene table"),
     (["M=0,1", "field.M=2"], "varied twice"),

@@ -680,7 +680,8 @@ def _add_sweep(commands):
     p = commands.add_parser("sweep", help="run a scene over a grid of parameter values into one sweep file")
     p.add_argument("scene", help=f"{SCENE_HELP}; the base scene")
     p.add_argument("--vary", action="append", required=True, metavar="KEY=SPEC",
-                   help="KEY=START:STOP:COUNT or KEY=v1,v2,...; KEY a dotted scene key (field.M, "
+                   help="KEY=START:STOP:num=COUNT (or START:STOP:COUNT, or linspace(START, STOP, COUNT): COUNT "
+                        "values, ends included) or KEY=v1,v2,...; KEY a dotted scene key (field.M, "
                         "field.coils[0].radius, material.alpha[0]) or a bare name of one table (M = field.M); "
                         "repeat for a cartesian product")
     p.add_argument("-o", "--output", required=True, help="sweep file (HDF5) to write or resume")

@@ -68,7 +68,9 @@ _INDEXED = re.compile(r"(\w+)\.(\w+)\[(\d+)\]")
 
 
 def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
-    """``KEY=START:STOP:COUNT`` (COUNT evenly spaced values, ends included) or ``KEY=v1,v2,...`` -> (key, values).
+    """``KEY=START:STOP:num=COUNT``, ``KEY=linspace(START, STOP, COUNT)`` or the short ``KEY=START:STOP:COUNT``
+    (COUNT evenly spaced values, ends included: never MATLAB's START:STEP:STOP), or ``KEY=v1,v2,...`` -> (key,
+    values).
 
     KEY is a dotted scene key (``field.M``, ``continuation.stop_stretch``, ``field.coils[0].radius``,
     ``material.alpha[0]``) or a bare name found in exactly one table (``M`` -> ``field.M``).
@@ -76,34 +78,50 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
     key, sep, text = spec.partition("=")
     key, text = key.strip(), text.strip()
     if not sep or not key or not text:
-        raise SweepError(f"--vary {spec!r}: expected KEY=START:STOP:COUNT or KEY=v1,v2,...")
+        raise SweepError(f"--vary {spec!r}: expected KEY=START:STOP:num=COUNT, KEY=linspace(START, STOP, COUNT) or "
+                         "KEY=v1,v2,...")
     try:
         key = scene.canonical_key(key)
     except SceneError as e:
         raise SweepError(f"--vary {e}") from None
-    if ":" in text:
-        parts = text.split(":")
-        if len(parts) != 3:
-            raise SweepError(f"--vary {spec!r}: a range is START:STOP:COUNT (three fields)")
-        try:
-            start, stop = (_number(p) for p in parts[:2])
-            count = int(parts[2])
-        except ValueError:
-            raise SweepError(f"--vary {spec!r}: START and STOP must be numbers and COUNT an integer") from None
-        if not (np.isfinite(start) and np.isfinite(stop)):
-            raise SweepError(f"--vary {spec!r}: START and STOP must be finite numbers")
-        if count < 1 or (count == 1 and start != stop):
-            raise SweepError(f"--vary {spec!r}: COUNT must be >= 2 (or 1 with START = STOP)")
-        if count > MAX_MEMBERS:
-            raise SweepError(f"--vary {spec!r}: COUNT = {count}: at most {MAX_MEMBERS} members per sweep")
-        values = np.linspace(start, stop, count).tolist()
-        if isinstance(start, int) and isinstance(stop, int) and all(float(v).is_integer() for v in values):
-            values = [int(v) for v in values]
-    else:
+    parts = _range_fields(text)
+    if parts is None:
         values = [_value(v.strip()) for v in text.split(",")]
         if any(v == "" for v in values):
             raise SweepError(f"--vary {spec!r}: empty value in the list")
+        return key, values
+    if len(parts) != 3:
+        raise SweepError(f"--vary {spec!r}: a range is START:STOP:num=COUNT or linspace(START, STOP, COUNT) (three "
+                         "fields)")
+    try:
+        start, stop = (_number(p) for p in parts[:2])
+        count = int(parts[2])
+    except ValueError:
+        raise SweepError(f"--vary {spec!r}: START and STOP must be numbers and COUNT an integer (the number of "
+                         "values, not a step)") from None
+    if not (np.isfinite(start) and np.isfinite(stop)):
+        raise SweepError(f"--vary {spec!r}: START and STOP must be finite numbers")
+    if count < 1 or (count == 1 and start != stop):
+        raise SweepError(f"--vary {spec!r}: COUNT must be >= 2 (or 1 with START = STOP)")
+    if count > MAX_MEMBERS:
+        raise SweepError(f"--vary {spec!r}: COUNT = {count}: at most {MAX_MEMBERS} members per sweep")
+    values = np.linspace(start, stop, count).tolist()
+    if isinstance(start, int) and isinstance(stop, int) and all(float(v).is_integer() for v in values):
+        values = [int(v) for v in values]
     return key, values
+
+
+def _range_fields(text: str) -> list[str] | None:
+    """[START, STOP, COUNT] of a range spec (``linspace(a, b, n)``, ``a:b:num=n`` or ``a:b:n``; a wrong field count
+    is kept for the caller to name), None for a list of values."""
+    if text.startswith("linspace(") and text.endswith(")"):
+        return [p.strip() for p in text[len("linspace("):-1].split(",")]
+    if ":" not in text:
+        return None
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) == 3 and parts[2].startswith("num="):
+        parts[2] = parts[2][len("num="):].strip()
+    return parts
 
 
 def expand(scene: Scene, specs: list[str]) -> list[Member]:
