@@ -195,15 +195,15 @@ def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
     elif kind == "surface":
         assert axes[0].name == "3d" and len(axes) == 2  # the surface and its section by y = 0
         assert any(isinstance(c, Poly3DCollection) for c in axes[0].collections)
-        assert "#1" in fig.get_suptitle()  # the first point past the start
-        sections = [line for line in axes[1].lines if len(line.get_xdata()) > 1]  # point 0 and #1, round
-        assert len(sections) == 2 and all(np.allclose(np.hypot(line.get_xdata(), line.get_ydata()), 1.2)
+        assert f"#{len(STRETCHES) - 1}" in fig.get_suptitle()  # the last point: what the branch reaches
+        sections = [line for line in axes[1].lines if len(line.get_xdata()) > 1]  # point 0 and the last, round
+        assert len(sections) == 2 and all(np.allclose(np.hypot(line.get_xdata(), line.get_ydata()), STRETCHES[-1])
                                           for line in sections[1:])
     elif kind == "stretch-map":
         meshes = [c for ax in axes[:2] for c in ax.collections if isinstance(c, QuadMesh)]  # then colour bars
         assert len(meshes) == 2 and len(axes) == 4
-        for mesh in meshes:  # a sphere of radius 1.2 (point 1): both stretches 1.2 at every node
-            assert np.allclose(mesh.get_array(), STRETCHES[1], rtol=1e-12)
+        for mesh in meshes:  # a sphere of radius 1.5 (the last point): both stretches 1.5 at every node
+            assert np.allclose(mesh.get_array(), STRETCHES[-1], rtol=1e-12)
     else:  # the axisymmetric kinds draw the primary branch only
         assert axes and not any("m = 1" in t.get_text() for leg in fig.legends for t in leg.get_texts())
 

@@ -742,7 +742,7 @@ SURFACE_SAMPLES = (61, 121)  # (θ, φ) values of the drawn surface, poles and b
 def surface_state(sources, points, branch: str | None, what: str) -> tuple:
     """(StoredBranch, point index) of the state the surface kinds draw: point ``points[0]`` (one index, or one
     Configuration naming its branch) of the surface branch ``branch`` (default: the first surface branch of the
-    file), by default the first point past its start (point 1)."""
+    file), by default its last point (the state the branch reaches: where it stops or rejoins)."""
     if len(sources) != 1:
         raise PlotError(f"{what} draws one state of one run file (got {len(sources)} files)")
     if named_points(points):
@@ -761,7 +761,7 @@ def surface_state(sources, points, branch: str | None, what: str) -> tuple:
     if points is not None and np.ndim(points) == 1 and len(points) > 1:
         raise PlotError(f"{what} draws one state: give one point (got {len(points)})")
     n = len(stored.data["pressure"])
-    index = int(select_points(stored.data, points)[0]) if points is not None else min(1, n - 1)
+    index = int(select_points(stored.data, points)[0]) if points is not None else n - 1
     return stored, index
 
 
