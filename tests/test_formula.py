@@ -248,3 +248,15 @@ def test_shear_coefficient_of_a_formula_with_logarithms():
         else:
             exact = float(divided.subs({e1: sp.Float(l1, 40) ** 2, e2: sp.Float(l2, 40) ** 2}).evalf(40))
         assert kernels.call("shear_coefficient", {"lam1": l1, "lam2": l2})[0] == pytest.approx(exact, rel=1e-13)
+
+
+def test_a_family_whose_committed_formula_is_stale_is_refused(monkeypatch):
+    """The scene layer's family formula and its committed class must be the same text: otherwise `make regenerate`
+    is asked for (never a quiet on-demand class in its place)."""
+    from balloon_cg import generated
+    from balloon_cg.model.kernels import KernelSet
+
+    stale = {**generated.ENERGY_CLASSES, "gent": ("an older formula", generated.ENERGY_CLASSES["gent"][1])}
+    monkeypatch.setattr(generated, "ENERGY_CLASSES", stale)
+    with pytest.raises(ImportError, match="make regenerate"):
+        KernelSet(ENERGY_PRESETS["Gent"])

@@ -3,11 +3,11 @@
 
 At a located BP of block m<m>_held the critical mode is the eigenvector of the held m-block whose eigenvalue is
 zero there (``azimuthal``, its zero modes removed; not always the lowest: at a later crossing of the block the
-lowest is already negative), δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. The branch it starts
-keeps the symmetry of that mode: the mirror y → −y always, the rotation by π about the axis for an even m, and on
-an equator-symmetric state the reflection z → −z (a mode even in z) or, for an odd m, the inversion x → −x (a mode
-odd in z, which rotation by π about the axis maps to −itself); it is solved in that invariant subspace of degree L (``surface.degree``), with the balloon's centre
-held and the relabelling modes removed (``surface.gauge``).
+lowest is already negative), δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. The branch it starts keeps the
+symmetry of that mode: the mirror y → −y always, the rotation by π about the axis for an even m, and on an
+equator-symmetric state the reflection z → −z (a mode even in z) or, for an odd m, the inversion x → −x (a mode
+odd in z, which rotation by π about the axis maps to −itself); it is solved in that invariant subspace of degree L
+(``surface.degree``), with the balloon's centre held and the relabelling modes removed (``surface.gauge``).
 
 Point 0 is the BP state solved on the whole sphere at P* within its axisymmetric family (``axisymmetric_solve``:
 regular there, where the subspace's Jacobian is singular). Switching: from (c*, P*) the predictor c* + δφ (φ the
@@ -53,8 +53,8 @@ from .surface_resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
 CRITICAL_SEARCH = 4  # the eigenvalues of the BP's block among which the critical (nearest zero) one is taken
-SWITCH_REACH, SWITCH_TRIES = 4.0, 3
-CLASSIFY_TRIES = 3  # halvings of the classification's amplitude δ before it gives up  # how far from the branch point (in steps) the first point may land; tries
+SWITCH_REACH, SWITCH_TRIES = 4.0, 3  # how far from the branch point (in steps) the first point may land; tries
+CLASSIFY_TRIES = 3  # halvings of the classification's amplitude δ before it gives up
 
 
 class SurfaceStartError(ArithmeticError):

@@ -463,12 +463,13 @@ def _read_open(f, label) -> dict:
             raise RunFileError(label, f"{len(f.attrs['phase_names'])} phase_names but "
                                       f"{len(f.attrs['phase_seconds'])} phase_seconds")
     attrs = {k: _attr(v) for k, v in f.attrs.items()}
+    branches = require_group(f, "branches", label, RunFileError)
     # every run writes its primary branch (a curve file, a run file with /two_parameter curves, has none)
-    if "primary" not in require_group(f, "branches", label, RunFileError) and not len(f.get("two_parameter", {})):
-        raise RunFileError(label, "missing branch primary (branches: "
-                                  f"{', '.join(f['branches']) or 'none'}): not a whole run file")
+    if "primary" not in branches and not len(f.get("two_parameter", {})):
+        raise RunFileError(label, f"missing branch primary (branches: {', '.join(branches) or 'none'}): not a whole "
+                                  "run file")
     if plain(fmt) == FORMAT:  # the current format always writes them (older ones may lack them: OPTIONAL_COLUMNS)
-        for name, branch in require_group(f, "branches", label, RunFileError).items():
+        for name, branch in branches.items():
             missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
             if missing:
                 raise RunFileError(f"{label}: branch {name}", f"missing dataset {missing[0]}")

@@ -81,8 +81,13 @@ def class_source(material, terms: tuple = PLAIN, kernel_class: str | None = None
     if isinstance(material, StrainEnergy):
         if kernel_class is not None:
             raise SceneError(f"kernel class {kernel_class!r}: only Ogden materials choose a kernel class")
-        name = committed_class(generated.ENERGY_CLASSES, material.formula.text, terms) \
-            if material.family is not None else None
+        if material.family is None:
+            return None, material.formula
+        formula, _ = generated.ENERGY_CLASSES[material.family]
+        if formula != material.formula.text:
+            raise ImportError(f"generated/{material.family}.py is for the formula {formula!r}, the scene layer's "
+                              f"family {material.family} is {material.formula.text!r}: run `make regenerate`")
+        name = committed_class(generated.ENERGY_CLASSES, formula, terms)
         return (name, None) if name is not None else (None, material.formula)
     if kernel_class is not None:
         if kernel_class not in generated.CLASSES:
