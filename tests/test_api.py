@@ -65,10 +65,49 @@ def test_save_load_round_trip_is_exact(result, tmp_path):
         result.save(path)
 
 
-def test_reprs_are_short(result):
-    assert len(repr(result)) < 300 and len(repr(result.picture)) < 300 and len(repr(result.scene)) < 1000
-    assert all(len(repr(b)) < 200 for b in result.branches.values())
-    assert all(len(repr(s)) < 200 for b in result.picture.branches for s in b.special)
+def test_reprs_are_one_short_line(result):
+    """Every object a notebook shows prints as one line of at most ~2 × 80 characters (the scene's was 712)."""
+    objects = [result, result.picture, result.scene, result.special_points, *result.branches.values(),
+               *(b.special_points for b in result.branches.values()), *result.picture.branches,
+               *(s for b in result.picture.branches for s in b.special)]
+    for item in objects:
+        text = repr(item)
+        assert "\n" not in text and len(text) <= 160, text
+    assert repr(result.scene) == "Scene('spom1': SPOM1, no field, pressure control, stop_stretch 3)"
+
+
+def test_results_show_as_html_tables(result):
+    """Result: a row per branch; a branch: its row and its special points; special points: a row each."""
+    html = result._repr_html_()
+    assert html.count("<table") == 1 and html.count("<tr") == 1 + len(result.branches)
+    assert all(f"<td>{name}</td>" in html for name in result.branches)
+    primary = result.branches["primary"]._repr_html_()
+    assert primary.count("<table") == 2 and "<td>BP</td>" in primary
+    special = result.special_points._repr_html_()
+    assert special.count("<tr") == 1 + len(result.special_points) and "<th>kind</th>" in special
+
+
+def test_special_points_are_one_table(result, tmp_path):
+    """One row per special point, in Python and in the file: special_points opens with xarray as a table of the
+    special points alone (its X rows in special_points/state: issue 29 found 9 points expanded into 828 rows)."""
+    xr = pytest.importorskip("xarray")
+    points = result.special_points
+    table = points.to_dataframe()
+    assert len(table) == len(points) == sum(len(b.special_points) for b in result.branches.values()) > 3
+    assert list(table.columns[:3]) == ["branch", "kind", "classification"]
+    assert table.kind.tolist() == [p["kind"] for p in points] and isinstance(points[0], dict)
+    ds = points.to_xarray()
+    assert dict(ds.sizes) == {"special": len(points)} and ds.pressure.attrs["units"] == "1"
+    path = result.save(tmp_path / "r.h5")
+    stored = read_run(path)["branches"]["primary"]
+    with xr.open_dataset(path, engine="h5netcdf", group="branches/primary/special_points") as ds:
+        assert dict(ds.sizes) == {"special": len(stored["special_points"])}
+        assert len(ds.to_dataframe()) == len(stored["special_points"])
+        assert ds.kind.values.tolist() == [p["kind"] for p in stored["special_points"]]
+    with xr.open_dataset(path, engine="h5netcdf", group="branches/primary/special_points/state") as ds:
+        assert ds.unknowns.dims == ("special", "unknown")
+        assert np.array_equal(ds.unknowns.values, stored["special_unknowns"])
+    assert dict(result.to_xarray("primary", "special").sizes) == {"special": len(stored["special_points"])}
 
 
 def test_bad_plot_arguments_are_plot_errors(result):

@@ -52,7 +52,7 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["scene_name"] == "small"
     assert summary["provenance"]["command"] == f"balloon-cg run {scene_file} -o {out}"
-    assert summary["provenance"]["format"] == "balloon-cg/4"
+    assert summary["provenance"]["format"] == "balloon-cg/5"
     branch = summary["branches"]["primary"]
     # SPOM1 up to stretch 2: the fold in P and the first pear pitchfork (λ = 1.6799), its pear branches
     assert [s["kind"] for s in branch["special_points"]] == ["EP", "LP", "BP", "EP"]

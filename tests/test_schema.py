@@ -89,3 +89,20 @@ def test_cf_global_attributes(run_file):
     with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary") as ds:
         assert ds.pressure.attrs["units"] == "1" and "units" not in ds.point.attrs
         assert "units" not in ds.converged.attrs and "units" not in ds.newton_iterations.attrs
+
+
+def test_format4_special_points_still_read(run_file, tmp_path):
+    """A balloon-cg/4 file kept each special point's X rows among the columns (special_points/unknowns): it reads
+    as the file it was made from."""
+    old = tmp_path / "format4.h5"
+    old.write_bytes(Path(run_file).read_bytes())
+    with h5py.File(old, "r+") as f:
+        f.attrs["format"] = "balloon-cg/4"
+        for branch in f["branches"].values():
+            branch["special_points"].move("state/unknowns", "unknowns")
+            del branch["special_points/state"]
+    now, then = read_run(run_file)["branches"], read_run(old)["branches"]
+    assert FORMAT == "balloon-cg/5" and list(now) == list(then)
+    for name in now:
+        assert np.array_equal(now[name]["special_unknowns"], then[name]["special_unknowns"])
+        assert repr(now[name]["special_points"]) == repr(then[name]["special_points"])  # NaN E2..E4 read alike

@@ -57,7 +57,7 @@ def test_round_trip(run_file, scene, branch):
     run = read_run(run_file)
     attrs = run["attrs"]
     assert run["scene_name"] == scene.name == attrs["scene_name"]
-    assert attrs["format"] == "balloon-cg/4"
+    assert attrs["format"] == "balloon-cg/5"
     assert attrs["scene_toml"] == scene.text
     assert attrs["package_version"] == balloon_cg.__version__
     assert attrs["generated_digest"] == generated_digest()

@@ -95,8 +95,9 @@ class Picture:
         return self.branches[0]
 
     def __repr__(self):
-        branches = ", ".join(f"{b.name} ({len(b.X)} points)" for b in self.branches)
-        return (f"Picture({branches}; {len(self.branch_points)} branch points, {len(self.snaps)} snap-throughs, "
+        n, surface = len(self.branches), len(self.surface_branches)
+        return (f"Picture({n} branch{'es' * (n != 1)} ({sum(len(b.X) for b in self.branches)} points), {surface} "
+                f"surface, {len(self.branch_points)} branch points, {len(self.snaps)} snap-throughs, "
                 f"{'complete' if not self.incomplete else f'{len(self.incomplete)} incomplete parts'})")
 
     @property

@@ -174,6 +174,11 @@ class Leg:
     stop: Stop
 
 
+def stop_codes(legs) -> str:
+    """Each leg's label and stop code, for one-line reprs ('up min_stretch, down stop_stretch')."""
+    return ", ".join(f"{leg.label} {leg.stop.code.value}" for leg in legs)
+
+
 @dataclass
 class Branch:
     """A traced branch: unknowns u and pressure P per point (all converged), solver records, special points,
@@ -251,7 +256,7 @@ class Branch:
     def __repr__(self):
         return (f"Branch({self.name!r}, {len(self.X)} points, degree {self.disc.degree}, "
                 f"P {self.pressure.min():.4g}..{self.pressure.max():.4g}, "
-                f"special {' '.join(s.kind.value for s in self.special)}, stop {self.stop_reason!r})")
+                f"special {' '.join(s.kind.value for s in self.special)}, stops {stop_codes(self.legs)})")
 
 
 @dataclass
@@ -298,4 +303,4 @@ class SurfaceBranch:
 
     def __repr__(self):
         return (f"SurfaceBranch({self.name!r}, m = {self.m}, {len(self.values)} points, degree {self.basis.degree}, "
-                f"P {self.pressure.min():.4g}..{self.pressure.max():.4g}, stop {self.stop_reason!r})")
+                f"P {self.pressure.min():.4g}..{self.pressure.max():.4g}, stops {stop_codes(self.legs)})")

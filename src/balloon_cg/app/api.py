@@ -11,7 +11,6 @@ when it was computed in this process, the analysis objects (``picture``: branche
 Tables come from the same content: ``to_dataframe`` (pandas) and ``to_xarray`` (xarray; named dimensions and
 units, read from the file image through h5netcdf), both from the optional extra ``balloon-cg[analysis]``.
 """
-import importlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,15 +24,7 @@ from ..io.run_file import RunFileError, read_run, read_run_image, run_image
 from ..numerics.interrupt import stop_on_signals
 from ..scene import Scene, SceneError, load_scene, parse_scene
 from .progress import PhaseBars
-
-EXTRA = "pip install 'balloon-cg[analysis]'"
-
-
-def _optional(module: str, what: str):
-    try:
-        return importlib.import_module(module)
-    except ImportError:
-        raise ImportError(f"{what} needs {module}, which is not installed: {EXTRA}") from None
+from .tables import SpecialPoints, counted, html_table, optional
 
 
 @dataclass(frozen=True, repr=False)
@@ -57,8 +48,9 @@ class BranchData:
         return self.data["attrs"]
 
     @property
-    def special_points(self) -> list[dict]:
-        return self.data["special_points"]
+    def special_points(self) -> SpecialPoints:
+        """The branch's special points, one table (app.tables.SpecialPoints: a dict per point)."""
+        return SpecialPoints(self.data["special_points"])
 
     @property
     def m(self) -> int:
@@ -85,13 +77,26 @@ class BranchData:
 
     def to_dataframe(self):
         """A pandas DataFrame, one row per point (index ``point``)."""
-        pd = _optional("pandas", "to_dataframe")
+        pd = optional("pandas", "to_dataframe")
         return pd.DataFrame(self.columns()).rename_axis("point")
 
-    def __repr__(self):
+    def summary(self) -> dict:
+        """One row about the branch: name, m, points, the ranges of P and λ2(0), its special points, its parent."""
         P, north = self.data["pressure"], self.data["lam2_north"]
-        return (f"BranchData({self.name!r}, {len(self)} points, P {P.min():.4g}..{P.max():.4g}, "
-                f"λ2(0) {north.min():.4g}..{north.max():.4g}, {len(self.special_points)} special points)")
+        parent = self.parent
+        return {"branch": self.name, "m": self.m, "points": len(self), "P min": P.min(), "P max": P.max(),
+                "λ2(0) min": north.min(), "λ2(0) max": north.max(),
+                "special points": " ".join(s["kind"] for s in self.data["special_points"]),
+                "parent": f"{parent[0]} BP {parent[1]}" if parent else ""}
+
+    def __repr__(self):
+        P, north, special = self.data["pressure"], self.data["lam2_north"], len(self.data["special_points"])
+        return (f"BranchData({self.name!r}, {counted(len(self), 'point')}, P {P.min():.4g}..{P.max():.4g}, "
+                f"λ2(0) {north.min():.4g}..{north.max():.4g}, {counted(special, 'special point')})")
+
+    def _repr_html_(self):
+        head = html_table([self.summary()], repr(self))
+        return head and head + (self.special_points._repr_html_() if self.data["special_points"] else "")
 
 
 @dataclass(frozen=True, repr=False)
@@ -118,9 +123,11 @@ class Result:
         return {name: BranchData(name, data) for name, data in self.run["branches"].items()}
 
     @property
-    def special_points(self) -> list[dict]:
-        """Every special point of every branch (dicts of the stored columns, with 'branch')."""
-        return [{"branch": name, **s} for name, b in self.run["branches"].items() for s in b["special_points"]]
+    def special_points(self) -> SpecialPoints:
+        """Every special point of every branch as one table (app.tables.SpecialPoints: a dict of the stored
+        columns per point, with 'branch'; ``.to_dataframe()``, ``.to_xarray()``)."""
+        return SpecialPoints({"branch": name, **s} for name, b in self.run["branches"].items()
+                             for s in b["special_points"])
 
     @property
     def snap_throughs(self) -> list[dict]:
@@ -147,9 +154,9 @@ class Result:
         """A pandas DataFrame: ``"points"``, one row per point of every branch (columns branch, m (0:
         axisymmetric, m ≥ 1: a surface branch), point, then the per-point columns; a column a branch does not
         have is NaN in its rows), or ``"special"``, one row per special point."""
-        pd = _optional("pandas", "to_dataframe")
+        pd = optional("pandas", "to_dataframe")
         if table == "special":
-            return pd.DataFrame(self.special_points)
+            return self.special_points.to_dataframe()
         if table != "points":
             raise ValueError(f"table = {table!r}: must be 'points' or 'special'")
         frames = [b.to_dataframe().reset_index().assign(branch=name, m=b.m) for name, b in self.branches.items()]
@@ -163,8 +170,8 @@ class Result:
         ``"points"`` (dims point, unknown, theta: the per-point columns, profiles and stability; a surface
         branch: point, coefficient, axis, eigenvalue) or
         ``"special"`` (dim special)."""
-        _optional("h5netcdf", "to_xarray")
-        xr = _optional("xarray", "to_xarray")
+        optional("h5netcdf", "to_xarray")
+        xr = optional("xarray", "to_xarray")
         if branch not in self.run["branches"]:
             raise KeyError(f"no branch {branch!r} (branches: {', '.join(self.run['branches'])})")
         data = self.run["branches"][branch]
@@ -186,11 +193,16 @@ class Result:
             raise FileExistsError(e.errno, "already exists (save(..., force=True) replaces it)", e.filename) from None
 
     def __repr__(self):
-        branches = ", ".join(f"{name} ({len(b['pressure'])} points)" for name, b in self.run["branches"].items())
+        branches = self.run["branches"]
+        points = sum(len(b["pressure"]) for b in branches.values())
         n = len(self.incomplete)
-        state = "complete" if self.complete else f"incomplete: {n} part{'s' * (n != 1)}"
-        return (f"Result({self.scene.name!r}: {branches}; {len(self.special_points)} special points, "
-                f"{len(self.snap_throughs)} snap-throughs; {state})")
+        state = "complete" if self.complete else f"incomplete: {counted(n, 'part')}"
+        return (f"Result({self.scene.name!r}: {counted(len(branches), 'branch', 'branches')}, "
+                f"{counted(points, 'point')}, {counted(len(self.special_points), 'special point')}, "
+                f"{counted(len(self.snap_throughs), 'snap-through')}; {state})")
+
+    def _repr_html_(self):
+        return html_table([b.summary() for b in self.branches.values()], repr(self))
 
 
 def _scene(scene) -> Scene:

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..io.curve_file import read_curve
 from ..io.layout import reading
-from .api import _optional
+from .tables import optional
 
 COLUMNS = ("pressure", "lam2_north", "lam2_south", "newton_iterations", "residual")
 
@@ -41,7 +41,7 @@ class CurveResult:
 
     def to_dataframe(self):
         """A pandas DataFrame, one row per point of every curve (module docstring)."""
-        pd = _optional("pandas", "to_dataframe")
+        pd = optional("pandas", "to_dataframe")
         frames = [pd.DataFrame({"curve": name, c["attrs"]["parameter"]: c["q"]} | {k: c[k] for k in COLUMNS})
                   for name, c in self.curves.items()]
         return pd.concat(frames, ignore_index=True).rename_axis("point")

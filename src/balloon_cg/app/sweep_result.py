@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from ..io.sweep_file import read_sweep
-from .api import BranchData, _optional
+from .api import BranchData
+from .tables import optional
 
 PEAR_BLOCK = "odd_held"  # the pear-shaped (m = 0, odd) instability of a held balloon
 
@@ -38,8 +39,8 @@ class SweepMember:
     def to_xarray(self, branch: str = "primary", group: str = ""):
         """The xarray Dataset of one stored group of a branch (``group``: '', 'profiles', 'stability',
         'special_points'), with its named dimensions and units."""
-        _optional("h5netcdf", "to_xarray")
-        xr = _optional("xarray", "to_xarray")
+        optional("h5netcdf", "to_xarray")
+        xr = optional("xarray", "to_xarray")
         if branch not in self.branches:
             raise KeyError(f"member {self.index}: no branch {branch!r} (branches: {', '.join(self.branches)})")
         where = "/".join(filter(None, ("members", str(self.index), "branches", branch, group)))
@@ -87,13 +88,13 @@ class SweepResult:
 
     def to_dataframe(self):
         """A pandas DataFrame, one row per member (module docstring)."""
-        pd = _optional("pandas", "to_dataframe")
+        pd = optional("pandas", "to_dataframe")
         return pd.DataFrame([m.row() for m in self.members.values()],
                             index=pd.Index(list(self.members), name="member"))
 
     def to_xarray(self):
         """``to_dataframe`` as an xarray Dataset along ``member``."""
-        _optional("xarray", "to_xarray")
+        optional("xarray", "to_xarray")
         return self.to_dataframe().to_xarray()
 
     def __repr__(self):

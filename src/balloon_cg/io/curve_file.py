@@ -10,7 +10,7 @@ Layout::
         q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
-                        the verified merge of the two pitchforks), unknowns in the branch layout (u, P), and q
+                        the verified merge of the two pitchforks), and q; state/unknowns in the branch layout (u, P)
 
 ``end`` is the curve's ``analysis.codim2.CurveEnd`` (how it ended: isola_merge, fold, nonpositive_pressure, wire,
 budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is partial); ``end_description``
@@ -26,7 +26,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, plain
 from .layout import FileError, check_columns, check_sizes, reading, require_attrs, require_group
-from .run_file import SPECIAL_COLUMNS, legendre_poles, read_run, read_special, root_attrs, write_special
+from .run_file import check_special, legendre_poles, read_run, read_special, root_attrs, write_special
 from .schema import attach_dimensions, describe, scale
 
 
@@ -92,7 +92,8 @@ def read_curve(path, name: str = "pear") -> dict:
         check_columns(group, where, CURVE_COLUMNS, CurveFileError)
         check_sizes(group, where, CurveFileError)
         special = require_group(group, "special_points", where, CurveFileError)
-        check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS | {"q": ("float", 1)}, CurveFileError)
+        check_special(special, f"{where}: special_points", group["unknowns"].shape[1], CurveFileError,
+                      {"q": ("float", 1)})
         data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}
         data["special_points"] = read_special(special)

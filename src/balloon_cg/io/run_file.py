@@ -1,4 +1,4 @@
-"""Run files (HDF5, format "balloon-cg/4"): traced branches with their provenance.
+"""Run files (HDF5, format "balloon-cg/5"): traced branches with their provenance.
 
 Layout::
 
@@ -27,7 +27,7 @@ Layout::
         special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, status (located, approximate),
                        reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
                        lam2_north, lam2_south, eta_north, eta_south                          (special,)
-        special_points/unknowns                            (special, unknown)
+        special_points/state/unknowns                      (special, unknown): each point's own X
         stability/stable_*                                 (point,) flags
         stability/lowest_<block>                           (point, eigenvalue): lowest eigenvalues
     /branches/<name>/      a surface branch (analysis.results.SurfaceBranch, m ≥ 1): attrs order, m, parent_branch,
@@ -41,7 +41,7 @@ Layout::
         converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
         centroid                                           (point, axis)
         coefficients                                       (point, coefficient)
-        special_points/ as above, unknowns (special, unknown): the coefficients c, then P (or Φ̄)
+        special_points/ as above, state/unknowns (special, unknown): the coefficients c, then P (or Φ̄)
         stability/lowest_<reading> (point, eigenvalue) for the readings held, free, held_volume, free_volume,
                            held_gas, free_gas; stable_pressure, stable_pressure_free, stable_volume, … (point,)
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
@@ -50,8 +50,10 @@ Every dataset carries ``long_name`` and ``description``, and a quantity its ``un
 are netCDF-4 dimensions (HDF5 dimension scales), so ``xarray.open_dataset(path, engine="h5netcdf", group=...)``
 names them.
 A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index + 1``; its own X is in
-special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous formats
-still read: "balloon-cg/3" (no ``m`` attribute, no surface branches: every branch reads as m = 0) and
+special_points/state/unknowns, a group of its own so that special_points opens (xarray) as a table of one row per
+special point. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous formats still read:
+"balloon-cg/4" (the X rows in special_points/unknowns), "balloon-cg/3" (no ``m`` attribute, no surface branches:
+every branch reads as m = 0) and
 "balloon-cg/2" (no volume, no dimension scales), and so do files without amount, control or the gas stability
 flags (written before gas control).
 """
@@ -66,8 +68,8 @@ from .hdf5 import atomic_file, plain, provenance, write_strings
 from .layout import FileError, check_columns, check_sizes, opened, reading, require_attrs, require_group
 from .schema import attach_dimensions, scale
 
-FORMAT = "balloon-cg/4"
-READABLE = (FORMAT, "balloon-cg/3", "balloon-cg/2")
+FORMAT = "balloon-cg/5"
+READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
 SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
 SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
@@ -424,9 +426,11 @@ def write_special(group, special: list, width: int, poles, unknown=None, paramet
     pole_values = poles(X)
     for name in POLES:
         group.create_dataset(name, data=pole_values[name])
-    group.create_dataset("unknowns", data=X)
     special_scale = scale(group, "special", len(special))
-    attach_dimensions(group, {1: (special_scale,), 2: (special_scale, unknown or scale(group, "unknown", width))})
+    attach_dimensions(group, {1: (special_scale,)})
+    state = group.create_group("state")  # the 2-D rows apart: special_points stays a table of one row per point
+    state.create_dataset("unknowns", data=X)
+    attach_dimensions(state, {2: (special_scale, unknown or scale(state, "unknown", width))})
 
 
 def read_run(path) -> dict:
@@ -436,7 +440,7 @@ def read_run(path) -> dict:
     arrays), 'special_points' (list of dicts: the special_points columns) and 'special_unknowns'
     (their X rows). The layout is checked first (``io.layout``).
     Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a readable run file
-    (format balloon-cg/3 or /2), naming the file and what is missing or wrong.
+    (format balloon-cg/5 or an earlier one of READABLE), naming the file and what is missing or wrong.
     """
     path = Path(path)
     with opened(path, RunFileError) as f:
@@ -468,7 +472,7 @@ def _read_open(f, label) -> dict:
     if "primary" not in branches and not len(f.get("two_parameter", {})):
         raise RunFileError(label, f"missing branch primary (branches: {', '.join(branches) or 'none'}): not a whole "
                                   "run file")
-    if plain(fmt) == FORMAT:  # the current format always writes them (older ones may lack them: OPTIONAL_COLUMNS)
+    if plain(fmt) in READABLE[:2]:  # written by /4 and /5 always (older ones may lack them: OPTIONAL_COLUMNS)
         for name, branch in branches.items():
             missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
             if missing:
@@ -498,7 +502,7 @@ BRANCH_COLUMNS = {**{name: ("float", 1) for name in ("pressure", *POLES, "lam1_e
                   "unknowns": ("float", 2)}
 PROFILES = {name: ("float", 2) for name in ("lam1", "lam2", "rho", "eta")}
 SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int", 1), "m": ("int", 1),
-                   **{name: ("float", 1) for name in SPECIAL_NUMBERS}, "unknowns": ("float", 2)}
+                   **{name: ("float", 1) for name in SPECIAL_NUMBERS}}
 OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage")}  # absent in older formats
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
@@ -555,20 +559,34 @@ def check_branch(group, where, error) -> None:
     for name, item in group["profiles"].items():
         if item.shape[1:] != (t,):
             raise error(f"{where}: profiles", f"dataset {name} has shape {item.shape}, expected ({n}, {t})")
-    special = require_group(group, "special_points", where, error)
-    check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
-    check_columns(special, f"{where}: special_points", {k: ("float", 1) for k in ("voltage",) if k in special}, error,
-                  rows=special["kind"].shape[0])
-    check_sizes(special, f"{where}: special_points", error)
-    if special["unknowns"].shape[1:] != (width,) and special["unknowns"].shape[0]:
-        raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
-                                                f"expected {width}")
+    check_special(require_group(group, "special_points", where, error), f"{where}: special_points", width, error)
     if "stability" in group:
         stability = require_group(group, "stability", where, error)
         flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
         lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
         check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
         check_sizes(stability, f"{where}: stability", error)
+
+
+def check_special(group, where, width: int, error, extra: dict | None = None) -> None:
+    """The columns of a special_points group (SPECIAL_COLUMNS, [voltage], ``extra``) and its X rows
+    (``special_unknowns``) ``width`` wide, one per special point."""
+    n = check_columns(group, where, SPECIAL_COLUMNS | (extra or {}), error)
+    check_columns(group, where, {k: ("float", 1) for k in ("voltage",) if k in group}, error, rows=n)
+    check_sizes(group, where, error)
+    unknowns = special_unknowns(group, where, error, rows=n)
+    if n and unknowns.shape[1] != width:
+        raise error(where, f"unknowns has {unknowns.shape[1]} columns, expected {width}")
+
+
+def special_unknowns(group, where="", error=FileError, rows: int | None = None):
+    """The X rows of a special_points group: its ``state/unknowns`` (format balloon-cg/5), or its ``unknowns``
+    (balloon-cg/4 and older, where the 2-D rows sat among the columns); checked 2-d float, ``rows`` long."""
+    holder = group if "unknowns" in group and "state" not in group else require_group(group, "state", where, error)
+    label = where if holder is group else f"{where}/state"
+    check_columns(holder, label, {"unknowns": ("float", 2)}, error, rows=rows)
+    check_sizes(holder, label, error)
+    return holder["unknowns"]
 
 
 def branch_m(group, where, error) -> int:
@@ -599,14 +617,7 @@ def check_surface_branch(group, where, error) -> None:
                            "of the basis its attributes describe)")
     if group["centroid"].shape[1] != 3:
         raise error(where, f"centroid has shape {group['centroid'].shape}, expected ({n}, 3)")
-    special = require_group(group, "special_points", where, error)
-    check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
-    check_columns(special, f"{where}: special_points", {k: ("float", 1) for k in ("voltage",) if k in special}, error,
-                  rows=special["kind"].shape[0])
-    check_sizes(special, f"{where}: special_points", error)
-    if special["unknowns"].shape[0] and special["unknowns"].shape[1] != size + 1:
-        raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
-                                                f"expected {size + 1}")
+    check_special(require_group(group, "special_points", where, error), f"{where}: special_points", size + 1, error)
     if "stability" in group:
         stability = require_group(group, "stability", where, error)
         flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
@@ -652,7 +663,7 @@ def _read_branch(group) -> dict:
         data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]
     data["special_points"] = read_special(sp)
-    data["special_unknowns"] = sp["unknowns"][()]
+    data["special_unknowns"] = special_unknowns(sp)[()]
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
     return data

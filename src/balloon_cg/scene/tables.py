@@ -238,6 +238,18 @@ class Scene:
             **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
         }
 
+    def __repr__(self):
+        """One line: the name, the material, the coils and M, the loading and where the continuation stops
+        (``to_toml()`` holds everything)."""
+        c, coils = self.continuation, len(self.field.coils)
+        field = f"{coils} coil{'s' * (coils != 1)}, M = {self.field.M:g}" if coils else "no field"
+        voltage = "" if self.electric is None else f", voltage {self.electric.voltage:g}"
+        stop = f"stop_stretch {c.stop_stretch:g}"
+        if c.parameter == ContinuationParameter.VOLTAGE:
+            stop = "in the voltage" + ("" if c.stop_voltage is None else f" to {c.stop_voltage:g}")
+        return (f"Scene({self.name!r}: {self.material.name}, {field}{voltage}, {self.loading.control.value} control, "
+                f"{stop})")
+
     def to_toml(self) -> str:
         """TOML text of ``to_dict()``; parsing it gives back this scene (apart from ``text``)."""
         return _to_toml(self.to_dict())
