@@ -344,3 +344,4 @@ def test_a_loaded_sweep_is_a_table_of_members(analysed_sweep):
     assert table["complete"].all() and table["P_cr1"].is_monotonic_increasing  # 2.26473, 2.26480, 2.26487
     ds = sweep.to_xarray()
     assert ds.sizes["member"] == 3 and float(ds["P_cr1"][2]) == table.loc[2, "P_cr1"]
+    assert "\n" not in repr(sweep) and len(repr(sweep)) <= 160 and sweep._repr_html_().count("<tr") == 1 + 3

@@ -107,6 +107,7 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     loaded = bc.load(path)  # a curve object named after its parameter
     assert isinstance(loaded, bc.CurveResult) and loaded.parameter == "alpha1"
     assert loaded.critical == {"pear": curve.critical[0]} and "critical alpha1 = " in repr(loaded)
+    assert "<th>critical alpha1</th>" in loaded._repr_html_() and "\n" not in repr(loaded)
     table = loaded.to_dataframe()
     assert list(table.columns[:3]) == ["curve", "alpha1", "pressure"] and len(table) == len(curve.q)
     with h5py.File(path, "r") as f:

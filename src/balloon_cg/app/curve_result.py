@@ -13,7 +13,7 @@ import numpy as np
 
 from ..io.curve_file import read_curve
 from ..io.layout import reading
-from .tables import optional
+from .tables import html_table, optional
 
 COLUMNS = ("pressure", "lam2_north", "lam2_south", "newton_iterations", "residual")
 
@@ -51,3 +51,9 @@ class CurveResult:
                            if np.isfinite(self.critical[name]) else f"{name} ({len(c['q'])} points)"
                            for name, c in self.curves.items())
         return f"CurveResult({Path(self.path).name!r} in {self.parameter}: {curves})"
+
+    def _repr_html_(self):
+        """A row per curve: its points, how it ended, the critical value of the parameter."""
+        return html_table([{"curve": name, "points": len(c["q"]), "end": c["attrs"]["end"],
+                            f"critical {self.parameter}": self.critical[name]} for name, c in self.curves.items()],
+                          repr(self))

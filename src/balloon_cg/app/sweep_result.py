@@ -16,7 +16,7 @@ import numpy as np
 
 from ..io.sweep_file import read_sweep
 from .api import BranchData
-from .tables import optional
+from .tables import html_table, optional
 
 PEAR_BLOCK = "odd_held"  # the pear-shaped (m = 0, odd) instability of a held balloon
 
@@ -101,3 +101,7 @@ class SweepResult:
         done = sum(m.complete for m in self.members.values())
         return (f"SweepResult({Path(self.path).name!r}: {self.attrs.get('scene_name')}, {len(self.members)} of "
                 f"{self.attrs.get('members')} members ({done} complete), mode {self.attrs.get('mode')})")
+
+    def _repr_html_(self):
+        """The table of ``to_dataframe``, a row per member."""
+        return html_table([{"member": index} | m.row() for index, m in self.members.items()], repr(self))
