@@ -4,6 +4,8 @@ import fcntl
 import json
 import os
 import select
+import shutil
+import shlex
 import signal
 import struct
 import subprocess
@@ -56,14 +58,50 @@ def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["run", str(scene), "--set", "continuation.stop_stretch=1.5", "--set", "solver.degree=30",
                  "--primary-only", "--quiet"]) == 0
-    run = read_run(tmp_path / "small_M0.h5")  # numerical keys keep the name
-    assert run["branches"]["primary"]["lam2_north"].max() == pytest.approx(1.5, abs=1e-12)
+    run = read_run(tmp_path / "small_M0_stop_stretch1.5_degree30.h5")  # the scene keeps its name, the file shows all
+    assert run["scene_name"] == "small_M0" and run["branches"]["primary"]["lam2_north"].max() == pytest.approx(1.5,
+                                                                                                            abs=1e-12)
     assert "stop_stretch = 1.5" in run["attrs"]["scene_toml"] and "degree = 30" in run["attrs"]["scene_toml"]
     # --max-points 15 stops the up leg short: written, flagged, exit 1
     assert main(["run", str(scene), "--set", "M=0", "--set", "material.preset=TPOM1", "--max-points", "15",
                  "--primary-only", "--quiet"]) == 1
-    run = read_run(tmp_path / "small_M0_tpom1.h5")  # renamed after the material
+    run = read_run(tmp_path / "small_M0_tpom1_max_points15.h5")  # renamed after the material, named after the limit
     assert len(run["branches"]["primary"]["pressure"]) <= 2 * 15 + 1 and not run["attrs"]["complete"]
+    assert sorted(p.name for p in tmp_path.glob("*.h5")) == ["small_M0_stop_stretch1.5_degree30.h5",
+                                                             "small_M0_tpom1_max_points15.h5"]
+
+
+def test_default_output_names_show_the_settings():
+    from balloon_cg.scene.tables import output_stem
+
+    assert output_stem("spom1", {"continuation.stop_stretch": 3.0}) == "spom1_stop_stretch3"
+    assert output_stem("spom1_M0.002", {"field.M": 0.002, "solver.degree": 60}) == "spom1_M0.002_degree60"
+    assert output_stem("spom1_M0.002", {"field.M": None}) == "spom1_Mdefault"
+    assert output_stem("spom1_tpom1", {"material.preset": "TPOM1", "continuation.symmetry": "none"}) == \
+        "spom1_tpom1_symmetrynone"
+    assert output_stem("spom1", {"material.alpha[1]": 3}) == "spom1_alpha1=3"
+
+
+@pytest.mark.parametrize("command, default", [
+    (["critical", "spom1", "--parameter", "alpha1", "--set", "solver.degree=30"], "spom1_degree30_critical_alpha1.h5"),
+    (["critical", "spom1_single_coil", "--parameter", "field.M"], "spom1_single_coil_critical_M.h5"),
+    (["sweep", "spom1_two_coils_M0.002", "--vary", "M=0:0.003:num=4", "--vary", "field.coils[0].radius=2,3"],
+     "spom1_two_coils_M0.002_sweep_M_radius.h5"),
+    (["figure", "fig9", "--quick"], "fig9.pdf"),
+    (["figure", "all", "--quick"], "paper-figures/fig2.pdf"),
+    (["run", "spom1", "--stop-stretch", "3"], "spom1_stop_stretch3.h5"),
+])
+def test_every_writing_command_has_a_default_output_that_is_never_overwritten(tmp_path, monkeypatch, capsys,
+                                                                              command, default):
+    """-o is optional for run, critical, sweep and figure; the default name is checked by the one rule for outputs
+    before anything is computed: a file already there (here a text file) is refused without --force (exit 2)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / default).parent.mkdir(exist_ok=True)
+    (tmp_path / default).write_text("an earlier result")
+    assert main(command) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and default in err[0] and "already exists (use --force" in err[0], err
+    assert (tmp_path / default).read_text() == "an earlier result"
 
 
 @pytest.mark.parametrize("setting, words", [
@@ -361,6 +399,20 @@ def test_every_subcommand_help_ends_with_examples_that_parse(capsys):
         examples = help_text.split("examples:\n", 1)[1].strip().splitlines()
         assert examples, name
         for example in examples:
-            words = example.split()
+            words = shlex.split(example.split(" > ")[0])  # the command, not where the shell writes its output
             assert words[:2] == ["balloon-cg", name]
             assert build_parser().parse_args(words[1:]).command == name
+
+
+@pytest.mark.skipif(shutil.which("bash") is None, reason="needs bash")
+def test_bash_completion_completes_commands_options_and_choices(tmp_path, capsys):
+    """`balloon-cg completion bash` (shtab) is a script bash sources; its function completes a subcommand, an
+    option of a subcommand and a choice."""
+    assert main(["completion", "bash"]) == 0
+    script = tmp_path / "balloon-cg.bash"
+    script.write_text(capsys.readouterr().out)
+    probe = ("source {script}; complete_line() {{ COMP_WORDS=(\"$@\"); COMP_CWORD=$(($# - 1)); COMPREPLY=(); "
+             "_shtab_balloon_cg; echo \"${{COMPREPLY[*]}}\"; }}; complete_line balloon-cg pl; "
+             "complete_line balloon-cg run --primary; complete_line balloon-cg completion ''").format(script=script)
+    lines = subprocess.run(["bash", "-c", probe], capture_output=True, text=True, check=True).stdout.splitlines()
+    assert lines == ["plot", "--primary-only", "bash zsh tcsh"]

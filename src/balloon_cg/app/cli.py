@@ -25,7 +25,6 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
-from ..io.lock import owned
 from ..io.output import IMAGE_FORMATS
 from ..scene.validation import did_you_mean
 from .kernels_cmd import add_kernels
@@ -144,9 +143,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels,
-                _add_figure):
+                _add_figure, _add_completion):
         add(commands)
     parser.commands = tuple(commands.choices)
+    parser.subcommands = dict(commands.choices)
     for name, subcommand in commands.choices.items():
         subcommand.epilog = EXAMPLES_HEADING + "\n".join(f"  {line}" for line in EXAMPLES[name])
         subcommand.formatter_class = ExamplesFormatter
@@ -161,10 +161,14 @@ EXAMPLES = {  # each subcommand's --help ends with these
     "inspect": ("balloon-cg inspect two_coils.h5", "balloon-cg inspect sweep.h5 --json"),
     "plot": ("balloon-cg plot two_coils.h5 --what pressure-pole,shapes -o p.pdf",
              "balloon-cg plot two_coils.h5 --what pressure-pole --stability volume"),
-    "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:21 -o sweep.h5",),
-    "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",),
+    "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:num=21 -o sweep.h5",
+              "balloon-cg sweep spom1_two_coils_M0.002 --vary 'M=linspace(0, 0.003, 4)' --primary-only --workers 2"),
+    "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",
+                 "balloon-cg critical spom1 --parameter alpha1 --set continuation.stop_stretch=3"),
     "kernels": ("balloon-cg kernels spom1 --json",),
-    "figure": ("balloon-cg figure fig9 -o fig9.pdf --width 3.5", "balloon-cg figure all -o paper-figures"),
+    "figure": ("balloon-cg figure fig9 --width 3.5", "balloon-cg figure all -o paper-figures --width 7.2"),
+    "completion": ("balloon-cg completion bash > ~/.local/share/bash-completion/completions/balloon-cg",
+                   "balloon-cg completion zsh > ~/.zfunc/_balloon-cg"),
 }
 
 
@@ -200,7 +204,7 @@ def _add_run(commands):
                                         "and write a run file")
     p.add_argument("scene", help=SCENE_HELP)
     p.add_argument("-o", "--output", help="run file to write (HDF5; default: SCENE_NAME.h5 in the current folder, "
-                                          "the name after --set changes)")
+                                          "with a token per --set, --unset: SCENE_NAME_stop_stretch3.h5)")
     _add_settings(p)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
@@ -229,14 +233,34 @@ def _add_settings(p, shorthands: bool = True):
 def scene_of(args):
     """The scene file with the command line's --set, --unset and continuation limits applied (renamed after them).
     A key given twice (also as a bare name and dotted, or by --set and its shorthand flag) is refused."""
-    from ..scene import SceneError, load_scene
+    return configured(args)[0]
 
-    scene = load_scene(args.scene)
+
+def configured(args):
+    """(scene, stem): ``scene_of``'s scene and the stem of its default output file, its name with a token for
+    each setting the name does not show (scene.tables.output_stem: ``spom1_stop_stretch3``)."""
+    from ..scene import load_scene
+    from ..scene.tables import output_stem
+
+    scene, overrides = _with_settings(args, load_scene(args.scene))
+    return scene, output_stem(scene.name, overrides)
+
+
+def default_output(given: str | None, stem: str, kind: str) -> str:
+    """``-o`` as given (an HDF5 name: ``hdf5_output``), or STEM.h5 in the current folder. Either way an existing
+    file is replaced only with --force (io.output, the one rule)."""
+    return hdf5_output(given, kind) if given is not None else f"{stem}.h5"
+
+
+def _with_settings(args, scene):
+    """(scene with the settings applied, {canonical key: value (None: --unset)})."""
+    from ..scene import SceneError
+
     shorthands = [f"continuation.{key}={getattr(args, key)}" for key in ("max_points", "stop_stretch", "stop_pressure")
                   if getattr(args, key, None) is not None]
     settings = list(args.settings) + shorthands
     if not settings and not args.unset:
-        return scene
+        return scene, {}
     from .sweep import SweepError, overridden, parse_vary
 
     for text in settings:
@@ -262,7 +286,7 @@ def scene_of(args):
         raise UsageError(str(e).replace("--vary", "--set")) from None
     except SceneError as e:
         raise UsageError(f"--unset {e}") from None
-    return overridden(scene, overrides)
+    return overridden(scene, overrides), overrides
 
 
 def axisymmetric(scene):
@@ -280,8 +304,9 @@ def run(args) -> int:
     from ..numerics.interrupt import requested, stop_on_signals
     from .progress import shown
 
-    scene = axisymmetric(scene_of(args))
-    output = hdf5_output(args.output, "run") if args.output is not None else f"{scene.name}.h5"
+    scene, stem = configured(args)
+    axisymmetric(scene)
+    output = default_output(args.output, stem, "run")
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
@@ -497,8 +522,9 @@ def _add_figure(commands):
     """``figure``: one figure of the paper, or all of them (app.figures, docs/paper.md)."""
     p = commands.add_parser("figure", help=f"draw a figure of the paper, computing its runs ({docs_path('paper.md')})")
     p.add_argument("name", help="fig2 .. fig13, or all (then --output is a folder)")
-    p.add_argument("-o", "--output", required=True,
-                   help=f"image file ({', '.join(IMAGE_FORMATS)}), or the folder for all")
+    p.add_argument("-o", "--output",
+                   help=f"image file ({', '.join(IMAGE_FORMATS)}), or the folder for all (default: NAME.pdf in the "
+                        "current folder; for all, the folder paper-figures)")
     p.add_argument("--runs", metavar="FOLDER", help="where run files are kept and reused (default: OUTPUT's folder/runs)")
     p.add_argument("--width", type=float, default=7.2, metavar="INCHES", help="figure width (3.5 one column, 7.2 two)")
     p.add_argument("--stability", default="pressure", metavar="READING", help="as for plot")
@@ -517,6 +543,35 @@ def _add_figure(commands):
             raise UsageError(str(e)) from None
 
     p.set_defaults(handler=figure)
+
+
+# --- completion --------------------------------------------------------------------------------------------
+
+COMPLETION_SHELLS = ("bash", "zsh", "tcsh")
+PATH_ARGUMENTS = ("scene", "file", "files", "output", "runs")  # completed as file names
+
+
+def _add_completion(commands):
+    p = commands.add_parser("completion", help="print the shell completion script of balloon-cg (shtab)",
+                            description="Print a completion script for the shell: subcommands, options, plot kinds "
+                                        "and file names complete with TAB. bash: save it as "
+                                        "~/.local/share/bash-completion/completions/balloon-cg; zsh: as _balloon-cg "
+                                        "in a folder of $fpath.")
+    p.add_argument("shell", choices=COMPLETION_SHELLS)
+    p.set_defaults(handler=completion)
+
+
+def completion(args) -> int:
+    """The completion script of the whole parser (shtab), the arguments that name files completed as files."""
+    import shtab
+
+    parser = build_parser()
+    for subcommand in parser.subcommands.values():
+        for action in subcommand._actions:
+            if action.dest in PATH_ARGUMENTS:
+                action.complete = shtab.FILE
+    print(shtab.complete(parser, args.shell))
+    return 0
 
 
 # --- critical ----------------------------------------------------------------------------------------------
@@ -540,11 +595,12 @@ def _add_critical(commands):
                                                        "material.parameters.Jm, voltage)")
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="start with the parameter increasing (1, default) or decreasing (-1)")
-    p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
+    p.add_argument("-o", "--output", help="curve file to write (HDF5; plot it with --what phase; default: "
+                                          "SCENE_NAME_critical_PARAMETER.h5 in the current folder, tokens as run's)")
     _add_settings(p)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.set_defaults(handler=owned(critical, "critical"))
+    p.set_defaults(handler=critical)
 
 
 def critical(args) -> int:
@@ -563,6 +619,17 @@ def critical(args) -> int:
     point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is.
     Progress goes to stderr (``--quiet``: none).
     """
+    from ..io.lock import claim
+
+    scene, stem = configured(args)
+    short = re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
+    args.output = default_output(args.output, f"{stem}_critical_{short}", "curve")
+    with claim(args.output, "critical"):  # owned from here: no other process writes it meanwhile
+        return _critical(args, scene)
+
+
+def _critical(args, scene) -> int:
+    """``critical`` on ``scene`` into ``args.output`` (owned)."""
     from ..analysis.codim2 import CurveEnd
     from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
@@ -571,7 +638,6 @@ def critical(args) -> int:
     from ..numerics.interrupt import requested, stop_on_signals
     from ..scene import ContinuationParameter
 
-    scene = scene_of(args)
     asymmetry = _asymmetry(scene)
     if asymmetry:
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
@@ -586,7 +652,7 @@ def critical(args) -> int:
         resolve(scene, args.parameter)
     except UnknownParameter as e:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
-    check_output(hdf5_output(args.output, "curve"), args.force)
+    check_output(args.output, args.force)
     with stop_on_signals():
         curve = _pitchfork_curve(scene, args)
         if curve is not None:
@@ -684,7 +750,8 @@ def _add_sweep(commands):
                         "values, ends included) or KEY=v1,v2,...; KEY a dotted scene key (field.M, "
                         "field.coils[0].radius, material.alpha[0]) or a bare name of one table (M = field.M); "
                         "repeat for a cartesian product")
-    p.add_argument("-o", "--output", required=True, help="sweep file (HDF5) to write or resume")
+    p.add_argument("-o", "--output", help="sweep file (HDF5) to write or resume (default: SCENE_NAME_sweep_KEY.h5 "
+                                          "in the current folder, KEY the last part of each varied key)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="send the members to this dask.distributed scheduler")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="local worker processes (default: all cores; 1: compute in this process; at most the CPU "
@@ -735,8 +802,10 @@ def sweep(args) -> int:
     from ..numerics.interrupt import sigterm_raises
 
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"
-    hdf5_output(args.output, "sweep")
     scene = load_scene(args.scene)
+    varied = "_".join(re.sub(r"[^A-Za-z0-9.+-]+", "", text.partition("=")[0].strip().split(".")[-1])
+                      for text in args.vary)
+    args.output = default_output(args.output, f"{scene.name}_sweep_{varied}", "sweep")
     try:
         with sigterm_raises():
             result = run_sweep(scene, args.vary, args.output, mode=mode, workers=args.workers,

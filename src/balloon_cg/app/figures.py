@@ -19,6 +19,7 @@ from .api import analyse
 from .progress import shown
 
 MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (docs/cli.md)
+ALL_FOLDER = "paper-figures"  # figure all's default output folder (the Makefile's PAPER_OUT)
 
 
 class FigureError(ValueError):
@@ -98,11 +99,13 @@ def make_all(folder, runs=None, width: float = TWO_COLUMNS, reading: Reading = R
 
 
 def command(args) -> int:
-    """``balloon-cg figure NAME|all -o FILE|FOLDER [--width IN] [--stability READING] [--runs FOLDER] [--quick]
+    """``balloon-cg figure NAME|all [-o FILE|FOLDER] [--width IN] [--stability READING] [--runs FOLDER] [--quick]
     [--allow-partial]``: prints the image paths. Exit 1 when a run drawn is incomplete (the figures are still
     written; ``--allow-partial``: 0), as for ``run``."""
     reading = Reading.parse(args.stability)
     progress = shown(args.quiet)
+    if args.output is None:
+        args.output = ALL_FOLDER if args.name == "all" else f"{args.name}.pdf"
     if args.name == "all":
         names = list(figures(args.quick))
         paths = make_all(args.output, args.runs, args.width, reading, args.quick, progress=progress, force=args.force)

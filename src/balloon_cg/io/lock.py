@@ -71,15 +71,6 @@ def claim(path, what: str = "balloon-cg"):
         os.close(fd)
 
 
-def owned(handler, what: str = "balloon-cg"):
-    """``handler(args)`` run while owning ``args.output`` (a command-line handler that writes one file)."""
-    def run(args):
-        with claim(args.output, what):
-            return handler(args)
-
-    return run
-
-
 def debris(path) -> list[Path]:
     """Temporary files of interrupted atomic writes of ``path`` (``.NAME.<hex>.tmp``)."""
     path = Path(path)

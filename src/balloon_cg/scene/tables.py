@@ -309,13 +309,35 @@ def renamed(name: str, overrides: dict[str, object]) -> str:
         if isinstance(value, str):  # a preset or a material name
             name = f"{name}_{re.sub(r'[^A-Za-z0-9.+-]+', '-', value).strip('-').lower()}"
             continue
-        indices = "".join(i for i in re.findall(r"\[(\d+)\]", key) if i != "0")
-        short = re.sub(r"\[\d+\]", "", key.split(".")[-1]) + (f"{indices}=" if indices else "")
-        text = f"{value:g}" if isinstance(value, (int, float)) and not isinstance(value, bool) else str(value)
-        token = re.compile(rf"(^|_){re.escape(short)}-?[0-9][0-9.eE+-]*(?=_|$)")
-        name = token.sub(lambda m: f"{m.group(1)}{short}{text}", name, count=1) if token.search(name) \
-            else f"{name}_{short}{text}"
+        name = _with_token(name, key, value)
     return name
+
+
+def output_stem(name: str, overrides: dict[str, object]) -> str:
+    """The file stem of a scene run with ``overrides`` (the command line's --set and --unset), ``name`` the scene's
+    name (``renamed`` after its physical keys): a ``_<key><value>`` token also for every scalar key the name does
+    not show, numerical keys (``_stop_stretch3``, ``_degree60``) and list entries (``_alpha3``), and
+    ``_<key>default`` for a key restored to its default; a preset or material name is in ``name`` already."""
+    for key, value in overrides.items():
+        physical_text = isinstance(value, str) and key.split(".")[0] in ("field", "material", "loading", "electric")
+        if not physical_text and not isinstance(value, (list, tuple, dict)):
+            name = _with_token(name, key, value)
+    return name
+
+
+def _with_token(name: str, key: str, value) -> str:
+    """``name`` with its ``_<key><value>`` token (key: the last part of the dotted key, with its list index past
+    0) updated, or appended; a value None reads ``default``."""
+    indices = "".join(i for i in re.findall(r"\[(\d+)\]", key) if i != "0")
+    short = re.sub(r"\[\d+\]", "", key.split(".")[-1]) + (f"{indices}=" if indices else "")
+    text = "default" if value is None else str(value)
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        text = f"{value:g}"
+    elif isinstance(value, str):  # a file name's characters
+        text = re.sub(r"[^A-Za-z0-9.+-]+", "-", value).strip("-").lower()
+    token = re.compile(rf"(^|_){re.escape(short)}(-?[0-9][0-9.eE+-]*|default)(?=_|$)")
+    return token.sub(lambda m: f"{m.group(1)}{short}{text}", name, count=1) if token.search(name) \
+        else f"{name}_{short}{text}"
 
 
 def parse_scene(text: str, name: str = "scene") -> Scene:
