@@ -34,3 +34,24 @@ def test_first_use_is_announced_once_and_only_on_a_terminal(monkeypatch):
     monkeypatch.setattr(compile_notice, "compiled_before", lambda m: True)
     compile_notice.announce_first_use(module)  # compiled before: silent
     assert terminal.getvalue().count("\n") == 1
+
+
+def test_first_use_is_announced_in_a_notebook(monkeypatch):
+    """A Jupyter kernel's stderr is no terminal, but the notebook shows it: the notice is written there too (not in
+    plain IPython, whose stderr is the terminal's anyway)."""
+    import sys
+    import types
+
+    module = importlib.import_module("balloon_cg.generated.ogden_tpom1")
+    monkeypatch.setattr(compile_notice, "_announced", set())
+    monkeypatch.setattr(compile_notice, "compiled_before", lambda m: False)
+    kernel = types.SimpleNamespace(config={"IPKernelApp": {"connection_file": "kernel.json"}})
+    monkeypatch.setitem(sys.modules, "IPython", types.SimpleNamespace(get_ipython=lambda: kernel))
+    notebook = io.StringIO()  # ipykernel's stream: not a terminal
+    monkeypatch.setattr("sys.stderr", notebook)
+    compile_notice.announce_first_use(module)
+    assert notebook.getvalue().startswith("balloon-cg: compiling the numba kernels ogden_tpom1 on first use")
+    monkeypatch.setattr(compile_notice, "_announced", set())
+    kernel.config = {"TerminalIPythonApp": {}}
+    compile_notice.announce_first_use(module)
+    assert notebook.getvalue().count("\n") == 1

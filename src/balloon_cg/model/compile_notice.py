@@ -2,8 +2,9 @@
 
 numba's on-disk cache (``cache=True``, NUMBA_CACHE_DIR: balloon_cg/__init__.py) keeps an index file per compiled
 kernel; a module none of whose kernels has one is compiled on first use, which takes tens of seconds with no
-other output. The line is written once per module and process, and only to a terminal (as the progress bars:
-app/progress.py), so logs, pipes and captured output are unchanged.
+other output. The line is written once per module and process, and only where someone watches: a terminal (as the
+progress bars: app/progress.py) or a Jupyter kernel (the notebook shows its stderr), so logs, pipes and captured
+output are unchanged.
 """
 import os
 import sys
@@ -20,9 +21,19 @@ def compiled_before(module) -> bool:
     return any(os.path.exists(k._cache._cache_file._index_path) for k in kernels)
 
 
+def watched() -> bool:
+    """stderr is a terminal, or this process is a Jupyter kernel (IPython's kernel app: how tqdm.auto tells a
+    notebook)."""
+    if sys.stderr.isatty():
+        return True
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    return shell is not None and "IPKernelApp" in shell.config
+
+
 def announce_first_use(module) -> None:
-    """Say on a terminal's stderr that ``module``'s kernels are being compiled, if they never were."""
-    if module.__name__ in _announced or not sys.stderr.isatty():
+    """Say on a terminal's or a notebook's stderr that ``module``'s kernels are being compiled, if they never were."""
+    if module.__name__ in _announced or not watched():
         return
     _announced.add(module.__name__)
     if not compiled_before(module):
