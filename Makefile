@@ -5,7 +5,7 @@ RUN_FLAGS ?=
 PAPER_OUT ?= paper-figures
 PAPER_FLAGS ?=
 
-.PHONY: install install-dev regenerate test run paper bench clean
+.PHONY: install install-dev regenerate api-docs test run paper bench clean
 
 # Editable like install-dev. A regular `pip install .` before or after is fine too: it ships the generated kernels
 # and the scenes, and numba's cache goes to ~/.cache/balloon-cg/numba, never into site-packages
@@ -18,6 +18,10 @@ install-dev:
 
 regenerate:
 	$(PYTHON) -m codegen generated
+
+# docs/api_reference.md from the public API's docstrings (tests/test_api_reference.py fails when it is stale)
+api-docs: install-dev
+	$(PYTHON) benchmarks/api_reference.py
 
 test: install-dev
 	$(PYTHON) -m pytest -q

@@ -37,6 +37,7 @@ _API = {
     "Result": "balloon_cg.app.api", "BranchData": "balloon_cg.app.api", "trace": "balloon_cg.app.api",
     "analyse": "balloon_cg.app.api", "load": "balloon_cg.app.api", "plot": "balloon_cg.app.api",
     "SweepResult": "balloon_cg.app.sweep_result", "CurveResult": "balloon_cg.app.curve_result",
+    "SpecialPoints": "balloon_cg.app.tables",
     "journal_style": "balloon_cg.post.style", "JOURNAL_STYLE": "balloon_cg.post.style",
 }
 __all__ = ["__version__", *_API]

@@ -29,10 +29,18 @@ from .tables import SpecialPoints, counted, html_table, optional
 
 @dataclass(frozen=True, repr=False)
 class BranchData:
-    """One stored branch: ``data`` is its read_run() dict (per-point arrays, 'attrs', 'profiles',
-    'special_points', 'stability'); ``branch['pressure']`` indexes it. A surface branch (``m`` ≥ 1,
-    analysis.results.SurfaceBranch) holds 'coefficients', 'volume', 'centroid', 'tilt' instead of the
-    Legendre unknowns and profiles (docs/hdf5.md)."""
+    """One stored branch of a run (``result.branches[name]``).
+
+    ``data`` is its read_run() dict (per-point arrays, 'attrs', 'profiles', 'special_points', 'stability');
+    ``branch['pressure']`` indexes it and ``len(branch)`` is its number of points. A surface branch (``m`` ≥ 1,
+    analysis.results.SurfaceBranch) holds 'coefficients', 'volume', 'centroid', 'tilt' instead of the Legendre
+    unknowns and profiles (docs/hdf5.md).
+
+    Examples
+    --------
+    >>> primary = result.branches["primary"]
+    >>> primary["pressure"].max(), primary.special_points.kinds()
+    """
 
     name: str
     data: dict
@@ -45,6 +53,7 @@ class BranchData:
 
     @property
     def attrs(self) -> dict:
+        """The branch's stored attributes (docs/hdf5.md: degree, stop_reason, M, m, parent_branch, …)."""
         return self.data["attrs"]
 
     @property
@@ -65,8 +74,14 @@ class BranchData:
         return self.attrs["parent_branch"], int(self.attrs["parent_branch_point"])
 
     def columns(self) -> dict:
-        """The per-point columns: every 1-D per-point dataset, the centroid of a surface branch as centroid_x,
-        centroid_y, centroid_z, and the stability flags."""
+        """The per-point columns.
+
+        Returns
+        -------
+        dict
+            Every 1-D per-point dataset (name -> array), the centroid of a surface branch as centroid_x,
+            centroid_y, centroid_z, and the stability flags stable_*.
+        """
         n = len(self)
         flat = {k: v for k, v in self.data.items()
                 if isinstance(v, np.ndarray) and v.shape == (n,) and k != "point"}
@@ -76,12 +91,29 @@ class BranchData:
         return flat | centroid | flags
 
     def to_dataframe(self):
-        """A pandas DataFrame, one row per point (index ``point``)."""
+        """The branch as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per point (index ``point``), the ``columns``.
+
+        Raises
+        ------
+        ImportError
+            Without pandas (``pip install 'balloon-cg[analysis]'``).
+        """
         pd = optional("pandas", "to_dataframe")
         return pd.DataFrame(self.columns()).rename_axis("point")
 
     def summary(self) -> dict:
-        """One row about the branch: name, m, points, the ranges of P and λ2(0), its special points, its parent."""
+        """One row about the branch (its line in ``Result``'s HTML table).
+
+        Returns
+        -------
+        dict
+            branch, m, points, P min, P max, λ2(0) min, λ2(0) max, the kinds of its special points, its parent.
+        """
         P, north = self.data["pressure"], self.data["lam2_north"]
         parent = self.parent
         return {"branch": self.name, "m": self.m, "points": len(self), "P min": P.min(), "P max": P.max(),
@@ -101,10 +133,19 @@ class BranchData:
 
 @dataclass(frozen=True, repr=False)
 class Result:
-    """A computed or loaded run: ``scene``; ``image``, the bytes of its run file (what ``save`` writes);
-    ``run``, the same content as arrays (io.run_file.read_run's layout); ``picture``, the analysis objects when
-    computed in this process (else None). Tables: ``branches``, ``special_points``, ``to_dataframe``,
-    ``to_xarray``; verdict: ``complete``, ``incomplete``."""
+    """A computed or loaded run: what ``analyse``, ``trace`` and ``load`` return.
+
+    ``scene`` the Scene; ``image`` the bytes of its run file (what ``save`` writes); ``run`` the same content as
+    arrays (io.run_file.read_run's layout); ``picture`` the analysis objects when computed in this process (else
+    None). Tables: ``branches``, ``special_points``, ``to_dataframe``, ``to_xarray``; the verdict:
+    ``complete``, ``incomplete``, ``interrupted``. A notebook shows it as a table of its branches.
+
+    Examples
+    --------
+    >>> result = bc.analyse("spom1")
+    >>> result.to_dataframe().groupby("branch").pressure.max()
+    >>> result.special_points.to_dataframe().query("kind == 'BP'")
+    """
 
     scene: Scene
     image: bytes
@@ -131,6 +172,8 @@ class Result:
 
     @property
     def snap_throughs(self) -> list[dict]:
+        """The snap-throughs under the loading control (dicts: from_branch, from_index, pressure, to_branch,
+        to_index; docs/hdf5.md)."""
         return self.run["snap_throughs"]
 
     @property
@@ -151,9 +194,27 @@ class Result:
         return "interrupted" in self.run["attrs"].get("incomplete_gaps", [])
 
     def to_dataframe(self, table: str = "points"):
-        """A pandas DataFrame: ``"points"``, one row per point of every branch (columns branch, m (0:
-        axisymmetric, m ≥ 1: a surface branch), point, then the per-point columns; a column a branch does not
-        have is NaN in its rows), or ``"special"``, one row per special point."""
+        """The run as one tidy table.
+
+        Parameters
+        ----------
+        table : str, optional
+            ``"points"`` (default): one row per point of every branch, or ``"special"``: one row per special
+            point (``special_points.to_dataframe()``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            For ``"points"``: columns branch, m (0: axisymmetric, m ≥ 1: a surface branch), point, then the
+            per-point columns; a column a branch does not have is NaN in its rows.
+
+        Raises
+        ------
+        ValueError
+            Another ``table``.
+        ImportError
+            Without pandas (``pip install 'balloon-cg[analysis]'``).
+        """
         pd = optional("pandas", "to_dataframe")
         if table == "special":
             return self.special_points.to_dataframe()
@@ -166,10 +227,28 @@ class Result:
         return frame[["branch", "m", *[c for c in frame.columns if c not in ("branch", "m")]]]
 
     def to_xarray(self, branch: str = "primary", part: str = "points"):
-        """An xarray Dataset of one branch, read from the file image with named dimensions and units:
-        ``"points"`` (dims point, unknown, theta: the per-point columns, profiles and stability; a surface
-        branch: point, coefficient, axis, eigenvalue) or
-        ``"special"`` (dim special)."""
+        """One branch as an xarray Dataset, read from the file image with named dimensions and units.
+
+        Parameters
+        ----------
+        branch : str, optional
+            The branch's name (default ``"primary"``).
+        part : str, optional
+            ``"points"`` (default): dims point, unknown, theta (the per-point columns, profiles and stability;
+            a surface branch: point, coefficient, axis, eigenvalue), or ``"special"``: the special points, dim
+            special.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        KeyError
+            No such branch.
+        ValueError
+            Another ``part``.
+        """
         optional("h5netcdf", "to_xarray")
         xr = optional("xarray", "to_xarray")
         if branch not in self.run["branches"]:
@@ -186,7 +265,20 @@ class Result:
         return xr.merge(parts, combine_attrs="override")
 
     def save(self, path, force: bool = False) -> Path:
-        """Write the run file (atomically; an existing file only with ``force``)."""
+        """Write the run file, atomically.
+
+        Parameters
+        ----------
+        path : str or Path
+            The run file to write (HDF5, docs/hdf5.md).
+        force : bool, optional
+            Replace an existing file (default False: FileExistsError).
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
         try:
             return atomic_bytes(path, self.image, force)
         except FileExistsError as e:
@@ -231,8 +323,26 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
 
 
 def trace(scene, progress: bool = False) -> Result:
-    """The primary branch of ``scene`` (a Scene or a TOML path). Ctrl-C (SIGINT) stops it at the next point
-    and returns what is finished, flagged incomplete."""
+    """The primary branch of a scene.
+
+    Ctrl-C (SIGINT) stops it at the next point and returns what is finished, flagged incomplete.
+
+    Parameters
+    ----------
+    scene : Scene or str or Path
+        A Scene, a TOML file, or the name of a shipped scene (``shipped_scenes()``).
+    progress : bool, optional
+        Draw a progress bar (default False).
+
+    Returns
+    -------
+    Result
+        The primary branch alone.
+
+    Examples
+    --------
+    >>> result = bc.trace("spom1")
+    """
     scene = _scene(scene)
     with stop_on_signals():
         branches, snaps, found, _, clock = computed(scene, primary_only=True, progress=progress)
@@ -240,9 +350,31 @@ def trace(scene, progress: bool = False) -> Result:
 
 
 def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
-    """The whole picture of ``scene`` (a Scene or a TOML path): primary branch, stability of every point,
-    branch points located and classified, pear branches (``pear=False``: not traced), snap-throughs
-    (analysis.picture). Ctrl-C (SIGINT) stops at the next point and returns what is finished, flagged."""
+    """The whole picture of a scene.
+
+    The primary branch, the stability of every point, branch points located and classified, pear branches,
+    surface branches, snap-throughs (analysis.picture). Ctrl-C (SIGINT) stops at the next point and returns
+    what is finished, flagged incomplete.
+
+    Parameters
+    ----------
+    scene : Scene or str or Path
+        A Scene, a TOML file, or the name of a shipped scene (``shipped_scenes()``).
+    pear : bool, optional
+        Trace the pear branches (default True).
+    progress : bool, optional
+        One progress bar per phase (default False; a widget in a notebook).
+
+    Returns
+    -------
+    Result
+
+    Examples
+    --------
+    >>> scene = bc.Scene.from_toml("spom1_two_coils_M0.002").with_overrides({"M": 0.001})
+    >>> result = bc.analyse(scene, progress=True)
+    >>> result.save("two_coils_M0.001.h5")
+    """
     scene = _scene(scene)
     with stop_on_signals():
         branches, snaps, found, picture, clock = computed(scene, pear=pear, progress=progress)
@@ -251,10 +383,31 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
 
 
 def load(path):
-    """What a balloon-cg file holds: the Result of a run file, the ``SweepResult`` of a sweep file
-    (app.sweep_result: its members and a table of what each found), the ``CurveResult`` of a two-parameter curve
-    file (app.curve_result, named after its parameter). Raises FileNotFoundError or IsADirectoryError (no such
-    file), or an io FileError (a damaged or foreign file, a stored scene that does not parse: docs/api.md)."""
+    """What a balloon-cg file holds.
+
+    Parameters
+    ----------
+    path : str or Path
+        A run, sweep or two-parameter curve file.
+
+    Returns
+    -------
+    Result or SweepResult or CurveResult
+        The ``Result`` of a run file, the ``SweepResult`` of a sweep file (its members and a table of what each
+        found), the ``CurveResult`` of a curve file (named after its parameter).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file (IsADirectoryError: a folder).
+    FileError
+        A damaged or foreign file, or a stored scene that does not parse (io.layout.FileError: RunFileError,
+        SweepFileError, CurveFileError; one line naming the file and what is wrong).
+
+    Examples
+    --------
+    >>> table = bc.load("sweep.h5").to_dataframe()[["field.M", "P_cr1"]]
+    """
     kind = file_kind(path, RunFileError)
     if kind == "sweep":
         from .sweep_result import SweepResult
@@ -272,11 +425,39 @@ def load(path):
 
 def plot(source, what: str | None = None, ax=None, points=None, branch: str | None = None,
          stability: str | None = None):
-    """A matplotlib Figure of kind ``what`` (docs/plots.md; None: the pole curve of the continuation parameter,
-    ``pressure-pole`` or, for a run continued in the voltage, ``voltage-pole``) from Results or run files (one or
-    a list); drawn into ``ax`` (an Axes, or a sequence for the kinds with several panels) when given;
-    ``stability`` the reading that draws curves solid or dashed (post.plotting.Reading; None: each run's loading
-    control)."""
+    """A figure from Results or run files, in the journal style.
+
+    Parameters
+    ----------
+    source : Result or str or Path, or a list of them
+        What to draw (several: one curve set each).
+    what : str, optional
+        The kind (docs/plots.md); None: the pole curve of the continuation parameter, ``pressure-pole`` or, for
+        a run continued in the voltage, ``voltage-pole``.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (a sequence for the kinds with several panels); None: a new Figure.
+    points : list of int, optional
+        Point indices for shapes, stresses, field, curvature, surface, stretch-map.
+    branch : str, optional
+        The branch to draw (default: as docs/plots.md says per kind).
+    stability : str, optional
+        The reading that draws curves solid (stable) or dashed (post.plotting.Reading); None: each run's
+        loading control.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Raises
+    ------
+    PlotError
+        A figure that cannot be drawn from the given sources (missing branch, data or point, bad ``ax``).
+
+    Examples
+    --------
+    >>> fig = bc.plot(result, "pressure-pole")
+    >>> fig.savefig("pressure-pole.pdf")
+    """
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]

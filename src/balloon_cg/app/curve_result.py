@@ -20,7 +20,15 @@ COLUMNS = ("pressure", "lam2_north", "lam2_south", "newton_iterations", "residua
 
 @dataclass(frozen=True, repr=False)
 class CurveResult:
-    """A loaded curve file: ``path``, ``parameter`` (the name of q) and ``curves`` (name -> read_curve dict)."""
+    """A loaded two-parameter curve file (``load(curve)``): ``path``, ``parameter`` (the name of q: M, alpha1,
+    Jm, mu[0], …) and ``curves`` (name -> read_curve dict).
+
+    Examples
+    --------
+    >>> curve = bc.load("critical_M.h5")
+    >>> curve.parameter, curve.critical
+    >>> curve.to_dataframe().plot(x=curve.parameter, y="pressure")
+    """
 
     path: str
     parameter: str
@@ -36,11 +44,18 @@ class CurveResult:
 
     @property
     def critical(self) -> dict:
-        """The critical value of the parameter of each curve (where its two pitchforks merge; NaN if not)."""
+        """The critical value of the parameter per curve: where its two pitchforks merge (NaN if they do not)."""
         return {name: float(c["attrs"]["critical_q"]) for name, c in self.curves.items()}
 
     def to_dataframe(self):
-        """A pandas DataFrame, one row per point of every curve (module docstring)."""
+        """The curves as one table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per point of every curve: ``curve``, the parameter under its own name (``M``, ``alpha1``,
+            …), pressure, lam2_north, lam2_south, newton_iterations, residual.
+        """
         pd = optional("pandas", "to_dataframe")
         frames = [pd.DataFrame({"curve": name, c["attrs"]["parameter"]: c["q"]} | {k: c[k] for k in COLUMNS})
                   for name, c in self.curves.items()]

@@ -70,8 +70,16 @@ class SweepMember:
 
 @dataclass(frozen=True, repr=False)
 class SweepResult:
-    """A loaded sweep file: ``path``, ``attrs`` (root attributes: scene, vary, mode), ``members`` (index ->
-    SweepMember)."""
+    """A loaded sweep file (``load(sweep)``): ``path``, ``attrs`` (root attributes: scene, vary, mode) and
+    ``members`` (index -> SweepMember: overrides, attrs, branches as BranchData, ``to_xarray`` of a stored group).
+    A notebook shows it as the table of ``to_dataframe``.
+
+    Examples
+    --------
+    >>> sweep = bc.load("sweep.h5")
+    >>> sweep.to_dataframe()[["field.M", "P_LP", "P_cr1", "P_cr2"]]
+    >>> sweep.members[0].branches["primary"].special_points
+    """
 
     path: str
     attrs: dict
@@ -87,13 +95,28 @@ class SweepResult:
         return cls(str(path), sweep["attrs"], members)
 
     def to_dataframe(self):
-        """A pandas DataFrame, one row per member (module docstring)."""
+        """What each member found, one row per member.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index ``member``; the varied keys (dotted, as the overrides name them), ``complete``, the primary
+            branch's first fold ``P_LP``, ``lam2_LP``, the critical pressures of the pear-shaped instability
+            ``P_cr1`` ≥ ``P_cr2``, and every branch point of the primary branch in stored order (``P_BP1``,
+            ``block_BP1``, ``classification_BP1``, ``m_BP1``, …); NaN where a member has none.
+        """
         pd = optional("pandas", "to_dataframe")
         return pd.DataFrame([m.row() for m in self.members.values()],
                             index=pd.Index(list(self.members), name="member"))
 
     def to_xarray(self):
-        """``to_dataframe`` as an xarray Dataset along ``member``."""
+        """``to_dataframe`` as an xarray Dataset.
+
+        Returns
+        -------
+        xarray.Dataset
+            The same columns along the dimension ``member``.
+        """
         optional("xarray", "to_xarray")
         return self.to_dataframe().to_xarray()
 

@@ -44,12 +44,16 @@ def html_table(rows: list[dict], caption: str = "") -> str | None:
 
 
 class SpecialPoints(list):
-    """Special points, one dict per point (keys: docs/hdf5.md's special_points columns, and ``branch`` for the
-    points of a whole run), readable as one table.
+    """Special points, one dict per point, readable as one table (``Result.special_points``,
+    ``BranchData.special_points``).
+
+    The keys are docs/hdf5.md's special_points columns (kind, classification, block, m, status, index, pressure,
+    the pole values, E2, E3, E4, …), and ``branch`` for the points of a whole run. A notebook shows the table.
 
     Examples
     --------
-    >>> folds = result.special_points.to_dataframe().query("kind == 'LP'")  # doctest: +SKIP
+    >>> folds = result.special_points.to_dataframe().query("kind == 'LP'")
+    >>> result.special_points.to_xarray().pressure
     """
 
     def columns(self) -> list[str]:
@@ -58,12 +62,26 @@ class SpecialPoints(list):
         return [k for k in ORDER if k in keys] + [k for k in keys if k not in ORDER]
 
     def to_dataframe(self):
-        """A pandas DataFrame, one row per special point (index ``special``), the columns in ORDER."""
+        """The special points as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per special point (index ``special``): branch, kind, classification, block, m, status, index,
+            pressure, the pole values, E2, E3, E4, uncertainty, reason, stop_code, note.
+        """
         pd = optional("pandas", "to_dataframe")
         return pd.DataFrame(list(self), columns=self.columns()).rename_axis("special")
 
     def to_xarray(self):
-        """An xarray Dataset along ``special`` (one entry per point), units and long names as in the files."""
+        """The special points as an xarray Dataset.
+
+        Returns
+        -------
+        xarray.Dataset
+            The columns of ``to_dataframe`` along the dimension ``special``, with units and long names as in the
+            files.
+        """
         optional("xarray", "to_xarray")
         ds = self.to_dataframe().to_xarray()
         for name in ds.data_vars:

@@ -9,12 +9,26 @@ import matplotlib.style
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+#: The journal style sheet (``journal.mplstyle``, shipped with the package): ``plt.style.use(bc.JOURNAL_STYLE)``
+#: applies it for good; 8 pt serif text, TrueType fonts in PDF and EPS.
 JOURNAL_STYLE = Path(__file__).with_name("journal.mplstyle")
 
 
 def journal_style():
-    """A context manager applying the journal style (``matplotlib.style.context``; for good:
-    ``plt.style.use(balloon_cg.JOURNAL_STYLE)``)."""
+    """The journal style for a block of code (``matplotlib.style.context``; for good:
+    ``plt.style.use(balloon_cg.JOURNAL_STYLE)``).
+
+    Returns
+    -------
+    contextlib.AbstractContextManager
+        Applies the style inside its ``with`` block only.
+
+    Examples
+    --------
+    >>> with bc.journal_style():
+    ...     fig, ax = plt.subplots(figsize=(3.5, 2.6))
+    ...     fig.savefig("own.pdf")
+    """
     return matplotlib.style.context(JOURNAL_STYLE)
 
 

@@ -202,7 +202,16 @@ MAX_SCENE_BYTES = 1 << 20  # a scene file (a scene needs a few hundred bytes)
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene; ``text`` is the TOML it was parsed from (provenance)."""
+    """A validated scene: the membrane's material, the coils' field, the continuation, the solver, stability and
+    output settings (docs/scenes.md); ``text`` is the TOML it was parsed from (provenance). Frozen: change it with
+    ``with_overrides``.
+
+    Examples
+    --------
+    >>> scene = bc.Scene.from_toml("spom1_two_coils_M0.002")
+    >>> scene.field.M, scene.material.name
+    >>> print(scene.to_toml())
+    """
 
     name: str
     material: Material | StrainEnergy
@@ -218,7 +227,25 @@ class Scene:
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
-        """The scene of a TOML file (``load_scene``)."""
+        """The scene of a TOML file.
+
+        Parameters
+        ----------
+        path : str or Path
+            A TOML file, or the name of a shipped scene (``"spom1"``: ``shipped_scenes()``).
+
+        Returns
+        -------
+        Scene
+            Named after the file stem (``load_scene``).
+
+        Raises
+        ------
+        SceneError
+            An invalid scene (one line naming the key, the value and what is allowed).
+        FileNotFoundError
+            No such file and no shipped scene of that name.
+        """
         return load_scene(path)
 
     def to_dict(self) -> dict:
@@ -255,8 +282,23 @@ class Scene:
         return _to_toml(self.to_dict())
 
     def canonical_key(self, key: str) -> str:
-        """The dotted key for ``key``: a dotted key itself; a bare name, the key of that name in the one table
-        that has it (``M`` -> ``field.M``; ``preset`` -> ``material.preset``). SceneError if none or several do."""
+        """The dotted key for a key as the command line takes it.
+
+        Parameters
+        ----------
+        key : str
+            A dotted key (returned as it is), or a bare name of a key of one table (``M`` -> ``field.M``;
+            ``preset`` -> ``material.preset``).
+
+        Returns
+        -------
+        str
+
+        Raises
+        ------
+        SceneError
+            A bare name that no table, or several, have.
+        """
         if "." in key:
             return key
         tables = ["material"] if key == "preset" else [t for t, content in self.to_dict().items() if key in content]
@@ -267,13 +309,33 @@ class Scene:
         return f"{tables[0]}.{key}"
 
     def with_overrides(self, overrides: dict[str, object], name: str | None = None) -> "Scene":
-        """A re-validated copy with dotted keys set, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``,
-        or bare names of one table as on the command line (``{"M": 0.003}``: ``canonical_key``).
+        """A re-validated copy with keys set.
 
         ``material.preset`` replaces the whole material (applied first, whatever the order: the other material
-        keys change the new one); a value None restores the default. The copy is named
-        ``name``, or after what changed physically: each field, material or loading key's token in the name
-        (``_M0.002``, ``_radius4``) takes the new value, or is appended (numerical keys keep the name).
+        keys change the new one).
+
+        Parameters
+        ----------
+        overrides : dict
+            Dotted keys, e.g. ``{"field.M": 0.003, "field.coils[0].radius": 3.5}``, or bare names of one table
+            as on the command line (``{"M": 0.003}``: ``canonical_key``); a value None restores the default.
+        name : str, optional
+            The copy's name; default: this name after what changed physically (each field, material or loading
+            key's token, ``_M0.002``, ``_radius4``, takes the new value or is appended; numerical keys keep the
+            name).
+
+        Returns
+        -------
+        Scene
+
+        Raises
+        ------
+        SceneError
+            An unknown key, a key given twice, or a value out of range.
+
+        Examples
+        --------
+        >>> bc.Scene.from_toml("spom1_two_coils_M0.002").with_overrides({"M": 0.003}).name
         """
         data = self.to_dict()
         try:
@@ -341,14 +403,48 @@ def _with_token(name: str, key: str, value) -> str:
 
 
 def parse_scene(text: str, name: str = "scene") -> Scene:
-    """Parse and validate a scene from TOML text."""
+    """Parse and validate a scene from TOML text.
+
+    Parameters
+    ----------
+    text : str
+        The scene's TOML (docs/scenes.md).
+    name : str, optional
+        The scene's name (default ``"scene"``).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        Invalid TOML or an invalid scene (one line naming the key, the value and what is allowed).
+    """
     return _parse(text, name, name)
 
 
 def load_scene(path) -> Scene:
-    """Read a scene file; the scene is named after the file stem, error messages after the file name. A bare
-    name that is not a file (``"spom1"``, ``"spom1.toml"``) names a scene shipped with the package
-    (``shipped_scenes()``)."""
+    """Read a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A TOML file; a bare name that is not a file (``"spom1"``, ``"spom1.toml"``) names a scene shipped with the
+        package (``shipped_scenes()``).
+
+    Returns
+    -------
+    Scene
+        Named after the file stem (error messages name the file).
+
+    Raises
+    ------
+    SceneError
+        An invalid scene.
+    FileNotFoundError
+        No such file and no shipped scene of that name (the nearest names suggested).
+    """
     if str(path) == "":
         raise FileNotFoundError(errno.ENOENT, "an empty scene path (give a scene file or a shipped scene's name)",
                                 "''")
@@ -379,7 +475,13 @@ def _read_text(path: Path) -> str:
 
 
 def shipped_scenes() -> dict[str, Path]:
-    """The scenes shipped with the package (the repository's scenes/ folder): {name: path}."""
+    """The scenes shipped with the package (the repository's scenes/ folder).
+
+    Returns
+    -------
+    dict
+        {name: path of its TOML file}.
+    """
     from importlib import resources
 
     folder = resources.files("balloon_cg.scenes")
