@@ -33,6 +33,11 @@ def test_the_documented_example_runs(tmp_path, capsys, monkeypatch):
     assert len(left.get_lines()) >= len(result.branches)  # every branch drawn into the caller's Axes
     printed = capsys.readouterr().out
     assert printed.startswith("Result('spom1'") and "long_name" not in printed
+    sweep, curve = namespace["sweep"], namespace["curve"]
+    members = sweep.to_dataframe()
+    assert list(members["field.M"]) == [0.0, 0.001, 0.002] and members["complete"].all()
+    assert members["P_cr1"].notna().all() and members["P_LP"].notna().all()
+    assert curve.parameter == "alpha1" and curve.critical["pear"] == pytest.approx(1.739619649392, abs=1e-9)
 
 
 @pytest.fixture(scope="module")
