@@ -53,6 +53,11 @@ DAMAGE = {
     "missing primary": lambda f: f["branches"].__delitem__("primary"),  # was read as an empty, complete run
     "missing special_points": lambda f: f["branches/primary"].__delitem__("special_points"),
     "missing special kind": lambda f: f["branches/primary/special_points"].__delitem__("kind"),
+    "missing special state": lambda f: f["branches/primary/special_points"].__delitem__("state"),
+    "special unknowns short": lambda f: _replace(f["branches/primary/special_points/state"], "unknowns",
+                                                 f["branches/primary/special_points/state/unknowns"][:1]),
+    "special unknowns narrow": lambda f: _replace(f["branches/primary/special_points/state"], "unknowns",
+                                                  f["branches/primary/special_points/state/unknowns"][:, :3]),
     "unknowns 1-d": lambda f: _replace(f["branches/primary"], "unknowns", f["branches/primary/unknowns"][:, 0]),
     "profiles shape": lambda f: _replace(f["branches/primary/profiles"], "rho", np.zeros((2, 2))),
     "stability length": lambda f: _replace(f["branches/primary/stability"], "stable_pressure", np.ones(2, bool)),
