@@ -553,7 +553,7 @@ PATH_ARGUMENTS = ("scene", "file", "files", "output", "runs")  # completed as fi
 
 def _add_completion(commands):
     p = commands.add_parser("completion", help="print the shell completion script of balloon-cg (shtab)",
-                            description="Print a completion script for the shell: subcommands, options, plot kinds "
+                            description="Print a completion script for the shell: subcommands, options, choices "
                                         "and file names complete with TAB. bash: save it as "
                                         "~/.local/share/bash-completion/completions/balloon-cg; zsh: as _balloon-cg "
                                         "in a folder of $fpath.")
