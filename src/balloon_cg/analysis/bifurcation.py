@@ -1,11 +1,12 @@
 """Branch points of the primary branch, their classification, the pear-shaped branches and snap-through.
 
 Detection: a sign change, between neighbouring points, of the lowest eigenvalue of a block of the second
-variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks; the even block gives
-equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. Both are BP
-special points; their ``block`` says which.
+variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks of the held balloon,
+and with a field the pear block with the translation (odd_free) those of the free balloon; the even block gives
+equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. All are BP
+special points; their ``block`` says which (and ``gauge`` which reading: ``results.Gauge.of_block``).
 Location: Newton on an extended system that is regular at the branch point (``branch_point``: Werner–Spence
-for a pear point, Moore's system for an even-block point), from the detection bracket, on the plain degree in
+for a pear point of either reading, Moore's system for an even-block point), from the detection bracket, on the plain degree in
 x that holds it (``plain_degree``). The point is LOCATED when Newton converged, the crossing eigenvalue there is
 below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at the bracketing points (signs and
 values agree at each point's assessment degree and its check degree, ``stability.assessed_degrees`` and
@@ -28,7 +29,7 @@ from ..numerics.newton import newton
 from .branch_point import MooreSystem, WernerSpence
 from .problem import equilibrium_of
 from .resolution import Resolution
-from .results import Block, Branch, Classification, Kind, SpecialPoint, Status, approximate
+from .results import Block, Branch, Classification, Gauge, Kind, SpecialPoint, Status, approximate
 from .crossings import branch_point_crossings
 from .stability import SecondVariation, Variations, assessed_degrees, block_indices, convergence_problems
 from .tracer import Tracer
@@ -73,7 +74,8 @@ def locate(branch: Branch, index: int, block: Block, k: int = 0) -> SpecialPoint
         problems += crossing_problems(branch, index, block, k)
     fields = {"status": Status.LOCATED} if not problems else approximate(
         branch.disc, before, after, f"branch point ({block.value} block): " + "; ".join(problems))
-    return SpecialPoint(Kind.BP, index, found.X, block=block, mode=found.mode, **fields)
+    return SpecialPoint(Kind.BP, index, found.X, block=block, mode=found.mode,
+                        gauge=Gauge.of_block(block, branch.field_acts), **fields)
 
 
 @dataclass
@@ -114,7 +116,7 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     plain = Discretisation(degree, True, branch.disc.pin_translation)
     eq = Equilibrium(branch.scene, plain)
     variation = SecondVariation(eq, degree)
-    idx = block_indices(variation, block, field_on=False)
+    idx = block_indices(variation, block, field_on=True)
     params = branch.params
     if start is None:
         ends = branch.disc.transfer(branch.X[index:index + 2], plain)
@@ -124,9 +126,9 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     else:
         guess = branch.disc.transfer(start.X, plain)
     _, mode = _eigenpair(variation, guess[:-1], branch.params_at(guess), idx, k)
-    if block == Block.ODD_HELD:
+    if block != Block.EVEN:
         ell = mode[idx] / np.linalg.norm(mode[idx])
-        system = WernerSpence(eq, params, ell, branch.parameter)
+        system = WernerSpence(eq, params, ell, branch.parameter, block)
         X0 = np.concatenate([guess, ell])
     else:
         psi = plain.join(mode[: degree + 1], mode[degree + 1:])
@@ -161,16 +163,17 @@ def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[
 
     def eigenvalue(n, degree):
         variation, X = variations[degree], branch.X[n]
-        idx = block_indices(variation, block, field_on=False)
+        idx = block_indices(variation, block, field_on=True)
         return _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0]
 
     return convergence_problems(branch, index, eigenvalue, assessed_degrees(branch)[index:index + 2])
 
 
-def general_tracer(scene) -> Tracer:
-    """The general (non-symmetric) space, balloon held at its centre: the branch points are those of the held
-    reading (the 'odd_held' block), so the branches leaving them are traced with b_0 = 0 too."""
-    return Tracer(scene, symmetric=False, held=True)
+def general_tracer(scene, block: Block = Block.ODD_HELD) -> Tracer:
+    """The general (non-symmetric) space of the reading of a branch point of ``block``: the balloon held at its
+    centre (b_0 = 0, the 'odd_held' and 'even' blocks), or free (b_0 an unknown, its equation the vanishing net
+    axial force: the 'odd_free' block)."""
+    return Tracer(scene, symmetric=False, held=block != Block.ODD_FREE)
 
 
 def plain_degree(branch: Branch, X) -> int:
@@ -212,7 +215,7 @@ def classify(branch: Branch, bp: SpecialPoint, delta: float = 2e-2) -> SpecialPo
     """``bp`` with E2, E3, E4 of the reduced energy at its parameters (P, and Φ̄) and its classification (module
     docstring); unclassified (Classification.NONE) when fewer than three constrained minimisations converge."""
     solver = branch.scene.solver
-    tracer = general_tracer(branch.scene)
+    tracer = general_tracer(branch.scene, bp.block)
     degree = plain_degree(branch, bp.X)
     eq = tracer.system(degree, branch.params).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])

@@ -143,6 +143,7 @@ def summarise_branch(b: dict) -> dict:
         **({"voltage": _range(b["voltage"]), "parameter": attrs["parameter"]} if "voltage" in b else {}),
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
         "origin": attrs.get("origin", "traced"),  # files written before reflected mirrors: every branch traced
+        "gauge": attrs["gauge"],  # io.run_file reads it from the layout in files written before it
         "reflection_of": attrs.get("reflection_of", ""),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
@@ -280,7 +281,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
         return _format_surface_branch(name, b)
     lines = [
         f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
-        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
+        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, {READINGS[b['gauge']]}, M = {b['M']:g}, "
+        f"chi = {b['chi']:g})",
         *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
            f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]
           if b["basis_map"]["centres"] else []),
@@ -303,9 +305,14 @@ def _format_branch(name: str, b: dict) -> list[str]:
     return lines + _special_lines(b["special_points"])
 
 
+READINGS = {"both": "held and free", "held": "held at its centre", "free": "free (net axial force zero)"}
+
+
 def _special_lines(special: list) -> list[str]:
-    """One aligned line per stored special point: label, place, P (and Φ̄), the pole stretches, the note."""
+    """One aligned line per stored special point: label (with its reading where it is held or free only), place,
+    P (and Φ̄), the pole stretches, the note."""
     labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
+              + (f" {s['gauge']}" if s.get("gauge", "both") != "both" else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
               for s in special]
     places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"

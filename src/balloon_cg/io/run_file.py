@@ -15,8 +15,9 @@ Layout::
                                   kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
                                   the kernels), voltage (Φ̄, fixed unless it is the parameter), parameter
                                   ("P" or "voltage": what the last unknown is), origin (traced,
-                                  reflected, ...: analysis.results.Origin), [parent_branch,
-                                  parent_branch_point, rejoins_branch_point, reflection_of]
+                                  reflected, ...: analysis.results.Origin), gauge (held, free or both:
+                                  the reading its states are equilibria of, analysis.results.Gauge),
+                                  [parent_branch, parent_branch_point, rejoins_branch_point, reflection_of]
         point, unknown                                     dimension scales (0, 1, …)
         pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
@@ -24,8 +25,8 @@ Layout::
         unknowns                                           (point, unknown): Legendre unknowns u, then P (or Φ̄)
         theta                                              (theta,): linspace(0, π), a dimension scale
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
-        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, status (located, approximate),
-                       reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
+        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, gauge (held, free, both),
+                       status (located, approximate), reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
                        lam2_north, lam2_south, eta_north, eta_south                          (special,)
         special_points/unknowns                            (special, unknown)
         stability/stable_*                                 (point,) flags
@@ -53,7 +54,8 @@ A fold (LP, TP) or branch point (BP) lies between points ``index`` and ``index +
 special_points/unknowns. Files are written atomically (``io.hdf5.atomic_file``). Files of the previous formats
 still read: "balloon-cg/3" (no ``m`` attribute, no surface branches: every branch reads as m = 0) and
 "balloon-cg/2" (no volume, no dimension scales), and so do files without amount, control or the gas stability
-flags (written before gas control).
+flags (written before gas control), and files without ``gauge`` (written before the free balloon's branch points:
+a branch's is read from its layout, ``legacy_gauge``; a special point's from its block, ``read_special``).
 """
 import io
 from pathlib import Path
@@ -216,6 +218,7 @@ def _write_branch(group, branch, theta):
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
         "origin": branch.origin.value,
+        "gauge": branch.gauge.value,
     })
     if branch.parent is not None:
         group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
@@ -410,6 +413,7 @@ def write_special(group, special: list, width: int, poles, unknown=None, paramet
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
     write_strings(group, "block", [s.block.value for s in special])
+    write_strings(group, "gauge", [s.gauge.value for s in special])
     write_strings(group, "status", [s.status.value for s in special])
     write_strings(group, "reason", [s.reason for s in special])
     group.create_dataset("uncertainty", data=np.array([s.uncertainty for s in special], dtype=float))
@@ -503,6 +507,7 @@ OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
+OPTIONAL_SPECIAL = {"voltage": ("float", 1), "gauge": ("str", 1)}  # voltage: where electric; gauge: since issue 27
 
 
 def read_branches(parent, where, error=None) -> dict:
@@ -557,8 +562,8 @@ def check_branch(group, where, error) -> None:
             raise error(f"{where}: profiles", f"dataset {name} has shape {item.shape}, expected ({n}, {t})")
     special = require_group(group, "special_points", where, error)
     check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
-    check_columns(special, f"{where}: special_points", {k: ("float", 1) for k in ("voltage",) if k in special}, error,
-                  rows=special["kind"].shape[0])
+    check_columns(special, f"{where}: special_points", {k: v for k, v in OPTIONAL_SPECIAL.items() if k in special},
+                  error, rows=special["kind"].shape[0])
     check_sizes(special, f"{where}: special_points", error)
     if special["unknowns"].shape[1:] != (width,) and special["unknowns"].shape[0]:
         raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
@@ -601,8 +606,8 @@ def check_surface_branch(group, where, error) -> None:
         raise error(where, f"centroid has shape {group['centroid'].shape}, expected ({n}, 3)")
     special = require_group(group, "special_points", where, error)
     check_columns(special, f"{where}: special_points", SPECIAL_COLUMNS, error)
-    check_columns(special, f"{where}: special_points", {k: ("float", 1) for k in ("voltage",) if k in special}, error,
-                  rows=special["kind"].shape[0])
+    check_columns(special, f"{where}: special_points", {k: v for k, v in OPTIONAL_SPECIAL.items() if k in special},
+                  error, rows=special["kind"].shape[0])
     check_sizes(special, f"{where}: special_points", error)
     if special["unknowns"].shape[0] and special["unknowns"].shape[1] != size + 1:
         raise error(f"{where}: special_points", f"unknowns has {special['unknowns'].shape[1]} columns, "
@@ -648,10 +653,13 @@ def _attr(value):
 def _read_branch(group) -> dict:
     data = {name: group[name][()] for name, item in group.items() if isinstance(item, h5py.Dataset)}
     data["attrs"] = {"m": 0} | {k: _attr(v) for k, v in group.attrs.items()}  # m: files before surface branches
+    field_acts = float(data["attrs"]["M"]) > 0  # a scene with M > 0 has coils (scene validation)
+    if not data["attrs"]["m"] and "gauge" not in data["attrs"]:  # files before the free reading (issue 27)
+        data["attrs"]["gauge"] = legacy_gauge(data["attrs"], field_acts)
     if "profiles" in group:
         data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]
-    data["special_points"] = read_special(sp)
+    data["special_points"] = read_special(sp, field_acts)
     data["special_unknowns"] = sp["unknowns"][()]
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
@@ -671,8 +679,27 @@ def _read_snaps(group) -> list:
     return [{k: plain(v[i]) for k, v in columns.items()} for i in range(n)]
 
 
-def read_special(group) -> list:
-    """Special points written by write_special, as a list of dicts (text columns as str)."""
-    columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT}
+def read_special(group, field_acts: bool = True) -> list:
+    """Special points written by write_special, as a list of dicts (text columns as str). A file written before
+    the free reading (no ``gauge`` column) gets each point's from its block (``results.Gauge.of_block``; a
+    field acts when ``field_acts``): every other point was of the held reading where a field acts."""
+    from ..analysis.results import Block, Gauge
+
+    columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
     columns |= {name: group[name][()] for name in ("index", "m") + SPECIAL_NUMBERS + ("voltage",) if name in group}
-    return [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
+    points = [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
+    if "gauge" not in columns:
+        blocks = {block.value: block for block in Block if block != Block.NONE}
+        fallback = Gauge.HELD if field_acts else Gauge.BOTH
+        for s in points:
+            block = blocks.get(s["block"])
+            s["gauge"] = (Gauge.of_block(block, field_acts) if block else fallback).value
+    return points
+
+
+def legacy_gauge(attrs: dict, field_acts: bool) -> str:
+    """The reading of an axisymmetric branch stored without its ``gauge`` (``results.Branch.gauge`` from its
+    layout): both when equator-symmetric or without a field, else held or free as its translation is pinned."""
+    if attrs["symmetric"] or not field_acts:
+        return "both"
+    return "held" if attrs["pin_translation"] else "free"
