@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation, mirror, surface_branches
+from . import azimuthal_points, bifurcation, control_points, mirror, surface_branches
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
@@ -145,22 +145,14 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     if not _assess(primary, scene, primary.disc.symmetric, progress, clock):
         picture.interrupted = True
         return picture
-    if not primary.disc.symmetric:
-        progress.finish(Phase.STABILITY, len(primary.X))
-        picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
-                                "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
-        return picture
-    with clock.step(Step.BRANCH_POINTS):
-        # the free balloon's pear points (odd_free) after the others: the held numbering does not depend on them
-        crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
-        for n, (index, block, k) in enumerate(crossings):
-            if _stopped(picture):
-                break
-            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
-            bp.note = f"{MODES[block]} mode, branch point {n}"
-            picture.branch_points.append(bp)
-            primary.special.append(bp)
-    primary.special.sort(key=_along)
+    if primary.disc.symmetric:
+        _branch_points(primary, picture)
+    else:
+        with clock.step(Step.BRANCH_POINTS):
+            primary.special += control_points.find(primary)
+        primary.special.sort(key=_along)
+        picture.not_searched = _unsearched(primary)
+        pear = False  # no equator-symmetric pitchforks to switch at
     if _stopped(picture):
         return picture
     if pear:
@@ -196,6 +188,31 @@ def _label_readings(branches: list) -> None:
     for branch in branches:
         for s in branch.special:
             s.gauge = Gauge.of_block(s.block, branch.field_acts) if s.kind == Kind.BP else branch.gauge
+
+
+def _branch_points(primary: Branch, picture: Picture) -> None:
+    """The located and classified m = 0 branch points of an equator-symmetric primary branch (``bifurcation``),
+    in ``picture.branch_points`` and among the branch's special points."""
+    with picture.clock.step(Step.BRANCH_POINTS):
+        # the free balloon's pear points (odd_free) after the others: the held numbering does not depend on them
+        crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
+        for n, (index, block, k) in enumerate(crossings):
+            if _stopped(picture):
+                break
+            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
+            bp.note = f"{MODES[block]} mode, branch point {n}"
+            picture.branch_points.append(bp)
+            primary.special.append(bp)
+    primary.special.sort(key=_along)
+
+
+def _unsearched(primary: Branch) -> str:
+    """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``)."""
+    missing = ("the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
+               "and those at its branch points) are not traced")
+    if primary.gauge == Gauge.HELD:
+        missing += "; nor is the free balloon's branch (its axial translation free)"
+    return missing
 
 
 def _stopped(picture: Picture) -> bool:

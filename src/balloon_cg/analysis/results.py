@@ -43,6 +43,13 @@ class Block(enum.StrEnum):
     ODD_HELD = "odd_held"  # pear-shaped (symmetry-breaking) modes, balloon held at its centre
     ODD_FREE = "odd_free"  # pear-shaped modes and the axial translation b_0: a free balloon in a field
     EVEN = "even"  # equator-symmetric modes
+    # every axisymmetric mode of a branch without equator symmetry, balloon held, under pressure, volume, gas control
+    ALL_HELD = "all_held"
+    ALL_VOLUME_HELD = "all_volume_held"
+    ALL_GAS_HELD = "all_gas_held"
+    ALL_FREE = "all_free"  # ... balloon free (b_0 an unknown: a branch traced with continuation.symmetry = "none")
+    ALL_VOLUME_FREE = "all_volume_free"
+    ALL_GAS_FREE = "all_gas_free"
     # non-axisymmetric cos mφ modes, m = 1..8 (stability.m_max ≤ 8): held at the centre, or free (with a field)
     M1_HELD = "m1_held"
     M1_FREE = "m1_free"

@@ -233,13 +233,15 @@ def _snap_symbol(run: dict, branch: str) -> str:
 
 
 def _verdict(attrs: dict) -> str:
-    """'complete', or the incomplete parts stored in a run file's root attributes."""
+    """'complete', or the incomplete parts stored in a run file's root attributes; a complete result with stated
+    limitations (a part not searched, a surface branch at its basis' cap: ``analysis.verdict.Gap.fails`` false)
+    names them."""
     if "complete" not in attrs:
         return "not assessed"
-    if attrs["complete"]:
-        return "complete"
     parts = [f"{gap} ({branch}: {message})" for gap, branch, message in
              zip(attrs["incomplete_gaps"], attrs["incomplete_branches"], attrs["incomplete_messages"])]
+    if attrs["complete"]:
+        return "complete" + (", except: " + "; ".join(parts) if parts else "")
     return "incomplete: " + "; ".join(parts)
 
 
@@ -302,17 +304,17 @@ def _format_branch(name: str, b: dict) -> list[str]:
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
     ]
-    return lines + _special_lines(b["special_points"])
+    return lines + _special_lines(b["special_points"], b["gauge"])
 
 
 READINGS = {"both": "held and free", "held": "held at its centre", "free": "free (net axial force zero)"}
 
 
-def _special_lines(special: list) -> list[str]:
-    """One aligned line per stored special point: label (with its reading where it is held or free only), place,
-    P (and Φ̄), the pole stretches, the note."""
+def _special_lines(special: list, gauge: str = "both") -> list[str]:
+    """One aligned line per stored special point: label (with its reading where it is not its branch's ``gauge``),
+    place, P (and Φ̄), the pole stretches, the note."""
     labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
-              + (f" {s['gauge']}" if s.get("gauge", "both") != "both" else "")
+              + (f" {s['gauge']}" if s.get("gauge", gauge) != gauge else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
               for s in special]
     places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"
