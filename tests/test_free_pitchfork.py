@@ -81,7 +81,8 @@ def test_the_free_pear_branch_is_traced_with_the_translation_free(two_coils):
 
 def test_readings_are_stored_and_older_files_read_them_from_the_layout(two_coils, tmp_path, capsys):
     """A run file holds each branch's and each special point's reading (``gauge``); inspect shows them; a file
-    written before (no gauge column, no gauge attribute) reads them from the block and the layout."""
+    written before (no gauge column, no gauge attribute) reads them from the block (a branch point's) and the
+    layout (the branch's, and its other points')."""
     from balloon_cg.app.cli import main
 
     primary, points = two_coils
@@ -101,4 +102,4 @@ def test_readings_are_stored_and_older_files_read_them_from_the_layout(two_coils
         del f["branches/primary"].attrs["gauge"]
     branch = read_run(path)["branches"]["primary"]
     assert branch["attrs"]["gauge"] == "both"
-    assert [s["gauge"] for s in branch["special_points"]] == [s.gauge.value for s in primary.special[:2]] + ["held"]
+    assert [s["gauge"] for s in branch["special_points"]] == [s.gauge.value for s in primary.special]

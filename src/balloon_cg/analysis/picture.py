@@ -11,7 +11,9 @@ branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches
 whole sphere (``surface_branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
 snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
-Φ̄ as the parameter of every branch and of its branch points. Every branch carries its assessments in
+Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
+that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
+LN or BP) and its m ≥ 1 points; the branches bifurcating from it are not traced (``Picture.not_searched`` says so). Every branch carries its assessments in
 ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum

@@ -283,7 +283,7 @@ def _format_branch(name: str, b: dict) -> list[str]:
         return _format_surface_branch(name, b)
     lines = [
         f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
-        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, {READINGS[b['gauge']]}, M = {b['M']:g}, "
+        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
         f"chi = {b['chi']:g})",
         *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
            f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]

@@ -547,7 +547,7 @@ def check_branch(group, where, error) -> None:
     points of consistent shapes)."""
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
-    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS, error)
+    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str"}, error)  # gauge: since issue 27
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
@@ -659,7 +659,7 @@ def _read_branch(group) -> dict:
     if "profiles" in group:
         data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]
-    data["special_points"] = read_special(sp, field_acts)
+    data["special_points"] = read_special(sp, field_acts, data["attrs"].get("gauge"))
     data["special_unknowns"] = sp["unknowns"][()]
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
@@ -679,10 +679,11 @@ def _read_snaps(group) -> list:
     return [{k: plain(v[i]) for k, v in columns.items()} for i in range(n)]
 
 
-def read_special(group, field_acts: bool = True) -> list:
+def read_special(group, field_acts: bool = True, branch_gauge: str | None = None) -> list:
     """Special points written by write_special, as a list of dicts (text columns as str). A file written before
-    the free reading (no ``gauge`` column) gets each point's from its block (``results.Gauge.of_block``; a
-    field acts when ``field_acts``): every other point was of the held reading where a field acts."""
+    the free reading (no ``gauge`` column) gets a branch point's from its block (``results.Gauge.of_block``; a
+    field acts when ``field_acts``), every other point's its branch's (``branch_gauge``; unknown: held where a
+    field acts)."""
     from ..analysis.results import Block, Gauge
 
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
@@ -690,7 +691,7 @@ def read_special(group, field_acts: bool = True) -> list:
     points = [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
     if "gauge" not in columns:
         blocks = {block.value: block for block in Block if block != Block.NONE}
-        fallback = Gauge.HELD if field_acts else Gauge.BOTH
+        fallback = {g.value: g for g in Gauge}.get(branch_gauge, Gauge.HELD if field_acts else Gauge.BOTH)
         for s in points:
             block = blocks.get(s["block"])
             s["gauge"] = (Gauge.of_block(block, field_acts) if block else fallback).value
