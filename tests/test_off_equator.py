@@ -1,14 +1,16 @@
 """A coil off the equatorial plane (issue 27): SPOM1, one coil of radius 2 at height 0.5, M = 0.002. The primary
 branch has no equator symmetry; every stability change under every control mode is a special point (LP, LV, LN or
 BP: ``analysis.control_points``), its m = 1 crossings are located as on symmetric branches, and what is still not
-searched is said in the verdict line. With the coil back at h = 0 the symmetric analysis runs as before."""
+searched is said in the verdict line; the pear branch the broken symmetry disconnects is found by continuation in
+the coil height from 0. With the coil back at h = 0 the symmetric analysis runs as before."""
 import numpy as np
 import pytest
 
+from balloon_cg.analysis.broken_symmetry import distance_to
 from balloon_cg.analysis.control_points import FOLD_TOL, fold_rate
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.problem import branch_system, equilibrium_of
-from balloon_cg.analysis.results import Block, Gauge, Kind, Status
+from balloon_cg.analysis.results import Block, Gauge, Kind, Origin, Status, StopCode
 from balloon_cg.analysis.stability import SecondVariation
 from balloon_cg.analysis.verdict import Gap, failing
 from balloon_cg.io.run_file import write_run
@@ -35,7 +37,8 @@ def coil_at(height: float):
 
 @pytest.fixture(scope="module")
 def off_equator():
-    return analyse(coil_at(0.5))
+    """The picture without the disconnected pear branch (``pear=False``: its search is the slow test below)."""
+    return analyse(coil_at(0.5), pear=False)
 
 
 def gas_amount(branch, X) -> float:
@@ -98,3 +101,31 @@ def test_the_coil_back_on_the_equator_gives_the_symmetric_analysis():
     assert {Block.ODD_HELD, Block.ODD_FREE} <= blocks
     assert all(bp.status == Status.LOCATED for bp in picture.branch_points)
     assert not [s for s in picture.primary.special if s.kind in (Kind.LV, Kind.LN)]
+
+
+@pytest.mark.slow
+def test_the_disconnected_pear_branch_is_found_by_continuation_in_the_coil_height(tmp_path, capsys):
+    """The pear branch the coil's height breaks off the primary branch: found from the pear branch of the coil at
+    h = 0 (continued in h at its pear amplitude), traced both ways in P, stored with how it was found. Every point a
+    resolved Newton solution of the held problem at h = 0.5; it bulges the other way (the south pole stretch up to
+    stop_stretch), folds in P, and stays away from the primary branch (no point within 0.05 of it in (P, λ2(0),
+    λ2(π))); the verdict line no longer lists it as not searched."""
+    from balloon_cg.app.cli import main
+
+    picture = analyse(coil_at(0.5))
+    branches = {b.name: b for b in picture.branches}
+    assert set(branches) == {"primary", "broken_pear"}
+    broken, primary = branches["broken_pear"], branches["primary"]
+    assert broken.origin == Origin.CONTINUED_IN_HEIGHT and broken.gauge == Gauge.HELD and len(broken.X) > 20
+    tol = broken.scene.solver
+    assert broken.residual.max() <= tol.tol and broken.error_estimate.max() <= tol.max_error
+    assert broken.stopped(StopCode.SOUTH_STOP_STRETCH) and any(s.kind == Kind.LP for s in broken.special)
+    assert min(distance_to(primary, X, broken.disc) for X in broken.X) > 0.05
+    assert "broken pitchfork" not in picture.not_searched and not failing(picture.incomplete)
+    path = write_run(tmp_path / "off.h5", primary.scene, picture.branches, snaps=picture.snaps,
+                     found=picture.incomplete)
+    assert main(["inspect", str(path), "--json"]) == 0
+    import json
+
+    stored = json.loads(capsys.readouterr().out)["branches"]["broken_pear"]
+    assert stored["origin"] == "continued_in_height" and stored["gauge"] == "held"

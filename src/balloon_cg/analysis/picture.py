@@ -13,7 +13,9 @@ snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
-LN or BP) and its m ≥ 1 points; the branches bifurcating from it are not traced (``Picture.not_searched`` says so). Every branch carries its assessments in
+LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
+continuation in the coil heights (``broken_symmetry``); the branches bifurcating from it are not traced
+(``Picture.not_searched`` says so). Every branch carries its assessments in
 ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
@@ -21,7 +23,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation, control_points, mirror, surface_branches
+from . import azimuthal_points, bifurcation, broken_symmetry, control_points, mirror, surface_branches
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
@@ -36,6 +38,7 @@ from ..numerics.threads import limited_blas
 
 
 MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
+BROKEN = "broken_pear"  # the pear branch a broken equator symmetry disconnects (``broken_symmetry``)
 PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear branch's name: <prefix>_<BP number>
 MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",
          Block.EVEN: "equator-symmetric (even)"}
@@ -153,7 +156,11 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
         with clock.step(Step.BRANCH_POINTS):
             primary.special += control_points.find(primary)
         primary.special.sort(key=_along)
-        picture.not_searched = _unsearched(primary)
+        search = pear and not scene.field.is_equator_symmetric  # continuation.symmetry = "none": none broken
+        if search and not _stopped(picture):
+            with clock.step(Step.PEAR_BRANCHES):
+                _trace_broken(scene, primary, picture, progress)
+        picture.not_searched = _unsearched(primary, search)
         pear = False  # no equator-symmetric pitchforks to switch at
     if _stopped(picture):
         return picture
@@ -208,9 +215,24 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
     primary.special.sort(key=_along)
 
 
-def _unsearched(primary: Branch) -> str:
-    """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``)."""
-    missing = ("the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
+def _trace_broken(scene, primary: Branch, picture: Picture, progress: Progress) -> None:
+    """The pear branch the broken equator symmetry disconnects (``broken_symmetry``), assessed; a failure to find
+    it is a branch not started."""
+    try:
+        branch = broken_symmetry.broken_pear(scene, primary, BROKEN, progress.ticker(Phase.PEAR))
+    except broken_symmetry.HomotopyError as error:
+        picture.not_started.append((BROKEN, str(error)))
+        return
+    if branch is not None:
+        picture.branches.append(branch)
+        _assess(branch, scene, False, progress, picture.clock)
+
+
+def _unsearched(primary: Branch, searched: bool) -> str:
+    """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``); ``searched``:
+    the disconnected pear branch was searched for (``_trace_broken``)."""
+    missing = ("the branches at its branch points are not traced" if searched else
+               "the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
                "and those at its branch points) are not traced")
     if primary.gauge == Gauge.HELD:
         missing += "; nor is the free balloon's branch (its axial translation free)"

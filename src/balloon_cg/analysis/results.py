@@ -144,6 +144,9 @@ class Origin(enum.StrEnum):
     #                                                    the north pole only (min_stretch), which is not reflected
     TRACED_REFLECTION_FAILED = "traced_reflection_failed"  # a mirror image traced: a reflected point's residual
     #                                                        was above solver.tol
+    CONTINUED_IN_HEIGHT = "continued_in_height"  # a branch a broken equator symmetry disconnects: a point of the
+    #                                              symmetric relative's pear branch continued in the coil heights,
+    #                                              then traced (``analysis.broken_symmetry``)
 
 
 @dataclass
