@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..galerkin.discretisation import Discretisation
+from ..galerkin.equilibrium import Equilibrium
 from ..numerics import continuation
 from ..numerics.newton import newton
 from . import bifurcation
@@ -31,11 +31,10 @@ from .results import Block, Branch, Origin, StopCode
 from .stability import assess_branch
 from .switching import south_stop_stretch, trace_pear
 from .tracer import Tracer
-from ..galerkin.equilibrium import Equilibrium
 
 SEED_AMPLITUDE = 1.0  # |λ2(0) − λ2(π)| of the point continued in the coil heights: far from the primary branch
-HEIGHT_STEPS = 10
-MIN_STEP = 1e-3
+HEIGHT_STEPS = 10  # the first steps in t: 1/HEIGHT_STEPS
+MIN_STEP = 1e-3  # a step in t halved below this: the continuation failed
 ON_BRANCH = 1e-2  # max-norm distance in (P, λ2(0), λ2(π)) below which a continued point lies on the primary branch
 
 
