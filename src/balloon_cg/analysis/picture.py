@@ -179,7 +179,7 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
         with clock.step(Step.SURFACE_BRANCHES):
             _trace_surface(scene, primary, picture, progress)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
-    _label_readings(picture.branches)
+    _label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
     return picture
@@ -193,10 +193,10 @@ def _along(s) -> tuple:
 
 def _label_readings(branches: list) -> None:
     """Each special point's reading (``results.Gauge``): a branch point's from its block, the others' (folds, end
-    points) from their branch."""
+    points, a surface branch's secondary points) from their branch."""
     for branch in branches:
         for s in branch.special:
-            s.gauge = Gauge.of_block(s.block, branch.field_acts) if s.kind == Kind.BP else branch.gauge
+            s.gauge = Gauge.of_block(s.block, branch.field_acts) if s.kind == Kind.BP and s.block else branch.gauge
 
 
 def _branch_points(primary: Branch, picture: Picture) -> None:

@@ -333,6 +333,17 @@ class SurfaceBranch:
     unsettled: list = field(default_factory=list)  # (verdict's interface: no check degree on the whole sphere)
 
     @property
+    def field_acts(self) -> bool:
+        """Whether a field acts on the balloon (coils and M > 0)."""
+        return bool(self.scene.field.coils) and self.params.M > 0
+
+    @property
+    def gauge(self) -> Gauge:
+        """The reading of its states: held (the centre held laterally, as the m-blocks of the held reading it is
+        born from) where a field acts, else both."""
+        return Gauge.HELD if self.field_acts else Gauge.BOTH
+
+    @property
     def pressure(self):
         return self.values if self.parameter == "P" else np.full(len(self.values), self.params.P)
 

@@ -159,6 +159,7 @@ def summarise_surface_branch(b: dict) -> dict:
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])],
         "origin": attrs.get("origin", "traced"),
         "reflection_of": attrs.get("reflection_of", ""),
+        "gauge": attrs["gauge"],  # io.run_file reads it from M in files written before it
         "points": n,
         "pressure": _range(b["pressure"]),
         "pressures": [float(p) for p in b["pressure"]],
@@ -260,7 +261,8 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
     return [
         f"surface branch {name}   (m = {b['m']}, from {parent} branch point {point}; {b['kernel_class']}, degree "
         f"{b['surface_degree']}, reflections {_reflections(b['symmetry'], b['characters'])}, nodes "
-        f"{b['nodes'][0]} × {b['nodes'][1]}, M = {b['M']:g}, chi = {b['chi']:g})",
+        f"{b['nodes'][0]} × {b['nodes'][1]}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
+        f"chi = {b['chi']:g})",
         f"  points               {b['points']}"
         + (f"  (the rotation by π about the axis of {b['reflection_of']})" if b["reflection_of"] else ""),
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
@@ -274,7 +276,7 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"  trace time           {b['wall_time']:.3f} s",
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
-        *_special_lines(b["special_points"]),
+        *_special_lines(b["special_points"], b["gauge"]),
     ]
 
 

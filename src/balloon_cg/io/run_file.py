@@ -296,6 +296,7 @@ def _write_surface_branch(group, branch) -> None:
         "map_centres": np.array(basis.mapping.centres if basis.mapping else [], dtype=float),
         "map_widths": np.array(basis.mapping.widths if basis.mapping else [], dtype=float),
         "origin": branch.origin.value,
+        "gauge": branch.gauge.value,
     })
     if branch.reflection_of:
         group.attrs["reflection_of"] = branch.reflection_of
@@ -654,7 +655,7 @@ def _read_branch(group) -> dict:
     data = {name: group[name][()] for name, item in group.items() if isinstance(item, h5py.Dataset)}
     data["attrs"] = {"m": 0} | {k: _attr(v) for k, v in group.attrs.items()}  # m: files before surface branches
     field_acts = float(data["attrs"]["M"]) > 0  # a scene with M > 0 has coils (scene validation)
-    if not data["attrs"]["m"] and "gauge" not in data["attrs"]:  # files before the free reading (issue 27)
+    if "gauge" not in data["attrs"]:  # files before the free reading (issue 27)
         data["attrs"]["gauge"] = legacy_gauge(data["attrs"], field_acts)
     if "profiles" in group:
         data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
@@ -699,8 +700,9 @@ def read_special(group, field_acts: bool = True, branch_gauge: str | None = None
 
 
 def legacy_gauge(attrs: dict, field_acts: bool) -> str:
-    """The reading of an axisymmetric branch stored without its ``gauge`` (``results.Branch.gauge`` from its
-    layout): both when equator-symmetric or without a field, else held or free as its translation is pinned."""
-    if attrs["symmetric"] or not field_acts:
+    """The reading of a branch stored without its ``gauge`` (``results.Branch.gauge`` from its layout; a surface
+    branch's ``results.SurfaceBranch.gauge``): both when equator-symmetric or without a field, else held or free
+    as its translation is pinned (held: a surface branch)."""
+    if not field_acts or attrs.get("symmetric"):
         return "both"
-    return "held" if attrs["pin_translation"] else "free"
+    return "held" if attrs.get("pin_translation", True) else "free"  # a surface branch (m ≥ 1): held
