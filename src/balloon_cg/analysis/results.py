@@ -85,10 +85,12 @@ class Block(enum.StrEnum):
 
 
 class Gauge(enum.StrEnum):
-    """Which reading of the rigid axial translation a special point or a branch belongs to. Held: the balloon is
-    held at its centre (b_0 = 0, the net axial force is a reaction); free: the translation is an unknown (the net
-    axial force vanishes). Both: the readings coincide (no field acts, so the translation is an exact zero mode,
-    removed; or the point's mode and the branch's states have no translation component: equator-symmetric)."""
+    """Which reading of the rigid translation a special point or a branch belongs to. Held: the balloon is held at
+    its centre (axisymmetric: b_0 = 0, the net axial force is a reaction; m ≥ 1 blocks and the whole-sphere
+    branches born from them: the lateral translation, the axial one an unknown there); free: the translation is
+    an unknown (the net force vanishes). Both: the readings coincide (no field acts, so the translation is an
+    exact zero mode, removed; or the point's mode and the branch's states have no translation component:
+    equator-symmetric)."""
 
     BOTH = "both"
     HELD = "held"
