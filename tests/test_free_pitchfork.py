@@ -103,3 +103,30 @@ def test_readings_are_stored_and_older_files_read_them_from_the_layout(two_coils
     branch = read_run(path)["branches"]["primary"]
     assert branch["attrs"]["gauge"] == "both"
     assert [s["gauge"] for s in branch["special_points"]] == [s.gauge.value for s in primary.special]
+
+
+def test_the_crossing_eigenvalue_is_followed_by_its_eigenvector():
+    """A weak field leaves the free balloon's translation nearly a zero mode (eigenvalue ~1e-3): the pear eigenvalue
+    passes it on its way through zero, so by rank the crossing would be read as 1e-3 → −0.03 (and the Newton start
+    put at the bracket's start); followed by its eigenvector it is the pear eigenvalue, 0.118 → −0.031."""
+    values = [np.array([7.7e-4, 0.118, 2.7]), np.array([-0.031, 7.7e-4, 2.6])]
+    translation, pear, other = np.eye(3)
+    vectors = [np.stack([translation, pear, other], axis=1), np.stack([pear, translation, other], axis=1)]
+    assert bifurcation.followed_crossing(values, vectors, np.eye(3), 0) == (1, 0)
+    same = [np.array([0.2, 1.0, 2.0]), np.array([-0.1, 1.1, 2.1])]  # no passing: the rank's own crossing
+    assert bifurcation.followed_crossing(same, [np.eye(3), np.eye(3)], np.eye(3), 0) == (0, 0)
+
+
+def test_the_free_pitchfork_of_a_weak_field_is_located():
+    """The single coil of radius 4 (a weak field at the balloon): its free pitchforks, where the pear eigenvalue
+    passes the nearly free translation's, are located, within 1e-3 of the held ones in P (relative: the field barely
+    couples the translation), each the free block's zero."""
+    scene = load_scene(ROOT / "scenes" / "spom1_single_coil.toml")
+    primary = trace_primary(scene)
+    primary.stability, _ = assess_branch(primary, scene.stability.degree, True, check=True)
+    found = [bifurcation.locate(primary, *event) for event in bifurcation.detect(primary, primary.stability)]
+    held = [bp for bp in found if bp.block == Block.ODD_HELD]
+    free = [bp for bp in found if bp.block == Block.ODD_FREE]
+    assert len(free) == len(held) == 2 and all(bp.status == Status.LOCATED for bp in found)
+    for h, f in zip(held, free):
+        assert abs(h.X[-1] - f.X[-1]) < 1e-3 * h.X[-1] and f.gauge == Gauge.FREE

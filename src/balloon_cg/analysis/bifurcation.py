@@ -38,6 +38,24 @@ from ..numerics.threads import limited_blas
 EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
 
 
+def _eigenpairs(variation, u, params, idx, count: int):
+    """The ``count`` lowest eigenvalues of a block and their eigenvectors (columns, on the block's indices)."""
+    H, _ = variation.matrices(u, params)
+    return scipy.linalg.eigh(H[np.ix_(idx, idx)], variation.gram[np.ix_(idx, idx)], subset_by_index=[0, count - 1])
+
+
+def followed_crossing(values, vectors, gram, k: int) -> tuple[int, int]:
+    """(i, j): the eigenvalue i at one end of a bracket and j at the other that are one eigenvalue followed by its
+    eigenvector (j the largest Gram overlap of i's) and change sign, the one nearest rank k; (k, k) when none does.
+    By rank alone the crossing eigenvalue is misread where it passes another one inside the bracket (a free
+    balloon's translation in a weak field: an eigenvalue ~1e-3 that the pear eigenvalue passes on its way to 0)."""
+    (v0, V0), (v1, V1) = (values[0], vectors[0]), (values[1], vectors[1])
+    overlap = np.abs(V0.T @ gram @ V1)
+    candidates = [(abs(i - k), i, int(overlap[i].argmax())) for i in range(len(v0))
+                  if v0[i] * v1[int(overlap[i].argmax())] < 0]
+    return min(candidates)[1:] if candidates else (k, k)
+
+
 def _eigenpair(variation, u, params, idx, k):
     """The k-th lowest eigenvalue (from 0) of a block and its eigenvector on the full perturbation basis."""
     H, _ = variation.matrices(u, params)
@@ -111,21 +129,28 @@ def extended_degrees(branch: Branch, index: int) -> tuple[int, int]:
 
 def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "ExtendedSolution | None" = None):
     """Newton on the extended system of ``block`` (branch_point) on the plain degree that holds the bracket,
-    from the point of the bracket where the crossing eigenvalue interpolates to zero (or from ``start``)."""
+    from the point of the bracket where the crossing eigenvalue (``followed_crossing``) interpolates to zero, with
+    its mode there (or from ``start``, with the mode of the eigenvalue nearest zero)."""
     degree = max(extended_degrees(branch, index))
     plain = Discretisation(degree, True, branch.disc.pin_translation)
     eq = Equilibrium(branch.scene, plain)
     variation = SecondVariation(eq, degree)
     idx = block_indices(variation, block, field_on=True)
     params = branch.params
+    count, gram = min(k + 3, idx.size), variation.gram[np.ix_(idx, idx)]
+    reference = None  # the crossing mode at the bracket's start: the guess's mode is the one nearest it
     if start is None:
         ends = branch.disc.transfer(branch.X[index:index + 2], plain)
-        values = [_eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0] for X in ends]
-        s = float(np.clip(values[0] / (values[0] - values[1]), 0.0, 1.0))
-        guess = ends[0] + s * (ends[1] - ends[0])
+        pairs = [_eigenpairs(variation, X[:-1], branch.params_at(X), idx, count) for X in ends]
+        i, j = followed_crossing([p[0] for p in pairs], [p[1] for p in pairs], gram, k)
+        s = float(np.clip(pairs[0][0][i] / (pairs[0][0][i] - pairs[1][0][j]), 0.0, 1.0))
+        guess, reference = ends[0] + s * (ends[1] - ends[0]), pairs[0][1][:, i]
     else:
         guess = branch.disc.transfer(start.X, plain)
-    _, mode = _eigenpair(variation, guess[:-1], branch.params_at(guess), idx, k)
+    values, vectors = _eigenpairs(variation, guess[:-1], branch.params_at(guess), idx, count)
+    n = np.argmin(np.abs(values)) if reference is None else np.argmax(np.abs(vectors.T @ gram @ reference))
+    mode = np.zeros(variation.gram.shape[0])
+    mode[idx] = vectors[:, n]
     if block != Block.EVEN:
         ell = mode[idx] / np.linalg.norm(mode[idx])
         system = WernerSpence(eq, params, ell, branch.parameter, block)
@@ -139,7 +164,8 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     result = newton(system.residual, system.jacobian, X0, np.zeros((0, X0.size)), [], solver.tol, solver.max_newton)
     solution = result.x if result.converged else X0  # a failed Newton keeps its starting point (it says so)
     X = solution[:plain.size + 1]
-    eigenvalue, _ = _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)
+    values = _eigenpairs(variation, X[:-1], branch.params_at(X), idx, count)[0]
+    eigenvalue = values[np.argmin(np.abs(values))]  # the crossing one: nearest zero at the branch point
     beta = system.beta(solution) if block == Block.EVEN else 0.0
     return ExtendedSolution(plain.transfer(X, branch.disc), system.mode(solution), degree, result.converged,
                             result.message, float(eigenvalue), float(beta))
