@@ -84,6 +84,7 @@ def test_round_trip_is_bit_exact(run_path, surface_branch, basis):
     assert list(run["branches"]) == ["primary", "m1_bp0"]
     assert run["branches"]["primary"]["attrs"]["m"] == 0
     d, b = run["branches"]["m1_bp0"], surface_branch
+    assert d["attrs"]["gauge"] == b.gauge.value  # the reading (issue 27)
     assert np.array_equal(d["coefficients"], b.coefficients)
     assert np.array_equal(d["pressure"], b.values)
     assert np.array_equal(d["lam2_north"], b.measures["lam_north"])

@@ -1,11 +1,12 @@
 """Branch points of the primary branch, their classification, the pear-shaped branches and snap-through.
 
 Detection: a sign change, between neighbouring points, of the lowest eigenvalue of a block of the second
-variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks; the even block gives
-equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. Both are BP
-special points; their ``block`` says which.
+variation (``stability``): the pear block (odd_held) gives symmetry-breaking pitchforks of the held balloon,
+and with a field the pear block with the translation (odd_free) those of the free balloon; the even block gives
+equator-symmetric (prolate/oblate) branch points unless the change coincides with a fold in P. All are BP
+special points; their ``block`` says which (and ``gauge`` which reading: ``results.Gauge.of_block``).
 Location: Newton on an extended system that is regular at the branch point (``branch_point``: Werner–Spence
-for a pear point, Moore's system for an even-block point), from the detection bracket, on the plain degree in
+for a pear point of either reading, Moore's system for an even-block point), from the detection bracket, on the plain degree in
 x that holds it (``plain_degree``). The point is LOCATED when Newton converged, the crossing eigenvalue there is
 below ``EIGENVALUE_TOL`` (and Moore's β too), and the crossing is resolved at the bracketing points (signs and
 values agree at each point's assessment degree and its check degree, ``stability.assessed_degrees`` and
@@ -28,13 +29,31 @@ from ..numerics.newton import newton
 from .branch_point import MooreSystem, WernerSpence
 from .problem import equilibrium_of
 from .resolution import Resolution
-from .results import Block, Branch, Classification, Kind, SpecialPoint, Status, approximate
+from .results import Block, Branch, Classification, Gauge, Kind, SpecialPoint, Status, approximate
 from .crossings import branch_point_crossings
 from .stability import SecondVariation, Variations, assessed_degrees, block_indices, convergence_problems
 from .tracer import Tracer
 from ..numerics.threads import limited_blas
 
 EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
+
+
+def _eigenpairs(variation, u, params, idx, count: int):
+    """The ``count`` lowest eigenvalues of a block and their eigenvectors (columns, on the block's indices)."""
+    H, _ = variation.matrices(u, params)
+    return scipy.linalg.eigh(H[np.ix_(idx, idx)], variation.gram[np.ix_(idx, idx)], subset_by_index=[0, count - 1])
+
+
+def followed_crossing(values, vectors, gram, k: int) -> tuple[int, int]:
+    """(i, j): the eigenvalue i at one end of a bracket and j at the other that are one eigenvalue followed by its
+    eigenvector (j the largest Gram overlap of i's) and change sign, the one nearest rank k; (k, k) when none does.
+    By rank alone the crossing eigenvalue is misread where it passes another one inside the bracket (a free
+    balloon's translation in a weak field: an eigenvalue ~1e-3 that the pear eigenvalue passes on its way to 0)."""
+    (v0, V0), (v1, V1) = (values[0], vectors[0]), (values[1], vectors[1])
+    overlap = np.abs(V0.T @ gram @ V1)
+    candidates = [(abs(i - k), i, int(overlap[i].argmax())) for i in range(len(v0))
+                  if v0[i] * v1[int(overlap[i].argmax())] < 0]
+    return min(candidates)[1:] if candidates else (k, k)
 
 
 def _eigenpair(variation, u, params, idx, k):
@@ -73,7 +92,8 @@ def locate(branch: Branch, index: int, block: Block, k: int = 0) -> SpecialPoint
         problems += crossing_problems(branch, index, block, k)
     fields = {"status": Status.LOCATED} if not problems else approximate(
         branch.disc, before, after, f"branch point ({block.value} block): " + "; ".join(problems))
-    return SpecialPoint(Kind.BP, index, found.X, block=block, mode=found.mode, **fields)
+    return SpecialPoint(Kind.BP, index, found.X, block=block, mode=found.mode,
+                        gauge=Gauge.of_block(block, branch.field_acts), **fields)
 
 
 @dataclass
@@ -109,24 +129,31 @@ def extended_degrees(branch: Branch, index: int) -> tuple[int, int]:
 
 def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "ExtendedSolution | None" = None):
     """Newton on the extended system of ``block`` (branch_point) on the plain degree that holds the bracket,
-    from the point of the bracket where the crossing eigenvalue interpolates to zero (or from ``start``)."""
+    from the point of the bracket where the crossing eigenvalue (``followed_crossing``) interpolates to zero, with
+    its mode there (or from ``start``, with the mode of the eigenvalue nearest zero)."""
     degree = max(extended_degrees(branch, index))
     plain = Discretisation(degree, True, branch.disc.pin_translation)
     eq = Equilibrium(branch.scene, plain)
     variation = SecondVariation(eq, degree)
-    idx = block_indices(variation, block, field_on=False)
+    idx = block_indices(variation, block, field_on=True)
     params = branch.params
+    count, gram = min(k + 3, idx.size), variation.gram[np.ix_(idx, idx)]
+    reference = None  # the crossing mode at the bracket's start: the guess's mode is the one nearest it
     if start is None:
         ends = branch.disc.transfer(branch.X[index:index + 2], plain)
-        values = [_eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0] for X in ends]
-        s = float(np.clip(values[0] / (values[0] - values[1]), 0.0, 1.0))
-        guess = ends[0] + s * (ends[1] - ends[0])
+        pairs = [_eigenpairs(variation, X[:-1], branch.params_at(X), idx, count) for X in ends]
+        i, j = followed_crossing([p[0] for p in pairs], [p[1] for p in pairs], gram, k)
+        s = float(np.clip(pairs[0][0][i] / (pairs[0][0][i] - pairs[1][0][j]), 0.0, 1.0))
+        guess, reference = ends[0] + s * (ends[1] - ends[0]), pairs[0][1][:, i]
     else:
         guess = branch.disc.transfer(start.X, plain)
-    _, mode = _eigenpair(variation, guess[:-1], branch.params_at(guess), idx, k)
-    if block == Block.ODD_HELD:
+    values, vectors = _eigenpairs(variation, guess[:-1], branch.params_at(guess), idx, count)
+    n = np.argmin(np.abs(values)) if reference is None else np.argmax(np.abs(vectors.T @ gram @ reference))
+    mode = np.zeros(variation.gram.shape[0])
+    mode[idx] = vectors[:, n]
+    if block != Block.EVEN:
         ell = mode[idx] / np.linalg.norm(mode[idx])
-        system = WernerSpence(eq, params, ell, branch.parameter)
+        system = WernerSpence(eq, params, ell, branch.parameter, block)
         X0 = np.concatenate([guess, ell])
     else:
         psi = plain.join(mode[: degree + 1], mode[degree + 1:])
@@ -137,7 +164,8 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     result = newton(system.residual, system.jacobian, X0, np.zeros((0, X0.size)), [], solver.tol, solver.max_newton)
     solution = result.x if result.converged else X0  # a failed Newton keeps its starting point (it says so)
     X = solution[:plain.size + 1]
-    eigenvalue, _ = _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)
+    values = _eigenpairs(variation, X[:-1], branch.params_at(X), idx, count)[0]
+    eigenvalue = values[np.argmin(np.abs(values))]  # the crossing one: nearest zero at the branch point
     beta = system.beta(solution) if block == Block.EVEN else 0.0
     return ExtendedSolution(plain.transfer(X, branch.disc), system.mode(solution), degree, result.converged,
                             result.message, float(eigenvalue), float(beta))
@@ -161,16 +189,17 @@ def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[
 
     def eigenvalue(n, degree):
         variation, X = variations[degree], branch.X[n]
-        idx = block_indices(variation, block, field_on=False)
+        idx = block_indices(variation, block, field_on=True)
         return _eigenpair(variation, X[:-1], branch.params_at(X), idx, k)[0]
 
     return convergence_problems(branch, index, eigenvalue, assessed_degrees(branch)[index:index + 2])
 
 
-def general_tracer(scene) -> Tracer:
-    """The general (non-symmetric) space, balloon held at its centre: the branch points are those of the held
-    reading (the 'odd_held' block), so the branches leaving them are traced with b_0 = 0 too."""
-    return Tracer(scene, symmetric=False, held=True)
+def general_tracer(scene, block: Block = Block.ODD_HELD) -> Tracer:
+    """The general (non-symmetric) space of the reading of a branch point of ``block``: the balloon held at its
+    centre (b_0 = 0, the 'odd_held' and 'even' blocks), or free (b_0 an unknown, its equation the vanishing net
+    axial force: the 'odd_free' block)."""
+    return Tracer(scene, symmetric=False, held=block != Block.ODD_FREE)
 
 
 def plain_degree(branch: Branch, X) -> int:
@@ -212,7 +241,7 @@ def classify(branch: Branch, bp: SpecialPoint, delta: float = 2e-2) -> SpecialPo
     """``bp`` with E2, E3, E4 of the reduced energy at its parameters (P, and Φ̄) and its classification (module
     docstring); unclassified (Classification.NONE) when fewer than three constrained minimisations converge."""
     solver = branch.scene.solver
-    tracer = general_tracer(branch.scene)
+    tracer = general_tracer(branch.scene, bp.block)
     degree = plain_degree(branch, bp.X)
     eq = tracer.system(degree, branch.params).eq
     u_star = to_general(branch, tracer, degree, bp.X[:-1])

@@ -17,7 +17,9 @@ Pear (odd_held block; a symmetry-breaking pitchfork), Werner–Spence:
               ℓ·φ − 1       = 0   (1)    normalisation
 
 J_u is regular at a symmetry-breaking pitchfork (the singular direction is not in the symmetric space), and
-the system is regular there when the pear eigenvalue crosses zero transversally along the branch.
+the system is regular there when the pear eigenvalue crosses zero transversally along the branch. The same
+system with the odd_free block (the pear block and the axial translation b_0: a free balloon in a field) locates
+the free balloon's pitchfork: b_0 is odd under z → −z, and the symmetric state's net axial force vanishes.
 
 Even block (a branch point inside the symmetric space), Moore's system for a simple bifurcation point of
 F(x) = R(u; p), x = (u, p) (n equations, n + 1 unknowns), F_x = [J_u, R_p]:
@@ -56,15 +58,16 @@ def _parameter_step(p: float) -> float:
 
 class WernerSpence:
     """R(u; p) = 0, H_odd(u; p) φ = 0, ℓ·φ = 1 as a map of X = (u, p, φ) (module docstring): square, n + m + 1;
-    p the Parameters field ``parameter`` ("P" or "voltage")."""
+    p the Parameters field ``parameter`` ("P" or "voltage"), H_odd the block ``block`` (odd_held or odd_free)."""
 
-    def __init__(self, equilibrium: Equilibrium, params, ell: np.ndarray, parameter: str = "P"):
+    def __init__(self, equilibrium: Equilibrium, params, ell: np.ndarray, parameter: str = "P",
+                 block: str = "odd_held"):
         disc = equilibrium.disc
         if not disc.symmetric or disc.mapping is not None:
             raise ValueError("the pear system needs a plain equator-symmetric discretisation")
         self.eq, self.params, self.continuation_parameter = equilibrium, params, parameter
         self.variation = SecondVariation(equilibrium, disc.degree)
-        self.odd = block_indices(self.variation, "odd_held", field_on=False)
+        self.odd = block_indices(self.variation, block, field_on=True)
         self.basis = self.variation.basis
         self.embed = symmetric_embedding(disc)
         self.n, self.m = disc.size, self.odd.size

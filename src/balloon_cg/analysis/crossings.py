@@ -1,8 +1,8 @@
 """Crossings of the second variation's eigenvalues, and a perturbation degree per point that resolves them.
 
 A crossing (``sign_changes``) is an eigenvalue μ_k (from the lowest, k = 0) of a block that changes sign
-between neighbouring points n and n + 1: where the branch-point searches (``bifurcation``: the blocks odd_held
-and even of an equator-symmetric branch; ``azimuthal_points``: the blocks m<m>_held/free) look for a branch
+between neighbouring points n and n + 1: where the branch-point searches (``bifurcation``: the blocks odd_held,
+even and odd_free of an equator-symmetric branch; ``azimuthal_points``: the blocks m<m>_held/free) look for a branch
 point. At a bracketing point assessed at perturbation degree N, μ_k is *resolved* (``resolved``) when its value
 at the check degree N' (``stability.check_degree``: 2N, at solver.max_degree the coarser N/1.5) agrees with it
 in sign and to half its size,
@@ -47,9 +47,10 @@ def sign_changes(assessments, block: str) -> list[tuple[int, int]]:
 def branch_point_crossings(assessments, m_max: int, folds=frozenset()) -> list[tuple[int, Block, int]]:
     """(n, block, k) of every crossing a branch-point search reads, ordered by n: the pear and the even block
     (the even block's crossing at a fold in P, an interval in ``folds``, is the fold, not a branch point:
-    ``bifurcation.detect``), then the azimuthal blocks m = 1..m_max, held then free (``azimuthal_points``)."""
-    events = [(n, block, k) for block in (Block.ODD_HELD, Block.EVEN) for n, k in sign_changes(assessments, block)
-              if not (block == Block.EVEN and n in folds)]
+    ``bifurcation.detect``), the pear block of a free balloon in a field (odd_free: the translation included),
+    then the azimuthal blocks m = 1..m_max, held then free (``azimuthal_points``)."""
+    events = [(n, block, k) for block in (Block.ODD_HELD, Block.EVEN, Block.ODD_FREE)
+              for n, k in sign_changes(assessments, block) if not (block == Block.EVEN and n in folds)]
     events += [(n, block, k) for m in range(1, m_max + 1) for block in (Block.azimuthal(m, True),
                                                                           Block.azimuthal(m, False))
                for n, k in sign_changes(assessments, block)]

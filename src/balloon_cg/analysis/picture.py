@@ -1,7 +1,8 @@
 """The whole picture of a scene: primary branch, stability, branch points, pear branches, snap-through.
 
 ``analyse(scene)`` traces the primary branch, assesses every point (``stability``), locates and classifies its
-branch points (``bifurcation``), follows each pear-shaped branch (``switching``) until it rejoins the primary
+branch points (``bifurcation``; in a field those of the held and of the free balloon, each point and branch
+labelled with its reading, ``results.Gauge``), follows each pear-shaped branch (``switching``) until it rejoins the primary
 branch (a fold candidate there is the rejoin's branch point: ``switching.mark_rejoin``) or stops, assesses it,
 and adds its mirror image (north and south poles swapped: the reflection z → −z of the branch and its
 assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
@@ -9,8 +10,12 @@ locates the branch points of the non-axisymmetric blocks on every branch (``azim
 branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
 whole sphere (``surface_branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
 snap-throughs under the scene's loading control
-(pressure, volume or gas: its held stability flag). A voltage continuation (at fixed P) gets the same, with
-Φ̄ as the parameter of every branch and of its branch points. Every branch carries its assessments in
+(pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
+Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
+that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
+LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
+continuation in the coil heights (``broken_symmetry``); the branches bifurcating from it are not traced
+(``Picture.not_searched`` says so). Every branch carries its assessments in
 ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
@@ -18,12 +23,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation, mirror, surface_branches
+from . import azimuthal_points, bifurcation, broken_symmetry, control_points, mirror, surface_branches
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
 from .problem import equilibrium_of
-from .results import Block, Branch, Origin, Status, StopCode
+from .results import Block, Branch, Gauge, Kind, Origin, Status, StopCode
 from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
 from .timing import Clock, Step
@@ -33,6 +38,10 @@ from ..numerics.threads import limited_blas
 
 
 MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
+BROKEN = "broken_pear"  # the pear branch a broken equator symmetry disconnects (``broken_symmetry``)
+PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear branch's name: <prefix>_<BP number>
+MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",
+         Block.EVEN: "equator-symmetric (even)"}
 ROTATED = "_rotated"  # the suffix of a non-axisymmetric branch's image under the rotation by π about the axis
 OPPOSITE = "_opposite"  # the suffix of the branch traced along −φ (even m: the rotation by π maps the mode to itself)
 
@@ -82,7 +91,8 @@ class SnapThrough:
 @dataclass
 class Picture:
     branches: list
-    branch_points: list = field(default_factory=list)  # the primary branch's BP special points, in order
+    branch_points: list = field(default_factory=list)  # the primary branch's m = 0 BP special points, in order
+    #                                                    (the free balloon's odd_free points after the others)
     snaps: list = field(default_factory=list)  # SnapThrough
     not_searched: str = ""  # why branch points were not searched, if they were not
     not_started: list = field(default_factory=list)  # (name, reason) of bifurcating branches that could not start
@@ -141,21 +151,18 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     if not _assess(primary, scene, primary.disc.symmetric, progress, clock):
         picture.interrupted = True
         return picture
-    if not primary.disc.symmetric:
-        progress.finish(Phase.STABILITY, len(primary.X))
-        picture.not_searched = ("branch points are searched on equator-symmetric primary branches only; this "
-                                "scene's field (or continuation.symmetry = 'none') breaks the symmetry")
-        return picture
-    with clock.step(Step.BRANCH_POINTS):
-        for n, (index, block, k) in enumerate(bifurcation.detect(primary, primary.stability)):
-            if _stopped(picture):
-                break
-            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
-            mode = "pear (odd)" if block == Block.ODD_HELD else "equator-symmetric (even)"
-            bp.note = f"{mode} mode, branch point {n}"
-            picture.branch_points.append(bp)
-            primary.special.append(bp)
-    primary.special.sort(key=lambda s: s.index)
+    if primary.disc.symmetric:
+        _branch_points(primary, picture)
+    else:
+        with clock.step(Step.BRANCH_POINTS):
+            primary.special += control_points.find(primary)
+        primary.special.sort(key=_along)
+        search = pear and not scene.field.is_equator_symmetric  # continuation.symmetry = "none": none broken
+        if search and not _stopped(picture):
+            with clock.step(Step.PEAR_BRANCHES):
+                _trace_broken(scene, primary, picture, progress)
+        picture.not_searched = _unsearched(primary, search)
+        pear = False  # no equator-symmetric pitchforks to switch at
     if _stopped(picture):
         return picture
     if pear:
@@ -168,14 +175,69 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
             return picture
         with clock.step(Step.CROSSINGS):
             branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
-        branch.special.sort(key=lambda s: s.index)
+        branch.special.sort(key=_along)
     if pear and scene.surface.branches != "none":
         with clock.step(Step.SURFACE_BRANCHES):
             _trace_surface(scene, primary, picture, progress)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
+    _label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
-        picture.snaps = snap_throughs(picture.branches, scene.loading.control)
+        picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
     return picture
+
+
+def _along(s) -> tuple:
+    """The order of special points along a branch: by interval, the free reading's after the others in one (so
+    the numbering of the held reading's branch points does not depend on the free ones before them there)."""
+    return s.index, Gauge.of_block(s.block, True) == Gauge.FREE
+
+
+def _label_readings(branches: list) -> None:
+    """Each special point's reading (``results.Gauge``): a branch point's from its block, the others' (folds, end
+    points, a surface branch's secondary points) from their branch."""
+    for branch in branches:
+        for s in branch.special:
+            s.gauge = Gauge.of_block(s.block, branch.field_acts) if s.kind == Kind.BP and s.block else branch.gauge
+
+
+def _branch_points(primary: Branch, picture: Picture) -> None:
+    """The located and classified m = 0 branch points of an equator-symmetric primary branch (``bifurcation``),
+    in ``picture.branch_points`` and among the branch's special points."""
+    with picture.clock.step(Step.BRANCH_POINTS):
+        # the free balloon's pear points (odd_free) after the others: the held numbering does not depend on them
+        crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
+        for n, (index, block, k) in enumerate(crossings):
+            if _stopped(picture):
+                break
+            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
+            bp.note = f"{MODES[block]} mode, branch point {n}"
+            picture.branch_points.append(bp)
+            primary.special.append(bp)
+    primary.special.sort(key=_along)
+
+
+def _trace_broken(scene, primary: Branch, picture: Picture, progress: Progress) -> None:
+    """The pear branch the broken equator symmetry disconnects (``broken_symmetry``), assessed; a failure to find
+    it is a branch not started."""
+    try:
+        branch = broken_symmetry.broken_pear(scene, primary, BROKEN, progress.ticker(Phase.PEAR))
+    except broken_symmetry.HomotopyError as error:
+        picture.not_started.append((BROKEN, str(error)))
+        return
+    if branch is not None:
+        picture.branches.append(branch)
+        _assess(branch, scene, False, progress, picture.clock)
+
+
+def _unsearched(primary: Branch, searched: bool) -> str:
+    """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``); ``searched``:
+    the disconnected pear branch was searched for (``_trace_broken``)."""
+    missing = ("the branches at its branch points are not traced" if searched else
+               "the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
+               "and those at its branch points) are not traced")
+    if primary.gauge == Gauge.HELD:
+        missing += "; nor is the free balloon's branch (its axial translation free)"
+    return missing
 
 
 def _stopped(picture: Picture) -> bool:
@@ -186,20 +248,21 @@ def _stopped(picture: Picture) -> bool:
 
 
 def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
-    """Pear branches from the pear branch points, each with its mirror image: the reflection of the pear branch
+    """Pear branches from the pear branch points of both readings (held: pear_<n>; free, in a field: pear_free_<n>,
+    traced with the translation free), each with its mirror image: the reflection of the pear branch
     in a scene invariant under z → −z (``mirror``: its Origin says how it was obtained), else traced; a branch
     that rejoins at an already traced point is not repeated. An interrupt ends the search after the branch being
     traced (which is kept; assessed unless the signal came before or during its assessment)."""
     reached = set()
     reflect = mirror.reflectable(scene)
     for n, bp in enumerate(picture.branch_points):
-        if bp.block != Block.ODD_HELD or n in reached:
+        if bp.block not in PEAR_NAMES or n in reached:
             continue
         pear, south_turns = None, []
         for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
             if interrupt.requested():
                 return
-            name = f"pear_{n}{suffix}"
+            name = f"{PEAR_NAMES[bp.block]}_{n}{suffix}"
             origin = Origin.TRACED
             if sign < 0 and pear is not None:
                 reflected = mirror.reflection(pear, south_turns, name)
@@ -253,13 +316,14 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:
-    """The pear branch point where ``branch`` rejoined the primary branch (nearest in the continuation parameter,
-    P or Φ̄), if any."""
+    """The pear branch point of the reading of ``origin`` (the same block) where ``branch`` rejoined the primary
+    branch (nearest in the continuation parameter, P or Φ̄), if any."""
     if not branch.stopped(StopCode.REJOINED):
         return None
     p_end = branch.X[-1, -1]
+    block = branch_points[origin].block
     candidates = [(abs(bp.X[-1] - p_end), n) for n, bp in enumerate(branch_points)
-                  if n != origin and bp.block == Block.ODD_HELD]
+                  if n != origin and bp.block == block]
     return min(candidates)[1] if candidates else None
 
 

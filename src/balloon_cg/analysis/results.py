@@ -41,7 +41,15 @@ class Block(enum.StrEnum):
 
     NONE = ""
     ODD_HELD = "odd_held"  # pear-shaped (symmetry-breaking) modes, balloon held at its centre
+    ODD_FREE = "odd_free"  # pear-shaped modes and the axial translation b_0: a free balloon in a field
     EVEN = "even"  # equator-symmetric modes
+    # every axisymmetric mode of a branch without equator symmetry, balloon held, under pressure, volume, gas control
+    ALL_HELD = "all_held"
+    ALL_VOLUME_HELD = "all_volume_held"
+    ALL_GAS_HELD = "all_gas_held"
+    ALL_FREE = "all_free"  # ... balloon free (b_0 an unknown: a branch traced with continuation.symmetry = "none")
+    ALL_VOLUME_FREE = "all_volume_free"
+    ALL_GAS_FREE = "all_gas_free"
     # non-axisymmetric cos mφ modes, m = 1..8 (stability.m_max ≤ 8): held at the centre, or free (with a field)
     M1_HELD = "m1_held"
     M1_FREE = "m1_free"
@@ -74,6 +82,27 @@ class Block(enum.StrEnum):
     def held(self) -> bool:
         """Whether the block is the held reading (the balloon held at its centre)."""
         return self.value.endswith("_held")
+
+
+class Gauge(enum.StrEnum):
+    """Which reading of the rigid translation a special point or a branch belongs to. Held: the balloon is held at
+    its centre (axisymmetric: b_0 = 0, the net axial force is a reaction; m ≥ 1 blocks and the whole-sphere
+    branches born from them: the lateral translation, the axial one an unknown there); free: the translation is
+    an unknown (the net force vanishes). Both: the readings coincide (no field acts, so the translation is an
+    exact zero mode, removed; or the point's mode and the branch's states have no translation component:
+    equator-symmetric)."""
+
+    BOTH = "both"
+    HELD = "held"
+    FREE = "free"
+
+    @classmethod
+    def of_block(cls, block: Block, field_acts: bool) -> "Gauge":
+        """The reading of a branch point of ``block``: the held or free one of its name where a field acts, else
+        both (the even block never has a translation component)."""
+        if not field_acts or block in (Block.NONE, Block.EVEN):
+            return cls.BOTH
+        return cls.HELD if block.held else cls.FREE
 
 
 class Status(enum.StrEnum):
@@ -117,6 +146,9 @@ class Origin(enum.StrEnum):
     #                                                    the north pole only (min_stretch), which is not reflected
     TRACED_REFLECTION_FAILED = "traced_reflection_failed"  # a mirror image traced: a reflected point's residual
     #                                                        was above solver.tol
+    CONTINUED_IN_HEIGHT = "continued_in_height"  # a branch a broken equator symmetry disconnects: a point of the
+    #                                              symmetric relative's pear branch continued in the coil heights,
+    #                                              then traced (``analysis.broken_symmetry``)
 
 
 @dataclass
@@ -137,6 +169,7 @@ class SpecialPoint:
     mode: np.ndarray | None = None  # critical eigenvector of a branch point (a_0..a_N, b_0..b_N, in x)
     stop: Stop | None = None  # an end point's stop
     note: str = ""  # for people only
+    gauge: Gauge = Gauge.BOTH  # the reading it belongs to: a BP's block's, a fold's or end point's its branch's
 
     def __repr__(self):
         label = " ".join(v for v in (self.kind.value, self.classification.value, self.block.value) if v)
@@ -219,6 +252,19 @@ class Branch:
         """The value of parameter ``name`` at every point (constant unless it is the continuation parameter)."""
         return self.X[:, -1] if self.parameter == name else np.full(len(self.X), getattr(self.params, name))
 
+    @property
+    def field_acts(self) -> bool:
+        """Whether a field acts on the balloon (coils and M > 0): the held and free readings then differ."""
+        return bool(self.scene.field.coils) and self.params.M > 0
+
+    @property
+    def gauge(self) -> Gauge:
+        """The reading its states are equilibria of: both on an equator-symmetric layout (b_0 = 0 and the net axial
+        force vanishes by symmetry) or without a field; else held (b_0 = 0 pinned) or free (b_0 an unknown)."""
+        if self.disc.symmetric or not self.field_acts:
+            return Gauge.BOTH
+        return Gauge.HELD if self.disc.pin_translation else Gauge.FREE
+
     def params_at(self, X) -> Parameters:
         """The parameters of the point X = (u, p)."""
         return self.params.with_value(self.parameter, X[-1])
@@ -292,6 +338,17 @@ class SurfaceBranch:
     origin: Origin = Origin.TRACED
     reflection_of: str = ""  # REFLECTED: the branch this one is the image of (rotation by π about the axis)
     unsettled: list = field(default_factory=list)  # (verdict's interface: no check degree on the whole sphere)
+
+    @property
+    def field_acts(self) -> bool:
+        """Whether a field acts on the balloon (coils and M > 0)."""
+        return bool(self.scene.field.coils) and self.params.M > 0
+
+    @property
+    def gauge(self) -> Gauge:
+        """The reading of its states: held (the centre held laterally, as the m-blocks of the held reading it is
+        born from) where a field acts, else both."""
+        return Gauge.HELD if self.field_acts else Gauge.BOTH
 
     @property
     def pressure(self):

@@ -174,19 +174,30 @@ class SecondVariation:
         FLAGS). Azimuthal blocks m = 1..m_max enter every flag (their modes keep the volume to first order, so
         every control mode sees the same m ≥ 1 spectrum); a free balloon's flags take the held blocks where the
         translation is no zero mode to remove (no field)."""
-        half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
-        H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
-        H_gas = H + (params.P / self.eq.volume(u)) * np.outer(g, g)  # module docstring
+        out = self._axisymmetric(u, params, symmetric)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
-        matrices = (H, H_gas)
-        out = [(name, (eigen.restricted(matrices[gas], factor, g[idx] if constrained else eigen.NO_CONSTRAINT, idx),),
-                flags) for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on)]
         for m in range(1, m_max + 1):
             readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,))
             out.append((f"m{m}_held", readings[True], HELD_FLAGS if field_on else EVERY_FLAG))
             if field_on:
                 out.append((f"m{m}_free", readings[False], FREE_FLAGS))
         return out
+
+    def _axisymmetric(self, u, params: Parameters, symmetric: bool, names=None) -> list:
+        """``blocks`` of the m = 0 plan (``_plan``; only those named in ``names``, if given)."""
+        half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
+        H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
+        H_gas = H + (params.P / self.eq.volume(u)) * np.outer(g, g)  # module docstring
+        field_on = self.eq.coils.shape[0] > 0 and params.M > 0
+        matrices = (H, H_gas)
+        return [(name, (eigen.restricted(matrices[gas], factor, g[idx] if constrained else eigen.NO_CONSTRAINT, idx),),
+                 flags) for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on)
+                if names is None or name in names]
+
+    def lowest(self, u, params: Parameters, symmetric: bool, name: str) -> np.ndarray:
+        """The LOWEST eigenvalues of the one m = 0 block ``name`` at one equilibrium (``blocks``)."""
+        (_, parts, _), = self._axisymmetric(u, params, symmetric, (name,))
+        return merged_lowest(parts, LOWEST)
 
     def assess(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> Assessment:
         """Blocks (their LOWEST eigenvalues) and flags (a flag holds when every block it takes is positive) at one

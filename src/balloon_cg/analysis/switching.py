@@ -1,7 +1,8 @@
 """Branch switching at a pear branch point: the bifurcating branch and its mirror image.
 
 From u* + δφ (φ the critical mode, ±), corrected on the hyperplane normal to φ, then pseudo-arclength in the
-general (non-symmetric) space, balloon held (``bifurcation.general_tracer``), until it rejoins the primary
+general (non-symmetric) space of the branch point's reading (``bifurcation.general_tracer``: the balloon held, or
+free at an odd_free point, where the translation b_0 is an unknown and the net axial force vanishes), until it rejoins the primary
 branch (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch
 point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch);
 it ends exactly on stop_stretch (north or south), or on the loading's stop_volume/stop_amount, when it stops
@@ -47,7 +48,7 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
     too, labelled ``Turn.SOUTH`` (located as TP is for the north pole)."""
     t0 = time.perf_counter()
     scene = branch.scene
-    tracer = general_tracer(scene)
+    tracer = general_tracer(scene, bp.block)
     degree = plain_degree(branch, bp.X)
     params = branch.params
     system = tracer.system(degree, params)

@@ -143,6 +143,7 @@ def summarise_branch(b: dict) -> dict:
         **({"voltage": _range(b["voltage"]), "parameter": attrs["parameter"]} if "voltage" in b else {}),
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
         "origin": attrs.get("origin", "traced"),  # files written before reflected mirrors: every branch traced
+        "gauge": attrs["gauge"],  # io.run_file reads it from the layout in files written before it
         "reflection_of": attrs.get("reflection_of", ""),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
@@ -158,6 +159,7 @@ def summarise_surface_branch(b: dict) -> dict:
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])],
         "origin": attrs.get("origin", "traced"),
         "reflection_of": attrs.get("reflection_of", ""),
+        "gauge": attrs["gauge"],  # io.run_file reads it from M in files written before it
         "points": n,
         "pressure": _range(b["pressure"]),
         "pressures": [float(p) for p in b["pressure"]],
@@ -232,13 +234,15 @@ def _snap_symbol(run: dict, branch: str) -> str:
 
 
 def _verdict(attrs: dict) -> str:
-    """'complete', or the incomplete parts stored in a run file's root attributes."""
+    """'complete', or the incomplete parts stored in a run file's root attributes; a complete result with stated
+    limitations (a part not searched, a surface branch at its basis' cap: ``analysis.verdict.Gap.fails`` false)
+    names them."""
     if "complete" not in attrs:
         return "not assessed"
-    if attrs["complete"]:
-        return "complete"
     parts = [f"{gap} ({branch}: {message})" for gap, branch, message in
              zip(attrs["incomplete_gaps"], attrs["incomplete_branches"], attrs["incomplete_messages"])]
+    if attrs["complete"]:
+        return "complete" + (", except: " + "; ".join(parts) if parts else "")
     return "incomplete: " + "; ".join(parts)
 
 
@@ -257,7 +261,8 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
     return [
         f"surface branch {name}   (m = {b['m']}, from {parent} branch point {point}; {b['kernel_class']}, degree "
         f"{b['surface_degree']}, reflections {_reflections(b['symmetry'], b['characters'])}, nodes "
-        f"{b['nodes'][0]} × {b['nodes'][1]}, M = {b['M']:g}, chi = {b['chi']:g})",
+        f"{b['nodes'][0]} × {b['nodes'][1]}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
+        f"chi = {b['chi']:g})",
         f"  points               {b['points']}"
         + (f"  (the rotation by π about the axis of {b['reflection_of']})" if b["reflection_of"] else ""),
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
@@ -271,7 +276,7 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"  trace time           {b['wall_time']:.3f} s",
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
-        *_special_lines(b["special_points"]),
+        *_special_lines(b["special_points"], b["gauge"]),
     ]
 
 
@@ -280,7 +285,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
         return _format_surface_branch(name, b)
     lines = [
         f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
-        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, M = {b['M']:g}, chi = {b['chi']:g})",
+        f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
+        f"chi = {b['chi']:g})",
         *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "
            f"{', '.join(f'{w:.3g}' for w in b['basis_map']['widths'])} (near the wires)"]
           if b["basis_map"]["centres"] else []),
@@ -300,12 +306,17 @@ def _format_branch(name: str, b: dict) -> list[str]:
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
     ]
-    return lines + _special_lines(b["special_points"])
+    return lines + _special_lines(b["special_points"], b["gauge"])
 
 
-def _special_lines(special: list) -> list[str]:
-    """One aligned line per stored special point: label, place, P (and Φ̄), the pole stretches, the note."""
+READINGS = {"both": "held and free", "held": "held at its centre", "free": "free (net axial force zero)"}
+
+
+def _special_lines(special: list, gauge: str = "both") -> list[str]:
+    """One aligned line per stored special point: label (with its reading where it is not its branch's ``gauge``),
+    place, P (and Φ̄), the pole stretches, the note."""
     labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
+              + (f" {s['gauge']}" if s.get("gauge", gauge) != gauge else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
               for s in special]
     places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"

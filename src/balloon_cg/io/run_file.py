@@ -15,8 +15,9 @@ Layout::
                                   kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
                                   the kernels), voltage (Φ̄, fixed unless it is the parameter), parameter
                                   ("P" or "voltage": what the last unknown is), origin (traced,
-                                  reflected, ...: analysis.results.Origin), [parent_branch,
-                                  parent_branch_point, rejoins_branch_point, reflection_of]
+                                  reflected, ...: analysis.results.Origin), gauge (held, free or both:
+                                  the reading its states are equilibria of, analysis.results.Gauge),
+                                  [parent_branch, parent_branch_point, rejoins_branch_point, reflection_of]
         point, unknown                                     dimension scales (0, 1, …)
         pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
@@ -24,8 +25,8 @@ Layout::
         unknowns                                           (point, unknown): Legendre unknowns u, then P (or Φ̄)
         theta                                              (theta,): linspace(0, π), a dimension scale
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
-        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, status (located, approximate),
-                       reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
+        special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, gauge (held, free, both),
+                       status (located, approximate), reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
                        lam2_north, lam2_south, eta_north, eta_south                          (special,)
         special_points/state/unknowns                      (special, unknown): each point's own X
         stability/stable_*                                 (point,) flags
@@ -55,7 +56,8 @@ special point. Files are written atomically (``io.hdf5.atomic_file``). Files of 
 "balloon-cg/4" (the X rows in special_points/unknowns), "balloon-cg/3" (no ``m`` attribute, no surface branches:
 every branch reads as m = 0) and
 "balloon-cg/2" (no volume, no dimension scales), and so do files without amount, control or the gas stability
-flags (written before gas control).
+flags (written before gas control), and files without ``gauge`` (written before the free balloon's branch points:
+a branch's is read from its layout, ``legacy_gauge``; a special point's from its block, ``read_special``).
 """
 import io
 from pathlib import Path
@@ -218,6 +220,7 @@ def _write_branch(group, branch, theta):
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
         "origin": branch.origin.value,
+        "gauge": branch.gauge.value,
     })
     if branch.parent is not None:
         group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
@@ -295,6 +298,7 @@ def _write_surface_branch(group, branch) -> None:
         "map_centres": np.array(basis.mapping.centres if basis.mapping else [], dtype=float),
         "map_widths": np.array(basis.mapping.widths if basis.mapping else [], dtype=float),
         "origin": branch.origin.value,
+        "gauge": branch.gauge.value,
     })
     if branch.reflection_of:
         group.attrs["reflection_of"] = branch.reflection_of
@@ -412,6 +416,7 @@ def write_special(group, special: list, width: int, poles, unknown=None, paramet
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
     write_strings(group, "block", [s.block.value for s in special])
+    write_strings(group, "gauge", [s.gauge.value for s in special])
     write_strings(group, "status", [s.status.value for s in special])
     write_strings(group, "reason", [s.reason for s in special])
     group.create_dataset("uncertainty", data=np.array([s.uncertainty for s in special], dtype=float))
@@ -507,6 +512,7 @@ OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
+OPTIONAL_SPECIAL = {"voltage": ("float", 1), "gauge": ("str", 1)}  # voltage: where electric; gauge: since issue 27
 
 
 def read_branches(parent, where, error=None) -> dict:
@@ -546,7 +552,7 @@ def check_branch(group, where, error) -> None:
     points of consistent shapes)."""
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
-    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS, error)
+    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str"}, error)  # gauge: since issue 27
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
@@ -569,10 +575,10 @@ def check_branch(group, where, error) -> None:
 
 
 def check_special(group, where, width: int, error, extra: dict | None = None) -> None:
-    """The columns of a special_points group (SPECIAL_COLUMNS, [voltage], ``extra``) and its X rows
+    """The columns of a special_points group (SPECIAL_COLUMNS, OPTIONAL_SPECIAL where present, ``extra``) and its X rows
     (``special_unknowns``) ``width`` wide, one per special point."""
     n = check_columns(group, where, SPECIAL_COLUMNS | (extra or {}), error)
-    check_columns(group, where, {k: ("float", 1) for k in ("voltage",) if k in group}, error, rows=n)
+    check_columns(group, where, {k: v for k, v in OPTIONAL_SPECIAL.items() if k in group}, error, rows=n)
     check_sizes(group, where, error)
     unknowns = special_unknowns(group, where, error, rows=n)
     if n and unknowns.shape[1] != width:
@@ -659,10 +665,13 @@ def _attr(value):
 def _read_branch(group) -> dict:
     data = {name: group[name][()] for name, item in group.items() if isinstance(item, h5py.Dataset)}
     data["attrs"] = {"m": 0} | {k: _attr(v) for k, v in group.attrs.items()}  # m: files before surface branches
+    field_acts = float(data["attrs"]["M"]) > 0  # a scene with M > 0 has coils (scene validation)
+    if "gauge" not in data["attrs"]:  # files before the free reading (issue 27)
+        data["attrs"]["gauge"] = legacy_gauge(data["attrs"], field_acts)
     if "profiles" in group:
         data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
     sp = group["special_points"]
-    data["special_points"] = read_special(sp)
+    data["special_points"] = read_special(sp, field_acts, data["attrs"].get("gauge"))
     data["special_unknowns"] = special_unknowns(sp)[()]
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
@@ -682,8 +691,29 @@ def _read_snaps(group) -> list:
     return [{k: plain(v[i]) for k, v in columns.items()} for i in range(n)]
 
 
-def read_special(group) -> list:
-    """Special points written by write_special, as a list of dicts (text columns as str)."""
-    columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT}
+def read_special(group, field_acts: bool = True, branch_gauge: str | None = None) -> list:
+    """Special points written by write_special, as a list of dicts (text columns as str). A file written before
+    the free reading (no ``gauge`` column) gets a branch point's from its block (``results.Gauge.of_block``; a
+    field acts when ``field_acts``), every other point's its branch's (``branch_gauge``; unknown: held where a
+    field acts)."""
+    from ..analysis.results import Block, Gauge
+
+    columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
     columns |= {name: group[name][()] for name in ("index", "m") + SPECIAL_NUMBERS + ("voltage",) if name in group}
-    return [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
+    points = [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
+    if "gauge" not in columns:
+        blocks = {block.value: block for block in Block if block != Block.NONE}
+        fallback = {g.value: g for g in Gauge}.get(branch_gauge, Gauge.HELD if field_acts else Gauge.BOTH)
+        for s in points:
+            block = blocks.get(s["block"])
+            s["gauge"] = (Gauge.of_block(block, field_acts) if block else fallback).value
+    return points
+
+
+def legacy_gauge(attrs: dict, field_acts: bool) -> str:
+    """The reading of a branch stored without its ``gauge`` (``results.Branch.gauge`` from its layout; a surface
+    branch's ``results.SurfaceBranch.gauge``): both when equator-symmetric or without a field, else held or free
+    as its translation is pinned (held: a surface branch)."""
+    if not field_acts or attrs.get("symmetric"):
+        return "both"
+    return "held" if attrs.get("pin_translation", True) else "free"  # a surface branch (m ≥ 1): held

@@ -63,6 +63,8 @@ VARIABLES = {
                                        "LN fold in n, BP branch point, EP end point, UZ user point"),
     "classification": ("", "classification", "pitchfork, transcritical, ... (docs/hdf5.md); empty if none"),
     "block": ("", "stability block", "the second-variation block whose eigenvalue crosses zero"),
+    "gauge": ("", "reading", "held (centre held: b_0 = 0, the net axial force a reaction), free (net axial force "
+                             "zero) or both (no field, or no translation component)"),
     "status": ("", "location status", "located (converged extended system) or approximate"),
     "reason": ("", "reason", "why a special point is approximate; empty when located"),
     "stop_code": ("", "stop code", "analysis.results.StopCode of an end point"),
