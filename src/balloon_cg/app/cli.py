@@ -31,6 +31,7 @@ from ..scene.validation import did_you_mean
 from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
+CURVE_KINDS = ("BP", "LP", "LV", "LN")  # critical --of: the pear pitchfork, the folds in P, V, n
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
 BROKEN_PIPE = 141  # 128 + SIGPIPE: what a tool killed by SIGPIPE reports
 PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equator", "shapes", "stresses", "field",
@@ -538,6 +539,10 @@ def _add_critical(commands):
     p.add_argument("scene", help=f"{SCENE_HELP}; equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
                                                        "material.parameters.Jm, voltage)")
+    p.add_argument("--of", default="BP", choices=CURVE_KINDS, metavar="KIND",
+                   help="what to follow: BP (the first pear pitchfork, default), LP (the first fold in P: the "
+                        "snap-through boundary, ending in its cusp), LV or LN (the first fold in the volume or in the "
+                        "gas amount: volume or gas control)")
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="start with the parameter increasing (1, default) or decreasing (-1)")
     p.add_argument("-o", "--output", required=True, help="curve file to write (HDF5; plot it with --what phase)")
@@ -563,7 +568,7 @@ def critical(args) -> int:
     point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is.
     Progress goes to stderr (``--quiet``: none).
     """
-    from ..analysis.codim2 import CurveEnd
+    from ..analysis.codim2 import CODIM2_ENDS, CurveEnd
     from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
@@ -573,7 +578,7 @@ def critical(args) -> int:
 
     scene = scene_of(args)
     asymmetry = _asymmetry(scene)
-    if asymmetry:
+    if asymmetry and args.of == "BP":
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
     if scene.continuation.parameter != ContinuationParameter.PRESSURE:
         raise UsageError(f"critical needs a pressure continuation: {args.scene}: continuation.parameter = "
@@ -588,9 +593,10 @@ def critical(args) -> int:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
     check_output(hdf5_output(args.output, "curve"), args.force)
     with stop_on_signals():
-        curve = _pitchfork_curve(scene, args)
+        curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
         if curve is not None:
-            write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
+            write_curve(args.output, scene, curve, name="pear" if args.of == "BP" else args.of, force=args.force,
+                        extra_attrs={"command": args.command_line})
         interrupted = requested()
     if interrupted:
         written = (f"nothing is written to {args.output} (the curve had not started)" if curve is None else
@@ -598,15 +604,15 @@ def critical(args) -> int:
         print(f"{PROG}: interrupted: {written}", file=sys.stderr)
         return INTERRUPTED
     _say(args, f"curve: {len(curve.q)} points, ended: {curve.end.value}")
-    if curve.end != CurveEnd.ISOLA_MERGE:
+    if curve.end not in CODIM2_ENDS:
         raise Failure(f"no critical {curve.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
                       f"written to {args.output}")
     q, P, stretch = curve.critical
-    merge = curve.merge
+    merge, what = curve.merge, "cusp" if curve.end == CurveEnd.CUSP else "merge of the pitchforks"
     if merge.status != Status.LOCATED:
-        raise Failure(f"the merge of the pitchforks near {curve.parameter} = {q:.8g} is only approximately located "
+        raise Failure(f"the {what} near {curve.parameter} = {q:.8g} is only approximately located "
                       f"(±{merge.uncertainty:.1g}: {merge.reason}); curve written to {args.output}")
-    print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
+    print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}; {what}); "
           f"curve written to {args.output}")
     return 0
 
@@ -617,24 +623,41 @@ def _say(args, text: str) -> None:
         print(f"{PROG} critical: {text}", file=sys.stderr)
 
 
+def _primary(scene, args):
+    """The primary branch ``critical`` starts from (None when a signal stopped it)."""
+    from tqdm.auto import tqdm
+
+    from ..analysis.primary import trace_primary
+    from ..numerics.interrupt import requested
+    from .progress import shown, tqdm_disable
+
+    with tqdm(desc="primary branch", unit=" points", disable=tqdm_disable(shown(args.quiet)), file=sys.stderr) as bar:
+        branch = trace_primary(scene, progress=lambda point: bar.update())
+    return None if requested() else branch
+
+
+def _curve_bar(args):
+    """The progress bar of a two-parameter curve."""
+    from tqdm.auto import tqdm
+
+    from .progress import shown, tqdm_disable
+
+    return tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=tqdm_disable(shown(args.quiet)),
+                file=sys.stderr)
+
+
 def _pitchfork_curve(scene, args):
     """``critical``'s computation: the primary branch, its first pear pitchfork located, the curve of pitchforks
     in ``args.parameter`` (analysis.codim2). None when a signal (numerics.interrupt) stopped the work before the
     curve started; a signal during the curve ends it at its next point (end ``interrupted``)."""
-    from tqdm.auto import tqdm
-
     from ..analysis.bifurcation import detect, locate
     from ..analysis.codim2 import TwoParameterError, continue_branch_point
-    from ..analysis.primary import trace_primary
     from ..analysis.results import Block, Status
     from ..analysis.stability import assess_branch
     from ..numerics.interrupt import Interrupted, requested
-    from .progress import shown, tqdm_disable
 
-    disable = tqdm_disable(shown(args.quiet))
-    with tqdm(desc="primary branch", unit=" points", disable=disable, file=sys.stderr) as bar:
-        branch = trace_primary(scene, progress=lambda point: bar.update())
-    if requested():
+    branch = _primary(scene, args)
+    if branch is None:
         return None
     _say(args, f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
     try:
@@ -653,11 +676,45 @@ def _pitchfork_curve(scene, args):
         _say(args, f"the pear pitchfork is only approximately located (±{bp.uncertainty:.1g}: {bp.reason})")
     _say(args, f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
     try:
-        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=disable, file=sys.stderr) as bar:
+        with _curve_bar(args) as bar:
             return continue_branch_point(branch, bp, args.parameter, args.direction,
                                          progress=lambda point: bar.update())
     except TwoParameterError as e:
         raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
+
+
+FOLD_CONTROL = {"LP": "pressure", "LV": "volume", "LN": "gas"}  # the loading.control whose folds --of follows
+
+
+def _fold_curve(scene, args):
+    """``critical --of LP|LV|LN``: the primary branch traced under the control of that fold (loading.control
+    pressure, volume or gas), its first located fold of that kind, the fold curve in ``args.parameter``
+    (analysis.fold_curve). None when a signal stopped the work before the curve started."""
+    from ..analysis.codim2 import TwoParameterError
+    from ..analysis.fold_curve import continue_fold
+    from ..analysis.results import Kind, Status
+
+    control = FOLD_CONTROL[args.of]
+    if scene.loading.control.value != control:
+        scene = scene.with_overrides({"loading.control": control, "loading.stop_volume": None,
+                                      "loading.stop_amount": None}, name=scene.name)
+    branch = _primary(scene, args)
+    if branch is None:
+        return None
+    folds = [s for s in branch.special if s.kind == Kind(args.of)]
+    if not folds:
+        raise Failure(f"no {args.of} fold on the primary branch of {args.scene} ({branch.stop_reason}): nothing to "
+                      f"continue in {args.parameter}")
+    fold = folds[0]
+    if fold.status != Status.LOCATED:
+        _say(args, f"the {args.of} fold is only approximately located (±{fold.uncertainty:.1g}: {fold.reason})")
+    _say(args, f"primary branch: {len(branch.X)} points; {args.of} fold at P = {fold.X[-1]:.10g}; continuing it in "
+               f"{args.parameter}")
+    try:
+        with _curve_bar(args) as bar:
+            return continue_fold(branch, fold, args.parameter, args.direction, progress=lambda point: bar.update())
+    except TwoParameterError as e:
+        raise Failure(f"the {args.of} curve in {args.parameter} could not start: {e}") from None
 
 
 def _asymmetry(scene) -> str:
