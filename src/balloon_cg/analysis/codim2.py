@@ -307,15 +307,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     X0 = system.initial(bp, q0)
     if settings is None:
         settings = continuation_settings(scene, max_points)
-    e_q = np.zeros(X0.size)
-    e_q[-1] = 1.0
-    # corrected at fixed q0 (it may differ from the branch's): for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1
-    # may differ from the material's rounded μ1 (SPOM1: Σ μ_i α_i = 4.000004), and the located point carries the
-    # locator's tolerance
-    first = newton(system.residual, system.jacobian, X0, e_q, q0, settings.tol, settings.max_newton)
-    if not first.converged:
-        raise TwoParameterError(f"the extended system did not converge at the branch point: {first.message}")
-    path = trace_in_q(system, first, branch, parameter, q0, direction, settings, stop, progress)
+    path = trace_in_q(system, X0, "the branch point", branch, parameter, q0, direction, settings, stop, progress)
     end = _classify(path, branch.disc.size)
     name = parameter.name
     merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
@@ -338,15 +330,21 @@ def plain_branch(branch: Branch, X) -> Branch:
     return replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
 
 
-def trace_in_q(system, first, branch: Branch, parameter: SecondParameter, q0: float, direction: float,
+def trace_in_q(system, X0, what: str, branch: Branch, parameter: SecondParameter, q0: float, direction: float,
                settings: continuation.Settings, stop=None, progress=None) -> continuation.Path:
-    """Trace a curve X = (u, P, …, q) of an extended ``system`` in (q, P) from its converged point (``first``, a
-    Newton result at q0), q first moving in ``direction``, with the stop rules of the module docstring
+    """Trace a curve X = (u, P, …, q) of an extended ``system`` in (q, P) from X0 (at ``what``, a located point
+    of ``branch``, with q = q0), q first moving in ``direction``, with the stop rules of the module docstring
     (``stop(point)``: the caller's, default the return of q past q0, PARTNER) and the folds in q located (LP).
-    TwoParameterError if the point is already a fold in q."""
-    X0 = first.x
+    TwoParameterError if Newton does not converge at X0 or the point is already a fold in q."""
     e_q = np.zeros(X0.size)
     e_q[-1] = 1.0
+    # corrected at fixed q0 (it may differ from the branch's): for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1
+    # may differ from the material's rounded μ1 (SPOM1: Σ μ_i α_i = 4.000004), and the located point carries the
+    # locator's tolerance
+    first = newton(system.residual, system.jacobian, X0, e_q, q0, settings.tol, settings.max_newton)
+    if not first.converged:
+        raise TwoParameterError(f"the extended system did not converge at {what}: {first.message}")
+    X0 = first.x
     t = continuation.tangent(system, X0, direction * e_q)
     if abs(t[-1]) < 1e-8:
         raise TwoParameterError("the starting point is already a fold in q: no direction to start in")

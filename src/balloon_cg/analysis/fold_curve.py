@@ -34,7 +34,6 @@ import numpy as np
 
 from ..galerkin.equilibrium import Equilibrium
 from ..numerics import continuation
-from ..numerics.newton import newton
 from ..scene import Control
 from .branch_point import _parameter_step, _step
 from .codim2 import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status, plain_branch,
@@ -189,18 +188,13 @@ def continue_fold(branch: Branch, fold: SpecialPoint, parameter: str | SecondPar
     system = FoldSystem(eq, params, parameter, control, w)
     X0 = np.concatenate([X, w, [q0]])
     settings = settings or continuation_settings(branch.scene, max_points)
-    e_q = np.zeros(X0.size)
-    e_q[-1] = 1.0
-    first = newton(system.residual, system.jacobian, X0, e_q, q0, settings.tol, settings.max_newton)
-    if not first.converged:
-        raise TwoParameterError(f"the fold system did not converge at the {fold.kind.value}: {first.message}")
-    path = trace_in_q(system, first, branch, parameter, q0, direction, settings, stop, progress)
+    path = trace_in_q(system, X0, f"the {fold.kind.value}", branch, parameter, q0, direction, settings, stop,
+                      progress)
     end = _classify(system, path)
-    name, n = parameter.name, branch.disc.size
+    name = parameter.name
+    verdict = ": a cusp, the two folds merge" if end == CurveEnd.CUSP else " (not a verified cusp)"
     merges = [SpecialPoint(Kind.LP, f.index, f.point.X, **_merge_status(f, path, branch.disc, end, "a cusp"),
-                           note=f"fold of the {fold.kind.value} curve in {name}"
-                                + (": a cusp, the two folds merge" if end == CurveEnd.CUSP else " (not a verified cusp)"))
-              for f in path.folds]
+                           note=f"fold of the {fold.kind.value} curve in {name}{verdict}") for f in path.folds]
     return FoldCurve(parameter, branch.scene, branch.disc, params, w, np.array([p.X for p in path.points]),
                      np.array([p.iterations for p in path.points]), np.array([p.residual for p in path.points]),
                      merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), control)

@@ -11,12 +11,14 @@ Layout::
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block (BP), the
                                                    fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
-                        the verified merge of the two pitchforks or the verified cusp), unknowns in the branch layout (u, P), and q
+                        the verified merge of the two pitchforks or the verified cusp), unknowns in the branch
+                        layout (u, P), and q
 
 ``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
 the primary branch in P, V or n, group named so: ``analysis.fold_curve``). ``end`` is the curve's
-``analysis.codim2.CurveEnd`` (how it ended: isola_merge, cusp (a fold curve's two folds merge), fold, nonpositive_pressure, wire,
-budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is partial); ``end_description``
+``analysis.codim2.CurveEnd`` (how it ended: isola_merge, cusp (a fold curve's two folds merge), fold,
+nonpositive_pressure, wire, budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is
+partial); ``end_description``
 says the same for people, with where. ``parameter`` is q's short name (M, alpha1, Jm, mu[0]), ``parameter_key`` its
 scene key (field.M, material.parameters.Jm, material.mu[0]; alpha1: itself), ``parameter_derivative`` how ∂R/∂q was
 computed (exact: a generated kernel; central: central differences): ``analysis.second_parameter``. Files written
