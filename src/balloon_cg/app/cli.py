@@ -144,8 +144,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels,
-                _add_figure):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, _add_continue,
+                add_kernels, _add_figure):
         add(commands)
     parser.commands = tuple(commands.choices)
     for name, subcommand in commands.choices.items():
@@ -163,7 +163,10 @@ EXAMPLES = {  # each subcommand's --help ends with these
     "plot": ("balloon-cg plot two_coils.h5 --what pressure-pole,shapes -o p.pdf",
              "balloon-cg plot two_coils.h5 --what pressure-pole --stability volume"),
     "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:21 -o sweep.h5",),
-    "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",),
+    "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",
+                 "balloon-cg critical gent.toml --of LP --parameter material.parameters.Jm --direction -1 -o cusp.h5"),
+    "continue": ("balloon-cg continue two_coils.h5 3 -o again.h5",
+                 "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o lp.h5"),
     "kernels": ("balloon-cg kernels spom1 --json",),
     "figure": ("balloon-cg figure fig9 -o fig9.pdf --width 3.5", "balloon-cg figure all -o paper-figures"),
 }
@@ -715,6 +718,60 @@ def _fold_curve(scene, args):
             return continue_fold(branch, fold, args.parameter, args.direction, progress=lambda point: bar.update())
     except TwoParameterError as e:
         raise Failure(f"the {args.of} curve in {args.parameter} could not start: {e}") from None
+
+
+# --- continue ----------------------------------------------------------------------------------------------
+
+def _add_continue(commands):
+    p = commands.add_parser(
+        "continue", help="restart from a labelled special point of a run file (inspect shows the labels)",
+        description="Restart from the special point LABEL of a run file: without --parameter (or with the "
+                    "branch's own, P) the branch through it is traced again in both directions (a run file with "
+                    "one branch, primary); from a fold (LP, LV, LN) with --parameter KEY (a scene key, as for "
+                    "critical) the fold curve in KEY and its cusp (a curve file). Exit 0: written; 1: the "
+                    "computation did not give it (the curve did not start); 2: bad input (no such label, a "
+                    "label or parameter this does not continue yet: a BP, a surface branch).")
+    p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
+    p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
+    p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")
+    p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
+                   help="a fold curve: start with the parameter increasing (1, default) or decreasing (-1)")
+    p.add_argument("-o", "--output", required=True, help="run or curve file to write (HDF5)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(handler=owned(continue_run, "continue"))
+
+
+def continue_run(args) -> int:
+    """``continue``: the labelled point found, restarted (``app.restart``), written."""
+    from ..analysis.codim2 import TwoParameterError
+    from ..analysis.results import Branch
+    from ..analysis.second_parameter import UnknownParameter
+    from ..io.curve_file import write_curve
+    from ..io.output import check_output
+    from ..io.run_file import read_run, write_run
+    from .restart import RestartError, find_label, restart
+
+    check_output(hdf5_output(args.output, "run"), args.force)
+    run = read_run(args.run)
+    try:
+        start = find_label(run, args.label)
+        result = restart(start, args.parameter, args.direction)
+    except (RestartError, UnknownParameter) as e:
+        raise UsageError(f"continue {args.run}: {e}") from None
+    except TwoParameterError as e:
+        raise Failure(f"the curve from label {args.label} could not start: {e}") from None
+    attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
+    if isinstance(result, Branch):
+        write_run(args.output, result.scene, [result], force=args.force, extra_attrs=attrs)
+        print(f"branch continued from label {args.label}: {len(result.X)} points ({result.stop_reason}); written "
+              f"to {args.output}")
+        return 0
+    write_curve(args.output, result.scene, result, name=result.of.value, force=args.force, extra_attrs=attrs)
+    ending = f"{result.end.value}: {result.describe()}"
+    print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
+          f"written to {args.output}")
+    return 0
 
 
 def _asymmetry(scene) -> str:

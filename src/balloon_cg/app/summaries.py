@@ -305,8 +305,9 @@ def _format_branch(name: str, b: dict) -> list[str]:
 
 
 def _special_lines(special: list) -> list[str]:
-    """One aligned line per stored special point: label, place, P (and Φ̄), the pole stretches, the note."""
-    labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
+    """One aligned line per stored special point: its label (the number ``continue`` takes), kind, place, P (and
+    Φ̄), the pole stretches, the note."""
+    labels = [f"{s['label']:>3} {s['kind']} {s['classification']}".rstrip() + (f" m={s['m']}" if s["m"] else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
               for s in special]
     places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"
