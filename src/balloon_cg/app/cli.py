@@ -1,4 +1,4 @@
-"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical`` (``balloon-cg SUBCOMMAND -h``;
+"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical | continue`` (``SUBCOMMAND -h``;
 also ``python -m balloon_cg``). The computing layers are imported by the subcommand that needs them, so
 ``--help``, ``--version`` and ``inspect`` start fast.
 
@@ -6,7 +6,7 @@ Exit codes: 0 success: the result is complete (analysis.verdict: every branch re
 special point is located, stability settled); 1 the computation did not give what was asked (a branch could
 not start, or the result is incomplete: the file is still written, flagged, and the incomplete parts are named
 on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: the two-parameter curve did not
-end in a verified merge of the pitchforks); 2 bad input (invalid scene, missing or unreadable file, existing
+end in a verified merge of the pitchforks or cusp); 2 bad input (invalid scene, missing or unreadable file, existing
 output without --force or in use by another process, a damaged file, a scene ``critical`` cannot handle); 3 an
 internal error (a bug: one line asking to report it; ``--debug`` shows the traceback); 130 interrupted (SIGINT or
 SIGTERM: ``run`` and ``critical`` stop at the next point and write what is finished, flagged incomplete). Errors
@@ -164,9 +164,10 @@ EXAMPLES = {  # each subcommand's --help ends with these
              "balloon-cg plot two_coils.h5 --what pressure-pole --stability volume"),
     "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:21 -o sweep.h5",),
     "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",
-                 "balloon-cg critical gent.toml --of LP --parameter material.parameters.Jm --direction -1 -o cusp.h5"),
+                 "balloon-cg critical spom1 --set material.preset=Gent --of LP --parameter material.parameters.Jm "
+                 "--direction -1 -o cusp.h5"),
     "continue": ("balloon-cg continue two_coils.h5 3 -o again.h5",
-                 "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o lp.h5"),
+                 "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o fold.h5"),
     "kernels": ("balloon-cg kernels spom1 --json",),
     "figure": ("balloon-cg figure fig9 -o fig9.pdf --width 3.5", "balloon-cg figure all -o paper-figures"),
 }
