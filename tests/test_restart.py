@@ -100,6 +100,27 @@ def test_continue_from_a_user_point_of_the_two_coil_branch(tmp_path):
         assert len(before) == len(after) == 1 and abs(before[0] - after[0]) < tolerance, kind
 
 
+def test_continue_from_the_pear_pitchfork_gives_the_critical_curve(tmp_path, capsys):
+    """SPOM1 at M = 0: `continue RUN LABEL --parameter alpha1` from the first pear BP label (its mode recomputed,
+    not stored) traces the same curve as `critical --parameter alpha1` (every point to 1e-10) and its isola closes
+    at the same critical α1 (1.739619649392: tests/test_two_parameter.py, closed form)."""
+    scene = tmp_path / "spom1.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n[surface]\nbranches = "none"\n')
+    run, again, curve = tmp_path / "run.h5", tmp_path / "again.h5", tmp_path / "curve.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    (label, _), _ = special(run, "BP")
+    assert main(["continue", str(run), str(label), "--parameter", "alpha1", "-o", str(again), "--quiet"]) == 0
+    assert main(["critical", str(scene), "--parameter", "alpha1", "-o", str(curve), "--quiet"]) == 0
+    capsys.readouterr()
+    restarted, traced = read_curve(again), read_curve(curve)
+    assert restarted["attrs"]["end"] == traced["attrs"]["end"] == "isola_merge"
+    assert abs(restarted["attrs"]["critical_q"] - 1.739619649392) < 1e-11
+    assert abs(restarted["attrs"]["critical_q"] - traced["attrs"]["critical_q"]) < 1e-10
+    assert restarted["q"].shape == traced["q"].shape
+    assert np.abs(restarted["q"] - traced["q"]).max() < 1e-10
+    assert np.abs(restarted["pressure"] - traced["pressure"]).max() < 1e-10
+
+
 def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
     """A label the file does not have, a second parameter from an end point: one line, exit 2, nothing written."""
     path = gent_run / "gent.h5"

@@ -599,7 +599,7 @@ def critical(args) -> int:
     with stop_on_signals():
         curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
         if curve is not None:
-            write_curve(args.output, scene, curve, name="pear" if args.of == "BP" else args.of, force=args.force,
+            write_curve(args.output, scene, curve, name=curve_group(curve), force=args.force,
                         extra_attrs={"command": args.command_line})
         interrupted = requested()
     if interrupted:
@@ -687,6 +687,11 @@ def _pitchfork_curve(scene, args):
         raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
 
 
+def curve_group(curve) -> str:
+    """The group of a two-parameter curve in its file: ``pear`` (pitchforks), else its kind (LP, LV, LN)."""
+    return "pear" if curve.of.value == "BP" else curve.of.value
+
+
 FOLD_CONTROL = {"LP": "pressure", "LV": "volume", "LN": "gas"}  # the loading.control whose folds --of follows
 
 
@@ -728,10 +733,11 @@ def _add_continue(commands):
         "continue", help="restart from a labelled special point of a run file (inspect shows the labels)",
         description="Restart from the special point LABEL of a run file: without --parameter (or with the "
                     "branch's own, P) the branch through it is traced again in both directions (a run file with "
-                    "one branch, primary); from a fold (LP, LV, LN) with --parameter KEY (a scene key, as for "
-                    "critical) the fold curve in KEY and its cusp (a curve file). Exit 0: written; 1: the "
+                    "one branch, primary); with --parameter KEY (a scene key, as for critical) from a fold (LP, LV, "
+                    "LN) the fold curve in KEY and its cusp, from a pear pitchfork (BP odd_held) the curve of "
+                    "pitchforks and the isola's critical value (a curve file). Exit 0: written; 1: the "
                     "computation did not give it (the curve did not start); 2: bad input (no such label, a "
-                    "label or parameter this does not continue yet: a BP, a surface branch).")
+                    "label or parameter this does not continue yet: another BP, a surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")
@@ -768,7 +774,7 @@ def continue_run(args) -> int:
         print(f"branch continued from label {args.label}: {len(result.X)} points ({result.stop_reason}); written "
               f"to {args.output}")
         return 0
-    write_curve(args.output, result.scene, result, name=result.of.value, force=args.force, extra_attrs=attrs)
+    write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
     ending = f"{result.end.value}: {result.describe()}"
     print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
           f"written to {args.output}")

@@ -7,11 +7,13 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   branch through the point is traced again in both directions from it, with the scene's stop rules and
   ``[[events]]``, on the stored discretisation (``restart_branch``: a Branch named ``continued``);
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
-  (``analysis.fold_curve.continue_fold``).
+  (``analysis.fold_curve.continue_fold``);
+- a pear branch point (BP of block odd_held, on an equator-symmetric branch) in q: the curve of pitchforks through
+  it (``analysis.codim2.continue_branch_point``; its mode recomputed, ``pear_point``), as ``critical`` traces it.
 
 The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
-parameters and points. Not yet: a BP (its critical mode is not stored; ``critical`` follows the pear pitchfork),
-surface branches, an ordinary point in a second parameter.
+parameters and points. Not yet: the other branch points (even, m ≥ 1) in a second parameter, surface
+branches, an ordinary point in a second parameter, switching branches at a BP.
 """
 import time
 from dataclasses import dataclass
@@ -22,7 +24,10 @@ from ..analysis.assembly import assemble
 from ..analysis.events import with_events
 from ..analysis.fold_curve import CONTROL_OF_FOLD, continue_fold
 from ..analysis.primary import landing_targets, range_limits, stop_rule
-from ..analysis.results import Branch, Kind, SpecialPoint
+from ..analysis.branch_point import WernerSpence
+from ..analysis.codim2 import continue_branch_point, plain_branch
+from ..analysis.problem import equilibrium_of
+from ..analysis.results import Block, Branch, Kind, SpecialPoint
 from ..analysis.tracer import Tracer
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation
@@ -69,7 +74,7 @@ def find_label(run: dict, label: int) -> Labelled:
                 raise RestartError(f"label {label}: a point of the surface branch {name}; continue starts from "
                                    "axisymmetric branches only")
             special = SpecialPoint(Kind(point["kind"]), int(point["index"]), np.asarray(data["special_unknowns"][row]),
-                                   note=point["note"])
+                                   block=Block(point["block"]), note=point["note"])
             return Labelled(label, stored_branch(run, name), special)
     listed = f"{min(labels)}..{max(labels)}" if labels else "none"
     raise RestartError(f"label {label}: no special point has it in {run['path']} (its labels: {listed}; "
@@ -98,6 +103,18 @@ def restart_branch(start: Labelled, progress=None) -> Branch:
                                 land_on=landing_targets(scene, upper), labels=("up", "down")))
 
 
+def pear_point(branch: Branch, start: Labelled) -> SpecialPoint:
+    """The pear branch point of ``start`` on the plain symmetric ``branch`` (``codim2.plain_branch``) with its
+    critical mode, which run files do not store: the null vector of the pear block H_odd at the point (its
+    smallest right singular vector; ``codim2.continue_branch_point`` converges the extended system from it)."""
+    X = start.branch.disc.transfer(start.point.X, branch.disc)
+    pear = WernerSpence(equilibrium_of(branch), branch.params, np.zeros(0))
+    phi = np.linalg.svd(pear.odd_hessian(X[:-1], branch.params.with_value("P", X[-1])))[2][-1]
+    mode = np.zeros(pear.embed.shape[0])
+    mode[pear.odd] = phi
+    return SpecialPoint(Kind.BP, start.point.index, X, block=Block.ODD_HELD, mode=mode, note=start.point.note)
+
+
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
     """What ``continue`` computes from ``start`` (module docstring): a Branch (in the branch's own parameter) or
     a FoldCurve (a fold in a second parameter); RestartError for what is not built."""
@@ -107,8 +124,12 @@ def restart(start: Labelled, parameter: str | None, direction: float = 1.0, prog
     kind = start.point.kind
     if kind in CONTROL_OF_FOLD:
         return continue_fold(start.branch, start.point, parameter, direction, progress=progress)
+    if kind == Kind.BP and start.point.block == Block.ODD_HELD and start.branch.disc.symmetric:
+        branch = plain_branch(start.branch, start.point.X)
+        return continue_branch_point(branch, pear_point(branch, start), parameter, direction, progress=progress)
     if kind == Kind.BP:
-        raise RestartError(f"label {start.label}: a BP; its curve in {parameter} is not built from a run file yet "
-                           "(balloon-cg critical follows the first pear pitchfork)")
+        raise RestartError(f"--parameter {parameter}: label {start.label} is a BP of block "
+                           f"{start.point.block.value or 'none'}; only pear (odd_held) points of an equator-symmetric "
+                           "branch are continued in a second parameter")
     raise RestartError(f"--parameter {parameter}: label {start.label} is a {kind.value}; from it only the branch's "
                        f"own parameter {own} (a fold, LP, LV or LN, also continues in a second parameter)")
