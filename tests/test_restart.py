@@ -133,3 +133,17 @@ def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
     assert not (gent_run / "x.h5").exists()
     with pytest.raises(Exception):
         find_label(read_run(path), 0)
+
+
+def test_continue_from_python(gent_run):
+    """``balloon_cg.continue_from``: the same as the command, a Result for the branch, the curve for a fold."""
+    import balloon_cg as bc
+
+    path = gent_run / "gent.h5"
+    (label, point), _ = special(path, "LP")
+    result = bc.continue_from(path, label)
+    assert list(result.branches) == ["primary"] and result.complete
+    lp = [s for s in result.special_points if s["kind"] == "LP"]
+    assert abs(lp[0]["pressure"] - point["pressure"]) < 1e-10
+    curve = bc.continue_from(path, label, "material.parameters.Jm", direction=-1.0)
+    assert curve.end.value == "cusp" and abs(curve.critical[0] - 17.6380800759137) < 1e-9
