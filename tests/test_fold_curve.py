@@ -95,6 +95,23 @@ def test_gas_fold_curve_against_the_extremum_of_P_lambda3():
     assert np.abs(curve.mode[:, curve.n]).min() > 1e-3
 
 
+def test_pressure_fold_in_alpha1_uses_runtime_exponents():
+    """SPOM1's maximum of P followed in α1 (μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1: kernels with the exponents as runtime
+    arguments): at every point dP/dλ = Σ μ_i ((α_i − 3)λ^(α_i − 4) + (2α_i + 3)λ^(−2α_i − 4)) = 0 at its own α1
+    (written out here), to 1e-9 of its terms."""
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n', "spom1")
+    branch = trace_primary(scene, down=False)
+    fold = next(s for s in branch.special if s.kind == Kind.LP)
+    curve = continue_fold(branch, fold, "alpha1", max_points=12)
+    mu, alpha = np.array(scene.material.mu), np.array(scene.material.alpha)
+    assert curve.q.max() > alpha[0] + 0.05
+    for lam_i, a1 in zip(curve.pole_stretch, curve.q):
+        a = np.append(a1, alpha[1:])
+        m = np.append((4 - mu[1:] @ alpha[1:]) / a1, mu[1:])
+        terms = m * ((a - 3) * lam_i ** (a - 4) + (2 * a + 3) * lam_i ** (-2 * a - 4))
+        assert abs(terms.sum()) < 1e-9 * np.abs(terms).max()
+
+
 @pytest.mark.parametrize("control", list(Control))
 def test_fold_system_jacobian_is_the_derivative_of_its_residual(control):
     """The extended system's Jacobian (second derivatives by central differences of F_x) against central

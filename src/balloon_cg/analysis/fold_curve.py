@@ -54,6 +54,9 @@ class FoldSystem:
                  ell: np.ndarray):
         if equilibrium.disc.mapping is not None:
             raise TwoParameterError("the fold system needs a plain (unmapped) discretisation")
+        if parameter.kernel_class is not None and equilibrium.kernels.name != parameter.kernel_class:
+            # runtime exponents: an own equilibrium of the general class (as codim2.ExtendedSystem)
+            equilibrium = Equilibrium(equilibrium.scene, equilibrium.disc, kernel_class=parameter.kernel_class)
         self.eq, self.params, self.parameter, self.control = equilibrium, params, parameter, control
         self.n = equilibrium.disc.size
         self.ell = np.asarray(ell, dtype=float)
