@@ -98,3 +98,14 @@ def test_events_table_errors_are_one_line(table, message):
 def test_events_round_trip_through_the_scene_text():
     scene = parse_scene('[material]\npreset = "SPOM1"\n[[events]]\nquantity = "volume"\nvalue = 20\n', "s")
     assert parse_scene(scene.to_toml(), "s").events == scene.events and scene.events[0].value == 20.0
+
+
+def test_an_event_value_is_a_scene_key():
+    """`--set events[0].value=30` (with_overrides) changes an event, re-validated; one that is not there is named."""
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[[events]]\nquantity = "volume"\nvalue = 20\n', "s")
+    assert scene.with_overrides({"events[0].value": 30}).events[0].value == 30.0
+    for key, value, message in (("events[1].value", 3, "s: events[1].value = 3: there is no events[1]"),
+                                ("events[0].value", -3, "s: events[0].value = -3: must be > 0")):
+        with pytest.raises(SceneError) as error:
+            scene.with_overrides({key: value})
+        assert str(error.value) == message

@@ -664,6 +664,7 @@ def _to_toml(data: dict) -> str:
 
 _PARAMETER_KEY = re.compile(r"material\.parameters\.(\w+)")
 _OVERRIDE_KEY = re.compile(r"(\w+)\.(\w+)(?:\[(\d+)\]\.(\w+))?")
+_ARRAY_KEY = re.compile(r"(events)\[(\d+)\]\.(\w+)")  # the top-level arrays of tables
 
 
 def _assign(data: dict, key: str, value) -> None:
@@ -676,6 +677,14 @@ def _assign(data: dict, key: str, value) -> None:
             raise SceneError(f"{key} = {show(value)}: the material has no parameter {parameter.group(1)!r} "
                              f"(it has: {', '.join(parameters) or 'none'})")
         parameters[parameter.group(1)] = value
+        return
+    element = _ARRAY_KEY.fullmatch(key)
+    if element is not None:  # an entry of a top-level array of tables: events[0].value
+        name, index, sub = element.groups()
+        items = data.get(name)
+        if not isinstance(items, list) or int(index) >= len(items):
+            raise SceneError(f"{key} = {show(value)}: there is no {name}[{index}]")
+        items[int(index)][sub] = value
         return
     match = _OVERRIDE_KEY.fullmatch(key)
     if match is None:
