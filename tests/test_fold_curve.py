@@ -4,7 +4,8 @@ At M = 0 the primary branch is the sphere λ1 = λ2 = λ with P = 2Φ1/λ² (Φ1
 satisfy g(λ) = λ(Φ11 + Φ12) − 2Φ1 = 0 (dP/dλ = 0), and the cusp where the maximum and the minimum of P merge
 satisfies g = 0 and dg/dλ = 0 as well. Both are derived here by SymPy from Gent's energy typed again below and
 solved by mpmath to 30 digits: nothing is taken from the package's closed forms. The gas-control fold (LN) of an
-Ogden sphere is the extremum of n ∝ Pλ³: d(Pλ³)/dλ = 2 Σ μ_i α_i (λ^(α_i − 1) + 2λ^(−2α_i − 1)) = 0.
+Ogden sphere is the extremum of n ∝ Pλ³: d(Pλ³)/dλ = 2 Σ μ_i α_i (λ^(α_i − 1) + 2λ^(−2α_i − 1)) = 0. No sphere has
+a fold in V (LV): its curve is checked against the folds located on plain branches traced at the curve's values.
 """
 import json
 
@@ -21,7 +22,7 @@ from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.analysis.results import Kind, Status
 from balloon_cg.analysis.second_parameter import second_parameter
 from balloon_cg.io.curve_file import read_curve
-from balloon_cg.scene import Control, parse_scene
+from balloon_cg.scene import Control, load_scene, parse_scene
 
 GENT = '[material]\npreset = "Gent"\n[continuation]\nstart_stretch = 1.01\nmin_stretch = 1.005\nstop_stretch = 5.0\n'
 SOFT = ('[material]\nmu = [3.0, 0.0145, 0.06]\nalpha = [1.3, 4.0, -2.0]\n[continuation]\nstop_stretch = 4.0\n'
@@ -112,11 +113,25 @@ def test_pressure_fold_in_alpha1_uses_runtime_exponents():
         assert abs(terms.sum()) < 1e-9 * np.abs(terms).max()
 
 
+def test_volume_fold_curve_in_M_against_plain_branches():
+    """The paper's single coil under volume control has a fold in V (LV, after the TP of λ2(0)); followed in M, the
+    curve's pressure at two of its M values equals the LV fold located on the primary branch traced at that M
+    (a plain continuation and Brent on dV/ds: another method) to 1e-10."""
+    scene = load_scene("spom1_paper_coil").with_overrides({"loading.control": "volume"}, name="paper_coil")
+    branch = trace_primary(scene)
+    fold = next(s for s in branch.special if s.kind == Kind.LV)
+    curve = continue_fold(branch, fold, "M", max_points=7)
+    assert curve.q[-1] > 2 * curve.q[0]
+    for i in (3, 6):
+        again = trace_primary(scene.with_overrides({"field.M": float(curve.q[i])}, name="paper_coil"))
+        [located] = [s for s in again.special if s.kind == Kind.LV]
+        assert located.status == Status.LOCATED and abs(located.X[-1] - curve.pressure[i]) < 1e-10
+
+
 @pytest.mark.parametrize("control", list(Control))
 def test_fold_system_jacobian_is_the_derivative_of_its_residual(control):
     """The extended system's Jacobian (second derivatives by central differences of F_x) against central
-    differences of its residual, for every control (LV included, which no sphere has: V = 4πλ³/3 is monotone),
-    at a point of the Gent branch with an arbitrary w."""
+    differences of its residual, for every control, at a point of the Gent branch with an arbitrary w."""
     scene = parse_scene(GENT, "gent")
     branch = trace_primary(scene, stop_stretch=2.0, down=False)
     eq = equilibrium_of(branch)
