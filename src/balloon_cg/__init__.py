@@ -36,6 +36,7 @@ _API = {
     "parse_scene": "balloon_cg.scene", "shipped_scenes": "balloon_cg.scene", "PlotError": "balloon_cg.post.plotting",
     "Result": "balloon_cg.app.api", "BranchData": "balloon_cg.app.api", "trace": "balloon_cg.app.api",
     "analyse": "balloon_cg.app.api", "load": "balloon_cg.app.api", "plot": "balloon_cg.app.api",
+    "continue_from": "balloon_cg.app.api",
     "SweepResult": "balloon_cg.app.sweep_result", "CurveResult": "balloon_cg.app.curve_result",
     "SpecialPoints": "balloon_cg.app.tables",
     "journal_style": "balloon_cg.post.style", "JOURNAL_STYLE": "balloon_cg.post.style",

@@ -77,7 +77,7 @@ LANDING_RTOL = 1e-12
 LANDING_ROUNDS = 8
 
 
-def _quantity(system, name):
+def quantity_of(system, name):
     """(q, ∇q) of a landing target: the pole row ``name`` (linear) or the control parameter of a Control."""
     if isinstance(name, Control):
         return (lambda X: control_value(system.eq.disc, X, name)), (lambda X: control_gradient(system, X, name))
@@ -85,7 +85,7 @@ def _quantity(system, name):
     return (lambda X: float(row @ X)), (lambda X: row)
 
 
-def _land(system, before, after, quantity, target, settings):
+def land(system, before, after, quantity, target, settings):
     """The point with q(X) = target between two branch points (Newton from the linear interpolant, on the
     linearised constraint while q is not met: module docstring)."""
     q, gradient = quantity
@@ -109,15 +109,15 @@ def _landed(tracer, final, leg: LegTrace, points: list, folds: list, land_on: di
     before that end point, i.e. on the stored branch."""
     beyond = [f for f in folds if f[1] >= len(points) - 1]
     kept = [f for f in folds if f[1] < len(points) - 1]
-    land = land_on.get(leg.stop.code)
-    if land is None or not points:
+    target_of_stop = land_on.get(leg.stop.code)
+    if target_of_stop is None or not points:
         return points, kept, leg.stop
-    pole, target = land
+    pole, target = target_of_stop
     disc = final.eq.disc
     last_disc, last_path = leg.segments[-1]
     overshoot = last_disc.transfer(last_path.overshoot.X, disc)
-    quantity = _quantity(final, pole)
-    end = _land(final, points[-1][0], overshoot, quantity, target, tracer.settings)
+    quantity = quantity_of(final, pole)
+    end = land(final, points[-1][0], overshoot, quantity, target, tracer.settings)
     if end is None:
         return points, kept, Stop(StopCode.LANDING_FAILED, f"could not land on {pole} = {target:g} (Newton "
                                                            "failed); stopped before it")

@@ -89,6 +89,7 @@ class CurveEnd(enum.StrEnum):
 
     INTERRUPTED = "interrupted"  # SIGINT/SIGTERM stopped the trace (numerics.interrupt): the curve is partial
     ISOLA_MERGE = "isola_merge"  # a fold in q at P > 0, then back to q0 at the partner pitchfork
+    CUSP = "cusp"  # a fold curve (fold_curve) turns back in q where its fold coefficient changes sign
     FOLD = "fold"  # a fold in q not verified as a merge (P <= 0 there, or no return to the partner)
     NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # P reached 0 (no fold before)
     WIRE = "wire"  # the membrane reached continuation.wire_gap of a coil (no fold before)
@@ -98,6 +99,7 @@ class CurveEnd(enum.StrEnum):
     OTHER = "other"  # a caller's stop rule
 
 
+CODIM2_ENDS = (CurveEnd.ISOLA_MERGE, CurveEnd.CUSP)  # the ends that give a critical value
 _END_OF_STOP = {StopCode.NONPOSITIVE_PRESSURE: CurveEnd.NONPOSITIVE_PRESSURE, StopCode.WIRE_GAP: CurveEnd.WIRE,
                 TraceStop.MAX_POINTS: CurveEnd.BUDGET, TraceStop.STEP_MIN: CurveEnd.STEP_MIN,
                 StopCode.ALPHA1_ZERO: CurveEnd.ALPHA1_ZERO}
@@ -223,36 +225,43 @@ class TwoParameterCurve:
 
     @property
     def merge(self) -> SpecialPoint | None:
-        """The verified merge of the two pitchforks (ISOLA_MERGE only: the fold of extreme q), or None."""
-        if self.end != CurveEnd.ISOLA_MERGE or not self.merges:
+        """The verified merge of the two pitchforks (ISOLA_MERGE) or folds (CUSP): the fold of extreme q, or None."""
+        if self.end not in CODIM2_ENDS or not self.merges:
             return None
         return max(self.merges, key=lambda s: self.direction * s.X[-1])
 
     @property
     def critical(self):
-        """(q, P, north pole stretch) of the verified merge point (``end`` is ISOLA_MERGE), or None: a fold in q
-        that is not such a merge is no critical value."""
+        """(q, P, north pole stretch) of the verified merge point (``end`` is ISOLA_MERGE or CUSP), or None: a fold
+        in q that is not such a merge is no critical value."""
         merge = self.merge
         if merge is None:
             return None
         X = merge.X
         return float(X[-1]), float(self._parts(X)[1][0]), float(self.pole_values(X)["lam2_north"][0])
 
+    @property
+    def of(self) -> Kind:
+        """The kind of point the curve follows: BP (pear pitchforks); ``fold_curve.FoldCurve``: LP, LV or LN."""
+        return Kind.BP
+
     def describe(self) -> str:
         """One line for people: how the curve ended and where (q, P, pole stretch of its last point or fold)."""
-        name = self.parameter
+        name, points = self.parameter, "pitchforks" if self.of == Kind.BP else f"{self.of.value} folds"
         q, P, stretch = self.q[-1], self.pressure[-1], self.pole_stretch[-1]
         at = f"last point {name} = {q:.6g}, P = {P:.6g}, pole stretch {stretch:.6g}"
-        if self.end == CurveEnd.ISOLA_MERGE:
+        if self.end in CODIM2_ENDS:
             qc, Pc, sc = self.critical
-            return (f"the pitchforks merge at {name} = {qc:.12g} (P = {Pc:.10g}, pole stretch {sc:.10g}) and the "
-                    f"curve returns to {name} = {self.q0:g} at the partner pitchfork")
+            merge = f"the {points} merge" + (" in a cusp" if self.end == CurveEnd.CUSP else "")
+            return (f"{merge} at {name} = {qc:.12g} (P = {Pc:.10g}, pole stretch {sc:.10g}) and the "
+                    f"curve returns to {name} = {self.q0:g} at the partner point")
         if self.end == CurveEnd.INTERRUPTED:
             return f"a signal stopped the curve: it is partial ({len(self.q)} points, {at})"
         if self.end == CurveEnd.FOLD:
             folds = ", ".join(f"{name} = {s.X[-1]:.6g} at P = {s.X[self.n]:.4g}" for s in self.merges) or "not located"
-            return (f"the curve turns back in {name} ({folds}) but is not verified as a merge of the isola's two "
-                    f"pitchforks: it ended by {self.stop_reason} ({at})")
+            merge = "a merge of the isola's two pitchforks" if self.of == Kind.BP else "a cusp"
+            return (f"the curve turns back in {name} ({folds}) but is not verified as {merge}: it ended by "
+                    f"{self.stop_reason} ({at})")
         return f"{self.stop_reason or 'the curve stopped'} before the curve turned back in {name} ({at})"
 
 
@@ -279,10 +288,8 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
         raise TwoParameterError(f"the curve of pear points is traced in (q, P): the branch is continued in "
                                 f"{branch.parameter}, not in P")
     if branch.disc.mapping is not None:  # the extended system shares coefficients with the stability basis (in x)
-        mapped = branch.disc
-        plain = Discretisation(plain_degree(branch, bp.X), mapped.symmetric, mapped.pin_translation)
-        branch = replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
-        bp = replace(bp, X=mapped.transfer(bp.X, plain), mode=padded_mode(bp.mode, plain.degree))
+        mapped, branch = branch.disc, plain_branch(branch, bp.X)
+        bp = replace(bp, X=mapped.transfer(bp.X, branch.disc), mode=padded_mode(bp.mode, branch.disc.degree))
     eq = equilibrium_of(branch)
     if parameter in ("M", "field.M") and not scene.field.coils:
         raise TwoParameterError("continuation in M needs coils: without a field R does not depend on M")
@@ -300,6 +307,35 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     X0 = system.initial(bp, q0)
     if settings is None:
         settings = continuation_settings(scene, max_points)
+    path = trace_in_q(system, X0, "the branch point", branch, parameter, q0, direction, settings, stop, progress)
+    end = _classify(path, branch.disc.size)
+    name = parameter.name
+    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
+                           note=f"fold of the curve in {name}"
+                                + (": the two pitchforks merge" if end == CurveEnd.ISOLA_MERGE else
+                                   " (not verified as a merge of the pitchforks)")) for fold in path.folds]
+    points = path.points
+    return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
+                             np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
+                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction))
+
+
+def plain_branch(branch: Branch, X) -> Branch:
+    """``branch`` moved onto the plain (unmapped) discretisation of the degree that holds its point X
+    (``bifurcation.plain_degree``): the extended systems work in x; ``branch`` itself when it is not mapped."""
+    mapped = branch.disc
+    if mapped.mapping is None:
+        return branch
+    plain = Discretisation(plain_degree(branch, X), mapped.symmetric, mapped.pin_translation)
+    return replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
+
+
+def trace_in_q(system, X0, what: str, branch: Branch, parameter: SecondParameter, q0: float, direction: float,
+               settings: continuation.Settings, stop=None, progress=None) -> continuation.Path:
+    """Trace a curve X = (u, P, …, q) of an extended ``system`` in (q, P) from X0 (at ``what``, a located point
+    of ``branch``, with q = q0), q first moving in ``direction``, with the stop rules of the module docstring
+    (``stop(point)``: the caller's, default the return of q past q0, PARTNER) and the folds in q located (LP).
+    TwoParameterError if Newton does not converge at X0 or the point is already a fold in q."""
     e_q = np.zeros(X0.size)
     e_q[-1] = 1.0
     # corrected at fixed q0 (it may differ from the branch's): for α1 the family's μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1
@@ -307,22 +343,20 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     # locator's tolerance
     first = newton(system.residual, system.jacobian, X0, e_q, q0, settings.tol, settings.max_newton)
     if not first.converged:
-        raise TwoParameterError(f"the extended system did not converge at the branch point: {first.message}")
+        raise TwoParameterError(f"the extended system did not converge at {what}: {first.message}")
     X0 = first.x
     t = continuation.tangent(system, X0, direction * e_q)
     if abs(t[-1]) < 1e-8:
-        raise TwoParameterError("the branch point is already a fold in q: no direction to start in")
+        raise TwoParameterError("the starting point is already a fold in q: no direction to start in")
     start = continuation.Point(X0, t, first.iterations, first.residual)
 
     def default_stop(point):
         if (point.X[-1] - q0) * direction < 0:
-            return Stop(StopCode.PARTNER, f"q returned past its start value {q0:g} (reached the partner branch point)")
+            return Stop(StopCode.PARTNER, f"q returned past its start value {q0:g} (reached the partner point)")
         return None
 
     rule = stop or default_stop
-
-    n, coils, gap_limit = branch.disc.size, scene.field.coils, scene.continuation.wire_gap
-
+    n, coils, gap_limit = branch.disc.size, branch.scene.field.coils, branch.scene.continuation.wire_gap
     name = parameter.name
 
     def stop_point(point):
@@ -331,7 +365,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
         if parameter.bound and point.X[-1] * q0 <= 0:
             return Stop(StopCode.ALPHA1_ZERO, f"{name} reached 0")
         if point.X[n] <= 0:
-            return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 (P = {point.X[n]:.4g} "
+            return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pressure P reached 0 (P = {point.X[n]:.4g} "
                                                         f"at {name} = {point.X[-1]:.6g})")
         gap, coil = wire_gap(branch.disc, point.X[:n], coils)
         if gap < gap_limit:
@@ -341,15 +375,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
     if path.stop.code == StopCode.NONPOSITIVE_PRESSURE:
         path.stop = _pressure_zero_stop(system, path, name, settings)
-    end = _classify(path, n)
-    merges = [SpecialPoint(Kind.LP, fold.index, fold.point.X, **_merge_status(fold, path, branch.disc, end),
-                           note=f"fold of the curve in {name}"
-                                + (": the two pitchforks merge" if end == CurveEnd.ISOLA_MERGE else
-                                   " (not verified as a merge of the pitchforks)")) for fold in path.folds]
-    points = path.points
-    return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
-                             np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
-                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction))
+    return path
 
 
 def _classify(path, n: int) -> CurveEnd:
@@ -375,19 +401,20 @@ def _pressure_zero_stop(system, path, parameter: str, settings) -> Stop:
     result = newton(system.residual, system.jacobian, X, row, 0.0, settings.tol, settings.max_newton)
     if not result.converged:
         return path.stop
-    return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pitchfork pressure P reached 0 at {parameter} = "
+    return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pressure P reached 0 at {parameter} = "
                                                 f"{result.x[-1]:.10g}")
 
 
-def _merge_status(fold, path, disc, end: CurveEnd) -> dict:
+def _merge_status(fold, path, disc, end: CurveEnd, unverified: str = "a merge of the pitchforks") -> dict:
     """Status fields of a fold of the curve in q, bracketed by the curve points around it: LOCATED only for a
-    verified merge (ISOLA_MERGE) whose root search converged."""
+    verified codim-2 point (``CODIM2_ENDS``) whose root search converged; else APPROXIMATE, not verified as
+    ``unverified``."""
     before, after = path.bracket(fold)
     n = disc.size
     before, after = np.append(before[:n], before[n]), np.append(after[:n], after[n])
-    if end == CurveEnd.ISOLA_MERGE:
-        return located_or_bracketed(fold.status, disc, before, after, "merge of the pitchforks")
-    return approximate(disc, before, after, f"fold in q not verified as a merge of the pitchforks (curve end: "
+    if end in CODIM2_ENDS:
+        return located_or_bracketed(fold.status, disc, before, after, f"codim-2 point ({end.value})")
+    return approximate(disc, before, after, f"fold in q not verified as {unverified} (curve end: "
                                             f"{end.value}: {path.stop.message})")
 
 

@@ -28,6 +28,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .events import event_points
 from .primary import north_stop_stretch
 from .problem import branch_system
 from .results import Branch, Kind, Leg, Origin, SpecialPoint, Stop, StopCode
@@ -68,7 +69,9 @@ def reflection(pear: Branch, south_turns: list[SpecialPoint], name: str) -> Bran
             return Stop(s.code, f"{s.message} on {pear.name}; here the mirror image of that coil")
         return swapped.get(s.code, s)
 
-    special = [_reflected(s, pear.disc, stop) for s in pear.special + south_turns if s.kind != Kind.TP]
+    # the user points are located again on the image (an event of one pole is not one of the other)
+    special = [_reflected(s, pear.disc, stop) for s in pear.special + south_turns if s.kind not in (Kind.TP, Kind.UZ)]
+    special += event_points(mirror)
     return replace(mirror, special=sorted(special, key=lambda s: s.index),
                    legs=tuple(Leg(leg.label, stop(leg.stop)) for leg in pear.legs),
                    stability=[replace(a, blocks={k: v.copy() for k, v in a.blocks.items()}) for a in pear.stability],

@@ -28,6 +28,7 @@ from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .assembly import assemble
 from .control import control_stop, control_value, landing
+from .events import with_events
 from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
@@ -252,6 +253,12 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
                     limits=limits)
     below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree,
                         limits=limits) if down else None)
-    land_on = {StopCode.STOP_STRETCH: ("lam2_north", upper),
-               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
-    return assemble(tracer, params, "primary", up, below, t0, land_on=land_on, labels=("up", "down"))
+    return with_events(assemble(tracer, params, "primary", up, below, t0, land_on=landing_targets(scene, upper),
+                                labels=("up", "down")))
+
+
+def landing_targets(scene, upper: float) -> dict:
+    """``assembly.assemble``'s land_on of a primary branch: the north pole stretch at ``upper`` and at
+    min_stretch, and the control stop (``control.landing``)."""
+    return {StopCode.STOP_STRETCH: ("lam2_north", upper),
+            StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)

@@ -27,6 +27,7 @@ from ..numerics.newton import newton
 from .assembly import assemble
 from .bifurcation import general_tracer, mode_direction, plain_degree, to_general
 from .control import landing
+from .events import with_events
 from .primary import stop_rule
 from .results import Branch, Kind, SpecialPoint, StopCode
 from .tracer import NORTH_TURNING
@@ -80,8 +81,8 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
     land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
                StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
     turning = NORTH_TURNING | ({Turn.SOUTH: "lam2_south"} if south_turns else {})
-    return assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree, turning=turning),
-                    t0=t0, land_on=land_on)
+    return with_events(assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree,
+                                                                 turning=turning), t0=t0, land_on=land_on))
 
 
 def south_stop_stretch(upper: float) -> Stop:

@@ -382,6 +382,25 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
                      clock=clock)
 
 
+def continue_from(path, label: int, parameter: str | None = None, direction: float = 1.0):
+    """Restart from the special point ``label`` of the run file ``path`` (``balloon-cg continue``, app.restart):
+    in the branch's own parameter (``parameter`` None), the branch through it as a Result (its branch
+    ``primary``); from a fold (LP, LV, LN) or a pear pitchfork in a second parameter, the two-parameter curve
+    (analysis.fold_curve.FoldCurve or analysis.codim2.TwoParameterCurve: ``end``, ``critical``, ``q``,
+    ``pressure``). ValueError (app.restart.RestartError, analysis.second_parameter.UnknownParameter) for a label
+    or parameter it cannot start from."""
+    from ..analysis.results import Branch
+    from ..io.run_file import read_run
+    from .restart import find_label, restart
+
+    start = find_label(read_run(path), int(label))
+    with stop_on_signals():
+        result = restart(start, parameter, direction)
+    if isinstance(result, Branch):
+        return Result.of(result.scene, [result], command=f"balloon_cg.continue_from({str(path)!r}, {label})")
+    return result
+
+
 def load(path):
     """What a balloon-cg file holds.
 

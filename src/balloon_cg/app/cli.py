@@ -1,4 +1,4 @@
-"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical`` (``balloon-cg SUBCOMMAND -h``;
+"""Command line: ``balloon-cg run | solve | inspect | plot | sweep | critical | continue`` (``SUBCOMMAND -h``;
 also ``python -m balloon_cg``). The computing layers are imported by the subcommand that needs them, so
 ``--help``, ``--version`` and ``inspect`` start fast.
 
@@ -6,7 +6,7 @@ Exit codes: 0 success: the result is complete (analysis.verdict: every branch re
 special point is located, stability settled); 1 the computation did not give what was asked (a branch could
 not start, or the result is incomplete: the file is still written, flagged, and the incomplete parts are named
 on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: the two-parameter curve did not
-end in a verified merge of the pitchforks); 2 bad input (invalid scene, missing or unreadable file, existing
+end in a verified merge of the pitchforks or cusp); 2 bad input (invalid scene, missing or unreadable file, existing
 output without --force or in use by another process, a damaged file, a scene ``critical`` cannot handle); 3 an
 internal error (a bug: one line asking to report it; ``--debug`` shows the traceback); 130 interrupted (SIGINT or
 SIGTERM: ``run`` and ``critical`` stop at the next point and write what is finished, flagged incomplete). Errors
@@ -30,6 +30,7 @@ from ..scene.validation import did_you_mean
 from .kernels_cmd import add_kernels
 
 PROG = "balloon-cg"
+CURVE_KINDS = ("BP", "LP", "LV", "LN")  # critical --of: the pear pitchfork, the folds in P, V, n
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
 BROKEN_PIPE = 141  # 128 + SIGPIPE: what a tool killed by SIGPIPE reports
 PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equator", "shapes", "stresses", "field",
@@ -142,8 +143,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, add_kernels,
-                _add_figure, _add_completion):
+    for add in (_add_run, _add_solve, _add_inspect, _add_plot, _add_sweep, _add_critical, _add_continue,
+                add_kernels, _add_figure, _add_completion):
         add(commands)
     parser.commands = tuple(commands.choices)
     parser.subcommands = dict(commands.choices)
@@ -164,7 +165,11 @@ EXAMPLES = {  # each subcommand's --help ends with these
     "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:num=21 -o sweep.h5",
               "balloon-cg sweep spom1_two_coils_M0.002 --vary 'M=linspace(0, 0.003, 4)' --primary-only --workers 2"),
     "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",
-                 "balloon-cg critical spom1 --parameter alpha1 --set continuation.stop_stretch=3"),
+                 "balloon-cg critical spom1 --parameter alpha1 --set continuation.stop_stretch=3",
+                 "balloon-cg critical spom1 --set material.preset=Gent --of LP --parameter material.parameters.Jm "
+                 "--direction -1 -o cusp.h5"),
+    "continue": ("balloon-cg continue two_coils.h5 3 -o again.h5",
+                 "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o fold.h5"),
     "kernels": ("balloon-cg kernels spom1 --json",),
     "figure": ("balloon-cg figure fig9 --width 3.5", "balloon-cg figure all -o paper-figures --width 7.2"),
     "completion": ("balloon-cg completion bash > ~/.local/share/bash-completion/completions/balloon-cg",
@@ -593,6 +598,10 @@ def _add_critical(commands):
     p.add_argument("scene", help=f"{SCENE_HELP}; equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
                                                        "material.parameters.Jm, voltage)")
+    p.add_argument("--of", default="BP", choices=CURVE_KINDS, metavar="KIND",
+                   help="what to follow: BP (the first pear pitchfork, default), LP (the first fold in P: the "
+                        "snap-through boundary, ending in its cusp), LV or LN (the first fold in the volume or in the "
+                        "gas amount: volume or gas control)")
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="start with the parameter increasing (1, default) or decreasing (-1)")
     p.add_argument("-o", "--output", help="curve file to write (HDF5; plot it with --what phase; default: "
@@ -630,7 +639,7 @@ def critical(args) -> int:
 
 def _critical(args, scene) -> int:
     """``critical`` on ``scene`` into ``args.output`` (owned)."""
-    from ..analysis.codim2 import CurveEnd
+    from ..analysis.codim2 import CODIM2_ENDS, CurveEnd
     from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
@@ -639,7 +648,7 @@ def _critical(args, scene) -> int:
     from ..scene import ContinuationParameter
 
     asymmetry = _asymmetry(scene)
-    if asymmetry:
+    if asymmetry and args.of == "BP":
         raise UsageError(f"critical needs an equator-symmetric scene: {args.scene}: {asymmetry}")
     if scene.continuation.parameter != ContinuationParameter.PRESSURE:
         raise UsageError(f"critical needs a pressure continuation: {args.scene}: continuation.parameter = "
@@ -654,9 +663,10 @@ def _critical(args, scene) -> int:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
     check_output(args.output, args.force)
     with stop_on_signals():
-        curve = _pitchfork_curve(scene, args)
+        curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
         if curve is not None:
-            write_curve(args.output, scene, curve, force=args.force, extra_attrs={"command": args.command_line})
+            write_curve(args.output, scene, curve, name=curve_group(curve), force=args.force,
+                        extra_attrs={"command": args.command_line})
         interrupted = requested()
     if interrupted:
         written = (f"nothing is written to {args.output} (the curve had not started)" if curve is None else
@@ -664,15 +674,15 @@ def _critical(args, scene) -> int:
         print(f"{PROG}: interrupted: {written}", file=sys.stderr)
         return INTERRUPTED
     _say(args, f"curve: {len(curve.q)} points, ended: {curve.end.value}")
-    if curve.end != CurveEnd.ISOLA_MERGE:
+    if curve.end not in CODIM2_ENDS:
         raise Failure(f"no critical {curve.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
                       f"written to {args.output}")
     q, P, stretch = curve.critical
-    merge = curve.merge
+    merge, what = curve.merge, "cusp" if curve.end == CurveEnd.CUSP else "merge of the pitchforks"
     if merge.status != Status.LOCATED:
-        raise Failure(f"the merge of the pitchforks near {curve.parameter} = {q:.8g} is only approximately located "
+        raise Failure(f"the {what} near {curve.parameter} = {q:.8g} is only approximately located "
                       f"(±{merge.uncertainty:.1g}: {merge.reason}); curve written to {args.output}")
-    print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}); "
+    print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}; {what}); "
           f"curve written to {args.output}")
     return 0
 
@@ -683,24 +693,41 @@ def _say(args, text: str) -> None:
         print(f"{PROG} critical: {text}", file=sys.stderr)
 
 
+def _primary(scene, args):
+    """The primary branch ``critical`` starts from (None when a signal stopped it)."""
+    from tqdm.auto import tqdm
+
+    from ..analysis.primary import trace_primary
+    from ..numerics.interrupt import requested
+    from .progress import shown, tqdm_disable
+
+    with tqdm(desc="primary branch", unit=" points", disable=tqdm_disable(shown(args.quiet)), file=sys.stderr) as bar:
+        branch = trace_primary(scene, progress=lambda point: bar.update())
+    return None if requested() else branch
+
+
+def _curve_bar(args):
+    """The progress bar of a two-parameter curve."""
+    from tqdm.auto import tqdm
+
+    from .progress import shown, tqdm_disable
+
+    return tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=tqdm_disable(shown(args.quiet)),
+                file=sys.stderr)
+
+
 def _pitchfork_curve(scene, args):
     """``critical``'s computation: the primary branch, its first pear pitchfork located, the curve of pitchforks
     in ``args.parameter`` (analysis.codim2). None when a signal (numerics.interrupt) stopped the work before the
     curve started; a signal during the curve ends it at its next point (end ``interrupted``)."""
-    from tqdm.auto import tqdm
-
     from ..analysis.bifurcation import detect, locate
     from ..analysis.codim2 import TwoParameterError, continue_branch_point
-    from ..analysis.primary import trace_primary
     from ..analysis.results import Block, Status
     from ..analysis.stability import assess_branch
     from ..numerics.interrupt import Interrupted, requested
-    from .progress import shown, tqdm_disable
 
-    disable = tqdm_disable(shown(args.quiet))
-    with tqdm(desc="primary branch", unit=" points", disable=disable, file=sys.stderr) as bar:
-        branch = trace_primary(scene, progress=lambda point: bar.update())
-    if requested():
+    branch = _primary(scene, args)
+    if branch is None:
         return None
     _say(args, f"primary branch: {len(branch.X)} points ({branch.stop_reason}); assessing the pear block")
     try:
@@ -719,11 +746,105 @@ def _pitchfork_curve(scene, args):
         _say(args, f"the pear pitchfork is only approximately located (±{bp.uncertainty:.1g}: {bp.reason})")
     _say(args, f"pear pitchfork at P = {bp.X[-1]:.10g}; continuing it in {args.parameter}")
     try:
-        with tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=disable, file=sys.stderr) as bar:
+        with _curve_bar(args) as bar:
             return continue_branch_point(branch, bp, args.parameter, args.direction,
                                          progress=lambda point: bar.update())
     except TwoParameterError as e:
         raise Failure(f"the curve of pitchforks in {args.parameter} could not start: {e}") from None
+
+
+def curve_group(curve) -> str:
+    """The group of a two-parameter curve in its file: ``pear`` (pitchforks), else its kind (LP, LV, LN)."""
+    return "pear" if curve.of.value == "BP" else curve.of.value
+
+
+FOLD_CONTROL = {"LP": "pressure", "LV": "volume", "LN": "gas"}  # the loading.control whose folds --of follows
+
+
+def _fold_curve(scene, args):
+    """``critical --of LP|LV|LN``: the primary branch traced under the control of that fold (loading.control
+    pressure, volume or gas), its first located fold of that kind, the fold curve in ``args.parameter``
+    (analysis.fold_curve). None when a signal stopped the work before the curve started."""
+    from ..analysis.codim2 import TwoParameterError
+    from ..analysis.fold_curve import continue_fold
+    from ..analysis.results import Kind, Status
+
+    control = FOLD_CONTROL[args.of]
+    if scene.loading.control.value != control:
+        scene = scene.with_overrides({"loading.control": control, "loading.stop_volume": None,
+                                      "loading.stop_amount": None}, name=scene.name)
+    branch = _primary(scene, args)
+    if branch is None:
+        return None
+    folds = [s for s in branch.special if s.kind == Kind(args.of)]
+    if not folds:
+        raise Failure(f"no {args.of} fold on the primary branch of {args.scene} ({branch.stop_reason}): nothing to "
+                      f"continue in {args.parameter}")
+    fold = folds[0]
+    if fold.status != Status.LOCATED:
+        _say(args, f"the {args.of} fold is only approximately located (±{fold.uncertainty:.1g}: {fold.reason})")
+    _say(args, f"primary branch: {len(branch.X)} points; {args.of} fold at P = {fold.X[-1]:.10g}; continuing it in "
+               f"{args.parameter}")
+    try:
+        with _curve_bar(args) as bar:
+            return continue_fold(branch, fold, args.parameter, args.direction, progress=lambda point: bar.update())
+    except TwoParameterError as e:
+        raise Failure(f"the {args.of} curve in {args.parameter} could not start: {e}") from None
+
+
+# --- continue ----------------------------------------------------------------------------------------------
+
+def _add_continue(commands):
+    p = commands.add_parser(
+        "continue", help="restart from a labelled special point of a run file (inspect shows the labels)",
+        description="Restart from the special point LABEL of a run file: without --parameter (or with the "
+                    "branch's own, P) the branch through it is traced again in both directions (a run file with "
+                    "one branch, primary); with --parameter KEY (a scene key, as for critical) from a fold (LP, LV, "
+                    "LN) the fold curve in KEY and its cusp, from a pear pitchfork (BP odd_held) the curve of "
+                    "pitchforks and the isola's critical value (a curve file). Exit 0: written; 1: the "
+                    "computation did not give it (the curve did not start); 2: bad input (no such label, a "
+                    "label or parameter this does not continue yet: another BP, a surface branch).")
+    p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
+    p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
+    p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")
+    p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
+                   help="a fold curve: start with the parameter increasing (1, default) or decreasing (-1)")
+    p.add_argument("-o", "--output", required=True, help="run or curve file to write (HDF5)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(handler=owned(continue_run, "continue"))
+
+
+def continue_run(args) -> int:
+    """``continue``: the labelled point found, restarted (``app.restart``), written."""
+    from ..analysis.codim2 import TwoParameterError
+    from ..analysis.results import Branch
+    from ..analysis.second_parameter import UnknownParameter
+    from ..io.curve_file import write_curve
+    from ..io.output import check_output
+    from ..io.run_file import read_run, write_run
+    from .restart import RestartError, find_label, restart
+
+    check_output(hdf5_output(args.output, "run"), args.force)
+    run = read_run(args.run)
+    try:
+        start = find_label(run, args.label)
+        result = restart(start, args.parameter, args.direction)
+    except (RestartError, UnknownParameter) as e:
+        raise UsageError(f"continue {args.run}: {e}") from None
+    except TwoParameterError as e:
+        raise Failure(f"the curve from label {args.label} could not start: {e}") from None
+    attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
+    if isinstance(result, Branch):
+        write_run(args.output, result.scene, [result], force=args.force, extra_attrs=attrs)
+        print(f"branch continued from label {args.label}: {len(result.X)} points ({result.stop_reason}); written "
+              f"to {args.output}")
+        return 0
+    write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
+    ending = f"{result.end.value}: {result.describe()}"
+    print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
+          f"written to {args.output}")
+    return 0
 
 
 def _asymmetry(scene) -> str:

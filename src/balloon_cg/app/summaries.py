@@ -68,6 +68,7 @@ def summarise_curves(path) -> dict:
         c = read_curve(path, name)
         curves[name] = {**{k: c["attrs"][k] for k in ("parameter", "end", "end_description", "q0", "critical_q",
                                                       "degree", "wall_time")},
+                        "of": c["attrs"].get("of", "BP"),
                         "points": len(c["q"]), "q": _range(c["q"]), "pressure": _range(c["pressure"]),
                         "special_points": c["special_points"]}
     return {"file": str(path), "kind": "curve", "provenance": attrs, "curves": curves}
@@ -80,13 +81,13 @@ def format_curves(summary: dict) -> str:
              f"command        {p.get('command')}"]
     for name, c in summary["curves"].items():
         critical = c["critical_q"]
-        lines += ["", f"two-parameter curve {name}   (in {c['parameter']}, degree {c['degree']})",
+        lines += ["", f"two-parameter curve {name}   (of {c['of']} points, in {c['parameter']}, degree {c['degree']})",
                   f"  points               {c['points']}",
                   "  {:<20} {:.10g} .. {:.10g}".format(c["parameter"], *c["q"]),
                   "  pressure             {:.10g} .. {:.10g}".format(*c["pressure"]),
                   f"  ended                {c['end']}: {c['end_description']}",
                   f"  critical value       {critical:.12g}" if np.isfinite(critical) else
-                  "  critical value       none (the curve did not end in a verified merge)",
+                  "  critical value       none (the curve did not end in a verified merge or cusp)",
                   f"  wall time            {c['wall_time']:.3f} s"]
     return "\n".join(lines)
 
@@ -313,9 +314,9 @@ READINGS = {"both": "held and free", "held": "held at its centre", "free": "free
 
 
 def _special_lines(special: list, gauge: str = "both") -> list[str]:
-    """One aligned line per stored special point: label (with its reading where it is not its branch's ``gauge``),
-    place, P (and Φ̄), the pole stretches, the note."""
-    labels = [f"{s['kind']} {s['classification']}".strip() + (f" m={s['m']}" if s["m"] else "")
+    """One aligned line per stored special point: its label (the number ``continue`` takes), kind (with its reading
+    where it is not its branch's ``gauge``), place, P (and Φ̄), the pole stretches, the note."""
+    labels = [f"{s['label']:>3} {s['kind']} {s['classification']}".rstrip() + (f" m={s['m']}" if s["m"] else "")
               + (f" {s['gauge']}" if s.get("gauge", gauge) != gauge else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
               for s in special]

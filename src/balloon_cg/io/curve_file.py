@@ -4,16 +4,21 @@ Layout::
 
     /                            attrs: as a run file (format, scene, provenance) + extra_attrs
     /branches/                   (empty: the file is also a readable run file)
-    /two_parameter/<name>/       attrs: parameter, parameter_key, parameter_derivative, stop_reason, stop_code,
+    /two_parameter/<name>/       attrs: of, parameter, parameter_key, parameter_derivative, stop_reason, stop_code,
                                         end, end_description, q0, wall_time, degree, kernel_class, M, chi,
-                                        critical_q (NaN unless end = isola_merge)
+                                        critical_q (NaN unless end = isola_merge or cusp)
         q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
-        unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block
+        unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block (BP), the
+                                                   fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
-                        the verified merge of the two pitchforks), and q; state/unknowns in the branch layout (u, P)
+                        the verified merge of the two pitchforks or the verified cusp), and q; state/unknowns in the
+                        branch layout (u, P)
 
-``end`` is the curve's ``analysis.codim2.CurveEnd`` (how it ended: isola_merge, fold, nonpositive_pressure, wire,
-budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is partial); ``end_description``
+``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
+the primary branch in P, V or n, group named so: ``analysis.fold_curve``). ``end`` is the curve's
+``analysis.codim2.CurveEnd`` (how it ended: isola_merge, cusp (a fold curve's two folds merge), fold,
+nonpositive_pressure, wire, budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is
+partial); ``end_description``
 says the same for people, with where. ``parameter`` is q's short name (M, alpha1, Jm, mu[0]), ``parameter_key`` its
 scene key (field.M, material.parameters.Jm, material.mu[0]; alpha1: itself), ``parameter_derivative`` how ∂R/∂q was
 computed (exact: a generated kernel; central: central differences): ``analysis.second_parameter``. Files written
@@ -41,6 +46,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         group = f.create_group("two_parameter").create_group(name)
         group.attrs.update({
             "parameter": curve.parameter,
+            "of": curve.of.value,
             "parameter_key": curve.second.key,
             "parameter_derivative": curve.second.derivative.value,
             "stop_reason": curve.stop_reason,
@@ -77,7 +83,7 @@ CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_north
                  "newton_iterations": ("int", 1), "unknowns": ("float", 2), "mode": ("float", 2)}
 CURVE_REQUIRED = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float",
                   "end_description": "str", "degree": "int", "wall_time": "float"}
-CURVE_KINDS = CURVE_REQUIRED | {"parameter_key": "str", "parameter_derivative": "str"}
+CURVE_KINDS = CURVE_REQUIRED | {"parameter_key": "str", "parameter_derivative": "str", "of": "str"}
 
 
 def read_curve(path, name: str = "pear") -> dict:

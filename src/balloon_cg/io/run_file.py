@@ -197,15 +197,17 @@ def write_branches(parent, scene, branches, snaps=None) -> None:
 
     group = parent.create_group("branches")
     theta = theta_grid(scene.output.theta_points)
+    first_label = 1  # special points are labelled 1, 2, … through the branches in order (``labelled``)
     for order, branch in enumerate(branches):
-        write = _write_surface_branch if is_surface(branch) else lambda g, b: _write_branch(g, b, theta)
-        write(group.create_group(branch.name), branch)
+        write = _write_surface_branch if is_surface(branch) else lambda g, b, f: _write_branch(g, b, theta, f)
+        write(group.create_group(branch.name), branch, first_label)
         group[branch.name].attrs["order"] = order
+        first_label += len(branch.special)
     if snaps is not None:
         _write_snaps(parent.create_group("snap_throughs"), snaps)
 
 
-def _write_branch(group, branch, theta):
+def _write_branch(group, branch, theta, first_label: int = 1):
     from ..analysis.problem import equilibrium_of
     from ..galerkin.profiles import equator_values, profiles
 
@@ -254,7 +256,8 @@ def _write_branch(group, branch, theta):
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
     attach_dimensions(shapes, {2: (point, theta_scale)})
     write_special(group.create_group("special_points"), branch.special, branch.X.shape[1],
-                  lambda X: legendre_poles(branch.disc, X), unknown, lambda X: parameter_columns(branch, X))
+                  lambda X: legendre_poles(branch.disc, X), unknown, lambda X: parameter_columns(branch, X),
+                  first_label)
     if branch.stability:
         _write_stability(group.create_group("stability"), branch, point)
 
@@ -278,7 +281,7 @@ def _write_common_attrs(group, branch) -> None:
                        dtype=text)
 
 
-def _write_surface_branch(group, branch) -> None:
+def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     """A SurfaceBranch (module docstring): its basis as attributes, the per-point measures (the volume per 2π
     of ``surface.measures`` times 2π, as the axisymmetric ``volume``), the coefficients, special points with
     the pole values of their own states, and the lowest eigenvalues held and free with the pressure-control
@@ -326,7 +329,7 @@ def _write_surface_branch(group, branch) -> None:
         group.create_dataset(name, data=data)
     attach_dimensions(group, {"centroid": (point, axis), 1: (point,), 2: (point, coefficient)})
     write_special(group.create_group("special_points"), branch.special, rows.shape[1],
-                  lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X))
+                  lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X), first_label)
     if branch.stability:
         _write_surface_stability(group.create_group("stability"), branch.stability, point)
 
@@ -407,12 +410,15 @@ def surface_poles(basis, X) -> dict:
             "eta_south": heights[:, 1] if len(X) else np.zeros(0)}
 
 
-def write_special(group, special: list, width: int, poles, unknown=None, parameters=None) -> None:
+def write_special(group, special: list, width: int, poles, unknown=None, parameters=None,
+                  first_label: int = 1) -> None:
     """Special points (results.SpecialPoint) as columns; ``width`` the length of their X rows (unknowns, then
     the parameter), ``poles(X)`` the POLES columns of the rows (``legendre_poles``, ``surface_poles``);
     ``unknown``: the dimension scale of the X rows (default: a new one in ``group``); ``parameters(X)``: the
-    parameter columns of the rows (default pressure = the last unknown)."""
+    parameter columns of the rows (default pressure = the last unknown); ``label``: first_label, first_label + 1,
+    … (unique in the file: ``write_branches``)."""
     X = np.array([s.X for s in special]).reshape(len(special), width)
+    group.create_dataset("label", data=np.arange(first_label, first_label + len(special), dtype=np.int64))
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
     write_strings(group, "block", [s.block.value for s in special])
@@ -512,7 +518,8 @@ OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
-OPTIONAL_SPECIAL = {"voltage": ("float", 1), "gauge": ("str", 1)}  # voltage: where electric; gauge: since issue 27
+OPTIONAL_SPECIAL = {"voltage": ("float", 1), "gauge": ("str", 1), "label": ("int", 1)}  # voltage: where electric;
+#                                                               gauge, label: since issue 27 (absent in older files)
 
 
 def read_branches(parent, where, error=None) -> dict:
@@ -529,8 +536,19 @@ def read_branches(parent, where, error=None) -> dict:
     if snaps is not None:
         check_columns(snaps, f"{where}: snap_throughs", SNAP_COLUMNS, error)
         _check_snaps(snaps, group, f"{where}: snap_throughs", error)
-    return {"branches": {name: _read_branch(group[name]) for name in _branch_order(group)},
+    return {"branches": labelled({name: _read_branch(group[name]) for name in _branch_order(group)}),
             "snap_throughs": _read_snaps(snaps)}
+
+
+def labelled(branches: dict) -> dict:
+    """The read branches with every special point's ``label``: as stored, or (files written before labels)
+    1, 2, … through the branches in their order, as ``write_branches`` numbers them."""
+    label = 1
+    for branch in branches.values():
+        for point in branch["special_points"]:
+            point.setdefault("label", label)
+            label += 1
+    return branches
 
 
 def _check_snaps(snaps, branches, where, error) -> None:
@@ -699,7 +717,7 @@ def read_special(group, field_acts: bool = True, branch_gauge: str | None = None
     from ..analysis.results import Block, Gauge
 
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
-    columns |= {name: group[name][()] for name in ("index", "m") + SPECIAL_NUMBERS + ("voltage",) if name in group}
+    columns |= {name: group[name][()] for name in ("index", "m", "label") + SPECIAL_NUMBERS + ("voltage",) if name in group}
     points = [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
     if "gauge" not in columns:
         blocks = {block.value: block for block in Block if block != Block.NONE}

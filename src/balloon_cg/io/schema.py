@@ -71,6 +71,8 @@ VARIABLES = {
     "note": ("", "note", "for people: the stop message or the mode"),
     "index": (COUNT, "point index", "the special point lies between points index and index + 1"),
     "m": (COUNT, "azimuthal wave number", "m of the crossing mode (0: axisymmetric)"),
+    "label": (COUNT, "special-point label", "unique in the file (1, 2, … through the branches): what `continue` "
+                                            "takes"),
     "uncertainty": (NONDIMENSIONAL, "uncertainty in P", "bracket width in P of an approximate point; 0 if located"),
     "E2": (NONDIMENSIONAL, "normal-form E2", "energy expansion coefficient along the mode (docs/second_variation.md)"),
     "E3": (NONDIMENSIONAL, "normal-form E3", "cubic coefficient"),

@@ -945,11 +945,12 @@ PARAMETER_LABELS = {"M": r"field intensity $M$", "alpha1": r"Ogden exponent $\al
 
 def plot_phase(paths, axes=None) -> Figure:
     """Phase diagram from two-parameter curves (files written by ``io.curve_file.write_curve``): the pear
-    bifurcation pressure against the second parameter q; the two pitchforks of an isola meet where q turns
-    back (the critical q, marked); the region where the isola exists (q between its start and the critical
-    value, P between the two pitchfork pressures) is shaded."""
+    bifurcation pressure (or a fold curve's pressure) against the second parameter q; the two pitchforks of an
+    isola meet where q turns back (the critical q, marked), as a fold curve's two folds do at its cusp; the region
+    where the isola exists (q between its start and the critical value, P between the two pitchfork pressures),
+    or where the balloon snaps through (between the two folds), is shaded."""
     fig, (ax,), _ = _panels(axes, 1, (6.4, 4.6))
-    parameters = set()
+    parameters, kinds = set(), set()
     if any(isinstance(path, dict) for path in paths):
         raise PlotError("phase draws curve files (balloon-cg critical) or sweep files, not runs")
     for path in paths:
@@ -978,17 +979,24 @@ def plot_phase(paths, axes=None) -> Figure:
             ax.plot(q, P, "o", markersize=2, color=line.get_color())
             critical = curve["attrs"].get("critical_q", np.nan)
             merges = [s for s in curve["special_points"] if s["kind"] == "LP"]
+            of = curve["attrs"].get("of", "BP")
+            kinds.add(of)
             if np.isfinite(critical) and merges:
                 P_merge = merges[0]["pressure"]
+                region = "isola exists" if of == "BP" else f"snap-through ({of}: two folds)"
                 ax.fill(dense_q, dense_P, alpha=0.15, color=line.get_color(),  # closed at the start value q0
-                        label=f"isola exists ({curve['attrs']['parameter']} ≥ {curve['attrs']['q0']:g} traced)")
+                        label=f"{region} (traced from {curve['attrs']['parameter']} = {curve['attrs']['q0']:g})")
                 ax.plot(critical, P_merge, "o", color=line.get_color())
-                ax.annotate(f"critical {curve['attrs']['parameter']} = {critical:.6g}", (critical, P_merge),
-                            textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
+                ax.annotate(f"{'critical' if of == 'BP' else 'cusp'} {curve['attrs']['parameter']} = {critical:.6g}",
+                            (critical, P_merge), textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
     parameter = parameters.pop() if len(parameters) == 1 else "q"
     ax.set_xlabel(PARAMETER_LABELS.get(parameter, parameter))
-    ax.set_ylabel(r"bifurcation pressure $P = \bar P R_0/(T_0\mu/2)$")
-    ax.set_title("pear-shaped pitchforks (the isola lies between the two)")
+    if kinds <= {"BP"}:
+        ax.set_ylabel(r"bifurcation pressure $P = \bar P R_0/(T_0\mu/2)$")
+        ax.set_title("pear-shaped pitchforks (the isola lies between the two)")
+    else:
+        ax.set_ylabel(r"pressure $P = \bar P R_0/(T_0\mu/2)$ at the pitchfork (BP) or fold (LP, LV, LN)")
+        ax.set_title("pitchforks and folds (snap-through between a fold curve's two branches)")
     ax.legend()
     return fig
 

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
+from .events import Event, events_from_list
 from .loading import Control, Loading, loading_from_table
 from .materials import Material, material_from_table
 
@@ -182,7 +183,8 @@ class Output:
     memory_limit: float = 2.0  # GiB: the bound on products of keys (_check_products)
 
 
-_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric", "surface")
+_TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric", "surface",
+           "events")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 # docs/scenes.md, Bounds: ranges that keep the computation finite (the paper's values are far inside them)
@@ -224,6 +226,7 @@ class Scene:
     text: str = dataclass_field(repr=False)
     loading: Loading = Loading()
     surface: Surface = Surface()
+    events: tuple[Event, ...] = ()  # [[events]]: points wanted where a stored quantity reaches a value (UZ)
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
@@ -263,6 +266,7 @@ class Scene:
                                                                   "control": self.loading.control.value}}),
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
             **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
+            **({"events": [e.to_table() for e in self.events]} if self.events else {}),
         }
 
     def __repr__(self):
@@ -545,6 +549,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         text=text,
         loading=loading,
         surface=_surface(data.get("surface", {})),
+        events=events_from_list(data.get("events", [])),
     )
 
 
@@ -775,9 +780,14 @@ def _check_products(continuation: Continuation, output: Output) -> None:
 
 
 def _to_toml(data: dict) -> str:
-    """TOML for a dict of tables holding scalars, lists and arrays of tables; None values are left out."""
+    """TOML for a dict of tables holding scalars, lists and arrays of tables, and top-level arrays of tables
+    ([[events]]); None values are left out."""
     lines = []
     for name, content in data.items():
+        if isinstance(content, list):
+            for item in content:
+                lines += [f"[[{name}]]"] + [f"{k} = {show(v)}" for k, v in item.items()] + [""]
+            continue
         arrays = {k: v for k, v in content.items() if isinstance(v, list) and v and isinstance(v[0], dict)}
         lines.append(f"[{name}]")
         lines += [f"{k} = {show(v)}" for k, v in content.items() if v is not None and k not in arrays]
@@ -790,6 +800,7 @@ def _to_toml(data: dict) -> str:
 
 _PARAMETER_KEY = re.compile(r"material\.parameters\.(\w+)")
 _OVERRIDE_KEY = re.compile(r"(\w+)\.(\w+)(?:\[(\d+)\]\.(\w+))?")
+_ARRAY_KEY = re.compile(r"(events)\[(\d+)\]\.(\w+)")  # the top-level arrays of tables
 
 
 def _assign(data: dict, key: str, value) -> None:
@@ -802,6 +813,14 @@ def _assign(data: dict, key: str, value) -> None:
             raise SceneError(f"{key} = {show(value)}: the material has no parameter {parameter.group(1)!r} "
                              f"(it has: {', '.join(parameters) or 'none'})")
         parameters[parameter.group(1)] = value
+        return
+    element = _ARRAY_KEY.fullmatch(key)
+    if element is not None:  # an entry of a top-level array of tables: events[0].value
+        name, index, sub = element.groups()
+        items = data.get(name)
+        if not isinstance(items, list) or int(index) >= len(items):
+            raise SceneError(f"{key} = {show(value)}: there is no {name}[{index}]")
+        items[int(index)][sub] = value
         return
     match = _OVERRIDE_KEY.fullmatch(key)
     if match is None:

@@ -1,0 +1,60 @@
+"""User events: the ``[[events]]`` array of tables, each a stored quantity and the value at which a point is wanted.
+
+    [[events]]
+    quantity = "volume"      # one of QUANTITIES
+    value = 20.0             # > 0
+
+Every branch then gets a special point labelled UZ wherever its quantity passes the value, located to the solver
+tolerance (``analysis.events``). The quantities are those stored per point: the enclosed volume V, the gas amount
+n = P V, the pressure P, and the hoop stretch λ2 at the north pole, the south pole and the equator.
+"""
+import enum
+from dataclasses import dataclass
+
+from .validation import SceneError, did_you_mean, number, show, table
+
+MAX_EVENTS = 64  # a scene asks for a few; the bound keeps a hostile file from asking for millions
+
+
+class Quantity(enum.StrEnum):
+    VOLUME = "volume"
+    AMOUNT = "amount"
+    PRESSURE = "pressure"
+    LAM2_NORTH = "lam2_north"
+    LAM2_SOUTH = "lam2_south"
+    LAM2_EQUATOR = "lam2_equator"
+
+
+@dataclass(frozen=True)
+class Event:
+    """A point wanted where ``quantity`` equals ``value``."""
+
+    quantity: Quantity
+    value: float
+
+    def to_table(self) -> dict:
+        return {"quantity": self.quantity.value, "value": self.value}
+
+
+def events_from_list(data) -> tuple[Event, ...]:
+    """The checked ``[[events]]`` array (default: none); SceneError naming the key, the value and what is allowed."""
+    if not isinstance(data, list):
+        raise SceneError(f"events = {show(data)}: must be an array of tables [[events]] with quantity and value")
+    if len(data) > MAX_EVENTS:
+        raise SceneError(f"events: {len(data)} events; at most {MAX_EVENTS}")
+    return tuple(_event(f"events[{i}]", entry) for i, entry in enumerate(data))
+
+
+def _event(key: str, data) -> Event:
+    data = table(key, data, ("quantity", "value"))
+    for name in ("quantity", "value"):
+        if name not in data:
+            raise SceneError(f"{key}.{name}: missing (an event needs quantity and value)")
+    quantity = data["quantity"]
+    if quantity not in tuple(Quantity):
+        raise SceneError(f"{key}.quantity = {show(quantity)}: must be one of "
+                         f"{', '.join(show(q.value) for q in Quantity)}{did_you_mean(quantity, tuple(Quantity))}")
+    value = number(f"{key}.value", data["value"])
+    if value <= 0:
+        raise SceneError(f"{key}.value = {show(data['value'])}: must be > 0")
+    return Event(Quantity(quantity), value)

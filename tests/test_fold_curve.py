@@ -1,0 +1,175 @@
+"""Fold curves (analysis/fold_curve.py, ``critical --of LP|LV|LN``) against closed forms of the inflated sphere.
+
+At M = 0 the primary branch is the sphere λ1 = λ2 = λ with P = 2Φ1/λ² (Φ1 = ∂Φ/∂λ1 at (λ, λ)). Its pressure folds
+satisfy g(λ) = λ(Φ11 + Φ12) − 2Φ1 = 0 (dP/dλ = 0), and the cusp where the maximum and the minimum of P merge
+satisfies g = 0 and dg/dλ = 0 as well. Both are derived here by SymPy from Gent's energy typed again below and
+solved by mpmath to 30 digits: nothing is taken from the package's closed forms. The gas-control fold (LN) of an
+Ogden sphere is the extremum of n ∝ Pλ³: d(Pλ³)/dλ = 2 Σ μ_i α_i (λ^(α_i − 1) + 2λ^(−2α_i − 1)) = 0. No sphere has
+a fold in V (LV): its curve is checked against the folds located on plain branches traced at the curve's values.
+"""
+import json
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from balloon_cg.app.cli import main
+from balloon_cg.analysis.codim2 import CurveEnd
+from balloon_cg.analysis.fold_curve import FoldSystem, continue_fold
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.results import Kind, Status
+from balloon_cg.analysis.second_parameter import second_parameter
+from balloon_cg.io.curve_file import read_curve
+from balloon_cg.scene import Control, load_scene, parse_scene
+
+GENT = '[material]\npreset = "Gent"\n[continuation]\nstart_stretch = 1.01\nmin_stretch = 1.005\nstop_stretch = 5.0\n'
+SOFT = ('[material]\nmu = [3.0, 0.0145, 0.06]\nalpha = [1.3, 4.0, -2.0]\n[continuation]\nstop_stretch = 4.0\n'
+        '[stability]\nm_max = 0\n[loading]\ncontrol = "gas"\n')
+
+lam, Jm, l1, l2 = sp.symbols("lam Jm l1 l2", positive=True)
+
+
+def gent_closed_forms():
+    """(P(λ, Jm), g(λ, Jm)) of Gent's Φ = −Jm ln(1 − (I1 − 3)/Jm) (μ = 2) on the sphere, as SymPy expressions."""
+    phi = -Jm * sp.log(1 - (l1**2 + l2**2 + (l1 * l2) ** -2 - 3) / Jm)
+    d1 = sp.diff(phi, l1)
+    at = {l1: lam, l2: lam}
+    phi1, S = d1.subs(at), (sp.diff(d1, l1) + sp.diff(d1, l2)).subs(at)
+    return 2 * phi1 / lam**2, lam * S - 2 * phi1
+
+
+@pytest.fixture(scope="module")
+def gent_curve():
+    scene = parse_scene(GENT, "gent")
+    branch = trace_primary(scene)
+    maximum = next(s for s in branch.special if s.kind == Kind.LP)
+    return continue_fold(branch, maximum, "material.parameters.Jm", direction=-1.0)
+
+
+def test_gent_cusp_against_the_closed_form(gent_curve):
+    """The LP curve from Jm = 97.2 down: it turns back at the cusp (g = dg/dλ = 0), located to 1e-8 in Jm and in
+    λ, and comes back along the minimum of P to Jm = 97.2 (the partner fold)."""
+    pressure, g = gent_closed_forms()
+    mpmath.mp.dps = 30
+    lam_c, Jm_c = sp.nsolve([g, sp.diff(g, lam)], [lam, Jm], [1.6, 18.0], prec=30)
+    curve = gent_curve
+    assert curve.end == CurveEnd.CUSP and curve.stop.code.value == "partner"
+    assert curve.merge.status == Status.LOCATED and len(curve.merges) == 1
+    q, P, stretch = curve.critical
+    assert abs(q - float(Jm_c)) < 1e-8 and abs(stretch - float(lam_c)) < 1e-8
+    assert abs(P - float(pressure.subs({lam: lam_c, Jm: Jm_c}))) < 1e-8
+    lam_north = curve.pole_stretch
+    assert lam_north[0] < float(lam_c) < lam_north[-1]  # from the maximum of P, back along the minimum
+
+
+def test_every_gent_fold_point_satisfies_the_closed_form(gent_curve):
+    """At every point of the curve, at its own Jm: the state is the sphere (both poles at λ), g(λ) = 0 to 1e-9 of
+    its terms' scale and P is the sphere's pressure to 1e-10."""
+    pressure, g = gent_closed_forms()
+    P_of, g_of = sp.lambdify((lam, Jm), pressure), sp.lambdify((lam, Jm), g)
+    scale = sp.lambdify((lam, Jm), 2 * lam**2 * pressure / 2)  # 2Φ1: the size of the terms of g
+    curve = gent_curve
+    poles = curve.pole_values()
+    assert np.abs(poles["lam2_south"] - poles["lam2_north"]).max() < 1e-12
+    lams, q = poles["lam2_north"], curve.q
+    assert len(q) > 50 and q.min() < 17.65 and q.max() <= 97.2
+    assert np.abs(g_of(lams, q) / scale(lams, q)).max() < 1e-9
+    assert np.abs(curve.pressure / P_of(lams, q) - 1).max() < 1e-10
+
+
+def test_gas_fold_curve_against_the_extremum_of_P_lambda3():
+    """The LN fold (gas control) of a soft Ogden sphere followed in μ3: d(Pλ³)/dλ = 0 at every point, at its own
+    μ3, to 1e-9 relative; the tangent's pressure part μ is not zero (this is not a fold in P)."""
+    scene = parse_scene(SOFT, "soft")
+    branch = trace_primary(scene)
+    fold = next(s for s in branch.special if s.kind == Kind.LN)
+    curve = continue_fold(branch, fold, "material.mu[2]", direction=-1.0, max_points=30)
+    mu, alpha = np.array(scene.material.mu), np.array(scene.material.alpha)
+    lams = curve.pole_stretch
+    assert len(lams) == 30 and curve.q.min() < 0.03
+    for lam_i, mu3 in zip(lams, curve.q):
+        mu_i = np.append(mu[:2], mu3)
+        terms = 2 * mu_i * alpha * (lam_i ** (alpha - 1) + 2 * lam_i ** (-2 * alpha - 1))
+        assert abs(terms.sum()) < 1e-9 * np.abs(terms).max()
+    assert np.abs(curve.mode[:, curve.n]).min() > 1e-3
+
+
+def test_pressure_fold_in_alpha1_uses_runtime_exponents():
+    """SPOM1's maximum of P followed in α1 (μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1: kernels with the exponents as runtime
+    arguments): at every point dP/dλ = Σ μ_i ((α_i − 3)λ^(α_i − 4) + (2α_i + 3)λ^(−2α_i − 4)) = 0 at its own α1
+    (written out here), to 1e-9 of its terms."""
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n', "spom1")
+    branch = trace_primary(scene, down=False)
+    fold = next(s for s in branch.special if s.kind == Kind.LP)
+    curve = continue_fold(branch, fold, "alpha1", max_points=12)
+    mu, alpha = np.array(scene.material.mu), np.array(scene.material.alpha)
+    assert curve.q.max() > alpha[0] + 0.05
+    for lam_i, a1 in zip(curve.pole_stretch, curve.q):
+        a = np.append(a1, alpha[1:])
+        m = np.append((4 - mu[1:] @ alpha[1:]) / a1, mu[1:])
+        terms = m * ((a - 3) * lam_i ** (a - 4) + (2 * a + 3) * lam_i ** (-2 * a - 4))
+        assert abs(terms.sum()) < 1e-9 * np.abs(terms).max()
+
+
+def test_volume_fold_curve_in_M_against_plain_branches():
+    """The paper's single coil under volume control has a fold in V (LV, after the TP of λ2(0)); followed in M, the
+    curve's pressure at two of its M values equals the LV fold located on the primary branch traced at that M
+    (a plain continuation and Brent on dV/ds: another method) to 1e-10."""
+    scene = load_scene("spom1_paper_coil").with_overrides({"loading.control": "volume"}, name="paper_coil")
+    branch = trace_primary(scene)
+    fold = next(s for s in branch.special if s.kind == Kind.LV)
+    curve = continue_fold(branch, fold, "M", max_points=7)
+    assert curve.q[-1] > 2 * curve.q[0]
+    for i in (3, 6):
+        again = trace_primary(scene.with_overrides({"field.M": float(curve.q[i])}, name="paper_coil"))
+        [located] = [s for s in again.special if s.kind == Kind.LV]
+        assert located.status == Status.LOCATED and abs(located.X[-1] - curve.pressure[i]) < 1e-10
+
+
+@pytest.mark.parametrize("control", list(Control))
+def test_fold_system_jacobian_is_the_derivative_of_its_residual(control):
+    """The extended system's Jacobian (second derivatives by central differences of F_x) against central
+    differences of its residual, for every control, at a point of the Gent branch with an arbitrary w."""
+    scene = parse_scene(GENT, "gent")
+    branch = trace_primary(scene, stop_stretch=2.0, down=False)
+    eq = equilibrium_of(branch)
+    parameter = second_parameter(scene, eq, branch.params, "material.parameters.Jm")
+    rng = np.random.default_rng(0)
+    n = branch.disc.size
+    w = rng.standard_normal(n + 1)
+    system = FoldSystem(eq, branch.params, parameter, control, w / np.linalg.norm(w))
+    X = np.concatenate([branch.X[len(branch.X) // 2], w, [80.0]])
+    J = system.jacobian(X)
+    numeric = np.empty_like(J)
+    for k in range(X.size):
+        h = 1e-6 * max(1.0, abs(X[k]))
+        e = np.zeros(X.size)
+        e[k] = h
+        numeric[:, k] = (system.residual(X + e) - system.residual(X - e)) / (2 * h)
+    assert np.abs(J - numeric).max() < 1e-6 * max(1.0, np.abs(J).max())
+
+
+def test_critical_of_LP_from_the_command_line(tmp_path, capsys):
+    """`critical --of LP`: the cusp printed (exit 0), `inspect --json` shows of, end = cusp and critical_q;
+    `plot --what phase` draws it; an --of outside the allowed set is one error line naming them (exit 2)."""
+    scene = tmp_path / "gent.toml"
+    scene.write_text(GENT)
+    out = tmp_path / "lp.h5"
+    assert main(["critical", str(scene), "--of", "LP", "--parameter", "material.parameters.Jm", "--direction", "-1",
+                 "-o", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith("critical Jm = 17.63808007")
+    assert main(["inspect", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)["curves"]["LP"]
+    assert summary["of"] == "LP" and summary["end"] == "cusp"
+    assert summary["critical_q"] == pytest.approx(17.6380800759137, abs=1e-9)
+    assert read_curve(out, "LP")["special_points"][0]["status"] == "located"
+    assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as error:
+        main(["critical", str(scene), "--of", "LX", "--parameter", "Jm", "-o", str(tmp_path / "x.h5")])
+    assert error.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "--of" in err and "'LX'" in err and "LP" in err and "LN" in err
+    assert not (tmp_path / "x.h5").exists()

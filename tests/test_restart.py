@@ -1,0 +1,149 @@
+"""Labels and ``continue`` (app/restart.py): every special point of a run file has a unique label; restarting from
+one reproduces the branch, and from a fold in a second parameter gives the fold curve ``critical --of`` gives."""
+import json
+
+import numpy as np
+import pytest
+
+from balloon_cg.analysis.problem import branch_system
+from balloon_cg.app.cli import main
+from balloon_cg.app.restart import find_label, stored_branch
+from balloon_cg.io.curve_file import read_curve
+from balloon_cg.io.run_file import read_run
+from balloon_cg.numerics.newton import newton
+from balloon_cg.scene import load_scene
+
+GENT = '[material]\npreset = "Gent"\n[continuation]\nstart_stretch = 1.01\nmin_stretch = 1.005\nstop_stretch = 5.0\n'
+EVENTS = '\n[[events]]\nquantity = "volume"\nvalue = 20\n'
+
+
+def special(path, kind):
+    """(label, dict) of every special point of ``kind`` in a run file, in file order."""
+    return [(s["label"], s) for b in read_run(path)["branches"].values() for s in b["special_points"]
+            if s["kind"] == kind]
+
+
+def on_branch(original, X):
+    """P of the point of the stored branch ``original`` at the north pole stretch of X (Newton from its stored
+    point nearest in (λ2(0), P): past a turning point of λ2(0) two points share it), to compare a restarted point
+    with the branch it came from."""
+    system, solver = branch_system(original), original.scene.solver
+    north = np.append(original.disc.pole_rows()["lam2_north"], 0.0)
+    nearest = original.X[np.argmin(np.hypot(original.X @ north - north @ X, original.X[:, -1] - X[-1]))]
+    result = newton(system.residual, system.jacobian, nearest, north, north @ X, solver.tol, solver.max_newton)
+    assert result.converged
+    return result.x[-1]
+
+
+@pytest.fixture(scope="module")
+def gent_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("gent")
+    (folder / "gent.toml").write_text(GENT)
+    assert main(["run", str(folder / "gent.toml"), "--primary-only", "-o", str(folder / "gent.h5"), "--quiet"]) == 0
+    return folder
+
+
+def test_labels_are_unique_and_shown_by_inspect(gent_run, capsys):
+    path = gent_run / "gent.h5"
+    labels = [s["label"] for b in read_run(path)["branches"].values() for s in b["special_points"]]
+    assert labels == list(range(1, len(labels) + 1)) and len(labels) == 4  # EP, LP, LP, EP
+    capsys.readouterr()
+    assert main(["inspect", str(path)]) == 0
+    lines = [line.split() for line in capsys.readouterr().out.splitlines()]
+    assert [(int(line[0]), line[1]) for line in lines if len(line) > 2 and line[0].isdigit()] == \
+        [(1, "EP"), (2, "LP"), (3, "LP"), (4, "EP")]
+
+
+def test_continue_from_a_fold_in_Jm_gives_the_cusp(gent_run, capsys):
+    """`continue RUN LABEL --parameter Jm` from the maximum of P (an LP label): the LP curve and its cusp, the same
+    as `critical --of LP` (tests/test_fold_curve.py checks it against the closed form)."""
+    (label, point), _ = special(gent_run / "gent.h5", "LP")
+    out = gent_run / "lp.h5"
+    assert main(["continue", str(gent_run / "gent.h5"), str(label), "--parameter", "material.parameters.Jm",
+                 "--direction", "-1", "-o", str(out)]) == 0
+    assert "LP curve from label 2 in Jm" in capsys.readouterr().out
+    attrs = read_curve(out, "LP")["attrs"]
+    assert attrs["end"] == "cusp" and attrs["critical_q"] == pytest.approx(17.6380800759137, abs=1e-9)
+
+
+def test_continue_from_a_fold_in_P_reproduces_the_branch(gent_run):
+    """Without --parameter: the branch through the labelled point traced again; every point lies on the stored
+    branch (P at its pole stretch) to 1e-10, and the two folds are found again to 1e-10."""
+    path, out = gent_run / "gent.h5", gent_run / "again.h5"
+    (label, _), _ = special(path, "LP")
+    assert main(["continue", str(path), str(label), "-o", str(out), "--quiet"]) == 0
+    run, again = read_run(path), read_run(out)
+    original, continued = stored_branch(run, "primary"), stored_branch(again, "primary")
+    assert np.abs([on_branch(original, X) - X[-1] for X in continued.X]).max() < 1e-10
+    folds = [s["pressure"] for _, s in special(path, "LP")]
+    assert np.abs(np.array([s["pressure"] for _, s in special(out, "LP")]) - folds).max() < 1e-10
+    assert json.loads(json.dumps(again["attrs"]["continued_from"])) == f"{path} label {label}"
+
+
+def test_continue_from_a_user_point_of_the_two_coil_branch(tmp_path):
+    """Two coils, M = 0.002, mapped basis: the restart from the UZ point (volume 20, an ordinary point of the
+    branch) reproduces the primary branch to 1e-10 (every point, its LP and its UZ point). Its TP agrees only to
+    the discretisation's error bound solver.max_error = 1e-9 (measured 1.9e-10; the cause is not isolated:
+    presumably each trace locates the TP on the wire map in use when it passes the turn, re-centred near the
+    coils, and the two traces reach it on different maps)."""
+    scene = tmp_path / "two_coils.toml"
+    scene.write_text(load_scene("spom1_two_coils_M0.002").to_toml() + EVENTS)
+    path, out = tmp_path / "run.h5", tmp_path / "again.h5"
+    assert main(["run", str(scene), "--primary-only", "-o", str(path), "--quiet"]) == 0
+    [(label, point)] = special(path, "UZ")
+    assert main(["continue", str(path), str(label), "-o", str(out), "--quiet"]) == 0
+    original, continued = stored_branch(read_run(path), "primary"), stored_branch(read_run(out), "primary")
+    assert continued.disc.mapping is not None
+    assert np.abs([on_branch(original, X) - X[-1] for X in continued.X]).max() < 1e-10
+    for kind, tolerance in (("LP", 1e-10), ("UZ", 1e-10), ("TP", original.scene.solver.max_error)):
+        before, after = [s["pressure"] for _, s in special(path, kind)], [s["pressure"] for _, s in special(out, kind)]
+        assert len(before) == len(after) == 1 and abs(before[0] - after[0]) < tolerance, kind
+
+
+def test_continue_from_the_pear_pitchfork_gives_the_critical_curve(tmp_path, capsys):
+    """SPOM1 at M = 0: `continue RUN LABEL --parameter alpha1` from the first pear BP label (its mode recomputed,
+    not stored) traces the same curve as `critical --parameter alpha1` (every point to 1e-10) and its isola closes
+    at the same critical α1 (1.739619649392: tests/test_two_parameter.py, closed form)."""
+    scene = tmp_path / "spom1.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 4.0\n[surface]\nbranches = "none"\n')
+    run, again, curve = tmp_path / "run.h5", tmp_path / "again.h5", tmp_path / "curve.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    (label, _), _ = special(run, "BP")
+    assert main(["continue", str(run), str(label), "--parameter", "alpha1", "-o", str(again), "--quiet"]) == 0
+    assert main(["critical", str(scene), "--parameter", "alpha1", "-o", str(curve), "--quiet"]) == 0
+    capsys.readouterr()
+    restarted, traced = read_curve(again), read_curve(curve)
+    assert restarted["attrs"]["end"] == traced["attrs"]["end"] == "isola_merge"
+    assert abs(restarted["attrs"]["critical_q"] - 1.739619649392) < 1e-11
+    assert abs(restarted["attrs"]["critical_q"] - traced["attrs"]["critical_q"]) < 1e-10
+    assert restarted["q"].shape == traced["q"].shape
+    assert np.abs(restarted["q"] - traced["q"]).max() < 1e-10
+    assert np.abs(restarted["pressure"] - traced["pressure"]).max() < 1e-10
+
+
+def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
+    """A label the file does not have, a second parameter from an end point: one line, exit 2, nothing written."""
+    path = gent_run / "gent.h5"
+    assert main(["continue", str(path), "9", "-o", str(gent_run / "x.h5")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "label 9: no special point has it" in err and "1..4" in err
+    assert main(["continue", str(path), "1", "--parameter", "material.parameters.Jm", "-o", str(gent_run / "x.h5")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "label 1 is a EP" in err
+    assert not (gent_run / "x.h5").exists()
+    with pytest.raises(Exception):
+        find_label(read_run(path), 0)
+
+
+def test_continue_from_python(gent_run):
+    """``balloon_cg.continue_from``: the same as the command, a Result for the branch, the curve for a fold."""
+    import balloon_cg as bc
+
+    path = gent_run / "gent.h5"
+    (label, point), _ = special(path, "LP")
+    result = bc.continue_from(path, label)
+    assert list(result.branches) == ["primary"] and result.complete
+    lp = [s for s in result.special_points if s["kind"] == "LP"]
+    assert abs(lp[0]["pressure"] - point["pressure"]) < 1e-10
+    curve = bc.continue_from(path, label, "material.parameters.Jm", direction=-1.0)
+    assert curve.end.value == "cusp" and abs(curve.critical[0] - 17.6380800759137) < 1e-9
