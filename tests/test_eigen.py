@@ -82,6 +82,19 @@ def test_lowest_following_matches_the_dense_spectrum(guess):
     assert np.abs(values - spectrum[:4]).max() < 1e-10
 
 
+def test_lanczos_goes_on_past_an_invariant_krylov_space():
+    """The start vector an eigenvector (of 2.0) of an operator of rank 4 in 60 dimensions: its Krylov space closes at
+    once (breakdown) and the other wanted eigenvalues come only from the new directions; all four to rounding."""
+    start = np.random.default_rng(eigen.LANCZOS_START).standard_normal(60)
+    Q, _ = np.linalg.qr(np.column_stack([start, np.random.default_rng(4).normal(size=(60, 59))]))
+    spectrum = np.concatenate([[2.0, 3.0, 3.5, 7.0], np.zeros(56)])
+    S = (Q * spectrum) @ Q.T
+    calls = []
+    values = eigen.largest_by_lanczos(lambda v: calls.append(1) or S @ v, 60, 4)
+    assert np.abs(values - [2.0, 3.0, 3.5, 7.0]).max() < 1e-13
+    assert len(calls) > 4  # the breakdown happened and was passed (4 products would have sufficed otherwise)
+
+
 @pytest.mark.parametrize("controls", ["pressure", "volume", "gas"])
 def test_one_shifted_factorisation_serves_the_constrained_and_updated_readings(controls):
     """ShiftInvert of the matrix with fewer constraints (the free balloon under pressure) gives the lowest

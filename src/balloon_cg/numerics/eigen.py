@@ -9,7 +9,8 @@ The reduction L⁻¹ H L⁻ᵀ is BLAS or LAPACK (``LARGE_BLOCK``), the gatherin
 (quick to compile);
 the eigenvalues come from LAPACK's dsyevr for the lowest ``count`` only (tridiagonalisation and bisection).
 
-Large matrices along a branch (``lowest_following``): Lanczos (ARPACK) on (A − σI)⁻¹ with σ below the spectrum,
+Large matrices along a branch (``lowest_following``, ``ShiftInvert``): Lanczos (``largest_by_lanczos``) on
+(A − σI)⁻¹ with σ below the spectrum,
 proved so by a Cholesky factorisation of A − σI (n³/3 flops against dsyevr's 4n³/3 for the tridiagonal form): the
 eigenvalues of the inverse closest to its top are the lowest of A. The inertia of an indefinite matrix
 (``negative_count``) is the Bunch–Kaufman LDLᵀ's (Sylvester's law), again a factorisation, no eigensolve.
@@ -21,7 +22,8 @@ import numpy as np
 from numba import njit
 from scipy import linalg
 from scipy.linalg.lapack import dpotrf, dpotrs, dsyevr, dsygst, dsytrf
-from scipy.sparse.linalg import LinearOperator, eigsh
+
+EPS = np.finfo(float).eps
 
 RCOND = 1e-9  # constraint directions below RCOND times the largest are dependent ones (dropped)
 NO_CONSTRAINT = np.zeros((0, 1))
@@ -139,7 +141,7 @@ def lowest_of(A, count: int) -> np.ndarray:
 
 
 FOLLOWING_SIZE = 600  # from this size on ``lowest_following`` factors and iterates; below it dsyevr is as quick
-LANCZOS_VECTORS = 20  # ARPACK's Lanczos basis (fewer restarts than its default 2k + 1)
+LANCZOS_START = 0  # the seed of the Lanczos start vector (a fixed one: the same numbers every run)
 SHIFT_TRIES = 4  # shifts tried (each 4× farther below the guess) before the dense eigensolve
 
 
@@ -156,7 +158,7 @@ def lowest_following(A, count: int, guess: float | None) -> np.ndarray:
 class ShiftInvert:
     """The Cholesky factor of A − σI for a σ proved below A's spectrum (the factorisation exists), and the lowest
     eigenvalues of A and of its relatives through it: ν = 1/(μ − σ), the largest eigenvalues of (A − σI)⁻¹, by
-    ARPACK's Lanczos to machine precision.
+    Lanczos to machine precision (``largest_by_lanczos``).
 
     A relative of A (``lowest``) is A + ρ u uᵀ (ρ > 0, a gas under pressure) restricted to Uᵀy = 0 (constraints):
     its spectrum is still above σ (a positive update raises it, a restriction interlaces), and with S = (A − σI)⁻¹
@@ -215,10 +217,46 @@ class ShiftInvert:
 
                 def operator(v):
                     return base(v) - correction @ (correction.T @ v)
-        nu = eigsh(LinearOperator((n, n), matvec=lambda v: operator(np.asarray(v, dtype=float).ravel()), dtype=float),
-                   k=count, which="LA", tol=0.0, ncv=min(n - 1, max(2 * count + 1, LANCZOS_VECTORS)),
-                   return_eigenvectors=False)
+        nu = largest_by_lanczos(operator, n, count)
         return np.sort(self.sigma + 1.0 / nu)
+
+
+def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
+    """The ``count`` largest eigenvalues (ascending) of the symmetric positive semidefinite operator (x ↦ Sx on
+    vectors of size n) by Lanczos with full reorthogonalisation (two Gram–Schmidt passes a step, no restarts: ~2/3
+    of the products ARPACK's implicitly restarted Lanczos needs here), stopped when every wanted Ritz pair's
+    residual |β_j y_j| is below 4ε times the largest Ritz value (ARPACK's tol = 0 is ε: the Ritz values are then
+    exact to rounding, their error ≤ residual²/gap). A breakdown (an invariant Krylov space) continues from a new
+    vector orthogonal to it; at n steps the space is everything and the Ritz values are the eigenvalues. As any
+    single-vector Krylov method (ARPACK's too) it sees an exactly multiple eigenvalue once: its callers read
+    states off any symmetry that forces one (an axisymmetric point 0 of a surface branch is solved dense)."""
+    rng = np.random.default_rng(LANCZOS_START)
+    V = np.empty((min(n, 4 * count + 40), n))
+    alpha, beta = np.empty(n), np.empty(n)
+    v = rng.standard_normal(n)
+    V[0] = v / np.linalg.norm(v)
+    for j in range(n):
+        w = operator(V[j])
+        alpha[j] = V[j] @ w
+        basis = V[:j + 1]
+        for _ in range(2):
+            w -= basis.T @ (basis @ w)
+        beta[j] = np.linalg.norm(w)
+        if j + 1 >= count:
+            theta, Y = linalg.eigh_tridiagonal(alpha[:j + 1], beta[:j], select="i", select_range=(j + 1 - count, j))
+            if j + 1 == n or np.all(np.abs(beta[j] * Y[-1]) <= 4.0 * EPS * theta.max()):
+                return theta
+        if j + 1 == V.shape[0]:
+            V = np.vstack([V, np.empty((min(V.shape[0], n - V.shape[0]), n))])
+        if beta[j] <= EPS * max(abs(alpha[j]), 1.0):  # invariant: go on from a new direction (β_j = 0)
+            w = rng.standard_normal(n)
+            for _ in range(2):
+                w -= basis.T @ (basis @ w)
+            beta[j] = 0.0
+            V[j + 1] = w / np.linalg.norm(w)
+        else:
+            V[j + 1] = w / beta[j]
+    raise AssertionError("unreachable: at n steps the Krylov space is complete")
 
 
 def negative_count(A) -> int:
