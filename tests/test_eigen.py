@@ -82,6 +82,47 @@ def test_lowest_following_matches_the_dense_spectrum(guess):
     assert np.abs(values - spectrum[:4]).max() < 1e-10
 
 
+def test_lanczos_goes_on_past_an_invariant_krylov_space():
+    """The start vector an eigenvector (of 2.0) of an operator of rank 4 in 60 dimensions: its Krylov space closes at
+    once (breakdown) and the other wanted eigenvalues come only from the new directions; all four to rounding."""
+    start = np.random.default_rng(eigen.LANCZOS_START).standard_normal(60)
+    Q, _ = np.linalg.qr(np.column_stack([start, np.random.default_rng(4).normal(size=(60, 59))]))
+    spectrum = np.concatenate([[2.0, 3.0, 3.5, 7.0], np.zeros(56)])
+    S = (Q * spectrum) @ Q.T
+    calls = []
+    values = eigen.largest_by_lanczos(lambda v: calls.append(1) or S @ v, 60, 4)
+    assert np.abs(values - [2.0, 3.0, 3.5, 7.0]).max() < 1e-13
+    assert len(calls) > 4  # the breakdown happened and was passed (4 products would have sufficed otherwise)
+
+
+@pytest.mark.parametrize("controls", ["pressure", "volume", "gas"])
+def test_one_shifted_factorisation_serves_the_constrained_and_updated_readings(controls):
+    """ShiftInvert of the matrix with fewer constraints (the free balloon under pressure) gives the lowest
+    eigenvalues of its relatives, more constraints (held: restricted_rows of the extra normals), a volume
+    constraint, a positive rank-one term (gas), to 1e-10 of each relative's own restricted matrix solved dense."""
+    n = eigen.FOLLOWING_SIZE + 40
+    A, _ = stiff_matrix(n, [-3.9, -0.2, 0.3, 0.3 + 1e-7, 0.5], 7)
+    rng = np.random.default_rng(8)
+    G = np.full(n, 2.0)
+    factor = eigen.GramFactor(G, orthogonal=True)
+    H = A * G  # the pencil (H, 2I): its standard matrix is A
+    base = rng.normal(size=(2, n))
+    held = np.vstack([base, rng.normal(size=(2, n)), 3.0 * base[0] - base[1]])  # one dependent row
+    g = rng.normal(size=n)
+    if controls == "volume":
+        normals, extra, update = np.vstack([held, g]), np.vstack([held, g]), None
+    else:
+        normals, extra = held, held
+        update = (eigen.restricted_rows(factor, base, g[None, :])[0], 0.7) if controls == "gas" else None
+    explicit = eigen.restricted(H + (0.7 * np.outer(g, g) if controls == "gas" else 0.0), factor, normals)
+    shifted = eigen.ShiftInvert.below(eigen.restricted(H, factor, base), -3.0)
+    values = shifted.lowest(4, eigen.restricted_rows(factor, base, extra), update)
+    assert eigen.rank_of(factor.directions(extra)) == n - explicit.shape[0]
+    assert np.abs(values - eigen.lowest_of(explicit, 4)).max() < 1e-10
+    if update is not None:  # a negative term may take the spectrum below σ: refused
+        assert shifted.lowest(4, update=(update[0], -0.7)) is None
+
+
 def test_negative_count_is_the_inertia():
     """The Bunch–Kaufman inertia counts the negative eigenvalues, with 2×2 pivots (zero diagonal blocks force them)."""
     for negatives in (0, 1, 3, 7):

@@ -9,7 +9,8 @@ The reduction L⁻¹ H L⁻ᵀ is BLAS or LAPACK (``LARGE_BLOCK``), the gatherin
 (quick to compile);
 the eigenvalues come from LAPACK's dsyevr for the lowest ``count`` only (tridiagonalisation and bisection).
 
-Large matrices along a branch (``lowest_following``): Lanczos (ARPACK) on (A − σI)⁻¹ with σ below the spectrum,
+Large matrices along a branch (``lowest_following``, ``ShiftInvert``): Lanczos (``largest_by_lanczos``) on
+(A − σI)⁻¹ with σ below the spectrum,
 proved so by a Cholesky factorisation of A − σI (n³/3 flops against dsyevr's 4n³/3 for the tridiagonal form): the
 eigenvalues of the inverse closest to its top are the lowest of A. The inertia of an indefinite matrix
 (``negative_count``) is the Bunch–Kaufman LDLᵀ's (Sylvester's law), again a factorisation, no eigensolve.
@@ -19,8 +20,10 @@ from functools import cached_property
 
 import numpy as np
 from numba import njit
+from scipy import linalg
 from scipy.linalg.lapack import dpotrf, dpotrs, dsyevr, dsygst, dsytrf
-from scipy.sparse.linalg import LinearOperator, eigsh
+
+EPS = np.finfo(float).eps
 
 RCOND = 1e-9  # constraint directions below RCOND times the largest are dependent ones (dropped)
 NO_CONSTRAINT = np.zeros((0, 1))
@@ -82,6 +85,49 @@ def restricted(H, factor: GramFactor, normals=NO_CONSTRAINT, index=None, rcond: 
     return _reflect_out(A, directions, rcond)
 
 
+def restricted_rows(factor: GramFactor, normals, rows, rcond: float = RCOND) -> np.ndarray:
+    """The rows L⁻¹wᵢ of the vectors wᵢ (``rows``, k × n) in the coordinates of ``restricted``'s matrix for
+    ``normals``: each reflection Q of ``_reflect`` applied, its first coordinate dropped ((Q w)[1:]: a constraint
+    wᵀy = 0 or a rank-one term w wᵀ reads so there). A row whose remainder is below rcond times its own norm lies
+    in the normals' span and is dropped."""
+    rows = factor.directions(np.atleast_2d(rows))
+    normals = np.atleast_2d(normals)
+    directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, rows.shape[1]))
+    mapped = _reflect_rows(directions, rcond, rows)
+    keep = np.linalg.norm(mapped, axis=1) > rcond * np.linalg.norm(rows, axis=1)
+    return mapped[keep]
+
+
+def rank_of(rows, rcond: float = RCOND) -> int:
+    """The number of independent rows (k × n) as ``restricted`` counts them (pivoted Gram–Schmidt, rcond)."""
+    rows = np.ascontiguousarray(np.atleast_2d(rows), dtype=float)
+    return _orthonormal_rows(rows, rcond).shape[0] if rows.size else 0
+
+
+@njit(cache=True)
+def _reflect_rows(directions, rcond, rows):
+    """The rows w of ``rows`` through the reflections ``_reflect`` makes of ``directions``: (Q w)[1:] each time."""
+    D = _orthonormal_rows(directions, rcond)
+    W = rows.copy()
+    for r in range(D.shape[0]):
+        n = D.shape[1]
+        v = D[r].copy()
+        v[0] += 1.0 if v[0] >= 0.0 else -1.0
+        w = 2.0 / _dot(v, v)
+        rest = np.empty((D.shape[0], n - 1))
+        for s in range(r + 1, D.shape[0]):
+            projected = _dot(D[s], v)
+            for i in range(1, n):
+                rest[s, i - 1] = D[s, i] - w * v[i] * projected
+        moved = np.empty((W.shape[0], n - 1))
+        for s in range(W.shape[0]):
+            projected = _dot(W[s], v)
+            for i in range(1, n):
+                moved[s, i - 1] = W[s, i] - w * v[i] * projected
+        D, W = rest, moved
+    return W
+
+
 def lowest_of(A, count: int) -> np.ndarray:
     """The ``count`` lowest eigenvalues (ascending) of the symmetric A, overwritten: below SMALL_EIGEN rows by
     the jitted Householder tridiagonalisation and bisection (``_lowest_small``), else LAPACK dsyevr, range 'I' (A
@@ -95,37 +141,122 @@ def lowest_of(A, count: int) -> np.ndarray:
 
 
 FOLLOWING_SIZE = 600  # from this size on ``lowest_following`` factors and iterates; below it dsyevr is as quick
-LANCZOS_VECTORS = 20  # ARPACK's Lanczos basis (fewer restarts than its default 2k + 1)
+LANCZOS_START = 0  # the seed of the Lanczos start vector (a fixed one: the same numbers every run)
 SHIFT_TRIES = 4  # shifts tried (each 4× farther below the guess) before the dense eigensolve
 
 
 def lowest_following(A, count: int, guess: float | None) -> np.ndarray:
     """The ``count`` lowest eigenvalues (ascending) of the symmetric A (lower triangle read; kept), where ``guess``
-    estimates the lowest (the previous point's along a branch; None: unknown): σ = guess − δ, δ = max(|guess|,
-    1e-2), tried as a lower bound by Cholesky of A − σI (δ × 4 per failure, SHIFT_TRIES times); then the largest
-    eigenvalues ν = 1/(μ − σ) of (A − σI)⁻¹ by ARPACK to machine precision (module docstring). Falls back to
-    ``lowest_of`` (dsyevr) below FOLLOWING_SIZE, without a guess, or when no shift is a lower bound."""
+    estimates the lowest (the previous point's along a branch; None: unknown): Lanczos on (A − σI)⁻¹ with σ below
+    the spectrum (``ShiftInvert``). Falls back to ``lowest_of`` (dsyevr) below FOLLOWING_SIZE, without a guess, or
+    when no shift is a lower bound."""
     n = A.shape[0]
-    if guess is None or n < FOLLOWING_SIZE or count >= n - 1:
-        return lowest_of(np.array(A), count)
-    delta = max(abs(guess), 1e-2)
-    for _ in range(SHIFT_TRIES):
-        sigma = guess - delta
-        shifted = np.array(A, order="F")
-        shifted[np.diag_indices(n)] -= sigma
-        factor, info = dpotrf(shifted, lower=1, clean=0, overwrite_a=1)
-        if info == 0:
-            break
-        delta *= 4.0
-    else:
-        return lowest_of(np.array(A), count)
+    shifted = None if guess is None or n < FOLLOWING_SIZE or count >= n - 1 else ShiftInvert.below(A, guess)
+    return lowest_of(np.array(A), count) if shifted is None else shifted.lowest(count)
 
-    def solve(v):
-        return dpotrs(factor, np.asarray(v, dtype=float).ravel(), lower=1)[0]
 
-    nu = eigsh(LinearOperator((n, n), matvec=solve, dtype=float), k=count, which="LA", tol=0.0,
-               ncv=min(n - 1, max(2 * count + 1, LANCZOS_VECTORS)), return_eigenvectors=False)
-    return np.sort(sigma + 1.0 / nu)
+class ShiftInvert:
+    """The Cholesky factor of A − σI for a σ proved below A's spectrum (the factorisation exists), and the lowest
+    eigenvalues of A and of its relatives through it: ν = 1/(μ − σ), the largest eigenvalues of (A − σI)⁻¹, by
+    Lanczos to machine precision (``largest_by_lanczos``).
+
+    A relative of A (``lowest``) is A + ρ u uᵀ (ρ > 0, a gas under pressure) restricted to Uᵀy = 0 (constraints):
+    its spectrum is still above σ (a positive update raises it, a restriction interlaces), and with S = (A − σI)⁻¹
+    S' = (A + ρuuᵀ − σI)⁻¹ = S − ρ (Su)(Su)ᵀ/(1 + ρ uᵀSu) (Sherman–Morrison) and
+    T = S' − S'U (UᵀS'U)⁻¹ UᵀS' is the inverse of the restricted shifted matrix on {Uᵀy = 0} and zero on U's span
+    (T (A + ρuuᵀ − σI) y = y for Uᵀy = 0, T U = 0): its largest eigenvalues are the relative's ν. One factorisation
+    serves every reading of a matrix that differs by constraints and positive rank-one terms."""
+
+    def __init__(self, factor: np.ndarray, sigma: float):
+        self.factor, self.sigma, self.size = factor, sigma, factor.shape[0]
+
+    @classmethod
+    def below(cls, A, guess: float):
+        """σ = guess − δ, δ = max(|guess|, 1e-2), tried as a lower bound by Cholesky of A − σI (δ × 4 per failure,
+        SHIFT_TRIES times); None when none is."""
+        n = A.shape[0]
+        delta = max(abs(guess), 1e-2)
+        for _ in range(SHIFT_TRIES):
+            sigma = guess - delta
+            shifted = np.array(A, order="F")
+            shifted[np.diag_indices(n)] -= sigma
+            factor, info = dpotrf(shifted, lower=1, clean=0, overwrite_a=1)
+            if info == 0:
+                return cls(factor, sigma)
+            delta *= 4.0
+        return None
+
+    def solve(self, v) -> np.ndarray:
+        """(A − σI)⁻¹ v (v a vector or the columns of a matrix)."""
+        return dpotrs(self.factor, np.asarray(v, dtype=float), lower=1)[0]
+
+    def lowest(self, count: int, constraints=None, update=None, rcond: float = RCOND) -> np.ndarray | None:
+        """The ``count`` lowest eigenvalues (ascending) of A + ρ u uᵀ on Uᵀy = 0 (class docstring); ``update``:
+        (u, ρ) or None, ``constraints``: the rows of U (k × n; dependent ones dropped as in ``restricted``) or None.
+        None when ρ ≤ 0 or the update does not keep A + ρuuᵀ − σI positive (then σ is no lower bound)."""
+        n = self.size
+        base = self.solve
+        if update is not None:
+            u, rho = np.asarray(update[0], dtype=float), float(update[1])
+            Su = self.solve(u)
+            denominator = 1.0 + rho * (u @ Su)
+            if rho <= 0.0 or not denominator > 0.0:
+                return None
+            weight = rho / denominator
+
+            def base(v):
+                y = self.solve(v)
+                return y - (weight * (Su @ v)) * Su
+        operator = base
+        if constraints is not None and len(constraints):
+            U = _orthonormal_rows(np.ascontiguousarray(np.atleast_2d(constraints), dtype=float), rcond).T
+            if U.shape[1]:
+                SU = np.column_stack([base(U[:, k]) for k in range(U.shape[1])])
+                K = np.linalg.cholesky(U.T @ SU)
+                correction = linalg.solve_triangular(K, SU.T, lower=True).T  # S'U K⁻ᵀ: T = S' − C Cᵀ
+
+                def operator(v):
+                    return base(v) - correction @ (correction.T @ v)
+        nu = largest_by_lanczos(operator, n, count)
+        return np.sort(self.sigma + 1.0 / nu)
+
+
+def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
+    """The ``count`` largest eigenvalues (ascending) of the symmetric positive semidefinite operator (x ↦ Sx on
+    vectors of size n) by Lanczos with full reorthogonalisation (two Gram–Schmidt passes a step, no restarts: ~2/3
+    of the products ARPACK's implicitly restarted Lanczos needs here), stopped when every wanted Ritz pair's
+    residual |β_j y_j| is below 4ε times the largest Ritz value (ARPACK's tol = 0 is ε: the Ritz values are then
+    exact to rounding, their error ≤ residual²/gap). A breakdown (an invariant Krylov space) continues from a new
+    vector orthogonal to it; at n steps the space is everything and the Ritz values are the eigenvalues. As any
+    single-vector Krylov method (ARPACK's too) it sees an exactly multiple eigenvalue once: its callers read
+    states off any symmetry that forces one (an axisymmetric point 0 of a surface branch is solved dense)."""
+    rng = np.random.default_rng(LANCZOS_START)
+    V = np.empty((min(n, 4 * count + 40), n))
+    alpha, beta = np.empty(n), np.empty(n)
+    v = rng.standard_normal(n)
+    V[0] = v / np.linalg.norm(v)
+    for j in range(n):
+        w = operator(V[j])
+        alpha[j] = V[j] @ w
+        basis = V[:j + 1]
+        for _ in range(2):
+            w -= basis.T @ (basis @ w)
+        beta[j] = np.linalg.norm(w)
+        if j + 1 >= count:
+            theta, Y = linalg.eigh_tridiagonal(alpha[:j + 1], beta[:j], select="i", select_range=(j + 1 - count, j))
+            if j + 1 == n or np.all(np.abs(beta[j] * Y[-1]) <= 4.0 * EPS * theta.max()):
+                return theta
+        if j + 1 == V.shape[0]:
+            V = np.vstack([V, np.empty((min(V.shape[0], n - V.shape[0]), n))])
+        if beta[j] <= EPS * max(abs(alpha[j]), 1.0):  # invariant: go on from a new direction (β_j = 0)
+            w = rng.standard_normal(n)
+            for _ in range(2):
+                w -= basis.T @ (basis @ w)
+            beta[j] = 0.0
+            V[j + 1] = w / np.linalg.norm(w)
+        else:
+            V[j + 1] = w / beta[j]
+    raise AssertionError("unreachable: at n steps the Krylov space is complete")
 
 
 def negative_count(A) -> int:

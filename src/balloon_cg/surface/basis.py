@@ -308,8 +308,8 @@ class SphericalBasis:
     def hessian(self, pointwise: np.ndarray, pairs_rows: np.ndarray) -> np.ndarray:
         """Σ_{jk} W_j D(θ_j, φ_k) contracted with the node rows' derivatives on both sides (module docstring), D the
         45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (galerkin.discretisation.symmetric_rows of the kernels' pairs). Per
-        component pair (c, c'): the column weights Y_b = Σ_d' T^{dd'}[·, b, ·] Θ^{d'} of every row block b in one
-        jitted pass (``_weighted_columns``), then one product Θ_bᵀ Y_b per row block (BLAS)."""
+        component pair (c, c') and row block b: the column weights Y_b = Σ_d' T^{dd'}[·, b, ·] Θ^{d'} (jitted,
+        ``_weighted_columns``), then the product Θ_bᵀ Y_b (BLAS) while Y_b is in cache."""
         n, nodes, components = self.n_phi, self.nodes, self.tables["components"]
         spectra = np.fft.fft(pointwise.reshape(-1, self.n_theta, n) * nodes["weights"][None, :, None], axis=2)
         fourier = np.ascontiguousarray(np.concatenate([spectra.real, -spectra.imag], axis=2))  # C_q, S_q
@@ -323,11 +323,13 @@ class SphericalBasis:
                     continue
                 cols = components[c2]["range"]
                 channels = np.array([[pairs_rows[3 * d + c, 3 * d2 + c2] for d2 in range(3)] for d in range(3)])
-                Y = _weighted_columns(fourier, channels, *self._products[c, c2], components[c2]["theta"],
-                                      components[c2]["column_block"])
+                theta = components[c2]["theta"]
+                Y = np.empty(theta.shape)
                 left = components[c]["left"]
                 for r, (start, stop) in enumerate(components[c]["row_ranges"]):
-                    H[rows.start + start:rows.start + stop, cols] = left[r].T @ Y[r].reshape(3 * self.n_theta, -1)
+                    _weighted_columns(fourier, channels, *self._products[c, c2], theta, components[c2]["starts"], r,
+                                      Y)
+                    H[rows.start + start:rows.start + stop, cols] = left[r].T @ Y.reshape(3 * self.n_theta, -1)
                 if c2 != c:
                     H[cols, rows] = H[rows, cols].T
         return H
@@ -387,25 +389,23 @@ def _norm(m: int) -> float:
 
 
 @njit(cache=True)
-def _weighted_columns(fourier, channels, i1, i2, a1, a2, theta, block_of):
-    """Y[r, d, j, col] = Σ_d' T^{dd'}_j[r, b'] Θ^{d'}[j, col] for every row block r, b' = block_of[col] the block of
-    column col, T^{dd'}_j[r, b'] = α1 F_ch[j, i1] + α2 F_ch[j, i2] of the plan of φ-types (d // 2, d' // 2) and the
-    Fourier table F_ch of channel ch = channels[d, d']."""
-    n_r, n_b = i1.shape[2], i1.shape[3]
-    n_theta, n_cols = theta.shape[1], theta.shape[2]
-    Y = np.zeros((n_r, 3, n_theta, n_cols))
-    t = np.empty(n_b)
-    for r in range(n_r):
-        for d in range(3):
-            e = d // 2
-            for d2 in range(3):
-                e2 = d2 // 2
-                ch = channels[d, d2]
-                for j in range(n_theta):
-                    for b in range(n_b):
-                        t[b] = (a1[e, e2, r, b] * fourier[ch, j, i1[e, e2, r, b]]
-                                + a2[e, e2, r, b] * fourier[ch, j, i2[e, e2, r, b]])
-                    y, weights = Y[r, d, j], theta[d2, j]
-                    for col in range(n_cols):
-                        y[col] += t[block_of[col]] * weights[col]
-    return Y
+def _weighted_columns(fourier, channels, i1, i2, a1, a2, theta, starts, r, Y):
+    """Y[d, j, col] = Σ_d' T^{dd'}_j[r, b'] Θ^{d'}[j, col] for the row block r, b' the block of column col (columns
+    starts[b'] to starts[b' + 1]), T^{dd'}_j[r, b'] = α1 F_ch[j, i1] + α2 F_ch[j, i2] of the plan of φ-types
+    (d // 2, d' // 2) and the Fourier table F_ch of channel ch = channels[d, d'] (Y overwritten: one row block at a
+    time stays in cache; each block's columns one contiguous, vectorised run)."""
+    n_b = i1.shape[3]
+    n_theta = theta.shape[1]
+    Y[:] = 0.0
+    for d in range(3):
+        e = d // 2
+        for d2 in range(3):
+            e2 = d2 // 2
+            ch = channels[d, d2]
+            for j in range(n_theta):
+                y, weights = Y[d, j], theta[d2, j]
+                for b in range(n_b):
+                    t = (a1[e, e2, r, b] * fourier[ch, j, i1[e, e2, r, b]]
+                         + a2[e, e2, r, b] * fourier[ch, j, i2[e, e2, r, b]])
+                    for col in range(starts[b], starts[b + 1]):
+                        y[col] += t * weights[col]

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from numba import njit
 
 from .basis import SphericalBasis
 
@@ -98,13 +99,23 @@ class Gauge:
         free, touched, block = self._split
         return np.concatenate([r[free], block.T @ r[touched]])
 
-    def reduce_matrix(self, H: np.ndarray) -> np.ndarray:
-        """Zᵀ H Z."""
+    def reduce_matrix(self, H: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Zᵀ H Z (into ``out`` when given, e.g. the Jacobian's columns)."""
         free, touched, block = self._split
-        out = np.empty((self.size, self.size))
+        out = np.empty((self.size, self.size)) if out is None else out
         n = free.size
-        out[:n, :n] = H[np.ix_(free, free)]
+        _take(H, free, out)
         side = H[np.ix_(free, touched)] @ block
         out[:n, n:], out[n:, :n] = side, side.T
         out[n:, n:] = block.T @ H[np.ix_(touched, touched)] @ block
         return out
+
+
+@njit(cache=True)
+def _take(H, index, out):
+    """out[:k, :k] = H[index][:, index] (k = index.size; one pass, no index arrays of k² entries)."""
+    k = index.size
+    for i in range(k):
+        row = H[index[i]]
+        for j in range(k):
+            out[i, j] = row[index[j]]

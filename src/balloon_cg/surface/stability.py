@@ -78,37 +78,49 @@ def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
     return np.array(out).reshape(-1, basis.size)
 
 
-def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=PRESSURE_READINGS,
-                    only: tuple | None = None):
-    """Yields (characters, the readings, A) one matrix at a time: A the standard symmetric matrix of the sector's
-    pencil under those readings (module docstring), the zero modes removed (numerics.eigen.restricted: its
-    eigenvalues are the μ, its inertia the sector's), one assembly per sector and one matrix for the readings that
-    share it (a sector without a translation reads the same held and free; one without g the same under every
-    control); ``only``: the characters of the one sector wanted."""
+def _sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings, only: tuple | None):
+    """Yields (sector, H, g, groups, gas weight P/Ṽ) per symmetry sector: its Hessian, g = ∂Ṽ/∂c on the state's
+    own sector under a controlled reading (else None), and groups {(zero-mode rows' bytes, control): (rows, the
+    readings sharing that matrix)} (a sector without a translation reads the same held and free; one without g
+    the same under every control); ``only``: the characters of the one sector wanted."""
     state = eq.node_values(c)["state"]
     fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
               for held in {r.held for r in readings}}
     controlled = any(r.control != Control.PRESSURE for r in readings)
-    volume = body_moments(eq.basis, state)[0] if controlled else None
+    weight = params.P / body_moments(eq.basis, state)[0] if controlled else None
     for sector in eq.basis.sectors():
         if not sector.size or only not in (None, sector.characters):
             continue
         H = eq.hessian(c, params, sector)
         g = -eq.parameter_derivative(c, params, "P", sector) if controlled and _own(sector, eq.basis) else None
         rows_of = {held: mode_rows(sector, modes) for held, modes in fields.items()}
-        groups = {}  # (zero-mode rows, the control the sector sees) -> (rows, the readings sharing the matrix)
+        groups = {}
         for r in readings:
             rows = rows_of[r.held]
             control = r.control if g is not None else Control.PRESSURE
             groups.setdefault((rows.tobytes(), control), (rows, []))[1].append(r)
+        yield sector, H, g, groups, weight
+
+
+def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=PRESSURE_READINGS,
+                    only: tuple | None = None):
+    """Yields (characters, the readings, A) one matrix at a time: A the standard symmetric matrix of the sector's
+    pencil under those readings (module docstring), the zero modes removed (numerics.eigen.restricted: its
+    eigenvalues are the μ, its inertia the sector's), one assembly per sector and one matrix for the readings that
+    share it (``_sectors``); ``only``: the characters of the one sector wanted."""
+    for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only):
         for (_, control), (rows, shared) in groups.items():
-            if control == Control.VOLUME:
-                A = _restricted(H, sector.gram(), rows, g)
-            elif control == Control.GAS:
-                A = _restricted(H + (params.P / volume) * np.outer(g, g), sector.gram(), rows)
-            else:
-                A = _restricted(H, sector.gram(), rows)
-            yield sector.characters, tuple(shared), A
+            yield sector.characters, tuple(shared), _reading_matrix(H, sector.gram(), rows, control, g, weight)
+
+
+def _reading_matrix(H, gram: float, rows, control: Control, g, weight) -> np.ndarray:
+    """The standard matrix of one reading (module docstring): H without the zero modes ``rows``, on gᵀc = 0 under
+    volume control, H + (P/Ṽ) g gᵀ under gas control."""
+    if control == Control.VOLUME:
+        return _restricted(H, gram, rows, g)
+    if control == Control.GAS:
+        return _restricted(H + weight * np.outer(g, g), gram, rows)
+    return _restricted(H, gram, rows)
 
 
 def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=PRESSURE_READINGS,
@@ -123,16 +135,46 @@ def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
 
 def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
                    readings=PRESSURE_READINGS, guesses: dict | None = None) -> dict:
-    """{reading: {characters: the ``count`` lowest μ of the sector}}, each matrix solved as it is made (one at a
-    time in memory). ``guesses`` (the same layout, the previous point's along a branch) let a large sector follow
-    its lowest eigenvalue (numerics.eigen.lowest_following) instead of a dense eigensolve."""
+    """{reading: {characters: the ``count`` lowest μ of the sector}}, one sector at a time in memory. ``guesses``
+    (the same layout, the previous point's along a branch) let a large sector follow its lowest eigenvalues: one
+    Cholesky factorisation of its matrix with the fewest zero modes removed under pressure control (the lowest
+    spectrum of its readings), shifted below the lowest guess (numerics.eigen.ShiftInvert), serves every reading:
+    the other zero modes and the volume's gᵀc = 0 are constraints, the gas term a positive rank-one update in that
+    matrix's coordinates (numerics.eigen.restricted_rows). Without guesses, below FOLLOWING_SIZE, or without a
+    shift below the spectrum, each reading's matrix is solved dense (numerics.eigen.lowest_of)."""
     out = {r: {} for r in readings}
-    for key, shared, A in sector_matrices(eq, c, params, readings):
-        previous = (guesses or {}).get(shared[0], {}).get(key)
-        values = eigen.lowest_following(A, count, None if previous is None else float(previous[0]))
-        for r in shared:
-            out[r][key] = values
+    for sector, H, g, groups, weight in _sectors(eq, c, params, readings, None):
+        key, gram = sector.characters, sector.gram()
+        previous = [guesses[r][key][0] for r in readings if guesses and key in guesses.get(r, {})]
+        base_rows = min((rows for rows, _ in groups.values()), key=len)
+        shifted = None
+        if previous and H.shape[0] - eigen.rank_of(base_rows) >= eigen.FOLLOWING_SIZE:
+            shifted = eigen.ShiftInvert.below(_restricted(H, gram, base_rows), float(min(previous)))
+        for (_, control), (rows, shared) in groups.items():
+            values = None if shifted is None else _shifted_lowest(shifted, count, H, gram, base_rows, rows, control, g,
+                                                                  weight)
+            if values is None:
+                values = eigen.lowest_of(_reading_matrix(H, gram, rows, control, g, weight), count)
+            for r in shared:
+                out[r][key] = values
     return out
+
+
+def _shifted_lowest(shifted, count: int, H, gram: float, base_rows, rows, control: Control, g, weight):
+    """The ``count`` lowest μ of one reading through the factorisation ``shifted`` of the matrix without the zero
+    modes ``base_rows`` (``sector_spectra``), or None where the gas term does not keep the shift a lower bound."""
+    diagonal = np.full(H.shape[0], gram)
+    factor = eigen.GramFactor(diagonal, orthogonal=True)
+    normals = base_rows * diagonal
+    extra = np.vstack([rows * diagonal] + ([g[None, :]] if control == Control.VOLUME else []))
+    if H.shape[0] - eigen.rank_of(factor.directions(extra)) < eigen.FOLLOWING_SIZE:
+        return None  # this reading's matrix is small: dense, as lowest_following would
+    constraints = eigen.restricted_rows(factor, normals, extra) if extra.size else None
+    update = None
+    if control == Control.GAS:
+        u = eigen.restricted_rows(factor, normals, g[None, :])
+        update = (u[0], weight) if len(u) else None
+    return shifted.lowest(count, constraints, update)
 
 
 def spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,

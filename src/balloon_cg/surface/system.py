@@ -31,7 +31,7 @@ class SurfaceSystem:
     def jacobian(self, X):
         c, params = self.coefficients(X), self.params_at(X)
         J = np.empty((self.gauge.size, self.gauge.size + 1))
-        J[:, :-1] = self.gauge.reduce_matrix(self.eq.hessian(c, params))
+        self.gauge.reduce_matrix(self.eq.hessian(c, params), out=J[:, :-1])
         J[:, -1] = self.gauge.reduce(self.eq.parameter_derivative(c, params, self.name))
         return J
 
