@@ -18,12 +18,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation, mirror, surface_branches
+from . import azimuthal_points, bifurcation, mirror, surface_branches, surface_primary
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
 from .problem import equilibrium_of
-from .results import Block, Branch, Origin, Status, StopCode
+from .results import Block, Branch, Kind, Origin, Status, StopCode
 from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
 from .timing import Clock, Step
@@ -91,8 +91,9 @@ class Picture:
     clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
 
     @property
-    def primary(self) -> Branch:
-        return self.branches[0]
+    def primary(self):
+        """The primary branch: a Branch, or a SurfaceBranch for a field that is not axisymmetric."""
+        return self.branches[0] if self.branches else self.surface_branches[0]
 
     def __repr__(self):
         branches = ", ".join(f"{b.name} ({len(b.X)} points)" for b in self.branches)
@@ -131,6 +132,8 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     then holds what is finished (``interrupted``; the branches after it are not traced, nor assessed).
     ``clock``: the Clock its phases are charged to (``Picture.clock``; default: one started here)."""
     progress, clock = progress or Progress(), clock or Clock()
+    if not scene.field.is_axisymmetric:
+        return _whole_sphere(scene, progress, clock)
     with clock.step(Step.TRACE):
         primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
     progress.finish(Phase.PRIMARY, len(primary.X))
@@ -174,6 +177,20 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs(picture.branches, scene.loading.control)
+    return picture
+
+
+def _whole_sphere(scene, progress: Progress, clock: Clock) -> Picture:
+    """The picture of a field that is not axisymmetric: its primary branch traced on the whole sphere, assessed
+    held under every control, its secondary branch points located (``surface_primary``). Branches are not yet
+    switched from them: ``not_searched`` says so when there are any."""
+    primary = surface_primary.trace_surface_primary(scene, progress.ticker(Phase.PRIMARY), clock)
+    progress.finish(Phase.PRIMARY, len(primary.values))
+    picture = Picture([], surface_branches=[primary], clock=clock)
+    if any(s.kind == Kind.BP for s in primary.special):
+        picture.not_searched = ("the branches born at the branch points of a primary branch traced on the whole "
+                                "sphere are not traced yet")
+    _stopped(picture)
     return picture
 
 

@@ -36,6 +36,7 @@ from .primary import start_parameters
 from .results import SurfaceBranch
 from .surface_assessment import assess
 from .surface_branches import SurfaceStartError, SurfaceTrace, collected, follow, traced_points
+from .timing import Clock, Step
 from .tracer import ContinuationError
 
 FIELD_STEPS = 12  # halvings of the step in M before the field cannot be switched on
@@ -94,10 +95,11 @@ def _field_on(trace: SurfaceTrace, c: np.ndarray, params) -> np.ndarray:
 
 
 @limited_blas
-def trace_surface_primary(scene, progress=None) -> SurfaceBranch:
+def trace_surface_primary(scene, progress=None, clock: Clock | None = None) -> SurfaceBranch:
     """The primary branch of ``scene`` on the whole sphere (module docstring), assessed held under every control,
-    with the field's net force and torque at every point."""
-    t0 = time.perf_counter()
+    with the field's net force and torque at every point; ``clock``: the Clock the trace and the stability are
+    charged to."""
+    t0, clock = time.perf_counter(), clock or Clock()
     params = start_parameters(scene, "P").with_value("M", scene.field.M)
     symmetry = field_reflections(scene.field.coils)
     basis = SphericalBasis(scene.surface.degree, symmetry)
@@ -105,29 +107,24 @@ def trace_surface_primary(scene, progress=None) -> SurfaceBranch:
     if trace.gauge.field_symmetry != FieldSymmetry.GENERAL:
         raise ValueError("trace_surface_primary: the field of this scene is axisymmetric (or off): trace it with "
                          "analysis.primary")
-    lam = scene.continuation.start_stretch
-    sphere = displacement_coefficients(basis, (lam - 1.0) * basis.nodes["reference"][:3])
-    c = _field_on(trace, sphere, params)
-    X = trace.system.point(c, params.P)
-    solved = newton(trace.system.residual, trace.system.jacobian, X, np.eye(X.size)[-1], X[-1], scene.solver.tol,
-                    scene.solver.max_newton)
-    if not solved.converged:
-        raise SurfaceStartError(f"the start at M = {params.M:g} did not converge in P: {solved.message}")
-    up = np.eye(X.size)[-1]
-    start = continuation.Point(solved.x, continuation.tangent(trace.system, solved.x, up), solved.iterations,
-                               solved.residual)
-    trace, segments, folds, stop = follow(trace, [], start, scene.continuation.max_points, None, progress)
-    return _branch(trace, segments, folds, stop, t0)
-
-
-def _branch(trace: SurfaceTrace, segments, folds, stop, t0) -> SurfaceBranch:
-    """The SurfaceBranch of the traced segments (``surface_branches.collected``) with the loads of every point, its
-    stability read held under every control on each point's own basis."""
-    fields = collected(trace, segments, folds, stop)
-    per_point = [loads(trace.eq, c, trace.system.params) for c in fields["coefficients"]]
-    fields["measures"] |= {key: np.array([load[key] for load in per_point]) for key in LOADS}
-    out = SurfaceBranch(name="primary", scene=trace.scene, kernel_class=trace.eq.kernels.name,
-                        params=trace.system.params, m=0, parent=("", -1), **fields)
-    assess(out, traced_points(segments), READINGS)
-    out.wall_time = time.perf_counter() - t0
+    with clock.step(Step.TRACE):
+        lam = scene.continuation.start_stretch
+        sphere = displacement_coefficients(basis, (lam - 1.0) * basis.nodes["reference"][:3])
+        c = _field_on(trace, sphere, params)
+        X = trace.system.point(c, params.P)
+        solved = newton(trace.system.residual, trace.system.jacobian, X, np.eye(X.size)[-1], X[-1],
+                        scene.solver.tol, scene.solver.max_newton)
+        if not solved.converged:
+            raise SurfaceStartError(f"the start at M = {params.M:g} did not converge in P: {solved.message}")
+        start = continuation.Point(solved.x, continuation.tangent(trace.system, solved.x, np.eye(X.size)[-1]),
+                                   solved.iterations, solved.residual)
+        trace, segments, folds, stop = follow(trace, [], start, scene.continuation.max_points, None, progress)
+        fields = collected(trace, segments, folds, stop)
+        per_point = [loads(trace.eq, c, trace.system.params) for c in fields["coefficients"]]
+        fields["measures"] |= {key: np.array([load[key] for load in per_point]) for key in LOADS}
+        out = SurfaceBranch(name="primary", scene=scene, kernel_class=trace.eq.kernels.name,
+                            params=trace.system.params, m=0, parent=("", -1), **fields)
+        out.wall_time = time.perf_counter() - t0
+    with clock.step(Step.STABILITY):
+        assess(out, traced_points(segments), READINGS)
     return out

@@ -280,7 +280,7 @@ def run(args) -> int:
     from ..numerics.interrupt import requested, stop_on_signals
     from .progress import shown
 
-    scene = axisymmetric(scene_of(args))
+    scene = scene_of(args)
     output = hdf5_output(args.output, "run") if args.output is not None else f"{scene.name}.h5"
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
