@@ -26,7 +26,7 @@ from balloon_cg.scene import load_scene
 from balloon_cg.surface.basis import EQUATOR, MIRROR_Y, SphericalBasis
 from balloon_cg.surface.embedding import displacement_coefficients
 from balloon_cg.surface.equilibrium import SurfaceEquilibrium
-from balloon_cg.surface.gauge import Gauge
+from balloon_cg.surface.gauge import FieldSymmetry, Gauge
 from balloon_cg.surface.measures import axial_stretch_row
 from balloon_cg.surface.system import SurfaceSystem
 
@@ -97,7 +97,7 @@ def sphere_solves(scene):
     for degree in (16, 24):
         basis = SphericalBasis(degree, (MIRROR_Y, EQUATOR))
         eq = SurfaceEquilibrium(scene, basis)
-        system = SurfaceSystem(eq, Gauge(basis, held=True, in_field=False), Parameters(P))
+        system = SurfaceSystem(eq, Gauge(basis, held=True, field_symmetry=FieldSymmetry.NONE), Parameters(P))
         row, offset = axial_stretch_row(basis)
         c = displacement_coefficients(basis, (stretch - 1) * basis.nodes["reference"][:3])
         c = c + 1e-3 * np.random.default_rng(0).standard_normal(basis.size)

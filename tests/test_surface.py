@@ -18,7 +18,7 @@ from balloon_cg.surface import stability
 from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 from balloon_cg.surface.embedding import axisymmetric_coefficients, displacement_coefficients, mode_coefficients
 from balloon_cg.surface.equilibrium import SurfaceEquilibrium
-from balloon_cg.surface.gauge import Gauge, UnsupportedGauge
+from balloon_cg.surface.gauge import FieldSymmetry, Gauge, UnsupportedGauge
 from balloon_cg.surface.measures import axial_stretch_row, measures
 from balloon_cg.surface.system import SurfaceSystem
 
@@ -103,7 +103,7 @@ def test_sphere_states_are_equilibria_and_the_solver_returns_them(text, stretch)
     eq = SurfaceEquilibrium(scene, basis)
     c = axisymmetric_coefficients(basis, eq1.disc, u)
     assert np.abs(eq.residual(c, params)).max() <= 1e-10
-    system = SurfaceSystem(eq, Gauge(basis, held=True, in_field=False), params)
+    system = SurfaceSystem(eq, Gauge(basis, held=True, field_symmetry=FieldSymmetry.NONE), params)
     row, offset = axial_stretch_row(basis)
     X0 = system.point(c + 0.01 * np.random.default_rng(3).standard_normal(basis.size), params.P * 1.05)
     X0[:-1] = system.gauge.reduce(system.gauge.expand(X0[:-1]))
@@ -192,7 +192,7 @@ def test_primary_branch_states_are_equilibria_with_a_field(two_coil_picture):
         assert axisymmetric.converged and fine.tail(axisymmetric.x[:-1]) <= 1e-11
         c = axisymmetric_coefficients(basis, fine, axisymmetric.x[:-1])
         assert np.abs(eq.residual(c, params)).max() <= 1e-10
-        system = SurfaceSystem(eq, Gauge(basis, held=True, in_field=True), params)
+        system = SurfaceSystem(eq, Gauge(basis, held=True, field_symmetry=FieldSymmetry.AXIAL), params)
         row, offset = axial_stretch_row(basis)
         stretch = branch.pole_values(X)["lam2_north"][0]
         result = newton(system.residual, system.jacobian, system.point(c, params.P * 1.01),
@@ -211,7 +211,7 @@ def test_relabelling_and_rigid_modes_are_exact_null_vectors(spom1):
     eq = SurfaceEquilibrium(spom1, basis)
     c = axisymmetric_coefficients(basis, eq1.disc, u)
     H = eq.hessian(c, params)
-    fields = stability.zero_mode_fields(eq.node_values(c)["state"], basis.nodes["reference"], False, True)
+    fields = stability.zero_mode_fields(eq.node_values(c)["state"], basis.nodes["reference"], FieldSymmetry.NONE, True)
     rows = stability.mode_rows(basis, fields)
     assert len(rows) == 9
     for v in rows:
@@ -225,14 +225,14 @@ def test_gauge_removes_the_subspace_zero_modes(spom1):
     """The relabelling about y lives in the mirror subspace and is removed; a subspace that keeps a rigid rotation
     the field leaves free is refused."""
     basis = SphericalBasis(8, (MIRROR_Y,))
-    gauge = Gauge(basis, held=True, in_field=True)
+    gauge = Gauge(basis, held=True, field_symmetry=FieldSymmetry.AXIAL)
     assert gauge.size == basis.size - 2  # the x translation held (z is free in a field), the relabelling about y
     a = np.random.default_rng(1).standard_normal(gauge.size)
     c = gauge.expand(a)
     assert np.abs(gauge.constraints @ c).max() <= 1e-14
     assert np.allclose(gauge.reduce(c), a)
     with pytest.raises(UnsupportedGauge, match="rotation about the y axis"):
-        Gauge(basis, held=True, in_field=False)
+        Gauge(basis, held=True, field_symmetry=FieldSymmetry.NONE)
 
 
 def test_measures_of_a_shifted_ellipsoid():

@@ -23,7 +23,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import azimuthal_points, bifurcation, broken_symmetry, control_points, mirror, surface_branches
+from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, mirror, surface_branches,
+               surface_primary)
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
@@ -101,8 +102,9 @@ class Picture:
     clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
 
     @property
-    def primary(self) -> Branch:
-        return self.branches[0]
+    def primary(self):
+        """The primary branch: a Branch, or a SurfaceBranch for a field that is not axisymmetric."""
+        return self.branches[0] if self.branches else self.surface_branches[0]
 
     def __repr__(self):
         n, surface = len(self.branches), len(self.surface_branches)
@@ -142,6 +144,8 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     then holds what is finished (``interrupted``; the branches after it are not traced, nor assessed).
     ``clock``: the Clock its phases are charged to (``Picture.clock``; default: one started here)."""
     progress, clock = progress or Progress(), clock or Clock()
+    if not scene.field.is_axisymmetric:
+        return _whole_sphere(scene, progress, clock)
     with clock.step(Step.TRACE):
         primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
     progress.finish(Phase.PRIMARY, len(primary.X))
@@ -238,6 +242,20 @@ def _unsearched(primary: Branch, searched: bool) -> str:
     if primary.gauge == Gauge.HELD:
         missing += "; nor is the free balloon's branch (its axial translation free)"
     return missing
+
+
+def _whole_sphere(scene, progress: Progress, clock: Clock) -> Picture:
+    """The picture of a field that is not axisymmetric: its primary branch traced on the whole sphere, assessed
+    held under every control, its secondary branch points located (``surface_primary``). Branches are not yet
+    switched from them: ``not_searched`` says so when there are any."""
+    primary = surface_primary.trace_surface_primary(scene, progress.ticker(Phase.PRIMARY), clock)
+    progress.finish(Phase.PRIMARY, len(primary.values))
+    picture = Picture([], surface_branches=[primary], clock=clock)
+    if any(s.kind == Kind.BP for s in primary.special):
+        picture.not_searched = ("the branches born at the branch points of a primary branch traced on the whole "
+                                "sphere are not traced yet")
+    _stopped(picture)
+    return picture
 
 
 def _stopped(picture: Picture) -> bool:

@@ -14,16 +14,18 @@ from .results import Kind, SpecialPoint, Status, SurfaceBranch
 STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
 
 
-def assess(sb: SurfaceBranch, traced: list) -> None:
+def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> None:
     """The stability readings of every point (held and free, under pressure, volume and gas control:
     ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
     of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
     the zero of the crossing eigenvalue, located by Brent's method along the chord with the corrector on its
     hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails. ``traced``: per
     point, (the SurfaceTrace it was traced on, its coefficients there): a point is read on its own basis (resolved
-    there; the final basis of a branch that refined is several times larger than its first points need)."""
+    there; the final basis of a branch that refined is several times larger than its first points need).
+    ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). A fold (LP) of the
+    branch changes the count of the state's own sector between its points: not a branch point."""
     held = surface_stability.Reading(True)
-    readings = {r: [] for r in surface_stability.READINGS}
+    readings = {r: [] for r in readings}
     counts, held_spectra, spectra = [], [], None
     for (trace, c), value in zip(traced, sb.values):
         params = sb.params.with_value(sb.parameter, value)
@@ -33,9 +35,10 @@ def assess(sb: SurfaceBranch, traced: list) -> None:
         counts.append(_negative_counts(trace, c, params, spectra[held]))
         held_spectra.append(spectra[held])
     sb.stability = {r.name: np.array(rows) for r, rows in readings.items()}
+    folds = {s.index for s in sb.special if s.kind == Kind.LP}
     for i in range(1, len(counts) - 1):
         for key in counts[i]:
-            if counts[i][key] != counts[i + 1][key]:
+            if counts[i][key] != counts[i + 1][key] and not (i in folds and key == sb.basis.characters):
                 sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
                                              float(held_spectra[i][key][0])))
     sb.special.sort(key=lambda s: s.index)

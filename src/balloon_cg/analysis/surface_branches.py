@@ -32,7 +32,7 @@ import numpy as np
 from scipy import linalg
 
 from ..galerkin.equilibrium import Parameters
-from ..model.field import coaxial_table, wire_distance
+from ..model.loop import loop_distance
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
@@ -116,7 +116,7 @@ class SurfaceTrace:
     def __init__(self, scene, basis: SphericalBasis, params: Parameters):
         self.scene, self.basis = scene, basis
         self.eq = SurfaceEquilibrium(scene, basis)
-        self.gauge = Gauge(basis, held=True, in_field=surface_stability.in_field(self.eq, params))
+        self.gauge = Gauge(basis, held=True, field_symmetry=surface_stability.field_symmetry(self.eq, params))
         self.system = SurfaceSystem(self.eq, self.gauge, params, "P")
 
     def on(self, basis: SphericalBasis) -> "SurfaceTrace":
@@ -170,14 +170,15 @@ def axisymmetric_solve(trace: SurfaceTrace, c: np.ndarray, P: float) -> np.ndarr
     return c + E @ result.x[:-1] if result.converged else None
 
 
-def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
-    """stop(point) -> Stop or None (module docstring); StopCode.RESOLUTION when a tail exceeds solver.max_error."""
+def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
+    """stop(point) -> Stop or None (module docstring); ``rejoin`` (φ, X*): the branch ends where it crosses the
+    hyperplane of its branch point back (None: a primary branch); StopCode.RESOLUTION when a tail exceeds
+    solver.max_error."""
     scene, basis = trace.scene, trace.basis
     upper, gap = scene.continuation.stop_stretch, scene.continuation.wire_gap
-    coils = coaxial_table(scene.field.coils)
 
     def stop(point):
-        if direction @ (point.X - X_star) < 0:
+        if rejoin is not None and rejoin[0] @ (point.X - rejoin[1]) < 0:
             return Stop(StopCode.REJOINED, "rejoined the axisymmetric branch")
         c = trace.system.coefficients(point.X)
         m = measures(basis, c)
@@ -185,9 +186,8 @@ def _stop_rule(trace: SurfaceTrace, direction: np.ndarray, X_star: np.ndarray):
             return Stop(StopCode.STOP_STRETCH, f"north pole stretch reached stop_stretch {upper:g}")
         if m["lam_south"] >= upper:
             return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
-        if coils.shape[0]:
-            x = trace.eq.node_values(c)["state"][:3]
-            distance = float(wire_distance(np.hypot(x[0], x[1]), x[2], coils).min())
+        if trace.eq.has_field:
+            distance = float(loop_distance(trace.eq.node_values(c)["state"][:3], trace.eq.coils).min())
             if distance < gap:
                 return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap:g} of a coil (gap {distance:.3g})")
         error = tail(basis, c)
@@ -249,19 +249,33 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
         raise SurfaceStartError(f"the first correction from branch point {number} along its m = {bp.m} mode did "
                                 f"not converge: {first.message}")
     start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
-    segments, folds = [(trace, [start])], []
+    trace, segments, folds, stop = follow(trace, [start], first, max_points, (phi, X_star), progress)
+    return _branch(trace, segments, folds, stop, branch, number, origin, name, t0)
+
+
+def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_points: int, rejoin: tuple | None,
+           progress=None) -> tuple:
+    """Pseudo-arclength continuation in P from ``first`` (after the stored ``points``) until a stop of ``_stop_rule``
+    (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch); a point whose tail exceeds
+    solver.max_error refines the basis (the wire map re-centred on the state, then the degree and the order
+    extended), the last point is solved again there and the trace goes on. Returns (the last trace, the segments
+    [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop)."""
+    scene = trace.scene
+    segments, folds = [(trace, list(points))], []
     while True:
         done = sum(len(points) for _, points in segments)
         settings = continuation_settings(scene, max(max_points - done, 1))
-        path = continuation.trace(trace.system, first, settings, _stop_rule(trace, phi, X_star),
-                                  {Kind.LP: np.eye(X_star.size)[-1]}, progress)
-        folds += [(trace, replace(f, index=f.index + done)) for f in path.folds]
-        segments[-1][1].extend(path.points)
+        path = continuation.trace(trace.system, first, settings, _stop_rule(trace, rejoin),
+                                  {Kind.LP: np.eye(first.X.size)[-1]}, progress)
         stop = path.stop
+        # a fold in the step to a point the resolution stop rejects is found again from the re-solved last point
+        folds += [(trace, replace(f, index=f.index + done)) for f in path.folds
+                  if stop.code != StopCode.RESOLUTION or f.index < len(path.points) - 1]
+        segments[-1][1].extend(path.points)
         if stop.code == TraceStop.MAX_POINTS:
             stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
-            break
+            return trace, segments, folds, stop
         c = trace.system.coefficients(path.overshoot.X)
         target = remapped(trace.basis, c, scene.field.coils)
         finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target),
@@ -269,7 +283,7 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
         if finer is None:
             stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
                                                                   f"order {MAX_ORDER})")
-            break
+            return trace, segments, folds, stop
         new = trace.on(finer)
         last = segments[-1][1].pop()  # solved again on the finer basis: the first point of the next segment
         X = newton(new.system.residual, new.system.jacobian, trace.move(last.X, new), np.eye(new.gauge.size + 1)[-1],
@@ -278,41 +292,53 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
             segments[-1][1].append(last)
             stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
                                                 f"{finer.order}): {X.message}")
-            break
+            return trace, segments, folds, stop
         reference = trace.move_direction(last.tangent, new)
         first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference), X.iterations, X.residual)
-        phi, X_star = trace.move_direction(phi, new), trace.move(X_star, new)
+        if rejoin is not None:
+            rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
         trace = new
         segments.append((trace, []))
-    return _branch(trace, segments, folds, stop, branch, number, origin, name, t0)
 
 
-def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: int, bp: SpecialPoint, name: str,
-            t0) -> SurfaceBranch:
-    """The SurfaceBranch of the traced segments, every point on the final basis: measures, folds, end point; the
-    stability of each point read on the basis it was traced on (``assess``)."""
+def collected(trace: SurfaceTrace, segments, folds, stop) -> dict:
+    """The SurfaceBranch fields of traced segments, every point on the final basis: coefficients, values, solver
+    records, tails, measures, and the special points of the trace (its folds, LP, and its end point, EP)."""
     basis = trace.basis
     coefficients = np.array([transfer(t.basis, t.system.coefficients(p.X), basis) if t is not trace
                              else t.system.coefficients(p.X) for t, points in segments for p in points])
     values = np.array([p.X[-1] for _, points in segments for p in points])
     per_point = [measures(basis, c) for c in coefficients]
-    first_basis = segments[0][0].basis
-    if first_basis is not basis:  # the origin was made on the first basis
-        bp = replace(bp, X=np.append(transfer(first_basis, bp.X[:-1], basis), bp.X[-1]))
-    special = [bp] + [SpecialPoint(Kind.LP, f.index, np.append(transfer(t.basis, t.system.coefficients(f.point.X),
-                                                                        basis), f.point.X[-1]),
-                                   status=Status.LOCATED if f.status == continuation.RootStatus.LOCATED
-                                   else Status.APPROXIMATE) for t, f in folds]
+    special = [SpecialPoint(Kind.LP, f.index, np.append(transfer(t.basis, t.system.coefficients(f.point.X),
+                                                                 basis), f.point.X[-1]),
+                            status=Status.LOCATED if f.status == continuation.RootStatus.LOCATED
+                            else Status.APPROXIMATE) for t, f in folds]
     special.append(SpecialPoint(Kind.EP, len(values) - 1, np.append(coefficients[-1], values[-1]), stop=stop))
-    out = SurfaceBranch(
-        name=name, scene=parent.scene, basis=basis, kernel_class=parent.kernel_class,
-        kernel_signature=trace.eq.kernels.signature, params=parent.params, coefficients=coefficients, values=values,
-        iterations=np.array([p.iterations for _, points in segments for p in points]),
-        residual=np.array([p.residual for _, points in segments for p in points]),
-        error_estimate=np.array([tail(basis, c) for c in coefficients]),
-        measures={key: np.array([m[key] for m in per_point]) for key in MEASURES}, m=bp.m,
-        parent=(parent.name, number), legs=(Leg("forward", stop),), special=special)
-    assess(out, [(t, t.system.coefficients(p.X)) for t, points in segments for p in points])
+    return dict(basis=basis, coefficients=coefficients, values=values,
+                iterations=np.array([p.iterations for _, points in segments for p in points]),
+                residual=np.array([p.residual for _, points in segments for p in points]),
+                error_estimate=np.array([tail(basis, c) for c in coefficients]),
+                measures={key: np.array([m[key] for m in per_point]) for key in MEASURES}, special=special,
+                legs=(Leg("forward", stop),), kernel_signature=trace.eq.kernels.signature)
+
+
+def traced_points(segments) -> list:
+    """(the SurfaceTrace, the coefficients there) of every point: a point is assessed on its own basis."""
+    return [(t, t.system.coefficients(p.X)) for t, points in segments for p in points]
+
+
+def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: int, bp: SpecialPoint, name: str,
+            t0) -> SurfaceBranch:
+    """The SurfaceBranch of the traced segments (``collected``), its origin ``bp`` first; the stability of each
+    point read on the basis it was traced on (``assess``)."""
+    fields = collected(trace, segments, folds, stop)
+    first_basis = segments[0][0].basis
+    if first_basis is not trace.basis:  # the origin was made on the first basis
+        bp = replace(bp, X=np.append(transfer(first_basis, bp.X[:-1], trace.basis), bp.X[-1]))
+    fields["special"].insert(0, bp)
+    out = SurfaceBranch(name=name, scene=parent.scene, kernel_class=parent.kernel_class, params=parent.params,
+                        m=bp.m, parent=(parent.name, number), **fields)
+    assess(out, traced_points(segments))
     out.wall_time = time.perf_counter() - t0
     return out
 

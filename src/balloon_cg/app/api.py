@@ -303,7 +303,8 @@ def _scene(scene) -> Scene:
 
 def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progress: bool = False):
     """(branches, snap-throughs, incomplete entries, picture, clock) of ``scene``, one progress bar per phase: the
-    primary branch only (snap-throughs and picture None), or the whole picture (analysis.picture.analyse; its
+    primary branch only (snap-throughs and picture None; a field that is not axisymmetric has no other branches
+    yet: its picture), or the whole picture (analysis.picture.analyse; its
     axisymmetric branches, then its surface branches); ``clock`` the seconds of each phase (analysis.timing,
     started here: the writer adds its own)."""
     from ..analysis.picture import analyse as analyse_picture
@@ -313,7 +314,7 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
 
     clock = Clock()
     with PhaseBars(scene.name, progress) as bars:
-        if primary_only:
+        if primary_only and scene.field.is_axisymmetric:
             with clock.step(Step.TRACE):
                 branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
             bars.finish(Phase.PRIMARY, len(branches[0].X))

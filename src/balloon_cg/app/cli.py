@@ -310,7 +310,6 @@ def run(args) -> int:
     from .progress import shown
 
     scene, stem = configured(args)
-    axisymmetric(scene)
     output = default_output(args.output, stem, "run")
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,

@@ -117,7 +117,7 @@ def run_time(attrs: dict) -> dict | None:
 def summarise_branch(b: dict) -> dict:
     """Points, ranges, special points, accuracy and run time of one stored branch (``m`` = 0: axisymmetric;
     a surface branch, m ≥ 1: ``summarise_surface_branch``)."""
-    if b["attrs"].get("m", 0):
+    if "surface_degree" in b["attrs"]:
         return summarise_surface_branch(b)
     n, attrs = len(b["pressure"]), b["attrs"]
     wall = float(attrs["wall_time"])
@@ -157,7 +157,7 @@ def summarise_surface_branch(b: dict) -> dict:
     wall = float(attrs["wall_time"])
     return {
         "m": int(attrs["m"]),
-        "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])],
+        "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if attrs["parent_branch"] else None,
         "origin": attrs.get("origin", "traced"),
         "reflection_of": attrs.get("reflection_of", ""),
         "gauge": attrs["gauge"],  # io.run_file reads it from M in files written before it
@@ -168,6 +168,8 @@ def summarise_surface_branch(b: dict) -> dict:
         "lam2_south": _range(b["lam2_south"]),
         "volume": _range(b["volume"]),
         "tilt": _range(b["tilt"]),
+        **{name: {"max": float(np.abs(b[name]).max()), "last": [float(v) for v in b[name][-1]]}
+           for name in ("force", "torque") if name in b},
         "special_points": b["special_points"],
         "stop_reason": attrs["stop_reason"],
         "stop_codes": dict(zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", []))),
@@ -184,6 +186,10 @@ def summarise_surface_branch(b: dict) -> dict:
         "chi": float(attrs["chi"]),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
     }
+
+
+def _vector(values) -> str:
+    return "(" + ", ".join(f"{v:.6g}" for v in values) + ")"
 
 
 def _range(values) -> list:
@@ -258,9 +264,10 @@ def _reflections(symmetry, characters) -> str:
 
 
 def _format_surface_branch(name: str, b: dict) -> list[str]:
-    parent, point = b["parent"]
+    born = "traced on the whole sphere from the start" if b["parent"] is None else \
+        f"m = {b['m']}, from {b['parent'][0]} branch point {b['parent'][1]}"
     return [
-        f"surface branch {name}   (m = {b['m']}, from {parent} branch point {point}; {b['kernel_class']}, degree "
+        f"surface branch {name}   ({born}; {b['kernel_class']}, degree "
         f"{b['surface_degree']}, reflections {_reflections(b['symmetry'], b['characters'])}, nodes "
         f"{b['nodes'][0]} × {b['nodes'][1]}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
         f"chi = {b['chi']:g})",
@@ -271,6 +278,9 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
         "  volume               {:.10g} .. {:.10g}".format(*b["volume"]),
         "  tilt                 {:.4g} .. {:.4g} degrees".format(*b["tilt"]),
+        *([f"  field force          {_vector(b['force']['last'])} at the last point (|F| ≤ {b['force']['max']:.3g}; "
+           "the hold's reaction is −F)", f"  field torque         |T| ≤ {b['torque']['max']:.3g} (zero at equilibrium)"]
+          if "force" in b else []),
         f"  stop reason          {b['stop_reason']}",
         f"  max residual         {b['max_residual']:.3e}",
         f"  max error estimate   {b['max_error_estimate']:.3e}",
@@ -282,7 +292,7 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
 
 
 def _format_branch(name: str, b: dict) -> list[str]:
-    if b["m"]:
+    if "surface_degree" in b:
         return _format_surface_branch(name, b)
     lines = [
         f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "

@@ -66,6 +66,7 @@ import h5py
 import numpy as np
 
 from ..analysis.timing import Clock, Step
+from ..surface.loads import LOADS
 from .hdf5 import atomic_file, plain, provenance, write_strings
 from .layout import FileError, check_columns, check_sizes, opened, reading, require_attrs, require_group
 from .schema import attach_dimensions, scale
@@ -322,12 +323,14 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
         "error_estimate": branch.error_estimate,
         "newton_iterations": branch.iterations,
         "coefficients": branch.coefficients,
+        **{name: np.asarray(measures[name], dtype=float).reshape(len(rows), 3) for name in LOADS if name in measures},
     }
     point, coefficient = scale(group, "point", len(rows)), scale(group, "coefficient", basis.size)
     axis = scale(group, "axis", 3)
     for name, data in columns.items():
         group.create_dataset(name, data=data)
-    attach_dimensions(group, {"centroid": (point, axis), 1: (point,), 2: (point, coefficient)})
+    attach_dimensions(group, {**{name: (point, axis) for name in ("centroid", *LOADS) if name in columns},
+                              1: (point,), 2: (point, coefficient)})
     write_special(group.create_group("special_points"), branch.special, rows.shape[1],
                   lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X), first_label)
     if branch.stability:
@@ -528,7 +531,8 @@ def read_branches(parent, where, error=None) -> dict:
     error = error or RunFileError
     group = require_group(parent, "branches", where, error)
     for name, branch in group.items():
-        if branch_m(branch, f"{where}: branch {name}", error):
+        branch_m(branch, f"{where}: branch {name}", error)
+        if is_surface_group(branch):
             check_surface_branch(branch, f"{where}: branch {name}", error)
         else:
             check_branch(branch, f"{where}: branch {name}", error)
@@ -627,6 +631,12 @@ def branch_m(group, where, error) -> int:
     return m
 
 
+def is_surface_group(group) -> bool:
+    """Whether a stored branch is a surface branch (its basis attributes: an m ≥ 1 branch, or the primary branch
+    of a field that is not axisymmetric, m = 0)."""
+    return "surface_degree" in group.attrs
+
+
 def check_surface_branch(group, where, error) -> None:
     """The attributes and columns of one stored surface branch: its basis (symmetry k × 3 of ±1, characters k of
     ±1) rebuilt, the coefficients as wide as its size, the centroid 3 wide, special points (c, p) rows and
@@ -639,8 +649,10 @@ def check_surface_branch(group, where, error) -> None:
     if group["coefficients"].shape[1] != size:
         raise error(where, f"coefficients has {group['coefficients'].shape[1]} columns, expected {size} (the size "
                            "of the basis its attributes describe)")
-    if group["centroid"].shape[1] != 3:
-        raise error(where, f"centroid has shape {group['centroid'].shape}, expected ({n}, 3)")
+    check_columns(group, where, {name: ("float", 2) for name in LOADS if name in group}, error, rows=n)
+    for name in ("centroid", *(name for name in LOADS if name in group)):
+        if group[name].shape[1] != 3:
+            raise error(where, f"{name} has shape {group[name].shape}, expected ({n}, 3)")
     check_special(require_group(group, "special_points", where, error), f"{where}: special_points", size + 1, error)
     if "stability" in group:
         stability = require_group(group, "stability", where, error)

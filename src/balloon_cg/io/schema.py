@@ -42,6 +42,11 @@ VARIABLES = {
     "coefficients": (NONDIMENSIONAL, "displacement coefficients c", "u = x − X in real spherical harmonics of "
                                                                     "degree ≤ surface_degree (docs/hdf5.md)"),
     "centroid": (NONDIMENSIONAL, "centroid of the enclosed body", "x_c / R0, offset from the held centre"),
+    "force": (NONDIMENSIONAL, "net force of the field", "F = ½ χ M (1/2π) ∫∫ ∇H² dA, per 2π in units of μ H R0 "
+                                                       "(the hold's reaction is −F; surface/loads.py)"),
+    "torque": (NONDIMENSIONAL, "net torque of the field about the centre", "T = ½ χ M (1/2π) ∫∫ x × ∇H² dA, per 2π "
+                                                                          "in units of μ H R0² (zero at equilibrium: "
+                                                                          "the balloon turns freely)"),
     "tilt": ("degree", "tilt of the long axis", "angle between e_z and the principal axis of the largest second "
                                                 "moment of the enclosed body, 0 … 90"),
     "eta_north": (NONDIMENSIONAL, "η at the north pole", "axial position η(0) / R0"),

@@ -112,3 +112,15 @@ def field_squared_cartesian(points, loops, out):
             for a in range(3):
                 total += J[a, b] * J[a, c] + h[a] * K[a, b, c]
             out[4 + row, i] = 2.0 * total
+
+
+def loop_distance(points: np.ndarray, loops: np.ndarray) -> np.ndarray:
+    """The distance from each point (columns x, y, z) to the nearest wire, √((ρ' − a)² + z'²) in each loop's frame
+    (module docstring); inf without loops."""
+    out = np.full(points.shape[1], np.inf)
+    for loop in loops:
+        r = points - loop[:3, None]
+        axial = loop[3:6] @ r
+        rho = np.linalg.norm(r - axial * loop[3:6, None], axis=0)
+        out = np.minimum(out, np.hypot(rho - loop[6], axial))
+    return out

@@ -202,9 +202,17 @@ class StoredBranch:
         return int(self.data["attrs"].get("m", 0))
 
     @property
+    def surface(self) -> bool:
+        """Whether it is a surface branch (traced on the whole sphere: its basis attributes, docs/hdf5.md)."""
+        return "surface_degree" in self.data["attrs"]
+
+    @property
     def surface_name(self) -> str:
-        """The legend name of a surface branch: 'm = 1 (parent BP 2)' (its parent's name when not primary)."""
+        """The legend name of a surface branch: 'm = 1 (parent BP 2)' (its parent's name when not primary), 'whole
+        sphere' for the primary branch of a field that is not axisymmetric."""
         attrs = self.data["attrs"]
+        if not attrs["parent_branch"]:
+            return "whole sphere"
         parent = "parent" if attrs["parent_branch"] == "primary" else f"parent {attrs['parent_branch']}"
         return f"m = {self.m} ({parent} BP {int(attrs['parent_branch_point'])})"
 
@@ -310,14 +318,14 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         label = key(b)
         if len(by_M[label]) > 1:
             label += f" ({b.run['scene_name']})"
-        if len(files) == 1 and b.m:  # a surface branch: by its mode and parent, never its internal name
+        if len(files) == 1 and b.surface:  # a surface branch: by its mode and parent, never its internal name
             label = b.surface_name
         elif len(files) == 1 and len(files[id(b.run)]) > 1:
             label += f", {branch_title(b.name)}"
         b.label = label
     colors = {}
     for b in branches:
-        partner = b.data["attrs"].get("reflection_of") or b.name if b.m else b.name.removesuffix(MIRROR_SUFFIX)
+        partner = b.data["attrs"].get("reflection_of") or b.name if b.surface else b.name.removesuffix(MIRROR_SUFFIX)
         key = (id(b.run), partner) if len(files) == 1 else id(b.run)
         b.color = colors.setdefault(key, f"C{len(colors) % 10}")
     return branches
@@ -331,7 +339,7 @@ def applicable_kinds(branches) -> list[str]:
             if kind != "phase" and (kind.split("-")[0] not in curves or prefixes == {kind.split("-")[0]})
             and (kind != "field" or any(b.coils for b in branches))
             and (kind != "energy" or any(b.bifurcations for b in branches))
-            and (kind not in SURFACE_KINDS or any(b.m for b in branches))]
+            and (kind not in SURFACE_KINDS or any(b.surface for b in branches))]
 
 
 def plot(sources, what: str | None, points=None, branch: str | None = None, axes=None,
@@ -370,12 +378,12 @@ def _draw(sources, what, points, branch, axes, stability) -> Figure:
         "primary" if per_point and branch is None else branch]
     branches = [b for source in sources for name in names for b in load_branches(source, name, stability)]
     if what not in SURFACE_DRAWN:  # the axisymmetric kinds: surface branches have no profiles or equator ring
-        named = [b for b in branches if b.m and (branch is not None or configurations)]
+        named = [b for b in branches if b.surface and (branch is not None or configurations)]
         if named:
             raise PlotError(f"{named[0].source}: branch {named[0].name} is a surface branch (m = {named[0].m}): "
                             f"{what} draws axisymmetric branches; draw it with {', '.join(SURFACE_DRAWN)}, "
                             f"{' or '.join(SURFACE_KINDS)}")
-        branches = [b for b in branches if not b.m]
+        branches = [b for b in branches if not b.surface]
     branches = _label(branches)
     return draw(branches, points, axes=axes) if per_point else draw(branches, axes=axes)
 
@@ -501,7 +509,7 @@ def _pole_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
     drawn = {(id(b.run), b.name) for b in branches}
     for b in branches:
         d, color, y = b.data, b.color, b.parameter_values
-        if b.m and (id(b.run), d["attrs"].get("reflection_of")) in drawn:
+        if b.surface and (id(b.run), d["attrs"].get("reflection_of")) in drawn:
             continue  # a surface branch's image under the rotation about the axis: its source's curve and points
         _curve(ax, d["lam2_north"], y, b.stable, color, mirror=b.mirror)
         scale = np.abs(d["lam2_north"]).max()
@@ -750,12 +758,12 @@ def surface_state(sources, points, branch: str | None, what: str) -> tuple:
     run = as_run(sources[0])
     source = run["path"] or run["scene_name"]
     if branch is None:
-        branch = next((name for name, d in run["branches"].items() if d["attrs"].get("m", 0)), None)
+        branch = next((name for name, d in run["branches"].items() if "surface_degree" in d["attrs"]), None)
         if branch is None:
             raise PlotError(f"{source}: no surface branch (m ≥ 1) in this file: {what} draws a state of a "
                             "non-axisymmetric branch (shapes draws axisymmetric ones)")
     stored = _label(load_branches(run, branch))[0]
-    if not stored.m:
+    if not stored.surface:
         raise PlotError(f"{source}: branch {branch} is axisymmetric (m = 0): {what} draws surface branches "
                         "(draw it with shapes)")
     if points is not None and np.ndim(points) == 1 and len(points) > 1:

@@ -72,6 +72,12 @@ class Field:
     coils: tuple[Coil, ...] = ()
 
     @property
+    def is_axisymmetric(self) -> bool:
+        """True when every coil is coaxial with the balloon (or none acts, M = 0): the axisymmetric solver traces
+        the primary branch; otherwise the whole-sphere one does (analysis.surface_primary)."""
+        return self.M == 0 or all(c.is_coaxial for c in self.coils)
+
+    @property
     def is_equator_symmetric(self) -> bool:
         """True when the coils are coaxial and mirror-symmetric about z = 0, so that H² is even in z.
 

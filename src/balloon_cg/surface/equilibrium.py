@@ -29,6 +29,7 @@ class SurfaceEquilibrium:
         self.coils = loop_table(scene.field.coils)
         self.kernels = kernels if kernels is not None else KernelSet.of_scene(scene).surface()
         self.has_field = self.coils.shape[0] > 0
+        self.coaxial = all(coil.is_coaxial for coil in scene.field.coils)  # H² is axisymmetric about z at any M
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
         self._held = None  # the coefficients whose node state (and field) are in _named, kernel outputs in _outputs
         self._outputs = {}

@@ -4,17 +4,21 @@
   conditions ∫∫ (e_k × X) · u dA = 0 (no rigid-rotation part of u in the reference frame), for each axis k whose
   rotation field lies in the basis' symmetry subspace. They are linear, homogeneous and hold for every
   axisymmetric state.
-- Translations: ∫∫ u dA = 0 (the l = 0 coefficients) along an axis where the balloon is held (``held``: the lateral
-  axes x, y; the multiplier is the reaction force) and where the field leaves the translation free (no field:
-  every axis; then held and free coincide). With a field the axial translation stays an unknown (net axial force
-  zero), as in the axisymmetric solver.
+- Translations: ∫∫ u dA = 0 (the l = 0 coefficients) along an axis where the balloon is held (``held``; the
+  multiplier is the reaction force) and where the field leaves the translation free (no field: every axis; then
+  held and free coincide). Coaxial loops: held means the lateral axes x, y, and the axial translation stays an
+  unknown (net axial force zero), as in the axisymmetric solver; loops anywhere: held means every axis (the
+  centre ∫∫ x dA/4π is held at the origin: the reaction is the field's net force), free none (an equilibrium
+  then needs a zero net force).
 - Rigid rotations of x are zero modes where the field allows them (every axis at M = 0, the coil axis for coaxial
-  loops). In a subspace that keeps one of them (other than on a sphere state, where it is a relabelling) the gauge
-  would need a phase condition on the current state: refused for now (``UnsupportedGauge``).
+  loops, none for loops anywhere: the balloon turns until the field's torque about its held centre vanishes). In
+  a subspace that keeps one of them (other than on a sphere state, where it is a relabelling) the gauge would need
+  a phase condition on the current state: refused for now (``UnsupportedGauge``).
 
 The constraints G c = 0 touch only l ≤ 1 coefficients; the reduced coordinates are c = Z a with Z the identity on
 every other coefficient and an orthonormal null-space block on those.
 """
+import enum
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -28,28 +32,46 @@ class UnsupportedGauge(ValueError):
     """A subspace with a rigid-rotation zero mode that this gauge does not remove."""
 
 
+class FieldSymmetry(enum.Enum):
+    """What the applied field leaves free (module docstring): the rigid motions that are zero modes."""
+
+    NONE = "none"  # no field acts (no coils, or M = 0): every translation and rotation
+    AXIAL = "axial"  # coaxial loops: the rotation about the coil axis z, the axial translation
+    GENERAL = "general"  # loops anywhere: none
+
+    @property
+    def free_rotations(self) -> tuple:
+        """The axes of the rigid rotations that are zero modes."""
+        return {FieldSymmetry.NONE: (0, 1, 2), FieldSymmetry.AXIAL: (2,), FieldSymmetry.GENERAL: ()}[self]
+
+    def held_translations(self, held: bool) -> tuple:
+        """The axes along which ∫∫ u dA = 0 is imposed for a balloon ``held`` (or free) at its centre."""
+        if self == FieldSymmetry.NONE:
+            return (0, 1, 2)
+        return ((0, 1) if self == FieldSymmetry.AXIAL else (0, 1, 2)) if held else ()
+
+
 @dataclass(frozen=True)
 class Gauge:
-    """Constraints of a SphericalBasis: ``held`` (the centre held laterally), ``in_field`` (coaxial coils:
-    the field fixes every translation and every rotation but the one about z; False: no field)."""
+    """Constraints of a SphericalBasis: ``held`` (the centre held), ``field_symmetry`` (what the applied field
+    leaves free, module docstring)."""
 
     basis: SphericalBasis
     held: bool = True
-    in_field: bool = False
+    field_symmetry: FieldSymmetry = FieldSymmetry.NONE
     constraints: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        rows = [self._translation(axis) for axis in range(3) if (axis < 2 and self.held) or not self.in_field]
+        rows = [self._translation(axis) for axis in self.field_symmetry.held_translations(self.held)]
         rows = [row for row in rows if row is not None]
         rotations = [self._rotation(axis) for axis in range(3)]
         rows += [row for row in rotations if row is not None]
-        free_rotations = (0, 1, 2) if not self.in_field else (2,)
-        kept = [axis for axis in free_rotations if rotations[axis] is not None]
+        kept = [axis for axis in self.field_symmetry.free_rotations if rotations[axis] is not None]
         if kept:
             raise UnsupportedGauge(
                 f"the rigid rotation about the {'xyz'[kept[0]]} axis is a zero mode of this subspace (symmetry "
-                f"{self.basis.symmetry}, field {self.in_field}) and no phase condition removes it: add a reflection "
-                "that excludes it")
+                f"{self.basis.symmetry}, field {self.field_symmetry.value}) and no phase condition removes it: add a "
+                "reflection that excludes it")
         object.__setattr__(self, "constraints", np.array(rows).reshape(-1, self.basis.size))
 
     def _translation(self, axis: int):

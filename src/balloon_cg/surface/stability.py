@@ -11,7 +11,8 @@ other sectors read the same under every control.
 
 Zero modes removed (MODEL.md §8), at the state x:
 - relabellings, δx = (w·e_θ) a_θ + (w·e_φ) a_φ for w = e_k × X: always (every axis);
-- rigid rotations δx = e_k × x where the field allows them: every axis at M = 0, the coil axis for coaxial loops;
+- rigid rotations δx = e_k × x where the field allows them: every axis at M = 0, the coil axis for coaxial loops,
+  none for loops anywhere (``gauge.FieldSymmetry``);
 - translations δx = e_k: without a field always (then held and free coincide), with one for a balloon held at its
   centre (``held``); the free balloon keeps them, so that a paramagnetic balloon can slide toward a coil.
 A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
@@ -23,6 +24,7 @@ import numpy as np
 
 from .basis import COS, MIRROR_Y, SIN, SphericalBasis
 from .equilibrium import SurfaceEquilibrium
+from .gauge import FieldSymmetry
 from .measures import body_moments
 from ..galerkin.equilibrium import Parameters
 from ..numerics import eigen
@@ -46,12 +48,15 @@ PRESSURE_READINGS = (Reading(True), Reading(False))
 READINGS = tuple(Reading(held, control) for control in Control for held in (True, False))
 
 
-def in_field(eq: SurfaceEquilibrium, params: Parameters) -> bool:
-    """Whether a field acts (coils and M ≠ 0): then only the rotation about the coil axis is free."""
-    return eq.has_field and params.M != 0.0
+def field_symmetry(eq: SurfaceEquilibrium, params: Parameters) -> FieldSymmetry:
+    """What the field leaves free: nothing acts without coils or at M = 0; coaxial loops leave the rotation about
+    their axis; loops anywhere no rigid motion."""
+    if not eq.has_field or params.M == 0.0:
+        return FieldSymmetry.NONE
+    return FieldSymmetry.AXIAL if eq.coaxial else FieldSymmetry.GENERAL
 
 
-def zero_mode_fields(state: np.ndarray, reference: np.ndarray, field: bool, held: bool) -> list:
+def zero_mode_fields(state: np.ndarray, reference: np.ndarray, symmetry: FieldSymmetry, held: bool) -> list:
     """The displacement fields (3, nodes) of the exact zero modes removed (module docstring) at the node state."""
     units = np.eye(3)[:, :, None]
     modes = []
@@ -59,9 +64,9 @@ def zero_mode_fields(state: np.ndarray, reference: np.ndarray, field: bool, held
         w = np.cross(units[k], reference[:3], axis=0)
         modes.append(np.einsum("in,in->n", w, reference[3:6]) * state[3:6]
                      + np.einsum("in,in->n", w, reference[6:9]) * state[6:9])
-    for k in (2,) if field else (0, 1, 2):
+    for k in symmetry.free_rotations:
         modes.append(np.cross(units[k], state[:3], axis=0))
-    if held or not field:
+    if held or symmetry == FieldSymmetry.NONE:
         modes += [np.broadcast_to(units[k], state[:3].shape) for k in range(3)]
     return modes
 
@@ -84,7 +89,7 @@ def _sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings
     readings sharing that matrix)} (a sector without a translation reads the same held and free; one without g
     the same under every control); ``only``: the characters of the one sector wanted."""
     state = eq.node_values(c)["state"]
-    fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], in_field(eq, params), held)
+    fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], field_symmetry(eq, params), held)
               for held in {r.held for r in readings}}
     controlled = any(r.control != Control.PRESSURE for r in readings)
     weight = params.P / body_moments(eq.basis, state)[0] if controlled else None
@@ -242,7 +247,7 @@ def azimuthal_spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
     the whole-sphere counterpart of analysis/azimuthal.spectrum."""
     E = azimuthal_family(eq.basis, m)
     H = E.T @ eq.hessian(c, params) @ E
-    fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"], in_field(eq, params), held)
+    fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"], field_symmetry(eq, params), held)
     rows = mode_rows(eq.basis, fields) @ E if m == 1 else np.zeros((0, E.shape[1]))
     rows = rows[np.linalg.norm(rows, axis=1) > 1e-10] if rows.size else rows
     return eigen.lowest_of(_restricted(H, eq.basis.gram(), rows), count)
