@@ -811,11 +811,19 @@ def _add_continue(commands):
     p.add_argument("-o", "--output", required=True, help="run or curve file to write (HDF5)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.set_defaults(handler=owned(continue_run, "continue"))
+    p.set_defaults(handler=continue_run)
 
 
 def continue_run(args) -> int:
-    """``continue``: the labelled point found, restarted (``app.restart``), written."""
+    """``continue``: the labelled point found, restarted (``app.restart``), written (the output owned meanwhile)."""
+    from ..io.lock import claim
+
+    with claim(args.output, "continue"):
+        return _continue(args)
+
+
+def _continue(args) -> int:
+    """``continue`` into ``args.output`` (owned)."""
     from ..analysis.codim2 import TwoParameterError
     from ..analysis.results import Branch
     from ..analysis.second_parameter import UnknownParameter
