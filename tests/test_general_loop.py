@@ -246,15 +246,19 @@ def test_a_coaxial_scene_in_the_general_form_traces_the_same_primary_branch():
 
 # --- a non-axisymmetric field is not traced by the axisymmetric solver --------------------------------------
 
-def test_run_and_solve_refuse_a_coil_that_is_not_coaxial(tmp_path, capsys):
+def test_the_axisymmetric_commands_refuse_a_coil_that_is_not_coaxial(tmp_path, capsys):
+    """solve, critical and sweep work on axisymmetric primary branches: one line, exit 2, nothing written (run
+    traces such a scene on the whole sphere: tests/test_surface_primary.py)."""
     path = tmp_path / "tilted.toml"
     path.write_text(coil_text(radius=2.0, centre="[0.5, 0, 0]", normal="[0, 0, 1]", current=1))
     out = tmp_path / "tilted.h5"
-    for argv in (["run", str(path), "-o", str(out)], ["solve", str(path), "--pole-stretch", "1.5"]):
+    for argv in (["solve", str(path), "--pole-stretch", "1.5"],
+                 ["critical", str(path), "--parameter", "M", "-o", str(out)],
+                 ["sweep", str(path), "--vary", "M=0.001,0.002", "-o", str(out)]):
         assert main(argv) == 2
         line = capsys.readouterr().err
         assert line.count("\n") == 1 and ("coil 0 is not coaxial (centre [0.5, 0.0, 0.0], normal [0.0, 0.0, 1.0]): "
-                                          "non-axisymmetric fields are traced on the whole sphere") in line
+                                          f"{argv[0]} works on axisymmetric fields only") in line
     assert not out.exists()
     with pytest.raises(FieldError, match="coil 0 is not coaxial"):
         trace_primary(load_scene(path))

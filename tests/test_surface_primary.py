@@ -11,7 +11,9 @@ from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import branch_system
 from balloon_cg.analysis.surface_branches import SurfaceTrace
 from balloon_cg.analysis.surface_primary import MIRROR_X, field_reflections, trace_surface_primary
+from balloon_cg.app.summaries import format_run
 from balloon_cg.galerkin.equilibrium import Parameters
+from balloon_cg.io.run_file import read_run, write_run
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import Coil, load_scene
 from balloon_cg.surface.basis import EQUATOR, INVERSION, MIRROR_Y, SphericalBasis
@@ -66,14 +68,20 @@ def _axisymmetric_volume(branch, P: float) -> float:
     return system.eq.volume(result.x[:-1])
 
 
-def test_the_turned_two_coil_scene_is_the_axisymmetric_branch_turned():
+@pytest.fixture(scope="module")
+def turned():
+    """The two coils turned by 30° about e_y through the centre, traced on the whole sphere to λ = 1.06."""
+    coils = [_turned(c, math.radians(30)) for c in load_scene(TWO_COILS).field.coils]
+    scene = _scene(coils, **{"continuation.stop_stretch": 1.06, "continuation.max_points": 20})
+    return scene, trace_surface_primary(scene)
+
+
+def test_the_turned_two_coil_scene_is_the_axisymmetric_branch_turned(turned):
     """The two coils turned by 30° about e_y through the centre: the field is the coaxial one turned, so every state
     is an axisymmetric state turned; traced from the start on the whole sphere (field on at the start pressure, then
     in P), each point's volume is the axisymmetric solver's at its P to 1e-10, the net force vanishes (the pair is
     symmetric under the inversion) and so does the torque about the centre (the balloon is free to turn)."""
-    coils = [_turned(c, math.radians(30)) for c in load_scene(TWO_COILS).field.coils]
-    scene = _scene(coils, **{"continuation.stop_stretch": 1.06, "continuation.max_points": 20})
-    surface = trace_surface_primary(scene)
+    scene, surface = turned
     assert len(surface.values) >= 5 and surface.legs[0].stop.code.value == "stop_stretch"
     axisymmetric = trace_primary(load_scene(TWO_COILS).with_overrides({"continuation.stop_stretch": 1.2}))
     errors = [abs(V - _axisymmetric_volume(axisymmetric, P)) / V
@@ -83,6 +91,21 @@ def test_the_turned_two_coil_scene_is_the_axisymmetric_branch_turned():
     assert np.abs(surface.measures["torque"]).max() < 1e-12
     assert surface.residual.max() < 1e-10 and surface.error_estimate.max() < scene.solver.max_error
     assert set(surface.stability) == {"held", "held_volume", "held_gas"}  # no free reading: module docstring
+
+
+def test_a_whole_sphere_primary_is_stored_and_shown(turned, tmp_path):
+    """The run file of a field that is not axisymmetric: its primary branch is a surface branch (m = 0, no parent)
+    with the force and torque columns; inspect says how it was traced and shows the pull."""
+    scene, surface = turned
+    path = tmp_path / "turned.h5"
+    write_run(path, scene, [surface])
+    run = read_run(path)
+    stored = run["branches"]["primary"]
+    assert np.array_equal(stored["force"], surface.measures["force"])
+    assert np.array_equal(stored["coefficients"], surface.coefficients)
+    text = format_run(run)
+    assert "surface branch primary   (traced on the whole sphere from the start" in text
+    assert "field force" in text and "field torque" in text
 
 
 @pytest.mark.slow

@@ -294,12 +294,13 @@ def _with_settings(args, scene):
     return overridden(scene, overrides), overrides
 
 
-def axisymmetric(scene):
-    """``scene``, refused (FieldError, exit 2) before any work when a coil is not coaxial: the primary branch is
-    traced by the axisymmetric solver, and a non-axisymmetric field is not."""
-    from ..model.field import coaxial_table
-
-    coaxial_table(scene.field.coils)
+def axisymmetric(scene, command: str):
+    """``scene``, refused (exit 2) before any work by a ``command`` that works on axisymmetric primary branches
+    only when a coil is not coaxial (``run`` traces such a scene on the whole sphere)."""
+    if not scene.field.is_axisymmetric:
+        k, coil = next((k, c) for k, c in enumerate(scene.field.coils) if not c.is_coaxial)
+        raise UsageError(f"coil {k} is not coaxial (centre {list(coil.centre)}, normal {list(coil.normal)}): {command} "
+                         "works on axisymmetric fields only; run traces this scene on the whole sphere")
     return scene
 
 
@@ -377,7 +378,7 @@ def solve(args) -> int:
     from ..analysis.results import StopCode
     from .summaries import format_table
 
-    scene = axisymmetric(scene_of(args))
+    scene = axisymmetric(scene_of(args), "solve")
     x = args.pole_stretch
     if not np.isfinite(x) or x <= 1:
         raise UsageError(f"--pole-stretch = {x:g}: must be > 1 (λ2(0) = 1 is the undeformed sphere)")
@@ -630,6 +631,7 @@ def critical(args) -> int:
     from ..io.lock import claim
 
     scene, stem = configured(args)
+    axisymmetric(scene, "critical")
     short = re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
     args.output = default_output(args.output, f"{stem}_critical_{short}", "curve")
     with claim(args.output, "critical"):  # owned from here: no other process writes it meanwhile
@@ -930,7 +932,7 @@ def sweep(args) -> int:
     from ..numerics.interrupt import sigterm_raises
 
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"
-    scene = load_scene(args.scene)
+    scene = axisymmetric(load_scene(args.scene), "sweep")
     varied = "_".join(re.sub(r"[^A-Za-z0-9.+-]+", "", text.partition("=")[0].strip().split(".")[-1])
                       for text in args.vary)
     args.output = default_output(args.output, f"{scene.name}_sweep_{varied}", "sweep")

@@ -427,9 +427,13 @@ def describe_scene(scene) -> str:
     coils = scene.field.coils
     if not coils:
         return f"{scene.material.name}, no field"
-    heights = sorted({abs(c.height) for c in coils})
     radii = sorted({c.radius for c in coils})
     count = {1: "one coil", 2: "two coils"}.get(len(coils), f"{len(coils)} coils")
+    if not all(c.is_coaxial for c in coils):
+        off = "off the axis: " + "; ".join(f"centre ({', '.join(f'{v:.3g}' for v in c.centre)}), normal "
+                                           f"({', '.join(f'{v:.3g}' for v in c.normal)})" for c in coils[:2])
+        return f"{scene.material.name}, {count} a = {'/'.join(f'{a:.4g}' for a in radii)} {off}"
+    heights = sorted({abs(c.height) for c in coils})
     height = "±" * (len(coils) == 2 * len(heights) and heights[0] > 0) + "/".join(f"{h:.4g}" for h in heights)
     return f"{scene.material.name}, {count} a = {'/'.join(f'{a:.4g}' for a in radii)}, h = {height}"
 
@@ -815,12 +819,11 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
     step = (x.shape[1] - 1) // 6, (x.shape[2] - 1) // 12  # the material lines θ, φ = multiples of 30°
     ax.plot_wireframe(*x, rstride=step[0], cstride=step[1], color="0.25", linewidth=0.3)
     handles = [Line2D([], [], color=branch.color, linewidth=6, alpha=0.85, label=f"#{index} of {branch.label}")]
-    psi = np.linspace(0.0, 2 * np.pi, 200)
     extent = np.abs(x).max()
     for coil in branch.coils:
-        ax.plot(coil.radius * np.cos(psi), coil.radius * np.sin(psi), np.full_like(psi, coil.height), color="k",
-                linewidth=1.4)
-        extent = max(extent, coil.radius, abs(coil.height))
+        wire = wire_points(coil)
+        ax.plot(*wire, color="k", linewidth=1.4)
+        extent = max(extent, np.abs(wire).max())
     if branch.coils:
         handles.append(Line2D([], [], color="k", linewidth=1.4, label="coil wire"))
     ax.set(xlim=(-extent, extent), ylim=(-extent, extent), zlim=(-extent, extent))
@@ -839,22 +842,41 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
 def _mirror_section(ax, branch: StoredBranch, index: int) -> None:
     """The section of the state by the plane y = 0 (the branches' mirror plane: it holds the axis and the sideways
     displacement of an m = 1 state), the meridians φ = 0 and π, with that of point 0 (the branch point, dashed) and
-    the coil wires where they cross the plane (x = ±a, z = h)."""
+    the coil wires where they cross the plane."""
     theta = np.linspace(0.0, np.pi, 181)
-    for i, style, label in ((0, "--", "point 0 (branch point)"), (index, "-", f"#{index}")):
+    start = "point 0 (branch point)" if branch.data["attrs"]["parent_branch"] else "point 0 (start)"
+    for i, style, label in ((0, "--", start), (index, "-", f"#{index}")):
         basis, c = stored_state(branch, i)
         x = np.concatenate([basis.point_values(c, theta, np.full_like(theta, phi))[0] for phi in (0.0, np.pi)],
                            axis=1)
         order = np.r_[np.arange(theta.size), np.arange(2 * theta.size - 1, theta.size - 1, -1)]  # round the section
         ax.plot(x[0, order], x[2, order], style, color=branch.color, linewidth=1.2, label=label)
-    for k, coil in enumerate(branch.coils):
-        ax.plot([-coil.radius, coil.radius], [coil.height] * 2, "o", color="k", markersize=4,
-                label="coil wire" if k == 0 else None)
+    crossings = np.hstack([_plane_crossings(wire_points(coil, 4000)) for coil in branch.coils] or [np.zeros((3, 0))])
+    if crossings.size:
+        ax.plot(crossings[0], crossings[2], "o", color="k", markersize=4, linestyle="none", label="coil wire")
     ax.set_aspect("equal")
     ax.set_xlabel(r"$x/R_0$")
     ax.set_ylabel(r"$z/R_0$")
     ax.set_title("section y = 0")
     ax.legend(loc="upper right")
+
+
+def wire_points(coil, count: int = 200) -> np.ndarray:
+    """Points (3, count) of a loop's wire: c + a (cos ψ e1 + sin ψ e2), (e1, e2, n) right-handed (MODEL.md §9)."""
+    n = np.array(coil.normal)
+    e1 = np.cross(n, [0.0, 1.0, 0.0] if abs(n[1]) < 0.9 else [1.0, 0.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    psi = np.linspace(0.0, 2 * np.pi, count)
+    return np.array(coil.centre)[:, None] + coil.radius * (np.outer(e1, np.cos(psi)) + np.outer(e2, np.sin(psi)))
+
+
+def _plane_crossings(wire: np.ndarray) -> np.ndarray:
+    """Where a closed polyline (3, n) crosses the plane y = 0 (linear between its samples), (3, k)."""
+    y0, y1 = wire[1, :-1], wire[1, 1:]
+    k = np.flatnonzero((y0 == 0) | (y0 * y1 < 0))
+    t = np.where(y1[k] != y0[k], y0[k] / (y0[k] - y1[k]), 0.0)
+    return wire[:, k] + t * (wire[:, k + 1] - wire[:, k])
 
 
 def principal_stretches(state: np.ndarray) -> tuple:
