@@ -384,12 +384,38 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
 
 
 def continue_from(path, label: int, parameter: str | None = None, direction: float = 1.0):
-    """Restart from the special point ``label`` of the run file ``path`` (``balloon-cg continue``, app.restart):
-    in the branch's own parameter (``parameter`` None), the branch through it as a Result (its branch
-    ``primary``); from a fold (LP, LV, LN) or a pear pitchfork in a second parameter, the two-parameter curve
-    (analysis.fold_curve.FoldCurve or analysis.codim2.TwoParameterCurve: ``end``, ``critical``, ``q``,
-    ``pressure``). ValueError (app.restart.RestartError, analysis.second_parameter.UnknownParameter) for a label
-    or parameter it cannot start from."""
+    """Restart from a labelled special point of a run file (``balloon-cg continue``, app.restart).
+
+    Ctrl-C (SIGINT) stops it at the next point.
+
+    Parameters
+    ----------
+    path : str or Path
+        A run file written by ``run`` (``inspect`` lists its labels).
+    label : int
+        The special point's label.
+    parameter : str, optional
+        A second parameter (a scene key, as for ``critical``); default None: the branch's own parameter.
+    direction : float, optional
+        A fold curve starts with the parameter increasing (1, default) or decreasing (-1).
+
+    Returns
+    -------
+    Result or FoldCurve or TwoParameterCurve
+        Without ``parameter``, the branch through the point (a Result whose branch is ``primary``); from a fold
+        (LP, LV, LN) or a pear pitchfork in ``parameter``, the two-parameter curve (``end``, ``critical``, ``q``,
+        ``pressure``).
+
+    Raises
+    ------
+    ValueError
+        A label or parameter it cannot start from (app.restart.RestartError,
+        analysis.second_parameter.UnknownParameter).
+
+    Examples
+    --------
+    >>> curve = bc.continue_from("gent.h5", 2, parameter="material.parameters.Jm", direction=-1)
+    """
     from ..analysis.results import Branch
     from ..io.run_file import read_run
     from .restart import find_label, restart
