@@ -22,7 +22,7 @@ def label_points(marks) -> None:
     for ax, points in by_axes.items():
         ax.margins(x=0.06)
         ax.autoscale_view()
-        _allocate(ax, _distinct(ax, points))
+        _allocate(ax, _kinds_first(_distinct(ax, points)))
 
 
 def _distinct(ax, points) -> list:
@@ -34,6 +34,15 @@ def _distinct(ax, points) -> list:
                    for t, u, v, _ in kept):
             kept.append((text, x, y, color))
     return kept
+
+
+def _kinds_first(points) -> list:
+    """``points`` with the first of each text before any repeat: textalloc places labels greedily in order, so a
+    crowded plot drops repeats (a second "BP m=1") rather than a kind (the only "TP")."""
+    repeat = []
+    for i, (text, *_) in enumerate(points):
+        repeat.append(sum(other == text for other, *_ in points[:i]))
+    return [point for _, point in sorted(zip(repeat, points), key=lambda pair: pair[0])]
 
 
 def _allocate(ax, points) -> None:
