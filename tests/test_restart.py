@@ -147,3 +147,75 @@ def test_continue_from_python(gent_run):
     assert abs(lp[0]["pressure"] - point["pressure"]) < 1e-10
     curve = bc.continue_from(path, label, "material.parameters.Jm", direction=-1.0)
     assert curve.end.value == "cusp" and abs(curve.critical[0] - 17.6380800759137) < 1e-9
+
+
+
+@pytest.fixture(scope="module")
+def two_coils(tmp_path_factory):
+    """The shipped two-coil scene (M = 0.002) up to λ2(0) = 1.7, past its first held and free pear pitchforks (1.669,
+    1.681), without surface branches: its run file (primary, pear branches) and the scene file."""
+    folder = tmp_path_factory.mktemp("two_coils")
+    scene = folder / "two_coils.toml"
+    scene.write_text(load_scene("spom1_two_coils_M0.002").with_overrides(
+        {"continuation.stop_stretch": 1.7, "surface.branches": "none"}).to_toml())
+    assert main(["run", str(scene), "-o", str(folder / "run.h5"), "--quiet"]) == 0
+    return folder
+
+
+def first(path, kind, block=""):
+    """The label of the first special point of ``kind`` (and ``block``) of the primary branch of a run file."""
+    return next(s["label"] for s in read_run(path)["branches"]["primary"]["special_points"]
+                if s["kind"] == kind and s["block"] == block)
+
+
+@pytest.mark.parametrize("of, block", [("BP", "odd_held"), ("LP", "")])
+def test_continue_in_M_from_a_two_coil_label_gives_the_critical_curve(two_coils, of, block, capsys):
+    """Two coils: `continue RUN LABEL --parameter M` from the first pear pitchfork (its mode recomputed from the
+    stored point) and from the LP traces the curve `critical --of BP|LP --parameter M` traces from its own primary
+    branch: the same points (q, P, every unknown) to 1e-8, ending alike (P reaches 0 before M turns back)."""
+    run, again, curve = two_coils / "run.h5", two_coils / f"again_{of}.h5", two_coils / f"critical_{of}.h5"
+    label = first(run, of, block)
+    assert main(["continue", str(run), str(label), "--parameter", "M", "-o", str(again), "--quiet"]) == 0
+    main(["critical", str(two_coils / "two_coils.toml"), "--of", of, "--parameter", "M", "-o", str(curve), "--quiet"])
+    capsys.readouterr()
+    group = "pear" if of == "BP" else of
+    restarted, traced = read_curve(again, group), read_curve(curve, group)
+    assert restarted["attrs"]["end"] == traced["attrs"]["end"]
+    assert restarted["q"].shape == traced["q"].shape and len(traced["q"]) > 5
+    assert abs(traced["q"][-1] - traced["q"][0]) > 1e-3  # the curve went somewhere in M
+    assert np.abs(restarted["q"] - traced["q"]).max() < 1e-8
+    assert np.abs(restarted["pressure"] - traced["pressure"]).max() < 1e-8
+
+
+@pytest.mark.parametrize("block, name", [("odd_held", "pear_0"), ("odd_free", "pear_free_1")])
+def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, block, name, capsys):
+    """`continue RUN LABEL` at a pear pitchfork, held or free (no --parameter): the pear branch and its mirror
+    image, the same as `run` traced from the same point (every stored unknown to 1e-10: measured 1.2e-13), after
+    the branch of the point; the free one with its translation free."""
+    run, out = two_coils / "run.h5", two_coils / f"switched_{block}.h5"
+    label = first(run, "BP", block)
+    assert main(["continue", str(run), str(label), "-o", str(out)]) == 0
+    assert f"branches switched to at label {label}: {name} (" in capsys.readouterr().out
+    stored, switched = read_run(run)["branches"], read_run(out)["branches"]
+    assert list(switched) == ["primary", name, f"{name}_mirror"]
+    for branch in (name, f"{name}_mirror"):
+        a, b = np.asarray(stored[branch]["unknowns"]), np.asarray(switched[branch]["unknowns"])
+        assert a.shape == b.shape and np.abs(a - b).max() < 1e-10
+        assert switched[branch]["attrs"]["gauge"] == stored[branch]["attrs"]["gauge"]
+        assert switched[branch]["attrs"]["parent_branch_point"] == stored[branch]["attrs"]["parent_branch_point"]
+    assert np.array_equal(switched["primary"]["unknowns"], stored["primary"]["unknowns"])
+
+
+def test_continue_refuses_a_switch_or_a_curve_it_does_not_build(two_coils, capsys):
+    """At a free m = 1 point (run traces no branch there either), and from the free pear pitchfork in a second
+    parameter: one line each, exit 2, nothing written."""
+    run, out = two_coils / "run.h5", two_coils / "refused.h5"
+    free_m1 = first(run, "BP", "m1_free")
+    assert main(["continue", str(run), str(free_m1), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"label {free_m1} is a BP of block m1_free: switching there is not" in err
+    free_pear = first(run, "BP", "odd_free")
+    assert main(["continue", str(run), str(free_pear), "--parameter", "M", "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "only pear (odd_held) points" in err
+    assert not out.exists()

@@ -49,9 +49,9 @@ def take_south_turns(branch: Branch) -> list[SpecialPoint]:
 
 
 def reflection(pear: Branch, south_turns: list[SpecialPoint], name: str) -> Branch | Origin:
-    """The mirror image ``name`` of the traced, assessed pear branch ``pear`` (module docstring), its residuals
-    checked; or, where it is not the mirror the trace would give or a reflected point fails the check, the Origin
-    to record on the traced mirror instead."""
+    """The mirror image ``name`` of the traced pear branch ``pear`` and of its assessments, if any (module
+    docstring), its residuals checked; or, where it is not the mirror the trace would give or a reflected point
+    fails the check, the Origin to record on the traced mirror instead."""
     t0 = time.perf_counter()
     cont = pear.scene.continuation
     if pear.stopped(StopCode.MIN_STRETCH) or pear.pole_values()["lam2_south"].min() <= cont.min_stretch:
@@ -74,7 +74,8 @@ def reflection(pear: Branch, south_turns: list[SpecialPoint], name: str) -> Bran
     special += event_points(mirror)
     return replace(mirror, special=sorted(special, key=lambda s: s.index),
                    legs=tuple(Leg(leg.label, stop(leg.stop)) for leg in pear.legs),
-                   stability=[replace(a, blocks={k: v.copy() for k, v in a.blocks.items()}) for a in pear.stability],
+                   stability=None if pear.stability is None else  # not assessed: ``continue`` at a BP
+                   [replace(a, blocks={k: v.copy() for k, v in a.blocks.items()}) for a in pear.stability],
                    unsettled=list(pear.unsettled), wall_time=time.perf_counter() - t0)
 
 

@@ -184,7 +184,7 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
         with clock.step(Step.SURFACE_BRANCHES):
             _trace_surface(scene, primary, picture, progress)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
-    _label_readings(picture.branches + picture.surface_branches)
+    label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
     return picture
@@ -196,7 +196,7 @@ def _along(s) -> tuple:
     return s.index, Gauge.of_block(s.block, True) == Gauge.FREE
 
 
-def _label_readings(branches: list) -> None:
+def label_readings(branches: list) -> None:
     """Each special point's reading (``results.Gauge``): a branch point's from its block, the others' (folds, end
     points, a surface branch's secondary points) from their branch."""
     for branch in branches:
@@ -266,52 +266,62 @@ def _stopped(picture: Picture) -> bool:
 
 
 def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
-    """Pear branches from the pear branch points of both readings (held: pear_<n>; free, in a field: pear_free_<n>,
-    traced with the translation free), each with its mirror image: the reflection of the pear branch
-    in a scene invariant under z → −z (``mirror``: its Origin says how it was obtained), else traced; a branch
-    that rejoins at an already traced point is not repeated. An interrupt ends the search after the branch being
-    traced (which is kept; assessed unless the signal came before or during its assessment)."""
+    """Pear branches from the pear branch points of both readings (``pear_pair``), a branch that rejoins at an
+    already traced point not repeated. An interrupt ends the search after the branch being traced (which is kept;
+    assessed unless the signal came before or during its assessment)."""
     reached = set()
-    reflect = mirror.reflectable(scene)
     for n, bp in enumerate(picture.branch_points):
         if bp.block not in PEAR_NAMES or n in reached:
             continue
-        pear, south_turns = None, []
-        for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
-            if interrupt.requested():
-                return
-            name = f"{PEAR_NAMES[bp.block]}_{n}{suffix}"
-            origin = Origin.TRACED
-            if sign < 0 and pear is not None:
-                reflected = mirror.reflection(pear, south_turns, name)
-                if isinstance(reflected, Branch):  # parent, rejoin and assessments are the pear's, reflected
-                    picture.branches.append(reflected)
-                    continue
-                origin = reflected
-            branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR), south_turns=reflect)
-            if branch is None:
-                picture.not_started.append((name, f"the first correction from branch point {n} along its mode "
-                                                  "did not converge"))
+        if not pear_pair(scene, primary, picture, n, progress, reached):
+            return
+
+
+def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progress, reached: set | None = None,
+              assess: bool = True) -> bool:
+    """The pear branch from the pear branch point ``n`` of ``picture.branch_points`` (held: pear_<n>; free, in a
+    field: pear_free_<n>, traced with the translation free) and its mirror image: the reflection of the pear branch
+    in a scene invariant under z → −z (``mirror``: its Origin says how it was obtained), else traced; appended to
+    ``picture.branches`` (a branch that cannot start to ``picture.not_started``), each assessed when ``assess``.
+    The branch points where they rejoin are added to ``reached``. False when a signal (``numerics.interrupt``)
+    stopped the work."""
+    bp, reflect = picture.branch_points[n], mirror.reflectable(scene)
+    pear, south_turns = None, []
+    for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
+        if interrupt.requested():
+            return False
+        name = f"{PEAR_NAMES[bp.block]}_{n}{suffix}"
+        origin = Origin.TRACED
+        if sign < 0 and pear is not None:
+            reflected = mirror.reflection(pear, south_turns, name)
+            if isinstance(reflected, Branch):  # parent, rejoin and assessments are the pear's, reflected
+                picture.branches.append(reflected)
                 continue
-            south_turns = mirror.take_south_turns(branch)
-            branch.origin = origin
-            branch.parent = ("primary", n)
-            branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
-            if branch.rejoins is not None:
+            origin = reflected
+        branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR), south_turns=reflect)
+        if branch is None:
+            picture.not_started.append((name, f"the first correction from branch point {n} along its mode "
+                                              "did not converge"))
+            continue
+        south_turns = mirror.take_south_turns(branch)
+        branch.origin = origin
+        branch.parent = (primary.name, n)
+        branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
+        if branch.rejoins is not None:
+            if reached is not None:
                 reached.add(branch.rejoins)
-                mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
-            picture.branches.append(branch)
-            if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):
-                return  # kept as traced, not assessed
-            pear = branch if sign > 0 and reflect else None
+            mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
+        picture.branches.append(branch)
+        if interrupt.requested() or (assess and not _assess(branch, scene, False, progress, picture.clock)):
+            return False  # kept as traced, not assessed
+        pear = branch if sign > 0 and reflect else None
+    return True
 
 
 def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress):
     """The non-axisymmetric branches born at the located m ≥ 1 branch points of the held reading on the primary
-    branch (the first one, or all: ``[surface] branches``), each with the other direction of its pitchfork: for an
-    odd m its image under the rotation by π about the axis (``surface_branches.rotated``), for an even m (which
-    that rotation maps to itself) traced along −φ; the parent point gets the classification from the reduced energy
-    on the whole sphere."""
+    branch (the first one, or all: ``[surface] branches``; ``surface_pair``); the parent point gets the
+    classification from the reduced energy on the whole sphere."""
     points = [(k, bp) for k, bp in enumerate(primary.branch_points())
               if bp.m >= 1 and bp.block.held and bp.status == Status.LOCATED]
     for k, bp in points[:1] if scene.surface.branches == "first" else points:
@@ -319,18 +329,27 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
             return
         name = f"m{bp.m}_bp{k}"
         try:
-            branch = surface_branches.trace_surface(primary, k, bp, 1.0, name, scene.surface.max_points,
-                                                    progress.ticker(Phase.SURFACE))
-            other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else
-                     surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}",
-                                                    scene.surface.max_points, progress.ticker(Phase.SURFACE)))
+            pair = surface_pair(primary, k, bp, scene.surface.max_points, progress)
         except surface_branches.SurfaceStartError as error:
             picture.not_started.append((name, str(error)))
             continue
-        picture.surface_branches += [branch, other]
-        origin = branch.special[0]
+        picture.surface_branches += pair
+        origin = pair[0].special[0]
         primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
                            for s in primary.special]
+
+
+def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progress) -> list:
+    """The two directions of the pitchfork at the m ≥ 1 branch point ``bp`` (number ``k`` in
+    ``primary.branch_points()``), named m<m>_bp<k>: along +φ, and for an odd m its image under the rotation by π
+    about the axis (``surface_branches.rotated``), for an even m (which that rotation maps to itself) traced along
+    −φ. SurfaceStartError when it cannot start."""
+    name = f"m{bp.m}_bp{k}"
+    branch = surface_branches.trace_surface(primary, k, bp, 1.0, name, max_points, progress.ticker(Phase.SURFACE))
+    other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else
+             surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}", max_points,
+                                            progress.ticker(Phase.SURFACE)))
+    return [branch, other]
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

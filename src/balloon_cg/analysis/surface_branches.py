@@ -48,6 +48,7 @@ from . import azimuthal
 from .problem import continuation_settings, equilibrium_of
 from .results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
+from .stability import assessed_degrees
 from .surface_assessment import assess
 from .surface_resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 
@@ -64,11 +65,12 @@ class SurfaceStartError(ArithmeticError):
 
 def located_degree(branch: Branch, bp: SpecialPoint) -> int:
     """The perturbation degree a branch point was located at: the larger of its bracketing points' assessments
-    (``azimuthal_points.find``; near a wire it reaches hundreds), stability.degree on an unassessed branch."""
-    if not branch.stability:
-        return branch.scene.stability.degree
-    last = len(branch.stability) - 1
-    return max(branch.stability[min(bp.index, last)].degree, branch.stability[min(bp.index + 1, last)].degree)
+    (``azimuthal_points.find``; near a wire it reaches hundreds); on a branch not assessed (read back from a run
+    file by ``continue``) the larger of their ``stability.point_degrees`` at stability.degree, which the
+    assessment starts from (stability.degree itself does not resolve the mode near a wire)."""
+    degrees = assessed_degrees(branch)
+    last = len(degrees) - 1
+    return max(degrees[min(bp.index, last)], degrees[min(bp.index + 1, last)])
 
 
 def critical_mode(branch: Branch, bp: SpecialPoint, degree: int, count: int = CRITICAL_SEARCH):

@@ -402,20 +402,24 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     Returns
     -------
     Result or FoldCurve or TwoParameterCurve
-        Without ``parameter``, the branch through the point (a Result whose branch is ``primary``); from a fold
-        (LP, LV, LN) or a pear pitchfork in ``parameter``, the two-parameter curve (``end``, ``critical``, ``q``,
-        ``pressure``).
+        Without ``parameter``, the branch through the point (a Result whose branch is ``primary``), or at a branch
+        point the branches bifurcating there (a Result of the point's branch, not assessed, and of them: ``pear_<n>``
+        and ``pear_<n>_mirror`` at a pear point, ``m<m>_bp<k>`` and its other direction at a held m ≥ 1 point); from a fold (LP, LV, LN) or a pear
+        pitchfork in ``parameter``, the two-parameter curve (``end``, ``critical``, ``q``, ``pressure``).
 
     Raises
     ------
     ValueError
         A label or parameter it cannot start from (app.restart.RestartError,
         analysis.second_parameter.UnknownParameter).
+    RuntimeError
+        At a branch point, no bifurcating branch started (the reasons named).
 
     Examples
     --------
     >>> curve = bc.continue_from("gent.h5", 2, parameter="material.parameters.Jm", direction=-1)
     """
+    from ..analysis.picture import Picture
     from ..analysis.results import Branch
     from ..io.run_file import read_run
     from .restart import find_label, restart
@@ -423,8 +427,15 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     start = find_label(read_run(path), int(label))
     with stop_on_signals():
         result = restart(start, parameter, direction)
+    command = f"balloon_cg.continue_from({str(path)!r}, {label})"
+    if isinstance(result, Picture):
+        branches = result.branches + result.surface_branches
+        if len(branches) == 1:
+            raise RuntimeError(f"no branch started at label {label}: " + "; ".join(
+                f"{name}: {reason}" for name, reason in result.not_started))
+        return Result.of(branches[0].scene, branches, found=result.incomplete, picture=result, command=command)
     if isinstance(result, Branch):
-        return Result.of(result.scene, [result], command=f"balloon_cg.continue_from({str(path)!r}, {label})")
+        return Result.of(result.scene, [result], command=command)
     return result
 
 

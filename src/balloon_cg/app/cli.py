@@ -800,11 +800,15 @@ def _add_continue(commands):
         "continue", help="restart from a labelled special point of a run file (inspect shows the labels)",
         description="Restart from the special point LABEL of a run file: without --parameter (or with the "
                     "branch's own, P) the branch through it is traced again in both directions (a run file with "
-                    "one branch, primary); with --parameter KEY (a scene key, as for critical) from a fold (LP, LV, "
-                    "LN) the fold curve in KEY and its cusp, from a pear pitchfork (BP odd_held) the curve of "
+                    "one branch, primary), and at a branch point of an equator-symmetric branch the branches "
+                    "bifurcating there instead (a pear point, held or free: the pear branch and its mirror image; "
+                    "a held m >= 1 point: the non-axisymmetric branch and its other direction; a run file of "
+                    "those after the branch of the point as read, none assessed); with --parameter KEY (a scene key, as for critical) from a fold (LP, "
+                    "LV, LN) the fold curve in KEY and its cusp, from a pear pitchfork (BP odd_held) the curve of "
                     "pitchforks and the isola's critical value (a curve file). Exit 0: written; 1: the "
-                    "computation did not give it (the curve did not start); 2: bad input (no such label, a "
-                    "label or parameter this does not continue yet: another BP, a surface branch).")
+                    "computation did not give it (the curve or no switched branch started); 2: bad input (no "
+                    "such label, a label or parameter this does not continue yet: an even or free m >= 1 BP, "
+                    "a BP in a second parameter other than a held pear point, a surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")
@@ -827,6 +831,7 @@ def continue_run(args) -> int:
 def _continue(args) -> int:
     """``continue`` into ``args.output`` (owned)."""
     from ..analysis.codim2 import TwoParameterError
+    from ..analysis.picture import Picture
     from ..analysis.results import Branch
     from ..analysis.second_parameter import UnknownParameter
     from ..io.curve_file import write_curve
@@ -844,6 +849,8 @@ def _continue(args) -> int:
     except TwoParameterError as e:
         raise Failure(f"the curve from label {args.label} could not start: {e}") from None
     attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
+    if isinstance(result, Picture):
+        return _write_switched(args, result, attrs)
     if isinstance(result, Branch):
         write_run(args.output, result.scene, [result], force=args.force, extra_attrs=attrs)
         print(f"branch continued from label {args.label}: {len(result.X)} points ({result.stop_reason}); written "
@@ -853,6 +860,24 @@ def _continue(args) -> int:
     ending = f"{result.end.value}: {result.describe()}"
     print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
           f"written to {args.output}")
+    return 0
+
+
+def _write_switched(args, picture, attrs) -> int:
+    """``continue`` at a branch point: the branch of the point and the branches switched to (``picture``)
+    written (exit 0), or none started (``Failure``: exit 1, nothing written)."""
+    from ..analysis.results import Branch, stop_codes
+    from ..io.run_file import write_run
+
+    branches = picture.branches + picture.surface_branches
+    if len(branches) == 1:
+        reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
+        raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
+    write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs,
+              found=picture.incomplete)
+    listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
+                       f"{stop_codes(b.legs)})" for b in branches[1:])
+    print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
     return 0
 
 

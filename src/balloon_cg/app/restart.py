@@ -3,20 +3,25 @@
 Every special point of a run file has a label, unique in the file (``io.run_file.labelled``: 1, 2, … through the
 branches in their order; ``inspect`` shows them). From the point with ``label``:
 
-- in the branch's own parameter (P, or Φ̄ of a voltage continuation; ``parameter`` None or that name): the
-  branch through the point is traced again in both directions from it, with the scene's stop rules and
-  ``[[events]]``, on the stored discretisation (``restart_branch``: a Branch named ``continued``);
+- in the branch's own parameter (P, or Φ̄ of a voltage continuation; ``parameter`` None or that name): from a
+  point that is no branch point, the branch through it is traced again in both directions from it, with the
+  scene's stop rules and ``[[events]]``, on the stored discretisation (``restart_branch``: a Branch named
+  primary); from a branch point of an equator-symmetric branch, the branches bifurcating there (``switch``):
+  at a pear point (odd_held, or odd_free: the free balloon) the pear branch and its mirror image, as ``run``
+  traces them (``picture.pear_pair``, its critical mode recomputed: ``pear_point``), at a held m ≥ 1 point the
+  non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``), not assessed;
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
   (``analysis.fold_curve.continue_fold``);
 - a pear branch point (BP of block odd_held, on an equator-symmetric branch) in q: the curve of pitchforks through
   it (``analysis.codim2.continue_branch_point``; its mode recomputed, ``pear_point``), as ``critical`` traces it.
 
 The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
-parameters and points. Not yet: the other branch points (even, m ≥ 1) in a second parameter, surface
-branches, an ordinary point in a second parameter, switching branches at a BP.
+parameters, points and special points. Not yet (RestartError, one line): the other branch points (odd_free, even,
+m ≥ 1) in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch without equator
+symmetry, points of surface branches, an ordinary point in a second parameter.
 """
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -26,11 +31,14 @@ from ..analysis.fold_curve import CONTROL_OF_FOLD, continue_fold
 from ..analysis.primary import landing_targets, range_limits, stop_rule
 from ..analysis.branch_point import WernerSpence
 from ..analysis.codim2 import continue_branch_point, plain_branch
+from ..analysis.picture import PEAR_NAMES, Picture, Progress, label_readings, pear_pair, surface_pair
 from ..analysis.problem import equilibrium_of
-from ..analysis.results import Block, Branch, Kind, SpecialPoint
+from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
+from ..analysis.surface_branches import SurfaceStartError
 from ..analysis.tracer import Tracer
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation
+from ..numerics.continuation import Stop, TraceStop
 from ..post.quantities import branch_discretisation, stored_scene
 
 
@@ -49,7 +57,7 @@ class Labelled:
 
 def stored_branch(run: dict, name: str) -> Branch:
     """The axisymmetric branch ``name`` of a read run file (``io.run_file.read_run``) as a Branch: scene,
-    discretisation, parameters and points (no stability, no special points)."""
+    discretisation, parameters, points and special points (``stored_special``; no stability)."""
     data = run["branches"][name]
     attrs = data["attrs"]
     parameter = attrs.get("parameter", "P")
@@ -59,7 +67,33 @@ def stored_branch(run: dict, name: str) -> Branch:
     disc = branch_discretisation(data)
     return Branch(name, stored_scene(run), disc, attrs["kernel_class"], attrs["kernel_signature"], params, X,
                   data["newton_iterations"], data["residual"], data["error_estimate"],
-                  np.full(len(X), disc.degree), parameter=parameter)
+                  np.full(len(X), disc.degree), special=stored_special(data), legs=stored_legs(attrs),
+                  parameter=parameter)
+
+
+def stored_stop(code: str, message: str) -> Stop:
+    """A stored stop code (a StopCode or TraceStop value) and its message as a Stop."""
+    return Stop(StopCode(code) if code in StopCode._value2member_map_ else TraceStop(code), message)
+
+
+def stored_legs(attrs: dict) -> tuple:
+    """The legs of a stored branch: its leg_labels and leg_stop_codes, each message read back from stop_reason
+    ('label: message; …'; the code where it cannot be)."""
+    parts = dict(part.split(": ", 1) for part in attrs.get("stop_reason", "").split("; ") if ": " in part)
+    return tuple(Leg(label, stored_stop(code, parts.get(label, code)))
+                 for label, code in zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", [])))
+
+
+def stored_special(data: dict) -> list[SpecialPoint]:
+    """The special points of a read branch (``io.run_file.read_run``) as SpecialPoints: kind, interval, X, block,
+    m, classification and E, status, reading, note and an end point's stop (no mode: run files do not store
+    it)."""
+    return [SpecialPoint(Kind(s["kind"]), int(s["index"]), np.asarray(data["special_unknowns"][row], dtype=float),
+                         classification=Classification(s["classification"]), block=Block(s["block"]),
+                         m=int(s.get("m", 0)), status=Status(s["status"]), uncertainty=float(s["uncertainty"]),
+                         reason=s["reason"], E=(s["E2"], s["E3"], s["E4"]), note=s["note"], gauge=Gauge(s["gauge"]),
+                         stop=stored_stop(s["stop_code"], s["note"]) if s["stop_code"] else None)
+            for row, s in enumerate(data["special_points"])]
 
 
 def find_label(run: dict, label: int) -> Labelled:
@@ -70,12 +104,11 @@ def find_label(run: dict, label: int) -> Labelled:
             labels.append(point["label"])
             if point["label"] != label:
                 continue
-            if data["attrs"].get("m", 0):
+            if data["attrs"].get("m", 0) or "surface_degree" in data["attrs"]:
                 raise RestartError(f"label {label}: a point of the surface branch {name}; continue starts from "
                                    "axisymmetric branches only")
-            special = SpecialPoint(Kind(point["kind"]), int(point["index"]), np.asarray(data["special_unknowns"][row]),
-                                   block=Block(point["block"]), note=point["note"])
-            return Labelled(label, stored_branch(run, name), special)
+            branch = stored_branch(run, name)
+            return Labelled(label, branch, branch.special[row])
     listed = f"{min(labels)}..{max(labels)}" if labels else "none"
     raise RestartError(f"label {label}: no special point has it in {run['path']} (its labels: {listed}; "
                        "balloon-cg inspect shows them)")
@@ -104,24 +137,79 @@ def restart_branch(start: Labelled, progress=None) -> Branch:
 
 
 def pear_point(branch: Branch, start: Labelled) -> SpecialPoint:
-    """The pear branch point of ``start`` on the plain symmetric ``branch`` (``codim2.plain_branch``) with its
-    critical mode, which run files do not store: the null vector of the pear block H_odd at the point (its
-    smallest right singular vector; ``codim2.continue_branch_point`` converges the extended system from it)."""
+    """The pear branch point of ``start`` (odd_held, or odd_free: the free balloon's) on the plain symmetric
+    ``branch`` (``codim2.plain_branch``) with its critical mode, which run files do not store: the null vector of
+    its block of the Hessian at the point (its smallest right singular vector, its largest entry positive so that
+    +φ is reproducible; ``codim2.continue_branch_point`` converges the extended system from it)."""
     X = start.branch.disc.transfer(start.point.X, branch.disc)
-    pear = WernerSpence(equilibrium_of(branch), branch.params, np.zeros(0))
+    pear = WernerSpence(equilibrium_of(branch), branch.params, np.zeros(0), block=start.point.block)
     phi = np.linalg.svd(pear.odd_hessian(X[:-1], branch.params.with_value("P", X[-1])))[2][-1]
     mode = np.zeros(pear.embed.shape[0])
-    mode[pear.odd] = phi
-    return SpecialPoint(Kind.BP, start.point.index, X, block=Block.ODD_HELD, mode=mode, note=start.point.note)
+    mode[pear.odd] = phi * np.sign(phi[np.argmax(np.abs(phi))])
+    return SpecialPoint(Kind.BP, start.point.index, X, block=start.point.block, mode=mode, note=start.point.note)
+
+
+def numbered_branch_points(branch: Branch) -> list[SpecialPoint]:
+    """The m = 0 branch points of an equator-symmetric branch in the numbering of ``run`` (its
+    ``picture.branch_points``: along the branch, the free balloon's after the others)."""
+    return sorted((s for s in branch.branch_points() if s.m == 0), key=lambda s: s.block == Block.ODD_FREE)
+
+
+class Ticks(Progress):
+    """The per-point callable ``progress`` of ``restart`` (None: nothing) as a ``picture.Progress``."""
+
+    def __init__(self, progress=None):
+        self.progress = progress
+
+    def tick(self, phase) -> None:
+        if self.progress is not None:
+            self.progress(phase)
+
+
+def switch(start: Labelled, progress=None) -> Picture:
+    """The branches bifurcating at the branch point ``start`` (module docstring) in a Picture: ``branches`` the
+    stored branch of the point (as read: not assessed) and the pear branches, ``surface_branches`` the
+    non-axisymmetric ones, ``not_started`` those that could not start; RestartError for a point this does not
+    switch at."""
+    branch, point, label = start.branch, start.point, start.label
+    if point.kind != Kind.BP:
+        raise RestartError(f"label {label} is a {point.kind.value}, not a branch point: nothing to switch at")
+    what = f"label {label} is a BP of block {point.block.value or 'none'}"
+    if not branch.disc.symmetric:
+        raise RestartError(f"{what} on {branch.name}, a branch without equator symmetry: switching there is not "
+                           "built (only at the pear and held m ≥ 1 points of an equator-symmetric branch)")
+    if branch.parameter != "P":
+        raise RestartError(f"{what} on {branch.name}, continued in {branch.parameter}: switching is built for "
+                           "branches continued in P only")
+    progress = Ticks(progress)
+    if point.block in PEAR_NAMES:
+        points = numbered_branch_points(branch)
+        n = next(i for i, s in enumerate(points) if s is point)
+        points[n] = replace(point, mode=pear_point(plain_branch(branch, point.X), start).mode)
+        picture = Picture([branch], branch_points=points)
+        pear_pair(branch.scene, branch, picture, n, progress, assess=False)
+        label_readings(picture.branches[1:])
+        return Picture(picture.branches, not_started=picture.not_started)
+    if point.m >= 1 and point.block.held:
+        k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
+        try:
+            pair = surface_pair(branch, k, point, branch.scene.surface.max_points, progress)
+        except SurfaceStartError as error:
+            return Picture([branch], not_started=[(f"m{point.m}_bp{k}", str(error))])
+        label_readings(pair)
+        return Picture([branch], surface_branches=pair)
+    raise RestartError(f"{what}: switching there is not built (only at pear points, odd_held or odd_free, and held "
+                       "m ≥ 1 points; run traces no branches at the others either)")
 
 
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
-    """What ``continue`` computes from ``start`` (module docstring): a Branch (in the branch's own parameter) or
-    a FoldCurve (a fold in a second parameter); RestartError for what is not built."""
+    """What ``continue`` computes from ``start`` (module docstring): a Branch (in the branch's own parameter), a
+    Picture of the branches switched to (a branch point, in its own parameter) or a two-parameter curve (a fold
+    or a pear point in a second parameter); RestartError for what is not built."""
     own = start.branch.parameter
-    if parameter in (None, own):
-        return restart_branch(start, progress)
     kind = start.point.kind
+    if parameter in (None, own):
+        return switch(start, progress) if kind == Kind.BP else restart_branch(start, progress)
     if kind in CONTROL_OF_FOLD:
         return continue_fold(start.branch, start.point, parameter, direction, progress=progress)
     if kind == Kind.BP and start.point.block == Block.ODD_HELD and start.branch.disc.symmetric:
