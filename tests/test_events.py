@@ -109,3 +109,40 @@ def test_an_event_value_is_a_scene_key():
         with pytest.raises(SceneError) as error:
             scene.with_overrides({key: value})
         assert str(error.value) == message
+
+
+def test_volume_event_on_a_surface_branch_is_the_pear_branch_s():
+    """SPOM1 at M = 0: the m = 1 branch (``picture.surface_pair``, 12 points) is the pear branch turned by 90°,
+    so its UZ point at V = 19.8 lies at the P of the pear branch's (measured 1.0e-14 apart; 1e-9 allowed, the
+    agreement of the two discretisations: tests/test_surface.py), with V at the landed state 19.8 to 1e-10
+    relative (measured 3e-13) and a residual below the solver tolerance; its image under the rotation by π has it
+    too. An event on λ2 at the equator is not located there, and the verdict says so."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis.picture import Picture, Progress, surface_pair, unsearched_events
+    from balloon_cg.analysis.results import Block
+    from balloon_cg.analysis.surface_branches import SurfaceTrace
+    from balloon_cg.surface.measures import body_moments
+
+    base = load_scene("spom1").with_overrides({"continuation.stop_stretch": 4.0, "surface.branches": "none"})
+    scene = parse_scene(base.to_toml() + '\n[[events]]\nquantity = "volume"\nvalue = 19.8\n')
+    pear_picture = analyse(scene)
+    primary, pear = pear_picture.primary, pear_picture.branches[1]
+    bp = replace(primary.branch_points()[0], m=1, block=Block.M1_HELD)
+    branch, image = surface_pair(primary, 0, bp, 12, Progress())
+    [uz] = user_points(branch, "volume = 19.8")
+    [turned] = user_points(image, "volume = 19.8")
+    reference = user_points(pear, "volume = 19.8")[0].X[-1]
+    assert uz.status == Status.LOCATED and abs(uz.X[-1] - reference) <= 1e-9 * reference
+    assert turned.X[-1] == uz.X[-1]
+    c = uz.X[:-1]
+    assert abs(2 * np.pi * body_moments(branch.basis, branch.basis.node_state(c))[0] - 19.8) <= 1e-10 * 19.8
+    system = SurfaceTrace(scene, branch.basis, branch.params).system
+    assert np.abs(system.residual(system.point(c, uz.X[-1]))).max() <= scene.solver.tol
+    equator = parse_scene(scene.to_toml() + '\n[[events]]\nquantity = "lam2_equator"\nvalue = 1.5\n')
+    picture = Picture([primary], surface_branches=[branch, image])
+    unsearched_events(picture, equator)
+    assert picture.not_searched == ("the [[events]] on lam2_equator are not located on the non-axisymmetric "
+                                    "branches")
+    unsearched_events(picture := Picture([primary], surface_branches=[branch, image]), scene)
+    assert picture.not_searched == ""

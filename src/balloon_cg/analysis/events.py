@@ -8,6 +8,11 @@ quantities (``scene.events.Quantity``): the enclosed volume V = 2π Ṽ(u), the 
 (the continuation parameter: a voltage continuation's P is fixed and never passes a value), and λ2 at the north
 pole, the south pole and the equator (linear rows in u). A landing that fails stores the linear interpolant,
 APPROXIMATE with its bracket.
+
+On a non-axisymmetric branch (``SurfaceBranch``, X = (a, P) of its ``surface.system``) the volume, the amount and
+the pressure are located the same way (``surface_event_points``): V = 2π Ṽ(c) (``surface.measures``), whose gradient
+is ∇_a V = −2π ∂R/∂P (R = Zᵀ∇E, and the −PṼ term of E gives ∂R/∂P = −∇_a Ṽ), n = P V, and P. λ2 at the poles and
+the equator are not located there (``SURFACE_UNLOCATED`` says so in the verdict line: ``unlocated_on_surface``).
 """
 import numpy as np
 
@@ -16,8 +21,9 @@ from ..scene import Control
 from ..scene.events import Quantity
 from .assembly import land, quantity_of
 from .control import control_gradient
+from ..surface.measures import body_moments
 from .problem import branch_system, continuation_settings
-from .results import Branch, Kind, SpecialPoint, approximate
+from .results import Branch, Kind, SpecialPoint, Status, SurfaceBranch, approximate
 
 POLE_ROWS = {Quantity.LAM2_NORTH: "lam2_north", Quantity.LAM2_SOUTH: "lam2_south"}
 
@@ -78,3 +84,74 @@ def with_events(branch: Branch) -> Branch:
     if points:
         branch.special = sorted(branch.special + points, key=lambda s: s.index)
     return branch
+
+
+SURFACE_QUANTITIES = (Quantity.VOLUME, Quantity.AMOUNT, Quantity.PRESSURE)  # located on surface branches
+
+
+def surface_quantity(system, quantity: Quantity):
+    """(q(X), ∇q(X)) of ``quantity`` (one of SURFACE_QUANTITIES) for a surface branch's continuation system
+    (``surface.system.SurfaceSystem`` in P; module docstring)."""
+    basis, size = system.eq.basis, system.gauge.size + 1
+    if quantity == Quantity.PRESSURE:
+        row = np.zeros(size)
+        row[-1] = 1.0
+        return (lambda X: float(X[-1])), (lambda X: row)
+
+    def volume(X):
+        return 2 * np.pi * body_moments(basis, basis.node_state(system.coefficients(X)))[0]
+
+    def volume_gradient(X):
+        c = system.coefficients(X)
+        return np.append(-2 * np.pi * system.gauge.reduce(system.eq.parameter_derivative(c, system.params_at(X), "P")),
+                         0.0)
+
+    if quantity == Quantity.VOLUME:
+        return volume, volume_gradient
+    return (lambda X: X[-1] * volume(X)), (lambda X: X[-1] * volume_gradient(X) + np.append(np.zeros(size - 1),
+                                                                                             volume(X)))
+
+
+def surface_event_points(branch: SurfaceBranch, system) -> list[SpecialPoint]:
+    """The UZ points of the surface ``branch`` (traced in P) for the events of its scene on SURFACE_QUANTITIES,
+    located on ``system`` (the branch's ``surface.system.SurfaceSystem`` on its stored basis), X = (c, P)."""
+    events = [e for e in branch.scene.events if e.quantity in SURFACE_QUANTITIES]
+    if not events or branch.parameter != "P":
+        return []
+    settings = continuation_settings(branch.scene)
+    X = np.array([system.point(c, P) for c, P in zip(branch.coefficients, branch.values)])
+    found = []
+    for event in events:
+        quantity = surface_quantity(system, event.quantity)
+        offset = np.array([quantity[0](x) for x in X]) - event.value
+        note = f"{event.quantity.value} = {event.value:g}"
+        for i in np.flatnonzero((offset[:-1] != 0) & (offset[:-1] * offset[1:] <= 0)):
+            point = land(system, X[i], X[i + 1], quantity, event.value, settings)
+            if point is not None:
+                found.append(SpecialPoint(Kind.UZ, int(i), np.append(system.coefficients(point.X), point.X[-1]),
+                                          note=note))
+                continue
+            t = offset[i] / (offset[i] - offset[i + 1])
+            c = branch.coefficients[i] + t * (branch.coefficients[i + 1] - branch.coefficients[i])
+            P0, P1 = branch.values[i], branch.values[i + 1]
+            found.append(SpecialPoint(Kind.UZ, int(i), np.append(c, P0 + t * (P1 - P0)), note=note,
+                                      status=Status.APPROXIMATE, uncertainty=0.5 * abs(P1 - P0),
+                                      reason=f"{note}: Newton did not land on the value; the linear interpolant"))
+    return found
+
+
+def with_surface_events(branch: SurfaceBranch, system) -> SurfaceBranch:
+    """``branch`` with its UZ points (``surface_event_points``) among its special points, ordered by index (its
+    origin, point 0, first)."""
+    points = surface_event_points(branch, system)
+    if points:
+        branch.special = sorted(branch.special + points, key=lambda s: s.index)
+    return branch
+
+
+def unlocated_on_surface(scene) -> str:
+    """What events of ``scene`` are not located on surface branches (module docstring), for the verdict line; ''
+    when all are."""
+    missing = sorted({e.quantity.value for e in scene.events if e.quantity not in SURFACE_QUANTITIES})
+    return (f"the [[events]] on {', '.join(missing)} are not located on the non-axisymmetric branches" if missing
+            else "")

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, mirror, surface_branches,
+from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, mirror, surface_branches,
                surface_primary)
 from ..scene import Control
 from .control import control_values, minimised_energy
@@ -337,6 +337,7 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
         origin = pair[0].special[0]
         primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
                            for s in primary.special]
+    unsearched_events(picture, scene)
 
 
 def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progress) -> list:
@@ -345,11 +346,27 @@ def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progres
     about the axis (``surface_branches.rotated``), for an even m (which that rotation maps to itself) traced along
     −φ. SurfaceStartError when it cannot start."""
     name = f"m{bp.m}_bp{k}"
-    branch = surface_branches.trace_surface(primary, k, bp, 1.0, name, max_points, progress.ticker(Phase.SURFACE))
-    other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else
-             surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}", max_points,
-                                            progress.ticker(Phase.SURFACE)))
+    branch = _with_events(surface_branches.trace_surface(primary, k, bp, 1.0, name, max_points,
+                                                         progress.ticker(Phase.SURFACE)))
+    other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else  # its UZ points turned with it
+             _with_events(surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}", max_points,
+                                                         progress.ticker(Phase.SURFACE))))
     return [branch, other]
+
+
+def _with_events(branch):
+    """A traced surface branch with the UZ points of its scene's ``[[events]]`` (``events.with_surface_events``,
+    on its stored basis)."""
+    trace = surface_branches.SurfaceTrace(branch.scene, branch.basis, branch.params)
+    return events.with_surface_events(branch, trace.system)
+
+
+def unsearched_events(picture: Picture, scene) -> None:
+    """Add to ``picture.not_searched`` the events not located on its surface branches, if it has any
+    (``events.unlocated_on_surface``)."""
+    missing = events.unlocated_on_surface(scene) if picture.surface_branches else ""
+    if missing:
+        picture.not_searched = "; ".join(filter(None, (picture.not_searched, missing)))
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

@@ -31,7 +31,8 @@ from ..analysis.fold_curve import CONTROL_OF_FOLD, continue_fold
 from ..analysis.primary import landing_targets, range_limits, stop_rule
 from ..analysis.branch_point import WernerSpence
 from ..analysis.codim2 import continue_branch_point, plain_branch
-from ..analysis.picture import PEAR_NAMES, Picture, Progress, label_readings, pear_pair, surface_pair
+from ..analysis.picture import (PEAR_NAMES, Picture, Progress, label_readings, pear_pair, surface_pair,
+                                unsearched_events)
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.surface_branches import SurfaceStartError
@@ -197,7 +198,9 @@ def switch(start: Labelled, progress=None) -> Picture:
         except SurfaceStartError as error:
             return Picture([branch], not_started=[(f"m{point.m}_bp{k}", str(error))])
         label_readings(pair)
-        return Picture([branch], surface_branches=pair)
+        picture = Picture([branch], surface_branches=pair)
+        unsearched_events(picture, branch.scene)
+        return picture
     raise RestartError(f"{what}: switching there is not built (only at pear points, odd_held or odd_free, and held "
                        "m ≥ 1 points; run traces no branches at the others either)")
 
