@@ -205,6 +205,12 @@ def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, blo
         assert switched[branch]["attrs"]["gauge"] == stored[branch]["attrs"]["gauge"]
         assert switched[branch]["attrs"]["parent_branch_point"] == stored[branch]["attrs"]["parent_branch_point"]
     assert np.array_equal(switched["primary"]["unknowns"], stored["primary"]["unknowns"])
+    if block == "odd_held":  # the same from Python
+        import balloon_cg as bc
+
+        result = bc.continue_from(run, label)
+        assert list(result.branches) == ["primary", name, f"{name}_mirror"] and result.complete
+        assert np.abs(np.asarray(result.branches[name].data["unknowns"]) - stored[name]["unknowns"]).max() < 1e-10
 
 
 def test_continue_refuses_a_switch_or_a_curve_it_does_not_build(two_coils, capsys):
