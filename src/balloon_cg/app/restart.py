@@ -74,7 +74,10 @@ def stored_branch(run: dict, name: str) -> Branch:
 
 def stored_stop(code: str, message: str) -> Stop:
     """A stored stop code (a StopCode or TraceStop value) and its message as a Stop."""
-    return Stop(StopCode(code) if code in StopCode._value2member_map_ else TraceStop(code), message)
+    try:
+        return Stop(StopCode(code), message)
+    except ValueError:
+        return Stop(TraceStop(code), message)
 
 
 def stored_legs(attrs: dict) -> tuple:
