@@ -214,17 +214,17 @@ def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, blo
 
 
 def test_continue_refuses_a_switch_or_a_curve_it_does_not_build(two_coils, capsys):
-    """At a free m = 1 point (run traces no branch there either), and from the free pear pitchfork in a second
-    parameter: one line each, exit 2, nothing written."""
+    """At a free m = 1 point (run traces no branch there either), and from an m = 1 point in a second parameter:
+    one line each, exit 2, nothing written."""
     run, out = two_coils / "run.h5", two_coils / "refused.h5"
     free_m1 = first(run, "BP", "m1_free")
     assert main(["continue", str(run), str(free_m1), "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"label {free_m1} is a BP of block m1_free: switching there is not" in err
-    free_pear = first(run, "BP", "odd_free")
-    assert main(["continue", str(run), str(free_pear), "--parameter", "M", "-o", str(out)]) == 2
+    held_m1 = first(run, "BP", "m1_held")
+    assert main(["continue", str(run), str(held_m1), "--parameter", "M", "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "only pear (odd_held) points" in err
+    assert len(err.splitlines()) == 1 and "is a BP of block m1_held; only pear points (odd_held, odd_free)" in err
     assert not out.exists()
 
 
@@ -250,3 +250,29 @@ def test_continue_at_a_held_m1_point_switches_to_the_surface_branch(two_coils, t
         assert np.abs(np.asarray(a["pressure"]) - np.asarray(b["pressure"])).max() < 1e-12
         assert [(s["kind"], s["classification"]) for s in a["special_points"]] == \
             [(s["kind"], s["classification"]) for s in b["special_points"]]
+
+
+def test_continue_in_M_from_the_free_pitchfork_gives_free_pitchforks(two_coils, capsys):
+    """Two coils: `continue RUN LABEL --parameter M` from the free balloon's pitchfork (odd_free: the pear block
+    with the axial translation) traces its curve (group pear_free); it turns back in M near 0.0144 and ends at a
+    wire. At a curve point of the first leg (M = 0.0109) the free pitchfork located on a primary branch traced at
+    that M (Werner–Spence at fixed M, from its own detection) is at the curve's P to 1e-10 (measured 8e-15)."""
+    from balloon_cg.analysis import bifurcation
+    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.results import Block, Status
+    from balloon_cg.analysis.stability import assess_branch
+
+    run, out = two_coils / "run.h5", two_coils / "free_curve.h5"
+    assert main(["continue", str(run), str(first(run, "BP", "odd_free")), "--parameter", "M", "-o", str(out),
+                 "--quiet"]) == 0
+    capsys.readouterr()
+    curve = read_curve(out, "pear_free")
+    q, P = curve["q"], curve["pressure"]
+    assert curve["attrs"]["end"] == "fold" and 0.0143 < q.max() < 0.0146 and q[0] == 0.002
+    scene = load_scene(two_coils / "two_coils.toml").with_overrides({"field.M": float(q[6]),
+                                                                     "continuation.stop_stretch": 2.0})
+    primary = trace_primary(scene)
+    primary.stability, _ = assess_branch(primary, scene.stability.degree, True, check=True)
+    free = [bifurcation.locate(primary, i, block, k) for i, block, k in bifurcation.detect(primary, primary.stability)
+            if block == Block.ODD_FREE]
+    assert free[0].status == Status.LOCATED and abs(free[0].X[-1] - P[6]) < 1e-10

@@ -13,7 +13,9 @@ branch's Legendre degree N:
               H_odd(u; P, q) φ      = 0     (m)      the pear block is singular, φ its null vector
               ℓ·φ − 1               = 0     (1)      normalisation (ℓ = the located critical mode)
 
-— one equation fewer than unknowns: a curve, traced by the generic pseudo-arclength ``continuation.trace``.
+— one equation fewer than unknowns: a curve, traced by the generic pseudo-arclength ``continuation.trace``. The
+free balloon's pitchfork in a field (the odd_free block: φ has the axial translation b_0 as one more entry) is
+followed by the same system with that block (``continue_branch_point`` from an odd_free point).
 
 Jacobian. ∂R/∂u is the generated Hessian (``Equilibrium.jacobian``), ∂R/∂P comes from
 ``Equilibrium.parameter_derivative``, and so does ∂R/∂q where a generated kernel gives it (``Derivative.EXACT``:
@@ -110,7 +112,8 @@ class ExtendedSystem(WernerSpence):
     ``branch_point`` with q as one more unknown. ``parameter``: a key of ``second_parameter`` or the looked-up
     SecondParameter (UnknownParameter, a ValueError, for a key the scene's kernels do not take)."""
 
-    def __init__(self, equilibrium: Equilibrium, params, parameter: str | SecondParameter, ell: np.ndarray):
+    def __init__(self, equilibrium: Equilibrium, params, parameter: str | SecondParameter, ell: np.ndarray,
+                 block: Block = Block.ODD_HELD):
         disc = equilibrium.disc
         if not disc.symmetric:
             raise TwoParameterError("the extended system needs the equator-symmetric layout of the primary branch")
@@ -119,7 +122,7 @@ class ExtendedSystem(WernerSpence):
         if parameter.kernel_class is not None and equilibrium.kernels.name != parameter.kernel_class:
             # runtime exponents: an own equilibrium of the general class (same energy, μ and α as arguments)
             equilibrium = Equilibrium(equilibrium.scene, disc, kernel_class=parameter.kernel_class)
-        super().__init__(equilibrium, params, ell)
+        super().__init__(equilibrium, params, ell, block=block)
         self.parameter = parameter
 
     def set_q(self, q: float):
@@ -174,6 +177,7 @@ class TwoParameterCurve:
     end: CurveEnd | None = None  # how the curve ended (module docstring); None: not classified
     q0: float = np.nan  # the start value of q
     direction: float = 1.0  # +1: q increased from q0, −1: decreased
+    block: Block = Block.ODD_HELD  # the pear block: odd_held, or odd_free (the free balloon's pitchforks)
 
     @property
     def n(self) -> int:
@@ -186,7 +190,7 @@ class TwoParameterCurve:
 
     def system(self) -> "ExtendedSystem":
         """The extended system the curve solves (rebuilt)."""
-        return ExtendedSystem(Equilibrium(self.scene, self.disc), self.params, self.second, self.ell)
+        return ExtendedSystem(Equilibrium(self.scene, self.disc), self.params, self.second, self.ell, self.block)
 
     def _parts(self, X):
         X = np.atleast_2d(X)
@@ -297,13 +301,14 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
         parameter = second_parameter(scene, eq, branch.params, parameter)
     if q0 is None:
         q0 = parameter.q0
-    if bp.block != Block.ODD_HELD:
-        raise TwoParameterError(f"branch point of block {bp.block.value!r}: only pear (odd_held) points are continued")
+    if bp.block not in (Block.ODD_HELD, Block.ODD_FREE):
+        raise TwoParameterError(f"branch point of block {bp.block.value!r}: only pear points (odd_held, odd_free) "
+                                "are continued")
     variation = SecondVariation(eq, branch.disc.degree)
-    odd = block_indices(variation, Block.ODD_HELD, field_on=False)
+    odd = block_indices(variation, bp.block, field_on=True)
     ell = bp.mode[odd] / np.linalg.norm(bp.mode[odd])
     params = branch.params.with_value("P", bp.X[-1])
-    system = ExtendedSystem(eq, params, parameter, ell)
+    system = ExtendedSystem(eq, params, parameter, ell, bp.block)
     X0 = system.initial(bp, q0)
     if settings is None:
         settings = continuation_settings(scene, max_points)
@@ -317,7 +322,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     points = path.points
     return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
-                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction))
+                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), bp.block)
 
 
 def plain_branch(branch: Branch, X) -> Branch:

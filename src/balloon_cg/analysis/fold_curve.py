@@ -200,7 +200,8 @@ def continue_fold(branch: Branch, fold: SpecialPoint, parameter: str | SecondPar
                            note=f"fold of the {fold.kind.value} curve in {name}{verdict}") for f in path.folds]
     return FoldCurve(parameter, branch.scene, branch.disc, params, w, np.array([p.X for p in path.points]),
                      np.array([p.iterations for p in path.points]), np.array([p.residual for p in path.points]),
-                     merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), control)
+                     merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction),
+                     control=control)
 
 
 def _classify(system: FoldSystem, path) -> CurveEnd:

@@ -755,8 +755,11 @@ def _pitchfork_curve(scene, args):
 
 
 def curve_group(curve) -> str:
-    """The group of a two-parameter curve in its file: ``pear`` (pitchforks), else its kind (LP, LV, LN)."""
-    return "pear" if curve.of.value == "BP" else curve.of.value
+    """The group of a two-parameter curve in its file: ``pear`` (pitchforks; ``pear_free``: the free balloon's),
+    else its kind (LP, LV, LN)."""
+    if curve.of.value != "BP":
+        return curve.of.value
+    return "pear_free" if curve.block.value == "odd_free" else "pear"
 
 
 FOLD_CONTROL = {"LP": "pressure", "LV": "volume", "LN": "gas"}  # the loading.control whose folds --of follows
@@ -803,12 +806,13 @@ def _add_continue(commands):
                     "one branch, primary), and at a branch point of an equator-symmetric branch the branches "
                     "bifurcating there instead (a pear point, held or free: the pear branch and its mirror image; "
                     "a held m >= 1 point: the non-axisymmetric branch and its other direction; a run file of "
-                    "those after the branch of the point as read, none assessed); with --parameter KEY (a scene key, as for critical) from a fold (LP, "
-                    "LV, LN) the fold curve in KEY and its cusp, from a pear pitchfork (BP odd_held) the curve of "
-                    "pitchforks and the isola's critical value (a curve file). Exit 0: written; 1: the "
-                    "computation did not give it (the curve or no switched branch started); 2: bad input (no "
-                    "such label, a label or parameter this does not continue yet: an even or free m >= 1 BP, "
-                    "a BP in a second parameter other than a held pear point, a surface branch).")
+                    "those after the branch of the point as read, none assessed); with --parameter KEY (a scene "
+                    "key, as for critical) from a fold (LP, LV, LN) the fold curve in KEY and its cusp, from a "
+                    "pear pitchfork (BP odd_held or odd_free) the curve of pitchforks and the isola's critical "
+                    "value (a curve file). Exit 0: written; 1: the computation did not give it (the curve or no "
+                    "switched branch started); 2: bad input (no such label, a label or parameter this does not "
+                    "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
+                    "surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")

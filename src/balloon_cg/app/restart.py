@@ -12,12 +12,13 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``), not assessed;
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
   (``analysis.fold_curve.continue_fold``);
-- a pear branch point (BP of block odd_held, on an equator-symmetric branch) in q: the curve of pitchforks through
-  it (``analysis.codim2.continue_branch_point``; its mode recomputed, ``pear_point``), as ``critical`` traces it.
+- a pear branch point (BP of block odd_held, or odd_free: the free balloon's, on an equator-symmetric branch) in q:
+  the curve of pitchforks through it (``analysis.codim2.continue_branch_point``; its mode recomputed,
+  ``pear_point``), as ``critical`` traces the held one.
 
 The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
-parameters, points and special points. Not yet (RestartError, one line): the other branch points (odd_free, even,
-m ≥ 1) in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch without equator
+parameters, points and special points. Not yet (RestartError, one line): the other branch points (even, m ≥ 1)
+in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch without equator
 symmetry, points of surface branches, an ordinary point in a second parameter.
 """
 import time
@@ -218,12 +219,12 @@ def restart(start: Labelled, parameter: str | None, direction: float = 1.0, prog
         return switch(start, progress) if kind == Kind.BP else restart_branch(start, progress)
     if kind in CONTROL_OF_FOLD:
         return continue_fold(start.branch, start.point, parameter, direction, progress=progress)
-    if kind == Kind.BP and start.point.block == Block.ODD_HELD and start.branch.disc.symmetric:
+    if kind == Kind.BP and start.point.block in PEAR_NAMES and start.branch.disc.symmetric:
         branch = plain_branch(start.branch, start.point.X)
         return continue_branch_point(branch, pear_point(branch, start), parameter, direction, progress=progress)
     if kind == Kind.BP:
         raise RestartError(f"--parameter {parameter}: label {start.label} is a BP of block "
-                           f"{start.point.block.value or 'none'}; only pear (odd_held) points of an equator-symmetric "
-                           "branch are continued in a second parameter")
+                           f"{start.point.block.value or 'none'}; only pear points (odd_held, odd_free) of an "
+                           "equator-symmetric branch are continued in a second parameter")
     raise RestartError(f"--parameter {parameter}: label {start.label} is a {kind.value}; from it only the branch's "
                        f"own parameter {own} (a fold, LP, LV or LN, also continues in a second parameter)")
