@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis import verdict
-from balloon_cg.analysis.results import Kind, Origin, Status
+from balloon_cg.analysis.results import Kind, Origin
 from balloon_cg.analysis.surface_pitchforks import kept_reflections
 from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 
@@ -33,7 +33,7 @@ def test_the_reflection_signs_map_a_field_to_its_image(S):
 def test_a_broken_mode_keeps_the_reflections_it_is_even_under():
     assert kept_reflections((MIRROR_Y, INVERSION), (1, -1)) == (MIRROR_Y,)
     assert kept_reflections((MIRROR_Y, INVERSION), (-1, 1)) == (INVERSION,)
-    assert kept_reflections((MIRROR_Y, INVERSION), (-1, -1)) == ((-1, 1, -1),)  # y → −y and the inversion: x → −x, z → −z
+    assert kept_reflections((MIRROR_Y, INVERSION), (-1, -1)) == ((-1, 1, -1),)  # their product: x → −x, z → −z
     assert kept_reflections((MIRROR_Y,), (-1,)) == ()
 
 
@@ -42,3 +42,99 @@ def test_a_branch_point_in_the_own_sector_is_a_typed_limitation():
     found = verdict.incomplete([], not_switched=(("bp2", "crosses in the state's own symmetry sector"),))
     assert [(item.gap, item.branch) for item in found] == [(verdict.Gap.NOT_SWITCHED, "bp2")]
     assert not verdict.failing(found)
+
+
+def test_a_whole_sphere_picture_without_branch_points_is_complete():
+    """The turned two-coil scene to λ = 1.06 (no branch point yet): the picture is the primary alone, with nothing
+    left unsearched or unswitched (before this slice it said the branches at its branch points were not traced)."""
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.scene import load_scene
+    from test_surface_primary import _scene, _turned
+
+    coils = [_turned(c, math.radians(30)) for c in load_scene(TWO_COILS).field.coils]
+    picture = analyse(_scene(coils, **{"continuation.stop_stretch": 1.06, "continuation.max_points": 20}))
+    assert [b.name for b in picture.surface_branches] == ["primary"]
+    assert not any(s.kind == Kind.BP for s in picture.primary.special)
+    assert picture.not_searched == "" and picture.not_switched == [] and picture.incomplete == []
+
+
+TWO_COILS = "scenes/spom1_two_coils_M0.002.toml"
+SETTINGS = {"M": 0.1, "continuation.stop_stretch": 1.5, "surface.degree": 12}  # the pear point before λ = 1.5
+
+
+@pytest.fixture(scope="module")
+def turned_pear():
+    """The two coils at M = 0.1 turned by 30° about e_y through the centre (their field keeps y → −y and the
+    inversion), traced on the whole sphere past the pear point (40 points); the branch born at its first pitchfork
+    odd under the inversion (4 points), its mirror image; the coaxial scene's picture with its pear branch."""
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.surface_pitchforks import mirror_image, pitchforks, trace_pitchfork
+    from balloon_cg.analysis.surface_primary import trace_surface_primary
+    from balloon_cg.scene import load_scene
+    from test_surface_primary import _scene, _turned
+
+    coils = [_turned(c, math.radians(30)) for c in load_scene(TWO_COILS).field.coils]
+    scene = _scene(coils, **SETTINGS, **{"continuation.max_points": 40})
+    primary = trace_surface_primary(scene)
+    search = pitchforks(primary)
+    number, bp, broken = next(p for p in search.pitchforks if p[2] == INVERSION)
+    branch = trace_pitchfork(primary, number, bp, broken, 4)
+    axisymmetric = analyse(load_scene(TWO_COILS).with_overrides({**SETTINGS, "surface.branches": "none"}))
+    return primary, search, (number, bp, broken), branch, mirror_image(branch, broken), axisymmetric
+
+
+def _axisymmetric_pear_volume(pear, P: float) -> float:
+    """V/2π of the coaxial scene's pear state at the pressure P: Newton at fixed P from the pear branch's point
+    nearest in P (the branch is monotone in P near its pitchfork)."""
+    from balloon_cg.analysis.problem import branch_system
+    from balloon_cg.numerics.newton import newton
+
+    system = branch_system(pear)
+    X0 = pear.X[int(np.argmin(np.abs(pear.pressure - P)))].copy()
+    X0[-1] = P
+    result = newton(system.residual, system.jacobian, X0, np.eye(X0.size)[-1], P, 1e-13, 30)
+    assert result.converged
+    return system.eq.volume(result.x[:-1])
+
+
+@pytest.mark.slow
+def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned(turned_pear):
+    """The pitchfork of the turned scene odd under the inversion is the coaxial pear point (P to 1e-8); the branch
+    born there leaves from it (its first point within the switching reach of point 0, residuals at solver.tol),
+    breaks the inversion (its odd part grows like the distance from the point: a pitchfork's even part is second
+    order), keeps y → −y, and each of its states is the coaxial pear state turned: its volume is the axisymmetric
+    solver's at its P. Its mirror image is its inversion, every reflected point a solution."""
+    from balloon_cg.analysis.surface_branches import SWITCH_REACH, SWITCH_STEP
+
+    primary, search, (number, bp, broken), branch, mirror, axisymmetric = turned_pear
+    (pear_point,) = [s for s in axisymmetric.branch_points if s.block.value == "odd_held"]
+    assert abs(bp.X[-1] - pear_point.X[-1]) < 1e-8
+    assert bp.sector[primary.basis.symmetry.index(INVERSION)] == -1
+    assert branch.basis.symmetry == (MIRROR_Y,) and branch.parent == ("primary", number)
+    origin = branch.special[0]
+    assert origin.kind == Kind.BP and origin.index == 0 and origin.classification.value == "pitchfork-super"
+    distance = np.linalg.norm(branch.coefficients - branch.coefficients[0], axis=1)
+    assert 0 < distance[1] <= SWITCH_REACH * SWITCH_STEP
+    assert branch.residual.max() <= branch.scene.solver.tol
+    signs = branch.basis.reflection_signs(broken)
+    odd = np.linalg.norm(branch.coefficients - branch.coefficients * signs, axis=1) / 2
+    assert odd[0] < 1e-12 and np.all(odd[1:] > 0.95 * distance[1:])
+    pear = next(b for b in axisymmetric.branches if b.name == "pear_0")
+    errors = [abs(V - _axisymmetric_pear_volume(pear, P)) / V
+              for V, P in zip(branch.measures["volume"][1:], branch.values[1:])]
+    assert max(errors) < 1e-8, errors
+    assert mirror is not None and mirror.origin == Origin.REFLECTED and mirror.name == branch.name + "_mirror"
+    assert np.abs(mirror.coefficients - branch.coefficients * signs).max() < 1e-12 * np.abs(branch.coefficients).max()
+    assert np.allclose(mirror.measures["centroid"], -branch.measures["centroid"], rtol=0, atol=1e-15)
+    assert np.array_equal(mirror.measures["lam_north"], branch.measures["lam_south"])
+
+
+@pytest.mark.slow
+def test_the_mirror_image_is_the_branch_traced_the_other_way(turned_pear):
+    """The first point traced along −φ (a continuation of its own) is the mirror image's first point."""
+    from balloon_cg.analysis.surface_pitchforks import trace_pitchfork
+
+    primary, _, (number, bp, broken), branch, mirror, _ = turned_pear
+    other = trace_pitchfork(primary, number, bp, broken, 2, sign=-1.0)
+    assert other.origin == Origin.TRACED_REFLECTION_FAILED and other.name == mirror.name
+    assert np.abs(other.coefficients[1] - mirror.coefficients[1]).max() < 1e-10

@@ -15,8 +15,10 @@ snap-throughs under the scene's loading control
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
 LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
 continuation in the coil heights (``broken_symmetry``); the branches bifurcating from it are not traced
-(``Picture.not_searched`` says so). Every branch carries its assessments in
-``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
+(``Picture.not_searched`` says so). A field that is not axisymmetric gets its primary branch traced on the whole
+sphere (``surface_primary``) and the branches born at its pitchforks with their mirror images
+(``surface_pitchforks``; its other branch points in ``Picture.not_switched``). Every branch carries its assessments
+in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
 from dataclasses import dataclass, field, replace
@@ -273,7 +275,8 @@ def _switch_pitchfork(scene, primary, number: int, bp, broken: tuple, picture: P
     """The branch born at one pitchfork of a whole-sphere primary branch and its mirror image (reflected, else
     traced along −φ), the classification written back to the parent point; a start that fails is a branch not
     started."""
-    name, budget, tick = surface_pitchforks.branch_name(number), scene.surface.max_points, progress.ticker(Phase.SURFACE)
+    name, budget = surface_pitchforks.branch_name(number), scene.surface.max_points
+    tick = progress.ticker(Phase.SURFACE)
     try:
         branch = surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, progress=tick)
         other = (surface_pitchforks.mirror_image(branch, broken)
