@@ -59,7 +59,8 @@ def test_a_whole_sphere_picture_without_branch_points_is_complete():
 
 
 TWO_COILS = "scenes/spom1_two_coils_M0.002.toml"
-SETTINGS = {"M": 0.1, "continuation.stop_stretch": 1.5, "surface.degree": 12}  # the pear point before λ = 1.5
+# the pear point before λ = 1.5; max_error 1e-6: degree 44 at the pear point (1e-9 asks for 68, ~10× the time)
+SETTINGS = {"M": 0.1, "continuation.stop_stretch": 1.5, "surface.degree": 12, "solver.max_error": 1e-6}
 
 
 @pytest.fixture(scope="module")
@@ -79,18 +80,23 @@ def turned_pear():
     search = pitchforks(primary)
     number, bp, broken = next(p for p in search.pitchforks if p[2] == INVERSION)
     branch = trace_pitchfork(primary, number, bp, broken, 4)
-    axisymmetric = analyse(load_scene(TWO_COILS).with_overrides({**SETTINGS, "surface.branches": "none"}))
+    axisymmetric = analyse(load_scene(TWO_COILS).with_overrides({"M": 0.1, "continuation.stop_stretch": 1.5,
+                                                                  "surface.branches": "none"}))
     return primary, search, (number, bp, broken), branch, mirror_image(branch, broken), axisymmetric
 
 
-def _axisymmetric_pear_volume(pear, P: float) -> float:
-    """V/2π of the coaxial scene's pear state at the pressure P: Newton at fixed P from the pear branch's point
-    nearest in P (the branch is monotone in P near its pitchfork)."""
+def _axisymmetric_pear_volume(pear, P_star: float, P: float) -> float:
+    """V/2π of the coaxial scene's pear state at the pressure P: Newton at fixed P from the pear's points
+    interpolated in the amplitude a = √(P* − P) (P* the branch point's: near a pitchfork P − P* is quadratic in the
+    amplitude, so a guess linear in P leads Newton back to the primary branch)."""
     from balloon_cg.analysis.problem import branch_system
     from balloon_cg.numerics.newton import newton
 
     system = branch_system(pear)
-    X0 = pear.X[int(np.argmin(np.abs(pear.pressure - P)))].copy()
+    amplitude = np.sqrt(np.maximum(P_star - pear.pressure, 0.0))
+    k = min(max(int(np.searchsorted(amplitude, np.sqrt(P_star - P))), 1), len(amplitude) - 1)
+    t = (np.sqrt(P_star - P) - amplitude[k - 1]) / (amplitude[k] - amplitude[k - 1])
+    X0 = pear.X[k - 1] + t * (pear.X[k] - pear.X[k - 1])
     X0[-1] = P
     result = newton(system.residual, system.jacobian, X0, np.eye(X0.size)[-1], P, 1e-13, 30)
     assert result.converged
@@ -99,7 +105,7 @@ def _axisymmetric_pear_volume(pear, P: float) -> float:
 
 @pytest.mark.slow
 def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned(turned_pear):
-    """The pitchfork of the turned scene odd under the inversion is the coaxial pear point (P to 1e-8); the branch
+    """The pitchfork of the turned scene odd under the inversion is the coaxial pear point (P to 1e-7); the branch
     born there leaves from it (its first point within the switching reach of point 0, residuals at solver.tol),
     breaks the inversion (its odd part grows like the distance from the point: a pitchfork's even part is second
     order), keeps y → −y, and each of its states is the coaxial pear state turned: its volume is the axisymmetric
@@ -108,7 +114,7 @@ def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned
 
     primary, search, (number, bp, broken), branch, mirror, axisymmetric = turned_pear
     (pear_point,) = [s for s in axisymmetric.branch_points if s.block.value == "odd_held"]
-    assert abs(bp.X[-1] - pear_point.X[-1]) < 1e-8
+    assert abs(bp.X[-1] - pear_point.X[-1]) < 1e-7  # measured 3.2e-8 at max_error 1e-6 (8e-12 at 1e-9)
     assert bp.sector[primary.basis.symmetry.index(INVERSION)] == -1
     assert branch.basis.symmetry == (MIRROR_Y,) and branch.parent == ("primary", number)
     origin = branch.special[0]
@@ -120,9 +126,9 @@ def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned
     odd = np.linalg.norm(branch.coefficients - branch.coefficients * signs, axis=1) / 2
     assert odd[0] < 1e-12 and np.all(odd[1:] > 0.95 * distance[1:])
     pear = next(b for b in axisymmetric.branches if b.name == "pear_0")
-    errors = [abs(V - _axisymmetric_pear_volume(pear, P)) / V
+    errors = [abs(V - _axisymmetric_pear_volume(pear, pear_point.X[-1], P)) / V
               for V, P in zip(branch.measures["volume"][1:], branch.values[1:])]
-    assert max(errors) < 1e-8, errors
+    assert max(errors) < 1e-7, errors  # measured 2.7e-8, 3.7e-8: the resolution of max_error 1e-6
     assert mirror is not None and mirror.origin == Origin.REFLECTED and mirror.name == branch.name + "_mirror"
     assert np.abs(mirror.coefficients - branch.coefficients * signs).max() < 1e-12 * np.abs(branch.coefficients).max()
     assert np.allclose(mirror.measures["centroid"], -branch.measures["centroid"], rtol=0, atol=1e-15)
@@ -130,11 +136,15 @@ def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned
 
 
 @pytest.mark.slow
-def test_the_mirror_image_is_the_branch_traced_the_other_way(turned_pear):
-    """The first point traced along −φ (a continuation of its own) is the mirror image's first point."""
-    from balloon_cg.analysis.surface_pitchforks import trace_pitchfork
+def test_the_mirror_image_is_the_branch_switched_the_other_way(turned_pear):
+    """The first point switched onto along −φ (a corrector of its own) is the mirror image's first point."""
+    from balloon_cg.analysis.surface_branches import switch
+    from balloon_cg.analysis.surface_pitchforks import switching_start
+    from balloon_cg.surface.embedding import transfer
 
-    primary, _, (number, bp, broken), branch, mirror, _ = turned_pear
-    other = trace_pitchfork(primary, number, bp, broken, 2, sign=-1.0)
-    assert other.origin == Origin.TRACED_REFLECTION_FAILED and other.name == mirror.name
-    assert np.abs(other.coefficients[1] - mirror.coefficients[1]).max() < 1e-10
+    primary, _, (_, bp, _), branch, mirror, _ = turned_pear
+    trace, X_star, phi = switching_start(primary, bp)
+    first = trace.system.coefficients(switch(trace, X_star, -phi).X)
+    if trace.basis != mirror.basis:
+        first = transfer(trace.basis, first, mirror.basis)
+    assert np.abs(first - mirror.coefficients[1]).max() < 1e-10

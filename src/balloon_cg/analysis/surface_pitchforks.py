@@ -101,13 +101,10 @@ def critical_vector(trace: SurfaceTrace, c: np.ndarray, P: float, characters: tu
     return sector, v * np.sign(v[np.argmax(np.abs(v))]), float(values[k] / sector.gram())
 
 
-@limited_blas
-def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broken: tuple, max_points: int,
-                    sign: float = 1.0, progress=None) -> SurfaceBranch:
-    """The branch born at the pitchfork ``bp`` (number ``number`` among the BPs of ``primary``) along sign·φ,
-    breaking the reflection ``broken`` (module docstring): named ``branch_name`` (−φ: with MIRROR, origin
-    TRACED_REFLECTION_FAILED, the mirror a reflection did not give); SurfaceStartError when it cannot start."""
-    t0 = time.perf_counter()
+def switching_start(primary: SurfaceBranch, bp: SpecialPoint) -> tuple:
+    """(the SurfaceTrace on the primary's final basis without the broken reflections, the BP state X* there, the
+    unit critical mode φ in X = (a, P)) of the pitchfork ``bp`` (module docstring): X* solved again at P* in the
+    primary's subspace (where that Newton fails, the located state itself)."""
     scene = primary.scene
     parent = SurfaceTrace(scene, primary.basis, primary.params)
     P = bp.X[-1]
@@ -116,13 +113,23 @@ def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broke
     sector, v, _ = critical_vector(parent, c_star, P, bp.sector)
     symmetry = kept_reflections(primary.basis.symmetry, bp.sector)
     trace = SurfaceTrace(scene, replace(primary.basis, symmetry=symmetry, characters=()), primary.params)
-    c_star = transfer(primary.basis, c_star, trace.basis)
     mode = transfer(sector, v, trace.basis) - transfer(sector, np.zeros(sector.size), trace.basis)
-    X_star = trace.system.point(c_star, P)
     phi = np.append(trace.gauge.reduce(mode), 0.0)
-    phi *= sign / np.linalg.norm(phi)
+    return trace, trace.system.point(transfer(primary.basis, c_star, trace.basis), P), phi / np.linalg.norm(phi)
+
+
+@limited_blas
+def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broken: tuple, max_points: int,
+                    sign: float = 1.0, progress=None) -> SurfaceBranch:
+    """The branch born at the pitchfork ``bp`` (number ``number`` among the BPs of ``primary``) along sign·φ,
+    breaking the reflection ``broken`` (module docstring): named ``branch_name`` (−φ: with MIRROR, origin
+    TRACED_REFLECTION_FAILED, the mirror a reflection did not give); SurfaceStartError when it cannot start."""
+    t0 = time.perf_counter()
+    trace, X_star, phi = switching_start(primary, bp)
+    phi = sign * phi
     E, kind = classify(trace, X_star, phi)
-    origin = replace(bp, index=0, X=np.append(c_star, P), E=E, classification=kind, mode=None,
+    origin = replace(bp, index=0, X=np.append(trace.system.coefficients(X_star), X_star[-1]), E=E,
+                     classification=kind, mode=None,
                      note=f"born here: branch point {number} of {primary.name} (its mode odd under {broken})")
     first = switch(trace, X_star, phi)
     if not isinstance(first, continuation.Point):
