@@ -285,6 +285,12 @@ def _switch_pitchfork(scene, primary, number: int, bp, broken: tuple, picture: P
         picture.not_started.append((name, str(error)))
         return
     picture.surface_branches += [branch, other]
+    _classified(primary, bp, branch)
+
+
+def _classified(primary, bp, branch) -> None:
+    """The classification of ``branch``'s origin (the reduced energy on the whole sphere) written back to its
+    parent point ``bp`` of ``primary``."""
     origin = branch.special[0]
     primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
                        for s in primary.special]
@@ -360,9 +366,7 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
             picture.not_started.append((name, str(error)))
             continue
         picture.surface_branches += [branch, other]
-        origin = branch.special[0]
-        primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
-                           for s in primary.special]
+        _classified(primary, bp, branch)
 
 
 def _rejoin_point(branch: Branch, branch_points: list, origin: int) -> int | None:

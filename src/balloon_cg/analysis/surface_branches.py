@@ -250,16 +250,24 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     X_star = trace.system.point(c_star, bp.X[-1])
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
-    E, kind = classify(trace, X_star, phi)
+    (E, kind), traced = leave(trace, X_star, phi, max_points, f"branch point {number} along its m = {bp.m} mode",
+                              progress)
     origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
                      note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
+    return branch_of(*traced, branch, number, origin, name, t0)
+
+
+def leave(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, max_points: int, what: str, progress=None):
+    """((E2, E3, E4), Classification) of the branch point X* along the unit mode φ (``classify``) and the branch
+    that leaves it along φ: (trace, segments, folds, stop) of ``follow`` from the first point off it (``switch``)
+    until it crosses back the hyperplane φ·(X − X*) = 0; SurfaceStartError (naming ``what``) when that first
+    correction does not converge."""
+    classified = classify(trace, X_star, phi)
     first = switch(trace, X_star, phi)
     if not isinstance(first, continuation.Point):
-        raise SurfaceStartError(f"the first correction from branch point {number} along its m = {bp.m} mode did "
-                                f"not converge: {first.message}")
+        raise SurfaceStartError(f"the first correction from {what} did not converge: {first.message}")
     start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
-    trace, segments, folds, stop = follow(trace, [start], first, max_points, (phi, X_star), progress)
-    return branch_of(trace, segments, folds, stop, branch, number, origin, name, t0)
+    return classified, follow(trace, [start], first, max_points, (phi, X_star), progress)
 
 
 def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_points: int, rejoin: tuple | None,

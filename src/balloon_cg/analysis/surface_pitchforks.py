@@ -31,13 +31,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy import linalg
 
-from ..numerics import continuation
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
 from ..surface.embedding import transfer
 from .results import Kind, Origin, SpecialPoint, Status, SurfaceBranch
-from .surface_branches import (CRITICAL_SEARCH, SurfaceStartError, SurfaceTrace, branch_of, classify, collected,
-                               follow, reflected, switch)
+from .surface_branches import CRITICAL_SEARCH, SurfaceTrace, branch_of, collected, leave, reflected
 from .surface_primary import READINGS, with_loads
 
 MIRROR = "_mirror"  # the suffix of a bifurcating branch's image under the reflection its mode breaks
@@ -126,20 +124,13 @@ def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broke
     TRACED_REFLECTION_FAILED, the mirror a reflection did not give); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     trace, X_star, phi = switching_start(primary, bp)
-    phi = sign * phi
-    E, kind = classify(trace, X_star, phi)
+    (E, kind), traced = leave(trace, X_star, sign * phi, max_points,
+                              f"branch point {number} of {primary.name} along its mode", progress)
     origin = replace(bp, index=0, X=np.append(trace.system.coefficients(X_star), X_star[-1]), E=E,
                      classification=kind, mode=None,
                      note=f"born here: branch point {number} of {primary.name} (its mode odd under {broken})")
-    first = switch(trace, X_star, phi)
-    if not isinstance(first, continuation.Point):
-        raise SurfaceStartError(f"the first correction from branch point {number} of {primary.name} along its "
-                                f"mode did not converge: {first.message}")
-    start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
-    trace, segments, folds, stop = follow(trace, [start], first, max_points, (phi, X_star), progress)
-    fields = with_loads(trace, collected(trace, segments, folds, stop))
     name = branch_name(number) + ("" if sign > 0 else MIRROR)
-    out = branch_of(trace, segments, folds, stop, primary, number, origin, name, t0, READINGS, fields)
+    out = branch_of(*traced, primary, number, origin, name, t0, READINGS, with_loads(traced[0], collected(*traced)))
     if sign < 0:
         out.origin = Origin.TRACED_REFLECTION_FAILED
     return out
