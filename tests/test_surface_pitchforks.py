@@ -148,3 +148,21 @@ def test_the_mirror_image_is_the_branch_switched_the_other_way(turned_pear):
     if trace.basis != mirror.basis:
         first = transfer(trace.basis, first, mirror.basis)
     assert np.abs(first - mirror.coefficients[1]).max() < 1e-10
+
+
+@pytest.mark.slow
+def test_the_branches_of_a_whole_sphere_pitchfork_are_stored_and_shown(turned_pear, tmp_path):
+    """The run file keeps the branch's parent and the mirror's reflection; inspect names the reflection."""
+    from balloon_cg.app.summaries import format_run
+    from balloon_cg.io.run_file import read_run, write_run
+
+    primary, _, (number, _, _), branch, mirror, _ = turned_pear
+    path = tmp_path / "turned.h5"
+    write_run(path, primary.scene, [primary, branch, mirror])
+    run = read_run(path)
+    stored = run["branches"][mirror.name]
+    assert np.array_equal(stored["coefficients"], mirror.coefficients)
+    assert list(stored["attrs"]["reflection"]) == list(INVERSION)
+    assert run["branches"][branch.name]["attrs"]["parent_branch_point"] == number
+    text = format_run(run)
+    assert f"(the reflection (x → −x, y → −y, z → −z) of {branch.name})" in text

@@ -339,6 +339,7 @@ class SurfaceBranch:
     wall_time: float = 0.0
     origin: Origin = Origin.TRACED
     reflection_of: str = ""  # REFLECTED: the branch this one is the image of (rotation by π about the axis)
+    reflection: tuple = ()  # REFLECTED: the diagonal reflection S it is the image under (``reflected``)
     unsettled: list = field(default_factory=list)  # (verdict's interface: no check degree on the whole sphere)
 
     @property

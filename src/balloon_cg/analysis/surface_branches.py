@@ -440,4 +440,4 @@ def reflected(branch: SurfaceBranch, S: tuple, name: str) -> SurfaceBranch:
     stability = None if branch.stability is None else {k: v.copy() for k, v in branch.stability.items()}
     return replace(branch, name=name, coefficients=branch.coefficients * signs, measures=measures_, special=special,
                    legs=tuple(Leg(leg.label, stop(leg.stop)) for leg in branch.legs), stability=stability,
-                   origin=Origin.REFLECTED, reflection_of=branch.name)
+                   origin=Origin.REFLECTED, reflection_of=branch.name, reflection=tuple(S))
