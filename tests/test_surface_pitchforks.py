@@ -30,6 +30,23 @@ def test_the_reflection_signs_map_a_field_to_its_image(S):
     assert np.abs(image - np.array(S, dtype=float)[:, None] * u_at_SX).max() < 1e-12 * np.abs(u_at_SX).max()
 
 
+def test_a_field_of_a_subspace_is_embedded_exactly_in_a_larger_basis():
+    """``embedded`` places a sector's (or the state's own subspace's) coefficients in the basis without the
+    broken reflection: the same field at arbitrary points, to rounding."""
+    from balloon_cg.surface.embedding import embedded
+
+    whole = SphericalBasis(8, (MIRROR_Y, INVERSION))
+    target = SphericalBasis(8, (MIRROR_Y,))
+    rng = np.random.default_rng(3)
+    cos_theta, phi = rng.uniform(-1, 1, 9), rng.uniform(0, 2 * np.pi, 11)
+    for sector in whole.sectors():
+        if MIRROR_Y in sector.symmetry and sector.characters[0] < 0:
+            continue  # odd under y → −y: not in the target's space
+        c = rng.normal(size=sector.size)
+        assert np.abs(target.grid_values(embedded(sector, c, target), cos_theta, phi)
+                      - sector.grid_values(c, cos_theta, phi)).max() < 1e-13
+
+
 def test_a_broken_mode_keeps_the_reflections_it_is_even_under():
     assert kept_reflections((MIRROR_Y, INVERSION), (1, -1)) == (MIRROR_Y,)
     assert kept_reflections((MIRROR_Y, INVERSION), (-1, 1)) == (INVERSION,)

@@ -33,7 +33,7 @@ from scipy import linalg
 
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
-from ..surface.embedding import transfer
+from ..surface.embedding import embedded
 from .results import Kind, Origin, SpecialPoint, Status, SurfaceBranch
 from .surface_branches import CRITICAL_SEARCH, SurfaceTrace, branch_of, collected, leave, reflected
 from .surface_primary import READINGS, with_loads
@@ -111,9 +111,8 @@ def switching_start(primary: SurfaceBranch, bp: SpecialPoint) -> tuple:
     sector, v, _ = critical_vector(parent, c_star, P, bp.sector)
     symmetry = kept_reflections(primary.basis.symmetry, bp.sector)
     trace = SurfaceTrace(scene, replace(primary.basis, symmetry=symmetry, characters=()), primary.params)
-    mode = transfer(sector, v, trace.basis) - transfer(sector, np.zeros(sector.size), trace.basis)
-    phi = np.append(trace.gauge.reduce(mode), 0.0)
-    return trace, trace.system.point(transfer(primary.basis, c_star, trace.basis), P), phi / np.linalg.norm(phi)
+    phi = np.append(trace.gauge.reduce(embedded(sector, v, trace.basis)), 0.0)
+    return trace, trace.system.point(embedded(primary.basis, c_star, trace.basis), P), phi / np.linalg.norm(phi)
 
 
 @limited_blas
