@@ -137,7 +137,10 @@ def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broke
 
 def mirror_image(branch: SurfaceBranch, broken: tuple) -> SurfaceBranch | None:
     """The image of ``branch`` under ``broken`` (``surface_branches.reflected``), named <name>_mirror, when every
-    reflected point passes the residual check (module docstring); None when one does not."""
+    reflected point passes the residual check (module docstring); None when one does not, or when a z-flip meets a
+    basis mapped toward a wire (its map is not symmetric; a whole-sphere primary's bases have none)."""
+    if broken[2] < 0 and branch.basis.mapping is not None:
+        return None
     image = reflected(branch, broken, branch.name + MIRROR)
     if reflection_excess(branch, image).max() > branch.scene.solver.tol:
         return None
