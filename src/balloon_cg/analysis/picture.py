@@ -15,8 +15,10 @@ snap-throughs under the scene's loading control
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
 LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
 continuation in the coil heights (``broken_symmetry``); the branches bifurcating from it are not traced
-(``Picture.not_searched`` says so). Every branch carries its assessments in
-``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
+(``Picture.not_searched`` says so). A field that is not axisymmetric gets its primary branch traced on the whole
+sphere (``surface_primary``) and the branches born at its pitchforks with their mirror images
+(``surface_pitchforks``; its other branch points in ``Picture.not_switched``). Every branch carries its assessments
+in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
 from dataclasses import dataclass, field, replace
@@ -24,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, mirror, surface_branches,
-               surface_primary)
+               surface_pitchforks, surface_primary)
 from ..scene import Control
 from .control import control_values, minimised_energy
 from .primary import trace_primary
@@ -97,6 +99,8 @@ class Picture:
     snaps: list = field(default_factory=list)  # SnapThrough
     not_searched: str = ""  # why branch points were not searched, if they were not
     not_started: list = field(default_factory=list)  # (name, reason) of bifurcating branches that could not start
+    not_switched: list = field(default_factory=list)  # (name, reason) of a whole-sphere primary's branch points that
+    #                                                   are not pitchforks (``surface_pitchforks``)
     surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
     interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
     clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
@@ -115,7 +119,8 @@ class Picture:
     @property
     def incomplete(self) -> list[Incomplete]:
         """What the picture lacks against the contract (``verdict``); empty when it is complete."""
-        found = incomplete(self.branches + self.surface_branches, self.not_searched, tuple(self.not_started))
+        found = incomplete(self.branches + self.surface_branches, self.not_searched, tuple(self.not_started),
+                           tuple(self.not_switched))
         if self.interrupted:
             found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, "interrupted by a signal: the branches "
                                     "and phases after the stored points were not computed"))
@@ -145,7 +150,7 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     ``clock``: the Clock its phases are charged to (``Picture.clock``; default: one started here)."""
     progress, clock = progress or Progress(), clock or Clock()
     if not scene.field.is_axisymmetric:
-        return _whole_sphere(scene, progress, clock)
+        return _whole_sphere(scene, progress, clock, pear)
     with clock.step(Step.TRACE):
         primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
     progress.finish(Phase.PRIMARY, len(primary.X))
@@ -244,18 +249,51 @@ def _unsearched(primary: Branch, searched: bool) -> str:
     return missing
 
 
-def _whole_sphere(scene, progress: Progress, clock: Clock) -> Picture:
+def _whole_sphere(scene, progress: Progress, clock: Clock, pear: bool) -> Picture:
     """The picture of a field that is not axisymmetric: its primary branch traced on the whole sphere, assessed
-    held under every control, its secondary branch points located (``surface_primary``). Branches are not yet
-    switched from them: ``not_searched`` says so when there are any."""
+    held under every control, its secondary branch points located (``surface_primary``), and the branches born at
+    its pitchforks (the first one, or all: ``[surface] branches``; none with ``pear=False``) followed with their
+    mirror images (``surface_pitchforks``); a branch point that is not a pitchfork is listed in
+    ``Picture.not_switched``."""
     primary = surface_primary.trace_surface_primary(scene, progress.ticker(Phase.PRIMARY), clock)
     progress.finish(Phase.PRIMARY, len(primary.values))
     picture = Picture([], surface_branches=[primary], clock=clock)
-    if any(s.kind == Kind.BP for s in primary.special):
-        picture.not_searched = ("the branches born at the branch points of a primary branch traced on the whole "
-                                "sphere are not traced yet")
-    _stopped(picture)
+    if _stopped(picture) or not pear or scene.surface.branches == "none":
+        return picture
+    search = surface_pitchforks.pitchforks(primary)
+    picture.not_switched = search.unswitched
+    with clock.step(Step.SURFACE_BRANCHES):
+        for number, bp, broken in search.pitchforks[:1] if scene.surface.branches == "first" else search.pitchforks:
+            if _stopped(picture):
+                break
+            _switch_pitchfork(scene, primary, number, bp, broken, picture, progress)
+    progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches[1:]))
     return picture
+
+
+def _switch_pitchfork(scene, primary, number: int, bp, broken: tuple, picture: Picture, progress: Progress) -> None:
+    """The branch born at one pitchfork of a whole-sphere primary branch and its mirror image (reflected, else
+    traced along −φ), the classification written back to the parent point; a start that fails is a branch not
+    started."""
+    name, budget = surface_pitchforks.branch_name(number), scene.surface.max_points
+    tick = progress.ticker(Phase.SURFACE)
+    try:
+        branch = surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, progress=tick)
+        other = (surface_pitchforks.mirror_image(branch, broken)
+                 or surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, -1.0, tick))
+    except surface_branches.SurfaceStartError as error:
+        picture.not_started.append((name, str(error)))
+        return
+    picture.surface_branches += [branch, other]
+    _classified(primary, bp, branch)
+
+
+def _classified(primary, bp, branch) -> None:
+    """The classification of ``branch``'s origin (the reduced energy on the whole sphere) written back to its
+    parent point ``bp`` of ``primary``."""
+    origin = branch.special[0]
+    primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
+                       for s in primary.special]
 
 
 def _stopped(picture: Picture) -> bool:
@@ -334,9 +372,7 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
             picture.not_started.append((name, str(error)))
             continue
         picture.surface_branches += pair
-        origin = pair[0].special[0]
-        primary.special = [replace(s, classification=origin.classification, E=origin.E) if s is bp else s
-                           for s in primary.special]
+        _classified(primary, bp, pair[0])
     unsearched_events(picture, scene)
 
 

@@ -170,6 +170,8 @@ class SpecialPoint:
     stop: Stop | None = None  # an end point's stop
     note: str = ""  # for people only
     gauge: Gauge = Gauge.BOTH  # the reading it belongs to: a BP's block's, a fold's or end point's its branch's
+    sector: tuple = ()  # a secondary BP of a surface branch: the characters of the symmetry sector whose held
+    #                     eigenvalue crosses zero (``surface_assessment``; not stored in run files: its note names it)
 
     def __repr__(self):
         label = " ".join(v for v in (self.kind.value, self.classification.value, self.block.value) if v)
@@ -337,6 +339,7 @@ class SurfaceBranch:
     wall_time: float = 0.0
     origin: Origin = Origin.TRACED
     reflection_of: str = ""  # REFLECTED: the branch this one is the image of (rotation by π about the axis)
+    reflection: tuple = ()  # REFLECTED: the diagonal reflection S it is the image under (``reflected``)
     unsettled: list = field(default_factory=list)  # (verdict's interface: no check degree on the whole sphere)
 
     @property

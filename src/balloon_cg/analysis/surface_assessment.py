@@ -81,9 +81,9 @@ def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, l
     found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
     note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"
     if found is not None and found.status == continuation.RootStatus.LOCATED:
-        return SpecialPoint(Kind.BP, i, found.payload, m=sb.m, note=note)
+        return SpecialPoint(Kind.BP, i, found.payload, m=sb.m, note=note, sector=sector)
     X = np.append(sb.coefficients[i], sb.values[i]) if found is None else found.payload
     return SpecialPoint(Kind.BP, i, X, m=sb.m, status=Status.APPROXIMATE,
                         uncertainty=0.5 * float(abs(sb.values[i + 1] - sb.values[i])),
                         reason="the root search along the chord failed; the nearest evaluated point is stored",
-                        note=note)
+                        note=note, sector=sector)

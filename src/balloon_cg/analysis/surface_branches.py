@@ -172,6 +172,15 @@ def axisymmetric_solve(trace: SurfaceTrace, c: np.ndarray, P: float) -> np.ndarr
     return c + E @ result.x[:-1] if result.converged else None
 
 
+POLE_STOPS = {StopCode.STOP_STRETCH: StopCode.SOUTH_STOP_STRETCH, StopCode.SOUTH_STOP_STRETCH: StopCode.STOP_STRETCH}
+
+
+def pole_stop(code: StopCode, upper: float) -> Stop:
+    """The stop of a material pole's stretch reaching stop_stretch ``upper`` (north: STOP_STRETCH)."""
+    pole = "north" if code == StopCode.STOP_STRETCH else "south"
+    return Stop(code, f"{pole} pole stretch reached stop_stretch {upper:g}")
+
+
 def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
     """stop(point) -> Stop or None (module docstring); ``rejoin`` (φ, X*): the branch ends where it crosses the
     hyperplane of its branch point back (None: a primary branch); StopCode.RESOLUTION when a tail exceeds
@@ -181,13 +190,13 @@ def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
 
     def stop(point):
         if rejoin is not None and rejoin[0] @ (point.X - rejoin[1]) < 0:
-            return Stop(StopCode.REJOINED, "rejoined the axisymmetric branch")
+            return Stop(StopCode.REJOINED, "rejoined the branch it was born on")
         c = trace.system.coefficients(point.X)
         m = measures(basis, c)
         if m["lam_north"] >= upper:
-            return Stop(StopCode.STOP_STRETCH, f"north pole stretch reached stop_stretch {upper:g}")
+            return pole_stop(StopCode.STOP_STRETCH, upper)
         if m["lam_south"] >= upper:
-            return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
+            return pole_stop(StopCode.SOUTH_STOP_STRETCH, upper)
         if trace.eq.has_field:
             distance = float(loop_distance(trace.eq.node_values(c)["state"][:3], trace.eq.coils).min())
             if distance < gap:
@@ -243,16 +252,24 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     X_star = trace.system.point(c_star, bp.X[-1])
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
-    E, kind = classify(trace, X_star, phi)
+    (E, kind), traced = leave(trace, X_star, phi, max_points, f"branch point {number} along its m = {bp.m} mode",
+                              progress)
     origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
                      note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
+    return branch_of(*traced, branch, number, origin, name, t0)
+
+
+def leave(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, max_points: int, what: str, progress=None):
+    """((E2, E3, E4), Classification) of the branch point X* along the unit mode φ (``classify``) and the branch
+    that leaves it along φ: (trace, segments, folds, stop) of ``follow`` from the first point off it (``switch``)
+    until it crosses back the hyperplane φ·(X − X*) = 0; SurfaceStartError (naming ``what``) when that first
+    correction does not converge."""
+    classified = classify(trace, X_star, phi)
     first = switch(trace, X_star, phi)
     if not isinstance(first, continuation.Point):
-        raise SurfaceStartError(f"the first correction from branch point {number} along its m = {bp.m} mode did "
-                                f"not converge: {first.message}")
+        raise SurfaceStartError(f"the first correction from {what} did not converge: {first.message}")
     start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
-    trace, segments, folds, stop = follow(trace, [start], first, max_points, (phi, X_star), progress)
-    return _branch(trace, segments, folds, stop, branch, number, origin, name, t0)
+    return classified, follow(trace, [start], first, max_points, (phi, X_star), progress)
 
 
 def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_points: int, rejoin: tuple | None,
@@ -329,18 +346,19 @@ def traced_points(segments) -> list:
     return [(t, t.system.coefficients(p.X)) for t, points in segments for p in points]
 
 
-def _branch(trace: SurfaceTrace, segments, folds, stop, parent: Branch, number: int, bp: SpecialPoint, name: str,
-            t0) -> SurfaceBranch:
-    """The SurfaceBranch of the traced segments (``collected``), its origin ``bp`` first; the stability of each
-    point read on the basis it was traced on (``assess``)."""
-    fields = collected(trace, segments, folds, stop)
+def branch_of(trace: SurfaceTrace, segments, folds, stop, parent, number: int, bp: SpecialPoint, name: str, t0,
+              readings=surface_stability.READINGS, fields: dict | None = None) -> SurfaceBranch:
+    """The SurfaceBranch of the traced segments (``collected``, or their ``fields``), born at point ``number`` of
+    the ``parent`` branch, its origin ``bp`` first; the stability of each point read on the basis it was traced on
+    (``assess``: ``readings``)."""
+    fields = fields or collected(trace, segments, folds, stop)
     first_basis = segments[0][0].basis
     if first_basis is not trace.basis:  # the origin was made on the first basis
         bp = replace(bp, X=np.append(transfer(first_basis, bp.X[:-1], trace.basis), bp.X[-1]))
     fields["special"].insert(0, bp)
     out = SurfaceBranch(name=name, scene=parent.scene, kernel_class=parent.kernel_class, params=parent.params,
                         m=bp.m, parent=(parent.name, number), **fields)
-    assess(out, traced_points(segments))
+    assess(out, traced_points(segments), readings)
     out.wall_time = time.perf_counter() - t0
     return out
 
@@ -389,18 +407,39 @@ def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: fl
 
 
 def rotated(branch: SurfaceBranch, name: str) -> SurfaceBranch:
-    """The image of ``branch`` under the rotation R by π about the axis, x ↦ R x(R⁻¹X): for an odd m the other
-    direction −φ of its pitchfork (R maps the mode to −itself; coaxial loops and the held gauge are invariant under
-    R; an even mode R maps to itself: ValueError). A
-    coefficient of e_c Y_{l,m,t} changes by the sign of e_c under R (−1 for x, y) times (−1)^m; P, the pole
-    stretches, volume, tilt and every eigenvalue are unchanged, the centroid turns with R."""
+    """The image of ``branch`` under the rotation R by π about the axis (``reflected`` by HALF_TURN, diagonal):
+    for an odd m the other direction −φ of its pitchfork (R maps the mode to −itself; coaxial loops and the held
+    gauge are invariant under R; an even mode R maps to itself: ValueError)."""
     if branch.m % 2 == 0:
         raise ValueError(f"rotated: the rotation by π maps the m = {branch.m} mode of {branch.name} to itself, not "
                          "to the other direction of its pitchfork (trace that one along −φ)")
-    signs = np.concatenate([np.full(len(b.degrees), (-1.0 if b.component < 2 else 1.0) * (-1.0) ** b.m)
-                            for b in branch.basis.blocks])
-    turn = np.array([-1.0, -1.0, 1.0])
-    measures_ = {**branch.measures, "centroid": branch.measures["centroid"] * turn}
-    special = [replace(s, X=np.append(s.X[:-1] * signs, s.X[-1])) for s in branch.special]
+    return reflected(branch, HALF_TURN, name)
+
+
+def reflected(branch: SurfaceBranch, S: tuple, name: str) -> SurfaceBranch:
+    """The image of ``branch`` under a diagonal reflection S that the scene keeps (the coils' H², the held gauge),
+    x ↦ S x(S X): a coefficient of e_c Y_{l,m,t} times s_c σ_S(l, m, t) (``SphericalBasis.reflection_signs``);
+    P, the volume, the tilt and every eigenvalue unchanged, the centroid and the field's force F ↦ S F, its torque
+    (a pseudovector) T ↦ det S · S T, and where S flips z the pole stretches and their stops swapped. A basis on a
+    polar map is not reflected by a z-flip (the map is not symmetric): ValueError."""
+    if S[2] < 0 and branch.basis.mapping is not None:
+        raise ValueError(f"reflected: {branch.name}'s basis is mapped toward a wire; the reflection {S} does not "
+                         "keep its map")
+    signs = branch.basis.reflection_signs(S)
+    flip, swap = np.array(S, dtype=float), S[2] < 0
+    image = {"centroid": flip, "force": flip, "torque": float(np.prod(flip)) * flip}
+    measures_ = {key: value * image[key] if key in image else value.copy()
+                 for key, value in branch.measures.items()}
+    if swap:
+        measures_["lam_north"], measures_["lam_south"] = branch.measures["lam_south"], branch.measures["lam_north"]
+
+    def stop(s: Stop | None) -> Stop | None:
+        if s is None or not swap or s.code not in POLE_STOPS:
+            return s
+        return pole_stop(POLE_STOPS[s.code], branch.scene.continuation.stop_stretch)
+
+    special = [replace(s, X=np.append(s.X[:-1] * signs, s.X[-1]), stop=stop(s.stop)) for s in branch.special]
+    stability = None if branch.stability is None else {k: v.copy() for k, v in branch.stability.items()}
     return replace(branch, name=name, coefficients=branch.coefficients * signs, measures=measures_, special=special,
-                   origin=Origin.REFLECTED, reflection_of=branch.name)
+                   legs=tuple(Leg(leg.label, stop(leg.stop)) for leg in branch.legs), stability=stability,
+                   origin=Origin.REFLECTED, reflection_of=branch.name, reflection=tuple(S))

@@ -94,6 +94,14 @@ def _field_on(trace: SurfaceTrace, c: np.ndarray, params) -> np.ndarray:
                             f"down to {dM:.3g} (field.M = {target:g})")
 
 
+def with_loads(trace: SurfaceTrace, fields: dict) -> dict:
+    """The fields of a branch (``collected``) with the field's net force and torque on each state among its
+    measures (``surface.loads``)."""
+    per_point = [loads(trace.eq, c, trace.system.params) for c in fields["coefficients"]]
+    fields["measures"] |= {key: np.array([load[key] for load in per_point]) for key in LOADS}
+    return fields
+
+
 @limited_blas
 def trace_surface_primary(scene, progress=None, clock: Clock | None = None) -> SurfaceBranch:
     """The primary branch of ``scene`` on the whole sphere (module docstring), assessed held under every control,
@@ -119,9 +127,7 @@ def trace_surface_primary(scene, progress=None, clock: Clock | None = None) -> S
         start = continuation.Point(solved.x, continuation.tangent(trace.system, solved.x, np.eye(X.size)[-1]),
                                    solved.iterations, solved.residual)
         trace, segments, folds, stop = follow(trace, [], start, scene.continuation.max_points, None, progress)
-        fields = collected(trace, segments, folds, stop)
-        per_point = [loads(trace.eq, c, trace.system.params) for c in fields["coefficients"]]
-        fields["measures"] |= {key: np.array([load[key] for load in per_point]) for key in LOADS}
+        fields = with_loads(trace, collected(trace, segments, folds, stop))
         out = SurfaceBranch(name="primary", scene=scene, kernel_class=trace.eq.kernels.name,
                             params=trace.system.params, m=0, parent=("", -1), **fields)
         out.wall_time = time.perf_counter() - t0

@@ -160,6 +160,7 @@ def summarise_surface_branch(b: dict) -> dict:
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if attrs["parent_branch"] else None,
         "origin": attrs.get("origin", "traced"),
         "reflection_of": attrs.get("reflection_of", ""),
+        "reflection": [int(k) for k in attrs.get("reflection", (-1, -1, 1))],  # files before it: the half turn
         "gauge": attrs["gauge"],  # io.run_file reads it from M in files written before it
         "points": n,
         "pressure": _range(b["pressure"]),
@@ -253,6 +254,14 @@ def _verdict(attrs: dict) -> str:
     return "incomplete: " + "; ".join(parts)
 
 
+def _image(reflection) -> str:
+    """What a reflected surface branch is the image under: 'the rotation by π about the axis' (diag(−1, −1, 1)),
+    else 'the reflection (x → −x, …)'."""
+    if list(reflection) == [-1, -1, 1]:
+        return "the rotation by π about the axis"
+    return "the reflection " + _reflections([reflection], [1])
+
+
 def _reflections(symmetry, characters) -> str:
     """'y → −y, z → −z' for the reflections a surface basis keeps (a character −1 as 'odd under …')."""
     axes = "xyz"
@@ -272,7 +281,7 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"{b['nodes'][0]} × {b['nodes'][1]}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
         f"chi = {b['chi']:g})",
         f"  points               {b['points']}"
-        + (f"  (the rotation by π about the axis of {b['reflection_of']})" if b["reflection_of"] else ""),
+        + (f"  ({_image(b['reflection'])} of {b['reflection_of']})" if b["reflection_of"] else ""),
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
         "  lam2 north pole      {:.10g} .. {:.10g}  (√(λ1 λ2) at the material pole)".format(*b["lam2_north"]),
         "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),

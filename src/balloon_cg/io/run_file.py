@@ -36,7 +36,8 @@ Layout::
                            kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
                            surface_degree, surface_order, symmetry (k × 3 int), characters (k int), n_theta,
                            n_phi, map_centres, map_widths (the polar coordinate map; empty: none); origin,
-                           [reflection_of] (a branch's image under the rotation by π about the axis)
+                           [reflection_of] (a branch's image under a diagonal reflection), [reflection] (its
+                           signs (s_x, s_y, s_z); absent: the rotation by π about the axis, (−1, −1, 1))
         point, coefficient, axis                           dimension scales (axis: x, y, z as 0, 1, 2)
         pressure, volume, amount, lam2_north, lam2_south (√J at the material poles), tilt (degrees),
         converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
@@ -306,6 +307,8 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     })
     if branch.reflection_of:
         group.attrs["reflection_of"] = branch.reflection_of
+    if branch.reflection:
+        group.attrs["reflection"] = np.array(branch.reflection, dtype=np.int64)
     rows = branch_rows(branch)
     parameters = parameter_columns(branch, rows)
     measures = branch.measures

@@ -131,6 +131,13 @@ class SphericalBasis:
     def size(self) -> int:
         return self.blocks[-1].offset + len(self.blocks[-1].degrees) if self.blocks else 0
 
+    def reflection_signs(self, reflection: tuple) -> np.ndarray:
+        """Per coefficient, the sign s_c σ_S(l, m, t) of its e_c Y_{l,m,t} in the image S u(S X) of a field u under
+        the diagonal reflection S (exact on the coefficients where S keeps the polar coordinate's map: no map, or
+        s_z = +1)."""
+        return np.array([reflection[b.component] * _sign_under(reflection, l, b.m, b.t)
+                         for b in self.blocks for l in b.degrees], dtype=float)
+
     def sectors(self) -> list:
         """The bases of every choice of characters for this basis' reflections (same degree and nodes): their
         spaces together are the whole space, and a Hessian at a state of the invariant subspace is block-diagonal

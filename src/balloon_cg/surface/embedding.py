@@ -46,3 +46,18 @@ def transfer(source: SphericalBasis, c: np.ndarray, target: SphericalBasis) -> n
     non-polynomial mapped functions)."""
     x = source.grid_values(c, target.nodes["cos_theta"], target.nodes["phi"]).reshape(3, -1)
     return displacement_coefficients(target, x - target.nodes["reference"][:3])
+
+
+def embedded(source: SphericalBasis, c: np.ndarray, target: SphericalBasis) -> np.ndarray:
+    """The coefficients c of ``source`` in ``target``, a basis of the same degree, order and unmapped harmonics whose
+    space holds the source's (fewer reflections, or another sector's characters): placed by (component, m, type,
+    degree), exact (``transfer`` projects through the nodes: rounding of the quadrature)."""
+    if source.mapping is not None or target.mapping is not None or (source.degree, source.order) != (
+            target.degree, target.order):
+        raise ValueError("embedded: the bases must share their degree and order and have no polar map")
+    blocks = {(b.component, b.m, b.t): b for b in target.blocks}
+    out = np.zeros(target.size)
+    for b in source.blocks:
+        into = blocks[b.component, b.m, b.t]
+        out[into.offset + np.searchsorted(into.degrees, b.degrees)] = c[b.slice]
+    return out
