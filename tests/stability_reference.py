@@ -1,8 +1,12 @@
 """The reference table of issue 28: every stored eigenvalue, flag and located point of the whole picture of the
 shipped scenes, as computed by the code this table was made with (main at 86f8543, before the stability work of
-issue 28; rewritten once since, when a surface branch's critical mode moved to the perturbation degree its point
-was located at: the two-coil m = 1 branch's points moved by ~2e-8, nothing else). tests/test_stability_reference.py computes the same table with the code under test and compares it to
-1e-10; ``python tests/stability_reference.py`` rewrites tests/data/stability_reference.npz (only to record a
+issue 28; rewritten twice since: when a surface branch's critical mode moved to the perturbation degree its point
+was located at: the two-coil m = 1 branch's points moved by ~2e-8, nothing else; and again from main at 5271428,
+whose two-coil table no longer matched it: the merges of issue 27a/27b added the free balloon's pitchfork (a BP of
+odd_free on the primary, the later special points renumbered; branches pear_free_1 and its mirror) and moved
+pear_0_mirror's m = 1 crossing by 1.8e-10, every other common entry within 1e-10).
+tests/test_stability_reference.py computes the same table with the code under test and compares it to 1e-10;
+``python tests/stability_reference.py`` rewrites tests/data/stability_reference.npz (only to record a
 deliberate change of the numbers).
 
 A picture's table (``table``): per branch, the lowest eigenvalues of every block (axisymmetric branches) or reading

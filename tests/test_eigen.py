@@ -123,6 +123,26 @@ def test_one_shifted_factorisation_serves_the_constrained_and_updated_readings(c
         assert shifted.lowest(4, update=(update[0], -0.7)) is None
 
 
+def test_relatives_in_lockstep_are_each_alone_bit_for_bit():
+    """The Lanczos runs of several relatives sharing each solve (one right-hand side of several columns) give every
+    relative exactly the numbers it gets alone, a refused one (a negative update) None among them."""
+    n = eigen.FOLLOWING_SIZE + 40
+    A, _ = stiff_matrix(n, [-3.9, -0.2, 0.3, 0.3 + 1e-7, 0.5], 7)
+    rng = np.random.default_rng(9)
+    factor = eigen.GramFactor(np.full(n, 2.0), orthogonal=True)
+    base, extra, g = rng.normal(size=(2, n)), rng.normal(size=(3, n)), rng.normal(size=n)
+    shifted = eigen.ShiftInvert.below(eigen.restricted(A * 2.0, factor, base), -3.0)
+    held = eigen.restricted_rows(factor, base, extra)
+    u = eigen.restricted_rows(factor, base, g[None, :])[0]
+    relatives = [(4, None, None), (4, held, None), (3, np.vstack([held, u]), None), (4, held, (u, 0.7)),
+                 (4, None, (u, -0.7)), (5, None, (u, 0.2))]
+    together = shifted.lowest_of_relatives(relatives)
+    assert together[4] is None
+    for relative, found in zip(relatives, together):
+        alone = shifted.lowest(*relative)
+        assert (found is None and alone is None) or np.array_equal(found, alone)
+
+
 def test_negative_count_is_the_inertia():
     """The Bunch–Kaufman inertia counts the negative eigenvalues, with 2×2 pivots (zero diagonal blocks force them)."""
     for negatives in (0, 1, 3, 7):

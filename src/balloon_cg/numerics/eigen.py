@@ -194,8 +194,36 @@ class ShiftInvert:
         """The ``count`` lowest eigenvalues (ascending) of A + ρ u uᵀ on Uᵀy = 0 (class docstring); ``update``:
         (u, ρ) or None, ``constraints``: the rows of U (k × n; dependent ones dropped as in ``restricted``) or None.
         None when ρ ≤ 0 or the update does not keep A + ρuuᵀ − σI positive (then σ is no lower bound)."""
-        n = self.size
-        base = self.solve
+        return self.lowest_of_relatives([(count, constraints, update)], rcond)[0]
+
+    def lowest_of_relatives(self, relatives, rcond: float = RCOND) -> list:
+        """``lowest(count, constraints, update)`` of every (count, constraints, update) in ``relatives``, their
+        Lanczos runs in lockstep: each step solves with the factor once for all of them (the columns of one
+        right-hand side: the factor, memory-bound to read, is read once instead of once per relative; LAPACK's
+        dpotrs gives each column the numbers it gives it alone), the rest of each run as alone."""
+        operators = [self._relative(constraints, update, rcond) for _, constraints, update in relatives]
+        runs = {k: _lanczos(self.size, count) for k, (count, _, _) in enumerate(relatives)
+                if operators[k] is not None}
+        wanted = {k: next(run) for k, run in runs.items()}
+        out = [None] * len(relatives)
+        while wanted:
+            keys = list(wanted)
+            solved = self.solve(np.column_stack([wanted[k] for k in keys]))
+            for i, k in enumerate(keys):
+                try:
+                    wanted[k] = runs[k].send(operators[k](wanted[k], solved[:, i]))
+                except StopIteration as done:
+                    out[k] = np.sort(self.sigma + 1.0 / done.value)
+                    del wanted[k]
+        return out
+
+    def _relative(self, constraints, update, rcond: float):
+        """(v, (A − σI)⁻¹v) ↦ T v of one relative (class docstring), or None when its update is no positive one
+        that keeps σ a lower bound (``lowest``)."""
+
+        def base(v, solved):
+            return solved
+
         if update is not None:
             u, rho = np.asarray(update[0], dtype=float), float(update[1])
             Su = self.solve(u)
@@ -204,21 +232,19 @@ class ShiftInvert:
                 return None
             weight = rho / denominator
 
-            def base(v):
-                y = self.solve(v)
-                return y - (weight * (Su @ v)) * Su
+            def base(v, solved):
+                return solved - (weight * (Su @ v)) * Su
         operator = base
         if constraints is not None and len(constraints):
             U = _orthonormal_rows(np.ascontiguousarray(np.atleast_2d(constraints), dtype=float), rcond).T
             if U.shape[1]:
-                SU = np.column_stack([base(U[:, k]) for k in range(U.shape[1])])
+                SU = np.column_stack([base(U[:, k], self.solve(U[:, k])) for k in range(U.shape[1])])
                 K = np.linalg.cholesky(U.T @ SU)
                 correction = linalg.solve_triangular(K, SU.T, lower=True).T  # S'U K⁻ᵀ: T = S' − C Cᵀ
 
-                def operator(v):
-                    return base(v) - correction @ (correction.T @ v)
-        nu = largest_by_lanczos(operator, n, count)
-        return np.sort(self.sigma + 1.0 / nu)
+                def operator(v, solved):
+                    return base(v, solved) - correction @ (correction.T @ v)
+        return operator
 
 
 def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
@@ -230,13 +256,25 @@ def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
     vector orthogonal to it; at n steps the space is everything and the Ritz values are the eigenvalues. As any
     single-vector Krylov method (ARPACK's too) it sees an exactly multiple eigenvalue once: its callers read
     states off any symmetry that forces one (an axisymmetric point 0 of a surface branch is solved dense)."""
+    run = _lanczos(n, count)
+    v = next(run)
+    while True:
+        try:
+            v = run.send(operator(v))
+        except StopIteration as done:
+            return done.value
+
+
+def _lanczos(n: int, count: int):
+    """``largest_by_lanczos`` as a generator: yields each vector the operator is to be applied to, is sent its
+    product, and returns the Ritz values (StopIteration.value); several runs can share their products' cost."""
     rng = np.random.default_rng(LANCZOS_START)
     V = np.empty((min(n, 4 * count + 40), n))
     alpha, beta = np.empty(n), np.empty(n)
     v = rng.standard_normal(n)
     V[0] = v / np.linalg.norm(v)
     for j in range(n):
-        w = operator(V[j])
+        w = yield V[j]
         alpha[j] = V[j] @ w
         basis = V[:j + 1]
         for _ in range(2):

@@ -145,7 +145,8 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
     Cholesky factorisation of its matrix with the fewest zero modes removed under pressure control (the lowest
     spectrum of its readings), shifted below the lowest guess (numerics.eigen.ShiftInvert), serves every reading:
     the other zero modes and the volume's gᵀc = 0 are constraints, the gas term a positive rank-one update in that
-    matrix's coordinates (numerics.eigen.restricted_rows). Without guesses, below FOLLOWING_SIZE, or without a
+    matrix's coordinates (numerics.eigen.restricted_rows); the readings' Lanczos runs share each solve
+    (numerics.eigen.ShiftInvert.lowest_of_relatives). Without guesses, below FOLLOWING_SIZE, or without a
     shift below the spectrum, each reading's matrix is solved dense (numerics.eigen.lowest_of)."""
     out = {r: {} for r in readings}
     for sector, H, g, groups, weight in _sectors(eq, c, params, readings, None):
@@ -155,31 +156,38 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
         shifted = None
         if previous and H.shape[0] - eigen.rank_of(base_rows) >= eigen.FOLLOWING_SIZE:
             shifted = eigen.ShiftInvert.below(_restricted(H, gram, base_rows), float(min(previous)))
-        for (_, control), (rows, shared) in groups.items():
-            values = None if shifted is None else _shifted_lowest(shifted, count, H, gram, base_rows, rows, control, g,
-                                                                  weight)
+        relatives = {}  # the readings read through the factorisation, in lockstep
+        for group, (rows, _) in groups.items() if shifted is not None else ():
+            relative = _relative(H, gram, base_rows, rows, group[1], g, weight)
+            if relative is not None:
+                relatives[group] = relative
+        found = {} if not relatives else dict(zip(relatives, shifted.lowest_of_relatives(
+            [(count, *relative) for relative in relatives.values()])))
+        for group, (rows, shared) in groups.items():
+            values = found.get(group)
             if values is None:
-                values = eigen.lowest_of(_reading_matrix(H, gram, rows, control, g, weight), count)
+                values = eigen.lowest_of(_reading_matrix(H, gram, rows, group[1], g, weight), count)
             for r in shared:
                 out[r][key] = values
     return out
 
 
-def _shifted_lowest(shifted, count: int, H, gram: float, base_rows, rows, control: Control, g, weight):
-    """The ``count`` lowest μ of one reading through the factorisation ``shifted`` of the matrix without the zero
-    modes ``base_rows`` (``sector_spectra``), or None where the gas term does not keep the shift a lower bound."""
+def _relative(H, gram: float, base_rows, rows, control: Control, g, weight):
+    """(constraints, update) of one reading in the coordinates of the matrix without the zero modes ``base_rows``
+    (``sector_spectra``: ``eigen.ShiftInvert.lowest``'s arguments), or None where its matrix is small (solved
+    dense, as lowest_following would)."""
     diagonal = np.full(H.shape[0], gram)
     factor = eigen.GramFactor(diagonal, orthogonal=True)
     normals = base_rows * diagonal
     extra = np.vstack([rows * diagonal] + ([g[None, :]] if control == Control.VOLUME else []))
     if H.shape[0] - eigen.rank_of(factor.directions(extra)) < eigen.FOLLOWING_SIZE:
-        return None  # this reading's matrix is small: dense, as lowest_following would
+        return None
     constraints = eigen.restricted_rows(factor, normals, extra) if extra.size else None
     update = None
     if control == Control.GAS:
         u = eigen.restricted_rows(factor, normals, g[None, :])
         update = (u[0], weight) if len(u) else None
-    return shifted.lowest(count, constraints, update)
+    return constraints, update
 
 
 def spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
