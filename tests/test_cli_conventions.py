@@ -344,13 +344,17 @@ def test_critical_interrupted_before_its_curve_leaves_the_output_alone(tmp_path,
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
     """Members of a few seconds each on 2 workers: the signal comes once the first member is stored; the
-    running members are abandoned (workers terminated), the stored ones kept, and the same command resumes."""
+    running members are abandoned (workers terminated), the stored ones kept, and the same command resumes.
+    "Within a second" on an idle machine; a loaded one slows the stop as it slows the members, so the bound is
+    max(2 s, half the time the first member took from launch): waiting for the running members instead would take
+    about a member's time (the stress runs of session 14 saw 5 s at load 6, where the first member took far more)."""
     out = tmp_path / "sweep.h5"
     command = [sys.executable, "-m", "balloon_cg", "sweep", "spom1_two_coils_M0.002", "--vary",
                "M=0.001,0.0012,0.0014,0.0016,0.0018,0.002", "--no-pear", "--workers", "2", "-o", str(out), "--quiet"]
+    launched = time.monotonic()
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     store = Path(f"{out}.members")
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + 600
     while not any(store.glob("0*.h5")) and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.1)
     if process.poll() is not None:  # say how it ended (seen once under load: no diagnosis was printed)
@@ -358,8 +362,9 @@ def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
                     f"{sorted(p.name for p in store.glob('*'))}; stderr: {process.communicate()[1][-3000:]}")
     started = time.monotonic()
     process.send_signal(sig)
-    _, err = process.communicate(timeout=60)
-    assert process.returncode == 130 and time.monotonic() - started < 2.0, err
+    _, err = process.communicate(timeout=600)
+    stopped, first_member = time.monotonic() - started, started - launched
+    assert process.returncode == 130 and stopped < max(2.0, first_member / 2), (stopped, first_member, err)
     assert "interrupted" in err and "Traceback" not in err
     stored = len(list(store.glob("0*.h5")))
     assert 1 <= stored < 6
