@@ -75,6 +75,22 @@ def test_a_whole_sphere_picture_without_branch_points_is_complete():
     assert picture.not_searched == "" and picture.not_switched == [] and picture.incomplete == []
 
 
+def test_events_of_a_whole_sphere_scene_are_said_to_be_unsearched():
+    """[[events]] are not located on branches traced on the whole sphere: the verdict says so (not a silent gap)."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis.picture import WHOLE_SPHERE_EVENTS, analyse
+    from balloon_cg.scene import load_scene, parse_scene
+    from test_surface_primary import _scene, _turned
+
+    coils = [_turned(c, math.radians(30)) for c in load_scene(TWO_COILS).field.coils]
+    scene = _scene(coils, **{"continuation.stop_stretch": 1.03, "continuation.max_points": 6})
+    events = parse_scene('[material]\npreset = "SPOM1"\n[[events]]\nquantity = "volume"\nvalue = 5\n', "s").events
+    picture = analyse(replace(scene, events=events))
+    assert picture.not_searched == WHOLE_SPHERE_EVENTS
+    assert [item.gap.value for item in picture.incomplete] == ["not_searched"]
+
+
 TWO_COILS = "scenes/spom1_two_coils_M0.002.toml"
 # the pear point before λ = 1.5; max_error 1e-6: degree 44 at the pear point (1e-9 asks for 68, ~10× the time)
 SETTINGS = {"M": 0.1, "continuation.stop_stretch": 1.5, "surface.degree": 12, "solver.max_error": 1e-6}

@@ -249,6 +249,9 @@ def _unsearched(primary: Branch, searched: bool) -> str:
     return missing
 
 
+WHOLE_SPHERE_EVENTS = "the [[events]] are not located on branches traced on the whole sphere"
+
+
 def _whole_sphere(scene, progress: Progress, clock: Clock, pear: bool) -> Picture:
     """The picture of a field that is not axisymmetric: its primary branch traced on the whole sphere, assessed
     held under every control, its secondary branch points located (``surface_primary``), and the branches born at
@@ -258,6 +261,8 @@ def _whole_sphere(scene, progress: Progress, clock: Clock, pear: bool) -> Pictur
     primary = surface_primary.trace_surface_primary(scene, progress.ticker(Phase.PRIMARY), clock)
     progress.finish(Phase.PRIMARY, len(primary.values))
     picture = Picture([], surface_branches=[primary], clock=clock)
+    if scene.events:
+        picture.not_searched = WHOLE_SPHERE_EVENTS
     if _stopped(picture) or not pear or scene.surface.branches == "none":
         return picture
     search = surface_pitchforks.pitchforks(primary)
