@@ -66,21 +66,32 @@ def event_points(branch: Branch) -> list[SpecialPoint]:
         note = f"{event.quantity.value} = {event.value:g}"
         if offset[0] == 0:
             found.append(SpecialPoint(Kind.UZ, 0, branch.X[0].copy(), note=note))
-        for i in np.flatnonzero((offset[:-1] != 0) & (offset[:-1] * offset[1:] <= 0)):
-            before, after = branch.X[i], branch.X[i + 1]
-            point = land(system, before, after, quantity, event.value, settings)
+        for i, point, t in crossings(system, branch.X, offset, quantity, event.value, settings):
             if point is not None:
-                found.append(SpecialPoint(Kind.UZ, int(i), point.X, note=note))
+                found.append(SpecialPoint(Kind.UZ, i, point.X, note=note))
                 continue
-            X = before + offset[i] / (offset[i] - offset[i + 1]) * (after - before)
-            found.append(SpecialPoint(Kind.UZ, int(i), X, note=note, **approximate(
-                branch.disc, before, after, f"{note}: Newton did not land on the value; the linear interpolant")))
+            before, after = branch.X[i], branch.X[i + 1]
+            found.append(SpecialPoint(Kind.UZ, i, before + t * (after - before), note=note, **approximate(
+                branch.disc, before, after, f"{note}: {NOT_LANDED}")))
     return found
 
 
-def with_events(branch: Branch) -> Branch:
-    """``branch`` with its UZ points (``event_points``) among its special points, ordered by index."""
-    points = event_points(branch)
+NOT_LANDED = "Newton did not land on the value; the linear interpolant"
+
+
+def crossings(system, X: np.ndarray, offset: np.ndarray, quantity, value: float, settings):
+    """Per interval i of the points X where ``offset`` = q(X) − value changes sign: (i, the point Newton landed on
+    q = value (``assembly.land``) or None, the fraction t of the interval where the linear interpolant of the
+    offset vanishes)."""
+    for i in np.flatnonzero((offset[:-1] != 0) & (offset[:-1] * offset[1:] <= 0)):
+        t = offset[i] / (offset[i] - offset[i + 1])
+        yield int(i), land(system, X[i], X[i + 1], quantity, value, settings), t
+
+
+def with_events(branch: Branch, points: list | None = None) -> Branch:
+    """``branch`` with its UZ points (``points``, default ``event_points``) among its special points, ordered by
+    index."""
+    points = event_points(branch) if points is None else points
     if points:
         branch.special = sorted(branch.special + points, key=lambda s: s.index)
     return branch
@@ -125,28 +136,23 @@ def surface_event_points(branch: SurfaceBranch, system) -> list[SpecialPoint]:
         quantity = surface_quantity(system, event.quantity)
         offset = np.array([quantity[0](x) for x in X]) - event.value
         note = f"{event.quantity.value} = {event.value:g}"
-        for i in np.flatnonzero((offset[:-1] != 0) & (offset[:-1] * offset[1:] <= 0)):
-            point = land(system, X[i], X[i + 1], quantity, event.value, settings)
+        for i, point, t in crossings(system, X, offset, quantity, event.value, settings):
             if point is not None:
-                found.append(SpecialPoint(Kind.UZ, int(i), np.append(system.coefficients(point.X), point.X[-1]),
+                found.append(SpecialPoint(Kind.UZ, i, np.append(system.coefficients(point.X), point.X[-1]),
                                           note=note))
                 continue
-            t = offset[i] / (offset[i] - offset[i + 1])
             c = branch.coefficients[i] + t * (branch.coefficients[i + 1] - branch.coefficients[i])
             P0, P1 = branch.values[i], branch.values[i + 1]
-            found.append(SpecialPoint(Kind.UZ, int(i), np.append(c, P0 + t * (P1 - P0)), note=note,
+            found.append(SpecialPoint(Kind.UZ, i, np.append(c, P0 + t * (P1 - P0)), note=note,
                                       status=Status.APPROXIMATE, uncertainty=0.5 * abs(P1 - P0),
-                                      reason=f"{note}: Newton did not land on the value; the linear interpolant"))
+                                      reason=f"{note}: {NOT_LANDED}"))
     return found
 
 
 def with_surface_events(branch: SurfaceBranch, system) -> SurfaceBranch:
     """``branch`` with its UZ points (``surface_event_points``) among its special points, ordered by index (its
     origin, point 0, first)."""
-    points = surface_event_points(branch, system)
-    if points:
-        branch.special = sorted(branch.special + points, key=lambda s: s.index)
-    return branch
+    return with_events(branch, surface_event_points(branch, system))
 
 
 def unlocated_on_surface(scene) -> str:

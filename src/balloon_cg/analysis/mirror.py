@@ -34,6 +34,8 @@ from .problem import branch_system
 from .results import Branch, Kind, Leg, Origin, SpecialPoint, Stop, StopCode
 from .switching import Turn, south_stop_stretch
 
+MIRROR = "_mirror"  # the suffix of a branch's mirror image (a pear branch's, a whole-sphere pitchfork branch's)
+
 
 def reflectable(scene) -> bool:
     """Whether the scene is invariant under z → −z (its coils are: ``Field.is_equator_symmetric``)."""

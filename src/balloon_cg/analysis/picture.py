@@ -29,6 +29,7 @@ from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, e
                surface_pitchforks, surface_primary)
 from ..scene import Control
 from .control import control_values, minimised_energy
+from .mirror import MIRROR
 from .primary import trace_primary
 from .problem import equilibrium_of
 from .results import Block, Branch, Gauge, Kind, Origin, Status, StopCode
@@ -40,7 +41,6 @@ from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 
 
-MIRROR = "_mirror"  # the suffix of a pear branch's mirror image
 BROKEN = "broken_pear"  # the pear branch a broken equator symmetry disconnects (``broken_symmetry``)
 PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear branch's name: <prefix>_<BP number>
 MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",

@@ -34,11 +34,10 @@ from scipy import linalg
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability
 from ..surface.embedding import embedded
+from .mirror import MIRROR
 from .results import Kind, Origin, SpecialPoint, Status, SurfaceBranch
 from .surface_branches import CRITICAL_SEARCH, SurfaceTrace, branch_of, collected, leave, reflected
 from .surface_primary import READINGS, with_loads
-
-MIRROR = "_mirror"  # the suffix of a bifurcating branch's image under the reflection its mode breaks
 
 
 @dataclass

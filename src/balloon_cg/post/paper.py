@@ -25,7 +25,8 @@ from .fit import fit_titles, fitted_legend
 from .style import JournalFigure, journal_style
 from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
 from ..analysis.control import control_values, minimised_energy
-from ..analysis.picture import MIRROR, Curve, find_snaps
+from ..analysis.mirror import MIRROR
+from ..analysis.picture import Curve, find_snaps
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..scene import Control, parse_scene
 
