@@ -173,3 +173,36 @@ def test_critical_of_LP_from_the_command_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "--of" in err and "'LX'" in err and "LP" in err and "LN" in err
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_phase_diagram_shades_between_the_upper_and_the_lower_fold(tmp_path, capsys):
+    """Gent's two pressure folds (the maximum and the minimum of P) each continued in Jm upward from its label: two
+    curves that never meet (the cusp is below, Jm = 17.6). `plot --what phase` of both shades the bistable region
+    between them over the Jm both span, bounded by the two curves (through every stored point); one curve alone is
+    drawn without shading."""
+    from balloon_cg.io.run_file import read_run
+    from balloon_cg.post.plotting import plot
+
+    scene = tmp_path / "gent.toml"
+    scene.write_text(GENT + "max_points = 80\n")
+    run = tmp_path / "gent.h5"
+    assert main(["run", str(scene), "--primary-only", "-o", str(run), "--quiet"]) == 0
+    labels = [s["label"] for s in read_run(run)["branches"]["primary"]["special_points"] if s["kind"] == "LP"]
+    assert len(labels) == 2
+    curves = [tmp_path / f"fold{label}.h5" for label in labels]
+    for label, out in zip(labels, curves):
+        assert main(["continue", str(run), str(label), "--parameter", "material.parameters.Jm", "-o", str(out),
+                     "--quiet"]) == 0
+    capsys.readouterr()
+    (q1, P1), (q2, P2) = [(read_curve(out, "LP")["q"], read_curve(out, "LP")["pressure"]) for out in curves]
+    assert np.all(np.diff(q1) > 0) and np.all(np.diff(q2) > 0) and P2[0] < P1[0]
+    [shaded] = plot(curves, "phase").axes[0].collections
+    assert shaded.get_label() == "bistable: snap-through between the two LP curves"
+    q, P = shaded.get_paths()[0].vertices.T
+    high = min(q1[-1], q2[-1])
+    assert q.min() == pytest.approx(97.2, abs=1e-9) and q.max() == pytest.approx(high, rel=1e-12)
+    for qs, Ps in ((q1, P1), (q2, P2)):  # every stored point of either curve in the overlap is on the boundary
+        inside = qs <= high
+        distance = np.hypot((q[:, None] - qs[inside]) / np.ptp(q), (P[:, None] - Ps[inside]) / np.ptp(P)).min(axis=0)
+        assert distance.max() < 1e-12
+    assert not plot(curves[:1], "phase").axes[0].collections

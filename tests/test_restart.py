@@ -98,6 +98,7 @@ def test_continue_from_a_user_point_of_the_two_coil_branch(tmp_path):
     for kind, tolerance in (("LP", 1e-10), ("UZ", 1e-10), ("TP", original.scene.solver.max_error)):
         before, after = [s["pressure"] for _, s in special(path, kind)], [s["pressure"] for _, s in special(out, kind)]
         assert len(before) == len(after) == 1 and abs(before[0] - after[0]) < tolerance, kind
+    assert "stability" not in read_run(out)["branches"]["primary"]  # as the stored branch: traced, not assessed
 
 
 def test_continue_from_the_pear_pitchfork_gives_the_critical_curve(tmp_path, capsys):
@@ -162,6 +163,15 @@ def two_coils(tmp_path_factory):
     return folder
 
 
+def leaves(group, prefix=""):
+    """(path, value) of every dataset of a read group (nested dicts), e.g. a branch's stability."""
+    for key, value in group.items():
+        if isinstance(value, dict):
+            yield from leaves(value, f"{prefix}{key}/")
+        else:
+            yield prefix + key, value
+
+
 def first(path, kind, block=""):
     """The label of the first special point of ``kind`` (and ``block``) of the primary branch of a run file."""
     return next(s["label"] for s in read_run(path)["branches"]["primary"]["special_points"]
@@ -188,6 +198,22 @@ def test_continue_in_M_from_a_two_coil_label_gives_the_critical_curve(two_coils,
     assert np.abs(restarted["pressure"] - traced["pressure"]).max() < 1e-10
 
 
+def test_continue_from_the_fold_of_an_assessed_run_locates_its_special_points_again(two_coils):
+    """Restart in P from the LP of a run that was assessed: the branch is assessed again and its special points
+    (LP, the held and free pear pitchforks, the m = 1 points, the ends) are the run's, in kind, block and
+    classification, at the same P to 1e-10 (measured 3.3e-13). The restart starts one step away from the fold
+    (``restart.step_away``): from the fold itself the even block's zero eigenvalue at the first point had a
+    rounding sign, and a spurious transcritical BP was located there."""
+    run, out = two_coils / "run.h5", two_coils / "from_lp.h5"
+    assert main(["continue", str(run), str(first(run, "LP")), "-o", str(out), "--quiet"]) == 0
+    before, after = [read_run(path)["branches"]["primary"] for path in (run, out)]
+    assert "stability" in after
+    key = [(s["kind"], s["block"], s["classification"]) for s in before["special_points"]]
+    assert len(key) == 7 and key == [(s["kind"], s["block"], s["classification"]) for s in after["special_points"]]
+    assert max(abs(a["pressure"] - b["pressure"])
+               for a, b in zip(before["special_points"], after["special_points"])) < 1e-10
+
+
 @pytest.mark.parametrize("block, name", [("odd_held", "pear_0"), ("odd_free", "pear_free_1")])
 def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, block, name, capsys):
     """`continue RUN LABEL` at a pear pitchfork, held or free (no --parameter): the pear branch and its mirror
@@ -204,6 +230,13 @@ def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, blo
         assert a.shape == b.shape and np.abs(a - b).max() < 1e-10
         assert switched[branch]["attrs"]["gauge"] == stored[branch]["attrs"]["gauge"]
         assert switched[branch]["attrs"]["parent_branch_point"] == stored[branch]["attrs"]["parent_branch_point"]
+        stability, again = dict(leaves(stored[branch]["stability"])), dict(leaves(switched[branch]["stability"]))
+        assert sorted(stability) == sorted(again) and any(k.startswith("lowest_m1") for k in stability)
+        for key, value in stability.items():  # assessed as run assesses it (measured 4.5e-13)
+            assert np.asarray(value).shape == np.asarray(again[key]).shape
+            assert np.allclose(value, again[key], rtol=0, atol=1e-10, equal_nan=True), key
+        assert [(s["kind"], s["block"]) for s in stored[branch]["special_points"]] == [
+            (s["kind"], s["block"]) for s in switched[branch]["special_points"]]
     assert np.array_equal(switched["primary"]["unknowns"], stored["primary"]["unknowns"])
     if block == "odd_held":  # the same from Python
         import balloon_cg as bc

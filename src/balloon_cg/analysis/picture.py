@@ -154,6 +154,15 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     with clock.step(Step.TRACE):
         primary = trace_primary(scene, progress=progress.ticker(Phase.PRIMARY))
     progress.finish(Phase.PRIMARY, len(primary.X))
+    return examine(scene, primary, progress, pear, clock)
+
+
+def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool = True,
+            clock: Clock | None = None) -> Picture:
+    """The picture of an axisymmetric scene from its traced primary branch (``analyse`` after the trace; also
+    ``continue``'s restarted branch): assessed, its branch points located, the branches born there followed as
+    ``pear`` and ``[surface] branches`` ask, the m ≥ 1 points of every branch, the snap-throughs."""
+    progress, clock = progress or Progress(), clock or Clock()
     picture = Picture([primary], clock=clock)
     if _stopped(picture):
         return picture
@@ -179,12 +188,8 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
             _trace_pears(scene, primary, picture, progress)
         progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
     progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
-    for branch in picture.branches:  # m ≥ 1 branch points: on the branches, not in picture.branch_points
-        if _stopped(picture):
-            return picture
-        with clock.step(Step.CROSSINGS):
-            branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
-        branch.special.sort(key=_along)
+    if not azimuthal_crossings(picture, picture.branches, scene):
+        return picture
     if pear and scene.surface.branches != "none":
         with clock.step(Step.SURFACE_BRANCHES):
             _trace_surface(scene, primary, picture, progress)
@@ -193,6 +198,18 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
     return picture
+
+
+def azimuthal_crossings(picture: Picture, branches: list, scene) -> bool:
+    """The m ≥ 1 branch points of each of ``branches`` (``azimuthal_points``: on the branches, not in
+    ``picture.branch_points``), in their order along it; False when a signal stopped the search."""
+    for branch in branches:
+        if _stopped(picture):
+            return False
+        with picture.clock.step(Step.CROSSINGS):
+            branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
+        branch.special.sort(key=_along)
+    return True
 
 
 def _along(s) -> tuple:

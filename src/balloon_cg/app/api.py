@@ -402,8 +402,9 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     Returns
     -------
     Result or FoldCurve or TwoParameterCurve
-        Without ``parameter``, the branch through the point (a Result whose branch is ``primary``), or at a branch
-        point the branches bifurcating there (a Result of the point's branch, not assessed, and of them: ``pear_<n>``
+        Without ``parameter``, the branch through the point (a Result whose branch is ``primary``, assessed and its
+        branch points located if the stored branch was), or at a branch point the branches bifurcating there (a Result of the point's
+        branch as read, not assessed, and of them, assessed: ``pear_<n>``
         and ``pear_<n>_mirror`` at a pear point, ``m<m>_bp<k>`` and its other direction at a held m ≥ 1 point);
         from a fold (LP, LV, LN) or a pear pitchfork (held or free) in ``parameter``, the two-parameter curve
         (``end``, ``critical``, ``q``, ``pressure``).
@@ -421,7 +422,7 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     >>> curve = bc.continue_from("gent.h5", 2, parameter="material.parameters.Jm", direction=-1)
     """
     from ..analysis.picture import Picture
-    from ..analysis.results import Branch
+    from ..analysis.results import Kind
     from ..io.run_file import read_run
     from .restart import find_label, restart
 
@@ -431,12 +432,10 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     command = f"balloon_cg.continue_from({str(path)!r}, {label})"
     if isinstance(result, Picture):
         branches = result.branches + result.surface_branches
-        if len(branches) == 1:
+        if len(branches) == 1 and start.point.kind == Kind.BP:
             raise RuntimeError(f"no branch started at label {label}: " + "; ".join(
                 f"{name}: {reason}" for name, reason in result.not_started))
         return Result.of(branches[0].scene, branches, found=result.incomplete, picture=result, command=command)
-    if isinstance(result, Branch):
-        return Result.of(result.scene, [result], command=command)
     return result
 
 

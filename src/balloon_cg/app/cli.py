@@ -802,11 +802,12 @@ def _add_continue(commands):
     p = commands.add_parser(
         "continue", help="restart from a labelled special point of a run file (inspect shows the labels)",
         description="Restart from the special point LABEL of a run file: without --parameter (or with the "
-                    "branch's own, P) the branch through it is traced again in both directions (a run file with "
-                    "one branch, primary), and at a branch point of an equator-symmetric branch the branches "
-                    "bifurcating there instead (a pear point, held or free: the pear branch and its mirror image; "
-                    "a held m >= 1 point: the non-axisymmetric branch and its other direction; a run file of "
-                    "those after the branch of the point as read, none assessed); with --parameter KEY (a scene "
+                    "branch's own, P) the branch through it is traced again in both directions (a run file with one "
+                    "branch, primary; assessed and its branch points located if the stored branch was), "
+                    "and at a branch point of an equator-symmetric branch the branches bifurcating there instead "
+                    "(a pear point, held or free: the pear branch and its mirror image; a held m >= 1 point: the "
+                    "non-axisymmetric branch and its other direction; a run file of those, assessed as run "
+                    "assesses them, after the branch of the point as read); with --parameter KEY (a scene "
                     "key, as for critical) from a fold (LP, LV, LN) the fold curve in KEY and its cusp, from a "
                     "pear pitchfork (BP odd_held or odd_free) the curve of pitchforks and the isola's critical "
                     "value (a curve file). Exit 0: written; 1: the computation did not give it (the curve or no "
@@ -836,7 +837,7 @@ def _continue(args) -> int:
     """``continue`` into ``args.output`` (owned)."""
     from ..analysis.codim2 import TwoParameterError
     from ..analysis.picture import Picture
-    from ..analysis.results import Branch
+    from ..analysis.results import Kind
     from ..analysis.second_parameter import UnknownParameter
     from ..io.curve_file import write_curve
     from ..io.output import check_output
@@ -853,12 +854,14 @@ def _continue(args) -> int:
     except TwoParameterError as e:
         raise Failure(f"the curve from label {args.label} could not start: {e}") from None
     attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
-    if isinstance(result, Picture):
+    if isinstance(result, Picture) and start.point.kind == Kind.BP:
         return _write_switched(args, result, attrs)
-    if isinstance(result, Branch):
-        write_run(args.output, result.scene, [result], force=args.force, extra_attrs=attrs)
-        print(f"branch continued from label {args.label}: {len(result.X)} points ({result.stop_reason}); written "
-              f"to {args.output}")
+    if isinstance(result, Picture):
+        branch = result.primary
+        write_run(args.output, branch.scene, result.branches, force=args.force, extra_attrs=attrs,
+                  found=result.incomplete)
+        print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
+              f"{len(branch.special)} special points; written to {args.output}")
         return 0
     write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
     ending = f"{result.end.value}: {result.describe()}"

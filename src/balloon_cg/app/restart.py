@@ -5,11 +5,14 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
 
 - in the branch's own parameter (P, or Φ̄ of a voltage continuation; ``parameter`` None or that name): from a
   point that is no branch point, the branch through it is traced again in both directions from it, with the
-  scene's stop rules and ``[[events]]``, on the stored discretisation (``restart_branch``: a Branch named
-  primary); from a branch point of an equator-symmetric branch, the branches bifurcating there (``switch``):
-  at a pear point (odd_held, or odd_free: the free balloon) the pear branch and its mirror image, as ``run``
-  traces them (``picture.pear_pair``, its critical mode recomputed: ``pear_point``), at a held m ≥ 1 point the
-  non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``), not assessed;
+  scene's stop rules and ``[[events]]``, on the stored discretisation, and, if the stored branch was assessed
+  (a run without --primary-only), assessed with its branch points and m ≥ 1 points located as ``run`` gives them
+  (``restart_branch``: a Picture of one branch, primary); from a branch point of an equator-symmetric branch,
+  the branches bifurcating there (``switch``): at a pear point (odd_held, or odd_free: the free balloon) the pear branch and its mirror image, as ``run``
+  traces them (``picture.pear_pair``, its critical mode recomputed: ``pear_point``), assessed and with their
+  m ≥ 1 points as ``run`` gives them, at a held m ≥ 1 point the non-axisymmetric branch and its other direction
+  on the whole sphere (``picture.surface_pair``, assessed as ``run`` assesses it); the branch of the point is
+  written as read (its stored stability is not read back);
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
   (``analysis.fold_curve.continue_fold``);
 - a pear branch point (BP of block odd_held, or odd_free: the free balloon's, on an equator-symmetric branch) in q:
@@ -32,8 +35,8 @@ from ..analysis.fold_curve import CONTROL_OF_FOLD, continue_fold
 from ..analysis.primary import landing_targets, range_limits, stop_rule
 from ..analysis.branch_point import WernerSpence
 from ..analysis.codim2 import continue_branch_point, plain_branch
-from ..analysis.picture import (PEAR_NAMES, Picture, Progress, label_readings, pear_pair, surface_pair,
-                                unsearched_events)
+from ..analysis.picture import (PEAR_NAMES, Picture, Progress, azimuthal_crossings, examine, label_readings,
+                                pear_pair, surface_pair, unsearched_events)
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.surface_branches import SurfaceStartError
@@ -55,6 +58,7 @@ class Labelled:
     label: int
     branch: Branch
     point: SpecialPoint
+    assessed: bool = False  # the stored branch has its stability (a run without --primary-only)
 
 
 def stored_branch(run: dict, name: str) -> Branch:
@@ -113,15 +117,16 @@ def find_label(run: dict, label: int) -> Labelled:
                 raise RestartError(f"label {label}: a point of the surface branch {name}; continue starts from "
                                    "axisymmetric branches only")
             branch = stored_branch(run, name)
-            return Labelled(label, branch, branch.special[row])
+            return Labelled(label, branch, branch.special[row], "stability" in data)
     listed = f"{min(labels)}..{max(labels)}" if labels else "none"
     raise RestartError(f"label {label}: no special point has it in {run['path']} (its labels: {listed}; "
                        "balloon-cg inspect shows them)")
 
 
-def restart_branch(start: Labelled, progress=None) -> Branch:
+def restart_branch(start: Labelled, progress=None) -> Picture:
     """The branch through the labelled point, traced again from it in both directions in the branch's parameter
-    (module docstring), on the stored degree and basis map."""
+    (module docstring), on the stored degree and basis map; if the stored branch was assessed, assessed and its
+    branch points and m ≥ 1 points located (``picture.examine``, no branch switched), as ``run`` gives them."""
     t0 = time.perf_counter()
     branch, scene = start.branch, start.branch.scene
     disc = branch.disc
@@ -129,16 +134,33 @@ def restart_branch(start: Labelled, progress=None) -> Branch:
     tracer = Tracer(scene, disc.symmetric, held)
     params = branch.params
     system = tracer.system(disc.degree, params, disc.mapping)
-    north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
-    X = start.point.X
-    tangent = continuation.tangent(system, X, north)
+    point = step_away(system, start, tracer.settings)
     upper = scene.continuation.stop_stretch
     stop, limits = stop_rule(scene, upper), range_limits(scene, upper)
-    residual = float(np.abs(system.residual(X)).max())
-    legs = [tracer.leg(continuation.Point(X, sign * tangent, 0, residual), params, stop, progress,
-                       degree=disc.degree, mapping=disc.mapping, limits=limits) for sign in (1.0, -1.0)]
-    return with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0,
-                                land_on=landing_targets(scene, upper), labels=("up", "down")))
+    legs = [tracer.leg(replace(point, tangent=sign * point.tangent), params, stop, progress, degree=disc.degree,
+                       mapping=disc.mapping, limits=limits) for sign in (1.0, -1.0)]
+    primary = with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0,
+                                   land_on=landing_targets(scene, upper), labels=("up", "down")))
+    return examine(scene, primary, Ticks(progress), pear=False) if start.assessed else Picture([primary])
+
+
+def step_away(system, start: Labelled, settings: continuation.Settings) -> continuation.Point:
+    """The start of a restart: the labelled point moved one continuation step (``settings.step``, else a tenth,
+    a hundredth of it) along the branch toward its interior (Keller's corrector), with its tangent along the
+    stored order of the points. Not the point itself: there the test function that located it (P′, V′, λ2′, the
+    event's quantity − value, …) is zero, so its sign at the first point of a leg would be rounding, and at a
+    turning point of λ2(0) a tangent oriented by it is undefined."""
+    X, rows, i = start.point.X, start.branch.X, start.point.index
+    along = rows[i + 1] - rows[i] if i + 1 < len(rows) else rows[i] - rows[i - 1]
+    tangent = continuation.tangent(system, X, along)
+    side = 1.0 if i == 0 else -1.0
+    for h in settings.step * np.array([1.0, 0.1, 0.01]):
+        result = continuation.correct(system, X + side * h * tangent, tangent, settings)
+        if result.converged:
+            return continuation.Point(result.x, continuation.tangent(system, result.x, tangent), result.iterations,
+                                      float(np.abs(system.residual(result.x)).max()))
+    raise RestartError(f"label {start.label}: the corrector did not converge one step (down to "
+                       f"{0.01 * settings.step:g}) from the point along its branch")
 
 
 def pear_point(branch: Branch, start: Labelled) -> SpecialPoint:
@@ -173,7 +195,7 @@ class Ticks(Progress):
 
 def switch(start: Labelled, progress=None) -> Picture:
     """The branches bifurcating at the branch point ``start`` (module docstring) in a Picture: ``branches`` the
-    stored branch of the point (as read: not assessed) and the pear branches, ``surface_branches`` the
+    stored branch of the point (as read: not assessed) and the pear branches (assessed), ``surface_branches`` the
     non-axisymmetric ones, ``not_started`` those that could not start; RestartError for a point this does not
     switch at."""
     branch, point, label = start.branch, start.point, start.label
@@ -192,9 +214,10 @@ def switch(start: Labelled, progress=None) -> Picture:
         n = next(i for i, s in enumerate(points) if s is point)
         points[n] = replace(point, mode=pear_point(plain_branch(branch, point.X), start).mode)
         picture = Picture([branch], branch_points=points)
-        pear_pair(branch.scene, branch, picture, n, progress, assess=False)
+        if pear_pair(branch.scene, branch, picture, n, progress):
+            azimuthal_crossings(picture, picture.branches[1:], branch.scene)
         label_readings(picture.branches[1:])
-        return Picture(picture.branches, not_started=picture.not_started)
+        return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted)
     if point.m >= 1 and point.block.held:
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
         try:
@@ -210,8 +233,8 @@ def switch(start: Labelled, progress=None) -> Picture:
 
 
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
-    """What ``continue`` computes from ``start`` (module docstring): a Branch (in the branch's own parameter), a
-    Picture of the branches switched to (a branch point, in its own parameter) or a two-parameter curve (a fold
+    """What ``continue`` computes from ``start`` (module docstring): a Picture (in the branch's own parameter: of
+    the branch through it, or at a branch point of the branch of the point and the branches switched to) or a two-parameter curve (a fold
     or a pear point in a second parameter); RestartError for what is not built."""
     own = start.branch.parameter
     kind = start.point.kind

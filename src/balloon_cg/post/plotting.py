@@ -980,7 +980,7 @@ def plot_phase(paths, axes=None) -> Figure:
     where the isola exists (q between its start and the critical value, P between the two pitchfork pressures),
     or where the balloon snaps through (between the two folds), is shaded."""
     fig, (ax,), _ = _panels(axes, 1, (6.4, 4.6))
-    parameters, kinds = set(), set()
+    parameters, kinds, open_folds = set(), set(), {}
     if any(isinstance(path, dict) for path in paths):
         raise PlotError("phase draws curve files (balloon-cg critical) or sweep files, not runs")
     for path in paths:
@@ -1019,6 +1019,10 @@ def plot_phase(paths, axes=None) -> Figure:
                 ax.plot(critical, P_merge, "o", color=line.get_color())
                 ax.annotate(f"{'critical' if of == 'BP' else 'cusp'} {curve['attrs']['parameter']} = {critical:.6g}",
                             (critical, P_merge), textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
+            elif of != "BP":
+                open_folds.setdefault((of, curve["attrs"]["parameter"]), []).append((q, P))
+    for (of, parameter), folds in open_folds.items():
+        _shade_between_folds(ax, of, folds)
     parameter = parameters.pop() if len(parameters) == 1 else "q"
     ax.set_xlabel(PARAMETER_LABELS.get(parameter, parameter))
     if kinds <= {"BP"}:
@@ -1029,6 +1033,25 @@ def plot_phase(paths, axes=None) -> Figure:
         ax.set_title("pitchforks and folds (snap-through between a fold curve's two branches)")
     ax.legend()
     return fig
+
+
+def _shade_between_folds(ax, of: str, folds: list) -> None:
+    """Shade the bistable region between two fold curves of one kind (``of``: LP, LV, LN), each traced on its own
+    (the upper and the lower fold, e.g. ``continue`` from each, not met in a cusp): P between them over the q both
+    span (PCHIP through their stored points), where each is single-valued in q (a curve that turns in q has its
+    cusp or merge and is shaded whole).
+    Under that control the balloon snaps through at one fold and back at the other: between them two stable states.
+    With one such curve, or more than two, nothing is shaded."""
+    if len(folds) != 2 or any(np.any(np.diff(q) == 0) or np.any(np.diff(np.sign(np.diff(q)))) for q, _ in folds):
+        return
+    low, high = max(q.min() for q, _ in folds), min(q.max() for q, _ in folds)
+    if not low < high:
+        return
+    dense = np.union1d(np.linspace(low, high, 400), [x for q, _ in folds for x in q if low <= x <= high])
+    edges = [PchipInterpolator(*(np.array(v)[::-1] if q[0] > q[-1] else np.array(v) for v in (q, P)))(dense)
+             for q, P in folds]
+    ax.fill_between(dense, edges[0], edges[1], alpha=0.15, color="0.5",
+                    label=f"bistable: snap-through between the two {of} curves")
 
 
 def _with_points(q, P, extra):
