@@ -807,6 +807,7 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
 
     if axes is None:
         fig = JournalFigure(figsize=(10.0, 5.4), layout="constrained")
+        fig.get_layout_engine().set(wspace=0.08)  # the layout does not see mplot3d's z label: room for it
         ax, own = fig.add_subplot(1, 2, 1, projection="3d"), True
         _mirror_section(fig.add_subplot(1, 2, 2), branch, index)
     else:
