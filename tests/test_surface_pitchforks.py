@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis import verdict
-from balloon_cg.analysis.results import Kind, Origin
+from balloon_cg.analysis.results import Gauge, Kind, Origin
 from balloon_cg.analysis.surface_pitchforks import kept_reflections
 from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 
@@ -63,7 +63,8 @@ def test_a_branch_point_in_the_own_sector_is_a_typed_limitation():
 
 def test_a_whole_sphere_picture_without_branch_points_is_complete():
     """The turned two-coil scene to λ = 1.06 (no branch point yet): the picture is the primary alone, with nothing
-    left unsearched or unswitched (before this slice it said the branches at its branch points were not traced)."""
+    left unsearched or unswitched (before this slice it said the branches at its branch points were not traced);
+    its special points (the end point) are of its reading, held (they were left `both`)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.scene import load_scene
     from test_surface_primary import _scene, _turned
@@ -73,6 +74,7 @@ def test_a_whole_sphere_picture_without_branch_points_is_complete():
     assert [b.name for b in picture.surface_branches] == ["primary"]
     assert not any(s.kind == Kind.BP for s in picture.primary.special)
     assert picture.not_searched == "" and picture.not_switched == [] and picture.incomplete == []
+    assert {s.gauge for s in picture.primary.special} == {Gauge.HELD}  # its reading (the EP at least)
 
 
 def test_events_of_a_whole_sphere_scene_are_said_to_be_unsearched():

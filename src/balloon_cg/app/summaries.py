@@ -365,6 +365,8 @@ def _stable_counts(counts: dict, points: int) -> str:
     text = ", ".join(f"{reading} control {n}" for reading, n in held.items()) + f" (of {points}"
     if free == held:
         return text + "; the same with the centre free)"
+    if not free:  # a whole-sphere primary of a field without axial symmetry: no free equilibrium to read
+        return text + "; centre free: not read)"
     return text + "; centre free: " + ", ".join(f"{reading} control {n}" for reading, n in free.items()) + ")"
 
 
