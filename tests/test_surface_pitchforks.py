@@ -187,7 +187,8 @@ def test_the_mirror_image_is_the_branch_switched_the_other_way(turned_pear):
 
 @pytest.mark.slow
 def test_the_branches_of_a_whole_sphere_pitchfork_are_stored_and_shown(turned_pear, tmp_path):
-    """The run file keeps the branch's parent and the mirror's reflection; inspect names the reflection."""
+    """The run file keeps the branch's parent, the mirror's reflection and the primary's branch points' sectors (the
+    switched branch's first point has none: its sector is its parent point's); inspect names the reflection."""
     from balloon_cg.app.summaries import format_run
     from balloon_cg.io.run_file import read_run, write_run
 
@@ -199,5 +200,9 @@ def test_the_branches_of_a_whole_sphere_pitchfork_are_stored_and_shown(turned_pe
     assert np.array_equal(stored["coefficients"], mirror.coefficients)
     assert list(stored["attrs"]["reflection"]) == list(INVERSION)
     assert run["branches"][branch.name]["attrs"]["parent_branch_point"] == number
+    sectors = [s.sector for s in primary.special if s.kind == Kind.BP]
+    assert [s["sector"] for s in run["branches"]["primary"]["special_points"] if s["kind"] == "BP"] == sectors
+    assert INVERSION in primary.basis.symmetry and any(-1 in sector for sector in sectors)
+    assert run["branches"][branch.name]["special_points"][0]["sector"] == ()
     text = format_run(run)
     assert f"(the reflection (x → −x, y → −y, z → −z) of {branch.name})" in text
