@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis import verdict
-from balloon_cg.analysis.results import Kind, Origin
+from balloon_cg.analysis.results import Gauge, Kind, Origin
 from balloon_cg.analysis.surface_pitchforks import kept_reflections
 from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 
@@ -63,7 +63,8 @@ def test_a_branch_point_in_the_own_sector_is_a_typed_limitation():
 
 def test_a_whole_sphere_picture_without_branch_points_is_complete():
     """The turned two-coil scene to λ = 1.06 (no branch point yet): the picture is the primary alone, with nothing
-    left unsearched or unswitched (before this slice it said the branches at its branch points were not traced)."""
+    left unsearched or unswitched (before this slice it said the branches at its branch points were not traced);
+    its special points (the end point) are of its reading, held (they were left `both`)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.scene import load_scene
     from test_surface_primary import _scene, _turned
@@ -73,6 +74,7 @@ def test_a_whole_sphere_picture_without_branch_points_is_complete():
     assert [b.name for b in picture.surface_branches] == ["primary"]
     assert not any(s.kind == Kind.BP for s in picture.primary.special)
     assert picture.not_searched == "" and picture.not_switched == [] and picture.incomplete == []
+    assert {s.gauge for s in picture.primary.special} == {Gauge.HELD}  # its reading (the EP at least)
 
 
 def test_events_of_a_whole_sphere_scene_are_said_to_be_unsearched():
@@ -185,7 +187,8 @@ def test_the_mirror_image_is_the_branch_switched_the_other_way(turned_pear):
 
 @pytest.mark.slow
 def test_the_branches_of_a_whole_sphere_pitchfork_are_stored_and_shown(turned_pear, tmp_path):
-    """The run file keeps the branch's parent and the mirror's reflection; inspect names the reflection."""
+    """The run file keeps the branch's parent, the mirror's reflection and the primary's branch points' sectors (the
+    switched branch's first point has none: its sector is its parent point's); inspect names the reflection."""
     from balloon_cg.app.summaries import format_run
     from balloon_cg.io.run_file import read_run, write_run
 
@@ -197,5 +200,9 @@ def test_the_branches_of_a_whole_sphere_pitchfork_are_stored_and_shown(turned_pe
     assert np.array_equal(stored["coefficients"], mirror.coefficients)
     assert list(stored["attrs"]["reflection"]) == list(INVERSION)
     assert run["branches"][branch.name]["attrs"]["parent_branch_point"] == number
+    sectors = [s.sector for s in primary.special if s.kind == Kind.BP]
+    assert [s["sector"] for s in run["branches"]["primary"]["special_points"] if s["kind"] == "BP"] == sectors
+    assert INVERSION in primary.basis.symmetry and any(-1 in sector for sector in sectors)
+    assert run["branches"][branch.name]["special_points"][0]["sector"] == ()
     text = format_run(run)
     assert f"(the reflection (x → −x, y → −y, z → −z) of {branch.name})" in text

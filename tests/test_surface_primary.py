@@ -106,6 +106,7 @@ def test_a_whole_sphere_primary_is_stored_and_shown(turned, tmp_path):
     text = format_run(run)
     assert "surface branch primary   (traced on the whole sphere from the start" in text
     assert "field force" in text and "field torque" in text
+    assert f"(of {len(surface.values)}; centre free: not read)" in text  # no free reading (it printed 'centre free: )')
 
 
 @pytest.mark.slow

@@ -285,3 +285,62 @@ def test_analyse_stores_the_pictures_surface_branches(monkeypatch, scene, primar
         [primary], surface_branches=[surface_branch]))
     result = bc.analyse(scene)
     assert list(result.branches) == ["primary", "m1_bp0"] and result.branches["m1_bp0"].m == 1
+
+
+def _with_secondary(surface_branch, sector, name="m1_sector"):
+    """The branch with a secondary branch point between points 2 and 3 in the symmetry sector ``sector``."""
+    rows = np.column_stack([surface_branch.coefficients, surface_branch.values])
+    bp = SpecialPoint(Kind.BP, 2, rows[2].copy(), m=1, sector=sector,
+                      note=f"secondary branch point: held eigenvalue 0 of the symmetry sector {sector} crosses zero")
+    special = [surface_branch.special[0], bp, surface_branch.special[1]]
+    return replace(surface_branch, name=name, special=special)
+
+
+def test_a_secondary_branch_points_sector_round_trips(tmp_path, scene, primary, surface_branch, capsys):
+    """SpecialPoint.sector is stored (special_points/state/sector, one character per reflection of the basis, zeros
+    for the points without one), read back by read_run and bc.load, shown by inspect under the basis's reflections
+    (text and JSON) and opens in xarray; a file without it (written before) still reads, without sectors."""
+    branch = _with_secondary(surface_branch, (1, -1))
+    path = write_run(tmp_path / "sector.h5", scene, [primary, branch])
+    special = read_run(path)["branches"]["m1_sector"]["special_points"]
+    assert [s["sector"] for s in special] == [(), (1, -1), ()]
+    assert [s["sector"] for s in bc.load(path).special_points if s["branch"] == "m1_sector"] == [(), (1, -1), ()]
+    assert "sector" not in read_run(path)["branches"]["primary"]["special_points"][0]  # axisymmetric: none
+    with h5py.File(path) as f:
+        stored = f["branches/m1_sector/special_points/state/sector"]
+        assert stored.shape == (3, 2) and stored.attrs["long_name"] == "symmetry sector"
+    assert main(["inspect", str(path)]) == 0
+    text = capsys.readouterr().out.split("surface branch m1_sector")[1]
+    assert "BP m=1 sector (y → −y); (z → −z) odd  points 2-3" in text
+    assert main(["inspect", str(path), "--json"]) == 0
+    points = json.loads(capsys.readouterr().out)["branches"]["m1_sector"]["special_points"]
+    assert [s["sector"] for s in points] == [[], [1, -1], []]
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    with xr.open_dataset(path, engine="h5netcdf", group="branches/m1_sector/special_points/state") as ds:
+        assert ds.sector.dims == ("special", "reflection") and ds.sector.values.tolist()[1] == [1, -1]
+    with h5py.File(path, "a") as f:
+        state = f["branches/m1_sector/special_points/state"]
+        del state["sector"], state["reflection"]
+    old = read_run(path)["branches"]["m1_sector"]["special_points"]
+    assert [s["kind"] for s in old] == ["BP", "BP", "EP"] and not any("sector" in s for s in old)
+
+
+def test_a_sector_of_another_basis_is_not_written_nor_read(tmp_path, scene, primary, surface_branch, capsys):
+    """A sector that is not one character ±1 per reflection of the branch's basis is refused by the writer
+    (ValueError, nothing written) and, damaged in a file, by the reader (exit 2, one line naming the branch)."""
+    for sector in ((-1,), (1, 2)):
+        with pytest.raises(ValueError, match="have no symmetry sector of its 2 reflections"):
+            write_run(tmp_path / "bad.h5", scene, [_with_secondary(surface_branch, sector)])
+        assert not (tmp_path / "bad.h5").exists()
+    path = write_run(tmp_path / "sector.h5", scene, [primary, _with_secondary(surface_branch, (1, -1))])
+    for damage in (np.array([[0, 0], [1, 3], [0, 0]]), np.zeros((3, 1), dtype=np.int64)):
+        damaged = tmp_path / "damaged.h5"
+        shutil.copy(path, damaged)
+        with h5py.File(damaged, "a") as f:
+            state = f["branches/m1_sector/special_points/state"]
+            del state["sector"]
+            state.create_dataset("sector", data=damage)
+        assert main(["inspect", str(damaged)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "m1_sector" in err and "sector" in err, err

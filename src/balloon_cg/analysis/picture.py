@@ -280,17 +280,23 @@ def _whole_sphere(scene, progress: Progress, clock: Clock, pear: bool) -> Pictur
     picture = Picture([], surface_branches=[primary], clock=clock)
     if scene.events:
         picture.not_searched = WHOLE_SPHERE_EVENTS
-    if _stopped(picture) or not pear or scene.surface.branches == "none":
-        return picture
+    if not (_stopped(picture) or not pear or scene.surface.branches == "none"):
+        _switch_pitchforks(scene, primary, picture, progress)
+    label_readings(picture.surface_branches)  # folds, end points and secondary points: held, as their branches
+    return picture
+
+
+def _switch_pitchforks(scene, primary, picture: Picture, progress: Progress) -> None:
+    """The branches born at the pitchforks of a whole-sphere primary branch (the first one, or all: ``[surface]
+    branches``) with their mirror images; the branch points that are not pitchforks in ``Picture.not_switched``."""
     search = surface_pitchforks.pitchforks(primary)
     picture.not_switched = search.unswitched
-    with clock.step(Step.SURFACE_BRANCHES):
+    with picture.clock.step(Step.SURFACE_BRANCHES):
         for number, bp, broken in search.pitchforks[:1] if scene.surface.branches == "first" else search.pitchforks:
             if _stopped(picture):
                 break
             _switch_pitchfork(scene, primary, number, bp, broken, picture, progress)
     progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches[1:]))
-    return picture
 
 
 def _switch_pitchfork(scene, primary, number: int, bp, broken: tuple, picture: Picture, progress: Progress) -> None:

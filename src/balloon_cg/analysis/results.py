@@ -171,7 +171,8 @@ class SpecialPoint:
     note: str = ""  # for people only
     gauge: Gauge = Gauge.BOTH  # the reading it belongs to: a BP's block's, a fold's or end point's its branch's
     sector: tuple = ()  # a secondary BP of a surface branch: the characters of the symmetry sector whose held
-    #                     eigenvalue crosses zero (``surface_assessment``; not stored in run files: its note names it)
+    #                     eigenvalue crosses zero, one per reflection of its basis (``surface_assessment``; run
+    #                     files: special_points/state/sector)
 
     def __repr__(self):
         label = " ".join(v for v in (self.kind.value, self.classification.value, self.block.value) if v)

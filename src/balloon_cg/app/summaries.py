@@ -296,7 +296,7 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"  trace time           {b['wall_time']:.3f} s",
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
-        *_special_lines(b["special_points"], b["gauge"]),
+        *_special_lines(b["special_points"], b["gauge"], b["symmetry"]),
     ]
 
 
@@ -332,11 +332,13 @@ def _format_branch(name: str, b: dict) -> list[str]:
 READINGS = {"both": "held and free", "held": "held at its centre", "free": "free (net axial force zero)"}
 
 
-def _special_lines(special: list, gauge: str = "both") -> list[str]:
+def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]:
     """One aligned line per stored special point: its label (the number ``continue`` takes), kind (with its reading
-    where it is not its branch's ``gauge``), place, P (and Φ̄), the pole stretches, the note."""
+    where it is not its branch's ``gauge``, and a surface branch's secondary branch point's sector under the
+    reflections ``symmetry`` of its basis), place, P (and Φ̄), the pole stretches, the note."""
     labels = [f"{s['label']:>3} {s['kind']} {s['classification']}".rstrip() + (f" m={s['m']}" if s["m"] else "")
               + (f" {s['gauge']}" if s.get("gauge", gauge) != gauge else "")
+              + (f" sector {_reflections(symmetry, s['sector'])}" if s.get("sector") else "")
               + ("" if s["status"] == "located" else f" ({s['status']}, ±{s['uncertainty']:.1g})")
               for s in special]
     places = [f"point {s['index']}" if s["kind"] == "EP" else f"points {s['index']}-{s['index'] + 1}"
@@ -365,6 +367,8 @@ def _stable_counts(counts: dict, points: int) -> str:
     text = ", ".join(f"{reading} control {n}" for reading, n in held.items()) + f" (of {points}"
     if free == held:
         return text + "; the same with the centre free)"
+    if not free:  # a whole-sphere primary of a field without axial symmetry: no free equilibrium to read
+        return text + "; centre free: not read)"
     return text + "; centre free: " + ", ".join(f"{reading} control {n}" for reading, n in free.items()) + ")"
 
 

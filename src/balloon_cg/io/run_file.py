@@ -43,7 +43,9 @@ Layout::
         converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
         centroid                                           (point, axis)
         coefficients                                       (point, coefficient)
-        special_points/ as above, state/unknowns (special, unknown): the coefficients c, then P (or Φ̄)
+        special_points/ as above, state/unknowns (special, unknown): the coefficients c, then P (or Φ̄);
+                           state/sector (special, reflection) int: a secondary branch point's symmetry sector, its
+                           character ±1 under each reflection of ``symmetry`` (0 … 0: none; absent in older files)
         stability/lowest_<reading> (point, eigenvalue) for the readings held, free, held_volume, free_volume,
                            held_gas, free_gas; stable_pressure, stable_pressure_free, stable_volume, … (point,)
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
@@ -175,6 +177,12 @@ def check_branches(branches) -> None:
         if wrong:
             raise ValueError(f"branch {branch.name!r}: special points {', '.join(wrong)} are not rows of its {width} "
                              "unknowns and parameter (another basis?); not written")
+        reflections = len(branch.basis.symmetry) if is_surface(branch) else 0
+        wrong = [f"{s.kind.value} after point {s.index} {s.sector}" for s in branch.special
+                 if s.sector and (len(s.sector) != reflections or not set(s.sector) <= {-1, 1})]
+        if wrong:
+            raise ValueError(f"branch {branch.name!r}: special points {', '.join(wrong)} have no symmetry sector of its "
+                             f"{reflections} reflections (characters ±1, one each); not written")
 
 
 def finite(branch) -> np.ndarray:
@@ -335,7 +343,8 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     attach_dimensions(group, {**{name: (point, axis) for name in ("centroid", *LOADS) if name in columns},
                               1: (point,), 2: (point, coefficient)})
     write_special(group.create_group("special_points"), branch.special, rows.shape[1],
-                  lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X), first_label)
+                  lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X), first_label,
+                  len(basis.symmetry))
     if branch.stability:
         _write_surface_stability(group.create_group("stability"), branch.stability, point)
 
@@ -417,12 +426,13 @@ def surface_poles(basis, X) -> dict:
 
 
 def write_special(group, special: list, width: int, poles, unknown=None, parameters=None,
-                  first_label: int = 1) -> None:
+                  first_label: int = 1, reflections: int | None = None) -> None:
     """Special points (results.SpecialPoint) as columns; ``width`` the length of their X rows (unknowns, then
     the parameter), ``poles(X)`` the POLES columns of the rows (``legendre_poles``, ``surface_poles``);
     ``unknown``: the dimension scale of the X rows (default: a new one in ``group``); ``parameters(X)``: the
     parameter columns of the rows (default pressure = the last unknown); ``label``: first_label, first_label + 1,
-    … (unique in the file: ``write_branches``)."""
+    … (unique in the file: ``write_branches``); ``reflections``: a surface branch's number of reflections, whose
+    points' sectors go to state/sector (``sector_rows``; None: an axisymmetric branch, no sectors)."""
     X = np.array([s.X for s in special]).reshape(len(special), width)
     group.create_dataset("label", data=np.arange(first_label, first_label + len(special), dtype=np.int64))
     write_strings(group, "kind", [s.kind.value for s in special])
@@ -447,7 +457,20 @@ def write_special(group, special: list, width: int, poles, unknown=None, paramet
     attach_dimensions(group, {1: (special_scale,)})
     state = group.create_group("state")  # the 2-D rows apart: special_points stays a table of one row per point
     state.create_dataset("unknowns", data=X)
-    attach_dimensions(state, {2: (special_scale, unknown or scale(state, "unknown", width))})
+    axes = {}
+    if reflections is not None:
+        state.create_dataset("sector", data=sector_rows(special, reflections))
+        axes["sector"] = (special_scale, scale(state, "reflection", reflections))
+    attach_dimensions(state, axes | {2: (special_scale, unknown or scale(state, "unknown", width))})
+
+
+def sector_rows(special: list, reflections: int) -> np.ndarray:
+    """(special, reflections) int: each point's ``sector`` (its character ±1 under each reflection of its basis),
+    zeros where it has none (folds, end points, the point a branch is born at)."""
+    rows = np.zeros((len(special), reflections), dtype=np.int64)
+    for row, s in zip(rows, special):
+        row[:len(s.sector)] = s.sector
+    return rows
 
 
 def read_run(path) -> dict:
@@ -599,15 +622,22 @@ def check_branch(group, where, error) -> None:
         check_sizes(stability, f"{where}: stability", error)
 
 
-def check_special(group, where, width: int, error, extra: dict | None = None) -> None:
-    """The columns of a special_points group (SPECIAL_COLUMNS, OPTIONAL_SPECIAL where present, ``extra``) and its X rows
-    (``special_unknowns``) ``width`` wide, one per special point."""
+def check_special(group, where, width: int, error, extra: dict | None = None, reflections: int = 0) -> None:
+    """The columns of a special_points group (SPECIAL_COLUMNS, OPTIONAL_SPECIAL where present, ``extra``), its X rows
+    (``special_unknowns``) ``width`` wide, one per special point, and, where present, its sectors (state/sector:
+    ``reflections`` wide, characters ±1 or a row of zeros)."""
     n = check_columns(group, where, SPECIAL_COLUMNS | (extra or {}), error)
     check_columns(group, where, {k: v for k, v in OPTIONAL_SPECIAL.items() if k in group}, error, rows=n)
     check_sizes(group, where, error)
     unknowns = special_unknowns(group, where, error, rows=n)
     if n and unknowns.shape[1] != width:
         raise error(where, f"unknowns has {unknowns.shape[1]} columns, expected {width}")
+    if "sector" in unknowns.parent:
+        check_columns(unknowns.parent, f"{where}/state", {"sector": ("int", 2)}, error, rows=n)
+        sectors = unknowns.parent["sector"][()]
+        if sectors.shape[1] != reflections or not all(set(row) <= {-1, 1} or not row.any() for row in sectors):
+            raise error(f"{where}/state", f"sector has shape {sectors.shape} and rows {sectors.tolist()}, expected "
+                                          f"{reflections} characters ±1 per row (a row of zeros: none)")
 
 
 def special_unknowns(group, where="", error=FileError, rows: int | None = None):
@@ -656,7 +686,8 @@ def check_surface_branch(group, where, error) -> None:
     for name in ("centroid", *(name for name in LOADS if name in group)):
         if group[name].shape[1] != 3:
             raise error(where, f"{name} has shape {group[name].shape}, expected ({n}, 3)")
-    check_special(require_group(group, "special_points", where, error), f"{where}: special_points", size + 1, error)
+    check_special(require_group(group, "special_points", where, error), f"{where}: special_points", size + 1, error,
+                  reflections=len(group.attrs["symmetry"]))
     if "stability" in group:
         stability = require_group(group, "stability", where, error)
         flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
@@ -728,12 +759,16 @@ def read_special(group, field_acts: bool = True, branch_gauge: str | None = None
     """Special points written by write_special, as a list of dicts (text columns as str). A file written before
     the free reading (no ``gauge`` column) gets a branch point's from its block (``results.Gauge.of_block``; a
     field acts when ``field_acts``), every other point's its branch's (``branch_gauge``; unknown: held where a
-    field acts)."""
+    field acts). A surface branch's points have their ``sector`` (a tuple of characters, () for none) where the file
+    stores it (state/sector)."""
     from ..analysis.results import Block, Gauge
 
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
     columns |= {name: group[name][()] for name in ("index", "m", "label") + SPECIAL_NUMBERS + ("voltage",) if name in group}
     points = [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
+    if "state" in group and "sector" in group["state"]:  # a surface branch's (files before it: none)
+        for s, row in zip(points, group["state"]["sector"][()]):
+            s["sector"] = tuple(int(chi) for chi in row) if row.any() else ()
     if "gauge" not in columns:
         blocks = {block.value: block for block in Block if block != Block.NONE}
         fallback = {g.value: g for g in Gauge}.get(branch_gauge, Gauge.HELD if field_acts else Gauge.BOTH)

@@ -76,6 +76,10 @@ VARIABLES = {
     "note": ("", "note", "for people: the stop message or the mode"),
     "index": (COUNT, "point index", "the special point lies between points index and index + 1"),
     "m": (COUNT, "azimuthal wave number", "m of the crossing mode (0: axisymmetric)"),
+    "sector": (COUNT, "symmetry sector", "a secondary branch point of a surface branch: the character ±1 of its "
+                                         "crossing mode under each reflection of the branch's symmetry attribute; "
+                                         "0 … 0: none"),
+    "reflection": (COUNT, "reflection index", "row of the branch's symmetry attribute"),
     "label": (COUNT, "special-point label", "unique in the file (1, 2, … through the branches): what `continue` "
                                             "takes"),
     "uncertainty": (NONDIMENSIONAL, "uncertainty in P", "bracket width in P of an approximate point; 0 if located"),
