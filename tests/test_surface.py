@@ -35,6 +35,19 @@ def sphere(scene, stretch, degree):
             Parameters(sphere_pressure(scene.material, stretch, voltage), voltage=voltage))
 
 
+@pytest.mark.parametrize("semi_axes", [(1.3, 1.3, 0.8), (1.0, 1.0, 1.4), (1.3, 1.2, 0.8)])
+def test_the_tilt_is_that_of_the_body_axis_whether_elongated_or_flattened(semi_axes):
+    """Spheroids with their axis (the third) turned by 30° about e_y: flattened along it (oblate), elongated
+    (prolate), and a flattened body with unequal other axes: the tilt is 30° (the axis of the largest moment of the
+    oblate body is any direction normal to its axis: it read 60°–90°)."""
+    basis = SphericalBasis(6, (MIRROR_Y,))
+    X = basis.nodes["reference"][:3]
+    t = np.radians(30.0)
+    turn = np.array([[np.cos(t), 0.0, np.sin(t)], [0.0, 1.0, 0.0], [-np.sin(t), 0.0, np.cos(t)]])
+    c = displacement_coefficients(basis, turn @ (np.array(semi_axes)[:, None] * X) - X)
+    assert measures(basis, c)["tilt"] == pytest.approx(30.0, abs=1e-9)
+
+
 @pytest.fixture(scope="module")
 def spom1():
     return load_scene(ROOT / "scenes" / "spom1.toml")

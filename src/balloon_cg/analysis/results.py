@@ -313,7 +313,7 @@ class SurfaceBranch:
     """A branch of non-axisymmetric states traced on the whole sphere (``surface``): per point the coefficients c
     of the displacement in ``basis`` (a SphericalBasis: degree L and the reflections its states keep) and the value
     of the continuation parameter, the solver records, the measures of ``surface.measures`` (pole stretches,
-    centroid offset, tilt of the long axis, volume) and the stability readings (lowest eigenvalues of the second
+    centroid offset, tilt of the body's axis, volume) and the stability readings (lowest eigenvalues of the second
     variation over every symmetry sector, balloon held at its centre or free; ``surface.stability``).
 
     ``m`` is the azimuthal number of the mode it was born from, ``parent`` (branch name, branch point number)

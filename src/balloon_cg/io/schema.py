@@ -47,8 +47,9 @@ VARIABLES = {
     "torque": (NONDIMENSIONAL, "net torque of the field about the centre", "T = ½ χ M (1/2π) ∫∫ x × ∇H² dA, per 2π "
                                                                           "in units of μ H R0² (zero at equilibrium: "
                                                                           "the balloon turns freely)"),
-    "tilt": ("degree", "tilt of the long axis", "angle between e_z and the principal axis of the largest second "
-                                                "moment of the enclosed body, 0 … 90"),
+    "tilt": ("degree", "tilt of the body's axis", "angle between e_z and the principal axis of the enclosed "
+                                                  "body's second moments that stands apart (the largest, or the "
+                                                  "smallest when closer to the middle one), 0 … 90"),
     "eta_north": (NONDIMENSIONAL, "η at the north pole", "axial position η(0) / R0"),
     "eta_south": (NONDIMENSIONAL, "η at the south pole", "axial position η(π) / R0"),
     "lam1_equator": (NONDIMENSIONAL, "λ1 at the equator", "meridional stretch λ1(π/2)"),

@@ -1,5 +1,5 @@
 """What a non-axisymmetric state is measured by: the stretch at the material poles, the enclosed volume, the
-centroid of the enclosed body (offset from the held centre) and the tilt of its long axis, and the spectral tail.
+centroid of the enclosed body (offset from the held centre) and the tilt of its axis, and the spectral tail.
 
 Volume integrals become surface integrals over the reference sphere with n dS = (a_θ × a_φ) dA (divergence theorem):
 V = ⅓ ∫ x·n dS, ∫_V x_i dV = ½ ∫ x_i² n_i dS, ∫_V x_i x_j dV = ⅕ ∫ x_i x_j (x·n) dS. Every value is per 2π like E
@@ -31,15 +31,23 @@ def body_moments(basis: SphericalBasis, state: np.ndarray) -> tuple:
 
 
 def measures(basis: SphericalBasis, c: np.ndarray) -> dict:
-    """The MEASURES of the state c: the pole stretches, V/(2π), the centroid x_c and the angle (degrees, 0..90)
-    between e_z and the principal axis of the largest second moment of the body about its centroid."""
+    """The MEASURES of the state c: the pole stretches, V/(2π), the centroid x_c and the tilt: the angle (degrees,
+    0..90) between e_z and the body's axis (``body_axis``)."""
     volume, first, second = body_moments(basis, basis.node_state(c))
     centroid = first / volume
     central = second / volume - np.outer(centroid, centroid)
-    _, axes = np.linalg.eigh(central)
-    tilt = np.degrees(np.arccos(min(1.0, abs(float(axes[2, -1])))))
+    tilt = np.degrees(np.arccos(min(1.0, abs(float(body_axis(central)[2])))))
     return {"lam_north": pole_stretch(basis, c, 0.0), "lam_south": pole_stretch(basis, c, np.pi),
             "volume": volume, "centroid": centroid, "tilt": tilt}
+
+
+def body_axis(central: np.ndarray) -> np.ndarray:
+    """The axis of a body from its central second moments m0 ≤ m1 ≤ m2: the principal axis whose moment stands
+    apart, that of m2 when m2 − m1 ≥ m1 − m0 (a body longest along it), else that of m0 (a body shortest along it).
+    For a body of revolution it is the axis of revolution either way: a balloon that turns from elongated to
+    flattened along one axis keeps it, where the axis of the largest moment would jump to any normal direction."""
+    moments, axes = np.linalg.eigh(central)
+    return axes[:, 2] if moments[2] - moments[1] >= moments[1] - moments[0] else axes[:, 0]
 
 
 def tails(basis: SphericalBasis, c: np.ndarray) -> tuple:
