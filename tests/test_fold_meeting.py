@@ -1,0 +1,84 @@
+"""Meetings of a fold and a pitchfork (analysis/fold_meeting.py) against folds and pitchforks located on plain branches.
+
+SPOM1 between the two coils, the pear pitchfork followed in M from M = 0.002: at M* the symmetric branch through
+the pitchfork has its gas-control fold (LN). Checked independently of the meeting's test function: on a primary
+branch traced under gas control at M*, the LN located by the continuation's fold locator (Brent on dn/ds along
+the branch) and the pear pitchfork located by the Werner–Spence system are both at the meeting's P; at M*(1 ∓ δ)
+they lie on opposite sides of each other along the branch (the fold and the pitchfork cross at M*).
+"""
+import json
+
+import numpy as np
+import pytest
+
+from balloon_cg.analysis.bifurcation import detect, locate
+from balloon_cg.analysis.codim2 import continue_branch_point
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.results import Block, Kind, Status
+from balloon_cg.analysis.stability import assess_branch
+from balloon_cg.app.cli import main
+from balloon_cg.scene import load_scene
+
+SCENE = "spom1_two_coils_M0.002"
+
+
+def pear_point(branch):
+    """The first held pear pitchfork of ``branch``, located."""
+    assessments, _ = assess_branch(branch, branch.scene.stability.degree)
+    return locate(branch, *next(e for e in detect(branch, assessments) if e[1] == Block.ODD_HELD))
+
+
+def gas_branch(M: float):
+    """The primary branch at M under gas control, its located LN fold and pear pitchfork as (P, λ2(0)) each."""
+    scene = load_scene(SCENE).with_overrides({"field.M": M, "loading.control": "gas"}, name="gas")
+    branch = trace_primary(scene)
+    folds = [s for s in branch.special if s.kind == Kind.LN]
+    assert len(folds) == 1 and folds[0].status == Status.LOCATED
+    bp = pear_point(branch)
+    assert bp.status == Status.LOCATED
+    north = branch.disc.pole_rows()["lam2_north"]
+    return [(float(s.X[-1]), float(north @ s.X[:-1])) for s in (folds[0], bp)]
+
+
+@pytest.fixture(scope="module")
+def meeting():
+    branch = trace_primary(load_scene(SCENE))
+    curve = continue_branch_point(branch, pear_point(branch), "M", 1.0, max_points=16)
+    return curve, curve.meetings
+
+
+def test_the_ln_meets_the_pitchfork(meeting):
+    """One meeting on the first 16 curve points, LN-BP, located; the LN and the pitchfork of a primary branch at
+    M* are at its P to 1e-9 (measured: 2e-14 and 1e-13)."""
+    curve, meetings = meeting
+    assert [(m.kind, m.status, m.block) for m in meetings] == [(Kind.LN_BP, Status.LOCATED, Block.ODD_HELD)]
+    M, P = meetings[0].X[-1], meetings[0].X[curve.n]
+    assert curve.q[meetings[0].index] < M < curve.q[meetings[0].index + 1]
+    (P_fold, lam_fold), (P_bp, lam_bp) = gas_branch(M)
+    assert abs(P_fold - P) < 1e-9 and abs(P_bp - P) < 1e-9
+    assert abs(lam_fold - lam_bp) < 1e-6  # λ at a fold of n is only as sharp as √(tolerance)
+
+
+def test_fold_and_pitchfork_change_order_at_the_meeting(meeting):
+    """Along the branch (in λ2(0)) the LN lies beyond the pitchfork on one side of M* and before it on the other."""
+    curve, meetings = meeting
+    M = meetings[0].X[-1]
+    sides = [np.sign(lam_fold - lam_bp) for (_, lam_fold), (_, lam_bp) in (gas_branch(M * (1 + d)) for d in (-1e-3, 1e-3))]
+    assert sides[0] * sides[1] < 0
+
+
+def test_meeting_stored_shown_and_drawn(meeting, tmp_path, capsys):
+    """``critical`` writes the meeting to the curve file; ``inspect`` prints it, ``inspect --json`` lists it (q and
+    P of the meeting found in memory); the phase diagram draws it."""
+    curve, meetings = meeting
+    out = tmp_path / "M.h5"
+    assert main(["critical", SCENE, "--parameter", "M", "-o", str(out), "--quiet"]) == 1  # no critical M: P reaches 0
+    assert f"the LN fold meets the pitchfork at M = {meetings[0].X[-1]:.10g}" in capsys.readouterr().err
+    assert main(["inspect", str(out), "--json"]) == 0
+    stored = json.loads(capsys.readouterr().out)["curves"]["pear"]["meetings"]
+    assert [(m["kind"], m["status"]) for m in stored] == [("LN-BP", "located")]
+    assert stored[0]["q"] == pytest.approx(meetings[0].X[-1], rel=1e-12)
+    assert stored[0]["pressure"] == pytest.approx(meetings[0].X[curve.n], rel=1e-12)
+    assert main(["inspect", str(out)]) == 0
+    assert "LN-BP meeting       M = " in capsys.readouterr().out
+    assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0
