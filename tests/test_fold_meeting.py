@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.bifurcation import detect, locate
-from balloon_cg.analysis.codim2 import continue_branch_point
+from balloon_cg.analysis.codim2 import continue_branch_point, land_on_q
+from balloon_cg.analysis.fold_curve import continue_fold
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.results import Block, Kind, Status
 from balloon_cg.analysis.stability import assess_branch
@@ -49,7 +50,7 @@ def meeting():
 
 def test_the_ln_meets_the_pitchfork(meeting):
     """One meeting on the first 16 curve points, LN-BP, located; the LN and the pitchfork of a primary branch at
-    M* are at its P to 1e-9 (measured: 2e-14 and 1e-13)."""
+    M* are at its P to 1e-9 (measured: 8e-14 and 5e-15)."""
     curve, meetings = meeting
     assert [(m.kind, m.status, m.block) for m in meetings] == [(Kind.LN_BP, Status.LOCATED, Block.ODD_HELD)]
     M, P = meetings[0].X[-1], meetings[0].X[curve.n]
@@ -59,6 +60,21 @@ def test_the_ln_meets_the_pitchfork(meeting):
     assert abs(lam_fold - lam_bp) < 1e-6  # λ at a fold of n is only as sharp as √(tolerance)
 
 
+def test_the_ln_curve_passes_through_the_meeting(meeting):
+    """The LN fold curve in M (fold_curve, from the LN of the gas-control branch at M = 0.002), landed on M*, is at
+    the meeting's P to 1e-9 (measured: 1.4e-13)."""
+    curve, meetings = meeting
+    M, P = meetings[0].X[-1], meetings[0].X[curve.n]
+    branch = trace_primary(load_scene(SCENE).with_overrides({"loading.control": "gas"}, name="gas"))
+    fold = next(s for s in branch.special if s.kind == Kind.LN)
+    ln_curve = continue_fold(branch, fold, "M", 1.0, stop=lambda point: None, max_points=60)
+    near = int(np.searchsorted(ln_curve.q, M))
+    assert 0 < near < len(ln_curve.q) and ln_curve.q[near - 1] < M
+    X = land_on_q(ln_curve, M, near)
+    assert X is not None and abs(X[ln_curve.n] - P) < 1e-9
+
+
+@pytest.mark.slow
 def test_fold_and_pitchfork_change_order_at_the_meeting(meeting):
     """Along the branch (in λ2(0)) the LN lies beyond the pitchfork on one side of M* and before it on the other."""
     curve, meetings = meeting
@@ -80,5 +96,5 @@ def test_meeting_stored_shown_and_drawn(meeting, tmp_path, capsys):
     assert stored[0]["q"] == pytest.approx(meetings[0].X[-1], rel=1e-12)
     assert stored[0]["pressure"] == pytest.approx(meetings[0].X[curve.n], rel=1e-12)
     assert main(["inspect", str(out)]) == 0
-    assert "LN-BP meeting       M = " in capsys.readouterr().out
+    assert "LN-BP meeting        M = " in capsys.readouterr().out
     assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0

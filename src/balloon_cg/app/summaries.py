@@ -88,7 +88,7 @@ def format_curves(summary: dict) -> str:
                   f"  ended                {c['end']}: {c['end_description']}",
                   f"  critical value       {critical:.12g}" if np.isfinite(critical) else
                   "  critical value       none (the curve did not end in a verified merge or cusp)",
-                  *(f"  {m['kind']} meeting       {c['parameter']} = {m['q']:.12g}, P = {m['pressure']:.10g} "
+                  *(f"  {m['kind']} meeting        {c['parameter']} = {m['q']:.12g}, P = {m['pressure']:.10g} "
                     f"(pole stretch {m['lam2_north']:.10g}), {m['status']}" +
                     (f" ±{m['uncertainty']:.1g}" if m["status"] != "located" else "") for m in c["meetings"]),
                   f"  wall time            {c['wall_time']:.3f} s"]
