@@ -14,11 +14,12 @@ import pytest
 from balloon_cg.analysis.bifurcation import detect, locate
 from balloon_cg.analysis.codim2 import continue_branch_point, land_on_q
 from balloon_cg.analysis.fold_curve import continue_fold
+from balloon_cg.analysis.fold_meeting import FoldTest, oriented_tangents
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.results import Block, Kind, Status
 from balloon_cg.analysis.stability import assess_branch
 from balloon_cg.app.cli import main
-from balloon_cg.scene import load_scene
+from balloon_cg.scene import Control, load_scene
 
 SCENE = "spom1_two_coils_M0.002"
 
@@ -79,7 +80,8 @@ def test_fold_and_pitchfork_change_order_at_the_meeting(meeting):
     """Along the branch (in λ2(0)) the LN lies beyond the pitchfork on one side of M* and before it on the other."""
     curve, meetings = meeting
     M = meetings[0].X[-1]
-    sides = [np.sign(lam_fold - lam_bp) for (_, lam_fold), (_, lam_bp) in (gas_branch(M * (1 + d)) for d in (-1e-3, 1e-3))]
+    sides = [np.sign(lam_fold - lam_bp)
+             for (_, lam_fold), (_, lam_bp) in (gas_branch(M * (1 + d)) for d in (-1e-3, 1e-3))]
     assert sides[0] * sides[1] < 0
 
 
@@ -88,7 +90,8 @@ def test_meeting_stored_shown_and_drawn(meeting, tmp_path, capsys):
     P of the meeting found in memory); the phase diagram draws it."""
     curve, meetings = meeting
     out = tmp_path / "M.h5"
-    assert main(["critical", SCENE, "--parameter", "M", "-o", str(out), "--quiet"]) == 1  # no critical M: P reaches 0
+    # exit 1: no critical M (P reaches 0 before the curve turns back)
+    assert main(["critical", SCENE, "--parameter", "M", "-o", str(out), "--quiet"]) == 1
     assert f"the LN fold meets the pitchfork at M = {meetings[0].X[-1]:.10g}" in capsys.readouterr().err
     assert main(["inspect", str(out), "--json"]) == 0
     stored = json.loads(capsys.readouterr().out)["curves"]["pear"]["meetings"]
@@ -98,3 +101,21 @@ def test_meeting_stored_shown_and_drawn(meeting, tmp_path, capsys):
     assert main(["inspect", str(out)]) == 0
     assert "LN-BP meeting        M = " in capsys.readouterr().out
     assert main(["plot", str(out), "--what", "phase", "-o", str(tmp_path / "phase.png")]) == 0
+
+
+def test_sphere_pitchforks_against_the_closed_form():
+    """At M = 0 (the sphere, P = 2Φ1/λ², n = P V ∝ Pλ³) every pear point has d ln P/d ln λ = −1 and d ln n/d ln λ = 2
+    (docs/numerics.md): the fold tests of the symmetric tangent along the SPOM1 pitchfork curve in α1 (λ the pole
+    stretch, V from ``Equilibrium.volume``) to 1e-8 (measured: 5e-12, 1e-11; α1 1.3 to 1.66); no meeting."""
+    branch = trace_primary(load_scene("spom1"))
+    curve = continue_branch_point(branch, pear_point(branch), "alpha1", 1.0, max_points=12)
+    assert curve.meetings == []
+    system = curve.system()
+    north = curve.disc.pole_rows()["lam2_north"]
+    tangents = oriented_tangents(system, curve.X)
+    for X, tau in zip(curve.X, tangents):
+        u, P = X[:curve.n], X[curve.n]
+        lam, dlam = north @ u, north @ tau[:curve.n]
+        assert FoldTest(system, Control.PRESSURE)(X, tau) * lam / (P * dlam) == pytest.approx(-1.0, abs=1e-8)
+        rate = FoldTest(system, Control.GAS)(X, tau) * lam / (P * 2 * np.pi * system.eq.volume(u) * dlam)
+        assert rate == pytest.approx(2.0, abs=1e-8)

@@ -28,6 +28,25 @@ from .results import Kind, SpecialPoint, located_or_bracketed
 MEETING_KIND = {Control.PRESSURE: Kind.LP_BP, Control.VOLUME: Kind.LV_BP, Control.GAS: Kind.LN_BP}
 
 
+def symmetric_tangent(system, X, reference=None) -> np.ndarray:
+    """τ of the symmetric branch at the point X = (u, P, φ, q) of the extended pitchfork ``system``: the unit null
+    vector of F_x (its smallest right singular vector) without ``reference``, else normalised by reference·τ = 1."""
+    u, P, _, q = system.split(X)
+    F = system.eq.bordered_jacobian(u, system.set_q(q).with_value("P", P), "P")
+    if reference is None:
+        return np.linalg.svd(F)[2][-1]
+    return np.linalg.solve(np.vstack([F, reference]), np.append(np.zeros(F.shape[0]), 1.0))
+
+
+def oriented_tangents(system, X) -> np.ndarray:
+    """Unit tangents τ of the symmetric branch at the curve points X, each oriented along the previous one."""
+    out = [symmetric_tangent(system, X[0])]
+    for x in X[1:]:
+        tau = symmetric_tangent(system, x, out[-1])
+        out.append(tau / np.linalg.norm(tau))
+    return np.array(out)
+
+
 @dataclass(frozen=True)
 class FoldTest:
     """g_c of the module docstring on an extended pitchfork system (``codim2.ExtendedSystem``)."""
@@ -35,28 +54,11 @@ class FoldTest:
     system: object
     control: Control
 
-    def symmetric_tangent(self, X, reference=None) -> np.ndarray:
-        """τ of the symmetric branch at the curve point X: unit (its smallest right singular vector) without
-        ``reference``, else normalised by reference·τ = 1."""
-        u, P, _, q = self.system.split(X)
-        F = self.system.eq.bordered_jacobian(u, self.system.set_q(q).with_value("P", P), "P")
-        if reference is None:
-            return np.linalg.svd(F)[2][-1]
-        return np.linalg.solve(np.vstack([F, reference]), np.append(np.zeros(F.shape[0]), 1.0))
-
-    def value(self, X, tau) -> float:
+    def __call__(self, X, tau) -> float:
         """g_c = ∇c·τ at the curve point X."""
         u, P, _, q = self.system.split(X)
-        return float(control_gradient_at(self.system.eq, u, self.system.set_q(q).with_value("P", P), self.control) @ tau)
-
-
-def oriented_tangents(test: FoldTest, X) -> np.ndarray:
-    """Unit tangents τ of the symmetric branch at the curve points X, each oriented along the previous one."""
-    out = []
-    for x in X:
-        tau = test.symmetric_tangent(x)
-        out.append(-tau if out and tau @ out[-1] < 0 else tau)
-    return np.array(out)
+        return float(control_gradient_at(self.system.eq, u, self.system.set_q(q).with_value("P", P), self.control)
+                     @ tau)
 
 
 def fold_meetings(system, points: list, disc, settings: continuation.Settings, block) -> list[SpecialPoint]:
@@ -65,11 +67,11 @@ def fold_meetings(system, points: list, disc, settings: continuation.Settings, b
     curve points where its g_c changes sign (module docstring); SpecialPoints of kind ``MEETING_KIND`` with X
     on the curve's layout (u, P, φ, q), in order along the curve."""
     X = np.array([p.X for p in points])
+    tangents = oriented_tangents(system, X)
     found = []
     for control in MEETING_KIND:
         test = FoldTest(system, control)
-        tangents = oriented_tangents(test, X)
-        g = np.array([test.value(x, tau) for x, tau in zip(X, tangents)])
+        g = np.array([test(x, tau) for x, tau in zip(X, tangents)])
         for i in np.flatnonzero(g[:-1] * g[1:] < 0):
             found.append(_locate(test, i, points[i], points[i + 1], tangents[i], disc, settings, block))
     return sorted(found, key=lambda s: (s.index, s.X[-1]))
@@ -84,9 +86,10 @@ def _locate(test: FoldTest, index: int, start, end, reference, disc, settings, b
         result = continuation.correct(test.system, start.X + s * start.tangent, start.tangent, settings)
         if not result.converged:
             raise ArithmeticError(result.message)
-        return test.value(result.x, test.symmetric_tangent(result.x, reference)), result.x
+        return test(result.x, symmetric_tangent(test.system, result.x, reference)), result.x
 
-    known = {s: (test.value(x, test.symmetric_tangent(x, reference)), x) for s, x in ((0.0, start.X), (sigma, end.X))}
+    known = {s: (test(x, symmetric_tangent(test.system, x, reference)), x)
+             for s, x in ((0.0, start.X), (sigma, end.X))}
     root = continuation.locate_root(value_at, sigma, known=known)
     n = test.system.n
     before, after = (np.append(x[:n], x[n]) for x in (start.X, end.X))
