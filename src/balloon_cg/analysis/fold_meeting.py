@@ -13,8 +13,10 @@ crosses the fold curve of c in (q, P): a codim-2 point, the meeting of a fold (L
 (``MEETING_KIND``). It is located by Brent's method in the arclength of the pitchfork curve between the two
 points (``continuation.locate_root``, 1e-13 in s), each evaluation a curve point corrected on the hyperplane
 normal to the curve's tangent at the first point: LOCATED, or APPROXIMATE with the bracket's half-width when the
-root search fell back. Pitchfork and fold are then both at that (q, P) (tests/test_fold_meeting.py: the fold and
-the pitchfork located on a primary branch traced at that q).
+root search fell back. Pitchfork and fold are then both at that (q, P) (tests/test_fold_meeting.py: the fold
+and the pitchfork located on a primary branch traced at that q). Not covered: a point where F_x itself loses rank
+(an even-block branch point of the symmetric branch on the curve: codim 2 for an n × (n + 1) matrix, so met along
+a curve only through a symmetry, as on the sphere); τ would turn over there and every g_c change sign.
 """
 from dataclasses import dataclass
 
@@ -28,11 +30,16 @@ from .results import Kind, SpecialPoint, located_or_bracketed
 MEETING_KIND = {Control.PRESSURE: Kind.LP_BP, Control.VOLUME: Kind.LV_BP, Control.GAS: Kind.LN_BP}
 
 
-def symmetric_tangent(system, X, reference=None) -> np.ndarray:
-    """τ of the symmetric branch at the point X = (u, P, φ, q) of the extended pitchfork ``system``: the unit null
-    vector of F_x (its smallest right singular vector) without ``reference``, else normalised by reference·τ = 1."""
+def tangent_matrix(system, X) -> np.ndarray:
+    """F_x = [J_u  R_P] of the symmetric branch at the point X = (u, P, φ, q) of the extended pitchfork
+    ``system``."""
     u, P, _, q = system.split(X)
-    F = system.eq.bordered_jacobian(u, system.set_q(q).with_value("P", P), "P")
+    return system.eq.bordered_jacobian(u, system.set_q(q).with_value("P", P), "P")
+
+
+def symmetric_tangent(F, reference=None) -> np.ndarray:
+    """τ with F τ = 0: the unit null vector of F (its smallest right singular vector) without ``reference``, else
+    normalised by reference·τ = 1."""
     if reference is None:
         return np.linalg.svd(F)[2][-1]
     return np.linalg.solve(np.vstack([F, reference]), np.append(np.zeros(F.shape[0]), 1.0))
@@ -40,9 +47,9 @@ def symmetric_tangent(system, X, reference=None) -> np.ndarray:
 
 def oriented_tangents(system, X) -> np.ndarray:
     """Unit tangents τ of the symmetric branch at the curve points X, each oriented along the previous one."""
-    out = [symmetric_tangent(system, X[0])]
-    for x in X[1:]:
-        tau = symmetric_tangent(system, x, out[-1])
+    out = []
+    for x in X:
+        tau = symmetric_tangent(tangent_matrix(system, x), out[-1] if out else None)
         out.append(tau / np.linalg.norm(tau))
     return np.array(out)
 
@@ -82,14 +89,16 @@ def _locate(test: FoldTest, index: int, start, end, reference, disc, settings, b
     the arclength, module docstring)."""
     sigma = float(start.tangent @ (end.X - start.X))
 
+    def value(X):
+        return test(X, symmetric_tangent(tangent_matrix(test.system, X), reference))
+
     def value_at(s):
         result = continuation.correct(test.system, start.X + s * start.tangent, start.tangent, settings)
         if not result.converged:
             raise ArithmeticError(result.message)
-        return test(result.x, symmetric_tangent(test.system, result.x, reference)), result.x
+        return value(result.x), result.x
 
-    known = {s: (test(x, symmetric_tangent(test.system, x, reference)), x)
-             for s, x in ((0.0, start.X), (sigma, end.X))}
+    known = {s: (value(x), x) for s, x in ((0.0, start.X), (sigma, end.X))}
     root = continuation.locate_root(value_at, sigma, known=known)
     n = test.system.n
     before, after = (np.append(x[:n], x[n]) for x in (start.X, end.X))
