@@ -119,3 +119,24 @@ def test_sphere_pitchforks_against_the_closed_form():
         assert FoldTest(system, Control.PRESSURE)(X, tau) * lam / (P * dlam) == pytest.approx(-1.0, abs=1e-8)
         rate = FoldTest(system, Control.GAS)(X, tau) * lam / (P * 2 * np.pi * system.eq.volume(u) * dlam)
         assert rate == pytest.approx(2.0, abs=1e-8)
+
+
+@pytest.mark.slow
+def test_paper_coil_meetings_on_the_isola_curve():
+    """The paper's single coil (a = 1.961): the pitchfork curve in M merges at the critical M and comes back along
+    the partner pitchfork, meeting the LN and then the LV (measured: M = 0.0039361829, 0.0033308375). At each, a
+    primary branch traced at that M under that control has the fold and a held pitchfork at the meeting's P to
+    1e-8 (measured: LN 1.2e-12, BP 2.0e-12; LV 1.4e-10, BP 3.4e-11)."""
+    scene = load_scene("spom1_paper_coil")
+    branch = trace_primary(scene)
+    curve = continue_branch_point(branch, pear_point(branch), "M", 1.0)
+    assert curve.end.value == "isola_merge"
+    assert [(m.kind, m.status) for m in curve.meetings] == [(Kind.LN_BP, Status.LOCATED), (Kind.LV_BP, Status.LOCATED)]
+    for meeting, control in zip(curve.meetings, ("gas", "volume")):
+        M, P = meeting.X[-1], meeting.X[curve.n]
+        assert M < curve.critical[0]
+        plain = trace_primary(scene.with_overrides({"field.M": M, "loading.control": control}, name=control))
+        folds = [s.X[-1] for s in plain.special if s.kind == Kind(meeting.kind.value[:2])]
+        assessments, _ = assess_branch(plain, scene.stability.degree)
+        pitchforks = [locate(plain, *e).X[-1] for e in detect(plain, assessments) if e[1] == Block.ODD_HELD]
+        assert min(abs(np.array(folds) - P)) < 1e-8 and min(abs(np.array(pitchforks) - P)) < 1e-8
