@@ -254,9 +254,12 @@ class TwoParameterCurve:
     def describe(self) -> str:
         """One line for people: how the curve ended and where (q, P, pole stretch of its last point or fold), and
         where a fold meets the pitchfork (``meetings``)."""
-        meetings = "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets the pitchfork at {self.parameter} = "
-                           f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value})" for m in self.meetings)
-        return self._ending() + meetings
+        return self._ending() + self.describe_meetings()
+
+    def describe_meetings(self) -> str:
+        """'; the LN fold meets the pitchfork at q = … (P = …, located)' per meeting, or ''."""
+        return "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets the pitchfork at {self.parameter} = "
+                       f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value})" for m in self.meetings)
 
     def _ending(self) -> str:
         """``describe`` without the meetings."""
