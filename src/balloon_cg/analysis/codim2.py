@@ -74,6 +74,7 @@ from ..numerics.newton import newton
 from ..scene import Scene
 from .bifurcation import padded_mode, plain_degree
 from .branch_point import H_STEP, WernerSpence
+from .fold_meeting import fold_meetings
 from .problem import continuation_settings, equilibrium_of
 from .results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
 from .second_parameter import Derivative, SecondParameter, alpha1_material, second_parameter
@@ -178,6 +179,7 @@ class TwoParameterCurve:
     q0: float = np.nan  # the start value of q
     direction: float = 1.0  # +1: q increased from q0, −1: decreased
     block: Block = Block.ODD_HELD  # the pear block: odd_held, or odd_free (the free balloon's pitchforks)
+    meetings: list = field(default_factory=list)  # codim-2 points LP-BP, LV-BP, LN-BP (``fold_meeting``)
 
     @property
     def n(self) -> int:
@@ -250,7 +252,17 @@ class TwoParameterCurve:
         return Kind.BP
 
     def describe(self) -> str:
-        """One line for people: how the curve ended and where (q, P, pole stretch of its last point or fold)."""
+        """One line for people: how the curve ended and where (q, P, pole stretch of its last point or fold), and
+        where a fold meets the pitchfork (``meetings``)."""
+        return self._ending() + self.describe_meetings()
+
+    def describe_meetings(self) -> str:
+        """'; the LN fold meets the pitchfork at q = … (P = …, located)' per meeting, or ''."""
+        return "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets the pitchfork at {self.parameter} = "
+                       f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value})" for m in self.meetings)
+
+    def _ending(self) -> str:
+        """``describe`` without the meetings."""
         name, points = self.parameter, "pitchforks" if self.of == Kind.BP else f"{self.of.value} folds"
         q, P, stretch = self.q[-1], self.pressure[-1], self.pole_stretch[-1]
         at = f"last point {name} = {q:.6g}, P = {P:.6g}, pole stretch {stretch:.6g}"
@@ -320,9 +332,11 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
                                 + (": the two pitchforks merge" if end == CurveEnd.ISOLA_MERGE else
                                    " (not verified as a merge of the pitchforks)")) for fold in path.folds]
     points = path.points
+    meetings = fold_meetings(system, points, branch.disc, settings, bp.block)
     return TwoParameterCurve(parameter, scene, branch.disc, params, ell, np.array([p.X for p in points]),
                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
-                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), bp.block)
+                             merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), bp.block,
+                             meetings)
 
 
 def plain_branch(branch: Branch, X) -> Branch:

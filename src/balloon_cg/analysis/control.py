@@ -9,6 +9,7 @@ import numpy as np
 
 from ..galerkin.equilibrium import enclosed_volume
 from ..scene import Control
+from .problem import ParameterSystem
 from .results import Kind, StopCode
 
 FOLD_KIND = {Control.PRESSURE: Kind.LP, Control.VOLUME: Kind.LV, Control.GAS: Kind.LN}
@@ -61,6 +62,14 @@ def control_gradient(system, X, control: Control) -> np.ndarray:
     if control == Control.VOLUME:
         return np.append(dV, 0.0)
     return np.append(X[-1] * dV, 2 * np.pi * eq.volume(X[:-1]))
+
+
+def control_gradient_at(eq, u, params, control: Control) -> np.ndarray:
+    """∇c = ∂c/∂(u, P) of the control parameter c at the state u of ``eq`` (a galerkin Equilibrium) and ``params``:
+    e_P under pressure control, else ``control_gradient``."""
+    if control == Control.PRESSURE:
+        return np.append(np.zeros(u.size), 1.0)
+    return control_gradient(ParameterSystem(eq, params, "P"), np.append(u, params.P), control)
 
 
 def fold_monitors(system, control: Control) -> dict:

@@ -38,8 +38,8 @@ from ..scene import Control
 from .branch_point import _parameter_step, _step
 from .codim2 import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status, plain_branch,
                      trace_in_q)
-from .control import FOLD_KIND, control_gradient as loading_gradient
-from .problem import ParameterSystem, continuation_settings, equilibrium_of
+from .control import FOLD_KIND, control_gradient_at as control_gradient
+from .problem import continuation_settings, equilibrium_of
 from .results import Branch, Kind, SpecialPoint, StopCode
 from .second_parameter import Derivative, SecondParameter, second_parameter
 from ..numerics.threads import limited_blas
@@ -148,14 +148,6 @@ class FoldCurve(TwoParameterCurve):
 
     def system(self) -> FoldSystem:
         return FoldSystem(Equilibrium(self.scene, self.disc), self.params, self.second, self.control, self.ell)
-
-
-def control_gradient(eq: Equilibrium, u, params, control: Control) -> np.ndarray:
-    """∇c = ∂c/∂(u, P) of the control parameter c at (u, params): e_P under pressure control, else
-    ``control.control_gradient``."""
-    if control == Control.PRESSURE:
-        return np.append(np.zeros(u.size), 1.0)
-    return loading_gradient(ParameterSystem(eq, params, "P"), np.append(u, params.P), control)
 
 
 def fold_tangent(eq: Equilibrium, X, control: Control, params) -> np.ndarray:

@@ -684,7 +684,7 @@ def _critical(args, scene) -> int:
         raise Failure(f"the {what} near {curve.parameter} = {q:.8g} is only approximately located "
                       f"(±{merge.uncertainty:.1g}: {merge.reason}); curve written to {args.output}")
     print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}; {what}); "
-          f"curve written to {args.output}")
+          f"curve written to {args.output}{curve.describe_meetings()}")
     return 0
 
 

@@ -56,7 +56,7 @@ def summarise_curves(path) -> dict:
     """Provenance and, per two-parameter curve, its parameter, end, critical value and ranges."""
     import h5py
 
-    from ..io.curve_file import CurveFileError, read_curve
+    from ..io.curve_file import CurveFileError, curve_meetings, read_curve
     from ..io.hdf5 import plain
     from ..io.layout import reading
 
@@ -70,7 +70,7 @@ def summarise_curves(path) -> dict:
                                                       "degree", "wall_time")},
                         "of": c["attrs"].get("of", "BP"),
                         "points": len(c["q"]), "q": _range(c["q"]), "pressure": _range(c["pressure"]),
-                        "special_points": c["special_points"]}
+                        "special_points": c["special_points"], "meetings": curve_meetings(c)}
     return {"file": str(path), "kind": "curve", "provenance": attrs, "curves": curves}
 
 
@@ -88,6 +88,9 @@ def format_curves(summary: dict) -> str:
                   f"  ended                {c['end']}: {c['end_description']}",
                   f"  critical value       {critical:.12g}" if np.isfinite(critical) else
                   "  critical value       none (the curve did not end in a verified merge or cusp)",
+                  *(f"  {m['kind']} meeting        {c['parameter']} = {m['q']:.12g}, P = {m['pressure']:.10g} "
+                    f"(pole stretch {m['lam2_north']:.10g}), {m['status']}" +
+                    (f" ±{m['uncertainty']:.1g}" if m["status"] != "located" else "") for m in c["meetings"]),
                   f"  wall time            {c['wall_time']:.3f} s"]
     return "\n".join(lines)
 

@@ -11,8 +11,9 @@ Layout::
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block (BP), the
                                                    fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
-                        the verified merge of the two pitchforks or the verified cusp), and q; state/unknowns in the
-                        branch layout (u, P)
+                        the verified merge of the two pitchforks or the verified cusp; kinds LP-BP, LV-BP, LN-BP:
+                        the meetings of a fold and the pitchfork, analysis.fold_meeting), and q; state/unknowns in
+                        the branch layout (u, P)
 
 ``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
 the primary branch in P, V or n, group named so: ``analysis.fold_curve``). ``end`` is the curve's
@@ -29,6 +30,7 @@ from dataclasses import replace
 import h5py
 import numpy as np
 
+from ..analysis.results import Kind
 from .hdf5 import atomic_file, plain
 from .layout import FileError, check_columns, check_sizes, reading, require_attrs, require_group
 from .run_file import check_special, legendre_poles, read_run, read_special, root_attrs, write_special
@@ -70,10 +72,11 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         attach_dimensions(group, {1: (point,), "unknowns": (point, unknown),
                                   "mode": (point, scale(group, "mode_unknown", columns["mode"].shape[1]))})
         group["q"].attrs["long_name"] = curve.parameter  # q by its name (M, alpha1, …)
-        merges = [replace(s, X=curve.branch_X(s.X)[0]) for s in curve.merges]
+        points = sorted(curve.merges + curve.meetings, key=lambda s: (s.index, s.X[-1]))
         special = group.create_group("special_points")
-        write_special(special, merges, curve.n + 1, lambda X: legendre_poles(curve.disc, X), unknown)
-        q = special.create_dataset("q", data=np.array([s.X[-1] for s in curve.merges], dtype=float))
+        write_special(special, [replace(s, X=curve.branch_X(s.X)[0]) for s in points], curve.n + 1,
+                      lambda X: legendre_poles(curve.disc, X), unknown)
+        q = special.create_dataset("q", data=np.array([s.X[-1] for s in points], dtype=float))
         q.dims[0].attach_scale(special["special"])
         describe(q)
     return path
@@ -109,6 +112,17 @@ def read_curve(path, name: str = "pear") -> dict:
         if not np.isfinite(np.asarray(values, dtype=float)).all():
             raise CurveFileError(where, f"dataset {key} holds NaN or inf (a stored curve point is always finite)")
     return data
+
+
+MEETING_KINDS = (Kind.LP_BP, Kind.LV_BP, Kind.LN_BP)  # the meetings of a fold and the pitchfork
+
+
+def curve_meetings(curve: dict) -> list[dict]:
+    """The meetings of a fold and the pitchfork on a stored curve (``read_curve``): kind, q, pressure, north
+    pole stretch, status and uncertainty each."""
+    return [{"kind": s["kind"], "q": float(q), "pressure": s["pressure"], "lam2_north": s["lam2_north"],
+             "status": s["status"], "uncertainty": s["uncertainty"]}
+            for s, q in zip(curve["special_points"], curve["special_q"]) if s["kind"] in MEETING_KINDS]
 
 
 class CurveFileError(FileError):

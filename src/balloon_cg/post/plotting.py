@@ -36,7 +36,7 @@ from .quantities import branch_discretisation, postprocess, stored_scene, surfac
 from .labels import label_points
 from .style import JournalFigure, journal_style
 from ..galerkin.profiles import EQUATOR
-from ..io.curve_file import read_curve
+from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, reading
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
@@ -1022,6 +1022,11 @@ def plot_phase(paths, axes=None) -> Figure:
                             (critical, P_merge), textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
             elif of != "BP":
                 open_folds.setdefault((of, curve["attrs"]["parameter"]), []).append((q, P))
+            for meeting in curve_meetings(curve):  # a fold curve crosses this pitchfork curve
+                ax.plot(meeting["q"], meeting["pressure"], "D", color=line.get_color(), markerfacecolor="none")
+                ax.annotate(f"{meeting['kind']} {curve['attrs']['parameter']} = {meeting['q']:.6g}",
+                            (meeting["q"], meeting["pressure"]), textcoords="offset points", xytext=(8, -12),
+                            fontsize=8)
     for (of, parameter), folds in open_folds.items():
         _shade_between_folds(ax, of, folds)
     parameter = parameters.pop() if len(parameters) == 1 else "q"
