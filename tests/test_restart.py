@@ -136,6 +136,23 @@ def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
         find_label(read_run(path), 0)
 
 
+def test_continue_exits_1_when_the_branch_it_wrote_is_incomplete(tmp_path, capsys):
+    """A restarted branch that stops short (max_points, as the run's did) is written flagged incomplete, and
+    `continue` says so as `run` does: exit 1 with the verdict on stderr (it exited 0), `--allow-partial` exit 0."""
+    scene = tmp_path / "short.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nmax_points = 5\n')
+    run = tmp_path / "short.h5"
+    assert main(["run", str(scene), "--primary-only", "-o", str(run), "--quiet"]) == 1
+    capsys.readouterr()
+    [(label, _)] = [(label, s) for label, s in special(run, "EP") if s["index"] > 0]
+    out = tmp_path / "again.h5"
+    assert main(["continue", str(run), str(label), "-o", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "stopped_short" in err and "maximum number of points (5)" in err
+    assert not read_run(out)["attrs"]["complete"]
+    assert main(["continue", str(run), str(label), "-o", str(out), "--force", "--quiet", "--allow-partial"]) == 0
+
+
 def test_continue_from_python(gent_run):
     """``balloon_cg.continue_from``: the same as the command, a Result for the branch, the curve for a fold."""
     import balloon_cg as bc

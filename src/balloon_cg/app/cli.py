@@ -810,8 +810,9 @@ def _add_continue(commands):
                     "assesses them, after the branch of the point as read); with --parameter KEY (a scene "
                     "key, as for critical) from a fold (LP, LV, LN) the fold curve in KEY and its cusp, from a "
                     "pear pitchfork (BP odd_held or odd_free) the curve of pitchforks and the isola's critical "
-                    "value (a curve file). Exit 0: written; 1: the computation did not give it (the curve or no "
-                    "switched branch started); 2: bad input (no such label, a label or parameter this does not "
+                    "value (a curve file). Exit 0: written (a run file: and complete); 1: the computation did not "
+                    "give it (the curve or no switched branch started; a run file written but incomplete, as run: "
+                    "--allow-partial exits 0); 2: bad input (no such label, a label or parameter this does not "
                     "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
                     "surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
@@ -822,6 +823,9 @@ def _add_continue(commands):
     p.add_argument("-o", "--output", required=True, help="run or curve file to write (HDF5)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--allow-partial", action="store_true",
+                   help="exit 0 also when the run file written is incomplete (it is still flagged in the file and "
+                        "on stderr)")
     p.set_defaults(handler=continue_run)
 
 
@@ -862,7 +866,7 @@ def _continue(args) -> int:
                   found=result.incomplete)
         print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
               f"{len(branch.special)} special points; written to {args.output}")
-        return 0
+        return verdict_status(result.incomplete, args.allow_partial)
     write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
     ending = f"{result.end.value}: {result.describe()}"
     print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
@@ -872,7 +876,8 @@ def _continue(args) -> int:
 
 def _write_switched(args, picture, attrs) -> int:
     """``continue`` at a branch point: the branch of the point and the branches switched to (``picture``)
-    written (exit 0), or none started (``Failure``: exit 1, nothing written)."""
+    written (exit 0; 1 when incomplete, unless --allow-partial: ``verdict_status``), or none started
+    (``Failure``: exit 1, nothing written)."""
     from ..analysis.results import Branch, stop_codes
     from ..io.run_file import write_run
 
@@ -885,7 +890,7 @@ def _write_switched(args, picture, attrs) -> int:
     listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
                        f"{stop_codes(b.legs)})" for b in branches[1:])
     print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
-    return 0
+    return verdict_status(picture.incomplete, args.allow_partial)
 
 
 def _asymmetry(scene) -> str:
