@@ -13,7 +13,8 @@ by Newton from the previous t (steps of 1/HEIGHT_STEPS, halved on failure down t
 basis (balloon held) of the pear branch's degree. At t = 1 a continued point within ON_BRANCH of the primary
 branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
 branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
-the south pole reaching stop_stretch) and stored with origin ``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
+the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
 """
 import time
 
@@ -25,6 +26,7 @@ from ..numerics.newton import newton
 from . import bifurcation
 from .assembly import assemble
 from .control import landing
+from .events import with_events
 from .primary import stop_rule, trace_primary
 from .problem import ParameterSystem
 from .results import Block, Branch, Origin, StopCode
@@ -140,7 +142,8 @@ def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None
                            stop, progress, degree=_degree(X)) for sign in (1.0, -1.0)]
         land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
                    StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
-        branch = assemble(tracer, params, name, legs[0], legs[1], t0, land_on=land_on, labels=("up", "down"))
+        branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=land_on,
+                                      labels=("up", "down")))
         branch.origin = Origin.CONTINUED_IN_HEIGHT
         return branch
     raise HomotopyError("both halves of the pear branch, continued in the coil heights, lie on the primary branch")
