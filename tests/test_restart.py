@@ -231,6 +231,22 @@ def test_continue_from_the_fold_of_an_assessed_run_locates_its_special_points_ag
                for a, b in zip(before["special_points"], after["special_points"])) < 1e-10
 
 
+def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coils):
+    """Restart in P from the end of the held pear branch pear_0 (λ2(0) = stop_stretch 1.7): back through the
+    pitchfork onto its mirror half, the branch stops where its south pole stretch reaches stop_stretch, landed on it,
+    as `run` stops pear branches (pear_0_mirror there). It went on to λ2(π) = 3.0 and the wire instead, the north
+    pole rule of a primary branch only, where the stability degree no longer resolved it."""
+    run, out = two_coils / "run.h5", two_coils / "from_pear_end.h5"
+    [(label, end)] = [(s["label"], s) for s in read_run(run)["branches"]["pear_0"]["special_points"]
+                      if s["kind"] == "EP"]
+    main(["continue", str(run), str(label), "-o", str(out), "--quiet", "--allow-partial"])
+    branch = read_run(out)["branches"]["primary"]
+    assert list(branch["attrs"]["leg_stop_codes"]) == ["stop_stretch", "south_stop_stretch"]
+    assert abs(max(branch["lam2_south"]) - 1.7) < 1e-12 and abs(max(branch["lam2_north"]) - 1.7) < 1e-12
+    mirror = read_run(run)["branches"]["pear_0_mirror"]
+    assert abs(branch["pressure"][np.argmax(branch["lam2_south"])] - mirror["pressure"][-1]) < 1e-10
+
+
 @pytest.mark.parametrize("block, name", [("odd_held", "pear_0"), ("odd_free", "pear_free_1")])
 def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, block, name, capsys):
     """`continue RUN LABEL` at a pear pitchfork, held or free (no --parameter): the pear branch and its mirror
