@@ -229,6 +229,14 @@ def test_continue_from_the_fold_of_an_assessed_run_locates_its_special_points_ag
     assert len(key) == 7 and key == [(s["kind"], s["block"], s["classification"]) for s in after["special_points"]]
     assert max(abs(a["pressure"] - b["pressure"])
                for a, b in zip(before["special_points"], after["special_points"])) < 1e-10
+    # and its snap-through (the assessment's, as run lists it: at the LP to no stable state); it had none
+    [snap], [again] = [read_run(path)["snap_throughs"] for path in (run, out)]
+    assert (again["from_branch"], again["to_branch"]) == (snap["from_branch"], snap["to_branch"]) == ("primary", "")
+    assert abs(again["pressure"] - snap["pressure"]) < 1e-3
+    import balloon_cg as bc
+
+    result = bc.continue_from(run, first(run, "LP"))  # the same from Python
+    assert len(result.snap_throughs) == 1 and result.snap_throughs[0]["pressure"] == again["pressure"]
 
 
 def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coils):

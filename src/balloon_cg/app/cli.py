@@ -863,7 +863,7 @@ def _continue(args) -> int:
     if isinstance(result, Picture):
         branch = result.primary
         write_run(args.output, branch.scene, result.branches, force=args.force, extra_attrs=attrs,
-                  found=result.incomplete)
+                  snaps=result.snaps, found=result.incomplete)
         print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
               f"{len(branch.special)} special points; written to {args.output}")
         return verdict_status(result.incomplete, args.allow_partial)
@@ -885,7 +885,7 @@ def _write_switched(args, picture, attrs) -> int:
     if len(branches) == 1:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
-    write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs,
+    write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
               found=picture.incomplete)
     listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
                        f"{stop_codes(b.legs)})" for b in branches[1:])
