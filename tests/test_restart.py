@@ -239,7 +239,7 @@ def test_continue_from_the_fold_of_an_assessed_run_locates_its_special_points_ag
     assert len(result.snap_throughs) == 1 and result.snap_throughs[0]["pressure"] == again["pressure"]
 
 
-def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coils):
+def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coils, capsys):
     """Restart in P from the end of the held pear branch pear_0 (λ2(0) = stop_stretch 1.7): back through the
     pitchfork onto its mirror half, the branch stops where its south pole stretch reaches stop_stretch, landed on it,
     as `run` stops pear branches (pear_0_mirror there). It went on to λ2(π) = 3.0 and the wire instead, the north
@@ -253,6 +253,12 @@ def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coi
     assert abs(max(branch["lam2_south"]) - 1.7) < 1e-12 and abs(max(branch["lam2_north"]) - 1.7) < 1e-12
     mirror = read_run(run)["branches"]["pear_0_mirror"]
     assert abs(branch["pressure"][np.argmax(branch["lam2_south"])] - mirror["pressure"][-1]) < 1e-10
+    # what is not searched on it: its branch points' branches; no "broken pitchfork" in a scene whose coils are
+    # mirror-symmetric (the verdict said the pear branch of a broken pitchfork was not traced)
+    capsys.readouterr()
+    assert main(["inspect", str(out)]) == 0
+    verdict = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("result"))
+    assert "the branches at its branch points are not traced" in verdict and "broken" not in verdict
 
 
 @pytest.mark.parametrize("block, name", [("odd_held", "pear_0"), ("odd_free", "pear_free_1")])
