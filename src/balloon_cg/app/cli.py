@@ -589,13 +589,15 @@ def _add_critical(commands):
         description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in the second "
                     "parameter: any runtime parameter of the scene's kernels, named by its scene key (field.M or M, "
                     "field.chi, material.parameters.Jm, material.mu[0], material.alpha[0]) or alpha1 (with mu1 "
-                    "keeping sum mu_i alpha_i = 4); an unknown name lists the scene's. "
-                    "Exit 0: the two pitchforks merge at P > 0 and the curve returns to the partner pitchfork "
-                    "(critical value printed). Exit 1: the computation gave no critical value (no pear pitchfork, "
-                    "or the curve ended otherwise: one line says how and where; the curve file is still written). "
-                    "Exit 2: a scene this command cannot handle (not equator-symmetric; --parameter M without "
-                    "coils), a parameter the scene does not have, or bad input.")
-    p.add_argument("scene", help=f"{SCENE_HELP}; equator-symmetric: coils mirror-symmetric about z = 0")
+                    "keeping sum mu_i alpha_i = 4); an unknown name lists the scene's. With --of LP, LV or LN: its "
+                    "first fold in P, V or n instead, to the cusp where the fold curve turns back. "
+                    "Exit 0: the two pitchforks merge at P > 0 and the curve returns to the partner pitchfork, or "
+                    "the fold curve ends in a cusp (critical value printed). Exit 1: the computation gave no critical "
+                    "value (no pear pitchfork or fold, or the curve ended otherwise: one line says how and where; the "
+                    "curve file is still written). Exit 2: a scene this command cannot handle (--of BP: not "
+                    "equator-symmetric; --parameter M without coils), a parameter the scene does not have, or bad "
+                    "input.")
+    p.add_argument("scene", help=f"{SCENE_HELP}; with --of BP equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
                                                        "material.parameters.Jm, voltage)")
     p.add_argument("--of", default="BP", choices=CURVE_KINDS, metavar="KIND",
