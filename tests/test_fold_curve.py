@@ -206,3 +206,23 @@ def test_phase_diagram_shades_between_the_upper_and_the_lower_fold(tmp_path, cap
         distance = np.hypot((q[:, None] - qs[inside]) / np.ptp(q), (P[:, None] - Ps[inside]) / np.ptp(P)).min(axis=0)
         assert distance.max() < 1e-12
     assert not plot(curves[:1], "phase").axes[0].collections
+
+
+def test_phase_diagram_refuses_curves_of_two_parameters(gent_curve, tmp_path):
+    """Curves in two second parameters (Gent's fold in Jm, SPOM1's in α1) have no common q axis: `plot --what
+    phase` of both is one line naming each parameter and its curves (they were drawn on one axis labelled q);
+    each alone draws."""
+    from balloon_cg.io.curve_file import write_curve
+    from balloon_cg.post.plotting import PlotError, plot
+
+    spom1 = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n', "spom1")
+    branch = trace_primary(spom1, down=False)
+    alpha1 = continue_fold(branch, next(s for s in branch.special if s.kind == Kind.LP), "alpha1", max_points=5)
+    jm = write_curve(tmp_path / "jm.h5", parse_scene(GENT, "gent"), gent_curve, name="LP")
+    a1 = write_curve(tmp_path / "a1.h5", spom1, alpha1, name="LP")
+    with pytest.raises(PlotError) as error:
+        plot([jm, a1], "phase")
+    message = str(error.value)
+    assert "\n" not in message and "material.parameters.Jm (jm: LP)" in message and "alpha1 (a1: LP)" in message
+    assert "Jm" in plot([jm], "phase").axes[0].get_xlabel()
+    assert "alpha_1" in plot([a1], "phase").axes[0].get_xlabel()

@@ -129,3 +129,46 @@ def test_the_disconnected_pear_branch_is_found_by_continuation_in_the_coil_heigh
 
     stored = json.loads(capsys.readouterr().out)["branches"]["broken_pear"]
     assert stored["origin"] == "continued_in_height" and stored["gauge"] == "held"
+
+
+@pytest.mark.slow
+def test_the_disconnected_pear_branch_gets_its_user_points():
+    """A volume event (``[[events]]`` volume = 20) on the coil at h = 0.5: the disconnected pear branch passes V = 20
+    twice (its volume has a minimum 19.886 between them) and holds a located UZ point in each interval, V = 20 there
+    to 1e-10 relative (the volume of the stored state recomputed) and R = 0 to the solver tolerance (it had none:
+    only the primary branch's were located)."""
+    from balloon_cg.analysis.broken_symmetry import broken_pear
+    from balloon_cg.analysis.primary import trace_primary
+
+    scene = parse_scene(SCENE.format(height=0.5).replace("stop_stretch = 3.2", "stop_stretch = 5.0")
+                        + '[[events]]\nquantity = "volume"\nvalue = 20\n', name="coil_at_0.5")
+    broken = broken_pear(scene, trace_primary(scene))
+    eq, system = equilibrium_of(broken), branch_system(broken)
+    volume = np.array([2 * np.pi * eq.volume(X[:-1]) for X in broken.X])
+    crossings = np.flatnonzero((volume[:-1] - 20) * (volume[1:] - 20) < 0)
+    assert len(crossings) == 2
+    points = [s for s in broken.special if s.kind == Kind.UZ]
+    assert [s.index for s in points] == list(crossings) and all(s.note == "volume = 20" for s in points)
+    for s in points:
+        assert s.status == Status.LOCATED and abs(2 * np.pi * eq.volume(s.X[:-1]) / 20 - 1) < 1e-10
+        assert np.abs(system.residual(s.X)).max() <= scene.solver.tol
+
+
+def test_critical_follows_a_fold_of_the_off_equator_coil_and_its_help_says_so(tmp_path, capsys):
+    """`critical --of LP` needs no equator symmetry (a fold is no pitchfork): on the coil at h = 0.5 the fold of P in
+    M runs until P reaches 0 (exit 1, no cusp), while the pitchfork (--of BP) is refused naming the coil (exit 2);
+    the help says the symmetry is needed with --of BP only (it said it of every scene)."""
+    from balloon_cg.app.cli import main
+
+    scene = tmp_path / "off.toml"
+    scene.write_text(SCENE.format(height=0.5).replace("stop_stretch = 3.2", "stop_stretch = 1.5"))
+    assert main(["critical", str(scene), "--of", "LP", "--parameter", "M", "-o", str(tmp_path / "lp.h5"),
+                 "--quiet"]) == 1
+    assert "P reached 0" in capsys.readouterr().err
+    assert main(["critical", str(scene), "--parameter", "M", "-o", str(tmp_path / "bp.h5"), "--quiet"]) == 2
+    assert "coil 0 (radius 2, height 0.5) has no mirror image" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["critical", "--help"])
+    text = " ".join(capsys.readouterr().out.split()).replace("- ", "-")  # argparse wraps after a hyphen
+    assert "--of BP: not equator-symmetric" in text and "with --of BP equator-symmetric" in text
+    assert "the fold curve ends in a cusp" in text

@@ -136,6 +136,23 @@ def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
         find_label(read_run(path), 0)
 
 
+def test_continue_exits_1_when_the_branch_it_wrote_is_incomplete(tmp_path, capsys):
+    """A restarted branch that stops short (max_points, as the run's did) is written flagged incomplete, and
+    `continue` says so as `run` does: exit 1 with the verdict on stderr (it exited 0), `--allow-partial` exit 0."""
+    scene = tmp_path / "short.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[continuation]\nmax_points = 5\n')
+    run = tmp_path / "short.h5"
+    assert main(["run", str(scene), "--primary-only", "-o", str(run), "--quiet"]) == 1
+    capsys.readouterr()
+    [(label, _)] = [(label, s) for label, s in special(run, "EP") if s["index"] > 0]
+    out = tmp_path / "again.h5"
+    assert main(["continue", str(run), str(label), "-o", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "stopped_short" in err and "maximum number of points (5)" in err
+    assert not read_run(out)["attrs"]["complete"]
+    assert main(["continue", str(run), str(label), "-o", str(out), "--force", "--quiet", "--allow-partial"]) == 0
+
+
 def test_continue_from_python(gent_run):
     """``balloon_cg.continue_from``: the same as the command, a Result for the branch, the curve for a fold."""
     import balloon_cg as bc
@@ -212,6 +229,36 @@ def test_continue_from_the_fold_of_an_assessed_run_locates_its_special_points_ag
     assert len(key) == 7 and key == [(s["kind"], s["block"], s["classification"]) for s in after["special_points"]]
     assert max(abs(a["pressure"] - b["pressure"])
                for a, b in zip(before["special_points"], after["special_points"])) < 1e-10
+    # and its snap-through (the assessment's, as run lists it: at the LP to no stable state); it had none
+    [snap], [again] = [read_run(path)["snap_throughs"] for path in (run, out)]
+    assert (again["from_branch"], again["to_branch"]) == (snap["from_branch"], snap["to_branch"]) == ("primary", "")
+    assert abs(again["pressure"] - snap["pressure"]) < 1e-3
+    import balloon_cg as bc
+
+    result = bc.continue_from(run, first(run, "LP"))  # the same from Python
+    assert len(result.snap_throughs) == 1 and result.snap_throughs[0]["pressure"] == again["pressure"]
+
+
+def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coils, capsys):
+    """Restart in P from the end of the held pear branch pear_0 (λ2(0) = stop_stretch 1.7): back through the
+    pitchfork onto its mirror half, the branch stops where its south pole stretch reaches stop_stretch, landed on it,
+    as `run` stops pear branches (pear_0_mirror there). It went on to λ2(π) = 3.0 and the wire instead, the north
+    pole rule of a primary branch only, where the stability degree no longer resolved it."""
+    run, out = two_coils / "run.h5", two_coils / "from_pear_end.h5"
+    [(label, end)] = [(s["label"], s) for s in read_run(run)["branches"]["pear_0"]["special_points"]
+                      if s["kind"] == "EP"]
+    main(["continue", str(run), str(label), "-o", str(out), "--quiet", "--allow-partial"])
+    branch = read_run(out)["branches"]["primary"]
+    assert list(branch["attrs"]["leg_stop_codes"]) == ["stop_stretch", "south_stop_stretch"]
+    assert abs(max(branch["lam2_south"]) - 1.7) < 1e-12 and abs(max(branch["lam2_north"]) - 1.7) < 1e-12
+    mirror = read_run(run)["branches"]["pear_0_mirror"]
+    assert abs(branch["pressure"][np.argmax(branch["lam2_south"])] - mirror["pressure"][-1]) < 1e-10
+    # what is not searched on it: its branch points' branches; no "broken pitchfork" in a scene whose coils are
+    # mirror-symmetric (the verdict said the pear branch of a broken pitchfork was not traced)
+    capsys.readouterr()
+    assert main(["inspect", str(out)]) == 0
+    verdict = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("result"))
+    assert "the branches at its branch points are not traced" in verdict and "broken" not in verdict
 
 
 @pytest.mark.parametrize("block, name", [("odd_held", "pear_0"), ("odd_free", "pear_free_1")])

@@ -258,6 +258,24 @@ def test_two_coil_curve_in_alpha1_reaches_the_wire(two_coils):
     assert curve.merges == [] and np.all(curve.pressure > 0) and curve.q[-1] > 3
 
 
+@pytest.mark.parametrize("of", ["BP", "LP"])
+def test_a_curve_in_M_stops_where_M_reaches_zero(two_coils, of):
+    """M = I²/(16π²R0²μ) is never negative (the scene's range is [0, 1000]): the two-coil pitchfork and the fold of
+    P, continued in M downward, stop where M falls below 0 (end ALPHA1_ZERO, the stop of a parameter leaving its
+    range) instead of tracing on into M < 0 (they did: a 'cusp' at M = −0.78 was printed as the critical M)."""
+    from balloon_cg.analysis.fold_curve import continue_fold
+    from balloon_cg.analysis.results import Kind
+
+    branch, bp = two_coils
+    if of == "BP":
+        curve = continue_branch_point(branch, bp, "M", direction=-1.0)
+    else:
+        curve = continue_fold(branch, next(s for s in branch.special if s.kind == Kind.LP), "M", direction=-1.0)
+    assert curve.stop.code == StopCode.ALPHA1_ZERO and curve.end == CurveEnd.ALPHA1_ZERO
+    assert curve.critical is None and np.all(curve.q >= 0) and np.all(np.diff(curve.q) < 0)
+    assert "M fell below 0" in curve.stop.message
+
+
 def test_fold_without_the_partner_is_not_a_merge():
     """A coil of radius 2.2 in the equatorial plane: the curve turns back in M at P > 0 (M ≈ 0.030) but reaches the
     wire gap before it comes back to the scene's M: end FOLD, the fold APPROXIMATE, no critical M."""

@@ -13,7 +13,8 @@ by Newton from the previous t (steps of 1/HEIGHT_STEPS, halved on failure down t
 basis (balloon held) of the pear branch's degree. At t = 1 a continued point within ON_BRANCH of the primary
 branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
 branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
-the south pole reaching stop_stretch) and stored with origin ``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
+the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
 """
 import time
 
@@ -24,12 +25,12 @@ from ..numerics import continuation
 from ..numerics.newton import newton
 from . import bifurcation
 from .assembly import assemble
-from .control import landing
-from .primary import stop_rule, trace_primary
+from .events import with_events
+from .primary import trace_primary
 from .problem import ParameterSystem
-from .results import Block, Branch, Origin, StopCode
+from .results import Block, Branch, Origin
 from .stability import assess_branch
-from .switching import south_stop_stretch, trace_pear
+from .switching import pear_landing, pear_stop_rule, trace_pear
 from .tracer import Tracer
 
 SEED_AMPLITUDE = 1.0  # |λ2(0) − λ2(π)| of the point continued in the coil heights: far from the primary branch
@@ -128,19 +129,11 @@ def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None
         system = tracer.system(_degree(X), params)
         if distance_to(primary, X, system.eq.disc) <= ON_BRANCH:
             continue  # the half that joins the primary branch
-        stretch = scene.continuation.stop_stretch
-        base = stop_rule(scene, stretch)
-
-        def stop(disc, point):
-            south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
-            return south_stop_stretch(stretch) if south >= stretch else base(disc, point)
-
-        pressure = np.eye(X.size)[-1]
+        stop, pressure = pear_stop_rule(scene), np.eye(X.size)[-1]
         legs = [tracer.leg(continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0), params,
                            stop, progress, degree=_degree(X)) for sign in (1.0, -1.0)]
-        land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
-                   StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
-        branch = assemble(tracer, params, name, legs[0], legs[1], t0, land_on=land_on, labels=("up", "down"))
+        branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=pear_landing(scene),
+                                      labels=("up", "down")))
         branch.origin = Origin.CONTINUED_IN_HEIGHT
         return branch
     raise HomotopyError("both halves of the pear branch, continued in the coil heights, lie on the primary branch")

@@ -38,9 +38,9 @@ if the curve, after it, comes back to q0 at the partner pitchfork with P > 0 all
 returns past q0 (stop ``PARTNER``), when P ≤ 0 (``StopCode.NONPOSITIVE_PRESSURE``: the pitchforks leave the
 physical range of an inflated balloon; the message gives q where the curve crosses P = 0), when the membrane
 comes within ``continuation.wire_gap`` of a coil (``WIRE_GAP``), when q reaches 0 for a parameter that must
-not (α1, an exponent, a family's positive parameter: ``ALPHA1_ZERO``), at ``max_points``, at the minimum step,
-or at the next point after SIGINT/SIGTERM (``numerics.interrupt``: ``StopCode.INTERRUPTED``). The end is then, in
-this order of precedence:
+not (α1, an exponent, a family's positive parameter) or falls below 0 (M, χ, Φ̄: ``ALPHA1_ZERO``), at
+``max_points``, at the minimum step, or at the next point after SIGINT/SIGTERM (``numerics.interrupt``:
+``StopCode.INTERRUPTED``). The end is then, in this order of precedence:
 
     INTERRUPTED            a signal stopped the trace: the curve is partial (folds so far are not verified)
     ISOLA_MERGE            a fold in q at P > 0, then the partner pitchfork (stop PARTNER): the isola is born or
@@ -51,7 +51,8 @@ this order of precedence:
     WIRE                   no fold, and the membrane reached continuation.wire_gap of a coil
     BUDGET                 no fold, and max_points were traced
     STEP_MIN               no fold, and the corrector failed at the minimum step
-    ALPHA1_ZERO            no fold, and q reached 0 (α1, an exponent or a positive parameter)
+    ALPHA1_ZERO            no fold, and q reached 0 (α1, an exponent or a positive parameter) or fell below 0
+                           (M, χ, Φ̄)
     OTHER                  a caller's own stop rule stopped the curve
 
 The merge points (``merges``: every fold in q, LP special points) carry ``Status.LOCATED`` only for the merge of
@@ -98,7 +99,7 @@ class CurveEnd(enum.StrEnum):
     WIRE = "wire"  # the membrane reached continuation.wire_gap of a coil (no fold before)
     BUDGET = "budget"  # max_points traced (no fold before)
     STEP_MIN = "step_min"  # the corrector failed at the minimum step (no fold before)
-    ALPHA1_ZERO = "alpha1_zero"  # q (α1, an exponent, a positive parameter) reached 0 (no fold before)
+    ALPHA1_ZERO = "alpha1_zero"  # q reached 0 (α1, an exponent, a positive parameter) or fell below it (M, χ, Φ̄)
     OTHER = "other"  # a caller's stop rule
 
 
@@ -389,7 +390,10 @@ def trace_in_q(system, X0, what: str, branch: Branch, parameter: SecondParameter
         gap, coil = wire_gap(branch.disc, point.X[:n], coils)
         if gap < gap_limit:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap_limit:g} of coil {coil} (gap {gap:.3g})")
-        return rule(point)
+        stopped = rule(point)  # first: a curve back at its partner past a small q0 > 0 is back, not out of range
+        if stopped is None and parameter.nonnegative and point.X[-1] < 0:
+            return Stop(StopCode.ALPHA1_ZERO, f"{name} fell below 0 (its range starts at 0)")
+        return stopped
 
     path = continuation.trace(system, start, settings, stop_point, {Kind.LP: e_q}, progress)
     if path.stop.code == StopCode.NONPOSITIVE_PRESSURE:

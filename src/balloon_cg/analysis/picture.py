@@ -257,10 +257,12 @@ def _trace_broken(scene, primary: Branch, picture: Picture, progress: Progress) 
 
 def _unsearched(primary: Branch, searched: bool) -> str:
     """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``); ``searched``:
-    the disconnected pear branch was searched for (``_trace_broken``)."""
-    missing = ("the branches at its branch points are not traced" if searched else
-               "the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
-               "and those at its branch points) are not traced")
+    the disconnected pear branch was searched for (``_trace_broken``). A scene whose coils are equator-symmetric
+    breaks no pitchfork (a pear branch restarted by ``continue``, ``continuation.symmetry = "none"``)."""
+    broken = not searched and not primary.scene.field.is_equator_symmetric
+    missing = ("the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
+               "and those at its branch points) are not traced" if broken else
+               "the branches at its branch points are not traced")
     if primary.gauge == Gauge.HELD:
         missing += "; nor is the free balloon's branch (its axial translation free)"
     return missing

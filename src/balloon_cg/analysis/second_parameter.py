@@ -16,7 +16,8 @@ parameter added to the kernels later needs no change here:
 ``Equilibrium.derivative_kernel``: M's field_gradient, NAME_gradient), else CENTRAL: the central difference
 (R(q + h) − R(q − h))/(2h) with h = H_STEP·max(1, |q|) (``branch_point.H_STEP``, relative 1e-6). Ogden exponents,
 α1 and a family's positive parameters (``energies.Family.positive``) must not reach 0 (``bound``: the curve
-stops there).
+stops there); the runtime scalars M, χ and Φ̄ must not fall below 0 (``nonnegative``: their scene ranges start at 0;
+M = I²/(16π²R0²μ) is a square), so the curve stops where one does.
 """
 import enum
 import re
@@ -55,7 +56,8 @@ class Derivative(enum.StrEnum):
 class SecondParameter:
     """One second parameter of a scene (module docstring): its key, short name (labels, messages), where it
     enters, its index among the material's values or terms, the scene's value q0, how ∂R/∂q is computed, the
-    kernel class it needs (None: the scene's) and whether q must keep the sign of q0."""
+    kernel class it needs (None: the scene's), whether q must keep the sign of q0 (``bound``) and whether it must
+    not fall below 0 (``nonnegative``: a runtime scalar, M, χ, Φ̄)."""
 
     key: str
     name: str
@@ -65,6 +67,7 @@ class SecondParameter:
     derivative: Derivative
     kernel_class: str | None
     bound: bool
+    nonnegative: bool = False
 
     def at(self, params: Parameters, material, q: float) -> Parameters:
         """``params`` with q set; ``material`` is the scene's (the values q does not replace)."""
@@ -163,4 +166,4 @@ def second_parameter(scene, eq: Equilibrium, params: Parameters, key: str) -> Se
     name = key.split(".")[-1]
     exact = eq.derivative_kernel(name) is not None
     return SecondParameter(key, name, Source.SCALAR, -1, float(getattr(params, name)),
-                           Derivative.EXACT if exact else Derivative.CENTRAL, None, False)
+                           Derivative.EXACT if exact else Derivative.CENTRAL, None, False, nonnegative=True)

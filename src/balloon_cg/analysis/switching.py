@@ -62,7 +62,7 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
         return None
     start = continuation.Point(result.x, continuation.tangent(system, result.x, phi), result.iterations,
                                result.residual)
-    base = stop_rule(scene, scene.continuation.stop_stretch)
+    base = pear_stop_rule(scene)
     anchors = {}
 
     def stop(disc, point):
@@ -72,22 +72,38 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
         direction, star = anchors[disc]
         if direction @ (point.X - star) < 0:
             return Stop(StopCode.REJOINED, "rejoined the primary branch")
-        south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
-        if south >= scene.continuation.stop_stretch:
-            return south_stop_stretch(scene.continuation.stop_stretch)
         return base(disc, point)
 
-    stretch = scene.continuation.stop_stretch
-    land_on = {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
-               StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
     turning = NORTH_TURNING | ({Turn.SOUTH: "lam2_south"} if south_turns else {})
     return with_events(assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree,
-                                                                 turning=turning), t0=t0, land_on=land_on))
+                                                                 turning=turning), t0=t0, land_on=pear_landing(scene)))
 
 
 def south_stop_stretch(upper: float) -> Stop:
     """The stop of a pear branch whose south pole stretch reached ``upper`` (continuation.stop_stretch)."""
     return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
+
+
+def pear_stop_rule(scene):
+    """stop(disc, point) -> Stop or None of a pear branch (no equator symmetry, either pole may grow): its south
+    pole stretch reaches continuation.stop_stretch (``south_stop_stretch``), or the primary branch's rule
+    (``primary.stop_rule``: the north pole's range, the wires, the control's stops)."""
+    stretch = scene.continuation.stop_stretch
+    base = stop_rule(scene, stretch)
+
+    def stop(disc, point):
+        south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
+        return south_stop_stretch(stretch) if south >= stretch else base(disc, point)
+
+    return stop
+
+
+def pear_landing(scene) -> dict:
+    """``assembly.assemble``'s land_on of a pear branch: either pole stretch at stop_stretch, the north pole at
+    min_stretch, and the control stop (``control.landing``)."""
+    stretch = scene.continuation.stop_stretch
+    return {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
+            StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
 
 
 def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:

@@ -435,7 +435,7 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
         if len(branches) == 1 and start.point.kind == Kind.BP:
             raise RuntimeError(f"no branch started at label {label}: " + "; ".join(
                 f"{name}: {reason}" for name, reason in result.not_started))
-        return Result.of(branches[0].scene, branches, found=result.incomplete, picture=result, command=command)
+        return Result.of(branches[0].scene, branches, result.snaps, result.incomplete, result, command=command)
     return result
 
 

@@ -589,13 +589,15 @@ def _add_critical(commands):
         description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in the second "
                     "parameter: any runtime parameter of the scene's kernels, named by its scene key (field.M or M, "
                     "field.chi, material.parameters.Jm, material.mu[0], material.alpha[0]) or alpha1 (with mu1 "
-                    "keeping sum mu_i alpha_i = 4); an unknown name lists the scene's. "
-                    "Exit 0: the two pitchforks merge at P > 0 and the curve returns to the partner pitchfork "
-                    "(critical value printed). Exit 1: the computation gave no critical value (no pear pitchfork, "
-                    "or the curve ended otherwise: one line says how and where; the curve file is still written). "
-                    "Exit 2: a scene this command cannot handle (not equator-symmetric; --parameter M without "
-                    "coils), a parameter the scene does not have, or bad input.")
-    p.add_argument("scene", help=f"{SCENE_HELP}; equator-symmetric: coils mirror-symmetric about z = 0")
+                    "keeping sum mu_i alpha_i = 4); an unknown name lists the scene's. With --of LP, LV or LN: its "
+                    "first fold in P, V or n instead, to the cusp where the fold curve turns back. "
+                    "Exit 0: the two pitchforks merge at P > 0 and the curve returns to the partner pitchfork, or "
+                    "the fold curve ends in a cusp (critical value printed). Exit 1: the computation gave no critical "
+                    "value (no pear pitchfork or fold, or the curve ended otherwise: one line says how and where; the "
+                    "curve file is still written). Exit 2: a scene this command cannot handle (--of BP: not "
+                    "equator-symmetric; --parameter M without coils), a parameter the scene does not have, or bad "
+                    "input.")
+    p.add_argument("scene", help=f"{SCENE_HELP}; with --of BP equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
                                                        "material.parameters.Jm, voltage)")
     p.add_argument("--of", default="BP", choices=CURVE_KINDS, metavar="KIND",
@@ -810,8 +812,9 @@ def _add_continue(commands):
                     "assesses them, after the branch of the point as read); with --parameter KEY (a scene "
                     "key, as for critical) from a fold (LP, LV, LN) the fold curve in KEY and its cusp, from a "
                     "pear pitchfork (BP odd_held or odd_free) the curve of pitchforks and the isola's critical "
-                    "value (a curve file). Exit 0: written; 1: the computation did not give it (the curve or no "
-                    "switched branch started); 2: bad input (no such label, a label or parameter this does not "
+                    "value (a curve file). Exit 0: written (a run file: and complete); 1: the computation did not "
+                    "give it (the curve or no switched branch started; a run file written but incomplete, as run: "
+                    "--allow-partial exits 0); 2: bad input (no such label, a label or parameter this does not "
                     "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
                     "surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
@@ -822,6 +825,9 @@ def _add_continue(commands):
     p.add_argument("-o", "--output", required=True, help="run or curve file to write (HDF5)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--allow-partial", action="store_true",
+                   help="exit 0 also when the run file written is incomplete (it is still flagged in the file and "
+                        "on stderr)")
     p.set_defaults(handler=continue_run)
 
 
@@ -859,10 +865,10 @@ def _continue(args) -> int:
     if isinstance(result, Picture):
         branch = result.primary
         write_run(args.output, branch.scene, result.branches, force=args.force, extra_attrs=attrs,
-                  found=result.incomplete)
+                  snaps=result.snaps, found=result.incomplete)
         print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
               f"{len(branch.special)} special points; written to {args.output}")
-        return 0
+        return verdict_status(result.incomplete, args.allow_partial)
     write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
     ending = f"{result.end.value}: {result.describe()}"
     print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
@@ -872,7 +878,8 @@ def _continue(args) -> int:
 
 def _write_switched(args, picture, attrs) -> int:
     """``continue`` at a branch point: the branch of the point and the branches switched to (``picture``)
-    written (exit 0), or none started (``Failure``: exit 1, nothing written)."""
+    written (exit 0; 1 when incomplete, unless --allow-partial: ``verdict_status``), or none started
+    (``Failure``: exit 1, nothing written)."""
     from ..analysis.results import Branch, stop_codes
     from ..io.run_file import write_run
 
@@ -880,12 +887,12 @@ def _write_switched(args, picture, attrs) -> int:
     if len(branches) == 1:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
-    write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs,
+    write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
               found=picture.incomplete)
     listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
                        f"{stop_codes(b.legs)})" for b in branches[1:])
     print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
-    return 0
+    return verdict_status(picture.incomplete, args.allow_partial)
 
 
 def _asymmetry(scene) -> str:

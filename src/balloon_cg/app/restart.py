@@ -40,6 +40,7 @@ from ..analysis.picture import (PEAR_NAMES, Picture, Progress, azimuthal_crossin
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.surface_branches import SurfaceStartError
+from ..analysis.switching import pear_landing, pear_stop_rule
 from ..analysis.tracer import Tracer
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation
@@ -125,7 +126,8 @@ def find_label(run: dict, label: int) -> Labelled:
 
 def restart_branch(start: Labelled, progress=None) -> Picture:
     """The branch through the labelled point, traced again from it in both directions in the branch's parameter
-    (module docstring), on the stored degree and basis map; if the stored branch was assessed, assessed and its
+    (module docstring), on the stored degree and basis map, with the stops of its kind (a pear branch's: either pole
+    stretch at stop_stretch, ``switching.pear_stop_rule``); if the stored branch was assessed, assessed and its
     branch points and m ≥ 1 points located (``picture.examine``, no branch switched), as ``run`` gives them."""
     t0 = time.perf_counter()
     branch, scene = start.branch, start.branch.scene
@@ -136,11 +138,12 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
     system = tracer.system(disc.degree, params, disc.mapping)
     point = step_away(system, start, tracer.settings)
     upper = scene.continuation.stop_stretch
-    stop, limits = stop_rule(scene, upper), range_limits(scene, upper)
+    pear = branch.name != "primary"  # a pear branch (pear_<n>, its mirror, broken_pear): stopped as run stops them
+    stop = pear_stop_rule(scene) if pear else stop_rule(scene, upper)
     legs = [tracer.leg(replace(point, tangent=sign * point.tangent), params, stop, progress, degree=disc.degree,
-                       mapping=disc.mapping, limits=limits) for sign in (1.0, -1.0)]
-    primary = with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0,
-                                   land_on=landing_targets(scene, upper), labels=("up", "down")))
+                       mapping=disc.mapping, limits=range_limits(scene, upper)) for sign in (1.0, -1.0)]
+    primary = with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0, labels=("up", "down"),
+                                   land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
     return examine(scene, primary, Ticks(progress), pear=False) if start.assessed else Picture([primary])
 
 

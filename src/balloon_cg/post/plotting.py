@@ -981,7 +981,7 @@ def plot_phase(paths, axes=None) -> Figure:
     where the isola exists (q between its start and the critical value, P between the two pitchfork pressures),
     or where the balloon snaps through (between the two folds), is shaded."""
     fig, (ax,), _ = _panels(axes, 1, (6.4, 4.6))
-    parameters, kinds, open_folds = set(), set(), {}
+    parameters, kinds, open_folds = {}, set(), {}  # parameters: {scene key: (short name, [what is drawn in it])}
     if any(isinstance(path, dict) for path in paths):
         raise PlotError("phase draws curve files (balloon-cg critical) or sweep files, not runs")
     for path in paths:
@@ -994,7 +994,8 @@ def plot_phase(paths, axes=None) -> Figure:
             names = list(f.get("two_parameter", {}))
             is_sweep = "members" in f
         if is_sweep:
-            parameters.add(_sweep_phase(ax, path))
+            key = _sweep_phase(ax, path)
+            parameters.setdefault(key, ("M" if key == "field.M" else key, []))[1].append(Path(path).stem)
             continue
         if not names:
             raise PlotError(f"{path}: no two-parameter curve and no sweep members in this file (write one with "
@@ -1002,7 +1003,9 @@ def plot_phase(paths, axes=None) -> Figure:
         for name in names:
             curve = read_curve(path, name)
             q, P = curve["q"], curve["pressure"]
-            parameters.add(curve["attrs"]["parameter"])
+            short = curve["attrs"]["parameter"]
+            key = curve["attrs"].get("parameter_key", "field.M" if short == "M" else short)  # older files: M, alpha1
+            parameters.setdefault(key, (short, []))[1].append(f"{Path(path).stem}: {name}")
             folds = [(s["index"], q_s, s["pressure"]) for s, q_s in zip(curve["special_points"], curve["special_q"])
                      if s["kind"] == "LP"]
             dense_q, dense_P = smooth_curve(*_with_points(q, P, folds))
@@ -1029,7 +1032,11 @@ def plot_phase(paths, axes=None) -> Figure:
                             fontsize=8)
     for (of, parameter), folds in open_folds.items():
         _shade_between_folds(ax, of, folds)
-    parameter = parameters.pop() if len(parameters) == 1 else "q"
+    if len(parameters) > 1:  # one q axis
+        listed = "; ".join(f"{key} ({', '.join(drawn)})" for key, (_, drawn) in parameters.items())
+        raise PlotError(f"phase draws the curves of one second parameter on one axis; these are in "
+                        f"{len(parameters)}: {listed} (draw each parameter's files on their own)")
+    [(parameter, _)] = parameters.values()
     ax.set_xlabel(PARAMETER_LABELS.get(parameter, parameter))
     if kinds <= {"BP"}:
         ax.set_ylabel(r"bifurcation pressure $P = \bar P R_0/(T_0\mu/2)$")
@@ -1088,7 +1095,7 @@ def smooth_curve(q, P, samples: int = 400):
 def _sweep_phase(ax, path) -> str:
     """Pear pitchfork pressures of every sweep member against the first varied key, and the primary branch's
     fold (LP, the pressure maximum); the isola region (two pitchforks) shaded between them, its edges
-    interpolated between the members monotonically (PCHIP: no overshoot). Returns the parameter name."""
+    interpolated between the members monotonically (PCHIP: no overshoot). Returns the varied key (dotted)."""
     sweep = read_sweep(path)
     if sweep["attrs"].get("mode") == "primary-only":  # no stability, so no branch points: an empty diagram
         raise PlotError(f"{path}: a primary-only sweep has no branch points to draw (sweep without --primary-only)")
@@ -1116,7 +1123,7 @@ def _sweep_phase(ax, path) -> str:
         dense = np.linspace(q[0], q[-1], 200)
         low, high = (PchipInterpolator(q, [r[1][k] for r in two])(dense) for k in (0, -1))
         ax.fill_between(dense, low, high, alpha=0.15, label="isola exists")
-    return "M" if key == "field.M" else key
+    return key
 
 
 KINDS = {
