@@ -293,6 +293,28 @@ def test_continue_at_a_pear_pitchfork_switches_to_the_pear_branch(two_coils, blo
         assert np.abs(np.asarray(result.branches[name].data["unknowns"]) - stored[name]["unknowns"]).max() < 1e-10
 
 
+@pytest.mark.parametrize("name, block", [("pear_0", "odd_held"), ("pear_free_1", "odd_free")])
+def test_continue_from_the_end_of_a_pear_branch_passes_its_pitchfork_into_the_mirror_image(two_coils, name, block):
+    """Restart in P from the end point of a pear branch (held or free): the branch runs back to its pitchfork on
+    the primary branch and through it into its mirror image, as a pitchfork's pear branch does (P is even in the
+    pear amplitude). The fold of P there is that pitchfork (the primary's point, of the branch's own reading),
+    not an LP whose root search fails at the singular point; the far end is the run's mirror branch's end
+    (reflected in run, traced here) to 1e-10; exit 0."""
+    run, out = two_coils / "run.h5", two_coils / f"from_{name}_end.h5"
+    stored = read_run(run)["branches"]
+    end = next(s for s in stored[name]["special_points"] if s["kind"] == "EP" and s["index"] > 0)
+    assert main(["continue", str(run), str(end["label"]), "-o", str(out), "--quiet"]) == 0
+    again = read_run(out)["branches"]["primary"]
+    kinds = [(s["kind"], s["block"]) for s in again["special_points"]]
+    assert kinds == [("EP", ""), ("BP", block), ("EP", "")]
+    pitchfork = next(s for s in stored["primary"]["special_points"] if s["kind"] == "BP" and s["block"] == block)
+    assert again["special_points"][1]["pressure"] == pitchfork["pressure"]
+    mirror_end = next(s for s in stored[f"{name}_mirror"]["special_points"] if s["kind"] == "EP" and s["index"] > 0)
+    far = max(again["special_points"][::2], key=lambda s: abs(s["lam2_north"] - end["lam2_north"]))
+    for key in ("pressure", "lam2_north", "lam2_south"):
+        assert abs(far[key] - mirror_end[key]) < 1e-10, key
+
+
 def test_continue_refuses_a_switch_or_a_curve_it_does_not_build(two_coils, capsys):
     """At a free m = 1 point (run traces no branch there either), and from an m = 1 point in a second parameter:
     one line each, exit 2, nothing written."""

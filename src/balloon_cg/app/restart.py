@@ -40,7 +40,7 @@ from ..analysis.picture import (PEAR_NAMES, Picture, Progress, azimuthal_crossin
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.surface_branches import SurfaceStartError
-from ..analysis.switching import pear_landing, pear_stop_rule
+from ..analysis.switching import mark_rejoin, pear_landing, pear_stop_rule
 from ..analysis.tracer import Tracer
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation
@@ -60,6 +60,8 @@ class Labelled:
     branch: Branch
     point: SpecialPoint
     assessed: bool = False  # the stored branch has its stability (a run without --primary-only)
+    parent: Branch | None = None  # a pear branch's parent (the primary branch, as read) ...
+    parent_point: int = -1  # ... and the number of its pitchfork there (``numbered_branch_points``)
 
 
 def stored_branch(run: dict, name: str) -> Branch:
@@ -117,8 +119,10 @@ def find_label(run: dict, label: int) -> Labelled:
             if data["attrs"].get("m", 0) or "surface_degree" in data["attrs"]:
                 raise RestartError(f"label {label}: a point of the surface branch {name}; continue starts from "
                                    "axisymmetric branches only")
-            branch = stored_branch(run, name)
-            return Labelled(label, branch, branch.special[row], "stability" in data)
+            branch, parent = stored_branch(run, name), data["attrs"].get("parent_branch", "")
+            return Labelled(label, branch, branch.special[row], "stability" in data,
+                            stored_branch(run, parent) if parent in run["branches"] else None,
+                            int(data["attrs"].get("parent_branch_point", -1)))
     listed = f"{min(labels)}..{max(labels)}" if labels else "none"
     raise RestartError(f"label {label}: no special point has it in {run['path']} (its labels: {listed}; "
                        "balloon-cg inspect shows them)")
@@ -144,6 +148,13 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
                        mapping=disc.mapping, limits=range_limits(scene, upper)) for sign in (1.0, -1.0)]
     primary = with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0, labels=("up", "down"),
                                    land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
+    if start.parent is not None:  # through its pitchfork on the parent into the mirror image: the fold of P there
+        #                             is that pitchfork (P is even in the pear amplitude), as run marks a rejoin
+        points = numbered_branch_points(start.parent)
+        block = points[start.parent_point].block  # its reading's pitchforks (held or free)
+        for number, bp in enumerate(points):
+            if bp.block == block:
+                mark_rejoin(primary, start.parent, number, bp)
     return examine(scene, primary, Ticks(progress), pear=False) if start.assessed else Picture([primary])
 
 
