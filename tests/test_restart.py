@@ -122,6 +122,27 @@ def test_continue_from_the_pear_pitchfork_gives_the_critical_curve(tmp_path, cap
     assert np.abs(restarted["pressure"] - traced["pressure"]).max() < 1e-10
 
 
+def test_continue_with_set_finishes_a_run_that_stopped_at_max_points(gent_run, tmp_path, capsys):
+    """A run stopped short at max_points = 30 (one fold of two, exit 1): `continue RUN LABEL --set
+    continuation.max_points=200` from its fold reaches both ends, and its two folds are the full run's to 1e-10; a
+    key that changes the equations is refused in one line (exit 2, nothing written)."""
+    scene, short, out = tmp_path / "short.toml", tmp_path / "short.h5", tmp_path / "long.h5"
+    scene.write_text(GENT + "max_points = 30\n")
+    assert main(["run", str(scene), "--primary-only", "-o", str(short), "--quiet"]) == 1
+    [(label, _)] = special(short, "LP")
+    assert main(["continue", str(short), str(label), "-o", str(out), "--quiet"]) == 1  # max_points again
+    assert main(["continue", str(short), str(label), "-o", str(out), "--quiet", "--force",
+                 "--set", "continuation.max_points=200"]) == 0
+    full = [s["pressure"] for _, s in special(gent_run / "gent.h5", "LP")]
+    assert len(full) == 2 and np.abs(np.array([s["pressure"] for _, s in special(out, "LP")]) - full).max() < 1e-10
+    capsys.readouterr()
+    refused = tmp_path / "refused.h5"
+    assert main(["continue", str(short), str(label), "-o", str(refused), "--set", "material.parameters.Jm=50"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--set material.parameters.Jm: continue keeps the stored point's" in err
+    assert not refused.exists()
+
+
 def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
     """A label the file does not have, a second parameter from an end point: one line, exit 2, nothing written."""
     path = gent_run / "gent.h5"

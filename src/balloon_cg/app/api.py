@@ -383,7 +383,8 @@ def analyse(scene, pear: bool = True, progress: bool = False) -> Result:
                      clock=clock)
 
 
-def continue_from(path, label: int, parameter: str | None = None, direction: float = 1.0):
+def continue_from(path, label: int, parameter: str | None = None, direction: float = 1.0,
+                  overrides: dict | None = None):
     """Restart from a labelled special point of a run file (``balloon-cg continue``, app.restart).
 
     Ctrl-C (SIGINT) stops it at the next point.
@@ -398,6 +399,9 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
         A second parameter (a scene key, as for ``critical``); default None: the branch's own parameter.
     direction : float, optional
         A fold curve starts with the parameter increasing (1, default) or decreasing (-1).
+    overrides : dict, optional
+        Scene keys to set for what is traced (``continue --set``): continuation, solver, stability, surface,
+        loading and events keys only (``{"continuation.max_points": 800}``; None restores a default).
 
     Returns
     -------
@@ -424,9 +428,9 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     from ..analysis.picture import Picture
     from ..analysis.results import Kind
     from ..io.run_file import read_run
-    from .restart import find_label, restart
+    from .restart import find_label, restart, with_settings
 
-    start = find_label(read_run(path), int(label))
+    start = with_settings(find_label(read_run(path), int(label)), overrides or {})
     with stop_on_signals():
         result = restart(start, parameter, direction)
     command = f"balloon_cg.continue_from({str(path)!r}, {label})"

@@ -828,6 +828,7 @@ def _add_continue(commands):
     p.add_argument("--allow-partial", action="store_true",
                    help="exit 0 also when the run file written is incomplete (it is still flagged in the file and "
                         "on stderr)")
+    _add_settings(p)
     p.set_defaults(handler=continue_run)
 
 
@@ -848,12 +849,13 @@ def _continue(args) -> int:
     from ..io.curve_file import write_curve
     from ..io.output import check_output
     from ..io.run_file import read_run, write_run
-    from .restart import RestartError, find_label, restart
+    from .restart import RestartError, find_label, restart, with_settings
 
     check_output(hdf5_output(args.output, "run"), args.force)
     run = read_run(args.run)
     try:
         start = find_label(run, args.label)
+        start = with_settings(start, _with_settings(args, start.branch.scene)[1])
         result = restart(start, args.parameter, args.direction)
     except (RestartError, UnknownParameter) as e:
         raise UsageError(f"continue {args.run}: {e}") from None

@@ -20,7 +20,8 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   ``pear_point``), as ``critical`` traces the held one.
 
 The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
-parameters, points and special points. Not yet (RestartError, one line): the other branch points (even, m ≥ 1)
+parameters, points and special points; ``with_settings`` sets keys of the scene that do not change the equations
+(stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch points (even, m ≥ 1)
 in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch without equator
 symmetry, points of surface branches, an ordinary point in a second parameter.
 """
@@ -126,6 +127,28 @@ def find_label(run: dict, label: int) -> Labelled:
     listed = f"{min(labels)}..{max(labels)}" if labels else "none"
     raise RestartError(f"label {label}: no special point has it in {run['path']} (its labels: {listed}; "
                        "balloon-cg inspect shows them)")
+
+
+SETTABLE = ("continuation", "solver", "stability", "surface", "loading", "events")  # what ``with_settings`` changes
+
+
+def with_settings(start: Labelled, overrides: dict) -> Labelled:
+    """``start`` with its scene's keys set (``Scene.with_overrides``: dotted keys, None restores the default), for
+    what is traced from it: the stops, the tolerances, the readings, the [[events]]. A key that changes the
+    equations (material, field, electric) would leave the stored point off its equilibrium: RestartError naming
+    it (run a new scene with it, or continue in it as a second parameter)."""
+    if not overrides:
+        return start
+    scene = start.branch.scene
+    for key in overrides:
+        section = scene.canonical_key(key).split(".")[0].split("[")[0]
+        if section not in SETTABLE:
+            raise RestartError(f"--set {key}: continue keeps the stored point's equations, so only "
+                               f"{', '.join(s + '.*' for s in SETTABLE)} can change (for {section}.*: a new "
+                               f"run with --set, or continue --parameter {key} to follow the point in it)")
+    scene = scene.with_overrides(overrides, name=scene.name)
+    return replace(start, branch=replace(start.branch, scene=scene),
+                   parent=None if start.parent is None else replace(start.parent, scene=scene))
 
 
 def restart_branch(start: Labelled, progress=None) -> Picture:
