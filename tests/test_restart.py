@@ -143,6 +143,21 @@ def test_continue_with_set_finishes_a_run_that_stopped_at_max_points(gent_run, t
     assert not refused.exists()
 
 
+def test_continue_names_a_curve_file_and_a_direction_without_a_parameter(gent_run, capsys):
+    """A curve file (no branches) and --direction without --parameter: one line each saying why, exit 2."""
+    path, curve = gent_run / "gent.h5", gent_run / "cusp.h5"
+    (label, _), _ = special(path, "LP")
+    assert main(["continue", str(path), str(label), "--parameter", "material.parameters.Jm", "--direction", "-1",
+                 "-o", str(curve), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["continue", str(curve), "1", "-o", str(gent_run / "x.h5")]) == 2
+    assert "has no branches (a curve file: continue starts from a point of a run file" in capsys.readouterr().err
+    assert main(["continue", str(path), str(label), "--direction", "-1", "-o", str(gent_run / "x.h5")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--direction -1 starts a curve in a second parameter" in err
+    assert not (gent_run / "x.h5").exists()
+
+
 def test_continue_refuses_what_it_cannot_start_from(gent_run, capsys):
     """A label the file does not have, a second parameter from an end point: one line, exit 2, nothing written."""
     path = gent_run / "gent.h5"

@@ -851,6 +851,9 @@ def _continue(args) -> int:
     from ..io.run_file import read_run, write_run
     from .restart import RestartError, find_label, restart, with_settings
 
+    if args.direction != 1.0 and args.parameter is None:
+        raise UsageError(f"continue: --direction {args.direction:g} starts a curve in a second parameter: give "
+                         "--parameter KEY (without it the branch is traced both ways)")
     check_output(hdf5_output(args.output, "run"), args.force)
     run = read_run(args.run)
     try:

@@ -124,6 +124,9 @@ def find_label(run: dict, label: int) -> Labelled:
             return Labelled(label, branch, branch.special[row], "stability" in data,
                             stored_branch(run, parent) if parent in run["branches"] else None,
                             int(data["attrs"].get("parent_branch_point", -1)))
+    if not run["branches"]:
+        raise RestartError(f"label {label}: {run['path']} has no branches (a curve file: continue starts from a "
+                           "point of a run file; critical or continue --parameter traced this curve)")
     listed = f"{min(labels)}..{max(labels)}" if labels else "none"
     raise RestartError(f"label {label}: no special point has it in {run['path']} (its labels: {listed}; "
                        "balloon-cg inspect shows them)")
