@@ -38,7 +38,7 @@ from ..scene import Control
 from .branch_point import _parameter_step, _step
 from .codim2 import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status, plain_branch,
                      trace_in_q)
-from .control import FOLD_KIND, control_gradient_at as control_gradient
+from .control import FOLD_KIND, control_gradient_at
 from .problem import continuation_settings, equilibrium_of
 from .results import Branch, Kind, SpecialPoint, StopCode
 from .second_parameter import Derivative, SecondParameter, second_parameter
@@ -74,8 +74,8 @@ class FoldSystem:
         return self.eq.bordered_jacobian(u, params, "P")
 
     def control_gradient(self, u, params) -> np.ndarray:
-        """∇c = ∂c/∂(u, P) at the point (``control.control_gradient``; e_P under pressure control)."""
-        return control_gradient(self.eq, u, params, self.control)
+        """∇c = ∂c/∂(u, P) at the point (``control.control_gradient_at``: e_P under pressure control)."""
+        return control_gradient_at(self.eq, u, params, self.control)
 
     def residual(self, X):
         u, P, w, q = self.split(X)
@@ -154,7 +154,7 @@ def fold_tangent(eq: Equilibrium, X, control: Control, params) -> np.ndarray:
     """The unit null vector w of [F_x; ∇c] at the fold X = (u, P) (its smallest right singular vector)."""
     u, at = X[:-1], params.with_value("P", float(X[-1]))
     F = eq.bordered_jacobian(u, at, "P")
-    return np.linalg.svd(np.vstack([F, control_gradient(eq, u, at, control)]))[2][-1]
+    return np.linalg.svd(np.vstack([F, control_gradient_at(eq, u, at, control)]))[2][-1]
 
 
 @limited_blas

@@ -345,12 +345,12 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
             return
 
 
-def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progress, reached: set | None = None,
-              assess: bool = True) -> bool:
+def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progress,
+              reached: set | None = None) -> bool:
     """The pear branch from the pear branch point ``n`` of ``picture.branch_points`` (held: pear_<n>; free, in a
     field: pear_free_<n>, traced with the translation free) and its mirror image: the reflection of the pear branch
     in a scene invariant under z → −z (``mirror``: its Origin says how it was obtained), else traced; appended to
-    ``picture.branches`` (a branch that cannot start to ``picture.not_started``), each assessed when ``assess``.
+    ``picture.branches`` (a branch that cannot start to ``picture.not_started``), each assessed.
     The branch points where they rejoin are added to ``reached``. False when a signal (``numerics.interrupt``)
     stopped the work."""
     bp, reflect = picture.branch_points[n], mirror.reflectable(scene)
@@ -380,7 +380,7 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
                 reached.add(branch.rejoins)
             mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
         picture.branches.append(branch)
-        if interrupt.requested() or (assess and not _assess(branch, scene, False, progress, picture.clock)):
+        if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):
             return False  # kept as traced, not assessed
         pear = branch if sign > 0 and reflect else None
     return True

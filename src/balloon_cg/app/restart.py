@@ -8,11 +8,11 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   scene's stop rules and ``[[events]]``, on the stored discretisation, and, if the stored branch was assessed
   (a run without --primary-only), assessed with its branch points and m ≥ 1 points located as ``run`` gives them
   (``restart_branch``: a Picture of one branch, primary); from a branch point of an equator-symmetric branch,
-  the branches bifurcating there (``switch``): at a pear point (odd_held, or odd_free: the free balloon) the pear branch and its mirror image, as ``run``
-  traces them (``picture.pear_pair``, its critical mode recomputed: ``pear_point``), assessed and with their
-  m ≥ 1 points as ``run`` gives them, at a held m ≥ 1 point the non-axisymmetric branch and its other direction
-  on the whole sphere (``picture.surface_pair``, assessed as ``run`` assesses it); the branch of the point is
-  written as read (its stored stability is not read back);
+  the branches bifurcating there (``switch``): at a pear point (odd_held, or odd_free: the free balloon) the
+  pear branch and its mirror image, as ``run`` traces them (``picture.pear_pair``, its critical mode recomputed:
+  ``pear_point``), assessed and with their m ≥ 1 points as ``run`` gives them, at a held m ≥ 1 point the
+  non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``, assessed as
+  ``run`` assesses it); the branch of the point is written as read (its stored stability is not read back);
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
   (``analysis.fold_curve.continue_fold``);
 - a pear branch point (BP of block odd_held, or odd_free: the free balloon's, on an equator-symmetric branch) in q:
@@ -21,9 +21,9 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
 
 The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
 parameters, points and special points; ``with_settings`` sets keys of the scene that do not change the equations
-(stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch points (even, m ≥ 1)
-in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch without equator
-symmetry, points of surface branches, an ordinary point in a second parameter.
+(stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch
+points (even, m ≥ 1) in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch
+without equator symmetry, points of surface branches, an ordinary point in a second parameter.
 """
 import time
 from dataclasses import dataclass, replace
@@ -274,8 +274,8 @@ def switch(start: Labelled, progress=None) -> Picture:
 
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
     """What ``continue`` computes from ``start`` (module docstring): a Picture (in the branch's own parameter: of
-    the branch through it, or at a branch point of the branch of the point and the branches switched to) or a two-parameter curve (a fold
-    or a pear point in a second parameter); RestartError for what is not built."""
+    the branch through it, or at a branch point of the branch of the point and the branches switched to) or a
+    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built."""
     own = start.branch.parameter
     kind = start.point.kind
     if parameter in (None, own):

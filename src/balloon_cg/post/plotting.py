@@ -1024,13 +1024,13 @@ def plot_phase(paths, axes=None) -> Figure:
                 ax.annotate(f"{'critical' if of == 'BP' else 'cusp'} {curve['attrs']['parameter']} = {critical:.6g}",
                             (critical, P_merge), textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
             elif of != "BP":
-                open_folds.setdefault((of, curve["attrs"]["parameter"]), []).append((q, P))
+                open_folds.setdefault(of, []).append((q, P))  # one parameter: checked below
             for meeting in curve_meetings(curve):  # a fold curve crosses this pitchfork curve
                 ax.plot(meeting["q"], meeting["pressure"], "D", color=line.get_color(), markerfacecolor="none")
                 ax.annotate(f"{meeting['kind']} {curve['attrs']['parameter']} = {meeting['q']:.6g}",
                             (meeting["q"], meeting["pressure"]), textcoords="offset points", xytext=(8, -12),
                             fontsize=8)
-    for (of, parameter), folds in open_folds.items():
+    for of, folds in open_folds.items():
         _shade_between_folds(ax, of, folds)
     if len(parameters) > 1:  # one q axis
         listed = "; ".join(f"{key} ({', '.join(drawn)})" for key, (_, drawn) in parameters.items())
@@ -1052,8 +1052,7 @@ def _shade_between_folds(ax, of: str, folds: list) -> None:
     """Shade the bistable region between two fold curves of one kind (``of``: LP, LV, LN), each traced on its own
     (the upper and the lower fold, e.g. ``continue`` from each, not met in a cusp): P between them over the q both
     span (PCHIP through their stored points), where each is single-valued in q (a curve that turns in q has its
-    cusp or merge and is shaded whole).
-    Under that control the balloon snaps through at one fold and back at the other: between them two stable states.
+    cusp or merge and is shaded whole). Under that control the balloon snaps through at one fold and back at the other: between them two stable states.
     With one such curve, or more than two, nothing is shaded."""
     if len(folds) != 2 or any(np.any(np.diff(q) == 0) or np.any(np.diff(np.sign(np.diff(q)))) for q, _ in folds):
         return
@@ -1061,8 +1060,7 @@ def _shade_between_folds(ax, of: str, folds: list) -> None:
     if not low < high:
         return
     dense = np.union1d(np.linspace(low, high, 400), [x for q, _ in folds for x in q if low <= x <= high])
-    edges = [PchipInterpolator(*(np.array(v)[::-1] if q[0] > q[-1] else np.array(v) for v in (q, P)))(dense)
-             for q, P in folds]
+    edges = [PchipInterpolator(np.sort(q), P[np.argsort(q)])(dense) for q, P in folds]
     ax.fill_between(dense, edges[0], edges[1], alpha=0.15, color="0.5",
                     label=f"bistable: snap-through between the two {of} curves")
 
