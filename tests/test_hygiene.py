@@ -1,4 +1,4 @@
-"""Pool workers die with their parent (app.hygiene): killing only the sweep's parent, as the OOM killer does,
+"""Pool workers die with their parent (numerics.hygiene): killing only the sweep's parent, as the OOM killer does,
 leaves no worker running."""
 import os
 import signal
@@ -57,7 +57,7 @@ def test_the_watchdog_fallback_exits_when_the_parent_dies(tmp_path):
     """The path taken where prctl is not available: a thread polling os.getppid()."""
     pid_file = tmp_path / "child.pid"
     script = ("import os, sys, threading, time\n"
-              "from balloon_cg.app import hygiene\n"
+              "from balloon_cg.numerics import hygiene\n"
               "pid = os.fork()\n"
               "if pid == 0:\n"
               "    threading.Thread(target=hygiene._watch, args=(os.getppid(),), daemon=True).start()\n"

@@ -34,7 +34,7 @@ from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
                                        read_only)
 from ..galerkin.equilibrium import NodeKernels, Parameters
-from ..numerics import eigen, interrupt
+from ..numerics import eigen, interrupt, workers
 from .problem import equilibrium_of
 from .resolution import Resolution
 from ..numerics.threads import limited_blas
@@ -290,7 +290,9 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
                   near_zero: float = 0.1, m_max: int = 0, on_point=None):
     """Assessments of every point and, with ``check``, the points whose flags change at the check degree.
     ``on_point()`` is called after each point's first assessment. A stop asked for by a signal
-    (``numerics.interrupt``) raises ``interrupt.Interrupted`` at the next point: the assessment is abandoned.
+    (``numerics.interrupt``) raises ``interrupt.Interrupted`` at the next point: the assessment is abandoned. The
+    points' first assessments and their flag checks run on every core (``numerics.workers.spread``: the numbers of
+    the serial loop).
 
     Each point is assessed at its ``point_degrees`` (``degree`` far from wires, the degree in x that holds the
     equilibrium near one). With ``check``, the degree then follows the modes: the bracketing points of every
@@ -306,14 +308,13 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         interrupt.check()
         return variations[N].assess(branch.X[n][:-1], branch.params_at(branch.X[n]), symmetric, m_max)
 
-    def first(n, N):
-        assessment = assess(n, N)
-        if on_point is not None:
-            on_point()
-        return assessment
+    def fine_flags(n):
+        X = branch.X[n]
+        return variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max)
 
     degrees = point_degrees(branch, degree)
-    results = [first(n, N) for n, N in enumerate(degrees)]
+    results = workers.spread(lambda job: assess(*job), list(enumerate(degrees)), [_cost(N, m_max) for N in degrees],
+                             on_point)
     unsettled = []
     if check:
         folds = branch.fold_intervals
@@ -321,16 +322,27 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
                                 lambda found: branch_point_crossings(found, m_max, folds))
         results, degrees = followed.assessments, followed.degrees
         flags = [_flags(a) for a in results]
-        for n, (X, coarse) in enumerate(zip(branch.X, results)):
-            changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])
-            small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
-            if not (changes or small or n % 10 == 0):
-                continue
-            fine = (_flags(followed.checked[n]) if n in followed.checked else
-                    variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max))
-            if fine != flags[n]:
-                unsettled.append(n)
+        checked = {n: _flags(a) for n, a in followed.checked.items()}
+        asked = [n for n, coarse in enumerate(results)
+                 if n not in checked and _worth_checking(flags, coarse, n, near_zero)]
+        checked |= zip(asked, workers.spread(fine_flags, asked, [_cost(check_degree(branch, degrees[n]), m_max)
+                                                                  for n in asked]))
+        unsettled = [n for n, coarse in enumerate(results)
+                     if _worth_checking(flags, coarse, n, near_zero) and checked[n] != flags[n]]
     return results, unsettled
+
+
+def _worth_checking(flags: list, coarse: Assessment, n: int, near_zero: float) -> bool:
+    """Whether point n's flags are checked at the check degree (``assess_branch``): next to a change of a flag,
+    a lowest eigenvalue of magnitude below ``near_zero``, or every tenth point."""
+    changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])
+    small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
+    return changes or small or n % 10 == 0
+
+
+def _cost(degree: int, m_max: int) -> float:
+    """The relative cost of one assessment at perturbation degree N: its dense blocks, ~(1 + m_max) N³ flops."""
+    return (1 + m_max) * float(degree) ** 3
 
 
 def assessed_degrees(branch) -> list[int]:

@@ -33,9 +33,9 @@ from ..io.lock import claim
 from ..io.output import check_output
 from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
                              store_path)
-from .hygiene import worker_hygiene
+from ..numerics import interrupt, workers
+from ..numerics.hygiene import worker_hygiene
 from .progress import tqdm_disable
-from ..numerics import interrupt
 from ..scene import Scene, SceneError, parse_scene
 
 MODES = ("analysis", "no-pear", "primary-only")
@@ -227,15 +227,17 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
     """Worker side: compute one member (local pool or dask worker); picklable in and out."""
     # BLAS runs single-threaded in every member: importing balloon_cg limits it (balloon_cg/__init__); with
     # 2 BLAS threads per member on busy cores a member ran 35x slower (benchmarks/sweep.py).
+    # the members are the parallel unit: a member's points are not spread over more processes (numerics.workers)
     scene = parse_scene(scene_toml, scene_name)
     start = time.perf_counter()
-    if mode == "primary-only":
-        branches, snaps, points = [trace_primary(scene)], None, []
-        found = incomplete(branches)
-    else:
-        picture = analyse(scene, pear=(mode == "analysis"))
-        branches, snaps, points, found = (picture.branches + picture.surface_branches, picture.snaps,
-                                          picture.branch_points, picture.incomplete)
+    with workers.serial():
+        if mode == "primary-only":
+            branches, snaps, points = [trace_primary(scene)], None, []
+            found = incomplete(branches)
+        else:
+            picture = analyse(scene, pear=(mode == "analysis"))
+            branches, snaps, points, found = (picture.branches + picture.surface_branches, picture.snaps,
+                                              picture.branch_points, picture.incomplete)
     return MemberResult(index, branches, snaps, points, found, time.perf_counter() - start, os.getpid())
 
 

@@ -1,10 +1,11 @@
-"""Pool workers that die with their parent: ``ProcessPoolExecutor(initializer=worker_hygiene, initargs=(pid,))``.
+"""Pool workers that die with their parent: ``ProcessPoolExecutor(initializer=worker_hygiene, initargs=(pid,))``
+(a sweep's members, ``app.sweep``; the points of a branch, ``workers``).
 
 A worker whose parent is killed (SIGKILL, the OOM killer) would otherwise keep computing, blocked on the result
 pipe. On Linux the worker asks the kernel for SIGKILL when the process that started it dies
-(``prctl(PR_SET_PDEATHSIG)``: the sweep's process with the fork start method, or the forkserver, which exits
+(``prctl(PR_SET_PDEATHSIG)``: the parent with the fork start method, or the forkserver, which exits
 with it); elsewhere a daemon thread polls ``os.getppid()`` once a second. Either way the worker then exits at
-once if the sweep's process ``pid`` died before the request was made.
+once if the parent ``pid`` died before the request was made.
 """
 import ctypes
 import ctypes.util
@@ -18,15 +19,15 @@ PR_SET_PDEATHSIG = 1
 POLL_SECONDS = 1.0
 
 
-def worker_hygiene(sweep_pid: int) -> None:
-    """Initializer of a pool worker: exit when its parent dies, or now if the process ``sweep_pid`` is gone;
+def worker_hygiene(parent_pid: int) -> None:
+    """Initializer of a pool worker: exit when its parent dies, or now if the process ``parent_pid`` is gone;
     Ctrl-C (SIGINT to the terminal's process group) is left to the parent, which stops the workers itself with
     SIGTERM, whose default (die) is restored here (a forked worker inherits the parent's handlers)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if not (sys.platform.startswith("linux") and _pdeathsig()):
         threading.Thread(target=_watch, args=(os.getppid(),), daemon=True, name="parent-watchdog").start()
-    if not _alive(sweep_pid):
+    if not _alive(parent_pid):
         os._exit(1)
 
 

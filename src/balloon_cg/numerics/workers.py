@@ -1,0 +1,100 @@
+"""Independent pieces of one computation on every core: ``spread(work, items, costs)``.
+
+The points of a branch are independent for stability (each is one set of dense Hessian blocks and eigensolves), so
+``[work(i) for i in items]`` is handed to forked worker processes: a forked child inherits the jitted kernels and
+the data ``work`` reads (nothing is pickled but item numbers and results), and each child runs the same code on the
+same numbers with single-threaded BLAS, so the results are those of the serial loop, bit for bit. The items go out
+costliest first (the near-wire points of a branch cost N³ at degrees up to 320) and come back in their order.
+
+The work stays in this process where forking does not pay or is not allowed: one core, a total cost below
+``MIN_COST`` (starting the workers costs ~50–100 ms), inside ``serial()`` (a sweep's member: the members are the
+parallel unit there), or BALLOON_CG_WORKERS=1 (the number of worker processes; default: the cores this process may
+run on). The workers leave Ctrl-C to this process and die with it (``hygiene.worker_hygiene``); a signal here
+(``numerics.interrupt``) stops the pool within a second and raises ``Interrupted``; a worker killed from outside
+raises ``BrokenProcessPool`` (``Interrupted`` if a signal came too).
+"""
+import multiprocessing
+import os
+import threading
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
+
+from . import interrupt
+from .hygiene import worker_hygiene
+
+# Σ cost below which the work stays here: ~0.2 s of assessments (degree³ per block; a point at N = 20 with m = 1,
+# cost 1.6e4, is ~0.3 ms), against ~50–100 ms to start two workers and collect 50 results
+MIN_COST = 1e7
+_state = threading.local()
+_job = None  # (work, items) of the running ``spread``, inherited by the forked workers
+
+
+def count() -> int:
+    """Worker processes ``spread`` may use: BALLOON_CG_WORKERS, else the cores this process may run on; 1 inside
+    ``serial()``."""
+    if getattr(_state, "serial", 0):
+        return 1
+    setting = os.environ.get("BALLOON_CG_WORKERS", "").strip()
+    if setting:
+        return max(1, int(setting))
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+@contextmanager
+def serial():
+    """``spread`` runs in this process for the duration (a sweep member: its siblings use the other cores)."""
+    _state.serial = getattr(_state, "serial", 0) + 1
+    try:
+        yield
+    finally:
+        _state.serial -= 1
+
+
+def spread(work, items, costs=None, on_result=None) -> list:
+    """``[work(item) for item in items]``, on ``count()`` forked workers where it pays (module docstring).
+    ``costs``: a relative cost per item (default 1 each); ``on_result()`` is called here as each result arrives.
+    ``work``'s exceptions are raised here; a signal raises ``interrupt.Interrupted``."""
+    global _job
+    items = list(items)
+    costs = [1.0] * len(items) if costs is None else [float(c) for c in costs]
+    workers = min(count(), len(items))
+    forking = "fork" in multiprocessing.get_all_start_methods()
+    if workers < 2 or sum(costs) < MIN_COST or _job is not None or not forking:  # _job: inside a worker
+        return [_counted(work(item), on_result) for item in items]
+    order = sorted(range(len(items)), key=lambda i: -costs[i])
+    results = [None] * len(items)
+    _job = (work, items)
+    pool = ProcessPoolExecutor(workers, multiprocessing.get_context("fork"), worker_hygiene, (os.getpid(),))
+    try:
+        futures = [(i, pool.submit(_run, i)) for i in order]
+        for i, future in futures:
+            results[i] = _counted(_result(future), on_result)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+        _job = None
+    return results
+
+
+def _result(future):
+    """The future's result, waiting in steps so that a signal here is seen within a second (``Interrupted``)."""
+    while True:
+        interrupt.check()
+        try:
+            return future.result(timeout=1.0)
+        except TimeoutError:
+            continue
+        except BrokenProcessPool:
+            interrupt.check()
+            raise
+
+
+def _counted(result, on_result):
+    if on_result is not None:
+        on_result()
+    return result
+
+
+def _run(i: int):
+    work, items = _job
+    return work(items[i])

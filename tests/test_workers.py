@@ -1,0 +1,78 @@
+"""Independent work on every core (numerics.workers): the results of the serial loop, in order, from forked
+workers; in this process where it does not pay, inside ``serial()`` and with BALLOON_CG_WORKERS=1."""
+import os
+
+import numpy as np
+import pytest
+
+from balloon_cg.numerics import interrupt, workers
+
+BIG = [workers.MIN_COST] * 6  # costs that make ``spread`` fork
+
+
+def _pid_and_square(i):
+    return os.getpid(), i * i
+
+
+def test_spread_forks_and_keeps_the_order(monkeypatch):
+    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
+    arrived = []
+    found = workers.spread(_pid_and_square, range(6), BIG, on_result=lambda: arrived.append(1))
+    assert [square for _, square in found] == [i * i for i in range(6)]
+    assert os.getpid() not in {pid for pid, _ in found}
+    assert len(arrived) == 6
+
+
+@pytest.mark.parametrize("how", ["cheap", "one worker", "serial"])
+def test_spread_stays_in_this_process(monkeypatch, how):
+    monkeypatch.setenv("BALLOON_CG_WORKERS", "1" if how == "one worker" else "2")
+    costs = [1.0] * 6 if how == "cheap" else BIG
+    if how == "serial":
+        with workers.serial():
+            found = workers.spread(_pid_and_square, range(6), costs)
+    else:
+        found = workers.spread(_pid_and_square, range(6), costs)
+    assert found == [(os.getpid(), i * i) for i in range(6)]
+
+
+def _fails_at_three(i):
+    if i == 3:
+        raise ValueError("point 3")
+    return i
+
+
+def test_spread_raises_the_work_s_error(monkeypatch):
+    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
+    with pytest.raises(ValueError, match="point 3"):
+        workers.spread(_fails_at_three, range(6), BIG)
+
+
+def test_a_signal_stops_the_pool(monkeypatch):
+    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
+    interrupt.request()
+    try:
+        with pytest.raises(interrupt.Interrupted):
+            workers.spread(_pid_and_square, range(6), BIG)
+    finally:
+        interrupt._flag.clear()
+
+
+def test_assessments_on_two_workers_are_the_serial_ones(monkeypatch):
+    """The SPOM1 primary branch assessed at degree 60 with m = 1 (a cost that forks) on two workers and in this
+    process: every eigenvalue, flag, degree and unsettled point identical."""
+    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.stability import assess_branch
+    from balloon_cg.scene import load_scene
+
+    branch = trace_primary(load_scene("spom1"))
+    found = {}
+    for count in ("1", "2"):
+        monkeypatch.setenv("BALLOON_CG_WORKERS", count)
+        found[count] = assess_branch(branch, 60, check=True, m_max=1)
+    (serial, unsettled), (spread, unsettled_spread) = found["1"], found["2"]
+    assert sum(2 * 60.0 ** 3 for _ in serial) > workers.MIN_COST  # it forked
+    assert unsettled == unsettled_spread
+    for a, b in zip(serial, spread):
+        assert a.flags() == b.flags() and a.degree == b.degree
+        for block, values in a.blocks.items():
+            np.testing.assert_array_equal(values, b.blocks[block])
