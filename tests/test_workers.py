@@ -76,3 +76,28 @@ def test_assessments_on_two_workers_are_the_serial_ones(monkeypatch):
         assert a.flags() == b.flags() and a.degree == b.degree
         for block, values in a.blocks.items():
             np.testing.assert_array_equal(values, b.blocks[block])
+
+
+def _sleep_then_mark(item):
+    import time
+
+    i, folder = item
+    time.sleep(30 if i == 0 else 0)
+    (folder / f"done_{i}").write_text("")
+
+
+def test_workers_are_gone_when_spread_raises(monkeypatch, tmp_path):
+    """A signal while an item runs: Interrupted, the worker running the 30 s item killed, not waited for (its mark
+    never written), no worker left."""
+    import multiprocessing
+    import threading
+
+    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
+    threading.Timer(0.5, interrupt.request).start()
+    try:
+        with pytest.raises(interrupt.Interrupted):
+            workers.spread(_sleep_then_mark, [(i, tmp_path) for i in range(4)], BIG[:4])
+    finally:
+        interrupt._flag.clear()
+    assert not multiprocessing.active_children()
+    assert not (tmp_path / "done_0").exists()

@@ -19,12 +19,13 @@ PR_SET_PDEATHSIG = 1
 POLL_SECONDS = 1.0
 
 
-def worker_hygiene(parent_pid: int) -> None:
+def worker_hygiene(parent_pid: int, terminable: bool = True) -> None:
     """Initializer of a pool worker: exit when its parent dies, or now if the process ``parent_pid`` is gone;
     Ctrl-C (SIGINT to the terminal's process group) is left to the parent, which stops the workers itself with
-    SIGTERM, whose default (die) is restored here (a forked worker inherits the parent's handlers)."""
+    SIGTERM, whose default (die) is restored here (a forked worker inherits the parent's handlers); not
+    ``terminable``: SIGTERM is left to the parent too (which then stops the workers with SIGKILL)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL if terminable else signal.SIG_IGN)
     if not (sys.platform.startswith("linux") and _pdeathsig()):
         threading.Thread(target=_watch, args=(os.getppid(),), daemon=True, name="parent-watchdog").start()
     if not _alive(parent_pid):

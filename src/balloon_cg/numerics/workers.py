@@ -9,15 +9,14 @@ costliest first (the near-wire points of a branch cost N³ at degrees up to 320)
 The work stays in this process where forking does not pay or is not allowed: one core, a total cost below
 ``MIN_COST`` (starting the workers costs ~50–100 ms), inside ``serial()`` (a sweep's member: the members are the
 parallel unit there), or BALLOON_CG_WORKERS=1 (the number of worker processes; default: the cores this process may
-run on). The workers leave Ctrl-C to this process and die with it (``hygiene.worker_hygiene``); a signal here
-(``numerics.interrupt``) stops the pool within a second and raises ``Interrupted``; a worker killed from outside
-raises ``BrokenProcessPool`` (``Interrupted`` if a signal came too).
+run on). The workers leave SIGINT and SIGTERM to this process and die with it (``hygiene.worker_hygiene``); a
+signal here (``numerics.interrupt``) raises ``Interrupted`` within a second, and the workers are killed as
+``spread`` returns or raises; a worker killed from outside (the OOM killer) raises ``BrokenProcessPool``.
 """
 import multiprocessing
 import os
 import threading
 from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 
 from . import interrupt
@@ -65,13 +64,13 @@ def spread(work, items, costs=None, on_result=None) -> list:
     order = sorted(range(len(items)), key=lambda i: -costs[i])
     results = [None] * len(items)
     _job = (work, items)
-    pool = ProcessPoolExecutor(workers, multiprocessing.get_context("fork"), worker_hygiene, (os.getpid(),))
+    pool = ProcessPoolExecutor(workers, multiprocessing.get_context("fork"), worker_hygiene, (os.getpid(), False))
     try:
         futures = [(i, pool.submit(_run, i)) for i in order]
         for i, future in futures:
             results[i] = _counted(_result(future), on_result)
     finally:
-        pool.shutdown(wait=False, cancel_futures=True)
+        _stop(pool)
         _job = None
     return results
 
@@ -84,9 +83,18 @@ def _result(future):
             return future.result(timeout=1.0)
         except TimeoutError:
             continue
-        except BrokenProcessPool:
-            interrupt.check()
-            raise
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel what is queued and kill the workers (they ignore SIGTERM; an item still running is not waited for):
+    the executor has no public way to stop its workers before Python 3.14's ``kill_workers``."""
+    processes = list((pool._processes or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.kill()
+    for process in processes:
+        process.join()
 
 
 def _counted(result, on_result):
