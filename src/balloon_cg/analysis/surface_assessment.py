@@ -1,11 +1,13 @@
 """The stability of a branch on the whole sphere (``surface_branches``) and its secondary branch points: every point
 read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
 change of the number of negative held eigenvalues of a sector under pressure control between two points is a
-secondary branch point, located by Brent's method on that eigenvalue.
+secondary branch point, located by Brent's method on that eigenvalue. The points are read in stretches, one per
+core (``numerics.workers``; a signal waits for them, as it waited for the serial loop: the callers keep no
+half-assessed surface branch).
 """
 import numpy as np
 
-from ..numerics import continuation, eigen
+from ..numerics import continuation, eigen, workers
 from ..numerics.newton import newton
 from ..surface import stability as surface_stability
 from ..surface.embedding import transfer
@@ -25,16 +27,14 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
     ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). A fold (LP) of the
     branch changes the count of the state's own sector between its points: not a branch point."""
     held = surface_stability.Reading(True)
-    readings = {r: [] for r in readings}
-    counts, held_spectra, spectra = [], [], None
-    for (trace, c), value in zip(traced, sb.values):
-        params = sb.params.with_value(sb.parameter, value)
-        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
-        for r in readings:
-            readings[r].append(surface_stability.lowest_over(spectra[r], STABILITY_COUNT))
-        counts.append(_negative_counts(trace, c, params, spectra[held]))
-        held_spectra.append(spectra[held])
-    sb.stability = {r.name: np.array(rows) for r, rows in readings.items()}
+    stretches = [stretch for stretch in np.array_split(np.arange(len(traced)), workers.count()) if stretch.size]
+    sizes = [traced[stretch[-1]][1].size for stretch in stretches]
+    read = workers.spread(lambda points: _read(sb, traced, readings, points), stretches,
+                          [stretch.size * float(n) ** 3 for stretch, n in zip(stretches, sizes)], interruptible=False)
+    spectra, counts = [s for part in read for s, _ in part], [n for part in read for _, n in part]
+    held_spectra = [s[held] for s in spectra]
+    sb.stability = {r.name: np.array([surface_stability.lowest_over(s[r], STABILITY_COUNT) for s in spectra])
+                    for r in readings}
     folds = {s.index for s in sb.special if s.kind == Kind.LP}
     for i in range(1, len(counts) - 1):
         for key in counts[i]:
@@ -42,6 +42,19 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
                 sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
                                              float(held_spectra[i][key][0])))
     sb.special.sort(key=lambda s: s.index)
+
+
+def _read(sb: SurfaceBranch, traced: list, readings, points) -> list:
+    """(spectra, negative held counts) of the points ``points`` of the branch in order, each following the previous
+    one's spectra (``surface.stability.sector_spectra``; the first of a stretch solves dense, as a branch's first
+    point does). The stretches of a branch go to every core (``numerics.workers``)."""
+    out, spectra, held = [], None, surface_stability.Reading(True)
+    for i in points:
+        trace, c = traced[i]
+        params = sb.params.with_value(sb.parameter, sb.values[i])
+        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
+        out.append((spectra, _negative_counts(trace, c, params, spectra[held])))
+    return out
 
 
 def _negative_counts(trace, c, params, lowest: dict) -> dict:

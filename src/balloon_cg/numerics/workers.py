@@ -50,10 +50,11 @@ def serial():
         _state.serial -= 1
 
 
-def spread(work, items, costs=None, on_result=None) -> list:
+def spread(work, items, costs=None, on_result=None, interruptible: bool = True) -> list:
     """``[work(item) for item in items]``, on ``count()`` forked workers where it pays (module docstring).
     ``costs``: a relative cost per item (default 1 each); ``on_result()`` is called here as each result arrives.
-    ``work``'s exceptions are raised here; a signal raises ``interrupt.Interrupted``."""
+    ``work``'s exceptions are raised here; a signal raises ``interrupt.Interrupted`` (not ``interruptible``: the
+    work is finished first, as a serial loop without checks would)."""
     global _job
     items = list(items)
     costs = [1.0] * len(items) if costs is None else [float(c) for c in costs]
@@ -68,7 +69,7 @@ def spread(work, items, costs=None, on_result=None) -> list:
     try:
         futures = [(i, pool.submit(_run, i)) for i in order]
         for i, future in futures:
-            results[i] = _counted(_result(future), on_result)
+            results[i] = _counted(_result(future) if interruptible else future.result(), on_result)
     finally:
         _stop(pool)
         _job = None
