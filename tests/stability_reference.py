@@ -1,66 +1,100 @@
-"""The reference table of issue 28: every stored eigenvalue, flag and located point of the whole picture of the
-shipped scenes, as computed by the code this table was made with (main at 86f8543, before the stability work of
-issue 28; rewritten twice since: when a surface branch's critical mode moved to the perturbation degree its point
-was located at: the two-coil m = 1 branch's points moved by ~2e-8, nothing else; and again from main at 5271428,
-whose two-coil table no longer matched it: the merges of issue 27a/27b added the free balloon's pitchfork (a BP of
-odd_free on the primary, the later special points renumbered; branches pear_free_1 and its mirror) and moved
-pear_0_mirror's m = 1 crossing by 1.8e-10, every other common entry within 1e-10).
-tests/test_stability_reference.py computes the same table with the code under test and compares it to 1e-10;
-``python tests/stability_reference.py`` rewrites tests/data/stability_reference.npz (only to record a
-deliberate change of the numbers).
+"""The reference tables of issue 37's "unchanged": every stored eigenvalue, flag and located point of the whole
+picture of every shipped scene and of the off-equator scene (tests/data/off_equator.toml), as computed by main at
+94ce54e (before the speed work of issue 37). tests/test_stability_reference.py computes the same tables with the
+code under test and compares them (``compare``); ``python tests/stability_reference.py [SCENE ...]`` rewrites
+tests/data/reference/SCENE.npz (only to record a deliberate change of the numbers).
 
 A picture's table (``table``): per branch, the lowest eigenvalues of every block (axisymmetric branches) or reading
-(surface branches), the six flags, the unsettled points, and per special point its kind, block, m, status and
-classification (one text row) and its X (the located point).
+(surface branches), the six flags, the perturbation degree of each assessment, the unsettled points, and per
+special point its kind, block, m, status, classification and index (one text row) and its X (the located point).
+Where an assessment's degree N was raised above stability.degree (near a wire), ``error_<block>`` holds its own error
+estimate, |μ(N) − μ(⌊N/1.5⌋)| per eigenvalue (the coarser degree: an over-estimate of the error at N, where the
+eigenvalues converge spectrally); zero elsewhere. A special point's ``uncertainty`` is the one it was stored with (an
+approximate point's bracket).
 """
 import sys
 from pathlib import Path
 
 import numpy as np
 
-SCENES = ("spom1", "spom1_two_coils_M0.002")
 ROOT = Path(__file__).resolve().parents[1]
-REFERENCE = Path(__file__).resolve().parent / "data" / "stability_reference.npz"
+DATA = Path(__file__).resolve().parent / "data"
+OFF_EQUATOR = DATA / "off_equator.toml"
+SCENES = tuple(sorted(p.stem for p in (ROOT / "scenes").glob("*.toml"))) + (OFF_EQUATOR.stem,)
 
 
-def table(picture, prefix: str) -> dict[str, np.ndarray]:
-    """{key: array} of a picture's stored stability and special points (module docstring)."""
+def reference_path(scene: str) -> Path:
+    return DATA / "reference" / f"{scene}.npz"
+
+
+def table(picture, errors: bool = False) -> dict[str, np.ndarray]:
+    """{key: array} of a picture's stored stability and special points (module docstring); ``errors``: with the
+    eigenvalues' error estimates (``eigenvalue_errors``)."""
     out = {}
     for branch in picture.branches + picture.surface_branches:
-        key = f"{prefix}/{branch.name}"
+        key = branch.name
         if isinstance(branch.stability, dict):  # a surface branch: lowest eigenvalues per reading
             for reading, values in branch.stability.items():
                 out[f"{key}/lowest_{reading}"] = np.asarray(values, dtype=float)
-        else:
+        elif branch.stability:
             for block in branch.stability[0].blocks:
                 out[f"{key}/lowest_{block}"] = np.array([a.blocks[block] for a in branch.stability])
             out[f"{key}/flags"] = np.array([list(a.flags().values()) for a in branch.stability], dtype=bool)
             out[f"{key}/degrees"] = np.array([a.degree for a in branch.stability])
             out[f"{key}/unsettled"] = np.asarray(branch.unsettled, dtype=np.int64)
+            if errors:
+                out |= {f"{key}/error_{block}": e for block, e in eigenvalue_errors(branch).items()}
         for n, s in enumerate(branch.special):
             out[f"{key}/special_{n}/label"] = np.array(
                 f"{s.kind.value} {s.block.value} m={s.m} {s.status.value} {s.classification.value} index={s.index}")
             out[f"{key}/special_{n}/X"] = np.asarray(s.X, dtype=float)
+            out[f"{key}/special_{n}/uncertainty"] = np.asarray(s.uncertainty, dtype=float)
     return out
 
 
-def scene_table(name: str) -> dict[str, np.ndarray]:
-    """``table`` of the whole picture of the shipped scene ``name``."""
+def eigenvalue_errors(branch) -> dict[str, np.ndarray]:
+    """Per block, |μ(N) − μ(⌊N/1.5⌋)| of every stored eigenvalue whose degree N exceeds stability.degree (module
+    docstring), zero elsewhere."""
+    from balloon_cg.analysis.problem import equilibrium_of
+    from balloon_cg.analysis.stability import Variations
+    from balloon_cg.numerics.threads import blas_threads
+
+    variations, base = Variations(equilibrium_of(branch)), branch.scene.stability.degree
+    symmetric, m_max = branch.disc.symmetric, branch.scene.stability.m_max
+    out = {block: np.zeros_like(np.array([a.blocks[block] for a in branch.stability]))
+           for block in branch.stability[0].blocks}
+    for n, a in enumerate(branch.stability):
+        if a.degree <= base:
+            continue
+        X = branch.X[n]
+        with blas_threads():
+            coarse = variations[int(a.degree / 1.5)].assess(X[:-1], branch.params_at(X), symmetric, m_max)
+        for block, values in a.blocks.items():
+            out[block][n] = np.abs(values - coarse.blocks[block])
+    return out
+
+
+def scene_path(scene: str) -> Path:
+    return OFF_EQUATOR if scene == OFF_EQUATOR.stem else ROOT / "scenes" / f"{scene}.toml"
+
+
+def scene_table(scene: str, errors: bool = False) -> dict[str, np.ndarray]:
+    """``table`` of the whole picture of ``scene`` (a shipped scene's name, or off_equator)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.scene import load_scene
 
-    return table(analyse(load_scene(ROOT / "scenes" / f"{name}.toml")), name)
+    return table(analyse(load_scene(scene_path(scene))), errors)
 
 
-def main() -> int:
-    tables = {}
-    for name in SCENES:
-        tables |= scene_table(name)
-    REFERENCE.parent.mkdir(exist_ok=True)
-    np.savez_compressed(REFERENCE, **tables)
-    print(f"{REFERENCE}: {len(tables)} arrays")
+def main(argv: list[str]) -> int:
+    for scene in argv or SCENES:
+        tables = scene_table(scene, errors=True)
+        path = reference_path(scene)
+        path.parent.mkdir(exist_ok=True)
+        np.savez_compressed(path, **tables)
+        print(f"{path}: {len(tables)} arrays", flush=True)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))
