@@ -281,8 +281,12 @@ class SphericalBasis:
 
     def node_state(self, c: np.ndarray) -> np.ndarray:
         """The 9 node rows (x, a_θ, a_φ) of x = X + u for coefficients ``c``, shape (9, n_theta n_phi)."""
-        tables, nodes = self.tables, self.nodes
-        out = np.array(nodes["reference"])
+        return self.nodes["reference"] + self.node_displacement(c)
+
+    def node_displacement(self, c: np.ndarray) -> np.ndarray:
+        """The 9 node rows (u, ∂θu, ∂φu) of the displacement u of coefficients ``c`` (linear in c)."""
+        tables = self.tables
+        out = np.zeros((STATE_ROWS, self.n_theta * self.n_phi))
         for comp in range(3):
             info = tables["components"][comp]
             if not info["blocks"]:
@@ -291,7 +295,7 @@ class SphericalBasis:
             for d in range(3):
                 per_block = (info["theta"][d] * coefficients) @ info["sums"]  # (n_theta, n_b)
                 phis = tables["phi"][info["blocks"], 0 if d < 2 else 1]
-                out[3 * d + comp] += (per_block @ phis).ravel()
+                out[3 * d + comp] = (per_block @ phis).ravel()
         return out
 
     def project(self, rows: np.ndarray) -> np.ndarray:
@@ -399,20 +403,22 @@ def _norm(m: int) -> float:
 def _weighted_columns(fourier, channels, i1, i2, a1, a2, theta, starts, r, Y):
     """Y[d, j, col] = Σ_d' T^{dd'}_j[r, b'] Θ^{d'}[j, col] for the row block r, b' the block of column col (columns
     starts[b'] to starts[b' + 1]), T^{dd'}_j[r, b'] = α1 F_ch[j, i1] + α2 F_ch[j, i2] of the plan of φ-types
-    (d // 2, d' // 2) and the Fourier table F_ch of channel ch = channels[d, d'] (Y overwritten: one row block at a
-    time stays in cache; each block's columns one contiguous, vectorised run)."""
+    (d // 2, d' // 2) and the Fourier table F_ch of channel ch = channels[d, d'] (Y overwritten: each entry written
+    once, its three terms summed in the order d' = 0, 1, 2; a node's three θ-rows stay in cache over its three
+    rows of Y; each block's columns one contiguous, vectorised run)."""
     n_b = i1.shape[3]
     n_theta = theta.shape[1]
-    Y[:] = 0.0
-    for d in range(3):
-        e = d // 2
-        for d2 in range(3):
-            e2 = d2 // 2
-            ch = channels[d, d2]
-            for j in range(n_theta):
-                y, weights = Y[d, j], theta[d2, j]
-                for b in range(n_b):
-                    t = (a1[e, e2, r, b] * fourier[ch, j, i1[e, e2, r, b]]
-                         + a2[e, e2, r, b] * fourier[ch, j, i2[e, e2, r, b]])
-                    for col in range(starts[b], starts[b + 1]):
-                        y[col] += t * weights[col]
+    for j in range(n_theta):
+        w0, w1, w2 = theta[0, j], theta[1, j], theta[2, j]
+        for d in range(3):
+            e = d // 2
+            y = Y[d, j]
+            ch0, ch1, ch2 = channels[d, 0], channels[d, 1], channels[d, 2]
+            for b in range(n_b):
+                p, q, alpha, beta = i1[e, 0, r, b], i2[e, 0, r, b], a1[e, 0, r, b], a2[e, 0, r, b]
+                t0 = alpha * fourier[ch0, j, p] + beta * fourier[ch0, j, q]
+                t1 = alpha * fourier[ch1, j, p] + beta * fourier[ch1, j, q]
+                p, q, alpha, beta = i1[e, 1, r, b], i2[e, 1, r, b], a1[e, 1, r, b], a2[e, 1, r, b]
+                t2 = alpha * fourier[ch2, j, p] + beta * fourier[ch2, j, q]
+                for col in range(starts[b], starts[b + 1]):
+                    y[col] = t0 * w0[col] + t1 * w1[col] + t2 * w2[col]

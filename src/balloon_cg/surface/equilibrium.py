@@ -80,6 +80,14 @@ class SurfaceEquilibrium:
         symmetry sector: the second variation against perturbations of that space)."""
         return (basis or self.basis).hessian(self._nodes("surface_hessian", c, params), self._pairs)
 
+    def hessian_product(self, c: np.ndarray, params: Parameters, w: np.ndarray) -> np.ndarray:
+        """∂²E/∂c² w without the matrix: the node Hessian D (the rows ``hessian`` assembles) applied to the node
+        rows δs = ∂s/∂c w of the displacement w, then projected, Σ_jk W_j (∂s/∂c)ᵀ D δs (the same quadrature as
+        ``hessian``: equal to it times w up to rounding, at the cost of a residual)."""
+        rows = self._nodes("surface_hessian", c, params)
+        delta = self.basis.node_displacement(w)
+        return self.basis.project(np.einsum("kln,ln->kn", rows[self._pairs], delta))
+
     def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str,
                              basis: SphericalBasis | None = None) -> np.ndarray:
         """∂R/∂name for a continuation parameter (P; M with a field; the voltage of a dielectric class), in
