@@ -11,7 +11,8 @@ measured by wrapping the functions ``analyse`` calls for it, the same in every i
 
 Then the floors as ratios of one run: the two-coil picture ≤ 2× the spom1 picture, paper_coil ≤ 5× it; also without
 the surface branches (the axisymmetric analysis the issue measured when it was filed). Installs are given as
-interpreters (``--python``, default this one) and run in alternation, scene by scene.
+interpreters (``--python``, default this one) and run in alternation, scene by scene; with several, the ratios of
+each install's seconds to the first's, per phase.
 
     python benchmarks/whole_picture.py --python /path/to/main/venv/bin/python --python python
 """
@@ -88,7 +89,20 @@ def main(argv=None) -> int:
                                 / (base["total"] - base["phases"].get("surface branches", 0.0)))
                 print(f"  {scene} / spom1: whole picture {whole:.1f}x (floor <= {floor:g}x: "
                       f"{'met' if whole <= floor else 'NOT met'}), without the surface branches {axisymmetric:.1f}x")
+    first = pythons[0]
+    for python in pythons[1:]:
+        print(f"\n{python} / {first} (CPU time ratios of one run)")
+        print(f"  {'scene':<24}{'total':>9}" + "".join(f"{p:>18}" for p in PHASES))
+        for scene, r in results[python].items():
+            r0 = results[first][scene]
+            ratios = [_ratio(r["phases"].get(p), r0["phases"].get(p)) for p in PHASES]
+            print(f"  {scene:<24}{_ratio(r['total'], r0['total']):>9}" + "".join(f"{q:>18}" for q in ratios))
     return 0
+
+
+def _ratio(new: float | None, old: float | None) -> str:
+    """new/old to two decimals, '–' where a phase did not run or took no measurable time."""
+    return "–" if not new or not old or old < 0.005 else f"{new / old:.2f}"
 
 
 if __name__ == "__main__":
