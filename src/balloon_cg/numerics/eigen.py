@@ -173,8 +173,9 @@ class ShiftInvert:
     @classmethod
     def below(cls, A, guess: float):
         """σ = guess − δ, δ = max(|guess|, 1e-2), tried as a lower bound by Cholesky of A − σI (δ × 4 per failure,
-        SHIFT_TRIES times); None when none is. A symmetric, both triangles (as ``restricted`` makes it): its
-        column-major copy is that of Aᵀ, a plain memory copy of a C-ordered A instead of a transposing one."""
+        SHIFT_TRIES times); None when none is. A symmetric, both triangles (as ``restricted`` makes it, to rounding:
+        its reflections' c vᵢvⱼ): its column-major copy is that of Aᵀ, a plain memory copy of a C-ordered A instead
+        of a transposing one (the upper triangle read, which differs from the lower by rounding)."""
         n = A.shape[0]
         delta = max(abs(guess), 1e-2)
         for _ in range(SHIFT_TRIES):

@@ -300,7 +300,8 @@ class SphericalBasis:
 
     def project(self, rows: np.ndarray) -> np.ndarray:
         """Σ_{jk} W_j Σ_{d,c} rows[3d + c](θ_j, φ_k) ∂(node row 3d + c)/∂coefficient for every coefficient: the
-        residual from the node gradient, or ⟨f, Y⟩ (with 1/2π) from rows holding f in the value rows only."""
+        residual from the node gradient (9 rows), or ⟨f, Y⟩ (with 1/2π) from the 3 value rows of a field f alone
+        (its derivative rows zero: not projected)."""
         tables, nodes = self.tables, self.nodes
         out = np.zeros(self.size)
         weights = nodes["weights"][:, None]
@@ -309,7 +310,7 @@ class SphericalBasis:
             if not info["blocks"]:
                 continue
             total = np.zeros(len(info["unknowns"]))
-            for d in range(3):
+            for d in range(rows.shape[0] // 3):
                 phis = tables["phi"][info["blocks"], 0 if d < 2 else 1]  # (n_b, n_phi)
                 rings = (rows[3 * d + comp].reshape(self.n_theta, self.n_phi) * weights) @ phis.T  # (n_theta, n_b)
                 total += np.einsum("jn,jn->n", info["theta"][d], rings[:, info["column_block"]])
