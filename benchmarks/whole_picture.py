@@ -14,7 +14,8 @@ for it, the same in every install:
 
 Then the floors as ratios of one run, in wall time: the two-coil picture ≤ 10× the spom1 picture, the paper coil
 and the off-equator coil ≤ 20× it; also in CPU time. Installs are given as interpreters (``--python``, default this
-one) and run in alternation, scene by scene.
+one) and run in alternation, scene by scene; with several, the ratios of each install's seconds to the first's, wall,
+CPU and per phase.
 
     python benchmarks/whole_picture.py --python /path/to/main/venv/bin/python --python python
 """
@@ -98,7 +99,21 @@ def main(argv=None) -> int:
                 whole, cpu = r["wall"] / base["wall"], r["total"] / base["total"]
                 print(f"  {scene} / spom1: whole picture {whole:.1f}x in wall time (floor <= {floor:g}x: "
                       f"{'met' if whole <= floor else 'NOT met'}), {cpu:.1f}x in CPU time")
+    first = pythons[0]
+    for python in pythons[1:]:
+        print(f"\n{python} / {first} (ratios of one run: wall, CPU with workers, per phase CPU of the process)")
+        print(f"  {'scene':<24}{'wall':>9}{'CPU':>9}" + "".join(f"{p:>18}" for p in PHASES))
+        for scene, r in results[python].items():
+            r0 = results[first][scene]
+            ratios = [_ratio(r["phases"].get(p), r0["phases"].get(p)) for p in PHASES]
+            print(f"  {scene:<24}{_ratio(r['wall'], r0['wall']):>9}{_ratio(r['total'], r0['total']):>9}"
+                  + "".join(f"{q:>18}" for q in ratios))
     return 0
+
+
+def _ratio(new: float | None, old: float | None) -> str:
+    """new/old to two decimals, '–' where a phase did not run or took no measurable time."""
+    return "–" if not new or not old or old < 0.005 else f"{new / old:.2f}"
 
 
 if __name__ == "__main__":

@@ -40,7 +40,7 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
         for key in counts[i]:
             if counts[i][key] != counts[i + 1][key] and not (i in folds and key == sb.basis.characters):
                 sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
-                                             float(held_spectra[i][key][0])))
+                                             (held_spectra[i][key], held_spectra[i + 1][key])))
     sb.special.sort(key=lambda s: s.index)
 
 
@@ -70,9 +70,11 @@ def _negative_counts(trace, c, params, lowest: dict) -> dict:
     return counts
 
 
-def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, lowest: float) -> SpecialPoint:
+def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, ends: tuple) -> SpecialPoint:
     """The secondary branch point between points i and i + 1 where eigenvalue k of ``sector`` crosses zero, searched
-    on the basis of point i + 1 (``lowest``: the sector's lowest eigenvalue at point i, which the spectra follow)."""
+    on the basis of point i + 1 (``ends``: the sector's lowest held eigenvalues at points i and i + 1; the spectra
+    follow the lowest at i, and where eigenvalue k is among them the search starts from their values at the ends
+    it read on that basis instead of solving there again)."""
     (before, c0), (trace, c1) = traced[i], traced[i + 1]
     if before is not trace:
         c0 = transfer(before.basis, c0, trace.basis)
@@ -82,16 +84,24 @@ def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, l
     d = chord / np.linalg.norm(chord)
     held = surface_stability.Reading(True)
 
+    def on_final(c, value):
+        return np.append(c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis), value)
+
     def value_at(s):
         result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
         if not result.converged:
             raise ArithmeticError(result.message)
         c, params = system.coefficients(result.x), system.params_at(result.x)
         A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), sector)[held][sector]
-        final = c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis)
-        return float(eigen.lowest_following(A, k + 1, lowest)[k]), np.append(final, result.x[-1])
+        return float(eigen.lowest_following(A, k + 1, float(ends[0][0]))[k]), on_final(c, result.x[-1])
 
-    found = continuation.locate_root(value_at, float(np.linalg.norm(chord)))
+    length = float(np.linalg.norm(chord))
+    known = {}
+    if k < len(ends[1]):
+        known[length] = float(ends[1][k]), on_final(c1, sb.values[i + 1])
+    if k < len(ends[0]) and before is trace:
+        known[0.0] = float(ends[0][k]), on_final(c0, sb.values[i])
+    found = continuation.locate_root(value_at, length, known=known)
     note = f"secondary branch point: held eigenvalue {k} of the symmetry sector {sector} crosses zero"
     if found is not None and found.status == continuation.RootStatus.LOCATED:
         return SpecialPoint(Kind.BP, i, found.payload, m=sb.m, note=note, sector=sector)

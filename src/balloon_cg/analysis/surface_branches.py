@@ -221,7 +221,7 @@ def switch(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, step: float
         result = newton(trace.system.residual, trace.system.jacobian, guess, phi, phi @ guess, solver.tol,
                         solver.max_newton)
         if result.converged and np.linalg.norm(result.x - X_star) <= SWITCH_REACH * step:
-            return continuation.Point(result.x, continuation.tangent(trace.system, result.x, phi),
+            return continuation.Point(result.x, continuation.tangent(trace.system, result.x, phi, result.factors),
                                       result.iterations, result.residual)
         if result.converged:
             far = float(np.linalg.norm(result.x - X_star))
@@ -305,15 +305,17 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
             return trace, segments, folds, stop
         new = trace.on(finer)
         last = segments[-1][1].pop()  # solved again on the finer basis: the first point of the next segment
-        X = newton(new.system.residual, new.system.jacobian, trace.move(last.X, new), np.eye(new.gauge.size + 1)[-1],
-                   last.X[-1], scene.solver.tol, scene.solver.max_newton)
+        fixed = np.eye(new.gauge.size + 1)[-1]
+        X = newton(new.system.residual, new.system.jacobian, trace.move(last.X, new), fixed, last.X[-1],
+                   scene.solver.tol, scene.solver.max_newton)
         if not X.converged:
             segments[-1][1].append(last)
             stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
                                                 f"{finer.order}): {X.message}")
             return trace, segments, folds, stop
         reference = trace.move_direction(last.tangent, new)
-        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference), X.iterations, X.residual)
+        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, fixed), X.iterations,
+                                   X.residual)
         if rejoin is not None:
             rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
         trace = new

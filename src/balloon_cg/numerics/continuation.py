@@ -16,9 +16,14 @@ import enum
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.linalg.lapack import dgetrs
 
 from .newton import newton
 from .roots import brent
+
+
+TANGENT_REFINEMENTS = 10  # refinement steps of a tangent from the corrector's factors before the dense solve
+TANGENT_TOL = 1e-14  # the last refinement step, relative to |t|, that ends it (rounding: ~ε·cond of the bordered J)
 
 
 @dataclass
@@ -84,14 +89,38 @@ class Path:
         return self.points[fold.index].X, after.X
 
 
-def tangent(system, X, reference) -> np.ndarray:
-    """Unit null vector of J(X) oriented along ``reference``."""
+def tangent(system, X, reference, factors: tuple | None = None, row: np.ndarray | None = None) -> np.ndarray:
+    """Unit null vector of J(X) oriented along ``reference``: t of A t = e_{n+1}, A = [J(X); referenceᵀ], normalised.
+    Given ``factors`` (dgetrf's LU of M = [J(X_k); rowᵀ], a corrector's at an iterate X_k near X; ``row`` its
+    bordering row, default ``reference``) and a system that applies J(X) without assembling it
+    (``jacobian_vector(X, v)``), by iterative refinement of [J(X); rowᵀ] t = e_{n+1} (the same null vector, scaled),
+    t ← t + M⁻¹(e_{n+1} − [J(X); rowᵀ] t), which contracts as ‖I − M⁻¹[J(X); rowᵀ]‖ = O(|X − X_k|): a few
+    matrix-free products instead of an assembly and a factorisation; the dense solve where it does not reach
+    TANGENT_TOL in TANGENT_REFINEMENTS steps."""
+    if factors is not None and hasattr(system, "jacobian_vector"):
+        t = _refined_tangent(system, X, reference if row is None else row, factors)
+        if t is not None:
+            return t if t @ reference > 0 else -t
     J = system.jacobian(X)
     matrix = np.vstack([J, reference])
     rhs = np.zeros(J.shape[0] + 1)
     rhs[-1] = 1.0
     t = np.linalg.solve(matrix, rhs)
     return t / np.linalg.norm(t)
+
+
+def _refined_tangent(system, X, row, factors: tuple) -> np.ndarray | None:
+    """The unit solution of [J(X); rowᵀ] t = e_{n+1} by iterative refinement on ``factors`` (``tangent``), or None
+    when a step is not below TANGENT_TOL·|t| within TANGENT_REFINEMENTS steps."""
+    rhs = np.zeros(X.size)
+    rhs[-1] = 1.0
+    t = dgetrs(*factors, rhs)[0]
+    for _ in range(TANGENT_REFINEMENTS):
+        step = dgetrs(*factors, rhs - np.append(system.jacobian_vector(X, t), row @ t))[0]
+        t = t + step
+        if np.linalg.norm(step) <= TANGENT_TOL * np.linalg.norm(t):
+            return t / np.linalg.norm(t)
+    return None
 
 
 def correct(system, predictor, direction, settings: Settings):
@@ -159,7 +188,7 @@ def _locate_fold(system, start: Point, sigma: float, c, settings: Settings, end:
         result = correct(system, start.X + s * start.tangent, start.tangent, settings)
         if not result.converged:
             raise ArithmeticError(result.message)
-        t = tangent(system, result.x, start.tangent)
+        t = tangent(system, result.x, start.tangent, result.factors)
         return rate(c, result.x, t), Point(result.x, t, result.iterations, result.residual)
 
     reached = Point(end.X.copy(), end.tangent.copy(), end.iterations, end.residual)  # a fold's own arrays
@@ -185,7 +214,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         new_tangent = None
         if result.converged and result.iterations <= settings.slow_newton:
             try:
-                new_tangent = tangent(system, result.x, current.tangent)
+                new_tangent = tangent(system, result.x, current.tangent, result.factors)
             except np.linalg.LinAlgError:
                 new_tangent = None
         if new_tangent is None or float(new_tangent @ current.tangent) < np.cos(settings.max_turn):

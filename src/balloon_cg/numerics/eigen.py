@@ -146,7 +146,7 @@ SHIFT_TRIES = 4  # shifts tried (each 4× farther below the guess) before the de
 
 
 def lowest_following(A, count: int, guess: float | None) -> np.ndarray:
-    """The ``count`` lowest eigenvalues (ascending) of the symmetric A (lower triangle read; kept), where ``guess``
+    """The ``count`` lowest eigenvalues (ascending) of the symmetric A (both triangles; kept), where ``guess``
     estimates the lowest (the previous point's along a branch; None: unknown): Lanczos on (A − σI)⁻¹ with σ below
     the spectrum (``ShiftInvert``). Falls back to ``lowest_of`` (dsyevr) below FOLLOWING_SIZE, without a guess, or
     when no shift is a lower bound."""
@@ -173,12 +173,14 @@ class ShiftInvert:
     @classmethod
     def below(cls, A, guess: float):
         """σ = guess − δ, δ = max(|guess|, 1e-2), tried as a lower bound by Cholesky of A − σI (δ × 4 per failure,
-        SHIFT_TRIES times); None when none is."""
+        SHIFT_TRIES times); None when none is. A symmetric, both triangles (as ``restricted`` makes it, to rounding:
+        its reflections' c vᵢvⱼ): its column-major copy is that of Aᵀ, a plain memory copy of a C-ordered A instead
+        of a transposing one (the upper triangle read, which differs from the lower by rounding)."""
         n = A.shape[0]
         delta = max(abs(guess), 1e-2)
         for _ in range(SHIFT_TRIES):
             sigma = guess - delta
-            shifted = np.array(A, order="F")
+            shifted = np.array(A.T if A.flags.c_contiguous else A, order="F")
             shifted[np.diag_indices(n)] -= sigma
             factor, info = dpotrf(shifted, lower=1, clean=0, overwrite_a=1)
             if info == 0:

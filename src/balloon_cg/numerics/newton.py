@@ -42,6 +42,7 @@ class NewtonResult:
     step: float  # the last correction in the scaled max-norm max_i |dx_i|/(1 + |x_i|)
     message: str
     jacobians: int = 0  # Jacobian evaluations and factorisations
+    factors: tuple | None = None  # converged: dgetrf's (lu, pivots) of the last [∂R/∂x; rows] (at an earlier iterate)
 
 
 def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> NewtonResult:
@@ -102,7 +103,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
                                     jacobians)
             if not math.isfinite(final):
                 return NewtonResult(x, False, iteration, final, step, "non-finite residual at the solution", jacobians)
-            return NewtonResult(x, True, iteration, final, step, "converged", jacobians)
+            return NewtonResult(x, True, iteration, final, step, "converged", jacobians, factors)
         growth = growth + 1 if step > previous else 0
         if growth >= 3:
             return NewtonResult(x, False, iteration, np.inf, step, "Newton corrections grow", jacobians)

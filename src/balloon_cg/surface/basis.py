@@ -281,8 +281,12 @@ class SphericalBasis:
 
     def node_state(self, c: np.ndarray) -> np.ndarray:
         """The 9 node rows (x, a_θ, a_φ) of x = X + u for coefficients ``c``, shape (9, n_theta n_phi)."""
-        tables, nodes = self.tables, self.nodes
-        out = np.array(nodes["reference"])
+        return self.nodes["reference"] + self.node_displacement(c)
+
+    def node_displacement(self, c: np.ndarray) -> np.ndarray:
+        """The 9 node rows (u, ∂θu, ∂φu) of the displacement u of coefficients ``c`` (linear in c)."""
+        tables = self.tables
+        out = np.zeros((STATE_ROWS, self.n_theta * self.n_phi))
         for comp in range(3):
             info = tables["components"][comp]
             if not info["blocks"]:
@@ -291,12 +295,13 @@ class SphericalBasis:
             for d in range(3):
                 per_block = (info["theta"][d] * coefficients) @ info["sums"]  # (n_theta, n_b)
                 phis = tables["phi"][info["blocks"], 0 if d < 2 else 1]
-                out[3 * d + comp] += (per_block @ phis).ravel()
+                out[3 * d + comp] = (per_block @ phis).ravel()
         return out
 
     def project(self, rows: np.ndarray) -> np.ndarray:
         """Σ_{jk} W_j Σ_{d,c} rows[3d + c](θ_j, φ_k) ∂(node row 3d + c)/∂coefficient for every coefficient: the
-        residual from the node gradient, or ⟨f, Y⟩ (with 1/2π) from rows holding f in the value rows only."""
+        residual from the node gradient (9 rows), or ⟨f, Y⟩ (with 1/2π) from the 3 value rows of a field f alone
+        (its derivative rows zero: not projected)."""
         tables, nodes = self.tables, self.nodes
         out = np.zeros(self.size)
         weights = nodes["weights"][:, None]
@@ -305,21 +310,27 @@ class SphericalBasis:
             if not info["blocks"]:
                 continue
             total = np.zeros(len(info["unknowns"]))
-            for d in range(3):
+            for d in range(rows.shape[0] // 3):
                 phis = tables["phi"][info["blocks"], 0 if d < 2 else 1]  # (n_b, n_phi)
                 rings = (rows[3 * d + comp].reshape(self.n_theta, self.n_phi) * weights) @ phis.T  # (n_theta, n_b)
                 total += np.einsum("jn,jn->n", info["theta"][d], rings[:, info["column_block"]])
             out[info["unknowns"]] = total
         return out
 
-    def hessian(self, pointwise: np.ndarray, pairs_rows: np.ndarray) -> np.ndarray:
+    def fourier_table(self, pointwise: np.ndarray) -> np.ndarray:
+        """F = [C_0 … C_{N−1}, S_0 … S_{N−1}] per node row of ``pointwise`` and θ-node j: C_q = Σ_k W_j f_jk cos qφ_k,
+        S_q = Σ_k W_j f_jk sin qφ_k (what ``hessian`` contracts; the same for every basis on these nodes)."""
+        spectra = np.fft.fft(pointwise.reshape(-1, self.n_theta, self.n_phi) * self.nodes["weights"][None, :, None],
+                             axis=2)
+        return np.ascontiguousarray(np.concatenate([spectra.real, -spectra.imag], axis=2))
+
+    def hessian(self, fourier: np.ndarray, pairs_rows: np.ndarray) -> np.ndarray:
         """Σ_{jk} W_j D(θ_j, φ_k) contracted with the node rows' derivatives on both sides (module docstring), D the
-        45 node-Hessian rows of ``pointwise`` laid out by ``pairs_rows`` (galerkin.discretisation.symmetric_rows of the kernels' pairs). Per
-        component pair (c, c') and row block b: the column weights Y_b = Σ_d' T^{dd'}[·, b, ·] Θ^{d'} (jitted,
-        ``_weighted_columns``), then the product Θ_bᵀ Y_b (BLAS) while Y_b is in cache."""
-        n, nodes, components = self.n_phi, self.nodes, self.tables["components"]
-        spectra = np.fft.fft(pointwise.reshape(-1, self.n_theta, n) * nodes["weights"][None, :, None], axis=2)
-        fourier = np.ascontiguousarray(np.concatenate([spectra.real, -spectra.imag], axis=2))  # C_q, S_q
+        45 node-Hessian rows laid out by ``pairs_rows`` (galerkin.discretisation.symmetric_rows of the kernels'
+        pairs), given as their ``fourier_table``. Per component pair (c, c') and row block b: the column weights
+        Y_b = Σ_d' T^{dd'}[·, b, ·] Θ^{d'} (jitted, ``_weighted_columns``), then the product Θ_bᵀ Y_b (BLAS) while
+        Y_b is in cache."""
+        components = self.tables["components"]
         H = np.empty((self.size, self.size))
         for c in range(3):
             if not components[c]["blocks"]:
@@ -333,12 +344,18 @@ class SphericalBasis:
                 theta = components[c2]["theta"]
                 Y = np.empty(theta.shape)
                 left = components[c]["left"]
+                starts = components[c2]["starts"]
                 for r, (start, stop) in enumerate(components[c]["row_ranges"]):
-                    _weighted_columns(fourier, channels, *self._products[c, c2], theta, components[c2]["starts"], r,
-                                      Y)
-                    H[rows.start + start:rows.start + stop, cols] = left[r].T @ Y.reshape(3 * self.n_theta, -1)
+                    first = r if c2 == c else 0  # a diagonal pair's block b' < b is the transpose of (b', b)
+                    _weighted_columns(fourier, channels, *self._products[c, c2], theta, starts, r, first, Y)
+                    H[rows.start + start:rows.start + stop, cols.start + starts[first]:cols.stop] = (
+                        left[r].T @ Y.reshape(3 * self.n_theta, -1)[:, starts[first]:])
                 if c2 != c:
                     H[cols, rows] = H[rows, cols].T
+                    continue
+                for start, stop in components[c]["row_ranges"]:
+                    H[rows.start + start:rows.start + stop, rows.start:rows.start + start] = (
+                        H[rows.start:rows.start + start, rows.start + start:rows.start + stop].T)
         return H
 
     def point_values(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> tuple:
@@ -396,23 +413,25 @@ def _norm(m: int) -> float:
 
 
 @njit(cache=True)
-def _weighted_columns(fourier, channels, i1, i2, a1, a2, theta, starts, r, Y):
-    """Y[d, j, col] = Σ_d' T^{dd'}_j[r, b'] Θ^{d'}[j, col] for the row block r, b' the block of column col (columns
-    starts[b'] to starts[b' + 1]), T^{dd'}_j[r, b'] = α1 F_ch[j, i1] + α2 F_ch[j, i2] of the plan of φ-types
-    (d // 2, d' // 2) and the Fourier table F_ch of channel ch = channels[d, d'] (Y overwritten: one row block at a
-    time stays in cache; each block's columns one contiguous, vectorised run)."""
+def _weighted_columns(fourier, channels, i1, i2, a1, a2, theta, starts, r, first, Y):
+    """Y[d, j, col] = Σ_d' T^{dd'}_j[r, b'] Θ^{d'}[j, col] for the row block r, b' ≥ ``first`` the block of column
+    col (columns starts[b'] to starts[b' + 1]), T^{dd'}_j[r, b'] = α1 F_ch[j, i1] + α2 F_ch[j, i2] of the plan of
+    φ-types (d // 2, d' // 2) and the Fourier table F_ch of channel ch = channels[d, d'] (Y overwritten from column
+    starts[first] on: each entry written once, its three terms summed in the order d' = 0, 1, 2; a node's three
+    θ-rows stay in cache over its three rows of Y; each block's columns one contiguous, vectorised run)."""
     n_b = i1.shape[3]
     n_theta = theta.shape[1]
-    Y[:] = 0.0
-    for d in range(3):
-        e = d // 2
-        for d2 in range(3):
-            e2 = d2 // 2
-            ch = channels[d, d2]
-            for j in range(n_theta):
-                y, weights = Y[d, j], theta[d2, j]
-                for b in range(n_b):
-                    t = (a1[e, e2, r, b] * fourier[ch, j, i1[e, e2, r, b]]
-                         + a2[e, e2, r, b] * fourier[ch, j, i2[e, e2, r, b]])
-                    for col in range(starts[b], starts[b + 1]):
-                        y[col] += t * weights[col]
+    for j in range(n_theta):
+        w0, w1, w2 = theta[0, j], theta[1, j], theta[2, j]
+        for d in range(3):
+            e = d // 2
+            y = Y[d, j]
+            ch0, ch1, ch2 = channels[d, 0], channels[d, 1], channels[d, 2]
+            for b in range(first, n_b):
+                p, q, alpha, beta = i1[e, 0, r, b], i2[e, 0, r, b], a1[e, 0, r, b], a2[e, 0, r, b]
+                t0 = alpha * fourier[ch0, j, p] + beta * fourier[ch0, j, q]
+                t1 = alpha * fourier[ch1, j, p] + beta * fourier[ch1, j, q]
+                p, q, alpha, beta = i1[e, 1, r, b], i2[e, 1, r, b], a1[e, 1, r, b], a2[e, 1, r, b]
+                t2 = alpha * fourier[ch2, j, p] + beta * fourier[ch2, j, q]
+                for col in range(starts[b], starts[b + 1]):
+                    y[col] = t0 * w0[col] + t1 * w1[col] + t2 * w2[col]

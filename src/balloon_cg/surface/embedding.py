@@ -13,9 +13,7 @@ from .basis import SphericalBasis
 
 def displacement_coefficients(basis: SphericalBasis, displacement: np.ndarray) -> np.ndarray:
     """The coefficients of the vector field given at the basis' nodes (3 rows x, y, z)."""
-    rows = np.zeros((9, displacement.shape[1]))
-    rows[:3] = displacement
-    return 2.0 * np.pi * basis.project(rows)
+    return 2.0 * np.pi * basis.project(displacement)
 
 
 def node_angles(basis: SphericalBasis) -> tuple:

@@ -58,7 +58,7 @@ class SurfaceEquilibrium:
         """The kernel's node rows at c, kept for the held state and parameters (stability asks for the same
         Hessian rows once per symmetry sector)."""
         values = self.node_values(c)
-        key = (kernel, params.P, params.M, params.chi, params.voltage, params.mu, params.alpha, params.material)
+        key = _key(kernel, params)
         if key not in self._outputs:
             out = self.kernels.nodes(kernel, values, params)
             if not finite(out):
@@ -78,7 +78,19 @@ class SurfaceEquilibrium:
     def hessian(self, c: np.ndarray, params: Parameters, basis: SphericalBasis | None = None) -> np.ndarray:
         """∂²E/∂c² at the state c, in ``basis`` (default the state's own; another one on the same nodes, e.g. a
         symmetry sector: the second variation against perturbations of that space)."""
-        return (basis or self.basis).hessian(self._nodes("surface_hessian", c, params), self._pairs)
+        rows = self._nodes("surface_hessian", c, params)
+        key = _key("fourier of surface_hessian", params)  # kept with the rows: every sector contracts the same table
+        if key not in self._outputs:
+            self._outputs[key] = self.basis.fourier_table(rows)
+        return (basis or self.basis).hessian(self._outputs[key], self._pairs)
+
+    def hessian_product(self, c: np.ndarray, params: Parameters, w: np.ndarray) -> np.ndarray:
+        """∂²E/∂c² w without the matrix: the node Hessian D (the rows ``hessian`` assembles) applied to the node
+        rows δs = ∂s/∂c w of the displacement w, then projected, Σ_jk W_j (∂s/∂c)ᵀ D δs (the same quadrature as
+        ``hessian``: equal to it times w up to rounding, at the cost of a residual)."""
+        rows = self._nodes("surface_hessian", c, params)
+        delta = self.basis.node_displacement(w)
+        return self.basis.project(np.einsum("kln,ln->kn", rows[self._pairs], delta))
 
     def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str,
                              basis: SphericalBasis | None = None) -> np.ndarray:
@@ -88,6 +100,11 @@ class SurfaceEquilibrium:
         if kernel is None or kernel not in self.kernels.module.KERNELS:
             raise ValueError(f"no generated derivative of the surface residual in {name!r} for this scene class")
         return (basis or self.basis).project(self._nodes(kernel, c, params))
+
+
+def _key(kernel: str, params: Parameters) -> tuple:
+    """What a kernel's node rows at the held state depend on besides it."""
+    return kernel, params.P, params.M, params.chi, params.voltage, params.mu, params.alpha, params.material
 
 
 def _oriented(state: np.ndarray, reference: np.ndarray) -> bool:

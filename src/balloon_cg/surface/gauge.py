@@ -85,9 +85,7 @@ class Gauge:
         return self._moments(np.cross(np.eye(3)[axis][:, None], reference, axis=0))
 
     def _moments(self, field: np.ndarray):
-        rows = np.zeros((9, field.shape[1]))
-        rows[:3] = field
-        row = self.basis.project(rows)
+        row = self.basis.project(field)
         norm = np.linalg.norm(row)
         return row / norm if norm > 1e-10 else None
 

@@ -73,11 +73,9 @@ def zero_mode_fields(state: np.ndarray, reference: np.ndarray, symmetry: FieldSy
 
 def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
     """The coefficients in ``basis`` of the displacement fields (rows; those outside its space dropped)."""
-    rows = np.zeros((9, fields[0].shape[1])) if fields else None
     out = []
     for f in fields:
-        rows[:3] = f
-        row = 2.0 * np.pi * basis.project(rows)
+        row = 2.0 * np.pi * basis.project(f)
         if np.linalg.norm(row) > 1e-10 * max(1.0, np.abs(f).max()):
             out.append(row)
     return np.array(out).reshape(-1, basis.size)

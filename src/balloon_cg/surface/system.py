@@ -35,6 +35,12 @@ class SurfaceSystem:
         J[:, -1] = self.gauge.reduce(self.eq.parameter_derivative(c, params, self.name))
         return J
 
+    def jacobian_vector(self, X, v):
+        """J(X) v = Zᵀ(∇²E(c) Z v_a + ∂∇E/∂p v_p) without assembling J (``SurfaceEquilibrium.hessian_product``)."""
+        c, params = self.coefficients(X), self.params_at(X)
+        return self.gauge.reduce(self.eq.hessian_product(c, params, self.gauge.expand(v[:-1]))
+                                 + v[-1] * self.eq.parameter_derivative(c, params, self.name))
+
     def solve(self, X0, tol: float = 1e-12, max_iter: int = 25) -> NewtonResult:
         """Newton at the fixed parameter X0[-1]."""
         row = np.zeros(X0.size)
