@@ -161,10 +161,16 @@ class Solver:
 
 @dataclass(frozen=True)
 class Stability:
-    """Second variation: Legendre ``degree`` of the perturbations and the largest azimuthal number ``m_max``."""
+    """Second variation: Legendre ``degree`` of the perturbations, the largest azimuthal number ``m_max`` and the
+    perturbation ``basis``: "legendre" (polynomials of x = cos θ) or "mapped" (of the mapped coordinate s(x) of a
+    branch's wire map; the same as "legendre" on a branch without one)."""
 
     degree: int = 20
     m_max: int = 1
+    basis: str = "legendre"
+
+
+STABILITY_BASES = ("legendre", "mapped")
 
 
 @dataclass(frozen=True)
@@ -750,10 +756,16 @@ def _solver(data) -> Solver:
 
 
 def _stability(data) -> Stability:
-    get = _getter(table("stability", data, _keys(Stability)), "stability", Stability)
+    data = table("stability", data, _keys(Stability))
+    get = _getter(data, "stability", Stability)
+    basis = data.get("basis", Stability.basis)
+    if basis not in STABILITY_BASES:
+        raise SceneError(f"stability.basis = {show(basis)}: must be one of "
+                         + ", ".join(f'"{b}"' for b in STABILITY_BASES))
     return Stability(
         get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
         get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
+        basis,
     )
 
 
