@@ -11,9 +11,11 @@ measured by wrapping the functions ``analyse`` calls for it, the same in every i
 
 Then the floors as ratios of one run: the two-coil picture ≤ 2× the spom1 picture, paper_coil ≤ 5× it; also without
 the surface branches (the axisymmetric analysis the issue measured when it was filed). Installs are given as
-interpreters (``--python``, default this one) and run in alternation, scene by scene.
+interpreters (``--python``, default this one) and run in alternation, scene by scene; an interpreter may carry scene
+keys to set, ``PYTHON::KEY=VALUE[,KEY=VALUE]`` (one install against itself with another setting).
 
     python benchmarks/whole_picture.py --python /path/to/main/venv/bin/python --python python
+    python benchmarks/whole_picture.py --python python --python python::stability.basis=mapped
 """
 import argparse
 import json
@@ -47,6 +49,9 @@ for module, name, phase in ((picture, "trace_primary", "trace"), (picture, "asse
                             (surface_branches, "trace_surface", "surface branches")):
     setattr(module, name, timed(phase, getattr(module, name)))
 scene = load_scene(sys.argv[1])
+overrides = json.loads(sys.argv[2])
+if overrides:
+    scene = scene.with_overrides(overrides, name=scene.name)
 picture.analyse(scene)
 seconds.clear()
 start = time.process_time()
@@ -57,9 +62,21 @@ print(json.dumps({"total": total, "phases": seconds, "points": int(sum(len(b.X) 
 
 
 def measure(python: str, scene: str) -> dict:
-    out = subprocess.run([python, "-c", MEASURE, str(ROOT / "scenes" / f"{scene}.toml")], capture_output=True,
+    """One fresh process of ``python`` (``PYTHON::KEY=VALUE,...``: with those scene keys set) on ``scene``."""
+    python, _, settings = python.partition("::")
+    overrides = {key: _value(value) for key, value in (item.split("=", 1) for item in settings.split(",") if item)}
+    out = subprocess.run([python, "-c", MEASURE, str(ROOT / "scenes" / f"{scene}.toml"), json.dumps(overrides)],
+                         capture_output=True,
                          text=True, check=True, cwd=ROOT.parent)
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _value(text: str):
+    """A number or boolean as such (JSON), anything else as the string it is."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text
 
 
 def main(argv=None) -> int:
