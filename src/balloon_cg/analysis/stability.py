@@ -25,7 +25,7 @@ equilibrium.
 Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) form blocks 'm<m>_held' and
 'm<m>_free' with the symmetry zero modes removed; they enter every flag.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.polynomial import legendre
@@ -37,7 +37,7 @@ from ..galerkin.discretisation import (Discretisation, assemble_gradient, assemb
 from ..galerkin.equilibrium import NodeKernels, Parameters
 from ..numerics import eigen, interrupt
 from .problem import equilibrium_of
-from .resolution import Resolution
+from .resolution import Resolution, transfer_error
 from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
@@ -90,8 +90,11 @@ class SecondVariation:
         self.translation = na  # b_0
         self.ops, self.weights = _held_ops(self.basis), self.basis.weights
         ops, w = self.ops, self.weights
-        self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
-        self._orthogonal = mapping is None  # the Gram matrix is diagonal in x only
+        # the norm: ∫(δλ2² + δη²) dx ("unknowns"), or |δx|² = ∫(sin²θ δλ2² + δη²) dx ("displacement", δρ = sin θ δλ2)
+        displacement = equilibrium.scene.stability.norm == "displacement"
+        weight_a = w * self.basis.sin_theta ** 2 if displacement else w
+        self.gram = ops[0].T @ (weight_a[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+        self._orthogonal = mapping is None and not displacement  # diagonal: "unknowns" in x only
         if mapping is None:
             self.basis_a, self.basis_b, self._gradient_ops = (self.basis.basis_a, self.basis.basis_b,
                                                               self.basis._gradient_ops)
@@ -277,8 +280,29 @@ def point_degrees(branch, degree: int) -> np.ndarray:
     if branch.disc.mapping is None:
         return np.full(len(branch.X), degree)
     if branch.scene.stability.basis == "mapped":
-        return np.full(len(branch.X), max(degree, branch.disc.degree))
+        return np.maximum(degree, mapped_degrees(branch, degree))
     return np.maximum(degree, Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X, start=degree))
+
+
+def mapped_degrees(branch, start: int) -> np.ndarray:
+    """Per point of a mapped branch: the degree on its map that holds it, grown from ``start`` (by the resolution's
+    growth) until the point truncated to it loses at most max_error (``transfer_error``) and its tail estimate is
+    within max_error, at most the branch's degree (where every point is stored): a branch that ends next to a wire
+    at a high mapped degree keeps its earlier points at the degree they need."""
+    resolution, disc = Resolution.of(branch.scene.solver), branch.disc
+    X = np.atleast_2d(branch.X)
+    degrees = np.full(len(X), disc.degree)
+    open_rows, degree = np.arange(len(X)), start
+    while open_rows.size and degree < disc.degree:
+        lower = replace(disc, degree=degree)
+        moved = np.array([lower.join(*(c[: degree + 1] for c in disc.split(row[: disc.size]))) for row in X[open_rows]])
+        loss = transfer_error(disc, X[open_rows], lower, moved)
+        tails = np.array([lower.tail(row) for row in moved])
+        settled = np.maximum(loss, tails) <= resolution.max_error
+        degrees[open_rows[settled]] = degree
+        open_rows = open_rows[~settled]
+        degree = resolution.grow(degree)
+    return degrees
 
 
 def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:
