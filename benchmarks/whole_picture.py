@@ -15,9 +15,11 @@ for it, the same in every install:
 Then the floors as ratios of one run, in wall time: the two-coil picture ≤ 10× the spom1 picture, the paper coil
 and the off-equator coil ≤ 20× it; also in CPU time. Installs are given as interpreters (``--python``, default this
 one) and run in alternation, scene by scene; with several, the ratios of each install's seconds to the first's, wall,
-CPU and per phase.
+CPU and per phase. An interpreter may carry scene keys to set, ``PYTHON::KEY=VALUE[,KEY=VALUE]`` (one install
+against itself with another setting).
 
     python benchmarks/whole_picture.py --python /path/to/main/venv/bin/python --python python
+    python benchmarks/whole_picture.py --python python --python python::stability.basis=mapped
 """
 import argparse
 import json
@@ -52,6 +54,10 @@ for module, name, phase in ((picture, "trace_primary", "trace"), (picture, "asse
                             (surface_branches, "trace_surface", "surface branches")):
     setattr(module, name, timed(phase, getattr(module, name)))
 scene = load_scene(sys.argv[1])
+overrides = json.loads(sys.argv[2])
+if overrides:
+    scene = scene.with_overrides(overrides, name=scene.name)
+
 def cpu():
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
@@ -67,10 +73,21 @@ print(json.dumps({"wall": wall, "total": total, "phases": seconds,
 
 
 def measure(python: str, scene: str) -> dict:
+    """One fresh process of ``python`` (``PYTHON::KEY=VALUE,...``: with those scene keys set) on ``scene``."""
+    python, _, settings = python.partition("::")
+    overrides = {key: _value(value) for key, value in (item.split("=", 1) for item in settings.split(",") if item)}
     path = PATHS.get(scene, ROOT / "scenes" / f"{scene}.toml")
-    out = subprocess.run([python, "-c", MEASURE, str(path)], capture_output=True,
+    out = subprocess.run([python, "-c", MEASURE, str(path), json.dumps(overrides)], capture_output=True,
                          text=True, check=True, cwd=ROOT.parent)
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _value(text: str):
+    """A number or boolean as such (JSON), anything else as the string it is."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text
 
 
 def main(argv=None) -> int:

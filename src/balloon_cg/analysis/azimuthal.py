@@ -42,6 +42,7 @@ from scipy import linalg
 
 from numba import njit
 
+from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import even_half, symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.legendre import assoc_legendre, legendre_values
@@ -50,11 +51,14 @@ from ..numerics import eigen
 
 @dataclass(frozen=True)
 class AzimuthalBasis:
-    """Basis of the cos mφ perturbations (module docstring) at Gauss–Legendre nodes in x = cos θ."""
+    """Basis of the cos mφ perturbations (module docstring) at Gauss–Legendre nodes in x = cos θ; with a ``mapping``
+    (coordinate_map.WireMap, s = h(x)) the functions P̄_k^j(s(x)) at Gauss nodes in s, weights w_q/h'(x_q)
+    (``_nodes_and_functions``)."""
 
     m: int
     degree: int
     quadrature: int
+    mapping: WireMap | None = None
 
     def __post_init__(self):
         m, n = self.m, self.degree
@@ -62,7 +66,10 @@ class AzimuthalBasis:
             raise ValueError(f"m = {m}: the azimuthal second variation needs m ≥ 1 (m = 0 is Equilibrium.jacobian)")
         if n < m:
             raise ValueError(f"degree = {n}: must be ≥ m = {m}")
-        x, weights = legendre.leggauss(self.quadrature)
+        nodes, weights = legendre.leggauss(self.quadrature)
+        x = nodes if self.mapping is None else self.mapping.x(nodes)
+        if self.mapping is not None:
+            weights = weights / self.mapping.ds_dx(x)  # dx = ds/h'
         put = object.__setattr__
         put(self, "x", x)
         put(self, "weights", weights)
@@ -72,7 +79,7 @@ class AzimuthalBasis:
         offset = 0
         columns = []
         for name, order in (("Z", m), ("U", m + 1), ("D", m - 1)):
-            p, dp = assoc_legendre(x, n, order)
+            p, dp = _functions(nodes, x, n, order, self.mapping)
             k = np.arange(order, n + 1)
             blocks[name] = (slice(offset, offset + k.size), k)
             columns.append((name, p[:, k], dp[:, k]))
@@ -97,23 +104,27 @@ class AzimuthalBasis:
         w = weights[:, None]
         gram = 0.5 * sum(ops[k].T @ (w * ops[k]) for k in (0, 2, 4))
         put(self, "gram", 0.5 * (gram + gram.T))
-        put(self, "factor", eigen.GramFactor(self.gram, orthogonal=True))  # orthonormal P̄: G = diag(½ | ¼, ¼)
+        # orthonormal P̄ in x: G = diag(½ | ¼, ¼); in s, ∫ P̄_k^j(s) P̄_l^j(s) dx is not diagonal
+        orthogonal = self.mapping is None
+        put(self, "factor", eigen.GramFactor(self.gram, orthogonal=orthogonal))
         # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
         moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
         put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
-        # reflection classes z → −z of an equator-symmetric state (P̄_k^j(−x) = (−1)^{k+j} P̄_k^j(x)): k + m odd is
+        # reflection classes z → −z of an equator-symmetric state (P̄_k^j(−x) = (−1)^{k+j} P̄_k^j(x); on the odd map of
+        # an equator-symmetric state, s(−x) = −s(x), the same): k + m odd is
         # (R, T even in x, Z odd), k + m even the opposite; H and G have no entries between them
         parity = np.concatenate([(k + m) % 2 for _, k in blocks.values()])
         classes = tuple(np.flatnonzero(parity == p) for p in (1, 0))
         put(self, "classes", classes)
         # within a class every integrand is even in x: its blocks need only the nodes x ≥ 0 (``even_half``), and
         # only the class's own columns (Z ones first, as in the class's index order)
-        keep, even_weights = even_half(x, weights)
+        keep, even_weights = even_half(nodes, weights)  # nodes mirror-symmetric in s (x = g(s) only to rounding)
         nz = z.stop
         put(self, "even", (keep, even_weights, tuple(
             (np.ascontiguousarray(self.ops_ud[:, keep][:, :, c[c >= nz] - nz]),
              np.ascontiguousarray(self.ops_z[:, keep][:, :, c[c < nz]])) for c in classes)))
-        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)], orthogonal=True) for c in classes))
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)], orthogonal=orthogonal)
+                                         for c in classes))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
@@ -126,13 +137,31 @@ class AzimuthalBasis:
         fields = {}
         for name, order in (("Z", self.m), ("U", self.m + 1), ("D", self.m - 1)):
             sl, k = self.blocks[name]
-            p = legendre_values(x, self.degree, order)
+            p = legendre_values(x if self.mapping is None else np.clip(self.mapping.s(x), -1.0, 1.0), self.degree, order)
             fields[name] = p[:, k] @ c[sl]
         R, T, Z = (fields["U"] + fields["D"]) / 2, (fields["U"] - fields["D"]) / 2, fields["Z"]
         cm, sm = np.cos(self.m * phi), np.sin(self.m * phi)
         horizontal_r, horizontal_p = R * cm, T * sm
         return np.array([horizontal_r * np.cos(phi) - horizontal_p * np.sin(phi),
                          horizontal_r * np.sin(phi) + horizontal_p * np.cos(phi), Z * cm])
+
+
+def _functions(nodes, x, degree: int, order: int, mapping):
+    """(P̄_k^order, dP̄_k^order/dθ) at the nodes, k = 0..degree: of x = cos θ without a map; with one of s = h(x)
+    (``nodes``), dP̄/dθ = dP̄/dσ · h'(x) sin θ / sin σ (s = cos σ: ds/dθ = −h' sin θ, ds/dσ = −sin σ). P̄_k^j(s) =
+    (1 − s²)^{j/2} q(s) and (1 − s²)/(1 − x²) is smooth and positive on [−1, 1] (h fixes ±1, h' > 0), so
+    P̄_k^j(s(x)) = sin^j θ · (a smooth function of x): the pole regularity of the unmapped basis."""
+    if mapping is None:
+        return assoc_legendre(x, degree, order)
+    p, dp = assoc_legendre(nodes, degree, order)
+    return p, dp * (mapping.ds_dx(x) * np.sqrt(1.0 - x * x) / np.sqrt(1.0 - nodes * nodes))[:, None]
+
+
+def perturbation_map(equilibrium: Equilibrium, basis: str | None = None) -> WireMap | None:
+    """The map of the perturbation bases at ``equilibrium``: its own wire map for the stability basis "mapped"
+    (``basis``; None: the scene's stability.basis), else None (Legendre in x)."""
+    kind = equilibrium.scene.stability.basis if basis is None else basis
+    return equilibrium.disc.mapping if kind == "mapped" else None
 
 
 def default_quadrature(degree: int, equilibrium_degree: int) -> int:
@@ -142,8 +171,8 @@ def default_quadrature(degree: int, equilibrium_degree: int) -> int:
 
 
 @lru_cache(maxsize=32)
-def basis(m: int, degree: int, quadrature: int) -> AzimuthalBasis:
-    return AzimuthalBasis(m, degree, quadrature)
+def basis(m: int, degree: int, quadrature: int, mapping: WireMap | None = None) -> AzimuthalBasis:
+    return AzimuthalBasis(m, degree, quadrature, mapping)
 
 
 @dataclass(frozen=True)
@@ -266,9 +295,13 @@ def azimuthal_hessian(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     return _hessian(equilibrium, u, params, m, b), b.gram
 
 
-def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature: int = 0) -> AzimuthalBasis:
-    """The basis ``azimuthal_hessian`` uses for this equilibrium's discretisation (cached)."""
-    return basis(int(m), int(degree), int(quadrature or default_quadrature(degree, equilibrium.disc.degree)))
+def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature: int = 0,
+                       kind: str | None = None) -> AzimuthalBasis:
+    """The basis ``azimuthal_hessian`` uses for this equilibrium's discretisation (cached): in x, or in s on its
+    wire map (``perturbation_map``; ``kind`` None: the scene's stability.basis). Quadrature: ``default_quadrature``
+    (on a map both degrees are in s)."""
+    return basis(int(m), int(degree), int(quadrature or default_quadrature(degree, equilibrium.disc.degree)),
+                 perturbation_map(equilibrium, kind))
 
 
 MODES = ("translation", "rotation", "relabelling")
@@ -358,14 +391,14 @@ def merged_lowest(parts, count: int) -> np.ndarray:
 
 
 def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, readings=(True, False),
-                      quadrature: int = 0) -> dict:
+                      quadrature: int = 0, kind: str | None = None) -> dict:
     """The m-th block for each reading (held: True, free: False) as standard symmetric matrices with the special
     modes removed (``numerics.eigen.restricted``): their eigenvalues together are ``spectrum``'s, and the block is
     positive when each is. On an equator-symmetric discretisation the state is symmetric and the block splits
     into its two reflection classes (``AzimuthalBasis.classes``, each mode in its own: MODE_CLASS), two matrices
     of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
-    serve every reading."""
-    b = perturbation_basis(equilibrium, m, degree, quadrature)
+    serve every reading. ``kind``: the perturbation basis (``perturbation_basis``)."""
+    b = perturbation_basis(equilibrium, m, degree, quadrature, kind)
     moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
     if equilibrium.disc.symmetric:
         parts = tuple(zip(_class_hessians(equilibrium, u, params, m, b), b.classes, b.class_factors, (0, 1)))

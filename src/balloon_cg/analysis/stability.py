@@ -25,18 +25,19 @@ equilibrium.
 Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) form blocks 'm<m>_held' and
 'm<m>_free' with the symmetry zero modes removed; they enter every flag.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.polynomial import legendre
 
-from .azimuthal import merged_lowest, restricted_blocks
+from .azimuthal import merged_lowest, perturbation_map, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
                                        read_only)
 from ..galerkin.equilibrium import NodeKernels, Parameters
 from ..numerics import eigen, interrupt, workers
 from .problem import equilibrium_of
-from .resolution import Resolution
+from .resolution import Resolution, transfer_error
 from ..numerics.threads import limited_blas
 
 LOWEST = 3  # eigenvalues reported per block
@@ -70,12 +71,15 @@ class Assessment:
 class SecondVariation:
     """Galerkin Hessians of the energy on a Legendre perturbation basis of degree N, at equilibria of ``eq``."""
 
-    def __init__(self, equilibrium, degree: int):
+    def __init__(self, equilibrium, degree: int, basis: str | None = None):
         self.eq = equilibrium
+        self.basis_kind = equilibrium.scene.stability.basis if basis is None else basis
         quadrature = max(equilibrium.disc.x.size, gauss_nodes(degree))
-        # Legendre in x even when the equilibrium's basis is mapped: the held blocks drop b_0, i.e. ∫η dx = 0,
-        # which is the same physical constraint only in this basis
-        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature)
+        # "legendre": P_k(x) even when the equilibrium's basis is mapped; "mapped": P_k(s) on the equilibrium's own
+        # wire map (its Gauss nodes in s); on an unmapped equilibrium both are the same basis
+        mapping = perturbation_map(equilibrium, self.basis_kind)
+        self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature,
+                                    mapping=mapping)
         self.theta = np.arccos(self.basis.x)
         k = np.arange(degree + 1)
         na = degree + 1
@@ -84,8 +88,20 @@ class SecondVariation:
             "b_even": na + k[k % 2 == 0], "b_odd": na + k[k % 2 == 1],
         }
         self.translation = na  # b_0
-        ops, w = self.basis.ops, self.basis.weights
-        self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+        self.ops, self.weights = _held_ops(self.basis), self.basis.weights
+        ops, w = self.ops, self.weights
+        # the norm: ∫(δλ2² + δη²) dx ("unknowns"), or |δx|² = ∫(sin²θ δλ2² + δη²) dx ("displacement", δρ = sin θ δλ2)
+        displacement = equilibrium.scene.stability.norm == "displacement"
+        weight_a = w * self.basis.sin_theta ** 2 if displacement else w
+        self.gram = ops[0].T @ (weight_a[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+        self._orthogonal = mapping is None and not displacement  # diagonal: "unknowns" in x only
+        if mapping is None:
+            self.basis_a, self.basis_b, self._gradient_ops = (self.basis.basis_a, self.basis.basis_b,
+                                                              self.basis._gradient_ops)
+        else:
+            self.basis_a, self.basis_b = (read_only(np.ascontiguousarray(ops[0:2, :, :na])),
+                                          read_only(np.ascontiguousarray(ops[2:4, :, na:])))
+            self._gradient_ops = read_only(np.ascontiguousarray(ops.reshape(-1, self.basis.size).T))
         # the state at the nodes is linear in the equilibrium's unknowns: (λ2, v, η, w) = u @ state_map
         unit = self.eq.state_at(np.eye(self.eq.disc.size), self.theta)
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
@@ -97,11 +113,14 @@ class SecondVariation:
         """(state map, the kernels at the nodes, weights, basis_a, basis_b, gradient ops) on the nodes x ≥ 0
         (``even_half``)."""
         b = self.basis
-        keep, weights = even_half(b.x, b.weights)
+        # mirror-symmetric nodes: in x without a map, in s with one (x = g(s) is odd only to rounding, and the middle
+        # node of an odd rule must count once)
+        nodes = b.x if b.mapping is None else legendre.leggauss(b.x.size)[0]
+        keep, weights = even_half(nodes, b.weights)
         n_q = b.x.size
         state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])
-        ops = np.ascontiguousarray(b.ops[:, keep])
-        tables = (read_only(weights), *(read_only(np.ascontiguousarray(t[:, keep])) for t in (b.basis_a, b.basis_b)),
+        ops = np.ascontiguousarray(self.ops[:, keep])
+        tables = (read_only(weights), *(read_only(np.ascontiguousarray(t[:, keep])) for t in (self.basis_a, self.basis_b)),
                   read_only(np.ascontiguousarray(ops.reshape(-1, b.size).T)))
         return (state_map, NodeKernels(self.eq, (b.cos_theta[keep], b.sin_theta[keep])), *tables)
 
@@ -117,8 +136,9 @@ class SecondVariation:
     def matrices(self, u, params: Parameters):
         """(H, g): the Hessian of E/2π and the gradient of Ṽ = V/2π on the perturbation basis."""
         _hold(self._nodes, u, self.state_map, params)
-        hessian = self.basis.hessian(self._nodes("energy_hessian", params))
-        volume = -self.basis.gradient(self._nodes("pressure_gradient", params))
+        hessian = assemble_hessian(self._nodes("energy_hessian", params), self.weights, self.basis_a, self.basis_b)
+        volume = -assemble_gradient(self._nodes("pressure_gradient", params), self.weights, self.basis_a,
+                                    self.basis_b, self._gradient_ops)
         return hessian, volume
 
     def _lowest(self, H, idx, constraint=None):
@@ -136,7 +156,8 @@ class SecondVariation:
         cache = self.__dict__.setdefault("_cholesky", {})
         key = idx.tobytes()
         if key not in cache:
-            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)], orthogonal=True)  # Legendre in x
+            # Legendre in x: G diagonal; in s it is not (∫ P_k(s) P_l(s) dx, dx = ds/h')
+            cache[key] = eigen.GramFactor(self.gram[np.ix_(idx, idx)], orthogonal=self._orthogonal)
         return cache[key]
 
     def _plan(self, symmetric: bool, field_on: bool) -> tuple:
@@ -177,7 +198,8 @@ class SecondVariation:
         out = self._axisymmetric(u, params, symmetric)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         for m in range(1, m_max + 1):
-            readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,))
+            readings = restricted_blocks(self.eq, u, params, m, self.basis.degree, (True, False) if field_on else (True,),
+                                         kind=self.basis_kind)
             out.append((f"m{m}_held", readings[True], HELD_FLAGS if field_on else EVERY_FLAG))
             if field_on:
                 out.append((f"m{m}_free", readings[False], FREE_FLAGS))
@@ -221,6 +243,20 @@ class SecondVariation:
         return tuple(stable)
 
 
+def _held_ops(basis: Discretisation) -> np.ndarray:
+    """The node values (λ2, v, η, w) per perturbation coefficient (a_0..a_N, b_0..b_N), shape (4, n_q, 2N + 2).
+    On a mapped basis the η functions are 1 and P_k(s) − m_k (k ≥ 1), m_k = ½∫P_k(s(x)) dx, the span of
+    P_0(s)..P_N(s): dropping b_0 (a held balloon) then means ∫δη dx = 0, the hold of the Legendre basis in x and of
+    the equilibrium's held mapped basis (``Discretisation``), not ∫δη ds = 0. In x, m_k = 0: the basis's own ops."""
+    if basis.mapping is None:
+        return basis.ops
+    na = basis.a_index.size
+    ops = np.array(basis.ops)
+    means = 0.5 * basis.weights @ ops[2, :, na + 1:]
+    ops[2, :, na + 1:] -= means
+    return read_only(ops)
+
+
 def _hold(nodes: NodeKernels, u, state_map: np.ndarray, params: Parameters):
     """The node state u @ state_map (rows λ2, v, η, w) of the unknowns u into ``nodes``, held at ``params``."""
     np.dot(np.asarray(u, dtype=float), state_map, out=nodes.state.reshape(-1))
@@ -238,11 +274,35 @@ def block_indices(variation, block: str, field_on: bool):
 
 def point_degrees(branch, degree: int) -> np.ndarray:
     """The perturbation degree per point of ``branch``: at least ``degree`` (the scene's stability.degree) and at
-    least the Legendre degree in x that holds the equilibrium (``Resolution.plain_degrees`` from ``degree`` up:
-    near a wire, on a mapped basis); on an unmapped branch ``degree``."""
+    least the degree that holds the equilibrium. On a mapped branch that is, for stability.basis "legendre", the
+    Legendre degree in x (``Resolution.plain_degrees`` from ``degree`` up: near a wire up to hundreds) and for
+    "mapped" the branch's own degree on its map (every point is stored there); on an unmapped branch ``degree``."""
     if branch.disc.mapping is None:
         return np.full(len(branch.X), degree)
+    if branch.scene.stability.basis == "mapped":
+        return np.maximum(degree, mapped_degrees(branch, degree))
     return np.maximum(degree, Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X, start=degree))
+
+
+def mapped_degrees(branch, start: int) -> np.ndarray:
+    """Per point of a mapped branch: the degree on its map that holds it, grown from ``start`` (by the resolution's
+    growth) until the point truncated to it loses at most max_error (``transfer_error``) and its tail estimate is
+    within max_error, at most the branch's degree (where every point is stored): a branch that ends next to a wire
+    at a high mapped degree keeps its earlier points at the degree they need."""
+    resolution, disc = Resolution.of(branch.scene.solver), branch.disc
+    X = np.atleast_2d(branch.X)
+    degrees = np.full(len(X), disc.degree)
+    open_rows, degree = np.arange(len(X)), start
+    while open_rows.size and degree < disc.degree:
+        lower = replace(disc, degree=degree)
+        moved = np.array([lower.join(*(c[: degree + 1] for c in disc.split(row[: disc.size]))) for row in X[open_rows]])
+        loss = transfer_error(disc, X[open_rows], lower, moved)
+        tails = np.array([lower.tail(row) for row in moved])
+        settled = np.maximum(loss, tails) <= resolution.max_error
+        degrees[open_rows[settled]] = degree
+        open_rows = open_rows[~settled]
+        degree = resolution.grow(degree)
+    return degrees
 
 
 def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:

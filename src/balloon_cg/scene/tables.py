@@ -161,10 +161,20 @@ class Solver:
 
 @dataclass(frozen=True)
 class Stability:
-    """Second variation: Legendre ``degree`` of the perturbations and the largest azimuthal number ``m_max``."""
+    """Second variation: Legendre ``degree`` of the perturbations, the largest azimuthal number ``m_max`` and the
+    perturbation ``basis``: "legendre" (polynomials of x = cos θ) or "mapped" (of the mapped coordinate s(x) of a
+    branch's wire map; the same as "legendre" on a branch without one), and the ``norm`` the m = 0 eigenvalues are
+    relative to: "unknowns" ∫(δλ2² + δη²) d(cos θ) or "displacement" ∫(sin²θ δλ2² + δη²) d(cos θ) = |δx|², the
+    m ≥ 1 blocks' norm (flags and branch points do not depend on it)."""
 
     degree: int = 20
     m_max: int = 1
+    basis: str = "legendre"
+    norm: str = "unknowns"
+
+
+STABILITY_BASES = ("legendre", "mapped")
+STABILITY_NORMS = ("unknowns", "displacement")
 
 
 @dataclass(frozen=True)
@@ -750,10 +760,18 @@ def _solver(data) -> Solver:
 
 
 def _stability(data) -> Stability:
-    get = _getter(table("stability", data, _keys(Stability)), "stability", Stability)
+    data = table("stability", data, _keys(Stability))
+    get = _getter(data, "stability", Stability)
+    choices = {}
+    for key, allowed in (("basis", STABILITY_BASES), ("norm", STABILITY_NORMS)):
+        choices[key] = data.get(key, getattr(Stability, key))
+        if choices[key] not in allowed:
+            raise SceneError(f"stability.{key} = {show(choices[key])}: must be one of "
+                             + ", ".join(f'"{b}"' for b in allowed))
     return Stability(
         get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
         get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
+        **choices,
     )
 
 
