@@ -205,6 +205,43 @@ def test_a_damaged_cached_module_is_regenerated_with_a_warning(damage, tmp_path,
     sys.modules.pop(path.stem, None)
 
 
+def test_processes_missing_the_same_module_generate_it_once(tmp_path, monkeypatch):
+    """Two loaders of one missing class at once (test or sweep workers; threads here, each with its own lock file
+    handle as a process has): one generates, the other waits for the lock and imports the module written."""
+    import threading
+
+    from balloon_cg.scene.formula import parse_formula as parse
+
+    monkeypatch.setenv(kernel_cache.CACHE_ENV, str(tmp_path))
+    formula = parse("I1 - 3 + 0.25*(I2 - 3)")
+    path = kernel_cache.module_path(formula, PLAIN)
+    both_looked, generations = threading.Barrier(2), []
+
+    def slow_generate(*args, **kwargs):
+        generations.append(threading.get_ident())
+        time.sleep(0.5)  # the other loader is waiting on the lock by now, or arrives to a written module
+        return "INPUTS = ()\nKERNELS = {}\n"
+
+    monkeypatch.setattr(kernel_cache, "bounded_generate", slow_generate)
+    modules, errors = [], []
+
+    def loader():
+        try:
+            both_looked.wait(timeout=60)
+            modules.append(kernel_cache.load(formula, PLAIN))
+        except BaseException as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+
+    threads = [threading.Thread(target=loader) for _ in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=120)
+    sys.modules.pop(path.stem, None)
+    assert not errors and len(modules) == 2 and all(m.KERNELS == {} for m in modules)
+    assert len(generations) == 1 and kernel_cache._damage(path) is None
+
+
 def test_a_generated_module_past_its_size_bound_is_one_line(monkeypatch):
     monkeypatch.setattr(kernel_cache, "MAX_MODULE_CHARS", 1000)
     assert kernel_cache.checked_size("x" * 1000, "f") == "x" * 1000
