@@ -240,6 +240,7 @@ def test_processes_missing_the_same_module_generate_it_once(tmp_path, monkeypatc
     sys.modules.pop(path.stem, None)
     assert not errors and len(modules) == 2 and all(m.KERNELS == {} for m in modules)
     assert len(generations) == 1 and kernel_cache._damage(path) is None
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no lock file or temporary file left
 
 
 def test_a_generated_module_past_its_size_bound_is_one_line(monkeypatch):

@@ -172,17 +172,23 @@ def _generation_lock(path: Path):
     """An exclusive advisory lock (flock) on ``.STEM.lock`` beside ``path`` for the duration: processes missing the
     same module generate it once, the others wait and import what the first wrote (without it each would spend the
     generation's minute and replace the file under the others, whose numba cache then misses: test workers, sweep
-    workers). Released when the holder exits, however it exits; where flock is missing (not POSIX), no lock."""
+    workers). The holder removes the lock file before releasing it, so that nothing is left beside the modules; a
+    process that opened it before then still waits for the release and finds the module written (one that opens a
+    new lock file finds it written before locking), and after a failed generation two waiting processes may both
+    generate, each writing atomically. Released when the holder exits, however it exits; where flock is missing
+    (not POSIX), no lock."""
     try:
         import fcntl
     except ImportError:
         yield
         return
-    with open(path.parent / f".{path.stem}.lock", "a") as handle:
+    lock = path.parent / f".{path.stem}.lock"
+    with open(lock, "a") as handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
         try:
             yield
         finally:
+            lock.unlink(missing_ok=True)
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
