@@ -6,8 +6,16 @@ named in SHARED_GROUPS puts the files that use one session fixture on one worker
 On the workers the groups are sent longest first (COST, seconds of a serial run: a hint for the balance, which a
 stale value spoils a little, never the outcome), the others after them in the order of collection. A serial run
 (``-n 0``, ``-p no:xdist``) keeps the order of collection.
+
+A worker owns one core: its BLAS runs on one thread, and so do the processes it starts (tests that call the
+numerics below the entry points that limit BLAS themselves, numerics/threads.py; two workers with two OpenBLAS
+threads each on two cores spend their time waiting for one another).
 """
+import os
+
 import pytest
+
+ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 COST = {  # seconds of each file in a serial --durations=0 run on a loaded 2-core machine (issue 37)
     "test_restart": 182, "test_surface": 168, "test_verdict": 103, "test_paper": 101, "test_formula": 68,
@@ -22,6 +30,15 @@ COST = {  # seconds of each file in a serial --durations=0 run on a loaded 2-cor
     "test_fold_curve": 8,
 }
 SHARED_GROUPS = {}  # file -> group, for files sharing a session fixture
+
+
+def pytest_configure(config):
+    if not hasattr(config, "workerinput"):
+        return
+    os.environ.update(dict.fromkeys(ONE_THREAD, "1"))  # before numpy loads its BLAS here, and for children
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(1, user_api="blas")  # in case it was loaded already
 
 
 def module_of(item) -> str:
