@@ -71,7 +71,7 @@ def test_sweep_on_a_real_cluster_survives_a_lost_worker(tmp_path):
                                      "--nthreads", "1", "--no-nanny", "--no-dashboard", "--name", f"w{i}"],
                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for i in range(2)]
         processes += workers
-        with distributed.Client(address, timeout="30s") as client:
+        with distributed.Client(address, timeout="300s") as client:  # generous, as wait_for
             client.wait_for_workers(2, timeout=300)
         out = tmp_path / "cluster.h5"
         sweep = subprocess.Popen(soak.cli("sweep", scene, "--vary", VARY, "-o", out, "--primary-only",

@@ -66,9 +66,9 @@ def test_bad_magnitudes_and_products_are_one_line_before_any_work(case, tmp_path
     text, words = BAD[case]
     scene = tmp_path / "s.toml"
     scene.write_text(text)
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: a loaded machine stretches the wall clock, not the work
     assert main(["run", str(scene), "-o", str(tmp_path / "x.h5"), "--quiet"]) == 2
-    assert time.perf_counter() - start < 60  # validation only (10^4 coils took 53 s to be refused)
+    assert time.process_time() - start < 60  # validation only (10^4 coils took 53 s to be refused)
     assert words in one_line(capsys) and not (tmp_path / "x.h5").exists()
 
 

@@ -119,9 +119,9 @@ def test_member_count_is_refused_before_expanding(tmp_path, capsys):
 
     scene = tmp_path / "small.toml"
     scene.write_text(SCENE.text)
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: a loaded machine stretches the wall clock, not the work
     assert main(["sweep", str(scene), "--vary", "material.alpha[0]=1:1.001:10000000", "-o", str(tmp_path / "x.h5")]) == 2
-    assert time.perf_counter() - start < 5
+    assert time.process_time() - start < 5
     assert "at most 10000 members" in capsys.readouterr().err
     with pytest.raises(SweepError, match="200000 members; at most 10000"):
         run_sweep(SCENE, ["material.alpha[0]=1.2:1.4:400", "continuation.stop_stretch=2:3:500"], tmp_path / "y.h5")

@@ -11,8 +11,9 @@ there by every later run. The key is the SHA-256 of
 
 so an edited formula, a new generator or another SymPy gives a new module; parameter values (material
 parameters, the voltage) are kernel arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
-place with ``os.replace`` (atomic on one file system): concurrent sweep workers generating the same class all
-succeed, each finds either no module or a complete one, and the deterministic text makes the winner irrelevant.
+place with ``os.replace`` (atomic on one file system), under an exclusive lock on ``.NAME.lock`` beside it: of
+concurrent processes missing the same class (sweep workers, test workers) one generates it and the others wait for
+it and import the module it wrote; each finds either no module or a complete one.
 
 Generation runs in a child process (``python -m balloon_cg.model.kernel_cache``) under a time budget
 (GENERATION_TIMEOUT seconds, $BALLOON_CG_CODEGEN_TIMEOUT to change it) and a memory bound (GENERATION_MEMORY
@@ -140,20 +141,22 @@ def load(material, terms: tuple, timings: dict | None = None, surface: bool = Fa
     path = module_path(material, terms, surface)
     if path.stem in sys.modules:
         return sys.modules[path.stem]
-    damage = _damage(path)
-    if damage is not None:
-        if damage != "missing":
-            warnings.warn(f"{path}: damaged cached kernel module ({damage}); generating it again", KernelCacheWarning,
-                          stacklevel=2)
-        text = bounded_generate(material, terms, timings, surface)
-        start = time.perf_counter()
+    if _damage(path) is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",
-                                         delete=False, encoding="utf-8") as handle:
-            handle.write(sealed(text))
-        os.replace(handle.name, path)
-        if timings is not None:
-            timings["write"] = time.perf_counter() - start
+        with _generation_lock(path):
+            damage = _damage(path)  # again: another process may have written it while this one waited
+            if damage is not None:
+                if damage != "missing":
+                    warnings.warn(f"{path}: damaged cached kernel module ({damage}); generating it again",
+                                  KernelCacheWarning, stacklevel=2)
+                text = bounded_generate(material, terms, timings, surface)
+                start = time.perf_counter()
+                with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",
+                                                 delete=False, encoding="utf-8") as handle:
+                    handle.write(sealed(text))
+                os.replace(handle.name, path)
+                if timings is not None:
+                    timings["write"] = time.perf_counter() - start
     start = time.perf_counter()
     spec = importlib.util.spec_from_file_location(path.stem, path)
     module = importlib.util.module_from_spec(spec)
@@ -162,6 +165,31 @@ def load(material, terms: tuple, timings: dict | None = None, surface: bool = Fa
     if timings is not None:
         timings["import"] = time.perf_counter() - start
     return module
+
+
+@contextlib.contextmanager
+def _generation_lock(path: Path):
+    """An exclusive advisory lock (flock) on ``.STEM.lock`` beside ``path`` for the duration: processes missing the
+    same module generate it once, the others wait and import what the first wrote (without it each would spend the
+    generation's minute and replace the file under the others, whose numba cache then misses: test workers, sweep
+    workers). The holder removes the lock file before releasing it, so that nothing is left beside the modules; a
+    process that opened it before then still waits for the release and finds the module written (one that opens a
+    new lock file finds it written before locking), and after a failed generation two waiting processes may both
+    generate, each writing atomically. Released when the holder exits, however it exits; where flock is missing
+    (not POSIX), no lock."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    lock = path.parent / f".{path.stem}.lock"
+    with open(lock, "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            lock.unlink(missing_ok=True)
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def sealed(text: str) -> str:
