@@ -374,7 +374,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
 
     degrees = point_degrees(branch, degree)
     results = workers.spread(lambda job: assess(*job), list(enumerate(degrees)), [_cost(N, m_max) for N in degrees],
-                             on_point)
+                             on_point, here=_first_of_each(degrees))
     unsettled = []
     if check:
         folds = branch.fold_intervals
@@ -385,8 +385,9 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         checked = {n: _flags(a) for n, a in followed.checked.items()}
         asked = [n for n, coarse in enumerate(results)
                  if n not in checked and _worth_checking(flags, coarse, n, near_zero)]
-        checked |= zip(asked, workers.spread(fine_flags, asked, [_cost(check_degree(branch, degrees[n]), m_max)
-                                                                  for n in asked]))
+        finer = [check_degree(branch, degrees[n]) for n in asked]
+        checked |= zip(asked, workers.spread(fine_flags, asked, [_cost(N, m_max) for N in finer],
+                                             here=_first_of_each(finer)))
         unsettled = [n for n, coarse in enumerate(results)
                      if _worth_checking(flags, coarse, n, near_zero) and checked[n] != flags[n]]
     return results, unsettled
@@ -398,6 +399,15 @@ def _worth_checking(flags: list, coarse: Assessment, n: int, near_zero: float) -
     changes = (n > 0 and flags[n - 1] != flags[n]) or (n + 1 < len(flags) and flags[n + 1] != flags[n])
     small = min(abs(values[0]) for values in coarse.blocks.values()) < near_zero
     return changes or small or n % 10 == 0
+
+
+def _first_of_each(degrees) -> list[int]:
+    """The position of the first point at each degree: assessed before the others go to workers
+    (``workers.spread(here=...)``), its second variation is built once and inherited."""
+    first = {}
+    for n, N in enumerate(degrees):
+        first.setdefault(int(N), n)
+    return list(first.values())
 
 
 def _cost(degree: int, m_max: int) -> float:

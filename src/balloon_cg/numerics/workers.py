@@ -50,9 +50,11 @@ def serial():
         _state.serial -= 1
 
 
-def spread(work, items, costs=None, on_result=None, interruptible: bool = True) -> list:
+def spread(work, items, costs=None, on_result=None, interruptible: bool = True, here=()) -> list:
     """``[work(item) for item in items]``, on ``count()`` forked workers where it pays (module docstring).
     ``costs``: a relative cost per item (default 1 each); ``on_result()`` is called here as each result arrives.
+    ``here``: positions of items computed in this process before the workers start, so that what they build and
+    cache (a second variation per degree) is inherited, not built again in every worker.
     ``work``'s exceptions are raised here; a signal raises ``interrupt.Interrupted`` (not ``interruptible``: the
     work is finished first, as a serial loop without checks would)."""
     global _job
@@ -62,8 +64,10 @@ def spread(work, items, costs=None, on_result=None, interruptible: bool = True) 
     forking = "fork" in multiprocessing.get_all_start_methods()
     if workers < 2 or sum(costs) < MIN_COST or _job is not None or not forking:  # _job: inside a worker
         return [_counted(work(item), on_result) for item in items]
-    order = sorted(range(len(items)), key=lambda i: -costs[i])
     results = [None] * len(items)
+    for i in sorted(set(here)):
+        results[i] = _counted(work(items[i]), on_result)
+    order = sorted(set(range(len(items))) - set(here), key=lambda i: (-costs[i], i))
     _job = (work, items)
     pool = ProcessPoolExecutor(workers, multiprocessing.get_context("fork"), worker_hygiene, (os.getpid(), False))
     try:
@@ -90,10 +94,10 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     """Cancel what is queued and kill the workers (they ignore SIGTERM; an item still running is not waited for):
     the executor has no public way to stop its workers before Python 3.14's ``kill_workers``."""
     processes = list((pool._processes or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
     for process in processes:
         if process.is_alive():
             process.kill()
+    pool.shutdown(wait=True, cancel_futures=True)  # its manager thread sees the killed workers and ends
     for process in processes:
         process.join()
 
