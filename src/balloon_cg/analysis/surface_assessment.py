@@ -27,10 +27,11 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
     ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). A fold (LP) of the
     branch changes the count of the state's own sector between its points: not a branch point."""
     held = surface_stability.Reading(True)
-    stretches = [stretch for stretch in np.array_split(np.arange(len(traced)), workers.count()) if stretch.size]
-    sizes = [traced[stretch[-1]][1].size for stretch in stretches]
+    cost = sum(float(c.size) ** 3 for _, c in traced)  # a dense factorisation per point
+    stretches = np.array_split(np.arange(len(traced)), workers.sharing(len(traced), cost))  # one when not shared
     read = workers.spread(lambda points: _read(sb, traced, readings, points), stretches,
-                          [stretch.size * float(n) ** 3 for stretch, n in zip(stretches, sizes)], interruptible=False)
+                          [sum(float(traced[i][1].size) ** 3 for i in stretch) for stretch in stretches],
+                          interruptible=False)
     spectra, counts = [s for part in read for s, _ in part], [n for part in read for _, n in part]
     held_spectra = [s[held] for s in spectra]
     sb.stability = {r.name: np.array([surface_stability.lowest_over(s[r], STABILITY_COUNT) for s in spectra])

@@ -50,6 +50,15 @@ def serial():
         _state.serial -= 1
 
 
+def sharing(items: int, cost: float) -> int:
+    """The worker processes ``spread`` uses for ``items`` items of total ``cost``: 1 (this process) where forking does
+    not pay or is not allowed (module docstring; inside a worker too), else ``count()`` at most ``items``."""
+    forking = "fork" in multiprocessing.get_all_start_methods()
+    if cost < MIN_COST or _job is not None or not forking:  # _job: inside a worker
+        return 1
+    return min(count(), items)
+
+
 def spread(work, items, costs=None, on_result=None, interruptible: bool = True, here=()) -> list:
     """``[work(item) for item in items]``, on ``count()`` forked workers where it pays (module docstring).
     ``costs``: a relative cost per item (default 1 each); ``on_result()`` is called here as each result arrives.
@@ -60,9 +69,8 @@ def spread(work, items, costs=None, on_result=None, interruptible: bool = True, 
     global _job
     items = list(items)
     costs = [1.0] * len(items) if costs is None else [float(c) for c in costs]
-    workers = min(count(), len(items))
-    forking = "fork" in multiprocessing.get_all_start_methods()
-    if workers < 2 or sum(costs) < MIN_COST or _job is not None or not forking:  # _job: inside a worker
+    workers = sharing(len(items), sum(costs))
+    if workers < 2:
         return [_counted(work(item), on_result) for item in items]
     results = [None] * len(items)
     for i in sorted(set(here)):
