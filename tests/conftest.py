@@ -14,8 +14,6 @@ threads each on two cores spend their time waiting for one another).
 """
 import os
 
-import pytest
-
 ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 COST = {  # seconds of each file in a serial --durations=0 run on a loaded 2-core machine (issue 37); the files whose
