@@ -383,13 +383,12 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         results, degrees = followed.assessments, followed.degrees
         flags = [_flags(a) for a in results]
         checked = {n: _flags(a) for n, a in followed.checked.items()}
-        asked = [n for n, coarse in enumerate(results)
-                 if n not in checked and _worth_checking(flags, coarse, n, near_zero)]
+        worth = [n for n, coarse in enumerate(results) if _worth_checking(flags, coarse, n, near_zero)]
+        asked = [n for n in worth if n not in checked]
         finer = [check_degree(branch, degrees[n]) for n in asked]
         checked |= zip(asked, workers.spread(fine_flags, asked, [_cost(N, m_max) for N in finer],
                                              here=_first_of_each(finer)))
-        unsettled = [n for n, coarse in enumerate(results)
-                     if _worth_checking(flags, coarse, n, near_zero) and checked[n] != flags[n]]
+        unsettled = [n for n in worth if checked[n] != flags[n]]
     return results, unsettled
 
 
