@@ -9,6 +9,7 @@ from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.sphere import sphere_pressure
 from balloon_cg.model.sphere_modes import bifurcation_stretches
+from shared_pictures import two_coil_picture
 
 ISOLA = ["SPOM1", "SPOM2", "FPOM1", "FPOM2"]
 SINGLE = ["TPOM1", "TPOM2"]
@@ -101,10 +102,8 @@ def test_tpom_bifurcation_pressure_decreases_with_alpha():
     assert pressures[1] < pressures[0]
 
 
-def test_two_coils_have_one_pear_branch_point_and_no_isola():
-    scene = load_scene(__file__.replace("tests/test_bifurcation.py", "scenes/spom1_two_coils_M0.002.toml"))
-    scene = scene.with_overrides({"solver.max_degree": 120, "solver.max_error": 1e-8})
-    pic = analyse(scene)
+def test_two_coils_have_one_pear_branch_point_and_no_isola(tmp_path_factory):
+    pic = two_coil_picture(tmp_path_factory)  # the shipped scene's axisymmetric picture (tests/shared_pictures.py)
     bps = [bp for bp in pic.branch_points if bp.block == Block.ODD_HELD]
     assert len(bps) == 1
     assert not any(b.stopped(StopCode.REJOINED) for b in pic.branches if b.name.startswith("pear"))

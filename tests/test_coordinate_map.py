@@ -20,6 +20,8 @@ from balloon_cg.post.quantities import surface
 from balloon_cg.scene import load_scene
 from balloon_cg.model.shooting import shoot_symmetric
 
+import shared_pictures
+
 SCENE = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
 MAP = WireMap((0.5, -0.5), (0.06, 0.06))
 
@@ -201,10 +203,8 @@ def test_mapped_branch_round_trips_through_hdf5(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def two_coil_picture():
-    from balloon_cg.analysis.picture import analyse
-
-    return analyse(load_scene(SCENE).with_overrides({"surface.branches": "none"}))  # the axisymmetric branches
+def two_coil_picture(tmp_path_factory):
+    return shared_pictures.two_coil_picture(tmp_path_factory)  # the axisymmetric branches
 
 
 def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire(two_coil_picture):

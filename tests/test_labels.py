@@ -6,14 +6,14 @@ import pytest
 import balloon_cg as bc
 from balloon_cg.post.labels import GID
 from balloon_cg.post.style import JournalFigure, journal_style
+from shared_pictures import two_coil_result
 
 
 @pytest.fixture(scope="module")
-def two_coils():
+def two_coils(tmp_path_factory):
     """SPOM1 between the paper's two coils at M = 0.002, the axisymmetric picture (four BP m=1 labels, a
-    pitchfork, TP and EP crowd λ2(0) ≈ 1.65–1.8)."""
-    scene = bc.Scene.from_toml("spom1_two_coils_M0.002").with_overrides({"surface.branches": "none"})
-    return bc.analyse(scene)
+    pitchfork, TP and EP crowd λ2(0) ≈ 1.65–1.8), shared with other files (tests/shared_pictures.py)."""
+    return two_coil_result(tmp_path_factory)
 
 
 def densified(points: np.ndarray, step: float = 0.5) -> np.ndarray:

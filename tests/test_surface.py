@@ -22,6 +22,8 @@ from balloon_cg.surface.gauge import FieldSymmetry, Gauge, UnsupportedGauge
 from balloon_cg.surface.measures import axial_stretch_row, measures
 from balloon_cg.surface.system import SurfaceSystem
 
+import shared_pictures
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -333,10 +335,8 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
 
 
 @pytest.fixture(scope="module")
-def two_coil_picture():
-    from balloon_cg.analysis.picture import analyse
-    scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml").with_overrides({"surface.branches": "none"})
-    return analyse(scene, pear=False)
+def two_coil_picture(tmp_path_factory):
+    return shared_pictures.two_coil_picture(tmp_path_factory)  # its primary branch is read
 
 
 def test_m1_eigenvalue_and_crossing_with_a_field(two_coil_picture):
