@@ -1,15 +1,18 @@
 """The energy functional of MODEL.md §2 for one scene class: the sum of its energy terms (codegen/terms/).
 
-Π(θ, λ2, v, η, w) = Φ(λ1, λ2) sin θ + (the terms' densities) sin θ,   λ1 = sqrt((λ2 cos θ + v)² + w²),
+Π(θ, λ2, v, η, w) = Φ(λ1, λ2) S' sin θ + (the terms' densities) sin θ,   λ1 = sqrt((λ2 cos θ + v)² + w²)/S',
 
 Φ the elastic term's strain energy plus every term that is a function of the stretches (the dielectric one), the
 others in the state at the node: ½ P λ2² w sin θ (pressure), −½ χ M H²(ρ, η) (magnetic, ρ = λ2 sin θ), i.e.
-for the full set Π = Φ sin θ − ½ χ M H² sin θ + ½ P λ2² w sin² θ.
+for the full set Π = Φ sin θ − ½ χ M H² sin θ + ½ P λ2² w sin² θ on the sphere. S' = dS/dθ is the class's
+reference meridian's (codegen/meridian.py: 1 on the sphere, so the sphere's kernels are unchanged); the densities
+per reference area (Φ, the field's) carry it, the pressure's work does not.
 """
 from dataclasses import dataclass
 
 import sympy as sp
 
+from .meridian import SPHERE, Meridian
 from .terms.elastic import Elastic
 
 theta = sp.Symbol("theta", real=True)
@@ -20,12 +23,14 @@ STATE = (lam2, v, eta, w)
 
 @dataclass(frozen=True)
 class SceneClass:
-    """What a kernel module is specialised to: its elastic term (the material) and its further energy terms, in
-    kernel order (codegen/classes.py: pressure, then magnetic, then dielectric where present)."""
+    """What a kernel module is specialised to: its elastic term (the material), its further energy terms, in
+    kernel order (codegen/classes.py: pressure, then magnetic, then dielectric where present), and its reference
+    meridian (codegen/meridian.py)."""
 
     name: str
     elastic: Elastic
     terms: tuple = ()
+    meridian: Meridian = SPHERE
 
     def inputs(self) -> dict:
         """What the module is generated from (its header): every header says whether the magnetic term is present
@@ -33,7 +38,7 @@ class SceneClass:
         inputs = {"class": self.name, **self.elastic.inputs(), "field": False}
         for term in self.terms:
             inputs.update(term.inputs())
-        return inputs
+        return inputs | self.meridian.inputs()
 
     @property
     def term_names(self) -> tuple:
@@ -48,6 +53,7 @@ class SceneClass:
     def title(self, kind: str, surface: bool = False) -> str:
         """The module's title line: ``kind`` (what the module holds), the material, the field, the other terms."""
         phrases = [phrase for t in self.terms if (phrase := t.title(surface))]
+        phrases += [phrase for phrase in (self.meridian.title(),) if phrase]
         return f"{kind} {self.name}: {', '.join([self.elastic.title(), f'field {self.field}', *phrases])}."
 
 
@@ -70,9 +76,11 @@ def at_node(cls: SceneClass, expr):
 
 
 def energy_density(cls: SceneClass, c=cos_theta, s=sin_theta):
-    """π̂ = Π / sin θ (the integrand per d(cos θ)), as a function of the node's (cos θ, sin θ) and state."""
-    density = membrane_energy(cls, meridional_stretch(c, v, w), lam2)
-    return density + sum((t.axisymmetric(c, s) for t in cls.terms), sp.S.Zero)
+    """π̂ = Π / sin θ (the integrand per d(cos θ)), as a function of the node's (cos θ, sin θ) and state:
+    Φ(λ1, λ2) S' with λ1 = |x'|/S', plus the terms' densities (those per reference area times S')."""
+    metric = cls.meridian.metric(c, s)
+    density = membrane_energy(cls, meridional_stretch(c, v, w) / metric, lam2) * metric
+    return density + sum((t.axisymmetric(c, s, metric) for t in cls.terms), sp.S.Zero)
 
 
 def lagrangian(cls: SceneClass):
@@ -81,8 +89,9 @@ def lagrangian(cls: SceneClass):
 
 
 def runtime_args(cls: SceneClass) -> list:
-    """Branch-parameter symbols a kernel of this class takes, in order: every term's runtime scalars."""
-    return [p for term in cls.terms for p in term.parameters]
+    """Scalar symbols a kernel of this class takes, in order: every term's runtime scalars (branch parameters),
+    then the meridian's (its shape: the spheroid's aspect)."""
+    return [p for term in cls.terms for p in term.parameters] + list(cls.meridian.parameters)
 
 
 def continuations(cls: SceneClass) -> list:

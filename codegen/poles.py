@@ -24,6 +24,7 @@ from .classes import KNOWN_TERMS
 from .equations import kernel_args
 from .functional import SceneClass
 from .kernels import Kernel
+from .meridian import SPHERE, Meridian
 from .series import derivative, truncated_series
 
 c0, c2, e0, e2 = sp.symbols("c0 c2 e0 e2", positive=True)
@@ -46,14 +47,15 @@ def _abstract_energy(l1, l2):
 
 
 @functools.cache
-def pole_coefficients(pole: str, terms: tuple = KNOWN_TERMS):
+def pole_coefficients(pole: str, terms: tuple = KNOWN_TERMS, meridian: Meridian = SPHERE):
     """(c2, e2) at the 'north' (θ = t) or 'south' (θ = π − t) pole, for abstract Φ and the pole Lagrangians of
-    ``terms``."""
+    ``terms``, on the reference ``meridian`` (λ1 = |x'|/S', Φ per reference area: Φ S' sin θ)."""
     lam, p, z, q = sp.symbols("lam p z q", real=True)
     sign = 1 if pole == "north" else -1
     s, c = sp.sin(_t), sign * sp.cos(_t)
-    l1 = sp.sqrt((lam * c + p * s) ** 2 + q**2)
-    L = _abstract_energy(l1, lam) * s + sum(term.pole(lam, z, q, s, e0) for term in terms)
+    metric = meridian.metric(c, s)
+    l1 = sp.sqrt((lam * c + p * s) ** 2 + q**2) / metric
+    L = _abstract_energy(l1, lam) * s * metric + sum(term.pole(lam, z, q, s, e0, metric) for term in terms)
     lam_t = [c0, 0, c2]
     eta_t = [e0, 0, e2]
     known = {lam: lam_t, z: eta_t, p: [sign * x for x in derivative(lam_t)], q: [sign * x for x in derivative(eta_t)]}
@@ -84,7 +86,7 @@ def pole_kernel(cls: SceneClass) -> Kernel:
             off.update(term.off())
     outputs = []
     for pole in ("north", "south"):
-        c2_value, e2_value, _, _ = pole_coefficients(pole, derived)
+        c2_value, e2_value, _, _ = pole_coefficients(pole, derived, cls.meridian)
         phis = {_phi_symbol(i, j): sp.diff(energy, l1, i, l2, j).subs({l1: lam0, l2: lam0})
                 for i in range(_TAYLOR_ORDER + 1) for j in range(_TAYLOR_ORDER + 1 - i)}
         subs = {**phis, c0: lam0}

@@ -11,8 +11,9 @@ R = a sin θ (a: the λ2 perturbation), T the azimuthal displacement (T = ρ0 B 
     x_θ = (ρ0' + ε R' c, ε T' s, η0' + ε Z' c),
     x_φ = (−ε (mR + T) s, ρ0 + ε (R + mT) c, −ε m Z s),      c = cos mφ, s = sin mφ,
 
-and C = G⁻¹g, G = diag(1, sin²θ), in the orthonormal reference frame: c11 = |x_θ|², c22 = |x_φ|²/sin²θ,
-c12 = x_θ·x_φ / sin θ (c12 = O(ε)). The principal stretches squared are the eigenvalues e1, e2 of that matrix;
+and C = G⁻¹g, G = diag(S'², sin²θ), in the orthonormal reference frame: c11 = |x_θ|²/S'², c22 = |x_φ|²/sin²θ,
+c12 = x_θ·x_φ / (S' sin θ) (c12 = O(ε)); S' = dS/dθ of the reference meridian (codegen/meridian.py: 1 on the
+sphere), which also multiplies the elastic density per d(cos θ). The principal stretches squared are the eigenvalues e1, e2 of that matrix;
 with φ̂(e1, e2) = Φ(√e1, √e2) and c12 = O(ε), to second order
 
     Φ(Λ1, Λ2) = φ̂(c11, c22) + K c12²,      K = (φ̂_1 − φ̂_2)/(λ1² − λ2²)   (the shear coefficient),
@@ -97,14 +98,15 @@ def second_order_density(cls: SceneClass):
     (λ1 = lam1, p1, p2, p11, p12, p22, K) and the node/state/field symbols; quadratic in PERTURBATION. The
     material stage carries Φ (every term of the stretches); the other terms add their own (``Term.second_order``)."""
     x, x_t, x_p = surface()
-    c11 = dot(x_t, x_t)
+    metric = cls.meridian.metric(cos_theta, sin_theta)
+    c11 = dot(x_t, x_t) / metric**2
     c22 = dot(x_p, x_p) / sin_theta**2
-    c12 = dot(x_t, x_p) / sin_theta
+    c12 = dot(x_t, x_p) / (sin_theta * metric)
     a1, a2 = epsilon_order(c11, 1), epsilon_order(c22, 1)
     elastic = p1 * epsilon_order(c11, 2) + p2 * epsilon_order(c22, 2)
     elastic += p11 * a1**2 / 2 + p12 * a1 * a2 + p22 * a2**2 / 2
     elastic += shear * epsilon_order(c12, 1) ** 2
-    return phi_average(elastic) + sum(term.second_order(x, x_t, x_p) for term in cls.terms)
+    return phi_average(elastic) * metric + sum(term.second_order(x, x_t, x_p, metric) for term in cls.terms)
 
 
 def material_stage(cls: SceneClass):
@@ -187,7 +189,7 @@ def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
     outputs = tuple(sp.diff(density, PERTURBATION[i], PERTURBATION[j]) for i, j in PAIRS)
     material = material_stage(cls)
     stages = (
-        ((l1, fn.meridional_stretch(cos_theta, v, w)),),
+        ((l1, fn.meridional_stretch(cos_theta, v, w) / cls.meridian.metric(cos_theta, sin_theta)),),
         tuple(zip((p1, p2, p11, p12, p22), material)) + ((shear, shear_coefficient(cls)[0]),),
     )
     return Kernel(

@@ -33,8 +33,10 @@ class Term:
         """Its part of Φ(λ1, λ2), the energy per reference area as a function of the principal stretches alone."""
         return sp.S.Zero
 
-    def axisymmetric(self, c, s):
-        """Its part of π̂ = Π/sin θ (MODEL.md §2) beyond Φ, in the node's (cos θ, sin θ) = (c, s) and the state."""
+    def axisymmetric(self, c, s, metric):
+        """Its part of π̂ = Π/sin θ (MODEL.md §2) beyond Φ, in the node's (cos θ, sin θ) = (c, s) and the state;
+        ``metric`` is the reference meridian's S' = dS/dθ there (codegen/meridian.py), the factor of a density per
+        reference area."""
         return sp.S.Zero
 
     def surface(self, point, a_t, a_p, areal):
@@ -42,14 +44,15 @@ class Term:
         a_θ, a_φ and J = |a_θ × a_φ|."""
         return sp.S.Zero
 
-    def second_order(self, x, x_t, x_p):
+    def second_order(self, x, x_t, x_p, metric):
         """Its part of the φ-averaged ε² coefficient of the energy per d(cos θ) along the perturbed surface
-        (x, x_θ, x_φ) of codegen/second_variation.py."""
+        (x, x_θ, x_φ) of codegen/second_variation.py (``metric``: as for ``axisymmetric``)."""
         return sp.S.Zero
 
-    def pole(self, lam, z, q, s, z0):
+    def pole(self, lam, z, q, s, z0, metric):
         """Its part of the Lagrangian L = Π of the pole series (codegen/poles.py) in λ2 = lam, η = z, η' = q near
-        the pole (s = sin θ, z0 = η at the pole), the stretches' part excluded (Φ enters there abstractly)."""
+        the pole (s = sin θ, z0 = η at the pole, ``metric`` as for ``axisymmetric``), the stretches' part excluded
+        (Φ enters there abstractly)."""
         return sp.S.Zero
 
     def pole_values(self, letter: str) -> dict:

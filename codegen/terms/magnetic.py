@@ -50,13 +50,13 @@ class MagneticField(Term):
     parameters = (M, chi)
     continuation = (M, "field", "M")
 
-    def axisymmetric(self, c, s):
-        return -chi * M * field_proxy(lam2 * s, eta) / 2
+    def axisymmetric(self, c, s, metric):
+        return -chi * M * field_proxy(lam2 * s, eta) / 2 * metric
 
     def surface(self, point, a_t, a_p, areal):
         return -chi * M * surface_field_proxy(point) / 2
 
-    def second_order(self, x, x_t, x_p):
+    def second_order(self, x, x_t, x_p, metric):
         """H²(|x_h|, z) with |x_h| = √(x² + y²) expanded to O(ε²) about ρ0 = λ2 sin θ: with x² + y² = ρ0² + ε q1 +
         ε² q2, |x_h| = ρ0 + ε q1/(2ρ0) + ε² (q2/(2ρ0) − q1²/(8ρ0³))."""
         rho_sq = x[0] ** 2 + x[1] ** 2
@@ -64,11 +64,11 @@ class MagneticField(Term):
         q1, q2 = epsilon_order(rho_sq, 1), epsilon_order(rho_sq, 2)
         radius = rho0 + eps * q1 / (2 * rho0) + eps**2 * (q2 / (2 * rho0) - q1**2 / (8 * rho0**3))
         H2 = sp.expand(field_proxy(radius, x[2])).subs(self.expansion())
-        return -chi * M * phi_average(epsilon_order(H2, 2)) / 2
+        return -chi * M * phi_average(epsilon_order(H2, 2)) / 2 * metric
 
-    def pole(self, lam, z, q, s, z0):
+    def pole(self, lam, z, q, s, z0, metric):
         """H² = Q + H²_η (η − η0) + ½ H²_ρρ ρ² near the axis (H²_ρ = H²_ρη = 0 there, H² even in ρ)."""
-        return -chi * M * (Q + Q_z * (z - z0) + Q_rr * (lam * s) ** 2 / 2) * s / 2
+        return -chi * M * (Q + Q_z * (z - z0) + Q_rr * (lam * s) ** 2 / 2) * s / 2 * metric
 
     def pole_values(self, letter: str) -> dict:
         return dict(zip((Q_z, Q_rr), POLE_FIELD[letter]))

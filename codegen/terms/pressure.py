@@ -27,16 +27,16 @@ class Pressure(Term):
     parameters = (P,)
     continuation = (P, "pressure", "P")
 
-    def axisymmetric(self, c, s):
+    def axisymmetric(self, c, s, metric):
         return P * lam2**2 * w * s / 2
 
     def surface(self, point, a_t, a_p, areal):
         return -P * volume_density(point, a_t, a_p)
 
-    def second_order(self, x, x_t, x_p):
+    def second_order(self, x, x_t, x_p, metric):
         return -P * phi_average(epsilon_order(volume_density(x, x_t, x_p), 2)) / sin_theta
 
-    def pole(self, lam, z, q, s, z0):
+    def pole(self, lam, z, q, s, z0, metric):
         return P * lam**2 * q * s**2 / 2
 
 

@@ -2,7 +2,10 @@
 
 1. Start: the exact sphere (``model.sphere``) at the scene's start stretch, where the membrane is taut (the
    first-order system is singular at the undeformed state, MODEL.md §4): its pressure at the scene's voltage,
-   or, for continuation.parameter = "voltage", its voltage at the scene's fixed pressure.
+   or, for continuation.parameter = "voltage", its voltage at the scene's fixed pressure. Another reference
+   shape (scene.Geometry: the spheroid) has no closed form: its start is solved from the unstressed reference
+   (λ2 = 1, η = Z(θ), P = 0, an exact equilibrium) by natural continuation in the north pole stretch up to the
+   start stretch, P an unknown (``inflated_reference``).
 2. Field on: natural continuation in M at that pressure (and voltage) from 0 to the scene's M.
 3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards
    to ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``),
@@ -21,6 +24,7 @@ import numpy as np
 
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.profiles import meridional_stretch
+from ..model.meridian import meridional_stretch as stretch_on
 from ..model.sphere import sphere_pressure, sphere_voltage
 from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics import continuation
@@ -33,7 +37,7 @@ from .problem import ParameterSystem
 from .results import Branch, StopCode
 from .tracer import ContinuationError, Tracer, unit
 from .wires import wire_gap
-from ..scene import ContinuationParameter
+from ..scene import ContinuationParameter, Shape
 from ..numerics.threads import limited_blas
 
 
@@ -46,11 +50,15 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     eq = tracer.system(degree, Parameters(0.0)).eq
     disc = eq.disc
     lam = scene.continuation.start_stretch
-    a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
-    a[0], b[1] = lam, lam
-    u = disc.join(a, b)
     params = start_parameters(scene, tracer.parameter)
-    if scene.electric is not None and not _taut(disc, u, scene.material, params.voltage):
+    if scene.geometry.shape == Shape.SPHERE:
+        a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
+        a[0], b[1] = lam, lam
+        u = disc.join(a, b)
+    else:
+        u, P = inflated_reference(tracer, degree, lam, params)
+        params = params.with_value("P", P)
+    if scene.electric is not None and not _taut(disc, u, scene.material, params.voltage, scene.geometry):
         raise ContinuationError(f"the sphere at continuation.start_stretch = {lam:g} is compressed at the voltage "
                                 f"{params.voltage:.6g} (its dielectric stress exceeds the elastic tension); "
                                 "start at another continuation.start_stretch")
@@ -60,7 +68,7 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
         trial = min(M + dM, target)
         result = newton(system.residual, system.jacobian, np.append(u, trial), unit(u.size + 1, -1), trial,
                         scene.solver.tol, scene.solver.max_newton)
-        if result.converged and _taut(disc, result.x[:-1], scene.material, params.voltage):
+        if result.converged and _taut(disc, result.x[:-1], scene.material, params.voltage, scene.geometry):
             u, M = result.x[:-1], trial
             dM *= 2
         elif result.converged:
@@ -77,6 +85,35 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     X, degree = _resolved_start(tracer, np.append(u, getattr(params, tracer.parameter)), degree, params)
     residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
     return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
+
+
+def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Parameters) -> tuple[np.ndarray, float]:
+    """(u, P) of the M = 0 equilibrium whose north pole stretch is ``stretch``, on the scene's reference shape:
+    from the unstressed reference (a_0 = 1, b_1 = aspect: λ2 = 1, η = aspect cos θ, P = 0) by natural
+    continuation in the pole stretch (steps doubled after a success, halved after a failure), each point solved
+    by Newton on R(u; P) = 0 with the pole row λ2(0) = r_n·u prescribed (galerkin.point_solve's system).
+    ContinuationError when the step falls below 1e-6 of the way."""
+    scene = tracer.scene
+    system = tracer.system(degree, params.with_value("P", 0.0))
+    disc = system.eq.disc
+    a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
+    a[0], b[1] = 1.0, scene.geometry.aspect
+    X = np.append(disc.join(a, b), 0.0)
+    row = np.append(disc.pole_rows()["lam2_north"], 0.0)
+    reached, step = 1.0, (stretch - 1.0) / 4
+    while reached < stretch:
+        trial = min(reached + step, stretch)
+        result = newton(system.residual, system.jacobian, X, row, trial, scene.solver.tol, scene.solver.max_newton)
+        if result.converged:
+            X, reached = result.x, trial
+            step *= 2
+            continue
+        step *= 0.5
+        if step < 1e-6 * (stretch - 1.0):
+            raise ContinuationError(f"could not inflate the {scene.geometry.shape.value} to continuation.start_stretch "
+                                    f"= {stretch:g} beyond the north pole stretch {reached:.6g} ({result.message}); "
+                                    "try a smaller continuation.start_stretch")
+    return X[:-1], float(X[-1])
 
 
 def start_parameters(scene, parameter: str) -> Parameters:
@@ -104,20 +141,22 @@ def _smallest_stress(material, lam1, lam2, voltage: float) -> tuple[float, float
     return float(np.min(elastic + dielectric_stress(voltage, lam1, lam2))), float(np.min(elastic))
 
 
-def _taut(disc, u, material, voltage: float = 0.0) -> bool:
+def _taut(disc, u, material, voltage: float, geometry) -> bool:
     """Both elastic principal stresses positive on a fine θ grid (MODEL.md §6: tension-field theory) and the
-    dielectric stress not above them (within SLACK_TOLERANCE)."""
+    dielectric stress not above them (within SLACK_TOLERANCE), on the scene's reference ``geometry``."""
     lam2, dlam2, _, deta = disc.evaluate(u, _STRESS_GRID)
-    total, elastic = _smallest_stress(material, meridional_stretch(_STRESS_GRID, lam2, dlam2, deta), lam2, voltage)
+    lam1 = meridional_stretch(_STRESS_GRID, lam2, dlam2, deta, geometry)
+    total, elastic = _smallest_stress(material, lam1, lam2, voltage)
     return elastic > 0.0 and total >= -SLACK_TOLERANCE * elastic
 
 
-def compressed(disc, u, material, voltage: float) -> bool:
+def compressed(disc, u, material, voltage: float, geometry) -> bool:
     """At a quadrature node a principal stress (elastic + dielectric) below −SLACK_TOLERANCE × the smallest elastic
     one: the membrane would carry compression, which it cannot (the voltage's Maxwell stress exceeds the elastic
     tension). Checked at every point of a dielectric branch, so on the nodes the solver has (no new grid)."""
     lam2, v, _, w = disc.node_state(u)
-    total, elastic = _smallest_stress(material, np.hypot(lam2 * disc.cos_theta + v, w), lam2, voltage)
+    lam1 = stretch_on(geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
+    total, elastic = _smallest_stress(material, lam1, lam2, voltage)
     return total < -SLACK_TOLERANCE * abs(elastic)
 
 
@@ -131,7 +170,7 @@ def _wrinkling_limit(system: ParameterSystem, u, taut_M: float, wrinkled_M: floa
                         solver.tol, solver.max_newton)
         if not result.converged:
             break
-        if _taut(disc, result.x[:-1], scene.material, system.params.voltage):
+        if _taut(disc, result.x[:-1], scene.material, system.params.voltage, scene.geometry):
             u, taut_M = result.x[:-1], middle
         else:
             wrinkled_M = middle
@@ -201,7 +240,7 @@ def range_limits(scene, upper: float):
     def limits(disc, point):
         if scene.electric is not None:  # first: a compressed point is not landed on, whatever its stretch
             voltage = point.X[-1] if in_voltage else scene.electric.voltage
-            if compressed(disc, point.X[:-1], scene.material, voltage):
+            if compressed(disc, point.X[:-1], scene.material, voltage, scene.geometry):
                 return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
                                                  "tension: tension-field theory is not modelled)")
         stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])

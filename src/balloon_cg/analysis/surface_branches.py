@@ -51,6 +51,7 @@ from .results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, S
 from .stability import assessed_degrees
 from .surface_assessment import assess
 from .surface_resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
+from ..scene import Shape
 
 SWITCH_STEP = 2e-2  # the first step off the axisymmetric branch, along the unit mode in coefficient space
 CRITICAL_SEARCH = 4  # the eigenvalues of the BP's block among which the critical (nearest zero) one is taken
@@ -238,6 +239,10 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     along sign·φ (module docstring); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     scene = branch.scene
+    if scene.geometry.shape != Shape.SPHERE:
+        raise SurfaceStartError(f"the whole-sphere engine has a spherical reference only; the scene's is a "
+                                f"{scene.geometry.shape.value} (its m = {bp.m} branch point is located, the branch "
+                                "born there is not traced)")
     az_basis, vector = critical_mode(branch, bp, located_degree(branch, bp))
     symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
     params = branch.params_at(bp.X)

@@ -26,8 +26,9 @@ MAP_GAP = 2.0  # wires farther than this get no map centre (up to 2 no point nee
 
 @dataclass(frozen=True)
 class Approach:
-    """The membrane's closest approach to one wire: x = cos θ there, the gap, and |dx/ds| = sin θ/λ1 there
-    (s the arclength along the deformed meridian, reference radius 1)."""
+    """The membrane's closest approach to one wire: x = cos θ there, the gap, and |dx/ds| = sin θ/|x'| there
+    (s the arclength along the deformed meridian; |x'| = ds/dθ, λ1 on the sphere: ``meridional_stretch`` on
+    its default geometry)."""
 
     x: float
     gap: float

@@ -403,7 +403,7 @@ def solution(branch, i: int) -> dict:
     from ..galerkin.profiles import equator_values
 
     X = branch.X[i]
-    values = {"pressure": X[-1], **branch.pole_values(X), **equator_values(branch.disc, X)}
+    values = {"pressure": X[-1], **branch.pole_values(X), **equator_values(branch.disc, X, branch.scene.geometry)}
     return {
         **{k: float(np.squeeze(v)) for k, v in values.items()},
         "residual": float(branch.residual[i]),

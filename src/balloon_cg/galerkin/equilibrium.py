@@ -12,6 +12,7 @@ from numba import njit
 from .discretisation import Discretisation, read_only
 from ..model.field import coaxial_table, field_squared_nodes
 from ..model.kernels import KernelSet
+from ..model.meridian import meridional_stretch
 from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
@@ -106,7 +107,7 @@ class NodeKernels:
         kernels = self.eq.kernels
         spec = kernels.module.KERNELS[kernel]
         slots = tuple((i, name) for i, (name, kind, _) in enumerate(spec["args"])
-                      if kind == "param" and name not in dict(fixed))
+                      if kind == "param" and name not in dict(fixed) and name not in kernels.shape_values)
         entry = (getattr(kernels.module, f"{kernel}_nodes"),
                  list(kernels.arguments(kernel, self.values | dict(fixed), params)), slots,
                  np.empty((len(spec["outputs"]), self.geometry[0].shape[0])))
@@ -138,7 +139,7 @@ class Equilibrium:
         with log/sqrt terms, e.g. Gent's I1 − 3 < Jm: its kernels stay finite beyond it)."""
         if self._domain_check:
             lam2, v, _, w = state
-            lam1 = np.hypot(lam2 * geometry[0] + v, w)
+            lam1 = meridional_stretch(self.scene.geometry, *geometry, lam2, v, w)
             margins = self.kernels.nodes("domain_margins", {"lam1": lam1, "lam2": lam2}, params)
             violation = self.scene.material.domain_violation(margins, lam1, lam2)
             if violation is not None:

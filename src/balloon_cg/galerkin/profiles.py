@@ -2,10 +2,14 @@
 
 From the Legendre series λ2(θ), η(θ) of every point:
     λ2' = −sin θ dλ2/dx,   η' = −sin θ dη/dx   (x = cos θ),
-    ρ = λ2 sin θ,          λ1 = sqrt((λ2 cos θ + λ2' sin θ)² + η'²)   (= sqrt(ρ'² + η'²)).
-At the poles λ2' = η' = 0, so λ1 = λ2 there. η is measured from the centre of the undeformed sphere.
+    ρ = λ2 sin θ,          λ1 = sqrt((λ2 cos θ + λ2' sin θ)² + η'²)/S'   (= sqrt(ρ'² + η'²)/S'),
+S' = dS/dθ of the reference meridian (model/meridian.py: 1 on the sphere). At the poles λ2' = η' = 0, so
+λ1 = λ2 there. η is measured from the centre of the reference surface.
 """
 import numpy as np
+
+from ..model import meridian
+from ..scene.tables import Geometry
 
 
 EQUATOR = np.array([0.5 * np.pi])
@@ -21,30 +25,32 @@ def fields(disc, U: np.ndarray, theta: np.ndarray):
     return disc.evaluate(np.atleast_2d(U), theta)
 
 
-def meridional_stretch(theta, lam2, dlam2, deta):
-    """λ1 = sqrt((λ2 cos θ + λ2' sin θ)² + η'²)."""
-    return np.hypot(lam2 * np.cos(theta) + dlam2 * np.sin(theta), deta)
+def meridional_stretch(theta, lam2, dlam2, deta, geometry: Geometry = Geometry()):
+    """λ1 = sqrt((λ2 cos θ + λ2' sin θ)² + η'²)/S' on the reference ``geometry``."""
+    c, s = np.cos(theta), np.sin(theta)
+    return meridian.meridional_stretch(geometry, c, s, lam2, dlam2 * s, deta)
 
 
-def profiles(disc, X: np.ndarray, theta: np.ndarray) -> dict:
-    """λ1, λ2, ρ = λ2 sin θ and η on ``theta`` for the rows X = (u, P) of points on ``disc``.
+def profiles(disc, X: np.ndarray, theta: np.ndarray, geometry: Geometry = Geometry()) -> dict:
+    """λ1, λ2, ρ = λ2 sin θ and η on ``theta`` for the rows X = (u, P) of points on ``disc`` (a scene of reference
+    ``geometry``).
 
     Each array has shape (n_points, len(theta)).
     """
     lam2, dlam2, eta, deta = fields(disc, np.atleast_2d(X)[:, :-1], theta)
     return {
-        "lam1": meridional_stretch(theta, lam2, dlam2, deta),
+        "lam1": meridional_stretch(theta, lam2, dlam2, deta, geometry),
         "lam2": lam2,
         "rho": lam2 * np.sin(theta),
         "eta": eta,
     }
 
 
-def equator_values(disc, X: np.ndarray) -> dict:
-    """λ1(π/2) = sqrt(λ2'² + η'²) and λ2(π/2) for the rows X = (u, P) of points on ``disc``: arrays
+def equator_values(disc, X: np.ndarray, geometry: Geometry = Geometry()) -> dict:
+    """λ1(π/2) = sqrt(λ2'² + η'²)/S' and λ2(π/2) for the rows X = (u, P) of points on ``disc``: arrays
     'lam1_equator', 'lam2_equator'."""
     lam2, dlam2, _, deta = fields(disc, np.atleast_2d(X)[:, :-1], EQUATOR)
     return {
-        "lam1_equator": meridional_stretch(EQUATOR, lam2, dlam2, deta)[:, 0],
+        "lam1_equator": meridional_stretch(EQUATOR, lam2, dlam2, deta, geometry)[:, 0],
         "lam2_equator": lam2[:, 0],
     }

@@ -248,7 +248,7 @@ def _write_branch(group, branch, theta, first_label: int = 1):
         "volume": volumes,
         "amount": parameters["pressure"] * volumes,
         **branch.pole_values(),
-        **equator_values(branch.disc, branch.X),
+        **equator_values(branch.disc, branch.X, branch.scene.geometry),
         "converged": finite(branch),
         "residual": branch.residual,
         "error_estimate": branch.error_estimate,
@@ -262,7 +262,7 @@ def _write_branch(group, branch, theta, first_label: int = 1):
         group.create_dataset(name, data=data)
     attach_dimensions(group, {1: (point,), 2: (point, unknown)})
     shapes = group.create_group("profiles")
-    for name, data in profiles(branch.disc, branch.X, theta).items():
+    for name, data in profiles(branch.disc, branch.X, theta, branch.scene.geometry).items():
         shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
     attach_dimensions(shapes, {2: (point, theta_scale)})
     write_special(group.create_group("special_points"), branch.special, branch.X.shape[1],

@@ -54,6 +54,7 @@ GENERATION_TIMEOUT = 600.0  # seconds (a user formula at the bounds of scene/for
 GENERATION_MEMORY = 2 * 1024**3  # bytes of address space of the generating process
 MAX_MODULE_CHARS = 2_000_000  # a generated module's text (the largest committed one: 85 kB)
 DIGEST_MARK = "# content-sha256 "
+SPHERE = "sphere"  # the reference shape of every committed class (codegen/meridian.py)
 
 
 class KernelCacheWarning(UserWarning):
@@ -98,47 +99,49 @@ def _identity(material) -> tuple:
     return (material.text, tuple(material.parameters))
 
 
-def class_key(material, terms: tuple, surface: bool = False) -> str:
+def class_key(material, terms: tuple, surface: bool = False, shape: str = SPHERE) -> str:
     """The cache key of the class of ``material`` (scene/formula.Formula or Exponents) with the energy terms
-    ``terms`` (names, model/kernels.py: scene_terms); ``surface``: its surface kernels (MODEL.md §8) instead of the
-    axisymmetric ones."""
+    ``terms`` (names, model/kernels.py: scene_terms) on the reference ``shape`` (codegen/meridian.py: MERIDIANS);
+    ``surface``: its surface kernels (MODEL.md §8) instead of the axisymmetric ones."""
     text = repr((*_identity(material), tuple(terms), bool(surface), codegen.GENERATOR_VERSION,
-                 generator_digest(), _sympy_version()))
+                 generator_digest(), _sympy_version(), *(() if shape == SPHERE else (shape,))))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def module_name(material, terms: tuple, surface: bool = False) -> str:
-    """kind (surface_, ogden or energy), the terms other than the pressure, the key's first 32 digits."""
+def module_name(material, terms: tuple, surface: bool = False, shape: str = SPHERE) -> str:
+    """kind (surface_, ogden or energy), the terms other than the pressure, a shape other than the sphere, the
+    key's first 32 digits."""
     kind = ("surface_" if surface else "") + ("ogden" if isinstance(material, Exponents) else "energy")
-    extra = "".join(f"_{name}" for name in terms if name != "pressure")
-    return f"{kind}{extra}_{class_key(material, terms, surface)[:32]}"
+    extra = "".join(f"_{name}" for name in terms if name != "pressure") + ("" if shape == SPHERE else f"_{shape}")
+    return f"{kind}{extra}_{class_key(material, terms, surface, shape)[:32]}"
 
 
-def module_path(material, terms: tuple, surface: bool = False) -> Path:
-    return cache_dir() / f"{module_name(material, terms, surface)}.py"
+def module_path(material, terms: tuple, surface: bool = False, shape: str = SPHERE) -> Path:
+    return cache_dir() / f"{module_name(material, terms, surface, shape)}.py"
 
 
-def generate(material, terms: tuple, timings: dict | None = None, surface: bool = False) -> str:
+def generate(material, terms: tuple, timings: dict | None = None, surface: bool = False, shape: str = SPHERE) -> str:
     """The module text of the class, or of its surface kernels (stage timings in seconds into ``timings``: see
     codegen/build.py)."""
     _sympy_version()
     from ..codegen import build, classes
     from ..codegen.functional import SceneClass
+    from ..codegen.meridian import MERIDIANS
     from ..codegen.terms.elastic import Elastic
 
     if isinstance(material, Exponents):
         elastic = Elastic(material.alphas)
     else:
         elastic = classes.strain_energy(material.text, material.parameters)
-    cls = SceneClass(module_name(material, terms, surface), elastic, classes.terms(terms))
+    cls = SceneClass(module_name(material, terms, surface, shape), elastic, classes.terms(terms), MERIDIANS[shape])
     return (build.surface_module if surface else build.class_module)(cls, timings)
 
 
-def load(material, terms: tuple, timings: dict | None = None, surface: bool = False):
-    """The kernel module of the class (``surface``: its surface kernels), generated (bounded_generate) and written
-    atomically into the cache first if missing or damaged; imported once per process (as
-    ``sys.modules[module_name]``)."""
-    path = module_path(material, terms, surface)
+def load(material, terms: tuple, timings: dict | None = None, surface: bool = False, shape: str = SPHERE):
+    """The kernel module of the class (``surface``: its surface kernels; ``shape``: its reference meridian),
+    generated (bounded_generate) and written atomically into the cache first if missing or damaged; imported once
+    per process (as ``sys.modules[module_name]``)."""
+    path = module_path(material, terms, surface, shape)
     if path.stem in sys.modules:
         return sys.modules[path.stem]
     if _damage(path) is not None:
@@ -149,7 +152,7 @@ def load(material, terms: tuple, timings: dict | None = None, surface: bool = Fa
                 if damage != "missing":
                     warnings.warn(f"{path}: damaged cached kernel module ({damage}); generating it again",
                                   KernelCacheWarning, stacklevel=2)
-                text = bounded_generate(material, terms, timings, surface)
+                text = bounded_generate(material, terms, timings, surface, shape)
                 start = time.perf_counter()
                 with tempfile.NamedTemporaryFile("w", dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp",
                                                  delete=False, encoding="utf-8") as handle:
@@ -215,11 +218,12 @@ def _damage(path: Path) -> str | None:
     return None
 
 
-def bounded_generate(material, terms: tuple, timings: dict | None = None, surface: bool = False) -> str:
+def bounded_generate(material, terms: tuple, timings: dict | None = None, surface: bool = False,
+                     shape: str = SPHERE) -> str:
     """``generate`` in a child process under the time budget and memory bound (SceneError naming the formula
     when one is hit); SIGINT or SIGTERM here raises KeyboardInterrupt after killing the child."""
     _sympy_version()
-    request = {"terms": list(terms), "surface": bool(surface),
+    request = {"terms": list(terms), "surface": bool(surface), "shape": shape,
                **({"alphas": material.alphas} if isinstance(material, Exponents) else
                   {"formula": material.text, "parameters": list(material.parameters)})}
     budget = _budget()
@@ -313,7 +317,7 @@ def _child_main() -> int:
         material = formula_module.parse_formula(request["formula"], tuple(request["parameters"]))
     timings = {}
     try:
-        text = generate(material, tuple(request["terms"]), timings, request["surface"])
+        text = generate(material, tuple(request["terms"]), timings, request["surface"], request["shape"])
     except MemoryError:
         return _OUT_OF_MEMORY
     json.dump({"text": text, "timings": timings}, sys.stdout)

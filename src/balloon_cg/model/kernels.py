@@ -6,7 +6,8 @@ general class with runtime exponents, its unused terms padded with μ = 0. A str
 uses its family's committed class or, for a user formula, the on-demand cache; its parameters are the
 ``material`` argument. The committed module is the one with the fewest terms that include the scene's (the
 registry generated.CLASSES lists each module's terms); a term set no committed module covers (the dielectric
-term) is generated on demand from the same exponents or formula (model/kernel_cache.py).
+term) is generated on demand from the same exponents or formula (model/kernel_cache.py), and so is every class of a
+reference shape other than the sphere (scene.Geometry; its scalars, the spheroid's aspect, are bound from it).
 
 Calling convention: every generated module lists, in ``KERNELS``, each kernel's arguments as (name, kind,
 rows) and its output labels (codegen/kernels.py: convention). ``KernelSet.arguments`` is the one place that
@@ -31,7 +32,9 @@ import numpy as np
 from . import kernel_cache
 from .compile_notice import announce_first_use
 from .. import generated
+from . import meridian
 from ..scene.energies import StrainEnergy
+from ..scene.tables import Geometry, Shape
 from ..scene.validation import SceneError
 
 
@@ -74,10 +77,17 @@ def exponent_class(alpha) -> str:
     return committed_class(generated.CLASSES, None, PLAIN)
 
 
-def class_source(material, terms: tuple = PLAIN, kernel_class: str | None = None):
+def class_source(material, terms: tuple = PLAIN, kernel_class: str | None = None, shape: Shape = Shape.SPHERE):
     """(committed module name or None, what an on-demand class is generated from: a scene/formula.Formula or
     kernel_cache.Exponents, or None) of a material with ``terms``; ``kernel_class`` forces a committed Ogden class
-    (it must include the terms and fit the exponents)."""
+    (it must include the terms and fit the exponents). Classes are committed for the sphere only: another
+    ``shape`` is generated on demand from the sphere's class's material."""
+    if shape != Shape.SPHERE:
+        if kernel_class is not None:
+            raise SceneError(f"kernel class {kernel_class!r}: committed classes have a spherical reference, the scene "
+                             f"is a {shape.value}")
+        name, source = class_source(material, terms)
+        return None, source if name is None else _source_of(name, material)
     if isinstance(material, StrainEnergy):
         if kernel_class is not None:
             raise SceneError(f"kernel class {kernel_class!r}: only Ogden materials choose a kernel class")
@@ -117,20 +127,23 @@ class KernelSet:
 
     @classmethod
     def of_scene(cls, scene, kernel_class: str | None = None) -> "KernelSet":
-        """The kernels of a scene's class: its material and its terms (``scene_terms``)."""
-        return cls(scene.material, scene_terms(scene), kernel_class=kernel_class)
+        """The kernels of a scene's class: its material, its terms (``scene_terms``) and its reference shape."""
+        return cls(scene.material, scene_terms(scene), kernel_class=kernel_class, geometry=scene.geometry)
 
-    def __init__(self, material, terms: tuple = PLAIN, kernel_class: str | None = None):
+    def __init__(self, material, terms: tuple = PLAIN, kernel_class: str | None = None,
+                 geometry: Geometry = Geometry()):
         self.terms = tuple(terms)
         self.scene_material = material
+        self.geometry = geometry
+        self.shape_values = meridian.kernel_values(geometry)  # the meridian's scalar arguments (aspect)
         self._binders, self._node_kernels = {}, {}
-        name, self.source = class_source(material, self.terms, kernel_class)
+        name, self.source = class_source(material, self.terms, kernel_class, geometry.shape)
         if name is not None:
             self.module = importlib.import_module(f"{generated.__name__}.{name}")
             registry = generated.ENERGY_CLASSES if isinstance(material, StrainEnergy) else generated.CLASSES
             self.class_terms = registry[name][1]
         else:
-            self.module = kernel_cache.load(self.source, self.terms)
+            self.module = kernel_cache.load(self.source, self.terms, shape=geometry.shape.value)
             self.class_terms = self.terms
         self.name = dict(self.module.INPUTS)["class"]
         if isinstance(material, StrainEnergy):
@@ -158,6 +171,9 @@ class KernelSet:
         """The surface kernels (MODEL.md §8; codegen/surface.py) of the same class and material packing: a committed
         class's ``generated.surface_<class>``, or for a user formula and every dielectric class the on-demand
         module (model/kernel_cache.py, ``surface=True``)."""
+        if self.geometry.shape != Shape.SPHERE:
+            raise ValueError(f"the whole-sphere kernels have a spherical reference; this class's is a "
+                             f"{self.geometry.shape.value}")
         twin = copy.copy(self)
         twin._binders, twin._node_kernels = {}, {}
         twin.module = surface_module(self)
@@ -213,6 +229,7 @@ class KernelSet:
             mu, alpha, energy = params.mu, params.alpha, params.material
             source = {"P": params.P, "M": params.M, "chi": params.chi, "voltage": params.voltage, **values}
         source.update(self.material(mu, alpha, energy))
+        source.update(self.shape_values)
         try:
             for name in scalars:
                 source[name] = float(source[name])
@@ -268,6 +285,13 @@ class KernelSet:
     def state(self, state) -> dict:
         """Named values of the state (λ2, v, η, w) in the generated order STATE."""
         return dict(zip(self.module.STATE, state))
+
+
+def _source_of(name: str, material):
+    """What the committed class ``name`` of ``material`` is generated from, to generate it for another shape."""
+    if isinstance(material, StrainEnergy):
+        return material.formula
+    return exponents_of(importlib.import_module(f"{generated.__name__}.{name}"))
 
 
 def exponents_of(module) -> kernel_cache.Exponents:

@@ -6,13 +6,14 @@ s = x = cos θ, or s = h(x) for a branch stored with a coordinate map) on a θ g
 
     d/dθ = −sin θ d/dx,    d²/dθ² = sin²θ d²/dx² − cos θ d/dx,
     ρ = λ2 sin θ,   ρ' = λ2' sin θ + λ2 cos θ,   ρ'' = λ2'' sin θ + 2 λ2' cos θ − λ2 sin θ,
-    λ1 = sqrt(ρ'² + η'²).
+    s' = sqrt(ρ'² + η'²) (the deformed arclength per dθ),   λ1 = s'/S'
+(S' = dS/dθ of the reference meridian, model/meridian.py: 1 on the sphere, where λ1 = s').
 
 Geometry (t, n unit tangent along increasing θ and outward normal in the (e_ρ, e_z) plane):
 
-    t = (ρ', η')/λ1,   n = (−η', ρ')/λ1          (on a sphere n = (sin θ, cos θ), away from the centre),
-    k_m = −(ρ'η'' − ρ''η')/λ1³                   meridian curvature,
-    k_p = −η'/(ρ λ1) = (dη/dx)/(λ2 λ1)            parallel curvature (η'/ρ = −(dη/dx)/λ2 exactly: no 0/0),
+    t = (ρ', η')/s',   n = (−η', ρ')/s'          (on a sphere n = (sin θ, cos θ), away from the centre),
+    k_m = −(ρ'η'' − ρ''η')/s'³                   meridian curvature,
+    k_p = −η'/(ρ s') = (dη/dx)/(λ2 s')            parallel curvature (η'/ρ = −(dη/dx)/λ2 exactly: no 0/0),
     κ = k_m k_p = η'(ρ'η'' − ρ''η')/(ρ (ρ'² + η'²)²)  Gaussian curvature (κ R0²);
 
 both principal curvatures are 1/λ on a sphere of radius λ, and at a pole k_p = k_m, so κ there is the square of
@@ -26,8 +27,9 @@ from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import Discretisation
 from ..model.field import coaxial_table, coil_table, field_components, field_squared_nodes
 from ..model.stresses import elastic_stresses
-from ..galerkin.profiles import meridional_stretch
+from ..model.meridian import metric
 from ..scene import parse_scene
+from ..scene.tables import Geometry
 
 WRINKLING_STATES = ("taut", "wrinkled", "slack")
 
@@ -48,11 +50,12 @@ def branch_discretisation(branch: dict) -> Discretisation:
                           int(attrs.get("quadrature", 0)), mapping)
 
 
-def surface(disc: Discretisation, X, theta) -> dict:
-    """Shape, stretches and principal curvatures (module docstring) for the rows X = (u, P) on ``theta``.
+def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> dict:
+    """Shape, stretches and principal curvatures (module docstring) for the rows X = (u, P) on ``theta`` of a
+    scene of reference ``geometry``.
 
-    Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), k_meridian, k_parallel, gaussian_curvature (κ);
-    each array has shape (n_points, len(theta)).
+    Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), speed (s'), k_meridian, k_parallel,
+    gaussian_curvature (κ); each array has shape (n_points, len(theta)).
     """
     a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
     c, s = np.cos(theta), np.sin(theta)
@@ -73,11 +76,12 @@ def surface(disc: Discretisation, X, theta) -> dict:
     rho = lam2 * s
     drho = dlam2 * s + lam2 * c
     d2rho = d2lam2 * s + 2 * dlam2 * c - lam2 * s
-    lam1 = meridional_stretch(theta, lam2, dlam2, deta)
-    k_meridian = -(drho * d2eta - d2rho * deta) / lam1**3
-    k_parallel = deta_dx / (lam2 * lam1)
+    speed = np.hypot(drho, deta)
+    k_meridian = -(drho * d2eta - d2rho * deta) / speed**3
+    k_parallel = deta_dx / (lam2 * speed)
     return {
-        "lam1": lam1, "lam2": lam2, "rho": rho, "eta": eta, "drho": drho, "deta": deta,
+        "lam1": speed / metric(geometry, c, s), "lam2": lam2, "rho": rho, "eta": eta, "drho": drho, "deta": deta,
+        "speed": speed,
         "k_meridian": k_meridian, "k_parallel": k_parallel,
         "gaussian_curvature": k_meridian * k_parallel,
     }
@@ -95,7 +99,7 @@ def surface_field(coils, geometry: dict) -> dict:
     h_rho, h_z = field_components(rho, eta, table)
     derivatives = np.empty((6, rho.size))
     field_squared_nodes(np.ascontiguousarray(rho.ravel()), np.ascontiguousarray(eta.ravel()), table, derivatives)
-    t_rho, t_z = geometry["drho"] / geometry["lam1"], geometry["deta"] / geometry["lam1"]
+    t_rho, t_z = geometry["drho"] / geometry["speed"], geometry["deta"] / geometry["speed"]
     return {
         "h_rho": h_rho, "h_z": h_z,
         "H_theta": h_rho * t_rho + h_z * t_z,
@@ -141,7 +145,7 @@ def quantities(scene, disc: Discretisation, X, theta, M: float | None = None, ch
     X = np.atleast_2d(X)
     M = scene.field.M if M is None else M
     chi = scene.field.chi if chi is None else chi
-    geometry = surface(disc, X, theta)
+    geometry = surface(disc, X, theta, scene.geometry)
     field = surface_field(coaxial_table(scene.field.coils), geometry)
     sigma_theta, sigma_phi = elastic_stresses(scene.material, geometry["lam1"], geometry["lam2"])
     extra_theta, extra_phi = paper_magnetic_stresses(M, chi, theta, geometry["lam2"], field)

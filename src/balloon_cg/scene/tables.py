@@ -22,7 +22,7 @@ from .loading import Control, Loading, loading_from_table
 from .materials import Material, material_from_table
 
 __all__ = [
-    "Coil", "Field", "Electric", "ContinuationParameter", "Continuation", "Solver", "Stability", "Output", "Loading",
+    "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability", "Output", "Loading",
     "Control", "Scene", "SceneError",
     "parse_scene", "load_scene",
 ]
@@ -106,6 +106,23 @@ class Electric:
     along a pressure continuation; a voltage continuation starts from the sphere's voltage instead."""
 
     voltage: float = 0.0
+
+
+class Shape(enum.StrEnum):
+    """The reference surface the membrane is cut from (``Geometry.shape``)."""
+
+    SPHERE = "sphere"
+    SPHEROID = "spheroid"
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """The reference surface (docs/scenes.md, [geometry]): the unit sphere, or a spheroid of equatorial semi-axis 1
+    and polar semi-axis ``aspect`` (< 1 oblate, > 1 prolate; 1 is the sphere), the axis that of the coils. Lengths
+    stay in units of the equatorial radius; the reference meridian is model/meridian.py's."""
+
+    shape: Shape = Shape.SPHERE
+    aspect: float = 1.0
 
 
 class ContinuationParameter(enum.StrEnum):
@@ -200,7 +217,7 @@ class Output:
 
 
 _TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric", "surface",
-           "events")
+           "events", "geometry")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 # docs/scenes.md, Bounds: ranges that keep the computation finite (the paper's values are far inside them)
@@ -211,6 +228,7 @@ MAX_M = 1e3  # field.M (the paper's isolas close near M = 0.003; critical curves
 MAX_CHI = 100.0
 MAX_VOLTAGE = 10.0  # electric.voltage, continuation.stop_voltage (a sphere's voltage peaks below 1)
 MAX_STRETCH = 100.0  # continuation.start_stretch, stop_stretch
+MIN_ASPECT, MAX_ASPECT = 0.1, 10.0  # geometry.aspect of a spheroid
 MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
 MAX_WIRE_GAP = 10.0
 MIN_TOLERANCE = 1e-15  # solver.tol, solver.max_error (below rounding no Newton step converges)
@@ -243,6 +261,7 @@ class Scene:
     loading: Loading = Loading()
     surface: Surface = Surface()
     events: tuple[Event, ...] = ()  # [[events]]: points wanted where a stored quantity reaches a value (UZ)
+    geometry: Geometry = Geometry()  # [geometry]: the reference surface
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
@@ -283,6 +302,8 @@ class Scene:
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
             **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
             **({"events": [e.to_table() for e in self.events]} if self.events else {}),
+            **({} if self.geometry == Geometry() else {"geometry": {"shape": self.geometry.shape.value,
+                                                                     "aspect": self.geometry.aspect}}),
         }
 
     def __repr__(self):
@@ -385,7 +406,7 @@ def renamed(name: str, overrides: dict[str, object]) -> str:
     filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
     (``field.coils``, ``material.mu``) leave the name alone."""
     for key, value in overrides.items():
-        physical = key.split(".")[0] in ("field", "material", "loading", "electric")
+        physical = key.split(".")[0] in ("field", "material", "loading", "electric", "geometry")
         if not physical or value is None or isinstance(value, (list, tuple, dict)):
             continue
         if isinstance(value, str):  # a preset or a material name
@@ -401,7 +422,8 @@ def output_stem(name: str, overrides: dict[str, object]) -> str:
     not show, numerical keys (``_stop_stretch3``, ``_degree60``) and list entries (``_alpha3``), and
     ``_<key>default`` for a key restored to its default; a preset or material name is in ``name`` already."""
     for key, value in overrides.items():
-        physical_text = isinstance(value, str) and key.split(".")[0] in ("field", "material", "loading", "electric")
+        physical_text = isinstance(value, str) and key.split(".")[0] in ("field", "material", "loading", "electric",
+                                                                          "geometry")
         if not physical_text and not isinstance(value, (list, tuple, dict)):
             name = _with_token(name, key, value)
     return name
@@ -553,6 +575,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
+    geometry = _geometry(data.get("geometry", {}), field, electric)
     return Scene(
         name=name,
         material=material,
@@ -566,6 +589,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         loading=loading,
         surface=_surface(data.get("surface", {})),
         events=events_from_list(data.get("events", [])),
+        geometry=geometry,
     )
 
 
@@ -682,6 +706,39 @@ def _unit(key: str, raw) -> tuple[float, float, float]:
 def _electric(data) -> Electric:
     get = _getter(table("electric", data, _keys(Electric)), "electric", Electric)
     return Electric(get("voltage", lambda x: 0 <= x <= MAX_VOLTAGE, f"in [0, {MAX_VOLTAGE:g}]"))
+
+
+def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
+    """[geometry]: the shape, a spheroid's aspect; the parts of the model that are written for the sphere alone
+    (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a voltage) refuse
+    other shapes here."""
+    data = table("geometry", data, _keys(Geometry))
+    raw = data.get("shape")
+    raw = Geometry.shape.value if raw is None else raw
+    if raw not in tuple(Shape):
+        raise SceneError(f"geometry.shape = {show(raw)}: must be one of " + ", ".join(f'"{s.value}"' for s in Shape))
+    shape = Shape(raw)
+    if shape == Shape.SPHERE:
+        if data.get("aspect") is not None and data["aspect"] != 1:
+            raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (the '
+                             "sphere's is 1)")
+        return Geometry()
+    aspect = _getter(data, "geometry", Geometry)("aspect", lambda x: MIN_ASPECT <= x <= MAX_ASPECT,
+                                                  f"in [{MIN_ASPECT:g}, {MAX_ASPECT:g}]")
+    where = f'geometry.shape = "{shape.value}"'
+    if not field.is_axisymmetric:
+        raise SceneError(f"{where}: coils off the axis are traced on the whole sphere, which has a spherical "
+                         'reference only; use coaxial coils or geometry.shape = "sphere"')
+    for k, coil in enumerate(field.coils):
+        inside = coil.radius**2 + (coil.height / aspect) ** 2
+        if inside <= 1 + 1e-9:
+            raise SceneError(f"field.coils[{k}]: wire at (radius {show(coil.radius)}, height {show(coil.height)}) lies "
+                             f"inside the reference spheroid of aspect {aspect:g} (radius² + (height/aspect)² = "
+                             f"{inside:.6g} must be > 1)")
+    if electric is not None:
+        raise SceneError(f"{where}: the [electric] term starts from the sphere held by its voltage, which has no "
+                         'counterpart on another shape yet; leave [electric] out or use geometry.shape = "sphere"')
+    return Geometry(shape, aspect)
 
 
 def _parameter(data, electric: Electric | None):
