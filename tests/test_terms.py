@@ -18,19 +18,20 @@ g = sp.Symbol("g", real=True)
 
 @dataclass(frozen=True)
 class Weight(Term):
-    """π += g η (axisymmetric), g z (whole sphere): the weight of the membrane along the axis."""
+    """π += g η (axisymmetric), g z (whole sphere): the weight of the membrane along the axis (per reference area:
+    times the meridian's metric S', 1 on the sphere)."""
 
     parameters = (g,)
     continuation = (g, "weight", "g")
 
-    def axisymmetric(self, c, s):
-        return g * fn.eta
+    def axisymmetric(self, c, s, metric):
+        return g * fn.eta * metric
 
     def surface(self, point, a_t, a_p, areal):
         return g * point[2]
 
-    def pole(self, lam, z, q, s, z0):
-        return g * z * s
+    def pole(self, lam, z, q, s, z0, metric):
+        return g * z * s * metric
 
 
 NEO_HOOKEAN = Elastic(("2",))
