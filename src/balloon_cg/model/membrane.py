@@ -1,4 +1,8 @@
-"""Φ(λ1, λ2) and its derivatives for a strain energy (scene/energies.py), from its generated kernels.
+"""Φ(λ1, λ2) and its derivatives: for a strain energy (scene/energies.py) from its generated kernels, for an Ogden
+material (MODEL.md §2) in closed form,
+
+    Φ = Σ (μ/α)(λ1^α + λ2^α + (λ1λ2)^−α − 3),   Φ_1 = Σ μ (λ1^(α−1) − λ1^(−α−1) λ2^−α),
+    Φ_11 = Σ μ ((α − 1) λ1^(α−2) + (α + 1) λ1^(−α−2) λ2^−α),   Φ_12 = Σ μ α (λ1λ2)^(−α−1)   (Φ_2, Φ_22 by symmetry).
 
 The sphere closed forms and the elastic stresses of the Ogden presets are written out in numpy
 (model/sphere.py, model/sphere_modes.py, model/stresses.py); for any other energy they use these values,
@@ -9,6 +13,7 @@ import functools
 import numpy as np
 
 from .kernels import KernelSet
+from ..scene.energies import StrainEnergy
 
 LABELS = ("phi", "phi_1", "phi_2", "phi_11", "phi_12", "phi_22")
 
@@ -22,6 +27,25 @@ def stretch_derivatives(material, lam1, lam2) -> dict:
     """{label: array} of Φ, Φ_1, Φ_2, Φ_11, Φ_12, Φ_22 at (λ1, λ2) (broadcast; scalars give 0-d arrays)."""
     l1, l2 = np.broadcast_arrays(np.asarray(lam1, dtype=float), np.asarray(lam2, dtype=float))
     shape = l1.shape
+    if not isinstance(material, StrainEnergy):
+        return _ogden(material, l1, l2)
     out = _kernels(material).nodes("membrane_derivatives", {"lam1": np.ascontiguousarray(l1.ravel()),
                                                              "lam2": np.ascontiguousarray(l2.ravel())})
     return {label: row.reshape(shape) for label, row in zip(LABELS, out)}
+
+
+def _ogden(material, l1, l2) -> dict:
+    """``stretch_derivatives`` of an Ogden material in closed form (module docstring)."""
+    mu = np.asarray(material.mu, dtype=float).reshape((-1,) + (1,) * l1.ndim)
+    alpha = np.asarray(material.alpha, dtype=float).reshape(mu.shape)
+    j = (l1 * l2) ** -alpha
+
+    def first(a, b):
+        return np.sum(mu * (a ** (alpha - 1) - j / a), axis=0)
+
+    def second(a):
+        return np.sum(mu * ((alpha - 1) * a ** (alpha - 2) + (alpha + 1) * j / a**2), axis=0)
+
+    return {"phi": np.sum(mu / alpha * (l1**alpha + l2**alpha + j - 3), axis=0), "phi_1": first(l1, l2),
+            "phi_2": first(l2, l1), "phi_11": second(l1), "phi_12": np.sum(mu * alpha * j / (l1 * l2), axis=0),
+            "phi_22": second(l2)}

@@ -1,0 +1,90 @@
+"""The uniformly inflated tube with closed, sliding ends: the state a tube's bulge bifurcates from (docs/shapes.md).
+
+A cylinder of reference radius 1 inflated to the hoop stretch λθ (radius λθ) and the axial stretch λz, both
+uniform; its ends are closed by plugs that carry the pressure on their faces and slide freely (no axial force
+beyond the plugs' load). Per 2π and per unit reference length the energy is (MODEL.md §2 units: Φ in μ/2,
+P = P̄R/(T0 μ/2), the tube's radius R for the sphere's)
+
+    e(λθ, λz; P) = Φ(λz, λθ) − ½ P λθ² λz          (λ1 = λz meridional, λ2 = λθ hoop),
+
+and its stationarity gives the hoop balance and the closed-end axial balance
+
+    P = Φ_2/(λθ λz),        N = Φ_1 − ½ P λθ² = Φ_1 − λθ Φ_2/(2 λz) = 0.
+
+So the uniform path is λz(λθ) from N = 0 and P(λθ) along it. Its pressure maximum is the limit point under
+pressure control and, for a long tube, the onset of bulging (Yu & Fu: det ∂(P, N)/∂(λθ, λz) = 0), where along
+N = 0
+
+    dP/dλθ = P_θ − P_z N_θ/N_z = det ∂(P, N)/∂(λθ, λz) / N_z = 0,
+
+with P_θ = Φ_22/(λθλz) − P/λθ, P_z = Φ_12/(λθλz) − P/λz, N_θ = Φ_12 − (Φ_2 + λθΦ_22)/(2λz),
+N_z = Φ_11 − λθ(Φ_12 − Φ_2/λz)/(2λz).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .membrane import stretch_derivatives
+
+TOLERANCE = 1e-15  # brentq's relative tolerance on the stretches (xtol and rtol)
+_BRACKET_GROWTH = 60  # doublings of the axial bracket before giving up
+_SCAN_POINTS = 400  # hoop stretches scanned for the pressure maximum
+
+
+@dataclass(frozen=True)
+class UniformTube:
+    """A uniform state: hoop stretch λθ, axial stretch λz, pressure P."""
+
+    hoop: float
+    axial: float
+    pressure: float
+
+
+def hoop_pressure(material, hoop, axial):
+    """P = Φ_2(λz, λθ)/(λθ λz): the pressure that holds the radius λθ at the axial stretch λz."""
+    return stretch_derivatives(material, axial, hoop)["phi_2"] / (hoop * axial)
+
+
+def axial_force(material, hoop, axial):
+    """N = Φ_1 − λθ Φ_2/(2λz) (per 2π and per unit reference circumference, at the hoop-balancing pressure):
+    the axial membrane force beyond the plugs' pressure load; zero on a closed tube with sliding ends."""
+    d = stretch_derivatives(material, axial, hoop)
+    return d["phi_1"] - hoop * d["phi_2"] / (2 * axial)
+
+
+def closed_end_state(material, hoop: float) -> UniformTube:
+    """The uniform state of hoop stretch λθ with N = 0 (brentq in λz from the bracket [1/2, 2], doubled outwards
+    until N changes sign); ValueError where no axial stretch balances it."""
+    low, high = 0.5, 2.0
+    for _ in range(_BRACKET_GROWTH):
+        if axial_force(material, hoop, low) < 0 < axial_force(material, hoop, high):
+            axial = brentq(lambda z: axial_force(material, hoop, z), low, high, xtol=TOLERANCE, rtol=TOLERANCE)
+            return UniformTube(float(hoop), float(axial), float(hoop_pressure(material, hoop, axial)))
+        low, high = low / 2, high * 2
+    raise ValueError(f"no axial stretch balances the closed tube at the hoop stretch {hoop:g}")
+
+
+def pressure_slope(material, hoop: float) -> float:
+    """dP/dλθ along the closed-end path N = 0 (module docstring)."""
+    state = closed_end_state(material, hoop)
+    theta, z, P = state.hoop, state.axial, state.pressure
+    d = stretch_derivatives(material, z, theta)
+    P_theta = d["phi_22"] / (theta * z) - P / theta
+    P_z = d["phi_12"] / (theta * z) - P / z
+    N_theta = d["phi_12"] - (d["phi_2"] + theta * d["phi_22"]) / (2 * z)
+    N_z = d["phi_11"] - theta * (d["phi_12"] - d["phi_2"] / z) / (2 * z)
+    return float(P_theta - P_z * N_theta / N_z)
+
+
+def pressure_maximum(material, largest_hoop: float = 10.0) -> UniformTube | None:
+    """The first pressure maximum of the closed-end path for λθ in (1, ``largest_hoop``]: the first sign change
+    + → − of dP/dλθ on a geometric grid, then brentq; None where P rises throughout."""
+    hoops = np.geomspace(1.0 + 1e-3, largest_hoop, _SCAN_POINTS)
+    slopes = [pressure_slope(material, h) for h in hoops]
+    for k in range(len(hoops) - 1):
+        if slopes[k] > 0 >= slopes[k + 1]:
+            hoop = brentq(lambda h: pressure_slope(material, h), hoops[k], hoops[k + 1], xtol=TOLERANCE,
+                          rtol=TOLERANCE)
+            return closed_end_state(material, hoop)
+    return None

@@ -1,0 +1,99 @@
+"""The uniformly inflated closed tube with sliding ends (model/tube.py) against closed forms derived here.
+
+Energy per 2π and unit reference length e = Φ(λz, λθ) − ½ P λθ² λz: ∂e/∂λθ = 0 gives P = Φ_2/(λθλz), ∂e/∂λz = 0
+the closed-end balance N = Φ_1 − λθΦ_2/(2λz) = 0. The pressure maximum along N = 0 is where
+det ∂(P, N)/∂(λθ, λz) = 0 (Yu & Fu), solved below with SymPy/mpmath at 30 digits from the strain energy alone.
+"""
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+from scipy.optimize import brentq
+
+from balloon_cg.model.tube import axial_force, closed_end_state, hoop_pressure, pressure_maximum
+from balloon_cg.scene import parse_scene
+
+theta, z = sp.symbols("theta z", positive=True)
+
+
+def neo_hookean_state(hoop):
+    """Neo-Hookean (Φ = λ1² + λ2² + (λ1λ2)⁻² − 3): N = 0 is 2λθ²λz⁴ − λθ⁴λz² − 1 = 0, a quadratic in λz², so
+    λz² = (λθ⁴ + sqrt(λθ⁸ + 8λθ²))/(4λθ²), and P = 2(1 − λz⁻²λθ⁻⁴)/λz."""
+    axial = sp.sqrt((hoop**4 + sp.sqrt(hoop**8 + 8 * hoop**2)) / (4 * hoop**2))
+    return axial, 2 * (1 - axial**-2 * hoop**-4) / axial
+
+
+def material(preset):
+    return parse_scene(f'[material]\npreset = "{preset}"\n').material
+
+
+def symbolic_energy(m):
+    """Φ(λ1 = z, λ2 = θ) of the material ``m`` (Ogden, or the Gent family), its numbers as exact decimals."""
+    if hasattr(m, "values"):
+        mu, Jm = (sp.Rational(repr(v)) for v in m.values)
+        I1 = theta**2 + z**2 + (theta * z) ** -2
+        return -(mu * Jm / 2) * sp.log(1 - (I1 - 3) / Jm)
+    terms = zip(map(lambda v: sp.Rational(repr(v)), m.mu), map(lambda v: sp.Rational(repr(v)), m.alpha))
+    return sum(mu / a * (z**a + theta**a + (z * theta) ** -a - 3) for mu, a in terms)
+
+
+def closed_end_path(energy):
+    """(P(λθ, λz), N(λθ, λz), λz(λθ) on N = 0): lambdified from the energy; λz by brentq from the bracket
+    [0.3, b], b the first of 2, 5, 10, 30, 100 where N changes sign (and is finite)."""
+    P = sp.diff(energy, theta) / (theta * z)
+    N = sp.diff(energy, z) - theta * sp.diff(energy, theta) / (2 * z)
+    N_of = sp.lambdify((theta, z), N)
+
+    def axial(hoop):
+        b = next(b for b in (2, 5, 10, 30, 100) if N_of(hoop, 0.3) * N_of(hoop, b) < 0)
+        return brentq(lambda a: N_of(hoop, a), 0.3, b)
+
+    return P, N, axial
+
+
+@pytest.mark.parametrize("hoop", [1.05, 1.5, 2.5, 6.0])
+def test_neo_hookean_uniform_state_is_the_closed_form(hoop):
+    state = closed_end_state(material("neo-Hookean"), hoop)
+    axial, P = (float(v) for v in neo_hookean_state(sp.Float(hoop, 30)))
+    assert abs(state.axial - axial) <= 1e-13 * axial and abs(state.pressure - P) <= 1e-13 * P
+    assert abs(axial_force(material("neo-Hookean"), hoop, state.axial)) < 1e-13
+    assert hoop_pressure(material("neo-Hookean"), hoop, axial) == pytest.approx(P, rel=1e-14)
+
+
+def test_neo_hookean_pressure_maximum_is_the_closed_form():
+    """dP/dλθ = 0 of the explicit P(λθ) along N = 0, solved at 30 digits."""
+    axial, P = neo_hookean_state(theta)
+    with mpmath.workdps(30):
+        hoop = sp.nsolve(sp.diff(P, theta), theta, 1.5, prec=30)
+    found = pressure_maximum(material("neo-Hookean"))
+    assert abs(found.hoop - float(hoop)) <= 1e-10
+    assert abs(found.pressure - float(P.subs(theta, hoop))) <= 1e-13 * found.pressure
+
+
+@pytest.mark.parametrize("preset, largest_hoop", [("SPOM1", 10.0), ("TPOM2", 10.0), ("Gent", 5.0)])
+def test_pressure_maximum_solves_yu_and_fu(preset, largest_hoop):
+    """det ∂(P, N)/∂(λθ, λz) = 0 and N = 0 from the strain energy by SymPy, solved by nsolve at 30 digits from the
+    largest P of a coarse scan of the closed-end path (lambdified here, brentq in λz)."""
+    energy = symbolic_energy(material(preset))
+    P, N, axial_of = closed_end_path(energy)
+    det = sp.diff(P, theta) * sp.diff(N, z) - sp.diff(P, z) * sp.diff(N, theta)
+    P_of = sp.lambdify((theta, z), P)
+    coarse = np.linspace(1.05, largest_hoop, 80)
+    k = int(np.argmax([P_of(h, axial_of(h)) for h in coarse]))
+    guess = (coarse[k], axial_of(coarse[k]))
+    with mpmath.workdps(30):
+        hoop, axial = sp.nsolve((N, det), (theta, z), guess, prec=30)
+    found = pressure_maximum(material(preset), largest_hoop)
+    assert abs(found.hoop - float(hoop)) <= 1e-10 and abs(found.axial - float(axial)) <= 1e-10
+    assert abs(found.pressure - float(P.subs({theta: hoop, z: axial}))) <= 1e-12 * found.pressure
+
+
+def test_a_tube_without_a_pressure_maximum_says_so():
+    """Mooney–Rivlin with C2/C1 = 1 (μ = (1, −1), α = (2, −2)): P rises along the whole closed-end path up to
+    λθ = 30 (checked on 300 points with P and N lambdified here), and pressure_maximum returns None."""
+    stiff = parse_scene("[material]\nmu = [1, -1]\nalpha = [2, -2]\n").material
+    P, _, axial_of = closed_end_path(symbolic_energy(stiff))
+    P_of = sp.lambdify((theta, z), P)
+    pressures = [P_of(h, axial_of(h)) for h in np.geomspace(1.001, 30.0, 300)]
+    assert np.all(np.diff(pressures) > 0)
+    assert pressure_maximum(stiff, 30.0) is None
