@@ -1,1 +1,2 @@
-"""The model layer: generated kernels bound to a scene class, the coil field, sphere closed forms, shooting."""
+"""The model layer: generated kernels bound to a scene class, the reference meridian, the coil field, sphere and
+uniform-tube closed forms, shooting."""
