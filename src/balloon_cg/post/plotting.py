@@ -40,6 +40,8 @@ from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, reading
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
+from ..model.meridian import reference_height
+from ..scene.tables import Shape
 from ..scene.validation import did_you_mean
 
 NORMAL_FORM = ("E2", "E3", "E4")
@@ -539,7 +541,7 @@ def _equator_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
     marks = []
     for b in branches:
         d, color = b.data, b.color
-        at_equator = surface(branch_discretisation(d), d["special_unknowns"], EQUATOR)
+        at_equator = surface(branch_discretisation(d), d["special_unknowns"], EQUATOR, stored_scene(b.run).geometry)
         special_y = [s[ordinate.column] for s in d["special_points"]]
         for ax, key in zip(axes, ("lam2", "lam1")):
             _curve(ax, d[f"{key}_equator"], b.parameter_values, b.stable, color, mirror=b.mirror)
@@ -672,8 +674,12 @@ def plot_shapes(branches, points=None, axes=None) -> Figure:
     ax = panels[0]
     ax.set_aspect("equal")
     psi = np.linspace(0, 2 * np.pi, 200)
-    ax.plot(np.cos(psi), np.sin(psi), color="0.6", linewidth=0.8, linestyle=":")
-    handles = [Line2D([], [], color="0.6", linewidth=0.8, linestyle=":", label="undeformed ($R_0$ = 1)")]
+    handles = []
+    for geometry in dict.fromkeys(stored_scene(b.run).geometry for b in branches):  # each reference drawn once
+        ax.plot(np.sin(psi), reference_height(geometry, psi), color="0.6", linewidth=0.8, linestyle=":")
+        shape = "" if geometry.shape == Shape.SPHERE else f", spheroid of aspect {geometry.aspect:g}"
+        handles.append(Line2D([], [], color="0.6", linewidth=0.8, linestyle=":",
+                              label=f"undeformed ($R_0$ = 1{shape})"))
     for label, color, q, _ in _configurations(branches, points):
         ax.fill(np.r_[q["rho"], -q["rho"][::-1]], np.r_[q["eta"], q["eta"][::-1]], fill=False, edgecolor=color,
                 linewidth=1.4)  # one closed outline: no seam at the poles
