@@ -16,6 +16,7 @@ from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.profiles import equator_values, profiles
 from balloon_cg.model.meridian import reference_volume
 from balloon_cg.model.shooting import shoot_symmetric
+from balloon_cg.post.quantities import quantities
 from balloon_cg.scene import SceneError, Shape, load_scene, parse_scene
 
 SPHEROID = '[geometry]\nshape = "spheroid"\naspect = {aspect}\n'
@@ -59,6 +60,23 @@ def test_spheroid_reference_state(aspect):
     shape = profiles(disc, np.append(u, 0.0), np.linspace(0, np.pi, 37), scene.geometry)
     assert np.abs(shape["lam1"] - 1).max() < 1e-14 and np.abs(shape["lam2"] - 1).max() < 1e-14
     assert np.abs(shape["eta"] - aspect * np.cos(np.linspace(0, np.pi, 37))).max() < 1e-14
+
+
+def test_spheroid_surface_quantities_measure_from_the_spheroid():
+    """post.quantities on the unstressed spheroid: λ1 = λ2 = 1, and the principal curvatures are the spheroid's,
+    k_meridian = c/g³ and k_parallel = c/g with g = sqrt(cos²θ + c² sin²θ) (for ρ = sin θ, η = c cos θ:
+    ρ'η'' − ρ''η' = −c, s' = g); its stresses vanish."""
+    aspect, theta = 1.6, np.linspace(0, np.pi, 41)
+    scene = spheroid_scene("SPOM1", aspect)
+    disc = Discretisation(12, True, True)
+    a, b = np.zeros(13), np.zeros(13)
+    a[0], b[1] = 1.0, aspect
+    q = quantities(scene, disc, np.append(disc.join(a, b), 0.0), theta)
+    g = np.hypot(np.cos(theta), aspect * np.sin(theta))
+    assert np.abs(q["lam1"] - 1).max() < 1e-14 and np.abs(q["lam2"] - 1).max() < 1e-14
+    assert np.abs(q["k_meridian"] - aspect / g**3).max() < 1e-13
+    assert np.abs(q["k_parallel"] - aspect / g).max() < 1e-13
+    assert np.abs(q["sigma_theta"]).max() < 1e-13 and np.abs(q["sigma_phi"]).max() < 1e-13
 
 
 def membrane_derivatives(material):

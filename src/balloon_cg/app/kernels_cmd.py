@@ -45,15 +45,15 @@ def kernel_report(scene) -> dict:
     from ..model import kernel_cache
     from ..model.kernels import KernelSet, class_source, scene_terms
 
-    material, terms = scene.material, scene_terms(scene)
+    material, terms, shape = scene.material, scene_terms(scene), scene.geometry.shape
     stages, key, source = {}, None, "committed"
-    _, cached = class_source(material, terms)
+    _, cached = class_source(material, terms, shape=shape)
     if cached is not None:
-        key = kernel_cache.class_key(cached, terms)
-        source = "cached" if kernel_cache.module_path(cached, terms).is_file() else "generated"
-        kernel_cache.load(cached, terms, stages)
+        key = kernel_cache.class_key(cached, terms, shape=shape.value)
+        source = "cached" if kernel_cache.module_path(cached, terms, shape=shape.value).is_file() else "generated"
+        kernel_cache.load(cached, terms, stages, shape=shape.value)
     start = time.perf_counter()
-    kernel_set = KernelSet(material, terms)
+    kernel_set = KernelSet(material, terms, geometry=scene.geometry)
     stages["bind"] = time.perf_counter() - start
     return {"class": kernel_set.name, "source": source, "key": key, "stages": stages, "jit": _first_calls(kernel_set)}
 
