@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 from scipy.optimize import brentq
 
-from balloon_cg.model.tube import axial_force, closed_end_state, hoop_pressure, pressure_maximum
+from balloon_cg.model.tube import axial_force, bulge_onset, closed_end_state, hoop_pressure, pressure_maximum
 from balloon_cg.scene import parse_scene
 
 theta, z = sp.symbols("theta z", positive=True)
@@ -97,3 +97,51 @@ def test_a_tube_without_a_pressure_maximum_says_so():
     pressures = [P_of(h, axial_of(h)) for h in np.geomspace(1.001, 30.0, 300)]
     assert np.all(np.diff(pressures) > 0)
     assert pressure_maximum(stiff, 30.0) is None
+
+
+def bulge_determinant(energy):
+    """det of the period-averaged Hessian in (A, B) of e = Φ(λ1, λ2) − ½ P ρ² η' about the uniform state under
+    ρ = λθ + ε A cos kS, η = λz S + ε B sin kS (λ1 = sqrt(ρ'² + η'²), λ2 = ρ), at P = Φ_2/(λθλz), divided by k²:
+    a function of (λθ, λz, k). The ε² coefficient is quadratic in (cos kS, sin kS), so its mean over a period is
+    half its values at kS = 0 and kS = π/2."""
+    eps, A, B, k, phase, P = sp.symbols("epsilon A B k phase P", real=True)
+    l1, l2 = sp.symbols("l1 l2", positive=True)
+    rho, drho = theta + eps * A * sp.cos(phase), -eps * A * k * sp.sin(phase)
+    deta = z + eps * B * k * sp.cos(phase)
+    phi = energy.subs({z: l1, theta: l2}, simultaneous=True).subs({l1: sp.sqrt(drho**2 + deta**2), l2: rho})
+    second = sp.diff(phi - P * rho**2 * deta / 2, eps, 2).subs(eps, 0)
+    mean = (second.subs(phase, 0) + second.subs(phase, sp.pi / 2)) / 2
+    H = sp.hessian(mean, (A, B))
+    pressure = sp.diff(energy, theta) / (theta * z)
+    return sp.simplify((H.det() / k**2).subs(P, pressure)), k
+
+
+@pytest.mark.parametrize("preset", ["neo-Hookean", "SPOM1"])
+def test_bulge_onset_solves_the_dispersion_relation(preset):
+    """The onset of the mode cos(πS/L) on tubes of length 10 and 40: bulge_onset against N = 0 and the determinant
+    of the second variation derived here, solved at 30 digits from a sign change on a coarse scan."""
+    energy = symbolic_energy(material(preset))
+    P, N, axial_of = closed_end_path(energy)
+    det, k = bulge_determinant(energy)
+    for length in (10.0, 40.0):
+        det_L = det.subs(k, sp.pi / length)
+        det_of = sp.lambdify((theta, z), det_L)
+        coarse = np.linspace(1.05, 4.0, 120)
+        values = [det_of(h, axial_of(h)) for h in coarse]
+        j = next(j for j in range(len(coarse)) if values[j] > 0 >= values[j + 1])
+        with mpmath.workdps(30):
+            hoop, axial = sp.nsolve((N, det_L), (theta, z), (coarse[j], axial_of(coarse[j])), prec=30)
+        found = bulge_onset(material(preset), length)
+        assert abs(found.hoop - float(hoop)) <= 1e-10 and abs(found.axial - float(axial)) <= 1e-10
+
+
+def test_bulge_onset_tends_to_the_pressure_maximum():
+    """λθ at the onset of cos(πS/L) minus λθ at the pressure maximum falls like 1/L² (the condition is the long-wave
+    one plus Φ_1Φ_11 k²/λz, k = π/L): SPOM1, L = 10, 20, 40, 80, 160 (docs/shapes.md has the table); the ratio of
+    successive gaps is 4 within 1 % from L = 20 on, and the onset pressure approaches the maximum from below."""
+    spom1 = material("SPOM1")
+    peak = pressure_maximum(spom1)
+    onsets = [bulge_onset(spom1, length) for length in (10.0, 20.0, 40.0, 80.0, 160.0)]
+    gaps = np.array([o.hoop - peak.hoop for o in onsets])
+    assert np.all(gaps > 0) and np.all([o.pressure < peak.pressure for o in onsets])
+    assert np.all(np.abs(gaps[1:-1] / gaps[2:] - 4) < 0.04)

@@ -18,7 +18,8 @@ N = 0
     dP/dλθ = P_θ − P_z N_θ/N_z = det ∂(P, N)/∂(λθ, λz) / N_z = 0,
 
 with P_θ = Φ_22/(λθλz) − P/λθ, P_z = Φ_12/(λθλz) − P/λz, N_θ = Φ_12 − (Φ_2 + λθΦ_22)/(2λz),
-N_z = Φ_11 − λθ(Φ_12 − Φ_2/λz)/(2λz).
+N_z = Φ_11 − λθ(Φ_12 − Φ_2/λz)/(2λz). On a tube of length L the bulge mode cos(nπS/L) sets in where
+``bulge_condition`` changes sign (``bulge_onset``), which tends to the pressure maximum as 1/L².
 """
 from dataclasses import dataclass
 
@@ -86,5 +87,39 @@ def pressure_maximum(material, largest_hoop: float = 10.0) -> UniformTube | None
         if slopes[k] > 0 >= slopes[k + 1]:
             hoop = brentq(lambda h: pressure_slope(material, h), hoops[k], hoops[k + 1], xtol=TOLERANCE,
                           rtol=TOLERANCE)
+            return closed_end_state(material, hoop)
+    return None
+
+
+def bulge_condition(material, state: UniformTube, wavenumber: float) -> float:
+    """The sign of the second variation of the uniform ``state`` at fixed P under the bulge mode of axial
+    wavenumber k (docs/shapes.md): ρ = λθ + ε A cos kS, η = λz S + ε B sin kS (k = nπ/L on a tube of length L with
+    sliding ends: ρ' = 0 and η fixed at both ends). Averaged over a period its Hessian in (A, B) is
+
+        ½ [[Φ_22 + Φ_1 k²/λz − P λz,  k (Φ_12 − P λθ)], [k (Φ_12 − P λθ),  Φ_11 k²]],
+
+    whose determinant is k²/4 times the value returned, (Φ_22 + Φ_1 k²/λz − P λz) Φ_11 − (Φ_12 − P λθ)²: positive
+    where the uniform state is stable against the mode (Φ_11 > 0), zero at its onset. As k → 0 it is λθλz times
+    det ∂(P, N)/∂(λθ, λz) (the pressure maximum of a long tube)."""
+    d = stretch_derivatives(material, state.axial, state.hoop)
+    P, k2 = state.pressure, wavenumber**2
+    return float((d["phi_22"] + d["phi_1"] * k2 / state.axial - P * state.axial) * d["phi_11"]
+                 - (d["phi_12"] - P * state.hoop) ** 2)
+
+
+def bulge_onset(material, length: float, mode: int = 1, largest_hoop: float = 10.0) -> UniformTube | None:
+    """The first uniform closed-end state (λθ rising from 1) where ``bulge_condition`` of the mode cos(nπS/L),
+    n = ``mode``, on a tube of ``length`` L (in reference radii) changes sign: the bulge's onset; None where it
+    does not in (1, ``largest_hoop``]."""
+    wavenumber = mode * np.pi / length
+
+    def condition(hoop):
+        return bulge_condition(material, closed_end_state(material, hoop), wavenumber)
+
+    hoops = np.geomspace(1.0 + 1e-3, largest_hoop, _SCAN_POINTS)
+    values = [condition(h) for h in hoops]
+    for k in range(len(hoops) - 1):
+        if values[k] > 0 >= values[k + 1]:
+            hoop = brentq(condition, hoops[k], hoops[k + 1], xtol=TOLERANCE, rtol=TOLERANCE)
             return closed_end_state(material, hoop)
     return None
