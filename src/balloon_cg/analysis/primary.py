@@ -24,7 +24,7 @@ import numpy as np
 
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.profiles import meridional_stretch
-from ..model.meridian import meridional_stretch as stretch_on
+from ..model import meridian
 from ..model.sphere import sphere_pressure, sphere_voltage
 from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics import continuation
@@ -155,7 +155,7 @@ def compressed(disc, u, material, voltage: float, geometry) -> bool:
     one: the membrane would carry compression, which it cannot (the voltage's Maxwell stress exceeds the elastic
     tension). Checked at every point of a dielectric branch, so on the nodes the solver has (no new grid)."""
     lam2, v, _, w = disc.node_state(u)
-    lam1 = stretch_on(geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
+    lam1 = meridian.meridional_stretch(geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
     total, elastic = _smallest_stress(material, lam1, lam2, voltage)
     return total < -SLACK_TOLERANCE * abs(elastic)
 

@@ -1,5 +1,6 @@
 """On-demand kernels for a scene class that is not committed in generated/: a user formula, or any material with
-the dielectric term (a committed class's Ogden exponents or a strain energy, with or without a field).
+the dielectric term (a committed class's Ogden exponents or a strain energy, with or without a field), or any class
+on a reference shape other than the sphere (a spheroid).
 
 The module is generated at first use by the same generator as generated/ (codegen/, shipped as
 balloon_cg.codegen; it needs SymPy, the ``codegen`` extra) into a content-keyed cache folder, and imported from
@@ -7,7 +8,7 @@ there by every later run. The key is the SHA-256 of
 
     (canonical formula and parameter names, or 'ogden' and the exponents (None: runtime exponents), the names of
      the energy terms beyond the elastic one, surface kernels or not, codegen.GENERATOR_VERSION, the generator's
-     source digest, SymPy version),
+     source digest, SymPy version, and a reference shape other than the sphere: scene.Geometry),
 
 so an edited formula, a new generator or another SymPy gives a new module; parameter values (material
 parameters, the voltage) are kernel arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
@@ -46,6 +47,7 @@ from pathlib import Path
 
 from .. import codegen
 from ..scene import formula as formula_module
+from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
 CACHE_ENV = "BALLOON_CG_KERNEL_CACHE"
@@ -54,7 +56,7 @@ GENERATION_TIMEOUT = 600.0  # seconds (a user formula at the bounds of scene/for
 GENERATION_MEMORY = 2 * 1024**3  # bytes of address space of the generating process
 MAX_MODULE_CHARS = 2_000_000  # a generated module's text (the largest committed one: 85 kB)
 DIGEST_MARK = "# content-sha256 "
-SPHERE = "sphere"  # the reference shape of every committed class (codegen/meridian.py)
+SPHERE = Shape.SPHERE.value  # the reference shape of every committed class (codegen/meridian.py: MERIDIANS)
 
 
 class KernelCacheWarning(UserWarning):

@@ -36,11 +36,6 @@ def reference_height(geometry: Geometry, theta):
     return geometry.aspect * np.cos(theta)
 
 
-def reference_volume(geometry: Geometry) -> float:
-    """V0 = 4π/3 · aspect, the volume the reference surface encloses."""
-    return 4.0 * np.pi / 3.0 * geometry.aspect
-
-
 def kernel_values(geometry: Geometry) -> dict:
     """The meridian's scalar arguments of its class's kernels by name (codegen/meridian.py: ``parameters``): none
     for the sphere, the spheroid's aspect."""
