@@ -13,8 +13,8 @@ R = a sin θ (a: the λ2 perturbation), T the azimuthal displacement (T = ρ0 B 
 
 and C = G⁻¹g, G = diag(S'², sin²θ), in the orthonormal reference frame: c11 = |x_θ|²/S'², c22 = |x_φ|²/sin²θ,
 c12 = x_θ·x_φ / (S' sin θ) (c12 = O(ε)); S' = dS/dθ of the reference meridian (codegen/meridian.py: 1 on the
-sphere), which also multiplies the elastic density per d(cos θ). The principal stretches squared are the eigenvalues e1, e2 of that matrix;
-with φ̂(e1, e2) = Φ(√e1, √e2) and c12 = O(ε), to second order
+sphere), which also multiplies the elastic density per d(cos θ). The principal stretches squared are the
+eigenvalues e1, e2 of that matrix; with φ̂(e1, e2) = Φ(√e1, √e2) and c12 = O(ε), to second order
 
     Φ(Λ1, Λ2) = φ̂(c11, c22) + K c12²,      K = (φ̂_1 − φ̂_2)/(λ1² − λ2²)   (the shear coefficient),
 

@@ -22,8 +22,8 @@ from .loading import Control, Loading, loading_from_table
 from .materials import Material, material_from_table
 
 __all__ = [
-    "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability", "Output", "Loading",
-    "Control", "Scene", "SceneError",
+    "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability",
+    "Output", "Loading", "Control", "Scene", "SceneError",
     "parse_scene", "load_scene",
 ]
 
@@ -315,8 +315,10 @@ class Scene:
         stop = f"stop_stretch {c.stop_stretch:g}"
         if c.parameter == ContinuationParameter.VOLTAGE:
             stop = "in the voltage" + ("" if c.stop_voltage is None else f" to {c.stop_voltage:g}")
-        return (f"Scene({self.name!r}: {self.material.name}, {field}{voltage}, {self.loading.control.value} control, "
-                f"{stop})")
+        g = self.geometry
+        shape = "" if g == Geometry() else f", {g.shape.value} of aspect {g.aspect:g}"
+        return (f"Scene({self.name!r}: {self.material.name}{shape}, {field}{voltage}, {self.loading.control.value} "
+                f"control, {stop})")
 
     def to_toml(self) -> str:
         """TOML text of ``to_dict()``; parsing it gives back this scene (apart from ``text``)."""
