@@ -237,11 +237,13 @@ def test_relabelling_and_rigid_modes_are_exact_null_vectors(spom1):
 
 
 def test_gauge_removes_the_subspace_zero_modes(spom1):
-    """The relabelling about y lives in the mirror subspace and is removed; a subspace that keeps a rigid rotation
-    the field leaves free is refused."""
+    """The relabelling about y lives in the mirror subspace and is removed, and a held balloon's x and z translations
+    (the y one is odd under the mirror); a free balloon keeps its translations; a subspace that keeps a rigid
+    rotation the field leaves free is refused."""
     basis = SphericalBasis(8, (MIRROR_Y,))
     gauge = Gauge(basis, held=True, field_symmetry=FieldSymmetry.AXIAL)
-    assert gauge.size == basis.size - 2  # the x translation held (z is free in a field), the relabelling about y
+    assert gauge.size == basis.size - 3  # the x and z translations held (the reaction: the field's net force)
+    assert Gauge(basis, held=False, field_symmetry=FieldSymmetry.AXIAL).size == basis.size - 1  # the relabelling
     a = np.random.default_rng(1).standard_normal(gauge.size)
     c = gauge.expand(a)
     assert np.abs(gauge.constraints @ c).max() <= 1e-14

@@ -101,6 +101,8 @@ class Picture:
     not_started: list = field(default_factory=list)  # (name, reason) of bifurcating branches that could not start
     not_switched: list = field(default_factory=list)  # (name, reason) of a whole-sphere primary's branch points that
     #                                                   are not pitchforks (``surface_pitchforks``)
+    not_asked: list = field(default_factory=list)  # (names, reason) of branch points whose branches the scene did
+    #                                                not ask for (``[surface] branches = "first"``)
     surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
     interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
     clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
@@ -120,7 +122,7 @@ class Picture:
     def incomplete(self) -> list[Incomplete]:
         """What the picture lacks against the contract (``verdict``); empty when it is complete."""
         found = incomplete(self.branches + self.surface_branches, self.not_searched, tuple(self.not_started),
-                           tuple(self.not_switched))
+                           tuple(self.not_switched), tuple(self.not_asked))
         if self.interrupted:
             found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, "interrupted by a signal: the branches "
                                     "and phases after the stored points were not computed"))
@@ -164,6 +166,7 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
     ``pear`` and ``[surface] branches`` ask, the m ≥ 1 points of every branch, the snap-throughs."""
     progress, clock = progress or Progress(), clock or Clock()
     picture = Picture([primary], clock=clock)
+    surface = pear and scene.surface.branches != "none"
     if _stopped(picture):
         return picture
     if not _assess(primary, scene, primary.disc.symmetric, progress, clock):
@@ -179,7 +182,7 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
         if search and not _stopped(picture):
             with clock.step(Step.PEAR_BRANCHES):
                 _trace_broken(scene, primary, picture, progress)
-        picture.not_searched = _unsearched(primary, search)
+        picture.not_searched = _unsearched(primary, search, surface)
         pear = False  # no equator-symmetric pitchforks to switch at
     if _stopped(picture):
         return picture
@@ -190,7 +193,7 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
     progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
     if not azimuthal_crossings(picture, picture.branches, scene):
         return picture
-    if pear and scene.surface.branches != "none":
+    if surface:
         with clock.step(Step.SURFACE_BRANCHES):
             _trace_surface(scene, primary, picture, progress)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
@@ -255,17 +258,22 @@ def _trace_broken(scene, primary: Branch, picture: Picture, progress: Progress) 
         _assess(branch, scene, False, progress, picture.clock)
 
 
-def _unsearched(primary: Branch, searched: bool) -> str:
+def _unsearched(primary: Branch, searched: bool, surface: bool) -> str:
     """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``); ``searched``:
-    the disconnected pear branch was searched for (``_trace_broken``). A scene whose coils are equator-symmetric
-    breaks no pitchfork (a pear branch restarted by ``continue``, ``continuation.symmetry = "none"``)."""
-    broken = not searched and not primary.scene.field.is_equator_symmetric
-    missing = ("the bifurcating branches (the pear branch of the broken pitchfork, disconnected from this branch, "
-               "and those at its branch points) are not traced" if broken else
-               "the branches at its branch points are not traced")
+    the disconnected pear branch was searched for (``_trace_broken``); ``surface``: the branches at its m ≥ 1
+    points are traced (``_trace_surface``). A scene whose coils are equator-symmetric breaks no pitchfork (a pear
+    branch restarted by ``continue``, ``continuation.symmetry = "none"``). The free balloon's branches are not
+    traced: its held states carry the field's net axial force (the reaction of the hold), so they are no
+    equilibria of a free balloon, which moves along the axis until that force vanishes."""
+    missing = []
+    if not searched and not primary.scene.field.is_equator_symmetric:
+        missing.append("the pear branch of the broken pitchfork (disconnected from this branch) is not traced")
+    if not surface:
+        missing.append("the branches at its branch points are not traced")
     if primary.gauge == Gauge.HELD:
-        missing += "; nor is the free balloon's branch (its axial translation free)"
-    return missing
+        missing.append("the free balloon's branch is not traced (its held states carry the field's net axial "
+                       "force: a free balloon moves along the axis until it vanishes)")
+    return "; ".join(missing)
 
 
 WHOLE_SPHERE_EVENTS = "the [[events]] are not located on branches traced on the whole sphere"
@@ -387,12 +395,25 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
 
 
 def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress):
-    """The non-axisymmetric branches born at the located m ≥ 1 branch points of the held reading on the primary
-    branch (the first one, or all: ``[surface] branches``; ``surface_pair``); the parent point gets the
-    classification from the reduced energy on the whole sphere."""
-    points = [(k, bp) for k, bp in enumerate(primary.branch_points())
-              if bp.m >= 1 and bp.block.held and bp.status == Status.LOCATED]
-    for k, bp in points[:1] if scene.surface.branches == "first" else points:
+    """The non-axisymmetric branches born at the located m ≥ 1 branch points of the primary branch (the held
+    reading's first one, or all of both readings: ``[surface] branches``; ``surface_pair``); the parent point gets
+    the classification from the reduced energy on the whole sphere. The free reading's points are switched where
+    the held states are free equilibria (coils symmetric about the equator: no net axial force); elsewhere the held
+    states carry the field's net axial force and the free balloon's branches are not traced (said in
+    ``Picture.not_searched``). The points the scene leaves out are listed in ``Picture.not_asked``."""
+    points = [(k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m >= 1 and bp.status == Status.LOCATED]
+    free = [(k, bp) for k, bp in points if not bp.block.held]
+    if free and not scene.field.is_equator_symmetric:
+        picture.not_searched = "; ".join(filter(None, (picture.not_searched, (
+            f"the free balloon's branches at its m ≥ 1 points ({', '.join(f'm{bp.m}_bp{k}' for k, bp in free)}) "
+            "are not traced"))))
+        points = [(k, bp) for k, bp in points if bp.block.held]
+    chosen = [(k, bp) for k, bp in points if bp.block.held][:1] if scene.surface.branches == "first" else points
+    if len(chosen) < len(points):
+        traced = {k for k, _ in chosen}
+        picture.not_asked.append((", ".join(f"m{bp.m}_bp{k}" for k, bp in points if k not in traced),
+                                  'not traced: [surface] branches = "first" (set "all" to trace them)'))
+    for k, bp in chosen:
         if _stopped(picture):
             return
         name = f"m{bp.m}_bp{k}"
@@ -423,7 +444,7 @@ def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progres
 def _with_events(branch):
     """A traced surface branch with the UZ points of its scene's ``[[events]]`` (``events.with_surface_events``,
     on its stored basis)."""
-    trace = surface_branches.SurfaceTrace(branch.scene, branch.basis, branch.params)
+    trace = surface_branches.SurfaceTrace(branch.scene, branch.basis, branch.params, branch.held)
     return events.with_surface_events(branch, trace.system)
 
 

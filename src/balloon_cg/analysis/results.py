@@ -92,8 +92,8 @@ class Block(enum.StrEnum):
 class Gauge(enum.StrEnum):
     """Which reading of the rigid translation a special point or a branch belongs to. Held: the balloon is held at
     its centre (axisymmetric: b_0 = 0, the net axial force is a reaction; m ≥ 1 blocks and the whole-sphere
-    branches born from them: the lateral translation, the axial one an unknown there); free: the translation is
-    an unknown (the net force vanishes). Both: the readings coincide (no field acts, so the translation is an
+    branches born from them: every translation, the net force a reaction); free: the translation is an unknown
+    (the net force vanishes). Both: the readings coincide (no field acts, so the translation is an
     exact zero mode, removed; or the point's mode and the branch's states have no translation component:
     equator-symmetric)."""
 
@@ -347,6 +347,7 @@ class SurfaceBranch:
     reflection_of: str = ""  # REFLECTED: the branch this one is the image of (rotation by π about the axis)
     reflection: tuple = ()  # REFLECTED: the diagonal reflection S it is the image under (``reflected``)
     unsettled: list = field(default_factory=list)  # (verdict's interface: no check degree on the whole sphere)
+    held: bool = True  # its states' gauge: the centre held (the net force a reaction) or free (the net force zero)
 
     @property
     def field_acts(self) -> bool:
@@ -355,9 +356,11 @@ class SurfaceBranch:
 
     @property
     def gauge(self) -> Gauge:
-        """The reading of its states: held (the centre held laterally, as the m-blocks of the held reading it is
-        born from) where a field acts, else both."""
-        return Gauge.HELD if self.field_acts else Gauge.BOTH
+        """The reading of its states where a field acts: held (the centre held, as the m-block of the held reading
+        it is born from) or free (born at a point of the free reading, the translation an unknown); else both."""
+        if not self.field_acts:
+            return Gauge.BOTH
+        return Gauge.HELD if self.held else Gauge.FREE
 
     @property
     def pressure(self):

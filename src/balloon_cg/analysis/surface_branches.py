@@ -75,8 +75,8 @@ def located_degree(branch: Branch, bp: SpecialPoint) -> int:
 
 
 def critical_mode(branch: Branch, bp: SpecialPoint, degree: int, count: int = CRITICAL_SEARCH):
-    """(the azimuthal basis, the held eigenvector of block m at the BP whose eigenvalue is nearest zero, among the
-    ``count`` lowest) at perturbation degree ``degree`` (``located_degree``: a lower one may not resolve the mode):
+    """(the azimuthal basis, the eigenvector of block m at the BP (of its reading: held or free) whose eigenvalue is
+    nearest zero, among the ``count`` lowest) at perturbation degree ``degree`` (``located_degree``: a lower one may not resolve the mode):
     at a later crossing of the block the lowest eigenvalue is already negative and the one that crosses is above it
     (module docstring). Its sign (which direction is +φ, which branch the rotated image) is fixed by its largest
     entry, positive, not left to the eigensolver."""
@@ -87,7 +87,7 @@ def critical_mode(branch: Branch, bp: SpecialPoint, degree: int, count: int = CR
     exclude = None
     if bp.m == 1:
         modes = azimuthal.special_modes(eq, u, degree)
-        exclude = np.array([modes[azimuthal.MODES[k]] for k in azimuthal.excluded_modes(eq, params, True)])
+        exclude = np.array([modes[azimuthal.MODES[k]] for k in azimuthal.excluded_modes(eq, params, bp.block.held)])
     values, vectors = azimuthal.lowest_eigenvalues(H, G, count, exclude, vectors=True)
     vector = vectors[:, int(np.argmin(np.abs(values)))]
     return b, vector * np.sign(vector[np.argmax(np.abs(vector))])  # its largest entry positive: +φ is reproducible
@@ -114,16 +114,17 @@ def mode_symmetry(branch: Branch, az_basis, vector, degree: int) -> tuple:
 
 class SurfaceTrace:
     """The problem of one surface branch on one basis: the equilibrium, gauge and continuation system at the
-    branch's parameters."""
+    branch's parameters; ``held``: the balloon held at its centre (the net force a reaction) or free (its
+    translation an unknown, the net force zero)."""
 
-    def __init__(self, scene, basis: SphericalBasis, params: Parameters):
-        self.scene, self.basis = scene, basis
+    def __init__(self, scene, basis: SphericalBasis, params: Parameters, held: bool = True):
+        self.scene, self.basis, self.held = scene, basis, held
         self.eq = SurfaceEquilibrium(scene, basis)
-        self.gauge = Gauge(basis, held=True, field_symmetry=surface_stability.field_symmetry(self.eq, params))
+        self.gauge = Gauge(basis, held=held, field_symmetry=surface_stability.field_symmetry(self.eq, params))
         self.system = SurfaceSystem(self.eq, self.gauge, params, "P")
 
     def on(self, basis: SphericalBasis) -> "SurfaceTrace":
-        return SurfaceTrace(self.scene, basis, self.system.params)
+        return SurfaceTrace(self.scene, basis, self.system.params, self.held)
 
     def move(self, X: np.ndarray, to: "SurfaceTrace") -> np.ndarray:
         """A point X = (a, p) of this trace's system on ``to``'s (its coefficients transferred)."""
@@ -246,7 +247,7 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     az_basis, vector = critical_mode(branch, bp, located_degree(branch, bp))
     symmetry = mode_symmetry(branch, az_basis, vector, scene.surface.degree)
     params = branch.params_at(bp.X)
-    trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params)
+    trace = SurfaceTrace(scene, initial_basis(scene, branch.disc, bp.X[:-1], symmetry), params, bp.block.held)
     c_star = axisymmetric_coefficients(trace.basis, branch.disc, bp.X[:-1])
     # point 0: the axisymmetric state as the whole-sphere solution at P* (its truncation differs), solved in the
     # axisymmetric family, where the Jacobian is regular at an m ≥ 1 point; where that Newton fails, the embedded
@@ -364,7 +365,7 @@ def branch_of(trace: SurfaceTrace, segments, folds, stop, parent, number: int, b
         bp = replace(bp, X=np.append(transfer(first_basis, bp.X[:-1], trace.basis), bp.X[-1]))
     fields["special"].insert(0, bp)
     out = SurfaceBranch(name=name, scene=parent.scene, kernel_class=parent.kernel_class, params=parent.params,
-                        m=bp.m, parent=(parent.name, number), **fields)
+                        m=bp.m, parent=(parent.name, number), held=trace.held, **fields)
     assess(out, traced_points(segments), readings)
     out.wall_time = time.perf_counter() - t0
     return out

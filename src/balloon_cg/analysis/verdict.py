@@ -42,6 +42,7 @@ class Gap(enum.StrEnum):
     NOT_SEARCHED = "not_searched"  # branch points were not searched (a limitation, stated; not a failure)
     NOT_SWITCHED = "not_switched"  # a branch point of a whole-sphere primary branch in its own symmetry sector: not
     #                                a pitchfork of a kept reflection, no branch switched there (a limitation, stated)
+    NOT_ASKED = "not_asked"  # branch points whose branches the scene did not ask for ([surface] branches = "first")
     LIMITED = "limited"  # a non-axisymmetric branch ended at the whole-sphere basis' cap or its [surface] max_points
     #                      (a limitation of the method or the budget asked for, stated; every stored point resolved)
     INTERRUPTED = "interrupted"  # a signal stopped the computation: what follows the stored points is missing
@@ -51,7 +52,7 @@ class Gap(enum.StrEnum):
     @property
     def fails(self) -> bool:
         """Whether an entry of this kind makes the result incomplete."""
-        return self not in (Gap.NOT_SEARCHED, Gap.NOT_SWITCHED, Gap.LIMITED)
+        return self not in (Gap.NOT_SEARCHED, Gap.NOT_SWITCHED, Gap.NOT_ASKED, Gap.LIMITED)
 
 
 @dataclass(frozen=True)
@@ -62,13 +63,15 @@ class Incomplete:
 
 
 def incomplete(branches: list, not_searched: str = "", not_started: tuple = (),
-               not_switched: tuple = ()) -> list[Incomplete]:
+               not_switched: tuple = (), not_asked: tuple = ()) -> list[Incomplete]:
     """What the traced ``branches`` lack against the contract (module docstring); ``not_searched``: why branch
     points were not searched on the primary branch, if they were asked for and not searched; ``not_started``:
     (name, reason) of the bifurcating branches that could not be started; ``not_switched``: (name, reason) of the
-    branch points of a whole-sphere primary branch that are not pitchforks."""
+    branch points of a whole-sphere primary branch that are not pitchforks; ``not_asked``: (names, reason) of the
+    branches the scene chose not to trace."""
     found = [Incomplete(Gap.NOT_STARTED, name, reason) for name, reason in not_started]
     found += [Incomplete(Gap.NOT_SWITCHED, name, reason) for name, reason in not_switched]
+    found += [Incomplete(Gap.NOT_ASKED, names, reason) for names, reason in not_asked]
     for branch in branches:
         for leg in branch.legs:
             if isinstance(branch, SurfaceBranch) and leg.stop.code in SURFACE_LIMITS:

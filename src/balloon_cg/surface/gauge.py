@@ -4,12 +4,10 @@
   conditions ∫∫ (e_k × X) · u dA = 0 (no rigid-rotation part of u in the reference frame), for each axis k whose
   rotation field lies in the basis' symmetry subspace. They are linear, homogeneous and hold for every
   axisymmetric state.
-- Translations: ∫∫ u dA = 0 (the l = 0 coefficients) along an axis where the balloon is held (``held``; the
-  multiplier is the reaction force) and where the field leaves the translation free (no field: every axis; then
-  held and free coincide). Coaxial loops: held means the lateral axes x, y, and the axial translation stays an
-  unknown (net axial force zero), as in the axisymmetric solver; loops anywhere: held means every axis (the
-  centre ∫∫ x dA/4π is held at the origin: the reaction is the field's net force), free none (an equilibrium
-  then needs a zero net force).
+- Translations: ∫∫ u dA = 0 (the l = 0 coefficients) along every axis where the balloon is held (``held``: the
+  centre ∫∫ x dA/4π is held at the origin, the multiplier is the reaction force: the field's net force, along the
+  axis of coaxial loops off the equator as in the axisymmetric solver's held reading), along none where it is free
+  (an equilibrium then needs a zero net force); without a field along every axis (held and free coincide).
 - Rigid rotations of x are zero modes where the field allows them (every axis at M = 0, the coil axis for coaxial
   loops, none for loops anywhere: the balloon turns until the field's torque about its held centre vanishes). In
   a subspace that keeps one of them (other than on a sphere state, where it is a relabelling) the gauge would need
@@ -48,7 +46,7 @@ class FieldSymmetry(enum.Enum):
         """The axes along which ∫∫ u dA = 0 is imposed for a balloon ``held`` (or free) at its centre."""
         if self == FieldSymmetry.NONE:
             return (0, 1, 2)
-        return ((0, 1) if self == FieldSymmetry.AXIAL else (0, 1, 2)) if held else ()
+        return (0, 1, 2) if held else ()
 
 
 @dataclass(frozen=True)
