@@ -1,0 +1,53 @@
+"""The free balloon's m = 1 branches (issue 41): born at the free reading's m = 1 points of the shipped two-coil
+scene, traced on the whole sphere with the translation an unknown, so every state must be an equilibrium with
+zero net force, which the held branches need not be (their reaction holds them)."""
+import numpy as np
+import pytest
+
+from balloon_cg.analysis.results import Gauge
+from balloon_cg.analysis.surface_branches import SurfaceTrace, rotated, trace_surface
+from balloon_cg.surface.loads import loads
+from shared_pictures import two_coil_picture
+
+
+@pytest.fixture(scope="module")
+def free_branch(tmp_path_factory):
+    """The branch born at the first free m = 1 point of the two-coil primary branch (P = 2.237770863), 8 points."""
+    primary = two_coil_picture(tmp_path_factory).primary
+    k, bp = next((k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m == 1 and not bp.block.held)
+    assert abs(bp.X[-1] - 2.237770863) < 1e-8
+    return primary, trace_surface(primary, k, bp, 1.0, "m1_free", 8)
+
+
+def test_free_m1_branch_has_zero_net_force_and_moves_its_centre(free_branch):
+    """Every point: the field's net force (surface.loads: a quadrature of ∇H², not the residual) ≤ 1e-10 and the
+    residual of the unconstrained (free) whole-sphere problem on the basis it was solved on ≤ 1e-10 (the solver's
+    record; the last point recomputed on the stored basis); the centre moves sideways (the m = 1 mode carries the
+    translation a held balloon's reaction would stop) and grows with the amplitude."""
+    primary, branch = free_branch
+    assert branch.gauge == Gauge.FREE and not branch.held and len(branch.values) == 8
+    trace = SurfaceTrace(branch.scene, branch.basis, branch.params, held=False)
+    for c, P in zip(branch.coefficients, branch.values):
+        assert np.abs(loads(trace.eq, c, branch.params.with_value("P", P))["force"]).max() <= 1e-10
+    assert branch.residual.max() <= 1e-10
+    last = branch.params.with_value("P", branch.values[-1])
+    assert np.abs(trace.gauge.reduce(trace.eq.residual(branch.coefficients[-1], last))).max() <= 1e-10
+    sideways = np.abs(branch.measures["centroid"][:, 0])
+    assert sideways[0] < 1e-12 and np.all(np.diff(sideways) > 0)
+    assert np.abs(branch.measures["centroid"][:, 1:]).max() < 1e-12
+
+
+def test_free_m1_branch_is_not_a_held_equilibrium(free_branch):
+    """Held at its centre the same states are no equilibria off the branch point (the held gauge's reaction would be
+    needed to move the centre back): the held residual of the moved states is O(amplitude), not zero; and the
+    rotated image is a free branch too."""
+    _, branch = free_branch
+    held = SurfaceTrace(branch.scene, branch.basis, branch.params, held=True)
+    c = branch.coefficients[-1]
+    assert np.abs(held.gauge.constraints @ c).max() > 1e-3  # the centre moved: outside the held subspace
+    image = rotated(branch, "m1_free_rotated")
+    assert image.gauge == Gauge.FREE
+    free = SurfaceTrace(image.scene, image.basis, image.params, held=False)
+    c, P = image.coefficients[-1], image.values[-1]
+    assert np.abs(free.gauge.reduce(free.eq.residual(c, image.params.with_value("P", P)))).max() <= 1e-10
+    assert np.abs(loads(free.eq, c, image.params.with_value("P", P))["force"]).max() <= 1e-10
