@@ -42,7 +42,8 @@ from .hdf5 import atomic_file, copy_attrs, copy_tree, plain, provenance
 from .output import store_path
 from .lock import remove_debris
 from .run_file import read_branches, verdict_attrs, write_branches
-from .layout import FileError, check_input, reading, require_attrs
+from .layout import FileError, check_data, check_input, reading, require_attrs
+from .schema import FINITE
 
 FORMAT = "balloon-cg-sweep/2"
 FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
@@ -295,6 +296,7 @@ def _open(path):
     except (OSError, RuntimeError):
         raise SweepFileError(path, "not a readable HDF5 file (damaged or not HDF5)") from None
     with f, reading(path, SweepFileError):
+        check_data(f, path, SweepFileError, FINITE)
         yield f
 
 
