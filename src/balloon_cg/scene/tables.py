@@ -19,7 +19,7 @@ from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
 from .events import Event, events_from_list
 from .loading import Control, Loading, loading_from_table
-from .materials import Material, material_from_table
+from .materials import Material, material_from_table, modified_name
 
 __all__ = [
     "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability",
@@ -393,10 +393,13 @@ class Scene:
                 _assign(data, "material.preset", preset)
                 if any(_PARAMETER_KEY.fullmatch(key) for key in overrides):  # its family's parameters, written out
                     data = _build(data, self.name, "").to_dict()
+            base = material_from_table(dict(data["material"])) if preset is not None else self.material
             for key, value in overrides.items():
                 if key != "material.preset" or preset is None:
                     _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
+            if "material.name" not in overrides:  # the values computed with, never a preset's name they left
+                scene = replace(scene, material=replace(scene.material, name=modified_name(base, scene.material)))
         except SceneError as e:
             raise SceneError(f"{self.name}: {e}") from None
         return replace(scene, text=scene.to_toml())
