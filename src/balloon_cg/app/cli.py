@@ -305,7 +305,9 @@ def axisymmetric(scene, command: str):
 
 
 def run(args) -> int:
-    """Analyse, write, read back and summarise; exit 130 after an interrupt (what is finished is written)."""
+    """Analyse, write, read back and summarise; exit 130 when a signal stopped the work (what is finished is written,
+    flagged interrupted: the message is the file's), or the run's own status when it had finished (and says so)."""
+    from ..analysis.verdict import Gap
     from ..io.run_file import read_run
     from ..numerics.interrupt import requested, stop_on_signals
     from .progress import shown
@@ -315,10 +317,14 @@ def run(args) -> int:
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
-        interrupted = requested()
-    if interrupted:
-        print(f"{PROG}: interrupted: what was finished is written to {output} (flagged incomplete)", file=sys.stderr)
+        signalled = requested()
+    stopped = [item for item in found if item.gap == Gap.INTERRUPTED]
+    if stopped:
+        print(f"{PROG}: interrupted ({stopped[-1].branch}: {stopped[-1].message}); what was finished is written to "
+              f"{output} (flagged incomplete)", file=sys.stderr)
         return INTERRUPTED
+    if signalled:
+        print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
     if not args.quiet:
         from .summaries import format_run
 
