@@ -606,7 +606,7 @@ def _getter(data: dict, prefix: str, cls):
         raw = getattr(cls, key) if raw is None else raw
         if raw is None:
             return None
-        x = number(f"{prefix}.{key}", raw, integer=integer)
+        x = number(f"{prefix}.{key}", raw, integer=integer, allowed=allowed)
         if not ok(x):
             raise SceneError(f"{prefix}.{key} = {show(raw)}: must be {allowed}")
         return x
