@@ -16,7 +16,7 @@ import pytest
 import balloon_cg as bc
 from balloon_cg.app.cli import main
 from balloon_cg.io import hdf5
-from balloon_cg.io.layout import can_checksum
+from balloon_cg.io.layout import FileError, can_checksum
 from balloon_cg.io.run_file import RunFileError
 from balloon_cg.io.schema import FINITE
 
@@ -142,6 +142,11 @@ def _deletions(good: Path, every: bool) -> list:
         groups = [item.name for item in holders if isinstance(item, h5py.Group) and item.name != "/"]
     if not every:
         attributes = list({key: (name, key) for name, key in reversed(attributes)}.values())
+    return _deleting(attributes, groups)
+
+
+def _deleting(attributes: list, groups: list) -> list:
+    """(label, change) deleting each (object, attribute) of ``attributes``, then each group of ``groups``."""
     return [(f"{name} attribute {key}", lambda f, n=name, k=key: f[n].attrs.__delitem__(k))
             for name, key in attributes] + [(name, lambda f, n=name: f.__delitem__(n)) for name in groups]
 
@@ -153,7 +158,7 @@ def _accepted(good: Path, folder: Path, deletions: list) -> list:
         shutil.copy(good, path)
         with h5py.File(path, "a") as f:
             change(f)
-        with contextlib.suppress(RunFileError):
+        with contextlib.suppress(FileError):  # RunFileError, SweepFileError
             bc.load(path)
             accepted.append(label)
     return accepted
@@ -215,15 +220,38 @@ def test_a_file_without_checksums_still_loads(good, tmp_path, monkeypatch):
         bc.load(old)
 
 
-def test_a_sweep_member_with_a_flipped_byte_is_refused(tmp_path, capsys):
+@pytest.fixture(scope="module")
+def sweep(tmp_path_factory) -> Path:
+    """A sweep view of two members (its store removed: the view alone is what the readers read)."""
+    scene = tmp_path_factory.mktemp("sweep") / "s.toml"
+    scene.write_text(SCENE)
+    view = scene.with_name("sweep.h5")
+    assert main(["sweep", str(scene), "--vary", "stop_stretch=1.3,1.4", "--primary-only", "--workers", "1",
+                 "--quiet", "-o", str(view)]) == 0
+    shutil.rmtree(view.with_name(view.name + ".members"))
+    return view
+
+
+def test_a_sweep_member_with_a_flipped_byte_is_refused(sweep, tmp_path, capsys):
     """The sweep view reads its members through the same checks: a flipped byte in a member's data is exit 2
     naming the dataset."""
-    (tmp_path / "s.toml").write_text(SCENE)
-    sweep = tmp_path / "sweep.h5"
-    assert main(["sweep", str(tmp_path / "s.toml"), "--vary", "stop_stretch=1.3,1.4", "--primary-only",
-                 "--workers", "1", "--quiet", "-o", str(sweep)]) == 0
+    path = tmp_path / "sweep.h5"
+    shutil.copy(sweep, path)
     capsys.readouterr()
-    flip_a_byte(sweep, "/members/1/branches/primary/lam2_north")
+    flip_a_byte(path, "/members/1/branches/primary/lam2_north")
     with contextlib.redirect_stdout(io.StringIO()):
-        assert main(["inspect", str(sweep)]) == 2
-    assert "dataset /members/1/branches/primary/lam2_north: unreadable data" in capsys.readouterr().err
+        assert main(["inspect", str(path)]) == 2
+    assert "dataset /members/1/branches/primary/lam2_north: unreadable, damaged" in capsys.readouterr().err
+
+
+def test_each_sweep_attribute_and_group_deletion_is_refused(sweep, tmp_path):
+    """Each attribute name of a sweep view at each depth (root, member, branch, dataset), and each group but a
+    whole member (a view may hold fewer members than the sweep: an unfinished sweep), deleted: refused."""
+    with h5py.File(sweep, "r") as f:
+        holders = _holders(f)
+        attributes = list({(item.name.count("/"), key): (item.name, key) for item in reversed(holders)
+                           for key in item.attrs}.values())
+        groups = [item.name for item in holders if isinstance(item, h5py.Group)
+                  and item.name.rsplit("/", 1)[0] not in ("", "/members")]
+    assert len(attributes) > 60 and len(groups) >= 8
+    assert _accepted(sweep, tmp_path, _deleting(attributes, groups)) == []

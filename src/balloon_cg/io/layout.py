@@ -72,21 +72,32 @@ def stored_objects(group, path, error=FileError):
     a named datatype, a virtual dataset (its data in other files, read as fill values when they are missing) or
     a dataset stored in external files is ``error`` naming it (balloon-cg writes none of them)."""
     for name in group:
-        link = group.get(name, getlink=True)
         where = f"{group.name.rstrip('/')}/{name}"
-        if not isinstance(link, h5py.HardLink):
-            raise error(path, f"{where} is a {type(link).__name__} (refused: a balloon-cg file holds its own data)")
-        item = group[name]
+        with naming(where, path, error):
+            link = group.get(name, getlink=True)
+            if not isinstance(link, h5py.HardLink):
+                raise error(path, f"{where} is a {type(link).__name__} (refused: a balloon-cg file holds its own data)")
+            item = group[name]
+            if isinstance(item, h5py.Dataset) and (item.is_virtual or item.id.get_create_plist().get_external_count()):
+                raise error(path, f"dataset {where} is {'virtual' if item.is_virtual else 'stored in external files'} "
+                                  "(refused: a balloon-cg file holds its own data)")
+            if not isinstance(item, (h5py.Group, h5py.Dataset)):
+                raise error(path, f"{where} is a {type(item).__name__}, not a group or a dataset")
+        yield item
         if isinstance(item, h5py.Group):
-            yield item
             yield from stored_objects(item, path, error)
-        elif not isinstance(item, h5py.Dataset):
-            raise error(path, f"{where} is a {type(item).__name__}, not a group or a dataset")
-        elif item.is_virtual or item.id.get_create_plist().get_external_count():
-            raise error(path, f"dataset {where} is {'virtual' if item.is_virtual else 'stored in external files'} "
-                              "(refused: a balloon-cg file holds its own data)")
-        else:
-            yield item
+
+
+@contextlib.contextmanager
+def naming(where: str, path, error):
+    """What h5py raises on a damaged object (its header, its type, its data) as ``error`` naming it."""
+    try:
+        yield
+    except (OSError, RuntimeError, ValueError, KeyError, TypeError) as e:
+        if isinstance(e, FileError):
+            raise
+        text = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise error(path, f"{where}: unreadable, damaged ({text[:120]})") from None
 
 
 def check_data(group, path, error=FileError, finite=frozenset()) -> None:
@@ -96,12 +107,9 @@ def check_data(group, path, error=FileError, finite=frozenset()) -> None:
     for item in stored_objects(group, path, error):
         if not isinstance(item, h5py.Dataset):
             continue
-        check_size(item, path, error)
-        try:
+        with naming(f"dataset {item.name}", path, error):
+            check_size(item, path, error)
             data = item[()]
-        except (OSError, RuntimeError, ValueError) as e:
-            text = str(e).splitlines()[0] if str(e) else type(e).__name__
-            raise error(path, f"dataset {item.name}: unreadable data, damaged ({text[:120]})") from None
         name = item.name.rsplit("/", 1)[-1]
         if name in finite and item.dtype.kind == "f" and not np.isfinite(data).all():
             bad = np.argwhere(~np.isfinite(np.atleast_1d(data)))[0]

@@ -145,7 +145,7 @@ def check_described(group, path, error) -> None:
     written with checksums (io.layout.carries_checksums): checksummed where it can be (layout.can_checksum), a
     dimension scale with its SCALE_ATTRIBUTES, every other dataset with DIMENSION_LIST, and each with long_name,
     description and, a quantity's (VARIABLES), units; ``error`` naming the dataset otherwise."""
-    from .layout import can_checksum
+    from .layout import can_checksum, naming
 
     items = []
     group.visititems(lambda name, item: items.append(item) if isinstance(item, h5py.Dataset) else None)
@@ -154,11 +154,13 @@ def check_described(group, path, error) -> None:
             raise error(path, f"dataset {item.name} has no Fletcher32 checksum (every dataset of this file has: "
                               "rewritten after it was written)")
         name = item.name.rsplit("/", 1)[-1]
-        is_scale = h5py.h5ds.is_scale(item.id)
+        with naming(f"dataset {item.name}", path, error):  # a damaged attribute (CLASS) is not a datatype
+            is_scale = h5py.h5ds.is_scale(item.id)
+            keys = set(item.attrs)
         units = (LOWEST if name.startswith("lowest_") else VARIABLES.get(name, (COUNT,)))[0]
         needed = (SCALE_ATTRIBUTES if is_scale else ("DIMENSION_LIST",) if item.ndim else ()) + (
             "long_name", "description") + (("units",) if units else ())
-        missing = [key for key in needed if key not in item.attrs]
+        missing = [key for key in needed if key not in keys]
         if missing:
             raise error(path, f"dataset {item.name} is missing its attribute{'s' if len(missing) > 1 else ''} "
                               f"{', '.join(missing)}")
