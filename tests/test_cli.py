@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import balloon_cg as bc
 from balloon_cg.app.cli import main
 from balloon_cg.io.curve_file import read_curve
 from balloon_cg.scene.materials import PRESETS
@@ -230,3 +231,21 @@ def test_critical_without_a_pear_pitchfork(tmp_path, capsys):
     assert main(["critical", str(scene), "--parameter", "alpha1", "-o", str(out), "--quiet"]) == 1
     one_error_line(capsys, "no pear-shaped pitchfork on the primary branch", "short.toml")
     assert not out.exists()
+
+
+def test_a_set_material_is_stored_as_computed_not_as_its_preset(tmp_path):
+    """``--set material.mu[0]=1`` on TPOM2 (μ1 = 2.0202): the file names the material ``TPOM2 (mu1 = 1)``, stores
+    μ1 = 1, and its pressures are those of μ1 = 1 (the sphere's closed form, MODEL.md §4, P = 2 μ1 (λ^(α1 − 3) −
+    λ^(−2α1 − 3)), here with α1 = 1.98)."""
+    out = tmp_path / "tpom2_mu1.h5"
+    assert main(["run", str(SCENES / "tpom2.toml"), "--set", "material.mu[0]=1", "--set", "stop_stretch=1.3",
+                 "-o", str(out), "--quiet"]) == 0
+    result = bc.load(out)
+    material = result.scene.material
+    assert material.name == "TPOM2 (mu1 = 1)" and material.mu == (1.0,) and material.alpha == (1.98,)
+    assert material != PRESETS["TPOM2"] and material.name != PRESETS["TPOM2"].name
+    primary = result.branches["primary"]
+    lam, pressure = primary["lam2_north"], primary["pressure"]
+    assert len(lam) > 5
+    assert np.allclose(pressure, 2 * 1.0 * (lam ** (1.98 - 3) - lam ** (-2 * 1.98 - 3)), rtol=1e-9, atol=0)
+    assert not np.allclose(pressure, 2 * 2.0202 * (lam ** (1.98 - 3) - lam ** (-2 * 1.98 - 3)), rtol=1e-3)

@@ -220,7 +220,7 @@ def test_the_issues_damaged_curve_files(curve_file, tmp_path, capsys, change):
     with h5py.File(path, "a") as f:
         curve = f["two_parameter/pear"]
         if change == "long double root attribute":  # an undocumented attribute: shown, as a float
-            f.attrs["control"] = np.longdouble(1.5)
+            f.attrs["remark"] = np.longdouble(1.5)
             curve.attrs["extra"] = np.clongdouble(1 + 2j)
         elif change == "inf merge pressure":
             special = curve["special_points"]
@@ -235,7 +235,7 @@ def test_the_issues_damaged_curve_files(curve_file, tmp_path, capsys, change):
     if change == "long double root attribute":
         for argv in (["inspect", str(path)], ["inspect", "--json", str(path)]):
             assert main(argv) == 0  # a RecursionError in inspect --json before
-        assert '"control": 1.5' in capsys.readouterr().out
+        assert '"remark": 1.5' in capsys.readouterr().out
         return
     for argv in (["inspect", str(path)], ["plot", str(path), "--what", "phase", "-o", str(tmp_path / "p.png")]):
         assert main(argv) == 2

@@ -43,7 +43,7 @@ BAD = {  # scene text -> words of the one line
     "alpha 200": ('[material]\nmu = [0.01]\nalpha = [200.0]\n', "within ±100"),
     "formula parameter": ('[material]\nenergy = "c*(I1 - 3)"\n[material.parameters]\nc = 1e308\n',
                           "material.parameters.c = 1e+308"),
-    "M": (f'{SPOM1}[field]\nM = 1e308\n{COILS}', "field.M = 1e+308"),
+    "M": (f'{SPOM1}[field]\nM = 1e308\n{COILS}', "field.M = 1e+308: must be in [0, 1000]"),  # one bound, quoted once
     "M = 2000": (f"{SPOM1}[field]\nM = 2000.0\n{COILS}", "field.M = 2000.0: must be in [0, 1000]"),
     "coil current": (f'{SPOM1}[field]\nM = 0.001\n{COILS.replace("current = 1.0", "current = 1e308")}',
                      "field.coils[0].current = 1e+308"),
@@ -83,7 +83,7 @@ def test_memory_limit_raises_the_product_bound():
 
 @pytest.mark.parametrize("argv, words", [
     (["--workers", "100000"], "--workers 100000: must be in [1, "),
-    (["--workers", "100000", "--oversubscribe"], "must be in [1, 256]"),
+    (["--workers", "100000", "--oversubscribe"], "--workers 100000: must be in [1, "),
     (["--workers", "0"], "--workers 0"),
     (["--scheduler", "not a url"], "not a scheduler address"),
     (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "1"], "give one of the two"),
@@ -103,6 +103,24 @@ def test_workers_up_to_the_cpu_count_are_accepted():
 
     check_workers(cpu_count(), False, None)
     check_workers(cpu_count() + 1, True, None)
+
+
+def test_oversubscribe_is_bounded_by_the_available_memory(monkeypatch):
+    """--oversubscribe starts no more workers than the available memory holds at WORKER_MEMORY each (64 workers of
+    ~140 MB on a 23 GB machine were allowed up to 256), and at most MAX_WORKERS where memory is plenty or unknown."""
+    from balloon_cg.app import sweep
+    from balloon_cg.app.cli import MAX_WORKERS, UsageError, check_workers
+
+    monkeypatch.setattr(sweep, "available_memory", lambda: 10 * sweep.WORKER_MEMORY + 1)
+    check_workers(10, True, None)
+    with pytest.raises(UsageError, match=r"--workers 11: must be in \[1, 10\] \(with --oversubscribe: the workers of "
+                                         r"~160 MiB each that the available memory, 1.56 GiB, holds\)"):
+        check_workers(11, True, None)
+    for plenty in (None, 1000 * sweep.WORKER_MEMORY):
+        monkeypatch.setattr(sweep, "available_memory", lambda: plenty)
+        check_workers(MAX_WORKERS, True, None)
+        with pytest.raises(UsageError, match=rf"must be in \[1, {MAX_WORKERS}\]$"):
+            check_workers(MAX_WORKERS + 1, True, None)
 
 
 def test_the_default_worker_count_is_the_affinity_not_the_machine(monkeypatch):

@@ -10,9 +10,10 @@ import pytest
 
 from balloon_cg.app import default_run
 from balloon_cg.app.cli import main
+from balloon_cg.io.run_file import STABILITY_FLAGS, read_run
+from balloon_cg.io.schema import describe
 from balloon_cg.post.plotting import KINDS, PlotError, plot
 from balloon_cg.post.quantities import postprocess
-from balloon_cg.io.run_file import read_run
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 PER_POINT_KINDS = ("shapes", "stresses", "field", "curvature")
@@ -45,7 +46,12 @@ def bifurcation_file(files, tmp_path_factory):
         n = group["pressure"].shape[0]
         if "stability" in group:
             del group["stability"]
-        group.create_dataset("stability/stable_pressure", data=np.arange(n) < n // 2)
+        stable = group.create_dataset("stability/stable_pressure", data=np.arange(n) < n // 2, fletcher32=True)
+        stable.dims[0].attach_scale(group["point"])  # as the writer lays it out (io.run_file, checked on reading)
+        describe(stable)
+        stable.attrs["meaning"] = STABILITY_FLAGS["stable_pressure"]
+        group["stability"].attrs["unsettled_points"] = np.zeros(0, dtype=np.int64)
+        group.attrs["assessed"] = True
         special = group["special_points"]
         special["kind"][1] = "BP"
         special["classification"][1] = "pitchfork-super"

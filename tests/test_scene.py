@@ -120,7 +120,12 @@ def test_with_overrides():
     assert scene.field.M == 0.002  # the original is untouched
     assert swept.with_overrides({"material.preset": "tpom2"}).material == PRESETS["TPOM2"]
     custom = swept.with_overrides({"material.alpha": np.array([1.3, 4.0, -2.5])})
-    assert custom.material.alpha == (1.3, 4.0, -2.5) and custom.material.name == "SPOM1"
+    assert custom.material.alpha == (1.3, 4.0, -2.5) and custom.material.name == "SPOM1 (alpha3 = -2.5)"
+    assert parse_scene(custom.text, name=custom.name) == custom  # named as what it is, read back the same
+    assert swept.with_overrides({"material.mu": [1.0], "material.alpha": [2.0]}).material.name == "custom"
+    gent = swept.with_overrides({"material.preset": "gent"})
+    assert gent.with_overrides({"material.parameters.Jm": 50}).material.name == "Gent (Jm = 50)"
+    assert swept.with_overrides({"field.M": 0.001}).material.name == "SPOM1"  # the material untouched
     assert swept.with_overrides({"field.M": None}).field.M == 0.0
     for overrides, key in (
         ({"field.M": -0.1}, "field.M"),

@@ -105,6 +105,7 @@ class Picture:
     #                                                not ask for (``[surface] branches = "first"``)
     surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
     interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
+    interrupted_in: str = ""  # the phase it stopped (a timing.Step value; "" where none had started)
     clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
 
     @property
@@ -124,8 +125,9 @@ class Picture:
         found = incomplete(self.branches + self.surface_branches, self.not_searched, tuple(self.not_started),
                            tuple(self.not_switched), tuple(self.not_asked))
         if self.interrupted:
-            found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, "interrupted by a signal: the branches "
-                                    "and phases after the stored points were not computed"))
+            during = f" during {self.interrupted_in}" if self.interrupted_in else ""
+            found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, f"interrupted by a signal{during}: the "
+                                    "branches and phases after the stored points were not computed"))
         return found
 
 
@@ -167,10 +169,10 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
     progress, clock = progress or Progress(), clock or Clock()
     picture = Picture([primary], clock=clock)
     surface = pear and scene.surface.branches != "none"
-    if _stopped(picture):
+    if stopped(picture):
         return picture
     if not _assess(primary, scene, primary.disc.symmetric, progress, clock):
-        picture.interrupted = True
+        stopped(picture)
         return picture
     if primary.disc.symmetric:
         _branch_points(primary, picture)
@@ -179,12 +181,12 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
             primary.special += control_points.find(primary)
         primary.special.sort(key=_along)
         search = pear and not scene.field.is_equator_symmetric  # continuation.symmetry = "none": none broken
-        if search and not _stopped(picture):
+        if search and not stopped(picture):
             with clock.step(Step.PEAR_BRANCHES):
                 _trace_broken(scene, primary, picture, progress)
         picture.not_searched = _unsearched(primary, search, surface)
         pear = False  # no equator-symmetric pitchforks to switch at
-    if _stopped(picture):
+    if stopped(picture):
         return picture
     if pear:
         with clock.step(Step.PEAR_BRANCHES):
@@ -196,6 +198,8 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
     if surface:
         with clock.step(Step.SURFACE_BRANCHES):
             _trace_surface(scene, primary, picture, progress)
+            if stopped(picture):
+                return picture
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
     label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
@@ -207,7 +211,7 @@ def azimuthal_crossings(picture: Picture, branches: list, scene) -> bool:
     """The m ≥ 1 branch points of each of ``branches`` (``azimuthal_points``: on the branches, not in
     ``picture.branch_points``), in their order along it; False when a signal stopped the search."""
     for branch in branches:
-        if _stopped(picture):
+        if stopped(picture):
             return False
         with picture.clock.step(Step.CROSSINGS):
             branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
@@ -236,7 +240,7 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
         # the free balloon's pear points (odd_free) after the others: the held numbering does not depend on them
         crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
         for n, (index, block, k) in enumerate(crossings):
-            if _stopped(picture):
+            if stopped(picture):
                 break
             bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
             bp.note = f"{MODES[block]} mode, branch point {n}"
@@ -290,7 +294,7 @@ def _whole_sphere(scene, progress: Progress, clock: Clock, pear: bool) -> Pictur
     picture = Picture([], surface_branches=[primary], clock=clock)
     if scene.events:
         picture.not_searched = WHOLE_SPHERE_EVENTS
-    if not (_stopped(picture) or not pear or scene.surface.branches == "none"):
+    if not (stopped(picture) or not pear or scene.surface.branches == "none"):
         _switch_pitchforks(scene, primary, picture, progress)
     label_readings(picture.surface_branches)  # folds, end points and secondary points: held, as their branches
     return picture
@@ -303,7 +307,7 @@ def _switch_pitchforks(scene, primary, picture: Picture, progress: Progress) -> 
     picture.not_switched = search.unswitched
     with picture.clock.step(Step.SURFACE_BRANCHES):
         for number, bp, broken in search.pitchforks[:1] if scene.surface.branches == "first" else search.pitchforks:
-            if _stopped(picture):
+            if stopped(picture):
                 break
             _switch_pitchfork(scene, primary, number, bp, broken, picture, progress)
     progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches[1:]))
@@ -317,12 +321,13 @@ def _switch_pitchfork(scene, primary, number: int, bp, broken: tuple, picture: P
     tick = progress.ticker(Phase.SURFACE)
     try:
         branch = surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, progress=tick)
-        other = (surface_pitchforks.mirror_image(branch, broken)
-                 or surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, -1.0, tick))
+        other = surface_pitchforks.mirror_image(branch, broken) or (
+            None if interrupt.requested() else  # a signal: the other direction is not started
+            surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, -1.0, tick))
     except surface_branches.SurfaceStartError as error:
         picture.not_started.append((name, str(error)))
         return
-    picture.surface_branches += [branch, other]
+    picture.surface_branches += [b for b in (branch, other) if b is not None]
     _classified(primary, bp, branch)
 
 
@@ -334,10 +339,13 @@ def _classified(primary, bp, branch) -> None:
                        for s in primary.special]
 
 
-def _stopped(picture: Picture) -> bool:
-    """Whether a signal asked the analysis to stop (``numerics.interrupt``); the picture is then ``interrupted``."""
-    if interrupt.requested():
+def stopped(picture: Picture) -> bool:
+    """Whether a signal asked the analysis to stop (``numerics.interrupt``); the picture is then ``interrupted``,
+    in the phase its clock is in (or left last: the phases poll the flag at every point and step)."""
+    if interrupt.requested() and not picture.interrupted:
         picture.interrupted = True
+        current = picture.clock.current
+        picture.interrupted_in = current.value if current is not None else ""
     return picture.interrupted
 
 
@@ -414,7 +422,7 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
         picture.not_asked.append((", ".join(f"m{bp.m}_bp{k}" for k, bp in points if k not in traced),
                                   'not traced: [surface] branches = "first" (set "all" to trace them)'))
     for k, bp in chosen:
-        if _stopped(picture):
+        if stopped(picture):
             return
         name = f"m{bp.m}_bp{k}"
         try:
@@ -435,6 +443,8 @@ def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progres
     name = f"m{bp.m}_bp{k}"
     branch = _with_events(surface_branches.trace_surface(primary, k, bp, 1.0, name, max_points,
                                                          progress.ticker(Phase.SURFACE)))
+    if interrupt.requested():  # the other direction is not started
+        return [branch]
     other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else  # its UZ points turned with it
              _with_events(surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}", max_points,
                                                          progress.ticker(Phase.SURFACE))))

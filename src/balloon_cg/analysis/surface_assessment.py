@@ -2,12 +2,12 @@
 read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
 change of the number of negative held eigenvalues of a sector under pressure control between two points is a
 secondary branch point, located by Brent's method on that eigenvalue. The points are read in stretches, one per
-core (``numerics.workers``; a signal waits for them, as it waited for the serial loop: the callers keep no
-half-assessed surface branch).
+core (``numerics.workers``). A signal (``numerics.interrupt``) stops the assessment at the next point or root
+search: the branch is left as traced, not assessed (no half-assessed surface branch is kept).
 """
 import numpy as np
 
-from ..numerics import continuation, eigen, workers
+from ..numerics import continuation, eigen, interrupt, workers
 from ..numerics.newton import newton
 from ..surface import stability as surface_stability
 from ..surface.embedding import transfer
@@ -16,7 +16,19 @@ from .results import Kind, SpecialPoint, Status, SurfaceBranch
 STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
 
 
-def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> None:
+def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> bool:
+    """``assessed``; False when a signal stopped it (``sb`` then left as traced: no stability, no secondary
+    points)."""
+    special = list(sb.special)
+    try:
+        assessed(sb, traced, readings)
+    except interrupt.Interrupted:
+        sb.stability, sb.special = {}, special
+        return False
+    return True
+
+
+def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> None:
     """The stability readings of every point (held and free, under pressure, volume and gas control:
     ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
     of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
@@ -30,8 +42,7 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
     cost = sum(float(c.size) ** 3 for _, c in traced)  # a dense factorisation per point
     stretches = np.array_split(np.arange(len(traced)), workers.sharing(len(traced), cost))  # one when not shared
     read = workers.spread(lambda points: _read(sb, traced, readings, points), stretches,
-                          [sum(float(traced[i][1].size) ** 3 for i in stretch) for stretch in stretches],
-                          interruptible=False)
+                          [sum(float(traced[i][1].size) ** 3 for i in stretch) for stretch in stretches])
     spectra, counts = [s for part in read for s, _ in part], [n for part in read for _, n in part]
     held_spectra = [s[held] for s in spectra]
     sb.stability = {r.name: np.array([surface_stability.lowest_over(s[r], STABILITY_COUNT) for s in spectra])
@@ -40,6 +51,7 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
     for i in range(1, len(counts) - 1):
         for key in counts[i]:
             if counts[i][key] != counts[i + 1][key] and not (i in folds and key == sb.basis.characters):
+                interrupt.check()
                 sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
                                              (held_spectra[i][key], held_spectra[i + 1][key])))
     sb.special.sort(key=lambda s: s.index)
@@ -51,6 +63,7 @@ def _read(sb: SurfaceBranch, traced: list, readings, points) -> list:
     point does). The stretches of a branch go to every core (``numerics.workers``)."""
     out, spectra, held = [], None, surface_stability.Reading(True)
     for i in points:
+        interrupt.check()
         trace, c = traced[i]
         params = sb.params.with_value(sb.parameter, sb.values[i])
         spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)

@@ -33,7 +33,7 @@ from scipy import linalg
 
 from ..galerkin.equilibrium import Parameters
 from ..model.loop import loop_distance
-from ..numerics import continuation
+from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from ..numerics.threads import limited_blas
@@ -186,11 +186,13 @@ def pole_stop(code: StopCode, upper: float) -> Stop:
 def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
     """stop(point) -> Stop or None (module docstring); ``rejoin`` (φ, X*): the branch ends where it crosses the
     hyperplane of its branch point back (None: a primary branch); StopCode.RESOLUTION when a tail exceeds
-    solver.max_error."""
+    solver.max_error; StopCode.INTERRUPTED at the first point after a signal (``numerics.interrupt``)."""
     scene, basis = trace.scene, trace.basis
     upper, gap = scene.continuation.stop_stretch, scene.continuation.wire_gap
 
     def stop(point):
+        if interrupt.requested():  # SIGINT/SIGTERM: the points so far are kept (numerics.interrupt)
+            return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
         if rejoin is not None and rejoin[0] @ (point.X - rejoin[1]) < 0:
             return Stop(StopCode.REJOINED, "rejoined the branch it was born on")
         c = trace.system.coefficients(point.X)

@@ -30,12 +30,19 @@ class Clock:
         self.seconds = {}
         self._running = []  # the open steps, innermost last
         self._since = self.start
+        self._last = None  # the step entered last
+
+    @property
+    def current(self) -> "Step | None":
+        """The innermost open step, else the one entered last (None before any)."""
+        return self._running[-1] if self._running else self._last
 
     @contextmanager
     def step(self, step: Step):
         """``with clock.step(Step.X):`` charges the block's time, less that of steps nested in it, to X."""
         self._charge()
         self._running.append(step)
+        self._last = step
         try:
             yield
         finally:

@@ -76,6 +76,8 @@ def incomplete(branches: list, not_searched: str = "", not_started: tuple = (),
         for leg in branch.legs:
             if isinstance(branch, SurfaceBranch) and leg.stop.code in SURFACE_LIMITS:
                 found.append(Incomplete(Gap.LIMITED, branch.name, f"{leg.label} leg: {leg.stop.message}"))
+            elif leg.stop.code == StopCode.INTERRUPTED:
+                found.append(Incomplete(Gap.INTERRUPTED, branch.name, f"{leg.label} leg: {leg.stop.message}"))
             elif leg.stop.code not in REQUESTED_STOPS:
                 found.append(Incomplete(Gap.STOPPED_SHORT, branch.name, f"{leg.label} leg: {leg.stop.message}"))
         for s in branch.special:

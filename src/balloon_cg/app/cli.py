@@ -305,7 +305,9 @@ def axisymmetric(scene, command: str):
 
 
 def run(args) -> int:
-    """Analyse, write, read back and summarise; exit 130 after an interrupt (what is finished is written)."""
+    """Analyse, write, read back and summarise; exit 130 when a signal stopped the work (what is finished is written,
+    flagged interrupted: the message is the file's), or the run's own status when it had finished (and says so)."""
+    from ..analysis.verdict import Gap
     from ..io.run_file import read_run
     from ..numerics.interrupt import requested, stop_on_signals
     from .progress import shown
@@ -315,10 +317,14 @@ def run(args) -> int:
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
-        interrupted = requested()
-    if interrupted:
-        print(f"{PROG}: interrupted: what was finished is written to {output} (flagged incomplete)", file=sys.stderr)
+        signalled = requested()
+    stopped = [item for item in found if item.gap == Gap.INTERRUPTED]
+    if stopped:
+        print(f"{PROG}: interrupted ({stopped[-1].branch}: {stopped[-1].message}); what was finished is written to "
+              f"{output} (flagged incomplete)", file=sys.stderr)
         return INTERRUPTED
+    if signalled:
+        print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
     if not args.quiet:
         from .summaries import format_run
 
@@ -931,7 +937,8 @@ def _add_sweep(commands):
                    help="local worker processes (default: all cores; 1: compute in this process; at most the CPU "
                         "count unless --oversubscribe)")
     p.add_argument("--oversubscribe", action="store_true",
-                   help=f"allow --workers above the CPU count (up to {MAX_WORKERS})")
+                   help=f"allow --workers above the CPU count (up to {MAX_WORKERS}, and as many as the available "
+                        "memory holds)")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--primary-only", action="store_true", help="trace the primary branch only")
     mode.add_argument("--no-pear", action="store_true",
@@ -947,7 +954,8 @@ MAX_WORKERS = 256  # local worker processes, even with --oversubscribe
 
 
 def check_workers(workers: int | None, oversubscribe: bool, scheduler: str | None) -> None:
-    """UsageError unless ``workers`` is None or in [1, CPU count] ([1, MAX_WORKERS] with ``oversubscribe``), and
+    """UsageError unless ``workers`` is None or in [1, CPU count] (with ``oversubscribe``: [1, MAX_WORKERS], and
+    at most the workers the available memory holds, ``sweep.memory_workers``), and
     not given with ``scheduler`` (the cluster's workers compute; local ones would be ignored); ``scheduler`` must
     look like an address ([PROTOCOL://]HOST:PORT)."""
     if scheduler is not None and not re.fullmatch(r"([a-z]+://)?[\w.\-\[\]:]+:\d+", scheduler):
@@ -957,11 +965,17 @@ def check_workers(workers: int | None, oversubscribe: bool, scheduler: str | Non
     if scheduler is not None:
         raise UsageError(f"--workers {workers} with --scheduler {scheduler}: the cluster's workers compute the members; "
                          "give one of the two")
-    from .sweep import cpu_count
+    from .sweep import WORKER_MEMORY, available_memory, cpu_count, memory_workers
 
-    limit = MAX_WORKERS if oversubscribe else cpu_count()
+    if not oversubscribe:
+        limit, more = cpu_count(), f" (the CPU count; --oversubscribe allows up to {MAX_WORKERS})"
+    elif memory_workers() < MAX_WORKERS:
+        limit = memory_workers()
+        more = (f" (with --oversubscribe: the workers of ~{WORKER_MEMORY / 2**20:.0f} MiB each that the available "
+                f"memory, {available_memory() / 2**30:.3g} GiB, holds)")
+    else:
+        limit, more = MAX_WORKERS, ""
     if not 1 <= workers <= limit:
-        more = "" if oversubscribe else f" (the CPU count; --oversubscribe allows up to {MAX_WORKERS})"
         raise UsageError(f"--workers {workers}: must be in [1, {limit}]{more}")
 
 

@@ -37,7 +37,7 @@ from ..analysis.primary import landing_targets, range_limits, stop_rule
 from ..analysis.branch_point import WernerSpence
 from ..analysis.codim2 import continue_branch_point, plain_branch
 from ..analysis.picture import (PEAR_NAMES, Picture, Progress, azimuthal_crossings, examine, label_readings,
-                                pear_pair, surface_pair, unsearched_events)
+                                pear_pair, stopped, surface_pair, unsearched_events)
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.surface_branches import SurfaceStartError
@@ -257,7 +257,8 @@ def switch(start: Labelled, progress=None) -> Picture:
         if pear_pair(branch.scene, branch, picture, n, progress):
             azimuthal_crossings(picture, picture.branches[1:], branch.scene)
         label_readings(picture.branches[1:])
-        return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted)
+        return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted,
+                       interrupted_in=picture.interrupted_in)
     if point.m >= 1 and point.block.held:
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
         try:
@@ -266,6 +267,7 @@ def switch(start: Labelled, progress=None) -> Picture:
             return Picture([branch], not_started=[(f"m{point.m}_bp{k}", str(error))])
         label_readings(pair)
         picture = Picture([branch], surface_branches=pair)
+        stopped(picture)  # a signal in the surface branches (their trace, their assessment): flagged
         unsearched_events(picture, branch.scene)
         return picture
     raise RestartError(f"{what}: switching there is not built (only at pear points, odd_held or odd_free, and held "

@@ -303,6 +303,35 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
     return result
 
 
+# bytes one local sweep worker holds at least: a worker computing a SPOM1 member (degree 40) peaks at 154 MiB resident
+# (measured, issue 42; the issue's 49 workers were ~140 MB each; a wire-refined member needs more): --oversubscribe
+# starts no more than the available memory holds at this floor
+WORKER_MEMORY = 160 * 2**20
+
+
+def available_memory() -> int | None:
+    """Bytes of memory available to new processes (Linux: MemAvailable of /proc/meminfo; elsewhere the free physical
+    pages), None where the system does not say."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def memory_workers() -> int:
+    """The local sweep workers the available memory holds (``available_memory`` / WORKER_MEMORY, at least 1; no bound,
+    a very large number, where the system does not say)."""
+    available = available_memory()
+    return 2**31 if available is None else max(1, available // WORKER_MEMORY)
+
+
 def cpu_count() -> int:
     """The CPUs this process may run on (its affinity mask where the system has one): the default and the cap of
     --workers."""

@@ -31,8 +31,8 @@ import h5py
 import numpy as np
 
 from ..analysis.results import Kind
-from .hdf5 import atomic_file, plain
-from .layout import FileError, check_columns, check_sizes, reading, require_attrs, require_group
+from .hdf5 import atomic_file, checksummed, plain
+from .layout import FileError, carries_checksums, check_columns, check_sizes, reading, require_attrs, require_group
 from .run_file import check_special, legendre_poles, read_run, read_special, root_attrs, write_special
 from .schema import attach_dimensions, describe, scale
 
@@ -44,7 +44,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
     critical = curve.critical
     with atomic_file(path, force) as f:
         f.attrs.update(attrs)
-        f.create_group("branches")
+        f.create_group("branches").attrs["snap_throughs"] = False  # a run file with no branches
         group = f.create_group("two_parameter").create_group(name)
         group.attrs.update({
             "parameter": curve.parameter,
@@ -67,7 +67,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
                    "newton_iterations": curve.iterations, "residual": curve.residual,
                    "unknowns": curve.branch_X(), "mode": curve.mode}
         for key, data in columns.items():
-            group.create_dataset(key, data=data)
+            checksummed(group, key, data)
         point, unknown = scale(group, "point", len(curve.q)), scale(group, "unknown", columns["unknowns"].shape[1])
         attach_dimensions(group, {1: (point,), "unknowns": (point, unknown),
                                   "mode": (point, scale(group, "mode_unknown", columns["mode"].shape[1]))})
@@ -76,7 +76,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         special = group.create_group("special_points")
         write_special(special, [replace(s, X=curve.branch_X(s.X)[0]) for s in points], curve.n + 1,
                       lambda X: legendre_poles(curve.disc, X), unknown)
-        q = special.create_dataset("q", data=np.array([s.X[-1] for s in points], dtype=float))
+        q = checksummed(special, "q", np.array([s.X[-1] for s in points], dtype=float))
         q.dims[0].attach_scale(special["special"])
         describe(q)
     return path
@@ -97,12 +97,13 @@ def read_curve(path, name: str = "pear") -> dict:
         curves = require_group(f, "two_parameter", path, CurveFileError)
         group = require_group(curves, name, f"{path}: two_parameter", CurveFileError)
         where = f"{path}: two_parameter/{name}"
-        require_attrs(group.attrs, where, CURVE_REQUIRED, CURVE_KINDS, CurveFileError)
+        written = carries_checksums(f)  # a file of this version: every attribute it writes
+        require_attrs(group.attrs, where, CURVE_KINDS if written else CURVE_REQUIRED, CURVE_KINDS, CurveFileError)
         check_columns(group, where, CURVE_COLUMNS, CurveFileError)
         check_sizes(group, where, CurveFileError)
         special = require_group(group, "special_points", where, CurveFileError)
         check_special(special, f"{where}: special_points", group["unknowns"].shape[1], CurveFileError,
-                      {"q": ("float", 1)})
+                      {"q": ("float", 1)}, written=written)
         data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}
         data["special_points"] = read_special(special)

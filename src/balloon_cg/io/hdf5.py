@@ -17,6 +17,7 @@ import numpy as np
 import balloon_cg
 
 from ..model.kernels import generated_digest
+from .layout import can_checksum
 from .output import replacing
 
 
@@ -59,6 +60,14 @@ def command_line() -> str:
     if spec is None or not spec.name:
         return shlex.join(sys.argv)
     return shlex.join(["python", "-m", spec.name.removesuffix(".__main__"), *sys.argv[1:]])
+
+
+def checksummed(group, name: str, data, **options):
+    """``group.create_dataset(name, data=data, **options)`` guarded by HDF5's Fletcher32 checksum wherever HDF5
+    can (``layout.can_checksum``: numbers, at least one element): a flipped byte in the stored data is then an
+    error of HDF5's own when it is read, not a wrong number."""
+    data = np.asarray(data)
+    return group.create_dataset(name, data=data, fletcher32=can_checksum(data.dtype, data.size), **options)
 
 
 def write_strings(group, name: str, values) -> None:

@@ -61,6 +61,68 @@ def check_sizes(group, where, error=FileError) -> None:
             check_size(item, where, error)
 
 
+def can_checksum(dtype, size: int) -> bool:
+    """Whether HDF5's Fletcher32 filter can guard a dataset: numbers, at least one element (a filter needs a
+    chunked layout, which an empty dataset or variable-length strings cannot have)."""
+    return size > 0 and h5py.check_string_dtype(dtype) is None and dtype.kind in "biuf"
+
+
+def stored_objects(group, path, error=FileError):
+    """Every group and dataset below ``group``, depth first, reached by hard links only: a soft or external link,
+    a named datatype, a virtual dataset (its data in other files, read as fill values when they are missing) or
+    a dataset stored in external files is ``error`` naming it (balloon-cg writes none of them)."""
+    for name in group:
+        where = f"{group.name.rstrip('/')}/{name}"
+        with naming(where, path, error):
+            link = group.get(name, getlink=True)
+            if not isinstance(link, h5py.HardLink):
+                raise error(path, f"{where} is a {type(link).__name__} (refused: a balloon-cg file holds its own data)")
+            item = group[name]
+            if isinstance(item, h5py.Dataset) and (item.is_virtual or item.id.get_create_plist().get_external_count()):
+                raise error(path, f"dataset {where} is {'virtual' if item.is_virtual else 'stored in external files'} "
+                                  "(refused: a balloon-cg file holds its own data)")
+            if not isinstance(item, (h5py.Group, h5py.Dataset)):
+                raise error(path, f"{where} is a {type(item).__name__}, not a group or a dataset")
+        yield item
+        if isinstance(item, h5py.Group):
+            yield from stored_objects(item, path, error)
+
+
+@contextlib.contextmanager
+def naming(where: str, path, error):
+    """What h5py raises on a damaged object (its header, its type, its data) as ``error`` naming it."""
+    try:
+        yield
+    except (OSError, RuntimeError, ValueError, KeyError, TypeError) as e:
+        if isinstance(e, FileError):
+            raise
+        text = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise error(path, f"{where}: unreadable, damaged ({text[:120]})") from None
+
+
+def check_data(group, path, error=FileError, finite=frozenset()) -> None:
+    """Read every dataset below ``group`` once (``stored_objects``; the declared size bounded first,
+    ``check_size``): a checksum that does not match (HDF5's Fletcher32 filter) or a damaged chunk is ``error``
+    naming the dataset, and so is NaN or inf in a float dataset whose name is in ``finite``."""
+    for item in stored_objects(group, path, error):
+        if not isinstance(item, h5py.Dataset):
+            continue
+        with naming(f"dataset {item.name}", path, error):
+            check_size(item, path, error)
+            data = item[()]
+        name = item.name.rsplit("/", 1)[-1]
+        if name in finite and item.dtype.kind == "f" and not np.isfinite(data).all():
+            bad = np.argwhere(~np.isfinite(np.atleast_1d(data)))[0]
+            raise error(path, f"dataset {item.name} holds NaN or inf (at {tuple(int(i) for i in bad)}), a "
+                              "quantity that is always finite")
+
+
+def carries_checksums(group) -> bool:
+    """Whether datasets below ``group`` carry Fletcher32 checksums: written by a balloon-cg that checksums and
+    describes everything it writes, so its whole layout is required (an older file has none)."""
+    return bool(group.visititems(lambda name, item: isinstance(item, h5py.Dataset) and item.fletcher32 or None))
+
+
 def check_input(path, error=FileError) -> None:
     """``path`` is a regular file (FileNotFoundError, IsADirectoryError, or ``error`` for a FIFO, a device, a
     socket: opening one could block forever or never end)."""

@@ -8,9 +8,11 @@ Layout::
                                   incomplete_gaps, incomplete_branches, incomplete_messages (analysis.verdict),
                                   [phase_names, phase_seconds, total_seconds] (analysis.timing: seconds per
                                   phase and of the whole run, writing included), + extra_attrs
-    /branches/<name>/      attrs: order, m (0: axisymmetric, this layout; m ≥ 1: a surface branch, below),
-                                  stop_reason (for people), leg_labels, leg_stop_codes (per traced leg:
-                                  'up'/'down'/'forward' and a StopCode/TraceStop value), wall_time, degree,
+    /branches              attrs: snap_throughs (bool: the group /snap_throughs is written)
+    /branches/<name>/      attrs: order, assessed (bool: a stability group), m (0: axisymmetric, this layout;
+                                  m ≥ 1: a surface branch, below), stop_reason (for people), leg_labels,
+                                  leg_stop_codes (per traced leg: 'up'/'down'/'forward' and a StopCode/TraceStop
+                                  value), wall_time, degree,
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
                                   kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
                                   the kernels), voltage (Φ̄, fixed unless it is the parameter), parameter
@@ -70,9 +72,10 @@ import numpy as np
 
 from ..analysis.timing import Clock, Step
 from ..surface.loads import LOADS
-from .hdf5 import atomic_file, plain, provenance, write_strings
-from .layout import FileError, check_columns, check_sizes, opened, reading, require_attrs, require_group
-from .schema import attach_dimensions, scale
+from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
+from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
+                     require_group)
+from .schema import FINITE, attach_dimensions, check_described, scale
 
 FORMAT = "balloon-cg/5"
 READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
@@ -206,12 +209,13 @@ def write_branches(parent, scene, branches, snaps=None) -> None:
     from ..galerkin.profiles import theta_grid
 
     group = parent.create_group("branches")
+    group.attrs["snap_throughs"] = snaps is not None
     theta = theta_grid(scene.output.theta_points)
     first_label = 1  # special points are labelled 1, 2, … through the branches in order (``labelled``)
     for order, branch in enumerate(branches):
         write = _write_surface_branch if is_surface(branch) else lambda g, b, f: _write_branch(g, b, theta, f)
         write(group.create_group(branch.name), branch, first_label)
-        group[branch.name].attrs["order"] = order
+        group[branch.name].attrs.update({"order": order, "assessed": bool(branch.stability)})
         first_label += len(branch.special)
     if snaps is not None:
         _write_snaps(parent.create_group("snap_throughs"), snaps)
@@ -259,11 +263,11 @@ def _write_branch(group, branch, theta, first_label: int = 1):
     point, unknown = scale(group, "point", len(branch.X)), scale(group, "unknown", branch.X.shape[1])
     theta_scale = scale(group, "theta", values=theta)
     for name, data in columns.items():
-        group.create_dataset(name, data=data)
+        checksummed(group, name, data)
     attach_dimensions(group, {1: (point,), 2: (point, unknown)})
     shapes = group.create_group("profiles")
     for name, data in profiles(branch.disc, branch.X, theta, branch.scene.geometry).items():
-        shapes.create_dataset(name, data=data, compression="gzip", shuffle=True)
+        checksummed(shapes, name, data, compression="gzip", shuffle=True)
     attach_dimensions(shapes, {2: (point, theta_scale)})
     write_special(group.create_group("special_points"), branch.special, branch.X.shape[1],
                   lambda X: legendre_poles(branch.disc, X), unknown, lambda X: parameter_columns(branch, X),
@@ -339,7 +343,7 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     point, coefficient = scale(group, "point", len(rows)), scale(group, "coefficient", basis.size)
     axis = scale(group, "axis", 3)
     for name, data in columns.items():
-        group.create_dataset(name, data=data)
+        checksummed(group, name, data)
     attach_dimensions(group, {**{name: (point, axis) for name in ("centroid", *LOADS) if name in columns},
                               1: (point,), 2: (point, coefficient)})
     write_special(group.create_group("special_points"), branch.special, rows.shape[1],
@@ -357,11 +361,11 @@ def _write_surface_stability(group, lowest: dict, point) -> None:
                           ("stable_volume", "held_volume"), ("stable_volume_free", "free_volume"),
                           ("stable_gas", "held_gas"), ("stable_gas_free", "free_gas")):
         if reading in lowest:
-            group.create_dataset(name, data=np.asarray(lowest[reading])[:, 0] > 0)
+            checksummed(group, name, np.asarray(lowest[reading])[:, 0] > 0)
             group[name].attrs["meaning"] = STABILITY_FLAGS[name]
     eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in columns.values()))
     for name, values in columns.items():
-        group.create_dataset(name, data=values)
+        checksummed(group, name, values)
     attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
     group.attrs["unsettled_points"] = np.zeros(0, dtype=np.int64)
 
@@ -380,12 +384,12 @@ def _write_stability(group, branch, point):
     """Flags per point (what each means is in the dataset's 'meaning' attribute) and lowest eigenvalues."""
     results = branch.stability
     for name, meaning in STABILITY_FLAGS.items():
-        group.create_dataset(name, data=np.array([a.flags()[name] for a in results], dtype=bool))
+        checksummed(group, name, np.array([a.flags()[name] for a in results], dtype=bool))
         group[name].attrs["meaning"] = meaning
     lowest = {f"lowest_{block}": np.array([a.blocks[block] for a in results]) for block in results[0].blocks}
     eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in lowest.values()))
     for name, values in lowest.items():
-        group.create_dataset(name, data=values)
+        checksummed(group, name, values)
     attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
     group.attrs["unsettled_points"] = np.asarray(branch.unsettled, dtype=np.int64)
 
@@ -394,9 +398,9 @@ def _write_snaps(group, snaps):
     """Snap-throughs under the loading control: from (branch, index) at pressure P to (branch, index) or none."""
     write_strings(group, "from_branch", [s.from_branch for s in snaps])
     write_strings(group, "to_branch", [s.to_branch for s in snaps])
-    group.create_dataset("from_index", data=np.array([s.from_index for s in snaps], dtype=np.int64))
-    group.create_dataset("to_index", data=np.array([s.to_index for s in snaps], dtype=np.int64))
-    group.create_dataset("pressure", data=np.array([s.pressure for s in snaps], dtype=float))
+    checksummed(group, "from_index", np.array([s.from_index for s in snaps], dtype=np.int64))
+    checksummed(group, "to_index", np.array([s.to_index for s in snaps], dtype=np.int64))
+    checksummed(group, "pressure", np.array([s.pressure for s in snaps], dtype=float))
     attach_dimensions(group, {1: (scale(group, "snap", len(snaps)),)})
 
 
@@ -434,32 +438,32 @@ def write_special(group, special: list, width: int, poles, unknown=None, paramet
     … (unique in the file: ``write_branches``); ``reflections``: a surface branch's number of reflections, whose
     points' sectors go to state/sector (``sector_rows``; None: an axisymmetric branch, no sectors)."""
     X = np.array([s.X for s in special]).reshape(len(special), width)
-    group.create_dataset("label", data=np.arange(first_label, first_label + len(special), dtype=np.int64))
+    checksummed(group, "label", np.arange(first_label, first_label + len(special), dtype=np.int64))
     write_strings(group, "kind", [s.kind.value for s in special])
     write_strings(group, "classification", [s.classification.value for s in special])
     write_strings(group, "block", [s.block.value for s in special])
     write_strings(group, "gauge", [s.gauge.value for s in special])
     write_strings(group, "status", [s.status.value for s in special])
     write_strings(group, "reason", [s.reason for s in special])
-    group.create_dataset("uncertainty", data=np.array([s.uncertainty for s in special], dtype=float))
+    checksummed(group, "uncertainty", np.array([s.uncertainty for s in special], dtype=float))
     write_strings(group, "stop_code", [s.stop.code.value if s.stop else "" for s in special])
     write_strings(group, "note", [s.stop.message if s.stop else s.note for s in special])
-    group.create_dataset("index", data=np.array([s.index for s in special], dtype=np.int64))
-    group.create_dataset("m", data=np.array([s.m for s in special], dtype=np.int64))
+    checksummed(group, "index", np.array([s.index for s in special], dtype=np.int64))
+    checksummed(group, "m", np.array([s.m for s in special], dtype=np.int64))
     for name, values in (parameters or (lambda X: {"pressure": X[:, -1]}))(X).items():
-        group.create_dataset(name, data=values)
+        checksummed(group, name, values)
     for n, name in enumerate(("E2", "E3", "E4")):
-        group.create_dataset(name, data=np.array([s.E[n] for s in special], dtype=float))
+        checksummed(group, name, np.array([s.E[n] for s in special], dtype=float))
     pole_values = poles(X)
     for name in POLES:
-        group.create_dataset(name, data=pole_values[name])
+        checksummed(group, name, pole_values[name])
     special_scale = scale(group, "special", len(special))
     attach_dimensions(group, {1: (special_scale,)})
     state = group.create_group("state")  # the 2-D rows apart: special_points stays a table of one row per point
-    state.create_dataset("unknowns", data=X)
+    checksummed(state, "unknowns", X)
     axes = {}
     if reflections is not None:
-        state.create_dataset("sector", data=sector_rows(special, reflections))
+        checksummed(state, "sector", sector_rows(special, reflections))
         axes["sector"] = (special_scale, scale(state, "reflection", reflections))
     attach_dimensions(state, axes | {2: (special_scale, unknown or scale(state, "unknown", width))})
 
@@ -484,12 +488,14 @@ def read_run(path) -> dict:
     """
     path = Path(path)
     with opened(path, RunFileError) as f:
+        check_data(f, path, RunFileError, FINITE)
         return _read_open(f, path) | {"path": str(path)}
 
 
 def read_run_image(image: bytes, label: str = "run") -> dict:
     """``read_run`` of a file image (``run_image``); 'path' is None and errors name ``label``."""
     with reading(label, RunFileError), h5py.File(io.BytesIO(image), "r") as f:
+        check_data(f, label, RunFileError, FINITE)
         return _read_open(f, label) | {"path": None}
 
 
@@ -499,6 +505,10 @@ def _read_open(f, label) -> dict:
         found = "no format attribute" if fmt is None else f"format {plain(fmt)!r}"
         raise RunFileError(label, f"not a balloon-cg run file ({found}, expected one of {', '.join(READABLE)})")
     require_attrs(f.attrs, label, ROOT_KINDS, ROOT_KINDS, error=RunFileError)
+    written = plain(fmt) == FORMAT and carries_checksums(f)  # by this version: every attribute it writes
+    if written:
+        required = WRITTEN_ROOT | ({} if "two_parameter" in f else VERDICT_KINDS)  # a curve has no verdict
+        require_attrs(f.attrs, label, required, required, error=RunFileError)
     if "complete" in f.attrs:
         require_attrs(f.attrs, label, VERDICT_KINDS, VERDICT_KINDS, error=RunFileError)
     if any(k in f.attrs for k in TIMING_KINDS):  # written since issue 28
@@ -517,11 +527,13 @@ def _read_open(f, label) -> dict:
             missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
             if missing:
                 raise RunFileError(f"{label}: branch {name}", f"missing dataset {missing[0]}")
-    return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f, label, RunFileError)}
+    return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f, label, RunFileError, written)}
 
 
 ROOT_KINDS = {"scene_name": "str", "scene_toml": "str", "tolerance": "float", "package_version": "str",
               "generated_digest": "str", "created": "str", "command": "str"}
+WRITTEN_ROOT = {"format": "str", "control": "str", "title": "str", "Conventions": "str", "history": "str"}
+#                 required (with ROOT_KINDS, and a run's VERDICT_KINDS) in a file with checksums
 VERDICT_KINDS = {"complete": "bool", "incomplete_gaps": "str[]", "incomplete_branches": "str[]",
                  "incomplete_messages": "str[]"}
 TIMING_KINDS = {"phase_names": "str[]", "phase_seconds": "float[]", "total_seconds": "float"}
@@ -544,6 +556,8 @@ PROFILES = {name: ("float", 2) for name in ("lam1", "lam2", "rho", "eta")}
 SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int", 1), "m": ("int", 1),
                    **{name: ("float", 1) for name in SPECIAL_NUMBERS}}
 OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage")}  # absent in older formats
+WRITTEN_BRANCH = {"order": "int", "m": "int", "assessed": "bool", "origin": "str", "gauge": "str", "electric": "bool",
+                  "voltage": "float", "parameter": "str"}  # required in a file with checksums (older: optional)
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
@@ -551,17 +565,26 @@ OPTIONAL_SPECIAL = {"voltage": ("float", 1), "gauge": ("str", 1), "label": ("int
 #                                                               gauge, label: since issue 27 (absent in older files)
 
 
-def read_branches(parent, where, error=None) -> dict:
+def read_branches(parent, where, error=None, written: bool | None = None) -> dict:
     """{'branches': {name: branch dict}, 'snap_throughs': [...]} of an h5py group written by write_branches,
-    checked first (``error``, default RunFileError, names ``where`` and what is missing)."""
+    checked first (``error``, default RunFileError, names ``where`` and what is missing); ``written``: written by
+    this version, its whole layout required (default: where ``parent`` carries checksums)."""
     error = error or RunFileError
     group = require_group(parent, "branches", where, error)
+    if written is None:
+        written = carries_checksums(parent)
+    if written:  # a file of this version: its whole layout (older files: what they may hold)
+        check_described(parent, where, error)
+        require_attrs(group.attrs, f"{where}: branches", ("snap_throughs",), {"snap_throughs": "bool"}, error)
+        if bool(group.attrs["snap_throughs"]) != ("snap_throughs" in parent):
+            raise error(where, "missing group snap_throughs" if group.attrs["snap_throughs"] else
+                               "group snap_throughs where /branches says none were searched")
     for name, branch in group.items():
         branch_m(branch, f"{where}: branch {name}", error)
         if is_surface_group(branch):
-            check_surface_branch(branch, f"{where}: branch {name}", error)
+            check_surface_branch(branch, f"{where}: branch {name}", error, written)
         else:
-            check_branch(branch, f"{where}: branch {name}", error)
+            check_branch(branch, f"{where}: branch {name}", error, written)
     snaps = parent.get("snap_throughs")
     if snaps is not None:
         check_columns(snaps, f"{where}: snap_throughs", SNAP_COLUMNS, error)
@@ -595,39 +618,77 @@ def _check_snaps(snaps, branches, where, error) -> None:
                 raise error(where, f"{end}_index {index} is not a point of branch {name!r}")
 
 
-def check_branch(group, where, error) -> None:
+def check_branch(group, where, error, written: bool = False) -> None:
     """The attributes and columns of one stored branch (at least one point; unknowns, profiles and special
-    points of consistent shapes)."""
+    points of consistent shapes; ``written``: a file with checksums, also what this version writes,
+    ``check_written``)."""
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
     require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str"}, error)  # gauge: since issue 27
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
-    check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items() if k in group}, error, rows=n)
+    check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items()
+                                 if k in group or (written and k != "voltage")}, error, rows=n)
     check_sizes(group, where, error)
     width = group["unknowns"].shape[1]
+    check_scales(group, where, error, {"point": n, "unknown": width}, written)
     t = check_columns(group, where, {"theta": ("float", 1)}, error)
     check_columns(require_group(group, "profiles", where, error), f"{where}: profiles", PROFILES, error, rows=n)
     check_sizes(group["profiles"], f"{where}: profiles", error)
     for name, item in group["profiles"].items():
         if item.shape[1:] != (t,):
             raise error(f"{where}: profiles", f"dataset {name} has shape {item.shape}, expected ({n}, {t})")
-    check_special(require_group(group, "special_points", where, error), f"{where}: special_points", width, error)
-    if "stability" in group:
-        stability = require_group(group, "stability", where, error)
-        flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
-        lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
-        check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
-        check_sizes(stability, f"{where}: stability", error)
+    check_special(require_group(group, "special_points", where, error), f"{where}: special_points", width, error,
+                  written=written)
+    check_stability(group, where, error, n, written)
 
 
-def check_special(group, where, width: int, error, extra: dict | None = None, reflections: int = 0) -> None:
-    """The columns of a special_points group (SPECIAL_COLUMNS, OPTIONAL_SPECIAL where present, ``extra``), its X rows
-    (``special_unknowns``) ``width`` wide, one per special point, and, where present, its sectors (state/sector:
-    ``reflections`` wide, characters ±1 or a row of zeros)."""
+def check_stability(group, where, error, n: int, written: bool) -> None:
+    """A branch's stability group, where present (``written``: exactly where its ``assessed`` says, with every
+    flag's ``meaning``, ``unsettled_points`` and the ``eigenvalue`` scale): flags and lowest eigenvalues ``n``
+    rows each."""
+    if written:
+        require_attrs(group.attrs, where, WRITTEN_BRANCH, WRITTEN_BRANCH, error)
+        if bool(group.attrs["assessed"]) != ("stability" in group):
+            raise error(where, "missing group stability" if group.attrs["assessed"] else
+                               "group stability where attribute assessed says none was assessed")
+    if "stability" not in group:
+        return
+    stability = require_group(group, "stability", where, error)
+    flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
+    lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
+    check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
+    check_sizes(stability, f"{where}: stability", error)
+    if written:
+        require_attrs(stability.attrs, f"{where}: stability", ("unsettled_points",), error=error)
+        for name in flags:
+            require_attrs(stability[name].attrs, f"{where}: stability/{name}", ("meaning",), error=error)
+        if lowest:
+            check_scales(stability, f"{where}: stability", error,
+                         {"eigenvalue": max(stability[name].shape[1] for name in lowest)}, written)
+
+
+def check_scales(group, where, error, lengths: dict, written: bool) -> None:
+    """The dimension scales ``lengths`` ({name: length}) of ``group``: each 1-d int of its length, 0, 1, …; required
+    where ``written`` (files before scales, balloon-cg/2, have none)."""
+    present = {name: length for name, length in lengths.items() if written or name in group}
+    for name, length in present.items():
+        check_columns(group, where, {name: ("int", 1)}, error, rows=length)
+        if not np.array_equal(group[name][()], np.arange(length)):
+            raise error(where, f"dataset {name} is not the index 0 … {length - 1}")
+
+
+def check_special(group, where, width: int, error, extra: dict | None = None, reflections: int = 0,
+                  written: bool = False) -> None:
+    """The columns of a special_points group (SPECIAL_COLUMNS, OPTIONAL_SPECIAL where present (``written``: gauge
+    and label always, and the ``special`` scale), ``extra``), its X rows (``special_unknowns``) ``width`` wide, one
+    per special point, and, where present, its sectors (state/sector: ``reflections`` wide, characters ±1 or a
+    row of zeros)."""
     n = check_columns(group, where, SPECIAL_COLUMNS | (extra or {}), error)
-    check_columns(group, where, {k: v for k, v in OPTIONAL_SPECIAL.items() if k in group}, error, rows=n)
+    check_columns(group, where, {k: v for k, v in OPTIONAL_SPECIAL.items()
+                                 if k in group or (written and k != "voltage")}, error, rows=n)
+    check_scales(group, where, error, {"special": n}, written)
     check_sizes(group, where, error)
     unknowns = special_unknowns(group, where, error, rows=n)
     if n and unknowns.shape[1] != width:
@@ -670,15 +731,17 @@ def is_surface_group(group) -> bool:
     return "surface_degree" in group.attrs
 
 
-def check_surface_branch(group, where, error) -> None:
+def check_surface_branch(group, where, error, written: bool = False) -> None:
     """The attributes and columns of one stored surface branch: its basis (symmetry k × 3 of ±1, characters k of
     ±1) rebuilt, the coefficients as wide as its size, the centroid 3 wide, special points (c, p) rows and
     stability of consistent shapes."""
     require_attrs(group.attrs, where, (*SURFACE_KINDS, "symmetry", "characters"), SURFACE_KINDS, error)
     n = check_columns(group, where, SURFACE_COLUMNS, error, min_rows=1)
-    check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items() if k in group}, error, rows=n)
+    check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items()
+                                 if k in group or (written and k != "voltage")}, error, rows=n)
     check_sizes(group, where, error)
     size = stored_basis(group.attrs, where, error).size
+    check_scales(group, where, error, {"point": n, "coefficient": size, "axis": 3}, written)
     if group["coefficients"].shape[1] != size:
         raise error(where, f"coefficients has {group['coefficients'].shape[1]} columns, expected {size} (the size "
                            "of the basis its attributes describe)")
@@ -687,13 +750,8 @@ def check_surface_branch(group, where, error) -> None:
         if group[name].shape[1] != 3:
             raise error(where, f"{name} has shape {group[name].shape}, expected ({n}, 3)")
     check_special(require_group(group, "special_points", where, error), f"{where}: special_points", size + 1, error,
-                  reflections=len(group.attrs["symmetry"]))
-    if "stability" in group:
-        stability = require_group(group, "stability", where, error)
-        flags = {name: ("bool", 1) for name in STABILITY_FLAGS if name in stability}
-        lowest = {name: ("float", 2) for name in stability if name.startswith("lowest_")}
-        check_columns(stability, f"{where}: stability", flags | lowest, error, rows=n)
-        check_sizes(stability, f"{where}: stability", error)
+                  reflections=len(group.attrs["symmetry"]), written=written)
+    check_stability(group, where, error, n, written)
 
 
 def stored_basis(attrs, where="", error=FileError):

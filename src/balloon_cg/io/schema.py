@@ -10,6 +10,8 @@ makes ``point``, ``theta``, ``unknown``, ``coefficient``, ``axis`` and ``special
 import h5py
 import numpy as np
 
+from .hdf5 import checksummed
+
 NONDIMENSIONAL = "1"
 COUNT = ""  # an index, a count, a flag or a label: no units attribute
 
@@ -112,7 +114,7 @@ def describe(dataset, name: str | None = None) -> None:
 
 def scale(group, name: str, length: int = 0, values=None):
     """A dimension scale ``name`` in ``group`` (described): ``values``, or the index 0 … length − 1."""
-    dataset = group.create_dataset(name, data=np.arange(length, dtype=np.int64) if values is None else values)
+    dataset = checksummed(group, name, np.arange(length, dtype=np.int64) if values is None else values)
     dataset.make_scale(name)
     describe(dataset)
     return dataset
@@ -126,3 +128,39 @@ def attach_dimensions(group, axes: dict) -> None:
             for axis, dimension in enumerate(axes.get(name) or axes[item.ndim]):
                 item.dims[axis].attach_scale(dimension)
             describe(item)
+
+
+#: Datasets whose every value is finite (a stored point is a converged solution, its measures and shape; a
+#: special point's state and pole values; a curve's q and mode): the readers refuse NaN or inf in them. The others
+#: may hold NaN (E2, E3, E4 of a point that has no normal form, critical_q) or are bounds and estimates
+#: (uncertainty, error_estimate, the lowest eigenvalues).
+FINITE = frozenset({"pressure", "voltage", "volume", "amount", "lam2_north", "lam2_south", "eta_north", "eta_south",
+                    "lam1_equator", "lam2_equator", "residual", "unknowns", "coefficients", "centroid", "tilt",
+                    "force", "torque", "theta", "lam1", "lam2", "rho", "eta", "q", "mode"})
+SCALE_ATTRIBUTES = ("CLASS", "NAME", "REFERENCE_LIST")  # HDF5 dimension scales (netCDF-4 dimensions)
+
+
+def check_described(group, path, error) -> None:
+    """Every dataset below ``group`` as ``describe``, ``scale`` and ``attach_dimensions`` write it, for a file
+    written with checksums (io.layout.carries_checksums): checksummed where it can be (layout.can_checksum), a
+    dimension scale with its SCALE_ATTRIBUTES, every other dataset with DIMENSION_LIST, and each with long_name,
+    description and, a quantity's (VARIABLES), units; ``error`` naming the dataset otherwise."""
+    from .layout import can_checksum, naming
+
+    items = []
+    group.visititems(lambda name, item: items.append(item) if isinstance(item, h5py.Dataset) else None)
+    for item in items:
+        if can_checksum(item.dtype, item.size) and not item.fletcher32:
+            raise error(path, f"dataset {item.name} has no Fletcher32 checksum (every dataset of this file has: "
+                              "rewritten after it was written)")
+        name = item.name.rsplit("/", 1)[-1]
+        with naming(f"dataset {item.name}", path, error):  # a damaged attribute (CLASS) is not a datatype
+            is_scale = h5py.h5ds.is_scale(item.id)
+            keys = set(item.attrs)
+        units = (LOWEST if name.startswith("lowest_") else VARIABLES.get(name, (COUNT,)))[0]
+        needed = (SCALE_ATTRIBUTES if is_scale else ("DIMENSION_LIST",) if item.ndim else ()) + (
+            "long_name", "description") + (("units",) if units else ())
+        missing = [key for key in needed if key not in keys]
+        if missing:
+            raise error(path, f"dataset {item.name} is missing its attribute{'s' if len(missing) > 1 else ''} "
+                              f"{', '.join(missing)}")

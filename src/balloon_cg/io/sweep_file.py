@@ -41,8 +41,9 @@ import numpy as np
 from .hdf5 import atomic_file, copy_attrs, copy_tree, plain, provenance
 from .output import store_path
 from .lock import remove_debris
-from .run_file import read_branches, verdict_attrs, write_branches
-from .layout import FileError, check_input, reading, require_attrs
+from .run_file import VERDICT_KINDS, read_branches, verdict_attrs, write_branches
+from .layout import FileError, carries_checksums, check_data, check_input, reading, require_attrs
+from .schema import FINITE
 
 FORMAT = "balloon-cg-sweep/2"
 FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
@@ -50,6 +51,14 @@ MEMBER_FORMAT = "balloon-cg-sweep-member/1"
 MANIFEST = "sweep.h5"
 ROOT_KEYS = ("scene_name", "scene_toml", "vary", "mode", "members")
 MEMBER_KEYS = ("overrides", "scene_hash", "scene_toml")
+# every attribute a member is written with: required where its datasets carry checksums (written by this version)
+WRITTEN_MEMBER = {"format": "str", "tolerance": "float", "worker_pid": "int", "wall_time": "float",
+                  "branch_point_pressures": "float[]", "branch_point_kinds": "str[]",
+                  "branch_point_classifications": "str[]", "branch_point_blocks": "str[]", "package_version": "str",
+                  "generated_digest": "str", "created": "str", "Conventions": "str", "history": "str"} | VERDICT_KINDS
+WRITTEN_ROOT = {key: "str" for key in ("format", "scene_name", "scene_toml", "vary", "mode", "store", "title",
+                                       "package_version", "generated_digest", "created", "command", "Conventions",
+                                       "history")} | {"members": "int"}  # the view's, where its members carry checksums
 _MEMBER = re.compile(r"(\d{6})\.h5")
 _OLD_TMP_PREFIX = ".tmp-"  # /1 files: a member group whose write was cut before its rename
 
@@ -295,6 +304,7 @@ def _open(path):
     except (OSError, RuntimeError):
         raise SweepFileError(path, "not a readable HDF5 file (damaged or not HDF5)") from None
     with f, reading(path, SweepFileError):
+        check_data(f, path, SweepFileError, FINITE)
         yield f
 
 
@@ -308,6 +318,8 @@ def read_sweep(path) -> dict:
             raise SweepFileError(path, f"not a balloon-cg sweep file (format {plain(f.attrs.get('format'))!r}, "
                                        f"expected one of {', '.join(FORMATS)})")
         require_attrs(f.attrs, path, ROOT_KEYS, error=SweepFileError)
+        if plain(f.attrs.get("format")) == FORMAT and carries_checksums(f):
+            require_attrs(f.attrs, path, WRITTEN_ROOT, WRITTEN_ROOT, error=SweepFileError)
         if not isinstance(f.get("members"), h5py.Group):
             raise SweepFileError(path, "no /members group")
         out = {"path": str(path), "attrs": {k: plain(v) for k, v in f.attrs.items()}, "members": {}}
@@ -333,6 +345,10 @@ def read_store(directory) -> dict:
 
 def _read_member(group, where: str) -> dict:
     require_attrs(group.attrs, where, MEMBER_KEYS, error=SweepFileError)
+    if carries_checksums(group):
+        require_attrs(group.attrs, where, WRITTEN_MEMBER, WRITTEN_MEMBER, error=SweepFileError)
+    if isinstance(group.get("branches"), h5py.Group) and "primary" not in group["branches"]:
+        raise SweepFileError(where, "missing branch primary (every member traces it)")
     attrs = {k: (v.tolist() if isinstance(v, np.ndarray) else plain(v)) for k, v in group.attrs.items()}
     try:
         overrides = json.loads(attrs["overrides"])

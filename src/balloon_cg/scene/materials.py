@@ -136,3 +136,20 @@ def _terms(key: str, values) -> tuple[float, ...]:
     if len(values) > MAX_TERMS:
         raise SceneError(f"{key} = {show(values)}: at most {MAX_TERMS} Ogden terms (got {len(values)})")
     return tuple(number(f"{key}[{i}]", v) for i, v in enumerate(values))
+
+
+def modified_name(before: Material | StrainEnergy, after: Material | StrainEnergy) -> str:
+    """The name of ``after``, the material ``before`` with keys set (``Scene.with_overrides``): ``before``'s name
+    while the values are the same, else that name with what changed (``TPOM2 (mu1 = 1)``: the terms numbered
+    from 1, a family's parameters by name), or ``custom`` when more than the values changed (the number of
+    terms, the family, the formula). A file then never names a preset whose values it did not compute with."""
+    if isinstance(before, Material) and isinstance(after, Material) and len(before.mu) == len(after.mu):
+        changed = [f"{key}{i + 1} = {new:g}" for key in ("mu", "alpha")
+                   for i, (old, new) in enumerate(zip(getattr(before, key), getattr(after, key))) if old != new]
+    elif (isinstance(before, StrainEnergy) and isinstance(after, StrainEnergy) and before.family == after.family
+          and before.formula == after.formula):
+        changed = [f"{key} = {new:g}" for (key, new), old in zip(after.parameters.items(), before.values)
+                   if old != new]
+    else:
+        return "custom"
+    return f"{before.name} ({', '.join(changed)})" if changed else before.name

@@ -19,7 +19,7 @@ from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
 from .events import Event, events_from_list
 from .loading import Control, Loading, loading_from_table
-from .materials import Material, material_from_table
+from .materials import Material, material_from_table, modified_name
 
 __all__ = [
     "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability",
@@ -393,10 +393,13 @@ class Scene:
                 _assign(data, "material.preset", preset)
                 if any(_PARAMETER_KEY.fullmatch(key) for key in overrides):  # its family's parameters, written out
                     data = _build(data, self.name, "").to_dict()
+            base = material_from_table(dict(data["material"])) if preset is not None else self.material
             for key, value in overrides.items():
                 if key != "material.preset" or preset is None:
                     _assign(data, key, value)
             scene = _build(data, name or renamed(self.name, overrides), "")
+            if "material.name" not in overrides:  # the values computed with, never a preset's name they left
+                scene = replace(scene, material=replace(scene.material, name=modified_name(base, scene.material)))
         except SceneError as e:
             raise SceneError(f"{self.name}: {e}") from None
         return replace(scene, text=scene.to_toml())
@@ -603,7 +606,7 @@ def _getter(data: dict, prefix: str, cls):
         raw = getattr(cls, key) if raw is None else raw
         if raw is None:
             return None
-        x = number(f"{prefix}.{key}", raw, integer=integer)
+        x = number(f"{prefix}.{key}", raw, integer=integer, allowed=allowed)
         if not ok(x):
             raise SceneError(f"{prefix}.{key} = {show(raw)}: must be {allowed}")
         return x

@@ -43,8 +43,9 @@ def show(value) -> str:
 MAX_MAGNITUDE = 1e6  # docs/scenes.md, Bounds: |any number of a scene| (most keys have a tighter range)
 
 
-def number(key: str, value, *, integer: bool = False):
-    """``value`` as a finite float within ±MAX_MAGNITUDE (or an int when ``integer``); bool is not a number."""
+def number(key: str, value, *, integer: bool = False, allowed: str | None = None):
+    """``value`` as a finite float within ±MAX_MAGNITUDE (or an int when ``integer``); bool is not a number.
+    ``allowed``: the key's own range, quoted when the value is beyond ±MAX_MAGNITUDE too (one bound per key)."""
     kind = numbers.Integral if integer else numbers.Real
     if isinstance(value, bool) or not isinstance(value, kind):
         raise SceneError(f"{key} = {show(value)}: must be {'an integer' if integer else 'a number'}")
@@ -53,7 +54,8 @@ def number(key: str, value, *, integer: bool = False):
     if not math.isfinite(value):
         raise SceneError(f"{key} = {show(value)}: must be finite")
     if abs(value) > MAX_MAGNITUDE:
-        raise SceneError(f"{key} = {show(value)}: must be within ±{MAX_MAGNITUDE:g} (no balloon needs more: "
+        raise SceneError(f"{key} = {show(value)}: must be {allowed}" if allowed else
+                         f"{key} = {show(value)}: must be within ±{MAX_MAGNITUDE:g} (no balloon needs more: "
                          "docs/scenes.md, Bounds)")
     return float(value)
 

@@ -1,0 +1,109 @@
+"""A signal at every moment of balloon-cg's own code (issue 42, items 2 and 3): at start-up (the imports, the
+argument parsing), at the end of a sweep (the last member stored, the view rebuilt, the summary, after the
+command returned, while Python exits) the command ends with exit 130 and one line saying what is kept, or exit 0
+when the work had finished (and one line saying so, or nothing once Python exits), never by the signal (−2, −15)
+nor with a traceback. The moments are picked by the code's own hooks (an import, a function called), in a fresh
+interpreter that sends the signal to itself there: no sleeps, the same on any machine."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+import balloon_cg as bc
+
+# The driver: a hook that sends ``sig`` to this process at ``moment``, then the `balloon-cg` entry point itself.
+DRIVER = r'''
+import atexit, importlib, os, signal, sys
+sig, moment, argv = getattr(signal, sys.argv[1]), sys.argv[2], sys.argv[3:]
+fire = lambda: os.kill(os.getpid(), sig)
+if moment.startswith("import "):
+    class Hook:
+        def find_spec(self, name, path=None, target=None):
+            if name == moment.removeprefix("import "):
+                sys.meta_path.remove(self)
+                fire()
+    sys.meta_path.insert(0, Hook())
+from balloon_cg.__main__ import run
+if moment.startswith("after "):  # after a function returns: "after module:function"
+    module, _, name = moment.removeprefix("after ").partition(":")
+    module = importlib.import_module(module)
+    owner, _, attribute = name.rpartition(".")
+    holder = getattr(module, owner) if owner else module
+    original = getattr(holder, attribute)
+    calls = {"n": 0}
+    def wrapped(*args, **kwargs):
+        value = original(*args, **kwargs)
+        calls["n"] += 1
+        if calls["n"] == int(os.environ.get("SIGNAL_AT_CALL", "1")):
+            fire()
+        return value
+    setattr(holder, attribute, wrapped)
+if moment == "at exit":  # registered before run: Python calls it after run's own exit handler
+    atexit.register(fire)
+sys.argv = ["balloon-cg", *argv]
+sys.exit(run())
+'''
+
+
+def balloon_cg(tmp_path, sig: str, moment: str, argv: list, at_call: int = 1):
+    """Run the `balloon-cg` entry point with ``argv``, ``sig`` sent to itself at ``moment``: (exit code, stderr)."""
+    env = os.environ | {"BALLOON_CG_WORKERS": "1", "SIGNAL_AT_CALL": str(at_call)}
+    done = subprocess.run([sys.executable, "-c", DRIVER, sig, moment, *argv], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path, env=env)
+    return done.returncode, done.stderr
+
+
+def one_line(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    return lines[0]
+
+
+SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 1.4\n'
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("moment", ["import balloon_cg.app.cli", "import numpy", "import balloon_cg.scene",
+                                    "after argparse:ArgumentParser.parse_args", "import balloon_cg.analysis.picture"])
+def test_a_signal_at_start_up_exits_130_in_one_line(tmp_path, sig, moment):
+    (tmp_path / "s.toml").write_text(SCENE)
+    code, err = balloon_cg(tmp_path, sig, moment, ["run", "s.toml", "-o", "r.h5", "--quiet"])
+    assert code == 130 and one_line(err) == "balloon-cg: error: interrupted", (code, err)
+    assert not (tmp_path / "r.h5").exists()
+
+
+@pytest.fixture(scope="module")
+def scene_folder(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("sweep")
+    (folder / "s.toml").write_text(SCENE)
+    return folder
+
+
+SWEEP = ["sweep", "s.toml", "--vary", "stop_stretch=1.2,1.3", "--primary-only", "--workers", "2", "-o", "w.h5",
+         "--quiet"]
+KEPT = "balloon-cg: interrupted: the finished members are stored; re-run the same command to resume"
+
+
+@pytest.mark.parametrize("sig, moment, at_call, code, line", [
+    ("SIGTERM", "after balloon_cg.io.sweep_file:Store.write_member", 2, 130, KEPT),  # the last member stored
+    ("SIGINT", "after balloon_cg.app.sweep:consolidate", 1, 130, KEPT),  # the view rebuilt
+    ("SIGTERM", "after balloon_cg.app.sweep:run_sweep", 1, 130, KEPT),
+    ("SIGINT", "after balloon_cg.app.cli:main", 1, 130, "balloon-cg: error: interrupted"),  # before run has it
+    ("SIGINT", "after balloon_cg.__main__:_over", 1, 0, "balloon-cg: SIGINT after the work had finished: exit 0"),
+    ("SIGTERM", "at exit", 1, 0, None),
+], ids=["last member stored", "view rebuilt", "sweep returned", "command returning", "command over",
+        "python exiting"])
+def test_a_signal_at_the_end_of_a_sweep_exits_130_or_0_and_says_so(scene_folder, tmp_path, sig, moment, at_call,
+                                                                    code, line):
+    """Exit 130 where the command had not returned to the entry point (the file is whole all the same: the same
+    command resumes it, computing nothing), 0 after; one line each, never −2 or −15."""
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "s.toml").write_text(SCENE)
+    got, err = balloon_cg(folder, sig, moment, SWEEP, at_call)
+    assert got == code, (got, err)
+    assert (err.strip() == "") if line is None else (one_line(err) == line), err
+    assert sorted(bc.load(folder / "w.h5").members) == [0, 1]  # both members stored and in the view
+    again, err = balloon_cg(folder, "SIGTERM", "never", SWEEP)  # no signal
+    assert again == 0 and err == "", err
