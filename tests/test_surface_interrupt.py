@@ -15,7 +15,7 @@ from balloon_cg.analysis.results import Block, StopCode, TraceStop
 from balloon_cg.analysis.surface_branches import trace_surface
 from balloon_cg.analysis.timing import Step
 from balloon_cg.analysis.verdict import Gap, incomplete
-from balloon_cg.numerics import interrupt
+from balloon_cg.numerics import interrupt, workers
 from balloon_cg.scene import load_scene
 
 from test_signal_moments import balloon_cg, one_line
@@ -65,7 +65,7 @@ def test_a_signal_during_a_surface_assessment_stops_it_at_the_next_point(pear_po
         return spectra(*args, **kwargs)
 
     monkeypatch.setattr(surface_assessment.surface_stability, "sector_spectra", counted)
-    with interrupt.stop_on_signals():
+    with interrupt.stop_on_signals(), workers.serial():  # counted in this process (forked workers count their own)
         branch = trace_surface(primary, 0, bp, 1.0, "m1", 6)
     assert len(calls) == 2  # the point being read finished, no further one started
     assert branch.stability == {} and [s.kind.value for s in branch.special] == ["BP", "EP"]  # as traced
