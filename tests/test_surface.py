@@ -336,6 +336,47 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
         rotated(replace(branch, m=2), "m2_rotated")
 
 
+OFF_EQUATOR = """[material]
+preset = "SPOM1"
+[field]
+M = {M}
+[[field.coils]]
+radius = 2.0
+height = 0.5
+current = 1.0
+[continuation]
+stop_stretch = 2.0
+[surface]
+branches = "none"
+"""
+
+
+def test_held_m1_branch_of_an_off_equator_coil(tmp_path):
+    """Issue 41: a coil off the equator (r = 2, h = 0.5, M = 0.002) keeps no z-reflection, so the held m = 1 branch is
+    traced with the mirror y → −y alone and every translation held: its branch point is solved on the whole sphere
+    as the axisymmetric held state (whose net axial field force, the hold's reaction, is not zero: the gauge that
+    left the axial translation free had no such equilibrium and switching failed), every point is a held
+    equilibrium, and the pear it becomes is tilted (neither axial nor turned by 90°, as the equator-symmetric
+    scenes' are: nothing fixes its axis here)."""
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.surface_branches import SurfaceTrace, trace_surface
+    from balloon_cg.surface.loads import loads
+
+    primary = analyse(parse_scene(OFF_EQUATOR.format(M=0.002), name="off_equator"), pear=False).primary
+    assert not primary.disc.symmetric
+    k, bp = next((k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m == 1 and bp.block.held)
+    assert abs(bp.X[-1] - 2.266905948) < 1e-8  # the issue's held m = 1 point (its scene: the default gap, stop 3)
+    branch = trace_surface(primary, k, bp, 1.0, "m1", 6)
+    assert branch.basis.symmetry == (MIRROR_Y,) and branch.held and len(branch.values) == 6
+    assert branch.residual.max() <= 1e-10  # point 0 included: solved, not the embedded state
+    trace = SurfaceTrace(branch.scene, branch.basis, branch.params)
+    force = loads(trace.eq, branch.coefficients[0], branch.params.with_value("P", branch.values[0]))["force"]
+    assert abs(force[2]) > 1e-4 and np.abs(force[:2]).max() < 1e-12  # the axial reaction of the hold
+    assert np.all(np.abs(trace.gauge.constraints @ branch.coefficients.T) < 1e-12)  # the centre held
+    tilt = branch.measures["tilt"][1:]
+    assert 1.0 < tilt.min() and tilt.max() < 89.0
+
+
 @pytest.fixture(scope="module")
 def two_coil_picture(tmp_path_factory):
     return shared_pictures.two_coil_picture(tmp_path_factory)  # its primary branch is read

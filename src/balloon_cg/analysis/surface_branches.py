@@ -156,9 +156,13 @@ def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
 
 def axisymmetric_solve(trace: SurfaceTrace, c: np.ndarray, P: float) -> np.ndarray | None:
     """The axisymmetric state near c at the pressure P solved on the whole sphere within its axisymmetric family
-    (c + E_0 a, ``surface.stability.azimuthal_family``): the Jacobian E_0ᵀ H E_0 is regular at an m ≥ 1 branch point,
-    where the whole subspace's is singular; None when Newton does not converge."""
+    (c + E a, E spanning the part of ``surface.stability.azimuthal_family`` the gauge's constraints keep: a held
+    balloon's axial translation is not an unknown, its net axial force a reaction): the Jacobian Eᵀ H E is regular
+    at an m ≥ 1 branch point, where the whole subspace's is singular; None when Newton does not converge."""
     E = surface_stability.azimuthal_family(trace.basis, 0)
+    held = trace.gauge.constraints @ E
+    if held.size and np.abs(held).max() > 1e-14:  # an axial translation in the family (no z-reflection kept)
+        E = E @ linalg.null_space(held)
     params, solver = trace.system.params, trace.scene.solver
 
     def residual(X):
