@@ -404,7 +404,8 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
 
 def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress):
     """The non-axisymmetric branches born at the located m ≥ 1 branch points of the primary branch (the held
-    reading's first one, or all of both readings: ``[surface] branches``; ``surface_pair``); the parent point gets
+    reading's first one, or all of both readings: ``[surface] branches``; ``surface_pair``; on a branch without
+    equator symmetry "first" traces none: their basis keeps one reflection, and costs); the parent point gets
     the classification from the reduced energy on the whole sphere. The free reading's points are switched where
     the held states are free equilibria (coils symmetric about the equator: no net axial force); elsewhere the held
     states carry the field's net axial force and the free balloon's branches are not traced (said in
@@ -416,11 +417,14 @@ def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress)
             f"the free balloon's branches at its m ≥ 1 points ({', '.join(f'm{bp.m}_bp{k}' for k, bp in free)}) "
             "are not traced"))))
         points = [(k, bp) for k, bp in points if bp.block.held]
-    chosen = [(k, bp) for k, bp in points if bp.block.held][:1] if scene.surface.branches == "first" else points
+    first = scene.surface.branches == "first"
+    chosen = points if not first else [] if not primary.disc.symmetric else [p for p in points if p[1].block.held][:1]
     if len(chosen) < len(points):
         traced = {k for k, _ in chosen}
-        picture.not_asked.append((", ".join(f"m{bp.m}_bp{k}" for k, bp in points if k not in traced),
-                                  'not traced: [surface] branches = "first" (set "all" to trace them)'))
+        reason = ('not traced: [surface] branches = "first" (set "all" to trace them)' if primary.disc.symmetric else
+                  'not traced: [surface] branches = "first" traces none on a branch without equator symmetry (its '
+                  'whole-sphere basis keeps the mirror y → −y alone: near a wire minutes to hours a branch); set "all"')
+        picture.not_asked.append((", ".join(f"m{bp.m}_bp{k}" for k, bp in points if k not in traced), reason))
     for k, bp in chosen:
         if stopped(picture):
             return
