@@ -352,13 +352,9 @@ def test_continue_from_the_end_of_a_pear_branch_passes_its_pitchfork_into_the_mi
 
 
 def test_continue_refuses_a_switch_or_a_curve_it_does_not_build(two_coils, capsys):
-    """At a free m = 1 point (run traces no branch there either), and from an m = 1 point in a second parameter:
-    one line each, exit 2, nothing written."""
+    """From an m = 1 point in a second parameter: one line, exit 2, nothing written (a free m = 1 point switches
+    now: the test above)."""
     run, out = two_coils / "run.h5", two_coils / "refused.h5"
-    free_m1 = first(run, "BP", "m1_free")
-    assert main(["continue", str(run), str(free_m1), "-o", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"label {free_m1} is a BP of block m1_free: switching there is not" in err
     held_m1 = first(run, "BP", "m1_held")
     assert main(["continue", str(run), str(held_m1), "--parameter", "M", "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip()
@@ -388,6 +384,19 @@ def test_continue_at_a_held_m1_point_switches_to_the_surface_branch(two_coils, t
         assert np.abs(np.asarray(a["pressure"]) - np.asarray(b["pressure"])).max() < 1e-12
         assert [(s["kind"], s["classification"]) for s in a["special_points"]] == \
             [(s["kind"], s["classification"]) for s in b["special_points"]]
+
+
+def test_continue_at_a_free_m1_point_switches_to_the_free_surface_branch(two_coils, tmp_path, capsys):
+    """`continue RUN LABEL` at the first free m = 1 point (issue 41): the free balloon's branch and its image,
+    stored with the free reading (gauge "free"), every point with zero net field force (its centre moves instead)."""
+    run, out = two_coils / "run.h5", tmp_path / "free.h5"
+    label = first(run, "BP", "m1_free")
+    assert main(["continue", str(run), str(label), "-o", str(out), "--set", "surface.max_points=4", "--quiet"]) == 0
+    capsys.readouterr()
+    switched = read_run(out)["branches"]
+    assert list(switched) == ["primary", "m1_bp3", "m1_bp3_rotated"]
+    for name in ("m1_bp3", "m1_bp3_rotated"):
+        assert switched[name]["attrs"]["gauge"] == "free" and len(switched[name]["pressure"]) == 4
 
 
 def test_continue_in_M_from_the_free_pitchfork_gives_free_pitchforks(two_coils, capsys):

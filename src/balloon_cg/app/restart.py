@@ -242,9 +242,9 @@ def switch(start: Labelled, progress=None) -> Picture:
     if point.kind != Kind.BP:
         raise RestartError(f"label {label} is a {point.kind.value}, not a branch point: nothing to switch at")
     what = f"label {label} is a BP of block {point.block.value or 'none'}"
-    if not branch.disc.symmetric:
-        raise RestartError(f"{what} on {branch.name}, a branch without equator symmetry: switching there is not "
-                           "built (only at the pear and held m ≥ 1 points of an equator-symmetric branch)")
+    if not branch.disc.symmetric and not (point.m >= 1 and point.block.held):
+        raise RestartError(f"{what} on {branch.name}, a branch without equator symmetry: switching there is built "
+                           "at its held m ≥ 1 points only (its free points: the held states are no free equilibria)")
     if branch.parameter != "P":
         raise RestartError(f"{what} on {branch.name}, continued in {branch.parameter}: switching is built for "
                            "branches continued in P only")
@@ -259,7 +259,7 @@ def switch(start: Labelled, progress=None) -> Picture:
         label_readings(picture.branches[1:])
         return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted,
                        interrupted_in=picture.interrupted_in)
-    if point.m >= 1 and point.block.held:
+    if point.m >= 1:  # held, or free on an equator-symmetric branch (its held states are free equilibria)
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
         try:
             pair = surface_pair(branch, k, point, branch.scene.surface.max_points, progress)
@@ -270,7 +270,7 @@ def switch(start: Labelled, progress=None) -> Picture:
         stopped(picture)  # a signal in the surface branches (their trace, their assessment): flagged
         unsearched_events(picture, branch.scene)
         return picture
-    raise RestartError(f"{what}: switching there is not built (only at pear points, odd_held or odd_free, and held "
+    raise RestartError(f"{what}: switching there is not built (only at pear points, odd_held or odd_free, and "
                        "m ≥ 1 points; run traces no branches at the others either)")
 
 
