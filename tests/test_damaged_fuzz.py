@@ -228,7 +228,7 @@ def test_the_issues_damaged_curve_files(curve_file, tmp_path, capsys, change):
         elif change.startswith("missing"):
             del curve.attrs[change.removeprefix("missing ")]
         else:
-            name = "q" if change == "nan q" else "pressure"
+            name = "alpha1" if change == "nan q" else "pressure"  # q stored under its parameter's name
             data = curve[name][()]
             data[len(data) // 2] = np.nan if change == "nan q" else np.inf
             curve[name][...] = data

@@ -110,8 +110,11 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     assert "<th>critical alpha1</th>" in loaded._repr_html_() and "\n" not in repr(loaded)
     table = loaded.to_dataframe()
     assert list(table.columns[:3]) == ["curve", "alpha1", "pressure"] and len(table) == len(curve.q)
-    with h5py.File(path, "r") as f:
-        assert f["two_parameter/pear/q"].attrs["long_name"] == "alpha1"
+    with h5py.File(path, "r") as f:  # q stored under its parameter's name, a coordinate of the quantities
+        group = f["two_parameter/pear"]
+        assert "q" not in group and group["alpha1"].attrs["units"] == "1"
+        assert "α1" in group["alpha1"].attrs["long_name"] and group["pressure"].attrs["coordinates"] == "alpha1"
+        np.testing.assert_array_equal(group["special_points/alpha1"][()], data["special_q"])
 
 
 SINGLE_COIL = Path(__file__).resolve().parent.parent / "scenes" / "spom1_single_coil.toml"

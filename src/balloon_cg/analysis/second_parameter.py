@@ -26,9 +26,9 @@ from dataclasses import dataclass, fields, replace
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model.kernels import KernelSet
 from ..scene.energies import FAMILIES, StrainEnergy
+from ..scene.materials import ALPHA1, alpha1_terms
 
 GENERAL_CLASS = "ogden_general_field"
-ALPHA1 = "alpha1"
 
 
 class UnknownParameter(ValueError):
@@ -86,9 +86,8 @@ class SecondParameter:
 
 def alpha1_material(material, alpha1: float):
     """``material`` with α1 replaced and μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 (Σ μ_i α_i = 4 kept)."""
-    rest = sum(m * a for m, a in zip(material.mu[1:], material.alpha[1:]))
-    return replace(material, name=f"{material.name}(alpha1={alpha1:g})",
-                   mu=((4.0 - rest) / alpha1,) + tuple(material.mu[1:]), alpha=(alpha1,) + tuple(material.alpha[1:]))
+    mu, alpha = alpha1_terms(material.mu, material.alpha, alpha1)
+    return replace(material, name=f"{material.name}(alpha1={alpha1:g})", mu=mu, alpha=alpha)
 
 
 def _put(values, index: int, q: float) -> tuple:

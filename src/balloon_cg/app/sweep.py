@@ -17,6 +17,7 @@ import itertools
 import os
 import re
 import sys
+from fractions import Fraction
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -105,10 +106,19 @@ def parse_vary(spec: str, scene: Scene) -> tuple[str, list]:
         raise SweepError(f"--vary {spec!r}: COUNT must be >= 2 (or 1 with START = STOP)")
     if count > MAX_MEMBERS:
         raise SweepError(f"--vary {spec!r}: COUNT = {count}: at most {MAX_MEMBERS} members per sweep")
-    values = np.linspace(start, stop, count).tolist()
+    values = grid(*(Fraction(p.strip()) for p in parts[:2]), count)  # finite numbers: exact fractions
     if isinstance(start, int) and isinstance(stop, int) and all(float(v).is_integer() for v in values):
         values = [int(v) for v in values]
     return key, values
+
+
+def grid(start: Fraction, stop: Fraction, count: int) -> list[float]:
+    """``count`` evenly spaced values from ``start`` to ``stop`` (ends included), each computed exactly from the
+    decimals written and then rounded once: start + (stop − start)·i/(count − 1), so that 1.2:1.4:3 gives 1.3 (where
+    numpy's linspace gives 1.2999999999999998) and every value is the float nearest the exact one."""
+    if count == 1:
+        return [float(start)]
+    return [float(start + (stop - start) * i / (count - 1)) for i in range(count)]
 
 
 def _range_fields(text: str) -> list[str] | None:

@@ -7,12 +7,14 @@ Layout::
     /two_parameter/<name>/       attrs: of, parameter, parameter_key, parameter_derivative, stop_reason, stop_code,
                                         end, end_description, q0, wall_time, degree, kernel_class, M, chi,
                                         critical_q (NaN unless end = isola_merge or cusp)
-        q, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
+        <parameter>, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
+                        (<parameter>: q under its short name, alpha1, M, Jm, mu[0], with units and long_name;
+                        files written before: q)
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block (BP), the
                                                    fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
                         the verified merge of the two pitchforks or the verified cusp; kinds LP-BP, LV-BP, LN-BP:
-                        the meetings of a fold and the pitchfork, analysis.fold_meeting), and q; state/unknowns in
+                        the meetings of a fold and the pitchfork, analysis.fold_meeting), and <parameter>; state/unknowns in
                         the branch layout (u, P)
 
 ``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
@@ -34,7 +36,7 @@ from ..analysis.results import Kind
 from .hdf5 import atomic_file, checksummed, plain
 from .layout import FileError, carries_checksums, check_columns, check_sizes, reading, require_attrs, require_group
 from .run_file import check_special, legendre_poles, read_run, read_special, root_attrs, write_special
-from .schema import attach_dimensions, describe, scale
+from .schema import attach_dimensions, describe_parameter, scale
 
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):
@@ -63,7 +65,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
             "chi": curve.params.chi,
             "critical_q": np.nan if critical is None else critical[0],
         })
-        columns = {"q": curve.q, "pressure": curve.pressure, **curve.pole_values(),
+        columns = {"pressure": curve.pressure, **curve.pole_values(),
                    "newton_iterations": curve.iterations, "residual": curve.residual,
                    "unknowns": curve.branch_X(), "mode": curve.mode}
         for key, data in columns.items():
@@ -71,15 +73,26 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         point, unknown = scale(group, "point", len(curve.q)), scale(group, "unknown", columns["unknowns"].shape[1])
         attach_dimensions(group, {1: (point,), "unknowns": (point, unknown),
                                   "mode": (point, scale(group, "mode_unknown", columns["mode"].shape[1]))})
-        group["q"].attrs["long_name"] = curve.parameter  # q by its name (M, alpha1, …)
+        parameter_coordinate(group, curve.parameter, curve.second.key, curve.q, point)
         points = sorted(curve.merges + curve.meetings, key=lambda s: (s.index, s.X[-1]))
         special = group.create_group("special_points")
         write_special(special, [replace(s, X=curve.branch_X(s.X)[0]) for s in points], curve.n + 1,
                       lambda X: legendre_poles(curve.disc, X), unknown)
-        q = checksummed(special, "q", np.array([s.X[-1] for s in points], dtype=float))
-        q.dims[0].attach_scale(special["special"])
-        describe(q)
+        parameter_coordinate(special, curve.parameter, curve.second.key, [s.X[-1] for s in points],
+                             special["special"])
     return path
+
+
+def parameter_coordinate(group, name: str, key: str, values, dimension) -> None:
+    """q's values as the dataset ``name`` (its short name) along ``dimension``, described, and named a coordinate
+    (CF ``coordinates``) of the group's other one-dimensional quantities along it (xarray: a coordinate)."""
+    q = checksummed(group, name, np.asarray(values, dtype=float))
+    q.dims[0].attach_scale(dimension)
+    describe_parameter(q, key)
+    for item in group.values():
+        if isinstance(item, h5py.Dataset) and item.ndim == 1 and not item.is_scale and item.name != q.name \
+                and item.dtype.kind == "f":
+            item.attrs["coordinates"] = name
 
 
 CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_north", "lam2_south", "residual")},
@@ -99,20 +112,31 @@ def read_curve(path, name: str = "pear") -> dict:
         where = f"{path}: two_parameter/{name}"
         written = carries_checksums(f)  # a file of this version: every attribute it writes
         require_attrs(group.attrs, where, CURVE_KINDS if written else CURVE_REQUIRED, CURVE_KINDS, CurveFileError)
-        check_columns(group, where, CURVE_COLUMNS, CurveFileError)
+        coordinate = parameter_column(group)
+        columns = {coordinate if k == "q" else k: kind for k, kind in CURVE_COLUMNS.items()}
+        check_columns(group, where, columns, CurveFileError)
         check_sizes(group, where, CurveFileError)
         special = require_group(group, "special_points", where, CurveFileError)
         check_special(special, f"{where}: special_points", group["unknowns"].shape[1], CurveFileError,
-                      {"q": ("float", 1)}, written=written)
-        data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset)}
+                      {coordinate: ("float", 1)}, written=written)
+        data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset) and key != coordinate}
+        data["q"] = group[coordinate][()]
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}
         data["special_points"] = read_special(special)
-        data["special_q"] = special["q"][()]
-    for key, values in (("q", data["q"]), ("pressure", data["pressure"]), ("special_points/q", data["special_q"]),
+        data["special_q"] = special[coordinate][()]
+    for key, values in ((coordinate, data["q"]), ("pressure", data["pressure"]),
+                        (f"special_points/{coordinate}", data["special_q"]),
                         ("special_points/pressure", [s["pressure"] for s in data["special_points"]])):
         if not np.isfinite(np.asarray(values, dtype=float)).all():
             raise CurveFileError(where, f"dataset {key} holds NaN or inf (a stored curve point is always finite)")
     return data
+
+
+def parameter_column(group) -> str:
+    """The dataset of a curve group holding q: named after the parameter (``parameter`` attribute), or ``q`` in
+    files written before the coordinate had its parameter's name."""
+    name = str(plain(group.attrs["parameter"]))
+    return name if name in group and name not in CURVE_COLUMNS and name != "special_points" else "q"
 
 
 MEETING_KINDS = (Kind.LP_BP, Kind.LV_BP, Kind.LN_BP)  # the meetings of a fold and the pitchfork

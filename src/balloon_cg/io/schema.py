@@ -89,7 +89,6 @@ VARIABLES = {
     "E2": (NONDIMENSIONAL, "normal-form E2", "energy expansion coefficient along the mode (docs/second_variation.md)"),
     "E3": (NONDIMENSIONAL, "normal-form E3", "cubic coefficient"),
     "E4": (NONDIMENSIONAL, "normal-form E4", "quartic coefficient"),
-    "q": (NONDIMENSIONAL, "second parameter q", "the continued parameter (its name: the parameter attribute)"),
     "mode": (NONDIMENSIONAL, "critical mode", "null vector φ on the odd perturbation block"),
     "stable_pressure": (COUNT, "stable, pressure control", "held at the centre, pressure control"),
     "stable_volume": (COUNT, "stable, volume control", "held at the centre, volume-preserving"),
@@ -110,6 +109,19 @@ def describe(dataset, name: str | None = None) -> None:
         long_name = f"{long_name}, block {name.removeprefix('lowest_')}"
     dataset.attrs.update({"units": units} if units else {})
     dataset.attrs.update({"long_name": long_name, "description": description})
+
+
+#: short name of a second parameter: its long name (others: "second parameter KEY", KEY its scene key)
+PARAMETERS = {"M": "field intensity M", "chi": "magnetic susceptibility χ",
+              "alpha1": "Ogden exponent α1 (μ1 keeps Σ μ_i α_i = 4)"}
+
+
+def describe_parameter(dataset, key: str) -> None:
+    """``units``, ``long_name`` and ``description`` of a second parameter's values stored under its short name
+    (``key``: its scene key, as ``analysis.second_parameter`` names it)."""
+    name = dataset.name.rsplit("/", 1)[-1]
+    dataset.attrs.update({"units": NONDIMENSIONAL, "long_name": PARAMETERS.get(name, f"second parameter {key}"),
+                          "description": f"the continued second parameter, scene key {key} (docs/hdf5.md)"})
 
 
 def scale(group, name: str, length: int = 0, values=None):

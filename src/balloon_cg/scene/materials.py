@@ -27,6 +27,16 @@ class Material:
         return sum(m * a for m, a in zip(self.mu, self.alpha))
 
 
+ALPHA1 = "alpha1"  # the scene key of the Ogden family α1 (``alpha1_terms``): --set, sweep --vary, critical
+
+
+def alpha1_terms(mu, alpha, alpha1: float) -> tuple[tuple, tuple]:
+    """(μ, α) with α1 replaced and μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1, so that Σ μ_i α_i = 4 stays true: the one-parameter
+    family ``alpha1`` names (a sweep's and a critical curve's alike)."""
+    rest = sum(m * a for m, a in zip(mu[1:], alpha[1:]))
+    return ((4.0 - rest) / alpha1,) + tuple(mu[1:]), (alpha1,) + tuple(alpha[1:])
+
+
 # Named materials (SPOM/FPOM/TPOM: six-, four-, two-parameter Ogden fits, the paper's Table 1).
 PRESETS: dict[str, Material] = {
     m.name: m

@@ -19,7 +19,7 @@ from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
 from .events import Event, events_from_list
 from .loading import Control, Loading, loading_from_table
-from .materials import Material, material_from_table, modified_name
+from .materials import ALPHA1, MAX_EXPONENT, Material, alpha1_terms, material_from_table, modified_name
 
 __all__ = [
     "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability",
@@ -342,13 +342,17 @@ class Scene:
         SceneError
             A bare name that no table, or several, have.
         """
-        if "." in key:
+        if "." in key or key == ALPHA1:
             return key
-        tables = ["material"] if key == "preset" else [t for t, content in self.to_dict().items() if key in content]
-        if len(tables) != 1:
-            found = f"in tables {', '.join(tables)}" if tables else "in no table"
-            raise SceneError(f"{key}: a bare name must name a key of exactly one scene table; {key!r} is {found} "
-                             f"(write TABLE.{key})")
+        data = self.to_dict()
+        tables = ["material"] if key == "preset" else [t for t, content in data.items() if key in content]
+        if len(tables) > 1:
+            raise SceneError(f"{key}: a bare name must name a key of exactly one scene table; {key!r} is in tables "
+                             f"{', '.join(tables)} (write one of {', '.join(f'{t}.{key}' for t in tables)})")
+        if not tables:
+            names = [k for content in data.values() if isinstance(content, dict) for k in content] + [ALPHA1]
+            raise SceneError(f"{key}: not a scene key{did_you_mean(key, names)} (a dotted key such as field.M, "
+                             f"or a bare name of one table's key, or {ALPHA1}: docs/scenes.md)")
         return f"{tables[0]}.{key}"
 
     def with_overrides(self, overrides: dict[str, object], name: str | None = None) -> "Scene":
@@ -391,7 +395,7 @@ class Scene:
             preset = overrides.get("material.preset")
             if preset is not None:  # first, in any order: it replaces the material the other material keys change
                 _assign(data, "material.preset", preset)
-                if any(_PARAMETER_KEY.fullmatch(key) for key in overrides):  # its family's parameters, written out
+                if any(_PARAMETER_KEY.fullmatch(key) or key == ALPHA1 for key in overrides):  # its terms, written out
                     data = _build(data, self.name, "").to_dict()
             base = material_from_table(dict(data["material"])) if preset is not None else self.material
             for key, value in overrides.items():
@@ -411,7 +415,7 @@ def renamed(name: str, overrides: dict[str, object]) -> str:
     filename-safe characters): an existing token of that key is updated, else one is appended. Lists and tables
     (``field.coils``, ``material.mu``) leave the name alone."""
     for key, value in overrides.items():
-        physical = key.split(".")[0] in ("field", "material", "loading", "electric", "geometry")
+        physical = key.split(".")[0] in ("field", "material", "loading", "electric", "geometry", ALPHA1)
         if not physical or value is None or isinstance(value, (list, tuple, dict)):
             continue
         if isinstance(value, str):  # a preset or a material name
@@ -889,9 +893,26 @@ _OVERRIDE_KEY = re.compile(r"(\w+)\.(\w+)(?:\[(\d+)\]\.(\w+))?")
 _ARRAY_KEY = re.compile(r"(events)\[(\d+)\]\.(\w+)")  # the top-level arrays of tables
 
 
+def _assign_alpha1(material: dict, value) -> None:
+    """``alpha1 = value`` in a material table: α1 replaced, μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1 (``alpha1_terms``)."""
+    if not isinstance(material.get("alpha"), list):
+        raise SceneError(f"{ALPHA1} = {show(value)}: the first Ogden exponent (with μ1 keeping Σ μ_i α_i = 4); the "
+                         f"material is not an Ogden material (vary its material.parameters.NAME instead)")
+    if value is None:
+        raise SceneError(f"{ALPHA1}: has no default to restore (--unset material.preset or set material.alpha)")
+    alpha1 = number(ALPHA1, value)
+    if alpha1 == 0 or abs(alpha1) > MAX_EXPONENT:
+        raise SceneError(f"{ALPHA1} = {show(value)}: exponents must be nonzero and within ±{MAX_EXPONENT:g}")
+    mu, alpha = alpha1_terms(material["mu"], material["alpha"], alpha1)
+    material["mu"], material["alpha"] = list(mu), list(alpha)
+
+
 def _assign(data: dict, key: str, value) -> None:
     """Set the dotted override ``key`` in a scene dict (numpy values become plain Python ones)."""
     value = value.tolist() if hasattr(value, "tolist") else value
+    if key == ALPHA1:
+        _assign_alpha1(data.get("material", {}), value)
+        return
     parameter = _PARAMETER_KEY.fullmatch(key)
     if parameter is not None:  # a strain energy's parameter (scene/energies.py)
         parameters = data.get("material", {}).get("parameters", {})
