@@ -423,3 +423,32 @@ def test_continue_in_M_from_the_free_pitchfork_gives_free_pitchforks(two_coils, 
     free = [bifurcation.locate(primary, i, block, k) for i, block, k in bifurcation.detect(primary, primary.stability)
             if block == Block.ODD_FREE]
     assert free[0].status == Status.LOCATED and abs(free[0].X[-1] - P[6]) < 1e-10
+
+
+def test_a_restart_on_the_isola_ends_where_its_closed_loop_does(tmp_path, capsys):
+    """SPOM1 at M = 0: the pear branch of the first pitchfork rejoins the primary branch at the second (an isola).
+    `continue RUN LABEL` from its turning point (TP) goes once round the closed loop the pear branch and its mirror
+    image make, and stops where `run` stopped them: both legs at the second pitchfork (stop rejoined; it went round
+    the loop to max_points before, exit 1). It marks what run marks on those two branches, once each: their two
+    turning points (the same P to 1e-8), the first pitchfork it passes (the primary's point), no LV or LN (run
+    marks none on pear branches; it marked them before)."""
+    scene = tmp_path / "spom1.toml"
+    scene.write_text(load_scene("spom1").with_overrides({"surface.branches": "none"}).to_toml())
+    run, out = tmp_path / "run.h5", tmp_path / "again.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    stored = read_run(run)["branches"]
+    assert stored["pear_0"]["attrs"]["rejoins_branch_point"] == 1
+    [tp] = [s for s in stored["pear_0"]["special_points"] if s["kind"] == "TP"]
+    assert main(["continue", str(run), str(tp["label"]), "-o", str(out), "--quiet"]) == 0
+    branch = read_run(out)["branches"]["primary"]
+    assert list(branch["attrs"]["leg_stop_codes"]) == ["rejoined", "rejoined"]
+    kinds = [s["kind"] for s in branch["special_points"]]
+    assert kinds == ["EP", "TP", "BP", "TP", "EP"]
+    turns = sorted(s["pressure"] for name in ("pear_0", "pear_0_mirror") for s in stored[name]["special_points"]
+                   if s["kind"] == "TP")
+    again = sorted(s["pressure"] for s in branch["special_points"] if s["kind"] == "TP")
+    assert np.abs(np.subtract(turns, again)).max() < 1e-8
+    pitchforks = [s["pressure"] for s in stored["primary"]["special_points"] if s["kind"] == "BP"]
+    assert branch["special_points"][2]["pressure"] == pitchforks[0]
+    for end in branch["special_points"][::4]:  # both ends a step past the second pitchfork, as the run's pear ends
+        assert abs(end["pressure"] - pitchforks[1]) < 1e-4 and abs(end["lam2_north"] - end["lam2_south"]) < 0.05

@@ -162,10 +162,12 @@ def analyse(scene, progress: Progress | None = None, pear: bool = True, clock: C
 
 
 def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool = True,
-            clock: Clock | None = None) -> Picture:
+            clock: Clock | None = None, control: bool = True) -> Picture:
     """The picture of an axisymmetric scene from its traced primary branch (``analyse`` after the trace; also
     ``continue``'s restarted branch): assessed, its branch points located, the branches born there followed as
-    ``pear`` and ``[surface] branches`` ask, the m ≥ 1 points of every branch, the snap-throughs."""
+    ``pear`` and ``[surface] branches`` ask, the m ≥ 1 points of every branch, the snap-throughs. ``control``: a
+    branch without equator symmetry gets its stability changes under every control (LV, LN: ``control_points``),
+    as a broken-symmetry primary does; a restarted pear branch does not, as ``run`` marks none on pear branches."""
     progress, clock = progress or Progress(), clock or Clock()
     picture = Picture([primary], clock=clock)
     surface = pear and scene.surface.branches != "none"
@@ -178,7 +180,7 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
         _branch_points(primary, picture)
     else:
         with clock.step(Step.BRANCH_POINTS):
-            primary.special += control_points.find(primary)
+            primary.special += control_points.find(primary) if control else []
         primary.special.sort(key=_along)
         search = pear and not scene.field.is_equator_symmetric  # continuation.symmetry = "none": none broken
         if search and not stopped(picture):

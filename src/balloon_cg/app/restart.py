@@ -169,8 +169,13 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
     point = step_away(system, start, tracer.settings)
     upper = scene.continuation.stop_stretch
     pear = branch.name != "primary"  # a pear branch (pear_<n>, its mirror, broken_pear): stopped as run stops them
-    stop = pear_stop_rule(scene) if pear else stop_rule(scene, upper)
-    legs = [tracer.leg(replace(point, tangent=sign * point.tangent), params, stop, progress, degree=disc.degree,
+
+    def stop():  # a leg's own rule (a pear leg remembers its crossings of the parent)
+        if not pear:
+            return stop_rule(scene, upper)
+        return pear_stop_rule(scene) if start.parent is None else rejoin_rule(start, pear_stop_rule(scene))
+
+    legs = [tracer.leg(replace(point, tangent=sign * point.tangent), params, stop(), progress, degree=disc.degree,
                        mapping=disc.mapping, limits=range_limits(scene, upper)) for sign in (1.0, -1.0)]
     primary = with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0, labels=("up", "down"),
                                    land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
@@ -181,7 +186,34 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
         for number, bp in enumerate(points):
             if bp.block == block:
                 mark_rejoin(primary, start.parent, number, bp)
-    return examine(scene, primary, Ticks(progress), pear=False) if start.assessed else Picture([primary])
+    return (examine(scene, primary, Ticks(progress), pear=False, control=not pear) if start.assessed else
+            Picture([primary]))
+
+
+def rejoin_rule(start: Labelled, base):
+    """stop(disc, point) of one leg of a restarted pear branch whose parent is known: where the pear amplitude
+    A = λ2(0) − λ2(π) changes sign the leg crosses the equator-symmetric parent; it passes the pitchfork it was
+    born at once (into its mirror image: P is even in A there, ``mark_rejoin``) and stops at any other crossing
+    (StopCode.REJOINED, at the parent's pitchfork of its reading nearest in the branch parameter), as ``run``'s
+    pear branches stop: so a restart on an isola ends where the closed loop does instead of going round it.
+    Elsewhere ``base`` (``switching.pear_stop_rule``)."""
+    points = numbered_branch_points(start.parent)
+    block = points[start.parent_point].block
+    pitchforks = [(n, bp.X[-1]) for n, bp in enumerate(points) if bp.block == block]
+    state = {"amplitude": None, "passed": False}
+
+    def stop(disc, point):
+        rows = disc.pole_rows()
+        amplitude = float((rows["lam2_north"] - rows["lam2_south"]) @ point.X[:-1])
+        before, state["amplitude"] = state["amplitude"], amplitude
+        if before is not None and before * amplitude < 0:
+            n = min(pitchforks, key=lambda item: abs(item[1] - point.X[-1]))[0]
+            if n != start.parent_point or state["passed"]:
+                return Stop(StopCode.REJOINED, f"rejoined the primary branch at branch point {n}")
+            state["passed"] = True
+        return base(disc, point)
+
+    return stop
 
 
 def step_away(system, start: Labelled, settings: continuation.Settings) -> continuation.Point:
