@@ -397,6 +397,10 @@ def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
     (["run", "spom1_two_coil_M0.002"], "(did you mean spom1_two_coils_M0.002?)"),
     (["run", str(SCENES / "spom1.tml")], f"No such file or directory (did you mean {SCENES / 'spom1.toml'}?)"),
     (["plot", "x.h5", "--what", "presure-pole"], "not a plot kind (did you mean pressure-pole?)"),
+    (["run", "spom1", "--stop-strech", "3"], "run: unrecognized arguments: --stop-strech 3 (did you mean "
+                                             "--stop-stretch?; balloon-cg run -h lists its options)"),
+    (["inspect", "x.h5", "--jsn=1"], "inspect: unrecognized arguments: --jsn=1 (did you mean --json?;"),
+    (["run", "spom1", "--stop-stretch=3", "--set", "alpa1=1.4"], "not a scene key (did you mean alpha1?)"),
 ])
 def test_a_near_miss_gets_a_suggestion(argv, suggestion, tmp_path, monkeypatch, capsys):
     """A mistyped subcommand, scene key, preset, shipped scene, file name or plot kind: the error line (exit 2)

@@ -66,21 +66,48 @@ def test_grid_values_are_the_decimals_written(scene):
         assert all(error <= abs(Fraction(float(np.nextafter(v, side))) - Fraction(k, 3)) for side in (-1, 2))
 
 
-def test_sweep_in_alpha1_meets_the_critical_curve(scene, tmp_path):
+@pytest.fixture(scope="module")
+def alpha1_files(scene, tmp_path_factory):
+    """A sweep of alpha1 over 1.2:1.4:3 (no pear branches) and the α1 curve of pear pitchforks traced from the
+    scene's first pitchfork (α1 = 1.3): (sweep path, curve file path, curve, branch)."""
+    from balloon_cg.io.curve_file import write_curve
+
+    folder = tmp_path_factory.mktemp("alpha1")
+    run_sweep(scene, ["alpha1=1.2:1.4:3"], folder / "sweep.h5", mode="no-pear", workers=1)
+    branch = trace_primary(scene, down=False)
+    bp = bifurcation.locate(branch, *pear_events(branch)[0])
+    curve = continue_branch_point(branch, bp, "alpha1")
+    return folder / "sweep.h5", write_curve(folder / "curve.h5", scene, curve), curve, branch
+
+
+def test_sweep_in_alpha1_meets_the_critical_curve(alpha1_files):
     """The acceptance test: the pear pitchfork of the sweep member α1 = 1.4 and the point of the α1 curve of
     pitchforks (``critical --parameter alpha1``, traced from the scene's α1 = 1.3) landed on α1 = 1.4 have the same
     P to 1e-8; the sweep's grid value prints as written."""
     import balloon_cg as bc
 
-    path = tmp_path / "alpha1.h5"
-    run_sweep(scene, ["alpha1=1.2:1.4:3"], path, mode="no-pear", workers=1)
-    table = bc.load(path).to_dataframe()
+    sweep, _, curve, branch = alpha1_files
+    table = bc.load(sweep).to_dataframe()
     assert list(table["alpha1"]) == [1.2, 1.3, 1.4] and str(table.loc[1, "alpha1"]) == "1.3"
-    branch = trace_primary(scene, down=False)
-    bp = bifurcation.locate(branch, *pear_events(branch)[0])
-    curve = continue_branch_point(branch, bp, "alpha1")
     near = int(np.argmax(curve.q >= 1.4))
     X = land_on_q(curve, 1.4, near)
     assert X is not None and X[-1] == 1.4
     assert abs(X[branch.disc.size] - table.loc[2, "P_cr1"]) < 1e-8
     assert abs(table.loc[2, "P_cr1"] - 2.2224) < 1e-4  # not the μ1-kept family's ≈ 2.39 (issue 40)
+
+
+def test_loaded_sweeps_and_curves_plot_on_one_parameter_axis(alpha1_files):
+    """``bc.plot(bc.load(sweep))`` and a CurveResult draw (their kind: phase), together on the one α1 axis: the
+    sweep's three pitchfork pressures and the curve; anything else is one PlotError line, not a TypeError."""
+    import balloon_cg as bc
+    from balloon_cg.post.plotting import PlotError
+
+    sweep, path, curve, _ = alpha1_files
+    for source in (bc.load(sweep), bc.load(path), sweep):
+        assert "alpha_1" in bc.plot(source).axes[0].get_xlabel()
+    ax = bc.plot([bc.load(sweep), bc.load(path)]).axes[0]
+    drawn = [line for line in ax.get_lines() if "pear pitchfork" in line.get_label()]
+    assert len(drawn) == 1 and list(drawn[0].get_xdata()) == [1.2, 1.3, 1.4]
+    assert any(len(line.get_xdata()) == len(curve.q) for line in ax.get_lines())
+    with pytest.raises(PlotError, match="plot draws a Result, a loaded sweep or curve .* got int"):
+        bc.plot(42)

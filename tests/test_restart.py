@@ -425,17 +425,50 @@ def test_continue_in_M_from_the_free_pitchfork_gives_free_pitchforks(two_coils, 
     assert free[0].status == Status.LOCATED and abs(free[0].X[-1] - P[6]) < 1e-10
 
 
-def test_a_restart_on_the_isola_ends_where_its_closed_loop_does(tmp_path, capsys):
+@pytest.fixture(scope="module")
+def spom1_run(tmp_path_factory):
+    """SPOM1 at M = 0 (no coils), without surface branches: its run file (primary, the isola's pear branches)."""
+    folder = tmp_path_factory.mktemp("spom1")
+    scene = folder / "spom1.toml"
+    scene.write_text(load_scene("spom1").with_overrides({"surface.branches": "none"}).to_toml())
+    assert main(["run", str(scene), "-o", str(folder / "run.h5"), "--quiet"]) == 0
+    return folder / "run.h5"
+
+
+def test_continue_in_M_without_coils_is_bad_input(spom1_run, tmp_path, capsys):
+    """`continue RUN LABEL --parameter M` on a run without coils: exit 2 before any work, as `critical` (it was
+    exit 1 from inside the curve's start), one line; nothing written."""
+    out = tmp_path / "m.h5"
+    for kind in ("LP", "BP"):
+        assert main(["continue", str(spom1_run), str(first(spom1_run, kind, "odd_held" * (kind == "BP"))),
+                     "--parameter", "M", "-o", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "continue --parameter M needs coils" in err and str(spom1_run) in err
+    assert not out.exists()
+
+
+def test_continue_writes_to_a_default_path(spom1_run, tmp_path, monkeypatch, capsys):
+    """Without -o, continue writes RUN_label<LABEL>.h5 (a curve: RUN_label<LABEL>_<KEY>.h5) in the current folder,
+    as run and critical name their outputs; an existing one is kept without --force."""
+    monkeypatch.chdir(tmp_path)
+    label = first(spom1_run, "LP")
+    assert main(["continue", str(spom1_run), str(label), "--quiet", "--stop-stretch", "1.5"]) == 0
+    assert f"written to run_label{label}.h5" in capsys.readouterr().out
+    assert read_run(tmp_path / f"run_label{label}.h5")["branches"]["primary"]["attrs"]["kernel_class"]
+    assert main(["continue", str(spom1_run), str(label), "--quiet"]) == 2
+    assert "exists" in capsys.readouterr().err
+    assert main(["continue", str(spom1_run), str(label), "--parameter", "material.mu[1]", "--quiet"]) in (0, 1)
+    assert (tmp_path / f"run_label{label}_mu1.h5").exists()  # the key reduced to file-name characters, as critical
+
+
+def test_a_restart_on_the_isola_ends_where_its_closed_loop_does(spom1_run, tmp_path, capsys):
     """SPOM1 at M = 0: the pear branch of the first pitchfork rejoins the primary branch at the second (an isola).
     `continue RUN LABEL` from its turning point (TP) goes once round the closed loop the pear branch and its mirror
     image make, and stops where `run` stopped them: both legs at the second pitchfork (stop rejoined; it went round
     the loop to max_points before, exit 1). It marks what run marks on those two branches, once each: their two
     turning points (the same P to 1e-8), the first pitchfork it passes (the primary's point), no LV or LN (run
     marks none on pear branches; it marked them before)."""
-    scene = tmp_path / "spom1.toml"
-    scene.write_text(load_scene("spom1").with_overrides({"surface.branches": "none"}).to_toml())
-    run, out = tmp_path / "run.h5", tmp_path / "again.h5"
-    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    run, out = spom1_run, tmp_path / "again.h5"
     stored = read_run(run)["branches"]
     assert stored["pear_0"]["attrs"]["rejoins_branch_point"] == 1
     [tp] = [s for s in stored["pear_0"]["special_points"] if s["kind"] == "TP"]

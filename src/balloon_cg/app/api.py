@@ -490,11 +490,11 @@ def plot(source, what: str | None = None, ax=None, points=None, branch: str | No
 
     Parameters
     ----------
-    source : Result or str or Path, or a list of them
-        What to draw (several: one curve set each).
+    source : Result, SweepResult, CurveResult, str or Path, or a list of them
+        What to draw (several: one curve set each): a run, a loaded sweep or curve file (``load``), a file's path.
     what : str, optional
         The kind (docs/plots.md); None: the pole curve of the continuation parameter, ``pressure-pole`` or, for
-        a run continued in the voltage, ``voltage-pole``.
+        a run continued in the voltage, ``voltage-pole``; ``phase`` for a sweep or curve.
     ax : matplotlib Axes or sequence of Axes, optional
         Draw into these (a sequence for the kinds with several panels); None: a new Figure.
     points : list of int, optional
@@ -522,5 +522,21 @@ def plot(source, what: str | None = None, ax=None, points=None, branch: str | No
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]
-    return draw([s.run if isinstance(s, Result) else s for s in sources], what, points, branch, axes=ax,
-                stability=stability)
+    return draw([_drawable(s) for s in sources], what, points, branch, axes=ax, stability=stability)
+
+
+def _drawable(source):
+    """What ``post.plotting.plot`` draws for one source of ``plot``: a Result's run, a loaded sweep's or curve's
+    file (``load``), a path; PlotError (one line) for anything else."""
+    from ..post.plotting import PlotError
+    from .curve_result import CurveResult
+    from .sweep_result import SweepResult
+
+    if isinstance(source, Result):
+        return source.run
+    if isinstance(source, (SweepResult, CurveResult)):
+        return Path(source.path)
+    if isinstance(source, (str, Path)):
+        return source
+    raise PlotError(f"plot draws a Result, a loaded sweep or curve (bc.load) or the path of a balloon-cg file; "
+                    f"got {type(source).__name__}")

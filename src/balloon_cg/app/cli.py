@@ -96,7 +96,9 @@ def _main(argv) -> int:
     if command is not None and command not in parser.commands:  # argparse names no near miss before Python 3.14
         return _error(f"{command!r}: not a command{did_you_mean(command, parser.commands)} (choose from "
                       f"{', '.join(parser.commands)}; {PROG} COMMAND -h)", 2)
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # argparse would print the top-level usage, naming no near miss
+        return _error(unrecognized(parser.subcommands[args.command], extra), 2)
     args.command_line = shlex.join([PROG, *argv])
     try:
         return args.handler(args)
@@ -114,6 +116,15 @@ def _main(argv) -> int:
     except Exception as e:  # noqa: BLE001 - a bug: one line and exit 3 (the traceback with --debug)
         return _debug(args) or _error(f"internal error ({type(e).__name__}: {e}); please report it with the "
                                       f"command and the output of `{PROG} --debug ...`", 3)
+
+
+def unrecognized(command: argparse.ArgumentParser, extra: list[str]) -> str:
+    """One line for arguments a command does not take, naming the option nearest the first unknown one."""
+    options = [o for action in command._actions for o in action.option_strings]
+    unknown = next((word.partition("=")[0] for word in extra if word.startswith("-")), "")
+    near = did_you_mean(unknown, options).strip(" ()") if unknown else ""
+    return (f"{command.prog.removeprefix(PROG).strip()}: unrecognized arguments: {' '.join(extra)} "
+            f"({near + '; ' if near else ''}{command.prog} -h lists its options)")
 
 
 def _debug(args) -> None:
@@ -663,9 +674,7 @@ def _critical(args, scene) -> int:
         raise UsageError(f"critical needs a pressure continuation: {args.scene}: continuation.parameter = "
                          f"{scene.continuation.parameter.value!r} (the curve of pitchforks is traced in (q, P); "
                          "continue P at a fixed electric.voltage instead)")
-    if args.parameter in ("M", "field.M") and not scene.field.coils:
-        raise UsageError(f"critical --parameter M needs coils: {args.scene} has no [[field.coils]], so the "
-                         "equilibrium does not depend on M")
+    field_needed(scene, args.parameter, "critical --parameter M", args.scene)
     try:
         resolve(scene, args.parameter)
     except UnknownParameter as e:
@@ -694,6 +703,14 @@ def _critical(args, scene) -> int:
     print(f"critical {curve.parameter} = {q:.12g} (P = {P:.10g}, pole stretch {stretch:.10g}; {what}); "
           f"curve written to {args.output}{curve.describe_meetings()}")
     return 0
+
+
+def field_needed(scene, parameter: str, what: str, where: str) -> None:
+    """UsageError (exit 2, before any work) for a second parameter M on a scene without coils: the equilibrium
+    does not depend on M (``critical`` and ``continue`` alike)."""
+    if parameter in ("M", "field.M") and not scene.field.coils:
+        raise UsageError(f"{what} needs coils: {where} has no [[field.coils]], so the equilibrium does not depend "
+                         "on M")
 
 
 def _say(args, text: str) -> None:
@@ -828,7 +845,8 @@ def _add_continue(commands):
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="a fold curve: start with the parameter increasing (1, default) or decreasing (-1)")
-    p.add_argument("-o", "--output", required=True, help="run or curve file to write (HDF5)")
+    p.add_argument("-o", "--output", help="run or curve file to write (HDF5; default: RUN_label<LABEL>.h5 in the "
+                                          "current folder, RUN_label<LABEL>_<KEY>.h5 with --parameter KEY)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--allow-partial", action="store_true",
@@ -842,6 +860,8 @@ def continue_run(args) -> int:
     """``continue``: the labelled point found, restarted (``app.restart``), written (the output owned meanwhile)."""
     from ..io.lock import claim
 
+    parameter = "" if args.parameter is None else "_" + re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
+    args.output = default_output(args.output, f"{Path(args.run).stem}_label{args.label}{parameter}", "run")
     with claim(args.output, "continue"):
         return _continue(args)
 
@@ -865,6 +885,8 @@ def _continue(args) -> int:
     try:
         start = find_label(run, args.label)
         start = with_settings(start, _with_settings(args, start.branch.scene)[1])
+        if args.parameter is not None:
+            field_needed(start.branch.scene, args.parameter, f"continue --parameter {args.parameter}", args.run)
         result = restart(start, args.parameter, args.direction)
     except (RestartError, UnknownParameter) as e:
         raise UsageError(f"continue {args.run}: {e}") from None

@@ -37,7 +37,7 @@ from .labels import label_points
 from .style import JournalFigure, journal_style
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import curve_meetings, read_curve
-from ..io.layout import FileError, check_input, reading
+from ..io.layout import FileError, check_input, file_kind, reading
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
 from ..model.meridian import reference_height
@@ -348,7 +348,8 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
          stability: Reading | None = None) -> Figure:
     """The figure of kind ``what`` (one of KINDS) for ``sources``: runs (read_run() output) or run files, one
     or a list (``phase``: curve or sweep files). ``what`` None: the pole curve of the first run's continuation
-    parameter (``pressure-pole``, or ``voltage-pole`` for a run continued in the voltage).
+    parameter (``pressure-pole``, or ``voltage-pole`` for a run continued in the voltage); ``phase`` for a sweep or
+    curve file.
 
     ``branch``: the branch to draw (default: all branches for the branch curves and the energy, 'primary' for
     the per-point kinds). ``points``: indices (negative count from the end) of the configurations drawn by the
@@ -364,6 +365,8 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
 def _draw(sources, what, points, branch, axes, stability) -> Figure:
     """``plot`` in the current matplotlib style."""
     sources = [sources] if isinstance(sources, (str, Path, dict)) else list(sources)
+    if what is None and not isinstance(sources[0], dict) and file_kind(sources[0]) in ("sweep", "curve"):
+        what = "phase"  # what a sweep or curve file draws
     if what is None:
         sources = [as_run(s) for s in sources]
         stored = list(sources[0]["branches"].values())  # none in a curve file: load_branches says so in one line
