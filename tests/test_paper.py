@@ -145,6 +145,9 @@ def test_snap_throughs_from_stored_data_equal_the_analysis():
     P = run["branches"]["primary"]["pressure"]
     between = lambda i, value: (P[i] - value) * (P[i + 1] - value) <= 0  # noqa: E731
     assert P[stored[0][1]] == pytest.approx(2.568464, abs=5e-3)  # the last stable point before the fold
+    [fold] = [s for s in run["branches"]["primary"]["special_points"] if s["kind"] == "LP"]
+    assert fold["status"] == "located" and P[stored[0][1]] < fold["pressure"]
+    assert run["snap_throughs"][0]["pressure"] == snap_throughs(run, Reading.PRESSURE)[0].pressure == fold["pressure"]
     [volume] = snap_throughs(run, Reading.VOLUME)
     assert between(volume.from_index, 2.26473)  # P_cr1 lies between the last stable point and the next
     assert volume.pressure == pytest.approx(run["branches"]["primary"]["volume"][volume.from_index])

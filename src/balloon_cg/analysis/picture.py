@@ -28,7 +28,7 @@ import numpy as np
 from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, mirror, surface_branches,
                surface_pitchforks, surface_primary)
 from ..scene import Control
-from .control import control_values, minimised_energy
+from .control import FOLD_KIND, control_value, control_values, minimised_energy
 from .mirror import MIRROR
 from .primary import trace_primary
 from .problem import equilibrium_of
@@ -499,8 +499,16 @@ def snap_throughs(branches: list, control: Control = Control.PRESSURE) -> list:
         q = b.X[:, -1] if b.parameter != "P" else control_values(P, volume, control)
         energy = minimised_energy(energy, P, volume, control)
         stable = np.array([a.flags()[HELD_FLAG[control]] for a in b.stability], dtype=bool)
-        curves.append(Curve(b.name, q, stable, energy))
+        folds = located_folds(b.disc, [(s.kind, s.status, s.index, s.X) for s in b.special], control)
+        curves.append(Curve(b.name, q, stable, energy, folds))
     return find_snaps(curves)
+
+
+def located_folds(disc, special, control: Control) -> dict:
+    """{interval i: q at the fold} of the located folds of the control q (``control.FOLD_KIND``: LP, LV, LN; on a
+    voltage branch LP is the fold in Φ̄ = X[-1], q there) among ``special`` ((kind, status, index, X) on ``disc``)."""
+    return {int(index): control_value(disc, X, control) for kind, status, index, X in special
+            if kind == FOLD_KIND[control] and status == Status.LOCATED}
 
 
 @dataclass(frozen=True)
@@ -512,6 +520,7 @@ class Curve:
     control: np.ndarray
     stable: np.ndarray
     energy: np.ndarray
+    folds: dict = field(default_factory=dict)  # interval i -> q at the located fold of q there (located_folds)
 
 
 def find_snaps(curves: list[Curve]) -> list[SnapThrough]:
@@ -519,14 +528,15 @@ def find_snaps(curves: list[Curve]) -> list[SnapThrough]:
     by raising or lowering the control along the stretch: both ends of every stretch), the jump at that control
     value to the stable point of lowest energy on any branch (an interval of two stable points strictly bracketing
     it, not within one point of the start on its branch or on the branch's mirror image: the same state
-    reflected; none: to_branch ""). ``pressure`` of the result is the control value."""
+    reflected; none: to_branch ""). ``pressure`` of the result is the control value: the located fold's where the
+    stretch ends at one (``Curve.folds``), else the last stable point's."""
     snaps = []
     for curve in curves:
         stable = curve.stable
         for i in range(len(stable) - 1):
             if stable[i] != stable[i + 1]:
                 end = i if stable[i] else i + 1
-                value = float(curve.control[end])
+                value = float(curve.folds.get(i, curve.control[end]))
                 target = _stable_at(curves, value, exclude=(curve.name, end))
                 snaps.append(SnapThrough(curve.name, end, value, *(target or ())))
     return snaps

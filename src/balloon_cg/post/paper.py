@@ -26,7 +26,8 @@ from .style import JournalFigure, journal_style
 from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
 from ..analysis.control import control_values, minimised_energy
 from ..analysis.mirror import MIRROR
-from ..analysis.picture import Curve, find_snaps
+from ..analysis.picture import Curve, find_snaps, located_folds
+from ..analysis.results import Kind, Status
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..scene import Control, parse_scene
 
@@ -198,7 +199,10 @@ def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
         E = np.array([eq.energy(X[:disc.size], Parameters(p, M, chi, phi)) for X, p, phi in
                       zip(data["unknowns"], P, voltage)])
         q = voltage if data["attrs"].get("parameter") == "voltage" else control_values(P, V, control)
-        curves.append(Curve(name, q, stable, minimised_energy(E, P, V, control)))
+        special = [(Kind(s["kind"]), Status(s["status"]), s["index"], X)
+                   for s, X in zip(data["special_points"], data["special_unknowns"])]
+        curves.append(Curve(name, q, stable, minimised_energy(E, P, V, control),
+                            located_folds(disc, special, control)))
     return find_snaps(curves)
 
 
