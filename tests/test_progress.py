@@ -60,3 +60,26 @@ def test_a_phase_with_a_known_total_shows_its_fraction_and_eta(monkeypatch):
         bars.expect(Phase.STABILITY, 40)
         assert re.search(r"stability:\s+0%\|.*\| 0/40 \[00:00<", terminal.getvalue())  # <: the time left
         bars.finish(Phase.STABILITY, 40)
+
+
+def test_a_budgeted_trace_shows_a_total_and_gives_back_what_it_did_not_use(monkeypatch):
+    """The non-axisymmetric branches (the longest phase): each trace's max_points are expected ahead, so its bar
+    has a total and a time left while it runs; the budget a branch did not use is taken back when it ends, so the
+    total is then the points traced. Its name is the one the run's timing stores (Step.SURFACE_BRANCHES)."""
+    from balloon_cg.analysis.timing import Step
+
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    assert Phase.SURFACE.value == Step.SURFACE_BRANCHES.value == "non-axisymmetric branches"
+    with PhaseBars("spom1", ON_TERMINAL) as bars:
+        with bars.budget(Phase.SURFACE, 300) as tick:
+            for _ in range(5):
+                tick(None)
+            bar = bars.bars[Phase.SURFACE]
+            assert bar.total == 300 and bar.n == 5
+            assert re.search(r"non-axisymmetric branches:\s+0%\|.*\| 0/300 \[00:00<", terminal.getvalue())
+        assert bar.total == 5
+        with bars.budget(Phase.SURFACE, 300) as tick:
+            tick(None)
+        assert bar.total == bar.n == 6
+        bars.finish(Phase.SURFACE, 6)

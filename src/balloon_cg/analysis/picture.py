@@ -21,6 +21,7 @@ sphere (``surface_primary``) and the branches born at its pitchforks with their 
 in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -75,6 +76,23 @@ class Progress:
     def ticker(self, phase: Phase):
         """A per-point callable for the tracers."""
         return lambda point: self.tick(phase)
+
+    @contextmanager
+    def budget(self, phase: Phase, count: int):
+        """``ticker`` for a trace of at most ``count`` points (a branch's max_points): they are expected ahead, so
+        the phase shows a total and a time left (an upper bound: the branch may stop sooner), and the part not
+        used is taken back when the trace ends."""
+        done = [0]
+
+        def tick(point):
+            done[0] += 1
+            self.tick(phase)
+
+        self.expect(phase, count)
+        try:
+            yield tick
+        finally:
+            self.expect(phase, min(done[0] - count, 0))
 
 
 
@@ -320,12 +338,15 @@ def _switch_pitchfork(scene, primary, number: int, bp, broken: tuple, picture: P
     traced along −φ), the classification written back to the parent point; a start that fails is a branch not
     started."""
     name, budget = surface_pitchforks.branch_name(number), scene.surface.max_points
-    tick = progress.ticker(Phase.SURFACE)
+
+    def traced(sign: float):
+        with progress.budget(Phase.SURFACE, budget) as tick:
+            return surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, sign, tick)
+
     try:
-        branch = surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, progress=tick)
+        branch = traced(1.0)
         other = surface_pitchforks.mirror_image(branch, broken) or (
-            None if interrupt.requested() else  # a signal: the other direction is not started
-            surface_pitchforks.trace_pitchfork(primary, number, bp, broken, budget, -1.0, tick))
+            None if interrupt.requested() else traced(-1.0))  # a signal: the other direction is not started
     except surface_branches.SurfaceStartError as error:
         picture.not_started.append((name, str(error)))
         return
@@ -447,13 +468,16 @@ def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progres
     about the axis (``surface_branches.rotated``), for an even m (which that rotation maps to itself) traced along
     −φ. SurfaceStartError when it cannot start."""
     name = f"m{bp.m}_bp{k}"
-    branch = _with_events(surface_branches.trace_surface(primary, k, bp, 1.0, name, max_points,
-                                                         progress.ticker(Phase.SURFACE)))
+
+    def traced(sign: float, called: str):
+        with progress.budget(Phase.SURFACE, max_points) as tick:
+            return _with_events(surface_branches.trace_surface(primary, k, bp, sign, called, max_points, tick))
+
+    branch = traced(1.0, name)
     if interrupt.requested():  # the other direction is not started
         return [branch]
     other = (surface_branches.rotated(branch, f"{name}{ROTATED}") if bp.m % 2 else  # its UZ points turned with it
-             _with_events(surface_branches.trace_surface(primary, k, bp, -1.0, f"{name}{OPPOSITE}", max_points,
-                                                         progress.ticker(Phase.SURFACE))))
+             traced(-1.0, f"{name}{OPPOSITE}"))
     return [branch, other]
 
 

@@ -16,7 +16,7 @@ class Step(enum.StrEnum):
     BRANCH_POINTS = "branch points"  # m = 0: detected, located, classified
     PEAR_BRANCHES = "pear branches"  # traced (their stability is STABILITY's)
     CROSSINGS = "m >= 1 crossings"  # the branch points of the non-axisymmetric blocks, located
-    SURFACE_BRANCHES = "surface branches"  # the non-axisymmetric branches on the whole sphere, assessed
+    SURFACE_BRANCHES = "non-axisymmetric branches"  # on the whole sphere, assessed (as Phase.SURFACE names them)
     SNAP_THROUGHS = "snap-throughs"
     WRITING = "writing"  # the run file
 
