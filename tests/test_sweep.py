@@ -344,4 +344,13 @@ def test_a_loaded_sweep_is_a_table_of_members(analysed_sweep):
     assert table["complete"].all() and table["P_cr1"].is_monotonic_increasing  # 2.26473, 2.26480, 2.26487
     ds = sweep.to_xarray()
     assert ds.sizes["member"] == 3 and float(ds["P_cr1"][2]) == table.loc[2, "P_cr1"]
+    xr = pytest.importorskip("xarray")
+    with xr.open_dataset(analysed_sweep, engine="h5netcdf") as root:  # the file's root: the same table
+        assert root.sizes == {"member": 3} and list(root["member"].values) == [0, 1, 2]
+        assert "field.M" in root.coords and list(root["field.M"].values) == [0.0, 0.002, 0.004]
+        assert root["P_cr1"].dims == ("member",) and root["P_cr1"].attrs["units"] == "1"
+        for column in ("P_LP", "lam2_LP", "P_cr1", "P_cr2", "P_BP1", "P_BP2"):
+            np.testing.assert_array_equal(root[column].values, table[column].values)
+        assert list(root["block_BP1"].values) == list(table["block_BP1"]) and root["complete"].values.all()
+        assert float(root["P_cr1"].sel(member=2)) == table.loc[2, "P_cr1"]
     assert "\n" not in repr(sweep) and len(repr(sweep)) <= 160 and sweep._repr_html_().count("<tr") == 1 + 3

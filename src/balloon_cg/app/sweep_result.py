@@ -12,14 +12,10 @@ xarray (``to_xarray``).
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 
-from ..io.sweep_file import read_sweep
+from ..io.sweep_file import member_row, read_sweep
 from .api import BranchData
 from .tables import html_table, optional
-
-PEAR_BLOCK = "odd_held"  # the pear-shaped (m = 0, odd) instability of a held balloon
-
 
 @dataclass(frozen=True, repr=False)
 class SweepMember:
@@ -48,20 +44,10 @@ class SweepMember:
             return ds.load()
 
     def row(self) -> dict:
-        """This member's line of ``SweepResult.to_dataframe``."""
+        """This member's line of ``SweepResult.to_dataframe`` (``io.sweep_file.member_row``, as the file's root
+        table)."""
         primary = self.branches.get("primary")
-        special = primary.special_points if primary is not None else []
-        folds = [s for s in special if s["kind"] == "LP"]
-        branch_points = [s for s in special if s["kind"] == "BP"]
-        critical = sorted((s["pressure"] for s in branch_points if s["block"] == PEAR_BLOCK), reverse=True)
-        row = dict(self.overrides) | {"complete": self.complete,
-                                      "P_LP": folds[0]["pressure"] if folds else np.nan,
-                                      "lam2_LP": folds[0]["lam2_north"] if folds else np.nan}
-        row |= {f"P_cr{k}": critical[k - 1] if len(critical) >= k else np.nan for k in (1, 2)}
-        for k, s in enumerate(branch_points, 1):
-            row |= {f"P_BP{k}": s["pressure"], f"block_BP{k}": s["block"],
-                    f"classification_BP{k}": s["classification"], f"m_BP{k}": int(s["m"])}
-        return row
+        return member_row(self.overrides, self.complete, primary.special_points if primary is not None else [])
 
     def __repr__(self):
         state = "complete" if self.complete else "incomplete"

@@ -38,10 +38,10 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .hdf5 import atomic_file, copy_attrs, copy_tree, plain, provenance
+from .hdf5 import atomic_file, checksummed, copy_attrs, copy_tree, plain, provenance, write_strings
 from .output import store_path
 from .lock import remove_debris
-from .run_file import VERDICT_KINDS, read_branches, verdict_attrs, write_branches
+from .run_file import VERDICT_KINDS, read_branches, read_special, verdict_attrs, write_branches
 from .layout import FileError, carries_checksums, check_data, check_input, reading, require_attrs
 from .schema import FINITE
 
@@ -255,8 +255,10 @@ def _scene_diff(old: str, new: str) -> str:
 # --- the consolidated view ---------------------------------------------------------------------------------
 
 def consolidate(path, directory: Path) -> None:
-    """Rebuild the sweep file ``path`` from the store ``directory`` (atomically replacing it)."""
+    """Rebuild the sweep file ``path`` from the store ``directory`` (atomically replacing it): its members, and at
+    the root the table of what each found (``write_table``)."""
     path = Path(path)
+    rows = {}
     with _open(directory / MANIFEST) as manifest, atomic_file(path, force=True, keep_store=True) as f:
         copy_attrs(manifest, f)
         f.attrs["format"] = FORMAT
@@ -267,6 +269,75 @@ def consolidate(path, directory: Path) -> None:
             if match is not None:
                 with _open(item) as member:
                     copy_tree(member, group.create_group(str(int(match.group(1)))))
+                    rows[int(match.group(1))] = _stored_row(member, item)
+        write_table(f, rows, [key for key, _ in json.loads(plain(f.attrs["vary"]))])
+
+
+PEAR_BLOCK = "odd_held"  # the pear-shaped (m = 0, odd) instability of a held balloon
+
+
+def member_row(overrides: dict, complete: bool, special: list[dict]) -> dict:
+    """One member's line of the sweep table: the varied keys, ``complete``, the primary branch's first fold
+    (``P_LP``, ``lam2_LP``), the critical pressures of the pear-shaped instability (``P_cr1`` ≥ ``P_cr2``: the branch
+    points of the odd held block) and every branch point in stored order (``P_BP1``, ``block_BP1``,
+    ``classification_BP1``, ``m_BP1``, …), from its primary branch's ``special`` points (read_special dicts)."""
+    folds = [s for s in special if s["kind"] == "LP"]
+    branch_points = [s for s in special if s["kind"] == "BP"]
+    critical = sorted((s["pressure"] for s in branch_points if s["block"] == PEAR_BLOCK), reverse=True)
+    row = dict(overrides) | {"complete": bool(complete), "P_LP": folds[0]["pressure"] if folds else np.nan,
+                             "lam2_LP": folds[0]["lam2_north"] if folds else np.nan}
+    row |= {f"P_cr{k}": critical[k - 1] if len(critical) >= k else np.nan for k in (1, 2)}
+    for k, s in enumerate(branch_points, 1):
+        row |= {f"P_BP{k}": s["pressure"], f"block_BP{k}": s["block"],
+                f"classification_BP{k}": s["classification"], f"m_BP{k}": int(s["m"])}
+    return row
+
+
+def _stored_row(member, where) -> dict:
+    """``member_row`` of a member file (or group) as written by Store.write_member."""
+    require_attrs(member.attrs, where, MEMBER_KEYS, error=SweepFileError)
+    special = member.get("branches/primary/special_points")
+    return member_row(json.loads(plain(member.attrs["overrides"])), bool(member.attrs.get("complete", False)),
+                      read_special(special) if special is not None else [])
+
+
+#: the table's columns: (units, long_name) of the quantities; the branch point columns per k
+TABLE_COLUMNS = {"complete": ("", "member complete (analysis.verdict)"),
+                 "P_LP": ("1", "pressure P at the first fold (LP) of the primary branch"),
+                 "lam2_LP": ("1", "λ2(0) at the first fold (LP) of the primary branch"),
+                 "P_cr": ("1", "critical pressure of the pear-shaped instability (odd held branch point)"),
+                 "P_BP": ("1", "pressure P at the branch point of the primary branch"),
+                 "block_BP": ("", "stability block of the branch point"),
+                 "classification_BP": ("", "classification of the branch point"),
+                 "m_BP": ("", "azimuthal wave number of the branch point (−1: none)")}
+
+
+def write_table(f, rows: dict, keys: list) -> None:
+    """The sweep's table at the root of the view ``f``: dimension ``member`` (the stored members' indices), each
+    varied key a coordinate along it (CF ``coordinates`` of every column: xarray opens the root as one Dataset,
+    a row per member), and the columns of ``member_row`` (missing: NaN, "" or −1)."""
+    member = checksummed(f, "member", np.array(sorted(rows), dtype=np.int64))
+    member.make_scale("member")
+    member.attrs.update({"long_name": "member index", "description": "the member's index in the sweep (/members)"})
+    ordered = [rows[i] for i in sorted(rows)]
+    for name in dict.fromkeys(name for row in ordered for name in row):
+        values = [row.get(name) for row in ordered]
+        present = [v for v in values if v is not None]
+        if all(isinstance(v, str) for v in present):
+            write_strings(f, name, ["" if v is None else v for v in values])
+        elif all(isinstance(v, (bool, np.bool_)) for v in present):
+            checksummed(f, name, np.array([bool(v) for v in values], dtype=np.int8))
+        elif name.startswith("m_BP"):
+            checksummed(f, name, np.array([-1 if v is None else v for v in values], dtype=np.int64))
+        else:
+            checksummed(f, name, np.array([np.nan if v is None else v for v in values], dtype=float))
+        dataset = f[name]
+        dataset.dims[0].attach_scale(member)
+        units, long_name = TABLE_COLUMNS.get(re.sub(r"\d+$", "", name), ("", f"varied scene key {name}"))
+        dataset.attrs.update({"long_name": long_name, "description": f"{long_name}, per member (docs/hdf5.md)"}
+                             | ({"units": units} if units else {}))
+        if name not in keys:
+            dataset.attrs["coordinates"] = " ".join(keys)
 
 
 def commit_replacement(path) -> None:
