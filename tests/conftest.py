@@ -14,6 +14,8 @@ threads each on two cores spend their time waiting for one another).
 """
 import os
 
+import pytest
+
 ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 COST = {  # seconds of each file in a serial --durations=0 run on a loaded 2-core machine (issue 37); the files whose
@@ -27,7 +29,7 @@ COST = {  # seconds of each file in a serial --durations=0 run on a loaded 2-cor
     "test_azimuthal_points": 17, "test_api": 17, "test_dielectric": 16, "test_energies": 15, "test_quadrature": 15,
     "test_branch_points": 13, "test_fold_meeting": 13, "test_terms": 12, "test_formula_bounds": 11,
     "test_api_notebook": 11, "test_pear_points": 10, "test_free_pitchfork": 10, "test_sweep_store": 9,
-    "test_fold_curve": 8,
+    "test_fold_curve": 8, "test_plot_sizes": 40, "test_parameter_names": 15,
 }
 
 
@@ -52,3 +54,20 @@ def pytest_collection_modifyitems(config, items):
         files.setdefault(module_of(item), []).append(item)
     order = sorted(files, key=lambda module: -COST.get(module, 0))  # stable: uncosted files keep collection order
     items[:] = [item for module in order for item in files[module]]
+
+
+@pytest.fixture
+def drawn_texts(monkeypatch):
+    """Every matplotlib Text drawn while the test runs (tick labels of ticks outside the view are never drawn): the
+    fit tests of figures (test_paper, test_plot_sizes)."""
+    import matplotlib.text
+
+    drawn = []
+    draw = matplotlib.text.Text.draw
+
+    def recording(text, renderer):
+        drawn.append(text)
+        return draw(text, renderer)
+
+    monkeypatch.setattr(matplotlib.text.Text, "draw", recording)
+    return drawn

@@ -31,7 +31,7 @@ def test_labels_at_one_column_do_not_overlap_or_cross_curves(two_coils):
         fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     labels = [t for t in ax.texts if t.get_gid() == GID]
-    assert {"LP", "TP", "EP", "pitchfork-super", "BP m=1"} <= {t.get_text() for t in labels}
+    assert {"LP", "TP", "EP", "pitchfork-super", "BP m=1"} <= {t.get_text().partition(" ")[2] for t in labels}
     boxes = [t.get_window_extent(renderer) for t in labels]
     frame = ax.get_window_extent(renderer)
     for i, box in enumerate(boxes):
@@ -45,3 +45,39 @@ def test_labels_at_one_column_do_not_overlap_or_cross_curves(two_coils):
         for label, box in zip(labels, boxes):
             inside = ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1) & (xy[:, 1] > box.y0) & (xy[:, 1] < box.y1))
             assert not inside.any(), f"{label.get_text()!r} crosses a curve"
+
+
+def test_every_marker_is_numbered_with_a_label_continue_takes(two_coils, tmp_path, capsys):
+    """The acceptance test of issue 40: in the two-coil figure every special-point label starts with numbers that
+    are labels of the file (what `inspect` lists and `continue` takes: each restarts), every marked point's label
+    is drawn unless textalloc found no room, and the legend names each pear branch by its parent's label."""
+    import re
+
+    from balloon_cg.app.cli import main
+    from balloon_cg.app.restart import find_label
+    from balloon_cg.io.run_file import read_run
+
+    path = tmp_path / "two_coils.h5"
+    two_coils.save(path)
+    run = read_run(path)
+    labels = {s["label"]: s for b in run["branches"].values() for s in b["special_points"]}
+    assert main(["inspect", str(path)]) == 0
+    listed = capsys.readouterr().out
+    fig = bc.plot(path, "pressure-pole")
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts if t.get_gid() == GID]
+    numbered = [re.fullmatch(r"(\d+(?:,\d+)*) (.+)", text) for text in texts]
+    assert texts and all(numbered)
+    for match in numbered:
+        for number in map(int, match[1].split(",")):
+            point = labels[number]
+            assert match[2] == (point["classification"] or point["kind"]) + (f" m={point['m']}" if point["m"] else "")
+            assert re.search(rf"^\s+{number} {point['kind']}\b", listed, re.M)  # inspect lists it
+    assert len({n for m in numbered for n in m[1].split(",")}) >= 0.8 * len(labels)
+    legend = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    pears = [text for text in legend if "pear" in text]
+    assert pears and all(re.search(r"pear from (\d+)", text) for text in pears)
+    for text in pears:
+        parent = labels[int(re.search(r"pear from (\d+)", text)[1])]
+        assert parent["kind"] == "BP" and parent["block"] in ("odd_held", "odd_free")
+    for number in labels:  # continue finds each (restarting from them: tests/test_restart.py)
+        assert find_label(run, number).point.kind.value == labels[number]["kind"]

@@ -60,6 +60,7 @@ def bifurcation_file(files, tmp_path_factory):
         for name in [b for b in f["branches"] if b != "primary"]:
             del f["branches"][name]
         f.copy(group, "branches/pear_0")
+        f["branches/pear_0"].attrs.update({"parent_branch": "primary", "parent_branch_point": 0})
     return path
 
 
@@ -122,7 +123,7 @@ def test_several_files_are_labelled_by_M(files):
     legend = fig.legends[0]
     assert [t.get_text() for t in legend.get_texts()] == ["M = 0", "M = 0.002"]
     assert "dashed: unstable" in legend.get_title().get_text()  # the default run assesses stability
-    assert {t.get_text() for t in fig.axes[0].texts} >= {"EP"}  # special points labelled with their kind
+    assert {t.get_text() for t in fig.axes[0].texts} >= {"1 EP", "2 EP"}  # special points: label and kind
     shapes = plot(list(files.values()), "shapes", points=[-1])
     assert any(text.startswith("M = 0.002: #") for text in legend_texts(shapes))
 
@@ -133,8 +134,8 @@ def test_stability_and_special_points(bifurcation_file):
     assert "dashed: unstable" in fig.legends[0].get_title().get_text()
     styles = {line.get_linestyle() for line in ax.get_lines() if len(line.get_xdata()) > 1}
     assert {"-", "--"} <= styles
-    assert "pitchfork-super" in {t.get_text() for t in ax.texts}
-    assert legend_texts(fig) == ["M = 0.002, primary", "M = 0.002, pear (BP 0)"]  # never the stored name
+    assert "2 pitchfork-super" in {t.get_text() for t in ax.texts}  # its label in the file, and what it is
+    assert legend_texts(fig) == ["M = 0.002, primary", "M = 0.002, pear from 2"]  # never the stored name
     assert legend_texts(plot([bifurcation_file], "pressure-pole", branch="pear_0")) == ["M = 0.002"]
 
 
@@ -186,7 +187,10 @@ def test_plot_and_bc_plot_draw_in_the_journal_style(files, tmp_path, capsys):
     ax = Figure().add_subplot()
     bc_plot(files["spom1"], "pressure-pole", ax=ax)
     assert ax.title.get_fontsize() == 8 and ax.get_legend().get_texts()[0].get_fontsize() == 6.5  # the Axes' own
-    # tick and axis-label sizes are the caller's (set when the Axes was made)
+    # tick and axis-label sizes are the caller's (set when the Axes was made), their family the journal's: one family
+    families = {tuple(t.get_fontfamily()) for t in [ax.xaxis.label, ax.yaxis.label, *ax.get_xticklabels(),
+                                                   *ax.get_yticklabels(), *ax.texts, *ax.get_legend().get_texts()]}
+    assert families == {("serif",)}, families
     pdf = tmp_path / "p.pdf"
     fig.savefig(pdf)
     assert b"/Type3" not in pdf.read_bytes() and b"/FontFile2" in pdf.read_bytes()

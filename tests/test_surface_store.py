@@ -143,7 +143,7 @@ def test_a_rotated_image_shares_its_partners_entry(tmp_path, scene, primary, sur
     assert (attrs["origin"], attrs["reflection_of"]) == ("reflected", "m1_bp0")
     fig = plot([path], "pressure-pole")
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert labels.count("m = 1 (parent BP 0)") == 1 and len(labels) == 2
+    assert labels.count("m = 1") == 1 and len(labels) == 2  # its parent point is not in this file: no label
     colours = {line.get_color() for line in fig.axes[0].lines if len(line.get_xdata()) > 1}
     assert len(colours) == 2  # the primary branch's and the pair's
     assert main(["inspect", str(path)]) == 0
@@ -166,7 +166,7 @@ def test_files_without_m_read_as_axisymmetric(run_path, tmp_path):
 def test_inspect_text_and_json(run_path, capsys):
     assert main(["inspect", str(run_path)]) == 0
     text = capsys.readouterr().out
-    assert "surface branch m1_bp0   (m = 1, from primary branch point 0" in text
+    assert "surface branch m1_bp0   (m = 1, from primary branch point 0" in text  # a parent point not in the file
     assert "stop reason          forward: the north pole stretch reached 1.5" in text
     assert main(["inspect", str(run_path), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
@@ -185,14 +185,15 @@ def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
     axes = fig.axes
     if kind == "pressure-pole":
         legend = {t.get_text(): h for t, h in zip(fig.legends[0].get_texts(), fig.legends[0].legend_handles)}
-        assert "m = 1 (parent BP 0)" in legend and not any("m1_bp0" in label for label in legend)
-        color = legend["m = 1 (parent BP 0)"].get_color()
+        name = "m = 1"  # by its mode (its parent point, with the label it would be named by, is not in the file)
+        assert name in legend and not any("m1_bp0" in label for label in legend)
+        color = legend[name].get_color()
         drawn = [line.get_xdata() for line in axes[0].lines if line.get_color() == color
                  and len(line.get_xdata()) > 1 and line.get_gid() != GID]  # not the labels' leader lines
         assert np.allclose(np.unique(np.concatenate(drawn).round(12)), STRETCHES)  # P against lam2_north
     elif kind == "energy":  # the normal form at the branch point the surface branch is born at
-        labels = [t.get_text() for t in axes[0].get_legend().get_texts()]
-        assert len(labels) == 1 and labels[0].startswith("m = 1 (parent BP 0): pitchfork-sub m=1 at P = ")
+        labels = [t.get_text() for t in fig.legends[0].get_texts()]  # under the panel, not over the curves
+        assert len(labels) == 1 and labels[0].startswith("m = 1: pitchfork-sub m=1 at P = ")
     elif kind == "surface":
         assert axes[0].name == "3d" and len(axes) == 2  # the surface and its section by y = 0
         assert any(isinstance(c, Poly3DCollection) for c in axes[0].collections)

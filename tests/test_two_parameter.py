@@ -187,9 +187,10 @@ def test_phase_diagram_plot(curve, tmp_path):
     assert len(shaded.get_xy()) >= 400 > len(read_curve(path)["q"])
     fig.savefig(tmp_path / "phase.png")
     assert (tmp_path / "phase.png").stat().st_size > 1000
-    for kind in ("pressure-pole", "shapes", "energy", None):  # a curve file has no branches: no empty figure
+    for kind in ("pressure-pole", "shapes", "energy"):  # a curve file has no branches: no empty figure
         with pytest.raises(PlotError, match="no branches to draw .* its kind is phase"):
             plot([path], kind)
+    assert "alpha_1" in plot([path], None).axes[0].get_xlabel()  # no kind: a curve file's, phase
 
 
 def test_smooth_curve_follows_a_sparse_arc():

@@ -20,6 +20,7 @@ import numpy as np
 from ..analysis.picture import Phase
 from ..io.hdf5 import atomic_bytes, command_line
 from ..io.layout import file_kind
+from ..io.parents import parent_label
 from ..io.run_file import RunFileError, read_run, read_run_image, run_image
 from ..numerics.interrupt import stop_on_signals
 from ..scene import Scene, SceneError, load_scene, parse_scene
@@ -44,6 +45,7 @@ class BranchData:
 
     name: str
     data: dict
+    born_at: int | None = None  # the label of the point it leaves from (io.parents; None: the primary branch)
 
     def __getitem__(self, key: str):
         return self.data[key]
@@ -112,14 +114,15 @@ class BranchData:
         Returns
         -------
         dict
-            branch, m, points, P min, P max, λ2(0) min, λ2(0) max, the kinds of its special points, its parent.
+            branch, m, points, P min, P max, λ2(0) min, λ2(0) max, the kinds of its special points, its parent
+            branch and the label of the point it leaves from.
         """
         P, north = self.data["pressure"], self.data["lam2_north"]
         parent = self.parent
         return {"branch": self.name, "m": self.m, "points": len(self), "P min": P.min(), "P max": P.max(),
                 "λ2(0) min": north.min(), "λ2(0) max": north.max(),
                 "special points": " ".join(s["kind"] for s in self.data["special_points"]),
-                "parent": f"{parent[0]} BP {parent[1]}" if parent else ""}
+                "parent": f"{parent[0]}, from label {self.born_at}" if self.born_at is not None else ""}
 
     def __repr__(self):
         P, north, special = self.data["pressure"], self.data["lam2_north"], len(self.data["special_points"])
@@ -161,7 +164,8 @@ class Result:
     @property
     def branches(self) -> dict[str, BranchData]:
         """The stored branches by name, the primary branch first."""
-        return {name: BranchData(name, data) for name, data in self.run["branches"].items()}
+        return {name: BranchData(name, data, parent_label(self.run, name))
+                for name, data in self.run["branches"].items()}
 
     @property
     def special_points(self) -> SpecialPoints:
@@ -485,7 +489,7 @@ def load(path):
 
 
 def plot(source, what: str | None = None, ax=None, points=None, branch: str | None = None,
-         stability: str | None = None):
+         stability: str | None = None, width: float | None = None):
     """A figure from Results or run files, in the journal style.
 
     Parameters
@@ -504,6 +508,9 @@ def plot(source, what: str | None = None, ax=None, points=None, branch: str | No
     stability : str, optional
         The reading that draws curves solid (stable) or dashed (post.plotting.Reading); None: each run's
         loading control.
+    width : float, optional
+        A new figure's width in inches (3.5 one journal column, 7.2 two): laid out at it, its legend under the
+        panels, its titles and labels fitted (not with ``ax``: your figure has its size).
 
     Returns
     -------
@@ -516,13 +523,13 @@ def plot(source, what: str | None = None, ax=None, points=None, branch: str | No
 
     Examples
     --------
-    >>> fig = bc.plot(result, "pressure-pole")
+    >>> fig = bc.plot(result, "pressure-pole", width=3.5)
     >>> fig.savefig("pressure-pole.pdf")
     """
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]
-    return draw([_drawable(s) for s in sources], what, points, branch, axes=ax, stability=stability)
+    return draw([_drawable(s) for s in sources], what, points, branch, axes=ax, stability=stability, width=width)
 
 
 def _drawable(source):

@@ -486,6 +486,11 @@ def _add_plot(commands):
                    help="what solid (stable) and dashed (unstable) mean: pressure (held at the centre, pressure "
                         "control), volume, gas, free, free-volume, free-gas, or axisymmetric (the paper's: m = 0 "
                         "modes only); default: the run's loading.control, held")
+    p.add_argument("--width", type=float, metavar="INCHES",
+                   help="figure width in inches, its height in proportion (a journal's: 3.5 one column, "
+                        "7.2 two; default: each kind's own, 6.4 to 12); titles and legends fitted to it")
+    p.add_argument("--dpi", type=int, metavar="N", help="resolution of PNG, JPEG and TIFF images (default: the "
+                                                        "journal style's 300)")
     p.set_defaults(handler=plot)
 
 
@@ -531,9 +536,9 @@ def plot(args) -> int:
     runs = [as_run(f) for f in args.files] if any(kind != "phase" for kind in args.what) else []
     for kind, output in outputs.items():
         figure = draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
-                      stability=args.stability)
+                      stability=args.stability, width=args.width)
         with replacing(output, args.force) as tmp:
-            figure.savefig(tmp, dpi=150, format=output.suffix.lower()[1:])
+            figure.savefig(tmp, format=output.suffix.lower()[1:], **({} if args.dpi is None else {"dpi": args.dpi}))
         print(output)
     return 0
 

@@ -13,12 +13,11 @@ from pathlib import Path
 from ..io.output import IMAGE_FORMATS, check_output, replacing
 from ..io.run_file import read_run
 from ..post.paper import TWO_COLUMNS, draw_figure, figures
-from ..post.plotting import Reading
+from ..post.plotting import MAX_WIDTH, MIN_WIDTH, Reading
 from ..scene import parse_scene
 from .api import analyse
 from .progress import shown
 
-MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (docs/cli.md)
 ALL_FOLDER = "paper-figures"  # figure all's default output folder (the Makefile's PAPER_OUT)
 
 

@@ -3,6 +3,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.parents import parent_label
+
 
 def summarise_file(path) -> tuple[dict, str]:
     """(JSON-ready summary, readable text) of a run, sweep or curve file, told apart by their format and
@@ -103,7 +105,8 @@ def summarise_run(run: dict) -> dict:
         "scene_name": run["scene_name"],
         "provenance": run["attrs"],
         "run_time": run_time(run["attrs"]),
-        "branches": {name: summarise_branch(b) for name, b in run["branches"].items()},
+        "branches": {name: summarise_branch(b) | {"parent_label": parent_label(run, name)}
+                     for name, b in run["branches"].items()},
         "snap_throughs": run.get("snap_throughs", []),
     }
 
@@ -277,7 +280,7 @@ def _reflections(symmetry, characters) -> str:
 
 def _format_surface_branch(name: str, b: dict) -> list[str]:
     born = "traced on the whole sphere from the start" if b["parent"] is None else \
-        f"m = {b['m']}, from {b['parent'][0]} branch point {b['parent'][1]}"
+        f"m = {b['m']}, from {_parent_point(b)}"
     return [
         f"surface branch {name}   ({born}; {b['kernel_class']}, degree "
         f"{b['surface_degree']}, reflections {_reflections(b['symmetry'], b['characters'])}, nodes "
@@ -303,11 +306,20 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
     ]
 
 
+def _parent_point(b: dict) -> str:
+    """Where a branch leaves its parent: 'label 3 on primary' (the label inspect lists and continue takes), or
+    'primary branch point 0' when that point is not in the file."""
+    if b["parent_label"] is None:
+        return f"{b['parent'][0]} branch point {b['parent'][1]}"
+    return f"label {b['parent_label']} on {b['parent'][0]}"
+
+
 def _format_branch(name: str, b: dict) -> list[str]:
     if "surface_degree" in b:
         return _format_surface_branch(name, b)
+    born = "" if b["parent"] is None else f"from {_parent_point(b)}; "
     lines = [
-        f"branch {name}   ({b['kernel_class']}, degree {b['degree']}, "
+        f"branch {name}   ({born}{b['kernel_class']}, degree {b['degree']}, "
         f"{'equator-symmetric' if b['symmetric'] else 'no symmetry'}, {READINGS.get(b['gauge'], b['gauge'])}, M = {b['M']:g}, "
         f"chi = {b['chi']:g})",
         *([f"  basis map            centres cos θ = {', '.join(f'{c:.4g}' for c in b['basis_map']['centres'])}, widths "

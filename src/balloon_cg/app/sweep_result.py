@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 
+from ..io.parents import parent_label
 from ..io.sweep_file import member_row, read_sweep
 from .api import BranchData
 from .tables import html_table, optional
@@ -75,7 +76,7 @@ class SweepResult:
     def read(cls, path) -> "SweepResult":
         sweep = read_sweep(path)
         members = {index: SweepMember(index, m["overrides"], m["attrs"],
-                                      {name: BranchData(name, data) for name, data in m["branches"].items()},
+                                      {name: BranchData(name, data, parent_label(m, name)) for name, data in m["branches"].items()},
                                       str(path))
                    for index, m in sweep["members"].items()}
         return cls(str(path), sweep["attrs"], members)

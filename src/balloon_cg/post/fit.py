@@ -7,17 +7,20 @@ import textwrap
 
 from matplotlib.text import Text
 
+from .labels import relabel
+
 MIN_CHARS = 12  # the narrowest wrap tried, characters per line
 
 
-def wrap_to(text: Text, width: float) -> None:
+def wrap_to(text: Text, width: float, along: str = "width") -> None:
     """Wrap ``text`` at spaces (each of its lines; none inside $…$ math) until it is at most ``width`` display
-    units wide, or its lines are MIN_CHARS characters."""
+    units long ``along`` its extent's width (or height: a rotated y label), or its lines are MIN_CHARS characters."""
     renderer = text.figure.canvas.get_renderer()
     original = text.get_text()
     chars = max(map(len, original.splitlines()), default=0)
-    while text.get_window_extent(renderer).width > width and chars > MIN_CHARS:
-        chars = max(MIN_CHARS, min(chars - 1, int(chars * width / text.get_window_extent(renderer).width)))
+    while getattr(text.get_window_extent(renderer), along) > width and chars > MIN_CHARS:
+        length = getattr(text.get_window_extent(renderer), along)
+        chars = max(MIN_CHARS, min(chars - 1, int(chars * width / length)))
         text.set_text("\n".join(textwrap.fill(line, chars, break_long_words=False)
                                 for line in original.splitlines()))
 
@@ -67,3 +70,35 @@ def fitted_legend(fig, handles, labels, ncols: int, **options):
 
 
 MIN_LABEL_SHARE = 0.5  # a legend label is wrapped to no less than this share of the widest before a column goes
+
+
+NARROW = 5.0  # inches: below this width a figure is at least NARROW_ASPECT times as tall as wide
+NARROW_ASPECT = 0.8
+
+
+def fitted_size(figsize, width: float) -> tuple:
+    """(width, height) of a figure drawn at ``figsize``: its height in proportion, at least NARROW_ASPECT of the
+    width below NARROW inches."""
+    w, h = figsize
+    return width, max(h * width / w, NARROW_ASPECT * width if width < NARROW else 0.0)
+
+
+def fit_width(fig, width: float) -> None:
+    """Make a figure drawn at its own size ``width`` inches wide, its height in proportion (at least NARROW_ASPECT
+    of the width below NARROW inches: room for the legend), each figure legend moved under the panels in as many
+    columns as fit (``fitted_legend``), the axis labels wrapped to their panels and the titles to their room
+    (``fit_titles``), the special points labelled again at that size (``labels.relabel``)."""
+    fig.set_size_inches(*fitted_size(fig.get_size_inches(), width))
+    for legend in list(fig.legends):
+        handles, labels = legend.legend_handles, [t.get_text() for t in legend.get_texts()]
+        title = legend.get_title().get_text()
+        legend.remove()
+        fitted_legend(fig, handles, labels, len(labels), loc="outside lower center", title=title or None)
+    fig.draw_without_rendering()
+    for ax in fig.axes:  # axis labels to their panel's size
+        box = ax.get_window_extent()
+        wrap_to(ax.xaxis.label, box.width)
+        wrap_to(ax.yaxis.label, box.height, along="height")
+    fit_titles(fig)
+    relabel(fig)
+

@@ -1,11 +1,14 @@
-"""Labels of the special points of branch curves (LP, TP, EP, BP m=1, pitchfork-super, …), placed by textalloc
-(a maintained library: a greedy search over candidate positions around each point) clear of one another, of every
-curve drawn in the Axes and of the markers; a label away from its marker gets a thin leader line. Labels of
-coincident points that read the same are one label. Every label and leader carries the gid ``GID`` (the paper's
-figures remove them: their key is in the legend).
+"""Labels of the special points of branch curves, AUTO style: each point's label in the file (what ``continue``
+takes and ``inspect`` lists) and what it is ("3 LP", "5 pitchfork-super", "7 BP m=1"), placed by textalloc (a
+maintained library: a greedy search over candidate positions around each point) clear of one another, of every
+curve drawn in the Axes and of the markers; a label away from its marker gets a thin leader line. Coincident
+points of one kind share a label ("7,9 EP": a pear branch's end and its mirror image's). Every label and leader
+carries the gid ``GID``; the paper's figures draw none (``unlabelled``: their key is in the legend).
 """
 import contextlib
+import contextvars
 import io
+import weakref
 
 import textalloc
 
@@ -15,34 +18,71 @@ SAME_PLACE = 1.0  # display units: coincident points
 
 
 def label_points(marks) -> None:
-    """Label the marked points ``marks`` (Axes, text, x, y, colour): call after every curve is drawn."""
+    """Label the marked points ``marks`` (Axes, label number, kind text, x, y, colour): call after every curve is
+    drawn; nothing inside ``unlabelled``."""
+    if not LABELLED.get():
+        return
     by_axes = {}
-    for ax, text, x, y, color in marks:
-        by_axes.setdefault(ax, []).append((text, x, y, color))
+    for ax, number, kind, x, y, color in marks:
+        by_axes.setdefault(ax, []).append((number, kind, x, y, color))
     for ax, points in by_axes.items():
         ax.margins(x=0.06)
         ax.autoscale_view()
+        PLACED[ax] = points
         _allocate(ax, _kinds_first(_distinct(ax, points)))
 
 
+LABELLED = contextvars.ContextVar("labelled", default=True)
+
+
+@contextlib.contextmanager
+def unlabelled():
+    """Draw the special points' markers only, without their labels (the paper's figures: the markers' key is in
+    the legend); placing labels lays a figure out, which a half-drawn panel grid cannot be at a journal column."""
+    token = LABELLED.set(False)
+    try:
+        yield
+    finally:
+        LABELLED.reset(token)
+
+
+PLACED = weakref.WeakKeyDictionary()  # Axes -> the points labelled in it (``relabel``)
+
+
+def relabel(fig) -> None:
+    """Place the labels of every Axes of ``fig`` again (after its size or layout changed: the labels were placed
+    clear of one another and of the curves in display units), laid out first."""
+    fig.draw_without_rendering()
+    for ax in fig.axes:
+        if ax in PLACED:
+            for artist in [*ax.texts, *ax.lines]:
+                if artist.get_gid() == GID:
+                    artist.remove()
+            _allocate(ax, _kinds_first(_distinct(ax, PLACED[ax])))
+
+
 def _distinct(ax, points) -> list:
-    """``points`` without repeats: the same text within SAME_PLACE of a point kept already."""
+    """(text, kind, x, y, colour) of ``points``, coincident points of one kind (within SAME_PLACE) one label with
+    their numbers ("7,9 EP")."""
     kept = []
-    for text, x, y, color in points:
+    for number, kind, x, y, color in points:
         here = ax.transData.transform((x, y))
-        if not any(t == text and abs(ax.transData.transform((u, v)) - here).max() < SAME_PLACE
-                   for t, u, v, _ in kept):
-            kept.append((text, x, y, color))
-    return kept
+        same = next((k for k in kept if k[1] == kind and abs(ax.transData.transform(k[2:4]) - here).max()
+                     < SAME_PLACE), None)
+        if same is None:
+            kept.append([[number], kind, x, y, color])
+        elif number not in same[0]:
+            same[0].append(number)
+    return [(f"{','.join(map(str, numbers))} {kind}", kind, x, y, color) for numbers, kind, x, y, color in kept]
 
 
 def _kinds_first(points) -> list:
-    """``points`` with the first of each text before any repeat: textalloc places labels greedily in order, so a
-    crowded plot drops repeats (a second "BP m=1") rather than a kind (the only "TP")."""
+    """(text, x, y, colour) of ``points`` with the first of each kind before any repeat: textalloc places labels
+    greedily in order, so a crowded plot drops repeats (a second "BP m=1") rather than a kind (the only "TP")."""
     repeat = []
-    for i, (text, *_) in enumerate(points):
-        repeat.append(sum(other == text for other, *_ in points[:i]))
-    return [point for _, point in sorted(zip(repeat, points), key=lambda pair: pair[0])]
+    for i, (_, kind, *_) in enumerate(points):
+        repeat.append(sum(other == kind for _, other, *_ in points[:i]))
+    return [(text, x, y, color) for _, (text, _, x, y, color) in sorted(zip(repeat, points), key=lambda p: p[0])]
 
 
 def _allocate(ax, points) -> None:

@@ -81,7 +81,6 @@ def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
     """Replace the legends drawn inside ``axes`` by one legend below the figure (entries deduplicated by
     label; the title of the first; at most ``ncols`` columns, as many as fit: ``fit.fitted_legend``), with the
     key of the special-point markers (``markers``)."""
-    markers_only(axes)
     handles, title = {}, None
     for ax in axes:
         legend = ax.get_legend()
@@ -94,14 +93,6 @@ def shared_legend(fig, axes, ncols: int = 4, markers: bool = True):
     handles |= {h.get_label(): h for h in MARKER_KEY} if markers else {}
     fitted_legend(fig, list(handles.values()), list(handles), min(ncols, len(handles)), title=title,
                   loc="outside lower center")
-
-
-def markers_only(axes):
-    """Remove the kind labels of the special points and their leaders (their markers stay; the key is in the
-    legend)."""
-    for ax in axes:
-        for artist in ax.findobj(lambda a: a.get_gid() == labels.GID and a is not ax):
-            artist.remove()
 
 
 MARKER_KEY = [Line2D([], [], linestyle="none", marker=m, markerfacecolor="0.7", markeredgecolor="k",
@@ -470,7 +461,7 @@ def draw_figure(figure: PaperFigure, runs: list[dict], width: float = TWO_COLUMN
     journal style (``style``)."""
     height = figure.height * width * (COMPACT_HEIGHT if width < COMPACT_WIDTH else 1.0)
     fig = JournalFigure(figsize=(width, height), layout="constrained")
-    with journal_style():
+    with journal_style(), labels.unlabelled():  # markers only: their key is in the legend
         figure.draw(runs, fig, Reading(reading))
     if width < COMPACT_WIDTH:
         compact(fig)

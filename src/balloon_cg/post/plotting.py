@@ -15,29 +15,34 @@ thinner and lighter. Branch curves are solid where stable and dashed where unsta
 ``Reading`` (default: the run's loading control, balloon held at its centre), named in the legend title; without
 stability data all solid, and the legend title says so. Titles name the material and the coils. Special points
 are marked and labelled with their kind (LP, TP, EP, branch points, …). Surface branches (m ≥ 1, states on the
-whole sphere) are drawn by the pole curves and the energy landscape, labelled 'm = 1 (parent BP k)', and left
+whole sphere) are drawn by the pole curves and the energy landscape, labelled 'm = 1 from 5' (their parent point's label), and left
 out of the other branch and per-point kinds; ``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
 The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest (``robust_limits``).
 Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2,
 field in I/(4π R0).
 """
+import contextvars
 import enum
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
+import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 from scipy.interpolate import PchipInterpolator
 
 from .quantities import branch_discretisation, postprocess, stored_scene, surface
+from .fit import NARROW, fit_width, fitted_size
 from .labels import label_points
 from .style import JournalFigure, journal_style
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, file_kind, reading
+from ..io.parents import parent_label
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
 from ..model.meridian import reference_height
@@ -210,13 +215,17 @@ class StoredBranch:
 
     @property
     def surface_name(self) -> str:
-        """The legend name of a surface branch: 'm = 1 (parent BP 2)' (its parent's name when not primary), 'whole
-        sphere' for the primary branch of a field that is not axisymmetric."""
-        attrs = self.data["attrs"]
-        if not attrs["parent_branch"]:
+        """The legend name of a surface branch: 'm = 1 from 5' (the label of its parent point), 'whole sphere' for
+        the primary branch of a field that is not axisymmetric."""
+        if not self.data["attrs"]["parent_branch"]:
             return "whole sphere"
-        parent = "parent" if attrs["parent_branch"] == "primary" else f"parent {attrs['parent_branch']}"
-        return f"m = {self.m} ({parent} BP {int(attrs['parent_branch_point'])})"
+        return f"m = {self.m} {self.born}".rstrip()
+
+    @property
+    def born(self) -> str:
+        """'from 5': the label of the point the branch leaves from (``io.parents``), '' for the primary branch."""
+        label = parent_label(self.run, self.name)
+        return "" if label is None else f"from {label}"
 
     @property
     def ordinate(self) -> Ordinate:
@@ -290,20 +299,20 @@ def load_branches(source, branch: str | None = None, reading: Reading | None = N
     return loaded
 
 
-def branch_title(name: str) -> str:
-    """A stored branch's name as legends show it: 'pear_2' → 'pear (BP 2)', 'pear_2_mirror' → 'pear (BP 2),
-    mirror image' (analysis.picture's names: the pear branch from branch point 2 and its mirror image), any other
-    name with spaces for underscores."""
-    pear = re.fullmatch(r"pear_(\d+)(_mirror)?", name)
-    if pear:
-        return f"pear (BP {pear[1]})" + ", mirror image" * bool(pear[2])
-    return name.replace("_", " ")
+def branch_title(branch: "StoredBranch") -> str:
+    """A stored branch's name as legends show it, by the label of the point it leaves from (``io.parents``):
+    'pear_2' → 'pear from 3', 'pear_2_mirror' → 'pear from 3, mirror image', 'pear_free_4' → 'free pear from 6'
+    (analysis.picture's names), any other name with spaces for underscores."""
+    pear = re.fullmatch(r"pear(_free)?_\d+(_mirror)?", branch.name)
+    if pear and branch.born:
+        return f"{'free ' * bool(pear[1])}pear {branch.born}" + ", mirror image" * bool(pear[2])
+    return branch.name.replace("_", " ")
 
 
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     """Set each branch's legend label and colour. One file: a colour per branch (a mirror image, or a surface
     branch's rotation by π, sharing its partner's), labelled 'M = …, <branch title>' (``branch_title``) when
-    there are several, a surface branch 'm = 1 (parent BP k)'. Several files: a colour per file, labelled
+    there are several, a surface branch 'm = 1 from 5' (the label of its parent point). Several files: a colour per file, labelled
     'M = …', with the scene name where two files share an M (its branches told apart by their curves). A
     dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
 
@@ -323,7 +332,7 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         if len(files) == 1 and b.surface:  # a surface branch: by its mode and parent, never its internal name
             label = b.surface_name
         elif len(files) == 1 and len(files[id(b.run)]) > 1:
-            label += f", {branch_title(b.name)}"
+            label += f", {branch_title(b)}"
         b.label = label
     colors = {}
     for b in branches:
@@ -345,7 +354,7 @@ def applicable_kinds(branches) -> list[str]:
 
 
 def plot(sources, what: str | None, points=None, branch: str | None = None, axes=None,
-         stability: Reading | None = None) -> Figure:
+         stability: Reading | None = None, width: float | None = None) -> Figure:
     """The figure of kind ``what`` (one of KINDS) for ``sources``: runs (read_run() output) or run files, one
     or a list (``phase``: curve or sweep files). ``what`` None: the pole curve of the first run's continuation
     parameter (``pressure-pole``, or ``voltage-pole`` for a run continued in the voltage); ``phase`` for a sweep or
@@ -356,10 +365,49 @@ def plot(sources, what: str | None, points=None, branch: str | None = None, axes
     per-point kinds (default: DEFAULT_POINTS spread along the branch), or ``Configuration`` s (each names its
     branch; ``branch`` is then ignored). ``axes``: draw into these matplotlib Axes (one, or as many as the kind
     has panels) instead of a new figure. ``stability``: the Reading that draws curves solid or dashed (None: each
-    run's loading control). Drawn in the journal style (``style``); a new figure is also saved in it.
+    run's loading control). ``width``: a new figure's width in inches (``fit.fit_width``: its legend under the
+    panels, its titles wrapped; MIN_WIDTH to MAX_WIDTH). Drawn in the journal style (``style``); a new figure is
+    also saved in it.
     """
-    with journal_style():
-        return _draw(sources, what, points, branch, axes, stability)
+    if width is not None and not MIN_WIDTH <= width <= MAX_WIDTH:
+        raise PlotError(f"width {width:g}: must be in [{MIN_WIDTH:g}, {MAX_WIDTH:g}] inches (3.5 one column, 7.2 two)")
+    if width is not None and axes is not None:
+        raise PlotError("width: the figure of the Axes given has its own size (set it with fig.set_size_inches)")
+    token = WIDTH.set(width)
+    try:
+        with journal_style():
+            fig = _draw(sources, what, points, branch, axes, stability)
+            if width is not None:
+                fit_width(fig, width)
+            if axes is not None:
+                _journal_family(axes)
+    finally:
+        WIDTH.reset(token)
+    return fig
+
+
+def _journal_family(axes) -> None:
+    """The caller's Axes with the journal style's font family (the current one, inside ``journal_style``) on their
+    tick labels, axis labels and title, as on everything the plot drew into them: one family in the figure (their
+    sizes stay the caller's)."""
+    family = matplotlib.rcParams["font.family"]
+    for ax in np.ravel(np.asarray(axes, dtype=object)):
+        ax.tick_params(labelfontfamily=family)
+        for text in [ax.title] + [getattr(ax, name).label for name in ("xaxis", "yaxis", "zaxis") if hasattr(ax, name)]:
+            text.set_fontfamily(family)
+
+
+WIDTH = contextvars.ContextVar("width", default=None)  # plot's width: a new figure is made at it (``sized``)
+
+
+def sized(figsize):
+    """A new figure's size: ``figsize`` (each kind's own) scaled to the width ``plot`` was asked for, if any
+    (``fit.fitted_size``), so that it is laid out at that size from the start."""
+    width = WIDTH.get()
+    return figsize if width is None or figsize is None else fitted_size(figsize, width)
+
+
+MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (as ``figure --width``)
 
 
 def _draw(sources, what, points, branch, axes, stability) -> Figure:
@@ -397,7 +445,7 @@ def _panels(axes, count: int, figsize, **subplots):
     """(figure, ``count`` Axes, own): a new constrained-layout Figure with ``count`` panels (own = True), or
     the caller's ``axes`` (one Axes or a sequence of ``count``) and their figure."""
     if axes is None:
-        fig = JournalFigure(figsize=figsize, layout="constrained")
+        fig = JournalFigure(figsize=sized(figsize), layout="constrained")
         return fig, np.atleast_1d(fig.subplots(**subplots) if subplots else fig.add_subplot()), True
     given = list(np.ravel(np.asarray(axes, dtype=object)))
     if len(given) != count:
@@ -472,7 +520,7 @@ def _special(ax, branch: StoredBranch, x, y, color) -> list:
     for s, xs, ys in zip(branch.data["special_points"], x, y):
         ax.plot(xs, ys, MARKERS.get(s["kind"], "D"), color=color, markersize=6, markeredgecolor="k",
                 markeredgewidth=0.5)
-        marks.append((ax, special_label(s), xs, ys, color))
+        marks.append((ax, int(s["label"]), special_label(s), xs, ys, color))
     return marks
 
 
@@ -814,11 +862,12 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
     mirror plane y = 0 beside it (``_mirror_section``) (docs/plots.md)."""
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
 
-    if axes is None:
-        fig = JournalFigure(figsize=(10.0, 5.4), layout="constrained")
+    if axes is None:  # at a narrow width (fit.NARROW) the section under the surface, else beside it
+        narrow = WIDTH.get() is not None and WIDTH.get() < NARROW
+        fig = JournalFigure(figsize=sized((5.4, 9.0) if narrow else (10.0, 5.4)), layout="constrained")
         fig.get_layout_engine().set(wspace=0.08)  # the layout does not see mplot3d's z label: room for it
-        ax, own = fig.add_subplot(1, 2, 1, projection="3d"), True
-        _mirror_section(fig.add_subplot(1, 2, 2), branch, index)
+        ax, own = fig.add_subplot(2 if narrow else 1, 1 if narrow else 2, 1, projection="3d"), True
+        _mirror_section(fig.add_subplot(2 if narrow else 1, 1 if narrow else 2, 2), branch, index)
     else:
         fig, (ax,), own = _panels(axes, 1, None)
         if getattr(ax, "name", "") != "3d":
@@ -838,6 +887,8 @@ def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
         handles.append(Line2D([], [], color="k", linewidth=1.4, label="coil wire"))
     ax.set(xlim=(-extent, extent), ylim=(-extent, extent), zlim=(-extent, extent))
     ax.set_box_aspect((1.0, 1.0, 1.0))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # mplot3d's default ticks crowd at a journal column
+        axis.set_major_locator(MaxNLocator(4))
     ax.set_xlabel(r"$x/R_0$")
     ax.set_ylabel(r"$y/R_0$")
     ax.set_zlabel(r"$z/R_0$")
@@ -868,7 +919,7 @@ def _mirror_section(ax, branch: StoredBranch, index: int) -> None:
     ax.set_xlabel(r"$x/R_0$")
     ax.set_ylabel(r"$z/R_0$")
     ax.set_title("section y = 0")
-    ax.legend(loc="upper right")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))  # beside the section, not over it
 
 
 def wire_points(coil, count: int = 200) -> np.ndarray:
@@ -932,7 +983,7 @@ def plot_stretch_map(branch: StoredBranch, index: int, axes=None) -> Figure:
         low, high = _colour_range(values)
         mesh = ax.pcolormesh(phi, theta, np.c_[values, values[:, :1]], shading="flat", cmap="viridis", vmin=low,
                              vmax=high)
-        fig.colorbar(mesh, ax=ax, shrink=0.9)
+        fig.colorbar(mesh, ax=ax, shrink=0.9, label=name.split(" (")[0])
         ax.set_title(name)
         ax.set_xlabel(r"material angle $\phi$ (rad)")
         ax.set_xlim(0.0, 2 * np.pi)
@@ -960,7 +1011,7 @@ def plot_energy(branches, axes=None) -> Figure:
         files = ", ".join(dict.fromkeys(str(b.source) for b in branches))
         raise PlotError(f"{files}: no bifurcation data (no special point with finite special_points/E2, E3, E4, "
                         "which the stability analysis writes); the energy landscape cannot be drawn")
-    fig, (ax,), _ = _panels(axes, 1, (6.4, 4.8))
+    fig, (ax,), own = _panels(axes, 1, (6.4, 4.8))
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     styles = ["-", "--", "-.", ":"]
     drawn = 0
@@ -976,7 +1027,7 @@ def plot_energy(branches, axes=None) -> Figure:
     ax.set_xlabel(r"amplitude $\Lambda$ along the critical mode")
     ax.set_ylabel(r"$E(\Lambda) - E_0$ (per $2\pi$, units of $T_0 R_0^2 \mu/2$)")
     ax.set_title(_title(branches))
-    ax.legend()
+    _legend(fig, [ax], own, "lower center")  # an own figure's under the panel, not over the curves
     return fig
 
 
@@ -989,7 +1040,7 @@ def plot_phase(paths, axes=None) -> Figure:
     isola meet where q turns back (the critical q, marked), as a fold curve's two folds do at its cusp; the region
     where the isola exists (q between its start and the critical value, P between the two pitchfork pressures),
     or where the balloon snaps through (between the two folds), is shaded."""
-    fig, (ax,), _ = _panels(axes, 1, (6.4, 4.6))
+    fig, (ax,), own = _panels(axes, 1, (6.4, 4.6))
     parameters, kinds, open_folds = {}, set(), {}  # parameters: {scene key: (short name, [what is drawn in it])}
     if any(isinstance(path, dict) for path in paths):
         raise PlotError("phase draws curve files (balloon-cg critical) or sweep files, not runs")
@@ -1053,7 +1104,7 @@ def plot_phase(paths, axes=None) -> Figure:
     else:
         ax.set_ylabel(r"pressure $P = \bar P R_0/(T_0\mu/2)$ at the pitchfork (BP) or fold (LP, LV, LN)")
         ax.set_title("pitchforks and folds (snap-through between a fold curve's two branches)")
-    ax.legend()
+    _legend(fig, [ax], own, "lower center")  # an own figure's under the panel, not over the curves
     return fig
 
 
