@@ -106,7 +106,7 @@ def test_every_writing_command_has_a_default_output_that_is_never_overwritten(tm
 
 @pytest.mark.parametrize("setting, words", [
     ("field.M=-1", ("field.M = -1", "in [0, 1000]")),
-    ("nope=1", ("--set nope", "no table")),
+    ("nope=1", ("--set nope", "not a scene key")),
     ("M=0:1:3", ("--set M=0:1:3", "one value")),
     ("continuation.max_points=abc", ("max_points", "abc")),
     ("field.M", ("--set field.M", "KEY=VALUE")),
@@ -152,7 +152,7 @@ def test_unset_restores_the_default_and_a_key_is_given_once(tmp_path, capsys):
     out = tmp_path / "x.h5"
     for flags, words in ((["--set", "M=0", "--set", "field.M=0"], "given twice"),
                          (["--unset", "continuation.stop_stretch", "--stop-stretch", "3"], "also given a value"),
-                         (["--unset", "nope"], "--unset nope: a bare name")):
+                         (["--unset", "nope"], "--unset nope: not a scene key")):
         assert main(["run", "spom1", *flags, "-o", str(out)]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and words in err, err
