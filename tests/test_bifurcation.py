@@ -70,7 +70,7 @@ def test_mirror_branch_swaps_the_poles(picture):
     pear, mirror = branches["pear_0"], branches["pear_0_mirror"]
     traced = trace_pear(primary, bps[0], -1.0, "traced")
     if pear.rejoins is not None:
-        mark_rejoin(traced, primary, pear.rejoins, bps[pear.rejoins])
+        mark_rejoin(traced, primary, bps[pear.rejoins])
     assert mirror.origin == Origin.REFLECTED and mirror.reflection_of == "pear_0"
     assert traced.origin == Origin.TRACED and len(traced.X) == len(mirror.X) == len(pear.X)
     np.testing.assert_allclose(traced.pole_values()["lam2_north"], pear.pole_values()["lam2_south"], rtol=1e-9)

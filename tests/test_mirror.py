@@ -75,7 +75,7 @@ def test_copied_assessments_match_the_traced_mirrors_own(picture):
     primary, pear, mirror = picture.branches
     bp = picture.branch_points[0]
     traced = trace_pear(primary, bp, -1.0, "traced")
-    mark_rejoin(traced, primary, pear.rejoins, picture.branch_points[pear.rejoins])
+    mark_rejoin(traced, primary, picture.branch_points[pear.rejoins])
     scene = primary.scene
     stability, unsettled = assess_branch(traced, scene.stability.degree, False, check=True, m_max=scene.stability.m_max)
     assert mirror.stability is not pear.stability and len(stability) == len(mirror.stability)

@@ -45,7 +45,7 @@ def test_fold_at_the_rejoin_is_the_branch_point(isola):
     crossed = across_the_rejoin(pear, mirror)
     P = crossed.pressure[-2:]
     assert bp.X[-1] < P.min() or bp.X[-1] > P.max()  # an extremum of P: not bracketed in P
-    mark_rejoin(crossed, picture.primary, 1, bp)
+    mark_rejoin(crossed, picture.primary, bp)
     (s,) = crossed.special
     assert (s.kind, s.block, s.status, s.index) == (Kind.BP, Block.ODD_HELD, Status.LOCATED, len(crossed.X) - 2)
     assert s.classification == bp.classification != Classification.NONE
@@ -65,5 +65,5 @@ def test_other_fold_candidates_stay_folds(isola):
     middle = replace(crossed.special[0], index=len(pear.X) // 2)  # no sign change of the amplitude there
     assert not rejoin_fold(crossed, middle, rejoin)
     kept = replace(crossed, special=[middle])
-    mark_rejoin(kept, primary, 1, picture.branch_points[1])
+    mark_rejoin(kept, primary, picture.branch_points[1])
     assert kept.special == [middle]

@@ -1,6 +1,7 @@
 """Labels and ``continue`` (app/restart.py): every special point of a run file has a unique label; restarting from
 one reproduces the branch, and from a fold in a second parameter gives the fold curve ``critical --of`` gives."""
 import json
+import re
 
 import numpy as np
 import pytest
@@ -433,6 +434,27 @@ def spom1_run(tmp_path_factory):
     scene.write_text(load_scene("spom1").with_overrides({"surface.branches": "none"}).to_toml())
     assert main(["run", str(scene), "-o", str(folder / "run.h5"), "--quiet"]) == 0
     return folder / "run.h5"
+
+
+def test_inspect_names_where_a_pear_branch_leaves_and_rejoins_by_label(spom1_run, capsys):
+    """SPOM1's isola: the pear branch leaves the primary branch at its first pitchfork and rejoins it at its second;
+    inspect (text and --json) and the legend name both by their labels (what continue takes), not by the
+    analysis's numbering of branch points; the notes carry no such number."""
+    import balloon_cg as bc
+
+    run = read_run(spom1_run)
+    first_bp, second_bp = [s["label"] for s in run["branches"]["primary"]["special_points"] if s["kind"] == "BP"]
+    assert main(["inspect", str(spom1_run)]) == 0
+    text = capsys.readouterr().out
+    assert f"branch pear_0   (from label {first_bp} on primary;" in text
+    assert f"forward: rejoined the primary branch (at label {second_bp})" in text
+    assert not re.search(r"branch point \d", text)
+    assert main(["inspect", str(spom1_run), "--json"]) == 0
+    pear = json.loads(capsys.readouterr().out)["branches"]["pear_0"]
+    assert (pear["parent_label"], pear["rejoin_label"]) == (first_bp, second_bp)
+    assert bc.load(spom1_run).branches["pear_0"].born_at == first_bp
+    legend = [t.get_text() for t in bc.plot(spom1_run).legends[0].get_texts()]
+    assert f"M = 0, pear from {first_bp}" in legend
 
 
 def test_continue_in_M_without_coils_is_bad_input(spom1_run, tmp_path, capsys):

@@ -263,7 +263,7 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
             if stopped(picture):
                 break
             bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
-            bp.note = f"{MODES[block]} mode, branch point {n}"
+            bp.note = f"{MODES[block]} mode"  # its name: its label in the file
             picture.branch_points.append(bp)
             primary.special.append(bp)
     primary.special.sort(key=_along)
@@ -417,7 +417,7 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
         if branch.rejoins is not None:
             if reached is not None:
                 reached.add(branch.rejoins)
-            mark_rejoin(branch, primary, branch.rejoins, picture.branch_points[branch.rejoins])
+            mark_rejoin(branch, primary, picture.branch_points[branch.rejoins])
         picture.branches.append(branch)
         if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):
             return False  # kept as traced, not assessed

@@ -286,8 +286,6 @@ class Branch:
     def stop_reason(self) -> str:
         """Why the branch ended, for people (``legs`` hold the codes)."""
         text = "; ".join(f"{leg.label}: {leg.stop.message}" for leg in self.legs)
-        if self.rejoins is not None:
-            text += f" at branch point {self.rejoins}"
         if self.lossy:
             text += (f"; {len(self.lossy)} points stored on the final basis with a projection loss up to "
                      f"{max(self.lossy):.1g} (in their error estimate)")

@@ -267,7 +267,7 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     (E, kind), traced = leave(trace, X_star, phi, max_points, f"branch point {number} along its m = {bp.m} mode",
                               progress)
     origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
-                     note=f"born here: branch point {number} of {branch.name} (m = {bp.m})")
+                     note=f"born here, on {branch.name} (m = {bp.m})")
     return branch_of(*traced, branch, number, origin, name, t0)
 
 

@@ -126,7 +126,7 @@ def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broke
                               f"branch point {number} of {primary.name} along its mode", progress)
     origin = replace(bp, index=0, X=np.append(trace.system.coefficients(X_star), X_star[-1]), E=E,
                      classification=kind, mode=None, sector=(),  # its sector is the parent's, on the parent's basis
-                     note=f"born here: branch point {number} of {primary.name} (its mode odd under {broken})")
+                     note=f"born here, on {primary.name} (its mode odd under {broken})")
     name = branch_name(number) + ("" if sign > 0 else MIRROR)
     out = branch_of(*traced, primary, number, origin, name, t0, READINGS, with_loads(traced[0], collected(*traced)))
     if sign < 0:

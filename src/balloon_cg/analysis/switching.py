@@ -124,11 +124,11 @@ def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:
     return float(np.abs(ends - point).max(axis=1).min()) <= float(np.abs(ends[1] - ends[0]).max())
 
 
-def mark_rejoin(branch: Branch, primary: Branch, number: int, bp: SpecialPoint) -> None:
+def mark_rejoin(branch: Branch, primary: Branch, bp: SpecialPoint) -> None:
     """Replace each fold candidate of ``branch`` that is its rejoin at the primary branch's branch point ``bp``
-    (number ``number``; ``rejoin_fold``) by that branch point on the branch's basis (its location status,
+    (``rejoin_fold``) by that branch point on the branch's basis (its location status,
     classification and mode; ``index`` the fold's interval)."""
     X = primary.disc.transfer(bp.X, branch.disc)
-    branch.special = [replace(bp, index=s.index, X=X, note=f"the rejoin: branch point {number} of the primary "
-                                                           "branch (P is even in the pear amplitude there)")
+    branch.special = [replace(bp, index=s.index, X=X, note="the rejoin on the primary branch (P is even in the pear "
+                                                           "amplitude there)")
                       if rejoin_fold(branch, s, X) else s for s in branch.special]

@@ -183,9 +183,9 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
         #                             is that pitchfork (P is even in the pear amplitude), as run marks a rejoin
         points = numbered_branch_points(start.parent)
         block = points[start.parent_point].block  # its reading's pitchforks (held or free)
-        for number, bp in enumerate(points):
+        for bp in points:
             if bp.block == block:
-                mark_rejoin(primary, start.parent, number, bp)
+                mark_rejoin(primary, start.parent, bp)
     return (examine(scene, primary, Ticks(progress), pear=False, control=not pear) if start.assessed else
             Picture([primary]))
 
@@ -209,7 +209,7 @@ def rejoin_rule(start: Labelled, base):
         if before is not None and before * amplitude < 0:
             n = min(pitchforks, key=lambda item: abs(item[1] - point.X[-1]))[0]
             if n != start.parent_point or state["passed"]:
-                return Stop(StopCode.REJOINED, f"rejoined the primary branch at branch point {n}")
+                return Stop(StopCode.REJOINED, f"rejoined the primary branch at its pitchfork at P = {point.X[-1]:.6g}")
             state["passed"] = True
         return base(disc, point)
 

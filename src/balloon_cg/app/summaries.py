@@ -3,7 +3,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.parents import parent_label
+from ..io.parents import parent_label, rejoin_label
 
 
 def summarise_file(path) -> tuple[dict, str]:
@@ -105,7 +105,8 @@ def summarise_run(run: dict) -> dict:
         "scene_name": run["scene_name"],
         "provenance": run["attrs"],
         "run_time": run_time(run["attrs"]),
-        "branches": {name: summarise_branch(b) | {"parent_label": parent_label(run, name)}
+        "branches": {name: summarise_branch(b) | {"parent_label": parent_label(run, name),
+                                                  "rejoin_label": rejoin_label(run, name)}
                      for name, b in run["branches"].items()},
         "snap_throughs": run.get("snap_throughs", []),
     }
@@ -332,7 +333,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
           if "voltage" in b else []),
         "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
         "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
-        f"  stop reason          {b['stop_reason']}",
+        f"  stop reason          {b['stop_reason']}"
+        + ("" if b.get("rejoin_label") is None else f" (at label {b['rejoin_label']})"),
         f"  max residual         {b['max_residual']:.3e}",
         f"  max error estimate   {b['max_error_estimate']:.3e}",
         f"  trace time           {b['wall_time']:.3f} s",
