@@ -76,7 +76,8 @@ class SweepResult:
     def read(cls, path) -> "SweepResult":
         sweep = read_sweep(path)
         members = {index: SweepMember(index, m["overrides"], m["attrs"],
-                                      {name: BranchData(name, data, parent_label(m, name)) for name, data in m["branches"].items()},
+                                      {name: BranchData(name, data, parent_label(m, name))
+                                       for name, data in m["branches"].items()},
                                       str(path))
                    for index, m in sweep["members"].items()}
         return cls(str(path), sweep["attrs"], members)

@@ -14,8 +14,8 @@ Layout::
                                                    fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
                         the verified merge of the two pitchforks or the verified cusp; kinds LP-BP, LV-BP, LN-BP:
-                        the meetings of a fold and the pitchfork, analysis.fold_meeting), and <parameter>; state/unknowns in
-                        the branch layout (u, P)
+                        the meetings of a fold and the pitchfork, analysis.fold_meeting), and <parameter>;
+                        state/unknowns in the branch layout (u, P)
 
 ``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
 the primary branch in P, V or n, group named so: ``analysis.fold_curve``). ``end`` is the curve's

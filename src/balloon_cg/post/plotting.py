@@ -14,9 +14,10 @@ name when a file holds several; a mirror-image branch (``<name>_mirror``) takes 
 thinner and lighter. Branch curves are solid where stable and dashed where unstable under the chosen stability
 ``Reading`` (default: the run's loading control, balloon held at its centre), named in the legend title; without
 stability data all solid, and the legend title says so. Titles name the material and the coils. Special points
-are marked and labelled with their kind (LP, TP, EP, branch points, …). Surface branches (m ≥ 1, states on the
-whole sphere) are drawn by the pole curves and the energy landscape, labelled 'm = 1 from 5' (their parent point's label), and left
-out of the other branch and per-point kinds; ``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
+are marked and labelled with their label in the file and their kind ("2 LP", "3 pitchfork-super": ``labels``).
+Surface branches (m ≥ 1, states on the whole sphere) are drawn by the pole curves and the energy landscape,
+labelled 'm = 1 from 5' (their parent point's label), and left out of the other branch and per-point kinds;
+``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
 The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest (``robust_limits``).
 Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2,
 field in I/(4π R0).
@@ -312,9 +313,9 @@ def branch_title(branch: "StoredBranch") -> str:
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     """Set each branch's legend label and colour. One file: a colour per branch (a mirror image, or a surface
     branch's rotation by π, sharing its partner's), labelled 'M = …, <branch title>' (``branch_title``) when
-    there are several, a surface branch 'm = 1 from 5' (the label of its parent point). Several files: a colour per file, labelled
-    'M = …', with the scene name where two files share an M (its branches told apart by their curves). A
-    dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+    there are several, a surface branch 'm = 1 from 5' (the label of its parent point). Several files: a colour
+    per file, labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
+    curves). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
 
     def key(b):
         return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
@@ -393,7 +394,8 @@ def _journal_family(axes) -> None:
     family = matplotlib.rcParams["font.family"]
     for ax in np.ravel(np.asarray(axes, dtype=object)):
         ax.tick_params(labelfontfamily=family)
-        for text in [ax.title] + [getattr(ax, name).label for name in ("xaxis", "yaxis", "zaxis") if hasattr(ax, name)]:
+        labels = [getattr(ax, name).label for name in ("xaxis", "yaxis", "zaxis") if hasattr(ax, name)]
+        for text in [ax.title, *labels]:
             text.set_fontfamily(family)
 
 
