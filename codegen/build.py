@@ -4,7 +4,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from . import equations, poles
-from . import second_variation, stretch_derivatives, surface
+from . import inertia, second_variation, stretch_derivatives, surface
 from .classes import scene_classes
 from .emit import module_text
 from .functional import SceneClass
@@ -75,6 +75,11 @@ def field_module_text() -> str:
     return module_text(title, inputs, [lower(k) for k in kernels], "codegen/field.py", constants, layout)
 
 
+def inertia_module_text() -> str:
+    title, inputs, kernels = inertia.inertia_module()
+    return module_text(title, inputs, [lower(k) for k in kernels], "codegen/inertia.py")
+
+
 def _class_job(job):
     kind, cls = job
     if kind == "surface":
@@ -89,6 +94,7 @@ def all_modules(workers: int = 2):
     with ProcessPoolExecutor(workers) as pool:
         texts = dict(pool.map(_class_job, jobs))
     texts["coil_field"] = field_module_text()
+    texts["inertia"] = inertia_module_text()
     return dict(sorted(texts.items()))
 
 

@@ -46,6 +46,7 @@ from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import even_half, symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.legendre import assoc_legendre, legendre_values
+from ..generated import AZIMUTHAL_PAIRS, inertia
 from ..numerics import eigen
 
 
@@ -101,9 +102,10 @@ class AzimuthalBasis:
         z = blocks["Z"][0]
         put(self, "ops_z", np.ascontiguousarray(ops[2:4, :, z]))
         put(self, "ops_ud", np.ascontiguousarray(ops[[0, 1, 4, 5], :, z.stop:]))
-        w = weights[:, None]
-        gram = 0.5 * sum(ops[k].T @ (w * ops[k]) for k in (0, 2, 4))
-        put(self, "gram", 0.5 * (gram + gram.T))
+        # the kinetic energy's mass matrix (generated/inertia.py: t = ¼(Ṙ² + Ṫ² + Ż²) per d(cos θ))
+        mass = np.empty((len(inertia.KERNELS["azimuthal_mass"]["outputs"]), x.size))
+        inertia.azimuthal_mass_nodes(x, self.sin_theta, mass)
+        put(self, "gram", _assemble(mass, weights, _pair_rows(AZIMUTHAL_PAIRS), self.ops_ud, self.ops_z))
         # orthonormal P̄ in x: G = diag(½ | ¼, ¼); in s, ∫ P̄_k^j(s) P̄_l^j(s) dx is not diagonal
         orthogonal = self.mapping is None
         put(self, "factor", eigen.GramFactor(self.gram, orthogonal=orthogonal))

@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.polynomial import legendre
 
+from ..generated import inertia
 from .azimuthal import merged_lowest, perturbation_map, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
@@ -71,9 +72,10 @@ class Assessment:
 class SecondVariation:
     """Galerkin Hessians of the energy on a Legendre perturbation basis of degree N, at equilibria of ``eq``."""
 
-    def __init__(self, equilibrium, degree: int, basis: str | None = None):
+    def __init__(self, equilibrium, degree: int, basis: str | None = None, norm: str | None = None):
         self.eq = equilibrium
         self.basis_kind = equilibrium.scene.stability.basis if basis is None else basis
+        norm = equilibrium.scene.stability.norm if norm is None else norm
         quadrature = max(equilibrium.disc.x.size, gauss_nodes(degree))
         # "legendre": P_k(x) even when the equilibrium's basis is mapped; "mapped": P_k(s) on the equilibrium's own
         # wire map (its Gauss nodes in s); on an unmapped equilibrium both are the same basis
@@ -90,11 +92,6 @@ class SecondVariation:
         self.translation = na  # b_0
         self.ops, self.weights = _held_ops(self.basis), self.basis.weights
         ops, w = self.ops, self.weights
-        # the norm: ∫(δλ2² + δη²) dx ("unknowns"), or |δx|² = ∫(sin²θ δλ2² + δη²) dx ("displacement", δρ = sin θ δλ2)
-        displacement = equilibrium.scene.stability.norm == "displacement"
-        weight_a = w * self.basis.sin_theta ** 2 if displacement else w
-        self.gram = ops[0].T @ (weight_a[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
-        self._orthogonal = mapping is None and not displacement  # diagonal: "unknowns" in x only
         if mapping is None:
             self.basis_a, self.basis_b, self._gradient_ops = (self.basis.basis_a, self.basis.basis_b,
                                                               self.basis._gradient_ops)
@@ -102,6 +99,14 @@ class SecondVariation:
             self.basis_a, self.basis_b = (read_only(np.ascontiguousarray(ops[0:2, :, :na])),
                                           read_only(np.ascontiguousarray(ops[2:4, :, na:])))
             self._gradient_ops = read_only(np.ascontiguousarray(ops.reshape(-1, self.basis.size).T))
+        # the norm: ∫(δλ2² + δη²) dx ("unknowns"), or |δx|² = ∫(sin²θ δλ2² + δη²) dx ("displacement", δρ = sin θ δλ2):
+        # the mass matrix of the membrane's kinetic energy (generated/inertia.py)
+        self.norm = norm
+        if norm == "displacement":
+            self.gram = assemble_hessian(_axisymmetric_mass(self.basis), w, self.basis_a, self.basis_b)
+        else:
+            self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
+        self._orthogonal = mapping is None and norm != "displacement"  # diagonal: "unknowns" in x only
         # the state at the nodes is linear in the equilibrium's unknowns: (λ2, v, η, w) = u @ state_map
         unit = self.eq.state_at(np.eye(self.eq.disc.size), self.theta)
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
@@ -241,6 +246,14 @@ class SecondVariation:
                 for flag in flags:
                     stable[flag] = False
         return tuple(stable)
+
+
+def _axisymmetric_mass(basis: Discretisation) -> np.ndarray:
+    """The kinetic energy's mass density ∂²t/∂(λ2, v, η, w)² at the nodes of ``basis`` (``axisymmetric_mass``, in
+    the layout of energy_hessian): t = ½(sin²θ λ̇2² + η̇²) per d(cos θ)."""
+    out = np.empty((len(inertia.KERNELS["axisymmetric_mass"]["outputs"]), basis.x.size))
+    inertia.axisymmetric_mass_nodes(basis.cos_theta, basis.sin_theta, out)
+    return out
 
 
 def _held_ops(basis: Discretisation) -> np.ndarray:

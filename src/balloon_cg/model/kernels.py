@@ -318,9 +318,9 @@ def _frozen(values) -> np.ndarray:
 @cache
 def generated_digest() -> str:
     """SHA-256 over the signatures of every generated module (stored as provenance): each class, its whole-sphere
-    module, the coil field; read from the modules' text: importing all of them would build every numba dispatcher
-    of every class (~0.2 s at start-up)."""
-    names = sorted(generated.CLASSES) + sorted(generated.SURFACE_CLASSES.values()) + ["coil_field"]
+    module, the coil field, the mass matrices (inertia); read from the modules' text: importing all of them would build
+    every numba dispatcher of every class (~0.2 s at start-up)."""
+    names = sorted(generated.CLASSES) + sorted(generated.SURFACE_CLASSES.values()) + ["coil_field", "inertia"]
     return hashlib.sha256("".join(map(module_signature, names)).encode()).hexdigest()
 
 

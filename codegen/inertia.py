@@ -1,0 +1,66 @@
+"""Inertia of the membrane: the mass matrices of small oscillations from the kinetic energy (MODEL.md §11).
+
+The membrane's kinetic energy is ½ ρ T0 ∫ |u̇|² dA over the reference surface (the gas massless). In the units of
+the energy (lengths over R0, per 2π; docs/dynamics.md) it is the functional
+
+    T = ½ (1/2π) ∫∫ |δẋ|² sin θ dθ dφ = ∫_{-1}^{1} t(θ) d(cos θ),
+
+a quadratic form in the velocity of the perturbation. Its density t is derived here in the variables of each
+second-variation block, from the same kinematics, so that the mass matrix M = ∂²T/∂q̇² is assembled on the same
+basis as the Hessian K and the small oscillations q = q̂ e^{iωt} solve K q̂ = ω² M q̂:
+
+- m = 0 (axisymmetric, codegen/equations.py: the state (λ2, v, η, w)): the mid-surface is λ2 sin θ e_ρ + η e_z,
+  so δx = sin θ δλ2 e_ρ + δη e_z and t = ½ (sin²θ λ̇2² + η̇²);
+- m ≥ 1 (codegen/second_variation.py: y = (R, R', Z, Z', T, T')): δx is the ε-coefficient of its ``surface()``,
+  R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z, and the φ-average gives t = ¼ (R² + T² + Z²).
+
+The kernels return ∂²t over the pairs of each block's variables (the layouts of ``energy_hessian`` and
+``azimuthal_hessian``); they depend on the node alone (the reference sphere), so they form one module for every
+scene class, ``generated/inertia.py``.
+"""
+import sympy as sp
+
+from .equations import HESSIAN_PAIRS, pair_labels
+from .functional import STATE, cos_theta, eta, lam2, sin_theta
+from .kernels import Arg, Kernel
+from .second_variation import PAIRS, PERTURBATION, dot, epsilon_order, phi_average, surface
+
+TITLE = "Mass matrices of the membrane's kinetic energy for the second-variation blocks (MODEL.md §11)."
+
+
+def axisymmetric_density():
+    """t(θ) of an axisymmetric perturbation per d(cos θ): ½|δx|², δx = ∂x/∂(λ2, η)·δ(λ2, η), x = λ2 sin θ e_ρ + η e_z
+    (the perturbation symbols are the state's own: t is quadratic in them)."""
+    x = (lam2 * sin_theta, 0, eta)
+    return sp.expand(dot(x, x) / 2)
+
+
+def azimuthal_density():
+    """t(θ) of a cos mφ perturbation per d(cos θ): the φ-average of ½|δx|², δx the ε-coefficient of the straight
+    Cartesian line of codegen/second_variation.py (the same kinematics as its Hessian)."""
+    x, _, _ = surface()
+    moved = tuple(epsilon_order(c, 1) for c in x)
+    return phi_average(dot(moved, moved) / 2)
+
+
+def _mass_entries(density, variables, pairs):
+    return tuple(sp.diff(density, variables[i], variables[j]) for i, j in pairs)
+
+
+def inertia_kernels() -> list[Kernel]:
+    args = (Arg.node(cos_theta), Arg.node(sin_theta))
+    return [
+        Kernel("axisymmetric_mass",
+               "∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(sin²θ λ̇2² + η̇²) (m = 0), "
+               "upper triangle row by row (the layout of energy_hessian).",
+               args, _mass_entries(axisymmetric_density(), STATE, HESSIAN_PAIRS), pair_labels(STATE, HESSIAN_PAIRS)),
+        Kernel("azimuthal_mass",
+               "∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²) (m ≥ 1), y = (R, R', Z, Z', T, T'), "
+               "upper triangle row by row (the layout of azimuthal_hessian).",
+               args, _mass_entries(azimuthal_density(), PERTURBATION, PAIRS), pair_labels(PERTURBATION, PAIRS)),
+    ]
+
+
+def inertia_module():
+    """(title, inputs, kernels) for ``generated/inertia.py``."""
+    return TITLE, {"kinetic_energy": "1/2 rho T0 |du/dt|^2 dA over the reference sphere"}, inertia_kernels()

@@ -1,0 +1,75 @@
+"""Natural frequencies of an equilibrium per second-variation block (MODEL.md §11, docs/dynamics.md).
+
+The membrane's kinetic energy ½ ρ T0 ∫ |u̇|² dA (the gas massless) is, for a perturbation q(t) on a block's
+basis, (2π ρ T0 R0⁴) ½ q̇ᵀ M q̇ with M the mass matrix of generated/inertia.py (codegen/inertia.py); the loaded
+energy is (2π T0 R0² μ/2) ½ qᵀ K q with K the block's second variation of E (per 2π, moduli over μ/2: MODEL.md §2).
+Small oscillations q = q̂ e^{iωt} solve K q̂ = ν M q̂ with ω² = (μ/2) ν / (ρ R0²), so the dimensionless frequency
+Ω = ω R0 √(ρ/μ) (μ the initial shear modulus) is
+
+    Ω² = ν / 2.
+
+K is the block's matrix under the scene's control: pressure, the Hessian H; volume, H on the perturbations that
+keep the volume (gᵀq = 0, g = ∂Ṽ/∂q: the constrained subspace); gas, H + (P/Ṽ) g gᵀ (its stiffness); held or free
+(analysis/stability.py: the same blocks and names as the stability assessment). M is the displacement norm of the
+stability blocks, so ν are their eigenvalues on that norm (``SecondVariation(norm="displacement")`` for m = 0,
+``AzimuthalBasis.gram`` for m ≥ 1): one assembly, one reduction to a standard matrix (``numerics.eigen``) per block.
+Ω² < 0 is an unstable mode (kept as such).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.azimuthal import merged_lowest
+from ..analysis.problem import equilibrium_of
+from ..analysis.stability import SecondVariation, assessed_degrees
+from ..numerics import interrupt
+
+PER_EIGENVALUE = 0.5  # Ω² per eigenvalue ν of K q = ν M q (module docstring)
+MASS_NORM = "displacement"  # the SecondVariation norm whose Gram matrix is the mass matrix
+
+
+def mass_variation(equilibrium, degree: int) -> SecondVariation:
+    """The second variation of ``equilibrium`` at perturbation ``degree`` with the mass matrix as its Gram matrix."""
+    return SecondVariation(equilibrium, int(degree), norm=MASS_NORM)
+
+
+def frequencies(variation: SecondVariation, u, params, symmetric: bool, m_max: int = 0, count: int = 3) -> dict:
+    """{block name: its ``count`` lowest Ω² (ascending)} at the equilibrium u (unknowns of the variation's
+    equilibrium) at ``params``: the m = 0 blocks of the control modes and, m = 1..m_max, 'm<m>_held' (and
+    'm<m>_free' with a field) (``SecondVariation.blocks``)."""
+    if variation.norm != MASS_NORM:
+        raise ValueError(f"frequencies need the mass matrix as the Gram matrix (norm {MASS_NORM!r}), "
+                         f"not {variation.norm!r}")
+    return {name: PER_EIGENVALUE * merged_lowest(parts, count)
+            for name, parts, _ in variation.blocks(u, params, symmetric, m_max)}
+
+
+@dataclass(frozen=True)
+class BranchFrequencies:
+    """The lowest Ω² of every block at every point of a branch: ``omega2[name]`` (points × count), NaN where a point
+    has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (that of its stability
+    assessment, so a stored Ω² and a located special point of the same block share their basis)."""
+
+    omega2: dict
+    degree: np.ndarray
+    count: int
+    m_max: int
+
+
+def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None) -> BranchFrequencies:
+    """``frequencies`` at every point of ``branch`` (module docstring), each at its ``assessed_degrees``."""
+    symmetric = branch.disc.symmetric if symmetric is None else symmetric
+    eq = equilibrium_of(branch)
+    degrees = np.array(assessed_degrees(branch), dtype=int)
+    variations = {}
+    rows = []
+    for X, N in zip(branch.X, degrees):
+        interrupt.check()
+        variation = variations.get(N) or variations.setdefault(N, mass_variation(eq, N))
+        rows.append(frequencies(variation, X[:-1], branch.params_at(X), symmetric, m_max, count))
+    names = list(dict.fromkeys(name for row in rows for name in row))
+    omega2 = {name: np.full((len(rows), count), np.nan) for name in names}
+    for n, row in enumerate(rows):
+        for name, values in row.items():
+            omega2[name][n, :values.size] = values
+    return BranchFrequencies(omega2, degrees, count, m_max)

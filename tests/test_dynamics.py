@@ -1,0 +1,207 @@
+"""Natural frequencies (balloon_cg.dynamics, codegen/inertia.py; MODEL.md §11) against closed forms derived here.
+
+Units. A sphere of reference radius R0, thickness T0, density ρ, strain energy per reference volume W = (μ/2) Φ
+(Φ the nondimensional Ogden sum, Σ μ_i α_i = 4), pressure P̄ = P T0 (μ/2)/R0. A displacement R0 ε u(θ) of the
+sphere of radius λ R0 has potential energy 2π T0 R0² (μ/2) [E₀ + ½ ε² K(u)] and kinetic energy
+2π ρ T0 R0⁴ ½ ε̇² M(u) (both per 2π as below), so ω² = (μ/2) ν/(ρ R0²) for K u = ν M u and Ω² = ω² R0² ρ/μ = ν/2.
+
+Breathing mode (the sphere's radial equation of motion). The mass 4π R0² ρ T0 of the membrane moves with the radius
+r = λ R0: m r̈ = 4π r² P̄ − 4π R0 T0 W'(λ), W(λ) = (μ/2) φ(λ), φ(λ) = Φ(λ, λ). Linearised at fixed P̄ about the
+equilibrium: m R0 δλ̈ = (8π R0² P̄ λ − 4π R0 T0 W'') δλ, so ω² = (W'' − 2 P̄ R0 λ/T0)/(ρ R0²) and
+
+    Ω² = (φ''(λ) − 2 P λ)/2,
+
+and as the equilibrium is P = φ'/λ², Ω² = λ² (dP/dλ)/2: zero at the pressure maximum.
+
+Spheroidal modes of degree n (linearised membrane equations on spherical harmonics). The displacement
+u = U e_r + W e_θ, U = w P_n(cos θ), W = v dP_n(cos θ)/dθ, on the sphere of radius λ: x = (λ + εU) e_r + εW e_θ,
+x_θ = ε(U' − W) e_r + (λ + ε(U + W')) e_θ, so λ1 = λ + εA + ε² B²/(2λ) + O(ε³), A = U + W', B = U' − W, and
+λ2 = ρ/sin θ = λ + εC exactly, C = U + W cot θ. With Φ1 = Φ2, Φ11 = Φ22, Φ12 at (λ, λ) the ε² part of
+∫ Φ sin θ dθ is ∫ [Φ1 B²/(2λ) + ½ Φ11 (A² + C²) + Φ12 A C] sin θ dθ. The volume per 2π,
+V/2π = (1/3) ∫ ρ [a(a + b') − b(a' − b)] dθ (a = λ + εU, b = εW, ρ = a sin θ + b cos θ), has the ε² part
+(1/3) ∫ [λ sin θ (U² + U W' − W U' + W²) + λ (U sin θ + W cos θ)(2U + W')] dθ. K(u) is twice the ε² part of
+∫ Φ sin θ dθ − P V/2π, M(u) = ∫ (U² + W²) sin θ dθ; in x = cos θ every integrand is a polynomial, integrated
+exactly by Gauss–Legendre. (w, v) → K, M by polarisation; Ω² = eig(K, M)/2 (two per n ≥ 1).
+"""
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.polynomial import legendre
+from scipy import linalg, optimize
+
+from balloon_cg.analysis import azimuthal as az
+from balloon_cg.dynamics.frequencies import frequencies, mass_variation
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.scene import load_scene
+
+ROOT = Path(__file__).resolve().parent.parent
+DEGREE = 14
+MATERIALS = {"neo-Hookean": ((2.0,), (2.0,)), "SPOM1": ((3.00508, 0.0145, -0.0177), (1.3, 4.0, -2.0))}
+
+
+def ogden(name):
+    mu, alpha = MATERIALS[name]
+    return np.array(mu)[:, None], np.array(alpha)[:, None]
+
+
+def phi_derivatives(name, lam):
+    """Φ1, Φ11, Φ12 of Φ = Σ (μ/α)(λ1^α + λ2^α + (λ1 λ2)^−α − 3) at λ1 = λ2 = λ, and φ' , φ'' of φ(λ) = Φ(λ, λ)."""
+    mu, alpha = ogden(name)
+    lam = np.atleast_1d(np.asarray(lam, dtype=float))
+    phi1 = np.sum(mu * (lam ** (alpha - 1) - lam ** (-2 * alpha - 1)), axis=0)
+    phi11 = np.sum(mu * ((alpha - 1) * lam ** (alpha - 2) + (alpha + 1) * lam ** (-2 * alpha - 2)), axis=0)
+    phi12 = np.sum(mu * alpha * lam ** (-2 * alpha - 2), axis=0)
+    dphi = np.sum(mu * (2 * lam ** (alpha - 1) - 2 * lam ** (-2 * alpha - 1)), axis=0)  # φ' = 2 Φ1
+    ddphi = np.sum(mu * (2 * (alpha - 1) * lam ** (alpha - 2) + 2 * (2 * alpha + 1) * lam ** (-2 * alpha - 2)), axis=0)
+    return phi1, phi11, phi12, dphi, ddphi
+
+
+def pressure(name, lam):
+    """The sphere's equilibrium: 4π r² P̄ = 4π R0 T0 W'(λ) ⇔ P = φ'(λ)/λ² (MODEL.md §4's 2Σμ(λ^(α−3) − λ^(−2α−3)))."""
+    return phi_derivatives(name, lam)[3] / np.asarray(lam) ** 2
+
+
+def breathing(name, lam, P):
+    """Ω² of the radial equation of motion linearised at fixed P (module docstring)."""
+    return (phi_derivatives(name, lam)[4] - 2 * P * lam) / 2
+
+
+def pressure_maximum(name):
+    """dP/dλ = 0: φ'' λ² − 2 λ φ' = 0 (the first root above λ = 1)."""
+    def slope(lam):
+        _, _, _, dphi, ddphi = phi_derivatives(name, lam)
+        return float(ddphi[0] * lam - 2 * dphi[0])
+    grid = np.linspace(1.01, 6.0, 500)
+    values = [slope(g) for g in grid]
+    k = next(i for i in range(len(grid) - 1) if values[i] * values[i + 1] < 0)
+    return optimize.brentq(slope, grid[k], grid[k + 1], xtol=1e-15, rtol=1e-15)
+
+
+def spheroidal(name, lam, P, n):
+    """The two Ω² of the degree-n spheroidal modes (module docstring), n ≥ 1."""
+    phi1, phi11, phi12 = (float(d[0]) for d in phi_derivatives(name, lam)[:3])
+    x, weights = legendre.leggauss(2 * n + 8)
+    s = np.sqrt(1 - x * x)
+    c = np.zeros(n + 1)
+    c[n] = 1.0
+    p, dp, ddp = (legendre.legval(x, legendre.legder(c, k)) for k in range(3))  # P_n and its x-derivatives
+
+    def fields(w, v):
+        U, dU = w * p, -w * s * dp  # d/dθ = −sin θ d/dx
+        W = -v * s * dp
+        dW = -v * (x * dp - s * s * ddp)
+        W_cot = -v * x * dp  # W cot θ
+        return U, dU, W, dW, W_cot
+
+    def quadratic_forms(w, v):
+        U, dU, W, dW, W_cot = fields(w, v)
+        A, B, C = U + dW, dU - W, U + W_cot
+        elastic = phi1 * B * B / (2 * lam) + 0.5 * phi11 * (A * A + C * C) + phi12 * A * C  # × sin θ dθ = dx
+        # (1/3)[λ sin θ (U² + U W' − W U' + W²) + λ (U sin θ + W cos θ)(2U + W')] dθ, U sin θ + W cos θ = sin θ (U + W cot θ)
+        volume = lam * (U * U + U * dW - W * dU + W * W) / 3 + lam * (U + W_cot) * (2 * U + dW) / 3  # × dx
+        stiffness = 2 * weights @ (elastic - P * volume)
+        mass = weights @ (U * U + W * W)
+        return stiffness, mass
+
+    def matrix(which):
+        q = lambda w, v: quadratic_forms(w, v)[which]  # noqa: E731
+        off = (q(1, 1) - q(1, 0) - q(0, 1)) / 2
+        return np.array([[q(1, 0), off], [off, q(0, 1)]])
+
+    return linalg.eigh(matrix(0), matrix(1), eigvals_only=True) / 2
+
+
+def sphere(name, lam):
+    """The equilibrium object (full basis, b_0 kept), the exact sphere of radius lam and its pressure."""
+    scene = load_scene(ROOT / "scenes" / "spom1.toml").with_overrides({"material.preset": name})
+    disc = Discretisation(DEGREE, symmetric=False, pin_translation=False)
+    a, b = np.zeros(DEGREE + 1), np.zeros(DEGREE + 1)
+    a[0], b[1] = lam, lam  # λ2 = λ, η = λ cos θ
+    return Equilibrium(scene, disc), disc.join(a, b), float(pressure(name, lam)[0])
+
+
+@pytest.fixture(scope="module", params=list(MATERIALS))
+def material(request):
+    eq, _, _ = sphere(request.param, 1.5)
+    return request.param, eq, mass_variation(eq, DEGREE)
+
+
+def sphere_frequencies(material, lam, m_max=0, count=4):
+    name, eq, variation = material
+    _, u, P = sphere(name, lam)
+    return frequencies(variation, u, Parameters(P), True, m_max, count), P
+
+
+def test_mass_matrices_are_the_kinetic_energy_of_the_displacement():
+    """cᵀ M c = (1/2π) ∫∫ |δx|² dA for random coefficients c: m = 0 from δx = sin θ δλ2 e_ρ + δη e_z at the nodes
+    of a finer rule, m = 1, 2, 3 from the Cartesian displacement (AzimuthalBasis.cartesian) on a θ × φ grid."""
+    rng = np.random.default_rng(39)
+    eq, _, _ = sphere("neo-Hookean", 1.5)
+    variation = mass_variation(eq, DEGREE)
+    c = rng.standard_normal(variation.basis.size)
+    x, weights = legendre.leggauss(60)
+    a, b = variation.basis.split(c)
+    dlam2, deta = legendre.legval(x, a), legendre.legval(x, b)
+    direct = weights @ ((1 - x * x) * dlam2**2 + deta**2)
+    assert c @ variation.gram @ c == pytest.approx(direct, rel=1e-13)
+    x, wx = legendre.leggauss(50)
+    phi = 2 * np.pi * np.arange(24) / 24
+    theta = np.repeat(np.arccos(x), phi.size)
+    for m in (1, 2, 3):
+        basis = az.AzimuthalBasis(m, 12, 40)
+        c = rng.standard_normal(basis.size)
+        dx = basis.cartesian(c, theta, np.tile(phi, x.size)).reshape(3, x.size, phi.size)
+        direct = wx @ np.mean(np.sum(dx**2, axis=0), axis=1)  # (1/2π) ∫ dφ ∫ d(cos θ)
+        assert c @ basis.gram @ c == pytest.approx(direct, rel=1e-13)
+
+
+def test_breathing_mode_is_the_radial_equation_of_motion_along_the_sphere_branch(material):
+    """Pressure control, held: the breathing mode's Ω² (in the 'even' block) equals (φ'' − 2Pλ)/2 to 1e-9 at
+    every λ of the branch (the whole block's lowest values are the breathing mode and the even n ≥ 2 spheroidal
+    pairs), and changes sign at the pressure maximum to 1e-10."""
+    name = material[0]
+    for lam in np.linspace(1.05, 4.0, 12):
+        blocks, P = sphere_frequencies(material, lam)
+        expected = np.sort(np.concatenate([[breathing(name, lam, P)[0]],
+                                           *(spheroidal(name, lam, P, n) for n in (2, 4, 6))]))[:4]
+        assert blocks["even"] == pytest.approx(expected, rel=1e-9, abs=1e-9)
+
+    def lowest_even(lam):
+        blocks, _ = sphere_frequencies(material, lam, count=1)
+        return blocks["even"][0]
+
+    peak = pressure_maximum(name)
+    found = optimize.brentq(lowest_even, peak - 0.05, peak + 0.05, xtol=1e-14)
+    assert abs(found - peak) < 1e-10
+    if name == "neo-Hookean":
+        assert peak == pytest.approx(7 ** (1 / 6), abs=1e-14)  # P = 4(1/λ − 1/λ⁷): λ⁶ = 7
+
+
+@pytest.mark.parametrize("lam", [1.3, 2.5])
+def test_spheroidal_modes_of_every_degree_are_in_every_block_m_up_to_n(material, lam):
+    """Degrees n = 2..5: both spheroidal Ω² of the closed form appear in the m = 0 block of their parity and in
+    every block m = 1..n (the sphere's degeneracy), each to 1e-9; the values found for one mode agree across m."""
+    name = material[0]
+    blocks, P = sphere_frequencies(material, lam, m_max=5, count=16)
+    for n in range(2, 6):
+        axisymmetric = blocks["even" if n % 2 == 0 else "odd_held"]
+        for value in spheroidal(name, lam, P, n):
+            found = [axisymmetric[np.argmin(abs(axisymmetric - value))]]
+            found += [blocks[f"m{m}_held"][np.argmin(abs(blocks[f"m{m}_held"] - value))] for m in range(1, n + 1)]
+            assert np.allclose(found, value, rtol=1e-9, atol=1e-9), (n, value, found)
+            assert np.ptp(found) <= 1e-9 * max(1.0, abs(value))
+
+
+def test_gas_stiffness_raises_and_the_volume_constraint_removes_the_breathing_mode(material):
+    """Gas control (isothermal, P V = const): the breathing mode's stiffness gains (P/Ṽ)(dṼ/dλ)² = 6Pλ
+    (Ṽ = ⅔λ³), so Ω²_gas = Ω² + 6Pλ/(2·2) (its mass ∫ sin θ dθ = 2); volume control leaves the even block
+    without it (the n ≥ 2 modes keep their values: they keep the volume)."""
+    name = material[0]
+    for lam in (1.2, 1.6, 3.0):
+        blocks, P = sphere_frequencies(material, lam, count=6)
+        others = np.sort(np.concatenate([spheroidal(name, lam, P, n) for n in (2, 4, 6, 8)]))
+        gas = breathing(name, lam, P)[0] + 1.5 * P * lam
+        assert blocks["even_gas"] == pytest.approx(np.sort(np.append(others, gas))[:6], rel=1e-9, abs=1e-9)
+        assert blocks["even_volume"] == pytest.approx(others[:6], rel=1e-9, abs=1e-9)
