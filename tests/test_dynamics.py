@@ -23,15 +23,20 @@ V/2π = (1/3) ∫ ρ [a(a + b') − b(a' − b)] dθ (a = λ + εU, b = εW, ρ 
 ∫ Φ sin θ dθ − P V/2π, M(u) = ∫ (U² + W²) sin θ dθ; in x = cos θ every integrand is a polynomial, integrated
 exactly by Gauss–Legendre. (w, v) → K, M by polarisation; Ω² = eig(K, M)/2 (two per n ≥ 1).
 """
+import json
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 from numpy.polynomial import legendre
 from scipy import linalg, optimize
 
+import balloon_cg as bc
 from balloon_cg.analysis import azimuthal as az
-from balloon_cg.dynamics.frequencies import frequencies, mass_variation
+from balloon_cg.analysis.results import Status
+from balloon_cg.app.cli import main
+from balloon_cg.dynamics.frequencies import frequencies, mass_variation, matching_block
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.scene import load_scene
@@ -205,3 +210,74 @@ def test_gas_stiffness_raises_and_the_volume_constraint_removes_the_breathing_mo
         gas = breathing(name, lam, P)[0] + 1.5 * P * lam
         assert blocks["even_gas"] == pytest.approx(np.sort(np.append(others, gas))[:6], rel=1e-9, abs=1e-9)
         assert blocks["even_volume"] == pytest.approx(others[:6], rel=1e-9, abs=1e-9)
+
+
+@pytest.fixture(scope="module")
+def spom1_run(tmp_path_factory):
+    """The SPOM1 whole picture to a pole stretch of 3 (an LP and the pear BP on the primary branch, a pear pair)
+    with [dynamics] frequencies = true (m_max 1), analysed and written to a run file."""
+    scene = load_scene(ROOT / "scenes" / "spom1.toml").with_overrides(
+        {"continuation.stop_stretch": 3.0, "dynamics.frequencies": True, "dynamics.count": 4})
+    result = bc.analyse(scene)
+    path = tmp_path_factory.mktemp("dynamics") / "spom1.h5"
+    result.save(path)
+    return result, path
+
+
+def test_located_special_points_have_a_vanishing_frequency_in_their_block(spom1_run):
+    """At every located fold and branch point one stored Ω² of its block (``matching_block``) is zero to the
+    solver's tolerance; the frequencies at the points around it change sign there."""
+    result, _ = spom1_run
+    checked = 0
+    for branch in result.picture.branches:
+        for n, s in enumerate(branch.special):
+            block = matching_block(s, branch)
+            if block is None or s.status != Status.LOCATED:
+                continue
+            assert np.min(np.abs(branch.frequencies.special[block][n])) <= branch.scene.solver.tol, (branch.name, s)
+            around = branch.frequencies.omega2[block][s.index:s.index + 2, 0]
+            assert around[0] * around[1] < 0, (branch.name, s, around)
+            checked += 1
+    assert checked >= 2  # the LP and the pear BP of the primary branch
+
+
+def test_frequencies_are_stored_with_units_and_read_back(spom1_run):
+    """frequencies/omega2_<block> (point, frequency) and special_omega2_<block> (special, frequency), units "1";
+    bc.load gives them back as computed."""
+    result, path = spom1_run
+    primary = next(b for b in result.picture.branches if b.name == "primary")
+    with h5py.File(path, "r") as f:
+        group = f["branches/primary/frequencies"]
+        assert group["omega2_even"].attrs["units"] == "1"
+        assert "Ω²" in group["omega2_even"].attrs["long_name"]
+        assert group.attrs["count"] == 4 and group.attrs["m_max"] == 1
+        assert group["special_omega2_odd_held"].shape == (len(primary.special), 4)
+    stored = bc.load(path).branches["primary"].data
+    assert stored["frequencies"].keys() == primary.frequencies.omega2.keys()
+    for block, values in primary.frequencies.omega2.items():
+        np.testing.assert_array_equal(stored["frequencies"][block], values)
+        np.testing.assert_array_equal(stored["special_frequencies"][block], primary.frequencies.special[block])
+
+
+def test_inspect_tables_the_special_points_and_json_lists_the_frequencies(spom1_run, capsys):
+    _, path = spom1_run
+    assert main(["inspect", str(path)]) == 0
+    text = capsys.readouterr().out.split("branch primary")[1].split("\nbranch ")[0]
+    assert "lowest Ω² = ω² R0² ρ/μ per block at the special points" in text
+    assert main(["inspect", str(path), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)["branches"]["primary"]
+    stored = bc.load(path).branches["primary"].data
+    assert summary["frequencies"]["even"] == pytest.approx(stored["frequencies"]["even"][:, 0], rel=0, abs=0)
+    lp = next(n for n, s in enumerate(summary["special_points"]) if s["kind"] == "LP")
+    assert abs(summary["special_frequencies"]["even"][lp]) < 1e-11
+
+
+@pytest.mark.parametrize("key, value, allowed", [("count", "0", "an integer in [1, 50]"),
+                                                 ("m_max", "9", "an integer in [0, 8]"),
+                                                 ("frequencies", "1", "true or false")])
+def test_bad_dynamics_values_are_one_line_and_exit_2(tmp_path, capsys, key, value, allowed):
+    out = tmp_path / "run.h5"
+    assert main(["run", "spom1", "--set", f"dynamics.{key}={value}", "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"dynamics.{key} = {value}: must be {allowed}" in err
+    assert not out.exists()

@@ -292,6 +292,10 @@ BAD = [
     ("stability-degree", MAT + "[stability]\ndegree = 3", "stability.degree"),
     ("m-max", MAT + "[stability]\nm_max = 9", "stability.m_max"),
     ("theta-points", MAT + "[output]\ntheta_points = 2", "output.theta_points"),
+    ("dynamics-count", MAT + "[dynamics]\ncount = 51", "dynamics.count = 51: must be an integer in [1, 50]"),
+    ("dynamics-m-max", MAT + "[dynamics]\nm_max = -1", "dynamics.m_max = -1: must be an integer in [0, 8]"),
+    ("dynamics-flag", MAT + '[dynamics]\nfrequencies = "yes"', 'dynamics.frequencies = "yes": must be true or false'),
+    ("dynamics-unknown", MAT + "[dynamics]\nmodes = 3", "dynamics.modes = 3: unknown key"),
     ("unknown-key-newline", MAT + '[output]\n"a\\nb" = 1', "output."),
 ]
 

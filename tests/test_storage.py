@@ -41,13 +41,14 @@ def run_file(tmp_path, scene, branch):
 
 def test_generated_digest_reads_the_signatures_the_modules_hold():
     """The provenance digest reads each module's SIGNATURE line from its text (no import); it must be the
-    constant the imported module holds, for every class, its whole-sphere module and the coil field."""
+    constant the imported module holds, for every class, its whole-sphere module, the coil field and the mass
+    matrices."""
     import hashlib
     import importlib
 
     from balloon_cg import generated
 
-    names = sorted(generated.CLASSES) + sorted(generated.SURFACE_CLASSES.values()) + ["coil_field"]
+    names = sorted(generated.CLASSES) + sorted(generated.SURFACE_CLASSES.values()) + ["coil_field", "inertia"]
     signatures = [importlib.import_module(f"balloon_cg.generated.{n}").SIGNATURE for n in names]
     assert [module_signature(n) for n in names] == signatures
     assert generated_digest() == hashlib.sha256("".join(signatures).encode()).hexdigest()

@@ -241,6 +241,7 @@ class Branch:
     lossy: tuple = ()  # projection losses above max_error/2 of points moved to the final basis
     wall_time: float = 0.0
     stability: list | None = None  # stability.Assessment per point
+    frequencies: object = None  # dynamics.frequencies.BranchFrequencies ([dynamics] frequencies = true)
     unsettled: list = field(default_factory=list)  # point indices whose flags change at the check degree
     parent: tuple | None = None  # (branch name, branch point number) a bifurcating branch leaves from
     rejoins: int | None = None  # the parent's branch point number where a bifurcating branch rejoins it

@@ -18,6 +18,7 @@ class Step(enum.StrEnum):
     CROSSINGS = "m >= 1 crossings"  # the branch points of the non-axisymmetric blocks, located
     SURFACE_BRANCHES = "non-axisymmetric branches"  # on the whole sphere, assessed (as Phase.SURFACE names them)
     SNAP_THROUGHS = "snap-throughs"
+    FREQUENCIES = "frequencies"  # [dynamics]: the natural frequencies of every axisymmetric branch
     WRITING = "writing"  # the run file
 
 

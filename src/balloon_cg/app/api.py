@@ -310,7 +310,8 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
     primary branch only (snap-throughs and picture None; a field that is not axisymmetric has no other branches
     yet: its picture), or the whole picture (analysis.picture.analyse; its
     axisymmetric branches, then its surface branches); ``clock`` the seconds of each phase (analysis.timing,
-    started here: the writer adds its own)."""
+    started here: the writer adds its own). With [dynamics] frequencies = true the axisymmetric branches get their
+    natural frequencies (dynamics.frequencies.attach)."""
     from ..analysis.picture import analyse as analyse_picture
     from ..analysis.primary import trace_primary
     from ..analysis.timing import Clock, Step
@@ -322,9 +323,23 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
             with clock.step(Step.TRACE):
                 branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
             bars.finish(Phase.PRIMARY, len(branches[0].X))
+            _with_frequencies(branches, scene, clock)
             return branches, None, incomplete(branches), None, clock
         picture = analyse_picture(scene, bars, pear=pear, clock=clock)
-        return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture, clock
+        branches = picture.branches + picture.surface_branches
+        _with_frequencies(branches, scene, clock)
+        return branches, picture.snaps, picture.incomplete, picture, clock
+
+
+def _with_frequencies(branches, scene: Scene, clock) -> None:
+    """The natural frequencies of the axisymmetric branches (dynamics.frequencies.attach), timed, when the scene asks
+    for them ([dynamics] frequencies = true)."""
+    from ..analysis.timing import Step
+    from ..dynamics.frequencies import attach
+
+    if scene.dynamics.frequencies:
+        with clock.step(Step.FREQUENCIES):
+            attach(branches, scene.dynamics.count, scene.dynamics.m_max)
 
 
 def trace(scene, progress: bool = False) -> Result:

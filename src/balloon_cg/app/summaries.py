@@ -154,6 +154,9 @@ def summarise_branch(b: dict) -> dict:
         "gauge": attrs["gauge"],  # io.run_file reads it from the layout in files written before it
         "reflection_of": attrs.get("reflection_of", ""),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
+        **({"frequencies": {block: values[:, 0] for block, values in b["frequencies"].items()},
+            "special_frequencies": {block: values[:, 0] for block, values in b["special_frequencies"].items()}}
+           if "frequencies" in b else {}),
     }
 
 
@@ -343,7 +346,7 @@ def _format_branch(name: str, b: dict) -> list[str]:
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
     ]
-    return lines + _special_lines(b["special_points"], b["gauge"])
+    return lines + _special_lines(b["special_points"], b["gauge"]) + _frequency_lines(b)
 
 
 READINGS = {"both": "held and free", "held": "held at its centre", "free": "free (net axial force zero)"}
@@ -370,6 +373,25 @@ def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]
             f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
         )
     return lines
+
+
+def _frequency_lines(b: dict) -> list[str]:
+    """The lowest Ω² of every block at each special point (its label and kind), one aligned row each, when the branch
+    stores frequencies ([dynamics])."""
+    if "special_frequencies" not in b or not b["special_points"]:
+        return []
+    blocks = list(b["special_frequencies"])
+    rows = [[f"{s['label']} {s['kind']}"] + [_omega2(b["special_frequencies"][k][n]) for k in blocks]
+            for n, s in enumerate(b["special_points"])]
+    widths = [max(len(r[j]) for r in rows + [["", *blocks]]) for j in range(len(blocks) + 1)]
+    table = [["", *blocks]] + rows
+    return ["  lowest Ω² = ω² R0² ρ/μ per block at the special points (negative: unstable; docs/dynamics.md)",
+            *("    " + "  ".join(cell.rjust(w) if j else cell.ljust(w) for j, (cell, w) in enumerate(zip(r, widths)))
+              for r in table)]
+
+
+def _omega2(value) -> str:
+    return "-" if not np.isfinite(value) else f"{value:.6g}"
 
 
 def _stable_counts(counts: dict, points: int) -> str:

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..analysis.azimuthal import merged_lowest
 from ..analysis.problem import equilibrium_of
+from ..analysis.results import Branch, Gauge, Kind
 from ..analysis.stability import SecondVariation, assessed_degrees
 from ..numerics import interrupt
 
@@ -48,28 +49,65 @@ def frequencies(variation: SecondVariation, u, params, symmetric: bool, m_max: i
 class BranchFrequencies:
     """The lowest Ω² of every block at every point of a branch: ``omega2[name]`` (points × count), NaN where a point
     has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (that of its stability
-    assessment, so a stored Ω² and a located special point of the same block share their basis)."""
+    assessment); ``special[name]`` (special points × count) the same at each special point's own state, at the
+    higher degree of the points around it."""
 
     omega2: dict
     degree: np.ndarray
+    special: dict
     count: int
     m_max: int
 
 
 def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None) -> BranchFrequencies:
-    """``frequencies`` at every point of ``branch`` (module docstring), each at its ``assessed_degrees``."""
+    """``frequencies`` at every point and every special point of ``branch`` (module docstring), each point at its
+    ``assessed_degrees``."""
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     eq = equilibrium_of(branch)
     degrees = np.array(assessed_degrees(branch), dtype=int)
     variations = {}
-    rows = []
-    for X, N in zip(branch.X, degrees):
+
+    def at(X, N):
         interrupt.check()
         variation = variations.get(N) or variations.setdefault(N, mass_variation(eq, N))
-        rows.append(frequencies(variation, X[:-1], branch.params_at(X), symmetric, m_max, count))
+        return frequencies(variation, X[:-1], branch.params_at(X), symmetric, m_max, count)
+
+    rows = [at(X, N) for X, N in zip(branch.X, degrees)]
+    special = [at(s.X, int(degrees[s.index:s.index + 2].max())) for s in branch.special]
     names = list(dict.fromkeys(name for row in rows for name in row))
-    omega2 = {name: np.full((len(rows), count), np.nan) for name in names}
+    return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), count, m_max)
+
+
+def _table(rows: list, names: list, count: int) -> dict:
+    """{block: (rows × count) Ω²} from per-row dicts, NaN where a row has fewer values (or not the block)."""
+    table = {name: np.full((len(rows), count), np.nan) for name in names}
     for n, row in enumerate(rows):
         for name, values in row.items():
-            omega2[name][n, :values.size] = values
-    return BranchFrequencies(omega2, degrees, count, m_max)
+            table[name][n, :values.size] = values
+    return table
+
+
+FOLD_CONTROL = {Kind.LP: "", Kind.LV: "_volume", Kind.LN: "_gas"}  # the control whose Hessian a fold makes singular
+
+
+def matching_block(special, branch) -> str | None:
+    """The block one of whose Ω² vanishes at a special point of ``branch``: a branch point's own block; a fold in P
+    (LP), V (LV) or n (LN) the block of the equator-symmetric modes under that control (even, even_volume,
+    even_gas), on a branch without that symmetry all modes in the branch's reading (all_held, all_volume_free,
+    ...); None for the others (TP, EP, UZ: no stability change)."""
+    if special.kind == Kind.BP:
+        return special.block.value
+    if special.kind not in FOLD_CONTROL:
+        return None
+    control = FOLD_CONTROL[special.kind]
+    if branch.disc.symmetric:
+        return f"even{control}"
+    return f"all{control}_{'free' if branch.gauge == Gauge.FREE else 'held'}"
+
+
+def attach(branches, count: int, m_max: int) -> None:
+    """``branch.frequencies`` (``branch_frequencies``) of every axisymmetric branch; surface branches are left
+    without."""
+    for branch in branches:
+        if isinstance(branch, Branch):
+            branch.frequencies = branch_frequencies(branch, count, m_max)

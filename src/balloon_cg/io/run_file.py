@@ -33,6 +33,11 @@ Layout::
         special_points/state/unknowns                      (special, unknown): each point's own X
         stability/stable_*                                 (point,) flags
         stability/lowest_<block>                           (point, eigenvalue): lowest eigenvalues
+        frequencies/omega2_<block>                         (point, frequency): the lowest Ω² = ω² R0² ρ/μ of the
+                                                           block (NaN: fewer modes); attrs count, m_max ([dynamics])
+        frequencies/perturbation_degree                    (point,): the degree they were computed at
+        frequencies/special_omega2_<block>                 (special, frequency): the same at each special point's
+                                                           own state
     /branches/<name>/      a surface branch (analysis.results.SurfaceBranch, m ≥ 1): attrs order, m, parent_branch,
                            parent_branch_point, stop_reason, leg_labels, leg_stop_codes, wall_time, kernel_class,
                            kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
@@ -75,7 +80,7 @@ from ..surface.loads import LOADS
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
                      require_group)
-from .schema import FINITE, attach_dimensions, check_described, scale
+from .schema import FINITE, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, scale
 
 FORMAT = "balloon-cg/5"
 READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
@@ -274,6 +279,8 @@ def _write_branch(group, branch, theta, first_label: int = 1):
                   first_label)
     if branch.stability:
         _write_stability(group.create_group("stability"), branch, point)
+    if branch.frequencies is not None:
+        _write_frequencies(group.create_group("frequencies"), branch.frequencies, point)
 
 
 def _write_common_attrs(group, branch) -> None:
@@ -392,6 +399,20 @@ def _write_stability(group, branch, point):
         checksummed(group, name, values)
     attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
     group.attrs["unsettled_points"] = np.asarray(branch.unsettled, dtype=np.int64)
+
+
+def _write_frequencies(group, frequencies, point):
+    """Ω² per block (dynamics.frequencies.BranchFrequencies) and the degree per point."""
+    group.attrs.update({"count": frequencies.count, "m_max": frequencies.m_max})
+    frequency = scale(group, "frequency", frequencies.count)
+    special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
+    group.create_dataset("perturbation_degree", data=frequencies.degree)
+    axes = {1: (point,), 2: (point, frequency)}
+    for block, values in frequencies.omega2.items():
+        group.create_dataset(f"{OMEGA2}{block}", data=values)
+        group.create_dataset(f"{SPECIAL_OMEGA2}{block}", data=frequencies.special[block])
+        axes[f"{SPECIAL_OMEGA2}{block}"] = (special, frequency)
+    attach_dimensions(group, axes)
 
 
 def _write_snaps(group, snaps):
@@ -642,6 +663,19 @@ def check_branch(group, where, error, written: bool = False) -> None:
     check_special(require_group(group, "special_points", where, error), f"{where}: special_points", width, error,
                   written=written)
     check_stability(group, where, error, n, written)
+    check_frequencies(group, where, error, n)
+
+
+def check_frequencies(group, where, error, n: int) -> None:
+    """A branch's frequencies group, where present: Ω² per block ``n`` rows, at the special points one row each."""
+    if "frequencies" not in group:
+        return
+    frequencies = require_group(group, "frequencies", where, error)
+    columns = {name: ("float", 2) for name in frequencies if name.startswith(OMEGA2)}
+    check_columns(frequencies, f"{where}: frequencies", columns | {"perturbation_degree": ("int", 1)}, error, rows=n)
+    special = {name: ("float", 2) for name in frequencies if name.startswith(SPECIAL_OMEGA2)}
+    check_columns(frequencies, f"{where}: frequencies", special, error, rows=len(group["special_points"]["kind"]))
+    check_sizes(frequencies, f"{where}: frequencies", error)
 
 
 def check_stability(group, where, error, n: int, written: bool) -> None:
@@ -797,6 +831,10 @@ def _read_branch(group) -> dict:
     data["special_unknowns"] = special_unknowns(sp)[()]
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
+    if "frequencies" in group:
+        for key, prefix in (("frequencies", OMEGA2), ("special_frequencies", SPECIAL_OMEGA2)):
+            data[key] = {name.removeprefix(prefix): item[()] for name, item in group["frequencies"].items()
+                         if name.startswith(prefix)}
     return data
 
 

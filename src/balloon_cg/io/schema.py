@@ -29,6 +29,8 @@ VARIABLES = {
     "to_branch": ("", "to branch", "the branch of the lowest-energy stable state at that P (empty: none)"),
     "to_index": (COUNT, "to point", "its point near the same P (-1: none)"),
     "eigenvalue": (COUNT, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
+    "frequency": (COUNT, "frequency index", "0: the lowest natural frequency of the block, 1: the next, …"),
+    "perturbation_degree": (COUNT, "perturbation degree", "Legendre degree N of the perturbation basis"),
     "coefficient": (COUNT, "coefficient index", "coefficients c of the displacement in the branch's "
                                                          "spherical harmonics, in block order (docs/hdf5.md)"),
     "axis": (COUNT, "Cartesian axis", "0: x, 1: y, 2: z (z the coil axis)"),
@@ -98,15 +100,23 @@ VARIABLES = {
     "stable_gas_free": (COUNT, "stable, free, gas control", "axial translation included"),
 }
 LOWEST = (NONDIMENSIONAL, "lowest eigenvalue", "smallest eigenvalue of the second-variation block")
+OMEGA2 = "omega2_"  # the prefix of the natural frequencies per block (frequencies/omega2_<block>)
+FREQUENCY = (NONDIMENSIONAL, "squared natural frequency Ω²", "Ω² = ω² R0² ρ/μ of a mode of the block (ω the angular "
+                                                           "frequency, ρ the density, μ the initial shear modulus); "
+                                                           "negative: an unstable mode; NaN: the block has fewer modes")
+SPECIAL_OMEGA2 = "special_" + OMEGA2  # ... at the special points (frequencies/special_omega2_<block>)
+PREFIXED = {"lowest_": LOWEST, OMEGA2: FREQUENCY,
+            SPECIAL_OMEGA2: (NONDIMENSIONAL, "squared natural frequency Ω² at a special point", FREQUENCY[2])}
 
 
 def describe(dataset, name: str | None = None) -> None:
     """Set ``units`` (a quantity's only), ``long_name`` and ``description`` of an h5py dataset from VARIABLES (by
     its own name)."""
     name = name or dataset.name.rsplit("/", 1)[-1]
-    units, long_name, description = LOWEST if name.startswith("lowest_") else VARIABLES[name]
-    if name.startswith("lowest_"):
-        long_name = f"{long_name}, block {name.removeprefix('lowest_')}"
+    prefix = next((p for p in PREFIXED if name.startswith(p)), None)
+    units, long_name, description = VARIABLES[name] if prefix is None else PREFIXED[prefix]
+    if prefix is not None:
+        long_name = f"{long_name}, block {name.removeprefix(prefix)}"
     dataset.attrs.update({"units": units} if units else {})
     dataset.attrs.update({"long_name": long_name, "description": description})
 

@@ -209,6 +209,16 @@ SURFACE_BRANCHES = ("first", "all", "none")
 
 
 @dataclass(frozen=True)
+class Dynamics:
+    """Natural frequencies (MODEL.md §11, docs/dynamics.md): with ``frequencies`` the lowest ``count`` Ω² of every
+    second-variation block, m = 0..``m_max``, at every point of every axisymmetric branch."""
+
+    frequencies: bool = False
+    count: int = 3
+    m_max: int = 1
+
+
+@dataclass(frozen=True)
 class Output:
     """Sampling of the reported shapes and fields: ``theta_points`` values of θ on [0, π]."""
 
@@ -217,7 +227,7 @@ class Output:
 
 
 _TABLES = ("material", "field", "continuation", "solver", "stability", "output", "loading", "electric", "surface",
-           "events", "geometry")
+           "events", "geometry", "dynamics")
 MAX_NESTING = 8  # docs/scenes.md, Bounds: arrays/tables within one another (a scene needs 3)
 MAX_QUADRATURE = 1000  # Gauss points (automatic at degree 400: 608)
 # docs/scenes.md, Bounds: ranges that keep the computation finite (the paper's values are far inside them)
@@ -262,6 +272,7 @@ class Scene:
     surface: Surface = Surface()
     events: tuple[Event, ...] = ()  # [[events]]: points wanted where a stored quantity reaches a value (UZ)
     geometry: Geometry = Geometry()  # [geometry]: the reference surface
+    dynamics: Dynamics = Dynamics()
 
     @classmethod
     def from_toml(cls, path) -> "Scene":
@@ -288,7 +299,8 @@ class Scene:
 
     def to_dict(self) -> dict:
         """The normalised, fully defaulted scene as plain dicts, lists and numbers (presets expanded); the
-        [loading] and [surface] tables only when they are not the default, so older scenes keep their text."""
+        [loading], [surface] and [dynamics] tables only when they are not the default, so older scenes keep their
+        text."""
         m, f = self.material, self.field
         return {
             "material": m.to_table() if isinstance(m, StrainEnergy) else
@@ -304,6 +316,7 @@ class Scene:
             **({"events": [e.to_table() for e in self.events]} if self.events else {}),
             **({} if self.geometry == Geometry() else {"geometry": {"shape": self.geometry.shape.value,
                                                                      "aspect": self.geometry.aspect}}),
+            **({} if self.dynamics == Dynamics() else {"dynamics": asdict(self.dynamics)}),
         }
 
     def __repr__(self):
@@ -599,6 +612,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         surface=_surface(data.get("surface", {})),
         events=events_from_list(data.get("events", [])),
         geometry=geometry,
+        dynamics=_dynamics(data.get("dynamics", {})),
     )
 
 
@@ -850,6 +864,16 @@ def _surface(data) -> Surface:
                          + ", ".join(f'"{b}"' for b in SURFACE_BRANCHES))
     return Surface(branches, get("degree", lambda n: 4 <= n <= 48, "an integer in [4, 48]", integer=True),
                    get("max_points", lambda n: 1 <= n <= 10_000, "an integer in [1, 10000]", integer=True))
+
+
+def _dynamics(data) -> Dynamics:
+    data = table("dynamics", data, _keys(Dynamics))
+    get = _getter(data, "dynamics", Dynamics)
+    wanted = data.get("frequencies", Dynamics.frequencies)
+    if not isinstance(wanted, bool):
+        raise SceneError(f"dynamics.frequencies = {show(wanted)}: must be true or false")
+    return Dynamics(wanted, get("count", lambda n: 1 <= n <= 50, "an integer in [1, 50]", integer=True),
+                    get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True))
 
 
 def _output(data) -> Output:
