@@ -39,6 +39,7 @@ from balloon_cg.app.cli import main
 from balloon_cg.dynamics.frequencies import frequencies, mass_variation, matching_block
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.post.plotting import plot
 from balloon_cg.scene import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -281,3 +282,16 @@ def test_bad_dynamics_values_are_one_line_and_exit_2(tmp_path, capsys, key, valu
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"dynamics.{key} = {value}: must be {allowed}" in err
     assert not out.exists()
+
+
+def test_frequency_pressure_figure(spom1_run, tmp_path):
+    """plot --what frequencies: Ω² of every block against P, the LP and the pear BP marked at Ω² = 0."""
+    _, path = spom1_run
+    out = tmp_path / "frequencies.png"
+    assert main(["plot", str(path), "--what", "frequencies", "-o", str(out)]) == 0
+    assert out.read_bytes().startswith(b"\x89PNG")
+    fig = plot([path], "frequencies")
+    ax = fig.axes[0]
+    assert ax.get_ylabel().startswith(r"$\Omega^2")
+    marked = [line for line in ax.lines if line.get_marker() in ("o", "D") and len(line.get_xdata()) == 1]
+    assert len(marked) >= 2 and all(line.get_ydata()[0] == 0.0 for line in marked)

@@ -351,6 +351,7 @@ def applicable_kinds(branches) -> list[str]:
             if kind != "phase" and (kind.split("-")[0] not in curves or prefixes == {kind.split("-")[0]})
             and (kind != "field" or any(b.coils for b in branches))
             and (kind != "energy" or any(b.bifurcations for b in branches))
+            and (kind != "frequencies" or any("frequencies" in b.data for b in branches))
             and (kind not in SURFACE_KINDS or any(b.surface for b in branches))]
 
 
@@ -1006,6 +1007,43 @@ def _amplitude_range(e2, e3, e4) -> float:
     return float(np.clip(1.5 * scale, 0.04, 0.5))
 
 
+FREQUENCY_STYLES = ("-", "--", "-.", ":")  # one per drawn branch
+
+
+def plot_frequencies(branches, axes=None) -> Figure:
+    """The lowest squared natural frequency Ω² = ω² R0² ρ/μ of every stored block against the continuation
+    parameter (P or Φ̄), one colour per block and one line style per branch; the folds and branch points marked
+    at Ω² = 0, where a block's Ω² passes through zero (docs/dynamics.md). Branches without frequencies are left
+    out."""
+    drawn = [b for b in branches if "frequencies" in b.data]
+    if not drawn:
+        files = ", ".join(dict.fromkeys(str(b.source) for b in branches))
+        raise PlotError(f"{files}: no stored frequencies (frequencies/ of a branch); run the scene with "
+                        "[dynamics] frequencies = true")
+    fig, panels, own = _panels(axes, 1, (8.4, 4.8))
+    ax = panels[0]
+    ax.axhline(0.0, color="0.6", linewidth=0.6)
+    blocks = list(dict.fromkeys(block for b in drawn for block in b.data["frequencies"]))
+    colours = {block: f"C{k % 10}" for k, block in enumerate(blocks)}
+    marks = []
+    for b, style in zip(drawn, FREQUENCY_STYLES * len(drawn)):
+        for block, values in b.data["frequencies"].items():
+            ax.plot(b.parameter_values, values[:, 0], style, color=colours[block], linewidth=1.2)
+        crossing = [s for s in b.data["special_points"] if s["kind"] in ("LP", "LV", "LN", "BP")]
+        for s in crossing:
+            ax.plot(s[b.ordinate.column], 0.0, MARKERS.get(s["kind"], "D"), color="k", markersize=5)
+            marks.append((ax, special_label(s), s[b.ordinate.column], 0.0, "k"))
+    ax.set_xlabel(drawn[0].ordinate.label)
+    ax.set_ylabel(r"$\Omega^2 = \omega^2 R_0^2 \rho/\mu$ (lowest of each block)")
+    ax.set_title(_title(drawn))
+    handles = [Line2D([], [], color=colours[block], label=block) for block in blocks]
+    handles += [Line2D([], [], color="0.3", linestyle=style, label=b.label or b.name)
+                for b, style in zip(drawn, FREQUENCY_STYLES * len(drawn))]
+    _legend(fig, panels, own, "right upper", handles=handles, title="block; branch")
+    label_points(marks)
+    return fig
+
+
 def plot_energy(branches, axes=None) -> Figure:
     """Energy landscape E(Λ) − E0 = E2Λ² + E3Λ³ + E4Λ⁴ along the critical mode at each branch point (the
     special points with finite E2, E3, E4, written by the stability analysis)."""
@@ -1196,6 +1234,7 @@ KINDS = {
     "field": (plot_field, True),
     "curvature": (plot_curvature, True),
     "energy": (plot_energy, False),
+    "frequencies": (plot_frequencies, False),
     "phase": (plot_phase, False),
     "surface": (plot_surface, True),
     "stretch-map": (plot_stretch_map, True),
