@@ -36,9 +36,14 @@ import balloon_cg as bc
 from balloon_cg.analysis import azimuthal as az
 from balloon_cg.analysis.results import Status
 from balloon_cg.app.cli import main
-from balloon_cg.dynamics.frequencies import frequencies, mass_variation, matching_block
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.dynamics.frequencies import branch_frequencies, frequencies, matching_block
+from balloon_cg.dynamics.pencil import mass_variation
+from balloon_cg.dynamics.translation import DIRECTIONS
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.model.field import field_squared
 from balloon_cg.post.plotting import plot
 from balloon_cg.scene import load_scene
 
@@ -295,3 +300,52 @@ def test_frequency_pressure_figure(spom1_run, tmp_path):
     assert ax.get_ylabel().startswith(r"$\Omega^2")
     marked = [line for line in ax.lines if line.get_marker() in ("o", "D") and len(line.get_xdata()) == 1]
     assert len(marked) >= 2 and all(line.get_ydata()[0] == 0.0 for line in marked)
+
+
+def test_rigid_translations_are_zero_frequencies_without_a_field(spom1_run):
+    """M = 0: the free balloon's rigid translations (axial and lateral) cost nothing: Ω²_t = 0 at every point."""
+    result, _ = spom1_run
+    for branch in result.picture.branches:
+        for values in branch.frequencies.translation.values():
+            assert np.abs(values).max() < 1e-12
+
+
+def field_translation_omega2(eq, u, chi, M, direction):
+    """Ω²_t of a rigid translation in a field from the field energy alone: −½χM d²/dε² (1/2π)∫∫H²(x0 + ε e) dA
+    (the membrane and the pressure do not see a translation) over its mass (1/2π)∫∫|e|² dA = 2, halved (units),
+    the second difference in ε with one Richardson step, H² from the coil field at the 3D points."""
+    x, w = legendre.leggauss(72)
+    theta = np.arccos(x)
+    lam2, _, eta, _ = eq.disc.evaluate(u, theta)
+    phi = 2 * np.pi * np.arange(48) / 48
+    points = np.stack([np.outer(lam2 * np.sin(theta), np.cos(phi)), np.outer(lam2 * np.sin(theta), np.sin(phi)),
+                       np.outer(eta, np.ones_like(phi))])
+    shift = np.zeros(3)
+    shift[{"axial": 2, "lateral": 0}[direction]] = 1.0
+
+    def field_integral(eps):
+        y = points + eps * shift[:, None, None]
+        r = np.hypot(y[0], y[1])
+        H2 = np.array([[field_squared(r[i, j], y[2][i, j], eq.coils)[0] for j in range(phi.size)]
+                       for i in range(x.size)])
+        return w @ H2.mean(axis=1)
+
+    e = 1e-2
+    d2 = [(field_integral(h) + field_integral(-h) - 2 * field_integral(0.0)) / h**2 for h in (e, e / 2)]
+    d2 = (4 * d2[1] - d2[0]) / 3
+    return 0.5 * (-0.5 * chi * M * d2) / 2.0
+
+
+def test_rigid_translations_in_a_field_are_the_field_stiffness():
+    """Two opposed coils, M = 0.002, a point of the primary branch: the stored Ω²_t of each translation equals the
+    field's second difference along it (``field_translation_omega2``) to 1e-6; the field pulls the paramagnetic
+    balloon away from the centre both along and across the axis (Ω²_t < 0: |H|² of a current-free field is
+    subharmonic, so no position restores it in every direction)."""
+    scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml")
+    branch = trace_primary(scene, stop_stretch=1.5, down=False)
+    found = branch_frequencies(branch, count=2, m_max=1)
+    eq, X = equilibrium_of(branch), branch.X[-1]
+    for direction in DIRECTIONS:
+        expected = field_translation_omega2(eq, X[:-1], branch.params.chi, branch.params.M, direction)
+        assert found.translation[direction][-1] == pytest.approx(expected, rel=1e-6)
+    assert found.translation["axial"][-1] < 0 and found.translation["lateral"][-1] < 0

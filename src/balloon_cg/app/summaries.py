@@ -155,8 +155,8 @@ def summarise_branch(b: dict) -> dict:
         "reflection_of": attrs.get("reflection_of", ""),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
         **({"frequencies": {block: values[:, 0] for block, values in b["frequencies"].items()},
-            "special_frequencies": {block: values[:, 0] for block, values in b["special_frequencies"].items()}}
-           if "frequencies" in b else {}),
+            "special_frequencies": {block: values[:, 0] for block, values in b["special_frequencies"].items()},
+            "translation_omega2": b["translation_omega2"]} if "frequencies" in b else {}),
     }
 
 
@@ -378,16 +378,25 @@ def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]
 def _frequency_lines(b: dict) -> list[str]:
     """The lowest Ω² of every block at each special point (its label and kind), one aligned row each, when the branch
     stores frequencies ([dynamics])."""
-    if "special_frequencies" not in b or not b["special_points"]:
+    if "special_frequencies" not in b:
         return []
+    rigid = [f"  rigid translation Ω² {direction} {_range_text(values)}" for direction, values in
+             b["translation_omega2"].items()]
+    rigid[-1] += "  (0: no field, the balloon drifts; > 0 the field restores it, < 0 pulls it away)"
+    if not b["special_points"]:
+        return rigid
     blocks = list(b["special_frequencies"])
     rows = [[f"{s['label']} {s['kind']}"] + [_omega2(b["special_frequencies"][k][n]) for k in blocks]
             for n, s in enumerate(b["special_points"])]
     widths = [max(len(r[j]) for r in rows + [["", *blocks]]) for j in range(len(blocks) + 1)]
     table = [["", *blocks]] + rows
-    return ["  lowest Ω² = ω² R0² ρ/μ per block at the special points (negative: unstable; docs/dynamics.md)",
+    return rigid + ["  lowest Ω² = ω² R0² ρ/μ per block at the special points (negative: unstable; docs/dynamics.md)",
             *("    " + "  ".join(cell.rjust(w) if j else cell.ljust(w) for j, (cell, w) in enumerate(zip(r, widths)))
               for r in table)]
+
+
+def _range_text(values) -> str:
+    return f"{min(values):.3g} .. {max(values):.3g}"
 
 
 def _omega2(value) -> str:

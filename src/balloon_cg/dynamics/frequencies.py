@@ -1,12 +1,7 @@
 """Natural frequencies of an equilibrium per second-variation block (MODEL.md §11, docs/dynamics.md).
 
-The membrane's kinetic energy ½ ρ T0 ∫ |u̇|² dA (the gas massless) is, for a perturbation q(t) on a block's
-basis, (2π ρ T0 R0⁴) ½ q̇ᵀ M q̇ with M the mass matrix of generated/inertia.py (codegen/inertia.py); the loaded
-energy is (2π T0 R0² μ/2) ½ qᵀ K q with K the block's second variation of E (per 2π, moduli over μ/2: MODEL.md §2).
-Small oscillations q = q̂ e^{iωt} solve K q̂ = ν M q̂ with ω² = (μ/2) ν / (ρ R0²), so the dimensionless frequency
-Ω = ω R0 √(ρ/μ) (μ the initial shear modulus) is
-
-    Ω² = ν / 2.
+Small oscillations solve K q̂ = ν M q̂ per block, M the mass matrix of the membrane's kinetic energy
+(generated/inertia.py), and the dimensionless frequency Ω = ω R0 √(ρ/μ) has Ω² = ν/2 (``pencil``).
 
 K is the block's matrix under the scene's control: pressure, the Hessian H; volume, H on the perturbations that
 keep the volume (gᵀq = 0, g = ∂Ṽ/∂q: the constrained subspace); gas, H + (P/Ṽ) g gᵀ (its stiffness); held or free
@@ -24,14 +19,8 @@ from ..analysis.problem import equilibrium_of
 from ..analysis.results import Branch, Gauge, Kind
 from ..analysis.stability import SecondVariation, assessed_degrees
 from ..numerics import interrupt
-
-PER_EIGENVALUE = 0.5  # Ω² per eigenvalue ν of K q = ν M q (module docstring)
-MASS_NORM = "displacement"  # the SecondVariation norm whose Gram matrix is the mass matrix
-
-
-def mass_variation(equilibrium, degree: int) -> SecondVariation:
-    """The second variation of ``equilibrium`` at perturbation ``degree`` with the mass matrix as its Gram matrix."""
-    return SecondVariation(equilibrium, int(degree), norm=MASS_NORM)
+from .pencil import MASS_NORM, PER_EIGENVALUE, mass_variation
+from .translation import DIRECTIONS, translation_omega2
 
 
 def frequencies(variation: SecondVariation, u, params, symmetric: bool, m_max: int = 0, count: int = 3) -> dict:
@@ -50,11 +39,13 @@ class BranchFrequencies:
     """The lowest Ω² of every block at every point of a branch: ``omega2[name]`` (points × count), NaN where a point
     has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (that of its stability
     assessment); ``special[name]`` (special points × count) the same at each special point's own state, at the
-    higher degree of the points around it."""
+    higher degree of the points around it; ``translation[direction]`` (points,) the rigid translations' Ω²
+    (translation.translation_omega2: 0 without a field, else > 0 restored, < 0 pulled)."""
 
     omega2: dict
     degree: np.ndarray
     special: dict
+    translation: dict
     count: int
     m_max: int
 
@@ -74,8 +65,11 @@ def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool |
 
     rows = [at(X, N) for X, N in zip(branch.X, degrees)]
     special = [at(s.X, int(degrees[s.index:s.index + 2].max())) for s in branch.special]
+    rigid = [translation_omega2(variations[N], X[:-1], branch.params_at(X)) for X, N in zip(branch.X, degrees)]
     names = list(dict.fromkeys(name for row in rows for name in row))
-    return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), count, m_max)
+    translation = {direction: np.array([r[direction] for r in rigid]) for direction in DIRECTIONS}
+    return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), translation, count,
+                             m_max)
 
 
 def _table(rows: list, names: list, count: int) -> dict:

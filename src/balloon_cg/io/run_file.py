@@ -38,6 +38,8 @@ Layout::
         frequencies/perturbation_degree                    (point,): the degree they were computed at
         frequencies/special_omega2_<block>                 (special, frequency): the same at each special point's
                                                            own state
+        frequencies/translation_axial, translation_lateral (point,): Ω² of the rigid translations (0 without a
+                                                           field; > 0 the field restores, < 0 it pulls)
     /branches/<name>/      a surface branch (analysis.results.SurfaceBranch, m ≥ 1): attrs order, m, parent_branch,
                            parent_branch_point, stop_reason, leg_labels, leg_stop_codes, wall_time, kernel_class,
                            kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
@@ -87,6 +89,7 @@ READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
 POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
 SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
 SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
+TRANSLATIONS = ("translation_axial", "translation_lateral")  # frequencies/: the rigid translations' Ω²
 
 
 class RunFileError(FileError):
@@ -407,6 +410,8 @@ def _write_frequencies(group, frequencies, point):
     frequency = scale(group, "frequency", frequencies.count)
     special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
     group.create_dataset("perturbation_degree", data=frequencies.degree)
+    for direction, values in frequencies.translation.items():
+        group.create_dataset(f"translation_{direction}", data=values)
     axes = {1: (point,), 2: (point, frequency)}
     for block, values in frequencies.omega2.items():
         group.create_dataset(f"{OMEGA2}{block}", data=values)
@@ -672,7 +677,9 @@ def check_frequencies(group, where, error, n: int) -> None:
         return
     frequencies = require_group(group, "frequencies", where, error)
     columns = {name: ("float", 2) for name in frequencies if name.startswith(OMEGA2)}
-    check_columns(frequencies, f"{where}: frequencies", columns | {"perturbation_degree": ("int", 1)}, error, rows=n)
+    rigid = {name: ("float", 1) for name in TRANSLATIONS}
+    check_columns(frequencies, f"{where}: frequencies", columns | rigid | {"perturbation_degree": ("int", 1)}, error,
+                  rows=n)
     special = {name: ("float", 2) for name in frequencies if name.startswith(SPECIAL_OMEGA2)}
     check_columns(frequencies, f"{where}: frequencies", special, error, rows=len(group["special_points"]["kind"]))
     check_sizes(frequencies, f"{where}: frequencies", error)
@@ -832,7 +839,8 @@ def _read_branch(group) -> dict:
     if "stability" in group:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
     if "frequencies" in group:
-        for key, prefix in (("frequencies", OMEGA2), ("special_frequencies", SPECIAL_OMEGA2)):
+        for key, prefix in (("frequencies", OMEGA2), ("special_frequencies", SPECIAL_OMEGA2),
+                            ("translation_omega2", "translation_")):
             data[key] = {name.removeprefix(prefix): item[()] for name, item in group["frequencies"].items()
                          if name.startswith(prefix)}
     return data

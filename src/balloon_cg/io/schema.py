@@ -30,6 +30,11 @@ VARIABLES = {
     "to_index": (COUNT, "to point", "its point near the same P (-1: none)"),
     "eigenvalue": (COUNT, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
     "frequency": (COUNT, "frequency index", "0: the lowest natural frequency of the block, 1: the next, …"),
+    "translation_axial": (NONDIMENSIONAL, "Ω² of the rigid axial translation",
+                          "½ tᵀKt/tᵀMt of the translation along the axis: the field's stiffness (0 without a field, "
+                          "> 0 the field restores the balloon, < 0 it pulls it away; docs/dynamics.md)"),
+    "translation_lateral": (NONDIMENSIONAL, "Ω² of the rigid lateral translation",
+                            "the same for the translation across the axis (m = 1)"),
     "perturbation_degree": (COUNT, "perturbation degree", "Legendre degree N of the perturbation basis"),
     "coefficient": (COUNT, "coefficient index", "coefficients c of the displacement in the branch's "
                                                          "spherical harmonics, in block order (docs/hdf5.md)"),
