@@ -36,6 +36,7 @@ import balloon_cg as bc
 from balloon_cg.analysis import azimuthal as az
 from balloon_cg.analysis.results import Status
 from balloon_cg.app.cli import main
+from balloon_cg.app.sweep import run_sweep
 from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.analysis.problem import equilibrium_of
 from balloon_cg.dynamics.frequencies import branch_frequencies, frequencies, matching_block
@@ -43,6 +44,7 @@ from balloon_cg.dynamics.pencil import mass_variation
 from balloon_cg.dynamics.translation import DIRECTIONS
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.io.sweep_file import read_sweep
 from balloon_cg.model.field import field_squared
 from balloon_cg.post.plotting import plot
 from balloon_cg.scene import load_scene
@@ -349,3 +351,16 @@ def test_rigid_translations_in_a_field_are_the_field_stiffness():
         expected = field_translation_omega2(eq, X[:-1], branch.params.chi, branch.params.M, direction)
         assert found.translation[direction][-1] == pytest.approx(expected, rel=1e-6)
     assert found.translation["axial"][-1] < 0 and found.translation["lateral"][-1] < 0
+
+
+def test_a_sweep_stores_each_members_frequencies(tmp_path):
+    """[dynamics] in a sweep over M (two opposed coils, primary branches to a pole stretch of 1.3): every member's
+    branch carries its frequencies in the sweep file, and the field retunes them (M = 0.001 against 0.003 at the
+    first point, the same pole stretch)."""
+    scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml").with_overrides(
+        {"continuation.stop_stretch": 1.3, "dynamics.frequencies": True, "dynamics.m_max": 0})
+    out = tmp_path / "sweep.h5"
+    run_sweep(scene, ["M=0.001,0.003"], out, mode="primary-only", workers=1)
+    members = read_sweep(out)["members"]
+    even = [members[k]["branches"]["primary"]["frequencies"]["even"][0, 0] for k in sorted(members)]
+    assert len(even) == 2 and np.all(np.isfinite(even)) and abs(even[1] - even[0]) > 1e-6

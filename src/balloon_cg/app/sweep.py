@@ -30,6 +30,7 @@ from tqdm.auto import tqdm
 from ..analysis.picture import analyse
 from ..analysis.primary import trace_primary
 from ..analysis.verdict import incomplete
+from ..dynamics.frequencies import attach
 from ..io.lock import claim
 from ..io.output import check_output
 from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
@@ -248,6 +249,8 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
             picture = analyse(scene, pear=(mode == "analysis"))
             branches, snaps, points, found = (picture.branches + picture.surface_branches, picture.snaps,
                                               picture.branch_points, picture.incomplete)
+        if scene.dynamics.frequencies:  # [dynamics]: each member's natural frequencies (docs/dynamics.md)
+            attach(branches, scene.dynamics.count, scene.dynamics.m_max)
     return MemberResult(index, branches, snaps, points, found, time.perf_counter() - start, os.getpid())
 
 
