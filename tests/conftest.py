@@ -29,7 +29,7 @@ COST = {  # seconds of each file in a serial --durations=0 run on a loaded 2-cor
     "test_azimuthal_points": 17, "test_api": 17, "test_dielectric": 16, "test_energies": 15, "test_quadrature": 15,
     "test_branch_points": 13, "test_fold_meeting": 13, "test_terms": 12, "test_formula_bounds": 11,
     "test_api_notebook": 11, "test_pear_points": 10, "test_free_pitchfork": 10, "test_sweep_store": 9,
-    "test_fold_curve": 8, "test_plot_sizes": 40, "test_parameter_names": 15,
+    "test_fold_curve": 8, "test_plot_sizes": 40, "test_parameter_names": 15, "test_dynamics": 60,
 }
 
 

@@ -251,7 +251,7 @@ def test_located_special_points_have_a_vanishing_frequency_in_their_block(spom1_
 
 def test_frequencies_are_stored_with_units_and_read_back(spom1_run):
     """frequencies/omega2_<block> (point, frequency) and special_omega2_<block> (special, frequency), units "1";
-    bc.load gives them back as computed."""
+    bc.load and to_xarray give them back as computed."""
     result, path = spom1_run
     primary = next(b for b in result.picture.branches if b.name == "primary")
     with h5py.File(path, "r") as f:
@@ -260,8 +260,12 @@ def test_frequencies_are_stored_with_units_and_read_back(spom1_run):
         assert "Ω²" in group["omega2_even"].attrs["long_name"]
         assert group.attrs["count"] == 4 and group.attrs["m_max"] == 1
         assert group["special_omega2_odd_held"].shape == (len(primary.special), 4)
-    stored = bc.load(path).branches["primary"].data
+    loaded = bc.load(path)
+    stored = loaded.branches["primary"].data
     assert stored["frequencies"].keys() == primary.frequencies.omega2.keys()
+    frame = loaded.to_xarray("primary")
+    assert frame["omega2_even"].dims == ("point", "frequency") and frame["omega2_even"].attrs["units"] == "1"
+    np.testing.assert_array_equal(frame["omega2_even"].values, primary.frequencies.omega2["even"])
     for block, values in primary.frequencies.omega2.items():
         np.testing.assert_array_equal(stored["frequencies"][block], values)
         np.testing.assert_array_equal(stored["special_frequencies"][block], primary.frequencies.special[block])

@@ -238,9 +238,9 @@ class Result:
         branch : str, optional
             The branch's name (default ``"primary"``).
         part : str, optional
-            ``"points"`` (default): dims point, unknown, theta (the per-point columns, profiles and stability;
-            a surface branch: point, coefficient, axis, eigenvalue), or ``"special"``: the special points, dim
-            special.
+            ``"points"`` (default): dims point, unknown, theta (the per-point columns, profiles, stability and
+            natural frequencies, dims eigenvalue, frequency; a surface branch: point, coefficient, axis, eigenvalue),
+            or ``"special"``: the special points, dim special.
 
         Returns
         -------
@@ -258,7 +258,7 @@ class Result:
         if branch not in self.run["branches"]:
             raise KeyError(f"no branch {branch!r} (branches: {', '.join(self.run['branches'])})")
         data = self.run["branches"][branch]
-        groups = {"points": [""] + ["/profiles"] * ("profiles" in data) + ["/stability"] * ("stability" in data),
+        groups = {"points": [""] + [f"/{g}" for g in ("profiles", "stability", "frequencies") if g in data],
                   "special": ["/special_points"]}
         if part not in groups:
             raise ValueError(f"part = {part!r}: must be 'points' or 'special'")
