@@ -368,3 +368,16 @@ def test_a_sweep_stores_each_members_frequencies(tmp_path):
     members = read_sweep(out)["members"]
     even = [members[k]["branches"]["primary"]["frequencies"]["even"][0, 0] for k in sorted(members)]
     assert len(even) == 2 and np.all(np.isfinite(even)) and abs(even[1] - even[0]) > 1e-6
+
+
+def test_continue_keeps_the_frequencies_a_scene_asks_for(spom1_run, tmp_path):
+    """`continue` from the LP of a run with [dynamics] frequencies: the branch traced again carries them, zero at
+    its own located LP."""
+    _, path = spom1_run
+    lp = next(s for s in bc.load(path).special_points if s["kind"] == "LP" and s["branch"] == "primary")
+    out = tmp_path / "again.h5"
+    assert main(["continue", str(path), str(lp["label"]), "-o", str(out)]) == 0
+    again = bc.load(out).branches["primary"].data
+    kinds = [s["kind"] for s in again["special_points"]]
+    assert "frequencies" in again and "LP" in kinds
+    assert abs(again["special_frequencies"]["even"][kinds.index("LP"), 0]) < 1e-11

@@ -43,6 +43,7 @@ from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, 
 from ..analysis.surface_branches import SurfaceStartError
 from ..analysis.switching import mark_rejoin, pear_landing, pear_stop_rule
 from ..analysis.tracer import Tracer
+from ..dynamics.frequencies import attach
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation
 from ..numerics.continuation import Stop, TraceStop
@@ -309,11 +310,16 @@ def switch(start: Labelled, progress=None) -> Picture:
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
     """What ``continue`` computes from ``start`` (module docstring): a Picture (in the branch's own parameter: of
     the branch through it, or at a branch point of the branch of the point and the branches switched to) or a
-    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built."""
+    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built. The
+    Picture's branches get their natural frequencies when the scene asks for them ([dynamics])."""
     own = start.branch.parameter
     kind = start.point.kind
     if parameter in (None, own):
-        return switch(start, progress) if kind == Kind.BP else restart_branch(start, progress)
+        picture = switch(start, progress) if kind == Kind.BP else restart_branch(start, progress)
+        dynamics = start.branch.scene.dynamics
+        if dynamics.frequencies:
+            attach(picture.branches + picture.surface_branches, dynamics.count, dynamics.m_max)
+        return picture
     if kind in CONTROL_OF_FOLD:
         return continue_fold(start.branch, start.point, parameter, direction, progress=progress)
     if kind == Kind.BP and start.point.block in PEAR_NAMES and start.branch.disc.symmetric:
