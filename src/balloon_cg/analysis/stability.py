@@ -386,8 +386,8 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         return variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max)
 
     degrees = point_degrees(branch, degree)
-    results = workers.spread(lambda job: assess(*job), list(enumerate(degrees)), [_cost(N, m_max) for N in degrees],
-                             on_point, here=_first_of_each(degrees))
+    results = workers.spread(lambda job: assess(*job), list(enumerate(degrees)),
+                             [assessment_cost(N, m_max) for N in degrees], on_point, here=first_of_each(degrees))
     unsettled = []
     if check:
         folds = branch.fold_intervals
@@ -399,8 +399,8 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         worth = [n for n, coarse in enumerate(results) if _worth_checking(flags, coarse, n, near_zero)]
         asked = [n for n in worth if n not in checked]
         finer = [check_degree(branch, degrees[n]) for n in asked]
-        checked |= zip(asked, workers.spread(fine_flags, asked, [_cost(N, m_max) for N in finer],
-                                             here=_first_of_each(finer)))
+        checked |= zip(asked, workers.spread(fine_flags, asked, [assessment_cost(N, m_max) for N in finer],
+                                             here=first_of_each(finer)))
         unsettled = [n for n in worth if checked[n] != flags[n]]
     return results, unsettled
 
@@ -413,7 +413,7 @@ def _worth_checking(flags: list, coarse: Assessment, n: int, near_zero: float) -
     return changes or small or n % 10 == 0
 
 
-def _first_of_each(degrees) -> list[int]:
+def first_of_each(degrees) -> list[int]:
     """The position of the first point at each degree: assessed before the others go to workers
     (``workers.spread(here=...)``), its second variation is built once and inherited."""
     first = {}
@@ -422,7 +422,7 @@ def _first_of_each(degrees) -> list[int]:
     return list(first.values())
 
 
-def _cost(degree: int, m_max: int) -> float:
+def assessment_cost(degree: int, m_max: int) -> float:
     """The relative cost of one assessment at perturbation degree N: its dense blocks, ~(1 + m_max) N³ flops."""
     return (1 + m_max) * float(degree) ** 3
 

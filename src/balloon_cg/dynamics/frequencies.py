@@ -10,15 +10,15 @@ stability blocks, so ν are their eigenvalues on that norm (``SecondVariation(no
 ``AzimuthalBasis.gram`` for m ≥ 1): one assembly, one reduction to a standard matrix (``numerics.eigen``) per block.
 Ω² < 0 is an unstable mode (kept as such).
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..analysis.azimuthal import merged_lowest
 from ..analysis.problem import equilibrium_of
-from ..analysis.results import Branch, Gauge, Kind
-from ..analysis.stability import SecondVariation, assessed_degrees
-from ..numerics import interrupt
+from ..analysis.results import Branch, Gauge, Kind, Origin
+from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
+from ..numerics import interrupt, workers
 from .pencil import MASS_NORM, PER_EIGENVALUE, mass_variation
 from .translation import DIRECTIONS, translation_omega2
 
@@ -50,9 +50,13 @@ class BranchFrequencies:
     m_max: int
 
 
-def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None) -> BranchFrequencies:
-    """``frequencies`` at every point and every special point of ``branch`` (module docstring), each point at its
-    ``assessed_degrees``."""
+def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None,
+                       copied: "BranchFrequencies | None" = None) -> BranchFrequencies:
+    """``frequencies`` and ``translation_omega2`` at every point of ``branch``, each at its ``assessed_degrees``
+    (on every core: ``numerics.workers.spread``, as the stability assessment), and ``frequencies`` at each special
+    point's own state. ``copied``: the points' values of the branch this one is the mirror image of (the energy is
+    invariant under the reflection: every block's spectrum and the translations' are the same), so that only
+    its special points are computed."""
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     eq = equilibrium_of(branch)
     degrees = np.array(assessed_degrees(branch), dtype=int)
@@ -63,11 +67,18 @@ def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool |
         variation = variations.get(N) or variations.setdefault(N, mass_variation(eq, N))
         return frequencies(variation, X[:-1], branch.params_at(X), symmetric, m_max, count)
 
-    rows = [at(X, N) for X, N in zip(branch.X, degrees)]
+    def point(n):
+        X, N = branch.X[n], int(degrees[n])
+        return at(X, N), translation_omega2(eq, X[:-1], branch.params_at(X), N)
+
     special = [at(s.X, int(degrees[s.index:s.index + 2].max())) for s in branch.special]
-    rigid = [translation_omega2(variations[N], X[:-1], branch.params_at(X)) for X, N in zip(branch.X, degrees)]
+    if copied is not None:
+        return replace(copied, special=_table(special, list(copied.omega2), count))
+    results = workers.spread(point, range(len(branch.X)), [assessment_cost(N, m_max) for N in degrees],
+                             here=first_of_each(degrees))
+    rows = [row for row, _ in results]
     names = list(dict.fromkeys(name for row in rows for name in row))
-    translation = {direction: np.array([r[direction] for r in rigid]) for direction in DIRECTIONS}
+    translation = {direction: np.array([rigid[direction] for _, rigid in results]) for direction in DIRECTIONS}
     return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), translation, count,
                              m_max)
 
@@ -100,8 +111,10 @@ def matching_block(special, branch) -> str | None:
 
 
 def attach(branches, count: int, m_max: int) -> None:
-    """``branch.frequencies`` (``branch_frequencies``) of every axisymmetric branch; surface branches are left
-    without."""
+    """``branch.frequencies`` (``branch_frequencies``) of every axisymmetric branch, a reflected mirror image's
+    points copied from its source; surface branches are left without."""
+    done = {}
     for branch in branches:
         if isinstance(branch, Branch):
-            branch.frequencies = branch_frequencies(branch, count, m_max)
+            source = done.get(branch.reflection_of) if branch.origin == Origin.REFLECTED else None
+            branch.frequencies = done[branch.name] = branch_frequencies(branch, count, m_max, copied=source)

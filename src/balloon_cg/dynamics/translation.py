@@ -1,26 +1,52 @@
 """The rigid translations of the balloon as oscillators: does the field restore it or pull it away?
 
 For a rigid translation t of the whole membrane, Ω²_t = ½ tᵀKt / tᵀMt (the Rayleigh quotient of K q = ν M q,
-frequencies.PER_EIGENVALUE) is the squared frequency at which the balloon would oscillate as a rigid body about the
-point where it is held: along the axis t is δη = 1 (the coefficient b_0 of the m = 0 basis), across it the m = 1
-translation R = 1, T = −1 (``azimuthal.special_modes``). The pressure and the membrane do not see a translation, so
-Ω²_t is the field's stiffness alone: 0 without a field (an exact zero mode: a free balloon drifts), > 0 where the
-field restores the balloon, < 0 where it pulls it away (a paramagnetic balloon at a field minimum slides toward a
-coil; the free reading's instability, MODEL.md §5).
+``pencil``) is the squared frequency at which the balloon would oscillate as a rigid body about the point where it
+is held: along the axis t is δη = 1 (the coefficient b_0 of the m = 0 basis: the state (λ2, v, η, w) moves by
+(0, 0, 1, 0)), across it the m = 1 translation R = 1, T = −1 (y = (R, R', Z, Z', T, T') = (1, 0, 0, 0, −1, 0)).
+Both are exact in every basis, so tᵀKt = ∫ tᵀ h t d(cos θ) and tᵀMt = ∫ tᵀ m t d(cos θ) from the node kernels
+(``energy_hessian``, ``azimuthal_hessian`` at m = 1, the mass densities of generated/inertia.py) on the m = 1
+basis's nodes, no assembly. The pressure and the membrane do not see a translation, so Ω²_t is the field's
+stiffness alone: 0 without a field (an exact zero mode: a free balloon drifts), > 0 where the field restores the
+balloon, < 0 where it pulls it away (a paramagnetic balloon at a field minimum slides toward a coil; the free
+reading's instability, MODEL.md §5).
 """
-from ..analysis.azimuthal import azimuthal_hessian, special_modes
+import numpy as np
+
+from ..analysis.azimuthal import kernel_state_map, perturbation_basis
+from ..galerkin.discretisation import symmetric_rows
+from ..generated import AZIMUTHAL_PAIRS, HESSIAN_PAIRS, inertia
 from .pencil import PER_EIGENVALUE
 
-DIRECTIONS = ("axial", "lateral")
+# direction: (the node values of its translation, the stiffness kernel and its layout, the mass kernel)
+DIRECTIONS = {
+    "axial": (np.array([0.0, 0.0, 1.0, 0.0]), "energy_hessian", HESSIAN_PAIRS, "axisymmetric_mass"),
+    "lateral": (np.array([1.0, 0.0, 0.0, 0.0, -1.0, 0.0]), "azimuthal_hessian", AZIMUTHAL_PAIRS, "azimuthal_mass"),
+}
 
 
-def translation_omega2(variation, u, params) -> dict:
-    """{"axial": Ω²_t along the axis, "lateral": Ω²_t across it} at the equilibrium u (module docstring);
-    ``variation`` has the mass matrix as its Gram matrix (frequencies.mass_variation)."""
-    H, _ = variation.matrices(u, params)
-    t = variation.translation
-    degree = variation.basis.degree
-    across = special_modes(variation.eq, u, degree)["translation"]
-    H1, M1 = azimuthal_hessian(variation.eq, u, params, 1, degree)
-    return {"axial": PER_EIGENVALUE * H[t, t] / variation.gram[t, t],
-            "lateral": PER_EIGENVALUE * (across @ H1 @ across) / (across @ M1 @ across)}
+def _form(pointwise, pairs, t) -> np.ndarray:
+    """tᵀ h t at every node from a kernel's upper-triangle rows (``pairs``)."""
+    rows = symmetric_rows(pairs)
+    return sum(t[k] * t[l] * pointwise[rows[k, l]] for k in range(t.size) for l in range(t.size) if t[k] and t[l])
+
+
+def _mass_density(kernel: str, b) -> np.ndarray:
+    out = np.empty((len(inertia.KERNELS[kernel]["outputs"]), b.x.size))
+    getattr(inertia, f"{kernel}_nodes")(b.x, b.sin_theta, out)
+    return out
+
+
+def translation_omega2(equilibrium, u, params, degree: int) -> dict:
+    """{"axial": Ω²_t along the axis, "lateral": Ω²_t across it} at the equilibrium u of ``equilibrium`` (module
+    docstring), on the nodes of its m = 1 basis of ``degree``."""
+    b = perturbation_basis(equilibrium, 1, degree)
+    nodes = equilibrium.at_nodes(("translation", b), (b.x, b.sin_theta))
+    np.dot(np.asarray(u, dtype=float), kernel_state_map(equilibrium.disc, b, False), out=nodes.state.reshape(-1))
+    nodes.hold(params)
+    out = {}
+    for direction, (t, stiffness, pairs, mass) in DIRECTIONS.items():
+        h = nodes(stiffness, params, m=1.0) if stiffness == "azimuthal_hessian" else nodes(stiffness, params)
+        out[direction] = PER_EIGENVALUE * (b.weights @ _form(h, pairs, t)) / (
+            b.weights @ _form(_mass_density(mass, b), pairs, t))
+    return out
