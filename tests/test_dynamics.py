@@ -47,7 +47,7 @@ from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.io.sweep_file import read_sweep
 from balloon_cg.model.field import field_squared
 from balloon_cg.post.plotting import plot
-from balloon_cg.scene import load_scene
+from balloon_cg.scene import load_scene, shipped_scenes
 
 ROOT = Path(__file__).resolve().parent.parent
 DEGREE = 14
@@ -381,3 +381,22 @@ def test_continue_keeps_the_frequencies_a_scene_asks_for(spom1_run, tmp_path):
     kinds = [s["kind"] for s in again["special_points"]]
     assert "frequencies" in again and "LP" in kinds
     assert abs(again["special_frequencies"]["even"][kinds.index("LP"), 0]) < 1e-11
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(shipped_scenes()))
+def test_every_located_special_point_of_a_shipped_scene_has_a_zero_frequency(name):
+    """The whole picture of a shipped scene with [dynamics] (count 6, m_max as the stability's): at every located
+    fold and branch point one stored Ω² of its block is zero to the solver's tolerance."""
+    scene = load_scene(name)
+    scene = scene.with_overrides({"dynamics.frequencies": True, "dynamics.count": 6,
+                                  "dynamics.m_max": scene.stability.m_max})
+    result = bc.analyse(scene)
+    checked = 0
+    for branch in result.picture.branches:
+        for n, s in enumerate(branch.special):
+            block = matching_block(s, branch)
+            if block is not None and s.status == Status.LOCATED:
+                assert np.nanmin(np.abs(branch.frequencies.special[block][n])) <= scene.solver.tol, (branch.name, s)
+                checked += 1
+    assert checked

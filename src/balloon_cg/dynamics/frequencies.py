@@ -19,6 +19,7 @@ from ..analysis.problem import equilibrium_of
 from ..analysis.results import Branch, Gauge, Kind, Origin
 from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
 from ..numerics import interrupt, workers
+from ..numerics.threads import limited_blas
 from .pencil import MASS_NORM, PER_EIGENVALUE, mass_variation
 from .translation import DIRECTIONS, translation_omega2
 
@@ -37,8 +38,8 @@ def frequencies(variation: SecondVariation, u, params, symmetric: bool, m_max: i
 @dataclass(frozen=True)
 class BranchFrequencies:
     """The lowest Ω² of every block at every point of a branch: ``omega2[name]`` (points × count), NaN where a point
-    has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (that of its stability
-    assessment); ``special[name]`` (special points × count) the same at each special point's own state, at the
+    has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (``frequency_degrees``);
+    ``special[name]`` (special points × count) the same at each special point's own state, at the
     higher degree of the points around it; ``translation[direction]`` (points,) the rigid translations' Ω²
     (translation.translation_omega2: 0 without a field, else > 0 restored, < 0 pulled)."""
 
@@ -50,16 +51,17 @@ class BranchFrequencies:
     m_max: int
 
 
+@limited_blas
 def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None,
                        copied: "BranchFrequencies | None" = None) -> BranchFrequencies:
-    """``frequencies`` and ``translation_omega2`` at every point of ``branch``, each at its ``assessed_degrees``
-    (on every core: ``numerics.workers.spread``, as the stability assessment), and ``frequencies`` at each special
-    point's own state. ``copied``: the points' values of the branch this one is the mirror image of (the energy is
-    invariant under the reflection: every block's spectrum and the translations' are the same), so that only
-    its special points are computed."""
+    """``frequencies`` and ``translation_omega2`` at every point of ``branch`` (on every core:
+    ``numerics.workers.spread``, as the stability assessment; one BLAS thread: ``numerics.threads``), and ``frequencies`` at each special point's own
+    state (at the higher degree of the points around it), each point at ``frequency_degrees``. ``copied``: the
+    points' values of the branch this one is the mirror image of (the energy is invariant under the reflection:
+    every block's spectrum and the translations' are the same), so that only its special points are computed."""
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     eq = equilibrium_of(branch)
-    degrees = np.array(assessed_degrees(branch), dtype=int)
+    degrees = frequency_degrees(branch)
     variations = {}
 
     def at(X, N):
@@ -81,6 +83,15 @@ def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool |
     translation = {direction: np.array([rigid[direction] for _, rigid in results]) for direction in DIRECTIONS}
     return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), translation, count,
                              m_max)
+
+
+def frequency_degrees(branch) -> np.ndarray:
+    """The perturbation degree per point: its stability assessment's (``assessed_degrees``), at least the Legendre
+    degree of a branch stored in x (its basis holds the equilibrium and its Jacobian: a located fold's or branch
+    point's null vector is in it; at the default stability.degree 20 a pear branch of degree 90 leaves that
+    eigenvalue ~1e-3 from zero); a mapped branch's assessed degrees hold its points already."""
+    degrees = np.array(assessed_degrees(branch), dtype=int)
+    return degrees if branch.disc.mapping is not None else np.maximum(degrees, branch.disc.degree)
 
 
 def _table(rows: list, names: list, count: int) -> dict:
