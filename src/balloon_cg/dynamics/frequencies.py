@@ -55,8 +55,9 @@ class BranchFrequencies:
 def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None,
                        copied: "BranchFrequencies | None" = None) -> BranchFrequencies:
     """``frequencies`` and ``translation_omega2`` at every point of ``branch`` (on every core:
-    ``numerics.workers.spread``, as the stability assessment; one BLAS thread: ``numerics.threads``), and ``frequencies`` at each special point's own
-    state (at the higher degree of the points around it), each point at ``frequency_degrees``. ``copied``: the
+    ``numerics.workers.spread``, as the stability assessment; one BLAS thread: ``numerics.threads``), and
+    ``frequencies`` at each special point's own state (at the higher degree of the points around it), each point
+    at ``frequency_degrees``. ``copied``: the
     points' values of the branch this one is the mirror image of (the energy is invariant under the reflection:
     every block's spectrum and the translations' are the same), so that only its special points are computed."""
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
