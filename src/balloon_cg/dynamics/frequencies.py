@@ -16,7 +16,7 @@ import numpy as np
 
 from ..analysis.azimuthal import merged_lowest
 from ..analysis.problem import equilibrium_of
-from ..analysis.results import Branch, Gauge, Kind, Origin
+from ..analysis.results import Block, Branch, Gauge, Kind, Origin
 from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
 from ..numerics import interrupt, workers
 from ..numerics.threads import limited_blas
@@ -108,18 +108,25 @@ FOLD_CONTROL = {Kind.LP: "", Kind.LV: "_volume", Kind.LN: "_gas"}  # the control
 
 
 def matching_block(special, branch) -> str | None:
-    """The block one of whose Ω² vanishes at a special point of ``branch``: a branch point's own block; a fold in P
-    (LP), V (LV) or n (LN) the block of the equator-symmetric modes under that control (even, even_volume,
-    even_gas), on a branch without that symmetry all modes in the branch's reading (all_held, all_volume_free,
-    ...); None for the others (TP, EP, UZ: no stability change)."""
+    """The block one of whose Ω² vanishes at a special point of ``branch``: a branch point's own block (on a branch
+    without equator symmetry an even or odd block's point, e.g. a pear branch's rejoin at the primary's pitchfork,
+    is in all modes of its reading: all_held, all_free); a fold in P (LP), V (LV) or n (LN) the block of the
+    equator-symmetric modes under that control (even, even_volume, even_gas), on a branch without that symmetry
+    all modes in the branch's reading (all_held, all_volume_free, ...); None for the others (TP, EP, UZ: no
+    stability change)."""
+    free = branch.gauge == Gauge.FREE
     if special.kind == Kind.BP:
-        return special.block.value
+        block = special.block
+        if branch.disc.symmetric or block.m or block.value.startswith("all"):
+            return block.value
+        free = block == Block.ODD_FREE or (block == Block.EVEN and free)
+        return f"all_{'free' if free else 'held'}"
     if special.kind not in FOLD_CONTROL:
         return None
     control = FOLD_CONTROL[special.kind]
     if branch.disc.symmetric:
         return f"even{control}"
-    return f"all{control}_{'free' if branch.gauge == Gauge.FREE else 'held'}"
+    return f"all{control}_{'free' if free else 'held'}"
 
 
 def attach(branches, count: int, m_max: int) -> None:
