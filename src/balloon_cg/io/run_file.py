@@ -409,13 +409,13 @@ def _write_frequencies(group, frequencies, point):
     group.attrs.update({"count": frequencies.count, "m_max": frequencies.m_max})
     frequency = scale(group, "frequency", frequencies.count)
     special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
-    group.create_dataset("perturbation_degree", data=frequencies.degree)
+    checksummed(group, "perturbation_degree", frequencies.degree)
     for direction, values in frequencies.translation.items():
-        group.create_dataset(f"translation_{direction}", data=values)
+        checksummed(group, f"translation_{direction}", values)
     axes = {1: (point,), 2: (point, frequency)}
     for block, values in frequencies.omega2.items():
-        group.create_dataset(f"{OMEGA2}{block}", data=values)
-        group.create_dataset(f"{SPECIAL_OMEGA2}{block}", data=frequencies.special[block])
+        checksummed(group, f"{OMEGA2}{block}", values)
+        checksummed(group, f"{SPECIAL_OMEGA2}{block}", frequencies.special[block])
         axes[f"{SPECIAL_OMEGA2}{block}"] = (special, frequency)
     attach_dimensions(group, axes)
 
