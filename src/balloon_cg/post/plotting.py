@@ -1032,7 +1032,7 @@ def plot_frequencies(branches, axes=None) -> Figure:
         crossing = [s for s in b.data["special_points"] if s["kind"] in ("LP", "LV", "LN", "BP")]
         for s in crossing:
             ax.plot(s[b.ordinate.column], 0.0, MARKERS.get(s["kind"], "D"), color="k", markersize=5)
-            marks.append((ax, special_label(s), s[b.ordinate.column], 0.0, "k"))
+            marks.append((ax, int(s["label"]), special_label(s), s[b.ordinate.column], 0.0, "k"))
     ax.set_xlabel(drawn[0].ordinate.label)
     ax.set_ylabel(r"$\Omega^2 = \omega^2 R_0^2 \rho/\mu$ (lowest of each block)")
     ax.set_title(_title(drawn))
