@@ -65,7 +65,7 @@ SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 1.4\n'
 
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
 @pytest.mark.parametrize("moment", ["import balloon_cg.app.cli", "import numpy", "import balloon_cg.scene",
-                                    "after argparse:ArgumentParser.parse_args", "import balloon_cg.analysis.picture"])
+                                    "after argparse:ArgumentParser.parse_known_args", "import balloon_cg.analysis.picture"])
 def test_a_signal_at_start_up_exits_130_in_one_line(tmp_path, sig, moment):
     (tmp_path / "s.toml").write_text(SCENE)
     code, err = balloon_cg(tmp_path, sig, moment, ["run", "s.toml", "-o", "r.h5", "--quiet"])

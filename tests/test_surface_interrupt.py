@@ -83,7 +83,7 @@ def test_the_picture_names_the_phase_it_stopped_in(pear_point):
         with picture.clock.step(Step.SNAP_THROUGHS):
             assert stopped(picture)  # the first phase it was seen in stays
     entry = [item for item in picture.incomplete if item.gap == Gap.INTERRUPTED]
-    assert len(entry) == 1 and "interrupted by a signal during surface branches" in entry[0].message
+    assert len(entry) == 1 and "interrupted by a signal during non-axisymmetric branches" in entry[0].message
 
 
 def test_run_says_what_the_file_says(tmp_path):
@@ -109,7 +109,7 @@ def test_run_of_two_coils_interrupted_in_its_surface_branches(tmp_path):
     code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.analysis.surface_branches:switch",
                            ["run", str(ROOT / "scenes" / "spom1_two_coils_M0.002.toml"), "-o", "r.h5", "--quiet"])
     line = one_line(err)
-    assert code == 130 and "during surface branches" in line, err
+    assert code == 130 and "during non-axisymmetric branches" in line, err
     with h5py.File(tmp_path / "r.h5", "r") as f:
         assert not f.attrs["complete"] and "interrupted" in list(f.attrs["incomplete_gaps"])
         assert list(f["branches/m1_bp1"].attrs["leg_stop_codes"]) == ["interrupted"]

@@ -391,6 +391,7 @@ def read_sweep(path) -> dict:
         require_attrs(f.attrs, path, ROOT_KEYS, error=SweepFileError)
         if plain(f.attrs.get("format")) == FORMAT and carries_checksums(f):
             require_attrs(f.attrs, path, WRITTEN_ROOT, WRITTEN_ROOT, error=SweepFileError)
+            _check_table(f, path)
         if not isinstance(f.get("members"), h5py.Group):
             raise SweepFileError(path, "no /members group")
         out = {"path": str(path), "attrs": {k: plain(v) for k, v in f.attrs.items()}, "members": {}}
@@ -400,6 +401,31 @@ def read_sweep(path) -> dict:
                 raise SweepFileError(path, f"member group /members/{name} is not named by an index")
             out["members"][int(name)] = _read_member(f["members"][name], f"{path}: /members/{name}")
     return out
+
+
+TABLE_SCALE_ATTRS = ("CLASS", "NAME", "REFERENCE_LIST", "long_name", "description")  # /member, the dimension
+TABLE_COLUMN_ATTRS = ("DIMENSION_LIST", "long_name", "description")  # every column along it
+
+
+def _check_table(f, path) -> None:
+    """The root table (``write_table``) of a view written with checksums: the dimension ``member`` and every column
+    with the attributes that make it one (its scale, its long name and description); SweepFileError naming the
+    dataset and the attribute missing."""
+    if not isinstance(f.get("member"), h5py.Dataset):
+        raise SweepFileError(path, "no /member dataset (the table's dimension)")
+    columns = [n for n, item in f.items() if n != "member" and isinstance(item, h5py.Dataset)]
+    keys = {k for n in columns for k in plain(f[n].attrs.get("coordinates", "")).split()}
+    for name, wanted in [("member", TABLE_SCALE_ATTRS)] + [(n, _column_attrs(n, keys)) for n in columns]:
+        missing = [key for key in wanted if key not in f[name].attrs]
+        if missing:
+            raise SweepFileError(path, f"/{name} lacks the attribute {missing[0]}")
+
+
+def _column_attrs(name: str, keys: set) -> tuple:
+    """The attributes a table column carries (``write_table``): units where its quantity has some, the varied keys
+    as CF coordinates where it is not one of them."""
+    units = TABLE_COLUMNS.get(re.sub(r"\d+$", "", name), ("",))[0]
+    return TABLE_COLUMN_ATTRS + (("units",) if units else ()) + (("coordinates",) if keys and name not in keys else ())
 
 
 def read_store(directory) -> dict:
