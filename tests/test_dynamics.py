@@ -38,15 +38,16 @@ from balloon_cg.analysis.results import Status
 from balloon_cg.app.cli import main
 from balloon_cg.app.sweep import run_sweep
 from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.problem import branch_system, equilibrium_of
 from balloon_cg.dynamics.frequencies import branch_frequencies, frequencies, matching_block
+from balloon_cg.dynamics.modes import AZIMUTHAL, block_modes
 from balloon_cg.dynamics.pencil import mass_variation
 from balloon_cg.dynamics.translation import DIRECTIONS
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.io.sweep_file import read_sweep
 from balloon_cg.model.field import field_squared
-from balloon_cg.post.plotting import plot
+from balloon_cg.post.plotting import MODE_AMPLITUDE, plot
 from balloon_cg.scene import load_scene, shipped_scenes
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -223,9 +224,9 @@ def test_gas_stiffness_raises_and_the_volume_constraint_removes_the_breathing_mo
 @pytest.fixture(scope="module")
 def spom1_run(tmp_path_factory):
     """The SPOM1 whole picture to a pole stretch of 3 (an LP and the pear BP on the primary branch, a pear pair)
-    with [dynamics] frequencies = true (m_max 1), analysed and written to a run file."""
+    with [dynamics] frequencies = true (m_max 1) and modes = true, analysed and written to a run file."""
     scene = load_scene(ROOT / "scenes" / "spom1.toml").with_overrides(
-        {"continuation.stop_stretch": 3.0, "dynamics.frequencies": True, "dynamics.count": 4})
+        {"continuation.stop_stretch": 3.0, "dynamics.frequencies": True, "dynamics.count": 4, "dynamics.modes": True})
     result = bc.analyse(scene)
     path = tmp_path_factory.mktemp("dynamics") / "spom1.h5"
     result.save(path)
@@ -271,6 +272,83 @@ def test_frequencies_are_stored_with_units_and_read_back(spom1_run):
         np.testing.assert_array_equal(stored["special_frequencies"][block], primary.frequencies.special[block])
 
 
+def unit_shape(shape):
+    """A mode shape (components × θ) scaled to a largest magnitude of 1, that entry positive."""
+    flat = shape.reshape(-1)
+    return shape / flat[np.abs(flat).argmax()]
+
+
+def test_the_fold_mode_is_the_branch_tangent(spom1_run):
+    """At the primary branch's located LP the stored shape of the zero mode of the pressure-control block (even)
+    is the branch's tangent there: the null vector of the equilibrium Jacobian ∂R/∂u (its smallest right singular
+    vector), drawn as (δρ, δz) = (sin θ δλ2, δη), to 1e-6 after both are scaled to a largest entry of 1 (observed
+    1e-15); the stored shapes are read back by bc.load, as (special, frequency, component, θ) with units and the θ
+    scale of the profiles."""
+    result, path = spom1_run
+    primary = next(b for b in result.picture.branches if b.name == "primary")
+    n, lp = next((n, s) for n, s in enumerate(primary.special) if s.kind.value == "LP")
+    loaded = bc.load(path)
+    data = loaded.branches["primary"].data
+    theta = data["theta"]
+    frame = loaded.to_xarray("primary")
+    assert frame["modes_even"].dims == ("special", "frequency", "component", "theta")
+    np.testing.assert_array_equal(frame["modes_even"].values, data["modes"]["even"])
+    shape = data["modes"]["even"][n, 0]
+    assert abs(data["special_frequencies"]["even"][n, 0]) < 1e-11
+    np.testing.assert_array_equal(shape, primary.frequencies.modes["even"][n, 0])
+    J = branch_system(primary).jacobian(lp.X)[:, :-1]
+    null = linalg.svd(J)[2][-1]
+    lam2, _, eta, _ = primary.disc.evaluate(null, theta)
+    tangent = np.stack([np.sin(theta) * lam2, eta, np.zeros_like(eta)])
+    np.testing.assert_allclose(unit_shape(shape), unit_shape(tangent), atol=1e-6)
+    with h5py.File(path, "r") as f:
+        stored = f["branches/primary/frequencies/modes_even"]
+        assert stored.attrs["units"] == "1" and stored.shape == (len(primary.special), 4, 3, theta.size)
+        assert stored.dims[3][0].name.endswith("/theta")
+
+
+def test_the_modes_have_their_frequencies_and_the_kinetic_energy_as_mass(spom1_run):
+    """At every special point of the run, for every block: ``block_modes`` (the pencil solved on the null space of
+    its constraints) gives the stored Ω² to 1e-10, and each mode has unit modal mass (1/2π)∫∫|δx|² dA = 1 on a
+    Gauss rule (its shape on Gauss nodes in θ: ∫(δρ² + δz²) dx for m = 0, ½∫(δρ² + δz² + δφ²) dx for m ≥ 1) to
+    1e-10."""
+    result, _ = spom1_run
+    x, w = legendre.leggauss(120)
+    for branch in result.picture.branches:
+        eq, found = equilibrium_of(branch), branch.frequencies
+        for n, s in enumerate(branch.special):
+            variation = mass_variation(eq, int(found.degree[s.index:s.index + 2].max()))
+            for block, stored in found.special.items():
+                omega2, shapes = block_modes(variation, s.X[:-1], branch.params_at(s.X), branch.disc.symmetric,
+                                             block, found.count, np.arccos(x))
+                np.testing.assert_allclose(omega2, stored[n, :omega2.size], atol=1e-10, rtol=1e-10)
+                weight = 0.5 if AZIMUTHAL.fullmatch(block) else 1.0
+                np.testing.assert_allclose(weight * (shapes ** 2).sum(axis=1) @ w, 1.0, atol=1e-10)
+
+
+def test_free_translation_modes_become_the_rigid_translations_as_the_field_vanishes():
+    """Two opposed coils at a small M: the lowest mode of the free blocks is the translation the field pulls
+    (Ω² < 0), tending to the rigid translation as M → 0 (without a field the translation is no mode of any block:
+    it is removed as a zero mode). At M = 1e-9: along the axis (odd_free) δz = 1/√2, δρ = 0 (unit modal mass);
+    across it (m1_free) R = 1/√2, T = −1/√2, Z = 0 (δx uniform), to 1e-6; the distance falls as M (x100 ± 1%
+    from M = 1e-7)."""
+    theta = np.linspace(0.0, np.pi, 91)
+    rigid = {"odd_free": (0.0, 2 ** -0.5, 0.0), "m1_free": (2 ** -0.5, 0.0, -2 ** -0.5)}
+    distance = {}
+    for M in (1e-7, 1e-9):
+        scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml").with_overrides({"field.M": M})
+        branch = trace_primary(scene, stop_stretch=1.5, down=False)
+        X = branch.X[-1]
+        variation = mass_variation(equilibrium_of(branch), max(20, branch.disc.degree))
+        for block, expected in rigid.items():
+            omega2, shapes = block_modes(variation, X[:-1], branch.params_at(X), True, block, 2, theta)
+            assert omega2[0] < 0
+            distance[M, block] = np.abs(shapes[0] - np.array(expected)[:, None]).max()
+    for block in rigid:
+        assert distance[1e-9, block] < 1e-6
+        assert distance[1e-7, block] / distance[1e-9, block] == pytest.approx(100.0, rel=0.01)
+
+
 def test_inspect_tables_the_special_points_and_json_lists_the_frequencies(spom1_run, capsys):
     _, path = spom1_run
     assert main(["inspect", str(path)]) == 0
@@ -286,12 +364,21 @@ def test_inspect_tables_the_special_points_and_json_lists_the_frequencies(spom1_
 
 @pytest.mark.parametrize("key, value, allowed", [("count", "0", "an integer in [1, 50]"),
                                                  ("m_max", "9", "an integer in [0, 8]"),
-                                                 ("frequencies", "1", "true or false")])
+                                                 ("frequencies", "1", "true or false"),
+                                                 ("modes", "1", "true or false")])
 def test_bad_dynamics_values_are_one_line_and_exit_2(tmp_path, capsys, key, value, allowed):
     out = tmp_path / "run.h5"
     assert main(["run", "spom1", "--set", f"dynamics.{key}={value}", "-o", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"dynamics.{key} = {value}: must be {allowed}" in err
+    assert not out.exists()
+
+
+def test_modes_need_the_frequencies(tmp_path, capsys):
+    out = tmp_path / "run.h5"
+    assert main(["run", "spom1", "--set", "dynamics.modes=true", "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "dynamics.modes = true: needs dynamics.frequencies = true" in err
     assert not out.exists()
 
 
@@ -306,6 +393,36 @@ def test_frequency_pressure_figure(spom1_run, tmp_path):
     assert ax.get_ylabel().startswith(r"$\Omega^2")
     marked = [line for line in ax.lines if line.get_marker() in ("o", "D") and len(line.get_xdata()) == 1]
     assert len(marked) >= 2 and all(line.get_ydata()[0] == 0.0 for line in marked)
+
+
+def test_mode_figure(spom1_run, tmp_path, capsys):
+    """plot --what modes: a panel per fold and branch point, the outline (black) and the outline ± the stored
+    mode of the Ω² nearest zero, scaled to MODE_AMPLITUDE of the largest radius: at the LP the even block's
+    breathing-like mode, drawn from the stored δρ, δz; a run without modes fails with one line (exit 2)."""
+    result, path = spom1_run
+    out = tmp_path / "modes.png"
+    assert main(["plot", str(path), "--what", "modes", "-o", str(out)]) == 0
+    assert out.read_bytes().startswith(b"\x89PNG")
+    fig = plot([path], "modes")
+    primary = next(b for b in result.picture.branches if b.name == "primary")
+    crossings = [s for b in result.picture.branches for s in b.special if s.kind.value in ("LP", "LV", "LN", "BP")]
+    panels = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(panels) == len(crossings)
+    n = next(n for n, s in enumerate(primary.special) if s.kind.value == "LP")
+    assert "LP, even" in panels[0].get_title()
+    outline, plus = panels[0].lines[0], panels[0].lines[1]
+    shape = primary.frequencies.modes["even"][n, 0]
+    rho = outline.get_xdata()
+    scale = MODE_AMPLITUDE * rho.max() / np.abs(shape[:2]).max()
+    np.testing.assert_allclose(plus.get_xdata() - rho, scale * shape[0], atol=1e-12)
+    np.testing.assert_allclose(plus.get_ydata() - outline.get_ydata(), scale * shape[1], atol=1e-12)
+    bare = tmp_path / "bare.h5"
+    bc.analyse(load_scene("spom1").with_overrides({"continuation.stop_stretch": 2.0, "surface.branches": "none",
+                                                   "dynamics.frequencies": True})).save(bare)
+    capsys.readouterr()
+    assert main(["plot", str(bare), "--what", "modes", "-o", str(tmp_path / "no.png")]) == 2
+    message = capsys.readouterr().err.strip().splitlines()
+    assert len(message) == 1 and "modes = true" in message[0]
 
 
 def test_rigid_translations_are_zero_frequencies_without_a_field(spom1_run):
