@@ -476,20 +476,23 @@ def test_rigid_translations_in_a_field_are_the_field_stiffness():
 
 def test_a_sweep_stores_each_members_frequencies(tmp_path):
     """[dynamics] in a sweep over M (two opposed coils, primary branches to a pole stretch of 1.3): every member's
-    branch carries its frequencies in the sweep file, and the field retunes them (M = 0.001 against 0.003 at the
-    first point, the same pole stretch)."""
+    branch carries its frequencies in the sweep file (and with modes = true their shapes at the special points),
+    and the field retunes them (M = 0.001 against 0.003 at the first point, the same pole stretch)."""
     scene = load_scene(ROOT / "scenes" / "spom1_two_coils_M0.002.toml").with_overrides(
-        {"continuation.stop_stretch": 1.3, "dynamics.frequencies": True, "dynamics.m_max": 0})
+        {"continuation.stop_stretch": 1.3, "dynamics.frequencies": True, "dynamics.m_max": 0, "dynamics.modes": True})
     out = tmp_path / "sweep.h5"
     run_sweep(scene, ["M=0.001,0.003"], out, mode="primary-only", workers=1)
     members = read_sweep(out)["members"]
     even = [members[k]["branches"]["primary"]["frequencies"]["even"][0, 0] for k in sorted(members)]
     assert len(even) == 2 and np.all(np.isfinite(even)) and abs(even[1] - even[0]) > 1e-6
+    for member in members.values():
+        primary = member["branches"]["primary"]
+        assert primary["modes"]["even"].shape == (len(primary["special_points"]), 3, 3, primary["theta"].size)
 
 
 def test_continue_keeps_the_frequencies_a_scene_asks_for(spom1_run, tmp_path):
-    """`continue` from the LP of a run with [dynamics] frequencies: the branch traced again carries them, zero at
-    its own located LP."""
+    """`continue` from the LP of a run with [dynamics] frequencies and modes: the branch traced again carries them,
+    zero at its own located LP, and the mode shapes there."""
     _, path = spom1_run
     lp = next(s for s in bc.load(path).special_points if s["kind"] == "LP" and s["branch"] == "primary")
     out = tmp_path / "again.h5"
@@ -498,6 +501,7 @@ def test_continue_keeps_the_frequencies_a_scene_asks_for(spom1_run, tmp_path):
     kinds = [s["kind"] for s in again["special_points"]]
     assert "frequencies" in again and "LP" in kinds
     assert abs(again["special_frequencies"]["even"][kinds.index("LP"), 0]) < 1e-11
+    assert np.isfinite(again["modes"]["even"][kinds.index("LP"), 0]).all()
 
 
 def resolved_zero(branch, special, block: str, omega2) -> float:
