@@ -14,18 +14,16 @@ kinetic energy per 2π of generated/inertia.py): ∫(δρ² + δz²) dx = 1 for 
 (x = cos θ); a rigid translation along the axis is δz = 1/√2. The sign: the component of largest magnitude is
 positive.
 """
-import re
-
 import numpy as np
 from scipy import linalg
 
 from ..analysis.azimuthal import block_pencils
+from ..analysis.results import Block
 from ..analysis.stability import held_means
 from ..numerics.eigen import RCOND
 from .pencil import PER_EIGENVALUE
 
 COMPONENTS = ("d_rho", "d_z", "d_phi")  # the stored displacement components (m ≥ 1: amplitudes of cos mφ, sin mφ)
-AZIMUTHAL = re.compile(r"m(\d+)_(held|free)")  # the m ≥ 1 block names of SecondVariation.blocks
 
 
 def lowest_modes(K, M, normals, count: int) -> tuple:
@@ -41,16 +39,16 @@ def block_modes(variation, u, params, symmetric: bool, name: str, count: int, th
     """(Ω², shapes) of the block ``name`` at the equilibrium u: its ``count`` lowest Ω² (ascending) and their mode
     shapes (count × 3 components (COMPONENTS) × θ), module docstring; ``variation`` the pencil's second variation
     (frequencies' ``mass_variation``)."""
-    azimuthal = AZIMUTHAL.fullmatch(name)
-    if azimuthal is None:
+    m = Block.order_of(name)
+    if not m:
         K, M, normals, index = variation.block_pencil(u, params, symmetric, name)
         values, q = lowest_modes(K, M, normals, count)
         c = np.zeros((values.size, variation.basis.size))
         c[:, index] = q
         shapes = _axisymmetric_shapes(variation.basis, c, theta)
     else:
-        basis, parts = block_pencils(variation.eq, u, params, int(azimuthal[1]), variation.basis.degree,
-                                     azimuthal[2] == "held", variation.basis_kind)
+        basis, parts = block_pencils(variation.eq, u, params, m, variation.basis.degree, Block(name).held,
+                                     variation.basis_kind)
         found = [lowest_modes(K, M, normals, count) + (index,) for K, M, normals, index in parts]
         values = np.concatenate([v for v, _, _ in found])
         c = np.zeros((values.size, basis.size))

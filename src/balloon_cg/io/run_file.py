@@ -81,7 +81,6 @@ import h5py
 import numpy as np
 
 from ..analysis.timing import Clock, Step
-from ..dynamics.modes import COMPONENTS as MODE_COMPONENTS
 from ..surface.loads import LOADS
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
@@ -423,7 +422,7 @@ def _write_frequencies(group, frequencies, point, theta):
         checksummed(group, f"{SPECIAL_OMEGA2}{block}", frequencies.special[block])
         axes[f"{SPECIAL_OMEGA2}{block}"] = (special, frequency)
     if frequencies.modes is not None:
-        component = scale(group, "component", len(MODE_COMPONENTS))
+        component = scale(group, "component", next(iter(frequencies.modes.values())).shape[2])
         for block, shapes in frequencies.modes.items():
             checksummed(group, f"{MODES}{block}", shapes, compression="gzip", shuffle=True)
             axes[f"{MODES}{block}"] = (special, frequency, component, theta)

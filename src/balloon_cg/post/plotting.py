@@ -40,7 +40,7 @@ from .quantities import branch_discretisation, postprocess, stored_scene, surfac
 from .fit import NARROW, fit_width, fitted_size
 from .labels import label_points
 from .style import JournalFigure, journal_style
-from ..dynamics.modes import AZIMUTHAL
+from ..analysis.results import Block
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, file_kind, reading
@@ -1088,8 +1088,7 @@ def plot_modes(branches, axes=None) -> Figure:
         d = b.data
         outline = surface(branch_discretisation(d), d["special_unknowns"][n], d["theta"], stored_scene(b.run).geometry)
         rho, eta = outline["rho"][0], outline["eta"][0]
-        azimuthal = AZIMUTHAL.fullmatch(block)
-        m = int(azimuthal[1]) if azimuthal else 0
+        m = Block.order_of(block)
         scale = MODE_AMPLITUDE * rho.max() / max(np.abs(shape[:2]).max(), np.finfo(float).tiny)
         for side in (1.0, -1.0):  # φ = 0, φ = π (cos mφ = (−1)^m)
             turn = side ** m
