@@ -11,7 +11,7 @@ from balloon_cg.analysis import mirror as mirror_module
 from balloon_cg.analysis.mirror import reflection, reflection_excess
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.problem import branch_system
-from balloon_cg.analysis.results import Leg, Origin, Stop, StopCode
+from balloon_cg.analysis.results import Kind, Leg, Origin, Stop, StopCode
 from balloon_cg.analysis.stability import FLAGS, assess_branch
 from balloon_cg.analysis.switching import mark_rejoin, trace_pear
 from balloon_cg.galerkin.coordinate_map import WireMap
@@ -110,3 +110,28 @@ def test_failed_reflection_is_traced_and_recorded(monkeypatch):
     assert traced.name == "pear_0_mirror" and traced.origin == Origin.TRACED_REFLECTION_FAILED
     assert traced.reflection_of == "" and traced.stability is not None and traced.rejoins == pear.rejoins == 1
     np.testing.assert_allclose(traced.pole_values()["lam2_north"], pear.pole_values()["lam2_south"], rtol=1e-9)
+
+
+def test_every_special_point_of_a_mirror_on_a_map_is_the_reflected_state(picture):
+    """On a wire-mapped basis (here the SPOM1 pear branch moved onto a map centred off the equator) each special
+    point of the mirror, the rejoin BP included, evaluated on the mirror's (mirrored) map is its source's state
+    reflected: λ2̃(θ) = λ2(π − θ), η̃(θ) = −η(π − θ), to rounding. (An equator-symmetric state's coefficients on a
+    map are not their own reflection: the rejoin kept as it was read 1e-2 off on the mirrored map, the paper
+    coil's pear_0_mirror BP that was not singular on its own system.)"""
+    primary, pear = picture.branches[:2]
+    mapped = Discretisation(pear.disc.degree, False, pear.disc.pin_translation, mapping=WireMap((0.5,), (0.05,)))
+    rejoin = picture.branch_points[pear.rejoins]  # where mark_rejoin puts it (a fold candidate there at stretch 6)
+    special = [replace(s, X=pear.disc.transfer(s.X, mapped)) for s in pear.special]
+    special.append(replace(rejoin, index=len(pear.X) - 2, X=primary.disc.transfer(rejoin.X, mapped)))
+    moved = replace(pear, disc=mapped, X=pear.disc.transfer(pear.X, mapped), special=special)
+    image = reflection(moved, [], "m")
+    theta = np.linspace(0.0, np.pi, 41)
+    kinds = [s.kind for s in image.special]
+    assert Kind.BP in kinds and len(image.special) >= 2
+    sources = [s for s in moved.special if s.kind not in (Kind.TP, Kind.UZ)]
+    for ours, theirs in zip(image.special, sorted(sources, key=lambda s: s.index)):
+        lam2, _, eta, _ = image.disc.evaluate(ours.X[:-1], theta)
+        source_lam2, _, source_eta, _ = mapped.evaluate(theirs.X[:-1], theta[::-1])
+        np.testing.assert_allclose(lam2, source_lam2, atol=1e-12, err_msg=str(ours))
+        np.testing.assert_allclose(eta, -source_eta, atol=1e-12, err_msg=str(ours))
+        assert ours.X[-1] == theirs.X[-1]

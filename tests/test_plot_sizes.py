@@ -16,11 +16,12 @@ WIDTHS = (3.5, 7.2)
 @pytest.fixture(scope="module")
 def sources(tmp_path_factory, run_path, voltage_file):  # noqa: F811
     """A file per kind: SPOM1 at M = 0 (its isola: special points, pear branches, normal forms, natural
-    frequencies), two coils
+    frequencies and mode shapes), two coils
     (primary only, for the field), the α1 curve of pitchforks (phase), a surface branch, a voltage run."""
     folder = tmp_path_factory.mktemp("sizes")
     spom1, coils, curve = folder / "spom1.h5", folder / "coils.h5", folder / "curve.h5"
-    scene = load_scene("spom1").with_overrides({"surface.branches": "none", "dynamics.frequencies": True})
+    scene = load_scene("spom1").with_overrides({"surface.branches": "none", "dynamics.frequencies": True,
+                                                "dynamics.modes": True})
     (folder / "spom1.toml").write_text(scene.to_toml())
     assert main(["run", str(folder / "spom1.toml"), "-o", str(spom1), "--quiet"]) == 0
     assert main(["run", "spom1_two_coils_M0.002", "--stop-stretch", "1.6", "--primary-only", "-o", str(coils),

@@ -99,9 +99,9 @@ LABELS = {
 
 
 # phase: tests/test_two_parameter.py; voltage-pole, voltage-equator (voltage continuations): test_voltage_branches.py;
-# surface, stretch-map (states of surface branches): test_surface_store.py; frequencies: test_dynamics.py
+# surface, stretch-map (states of surface branches): test_surface_store.py; frequencies, modes: test_dynamics.py
 @pytest.mark.parametrize("kind", [k for k in KINDS if k not in ("phase", "voltage-pole", "voltage-equator",
-                                                                "surface", "stretch-map", "frequencies")])
+                                                                "surface", "stretch-map", "frequencies", "modes")])
 def test_every_kind_draws_with_labels(kind, files, bifurcation_file, tmp_path):
     paths = [bifurcation_file] if kind == "energy" else list(files.values())
     fig = plot(paths, kind, points=[0, -1] if kind in PER_POINT_KINDS else None)

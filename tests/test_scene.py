@@ -295,7 +295,8 @@ BAD = [
     ("dynamics-count", MAT + "[dynamics]\ncount = 51", "dynamics.count = 51: must be an integer in [1, 50]"),
     ("dynamics-m-max", MAT + "[dynamics]\nm_max = -1", "dynamics.m_max = -1: must be an integer in [0, 8]"),
     ("dynamics-flag", MAT + '[dynamics]\nfrequencies = "yes"', 'dynamics.frequencies = "yes": must be true or false'),
-    ("dynamics-unknown", MAT + "[dynamics]\nmodes = 3", "dynamics.modes = 3: unknown key"),
+    ("dynamics-unknown", MAT + "[dynamics]\nshapes = 3", "dynamics.shapes = 3: unknown key"),
+    ("dynamics-modes", MAT + "[dynamics]\nmodes = 3", "dynamics.modes = 3: must be true or false"),
     ("unknown-key-newline", MAT + '[output]\n"a\\nb" = 1', "output."),
 ]
 

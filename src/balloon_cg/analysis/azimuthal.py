@@ -76,26 +76,10 @@ class AzimuthalBasis:
         put(self, "weights", weights)
         put(self, "sin_theta", np.sqrt(1.0 - x * x))
         put(self, "theta", np.arccos(x))
-        blocks = {}
-        offset = 0
-        columns = []
-        for name, order in (("Z", m), ("U", m + 1), ("D", m - 1)):
-            p, dp = _functions(nodes, x, n, order, self.mapping)
-            k = np.arange(order, n + 1)
-            blocks[name] = (slice(offset, offset + k.size), k)
-            columns.append((name, p[:, k], dp[:, k]))
-            offset += k.size
+        blocks, ops = _point_ops(m, n, nodes, x, self.mapping)
+        offset = ops.shape[2]
         put(self, "blocks", blocks)
         put(self, "size", offset)
-        ops = np.zeros((6, x.size, offset))  # node values of (R, R', Z, Z', T, T') per unknown
-        for name, p, dp in columns:
-            sl = blocks[name][0]
-            if name == "Z":
-                ops[2, :, sl], ops[3, :, sl] = p, dp
-            else:  # R = (U + D)/2, T = (U − D)/2
-                sign = 1.0 if name == "U" else -1.0
-                ops[0, :, sl], ops[1, :, sl] = p / 2, dp / 2
-                ops[4, :, sl], ops[5, :, sl] = sign * p / 2, sign * dp / 2
         put(self, "ops", ops)
         # R, R', T, T' involve only the U and D coefficients, Z, Z' only the Z ones: the assembly works on these
         # column groups (about half the work of the full products)
@@ -132,6 +116,16 @@ class AzimuthalBasis:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
         return self.ops @ c
 
+    def displacement(self, c: np.ndarray, theta: np.ndarray) -> np.ndarray:
+        """(R, Z, T) on any θ grid (poles included) for coefficients c (one vector or rows): the amplitudes of
+        δρ = R cos mφ, δz = Z cos mφ, δφ = T sin mφ, shape (3, n_θ) or (rows, 3, n_θ)."""
+        x = np.cos(theta)
+        with np.errstate(divide="ignore", invalid="ignore"):  # the θ-derivatives (not used) divide by sin σ at a pole
+            _, ops = _point_ops(self.m, self.degree, x if self.mapping is None else self.mapping.s(x), x,
+                                self.mapping)
+        c = np.asarray(c, dtype=float)
+        return ops[[0, 2, 4]] @ c if c.ndim == 1 else np.moveaxis(ops[[0, 2, 4]] @ c.T, -1, 0)
+
     def cartesian(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
         """Cartesian displacement δx (3, len(theta)) at points (θ, φ), θ anywhere in [0, π] (poles included)."""
         theta = np.asarray(theta, dtype=float)
@@ -146,6 +140,29 @@ class AzimuthalBasis:
         horizontal_r, horizontal_p = R * cm, T * sm
         return np.array([horizontal_r * np.cos(phi) - horizontal_p * np.sin(phi),
                          horizontal_r * np.sin(phi) + horizontal_p * np.cos(phi), Z * cm])
+
+
+def _point_ops(m: int, degree: int, nodes, x, mapping) -> tuple:
+    """({"Z", "U", "D": (columns, k)}, the values of (R, R', Z, Z', T, T') at the points x (s = ``nodes`` on a map)
+    per coefficient, shape (6, points, size)): Z on P̄_k^m, U on P̄_k^(m+1), D on P̄_k^(m−1), R = (U + D)/2,
+    T = (U − D)/2 (docs/second_variation.md)."""
+    blocks, columns, offset = {}, [], 0
+    for name, order in (("Z", m), ("U", m + 1), ("D", m - 1)):
+        p, dp = _functions(nodes, x, degree, order, mapping)
+        k = np.arange(order, degree + 1)
+        blocks[name] = (slice(offset, offset + k.size), k)
+        columns.append((name, p[:, k], dp[:, k]))
+        offset += k.size
+    ops = np.zeros((6, np.size(x), offset))
+    for name, p, dp in columns:
+        sl = blocks[name][0]
+        if name == "Z":
+            ops[2, :, sl], ops[3, :, sl] = p, dp
+        else:  # R = (U + D)/2, T = (U − D)/2
+            sign = 1.0 if name == "U" else -1.0
+            ops[0, :, sl], ops[1, :, sl] = p / 2, dp / 2
+            ops[4, :, sl], ops[5, :, sl] = sign * p / 2, sign * dp / 2
+    return blocks, ops
 
 
 def _functions(nodes, x, degree: int, order: int, mapping):
@@ -401,17 +418,35 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     of half the size; else one. One assembly and, for m = 1, one evaluation of the modes' constraint rows G c
     serve every reading. ``kind``: the perturbation basis (``perturbation_basis``)."""
     b = perturbation_basis(equilibrium, m, degree, quadrature, kind)
-    moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
-    if equilibrium.disc.symmetric:
-        parts = tuple(zip(_class_hessians(equilibrium, u, params, m, b), b.classes, b.class_factors, (0, 1)))
-    else:
-        parts = ((_hessian(equilibrium, u, params, m, b), None, b.factor, None),)
+    moments, parts = _parts(equilibrium, u, params, m, b)
     out = {}
     for held in readings:
         modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []
         out[held] = tuple(eigen.restricted(H, factor, _class_rows(moments, modes, cls, index))
                           for H, index, factor, cls in parts)
     return out
+
+
+def _parts(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:
+    """(the special modes' constraint rows G c, ((H, index, Gram factor, class) of each uncoupled part)): the two
+    reflection classes of an equator-symmetric state, else the whole block (index and class None)."""
+    moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
+    if equilibrium.disc.symmetric:
+        return moments, tuple(zip(_class_hessians(equilibrium, u, params, m, b), b.classes, b.class_factors, (0, 1)))
+    return moments, ((_hessian(equilibrium, u, params, m, b), None, b.factor, None),)
+
+
+def block_pencils(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, held: bool,
+                  kind: str | None = None) -> tuple:
+    """The m-th block of one reading (``restricted_blocks``) as the pencils of its uncoupled parts on the
+    coefficients of its basis: (basis, ((K, G, N, index), ...)), K q = ν G q on N q = 0 (N the removed special
+    modes' rows) for q supported on ``index``; for the eigenvectors (dynamics.modes)."""
+    b = perturbation_basis(equilibrium, m, degree, 0, kind)
+    moments, parts = _parts(equilibrium, u, params, m, b)
+    modes = list(excluded_modes(equilibrium, params, held)) if m == 1 else []
+    every = np.arange(b.size)
+    return b, tuple((H, b.gram[np.ix_(index, index)] if cls is not None else b.gram, _class_rows(moments, modes, cls, index),
+                     index if cls is not None else every) for H, index, _, cls in parts)
 
 
 def _class_rows(moments, modes: list, cls, index):

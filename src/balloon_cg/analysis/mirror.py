@@ -14,7 +14,9 @@ the tracer locates the turning points of the north pole stretch (TP) only, and s
 pole only. So the pear branch is traced with its south pole turning points located too (``switching.Turn.SOUTH``):
 they become the mirror's TP, while the pear's own TP (the mirror's south turning points) are not carried over; the
 stops STOP_STRETCH and SOUTH_STOP_STRETCH swap; LP, LV, LN and EP keep their kind with X reflected; a rejoin (the
-BP of an equator-symmetric primary point) is its own reflection. A pear branch that stopped on min_stretch, or whose
+BP of an equator-symmetric primary point) is its own reflection as a state, its coefficients reflected onto the
+mirrored wire map like every other point's (on a map an equator-symmetric state's coefficients are not their own
+reflection). A pear branch that stopped on min_stretch, or whose
 south pole stretch reached it (where the mirror's trace would have stopped), is not reflected: the mirror is traced
 (``Origin.TRACED_NOT_REFLECTABLE``).
 
@@ -92,9 +94,9 @@ def reflection_excess(branch: Branch, mirror: Branch) -> np.ndarray:
 
 
 def _reflected(s: SpecialPoint, disc, stop) -> SpecialPoint:
-    """A special point of the pear branch (on ``disc``) as one of its mirror image: a south turning point becomes
-    a TP; a rejoin (BP, a primary branch point) is its own reflection."""
-    if s.kind == Kind.BP:
-        return replace(s)
+    """A special point of the pear branch (on ``disc``) as one of its mirror image, X reflected onto the mirror's
+    basis: a south turning point becomes a TP. A rejoin (BP, a primary branch point) is its own reflection as a
+    state, but not as coefficients on a wire map: there ``disc.reflect`` gives the same state on the mirrored map
+    (its critical mode, in x, is the primary's and stays)."""
     kind = Kind.TP if s.kind == Turn.SOUTH else s.kind
     return replace(s, kind=kind, X=disc.reflect(s.X), stop=None if s.stop is None else stop(s.stop))

@@ -88,6 +88,12 @@ class Block(enum.StrEnum):
         """Whether the block is the held reading (the balloon held at its centre)."""
         return self.value.endswith("_held")
 
+    @classmethod
+    def order_of(cls, name: str) -> int:
+        """The azimuthal number of a block name of the second variation: m of ``azimuthal``'s m<m>_held and
+        m<m>_free, 0 for the m = 0 blocks (whose control variants, even_volume, …, are no Block)."""
+        return cls(name).m if name[:1] == "m" else 0
+
 
 class Gauge(enum.StrEnum):
     """Which reading of the rigid translation a special point or a branch belongs to. Held: the balloon is held at

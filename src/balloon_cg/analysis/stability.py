@@ -214,12 +214,31 @@ class SecondVariation:
         """``blocks`` of the m = 0 plan (``_plan``; only those named in ``names``, if given)."""
         half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
         H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
-        H_gas = H + (params.P / self.eq.volume(u)) * np.outer(g, g)  # module docstring
+        H_gas = self._gas(H, g, u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         matrices = (H, H_gas)
         return [(name, (eigen.restricted(matrices[gas], factor, g[idx] if constrained else eigen.NO_CONSTRAINT, idx),),
                  flags) for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on)
                 if names is None or name in names]
+
+    def _gas(self, H, g, u, params: Parameters) -> np.ndarray:
+        """The Hessian under gas control, H + (P/Ṽ) g gᵀ (module docstring)."""
+        return H + (params.P / self.eq.volume(u)) * np.outer(g, g)
+
+    def block_pencil(self, u, params: Parameters, symmetric: bool, name: str) -> tuple:
+        """The m = 0 block ``name`` (``blocks``) as its pencil on the perturbation coefficients ``index``:
+        (K, G, N, index), K q = ν G q on N q = 0 (K the Hessian, under gas control H + (P/Ṽ) g gᵀ; G the Gram
+        matrix; N the volume gradient's row where the block keeps the volume, else no rows), the full assembly
+        (``matrices``), for the eigenvectors (dynamics.modes)."""
+        field_on = self.eq.coils.shape[0] > 0 and params.M > 0
+        plan = {entry[0]: entry for entry in self._plan(symmetric, field_on)}
+        if name not in plan:
+            raise KeyError(f"no m = 0 block {name!r} here (blocks: {', '.join(plan)})")
+        _, gas, idx, constrained, _, _ = plan[name]
+        H, g = self.matrices(u, params)
+        K = self._gas(H, g, u, params) if gas else H
+        normals = g[idx][None, :] if constrained else np.zeros((0, idx.size))
+        return K[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)], normals, idx
 
     def lowest(self, u, params: Parameters, symmetric: bool, name: str) -> np.ndarray:
         """The LOWEST eigenvalues of the one m = 0 block ``name`` at one equilibrium (``blocks``)."""
@@ -258,16 +277,23 @@ def _axisymmetric_mass(basis: Discretisation) -> np.ndarray:
 
 def _held_ops(basis: Discretisation) -> np.ndarray:
     """The node values (λ2, v, η, w) per perturbation coefficient (a_0..a_N, b_0..b_N), shape (4, n_q, 2N + 2).
-    On a mapped basis the η functions are 1 and P_k(s) − m_k (k ≥ 1), m_k = ½∫P_k(s(x)) dx, the span of
+    On a mapped basis the η functions are 1 and P_k(s) − m_k (k ≥ 1, ``held_means``), the span of
     P_0(s)..P_N(s): dropping b_0 (a held balloon) then means ∫δη dx = 0, the hold of the Legendre basis in x and of
     the equilibrium's held mapped basis (``Discretisation``), not ∫δη ds = 0. In x, m_k = 0: the basis's own ops."""
     if basis.mapping is None:
         return basis.ops
     na = basis.a_index.size
     ops = np.array(basis.ops)
-    means = 0.5 * basis.weights @ ops[2, :, na + 1:]
-    ops[2, :, na + 1:] -= means
+    ops[2, :, na + 1:] -= held_means(basis)
     return read_only(ops)
+
+
+def held_means(basis: Discretisation) -> np.ndarray:
+    """m_k = ½∫P_k(s(x)) dx, k = 1..N, subtracted from the η functions of a mapped perturbation basis
+    (``_held_ops``); zero in x."""
+    if basis.mapping is None:
+        return np.zeros(basis.degree)
+    return 0.5 * basis.weights @ basis.ops[2, :, basis.a_index.size + 1:]
 
 
 def _hold(nodes: NodeKernels, u, state_map: np.ndarray, params: Parameters):

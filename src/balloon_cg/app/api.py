@@ -339,7 +339,7 @@ def _with_frequencies(branches, scene: Scene, clock) -> None:
 
     if scene.dynamics.frequencies:
         with clock.step(Step.FREQUENCIES):
-            attach(branches, scene.dynamics.count, scene.dynamics.m_max)
+            attach(branches, scene.dynamics.count, scene.dynamics.m_max, scene.dynamics.modes)
 
 
 def trace(scene, progress: bool = False) -> Result:

@@ -34,7 +34,7 @@ CURVE_KINDS = ("BP", "LP", "LV", "LN")  # critical --of: the pear pitchfork, the
 INTERRUPTED = 130  # 128 + SIGINT, the shell's convention
 BROKEN_PIPE = 141  # 128 + SIGPIPE: what a tool killed by SIGPIPE reports
 PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equator", "shapes", "stresses", "field",
-              "curvature", "energy", "frequencies", "phase", "surface", "stretch-map")
+              "curvature", "energy", "frequencies", "modes", "phase", "surface", "stretch-map")
 # the exceptions that mean bad input (exit 2) or a computation that did not give what was asked (exit 1), by
 # module: a module that is not loaded cannot have raised its exception, so none is imported to catch it
 BAD_INPUT = {"balloon_cg.scene.validation": "SceneError", "balloon_cg.io.layout": "FileError",

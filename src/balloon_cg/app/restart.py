@@ -318,7 +318,7 @@ def restart(start: Labelled, parameter: str | None, direction: float = 1.0, prog
         picture = switch(start, progress) if kind == Kind.BP else restart_branch(start, progress)
         dynamics = start.branch.scene.dynamics
         if dynamics.frequencies:
-            attach(picture.branches + picture.surface_branches, dynamics.count, dynamics.m_max)
+            attach(picture.branches + picture.surface_branches, dynamics.count, dynamics.m_max, dynamics.modes)
         return picture
     if kind in CONTROL_OF_FOLD:
         return continue_fold(start.branch, start.point, parameter, direction, progress=progress)

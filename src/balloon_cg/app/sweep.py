@@ -250,7 +250,7 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
             branches, snaps, points, found = (picture.branches + picture.surface_branches, picture.snaps,
                                               picture.branch_points, picture.incomplete)
         if scene.dynamics.frequencies:  # [dynamics]: each member's natural frequencies (docs/dynamics.md)
-            attach(branches, scene.dynamics.count, scene.dynamics.m_max)
+            attach(branches, scene.dynamics.count, scene.dynamics.m_max, scene.dynamics.modes)
     return MemberResult(index, branches, snaps, points, found, time.perf_counter() - start, os.getpid())
 
 

@@ -18,8 +18,10 @@ from ..analysis.azimuthal import merged_lowest
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Gauge, Kind, Origin
 from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
+from ..galerkin.profiles import theta_grid
 from ..numerics import interrupt, workers
 from ..numerics.threads import limited_blas
+from .modes import COMPONENTS, block_modes
 from .pencil import MASS_NORM, PER_EIGENVALUE, mass_variation
 from .translation import DIRECTIONS, translation_omega2
 
@@ -41,7 +43,9 @@ class BranchFrequencies:
     has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (``frequency_degrees``);
     ``special[name]`` (special points × count) the same at each special point's own state, at the
     higher degree of the points around it; ``translation[direction]`` (points,) the rigid translations' Ω²
-    (translation.translation_omega2: 0 without a field, else > 0 restored, < 0 pulled)."""
+    (translation.translation_omega2: 0 without a field, else > 0 restored, < 0 pulled); ``modes[name]``
+    (special points × count × 3 × θ, NaN where fewer modes) the mode shapes of ``special`` on ``theta``
+    (modes.block_modes: δρ, δz, δφ over R0 for a unit modal mass), or None when not asked for."""
 
     omega2: dict
     degree: np.ndarray
@@ -49,41 +53,61 @@ class BranchFrequencies:
     translation: dict
     count: int
     m_max: int
+    modes: dict | None = None
+    theta: np.ndarray | None = None
 
 
 @limited_blas
 def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool | None = None,
-                       copied: "BranchFrequencies | None" = None) -> BranchFrequencies:
+                       copied: "BranchFrequencies | None" = None, modes: bool = False) -> BranchFrequencies:
     """``frequencies`` and ``translation_omega2`` at every point of ``branch`` (on every core:
     ``numerics.workers.spread``, as the stability assessment; one BLAS thread: ``numerics.threads``), and
     ``frequencies`` at each special point's own state (at the higher degree of the points around it), each point
-    at ``frequency_degrees``. ``copied``: the
+    at ``frequency_degrees``; with ``modes`` the special points' mode shapes too (``modes.block_modes`` on the
+    run's θ grid, scene.output.theta_points). ``copied``: the
     points' values of the branch this one is the mirror image of (the energy is invariant under the reflection:
     every block's spectrum and the translations' are the same), so that only its special points are computed."""
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
     eq = equilibrium_of(branch)
     degrees = frequency_degrees(branch)
     variations = {}
+    theta = theta_grid(branch.scene.output.theta_points) if modes else None
+
+    def variation_at(N):
+        return variations.get(N) or variations.setdefault(N, mass_variation(eq, N))
 
     def at(X, N):
         interrupt.check()
-        variation = variations.get(N) or variations.setdefault(N, mass_variation(eq, N))
-        return frequencies(variation, X[:-1], branch.params_at(X), symmetric, m_max, count)
+        return frequencies(variation_at(N), X[:-1], branch.params_at(X), symmetric, m_max, count)
 
     def point(n):
         X, N = branch.X[n], int(degrees[n])
         return at(X, N), translation_omega2(eq, X[:-1], branch.params_at(X), N)
 
+    def shapes(s, blocks):
+        interrupt.check()
+        variation = variation_at(int(degrees[s.index:s.index + 2].max()))
+        return {name: block_modes(variation, s.X[:-1], branch.params_at(s.X), symmetric, name, count, theta)[1]
+                for name in blocks}
+
     special = [at(s.X, int(degrees[s.index:s.index + 2].max())) for s in branch.special]
+    shaped = {} if modes else None
+    if modes:
+        per_point = [shapes(s, row) for s, row in zip(branch.special, special)]
+        for name in dict.fromkeys(name for row in special for name in row):
+            shaped[name] = np.full((len(special), count, len(COMPONENTS), theta.size), np.nan)
+            for n, row in enumerate(per_point):
+                if name in row:
+                    shaped[name][n, :len(row[name])] = row[name]
     if copied is not None:
-        return replace(copied, special=_table(special, list(copied.omega2), count))
+        return replace(copied, special=_table(special, list(copied.omega2), count), modes=shaped, theta=theta)
     results = workers.spread(point, range(len(branch.X)), [assessment_cost(N, m_max) for N in degrees],
                              here=first_of_each(degrees))
     rows = [row for row, _ in results]
     names = list(dict.fromkeys(name for row in rows for name in row))
     translation = {direction: np.array([rigid[direction] for _, rigid in results]) for direction in DIRECTIONS}
     return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), translation, count,
-                             m_max)
+                             m_max, shaped, theta)
 
 
 def frequency_degrees(branch) -> np.ndarray:
@@ -129,11 +153,13 @@ def matching_block(special, branch) -> str | None:
     return f"all{control}_{'free' if free else 'held'}"
 
 
-def attach(branches, count: int, m_max: int) -> None:
-    """``branch.frequencies`` (``branch_frequencies``) of every axisymmetric branch, a reflected mirror image's
-    points copied from its source; surface branches are left without."""
+def attach(branches, count: int, m_max: int, modes: bool = False) -> None:
+    """``branch.frequencies`` (``branch_frequencies``, with the special points' mode shapes if ``modes``) of every
+    axisymmetric branch, a reflected mirror image's points copied from its source; surface branches are left
+    without."""
     done = {}
     for branch in branches:
         if isinstance(branch, Branch):
             source = done.get(branch.reflection_of) if branch.origin == Origin.REFLECTED else None
-            branch.frequencies = done[branch.name] = branch_frequencies(branch, count, m_max, copied=source)
+            branch.frequencies = done[branch.name] = branch_frequencies(branch, count, m_max, copied=source,
+                                                                        modes=modes)

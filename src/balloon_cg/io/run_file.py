@@ -40,6 +40,9 @@ Layout::
                                                            own state
         frequencies/translation_axial, translation_lateral (point,): Ω² of the rigid translations (0 without a
                                                            field; > 0 the field restores, < 0 it pulls)
+        frequencies/modes_<block>                          (special, frequency, component, theta): with [dynamics]
+                                                           modes, the mode shapes of special_omega2_<block>
+                                                           (δρ, δz, δφ over R0 for a unit modal mass)
     /branches/<name>/      a surface branch (analysis.results.SurfaceBranch, m ≥ 1): attrs order, m, parent_branch,
                            parent_branch_point, stop_reason, leg_labels, leg_stop_codes, wall_time, kernel_class,
                            kernel_signature, M, chi, electric, voltage, parameter, and its SphericalBasis:
@@ -82,7 +85,7 @@ from ..surface.loads import LOADS
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
                      require_group)
-from .schema import FINITE, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, scale
+from .schema import FINITE, MODES, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, scale
 
 FORMAT = "balloon-cg/5"
 READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
@@ -283,7 +286,7 @@ def _write_branch(group, branch, theta, first_label: int = 1):
     if branch.stability:
         _write_stability(group.create_group("stability"), branch, point)
     if branch.frequencies is not None:
-        _write_frequencies(group.create_group("frequencies"), branch.frequencies, point)
+        _write_frequencies(group.create_group("frequencies"), branch.frequencies, point, theta_scale)
 
 
 def _write_common_attrs(group, branch) -> None:
@@ -404,8 +407,9 @@ def _write_stability(group, branch, point):
     group.attrs["unsettled_points"] = np.asarray(branch.unsettled, dtype=np.int64)
 
 
-def _write_frequencies(group, frequencies, point):
-    """Ω² per block (dynamics.frequencies.BranchFrequencies) and the degree per point."""
+def _write_frequencies(group, frequencies, point, theta):
+    """Ω² per block (dynamics.frequencies.BranchFrequencies) and the degree per point; the special points' mode
+    shapes where computed (on the branch's ``theta`` scale)."""
     group.attrs.update({"count": frequencies.count, "m_max": frequencies.m_max})
     frequency = scale(group, "frequency", frequencies.count)
     special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
@@ -417,6 +421,11 @@ def _write_frequencies(group, frequencies, point):
         checksummed(group, f"{OMEGA2}{block}", values)
         checksummed(group, f"{SPECIAL_OMEGA2}{block}", frequencies.special[block])
         axes[f"{SPECIAL_OMEGA2}{block}"] = (special, frequency)
+    if frequencies.modes is not None:
+        component = scale(group, "component", next(iter(frequencies.modes.values())).shape[2])
+        for block, shapes in frequencies.modes.items():
+            checksummed(group, f"{MODES}{block}", shapes, compression="gzip", shuffle=True)
+            axes[f"{MODES}{block}"] = (special, frequency, component, theta)
     attach_dimensions(group, axes)
 
 
@@ -681,6 +690,7 @@ def check_frequencies(group, where, error, n: int) -> None:
     check_columns(frequencies, f"{where}: frequencies", columns | rigid | {"perturbation_degree": ("int", 1)}, error,
                   rows=n)
     special = {name: ("float", 2) for name in frequencies if name.startswith(SPECIAL_OMEGA2)}
+    special |= {name: ("float", 4) for name in frequencies if name.startswith(MODES)}
     check_columns(frequencies, f"{where}: frequencies", special, error, rows=len(group["special_points"]["kind"]))
     check_sizes(frequencies, f"{where}: frequencies", error)
 
@@ -840,7 +850,7 @@ def _read_branch(group) -> dict:
         data["stability"] = {name: item[()] for name, item in group["stability"].items()}
     if "frequencies" in group:
         for key, prefix in (("frequencies", OMEGA2), ("special_frequencies", SPECIAL_OMEGA2),
-                            ("translation_omega2", "translation_")):
+                            ("translation_omega2", "translation_"), ("modes", MODES)):
             data[key] = {name.removeprefix(prefix): item[()] for name, item in group["frequencies"].items()
                          if name.startswith(prefix)}
     return data

@@ -30,6 +30,8 @@ VARIABLES = {
     "to_index": (COUNT, "to point", "its point near the same P (-1: none)"),
     "eigenvalue": (COUNT, "eigenvalue index", "0: the lowest eigenvalue of the block, 1: the next, …"),
     "frequency": (COUNT, "frequency index", "0: the lowest natural frequency of the block, 1: the next, …"),
+    "component": (COUNT, "displacement component", "0: δρ, 1: δz, 2: δφ (m ≥ 1: the amplitudes of cos mφ, cos mφ, "
+                                                    "sin mφ; m = 0: δφ = 0)"),
     "translation_axial": (NONDIMENSIONAL, "Ω² of the rigid axial translation",
                           "½ tᵀKt/tᵀMt of the translation along the axis: the field's stiffness (0 without a field, "
                           "> 0 the field restores the balloon, < 0 it pulls it away; docs/dynamics.md)"),
@@ -110,8 +112,12 @@ FREQUENCY = (NONDIMENSIONAL, "squared natural frequency Ω²", "Ω² = ω² R0²
                                                            "frequency, ρ the density, μ the initial shear modulus); "
                                                            "negative: an unstable mode; NaN: the block has fewer modes")
 SPECIAL_OMEGA2 = "special_" + OMEGA2  # ... at the special points (frequencies/special_omega2_<block>)
+MODES = "modes_"  # ... their mode shapes at the special points (frequencies/modes_<block>, [dynamics] modes)
 PREFIXED = {"lowest_": LOWEST, OMEGA2: FREQUENCY,
-            SPECIAL_OMEGA2: (NONDIMENSIONAL, "squared natural frequency Ω² at a special point", FREQUENCY[2])}
+            SPECIAL_OMEGA2: (NONDIMENSIONAL, "squared natural frequency Ω² at a special point", FREQUENCY[2]),
+            MODES: (NONDIMENSIONAL, "mode shape at a special point", "displacement of the reference meridian "
+                    "(δρ, δz, δφ) / R0 of the mode of special_omega2 for a unit modal mass, (1/2π)∫∫|δx|² dA = 1 on "
+                    "the reference sphere (docs/dynamics.md); NaN: fewer modes")}
 
 
 def describe(dataset, name: str | None = None) -> None:

@@ -40,6 +40,7 @@ from .quantities import branch_discretisation, postprocess, stored_scene, surfac
 from .fit import NARROW, fit_width, fitted_size
 from .labels import label_points
 from .style import JournalFigure, journal_style
+from ..analysis.results import Block
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, file_kind, reading
@@ -352,6 +353,7 @@ def applicable_kinds(branches) -> list[str]:
             and (kind != "field" or any(b.coils for b in branches))
             and (kind != "energy" or any(b.bifurcations for b in branches))
             and (kind != "frequencies" or any("frequencies" in b.data for b in branches))
+            and (kind != "modes" or any(b.data.get("modes") for b in branches))
             and (kind not in SURFACE_KINDS or any(b.surface for b in branches))]
 
 
@@ -1044,6 +1046,64 @@ def plot_frequencies(branches, axes=None) -> Figure:
     return fig
 
 
+STABILITY_CHANGES = ("LP", "LV", "LN", "BP")  # the special points where an Ω² of a block passes through zero
+MODE_AMPLITUDE = 0.15  # the drawn mode's largest displacement, as a fraction of the outline's largest radius
+
+
+def critical_modes(branches) -> list:
+    """(branch, special point, its state's row, block, Ω², mode shape (3 × θ)) at every fold and branch point of
+    the branches with stored mode shapes: the mode of the stored Ω² nearest zero over the blocks (the mode whose
+    frequency vanishes there)."""
+    found = []
+    for b in branches:
+        modes = b.data.get("modes") or {}
+        for n, s in enumerate(b.data["special_points"]):
+            if s["kind"] not in STABILITY_CHANGES or not modes:
+                continue
+            block, k = min(((block, int(np.nanargmin(np.abs(values[n])))) for block, values in
+                            b.data["special_frequencies"].items() if np.isfinite(values[n]).any()),
+                           key=lambda pair: abs(b.data["special_frequencies"][pair[0]][n, pair[1]]))
+            found.append((b, s, n, block, b.data["special_frequencies"][block][n, k], modes[block][n, k]))
+    return found
+
+
+def plot_modes(branches, axes=None) -> Figure:
+    """The mode shape of every fold and branch point (``critical_modes``): the special point's deformed meridian
+    section (ρ, η) at φ = 0 and φ = π and the outline displaced by ± the mode (δρ, δz at φ = 0, times cos mφ = ±1
+    at φ = π; δφ, in the plane of neither, is not drawn), scaled to MODE_AMPLITUDE of the largest radius; one
+    panel per point (docs/dynamics.md). Runs without [dynamics] modes = true fail with a one-line message."""
+    found = critical_modes(branches)
+    if not found:
+        files = ", ".join(dict.fromkeys(str(b.source) for b in branches))
+        raise PlotError(f"{files}: no stored mode shapes at a fold or branch point (frequencies/modes_<block>); run "
+                        "the scene with [dynamics] frequencies = true and modes = true")
+    columns = min(3, len(found))
+    rows = -(-len(found) // columns)
+    fig, panels, own = _panels(axes, len(found), (2.6 * columns, 2.8 * rows), nrows=rows, ncols=columns,
+                               squeeze=False)
+    panels = np.ravel(panels)
+    for ax in panels[len(found):]:
+        ax.set_visible(False)
+    for ax, (b, s, n, block, omega2, shape) in zip(panels, found):
+        d = b.data
+        outline = surface(branch_discretisation(d), d["special_unknowns"][n], d["theta"], stored_scene(b.run).geometry)
+        rho, eta = outline["rho"][0], outline["eta"][0]
+        m = Block.order_of(block)
+        scale = MODE_AMPLITUDE * rho.max() / max(np.abs(shape[:2]).max(), np.finfo(float).tiny)
+        for side in (1.0, -1.0):  # φ = 0, φ = π (cos mφ = (−1)^m)
+            turn = side ** m
+            ax.plot(side * rho, eta, color="k", linewidth=1.0)
+            for sign, style in ((1.0, "-"), (-1.0, "--")):
+                ax.plot(side * (rho + sign * scale * turn * shape[0]), eta + sign * scale * turn * shape[1], style,
+                        color=b.color, linewidth=0.9)
+        ax.set_aspect("equal")
+        ax.set_title(f"{s['label']} {s['kind']}, {block}\n$\\Omega^2$ = {omega2:.1e}", fontsize="small")
+        ax.set_xlabel(r"$\rho$")
+        ax.set_ylabel(r"$\eta$")
+    _suptitle(fig, panels, own, _title(branches))
+    return fig
+
+
 def plot_energy(branches, axes=None) -> Figure:
     """Energy landscape E(Λ) − E0 = E2Λ² + E3Λ³ + E4Λ⁴ along the critical mode at each branch point (the
     special points with finite E2, E3, E4, written by the stability analysis)."""
@@ -1235,6 +1295,7 @@ KINDS = {
     "curvature": (plot_curvature, True),
     "energy": (plot_energy, False),
     "frequencies": (plot_frequencies, False),
+    "modes": (plot_modes, False),
     "phase": (plot_phase, False),
     "surface": (plot_surface, True),
     "stretch-map": (plot_stretch_map, True),

@@ -211,11 +211,13 @@ SURFACE_BRANCHES = ("first", "all", "none")
 @dataclass(frozen=True)
 class Dynamics:
     """Natural frequencies (MODEL.md §11, docs/dynamics.md): with ``frequencies`` the lowest ``count`` Ω² of every
-    second-variation block, m = 0..``m_max``, at every point of every axisymmetric branch."""
+    second-variation block, m = 0..``m_max``, at every point of every axisymmetric branch; with ``modes`` also
+    their mode shapes at the special points."""
 
     frequencies: bool = False
     count: int = 3
     m_max: int = 1
+    modes: bool = False
 
 
 @dataclass(frozen=True)
@@ -869,11 +871,14 @@ def _surface(data) -> Surface:
 def _dynamics(data) -> Dynamics:
     data = table("dynamics", data, _keys(Dynamics))
     get = _getter(data, "dynamics", Dynamics)
-    wanted = data.get("frequencies", Dynamics.frequencies)
-    if not isinstance(wanted, bool):
-        raise SceneError(f"dynamics.frequencies = {show(wanted)}: must be true or false")
-    return Dynamics(wanted, get("count", lambda n: 1 <= n <= 50, "an integer in [1, 50]", integer=True),
-                    get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True))
+    switches = {key: data.get(key, getattr(Dynamics, key)) for key in ("frequencies", "modes")}
+    for key, wanted in switches.items():
+        if not isinstance(wanted, bool):
+            raise SceneError(f"dynamics.{key} = {show(wanted)}: must be true or false")
+    if switches["modes"] and not switches["frequencies"]:
+        raise SceneError("dynamics.modes = true: needs dynamics.frequencies = true (the shapes of those modes)")
+    return Dynamics(switches["frequencies"], get("count", lambda n: 1 <= n <= 50, "an integer in [1, 50]", integer=True),
+                    get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True), switches["modes"])
 
 
 def _output(data) -> Output:
