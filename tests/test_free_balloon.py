@@ -1,0 +1,109 @@
+"""The free balloon in a field without equator symmetry (issue 41): one coil off the equator (r = 2, h = 0.5,
+M = 0.002). Its held states carry the field's net axial force (the hold's reaction), so the free balloon has its own
+primary branch, traced with the axial translation an unknown (``trace_primary(held=False)``), and its own m = 1
+points and branches. A single loop's H² is symmetric about the loop's plane, so the net force on a balloon centred
+there vanishes: the free balloon is the balloon of the coil at h = 0 moved up by 0.5, which the tests use as an
+independent check (a state moved by −0.5 must be an equilibrium of the h = 0 scene, with its spectrum)."""
+import numpy as np
+import pytest
+
+from balloon_cg.analysis import azimuthal, azimuthal_points
+from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.results import Block, Gauge, Status
+from balloon_cg.analysis.stability import assess_branch, assessed_degrees
+from balloon_cg.analysis.surface_branches import SurfaceTrace, trace_surface
+from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.scene import parse_scene
+from balloon_cg.surface.basis import MIRROR_Y, SphericalBasis
+from balloon_cg.surface.embedding import axisymmetric_coefficients
+from balloon_cg.surface.loads import loads
+from balloon_cg.surface.equilibrium import SurfaceEquilibrium
+
+COIL = """[material]
+preset = "SPOM1"
+[field]
+M = 0.002
+[[field.coils]]
+radius = 2.0
+height = {height}
+current = 1.0
+[continuation]
+stop_stretch = 1.7
+"""  # stop_stretch 1.7: past the free m = 1 point (λ2(0) = 1.66) at a third of the issue's scene's points
+HELD_FREE_READING = 2.202508818  # the free-reading m = 1 point of the held branch (the issue's 'free m = 1 point')
+
+
+@pytest.fixture(scope="module")
+def free_primary():
+    """The free balloon's primary branch up from the start to λ2(0) = 1.7, assessed, its m ≥ 1 points located."""
+    scene = parse_scene(COIL.format(height=0.5), name="off_equator")
+    branch = trace_primary(scene, down=False, held=False, name="primary_free")
+    branch.stability, branch.unsettled = assess_branch(branch, scene.stability.degree, False, check=True,
+                                                       m_max=scene.stability.m_max)
+    branch.special += azimuthal_points.find(branch, assessed_degrees(branch), scene.stability.m_max)
+    return branch
+
+
+def moved_down(branch, X) -> tuple:
+    """(the h = 0 scene's Equilibrium, the point X = (u, P) of ``branch`` moved down by 0.5 on its
+    discretisation: b_0 − 0.5)."""
+    at_zero = parse_scene(COIL.format(height=0.0), name="coil_at_0")
+    disc = branch.disc
+    eq = Equilibrium(at_zero, Discretisation(disc.degree, False, False, disc.quadrature, disc.mapping))
+    a, b = disc.split(X[:-1])
+    b[0] -= 0.5
+    return eq, np.append(disc.join(a, b), X[-1])
+
+
+def test_the_free_primary_branch_centres_where_the_net_force_vanishes(free_primary):
+    """Every point: the centre (b_0) at the coil's plane z = 0.5 to 1e-10, the net axial force by the whole-sphere
+    quadrature of ∇H² (surface.loads, not the residual) ≤ 1e-10 at every tenth point, and the point moved down by
+    0.5 has on the coil at h = 0 the residual it has here (to 1e-13, every entry): the free balloon is that
+    balloon moved up (the solver's residual record ≤ 1e-10)."""
+    branch = free_primary
+    assert branch.gauge == Gauge.FREE and not branch.disc.pin_translation and branch.residual.max() <= 1e-10
+    for X in branch.X:
+        a, b = branch.disc.split(X[:-1])
+        assert abs(b[0] - 0.5) <= 1e-10
+    surface = SurfaceEquilibrium(branch.scene, SphericalBasis(branch.disc.degree, (MIRROR_Y,), order=2,
+                                                              mapping=branch.disc.mapping))
+    for X in branch.X[::10]:
+        c = axisymmetric_coefficients(surface.basis, branch.disc, X[:-1])
+        assert np.abs(loads(surface, c, branch.params_at(X))["force"]).max() <= 1e-10
+    own = equilibrium_of(branch)
+    for X in branch.X:
+        at_zero, Y = moved_down(branch, X)
+        difference = at_zero.residual(Y[:-1], branch.params_at(X)) - own.residual(X[:-1], branch.params_at(X))
+        assert np.abs(difference).max() <= 1e-13
+
+
+def test_the_free_m1_point_is_the_translated_balloons_and_not_the_held_branchs(free_primary):
+    """The free reading's m = 1 point of the free branch (located, P = 2.253168747) is the free m = 1 point of the
+    coil at h = 0 moved up: the lowest free m = 1 eigenvalue of the moved-down state on the h = 0 scene vanishes
+    (≤ 1e-9 of the spectrum's scale). The free-reading zero the held branch carries (P = 2.202508818) is another P:
+    a zero of the free second variation of states that are no free equilibria."""
+    bp = next(s for s in free_primary.special if s.block == Block.M1_FREE)
+    assert bp.status == Status.LOCATED and abs(bp.X[-1] - 2.253168747) < 1e-8
+    at_zero, Y = moved_down(free_primary, bp.X)
+    degree = free_primary.stability[bp.index].degree
+    values = azimuthal.spectrum(at_zero, Y[:-1], free_primary.params_at(bp.X), 1, degree, 3, held=False)
+    assert np.abs(values).min() <= 1e-9 * np.abs(values).max()
+    assert abs(bp.X[-1] - HELD_FREE_READING) > 0.05
+
+
+def test_the_free_m1_branch_has_zero_net_force_at_every_point(free_primary):
+    """The branch born at the free m = 1 point, traced on the whole sphere (mirror y → −y only, the translation
+    an unknown), 6 points: the net field force by surface.loads' quadrature ≤ 1e-10 at every point, the residual of
+    the free problem ≤ 1e-10 (point 0 solved, not embedded), the centre at the coil's plane and moving sideways."""
+    k, bp = next((k, bp) for k, bp in enumerate(free_primary.branch_points()) if bp.block == Block.M1_FREE)
+    branch = trace_surface(free_primary, k, bp, 1.0, "primary_free_m1", 6)
+    assert branch.basis.symmetry == (MIRROR_Y,) and not branch.held and len(branch.values) == 6
+    assert branch.residual.max() <= 1e-10
+    trace = SurfaceTrace(branch.scene, branch.basis, branch.params, held=False)
+    for c, P in zip(branch.coefficients, branch.values):
+        assert np.abs(loads(trace.eq, c, branch.params.with_value("P", P))["force"]).max() <= 1e-10
+    centroid = branch.measures["centroid"]
+    assert np.abs(centroid[:, 2] - 0.5).max() <= 1e-10
+    assert abs(centroid[0, 0]) < 1e-12 and np.all(np.diff(np.abs(centroid[:, 0])) > 0)
