@@ -14,8 +14,10 @@ snap-throughs under the scene's loading control
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
 LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
-continuation in the coil heights (``broken_symmetry``); the branches bifurcating from it are not traced
-(``Picture.not_searched`` says so). A field that is not axisymmetric gets its primary branch traced on the whole
+continuation in the coil heights (``broken_symmetry``); its held states carry the field's net axial force (the
+hold's reaction), so the free balloon gets its own primary branch (``FREE_PRIMARY``, the axial translation an
+unknown: ``_trace_free``) with ``[surface] branches = "all"``, and the branches at the m ≥ 1 points of each branch's
+own reading are traced on the whole sphere (``Branch.reads``; the other reading's in ``Picture.not_switched``). A field that is not axisymmetric gets its primary branch traced on the whole
 sphere (``surface_primary``) and the branches born at its pitchforks with their mirror images
 (``surface_pitchforks``; its other branch points in ``Picture.not_switched``). Every branch carries its assessments
 in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
@@ -45,6 +47,8 @@ from ..numerics.threads import limited_blas
 
 BROKEN = "broken_pear"  # the pear branch a broken equator symmetry disconnects (``broken_symmetry``)
 FREE_PRIMARY = "primary_free"  # the free balloon's primary branch in a field without equator symmetry
+FREE_NOT_ASKED = ('not traced: [surface] branches = "first" (the free balloon\'s primary branch, with the axial '
+                  'translation free, and the branches at its m ≥ 1 points); set "all"')
 PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear branch's name: <prefix>_<BP number>
 MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",
          Block.EVEN: "equator-symmetric (even)"}
@@ -207,7 +211,9 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
         if search and not stopped(picture):
             with clock.step(Step.PEAR_BRANCHES):
                 _trace_broken(scene, primary, picture, progress)
-        if surface and primary.gauge == Gauge.HELD and scene.surface.branches == "all" and not stopped(picture):
+        if surface and primary.gauge == Gauge.HELD and scene.surface.branches == "first":
+            picture.not_asked.append((FREE_PRIMARY, FREE_NOT_ASKED))
+        elif surface and primary.gauge == Gauge.HELD and not stopped(picture):
             _trace_free(scene, picture, progress)
         picture.not_searched = _unsearched(primary, search, surface)
         pear = False  # no equator-symmetric pitchforks to switch at
@@ -473,8 +479,7 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
         traced = {k for k, _ in chosen}
         reason = ('not traced: [surface] branches = "first" (set "all" to trace them)' if branch.disc.symmetric else
                   'not traced: [surface] branches = "first" traces none on a branch without equator symmetry (its '
-                  'whole-sphere basis keeps the mirror y → −y alone: near a wire minutes to hours a branch), nor the '
-                  f'free balloon\'s branch ({FREE_PRIMARY}); set "all"')
+                  'whole-sphere basis keeps the mirror y → −y alone: near a wire minutes to hours a branch); set "all"')
         picture.not_asked.append((", ".join(surface_name(branch, k, bp) for k, bp in points if k not in traced),
                                   reason))
     for k, bp in chosen:
