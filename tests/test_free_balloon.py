@@ -107,3 +107,40 @@ def test_the_free_m1_branch_has_zero_net_force_at_every_point(free_primary):
     centroid = branch.measures["centroid"]
     assert np.abs(centroid[:, 2] - 0.5).max() <= 1e-10
     assert abs(centroid[0, 0]) < 1e-12 and np.all(np.diff(np.abs(centroid[:, 0])) > 0)
+
+
+@pytest.mark.slow
+def test_the_verdict_names_every_branch_not_traced(tmp_path, capsys):
+    """The issue's scene (tests/data/off_equator.toml) with ``[surface] branches = "all"`` (4 points a branch): no
+    not_searched entry; the free balloon's primary branch traced (primary_free) with its free m = 1 branches; the
+    m = 1 points of the other reading on each branch (the held branch's free-reading zero, primary_free's held
+    one) named as not switched with why; the free balloon named once in the summary line."""
+    from pathlib import Path
+
+    from balloon_cg.analysis.picture import FREE_PRIMARY, analyse
+    from balloon_cg.analysis.verdict import Gap
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.run_file import write_run
+    from balloon_cg.scene import load_scene
+
+    scene = load_scene(Path(__file__).parent / "data" / "off_equator.toml").with_overrides(
+        {"surface.branches": "all", "surface.max_points": 4}, name="off_equator")
+    picture = analyse(scene)
+    found = picture.incomplete
+    assert Gap.NOT_SEARCHED not in {item.gap for item in found} and picture.not_searched == ""
+    assert [b.name for b in picture.branches] == ["primary", "broken_pear", FREE_PRIMARY]
+    surface = {b.name: b for b in picture.surface_branches}
+    held = [name for name, b in surface.items() if b.held]
+    free = [name for name, b in surface.items() if not b.held]
+    assert held == ["m1_bp0", "m1_bp0_rotated"] and free and all(n.startswith(FREE_PRIMARY) for n in free)
+    switched = {item.branch: item.message for item in found if item.gap == Gap.NOT_SWITCHED}
+    primary_free_reading = [k for k, s in enumerate(picture.primary.branch_points()) if s.block == Block.M1_FREE]
+    assert f"m1_bp{primary_free_reading[0]}" in switched and "no free equilibria" in switched[
+        f"m1_bp{primary_free_reading[0]}"]
+    assert any(name.startswith(FREE_PRIMARY) and "held-reading points of free states" in message
+               for name, message in switched.items())
+    path = write_run(tmp_path / "off.h5", scene, picture.branches + picture.surface_branches, snaps=picture.snaps,
+                     found=found)
+    assert main(["inspect", str(path)]) == 0
+    verdict = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("result"))
+    assert "not_searched" not in verdict and verdict.count("free balloon") <= 1
