@@ -28,8 +28,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, mirror, surface_branches,
-               surface_pitchforks, surface_primary)
+from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, free_pitchforks, mirror,
+               surface_branches, surface_pitchforks, surface_primary)
 from ..scene import Control
 from .control import FOLD_KIND, control_value, control_values, minimised_energy
 from .mirror import MIRROR
@@ -318,7 +318,10 @@ def _trace_free(scene, picture: Picture, progress: Progress) -> None:
     branch, traced with the axial translation b_0 an unknown and the net axial force zero (``primary.released``:
     it starts where that force vanishes), assessed, its stability changes under every control located
     (``control_points``); its m ≥ 1 points are switched with the primary branch's (``_trace_surface``). A start
-    that fails is a branch not started (the result is then incomplete)."""
+    that fails is a branch not started (the result is then incomplete). Its m = 0 branch points (the pitchforks
+    of a symmetry about the plane where the free balloon centres: one coil's own plane) are classified and the
+    pear branches born at them traced both ways, <FREE_PRIMARY>_pear_<n> and its _mirror (``free_pitchforks``),
+    assessed."""
     with picture.clock.step(Step.FREE_BALLOON):
         try:
             free = trace_primary(scene, symmetric=False, held=False, name=FREE_PRIMARY,
@@ -328,10 +331,31 @@ def _trace_free(scene, picture: Picture, progress: Progress) -> None:
             return
     progress.finish(Phase.FREE, len(free.X))
     picture.branches.append(free)
-    if _assess(free, scene, False, progress, picture.clock):
-        with picture.clock.step(Step.BRANCH_POINTS):
-            free.special += control_points.find(free)
+    if not _assess(free, scene, False, progress, picture.clock):
+        return
+    with picture.clock.step(Step.BRANCH_POINTS):
+        free.special += control_points.find(free)
         free.special.sort(key=_along)
+        pitchforks = free_pitchforks.classified(free)
+    m0 = [s for s in free.branch_points() if s.m == 0]
+    with picture.clock.step(Step.PEAR_BRANCHES):
+        for n, bp in pitchforks:
+            for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
+                if stopped(picture):
+                    return
+                name = f"{FREE_PRIMARY}_pear_{n}{suffix}"
+                branch = trace_pear(free, bp, sign, name, progress.ticker(Phase.PEAR))
+                if branch is None:
+                    picture.not_started.append((name, f"the first correction from branch point {n} of "
+                                                      f"{FREE_PRIMARY} along its mode did not converge"))
+                    continue
+                branch.parent = (FREE_PRIMARY, n)
+                branch.rejoins = _rejoin_point(branch, m0, n)
+                if branch.rejoins is not None:
+                    mark_rejoin(branch, free, m0[branch.rejoins])
+                picture.branches.append(branch)
+                if not _assess(branch, scene, False, progress, picture.clock):
+                    return
 
 
 WHOLE_SPHERE_EVENTS = "the [[events]] are not located on branches traced on the whole sphere"
