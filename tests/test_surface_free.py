@@ -51,3 +51,38 @@ def test_free_m1_branch_is_not_a_held_equilibrium(free_branch):
     c, P = image.coefficients[-1], image.values[-1]
     assert np.abs(free.gauge.reduce(free.eq.residual(c, image.params.with_value("P", P)))).max() <= 1e-10
     assert np.abs(loads(free.eq, c, image.params.with_value("P", P))["force"]).max() <= 1e-10
+
+
+def test_free_m1_branch_follows_its_normal_form(free_branch):
+    """The branch's first points against its own second-order normal form: with the reduced energy
+    E(Λ, P) = E2(P) Λ² + E4 Λ⁴ + … along the unit mode φ (Λ = φ·(a − a*)), the branch is P − P* = κ Λ² + O(Λ⁴),
+    κ = −2 E4 / E2'(P*), E4 the located point's quartic coefficient (``classify``, stored with the origin) and E2'
+    from the test: E2(P) = ½ (φᵀ H(P)⁻¹ φ)⁻¹ (the minimum of ½ aᵀ H a on φ·a = Λ) at the axisymmetric states
+    P* ± 1e-4 solved on the whole sphere, by central difference. The first point (Λ = 0.02) reads κ to 1e-4
+    relative (measured 8e-5: its Λ² term), and the intercept of (P − P*)/Λ² = κ + κ4 Λ² through the first three
+    to 1e-4 (measured 2e-5)."""
+    from balloon_cg.analysis.surface_branches import axisymmetric_solve, critical_mode, located_degree
+    from balloon_cg.surface.embedding import mode_coefficients
+
+    primary, branch = free_branch
+    k, bp = next((k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m == 1 and not bp.block.held)
+    P_star = branch.values[0]
+    trace = SurfaceTrace(branch.scene, branch.basis, branch.params.with_value("P", P_star), held=False)
+    phi = trace.gauge.reduce(mode_coefficients(trace.basis, *critical_mode(primary, bp, located_degree(primary, bp))))
+    phi /= np.linalg.norm(phi)
+
+    def E2(P):
+        c = axisymmetric_solve(trace, branch.coefficients[0], P)
+        H = trace.gauge.reduce_matrix(trace.eq.hessian(c, branch.params.with_value("P", P)))
+        return 0.5 / (phi @ np.linalg.solve(H, phi))
+
+    h = 1e-4
+    slope = (E2(P_star + h) - E2(P_star - h)) / (2 * h)
+    kappa = -2 * branch.special[0].E[2] / slope
+    amplitude = np.array([trace.gauge.reduce(c) for c in branch.coefficients[1:4]]) @ phi - \
+        phi @ trace.gauge.reduce(branch.coefficients[0])
+    ratio = (branch.values[1:4] - P_star) / amplitude**2
+    assert abs(amplitude[0] - 0.02) < 1e-10  # the switch hyperplane φ·(X − X*) = 0.02, met to the solver's tol
+    assert abs(ratio[0] / kappa - 1) <= 1e-4
+    intercept = np.polynomial.polynomial.polyfit(amplitude**2, ratio, 1)[0]
+    assert abs(intercept / kappa - 1) <= 1e-4

@@ -38,7 +38,7 @@ from ..numerics.threads import limited_blas
 EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
 
 
-def _eigenpairs(variation, u, params, idx, count: int):
+def eigenpairs(variation, u, params, idx, count: int):
     """The ``count`` lowest eigenvalues of a block and their eigenvectors (columns, on the block's indices)."""
     H, _ = variation.matrices(u, params)
     return scipy.linalg.eigh(H[np.ix_(idx, idx)], variation.gram[np.ix_(idx, idx)], subset_by_index=[0, count - 1])
@@ -141,13 +141,13 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     reference = None  # the crossing mode at the bracket's start: the guess's mode is the one nearest it
     if start is None:
         ends = branch.disc.transfer(branch.X[index:index + 2], plain)
-        pairs = [_eigenpairs(variation, X[:-1], branch.params_at(X), idx, count) for X in ends]
+        pairs = [eigenpairs(variation, X[:-1], branch.params_at(X), idx, count) for X in ends]
         i, j = followed_crossing([p[0] for p in pairs], [p[1] for p in pairs], gram, k)
         s = float(np.clip(pairs[0][0][i] / (pairs[0][0][i] - pairs[1][0][j]), 0.0, 1.0))
         guess, reference = ends[0] + s * (ends[1] - ends[0]), pairs[0][1][:, i]
     else:
         guess = branch.disc.transfer(start.X, plain)
-    values, vectors = _eigenpairs(variation, guess[:-1], branch.params_at(guess), idx, count)
+    values, vectors = eigenpairs(variation, guess[:-1], branch.params_at(guess), idx, count)
     n = np.argmin(np.abs(values)) if reference is None else np.argmax(np.abs(vectors.T @ gram @ reference))
     mode = np.zeros(variation.gram.shape[0])
     mode[idx] = vectors[:, n]
@@ -164,7 +164,7 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     result = newton(system.residual, system.jacobian, X0, np.zeros((0, X0.size)), [], solver.tol, solver.max_newton)
     solution = result.x if result.converged else X0  # a failed Newton keeps its starting point (it says so)
     X = solution[:plain.size + 1]
-    values = _eigenpairs(variation, X[:-1], branch.params_at(X), idx, count)[0]
+    values = eigenpairs(variation, X[:-1], branch.params_at(X), idx, count)[0]
     eigenvalue = values[np.argmin(np.abs(values))]  # the crossing one: nearest zero at the branch point
     beta = system.beta(solution) if block == Block.EVEN else 0.0
     return ExtendedSolution(plain.transfer(X, branch.disc), system.mode(solution), degree, result.converged,
@@ -198,8 +198,9 @@ def crossing_problems(branch: Branch, index: int, block: Block, k: int) -> list[
 def general_tracer(scene, block: Block = Block.ODD_HELD) -> Tracer:
     """The general (non-symmetric) space of the reading of a branch point of ``block``: the balloon held at its
     centre (b_0 = 0, the 'odd_held' and 'even' blocks), or free (b_0 an unknown, its equation the vanishing net
-    axial force: the 'odd_free' block)."""
-    return Tracer(scene, symmetric=False, held=block != Block.ODD_FREE)
+    axial force: the 'odd_free' block, and the free balloon's blocks of a branch without equator symmetry,
+    'all_free', ...)."""
+    return Tracer(scene, symmetric=False, held=block == Block.EVEN or block.held)
 
 
 def plain_degree(branch: Branch, X) -> int:

@@ -14,8 +14,10 @@ snap-throughs under the scene's loading control
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
 LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
-continuation in the coil heights (``broken_symmetry``); the branches bifurcating from it are not traced
-(``Picture.not_searched`` says so). A field that is not axisymmetric gets its primary branch traced on the whole
+continuation in the coil heights (``broken_symmetry``); its held states carry the field's net axial force (the
+hold's reaction), so the free balloon gets its own primary branch (``FREE_PRIMARY``, the axial translation an
+unknown: ``_trace_free``) with ``[surface] branches = "all"``, and the branches at the m ≥ 1 points of each branch's
+own reading are traced on the whole sphere (``Branch.reads``; the other reading's in ``Picture.not_switched``). A field that is not axisymmetric gets its primary branch traced on the whole
 sphere (``surface_primary``) and the branches born at its pitchforks with their mirror images
 (``surface_pitchforks``; its other branch points in ``Picture.not_switched``). Every branch carries its assessments
 in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
@@ -26,8 +28,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, mirror, surface_branches,
-               surface_pitchforks, surface_primary)
+from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, free_pitchforks, mirror,
+               surface_branches, surface_pitchforks, surface_primary)
 from ..scene import Control
 from .control import FOLD_KIND, control_value, control_values, minimised_energy
 from .mirror import MIRROR
@@ -37,12 +39,16 @@ from .results import Block, Branch, Gauge, Kind, Origin, Status, StopCode
 from .stability import assess_branch, assessed_degrees
 from .switching import mark_rejoin, trace_pear
 from .timing import Clock, Step
+from .tracer import ContinuationError
 from .verdict import Gap, Incomplete, incomplete
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 
 
 BROKEN = "broken_pear"  # the pear branch a broken equator symmetry disconnects (``broken_symmetry``)
+FREE_PRIMARY = "primary_free"  # the free balloon's primary branch in a field without equator symmetry
+FREE_NOT_ASKED = ('not traced: [surface] branches = "first" (the free balloon\'s primary branch, with the axial '
+                  'translation free, and the branches at its m ≥ 1 points); set "all"')
 PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear branch's name: <prefix>_<BP number>
 MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",
          Block.EVEN: "equator-symmetric (even)"}
@@ -56,6 +62,7 @@ class Phase(enum.StrEnum):
     PRIMARY = "primary branch"
     STABILITY = "stability"
     PEAR = "pear branches"
+    FREE = "free balloon"
     SURFACE = "non-axisymmetric branches"
 
 
@@ -204,6 +211,10 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
         if search and not stopped(picture):
             with clock.step(Step.PEAR_BRANCHES):
                 _trace_broken(scene, primary, picture, progress)
+        if surface and primary.gauge == Gauge.HELD and scene.surface.branches == "first":
+            picture.not_asked.append((FREE_PRIMARY, FREE_NOT_ASKED))
+        elif surface and primary.gauge == Gauge.HELD and not stopped(picture):
+            _trace_free(scene, picture, progress)
         picture.not_searched = _unsearched(primary, search, surface)
         pear = False  # no equator-symmetric pitchforks to switch at
     if stopped(picture):
@@ -217,9 +228,11 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
         return picture
     if surface:
         with clock.step(Step.SURFACE_BRANCHES):
-            _trace_surface(scene, primary, picture, progress)
-            if stopped(picture):
-                return picture
+            for branch in [b for b in picture.branches if b.name in (primary.name, FREE_PRIMARY)]:
+                _trace_surface(scene, branch, picture, progress)
+                if stopped(picture):
+                    return picture
+            unsearched_events(picture, scene)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
     label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
@@ -286,18 +299,63 @@ def _unsearched(primary: Branch, searched: bool, surface: bool) -> str:
     """What is not searched on a primary branch without equator symmetry (``Picture.not_searched``); ``searched``:
     the disconnected pear branch was searched for (``_trace_broken``); ``surface``: the branches at its m ≥ 1
     points are traced (``_trace_surface``). A scene whose coils are equator-symmetric breaks no pitchfork (a pear
-    branch restarted by ``continue``, ``continuation.symmetry = "none"``). The free balloon's branches are not
-    traced: its held states carry the field's net axial force (the reaction of the hold), so they are no
-    equilibria of a free balloon, which moves along the axis until that force vanishes."""
+    branch restarted by ``continue``, ``continuation.symmetry = "none"``). Without ``surface`` the free balloon's
+    primary branch is not traced either (``_trace_free``; with it, "first" names it in ``Picture.not_asked``)."""
     missing = []
     if not searched and not primary.scene.field.is_equator_symmetric:
         missing.append("the pear branch of the broken pitchfork (disconnected from this branch) is not traced")
     if not surface:
         missing.append("the branches at its branch points are not traced")
-    if primary.gauge == Gauge.HELD:
-        missing.append("the free balloon's branch is not traced (its held states carry the field's net axial "
-                       "force: a free balloon moves along the axis until it vanishes)")
+    if not surface and primary.gauge == Gauge.HELD:
+        missing.append("nor is the free balloon's branch (its held states carry the field's net axial force: a "
+                       "free balloon moves along the axis until it vanishes)")
     return "; ".join(missing)
+
+
+def _trace_free(scene, picture: Picture, progress: Progress) -> None:
+    """The free balloon's primary branch (FREE_PRIMARY) of a field without equator symmetry: the held primary
+    branch's states carry the field's net axial force (the hold's reaction), so the free balloon needs its own
+    branch, traced with the axial translation b_0 an unknown and the net axial force zero (``primary.released``:
+    it starts where that force vanishes), assessed, its stability changes under every control located
+    (``control_points``); its m ≥ 1 points are switched with the primary branch's (``_trace_surface``). A start
+    that fails is a branch not started (the result is then incomplete). Its m = 0 branch points (the pitchforks
+    of a symmetry about the plane where the free balloon centres: one coil's own plane) are classified and the
+    pear branches born at them traced both ways, <FREE_PRIMARY>_pear_<n> and its _mirror (``free_pitchforks``),
+    assessed."""
+    with picture.clock.step(Step.FREE_BALLOON):
+        try:
+            free = trace_primary(scene, symmetric=False, held=False, name=FREE_PRIMARY,
+                                 progress=progress.ticker(Phase.FREE))
+        except ContinuationError as error:
+            picture.not_started.append((FREE_PRIMARY, str(error)))
+            return
+    progress.finish(Phase.FREE, len(free.X))
+    picture.branches.append(free)
+    if not _assess(free, scene, False, progress, picture.clock):
+        return
+    with picture.clock.step(Step.BRANCH_POINTS):
+        free.special += control_points.find(free)
+        free.special.sort(key=_along)
+        pitchforks = free_pitchforks.classified(free)
+    m0 = [s for s in free.branch_points() if s.m == 0]
+    with picture.clock.step(Step.PEAR_BRANCHES):
+        for n, bp in pitchforks:
+            for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
+                if stopped(picture):
+                    return
+                name = f"{FREE_PRIMARY}_pear_{n}{suffix}"
+                branch = trace_pear(free, bp, sign, name, progress.ticker(Phase.PEAR))
+                if branch is None:
+                    picture.not_started.append((name, f"the first correction from branch point {n} of "
+                                                      f"{FREE_PRIMARY} along its mode did not converge"))
+                    continue
+                branch.parent = (FREE_PRIMARY, n)
+                branch.rejoins = _rejoin_point(branch, m0, n)
+                if branch.rejoins is not None:
+                    mark_rejoin(branch, free, m0[branch.rejoins])
+                picture.branches.append(branch)
+                if not _assess(branch, scene, False, progress, picture.clock):
+                    return
 
 
 WHOLE_SPHERE_EVENTS = "the [[events]] are not located on branches traced on the whole sphere"
@@ -425,41 +483,56 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
     return True
 
 
-def _trace_surface(scene, primary: Branch, picture: Picture, progress: Progress):
-    """The non-axisymmetric branches born at the located m ≥ 1 branch points of the primary branch (the held
-    reading's first one, or all of both readings: ``[surface] branches``; ``surface_pair``; on a branch without
-    equator symmetry "first" traces none: their basis keeps one reflection, and costs); the parent point gets
-    the classification from the reduced energy on the whole sphere. The free reading's points are switched where
-    the held states are free equilibria (coils symmetric about the equator: no net axial force); elsewhere the held
-    states carry the field's net axial force and the free balloon's branches are not traced (said in
-    ``Picture.not_searched``). The points the scene leaves out are listed in ``Picture.not_asked``."""
-    points = [(k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m >= 1 and bp.status == Status.LOCATED]
-    free = [(k, bp) for k, bp in points if not bp.block.held]
-    if free and not scene.field.is_equator_symmetric:
-        picture.not_searched = "; ".join(filter(None, (picture.not_searched, (
-            f"the free balloon's branches at its m ≥ 1 points ({', '.join(f'm{bp.m}_bp{k}' for k, bp in free)}) "
-            "are not traced"))))
-        points = [(k, bp) for k, bp in points if bp.block.held]
+def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
+    """The non-axisymmetric branches born at the located m ≥ 1 branch points of an axisymmetric ``branch`` (the
+    primary branch, the free balloon's: ``FREE_PRIMARY``), as ``[surface] branches`` asks (the held reading's
+    first one, or all; on a branch without equator symmetry "first" traces none: their basis keeps one reflection,
+    and costs); ``surface_pair``; the parent point gets the classification from the reduced energy on the whole
+    sphere. Only the points of the reading the branch's states are equilibria of are switched (``Branch.reads``):
+    the others are listed in ``Picture.not_switched`` with why, those the scene leaves out in
+    ``Picture.not_asked``."""
+    points = [(k, bp) for k, bp in enumerate(branch.branch_points()) if bp.m >= 1 and bp.status == Status.LOCATED]
+    other = [(k, bp) for k, bp in points if not branch.reads(bp.block)]
+    if other:
+        picture.not_switched.append((", ".join(surface_name(branch, k, bp) for k, bp in other),
+                                     _other_reading(branch)))
+        points = [(k, bp) for k, bp in points if branch.reads(bp.block)]
     first = scene.surface.branches == "first"
-    chosen = points if not first else [] if not primary.disc.symmetric else [p for p in points if p[1].block.held][:1]
+    chosen = points if not first else [] if not branch.disc.symmetric else [p for p in points if p[1].block.held][:1]
     if len(chosen) < len(points):
         traced = {k for k, _ in chosen}
-        reason = ('not traced: [surface] branches = "first" (set "all" to trace them)' if primary.disc.symmetric else
+        reason = ('not traced: [surface] branches = "first" (set "all" to trace them)' if branch.disc.symmetric else
                   'not traced: [surface] branches = "first" traces none on a branch without equator symmetry (its '
                   'whole-sphere basis keeps the mirror y → −y alone: near a wire minutes to hours a branch); set "all"')
-        picture.not_asked.append((", ".join(f"m{bp.m}_bp{k}" for k, bp in points if k not in traced), reason))
+        picture.not_asked.append((", ".join(surface_name(branch, k, bp) for k, bp in points if k not in traced),
+                                  reason))
     for k, bp in chosen:
         if stopped(picture):
             return
-        name = f"m{bp.m}_bp{k}"
+        name = surface_name(branch, k, bp)
         try:
-            pair = surface_pair(primary, k, bp, scene.surface.max_points, progress)
+            pair = surface_pair(branch, k, bp, scene.surface.max_points, progress)
         except surface_branches.SurfaceStartError as error:
             picture.not_started.append((name, str(error)))
             continue
         picture.surface_branches += pair
-        _classified(primary, bp, pair[0])
-    unsearched_events(picture, scene)
+        _classified(branch, bp, pair[0])
+
+
+def surface_name(branch: Branch, k: int, bp) -> str:
+    """The name of the branch born at the m ≥ 1 point ``bp`` (number ``k`` in ``branch.branch_points()``):
+    m<m>_bp<k>, prefixed by the parent's name on the free balloon's primary branch."""
+    return f"{FREE_PRIMARY}_m{bp.m}_bp{k}" if branch.name == FREE_PRIMARY else f"m{bp.m}_bp{k}"
+
+
+def _other_reading(branch: Branch) -> str:
+    """Why the points of the other reading on a held or free ``branch`` are not switched (``Branch.reads``)."""
+    if branch.gauge == Gauge.HELD:
+        return ("not switched: free-reading points of held states, which carry the field's net axial force (the "
+                "hold's reaction) and are no free equilibria; the free balloon's m ≥ 1 points are on "
+                f"{FREE_PRIMARY} (traced with [surface] branches = \"all\")")
+    return ("not switched: held-reading points of free states, whose centre is where the net force vanishes, not "
+            "where the scene holds the balloon; the held balloon's are on the primary branch")
 
 
 def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progress) -> list:
@@ -467,7 +540,7 @@ def surface_pair(primary: Branch, k: int, bp, max_points: int, progress: Progres
     ``primary.branch_points()``), named m<m>_bp<k>: along +φ, and for an odd m its image under the rotation by π
     about the axis (``surface_branches.rotated``), for an even m (which that rotation maps to itself) traced along
     −φ. SurfaceStartError when it cannot start."""
-    name = f"m{bp.m}_bp{k}"
+    name = surface_name(primary, k, bp)
 
     def traced(sign: float, called: str):
         with progress.budget(Phase.SURFACE, max_points) as tick:

@@ -22,6 +22,7 @@ import time
 
 import numpy as np
 
+from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.profiles import meridional_stretch
 from ..model import meridian
@@ -44,8 +45,12 @@ from ..numerics.threads import limited_blas
 def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     """The inflated M = 0 sphere, then the field switched on by natural continuation in M (bounded halving), on
     a degree that resolves it: (the start point, its parameters, its degree). Raises ContinuationError when the
-    field cannot be switched on or the start is not resolved up to solver.max_degree (never a guess)."""
+    field cannot be switched on or the start is not resolved up to solver.max_degree (never a guess). A free
+    balloon in a field without equator symmetry (``Tracer.free_off_equator``) is switched on held, then released
+    (``released``)."""
     scene = tracer.scene
+    if tracer.free_off_equator:
+        return released(tracer, *start(Tracer(scene, tracer.symmetric, held=True)))
     degree = scene.solver.degree
     eq = tracer.system(degree, Parameters(0.0)).eq
     disc = eq.disc
@@ -83,6 +88,26 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
                 )
     params = params.with_value("M", target)
     X, degree = _resolved_start(tracer, np.append(u, getattr(params, tracer.parameter)), degree, params)
+    residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
+    return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
+
+
+def released(tracer: Tracer, held: continuation.Point, params: Parameters,
+             degree: int) -> tuple[continuation.Point, Parameters, int]:
+    """The free balloon's start from the held one at the same P and M (MODEL.md §8: a free balloon centres where
+    the net force vanishes): the held state (b_0 = 0) with its axial translation b_0 an unknown, solved by Newton
+    at fixed P, where the b_0 row of the residual is the net axial force (its ∂E/∂b_0); then resolved
+    (``_resolved_start``). ContinuationError when Newton does not reach a free equilibrium."""
+    scene = tracer.scene
+    pinned = Discretisation(degree, tracer.symmetric, True)
+    system = tracer.system(degree, params)
+    X = np.append(system.eq.disc.join(*pinned.split(held.X[:-1])), held.X[-1])
+    result = newton(system.residual, system.jacobian, X, unit(X.size, -1), X[-1], scene.solver.tol,
+                    scene.solver.max_newton)
+    if not result.converged:
+        raise ContinuationError(f"the free balloon's start (the held start at P = {X[-1]:.6g}, M = {params.M:g} "
+                                f"released along the axis) did not converge: {result.message}")
+    X, degree = _resolved_start(tracer, result.x, degree, params)
     residual = float(np.abs(tracer.system(degree, params).residual(X)).max())
     return continuation.Point(X, np.zeros_like(X), 0, residual), params, degree
 
@@ -281,10 +306,11 @@ def stop_rule(scene, upper: float):
 
 @limited_blas
 def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | None = None, down: bool = True,
-                  progress=None) -> Branch:
-    """Trace the primary branch of a scene (module docstring). ``down=False`` skips the leg below the start."""
+                  progress=None, held: bool | None = None, name: str = "primary") -> Branch:
+    """Trace the primary branch of a scene (module docstring). ``down=False`` skips the leg below the start;
+    ``held=False``: the free balloon's (b_0 an unknown, the net axial force zero; ``Tracer``), named ``name``."""
     t0 = time.perf_counter()
-    tracer = Tracer(scene, symmetric)
+    tracer = Tracer(scene, symmetric, held)
     first, params, degree = start(tracer)
     upper = scene.continuation.stop_stretch if stop_stretch is None else stop_stretch
     stop, limits = stop_rule(scene, upper), range_limits(scene, upper)
@@ -292,7 +318,7 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
                     limits=limits)
     below = (tracer.leg(initial_point(tracer, first, -1.0, params, degree), params, stop, progress, degree=degree,
                         limits=limits) if down else None)
-    return with_events(assemble(tracer, params, "primary", up, below, t0, land_on=landing_targets(scene, upper),
+    return with_events(assemble(tracer, params, name, up, below, t0, land_on=landing_targets(scene, upper),
                                 labels=("up", "down")))
 
 

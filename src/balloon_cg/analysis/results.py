@@ -280,6 +280,18 @@ class Branch:
             return Gauge.BOTH
         return Gauge.HELD if self.disc.pin_translation else Gauge.FREE
 
+    def reads(self, block: Block) -> bool:
+        """Whether a branch point of ``block`` is one of a reading the branch's states are equilibria of: any on a
+        branch of both readings; on a held branch a held block's (a free block's point there is a zero of the free
+        second variation of states that carry a net axial force, the hold's reaction: no free equilibria branch
+        there; the free balloon's are on its own primary branch); on a free branch a free block's, and a held
+        one's where the coils are equator-symmetric (its centre at the origin, where the balloon is held)."""
+        if self.gauge == Gauge.BOTH:
+            return True
+        if self.gauge == Gauge.HELD:
+            return block.held
+        return not block.held or self.scene.field.is_equator_symmetric
+
     def params_at(self, X) -> Parameters:
         """The parameters of the point X = (u, p)."""
         return self.params.with_value(self.parameter, X[-1])

@@ -23,7 +23,8 @@ its second variation over every symmetry sector, held and free, under pressure, 
 secondary branch points are located (``surface_assessment``).
 
 Classification of the parent point: the reduced energy E(Λ) − E* along φ at P* (the other coefficients relax on
-φ·(c − c*) = Λ, as ``bifurcation.classify`` for the pear points), fitted by E2 Λ² + E3 Λ³ + E4 Λ⁴.
+φ·(c − c*) = Λ, as ``bifurcation.classify`` for the pear points), fitted by E2 Λ² + E3 Λ³ + E4 Λ⁴ (+ E6 Λ⁶:
+``classify``).
 """
 import time
 from dataclasses import replace
@@ -378,9 +379,12 @@ def branch_of(trace: SurfaceTrace, segments, folds, stop, parent, number: int, b
 
 
 def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: float = 2e-2) -> tuple:
-    """(E2, E3, E4, Classification) of the reduced energy along the unit mode φ (in a) at P* (module docstring),
-    fitted to the constrained minimisations at Λ = ±δ, ±2δ; δ is halved (CLASSIFY_TRIES times) until all four
-    converge, else Classification.NONE."""
+    """((E2, E3, E4), Classification) of the reduced energy along the unit mode φ (in a) at P* (module docstring):
+    E2 Λ² + E3 Λ³ + E4 Λ⁴ + E6 Λ⁶ through the constrained minimisations at Λ = −δ, δ, 2δ, 3δ (three amplitudes for
+    the even part: the Λ⁶ term keeps E4 to O(δ⁴) at a pitchfork, whose energy is even in Λ, and the branch's
+    normal form P − P* = −2 E4 Λ²/E2'(P*) reads its first points to 1e-4, where E2..E4 through ±δ, ±2δ were 2e-3
+    off at δ = 2e-2; E3 from the odd part E(δ) − E(−δ) to O(δ²), as before); δ is halved (CLASSIFY_TRIES times)
+    until all four converge, else Classification.NONE."""
     system, solver = trace.system, trace.scene.solver
     params = system.params_at(X_star)
     a_star, direction = X_star[:-1], phi[:-1]
@@ -400,7 +404,7 @@ def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: fl
 
     E0 = trace.eq.energy(system.gauge.expand(a_star), params)
     for _ in range(CLASSIFY_TRIES):
-        L = np.array([-2 * delta, -delta, delta, 2 * delta])
+        L = delta * np.array([-1.0, 1.0, 2.0, 3.0])
         energies = []
         for lam in L:
             energy = reduced_energy(lam)
@@ -412,7 +416,7 @@ def classify(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, delta: fl
         delta /= 2
     else:
         return (np.nan, np.nan, np.nan), Classification.NONE
-    E2, E3, E4 = linalg.lstsq(np.stack([L**2, L**3, L**4], axis=1), np.array(energies))[0]
+    E2, E3, E4, _ = linalg.solve(np.stack([L**2, L**3, L**4, L**6], axis=1), np.array(energies))
     if abs(E3) * delta > abs(E4) * delta**2:
         kind = Classification.TRANSCRITICAL
     else:

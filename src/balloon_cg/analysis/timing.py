@@ -15,6 +15,8 @@ class Step(enum.StrEnum):
     STABILITY = "stability"  # the assessment of every point of the axisymmetric branches
     BRANCH_POINTS = "branch points"  # m = 0: detected, located, classified
     PEAR_BRANCHES = "pear branches"  # traced (their stability is STABILITY's)
+    FREE_BALLOON = "free balloon"  # the free balloon's primary branch without equator symmetry (its stability is
+    #                                STABILITY's)
     CROSSINGS = "m >= 1 crossings"  # the branch points of the non-axisymmetric blocks, located
     SURFACE_BRANCHES = "non-axisymmetric branches"  # on the whole sphere, assessed (as Phase.SURFACE names them)
     SNAP_THROUGHS = "snap-throughs"

@@ -65,6 +65,9 @@ class Tracer:
         if held is None:
             held = bool(scene.field.coils) and not scene.field.is_equator_symmetric
         self.pin = (not scene.field.coils) or scene.field.M == 0 or held
+        # a free balloon in a field without equator symmetry: the net axial force at its start is not zero by
+        # symmetry, and b_0 is a zero mode at M = 0 (``primary.start`` switches the field on held, then releases)
+        self.free_off_equator = not self.pin and not scene.field.is_equator_symmetric
         # the continuation parameter (Parameters field): P, or Φ̄ for continuation.parameter = "voltage"
         self.parameter = "voltage" if scene.continuation.parameter == ContinuationParameter.VOLTAGE else "P"
         self.settings = continuation_settings(scene)

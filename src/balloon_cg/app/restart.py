@@ -10,7 +10,9 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   (``restart_branch``: a Picture of one branch, primary); from a branch point of an equator-symmetric branch,
   the branches bifurcating there (``switch``): at a pear point (odd_held, or odd_free: the free balloon) the
   pear branch and its mirror image, as ``run`` traces them (``picture.pear_pair``, its critical mode recomputed:
-  ``pear_point``), assessed and with their m ≥ 1 points as ``run`` gives them, at a held m ≥ 1 point the
+  ``pear_point``), assessed and with their m ≥ 1 points as ``run`` gives them, at an m ≥ 1 point of a reading
+  the branch's states are equilibria of (``Branch.reads``: held or free on an equator-symmetric branch, the held
+  reading's on a held branch without it, the free one's on the free balloon's ``primary_free``) the
   non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``, assessed as
   ``run`` assesses it); the branch of the point is written as read (its stored stability is not read back);
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
@@ -22,8 +24,9 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
 The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
 parameters, points and special points; ``with_settings`` sets keys of the scene that do not change the equations
 (stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch
-points (even, m ≥ 1) in a second parameter, switching at an even, a free m ≥ 1 point or a point of a branch
-without equator symmetry, points of surface branches, an ordinary point in a second parameter.
+points (even, m ≥ 1) in a second parameter, switching at an even point, at an m ≥ 1 point of the other reading
+or at an m = 0 point of a branch without equator symmetry, points of surface branches, an ordinary point in a
+second parameter.
 """
 import time
 from dataclasses import dataclass, replace
@@ -36,8 +39,8 @@ from ..analysis.fold_curve import CONTROL_OF_FOLD, continue_fold
 from ..analysis.primary import landing_targets, range_limits, stop_rule
 from ..analysis.branch_point import WernerSpence
 from ..analysis.codim2 import continue_branch_point, plain_branch
-from ..analysis.picture import (PEAR_NAMES, Picture, Progress, azimuthal_crossings, examine, label_readings,
-                                pear_pair, stopped, surface_pair, unsearched_events)
+from ..analysis.picture import (FREE_PRIMARY, PEAR_NAMES, Picture, Progress, azimuthal_crossings, examine,
+                                label_readings, pear_pair, stopped, surface_name, surface_pair, unsearched_events)
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.surface_branches import SurfaceStartError
@@ -169,7 +172,8 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
     system = tracer.system(disc.degree, params, disc.mapping)
     point = step_away(system, start, tracer.settings)
     upper = scene.continuation.stop_stretch
-    pear = branch.name != "primary"  # a pear branch (pear_<n>, its mirror, broken_pear): stopped as run stops them
+    pear = branch.name not in ("primary", FREE_PRIMARY)  # a pear branch (pear_<n>, its mirror, broken_pear): stopped
+    #                                                       as run stops them
 
     def stop():  # a leg's own rule (a pear leg remembers its crossings of the parent)
         if not pear:
@@ -178,7 +182,8 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
 
     legs = [tracer.leg(replace(point, tangent=sign * point.tangent), params, stop(), progress, degree=disc.degree,
                        mapping=disc.mapping, limits=range_limits(scene, upper)) for sign in (1.0, -1.0)]
-    primary = with_events(assemble(tracer, params, "primary", legs[0], legs[1], t0, labels=("up", "down"),
+    name = branch.name if branch.name == FREE_PRIMARY else "primary"
+    primary = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, labels=("up", "down"),
                                    land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
     if start.parent is not None:  # through its pitchfork on the parent into the mirror image: the fold of P there
         #                             is that pitchfork (P is even in the pear amplitude), as run marks a rejoin
@@ -275,9 +280,10 @@ def switch(start: Labelled, progress=None) -> Picture:
     if point.kind != Kind.BP:
         raise RestartError(f"label {label} is a {point.kind.value}, not a branch point: nothing to switch at")
     what = f"label {label} is a BP of block {point.block.value or 'none'}"
-    if not branch.disc.symmetric and not (point.m >= 1 and point.block.held):
+    if not branch.disc.symmetric and not (point.m >= 1 and branch.reads(point.block)):
         raise RestartError(f"{what} on {branch.name}, a branch without equator symmetry: switching there is built "
-                           "at its held m ≥ 1 points only (its free points: the held states are no free equilibria)")
+                           f"at the m ≥ 1 points of its own reading ({branch.gauge.value}) only (the other reading's "
+                           "states are no equilibria of it)")
     if branch.parameter != "P":
         raise RestartError(f"{what} on {branch.name}, continued in {branch.parameter}: switching is built for "
                            "branches continued in P only")
@@ -297,7 +303,7 @@ def switch(start: Labelled, progress=None) -> Picture:
         try:
             pair = surface_pair(branch, k, point, branch.scene.surface.max_points, progress)
         except SurfaceStartError as error:
-            return Picture([branch], not_started=[(f"m{point.m}_bp{k}", str(error))])
+            return Picture([branch], not_started=[(surface_name(branch, k, point), str(error))])
         label_readings(pair)
         picture = Picture([branch], surface_branches=pair)
         stopped(picture)  # a signal in the surface branches (their trace, their assessment): flagged
