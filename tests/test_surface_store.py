@@ -179,7 +179,7 @@ def test_inspect_text_and_json(run_path, capsys):
 
 
 @pytest.mark.parametrize("kind", [k for k in PLOT_KINDS if k not in ("phase", "voltage-pole", "voltage-equator",
-                                                                      "field", "frequencies")])
+                                                                      "field", "frequencies", "modes")])
 def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
     fig = plot([run_path], kind)
     axes = fig.axes
