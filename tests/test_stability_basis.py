@@ -1,7 +1,7 @@
 """stability.basis = "mapped" (issue 37): the second variation on Legendre polynomials of the branch's wire-map
 coordinate s instead of x = cos θ.
 
-- the scene key: default "legendre", anything but the two names refused in one line;
+- the scene keys: default "mapped" and "displacement", anything but the two names refused in one line;
 - on an unmapped branch both bases are one: the whole SPOM1 M = 0 picture is the same bit for bit;
 - near a wire (the two-coil primary branch's last point, gap 0.1, stored at mapped degree 90): at the branch's own
   degree every block the flags take agrees with a converged x-Legendre reference (degree 320) to the eigenvalues'
@@ -26,11 +26,11 @@ TWO_COILS = SCENES / "spom1_two_coils_M0.002.toml"
 
 
 def test_basis_key_default_and_refusal():
-    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.basis == "legendre"
-    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.norm == "unknowns"
+    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.basis == "mapped"
+    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.norm == "displacement"
     with pytest.raises(SceneError, match='stability.norm = "h1": must be one of "unknowns", "displacement"'):
         parse_scene('[material]\npreset = "SPOM1"\n[stability]\nnorm = "h1"\n', name="s")
-    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbasis = "mapped"\n').stability.basis == "mapped"
+    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbasis = "legendre"\n').stability.basis == "legendre"
     with pytest.raises(SceneError) as error:
         parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbasis = "chebyshev"\n', name="s")
     message = str(error.value)
@@ -52,8 +52,8 @@ def _tables(picture):
 
 def test_unmapped_picture_is_the_same_in_both_bases():
     scene = load_scene(SCENES / "spom1.toml")
-    legendre = _tables(analyse(scene))
-    mapped = _tables(analyse(scene.with_overrides({"stability.basis": "mapped"}, name=scene.name)))
+    mapped = _tables(analyse(scene))
+    legendre = _tables(analyse(scene.with_overrides({"stability.basis": "legendre"}, name=scene.name)))
     assert legendre.keys() == mapped.keys()
     for key, value in legendre.items():
         assert np.array_equal(value, mapped[key]), key
@@ -61,8 +61,10 @@ def test_unmapped_picture_is_the_same_in_both_bases():
 
 @pytest.fixture(scope="module")
 def wire_point():
-    """The two-coil primary branch to its wire gap (mapped degree 90) and its last point."""
-    branch = trace_primary(load_scene(TWO_COILS), down=False)
+    """The two-coil primary branch to its wire gap (mapped degree 90) and its last point, in the x basis and the norm
+    ∫(δλ2² + δη²) dx (the defaults these tests compare the map against; each test sets what it reads)."""
+    scene = load_scene(TWO_COILS).with_overrides({"stability.basis": "legendre", "stability.norm": "unknowns"})
+    branch = trace_primary(scene, down=False)
     assert branch.disc.mapping is not None
     return branch, branch.X[-1]
 
@@ -170,3 +172,4 @@ def test_displacement_norm_takes_the_degree_its_eigenvalues_need(wire_point):
         for block, values in reference.blocks.items():
             stored = assessments[n].blocks[block]
             assert np.all(np.abs(stored - values) <= 1e-8 * np.maximum(1.0, np.abs(values))), (n, block, stored, values)
+

@@ -186,8 +186,8 @@ class Stability:
 
     degree: int = 20
     m_max: int = 1
-    basis: str = "legendre"
-    norm: str = "unknowns"
+    basis: str = "mapped"
+    norm: str = "displacement"
 
 
 STABILITY_BASES = ("legendre", "mapped")
