@@ -1,0 +1,158 @@
+"""The primary branch of a meridian over an interval (galerkin/interval.py): a tube inflated from its unstressed
+reference by continuation in P, its pressure folds and the branch points of its mirror blocks.
+
+The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium. From it the branch is traced by pseudo-arclength
+continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted to the even block,
+interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps its equator
+symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the north
+pole stretch means nothing), or after ``continuation.max_points``. Folds in P (LP) are located by the tracer's fold
+monitor. At every point the second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the
+lowest eigenvalue of each is stored; where one changes sign between neighbours, the point where it vanishes is
+located by Brent's method in the arclength from the earlier point (``continuation.locate_root``, each evaluation a
+Keller corrector), and kept as a branch point (BP) when its null vector φ is orthogonal to ∂R/∂P
+(|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's zero where it is not is the fold in P itself (LP).
+
+On a tube with sliding closed ends the branch is the uniform tube (model/tube.py's closed-end path, exact in the
+basis) and its first odd-block branch point is the onset of the bulge mode cos(πS/L) (model/tube.bulge_onset).
+"""
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+
+from .problem import ParameterSystem, continuation_settings
+from .results import Kind
+from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..galerkin.interval import IntervalDiscretisation, Mirror
+from ..numerics import continuation
+from ..numerics.continuation import RootStatus, Stop
+from ..scene.tables import Shape
+from ..scene.validation import SceneError
+
+ORTHOGONAL = 1e-6  # |φ·∂R/∂P| relative to |φ||∂R/∂P| below which a block's zero is a branch point, not the fold
+BRENT_XTOL = 1e-13  # Brent's tolerance in the arclength, relative to the step
+
+
+class IntervalStop(enum.StrEnum):
+    """Why an interval branch stopped (beside the tracer's TraceStop)."""
+
+    HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
+
+
+@dataclass(frozen=True)
+class IntervalSpecial:
+    """A located point: LP (fold in P) or BP (``block`` the mirror block whose lowest eigenvalue vanishes), its
+    state ``u`` and pressure, between points ``index`` and ``index + 1``; ``status`` of its location."""
+
+    kind: Kind
+    u: np.ndarray
+    pressure: float
+    index: int
+    status: RootStatus
+    block: Mirror | None = None
+
+
+@dataclass(frozen=True)
+class IntervalBranch:
+    """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
+    lowest eigenvalue of each mirror block at every point, the located points and why the trace stopped."""
+
+    disc: IntervalDiscretisation
+    states: np.ndarray
+    pressure: np.ndarray
+    volume: np.ndarray
+    lowest: dict
+    special: tuple
+    stop: Stop
+
+    def branch_points(self, block: Mirror | None = None) -> list:
+        return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]
+
+
+class MirrorSystem:
+    """R(u; P) on the mirror-symmetric states: X = (u[even block], P) (module docstring)."""
+
+    def __init__(self, system: ParameterSystem, disc: IntervalDiscretisation):
+        self.system, self.even = system, disc.block(Mirror.EVEN)
+        self.columns = np.append(self.even, disc.size)
+        self.size = disc.size
+
+    def full(self, X) -> np.ndarray:
+        Y = np.zeros(self.size + 1)
+        Y[self.columns] = X
+        return Y
+
+    def residual(self, X):
+        return self.system.residual(self.full(X))[self.even]
+
+    def jacobian(self, X):
+        return self.system.jacobian(self.full(X))[np.ix_(self.even, self.columns)]
+
+
+def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
+    """The primary branch of a tube scene (module docstring) at Legendre ``degree`` (None: solver.degree)."""
+    geometry = scene.geometry
+    if geometry.shape != Shape.TUBE:
+        raise SceneError(f'geometry.shape = "{geometry.shape.value}": an interval branch is a tube\'s; allowed: "tube"')
+    disc = IntervalDiscretisation(scene.solver.degree if degree is None else degree, geometry.length,
+                                  scene.solver.quadrature)
+    eq = Equilibrium(scene, disc)
+    system = MirrorSystem(ParameterSystem(eq, Parameters(0.0), "P"), disc)
+    settings = continuation_settings(scene)
+    X = np.append(disc.uniform(1.0, 1.0), 0.0)[system.columns]
+    t = continuation.tangent(system, X, np.eye(X.size)[-1])
+    start = continuation.Point(X, t, 0, float(np.abs(system.residual(X)).max()))
+    limit = scene.continuation.stop_stretch
+
+    def stop(point):
+        hoop = eq.disc.node_state(system.full(point.X)[:-1])[0].max()
+        if hoop > limit:
+            return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch {limit:g}")
+        return None
+
+    path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
+    full = [system.full(p.X) for p in path.points]
+    lowest = {block: np.array([_lowest(eq, Y, disc.block(block)) for Y in full]) for block in Mirror}
+    special = [IntervalSpecial(Kind.LP, system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index, f.status)
+               for f in path.folds]
+    for block in Mirror:
+        values = lowest[block]
+        for i in np.flatnonzero(values[:-1] * values[1:] < 0):
+            found = _located_zero(system, eq, path.points[i], path.points[i + 1], block, settings)
+            if found is not None:
+                special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1], block))
+    special.sort(key=lambda s: (s.index, s.kind))
+    volume = np.array([2 * eq.volume(Y[:-1]) / geometry.length for Y in full])
+    return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
+                          tuple(special), path.stop)
+
+
+def _lowest(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> float:
+    """The lowest eigenvalue of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``."""
+    H = eq.jacobian(Y[:-1], Parameters(Y[-1]))
+    return float(np.linalg.eigvalsh(H[np.ix_(index, index)])[0])
+
+
+def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: Mirror, settings):
+    """(Y = (u, P), status) where the lowest eigenvalue of ``block`` vanishes between two points, by Brent in the
+    arclength from ``before``; None when it is the fold in P (the null vector not orthogonal to ∂R/∂P)."""
+    index = eq.disc.block(block)
+
+    def value_at(s):
+        result = continuation.correct(system, before.X + s * before.tangent, before.tangent, settings)
+        if not result.converged:
+            raise ArithmeticError(result.message)
+        Y = system.full(result.x)
+        return _lowest(eq, Y, index), Y
+
+    length = float(before.tangent @ (after.X - before.X))
+    root = continuation.locate_root(value_at, length, BRENT_XTOL,
+                                    known={length: (_lowest(eq, system.full(after.X), index), system.full(after.X))})
+    Y = root.payload
+    params = Parameters(Y[-1])
+    H = eq.jacobian(Y[:-1], params)[np.ix_(index, index)]
+    phi = np.linalg.eigh(H)[1][:, 0]
+    dP = eq.parameter_derivative(Y[:-1], params, "P")
+    if abs(phi @ dP[index]) > ORTHOGONAL * np.linalg.norm(dP):
+        return None
+    return Y, root.status
