@@ -149,6 +149,49 @@ def test_first_branch_point_is_the_bulge_onset(preset, length):
     assert abs(amplitude) > 1e-3 * abs(scale)
 
 
+def first_integral(material, disc, u):
+    """H = λ1Φ_1 − Φ at 401 points along the tube (module docstring: ρ'∂π/∂ρ' + η'∂π/∂η' − π, the pressure's
+    term linear in η' dropping out; constant along S on an equilibrium, the Noether integral of axial translation),
+    Φ_1 = Σ μ_i (λ1^(α_i − 1) − λ1^(−α_i − 1) λ2^(−α_i)) written here."""
+    _, lam1, lam2, _ = series(disc, u, 401)
+    phi_1 = sum(m * (lam1 ** (a - 1) - lam1 ** (-a - 1) * lam2**-a) for m, a in zip(material.mu, material.alpha))
+    return lam1 * phi_1 - ogden(material, lam1, lam2)
+
+
+def test_bulge_branch_from_the_onset_through_its_volume_fold():
+    """SPOM1, L = 10: the branch switched at the first (odd) branch point bulges at S = 0, its V/V0 falls to a
+    located minimum (LV: P and V/V0 at degrees 30 and 40 within 1e-9; measured 3e-11) and then rises while P falls,
+    beyond V/V0 = 50 up to the stop at 60, with P above Maxwell's pressure (model/tube.maxwell_pressure, checked against the
+    equal-area rule in tests/test_tube.py). Near the fold the state solves the continuous problem: the first
+    integral H (written here) is constant along the tube to 1e-6 (measured 4e-8 at degree 40)."""
+    from balloon_cg.analysis.interval_bulge import bulge_branch
+
+    folds = []
+    for degree in (30, 40):
+        scene = tube_scene("SPOM1", 10.0).with_overrides({"solver.degree": degree, "continuation.stop_stretch": 1.75,
+                                                          "continuation.step_max": 0.5})
+        primary = primary_branch(scene)
+        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=60.0, step=0.02)
+        assert branch.stop.code == "volume" and 50 < branch.volume[-1] <= 60
+        eq = Equilibrium(scene, branch.disc)
+        folds.append([(s, 2 * eq.volume(s.u) / 10.0) for s in branch.special if s.kind == "LV"])  # V/V0
+    assert len(folds[0]) == len(folds[1]) == 1
+    ((coarse, coarse_volume),), ((fold, fold_volume),) = folds
+    assert fold.status == "located"
+    assert abs(coarse.pressure - fold.pressure) <= 1e-9 and abs(coarse_volume - fold_volume) <= 1e-9
+    disc = branch.disc
+    assert branch.pressure[0] == primary.branch_points()[0].pressure
+    rho, _ = disc.profile(branch.states[5], np.array([0.0, 10.0]))
+    assert rho[0] > rho[1]
+    after = slice(fold.index + 1, None)
+    assert np.all(np.diff(branch.volume[after]) > 0) and np.all(np.diff(branch.pressure[after]) < 0)
+    assert branch.volume[fold.index] > fold_volume and branch.volume[fold.index + 1] > fold_volume
+    maxwell, _, _ = tube.maxwell_pressure(scene.material)
+    assert branch.pressure[-1] > maxwell
+    H = first_integral(scene.material, disc, fold.u)
+    assert np.abs(H - H.mean()).max() <= 1e-6 * abs(H.mean())
+
+
 def test_mirror_blocks_split_the_hessian_of_a_symmetric_state():
     """On a mirror-symmetric non-uniform state the Hessian has no entries between the even and odd blocks, and the
     blocks partition the unknowns."""

@@ -37,6 +37,8 @@ class IntervalStop(enum.StrEnum):
     """Why an interval branch stopped (beside the tracer's TraceStop)."""
 
     HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
+    REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (analysis/interval_bulge.py)
+    VOLUME = "volume"  # V/V0 passed the stop_volume asked for
 
 
 @dataclass(frozen=True)
@@ -55,7 +57,8 @@ class IntervalSpecial:
 @dataclass(frozen=True)
 class IntervalBranch:
     """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
-    lowest eigenvalue of each mirror block at every point, the located points and why the trace stopped."""
+    lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
+    mirror symmetry), the located points and why the trace stopped."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
