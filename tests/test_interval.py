@@ -18,7 +18,7 @@ from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
 from balloon_cg.model import tube
 from balloon_cg.model.kernels import KernelSet
-from balloon_cg.scene import parse_scene
+from balloon_cg.scene import Control, parse_scene
 from balloon_cg.scene.validation import SceneError
 
 
@@ -119,7 +119,8 @@ def test_uniform_tube_is_an_exact_state(preset):
 @pytest.mark.parametrize("preset", ["SPOM1", "neo-Hookean"])
 @pytest.mark.parametrize("length", [10.0, 40.0])
 def test_first_branch_point_is_the_bulge_onset(preset, length):
-    """Along the uniform branch: the fold in P is model/tube.pressure_maximum (1e-10) and the first branch point is
+    """Along the uniform branch: stable under pressure control up to the fold in P, under volume control up to the
+    first branch point; the fold in P is model/tube.pressure_maximum (1e-10) and the first branch point is
     in the mirror-odd block at model/tube.bulge_onset of the mode cos(πS/L) (λθ, λz, P to 1e-8); its null vector
     is that mode: λ2 ∝ cos(πS/L), η ∝ sin(πS/L) (to 1e-8 in the sample's sup norm)."""
     scene = tube_scene(preset, length).with_overrides({"solver.degree": 20, "continuation.stop_stretch": 1.75})
@@ -132,6 +133,12 @@ def test_first_branch_point_is_the_bulge_onset(preset, length):
     onset = tube.bulge_onset(scene.material, length)
     first = branch.branch_points()[0]
     assert first.block == Mirror.ODD and first.status == "located"
+    assert first.index >= folds[0].index  # the onset beyond the maximum
+    unstable = branch.unstable
+    assert np.all(unstable[Control.PRESSURE][: folds[0].index + 1] == 0)
+    assert np.all(unstable[Control.PRESSURE][folds[0].index + 1:] >= 1)
+    assert np.all(unstable[Control.VOLUME][: first.index + 1] == 0)
+    assert np.all(unstable[Control.VOLUME][first.index + 1:] >= 1)
     assert abs(first.u[0] - onset.hoop) <= 1e-8
     assert abs(first.u[k] - onset.axial) <= 1e-8
     assert abs(first.pressure - onset.pressure) <= 1e-8
@@ -162,7 +169,8 @@ def test_bulge_branch_from_the_onset_through_its_volume_fold():
     """SPOM1, L = 10: the branch switched at the first (odd) branch point bulges at S = 0, its V/V0 falls to a
     located minimum (LV: P and V/V0 at degrees 30 and 40 within 1e-9; measured 3e-11) and then rises while P falls,
     beyond V/V0 = 50 up to the stop at 60, with P above Maxwell's pressure (model/tube.maxwell_pressure, checked against the
-    equal-area rule in tests/test_tube.py). Near the fold the state solves the continuous problem: the first
+    equal-area rule in tests/test_tube.py). Unstable (one direction) under pressure control throughout; under
+    volume control one unstable direction up to the fold and stable beyond it (the plateau). Near the fold the state solves the continuous problem: the first
     integral H (written here) is constant along the tube to 1e-6 (measured 4e-8 at degree 40)."""
     from balloon_cg.analysis.interval_bulge import bulge_branch
 
@@ -188,6 +196,9 @@ def test_bulge_branch_from_the_onset_through_its_volume_fold():
     assert branch.volume[fold.index] > fold_volume and branch.volume[fold.index + 1] > fold_volume
     maxwell, _, _ = tube.maxwell_pressure(scene.material)
     assert branch.pressure[-1] > maxwell
+    unstable = branch.unstable
+    assert np.all(unstable[Control.PRESSURE][1:] == 1)
+    assert np.all(unstable[Control.VOLUME][1: fold.index + 1] == 1) and np.all(unstable[Control.VOLUME][after] == 0)
     H = first_integral(scene.material, disc, fold.u)
     assert np.abs(H - H.mean()).max() <= 1e-6 * abs(H.mean())
 

@@ -11,6 +11,9 @@ lowest eigenvalue of each is stored; where one changes sign between neighbours, 
 located by Brent's method in the arclength from the earlier point (``continuation.locate_root``, each evaluation a
 Keller corrector), and kept as a branch point (BP) when its null vector φ is orthogonal to ∂R/∂P
 (|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's zero where it is not is the fold in P itself (LP).
+Stability at every point (``unstable_counts``): the number of negative eigenvalues of ∂R/∂u under pressure control
+(all of u) and under volume control (on δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman
+factorisation (numerics/eigen.py: ``restricted`` removes the constraint).
 
 On a tube with sliding closed ends the branch is the uniform tube (model/tube.py's closed-end path, exact in the
 basis) and its first odd-block branch point is the onset of the bulge mode cos(πS/L) (model/tube.bulge_onset).
@@ -26,6 +29,8 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics import continuation
 from ..numerics.continuation import RootStatus, Stop
+from ..numerics.eigen import GramFactor, negative_count, restricted
+from ..scene.loading import Control
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
@@ -58,13 +63,15 @@ class IntervalSpecial:
 class IntervalBranch:
     """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
     lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
-    mirror symmetry), the located points and why the trace stopped."""
+    mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
+    Control.PRESSURE and Control.VOLUME -> int array), the located points and why the trace stopped."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
     pressure: np.ndarray
     volume: np.ndarray
     lowest: dict
+    unstable: dict
     special: tuple
     stop: Stop
 
@@ -127,7 +134,21 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     special.sort(key=lambda s: (s.index, s.kind))
     volume = np.array([2 * eq.volume(Y[:-1]) / geometry.length for Y in full])
     return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
-                          tuple(special), path.stop)
+                          unstable_counts(eq, full), tuple(special), path.stop)
+
+
+def unstable_counts(eq: Equilibrium, points) -> dict:
+    """{Control.PRESSURE, Control.VOLUME: the number of negative eigenvalues of ∂R/∂u at each Y = (u, P) of
+    ``points``, without and with δV = 0} (module docstring)."""
+    counts = {Control.PRESSURE: [], Control.VOLUME: []}
+    unit = GramFactor(np.ones(eq.disc.size), orthogonal=True)
+    for Y in points:
+        params = Parameters(Y[-1])
+        H = eq.jacobian(Y[:-1], params)
+        counts[Control.PRESSURE].append(negative_count(H))
+        gradient = -eq.parameter_derivative(Y[:-1], params, "P")
+        counts[Control.VOLUME].append(negative_count(restricted(H, unit, gradient[None, :])))
+    return {control: np.array(values, dtype=int) for control, values in counts.items()}
 
 
 def _lowest(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> float:

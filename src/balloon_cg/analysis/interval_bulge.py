@@ -12,11 +12,12 @@ rejoins the mirror-symmetric states (ρ(0) − ρ(L) = −2 Σ_{k odd} a_k chang
 and the branch meets the primary branch again at another odd branch point, the other end of the pitchfork's loop,
 where P and V are again even in the arclength: the monitors' sign changes in that last step are that symmetry,
 not folds, and are not kept), its V/V0 passes ``stop_volume``, or after ``continuation.max_points``. The branch
-point X* is the branch's first point.
+point X* is the branch's first point; the stability of every point is ``unstable_counts``' (at X*
+itself one eigenvalue is zero, its sign rounding).
 """
 import numpy as np
 
-from .interval_branch import IntervalBranch, IntervalSpecial, IntervalStop
+from .interval_branch import IntervalBranch, IntervalSpecial, IntervalStop, unstable_counts
 from .problem import ParameterSystem, continuation_settings
 from .results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
@@ -78,4 +79,4 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                     for f in sorted(folds, key=lambda f: f.index))
     points = [X] + [p.X for p in path.points]
     return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
-                          np.array([volume(Y) for Y in points]), {}, special, path.stop)
+                          np.array([volume(Y) for Y in points]), {}, unstable_counts(eq, points), special, path.stop)
