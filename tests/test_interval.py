@@ -156,6 +156,18 @@ def test_first_branch_point_is_the_bulge_onset(preset, length):
     assert abs(amplitude) > 1e-3 * abs(scale)
 
 
+def test_later_branch_points_are_the_higher_modes():
+    """SPOM1, L = 10, to λθ = 2.3: the branch points of the uniform branch are the modes cos(nπS/L), n = 1..4, in
+    the odd, even, odd, even block, each at model/tube.bulge_onset(mode = n) (λθ and P to 1e-8; measured 1e-14)."""
+    scene = tube_scene("SPOM1", 10.0).with_overrides({"solver.degree": 30, "continuation.stop_stretch": 2.3})
+    branch = primary_branch(scene)
+    points = branch.branch_points()
+    assert [p.block for p in points] == [Mirror.ODD, Mirror.EVEN, Mirror.ODD, Mirror.EVEN]
+    for n, point in enumerate(points, start=1):
+        onset = tube.bulge_onset(scene.material, 10.0, mode=n)
+        assert abs(point.u[0] - onset.hoop) <= 1e-8 and abs(point.pressure - onset.pressure) <= 1e-8
+
+
 def first_integral(material, disc, u):
     """H = λ1Φ_1 − Φ at 401 points along the tube (module docstring: ρ'∂π/∂ρ' + η'∂π/∂η' − π, the pressure's
     term linear in η' dropping out; constant along S on an equilibrium, the Noether integral of axial translation),

@@ -5,11 +5,13 @@ The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium. From it 
 continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted to the even block,
 interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps its equator
 symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the north
-pole stretch means nothing), or after ``continuation.max_points``. Folds in P (LP) are located by the tracer's fold
+pole stretch means nothing), or after ``continuation.max_points``; the points located up to stop_stretch are kept,
+those in the step that passed it included. Folds in P (LP) are located by the tracer's fold
 monitor. At every point the second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the
-lowest eigenvalue of each is stored; where one changes sign between neighbours, the point where it vanishes is
-located by Brent's method in the arclength from the earlier point (``continuation.locate_root``, each evaluation a
-Keller corrector), and kept as a branch point (BP) when its null vector φ is orthogonal to ∂R/∂P
+spectrum of each is computed (its lowest eigenvalue stored); where a block's number of negative eigenvalues
+changes between neighbours, each eigenvalue that crossed (by its order in the spectrum) is followed to the point
+where it vanishes, located by Brent's method in the arclength from the earlier point (``continuation.locate_root``,
+each evaluation a Keller corrector), and kept as a branch point (BP) when its null vector φ is orthogonal to ∂R/∂P
 (|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's zero where it is not is the fold in P itself (LP).
 Stability at every point (``unstable_counts``): the number of negative eigenvalues of ∂R/∂u under pressure control
 (all of u) and under volume control (on δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman
@@ -49,7 +51,8 @@ class IntervalStop(enum.StrEnum):
 @dataclass(frozen=True)
 class IntervalSpecial:
     """A located point: LP (fold in P) or BP (``block`` the mirror block whose lowest eigenvalue vanishes), its
-    state ``u`` and pressure, between points ``index`` and ``index + 1``; ``status`` of its location."""
+    state ``u`` and pressure, between points ``index`` and ``index + 1`` (the last index: in the step that passed
+    the stop, whose end is not stored); ``status`` of its location."""
 
     kind: Kind
     u: np.ndarray
@@ -121,18 +124,24 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
         return None
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
-    full = [system.full(p.X) for p in path.points]
-    lowest = {block: np.array([_lowest(eq, Y, disc.block(block)) for Y in full]) for block in Mirror}
+    reached = path.points + ([path.overshoot] if path.overshoot is not None else [])  # the last step's too
+    full = [system.full(p.X) for p in reached]
+    spectra = {block: np.array([_spectrum(eq, Y, disc.block(block)) for Y in full]) for block in Mirror}
     special = [IntervalSpecial(Kind.LP, system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index, f.status)
                for f in path.folds]
     for block in Mirror:
-        values = lowest[block]
-        for i in np.flatnonzero(values[:-1] * values[1:] < 0):
-            found = _located_zero(system, eq, path.points[i], path.points[i + 1], block, settings)
-            if found is not None:
-                special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1], block))
-    special.sort(key=lambda s: (s.index, s.kind))
+        negatives = (spectra[block] < 0).sum(axis=1)
+        for i in np.flatnonzero(negatives[:-1] != negatives[1:]):
+            for order in range(min(negatives[i:i + 2]), max(negatives[i:i + 2])):
+                found = _located_zero(system, eq, reached[i], reached[i + 1], block, order, settings)
+                if found is not None:
+                    special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1],
+                                                   block))
+    special = sorted((s for s in special if disc.node_state(s.u)[0].max() <= limit),
+                     key=lambda s: _position(system, reached, s))
+    full, spectra = full[: len(path.points)], {block: values[: len(path.points)] for block, values in spectra.items()}
     volume = np.array([2 * eq.volume(Y[:-1]) / geometry.length for Y in full])
+    lowest = {block: spectra[block][:, 0] for block in Mirror}
     return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
                           unstable_counts(eq, full), tuple(special), path.stop)
 
@@ -151,15 +160,25 @@ def unstable_counts(eq: Equilibrium, points) -> dict:
     return {control: np.array(values, dtype=int) for control, values in counts.items()}
 
 
-def _lowest(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> float:
-    """The lowest eigenvalue of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``."""
+def _position(system: MirrorSystem, points: list, special: IntervalSpecial) -> float:
+    """Where a located point lies along the branch: its index plus its arclength from that point along the point's
+    tangent, over the step's (the order of points located in one step)."""
+    before, after = points[special.index], points[special.index + 1]
+    tangent = system.full(before.tangent)
+    along = tangent @ (np.append(special.u, special.pressure) - system.full(before.X))
+    return special.index + along / (tangent @ (system.full(after.X) - system.full(before.X)))
+
+
+def _spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """The eigenvalues (ascending) of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``."""
     H = eq.jacobian(Y[:-1], Parameters(Y[-1]))
-    return float(np.linalg.eigvalsh(H[np.ix_(index, index)])[0])
+    return np.linalg.eigvalsh(H[np.ix_(index, index)])
 
 
-def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: Mirror, settings):
-    """(Y = (u, P), status) where the lowest eigenvalue of ``block`` vanishes between two points, by Brent in the
-    arclength from ``before``; None when it is the fold in P (the null vector not orthogonal to ∂R/∂P)."""
+def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: Mirror, order: int, settings):
+    """(Y = (u, P), status) where the eigenvalue number ``order`` (ascending, from 0) of ``block`` vanishes between
+    two points, by Brent in the arclength from ``before``; None when it is the fold in P (the null vector not
+    orthogonal to ∂R/∂P)."""
     index = eq.disc.block(block)
 
     def value_at(s):
@@ -167,15 +186,16 @@ def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: M
         if not result.converged:
             raise ArithmeticError(result.message)
         Y = system.full(result.x)
-        return _lowest(eq, Y, index), Y
+        return _spectrum(eq, Y, index)[order], Y
 
     length = float(before.tangent @ (after.X - before.X))
-    root = continuation.locate_root(value_at, length, BRENT_XTOL,
-                                    known={length: (_lowest(eq, system.full(after.X), index), system.full(after.X))})
+    end = system.full(after.X)
+    root = continuation.locate_root(value_at, length, BRENT_XTOL, known={length: (_spectrum(eq, end, index)[order],
+                                                                                  end)})
     Y = root.payload
     params = Parameters(Y[-1])
     H = eq.jacobian(Y[:-1], params)[np.ix_(index, index)]
-    phi = np.linalg.eigh(H)[1][:, 0]
+    phi = np.linalg.eigh(H)[1][:, order]
     dP = eq.parameter_derivative(Y[:-1], params, "P")
     if abs(phi @ dP[index]) > ORTHOGONAL * np.linalg.norm(dP):
         return None
