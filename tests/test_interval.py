@@ -31,14 +31,23 @@ def ogden(material, l1, l2):
     return sum(m / a * (l1**a + l2**a + (l1 * l2) ** -a - 3) for m, a in zip(material.mu, material.alpha))
 
 
-def series(disc, u, nodes=200):
-    """(weights per dS, λ1, λ2, η') at a Gauss rule of ``nodes`` points, λ2 and η from the Legendre series of u (the
-    bubbles P_{k+2} − P_k as Legendre coefficients) by numpy."""
-    n, L = disc.degree, disc.length
-    a, stretch, b = u[: n + 1], u[n + 1], u[n + 2:]
+def bubble_series(n, b):
+    """The Legendre coefficients of Σ_k b_k (P_{k+2} − P_k), k ≤ n − 2."""
     c = np.zeros(n + 1)
     c[2:] += b
     c[: n - 1] -= b
+    return c
+
+
+def series(disc, u, nodes=200):
+    """(weights per dS, λ1, λ2, η') at a Gauss rule of ``nodes`` points, λ2 and η from the Legendre series of u (the
+    bubbles P_{k+2} − P_k as Legendre coefficients; plugged ends: λ2 = 1 + bubbles) by numpy."""
+    n, L, k = disc.degree, disc.length, disc.axial_index
+    a, stretch, b = u[:k], u[k], u[k + 1:]
+    if disc.ends == "plugged":
+        a = bubble_series(n, a)
+        a[0] += 1.0
+    c = bubble_series(n, b)
     x, w = legendre.leggauss(nodes)
     rate = 2 / L * legendre.legval(x, legendre.legder(a))
     slope = -stretch + 2 / L * legendre.legval(x, legendre.legder(c))
@@ -69,14 +78,15 @@ def test_tube_kernels_are_the_sphere_kernels_at_its_equator_node():
         assert np.abs(ours - sphere).max() <= 1e-13 * np.abs(sphere).max()
 
 
-def test_discrete_energy_and_residual_are_those_written_here():
+@pytest.mark.parametrize("ends", ["sliding", "plugged"])
+def test_discrete_energy_and_residual_are_those_written_here(ends):
     """At a non-uniform state: E/(2π) and V/(2π) to 1e-13 (relative), R = ∂E/∂u against central differences of the
     energy written here, J symmetric and the derivative of R."""
-    scene = tube_scene("SPOM1", 7.0)
-    disc = IntervalDiscretisation(10, 7.0, quadrature=120)  # the energy's quadrature error below rounding
+    scene = tube_scene("SPOM1", 7.0, f'ends = "{ends}"\n')
+    disc = IntervalDiscretisation(10, 7.0, quadrature=120, ends=scene.geometry.ends)  # quadrature error < rounding
     eq = Equilibrium(scene, disc)
     rng = np.random.default_rng(3)
-    u = disc.uniform(1.3, 1.1) + 0.02 * rng.standard_normal(disc.size) / (1 + np.arange(disc.size) % 11)
+    u = disc.reference() * 1.2 + 0.02 * rng.standard_normal(disc.size) / (1 + np.arange(disc.size) % 11)
     P = 0.8
     E = energy_written_here(scene.material, disc, u, P)
     assert abs(eq.energy(u, Parameters(P)) - E) <= 1e-13 * abs(E)
@@ -215,6 +225,31 @@ def test_bulge_branch_from_the_onset_through_its_volume_fold():
     assert np.all(unstable[Control.VOLUME][1: fold.index + 1] == 1) and np.all(unstable[Control.VOLUME][after] == 0)
     H = first_integral(scene.material, disc, fold.u)
     assert np.abs(H - H.mean()).max() <= 1e-6 * abs(H.mean())
+
+
+def test_plugged_tube_has_a_pressure_maximum_above_the_uniform_one():
+    """Plugged ends (ρ = 1 at both ends, closed): SPOM1, L = 10, the primary branch's fold in P at degrees 30 and 40
+    within 1e-10 (measured 1.7e-13); ρ(0) = ρ(L) = 1; at the fold the first integral H (written here) is constant
+    along the tube to 1e-6 (measured 5e-8 at degree 40): the state solves the continuous problem with the plugs'
+    conditions. The plugs stiffen the tube: the maximum lies above the uniform closed tube's and approaches it as L
+    grows (L = 5, 10, 20 at degree 40: 0.123, 0.0204, 0.00253 above; each gap below a fifth of the last)."""
+    peak = tube.pressure_maximum(tube_scene().material)
+    folds = {}
+    for length, degree in ((10.0, 30), (10.0, 40), (5.0, 40), (20.0, 40)):
+        scene = tube_scene("SPOM1", length, 'ends = "plugged"\n').with_overrides(
+            {"solver.degree": degree, "continuation.stop_stretch": 1.8})
+        branch = primary_branch(scene)
+        found = [s for s in branch.special if s.kind == "LP"]
+        assert len(found) == 1 and found[0].status == "located"
+        folds[length, degree] = found[0]
+    assert abs(folds[10.0, 30].pressure - folds[10.0, 40].pressure) <= 1e-10
+    fold, disc = folds[10.0, 40], IntervalDiscretisation(40, 10.0, ends=scene.geometry.ends)
+    rho, _ = disc.profile(fold.u, np.array([0.0, 10.0]))
+    assert np.abs(rho - 1).max() <= 1e-14
+    H = first_integral(scene.material, disc, fold.u)
+    assert np.abs(H - H.mean()).max() <= 1e-6 * abs(H.mean())
+    gaps = [folds[length, 40].pressure - peak.pressure for length in (5.0, 10.0, 20.0)]
+    assert gaps[0] > 5 * gaps[1] > 0 and gaps[1] > 5 * gaps[2] > 0
 
 
 def test_mirror_blocks_split_the_hessian_of_a_symmetric_state():

@@ -108,11 +108,11 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     if geometry.shape != Shape.TUBE:
         raise SceneError(f'geometry.shape = "{geometry.shape.value}": an interval branch is a tube\'s; allowed: "tube"')
     disc = IntervalDiscretisation(scene.solver.degree if degree is None else degree, geometry.length,
-                                  scene.solver.quadrature)
+                                  scene.solver.quadrature, geometry.ends)
     eq = Equilibrium(scene, disc)
     system = MirrorSystem(ParameterSystem(eq, Parameters(0.0), "P"), disc)
     settings = continuation_settings(scene)
-    X = np.append(disc.uniform(1.0, 1.0), 0.0)[system.columns]
+    X = np.append(disc.reference(), 0.0)[system.columns]
     t = continuation.tangent(system, X, np.eye(X.size)[-1])
     start = continuation.Point(X, t, 0, float(np.abs(system.residual(X)).max()))
     limit = scene.continuation.stop_stretch

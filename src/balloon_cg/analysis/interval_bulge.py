@@ -24,6 +24,7 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
+from ..scene.tables import Ends
 
 
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
@@ -34,6 +35,8 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         raise ValueError(f"a bulge branch starts at a branch point of the odd block, not at {point.kind} "
                          f"({point.block})")
     disc, length = primary.disc, primary.disc.length
+    if disc.ends != Ends.SLIDING:
+        raise ValueError(f"a bulge branch is switched on a tube with sliding ends, not {disc.ends.value}")
     eq = Equilibrium(scene, disc)
     odd = disc.block(Mirror.ODD)
     params = Parameters(point.pressure)

@@ -6,9 +6,10 @@ axis (codegen/meridian.py: R = 1, R' = 0, S' = 1, Z = −S). In x = 2S/L − 1 �
     λ2(x) = Σ_{k=0}^{N} a_k P_k(x),      η(x) = −λ̄ (L/2) x + Σ_{k=0}^{N−2} b_k (P_{k+2} − P_k)(x),
 
 u = (a_0..a_N, λ̄, b_0..b_{N−2}) (2N + 1 unknowns). The bubbles P_{k+2} − P_k vanish at x = ±1, so η(±1) = ∓λ̄L/2:
-the ends are the planes of symmetry Z = ±λ̄L/2 of sliding ends, η fixed on each, their distance λ̄L an unknown
-(closed ends: its equation is the axial balance, the plugs carrying the pressure on their faces), the radius free
-there (ρ' = 0 is the natural end condition). At a node
+the ends are the planes Z = ±λ̄L/2, η fixed on each, their distance λ̄L an unknown (closed ends: its equation is the
+axial balance, the ends carrying the pressure on their faces). Sliding ends (planes of symmetry) leave the radius
+free there (ρ' = 0 is the natural end condition); plugged ends (rigid plugs of the reference radius) hold
+ρ(±1) = 1: λ2 = 1 + Σ_{k=0}^{N−2} a_k (P_{k+2} − P_k)(x), u = (a_0..a_{N−2}, λ̄, b) (2N − 1 unknowns). At a node
 
     ρ = λ2 R = λ2,   v = λ2' R = (2/L) dλ2/dx,   w = η' = (2/L) dη/dx,
 
@@ -33,6 +34,7 @@ from numpy.polynomial import legendre
 
 from .discretisation import gauss_nodes, legendre_table, read_only, symmetric_rows
 from ..generated import HESSIAN_PAIRS
+from ..scene.tables import Ends
 
 _HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)
 
@@ -46,25 +48,31 @@ class Mirror(enum.StrEnum):
 
 @dataclass(frozen=True)
 class IntervalDiscretisation:
-    """Legendre ``degree`` N over a tube of ``length`` L (reference radii), ``quadrature`` Gauss nodes (0: the
-    sphere's default rule at N, discretisation.gauss_nodes)."""
+    """Legendre ``degree`` N over a tube of ``length`` L (reference radii) with ``ends``, ``quadrature`` Gauss nodes
+    (0: the sphere's default rule at N, discretisation.gauss_nodes)."""
 
     degree: int
     length: float
     quadrature: int = 0
+    ends: Ends = Ends.SLIDING
 
     def __post_init__(self):
         if self.degree < 2:
             raise ValueError(f"an interval discretisation needs degree ≥ 2 (the bubbles of η), not {self.degree}")
 
     @property
+    def hoops(self) -> int:
+        """The number of λ2's coefficients: N + 1 (sliding ends), N − 1 (plugged: bubbles about λ2 = 1)."""
+        return self.degree + 1 if self.ends == Ends.SLIDING else self.degree - 1
+
+    @property
     def size(self) -> int:
-        return 2 * self.degree + 1
+        return self.hoops + self.degree
 
     @property
     def axial_index(self) -> int:
         """The position of λ̄ (the ends' distance over L) in u."""
-        return self.degree + 1
+        return self.hoops
 
     @property
     def x(self) -> np.ndarray:
@@ -91,8 +99,11 @@ class IntervalDiscretisation:
         return _tables(self)["maps"]
 
     def node_state(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """(λ2, v, η, w) at the nodes, (4, n_q), into ``out`` if given."""
-        return np.matmul(self.maps, u, out=out)
+        """(λ2, v, η, w) at the nodes, (4, n_q), into ``out`` if given (plugged ends: λ2's 1 added)."""
+        out = np.matmul(self.maps, u, out=out)
+        if self.ends == Ends.PLUGGED:
+            out[0] += 1.0
+        return out
 
     def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k T_k[q] from ``pointwise`` (4, n_q): energy_gradient at the nodes."""
@@ -111,26 +122,36 @@ class IntervalDiscretisation:
         return out
 
     def uniform(self, hoop: float, axial: float) -> np.ndarray:
-        """u of the uniform tube: λ2 = λθ, η = −λz(S − L/2)."""
+        """u of the uniform tube with sliding ends: λ2 = λθ, η = −λz(S − L/2)."""
+        if self.ends != Ends.SLIDING:
+            raise ValueError(f"a tube with {self.ends.value} ends is not uniform")
         u = np.zeros(self.size)
         u[0], u[self.axial_index] = hoop, axial
         return u
 
+    def reference(self) -> np.ndarray:
+        """u of the unstressed tube (λ2 = 1, η = −(S − L/2))."""
+        u = np.zeros(self.size)
+        u[self.axial_index] = 1.0
+        if self.ends == Ends.SLIDING:
+            u[0] = 1.0
+        return u
+
     def block(self, mirror: Mirror) -> np.ndarray:
         """The indices into u of a mirror block (module docstring)."""
-        n = self.degree
         parity = 0 if mirror == Mirror.EVEN else 1
-        a = np.arange(parity, n + 1, 2)
-        b = n + 2 + np.arange(1 - parity, n - 1, 2)
+        a = np.arange(parity, self.hoops, 2)
+        b = self.hoops + 1 + np.arange(1 - parity, self.degree - 1, 2)
         return np.concatenate([a, [self.axial_index] if mirror == Mirror.EVEN else [], b]).astype(int)
 
     def profile(self, u: np.ndarray, s: np.ndarray) -> tuple:
         """(ρ, η) at reference arclengths s ∈ [0, L]."""
         x = 2 * np.asarray(s, dtype=float) / self.length - 1
         p, _ = legendre_table(x, self.degree)
-        n = self.degree
-        lam, b = u[: n + 1], u[n + 2:]
-        return p @ lam, -u[self.axial_index] * self.length / 2 * x + (p[:, 2:] - p[:, : n - 1]) @ b
+        n, k = self.degree, self.axial_index
+        bubbles = p[:, 2:] - p[:, : n - 1]
+        rho = p @ u[:k] if self.ends == Ends.SLIDING else 1.0 + bubbles @ u[:k]
+        return rho, -u[k] * self.length / 2 * x + bubbles @ u[k + 1:]
 
 
 @functools.lru_cache(maxsize=16)
@@ -139,12 +160,14 @@ def _tables(disc: IntervalDiscretisation) -> dict:
     n, length = disc.degree, disc.length
     x, w = legendre.leggauss(disc.quadrature or gauss_nodes(n))
     p, dp = legendre_table(x, n)
+    bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
+    k = disc.axial_index
     maps = np.zeros((4, x.size, disc.size))
-    maps[0, :, : n + 1] = p
-    maps[1, :, : n + 1] = 2 / length * dp
-    maps[2, :, n + 1] = -length / 2 * x
-    maps[2, :, n + 2:] = p[:, 2:] - p[:, : n - 1]
-    maps[3, :, n + 1] = -1.0
-    maps[3, :, n + 2:] = 2 / length * (dp[:, 2:] - dp[:, : n - 1])
+    hoop, rate = (p, dp) if disc.ends == Ends.SLIDING else (bubbles, slopes)
+    maps[0, :, :k], maps[1, :, :k] = hoop, 2 / length * rate
+    maps[2, :, k] = -length / 2 * x
+    maps[2, :, k + 1:] = bubbles
+    maps[3, :, k] = -1.0
+    maps[3, :, k + 1:] = 2 / length * slopes
     tables = {"x": x, "weights": length / 2 * w, "rate": np.zeros_like(x), "radius": np.ones_like(x), "maps": maps}
     return {name: read_only(table) for name, table in tables.items()}

@@ -118,9 +118,11 @@ class Shape(enum.StrEnum):
 
 class Ends(enum.StrEnum):
     """How a tube ends (``Geometry.ends``): "sliding", planes of symmetry the meridian meets at a right angle (its
-    radius free there), closed: no axial force beyond the pressure's on the ends (docs/shapes.md)."""
+    radius free there), or "plugged", rigid plugs of the reference radius; both closed: no axial force beyond the
+    pressure's on the ends (docs/shapes.md)."""
 
     SLIDING = "sliding"
+    PLUGGED = "plugged"
 
 
 @dataclass(frozen=True)
@@ -809,8 +811,7 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
                                                   f"in [{MIN_LENGTH:g}, {MAX_LENGTH:g}]")
     raw = Ends.SLIDING.value if data.get("ends") is None else data["ends"]
     if raw not in tuple(Ends):
-        raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends)
-                         + ' (plugged ends are not built yet)')
+        raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends))
     where = 'geometry.shape = "tube"'
     if field.coils:
         raise SceneError(f"{where}: coils around a tube are not built yet; leave [field] coils out or use another "
