@@ -29,13 +29,17 @@ def layout() -> dict:
 
 
 def class_module(cls: SceneClass, timings: dict | None = None) -> str:
-    """Module text of one scene class: Galerkin energy kernels, first-order system, pole series. ``timings``
+    """Module text of one scene class: Galerkin energy kernels, first-order system, pole series (the last two and
+    the m ≥ 1 second variation only on a meridian with poles). ``timings``
     (if given) receives the seconds spent per stage: 'derive' (equations, poles, second variation), 'lower'
     (CSE), 'print'."""
     start = time.perf_counter()
-    kernels = equations.energy_kernels(cls) + equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
-    # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient (codegen/second_variation.py)
-    kernels += second_variation.second_variation_kernels(cls)
+    kernels = equations.energy_kernels(cls)
+    if cls.meridian.poles:  # a meridian without poles (a tube) has its energy kernels only (codegen/meridian.py)
+        kernels += equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
+        # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient
+        # (codegen/second_variation.py)
+        kernels += second_variation.second_variation_kernels(cls)
     if cls.elastic.energy is not None:
         kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
     title = cls.title("Kernels for scene class")

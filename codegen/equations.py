@@ -43,7 +43,7 @@ def energy_kernels(cls: SceneClass) -> list[Kernel]:
     gradient = [sp.diff(density, x) for x in STATE]
     hessian = [sp.diff(gradient[i], STATE[j]) for i, j in HESSIAN_PAIRS]
     at_node = lambda exprs: tuple(fn.at_node(cls, e) for e in exprs)  # noqa: E731
-    args = kernel_args(cls, (cos_theta, sin_theta) + STATE)
+    args = kernel_args(cls, cls.meridian.node_symbols + STATE)
     kernels = [
         Kernel("energy_density", "π̂ = Π/sin θ at a node (MODEL.md §2).", args, at_node([density]), ("pi_hat",)),
         Kernel("energy_gradient", "∂π̂/∂(λ2, v, η, w).", args, at_node(gradient), STATE_LABELS),

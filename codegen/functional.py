@@ -76,11 +76,14 @@ def at_node(cls: SceneClass, expr):
 
 
 def energy_density(cls: SceneClass, c=cos_theta, s=sin_theta):
-    """π̂ = Π / sin θ (the integrand per d(cos θ)), as a function of the node's (cos θ, sin θ) and state:
-    Φ(λ1, λ2) S' with λ1 = |x'|/S', plus the terms' densities (those per reference area times S')."""
-    metric = cls.meridian.metric(c, s)
-    density = membrane_energy(cls, meridional_stretch(c, v, w) / metric, lam2) * metric
-    return density + sum((t.axisymmetric(c, s, metric) for t in cls.terms), sp.S.Zero)
+    """π̂ = Π / R (on a meridian with poles the integrand per d(cos θ)), as a function of the node's
+    (cos θ, sin θ) and state: Φ(λ1, λ2) S' with λ1 = |x'|/S' = sqrt((λ2 R' + v)² + w²)/S', plus the terms' densities
+    (those per reference area times S'), with R', R and S' the meridian's at the node (codegen/meridian.py: the
+    sphere's are cos θ, sin θ and 1, a tube's 0, 1 and 1)."""
+    meridian = cls.meridian
+    metric, rate, radius = meridian.metric(c, s), meridian.hoop_rate(c, s), meridian.hoop(c, s)
+    density = membrane_energy(cls, meridional_stretch(rate, v, w) / metric, lam2) * metric
+    return density + sum((t.axisymmetric(rate, radius, metric) for t in cls.terms), sp.S.Zero)
 
 
 def lagrangian(cls: SceneClass):

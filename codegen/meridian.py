@@ -1,16 +1,23 @@
 """The reference meridian of a scene class: the surface of revolution the membrane is cut from, as data.
 
-A meridian is given by its hoop radius R(θ) and height Z(θ) over the polar angle θ ∈ [0, π], with R = sin θ
-(zero at both ends: two poles, the Legendre basis in cos θ and the pole series apply):
+A meridian is its hoop radius R(t) and height Z(t) over a parameter t ∈ [t0, t1] with named ends; the kernels see it
+through the node values R', R and the metric S' = dS/dt = sqrt(R'² + Z'²) (S the reference arclength):
 
-    sphere     R = sin θ,   Z = cos θ,            S' = 1
-    spheroid   R = sin θ,   Z = aspect · cos θ,   S' = g(θ) = sqrt(cos²θ + aspect² sin²θ)
+    sphere     t = θ ∈ [0, π]   R = sin θ,  Z = cos θ,            S' = 1,     ends: two poles
+    spheroid   t = θ ∈ [0, π]   R = sin θ,  Z = aspect · cos θ,   S' = sqrt(cos²θ + aspect² sin²θ),  two poles
+    tube       t = S ∈ [0, L]   R = 1,      Z = −S,               S' = 1,     ends: planes (sliding) or plugs
 
-(S' = dS/dθ = sqrt(R'² + Z'²), S the reference arclength; aspect = polar over equatorial semi-axis, a runtime
-argument of the kernels). On it the stretches are λ1 = |x'|/S' (meridional) and λ2 = ρ/R (hoop), the reference
-area element is R S' dθ dφ: per d(cos θ) every density per reference area carries the factor S' (``metric``),
-the pressure's work does not (the enclosed volume is the deformed surface's). The sphere's metric is the number 1,
-so its kernels are those derived before the meridian was data, byte for byte.
+(aspect = polar over equatorial semi-axis, a runtime argument of the kernels; the tube's length L enters no
+kernel). On it the stretches are λ1 = |x'|/S' (meridional) and λ2 = ρ/R (hoop) with ρ = λ2 R, ρ' = λ2 R' + v,
+v = λ2' R, and the energy per dt divided by R is π̂ = Φ(λ1, λ2) S' + (the terms' densities): every density per
+reference area carries the factor S' (``metric``), the pressure's work does not (the enclosed volume is the
+deformed surface's, −½ρ²η' per dt, the meridian running downwards as the sphere's does from its north pole).
+
+A meridian with poles (R = 0 at both ends) has its node at (cos θ, sin θ) = (R', R) of the sphere's kernels, the
+Legendre basis in cos θ and the pole series. A tube has no node coordinate at all: R' = 0, R = 1 and S' = 1 are
+folded into its kernels (only the energy kernels: no pole series, no first-order system in θ), and its ends are
+rows of its discretisation (galerkin/interval.py). The sphere's expressions are those derived before the meridian
+was data, so its kernels are byte for byte what they were.
 """
 from dataclasses import dataclass
 
@@ -18,24 +25,47 @@ import sympy as sp
 
 aspect = sp.Symbol("aspect", positive=True)
 _theta = sp.Symbol("theta", real=True)
+_cos, _sin = sp.symbols("cos_theta sin_theta", real=True)
 
 
 @dataclass(frozen=True)
 class Meridian:
-    """The sphere; subclasses change ``height`` (and name their runtime scalars in ``parameters``)."""
+    """The sphere; subclasses change ``radius`` and ``height`` (and name their runtime scalars in ``parameters``)."""
 
     name = "sphere"
     parameters: tuple = ()
+    poles = True  # both ends on the axis (R = 0): the pole series, the Legendre basis in cos θ
 
-    def height(self, theta):
-        """Z(θ) of the reference meridian (R(θ) = sin θ for every meridian here)."""
-        return sp.cos(theta)
+    @property
+    def node_symbols(self) -> tuple:
+        """The node coordinates its kernels take: (cos θ, sin θ) for a meridian with poles, none for a tube."""
+        return (_cos, _sin) if self.poles else ()
+
+    def radius(self, t):
+        """R(t)."""
+        return sp.sin(t)
+
+    def height(self, t):
+        """Z(t)."""
+        return sp.cos(t)
+
+    def _at_node(self, expr, c, s):
+        return expr.subs({sp.cos(_theta): c, sp.sin(_theta): s})
+
+    def hoop(self, c, s):
+        """R at the node (cos θ, sin θ) = (c, s)."""
+        return self._at_node(self.radius(_theta), c, s)
+
+    def hoop_rate(self, c, s):
+        """R' = dR/dt at the node."""
+        return self._at_node(sp.diff(self.radius(_theta), _theta), c, s)
 
     def metric(self, c, s):
-        """S' = dS/dθ = sqrt(R'² + Z'²) at the node (cos θ, sin θ) = (c, s), derived from R and Z (simplified:
-        the sphere's is 1)."""
-        speed = sp.trigsimp(sp.sqrt(sp.diff(sp.sin(_theta), _theta) ** 2 + sp.diff(self.height(_theta), _theta) ** 2))
-        return speed.subs({sp.cos(_theta): c, sp.sin(_theta): s})
+        """S' = dS/dt = sqrt(R'² + Z'²) at the node (c, s), derived from R and Z (simplified: the sphere's and the
+        tube's are 1)."""
+        speed = sp.trigsimp(sp.sqrt(sp.diff(self.radius(_theta), _theta) ** 2
+                                    + sp.diff(self.height(_theta), _theta) ** 2))
+        return self._at_node(speed, c, s)
 
     def inputs(self) -> dict:
         """Its entries in a module's header: none for the sphere (its modules' headers stay as they were)."""
@@ -44,6 +74,8 @@ class Meridian:
     def title(self) -> str | None:
         if self.name == SPHERE.name:
             return None
+        if not self.parameters:
+            return f"{self.name} reference"
         return f"{self.name} reference (parameters {', '.join(map(str, self.parameters))})"
 
 
@@ -52,10 +84,25 @@ class Spheroid(Meridian):
     name = "spheroid"
     parameters: tuple = (aspect,)
 
-    def height(self, theta):
-        return aspect * sp.cos(theta)
+    def height(self, t):
+        return aspect * sp.cos(t)
+
+
+@dataclass(frozen=True)
+class Tube(Meridian):
+    """The circular cylinder of radius 1 over its arclength t = S (no poles: its ends are the discretisation's)."""
+
+    name = "tube"
+    poles = False
+
+    def radius(self, t):
+        return sp.S.One
+
+    def height(self, t):
+        return -t
 
 
 SPHERE = Meridian()
 SPHEROID = Spheroid()
-MERIDIANS = {m.name: m for m in (SPHERE, SPHEROID)}
+TUBE = Tube()
+MERIDIANS = {m.name: m for m in (SPHERE, SPHEROID, TUBE)}

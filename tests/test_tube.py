@@ -10,7 +10,8 @@ import pytest
 import sympy as sp
 from scipy.optimize import brentq
 
-from balloon_cg.model.tube import axial_force, bulge_onset, closed_end_state, hoop_pressure, pressure_maximum
+from balloon_cg.model.tube import (axial_force, bulge_onset, closed_end_state, hoop_pressure, maxwell_pressure,
+                                   pressure_maximum)
 from balloon_cg.scene import parse_scene
 
 theta, z = sp.symbols("theta z", positive=True)
@@ -145,3 +146,28 @@ def test_bulge_onset_tends_to_the_pressure_maximum():
     gaps = np.array([o.hoop - peak.hoop for o in onsets])
     assert np.all(gaps > 0) and np.all([o.pressure < peak.pressure for o in onsets])
     assert np.all(np.abs(gaps[1:-1] / gaps[2:] - 4) < 0.04)
+
+
+def test_maxwell_pressure_is_the_equal_area_rule():
+    """SPOM1's Maxwell pressure (maxwell_pressure: equal energies e(a) = e(b) of the two uniform states) against the
+    equal-area rule written here: along N = 0, ∫_a^b (P − P_M) dv = 0 with v = λθ²λz, dv/dλθ = 2λθλz + λθ² dλz/dλθ
+    and dλz/dλθ = −N_θ/N_z (from the energy derived here), by Gauss–Legendre on the pieces between a, the pressure
+    maximum, the minimum and b: zero to 1e-9 of ∫|P − P_M| dv; a and b at P_M; neo-Hookean (P falls throughout
+    beyond its maximum) has none."""
+    spom1 = material("SPOM1")
+    found, a, b = maxwell_pressure(spom1)
+    assert abs(a.pressure - found) <= 1e-12 and abs(b.pressure - found) <= 1e-12 and a.hoop < 1.2 < 10 < b.hoop
+    energy = symbolic_energy(spom1)
+    P, N, axial_of = closed_end_path(energy)
+    P_of = sp.lambdify((theta, z), P)
+    slope_of = sp.lambdify((theta, z), 2 * theta * z - theta**2 * sp.diff(N, theta) / sp.diff(N, z))
+    x, w = np.polynomial.legendre.leggauss(80)
+    cuts = [a.hoop, pressure_maximum(spom1).hoop, 3.0, 7.7, b.hoop]
+    signed = absolute = 0.0
+    for low, high in zip(cuts, cuts[1:]):
+        for hoop, weight in zip((high - low) / 2 * x + (high + low) / 2, (high - low) / 2 * w):
+            axial = axial_of(hoop)
+            value = (P_of(hoop, axial) - found) * slope_of(hoop, axial) * weight
+            signed, absolute = signed + value, absolute + abs(value)
+    assert abs(signed) <= 1e-9 * absolute
+    assert maxwell_pressure(material("neo-Hookean")) is None

@@ -10,12 +10,15 @@ import numpy as np
 from numba import njit
 
 from .discretisation import Discretisation, read_only
+from .interval import IntervalDiscretisation
 from ..model.field import coaxial_table, field_squared_nodes
 from ..model.kernels import KernelSet
 from ..model.meridian import meridional_stretch
 from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
+from ..scene.tables import Shape
+from ..scene.validation import SceneError
 
 
 # the kernel of ∂R/∂name for a runtime scalar name; any other name: "NAME_gradient" if the class has one
@@ -118,9 +121,18 @@ class NodeKernels:
 class Equilibrium:
     """Residual, Jacobian and parameter derivatives of the Ritz–Galerkin system for one scene."""
 
-    def __init__(self, scene, discretisation: Discretisation, kernel_class: str | None = None):
+    def __init__(self, scene, discretisation: Discretisation | IntervalDiscretisation,
+                 kernel_class: str | None = None):
         """``kernel_class``: a generated class by name instead of the material's (model/kernels.KernelSet), e.g.
-        the general class, whose exponents are runtime arguments (Parameters.alpha)."""
+        the general class, whose exponents are runtime arguments (Parameters.alpha). A tube's scene takes an
+        interval discretisation (galerkin/interval.py: its nodes pass the meridian's R' and R as cos θ and sin θ),
+        every other scene the Legendre basis in cos θ; a tube on the latter is refused in one line (SceneError)."""
+        if (scene.geometry.shape == Shape.TUBE) != isinstance(discretisation, IntervalDiscretisation):
+            if scene.geometry.shape == Shape.TUBE:
+                raise SceneError('geometry.shape = "tube": this command is not built for a tube yet (run, solve, '
+                                 'sweep, critical and continue trace spheres and spheroids); a tube\'s uniform branch '
+                                 'and bulge onset: balloon_cg.analysis.interval_branch.primary_branch (docs/shapes.md)')
+            raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")
         self.scene = scene
         self.disc = discretisation
         self.coils = coaxial_table(scene.field.coils)

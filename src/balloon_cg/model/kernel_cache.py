@@ -1,6 +1,6 @@
 """On-demand kernels for a scene class that is not committed in generated/: a user formula, or any material with
 the dielectric term (a committed class's Ogden exponents or a strain energy, with or without a field), or any class
-on a reference shape other than the sphere (a spheroid).
+on a reference shape other than the sphere (a spheroid, a tube).
 
 The module is generated at first use by the same generator as generated/ (codegen/, shipped as
 balloon_cg.codegen; it needs SymPy, the ``codegen`` extra) into a content-keyed cache folder, and imported from

@@ -12,7 +12,9 @@ On a deformed state (λ2, v = λ2' sin θ, η, w = η'), ρ = λ2 R and the stre
 
     λ2 = ρ/R (hoop),   λ1 = sqrt(ρ'² + η'²)/S' = sqrt((λ2 cos θ + v)² + w²)/S' (meridional),
 
-and the reference encloses V0 = 4π/3 · aspect.
+and the reference encloses V0 = 4π/3 · aspect. A tube (``shape = "tube"``) is a meridian over its arclength
+t = S ∈ [0, L] with R = 1, R' = 0, S' = 1 and Z = −S (codegen/meridian.py), discretised in galerkin/interval.py;
+it encloses V0 = πL.
 """
 import numpy as np
 
@@ -20,8 +22,9 @@ from ..scene.tables import Geometry, Shape
 
 
 def metric(geometry: Geometry, cos_theta, sin_theta):
-    """S' = dS/dθ at (cos θ, sin θ): ones on the sphere."""
-    if geometry.shape == Shape.SPHERE:
+    """S' = dS/dt at the node (cos θ, sin θ): ones on the sphere and on a tube (t = S, whose nodes pass R' = 0 and
+    R = 1 for (cos θ, sin θ): galerkin/interval.py)."""
+    if geometry.shape in (Shape.SPHERE, Shape.TUBE):
         return np.ones_like(np.asarray(cos_theta, dtype=float))
     return np.sqrt(np.square(cos_theta) + np.square(geometry.aspect * np.asarray(sin_theta)))
 
@@ -31,12 +34,15 @@ def meridional_stretch(geometry: Geometry, cos_theta, sin_theta, lam2, v, w):
     return np.hypot(lam2 * cos_theta + v, w) / metric(geometry, cos_theta, sin_theta)
 
 
-def reference_height(geometry: Geometry, theta):
-    """Z(θ) of the reference meridian (its hoop radius is sin θ)."""
-    return geometry.aspect * np.cos(theta)
+def reference_height(geometry: Geometry, t):
+    """Z(t) of the reference meridian: aspect · cos θ (its hoop radius is sin θ), or a tube's −S over its arclength
+    S = t (its hoop radius is 1; downwards, as the sphere's meridian runs from its north pole)."""
+    if geometry.shape == Shape.TUBE:
+        return -np.asarray(t, dtype=float)
+    return geometry.aspect * np.cos(t)
 
 
 def kernel_values(geometry: Geometry) -> dict:
     """The meridian's scalar arguments of its class's kernels by name (codegen/meridian.py: ``parameters``): none
     for the sphere, the spheroid's aspect."""
-    return {} if geometry.shape == Shape.SPHERE else {"aspect": float(geometry.aspect)}
+    return {"aspect": float(geometry.aspect)} if geometry.shape == Shape.SPHEROID else {}

@@ -20,6 +20,12 @@ N = 0
 with P_θ = Φ_22/(λθλz) − P/λθ, P_z = Φ_12/(λθλz) − P/λz, N_θ = Φ_12 − (Φ_2 + λθΦ_22)/(2λz),
 N_z = Φ_11 − λθ(Φ_12 − Φ_2/λz)/(2λz). On a tube of length L the bulge mode cos(nπS/L) sets in where
 ``bulge_condition`` changes sign (``bulge_onset``), which tends to the pressure maximum as 1/L².
+
+A bulge on a long closed tube propagates at Maxwell's pressure P_M (``maxwell_pressure``): its front joins two
+uniform states a (λθ below the pressure maximum) and b (beyond the pressure minimum) at the same P, and the first
+integral of the axial translation, H = λ1Φ_1 − Φ (constant along the meridian; ρ'∂π/∂ρ' + η'∂π/∂η' − π with the
+pressure's term, linear in η', dropping out), is the same on both: on a uniform state with N = 0 it is −e, so
+e(a) = e(b) (Φ_1 = ½Pλθ² there), which along N = 0 is the equal-area rule ∫_a^b (P − P_M) d(λθ²λz) = 0.
 """
 from dataclasses import dataclass
 
@@ -123,3 +129,59 @@ def bulge_onset(material, length: float, mode: int = 1, largest_hoop: float = 10
             hoop = brentq(condition, hoops[k], hoops[k + 1], xtol=TOLERANCE, rtol=TOLERANCE)
             return closed_end_state(material, hoop)
     return None
+
+
+def pressure_minimum(material, largest_hoop: float = 100.0) -> UniformTube | None:
+    """The first pressure minimum of the closed-end path beyond its maximum (the first sign change − → + of
+    dP/dλθ on a geometric grid up to ``largest_hoop``, then brentq); None where there is no maximum or P falls
+    throughout."""
+    peak = pressure_maximum(material)
+    if peak is None:
+        return None
+    hoops = np.geomspace(peak.hoop * (1 + 1e-6), largest_hoop, _SCAN_POINTS)
+    slopes = [pressure_slope(material, h) for h in hoops]
+    for k in range(len(hoops) - 1):
+        if slopes[k] < 0 <= slopes[k + 1]:
+            hoop = brentq(lambda h: pressure_slope(material, h), hoops[k], hoops[k + 1], xtol=TOLERANCE,
+                          rtol=TOLERANCE)
+            return closed_end_state(material, hoop)
+    return None
+
+
+def closed_end_energy(material, state: UniformTube, pressure: float) -> float:
+    """e = Φ(λz, λθ) − ½ P λθ² λz of a uniform state at the pressure P (per 2π and unit reference length)."""
+    return float(stretch_derivatives(material, state.axial, state.hoop)["phi"]
+                 - pressure * state.hoop**2 * state.axial / 2)
+
+
+def maxwell_pressure(material, largest_hoop: float = 100.0) -> tuple | None:
+    """(P_M, a, b): the pressure at which the uniform states a (below the pressure maximum) and b (beyond the
+    pressure minimum) of the closed-end path have the same e (module docstring), by brentq in P between the
+    minimum and the maximum; None where the path has no maximum and minimum."""
+    peak, low = pressure_maximum(material), pressure_minimum(material, largest_hoop)
+    if peak is None or low is None:
+        return None
+
+    def states(P):
+        def at(h):
+            return closed_end_state(material, h).pressure - P
+
+        a = brentq(at, 1.0, peak.hoop, xtol=TOLERANCE, rtol=TOLERANCE)
+        b = brentq(at, low.hoop, _beyond(material, low.hoop, P, largest_hoop), xtol=TOLERANCE, rtol=TOLERANCE)
+        return closed_end_state(material, a), closed_end_state(material, b)
+
+    def difference(P):
+        a, b = states(P)
+        return closed_end_energy(material, a, P) - closed_end_energy(material, b, P)
+
+    span = peak.pressure - low.pressure
+    P = brentq(difference, low.pressure + 1e-9 * span, peak.pressure - 1e-9 * span, xtol=TOLERANCE, rtol=TOLERANCE)
+    return (P, *states(P))
+
+
+def _beyond(material, hoop: float, pressure: float, largest_hoop: float) -> float:
+    """A hoop stretch beyond ``hoop`` (on the rising path after the minimum) where P exceeds ``pressure``."""
+    for h in np.geomspace(hoop, largest_hoop, _SCAN_POINTS)[1:]:
+        if closed_end_state(material, h).pressure > pressure:
+            return float(h)
+    raise ValueError(f"the closed-end pressure stays below {pressure:g} up to the hoop stretch {largest_hoop:g}")

@@ -733,7 +733,7 @@ def plot_shapes(branches, points=None, axes=None) -> Figure:
     handles = []
     for geometry in dict.fromkeys(stored_scene(b.run).geometry for b in branches):  # each reference drawn once
         ax.plot(np.sin(psi), reference_height(geometry, psi), color="0.6", linewidth=0.8, linestyle=":")
-        shape = "" if geometry.shape == Shape.SPHERE else f", spheroid of aspect {geometry.aspect:g}"
+        shape = "" if geometry.shape == Shape.SPHERE else f", {geometry.describe()}"
         handles.append(Line2D([], [], color="0.6", linewidth=0.8, linestyle=":",
                               label=f"undeformed ($R_0$ = 1{shape})"))
     for label, color, q, _ in _configurations(branches, points):

@@ -22,8 +22,8 @@ from .loading import Control, Loading, loading_from_table
 from .materials import ALPHA1, MAX_EXPONENT, Material, alpha1_terms, material_from_table, modified_name
 
 __all__ = [
-    "Coil", "Field", "Electric", "Geometry", "Shape", "ContinuationParameter", "Continuation", "Solver", "Stability",
-    "Output", "Loading", "Control", "Scene", "SceneError",
+    "Coil", "Field", "Electric", "Geometry", "Shape", "Ends", "ContinuationParameter", "Continuation", "Solver",
+    "Stability", "Output", "Loading", "Control", "Scene", "SceneError",
     "parse_scene", "load_scene",
 ]
 
@@ -113,16 +113,41 @@ class Shape(enum.StrEnum):
 
     SPHERE = "sphere"
     SPHEROID = "spheroid"
+    TUBE = "tube"
+
+
+class Ends(enum.StrEnum):
+    """How a tube ends (``Geometry.ends``): "sliding", planes of symmetry the meridian meets at a right angle (its
+    radius free there), or "plugged", rigid plugs of the reference radius; both closed: no axial force beyond the
+    pressure's on the ends (docs/shapes.md)."""
+
+    SLIDING = "sliding"
+    PLUGGED = "plugged"
 
 
 @dataclass(frozen=True)
 class Geometry:
-    """The reference surface (docs/scenes.md, [geometry]): the unit sphere, or a spheroid of equatorial semi-axis 1
-    and polar semi-axis ``aspect`` (< 1 oblate, > 1 prolate; 1 is the sphere), the axis that of the coils. Lengths
-    stay in units of the equatorial radius; the reference meridian is model/meridian.py's."""
+    """The reference surface (docs/scenes.md, [geometry]): the unit sphere, a spheroid of equatorial semi-axis 1
+    and polar semi-axis ``aspect`` (< 1 oblate, > 1 prolate; 1 is the sphere), the axis that of the coils, or a
+    circular cylinder of radius 1 and ``length`` with ``ends``. Lengths stay in units of the equatorial radius; the
+    reference meridian is model/meridian.py's."""
 
     shape: Shape = Shape.SPHERE
     aspect: float = 1.0
+    length: float | None = None  # a tube's
+    ends: Ends | None = None  # a tube's
+
+    def to_table(self) -> dict:
+        """Its [geometry] table (a spheroid's keeps the text it had before tubes)."""
+        if self.shape == Shape.TUBE:
+            return {"shape": self.shape.value, "length": self.length, "ends": self.ends.value}
+        return {"shape": self.shape.value, "aspect": self.aspect}
+
+    def describe(self) -> str:
+        """'spheroid of aspect 1.5', 'tube of length 10 with sliding ends'."""
+        if self.shape == Shape.TUBE:
+            return f"tube of length {self.length:g} with {self.ends.value} ends"
+        return f"{self.shape.value} of aspect {self.aspect:g}"
 
 
 class ContinuationParameter(enum.StrEnum):
@@ -241,6 +266,7 @@ MAX_CHI = 100.0
 MAX_VOLTAGE = 10.0  # electric.voltage, continuation.stop_voltage (a sphere's voltage peaks below 1)
 MAX_STRETCH = 100.0  # continuation.start_stretch, stop_stretch
 MIN_ASPECT, MAX_ASPECT = 0.1, 10.0  # geometry.aspect of a spheroid
+MIN_LENGTH, MAX_LENGTH = 0.1, 1000.0  # geometry.length of a tube (in reference radii)
 MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
 MAX_WIRE_GAP = 10.0
 MIN_TOLERANCE = 1e-15  # solver.tol, solver.max_error (below rounding no Newton step converges)
@@ -316,8 +342,7 @@ class Scene:
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
             **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
             **({"events": [e.to_table() for e in self.events]} if self.events else {}),
-            **({} if self.geometry == Geometry() else {"geometry": {"shape": self.geometry.shape.value,
-                                                                     "aspect": self.geometry.aspect}}),
+            **({} if self.geometry == Geometry() else {"geometry": self.geometry.to_table()}),
             **({} if self.dynamics == Dynamics() else {"dynamics": asdict(self.dynamics)}),
         }
 
@@ -330,8 +355,7 @@ class Scene:
         stop = f"stop_stretch {c.stop_stretch:g}"
         if c.parameter == ContinuationParameter.VOLTAGE:
             stop = "in the voltage" + ("" if c.stop_voltage is None else f" to {c.stop_voltage:g}")
-        g = self.geometry
-        shape = "" if g == Geometry() else f", {g.shape.value} of aspect {g.aspect:g}"
+        shape = "" if self.geometry == Geometry() else f", {self.geometry.describe()}"
         return (f"Scene({self.name!r}: {self.material.name}{shape}, {field}{voltage}, {self.loading.control.value} "
                 f"control, {stop})")
 
@@ -599,7 +623,11 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
-    geometry = _geometry(data.get("geometry", {}), field, electric)
+    geometry = _geometry(data.get("geometry", {}), field, electric, loading)
+    dynamics = _dynamics(data.get("dynamics", {}))
+    if geometry.shape == Shape.TUBE and dynamics.frequencies:
+        raise SceneError('dynamics.frequencies = true: the natural frequencies of a tube are not built yet; leave it '
+                         'false or use geometry.shape = "sphere"')
     return Scene(
         name=name,
         material=material,
@@ -614,7 +642,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         surface=_surface(data.get("surface", {})),
         events=events_from_list(data.get("events", [])),
         geometry=geometry,
-        dynamics=_dynamics(data.get("dynamics", {})),
+        dynamics=dynamics,
     )
 
 
@@ -733,16 +761,21 @@ def _electric(data) -> Electric:
     return Electric(get("voltage", lambda x: 0 <= x <= MAX_VOLTAGE, f"in [0, {MAX_VOLTAGE:g}]"))
 
 
-def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
-    """[geometry]: the shape, a spheroid's aspect; the parts of the model that are written for the sphere alone
-    (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a voltage) refuse
-    other shapes here."""
+def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
+    """[geometry]: the shape, a spheroid's aspect, a tube's length and ends; the parts of the model that are written
+    for the sphere alone (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a
+    voltage) refuse other shapes here."""
     data = table("geometry", data, _keys(Geometry))
     raw = data.get("shape")
     raw = Geometry.shape.value if raw is None else raw
     if raw not in tuple(Shape):
         raise SceneError(f"geometry.shape = {show(raw)}: must be one of " + ", ".join(f'"{s.value}"' for s in Shape))
     shape = Shape(raw)
+    for key in ("length", "ends"):
+        if shape != Shape.TUBE and data.get(key) is not None:
+            raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "tube"')
+    if shape == Shape.TUBE:
+        return _tube(data, field, electric, loading)
     if shape == Shape.SPHERE:
         if data.get("aspect") is not None and data["aspect"] != 1:
             raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (the '
@@ -764,6 +797,32 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
         raise SceneError(f"{where}: the [electric] term starts from the sphere held by its voltage, which has no "
                          'counterpart on another shape yet; leave [electric] out or use geometry.shape = "sphere"')
     return Geometry(shape, aspect)
+
+
+def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
+    """A tube's [geometry] (length, ends) and the parts of the model a tube does not have yet, refused one line each."""
+    if data.get("aspect") is not None:
+        raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a tube has '
+                         "geometry.length)")
+    if data.get("length") is None:
+        raise SceneError(f'geometry.length: missing; a tube needs its length in reference radii, in '
+                         f'[{MIN_LENGTH:g}, {MAX_LENGTH:g}]')
+    length = _getter(data, "geometry", Geometry)("length", lambda x: MIN_LENGTH <= x <= MAX_LENGTH,
+                                                  f"in [{MIN_LENGTH:g}, {MAX_LENGTH:g}]")
+    raw = Ends.SLIDING.value if data.get("ends") is None else data["ends"]
+    if raw not in tuple(Ends):
+        raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends))
+    where = 'geometry.shape = "tube"'
+    if field.coils:
+        raise SceneError(f"{where}: coils around a tube are not built yet; leave [field] coils out or use another "
+                         "shape")
+    if electric is not None:
+        raise SceneError(f"{where}: the [electric] term on a tube is not built yet; leave [electric] out or use "
+                         "another shape")
+    if loading.control != Control.PRESSURE:
+        raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
+                         'for now; allowed: "pressure"')
+    return Geometry(Shape.TUBE, length=length, ends=Ends(raw))
 
 
 def _parameter(data, electric: Electric | None):

@@ -1,0 +1,173 @@
+"""Ritz–Galerkin discretisation of a meridian over an interval without poles: a tube over its arclength S ∈ [0, L].
+
+The sibling of discretisation.py (Legendre in cos θ between two poles) for a meridian whose ends are not on the
+axis (codegen/meridian.py: R = 1, R' = 0, S' = 1, Z = −S). In x = 2S/L − 1 ∈ [−1, 1]
+
+    λ2(x) = Σ_{k=0}^{N} a_k P_k(x),      η(x) = −λ̄ (L/2) x + Σ_{k=0}^{N−2} b_k (P_{k+2} − P_k)(x),
+
+u = (a_0..a_N, λ̄, b_0..b_{N−2}) (2N + 1 unknowns). The bubbles P_{k+2} − P_k vanish at x = ±1, so η(±1) = ∓λ̄L/2:
+the ends are the planes Z = ±λ̄L/2, η fixed on each, their distance λ̄L an unknown (closed ends: its equation is the
+axial balance, the ends carrying the pressure on their faces). Sliding ends (planes of symmetry) leave the radius
+free there (ρ' = 0 is the natural end condition); plugged ends (rigid plugs of the reference radius) hold
+ρ(±1) = 1: λ2 = 1 + Σ_{k=0}^{N−2} a_k (P_{k+2} − P_k)(x), u = (a_0..a_{N−2}, λ̄, b) (2N − 1 unknowns). At a node
+
+    ρ = λ2 R = λ2,   v = λ2' R = (2/L) dλ2/dx,   w = η' = (2/L) dη/dx,
+
+and the energy E/(2π) = ∫_0^L π̂ dS = (L/2) Σ_q w_q π̂(x_q) by Gauss–Legendre quadrature (π̂ = Π/R, R = 1: the
+tube's kernels). The uniform tube (λ2 = λθ, η = −λz(S − L/2)) is exact in the basis: a_0 = λθ, λ̄ = λz, the rest 0.
+
+Mirror symmetry S → L − S (x → −x) in place of the sphere's equator symmetry: a state is mirror-symmetric when λ2
+is even and η odd in x, i.e. its a_odd and b_even vanish (P_{k+2} − P_k has the parity of k); the Hessian of a
+symmetric state splits into the even block (a_even, λ̄, b_odd) and the odd block (a_odd, b_even), whose first
+modes are the bulge modes cos(πS/L) (odd: a bulge at one end, a neck at the other) and cos(2πS/L) (even).
+
+The node arrays ``cos_theta`` and ``sin_theta`` hold the meridian's R' = 0 and R = 1 (the names of the sphere's
+node values, for galerkin/equilibrium.py and model/meridian.py: λ1 = sqrt((λ2 R' + v)² + w²)/S', the field at
+(λ2 R, η)); the tube's kernels take neither.
+"""
+import enum
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import legendre
+
+from .discretisation import gauss_nodes, legendre_table, read_only, symmetric_rows
+from ..generated import HESSIAN_PAIRS
+from ..scene.tables import Ends
+
+_HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)
+
+
+class Mirror(enum.StrEnum):
+    """A block of the second variation of a mirror-symmetric state (module docstring)."""
+
+    EVEN = "even"
+    ODD = "odd"
+
+
+@dataclass(frozen=True)
+class IntervalDiscretisation:
+    """Legendre ``degree`` N over a tube of ``length`` L (reference radii) with ``ends``, ``quadrature`` Gauss nodes
+    (0: the sphere's default rule at N, discretisation.gauss_nodes)."""
+
+    degree: int
+    length: float
+    quadrature: int = 0
+    ends: Ends = Ends.SLIDING
+
+    def __post_init__(self):
+        if self.degree < 2:
+            raise ValueError(f"an interval discretisation needs degree ≥ 2 (the bubbles of η), not {self.degree}")
+
+    @property
+    def hoops(self) -> int:
+        """The number of λ2's coefficients: N + 1 (sliding ends), N − 1 (plugged: bubbles about λ2 = 1)."""
+        return self.degree + 1 if self.ends == Ends.SLIDING else self.degree - 1
+
+    @property
+    def size(self) -> int:
+        return self.hoops + self.degree
+
+    @property
+    def axial_index(self) -> int:
+        """The position of λ̄ (the ends' distance over L) in u."""
+        return self.hoops
+
+    @property
+    def x(self) -> np.ndarray:
+        return _tables(self)["x"]
+
+    @property
+    def weights(self) -> np.ndarray:
+        """(L/2) w_q: the quadrature weights per dS."""
+        return _tables(self)["weights"]
+
+    @property
+    def cos_theta(self) -> np.ndarray:
+        """R' = 0 at the nodes (module docstring)."""
+        return _tables(self)["rate"]
+
+    @property
+    def sin_theta(self) -> np.ndarray:
+        """R = 1 at the nodes (module docstring)."""
+        return _tables(self)["radius"]
+
+    @property
+    def maps(self) -> np.ndarray:
+        """(4, n_q, size): the node values of (λ2, v, η, w) as linear maps of u (the state is T u)."""
+        return _tables(self)["maps"]
+
+    def node_state(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """(λ2, v, η, w) at the nodes, (4, n_q), into ``out`` if given (plugged ends: λ2's 1 added)."""
+        out = np.matmul(self.maps, u, out=out)
+        if self.ends == Ends.PLUGGED:
+            out[0] += 1.0
+        return out
+
+    def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k T_k[q] from ``pointwise`` (4, n_q): energy_gradient at the nodes."""
+        return np.einsum("kq,kqj->j", pointwise * self.weights, self.maps, out=out)
+
+    def hessian(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """∂²E/∂u² = Σ_kl T_kᵀ diag(W h_kl) T_l from ``pointwise`` (10, n_q): energy_hessian at the nodes, into the
+        leading columns of ``out`` if given (a bordered Jacobian's)."""
+        maps, weighted = self.maps, pointwise * self.weights
+        out = np.zeros((self.size, self.size)) if out is None else out
+        target = out[:, : self.size]
+        target[:] = 0.0
+        for k in range(4):
+            scaled = np.stack([weighted[_HESSIAN_ROW[k, l]] for l in range(4)])  # (4, n_q)
+            target += maps[k].T @ np.einsum("lq,lqj->qj", scaled, maps)
+        return out
+
+    def uniform(self, hoop: float, axial: float) -> np.ndarray:
+        """u of the uniform tube with sliding ends: λ2 = λθ, η = −λz(S − L/2)."""
+        if self.ends != Ends.SLIDING:
+            raise ValueError(f"a tube with {self.ends.value} ends is not uniform")
+        u = np.zeros(self.size)
+        u[0], u[self.axial_index] = hoop, axial
+        return u
+
+    def reference(self) -> np.ndarray:
+        """u of the unstressed tube (λ2 = 1, η = −(S − L/2))."""
+        u = np.zeros(self.size)
+        u[self.axial_index] = 1.0
+        if self.ends == Ends.SLIDING:
+            u[0] = 1.0
+        return u
+
+    def block(self, mirror: Mirror) -> np.ndarray:
+        """The indices into u of a mirror block (module docstring)."""
+        parity = 0 if mirror == Mirror.EVEN else 1
+        a = np.arange(parity, self.hoops, 2)
+        b = self.hoops + 1 + np.arange(1 - parity, self.degree - 1, 2)
+        return np.concatenate([a, [self.axial_index] if mirror == Mirror.EVEN else [], b]).astype(int)
+
+    def profile(self, u: np.ndarray, s: np.ndarray) -> tuple:
+        """(ρ, η) at reference arclengths s ∈ [0, L]."""
+        x = 2 * np.asarray(s, dtype=float) / self.length - 1
+        p, _ = legendre_table(x, self.degree)
+        n, k = self.degree, self.axial_index
+        bubbles = p[:, 2:] - p[:, : n - 1]
+        rho = p @ u[:k] if self.ends == Ends.SLIDING else 1.0 + bubbles @ u[:k]
+        return rho, -u[k] * self.length / 2 * x + bubbles @ u[k + 1:]
+
+
+@functools.lru_cache(maxsize=16)
+def _tables(disc: IntervalDiscretisation) -> dict:
+    """Nodes, weights per dS, the meridian's R' and R at the nodes and the state maps (read-only)."""
+    n, length = disc.degree, disc.length
+    x, w = legendre.leggauss(disc.quadrature or gauss_nodes(n))
+    p, dp = legendre_table(x, n)
+    bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
+    k = disc.axial_index
+    maps = np.zeros((4, x.size, disc.size))
+    hoop, rate = (p, dp) if disc.ends == Ends.SLIDING else (bubbles, slopes)
+    maps[0, :, :k], maps[1, :, :k] = hoop, 2 / length * rate
+    maps[2, :, k] = -length / 2 * x
+    maps[2, :, k + 1:] = bubbles
+    maps[3, :, k] = -1.0
+    maps[3, :, k + 1:] = 2 / length * slopes
+    tables = {"x": x, "weights": length / 2 * w, "rate": np.zeros_like(x), "radius": np.ones_like(x), "maps": maps}
+    return {name: read_only(table) for name, table in tables.items()}
