@@ -34,8 +34,8 @@ def azimuthal(branch) -> list:
 
 def location_degree(branch, s, scene) -> int:
     """The perturbation degree a point was located at: the larger of its bracketing points' assessment degrees (at
-    least stability.degree; in the norm |δx|², where the eigenvalues settle: below the degree that holds the state
-    next to the wire, ``point_degrees``, which the tests below check the location at as well)."""
+    least stability.degree; on the branch's wire map by default, below the degree in x that holds the state next
+    to the wire, which the tests below check the location at as well)."""
     degrees = assessed_degrees(branch)
     assert min(degrees[s.index: s.index + 2]) >= scene.stability.degree
     return max(degrees[s.index], degrees[s.index + 1])

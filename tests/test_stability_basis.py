@@ -149,12 +149,11 @@ def test_displacement_norm_converges_on_the_map_and_keeps_the_inertia(wire_point
     assert mapped.flags() == reference.flags() == unknowns.flags()
 
 
-def test_displacement_norm_takes_the_degree_its_eigenvalues_need(wire_point):
-    """In the norm |δx|² a mapped branch's points are assessed at the degree where their eigenvalues settle
-    (``stability.converged_assessment``): 45 to 67 on the map (measured), where the degree in x that holds the
-    state rises from 30 to 320 toward the wire (the map is coarser than x far from it: 67 against 30 on the first
-    points), and every stored eigenvalue of every block (three each, m = 0 and 1) agrees with an independent basis
-    (Legendre in x at degree 320) to 1e-8 · max(1, |μ|) at the first, middle and last points."""
+def test_default_assessment_on_the_map_agrees_with_an_independent_basis(wire_point):
+    """The defaults (norm |δx|², basis "mapped") assess each point of a mapped branch at the degree on its map that
+    holds the point (67 and 90, measured), where x needs 30 to 320 near the wire, and every stored eigenvalue of
+    every block (three each, m = 0 and 1) agrees with an independent basis (Legendre in x at degree 320) to
+    1e-8 · max(1, |μ|) at the first, middle and last points."""
     from balloon_cg.analysis.stability import assess_branch
     branch, _ = wire_point
     scene = branch.scene.with_overrides({"stability.norm": "displacement", "stability.basis": "mapped"},
@@ -164,7 +163,6 @@ def test_displacement_norm_takes_the_degree_its_eigenvalues_need(wire_point):
     degrees = np.array([a.degree for a in assessments])
     in_x = point_degrees(wire_point[0], 20)
     assert degrees.max() <= branch.disc.degree and (degrees < in_x)[in_x >= 100].all(), (degrees, in_x)
-    assert np.sum(degrees ** 3.0) < 0.5 * np.sum(in_x ** 3.0)  # the dense blocks' cost, ~N³
     eq = equilibrium_of(branch)
     for n in (0, len(degrees) // 2, len(degrees) - 1):
         X = branch.X[n]
@@ -172,4 +170,3 @@ def test_displacement_norm_takes_the_degree_its_eigenvalues_need(wire_point):
         for block, values in reference.blocks.items():
             stored = assessments[n].blocks[block]
             assert np.all(np.abs(stored - values) <= 1e-8 * np.maximum(1.0, np.abs(values))), (n, block, stored, values)
-

@@ -15,7 +15,7 @@ by value.
 Re-recorded with the default norm, after checking them against 94ce54e's (docs/numerics.md §4): tpom1 between the
 two coils at M = 0.001 and 0.002, whose free pear branch is now traced through other points on another wire map
 (its switch reads the critical mode of the mapped basis): every label and flag identical, every special point's P
-within 6e-12 relative; the raw coefficients and the eigenvalues at a point index compare other points. The paper
+within 2e-12 relative; the raw coefficients and the eigenvalues at a point index compare other points. The paper
 coil: every label and flag identical; its m1_free point next to the wire at P 1.80595332 (main's 1.80595334 carried
 its x-basis gap: the crossing eigenvalue there is −1.4e-8 in x at 400 and on the map); the m1_free eigenvalues of
 the primary's last points moved by up to 7.8e-8 (main's at x-degree 320, unconverged there; now the map's at 67);

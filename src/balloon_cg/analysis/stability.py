@@ -412,16 +412,8 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         return variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max)
 
     degrees = point_degrees(branch, degree)
-    if branch.scene.stability.norm == "displacement" and branch.disc.mapping is not None:
-        # near a wire: the degree the eigenvalues need, not the state's (``converged_assessment``)
-        resolution = Resolution.of(branch.scene.solver)
-        job = lambda n: converged_assessment(lambda N: assess(n, N), degree, resolution)  # noqa: E731
-        results = workers.spread(job, range(len(degrees)), [assessment_cost(N, m_max) for N in degrees], on_point,
-                                 here=(0,))
-        degrees = [a.degree for a in results]
-    else:
-        results = workers.spread(lambda job: assess(*job), list(enumerate(degrees)),
-                                 [assessment_cost(N, m_max) for N in degrees], on_point, here=first_of_each(degrees))
+    results = workers.spread(lambda job: assess(*job), list(enumerate(degrees)),
+                             [assessment_cost(N, m_max) for N in degrees], on_point, here=first_of_each(degrees))
     unsettled = []
     if check:
         folds = branch.fold_intervals
@@ -437,30 +429,6 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
                                              here=first_of_each(finer)))
         unsettled = [n for n in worth if checked[n] != flags[n]]
     return results, unsettled
-
-
-def converged_assessment(assess, start: int, resolution: Resolution) -> Assessment:
-    """The assessment of one point at the degree its eigenvalues need: ``assess(N)`` at N = ``start``, then up the
-    resolution's ladder (N → 1.5 N, at most solver.max_degree) until two successive degrees agree on every stored
-    eigenvalue of every block, |μ(N') − μ(N)| ≤ max_error · max(1, |μ|) (``eigenvalues_agree``), and the coarser
-    one returned: its error estimated by the finer (at max_degree: the last, which the flags check and
-    ``crossings.follow_modes`` judge as before). In
-    the norm |δx|² every block converges spectrally (docs/numerics.md §4), so the eigenvalues settle at a degree
-    set by their modes, typically far below the one that holds a state next to a wire."""
-    coarse = assess(start)
-    while coarse.degree < resolution.max_degree:
-        fine = assess(resolution.grow(coarse.degree))
-        if eigenvalues_agree(coarse, fine, resolution.max_error):
-            return coarse
-        coarse = fine
-    return coarse
-
-
-def eigenvalues_agree(coarse: Assessment, fine: Assessment, tolerance: float) -> bool:
-    """Whether every stored eigenvalue of every block agrees between two assessments of one point to
-    ``tolerance`` · max(1, |μ|)."""
-    return all(np.all(np.abs(fine.blocks[name] - values) <= tolerance * np.maximum(1.0, np.abs(fine.blocks[name])))
-               for name, values in coarse.blocks.items())
 
 
 def _worth_checking(flags: list, coarse: Assessment, n: int, near_zero: float) -> bool:
