@@ -339,23 +339,10 @@ def _trace_free(scene, picture: Picture, progress: Progress) -> None:
         pitchforks = free_pitchforks.classified(free)
     m0 = [s for s in free.branch_points() if s.m == 0]
     with picture.clock.step(Step.PEAR_BRANCHES):
-        for n, bp in pitchforks:
-            for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
-                if stopped(picture):
-                    return
-                name = f"{FREE_PRIMARY}_pear_{n}{suffix}"
-                branch = trace_pear(free, bp, sign, name, progress.ticker(Phase.PEAR))
-                if branch is None:
-                    picture.not_started.append((name, f"the first correction from branch point {n} of "
-                                                      f"{FREE_PRIMARY} along its mode did not converge"))
-                    continue
-                branch.parent = (FREE_PRIMARY, n)
-                branch.rejoins = _rejoin_point(branch, m0, n)
-                if branch.rejoins is not None:
-                    mark_rejoin(branch, free, m0[branch.rejoins])
-                picture.branches.append(branch)
-                if not _assess(branch, scene, False, progress, picture.clock):
-                    return
+        for n, _ in pitchforks:
+            if stopped(picture) or not pear_pair(scene, free, picture, n, progress, points=m0,
+                                                 prefix=f"{FREE_PRIMARY}_pear"):
+                return
 
 
 WHOLE_SPHERE_EVENTS = "the [[events]] are not located on branches traced on the whole sphere"
@@ -443,19 +430,21 @@ def _trace_pears(scene, primary: Branch, picture: Picture, progress: Progress):
 
 
 def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progress,
-              reached: set | None = None) -> bool:
-    """The pear branch from the pear branch point ``n`` of ``picture.branch_points`` (held: pear_<n>; free, in a
-    field: pear_free_<n>, traced with the translation free) and its mirror image: the reflection of the pear branch
-    in a scene invariant under z → −z (``mirror``: its Origin says how it was obtained), else traced; appended to
-    ``picture.branches`` (a branch that cannot start to ``picture.not_started``), each assessed.
-    The branch points where they rejoin are added to ``reached``. False when a signal (``numerics.interrupt``)
-    stopped the work."""
-    bp, reflect = picture.branch_points[n], mirror.reflectable(scene)
+              reached: set | None = None, points: list | None = None, prefix: str | None = None) -> bool:
+    """The pear branch from the pear branch point ``n`` of ``points`` (default ``picture.branch_points``, the
+    primary branch's) named <prefix>_<n> (default by its block, held: pear_<n>; free, in a field: pear_free_<n>,
+    traced with the translation free) and its mirror image: the reflection of the pear branch in a scene invariant
+    under z → −z (``mirror``: its Origin says how it was obtained), else traced; appended to ``picture.branches``
+    (a branch that cannot start to ``picture.not_started``), each assessed. The branch points where they rejoin
+    are added to ``reached``. False when a signal (``numerics.interrupt``) stopped the work."""
+    points = picture.branch_points if points is None else points
+    bp, reflect = points[n], mirror.reflectable(scene)
+    prefix = PEAR_NAMES[bp.block] if prefix is None else prefix
     pear, south_turns = None, []
     for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
         if interrupt.requested():
             return False
-        name = f"{PEAR_NAMES[bp.block]}_{n}{suffix}"
+        name = f"{prefix}_{n}{suffix}"
         origin = Origin.TRACED
         if sign < 0 and pear is not None:
             reflected = mirror.reflection(pear, south_turns, name)
@@ -465,17 +454,17 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
             origin = reflected
         branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR), south_turns=reflect)
         if branch is None:
-            picture.not_started.append((name, f"the first correction from branch point {n} along its mode "
-                                              "did not converge"))
+            picture.not_started.append((name, f"the first correction from branch point {n} of {primary.name} "
+                                              "along its mode did not converge"))
             continue
         south_turns = mirror.take_south_turns(branch)
         branch.origin = origin
         branch.parent = (primary.name, n)
-        branch.rejoins = _rejoin_point(branch, picture.branch_points, n)
+        branch.rejoins = _rejoin_point(branch, points, n)
         if branch.rejoins is not None:
             if reached is not None:
                 reached.add(branch.rejoins)
-            mark_rejoin(branch, primary, picture.branch_points[branch.rejoins])
+            mark_rejoin(branch, primary, points[branch.rejoins])
         picture.branches.append(branch)
         if interrupt.requested() or not _assess(branch, scene, False, progress, picture.clock):
             return False  # kept as traced, not assessed
