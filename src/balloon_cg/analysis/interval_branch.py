@@ -140,10 +140,15 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     special = sorted((s for s in special if disc.node_state(s.u)[0].max() <= limit),
                      key=lambda s: _position(system, reached, s))
     full, spectra = full[: len(path.points)], {block: values[: len(path.points)] for block, values in spectra.items()}
-    volume = np.array([2 * eq.volume(Y[:-1]) / geometry.length for Y in full])
+    volume = np.array([volume_ratio(eq, Y) for Y in full])
     lowest = {block: spectra[block][:, 0] for block in Mirror}
     return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
                           unstable_counts(eq, full), tuple(special), path.stop)
+
+
+def volume_ratio(eq: Equilibrium, Y: np.ndarray) -> float:
+    """V/V0 at Y = (u, P), V0 = πL the reference tube's (the volume per 2π: 2V/(2πL))."""
+    return 2 * eq.volume(Y[:-1]) / eq.disc.length
 
 
 def unstable_counts(eq: Equilibrium, points) -> dict:

@@ -17,7 +17,7 @@ itself one eigenvalue is zero, its sign rounding).
 """
 import numpy as np
 
-from .interval_branch import IntervalBranch, IntervalSpecial, IntervalStop, unstable_counts
+from .interval_branch import IntervalBranch, IntervalSpecial, IntervalStop, unstable_counts, volume_ratio
 from .problem import ParameterSystem, continuation_settings
 from .results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
@@ -34,7 +34,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     if point.kind != Kind.BP or point.block != Mirror.ODD:
         raise ValueError(f"a bulge branch starts at a branch point of the odd block, not at {point.kind} "
                          f"({point.block})")
-    disc, length = primary.disc, primary.disc.length
+    disc = primary.disc
     if disc.ends != Ends.SLIDING:
         raise ValueError(f"a bulge branch is switched on a tube with sliding ends, not {disc.ends.value}")
     eq = Equilibrium(scene, disc)
@@ -62,13 +62,10 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     start = continuation.Point(first.x, continuation.tangent(system, first.x, direction), first.iterations,
                                first.residual)
 
-    def volume(Y) -> float:
-        return 2 * eq.volume(Y[:-1]) / length  # V/V0, V0 = πL
-
     def stop(p):
         if bulge(p.X[:-1]) < 0:
             return Stop(IntervalStop.REJOINED, "the branch rejoined the mirror-symmetric states")
-        if stop_volume is not None and volume(p.X) > stop_volume:
+        if stop_volume is not None and volume_ratio(eq, p.X) > stop_volume:
             return Stop(IntervalStop.VOLUME, f"V/V0 passed stop_volume {stop_volume:g}")
         return None
 
@@ -82,4 +79,4 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                     for f in sorted(folds, key=lambda f: f.index))
     points = [X] + [p.X for p in path.points]
     return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
-                          np.array([volume(Y) for Y in points]), {}, unstable_counts(eq, points), special, path.stop)
+                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points), special, path.stop)
