@@ -170,3 +170,26 @@ def test_default_assessment_on_the_map_agrees_with_an_independent_basis(wire_poi
         for block, values in reference.blocks.items():
             stored = assessments[n].blocks[block]
             assert np.all(np.abs(stored - values) <= 1e-8 * np.maximum(1.0, np.abs(values))), (n, block, stored, values)
+
+
+def test_flags_are_checked_near_zero_by_the_convergence_of_the_defaults():
+    """A point's flags are checked at the check degree where a block's lowest eigenvalue is below ``near_zero``:
+    1e-4 on the defaults (every block converges spectrally there: the test above, and benchmarks/near_zero.py), 0.1
+    in the unknowns' norm or on the plain basis (m = 0 eigenvalues drifting with the degree). A point next to a
+    change of a flag and every tenth point are checked whatever their eigenvalues."""
+    from balloon_cg.analysis.stability import Assessment, NEAR_ZERO, _worth_checking, near_zero_of
+    defaults = load_scene("spom1_two_coils_M0.002").stability
+    assert near_zero_of(defaults) == NEAR_ZERO[True] == 1e-4
+    assert near_zero_of(replace(defaults, norm="unknowns")) == near_zero_of(replace(defaults, basis="legendre")) == 0.1
+
+    def point(lowest):
+        return Assessment({"even": np.array([lowest, 1.0, 2.0]), "m1_held": np.array([0.5, 1.0, 2.0])},
+                          *([True] * 6), 20)
+
+    flags = [(True,) * 6] * 4
+    assert not _worth_checking(flags, point(1e-3), 1, 1e-4)
+    assert _worth_checking(flags, point(-1e-5), 1, 1e-4)
+    assert _worth_checking(flags, point(1e-3), 1, 0.1)
+    assert _worth_checking(flags, point(1e-3), 0, 1e-4)  # every tenth point
+    changed = flags[:2] + [(False,) + (True,) * 5] + flags[3:]
+    assert _worth_checking(changed, point(1e-3), 1, 1e-4)  # next to a change

@@ -48,6 +48,13 @@ HELD, HELD_VOLUME, FREE, FREE_VOLUME, HELD_GAS, FREE_GAS = range(len(FLAGS))
 EVERY_FLAG = tuple(range(len(FLAGS)))
 HELD_FLAGS, FREE_FLAGS = (HELD, HELD_VOLUME, HELD_GAS), (FREE, FREE_VOLUME, FREE_GAS)
 CHECK_FACTOR = 2.0  # N-convergence is checked at CHECK_FACTOR·N
+# a point's flags are checked at the check degree where a block's lowest eigenvalue is below this in magnitude
+# (``near_zero``): 0.1 where eigenvalues are O(1) but the m = 0 blocks' are not converged in the degree (the
+# unknowns' norm: docs/numerics.md §4, or a plain basis on a mapped branch); on the defaults (|δx|², the wire map)
+# every block's lowest eigenvalue at a point's degree N was within 4.3e-9 of its value at the check degree at every
+# point the old rule checked (1496 blocks of the two-coil and paper-coil pictures, benchmarks/near_zero.py), so
+# 1e-4 keeps a margin of 2e4 over the error it guards against
+NEAR_ZERO = {True: 1e-4, False: 0.1}
 
 
 @dataclass
@@ -386,7 +393,7 @@ class Variations(dict):
 
 @limited_blas
 def assess_branch(branch, degree: int, symmetric: bool | None = None, check: bool = False,
-                  near_zero: float = 0.1, m_max: int = 0, on_point=None):
+                  near_zero: float | None = None, m_max: int = 0, on_point=None):
     """Assessments of every point and, with ``check``, the points whose flags change at the check degree.
     ``on_point()`` is called after each point's first assessment. A stop asked for by a signal
     (``numerics.interrupt``) raises ``interrupt.Interrupted`` at the next point: the assessment is abandoned. The
@@ -397,10 +404,11 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
     equilibrium near one). With ``check``, the degree then follows the modes: the bracketing points of every
     crossing a branch-point search reads are raised until its eigenvalue is resolved (``crossings.follow_modes``),
     and flags are checked at ``check_degree`` of each point's degree where a sign could change: points with a
-    lowest eigenvalue of magnitude below ``near_zero`` (eigenvalues are O(1) in the L2 normalisation), points
-    next to a change of a flag, and every tenth point.
+    lowest eigenvalue of magnitude below ``near_zero``, points
+    next to a change of a flag, and every tenth point (``near_zero``: by default ``near_zero_of`` the scene).
     """
     symmetric = branch.disc.symmetric if symmetric is None else symmetric
+    near_zero = near_zero_of(branch.scene.stability) if near_zero is None else near_zero
     variations = Variations(equilibrium_of(branch))
 
     def assess(n, N):
@@ -429,6 +437,12 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
                                              here=first_of_each(finer)))
         unsettled = [n for n in worth if checked[n] != flags[n]]
     return results, unsettled
+
+
+def near_zero_of(stability) -> float:
+    """The magnitude below which a lowest eigenvalue has its point's flags checked (``assess_branch``, NEAR_ZERO):
+    small where every block converges spectrally (the |δx|² norm on the wire-mapped basis), else 0.1."""
+    return NEAR_ZERO[stability.norm == "displacement" and stability.basis == "mapped"]
 
 
 def _worth_checking(flags: list, coarse: Assessment, n: int, near_zero: float) -> bool:
