@@ -9,6 +9,7 @@ import balloon_cg as bc
 from balloon_cg.app.cli import main
 from balloon_cg.io.curve_file import read_curve
 from balloon_cg.scene.materials import PRESETS
+from netcdf_groups import uncoordinated
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SPOM1 = SCENES / "spom1.toml"
@@ -177,6 +178,7 @@ def test_critical_alpha1_from_the_command_line(tmp_path, capsys):
         assert "alpha1" in ds.coords and ds.alpha1.dims == ("point",) and ds.pressure.alpha1.size == ds.sizes["point"]
         assert "α1" in ds.alpha1.attrs["long_name"] and ds.alpha1.attrs["units"] == "1"
         assert "units" not in ds.point.attrs
+    assert uncoordinated(out) == []  # special_points/state opened alone: special, unknown
 
 
 def test_critical_M_of_the_single_coil_scene(tmp_path, capsys):

@@ -49,6 +49,7 @@ from balloon_cg.io.sweep_file import read_sweep
 from balloon_cg.model.field import field_squared
 from balloon_cg.post.plotting import MODE_AMPLITUDE, plot
 from balloon_cg.scene import load_scene, shipped_scenes
+from netcdf_groups import uncoordinated
 
 ROOT = Path(__file__).resolve().parent.parent
 DEGREE = 14
@@ -252,7 +253,7 @@ def test_located_special_points_have_a_vanishing_frequency_in_their_block(spom1_
 
 def test_frequencies_are_stored_with_units_and_read_back(spom1_run):
     """frequencies/omega2_<block> (point, frequency) and special_omega2_<block> (special, frequency), units "1";
-    bc.load and to_xarray give them back as computed."""
+    bc.load and to_xarray give them back as computed; every group opens alone with its coordinates."""
     result, path = spom1_run
     primary = next(b for b in result.picture.branches if b.name == "primary")
     with h5py.File(path, "r") as f:
@@ -266,6 +267,7 @@ def test_frequencies_are_stored_with_units_and_read_back(spom1_run):
     assert stored["frequencies"].keys() == primary.frequencies.omega2.keys()
     frame = loaded.to_xarray("primary")
     assert frame["omega2_even"].dims == ("point", "frequency") and frame["omega2_even"].attrs["units"] == "1"
+    assert uncoordinated(path) == []  # frequencies/ opened alone: point, θ, special, frequency, component
     np.testing.assert_array_equal(frame["omega2_even"].values, primary.frequencies.omega2["even"])
     for block, values in primary.frequencies.omega2.items():
         np.testing.assert_array_equal(stored["frequencies"][block], values)

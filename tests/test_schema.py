@@ -6,11 +6,12 @@ import h5py
 import numpy as np
 import pytest
 
-from balloon_cg.io.run_file import FORMAT, read_run, write_run
+from balloon_cg.io.run_file import FORMAT, RunFileError, read_run, write_run
 from balloon_cg.io.schema import VARIABLES
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.post.plotting import plot
 from balloon_cg.scene import parse_scene
+from netcdf_groups import uncoordinated
 
 xr = pytest.importorskip("xarray")
 pytest.importorskip("h5netcdf")
@@ -47,6 +48,31 @@ def test_every_variable_has_named_dimensions_and_units(run_file):
         assert ds.rho.dims == ("point", "theta")
     with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary") as ds:
         assert ds.unknowns.dims == ("point", "unknown") and ds.theta.attrs["units"] == "rad"
+
+
+def test_every_group_opened_alone_carries_its_coordinates(run_file):
+    """``xr.open_dataset(f, group="branches/primary/profiles")`` (stability, special_points/state, …): the point
+    index and θ as coordinates, equal to the branch's own (issue 40: subgroups repeat their enclosing scales)."""
+    assert uncoordinated(run_file) == []
+    with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary/profiles") as ds, \
+            xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary") as branch:
+        assert ds.rho.dims == ("point", "theta") and ds.theta.attrs["units"] == "rad"
+        np.testing.assert_array_equal(ds.theta.values, branch.theta.values)
+        np.testing.assert_array_equal(ds.point.values, branch.point.values)
+        assert ds.rho.sel(theta=np.pi / 2, method="nearest").size == branch.sizes["point"]
+    with xr.open_dataset(run_file, engine="h5netcdf", group="branches/pear_0/special_points/state") as ds:
+        assert ds.unknowns.dims == ("special", "unknown") and list(ds.special.values) == list(range(ds.sizes["special"]))
+    assert set(read_run(run_file)["branches"]["primary"]["profiles"]) == {"lam1", "lam2", "rho", "eta"}
+
+
+def test_a_coordinate_that_does_not_repeat_its_own_is_refused(run_file, tmp_path):
+    """A subgroup's copy of θ that differs from the branch's: the reader names it (xarray would draw on it)."""
+    damaged = tmp_path / "damaged.h5"
+    damaged.write_bytes(Path(run_file).read_bytes())
+    with h5py.File(damaged, "r+") as f:
+        f["branches/primary/profiles/theta"][3] += 1e-3
+    with pytest.raises(RunFileError, match="profiles/theta does not repeat /branches/primary/theta"):
+        read_run(damaged)
 
 
 def test_kinds_read_as_strings(run_file):

@@ -26,6 +26,7 @@ from balloon_cg.scene import parse_scene
 from balloon_cg.surface.basis import EQUATOR, MIRROR_Y, SphericalBasis
 from balloon_cg.surface.embedding import displacement_coefficients
 from balloon_cg.surface.measures import MEASURES, measures
+from netcdf_groups import uncoordinated
 
 SCENE = '[material]\npreset = "neo-Hookean"\n[continuation]\nstop_stretch = 1.6\n'
 STRETCHES = np.linspace(1.1, 1.5, 5)
@@ -236,7 +237,8 @@ def test_xarray_opens_the_surface_group(run_path):
         assert ds.coefficients.dims == ("point", "coefficient") and ds.centroid.dims == ("point", "axis")
         assert ds.tilt.attrs["units"] == "degree" and ds.pressure.attrs["long_name"] == "pressure P"
     with xr.open_dataset(run_path, engine="h5netcdf", group="branches/m1_bp0/stability") as ds:
-        assert ds.lowest_held.dims == ("point", "eigenvalue")
+        assert ds.lowest_held.dims == ("point", "eigenvalue") and ds.point.size == ds.sizes["point"]
+    assert uncoordinated(run_path) == []  # stability, special_points/state of a surface branch opened alone
 
 
 DAMAGE = {

@@ -12,6 +12,7 @@ from balloon_cg.app.cli import main
 from balloon_cg.scene import SceneError, load_scene
 from balloon_cg.app.sweep import DASK_WORKER_CONFIG, SlowWorkersWarning, expand, run_sweep, scene_hash
 from balloon_cg.io.sweep_file import Store, SweepError, read_sweep, store_path
+from netcdf_groups import uncoordinated
 
 SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "spom1_single_coil.toml"
 SPECS = ["M=0:0.004:3"]
@@ -313,6 +314,7 @@ def test_every_group_of_a_sweep_file_opens_with_xarray(serial):
         with xr.open_dataset(path, engine="h5netcdf", group=group) as ds:
             if group.endswith("branches/primary"):
                 assert ds.pressure.dims == ("point",) and ds.unknowns.dims == ("point", "unknown")
+    assert uncoordinated(path) == []  # a member's profiles, stability, state opened alone: their coordinates
 
 
 @pytest.fixture(scope="module")

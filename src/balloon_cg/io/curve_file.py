@@ -35,7 +35,7 @@ import numpy as np
 from ..analysis.results import Kind
 from .hdf5 import atomic_file, checksummed, plain
 from .layout import FileError, carries_checksums, check_columns, check_sizes, reading, require_attrs, require_group
-from .run_file import check_special, legendre_poles, read_run, read_special, root_attrs, write_special
+from .run_file import check_coordinates, check_special, legendre_poles, read_run, read_special, root_attrs, write_special
 from .schema import attach_dimensions, describe_parameter, scale
 
 
@@ -77,7 +77,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         points = sorted(curve.merges + curve.meetings, key=lambda s: (s.index, s.X[-1]))
         special = group.create_group("special_points")
         write_special(special, [replace(s, X=curve.branch_X(s.X)[0]) for s in points], curve.n + 1,
-                      lambda X: legendre_poles(curve.disc, X), unknown)
+                      lambda X: legendre_poles(curve.disc, X))
         parameter_coordinate(special, curve.parameter, curve.second.key, [s.X[-1] for s in points],
                              special["special"])
     return path
@@ -119,6 +119,7 @@ def read_curve(path, name: str = "pear") -> dict:
         special = require_group(group, "special_points", where, CurveFileError)
         check_special(special, f"{where}: special_points", group["unknowns"].shape[1], CurveFileError,
                       {coordinate: ("float", 1)}, written=written)
+        check_coordinates(group, where, CurveFileError)
         data = {key: item[()] for key, item in group.items() if isinstance(item, h5py.Dataset) and key != coordinate}
         data["q"] = group[coordinate][()]
         data["attrs"] = {k: plain(v) for k, v in group.attrs.items()}

@@ -85,7 +85,7 @@ from ..surface.loads import LOADS
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
                      require_group)
-from .schema import FINITE, MODES, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, scale
+from .schema import FINITE, MODES, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, coordinates, scale
 
 FORMAT = "balloon-cg/5"
 READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
@@ -279,10 +279,9 @@ def _write_branch(group, branch, theta, first_label: int = 1):
     shapes = group.create_group("profiles")
     for name, data in profiles(branch.disc, branch.X, theta, branch.scene.geometry).items():
         checksummed(shapes, name, data, compression="gzip", shuffle=True)
-    attach_dimensions(shapes, {2: (point, theta_scale)})
+    attach_dimensions(shapes, {2: coordinates(shapes, point, theta_scale)})
     write_special(group.create_group("special_points"), branch.special, branch.X.shape[1],
-                  lambda X: legendre_poles(branch.disc, X), unknown, lambda X: parameter_columns(branch, X),
-                  first_label)
+                  lambda X: legendre_poles(branch.disc, X), lambda X: parameter_columns(branch, X), first_label)
     if branch.stability:
         _write_stability(group.create_group("stability"), branch, point)
     if branch.frequencies is not None:
@@ -360,7 +359,7 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     attach_dimensions(group, {**{name: (point, axis) for name in ("centroid", *LOADS) if name in columns},
                               1: (point,), 2: (point, coefficient)})
     write_special(group.create_group("special_points"), branch.special, rows.shape[1],
-                  lambda X: surface_poles(basis, X), None, lambda X: parameter_columns(branch, X), first_label,
+                  lambda X: surface_poles(basis, X), lambda X: parameter_columns(branch, X), first_label,
                   len(basis.symmetry))
     if branch.stability:
         _write_surface_stability(group.create_group("stability"), branch.stability, point)
@@ -379,6 +378,7 @@ def _write_surface_stability(group, lowest: dict, point) -> None:
     eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in columns.values()))
     for name, values in columns.items():
         checksummed(group, name, values)
+    (point,) = coordinates(group, point)
     attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
     group.attrs["unsettled_points"] = np.zeros(0, dtype=np.int64)
 
@@ -403,6 +403,7 @@ def _write_stability(group, branch, point):
     eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in lowest.values()))
     for name, values in lowest.items():
         checksummed(group, name, values)
+    (point,) = coordinates(group, point)
     attach_dimensions(group, {1: (point,), 2: (point, eigenvalue)})
     group.attrs["unsettled_points"] = np.asarray(branch.unsettled, dtype=np.int64)
 
@@ -411,6 +412,7 @@ def _write_frequencies(group, frequencies, point, theta):
     """Ω² per block (dynamics.frequencies.BranchFrequencies) and the degree per point; the special points' mode
     shapes where computed (on the branch's ``theta`` scale)."""
     group.attrs.update({"count": frequencies.count, "m_max": frequencies.m_max})
+    point, theta = coordinates(group, point, theta)
     frequency = scale(group, "frequency", frequencies.count)
     special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
     checksummed(group, "perturbation_degree", frequencies.degree)
@@ -464,11 +466,11 @@ def surface_poles(basis, X) -> dict:
             "eta_south": heights[:, 1] if len(X) else np.zeros(0)}
 
 
-def write_special(group, special: list, width: int, poles, unknown=None, parameters=None,
-                  first_label: int = 1, reflections: int | None = None) -> None:
+def write_special(group, special: list, width: int, poles, parameters=None, first_label: int = 1,
+                  reflections: int | None = None) -> None:
     """Special points (results.SpecialPoint) as columns; ``width`` the length of their X rows (unknowns, then
-    the parameter), ``poles(X)`` the POLES columns of the rows (``legendre_poles``, ``surface_poles``);
-    ``unknown``: the dimension scale of the X rows (default: a new one in ``group``); ``parameters(X)``: the
+    the parameter), ``poles(X)`` the POLES columns of the rows (``legendre_poles``, ``surface_poles``), in
+    state/unknowns along state's own ``special`` and ``unknown`` scales (it opens alone); ``parameters(X)``: the
     parameter columns of the rows (default pressure = the last unknown); ``label``: first_label, first_label + 1,
     … (unique in the file: ``write_branches``); ``reflections``: a surface branch's number of reflections, whose
     points' sectors go to state/sector (``sector_rows``; None: an axisymmetric branch, no sectors)."""
@@ -496,11 +498,12 @@ def write_special(group, special: list, width: int, poles, unknown=None, paramet
     attach_dimensions(group, {1: (special_scale,)})
     state = group.create_group("state")  # the 2-D rows apart: special_points stays a table of one row per point
     checksummed(state, "unknowns", X)
+    (special_scale,) = coordinates(state, special_scale)
     axes = {}
     if reflections is not None:
         checksummed(state, "sector", sector_rows(special, reflections))
         axes["sector"] = (special_scale, scale(state, "reflection", reflections))
-    attach_dimensions(state, axes | {2: (special_scale, unknown or scale(state, "unknown", width))})
+    attach_dimensions(state, axes | {2: (special_scale, scale(state, "unknown", width))})
 
 
 def sector_rows(special: list, reflections: int) -> np.ndarray:
@@ -620,6 +623,7 @@ def read_branches(parent, where, error=None, written: bool | None = None) -> dic
             check_surface_branch(branch, f"{where}: branch {name}", error, written)
         else:
             check_branch(branch, f"{where}: branch {name}", error, written)
+    check_coordinates(group, where, error)
     snaps = parent.get("snap_throughs")
     if snaps is not None:
         check_columns(snaps, f"{where}: snap_throughs", SNAP_COLUMNS, error)
@@ -671,7 +675,7 @@ def check_branch(group, where, error, written: bool = False) -> None:
     t = check_columns(group, where, {"theta": ("float", 1)}, error)
     check_columns(require_group(group, "profiles", where, error), f"{where}: profiles", PROFILES, error, rows=n)
     check_sizes(group["profiles"], f"{where}: profiles", error)
-    for name, item in group["profiles"].items():
+    for name, item in columns_of(group["profiles"]).items():
         if item.shape[1:] != (t,):
             raise error(f"{where}: profiles", f"dataset {name} has shape {item.shape}, expected ({n}, {t})")
     check_special(require_group(group, "special_points", where, error), f"{where}: special_points", width, error,
@@ -842,18 +846,39 @@ def _read_branch(group) -> dict:
     if "gauge" not in data["attrs"]:  # files before the free reading (issue 27)
         data["attrs"]["gauge"] = legacy_gauge(data["attrs"], field_acts)
     if "profiles" in group:
-        data["profiles"] = {name: item[()] for name, item in group["profiles"].items()}
+        data["profiles"] = {name: item[()] for name, item in columns_of(group["profiles"]).items()}
     sp = group["special_points"]
     data["special_points"] = read_special(sp, field_acts, data["attrs"].get("gauge"))
     data["special_unknowns"] = special_unknowns(sp)[()]
     if "stability" in group:
-        data["stability"] = {name: item[()] for name, item in group["stability"].items()}
+        data["stability"] = {name: item[()] for name, item in columns_of(group["stability"]).items()}
     if "frequencies" in group:
         for key, prefix in (("frequencies", OMEGA2), ("special_frequencies", SPECIAL_OMEGA2),
                             ("translation_omega2", "translation_"), ("modes", MODES)):
             data[key] = {name.removeprefix(prefix): item[()] for name, item in group["frequencies"].items()
                          if name.startswith(prefix)}
     return data
+
+
+def columns_of(group) -> dict:
+    """{name: dataset} of the datasets of ``group`` that are not its dimension scales (a subgroup's repeated
+    coordinates, ``schema.coordinates``, and its own index scales)."""
+    return {name: item for name, item in group.items() if isinstance(item, h5py.Dataset) and not item.is_scale}
+
+
+def check_coordinates(group, where, error) -> None:
+    """Every dimension scale below ``group`` that repeats one of an enclosing group's (``schema.coordinates``:
+    written since issue 40, absent before) holds the same values as that one."""
+    scales = []
+    group.visititems(lambda name, item: scales.append(item) if isinstance(item, h5py.Dataset) and item.is_scale
+                     else None)
+    for item in scales:
+        name, outer = item.name.rsplit("/", 1)[-1], item.parent.parent
+        while outer.name != group.parent.name and not isinstance(outer.get(name), h5py.Dataset):
+            outer = outer.parent
+        repeated = outer.get(name)
+        if isinstance(repeated, h5py.Dataset) and repeated.is_scale and not np.array_equal(repeated[()], item[()]):
+            raise error(where, f"dataset {item.name} does not repeat {repeated.name}, the coordinate it stands for")
 
 
 def _branch_order(group) -> list:

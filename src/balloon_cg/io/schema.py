@@ -5,7 +5,8 @@ field in I/(4π R0); their ``units`` attribute is "1" (dimensionless, CF convent
 scale (the tilt of a surface branch is in degrees). Indices, counts, flags and labels are not quantities: they
 have no ``units`` (``COUNT``). ``describe`` writes the attributes; ``attach_dimensions``
 makes ``point``, ``theta``, ``unknown``, ``coefficient``, ``axis`` and ``special`` HDF5 dimension scales
-(netCDF-4 dimensions, so xarray with h5netcdf names the axes) and attaches them.
+(netCDF-4 dimensions, so xarray with h5netcdf names the axes) and attaches them; ``coordinates`` repeats an
+enclosing group's scales in a subgroup, which then opens alone with its coordinates.
 """
 import h5py
 import numpy as np
@@ -153,6 +154,13 @@ def scale(group, name: str, length: int = 0, values=None):
     return dataset
 
 
+def coordinates(group, *dimensions) -> tuple:
+    """The dimension scales ``dimensions`` of an enclosing group repeated in ``group`` (same names and values), so
+    that ``group`` opened alone (``xarray.open_dataset(..., group=...)``, a netCDF-4 group) carries its coordinates;
+    returned in order, to attach its datasets to."""
+    return tuple(scale(group, d.name.rsplit("/", 1)[-1], values=d[()]) for d in dimensions)
+
+
 def attach_dimensions(group, axes: dict) -> None:
     """Attach to every dataset in ``group`` the scales of its axes (``axes``: {dataset name or ndim: (scale, …)},
     the name first) and describe it; the scales themselves are left alone."""
@@ -170,13 +178,21 @@ def attach_dimensions(group, axes: dict) -> None:
 FINITE = frozenset({"pressure", "voltage", "volume", "amount", "lam2_north", "lam2_south", "eta_north", "eta_south",
                     "lam1_equator", "lam2_equator", "residual", "unknowns", "coefficients", "centroid", "tilt",
                     "force", "torque", "theta", "lam1", "lam2", "rho", "eta", "q", "mode"})
-SCALE_ATTRIBUTES = ("CLASS", "NAME", "REFERENCE_LIST")  # HDF5 dimension scales (netCDF-4 dimensions)
+SCALE_ATTRIBUTES = ("CLASS", "NAME")  # HDF5 dimension scales (netCDF-4 dimensions); and REFERENCE_LIST (the
+#                                       datasets attached), but on a branch's theta (``stands_alone``)
+
+
+def stands_alone(scale) -> bool:
+    """Whether the dimension scale ``scale`` is a branch's θ: the coordinate of the branch's group, attached to no
+    dataset (its profiles and frequencies attach their own copies, ``coordinates``), so without REFERENCE_LIST."""
+    return scale.name.rsplit("/", 1)[-1] == "theta" and isinstance(scale.parent.get("profiles"), h5py.Group)
 
 
 def check_described(group, path, error) -> None:
     """Every dataset below ``group`` as ``describe``, ``scale`` and ``attach_dimensions`` write it, for a file
     written with checksums (io.layout.carries_checksums): checksummed where it can be (layout.can_checksum), a
-    dimension scale with its SCALE_ATTRIBUTES, every other dataset with DIMENSION_LIST, and each with long_name,
+    dimension scale with its SCALE_ATTRIBUTES and REFERENCE_LIST (a branch's θ none: ``stands_alone``), every other
+    dataset with DIMENSION_LIST, and each with long_name,
     description and, a quantity's (VARIABLES), units; ``error`` naming the dataset otherwise."""
     from .layout import can_checksum, naming
 
@@ -191,7 +207,8 @@ def check_described(group, path, error) -> None:
             is_scale = h5py.h5ds.is_scale(item.id)
             keys = set(item.attrs)
         units = (LOWEST if name.startswith("lowest_") else VARIABLES.get(name, (COUNT,)))[0]
-        needed = (SCALE_ATTRIBUTES if is_scale else ("DIMENSION_LIST",) if item.ndim else ()) + (
+        scale_needs = SCALE_ATTRIBUTES + (() if stands_alone(item) else ("REFERENCE_LIST",))
+        needed = (scale_needs if is_scale else ("DIMENSION_LIST",) if item.ndim else ()) + (
             "long_name", "description") + (("units",) if units else ())
         missing = [key for key in needed if key not in keys]
         if missing:
