@@ -14,6 +14,8 @@ from balloon_cg.io.run_file import STABILITY_FLAGS, read_run
 from balloon_cg.io.schema import describe
 from balloon_cg.post.plotting import KINDS, PlotError, plot
 from balloon_cg.post.quantities import postprocess
+from shared_pictures import two_coil_result
+from test_surface_store import basis, primary, run_path, scene, surface_branch  # noqa: F401 (fixtures)
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 PER_POINT_KINDS = ("shapes", "stresses", "field", "curvature")
@@ -126,6 +128,34 @@ def test_several_files_are_labelled_by_M(files):
     assert {t.get_text() for t in fig.axes[0].texts} >= {"1 EP", "2 EP"}  # special points: label and kind
     shapes = plot(list(files.values()), "shapes", points=[-1])
     assert any(text.startswith("M = 0.002: #") for text in legend_texts(shapes))
+
+
+def test_several_files_give_each_branch_kind_its_own_colour_family(tmp_path_factory, run_path):  # noqa: F811
+    """`plot A.h5 B.h5` with held pear, free pear and m = 1 branches (the two-coil picture; a file with a surface
+    branch): each kind in one hue family, a shade per file, no two legend entries of one colour, and every drawn
+    curve in its entry's colour (issue 40: they shared one colour per file)."""
+    from matplotlib.colors import rgb_to_hsv, to_hex, to_rgb
+
+    two_coils = two_coil_result(tmp_path_factory).save(tmp_path_factory.mktemp("families") / "two_coils.h5")
+    fig = plot([two_coils, run_path], "pressure-pole")  # run_path: a primary branch and an m = 1 branch
+    legend = fig.legends[0]
+    entries = {t.get_text(): to_hex(h.get_color()) for t, h in zip(legend.get_texts(), legend.legend_handles)
+               if t.get_text().startswith("M = ")}  # not the grey 'mirror-image branch' key
+    kinds = {label.rpartition(", ")[2] for label in entries}
+    assert {"primary", "pear", "free pear", "m = 1"} <= kinds, entries
+    assert len(set(entries.values())) == len(entries), entries  # no two entries share a colour
+    hue = {label: rgb_to_hsv(to_rgb(color))[0] for label, color in entries.items()}
+    by_kind = {kind: [hue[label] for label in entries if label.endswith(f", {kind}")] for kind in kinds}
+    primaries = [label for label in entries if label.endswith(", primary")]
+    assert len(primaries) == 2 and rgb_to_hsv(to_rgb(entries[primaries[0]]))[2] < rgb_to_hsv(
+        to_rgb(entries[primaries[1]]))[2]  # the first file the darker shade
+    for kind, hues in by_kind.items():
+        assert max(hues) - min(hues) < 0.05, (kind, hues)  # one family
+        for other, others in by_kind.items():
+            if other != kind:
+                assert min(abs(a - b) for a in hues for b in others) > 0.08, (kind, other, entries)
+    curves = {to_hex(line.get_color()) for line in fig.axes[0].get_lines() if len(line.get_xdata()) > 1}
+    assert curves == set(entries.values())  # a mirror image: its partner's colour, lighter (alpha)
 
 
 def test_stability_and_special_points(bifurcation_file):

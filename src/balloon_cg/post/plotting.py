@@ -11,7 +11,8 @@ branch of every file (or the one named); a branch curve whose ordinate is not th
 points of one branch per file (default: primary), or chosen ``Configuration`` s of several branches. One colour
 per drawn branch, labelled by M (branch attrs; a dielectric branch also by its fixed Φ̄ or P), plus the branch
 name when a file holds several; a mirror-image branch (``<name>_mirror``) takes its partner's colour, drawn
-thinner and lighter. Branch curves are solid where stable and dashed where unstable under the chosen stability
+thinner and lighter. Several files: a colour family per branch kind (primary, pear, free pear, m = 1, …) and a
+shade per file, so that kinds never share a colour (``family_colors``). Branch curves are solid where stable and dashed where unstable under the chosen stability
 ``Reading`` (default: the run's loading control, balloon held at its centre), named in the legend title; without
 stability data all solid, and the legend title says so. Titles name the material and the coils. Special points
 are marked and labelled with their label in the file and their kind ("2 LP", "3 pitchfork-super": ``labels``).
@@ -311,12 +312,43 @@ def branch_title(branch: "StoredBranch") -> str:
     return branch.name.replace("_", " ")
 
 
+def branch_kind(branch: "StoredBranch") -> str:
+    """What a branch is, for colour families and legends of several files: 'primary', 'pear', 'free pear'
+    (analysis.picture's pear_<n>, pear_free_<n> and their mirror images), 'm = 1' (a surface branch; 'whole
+    sphere' the primary branch of a field that is not axisymmetric), any other its name without indices."""
+    if branch.surface:
+        return f"m = {branch.m}" if branch.data["attrs"]["parent_branch"] else "whole sphere"
+    pear = re.fullmatch(r"pear(_free)?_\d+(_mirror)?", branch.name)
+    if pear:
+        return "free pear" if pear[1] else "pear"
+    return re.sub(r"(_\d+)*(_mirror)?$", "", branch.name).replace("_", " ")
+
+
+#: a matplotlib sequential colour map per branch kind (``branch_kind``); kinds not named take the spare ones in turn
+FAMILIES = {"primary": "Blues", "whole sphere": "Blues", "pear": "Oranges", "free pear": "Greens", "m = 1": "Purples",
+            "m = 2": "Reds"}
+SPARE_FAMILIES = ("Greys", "YlOrBr", "PuRd", "BuGn")
+SHADES = (0.9, 0.45)  # the darkest and the lightest shade of a family: the first file's and the last's
+
+
+def family_colors(kinds: list, files: int) -> dict:
+    """{(kind, file): colour}: each kind's family (FAMILIES, else the SPARE_FAMILIES in order), one shade per file
+    from the darkest to the lightest (SHADES; one file: the middle)."""
+    spare = iter(SPARE_FAMILIES * len(kinds))
+    maps = {kind: FAMILIES.get(kind) or next(spare) for kind in kinds}
+    shades = np.linspace(*SHADES, files) if files > 1 else [np.mean(SHADES)]
+    return {(kind, n): matplotlib.colors.to_hex(matplotlib.colormaps[maps[kind]](shade))
+            for kind in kinds for n, shade in enumerate(shades)}
+
+
 def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     """Set each branch's legend label and colour. One file: a colour per branch (a mirror image, or a surface
     branch's rotation by π, sharing its partner's), labelled 'M = …, <branch title>' (``branch_title``) when
     there are several, a surface branch 'm = 1 from 5' (the label of its parent point). Several files: a colour
-    per file, labelled 'M = …', with the scene name where two files share an M (its branches told apart by their
-    curves). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+    family per branch kind (``branch_kind``, ``family_colors``: primary blue, pear orange, free pear green, m = 1
+    purple, …), a shade per file, labelled 'M = …' and, where several kinds are drawn, the kind ('M = 0.002, free
+    pear'), with the scene name where two files share an M (branches of one kind told apart by their curves and
+    labelled points). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
 
     def key(b):
         return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
@@ -336,11 +368,18 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
         elif len(files) == 1 and len(files[id(b.run)]) > 1:
             label += f", {branch_title(b)}"
         b.label = label
+    if len(files) > 1:
+        kinds = list(dict.fromkeys(branch_kind(b) for b in branches))
+        colors = family_colors(kinds, len(files))
+        order = list(files)
+        for b in branches:
+            b.color = colors[branch_kind(b), order.index(id(b.run))]
+            b.label += f", {branch_kind(b)}" * (len(kinds) > 1)
+        return branches
     colors = {}
     for b in branches:
         partner = b.data["attrs"].get("reflection_of") or b.name if b.surface else b.name.removesuffix(MIRROR_SUFFIX)
-        key = (id(b.run), partner) if len(files) == 1 else id(b.run)
-        b.color = colors.setdefault(key, f"C{len(colors) % 10}")
+        b.color = colors.setdefault(partner, f"C{len(colors) % 10}")
     return branches
 
 
@@ -541,7 +580,7 @@ def _branch_legend(fig, axes, own, branches, extra=()):
     else:
         title = "stability not computed (all solid)"
     handles = {}
-    for b in branches:  # several files: one entry per file (its label)
+    for b in branches:  # several files: one entry per file and branch kind (its label)
         handles.setdefault(b.label, Line2D([], [], color=b.color, label=b.label, linewidth=0.9 if b.mirror else 1.4,
                                            alpha=0.55 if b.mirror else 1.0))
     handles = list(handles.values())
