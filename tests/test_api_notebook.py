@@ -2,6 +2,8 @@
 Jupyter kernel (nbclient): every paragraph a cell, no error, no terminal control codes in any output (progress and
 notices are plain text or widgets there), and results show as HTML tables. About 20 s (the run, a three-member sweep
 and the curve of critical α1), so it is in the default suite."""
+import re
+
 import pytest
 
 from test_api import example
@@ -20,21 +22,55 @@ def texts(output) -> list[str]:
     return found
 
 
-def test_the_documented_example_runs_as_a_notebook(tmp_path):
-    cells = [nbformat.v4.new_code_cell(block.strip()) for block in example().split("\n\n") if block.strip()]
-    cells += [nbformat.v4.new_code_cell(name) for name in ("result", "result.special_points", "sweep", "curve")]
-    notebook = nbformat.v4.new_notebook(cells=cells)
+def executed(sources: list[str], folder) -> nbformat.NotebookNode:
+    """A notebook of one cell per source, run in a fresh Jupyter kernel in ``folder``."""
+    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(source) for source in sources])
     client = nbclient.NotebookClient(notebook, timeout=600, kernel_name="python3",
-                                     resources={"metadata": {"path": str(tmp_path)}})
+                                     resources={"metadata": {"path": str(folder)}})
     client.execute()  # CellExecutionError on the first cell that raises
+    return notebook
+
+
+PHASE_LINE = re.compile(r"^\S+: [a-z -]+: \d+ points \[\d\d:\d\d\]$")  # a finished phase (app.progress)
+
+
+def test_the_documented_example_runs_as_a_notebook(tmp_path):
+    sources = [block.strip() for block in example().split("\n\n") if block.strip()]
+    notebook = executed(sources + ["result", "result.special_points", "sweep", "curve"], tmp_path)
     outputs = [output for cell in notebook.cells for output in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert not [text for o in outputs for text in texts(o) if ANSI in text or "\r" in text]
-    widgets = [o for o in outputs if "application/vnd.jupyter.widget-view+json" in o.get("data", {})]
-    assert len(widgets) >= 3  # the progress bars of the analysis' phases, as widgets
+    phases = [o["data"]["text/plain"] for o in outputs if o.output_type == "display_data"
+              and PHASE_LINE.match(o["data"].get("text/plain", ""))]
+    assert len(phases) >= 3  # the analysis' phases: each widget replaced by its finished line
     shown = {cell.source: cell.outputs[-1] for cell in notebook.cells[-4:]}
     for name in ("result", "result.special_points", "sweep", "curve"):
         html = shown[name]["data"]["text/html"]
         assert html.startswith("<p>") and "<table" in html, name
         assert "\n" not in shown[name]["data"]["text/plain"], name
     assert (tmp_path / "two_coils_sweep_M.h5").exists() and (tmp_path / "spom1.png").stat().st_size > 10_000
+
+
+SMALL = ("import balloon_cg as bc\nscene = bc.Scene.from_toml('spom1').with_overrides("
+         "{'continuation.stop_stretch': 2.0, 'surface.branches': 'none'})\nresult = bc.analyse(scene, progress=True)")
+
+
+def phase_outputs(notebook) -> tuple[list[str], list[str]]:
+    """(the display outputs', the stderr streams' lines) of the notebook's last cell."""
+    outputs = notebook.cells[-1].outputs
+    shown = [o["data"].get("text/plain", "") for o in outputs if o.output_type == "display_data"]
+    return shown, "".join(o.get("text", "") for o in outputs if o.get("name") == "stderr").splitlines()
+
+
+def test_progress_in_a_notebook_is_one_record_per_phase(tmp_path):
+    """With ipywidgets: a widget per phase, replaced in place by its finished line (a saved notebook shows each phase
+    once, never a stale '0 points' snapshot beside a stderr line); without (the kernel cannot import it): no
+    'IProgress not found' warning, no carriage returns or cursor codes, one notice and a line per finished phase."""
+    shown, stderr = phase_outputs(executed([SMALL], tmp_path))
+    phases = ("spom1: primary branch", "spom1: stability", "spom1: pear branches")
+    assert sorted(line.rsplit(": ", 1)[0] for line in shown) == sorted(phases), shown
+    assert all(PHASE_LINE.match(line) for line in shown) and stderr == [], (shown, stderr)
+    shown, stderr = phase_outputs(executed(["import sys\nsys.modules['ipywidgets'] = None", SMALL], tmp_path))
+    assert shown == [] and stderr[0].startswith("balloon-cg: progress as one line per finished phase"), stderr
+    assert sorted(line.rsplit(": ", 1)[0] for line in stderr[1:]) == sorted(phases), stderr
+    assert all(PHASE_LINE.match(line) for line in stderr[1:]), stderr

@@ -3,7 +3,7 @@ import io
 import re
 
 from balloon_cg.analysis.picture import Phase
-from balloon_cg.app.progress import ON_TERMINAL, PhaseBars
+from balloon_cg.app.progress import ON_TERMINAL, Display, PhaseBars
 
 
 class Terminal(io.StringIO):
@@ -51,6 +51,23 @@ def test_no_bars_into_a_pipe(monkeypatch):
         bars.tick(Phase.PRIMARY)
         bars.finish(Phase.PRIMARY, 1)
     assert pipe.getvalue() == ""
+
+
+def test_progress_asked_for_where_bars_garble_is_the_finished_lines(monkeypatch):
+    """progress=True into a stream that is no terminal (a log file; a notebook without ipywidgets, whose kernel is
+    tested in test_api_notebook.py): no live bar, no carriage return or cursor code, a line per finished phase
+    (the unfinished one at the end too), in the order they finish."""
+    log = io.StringIO()
+    monkeypatch.setattr("sys.stderr", log)
+    with PhaseBars("spom1", True) as bars:
+        assert bars.display == Display.LINES
+        bars.expect(Phase.STABILITY, 40)
+        for _ in range(40):
+            bars.tick(Phase.STABILITY)
+        bars.tick(Phase.PEAR)
+        bars.finish(Phase.STABILITY, 40)
+        bars.tick(Phase.PEAR)
+    assert log.getvalue() == "spom1: stability: 40 points [00:00]\nspom1: pear branches: 2 points [00:00]\n"
 
 
 def test_a_phase_with_a_known_total_shows_its_fraction_and_eta(monkeypatch):

@@ -726,25 +726,22 @@ def _say(args, text: str) -> None:
 
 def _primary(scene, args):
     """The primary branch ``critical`` starts from (None when a signal stopped it)."""
-    from tqdm.auto import tqdm
-
     from ..analysis.primary import trace_primary
     from ..numerics.interrupt import requested
-    from .progress import shown, tqdm_disable
+    from .progress import auto_tqdm, shown, tqdm_disable
 
-    with tqdm(desc="primary branch", unit=" points", disable=tqdm_disable(shown(args.quiet)), file=sys.stderr) as bar:
+    bar = auto_tqdm()(desc="primary branch", unit=" points", disable=tqdm_disable(shown(args.quiet)), file=sys.stderr)
+    with bar:
         branch = trace_primary(scene, progress=lambda point: bar.update())
     return None if requested() else branch
 
 
 def _curve_bar(args):
     """The progress bar of a two-parameter curve."""
-    from tqdm.auto import tqdm
+    from .progress import auto_tqdm, shown, tqdm_disable
 
-    from .progress import shown, tqdm_disable
-
-    return tqdm(desc=f"curve in {args.parameter}", unit=" points", disable=tqdm_disable(shown(args.quiet)),
-                file=sys.stderr)
+    return auto_tqdm()(desc=f"curve in {args.parameter}", unit=" points", disable=tqdm_disable(shown(args.quiet)),
+                       file=sys.stderr)
 
 
 def _pitchfork_curve(scene, args):

@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
 
 
 from ..analysis.picture import analyse
@@ -37,7 +36,7 @@ from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_s
                              store_path)
 from ..numerics import interrupt, workers
 from ..numerics.hygiene import worker_hygiene
-from .progress import tqdm_disable
+from .progress import auto_tqdm, tqdm_disable
 from ..scene import Scene, SceneError, parse_scene
 
 MODES = ("analysis", "no-pear", "primary-only")
@@ -294,8 +293,8 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
         todo = [m for m in members if m.index not in store.done]
         by_index = {m.index: m for m in members}
         try:
-            with tqdm(total=len(members), initial=len(store.done), desc="sweep", unit=" members",
-                      disable=tqdm_disable(progress), file=sys.stderr) as bar:
+            with auto_tqdm()(total=len(members), initial=len(store.done), desc="sweep", unit=" members",
+                             disable=tqdm_disable(progress), file=sys.stderr) as bar:
                 with contextlib.closing(_compute(todo, mode, workers, scheduler)) as outcomes:
                     for index, outcome in outcomes:
                         if isinstance(outcome, BaseException):

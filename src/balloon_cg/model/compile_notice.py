@@ -22,10 +22,12 @@ def compiled_before(module) -> bool:
 
 
 def watched() -> bool:
-    """stderr is a terminal, or this process is a Jupyter kernel (IPython's kernel app: how tqdm.auto tells a
-    notebook)."""
-    if sys.stderr.isatty():
-        return True
+    """stderr is a terminal, or this process is a Jupyter kernel (``jupyter_kernel``)."""
+    return sys.stderr.isatty() or jupyter_kernel()
+
+
+def jupyter_kernel() -> bool:
+    """Whether this process is a Jupyter kernel (IPython's kernel app: a notebook shows its stderr)."""
     ipython = sys.modules.get("IPython")
     shell = ipython.get_ipython() if ipython is not None else None
     return shell is not None and "IPKernelApp" in shell.config
