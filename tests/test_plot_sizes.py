@@ -17,7 +17,8 @@ WIDTHS = (3.5, 7.2)
 def sources(tmp_path_factory, run_path, voltage_file):  # noqa: F811
     """A file per kind: SPOM1 at M = 0 (its isola: special points, pear branches, normal forms, natural
     frequencies and mode shapes), two coils
-    (primary only, for the field), the α1 curve of pitchforks (phase), a surface branch, a voltage run."""
+    (primary only, for the field), the α1 curve of pitchforks (phase), a surface branch, a voltage run; and
+    ``cusp``, the Gent fold curve in Jm to its cusp (phase of a fold curve only)."""
     folder = tmp_path_factory.mktemp("sizes")
     spom1, coils, curve = folder / "spom1.h5", folder / "coils.h5", folder / "curve.h5"
     scene = load_scene("spom1").with_overrides({"surface.branches": "none", "dynamics.frequencies": True,
@@ -28,17 +29,21 @@ def sources(tmp_path_factory, run_path, voltage_file):  # noqa: F811
                  "--quiet"]) == 0
     assert main(["critical", str(folder / "spom1.toml"), "--parameter", "alpha1", "--stop-stretch", "3", "-o",
                  str(curve), "--quiet"]) == 0
+    assert main(["critical", "spom1", "--set", "material.preset=Gent", "--of", "LP", "--parameter",
+                 "material.parameters.Jm", "--direction", "-1", "-o", str(folder / "cusp.h5"), "--quiet"]) == 0
     files = {kind: spom1 for kind in KINDS} | {"field": coils, "phase": curve, "surface": run_path,
                                               "stretch-map": run_path}
-    return files | {"voltage-pole": voltage_file, "voltage-equator": voltage_file}
+    return files | {"voltage-pole": voltage_file, "voltage-equator": voltage_file, "cusp": folder / "cusp.h5"}
 
 
 @pytest.mark.parametrize("width", WIDTHS)
-@pytest.mark.parametrize("kind", list(KINDS))
+@pytest.mark.parametrize("kind", [*KINDS, "cusp"])  # cusp: phase of a fold curve
 def test_every_kind_fits_a_journal_width(kind, width, sources, drawn_texts):
+    """Every text inside the figure, each annotation of an Axes inside that Axes, no formula broken by wrapping (each
+    line's $ paired), no text over another or under a legend, no warning."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        fig = plot([sources[kind]], kind, width=width)
+        fig = plot([sources[kind]], "phase" if kind == "cusp" else kind, width=width)
         drawn_texts.clear()
         fig.canvas.draw()
     assert tuple(fig.get_size_inches())[0] == pytest.approx(width)
@@ -48,6 +53,14 @@ def test_every_kind_fits_a_journal_width(kind, width, sources, drawn_texts):
     for text, extent in zip(texts, extents):
         assert (extent.x0 >= box.x0 - 0.5 and extent.x1 <= box.x1 + 0.5 and extent.y0 >= box.y0 - 0.5
                 and extent.y1 <= box.y1 + 0.5), f"{kind} at {width} in: {text.get_text()!r} is cut off"
+        lines = text.get_text().replace(r"\$", "").splitlines()
+        assert all(line.count("$") % 2 == 0 for line in lines), f"{kind} at {width} in: {text.get_text()!r} broken"
+    for ax in fig.axes:
+        frame = ax.get_window_extent(renderer)
+        for text in (t for t in ax.texts if t in texts):
+            extent = text.get_window_extent(renderer)
+            assert (extent.x0 >= frame.x0 - 0.5 and extent.x1 <= frame.x1 + 0.5 and extent.y0 >= frame.y0 - 0.5
+                    and extent.y1 <= frame.y1 + 0.5), f"{kind} at {width} in: {text.get_text()!r} leaves its axes"
     for i, (a, box_a) in enumerate(zip(texts, extents)):
         for b, box_b in zip(texts[:i], extents[:i]):
             assert not box_a.overlaps(box_b), f"{kind} at {width} in: {a.get_text()!r} over {b.get_text()!r}"

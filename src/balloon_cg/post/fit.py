@@ -3,6 +3,7 @@ guessed: ``fit_titles`` wraps each panel title to the room it has and the figure
 ``fitted_legend`` gives a figure legend as many columns as fit across the figure (one column: its labels
 wrapped). Both need a figure with a renderer (``style.JournalFigure``: the Agg canvas).
 """
+import re
 import textwrap
 
 from matplotlib.text import Text
@@ -13,16 +14,28 @@ MIN_CHARS = 12  # the narrowest wrap tried, characters per line
 
 
 def wrap_to(text: Text, width: float, along: str = "width") -> None:
-    """Wrap ``text`` at spaces (each of its lines; none inside $…$ math) until it is at most ``width`` display
-    units long ``along`` its extent's width (or height: a rotated y label), or its lines are MIN_CHARS characters."""
+    """Wrap ``text`` at spaces (each of its lines; none inside $…$ math: ``wrapped``) until it is at most ``width``
+    display units long ``along`` its extent's width (or height: a rotated y label), or its lines are MIN_CHARS
+    characters."""
     renderer = text.figure.canvas.get_renderer()
     original = text.get_text()
     chars = max(map(len, original.splitlines()), default=0)
     while getattr(text.get_window_extent(renderer), along) > width and chars > MIN_CHARS:
         length = getattr(text.get_window_extent(renderer), along)
         chars = max(MIN_CHARS, min(chars - 1, int(chars * width / length)))
-        text.set_text("\n".join(textwrap.fill(line, chars, break_long_words=False)
-                                for line in original.splitlines()))
+        text.set_text(wrapped(original, chars))
+
+
+KEPT_SPACE = "\ue000"  # a private-use character: a space inside $…$ while wrapping (textwrap breaks ASCII spaces)
+
+
+def wrapped(text: str, chars: int) -> str:
+    """``text`` filled to ``chars`` characters a line (each of its lines; no word broken), never inside $…$ math
+    (mathtext is parsed line by line: a broken formula would be drawn as its source)."""
+    pieces = re.split(r"(?<!\\)(\$[^$]*(?<!\\)\$)", text)  # odd pieces: the formulas
+    kept = "".join(piece.replace(" ", KEPT_SPACE) if n % 2 else piece for n, piece in enumerate(pieces))
+    return "\n".join(textwrap.fill(line, chars, break_long_words=False)
+                     for line in kept.splitlines()).replace(KEPT_SPACE, " ")
 
 
 def fit_titles(fig) -> None:

@@ -1219,16 +1219,13 @@ def plot_phase(paths, axes=None) -> Figure:
                 region = "isola exists" if of == "BP" else f"snap-through ({of}: two folds)"
                 ax.fill(dense_q, dense_P, alpha=0.15, color=line.get_color(),  # closed at the start value q0
                         label=f"{region} (traced from {curve['attrs']['parameter']} = {curve['attrs']['q0']:g})")
-                ax.plot(critical, P_merge, "o", color=line.get_color())
-                ax.annotate(f"{'critical' if of == 'BP' else 'cusp'} {curve['attrs']['parameter']} = {critical:.6g}",
-                            (critical, P_merge), textcoords="offset points", xytext=(-10, 8), ha="right", fontsize=8)
+                ax.plot(critical, P_merge, "o", color=line.get_color(),  # its value in the legend: inside the figure
+                        label=f"{'critical' if of == 'BP' else 'cusp'} {curve['attrs']['parameter']} = {critical:.6g}")
             elif of != "BP":
                 open_folds.setdefault(of, []).append((q, P))  # one parameter: checked below
             for meeting in curve_meetings(curve):  # a fold curve crosses this pitchfork curve
-                ax.plot(meeting["q"], meeting["pressure"], "D", color=line.get_color(), markerfacecolor="none")
-                ax.annotate(f"{meeting['kind']} {curve['attrs']['parameter']} = {meeting['q']:.6g}",
-                            (meeting["q"], meeting["pressure"]), textcoords="offset points", xytext=(8, -12),
-                            fontsize=8)
+                ax.plot(meeting["q"], meeting["pressure"], "D", color=line.get_color(), markerfacecolor="none",
+                        label=f"{meeting['kind']} {curve['attrs']['parameter']} = {meeting['q']:.6g}")
     for of, folds in open_folds.items():
         _shade_between_folds(ax, of, folds)
     if len(parameters) > 1:  # one q axis
@@ -1237,14 +1234,24 @@ def plot_phase(paths, axes=None) -> Figure:
                         f"{len(parameters)}: {listed} (draw each parameter's files on their own)")
     [(parameter, _)] = parameters.values()
     ax.set_xlabel(PARAMETER_LABELS.get(parameter, parameter))
-    if kinds <= {"BP"}:
-        ax.set_ylabel(r"bifurcation pressure $P = \bar P R_0/(T_0\mu/2)$")
-        ax.set_title("pear-shaped pitchforks (the isola lies between the two)")
-    else:
-        ax.set_ylabel(r"pressure $P = \bar P R_0/(T_0\mu/2)$ at the pitchfork (BP) or fold (LP, LV, LN)")
-        ax.set_title("pitchforks and folds (snap-through between a fold curve's two branches)")
+    ylabel, title = phase_titles(kinds)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
     _legend(fig, [ax], own, "lower center")  # an own figure's under the panel, not over the curves
     return fig
+
+
+def phase_titles(kinds: set) -> tuple[str, str]:
+    """(y label, title) of a phase diagram of the curves of ``kinds`` (what they follow: BP, the pear pitchforks;
+    LP, LV, LN, folds), naming only what is drawn."""
+    folds = ", ".join(sorted(kinds - {"BP"}))
+    P = r"pressure $P = \bar P R_0/(T_0\mu/2)$"
+    if not folds:
+        return "bifurcation " + P, "pear-shaped pitchforks (the isola lies between the two)"
+    if "BP" not in kinds:
+        return f"{P} at the fold ({folds})", f"fold curve ({folds}): snap-through between its two branches"
+    return (f"{P} at the pitchfork (BP) or fold ({folds})",
+            "pitchforks and folds (snap-through between a fold curve's two branches)")
 
 
 def _shade_between_folds(ax, of: str, folds: list) -> None:
