@@ -138,6 +138,7 @@ class StopCode(enum.StrEnum):
     WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
     SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch
     REJOINED = "rejoined"  # a pear branch crossed back through the primary branch
+    CLOSED = "closed"  # a restarted branch came back to the point it was restarted from: a closed loop, traced once
     RESOLUTION = "resolution"  # the spectral error estimate exceeds max_error (the tracer refines)
     RESOLUTION_LIMIT = "resolution_limit"  # ... and the degree is at solver.max_degree
     REFINE_FAILED = "refine_failed"  # Newton failed on the refined basis

@@ -21,7 +21,9 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   the curve of pitchforks through it (``analysis.codim2.continue_branch_point``; its mode recomputed,
   ``pear_point``), as ``critical`` traces the held one.
 
-The branch is rebuilt from the file (``stored_branch``): its scene (the stored scene text), discretisation,
+A restarted leg stops where it crosses its known parent away from its own pitchfork (``rejoin_rule``) or comes
+back to where it started (``closing_rule``: a closed loop, traced once). The branch is rebuilt from the file
+(``stored_branch``): its scene (the stored scene text), discretisation,
 parameters, points and special points; ``with_settings`` sets keys of the scene that do not change the equations
 (stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch
 points (even, m ≥ 1) in a second parameter, switching at an even point, at an m ≥ 1 point of the other reading
@@ -172,18 +174,22 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
     system = tracer.system(disc.degree, params, disc.mapping)
     point = step_away(system, start, tracer.settings)
     upper = scene.continuation.stop_stretch
-    pear = branch.name not in ("primary", FREE_PRIMARY)  # a pear branch (pear_<n>, its mirror, broken_pear): stopped
-    #                                                       as run stops them
+    pear = is_pear(branch)  # stopped as run stops pear branches
 
-    def stop():  # a leg's own rule (a pear leg remembers its crossings of the parent)
+    def stop():  # a leg's own rule (a pear leg remembers its crossings of the parent; each leg its way round)
         if not pear:
-            return stop_rule(scene, upper)
-        return pear_stop_rule(scene) if start.parent is None else rejoin_rule(start, pear_stop_rule(scene))
+            return closing_rule(disc, point.X, stop_rule(scene, upper))
+        base = pear_stop_rule(scene) if start.parent is None else rejoin_rule(start, pear_stop_rule(scene))
+        return closing_rule(disc, point.X, base)
 
-    legs = [tracer.leg(replace(point, tangent=sign * point.tangent), params, stop(), progress, degree=disc.degree,
-                       mapping=disc.mapping, limits=range_limits(scene, upper)) for sign in (1.0, -1.0)]
+    def leg(sign):
+        return tracer.leg(replace(point, tangent=sign * point.tangent), params, stop(), progress, degree=disc.degree,
+                          mapping=disc.mapping, limits=range_limits(scene, upper))
+
+    up = leg(1.0)
+    down = None if up.stop.code == StopCode.CLOSED else leg(-1.0)  # closed: the loop is whole, traced once
     name = branch.name if branch.name == FREE_PRIMARY else "primary"
-    primary = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, labels=("up", "down"),
+    primary = with_events(assemble(tracer, params, name, up, down, t0, labels=("up", "down"),
                                    land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
     if start.parent is not None:  # through its pitchfork on the parent into the mirror image: the fold of P there
         #                             is that pitchfork (P is even in the pear amplitude), as run marks a rejoin
@@ -194,6 +200,50 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
                 mark_rejoin(primary, start.parent, bp)
     return (examine(scene, primary, Ticks(progress), pear=False, control=not pear) if start.assessed else
             Picture([primary]))
+
+
+def is_pear(branch: Branch) -> bool:
+    """Whether a stored branch is a pear branch (pear_<n>, its mirror image, broken_pear; or one of them restarted
+    and written as ``primary`` by ``continue``): another name than the primary branch's, or states without the
+    equator symmetry the scene's primary branch has."""
+    return branch.name not in ("primary", FREE_PRIMARY) or (
+        not branch.disc.symmetric and Tracer(branch.scene).symmetric)
+
+
+CLOSING_SHARE = 0.25  # the start lies within this share of a step's chord of it: the leg came back to it
+AWAY_STEPS = 3  # ... after having been farther from it than this many such chords
+
+
+def closing_rule(disc, X0, base):
+    """stop(disc, point) of a restarted leg that comes back to where it started (``X0`` on ``disc``): a closed
+    branch, the loop of an isola whose crossings of its parent are not known (a pear branch restarted from a file
+    that ``continue`` wrote) or an isolated loop, stops there with StopCode.CLOSED instead of going round to
+    max_points. Points compare by (λ2(0), λ2(π), η(0), η(π), p), the same on any discretisation the leg refines to:
+    the leg closes on the step whose chord passes within CLOSING_SHARE of its length of the start, once it has been
+    more than AWAY_STEPS chords away. Elsewhere ``base``."""
+    def signature(disc, X):
+        rows = disc.pole_rows()
+        return np.array([rows[name] @ X[:-1] for name in ("lam2_north", "lam2_south", "eta_north", "eta_south")]
+                        + [X[-1]])
+
+    origin = signature(disc, X0)
+    state = {"previous": None, "away": 0.0}
+
+    def stop(disc, point):
+        here = signature(disc, point.X)
+        previous, state["previous"] = state["previous"], here
+        if previous is not None:
+            chord = here - previous
+            length = float(np.linalg.norm(chord))
+            t = float(np.clip((origin - previous) @ chord / length ** 2, 0.0, 1.0)) if length > 0 else 0.0
+            gap = float(np.linalg.norm(previous + t * chord - origin))
+            if state["away"] > AWAY_STEPS * length and gap <= CLOSING_SHARE * length:
+                return Stop(StopCode.CLOSED, f"closed on itself: back at the point it was restarted from (P = "
+                                             f"{point.X[-1]:.6g})")
+        state["away"] = max(state["away"], float(np.linalg.norm(here - origin)))
+        return base(disc, point)
+
+    return stop
 
 
 def rejoin_rule(start: Labelled, base):
