@@ -40,7 +40,7 @@ def sources(tmp_path_factory, run_path, voltage_file):  # noqa: F811
 @pytest.mark.parametrize("kind", [*KINDS, "cusp"])  # cusp: phase of a fold curve
 def test_every_kind_fits_a_journal_width(kind, width, sources, drawn_texts):
     """Every text inside the figure, each annotation of an Axes inside that Axes, no formula broken by wrapping (each
-    line's $ paired), no text over another or under a legend, no warning."""
+    line's $ paired), no text over another or under a legend, every colour bar labelled, no warning."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         fig = plot([sources[kind]], "phase" if kind == "cusp" else kind, width=width)
@@ -55,6 +55,10 @@ def test_every_kind_fits_a_journal_width(kind, width, sources, drawn_texts):
                 and extent.y1 <= box.y1 + 0.5), f"{kind} at {width} in: {text.get_text()!r} is cut off"
         lines = text.get_text().replace(r"\$", "").splitlines()
         assert all(line.count("$") % 2 == 0 for line in lines), f"{kind} at {width} in: {text.get_text()!r} broken"
+    bars = [ax for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    assert len(bars) == 2 * (kind == "stretch-map")  # λ1 and λ2
+    for ax in bars:  # every colour bar says what its colours are
+        assert (ax.get_ylabel() or ax.get_xlabel()).strip(), f"{kind} at {width} in: a colour bar without label"
     for ax in fig.axes:
         frame = ax.get_window_extent(renderer)
         for text in (t for t in ax.texts if t in texts):
