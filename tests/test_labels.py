@@ -81,3 +81,22 @@ def test_every_marker_is_numbered_with_a_label_continue_takes(two_coils, tmp_pat
         assert parent["kind"] == "BP" and parent["block"] in ("odd_held", "odd_free")
     for number in labels:  # continue finds each (restarting from them: tests/test_restart.py)
         assert find_label(run, number).point.kind.value == labels[number]["kind"]
+
+
+@pytest.mark.parametrize("width", (3.5, 7.2))
+@pytest.mark.parametrize("kind", ("pressure-pole", "shapes"))
+def test_a_legend_in_the_callers_axes_hides_no_curve_and_no_label(two_coils, kind, width):
+    """Drawn into the caller's own Axes (issue 40: at one column the shapes legend lay over the outlines and out of
+    the Axes): the legend covers no vertex of a curve and no text of the Axes, and stays inside the figure."""
+    with journal_style():
+        fig = JournalFigure(figsize=(width, 0.7 * width), layout="constrained")
+        ax = fig.add_subplot()
+        bc.plot(two_coils, kind, ax=ax)
+        fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_legend().get_window_extent(renderer)
+    assert frame.x0 >= fig.bbox.x0 and frame.x1 <= fig.bbox.x1 and frame.y0 >= fig.bbox.y0
+    for line in ax.get_lines():
+        x, y = ax.transData.transform(np.column_stack([line.get_xdata(), line.get_ydata()]).astype(float)).T
+        assert not ((x > frame.x0) & (x < frame.x1) & (y > frame.y0) & (y < frame.y1)).any(), line.get_label()
+    assert not [t.get_text() for t in ax.texts if frame.overlaps(t.get_window_extent(renderer))]
