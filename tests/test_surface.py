@@ -397,7 +397,7 @@ def test_the_off_equator_held_m1_branch_tends_to_the_turned_pear_as_M_vanishes(s
     second moments. At P = 2.258 and 2.2565 the branch's point is continued in M at fixed P (halving from M = 4e-4,
     secant predictor) to 3.125e-6; the deviation from the axisymmetric pear solved at the same P (Galerkin,
     point-solved from the M = 0 pear branch) is linear in M (dV/M → −34.8), and its quadratic fit through the three
-    smallest M has an intercept ≤ 1e-9 in every invariant (measured ≤ 2.1e-10). ~30 s on a loaded 2-core machine."""
+    smallest M has an intercept ≤ 1e-9 in every invariant (measured ≤ 2.1e-10). 30–60 s on a loaded 2-core machine."""
     from balloon_cg.analysis import surface_branches
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.problem import equilibrium_of
