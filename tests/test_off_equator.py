@@ -3,6 +3,8 @@ branch has no equator symmetry; every stability change under every control mode 
 BP: ``analysis.control_points``), its m = 1 crossings are located as on symmetric branches, and what is still not
 searched is said in the verdict line; the pear branch the broken symmetry disconnects is found by continuation in
 the coil height from 0. With the coil back at h = 0 the symmetric analysis runs as before."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -172,3 +174,17 @@ def test_critical_follows_a_fold_of_the_off_equator_coil_and_its_help_says_so(tm
     text = " ".join(capsys.readouterr().out.split()).replace("- ", "-")  # argparse wraps after a hyphen
     assert "--of BP: not equator-symmetric" in text and "with --of BP equator-symmetric" in text
     assert "the fold curve ends in a cusp" in text
+
+
+@pytest.mark.parametrize("path", sorted((Path(__file__).parent.parent / "scenes").glob("*.toml")), ids=lambda p: p.stem)
+def test_no_shipped_scene_leaves_branch_points_unsearched_with_every_branch_asked_for(path):
+    """Issue 41: every shipped scene under ``[surface] branches = "all"`` (up to λ2(0) = 1.3, below every branch
+    point: what is searched follows from the scene's field and events, not from how far it is traced) has no
+    not_searched entry and a complete verdict. The off-equator scene's is the slow test of test_free_balloon."""
+    from balloon_cg.scene import load_scene
+
+    scene = load_scene(path).with_overrides({"surface.branches": "all", "continuation.stop_stretch": 1.3},
+                                            name=path.stem)
+    picture = analyse(scene)
+    assert picture.not_searched == "" and not failing(picture.incomplete)
+    assert Gap.NOT_SEARCHED not in {item.gap for item in picture.incomplete}

@@ -290,7 +290,10 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
     """Pseudo-arclength continuation in P from ``first`` (after the stored ``points``) until a stop of ``_stop_rule``
     (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch); a point whose tail exceeds
     solver.max_error refines the basis (the wire map re-centred on the state, then the degree and the order
-    extended), the last point is solved again there and the trace goes on. Returns (the last trace, the segments
+    extended), the last point is solved again there on the hyperplane through it normal to its tangent (at fixed P
+    the bordered Jacobian is near-singular where the branch is tangent to P = const: the free m = 1 branch of the
+    off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest singular value
+    1.3e-6 at fixed P, 1.0e-3 on that hyperplane) and the trace goes on. Returns (the last trace, the segments
     [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop)."""
     scene = trace.scene
     segments, folds = [(trace, list(points))], []
@@ -318,17 +321,17 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
             return trace, segments, folds, stop
         new = trace.on(finer)
         last = segments[-1][1].pop()  # solved again on the finer basis: the first point of the next segment
-        fixed = np.eye(new.gauge.size + 1)[-1]
-        X = newton(new.system.residual, new.system.jacobian, trace.move(last.X, new), fixed, last.X[-1],
-                   scene.solver.tol, scene.solver.max_newton)
+        moved, reference = trace.move(last.X, new), trace.move_direction(last.tangent, new)
+        across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
+        X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
+                   scene.solver.max_newton)
         if not X.converged:
             segments[-1][1].append(last)
             stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
                                                 f"{finer.order}): {X.message}")
             return trace, segments, folds, stop
-        reference = trace.move_direction(last.tangent, new)
-        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, fixed), X.iterations,
-                                   X.residual)
+        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
+                                   X.iterations, X.residual)
         if rejoin is not None:
             rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
         trace = new
