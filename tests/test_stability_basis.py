@@ -193,3 +193,29 @@ def test_flags_are_checked_near_zero_by_the_convergence_of_the_defaults():
     assert _worth_checking(flags, point(1e-3), 0, 1e-4)  # every tenth point
     changed = flags[:2] + [(False,) + (True,) * 5] + flags[3:]
     assert _worth_checking(changed, point(1e-3), 1, 1e-4)  # next to a change
+
+
+@pytest.mark.parametrize("symmetric, degree", [(True, 90), (False, 160)])
+def test_the_readings_of_one_index_set_share_its_reduction(wire_point, symmetric, degree):
+    """The pressure, volume and gas blocks of one index set share A = L⁻¹HL⁻ᵀ (``_axisymmetric``: the volume block
+    A on (L⁻¹g)ᵀy = 0, the gas block A + (P/Ṽ)(L⁻¹g)(L⁻¹g)ᵀ): at the last two-coil point before the wire, in the
+    equator-symmetric and the general layouts, every block's lowest eigenvalues equal those of its own pencil
+    reduced alone (H + (P/Ṽ) g gᵀ under gas control, the constraint gᵀc = 0 under volume control) to
+    1e-10 · max(1, |μ|)."""
+    from balloon_cg.analysis.stability import LOWEST, merged_lowest
+    from balloon_cg.numerics import eigen
+
+    branch, _ = wire_point
+    X, eq = branch.X[-1], equilibrium_of(branch)
+    defaults = branch.scene.with_overrides({"stability.norm": "displacement"}, name=branch.scene.name)
+    variation = SecondVariation(type(eq)(defaults, eq.disc), degree, "mapped")
+    u, params = X[:-1], branch.params_at(X)
+    shared = {name: merged_lowest(parts, LOWEST) for name, parts, _ in variation._axisymmetric(u, params, symmetric)}
+    H, g = variation._even_matrices(u, params) if symmetric else variation.matrices(u, params)
+    H_gas = H + params.P / eq.volume(u) * np.outer(g, g)
+    plan = variation._plan(symmetric, True)
+    assert {e[0] for e in plan} == set(shared) and sum(e[1] or e[3] for e in plan) >= 2
+    for name, gas, idx, constrained, factor, _ in plan:
+        alone = eigen.lowest_of(eigen.restricted(H_gas if gas else H, factor,
+                                                 g[idx] if constrained else eigen.NO_CONSTRAINT, idx), LOWEST)
+        assert np.all(np.abs(shared[name] - alone) <= 1e-10 * np.maximum(1.0, np.abs(alone))), (name, shared[name], alone)

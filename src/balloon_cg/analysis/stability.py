@@ -218,15 +218,29 @@ class SecondVariation:
         return out
 
     def _axisymmetric(self, u, params: Parameters, symmetric: bool, names=None) -> list:
-        """``blocks`` of the m = 0 plan (``_plan``; only those named in ``names``, if given)."""
+        """``blocks`` of the m = 0 plan (``_plan``; only those named in ``names``, if given). The blocks of one index
+        set share its reduction A = L⁻¹HL⁻ᵀ (one dsygst instead of three): volume control is A on (L⁻¹g)ᵀy = 0 (its
+        reflections), gas control A + (P/Ṽ)(L⁻¹g)(L⁻¹g)ᵀ; each block's matrix is its own array (the eigensolves
+        overwrite them)."""
         half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
         H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
-        H_gas = self._gas(H, g, u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
-        matrices = (H, H_gas)
-        return [(name, (eigen.restricted(matrices[gas], factor, g[idx] if constrained else eigen.NO_CONSTRAINT, idx),),
-                 flags) for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on)
-                if names is None or name in names]
+        weight = params.P / self.eq.volume(u)
+        reduced = {}  # per index set: A = L⁻¹HL⁻ᵀ and the row L⁻¹g, shared by its pressure, volume and gas blocks
+        out = []
+        for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on):
+            if names is not None and name not in names:
+                continue
+            if id(idx) not in reduced:
+                reduced[id(idx)] = (eigen.restricted(H, factor, eigen.NO_CONSTRAINT, idx),
+                                    factor.directions(g[idx][None, :]))
+            A, row = reduced[id(idx)]
+            if constrained:  # A on (L⁻¹g)ᵀy = 0
+                A = eigen.restricted(A, eigen.GramFactor(np.ones(idx.size), orthogonal=True), row)
+            elif gas:  # L⁻¹(H + (P/Ṽ) g gᵀ)L⁻ᵀ
+                A = A + weight * np.outer(row[0], row[0])
+            out.append((name, (A,), flags))
+        return out
 
     def _gas(self, H, g, u, params: Parameters) -> np.ndarray:
         """The Hessian under gas control, H + (P/Ṽ) g gᵀ (module docstring)."""

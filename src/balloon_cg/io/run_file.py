@@ -412,7 +412,7 @@ def _write_frequencies(group, frequencies, point, theta):
     """Ω² per block (dynamics.frequencies.BranchFrequencies) and the degree per point; the special points' mode
     shapes where computed (on the branch's ``theta`` scale)."""
     group.attrs.update({"count": frequencies.count, "m_max": frequencies.m_max})
-    point, theta = coordinates(group, point, theta)
+    point, *theta = coordinates(group, point, *([theta] if frequencies.modes is not None else []))  # θ: the modes'
     frequency = scale(group, "frequency", frequencies.count)
     special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
     checksummed(group, "perturbation_degree", frequencies.degree)
@@ -427,7 +427,7 @@ def _write_frequencies(group, frequencies, point, theta):
         component = scale(group, "component", next(iter(frequencies.modes.values())).shape[2])
         for block, shapes in frequencies.modes.items():
             checksummed(group, f"{MODES}{block}", shapes, compression="gzip", shuffle=True)
-            axes[f"{MODES}{block}"] = (special, frequency, component, theta)
+            axes[f"{MODES}{block}"] = (special, frequency, component, *theta)
     attach_dimensions(group, axes)
 
 
