@@ -12,7 +12,7 @@ Collisions: two `run`s on one output, the second started 0-20 ms after the first
 write it; the other must exit 2 with "in use by PID"; a "lost result" is both exiting 0.
 
 Run: python benchmarks/crash_soak.py [KILLS [COLLISIONS]]  (default 200 and 20; output also in
-benchmarks/results/crash_soak.txt; the test suite runs the same code with 20 kills and 3 collisions:
+benchmarks/results/crash_soak.txt; the test suite runs the same code with 6 kills (20 under -m slow) and 3 collisions:
 tests/test_crash.py)
 """
 import hashlib
