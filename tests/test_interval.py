@@ -1,4 +1,4 @@
-"""The tube over an interval (galerkin/interval.py, analysis/interval_branch.py) against the energy written here and
+"""The tube over an interval (galerkin/interval.py, tube/primary.py) against the energy written here and
 the uniform closed tube of model/tube.py (the oracle: its closed-end path, pressure maximum and bulge onset).
 
 A tube of radius 1 and length L over its arclength S, meridian downwards (Z = −S): per 2π its energy is
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from numpy.polynomial import legendre
 
-from balloon_cg.analysis.interval_branch import primary_branch
+from balloon_cg.tube.primary import primary_branch
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
@@ -196,7 +196,7 @@ def test_bulge_branch_from_the_onset_through_its_volume_fold():
     under volume control one unstable direction up to the fold and stable beyond it (the plateau). Near the fold
     the state solves the continuous problem: the first integral H (written here) is constant along the tube to
     1e-6 (measured 4e-8 at degree 40)."""
-    from balloon_cg.analysis.interval_bulge import bulge_branch
+    from balloon_cg.tube.bulge import bulge_branch
 
     folds = []
     for degree in (30, 40):
@@ -316,7 +316,7 @@ def test_bulge_propagates_at_maxwells_pressure():
     1.2e-9 at V/V0 = 415), the same P(V) at degree 140 within 1e-7 (measured 2.3e-8: the pressure converges
     although the steep front is not resolved pointwise, the first integral varying along the tube by 6–16 % at
     degree 100: docs/shapes.md), and under volume control the plateau is stable."""
-    from balloon_cg.analysis.interval_bulge import bulge_branch
+    from balloon_cg.tube.bulge import bulge_branch
 
     curves = {}
     for degree in (100, 140):

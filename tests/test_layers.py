@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "balloon_cg"
-LAYERS = ("scene", "model", "numerics", "galerkin", "surface", "analysis", "dynamics", "io", "post", "app")
+LAYERS = ("scene", "model", "numerics", "galerkin", "surface", "analysis", "tube", "dynamics", "io", "post", "app")
 ALLOWED = {layer: set(LAYERS[: i + 1]) | {"generated"} for i, layer in enumerate(LAYERS)}
 ALLOWED["numerics"] = {"numerics"}  # balloon-free
 # the on-demand kernel cache is the one runtime module that runs the generator (balloon_cg.codegen, with SymPy)

@@ -39,7 +39,13 @@ def sign_changes(assessments, block: str) -> list[tuple[int, int]]:
     (none when the assessments do not hold the block)."""
     if not assessments or block not in assessments[0].blocks:
         return []
-    negative = [int(np.sum(a.blocks[block] < 0)) for a in assessments]
+    return count_changes([int(np.sum(a.blocks[block] < 0)) for a in assessments])
+
+
+def count_changes(negative) -> list[tuple[int, int]]:
+    """(n, k) for every eigenvalue μ_k (ascending, from 0) that changes sign between points n and n + 1, from the
+    number of negative eigenvalues at each point (``negative``): k runs over min(a, b)..max(a, b) − 1 where it goes
+    from a to b."""
     return [(n, k) for n in range(len(negative) - 1)
             for k in range(min(negative[n], negative[n + 1]), max(negative[n], negative[n + 1]))]
 

@@ -131,7 +131,7 @@ class Equilibrium:
             if scene.geometry.shape == Shape.TUBE:
                 raise SceneError('geometry.shape = "tube": this command is not built for a tube yet (run, solve, '
                                  'sweep, critical and continue trace spheres and spheroids); a tube\'s uniform branch '
-                                 'and bulge onset: balloon_cg.analysis.interval_branch.primary_branch (docs/shapes.md)')
+                                 'and bulge onset: balloon_cg.tube.primary.primary_branch (docs/shapes.md)')
             raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")
         self.scene = scene
         self.disc = discretisation

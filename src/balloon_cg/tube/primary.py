@@ -13,73 +13,27 @@ changes between neighbours, each eigenvalue that crossed (by its order in the sp
 where it vanishes, located by Brent's method in the arclength from the earlier point (``continuation.locate_root``,
 each evaluation a Keller corrector), and kept as a branch point (BP) when its null vector φ is orthogonal to ∂R/∂P
 (|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's zero where it is not is the fold in P itself (LP).
-Stability at every point (``unstable_counts``): the number of negative eigenvalues of ∂R/∂u under pressure control
-(all of u) and under volume control (on δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman
-factorisation (numerics/eigen.py: ``restricted`` removes the constraint).
+Stability at every point: tube/stability.py's ``unstable_counts``.
 
 On a tube with sliding closed ends the branch is the uniform tube (model/tube.py's closed-end path, exact in the
 basis) and its first odd-block branch point is the onset of the bulge mode cos(πS/L) (model/tube.bulge_onset).
 """
-import enum
-from dataclasses import dataclass
-
 import numpy as np
 
-from .problem import ParameterSystem, continuation_settings
-from .results import Kind
+from .results import IntervalBranch, IntervalSpecial, IntervalStop
+from .stability import spectrum, unstable_counts
+from ..analysis.crossings import count_changes
+from ..analysis.problem import ParameterSystem, continuation_settings
+from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics import continuation
-from ..numerics.continuation import RootStatus, Stop
-from ..numerics.eigen import GramFactor, negative_count, restricted
-from ..scene.loading import Control
+from ..numerics.continuation import Stop
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
 ORTHOGONAL = 1e-6  # |φ·∂R/∂P| relative to |φ||∂R/∂P| below which a block's zero is a branch point, not the fold
 BRENT_XTOL = 1e-13  # Brent's tolerance in the arclength, relative to the step
-
-
-class IntervalStop(enum.StrEnum):
-    """Why an interval branch stopped (beside the tracer's TraceStop)."""
-
-    HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
-    REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (analysis/interval_bulge.py)
-    VOLUME = "volume"  # V/V0 passed the stop_volume asked for
-
-
-@dataclass(frozen=True)
-class IntervalSpecial:
-    """A located point: LP (fold in P) or BP (``block`` the mirror block whose lowest eigenvalue vanishes), its
-    state ``u`` and pressure, between points ``index`` and ``index + 1`` (the last index: in the step that passed
-    the stop, whose end is not stored); ``status`` of its location."""
-
-    kind: Kind
-    u: np.ndarray
-    pressure: float
-    index: int
-    status: RootStatus
-    block: Mirror | None = None
-
-
-@dataclass(frozen=True)
-class IntervalBranch:
-    """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
-    lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
-    mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
-    Control.PRESSURE and Control.VOLUME -> int array), the located points and why the trace stopped."""
-
-    disc: IntervalDiscretisation
-    states: np.ndarray
-    pressure: np.ndarray
-    volume: np.ndarray
-    lowest: dict
-    unstable: dict
-    special: tuple
-    stop: Stop
-
-    def branch_points(self, block: Mirror | None = None) -> list:
-        return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]
 
 
 class MirrorSystem:
@@ -126,17 +80,14 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
     reached = path.points + ([path.overshoot] if path.overshoot is not None else [])  # the last step's too
     full = [system.full(p.X) for p in reached]
-    spectra = {block: np.array([_spectrum(eq, Y, disc.block(block)) for Y in full]) for block in Mirror}
+    spectra = {block: np.array([spectrum(eq, Y, disc.block(block)) for Y in full]) for block in Mirror}
     special = [IntervalSpecial(Kind.LP, system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index, f.status)
                for f in path.folds]
     for block in Mirror:
-        negatives = (spectra[block] < 0).sum(axis=1)
-        for i in np.flatnonzero(negatives[:-1] != negatives[1:]):
-            for order in range(min(negatives[i:i + 2]), max(negatives[i:i + 2])):
-                found = _located_zero(system, eq, reached[i], reached[i + 1], block, order, settings)
-                if found is not None:
-                    special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1],
-                                                   block))
+        for i, order in count_changes((spectra[block] < 0).sum(axis=1)):
+            found = _located_zero(system, eq, reached[i], reached[i + 1], block, order, settings)
+            if found is not None:
+                special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1], block))
     special = sorted((s for s in special if disc.node_state(s.u)[0].max() <= limit),
                      key=lambda s: _position(system, reached, s))
     full, spectra = full[: len(path.points)], {block: values[: len(path.points)] for block, values in spectra.items()}
@@ -151,20 +102,6 @@ def volume_ratio(eq: Equilibrium, Y: np.ndarray) -> float:
     return 2 * eq.volume(Y[:-1]) / eq.disc.length
 
 
-def unstable_counts(eq: Equilibrium, points) -> dict:
-    """{Control.PRESSURE, Control.VOLUME: the number of negative eigenvalues of ∂R/∂u at each Y = (u, P) of
-    ``points``, without and with δV = 0} (module docstring)."""
-    counts = {Control.PRESSURE: [], Control.VOLUME: []}
-    unit = GramFactor(np.ones(eq.disc.size), orthogonal=True)
-    for Y in points:
-        params = Parameters(Y[-1])
-        H = eq.jacobian(Y[:-1], params)
-        counts[Control.PRESSURE].append(negative_count(H))
-        gradient = -eq.parameter_derivative(Y[:-1], params, "P")
-        counts[Control.VOLUME].append(negative_count(restricted(H, unit, gradient[None, :])))
-    return {control: np.array(values, dtype=int) for control, values in counts.items()}
-
-
 def _position(system: MirrorSystem, points: list, special: IntervalSpecial) -> float:
     """Where a located point lies along the branch: its index plus its arclength from that point along the point's
     tangent, over the step's (the order of points located in one step)."""
@@ -172,12 +109,6 @@ def _position(system: MirrorSystem, points: list, special: IntervalSpecial) -> f
     tangent = system.full(before.tangent)
     along = tangent @ (np.append(special.u, special.pressure) - system.full(before.X))
     return special.index + along / (tangent @ (system.full(after.X) - system.full(before.X)))
-
-
-def _spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> np.ndarray:
-    """The eigenvalues (ascending) of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``."""
-    H = eq.jacobian(Y[:-1], Parameters(Y[-1]))
-    return np.linalg.eigvalsh(H[np.ix_(index, index)])
 
 
 def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: Mirror, order: int, settings):
@@ -191,11 +122,11 @@ def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: M
         if not result.converged:
             raise ArithmeticError(result.message)
         Y = system.full(result.x)
-        return _spectrum(eq, Y, index)[order], Y
+        return spectrum(eq, Y, index)[order], Y
 
     length = float(before.tangent @ (after.X - before.X))
     end = system.full(after.X)
-    root = continuation.locate_root(value_at, length, BRENT_XTOL, known={length: (_spectrum(eq, end, index)[order],
+    root = continuation.locate_root(value_at, length, BRENT_XTOL, known={length: (spectrum(eq, end, index)[order],
                                                                                   end)})
     Y = root.payload
     params = Parameters(Y[-1])

@@ -1,4 +1,4 @@
-"""The branch born at a mirror-odd branch point of a tube's primary branch (analysis/interval_branch.py): the bulge.
+"""The branch born at a mirror-odd branch point of a tube's primary branch (tube/primary.py): the bulge.
 
 At a branch point of the odd block (interval.Mirror) the mirror-symmetric branch is crossed by a pitchfork whose
 states break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image). It leaves the branch
@@ -17,9 +17,11 @@ itself one eigenvalue is zero, its sign rounding).
 """
 import numpy as np
 
-from .interval_branch import IntervalBranch, IntervalSpecial, IntervalStop, unstable_counts, volume_ratio
-from .problem import ParameterSystem, continuation_settings
-from .results import Kind
+from .primary import volume_ratio
+from .results import IntervalBranch, IntervalSpecial, IntervalStop
+from .stability import unstable_counts
+from ..analysis.problem import ParameterSystem, continuation_settings
+from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import Mirror
 from ..numerics import continuation

@@ -1,0 +1,8 @@
+"""A tube's branches (docs/shapes.md): the layer after ``analysis`` whose branches live on an interval without poles
+(galerkin/interval.py), reading analysis's plain data and numerics. In reading order:
+
+- ``results``: a tube's branch and its located points as plain data, why a trace stopped
+- ``stability``: the spectra of the mirror blocks and the unstable directions under pressure and volume control
+- ``primary``: the primary branch in P from the unstressed tube, its folds and mirror-block branch points
+- ``bulge``: the branch switched at an odd branch point (the bulge), through its volume fold
+"""

@@ -1,0 +1,51 @@
+"""A tube's branch as plain data: its points, the located points (LP, LV, BP) and why the trace stopped."""
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.results import Kind
+from ..galerkin.interval import IntervalDiscretisation, Mirror
+from ..numerics.continuation import RootStatus, Stop
+
+
+class IntervalStop(enum.StrEnum):
+    """Why an interval branch stopped (beside the tracer's TraceStop)."""
+
+    HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
+    REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
+    VOLUME = "volume"  # V/V0 passed the stop_volume asked for
+
+
+@dataclass(frozen=True)
+class IntervalSpecial:
+    """A located point: LP (fold in P), LV (fold in V) or BP (``block`` the mirror block whose lowest eigenvalue
+    vanishes), its state ``u`` and pressure, between points ``index`` and ``index + 1`` (the last index: in the step
+    that passed the stop, whose end is not stored); ``status`` of its location."""
+
+    kind: Kind
+    u: np.ndarray
+    pressure: float
+    index: int
+    status: RootStatus
+    block: Mirror | None = None
+
+
+@dataclass(frozen=True)
+class IntervalBranch:
+    """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
+    lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
+    mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
+    Control.PRESSURE and Control.VOLUME -> int array), the located points and why the trace stopped."""
+
+    disc: IntervalDiscretisation
+    states: np.ndarray
+    pressure: np.ndarray
+    volume: np.ndarray
+    lowest: dict
+    unstable: dict
+    special: tuple
+    stop: Stop
+
+    def branch_points(self, block: Mirror | None = None) -> list:
+        return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]
