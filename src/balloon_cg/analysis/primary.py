@@ -125,19 +125,15 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
     a[0], b[1] = 1.0, scene.geometry.aspect
     X = np.append(disc.join(a, b), 0.0)
     row = np.append(disc.pole_rows()["lam2_north"], 0.0)
-    reached, step = 1.0, (stretch - 1.0) / 4
-    while reached < stretch:
-        trial = min(reached + step, stretch)
-        result = newton(system.residual, system.jacobian, X, row, trial, scene.solver.tol, scene.solver.max_newton)
-        if result.converged:
-            X, reached = result.x, trial
-            step *= 2
-            continue
-        step *= 0.5
-        if step < 1e-6 * (stretch - 1.0):
-            raise ContinuationError(f"could not inflate the {scene.geometry.shape.value} to continuation.start_stretch "
-                                    f"= {stretch:g} beyond the north pole stretch {reached:.6g} ({result.message}); "
-                                    "try a smaller continuation.start_stretch")
+
+    def solve(X, value):
+        return newton(system.residual, system.jacobian, X, row, value, scene.solver.tol, scene.solver.max_newton)
+
+    X, reached, message = continuation.natural(solve, X, 1.0, stretch)
+    if reached < stretch:
+        raise ContinuationError(f"could not inflate the {scene.geometry.shape.value} to continuation.start_stretch "
+                                f"= {stretch:g} beyond the north pole stretch {reached:.6g} ({message}); "
+                                "try a smaller continuation.start_stretch")
     return X[:-1], float(X[-1])
 
 

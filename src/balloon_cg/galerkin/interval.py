@@ -7,7 +7,8 @@ axis (codegen/meridian.py: R = 1, R' = 0, S' = 1, Z = −S). In x = 2S/L − 1 �
 
 u = (a_0..a_N, λ̄, b_0..b_{N−2}) (2N + 1 unknowns). The bubbles P_{k+2} − P_k vanish at x = ±1, so η(±1) = ∓λ̄L/2:
 the ends are the planes Z = ±λ̄L/2, η fixed on each, their distance λ̄L an unknown (closed ends: its equation is the
-axial balance, the ends carrying the pressure on their faces). Sliding ends (planes of symmetry) leave the radius
+axial balance, the ends carrying the pressure on their faces) or held (``axial_stretch`` λ: λ̄ = λ stays in u, fixed,
+and its row, the axial balance, is not an equation; ``free`` lists the other unknowns). Sliding ends (planes of symmetry) leave the radius
 free there (ρ' = 0 is the natural end condition); plugged ends (rigid plugs of the reference radius) hold
 ρ(±1) = 1: λ2 = 1 + Σ_{k=0}^{N−2} a_k (P_{k+2} − P_k)(x), u = (a_0..a_{N−2}, λ̄, b) (2N − 1 unknowns). At a node
 
@@ -49,12 +50,14 @@ class Mirror(enum.StrEnum):
 @dataclass(frozen=True)
 class IntervalDiscretisation:
     """Legendre ``degree`` N over a tube of ``length`` L (reference radii) with ``ends``, ``quadrature`` Gauss nodes
-    (0: the sphere's default rule at N, discretisation.gauss_nodes)."""
+    (0: the sphere's default rule at N, discretisation.gauss_nodes), the ends' distance over L held at
+    ``axial_stretch`` (None: an unknown)."""
 
     degree: int
     length: float
     quadrature: int = 0
     ends: Ends = Ends.SLIDING
+    axial_stretch: float | None = None
 
     def __post_init__(self):
         if self.degree < 2:
@@ -130,19 +133,30 @@ class IntervalDiscretisation:
         return u
 
     def reference(self) -> np.ndarray:
-        """u of the unstressed tube (λ2 = 1, η = −(S − L/2))."""
+        """u of the unstressed tube (λ2 = 1, η = −(S − L/2)); held ends: at their distance (η = −λ(S − L/2))."""
         u = np.zeros(self.size)
-        u[self.axial_index] = 1.0
+        u[self.axial_index] = self.axial_stretch if self.held else 1.0
         if self.ends == Ends.SLIDING:
             u[0] = 1.0
         return u
 
+    @property
+    def free(self) -> np.ndarray:
+        """The indices into u of the unknowns: all but λ̄ where the ends are held."""
+        return np.flatnonzero(np.arange(self.size) != (self.axial_index if self.held else -1))
+
+    @property
+    def held(self) -> bool:
+        """Whether the ends' distance is held (``axial_stretch``)."""
+        return self.axial_stretch is not None
+
     def block(self, mirror: Mirror) -> np.ndarray:
-        """The indices into u of a mirror block (module docstring)."""
+        """The indices into u of a mirror block's unknowns (module docstring; λ̄, even, where it is one)."""
         parity = 0 if mirror == Mirror.EVEN else 1
         a = np.arange(parity, self.hoops, 2)
         b = self.hoops + 1 + np.arange(1 - parity, self.degree - 1, 2)
-        return np.concatenate([a, [self.axial_index] if mirror == Mirror.EVEN else [], b]).astype(int)
+        axial = [self.axial_index] if mirror == Mirror.EVEN and not self.held else []
+        return np.concatenate([a, axial, b]).astype(int)
 
     def profile(self, u: np.ndarray, s: np.ndarray) -> tuple:
         """(ρ, η) at reference arclengths s ∈ [0, L]."""

@@ -174,6 +174,25 @@ def locate_root(value_at, length: float, xtol: float = 1e-13, known: dict | None
         return Root(payload, RootStatus.NEAREST, float(value), (low[1], high[1]))
 
 
+def natural(solve, X: np.ndarray, start: float, target: float) -> tuple:
+    """Natural continuation in a prescribed value from ``X`` (solved at ``start``) to ``target``: ``solve(X, value)``
+    returns a NewtonResult from the last solution; steps of a quarter of the way, doubled after a success, halved
+    after a failure. (X, value reached, the last failure's message): the value reached is ``target``, or where the
+    step fell below 1e-6 of the way."""
+    reached, step, message = start, (target - start) / 4, ""
+    while reached < target:
+        trial = min(reached + step, target)
+        result = solve(X, trial)
+        if result.converged:
+            X, reached = result.x, trial
+            step *= 2
+            continue
+        step, message = step * 0.5, result.message
+        if step < 1e-6 * (target - start):
+            break
+    return X, reached, message
+
+
 def rate(monitor, X: np.ndarray, t: np.ndarray) -> float:
     """dq/ds = ∇q(X)·τ of a fold monitor: a vector c (q = c·X) or a callable X ↦ ∇q(X)."""
     return float((monitor(X) if callable(monitor) else monitor) @ t)

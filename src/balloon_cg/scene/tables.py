@@ -136,17 +136,20 @@ class Geometry:
     aspect: float = 1.0
     length: float | None = None  # a tube's
     ends: Ends | None = None  # a tube's
+    axial_stretch: float | None = None  # a tube's ends held at the distance λL (None: closed, the distance free)
 
     def to_table(self) -> dict:
         """Its [geometry] table (a spheroid's keeps the text it had before tubes)."""
         if self.shape == Shape.TUBE:
-            return {"shape": self.shape.value, "length": self.length, "ends": self.ends.value}
+            held = {} if self.axial_stretch is None else {"axial_stretch": self.axial_stretch}
+            return {"shape": self.shape.value, "length": self.length, "ends": self.ends.value} | held
         return {"shape": self.shape.value, "aspect": self.aspect}
 
     def describe(self) -> str:
-        """'spheroid of aspect 1.5', 'tube of length 10 with sliding ends'."""
+        """'spheroid of aspect 1.5', 'tube of length 10 with sliding ends', '... held at 1.5 L'."""
         if self.shape == Shape.TUBE:
-            return f"tube of length {self.length:g} with {self.ends.value} ends"
+            held = "" if self.axial_stretch is None else f" held at {self.axial_stretch:g} L"
+            return f"tube of length {self.length:g} with {self.ends.value} ends{held}"
         return f"{self.shape.value} of aspect {self.aspect:g}"
 
 
@@ -267,6 +270,8 @@ MAX_VOLTAGE = 10.0  # electric.voltage, continuation.stop_voltage (a sphere's vo
 MAX_STRETCH = 100.0  # continuation.start_stretch, stop_stretch
 MIN_ASPECT, MAX_ASPECT = 0.1, 10.0  # geometry.aspect of a spheroid
 MIN_LENGTH, MAX_LENGTH = 0.1, 1000.0  # geometry.length of a tube (in reference radii)
+MIN_AXIAL, MAX_AXIAL = 1.0, 5.0  # geometry.axial_stretch: a tube's ends held at λL (below 1 the membrane would be
+#                                  compressed axially at P = 0)
 MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
 MAX_WIRE_GAP = 10.0
 MIN_TOLERANCE = 1e-15  # solver.tol, solver.max_error (below rounding no Newton step converges)
@@ -771,7 +776,7 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     if raw not in tuple(Shape):
         raise SceneError(f"geometry.shape = {show(raw)}: must be one of " + ", ".join(f'"{s.value}"' for s in Shape))
     shape = Shape(raw)
-    for key in ("length", "ends"):
+    for key in ("length", "ends", "axial_stretch"):
         if shape != Shape.TUBE and data.get(key) is not None:
             raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "tube"')
     if shape == Shape.TUBE:
@@ -800,7 +805,7 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
 
 
 def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
-    """A tube's [geometry] (length, ends) and the parts of the model a tube does not have yet, refused one line each."""
+    """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet, refused one line each."""
     if data.get("aspect") is not None:
         raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a tube has '
                          "geometry.length)")
@@ -812,6 +817,8 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
     raw = Ends.SLIDING.value if data.get("ends") is None else data["ends"]
     if raw not in tuple(Ends):
         raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends))
+    held = _getter(data, "geometry", Geometry)("axial_stretch", lambda x: MIN_AXIAL <= x <= MAX_AXIAL,
+                                                f"in [{MIN_AXIAL:g}, {MAX_AXIAL:g}]")
     where = 'geometry.shape = "tube"'
     if field.coils:
         raise SceneError(f"{where}: coils around a tube are not built yet; leave [field] coils out or use another "
@@ -822,7 +829,7 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
     if loading.control != Control.PRESSURE:
         raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
                          'for now; allowed: "pressure"')
-    return Geometry(Shape.TUBE, length=length, ends=Ends(raw))
+    return Geometry(Shape.TUBE, length=length, ends=Ends(raw), axial_stretch=held)
 
 
 def _parameter(data, electric: Electric | None):

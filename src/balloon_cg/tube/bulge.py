@@ -6,7 +6,7 @@ point X* = (u*, P*) along the odd block's null vector φ with dP = 0: the first 
 X* + σ(φ, 0)/|φ| on the hyperplane normal to (φ, 0) (which the symmetric branch never meets), oriented so that the
 tube bulges at S = 0 (ρ(0) > ρ(L)), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the
 symmetry (P and V are even in the arclength along a pitchfork), so the fold monitors start from the first point.
-It is traced by pseudo-arclength continuation in X = (u, P) on every unknown, its folds in P (LP) and in the
+It is traced by pseudo-arclength continuation in X = (u, P) on every unknown (a held λ̄ stays fixed), its folds in P (LP) and in the
 enclosed volume (LV: V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the tracer's fold monitors, until it
 rejoins the mirror-symmetric states (ρ(0) − ρ(L) = −2 Σ_{k odd} a_k changes sign: the bulge has filled the tube
 and the branch meets the primary branch again at another odd branch point, the other end of the pitchfork's loop,
@@ -17,7 +17,7 @@ itself one eigenvalue is zero, its sign rounding).
 """
 import numpy as np
 
-from .primary import volume_ratio
+from .primary import TubeSystem, held, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop
 from .stability import unstable_counts
 from ..analysis.problem import ParameterSystem, continuation_settings
@@ -53,11 +53,11 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
 
     if bulge(phi) < 0:
         phi = -phi
-    system = ParameterSystem(eq, params, "P")
+    system = TubeSystem(ParameterSystem(eq, params, "P"), disc.free, held(disc))
     settings = continuation_settings(scene)
     settings.step = settings.step if step is None else step
-    X = np.append(point.u, point.pressure)
-    direction = np.append(phi, 0.0) / np.linalg.norm(phi)
+    X = np.append(point.u, point.pressure)[system.columns]
+    direction = np.append(phi, 0.0)[system.columns] / np.linalg.norm(phi)
     first = continuation.correct(system, X + settings.step * direction, direction, settings)
     if not first.converged:
         raise ArithmeticError(f"the first step of the bulge branch did not converge: {first.message}")
@@ -65,20 +65,23 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                first.residual)
 
     def stop(p):
-        if bulge(p.X[:-1]) < 0:
+        Y = system.full(p.X)
+        if bulge(Y[:-1]) < 0:
             return Stop(IntervalStop.REJOINED, "the branch rejoined the mirror-symmetric states")
-        if stop_volume is not None and volume_ratio(eq, p.X) > stop_volume:
+        if stop_volume is not None and volume_ratio(eq, Y) > stop_volume:
             return Stop(IntervalStop.VOLUME, f"V/V0 passed stop_volume {stop_volume:g}")
         return None
 
-    def volume_gradient(Y):
-        return np.append(-eq.parameter_derivative(Y[:-1], Parameters(Y[-1]), "P"), 0.0)
+    def volume_gradient(X):
+        Y = system.full(X)
+        return np.append(-eq.parameter_derivative(Y[:-1], Parameters(Y[-1]), "P"), 0.0)[system.columns]
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1], Kind.LV: volume_gradient})
     last = len(path.points) - 1
     folds = [f for f in path.folds if not (path.stop.code == IntervalStop.REJOINED and f.index == last)]
-    special = tuple(IntervalSpecial(Kind(f.label), f.point.X[:-1], float(f.point.X[-1]), f.index + 1, f.status)
-                    for f in sorted(folds, key=lambda f: f.index))
-    points = [X] + [p.X for p in path.points]
+    special = tuple(IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + 1,
+                                    f.status) for f in sorted(folds, key=lambda f: f.index))
+    points = [system.full(X)] + [system.full(p.X) for p in path.points]
     return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
-                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points), special, path.stop)
+                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points), special,
+                          path.stop)

@@ -1,7 +1,8 @@
 """The primary branch of a meridian over an interval (galerkin/interval.py): a tube inflated from its unstressed
 reference by continuation in P, its pressure folds and the branch points of its mirror blocks.
 
-The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium. From it the branch is traced by pseudo-arclength
+The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium; with its ends held at λL
+(``geometry.axial_stretch``) the start is the tube stretched to it at P = 0 (``_start``). From it the branch is traced by pseudo-arclength
 continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted to the even block,
 interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps its equator
 symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the north
@@ -25,10 +26,12 @@ from .stability import spectrum, unstable_counts
 from ..analysis.crossings import count_changes
 from ..analysis.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
+from ..analysis.tracer import ContinuationError
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
+from ..numerics.newton import newton
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
@@ -36,37 +39,55 @@ ORTHOGONAL = 1e-6  # |φ·∂R/∂P| relative to |φ||∂R/∂P| below which a b
 BRENT_XTOL = 1e-13  # Brent's tolerance in the arclength, relative to the step
 
 
-class MirrorSystem:
-    """R(u; P) on the mirror-symmetric states: X = (u[even block], P) (module docstring)."""
+class TubeSystem:
+    """R(u; P) on a subset of the unknowns: X = (u[``unknowns``], P), the others at ``fixed`` (u, zero but λ̄ at the
+    held ends' distance: the residual's rows of the unknowns only, so that a held λ̄'s row, the axial balance, is
+    not an equation). The primary branch takes the even block (the mirror-symmetric states: the odd residual rows
+    vanish there by symmetry), the bulge branch every unknown."""
 
-    def __init__(self, system: ParameterSystem, disc: IntervalDiscretisation):
-        self.system, self.even = system, disc.block(Mirror.EVEN)
-        self.columns = np.append(self.even, disc.size)
-        self.size = disc.size
+    def __init__(self, system: ParameterSystem, unknowns: np.ndarray, fixed: np.ndarray):
+        self.system, self.unknowns = system, unknowns
+        self.columns = np.append(unknowns, fixed.size)
+        self.fixed = np.append(fixed, 0.0)
 
     def full(self, X) -> np.ndarray:
-        Y = np.zeros(self.size + 1)
+        """Y = (u, P) of X."""
+        Y = self.fixed.copy()
         Y[self.columns] = X
         return Y
 
     def residual(self, X):
-        return self.system.residual(self.full(X))[self.even]
+        return self.system.residual(self.full(X))[self.unknowns]
 
     def jacobian(self, X):
-        return self.system.jacobian(self.full(X))[np.ix_(self.even, self.columns)]
+        return self.system.jacobian(self.full(X))[np.ix_(self.unknowns, self.columns)]
+
+
+def held(disc: IntervalDiscretisation, stretch: float | None = None) -> np.ndarray:
+    """u of the fixed unknowns (``TubeSystem``): zero but λ̄ at ``stretch`` (None: the disc's ``axial_stretch``)."""
+    fixed = np.zeros(disc.size)
+    if disc.held:
+        fixed[disc.axial_index] = disc.axial_stretch if stretch is None else stretch
+    return fixed
+
+
+def discretisation(scene, degree: int | None = None) -> IntervalDiscretisation:
+    """The interval discretisation of a tube scene at Legendre ``degree`` (None: solver.degree)."""
+    geometry = scene.geometry
+    if geometry.shape != Shape.TUBE:
+        raise SceneError(f'geometry.shape = "{geometry.shape.value}": an interval branch is a tube\'s; allowed: "tube"')
+    return IntervalDiscretisation(scene.solver.degree if degree is None else degree, geometry.length,
+                                  scene.solver.quadrature, geometry.ends, geometry.axial_stretch)
 
 
 def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     """The primary branch of a tube scene (module docstring) at Legendre ``degree`` (None: solver.degree)."""
-    geometry = scene.geometry
-    if geometry.shape != Shape.TUBE:
-        raise SceneError(f'geometry.shape = "{geometry.shape.value}": an interval branch is a tube\'s; allowed: "tube"')
-    disc = IntervalDiscretisation(scene.solver.degree if degree is None else degree, geometry.length,
-                                  scene.solver.quadrature, geometry.ends)
+    disc = discretisation(scene, degree)
     eq = Equilibrium(scene, disc)
-    system = MirrorSystem(ParameterSystem(eq, Parameters(0.0), "P"), disc)
+    parameters = ParameterSystem(eq, Parameters(0.0), "P")
+    system = TubeSystem(parameters, disc.block(Mirror.EVEN), held(disc))
     settings = continuation_settings(scene)
-    X = np.append(disc.reference(), 0.0)[system.columns]
+    X = _start(parameters, disc, scene.solver)
     t = continuation.tangent(system, X, np.eye(X.size)[-1])
     start = continuation.Point(X, t, 0, float(np.abs(system.residual(X)).max()))
     limit = scene.continuation.stop_stretch
@@ -97,12 +118,34 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
                           unstable_counts(eq, full), tuple(special), path.stop)
 
 
+def _start(parameters: ParameterSystem, disc: IntervalDiscretisation, solver) -> np.ndarray:
+    """X = (u[even block], P = 0) of the unstressed tube: the reference (exact) where the ends' distance is free;
+    where it is held at λ, the tube stretched to it at P = 0 by natural continuation in the held distance from 1
+    (``continuation.natural``), each point solved by Newton on the even rows with P = 0 prescribed.
+    ContinuationError when it does not get there."""
+    even = disc.block(Mirror.EVEN)
+    X = np.append(disc.reference(), 0.0)[np.append(even, disc.size)]
+    if not disc.held:
+        return X
+    target = disc.axial_stretch
+
+    def solve(X, stretch):
+        system = TubeSystem(parameters, even, held(disc, stretch))
+        return newton(system.residual, system.jacobian, X, np.eye(X.size)[-1], 0.0, solver.tol, solver.max_newton)
+
+    X, reached, message = continuation.natural(solve, X, 1.0, target)
+    if reached < target:
+        raise ContinuationError(f"could not stretch the tube to geometry.axial_stretch = {target:g} at P = 0 beyond "
+                                f"{reached:.6g} ({message})")
+    return X
+
+
 def volume_ratio(eq: Equilibrium, Y: np.ndarray) -> float:
     """V/V0 at Y = (u, P), V0 = πL the reference tube's (the volume per 2π: 2V/(2πL))."""
     return 2 * eq.volume(Y[:-1]) / eq.disc.length
 
 
-def _position(system: MirrorSystem, points: list, special: IntervalSpecial) -> float:
+def _position(system: TubeSystem, points: list, special: IntervalSpecial) -> float:
     """Where a located point lies along the branch: its index plus its arclength from that point along the point's
     tangent, over the step's (the order of points located in one step)."""
     before, after = points[special.index], points[special.index + 1]
@@ -111,7 +154,7 @@ def _position(system: MirrorSystem, points: list, special: IntervalSpecial) -> f
     return special.index + along / (tangent @ (system.full(after.X) - system.full(before.X)))
 
 
-def _located_zero(system: MirrorSystem, eq: Equilibrium, before, after, block: Mirror, order: int, settings):
+def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mirror, order: int, settings):
     """(Y = (u, P), status) where the eigenvalue number ``order`` (ascending, from 0) of ``block`` vanishes between
     two points, by Brent in the arclength from ``before``; None when it is the fold in P (the null vector not
     orthogonal to ∂R/∂P)."""
