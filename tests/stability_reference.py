@@ -20,7 +20,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
 OFF_EQUATOR = DATA / "off_equator.toml"
-SCENES = tuple(sorted(p.stem for p in (ROOT / "scenes").glob("*.toml"))) + (OFF_EQUATOR.stem,)
+SCENES = tuple(sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")
+                     if not p.stem.startswith("tube_"))) + (OFF_EQUATOR.stem,)  # a tube's run is not a picture
 
 
 def reference_path(scene: str) -> Path:

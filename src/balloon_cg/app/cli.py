@@ -38,7 +38,8 @@ PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equa
 # the exceptions that mean bad input (exit 2) or a computation that did not give what was asked (exit 1), by
 # module: a module that is not loaded cannot have raised its exception, so none is imported to catch it
 BAD_INPUT = {"balloon_cg.scene.validation": "SceneError", "balloon_cg.io.layout": "FileError",
-             "balloon_cg.post.plotting": "PlotError", "balloon_cg.model.field": "FieldError"}
+             "balloon_cg.post.plotting": "PlotError", "balloon_cg.model.field": "FieldError",
+             "balloon_cg.post.tube_plots": "TubePlotError"}
 FAILED = {"balloon_cg.analysis.tracer": "ContinuationError"}
 
 
@@ -325,6 +326,8 @@ def run(args) -> int:
 
     scene, stem = configured(args)
     output = default_output(args.output, stem, "run")
+    if scene.geometry.shape == "tube":
+        return run_tube(scene, output, args)
     with stop_on_signals():
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
@@ -341,6 +344,24 @@ def run(args) -> int:
 
         print(format_run(read_run(output)))
     return verdict_status(found, args.allow_partial)
+
+
+def run_tube(scene, output, args) -> int:
+    """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
+    written to the tube run file ``output`` (io/tube_file.py) and summarised."""
+    from ..io.lock import claim
+    from ..io.output import check_output
+    from ..io.tube_file import read_tube_run, write_tube_run
+    from ..tube.picture import tube_picture
+    from .tube_summary import format_tube, summarise_tube
+
+    with claim(output, "run"):
+        check_output(output, args.force)
+        picture = tube_picture(scene, args.primary_only)
+        write_tube_run(output, scene, picture, args.force, args.command_line)
+    if not args.quiet:
+        print(format_tube(summarise_tube(read_tube_run(output))))
+    return 0
 
 
 def verdict_status(found: list, allow_partial: bool) -> int:
@@ -471,7 +492,8 @@ def _add_plot(commands):
     p = commands.add_parser("plot", help=f"draw figures from one or more run files ({docs_path('plots.md')})")
     p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
     p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
-                   help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}")
+                   help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}; of a tube's run file: "
+                        "pressure-volume, profiles")
     p.add_argument("-o", "--output", help=f"image file, {', '.join(IMAGE_FORMATS)} (default: "
                                           "FIRST_FILE_STEM_KIND.png next to the first file; with several kinds: "
                                           "OUTPUT_STEM_KIND.SUFFIX; an existing file is replaced only with --force)")
@@ -495,11 +517,13 @@ def _add_plot(commands):
 
 
 def _kinds(text: str) -> list[str]:
-    kinds = [k.strip() for k in text.split(",")]
-    unknown = [k for k in kinds if k not in PLOT_KINDS]
+    from ..post.tube_plots import TUBE_KINDS
+
+    kinds, known = [k.strip() for k in text.split(",")], PLOT_KINDS + TUBE_KINDS
+    unknown = [k for k in kinds if k not in known]
     if unknown:
-        raise argparse.ArgumentTypeError(f"{unknown[0]!r}: not a plot kind{did_you_mean(unknown[0], PLOT_KINDS)} "
-                                         f"(choose from {', '.join(PLOT_KINDS)})")
+        raise argparse.ArgumentTypeError(f"{unknown[0]!r}: not a plot kind{did_you_mean(unknown[0], known)} "
+                                         f"(choose from {', '.join(known)})")
     return kinds
 
 
@@ -518,6 +542,7 @@ def _indices(text: str) -> list[int]:
 
 def plot(args) -> int:
     """Draw one figure per kind and save it; prints the image paths."""
+    from ..io.layout import file_kind
     from ..io.output import check_output, replacing
     from ..post.plotting import as_run, plot as draw
 
@@ -533,10 +558,30 @@ def plot(args) -> int:
         if output.suffix.lower() not in IMAGE_FORMATS:
             raise UsageError(f"--output {output}: the suffix must be one of {', '.join(IMAGE_FORMATS)}")
         check_output(output, args.force)
+    if file_kind(first) == "tube":
+        return _plot_tube(args, outputs)
     runs = [as_run(f) for f in args.files] if any(kind != "phase" for kind in args.what) else []
     for kind, output in outputs.items():
         figure = draw(args.files if kind == "phase" else runs, kind, args.points, args.branch,
                       stability=args.stability, width=args.width)
+        with replacing(output, args.force) as tmp:
+            figure.savefig(tmp, format=output.suffix.lower()[1:], **({} if args.dpi is None else {"dpi": args.dpi}))
+        print(output)
+    return 0
+
+
+def _plot_tube(args, outputs: dict) -> int:
+    """``plot`` of a tube run file (post/tube_plots.py): one file, kinds pressure-volume and profiles."""
+    from ..io.output import replacing
+    from ..io.tube_file import read_tube_run
+    from ..post.tube_plots import tube_figure
+
+    if len(args.files) > 1:
+        raise UsageError(f"{args.files[1]}: a tube run file is drawn alone; give one file")
+    run = read_tube_run(args.files[0])
+    for kind, output in outputs.items():
+        figure = tube_figure(run, kind, args.stability or "pressure", args.branch, args.points,
+                             args.width or 3.5)
         with replacing(output, args.force) as tmp:
             figure.savefig(tmp, format=output.suffix.lower()[1:], **({} if args.dpi is None else {"dpi": args.dpi}))
         print(output)

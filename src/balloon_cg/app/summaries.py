@@ -7,7 +7,7 @@ from ..io.parents import parent_label, rejoin_label
 
 
 def summarise_file(path) -> tuple[dict, str]:
-    """(JSON-ready summary, readable text) of a run, sweep or curve file, told apart by their format and
+    """(JSON-ready summary, readable text) of a run, sweep, curve or tube file, told apart by their format and
     content (raises the readers' errors for anything else)."""
     from ..io.layout import file_kind
     from ..io.run_file import RunFileError, read_run
@@ -20,6 +20,12 @@ def summarise_file(path) -> tuple[dict, str]:
     if kind == "curve":
         summary = summarise_curves(path)
         return summary, format_curves(summary)
+    if kind == "tube":
+        from ..io.tube_file import read_tube_run
+        from .tube_summary import format_tube, summarise_tube
+
+        summary = summarise_tube(read_tube_run(path))
+        return summary, format_tube(summary)
     run = read_run(path)
     return summarise_run(run), format_run(run)
 

@@ -5,11 +5,11 @@ axis (codegen/meridian.py: R = 1, R' = 0, S' = 1, Z = −S). In x = 2S/L − 1 �
 
     λ2(x) = Σ_{k=0}^{N} a_k P_k(x),      η(x) = −λ̄ (L/2) x + Σ_{k=0}^{N−2} b_k (P_{k+2} − P_k)(x),
 
-u = (a_0..a_N, λ̄, b_0..b_{N−2}) (2N + 1 unknowns). The bubbles P_{k+2} − P_k vanish at x = ±1, so η(±1) = ∓λ̄L/2:
-the ends are the planes Z = ±λ̄L/2, η fixed on each, their distance λ̄L an unknown (closed ends: its equation is the
-axial balance, the ends carrying the pressure on their faces) or held (``axial_stretch`` λ: λ̄ = λ stays in u, fixed,
-and its row, the axial balance, is not an equation; ``free`` lists the other unknowns). Sliding ends (planes of symmetry) leave the radius
-free there (ρ' = 0 is the natural end condition); plugged ends (rigid plugs of the reference radius) hold
+u = (a_0..a_N, λ̄, b_0..b_{N−2}) (2N + 1 unknowns). The bubbles P_{k+2} − P_k vanish at x = ±1, so η(±1) = ∓λ̄L/2: the
+ends are the planes Z = ±λ̄L/2, η fixed on each, their distance λ̄L an unknown (closed ends: its equation is the axial
+balance, the ends carrying the pressure on their faces) or held (``axial_stretch`` λ: λ̄ = λ stays in u, fixed, and its
+row, the axial balance, is not an equation; ``free`` lists the other unknowns). Sliding ends (planes of symmetry) leave
+the radius free there (ρ' = 0 is the natural end condition); plugged ends (rigid plugs of the reference radius) hold
 ρ(±1) = 1: λ2 = 1 + Σ_{k=0}^{N−2} a_k (P_{k+2} − P_k)(x), u = (a_0..a_{N−2}, λ̄, b) (2N − 1 unknowns). At a node
 
     ρ = λ2 R = λ2,   v = λ2' R = (2/L) dλ2/dx,   w = η' = (2/L) dη/dx,

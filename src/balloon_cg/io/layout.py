@@ -227,9 +227,11 @@ def opened(path, error=FileError):
 
 
 def file_kind(path, error=FileError) -> str:
-    """'sweep', 'curve' or 'run': what a balloon-cg file holds, by its format and content (a curve file is a run
-    file with /two_parameter curves)."""
+    """'sweep', 'tube', 'curve' or 'run': what a balloon-cg file holds, by its format and content (a curve file is a
+    run file with /two_parameter curves; a tube's run file has its own format, io/tube_file.py)."""
     with opened(path, error) as f:
         if str(f.attrs.get("format", "")).startswith("balloon-cg-sweep"):
             return "sweep"
+        if str(f.attrs.get("format", "")).startswith("balloon-cg-tube"):
+            return "tube"
         return "curve" if len(f.get("two_parameter", {})) else "run"

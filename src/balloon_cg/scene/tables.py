@@ -805,7 +805,8 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
 
 
 def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
-    """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet, refused one line each."""
+    """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet,
+    refused one line each."""
     if data.get("aspect") is not None:
         raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a tube has '
                          "geometry.length)")

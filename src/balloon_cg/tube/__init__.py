@@ -5,4 +5,5 @@
 - ``stability``: the spectra of the mirror blocks and the unstable directions under pressure and volume control
 - ``primary``: the primary branch in P from the unstressed tube, its folds and mirror-block branch points
 - ``bulge``: the branch switched at an odd branch point (the bulge), through its volume fold
+- ``picture``: all of a tube scene's run (``balloon-cg run``)
 """

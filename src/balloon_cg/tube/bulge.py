@@ -1,19 +1,19 @@
 """The branch born at a mirror-odd branch point of a tube's primary branch (tube/primary.py): the bulge.
 
-At a branch point of the odd block (interval.Mirror) the mirror-symmetric branch is crossed by a pitchfork whose
-states break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image). It leaves the branch
-point X* = (u*, P*) along the odd block's null vector φ with dP = 0: the first point is the Keller corrector from
-X* + σ(φ, 0)/|φ| on the hyperplane normal to (φ, 0) (which the symmetric branch never meets), oriented so that the
-tube bulges at S = 0 (ρ(0) > ρ(L)), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the
-symmetry (P and V are even in the arclength along a pitchfork), so the fold monitors start from the first point.
-It is traced by pseudo-arclength continuation in X = (u, P) on every unknown (a held λ̄ stays fixed), its folds in P (LP) and in the
-enclosed volume (LV: V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the tracer's fold monitors, until it
-rejoins the mirror-symmetric states (ρ(0) − ρ(L) = −2 Σ_{k odd} a_k changes sign: the bulge has filled the tube
-and the branch meets the primary branch again at another odd branch point, the other end of the pitchfork's loop,
-where P and V are again even in the arclength: the monitors' sign changes in that last step are that symmetry,
-not folds, and are not kept), its V/V0 passes ``stop_volume``, or after ``continuation.max_points``. The branch
-point X* is the branch's first point; the stability of every point is ``unstable_counts``' (at X*
-itself one eigenvalue is zero, its sign rounding).
+At a branch point of the odd block (interval.Mirror) the mirror-symmetric branch is crossed by a pitchfork whose states
+break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image). It leaves the branch point X* = (u*,
+P*) along the odd block's null vector φ with dP = 0: the first point is the Keller corrector from X* + σ(φ, 0)/|φ| on
+the hyperplane normal to (φ, 0) (which the symmetric branch never meets), oriented so that the tube bulges at S = 0
+(ρ(0) > ρ(L)), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the symmetry (P and V are even in the
+arclength along a pitchfork), so the fold monitors start from the first point. It is traced by pseudo-arclength
+continuation in X = (u, P) on every unknown (a held λ̄ stays fixed), its folds in P (LP) and in the enclosed volume (LV:
+V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the tracer's fold monitors, until it rejoins the mirror-symmetric
+states (ρ(0) − ρ(L) = −2 Σ_{k odd} a_k changes sign: the bulge has filled the tube and the branch meets the primary
+branch again at another odd branch point, the other end of the pitchfork's loop, where P and V are again even in the
+arclength: the monitors' sign changes in that last step are that symmetry, not folds, and are not kept), its V/V0 passes
+``stop_volume``, its largest hoop stretch ``stop_stretch``, or after ``continuation.max_points``. The branch point X* is
+the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is zero, its
+sign rounding).
 """
 import numpy as np
 
@@ -30,9 +30,10 @@ from ..scene.tables import Ends
 
 
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
-                 step: float | None = None) -> IntervalBranch:
+                 step: float | None = None, stop_stretch: float | None = None) -> IntervalBranch:
     """The branch switched at ``point``, a branch point of the odd block of ``primary`` (module docstring);
-    ``step``: the first arclength step (None: continuation.step)."""
+    ``step``: the first arclength step (None: continuation.step); ``stop_stretch``: also stop where the largest hoop
+    stretch at the nodes passes it."""
     if point.kind != Kind.BP or point.block != Mirror.ODD:
         raise ValueError(f"a bulge branch starts at a branch point of the odd block, not at {point.kind} "
                          f"({point.block})")
@@ -70,6 +71,10 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
             return Stop(IntervalStop.REJOINED, "the branch rejoined the mirror-symmetric states")
         if stop_volume is not None and volume_ratio(eq, Y) > stop_volume:
             return Stop(IntervalStop.VOLUME, f"V/V0 passed stop_volume {stop_volume:g}")
+        hoop = disc.node_state(Y[:-1])[0].max()
+        if stop_stretch is not None and hoop > stop_stretch:
+            return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
+                                                   f"{stop_stretch:g}")
         return None
 
     def volume_gradient(X):

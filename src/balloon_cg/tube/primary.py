@@ -2,19 +2,18 @@
 reference by continuation in P, its pressure folds and the branch points of its mirror blocks.
 
 The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium; with its ends held at λL
-(``geometry.axial_stretch``) the start is the tube stretched to it at P = 0 (``_start``). From it the branch is traced by pseudo-arclength
-continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted to the even block,
-interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps its equator
-symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the north
-pole stretch means nothing), or after ``continuation.max_points``; the points located up to stop_stretch are kept,
-those in the step that passed it included. Folds in P (LP) are located by the tracer's fold
-monitor. At every point the second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the
-spectrum of each is computed (its lowest eigenvalue stored); where a block's number of negative eigenvalues
-changes between neighbours, each eigenvalue that crossed (by its order in the spectrum) is followed to the point
-where it vanishes, located by Brent's method in the arclength from the earlier point (``continuation.locate_root``,
-each evaluation a Keller corrector), and kept as a branch point (BP) when its null vector φ is orthogonal to ∂R/∂P
-(|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's zero where it is not is the fold in P itself (LP).
-Stability at every point: tube/stability.py's ``unstable_counts``.
+(``geometry.axial_stretch``) the start is the tube stretched to it at P = 0 (``_start``). From it the branch is traced
+by pseudo-arclength continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted
+to the even block, interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps
+its equator symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the
+north pole stretch means nothing), or after ``continuation.max_points``; the points located up to stop_stretch are kept,
+those in the step that passed it included. Folds in P (LP) are located by the tracer's fold monitor. At every point the
+second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the spectrum of each is computed (its
+lowest eigenvalue stored); where a block's number of negative eigenvalues changes between neighbours, each eigenvalue
+that crossed (by its order in the spectrum) is followed to the point where it vanishes, located by Brent's method in the
+arclength from the earlier point (``continuation.locate_root``, each evaluation a Keller corrector), and kept as a
+branch point (BP) when its null vector φ is orthogonal to ∂R/∂P (|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's
+zero where it is not is the fold in P itself (LP). Stability at every point: tube/stability.py's ``unstable_counts``.
 
 On a tube with sliding closed ends the branch is the uniform tube (model/tube.py's closed-end path, exact in the
 basis) and its first odd-block branch point is the onset of the bulge mode cos(πS/L) (model/tube.bulge_onset).

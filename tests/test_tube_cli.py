@@ -1,0 +1,85 @@
+"""Tubes from the command line: ``balloon-cg run`` on a tube scene writes a tube run file (io/tube_file.py) holding
+what tube/picture.py computes, ``inspect`` shows it, ``plot`` draws P against V/V0 with Maxwell's line and the
+bulge's profiles; bad requests exit 2 with one line and leave no file."""
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balloon_cg.app.cli import main
+from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.model import tube
+from balloon_cg.scene import load_scene
+from balloon_cg.tube.picture import tube_picture
+SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
+FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("tube") / "tube.h5"
+    assert main(["run", str(SCENE), "-o", str(path), "--quiet", *FAST]) == 0
+    return path
+
+
+def test_run_writes_what_the_tube_pipeline_computes(run_file):
+    """The file holds the primary and the bulge branch of tube_picture at the same settings, number for number;
+    the shape and its parameters as attributes; Maxwell's pressure model/tube's."""
+    scene = load_scene(SCENE).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 3})
+    picture = tube_picture(scene)
+    run = read_tube_run(run_file)
+    a = run["attrs"]
+    assert (a["shape"], a["length"], a["ends"], a["degree"]) == ("tube", 10.0, "sliding", 16)
+    assert math.isnan(a["axial_stretch"]) and a["format"] == "balloon-cg-tube/1"
+    assert a["maxwell_pressure"] == tube.maxwell_pressure(scene.material)[0]
+    assert set(run["branches"]) == {"primary", "bulge"}
+    for name, branch in picture.branches.items():
+        stored = run["branches"][name]
+        assert np.array_equal(stored["unknowns"], branch.states) and np.array_equal(stored["pressure"], branch.pressure)
+        assert np.array_equal(stored["volume"], branch.volume)
+        assert np.array_equal(stored["unstable_volume"], branch.unstable["volume"])
+        assert [s["kind"] for s in stored["special_points"]] == [s.kind.value for s in branch.special]
+        assert [s["pressure"] for s in stored["special_points"]] == [s.pressure for s in branch.special]
+        assert stored["attrs"]["stop_code"] == branch.stop.code.value
+    kinds = [(s["kind"], s["block"]) for s in run["branches"]["primary"]["special_points"]]
+    assert kinds[:2] == [("LP", ""), ("BP", "odd")] and ("LV", "") in [(s["kind"], s["block"]) for s in
+                                                                        run["branches"]["bulge"]["special_points"]]
+
+
+def test_inspect_names_the_shape_and_its_points(run_file, capsys):
+    assert main(["inspect", str(run_file)]) == 0
+    text = capsys.readouterr().out
+    assert "tube of length 10, sliding ends, end distance free (closed)" in text
+    assert "Maxwell        P_M = 0.445022155" in text and "branch bulge:" in text and " LV " in text
+    assert main(["inspect", str(run_file), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["kind"] == "tube" and summary["geometry"]["axial_stretch"] is None
+    assert summary["branches"]["primary"]["special_points"][0]["kind"] == "LP"
+
+
+def test_plot_draws_pressure_volume_and_profiles(run_file, tmp_path, capsys):
+    out = tmp_path / "t.png"
+    assert main(["plot", str(run_file), "--what", "pressure-volume,profiles", "-o", str(out)]) == 0
+    assert (tmp_path / "t_pressure-volume.png").stat().st_size > 10_000
+    assert (tmp_path / "t_profiles.png").stat().st_size > 10_000
+    assert main(["plot", str(run_file), "--what", "shapes", "-o", str(tmp_path / "s.png")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].endswith("--what shapes: not drawn for a tube run file; allowed: pressure-volume, profiles")
+    assert not (tmp_path / "s.png").exists()
+
+
+def test_pressure_volume_figure_has_the_maxwell_line(run_file):
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run = read_tube_run(run_file)
+    fig = tube_figure(run, "pressure-volume")
+    maxwell = [line for line in fig.axes[0].lines if line.get_linestyle() == ":"]
+    assert len(maxwell) == 1 and maxwell[0].get_ydata()[0] == run["attrs"]["maxwell_pressure"]
+
+
+def test_an_existing_file_is_kept_without_force(run_file, capsys):
+    before = run_file.read_bytes()
+    assert main(["run", str(SCENE), "-o", str(run_file), "--quiet", *FAST]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1 and run_file.read_bytes() == before
