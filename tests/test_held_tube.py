@@ -18,6 +18,7 @@ from balloon_cg.model import tube
 from balloon_cg.scene import parse_scene
 from balloon_cg.scene.validation import SceneError
 from balloon_cg.tube.primary import primary_branch
+from balloon_cg.tube.stability import COMPRESSED
 from test_interval import series
 from test_tube import symbolic_energy, theta, z
 
@@ -103,7 +104,8 @@ def test_plugged_held_tube_has_a_pressure_maximum_and_minimum():
     ρ = 1 and the ends' distance is λL; at the maximum the state solves the continuous problem: H is constant
     along the tube to 1e-6 (measured 1.8e-13). At the minimum it is not resolved pointwise (H varies by 10 % inside
     and 46 % at the plugs at degree 50): the necks beside the plugs are in hoop compression there (Φ_2 < 0, derived
-    here), where a membrane wrinkles and the Ritz problem is not elliptic; at the maximum every stress is tensile."""
+    here), where a membrane wrinkles and the Ritz problem is not elliptic; at the maximum every stress is tensile.
+    The pipeline flags it (``smallest_stress``): every branch point after the first lies in a compressed state."""
     found = {}
     for degree in (30, 40, 50):
         scene = held_scene("Gent", 10.0, 1.5, "plugged", degree)
@@ -126,5 +128,8 @@ def test_plugged_held_tube_has_a_pressure_maximum_and_minimum():
     assert np.abs(H - H.mean()).max() <= 1e-6 * abs(H.mean())
     hoop_stress = sp.lambdify((z, theta), sp.diff(energy, theta))
     assert hoop_stress(*series(disc, top.u, 401)[1:3]).min() > 0 > hoop_stress(*series(disc, bottom.u, 401)[1:3]).min()
+    assert top.smallest_stress > 0 > COMPRESSED > bottom.smallest_stress  # the pipeline's flag (tube/stability.py)
+    compressed = [p.smallest_stress < COMPRESSED for p in branch.branch_points()]
+    assert compressed[0] is False and len(compressed) > 2 and all(compressed[1:])  # the first odd BP only is taut
     eq = Equilibrium(scene, disc)
     assert np.abs(eq.residual(bottom.u, Parameters(bottom.pressure))[disc.free]).max() <= 1e-9

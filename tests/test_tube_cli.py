@@ -43,6 +43,8 @@ def test_run_writes_what_the_tube_pipeline_computes(run_file):
         assert [s["kind"] for s in stored["special_points"]] == [s.kind.value for s in branch.special]
         assert [s["pressure"] for s in stored["special_points"]] == [s.pressure for s in branch.special]
         assert stored["attrs"]["stop_code"] == branch.stop.code.value
+        assert np.array_equal(stored["smallest_stress"], branch.smallest_stress)
+        assert branch.smallest_stress.min() > -1e-8  # a closed sliding tube stays taut (no point flagged)
     kinds = [(s["kind"], s["block"]) for s in run["branches"]["primary"]["special_points"]]
     assert kinds[:2] == [("LP", ""), ("BP", "odd")] and ("LV", "") in [(s["kind"], s["block"]) for s in
                                                                         run["branches"]["bulge"]["special_points"]]

@@ -1,6 +1,9 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, Maxwell's pressure,
-per branch its points, P and V/V0 ranges, its stop and its located points."""
+per branch its points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py) and
+its located points (those in a compressed state marked: docs/shapes.md)."""
 import math
+
+from ..tube.stability import COMPRESSED
 
 
 def summarise_tube(run: dict) -> dict:
@@ -14,6 +17,7 @@ def summarise_tube(run: dict) -> dict:
                           "stop_message": b["attrs"]["stop_message"],
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
+                          "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
                           "special_points": b["special_points"]}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
@@ -36,9 +40,11 @@ def format_tube(summary: dict) -> str:
              f"Maxwell        P_M = {maxwell}"]
     for name, b in summary["branches"].items():
         lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
-                      f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"]
+                      f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"
+                      + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")]
         for k, s in enumerate(b["special_points"]):
             block = f" {s['block']}" if s["block"] else ""
+            compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
-                         f"V/V0 = {s['volume']:.8g}  {s['status']}")
+                         f"V/V0 = {s['volume']:.8g}  {s['status']}{compressed}")
     return "\n".join(lines)

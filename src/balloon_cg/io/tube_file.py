@@ -5,10 +5,11 @@ Root attributes: the format, the scene (name, TOML), the shape and its parameter
 ``axial_stretch``: NaN where the ends' distance is free), the discretisation (``degree``, ``quadrature``),
 ``maxwell_pressure`` (NaN where there is none) and the provenance. One group per branch under /branches/<name>/:
 per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``
-and ``unstable_volume`` (negative eigenvalues of ∂R/∂u without and with δV = 0), ``lowest_even``/``lowest_odd``
-(the mirror blocks' lowest eigenvalues, on the primary branch); its located points under special_points/ (``kind``,
-``block``, ``status``, ``index``, ``pressure``, ``volume``, ``unknowns``), and its stop (``stop_code``,
-``stop_message`` attributes).
+and ``unstable_volume`` (negative eigenvalues of ∂R/∂u without and with δV = 0), ``smallest_stress`` (the smallest
+principal stress: negative where the membrane is compressed, tube/stability.py), ``lowest_even``/``lowest_odd`` (the
+mirror blocks' lowest eigenvalues, on the primary branch); its located points under special_points/ (``kind``,
+``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``, ``unknowns``), and its stop
+(``stop_code``, ``stop_message`` attributes).
 """
 import math
 from pathlib import Path
@@ -23,8 +24,8 @@ from ..scene.tables import Ends
 from ..tube.primary import volume_ratio
 
 FORMAT = "balloon-cg-tube/1"
-POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume")
-SPECIAL_NUMBERS = ("index", "pressure", "volume")
+POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress")
+SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 SPECIAL_TEXT = ("kind", "block", "status")
 
 
@@ -49,7 +50,8 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
             checksummed(group, "unknowns", branch.states)
             for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
                                    ("unstable_pressure", branch.unstable["pressure"]),
-                                   ("unstable_volume", branch.unstable["volume"])):
+                                   ("unstable_volume", branch.unstable["volume"]),
+                                   ("smallest_stress", branch.smallest_stress)):
                 checksummed(group, column, values)
             for block, values in branch.lowest.items():
                 checksummed(group, f"lowest_{block.value}", values)
@@ -63,6 +65,7 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
             eq = Equilibrium(scene, branch.disc)
             volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
             checksummed(special, "volume", np.array(volume, dtype=float))
+            checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
             checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), -1))
     return Path(path)
 

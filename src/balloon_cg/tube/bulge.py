@@ -17,9 +17,9 @@ sign rounding).
 """
 import numpy as np
 
-from .primary import TubeSystem, held, volume_ratio
+from .primary import TubeSystem, held, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop
-from .stability import unstable_counts
+from .stability import smallest_stress, unstable_counts
 from ..analysis.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
@@ -88,5 +88,5 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                     f.status) for f in sorted(folds, key=lambda f: f.index))
     points = [system.full(X)] + [system.full(p.X) for p in path.points]
     return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
-                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points), special,
-                          path.stop)
+                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points),
+                          stressed(eq, special), path.stop, np.array([smallest_stress(eq, Y[:-1]) for Y in points]))

@@ -18,10 +18,12 @@ zero where it is not is the fold in P itself (LP). Stability at every point: tub
 On a tube with sliding closed ends the branch is the uniform tube (model/tube.py's closed-end path, exact in the
 basis) and its first odd-block branch point is the onset of the bulge mode cos(πS/L) (model/tube.bulge_onset).
 """
+from dataclasses import replace
+
 import numpy as np
 
 from .results import IntervalBranch, IntervalSpecial, IntervalStop
-from .stability import spectrum, unstable_counts
+from .stability import smallest_stress, spectrum, unstable_counts
 from ..analysis.crossings import count_changes
 from ..analysis.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
@@ -114,7 +116,13 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     volume = np.array([volume_ratio(eq, Y) for Y in full])
     lowest = {block: spectra[block][:, 0] for block in Mirror}
     return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
-                          unstable_counts(eq, full), tuple(special), path.stop)
+                          unstable_counts(eq, full), stressed(eq, special), path.stop,
+                          np.array([smallest_stress(eq, Y[:-1]) for Y in full]))
+
+
+def stressed(eq: Equilibrium, special) -> tuple:
+    """The located points with their ``smallest_stress``."""
+    return tuple(replace(s, smallest_stress=smallest_stress(eq, s.u)) for s in special)
 
 
 def _start(parameters: ParameterSystem, disc: IntervalDiscretisation, solver) -> np.ndarray:

@@ -21,7 +21,8 @@ class IntervalStop(enum.StrEnum):
 class IntervalSpecial:
     """A located point: LP (fold in P), LV (fold in V) or BP (``block`` the mirror block whose lowest eigenvalue
     vanishes), its state ``u`` and pressure, between points ``index`` and ``index + 1`` (the last index: in the step
-    that passed the stop, whose end is not stored); ``status`` of its location."""
+    that passed the stop, whose end is not stored); ``status`` of its location; ``smallest_stress`` of its state
+    (negative: the membrane is compressed there and the point is not to be trusted: tube/stability.py)."""
 
     kind: Kind
     u: np.ndarray
@@ -29,6 +30,7 @@ class IntervalSpecial:
     index: int
     status: RootStatus
     block: Mirror | None = None
+    smallest_stress: float = np.nan  # tube/stability.smallest_stress of the state: compressed below COMPRESSED
 
 
 @dataclass(frozen=True)
@@ -36,7 +38,8 @@ class IntervalBranch:
     """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
     lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
     mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
-    Control.PRESSURE and Control.VOLUME -> int array), the located points and why the trace stopped."""
+    Control.PRESSURE and Control.VOLUME -> int array), the located points, why the trace stopped and the smallest
+    principal stress at every point (negative: compressed, tube/stability.py)."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
@@ -46,6 +49,7 @@ class IntervalBranch:
     unstable: dict
     special: tuple
     stop: Stop
+    smallest_stress: np.ndarray  # per point: tube/stability.smallest_stress
 
     def branch_points(self, block: Mirror | None = None) -> list:
         return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]

@@ -1,12 +1,18 @@
 """Stability of a tube's states (m = 0): the spectra of the mirror blocks of ∂R/∂u and the number of unstable
 directions under pressure control (all of u's unknowns: a held λ̄ is not one) and under volume control (on
 δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman factorisation (numerics/eigen.py: ``restricted``
-removes the constraint)."""
+removes the constraint); and where the membrane is compressed (``smallest_stress``): a membrane wrinkles where a
+principal stress is negative, its Ritz problem is not elliptic there and the states and eigenvalues computed there
+do not converge in the degree (docs/shapes.md: the plugged tube's necks)."""
 import numpy as np
 
 from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..model import meridian
+from ..model.stresses import elastic_stresses
 from ..numerics.eigen import GramFactor, negative_count, restricted
 from ..scene.loading import Control
+
+COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the stresses are O(1)) is compression
 
 
 def unstable_counts(eq: Equilibrium, points) -> dict:
@@ -28,3 +34,12 @@ def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> np.ndarray:
     """The eigenvalues (ascending) of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``."""
     H = eq.jacobian(Y[:-1], Parameters(Y[-1]))
     return np.linalg.eigvalsh(H[np.ix_(index, index)])
+
+
+def smallest_stress(eq: Equilibrium, u: np.ndarray) -> float:
+    """The smallest elastic principal stress (λ1Φ_1, λ2Φ_2: model/stresses.py) over the quadrature nodes of the
+    state u; below COMPRESSED the membrane is compressed somewhere (module docstring)."""
+    disc = eq.disc
+    lam2, v, _, w = disc.node_state(u)
+    lam1 = meridian.meridional_stretch(eq.scene.geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
+    return float(min(np.min(stress) for stress in elastic_stresses(eq.scene.material, lam1, lam2)))
