@@ -26,9 +26,11 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
+from ..numerics.threads import limited_blas
 from ..scene.tables import Ends
 
 
+@limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None) -> IntervalBranch:
     """The branch switched at ``point``, a branch point of the odd block of ``primary`` (module docstring);

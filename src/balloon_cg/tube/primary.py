@@ -32,6 +32,7 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
+from ..numerics.threads import limited_blas
 from ..numerics.newton import newton
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
@@ -81,6 +82,7 @@ def discretisation(scene, degree: int | None = None) -> IntervalDiscretisation:
                                   scene.solver.quadrature, geometry.ends, geometry.axial_stretch)
 
 
+@limited_blas
 def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     """The primary branch of a tube scene (module docstring) at Legendre ``degree`` (None: solver.degree)."""
     disc = discretisation(scene, degree)
