@@ -309,7 +309,7 @@ def test_tube_scene_round_trips_and_the_sphere_pipeline_refuses_it(tmp_path):
 
 @pytest.mark.slow
 def test_bulge_propagates_at_maxwells_pressure():
-    """SPOM1, L = 20 (254 s on a loaded machine; degree 100 alone 33 s on a quiet one): the bulge branch to
+    """SPOM1, L = 20 (43 s on the loaded machine with one BLAS thread, 254 s before): the bulge branch to
     V/V0 = 420. Where its front is far from both ends (V/V0 ≥ 320) P is within 1e-6 of Maxwell's pressure
     (model/tube.maxwell_pressure, checked against the equal-area rule in tests/test_tube.py; measured ≤ 5.2e-7,
     1.2e-9 at V/V0 = 415), the same P(V) at degree 140 within 1e-7 (measured 2.3e-8: the pressure converges
