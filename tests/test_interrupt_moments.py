@@ -82,6 +82,8 @@ def interrupted_run(folder: Path, scene: str, run, expected: dict, t: float, sig
         assert got.code == 0 and line == "balloon-cg: a signal arrived once the work had finished: r.h5 is written whole"
         assert not stopped and digests(folder / "r.h5") == expected
         phase = "finished"
+    print(f"moment {t:.2f} s ({sig}): exit {got.code}, {phase}; after the signal {got.cpu_after:.3f} s CPU, "
+          f"{got.wall_after:.3f} s wall")
     if again:
         rerun = command(folder, run_argv(scene))
         assert rerun.code == 0 and rerun.stderr == "" and digests(folder / "r.h5") == expected, rerun.stderr
@@ -114,3 +116,85 @@ def test_a_signal_at_an_evenly_spaced_moment_of_the_two_coil_run(two_coils, k):
     code, _ = interrupted_run(folder, scene, run, expected, evenly(run.run_cpu, SLOW_MOMENTS)[k], SIGNALS[k % 2],
                               again=k == SLOW_MOMENTS // 2)
     assert code in (0, 130)
+
+
+# --- sweeps ------------------------------------------------------------------------------------------------
+
+SWEEP_SCENE = '[material]\npreset = "SPOM1"\n'  # members: stop_stretch 4 .. 5 (primary branch, its stability,
+#                                                  branch points, pear branches: ~0.2 s of CPU each)
+WHOLE_SWEEP_SCENE = FAST_SCENE  # members: M = 0.0016 .. 0.0024
+FAST_SWEEP_MOMENTS = 4
+KEPT = "balloon-cg: interrupted: the finished members are stored; re-run the same command to resume"
+FINISHED = "after the work had finished: exit 0"
+
+
+def sweep_argv(output: str, workers: int, vary: str) -> list:
+    """Six members on ``workers`` processes (``vary``: a key that leaves the kernels as they are, so that a member's
+    CPU does not depend on which member loaded them first)."""
+    return ["sweep", "s.toml", "--vary", vary, "--workers", str(workers), "-o", output, "--quiet", "--allow-partial"]
+
+
+def member_digests(path: Path) -> dict:
+    return {name: digest for name, digest in digests(path).items() if name.startswith("members/")}
+
+
+def sweep_reference(folder: Path, vary: str, scene: str = SWEEP_SCENE):
+    """The uninterrupted serial sweep (each member's CPU, the members' digests)."""
+    (folder / "s.toml").write_text(scene)
+    done = command(folder, sweep_argv("reference.h5", 1, vary))
+    assert done.code == 0 and done.stderr == "", done.stderr
+    return folder, vary, done, member_digests(folder / "reference.h5")
+
+
+def interrupted_sweep(reference, t: float, sig: str, output: str):
+    """The sweep on 2 workers signalled ``t`` CPU seconds into its members' work: exit 130 and the line (or 0 when it
+    had finished), the parent's CPU after the signal, the file holding exactly the stored members, each equal to the
+    serial reference's; then the same command resumes it: every member equal to the reference's, bit for bit."""
+    from balloon_cg.io.sweep_file import store_path
+
+    folder, vary, serial, expected = reference
+    got = command(folder, sweep_argv(output, 2, vary), sig, in_members(serial, t))
+    if got.fired:
+        assert got.cpu_after <= LATENCY, (got.cpu_after, got.stderr)
+        line = one_line(got.stderr)
+        assert (got.code, line) in ((130, KEPT), (0, f"balloon-cg: {sig} {FINISHED}")), (got.code, line)
+    else:  # every member finished before the moment (a replay faster than the reference)
+        assert got.code == 0 and got.stderr == "", got.stderr
+    stored = sorted(int(p.stem) for p in store_path(folder / output).glob("0*.h5"))
+    print(f"moment {t:.2f} s ({sig}): exit {got.code}, {len(stored)} members stored; after the signal "
+          + (f"{got.cpu_after:.3f} s CPU, {got.wall_after:.3f} s wall" if got.fired else "nothing (finished)"))
+    assert sorted(bc.load(folder / output).members) == stored  # the view is the store: what the line says is kept
+    kept = member_digests(folder / output)
+    assert kept == {name: expected[name] for name in kept}
+    again = command(folder, sweep_argv(output, 2, vary))
+    assert again.code == 0 and again.stderr == "", again.stderr
+    assert member_digests(folder / output) == expected
+    return got.code
+
+
+@pytest.fixture(scope="module")
+def sweep(tmp_path_factory):
+    return sweep_reference(tmp_path_factory.mktemp("sweep"), "stop_stretch=4:5:6")
+
+
+@pytest.mark.parametrize("k", range(FAST_SWEEP_MOMENTS))
+def test_a_signal_at_an_evenly_spaced_moment_of_a_sweep(sweep, k):
+    """Six SPOM1 members on 2 workers, moment k of 4 of their CPU laid end to end (SIGINT and SIGTERM in turn)."""
+    serial = sweep[2]
+    assert interrupted_sweep(sweep, evenly(sum(serial.record["member_cpu"].values()), FAST_SWEEP_MOMENTS)[k],
+                             SIGNALS[k % 2], f"w{k}.h5") in (0, 130)
+
+
+@pytest.fixture(scope="module")
+def whole_sweep(tmp_path_factory):
+    return sweep_reference(tmp_path_factory.mktemp("whole_sweep"), "M=0.0016:0.0024:6", WHOLE_SWEEP_SCENE)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("k", range(SLOW_MOMENTS))
+def test_a_signal_at_an_evenly_spaced_moment_of_a_whole_sweep(whole_sweep, k):
+    """Six two-coil members analysed whole (the fast run's scene: every phase, ~3 s of CPU a member) on 2 workers,
+    moment k of 10."""
+    serial = whole_sweep[2]
+    assert interrupted_sweep(whole_sweep, evenly(sum(serial.record["member_cpu"].values()), SLOW_MOMENTS)[k],
+                             SIGNALS[k % 2], f"w{k}.h5") in (0, 130)
