@@ -23,11 +23,11 @@ import h5py
 import numpy as np
 
 DRIVER = r'''
-import atexit, contextlib, functools, json, os, signal, sys, time
+import atexit, contextlib, functools, importlib, json, os, signal, sys, time
 sig, where, offset, report, argv = (getattr(signal, sys.argv[1]), sys.argv[2], float(sys.argv[3]), sys.argv[4],
                                     sys.argv[5:])
-record = {"start_cpu": time.process_time(), "armed_cpu": None, "expiry_cpu": None, "received_wall": None,
-          "received_cpu": None, "clock_cpu": None, "events": [], "marks": 0, "member_cpu": {}}
+record = {"start_cpu": time.process_time(), "armed_cpu": None, "expiry_cpu": None, "sent_wall": None, "received_wall": None,
+          "received_cpu": None, "clock_cpu": None, "call_cpu": None, "events": [], "marks": 0, "member_cpu": {}}
 DRIVER = os.getpid()
 install = signal.signal
 
@@ -49,11 +49,13 @@ signal.signal = noting
 
 def expired(signum, frame):  # the timer: the signal goes to the command's process (a sweep's parent)
     if os.getpid() == DRIVER:
-        record["expiry_cpu"] = record["armed_cpu"] + offset
+        record["expiry_cpu"], record["sent_wall"] = record["armed_cpu"] + offset, time.monotonic()
     os.kill(DRIVER, sig)
 
 
 def arm():
+    if offset == float("inf"):  # a reference: never
+        return
     if os.getpid() == DRIVER:
         record["armed_cpu"] = time.process_time()
     signal.setitimer(signal.ITIMER_PROF, offset)
@@ -129,6 +131,19 @@ def timed_member(index, *args):
 
 
 sweep.compute_member = timed_member
+if where.startswith("call "):  # the timer armed as the command's handler is called (after the imports)
+    module, _, name = where.removeprefix("call ").partition(":")
+    module = importlib.import_module(module)
+    handler = getattr(module, name)
+
+    @functools.wraps(handler)
+    def called(*args, **kwargs):
+        if record["call_cpu"] is None:
+            record["call_cpu"] = time.process_time()
+            arm()
+        return handler(*args, **kwargs)
+
+    setattr(module, name, called)
 sys.argv = ["balloon-cg", *argv]
 sys.exit(run())
 '''
@@ -142,8 +157,9 @@ class Moment:
 
     @property
     def fired(self) -> bool:
-        """Whether the signal was sent (the moment came before the command ended)."""
-        return self.record["received_wall"] is not None
+        """Whether the signal was sent (the moment came before the command ended): by this process's timer, or
+        received from a sweep member's worker."""
+        return self.record["expiry_cpu"] is not None or self.record["received_wall"] is not None
 
     @property
     def cpu_after(self) -> float:
@@ -153,8 +169,14 @@ class Moment:
 
     @property
     def wall_after(self) -> float:
-        """Wall seconds from the signal's receipt to exit (not a pass criterion: load stretches it)."""
-        return self.record["exit_wall"] - self.record["received_wall"]
+        """Wall seconds from the signal (sent by this process's timer, else received) to exit (not a pass criterion:
+        load stretches it)."""
+        return self.record["exit_wall"] - (self.record["sent_wall"] or self.record["received_wall"])
+
+    @property
+    def handler_cpu(self) -> float:
+        """The CPU seconds from the call of the command's handler (``handled``) to exit."""
+        return self.record["exit_cpu"] - self.record["call_cpu"]
 
     @property
     def run_cpu(self) -> float:
@@ -203,6 +225,13 @@ def anchored(reference: Moment, t: float) -> tuple[tuple, str]:
         if kind == "enter":
             open_phases.append(name)
     return (f"mark {marks}", at - since), (open_phases[-1] if open_phases else "")
+
+
+def handled(handler: str, t: float = float("inf")) -> tuple:
+    """The moment ``t`` CPU seconds after the command's handler (``module:function``, e.g.
+    ``balloon_cg.app.cli:continue_run``) is called: for commands without a run's clock (the default: never, the
+    call's CPU noted for a reference)."""
+    return f"call {handler}", t
 
 
 def in_members(reference: Moment, t: float) -> tuple:

@@ -18,7 +18,7 @@ import pytest
 
 import balloon_cg as bc
 
-from cpu_moments import NEVER, anchored, command, digests, evenly, in_members
+from cpu_moments import anchored, command, digests, evenly, handled, in_members
 
 ROOT = Path(__file__).resolve().parents[1]
 LATENCY = 2.0  # CPU seconds from the signal to the process's exit (issue 42: "within 2 s of the signal")
@@ -57,37 +57,62 @@ def one_line(err: str) -> str:
 
 
 def interrupted_run(folder: Path, scene: str, run, expected: dict, t: float, sig: str, again: bool):
-    """The run signalled ``t`` CPU seconds into its work (``run``: the reference): the contract, and with ``again``
-    the same command without a signal writes the reference bit for bit. Returns (exit code, phase named)."""
-    moment, _ = anchored(run, t)
-    got = command(folder, run_argv(scene), sig, moment)
+    """The run signalled ``t`` CPU seconds into its work (``run``: the reference): ``signalled``."""
+    return signalled(folder, run_argv(scene), anchored(run, t)[0], sig, expected, "r.h5", again)
+
+
+def signalled(folder: Path, argv: list, moment: tuple, sig: str, expected: dict, output: str, again: bool):
+    """`balloon-cg argv` (writing ``output``) signalled at ``moment``: within LATENCY of CPU, exit 130 with one line
+    that says what the file says (a run file: its last interrupted entry; a curve file: its end; or that nothing is
+    written, and nothing is), or 0 when the work had finished (the line says so, the file is the reference's);
+    with ``again``, the same command without a signal writes ``expected`` bit for bit. Returns (exit code, the
+    phase the line names, or what it says)."""
+    path = folder / output
+    path.unlink(missing_ok=True)
+    got = command(folder, argv, sig, moment)
     if not got.fired:  # the work ended before the moment (a replay faster than the reference): exit 0, the result
-        assert got.code == 0 and got.stderr == "" and digests(folder / "r.h5") == expected, got.stderr
+        assert got.code == 0 and got.stderr == "" and digests(path) == expected, got.stderr
         return 0, "finished"
     assert got.cpu_after <= LATENCY, (got.cpu_after, got.stderr)
     line = one_line(got.stderr)
-    with h5py.File(folder / "r.h5", "r") as f:
+    if got.code == 0:  # the work had finished (the signal came in the write): the whole result, and the line says so
+        assert line == f"balloon-cg: a signal arrived once the work had finished: {output} is written whole", line
+        assert digests(path) == expected
+        said = "finished"
+    else:
+        assert got.code == 130, (got.code, line)
+        said = interrupted_file(path, line)
+    print(f"moment {moment} ({sig}): exit {got.code}, {said}; after the signal {got.cpu_after:.3f} s CPU, "
+          f"{got.wall_after:.3f} s wall")
+    if again:
+        rerun = command(folder, argv)
+        assert rerun.code == 0 and rerun.stderr == "" and digests(path) == expected, rerun.stderr
+    return got.code, said
+
+
+def interrupted_file(path: Path, line: str) -> str:
+    """What the line of an interrupted command says, checked against its file ``path``."""
+    nothing = (f"balloon-cg: interrupted: nothing is written to {path.name} (", "balloon-cg: error: interrupted")
+    if line.startswith(nothing):  # before the work (or the curve) started: no file
+        assert not path.exists(), line
+        return "nothing written"
+    bc.load(path)  # every reader's checks pass
+    with h5py.File(path, "r") as f:
+        curves = [(group.attrs["end"], len(group["point"])) for group in f.get("two_parameter", {}).values()]
+        if curves:  # a curve file: the line names its end and its length
+            ((end, points),) = curves
+            assert end == "interrupted" and line == (f"balloon-cg: interrupted: the curve is written to {path.name} "
+                                                     f"(end: interrupted, {points} points)"), (end, line)
+            return "curve interrupted"
         complete = bool(f.attrs["complete"])
         entries = list(zip(f.attrs["incomplete_gaps"], f.attrs["incomplete_branches"],
                            f.attrs["incomplete_messages"]))
     stopped = [(branch, message) for gap, branch, message in entries if gap == "interrupted"]
-    if got.code == 130:  # the line names the file's (last) interrupted entry, the file is flagged and reads
-        branch, message = stopped[-1]
-        assert line == (f"balloon-cg: interrupted ({branch}: {message}); what was finished is written to r.h5 "
-                        "(flagged incomplete)"), (line, entries)
-        assert not complete
-        bc.load(folder / "r.h5")  # every reader's checks pass
-        phase = message.partition(" during ")[2].partition(":")[0] or message
-    else:  # the work had finished (the signal came in the write): the whole result, and the line says so
-        assert got.code == 0 and line == "balloon-cg: a signal arrived once the work had finished: r.h5 is written whole"
-        assert not stopped and digests(folder / "r.h5") == expected
-        phase = "finished"
-    print(f"moment {t:.2f} s ({sig}): exit {got.code}, {phase}; after the signal {got.cpu_after:.3f} s CPU, "
-          f"{got.wall_after:.3f} s wall")
-    if again:
-        rerun = command(folder, run_argv(scene))
-        assert rerun.code == 0 and rerun.stderr == "" and digests(folder / "r.h5") == expected, rerun.stderr
-    return got.code, phase
+    branch, message = stopped[-1]  # the line names the file's (last) interrupted entry, the file is flagged
+    assert line == (f"balloon-cg: interrupted ({branch}: {message}); what was finished is written to {path.name} "
+                    "(flagged incomplete)"), (line, entries)
+    assert not complete
+    return message.partition(" during ")[2].partition(":")[0] or message
 
 
 @pytest.mark.parametrize("k", range(FAST_MOMENTS))
@@ -198,3 +223,67 @@ def test_a_signal_at_an_evenly_spaced_moment_of_a_whole_sweep(whole_sweep, k):
     serial = whole_sweep[2]
     assert interrupted_sweep(whole_sweep, evenly(sum(serial.record["member_cpu"].values()), SLOW_MOMENTS)[k],
                              SIGNALS[k % 2], f"w{k}.h5") in (0, 130)
+
+
+# --- continue and critical ---------------------------------------------------------------------------------
+
+HANDLED_MOMENTS = 4
+
+
+def handled_moments(folder: Path, argv: list, handler: str, output: str, k: int):
+    """Moment k of HANDLED_MOMENTS of a command without a run's clock, evenly spaced over its CPU from its handler's
+    call (``handled``; the reference computed once per folder and command)."""
+    key = (folder, tuple(argv))
+    if key not in REFERENCES:
+        done = command(folder, argv, moment=handled(handler))
+        assert done.code == 0 and done.stderr == "", done.stderr
+        REFERENCES[key] = done, digests(folder / output)
+    done, expected = REFERENCES[key]
+    t = evenly(done.handler_cpu, HANDLED_MOMENTS)[k]
+    return signalled(folder, argv, handled(handler, t), SIGNALS[k % 2], expected, output, again=True)
+
+
+REFERENCES = {}
+
+
+@pytest.mark.parametrize("k", range(HANDLED_MOMENTS))
+def test_a_signal_at_an_evenly_spaced_moment_of_continue(fast, k):
+    """`continue` at the fast run's held pear point (label 3): the pear branch and its mirror image traced,
+    assessed, their natural frequencies; as run: what is finished is written, flagged, and the line says so."""
+    folder = fast[0]
+    argv = ["continue", "reference.h5", "3", "-o", "c.h5", "--force", "--quiet"]
+    code, _ = handled_moments(folder, argv, "balloon_cg.app.cli:continue_run", "c.h5", k)
+    assert code in (0, 130)
+
+
+@pytest.mark.parametrize("k", range(HANDLED_MOMENTS))
+def test_a_signal_at_an_evenly_spaced_moment_of_critical(tmp_path_factory, k):
+    """`critical` (SPOM1's pear pitchforks in alpha1): exit 130 when its file says interrupted (or nothing is
+    written), 0 when the curve had ended, whatever the flag says."""
+    folder = tmp_path_factory.getbasetemp() / "critical"
+    folder.mkdir(exist_ok=True)
+    argv = ["critical", "spom1", "--parameter", "alpha1", "--set", "continuation.stop_stretch=3", "-o", "k.h5",
+            "--force", "--quiet"]
+    code, _ = handled_moments(folder, argv, "balloon_cg.app.cli:critical", "k.h5", k)
+    assert code in (0, 130)
+
+
+def test_a_signal_once_the_work_had_finished_exits_0_and_says_so(fast, tmp_path):
+    """The exit follows the file, not the flag: a SIGTERM after the work of `critical` (the curve ended) and of
+    `continue` (restart returned) came before the write: the file is written whole, exit 0, one line saying so (the
+    moment picked by a wrapped function: tests/test_signal_moments)."""
+    from test_signal_moments import balloon_cg
+
+    code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.app.cli:_pitchfork_curve",
+                           ["critical", "spom1", "--parameter", "alpha1", "--set", "continuation.stop_stretch=3",
+                            "-o", "k.h5", "--quiet"])
+    assert code == 0 and one_line(err) == "balloon-cg: a signal arrived once the work had finished: k.h5 is written whole"
+    with h5py.File(tmp_path / "k.h5", "r") as f:
+        assert f["two_parameter/pear"].attrs["end"] == "isola_merge"
+    folder = fast[0]
+    code, err = balloon_cg(folder, "SIGTERM", "after balloon_cg.app.restart:restart",
+                           ["continue", "reference.h5", "3", "-o", "after.h5", "--quiet", "--force"])
+    assert code == 0 and one_line(err) == ("balloon-cg: a signal arrived once the work had finished: after.h5 is "
+                                           "written whole")
+    with h5py.File(folder / "after.h5", "r") as f:
+        assert f.attrs["complete"] and "interrupted" not in list(f.attrs["incomplete_gaps"])

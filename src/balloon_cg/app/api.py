@@ -311,11 +311,12 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
     yet: its picture), or the whole picture (analysis.picture.analyse; its
     axisymmetric branches, then its surface branches); ``clock`` the seconds of each phase (analysis.timing,
     started here: the writer adds its own). With [dynamics] frequencies = true the axisymmetric branches get their
-    natural frequencies (dynamics.frequencies.attach; not after a signal, and a signal during them stops them:
-    ``_with_frequencies``)."""
+    natural frequencies (dynamics.frequencies.attach_to: not after a signal, and a signal during them stops
+    them)."""
     from ..analysis.picture import Picture, analyse as analyse_picture
     from ..analysis.primary import trace_primary
     from ..analysis.timing import Clock, Step
+    from ..dynamics.frequencies import attach_to
 
     clock = Clock()
     with PhaseBars(scene.name, progress) as bars:
@@ -324,30 +325,11 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
                 branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
             bars.finish(Phase.PRIMARY, len(branches[0].X))
             traced = Picture(branches, clock=clock)  # for its verdict: what is incomplete, a signal's phase
-            _with_frequencies(traced, scene)
+            attach_to(traced, scene.dynamics)
             return branches, None, traced.incomplete, None, clock
         picture = analyse_picture(scene, bars, pear=pear, clock=clock)
-        _with_frequencies(picture, scene)
+        attach_to(picture, scene.dynamics)
         return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture, clock
-
-
-def _with_frequencies(picture, scene: Scene) -> None:
-    """The natural frequencies of the picture's axisymmetric branches (dynamics.frequencies.attach), timed, when the
-    scene asks for them ([dynamics] frequencies = true) and no signal stopped the work; a signal during them stops
-    them at the next point (the branches not reached are kept without) and the picture is interrupted in that
-    phase (``analysis.picture.stopped``)."""
-    from ..analysis.picture import stopped
-    from ..analysis.timing import Step
-    from ..dynamics.frequencies import attach
-    from ..numerics.interrupt import Interrupted, requested
-
-    if not scene.dynamics.frequencies or requested():
-        return
-    try:
-        with picture.clock.step(Step.FREQUENCIES):
-            attach(picture.branches, scene.dynamics.count, scene.dynamics.m_max, scene.dynamics.modes)
-    except Interrupted:
-        stopped(picture)
 
 
 def trace(scene, progress: bool = False) -> Result:
