@@ -9,7 +9,8 @@ on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: 
 end in a verified merge of the pitchforks or cusp); 2 bad input (invalid scene, missing or unreadable file, existing
 output without --force or in use by another process, a damaged file, a scene ``critical`` cannot handle); 3 an
 internal error (a bug: one line asking to report it; ``--debug`` shows the traceback); 130 interrupted (SIGINT or
-SIGTERM: ``run`` and ``critical`` stop at the next point and write what is finished, flagged incomplete). Errors
+SIGTERM: ``run``, ``continue`` and ``critical`` stop at the next point and write what is finished, flagged
+incomplete; their exit follows the file: 0 when the work had finished before the signal, and they say so). Errors
 are one line on stderr, ``balloon-cg: error: ...``.
 """
 import argparse
@@ -676,7 +677,8 @@ def critical(args) -> int:
     (q, P)), not equator-symmetric (the pear block needs the equator-symmetric layout), ``--parameter M`` without
     coils, or a parameter the scene's kernels do not take (one line listing those they do:
     ``analysis.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as ``run``): the work stops at its next
-    point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is.
+    point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is;
+    the exit follows the file (a curve that had ended when the signal came: its own status, and a line saying so).
     Progress goes to stderr (``--quiet``: none).
     """
     from ..io.lock import claim

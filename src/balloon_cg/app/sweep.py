@@ -305,7 +305,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
                         bar.update()
         finally:
             if not force:
-                consolidate(path, store.directory)
+                consolidate(path, store.directory, written=set(result.computed))
             elif len(store.done) == len(members):
                 commit_replacement(path)
                 result.store = store_path(path)
