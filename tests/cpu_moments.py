@@ -1,19 +1,22 @@
 """Signals at chosen moments of a command's own work, for the interrupt studies (issue 42): a moment is an amount of
 CPU time spent by the command (``setitimer(ITIMER_PROF)``: the process's CPU, all threads; in a sweep, the CPU of
-one member in its worker), so it lands anywhere in the work — inside a LAPACK call, a write, a pool wait — and at the
-same place of the work on an idle or a loaded machine (a wall-clock sleep would not). The latency is measured in the
-same clock: the command's CPU time from the moment (the timer's expiry) to Python's last atexit handler, ≤ 2 s by
-the contract; its wall time is recorded beside it (a loaded machine stretches it, so it is no pass criterion).
+one member in its worker), so it lands anywhere in the work (inside a LAPACK call, a write, a pool wait) and at the
+same place of the work on an idle or a loaded machine, where a wall-clock sleep would not. The timer is armed at a
+mark of the work: a phase of the run's clock entered or a point done (``anchored``: the last mark before the
+moment in a reference run), a sweep member started (``in_members``), the command's handler called (``handled``).
+The latency is measured in the same clock: the command's CPU time from the moment (the timer's expiry; in a
+sweep, the signal's receipt) to Python's last atexit handler; its wall time is recorded beside it (a loaded
+machine stretches it, so it is no pass criterion).
 
-``command(folder, argv, sig, at=...)`` runs `balloon-cg argv` through the entry point (``balloon_cg.__main__.run``)
-in a fresh interpreter and returns a ``Moment``: exit code, stderr, and the driver's record: the CPU seconds at the
-timer's expiry and at exit, the wall seconds from the signal's receipt to exit, and (``at=None``: no signal) the
-CPU the whole command took, and per sweep member the CPU its computation took (``member_cpu``), from which the
-moments of a study are placed (``evenly``).
+``command(folder, argv, sig, moment)`` runs `balloon-cg argv` through the entry point (``balloon_cg.__main__.run``)
+in a fresh interpreter and returns a ``Moment``: exit code, stderr, and the driver's record (the marks of the run
+with their CPU times, each sweep member's CPU, the CPU at the moment and at exit), from which a reference run (no
+signal) places the moments of a study (``evenly``).
 """
 import hashlib
 import json
 import os
+import signal
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -65,6 +68,7 @@ install(signal.SIGPROF, expired)
 
 
 def exiting():
+    signal.setitimer(signal.ITIMER_PROF, 0)  # a moment after the work: not in Python's finalization (SIGPROF kills)
     record["exit_cpu"], record["exit_wall"] = time.process_time(), time.monotonic()
     with open(report, "w") as f:
         json.dump(record, f)
@@ -187,6 +191,12 @@ class Moment:
 NEVER = ("never", 0.0)
 
 
+def foreground() -> None:
+    """In the child before it starts: SIGINT as in a foreground process (a shell starts a background job, and so
+    its children, with SIGINT ignored, and Python then leaves it ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def command(folder: Path, argv: list, sig: str = "SIGTERM", moment: tuple = NEVER, workers: int = 1,
             timeout: float = 1800) -> Moment:
     """`balloon-cg argv` in ``folder``, ``sig`` sent to it at ``moment`` (``anchored``, ``in_members``; NEVER: no
@@ -196,7 +206,8 @@ def command(folder: Path, argv: list, sig: str = "SIGTERM", moment: tuple = NEVE
     env = os.environ | {"BALLOON_CG_WORKERS": str(workers)}
     where, offset = moment
     done = subprocess.run([sys.executable, "-c", DRIVER, sig, where, repr(offset), str(report), *argv],
-                          capture_output=True, text=True, timeout=timeout, cwd=folder, env=env)
+                          capture_output=True, text=True, timeout=timeout, cwd=folder, env=env,
+                          preexec_fn=foreground)
     record = json.loads(report.read_text())
     report.unlink()
     record["member_cpu"] = {int(k): v for k, v in record["member_cpu"].items()}
