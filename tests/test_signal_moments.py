@@ -12,6 +12,8 @@ import pytest
 
 import balloon_cg as bc
 
+from cpu_moments import foreground
+
 # The driver: a hook that sends ``sig`` to this process at ``moment``, then the `balloon-cg` entry point itself.
 DRIVER = r'''
 import atexit, importlib, os, signal, sys
@@ -50,7 +52,7 @@ def balloon_cg(tmp_path, sig: str, moment: str, argv: list, at_call: int = 1):
     """Run the `balloon-cg` entry point with ``argv``, ``sig`` sent to itself at ``moment``: (exit code, stderr)."""
     env = os.environ | {"BALLOON_CG_WORKERS": "1", "SIGNAL_AT_CALL": str(at_call)}
     done = subprocess.run([sys.executable, "-c", DRIVER, sig, moment, *argv], capture_output=True, text=True,
-                          timeout=300, cwd=tmp_path, env=env)
+                          timeout=300, cwd=tmp_path, env=env, preexec_fn=foreground)
     return done.returncode, done.stderr
 
 

@@ -202,6 +202,33 @@ def test_a_swallowed_interrupt_still_stops_the_sweep(scene, tmp_path, monkeypatc
     assert 1 <= len(list(store_path(tmp_path / "s.h5").glob("0*.h5"))) < 3  # member files; not all 3 computed
 
 
+# A pool whose worker is killed in the middle of sending its result: the parent's manager thread has read the
+# message's length and waits for the rest; the process must still exit once the pool is stopped.
+CUT_SEND = r"""
+import os, struct, sys, time
+from concurrent.futures import ProcessPoolExecutor
+from balloon_cg.app.sweep import _terminate
+
+pool = ProcessPoolExecutor(1)
+pool.submit(time.sleep, 600)  # a worker computing
+writer = pool._result_queue._writer.fileno()  # as the worker writes a result: its length, then only its start
+os.write(writer, struct.pack("!i", 2**20) + b"partial")
+_terminate(pool)
+print("stopped", flush=True)
+"""
+
+
+def test_a_worker_killed_while_sending_its_result_does_not_hang_the_exit():
+    """Found by the interrupt study (tests/test_interrupt_moments.py, 1 of 10 two-coil sweeps hung after its line:
+    Python's exit joined the manager thread, which read the rest of a result for ever). The timeout is a hang guard:
+    the process ends at once when it ends."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", CUT_SEND], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout == "stopped\n", done.stderr
+
+
 def test_resume_refuses_changed_scene(scene, tmp_path):
     path = tmp_path / "s.h5"
     run_sweep(scene, ["M=0,0.002"], path, mode=MODE, workers=1)

@@ -193,14 +193,23 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
     ``pear`` and ``[surface] branches`` ask, the m ≥ 1 points of every branch, the snap-throughs. ``control``: a
     branch without equator symmetry gets its stability changes under every control (LV, LN: ``control_points``),
     as a broken-symmetry primary does; a restarted pear branch does not, as ``run`` marks none on pear branches."""
-    progress, clock = progress or Progress(), clock or Clock()
-    picture = Picture([primary], clock=clock)
+    picture = Picture([primary], clock=clock or Clock())
+    try:
+        _examine(scene, picture, progress or Progress(), pear, control)
+    except interrupt.Interrupted:  # raised in a unit of work that polls inside (a plain degree's search): abandoned
+        stopped(picture)
+    return picture
+
+
+def _examine(scene, picture: Picture, progress: Progress, pear: bool, control: bool) -> None:
+    """``examine`` into ``picture`` (its primary branch traced)."""
+    primary, clock = picture.primary, picture.clock
     surface = pear and scene.surface.branches != "none"
     if stopped(picture):
-        return picture
+        return
     if not _assess(primary, scene, primary.disc.symmetric, progress, clock):
         stopped(picture)
-        return picture
+        return
     if primary.disc.symmetric:
         _branch_points(primary, picture)
     else:
@@ -218,26 +227,25 @@ def examine(scene, primary: Branch, progress: Progress | None = None, pear: bool
         picture.not_searched = _unsearched(primary, search, surface)
         pear = False  # no equator-symmetric pitchforks to switch at
     if stopped(picture):
-        return picture
+        return
     if pear:
         with clock.step(Step.PEAR_BRANCHES):
             _trace_pears(scene, primary, picture, progress)
         progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
     progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
     if not azimuthal_crossings(picture, picture.branches, scene):
-        return picture
+        return
     if surface:
         with clock.step(Step.SURFACE_BRANCHES):
             for branch in [b for b in picture.branches if b.name in (primary.name, FREE_PRIMARY)]:
                 _trace_surface(scene, branch, picture, progress)
                 if stopped(picture):
-                    return picture
+                    return
             unsearched_events(picture, scene)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
     label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
-    return picture
 
 
 def azimuthal_crossings(picture: Picture, branches: list, scene) -> bool:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..galerkin.discretisation import Discretisation
+from ..numerics import interrupt
 
 
 @dataclass(frozen=True)
@@ -54,12 +55,14 @@ class Resolution:
         """Per row X = (u, P): the Legendre degree in x that holds it. Its own degree if the basis is not mapped;
         else grown from ``start`` (default: the mapped degree) until the projection loses at most max_error and
         the projected tail is within max_error (the mapped degree is far below what x needs near a wire), at
-        most max_degree."""
+        most max_degree. A signal (``numerics.interrupt``) raises ``Interrupted`` at the next degree (near a wire
+        the search costs seconds: a projection's pseudo-inverse per degree up to 320)."""
         X = np.atleast_2d(X)
         degree = disc.degree if start is None else start
         degrees = np.full(len(X), disc.degree if disc.mapping is None else degree)
         open_rows = np.arange(len(X)) if disc.mapping is not None else np.arange(0)
         while open_rows.size and degree < self.max_degree:
+            interrupt.check()
             plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
             moved = disc.transfer(X[open_rows], plain)
             loss = transfer_error(disc, X[open_rows], plain, moved)

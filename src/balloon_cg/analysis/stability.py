@@ -430,6 +430,7 @@ def assess_branch(branch, degree: int, symmetric: bool | None = None, check: boo
         return variations[N].assess(branch.X[n][:-1], branch.params_at(branch.X[n]), symmetric, m_max)
 
     def fine_flags(n):
+        interrupt.check()  # as assess: a point at the check degree costs as much (~0.3 s near a wire)
         X = branch.X[n]
         return variations[check_degree(branch, degrees[n])].flags(X[:-1], branch.params_at(X), symmetric, m_max)
 

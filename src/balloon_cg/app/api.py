@@ -311,11 +311,12 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
     yet: its picture), or the whole picture (analysis.picture.analyse; its
     axisymmetric branches, then its surface branches); ``clock`` the seconds of each phase (analysis.timing,
     started here: the writer adds its own). With [dynamics] frequencies = true the axisymmetric branches get their
-    natural frequencies (dynamics.frequencies.attach)."""
-    from ..analysis.picture import analyse as analyse_picture
+    natural frequencies (dynamics.frequencies.attach_to: not after a signal, and a signal during them stops
+    them)."""
+    from ..analysis.picture import Picture, analyse as analyse_picture
     from ..analysis.primary import trace_primary
     from ..analysis.timing import Clock, Step
-    from ..analysis.verdict import incomplete
+    from ..dynamics.frequencies import attach_to
 
     clock = Clock()
     with PhaseBars(scene.name, progress) as bars:
@@ -323,23 +324,12 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
             with clock.step(Step.TRACE):
                 branches = [trace_primary(scene, progress=bars.ticker(Phase.PRIMARY))]
             bars.finish(Phase.PRIMARY, len(branches[0].X))
-            _with_frequencies(branches, scene, clock)
-            return branches, None, incomplete(branches), None, clock
+            traced = Picture(branches, clock=clock)  # for its verdict: what is incomplete, a signal's phase
+            attach_to(traced, scene.dynamics)
+            return branches, None, traced.incomplete, None, clock
         picture = analyse_picture(scene, bars, pear=pear, clock=clock)
-        branches = picture.branches + picture.surface_branches
-        _with_frequencies(branches, scene, clock)
-        return branches, picture.snaps, picture.incomplete, picture, clock
-
-
-def _with_frequencies(branches, scene: Scene, clock) -> None:
-    """The natural frequencies of the axisymmetric branches (dynamics.frequencies.attach), timed, when the scene asks
-    for them ([dynamics] frequencies = true)."""
-    from ..analysis.timing import Step
-    from ..dynamics.frequencies import attach
-
-    if scene.dynamics.frequencies:
-        with clock.step(Step.FREQUENCIES):
-            attach(branches, scene.dynamics.count, scene.dynamics.m_max, scene.dynamics.modes)
+        attach_to(picture, scene.dynamics)
+        return picture.branches + picture.surface_branches, picture.snaps, picture.incomplete, picture, clock
 
 
 def trace(scene, progress: bool = False) -> Result:

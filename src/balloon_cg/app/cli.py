@@ -9,7 +9,8 @@ on stderr; ``--allow-partial`` makes an incomplete result exit 0; ``critical``: 
 end in a verified merge of the pitchforks or cusp); 2 bad input (invalid scene, missing or unreadable file, existing
 output without --force or in use by another process, a damaged file, a scene ``critical`` cannot handle); 3 an
 internal error (a bug: one line asking to report it; ``--debug`` shows the traceback); 130 interrupted (SIGINT or
-SIGTERM: ``run`` and ``critical`` stop at the next point and write what is finished, flagged incomplete). Errors
+SIGTERM: ``run``, ``continue`` and ``critical`` stop at the next point and write what is finished, flagged
+incomplete; their exit follows the file: 0 when the work had finished before the signal, and they say so). Errors
 are one line on stderr, ``balloon-cg: error: ...``.
 """
 import argparse
@@ -319,7 +320,6 @@ def axisymmetric(scene, command: str):
 def run(args) -> int:
     """Analyse, write, read back and summarise; exit 130 when a signal stopped the work (what is finished is written,
     flagged interrupted: the message is the file's), or the run's own status when it had finished (and says so)."""
-    from ..analysis.verdict import Gap
     from ..io.run_file import read_run
     from ..numerics.interrupt import requested, stop_on_signals
     from .progress import shown
@@ -332,6 +332,22 @@ def run(args) -> int:
         _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
                              primary_only=args.primary_only)
         signalled = requested()
+    code = interrupted_status(found, output, signalled)
+    if code is not None:
+        return code
+    if not args.quiet:
+        from .summaries import format_run
+
+        print(format_run(read_run(output)))
+    return verdict_status(found, args.allow_partial)
+
+
+def interrupted_status(found: list, output, signalled: bool) -> int | None:
+    """130 when a signal stopped the work of a written run file (``found``, its Incomplete entries: the line names
+    the file's interrupted entry, so that the message and the file agree); else None, having said so when a signal
+    came once the work had finished (``signalled``: the file is whole)."""
+    from ..analysis.verdict import Gap
+
     stopped = [item for item in found if item.gap == Gap.INTERRUPTED]
     if stopped:
         print(f"{PROG}: interrupted ({stopped[-1].branch}: {stopped[-1].message}); what was finished is written to "
@@ -339,11 +355,23 @@ def run(args) -> int:
         return INTERRUPTED
     if signalled:
         print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
-    if not args.quiet:
-        from .summaries import format_run
+    return None
 
-        print(format_run(read_run(output)))
-    return verdict_status(found, args.allow_partial)
+
+def curve_interrupted_status(curve, output, signalled: bool, before: str = "the curve had not started") -> int | None:
+    """``interrupted_status`` of a two-parameter curve: 130 when its file says a signal ended it (end
+    ``interrupted``; ``curve`` None: ``before`` it started, nothing is written); else None, having said so when a
+    signal came once it had ended."""
+    from ..analysis.codim2 import CurveEnd
+
+    if curve is None or curve.end == CurveEnd.INTERRUPTED:
+        written = (f"nothing is written to {output} ({before})" if curve is None else
+                   f"the curve is written to {output} (end: {curve.end.value}, {len(curve.q)} points)")
+        print(f"{PROG}: interrupted: {written}", file=sys.stderr)
+        return INTERRUPTED
+    if signalled:
+        print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
+    return None
 
 
 def run_tube(scene, output, args) -> int:
@@ -694,7 +722,8 @@ def critical(args) -> int:
     (q, P)), not equator-symmetric (the pear block needs the equator-symmetric layout), ``--parameter M`` without
     coils, or a parameter the scene's kernels do not take (one line listing those they do:
     ``analysis.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as ``run``): the work stops at its next
-    point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is.
+    point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is;
+    the exit follows the file (a curve that had ended when the signal came: its own status, and a line saying so).
     Progress goes to stderr (``--quiet``: none).
     """
     from ..io.lock import claim
@@ -714,7 +743,7 @@ def _critical(args, scene) -> int:
     from ..analysis.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
     from ..io.output import check_output
-    from ..numerics.interrupt import requested, stop_on_signals
+    from ..numerics.interrupt import Interrupted, requested, stop_on_signals
     from ..scene import ContinuationParameter
 
     asymmetry = _asymmetry(scene)
@@ -731,16 +760,17 @@ def _critical(args, scene) -> int:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
     check_output(args.output, args.force)
     with stop_on_signals():
-        curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
+        try:
+            curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
+        except Interrupted:  # in a unit that polls inside (a plain degree's search) before the curve started
+            curve = None
         if curve is not None:
             write_curve(args.output, scene, curve, name=curve_group(curve), force=args.force,
                         extra_attrs={"command": args.command_line})
-        interrupted = requested()
-    if interrupted:
-        written = (f"nothing is written to {args.output} (the curve had not started)" if curve is None else
-                   f"the curve is written to {args.output} (end: {curve.end.value}, {len(curve.q)} points)")
-        print(f"{PROG}: interrupted: {written}", file=sys.stderr)
-        return INTERRUPTED
+        signalled = requested()
+    code = curve_interrupted_status(curve, args.output, signalled)  # what the file says, not the flag
+    if code is not None:
+        return code
     _say(args, f"curve: {len(curve.q)} points, ended: {curve.end.value}")
     if curve.end not in CODIM2_ENDS:
         raise Failure(f"no critical {curve.parameter}: {curve.describe()}; curve (end: {curve.end.value}) still "
@@ -921,57 +951,70 @@ def _continue(args) -> int:
     from ..analysis.second_parameter import UnknownParameter
     from ..io.curve_file import write_curve
     from ..io.output import check_output
-    from ..io.run_file import read_run, write_run
+    from ..io.run_file import read_run
+    from ..numerics.interrupt import Interrupted, requested, stop_on_signals
     from .restart import RestartError, find_label, restart, with_settings
 
     if args.direction != 1.0 and args.parameter is None:
         raise UsageError(f"continue: --direction {args.direction:g} starts a curve in a second parameter: give "
                          "--parameter KEY (without it the branch is traced both ways)")
     check_output(hdf5_output(args.output, "run"), args.force)
-    run = read_run(args.run)
-    try:
-        start = find_label(run, args.label)
-        start = with_settings(start, _with_settings(args, start.branch.scene)[1])
-        if args.parameter is not None:
-            field_needed(start.branch.scene, args.parameter, f"continue --parameter {args.parameter}", args.run)
-        result = restart(start, args.parameter, args.direction)
-    except (RestartError, UnknownParameter) as e:
-        raise UsageError(f"continue {args.run}: {e}") from None
-    except TwoParameterError as e:
-        raise Failure(f"the curve from label {args.label} could not start: {e}") from None
-    attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
-    if isinstance(result, Picture) and start.point.kind == Kind.BP:
-        return _write_switched(args, result, attrs)
-    if isinstance(result, Picture):
-        branch = result.primary
-        write_run(args.output, branch.scene, result.branches, force=args.force, extra_attrs=attrs,
-                  snaps=result.snaps, found=result.incomplete)
-        print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
-              f"{len(branch.special)} special points; written to {args.output}")
-        return verdict_status(result.incomplete, args.allow_partial)
-    write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
+    with stop_on_signals():  # as run: a signal stops the work at its next point, what is finished is written
+        try:
+            start = find_label(read_run(args.run), args.label)
+            start = with_settings(start, _with_settings(args, start.branch.scene)[1])
+            if args.parameter is not None:
+                field_needed(start.branch.scene, args.parameter, f"continue --parameter {args.parameter}", args.run)
+            if requested():  # while the file was read: nothing computed
+                return curve_interrupted_status(None, args.output, True, "the work had not started")
+            result = restart(start, args.parameter, args.direction)
+        except (RestartError, UnknownParameter) as e:
+            raise UsageError(f"continue {args.run}: {e}") from None
+        except Interrupted:  # a curve's start (a plain degree's search) abandoned
+            return curve_interrupted_status(None, args.output, True)
+        except TwoParameterError as e:
+            raise Failure(f"the curve from label {args.label} could not start: {e}") from None
+        attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
+        if isinstance(result, Picture):
+            return _write_continued(args, result, attrs, start.point.kind == Kind.BP)
+        write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
+        signalled = requested()
+    code = curve_interrupted_status(result, args.output, signalled)
+    if code is not None:
+        return code
     ending = f"{result.end.value}: {result.describe()}"
     print(f"{result.of.value} curve from label {args.label} in {result.parameter}: {len(result.q)} points, {ending}; "
           f"written to {args.output}")
     return 0
 
 
-def _write_switched(args, picture, attrs) -> int:
-    """``continue`` at a branch point: the branch of the point and the branches switched to (``picture``)
-    written (exit 0; 1 when incomplete, unless --allow-partial: ``verdict_status``), or none started
-    (``Failure``: exit 1, nothing written)."""
+def _write_continued(args, picture, attrs, switched: bool) -> int:
+    """``continue`` in the branch's own parameter: the branch traced again through the point, or at a branch point
+    (``switched``) the branch of the point and the branches switched to, written (under ``stop_on_signals``);
+    exit 0, 1 when incomplete unless --allow-partial (``verdict_status``), 130 when a signal stopped the work (what
+    was finished written, flagged: ``interrupted_status``); at a branch point where no branch started, ``Failure``
+    (exit 1, nothing written) unless a signal stopped them."""
     from ..analysis.results import Branch, stop_codes
     from ..io.run_file import write_run
+    from ..numerics.interrupt import requested
 
     branches = picture.branches + picture.surface_branches
-    if len(branches) == 1:
+    if switched and len(branches) == 1 and not picture.interrupted:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
     write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
               found=picture.incomplete)
-    listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
-                       f"{stop_codes(b.legs)})" for b in branches[1:])
-    print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
+    code = interrupted_status(picture.incomplete, args.output, requested())
+    if code is not None:
+        return code
+    if switched:
+        listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
+                           f"{stop_codes(b.legs)})" for b in branches[1:])
+        print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
+    else:
+        branch = picture.primary
+        print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
+              f"{len(branch.special)} special points; written to {args.output}")
     return verdict_status(picture.incomplete, args.allow_partial)
 
 

@@ -48,9 +48,9 @@ from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, 
 from ..analysis.surface_branches import SurfaceStartError
 from ..analysis.switching import mark_rejoin, pear_landing, pear_stop_rule
 from ..analysis.tracer import Tracer
-from ..dynamics.frequencies import attach
+from ..dynamics.frequencies import attach_to
 from ..galerkin.equilibrium import Parameters
-from ..numerics import continuation
+from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop, TraceStop
 from ..post.quantities import branch_discretisation, stored_scene
 
@@ -295,9 +295,11 @@ def pear_point(branch: Branch, start: Labelled) -> SpecialPoint:
     """The pear branch point of ``start`` (odd_held, or odd_free: the free balloon's) on the plain symmetric
     ``branch`` (``codim2.plain_branch``) with its critical mode, which run files do not store: the null vector of
     its block of the Hessian at the point (its smallest right singular vector, its largest entry positive so that
-    +φ is reproducible; ``codim2.continue_branch_point`` converges the extended system from it)."""
+    +φ is reproducible; ``codim2.continue_branch_point`` converges the extended system from it). A signal raises
+    ``Interrupted`` before the decomposition."""
     X = start.branch.disc.transfer(start.point.X, branch.disc)
     pear = WernerSpence(equilibrium_of(branch), branch.params, np.zeros(0), block=start.point.block)
+    interrupt.check()
     phi = np.linalg.svd(pear.odd_hessian(X[:-1], branch.params.with_value("P", X[-1])))[2][-1]
     mode = np.zeros(pear.embed.shape[0])
     mode[pear.odd] = phi * np.sign(phi[np.argmax(np.abs(phi))])
@@ -341,10 +343,17 @@ def switch(start: Labelled, progress=None) -> Picture:
     if point.block in PEAR_NAMES:
         points = numbered_branch_points(branch)
         n = next(i for i, s in enumerate(points) if s is point)
-        points[n] = replace(point, mode=pear_point(plain_branch(branch, point.X), start).mode)
         picture = Picture([branch], branch_points=points)
-        if pear_pair(branch.scene, branch, picture, n, progress):
-            azimuthal_crossings(picture, picture.branches[1:], branch.scene)
+        try:
+            plain = plain_branch(branch, point.X)
+            interrupt.check()  # each of the two costs ~1 s near a wire, and neither polls inside
+            points[n] = replace(point, mode=pear_point(plain, start).mode)
+            if pear_pair(branch.scene, branch, picture, n, progress):
+                azimuthal_crossings(picture, picture.branches[1:], branch.scene)
+            else:  # a signal stopped them
+                stopped(picture)
+        except interrupt.Interrupted:  # in a unit that polls inside (a plain degree's search): abandoned
+            stopped(picture)
         label_readings(picture.branches[1:])
         return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted,
                        interrupted_in=picture.interrupted_in)
@@ -367,14 +376,13 @@ def restart(start: Labelled, parameter: str | None, direction: float = 1.0, prog
     """What ``continue`` computes from ``start`` (module docstring): a Picture (in the branch's own parameter: of
     the branch through it, or at a branch point of the branch of the point and the branches switched to) or a
     two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built. The
-    Picture's branches get their natural frequencies when the scene asks for them ([dynamics])."""
+    Picture's branches get their natural frequencies when the scene asks for them ([dynamics]: not after a signal;
+    a signal during them interrupts the picture there, ``attach_to``)."""
     own = start.branch.parameter
     kind = start.point.kind
     if parameter in (None, own):
         picture = switch(start, progress) if kind == Kind.BP else restart_branch(start, progress)
-        dynamics = start.branch.scene.dynamics
-        if dynamics.frequencies:
-            attach(picture.branches + picture.surface_branches, dynamics.count, dynamics.m_max, dynamics.modes)
+        attach_to(picture, start.branch.scene.dynamics)
         return picture
     if kind in CONTROL_OF_FOLD:
         return continue_fold(start.branch, start.point, parameter, direction, progress=progress)

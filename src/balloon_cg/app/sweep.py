@@ -305,7 +305,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
                         bar.update()
         finally:
             if not force:
-                consolidate(path, store.directory)
+                consolidate(path, store.directory, written=set(result.computed))
             elif len(store.done) == len(members):
                 commit_replacement(path)
                 result.store = store_path(path)
@@ -405,7 +405,7 @@ def _terminate(pool) -> None:
     The order of Python 3.14's ``terminate_workers`` (no public API before): shut the pool without waiting (no
     queued member starts), terminate, then wait for each worker itself; waiting on the pool's manager thread
     after killing its workers can hang when a worker died holding the call queue's lock."""
-    processes = list((pool._processes or {}).values())
+    processes, results = list((pool._processes or {}).values()), pool._result_queue
     pool.shutdown(wait=False, cancel_futures=True)
     for process in processes:
         process.terminate()
@@ -414,6 +414,12 @@ def _terminate(pool) -> None:
         if process.exitcode is None:
             process.kill()
             process.join()
+    # a worker killed while it sent its result (a member's is megabytes) leaves the pool's manager thread reading the
+    # rest of the message for ever (this process holds the pipe's write end too), and Python's exit joins that thread:
+    # the sweep hung after its line (seen once in 10 interrupts of two-coil members); with the last write end closed
+    # the read ends (EOFError) and the thread with it
+    if results is not None:
+        results._writer.close()
 
 
 # The dask config of a sweep's workers: dask's nanny starts every worker with MALLOC_TRIM_THRESHOLD_=65536, and

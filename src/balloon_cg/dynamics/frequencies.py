@@ -15,9 +15,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..analysis.azimuthal import merged_lowest
+from ..analysis.picture import stopped
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Gauge, Kind, Origin
 from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
+from ..analysis.timing import Step
 from ..galerkin.profiles import theta_grid
 from ..numerics import interrupt, workers
 from ..numerics.threads import limited_blas
@@ -163,3 +165,17 @@ def attach(branches, count: int, m_max: int, modes: bool = False) -> None:
             source = done.get(branch.reflection_of) if branch.origin == Origin.REFLECTED else None
             branch.frequencies = done[branch.name] = branch_frequencies(branch, count, m_max, copied=source,
                                                                         modes=modes)
+
+
+def attach_to(picture, dynamics) -> None:
+    """``attach`` to the axisymmetric branches of ``picture`` (analysis.picture.Picture), timed (Step.FREQUENCIES),
+    when ``dynamics`` (the scene's [dynamics]) asks for them and no signal stopped the work; a signal during them
+    stops them at the next point (the branches not reached are kept without) and the picture is interrupted in
+    that phase (``picture.stopped``)."""
+    if not dynamics.frequencies or interrupt.requested():
+        return
+    try:
+        with picture.clock.step(Step.FREQUENCIES):
+            attach(picture.branches, dynamics.count, dynamics.m_max, dynamics.modes)
+    except interrupt.Interrupted:
+        stopped(picture)

@@ -247,11 +247,12 @@ class Discretisation:
         for name, value in _tables(self).items():
             object.__setattr__(self, name, value)
 
-    @functools.cached_property
+    @property
     def projection(self) -> np.ndarray:
         """Values at the nodes -> Legendre coefficients in s, by least squares (the Gauss-weight formula
-        (k + ½) Σ_q w_q P_k(s_q) f_q loses ~1e-9 at degree 320 at the poles: numpy's end weights carry ~3e-14)."""
-        return np.linalg.pinv(self._node_table)
+        (k + ½) Σ_q w_q P_k(s_q) f_q loses ~1e-9 at degree 320 at the poles: numpy's end weights carry ~3e-14);
+        shared by equal discretisations (``_projection``)."""
+        return _projection(self)
 
     def split(self, u: np.ndarray):
         """Full Legendre coefficient vectors (a, b) of length degree + 1 from the unknowns u (for a held mapped
@@ -384,6 +385,16 @@ class Discretisation:
 def gauss_nodes(degree: int) -> int:
     """Gauss–Legendre nodes of the default rule at Legendre degree N (``Discretisation.quadrature`` = 0)."""
     return (3 * degree) // 2 + 8
+
+
+@functools.lru_cache(maxsize=4)
+def _projection(disc: Discretisation) -> np.ndarray:
+    """``Discretisation.projection``, computed once per set of fields (a pseudo-inverse: ~1 s of CPU at degree 320;
+    the search for the plain degree of a point, ``analysis.resolution``, builds the one its caller then transfers
+    to), read-only."""
+    projection = np.linalg.pinv(disc._node_table)
+    projection.flags.writeable = False
+    return projection
 
 
 @functools.lru_cache(maxsize=16)
