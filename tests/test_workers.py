@@ -101,24 +101,3 @@ def test_workers_are_gone_when_spread_raises(monkeypatch, tmp_path):
         interrupt._flag.clear()
     assert not multiprocessing.active_children()
     assert not (tmp_path / "done_0").exists()
-
-
-def test_stretches_are_contiguous_and_their_largest_cost_the_least_possible():
-    """``stretches`` cuts items into at most ``parts`` contiguous stretches covering every item once, and no other cut
-    has a smaller largest stretch cost (every cut enumerated); a branch whose points grow costlier (N³) is cut
-    where the cost halves, not where the count does."""
-    from itertools import combinations
-
-    rng = np.random.default_rng(3)
-    for n, parts in [(1, 2), (2, 2), (5, 2), (9, 3), (12, 2), (8, 4), (3, 5)]:
-        costs = rng.uniform(0.1, 5.0, n) ** 3
-        found = workers.stretches(costs, parts)
-        assert np.array_equal(np.concatenate(found), np.arange(n)) and len(found) <= parts
-        assert all(len(s) for s in found)
-        best = min(max(costs[a:b].sum() for a, b in zip((0,) + cut, cut + (n,)))
-                   for k in range(min(parts, n)) for cut in combinations(range(1, n), k))
-        assert max(costs[s].sum() for s in found) == pytest.approx(best, rel=1e-12)
-    growing = np.arange(600, 2700, 150.0) ** 3  # the two-coil m = 1 branch's sizes
-    first, second = workers.stretches(growing, 2)
-    assert len(first) > len(second) + 4 and abs(growing[first].sum() - growing[second].sum()) < growing.max()
-    assert workers.stretches([], 2) == []

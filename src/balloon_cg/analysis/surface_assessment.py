@@ -1,8 +1,8 @@
 """The stability of a branch on the whole sphere (``surface_branches``) and its secondary branch points: every point
 read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
 change of the number of negative held eigenvalues of a sector under pressure control between two points is a
-secondary branch point, located by Brent's method on that eigenvalue. The points are read in contiguous stretches
-of balanced cost, one per core (``numerics.workers.stretches``). A signal (``numerics.interrupt``) stops the assessment at the next point or root
+secondary branch point, located by Brent's method on that eigenvalue. The points are read in stretches, one per
+core (``numerics.workers``). A signal (``numerics.interrupt``) stops the assessment at the next point or root
 search: the branch is left as traced, not assessed (no half-assessed surface branch is kept).
 """
 import numpy as np
@@ -39,10 +39,10 @@ def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READING
     ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). A fold (LP) of the
     branch changes the count of the state's own sector between its points: not a branch point."""
     held = surface_stability.Reading(True)
-    costs = [float(c.size) ** 3 for _, c in traced]  # a dense factorisation per point
-    stretches = workers.stretches(costs, workers.sharing(len(traced), sum(costs)))  # one when not shared
+    cost = sum(float(c.size) ** 3 for _, c in traced)  # a dense factorisation per point
+    stretches = np.array_split(np.arange(len(traced)), workers.sharing(len(traced), cost))  # one when not shared
     read = workers.spread(lambda points: _read(sb, traced, readings, points), stretches,
-                          [sum(costs[i] for i in stretch) for stretch in stretches])
+                          [sum(float(traced[i][1].size) ** 3 for i in stretch) for stretch in stretches])
     spectra, counts = [s for part in read for s, _ in part], [n for part in read for _, n in part]
     held_spectra = [s[held] for s in spectra]
     sb.stability = {r.name: np.array([surface_stability.lowest_over(s[r], STABILITY_COUNT) for s in spectra])

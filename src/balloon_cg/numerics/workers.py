@@ -19,8 +19,6 @@ import threading
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
-import numpy as np
-
 from . import interrupt
 from .hygiene import worker_hygiene
 
@@ -59,28 +57,6 @@ def sharing(items: int, cost: float) -> int:
     if cost < MIN_COST or _job is not None or not forking:  # _job: inside a worker
         return 1
     return min(count(), items)
-
-
-def stretches(costs, parts: int) -> list:
-    """The positions 0..n−1 of items with relative ``costs`` cut into at most ``parts`` contiguous stretches whose
-    largest total cost is the least possible (items that follow each other, e.g. the points of a branch each
-    starting from the previous one's eigenvalues, handed to ``spread`` a stretch each: cut into equal counts,
-    a branch whose points grow costlier, N³ toward a wire, left one worker most of the work)."""
-    costs = np.asarray(costs, dtype=float)
-    if costs.size == 0:
-        return []
-    sums = np.concatenate([[0.0], np.cumsum(costs)])
-    candidates = np.unique((sums[None, :] - sums[:, None])[np.triu_indices(sums.size, 1)])
-
-    def cuts(bottleneck: float) -> list:  # greedy: each stretch as long as it stays within the bottleneck
-        starts = [0]
-        for i in range(1, costs.size):
-            if sums[i + 1] - sums[starts[-1]] > bottleneck:
-                starts.append(i)
-        return starts
-
-    best = next(cuts(b) for b in candidates if b >= costs.max() and len(cuts(b)) <= parts)
-    return np.split(np.arange(costs.size), best[1:])
 
 
 def spread(work, items, costs=None, on_result=None, interruptible: bool = True, here=()) -> list:
