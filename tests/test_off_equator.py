@@ -176,7 +176,8 @@ def test_critical_follows_a_fold_of_the_off_equator_coil_and_its_help_says_so(tm
     assert "the fold curve ends in a cusp" in text
 
 
-@pytest.mark.parametrize("path", sorted((Path(__file__).parent.parent / "scenes").glob("*.toml")), ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", sorted(p for p in (Path(__file__).parent.parent / "scenes").glob("*.toml")
+                                         if not p.stem.startswith("tube_")), ids=lambda p: p.stem)  # a tube: no picture
 def test_no_shipped_scene_leaves_branch_points_unsearched_with_every_branch_asked_for(path):
     """Issue 41: every shipped scene under ``[surface] branches = "all"`` (up to λ2(0) = 1.3, below every branch
     point: what is searched follows from the scene's field and events, not from how far it is traced) has no
