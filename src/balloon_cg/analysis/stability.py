@@ -225,7 +225,7 @@ class SecondVariation:
         half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
         H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
-        weight = params.P / self.eq.volume(u)
+        weight = self._gas_weight(u, params)
         reduced = {}  # per index set: A = L⁻¹HL⁻ᵀ and the row L⁻¹g, shared by its pressure, volume and gas blocks
         out = []
         for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on):
@@ -244,7 +244,11 @@ class SecondVariation:
 
     def _gas(self, H, g, u, params: Parameters) -> np.ndarray:
         """The Hessian under gas control, H + (P/Ṽ) g gᵀ (module docstring)."""
-        return H + (params.P / self.eq.volume(u)) * np.outer(g, g)
+        return H + self._gas_weight(u, params) * np.outer(g, g)
+
+    def _gas_weight(self, u, params: Parameters) -> float:
+        """P/Ṽ, the weight of the gas term g gᵀ."""
+        return params.P / self.eq.volume(u)
 
     def block_pencil(self, u, params: Parameters, symmetric: bool, name: str) -> tuple:
         """The m = 0 block ``name`` (``blocks``) as its pencil on the perturbation coefficients ``index``:

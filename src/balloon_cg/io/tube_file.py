@@ -95,7 +95,7 @@ def read_tube_run(path) -> dict:
                     raise TubeFileError(path, f"/branches/{name}/{column}: shape {branch[column].shape}, expected "
                                               f"({n},)")
             special = group["special_points"]
-            columns = {c: [_text(v) for v in special[c][()]] for c in SPECIAL_TEXT}
+            columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
             columns |= {c: special[c][()] for c in SPECIAL_NUMBERS}
             branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                         for i in range(len(columns["kind"]))]
