@@ -180,6 +180,22 @@ def test_ctrl_c_stops_kernel_generation(tmp_path, signum):
         assert not Path(f"/proc/{child}").exists() or "zombie" in Path(f"/proc/{child}/status").read_text()
 
 
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_child_is_spawned_is_held_until_it_can_be_killed(signum):
+    """A signal between the handlers' installation and the child's existence is not lost (a lost one left
+    balloon-cg waiting for a frozen child): ``arm()``, called once the child exists, raises it."""
+    with kernel_cache._signals_raise() as arm:
+        os.kill(os.getpid(), signum)
+        time.sleep(0.01)  # the handler runs at the next bytecode boundary
+        with pytest.raises(KeyboardInterrupt):
+            arm()
+    with kernel_cache._signals_raise() as arm:
+        arm()
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signum)
+            time.sleep(1)
+
+
 @pytest.mark.parametrize("damage", ["empty", "truncated", "garbled", "null bytes"])
 def test_a_damaged_cached_module_is_regenerated_with_a_warning(damage, tmp_path, monkeypatch):
     from balloon_cg.scene.formula import parse_formula as parse

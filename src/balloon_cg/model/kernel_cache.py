@@ -231,16 +231,19 @@ def bounded_generate(material, terms: tuple, timings: dict | None = None, surfac
     budget = _budget()
     what = (f"material.energy = {material.text!r}" if not isinstance(material, Exponents) else
             f"the Ogden class with exponents {material.alphas}")
-    child = subprocess.Popen([sys.executable, "-m", __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)  # no preexec_fn: unsafe in a threaded worker
+    child = None
     try:
-        with _signals_raise():
+        with _signals_raise() as arm:  # installed before the child exists: no signal falls between the two
+            child = subprocess.Popen([sys.executable, "-m", __name__], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True)  # no preexec_fn: unsafe in a threaded worker
+            arm()
             out, err = child.communicate(json.dumps(request), timeout=budget)
     except subprocess.TimeoutExpired:
         raise SceneError(f"{what}: its kernels were not generated within {budget:g} s (the time budget, "
                          f"${TIMEOUT_ENV} raises it); simplify the formula") from None
     finally:
-        if child.poll() is None:
+        if child is not None and child.poll() is None:
             child.kill()
             child.wait()
     if child.returncode == _OUT_OF_MEMORY:
@@ -292,17 +295,28 @@ def _child_limits() -> None:
 
 @contextlib.contextmanager
 def _signals_raise():
-    """SIGINT and SIGTERM raise KeyboardInterrupt for the duration (main thread only)."""
+    """SIGINT and SIGTERM raise KeyboardInterrupt for the duration (main thread only), from the moment the yielded
+    ``arm()`` is called; a signal before it (while the child is spawned, so that it is never left unkilled) is
+    held and raised by ``arm()``."""
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield lambda: None
         return
+    state = {"armed": False, "held": False}
 
     def stop(signum, frame):
+        if not state["armed"]:
+            state["held"] = True
+            return
         raise KeyboardInterrupt
+
+    def arm():
+        state["armed"] = True
+        if state["held"]:
+            raise KeyboardInterrupt
 
     previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield arm
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
