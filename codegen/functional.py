@@ -68,10 +68,12 @@ def meridional_stretch(c, vv, ww, l2=lam2):
 
 
 def at_node(cls: SceneClass, expr):
-    """Put the terms' Taylor proxies back at their own expansion points (after all differentiation)."""
+    """Put the terms' Taylor proxies back at their own expansion points (after all differentiation), at the node's
+    reference radius R (the meridian's: sin θ on a meridian with poles, 1 on a tube)."""
+    radius = cls.meridian.hoop(cos_theta, sin_theta)
     expansion = {}
     for term in cls.terms:
-        expansion.update(term.expansion())
+        expansion.update(term.expansion(radius))
     return expr.subs(expansion)
 
 

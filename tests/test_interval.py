@@ -281,8 +281,11 @@ def test_tube_table_errors_name_key_value_and_range(table, message):
 
 
 @pytest.mark.parametrize("extra, message", [
-    ("[field]\nM = 0.001\n[[field.coils]]\nradius = 2\nheight = 0\ncurrent = 1\n",
-     'geometry.shape = "tube": coils around a tube are not built yet'),
+    ("[field]\nM = 0.001\n[[field.coils]]\nradius = 2\nheight = 1\ncurrent = 1\n",
+     'geometry.shape = "tube": the coils around a tube must be coaxial and mirror-symmetric about its middle'),
+    ("[field]\nM = 0.001\n[[field.coils]]\nradius = 0.8\nheight = 3\ncurrent = 1\n[[field.coils]]\nradius = 0.8\n"
+     "height = -3\ncurrent = 1\n",
+     r"field.coils\[0\]: wire at \(radius 0.8, height 3\) lies on or inside the reference tube"),
     ("[electric]\nvoltage = 0.1\n", r'geometry.shape = "tube": the \[electric\] term on a tube is not built yet'),
     ('[loading]\ncontrol = "volume"\n', 'loading.control = "volume": a tube is continued in the pressure only'),
     ("[dynamics]\nfrequencies = true\n", "dynamics.frequencies = true: the natural frequencies of a tube"),

@@ -59,8 +59,9 @@ class Term:
         """Substitutions into the pole series at the pole 'N' or 'S' (its node values there)."""
         return {}
 
-    def expansion(self) -> dict:
-        """Substitutions that put a Taylor proxy's expansion point back after differentiation (axisymmetric)."""
+    def expansion(self, radius) -> dict:
+        """Substitutions that put a Taylor proxy's expansion point back after differentiation (axisymmetric), with
+        ``radius`` the reference meridian's R at the node (ρ = λ2 R there)."""
         return {}
 
     def surface_expansion(self, point) -> dict:

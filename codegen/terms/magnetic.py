@@ -63,7 +63,7 @@ class MagneticField(Term):
         rho0 = lam2 * sin_theta
         q1, q2 = epsilon_order(rho_sq, 1), epsilon_order(rho_sq, 2)
         radius = rho0 + eps * q1 / (2 * rho0) + eps**2 * (q2 / (2 * rho0) - q1**2 / (8 * rho0**3))
-        H2 = sp.expand(field_proxy(radius, x[2])).subs(self.expansion())
+        H2 = sp.expand(field_proxy(radius, x[2])).subs(self.expansion(sin_theta))
         return -chi * M * phi_average(epsilon_order(H2, 2)) / 2 * metric
 
     def pole(self, lam, z, q, s, z0, metric):
@@ -73,8 +73,9 @@ class MagneticField(Term):
     def pole_values(self, letter: str) -> dict:
         return dict(zip((Q_z, Q_rr), POLE_FIELD[letter]))
 
-    def expansion(self) -> dict:
-        return {_rho0: lam2 * sin_theta, _eta0: eta}
+    def expansion(self, radius) -> dict:
+        """The node's point (ρ0, η0) = (λ2 R, η): R = sin θ on a meridian with poles, 1 on a tube."""
+        return {_rho0: lam2 * radius, _eta0: eta}
 
     def surface_expansion(self, point) -> dict:
         return dict(zip(_X0, point))

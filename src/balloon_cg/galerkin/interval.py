@@ -32,12 +32,14 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.polynomial import legendre
+from scipy import optimize
 
 from .discretisation import gauss_nodes, legendre_table, read_only, symmetric_rows
 from ..generated import HESSIAN_PAIRS
 from ..scene.tables import Ends
 
 _HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)
+CREST_SAMPLES = 401  # the samples of ρ(S) the crest is searched on (``IntervalDiscretisation.crest``)
 
 
 class Mirror(enum.StrEnum):
@@ -166,6 +168,18 @@ class IntervalDiscretisation:
         bubbles = p[:, 2:] - p[:, : n - 1]
         rho = p @ u[:k] if self.ends == Ends.SLIDING else 1.0 + bubbles @ u[:k]
         return rho, -u[k] * self.length / 2 * x + bubbles @ u[k + 1:]
+
+    def crest(self, u: np.ndarray) -> tuple:
+        """(S, η) of the bulge's crest, the largest radius ρ of the state u: its reference arclength and its height
+        (measured from the tube's middle plane, where a mirror-symmetric field's coils lie). The largest of ρ on
+        CREST_SAMPLES evenly spaced S, refined by Brent's bounded search between its neighbours."""
+        s = np.linspace(0.0, self.length, CREST_SAMPLES)
+        k = int(np.argmax(self.profile(u, s)[0]))
+        lo, hi = s[max(k - 1, 0)], s[min(k + 1, s.size - 1)]
+        best = optimize.minimize_scalar(lambda t: -self.profile(u, np.array([t]))[0][0], bounds=(lo, hi),
+                                        method="bounded", options={"xatol": 1e-10 * self.length})
+        top = min((lo, hi, best.x), key=lambda t: -self.profile(u, np.array([t]))[0][0])
+        return float(top), float(self.profile(u, np.array([top]))[1][0])
 
 
 @functools.lru_cache(maxsize=16)

@@ -821,9 +821,15 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
     held = _getter(data, "geometry", Geometry)("axial_stretch", lambda x: MIN_AXIAL <= x <= MAX_AXIAL,
                                                 f"in [{MIN_AXIAL:g}, {MAX_AXIAL:g}]")
     where = 'geometry.shape = "tube"'
-    if field.coils:
-        raise SceneError(f"{where}: coils around a tube are not built yet; leave [field] coils out or use another "
-                         "shape")
+    if field.coils and not field.is_equator_symmetric:
+        raise SceneError(f"{where}: the coils around a tube must be coaxial and mirror-symmetric about its middle "
+                         "(z = 0: each coil (radius, height, current) with a partner at -height, one current sign "
+                         "for every pair), as the tube's branches keep that symmetry")
+    for k, coil in enumerate(field.coils):
+        if coil.radius <= 1 + 1e-9 and abs(coil.height) <= length / 2:
+            raise SceneError(f"field.coils[{k}]: wire at (radius {coil.radius:g}, height {coil.height:g}) lies on "
+                             f"or inside the reference tube (radius 1, heights within ±length/2 = "
+                             f"±{length / 2:g}); the radius must be > 1 there")
     if electric is not None:
         raise SceneError(f"{where}: the [electric] term on a tube is not built yet; leave [electric] out or use "
                          "another shape")

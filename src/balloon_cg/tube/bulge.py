@@ -22,7 +22,7 @@ from .results import IntervalBranch, IntervalSpecial, IntervalStop
 from .stability import smallest_stress, unstable_counts
 from ..analysis.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
-from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
@@ -44,7 +44,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         raise ValueError(f"a bulge branch is switched on a tube with sliding ends, not {disc.ends.value}")
     eq = Equilibrium(scene, disc)
     odd = disc.block(Mirror.ODD)
-    params = Parameters(point.pressure)
+    params = primary.params.with_value("P", point.pressure)
     H = eq.jacobian(point.u, params)[np.ix_(odd, odd)]
     phi = np.zeros(disc.size)
     phi[odd] = np.linalg.eigh(H)[1][:, 0]
@@ -81,7 +81,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
 
     def volume_gradient(X):
         Y = system.full(X)
-        return np.append(-eq.parameter_derivative(Y[:-1], Parameters(Y[-1]), "P"), 0.0)[system.columns]
+        return np.append(-eq.parameter_derivative(Y[:-1], params.with_value("P", Y[-1]), "P"), 0.0)[system.columns]
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1], Kind.LV: volume_gradient})
     last = len(path.points) - 1
@@ -90,5 +90,6 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                     f.status) for f in sorted(folds, key=lambda f: f.index))
     points = [system.full(X)] + [system.full(p.X) for p in path.points]
     return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
-                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points),
-                          stressed(eq, special), path.stop, np.array([smallest_stress(eq, Y[:-1]) for Y in points]))
+                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points, params),
+                          stressed(eq, special), path.stop, np.array([smallest_stress(eq, Y[:-1]) for Y in points]),
+                          primary.params)

@@ -65,6 +65,11 @@ class TubeSystem:
         return self.system.jacobian(self.full(X))[np.ix_(self.unknowns, self.columns)]
 
 
+def scene_parameters(scene, pressure: float = 0.0) -> Parameters:
+    """The branch parameters of a tube scene at ``pressure``: the field's M and χ (M = 0 without coils)."""
+    return Parameters(pressure, scene.field.M, scene.field.chi)
+
+
 def held(disc: IntervalDiscretisation, stretch: float | None = None) -> np.ndarray:
     """u of the fixed unknowns (``TubeSystem``): zero but λ̄ at ``stretch`` (None: the disc's ``axial_stretch``)."""
     fixed = np.zeros(disc.size)
@@ -87,7 +92,8 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     """The primary branch of a tube scene (module docstring) at Legendre ``degree`` (None: solver.degree)."""
     disc = discretisation(scene, degree)
     eq = Equilibrium(scene, disc)
-    parameters = ParameterSystem(eq, Parameters(0.0), "P")
+    params = scene_parameters(scene)
+    parameters = ParameterSystem(eq, params, "P")
     system = TubeSystem(parameters, disc.block(Mirror.EVEN), held(disc))
     settings = continuation_settings(scene)
     X = _start(parameters, disc, scene.solver)
@@ -104,12 +110,12 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
     reached = path.points + ([path.overshoot] if path.overshoot is not None else [])  # the last step's too
     full = [system.full(p.X) for p in reached]
-    spectra = {block: np.array([spectrum(eq, Y, disc.block(block)) for Y in full]) for block in Mirror}
+    spectra = {block: np.array([spectrum(eq, Y, disc.block(block), params) for Y in full]) for block in Mirror}
     special = [IntervalSpecial(Kind.LP, system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index, f.status)
                for f in path.folds]
     for block in Mirror:
         for i, order in count_changes((spectra[block] < 0).sum(axis=1)):
-            found = _located_zero(system, eq, reached[i], reached[i + 1], block, order, settings)
+            found = _located_zero(system, eq, reached[i], reached[i + 1], block, order, settings, params)
             if found is not None:
                 special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1], block))
     special = sorted((s for s in special if disc.node_state(s.u)[0].max() <= limit),
@@ -118,8 +124,8 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     volume = np.array([volume_ratio(eq, Y) for Y in full])
     lowest = {block: spectra[block][:, 0] for block in Mirror}
     return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
-                          unstable_counts(eq, full), stressed(eq, special), path.stop,
-                          np.array([smallest_stress(eq, Y[:-1]) for Y in full]))
+                          unstable_counts(eq, full, params), stressed(eq, special), path.stop,
+                          np.array([smallest_stress(eq, Y[:-1]) for Y in full]), params)
 
 
 def stressed(eq: Equilibrium, special) -> tuple:
@@ -128,24 +134,31 @@ def stressed(eq: Equilibrium, special) -> tuple:
 
 
 def _start(parameters: ParameterSystem, disc: IntervalDiscretisation, solver) -> np.ndarray:
-    """X = (u[even block], P = 0) of the unstressed tube: the reference (exact) where the ends' distance is free;
-    where it is held at λ, the tube stretched to it at P = 0 by natural continuation in the held distance from 1
-    (``continuation.natural``), each point solved by Newton on the even rows with P = 0 prescribed.
+    """X = (u[even block], P = 0) of the tube at P = 0: the unstressed reference (exact) where the ends' distance is
+    free; where it is held at λ, the tube stretched to it by natural continuation in the held distance from 1
+    (``continuation.natural``); in a field (M > 0), then the field switched on by natural continuation in M from 0
+    (the coils' pull on the tube at P = 0). Each point is solved by Newton on the even rows with P = 0 prescribed.
     ContinuationError when it does not get there."""
     even = disc.block(Mirror.EVEN)
     X = np.append(disc.reference(), 0.0)[np.append(even, disc.size)]
-    if not disc.held:
-        return X
-    target = disc.axial_stretch
+    field = parameters.params.M
 
-    def solve(X, stretch):
-        system = TubeSystem(parameters, even, held(disc, stretch))
+    def solve(X, stretch, M=0.0):
+        system = TubeSystem(ParameterSystem(parameters.eq, parameters.params.with_value("M", M), "P"), even,
+                            held(disc, stretch))
         return newton(system.residual, system.jacobian, X, np.eye(X.size)[-1], 0.0, solver.tol, solver.max_newton)
 
-    X, reached, message = continuation.natural(solve, X, 1.0, target)
-    if reached < target:
-        raise ContinuationError(f"could not stretch the tube to geometry.axial_stretch = {target:g} at P = 0 beyond "
-                                f"{reached:.6g} ({message})")
+    stretch = disc.axial_stretch if disc.held else 1.0
+    if disc.held:
+        X, reached, message = continuation.natural(solve, X, 1.0, stretch)
+        if reached < stretch:
+            raise ContinuationError(f"could not stretch the tube to geometry.axial_stretch = {stretch:g} at P = 0 "
+                                    f"beyond {reached:.6g} ({message})")
+    if field > 0:
+        X, reached, message = continuation.natural(lambda X, M: solve(X, stretch, M), X, 0.0, field)
+        if reached < field:
+            raise ContinuationError(f"could not switch the field on at P = 0 beyond M = {reached:.6g} of field.M = "
+                                    f"{field:g} ({message})")
     return X
 
 
@@ -163,10 +176,11 @@ def _position(system: TubeSystem, points: list, special: IntervalSpecial) -> flo
     return special.index + along / (tangent @ (system.full(after.X) - system.full(before.X)))
 
 
-def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mirror, order: int, settings):
+def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mirror, order: int, settings,
+                  params: Parameters):
     """(Y = (u, P), status) where the eigenvalue number ``order`` (ascending, from 0) of ``block`` vanishes between
-    two points, by Brent in the arclength from ``before``; None when it is the fold in P (the null vector not
-    orthogonal to ∂R/∂P)."""
+    two points, by Brent in the arclength from ``before`` (``params``: the branch's, P replaced); None when it is
+    the fold in P (the null vector not orthogonal to ∂R/∂P)."""
     index = eq.disc.block(block)
 
     def value_at(s):
@@ -174,17 +188,17 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
         if not result.converged:
             raise ArithmeticError(result.message)
         Y = system.full(result.x)
-        return spectrum(eq, Y, index)[order], Y
+        return spectrum(eq, Y, index, params)[order], Y
 
     length = float(before.tangent @ (after.X - before.X))
     end = system.full(after.X)
-    root = continuation.locate_root(value_at, length, BRENT_XTOL, known={length: (spectrum(eq, end, index)[order],
-                                                                                  end)})
+    root = continuation.locate_root(value_at, length, BRENT_XTOL,
+                                    known={length: (spectrum(eq, end, index, params)[order], end)})
     Y = root.payload
-    params = Parameters(Y[-1])
-    H = eq.jacobian(Y[:-1], params)[np.ix_(index, index)]
+    at = params.with_value("P", Y[-1])
+    H = eq.jacobian(Y[:-1], at)[np.ix_(index, index)]
     phi = np.linalg.eigh(H)[1][:, order]
-    dP = eq.parameter_derivative(Y[:-1], params, "P")
+    dP = eq.parameter_derivative(Y[:-1], at, "P")
     if abs(phi @ dP[index]) > ORTHOGONAL * np.linalg.norm(dP):
         return None
     return Y, root.status

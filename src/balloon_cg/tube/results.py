@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.results import Kind
+from ..galerkin.equilibrium import Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics.continuation import RootStatus, Stop
 
@@ -39,7 +40,8 @@ class IntervalBranch:
     lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
     mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
     Control.PRESSURE and Control.VOLUME -> int array), the located points, why the trace stopped and the smallest
-    principal stress at every point (negative: compressed, tube/stability.py)."""
+    principal stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters
+    (the field's M and χ; P is each point's)."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
@@ -50,6 +52,7 @@ class IntervalBranch:
     special: tuple
     stop: Stop
     smallest_stress: np.ndarray  # per point: tube/stability.smallest_stress
+    params: Parameters
 
     def branch_points(self, block: Mirror | None = None) -> list:
         return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]

@@ -15,24 +15,25 @@ from ..scene.loading import Control
 COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the stresses are O(1)) is compression
 
 
-def unstable_counts(eq: Equilibrium, points) -> dict:
+def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
     """{Control.PRESSURE, Control.VOLUME: the number of negative eigenvalues of ∂R/∂u at each Y = (u, P) of
-    ``points``, without and with δV = 0} (module docstring)."""
+    ``points`` (``params``: the branch's, P replaced), without and with δV = 0} (module docstring)."""
     counts = {Control.PRESSURE: [], Control.VOLUME: []}
     free = eq.disc.free
     unit = GramFactor(np.ones(free.size), orthogonal=True)
     for Y in points:
-        params = Parameters(Y[-1])
-        H = eq.jacobian(Y[:-1], params)[np.ix_(free, free)]
+        at = params.with_value("P", Y[-1])
+        H = eq.jacobian(Y[:-1], at)[np.ix_(free, free)]
         counts[Control.PRESSURE].append(negative_count(H))
-        gradient = -eq.parameter_derivative(Y[:-1], params, "P")[free]
+        gradient = -eq.parameter_derivative(Y[:-1], at, "P")[free]
         counts[Control.VOLUME].append(negative_count(restricted(H, unit, gradient[None, :])))
     return {control: np.array(values, dtype=int) for control, values in counts.items()}
 
 
-def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray) -> np.ndarray:
-    """The eigenvalues (ascending) of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``."""
-    H = eq.jacobian(Y[:-1], Parameters(Y[-1]))
+def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray, params: Parameters) -> np.ndarray:
+    """The eigenvalues (ascending) of the Hessian ∂R/∂u at Y = (u, P) restricted to the unknowns ``index``
+    (``params``: the branch's, P replaced)."""
+    H = eq.jacobian(Y[:-1], params.with_value("P", Y[-1]))
     return np.linalg.eigvalsh(H[np.ix_(index, index)])
 
 
