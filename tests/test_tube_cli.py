@@ -85,3 +85,41 @@ def test_an_existing_file_is_kept_without_force(run_file, capsys):
     before = run_file.read_bytes()
     assert main(["run", str(SCENE), "-o", str(run_file), "--quiet", *FAST]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1 and run_file.read_bytes() == before
+
+
+COIL_SCENE = SCENE.with_name("tube_spom1_L10_coil.toml")
+COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
+
+
+def test_critical_follows_the_onset_in_the_field_of_a_coil(tmp_path, capsys):
+    """``critical --parameter M`` on the coil scene: the onset curve of tube/onset.py in the file's /onset group
+    (the same numbers), exit 0 with the fold in M printed; ``inspect`` shows the field, the curve and the crests;
+    downwards it lands on M = 0 (no fold: exit 1, the file written); other kinds and parameters exit 2."""
+    from balloon_cg.galerkin.interval import Mirror
+    from balloon_cg.tube.onset import onset_curve
+    from balloon_cg.tube.primary import primary_branch
+
+    path = tmp_path / "onset.h5"
+    assert main(["critical", str(COIL_SCENE), "--parameter", "M", "-o", str(path), "--quiet", *COIL_FAST]) == 0
+    out = capsys.readouterr().out
+    scene = load_scene(COIL_SCENE).with_overrides({"continuation.stop_stretch": 1.75, "continuation.max_points": 60})
+    primary = primary_branch(scene)
+    curve = onset_curve(scene, primary, primary.branch_points(Mirror.ODD)[0], "M")
+    stored = read_tube_run(path)["onset"]
+    assert np.array_equal(stored["q"], curve.q) and np.array_equal(stored["pressure"], curve.pressure)
+    assert np.array_equal(stored["unknowns"], curve.states) and stored["attrs"]["parameter"] == "M"
+    assert out.startswith(f"critical M = {curve.fold_q[0]:.12g} (P = ")
+    assert np.abs(stored["crest_height"][:-1]).max() < 1e-6  # the crest at the coil, on the primary branch's states
+    assert main(["inspect", str(path)]) == 0
+    text = capsys.readouterr().out
+    assert "field          1 coil(s), M = 0.01" in text and "onset in M (from M = 0.01)" in text
+    assert "fold in M at M = " in text and "crest at" in text
+    down = tmp_path / "down.h5"
+    assert main(["critical", str(COIL_SCENE), "--parameter", "M", "--direction", "-1", "-o", str(down), "--quiet",
+                 *COIL_FAST]) == 1
+    assert "no critical M: the onset curve does not turn back in M" in capsys.readouterr().err
+    assert read_tube_run(down)["onset"]["q"][-1] == 0.0
+    for extra in (["--parameter", "M", "--of", "LP"], ["--parameter", "chi"]):
+        assert main(["critical", str(COIL_SCENE), "-o", str(tmp_path / "x.h5"), "--quiet", *extra]) == 2
+        assert "critical on a tube follows the onset of bulging (--of BP) in M" in capsys.readouterr().err
+    assert not (tmp_path / "x.h5").exists()

@@ -1,8 +1,11 @@
-"""What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, Maxwell's pressure,
-per branch its points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py) and
-its located points (those in a compressed state marked: docs/shapes.md)."""
+"""What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, Maxwell's
+pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are compressed
+(tube/stability.py), the height of its last point's crest and its located points (with their crest's height; those in
+a compressed state marked: docs/shapes.md), and the onset curve of ``critical`` (its range, folds and stop)."""
 import math
+import tomllib
 
+from ..io.tube_file import CREST
 from ..tube.stability import COMPRESSED
 
 
@@ -18,12 +21,32 @@ def summarise_tube(run: dict) -> dict:
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
+                          "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
                           "special_points": b["special_points"]}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
+    field = scene_field(a["scene_toml"])
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
-            "degree": a["degree"], "maxwell_pressure": maxwell,
+            "field": field, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
-            "branches": branches}
+            "branches": branches, "onset": _onset(run.get("onset"))}
+
+
+def scene_field(toml: str) -> dict:
+    """{'M', 'coils'} of the scene's [field] (the file's scene text)."""
+    field = tomllib.loads(toml).get("field", {})
+    return {"M": float(field.get("M", 0.0)), "coils": len(field.get("coils", []))}
+
+
+def _onset(onset: dict | None) -> dict | None:
+    if onset is None:
+        return None
+    a = onset["attrs"]
+    return {"parameter": a["parameter"], "q0": a["q0"], "points": len(onset["q"]),
+            "q": [float(onset["q"].min()), float(onset["q"].max())],
+            "pressure": [float(onset["pressure"].min()), float(onset["pressure"].max())],
+            "last": {"q": float(onset["q"][-1]), "pressure": float(onset["pressure"][-1]),
+                     "crest_height": float(onset[CREST][-1])},
+            "folds": onset["folds"], "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
 
 
 def format_tube(summary: dict) -> str:
@@ -36,15 +59,29 @@ def format_tube(summary: dict) -> str:
              f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
              f"command        {p['command']}",
              f"shape          tube of length {g['length']:g}, {g['ends']} ends, end distance {held}",
+             f"field          " + (f"{summary['field']['coils']} coil(s), M = {summary['field']['M']:g}"
+                                   if summary["field"]["coils"] else "none"),
              f"degree         {summary['degree']}",
              f"Maxwell        P_M = {maxwell}"]
     for name, b in summary["branches"].items():
         lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"
-                      + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")]
+                      + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
+                      + ("" if b["last_crest_height"] is None else
+                         f"; last crest at height {b['last_crest_height']:.6g}")]
         for k, s in enumerate(b["special_points"]):
             block = f" {s['block']}" if s["block"] else ""
             compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
+            crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
-                         f"V/V0 = {s['volume']:.8g}  {s['status']}{compressed}")
+                         f"V/V0 = {s['volume']:.8g}  {s['status']}{crest}{compressed}")
+    onset = summary["onset"]
+    if onset is not None:
+        name, last = onset["parameter"], onset["last"]
+        lines += ["", f"onset in {name} (from {name} = {onset['q0']:g}): {onset['points']} points, {name} "
+                      f"{onset['q'][0]:.6g}..{onset['q'][1]:.6g}, P {onset['pressure'][0]:.8g}..{onset['pressure'][1]:.8g}"
+                      f", stop {onset['stop_code']} ({onset['stop_message']}); last: {name} = {last['q']:.8g}, "
+                      f"P = {last['pressure']:.10g}, crest at {last['crest_height']:.6g}"]
+        lines += [f"  fold in {name} at {name} = {f['q']:.10g}, P = {f['pressure']:.10g}  {f['status']}"
+                  for f in onset["folds"]]
     return "\n".join(lines)

@@ -6,10 +6,14 @@ Root attributes: the format, the scene (name, TOML), the shape and its parameter
 ``maxwell_pressure`` (NaN where there is none) and the provenance. One group per branch under /branches/<name>/:
 per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``
 and ``unstable_volume`` (negative eigenvalues of ∂R/∂u without and with δV = 0), ``smallest_stress`` (the smallest
-principal stress: negative where the membrane is compressed, tube/stability.py), ``lowest_even``/``lowest_odd`` (the
-mirror blocks' lowest eigenvalues, on the primary branch); its located points under special_points/ (``kind``,
-``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``, ``unknowns``), and its stop
-(``stop_code``, ``stop_message`` attributes).
+principal stress: negative where the membrane is compressed, tube/stability.py), ``crest_height`` (the height η of
+the largest radius, the bulge's crest, from the tube's middle plane: IntervalDiscretisation.crest), ``lowest_even``/
+``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch); its located points under
+special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``,
+``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
+/onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
+``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
+under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``.
 """
 import math
 from pathlib import Path
@@ -25,7 +29,9 @@ from ..tube.primary import volume_ratio
 
 FORMAT = "balloon-cg-tube/1"
 POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress")
+CREST = "crest_height"  # per point and located point: η of the largest radius (files before it have none)
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
+CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
 
 
@@ -51,7 +57,8 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
             for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
                                    ("unstable_pressure", branch.unstable["pressure"]),
                                    ("unstable_volume", branch.unstable["volume"]),
-                                   ("smallest_stress", branch.smallest_stress)):
+                                   ("smallest_stress", branch.smallest_stress),
+                                   (CREST, crest_heights(branch.disc, branch.states))):
                 checksummed(group, column, values)
             for block, values in branch.lowest.items():
                 checksummed(group, f"lowest_{block.value}", values)
@@ -66,8 +73,29 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
             volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
             checksummed(special, "volume", np.array(volume, dtype=float))
             checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
+            checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
             checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), -1))
+        if picture.onset is not None:
+            _write_onset(f.create_group("onset"), picture.onset)
     return Path(path)
+
+
+def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
+    """η of the largest radius of each state (IntervalDiscretisation.crest)."""
+    return np.array([disc.crest(u)[1] for u in states], dtype=float)
+
+
+def _write_onset(group, curve) -> None:
+    group.attrs.update({"parameter": curve.name, "q0": curve.q0, "stop_code": curve.stop.code.value,
+                        "stop_message": curve.stop.message})
+    for column, values in (("q", curve.q), ("pressure", curve.pressure), ("volume", curve.volume),
+                           (CREST, crest_heights(curve.disc, curve.states)), ("unknowns", curve.states),
+                           ("modes", curve.modes)):
+        checksummed(group, column, values)
+    folds = group.create_group("folds")
+    checksummed(folds, "q", np.asarray(curve.fold_q, dtype=float))
+    checksummed(folds, "pressure", np.array([p.pressure for p in curve.folds], dtype=float))
+    write_strings(folds, "status", [p.status.value for p in curve.folds])
 
 
 def read_tube_run(path) -> dict:
@@ -89,19 +117,39 @@ def read_tube_run(path) -> dict:
             branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()},
                       "unknowns": group["unknowns"][()]}
             n = branch["unknowns"].shape[0]
-            for column in POINT_COLUMNS + tuple(f"lowest_{b.value}" for b in Mirror if f"lowest_{b.value}" in group):
+            optional = tuple(c for c in (CREST, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
+            for column in POINT_COLUMNS + optional:
                 branch[column] = group[column][()]
                 if branch[column].shape != (n,):
                     raise TubeFileError(path, f"/branches/{name}/{column}: shape {branch[column].shape}, expected "
                                               f"({n},)")
             special = group["special_points"]
             columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
-            columns |= {c: special[c][()] for c in SPECIAL_NUMBERS}
+            columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
             branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                         for i in range(len(columns["kind"]))]
             branch["special_unknowns"] = special["unknowns"][()]
             branches[name] = branch
-    return {"path": str(path), "attrs": attrs, "branches": branches}
+        onset = None if "onset" not in f else _read_onset(path, f["onset"])
+    return {"path": str(path), "attrs": attrs, "branches": branches, "onset": onset}
+
+
+def _read_onset(path, group) -> dict:
+    """The /onset group: its attributes, the point columns, ``unknowns``, ``modes`` and ``folds`` (dict per fold)."""
+    missing = [c for c in (*CURVE_COLUMNS, "unknowns", "modes", "folds") if c not in group]
+    if missing:
+        raise TubeFileError(path, f"/onset: missing {', '.join(missing)}")
+    onset = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}}
+    n = group["q"].shape[0]
+    for column in (*CURVE_COLUMNS, "unknowns", "modes"):
+        onset[column] = group[column][()]
+        if onset[column].shape[0] != n:
+            raise TubeFileError(path, f"/onset/{column}: {onset[column].shape[0]} rows, expected {n}")
+    folds = group["folds"]
+    status = list(folds["status"].asstr()[()])
+    onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s}
+                      for q, p, s in zip(folds["q"][()], folds["pressure"][()], status)]
+    return onset
 
 
 def discretisation(attrs: dict) -> IntervalDiscretisation:

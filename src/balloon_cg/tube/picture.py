@@ -7,6 +7,7 @@ no single one)."""
 from dataclasses import dataclass
 
 from .bulge import bulge_branch
+from .onset import OnsetCurve
 from .primary import primary_branch
 from .results import IntervalBranch
 from ..galerkin.interval import Mirror
@@ -16,11 +17,13 @@ from ..scene.tables import Ends
 
 @dataclass(frozen=True)
 class TubePicture:
-    """The branches by name ("primary", "bulge" where one was switched) and Maxwell's pressure (None where the
-    uniform closed path has no maximum and minimum, or the ends are held)."""
+    """The branches by name ("primary", "bulge" where one was switched), Maxwell's pressure (None where the
+    uniform closed path has no maximum and minimum, or the ends are held) and, for ``critical``, the onset of bulging
+    followed in a second parameter (tube/onset.py)."""
 
     branches: dict
     maxwell: float | None
+    onset: OnsetCurve | None = None
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
@@ -30,5 +33,10 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     onset = primary.branch_points(Mirror.ODD)
     if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
         branches["bulge"] = bulge_branch(scene, primary, onset[0], stop_stretch=scene.continuation.stop_stretch)
+    return TubePicture(branches, maxwell(scene))
+
+
+def maxwell(scene) -> float | None:
+    """Maxwell's pressure of the scene's uniform closed tube (None: ends held apart, or no maximum and minimum)."""
     found = None if scene.geometry.axial_stretch is not None else maxwell_pressure(scene.material)
-    return TubePicture(branches, None if found is None else float(found[0]))
+    return None if found is None else float(found[0])
