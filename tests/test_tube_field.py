@@ -79,7 +79,7 @@ def test_tube_in_a_coil_field_is_stationary_for_the_energy_written_here():
         return np.array([energy(u + step * e, M) - energy(u - step * e, M) for e in np.eye(disc.size)]) / (2 * step)
 
     assert np.abs(gradient(scene.field.M)).max() < 1e-8
-    assert np.abs(gradient(0.0)).max() > 1e-4
+    assert np.abs(gradient(0.0)).max() > 1e-2
     assert np.abs(u[disc.block(Mirror.ODD)]).max() == 0.0
     rho = disc.profile(u, np.linspace(0, disc.length, 11))[0]
     assert rho[5] - rho[0] > 1e-2  # bulged towards the coil
