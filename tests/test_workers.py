@@ -78,6 +78,42 @@ def test_assessments_on_two_workers_are_the_serial_ones(monkeypatch):
             np.testing.assert_array_equal(values, b.blocks[block])
 
 
+def test_a_surface_branch_read_by_sector_groups_on_two_workers_is_the_serial_reading(monkeypatch):
+    """The SPOM1 m = 1 branch at M = 0 (12 points, four symmetry sectors): its sectors read in two groups on two
+    workers, each group along the whole branch, give every stored eigenvalue and secondary point of the serial
+    reading bit for bit (a sector follows its own spectra only)."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis import surface_assessment, surface_branches
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.results import Block
+    from balloon_cg.scene import load_scene
+
+    primary = analyse(load_scene("spom1").with_overrides({"continuation.stop_stretch": 4.0,
+                                                          "surface.branches": "none"})).primary
+    bp = primary.branch_points()[0]
+    captured = []
+    monkeypatch.setattr(surface_branches, "assess", lambda sb, traced, readings: captured.append((sb, traced)))
+    branch = surface_branches.trace_surface(primary, 0, replace(bp, m=1, block=Block.M1_HELD), 1.0, "m1", 12)
+    (sb, traced), = captured
+    sizes = surface_assessment._sector_sizes(traced)
+    assert len(sizes) == 4 and len(surface_assessment._sector_groups(sizes, 2)) == 2
+    assert sum(float(c.size) ** 3 for _, c in traced) > workers.MIN_COST  # it forks
+    read = {}
+    for count in ("1", "2"):
+        monkeypatch.setenv("BALLOON_CG_WORKERS", count)
+        read[count] = replace(branch, special=list(sb.special), stability={})
+        surface_assessment.assessed(read[count], traced)
+    serial, spread = read["1"], read["2"]
+    assert serial.stability.keys() == spread.stability.keys()
+    for name, values in serial.stability.items():
+        np.testing.assert_array_equal(values, spread.stability[name])
+    assert [(s.kind, s.index, s.sector) for s in serial.special] == [(s.kind, s.index, s.sector)
+                                                                     for s in spread.special]
+    for a, b in zip(serial.special, spread.special):
+        np.testing.assert_array_equal(a.X, b.X)
+
+
 def _sleep_then_mark(item):
     import time
 

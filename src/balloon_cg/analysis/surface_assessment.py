@@ -1,8 +1,8 @@
 """The stability of a branch on the whole sphere (``surface_branches``) and its secondary branch points: every point
 read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
 change of the number of negative held eigenvalues of a sector under pressure control between two points is a
-secondary branch point, located by Brent's method on that eigenvalue. The points are read in stretches, one per
-core (``numerics.workers``). A signal (``numerics.interrupt``) stops the assessment at the next point or root
+secondary branch point, located by Brent's method on that eigenvalue. The symmetry sectors are read in groups,
+one per core (``numerics.workers``), each along the whole branch. A signal (``numerics.interrupt``) stops the assessment at the next point or root
 search: the branch is left as traced, not assessed (no half-assessed surface branch is kept).
 """
 import numpy as np
@@ -39,11 +39,12 @@ def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READING
     ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). A fold (LP) of the
     branch changes the count of the state's own sector between its points: not a branch point."""
     held = surface_stability.Reading(True)
-    cost = sum(float(c.size) ** 3 for _, c in traced)  # a dense factorisation per point
-    stretches = np.array_split(np.arange(len(traced)), workers.sharing(len(traced), cost))  # one when not shared
-    read = workers.spread(lambda points: _read(sb, traced, readings, points), stretches,
-                          [sum(float(traced[i][1].size) ** 3 for i in stretch) for stretch in stretches])
-    spectra, counts = [s for part in read for s, _ in part], [n for part in read for _, n in part]
+    sizes = _sector_sizes(traced)
+    groups = _sector_groups(sizes, workers.sharing(len(sizes), sum(float(c.size) ** 3 for _, c in traced)))
+    read = workers.spread(lambda keys: _read(sb, traced, readings, keys), groups,
+                          [sum(sizes[key] ** 3 for key in keys) for keys in groups])
+    spectra = [{r: _in_order([part[i][0][r] for part in read], sizes) for r in readings} for i in range(len(traced))]
+    counts = [_in_order([part[i][1] for part in read], sizes) for i in range(len(traced))]
     held_spectra = [s[held] for s in spectra]
     sb.stability = {r.name: np.array([surface_stability.lowest_over(s[r], STABILITY_COUNT) for s in spectra])
                     for r in readings}
@@ -57,16 +58,48 @@ def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READING
     sb.special.sort(key=lambda s: s.index)
 
 
-def _read(sb: SurfaceBranch, traced: list, readings, points) -> list:
-    """(spectra, negative held counts) of the points ``points`` of the branch in order, each following the previous
-    one's spectra (``surface.stability.sector_spectra``; the first of a stretch solves dense, as a branch's first
-    point does). The stretches of a branch go to every core (``numerics.workers``)."""
+def _sector_sizes(traced: list) -> dict:
+    """{characters: the sector's size on the last point's basis (the largest: a branch refines as it goes)} over the
+    sectors of every basis the branch was traced on."""
+    sizes = {}
+    for trace, _ in traced:
+        for sector in trace.basis.sectors():
+            if sector.size:
+                sizes[sector.characters] = float(sector.size)
+    return sizes
+
+
+def _sector_groups(sizes: dict, parts: int) -> list:
+    """The sectors in ``parts`` groups of about equal cost (size³: a factorisation per point), largest first into
+    the group with the least so far; one group of all, in their order, when ``parts`` is 1."""
+    if parts < 2:
+        return [tuple(sizes)]
+    groups, loads = [[] for _ in range(parts)], [0.0] * parts
+    for key in sorted(sizes, key=lambda k: -sizes[k]):
+        lightest = loads.index(min(loads))
+        groups[lightest].append(key)
+        loads[lightest] += sizes[key] ** 3
+    return [tuple(g) for g in groups if g]
+
+
+def _in_order(parts: list, order) -> dict:
+    """The groups' {characters: value} dicts as one, in the sectors' ``order`` (a serial reading's)."""
+    merged = {k: v for part in parts for k, v in part.items()}
+    return {k: merged[k] for k in order if k in merged}
+
+
+def _read(sb: SurfaceBranch, traced: list, readings, keys: tuple) -> list:
+    """(spectra, negative held counts) of the sectors ``keys`` at every point of the branch in order, each sector
+    following its own spectra at the previous point (``surface.stability.sector_spectra``; at the first point it
+    solves dense). The groups of sectors go to every core (``numerics.workers``): a sector's numbers are those of
+    a serial reading of all of them."""
     out, spectra, held = [], None, surface_stability.Reading(True)
-    for i in points:
+    for i in range(len(traced)):
         interrupt.check()
         trace, c = traced[i]
         params = sb.params.with_value(sb.parameter, sb.values[i])
-        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra)
+        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra,
+                                                   only=keys)
         out.append((spectra, _negative_counts(trace, c, params, spectra[held])))
     return out
 
@@ -79,7 +112,7 @@ def _negative_counts(trace, c, params, lowest: dict) -> dict:
         counts[key] = int((values < 0).sum())
         if counts[key] == values.size:
             held = surface_stability.Reading(True)
-            A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), key)[held][key]
+            A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), (key,))[held][key]
             counts[key] = eigen.negative_count(A)
     return counts
 
@@ -106,7 +139,7 @@ def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, e
         if not result.converged:
             raise ArithmeticError(result.message)
         c, params = system.coefficients(result.x), system.params_at(result.x)
-        A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), sector)[held][sector]
+        A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), (sector,))[held][sector]
         return float(eigen.lowest_following(A, k + 1, float(ends[0][0]))[k]), on_final(c, result.x[-1])
 
     length = float(np.linalg.norm(chord))

@@ -85,14 +85,14 @@ def _sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings
     """Yields (sector, H, g, groups, gas weight P/Ṽ) per symmetry sector: its Hessian, g = ∂Ṽ/∂c on the state's
     own sector under a controlled reading (else None), and groups {(zero-mode rows' bytes, control): (rows, the
     readings sharing that matrix)} (a sector without a translation reads the same held and free; one without g
-    the same under every control); ``only``: the characters of the one sector wanted."""
+    the same under every control); ``only``: the characters of the sectors wanted (default all)."""
     state = eq.node_values(c)["state"]
     fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], field_symmetry(eq, params), held)
               for held in {r.held for r in readings}}
     controlled = any(r.control != Control.PRESSURE for r in readings)
     weight = params.P / body_moments(eq.basis, state)[0] if controlled else None
     for sector in eq.basis.sectors():
-        if not sector.size or only not in (None, sector.characters):
+        if not sector.size or (only is not None and sector.characters not in only):
             continue
         H = eq.hessian(c, params, sector)
         g = -eq.parameter_derivative(c, params, "P", sector) if controlled and _own(sector, eq.basis) else None
@@ -110,7 +110,7 @@ def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, r
     """Yields (characters, the readings, A) one matrix at a time: A the standard symmetric matrix of the sector's
     pencil under those readings (module docstring), the zero modes removed (numerics.eigen.restricted: its
     eigenvalues are the μ, its inertia the sector's), one assembly per sector and one matrix for the readings that
-    share it (``_sectors``); ``only``: the characters of the one sector wanted."""
+    share it (``_sectors``); ``only``: the characters of the sectors wanted (default all)."""
     for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only):
         for (_, control), (rows, shared) in groups.items():
             yield sector.characters, tuple(shared), _reading_matrix(H, sector.gram(), rows, control, g, weight)
@@ -137,7 +137,7 @@ def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
 
 
 def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
-                   readings=PRESSURE_READINGS, guesses: dict | None = None) -> dict:
+                   readings=PRESSURE_READINGS, guesses: dict | None = None, only: tuple | None = None) -> dict:
     """{reading: {characters: the ``count`` lowest μ of the sector}}, one sector at a time in memory. ``guesses``
     (the same layout, the previous point's along a branch) let a large sector follow its lowest eigenvalues: one
     Cholesky factorisation of its matrix with the fewest zero modes removed under pressure control (the lowest
@@ -145,9 +145,11 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
     the other zero modes and the volume's gᵀc = 0 are constraints, the gas term a positive rank-one update in that
     matrix's coordinates (numerics.eigen.restricted_rows); the readings' Lanczos runs share each solve
     (numerics.eigen.ShiftInvert.lowest_of_relatives). Without guesses, below FOLLOWING_SIZE, or without a
-    shift below the spectrum, each reading's matrix is solved dense (numerics.eigen.lowest_of)."""
+    shift below the spectrum, each reading's matrix is solved dense (numerics.eigen.lowest_of). ``only``: the
+    characters of the sectors wanted (default all): each sector follows its own guesses alone, so the sectors of a
+    branch can be read apart (on different cores) with the same numbers."""
     out = {r: {} for r in readings}
-    for sector, H, g, groups, weight in _sectors(eq, c, params, readings, None):
+    for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only):
         key, gram = sector.characters, sector.gram()
         previous = [guesses[r][key][0] for r in readings if guesses and key in guesses.get(r, {})]
         base_rows = min((rows for rows, _ in groups.values()), key=len)
