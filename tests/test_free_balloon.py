@@ -167,8 +167,9 @@ def test_the_verdict_names_every_branch_not_traced(all_branches, tmp_path, capsy
     """The issue's scene (tests/data/off_equator.toml) with ``[surface] branches = "all"`` (4 points a branch): no
     not_searched entry; the free balloon's primary branch traced (primary_free) with its pear branches (its m = 0
     points classified) and its free m = 1 branches; the m = 1 points of the other reading on each branch (the held branch's free-reading zero, primary_free's held
-    one) named as not switched with why; the free balloon named once in the summary line. The one failing entry
-    left: the free primary branch's resolution limit near the wire (the result is not complete)."""
+    one) named as not switched with why; the free balloon named once in the summary line. The result is complete:
+    the free primary branch's end near the wire (degree 320 on its way to the balloon folded flat about the wire at
+    P = 0) is a flattening stop, a limited entry (``test_flattening``)."""
     from balloon_cg.analysis.picture import FREE_PRIMARY
     from balloon_cg.analysis.verdict import Gap, failing
     from balloon_cg.app.cli import main
@@ -177,10 +178,9 @@ def test_the_verdict_names_every_branch_not_traced(all_branches, tmp_path, capsy
     scene, picture = all_branches
     found = picture.incomplete
     assert Gap.NOT_SEARCHED not in {item.gap for item in found} and picture.not_searched == ""
-    # what still fails (the verdict is not complete): the free primary branch ends at the resolution limit (degree
-    # 320, gap 0.037 to the wire), as the h = 0 coil's held primary branch does (docs/surface.md)
-    assert [(item.gap, item.branch) for item in failing(found)] == [(Gap.STOPPED_SHORT, FREE_PRIMARY)]
-    assert "max_degree = 320" in failing(found)[0].message
+    assert not failing(found), failing(found)
+    flat = [item for item in found if item.gap == Gap.LIMITED and item.branch == FREE_PRIMARY]
+    assert len(flat) == 1 and flat[0].message.startswith("up leg: flattening") and "max_degree = 320" in flat[0].message
     names = [b.name for b in picture.branches]
     assert names[:3] == ["primary", "broken_pear", FREE_PRIMARY]
     assert names[3:] and all(name.startswith(f"{FREE_PRIMARY}_pear_") for name in names[3:])
@@ -199,7 +199,8 @@ def test_the_verdict_names_every_branch_not_traced(all_branches, tmp_path, capsy
                      found=found)
     assert main(["inspect", str(path)]) == 0
     verdict = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("result"))
-    assert "not_searched" not in verdict and verdict.count("free balloon") <= 1
+    assert verdict.split()[1].startswith("complete") and "not_searched" not in verdict
+    assert verdict.count("free balloon") <= 1
 
 
 @pytest.mark.slow

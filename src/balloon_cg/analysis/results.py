@@ -141,6 +141,7 @@ class StopCode(enum.StrEnum):
     CLOSED = "closed"  # a restarted branch came back to the point it was restarted from: a closed loop, traced once
     RESOLUTION = "resolution"  # the spectral error estimate exceeds max_error (the tracer refines)
     RESOLUTION_LIMIT = "resolution_limit"  # ... and the degree is at solver.max_degree
+    FLATTENING = "flattening"  # ... at max_degree, deflating towards the balloon folded flat about a wire at P = 0
     REFINE_FAILED = "refine_failed"  # Newton failed on the refined basis
     LANDING_FAILED = "landing_failed"  # Newton failed landing exactly on stop/min_stretch
     PARTNER = "partner"  # a two-parameter curve returned past its start value (reached the partner point)

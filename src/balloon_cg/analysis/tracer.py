@@ -6,7 +6,8 @@ point's spectral error estimate exceeds the resolution policy's max_error (``res
 with RESOLUTION and the last point is recomputed on a finer basis: with coils, first the wire map re-centred
 at the same degree (kept if the estimate leaves the policy's headroom, at most max_recentres times per degree);
 otherwise the degree grows and the better of the current and the re-centred map is kept. Past max_degree the
-leg stops with RESOLUTION_LIMIT.
+leg stops with RESOLUTION_LIMIT, or FLATTENING where it is on its way to the balloon folded flat about a wire at
+P = 0, which no degree reaches (``flattening``).
 
 The tracer is the same for the primary branch (``primary``) and the bifurcating ones (``switching``): they
 differ in the layout (equator-symmetric or general, held or free) and the stop rule.
@@ -22,6 +23,7 @@ from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
 from .control import fold_monitors
+from .flattening import flattening_stop
 from ..scene import ContinuationParameter
 from .problem import ParameterSystem, continuation_settings
 from .resolution import Resolution
@@ -122,7 +124,8 @@ class Tracer:
             if refined is None or isinstance(refined, str):
                 if degree >= policy.max_degree:
                     path.points.append(last)
-                    return LegTrace(segments, Stop(StopCode.RESOLUTION_LIMIT, (
+                    flat = flattening_stop(disc, last, policy.max_degree) if self.parameter == "P" else None
+                    return LegTrace(segments, flat or Stop(StopCode.RESOLUTION_LIMIT, (
                         f"resolution: spectral error estimate above solver.max_error = {policy.max_error:g} at "
                         f"solver.max_degree = {policy.max_degree}; raise max_degree or shorten the branch")))
                 degree, recentres = policy.grow(degree), 0

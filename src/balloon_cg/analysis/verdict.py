@@ -8,7 +8,9 @@ every bifurcating branch asked for could be started, and the stability flags of 
 between the stability degree and the check degree. A non-axisymmetric branch (``surface_branches``) may end at the
 caps of its whole-sphere basis or at its ``[surface] max_points``: a stated limitation (Gap.LIMITED), since every
 point it stores is resolved; a point whose tail on the branch's final basis exceeds max_error (points are traced
-on the bases of their segment and stored on the last) is flagged (Gap.UNRESOLVED). Everything else is an ``Incomplete`` entry: typed, named,
+on the bases of their segment and stored on the last) is flagged (Gap.UNRESOLVED). Any branch that ends at
+solver.max_degree on its way to the balloon folded flat about a wire at P = 0 (``flattening``: no degree reaches
+that end) is a stated limitation too (Gap.LIMITED). Everything else is an ``Incomplete`` entry: typed, named,
 explained. A limitation of the method
 that is not a failure of the computation (branch points not searched on a scene without equator symmetry) is
 an entry too, but does not make the result incomplete (``Gap.fails``). The CLI turns failing entries into exit
@@ -31,6 +33,9 @@ REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCo
 # where a non-axisymmetric branch may end short without failing: the caps of the whole-sphere basis (its points up to
 # there are resolved) and the [surface] max_points budget
 SURFACE_LIMITS = frozenset({StopCode.RESOLUTION_LIMIT, TraceStop.MAX_POINTS})
+# where any branch may end short without failing: on its way to an end no degree resolves (the balloon folded flat
+# about a wire at P = 0: ``flattening``), every point up to solver.max_degree resolved
+METHOD_LIMITS = frozenset({StopCode.FLATTENING})
 
 
 class Gap(enum.StrEnum):
@@ -43,8 +48,9 @@ class Gap(enum.StrEnum):
     NOT_SWITCHED = "not_switched"  # a branch point of a whole-sphere primary branch in its own symmetry sector: not
     #                                a pitchfork of a kept reflection, no branch switched there (a limitation, stated)
     NOT_ASKED = "not_asked"  # branch points whose branches the scene did not ask for ([surface] branches = "first")
-    LIMITED = "limited"  # a non-axisymmetric branch ended at the whole-sphere basis' cap or its [surface] max_points
-    #                      (a limitation of the method or the budget asked for, stated; every stored point resolved)
+    LIMITED = "limited"  # a non-axisymmetric branch ended at the whole-sphere basis' cap or its [surface] max_points,
+    #                      or a branch on its way to the balloon folded flat about a wire (METHOD_LIMITS): a
+    #                      limitation of the method or the budget asked for, stated; every stored point resolved
     INTERRUPTED = "interrupted"  # a signal stopped the computation: what follows the stored points is missing
     UNRESOLVED = "unresolved"  # stored points of a non-axisymmetric branch whose spectral tail on the branch's final
     #                            basis (they were traced on earlier ones) exceeds solver.max_error
@@ -74,7 +80,7 @@ def incomplete(branches: list, not_searched: str = "", not_started: tuple = (),
     found += [Incomplete(Gap.NOT_ASKED, names, reason) for names, reason in not_asked]
     for branch in branches:
         for leg in branch.legs:
-            if isinstance(branch, SurfaceBranch) and leg.stop.code in SURFACE_LIMITS:
+            if leg.stop.code in METHOD_LIMITS or (isinstance(branch, SurfaceBranch) and leg.stop.code in SURFACE_LIMITS):
                 found.append(Incomplete(Gap.LIMITED, branch.name, f"{leg.label} leg: {leg.stop.message}"))
             elif leg.stop.code == StopCode.INTERRUPTED:
                 found.append(Incomplete(Gap.INTERRUPTED, branch.name, f"{leg.label} leg: {leg.stop.message}"))
