@@ -86,3 +86,28 @@ def test_free_m1_branch_follows_its_normal_form(free_branch):
     assert abs(ratio[0] / kappa - 1) <= 1e-4
     intercept = np.polynomial.polynomial.polyfit(amplitude**2, ratio, 1)[0]
     assert abs(intercept / kappa - 1) <= 1e-4
+
+
+def test_a_switch_that_does_not_start_is_named_and_fails_the_verdict(tmp_path_factory, monkeypatch):
+    """Issue 41: where switching at an m ≥ 1 point fails (here every one: the first correction made to fail), the
+    picture names each branch not started (m1_bp<k>, the points of the reading the states are equilibria of: on the
+    two-coil scene both readings, held and free) and the verdict fails on them: never silence."""
+    from balloon_cg.analysis import surface_branches
+    from balloon_cg.analysis.picture import Picture, Progress, _trace_surface, surface_name
+    from balloon_cg.analysis.results import Status
+    from balloon_cg.analysis.verdict import Gap, failing
+
+    primary = two_coil_picture(tmp_path_factory).primary
+
+    def fails(*args, **kwargs):
+        raise surface_branches.SurfaceStartError("the first correction off the axisymmetric branch did not converge")
+
+    monkeypatch.setattr(surface_branches, "trace_surface", fails)
+    picture = Picture([primary])
+    _trace_surface(primary.scene.with_overrides({"surface.branches": "all"}), primary, picture, Progress())
+    expected = [surface_name(primary, k, bp) for k, bp in enumerate(primary.branch_points())
+                if bp.m >= 1 and bp.status == Status.LOCATED and primary.reads(bp.block)]
+    assert len(expected) >= 2 and {bp.block.held for bp in primary.branch_points() if bp.m == 1} == {True, False}
+    assert [name for name, _ in picture.not_started] == expected and not picture.surface_branches
+    assert [(item.gap, item.branch) for item in failing(picture.incomplete)] == [(Gap.NOT_STARTED, name)
+                                                                                  for name in expected]
