@@ -360,6 +360,8 @@ class SurfaceBranch:
     legs: tuple = ()
     special: list = field(default_factory=list)  # SpecialPoint, X = (c, p)
     stability: dict | None = None  # {'held': (n_points, k), 'free': (n_points, k)} lowest eigenvalues, ascending
+    sectors: dict | None = None  # {reading: {characters: (n_points, k)}}: each symmetry sector's lowest, ascending
+    frequencies: object = None  # dynamics.surface.SurfaceFrequencies ([dynamics] frequencies = true)
     parameter: str = "P"
     wall_time: float = 0.0
     origin: Origin = Origin.TRACED

@@ -23,14 +23,15 @@ def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS)
     try:
         assessed(sb, traced, readings)
     except interrupt.Interrupted:
-        sb.stability, sb.special = {}, special
+        sb.stability, sb.sectors, sb.special = {}, None, special
         return False
     return True
 
 
 def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> None:
     """The stability readings of every point (held and free, under pressure, volume and gas control:
-    ``surface.stability.READINGS``) and the secondary branch points: where the number of negative held eigenvalues
+    ``surface.stability.READINGS``: ``sb.stability`` the lowest over every sector, ``sb.sectors`` each sector's
+    ``spectrum_count`` lowest) and the secondary branch points: where the number of negative held eigenvalues
     of a sector under pressure control changes between points i and i + 1 (i ≥ 1: point 0 is the parent point),
     the zero of the crossing eigenvalue, located by Brent's method along the chord with the corrector on its
     hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails. ``traced``: per
@@ -48,6 +49,8 @@ def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READING
     held_spectra = [s[held] for s in spectra]
     sb.stability = {r.name: np.array([surface_stability.lowest_over(s[r], STABILITY_COUNT) for s in spectra])
                     for r in readings}
+    sb.sectors = {r.name: {key: _padded([s[r].get(key, ()) for s in spectra]) for key in spectra[0][r]}
+                  for r in readings}
     folds = {s.index for s in sb.special if s.kind == Kind.LP}
     for i in range(1, len(counts) - 1):
         for key in counts[i]:
@@ -56,6 +59,21 @@ def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READING
                 sb.special.append(_secondary(sb, traced, i, key, min(counts[i][key], counts[i + 1][key]),
                                              (held_spectra[i][key], held_spectra[i + 1][key])))
     sb.special.sort(key=lambda s: s.index)
+
+
+def spectrum_count(scene) -> int:
+    """The lowest eigenvalues read per sector: STABILITY_COUNT, or [dynamics] count where the scene asks for natural
+    frequencies and more (they are these eigenvalues over 2: dynamics.surface)."""
+    return max(STABILITY_COUNT, scene.dynamics.count if scene.dynamics.frequencies else 0)
+
+
+def _padded(rows: list) -> np.ndarray:
+    """(points × the longest row) of per-point eigenvalue rows, NaN where a row is shorter (a sector with fewer
+    modes)."""
+    out = np.full((len(rows), max(len(r) for r in rows)), np.nan)
+    for n, row in enumerate(rows):
+        out[n, :len(row)] = row
+    return out
 
 
 def _sector_sizes(traced: list) -> dict:
@@ -98,8 +116,8 @@ def _read(sb: SurfaceBranch, traced: list, readings, keys: tuple) -> list:
         interrupt.check()
         trace, c = traced[i]
         params = sb.params.with_value(sb.parameter, sb.values[i])
-        spectra = surface_stability.sector_spectra(trace.eq, c, params, STABILITY_COUNT, readings, guesses=spectra,
-                                                   only=keys)
+        spectra = surface_stability.sector_spectra(trace.eq, c, params, spectrum_count(sb.scene), readings,
+                                                   guesses=spectra, only=keys)
         out.append((spectra, _negative_counts(trace, c, params, spectra[held])))
     return out
 

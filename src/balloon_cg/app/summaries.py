@@ -160,10 +160,18 @@ def summarise_branch(b: dict) -> dict:
         "gauge": attrs["gauge"],  # io.run_file reads it from the layout in files written before it
         "reflection_of": attrs.get("reflection_of", ""),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
-        **({"frequencies": {block: values[:, 0] for block, values in b["frequencies"].items()},
-            "special_frequencies": {block: values[:, 0] for block, values in b["special_frequencies"].items()},
-            "translation_omega2": b["translation_omega2"]} if "frequencies" in b else {}),
+        **_lowest_frequencies(b),
     }
+
+
+def _lowest_frequencies(b: dict) -> dict:
+    """A branch's stored frequencies (per block the lowest Ω² at every point and special point; an axisymmetric
+    branch's rigid translations), or nothing when it stores none."""
+    if "frequencies" not in b:
+        return {}
+    return {"frequencies": {block: values[:, 0] for block, values in b["frequencies"].items()},
+            "special_frequencies": {block: values[:, 0] for block, values in b["special_frequencies"].items()},
+            **({"translation_omega2": b["translation_omega2"]} if b["translation_omega2"] else {})}
 
 
 def summarise_surface_branch(b: dict) -> dict:
@@ -202,6 +210,7 @@ def summarise_surface_branch(b: dict) -> dict:
         "M": float(attrs["M"]),
         "chi": float(attrs["chi"]),
         "stable_points": {k: int(np.sum(v)) for k, v in b.get("stability", {}).items() if k.startswith("stable")},
+        **_lowest_frequencies(b),
     }
 
 
@@ -313,6 +322,7 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"  stable points        {_stable_counts(b['stable_points'], b['points'])}",
         f"  special points       {len(b['special_points']) or 'none'}",
         *_special_lines(b["special_points"], b["gauge"], b["symmetry"]),
+        *_frequency_lines(b),
     ]
 
 
@@ -383,12 +393,14 @@ def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]
 
 def _frequency_lines(b: dict) -> list[str]:
     """The lowest Ω² of every block at each special point (its label and kind), one aligned row each, when the branch
-    stores frequencies ([dynamics])."""
+    stores frequencies ([dynamics]; a surface branch's blocks are its sectors under each reading,
+    dynamics.surface.sector_block)."""
     if "special_frequencies" not in b:
         return []
     rigid = [f"  rigid translation Ω² {direction} {_range_text(values)}" for direction, values in
-             b["translation_omega2"].items()]
-    rigid[-1] += "  (0: no field, the balloon drifts; > 0 the field restores it, < 0 pulls it away)"
+             b.get("translation_omega2", {}).items()]
+    if rigid:
+        rigid[-1] += "  (0: no field, the balloon drifts; > 0 the field restores it, < 0 pulls it away)"
     if not b["special_points"]:
         return rigid
     blocks = list(b["special_frequencies"])

@@ -17,14 +17,15 @@ import numpy as np
 from ..analysis.azimuthal import merged_lowest
 from ..analysis.picture import stopped
 from ..analysis.problem import equilibrium_of
-from ..analysis.results import Block, Branch, Gauge, Kind, Origin
+from ..analysis.results import Block, Branch, Gauge, Kind, Origin, SurfaceBranch
 from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
 from ..analysis.timing import Step
 from ..galerkin.profiles import theta_grid
 from ..numerics import interrupt, workers
 from ..numerics.threads import limited_blas
 from .modes import COMPONENTS, block_modes
-from .pencil import MASS_NORM, PER_EIGENVALUE, mass_variation
+from .pencil import FOLD_CONTROL, MASS_NORM, PER_EIGENVALUE, mass_variation, table_of
+from .surface import surface_frequencies
 from .translation import DIRECTIONS, translation_omega2
 
 
@@ -102,14 +103,14 @@ def branch_frequencies(branch, count: int = 3, m_max: int = 0, symmetric: bool |
                 if name in row:
                     shaped[name][n, :len(row[name])] = row[name]
     if copied is not None:
-        return replace(copied, special=_table(special, list(copied.omega2), count), modes=shaped, theta=theta)
+        return replace(copied, special=table_of(special, list(copied.omega2), count), modes=shaped, theta=theta)
     results = workers.spread(point, range(len(branch.X)), [assessment_cost(N, m_max) for N in degrees],
                              here=first_of_each(degrees))
     rows = [row for row, _ in results]
     names = list(dict.fromkeys(name for row in rows for name in row))
     translation = {direction: np.array([rigid[direction] for _, rigid in results]) for direction in DIRECTIONS}
-    return BranchFrequencies(_table(rows, names, count), degrees, _table(special, names, count), translation, count,
-                             m_max, shaped, theta)
+    return BranchFrequencies(table_of(rows, names, count), degrees, table_of(special, names, count), translation,
+                             count, m_max, shaped, theta)
 
 
 def frequency_degrees(branch) -> np.ndarray:
@@ -119,18 +120,6 @@ def frequency_degrees(branch) -> np.ndarray:
     eigenvalue ~1e-3 from zero); a mapped branch's assessed degrees hold its points already."""
     degrees = np.array(assessed_degrees(branch), dtype=int)
     return degrees if branch.disc.mapping is not None else np.maximum(degrees, branch.disc.degree)
-
-
-def _table(rows: list, names: list, count: int) -> dict:
-    """{block: (rows × count) Ω²} from per-row dicts, NaN where a row has fewer values (or not the block)."""
-    table = {name: np.full((len(rows), count), np.nan) for name in names}
-    for n, row in enumerate(rows):
-        for name, values in row.items():
-            table[name][n, :values.size] = values
-    return table
-
-
-FOLD_CONTROL = {Kind.LP: "", Kind.LV: "_volume", Kind.LN: "_gas"}  # the control whose Hessian a fold makes singular
 
 
 def matching_block(special, branch) -> str | None:
@@ -156,26 +145,28 @@ def matching_block(special, branch) -> str | None:
 
 
 def attach(branches, count: int, m_max: int, modes: bool = False) -> None:
-    """``branch.frequencies`` (``branch_frequencies``, with the special points' mode shapes if ``modes``) of every
-    axisymmetric branch, a reflected mirror image's points copied from its source; surface branches are left
-    without."""
+    """``branch.frequencies`` of every branch: ``branch_frequencies`` of an axisymmetric one (with the special points'
+    mode shapes if ``modes``), ``surface.surface_frequencies`` of an assessed surface branch (its sectors' Ω²; one
+    whose assessment a signal stopped is left without), a reflected image's points copied from its source."""
     done = {}
     for branch in branches:
+        source = done.get(branch.reflection_of) if branch.origin == Origin.REFLECTED else None
         if isinstance(branch, Branch):
-            source = done.get(branch.reflection_of) if branch.origin == Origin.REFLECTED else None
-            branch.frequencies = done[branch.name] = branch_frequencies(branch, count, m_max, copied=source,
-                                                                        modes=modes)
+            branch.frequencies = branch_frequencies(branch, count, m_max, copied=source, modes=modes)
+        elif isinstance(branch, SurfaceBranch) and branch.sectors is not None:
+            branch.frequencies = surface_frequencies(branch, count, copied=source)
+        done[branch.name] = branch.frequencies
 
 
 def attach_to(picture, dynamics) -> None:
-    """``attach`` to the axisymmetric branches of ``picture`` (analysis.picture.Picture), timed (Step.FREQUENCIES),
-    when ``dynamics`` (the scene's [dynamics]) asks for them and no signal stopped the work; a signal during them
-    stops them at the next point (the branches not reached are kept without) and the picture is interrupted in
-    that phase (``picture.stopped``)."""
+    """``attach`` to the branches and surface branches of ``picture`` (analysis.picture.Picture), timed
+    (Step.FREQUENCIES), when ``dynamics`` (the scene's [dynamics]) asks for them and no signal stopped the work; a
+    signal during them stops them at the next point (the branches not reached are kept without) and the picture is
+    interrupted in that phase (``picture.stopped``)."""
     if not dynamics.frequencies or interrupt.requested():
         return
     try:
         with picture.clock.step(Step.FREQUENCIES):
-            attach(picture.branches, dynamics.count, dynamics.m_max, dynamics.modes)
+            attach(picture.branches + picture.surface_branches, dynamics.count, dynamics.m_max, dynamics.modes)
     except interrupt.Interrupted:
         stopped(picture)

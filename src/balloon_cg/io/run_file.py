@@ -60,6 +60,9 @@ Layout::
                            character ±1 under each reflection of ``symmetry`` (0 … 0: none; absent in older files)
         stability/lowest_<reading> (point, eigenvalue) for the readings held, free, held_volume, free_volume,
                            held_gas, free_gas; stable_pressure, stable_pressure_free, stable_volume, … (point,)
+        frequencies/omega2_<reading>_<signs> (point, frequency), special_omega2_<reading>_<signs> (special,
+                           frequency): Ω² of each symmetry sector (its characters under ``symmetry`` as + and −) under
+                           each reading ([dynamics]: dynamics.surface); attrs count
     /snap_throughs/        from_branch, from_index, pressure, to_branch, to_index
 
 Every dataset carries ``long_name`` and ``description``, and a quantity its ``units`` (``io.schema``); its axes
@@ -363,6 +366,8 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
                   len(basis.symmetry))
     if branch.stability:
         _write_surface_stability(group.create_group("stability"), branch.stability, point)
+    if branch.frequencies is not None:
+        _write_surface_frequencies(group.create_group("frequencies"), branch.frequencies, point)
 
 
 def _write_surface_stability(group, lowest: dict, point) -> None:
@@ -411,24 +416,38 @@ def _write_stability(group, branch, point):
 def _write_frequencies(group, frequencies, point, theta):
     """Ω² per block (dynamics.frequencies.BranchFrequencies) and the degree per point; the special points' mode
     shapes where computed (on the branch's ``theta`` scale)."""
-    group.attrs.update({"count": frequencies.count, "m_max": frequencies.m_max})
+    group.attrs["m_max"] = frequencies.m_max
     point, *theta = coordinates(group, point, *([theta] if frequencies.modes is not None else []))  # θ: the modes'
-    frequency = scale(group, "frequency", frequencies.count)
-    special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
+    special, frequency, axes = _write_omega2(group, frequencies, point)
     checksummed(group, "perturbation_degree", frequencies.degree)
     for direction, values in frequencies.translation.items():
         checksummed(group, f"translation_{direction}", values)
-    axes = {1: (point,), 2: (point, frequency)}
-    for block, values in frequencies.omega2.items():
-        checksummed(group, f"{OMEGA2}{block}", values)
-        checksummed(group, f"{SPECIAL_OMEGA2}{block}", frequencies.special[block])
-        axes[f"{SPECIAL_OMEGA2}{block}"] = (special, frequency)
     if frequencies.modes is not None:
         component = scale(group, "component", next(iter(frequencies.modes.values())).shape[2])
         for block, shapes in frequencies.modes.items():
             checksummed(group, f"{MODES}{block}", shapes, compression="gzip", shuffle=True)
             axes[f"{MODES}{block}"] = (special, frequency, component, *theta)
     attach_dimensions(group, axes)
+
+
+def _write_surface_frequencies(group, frequencies, point):
+    """Ω² per sector and reading of a surface branch (dynamics.surface.SurfaceFrequencies)."""
+    (point,) = coordinates(group, point)
+    attach_dimensions(group, _write_omega2(group, frequencies, point)[2])
+
+
+def _write_omega2(group, frequencies, point) -> tuple:
+    """The ``count`` attribute, the frequency and special scales and omega2_<block>, special_omega2_<block> of
+    ``frequencies`` (its ``omega2``, ``special``, ``count``); returns (special, frequency, the datasets' axes)."""
+    group.attrs["count"] = frequencies.count
+    frequency = scale(group, "frequency", frequencies.count)
+    special = scale(group, "special", len(next(iter(frequencies.special.values()), ())))
+    axes = {1: (point,), 2: (point, frequency)}
+    for block, values in frequencies.omega2.items():
+        checksummed(group, f"{OMEGA2}{block}", values)
+        checksummed(group, f"{SPECIAL_OMEGA2}{block}", frequencies.special[block])
+        axes[f"{SPECIAL_OMEGA2}{block}"] = (special, frequency)
+    return special, frequency, axes
 
 
 def _write_snaps(group, snaps):
@@ -684,15 +703,17 @@ def check_branch(group, where, error, written: bool = False) -> None:
     check_frequencies(group, where, error, n)
 
 
-def check_frequencies(group, where, error, n: int) -> None:
-    """A branch's frequencies group, where present: Ω² per block ``n`` rows, at the special points one row each."""
+def check_frequencies(group, where, error, n: int, surface: bool = False) -> None:
+    """A branch's frequencies group, where present: Ω² per block ``n`` rows (an axisymmetric branch's with the
+    perturbation degree and the rigid translations; a ``surface`` branch's per sector and reading alone), at the
+    special points one row each."""
     if "frequencies" not in group:
         return
     frequencies = require_group(group, "frequencies", where, error)
     columns = {name: ("float", 2) for name in frequencies if name.startswith(OMEGA2)}
-    rigid = {name: ("float", 1) for name in TRANSLATIONS}
-    check_columns(frequencies, f"{where}: frequencies", columns | rigid | {"perturbation_degree": ("int", 1)}, error,
-                  rows=n)
+    if not surface:
+        columns |= {name: ("float", 1) for name in TRANSLATIONS} | {"perturbation_degree": ("int", 1)}
+    check_columns(frequencies, f"{where}: frequencies", columns, error, rows=n)
     special = {name: ("float", 2) for name in frequencies if name.startswith(SPECIAL_OMEGA2)}
     special |= {name: ("float", 4) for name in frequencies if name.startswith(MODES)}
     check_columns(frequencies, f"{where}: frequencies", special, error, rows=len(group["special_points"]["kind"]))
@@ -807,6 +828,7 @@ def check_surface_branch(group, where, error, written: bool = False) -> None:
     check_special(require_group(group, "special_points", where, error), f"{where}: special_points", size + 1, error,
                   reflections=len(group.attrs["symmetry"]), written=written)
     check_stability(group, where, error, n, written)
+    check_frequencies(group, where, error, n, surface=True)
 
 
 def stored_basis(attrs, where="", error=FileError):

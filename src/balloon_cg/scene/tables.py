@@ -239,8 +239,8 @@ SURFACE_BRANCHES = ("first", "all", "none")
 @dataclass(frozen=True)
 class Dynamics:
     """Natural frequencies (MODEL.md §11, docs/dynamics.md): with ``frequencies`` the lowest ``count`` Ω² of every
-    second-variation block, m = 0..``m_max``, at every point of every axisymmetric branch; with ``modes`` also
-    their mode shapes at the special points."""
+    second-variation block, m = 0..``m_max``, at every point of every axisymmetric branch (of every symmetry sector
+    and reading of a surface branch); with ``modes`` also their mode shapes at the special points."""
 
     frequencies: bool = False
     count: int = 3
