@@ -8,7 +8,8 @@ SOUTH_STOP_STRETCH) gets its exact end point there (Newton on the pole row r·X 
 interpolant); one that stopped on a value of the control parameter q (STOP_VOLUME, STOP_AMOUNT: q = V or n,
 nonlinear in X) lands by Newton on the linearised constraint ∇q(X_k)·(X − X_k) = target − q(X_k), repeated
 until |q − target| ≤ LANDING_RTOL·max(1, |target|); a fold found between the last point and the overshoot is
-kept only if it lies before that end.
+kept only if it lies before that end. One that stopped on a value of a continuation parameter that has a
+range (STOP_FIELD, ZERO_FIELD: M in [0, stop_field]) lands on its row X[-1] = target (``PARAMETER``).
 """
 import time
 
@@ -77,10 +78,18 @@ LANDING_RTOL = 1e-12
 LANDING_ROUNDS = 8
 
 
+PARAMETER = "parameter"  # a landing target: the continuation parameter itself, X[-1]
+
+
 def quantity_of(system, name):
-    """(q, ∇q) of a landing target: the pole row ``name`` (linear) or the control parameter of a Control."""
+    """(q, ∇q) of a landing target: the pole row ``name`` (linear), the control parameter of a Control, or the
+    continuation parameter (``PARAMETER``)."""
     if isinstance(name, Control):
         return (lambda X: control_value(system.eq.disc, X, name)), (lambda X: control_gradient(system, X, name))
+    if name == PARAMETER:
+        row = np.zeros(system.eq.disc.size + 1)
+        row[-1] = 1.0
+        return (lambda X: float(X[-1])), (lambda X: row)
     row = np.append(system.eq.disc.pole_rows()[name], 0.0)
     return (lambda X: float(row @ X)), (lambda X: row)
 

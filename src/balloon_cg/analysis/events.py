@@ -5,7 +5,7 @@ reaches 0 at its end) holds a UZ point: the equilibrium between the two stored p
 Newton on R(X) = 0 and the linearised constraint ∇q(X_k)·(X − X_k) = v − q(X_k), repeated until
 |q − v| ≤ LANDING_RTOL·max(1, |v|) (``assembly.land``, the landing of a branch end on a stop value). The
 quantities (``scene.events.Quantity``): the enclosed volume V = 2π Ṽ(u), the gas amount n = P V, the pressure P
-(the continuation parameter: a voltage continuation's P is fixed and never passes a value), and λ2 at the north
+(the continuation parameter: on a continuation in Φ̄ or M, P is fixed and passes no value: not searched), and λ2 at the north
 pole, the south pole and the equator (linear rows in u). A landing that fails stores the linear interpolant,
 APPROXIMATE with its bracket.
 
@@ -61,6 +61,8 @@ def event_points(branch: Branch) -> list[SpecialPoint]:
     system, settings = branch_system(branch), continuation_settings(branch.scene)
     found = []
     for event in events:
+        if event.quantity == Quantity.PRESSURE and branch.parameter != "P":
+            continue  # P is fixed along the branch: it passes no value (it is the value everywhere, or nowhere)
         quantity = event_quantity(system, event.quantity)
         offset = np.array([quantity[0](X) for X in branch.X]) - event.value
         note = f"{event.quantity.value} = {event.value:g}"

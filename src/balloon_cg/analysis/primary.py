@@ -31,14 +31,14 @@ from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.newton import newton
-from .assembly import assemble
+from .assembly import PARAMETER, assemble
 from .control import control_stop, control_value, landing
 from .events import with_events
 from .problem import ParameterSystem
 from .results import Branch, StopCode
-from .tracer import ContinuationError, Tracer, unit
+from .tracer import ContinuationError, Tracer, scene_parameter, unit
 from .wires import wire_gap
-from ..scene import ContinuationParameter, Shape
+from ..scene import Shape
 from ..numerics.threads import limited_blas
 
 
@@ -249,18 +249,22 @@ def north_stop_stretch(upper: float) -> Stop:
     return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
 
 
-def range_limits(scene, upper: float):
+def range_limits(scene, upper: float, parameter: str | None = None, params: Parameters | None = None):
     """limits(disc, point) -> Stop or None: a dielectric membrane is compressed, the north pole stretch leaves
     [min_stretch, upper], P reaches stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage
-    continuation), or the control parameter reaches loading.stop_volume or stop_amount: the range the scene asks
-    for, and the model's."""
+    continuation; M reaches stop_field or falls below 0 in a continuation in M), or the control parameter reaches
+    loading.stop_volume or stop_amount: the range the scene asks for, and the model's. ``parameter``: the
+    continuation parameter (default the scene's, ``tracer.scene_parameter``), ``params`` the fixed ones (default:
+    the scene's voltage)."""
     cont, control = scene.continuation, scene.loading.control
     by_control = control_stop(scene.loading)
-    in_voltage = cont.parameter == ContinuationParameter.VOLTAGE
+    parameter = parameter or scene_parameter(scene)
+    in_voltage = parameter == "voltage"
+    fixed_voltage = params.voltage if params is not None else getattr(scene.electric, "voltage", 0.0)
 
     def limits(disc, point):
         if scene.electric is not None:  # first: a compressed point is not landed on, whatever its stretch
-            voltage = point.X[-1] if in_voltage else scene.electric.voltage
+            voltage = point.X[-1] if in_voltage else fixed_voltage
             if compressed(disc, point.X[:-1], scene.material, voltage, scene.geometry):
                 return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
                                                  "tension: tension-field theory is not modelled)")
@@ -269,7 +273,7 @@ def range_limits(scene, upper: float):
             return north_stop_stretch(upper)
         if stretch <= cont.min_stretch:
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
-        if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and not in_voltage:
+        if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and parameter == "P":
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
         if by_control is not None and control_value(disc, point.X, control) >= by_control[2]:
             key, code, limit = by_control
@@ -278,15 +282,19 @@ def range_limits(scene, upper: float):
             return Stop(StopCode.STOP_VOLTAGE, f"reached stop_voltage {cont.stop_voltage:g}")
         if in_voltage and point.X[-1] < 0:  # Φ̄ → −Φ̄ is the same balloon: the branch ends at the voltage-free sphere
             return Stop(StopCode.ZERO_VOLTAGE, "reached voltage 0 (the sphere without voltage)")
+        if parameter == "M" and cont.stop_field is not None and point.X[-1] >= cont.stop_field:
+            return Stop(StopCode.STOP_FIELD, f"reached stop_field {cont.stop_field:g}")
+        if parameter == "M" and point.X[-1] < 0:  # M = I²/(16π²R0²μ) ≥ 0
+            return Stop(StopCode.ZERO_FIELD, "reached M = 0 (the balloon without field)")
         return None
 
     return limits
 
 
-def stop_rule(scene, upper: float):
+def stop_rule(scene, upper: float, parameter: str | None = None, params: Parameters | None = None):
     """stop(disc, point) -> Stop or None: ``range_limits``, or the membrane comes within wire_gap of a coil."""
     cont = scene.continuation
-    limits = range_limits(scene, upper)
+    limits = range_limits(scene, upper, parameter, params)
 
     def stop(disc, point):
         beyond = limits(disc, point)
@@ -320,6 +328,9 @@ def trace_primary(scene, symmetric: bool | None = None, stop_stretch: float | No
 
 def landing_targets(scene, upper: float) -> dict:
     """``assembly.assemble``'s land_on of a primary branch: the north pole stretch at ``upper`` and at
-    min_stretch, and the control stop (``control.landing``)."""
+    min_stretch, the control stop (``control.landing``), and a continuation in M's ends (M = 0, stop_field)."""
+    field_ends = {StopCode.ZERO_FIELD: (PARAMETER, 0.0)}
+    if scene.continuation.stop_field is not None:
+        field_ends[StopCode.STOP_FIELD] = (PARAMETER, scene.continuation.stop_field)
     return {StopCode.STOP_STRETCH: ("lam2_north", upper),
-            StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
+            StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading) | field_ends

@@ -134,6 +134,8 @@ class StopCode(enum.StrEnum):
     STOP_AMOUNT = "stop_amount"  # the gas amount n = P V reached loading.stop_amount (gas control)
     STOP_VOLTAGE = "stop_voltage"  # Φ̄ reached continuation.stop_voltage (a voltage continuation)
     ZERO_VOLTAGE = "zero_voltage"  # Φ̄ fell to 0 (a voltage continuation reached the voltage-free sphere)
+    STOP_FIELD = "stop_field"  # M reached continuation.stop_field (a continuation in M at fixed P)
+    ZERO_FIELD = "zero_field"  # M fell to 0 (a continuation in M reached the field-free balloon)
     COMPRESSED = "compressed"  # a principal stress (elastic + dielectric) became negative
     WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
     SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch

@@ -49,15 +49,22 @@ def unit(size: int, index: int) -> np.ndarray:
     return e
 
 
+def scene_parameter(scene) -> str:
+    """The Parameters field a scene's branches are continued in: P, or Φ̄ for continuation.parameter = "voltage"."""
+    return "voltage" if scene.continuation.parameter == ContinuationParameter.VOLTAGE else "P"
+
+
 NORTH_TURNING = MappingProxyType({Kind.TP: "lam2_north"})  # the pole stretch folds a leg locates by default
 
 
 class Tracer:
     """Discretisations of growing degree for one scene and one layout, and the legs traced on them."""
 
-    def __init__(self, scene, symmetric: bool | None = None, held: bool | None = None):
+    def __init__(self, scene, symmetric: bool | None = None, held: bool | None = None, parameter: str | None = None):
         """``symmetric``: the equator-symmetric layout (default: when the field allows it); ``held``: constrain the
-        axial translation b_0 = 0 (default: with coils that are not equator-symmetric). Without a field acting (no
+        axial translation b_0 = 0 (default: with coils that are not equator-symmetric); ``parameter``: the
+        continuation parameter, a Parameters field (default: the scene's, P or Φ̄; M: a continuation in the field
+        at fixed P, ``continue --parameter M``). Without a field acting (no
         coils, or M = 0: the field energy is proportional to M) the energy does not depend on b_0, an exact zero
         mode, and b_0 is always removed."""
         self.scene = scene
@@ -71,7 +78,7 @@ class Tracer:
         # symmetry, and b_0 is a zero mode at M = 0 (``primary.start`` switches the field on held, then releases)
         self.free_off_equator = not self.pin and not scene.field.is_equator_symmetric
         # the continuation parameter (Parameters field): P, or Φ̄ for continuation.parameter = "voltage"
-        self.parameter = "voltage" if scene.continuation.parameter == ContinuationParameter.VOLTAGE else "P"
+        self.parameter = parameter or scene_parameter(scene)
         self.settings = continuation_settings(scene)
         self.resolution = Resolution.of(scene.solver)
         self._systems = {}

@@ -26,6 +26,7 @@ from .results import Classification, Kind, Status, StopCode, SurfaceBranch, Trac
 
 REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCode.STOP_PRESSURE,
                              StopCode.STOP_VOLUME, StopCode.STOP_AMOUNT, StopCode.STOP_VOLTAGE, StopCode.ZERO_VOLTAGE,
+                             StopCode.STOP_FIELD, StopCode.ZERO_FIELD,
                              StopCode.COMPRESSED, StopCode.WIRE_GAP,
                              StopCode.SOUTH_STOP_STRETCH, StopCode.REJOINED, StopCode.CLOSED})
 

@@ -182,7 +182,8 @@ EXAMPLES = {  # each subcommand's --help ends with these
                  "balloon-cg critical spom1 --set material.preset=Gent --of LP --parameter material.parameters.Jm "
                  "--direction -1 -o cusp.h5"),
     "continue": ("balloon-cg continue two_coils.h5 3 -o again.h5",
-                 "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o fold.h5"),
+                 "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o fold.h5",
+                 "balloon-cg continue two_coils.h5 2 --parameter M --set continuation.stop_field=0.004 -o tuning.h5"),
     "kernels": ("balloon-cg kernels spom1 --json",),
     "figure": ("balloon-cg figure fig9 --width 3.5", "balloon-cg figure all -o paper-figures --width 7.2"),
     "completion": ("balloon-cg completion bash > ~/.local/share/bash-completion/completions/balloon-cg",
@@ -950,14 +951,17 @@ def _add_continue(commands):
                     "assesses them, after the branch of the point as read); with --parameter KEY (a scene "
                     "key, as for critical) from a fold (LP, LV, LN) the fold curve in KEY and its cusp, from a "
                     "pear pitchfork (BP odd_held or odd_free) the curve of pitchforks and the isola's critical "
-                    "value (a curve file). Exit 0: written (a run file: and complete); 1: the computation did not "
+                    "value (a curve file), from another point (UZ, EP, TP) with --parameter M or voltage the branch "
+                    "through it in that parameter at its fixed P (a run file of one branch, assessed as the stored "
+                    "one was, with [dynamics] its frequencies: tuning curves, docs/dynamics.md). Exit 0: written (a run file: and complete); 1: the computation did not "
                     "give it (the curve or no switched branch started; a run file written but incomplete, as run: "
                     "--allow-partial exits 0); 2: bad input (no such label, a label or parameter this does not "
                     "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
                     "surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
-    p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P)")
+    p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P; from a point "
+                                       "that is no fold or BP: M or voltage, at its fixed P)")
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="a fold curve: start with the parameter increasing (1, default) or decreasing (-1)")
     p.add_argument("-o", "--output", help="run or curve file to write (HDF5; default: RUN_label<LABEL>.h5 in the "

@@ -17,6 +17,9 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   ``run`` assesses it); the branch of the point is written as read (its stored stability is not read back);
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
   (``analysis.fold_curve.continue_fold``);
+- any other point (UZ, EP, TP) in M or Φ̄ (TUNED): the branch through it in that parameter at its fixed P
+  (``restart_in``: a Picture of one branch, primary, assessed as the stored branch was; with [dynamics] its
+  frequencies, the tuning curves Ω²(M) or Ω²(Φ̄) at fixed P);
 - a pear branch point (BP of block odd_held, or odd_free: the free balloon's, on an equator-symmetric branch) in q:
   the curve of pitchforks through it (``analysis.codim2.continue_branch_point``; its mode recomputed,
   ``pear_point``), as ``critical`` traces the held one.
@@ -28,7 +31,7 @@ parameters, points and special points; ``with_settings`` sets keys of the scene 
 (stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch
 points (even, m ≥ 1) in a second parameter, switching at an even point, at an m ≥ 1 point of the other reading
 or at an m = 0 point of a branch without equator symmetry, points of surface branches, an ordinary point in a
-second parameter.
+second parameter other than M or Φ̄.
 """
 import time
 from dataclasses import dataclass, replace
@@ -45,6 +48,7 @@ from ..analysis.picture import (FREE_PRIMARY, PEAR_NAMES, Picture, Progress, azi
                                 label_readings, pear_pair, stopped, surface_name, surface_pair, unsearched_events)
 from ..analysis.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
+from ..analysis.second_parameter import resolve
 from ..analysis.surface_branches import SurfaceStartError
 from ..analysis.switching import mark_rejoin, pear_landing, pear_stop_rule
 from ..analysis.tracer import Tracer
@@ -168,8 +172,7 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
     t0 = time.perf_counter()
     branch, scene = start.branch, start.branch.scene
     disc = branch.disc
-    held = disc.pin_translation and bool(scene.field.coils) and scene.field.M != 0
-    tracer = Tracer(scene, disc.symmetric, held)
+    tracer = Tracer(scene, disc.symmetric, held_layout(branch))
     params = branch.params
     system = tracer.system(disc.degree, params, disc.mapping)
     point = step_away(system, start, tracer.settings)
@@ -393,5 +396,60 @@ def restart(start: Labelled, parameter: str | None, direction: float = 1.0, prog
         raise RestartError(f"--parameter {parameter}: label {start.label} is a BP of block "
                            f"{start.point.block.value or 'none'}; only pear points (odd_held, odd_free) of an "
                            "equator-symmetric branch are continued in a second parameter")
-    raise RestartError(f"--parameter {parameter}: label {start.label} is a {kind.value}; from it only the branch's "
-                       f"own parameter {own} (a fold, LP, LV or LN, also continues in a second parameter)")
+    picture = restart_in(start, tuned(start, parameter), progress)
+    attach_to(picture, start.branch.scene.dynamics)
+    return picture
+
+
+TUNED = ("M", "voltage")  # the runtime scalars a point is followed in at fixed P (``restart_in``)
+
+
+def tuned(start: Labelled, key: str) -> str:
+    """The Parameters field of ``key`` (a scene key or bare name: ``analysis.second_parameter.resolve``) when it is
+    one a point can be followed in at fixed P (TUNED); RestartError otherwise (UnknownParameter for a key the
+    scene's kernels do not take)."""
+    name = resolve(start.branch.scene, key).split(".")[-1]
+    if name not in TUNED or name == start.branch.parameter:
+        raise RestartError(f"--parameter {key}: label {start.label} is a {start.point.kind.value}; from it the "
+                           f"branch's own parameter {start.branch.parameter}, or {' or '.join(TUNED)} at fixed P "
+                           "(a fold, LP, LV or LN, also continues in a second parameter)")
+    return name
+
+
+def restart_in(start: Labelled, name: str, progress=None) -> Picture:
+    """The branch through the labelled point in the runtime scalar ``name`` (M or Φ̄) at the point's fixed P (and
+    the other parameters): from the point, on the stored degree and basis map, traced both ways with the scene's
+    stops (the pole stretches, the wire gap, M in [0, continuation.stop_field] or Φ̄ in [0, stop_voltage], the
+    control's), M's ends landed on; assessed, with its branch points and m ≥ 1 points located, as ``run`` gives
+    them, if the stored branch was (``picture.examine``, no branch switched). A Picture of one branch, primary,
+    whose parameter is ``name``: with [dynamics] frequencies, the tuning curves Ω²(M) or Ω²(Φ̄) at fixed P.
+    Its folds in ``name`` are LP points; the point itself is a regular point of the new branch (a fold of P or a
+    branch point is continued as a curve instead: ``restart``)."""
+    t0 = time.perf_counter()
+    branch, scene = start.branch, start.branch.scene
+    disc = branch.disc
+    params = branch.params_at(start.point.X)
+    tracer = Tracer(scene, disc.symmetric, held_layout(branch), parameter=name)
+    system = tracer.system(disc.degree, params, disc.mapping)
+    X = np.append(start.point.X[:-1], getattr(params, name))
+    tangent = continuation.tangent(system, X, np.eye(X.size)[-1])  # oriented with the parameter increasing
+    point = continuation.Point(X, tangent, 0, float(np.abs(system.residual(X)).max()))
+    upper = scene.continuation.stop_stretch
+
+    def leg(sign):
+        return tracer.leg(replace(point, tangent=sign * tangent), params,
+                          closing_rule(disc, X, stop_rule(scene, upper, name, params)), progress, degree=disc.degree,
+                          mapping=disc.mapping, limits=range_limits(scene, upper, name, params))
+
+    up = leg(1.0)
+    down = None if up.stop.code == StopCode.CLOSED else leg(-1.0)
+    primary = with_events(assemble(tracer, params, "primary", up, down, t0, labels=("up", "down"),
+                                   land_on=landing_targets(scene, upper)))
+    return examine(scene, primary, Ticks(progress), pear=False) if start.assessed else Picture([primary])
+
+
+def held_layout(branch: Branch) -> bool:
+    """Whether a stored branch's layout holds the balloon's centre (b_0 = 0 pinned with a field acting), as its
+    Tracer was built."""
+    scene = branch.scene
+    return branch.disc.pin_translation and bool(scene.field.coils) and scene.field.M != 0

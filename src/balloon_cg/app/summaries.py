@@ -155,6 +155,7 @@ def summarise_branch(b: dict) -> dict:
         "M": float(attrs["M"]),
         "chi": float(attrs["chi"]),
         **({"voltage": _range(b["voltage"]), "parameter": attrs["parameter"]} if "voltage" in b else {}),
+        **({"field_M": _range(b["M"]), "parameter": "M"} if "M" in b else {}),  # continue --parameter M
         "parent": [attrs["parent_branch"], int(attrs["parent_branch_point"])] if "parent_branch" in attrs else None,
         "origin": attrs.get("origin", "traced"),  # files written before reflected mirrors: every branch traced
         "gauge": attrs["gauge"],  # io.run_file reads it from the layout in files written before it
@@ -257,11 +258,13 @@ def _run_time_lines(summary: dict) -> list[str]:
 
 
 def _snap_symbol(run: dict, branch: str) -> str:
-    """What a snap-through's stored value is: Φ̄ on a voltage branch, else the control value P, V or n."""
+    """What a snap-through's stored value is: Φ̄ on a voltage branch, M on a branch in M, else the control value P,
+    V or n."""
     from ..scene import Control
 
-    if run["branches"][branch]["attrs"].get("parameter") == "voltage":
-        return "voltage"
+    parameter = run["branches"][branch]["attrs"].get("parameter")
+    if parameter in ("voltage", "M"):
+        return parameter
     control = Control(run["attrs"].get("control", Control.PRESSURE))
     return {Control.PRESSURE: "P", Control.VOLUME: "V", Control.GAS: "n"}[control]
 
@@ -350,6 +353,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
         *(["  voltage              {:.10g} .. {:.10g}".format(*b["voltage"]) + f"  (continued in {b['parameter']})"]
           if "voltage" in b else []),
+        *(["  field M              {:.10g} .. {:.10g}  (continued in M at fixed P)".format(*b["field_M"])]
+          if "field_M" in b else []),
         "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
         "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
         f"  stop reason          {b['stop_reason']}"

@@ -16,19 +16,20 @@ Layout::
                                   symmetric, pin_translation, quadrature, map_centres, map_widths,
                                   kernel_class, kernel_signature, M, chi, electric (the dielectric term is in
                                   the kernels), voltage (Φ̄, fixed unless it is the parameter), parameter
-                                  ("P" or "voltage": what the last unknown is), origin (traced,
+                                  ("P", "voltage" or "M": what the last unknown is), origin (traced,
                                   reflected, ...: analysis.results.Origin), gauge (held, free or both:
                                   the reading its states are equilibria of, analysis.results.Gauge),
                                   [parent_branch, parent_branch_point, rejoins_branch_point, reflection_of]
         point, unknown                                     dimension scales (0, 1, …)
         pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
-        newton_iterations, solved_degree, [voltage]        (point,) (voltage: where electric)
+        newton_iterations, solved_degree, [voltage], [M]   (point,) (voltage: where electric; M: a
+                                                           continuation in M, ``continue --parameter M``)
         unknowns                                           (point, unknown): Legendre unknowns u, then P (or Φ̄)
         theta                                              (theta,): linspace(0, π), a dimension scale
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
         special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, gauge (held, free, both),
-                       status (located, approximate), reason, stop_code, note, index, m, pressure, [voltage], uncertainty, E2, E3, E4,
+                       status (located, approximate), reason, stop_code, note, index, m, pressure, [voltage], [M], uncertainty, E2, E3, E4,
                        lam2_north, lam2_south, eta_north, eta_south                          (special,)
         special_points/state/unknowns                      (special, unknown): each point's own X
         stability/stable_*                                 (point,) flags
@@ -461,11 +462,12 @@ def _write_snaps(group, snaps):
 
 
 def parameter_columns(branch, X) -> dict:
-    """{'pressure': P, and 'voltage': Φ̄ where the dielectric term is present} of the rows X = (u, p) of a branch
-    (p is its continuation parameter; the other one is fixed)."""
+    """{'pressure': P, 'voltage': Φ̄ where the dielectric term is present, 'M' on a continuation in M} of the rows
+    X = (u, p) of a branch (p is its continuation parameter; the others are fixed)."""
     last = X[:, -1]
     fixed = lambda name: last if branch.parameter == name else np.full(len(X), getattr(branch.params, name))  # noqa: E731
-    return {"pressure": fixed("P"), **({"voltage": fixed("voltage")} if branch.scene.electric is not None else {})}
+    return {"pressure": fixed("P"), **({"voltage": fixed("voltage")} if branch.scene.electric is not None else {}),
+            **({"M": last} if branch.parameter == "M" else {})}
 
 
 def legendre_poles(disc, X) -> dict:
@@ -612,13 +614,15 @@ BRANCH_COLUMNS = {**{name: ("float", 1) for name in ("pressure", *POLES, "lam1_e
 PROFILES = {name: ("float", 2) for name in ("lam1", "lam2", "rho", "eta")}
 SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int", 1), "m": ("int", 1),
                    **{name: ("float", 1) for name in SPECIAL_NUMBERS}}
-OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage")}  # absent in older formats
+OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage", "M")}  # absent in older formats
+CONDITIONAL_COLUMNS = ("voltage", "M")  # written where electric, on a continuation in M
 WRITTEN_BRANCH = {"order": "int", "m": "int", "assessed": "bool", "origin": "str", "gauge": "str", "electric": "bool",
                   "voltage": "float", "parameter": "str"}  # required in a file with checksums (older: optional)
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
-OPTIONAL_SPECIAL = {"voltage": ("float", 1), "gauge": ("str", 1), "label": ("int", 1)}  # voltage: where electric;
+OPTIONAL_SPECIAL = {"voltage": ("float", 1), "M": ("float", 1), "gauge": ("str", 1), "label": ("int", 1)}  # voltage, M:
+#                                                               where electric, on a continuation in M;
 #                                                               gauge, label: since issue 27 (absent in older files)
 
 
@@ -687,7 +691,7 @@ def check_branch(group, where, error, written: bool = False) -> None:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
     check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items()
-                                 if k in group or (written and k != "voltage")}, error, rows=n)
+                                 if k in group or (written and k not in CONDITIONAL_COLUMNS)}, error, rows=n)
     check_sizes(group, where, error)
     width = group["unknowns"].shape[1]
     check_scales(group, where, error, {"point": n, "unknown": width}, written)
@@ -763,7 +767,7 @@ def check_special(group, where, width: int, error, extra: dict | None = None, re
     row of zeros)."""
     n = check_columns(group, where, SPECIAL_COLUMNS | (extra or {}), error)
     check_columns(group, where, {k: v for k, v in OPTIONAL_SPECIAL.items()
-                                 if k in group or (written and k != "voltage")}, error, rows=n)
+                                 if k in group or (written and k not in CONDITIONAL_COLUMNS)}, error, rows=n)
     check_scales(group, where, error, {"special": n}, written)
     check_sizes(group, where, error)
     unknowns = special_unknowns(group, where, error, rows=n)
@@ -814,7 +818,7 @@ def check_surface_branch(group, where, error, written: bool = False) -> None:
     require_attrs(group.attrs, where, (*SURFACE_KINDS, "symmetry", "characters"), SURFACE_KINDS, error)
     n = check_columns(group, where, SURFACE_COLUMNS, error, min_rows=1)
     check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items()
-                                 if k in group or (written and k != "voltage")}, error, rows=n)
+                                 if k in group or (written and k not in CONDITIONAL_COLUMNS)}, error, rows=n)
     check_sizes(group, where, error)
     size = stored_basis(group.attrs, where, error).size
     check_scales(group, where, error, {"point": n, "coefficient": size, "axis": 3}, written)
@@ -925,7 +929,8 @@ def read_special(group, field_acts: bool = True, branch_gauge: str | None = None
     from ..analysis.results import Block, Gauge
 
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
-    columns |= {name: group[name][()] for name in ("index", "m", "label") + SPECIAL_NUMBERS + ("voltage",) if name in group}
+    columns |= {name: group[name][()] for name in ("index", "m", "label") + SPECIAL_NUMBERS + CONDITIONAL_COLUMNS
+                if name in group}
     points = [{k: plain(v[i]) for k, v in columns.items()} for i in range(group["kind"].shape[0])]
     if "state" in group and "sector" in group["state"]:  # a surface branch's (files before it: none)
         for s, row in zip(points, group["state"]["sector"][()]):

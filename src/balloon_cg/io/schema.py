@@ -44,6 +44,8 @@ VARIABLES = {
     "axis": (COUNT, "Cartesian axis", "0: x, 1: y, 2: z (z the coil axis)"),
     "pressure": (NONDIMENSIONAL, "pressure P", "P = P̄ R0 / (T0 μ/2)"),
     "voltage": (NONDIMENSIONAL, "voltage Φ̄", "Φ̄ = (Φ/H) √(ε/μ): voltage across the thickness (docs/scenes.md)"),
+    "M": (NONDIMENSIONAL, "field M", "M = I²/(16π² R0² μ): the coils' field intensity, the parameter of a "
+                                     "continuation in M at fixed P (docs/scenes.md)"),
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
     "amount": (NONDIMENSIONAL, "gas amount n", "n = P V, the isothermal ideal gas P V = n in these units: "
                                                "n = N R T / (T0 μ R0² / 2) for N moles at temperature T"),
@@ -175,7 +177,7 @@ def attach_dimensions(group, axes: dict) -> None:
 #: special point's state and pole values; a curve's q and mode): the readers refuse NaN or inf in them. The others
 #: may hold NaN (E2, E3, E4 of a point that has no normal form, critical_q) or are bounds and estimates
 #: (uncertainty, error_estimate, the lowest eigenvalues).
-FINITE = frozenset({"pressure", "voltage", "volume", "amount", "lam2_north", "lam2_south", "eta_north", "eta_south",
+FINITE = frozenset({"pressure", "voltage", "M", "volume", "amount", "lam2_north", "lam2_south", "eta_north", "eta_south",
                     "lam1_equator", "lam2_equator", "residual", "unknowns", "coefficients", "centroid", "tilt",
                     "force", "torque", "theta", "lam1", "lam2", "rho", "eta", "q", "mode"})
 SCALE_ATTRIBUTES = ("CLASS", "NAME")  # HDF5 dimension scales (netCDF-4 dimensions); and REFERENCE_LIST (the

@@ -132,7 +132,7 @@ VOLTAGE_MEANINGS = {  # the pressure readings on a voltage branch: P is fixed, �
 @dataclass(frozen=True)
 class Ordinate:
     """The y quantity of a branch curve: the continuation ``parameter`` it must be (the stored branch attribute
-    ``parameter``: "P" or "voltage"), its per-point and special-point ``column``, its axis ``label``, its
+    ``parameter``: "P", "voltage" or "M"), its per-point and special-point ``column``, its axis ``label``, its
     ``symbol`` in legends and the ``prefix`` of the kinds that draw it ("<prefix>-pole", "<prefix>-equator")."""
 
     parameter: str
@@ -144,7 +144,8 @@ class Ordinate:
 
 PRESSURE_ORDINATE = Ordinate("P", "pressure", P_LABEL, "P", "pressure")
 VOLTAGE_ORDINATE = Ordinate("voltage", "voltage", VOLTAGE_LABEL, r"$\bar\Phi$", "voltage")
-ORDINATES = {o.parameter: o for o in (PRESSURE_ORDINATE, VOLTAGE_ORDINATE)}
+FIELD_ORDINATE = Ordinate("M", "M", "field $M = I^2/(16\\pi^2 R_0^2 \\mu)$", "M", "M")  # continue --parameter M
+ORDINATES = {o.parameter: o for o in (PRESSURE_ORDINATE, VOLTAGE_ORDINATE, FIELD_ORDINATE)}
 
 
 def ordinate_of(data: dict) -> Ordinate:
@@ -349,10 +350,12 @@ def _label(branches: list[StoredBranch]) -> list[StoredBranch]:
     family per branch kind (``branch_kind``, ``family_colors``: primary blue, pear orange, free pear green, m = 1
     purple, …), a shade per file, labelled 'M = …' and, where several kinds are drawn, the kind ('M = 0.002, free
     pear'), with the scene name where two files share an M (branches of one kind told apart by their curves and
-    labelled points). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5')."""
+    labelled points). A dielectric branch adds its fixed parameter ('M = 0, Φ̄ = 0.3', 'M = 0, P = 0.5'); a
+    branch in M (continue --parameter M) is labelled by its fixed P."""
 
-    def key(b):
-        return ", ".join([f"M = {b.M:g}"] + [b.fixed] * bool(b.fixed))
+    def key(b):  # a branch in M at fixed P: that P
+        held = f"P = {b.data['pressure'][0]:g}" if b.ordinate == FIELD_ORDINATE else f"M = {b.M:g}"
+        return ", ".join([held] + [b.fixed] * bool(b.fixed))
 
     files = {}
     for b in branches:

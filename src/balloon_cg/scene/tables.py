@@ -170,7 +170,8 @@ class Continuation:
     start at ``step`` and stay in [step_min, step_max]. ``symmetry``: "equator" imposes η(π − θ) = −η(θ)
     (needs equator-symmetric coils), "none" never does, "auto" does when the field allows it.
     ``parameter``: "pressure" (P varies), or "voltage" (Φ̄ varies at the fixed P = ``pressure``, needs
-    [electric]; it stops when Φ̄ passes ``stop_voltage``, None: no limit).
+    [electric]; it stops when Φ̄ passes ``stop_voltage``, None: no limit). ``stop_field``: the field M where a
+    continuation in M at fixed P (``continue --parameter M``) stops, None: no limit.
     """
 
     start_stretch: float = 1.01
@@ -186,6 +187,7 @@ class Continuation:
     parameter: ContinuationParameter = ContinuationParameter.PRESSURE
     pressure: float | None = None
     stop_voltage: float | None = None
+    stop_field: float | None = None
 
 
 @dataclass(frozen=True)
@@ -891,8 +893,9 @@ def _continuation(data, field: Field, electric: Electric | None = None) -> Conti
             'continuation.symmetry = "equator": the coils are not mirror-symmetric about z = 0 (use "auto" or "none")'
         )
     parameter, fixed_pressure, stop_voltage = _parameter(data, electric)
+    stop_field = get("stop_field", lambda x: 0 < x <= MAX_M, f"in (0, {MAX_M:g}]")
     return Continuation(start, stop, low, pressure, step, step_min, step_max, points, symmetry, gap, parameter,
-                        fixed_pressure, stop_voltage)
+                        fixed_pressure, stop_voltage, stop_field)
 
 
 def _solver(data) -> Solver:
