@@ -183,3 +183,45 @@ def test_continuing_a_user_point_in_another_parameter_is_one_line(tuning, capsys
                  str(folder / "no.h5")]) == 2
     err = capsys.readouterr().err
     assert "--parameter material.mu[0]" in err and "M or voltage" in err and not (folder / "no.h5").exists()
+
+
+DIELECTRIC = """[material]
+preset = "neo-Hookean"
+[electric]
+voltage = 0.3
+[continuation]
+start_stretch = 1.1
+stop_stretch = 2.5
+[dynamics]
+frequencies = true
+count = 4
+m_max = 1
+[[events]]
+quantity = "pressure"
+value = 1.0
+"""
+
+
+def test_a_curve_in_the_voltage_holds_the_breathing_mode_of_each_sphere(tmp_path):
+    """``--parameter voltage`` from the user point at P = 1 of a neo-Hookean dielectric balloon at Φ̄ = 0.3: the
+    branch in Φ̄ at P = 1 down to Φ̄ = 0 and up through the pull-in (a fold in Φ̄, LP) to the stop stretch. Without a
+    field every point is the sphere P = 4(λ⁻¹ − λ⁻⁷) − 4Φ̄²λ (docs/scenes.md; 1e-10), and its breathing mode at fixed P
+    and Φ̄ is the radial equation of motion's (tests/test_dynamics.py, the dielectric energy at fixed Φ̄ a function
+    of λ on a sphere): Ω² = λ² (∂P/∂λ)_Φ̄ / 2 = λ² (−4λ⁻² + 28λ⁻⁸ − 4Φ̄²)/2, one of the even block's four stored Ω²
+    at every point to 1e-9 (observed ~1e-12); at the pull-in it vanishes (1e-11)."""
+    scene = tmp_path / "dielectric.toml"
+    scene.write_text(DIELECTRIC)
+    run, curve = tmp_path / "run.h5", tmp_path / "curve.h5"
+    assert main(["run", str(scene), "--primary-only", "--quiet", "-o", str(run)]) == 0
+    label = rising_user_point(bc.load(run))["label"]
+    assert main(["continue", str(run), str(label), "--parameter", "voltage", "--quiet", "-o", str(curve),
+                 "--set", "continuation.step_max=0.05"]) == 0
+    data = bc.load(curve).branches["primary"].data
+    assert data["attrs"]["parameter"] == "voltage"
+    assert sorted(data["attrs"]["leg_stop_codes"]) == ["stop_stretch", "zero_voltage"]
+    lam, voltage = data["lam2_north"], data["voltage"]
+    assert np.abs(4 * (1 / lam - lam ** -7) - 4 * voltage ** 2 * lam - 1.0).max() <= 1e-10
+    breathing_mode = lam ** 2 * (-4 * lam ** -2 + 28 * lam ** -8 - 4 * voltage ** 2) / 2
+    assert np.abs(data["frequencies"]["even"] - breathing_mode[:, None]).min(axis=1).max() <= 1e-9
+    n = next(n for n, s in enumerate(data["special_points"]) if s["kind"] == "LP")
+    assert abs(data["special_frequencies"]["even"][n, 0]) <= 1e-11
