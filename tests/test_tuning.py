@@ -173,6 +173,20 @@ def test_plot_draws_the_frequencies_against_M(tuning, tmp_path):
     assert [line.get_xdata()[0] for line in marked] == [fold["M"]]
 
 
+def test_a_curve_in_M_restarts_in_M(tuning):
+    """``continue`` from the curve's fold in its own parameter traces the branch in M again (not in P): the same
+    fold, at the same M to 1e-9, and the same ends at M = 0."""
+    folder, curve = tuning
+    data = curve.branches["primary"].data
+    fold = next(s for s in data["special_points"] if s["kind"] == "LP")
+    again = folder / "again.h5"
+    assert main(["continue", str(folder / "curve.h5"), str(fold["label"]), "--quiet", "-o", str(again), *STEPS]) == 0
+    restarted = bc.load(again).branches["primary"].data
+    assert restarted["attrs"]["parameter"] == "M"
+    assert list(restarted["attrs"]["leg_stop_codes"]) == ["zero_field", "zero_field"]
+    assert [abs(s["M"] - fold["M"]) <= 1e-9 for s in restarted["special_points"] if s["kind"] == "LP"] == [True]
+
+
 def test_continuing_a_user_point_in_another_parameter_is_one_line(tuning, capsys):
     """A key a point is not followed in at fixed P (a material parameter; the branch's own P is the usual
     restart): one line naming it, exit 2."""

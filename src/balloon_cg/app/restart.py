@@ -166,13 +166,13 @@ def with_settings(start: Labelled, overrides: dict) -> Labelled:
 
 def restart_branch(start: Labelled, progress=None) -> Picture:
     """The branch through the labelled point, traced again from it in both directions in the branch's parameter
-    (module docstring), on the stored degree and basis map, with the stops of its kind (a pear branch's: either pole
-    stretch at stop_stretch, ``switching.pear_stop_rule``); if the stored branch was assessed, assessed and its
+    (P, Φ̄, or M on a branch ``restart_in`` traced; module docstring), on the stored degree and basis map, with the
+    stops of its kind (a pear branch's: either pole stretch at stop_stretch, ``switching.pear_stop_rule``); if the stored branch was assessed, assessed and its
     branch points and m ≥ 1 points located (``picture.examine``, no branch switched), as ``run`` gives them."""
     t0 = time.perf_counter()
     branch, scene = start.branch, start.branch.scene
     disc = branch.disc
-    tracer = Tracer(scene, disc.symmetric, held_layout(branch))
+    tracer = Tracer(scene, disc.symmetric, held_layout(branch), parameter=branch.parameter)
     params = branch.params
     system = tracer.system(disc.degree, params, disc.mapping)
     point = step_away(system, start, tracer.settings)
@@ -181,13 +181,13 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
 
     def stop():  # a leg's own rule (a pear leg remembers its crossings of the parent; each leg its way round)
         if not pear:
-            return closing_rule(disc, point.X, stop_rule(scene, upper))
+            return closing_rule(disc, point.X, stop_rule(scene, upper, branch.parameter, params))
         base = pear_stop_rule(scene) if start.parent is None else rejoin_rule(start, pear_stop_rule(scene))
         return closing_rule(disc, point.X, base)
 
     def leg(sign):
         return tracer.leg(replace(point, tangent=sign * point.tangent), params, stop(), progress, degree=disc.degree,
-                          mapping=disc.mapping, limits=range_limits(scene, upper))
+                          mapping=disc.mapping, limits=range_limits(scene, upper, branch.parameter, params))
 
     up = leg(1.0)
     down = None if up.stop.code == StopCode.CLOSED else leg(-1.0)  # closed: the loop is whole, traced once
