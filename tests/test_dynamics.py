@@ -397,6 +397,26 @@ def test_frequency_pressure_figure(spom1_run, tmp_path):
     assert len(marked) >= 2 and all(line.get_ydata()[0] == 0.0 for line in marked)
 
 
+def test_frequency_figure_insets_the_mode_of_each_block(spom1_run):
+    """With stored mode shapes the frequency figure has an inset per block of the first branch (the primary): its
+    lowest mode at the special point where that Ω² is nearest zero (the even block's at the LP, odd_held's at the
+    pear BP), the outline and the outline ± the stored δρ, δz scaled to MODE_AMPLITUDE of the largest radius."""
+    result, path = spom1_run
+    primary = next(b for b in result.picture.branches if b.name == "primary")
+    fig = plot([path], "frequencies")
+    insets = {ax.get_title().split(":")[0]: ax for ax in fig.axes[1:]}
+    assert set(insets) == set(primary.frequencies.modes)
+    for block, kind in (("even", "LP"), ("odd_held", "BP")):
+        n = next(n for n, s in enumerate(primary.special) if s.kind.value == kind)
+        assert insets[block].get_title().endswith(f" {kind}")
+        outline, plus = insets[block].lines[0], insets[block].lines[1]
+        shape = primary.frequencies.modes[block][n, 0]
+        rho = outline.get_xdata()
+        scale = MODE_AMPLITUDE * rho.max() / np.abs(shape[:2]).max()
+        np.testing.assert_allclose(plus.get_xdata() - rho, scale * shape[0], atol=1e-12)
+        np.testing.assert_allclose(plus.get_ydata() - outline.get_ydata(), scale * shape[1], atol=1e-12)
+
+
 def test_mode_figure(spom1_run, tmp_path, capsys):
     """plot --what modes: a panel per fold and branch point, the outline (black) and the outline ± the stored
     mode of the Ω² nearest zero, scaled to MODE_AMPLITUDE of the largest radius: at the LP the even block's

@@ -1081,15 +1081,25 @@ FREQUENCY_STYLES = ("-", "--", "-.", ":")  # one per drawn branch
 
 def plot_frequencies(branches, axes=None) -> Figure:
     """The lowest squared natural frequency Ω² = ω² R0² ρ/μ of every stored block against the continuation
-    parameter (P or Φ̄), one colour per block and one line style per branch; the folds and branch points marked
+    parameter (P, Φ̄ or M), one colour per block and one line style per branch; the folds and branch points marked
     at Ω² = 0, where a block's Ω² passes through zero (docs/dynamics.md). Branches without frequencies are left
-    out."""
+    out. Where the first drawn branch stores mode shapes ([dynamics] modes = true) and the figure is its own (no
+    ``axes``), a strip of insets under it shows each block's lowest mode (``mode_points``: at the special point
+    where that Ω² is nearest zero), framed in the block's colour."""
     drawn = [b for b in branches if "frequencies" in b.data]
     if not drawn:
         files = ", ".join(dict.fromkeys(str(b.source) for b in branches))
         raise PlotError(f"{files}: no stored frequencies (frequencies/ of a branch); run the scene with "
                         "[dynamics] frequencies = true")
-    fig, panels, own = _panels(axes, 1, (8.4, 4.8))
+    shown = mode_points(drawn[0]) if axes is None else []
+    if shown:
+        fig = JournalFigure(figsize=sized((max(8.4, 1.2 * len(shown)), 6.6)), layout="constrained")
+        grid = fig.add_gridspec(2, len(shown), height_ratios=(3.0, 1.2))
+        panels, own = np.atleast_1d(fig.add_subplot(grid[0, :])), True
+        insets = [fig.add_subplot(grid[1, k]) for k in range(len(shown))]
+    else:
+        fig, panels, own = _panels(axes, 1, (8.4, 4.8))
+        insets = []
     ax = panels[0]
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     blocks = list(dict.fromkeys(block for b in drawn for block in b.data["frequencies"]))
@@ -1110,7 +1120,27 @@ def plot_frequencies(branches, axes=None) -> Figure:
                 for b, style in zip(drawn, FREQUENCY_STYLES * len(drawn))]
     _legend(fig, panels, own, "right upper", handles=handles, title="block; branch")
     label_points(marks)
+    for inset, (block, n) in zip(insets, shown):
+        b, s = drawn[0], drawn[0].data["special_points"][n]
+        draw_mode(inset, b, n, block, b.data["modes"][block][n, 0], colours[block])
+        inset.set_title(f"{block}: {s['label']} {s['kind']}", fontsize="x-small", color=colours[block])
+        inset.set_xticks([]), inset.set_yticks([])
+        for spine in inset.spines.values():
+            spine.set_edgecolor(colours[block])
     return fig
+
+
+def mode_points(b) -> list:
+    """(block, special point number) for each block with stored mode shapes of the branch ``b``: the special point
+    where the block's lowest Ω² is nearest zero among those with a stored shape (its own stability change where it
+    has one)."""
+    out = []
+    for block, shapes in (b.data.get("modes") or {}).items():
+        values = np.abs(b.data["special_frequencies"][block][:, 0])
+        stored = np.isfinite(shapes[:, 0]).all(axis=(1, 2)) & np.isfinite(values)
+        if stored.any():
+            out.append((block, int(np.flatnonzero(stored)[np.argmin(values[stored])])))
+    return out
 
 
 STABILITY_CHANGES = ("LP", "LV", "LN", "BP")  # the special points where an Ω² of a block passes through zero
@@ -1152,23 +1182,31 @@ def plot_modes(branches, axes=None) -> Figure:
     for ax in panels[len(found):]:
         ax.set_visible(False)
     for ax, (b, s, n, block, omega2, shape) in zip(panels, found):
-        d = b.data
-        outline = surface(branch_discretisation(d), d["special_unknowns"][n], d["theta"], stored_scene(b.run).geometry)
-        rho, eta = outline["rho"][0], outline["eta"][0]
-        m = Block.order_of(block)
-        scale = MODE_AMPLITUDE * rho.max() / max(np.abs(shape[:2]).max(), np.finfo(float).tiny)
-        for side in (1.0, -1.0):  # φ = 0, φ = π (cos mφ = (−1)^m)
-            turn = side ** m
-            ax.plot(side * rho, eta, color="k", linewidth=1.0)
-            for sign, style in ((1.0, "-"), (-1.0, "--")):
-                ax.plot(side * (rho + sign * scale * turn * shape[0]), eta + sign * scale * turn * shape[1], style,
-                        color=b.color, linewidth=0.9)
-        ax.set_aspect("equal")
+        draw_mode(ax, b, n, block, shape)
         ax.set_title(f"{s['label']} {s['kind']}, {block}\n$\\Omega^2$ = {omega2:.1e}", fontsize="small")
         ax.set_xlabel(r"$\rho$")
         ax.set_ylabel(r"$\eta$")
     _suptitle(fig, panels, own, _title(branches))
     return fig
+
+
+def draw_mode(ax, b, n: int, block: str, shape, color=None) -> None:
+    """Special point ``n`` of the branch ``b``: its deformed meridian section (ρ, η) at φ = 0 and φ = π (black) and
+    the outline displaced by ± the mode ``shape`` of ``block`` (δρ, δz at φ = 0, times cos mφ = ±1 at φ = π; δφ, in
+    the plane of neither, is not drawn), scaled to MODE_AMPLITUDE of the largest radius, in ``color`` (default the
+    branch's)."""
+    d = b.data
+    outline = surface(branch_discretisation(d), d["special_unknowns"][n], d["theta"], stored_scene(b.run).geometry)
+    rho, eta = outline["rho"][0], outline["eta"][0]
+    m = Block.order_of(block)
+    scale = MODE_AMPLITUDE * rho.max() / max(np.abs(shape[:2]).max(), np.finfo(float).tiny)
+    for side in (1.0, -1.0):  # φ = 0, φ = π (cos mφ = (−1)^m)
+        turn = side ** m
+        ax.plot(side * rho, eta, color="k", linewidth=1.0)
+        for sign, style in ((1.0, "-"), (-1.0, "--")):
+            ax.plot(side * (rho + sign * scale * turn * shape[0]), eta + sign * scale * turn * shape[1], style,
+                    color=color or b.color, linewidth=0.9)
+    ax.set_aspect("equal")
 
 
 def plot_energy(branches, axes=None) -> Figure:
