@@ -13,7 +13,7 @@ from .discretisation import Discretisation, read_only
 from .interval import IntervalDiscretisation
 from ..model.field import coaxial_table, field_squared_nodes
 from ..model.kernels import KernelSet
-from ..model.meridian import meridional_stretch
+from ..model.meridian import hoop, meridional_stretch
 from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
@@ -139,6 +139,8 @@ class Equilibrium:
         self.coils = coaxial_table(scene.field.coils)
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
+        # the meridian's R at the nodes where it is not sin θ (a capsule's; ``volume``)
+        self._radius = hoop(scene.geometry, *self.geometry) if scene.geometry.shape == Shape.CAPSULE else None
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
         # the node state and field of the last u (``_pointwise``), in arrays owned by ``nodes``, refilled in place
         self.nodes = NodeKernels(self, self.geometry)
@@ -231,13 +233,16 @@ class Equilibrium:
 
     def volume(self, u) -> float:
         """Enclosed volume / (2π) (``enclosed_volume``)."""
-        return enclosed_volume(self.disc, u)
+        return enclosed_volume(self.disc, u, self._radius)
 
 
-def enclosed_volume(disc: Discretisation, u) -> float:
-    """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ λ2² η' sin²θ dθ (MODEL.md §2: the pressure term is −P V/(2π))."""
+def enclosed_volume(disc: Discretisation, u, radius: np.ndarray | None = None) -> float:
+    """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ ρ² η' dθ, ρ = λ2 R (MODEL.md §2: the pressure term is −P V/(2π)),
+    per d(cos θ) −½ λ2² η' R²/sin θ; ``radius``: the meridian's R at the nodes where it is not sin θ (a capsule's)."""
     lam2, _, _, w = disc.node_state(u)
-    return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
+    if radius is None:
+        return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
+    return float(-disc.weights @ (0.5 * lam2**2 * w * radius**2 / disc.sin_theta))
 
 
 @njit(cache=True)

@@ -49,7 +49,7 @@ from ..io.layout import FileError, check_input, file_kind, reading
 from ..io.parents import parent_label
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
-from ..model.meridian import reference_height
+from ..model.meridian import hoop, reference_height
 from ..scene.tables import Shape
 from ..scene.validation import did_you_mean
 
@@ -799,7 +799,7 @@ def plot_shapes(branches, points=None, axes=None) -> Figure:
     psi = np.linspace(0, 2 * np.pi, 200)
     handles = []
     for geometry in dict.fromkeys(stored_scene(b.run).geometry for b in branches):  # each reference drawn once
-        ax.plot(np.sin(psi), reference_height(geometry, psi), color="0.6", linewidth=0.8, linestyle=":")
+        ax.plot(hoop(geometry, np.cos(psi), np.sin(psi)), reference_height(geometry, psi), color="0.6", linewidth=0.8, linestyle=":")
         shape = "" if geometry.shape == Shape.SPHERE else f", {geometry.describe()}"
         handles.append(Line2D([], [], color="0.6", linewidth=0.8, linestyle=":",
                               label=f"undeformed ($R_0$ = 1{shape})"))
