@@ -4,7 +4,7 @@ R(u; P, M, Φ̄) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (�
 J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M, ∂R/∂Φ̄ for
 continuation. A point is an equilibrium when R = 0 at fixed (P, M, Φ̄).
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -13,7 +13,7 @@ from .discretisation import Discretisation, read_only
 from .interval import IntervalDiscretisation
 from ..model.field import coaxial_table, field_squared_nodes
 from ..model.kernels import KernelSet
-from ..model.meridian import hoop, meridional_stretch
+from ..model.meridian import hoop, joins, meridional_stretch
 from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
@@ -135,6 +135,9 @@ class Equilibrium:
                                  '(docs/shapes.md)')
             raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")
         self.scene = scene
+        if isinstance(discretisation, Discretisation) and discretisation.joins != joins(scene.geometry):
+            # the quadrature split where the reference curvature jumps (a capsule's joins)
+            discretisation = replace(discretisation, joins=joins(scene.geometry))
         self.disc = discretisation
         self.coils = coaxial_table(scene.field.coils)
         self.kernels = KernelSet.of_scene(scene, kernel_class)

@@ -53,6 +53,15 @@ def hoop_rate(geometry: Geometry, cos_theta, sin_theta):
     return np.where(angle < np.pi / 2, side * capsule_rate(geometry) * np.cos(angle), 0.0)
 
 
+def joins(geometry: Geometry) -> tuple:
+    """The x = cos θ where the reference curvature jumps, where the quadrature splits (galerkin/discretisation.py:
+    ``split_rule``): a capsule's ±cos θj, θj = π/(2κ) (none at length 0, the sphere); none on other shapes."""
+    if geometry.shape != Shape.CAPSULE or geometry.length == 0:
+        return ()
+    join = float(np.cos(np.pi / (2 * capsule_rate(geometry))))
+    return (-join, join)
+
+
 def metric(geometry: Geometry, cos_theta, sin_theta):
     """S' = dS/dt at the node (cos θ, sin θ): ones on the sphere and on a tube (t = S, whose nodes pass R' = 0 and
     R = 1 for (cos θ, sin θ): galerkin/interval.py), κ on a capsule."""

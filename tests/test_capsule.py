@@ -1,0 +1,152 @@
+"""The capsule (docs/shapes.md): a cylinder of radius 1 and length L with hemispherical caps of the same membrane,
+discretised as the sphere is over θ = S/κ (codegen/meridian.py, model/meridian.py), its quadrature split at the
+joins where the reference curvature jumps (galerkin/discretisation.py: ``split_rule``).
+
+Checked: the capsule of length 0 is the sphere (another kernel module); the middle of a long capsule is the uniform
+closed-end tube, derived here from the strain energy; the enclosed volume converges in the degree as the table of
+docs/shapes.md says; one-line errors.
+"""
+import numpy as np
+import pytest
+import sympy as sp
+from scipy.optimize import brentq
+
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.primary import inflated_reference, start_parameters
+from balloon_cg.analysis.tracer import Tracer, unit
+from balloon_cg.galerkin.discretisation import split_rule
+from balloon_cg.model import meridian
+from balloon_cg.numerics import continuation
+from balloon_cg.numerics.newton import newton
+from balloon_cg.scene import SceneError, Shape, parse_scene
+
+CAPSULE = '[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = {length}\n[stability]\nm_max = 0\n'
+
+
+def capsule_scene(length: float, extra: str = ""):
+    return parse_scene(CAPSULE.format(length=length) + extra)
+
+
+def inflated(scene, degree: int, P: float):
+    """(Equilibrium, u) of the capsule at the pressure P: from the start at pole stretch 1.005, natural
+    continuation in P (Newton at prescribed P)."""
+    tracer = Tracer(scene, True)
+    params = start_parameters(scene, "P")
+    u, P0 = inflated_reference(tracer, degree, 1.005, params)
+    system = tracer.system(degree, params)
+
+    def solve(X, value):
+        return newton(system.residual, system.jacobian, X, unit(X.size, -1), value, 1e-13, 40)
+
+    X, reached, message = continuation.natural(solve, np.append(u, P0), P0, P)
+    assert reached == P, message
+    return system.eq, X[:-1]
+
+
+def test_capsule_of_length_zero_is_the_sphere():
+    """SPOM1 to a pole stretch of 3 with m = 0 stability: the same points, fold and equator-breaking branch points
+    as the sphere to 1e-10, although the capsule's kernels are another module (its R = sin(κ acos(cos θ)) with
+    κ = 1, S' = κ, and the Galerkin state turned into the meridian's by R/sin θ)."""
+    text = '[material]\npreset = "SPOM1"\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 3.0\n'
+    sphere = parse_scene(text)
+    capsule = parse_scene(text + '[geometry]\nshape = "capsule"\nlength = 0\n')
+    assert capsule.geometry.shape == Shape.CAPSULE and meridian.joins(capsule.geometry) == ()
+    one, other = (analyse(scene, pear=False).branches[0] for scene in (sphere, capsule))
+    assert other.kernel_class != one.kernel_class
+    assert [p.kind for p in other.special] == [p.kind for p in one.special]
+    assert sum(p.kind.value == "BP" for p in one.special) == 2
+    for a, b in zip(one.special, other.special):
+        assert (a.kind, a.block, a.status) == (b.kind, b.block, b.status)
+        assert abs(a.X[-1] - b.X[-1]) <= 1e-10 * abs(a.X[-1])
+        assert np.abs(a.X[:-1] - b.X[:-1]).max() <= 1e-10
+    assert one.X.shape == other.X.shape and np.abs(one.X - other.X).max() <= 1e-10
+
+
+def test_reference_meridian_is_c1_with_the_curvature_jumping_at_the_joins():
+    """model/meridian's R, R', Z of a capsule of length 6: R' is dR/dθ and S' = κ is sqrt(R'² + Z'²) (central
+    differences of R and Z, 1e-8) on both caps and the cylinder; R, R', Z continuous at the joins θj = π/(2κ),
+    where R'' jumps from −κ² to 0."""
+    geometry = capsule_scene(6.0).geometry
+    kappa = 1 + 6.0 / np.pi
+    joint = np.pi / (2 * kappa)
+    theta = np.array([0.2, joint - 1e-3, joint + 1e-3, 1.4, np.pi / 2, 2.0, np.pi - joint + 1e-3, 3.0])
+    h = 1e-6
+    R = lambda t: meridian.hoop(geometry, np.cos(t), np.sin(t))  # noqa: E731
+    Z = lambda t: meridian.reference_height(geometry, t)  # noqa: E731
+    dR, dZ = (R(theta + h) - R(theta - h)) / (2 * h), (Z(theta + h) - Z(theta - h)) / (2 * h)
+    assert np.abs(dR - meridian.hoop_rate(geometry, np.cos(theta), np.sin(theta))).max() < 1e-8
+    assert np.abs(np.hypot(dR, dZ) - kappa).max() < 1e-8
+    assert abs(Z(np.array(0.0)) - (3.0 + 1)) < 1e-15 and abs(Z(np.array(np.pi)) + (3.0 + 1)) < 1e-15
+    for t in (joint, np.pi - joint):
+        for f in (R, Z, lambda s: meridian.hoop_rate(geometry, np.cos(s), np.sin(s))):
+            assert abs(f(np.array(t - 1e-9)) - f(np.array(t + 1e-9))) < 1e-7
+    second = lambda t: (R(t + 1e-4) - 2 * R(t) + R(t - 1e-4)) / 1e-8  # noqa: E731
+    assert abs(second(joint - 1e-3) + kappa**2) < 1e-2 and abs(second(joint + 1e-3)) < 1e-6
+
+
+def test_split_rule_integrates_a_kink_exactly():
+    """The composite rule with joins at ±c integrates |x| − c piecewise polynomials exactly (1e-14); the single
+    rule of as many nodes per piece does not (the kink costs it more than 1e-6)."""
+    c = np.cos(np.pi / 2.6)
+    f = lambda x: np.maximum(np.abs(x), c) ** 3  # noqa: E731
+    exact = 2 * (c**3 * c + (1 - c**4) / 4)
+    nodes, weights = split_rule(20, (-c, c))
+    assert abs(weights @ f(nodes) - exact) < 1e-14 and np.allclose(nodes, -nodes[::-1])
+    plain, plain_weights = split_rule(20)
+    assert abs(plain_weights @ f(plain) - exact) > 1e-6
+
+
+def closed_end_tube(material):
+    """(P(λθ, λz), N(λθ, λz)) of the uniform tube with closed sliding ends, from Φ(λ1 = λz, λ2 = λθ) of the Ogden
+    material: the hoop balance P = Φ_2/(λθλz) and the axial balance N = Φ_1 − λθΦ_2/(2λz) = 0 (the wall's axial
+    force 2πΦ_1 carries the pressure on the end caps πλθ²P, i.e. Φ_1 = Pλθ²λz/2)."""
+    hoop, axial = sp.symbols("hoop axial", positive=True)
+    terms = zip(map(lambda v: sp.Rational(repr(v)), material.mu), map(lambda v: sp.Rational(repr(v)), material.alpha))
+    energy = sum(mu / a * (axial**a + hoop**a + (axial * hoop) ** -a - 3) for mu, a in terms)
+    P = sp.diff(energy, hoop) / (hoop * axial)
+    N = sp.diff(energy, axial) - hoop * sp.diff(energy, hoop) / (2 * axial)
+    return sp.lambdify((hoop, axial), P), sp.lambdify((hoop, axial), N)
+
+
+def test_middle_of_a_long_capsule_is_the_uniform_closed_tube():
+    """SPOM1 capsule of length 20 at P = 1.2 (below the tube's pressure maximum 1.4905), degrees 96 and 160: at the
+    middle (θ = π/2, 10 radii from either cap) the hoop stretch λθ = λ2 and the axial stretch λz = λ1 make the
+    closed-end tube's balances P = Φ_2/(λθλz) and N = 0 hold (derived here), ρ' = 0; λθ is the closed-end path's
+    at P (brentq on P along N = 0) within the degree's accuracy, better at the higher degree."""
+    P_of, N_of = closed_end_tube(capsule_scene(20.0).material)
+    errors = []
+    for degree in (96, 160):
+        eq, u = inflated(capsule_scene(20.0), degree, 1.2)
+        middle = np.array([np.pi / 2])
+        lam2, v, _, w = eq.state_at(u, middle)
+        lam1 = meridian.meridional_stretch(eq.scene.geometry, np.cos(middle), np.sin(middle), lam2, v, w)
+        hoop, axial = float(lam2[0]), float(lam1[0])
+        assert abs(v[0]) < 1e-12  # ρ' = 0 at the middle: the mirror symmetry
+        axial_of = lambda h: brentq(lambda a: N_of(h, a), 0.5, 3.0)  # noqa: E731
+        closed = brentq(lambda h: P_of(h, axial_of(h)) - 1.2, 1.01, 1.5883)
+        errors.append((abs(P_of(hoop, axial) - 1.2), abs(N_of(hoop, axial)), abs(hoop - closed)))
+    assert max(errors[-1]) < 1e-5
+    assert max(errors[-1]) < max(errors[0])
+
+
+def test_capsule_table_errors_name_key_value_and_range():
+    for extra, words in [
+        ('[geometry]\nshape = "capsule"\n', "geometry.length: missing"),
+        ('[geometry]\nshape = "capsule"\nlength = -1\n', "geometry.length = -1"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\naspect = 2\n', "geometry.aspect = 2"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\nends = "plugged"\n', "geometry.ends"),
+        ('[geometry]\nshape = "spheroid"\naspect = 2\nlength = 5\n', "geometry.length = 5"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 1\n', "stability.m_max = 1"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[loading]\ncontrol = "volume"\n',
+         'loading.control = "volume"'),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[electric]\nvoltage = 0.1\n',
+         "[electric]"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
+         '[[field.coils]]\nradius = 3.0\nheight = 0.0\ncurrent = 1.0\n', "coils"),
+    ]:
+        with pytest.raises(SceneError) as error:
+            parse_scene('[material]\npreset = "SPOM1"\n' + extra)
+        assert words in str(error.value) and "\n" not in str(error.value)
+    scene = capsule_scene(5.0)
+    assert scene.geometry.to_table() == {"shape": "capsule", "length": 5.0}
+    assert scene.geometry.describe() == "capsule of length 5"
