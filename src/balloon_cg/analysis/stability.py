@@ -345,7 +345,7 @@ def point_degrees(branch, degree: int) -> np.ndarray:
         return np.full(len(branch.X), degree)
     if branch.scene.stability.basis == "mapped":
         return np.maximum(degree, mapped_degrees(branch, degree))
-    return np.maximum(degree, Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X, start=degree))
+    return np.maximum(degree, Resolution.of(branch.scene).plain_degrees(branch.disc, branch.X, start=degree))
 
 
 def mapped_degrees(branch, start: int) -> np.ndarray:
@@ -353,7 +353,7 @@ def mapped_degrees(branch, start: int) -> np.ndarray:
     growth) until the point truncated to it loses at most max_error (``transfer_error``) and its tail estimate is
     within max_error, at most the branch's degree (where every point is stored): a branch that ends next to a wire
     at a high mapped degree keeps its earlier points at the degree they need."""
-    resolution, disc = Resolution.of(branch.scene.solver), branch.disc
+    resolution, disc = Resolution.of(branch.scene), branch.disc
     X = np.atleast_2d(branch.X)
     degrees = np.full(len(X), disc.degree)
     open_rows, degree = np.arange(len(X)), start
@@ -372,7 +372,7 @@ def mapped_degrees(branch, start: int) -> np.ndarray:
 def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:
     """The degree a result at perturbation degree N is checked against: ``factor``·N, at most solver.max_degree;
     at max_degree itself the coarser N/growth (then the check says whether N lies in the converged range)."""
-    resolution = Resolution.of(branch.scene.solver)
+    resolution = Resolution.of(branch.scene)
     if degree < resolution.max_degree:
         return min(int(factor * degree), resolution.max_degree)
     return int(degree / resolution.growth)
