@@ -820,40 +820,43 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     return Geometry(shape, aspect)
 
 
-def _capsule(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
-    """A capsule's [geometry] (its cylinder's length) and the parts of the model it does not have yet, refused one
-    line each."""
+def _length(data, shape: Shape, low: float) -> float:
+    """geometry.length of a tube or a capsule, in [low, MAX_LENGTH] (geometry.aspect is a spheroid's)."""
     if data.get("aspect") is not None:
-        raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a capsule '
-                         "has geometry.length)")
+        raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a '
+                         f"{shape.value} has geometry.length)")
     if data.get("length") is None:
-        raise SceneError(f"geometry.length: missing; a capsule needs its cylinder's length in reference radii, in "
-                         f"[0, {MAX_LENGTH:g}]")
-    length = _getter(data, "geometry", Geometry)("length", lambda x: 0 <= x <= MAX_LENGTH, f"in [0, {MAX_LENGTH:g}]")
-    where = 'geometry.shape = "capsule"'
-    if field.coils:
-        raise SceneError(f"{where}: coils around a capsule are not built yet; leave [[field.coils]] out or use "
-                         "another shape")
+        raise SceneError(f"geometry.length: missing; a {shape.value} needs its length in reference radii, in "
+                         f"[{low:g}, {MAX_LENGTH:g}]")
+    return _getter(data, "geometry", Geometry)("length", lambda x: low <= x <= MAX_LENGTH,
+                                                f"in [{low:g}, {MAX_LENGTH:g}]")
+
+
+def _pressure_only(shape: Shape, electric: Electric | None, loading: Loading):
+    """The parts a tube and a capsule do not have yet, refused one line each: [electric], control other than P."""
     if electric is not None:
-        raise SceneError(f"{where}: the [electric] term on a capsule is not built yet; leave [electric] out or use "
-                         "another shape")
+        raise SceneError(f'geometry.shape = "{shape.value}": the [electric] term on a {shape.value} is not built yet; '
+                         "leave [electric] out or use another shape")
     if loading.control != Control.PRESSURE:
-        raise SceneError(f'loading.control = "{loading.control.value}": a capsule is continued in the pressure only '
-                         'for now; allowed: "pressure"')
+        raise SceneError(f'loading.control = "{loading.control.value}": a {shape.value} is continued in the pressure '
+                         'only for now; allowed: "pressure"')
+
+
+def _capsule(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
+    """A capsule's [geometry] (its cylinder's length, 0 the sphere) and the parts of the model it does not have
+    yet, refused one line each."""
+    length = _length(data, Shape.CAPSULE, 0.0)
+    if field.coils:
+        raise SceneError('geometry.shape = "capsule": coils around a capsule are not built yet; leave '
+                         "[[field.coils]] out or use another shape")
+    _pressure_only(Shape.CAPSULE, electric, loading)
     return Geometry(Shape.CAPSULE, length=length)
 
 
 def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
     """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet,
     refused one line each."""
-    if data.get("aspect") is not None:
-        raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a tube has '
-                         "geometry.length)")
-    if data.get("length") is None:
-        raise SceneError(f'geometry.length: missing; a tube needs its length in reference radii, in '
-                         f'[{MIN_LENGTH:g}, {MAX_LENGTH:g}]')
-    length = _getter(data, "geometry", Geometry)("length", lambda x: MIN_LENGTH <= x <= MAX_LENGTH,
-                                                  f"in [{MIN_LENGTH:g}, {MAX_LENGTH:g}]")
+    length = _length(data, Shape.TUBE, MIN_LENGTH)
     raw = Ends.SLIDING.value if data.get("ends") is None else data["ends"]
     if raw not in tuple(Ends):
         raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends))
@@ -869,12 +872,7 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
             raise SceneError(f"field.coils[{k}]: wire at (radius {coil.radius:g}, height {coil.height:g}) lies on "
                              f"or inside the reference tube (radius 1, heights within ±length/2 = "
                              f"±{length / 2:g}); the radius must be > 1 there")
-    if electric is not None:
-        raise SceneError(f"{where}: the [electric] term on a tube is not built yet; leave [electric] out or use "
-                         "another shape")
-    if loading.control != Control.PRESSURE:
-        raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
-                         'for now; allowed: "pressure"')
+    _pressure_only(Shape.TUBE, electric, loading)
     return Geometry(Shape.TUBE, length=length, ends=Ends(raw), axial_stretch=held)
 
 
