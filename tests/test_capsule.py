@@ -15,11 +15,13 @@ from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.primary import inflated_reference, start_parameters
 from balloon_cg.analysis.tracer import Tracer, unit
 from balloon_cg.galerkin.discretisation import split_rule
+from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.model import meridian, tube
 from balloon_cg.numerics import continuation
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import SceneError, Shape, parse_scene
 
+DEGREE = 128  # the slow plateau test's (docs/shapes.md: the plateau at degrees 128 and 192)
 CAPSULE = '[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = {length}\n[stability]\nm_max = 0\n'
 
 
@@ -154,6 +156,26 @@ def test_a_long_capsule_starts_bulging_at_the_long_tubes_onset():
         gaps.append(fine - peak)
     assert all(gap > 0 for gap in gaps) and gaps[0] / gaps[1] > 5 and gaps[1] / gaps[2] > 5
     assert gaps[2] < 1e-3 and abs(fine - onset) < 1e-3
+
+
+@pytest.mark.slow
+def test_a_long_capsule_propagates_its_bulge_at_maxwells_pressure():
+    """SPOM1 capsule of length 40 at degree DEGREE, its primary branch under pressure control to pole stretch 3:
+    past its fold the middle bulges and the bulge widens, its two fronts moving towards the caps. Where both fronts
+    are far from the caps and from each other (200 ≤ V/V0 ≤ 600, V0 = 40π + 4π/3) P is within 1e-4 of Maxwell's
+    pressure (model/tube.maxwell_pressure, checked against the equal-area rule in tests/test_tube.py); beyond
+    V/V0 ≈ 700 the fronts reach the caps and P rises (docs/shapes.md has the table)."""
+    scene = capsule_scene(40.0, "[continuation]\nstop_stretch = 3.0\nmax_points = 3000\nstep_max = 1.0\n"
+                                f"[solver]\ndegree = {DEGREE}\n")
+    branch = analyse(scene, pear=False).branches[0]
+    fold = next(i for i, p in enumerate(branch.special) if p.kind.value == "LP")
+    assert abs(branch.special[fold].X[-1] - tube.pressure_maximum(scene.material).pressure) < 1e-3
+    maxwell, _, _ = tube.maxwell_pressure(scene.material)
+    eq = Equilibrium(scene, branch.disc)
+    volume = np.array([2 * np.pi * eq.volume(x[:-1]) for x in branch.X]) / (40 * np.pi + 4 * np.pi / 3)
+    plateau = (volume >= 200) & (volume <= 600)
+    assert plateau.sum() > 50 and np.all(np.diff(volume[plateau]) > 0)
+    assert np.abs(branch.X[plateau, -1] - maxwell).max() <= 1e-4
 
 
 def test_capsule_table_errors_name_key_value_and_range():
