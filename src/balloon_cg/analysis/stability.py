@@ -83,12 +83,14 @@ class SecondVariation:
         self.eq = equilibrium
         self.basis_kind = equilibrium.scene.stability.basis if basis is None else basis
         norm = equilibrium.scene.stability.norm if norm is None else norm
-        quadrature = max(equilibrium.disc.x.size, gauss_nodes(degree))
+        # per piece of the equilibrium's rule (split at a capsule's joins, where the integrand has kinks)
+        joins = equilibrium.disc.joins
+        quadrature = max(equilibrium.disc.x.size // (len(joins) + 1), gauss_nodes(degree))
         # "legendre": P_k(x) even when the equilibrium's basis is mapped; "mapped": P_k(s) on the equilibrium's own
         # wire map (its Gauss nodes in s); on an unmapped equilibrium both are the same basis
         mapping = perturbation_map(equilibrium, self.basis_kind)
         self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature,
-                                    mapping=mapping)
+                                    mapping=mapping, joins=joins)
         self.theta = np.arccos(self.basis.x)
         k = np.arange(degree + 1)
         na = degree + 1
