@@ -284,7 +284,7 @@ def range_limits(scene, upper: float, parameter: str | None = None, params: Para
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and parameter == "P":
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
-        if by_control is not None and control_value(disc, point.X, control) >= by_control[2]:
+        if by_control is not None and control_value(disc, point.X, control, scene.geometry) >= by_control[2]:
             key, code, limit = by_control
             return Stop(code, f"reached {key} {limit:g}")
         if in_voltage and cont.stop_voltage is not None and point.X[-1] >= cont.stop_voltage:

@@ -142,8 +142,7 @@ class Equilibrium:
         self.coils = coaxial_table(scene.field.coils)
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
-        # the meridian's R at the nodes where it is not sin θ (a capsule's; ``volume``)
-        self._radius = hoop(scene.geometry, *self.geometry) if scene.geometry.shape == Shape.CAPSULE else None
+        self._radius = node_radius(scene.geometry, discretisation)  # ``volume``
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
         # the node state and field of the last u (``_pointwise``), in arrays owned by ``nodes``, refilled in place
         self.nodes = NodeKernels(self, self.geometry)
@@ -237,6 +236,12 @@ class Equilibrium:
     def volume(self, u) -> float:
         """Enclosed volume / (2π) (``enclosed_volume``)."""
         return enclosed_volume(self.disc, u, self._radius)
+
+
+def node_radius(geometry, disc) -> np.ndarray | None:
+    """The meridian's R at the nodes of ``disc`` where it is not sin θ (a capsule's), else None
+    (``enclosed_volume``)."""
+    return hoop(geometry, disc.cos_theta, disc.sin_theta) if geometry.shape == Shape.CAPSULE else None
 
 
 def enclosed_volume(disc: Discretisation, u, radius: np.ndarray | None = None) -> float:

@@ -796,7 +796,7 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     if shape == Shape.TUBE:
         return _tube(data, field, electric, loading)
     if shape == Shape.CAPSULE:
-        return _capsule(data, field, electric, loading)
+        return _capsule(data, field, electric)
     if shape == Shape.SPHERE:
         if data.get("aspect") is not None and data["aspect"] != 1:
             raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (the '
@@ -832,24 +832,21 @@ def _length(data, shape: Shape, low: float) -> float:
                                                 f"in [{low:g}, {MAX_LENGTH:g}]")
 
 
-def _pressure_only(shape: Shape, electric: Electric | None, loading: Loading):
-    """The parts a tube and a capsule do not have yet, refused one line each: [electric], control other than P."""
+def _no_electric(shape: Shape, electric: Electric | None):
+    """[electric] on a tube or a capsule, refused in one line (not built yet)."""
     if electric is not None:
         raise SceneError(f'geometry.shape = "{shape.value}": the [electric] term on a {shape.value} is not built yet; '
                          "leave [electric] out or use another shape")
-    if loading.control != Control.PRESSURE:
-        raise SceneError(f'loading.control = "{loading.control.value}": a {shape.value} is continued in the pressure '
-                         'only for now; allowed: "pressure"')
 
 
-def _capsule(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
+def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
     """A capsule's [geometry] (its cylinder's length, 0 the sphere) and the parts of the model it does not have
     yet, refused one line each."""
     length = _length(data, Shape.CAPSULE, 0.0)
     if field.coils:
         raise SceneError('geometry.shape = "capsule": coils around a capsule are not built yet; leave '
                          "[[field.coils]] out or use another shape")
-    _pressure_only(Shape.CAPSULE, electric, loading)
+    _no_electric(Shape.CAPSULE, electric)
     return Geometry(Shape.CAPSULE, length=length)
 
 
@@ -872,7 +869,10 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
             raise SceneError(f"field.coils[{k}]: wire at (radius {coil.radius:g}, height {coil.height:g}) lies on "
                              f"or inside the reference tube (radius 1, heights within ±length/2 = "
                              f"±{length / 2:g}); the radius must be > 1 there")
-    _pressure_only(Shape.TUBE, electric, loading)
+    _no_electric(Shape.TUBE, electric)
+    if loading.control != Control.PRESSURE:
+        raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
+                         'for now; allowed: "pressure"')
     return Geometry(Shape.TUBE, length=length, ends=Ends(raw), axial_stretch=held)
 
 
