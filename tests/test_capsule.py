@@ -209,6 +209,28 @@ def test_volume_control_measures_the_capsules_volume():
     assert all(a.stable_volume for a in beside) and not all(a.stable_pressure for a in beside)
 
 
+def test_run_writes_the_capsules_profiles(tmp_path):
+    """``balloon-cg run`` on a capsule of length 10 (to pole stretch 1.05, before its fold) writes a run file whose
+    profiles measure from the capsule: ρ = λ2 R with R written here (1 on the cylinder, sin κθ on the caps), λ1
+    finite on the whole θ grid and equal to λ2 at the poles (isotropic there), 1e-10; ``inspect`` reads it."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.run_file import read_run
+
+    scene = tmp_path / "capsule.toml"
+    scene.write_text(CAPSULE.format(length=10.0) + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
+    path = tmp_path / "capsule.h5"
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    assert main(["inspect", str(path)]) == 0
+    branch = read_run(path)["branches"]["primary"]
+    profiles, theta = branch["profiles"], branch["theta"]
+    kappa = 1 + 10 / np.pi
+    R = np.where(kappa * theta < np.pi / 2, np.sin(kappa * theta),
+                 np.where(kappa * (np.pi - theta) < np.pi / 2, np.sin(kappa * (np.pi - theta)), 1.0))
+    assert np.abs(profiles["rho"] - profiles["lam2"] * R).max() < 1e-10
+    assert np.all(np.isfinite(profiles["lam1"]))
+    assert np.abs(profiles["lam1"][:, [0, -1]] - profiles["lam2"][:, [0, -1]]).max() < 1e-10
+
+
 def test_capsule_table_errors_name_key_value_and_range():
     for extra, words in [
         ('[geometry]\nshape = "capsule"\n', "geometry.length: missing"),

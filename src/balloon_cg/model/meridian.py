@@ -76,8 +76,10 @@ def metric(geometry: Geometry, cos_theta, sin_theta):
 def meridional_stretch(geometry: Geometry, cos_theta, sin_theta, lam2, v, w):
     """λ1 = sqrt((λ2 R' + v R/sin θ)² + w²)/S' with v = λ2' sin θ, w = η' (module docstring)."""
     if geometry.shape == Shape.CAPSULE:
-        radius = hoop(geometry, cos_theta, sin_theta)
-        rate = lam2 * hoop_rate(geometry, cos_theta, sin_theta) + v * radius / sin_theta
+        radius, s = hoop(geometry, cos_theta, sin_theta), np.asarray(sin_theta, dtype=float)
+        # R/sin θ, κ at the poles (R = sin κθ there): v R/sin θ = λ2' R
+        ratio = np.divide(radius, s, out=np.full(np.broadcast(radius, s).shape, capsule_rate(geometry)), where=s > 0)
+        rate = lam2 * hoop_rate(geometry, cos_theta, sin_theta) + v * ratio
         return np.hypot(rate, w) / metric(geometry, cos_theta, sin_theta)
     return np.hypot(lam2 * cos_theta + v, w) / metric(geometry, cos_theta, sin_theta)
 
