@@ -1,10 +1,13 @@
 """The capsule (docs/shapes.md): a cylinder of radius 1 and length L with hemispherical caps of the same membrane,
 discretised as the sphere is over θ = S/κ (codegen/meridian.py, model/meridian.py), its quadrature split at the
-joins where the reference curvature jumps (galerkin/discretisation.py: ``split_rule``).
+joins where the reference curvature jumps (galerkin/discretisation.py: ``split_rule``), traced at a fixed degree
+(analysis/resolution.py).
 
-Checked: the capsule of length 0 is the sphere (another kernel module); the middle of a long capsule is the uniform
-closed-end tube, derived here from the strain energy; the enclosed volume converges in the degree as the table of
-docs/shapes.md says; one-line errors.
+Checked: the capsule of length 0 is the sphere (another kernel module); its meridian is C¹ with the curvature
+jumping at the joins; the middle of a long capsule is the uniform closed-end tube and the capsule starts bulging at
+the long tube's pressure maximum, both derived or computed independently of the capsule; the bulge of a long
+capsule propagates at Maxwell's pressure (slow); volume control measures the capsule's volume (a quadrature written
+here); run and inspect store profiles measured from the capsule; one-line errors.
 """
 import numpy as np
 import pytest
