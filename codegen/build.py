@@ -35,7 +35,8 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     (CSE), 'print'."""
     start = time.perf_counter()
     kernels = equations.energy_kernels(cls)
-    if cls.meridian.poles:  # a meridian without poles (a tube) has its energy kernels only (codegen/meridian.py)
+    # a meridian without poles (a tube) or with joins (a capsule) has its energy kernels only (codegen/meridian.py)
+    if cls.meridian.analytic:
         kernels += equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
         # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient
         # (codegen/second_variation.py)

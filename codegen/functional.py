@@ -85,7 +85,8 @@ def energy_density(cls: SceneClass, c=cos_theta, s=sin_theta):
     meridian = cls.meridian
     metric, rate, radius = meridian.metric(c, s), meridian.hoop_rate(c, s), meridian.hoop(c, s)
     density = membrane_energy(cls, meridional_stretch(rate, v, w) / metric, lam2) * metric
-    return density + sum((t.axisymmetric(rate, radius, metric) for t in cls.terms), sp.S.Zero)
+    density = density + sum((t.axisymmetric(rate, radius, metric) for t in cls.terms), sp.S.Zero)
+    return meridian.galerkin(density, c, s)
 
 
 def lagrangian(cls: SceneClass):

@@ -6,6 +6,8 @@ through the node values R', R and the metric S' = dS/dt = sqrt(R'² + Z'²) (S t
     sphere     t = θ ∈ [0, π]   R = sin θ,  Z = cos θ,            S' = 1,     ends: two poles
     spheroid   t = θ ∈ [0, π]   R = sin θ,  Z = aspect · cos θ,   S' = sqrt(cos²θ + aspect² sin²θ),  two poles
     tube       t = S ∈ [0, L]   R = 1,      Z = −S,               S' = 1,     ends: planes (sliding) or plugs
+    capsule    t = θ ∈ [0, π]   θ = S/κ, κ = 1 + L/π: caps R = sin κθ (θ < θj = π/(2κ), mirrored), cylinder R = 1,
+                                S' = κ,     ends: two poles
 
 (aspect = polar over equatorial semi-axis, a runtime argument of the kernels; the tube's length L enters no
 kernel). On it the stretches are λ1 = |x'|/S' (meridional) and λ2 = ρ/R (hoop) with ρ = λ2 R, ρ' = λ2 R' + v,
@@ -18,14 +20,23 @@ Legendre basis in cos θ and the pole series. A tube has no node coordinate at a
 folded into its kernels (only the energy kernels: no pole series, no first-order system in θ), and its ends are
 rows of its discretisation (galerkin/interval.py). The sphere's expressions are those derived before the meridian
 was data, so its kernels are byte for byte what they were.
+
+A capsule (a cylinder of length L and radius 1 with hemispherical caps) is discretised as the sphere is, in
+x = cos θ with θ its arclength over κ: R and Z are C¹ in θ, only the curvature jumps at the joins θj, π − θj. Its
+R ≠ sin θ, so its kernels take the sphere's Galerkin state (v = λ2' sin θ, per d(cos θ)) and turn it into the
+meridian's (``galerkin``): v → v R/sin θ and π̂ → π̂ R/sin θ. R(θ) and R'(θ) are piecewise in the node's cos θ
+(θ = acos(cos θ)), and its kernels are the energy kernels only (``analytic`` is False: no pole series, no
+first-order system and no m ≥ 1 second variation across the joins).
 """
 from dataclasses import dataclass
 
 import sympy as sp
 
 aspect = sp.Symbol("aspect", positive=True)
+length = sp.Symbol("length", nonnegative=True)
 _theta = sp.Symbol("theta", real=True)
 _cos, _sin = sp.symbols("cos_theta sin_theta", real=True)
+_v = sp.Symbol("v", real=True)  # codegen/functional.py's state symbol v = λ2' R
 
 
 @dataclass(frozen=True)
@@ -34,7 +45,8 @@ class Meridian:
 
     name = "sphere"
     parameters: tuple = ()
-    poles = True  # both ends on the axis (R = 0): the pole series, the Legendre basis in cos θ
+    poles = True  # both ends on the axis (R = 0): the Legendre basis in cos θ
+    analytic = True  # R, Z analytic in θ: the pole series, the first-order system, the m ≥ 1 second variation
 
     @property
     def node_symbols(self) -> tuple:
@@ -67,6 +79,11 @@ class Meridian:
                                     + sp.diff(self.height(_theta), _theta) ** 2))
         return self._at_node(speed, c, s)
 
+    def galerkin(self, density, c, s):
+        """The energy density per d(cos θ) of the Galerkin state from the meridian's π̂ (its v = λ2' R): the same on
+        a meridian with R = sin θ (sphere, spheroid) or without node coordinates (tube)."""
+        return density
+
     def inputs(self) -> dict:
         """Its entries in a module's header: none for the sphere (its modules' headers stay as they were)."""
         return {} if self.name == SPHERE.name else {"shape": self.name}
@@ -94,6 +111,7 @@ class Tube(Meridian):
 
     name = "tube"
     poles = False
+    analytic = False
 
     def radius(self, t):
         return sp.S.One
@@ -102,7 +120,56 @@ class Tube(Meridian):
         return -t
 
 
+@dataclass(frozen=True)
+class Capsule(Meridian):
+    """The cylinder of radius 1 and ``length`` L with hemispherical caps, over θ = S/κ ∈ [0, π] (κ = 1 + L/π, S the
+    arclength from the north pole): the caps' R = sin κθ up to θj = π/(2κ), the cylinder's R = 1, Z running down
+    from L/2 + 1; S' = κ. L = 0 is the sphere."""
+
+    name = "capsule"
+    parameters: tuple = (length,)
+    analytic = False
+
+    @staticmethod
+    def _rate():
+        return 1 + length / sp.pi
+
+    def _cap(self, c, north, south, middle):
+        """Piecewise over the node: ``north``(θ) on the north cap (cos θ > cos θj), ``south``(π − θ) on the south
+        cap, ``middle`` on the cylinder."""
+        joint = sp.cos(sp.pi / (2 * self._rate()))
+        return sp.Piecewise((north(sp.acos(c)), c > joint), (south(sp.acos(-c)), c < -joint), (middle, True))
+
+    def radius(self, t):
+        kappa = self._rate()
+        return sp.Piecewise((sp.sin(kappa * t), kappa * t < sp.pi / 2),
+                            (sp.sin(kappa * (sp.pi - t)), kappa * (sp.pi - t) < sp.pi / 2), (1, True))
+
+    def height(self, t):
+        kappa = self._rate()
+        return sp.Piecewise((length / 2 + sp.cos(kappa * t), kappa * t < sp.pi / 2),
+                            (-length / 2 - sp.cos(kappa * (sp.pi - t)), kappa * (sp.pi - t) < sp.pi / 2),
+                            (length / 2 - kappa * t + sp.pi / 2, True))
+
+    def hoop(self, c, s):
+        kappa = self._rate()
+        return self._cap(c, lambda t: sp.sin(kappa * t), lambda t: sp.sin(kappa * t), sp.S.One)
+
+    def hoop_rate(self, c, s):
+        kappa = self._rate()
+        return self._cap(c, lambda t: kappa * sp.cos(kappa * t), lambda t: -kappa * sp.cos(kappa * t), sp.S.Zero)
+
+    def metric(self, c, s):
+        return self._rate()
+
+    def galerkin(self, density, c, s):
+        """π̂ R/sin θ with v → v R/sin θ (the module docstring)."""
+        scale = self.hoop(c, s) / s
+        return density.subs(_v, _v * scale) * scale
+
+
 SPHERE = Meridian()
 SPHEROID = Spheroid()
 TUBE = Tube()
-MERIDIANS = {m.name: m for m in (SPHERE, SPHEROID, TUBE)}
+CAPSULE = Capsule()
+MERIDIANS = {m.name: m for m in (SPHERE, SPHEROID, TUBE, CAPSULE)}

@@ -212,11 +212,11 @@ def test_spheroid_against_an_independent_shooting(preset, aspect, pole_stretch):
 
 
 @pytest.mark.parametrize("table, message", [
-    ('shape = "capsule"', 'geometry.shape = "capsule": must be one of "sphere", "spheroid", "tube"'),
+    ('shape = "cube"', 'geometry.shape = "cube": must be one of "sphere", "spheroid", "tube", "capsule"'),
     ("aspect = 2", 'geometry.aspect = 2: only for geometry.shape = "spheroid"'),
     ('shape = "spheroid"\naspect = 0.05', "geometry.aspect = 0.05: must be in [0.1, 10]"),
     ('shape = "spheroid"\naspect = "long"', 'geometry.aspect = "long": must be a number'),
-    ('shape = "spheroid"\nlength = 3', 'geometry.length = 3: only for geometry.shape = "tube"'),
+    ('shape = "spheroid"\nlength = 3', 'geometry.length = 3: only for geometry.shape = "tube" or "capsule"'),
     ('shape = "spheroid"\nwidth = 3', "geometry.width = 3: unknown key; allowed keys: shape, aspect, length, ends"),
 ])
 def test_geometry_table_errors_name_key_value_and_range(table, message):

@@ -85,7 +85,8 @@ def quantity_of(system, name):
     """(q, ∇q) of a landing target: the pole row ``name`` (linear), the control parameter of a Control, or the
     continuation parameter (``PARAMETER``)."""
     if isinstance(name, Control):
-        return (lambda X: control_value(system.eq.disc, X, name)), (lambda X: control_gradient(system, X, name))
+        return ((lambda X: control_value(system.eq.disc, X, name, system.eq.scene.geometry)),
+                (lambda X: control_gradient(system, X, name)))
     if name == PARAMETER:
         row = np.zeros(system.eq.disc.size + 1)
         row[-1] = 1.0

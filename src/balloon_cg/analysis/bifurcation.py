@@ -124,7 +124,7 @@ class ExtendedSolution:
 
 def extended_degrees(branch: Branch, index: int) -> tuple[int, int]:
     """The plain degrees that hold points index and index + 1 (``plain_degree``)."""
-    return tuple(int(d) for d in Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X[index:index + 2]))
+    return tuple(int(d) for d in Resolution.of(branch.scene).plain_degrees(branch.disc, branch.X[index:index + 2]))
 
 
 def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "ExtendedSolution | None" = None):
@@ -205,7 +205,7 @@ def general_tracer(scene, block: Block = Block.ODD_HELD) -> Tracer:
 
 def plain_degree(branch: Branch, X) -> int:
     """The Legendre degree in x that holds the point X of ``branch`` (``Resolution.plain_degree``)."""
-    return Resolution.of(branch.scene.solver).plain_degree(branch.disc, X)
+    return Resolution.of(branch.scene).plain_degree(branch.disc, X)
 
 
 def to_general(branch: Branch, tracer: Tracer, degree: int, u):

@@ -7,8 +7,8 @@ control); a fold of q is where dq/ds = ∇q·τ = 0 along the arclength, located
 """
 import numpy as np
 
-from ..galerkin.equilibrium import enclosed_volume
-from ..scene import Control
+from ..galerkin.equilibrium import enclosed_volume, node_radius
+from ..scene import Control, Geometry
 from .problem import ParameterSystem
 from .results import Kind, StopCode
 
@@ -32,11 +32,12 @@ def landing(loading) -> dict:
     return {} if stop is None else {stop[1]: (loading.control, stop[2])}
 
 
-def control_value(disc, X, control: Control) -> float:
-    """q(X) on the discretisation ``disc`` (module docstring)."""
+def control_value(disc, X, control: Control, geometry: Geometry = Geometry()) -> float:
+    """q(X) on the discretisation ``disc`` of a scene of reference ``geometry`` (module docstring)."""
     if control == Control.PRESSURE:
         return float(X[-1])
-    return float(control_values(X[-1], 2 * np.pi * enclosed_volume(disc, X[:-1]), control))
+    volume = enclosed_volume(disc, X[:-1], node_radius(geometry, disc))
+    return float(control_values(X[-1], 2 * np.pi * volume, control))
 
 
 def control_values(pressure, volume, control: Control):

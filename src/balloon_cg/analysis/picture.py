@@ -30,7 +30,7 @@ import numpy as np
 
 from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, free_pitchforks, mirror,
                surface_branches, surface_pitchforks, surface_primary)
-from ..scene import Control
+from ..scene import Control, Geometry
 from .control import FOLD_KIND, control_value, control_values, minimised_energy
 from .mirror import MIRROR
 from .primary import trace_primary
@@ -593,15 +593,17 @@ def snap_throughs(branches: list, control: Control = Control.PRESSURE) -> list:
         q = b.X[:, -1] if b.parameter != "P" else control_values(P, volume, control)
         energy = minimised_energy(energy, P, volume, control)
         stable = np.array([a.flags()[HELD_FLAG[control]] for a in b.stability], dtype=bool)
-        folds = located_folds(b.disc, [(s.kind, s.status, s.index, s.X) for s in b.special], control)
+        folds = located_folds(b.disc, [(s.kind, s.status, s.index, s.X) for s in b.special], control,
+                              b.scene.geometry)
         curves.append(Curve(b.name, q, stable, energy, folds))
     return find_snaps(curves)
 
 
-def located_folds(disc, special, control: Control) -> dict:
+def located_folds(disc, special, control: Control, geometry: Geometry = Geometry()) -> dict:
     """{interval i: q at the fold} of the located folds of the control q (``control.FOLD_KIND``: LP, LV, LN; on a
-    voltage branch LP is the fold in Φ̄ = X[-1], q there) among ``special`` ((kind, status, index, X) on ``disc``)."""
-    return {int(index): control_value(disc, X, control) for kind, status, index, X in special
+    voltage branch LP is the fold in Φ̄ = X[-1], q there) among ``special`` ((kind, status, index, X) on ``disc``
+    of a scene of reference ``geometry``)."""
+    return {int(index): control_value(disc, X, control, geometry) for kind, status, index, X in special
             if kind == FOLD_KIND[control] and status == Status.LOCATED}
 
 

@@ -114,7 +114,8 @@ def released(tracer: Tracer, held: continuation.Point, params: Parameters,
 
 def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Parameters) -> tuple[np.ndarray, float]:
     """(u, P) of the M = 0 equilibrium whose north pole stretch is ``stretch``, on the scene's reference shape:
-    from the unstressed reference (a_0 = 1, b_1 = aspect: λ2 = 1, η = aspect cos θ, P = 0) by natural
+    from the unstressed reference (a_0 = 1, b_1 = aspect: λ2 = 1, η = aspect cos θ, P = 0; a capsule's η = Z(θ)
+    projected on the basis and solved at P = 0, its meridian being no polynomial in cos θ) by natural
     continuation in the pole stretch (steps doubled after a success, halved after a failure), each point solved
     by Newton on R(u; P) = 0 with the pole row λ2(0) = r_n·u prescribed (galerkin.point_solve's system).
     ContinuationError when the step falls below 1e-6 of the way."""
@@ -123,12 +124,20 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
     disc = system.eq.disc
     a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
     a[0], b[1] = 1.0, scene.geometry.aspect
+    if scene.geometry.shape == Shape.CAPSULE:
+        b = disc.projection @ meridian.reference_height(scene.geometry, np.arccos(disc.x))
     X = np.append(disc.join(a, b), 0.0)
     row = np.append(disc.pole_rows()["lam2_north"], 0.0)
 
     def solve(X, value):
         return newton(system.residual, system.jacobian, X, row, value, scene.solver.tol, scene.solver.max_newton)
 
+    if scene.geometry.shape == Shape.CAPSULE:  # its projected reference: the discrete unstressed state at P = 0
+        reference = solve(X, 1.0)
+        if not reference.converged:
+            raise ContinuationError(f"the unstressed {scene.geometry.describe()} did not converge at P = 0 "
+                                    f"({reference.message}); try a higher solver.degree")
+        X = reference.x
     X, reached, message = continuation.natural(solve, X, 1.0, stretch)
     if reached < stretch:
         raise ContinuationError(f"could not inflate the {scene.geometry.shape.value} to continuation.start_stretch "
@@ -275,7 +284,7 @@ def range_limits(scene, upper: float, parameter: str | None = None, params: Para
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and parameter == "P":
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
-        if by_control is not None and control_value(disc, point.X, control) >= by_control[2]:
+        if by_control is not None and control_value(disc, point.X, control, scene.geometry) >= by_control[2]:
             key, code, limit = by_control
             return Stop(code, f"reached {key} {limit:g}")
         if in_voltage and cont.stop_voltage is not None and point.X[-1] >= cont.stop_voltage:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..galerkin.discretisation import Discretisation
+from ..model.meridian import joins
 from ..numerics import interrupt
 
 
@@ -26,9 +27,14 @@ class Resolution:
     max_recentres: int = 6
 
     @classmethod
-    def of(cls, solver) -> "Resolution":
-        """The policy of a scene's [solver] table."""
-        return cls(solver.max_error, solver.max_degree)
+    def of(cls, scene) -> "Resolution":
+        """The policy of a scene's [solver] table; on a meridian whose curvature jumps (a capsule: its Legendre
+        coefficients fall algebraically, so the geometric tail never reaches max_error; docs/shapes.md, "The
+        capsule") the degree stays solver.degree and every point counts as resolved (max_error ∞): its accuracy is
+        the convergence in solver.degree, not a per-point estimate."""
+        if joins(scene.geometry):
+            return cls(np.inf, scene.solver.degree)
+        return cls(scene.solver.max_error, scene.solver.max_degree)
 
     def resolved(self, disc: Discretisation, u) -> bool:
         return disc.tail(u) <= self.max_error

@@ -83,12 +83,14 @@ class SecondVariation:
         self.eq = equilibrium
         self.basis_kind = equilibrium.scene.stability.basis if basis is None else basis
         norm = equilibrium.scene.stability.norm if norm is None else norm
-        quadrature = max(equilibrium.disc.x.size, gauss_nodes(degree))
+        # per piece of the equilibrium's rule (split at a capsule's joins, where the integrand has kinks)
+        joins = equilibrium.disc.joins
+        quadrature = max(equilibrium.disc.x.size // (len(joins) + 1), gauss_nodes(degree))
         # "legendre": P_k(x) even when the equilibrium's basis is mapped; "mapped": P_k(s) on the equilibrium's own
         # wire map (its Gauss nodes in s); on an unmapped equilibrium both are the same basis
         mapping = perturbation_map(equilibrium, self.basis_kind)
         self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature,
-                                    mapping=mapping)
+                                    mapping=mapping, joins=joins)
         self.theta = np.arccos(self.basis.x)
         k = np.arange(degree + 1)
         na = degree + 1
@@ -345,7 +347,7 @@ def point_degrees(branch, degree: int) -> np.ndarray:
         return np.full(len(branch.X), degree)
     if branch.scene.stability.basis == "mapped":
         return np.maximum(degree, mapped_degrees(branch, degree))
-    return np.maximum(degree, Resolution.of(branch.scene.solver).plain_degrees(branch.disc, branch.X, start=degree))
+    return np.maximum(degree, Resolution.of(branch.scene).plain_degrees(branch.disc, branch.X, start=degree))
 
 
 def mapped_degrees(branch, start: int) -> np.ndarray:
@@ -353,7 +355,7 @@ def mapped_degrees(branch, start: int) -> np.ndarray:
     growth) until the point truncated to it loses at most max_error (``transfer_error``) and its tail estimate is
     within max_error, at most the branch's degree (where every point is stored): a branch that ends next to a wire
     at a high mapped degree keeps its earlier points at the degree they need."""
-    resolution, disc = Resolution.of(branch.scene.solver), branch.disc
+    resolution, disc = Resolution.of(branch.scene), branch.disc
     X = np.atleast_2d(branch.X)
     degrees = np.full(len(X), disc.degree)
     open_rows, degree = np.arange(len(X)), start
@@ -372,7 +374,7 @@ def mapped_degrees(branch, start: int) -> np.ndarray:
 def check_degree(branch, degree: int, factor: float = CHECK_FACTOR) -> int:
     """The degree a result at perturbation degree N is checked against: ``factor``·N, at most solver.max_degree;
     at max_degree itself the coarser N/growth (then the check says whether N lies in the converged range)."""
-    resolution = Resolution.of(branch.scene.solver)
+    resolution = Resolution.of(branch.scene)
     if degree < resolution.max_degree:
         return min(int(factor * degree), resolution.max_degree)
     return int(degree / resolution.growth)

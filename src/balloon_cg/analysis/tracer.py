@@ -80,7 +80,7 @@ class Tracer:
         # the continuation parameter (Parameters field): P, or Φ̄ for continuation.parameter = "voltage"
         self.parameter = parameter or scene_parameter(scene)
         self.settings = continuation_settings(scene)
-        self.resolution = Resolution.of(scene.solver)
+        self.resolution = Resolution.of(scene)
         self._systems = {}
 
     def system(self, degree: int, params: Parameters, mapping=None) -> ParameterSystem:

@@ -237,13 +237,17 @@ class Discretisation:
     pin_translation: bool
     quadrature: int = 0
     mapping: WireMap | None = None
+    joins: tuple = ()  # x where the quadrature splits (a capsule's, where its reference curvature jumps)
 
     def __reduce__(self):
-        """Pickled as its five defining fields (the tables are rebuilt): results holding one stay small."""
-        return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping)
+        """Pickled as its six defining fields (the tables are rebuilt): results holding one stay small."""
+        return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping,
+                                self.joins)
 
     def __post_init__(self):
         """Basis and quadrature tables from ``_tables`` (built once per set of fields, shared, read-only)."""
+        if self.joins and self.mapping is not None:
+            raise ValueError("Discretisation: a split quadrature (joins) and a wire map are not built together")
         for name, value in _tables(self).items():
             object.__setattr__(self, name, value)
 
@@ -387,6 +391,20 @@ def gauss_nodes(degree: int) -> int:
     return (3 * degree) // 2 + 8
 
 
+def split_rule(n_q: int, joins: tuple = ()):
+    """(nodes, weights) on [−1, 1]: Gauss–Legendre with n_q nodes, or with ``joins`` (sorted, in (−1, 1)) n_q nodes
+    on each piece between them (a composite rule: exact for an integrand that is a polynomial of degree < 2 n_q on
+    each piece, where a kink of the integrand at a join costs a single rule O(n_q⁻²)). Mirror-symmetric when the
+    joins are."""
+    if not joins:
+        return legendre.leggauss(n_q)
+    nodes, weights = legendre.leggauss(n_q)
+    ends = (-1.0, *joins, 1.0)
+    pieces = [(0.5 * (b - a), 0.5 * (b + a)) for a, b in zip(ends[:-1], ends[1:])]
+    return (np.concatenate([half * nodes + middle for half, middle in pieces]),
+            np.concatenate([half * weights for half, _ in pieces]))
+
+
 @functools.lru_cache(maxsize=4)
 def _projection(disc: Discretisation) -> np.ndarray:
     """``Discretisation.projection``, computed once per set of fields (a pseudo-inverse: ~1 s of CPU at degree 320;
@@ -399,10 +417,10 @@ def _projection(disc: Discretisation) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def _tables(disc: Discretisation) -> dict:
-    """The node, weight and basis tables of a Discretisation (keyed by its five fields: equal discretisations
+    """The node, weight and basis tables of a Discretisation (keyed by its six fields: equal discretisations
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
     n_q = disc.quadrature or gauss_nodes(disc.degree)
-    nodes, s_weights = legendre.leggauss(n_q)
+    nodes, s_weights = split_rule(n_q, disc.joins)
     p, dp = legendre_table(nodes, disc.degree)
     if disc.mapping is None:
         x, weights = nodes, s_weights

@@ -4,7 +4,7 @@ R(u; P, M, Φ̄) = ∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k ∂s_k/∂u  (s = (�
 J = ∂R/∂u = Hessian of E (symmetric: the axisymmetric second variation), and ∂R/∂P, ∂R/∂M, ∂R/∂Φ̄ for
 continuation. A point is an equilibrium when R = 0 at fixed (P, M, Φ̄).
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -13,7 +13,7 @@ from .discretisation import Discretisation, read_only
 from .interval import IntervalDiscretisation
 from ..model.field import coaxial_table, field_squared_nodes
 from ..model.kernels import KernelSet
-from ..model.meridian import meridional_stretch
+from ..model.meridian import hoop, joins, meridional_stretch
 from ..numerics.newton import finite
 from ..scene.energies import StrainEnergy
 from ..scene.formula import domain_conditions
@@ -135,10 +135,14 @@ class Equilibrium:
                                  '(docs/shapes.md)')
             raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")
         self.scene = scene
+        if isinstance(discretisation, Discretisation) and discretisation.joins != joins(scene.geometry):
+            # the quadrature split where the reference curvature jumps (a capsule's joins)
+            discretisation = replace(discretisation, joins=joins(scene.geometry))
         self.disc = discretisation
         self.coils = coaxial_table(scene.field.coils)
         self.kernels = KernelSet.of_scene(scene, kernel_class)
         self.geometry = (discretisation.cos_theta, discretisation.sin_theta)
+        self._radius = node_radius(scene.geometry, discretisation)  # ``volume``
         self._domain_check = isinstance(scene.material, StrainEnergy) and bool(domain_conditions(scene.material.formula))
         # the node state and field of the last u (``_pointwise``), in arrays owned by ``nodes``, refilled in place
         self.nodes = NodeKernels(self, self.geometry)
@@ -231,13 +235,22 @@ class Equilibrium:
 
     def volume(self, u) -> float:
         """Enclosed volume / (2π) (``enclosed_volume``)."""
-        return enclosed_volume(self.disc, u)
+        return enclosed_volume(self.disc, u, self._radius)
 
 
-def enclosed_volume(disc: Discretisation, u) -> float:
-    """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ λ2² η' sin²θ dθ (MODEL.md §2: the pressure term is −P V/(2π))."""
+def node_radius(geometry, disc) -> np.ndarray | None:
+    """The meridian's R at the nodes of ``disc`` where it is not sin θ (a capsule's), else None
+    (``enclosed_volume``)."""
+    return hoop(geometry, disc.cos_theta, disc.sin_theta) if geometry.shape == Shape.CAPSULE else None
+
+
+def enclosed_volume(disc: Discretisation, u, radius: np.ndarray | None = None) -> float:
+    """Enclosed volume / (2π) = −∂E/∂P = −∫ ½ ρ² η' dθ, ρ = λ2 R (MODEL.md §2: the pressure term is −P V/(2π)),
+    per d(cos θ) −½ λ2² η' R²/sin θ; ``radius``: the meridian's R at the nodes where it is not sin θ (a capsule's)."""
     lam2, _, _, w = disc.node_state(u)
-    return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
+    if radius is None:
+        return float(-disc.weights @ (0.5 * lam2**2 * w * disc.sin_theta))
+    return float(-disc.weights @ (0.5 * lam2**2 * w * radius**2 / disc.sin_theta))
 
 
 @njit(cache=True)

@@ -32,7 +32,7 @@ def meridional_stretch(theta, lam2, dlam2, deta, geometry: Geometry = Geometry()
 
 
 def profiles(disc, X: np.ndarray, theta: np.ndarray, geometry: Geometry = Geometry()) -> dict:
-    """λ1, λ2, ρ = λ2 sin θ and η on ``theta`` for the rows X = (u, P) of points on ``disc`` (a scene of reference
+    """λ1, λ2, ρ = λ2 R (R = sin θ but on a capsule: model/meridian.py) and η on ``theta`` for the rows X = (u, P) of points on ``disc`` (a scene of reference
     ``geometry``).
 
     Each array has shape (n_points, len(theta)).
@@ -41,7 +41,7 @@ def profiles(disc, X: np.ndarray, theta: np.ndarray, geometry: Geometry = Geomet
     return {
         "lam1": meridional_stretch(theta, lam2, dlam2, deta, geometry),
         "lam2": lam2,
-        "rho": lam2 * np.sin(theta),
+        "rho": lam2 * meridian.hoop(geometry, np.cos(theta), np.sin(theta)),
         "eta": eta,
     }
 

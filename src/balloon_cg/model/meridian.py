@@ -10,9 +10,12 @@ S' = dS/dθ the rate of the reference arclength (scene.Geometry: ``aspect`` is t
 semi-axis). Both meridians end at two poles on the axis (R = 0), where the Legendre basis in cos θ is smooth.
 On a deformed state (λ2, v = λ2' sin θ, η, w = η'), ρ = λ2 R and the stretches are
 
-    λ2 = ρ/R (hoop),   λ1 = sqrt(ρ'² + η'²)/S' = sqrt((λ2 cos θ + v)² + w²)/S' (meridional),
+    λ2 = ρ/R (hoop),   λ1 = sqrt(ρ'² + η'²)/S' = sqrt((λ2 R' + v R/sin θ)² + w²)/S' (meridional),
 
-and the reference encloses V0 = 4π/3 · aspect. A tube (``shape = "tube"``) is a meridian over its arclength
+and the reference encloses V0 = 4π/3 · aspect. A capsule (``shape = "capsule"``, its cylinder's ``length`` L) is a
+meridian over θ = S/κ, κ = 1 + L/π (S the arclength from the north pole): R = sin κθ on the caps (κθ < π/2 from
+either pole), R = 1 on the cylinder, S' = κ, Z = L/2 + cos κθ on the north cap and L/2 − (κθ − π/2) on the
+cylinder (mirrored below); it encloses V0 = πL + 4π/3. A tube (``shape = "tube"``) is a meridian over its arclength
 t = S ∈ [0, L] with R = 1, R' = 0, S' = 1 and Z = −S (codegen/meridian.py), discretised in galerkin/interval.py;
 it encloses V0 = πL.
 """
@@ -21,28 +24,86 @@ import numpy as np
 from ..scene.tables import Geometry, Shape
 
 
+def capsule_rate(geometry: Geometry) -> float:
+    """κ = dS/dθ = 1 + L/π of a capsule."""
+    return 1.0 + geometry.length / np.pi
+
+
+def _capsule_cap(geometry: Geometry, cos_theta):
+    """(κ d, σ) at the node: κ times the angle d from the nearer pole, clipped at the join (κ d ≤ π/2), and σ = ±1
+    on the north and south halves (θ = acos(cos θ), the south's measured from the south pole as the kernels do)."""
+    c = np.asarray(cos_theta, dtype=float)
+    kappa = capsule_rate(geometry)
+    return np.minimum(kappa * np.arccos(np.abs(c)), np.pi / 2), np.where(c >= 0.0, 1.0, -1.0)
+
+
+def hoop(geometry: Geometry, cos_theta, sin_theta):
+    """R at the node: sin θ on a sphere and a spheroid, a capsule's sin κd (1 on its cylinder)."""
+    if geometry.shape != Shape.CAPSULE:
+        return np.asarray(sin_theta, dtype=float)
+    angle, _ = _capsule_cap(geometry, cos_theta)
+    return np.where(angle < np.pi / 2, np.sin(angle), 1.0)
+
+
+def hoop_rate(geometry: Geometry, cos_theta, sin_theta):
+    """R' = dR/dθ at the node: cos θ on a sphere and a spheroid, a capsule's ±κ cos κd (0 on its cylinder)."""
+    if geometry.shape != Shape.CAPSULE:
+        return np.asarray(cos_theta, dtype=float)
+    angle, side = _capsule_cap(geometry, cos_theta)
+    return np.where(angle < np.pi / 2, side * capsule_rate(geometry) * np.cos(angle), 0.0)
+
+
+def joins(geometry: Geometry) -> tuple:
+    """The x = cos θ where the reference curvature jumps, where the quadrature splits (galerkin/discretisation.py:
+    ``split_rule``): a capsule's ±cos θj, θj = π/(2κ) (none at length 0, the sphere); none on other shapes."""
+    if geometry.shape != Shape.CAPSULE or geometry.length == 0:
+        return ()
+    join = float(np.cos(np.pi / (2 * capsule_rate(geometry))))
+    return (-join, join)
+
+
 def metric(geometry: Geometry, cos_theta, sin_theta):
     """S' = dS/dt at the node (cos θ, sin θ): ones on the sphere and on a tube (t = S, whose nodes pass R' = 0 and
-    R = 1 for (cos θ, sin θ): galerkin/interval.py)."""
+    R = 1 for (cos θ, sin θ): galerkin/interval.py), κ on a capsule."""
+    ones = np.ones_like(np.asarray(cos_theta, dtype=float))
     if geometry.shape in (Shape.SPHERE, Shape.TUBE):
-        return np.ones_like(np.asarray(cos_theta, dtype=float))
+        return ones
+    if geometry.shape == Shape.CAPSULE:
+        return capsule_rate(geometry) * ones
     return np.sqrt(np.square(cos_theta) + np.square(geometry.aspect * np.asarray(sin_theta)))
 
 
 def meridional_stretch(geometry: Geometry, cos_theta, sin_theta, lam2, v, w):
-    """λ1 = sqrt((λ2 cos θ + v)² + w²)/S' with v = λ2' sin θ, w = η' (module docstring)."""
+    """λ1 = sqrt((λ2 R' + v R/sin θ)² + w²)/S' with v = λ2' sin θ, w = η' (module docstring)."""
+    if geometry.shape == Shape.CAPSULE:
+        radius, s = hoop(geometry, cos_theta, sin_theta), np.asarray(sin_theta, dtype=float)
+        # R/sin θ, κ at the poles (R = sin κθ there): v R/sin θ = λ2' R
+        ratio = np.divide(radius, s, out=np.full(np.broadcast(radius, s).shape, capsule_rate(geometry)), where=s > 0)
+        rate = lam2 * hoop_rate(geometry, cos_theta, sin_theta) + v * ratio
+        return np.hypot(rate, w) / metric(geometry, cos_theta, sin_theta)
     return np.hypot(lam2 * cos_theta + v, w) / metric(geometry, cos_theta, sin_theta)
 
 
 def reference_height(geometry: Geometry, t):
-    """Z(t) of the reference meridian: aspect · cos θ (its hoop radius is sin θ), or a tube's −S over its arclength
-    S = t (its hoop radius is 1; downwards, as the sphere's meridian runs from its north pole)."""
+    """Z(t) of the reference meridian: aspect · cos θ (its hoop radius is sin θ), a capsule's (module docstring), or
+    a tube's −S over its arclength S = t (its hoop radius is 1; downwards, as the sphere's meridian runs from its
+    north pole)."""
     if geometry.shape == Shape.TUBE:
         return -np.asarray(t, dtype=float)
+    if geometry.shape == Shape.CAPSULE:
+        t = np.asarray(t, dtype=float)
+        kappa, half = capsule_rate(geometry), geometry.length / 2
+        north, south = kappa * t, kappa * (np.pi - t)
+        return np.where(north < np.pi / 2, half + np.cos(north),
+                        np.where(south < np.pi / 2, -half - np.cos(south), half - north + np.pi / 2))
     return geometry.aspect * np.cos(t)
 
 
 def kernel_values(geometry: Geometry) -> dict:
     """The meridian's scalar arguments of its class's kernels by name (codegen/meridian.py: ``parameters``): none
-    for the sphere, the spheroid's aspect."""
-    return {"aspect": float(geometry.aspect)} if geometry.shape == Shape.SPHEROID else {}
+    for the sphere, the spheroid's aspect, the capsule's length."""
+    if geometry.shape == Shape.SPHEROID:
+        return {"aspect": float(geometry.aspect)}
+    if geometry.shape == Shape.CAPSULE:
+        return {"length": float(geometry.length)}
+    return {}

@@ -49,7 +49,7 @@ from ..io.layout import FileError, check_input, file_kind, reading
 from ..io.parents import parent_label
 from ..io.run_file import read_run, stored_basis
 from ..io.sweep_file import read_sweep
-from ..model.meridian import reference_height
+from ..model.meridian import hoop, reference_height
 from ..scene.tables import Shape
 from ..scene.validation import did_you_mean
 
@@ -796,10 +796,11 @@ def plot_shapes(branches, points=None, axes=None) -> Figure:
     fig, panels, own = _panels(axes, 1, (6.4, 7.6))
     ax = panels[0]
     ax.set_aspect("equal")
-    psi = np.linspace(0, 2 * np.pi, 200)
+    meridian = np.linspace(0, np.pi, 100)  # the reference's, mirrored
     handles = []
     for geometry in dict.fromkeys(stored_scene(b.run).geometry for b in branches):  # each reference drawn once
-        ax.plot(np.sin(psi), reference_height(geometry, psi), color="0.6", linewidth=0.8, linestyle=":")
+        radius, height = hoop(geometry, np.cos(meridian), np.sin(meridian)), reference_height(geometry, meridian)
+        ax.plot(np.r_[radius, -radius[::-1]], np.r_[height, height[::-1]], color="0.6", linewidth=0.8, linestyle=":")
         shape = "" if geometry.shape == Shape.SPHERE else f", {geometry.describe()}"
         handles.append(Line2D([], [], color="0.6", linewidth=0.8, linestyle=":",
                               label=f"undeformed ($R_0$ = 1{shape})"))

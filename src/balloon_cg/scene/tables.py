@@ -114,6 +114,7 @@ class Shape(enum.StrEnum):
     SPHERE = "sphere"
     SPHEROID = "spheroid"
     TUBE = "tube"
+    CAPSULE = "capsule"
 
 
 class Ends(enum.StrEnum):
@@ -129,12 +130,13 @@ class Ends(enum.StrEnum):
 class Geometry:
     """The reference surface (docs/scenes.md, [geometry]): the unit sphere, a spheroid of equatorial semi-axis 1
     and polar semi-axis ``aspect`` (< 1 oblate, > 1 prolate; 1 is the sphere), the axis that of the coils, or a
-    circular cylinder of radius 1 and ``length`` with ``ends``. Lengths stay in units of the equatorial radius; the
+    circular cylinder of radius 1 and ``length`` with ``ends``, or a capsule: the cylinder of ``length`` closed by
+    hemispherical caps of radius 1 (length 0: the sphere). Lengths stay in units of the equatorial radius; the
     reference meridian is model/meridian.py's."""
 
     shape: Shape = Shape.SPHERE
     aspect: float = 1.0
-    length: float | None = None  # a tube's
+    length: float | None = None  # a tube's or a capsule's cylinder's
     ends: Ends | None = None  # a tube's
     axial_stretch: float | None = None  # a tube's ends held at the distance λL (None: closed, the distance free)
 
@@ -143,6 +145,8 @@ class Geometry:
         if self.shape == Shape.TUBE:
             held = {} if self.axial_stretch is None else {"axial_stretch": self.axial_stretch}
             return {"shape": self.shape.value, "length": self.length, "ends": self.ends.value} | held
+        if self.shape == Shape.CAPSULE:
+            return {"shape": self.shape.value, "length": self.length}
         return {"shape": self.shape.value, "aspect": self.aspect}
 
     def describe(self) -> str:
@@ -150,6 +154,8 @@ class Geometry:
         if self.shape == Shape.TUBE:
             held = "" if self.axial_stretch is None else f" held at {self.axial_stretch:g} L"
             return f"tube of length {self.length:g} with {self.ends.value} ends{held}"
+        if self.shape == Shape.CAPSULE:
+            return f"capsule of length {self.length:g}"
         return f"{self.shape.value} of aspect {self.aspect:g}"
 
 
@@ -632,16 +638,20 @@ def _build(data: dict, name: str, text: str) -> Scene:
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric, loading)
     dynamics = _dynamics(data.get("dynamics", {}))
-    if geometry.shape == Shape.TUBE and dynamics.frequencies:
-        raise SceneError('dynamics.frequencies = true: the natural frequencies of a tube are not built yet; leave it '
-                         'false or use geometry.shape = "sphere"')
+    if geometry.shape in (Shape.TUBE, Shape.CAPSULE) and dynamics.frequencies:
+        raise SceneError(f'dynamics.frequencies = true: the natural frequencies of a {geometry.shape.value} are not '
+                         'built yet; leave it false or use geometry.shape = "sphere"')
+    stability = _stability(data.get("stability", {}))
+    if geometry.shape == Shape.CAPSULE and stability.m_max != 0:
+        raise SceneError(f"stability.m_max = {stability.m_max}: a capsule's m ≥ 1 second variation is not built yet "
+                         "(its curvature jumps at the joins); allowed: 0")
     return Scene(
         name=name,
         material=material,
         field=field,
         continuation=continuation,
         solver=_solver(data.get("solver", {})),
-        stability=_stability(data.get("stability", {})),
+        stability=stability,
         output=output,
         electric=electric,
         text=text,
@@ -778,11 +788,15 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     if raw not in tuple(Shape):
         raise SceneError(f"geometry.shape = {show(raw)}: must be one of " + ", ".join(f'"{s.value}"' for s in Shape))
     shape = Shape(raw)
-    for key in ("length", "ends", "axial_stretch"):
+    for key in ("ends", "axial_stretch"):
         if shape != Shape.TUBE and data.get(key) is not None:
             raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "tube"')
+    if shape not in (Shape.TUBE, Shape.CAPSULE) and data.get("length") is not None:
+        raise SceneError(f'geometry.length = {show(data["length"])}: only for geometry.shape = "tube" or "capsule"')
     if shape == Shape.TUBE:
         return _tube(data, field, electric, loading)
+    if shape == Shape.CAPSULE:
+        return _capsule(data, field, electric)
     if shape == Shape.SPHERE:
         if data.get("aspect") is not None and data["aspect"] != 1:
             raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (the '
@@ -806,17 +820,40 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     return Geometry(shape, aspect)
 
 
+def _length(data, shape: Shape, low: float) -> float:
+    """geometry.length of a tube or a capsule, in [low, MAX_LENGTH] (geometry.aspect is a spheroid's)."""
+    if data.get("aspect") is not None:
+        raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a '
+                         f"{shape.value} has geometry.length)")
+    if data.get("length") is None:
+        raise SceneError(f"geometry.length: missing; a {shape.value} needs its length in reference radii, in "
+                         f"[{low:g}, {MAX_LENGTH:g}]")
+    return _getter(data, "geometry", Geometry)("length", lambda x: low <= x <= MAX_LENGTH,
+                                                f"in [{low:g}, {MAX_LENGTH:g}]")
+
+
+def _no_electric(shape: Shape, electric: Electric | None):
+    """[electric] on a tube or a capsule, refused in one line (not built yet)."""
+    if electric is not None:
+        raise SceneError(f'geometry.shape = "{shape.value}": the [electric] term on a {shape.value} is not built yet; '
+                         "leave [electric] out or use another shape")
+
+
+def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
+    """A capsule's [geometry] (its cylinder's length, 0 the sphere) and the parts of the model it does not have
+    yet, refused one line each."""
+    length = _length(data, Shape.CAPSULE, 0.0)
+    if field.coils:
+        raise SceneError('geometry.shape = "capsule": coils around a capsule are not built yet; leave '
+                         "[[field.coils]] out or use another shape")
+    _no_electric(Shape.CAPSULE, electric)
+    return Geometry(Shape.CAPSULE, length=length)
+
+
 def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
     """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet,
     refused one line each."""
-    if data.get("aspect") is not None:
-        raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (a tube has '
-                         "geometry.length)")
-    if data.get("length") is None:
-        raise SceneError(f'geometry.length: missing; a tube needs its length in reference radii, in '
-                         f'[{MIN_LENGTH:g}, {MAX_LENGTH:g}]')
-    length = _getter(data, "geometry", Geometry)("length", lambda x: MIN_LENGTH <= x <= MAX_LENGTH,
-                                                  f"in [{MIN_LENGTH:g}, {MAX_LENGTH:g}]")
+    length = _length(data, Shape.TUBE, MIN_LENGTH)
     raw = Ends.SLIDING.value if data.get("ends") is None else data["ends"]
     if raw not in tuple(Ends):
         raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends))
@@ -832,9 +869,7 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
             raise SceneError(f"field.coils[{k}]: wire at (radius {coil.radius:g}, height {coil.height:g}) lies on "
                              f"or inside the reference tube (radius 1, heights within ±length/2 = "
                              f"±{length / 2:g}); the radius must be > 1 there")
-    if electric is not None:
-        raise SceneError(f"{where}: the [electric] term on a tube is not built yet; leave [electric] out or use "
-                         "another shape")
+    _no_electric(Shape.TUBE, electric)
     if loading.control != Control.PRESSURE:
         raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
                          'for now; allowed: "pressure"')

@@ -1,0 +1,255 @@
+"""The capsule (docs/shapes.md): a cylinder of radius 1 and length L with hemispherical caps of the same membrane,
+discretised as the sphere is over θ = S/κ (codegen/meridian.py, model/meridian.py), its quadrature split at the
+joins where the reference curvature jumps (galerkin/discretisation.py: ``split_rule``), traced at a fixed degree
+(analysis/resolution.py).
+
+Checked: the capsule of length 0 is the sphere (another kernel module); its meridian is C¹ with the curvature
+jumping at the joins; the middle of a long capsule is the uniform closed-end tube and the capsule starts bulging at
+the long tube's pressure maximum, both derived or computed independently of the capsule; the bulge of a long
+capsule propagates at Maxwell's pressure (slow); volume control measures the capsule's volume (a quadrature written
+here); run and inspect store profiles measured from the capsule; one-line errors.
+"""
+import numpy as np
+import pytest
+import sympy as sp
+from scipy.optimize import brentq
+
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.primary import inflated_reference, start_parameters
+from balloon_cg.analysis.tracer import Tracer, unit
+from balloon_cg.galerkin.discretisation import split_rule
+from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.model import meridian, tube
+from balloon_cg.numerics import continuation
+from balloon_cg.numerics.newton import newton
+from balloon_cg.scene import SceneError, Shape, parse_scene
+
+DEGREE = 128  # the slow plateau test's (docs/shapes.md: the plateau at degrees 128 and 192)
+CAPSULE = '[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = {length}\n[stability]\nm_max = 0\n'
+
+
+def capsule_scene(length: float, extra: str = ""):
+    return parse_scene(CAPSULE.format(length=length) + extra)
+
+
+def inflated(scene, degree: int, P: float):
+    """(Equilibrium, u) of the capsule at the pressure P: from the start at pole stretch 1.005, natural
+    continuation in P (Newton at prescribed P)."""
+    tracer = Tracer(scene, True)
+    params = start_parameters(scene, "P")
+    u, P0 = inflated_reference(tracer, degree, 1.005, params)
+    system = tracer.system(degree, params)
+
+    def solve(X, value):
+        return newton(system.residual, system.jacobian, X, unit(X.size, -1), value, 1e-13, 40)
+
+    X, reached, message = continuation.natural(solve, np.append(u, P0), P0, P)
+    assert reached == P, message
+    return system.eq, X[:-1]
+
+
+def test_capsule_of_length_zero_is_the_sphere():
+    """SPOM1 to a pole stretch of 3 with m = 0 stability: the same points, fold and equator-breaking branch point
+    as the sphere to 1e-10, although the capsule's kernels are another module (its R = sin(κ acos(cos θ)) with
+    κ = 1, S' = κ, and the Galerkin state turned into the meridian's by R/sin θ)."""
+    text = '[material]\npreset = "SPOM1"\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 3.0\n'
+    sphere = parse_scene(text)
+    capsule = parse_scene(text + '[geometry]\nshape = "capsule"\nlength = 0\n')
+    assert capsule.geometry.shape == Shape.CAPSULE and meridian.joins(capsule.geometry) == ()
+    one, other = (analyse(scene, pear=False).branches[0] for scene in (sphere, capsule))
+    assert other.kernel_class != one.kernel_class
+    assert [p.kind for p in other.special] == [p.kind for p in one.special]
+    kinds = [p.kind.value for p in one.special]
+    assert kinds.count("BP") == 1 and kinds.count("LP") == 1
+    for a, b in zip(one.special, other.special):
+        assert (a.kind, a.block, a.status) == (b.kind, b.block, b.status)
+        assert abs(a.X[-1] - b.X[-1]) <= 1e-10 * abs(a.X[-1])
+        assert np.abs(a.X[:-1] - b.X[:-1]).max() <= 1e-10
+    assert one.X.shape == other.X.shape and np.abs(one.X - other.X).max() <= 1e-10
+
+
+def test_reference_meridian_is_c1_with_the_curvature_jumping_at_the_joins():
+    """model/meridian's R, R', Z of a capsule of length 6: R' is dR/dθ and S' = κ is sqrt(R'² + Z'²) (central
+    differences of R and Z, 1e-8) on both caps and the cylinder; R, R', Z continuous at the joins θj = π/(2κ),
+    where R'' jumps from −κ² to 0."""
+    geometry = capsule_scene(6.0).geometry
+    kappa = 1 + 6.0 / np.pi
+    joint = np.pi / (2 * kappa)
+    theta = np.array([0.2, joint - 1e-3, joint + 1e-3, 1.4, np.pi / 2, 2.0, np.pi - joint + 1e-3, 3.0])
+    h = 1e-6
+    R = lambda t: meridian.hoop(geometry, np.cos(t), np.sin(t))  # noqa: E731
+    Z = lambda t: meridian.reference_height(geometry, t)  # noqa: E731
+    dR, dZ = (R(theta + h) - R(theta - h)) / (2 * h), (Z(theta + h) - Z(theta - h)) / (2 * h)
+    assert np.abs(dR - meridian.hoop_rate(geometry, np.cos(theta), np.sin(theta))).max() < 1e-8
+    assert np.abs(np.hypot(dR, dZ) - kappa).max() < 1e-8
+    assert abs(Z(np.array(0.0)) - (3.0 + 1)) < 1e-15 and abs(Z(np.array(np.pi)) + (3.0 + 1)) < 1e-15
+    for t in (joint, np.pi - joint):
+        for f in (R, Z, lambda s: meridian.hoop_rate(geometry, np.cos(s), np.sin(s))):
+            assert abs(f(np.array(t - 1e-9)) - f(np.array(t + 1e-9))) < 1e-7
+    second = lambda t: (R(t + 1e-4) - 2 * R(t) + R(t - 1e-4)) / 1e-8  # noqa: E731
+    assert abs(second(joint - 1e-3) + kappa**2) < 1e-2 and abs(second(joint + 1e-3)) < 1e-6
+
+
+def test_split_rule_integrates_a_kink_exactly():
+    """The composite rule with joins at ±c integrates |x| − c piecewise polynomials exactly (1e-14); the single
+    rule of as many nodes per piece does not (the kink costs it more than 1e-6)."""
+    c = np.cos(np.pi / 2.6)
+    f = lambda x: np.maximum(np.abs(x), c) ** 3  # noqa: E731
+    exact = 2 * (c**3 * c + (1 - c**4) / 4)
+    nodes, weights = split_rule(20, (-c, c))
+    assert abs(weights @ f(nodes) - exact) < 1e-14 and np.allclose(nodes, -nodes[::-1])
+    plain, plain_weights = split_rule(20)
+    assert abs(plain_weights @ f(plain) - exact) > 1e-6
+
+
+def closed_end_tube(material):
+    """(P(λθ, λz), N(λθ, λz)) of the uniform tube with closed sliding ends, from Φ(λ1 = λz, λ2 = λθ) of the Ogden
+    material: the hoop balance P = Φ_2/(λθλz) and the axial balance N = Φ_1 − λθΦ_2/(2λz) = 0 (the wall's axial
+    force 2πΦ_1 carries the pressure on the end caps πλθ²P, i.e. Φ_1 = Pλθ²λz/2)."""
+    hoop, axial = sp.symbols("hoop axial", positive=True)
+    terms = zip(map(lambda v: sp.Rational(repr(v)), material.mu), map(lambda v: sp.Rational(repr(v)), material.alpha))
+    energy = sum(mu / a * (axial**a + hoop**a + (axial * hoop) ** -a - 3) for mu, a in terms)
+    P = sp.diff(energy, hoop) / (hoop * axial)
+    N = sp.diff(energy, axial) - hoop * sp.diff(energy, hoop) / (2 * axial)
+    return sp.lambdify((hoop, axial), P), sp.lambdify((hoop, axial), N)
+
+
+def test_middle_of_a_long_capsule_is_the_uniform_closed_tube():
+    """SPOM1 capsule of length 20 at P = 1.2 (below the tube's pressure maximum 1.4905), degrees 96 and 160: at the
+    middle (θ = π/2, 10 radii from either cap) the hoop stretch λθ = λ2 and the axial stretch λz = λ1 make the
+    closed-end tube's balances P = Φ_2/(λθλz) and N = 0 hold (derived here), ρ' = 0; λθ is the closed-end path's
+    at P (brentq on P along N = 0) within the degree's accuracy, better at the higher degree."""
+    P_of, N_of = closed_end_tube(capsule_scene(20.0).material)
+    errors = []
+    for degree in (96, 160):
+        eq, u = inflated(capsule_scene(20.0), degree, 1.2)
+        middle = np.array([np.pi / 2])
+        lam2, v, _, w = eq.state_at(u, middle)
+        lam1 = meridian.meridional_stretch(eq.scene.geometry, np.cos(middle), np.sin(middle), lam2, v, w)
+        hoop, axial = float(lam2[0]), float(lam1[0])
+        assert abs(v[0]) < 1e-12  # ρ' = 0 at the middle: the mirror symmetry
+        axial_of = lambda h: brentq(lambda a: N_of(h, a), 0.5, 3.0)  # noqa: E731
+        closed = brentq(lambda h: P_of(h, axial_of(h)) - 1.2, 1.01, 1.5883)
+        errors.append((abs(P_of(hoop, axial) - 1.2), abs(N_of(hoop, axial)), abs(hoop - closed)))
+    assert max(errors[-1]) < 1e-5
+    assert max(errors[-1]) < max(errors[0])
+
+
+def pressure_maximum(length: float, degree: int) -> float:
+    """P at the capsule's located pressure fold (``analyse``, m = 0 stability, to pole stretch 1.3)."""
+    scene = capsule_scene(length, f"[continuation]\nstop_stretch = 1.3\n[solver]\ndegree = {degree}\n")
+    folds = [p.X[-1] for p in analyse(scene, pear=False).branches[0].special if p.kind.value == "LP"]
+    assert len(folds) == 1
+    return float(folds[0])
+
+
+def test_a_long_capsule_starts_bulging_at_the_long_tubes_onset():
+    """SPOM1: the capsule's pressure maximum (where its middle starts to bulge: the caps hold the cylinder's ends
+    as plugs do, so the bulge is the even mode, a fold in P) at L = 10, 20, 40, degrees 64 and 96 (the tracer
+    keeps solver.degree on a capsule: analysis/resolution.py). It lies above the long tube's pressure maximum P*
+    (model/tube, Yu & Fu's condition) and falls onto it faster than 1/L² (gap ratio > 5 per doubling of L); at
+    L = 40 within 1e-3 of P* and of the onset of a sliding tube of length 40 (model/tube.bulge_onset, its
+    dispersion relation). Measured: gaps 1.58e-2, 2.18e-3, 2.22e-4; degrees 64 and 96 within 7e-7."""
+    material = capsule_scene(0.0).material
+    peak, onset = tube.pressure_maximum(material).pressure, tube.bulge_onset(material, 40.0).pressure
+    gaps = []
+    for length in (10.0, 20.0, 40.0):
+        coarse, fine = pressure_maximum(length, 64), pressure_maximum(length, 96)
+        assert abs(coarse - fine) < 1e-6
+        gaps.append(fine - peak)
+    assert all(gap > 0 for gap in gaps) and gaps[0] / gaps[1] > 5 and gaps[1] / gaps[2] > 5
+    assert gaps[2] < 1e-3 and abs(fine - onset) < 1e-3
+
+
+@pytest.mark.slow
+def test_a_long_capsule_propagates_its_bulge_at_maxwells_pressure():
+    """SPOM1 capsule of length 40 at degree DEGREE, its primary branch under pressure control to pole stretch 3:
+    past its fold the middle bulges and the bulge widens, its two fronts moving towards the caps. Where both fronts
+    are far from the caps and from each other (200 ≤ V/V0 ≤ 600, V0 = 40π + 4π/3) P is within 1e-4 of Maxwell's
+    pressure (model/tube.maxwell_pressure, checked against the equal-area rule in tests/test_tube.py); beyond
+    V/V0 ≈ 700 the fronts reach the caps and P rises (docs/shapes.md has the table)."""
+    scene = capsule_scene(40.0, "[continuation]\nstop_stretch = 3.0\nmax_points = 3000\nstep_max = 1.0\n"
+                                f"[solver]\ndegree = {DEGREE}\n")
+    branch = analyse(scene, pear=False).branches[0]
+    fold = next(i for i, p in enumerate(branch.special) if p.kind.value == "LP")
+    assert abs(branch.special[fold].X[-1] - tube.pressure_maximum(scene.material).pressure) < 1e-3
+    maxwell, _, _ = tube.maxwell_pressure(scene.material)
+    eq = Equilibrium(scene, branch.disc)
+    volume = np.array([2 * np.pi * eq.volume(x[:-1]) for x in branch.X]) / (40 * np.pi + 4 * np.pi / 3)
+    plateau = (volume >= 200) & (volume <= 600)
+    assert plateau.sum() > 50 and np.all(np.diff(volume[plateau]) > 0)
+    assert np.abs(branch.X[plateau, -1] - maxwell).max() <= 1e-4
+
+
+def test_volume_control_measures_the_capsules_volume():
+    """SPOM1 capsule of length 10 (degree 64) under volume control with stop_volume = 4 V0 (V0 = 10π + 4π/3): past
+    its pressure fold the branch lands on the stop, where the enclosed volume written here, π∫ρ²(−η') dθ with
+    ρ = λ2 R and the capsule's R(θ) written here (composite Gauss–Legendre in θ, 200 nodes on each cap and on the
+    cylinder), is the stop to 1e-9; the sphere's volume formula (ρ = λ2 sin θ) misses it by more than 1 %. The
+    pressure fold is no fold of V: the points beside it are stable under volume control."""
+    V0 = 10 * np.pi + 4 * np.pi / 3
+    scene = capsule_scene(10.0, f"[continuation]\nstop_stretch = 3.0\n[solver]\ndegree = 64\n"
+                                f"[loading]\ncontrol = \"volume\"\nstop_volume = {4 * V0!r}\n")
+    branch = analyse(scene, pear=False).branches[0]
+    assert branch.stop_reason.startswith("up: reached stop_volume")
+    kappa = 1 + 10 / np.pi
+    joint = np.pi / (2 * kappa)
+    nodes, weights = np.polynomial.legendre.leggauss(200)
+    theta, dtheta = [], []
+    for a, b in ((0.0, joint), (joint, np.pi - joint), (np.pi - joint, np.pi)):
+        theta.append((b - a) / 2 * nodes + (a + b) / 2)
+        dtheta.append((b - a) / 2 * weights)
+    theta, dtheta = np.concatenate(theta), np.concatenate(dtheta)
+    R = np.where(kappa * theta < np.pi / 2, np.sin(kappa * theta),
+                 np.where(kappa * (np.pi - theta) < np.pi / 2, np.sin(kappa * (np.pi - theta)), 1.0))
+    lam2, _, _, deta = branch.disc.evaluate(branch.X[-1, :-1], theta)
+    volume = np.pi * dtheta @ ((lam2 * R) ** 2 * -deta)
+    sphere_formula = np.pi * dtheta @ ((lam2 * np.sin(theta)) ** 2 * -deta)
+    assert abs(volume - 4 * V0) <= 1e-9 * 4 * V0
+    assert abs(sphere_formula - 4 * V0) > 1e-2 * 4 * V0
+    fold = next(p for p in branch.special if p.kind.value == "LP")
+    beside = [branch.stability[i] for i in (fold.index, fold.index + 1)]
+    assert all(a.stable_volume for a in beside) and not all(a.stable_pressure for a in beside)
+
+
+def test_run_writes_the_capsules_profiles(tmp_path):
+    """``balloon-cg run`` on a capsule of length 10 (to pole stretch 1.05, before its fold) writes a run file whose
+    profiles measure from the capsule: ρ = λ2 R with R written here (1 on the cylinder, sin κθ on the caps), λ1
+    finite on the whole θ grid and equal to λ2 at the poles (isotropic there), 1e-10; ``inspect`` reads it."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.run_file import read_run
+
+    scene = tmp_path / "capsule.toml"
+    scene.write_text(CAPSULE.format(length=10.0) + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
+    path = tmp_path / "capsule.h5"
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    assert main(["inspect", str(path)]) == 0
+    branch = read_run(path)["branches"]["primary"]
+    profiles, theta = branch["profiles"], branch["theta"]
+    kappa = 1 + 10 / np.pi
+    R = np.where(kappa * theta < np.pi / 2, np.sin(kappa * theta),
+                 np.where(kappa * (np.pi - theta) < np.pi / 2, np.sin(kappa * (np.pi - theta)), 1.0))
+    assert np.abs(profiles["rho"] - profiles["lam2"] * R).max() < 1e-10
+    assert np.all(np.isfinite(profiles["lam1"]))
+    assert np.abs(profiles["lam1"][:, [0, -1]] - profiles["lam2"][:, [0, -1]]).max() < 1e-10
+
+
+def test_capsule_table_errors_name_key_value_and_range():
+    for extra, words in [
+        ('[geometry]\nshape = "capsule"\n', "geometry.length: missing"),
+        ('[geometry]\nshape = "capsule"\nlength = -1\n', "geometry.length = -1"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\naspect = 2\n', "geometry.aspect = 2"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\nends = "plugged"\n', "geometry.ends"),
+        ('[geometry]\nshape = "spheroid"\naspect = 2\nlength = 5\n', "geometry.length = 5"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 1\n', "stability.m_max = 1"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[electric]\nvoltage = 0.1\n',
+         "[electric]"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
+         '[[field.coils]]\nradius = 3.0\nheight = 0.0\ncurrent = 1.0\n', "coils"),
+    ]:
+        with pytest.raises(SceneError) as error:
+            parse_scene('[material]\npreset = "SPOM1"\n' + extra)
+        assert words in str(error.value) and "\n" not in str(error.value)
+    scene = capsule_scene(5.0)
+    assert scene.geometry.to_table() == {"shape": "capsule", "length": 5.0}
+    assert scene.geometry.describe() == "capsule of length 5"
