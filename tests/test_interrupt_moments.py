@@ -117,10 +117,12 @@ def interrupted_file(path: Path, line: str) -> str:
 
 @pytest.mark.parametrize("k", range(FAST_MOMENTS))
 def test_a_signal_at_an_evenly_spaced_moment_of_a_run(fast, k):
-    """The cheap two-coil scene, moment k of 5 (SIGINT and SIGTERM in turn); each rerun equals the reference."""
+    """The cheap two-coil scene, moment k of 5 (SIGINT and SIGTERM in turn). The rerun is checked at the first and the
+    last moment (as the slow test does at one: it replaces the interrupted file without reading it, so every
+    moment's rerun is the same computation; the two ends leave the least and the most of a file behind)."""
     folder, scene, run, expected = fast
     code, _ = interrupted_run(folder, scene, run, expected, evenly(run.run_cpu, FAST_MOMENTS)[k], SIGNALS[k % 2],
-                              again=True)
+                              again=k in (0, FAST_MOMENTS - 1))
     assert code in (0, 130)
 
 
