@@ -89,12 +89,13 @@ KEPT = "balloon-cg: interrupted: the finished members are stored; re-run the sam
 
 @pytest.mark.parametrize("sig, moment, at_call, code, line", [
     ("SIGTERM", "after balloon_cg.io.sweep_file:Store.write_member", 2, 130, KEPT),  # the last member stored
-    ("SIGINT", "after balloon_cg.app.sweep:consolidate", 1, 130, KEPT),  # the view rebuilt
+    ("SIGINT", "after balloon_cg.io.sweep_file:View.catch_up", 2, 130, KEPT),  # the view finishing (its table)
+    ("SIGTERM", "after balloon_cg.io.sweep_file:View.finish", 1, 130, KEPT),  # the view finished, not renamed
     ("SIGTERM", "after balloon_cg.app.sweep:run_sweep", 1, 130, KEPT),
     ("SIGINT", "after balloon_cg.app.cli:main", 1, 130, "balloon-cg: error: interrupted"),  # before run has it
     ("SIGINT", "after balloon_cg.__main__:_over", 1, 0, "balloon-cg: SIGINT after the work had finished: exit 0"),
     ("SIGTERM", "at exit", 1, 0, None),
-], ids=["last member stored", "view rebuilt", "sweep returned", "command returning", "command over",
+], ids=["last member stored", "view finishing", "view finished", "sweep returned", "command returning", "command over",
         "python exiting"])
 def test_a_signal_at_the_end_of_a_sweep_exits_130_or_0_and_says_so(scene_folder, tmp_path, sig, moment, at_call,
                                                                     code, line):
