@@ -3,7 +3,8 @@ CPU time spent by the command (``setitimer(ITIMER_PROF)``: the process's CPU, al
 one member in its worker), so it lands anywhere in the work (inside a LAPACK call, a write, a pool wait) and at the
 same place of the work on an idle or a loaded machine, where a wall-clock sleep would not. The timer is armed at a
 mark of the work: a phase of the run's clock entered or a point done (``anchored``: the last mark before the
-moment in a reference run), a sweep member started (``in_members``), the command's handler called (``handled``).
+moment in a reference run), a sweep member started (``in_members``), a function called (``handled``: the command's
+handler, or the n-th call of a unit of the work).
 The latency is measured in the same clock: the command's CPU time from the moment (the timer's expiry; in a
 sweep, the signal's receipt) to Python's last atexit handler; its wall time is recorded beside it (a loaded
 machine stretches it, so it is no pass criterion).
@@ -135,19 +136,23 @@ def timed_member(index, *args):
 
 
 sweep.compute_member = timed_member
-if where.startswith("call "):  # the timer armed as the command's handler is called (after the imports)
-    module, _, name = where.removeprefix("call ").partition(":")
-    module = importlib.import_module(module)
-    handler = getattr(module, name)
+if where.startswith("call "):  # the timer armed as the n-th call of a function begins (after the imports)
+    target, _, nth = where.removeprefix("call ").partition("@")
+    module, _, name = target.partition(":")
+    owner, _, attribute = name.rpartition(".")
+    holder = importlib.import_module(module)
+    holder = getattr(holder, owner) if owner else holder
+    handler, calls = getattr(holder, attribute), [0]
 
     @functools.wraps(handler)
     def called(*args, **kwargs):
-        if record["call_cpu"] is None:
+        calls[0] += 1
+        if calls[0] == int(nth or 1):
             record["call_cpu"] = time.process_time()
             arm()
         return handler(*args, **kwargs)
 
-    setattr(module, name, called)
+    setattr(holder, attribute, called)
 sys.argv = ["balloon-cg", *argv]
 sys.exit(run())
 '''
@@ -238,11 +243,11 @@ def anchored(reference: Moment, t: float) -> tuple[tuple, str]:
     return (f"mark {marks}", at - since), (open_phases[-1] if open_phases else "")
 
 
-def handled(handler: str, t: float = float("inf")) -> tuple:
-    """The moment ``t`` CPU seconds after the command's handler (``module:function``, e.g.
-    ``balloon_cg.app.cli:continue_run``) is called: for commands without a run's clock (the default: never, the
-    call's CPU noted for a reference)."""
-    return f"call {handler}", t
+def handled(handler: str, t: float = float("inf"), call: int = 1) -> tuple:
+    """The moment ``t`` CPU seconds after the ``call``-th call of ``handler`` (``module:function`` or
+    ``module:Class.method``, e.g. ``balloon_cg.app.cli:continue_run``) begins: for commands without a run's clock
+    (the default: never, the call's CPU noted for a reference), or a moment in a given unit of the work."""
+    return f"call {handler}@{call}", t
 
 
 def in_members(reference: Moment, t: float) -> tuple:

@@ -146,3 +146,42 @@ def test_the_entry_points_catch_sigterm_before_importing_the_cli():
              "run()\n")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
     assert out.stdout.splitlines()[0] == "True", out
+
+
+@pytest.mark.parametrize("method", ["assess", "flags"])
+def test_a_stop_while_a_point_s_blocks_are_built_comes_before_their_eigenvalues(monkeypatch, method):
+    """A point's blocks cost up to ~1 s of CPU on two coils at the check degree: a stop asked for while the first
+    point of ``method`` builds them (``SecondVariation.blocks``) raises Interrupted before any of its blocks is solved
+    (``assess``, the first pass: their eigenvalues; ``flags``, the check-degree pass: their Cholesky test)."""
+    from balloon_cg.analysis import stability
+    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.numerics import eigen, workers
+
+    branch = trace_primary(load_scene("spom1").with_overrides({"continuation.stop_stretch": 2.0}))
+    blocks, run = stability.SecondVariation.blocks, getattr(stability.SecondVariation, method)
+    lowest, definite = stability.merged_lowest, eigen.positive_definite
+    inside, solved = [], []
+
+    def asked(self, *args, **kwargs):
+        out = blocks(self, *args, **kwargs)
+        if inside and not interrupt.requested():
+            interrupt.request()  # as the signal's handler does, as the first point of ``method`` builds its blocks
+        return out
+
+    def entered(self, *args, **kwargs):
+        inside.append(1)
+        return run(self, *args, **kwargs)
+
+    def solving(solve):
+        def counted(*args, **kwargs):
+            solved.append(interrupt.requested())
+            return solve(*args, **kwargs)
+        return counted
+
+    monkeypatch.setattr(stability.SecondVariation, "blocks", asked)
+    monkeypatch.setattr(stability.SecondVariation, method, entered)
+    monkeypatch.setattr(stability, "merged_lowest", solving(lowest))
+    monkeypatch.setattr(eigen, "positive_definite", solving(definite))
+    with interrupt.stop_on_signals(), workers.serial(), pytest.raises(interrupt.Interrupted):
+        stability.assess_branch(branch, branch.scene.stability.degree, check=True)
+    assert len(inside) == 1 and True not in solved  # the point's blocks built, none solved after the request

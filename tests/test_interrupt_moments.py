@@ -227,6 +227,28 @@ def test_a_signal_at_an_evenly_spaced_moment_of_a_whole_sweep(whole_sweep, k):
                              SIGNALS[k % 2], f"w{k}.h5") in (0, 130)
 
 
+LONG_SWEEP = 150  # members: rebuilding the view of 145 of them whole (as every interrupted sweep did before it was
+#                   built member by member) took 3.1-3.5 s of CPU here (0.021 s a member unchecked), past LATENCY
+
+
+def test_a_signal_late_in_a_long_sweep_costs_at_most_one_member_of_its_view(tmp_path):
+    """LONG_SWEEP cheap members (SPOM1's primary branch to a pole stretch of 1.1 .. 1.3: a member's file holds ~50
+    datasets) on 2 workers, SIGTERM as the parent begins copying member LONG_SWEEP − 5 into the view (the moment: the
+    call of ``View.add``, 1 ms of CPU into it): the parent stops within LATENCY of its CPU (the view gets at most the
+    member being copied and its table), exit 130 with the line, and the view holds exactly the stored members."""
+    from balloon_cg.io.sweep_file import store_path
+
+    (tmp_path / "s.toml").write_text(SWEEP_SCENE)
+    argv = ["sweep", "s.toml", "--vary", f"stop_stretch=1.1:1.3:{LONG_SWEEP}", "--primary-only", "--workers", "2",
+            "-o", "w.h5", "--quiet"]
+    got = command(tmp_path, argv, "SIGTERM", handled("balloon_cg.io.sweep_file:View.add", 0.001, LONG_SWEEP - 5))
+    assert got.fired and got.code == 130 and one_line(got.stderr) == KEPT, (got.code, got.stderr)
+    print(f"after the signal {got.cpu_after:.3f} s CPU, {got.wall_after:.3f} s wall")
+    assert got.cpu_after <= LATENCY, got.cpu_after
+    stored = sorted(int(p.stem) for p in store_path(tmp_path / "w.h5").glob("0*.h5"))
+    assert len(stored) >= LONG_SWEEP - 5 and sorted(bc.load(tmp_path / "w.h5").members) == stored
+
+
 # --- continue and critical ---------------------------------------------------------------------------------
 
 HANDLED_MOMENTS = 4

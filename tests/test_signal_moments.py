@@ -65,13 +65,21 @@ def one_line(err: str) -> str:
 SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 1.4\n'
 
 
+NOT_STARTED = "balloon-cg: interrupted: nothing is written to r.h5 (the work had not started)"
+
+
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("moment", ["import balloon_cg.app.cli", "import numpy", "import balloon_cg.scene",
-                                    "after argparse:ArgumentParser.parse_known_args", "import balloon_cg.analysis.picture"])
-def test_a_signal_at_start_up_exits_130_in_one_line(tmp_path, sig, moment):
+@pytest.mark.parametrize("moment, line", [
+    ("import balloon_cg.app.cli", "balloon-cg: error: interrupted"),
+    ("import numpy", "balloon-cg: error: interrupted"),
+    ("import balloon_cg.scene", "balloon-cg: error: interrupted"),
+    ("after argparse:ArgumentParser.parse_known_args", "balloon-cg: error: interrupted"),
+    ("import balloon_cg.analysis.picture", NOT_STARTED),  # imported as the scene loads: run's contract from there
+])
+def test_a_signal_at_start_up_exits_130_in_one_line(tmp_path, sig, moment, line):
     (tmp_path / "s.toml").write_text(SCENE)
     code, err = balloon_cg(tmp_path, sig, moment, ["run", "s.toml", "-o", "r.h5", "--quiet"])
-    assert code == 130 and one_line(err) == "balloon-cg: error: interrupted", (code, err)
+    assert code == 130 and one_line(err) == line, (code, err)
     assert not (tmp_path / "r.h5").exists()
 
 
@@ -89,12 +97,13 @@ KEPT = "balloon-cg: interrupted: the finished members are stored; re-run the sam
 
 @pytest.mark.parametrize("sig, moment, at_call, code, line", [
     ("SIGTERM", "after balloon_cg.io.sweep_file:Store.write_member", 2, 130, KEPT),  # the last member stored
-    ("SIGINT", "after balloon_cg.app.sweep:consolidate", 1, 130, KEPT),  # the view rebuilt
+    ("SIGINT", "after balloon_cg.io.sweep_file:View.catch_up", 2, 130, KEPT),  # the view finishing (its table)
+    ("SIGTERM", "after balloon_cg.io.sweep_file:View.finish", 1, 130, KEPT),  # the view finished, not renamed
     ("SIGTERM", "after balloon_cg.app.sweep:run_sweep", 1, 130, KEPT),
     ("SIGINT", "after balloon_cg.app.cli:main", 1, 130, "balloon-cg: error: interrupted"),  # before run has it
     ("SIGINT", "after balloon_cg.__main__:_over", 1, 0, "balloon-cg: SIGINT after the work had finished: exit 0"),
     ("SIGTERM", "at exit", 1, 0, None),
-], ids=["last member stored", "view rebuilt", "sweep returned", "command returning", "command over",
+], ids=["last member stored", "view finishing", "view finished", "sweep returned", "command returning", "command over",
         "python exiting"])
 def test_a_signal_at_the_end_of_a_sweep_exits_130_or_0_and_says_so(scene_folder, tmp_path, sig, moment, at_call,
                                                                     code, line):
@@ -109,3 +118,26 @@ def test_a_signal_at_the_end_of_a_sweep_exits_130_or_0_and_says_so(scene_folder,
     assert sorted(bc.load(folder / "w.h5").members) == [0, 1]  # both members stored and in the view
     again, err = balloon_cg(folder, "SIGTERM", "never", SWEEP)  # no signal
     assert again == 0 and err == "", err
+
+
+LOADS = {"run": ["run", "s.toml", "-o", "out.h5", "--quiet"],
+         "critical": ["critical", "s.toml", "--parameter", "alpha1", "-o", "out.h5", "--quiet"]}
+
+
+@pytest.mark.parametrize("command, moment, sig", [
+    ("run", "after balloon_cg.scene.tables:_read_text", "SIGINT"),  # the scene file read, not parsed
+    ("run", "after balloon_cg.app.cli:configured", "SIGTERM"),  # the scene and its settings loaded
+    ("critical", "after balloon_cg.scene.tables:_read_text", "SIGTERM"),
+    ("critical", "after balloon_cg.app.cli:configured", "SIGINT"),
+    ("critical", "after balloon_cg.analysis.second_parameter:resolve", "SIGTERM"),  # its kernels bound
+])
+def test_a_signal_while_the_scene_loads_writes_nothing_and_says_so(tmp_path, command, moment, sig):
+    """`run` and `critical` load their scene (and `critical` its kernels) under the interrupt contract of the work
+    (numerics.interrupt.stop_on_signals, as `continue` reads its file): the signal only sets the flag, so no
+    KeyboardInterrupt is raised where a finalizer (h5py's) could swallow it (a traceback and exit 0), and the command
+    exits 130 saying nothing is written, and writes nothing."""
+    (tmp_path / "s.toml").write_text(SCENE)
+    code, err = balloon_cg(tmp_path, sig, moment, LOADS[command])
+    assert code == 130, (code, err)
+    assert one_line(err) == "balloon-cg: interrupted: nothing is written to out.h5 (the work had not started)", err
+    assert not (tmp_path / "out.h5").exists() and not list(tmp_path.glob(".out.h5*"))

@@ -7,6 +7,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 
 from balloon_cg.analysis import surface_assessment
@@ -114,3 +115,61 @@ def test_run_of_two_coils_interrupted_in_its_surface_branches(tmp_path):
         assert not f.attrs["complete"] and "interrupted" in list(f.attrs["incomplete_gaps"])
         assert list(f["branches/m1_bp1"].attrs["leg_stop_codes"]) == ["interrupted"]
         assert "stability" not in f["branches/m1_bp1"]
+
+
+def test_a_signal_inside_a_point_s_spectra_stops_at_its_next_sector(pear_point, monkeypatch):
+    """A point's spectra are read one symmetry sector at a time (a large two-coil point: ~2 s of CPU for all of
+    them); a signal as the first sector of the first point is assembled stops the assessment before that sector's
+    eigenvalues (``surface.stability.sector_spectra`` polls at each sector): no other sector is read."""
+    primary, bp = pear_point
+    sectors = surface_assessment.surface_stability._sectors
+
+    def reading(signal: bool) -> list:
+        """The sectors assembled, per call of sector_spectra (a point), while the branch is assessed; with
+        ``signal`` the stop is requested as the first sector is assembled."""
+        calls = []
+
+        def counted(*args, **kwargs):
+            calls.append(0)
+            for sector in sectors(*args, **kwargs):
+                calls[-1] += 1
+                if signal and calls == [1]:
+                    interrupt.request()
+                yield sector
+
+        monkeypatch.setattr(surface_assessment.surface_stability, "_sectors", counted)
+        with interrupt.stop_on_signals(), workers.serial():
+            branch = trace_surface(primary, 0, bp, 1.0, "m1", 6)
+        return calls, branch
+
+    whole, _ = reading(False)
+    calls, branch = reading(True)
+    assert whole[0] >= 3  # a point has several sectors: stopping in the first cuts it short
+    assert calls == [1]  # the first sector assembled, its eigenvalues not computed, no other
+    assert branch.stability == {} and [s.kind.value for s in branch.special] == ["BP", "EP"]  # as traced
+
+
+def test_a_signal_as_a_surface_branch_would_refine_stops_it_there(pear_point, monkeypatch):
+    """A point whose tail exceeds solver.max_error refines the basis, solves the last point again and goes on (~1 s
+    of CPU on two coils before the next point's poll): a signal then stops the branch where it is, not refined
+    (the third point's tail made to exceed max_error as the signal comes)."""
+    from balloon_cg.analysis import surface_branches
+
+    primary, bp = pear_point
+    tail, refine, tails, refined = surface_branches.tail, surface_branches.refined, [], []
+
+    def exceeding(basis, c):
+        tails.append(1)
+        if len(tails) == 3:
+            interrupt.request()
+            return np.inf
+        return tail(basis, c)
+
+    monkeypatch.setattr(surface_branches, "tail", exceeding)
+    monkeypatch.setattr(surface_branches, "refined",
+                        lambda *args: refined.append(interrupt.requested()) or refine(*args))
+    with interrupt.stop_on_signals():
+        branch = trace_surface(primary, 0, bp, 1.0, "m1", 40)
+    assert True not in refined and branch.legs[0].stop.code == StopCode.INTERRUPTED  # no refinement after it
+    assert len(branch.values) == 4  # the branch point, the first step off it and the two points before the third
+    assert [item.gap for item in incomplete([branch])] == [Gap.INTERRUPTED]

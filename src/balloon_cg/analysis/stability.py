@@ -277,6 +277,7 @@ class SecondVariation:
         equilibrium (``blocks``)."""
         blocks, lowest = {}, [np.inf] * len(FLAGS)
         for name, parts, flags in self.blocks(u, params, symmetric, m_max):
+            interrupt.check()  # a signal: Interrupted at the next block (assess_branch's callers catch it)
             blocks[name] = merged_lowest(parts, LOWEST)
             for flag in flags:
                 lowest[flag] = min(lowest[flag], blocks[name][0])
@@ -288,6 +289,7 @@ class SecondVariation:
         it enters has failed."""
         stable = [True] * len(FLAGS)
         for _, parts, flags in self.blocks(u, params, symmetric, m_max):
+            interrupt.check()  # as assess
             if any(stable[flag] for flag in flags) and not all(eigen.positive_definite(A) for A in parts):
                 for flag in flags:
                     stable[flag] = False

@@ -129,6 +129,7 @@ def _negative_counts(trace, c, params, lowest: dict) -> dict:
     for key, values in lowest.items():
         counts[key] = int((values < 0).sum())
         if counts[key] == values.size:
+            interrupt.check()
             held = surface_stability.Reading(True)
             A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), (key,))[held][key]
             counts[key] = eigen.negative_count(A)
@@ -153,6 +154,7 @@ def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, e
         return np.append(c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis), value)
 
     def value_at(s):
+        interrupt.check()  # each evaluation is a Newton solve and a sector's eigenvalues (~0.5 s on two coils)
         result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
         if not result.converged:
             raise ArithmeticError(result.message)

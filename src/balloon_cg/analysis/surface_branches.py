@@ -188,6 +188,9 @@ def pole_stop(code: StopCode, upper: float) -> Stop:
     return Stop(code, f"{pole} pole stretch reached stop_stretch {upper:g}")
 
 
+INTERRUPTED = Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
+
+
 def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
     """stop(point) -> Stop or None (module docstring); ``rejoin`` (φ, X*): the branch ends where it crosses the
     hyperplane of its branch point back (None: a primary branch); StopCode.RESOLUTION when a tail exceeds
@@ -197,7 +200,7 @@ def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
 
     def stop(point):
         if interrupt.requested():  # SIGINT/SIGTERM: the points so far are kept (numerics.interrupt)
-            return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
+            return INTERRUPTED
         if rejoin is not None and rejoin[0] @ (point.X - rejoin[1]) < 0:
             return Stop(StopCode.REJOINED, "rejoined the branch it was born on")
         c = trace.system.coefficients(point.X)
@@ -293,7 +296,8 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
     extended), the last point is solved again there on the hyperplane through it normal to its tangent (at fixed P
     the bordered Jacobian is near-singular where the branch is tangent to P = const: the free m = 1 branch of the
     off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest singular value
-    1.3e-6 at fixed P, 1.0e-3 on that hyperplane) and the trace goes on. Returns (the last trace, the segments
+    1.3e-6 at fixed P, 1.0e-3 on that hyperplane) and the trace goes on (a signal before the refinement or during
+    it: the stop INTERRUPTED, the points so far kept). Returns (the last trace, the segments
     [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop)."""
     scene = trace.scene
     segments, folds = [(trace, list(points))], []
@@ -311,6 +315,8 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
             stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
             return trace, segments, folds, stop
+        if interrupt.requested():  # not refined (a refinement and its first step: ~1 s of CPU on two coils)
+            return trace, segments, folds, INTERRUPTED
         c = trace.system.coefficients(path.overshoot.X)
         target = remapped(trace.basis, c, scene.field.coils)
         finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target),
@@ -325,8 +331,10 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
         across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
         X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
                    scene.solver.max_newton)
-        if not X.converged:
+        if not X.converged or interrupt.requested():
             segments[-1][1].append(last)
+            if X.converged:  # a signal while the point was solved again: the trace not gone on
+                return trace, segments, folds, INTERRUPTED
             stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
                                                 f"{finer.order}): {X.message}")
             return trace, segments, folds, stop

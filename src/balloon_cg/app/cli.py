@@ -320,26 +320,33 @@ def axisymmetric(scene, command: str):
 
 def run(args) -> int:
     """Analyse, write, read back and summarise; exit 130 when a signal stopped the work (what is finished is written,
-    flagged interrupted: the message is the file's), or the run's own status when it had finished (and says so)."""
-    from ..io.run_file import read_run
+    flagged interrupted: the message is the file's; a signal while the scene loaded: nothing is written), or the
+    run's own status when it had finished (and says so). From the scene's load on a signal only sets the flag
+    (``stop_on_signals``, as ``continue``): no KeyboardInterrupt is raised that a finalizer could swallow."""
     from ..numerics.interrupt import requested, stop_on_signals
-    from .progress import shown
 
-    scene, stem = configured(args)
-    output = default_output(args.output, stem, "run")
-    if scene.geometry.shape == "tube":
-        return run_tube(scene, output, args)
     with stop_on_signals():
-        _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
-                             primary_only=args.primary_only)
-        signalled = requested()
+        from ..io.run_file import read_run
+        from .progress import shown
+
+        scene, stem = configured(args)
+        output = default_output(args.output, stem, "run")
+        if requested():  # while the scene loaded: nothing computed
+            return curve_interrupted_status(None, output, True, "the work had not started")
+        if scene.geometry.shape != "tube":
+            _, found = run_scene(scene, output, args.force, progress=shown(args.quiet), command=args.command_line,
+                                 primary_only=args.primary_only)
+            summary = None if args.quiet or requested() else read_run(output)
+            signalled = requested()
+    if scene.geometry.shape == "tube":
+        return run_tube(scene, output, args)  # its pipeline stops by KeyboardInterrupt (tube/ polls no flag yet)
     code = interrupted_status(found, output, signalled)
     if code is not None:
         return code
-    if not args.quiet:
+    if summary is not None and not signalled:
         from .summaries import format_run
 
-        print(format_run(read_run(output)))
+        print(format_run(summary))
     return verdict_status(found, args.allow_partial)
 
 
@@ -764,25 +771,30 @@ def critical(args) -> int:
     Progress goes to stderr (``--quiet``: none).
     """
     from ..io.lock import claim
+    from ..numerics.interrupt import requested, stop_on_signals
 
-    scene, stem = configured(args)
-    axisymmetric(scene, "critical")
-    short = re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
-    if scene.geometry.shape == "tube":
-        return critical_tube(scene, default_output(args.output, f"{stem}_critical_{short}", "tube"), args)
-    args.output = default_output(args.output, f"{stem}_critical_{short}", "curve")
-    with claim(args.output, "critical"):  # owned from here: no other process writes it meanwhile
-        return _critical(args, scene)
+    with stop_on_signals():  # from the scene's load on, as run
+        scene, stem = configured(args)
+        axisymmetric(scene, "critical")
+        short = re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
+        if scene.geometry.shape != "tube":
+            args.output = default_output(args.output, f"{stem}_critical_{short}", "curve")
+            with claim(args.output, "critical"):  # owned from here: no other process writes it meanwhile
+                return _critical(args, scene)
+        output = default_output(args.output, f"{stem}_critical_{short}", "tube")
+        if requested():  # while the scene loaded: nothing computed
+            return curve_interrupted_status(None, output, True, "the work had not started")
+    return critical_tube(scene, output, args)  # its pipeline stops by KeyboardInterrupt (tube/ polls no flag yet)
 
 
 def _critical(args, scene) -> int:
-    """``critical`` on ``scene`` into ``args.output`` (owned)."""
+    """``critical`` on ``scene`` into ``args.output`` (owned, under ``stop_on_signals``)."""
     from ..analysis.codim2 import CODIM2_ENDS, CurveEnd
     from ..analysis.results import Status
     from ..analysis.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
     from ..io.output import check_output
-    from ..numerics.interrupt import Interrupted, requested, stop_on_signals
+    from ..numerics.interrupt import Interrupted, requested
     from ..scene import ContinuationParameter
 
     asymmetry = _asymmetry(scene)
@@ -798,16 +810,16 @@ def _critical(args, scene) -> int:
     except UnknownParameter as e:
         raise UsageError(f"critical --parameter {args.parameter}: {args.scene}: {e}") from None
     check_output(args.output, args.force)
-    with stop_on_signals():
-        try:
-            curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
-        except Interrupted:  # in a unit that polls inside (a plain degree's search) before the curve started
-            curve = None
-        if curve is not None:
-            write_curve(args.output, scene, curve, name=curve_group(curve), force=args.force,
-                        extra_attrs={"command": args.command_line})
-        signalled = requested()
-    code = curve_interrupted_status(curve, args.output, signalled)  # what the file says, not the flag
+    if requested():  # while the scene and its kernels loaded: nothing computed
+        return curve_interrupted_status(None, args.output, True, "the work had not started")
+    try:
+        curve = (_pitchfork_curve if args.of == "BP" else _fold_curve)(scene, args)
+    except Interrupted:  # in a unit that polls inside (a plain degree's search) before the curve started
+        curve = None
+    if curve is not None:
+        write_curve(args.output, scene, curve, name=curve_group(curve), force=args.force,
+                    extra_attrs={"command": args.command_line})
+    code = curve_interrupted_status(curve, args.output, requested())  # what the file says, not the flag
     if code is not None:
         return code
     _say(args, f"curve: {len(curve.q)} points, ended: {curve.end.value}")

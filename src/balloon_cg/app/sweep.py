@@ -32,7 +32,7 @@ from ..analysis.verdict import incomplete
 from ..dynamics.frequencies import attach
 from ..io.lock import claim
 from ..io.output import check_output
-from ..io.sweep_file import (SweepError, commit_replacement, consolidate, open_store, read_store, root_attrs,
+from ..io.sweep_file import (SweepError, commit_replacement, open_store, read_store, rebuilding, root_attrs,
                              store_path)
 from ..numerics import interrupt, workers
 from ..numerics.hygiene import worker_hygiene
@@ -292,25 +292,26 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
         result = SweepResult(path, members, mode, store.directory, skipped=sorted(store.done))
         todo = [m for m in members if m.index not in store.done]
         by_index = {m.index: m for m in members}
-        try:
-            with auto_tqdm()(total=len(members), initial=len(store.done), desc="sweep", unit=" members",
-                             disable=tqdm_disable(progress), file=sys.stderr) as bar:
-                with contextlib.closing(_compute(todo, mode, workers, scheduler)) as outcomes:
-                    for index, outcome in outcomes:
-                        if isinstance(outcome, BaseException):
-                            result.failed[index] = f"{type(outcome).__name__}: {outcome}"
-                        else:
-                            store.write_member(by_index[index], outcome)
-                            result.computed.append(index)
-                        bar.update()
-        finally:
-            if not force:
-                consolidate(path, store.directory, written=set(result.computed))
-            elif len(store.done) == len(members):
-                commit_replacement(path)
-                result.store = store_path(path)
-            else:
-                result.replaced = False
+        with rebuilding(path, store.directory, trusted=store.done, kept=not force) as view:
+            try:
+                with auto_tqdm()(total=len(members), initial=len(store.done), desc="sweep", unit=" members",
+                                 disable=tqdm_disable(progress), file=sys.stderr) as bar:
+                    with contextlib.closing(_compute(todo, mode, workers, scheduler)) as outcomes:
+                        for index, outcome in outcomes:
+                            if isinstance(outcome, BaseException):
+                                result.failed[index] = f"{type(outcome).__name__}: {outcome}"
+                            else:
+                                store.write_member(by_index[index], outcome)
+                                view.add(index)
+                                result.computed.append(index)
+                            bar.update()
+            finally:
+                if force and len(store.done) == len(members):  # the new sweep complete: it replaces the old
+                    view.finish()
+                    commit_replacement(path)
+                    view.kept, result.store = True, store_path(path)
+                elif force:
+                    result.replaced = False
     result.wall_time = time.perf_counter() - start
     return result
 

@@ -86,3 +86,34 @@ def sigterm_raises():
 def stop_on_signals():
     """Turn SIGINT/SIGTERM into ``requested()`` for the duration."""
     return _handled_by(_handler)
+
+
+class Held:
+    """``with Held() as held: ... held.start() ...``: from ``start`` to the block's end SIGINT and SIGTERM only set the
+    flag (a second signal, the flag set, still raises KeyboardInterrupt at once); the block's end restores the handlers
+    and raises KeyboardInterrupt if a signal came meanwhile. For the last short steps of an output that must complete
+    once begun (a sweep's view: the member being copied, its table, its rename), whatever the handler around."""
+
+    def __init__(self):
+        self.previous, self.came = None, False
+
+    def __enter__(self):
+        return self
+
+    def start(self) -> None:
+        if threading.current_thread() is threading.main_thread():
+            self.previous = {s: signal.signal(s, self._hold) for s in SIGNALS}
+
+    def _hold(self, signum, frame):
+        if _flag.is_set():
+            raise KeyboardInterrupt
+        _flag.set()
+        self.came = True
+
+    def __exit__(self, kind, value, traceback):
+        if self.previous is not None:
+            for s, old in self.previous.items():
+                signal.signal(s, old)
+        if kind is None and self.came:
+            raise KeyboardInterrupt
+        return False

@@ -27,7 +27,7 @@ from .equilibrium import SurfaceEquilibrium
 from .gauge import FieldSymmetry
 from .measures import body_moments
 from ..galerkin.equilibrium import Parameters
-from ..numerics import eigen
+from ..numerics import eigen, interrupt
 from ..scene.loading import Control
 
 
@@ -147,9 +147,11 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
     (numerics.eigen.ShiftInvert.lowest_of_relatives). Without guesses, below FOLLOWING_SIZE, or without a
     shift below the spectrum, each reading's matrix is solved dense (numerics.eigen.lowest_of). ``only``: the
     characters of the sectors wanted (default all): each sector follows its own guesses alone, so the sectors of a
-    branch can be read apart (on different cores) with the same numbers."""
+    branch can be read apart (on different cores) with the same numbers. A signal (numerics.interrupt.check) raises
+    Interrupted before each sector and each dense reading."""
     out = {r: {} for r in readings}
     for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only):
+        interrupt.check()
         key, gram = sector.characters, sector.gram()
         previous = [guesses[r][key][0] for r in readings if guesses and key in guesses.get(r, {})]
         base_rows = min((rows for rows, _ in groups.values()), key=len)
@@ -166,6 +168,7 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
         for group, (rows, shared) in groups.items():
             values = found.get(group)
             if values is None:
+                interrupt.check()
                 values = eigen.lowest_of(_reading_matrix(H, gram, rows, group[1], g, weight), count)
             for r in shared:
                 out[r][key] = values
