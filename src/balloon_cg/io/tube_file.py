@@ -13,7 +13,9 @@ special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``vol
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
-under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``.
+under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
+stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
+started, and is absent where it had not), "" where the work is whole (files before it have none: read as "").
 """
 import math
 from pathlib import Path
@@ -47,6 +49,7 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
              "length": geometry.length, "ends": geometry.ends.value, "axial_stretch": held,
              "degree": primary.disc.degree, "quadrature": primary.disc.quadrature,
              "maxwell_pressure": math.nan if picture.maxwell is None else picture.maxwell,
+             "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
     with atomic_file(path, force) as f:
         f.attrs.update(attrs)
@@ -74,7 +77,7 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
             checksummed(special, "volume", np.array(volume, dtype=float))
             checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
             checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
-            checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), -1))
+            checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
         if picture.onset is not None:
             _write_onset(f.create_group("onset"), picture.onset)
     return Path(path)
@@ -106,7 +109,7 @@ def read_tube_run(path) -> dict:
         fmt = plain(f.attrs.get("format"))
         if fmt != FORMAT:
             raise TubeFileError(path, f"not a balloon-cg tube run file (format {fmt!r}, expected {FORMAT!r})")
-        attrs = {k: _text(plain(v)) for k, v in f.attrs.items()}
+        attrs = {"interrupted": ""} | {k: _text(plain(v)) for k, v in f.attrs.items()}
         if "branches" not in f or "primary" not in f["branches"]:
             raise TubeFileError(path, "no /branches/primary group")
         branches = {}
