@@ -30,6 +30,22 @@ class TubeResult:
 
     @classmethod
     def read(cls, path) -> "TubeResult":
+        """A tube run file, read and checked.
+
+        Parameters
+        ----------
+        path : str or Path
+            A tube run file (format ``balloon-cg-tube/1``).
+
+        Returns
+        -------
+        TubeResult
+
+        Raises
+        ------
+        FileError
+            Not a readable tube run file (io.tube_file.TubeFileError, one line naming the file and what is wrong).
+        """
         return cls(str(path), read_tube_run(path))
 
     @property
@@ -51,10 +67,27 @@ class TubeResult:
         return self.run["attrs"]["interrupted"] or None
 
     def to_dataframe(self, table: str = "points"):
-        """One tidy table: ``"points"`` (one row per point of every branch: branch, point, the per-point columns),
-        ``"special"`` (one row per located point: branch, kind, block, status, index, pressure, volume,
-        smallest_stress, crest_height) or ``"onset"`` (one row per point of the onset curve: the parameter under its
-        own name, pressure, volume, crest_height; KeyError without one). ValueError for another ``table``."""
+        """The file as one tidy table.
+
+        Parameters
+        ----------
+        table : str, optional
+            ``"points"`` (default): one row per point of every branch (branch, point, the per-point columns);
+            ``"special"``: one row per located point (branch, kind, block, status, index, pressure, volume,
+            smallest_stress, crest_height); ``"onset"``: one row per point of the onset curve of ``critical`` (the
+            parameter under its own name, pressure, volume, crest_height).
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ValueError
+            Another ``table``.
+        KeyError
+            ``"onset"`` of a file without an onset curve.
+        """
         pd = optional("pandas", "to_dataframe")
         if table == "onset":
             return pd.DataFrame(self._onset_columns()).rename_axis("point")
@@ -66,10 +99,29 @@ class TubeResult:
         return frame if table == "points" else frame.drop(columns="point")
 
     def to_xarray(self, branch: str = "primary", part: str = "points"):
-        """A branch as an xarray Dataset: ``part`` ``"points"`` (dims point, unknown: the per-point columns and
-        ``unknowns``, u of galerkin/interval.py) or ``"special"`` (dims special, unknown); ``branch`` ``"onset"``:
-        the onset curve of ``critical`` (dims point, unknown, mode). KeyError: no such branch; ValueError: another
-        part. The shape's parameters, Maxwell's pressure, the stop and the interruption are attributes."""
+        """A branch, or the onset curve, as an xarray Dataset; the shape's parameters, Maxwell's pressure, the stop
+        and the interruption are attributes.
+
+        Parameters
+        ----------
+        branch : str, optional
+            The branch's name (default ``"primary"``), or ``"onset"``: the onset curve of ``critical`` (dims point,
+            unknown, mode; ``part`` is not read).
+        part : str, optional
+            ``"points"`` (default): dims point, unknown (the per-point columns and ``unknowns``, u of
+            galerkin/interval.py), or ``"special"``: the located points, dims special, unknown.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        KeyError
+            No such branch (or no onset curve).
+        ValueError
+            Another ``part``.
+        """
         xr = optional("xarray", "to_xarray")
         attrs = {k: ("" if v is None else v) for k, v in self.geometry.items()}
         attrs |= {"maxwell_pressure": self.run["attrs"]["maxwell_pressure"],
