@@ -1,6 +1,6 @@
 """A tube run file in Python (``balloon_cg.load(tube)``, io/tube_file.py): its branches and the onset curve of
-``critical`` as tables (``to_dataframe``) and as xarray Datasets (``to_xarray``), the shape and its parameters, Maxwell's
-pressure and the stage a signal stopped (``interrupted``)."""
+``critical`` as tables (``to_dataframe``) and as xarray Datasets (``to_xarray``), the shape and its parameters,
+Maxwell's pressure and the stage a signal stopped (``interrupted``)."""
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -114,11 +114,12 @@ class TubeResult:
         Returns
         -------
         xarray.Dataset
+            Its attributes: the shape's parameters, Maxwell's pressure, the branch's stop, ``interrupted``.
 
         Raises
         ------
         KeyError
-            No such branch (or no onset curve).
+            No branch of that name (``"onset"``: no onset curve in the file).
         ValueError
             Another ``part``.
         """
@@ -129,7 +130,8 @@ class TubeResult:
         if branch == "onset":
             onset = self._onset()
             data = {k: ("point", v) for k, v in self._onset_columns().items()}
-            data |= {"unknowns": (("point", "unknown"), onset["unknowns"]), "modes": (("point", "mode"), onset["modes"])}
+            data |= {"unknowns": (("point", "unknown"), onset["unknowns"]),
+                     "modes": (("point", "mode"), onset["modes"])}
             return xr.Dataset(data, attrs=attrs | onset["attrs"])
         if branch not in self.run["branches"]:
             raise KeyError(f"no branch {branch!r} (branches: {', '.join(self.run['branches'])}"

@@ -43,6 +43,14 @@ class TubeFileError(FileError):
 
 def write_tube_run(path, scene, picture, force: bool = False, command: str | None = None) -> Path:
     """Write ``picture`` (tube/picture.TubePicture) traced for ``scene`` to ``path`` atomically."""
+    with atomic_file(path, force) as f:
+        write_tube(f, scene, picture, command)
+    return Path(path)
+
+
+def write_tube(f, scene, picture, command: str | None = None) -> None:
+    """The root attributes and groups of a tube run file (module docstring) into the open file or group ``f`` (a
+    tube run file's root, a sweep member's: io/sweep_file.py)."""
     geometry, primary = scene.geometry, picture.branches["primary"]
     held = math.nan if geometry.axial_stretch is None else geometry.axial_stretch
     attrs = {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.text, "shape": geometry.shape.value,
@@ -51,36 +59,34 @@ def write_tube_run(path, scene, picture, force: bool = False, command: str | Non
              "maxwell_pressure": math.nan if picture.maxwell is None else picture.maxwell,
              "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
-    with atomic_file(path, force) as f:
-        f.attrs.update(attrs)
-        for name, branch in picture.branches.items():
-            group = f.create_group(f"branches/{name}")
-            group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
-            checksummed(group, "unknowns", branch.states)
-            for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
-                                   ("unstable_pressure", branch.unstable["pressure"]),
-                                   ("unstable_volume", branch.unstable["volume"]),
-                                   ("smallest_stress", branch.smallest_stress),
-                                   (CREST, crest_heights(branch.disc, branch.states))):
-                checksummed(group, column, values)
-            for block, values in branch.lowest.items():
-                checksummed(group, f"lowest_{block.value}", values)
-            special = group.create_group("special_points")
-            s = branch.special
-            write_strings(special, "kind", [p.kind.value for p in s])
-            write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
-            write_strings(special, "status", [p.status.value for p in s])
-            checksummed(special, "index", np.array([p.index for p in s], dtype=int))
-            checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
-            eq = Equilibrium(scene, branch.disc)
-            volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
-            checksummed(special, "volume", np.array(volume, dtype=float))
-            checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
-            checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
-            checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
-        if picture.onset is not None:
-            _write_onset(f.create_group("onset"), picture.onset)
-    return Path(path)
+    f.attrs.update(attrs)
+    for name, branch in picture.branches.items():
+        group = f.create_group(f"branches/{name}")
+        group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
+        checksummed(group, "unknowns", branch.states)
+        for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
+                               ("unstable_pressure", branch.unstable["pressure"]),
+                               ("unstable_volume", branch.unstable["volume"]),
+                               ("smallest_stress", branch.smallest_stress),
+                               (CREST, crest_heights(branch.disc, branch.states))):
+            checksummed(group, column, values)
+        for block, values in branch.lowest.items():
+            checksummed(group, f"lowest_{block.value}", values)
+        special = group.create_group("special_points")
+        s = branch.special
+        write_strings(special, "kind", [p.kind.value for p in s])
+        write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
+        write_strings(special, "status", [p.status.value for p in s])
+        checksummed(special, "index", np.array([p.index for p in s], dtype=int))
+        checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
+        eq = Equilibrium(scene, branch.disc)
+        volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
+        checksummed(special, "volume", np.array(volume, dtype=float))
+        checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
+        checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
+        checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
+    if picture.onset is not None:
+        _write_onset(f.create_group("onset"), picture.onset)
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
@@ -103,38 +109,59 @@ def _write_onset(group, curve) -> None:
 
 def read_tube_run(path) -> dict:
     """{'path', 'attrs', 'branches': {name: {'attrs', the point columns, 'unknowns', 'lowest_*',
-    'special_points': [dict per point] , 'special_unknowns'}}}; TubeFileError for anything that is not one."""
+    'special_points': [dict per point] , 'special_unknowns'}}, 'onset'}; TubeFileError for anything that is not
+    one."""
     path = Path(path)
     with opened(path, TubeFileError) as f:
         fmt = plain(f.attrs.get("format"))
         if fmt != FORMAT:
             raise TubeFileError(path, f"not a balloon-cg tube run file (format {fmt!r}, expected {FORMAT!r})")
-        attrs = {"interrupted": ""} | {k: _text(plain(v)) for k, v in f.attrs.items()}
-        if "branches" not in f or "primary" not in f["branches"]:
-            raise TubeFileError(path, "no /branches/primary group")
-        branches = {}
-        for name, group in f["branches"].items():
-            missing = [c for c in ("unknowns", *POINT_COLUMNS, "special_points") if c not in group]
-            if missing:
-                raise TubeFileError(path, f"/branches/{name}: missing {', '.join(missing)}")
-            branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()},
-                      "unknowns": group["unknowns"][()]}
-            n = branch["unknowns"].shape[0]
-            optional = tuple(c for c in (CREST, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
-            for column in POINT_COLUMNS + optional:
-                branch[column] = group[column][()]
-                if branch[column].shape != (n,):
-                    raise TubeFileError(path, f"/branches/{name}/{column}: shape {branch[column].shape}, expected "
-                                              f"({n},)")
-            special = group["special_points"]
-            columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
-            columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
-            branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
-                                        for i in range(len(columns["kind"]))]
-            branch["special_unknowns"] = special["unknowns"][()]
-            branches[name] = branch
-        onset = None if "onset" not in f else _read_onset(path, f["onset"])
-    return {"path": str(path), "attrs": attrs, "branches": branches, "onset": onset}
+        return {"path": str(path), **read_tube(f, path)}
+
+
+def read_tube(f, path, where: str = "") -> dict:
+    """{'attrs', 'branches', 'onset'} of the tube run written by ``write_tube`` into the open file or group ``f``
+    (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
+    attrs = {"interrupted": ""} | {k: _text(plain(v)) for k, v in f.attrs.items()}
+    if "branches" not in f or "primary" not in f["branches"]:
+        raise TubeFileError(path, f"no {where}/branches/primary group")
+    branches = {}
+    for name, group in f["branches"].items():
+        missing = [c for c in ("unknowns", *POINT_COLUMNS, "special_points") if c not in group]
+        if missing:
+            raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
+        branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
+        n = branch["unknowns"].shape[0]
+        optional = tuple(c for c in (CREST, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
+        for column in POINT_COLUMNS + optional:
+            branch[column] = group[column][()]
+            if branch[column].shape != (n,):
+                raise TubeFileError(path, f"{where}/branches/{name}/{column}: shape {branch[column].shape}, expected "
+                                          f"({n},)")
+        special = group["special_points"]
+        columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
+        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
+        branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
+                                    for i in range(len(columns["kind"]))]
+        branch["special_unknowns"] = special["unknowns"][()]
+        branches[name] = branch
+    onset = None if "onset" not in f else _read_onset(path, f["onset"])
+    return {"attrs": attrs, "branches": branches, "onset": onset}
+
+
+def tube_row(run: dict) -> dict:
+    """What a tube run (``read_tube``'s dict) found, as a sweep's table row (io/sweep_file.py): the uniform
+    pressure maximum ``P_max`` (the primary branch's first LP), the onset of bulging ``P_onset``, ``V_onset`` (its
+    first odd BP: P and V/V0), the bulge's volume fold ``P_LV``, ``V_LV`` (its first LV) and Maxwell's pressure
+    ``P_M``; NaN where there is none."""
+    def first(branch: str, kind: str, block: str = "") -> dict:
+        points = run["branches"].get(branch, {"special_points": []})["special_points"]
+        return next((s for s in points if s["kind"] == kind and s["block"] == block),
+                    {"pressure": np.nan, "volume": np.nan})
+
+    fold, onset, lv = first("primary", "LP"), first("primary", "BP", Mirror.ODD.value), first("bulge", "LV")
+    return {"P_max": fold["pressure"], "P_onset": onset["pressure"], "V_onset": onset["volume"],
+            "P_LV": lv["pressure"], "V_LV": lv["volume"], "P_M": float(run["attrs"]["maxwell_pressure"])}
 
 
 def _read_onset(path, group) -> dict:
