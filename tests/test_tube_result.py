@@ -80,3 +80,23 @@ def test_the_onset_curve_as_xarray_and_table(files):
     assert np.array_equal(table.M.values, onset["q"]) and np.array_equal(table.crest_height.values,
                                                                           onset["crest_height"])
     assert "onset in M" in repr(tube)
+
+
+def test_every_group_opens_with_xarray_with_named_dimensions(files):
+    """xarray with h5netcdf opens each group of a tube run file alone, its axes named (the file's dimension
+    scales) and its datasets described; the values are the file's."""
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    stored = read_tube_run(files[1])
+    groups = {f"branches/{name}": ("point", "unknown") for name in stored["branches"]}
+    groups |= {f"branches/{name}/special_points": ("special", "unknown") for name in stored["branches"]}
+    groups |= {"onset": ("point", "unknown", "mode"), "onset/folds": ("special",)}
+    for group, dims in groups.items():
+        with xr.open_dataset(files[1], engine="h5netcdf", group=group) as ds:
+            assert set(ds.sizes) == set(dims), (group, ds.sizes)
+            assert all(ds[name].attrs["long_name"] for name in ds.data_vars), group
+    with xr.open_dataset(files[1], engine="h5netcdf", group="onset") as ds:
+        assert ds["modes"].dims == ("point", "mode") and np.array_equal(ds["q"].values, stored["onset"]["q"])
+    with xr.open_dataset(files[1], engine="h5netcdf", group="branches/primary") as ds:
+        assert ds["unknowns"].dims == ("point", "unknown") and ds["volume"].attrs["units"] == "1"
+        assert np.array_equal(ds["unknowns"].values, stored["branches"]["primary"]["unknowns"])

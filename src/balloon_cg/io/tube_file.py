@@ -20,6 +20,7 @@ started, and is absent where it had not), "" where the work is whole (files befo
 import math
 from pathlib import Path
 
+import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
@@ -35,6 +36,54 @@ CREST = "crest_height"  # per point and located point: η of the largest radius 
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
+
+
+#: name: (units, long_name, description) of a tube run file's datasets (io/schema.py's VARIABLES are the sphere's)
+TUBE_VARIABLES = {
+    "point": ("", "point index", "index of the point along the branch (or onset curve), in continuation order"),
+    "special": ("", "located point index", "index of the located point on its branch"),
+    "unknown": ("", "unknown index", "u of galerkin/interval.py: λ2's coefficients, λ̄, η's bubbles (docs/hdf5.md)"),
+    "mode": ("", "odd unknown index", "index into the odd block of u (galerkin/interval.py's block('odd'))"),
+    "unknowns": ("1", "unknowns u", "u of galerkin/interval.py (docs/hdf5.md)"),
+    "pressure": ("1", "pressure P", "P = P̄ R / (T0 μ/2), R the reference radius"),
+    "volume": ("1", "V/V0", "enclosed volume over the reference tube's, V0 = πL R³"),
+    "unstable_pressure": ("", "unstable directions, pressure control", "negative eigenvalues of ∂R/∂u"),
+    "unstable_volume": ("", "unstable directions, volume control", "negative eigenvalues of ∂R/∂u on δV = 0"),
+    "smallest_stress": ("1", "smallest principal stress", "over the nodes, in μ/2: negative where compressed"),
+    CREST: ("1", "crest height", "height η of the largest radius from the tube's middle plane, in R"),
+    "lowest_even": ("1", "lowest eigenvalue, even block", "of the mirror-symmetric block of ∂R/∂u"),
+    "lowest_odd": ("1", "lowest eigenvalue, odd block", "of the mirror-antisymmetric block of ∂R/∂u"),
+    "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point"),
+    "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
+    "status": ("", "location status", "located or nearest"),
+    "index": ("", "point index", "the located point lies between points index and index + 1"),
+    "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M)"),
+    "modes": ("1", "odd null vector", "the odd block's null vector φ at the onset"),
+}
+
+
+def _dimensions(group, rows: str, axes: dict) -> None:
+    """Named dimensions (netCDF-4, so that xarray with h5netcdf opens ``group`` alone with them): the scale ``rows``
+    (0 … n − 1, n the rows of its datasets) and those of ``axes`` ({second axis's scale name: length}), attached to
+    every dataset (its first axis ``rows``; a 2-D dataset's second: ``unknown``, ``mode`` for ``modes``) and each
+    described from TUBE_VARIABLES."""
+    items = [(name, item) for name, item in group.items() if isinstance(item, h5py.Dataset)]
+    n = items[0][1].shape[0]
+    scales = {name: checksummed(group, name, np.arange(length, dtype=np.int64))
+              for name, length in {rows: n, **axes}.items()}
+    for name, scale in scales.items():
+        scale.make_scale(name)
+        _describe(scale, name)
+    for name, item in items:
+        item.dims[0].attach_scale(scales[rows])
+        if item.ndim == 2:
+            item.dims[1].attach_scale(scales["mode" if name == "modes" else "unknown"])
+        _describe(item, name)
+
+
+def _describe(dataset, name: str) -> None:
+    units, long_name, description = TUBE_VARIABLES[name]
+    dataset.attrs.update(({"units": units} if units else {}) | {"long_name": long_name, "description": description})
 
 
 class TubeFileError(FileError):
@@ -85,6 +134,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
         checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
+        _dimensions(group, "point", {"unknown": branch.disc.size})
+        _dimensions(special, "special", {"unknown": branch.disc.size})
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
 
@@ -105,6 +156,8 @@ def _write_onset(group, curve) -> None:
     checksummed(folds, "q", np.asarray(curve.fold_q, dtype=float))
     checksummed(folds, "pressure", np.array([p.pressure for p in curve.folds], dtype=float))
     write_strings(folds, "status", [p.status.value for p in curve.folds])
+    _dimensions(group, "point", {"unknown": curve.states.shape[1], "mode": curve.modes.shape[1]})
+    _dimensions(folds, "special", {})
 
 
 def read_tube_run(path) -> dict:
