@@ -908,7 +908,9 @@ def _add_continue(commands):
                     "--allow-partial exits 0); 2: bad input (no such label, a label or parameter this does not "
                     "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
                     "surface branch).")
-    p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
+    p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run (a tube's: from the onset "
+                                              "of bulging, the bulge branch or with --parameter M its onset curve, "
+                                              "docs/shapes.md)")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P; from a point "
                                        "that is no fold or BP: M or voltage, at its fixed P)")
@@ -929,8 +931,14 @@ def continue_run(args) -> int:
     """``continue``: the labelled point found, restarted (``app.restart``), written (the output owned meanwhile)."""
     from ..io.lock import claim
 
+    from ..io.layout import file_kind
+
     parameter = "" if args.parameter is None else "_" + re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
     args.output = default_output(args.output, f"{Path(args.run).stem}_label{args.label}{parameter}", "run")
+    if file_kind(args.run) == "tube":
+        from .tube_commands import continue_tube
+
+        return continue_tube(args)
     with claim(args.output, "continue"):
         return _continue(args)
 

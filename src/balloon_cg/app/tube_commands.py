@@ -95,3 +95,74 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
     if signalled:
         print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
     return None
+
+
+def tube_labels(run: dict) -> list:
+    """The labels of a tube run (``read_tube_run``'s dict), as ``inspect`` numbers them: (branch, its k-th located
+    point, the point) for the primary branch's located points, then the other branches'."""
+    ordered = sorted(run["branches"].items(), key=lambda item: item[0] != "primary")
+    return [(name, k, s) for name, b in ordered for k, s in enumerate(b["special_points"])]
+
+
+def continue_tube(args) -> int:
+    """``continue`` from a label of a tube run file (``inspect`` numbers the located points of its branches in
+    order, from 0): at an odd branch point of the primary branch (the onset of bulging) the bulge branch switched
+    there, with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
+    traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
+    the stored primary branch to a tube run file (130 on a signal, as ``run``). Exit 2, before any work, for another
+    label, a setting outside [continuation], another parameter, or no coils for M."""
+    from ..io.tube_file import read_tube_run, stored_branch
+    from ..scene import SceneError, parse_scene
+    from ..scene.tables import Ends
+    from ..tube.picture import bulge_picture, maxwell, onset_from
+    from ..tube.primary import scene_parameters
+    from .cli import _with_settings
+
+    run = read_tube_run(args.run)
+    labels = tube_labels(run)
+    onsets = [i for i, (name, _, s) in enumerate(labels) if (name, s["kind"], s["block"]) == ("primary", "BP", "odd")]
+    if not 0 <= args.label < len(labels) or args.label not in onsets:
+        if 0 <= args.label < len(labels):
+            name, _, s = labels[args.label]
+            what = " ".join(filter(None, (s["kind"], s["block"]))) + f" on branch {name}"
+        else:
+            what = "no such label"
+        raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from an odd branch point "
+                         f"of its primary branch (the onset of bulging): labels {', '.join(map(str, onsets)) or 'none'}")
+    if args.parameter not in (None, "P", "M", "field.M"):
+        raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M "
+                         "(allowed: M, or none for the bulge branch)")
+    try:
+        stored = parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
+    except SceneError as e:
+        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
+    scene, overrides = _with_settings(args, stored)
+    other = [key for key in overrides if not key.startswith("continuation.")]
+    if other:
+        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
+                         "the file's scene; allowed: continuation.* keys")
+    in_field = args.parameter in ("M", "field.M")
+    if in_field:
+        field_needed(scene, "M", "continue --parameter M", args.run)
+    elif scene.geometry.ends != Ends.SLIDING:
+        raise UsageError(f"continue {args.run}: the bulge branch is switched on sliding ends, not "
+                         f"{scene.geometry.ends.value}")
+    name, k, _ = labels[args.label]
+    primary = stored_branch(run, "primary", scene_parameters(scene))
+    point = primary.special[k]
+
+    def picture():
+        pm = maxwell(scene)
+        if in_field:
+            return onset_from(scene, primary, point, "M", args.direction, pm)
+        return bulge_picture(scene, primary, point, pm)
+
+    written, signalled = _written(args.output, args, picture, scene)
+    code = interrupted_status(written, args.output, signalled)
+    if code is not None:
+        return code
+    grown = written["onset"] if in_field else written["branches"]["bulge"]
+    size = len(grown["q"] if in_field else grown["pressure"])
+    print(f"{'onset curve in M' if in_field else 'bulge branch'} from label {args.label}: {size} points, stop "
+          f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
+    return 0

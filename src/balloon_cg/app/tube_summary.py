@@ -66,13 +66,15 @@ def format_tube(summary: dict) -> str:
              f"Maxwell        P_M = {maxwell}"]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
+    label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)
     for name, b in summary["branches"].items():
         lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"
                       + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
                       + ("" if b["last_crest_height"] is None else
                          f"; last crest at height {b['last_crest_height']:.6g}")]
-        for k, s in enumerate(b["special_points"]):
+        for s in b["special_points"]:
+            k, label = label, label + 1
             block = f" {s['block']}" if s["block"] else ""
             compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""

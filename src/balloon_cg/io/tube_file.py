@@ -28,7 +28,11 @@ from .layout import FileError, opened
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..scene.tables import Ends
+from ..analysis.results import Kind, StopCode
+from ..numerics.continuation import RootStatus, Stop, TraceStop
 from ..tube.primary import volume_ratio
+from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
+from ..scene.loading import Control
 
 FORMAT = "balloon-cg-tube/1"
 POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress")
@@ -233,6 +237,23 @@ def _read_onset(path, group) -> dict:
     onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s}
                       for q, p, s in zip(folds["q"][()], folds["pressure"][()], status)]
     return onset
+
+
+def stored_branch(run: dict, name: str, params) -> IntervalBranch:
+    """The branch ``name`` of a tube run (``read_tube_run``'s dict) as tube/results.IntervalBranch (its points, located
+    points and stop as written; ``params``: the branch's parameters, tube/primary.scene_parameters), to restart from
+    (``continue``)."""
+    b = run["branches"][name]
+    special = tuple(IntervalSpecial(Kind(s["kind"]), u, float(s["pressure"]), int(s["index"]), RootStatus(s["status"]),
+                                    Mirror(s["block"]) if s["block"] else None, float(s["smallest_stress"]))
+                    for s, u in zip(b["special_points"], b["special_unknowns"]))
+    code = b["attrs"]["stop_code"]
+    stop = Stop(next(enum(code) for enum in (IntervalStop, StopCode, TraceStop) if code in enum._value2member_map_),
+                b["attrs"]["stop_message"])
+    lowest = {block: b[f"lowest_{block.value}"] for block in Mirror if f"lowest_{block.value}" in b}
+    unstable = {Control.PRESSURE: b["unstable_pressure"], Control.VOLUME: b["unstable_volume"]}
+    return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
+                          special, stop, b["smallest_stress"], params)
 
 
 def discretisation(attrs: dict) -> IntervalDiscretisation:

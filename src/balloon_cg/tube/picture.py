@@ -50,12 +50,19 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
         return TubePicture(branches, pm, interrupted=Stage.PRIMARY)
     onset = primary.branch_points(Mirror.ODD)
     if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
-        if interrupt.requested():  # in the primary branch's stability and branch points: the bulge not started
-            return TubePicture(branches, pm, interrupted=Stage.BULGE)
-        branches["bulge"] = bulge_branch(scene, primary, onset[0], stop_stretch=scene.continuation.stop_stretch)
-        if branches["bulge"].stop.code == StopCode.INTERRUPTED:
-            return TubePicture(branches, pm, interrupted=Stage.BULGE)
+        return bulge_picture(scene, primary, onset[0], pm)
     return TubePicture(branches, pm)
+
+
+def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:
+    """``primary`` and the bulge branch switched at its odd branch point ``point`` (tube/bulge.py), stopped as
+    ``tube_picture``'s; ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's label."""
+    branches = {"primary": primary}
+    if interrupt.requested():  # in the primary branch's stability and branch points: the bulge not started
+        return TubePicture(branches, pm, interrupted=Stage.BULGE)
+    branches["bulge"] = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
+    stopped = Stage.BULGE if branches["bulge"].stop.code == StopCode.INTERRUPTED else None
+    return TubePicture(branches, pm, interrupted=stopped)
 
 
 def onset_picture(scene, name: str = "M", direction: float = 1.0) -> TubePicture:
@@ -69,9 +76,16 @@ def onset_picture(scene, name: str = "M", direction: float = 1.0) -> TubePicture
     onsets = primary.branch_points(Mirror.ODD)
     if not onsets:
         return TubePicture(branches, pm)
+    return onset_from(scene, primary, onsets[0], name, direction, pm)
+
+
+def onset_from(scene, primary: IntervalBranch, point, name: str, direction: float, pm: float | None) -> TubePicture:
+    """``primary`` and the curve of its odd branch point ``point`` followed in ``name`` (tube/onset.py), as
+    ``onset_picture``'s; also ``continue --parameter M`` from a tube file's label."""
+    branches = {"primary": primary}
     if interrupt.requested():  # in the primary branch's stability and branch points: the curve not started
         return TubePicture(branches, pm, interrupted=Stage.ONSET)
-    curve = onset_curve(scene, primary, onsets[0], name, direction)
+    curve = onset_curve(scene, primary, point, name, direction)
     return TubePicture(branches, pm, curve, Stage.ONSET if curve.stop.code == StopCode.INTERRUPTED else None)
 
 
