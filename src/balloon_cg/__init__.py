@@ -38,6 +38,7 @@ _API = {
     "analyse": "balloon_cg.app.api", "load": "balloon_cg.app.api", "plot": "balloon_cg.app.api",
     "continue_from": "balloon_cg.app.api",
     "SweepResult": "balloon_cg.app.sweep_result", "CurveResult": "balloon_cg.app.curve_result",
+    "TubeResult": "balloon_cg.app.tube_result",
     "SpecialPoints": "balloon_cg.app.tables",
     "journal_style": "balloon_cg.post.style", "JOURNAL_STYLE": "balloon_cg.post.style",
 }

@@ -458,13 +458,14 @@ def load(path):
     Parameters
     ----------
     path : str or Path
-        A run, sweep or two-parameter curve file.
+        A run, sweep, two-parameter curve or tube run file.
 
     Returns
     -------
-    Result or SweepResult or CurveResult
+    Result or SweepResult or CurveResult or TubeResult
         The ``Result`` of a run file, the ``SweepResult`` of a sweep file (its members and a table of what each
-        found), the ``CurveResult`` of a curve file (named after its parameter).
+        found), the ``CurveResult`` of a curve file (named after its parameter), the ``TubeResult`` of a tube run
+        file (app/tube_result.py).
 
     Raises
     ------
@@ -485,6 +486,9 @@ def load(path):
     if kind == "curve":
         from .curve_result import CurveResult
         return CurveResult.read(path)
+    if kind == "tube":
+        from .tube_result import TubeResult
+        return TubeResult.read(path)
     run = read_run(path)
     try:
         scene = parse_scene(run["attrs"]["scene_toml"], run["scene_name"])

@@ -339,7 +339,9 @@ def run(args) -> int:
             summary = None if args.quiet or requested() else read_run(output)
             signalled = requested()
     if scene.geometry.shape == "tube":
-        return run_tube(scene, output, args)  # its pipeline stops by KeyboardInterrupt (tube/ polls no flag yet)
+        from .tube_commands import run_tube
+
+        return run_tube(scene, output, args)  # under its own stop_on_signals (app/tube_commands.py)
     code = interrupted_status(found, output, signalled)
     if code is not None:
         return code
@@ -380,60 +382,6 @@ def curve_interrupted_status(curve, output, signalled: bool, before: str = "the 
     if signalled:
         print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
     return None
-
-
-def run_tube(scene, output, args) -> int:
-    """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
-    written to the tube run file ``output`` (io/tube_file.py) and summarised."""
-    from ..io.lock import claim
-    from ..io.output import check_output
-    from ..io.tube_file import read_tube_run, write_tube_run
-    from ..tube.picture import tube_picture
-    from .tube_summary import format_tube, summarise_tube
-
-    with claim(output, "run"):
-        check_output(output, args.force)
-        picture = tube_picture(scene, args.primary_only)
-        write_tube_run(output, scene, picture, args.force, args.command_line)
-    if not args.quiet:
-        print(format_tube(summarise_tube(read_tube_run(output))))
-    return 0
-
-
-def critical_tube(scene, output, args) -> int:
-    """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
-    followed in M, written with the primary branch to the tube run file ``output`` (its /onset group) and summarised.
-    Exit 0 with ``critical M = ...`` where the curve turns back in M (a located fold: the onset's largest or smallest
-    M), 1 (the file still written) where it does not; 2 for anything but the onset (--of BP) in M, or no coils."""
-    from ..io.lock import claim
-    from ..io.output import check_output
-    from ..io.tube_file import write_tube_run
-    from ..tube.onset import onset_curve
-    from ..tube.picture import TubePicture, maxwell
-    from ..tube.primary import primary_branch
-
-    if args.of != "BP" or args.parameter not in ("M", "field.M"):
-        raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M: {args.scene}: --of "
-                         f"{args.of} --parameter {args.parameter}")
-    field_needed(scene, args.parameter, "critical --parameter M", args.scene)
-    with claim(output, "critical"):
-        check_output(output, args.force)
-        primary = primary_branch(scene)
-        onsets = primary.branch_points("odd")
-        if not onsets:
-            raise Failure(f"no odd branch point (the onset of bulging) on the primary branch of {args.scene} "
-                          f"({primary.stop.message}): nothing to follow in M")
-        curve = onset_curve(scene, primary, onsets[0], "M", args.direction)
-        write_tube_run(output, scene, TubePicture({"primary": primary}, maxwell(scene), curve), args.force,
-                       args.command_line)
-    _say(args, f"onset curve: {len(curve.q)} points, stop {curve.stop.code.value} ({curve.stop.message})")
-    if not curve.folds:
-        raise Failure(f"no critical M: the onset curve does not turn back in M ({curve.stop.message}; last point "
-                      f"M = {curve.q[-1]:.10g}, P = {curve.pressure[-1]:.10g}); curve written to {output}")
-    k = max(range(len(curve.folds)), key=lambda i: args.direction * curve.fold_q[i])
-    print(f"critical M = {curve.fold_q[k]:.12g} (P = {curve.folds[k].pressure:.10g}; the onset curve turns back in "
-          f"M: {curve.folds[k].status.value}); curve written to {output}")
-    return 0
 
 
 def verdict_status(found: list, allow_partial: bool) -> int:
@@ -784,7 +732,9 @@ def critical(args) -> int:
         output = default_output(args.output, f"{stem}_critical_{short}", "tube")
         if requested():  # while the scene loaded: nothing computed
             return curve_interrupted_status(None, output, True, "the work had not started")
-    return critical_tube(scene, output, args)  # its pipeline stops by KeyboardInterrupt (tube/ polls no flag yet)
+    from .tube_commands import critical_tube
+
+    return critical_tube(scene, output, args)  # under its own stop_on_signals (app/tube_commands.py)
 
 
 def _critical(args, scene) -> int:
@@ -970,7 +920,9 @@ def _add_continue(commands):
                     "--allow-partial exits 0); 2: bad input (no such label, a label or parameter this does not "
                     "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
                     "surface branch).")
-    p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run")
+    p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run (a tube's: from the onset "
+                                              "of bulging, the bulge branch or with --parameter M its onset curve, "
+                                              "docs/shapes.md)")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P; from a point "
                                        "that is no fold or BP: M or voltage, at its fixed P)")
@@ -991,8 +943,14 @@ def continue_run(args) -> int:
     """``continue``: the labelled point found, restarted (``app.restart``), written (the output owned meanwhile)."""
     from ..io.lock import claim
 
+    from ..io.layout import file_kind
+
     parameter = "" if args.parameter is None else "_" + re.sub(r"[^A-Za-z0-9.+-]+", "", args.parameter.split(".")[-1])
     args.output = default_output(args.output, f"{Path(args.run).stem}_label{args.label}{parameter}", "run")
+    if file_kind(args.run) == "tube":
+        from .tube_commands import continue_tube
+
+        return continue_tube(args)
     with claim(args.output, "continue"):
         return _continue(args)
 

@@ -38,6 +38,7 @@ from ..numerics import interrupt, workers
 from ..numerics.hygiene import worker_hygiene
 from .progress import auto_tqdm, tqdm_disable
 from ..scene import Scene, SceneError, parse_scene
+from ..scene.tables import Shape
 
 MODES = ("analysis", "no-pear", "primary-only")
 MAX_MEMBERS = 10_000  # docs/scenes.md, Bounds: a sweep's member count (the product of the --vary counts)
@@ -233,13 +234,30 @@ class MemberResult:
     pid: int
 
 
-def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> MemberResult:
+@dataclass
+class TubeMemberResult:
+    """What a worker returns for one member of a tube scene: tube/picture.tube_picture's TubePicture (the primary
+    branch and, unless the mode is primary-only, the bulge branch; ``no-pear`` is the whole picture: a tube has
+    no pear branches), its wall time and process id."""
+
+    index: int
+    picture: object
+    wall_time: float
+    pid: int
+
+
+def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> MemberResult | TubeMemberResult:
     """Worker side: compute one member (local pool or dask worker); picklable in and out."""
     # BLAS runs single-threaded in every member: importing balloon_cg limits it (balloon_cg/__init__); with
     # 2 BLAS threads per member on busy cores a member ran 35x slower (benchmarks/sweep.py).
     # the members are the parallel unit: a member's points are not spread over more processes (numerics.workers)
     scene = parse_scene(scene_toml, scene_name)
     start = time.perf_counter()
+    if scene.geometry.shape == Shape.TUBE:
+        from ..tube.picture import tube_picture
+
+        picture = tube_picture(scene, primary_only=mode == "primary-only")
+        return TubeMemberResult(index, picture, time.perf_counter() - start, os.getpid())
     with workers.serial():
         if mode == "primary-only":
             branches, snaps, points = [trace_primary(scene)], None, []
@@ -490,6 +508,8 @@ def format_summary(result: SweepResult) -> str:
         "",
     ]
     w = max([len("overrides")] + [len(m.label) for m in result.members])
+    if result.members and result.members[0].scene.geometry.shape == Shape.TUBE:
+        return "\n".join(lines + _tube_rows(result, stored_members, w))
     header = (f"{'member':>6}  {'overrides':<{w}}  {'result':<10}  {'points':>6}  {'pear BPs':>8}  "
               "pear branch point pressures (voltages on a voltage continuation)")
     lines.append(header)
@@ -510,3 +530,24 @@ def format_summary(result: SweepResult) -> str:
         verdict = "complete" if a.get("complete") else "incomplete"
         lines.append(f"{m.index:>6}  {m.label:<{w}}  {verdict:<10}  {n_points:>6}  {count:>8}  {pressures}")
     return "\n".join(lines)
+
+
+def _tube_rows(result: SweepResult, stored_members: dict, w: int) -> list[str]:
+    """format_summary's member lines of a tube sweep: per member its pressure maximum, the onset of bulging (P,
+    V/V0), the bulge's volume fold and Maxwell's pressure (io.tube_file.tube_row)."""
+    from ..io.tube_file import tube_row
+
+    lines = [f"{'member':>6}  {'overrides':<{w}}  {'result':<10}  {'points':>6}  {'P_max':>10}  {'P_onset':>10}  "
+             f"{'V_onset':>10}  {'P_LV':>10}  {'P_M':>10}"]
+    for m in result.members:
+        stored = stored_members.get(m.index)
+        if m.index in result.failed or stored is None:
+            what = f"failed: {result.failed[m.index]}" if m.index in result.failed else "not computed"
+            lines.append(f"{m.index:>6}  {m.label:<{w}}  {what}")
+            continue
+        row = tube_row(stored)
+        verdict = "complete" if stored["attrs"].get("complete") else "incomplete"
+        points = len(stored["branches"]["primary"]["pressure"])
+        values = "  ".join(f"{row[k]:>10.6g}" for k in ("P_max", "P_onset", "V_onset", "P_LV", "P_M"))
+        lines.append(f"{m.index:>6}  {m.label:<{w}}  {verdict:<10}  {points:>6}  {values}")
+    return lines

@@ -15,13 +15,15 @@ from pathlib import Path
 
 from ..io.parents import parent_label
 from ..io.sweep_file import member_row, read_sweep
+from ..io.tube_file import tube_row
 from .api import BranchData
 from .tables import html_table, optional
 
 @dataclass(frozen=True, repr=False)
 class SweepMember:
     """One member of a sweep: ``index``, its ``overrides`` (dotted key -> value), ``attrs`` (verdict,
-    provenance), ``branches`` (name -> BranchData) and ``path``, the sweep file."""
+    provenance), ``branches`` (name -> BranchData; a tube's: io.tube_file.read_tube's branch dicts) and ``path``, the
+    sweep file."""
 
     index: int
     overrides: dict
@@ -46,7 +48,10 @@ class SweepMember:
 
     def row(self) -> dict:
         """This member's line of ``SweepResult.to_dataframe`` (``io.sweep_file.member_row``, as the file's root
-        table)."""
+        table; a tube's: ``io.tube_file.tube_row``)."""
+        if self.attrs.get("shape") == "tube":
+            return self.overrides | {"complete": self.complete} | tube_row({"attrs": self.attrs,
+                                                                            "branches": self.branches})
         primary = self.branches.get("primary")
         return member_row(self.overrides, self.complete, primary.special_points if primary is not None else [])
 
@@ -76,6 +81,7 @@ class SweepResult:
     def read(cls, path) -> "SweepResult":
         sweep = read_sweep(path)
         members = {index: SweepMember(index, m["overrides"], m["attrs"],
+                                      m["branches"] if m["attrs"].get("shape") == "tube" else
                                       {name: BranchData(name, data, parent_label(m, name))
                                        for name, data in m["branches"].items()},
                                       str(path))

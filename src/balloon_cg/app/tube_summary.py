@@ -1,7 +1,8 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, Maxwell's
 pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are compressed
 (tube/stability.py), the height of its last point's crest and its located points (with their crest's height; those in
-a compressed state marked: docs/shapes.md), and the onset curve of ``critical`` (its range, folds and stop)."""
+a compressed state marked: docs/shapes.md), the onset curve of ``critical`` (its range, folds and stop), and the stage
+a signal stopped (``interrupted``)."""
 import math
 import tomllib
 
@@ -28,7 +29,7 @@ def summarise_tube(run: dict) -> dict:
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
-            "branches": branches, "onset": _onset(run.get("onset"))}
+            "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
 
 
 def scene_field(toml: str) -> dict:
@@ -63,13 +64,17 @@ def format_tube(summary: dict) -> str:
                                    if summary["field"]["coils"] else "none"),
              f"degree         {summary['degree']}",
              f"Maxwell        P_M = {maxwell}"]
+    if summary["interrupted"]:
+        lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
+    label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)
     for name, b in summary["branches"].items():
         lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"
                       + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
                       + ("" if b["last_crest_height"] is None else
                          f"; last crest at height {b['last_crest_height']:.6g}")]
-        for k, s in enumerate(b["special_points"]):
+        for s in b["special_points"]:
+            k, label = label, label + 1
             block = f" {s['block']}" if s["block"] else ""
             compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""

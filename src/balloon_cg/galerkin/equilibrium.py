@@ -129,8 +129,8 @@ class Equilibrium:
         every other scene the Legendre basis in cos θ; a tube on the latter is refused in one line (SceneError)."""
         if (scene.geometry.shape == Shape.TUBE) != isinstance(discretisation, IntervalDiscretisation):
             if scene.geometry.shape == Shape.TUBE:
-                raise SceneError('geometry.shape = "tube": this command is not built for a tube yet (solve, sweep '
-                                 'and continue trace spheres and spheroids); a tube\'s branches: balloon-cg run, its '
+                raise SceneError('geometry.shape = "tube": this command is not built for a tube yet (solve traces '
+                                 'spheres and spheroids); a tube\'s branches: balloon-cg run, sweep or continue, its '
                                  'onset in M: balloon-cg critical, or balloon_cg.tube.picture.tube_picture '
                                  '(docs/shapes.md)')
             raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")

@@ -46,6 +46,8 @@ from .lock import remove_debris
 from .run_file import VERDICT_KINDS, read_branches, read_special, verdict_attrs, write_branches
 from .layout import FileError, carries_checksums, check_data, check_input, reading, require_attrs
 from .schema import FINITE
+from .tube_file import read_tube, tube_row, write_tube
+from ..scene.tables import Shape
 
 FORMAT = "balloon-cg-sweep/2"
 FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
@@ -107,7 +109,11 @@ class Store:
         return member_file(self.directory, index)
 
     def write_member(self, member, result) -> None:
-        """Write one computed member (app.sweep.MemberResult) to its own file, atomically."""
+        """Write one computed member (app.sweep.MemberResult, or TubeMemberResult: ``write_tube_member``) to its own
+        file, atomically."""
+        if member.scene.geometry.shape == Shape.TUBE:
+            self.write_tube_member(member, result)
+            return
         path = self.member_file(member.index)
         primary = result.branches[0]
         points = [primary.params_at(bp.X) for bp in result.branch_points]
@@ -134,6 +140,35 @@ class Store:
                 f.attrs.create(key, np.array(values, dtype=object), dtype=text)
             f.attrs.update(verdict_attrs(found=result.incomplete))
             write_branches(f, member.scene, result.branches, result.snaps)
+        self.done[member.index] = path
+
+    def write_tube_member(self, member, result) -> None:
+        """A tube member (app.sweep.TubeMemberResult): the tube run file's content (io.tube_file.write_tube), its
+        branch points and its verdict (complete unless a signal stopped it: ``interrupted`` names the stage) beside
+        the member attributes."""
+        path = self.member_file(member.index)
+        picture = result.picture
+        points = picture.branches["primary"].branch_points()
+        stopped = picture.interrupted
+        with atomic_file(path, force=True) as f:
+            write_tube(f, member.scene, picture)
+            attrs = provenance()
+            del attrs["command"]
+            text = h5py.string_dtype()
+            f.attrs.update(attrs | {
+                "format": MEMBER_FORMAT, "tolerance": member.scene.solver.tol,
+                "overrides": json.dumps(member.overrides), "scene_hash": member.scene_hash,
+                "scene_toml": member.scene.to_toml(), "worker_pid": result.pid, "wall_time": result.wall_time,
+                "branch_point_pressures": np.array([p.pressure for p in points], dtype=float),
+                "complete": stopped is None})
+            for key, values in (("branch_point_kinds", [p.kind.value for p in points]),
+                                ("branch_point_classifications", ["" for _ in points]),
+                                ("branch_point_blocks", [p.block.value for p in points]),
+                                ("incomplete_gaps", [] if stopped is None else ["interrupted"]),
+                                ("incomplete_branches", [] if stopped is None else [stopped.value]),
+                                ("incomplete_messages", [] if stopped is None else
+                                 [f"interrupted by a signal during {stopped.value}"])):
+                f.attrs.create(key, np.array(values, dtype=object), dtype=text)
         self.done[member.index] = path
 
 
@@ -367,8 +402,11 @@ def member_row(overrides: dict, complete: bool, special: list[dict]) -> dict:
 
 
 def _stored_row(member, where) -> dict:
-    """``member_row`` of a member file (or group) as written by Store.write_member."""
+    """``member_row`` of a member file (or group) as written by Store.write_member (a tube's: ``tube_row``)."""
     require_attrs(member.attrs, where, MEMBER_KEYS, error=SweepFileError)
+    if is_tube(member):
+        return (json.loads(plain(member.attrs["overrides"])) | {"complete": bool(member.attrs.get("complete", False))}
+                | tube_row(read_tube(member, where)))
     special = member.get("branches/primary/special_points")
     return member_row(json.loads(plain(member.attrs["overrides"])), bool(member.attrs.get("complete", False)),
                       read_special(special) if special is not None else [])
@@ -382,7 +420,13 @@ TABLE_COLUMNS = {"complete": ("", "member complete (analysis.verdict)"),
                  "P_BP": ("1", "pressure P at the branch point of the primary branch"),
                  "block_BP": ("", "stability block of the branch point"),
                  "classification_BP": ("", "classification of the branch point"),
-                 "m_BP": ("", "azimuthal wave number of the branch point (−1: none)")}
+                 "m_BP": ("", "azimuthal wave number of the branch point (−1: none)"),
+                 "P_max": ("1", "pressure maximum of the uniform tube (the primary branch's first LP)"),
+                 "P_onset": ("1", "pressure at the onset of bulging (the primary branch's first odd BP)"),
+                 "V_onset": ("1", "V/V0 at the onset of bulging"),
+                 "P_LV": ("1", "pressure at the bulge branch's volume fold (its first LV)"),
+                 "V_LV": ("1", "V/V0 at the bulge branch's volume fold"),
+                 "P_M": ("1", "Maxwell's pressure of the uniform closed tube (NaN: none)")}
 
 
 def write_table(f, rows: dict, keys: list) -> None:
@@ -527,8 +571,17 @@ def _read_member(group, where: str) -> dict:
         overrides = json.loads(attrs["overrides"])
     except (TypeError, json.JSONDecodeError):
         raise SweepFileError(where, "attribute overrides is not a JSON object") from None
+    if is_tube(group):  # a tube's member: the tube run's branches and onset (io.tube_file.read_tube)
+        tube = read_tube(group, where)
+        return {"overrides": overrides, "scene_hash": attrs["scene_hash"], "attrs": attrs | tube["attrs"],
+                "branches": tube["branches"], "onset": tube["onset"]}
     return {"overrides": overrides, "scene_hash": attrs["scene_hash"], "attrs": attrs,
             **read_branches(group, where, SweepFileError)}
+
+
+def is_tube(member) -> bool:
+    """Whether a member file or group holds a tube's run (io.tube_file.write_tube: its ``shape`` attribute)."""
+    return plain(member.attrs.get("shape")) == Shape.TUBE.value
 
 
 def incomplete_members(path) -> list[int]:

@@ -13,11 +13,14 @@ special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``vol
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
-under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``.
+under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
+stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
+started, and is absent where it had not), "" where the work is whole (files before it have none: read as "").
 """
 import math
 from pathlib import Path
 
+import h5py
 import numpy as np
 
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
@@ -25,7 +28,11 @@ from .layout import FileError, opened
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..scene.tables import Ends
+from ..analysis.results import Kind, StopCode
+from ..numerics.continuation import RootStatus, Stop, TraceStop
 from ..tube.primary import volume_ratio
+from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
+from ..scene.loading import Control
 
 FORMAT = "balloon-cg-tube/1"
 POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress")
@@ -35,49 +42,106 @@ CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
 
 
+#: name: (units, long_name, description) of a tube run file's datasets (io/schema.py's VARIABLES are the sphere's)
+TUBE_VARIABLES = {
+    "point": ("", "point index", "index of the point along the branch (or onset curve), in continuation order"),
+    "special": ("", "located point index", "index of the located point on its branch"),
+    "unknown": ("", "unknown index", "u of galerkin/interval.py: λ2's coefficients, λ̄, η's bubbles (docs/hdf5.md)"),
+    "mode": ("", "odd unknown index", "index into the odd block of u (galerkin/interval.py's block('odd'))"),
+    "unknowns": ("1", "unknowns u", "u of galerkin/interval.py (docs/hdf5.md)"),
+    "pressure": ("1", "pressure P", "P = P̄ R / (T0 μ/2), R the reference radius"),
+    "volume": ("1", "V/V0", "enclosed volume over the reference tube's, V0 = πL R³"),
+    "unstable_pressure": ("", "unstable directions, pressure control", "negative eigenvalues of ∂R/∂u"),
+    "unstable_volume": ("", "unstable directions, volume control", "negative eigenvalues of ∂R/∂u on δV = 0"),
+    "smallest_stress": ("1", "smallest principal stress", "over the nodes, in μ/2: negative where compressed"),
+    CREST: ("1", "crest height", "height η of the largest radius from the tube's middle plane, in R"),
+    "lowest_even": ("1", "lowest eigenvalue, even block", "of the mirror-symmetric block of ∂R/∂u"),
+    "lowest_odd": ("1", "lowest eigenvalue, odd block", "of the mirror-antisymmetric block of ∂R/∂u"),
+    "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point"),
+    "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
+    "status": ("", "location status", "located or nearest"),
+    "index": ("", "point index", "the located point lies between points index and index + 1"),
+    "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M)"),
+    "modes": ("1", "odd null vector", "the odd block's null vector φ at the onset"),
+}
+
+
+def _dimensions(group, rows: str, axes: dict) -> None:
+    """Named dimensions (netCDF-4, so that xarray with h5netcdf opens ``group`` alone with them): the scale ``rows``
+    (0 … n − 1, n the rows of its datasets) and those of ``axes`` ({second axis's scale name: length}), attached to
+    every dataset (its first axis ``rows``; a 2-D dataset's second: ``unknown``, ``mode`` for ``modes``) and each
+    described from TUBE_VARIABLES."""
+    items = [(name, item) for name, item in group.items() if isinstance(item, h5py.Dataset)]
+    n = items[0][1].shape[0]
+    scales = {name: checksummed(group, name, np.arange(length, dtype=np.int64))
+              for name, length in {rows: n, **axes}.items()}
+    for name, scale in scales.items():
+        scale.make_scale(name)
+        _describe(scale, name)
+    for name, item in items:
+        item.dims[0].attach_scale(scales[rows])
+        if item.ndim == 2:
+            item.dims[1].attach_scale(scales["mode" if name == "modes" else "unknown"])
+        _describe(item, name)
+
+
+def _describe(dataset, name: str) -> None:
+    units, long_name, description = TUBE_VARIABLES[name]
+    dataset.attrs.update(({"units": units} if units else {}) | {"long_name": long_name, "description": description})
+
+
 class TubeFileError(FileError):
     """A file that is not a readable tube run file (names the file and what is missing or wrong)."""
 
 
 def write_tube_run(path, scene, picture, force: bool = False, command: str | None = None) -> Path:
     """Write ``picture`` (tube/picture.TubePicture) traced for ``scene`` to ``path`` atomically."""
+    with atomic_file(path, force) as f:
+        write_tube(f, scene, picture, command)
+    return Path(path)
+
+
+def write_tube(f, scene, picture, command: str | None = None) -> None:
+    """The root attributes and groups of a tube run file (module docstring) into the open file or group ``f`` (a
+    tube run file's root, a sweep member's: io/sweep_file.py)."""
     geometry, primary = scene.geometry, picture.branches["primary"]
     held = math.nan if geometry.axial_stretch is None else geometry.axial_stretch
     attrs = {"format": FORMAT, "scene_name": scene.name, "scene_toml": scene.text, "shape": geometry.shape.value,
              "length": geometry.length, "ends": geometry.ends.value, "axial_stretch": held,
              "degree": primary.disc.degree, "quadrature": primary.disc.quadrature,
              "maxwell_pressure": math.nan if picture.maxwell is None else picture.maxwell,
+             "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
-    with atomic_file(path, force) as f:
-        f.attrs.update(attrs)
-        for name, branch in picture.branches.items():
-            group = f.create_group(f"branches/{name}")
-            group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
-            checksummed(group, "unknowns", branch.states)
-            for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
-                                   ("unstable_pressure", branch.unstable["pressure"]),
-                                   ("unstable_volume", branch.unstable["volume"]),
-                                   ("smallest_stress", branch.smallest_stress),
-                                   (CREST, crest_heights(branch.disc, branch.states))):
-                checksummed(group, column, values)
-            for block, values in branch.lowest.items():
-                checksummed(group, f"lowest_{block.value}", values)
-            special = group.create_group("special_points")
-            s = branch.special
-            write_strings(special, "kind", [p.kind.value for p in s])
-            write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
-            write_strings(special, "status", [p.status.value for p in s])
-            checksummed(special, "index", np.array([p.index for p in s], dtype=int))
-            checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
-            eq = Equilibrium(scene, branch.disc)
-            volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
-            checksummed(special, "volume", np.array(volume, dtype=float))
-            checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
-            checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
-            checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), -1))
-        if picture.onset is not None:
-            _write_onset(f.create_group("onset"), picture.onset)
-    return Path(path)
+    f.attrs.update(attrs)
+    for name, branch in picture.branches.items():
+        group = f.create_group(f"branches/{name}")
+        group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
+        checksummed(group, "unknowns", branch.states)
+        for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
+                               ("unstable_pressure", branch.unstable["pressure"]),
+                               ("unstable_volume", branch.unstable["volume"]),
+                               ("smallest_stress", branch.smallest_stress),
+                               (CREST, crest_heights(branch.disc, branch.states))):
+            checksummed(group, column, values)
+        for block, values in branch.lowest.items():
+            checksummed(group, f"lowest_{block.value}", values)
+        special = group.create_group("special_points")
+        s = branch.special
+        write_strings(special, "kind", [p.kind.value for p in s])
+        write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
+        write_strings(special, "status", [p.status.value for p in s])
+        checksummed(special, "index", np.array([p.index for p in s], dtype=int))
+        checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
+        eq = Equilibrium(scene, branch.disc)
+        volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
+        checksummed(special, "volume", np.array(volume, dtype=float))
+        checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
+        checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
+        checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
+        _dimensions(group, "point", {"unknown": branch.disc.size})
+        _dimensions(special, "special", {"unknown": branch.disc.size})
+    if picture.onset is not None:
+        _write_onset(f.create_group("onset"), picture.onset)
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
@@ -96,42 +160,65 @@ def _write_onset(group, curve) -> None:
     checksummed(folds, "q", np.asarray(curve.fold_q, dtype=float))
     checksummed(folds, "pressure", np.array([p.pressure for p in curve.folds], dtype=float))
     write_strings(folds, "status", [p.status.value for p in curve.folds])
+    _dimensions(group, "point", {"unknown": curve.states.shape[1], "mode": curve.modes.shape[1]})
+    _dimensions(folds, "special", {})
 
 
 def read_tube_run(path) -> dict:
     """{'path', 'attrs', 'branches': {name: {'attrs', the point columns, 'unknowns', 'lowest_*',
-    'special_points': [dict per point] , 'special_unknowns'}}}; TubeFileError for anything that is not one."""
+    'special_points': [dict per point] , 'special_unknowns'}}, 'onset'}; TubeFileError for anything that is not
+    one."""
     path = Path(path)
     with opened(path, TubeFileError) as f:
         fmt = plain(f.attrs.get("format"))
         if fmt != FORMAT:
             raise TubeFileError(path, f"not a balloon-cg tube run file (format {fmt!r}, expected {FORMAT!r})")
-        attrs = {k: _text(plain(v)) for k, v in f.attrs.items()}
-        if "branches" not in f or "primary" not in f["branches"]:
-            raise TubeFileError(path, "no /branches/primary group")
-        branches = {}
-        for name, group in f["branches"].items():
-            missing = [c for c in ("unknowns", *POINT_COLUMNS, "special_points") if c not in group]
-            if missing:
-                raise TubeFileError(path, f"/branches/{name}: missing {', '.join(missing)}")
-            branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()},
-                      "unknowns": group["unknowns"][()]}
-            n = branch["unknowns"].shape[0]
-            optional = tuple(c for c in (CREST, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
-            for column in POINT_COLUMNS + optional:
-                branch[column] = group[column][()]
-                if branch[column].shape != (n,):
-                    raise TubeFileError(path, f"/branches/{name}/{column}: shape {branch[column].shape}, expected "
-                                              f"({n},)")
-            special = group["special_points"]
-            columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
-            columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
-            branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
-                                        for i in range(len(columns["kind"]))]
-            branch["special_unknowns"] = special["unknowns"][()]
-            branches[name] = branch
-        onset = None if "onset" not in f else _read_onset(path, f["onset"])
-    return {"path": str(path), "attrs": attrs, "branches": branches, "onset": onset}
+        return {"path": str(path), **read_tube(f, path)}
+
+
+def read_tube(f, path, where: str = "") -> dict:
+    """{'attrs', 'branches', 'onset'} of the tube run written by ``write_tube`` into the open file or group ``f``
+    (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
+    attrs = {"interrupted": ""} | {k: _text(plain(v)) for k, v in f.attrs.items()}
+    if "branches" not in f or "primary" not in f["branches"]:
+        raise TubeFileError(path, f"no {where}/branches/primary group")
+    branches = {}
+    for name, group in f["branches"].items():
+        missing = [c for c in ("unknowns", *POINT_COLUMNS, "special_points") if c not in group]
+        if missing:
+            raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
+        branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
+        n = branch["unknowns"].shape[0]
+        optional = tuple(c for c in (CREST, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
+        for column in POINT_COLUMNS + optional:
+            branch[column] = group[column][()]
+            if branch[column].shape != (n,):
+                raise TubeFileError(path, f"{where}/branches/{name}/{column}: shape {branch[column].shape}, expected "
+                                          f"({n},)")
+        special = group["special_points"]
+        columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
+        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
+        branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
+                                    for i in range(len(columns["kind"]))]
+        branch["special_unknowns"] = special["unknowns"][()]
+        branches[name] = branch
+    onset = None if "onset" not in f else _read_onset(path, f["onset"])
+    return {"attrs": attrs, "branches": branches, "onset": onset}
+
+
+def tube_row(run: dict) -> dict:
+    """What a tube run (``read_tube``'s dict) found, as a sweep's table row (io/sweep_file.py): the uniform
+    pressure maximum ``P_max`` (the primary branch's first LP), the onset of bulging ``P_onset``, ``V_onset`` (its
+    first odd BP: P and V/V0), the bulge's volume fold ``P_LV``, ``V_LV`` (its first LV) and Maxwell's pressure
+    ``P_M``; NaN where there is none."""
+    def first(branch: str, kind: str, block: str = "") -> dict:
+        points = run["branches"].get(branch, {"special_points": []})["special_points"]
+        return next((s for s in points if s["kind"] == kind and s["block"] == block),
+                    {"pressure": np.nan, "volume": np.nan})
+
+    fold, onset, lv = first("primary", "LP"), first("primary", "BP", Mirror.ODD.value), first("bulge", "LV")
+    return {"P_max": fold["pressure"], "P_onset": onset["pressure"], "V_onset": onset["volume"],
+            "P_LV": lv["pressure"], "V_LV": lv["volume"], "P_M": float(run["attrs"]["maxwell_pressure"])}
 
 
 def _read_onset(path, group) -> dict:
@@ -150,6 +237,23 @@ def _read_onset(path, group) -> dict:
     onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s}
                       for q, p, s in zip(folds["q"][()], folds["pressure"][()], status)]
     return onset
+
+
+def stored_branch(run: dict, name: str, params) -> IntervalBranch:
+    """The branch ``name`` of a tube run (``read_tube_run``'s dict) as tube/results.IntervalBranch (its points, located
+    points and stop as written; ``params``: the branch's parameters, tube/primary.scene_parameters), to restart from
+    (``continue``)."""
+    b = run["branches"][name]
+    special = tuple(IntervalSpecial(Kind(s["kind"]), u, float(s["pressure"]), int(s["index"]), RootStatus(s["status"]),
+                                    Mirror(s["block"]) if s["block"] else None, float(s["smallest_stress"]))
+                    for s, u in zip(b["special_points"], b["special_unknowns"]))
+    code = b["attrs"]["stop_code"]
+    stop = Stop(next(enum(code) for enum in (IntervalStop, StopCode, TraceStop) if code in enum._value2member_map_),
+                b["attrs"]["stop_message"])
+    lowest = {block: b[f"lowest_{block.value}"] for block in Mirror if f"lowest_{block.value}" in b}
+    unstable = {Control.PRESSURE: b["unstable_pressure"], Control.VOLUME: b["unstable_volume"]}
+    return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
+                          special, stop, b["smallest_stress"], params)
 
 
 def discretisation(attrs: dict) -> IntervalDiscretisation:

@@ -11,14 +11,15 @@ V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the tracer's 
 states (ρ(0) − ρ(L) = −2 Σ_{k odd} a_k changes sign: the bulge has filled the tube and the branch meets the primary
 branch again at another odd branch point, the other end of the pitchfork's loop, where P and V are again even in the
 arclength: the monitors' sign changes in that last step are that symmetry, not folds, and are not kept), its V/V0 passes
-``stop_volume``, its largest hoop stretch ``stop_stretch``, or after ``continuation.max_points``. The branch point X* is
+``stop_volume``, its largest hoop stretch ``stop_stretch``, after ``continuation.max_points``, or at the next point
+after SIGINT/SIGTERM (StopCode.INTERRUPTED). The branch point X* is
 the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is zero, its
 sign rounding).
 """
 import numpy as np
 
 from .primary import TubeSystem, held, stressed, volume_ratio
-from .results import IntervalBranch, IntervalSpecial, IntervalStop
+from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, unstable_counts
 from ..analysis.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
@@ -68,6 +69,8 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                first.residual)
 
     def stop(p):
+        if (interrupted := signalled()) is not None:
+            return interrupted
         Y = system.full(p.X)
         if bulge(Y[:-1]) < 0:
             return Stop(IntervalStop.REJOINED, "the branch rejoined the mirror-symmetric states")

@@ -18,7 +18,8 @@ symmetric), ∂(H_oo φ)/∂P and ∂/∂q central differences (H is affine in P
 ``H_STEP`` only set Newton's rate, never the converged points (the residual is exact).
 
 The curve stops where P ≤ 0, where q falls below 0 (M is a square: the last point is then landed on q = 0 exactly,
-the field-free onset), at ``continuation.max_points``, or at the minimum step; its folds in q (LP: the onset's
+the field-free onset), at ``continuation.max_points``, at the minimum step, or at the next point after SIGINT/SIGTERM
+(StopCode.INTERRUPTED); its folds in q (LP: the onset's
 largest or smallest q) are located by the tracer's fold monitor.
 """
 import enum
@@ -27,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .primary import held, volume_ratio
-from .results import IntervalBranch, IntervalSpecial
+from .results import IntervalBranch, IntervalSpecial, signalled
 from ..analysis.problem import continuation_settings
 from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
@@ -153,6 +154,8 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
     settings = continuation_settings(scene, max_points)
 
     def stop(p):
+        if (interrupted := signalled()) is not None:
+            return interrupted
         _, P, _, q = system.split(p.X)
         if P <= 0:
             return Stop(OnsetStop.NONPOSITIVE_PRESSURE, f"P reached 0 at {name} = {q:.6g}")

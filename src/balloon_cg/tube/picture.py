@@ -3,37 +3,90 @@ points (tube/primary.py), the bulge branch switched at its first odd branch poin
 on plugged ones the branch points are not trusted, docs/shapes.md) traced until it rejoins the mirror-symmetric
 states, its largest hoop stretch passes ``continuation.stop_stretch`` or after ``continuation.max_points``, and
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends only: ends held apart have
-no single one)."""
+no single one), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
+the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
+is finished is kept, and the picture names the stage (``Stage``)."""
+import enum
 from dataclasses import dataclass
 
 from .bulge import bulge_branch
-from .onset import OnsetCurve
+from .onset import OnsetCurve, onset_curve
 from .primary import primary_branch
 from .results import IntervalBranch
+from ..analysis.results import StopCode
 from ..galerkin.interval import Mirror
 from ..model.tube import maxwell_pressure
+from ..numerics import interrupt
 from ..scene.tables import Ends
+
+
+class Stage(enum.StrEnum):
+    """A stage of a tube's work, named where a signal stopped it (the file's ``interrupted`` attribute)."""
+
+    PRIMARY = "primary"  # the primary branch (tube/primary.py)
+    BULGE = "bulge"  # the bulge branch (tube/bulge.py)
+    ONSET = "onset"  # the onset curve of ``critical`` (tube/onset.py)
 
 
 @dataclass(frozen=True)
 class TubePicture:
     """The branches by name ("primary", "bulge" where one was switched), Maxwell's pressure (None where the
-    uniform closed path has no maximum and minimum, or the ends are held) and, for ``critical``, the onset of bulging
-    followed in a second parameter (tube/onset.py)."""
+    uniform closed path has no maximum and minimum, or the ends are held), for ``critical`` the onset of bulging
+    followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the work is whole; the
+    stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had not)."""
 
     branches: dict
     maxwell: float | None
     onset: OnsetCurve | None = None
+    interrupted: Stage | None = None
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     """The primary branch and, unless ``primary_only``, the bulge branch of a tube scene (module docstring)."""
+    pm = maxwell(scene)  # first: it does not poll for a signal (~1.3 s for SPOM1), the traces after it do
     primary = primary_branch(scene)
     branches: dict[str, IntervalBranch] = {"primary": primary}
+    if primary.stop.code == StopCode.INTERRUPTED:
+        return TubePicture(branches, pm, interrupted=Stage.PRIMARY)
     onset = primary.branch_points(Mirror.ODD)
     if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
-        branches["bulge"] = bulge_branch(scene, primary, onset[0], stop_stretch=scene.continuation.stop_stretch)
-    return TubePicture(branches, maxwell(scene))
+        return bulge_picture(scene, primary, onset[0], pm)
+    return TubePicture(branches, pm)
+
+
+def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:
+    """``primary`` and the bulge branch switched at its odd branch point ``point`` (tube/bulge.py), stopped as
+    ``tube_picture``'s; ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's label."""
+    branches = {"primary": primary}
+    if interrupt.requested():  # in the primary branch's stability and branch points: the bulge not started
+        return TubePicture(branches, pm, interrupted=Stage.BULGE)
+    branches["bulge"] = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
+    stopped = Stage.BULGE if branches["bulge"].stop.code == StopCode.INTERRUPTED else None
+    return TubePicture(branches, pm, interrupted=stopped)
+
+
+def onset_picture(scene, name: str = "M", direction: float = 1.0) -> TubePicture:
+    """``critical`` on a tube: the primary branch and the curve of its first odd branch point (the onset of bulging)
+    followed in ``name`` (tube/onset.py); no curve where the primary branch has no odd branch point."""
+    pm = maxwell(scene)  # first, as in tube_picture
+    primary = primary_branch(scene)
+    branches = {"primary": primary}
+    if primary.stop.code == StopCode.INTERRUPTED:
+        return TubePicture(branches, pm, interrupted=Stage.PRIMARY)
+    onsets = primary.branch_points(Mirror.ODD)
+    if not onsets:
+        return TubePicture(branches, pm)
+    return onset_from(scene, primary, onsets[0], name, direction, pm)
+
+
+def onset_from(scene, primary: IntervalBranch, point, name: str, direction: float, pm: float | None) -> TubePicture:
+    """``primary`` and the curve of its odd branch point ``point`` followed in ``name`` (tube/onset.py), as
+    ``onset_picture``'s; also ``continue --parameter M`` from a tube file's label."""
+    branches = {"primary": primary}
+    if interrupt.requested():  # in the primary branch's stability and branch points: the curve not started
+        return TubePicture(branches, pm, interrupted=Stage.ONSET)
+    curve = onset_curve(scene, primary, point, name, direction)
+    return TubePicture(branches, pm, curve, Stage.ONSET if curve.stop.code == StopCode.INTERRUPTED else None)
 
 
 def maxwell(scene) -> float | None:

@@ -6,7 +6,8 @@ The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium; with its
 by pseudo-arclength continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted
 to the even block, interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps
 its equator symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the
-north pole stretch means nothing), or after ``continuation.max_points``; the points located up to stop_stretch are kept,
+north pole stretch means nothing), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
+(numerics.interrupt: StopCode.INTERRUPTED); the points located up to stop_stretch are kept,
 those in the step that passed it included. Folds in P (LP) are located by the tracer's fold monitor. At every point the
 second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the spectrum of each is computed (its
 lowest eigenvalue stored); where a block's number of negative eigenvalues changes between neighbours, each eigenvalue
@@ -22,7 +23,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .results import IntervalBranch, IntervalSpecial, IntervalStop
+from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, spectrum, unstable_counts
 from ..analysis.crossings import count_changes
 from ..analysis.problem import ParameterSystem, continuation_settings
@@ -102,6 +103,8 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     limit = scene.continuation.stop_stretch
 
     def stop(point):
+        if (interrupted := signalled()) is not None:
+            return interrupted
         hoop = eq.disc.node_state(system.full(point.X)[:-1])[0].max()
         if hoop > limit:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch {limit:g}")

@@ -1,12 +1,14 @@
-"""A tube's branch as plain data: its points, the located points (LP, LV, BP) and why the trace stopped."""
+"""A tube's branch as plain data: its points, the located points (LP, LV, BP) and why the trace stopped (a signal:
+``signalled``, StopCode.INTERRUPTED)."""
 import enum
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.results import Kind
+from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
+from ..numerics import interrupt
 from ..numerics.continuation import RootStatus, Stop
 
 
@@ -16,6 +18,13 @@ class IntervalStop(enum.StrEnum):
     HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
     REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
     VOLUME = "volume"  # V/V0 passed the stop_volume asked for
+
+
+def signalled() -> Stop | None:
+    """The stop of a trace at its next point once SIGINT or SIGTERM asked for one (numerics.interrupt), else None."""
+    if interrupt.requested():
+        return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
+    return None
 
 
 @dataclass(frozen=True)

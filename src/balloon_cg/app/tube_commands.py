@@ -1,0 +1,168 @@
+"""The commands on a tube scene (docs/shapes.md): ``run`` (tube/picture.tube_picture) and ``critical``
+(tube/picture.onset_picture) write a tube run file (io/tube_file.py) and summarise it. A signal (SIGINT or SIGTERM,
+numerics.interrupt) stops the work at its next point or before its next stage: what is finished is written, the
+file's ``interrupted`` attribute names the stage, and the command exits 130 with one line read from the file."""
+import sys
+
+from .cli import INTERRUPTED, PROG, Failure, UsageError, _say, field_needed
+
+
+def run_tube(scene, output, args) -> int:
+    """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
+    written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring)."""
+    from ..io.tube_file import read_tube_run
+    from ..tube.picture import tube_picture
+    from .tube_summary import format_tube, summarise_tube
+
+    run, signalled = _written(output, args, lambda: tube_picture(scene, args.primary_only), scene)
+    code = interrupted_status(run, output, signalled)
+    if code is not None:
+        return code
+    if not args.quiet:
+        print(format_tube(summarise_tube(read_tube_run(output))))
+    return 0
+
+
+def critical_tube(scene, output, args) -> int:
+    """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
+    followed in M, written with the primary branch to the tube run file ``output`` (its /onset group) and summarised.
+    Exit 0 with ``critical M = ...`` where the curve turns back in M (a located fold: the onset's largest or smallest
+    M), 1 (the file still written) where it does not; 1 without a file where the primary branch has no odd branch
+    point; 2 for anything but the onset (--of BP) in M, or no coils; 130 when a signal stopped it (module
+    docstring)."""
+    from ..tube.picture import onset_picture
+
+    if args.of != "BP" or args.parameter not in ("M", "field.M"):
+        raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M: {args.scene}: --of "
+                         f"{args.of} --parameter {args.parameter}")
+    field_needed(scene, args.parameter, "critical --parameter M", args.scene)
+
+    def picture():
+        found = onset_picture(scene, "M", args.direction)
+        if found.onset is None and found.interrupted is None:
+            primary = found.branches["primary"]
+            raise Failure(f"no odd branch point (the onset of bulging) on the primary branch of {args.scene} "
+                          f"({primary.stop.message}): nothing to follow in M")
+        return found
+
+    run, signalled = _written(output, args, picture, scene)
+    code = interrupted_status(run, output, signalled)
+    if code is not None:
+        return code
+    onset = run["onset"]
+    _say(args, f"onset curve: {len(onset['q'])} points, stop {onset['attrs']['stop_code']} "
+               f"({onset['attrs']['stop_message']})")
+    if not onset["folds"]:
+        raise Failure(f"no critical M: the onset curve does not turn back in M ({onset['attrs']['stop_message']}; "
+                      f"last point M = {onset['q'][-1]:.10g}, P = {onset['pressure'][-1]:.10g}); curve written to "
+                      f"{output}")
+    fold = max(onset["folds"], key=lambda f: args.direction * f["q"])
+    print(f"critical M = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in M: "
+          f"{fold['status']}); curve written to {output}")
+    return 0
+
+
+def _written(output, args, compute, scene) -> tuple:
+    """``compute()`` (a TubePicture) under ``stop_on_signals``, written to ``output`` (owned, checked first) and read
+    back: (the file's contents, whether a signal came)."""
+    from ..io.lock import claim
+    from ..io.output import check_output
+    from ..io.tube_file import read_tube_run, write_tube_run
+    from ..numerics.interrupt import requested, stop_on_signals
+
+    with claim(output, args.command):
+        check_output(output, args.force)
+        with stop_on_signals():
+            write_tube_run(output, scene, compute(), args.force, args.command_line)
+            signalled = requested()
+    return read_tube_run(output), signalled
+
+
+def interrupted_status(run: dict, output, signalled: bool) -> int | None:
+    """130 when the tube run file ``run`` says a signal stopped its work (its ``interrupted`` stage; the line is
+    the file's: the stage, its points or that it had not started); else None, having said so when a signal came
+    once the work had finished (``signalled``: the file is whole)."""
+    stage = run["attrs"]["interrupted"]
+    if stage:
+        stored = run["onset"] if stage == "onset" else run["branches"].get(stage)
+        if stored is None:
+            what = "not started"
+        else:
+            what = f"{stored['attrs']['stop_message']}, after {len(stored['pressure'])} points"
+        print(f"{PROG}: interrupted ({stage}: {what}); what was finished is written to {output} (flagged "
+              "interrupted)", file=sys.stderr)
+        return INTERRUPTED
+    if signalled:
+        print(f"{PROG}: a signal arrived once the work had finished: {output} is written whole", file=sys.stderr)
+    return None
+
+
+def tube_labels(run: dict) -> list:
+    """The labels of a tube run (``read_tube_run``'s dict), as ``inspect`` numbers them: (branch, its k-th located
+    point, the point) for the primary branch's located points, then the other branches'."""
+    ordered = sorted(run["branches"].items(), key=lambda item: item[0] != "primary")
+    return [(name, k, s) for name, b in ordered for k, s in enumerate(b["special_points"])]
+
+
+def continue_tube(args) -> int:
+    """``continue`` from a label of a tube run file (``inspect`` numbers the located points of its branches in
+    order, from 0): at an odd branch point of the primary branch (the onset of bulging) the bulge branch switched
+    there, with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
+    traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
+    the stored primary branch to a tube run file (130 on a signal, as ``run``). Exit 2, before any work, for another
+    label, a setting outside [continuation], another parameter, or no coils for M."""
+    from ..io.tube_file import read_tube_run, stored_branch
+    from ..scene import SceneError, parse_scene
+    from ..scene.tables import Ends
+    from ..tube.picture import bulge_picture, maxwell, onset_from
+    from ..tube.primary import scene_parameters
+    from .cli import _with_settings
+
+    run = read_tube_run(args.run)
+    labels = tube_labels(run)
+    onsets = [i for i, (name, _, s) in enumerate(labels) if (name, s["kind"], s["block"]) == ("primary", "BP", "odd")]
+    if not 0 <= args.label < len(labels) or args.label not in onsets:
+        if 0 <= args.label < len(labels):
+            name, _, s = labels[args.label]
+            what = " ".join(filter(None, (s["kind"], s["block"]))) + f" on branch {name}"
+        else:
+            what = "no such label"
+        raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from an odd branch point "
+                         f"of its primary branch (the onset of bulging): labels {', '.join(map(str, onsets)) or 'none'}")
+    if args.parameter not in (None, "P", "M", "field.M"):
+        raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M "
+                         "(allowed: M, or none for the bulge branch)")
+    try:
+        stored = parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
+    except SceneError as e:
+        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
+    scene, overrides = _with_settings(args, stored)
+    other = [key for key in overrides if not key.startswith("continuation.")]
+    if other:
+        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
+                         "the file's scene; allowed: continuation.* keys")
+    in_field = args.parameter in ("M", "field.M")
+    if in_field:
+        field_needed(scene, "M", "continue --parameter M", args.run)
+    elif scene.geometry.ends != Ends.SLIDING:
+        raise UsageError(f"continue {args.run}: the bulge branch is switched on sliding ends, not "
+                         f"{scene.geometry.ends.value}")
+    name, k, _ = labels[args.label]
+    primary = stored_branch(run, "primary", scene_parameters(scene))
+    point = primary.special[k]
+
+    def picture():
+        pm = maxwell(scene)
+        if in_field:
+            return onset_from(scene, primary, point, "M", args.direction, pm)
+        return bulge_picture(scene, primary, point, pm)
+
+    written, signalled = _written(args.output, args, picture, scene)
+    code = interrupted_status(written, args.output, signalled)
+    if code is not None:
+        return code
+    grown = written["onset"] if in_field else written["branches"]["bulge"]
+    size = len(grown["q"] if in_field else grown["pressure"])
+    print(f"{'onset curve in M' if in_field else 'bulge branch'} from label {args.label}: {size} points, stop "
+          f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
+    return 0

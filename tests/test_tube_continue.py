@@ -1,0 +1,71 @@
+"""``balloon-cg continue`` from a tube run file's label (issue 38): at the onset of bulging (an odd branch point of
+the primary branch) the bulge branch switched there with new continuation settings is the one ``run`` traces with
+them, bit for bit (the bulge traced further than the file's); with ``--parameter M`` the onset curve is
+``critical``'s; any other label, setting or parameter exits 2 with one line and writes nothing."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balloon_cg.app.cli import main
+from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.scene import load_scene
+from balloon_cg.tube.picture import tube_picture
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "scenes" / "tube_spom1_L10.toml"
+COIL_SCENE = ROOT / "scenes" / "tube_spom1_L10_coil.toml"
+FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]
+COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("continue") / "tube.h5"
+    assert main(["run", str(SCENE), "-o", str(path), "--quiet", *FAST]) == 0
+    return path
+
+
+def test_the_bulge_from_the_onset_label_is_runs_with_the_new_settings(run_file, tmp_path, capsys):
+    out = tmp_path / "further.h5"
+    assert main(["continue", str(run_file), "1", "--set", "continuation.stop_stretch=4", "-o", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("bulge branch from label 1: ")
+    continued, stored = read_tube_run(out), read_tube_run(run_file)
+    assert np.array_equal(continued["branches"]["primary"]["unknowns"], stored["branches"]["primary"]["unknowns"])
+    scene = load_scene(SCENE).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 4})
+    bulge = tube_picture(scene).branches["bulge"]
+    assert np.array_equal(continued["branches"]["bulge"]["unknowns"], bulge.states)
+    assert [s["pressure"] for s in continued["branches"]["bulge"]["special_points"]] == \
+        [s.pressure for s in bulge.special]
+    assert len(bulge.pressure) > len(stored["branches"]["bulge"]["pressure"])  # further than the file's
+
+
+def test_the_onset_in_m_from_the_label_is_critical_s(tmp_path, capsys):
+    critical = tmp_path / "critical.h5"
+    assert main(["critical", str(COIL_SCENE), "--parameter", "M", "-o", str(critical), "--quiet", *COIL_FAST]) == 0
+    stored = read_tube_run(critical)
+    label = next(k for k, s in enumerate(stored["branches"]["primary"]["special_points"])
+                 if (s["kind"], s["block"]) == ("BP", "odd"))
+    out = tmp_path / "onset.h5"
+    assert main(["continue", str(critical), str(label), "--parameter", "M", "-o", str(out)]) == 0
+    onset = read_tube_run(out)["onset"]
+    assert np.array_equal(onset["q"], stored["onset"]["q"]) and np.array_equal(onset["unknowns"],
+                                                                                stored["onset"]["unknowns"])
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["0"], "label 0: LP on branch primary; a tube continues from an odd branch point of its primary branch (the "
+            "onset of bulging): labels 1, 3, 5"),
+    (["6"], "label 6: LV on branch bulge;"),
+    (["17"], "label 17: no such label;"),
+    (["1", "--set", "material.preset=TPOM1"], "--set material.preset=TPOM1: the stored branch belongs to the file's "
+                                              "scene; allowed: continuation.* keys"),
+    (["1", "--parameter", "chi"], "--parameter chi: a tube's onset is followed in M"),
+    (["1", "--parameter", "M"], "continue --parameter M needs coils"),
+])
+def test_other_labels_settings_and_parameters_exit_2_in_one_line(run_file, tmp_path, capsys, extra, message):
+    out = tmp_path / "x.h5"
+    assert main(["continue", str(run_file), *extra, "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+    assert not out.exists()

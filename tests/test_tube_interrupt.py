@@ -1,0 +1,136 @@
+"""Issue 42's contract on tubes (issue 38): a signal during `run` or `critical` on a tube scene stops it at its next
+point (or before its next stage), writes what is finished flagged ``interrupted`` with the stage named, and exits
+130 with one line that says what the file says; what is written is the uninterrupted run's, point for point, up to
+where it stopped. The moments are placed by the code's own hooks (the n-th call of a function, in a fresh
+interpreter that sends itself the signal there: test_signal_moments.py's driver) and, for the latency, by the
+command's own CPU time (tests/cpu_moments.py): no sleeps, the same on any machine."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balloon_cg.app.cli import main
+from balloon_cg.io.tube_file import read_tube_run
+
+from cpu_moments import command, evenly, handled
+from test_signal_moments import balloon_cg, one_line
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = str(ROOT / "scenes" / "tube_spom1_L10.toml")
+COIL_SCENE = str(ROOT / "scenes" / "tube_spom1_L10_coil.toml")
+FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s of CPU, both branches
+COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
+LATENCY = 2.0  # CPU seconds from the signal to the process's exit (issue 42)
+
+
+def run_argv(output: str) -> list:
+    return ["run", SCENE, "-o", output, "--quiet", "--force", *FAST]
+
+
+def critical_argv(output: str) -> list:
+    return ["critical", COIL_SCENE, "--parameter", "M", "-o", output, "--quiet", "--force", *COIL_FAST]
+
+
+@pytest.fixture(scope="module")
+def references(tmp_path_factory):
+    """The uninterrupted run and critical files."""
+    folder = tmp_path_factory.mktemp("reference")
+    assert balloon_cg(folder, "SIGTERM", "never", run_argv("run.h5")) == (0, "")
+    assert balloon_cg(folder, "SIGTERM", "never", critical_argv("critical.h5"))[0] == 0
+    return read_tube_run(folder / "run.h5"), read_tube_run(folder / "critical.h5")
+
+
+def checked(path: Path, line: str, reference: dict) -> str:
+    """The stage the file names, checked against the command's ``line`` and the uninterrupted ``reference``: the
+    stage's branch (or curve) ends ``interrupted`` where it had started, its points the reference's first ones bit for
+    bit, and is absent where it had not; every other branch is the reference's whole."""
+    run = read_tube_run(path)
+    stage = run["attrs"]["interrupted"]
+    stored = run["onset"] if stage == "onset" else run["branches"].get(stage)
+    if stored is None:
+        what = "not started"
+    else:
+        what = f"{stored['attrs']['stop_message']}, after {len(stored['pressure'])} points"
+        assert stored["attrs"]["stop_code"] == "interrupted"
+        whole = reference["onset"] if stage == "onset" else reference["branches"][stage]
+        n = len(stored["pressure"])
+        assert n < len(whole["pressure"]) and np.array_equal(stored["unknowns"], whole["unknowns"][:n])
+    assert line == (f"balloon-cg: interrupted ({stage}: {what}); what was finished is written to {path.name} "
+                    "(flagged interrupted)"), line
+    for name, branch in run["branches"].items():
+        if name != stage:
+            assert branch["attrs"]["stop_code"] != "interrupted"
+            assert np.array_equal(branch["unknowns"], reference["branches"][name]["unknowns"])
+    return stage
+
+
+# (the hook, its call, the stage it falls in, whether that stage's branch had started)
+RUN_MOMENTS = [("after balloon_cg.numerics.continuation:correct", 10, "primary", True),  # the primary's 10th step
+               ("after balloon_cg.tube.primary:stressed", 1, "bulge", False),  # the primary's points located
+               ("after balloon_cg.tube.bulge:Equilibrium", 1, "bulge", True)]  # the bulge's start
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("moment, call, stage, started", RUN_MOMENTS)
+def test_a_signal_during_a_tube_run_writes_what_is_finished(references, tmp_path, capsys, sig, moment, call, stage,
+                                                            started):
+    code, err = balloon_cg(tmp_path, sig, moment, run_argv("r.h5"), call)
+    assert code == 130, err
+    assert checked(tmp_path / "r.h5", one_line(err), references[0]) == stage
+    assert ("bulge" in read_tube_run(tmp_path / "r.h5")["branches"]) == (stage == "bulge" and started)
+    assert main(["inspect", str(tmp_path / "r.h5")]) == 0
+    assert f"interrupted    a signal stopped the {stage} stage: what follows it is missing" in capsys.readouterr().out
+
+
+CRITICAL_MOMENTS = [("after balloon_cg.numerics.continuation:correct", 10, "primary"),
+                    ("after balloon_cg.tube.primary:stressed", 1, "onset"),  # the curve not started
+                    ("after balloon_cg.tube.onset:newton", 1, "onset")]  # the curve's first point
+
+
+@pytest.mark.parametrize("moment, call, stage", CRITICAL_MOMENTS)
+def test_a_signal_during_critical_on_a_tube_writes_what_is_finished(references, tmp_path, moment, call, stage):
+    code, err = balloon_cg(tmp_path, "SIGINT", moment, critical_argv("c.h5"), call)
+    assert code == 130, err
+    assert checked(tmp_path / "c.h5", one_line(err), references[1]) == stage
+    run = read_tube_run(tmp_path / "c.h5")
+    assert (run["onset"] is not None) == (moment.endswith(":newton"))
+
+
+def test_a_signal_once_the_file_is_written_exits_0_and_says_so(references, tmp_path):
+    code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.io.tube_file:write_tube_run", run_argv("r.h5"))
+    assert code == 0 and one_line(err) == "balloon-cg: a signal arrived once the work had finished: r.h5 is " \
+                                          "written whole"
+    run = read_tube_run(tmp_path / "r.h5")
+    assert run["attrs"]["interrupted"] == "" and set(run["branches"]) == set(references[0]["branches"])
+
+
+@pytest.fixture(scope="module")
+def reference_cpu(tmp_path_factory):
+    """The CPU seconds of an uninterrupted tube run from the call of its command (cpu_moments.handled)."""
+    folder = tmp_path_factory.mktemp("cpu")
+    done = command(folder, run_argv("r.h5"), moment=handled("balloon_cg.app.tube_commands:run_tube"))
+    assert done.code == 0 and done.stderr == "", done.stderr
+    return folder, done.handler_cpu
+
+
+@pytest.mark.parametrize("k", range(3))
+def test_a_signal_at_an_evenly_spaced_moment_stops_a_tube_run_within_2_s(references, reference_cpu, k):
+    """Three moments evenly spaced over the run's CPU: within 2 s of CPU after the signal the command has exited,
+    130 with the file's line (or 0 where the work had finished, and it says so)."""
+    folder, total = reference_cpu
+    t = evenly(total, 3)[k]
+    (folder / "r.h5").unlink(missing_ok=True)
+    got = command(folder, run_argv("r.h5"), "SIGTERM", handled("balloon_cg.app.tube_commands:run_tube", t))
+    if not got.fired:  # the replay finished before the moment
+        assert got.code == 0 and got.stderr == ""
+        print(f"moment {t:.3f} s of {total:.3f} s CPU: finished before it")
+        return
+    assert got.cpu_after <= LATENCY, (got.cpu_after, got.stderr)
+    line = one_line(got.stderr)
+    if got.code == 0:
+        assert line == "balloon-cg: a signal arrived once the work had finished: r.h5 is written whole"
+        print(f"moment {t:.3f} s of {total:.3f} s CPU: the work had finished")
+        return
+    assert got.code == 130, line
+    stage = checked(folder / "r.h5", line, references[0])
+    print(f"moment {t:.3f} s of {total:.3f} s CPU: {stage}, exit after {got.cpu_after:.3f} s CPU")

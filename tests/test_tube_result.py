@@ -1,0 +1,102 @@
+"""``balloon_cg.load`` of a tube run file (app/tube_result.py): every group of the file (each branch's points and
+located points, the onset curve of ``critical``) as an xarray Dataset and as a pandas table holds the file's numbers
+(io.tube_file.read_tube_run), the shape's parameters are attributes; a branch or part that is not there is named."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import balloon_cg as bc
+from balloon_cg.app.cli import main
+from balloon_cg.io.tube_file import read_tube_run
+
+ROOT = Path(__file__).resolve().parents[1]
+FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]
+COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("tube")
+    run, critical = folder / "run.h5", folder / "critical.h5"
+    assert main(["run", str(ROOT / "scenes" / "tube_spom1_L10.toml"), "-o", str(run), "--quiet", *FAST]) == 0
+    assert main(["critical", str(ROOT / "scenes" / "tube_spom1_L10_coil.toml"), "--parameter", "M", "-o",
+                 str(critical), "--quiet", *COIL_FAST]) == 0
+    return run, critical
+
+
+def test_each_branch_as_xarray_holds_the_file(files):
+    pytest.importorskip("xarray")
+    tube = bc.load(files[0])
+    stored = read_tube_run(files[0])
+    assert isinstance(tube, bc.TubeResult) and tube.interrupted is None
+    assert tube.geometry == {"shape": "tube", "length": 10.0, "ends": "sliding", "axial_stretch": None}
+    assert tube.maxwell_pressure == stored["attrs"]["maxwell_pressure"]
+    for name, branch in stored["branches"].items():
+        points = tube.to_xarray(name)
+        assert points.sizes["point"] == len(branch["pressure"]) and points.attrs["stop_code"] == \
+            branch["attrs"]["stop_code"]
+        for column in ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress",
+                       "crest_height"):
+            assert np.array_equal(points[column].values, branch[column])
+        assert np.array_equal(points["unknowns"].values, branch["unknowns"])
+        special = tube.to_xarray(name, "special")
+        assert list(special["kind"].values) == [s["kind"] for s in branch["special_points"]]
+        assert np.array_equal(special["pressure"].values, [s["pressure"] for s in branch["special_points"]])
+        assert np.array_equal(special["unknowns"].values, branch["special_unknowns"])
+    assert "lowest_odd" in tube.to_xarray("primary") and tube.to_xarray("primary").attrs["length"] == 10.0
+    with pytest.raises(KeyError, match="no branch 'pear' \\(branches: bulge, primary\\)"):
+        tube.to_xarray("pear")
+    with pytest.raises(ValueError, match="part = 'shapes': must be 'points' or 'special'"):
+        tube.to_xarray("bulge", "shapes")
+    with pytest.raises(KeyError, match="has no onset curve"):
+        tube.to_xarray("onset")
+
+
+def test_tables_hold_every_point_and_located_point(files):
+    pytest.importorskip("pandas")
+    tube = bc.load(files[0])
+    stored = read_tube_run(files[0])
+    points = tube.to_dataframe()
+    for name, branch in stored["branches"].items():
+        rows = points[points.branch == name]
+        assert np.array_equal(rows.pressure.values, branch["pressure"]) and list(rows.point) == \
+            list(range(len(branch["pressure"])))
+    special = tube.to_dataframe("special")
+    assert list(special.kind) == [s["kind"] for b in stored["branches"].values() for s in b["special_points"]]
+    with pytest.raises(ValueError, match="must be 'points', 'special' or 'onset'"):
+        tube.to_dataframe("curve")
+
+
+def test_the_onset_curve_as_xarray_and_table(files):
+    pytest.importorskip("xarray")
+    tube = bc.load(files[1])
+    onset = read_tube_run(files[1])["onset"]
+    data = tube.to_xarray("onset")
+    assert np.array_equal(data["M"].values, onset["q"]) and np.array_equal(data["pressure"].values, onset["pressure"])
+    assert np.array_equal(data["modes"].values, onset["modes"]) and data.attrs["parameter"] == "M"
+    assert np.array_equal(data["unknowns"].values, onset["unknowns"])
+    table = tube.to_dataframe("onset")
+    assert np.array_equal(table.M.values, onset["q"]) and np.array_equal(table.crest_height.values,
+                                                                          onset["crest_height"])
+    assert "onset in M" in repr(tube)
+
+
+def test_every_group_opens_with_xarray_with_named_dimensions(files):
+    """xarray with h5netcdf opens each group of a tube run file alone, its axes named (the file's dimension
+    scales) and its datasets described; the values are the file's."""
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    stored = read_tube_run(files[1])
+    groups = {f"branches/{name}": ("point", "unknown") for name in stored["branches"]}
+    groups |= {f"branches/{name}/special_points": ("special", "unknown") for name in stored["branches"]}
+    groups |= {"onset": ("point", "unknown", "mode"), "onset/folds": ("special",)}
+    for group, dims in groups.items():
+        with xr.open_dataset(files[1], engine="h5netcdf", group=group) as ds:
+            assert set(ds.sizes) == set(dims), (group, ds.sizes)
+            assert all(ds[name].attrs["long_name"] for name in ds.data_vars), group
+    with xr.open_dataset(files[1], engine="h5netcdf", group="onset") as ds:
+        assert ds["modes"].dims == ("point", "mode") and np.array_equal(ds["q"].values, stored["onset"]["q"])
+    with xr.open_dataset(files[1], engine="h5netcdf", group="branches/primary") as ds:
+        assert ds["unknowns"].dims == ("point", "unknown") and ds["volume"].attrs["units"] == "1"
+        assert np.array_equal(ds["unknowns"].values, stored["branches"]["primary"]["unknowns"])
