@@ -14,15 +14,19 @@ basis as the Hessian K and the small oscillations q = q̂ e^{iωt} solve K q̂ =
 - m ≥ 1 (codegen/second_variation.py: y = (R, R', Z, Z', T, T')): δx is the ε-coefficient of its ``surface()``,
   R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z, and the φ-average gives t = ¼ (R² + T² + Z²).
 
-The kernels return ∂²t over the pairs of each block's variables (the layouts of ``energy_hessian`` and
-``azimuthal_hessian``); they depend on the node alone (the reference sphere), so they form one module for every
-scene class, ``generated/inertia.py``.
+On a reference meridian with poles (codegen/meridian.py: R = sin θ, so δx is the same) the area element is
+dA = R S' dθ dφ = S' d(−cos θ) dφ, S' = dS/dθ the meridian's metric: t carries the factor S' as every energy
+density does (``per_area``; the sphere's S' = 1 leaves its kernels as they were, the spheroid's kernels are
+``spheroid_*`` and take its aspect). The kernels return ∂²t over the pairs of each block's variables (the layouts
+of ``energy_hessian`` and ``azimuthal_hessian``); they depend on the node (and the meridian's scalars) alone, so
+they form one module for every scene class, ``generated/inertia.py``.
 """
 import sympy as sp
 
 from .equations import HESSIAN_PAIRS, pair_labels
 from .functional import STATE, cos_theta, eta, lam2, sin_theta
 from .kernels import Arg, Kernel
+from .meridian import SPHERE, SPHEROID, Meridian
 from .second_variation import PAIRS, PERTURBATION, dot, epsilon_order, phi_average, surface
 
 TITLE = "Mass matrices of the membrane's kinetic energy for the second-variation blocks (MODEL.md §11)."
@@ -43,24 +47,40 @@ def azimuthal_density():
     return phi_average(dot(moved, moved) / 2)
 
 
+def per_area(density, meridian: Meridian):
+    """A density per d(cos θ) of the sphere's area element as one per the meridian's: times S' (dA = S' d(cos θ) dφ
+    with R = sin θ)."""
+    return sp.expand(density * meridian.metric(cos_theta, sin_theta))
+
+
 def _mass_entries(density, variables, pairs):
     return tuple(sp.diff(density, variables[i], variables[j]) for i, j in pairs)
 
 
-def inertia_kernels() -> list[Kernel]:
-    args = (Arg.node(cos_theta), Arg.node(sin_theta))
+def kernel_name(block: str, meridian: Meridian) -> str:
+    """The mass kernel of ``block`` ('axisymmetric' or 'azimuthal') on ``meridian``: '<block>_mass' on the sphere,
+    '<meridian>_<block>_mass' on another."""
+    return f"{block}_mass" if meridian.name == SPHERE.name else f"{meridian.name}_{block}_mass"
+
+
+def inertia_kernels(meridian: Meridian = SPHERE) -> list[Kernel]:
+    args = (Arg.node(cos_theta), Arg.node(sin_theta), *map(Arg.param, meridian.parameters))
+    area = "" if meridian.name == SPHERE.name else f" S' (the {meridian.name}'s area element)"
     return [
-        Kernel("axisymmetric_mass",
-               "∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(sin²θ λ̇2² + η̇²) (m = 0), "
+        Kernel(kernel_name("axisymmetric", meridian),
+               f"∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(sin²θ λ̇2² + η̇²){area} (m = 0), "
                "upper triangle row by row (the layout of energy_hessian).",
-               args, _mass_entries(axisymmetric_density(), STATE, HESSIAN_PAIRS), pair_labels(STATE, HESSIAN_PAIRS)),
-        Kernel("azimuthal_mass",
-               "∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²) (m ≥ 1), y = (R, R', Z, Z', T, T'), "
-               "upper triangle row by row (the layout of azimuthal_hessian).",
-               args, _mass_entries(azimuthal_density(), PERTURBATION, PAIRS), pair_labels(PERTURBATION, PAIRS)),
+               args, _mass_entries(per_area(axisymmetric_density(), meridian), STATE, HESSIAN_PAIRS),
+               pair_labels(STATE, HESSIAN_PAIRS)),
+        Kernel(kernel_name("azimuthal", meridian),
+               f"∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²){area} (m ≥ 1), "
+               "y = (R, R', Z, Z', T, T'), upper triangle row by row (the layout of azimuthal_hessian).",
+               args, _mass_entries(per_area(azimuthal_density(), meridian), PERTURBATION, PAIRS),
+               pair_labels(PERTURBATION, PAIRS)),
     ]
 
 
 def inertia_module():
-    """(title, inputs, kernels) for ``generated/inertia.py``."""
-    return TITLE, {"kinetic_energy": "1/2 rho T0 |du/dt|^2 dA over the reference sphere"}, inertia_kernels()
+    """(title, inputs, kernels) for ``generated/inertia.py``: the sphere's and the spheroid's mass kernels."""
+    return (TITLE, {"kinetic_energy": "1/2 rho T0 |du/dt|^2 dA over the reference surface"},
+            inertia_kernels(SPHERE) + inertia_kernels(SPHEROID))

@@ -46,20 +46,23 @@ from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import even_half, symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.legendre import assoc_legendre, legendre_values
-from ..generated import AZIMUTHAL_PAIRS, inertia
+from ..generated import AZIMUTHAL_PAIRS
+from ..model.meridian import mass_density, metric
 from ..numerics import eigen
+from ..scene.tables import Geometry, Shape
 
 
 @dataclass(frozen=True)
 class AzimuthalBasis:
     """Basis of the cos mφ perturbations (module docstring) at Gauss–Legendre nodes in x = cos θ; with a ``mapping``
     (coordinate_map.WireMap, s = h(x)) the functions P̄_k^j(s(x)) at Gauss nodes in s, weights w_q/h'(x_q)
-    (``_nodes_and_functions``)."""
+    (``_nodes_and_functions``); ``geometry`` the reference surface of its mass matrix (model/meridian.py)."""
 
     m: int
     degree: int
     quadrature: int
     mapping: WireMap | None = None
+    geometry: Geometry = Geometry()
 
     def __post_init__(self):
         m, n = self.m, self.degree
@@ -86,15 +89,16 @@ class AzimuthalBasis:
         z = blocks["Z"][0]
         put(self, "ops_z", np.ascontiguousarray(ops[2:4, :, z]))
         put(self, "ops_ud", np.ascontiguousarray(ops[[0, 1, 4, 5], :, z.stop:]))
-        # the kinetic energy's mass matrix (generated/inertia.py: t = ¼(Ṙ² + Ṫ² + Ż²) per d(cos θ))
-        mass = np.empty((len(inertia.KERNELS["azimuthal_mass"]["outputs"]), x.size))
-        inertia.azimuthal_mass_nodes(x, self.sin_theta, mass)
+        # the kinetic energy's mass matrix (generated/inertia.py: t = ¼(Ṙ² + Ṫ² + Ż²) S' per d(cos θ))
+        mass = mass_density(self.geometry, "azimuthal", x, self.sin_theta)
         put(self, "gram", _assemble(mass, weights, _pair_rows(AZIMUTHAL_PAIRS), self.ops_ud, self.ops_z))
-        # orthonormal P̄ in x: G = diag(½ | ¼, ¼); in s, ∫ P̄_k^j(s) P̄_l^j(s) dx is not diagonal
-        orthogonal = self.mapping is None
+        # orthonormal P̄ in x: G = diag(½ | ¼, ¼) on the sphere; in s, ∫ P̄_k^j(s) P̄_l^j(s) dx is not diagonal, nor
+        # ∫ P̄_k^j P̄_l^j S' dx on a spheroid
+        orthogonal = self.mapping is None and self.geometry.shape == Shape.SPHERE
         put(self, "factor", eigen.GramFactor(self.gram, orthogonal=orthogonal))
-        # G c for the L2 (‖δx‖) projection c of node values (R, T, Z): ½ Σ_q w_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
-        moments = 0.5 * ops[[0, 4, 2]] * weights[None, :, None]
+        # G c for the L2 (‖δx‖ over the reference surface) projection c of node values (R, T, Z):
+        # ½ Σ_q w_q S'_q (R ∂R/∂c + T ∂T/∂c + Z ∂Z/∂c)
+        moments = 0.5 * ops[[0, 4, 2]] * (weights * metric(self.geometry, x, self.sin_theta))[None, :, None]
         put(self, "moments", np.ascontiguousarray(moments.reshape(-1, offset)))
         # reflection classes z → −z of an equator-symmetric state (P̄_k^j(−x) = (−1)^{k+j} P̄_k^j(x); on the odd map of
         # an equator-symmetric state, s(−x) = −s(x), the same): k + m odd is
@@ -190,8 +194,9 @@ def default_quadrature(degree: int, equilibrium_degree: int) -> int:
 
 
 @lru_cache(maxsize=32)
-def basis(m: int, degree: int, quadrature: int, mapping: WireMap | None = None) -> AzimuthalBasis:
-    return AzimuthalBasis(m, degree, quadrature, mapping)
+def basis(m: int, degree: int, quadrature: int, mapping: WireMap | None = None,
+          geometry: Geometry = Geometry()) -> AzimuthalBasis:
+    return AzimuthalBasis(m, degree, quadrature, mapping, geometry)
 
 
 @dataclass(frozen=True)
@@ -320,7 +325,7 @@ def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature
     wire map (``perturbation_map``; ``kind`` None: the scene's stability.basis). Quadrature: ``default_quadrature``
     (on a map both degrees are in s)."""
     return basis(int(m), int(degree), int(quadrature or default_quadrature(degree, equilibrium.disc.degree)),
-                 perturbation_map(equilibrium, kind))
+                 perturbation_map(equilibrium, kind), equilibrium.scene.geometry)
 
 
 MODES = ("translation", "rotation", "relabelling")

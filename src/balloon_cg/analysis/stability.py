@@ -30,12 +30,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.polynomial import legendre
 
-from ..generated import inertia
 from .azimuthal import merged_lowest, perturbation_map, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ..galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
                                        read_only)
 from ..galerkin.equilibrium import NodeKernels, Parameters
+from ..model.meridian import mass_density
 from ..numerics import eigen, interrupt, workers
 from .problem import equilibrium_of
 from .resolution import Resolution, transfer_error
@@ -109,10 +109,11 @@ class SecondVariation:
                                           read_only(np.ascontiguousarray(ops[2:4, :, na:])))
             self._gradient_ops = read_only(np.ascontiguousarray(ops.reshape(-1, self.basis.size).T))
         # the norm: ∫(δλ2² + δη²) dx ("unknowns"), or |δx|² = ∫(sin²θ δλ2² + δη²) dx ("displacement", δρ = sin θ δλ2):
-        # the mass matrix of the membrane's kinetic energy (generated/inertia.py)
+        # the mass matrix of the membrane's kinetic energy over the reference surface (model/meridian.py: S' dx)
         self.norm = norm
         if norm == "displacement":
-            self.gram = assemble_hessian(_axisymmetric_mass(self.basis), w, self.basis_a, self.basis_b)
+            mass = mass_density(equilibrium.scene.geometry, "axisymmetric", self.basis.cos_theta, self.basis.sin_theta)
+            self.gram = assemble_hessian(mass, w, self.basis_a, self.basis_b)
         else:
             self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
         self._orthogonal = mapping is None and norm != "displacement"  # diagonal: "unknowns" in x only
@@ -294,14 +295,6 @@ class SecondVariation:
                 for flag in flags:
                     stable[flag] = False
         return tuple(stable)
-
-
-def _axisymmetric_mass(basis: Discretisation) -> np.ndarray:
-    """The kinetic energy's mass density ∂²t/∂(λ2, v, η, w)² at the nodes of ``basis`` (``axisymmetric_mass``, in
-    the layout of energy_hessian): t = ½(sin²θ λ̇2² + η̇²) per d(cos θ)."""
-    out = np.empty((len(inertia.KERNELS["axisymmetric_mass"]["outputs"]), basis.x.size))
-    inertia.axisymmetric_mass_nodes(basis.cos_theta, basis.sin_theta, out)
-    return out
 
 
 def _held_ops(basis: Discretisation) -> np.ndarray:

@@ -9,9 +9,10 @@ mode is mass-normalised, qᵀMq = 1, and drawn as a displacement of the referenc
     m = 0:  δρ = sin θ δλ2,  δz = δη,  δφ = 0      (δλ2 = Σ a_k P_k, δη = Σ b_k P_k less its held mean on a map)
     m ≥ 1:  δρ = R cos mφ,  δz = Z cos mφ,  δφ = T sin mφ, stored as the amplitudes (R, Z, T)
 
-in lengths over R0 for a unit modal mass qᵀMq = (1/2π)∫∫|δx|² dA = 1 over the reference sphere (T = ½ q̇ᵀMq̇ the
-kinetic energy per 2π of generated/inertia.py): ∫(δρ² + δz²) dx = 1 for m = 0, ½∫(R² + Z² + T²) dx = 1 for m ≥ 1
-(x = cos θ); a rigid translation along the axis is δz = 1/√2. The sign: the component of largest magnitude is
+in lengths over R0 for a unit modal mass qᵀMq = (1/2π)∫∫|δx|² dA = 1 over the reference surface (T = ½ q̇ᵀMq̇ the
+kinetic energy per 2π of generated/inertia.py): ∫(δρ² + δz²) S' dx = 1 for m = 0, ½∫(R² + Z² + T²) S' dx = 1 for
+m ≥ 1 (x = cos θ, S' = 1 on the sphere: model/meridian.py); on the sphere a rigid translation along the axis is
+δz = 1/√2. The sign: the component of largest magnitude is
 positive.
 """
 import numpy as np

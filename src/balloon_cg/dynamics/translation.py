@@ -15,13 +15,14 @@ import numpy as np
 
 from ..analysis.azimuthal import kernel_state_map, perturbation_basis
 from ..galerkin.discretisation import symmetric_rows
-from ..generated import AZIMUTHAL_PAIRS, HESSIAN_PAIRS, inertia
+from ..generated import AZIMUTHAL_PAIRS, HESSIAN_PAIRS
+from ..model.meridian import mass_density
 from .pencil import PER_EIGENVALUE
 
 # direction: (the node values of its translation, the stiffness kernel and its layout, the mass kernel)
 DIRECTIONS = {
-    "axial": (np.array([0.0, 0.0, 1.0, 0.0]), "energy_hessian", HESSIAN_PAIRS, "axisymmetric_mass"),
-    "lateral": (np.array([1.0, 0.0, 0.0, 0.0, -1.0, 0.0]), "azimuthal_hessian", AZIMUTHAL_PAIRS, "azimuthal_mass"),
+    "axial": (np.array([0.0, 0.0, 1.0, 0.0]), "energy_hessian", HESSIAN_PAIRS, "axisymmetric"),
+    "lateral": (np.array([1.0, 0.0, 0.0, 0.0, -1.0, 0.0]), "azimuthal_hessian", AZIMUTHAL_PAIRS, "azimuthal"),
 }
 
 
@@ -29,12 +30,6 @@ def _form(pointwise, pairs, t) -> np.ndarray:
     """tᵀ h t at every node from a kernel's upper-triangle rows (``pairs``)."""
     rows = symmetric_rows(pairs)
     return sum(t[k] * t[l] * pointwise[rows[k, l]] for k in range(t.size) for l in range(t.size) if t[k] and t[l])
-
-
-def _mass_density(kernel: str, b) -> np.ndarray:
-    out = np.empty((len(inertia.KERNELS[kernel]["outputs"]), b.x.size))
-    getattr(inertia, f"{kernel}_nodes")(b.x, b.sin_theta, out)
-    return out
 
 
 def translation_omega2(equilibrium, u, params, degree: int) -> dict:
@@ -48,5 +43,5 @@ def translation_omega2(equilibrium, u, params, degree: int) -> dict:
     for direction, (t, stiffness, pairs, mass) in DIRECTIONS.items():
         h = nodes(stiffness, params, m=1.0) if stiffness == "azimuthal_hessian" else nodes(stiffness, params)
         out[direction] = PER_EIGENVALUE * (b.weights @ _form(h, pairs, t)) / (
-            b.weights @ _form(_mass_density(mass, b), pairs, t))
+            b.weights @ _form(mass_density(equilibrium.scene.geometry, mass, b.x, b.sin_theta), pairs, t))
     return out
