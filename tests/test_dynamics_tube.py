@@ -1,0 +1,140 @@
+"""Natural frequencies of a tube (balloon_cg.dynamics.tube) against the vibrations of the uniform inflated cylinder.
+
+Units as the sphere's (tests/test_dynamics.py): lengths over the reference radius, E/2π = ∫_0^L Φ(λ1, λ2) dS − P V/2π
+(the strain energy per reference area over μ/2, V/2π = −½ ∫ ρ² η' dS), kinetic energy per 2π ½ ∫ (ρ̇² + η̇²) dS, and
+Ω² = ν/2 for K u = ν M u.
+
+Uniform state: ρ = a, η = −b (S − L/2) (hoop stretch a, axial b). ∂/∂a of L Φ(b, a) − P · ½ a² b L gives the hoop
+balance P = Φ2/(a b); with closed ends whose distance is free, ∂/∂b gives the axial one Φ1 = ½ P a².
+
+Small vibrations. ρ = a + ε U cos κS, η = −b(S − L/2) + ε W sin κS, κ = kπ/L: ρ' = −ε U κ sin κS, η' = −b + ε W κ cos κS,
+so λ1 = sqrt(ρ'² + η'²) = b − ε W κ c + ε² U² κ² s²/(2b) + O(ε³) and λ2 = a + ε U c (c = cos κS, s = sin κS). The ε²
+part of Φ is Φ1 U² κ² s²/(2b) + ½ Φ11 W² κ² c² − Φ12 κ U W c² + ½ Φ22 U² c², that of V/2π is ½ b U² c² − a κ U W c²;
+with ∫c² = ∫s² = L/2 (k ≥ 1; L for k = 0, W absent), K = 2 × the ε² part and M = ∫(δρ² + δη²) dS:
+
+    K = (L/2) [[Φ1 κ²/b + Φ22 − P b,  (P a − Φ12) κ], [(P a − Φ12) κ, Φ11 κ²]],    M = (L/2) I,
+
+Ω² = eig(K, M)/2. These displacements vanish at the ends for every k (δη(0) = δη(L) = 0, ρ' = 0 there): with the ends
+held apart (λ̄ fixed) they are the modes of every k, k even in the even mirror block, odd in the odd one; with closed
+ends whose distance is free the odd k are (their inertia does work neither on the ends' symmetric motion nor on the
+uniform modes); volume control removes k = 0 (δV = L a b U for k = 0, 0 for k ≥ 1).
+"""
+import numpy as np
+import pytest
+import sympy as sp
+from scipy import linalg
+from scipy.optimize import brentq
+
+from balloon_cg.analysis.results import Kind, Status
+from balloon_cg.dynamics.tube import tube_branch_frequencies, tube_frequencies, tube_mass, tube_matching_block
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.galerkin.interval import Mirror
+from balloon_cg.scene import load_scene
+from balloon_cg.tube.picture import tube_picture
+from balloon_cg.tube.primary import discretisation
+
+SPOM1 = ((3.00508, 0.0145, -0.0177), (1.3, 4.0, -2.0))  # (μ_i, α_i), Σ μ_i α_i = 4
+COUNT = 6
+
+
+def ogden_derivatives():
+    """Φ1, Φ2, Φ11, Φ12, Φ22 of Φ = Σ (μ/α)(λ1^α + λ2^α + (λ1 λ2)^−α − 3) as functions of (λ1, λ2)."""
+    l1, l2 = sp.symbols("l1 l2", positive=True)
+    phi = sum(sp.nsimplify(m) / sp.nsimplify(a) * (l1**sp.nsimplify(a) + l2**sp.nsimplify(a)
+                                                   + (l1 * l2)**(-sp.nsimplify(a)) - 3) for m, a in zip(*SPOM1))
+    terms = (sp.diff(phi, l1), sp.diff(phi, l2), sp.diff(phi, l1, 2), sp.diff(phi, l1, l2), sp.diff(phi, l2, 2))
+    return sp.lambdify((l1, l2), terms)
+
+
+DERIVATIVES = ogden_derivatives()
+
+
+def closed_axial(a):
+    """The axial stretch b of the closed tube of hoop stretch a: Φ1(b, a) = ½ a² Φ2(b, a)/(a b)."""
+    def balance(b):
+        phi1, phi2, *_ = DERIVATIVES(b, a)
+        return phi1 - a * phi2 / (2 * b)
+    return brentq(balance, 0.3, 10.0, xtol=1e-15, rtol=1e-15)
+
+
+def dispersion(a, b, length, k):
+    """The Ω² of the mode k of the uniform tube (a, b) at its pressure (module docstring): two for k ≥ 1, one for 0."""
+    phi1, phi2, phi11, phi12, phi22 = DERIVATIVES(b, a)
+    P = phi2 / (a * b)
+    if k == 0:
+        return np.array([(phi22 - P * b) / 2])
+    kappa = k * np.pi / length
+    K = np.array([[phi1 * kappa**2 / b + phi22 - P * b, (P * a - phi12) * kappa],
+                  [(P * a - phi12) * kappa, phi11 * kappa**2]])
+    return linalg.eigvalsh(K) / 2  # M = I after the common factor L/2
+
+
+def lowest(a, b, length, ks, count=COUNT):
+    return np.sort(np.concatenate([dispersion(a, b, length, k) for k in ks]))[:count]
+
+
+def uniform_frequencies(hoop, held: bool):
+    """(Ω² per block of the tube of tube_spom1_L10 at the uniform state of hoop stretch ``hoop``, its (a, b, L)):
+    held ends at the closed tube's own axial stretch (the same state, another constraint)."""
+    b = closed_axial(hoop)
+    scene = load_scene("tube_spom1_L10")
+    if held:
+        scene = scene.with_overrides({"geometry.axial_stretch": b})
+    disc = discretisation(scene)
+    eq = Equilibrium(scene, disc)
+    u = disc.uniform(hoop, b)
+    P = DERIVATIVES(b, hoop)[1] / (hoop * b)
+    residual = eq.residual(u, Parameters(P))[disc.free]
+    assert np.abs(residual).max() <= 1e-11  # the state and P of the docstring are the code's equilibrium
+    return tube_frequencies(eq, tube_mass(eq), u, Parameters(P), True, COUNT), (hoop, b, disc.length)
+
+
+@pytest.mark.parametrize("hoop", [1.3, 2.0, 4.0])
+def test_held_tube_modes_are_the_uniform_cylinders_vibrations(hoop):
+    """Ends held at the closed tube's axial stretch, hoop stretches 1.3 (stable), 2.0 and 4.0 (beyond the pressure
+    maximum of the closed tube): the even block's 6 lowest Ω² are the k = 0, 2, 4, ... closed forms, the odd
+    block's the k = 1, 3, 5, ..., even_volume's the k = 2, 4, ... ones, to 1e-9 (relative above 1)."""
+    omega2, (a, b, length) = uniform_frequencies(hoop, held=True)
+    expected = {"even": lowest(a, b, length, range(0, 40, 2)), "odd": lowest(a, b, length, range(1, 40, 2)),
+                "even_volume": lowest(a, b, length, range(2, 40, 2))}
+    for block, values in expected.items():
+        assert np.abs(omega2[block] - values).max() <= 1e-9 * max(1.0, np.abs(values).max()), (block, omega2[block],
+                                                                                                values)
+
+
+@pytest.mark.parametrize("hoop", [1.3, 4.0])
+def test_closed_tube_odd_modes_are_the_uniform_cylinders_vibrations(hoop):
+    """Closed ends with their distance free: the odd block's 6 lowest Ω² are the k = 1, 3, 5, ... closed forms (1e-9);
+    the even block holds the ends' motion and is not a closed form."""
+    omega2, (a, b, length) = uniform_frequencies(hoop, held=False)
+    values = lowest(a, b, length, range(1, 40, 2))
+    assert np.abs(omega2["odd"] - values).max() <= 1e-9 * max(1.0, np.abs(values).max())
+
+
+@pytest.fixture(scope="module")
+def tube_run():
+    scene = load_scene("tube_spom1_L10")
+    picture = tube_picture(scene)
+    return scene, picture, {name: tube_branch_frequencies(scene, branch, COUNT) for name, branch in
+                            picture.branches.items()}
+
+
+def test_located_tube_points_have_a_vanishing_frequency_in_their_block(tube_run):
+    """tube_spom1_L10 (primary and bulge branches): at the pressure maximum (LP, even block), every branch point of
+    the primary branch (the bulge modes, odd and even blocks) and the bulge branch's folds (all, all_volume) one Ω²
+    of the matching block is zero to solver.tol, and the points around it differ by one in its negative Ω² (the
+    eigenvalue that crossed: not the lowest at the later branch points)."""
+    scene, picture, frequencies = tube_run
+    kinds = []
+    for name, branch in picture.branches.items():
+        symmetric = bool(branch.lowest)
+        for n, s in enumerate(branch.special):
+            if s.status != Status.LOCATED:
+                continue
+            block = tube_matching_block(s, symmetric)
+            assert np.nanmin(np.abs(frequencies[name].special[block][n])) <= scene.solver.tol, (name, s.kind, block)
+            around = frequencies[name].omega2[block][s.index:s.index + 2]
+            assert np.diff((around < 0).sum(axis=1)) != 0, (name, s.kind, around)
+            kinds.append((name, s.kind, block))
+    assert ("primary", Kind.LP, "even") in kinds and ("primary", Kind.BP, Mirror.ODD.value) in kinds, kinds
+    assert any(name == "bulge" for name, _, _ in kinds), kinds
