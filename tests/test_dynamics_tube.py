@@ -19,6 +19,9 @@ held apart (λ̄ fixed) they are the modes of every k, k even in the even mirror
 ends whose distance is free the odd k are (their inertia does work neither on the ends' symmetric motion nor on the
 uniform modes); volume control removes k = 0 (δV = L a b U for k = 0, 0 for k ≥ 1).
 """
+import json
+
+import h5py
 import numpy as np
 import pytest
 import sympy as sp
@@ -26,9 +29,12 @@ from scipy import linalg
 from scipy.optimize import brentq
 
 from balloon_cg.analysis.results import Kind, Status
-from balloon_cg.dynamics.tube import tube_branch_frequencies, tube_frequencies, tube_mass, tube_matching_block
+from balloon_cg.app.cli import main
+from balloon_cg.dynamics.tube import (tube_branch_frequencies, tube_frequencies, tube_mass, tube_matching_block,
+                                      with_frequencies)
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import Mirror
+from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.scene import load_scene
 from balloon_cg.tube.picture import tube_picture
 from balloon_cg.tube.primary import discretisation
@@ -113,10 +119,10 @@ def test_closed_tube_odd_modes_are_the_uniform_cylinders_vibrations(hoop):
 
 @pytest.fixture(scope="module")
 def tube_run():
-    scene = load_scene("tube_spom1_L10")
-    picture = tube_picture(scene)
-    return scene, picture, {name: tube_branch_frequencies(scene, branch, COUNT) for name, branch in
-                            picture.branches.items()}
+    """tube_spom1_L10 with [dynamics] frequencies (count 6): the picture with_frequencies and its frequencies."""
+    scene = load_scene("tube_spom1_L10").with_overrides({"dynamics.frequencies": True, "dynamics.count": COUNT})
+    picture = with_frequencies(scene, tube_picture(scene))
+    return scene, picture, picture.frequencies
 
 
 def test_located_tube_points_have_a_vanishing_frequency_in_their_block(tube_run):
@@ -138,3 +144,35 @@ def test_located_tube_points_have_a_vanishing_frequency_in_their_block(tube_run)
             kinds.append((name, s.kind, block))
     assert ("primary", Kind.LP, "even") in kinds and ("primary", Kind.BP, Mirror.ODD.value) in kinds, kinds
     assert any(name == "bulge" for name, _, _ in kinds), kinds
+
+
+def test_tube_frequencies_are_stored_with_units_and_shown_by_inspect(tmp_path, capsys):
+    """``run`` of a tube scene with [dynamics] frequencies (degree 16, to hoop stretch 3, primary and bulge): the file
+    holds every branch's Ω² of tube_branch_frequencies number for number, units "1"; ``inspect`` lists each located
+    point's lowest Ω² per block (the LP's even one zero), ``--json`` per branch block → lowest Ω² over the points."""
+    scene_file = tmp_path / "tube.toml"
+    scene_file.write_text(load_scene("tube_spom1_L10").text + "\n[dynamics]\nfrequencies = true\ncount = 4\n")
+    path = tmp_path / "tube.h5"
+    assert main(["run", str(scene_file), "-o", str(path), "--quiet", "--set", "solver.degree=16",
+                 "--set", "continuation.stop_stretch=3"]) == 0
+    scene = load_scene(scene_file).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 3})
+    picture = tube_picture(scene)
+    run = read_tube_run(path)
+    assert set(run["branches"]) == {"primary", "bulge"}
+    for name, branch in picture.branches.items():
+        expected, stored = tube_branch_frequencies(scene, branch, 4), run["branches"][name]["frequencies"]
+        assert stored["count"] == 4 and set(stored["omega2"]) == set(expected.omega2)
+        for block in expected.omega2:
+            assert np.array_equal(stored["omega2"][block], expected.omega2[block], equal_nan=True)
+            assert np.array_equal(stored["special"][block], expected.special[block], equal_nan=True)
+    with h5py.File(path) as f:
+        assert f["branches/primary/frequencies/omega2_odd"].attrs["units"] == "1"
+    assert main(["inspect", str(path)]) == 0
+    text = capsys.readouterr().out
+    lp = next(line for line in text.split("branch primary")[1].splitlines() if " LP " in line)
+    after = text.split(lp)[1].splitlines()[1]
+    assert after.strip().startswith("lowest Ω²") and abs(float(after.split("even ")[1].split()[0])) < 1e-9
+    assert main(["inspect", str(path), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)["branches"]
+    assert summary["bulge"]["frequencies"]["all_volume"] == list(run["branches"]["bulge"]["frequencies"]["omega2"]
+                                                                 ["all_volume"][:, 0])

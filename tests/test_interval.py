@@ -288,7 +288,7 @@ def test_tube_table_errors_name_key_value_and_range(table, message):
      r"field.coils\[0\]: wire at \(radius 0.8, height 3\) lies on or inside the reference tube"),
     ("[electric]\nvoltage = 0.1\n", r'geometry.shape = "tube": the \[electric\] term on a tube is not built yet'),
     ('[loading]\ncontrol = "volume"\n', 'loading.control = "volume": a tube is continued in the pressure only'),
-    ("[dynamics]\nfrequencies = true\n", "dynamics.frequencies = true: the natural frequencies of a tube"),
+    ("[dynamics]\nfrequencies = true\nmodes = true\n", "dynamics.modes = true: a tube's mode shapes are not stored"),
 ])
 def test_tube_refuses_the_parts_it_does_not_have(extra, message):
     with pytest.raises(SceneError, match=message) as error:

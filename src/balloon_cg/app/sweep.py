@@ -254,9 +254,10 @@ def compute_member(index: int, scene_toml: str, scene_name: str, mode: str) -> M
     scene = parse_scene(scene_toml, scene_name)
     start = time.perf_counter()
     if scene.geometry.shape == Shape.TUBE:
+        from ..dynamics.tube import with_frequencies
         from ..tube.picture import tube_picture
 
-        picture = tube_picture(scene, primary_only=mode == "primary-only")
+        picture = with_frequencies(scene, tube_picture(scene, primary_only=mode == "primary-only"))
         return TubeMemberResult(index, picture, time.perf_counter() - start, os.getpid())
     with workers.serial():
         if mode == "primary-only":

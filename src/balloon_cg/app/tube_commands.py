@@ -10,11 +10,13 @@ from .cli import INTERRUPTED, PROG, Failure, UsageError, _say, field_needed
 def run_tube(scene, output, args) -> int:
     """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
     written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring)."""
+    from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run
     from ..tube.picture import tube_picture
     from .tube_summary import format_tube, summarise_tube
 
-    run, signalled = _written(output, args, lambda: tube_picture(scene, args.primary_only), scene)
+    run, signalled = _written(output, args, lambda: with_frequencies(scene, tube_picture(scene, args.primary_only)),
+                              scene)
     code = interrupted_status(run, output, signalled)
     if code is not None:
         return code

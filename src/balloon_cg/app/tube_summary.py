@@ -1,8 +1,9 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, Maxwell's
 pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are compressed
 (tube/stability.py), the height of its last point's crest and its located points (with their crest's height; those in
-a compressed state marked: docs/shapes.md), the onset curve of ``critical`` (its range, folds and stop), and the stage
-a signal stopped (``interrupted``)."""
+a compressed state marked: docs/shapes.md), with [dynamics] frequencies each block's lowest Ω² at every located point
+(``frequencies``: per block over the points, as a sphere run's), the onset curve of ``critical`` (its range, folds
+and stop), and the stage a signal stopped (``interrupted``)."""
 import math
 import tomllib
 
@@ -23,13 +24,29 @@ def summarise_tube(run: dict) -> dict:
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
-                          "special_points": b["special_points"]}
+                          "special_points": _with_omega2(b["special_points"], b.get("frequencies")),
+                          **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
+
+
+def _frequencies(frequencies: dict | None) -> dict:
+    """{'frequencies': {block: the lowest Ω² at every point}} of a branch with frequencies, else {}."""
+    if frequencies is None:
+        return {}
+    return {"frequencies": {block: [float(v) for v in values[:, 0]] for block, values in frequencies["omega2"].items()}}
+
+
+def _with_omega2(special: list, frequencies: dict | None) -> list:
+    """The located points, each with 'omega2' (block: its lowest Ω² there) where the branch has frequencies."""
+    if frequencies is None:
+        return special
+    return [{**s, "omega2": {block: float(values[k, 0]) for block, values in frequencies["special"].items()}}
+            for k, s in enumerate(special)]
 
 
 def scene_field(toml: str) -> dict:
@@ -80,6 +97,9 @@ def format_tube(summary: dict) -> str:
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
                          f"V/V0 = {s['volume']:.8g}  {s['status']}{crest}{compressed}")
+            if "omega2" in s:
+                lines.append("        lowest Ω²  " + "  ".join(f"{name} {value:.4g}"
+                                                         for name, value in s["omega2"].items()))
     onset = summary["onset"]
     if onset is not None:
         name, last = onset["parameter"], onset["last"]

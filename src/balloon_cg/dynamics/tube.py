@@ -12,7 +12,7 @@ Hessian ∂R/∂u of the loaded energy per block:
 
 the blocks of tube/stability.py (interval.Mirror; a held λ̄ is no unknown). A tube has no m ≥ 1 blocks.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..model.meridian import mass_density
-from ..numerics import eigen
+from ..numerics import eigen, interrupt
 from .pencil import PER_EIGENVALUE, table_of
 
 VOLUME = "_volume"  # the suffix of a block under volume control
@@ -90,6 +90,12 @@ def tube_matching_block(special, symmetric: bool) -> str:
     return whole + (VOLUME if special.kind == Kind.LV else "")
 
 
-def attach(scene, picture, count: int) -> dict:
-    """{branch name: TubeFrequencies} of every branch of a tube picture (tube/picture.TubePicture)."""
-    return {name: tube_branch_frequencies(scene, branch, count) for name, branch in picture.branches.items()}
+def with_frequencies(scene, picture):
+    """``picture`` (tube/picture.TubePicture) with every branch's TubeFrequencies where the scene's [dynamics] asks
+    for them (``count`` each), else as it is: also where a signal stopped the picture or has come since (they are
+    not computed then: a signal ends the work at its next stage, numerics.interrupt)."""
+    if not scene.dynamics.frequencies or picture.interrupted is not None or interrupt.requested():
+        return picture
+    count = scene.dynamics.count
+    return replace(picture, frequencies={name: tube_branch_frequencies(scene, branch, count)
+                                         for name, branch in picture.branches.items()})

@@ -16,6 +16,7 @@ special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``vol
 under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
 started, and is absent where it had not), "" where the work is whole (files before it have none: read as "").
+With [dynamics] frequencies, each branch's natural frequencies under frequencies/ (io/tube_frequencies.py).
 """
 import math
 from pathlib import Path
@@ -25,6 +26,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import FileError, opened
+from .tube_frequencies import read_tube_frequencies, write_tube_frequencies
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..scene.tables import Ends
@@ -140,6 +142,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
         _dimensions(group, "point", {"unknown": branch.disc.size})
         _dimensions(special, "special", {"unknown": branch.disc.size})
+        if picture.frequencies is not None:
+            write_tube_frequencies(group, picture.frequencies[name])
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
 
@@ -166,8 +170,8 @@ def _write_onset(group, curve) -> None:
 
 def read_tube_run(path) -> dict:
     """{'path', 'attrs', 'branches': {name: {'attrs', the point columns, 'unknowns', 'lowest_*',
-    'special_points': [dict per point] , 'special_unknowns'}}, 'onset'}; TubeFileError for anything that is not
-    one."""
+    'special_points': [dict per point] , 'special_unknowns', 'frequencies' (None: not asked for)}}}; TubeFileError
+    for anything that is not one."""
     path = Path(path)
     with opened(path, TubeFileError) as f:
         fmt = plain(f.attrs.get("format"))
@@ -201,6 +205,7 @@ def read_tube(f, path, where: str = "") -> dict:
         branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                     for i in range(len(columns["kind"]))]
         branch["special_unknowns"] = special["unknowns"][()]
+        branch["frequencies"] = read_tube_frequencies(path, group, n, len(branch["special_points"]), TubeFileError)
         branches[name] = branch
     onset = None if "onset" not in f else _read_onset(path, f["onset"])
     return {"attrs": attrs, "branches": branches, "onset": onset}

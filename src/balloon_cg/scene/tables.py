@@ -638,9 +638,11 @@ def _build(data: dict, name: str, text: str) -> Scene:
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric, loading)
     dynamics = _dynamics(data.get("dynamics", {}))
-    if geometry.shape in (Shape.TUBE, Shape.CAPSULE) and dynamics.frequencies:
+    if geometry.shape == Shape.CAPSULE and dynamics.frequencies:
         raise SceneError(f'dynamics.frequencies = true: the natural frequencies of a {geometry.shape.value} are not '
                          'built yet; leave it false or use geometry.shape = "sphere"')
+    if geometry.shape == Shape.TUBE and dynamics.modes:
+        raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
     stability = _stability(data.get("stability", {}))
     if geometry.shape == Shape.CAPSULE and stability.m_max != 0:
         raise SceneError(f"stability.m_max = {stability.m_max}: a capsule's m ≥ 1 second variation is not built yet "

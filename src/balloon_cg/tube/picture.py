@@ -33,12 +33,14 @@ class TubePicture:
     """The branches by name ("primary", "bulge" where one was switched), Maxwell's pressure (None where the
     uniform closed path has no maximum and minimum, or the ends are held), for ``critical`` the onset of bulging
     followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the work is whole; the
-    stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had not)."""
+    stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had not); ``frequencies``:
+    with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch name)."""
 
     branches: dict
     maxwell: float | None
     onset: OnsetCurve | None = None
     interrupted: Stage | None = None
+    frequencies: dict | None = None
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
