@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "5e930fec84f17f2a0cddde1ffbfa5600ffbd786982aedbf494e13594b0c7d255"
+SIGNATURE = "c00312cf4500e4f31374032152afd29e6bf86a16e6273ab8419830a9c60f9acd"
 INPUTS = [('kinetic_energy', '1/2 rho T0 |du/dt|^2 dA over the reference surface')]
 
 
@@ -31,6 +31,11 @@ KERNELS = {
     'spheroid_azimuthal_mass': {
         'args': (('cos_theta', 'node', ()), ('sin_theta', 'node', ()), ('aspect', 'param', ())),
         'outputs': ('R_R', 'R_R1', 'R_Z', 'R_Z1', 'R_T', 'R_T1', 'R1_R1', 'R1_Z', 'R1_Z1', 'R1_T', 'R1_T1', 'Z_Z', 'Z_Z1', 'Z_T', 'Z_T1', 'Z1_Z1', 'Z1_T', 'Z1_T1', 'T_T', 'T_T1', 'T1_T1'),
+        'nodes': True,
+    },
+    'capsule_axisymmetric_mass': {
+        'args': (('cos_theta', 'node', ()), ('sin_theta', 'node', ()), ('length', 'param', ())),
+        'outputs': ('lam2_lam2', 'lam2_v', 'lam2_eta', 'lam2_w', 'v_v', 'v_eta', 'v_w', 'eta_eta', 'eta_w', 'w_w'),
         'nodes': True,
     },
 }
@@ -95,7 +100,7 @@ def azimuthal_mass_nodes(cos_theta, sin_theta, out):
 
 @njit(cache=True, inline='always')
 def spheroid_axisymmetric_mass(cos_theta, sin_theta, aspect):
-    """∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(sin²θ λ̇2² + η̇²) S' (the spheroid's area element) (m = 0), upper triangle row by row (the layout of energy_hessian)."""
+    """∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(R² λ̇2² + η̇²) S' R/sin θ (the spheroid's area element, R its hoop radius) (m = 0), upper triangle row by row (the layout of energy_hessian)."""
     t0 = (sin_theta*sin_theta)
     t1 = math.sqrt((aspect*aspect)*t0 + (cos_theta*cos_theta))
     return (t0*t1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t1, 0.0, 0.0,)
@@ -120,7 +125,7 @@ def spheroid_axisymmetric_mass_nodes(cos_theta, sin_theta, aspect, out):
 
 @njit(cache=True, inline='always')
 def spheroid_azimuthal_mass(cos_theta, sin_theta, aspect):
-    """∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²) S' (the spheroid's area element) (m ≥ 1), y = (R, R', Z, Z', T, T'), upper triangle row by row (the layout of azimuthal_hessian)."""
+    """∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²) S' R/sin θ (the spheroid's area element, R its hoop radius) (m ≥ 1), y = (R, R', Z, Z', T, T'), upper triangle row by row (the layout of azimuthal_hessian)."""
     t0 = (0.5)*math.sqrt((aspect*aspect)*(sin_theta*sin_theta) + (cos_theta*cos_theta))
     return (t0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t0, 0.0, 0.0,)
 
@@ -151,3 +156,33 @@ def spheroid_azimuthal_mass_nodes(cos_theta, sin_theta, aspect, out):
         out[18, i] = r[18]
         out[19, i] = r[19]
         out[20, i] = r[20]
+
+
+@njit(cache=True, inline='always')
+def capsule_axisymmetric_mass(cos_theta, sin_theta, length):
+    """∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(R² λ̇2² + η̇²) S' R/sin θ (the capsule's area element, R its hoop radius) (m = 0), upper triangle row by row (the layout of energy_hessian)."""
+    t0 = length/math.pi + 1.0
+    t1 = math.sin(t0*math.acos(cos_theta))
+    t2 = math.cos((0.5)*math.pi/t0)
+    t3 = (cos_theta > t2)
+    t4 = math.sin(t0*math.acos(-cos_theta))
+    t5 = (cos_theta < -t2)
+    t6 = t0*((t1) if t3 else (t4) if t5 else (1.0))/sin_theta
+    return (t6*(((t1*t1)) if t3 else ((t4*t4)) if t5 else (1.0)), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t6, 0.0, 0.0,)
+
+
+@njit(cache=True)
+def capsule_axisymmetric_mass_nodes(cos_theta, sin_theta, length, out):
+    """capsule_axisymmetric_mass at every node i; output k goes to out[k, i]."""
+    for i in range(cos_theta.shape[0]):
+        r = capsule_axisymmetric_mass(cos_theta[i], sin_theta[i], length)
+        out[0, i] = r[0]
+        out[1, i] = r[1]
+        out[2, i] = r[2]
+        out[3, i] = r[3]
+        out[4, i] = r[4]
+        out[5, i] = r[5]
+        out[6, i] = r[6]
+        out[7, i] = r[7]
+        out[8, i] = r[8]
+        out[9, i] = r[9]

@@ -6,7 +6,7 @@ solved on an orthonormal basis Z of the null space of N: Zᵀ K Z w = ν Zᵀ M 
 solver through scipy.linalg.eigh), q = Z w, a second solve of the pencil whose ν match the stored Ω² = ν/2. Each
 mode is mass-normalised, qᵀMq = 1, and drawn as a displacement of the reference meridian on a θ grid:
 
-    m = 0:  δρ = sin θ δλ2,  δz = δη,  δφ = 0      (δλ2 = Σ a_k P_k, δη = Σ b_k P_k less its held mean on a map)
+    m = 0:  δρ = R δλ2,  δz = δη,  δφ = 0      (δλ2 = Σ a_k P_k, δη = Σ b_k P_k less its held mean on a map)
     m ≥ 1:  δρ = R cos mφ,  δz = Z cos mφ,  δφ = T sin mφ, stored as the amplitudes (R, Z, T)
 
 in lengths over R0 for a unit modal mass qᵀMq = (1/2π)∫∫|δx|² dA = 1 over the reference surface (T = ½ q̇ᵀMq̇ the
@@ -21,6 +21,7 @@ from scipy import linalg
 from ..analysis.azimuthal import block_pencils
 from ..analysis.results import Block
 from ..analysis.stability import held_means
+from ..model.meridian import hoop
 from ..numerics.eigen import RCOND
 from .pencil import PER_EIGENVALUE
 
@@ -46,7 +47,7 @@ def block_modes(variation, u, params, symmetric: bool, name: str, count: int, th
         values, q = lowest_modes(K, M, normals, count)
         c = np.zeros((values.size, variation.basis.size))
         c[:, index] = q
-        shapes = _axisymmetric_shapes(variation.basis, c, theta)
+        shapes = _axisymmetric_shapes(variation.basis, c, theta, variation.eq.scene.geometry)
     else:
         basis, parts = block_pencils(variation.eq, u, params, m, variation.basis.degree, Block(name).held,
                                      variation.basis_kind)
@@ -65,9 +66,10 @@ def block_modes(variation, u, params, symmetric: bool, name: str, count: int, th
     return PER_EIGENVALUE * values, shapes * signs[:, None, None]
 
 
-def _axisymmetric_shapes(basis, c, theta) -> np.ndarray:
+def _axisymmetric_shapes(basis, c, theta, geometry) -> np.ndarray:
     """(δρ, δz, 0) on θ (rows × 3 × θ) of the m = 0 perturbation coefficients c (rows: a_0..a_N, b_0..b_N) on
-    ``basis`` (its η functions P_k(s) − m_k on a map: ``stability.held_means``)."""
+    ``basis`` (its η functions P_k(s) − m_k on a map: ``stability.held_means``), δρ = R δλ2 with R the reference
+    meridian's (model/meridian.hoop: sin θ on the sphere)."""
     lam2, _, eta, _ = basis.evaluate(c, theta)
     eta = eta - (c[:, basis.a_index.size + 1:] @ held_means(basis))[:, None]
-    return np.stack([np.sin(theta) * lam2, eta, np.zeros_like(eta)], axis=1)
+    return np.stack([hoop(geometry, np.cos(theta), np.sin(theta)) * lam2, eta, np.zeros_like(eta)], axis=1)

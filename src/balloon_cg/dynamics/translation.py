@@ -16,7 +16,7 @@ import numpy as np
 from ..analysis.azimuthal import kernel_state_map, perturbation_basis
 from ..galerkin.discretisation import symmetric_rows
 from ..generated import AZIMUTHAL_PAIRS, HESSIAN_PAIRS
-from ..model.meridian import mass_density
+from ..model.meridian import AZIMUTHAL, mass_density
 from .pencil import PER_EIGENVALUE
 
 # direction: (the node values of its translation, the stiffness kernel and its layout, the mass kernel)
@@ -32,10 +32,19 @@ def _form(pointwise, pairs, t) -> np.ndarray:
     return sum(t[k] * t[l] * pointwise[rows[k, l]] for k in range(t.size) for l in range(t.size) if t[k] and t[l])
 
 
-def translation_omega2(equilibrium, u, params, degree: int) -> dict:
-    """{"axial": Ω²_t along the axis, "lateral": Ω²_t across it} at the equilibrium u of ``equilibrium`` (module
-    docstring), on the nodes of its m = 1 basis of ``degree``."""
-    b = perturbation_basis(equilibrium, 1, degree)
+def translation_omega2(variation, u, params) -> dict:
+    """{"axial": Ω²_t along the axis, "lateral": Ω²_t across it} at the equilibrium u of ``variation`` (the pencil's
+    m = 0 second variation, dynamics.pencil.mass_variation; module docstring), on the nodes of its equilibrium's
+    m = 1 basis of its degree. On a shape without the m = 1 second variation (a capsule: model/meridian.AZIMUTHAL)
+    the axial one is the Rayleigh quotient of b_0 (δη = 1) on the m = 0 pencil (its quadrature split at the
+    capsule's joins), and the lateral one NaN (not computed)."""
+    equilibrium = variation.eq
+    geometry = equilibrium.scene.geometry
+    if geometry.shape not in AZIMUTHAL:
+        t = variation.translation
+        return {"axial": PER_EIGENVALUE * variation.matrices(u, params)[0][t, t] / variation.gram[t, t],
+                "lateral": np.nan}
+    b = perturbation_basis(equilibrium, 1, variation.basis.degree)
     nodes = equilibrium.at_nodes(("translation", b), (b.x, b.sin_theta))
     np.dot(np.asarray(u, dtype=float), kernel_state_map(equilibrium.disc, b, False), out=nodes.state.reshape(-1))
     nodes.hold(params)
@@ -43,5 +52,5 @@ def translation_omega2(equilibrium, u, params, degree: int) -> dict:
     for direction, (t, stiffness, pairs, mass) in DIRECTIONS.items():
         h = nodes(stiffness, params, m=1.0) if stiffness == "azimuthal_hessian" else nodes(stiffness, params)
         out[direction] = PER_EIGENVALUE * (b.weights @ _form(h, pairs, t)) / (
-            b.weights @ _form(mass_density(equilibrium.scene.geometry, mass, b.x, b.sin_theta), pairs, t))
+            b.weights @ _form(mass_density(geometry, mass, b.x, b.sin_theta), pairs, t))
     return out

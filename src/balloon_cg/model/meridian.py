@@ -19,8 +19,9 @@ cylinder (mirrored below); it encloses V0 = πL + 4π/3. A tube (``shape = "tube
 t = S ∈ [0, L] with R = 1, R' = 0, S' = 1 and Z = −S (codegen/meridian.py), discretised in galerkin/interval.py;
 it encloses V0 = πL.
 
-The membrane's kinetic energy is taken over the reference surface, dA = R S' dθ dφ = S' d(−cos θ) dφ: its mass
-densities per d(cos θ) (generated/inertia.py, codegen/inertia.py) carry S' (``mass_density``).
+The membrane's kinetic energy is taken over the reference surface, dA = R S' dθ dφ: its mass densities per
+d(cos θ) (generated/inertia.py, codegen/inertia.py) carry S' R/sin θ (``mass_density``). The sphere and the
+spheroid have the m ≥ 1 second variation (``AZIMUTHAL``), a capsule and a tube do not.
 """
 import numpy as np
 
@@ -113,12 +114,17 @@ def kernel_values(geometry: Geometry) -> dict:
     return {}
 
 
+AZIMUTHAL = (Shape.SPHERE, Shape.SPHEROID)  # the shapes with the m ≥ 1 second variation (codegen: ``analytic``)
+
+
 def mass_density(geometry: Geometry, block: str, cos_theta, sin_theta) -> np.ndarray:
     """∂²t of the kinetic energy at the nodes (cos θ, sin θ), ``block`` 'axisymmetric' (rows of energy_hessian's
-    layout) or 'azimuthal' (azimuthal_hessian's): the sphere's kernel, t = ½(R² λ̇2² + η̇²) S' with R = sin θ and
-    S' = 1, also a tube's (its nodes pass R' = 0, R = 1 for cos θ, sin θ and its S' is 1), or the spheroid's, whose
-    density carries its S' (generated/inertia.py)."""
-    name = f"{block}_mass" if geometry.shape != Shape.SPHEROID else f"{geometry.shape.value}_{block}_mass"
+    layout) or 'azimuthal' (azimuthal_hessian's; ``AZIMUTHAL`` shapes only): the sphere's kernel,
+    t = ½(R² λ̇2² + η̇²) S' with R = sin θ and S' = 1, also a tube's (its nodes pass R' = 0, R = 1 for cos θ, sin θ
+    and its S' is 1), or the spheroid's and the capsule's, whose densities carry their S' R/sin θ
+    (generated/inertia.py)."""
+    own = geometry.shape not in (Shape.SPHERE, Shape.TUBE)
+    name = f"{geometry.shape.value}_{block}_mass" if own else f"{block}_mass"
     cos_theta = np.ascontiguousarray(cos_theta, dtype=float)
     out = np.empty((len(inertia.KERNELS[name]["outputs"]), cos_theta.size))
     getattr(inertia, f"{name}_nodes")(cos_theta, np.ascontiguousarray(sin_theta, dtype=float),

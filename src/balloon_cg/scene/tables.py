@@ -638,9 +638,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric, loading)
     dynamics = _dynamics(data.get("dynamics", {}))
-    if geometry.shape == Shape.CAPSULE and dynamics.frequencies:
-        raise SceneError(f'dynamics.frequencies = true: the natural frequencies of a {geometry.shape.value} are not '
-                         'built yet; leave it false or use geometry.shape = "sphere"')
+    if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
+        raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 second variation is not built yet "
+                         "(its curvature jumps at the joins); allowed: 0")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
     stability = _stability(data.get("stability", {}))
