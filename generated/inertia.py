@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-SIGNATURE = "c00312cf4500e4f31374032152afd29e6bf86a16e6273ab8419830a9c60f9acd"
+SIGNATURE = "759f0cb5e9fe72292e2485072f9c128a93cf06443b0d19f08866ffe88f09e41c"
 INPUTS = [('kinetic_energy', '1/2 rho T0 |du/dt|^2 dA over the reference surface')]
 
 
@@ -100,7 +100,7 @@ def azimuthal_mass_nodes(cos_theta, sin_theta, out):
 
 @njit(cache=True, inline='always')
 def spheroid_axisymmetric_mass(cos_theta, sin_theta, aspect):
-    """∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(R² λ̇2² + η̇²) S' R/sin θ (the spheroid's area element, R its hoop radius) (m = 0), upper triangle row by row (the layout of energy_hessian)."""
+    """∂²t/∂(λ2, v, η, w)² of the kinetic energy T = ∫ t d(cos θ), t = ½(sin²θ λ̇2² + η̇²) S' (the spheroid's area element) (m = 0), upper triangle row by row (the layout of energy_hessian)."""
     t0 = (sin_theta*sin_theta)
     t1 = math.sqrt((aspect*aspect)*t0 + (cos_theta*cos_theta))
     return (t0*t1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t1, 0.0, 0.0,)
@@ -125,7 +125,7 @@ def spheroid_axisymmetric_mass_nodes(cos_theta, sin_theta, aspect, out):
 
 @njit(cache=True, inline='always')
 def spheroid_azimuthal_mass(cos_theta, sin_theta, aspect):
-    """∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²) S' R/sin θ (the spheroid's area element, R its hoop radius) (m ≥ 1), y = (R, R', Z, Z', T, T'), upper triangle row by row (the layout of azimuthal_hessian)."""
+    """∂²t/∂y² of the kinetic energy T = ∫ t d(cos θ), t = ¼(Ṙ² + Ṫ² + Ż²) S' (the spheroid's area element) (m ≥ 1), y = (R, R', Z, Z', T, T'), upper triangle row by row (the layout of azimuthal_hessian)."""
     t0 = (0.5)*math.sqrt((aspect*aspect)*(sin_theta*sin_theta) + (cos_theta*cos_theta))
     return (t0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, t0, 0.0, 0.0,)
 
