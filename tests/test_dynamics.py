@@ -544,7 +544,7 @@ def resolved_zero(branch, special, block: str, omega2) -> float:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", sorted(n for n in shipped_scenes() if not n.startswith("tube_")))  # no tube dynamics
+@pytest.mark.parametrize("name", sorted(n for n in shipped_scenes() if not n.startswith("tube_")))  # tubes: test_dynamics_tube
 def test_every_located_special_point_of_a_shipped_scene_has_a_zero_frequency(name):
     """The whole picture of a shipped scene with [dynamics] (count 6, m_max as the stability's): at every located
     fold and branch point one stored Ω² of its block is zero to the point's own tolerance (``resolved_zero``),
