@@ -28,6 +28,7 @@ import sympy as sp
 from scipy import linalg
 from scipy.optimize import brentq
 
+import balloon_cg as bc
 from balloon_cg.analysis.results import Kind, Status
 from balloon_cg.app.cli import main
 from balloon_cg.dynamics.tube import (tube_branch_frequencies, tube_frequencies, tube_mass, tube_matching_block,
@@ -197,3 +198,23 @@ def test_tube_frequencies_are_stored_with_units_and_shown_by_inspect(tmp_path, c
     summary = json.loads(capsys.readouterr().out)["branches"]
     assert summary["bulge"]["frequencies"]["all_volume"] == list(run["branches"]["bulge"]["frequencies"]["omega2"]
                                                                  ["all_volume"][:, 0])
+
+
+def test_a_tube_sweep_stores_each_members_frequencies(tmp_path):
+    """``sweep --primary-only`` over a tube scene with [dynamics] frequencies (length 8, degree 16, to hoop stretch
+    3): the member holds the frequencies of its scene's run alone, number for number."""
+    scene_file = tmp_path / "tube.toml"
+    scene_file.write_text(load_scene("tube_spom1_L10").text.replace("degree = 40", "degree = 16")
+                          .replace("stop_stretch = 9.0", "stop_stretch = 3.0")
+                          + "\n[dynamics]\nfrequencies = true\ncount = 2\n")
+    assert main(["sweep", str(scene_file), "--vary", "geometry.length=8", "-o", str(tmp_path / "sweep.h5"),
+                 "--workers", "1", "--primary-only", "--quiet"]) == 0
+    alone = tmp_path / "alone.h5"
+    assert main(["run", str(scene_file), "--set", "geometry.length=8", "-o", str(alone), "--primary-only",
+                 "--quiet"]) == 0
+    stored = bc.load(tmp_path / "sweep.h5").members[0].branches["primary"]["frequencies"]
+    expected = read_tube_run(alone)["branches"]["primary"]["frequencies"]
+    assert set(stored["omega2"]) == {"even", "even_volume", "odd"} and stored["count"] == 2
+    for key in ("omega2", "special"):
+        for block, values in expected[key].items():
+            assert np.array_equal(stored[key][block], values, equal_nan=True)
