@@ -218,3 +218,24 @@ def test_a_tube_sweep_stores_each_members_frequencies(tmp_path):
     for key in ("omega2", "special"):
         for block, values in expected[key].items():
             assert np.array_equal(stored[key][block], values, equal_nan=True)
+
+
+def test_continue_at_the_onset_keeps_the_frequencies(tmp_path):
+    """``continue`` of a tube run with [dynamics] frequencies at its onset label (degree 16, hoop stretch 3): the
+    written primary and bulge branches carry the frequencies of the run's, number for number."""
+    scene_file = tmp_path / "tube.toml"
+    scene_file.write_text(load_scene("tube_spom1_L10").text.replace("degree = 40", "degree = 16")
+                          .replace("stop_stretch = 9.0", "stop_stretch = 3.0")
+                          + "\n[dynamics]\nfrequencies = true\ncount = 2\n")
+    run, again = tmp_path / "run.h5", tmp_path / "again.h5"
+    assert main(["run", str(scene_file), "-o", str(run), "--quiet"]) == 0
+    first = read_tube_run(run)
+    label = next(k for k, s in enumerate(first["branches"]["primary"]["special_points"])
+                 if (s["kind"], s["block"]) == ("BP", "odd"))
+    assert main(["continue", str(run), str(label), "-o", str(again)]) == 0
+    for name, branch in read_tube_run(again)["branches"].items():
+        expected = first["branches"][name]["frequencies"]
+        for key in ("omega2", "special"):
+            assert set(branch["frequencies"][key]) == set(expected[key])
+            for block, values in expected[key].items():
+                assert np.array_equal(branch["frequencies"][key][block], values, equal_nan=True), (name, block)

@@ -113,6 +113,7 @@ def continue_tube(args) -> int:
     traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
     the stored primary branch to a tube run file (130 on a signal, as ``run``). Exit 2, before any work, for another
     label, a setting outside [continuation], another parameter, or no coils for M."""
+    from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
     from ..scene import SceneError, parse_scene
     from ..scene.tables import Ends
@@ -157,7 +158,7 @@ def continue_tube(args) -> int:
         pm = maxwell(scene)
         if in_field:
             return onset_from(scene, primary, point, "M", args.direction, pm)
-        return bulge_picture(scene, primary, point, pm)
+        return with_frequencies(scene, bulge_picture(scene, primary, point, pm))
 
     written, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
