@@ -1080,6 +1080,9 @@ def _amplitude_range(e2, e3, e4) -> float:
 FREQUENCY_STYLES = ("-", "--", "-.", ":")  # one per drawn branch
 
 
+INSET_WIDTH = 0.9  # inches: the narrowest mode-shape inset of the frequency figure
+
+
 def plot_frequencies(branches, axes=None) -> Figure:
     """The lowest squared natural frequency Ω² = ω² R0² ρ/μ of every stored block against the continuation
     parameter (P, Φ̄ or M), one colour per block and one line style per branch; the folds and branch points marked
@@ -1093,11 +1096,14 @@ def plot_frequencies(branches, axes=None) -> Figure:
         raise PlotError(f"{files}: no stored frequencies (frequencies/ of a branch); run the scene with "
                         "[dynamics] frequencies = true")
     shown = mode_points(drawn[0]) if axes is None else []
-    if shown:
-        fig = JournalFigure(figsize=sized((max(8.4, 1.2 * len(shown)), 6.6)), layout="constrained")
-        grid = fig.add_gridspec(2, len(shown), height_ratios=(3.0, 1.2))
+    if shown:  # the insets in rows of as many as fit the width, each at least INSET_WIDTH wide
+        width, height = sized((max(8.4, 1.2 * len(shown)), 6.6))
+        columns = min(len(shown), max(1, int(width / INSET_WIDTH)))
+        rows = -(-len(shown) // columns)
+        fig = JournalFigure(figsize=(width, height * (3.0 + 1.2 * rows) / 4.2), layout="constrained")
+        grid = fig.add_gridspec(1 + rows, columns, height_ratios=(3.0, *[1.2] * rows))
         panels, own = np.atleast_1d(fig.add_subplot(grid[0, :])), True
-        insets = [fig.add_subplot(grid[1, k]) for k in range(len(shown))]
+        insets = [fig.add_subplot(grid[1 + k // columns, k % columns]) for k in range(len(shown))]
     else:
         fig, panels, own = _panels(axes, 1, (8.4, 4.8))
         insets = []
