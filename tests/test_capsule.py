@@ -9,6 +9,8 @@ the long tube's pressure maximum, both derived or computed independently of the 
 capsule propagates at Maxwell's pressure (slow); volume control measures the capsule's volume (a quadrature written
 here); run and inspect store profiles measured from the capsule; one-line errors.
 """
+import json
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -212,10 +214,12 @@ def test_volume_control_measures_the_capsules_volume():
     assert all(a.stable_volume for a in beside) and not all(a.stable_pressure for a in beside)
 
 
-def test_run_writes_the_capsules_profiles(tmp_path):
+def test_run_writes_the_capsules_profiles(tmp_path, capsys):
     """``balloon-cg run`` on a capsule of length 10 (to pole stretch 1.05, before its fold) writes a run file whose
     profiles measure from the capsule: ρ = λ2 R with R written here (1 on the cylinder, sin κθ on the caps), λ1
-    finite on the whole θ grid and equal to λ2 at the poles (isotropic there), 1e-10; ``inspect`` reads it."""
+    finite on the whole θ grid and equal to λ2 at the poles (isotropic there), 1e-10; ``inspect`` (text and
+    --json), ``bc.load`` and its xarray name the shape and its length."""
+    import balloon_cg as bc
     from balloon_cg.app.cli import main
     from balloon_cg.io.run_file import read_run
 
@@ -223,7 +227,16 @@ def test_run_writes_the_capsules_profiles(tmp_path):
     scene.write_text(CAPSULE.format(length=10.0) + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
     path = tmp_path / "capsule.h5"
     assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    capsys.readouterr()
     assert main(["inspect", str(path)]) == 0
+    assert "shape          capsule of length 10\n" in capsys.readouterr().out
+    assert main(["inspect", "--json", str(path)]) == 0
+    assert json.loads(capsys.readouterr().out)["geometry"] == {"shape": "capsule", "length": 10.0}
+    result = bc.load(path)
+    assert result.geometry == {"shape": "capsule", "length": 10.0} and "capsule of length 10" in repr(result)
+    for part in ("points", "special"):
+        attrs = result.to_xarray(part=part).attrs
+        assert attrs["shape"] == "capsule" and attrs["length"] == 10.0
     branch = read_run(path)["branches"]["primary"]
     profiles, theta = branch["profiles"], branch["theta"]
     kappa = 1 + 10 / np.pi

@@ -3,6 +3,8 @@
 A spheroid of aspect 1 is the sphere; a spheroid of another aspect is checked against an axisymmetric membrane
 shooting written here from the strain energy alone, and its reference state against its closed forms.
 """
+import json
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -244,3 +246,27 @@ def test_spheroid_scene_round_trips_and_sphere_scenes_keep_their_text():
     assert again.geometry == scene.geometry
     assert "[geometry]" not in load_scene("spom1").to_toml()
     assert scene.with_overrides({"geometry.aspect": 0.8}).name.endswith("_aspect0.8")
+
+
+@pytest.mark.parametrize("geometry, shape, table", [
+    ("", "sphere", {"shape": "sphere", "aspect": 1.0}),
+    (SPHEROID.format(aspect=1.5), "spheroid of aspect 1.5", {"shape": "spheroid", "aspect": 1.5})])
+def test_inspect_and_load_name_the_shape_and_its_aspect(tmp_path, capsys, geometry, shape, table):
+    """``inspect`` (text and --json), ``bc.load`` and its xarray name the reference shape and its aspect (a run of
+    SPOM1 to pole stretch 1.05, m = 0 only)."""
+    import balloon_cg as bc
+    from balloon_cg.app.cli import main
+
+    scene = tmp_path / "s.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 1.05\n'
+                     + geometry)
+    path = tmp_path / "s.h5"
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["inspect", str(path)]) == 0
+    assert f"shape          {shape}\n" in capsys.readouterr().out
+    assert main(["inspect", "--json", str(path)]) == 0
+    assert json.loads(capsys.readouterr().out)["geometry"] == table
+    result = bc.load(path)
+    assert result.geometry == table and (shape in repr(result)) == (shape != "sphere")
+    assert {k: result.to_xarray().attrs[k] for k in table} == table

@@ -23,7 +23,7 @@ from ..io.layout import file_kind
 from ..io.parents import parent_label
 from ..io.run_file import RunFileError, read_run, read_run_image, run_image
 from ..numerics.interrupt import stop_on_signals
-from ..scene import Scene, SceneError, load_scene, parse_scene
+from ..scene import Scene, SceneError, Shape, load_scene, parse_scene
 from .progress import PhaseBars
 from .tables import SpecialPoints, counted, html_table, optional
 
@@ -181,6 +181,12 @@ class Result:
         return self.run["snap_throughs"]
 
     @property
+    def geometry(self) -> dict:
+        """The reference shape and its parameters: the scene's [geometry] table (shape with aspect, or a capsule's
+        length); also the attributes of every ``to_xarray`` Dataset."""
+        return self.scene.geometry.to_table()
+
+    @property
     def complete(self) -> bool:
         """Every branch reached its requested end, every special point is located, stability is settled."""
         return bool(self.run["attrs"].get("complete", False))
@@ -245,6 +251,7 @@ class Result:
         Returns
         -------
         xarray.Dataset
+            Its attributes: the branch's and the reference shape's (``geometry``: shape, aspect or length).
 
         Raises
         ------
@@ -266,7 +273,7 @@ class Result:
         for group in groups[part]:
             with xr.open_dataset(io.BytesIO(self.image), engine="h5netcdf", group=f"branches/{branch}{group}") as ds:
                 parts.append(ds.load())
-        return xr.merge(parts, combine_attrs="override")
+        return xr.merge(parts, combine_attrs="override").assign_attrs(self.geometry)
 
     def save(self, path, force: bool = False) -> Path:
         """Write the run file, atomically.
@@ -293,7 +300,8 @@ class Result:
         points = sum(len(b["pressure"]) for b in branches.values())
         n = len(self.incomplete)
         state = "complete" if self.complete else f"incomplete: {counted(n, 'part')}"
-        return (f"Result({self.scene.name!r}: {counted(len(branches), 'branch', 'branches')}, "
+        shape = "" if self.scene.geometry.shape == Shape.SPHERE else f"{self.scene.geometry.describe()}; "
+        return (f"Result({self.scene.name!r}: {shape}{counted(len(branches), 'branch', 'branches')}, "
                 f"{counted(points, 'point')}, {counted(len(self.special_points), 'special point')}, "
                 f"{counted(len(self.snap_throughs), 'snap-through')}; {state})")
 

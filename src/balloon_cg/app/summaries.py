@@ -4,6 +4,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io.parents import parent_label, rejoin_label
+from ..post.quantities import stored_scene
 
 
 def summarise_file(path) -> tuple[dict, str]:
@@ -104,11 +105,12 @@ def format_curves(summary: dict) -> str:
 
 
 def summarise_run(run: dict) -> dict:
-    """JSON-ready summary of read_run() output: provenance, the run time per phase (``run_time``) and one summary
-    per branch."""
+    """JSON-ready summary of read_run() output: the reference shape and its parameters (``geometry``: the stored
+    scene's [geometry] table), provenance, the run time per phase (``run_time``) and one summary per branch."""
     return {
         "file": run["path"],
         "scene_name": run["scene_name"],
+        "geometry": stored_scene(run).geometry.to_table(),
         "provenance": run["attrs"],
         "run_time": run_time(run["attrs"]),
         "branches": {name: summarise_branch(b) | {"parent_label": parent_label(run, name),
@@ -230,6 +232,7 @@ def format_run(run: dict) -> str:
     lines = [
         f"file           {summary['file']}",
         f"scene          {summary['scene_name']}",
+        f"shape          {stored_scene(run).geometry.describe()}",
         f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
         f"command        {p['command']}",
         f"tolerance      {p['tolerance']:g}",

@@ -116,14 +116,20 @@ class IntervalDiscretisation:
 
     def hessian(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """∂²E/∂u² = Σ_kl T_kᵀ diag(W h_kl) T_l from ``pointwise`` (10, n_q): energy_hessian at the nodes, into the
-        leading columns of ``out`` if given (a bordered Jacobian's)."""
-        maps, weighted = self.maps, pointwise * self.weights
+        leading columns of ``out`` if given (a bordered Jacobian's). λ2 and v are maps of λ2's coefficients only,
+        η and w of (λ̄, b) only, so each of the three blocks is one product over its own columns."""
+        weighted = pointwise * self.weights
         out = np.zeros((self.size, self.size)) if out is None else out
-        target = out[:, : self.size]
-        target[:] = 0.0
-        for k in range(4):
-            scaled = np.stack([weighted[_HESSIAN_ROW[k, l]] for l in range(4)])  # (4, n_q)
-            target += maps[k].T @ np.einsum("lq,lqj->qj", scaled, maps)
+        k = self.axial_index
+        columns = (slice(0, k), slice(k, self.size))
+        maps = (_tables(self)["hoop_maps"], _tables(self)["axial_maps"])  # (2, n_q, columns): (λ2, v), (η, w)
+        for i, j in ((0, 0), (0, 1), (1, 1)):
+            h = weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]  # (2, 2, n_q): W h_kl of the block
+            scaled = h[:, 0, :, None] * maps[j][0] + h[:, 1, :, None] * maps[j][1]  # Σ_l W h_kl T_l
+            block = maps[i].reshape(-1, maps[i].shape[2]).T @ scaled.reshape(-1, maps[j].shape[2])
+            out[columns[i], columns[j]] = block
+            if i != j:
+                out[columns[j], columns[i]] = block.T
         return out
 
     def uniform(self, hoop: float, axial: float) -> np.ndarray:
@@ -184,7 +190,8 @@ class IntervalDiscretisation:
 
 @functools.lru_cache(maxsize=16)
 def _tables(disc: IntervalDiscretisation) -> dict:
-    """Nodes, weights per dS, the meridian's R' and R at the nodes and the state maps (read-only)."""
+    """Nodes, weights per dS, the meridian's R' and R at the nodes and the state maps (read-only; also split by the
+    columns each reads: (λ2, v) of λ2's coefficients, (η, w) of (λ̄, b))."""
     n, length = disc.degree, disc.length
     x, w = legendre.leggauss(disc.quadrature or gauss_nodes(n))
     p, dp = legendre_table(x, n)
@@ -197,5 +204,6 @@ def _tables(disc: IntervalDiscretisation) -> dict:
     maps[2, :, k + 1:] = bubbles
     maps[3, :, k] = -1.0
     maps[3, :, k + 1:] = 2 / length * slopes
-    tables = {"x": x, "weights": length / 2 * w, "rate": np.zeros_like(x), "radius": np.ones_like(x), "maps": maps}
+    tables = {"x": x, "weights": length / 2 * w, "rate": np.zeros_like(x), "radius": np.ones_like(x), "maps": maps,
+              "hoop_maps": maps[:2, :, :k].copy(), "axial_maps": maps[2:, :, k:].copy()}
     return {name: read_only(table) for name, table in tables.items()}

@@ -72,23 +72,53 @@ def closed_end_state(material, hoop: float) -> UniformTube:
     raise ValueError(f"no axial stretch balances the closed tube at the hoop stretch {hoop:g}")
 
 
+def closed_end_axial(material, hoops) -> np.ndarray:
+    """λz of the closed-end path N = 0 at each of the hoop stretches ``hoops`` at once (the scans' grid): the root
+    ``closed_end_state`` finds one at a time, here by bisection from the same brackets (each [1/2, 2] doubled outwards
+    until N changes sign) to the same relative width; ValueError where no axial stretch balances one."""
+    hoops = np.asarray(hoops, dtype=float)
+    low, high = np.full(hoops.shape, 0.5), np.full(hoops.shape, 2.0)
+    for _ in range(_BRACKET_GROWTH):
+        open_ = ~((axial_force(material, hoops, low) < 0) & (axial_force(material, hoops, high) > 0))
+        if not open_.any():
+            break
+        low[open_], high[open_] = low[open_] / 2, high[open_] * 2
+    else:
+        raise ValueError(f"no axial stretch balances the closed tube at the hoop stretch {hoops[open_][0]:g}")
+    while np.any(high - low > TOLERANCE * high):
+        mid = (low + high) / 2
+        above = axial_force(material, hoops, mid) > 0
+        high, low = np.where(above, mid, high), np.where(above, low, mid)
+    return (low + high) / 2
+
+
 def pressure_slope(material, hoop: float) -> float:
     """dP/dλθ along the closed-end path N = 0 (module docstring)."""
     state = closed_end_state(material, hoop)
-    theta, z, P = state.hoop, state.axial, state.pressure
+    return float(_path_slope(material, state.hoop, state.axial))
+
+
+def _path_slope(material, theta, z):
+    """dP/dλθ = P_θ − P_z N_θ/N_z at closed-end states (λθ, λz) (broadcast)."""
     d = stretch_derivatives(material, z, theta)
+    P = d["phi_2"] / (theta * z)
     P_theta = d["phi_22"] / (theta * z) - P / theta
     P_z = d["phi_12"] / (theta * z) - P / z
     N_theta = d["phi_12"] - (d["phi_2"] + theta * d["phi_22"]) / (2 * z)
     N_z = d["phi_11"] - theta * (d["phi_12"] - d["phi_2"] / z) / (2 * z)
-    return float(P_theta - P_z * N_theta / N_z)
+    return P_theta - P_z * N_theta / N_z
+
+
+def _grid_slopes(material, hoops) -> np.ndarray:
+    """dP/dλθ along the closed-end path at the grid ``hoops`` (``closed_end_axial``)."""
+    return _path_slope(material, hoops, closed_end_axial(material, hoops))
 
 
 def pressure_maximum(material, largest_hoop: float = 10.0) -> UniformTube | None:
     """The first pressure maximum of the closed-end path for λθ in (1, ``largest_hoop``]: the first sign change
     + → − of dP/dλθ on a geometric grid, then brentq; None where P rises throughout."""
     hoops = np.geomspace(1.0 + 1e-3, largest_hoop, _SCAN_POINTS)
-    slopes = [pressure_slope(material, h) for h in hoops]
+    slopes = _grid_slopes(material, hoops)
     for k in range(len(hoops) - 1):
         if slopes[k] > 0 >= slopes[k + 1]:
             hoop = brentq(lambda h: pressure_slope(material, h), hoops[k], hoops[k + 1], xtol=TOLERANCE,
@@ -131,15 +161,15 @@ def bulge_onset(material, length: float, mode: int = 1, largest_hoop: float = 10
     return None
 
 
-def pressure_minimum(material, largest_hoop: float = 100.0) -> UniformTube | None:
-    """The first pressure minimum of the closed-end path beyond its maximum (the first sign change − → + of
-    dP/dλθ on a geometric grid up to ``largest_hoop``, then brentq); None where there is no maximum or P falls
-    throughout."""
-    peak = pressure_maximum(material)
+def pressure_minimum(material, largest_hoop: float = 100.0, peak: UniformTube | None = None) -> UniformTube | None:
+    """The first pressure minimum of the closed-end path beyond its maximum (``peak``; None: ``pressure_maximum``):
+    the first sign change − → + of dP/dλθ on a geometric grid up to ``largest_hoop``, then brentq; None where there
+    is no maximum or P falls throughout."""
+    peak = pressure_maximum(material) if peak is None else peak
     if peak is None:
         return None
     hoops = np.geomspace(peak.hoop * (1 + 1e-6), largest_hoop, _SCAN_POINTS)
-    slopes = [pressure_slope(material, h) for h in hoops]
+    slopes = _grid_slopes(material, hoops)
     for k in range(len(hoops) - 1):
         if slopes[k] < 0 <= slopes[k + 1]:
             hoop = brentq(lambda h: pressure_slope(material, h), hoops[k], hoops[k + 1], xtol=TOLERANCE,
@@ -157,17 +187,24 @@ def closed_end_energy(material, state: UniformTube, pressure: float) -> float:
 def maxwell_pressure(material, largest_hoop: float = 100.0) -> tuple | None:
     """(P_M, a, b): the pressure at which the uniform states a (below the pressure maximum) and b (beyond the
     pressure minimum) of the closed-end path have the same e (module docstring), by brentq in P between the
-    minimum and the maximum; None where the path has no maximum and minimum."""
-    peak, low = pressure_maximum(material), pressure_minimum(material, largest_hoop)
-    if peak is None or low is None:
+    minimum and the maximum; None where the path has no maximum and minimum. b is bracketed by the minimum and the
+    first point of a geometric grid beyond it where the path's P exceeds P (the grid's path computed once)."""
+    peak = pressure_maximum(material)
+    low = None if peak is None else pressure_minimum(material, largest_hoop, peak)
+    if low is None:
         return None
+    grid = np.geomspace(low.hoop, largest_hoop, _SCAN_POINTS)[1:]
+    rising = hoop_pressure(material, grid, closed_end_axial(material, grid))
 
     def states(P):
         def at(h):
             return closed_end_state(material, h).pressure - P
 
+        above = np.flatnonzero(rising > P)
+        if not above.size:
+            raise ValueError(f"the closed-end pressure stays below {P:g} up to the hoop stretch {largest_hoop:g}")
         a = brentq(at, 1.0, peak.hoop, xtol=TOLERANCE, rtol=TOLERANCE)
-        b = brentq(at, low.hoop, _beyond(material, low.hoop, P, largest_hoop), xtol=TOLERANCE, rtol=TOLERANCE)
+        b = brentq(at, low.hoop, float(grid[above[0]]), xtol=TOLERANCE, rtol=TOLERANCE)
         return closed_end_state(material, a), closed_end_state(material, b)
 
     def difference(P):
@@ -177,11 +214,3 @@ def maxwell_pressure(material, largest_hoop: float = 100.0) -> tuple | None:
     span = peak.pressure - low.pressure
     P = brentq(difference, low.pressure + 1e-9 * span, peak.pressure - 1e-9 * span, xtol=TOLERANCE, rtol=TOLERANCE)
     return (P, *states(P))
-
-
-def _beyond(material, hoop: float, pressure: float, largest_hoop: float) -> float:
-    """A hoop stretch beyond ``hoop`` (on the rising path after the minimum) where P exceeds ``pressure``."""
-    for h in np.geomspace(hoop, largest_hoop, _SCAN_POINTS)[1:]:
-        if closed_end_state(material, h).pressure > pressure:
-            return float(h)
-    raise ValueError(f"the closed-end pressure stays below {pressure:g} up to the hoop stretch {largest_hoop:g}")

@@ -150,12 +150,15 @@ class Geometry:
         return {"shape": self.shape.value, "aspect": self.aspect}
 
     def describe(self) -> str:
-        """'spheroid of aspect 1.5', 'tube of length 10 with sliding ends', '... held at 1.5 L'."""
+        """'sphere', 'spheroid of aspect 1.5', 'capsule of length 40', 'tube of length 10 with sliding ends',
+        '... held at 1.5 L'."""
         if self.shape == Shape.TUBE:
             held = "" if self.axial_stretch is None else f" held at {self.axial_stretch:g} L"
             return f"tube of length {self.length:g} with {self.ends.value} ends{held}"
         if self.shape == Shape.CAPSULE:
             return f"capsule of length {self.length:g}"
+        if self.shape == Shape.SPHERE:
+            return "sphere"
         return f"{self.shape.value} of aspect {self.aspect:g}"
 
 

@@ -45,7 +45,7 @@ class TubePicture:
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     """The primary branch and, unless ``primary_only``, the bulge branch of a tube scene (module docstring)."""
-    pm = maxwell(scene)  # first: it does not poll for a signal (~1.3 s for SPOM1), the traces after it do
+    pm = maxwell(scene)  # first: it does not poll for a signal (~0.16 s for SPOM1), the traces after it do
     primary = primary_branch(scene)
     branches: dict[str, IntervalBranch] = {"primary": primary}
     if primary.stop.code == StopCode.INTERRUPTED:
