@@ -141,3 +141,28 @@ def test_a_signal_while_the_scene_loads_writes_nothing_and_says_so(tmp_path, com
     assert code == 130, (code, err)
     assert one_line(err) == "balloon-cg: interrupted: nothing is written to out.h5 (the work had not started)", err
     assert not (tmp_path / "out.h5").exists() and not list(tmp_path.glob(".out.h5*"))
+
+
+def test_a_signal_swallowed_while_the_last_member_is_copied_still_stops_the_sweep(tmp_path, monkeypatch):
+    """A signal whose KeyboardInterrupt is swallowed (it landed in a finalizer, h5py's, while a member was copied
+    into the view: once in CI) has still set the flag: the sweep stops after that member as if it had raised, even
+    when it is the pool's last (the pool's loop checks the flag only between its waits). The swallowing is played
+    by setting the flag in the last ``View.add``; the view then holds every stored member."""
+    from balloon_cg.app.sweep import run_sweep
+    from balloon_cg.io import sweep_file
+    from balloon_cg.numerics import interrupt
+    from balloon_cg.scene import load_scene
+
+    add, calls = sweep_file.View.add, []
+
+    def add_then_swallowed(view, index):
+        add(view, index)
+        calls.append(index)
+        if len(calls) == 3:
+            interrupt.request()
+
+    monkeypatch.setattr(sweep_file.View, "add", add_then_swallowed)
+    with interrupt.sigterm_raises(), pytest.raises(KeyboardInterrupt):
+        run_sweep(load_scene("spom1"), ["stop_stretch=1.1:1.3:3"], tmp_path / "w.h5", mode="primary-only",
+                  workers=2)
+    assert len(calls) == 3 and sorted(bc.load(tmp_path / "w.h5").members) == sorted(calls)

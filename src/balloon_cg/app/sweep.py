@@ -324,6 +324,7 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
                                 view.add(index)
                                 result.computed.append(index)
                             bar.update()
+                            _check_interrupt()  # a signal swallowed while the member was stored or copied
             finally:
                 if force and len(store.done) == len(members):  # the new sweep complete: it replaces the old
                     view.finish()
@@ -414,7 +415,9 @@ INTERRUPT_POLL = 0.2  # s: how often the pool loop looks at the interrupt flag
 
 def _check_interrupt() -> None:
     """Raise KeyboardInterrupt if a signal asked to stop (``interrupt.sigterm_raises`` sets the flag too: its
-    exception can be swallowed when the signal lands in a callback, as once in CI)."""
+    exception can be swallowed when the signal lands in a callback, as once in CI; and once more, in an h5py
+    finalizer while a member of the pool's last batch was copied into the view: checked after every member stored,
+    not only between the pool's waits)."""
     if interrupt.requested():
         raise KeyboardInterrupt
 
