@@ -389,7 +389,6 @@ def _compute(todo: list[Member], mode: str, workers: int | None, scheduler: str 
                 yield job[0], compute_member(*job)
             except Exception as e:  # noqa: BLE001 - reported per member
                 yield job[0], e
-            _check_interrupt()
         return
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
@@ -415,9 +414,9 @@ INTERRUPT_POLL = 0.2  # s: how often the pool loop looks at the interrupt flag
 
 def _check_interrupt() -> None:
     """Raise KeyboardInterrupt if a signal asked to stop (``interrupt.sigterm_raises`` sets the flag too: its
-    exception can be swallowed when the signal lands in a callback, as once in CI; and once more, in an h5py
-    finalizer while a member of the pool's last batch was copied into the view: checked after every member stored,
-    not only between the pool's waits)."""
+    exception can be swallowed when the signal lands in a callback, as once in CI, e.g. an h5py finalizer while a
+    member is copied into the view): ``run_sweep`` checks after every member it stores (whichever way it was
+    computed), the pool's loop also between its waits."""
     if interrupt.requested():
         raise KeyboardInterrupt
 
