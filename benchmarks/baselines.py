@@ -203,7 +203,7 @@ def main():
             # (iii) ours: plain Legendre and, with coils, the tracer's wire-mapped basis (centred from the neighbour)
             mappings = [None]
             if case.scene.field.coils:
-                from balloon_cg.analysis.wires import wire_map
+                from balloon_cg.analysis.branches.wires import wire_map
 
                 mapped = wire_map(branch.disc, X_nb[:-1], case.scene.field.coils, solver.symmetric)
                 mappings += [mapped] if mapped is not None else []

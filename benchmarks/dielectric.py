@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.scene import parse_scene
 from materials import best_cpu_times  # benchmarks/materials.py (this folder is on sys.path when run as a script)
 

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.wires import wire_gap
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.branches.wires import wire_gap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.galerkin.point_solve import constrained_newton
@@ -155,7 +155,7 @@ def wire_approach():
 def stability_basis():
     say("7. Stability basis degree N up to 60 (second variation, two coils M = 0.002, primary branch to λ = 1.8)")
     try:
-        from balloon_cg.analysis import stability
+        from balloon_cg.analysis.stability import axisymmetric as stability
     except ImportError as error:
         say(f"  skipped: {error}")
         return

@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 import balloon_cg as bc
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.dynamics.frequencies import frequencies
 from balloon_cg.dynamics.pencil import mass_variation
 

@@ -7,7 +7,7 @@ parameter, with the default single coil and with the two coils.
    (scenes/spom1_paper_coil.toml, a = 1.961) and the two coils (scenes/spom1_two_coils_M0.002.toml) with
    material.preset = "Gent": the whole picture (balloon_cg.analyse: primary branch, pear pitchforks, pear
    branches).
-3. Where there is a pear pitchfork: its curve in M and in J_m, both ways (analysis.codim2: the critical value is
+3. Where there is a pear pitchfork: its curve in M and in J_m, both ways (analysis.critical.pitchfork_curve: the critical value is
    a fold of the curve at P > 0 followed by the partner pitchfork); checks: plain primary branches at a few J_m
    (their pear point must lie on the curve), and the J_m → ∞ end against the neo-Hookean preset (Ogden class,
    another kernel module) in the same field.
@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 import balloon_cg as bc
-from balloon_cg.analysis.codim2 import continue_branch_point, land_on_q
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.critical.pitchfork_curve import continue_branch_point, land_on_q
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.io.curve_file import write_curve
 from balloon_cg.model.sphere import sphere_pressure
 from balloon_cg.model.sphere_modes import bifurcation_condition, bifurcation_stretches

@@ -4,8 +4,8 @@ For the pear branches of SPOM1 with one coil of radius 2 (M = 0.001), the inferr
 M = 0.001) and the paper's two coils (M = 0.001, 0.002, 0.003), computed with the whole analysis (the runs are
 kept in paper-figures/runs and shared with `make paper`), prints per branch how many stored points have a negative
 held m = 1 eigenvalue (the run file's lowest_m1_held, at each point's stability degree), and at a few points the
-lowest held value from the generated second variation (analysis.azimuthal) and from the brute-force second method
-(analysis.brute_force: the directly integrated 3D energy differenced numerically) at the same perturbation degrees
+lowest held value from the generated second variation (analysis.stability.azimuthal) and from the brute-force second method
+(analysis.stability.brute_force: the directly integrated 3D energy differenced numerically) at the same perturbation degrees
 N, with the share of the brute-force mode that is the rigid tilt e_y × x0.
 Run: python benchmarks/m1_brute_force.py [RUNS_FOLDER]  (output kept in benchmarks/results/m1_brute_force.txt)
 """
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from balloon_cg.analysis import azimuthal as az, brute_force as bf
+from balloon_cg.analysis.stability import azimuthal as az, brute_force as bf
 from balloon_cg.app.figures import run_for
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.post.paper import SINGLE_COIL_M0001, SINGLE_COIL_REACH, Case
@@ -59,7 +59,7 @@ def rows(label: str, run: dict):
 
 def main(runs: Path):
     print("held m = 1: lowest eigenvalue of the m = 1 block, relabelling mode removed, translation constrained; "
-          "'gen': analysis.azimuthal, 'brute': analysis.brute_force, same N; 'tilt': |<mode, e_y × x0>| / norms")
+          "'gen': analysis.stability.azimuthal, 'brute': analysis.stability.brute_force, same N; 'tilt': |<mode, e_y × x0>| / norms")
     for label, case in CASES.items():
         rows(label, run_for(case, runs, progress=False))
 

@@ -19,7 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.codegen import build, classes
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene import parse_scene

@@ -1,4 +1,4 @@
-"""Study behind analysis/stability.NEAR_ZERO: how far the lowest eigenvalue of each block at a point's stability
+"""Study behind analysis/stability/axisymmetric.NEAR_ZERO: how far the lowest eigenvalue of each block at a point's stability
 degree N is from its value at the check degree (``check_degree``: 2N, or N/1.5 at solver.max_degree), at every point
 whose lowest eigenvalue is below the old threshold 0.1 (the points the flag check read before), on the defaults
 (|δx|² norm, wire-mapped basis). Prints per scene, by |μ_N| range, the blocks counted, the largest |μ_N − μ_check|
@@ -13,7 +13,8 @@ os.environ.setdefault("BALLOON_CG_WORKERS", "1")
 
 import numpy as np  # noqa: E402
 
-from balloon_cg.analysis import picture, stability  # noqa: E402
+from balloon_cg.analysis.stability import axisymmetric as stability
+from balloon_cg.analysis import picture
 from balloon_cg.scene import load_scene  # noqa: E402
 
 OLD_NEAR_ZERO = 0.1

@@ -40,7 +40,7 @@ def prepare(path):
     """The start of every point (X0 on its degree and basis, the branch parameters, the mapping) into ``path``."""
     sys.path.insert(0, str(HERE))
     import work_precision as wp
-    from balloon_cg.analysis.wires import wire_map
+    from balloon_cg.analysis.branches.wires import wire_map
 
     points = []
     for index, case in enumerate(wp.cases()):

@@ -4,7 +4,7 @@ For each coil radius a (height 0, current 1, chi and the rest as in scenes/spom1
 continuation.wire_gap = 0.05 instead of 0.1: with 0.1 the curves of coils near the balloon stop at the wire on
 their way back to the partner pitchfork; docs/numerics.md: gaps down to ~0.04 fit in max_degree 320) runs
 `balloon-cg critical SCENE --parameter M` for SPOM1 and TPOM1 and reads the curve file back: how the curve ended
-(`end`, balloon_cg.analysis.codim2.CurveEnd), the critical M (`critical_q`, a value only for a verified
+(`end`, balloon_cg.analysis.critical.pitchfork_curve.CurveEnd), the critical M (`critical_q`, a value only for a verified
 isola_merge) and the first fold of the curve in M (`special_q[0]`, a candidate merge, unverified unless the end is
 isola_merge). Then, if two radii with a verified SPOM1 merge bracket M = 0.004, bisects a there to
 |Δa| < 5e-4 (three significant digits; otherwise it says so and stops), runs SPOM1 and TPOM1 (the test of the

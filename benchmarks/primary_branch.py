@@ -24,7 +24,7 @@ CHILD = """
 import time
 t0 = time.perf_counter()
 from balloon_cg.scene import parse_scene
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 t1 = time.perf_counter()
 branch = trace_primary(parse_scene({scene!r}, name="bench"))
 t2 = time.perf_counter()
@@ -42,7 +42,7 @@ def cold_run() -> tuple[float, float, int]:
 
 
 def warm_runs(repeat: int = 5):
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.scene import parse_scene
 
     scene = parse_scene(SCENE, name="bench")

@@ -48,7 +48,7 @@ REPEAT = 5
 @contextmanager
 def default_rule(nodes):
     """Every Discretisation with quadrature = 0 (and the stability basis) on ``nodes(N)`` inside the block."""
-    from balloon_cg.analysis import stability
+    from balloon_cg.analysis.stability import axisymmetric as stability
 
     saved = discretisation.gauss_nodes
     discretisation.gauss_nodes = stability.gauss_nodes = nodes
@@ -93,7 +93,7 @@ def spectra(solvers, targets, rows, maps):
     """(b): {(rule, λ*, degree, N_s): {block: lowest eigenvalues}} at the plain-basis solutions, and the same
     under key (REFERENCE, λ*, degree, N_s) at the best-resolved solution (default rule, the largest degree, on
     the wire-mapped basis where there is one): the converged spectrum on the same perturbation basis."""
-    from balloon_cg.analysis.stability import SecondVariation
+    from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 
     out = {}
     top = max(DEGREES)
@@ -197,9 +197,9 @@ def format_spectra(found):
 def _pear_points(scene, first_only=False):
     """The located odd-held (pear) branch points of the primary branch of ``scene`` (all, or the first):
     (λ at the north pole, P, status) each."""
-    from balloon_cg.analysis import bifurcation
-    from balloon_cg.analysis.primary import trace_primary
-    from balloon_cg.analysis.stability import assess_branch
+    from balloon_cg.analysis.points import branch_points as bifurcation
+    from balloon_cg.analysis.branches.primary import trace_primary
+    from balloon_cg.analysis.stability.axisymmetric import assess_branch
 
     primary = trace_primary(scene)
     primary.stability, _ = assess_branch(primary, scene.stability.degree, True)

@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 
 import work_precision as wp  # noqa: E402
 from balloon_cg.numerics import continuation  # noqa: E402
-from balloon_cg.analysis.problem import ParameterSystem  # noqa: E402
+from balloon_cg.analysis.branches.problem import ParameterSystem  # noqa: E402
 from balloon_cg.galerkin.discretisation import Discretisation  # noqa: E402
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters  # noqa: E402
 from balloon_cg.numerics.newton import newton  # noqa: E402

@@ -1,18 +1,18 @@
 """Benchmark: stability per branch point (N = 20, m = 0 and 1) and the whole SPOM1 M = 0 picture.
 
 The picture is the primary branch 1 -> 6, stability of every point, the two pear branch points located and
-classified, and the isola (the pear branch traced, its mirror image the reflection: analysis.mirror) with
+classified, and the isola (the pear branch traced, its mirror image the reflection: analysis.switching.mirror) with
 stability on every point (the mirror's copied).
 Times: best of 3, process CPU time (BLAS single-threaded, so on a shared machine the CPU time is the reliable one)
 and wall time in parentheses. Run: python benchmarks/stability.py
 """
 import time
 
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.scene import parse_scene
-from balloon_cg.analysis.stability import SecondVariation
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 from balloon_cg.numerics.threads import blas_threads
 
 SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 6.0\n'
@@ -36,7 +36,7 @@ def main():
     variation = SecondVariation(equilibrium_of(branch), 20)
     params = branch.params
 
-    def assess_all(m_max):  # BLAS limited as in assess_branch (analysis.stability), the library's entry point
+    def assess_all(m_max):  # BLAS limited as in assess_branch (analysis.stability.axisymmetric), the library's entry point
         with blas_threads():
             return [variation.assess(X[:-1], params.with_value("P", X[-1]), True, m_max) for X in branch.X]
 

@@ -23,9 +23,9 @@ from pathlib import Path
 import numpy as np
 from scipy import linalg
 
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.stability import SecondVariation, block_indices, point_degrees
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, block_indices, point_degrees
 from balloon_cg.numerics.threads import blas_threads
 from balloon_cg.scene import load_scene
 

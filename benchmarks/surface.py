@@ -16,7 +16,7 @@ import numpy as np
 
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block
-from balloon_cg.analysis import surface_branches as sb
+from balloon_cg.analysis.surface import branches as sb
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.galerkin.point_solve import constrained_newton

@@ -1,4 +1,4 @@
-"""Benchmark: the stability assessment of the two-coil scene's m = 1 branch (``analysis.surface_assessment``), the
+"""Benchmark: the stability assessment of the two-coil scene's m = 1 branch (``analysis.surface.assessment``), the
 phase that reads every point of a surface branch under every reading, on every core (``numerics.workers``).
 
 For each install (``--python``, default this interpreter), in alternation, ``--repeat`` fresh processes each trace

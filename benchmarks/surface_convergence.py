@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from balloon_cg.analysis import surface_branches as sb
+from balloon_cg.analysis.surface import branches as sb
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.model.field import wire_distance
 from balloon_cg.scene import load_scene

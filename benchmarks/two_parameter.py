@@ -1,4 +1,4 @@
-"""Critical values from two-parameter continuation of a pear pitchfork (balloon_cg.analysis.codim2).
+"""Critical values from two-parameter continuation of a pear pitchfork (balloon_cg.analysis.critical.pitchfork_curve).
 
 1. SPOM1 at M = 0, continued in α1 (μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1): the critical α1 where the isola's two
    pitchforks merge (fold of the curve in α1), against the closed form of sphere_modes (α1 where the minimum over
@@ -15,13 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.analysis.stability import SecondVariation
-from balloon_cg.analysis.codim2 import continue_branch_point, sphere_critical_alpha1, sphere_pear_stretches
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation
+from balloon_cg.analysis.critical.pitchfork_curve import continue_branch_point, sphere_critical_alpha1, sphere_pear_stretches
 
 ROOT = Path(__file__).resolve().parent.parent
 SINGLE_COIL = ROOT / "scenes" / "spom1_single_coil.toml"

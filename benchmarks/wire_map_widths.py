@@ -2,7 +2,7 @@
 
 For points of three equator-symmetric coil scenes whose gaps span 0.05 (the paper's single coil at M = 0.003 past
 its turning point, near the end of its primary branch) to ~2 (the a = 4 coil at λ = 2), and for the map
-``analysis.wires.centred_map`` at the membrane's closest approach to each wire with widths
+``analysis.branches.wires.centred_map`` at the membrane's closest approach to each wire with widths
 
     ε_j = f · gap_j                  (x units per unit gap: main's rule is f = 0.4 below gap 0.5), and
     ε_j = f · gap_j · |dx/ds|_j      (the gap measured along the membrane: s the meridian's arclength),
@@ -59,8 +59,8 @@ def study_cases():
 def past_turn_targets(study: StudyCase, solver):
     """Targets at the full primary branch's points past its turning point nearest ``past_turn_gaps`` (0: the
     last point); X_neighbour_fine is not used here."""
-    from balloon_cg.analysis.primary import trace_primary
-    from balloon_cg.analysis.wires import wire_gap
+    from balloon_cg.analysis.branches.primary import trace_primary
+    from balloon_cg.analysis.branches.wires import wire_gap
     from balloon_cg.model.shooting import shoot_symmetric
 
     scene = study.case.scene
@@ -86,7 +86,7 @@ def past_turn_targets(study: StudyCase, solver):
 
 def bases(approach_list, symmetric, coils, disc, u):
     """(label, WireMap or None) per basis of the study (module docstring)."""
-    from balloon_cg.analysis.wires import centred_map, wire_map
+    from balloon_cg.analysis.branches.wires import centred_map, wire_map
 
     out = [("plain", None), ("shipped", wire_map(disc, u, coils, symmetric))]
     out += [(f"{f:g}·gap", centred_map(approach_list, [f * a.gap for a in approach_list], symmetric))
@@ -113,7 +113,7 @@ def ladder(solver, target, source_disc, mapping):
 
 
 def study(sc: StudyCase):
-    from balloon_cg.analysis.wires import approaches
+    from balloon_cg.analysis.branches.wires import approaches
 
     branch, solver, targets = wp.prepare(sc.case)
     points = [(t, branch.disc) for t in targets if t is not None]
@@ -157,7 +157,7 @@ def main():
         f"{LEVEL:g} / the cheapest with tail estimate ≤ {MAX_ERROR:g} ('-': beyond degree {DEGREES[-1]}; n/a: no map).",
         "gap: the membrane–wire distance at the closest approach, x = cos θ there, |dx/ds| = sin θ/λ1 there;",
         "check: the largest relative difference of the cross-checks (shooting from the pole, the fine Galerkin",
-        "solution) from the reference. 'shipped': analysis.wires.wire_map. See the module docstring.",
+        "solution) from the reference. 'shipped': analysis.branches.wires.wire_map. See the module docstring.",
         "",
     ]
     for k, sc in enumerate(study_cases()):

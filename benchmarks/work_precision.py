@@ -87,7 +87,7 @@ class PointSolver:
     def system(self, degree, mapping=None):
         """(R, its Jacobian, the pole row) of the constrained system at ``degree`` and ``mapping``, built once (as
         a tracer holds them along a branch: building them is no part of a solve's time)."""
-        from balloon_cg.analysis.problem import ParameterSystem
+        from balloon_cg.analysis.branches.problem import ParameterSystem
 
         if (degree, mapping) not in self._system:
             eq = self.equilibrium(degree, mapping)
@@ -128,7 +128,7 @@ class Target:
 
 def prepare(case: Case):
     """Trace the primary branch (adaptive degree) to the largest target; fine solutions at every λ* and λ* − H."""
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.model.shooting import shoot_symmetric
     from balloon_cg.model.sphere import sphere_pressure
 
@@ -176,7 +176,7 @@ def neighbour(solver, target: Target, degree: int, source_disc, mapping=None):
 
 def wire_maps(case, branch, targets):
     """Per target stretch: the tracer's wire-mapped basis centred from the neighbour's profile (coil scenes)."""
-    from balloon_cg.analysis.wires import wire_map
+    from balloon_cg.analysis.branches.wires import wire_map
 
     return {t.stretch: wire_map(branch.disc, t.X_neighbour_fine[:-1], case.scene.field.coils, branch.disc.symmetric)
             for t in targets if t is not None}
@@ -222,14 +222,14 @@ def sweep(case, branch, solver, targets, degrees=DEGREES, tols=TOLS, repeat=REPE
 
 
 def bifurcation_hook(case: Case):
-    """(b) the bifurcation pressure: uses balloon_cg.analysis.stability / balloon_cg.analysis.bifurcation when they exist.
+    """(b) the bifurcation pressure: uses balloon_cg.analysis.stability.axisymmetric / balloon_cg.analysis.points.branch_points when they exist.
 
     Returns a line for the report. The error of the bifurcation pressure against degree is the natural
     extension of this table once the detection is in place (a located branch point per degree).
     """
     try:
-        from balloon_cg.analysis import bifurcation  # noqa: F401
-        from balloon_cg.analysis import stability  # noqa: F401
+        from balloon_cg.analysis.points import branch_points as bifurcation
+        from balloon_cg.analysis.stability import axisymmetric as stability
     except ImportError as error:
         return f"(b) bifurcation pressure: not available ({error})"
     return bifurcation_rows(case, stability, bifurcation)
@@ -242,7 +242,7 @@ def bifurcation_rows(case, stability, bifurcation):
     ``bifurcation.locate`` takes the eigenvalue with the branch's own discretisation, so the primary branch
     degree is the resolution parameter here; the stability basis degree N = 20 only serves detection.
     """
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.branches.primary import trace_primary
 
     try:
         found_P = {}
@@ -264,7 +264,7 @@ def bifurcation_rows(case, stability, bifurcation):
             best = found_P[max(found_P)]
             lines.append("relative to degree {}: {}".format(max(found_P), ", ".join(
                 f"{d}: {abs(P / best - 1):.1e}" for d, P in found_P.items() if d != max(found_P))))
-        return "(b) bifurcation pressure (balloon_cg.analysis.bifurcation, first branch point, N = 20): " + "; ".join(lines)
+        return "(b) bifurcation pressure (balloon_cg.analysis.points.branch_points, first branch point, N = 20): " + "; ".join(lines)
     except Exception as error:  # the API is someone else's work in progress: report, don't fail
         return f"(b) bifurcation pressure: hook failed ({type(error).__name__}: {error})"
 
@@ -384,7 +384,7 @@ def main():
         "threaded (shared 2-core machine under load: the CPU time is the reliable one, see the module docstring);",
         "error = |P/P_ref − 1|; its = Newton iterations.",
         "Symmetric (equator) subspace in all three scenes: about degree + 1 unknowns. With coils, a last column:",
-        "the same solve on the wire-mapped basis the tracer uses near a wire (balloon_cg.analysis.wires.wire_map, centred",
+        "the same solve on the wire-mapped basis the tracer uses near a wire (balloon_cg.analysis.branches.wires.wire_map, centred",
         "from the neighbour's profile), tol 1e-12.",
         "",
     ]

@@ -2,11 +2,11 @@
 a primary branch, and the error of the extended system's Jacobian against central differences of its residual."""
 import numpy as np
 
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.codim2 import ExtendedSystem
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.stability import SecondVariation, assess_branch
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.critical.pitchfork_curve import ExtendedSystem
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, assess_branch
 
 
 def pear_events(branch) -> list:

@@ -56,8 +56,8 @@ def table(picture, errors: bool = False) -> dict[str, np.ndarray]:
 def eigenvalue_errors(branch) -> dict[str, np.ndarray]:
     """Per block, |μ(N) − μ(⌊N/1.5⌋)| of every stored eigenvalue whose degree N exceeds stability.degree (module
     docstring), zero elsewhere."""
-    from balloon_cg.analysis.problem import equilibrium_of
-    from balloon_cg.analysis.stability import Variations
+    from balloon_cg.analysis.branches.problem import equilibrium_of
+    from balloon_cg.analysis.stability.axisymmetric import Variations
     from balloon_cg.numerics.threads import blas_threads
 
     variations, base = Variations(equilibrium_of(branch)), branch.scene.stability.degree

@@ -1,4 +1,4 @@
-"""Non-axisymmetric (m ≥ 1) second variation (balloon_cg.analysis.azimuthal, codegen/second_variation.py).
+"""Non-axisymmetric (m ≥ 1) second variation (balloon_cg.analysis.stability.azimuthal, codegen/second_variation.py).
 
 Independent checks: the exact sphere's spectrum (spherical symmetry: m = 1 = axisymmetric n ≥ 1 + toroidal modes
 with the closed form below), rigid-body null vectors, the removable singularity of the shear coefficient against
@@ -13,9 +13,9 @@ import pytest
 from numpy.polynomial import legendre
 from scipy import linalg
 
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis import azimuthal as az
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability import azimuthal as az
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.galerkin import legendre as associated
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters

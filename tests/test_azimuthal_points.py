@@ -5,12 +5,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import azimuthal_points
-from balloon_cg.analysis.azimuthal import spectrum
+from balloon_cg.analysis.points import azimuthal_points
+from balloon_cg.analysis.stability.azimuthal import spectrum
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Block, Classification, Kind, Status
-from balloon_cg.analysis.stability import assessed_degrees, point_degrees
+from balloon_cg.analysis.stability.axisymmetric import assessed_degrees, point_degrees
 from balloon_cg.app.cli import main
 from balloon_cg.io.run_file import read_run, write_run
 from balloon_cg.scene import load_scene, parse_scene
@@ -114,7 +114,7 @@ def test_under_resolved_m1_crossings_are_refined_away():
     is left and the result is complete, with the special points of the run at degree 40 (the shipped scene): the
     same kinds, blocks and intervals, the primary branch's m = 1 points at the same P (located at the degree that
     holds the equilibrium there), the pear branch's within 1e-4 (at its degree 20 against 40)."""
-    from balloon_cg.analysis.crossings import resolved
+    from balloon_cg.analysis.stability.crossings import resolved
     from balloon_cg.analysis.verdict import failing
 
     scene = load_scene(SCENES / "tpom1_two_coils_M0.003.toml").with_overrides({"surface.branches": "none"})

@@ -4,7 +4,7 @@ import pytest
 
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block, Classification, Kind, Origin, Status, StopCode
-from balloon_cg.analysis.switching import mark_rejoin, trace_pear
+from balloon_cg.analysis.switching.pear import mark_rejoin, trace_pear
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.sphere import sphere_pressure
@@ -63,7 +63,7 @@ def test_isola_or_single_pitchfork(picture):
 
 def test_mirror_branch_swaps_the_poles(picture):
     """The traced mirror image (−φ: an independent continuation) has the pear branch's south pole stretch at its
-    north pole, and the stored mirror (the pear branch reflected, analysis.mirror) agrees with it point by point
+    north pole, and the stored mirror (the pear branch reflected, analysis.switching.mirror) agrees with it point by point
     in P and both pole stretches, in its stops and in its special points."""
     _, pic, primary, bps = pear_points(picture)
     branches = {b.name: b for b in pic.branches}

@@ -1,4 +1,4 @@
-"""Branch points located by regular extended systems (analysis/branch_point.py, docs/numerics.md §4).
+"""Branch points located by regular extended systems (analysis/points/extended_systems.py, docs/numerics.md §4).
 
 (a) At M = 0 every pear (n = 1) and equator-symmetric (n = 2) branch point of the primary branch against the
 closed forms of sphere_modes. (b) Near a coil, the second pear pitchfork against two independent routes: the
@@ -8,12 +8,12 @@ continued in M from the first pitchfork back to the scene's M (its partner point
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.codim2 import continue_branch_point, land_on_q
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.critical.pitchfork_curve import continue_branch_point, land_on_q
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Block, Kind, Status, StopCode
-from balloon_cg.analysis.stability import assess_branch
+from balloon_cg.analysis.stability.axisymmetric import assess_branch
 from balloon_cg.model.sphere_modes import bifurcation_stretches
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import parse_scene
@@ -117,7 +117,7 @@ def test_second_pitchfork_near_a_coil_other_cases(case):
 def test_traced_pear_branch_rejoins_at_the_located_pitchfork():
     """The pear branch traced from the first pitchfork (switching.trace_pear) rejoins where the second is
     located: from its last point, the amplitude limit of the pear equilibria is P* to 1e-8."""
-    from balloon_cg.analysis.switching import trace_pear
+    from balloon_cg.analysis.switching.pear import trace_pear
 
     primary, (first, second) = pear_points(coil_scene("SPOM1", 0.001))
     pear = trace_pear(primary, first, 1.0, "pear")
@@ -138,8 +138,8 @@ def tpom1():
 def test_extended_jacobians_match_differences_of_the_residual(tpom1, block):
     """Werner–Spence and Moore: the Jacobian (third-derivative terms by differences of the generated Hessian)
     against central differences of the exact residual, at the located point; β = 0 there."""
-    from balloon_cg.analysis.branch_point import MooreSystem, WernerSpence
-    from balloon_cg.analysis.problem import equilibrium_of
+    from balloon_cg.analysis.points.extended_systems import MooreSystem, WernerSpence
+    from balloon_cg.analysis.branches.problem import equilibrium_of
 
     bp = tpom1.branch_points(block)[0]
     eq, params = equilibrium_of(tpom1), tpom1.params

@@ -1,7 +1,7 @@
 """The capsule (docs/shapes.md): a cylinder of radius 1 and length L with hemispherical caps of the same membrane,
 discretised as the sphere is over θ = S/κ (codegen/meridian.py, model/meridian.py), its quadrature split at the
 joins where the reference curvature jumps (galerkin/discretisation.py: ``split_rule``), traced at a fixed degree
-(analysis/resolution.py).
+(analysis/branches/resolution.py).
 
 Checked: the capsule of length 0 is the sphere (another kernel module); its meridian is C¹ with the curvature
 jumping at the joins; the middle of a long capsule is the uniform closed-end tube and the capsule starts bulging at
@@ -17,8 +17,8 @@ import sympy as sp
 from scipy.optimize import brentq
 
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.primary import inflated_reference, start_parameters
-from balloon_cg.analysis.tracer import Tracer, unit
+from balloon_cg.analysis.branches.primary import inflated_reference, start_parameters
+from balloon_cg.analysis.branches.tracer import Tracer, unit
 from balloon_cg.galerkin.discretisation import split_rule
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.model import meridian, tube
@@ -148,7 +148,7 @@ def pressure_maximum(length: float, degree: int) -> float:
 def test_a_long_capsule_starts_bulging_at_the_long_tubes_onset():
     """SPOM1: the capsule's pressure maximum (where its middle starts to bulge: the caps hold the cylinder's ends
     as plugs do, so the bulge is the even mode, a fold in P) at L = 10, 20, 40, degrees 64 and 96 (the tracer
-    keeps solver.degree on a capsule: analysis/resolution.py). It lies above the long tube's pressure maximum P*
+    keeps solver.degree on a capsule: analysis/branches/resolution.py). It lies above the long tube's pressure maximum P*
     (model/tube, Yu & Fu's condition) and falls onto it faster than 1/L² (gap ratio > 5 per doubling of L); at
     L = 40 within 1e-3 of P* and of the onset of a sliding tube of length 40 (model/tube.bulge_onset, its
     dispersion relation). Measured: gaps 1.58e-2, 2.18e-3, 2.22e-4; degrees 64 and 96 within 7e-7."""

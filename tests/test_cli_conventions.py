@@ -306,7 +306,7 @@ def test_sigterm_on_critical_writes_the_partial_curve_and_exits_130(tmp_path, mo
     """`critical` as `run`: a SIGTERM during the curve of pitchforks (raised for real, at its fifth point: the
     whole curve takes well under a second, too short to hit from outside) ends it at its next point; the curve so
     far is written (atomically, end interrupted), one line says so, exit 130."""
-    from balloon_cg.analysis import codim2
+    from balloon_cg.analysis.critical import pitchfork_curve as codim2
     from balloon_cg.io.curve_file import read_curve
 
     follow = codim2.continue_branch_point
@@ -337,7 +337,7 @@ def test_sigterm_on_critical_writes_the_partial_curve_and_exits_130(tmp_path, mo
 
 def test_critical_interrupted_before_its_curve_leaves_the_output_alone(tmp_path, monkeypatch, capsys):
     """A signal during the primary branch: nothing to write; an existing output (--force) is left as it was."""
-    from balloon_cg.analysis import primary
+    from balloon_cg.analysis.branches import primary
     from balloon_cg.numerics import interrupt
 
     trace = primary.trace_primary

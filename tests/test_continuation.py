@@ -6,7 +6,7 @@ found by the fold monitor c = e_λ (sign change of c·τ = dλ/ds) and located b
 Pitchfork normal form R(u, λ) = λu − u³: on the trivial branch u = 0 the test function ∂R/∂u = λ − 3u²
 changes sign at λ = 0, where the branches u = ±√λ cross; the engine locates that root with ``locate_root``
 (it has no branch-point detection or classification of its own: those are balloon-specific, in
-analysis/bifurcation.py).
+analysis/points/branch_points.py).
 """
 import enum
 import math

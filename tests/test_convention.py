@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from balloon_cg import generated
-from balloon_cg.analysis.codim2 import ExtendedSystem, alpha1_material
+from balloon_cg.analysis.critical.pitchfork_curve import ExtendedSystem, alpha1_material
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.scene import parse_scene

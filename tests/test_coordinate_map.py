@@ -5,13 +5,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.problem import ParameterSystem
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.branches.problem import ParameterSystem
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Classification, StopCode
 
-from balloon_cg.analysis.wires import wire_gap, wire_map
+from balloon_cg.analysis.branches.wires import wire_gap, wire_map
 from balloon_cg.galerkin.coordinate_map import WireMap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
@@ -75,7 +75,7 @@ def test_curvature_of_a_mapped_profile_matches_the_plain_one():
 
 def test_map_width_follows_the_gap_along_the_membrane_within_its_bounds():
     """ε = gap · clip(0.8 |dx/ds|, 0.1, 0.4) below gap 2 (wires.map_width): positive at a pole (|dx/ds| = 0)."""
-    from balloon_cg.analysis.wires import Approach, map_width
+    from balloon_cg.analysis.branches.wires import Approach, map_width
 
     assert map_width(Approach(1.0, 0.3, 0.0)) == pytest.approx(0.03)
     assert map_width(Approach(0.0, 0.5, 0.3)) == pytest.approx(0.12)
@@ -143,8 +143,8 @@ def test_branch_reaches_the_wire_gap_and_its_end_matches_shooting():
 
 
 def _pear_point(branch):
-    from balloon_cg.analysis import bifurcation
-    from balloon_cg.analysis.stability import SecondVariation
+    from balloon_cg.analysis.points import branch_points as bifurcation
+    from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 
     variation = SecondVariation(equilibrium_of(branch), branch.disc.degree)
     odd = bifurcation.block_indices(variation, "odd_held", False)
@@ -245,7 +245,7 @@ def test_mirror_on_the_mirrored_map_matches_the_traced_mirror(two_coil_picture):
     same points (P, both pole stretches, solved degrees), the same stop; and the m ≥ 1 branch points found on the
     stored mirror (``azimuthal_points``, on its own points) lie where the pear branch's do."""
     from balloon_cg.analysis.results import Origin
-    from balloon_cg.analysis.switching import trace_pear
+    from balloon_cg.analysis.switching.pear import trace_pear
 
     picture = two_coil_picture
     branches = {b.name: b for b in picture.branches}
@@ -286,7 +286,7 @@ def test_projection_is_accurate_at_high_degree():
 def test_bifurcation_work_on_a_mapped_branch_uses_a_degree_that_holds_it(near_wire):
     """Branch points of a mapped branch are classified and continued in x at a degree whose projection and tail
     are within max_error, which near a wire is above the mapped degree."""
-    from balloon_cg.analysis.bifurcation import plain_degree
+    from balloon_cg.analysis.points.branch_points import plain_degree
 
     scene, branch, X, _ = near_wire
     assert branch.disc.mapping is not None

@@ -1,4 +1,4 @@
-"""The perturbation degree follows the mode (analysis/crossings.py): every sign change a branch-point search reads
+"""The perturbation degree follows the mode (analysis/stability/crossings.py): every sign change a branch-point search reads
 is confirmed at raised degrees before it is located.
 
 On model spectra μ(n, N) = c(n) + a(n)·(20/N)³ (converged value c, an under-resolution error that decays
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from balloon_cg.analysis.crossings import branch_point_crossings, follow_modes, resolved, sign_changes
+from balloon_cg.analysis.stability.crossings import branch_point_crossings, follow_modes, resolved, sign_changes
 from balloon_cg.analysis.results import Block
 
 BLOCK = Block.M1_HELD

@@ -14,10 +14,10 @@ import pytest
 from scipy.optimize import brentq
 
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Block, Kind, Status, StopCode
-from balloon_cg.analysis.stability import assess_branch
+from balloon_cg.analysis.stability.axisymmetric import assess_branch
 from balloon_cg.app.api import Result
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.model.kernels import PLAIN, KernelSet
@@ -305,7 +305,7 @@ def test_a_compressed_point_is_never_landed_on():
 
 def test_voltage_is_a_second_parameter():
     """critical --parameter voltage: the dielectric class's runtime voltage is found (KernelSet.of_scene)."""
-    from balloon_cg.analysis.second_parameter import resolve
+    from balloon_cg.analysis.critical.second_parameter import resolve
     scene = parse_scene('[material]\npreset = "SPOM1"\n[electric]\nvoltage = 0.05\n', "d")
     assert resolve(scene, "voltage") == "electric.voltage"
     with pytest.raises(ValueError, match="not a runtime parameter"):

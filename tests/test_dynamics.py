@@ -33,12 +33,12 @@ from numpy.polynomial import legendre
 from scipy import linalg, optimize
 
 import balloon_cg as bc
-from balloon_cg.analysis import azimuthal as az
+from balloon_cg.analysis.stability import azimuthal as az
 from balloon_cg.analysis.results import Block, Status
 from balloon_cg.app.cli import main
 from balloon_cg.app.sweep import run_sweep
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import branch_system, equilibrium_of
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import branch_system, equilibrium_of
 from balloon_cg.dynamics.frequencies import branch_frequencies, frequencies, matching_block
 from balloon_cg.dynamics.modes import block_modes
 from balloon_cg.dynamics.pencil import mass_variation
@@ -556,7 +556,7 @@ def resolved_zero(branch, special, block: str, omega2) -> float:
 def test_every_located_special_point_of_a_shipped_scene_has_a_zero_frequency(name):
     """The whole picture of a shipped scene with [dynamics] (count 6, m_max as the stability's): at every located
     fold and branch point one stored Ω² of its block is zero to the point's own tolerance (``resolved_zero``),
-    the reflected mirror's rejoin BP included (its state on the mirrored wire map: analysis/mirror.py)."""
+    the reflected mirror's rejoin BP included (its state on the mirrored wire map: analysis/switching/mirror.py)."""
     scene = load_scene(name)
     scene = scene.with_overrides({"dynamics.frequencies": True, "dynamics.count": 6,
                                   "dynamics.m_max": scene.stability.m_max})

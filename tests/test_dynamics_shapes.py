@@ -15,7 +15,7 @@ import pytest
 from numpy.polynomial import legendre
 
 import balloon_cg as bc
-from balloon_cg.analysis import azimuthal as az
+from balloon_cg.analysis.stability import azimuthal as az
 from balloon_cg.analysis.results import Kind
 from balloon_cg.app.cli import main
 from balloon_cg.dynamics.pencil import mass_variation

@@ -25,7 +25,7 @@ import pytest
 import balloon_cg as bc
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block, Kind, Status
-from balloon_cg.analysis.surface_branches import rotated, trace_surface
+from balloon_cg.analysis.surface.branches import rotated, trace_surface
 from balloon_cg.app.cli import main
 from balloon_cg.dynamics.frequencies import attach
 from balloon_cg.dynamics.surface import sector_block, surface_matching_block

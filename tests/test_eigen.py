@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from scipy import linalg
 
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.stability import SecondVariation
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 from balloon_cg.numerics import eigen
 from balloon_cg.scene import load_scene, parse_scene
 

@@ -95,7 +95,7 @@ def test_gent_pressure_has_a_maximum_and_a_minimum_then_stiffens():
 def test_leaving_gent_domain_is_an_error_naming_the_point_and_stretch():
     """A sphere beyond Gent's limit (I1 − 3 ≥ Jm, where the kernels would stay finite): NonFiniteState naming
     the node, the failing log argument and the stretches; Newton reports it as the state leaving the domain."""
-    from balloon_cg.analysis.problem import equilibrium_of
+    from balloon_cg.analysis.branches.problem import equilibrium_of
     from balloon_cg.galerkin.equilibrium import NonFiniteState, Parameters
 
     scene = parse_scene('[material]\nfamily = "gent"\n[material.parameters]\nmu = 2.0\nJm = 10.0\n'

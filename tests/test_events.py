@@ -1,11 +1,11 @@
-"""User events (``[[events]]``, analysis/events.py): UZ points where a stored quantity reaches a value, on the
+"""User events (``[[events]]``, analysis/branches/events.py): UZ points where a stored quantity reaches a value, on the
 primary branch, the pear branches and their mirror images; the scene table's one-line errors."""
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.control import control_value
+from balloon_cg.analysis.branches.control import control_value
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.problem import branch_system
+from balloon_cg.analysis.branches.problem import branch_system
 from balloon_cg.analysis.results import Kind, Status
 from balloon_cg.galerkin.profiles import equator_values, fields
 from balloon_cg.numerics.newton import newton
@@ -121,7 +121,7 @@ def test_volume_event_on_a_surface_branch_is_the_pear_branch_s():
 
     from balloon_cg.analysis.picture import Picture, Progress, surface_pair, unsearched_events
     from balloon_cg.analysis.results import Block
-    from balloon_cg.analysis.surface_branches import SurfaceTrace
+    from balloon_cg.analysis.surface.branches import SurfaceTrace
     from balloon_cg.surface.measures import body_moments
 
     base = load_scene("spom1").with_overrides({"continuation.stop_stretch": 4.0, "surface.branches": "none"})

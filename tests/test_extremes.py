@@ -7,11 +7,11 @@ bounded (max_points, max_degree, Newton iterations).
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import StopCode, TraceStop
 
-from balloon_cg.analysis.wires import wire_gap
+from balloon_cg.analysis.branches.wires import wire_gap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.galerkin.point_solve import constrained_newton
@@ -172,8 +172,8 @@ def test_wire_gap_stop_names_the_coil():
 
 def test_stability_basis_degree_60():
     """N = 60 in the second variation: finite lowest eigenvalues, the same flags as N = 40 (skipped while
-    balloon_cg.analysis.stability does not exist)."""
-    stability = pytest.importorskip("balloon_cg.analysis.stability")
+    balloon_cg.analysis.stability.axisymmetric does not exist)."""
+    stability = pytest.importorskip("balloon_cg.analysis.stability.axisymmetric")
     branch = trace_primary(spom1("[continuation]\nstop_stretch = 2.0\n"), down=False)
     params = branch.params
     coarse, fine = stability.SecondVariation(equilibrium_of(branch), 40), stability.SecondVariation(equilibrium_of(branch), 60)

@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 from scipy import linalg
 
-from balloon_cg.analysis import azimuthal
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.stability import SecondVariation
+from balloon_cg.analysis.stability import azimuthal
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 from balloon_cg.galerkin.discretisation import SMALL_GRADIENT, SMALL_SYSTEM, Discretisation, _HESSIAN_ROW, gauss_nodes
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import field

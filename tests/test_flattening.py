@@ -1,4 +1,4 @@
-"""The end of a branch at the balloon folded flat about a wire (issue 41: ``analysis.flattening``). SPOM1 with one
+"""The end of a branch at the balloon folded flat about a wire (issue 41: ``analysis.branches.flattening``). SPOM1 with one
 coil r = 2, M = 0.002, traced up past its fold in the pole stretch: the field holds the equator at the wire and
 the balloon deflates (P falls) into two caps spanning that rim, the poles' separation s proportional to P. At
 P = 0 the caps meet and the rim is a fold of the membrane: no degree reaches it, and the leg at max_degree says
@@ -6,8 +6,8 @@ so (FLATTENING, a stated limitation in the verdict), not RESOLUTION_LIMIT."""
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.flattening import FLAT_TOL, pole_separation
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.flattening import FLAT_TOL, pole_separation
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import StopCode
 from balloon_cg.analysis.verdict import Gap, failing, incomplete
 from balloon_cg.galerkin.profiles import meridional_stretch

@@ -1,4 +1,4 @@
-"""Fold curves (analysis/fold_curve.py, ``critical --of LP|LV|LN``) against closed forms of the inflated sphere.
+"""Fold curves (analysis/critical/fold_curve.py, ``critical --of LP|LV|LN``) against closed forms of the inflated sphere.
 
 At M = 0 the primary branch is the sphere λ1 = λ2 = λ with P = 2Φ1/λ² (Φ1 = ∂Φ/∂λ1 at (λ, λ)). Its pressure folds
 satisfy g(λ) = λ(Φ11 + Φ12) − 2Φ1 = 0 (dP/dλ = 0), and the cusp where the maximum and the minimum of P merge
@@ -15,12 +15,12 @@ import pytest
 import sympy as sp
 
 from balloon_cg.app.cli import main
-from balloon_cg.analysis.codim2 import CurveEnd
-from balloon_cg.analysis.fold_curve import FoldSystem, continue_fold
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.critical.pitchfork_curve import CurveEnd
+from balloon_cg.analysis.critical.fold_curve import FoldSystem, continue_fold
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Kind, Status
-from balloon_cg.analysis.second_parameter import second_parameter
+from balloon_cg.analysis.critical.second_parameter import second_parameter
 from balloon_cg.io.curve_file import read_curve
 from balloon_cg.scene import Control, load_scene, parse_scene
 

@@ -1,4 +1,4 @@
-"""Meetings of a fold and a pitchfork (analysis/fold_meeting.py) against folds and pitchforks located on plain branches.
+"""Meetings of a fold and a pitchfork (analysis/critical/fold_meeting.py) against folds and pitchforks located on plain branches.
 
 SPOM1 between the two coils, the pear pitchfork followed in M from M = 0.002: at M* the symmetric branch through
 the pitchfork has its gas-control fold (LN). Checked independently of the meeting's test function: on a primary
@@ -11,13 +11,13 @@ import json
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.bifurcation import detect, locate
-from balloon_cg.analysis.codim2 import continue_branch_point, land_on_q
-from balloon_cg.analysis.fold_curve import FoldSystem, continue_fold, fold_tangent
-from balloon_cg.analysis.fold_meeting import FoldTest, oriented_tangents
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.points.branch_points import detect, locate
+from balloon_cg.analysis.critical.pitchfork_curve import continue_branch_point, land_on_q
+from balloon_cg.analysis.critical.fold_curve import FoldSystem, continue_fold, fold_tangent
+from balloon_cg.analysis.critical.fold_meeting import FoldTest, oriented_tangents
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Block, Kind, Status
-from balloon_cg.analysis.stability import assess_branch
+from balloon_cg.analysis.stability.axisymmetric import assess_branch
 from balloon_cg.app.cli import main
 from balloon_cg.scene import Control, load_scene
 

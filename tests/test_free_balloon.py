@@ -7,12 +7,13 @@ independent check (a state moved by −0.5 must be an equilibrium of the h = 0 s
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import azimuthal, azimuthal_points, free_pitchforks
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.points import azimuthal_points, free_pitchforks
+from balloon_cg.analysis.stability import azimuthal
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Block, Classification, Gauge, Status
-from balloon_cg.analysis.stability import SecondVariation, assess_branch, assessed_degrees
-from balloon_cg.analysis.surface_branches import SurfaceTrace, trace_surface
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, assess_branch, assessed_degrees
+from balloon_cg.analysis.surface.branches import SurfaceTrace, trace_surface
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.surface.basis import MIRROR_Y, SphericalBasis
@@ -234,8 +235,8 @@ def test_a_free_pitchfork_the_chord_misses_is_located_on_the_scene_moved_to_the_
     issue's scene (traced to λ2(0) = 3) locates directly, P = 2.246446021 (1e-8), its state a free equilibrium
     of the scene (residual ≤ 1e-9) centred at z = 0.5, and on the h = 0 scene the moved-down state's lowest free
     pear eigenvalue vanishes (≤ 1e-9 of the block's scale); classified a supercritical pitchfork."""
-    from balloon_cg.analysis import control_points
-    from balloon_cg.analysis.problem import branch_system
+    from balloon_cg.analysis.points import control_points
+    from balloon_cg.analysis.branches.problem import branch_system
 
     scene = coil(0.5)
     assert free_pitchforks.symmetry_plane(scene.field.coils) == 0.5

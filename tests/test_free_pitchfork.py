@@ -7,11 +7,11 @@ import h5py
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Block, Classification, Gauge, Kind, SpecialPoint, Status
-from balloon_cg.analysis.stability import SecondVariation, assess_branch
-from balloon_cg.analysis.switching import trace_pear
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, assess_branch
+from balloon_cg.analysis.switching.pear import trace_pear
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.io import hdf5

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.app.cli import main
 from balloon_cg.model.field import FieldError, coaxial_table, field_components, field_squared
 from balloon_cg.model.loop import CARTESIAN, field_squared_cartesian, loop_field, loop_table

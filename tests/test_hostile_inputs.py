@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Kind
 from balloon_cg.app.cli import main
 from balloon_cg.app.sweep import cpu_count

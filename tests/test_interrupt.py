@@ -79,7 +79,7 @@ def test_a_stop_during_stability_ends_the_analysis_at_the_next_point(tmp_path, p
 def test_a_stop_while_branch_points_are_located_keeps_those_located(monkeypatch):
     """A stop asked for during the location of the first branch point: that one is kept (located and
     classified), no other is started, no pear branch is traced, the special points stay in order."""
-    from balloon_cg.analysis import bifurcation
+    from balloon_cg.analysis.points import branch_points as bifurcation
 
     locate = bifurcation.locate
 
@@ -153,8 +153,8 @@ def test_a_stop_while_a_point_s_blocks_are_built_comes_before_their_eigenvalues(
     """A point's blocks cost up to ~1 s of CPU on two coils at the check degree: a stop asked for while the first
     point of ``method`` builds them (``SecondVariation.blocks``) raises Interrupted before any of its blocks is solved
     (``assess``, the first pass: their eigenvalues; ``flags``, the check-degree pass: their Cholesky test)."""
-    from balloon_cg.analysis import stability
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.stability import axisymmetric as stability
+    from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.numerics import eigen, workers
 
     branch = trace_primary(load_scene("spom1").with_overrides({"continuation.stop_stretch": 2.0}))

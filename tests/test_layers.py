@@ -46,10 +46,45 @@ def third_party(path: Path) -> set:
 
 @pytest.mark.parametrize("layer", LAYERS)
 def test_layer_imports_only_downward(layer):
-    for path in sorted((PACKAGE / layer).glob("*.py")):
+    for path in sorted((PACKAGE / layer).rglob("*.py")):
         allowed = ALLOWED[layer] | ({"codegen"} if path.relative_to(PACKAGE).as_posix() in GENERATOR_USERS else set())
         wrong = imported_layers(path) - allowed - {"__init__", "__version__"}
         assert not wrong, f"{path.relative_to(PACKAGE)} imports {sorted(wrong)} (allowed: {sorted(ALLOWED[layer])})"
+
+
+# analysis/'s rooms, one per question (README, docs/shapes.md), in the order they may import one another: a module
+# reads the plain data at the top of analysis/ and the rooms before its own
+ROOMS = ("branches", "stability", "points", "switching", "critical", "surface")
+TOP = {"results": set(), "timing": set(), "verdict": {"results"}, "picture": set(ROOMS) | {"results", "timing", "verdict"}}
+
+
+def imported_rooms(path: Path) -> set:
+    """The rooms and top-level modules of analysis/ a module of analysis/ imports."""
+    module = ("balloon_cg",) + path.relative_to(PACKAGE).with_suffix("").parts
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            target = (list(module[: len(module) - node.level]) if node.level else []) + (
+                node.module.split(".") if node.module else [])
+            if target[:2] == ["balloon_cg", "analysis"]:
+                found |= {target[2]} if len(target) > 2 else {alias.name for alias in node.names}
+    return found
+
+
+@pytest.mark.parametrize("room", ROOMS + tuple(TOP))
+def test_analysis_rooms_import_only_earlier_rooms(room):
+    paths = sorted((PACKAGE / "analysis" / room).rglob("*.py")) if room in ROOMS else [
+        PACKAGE / "analysis" / f"{room}.py"]
+    allowed = TOP[room] if room in TOP else set(ROOMS[: ROOMS.index(room) + 1]) | {"results", "timing"}
+    for path in paths:
+        wrong = imported_rooms(path) - allowed - {room}
+        assert not wrong, f"{path.relative_to(PACKAGE)} imports {sorted(wrong)} (allowed: {sorted(allowed)})"
+
+
+def test_every_analysis_module_is_in_a_room():
+    found = {p.relative_to(PACKAGE / "analysis").parts[0].removesuffix(".py")
+             for p in (PACKAGE / "analysis").iterdir() if p.name not in ("__init__.py", "__pycache__")}
+    assert found == set(ROOMS) | set(TOP), found ^ (set(ROOMS) | set(TOP))
 
 
 def test_every_module_is_in_a_layer():
@@ -61,5 +96,5 @@ def test_every_module_is_in_a_layer():
 def test_runtime_never_imports_sympy_or_codegen():
     for path in PACKAGE.rglob("*.py"):
         assert not third_party(path) & {"sympy", "codegen"}, path
-        if path.relative_to(PACKAGE).as_posix() not in GENERATOR_USERS and path.parent.name in LAYERS:
+        if path.relative_to(PACKAGE).as_posix() not in GENERATOR_USERS and path.relative_to(PACKAGE).parts[0] in LAYERS:
             assert "codegen" not in imported_layers(path), path

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from balloon_cg.analysis.control import control_value
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.branches.control import control_value
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Kind, Status, StopCode
-from balloon_cg.analysis.stability import FLAGS, SecondVariation, assess_branch
+from balloon_cg.analysis.stability.axisymmetric import FLAGS, SecondVariation, assess_branch
 from balloon_cg.app.cli import main
 from balloon_cg.model.sphere import sphere_pressure
 from balloon_cg.post.plotting import Reading, load_branches

@@ -1,4 +1,4 @@
-"""The mirror image of a pear branch as its reflection z → −z (analysis.mirror, Discretisation.reflect): the
+"""The mirror image of a pear branch as its reflection z → −z (analysis.switching.mirror, Discretisation.reflect): the
 reflection operator on plain and mapped bases, the residual check and its fallback to a traced mirror, and the
 copied assessments against the traced mirror's own. The traced mirror's points, stops and special points are
 compared in tests/test_bifurcation.py (six presets at M = 0) and tests/test_coordinate_map.py (two coils, mapped)."""
@@ -7,13 +7,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import mirror as mirror_module
-from balloon_cg.analysis.mirror import reflection, reflection_excess
+from balloon_cg.analysis.switching import mirror as mirror_module
+from balloon_cg.analysis.switching.mirror import reflection, reflection_excess
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.problem import branch_system
+from balloon_cg.analysis.branches.problem import branch_system
 from balloon_cg.analysis.results import Kind, Leg, Origin, Stop, StopCode
-from balloon_cg.analysis.stability import FLAGS, assess_branch
-from balloon_cg.analysis.switching import mark_rejoin, trace_pear
+from balloon_cg.analysis.stability.axisymmetric import FLAGS, assess_branch
+from balloon_cg.analysis.switching.pear import mark_rejoin, trace_pear
 from balloon_cg.galerkin.coordinate_map import WireMap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.scene import parse_scene

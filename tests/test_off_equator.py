@@ -1,6 +1,6 @@
 """A coil off the equatorial plane (issue 27): SPOM1, one coil of radius 2 at height 0.5, M = 0.002. The primary
 branch has no equator symmetry; every stability change under every control mode is a special point (LP, LV, LN or
-BP: ``analysis.control_points``), its m = 1 crossings are located as on symmetric branches, and what is still not
+BP: ``analysis.points.control_points``), its m = 1 crossings are located as on symmetric branches, and what is still not
 searched is said in the verdict line; the pear branch the broken symmetry disconnects is found by continuation in
 the coil height from 0. With the coil back at h = 0 the symmetric analysis runs as before."""
 from pathlib import Path
@@ -8,12 +8,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.broken_symmetry import distance_to
-from balloon_cg.analysis.control_points import FOLD_TOL, fold_rate
+from balloon_cg.analysis.switching.broken_symmetry import distance_to
+from balloon_cg.analysis.points.control_points import FOLD_TOL, fold_rate
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.problem import branch_system, equilibrium_of
+from balloon_cg.analysis.branches.problem import branch_system, equilibrium_of
 from balloon_cg.analysis.results import Block, Gauge, Kind, Origin, Status, StopCode
-from balloon_cg.analysis.stability import SecondVariation
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 from balloon_cg.analysis.verdict import Gap, failing
 from balloon_cg.io.run_file import write_run
 from balloon_cg.scene import Control, parse_scene
@@ -139,8 +139,8 @@ def test_the_disconnected_pear_branch_gets_its_user_points():
     twice (its volume has a minimum 19.886 between them) and holds a located UZ point in each interval, V = 20 there
     to 1e-10 relative (the volume of the stored state recomputed) and R = 0 to the solver tolerance (it had none:
     only the primary branch's were located)."""
-    from balloon_cg.analysis.broken_symmetry import broken_pear
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.switching.broken_symmetry import broken_pear
+    from balloon_cg.analysis.branches.primary import trace_primary
 
     scene = parse_scene(SCENE.format(height=0.5).replace("stop_stretch = 3.2", "stop_stretch = 5.0")
                         + '[[events]]\nquantity = "volume"\nvalue = 20\n', name="coil_at_0.5")

@@ -6,9 +6,9 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.codim2 import continue_branch_point, land_on_q
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.critical.pitchfork_curve import continue_branch_point, land_on_q
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.app.cli import main
 from balloon_cg.app.sweep import grid, parse_vary, run_sweep
 from balloon_cg.scene import SceneError, load_scene

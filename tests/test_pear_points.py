@@ -1,21 +1,22 @@
 """Pear-shaped equilibria in a field (one coil of radius 2 and the paper's two coils, M = 0.001): the m = 1 claim
-of docs/paper.md checked by a second method (balloon_cg.analysis.brute_force: the held m = 1 block from the
-directly integrated 3D energy on a (θ, φ) grid, differenced numerically, against analysis.azimuthal's generated
+of docs/paper.md checked by a second method (balloon_cg.analysis.stability.brute_force: the held m = 1 block from the
+directly integrated 3D energy on a (θ, φ) grid, differenced numerically, against analysis.stability.azimuthal's generated
 second variation; the longer study over whole traced pear branches is benchmarks/m1_brute_force.py), and the
-energy landscape off the branch point (analysis.landscape, Fig. 13)."""
+energy landscape off the branch point (analysis.switching.landscape, Fig. 13)."""
 import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import azimuthal as az, bifurcation, brute_force as bf
-from balloon_cg.analysis.landscape import landscape, state_at
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.stability import azimuthal as az, brute_force as bf
+from balloon_cg.analysis.switching.landscape import landscape, state_at
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Block
-from balloon_cg.analysis.stability import assess_branch
-from balloon_cg.analysis.switching import trace_pear
+from balloon_cg.analysis.stability.axisymmetric import assess_branch
+from balloon_cg.analysis.switching.pear import trace_pear
 from balloon_cg.scene import load_scene
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.model.field import field_components
 from balloon_cg.post.quantities import (

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.scene import parse_scene
 from balloon_cg.model.sphere import sphere_pressure

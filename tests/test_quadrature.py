@@ -4,8 +4,8 @@ there is located at (benchmarks/quadrature.py is the full study)."""
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import ParameterSystem
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import ParameterSystem
 from balloon_cg.galerkin.discretisation import Discretisation, gauss_nodes
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.numerics.newton import newton

@@ -1,4 +1,4 @@
-"""A fold candidate at a pear branch's rejoin is the primary branch's branch point (analysis/switching.py).
+"""A fold candidate at a pear branch's rejoin is the primary branch's branch point (analysis/switching/pear.py).
 
 SPOM1 at M = 0: the isola leaves the sphere at its first pear point and rejoins it at the second, both closed
 forms (sphere_modes.bifurcation_pressures). P is even in the pear amplitude there, so a step across the rejoin
@@ -13,7 +13,7 @@ import pytest
 
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block, Classification, Kind, SpecialPoint, Status
-from balloon_cg.analysis.switching import mark_rejoin, rejoin_fold
+from balloon_cg.analysis.switching.pear import mark_rejoin, rejoin_fold
 from balloon_cg.model.sphere_modes import bifurcation_pressures
 from balloon_cg.scene import parse_scene
 from balloon_cg.scene.materials import get_preset

@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.problem import branch_system
+from balloon_cg.analysis.branches.problem import branch_system
 from balloon_cg.app.cli import main
 from balloon_cg.app.restart import find_label, stored_branch
 from balloon_cg.io.curve_file import read_curve
@@ -405,10 +405,10 @@ def test_continue_in_M_from_the_free_pitchfork_gives_free_pitchforks(two_coils, 
     with the axial translation) traces its curve (group pear_free); it turns back in M near 0.0144 and ends at a
     wire. At a curve point of the first leg (M = 0.0109) the free pitchfork located on a primary branch traced at
     that M (Werner–Spence at fixed M, from its own detection) is at the curve's P to 1e-10 (measured 8e-15)."""
-    from balloon_cg.analysis import bifurcation
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.points import branch_points as bifurcation
+    from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.analysis.results import Block, Status
-    from balloon_cg.analysis.stability import assess_branch
+    from balloon_cg.analysis.stability.axisymmetric import assess_branch
 
     run, out = two_coils / "run.h5", two_coils / "free_curve.h5"
     assert main(["continue", str(run), str(first(run, "BP", "odd_free")), "--parameter", "M", "-o", str(out),

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Block, Classification, Kind, Status, StopCode
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene import parse_scene

@@ -1,4 +1,4 @@
-"""Two-parameter continuation in any runtime parameter (analysis.second_parameter): a strain energy's parameter
+"""Two-parameter continuation in any runtime parameter (analysis.critical.second_parameter): a strain energy's parameter
 against the sphere's closed-form pear condition, a runtime scalar without a derivative kernel (χ, central
 differences) against the same curve in M (exact), the Jacobians against differences of the residual, and the
 one-line error for a name the scene does not have."""
@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.codim2 import CurveEnd, continue_branch_point
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.critical.pitchfork_curve import CurveEnd, continue_branch_point
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.results import Status, StopCode
-from balloon_cg.analysis.second_parameter import Derivative, UnknownParameter, parameter_keys, resolve
+from balloon_cg.analysis.critical.second_parameter import Derivative, UnknownParameter, parameter_keys, resolve
 from balloon_cg.app.cli import main
 from balloon_cg.io.curve_file import read_curve, write_curve
 from balloon_cg.scene import load_scene, parse_scene

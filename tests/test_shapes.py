@@ -13,7 +13,7 @@ from scipy.optimize import brentq
 
 from balloon_cg import generated
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.profiles import equator_values, profiles

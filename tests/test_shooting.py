@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.scene.materials import PRESETS
 from balloon_cg.scene import load_scene, parse_scene
 from balloon_cg.model.shooting import shoot_general, shoot_symmetric

@@ -129,7 +129,7 @@ LOADS = {"run": ["run", "s.toml", "-o", "out.h5", "--quiet"],
     ("run", "after balloon_cg.app.cli:configured", "SIGTERM"),  # the scene and its settings loaded
     ("critical", "after balloon_cg.scene.tables:_read_text", "SIGTERM"),
     ("critical", "after balloon_cg.app.cli:configured", "SIGINT"),
-    ("critical", "after balloon_cg.analysis.second_parameter:resolve", "SIGTERM"),  # its kernels bound
+    ("critical", "after balloon_cg.analysis.critical.second_parameter:resolve", "SIGTERM"),  # its kernels bound
 ])
 def test_a_signal_while_the_scene_loads_writes_nothing_and_says_so(tmp_path, command, moment, sig):
     """`run` and `critical` load their scene (and `critical` its kernels) under the interrupt contract of the work

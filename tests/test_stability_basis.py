@@ -14,11 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import azimuthal
+from balloon_cg.analysis.stability import azimuthal
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis.stability import SecondVariation, point_degrees
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, point_degrees
 from balloon_cg.scene import SceneError, load_scene, parse_scene
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -154,7 +154,7 @@ def test_default_assessment_on_the_map_agrees_with_an_independent_basis(wire_poi
     holds the point (67 and 90, measured), where x needs 30 to 320 near the wire, and every stored eigenvalue of
     every block (three each, m = 0 and 1) agrees with an independent basis (Legendre in x at degree 320) to
     1e-8 · max(1, |μ|) at the first, middle and last points."""
-    from balloon_cg.analysis.stability import assess_branch
+    from balloon_cg.analysis.stability.axisymmetric import assess_branch
     branch, _ = wire_point
     scene = branch.scene.with_overrides({"stability.norm": "displacement", "stability.basis": "mapped"},
                                         name=branch.scene.name)
@@ -177,7 +177,7 @@ def test_flags_are_checked_near_zero_by_the_convergence_of_the_defaults():
     1e-4 on the defaults (every block converges spectrally there: the test above, and benchmarks/near_zero.py), 0.1
     in the unknowns' norm or on the plain basis (m = 0 eigenvalues drifting with the degree). A point next to a
     change of a flag and every tenth point are checked whatever their eigenvalues."""
-    from balloon_cg.analysis.stability import Assessment, NEAR_ZERO, _worth_checking, near_zero_of
+    from balloon_cg.analysis.stability.axisymmetric import Assessment, NEAR_ZERO, _worth_checking, near_zero_of
     defaults = load_scene("spom1_two_coils_M0.002").stability
     assert near_zero_of(defaults) == NEAR_ZERO[True] == 1e-4
     assert near_zero_of(replace(defaults, norm="unknowns")) == near_zero_of(replace(defaults, basis="legendre")) == 0.1
@@ -202,7 +202,7 @@ def test_the_readings_of_one_index_set_share_its_reduction(wire_point, symmetric
     equator-symmetric and the general layouts, every block's lowest eigenvalues equal those of its own pencil
     reduced alone (H + (P/Ṽ) g gᵀ under gas control, the constraint gᵀc = 0 under volume control) to
     1e-10 · max(1, |μ|)."""
-    from balloon_cg.analysis.stability import LOWEST, merged_lowest
+    from balloon_cg.analysis.stability.axisymmetric import LOWEST, merged_lowest
     from balloon_cg.numerics import eigen
 
     branch, _ = wire_point

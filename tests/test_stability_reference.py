@@ -26,7 +26,7 @@ import pytest
 
 from stability_reference import SCENES, reference_path, scene_table
 
-from balloon_cg.analysis.stability import FLAGS
+from balloon_cg.analysis.stability.axisymmetric import FLAGS
 
 RELATIVE = 1e-9
 M0_BLOCKS = {"even", "even_volume", "even_gas", "odd_held", "odd_free", "all_held", "all_volume_held", "all_gas_held",

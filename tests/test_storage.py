@@ -9,7 +9,7 @@ import pytest
 
 import balloon_cg
 from balloon_cg.io import run_file as storage
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.model.kernels import generated_digest, module_signature
 from balloon_cg.galerkin.profiles import equator_values, fields, profiles, theta_grid
 from balloon_cg.scene import load_scene

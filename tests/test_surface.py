@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import linalg
 
-from balloon_cg.analysis import azimuthal as az
+from balloon_cg.analysis.stability import azimuthal as az
 from balloon_cg.galerkin.coordinate_map import WireMap
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
@@ -81,7 +81,7 @@ def test_hessian_is_the_derivative_of_the_residual_and_the_residual_of_the_energ
 def test_sphere_spectrum_is_the_union_of_the_azimuthal_blocks(spom1):
     """MODEL.md §8 check: at a sphere state (M = 0) the 2D Hessian in the mirror sector y → −y (the cos mφ family of
     every m: no torsion) has the eigenvalues of the axisymmetric m = 0 Hessian and of the m = 1..L blocks of
-    analysis/azimuthal.py, in the same displacement norm; the lowest 40 (every sphere mode of degree n well below L,
+    analysis/stability/azimuthal.py, in the same displacement norm; the lowest 40 (every sphere mode of degree n well below L,
     exact in both bases) to 1e-9. The other sector holds the sin mφ copies."""
     L = 10
     eq1, u, params = sphere(spom1, 1.5, L + 4)
@@ -138,7 +138,7 @@ def test_an_even_mode_keeps_the_half_turn(two_coil_picture, spom1):
     sectors of (MIRROR_Y, HALF_TURN) hold the mirror subspace's spectrum to 1e-9."""
     from dataclasses import replace
 
-    from balloon_cg.analysis.surface_branches import critical_mode, mode_symmetry
+    from balloon_cg.analysis.surface.branches import critical_mode, mode_symmetry
 
     primary = two_coil_picture.primary
     bp = next(s for s in primary.branch_points() if s.m == 1 and s.block.held)
@@ -173,8 +173,8 @@ def test_the_critical_mode_of_a_later_crossing_is_the_one_that_crosses(two_coil_
     the point was located at (320; at stability.degree the crossing eigenvalue reads 0.13: unresolved). The lowest
     mode, or the one nearest zero at stability.degree, could not start a branch (the first correction landed on
     another branch)."""
-    from balloon_cg.analysis.problem import equilibrium_of
-    from balloon_cg.analysis.surface_branches import critical_mode, located_degree
+    from balloon_cg.analysis.branches.problem import equilibrium_of
+    from balloon_cg.analysis.surface.branches import critical_mode, located_degree
 
     primary = two_coil_picture.primary
     second = [s for s in primary.branch_points() if s.m == 1 and s.block.held][1]
@@ -313,7 +313,7 @@ def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):
     from dataclasses import replace
 
     from balloon_cg.analysis.results import Block
-    from balloon_cg.analysis.surface_branches import SurfaceTrace, rotated, trace_surface
+    from balloon_cg.analysis.surface.branches import SurfaceTrace, rotated, trace_surface
 
     primary = spom1_picture.primary
     bp = primary.branch_points()[0]
@@ -360,7 +360,7 @@ def test_held_m1_branch_of_an_off_equator_coil(tmp_path):
     equilibrium, and the pear it becomes is tilted (neither axial nor turned by 90°, as the equator-symmetric
     scenes' are: nothing fixes its axis here)."""
     from balloon_cg.analysis.picture import analyse
-    from balloon_cg.analysis.surface_branches import SurfaceTrace, trace_surface
+    from balloon_cg.analysis.surface.branches import SurfaceTrace, trace_surface
     from balloon_cg.surface.loads import loads
 
     primary = analyse(parse_scene(OFF_EQUATOR.format(M=0.002), name="off_equator"), pear=False).primary
@@ -398,10 +398,10 @@ def test_the_off_equator_held_m1_branch_tends_to_the_turned_pear_as_M_vanishes(s
     secant predictor) to 3.125e-6; the deviation from the axisymmetric pear solved at the same P (Galerkin,
     point-solved from the M = 0 pear branch) is linear in M (dV/M → −34.8), and its quadratic fit through the three
     smallest M has an intercept ≤ 1e-9 in every invariant (measured ≤ 2.1e-10). 30–60 s on a loaded 2-core machine."""
-    from balloon_cg.analysis import surface_branches
+    from balloon_cg.analysis.surface import branches as surface_branches
     from balloon_cg.analysis.picture import analyse
-    from balloon_cg.analysis.problem import equilibrium_of
-    from balloon_cg.analysis.surface_branches import SurfaceTrace, trace_surface
+    from balloon_cg.analysis.branches.problem import equilibrium_of
+    from balloon_cg.analysis.surface.branches import SurfaceTrace, trace_surface
 
     monkeypatch.setattr(surface_branches, "assess", lambda *args: None)  # the stability is not read here
     M0 = 4e-4
@@ -453,10 +453,10 @@ def two_coil_picture(tmp_path_factory):
 
 def test_m1_eigenvalue_and_crossing_with_a_field(two_coil_picture):
     """Two coils, M = 0.002: on the wire-mapped whole-sphere basis (degree 72, order 4) the held m = 1 spectrum
-    (``stability.azimuthal_spectrum``) equals analysis/azimuthal's at perturbation degree 80 to 1e-9 at the
+    (``stability.azimuthal_spectrum``) equals analysis/stability/azimuthal's at perturbation degree 80 to 1e-9 at the
     first located m = 1 point, and the zero of its lowest eigenvalue along the primary branch (Brent on the chord,
     as azimuthal_points.locate) is that point's P to 1e-9."""
-    from balloon_cg.analysis.problem import branch_system
+    from balloon_cg.analysis.branches.problem import branch_system
     from balloon_cg.numerics import continuation
 
     primary = two_coil_picture.primary
@@ -536,7 +536,7 @@ def test_the_one_coil_m1_branch_reaches_the_wire_past_a_located_fold(tmp_path):
     stability (about a minute: ``pytest -m slow``)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Kind, Status, StopCode
-    from balloon_cg.analysis.surface_branches import trace_surface
+    from balloon_cg.analysis.surface.branches import trace_surface
 
     text = (ROOT / "scenes" / "spom1_single_coil.toml").read_text()
     scene = parse_scene(text.replace("radius = 4.0", "radius = 2.0").replace("M = 0.002", "M = 0.001"))
@@ -610,7 +610,7 @@ def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, 
     skipped). A study of tens of minutes (degree up to 64 on the whole sphere): ``pytest -m slow``."""
     from dataclasses import replace
 
-    from balloon_cg.analysis import surface_branches
+    from balloon_cg.analysis.surface import branches as surface_branches
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block, StopCode
 

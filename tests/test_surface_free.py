@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.results import Gauge
-from balloon_cg.analysis.surface_branches import SurfaceTrace, rotated, trace_surface
+from balloon_cg.analysis.surface.branches import SurfaceTrace, rotated, trace_surface
 from balloon_cg.surface.loads import loads
 from shared_pictures import two_coil_picture
 
@@ -61,7 +61,7 @@ def test_free_m1_branch_follows_its_normal_form(free_branch):
     P* ± 1e-4 solved on the whole sphere, by central difference. The first point (Λ = 0.02) reads κ to 1e-4
     relative (measured 8e-5: its Λ² term), and the intercept of (P − P*)/Λ² = κ + κ4 Λ² through the first three
     to 1e-4 (measured 2e-5)."""
-    from balloon_cg.analysis.surface_branches import axisymmetric_solve, critical_mode, located_degree
+    from balloon_cg.analysis.surface.branches import axisymmetric_solve, critical_mode, located_degree
     from balloon_cg.surface.embedding import mode_coefficients
 
     primary, branch = free_branch
@@ -92,7 +92,7 @@ def test_a_switch_that_does_not_start_is_named_and_fails_the_verdict(tmp_path_fa
     """Issue 41: where switching at an m ≥ 1 point fails (here every one: the first correction made to fail), the
     picture names each branch not started (m1_bp<k>, the points of the reading the states are equilibria of: on the
     two-coil scene both readings, held and free) and the verdict fails on them: never silence."""
-    from balloon_cg.analysis import surface_branches
+    from balloon_cg.analysis.surface import branches as surface_branches
     from balloon_cg.analysis.picture import Picture, Progress, _trace_surface, surface_name
     from balloon_cg.analysis.results import Status
     from balloon_cg.analysis.verdict import Gap, failing

@@ -10,10 +10,10 @@ import h5py
 import numpy as np
 import pytest
 
-from balloon_cg.analysis import surface_assessment
+from balloon_cg.analysis.surface import assessment as surface_assessment
 from balloon_cg.analysis.picture import Picture, analyse, stopped
 from balloon_cg.analysis.results import Block, StopCode, TraceStop
-from balloon_cg.analysis.surface_branches import trace_surface
+from balloon_cg.analysis.surface.branches import trace_surface
 from balloon_cg.analysis.timing import Step
 from balloon_cg.analysis.verdict import Gap, incomplete
 from balloon_cg.numerics import interrupt, workers
@@ -107,7 +107,7 @@ def test_run_of_two_coils_interrupted_in_its_surface_branches(tmp_path):
     """The issue's case: two coils, SIGTERM as the surface branch takes its first step off the branch point (about
     30 s of axisymmetric work before): exit 130, the line and the file name the phase, the surface branch is
     stored as far as it went."""
-    code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.analysis.surface_branches:switch",
+    code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.analysis.surface.branches:switch",
                            ["run", str(ROOT / "scenes" / "spom1_two_coils_M0.002.toml"), "-o", "r.h5", "--quiet"])
     line = one_line(err)
     assert code == 130 and "during non-axisymmetric branches" in line, err
@@ -153,7 +153,7 @@ def test_a_signal_as_a_surface_branch_would_refine_stops_it_there(pear_point, mo
     """A point whose tail exceeds solver.max_error refines the basis, solves the last point again and goes on (~1 s
     of CPU on two coils before the next point's poll): a signal then stops the branch where it is, not refined
     (the third point's tail made to exceed max_error as the signal comes)."""
-    from balloon_cg.analysis import surface_branches
+    from balloon_cg.analysis.surface import branches as surface_branches
 
     primary, bp = pear_point
     tail, refine, tails, refined = surface_branches.tail, surface_branches.refined, [], []

@@ -1,4 +1,4 @@
-"""Branch switching at the pitchforks of a primary branch traced on the whole sphere (analysis/surface_pitchforks.py):
+"""Branch switching at the pitchforks of a primary branch traced on the whole sphere (analysis/surface/pitchforks.py):
 the reflection of a field on the coefficients, the reflections a broken mode keeps, and the two-coil scene turned by
 30° (an exact rotation of the axisymmetric problem): its pitchfork odd under the inversion is the axisymmetric pear
 point, and the branch born there is the pear branch turned."""
@@ -9,7 +9,7 @@ import pytest
 
 from balloon_cg.analysis import verdict
 from balloon_cg.analysis.results import Gauge, Kind, Origin
-from balloon_cg.analysis.surface_pitchforks import kept_reflections
+from balloon_cg.analysis.surface.pitchforks import kept_reflections
 from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 
 MIRROR_X = (-1, 1, 1)
@@ -104,8 +104,8 @@ def turned_pear():
     inversion), traced on the whole sphere past the pear point (40 points); the branch born at its first pitchfork
     odd under the inversion (4 points), its mirror image; the coaxial scene's picture with its pear branch."""
     from balloon_cg.analysis.picture import analyse
-    from balloon_cg.analysis.surface_pitchforks import mirror_image, pitchforks, trace_pitchfork
-    from balloon_cg.analysis.surface_primary import trace_surface_primary
+    from balloon_cg.analysis.surface.pitchforks import mirror_image, pitchforks, trace_pitchfork
+    from balloon_cg.analysis.surface.primary import trace_surface_primary
     from balloon_cg.scene import load_scene
     from test_surface_primary import _scene, _turned
 
@@ -124,7 +124,7 @@ def _axisymmetric_pear_volume(pear, P_star: float, P: float) -> float:
     """V/2π of the coaxial scene's pear state at the pressure P: Newton at fixed P from the pear's points
     interpolated in the amplitude a = √(P* − P) (P* the branch point's: near a pitchfork P − P* is quadratic in the
     amplitude, so a guess linear in P leads Newton back to the primary branch)."""
-    from balloon_cg.analysis.problem import branch_system
+    from balloon_cg.analysis.branches.problem import branch_system
     from balloon_cg.numerics.newton import newton
 
     system = branch_system(pear)
@@ -145,7 +145,7 @@ def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned
     breaks the inversion (its odd part grows like the distance from the point: a pitchfork's even part is second
     order), keeps y → −y, and each of its states is the coaxial pear state turned: its volume is the axisymmetric
     solver's at its P. Its mirror image is its inversion, every reflected point a solution."""
-    from balloon_cg.analysis.surface_branches import SWITCH_REACH, SWITCH_STEP
+    from balloon_cg.analysis.surface.branches import SWITCH_REACH, SWITCH_STEP
 
     primary, search, (number, bp, broken), branch, mirror, axisymmetric = turned_pear
     (pear_point,) = [s for s in axisymmetric.branch_points if s.block.value == "odd_held"]
@@ -173,8 +173,8 @@ def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned
 @pytest.mark.slow
 def test_the_mirror_image_is_the_branch_switched_the_other_way(turned_pear):
     """The first point switched onto along −φ (a corrector of its own) is the mirror image's first point."""
-    from balloon_cg.analysis.surface_branches import switch
-    from balloon_cg.analysis.surface_pitchforks import switching_start
+    from balloon_cg.analysis.surface.branches import switch
+    from balloon_cg.analysis.surface.pitchforks import switching_start
     from balloon_cg.surface.embedding import transfer
 
     primary, _, (_, bp, _), branch, mirror, _ = turned_pear

@@ -1,5 +1,5 @@
 """The primary branch of a field that is not axisymmetric, traced on the whole sphere from the start
-(analysis/surface_primary.py): the field's reflections, the two-coil scene turned as a whole (an exact rotation of
+(analysis/surface/primary.py): the field's reflections, the two-coil scene turned as a whole (an exact rotation of
 the axisymmetric problem: the axisymmetric solver is the reference), a loop tilted by δ (the convergence in δ)."""
 import math
 from dataclasses import replace
@@ -7,10 +7,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.problem import branch_system
-from balloon_cg.analysis.surface_branches import SurfaceTrace
-from balloon_cg.analysis.surface_primary import MIRROR_X, field_reflections, trace_surface_primary
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import branch_system
+from balloon_cg.analysis.surface.branches import SurfaceTrace
+from balloon_cg.analysis.surface.primary import MIRROR_X, field_reflections, trace_surface_primary
 from balloon_cg.app.summaries import format_run
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.io.run_file import read_run, write_run

@@ -11,8 +11,8 @@ from matplotlib.collections import QuadMesh
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 import balloon_cg as bc
-from balloon_cg.analysis.primary import trace_primary
-from balloon_cg.analysis.surface_branches import rotated
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.surface.branches import rotated
 from balloon_cg.analysis.results import (Block, Classification, Kind, Leg, SpecialPoint, Stop, StopCode,
                                          SurfaceBranch)
 from balloon_cg.app.api import Result
@@ -136,7 +136,7 @@ def test_a_special_point_on_another_basis_is_not_written(tmp_path, scene, surfac
 
 
 def test_a_rotated_image_shares_its_partners_entry(tmp_path, scene, primary, surface_branch, capsys):
-    """The other direction of the pitchfork (analysis.surface_branches.rotated): stored with origin reflected and
+    """The other direction of the pitchfork (analysis.surface.branches.rotated): stored with origin reflected and
     reflection_of, drawn in its partner's colour under the same legend entry, named in inspect."""
     image = rotated(surface_branch, "m1_bp0_rotated")
     path = write_run(tmp_path / "rotated.h5", scene, [primary, surface_branch, image])

@@ -77,7 +77,7 @@ def test_a_scene_in_the_stretches_traces_its_m1_branch():
     6 minutes)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block
-    from balloon_cg.analysis.surface_branches import trace_surface
+    from balloon_cg.analysis.surface.branches import trace_surface
 
     traced = {}
     for name, material in (("stretches", f"energy = {SPOM1_TEXT!r}"), ("ogden", 'preset = "SPOM1"')):

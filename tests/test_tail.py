@@ -6,9 +6,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.problem import ParameterSystem
+from balloon_cg.analysis.branches.problem import ParameterSystem
 
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.numerics.newton import newton

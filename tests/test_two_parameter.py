@@ -8,18 +8,18 @@ import numpy as np
 import pytest
 
 import balloon_cg as bc
-from balloon_cg.analysis.problem import equilibrium_of
-from balloon_cg.analysis import bifurcation
-from balloon_cg.analysis.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.points import branch_points as bifurcation
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Status, StopCode
 from balloon_cg.scene.materials import get_preset
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.analysis.stability import SecondVariation
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation
 from balloon_cg.io.run_file import read_run
-from balloon_cg.analysis.codim2 import (CurveEnd, TwoParameterError, alpha1_material,
+from balloon_cg.analysis.critical.pitchfork_curve import (CurveEnd, TwoParameterError, alpha1_material,
                                        continue_branch_point, land_on_q, sphere_critical_alpha1,
                                        sphere_pear_stretches)
-from balloon_cg.analysis import codim2
+from balloon_cg.analysis.critical import pitchfork_curve as codim2
 from balloon_cg.numerics.continuation import Fold, Path as TracePath, Point, RootStatus, Stop, TraceStop
 from balloon_cg.io.curve_file import read_curve, write_curve
 from pitchforks import isola, jacobian_error
@@ -267,7 +267,7 @@ def test_a_curve_in_M_stops_where_M_reaches_zero(two_coils, of):
     """M = I²/(16π²R0²μ) is never negative (the scene's range is [0, 1000]): the two-coil pitchfork and the fold of
     P, continued in M downward, stop where M falls below 0 (end ALPHA1_ZERO, the stop of a parameter leaving its
     range) instead of tracing on into M < 0 (they did: a 'cusp' at M = −0.78 was printed as the critical M)."""
-    from balloon_cg.analysis.fold_curve import continue_fold
+    from balloon_cg.analysis.critical.fold_curve import continue_fold
     from balloon_cg.analysis.results import Kind
 
     branch, bp = two_coils

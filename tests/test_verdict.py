@@ -131,7 +131,7 @@ def test_near_undeformed_leg_with_a_field_reaches_min_stretch():
     resolves, and the resolution check came before the range check."""
     from pathlib import Path
 
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.analysis.results import StopCode
     from balloon_cg.scene import load_scene
 
@@ -148,8 +148,8 @@ def test_wrinkling_while_the_field_is_switched_on_is_located(tmp_path, capsys):
     """Single coil of radius 4 at h = 0, start stretch 1.01: the start wrinkles (an elastic principal stress reaches
     0) at M ≈ 0.6047 while the field is switched on; M = 1 stops there with that M named, and M = 0.6 (just below)
     starts taut."""
-    from balloon_cg.analysis.primary import start
-    from balloon_cg.analysis.tracer import ContinuationError, Tracer
+    from balloon_cg.analysis.branches.primary import start
+    from balloon_cg.analysis.branches.tracer import ContinuationError, Tracer
 
     code, out = run(tmp_path, SPOM1 + ONE_COIL.format(M=1.0, a=4.0, h=0.0))
     err = capsys.readouterr().err
@@ -167,7 +167,7 @@ def test_every_crossing_eigenvalue_is_an_event():
     """Two eigenvalues of one block crossing in the same interval are two branch points, not one."""
     from types import SimpleNamespace
 
-    from balloon_cg.analysis.bifurcation import detect
+    from balloon_cg.analysis.points.branch_points import detect
     from balloon_cg.analysis.results import Block
 
     def assessment(odd, even):

@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block, Classification, Status
-from balloon_cg.analysis.switching import trace_pear
+from balloon_cg.analysis.switching.pear import trace_pear
 from balloon_cg.app.api import Result, plot as api_plot
 from balloon_cg.app.cli import main
 from balloon_cg.app.summaries import format_run
@@ -225,7 +225,7 @@ def test_critical_refuses_a_voltage_continuation(tmp_path, capsys):
 
 
 def test_two_parameter_curves_refuse_a_voltage_branch(voltage_picture):
-    from balloon_cg.analysis.codim2 import TwoParameterError, continue_branch_point
+    from balloon_cg.analysis.critical.pitchfork_curve import TwoParameterError, continue_branch_point
     with pytest.raises(TwoParameterError, match="continued in voltage, not in P"):
         continue_branch_point(voltage_picture.primary, voltage_picture.branch_points[0], "material.mu[0]")
 
@@ -257,7 +257,7 @@ def test_a_snap_through_value_is_named_by_what_it_is(control, parameter, symbol)
 
 def test_the_default_kind_is_the_pole_curve_of_the_runs_own_parameter(voltage_file, tmp_path):
     """plot(source) with no kind: voltage-pole for a voltage run, pressure-pole for a pressure run."""
-    from balloon_cg.analysis.primary import trace_primary
+    from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.io.run_file import write_run
 
     ax = Figure().add_subplot()

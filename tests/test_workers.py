@@ -60,8 +60,8 @@ def test_a_signal_stops_the_pool(monkeypatch):
 def test_assessments_on_two_workers_are_the_serial_ones(monkeypatch):
     """The SPOM1 primary branch assessed at degree 60 with m = 1 (a cost that forks) on two workers and in this
     process: every eigenvalue, flag, degree and unsettled point identical."""
-    from balloon_cg.analysis.primary import trace_primary
-    from balloon_cg.analysis.stability import assess_branch
+    from balloon_cg.analysis.branches.primary import trace_primary
+    from balloon_cg.analysis.stability.axisymmetric import assess_branch
     from balloon_cg.scene import load_scene
 
     branch = trace_primary(load_scene("spom1"))
@@ -84,7 +84,7 @@ def test_a_surface_branch_read_by_sector_groups_on_two_workers_is_the_serial_rea
     reading bit for bit (a sector follows its own spectra only)."""
     from dataclasses import replace
 
-    from balloon_cg.analysis import surface_assessment, surface_branches
+    from balloon_cg.analysis.surface import assessment as surface_assessment, branches as surface_branches
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block
     from balloon_cg.scene import load_scene

@@ -21,7 +21,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import balloon_cg as bc  # noqa: E402
-from balloon_cg.analysis.problem import equilibrium_of  # noqa: E402
+from balloon_cg.analysis.branches.problem import equilibrium_of  # noqa: E402
 from balloon_cg.app.cli import main as balloon_cg  # noqa: E402
 from balloon_cg.app.restart import stored_branch  # noqa: E402
 from balloon_cg.dynamics.frequencies import frequencies  # noqa: E402

@@ -8,7 +8,7 @@ and adds its mirror image (north and south poles swapped: the reflection z → �
 assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
 locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
 branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
-whole sphere (``surface_branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
+whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
 snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
@@ -18,8 +18,8 @@ continuation in the coil heights (``broken_symmetry``); its held states carry th
 hold's reaction), so the free balloon gets its own primary branch (``FREE_PRIMARY``, the axial translation an
 unknown: ``_trace_free``) with ``[surface] branches = "all"``, and the branches at the m ≥ 1 points of each branch's
 own reading are traced on the whole sphere (``Branch.reads``; the other reading's in ``Picture.not_switched``). A field that is not axisymmetric gets its primary branch traced on the whole
-sphere (``surface_primary``) and the branches born at its pitchforks with their mirror images
-(``surface_pitchforks``; its other branch points in ``Picture.not_switched``). Every branch carries its assessments
+sphere (``surface.primary``) and the branches born at its pitchforks with their mirror images
+(``surface.pitchforks``; its other branch points in ``Picture.not_switched``). Every branch carries its assessments
 in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
@@ -28,18 +28,20 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import (azimuthal_points, bifurcation, broken_symmetry, control_points, events, free_pitchforks, mirror,
-               surface_branches, surface_pitchforks, surface_primary)
+from .branches import events
+from .points import azimuthal_points, branch_points as bifurcation, control_points, free_pitchforks
+from .surface import branches as surface_branches, pitchforks as surface_pitchforks, primary as surface_primary
+from .switching import broken_symmetry, mirror
 from ..scene import Control, Geometry
-from .control import FOLD_KIND, control_value, control_values, minimised_energy
-from .mirror import MIRROR
-from .primary import trace_primary
-from .problem import equilibrium_of
+from .branches.control import FOLD_KIND, control_value, control_values, minimised_energy
+from .switching.mirror import MIRROR
+from .branches.primary import trace_primary
+from .branches.problem import equilibrium_of
 from .results import Block, Branch, Gauge, Kind, Origin, Status, StopCode
-from .stability import assess_branch, assessed_degrees
-from .switching import mark_rejoin, trace_pear
+from .stability.axisymmetric import assess_branch, assessed_degrees
+from .switching.pear import mark_rejoin, trace_pear
 from .timing import Clock, Step
-from .tracer import ContinuationError
+from .branches.tracer import ContinuationError
 from .verdict import Gap, Incomplete, incomplete
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
@@ -125,7 +127,7 @@ class Picture:
     not_searched: str = ""  # why branch points were not searched, if they were not
     not_started: list = field(default_factory=list)  # (name, reason) of bifurcating branches that could not start
     not_switched: list = field(default_factory=list)  # (name, reason) of a whole-sphere primary's branch points that
-    #                                                   are not pitchforks (``surface_pitchforks``)
+    #                                                   are not pitchforks (``surface.pitchforks``)
     not_asked: list = field(default_factory=list)  # (names, reason) of branch points whose branches the scene did
     #                                                not ask for (``[surface] branches = "first"``)
     surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
@@ -358,9 +360,9 @@ WHOLE_SPHERE_EVENTS = "the [[events]] are not located on branches traced on the 
 
 def _whole_sphere(scene, progress: Progress, clock: Clock, pear: bool) -> Picture:
     """The picture of a field that is not axisymmetric: its primary branch traced on the whole sphere, assessed
-    held under every control, its secondary branch points located (``surface_primary``), and the branches born at
+    held under every control, its secondary branch points located (``surface.primary``), and the branches born at
     its pitchforks (the first one, or all: ``[surface] branches``; none with ``pear=False``) followed with their
-    mirror images (``surface_pitchforks``); a branch point that is not a pitchfork is listed in
+    mirror images (``surface.pitchforks``); a branch point that is not a pitchfork is listed in
     ``Picture.not_switched``."""
     primary = surface_primary.trace_surface_primary(scene, progress.ticker(Phase.PRIMARY), clock)
     progress.finish(Phase.PRIMARY, len(primary.values))

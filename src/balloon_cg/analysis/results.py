@@ -1,10 +1,10 @@
 """Results as plain data: branches, special points and stops, with typed decisions (no solver inside).
 
 A ``Branch`` is arrays and metadata (its scene, discretisation, kernel class, parameters, stability, parent):
-it pickles cheaply and the solver objects are rebuilt from it where needed (``analysis.problem``).
+it pickles cheaply and the solver objects are rebuilt from it where needed (``analysis.branches.problem``).
 Special points carry AUTO's labels where they exist (LP fold in the parameter, BP branch point, EP end point,
 UZ user point) plus TP, the turning point of the north pole stretch, and LV, LN, the folds in the volume and in
-the gas amount (the control parameters of volume and gas control, ``analysis.control``); a branch point's
+the gas amount (the control parameters of volume and gas control, ``analysis.branches.control``); a branch point's
 classification, block and the status of its location are separate fields. Stops are a code from ``StopCode`` (or the
 continuation engine's ``TraceStop``) plus a message for people; code decides, never the message.
 """
@@ -153,7 +153,7 @@ class StopCode(enum.StrEnum):
 
 
 class Origin(enum.StrEnum):
-    """How a branch's points were obtained (``analysis.mirror`` for the mirror image of a pear branch)."""
+    """How a branch's points were obtained (``analysis.switching.mirror`` for the mirror image of a pear branch)."""
 
     TRACED = "traced"  # by continuation
     REFLECTED = "reflected"  # the reflection z → −z of branch ``reflection_of``, every point's residual checked
@@ -163,7 +163,7 @@ class Origin(enum.StrEnum):
     #                                                        was above solver.tol
     CONTINUED_IN_HEIGHT = "continued_in_height"  # a branch a broken equator symmetry disconnects: a point of the
     #                                              symmetric relative's pear branch continued in the coil heights,
-    #                                              then traced (``analysis.broken_symmetry``)
+    #                                              then traced (``analysis.switching.broken_symmetry``)
 
 
 @dataclass
@@ -186,7 +186,7 @@ class SpecialPoint:
     note: str = ""  # for people only
     gauge: Gauge = Gauge.BOTH  # the reading it belongs to: a BP's block's, a fold's or end point's its branch's
     sector: tuple = ()  # a secondary BP of a surface branch: the characters of the symmetry sector whose held
-    #                     eigenvalue crosses zero, one per reflection of its basis (``surface_assessment``; run
+    #                     eigenvalue crosses zero, one per reflection of its basis (``surface.assessment``; run
     #                     files: special_points/state/sector)
 
     def __repr__(self):

@@ -5,7 +5,7 @@ stretch limits, stop_pressure, stop_volume, stop_amount, stop_voltage, zero volt
 membrane's compression (the end of the membrane model: tension-field theory is not modelled), a pear branch
 rejoining the primary branch), every special point is LOCATED (and every axisymmetric branch point classified),
 every bifurcating branch asked for could be started, and the stability flags of every assessed point are settled
-between the stability degree and the check degree. A non-axisymmetric branch (``surface_branches``) may end at the
+between the stability degree and the check degree. A non-axisymmetric branch (``surface.branches``) may end at the
 caps of its whole-sphere basis or at its ``[surface] max_points``: a stated limitation (Gap.LIMITED), since every
 point it stores is resolved; a point whose tail on the branch's final basis exceeds max_error (points are traced
 on the bases of their segment and stored on the last) is flagged (Gap.UNRESOLVED). Any branch that ends at

@@ -322,7 +322,7 @@ def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progre
     natural frequencies (dynamics.frequencies.attach_to: not after a signal, and a signal during them stops
     them)."""
     from ..analysis.picture import Picture, analyse as analyse_picture
-    from ..analysis.primary import trace_primary
+    from ..analysis.branches.primary import trace_primary
     from ..analysis.timing import Clock, Step
     from ..dynamics.frequencies import attach_to
 
@@ -434,7 +434,7 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     ------
     ValueError
         A label or parameter it cannot start from (app.restart.RestartError,
-        analysis.second_parameter.UnknownParameter).
+        analysis.critical.second_parameter.UnknownParameter).
     RuntimeError
         At a branch point, no bifurcating branch started (the reasons named).
 

@@ -41,7 +41,7 @@ PLOT_KINDS = ("pressure-pole", "pressure-equator", "voltage-pole", "voltage-equa
 BAD_INPUT = {"balloon_cg.scene.validation": "SceneError", "balloon_cg.io.layout": "FileError",
              "balloon_cg.post.plotting": "PlotError", "balloon_cg.model.field": "FieldError",
              "balloon_cg.post.tube_plots": "TubePlotError"}
-FAILED = {"balloon_cg.analysis.tracer": "ContinuationError"}
+FAILED = {"balloon_cg.analysis.branches.tracer": "ContinuationError"}
 
 
 class UsageError(ValueError):
@@ -372,7 +372,7 @@ def curve_interrupted_status(curve, output, signalled: bool, before: str = "the 
     """``interrupted_status`` of a two-parameter curve: 130 when its file says a signal ended it (end
     ``interrupted``; ``curve`` None: ``before`` it started, nothing is written); else None, having said so when a
     signal came once it had ended."""
-    from ..analysis.codim2 import CurveEnd
+    from ..analysis.critical.pitchfork_curve import CurveEnd
 
     if curve is None or curve.end == CurveEnd.INTERRUPTED:
         written = (f"nothing is written to {output} ({before})" if curve is None else
@@ -432,7 +432,7 @@ def solve(args) -> int:
     """Trace the primary branch up to the requested north pole stretch and report its end point."""
     import numpy as np
 
-    from ..analysis.primary import trace_primary
+    from ..analysis.branches.primary import trace_primary
     from ..analysis.results import StopCode
     from .summaries import format_table
 
@@ -713,7 +713,7 @@ def critical(args) -> int:
     scene the command cannot handle, checked before any computation: a voltage continuation (the curve lives in
     (q, P)), not equator-symmetric (the pear block needs the equator-symmetric layout), ``--parameter M`` without
     coils, or a parameter the scene's kernels do not take (one line listing those they do:
-    ``analysis.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as ``run``): the work stops at its next
+    ``analysis.critical.second_parameter``). 130 interrupted (SIGINT or SIGTERM, as ``run``): the work stops at its next
     point (or phase); a curve already started is written (atomically, end ``interrupted``), before it nothing is;
     the exit follows the file (a curve that had ended when the signal came: its own status, and a line saying so).
     Progress goes to stderr (``--quiet``: none).
@@ -739,9 +739,9 @@ def critical(args) -> int:
 
 def _critical(args, scene) -> int:
     """``critical`` on ``scene`` into ``args.output`` (owned, under ``stop_on_signals``)."""
-    from ..analysis.codim2 import CODIM2_ENDS, CurveEnd
+    from ..analysis.critical.pitchfork_curve import CODIM2_ENDS, CurveEnd
     from ..analysis.results import Status
-    from ..analysis.second_parameter import UnknownParameter, resolve
+    from ..analysis.critical.second_parameter import UnknownParameter, resolve
     from ..io.curve_file import write_curve
     from ..io.output import check_output
     from ..numerics.interrupt import Interrupted, requested
@@ -802,7 +802,7 @@ def _say(args, text: str) -> None:
 
 def _primary(scene, args):
     """The primary branch ``critical`` starts from (None when a signal stopped it)."""
-    from ..analysis.primary import trace_primary
+    from ..analysis.branches.primary import trace_primary
     from ..numerics.interrupt import requested
     from .progress import auto_tqdm, shown, tqdm_disable
 
@@ -822,12 +822,12 @@ def _curve_bar(args):
 
 def _pitchfork_curve(scene, args):
     """``critical``'s computation: the primary branch, its first pear pitchfork located, the curve of pitchforks
-    in ``args.parameter`` (analysis.codim2). None when a signal (numerics.interrupt) stopped the work before the
+    in ``args.parameter`` (analysis.critical.pitchfork_curve). None when a signal (numerics.interrupt) stopped the work before the
     curve started; a signal during the curve ends it at its next point (end ``interrupted``)."""
-    from ..analysis.bifurcation import detect, locate
-    from ..analysis.codim2 import TwoParameterError, continue_branch_point
+    from ..analysis.points.branch_points import detect, locate
+    from ..analysis.critical.pitchfork_curve import TwoParameterError, continue_branch_point
     from ..analysis.results import Block, Status
-    from ..analysis.stability import assess_branch
+    from ..analysis.stability.axisymmetric import assess_branch
     from ..numerics.interrupt import Interrupted, requested
 
     branch = _primary(scene, args)
@@ -871,9 +871,9 @@ FOLD_CONTROL = {"LP": "pressure", "LV": "volume", "LN": "gas"}  # the loading.co
 def _fold_curve(scene, args):
     """``critical --of LP|LV|LN``: the primary branch traced under the control of that fold (loading.control
     pressure, volume or gas), its first located fold of that kind, the fold curve in ``args.parameter``
-    (analysis.fold_curve). None when a signal stopped the work before the curve started."""
-    from ..analysis.codim2 import TwoParameterError
-    from ..analysis.fold_curve import continue_fold
+    (analysis.critical.fold_curve). None when a signal stopped the work before the curve started."""
+    from ..analysis.critical.pitchfork_curve import TwoParameterError
+    from ..analysis.critical.fold_curve import continue_fold
     from ..analysis.results import Kind, Status
 
     control = FOLD_CONTROL[args.of]
@@ -957,10 +957,10 @@ def continue_run(args) -> int:
 
 def _continue(args) -> int:
     """``continue`` into ``args.output`` (owned)."""
-    from ..analysis.codim2 import TwoParameterError
+    from ..analysis.critical.pitchfork_curve import TwoParameterError
     from ..analysis.picture import Picture
     from ..analysis.results import Kind
-    from ..analysis.second_parameter import UnknownParameter
+    from ..analysis.critical.second_parameter import UnknownParameter
     from ..io.curve_file import write_curve
     from ..io.output import check_output
     from ..io.run_file import read_run

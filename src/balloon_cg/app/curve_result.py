@@ -1,6 +1,6 @@
 """A two-parameter curve file in Python (``balloon_cg.load(curve)``), named after the parameter it follows.
 
-``CurveResult.parameter`` is q's name (M, alpha1, Jm, mu[0]: ``analysis.second_parameter``); ``to_dataframe``
+``CurveResult.parameter`` is q's name (M, alpha1, Jm, mu[0]: ``analysis.critical.second_parameter``); ``to_dataframe``
 has one row per point of every curve in the file (columns ``curve``, the parameter under its own name, pressure,
 the pole stretches, newton_iterations, residual); ``critical`` maps each curve to its critical value of the
 parameter (NaN unless the curve ended in the merge of the two pitchforks).

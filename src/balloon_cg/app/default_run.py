@@ -16,7 +16,7 @@ import time
 from importlib import resources
 from pathlib import Path
 
-from ..analysis.tracer import ContinuationError
+from ..analysis.branches.tracer import ContinuationError
 from ..analysis.verdict import failing, summary_line
 from ..io.output import replacing
 from .cli import run_scene

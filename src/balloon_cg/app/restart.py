@@ -15,13 +15,13 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   reading's on a held branch without it, the free one's on the free balloon's ``primary_free``) the
   non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``, assessed as
   ``run`` assesses it); the branch of the point is written as read (its stored stability is not read back);
-- a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.second_parameter``): the fold curve through it
-  (``analysis.fold_curve.continue_fold``);
+- a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.critical.second_parameter``): the fold curve through it
+  (``analysis.critical.fold_curve.continue_fold``);
 - any other point (UZ, EP, TP) in M or Φ̄ (TUNED): the branch through it in that parameter at its fixed P
   (``restart_in``: a Picture of one branch, primary, assessed as the stored branch was; with [dynamics] its
   frequencies, the tuning curves Ω²(M) or Ω²(Φ̄) at fixed P);
 - a pear branch point (BP of block odd_held, or odd_free: the free balloon's, on an equator-symmetric branch) in q:
-  the curve of pitchforks through it (``analysis.codim2.continue_branch_point``; its mode recomputed,
+  the curve of pitchforks through it (``analysis.critical.pitchfork_curve.continue_branch_point``; its mode recomputed,
   ``pear_point``), as ``critical`` traces the held one.
 
 A restarted leg stops where it crosses its known parent away from its own pitchfork (``rejoin_rule``) or comes
@@ -38,20 +38,20 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..analysis.assembly import assemble
-from ..analysis.events import with_events
-from ..analysis.fold_curve import CONTROL_OF_FOLD, continue_fold
-from ..analysis.primary import landing_targets, range_limits, stop_rule
-from ..analysis.branch_point import WernerSpence
-from ..analysis.codim2 import continue_branch_point, plain_branch
+from ..analysis.branches.assembly import assemble
+from ..analysis.branches.events import with_events
+from ..analysis.critical.fold_curve import CONTROL_OF_FOLD, continue_fold
+from ..analysis.branches.primary import landing_targets, range_limits, stop_rule
+from ..analysis.points.extended_systems import WernerSpence
+from ..analysis.critical.pitchfork_curve import continue_branch_point, plain_branch
 from ..analysis.picture import (FREE_PRIMARY, PEAR_NAMES, Picture, Progress, azimuthal_crossings, examine,
                                 label_readings, pear_pair, stopped, surface_name, surface_pair, unsearched_events)
-from ..analysis.problem import equilibrium_of
+from ..analysis.branches.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
-from ..analysis.second_parameter import resolve
-from ..analysis.surface_branches import SurfaceStartError
-from ..analysis.switching import mark_rejoin, pear_landing, pear_stop_rule
-from ..analysis.tracer import Tracer
+from ..analysis.critical.second_parameter import resolve
+from ..analysis.surface.branches import SurfaceStartError
+from ..analysis.switching.pear import mark_rejoin, pear_landing, pear_stop_rule
+from ..analysis.branches.tracer import Tracer
 from ..dynamics.frequencies import attach_to
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation, interrupt
@@ -328,7 +328,7 @@ class Ticks(Progress):
 
 def switch(start: Labelled, progress=None) -> Picture:
     """The branches bifurcating at the branch point ``start`` (module docstring) in a Picture: ``branches`` the
-    stored branch of the point (as read: not assessed) and the pear branches (assessed), ``surface_branches`` the
+    stored branch of the point (as read: not assessed) and the pear branches (assessed), ``surface.branches`` the
     non-axisymmetric ones, ``not_started`` those that could not start; RestartError for a point this does not
     switch at."""
     branch, point, label = start.branch, start.point, start.label
@@ -405,7 +405,7 @@ TUNED = ("M", "voltage")  # the runtime scalars a point is followed in at fixed 
 
 
 def tuned(start: Labelled, key: str) -> str:
-    """The Parameters field of ``key`` (a scene key or bare name: ``analysis.second_parameter.resolve``) when it is
+    """The Parameters field of ``key`` (a scene key or bare name: ``analysis.critical.second_parameter.resolve``) when it is
     one a point can be followed in at fixed P (TUNED); RestartError otherwise (UnknownParameter for a key the
     scene's kernels do not take)."""
     name = resolve(start.branch.scene, key).split(".")[-1]

@@ -27,7 +27,7 @@ import numpy as np
 
 
 from ..analysis.picture import analyse
-from ..analysis.primary import trace_primary
+from ..analysis.branches.primary import trace_primary
 from ..analysis.verdict import incomplete
 from ..dynamics.frequencies import attach
 from ..io.lock import claim

@@ -5,7 +5,7 @@ Small oscillations solve K q̂ = ν M q̂ per block, M the mass matrix of the me
 
 K is the block's matrix under the scene's control: pressure, the Hessian H; volume, H on the perturbations that
 keep the volume (gᵀq = 0, g = ∂Ṽ/∂q: the constrained subspace); gas, H + (P/Ṽ) g gᵀ (its stiffness); held or free
-(analysis/stability.py: the same blocks and names as the stability assessment). M is the displacement norm of the
+(analysis/stability/axisymmetric.py: the same blocks and names as the stability assessment). M is the displacement norm of the
 stability blocks, so ν are their eigenvalues on that norm (``SecondVariation(norm="displacement")`` for m = 0,
 ``AzimuthalBasis.gram`` for m ≥ 1): one assembly, one reduction to a standard matrix (``numerics.eigen``) per block.
 Ω² < 0 is an unstable mode (kept as such).
@@ -14,11 +14,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..analysis.azimuthal import merged_lowest
+from ..analysis.stability.azimuthal import merged_lowest
 from ..analysis.picture import stopped
-from ..analysis.problem import equilibrium_of
+from ..analysis.branches.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Gauge, Kind, Origin, SurfaceBranch
-from ..analysis.stability import SecondVariation, assessed_degrees, assessment_cost, first_of_each
+from ..analysis.stability.axisymmetric import SecondVariation, assessed_degrees, assessment_cost, first_of_each
 from ..analysis.timing import Step
 from ..galerkin.profiles import theta_grid
 from ..numerics import interrupt, workers

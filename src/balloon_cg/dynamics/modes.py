@@ -18,9 +18,9 @@ positive.
 import numpy as np
 from scipy import linalg
 
-from ..analysis.azimuthal import block_pencils
+from ..analysis.stability.azimuthal import block_pencils
 from ..analysis.results import Block
-from ..analysis.stability import held_means
+from ..analysis.stability.axisymmetric import held_means
 from ..model.meridian import hoop
 from ..numerics.eigen import RCOND
 from .pencil import PER_EIGENVALUE

@@ -8,7 +8,7 @@ K and M are the SecondVariation's Hessian and Gram matrix with the norm "displac
 import numpy as np
 
 from ..analysis.results import Kind
-from ..analysis.stability import SecondVariation
+from ..analysis.stability.axisymmetric import SecondVariation
 
 PER_EIGENVALUE = 0.5  # Ω² per eigenvalue ν of K q = ν M q
 MASS_NORM = "displacement"  # the SecondVariation norm whose Gram matrix is the mass matrix

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.results import Kind
-from ..analysis.surface_assessment import spectrum_count
+from ..analysis.surface.assessment import spectrum_count
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 from ..surface import stability as surface_stability

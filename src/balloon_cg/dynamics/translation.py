@@ -13,7 +13,7 @@ reading's instability, MODEL.md §5).
 """
 import numpy as np
 
-from ..analysis.azimuthal import kernel_state_map, perturbation_basis
+from ..analysis.stability.azimuthal import kernel_state_map, perturbation_basis
 from ..galerkin.discretisation import symmetric_rows
 from ..generated import AZIMUTHAL_PAIRS, HESSIAN_PAIRS
 from ..model.meridian import AZIMUTHAL, mass_density

@@ -408,7 +408,7 @@ def split_rule(n_q: int, joins: tuple = ()):
 @functools.lru_cache(maxsize=4)
 def _projection(disc: Discretisation) -> np.ndarray:
     """``Discretisation.projection``, computed once per set of fields (a pseudo-inverse: ~1 s of CPU at degree 320;
-    the search for the plain degree of a point, ``analysis.resolution``, builds the one its caller then transfers
+    the search for the plain degree of a point, ``analysis.branches.resolution``, builds the one its caller then transfers
     to), read-only."""
     projection = np.linalg.pinv(disc._node_table)
     projection.flags.writeable = False

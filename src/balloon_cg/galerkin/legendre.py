@@ -1,5 +1,5 @@
 """Orthonormal associated Legendre functions P̄_k^j(cos θ) and their θ-derivatives: the azimuthal perturbation
-bases (analysis/azimuthal.py) and the spherical harmonics of the whole-sphere engine (surface/basis.py)."""
+bases (analysis/stability/azimuthal.py) and the spherical harmonics of the whole-sphere engine (surface/basis.py)."""
 import numpy as np
 
 

@@ -14,17 +14,17 @@ Layout::
                                                    fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
                         the verified merge of the two pitchforks or the verified cusp; kinds LP-BP, LV-BP, LN-BP:
-                        the meetings of a fold and the pitchfork, analysis.fold_meeting), and <parameter>;
+                        the meetings of a fold and the pitchfork, analysis.critical.fold_meeting), and <parameter>;
                         state/unknowns in the branch layout (u, P)
 
 ``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
-the primary branch in P, V or n, group named so: ``analysis.fold_curve``). ``end`` is the curve's
-``analysis.codim2.CurveEnd`` (how it ended: isola_merge, cusp (a fold curve's two folds merge), fold,
+the primary branch in P, V or n, group named so: ``analysis.critical.fold_curve``). ``end`` is the curve's
+``analysis.critical.pitchfork_curve.CurveEnd`` (how it ended: isola_merge, cusp (a fold curve's two folds merge), fold,
 nonpositive_pressure, wire, budget, step_min, alpha1_zero, other, interrupted: a signal stopped it, the curve is
 partial); ``end_description``
 says the same for people, with where. ``parameter`` is q's short name (M, alpha1, Jm, mu[0]), ``parameter_key`` its
 scene key (field.M, material.parameters.Jm, material.mu[0]; alpha1: itself), ``parameter_derivative`` how ∂R/∂q was
-computed (exact: a generated kernel; central: central differences): ``analysis.second_parameter``. Files written
+computed (exact: a generated kernel; central: central differences): ``analysis.critical.second_parameter``. Files written
 before these two existed have ``parameter`` M or alpha1 and are read all the same.
 """
 from dataclasses import replace
@@ -40,7 +40,7 @@ from .schema import attach_dimensions, describe_parameter, scale
 
 
 def write_curve(path, scene, curve, name: str = "pear", force: bool = False, extra_attrs: dict | None = None):
-    """Write a two-parameter curve (analysis.codim2.TwoParameterCurve) to ``path`` atomically."""
+    """Write a two-parameter curve (analysis.critical.pitchfork_curve.TwoParameterCurve) to ``path`` atomically."""
     attrs = root_attrs(scene) | {"title": f"balloon-cg two-parameter curve of scene {scene.name}"} | dict(
         extra_attrs or {})
     critical = curve.critical

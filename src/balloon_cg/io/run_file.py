@@ -237,7 +237,7 @@ def write_branches(parent, scene, branches, snaps=None) -> None:
 
 
 def _write_branch(group, branch, theta, first_label: int = 1):
-    from ..analysis.problem import equilibrium_of
+    from ..analysis.branches.problem import equilibrium_of
     from ..galerkin.profiles import equator_values, profiles
 
     disc = branch.disc
@@ -315,7 +315,7 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     """A SurfaceBranch (module docstring): its basis as attributes, the per-point measures (the volume per 2π
     of ``surface.measures`` times 2π, as the axisymmetric ``volume``), the coefficients, special points with
     the pole values of their own states, and the lowest eigenvalues held and free with the pressure-control
-    flags they give (the lowest > 0, as ``analysis.stability.Assessment``)."""
+    flags they give (the lowest > 0, as ``analysis.stability.axisymmetric.Assessment``)."""
     basis = branch.basis
     _write_common_attrs(group, branch)
     group.attrs.update({

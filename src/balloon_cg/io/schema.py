@@ -142,7 +142,7 @@ PARAMETERS = {"M": "field intensity M", "chi": "magnetic susceptibility χ",
 
 def describe_parameter(dataset, key: str) -> None:
     """``units``, ``long_name`` and ``description`` of a second parameter's values stored under its short name
-    (``key``: its scene key, as ``analysis.second_parameter`` names it)."""
+    (``key``: its scene key, as ``analysis.critical.second_parameter`` names it)."""
     name = dataset.name.rsplit("/", 1)[-1]
     dataset.attrs.update({"units": NONDIMENSIONAL, "long_name": PARAMETERS.get(name, f"second parameter {key}"),
                           "description": f"the continued second parameter, scene key {key} (docs/hdf5.md)"})

@@ -1,5 +1,5 @@
 """Elastic Cauchy membrane stresses of the Ogden membrane (MODEL.md §6) and the dielectric part (the taut test on
-them: analysis/primary.py)."""
+them: analysis/branches/primary.py)."""
 
 from .membrane import stretch_derivatives
 from ..scene.energies import StrainEnergy

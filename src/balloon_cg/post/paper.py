@@ -23,9 +23,9 @@ from .quantities import branch_discretisation, stored_scene
 from . import labels
 from .fit import fit_titles, fitted_legend
 from .style import JournalFigure, journal_style
-from ..analysis.landscape import Landscape, LandscapeError, landscape, state_at
-from ..analysis.control import control_values, minimised_energy
-from ..analysis.mirror import MIRROR
+from ..analysis.switching.landscape import Landscape, LandscapeError, landscape, state_at
+from ..analysis.branches.control import control_values, minimised_energy
+from ..analysis.switching.mirror import MIRROR
 from ..analysis.picture import Curve, find_snaps, located_folds
 from ..analysis.results import Kind, Status
 from ..galerkin.equilibrium import Equilibrium, Parameters
@@ -170,7 +170,7 @@ SNAP_READINGS = (Reading.PRESSURE, Reading.VOLUME, Reading.GAS, Reading.FREE, Re
 def snap_throughs(run: dict, reading: Reading = Reading.PRESSURE) -> list:
     """The snap-throughs of a stored run with stability read as ``reading`` (``analysis.picture.find_snaps`` on
     the stored flags or blocks, ``plotting.stable_points``): at equal value of the reading's control (P, V or
-    n = P V) to the stable point of lowest energy that control minimises (``analysis.control.minimised_energy``),
+    n = P V) to the stable point of lowest energy that control minimises (``analysis.branches.control.minimised_energy``),
     E the Galerkin energy of the stored unknowns. Branches without stability data are left out, and so are
     surface branches (m ≥ 1: no Galerkin unknowns); ``pressure`` of each result is the control value."""
     if reading not in SNAP_READINGS:
@@ -307,7 +307,7 @@ AMPLITUDE_NORMALISATION = (r"$\Lambda=\varphi\cdot(u-u_s)$, $\varphi$ the unit v
 
 
 def offset_landscape(run: dict, bp: dict, offset: float = LANDSCAPE_OFFSET) -> Landscape:
-    """``analysis.landscape`` at P = P_bp ± ``offset`` next to the pear branch point ``bp`` of the primary branch:
+    """``analysis.switching.landscape`` at P = P_bp ± ``offset`` next to the pear branch point ``bp`` of the primary branch:
     on the side of the pear branch whose end lies nearest the point (its first or last 15 points), the pear state
     and the symmetric state at that P solved from the nearest stored points (the primary's within 5 of the
     point's index), on the pear branch's discretisation. LandscapeError if there is no pear branch or a solve

@@ -5,7 +5,7 @@
     value = 20.0             # > 0
 
 Every branch then gets a special point labelled UZ wherever its quantity passes the value, located to the solver
-tolerance (``analysis.events``). The quantities are those stored per point: the enclosed volume V, the gas amount
+tolerance (``analysis.branches.events``). The quantities are those stored per point: the enclosed volume V, the gas amount
 n = P V, the pressure P, and the hoop stretch λ2 at the north pole, the south pole and the equator.
 """
 import enum

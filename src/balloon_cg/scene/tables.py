@@ -74,7 +74,7 @@ class Field:
     @property
     def is_axisymmetric(self) -> bool:
         """True when every coil is coaxial with the balloon (or none acts, M = 0): the axisymmetric solver traces
-        the primary branch; otherwise the whole-sphere one does (analysis.surface_primary)."""
+        the primary branch; otherwise the whole-sphere one does (analysis.surface.primary)."""
         return self.M == 0 or all(c.is_coaxial for c in self.coils)
 
     @property

@@ -1,7 +1,7 @@
 """Axisymmetric states and azimuthal modes as coefficients of the whole-sphere basis (MODEL.md §8).
 
 An axisymmetric state (λ2, η)(θ) is the surface x = (λ2 sin θ cos φ, λ2 sin θ sin φ, η); an azimuthal mode of
-order m (analysis/azimuthal.py) the displacement δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. Both are
+order m (analysis/stability/azimuthal.py) the displacement δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z. Both are
 projected on the spherical harmonics by the basis' quadrature: exact for a Legendre state of degree N when
 L ≥ N + 1 (x, y are λ2 sin θ times cos φ, sin φ; z is η), and for a mode of degree ≤ L; a wire-mapped state is
 approximated to the truncation error of degree L.
@@ -33,7 +33,7 @@ def axisymmetric_coefficients(basis: SphericalBasis, disc, u: np.ndarray) -> np.
 
 
 def mode_coefficients(basis: SphericalBasis, azimuthal_basis, vector: np.ndarray) -> np.ndarray:
-    """c of an azimuthal mode (its coefficients ``vector`` in ``azimuthal_basis``, analysis.azimuthal)."""
+    """c of an azimuthal mode (its coefficients ``vector`` in ``azimuthal_basis``, analysis.stability.azimuthal)."""
     theta, phi = node_angles(basis)
     return displacement_coefficients(basis, azimuthal_basis.cartesian(vector, theta, phi))
 

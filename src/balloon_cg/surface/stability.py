@@ -1,8 +1,8 @@
 """Stability of a whole-sphere state: the lowest eigenvalues μ of the second variation, H c = μ G c with G the
-displacement norm (1/2π)∫∫|δu|² dA (analysis/azimuthal.py uses the same, so the spectra compare), on the
+displacement norm (1/2π)∫∫|δu|² dA (analysis/stability/azimuthal.py uses the same, so the spectra compare), on the
 G-orthogonal complement of the state's exact zero modes, in each symmetry sector of the state's basis
 (SphericalBasis.sectors: together the whole space), for a balloon held at its centre or free, under each control
-(a ``Reading``), as analysis/stability.py for axisymmetric modes:
+(a ``Reading``), as analysis/stability/axisymmetric.py for axisymmetric modes:
 - pressure control: H;
 - volume control: H on the perturbations that keep the volume, gᵀc = 0, g = ∂Ṽ/∂c = −∂²E/∂P∂c (Ṽ = V/2π);
 - gas control (isothermal ideal gas, P V fixed): H + (P/Ṽ) g gᵀ.
@@ -222,7 +222,7 @@ def _own(sector: SphericalBasis, basis: SphericalBasis) -> bool:
 
 def azimuthal_family(basis: SphericalBasis, m: int) -> np.ndarray:
     """E_m: orthonormal columns spanning the cos mφ family δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z in a basis
-    with the mirror y → −y (MODEL.md §5; analysis/azimuthal.py's space at the same degree; with more reflections,
+    with the mirror y → −y (MODEL.md §5; analysis/stability/azimuthal.py's space at the same degree; with more reflections,
     the part of it they keep):
     Z in the z blocks of order m, U = R + T in the pairs (x cos, y sin) of order m + 1, D = R − T in the pairs
     (x cos, −y sin) of order m − 1 (δx_x + i δx_y = ½ U e^{i(m+1)φ} + ½ D e^{−i(m−1)φ})."""
@@ -255,7 +255,7 @@ def azimuthal_spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
                        count: int = 6) -> np.ndarray:
     """The lowest μ of the whole-sphere Hessian restricted to the cos mφ family (``azimuthal_family``) at an
     axisymmetric state c of a mirror-invariant basis, its zero modes removed as ``restricted_sectors`` removes them:
-    the whole-sphere counterpart of analysis/azimuthal.spectrum."""
+    the whole-sphere counterpart of analysis/stability/azimuthal.spectrum."""
     E = azimuthal_family(eq.basis, m)
     H = E.T @ eq.hessian(c, params) @ E
     fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"], field_symmetry(eq, params), held)

@@ -21,7 +21,7 @@ import numpy as np
 from .primary import TubeSystem, held, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, unstable_counts
-from ..analysis.problem import ParameterSystem, continuation_settings
+from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror

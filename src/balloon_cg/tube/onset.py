@@ -29,7 +29,7 @@ import numpy as np
 
 from .primary import held, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, signalled
-from ..analysis.problem import continuation_settings
+from ..analysis.branches.problem import continuation_settings
 from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import Mirror

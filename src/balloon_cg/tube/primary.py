@@ -25,10 +25,10 @@ import numpy as np
 
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, spectrum, unstable_counts
-from ..analysis.crossings import count_changes
-from ..analysis.problem import ParameterSystem, continuation_settings
+from ..analysis.stability.crossings import count_changes
+from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
-from ..analysis.tracer import ContinuationError
+from ..analysis.branches.tracer import ContinuationError
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics import continuation

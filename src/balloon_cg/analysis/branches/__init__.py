@@ -1,0 +1,1 @@
+"""How a branch is traced: its discrete problem, the resolution policy, the adaptive tracer and its legs assembled into one Branch, the primary branch, the control parameter and its folds, user events, and the ends a branch can reach."""

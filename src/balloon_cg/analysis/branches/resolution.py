@@ -1,0 +1,92 @@
+"""The resolution policy: one object deciding when a discretisation holds a solution and how it grows.
+
+A point is resolved on a discretisation when its spectral error estimate (``Discretisation.tail``: the
+neglected geometric tail of the Legendre coefficients) is at most ``max_error``. Otherwise the degree grows by
+``growth`` (up to ``max_degree``). With a wire map, a re-centred map at the same degree is preferred when it
+leaves ``headroom`` · max_error (at most ``max_recentres`` times per degree). Points moved to another basis
+(storage on the final basis, a branch point projected to the stability basis in x) may lose at most
+``storage_loss`` · max_error to the projection (``transfer_error``) before the target degree is raised.
+The tracer, the storage-basis rule, bifurcation and two-parameter code all ask this object.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...galerkin.discretisation import Discretisation
+from ...model.meridian import joins
+from ...numerics import interrupt
+
+
+@dataclass(frozen=True)
+class Resolution:
+    max_error: float
+    max_degree: int
+    growth: float = 1.5
+    headroom: float = 0.25
+    storage_loss: float = 0.5
+    max_recentres: int = 6
+
+    @classmethod
+    def of(cls, scene) -> "Resolution":
+        """The policy of a scene's [solver] table; on a meridian whose curvature jumps (a capsule: its Legendre
+        coefficients fall algebraically, so the geometric tail never reaches max_error; docs/shapes.md, "The
+        capsule") the degree stays solver.degree and every point counts as resolved (max_error ∞): its accuracy is
+        the convergence in solver.degree, not a per-point estimate."""
+        if joins(scene.geometry):
+            return cls(np.inf, scene.solver.degree)
+        return cls(scene.solver.max_error, scene.solver.max_degree)
+
+    def resolved(self, disc: Discretisation, u) -> bool:
+        return disc.tail(u) <= self.max_error
+
+    def grow(self, degree: int) -> int:
+        """The next degree: ``growth`` times larger, at most max_degree."""
+        return min(int(degree * self.growth), self.max_degree)
+
+    @property
+    def recentre_accept(self) -> float:
+        """Largest error estimate for which a re-centred map at the same degree is kept."""
+        return self.headroom * self.max_error
+
+    @property
+    def loss_limit(self) -> float:
+        """Largest projection loss of a point moved to a storage basis."""
+        return self.storage_loss * self.max_error
+
+    def plain_degree(self, disc: Discretisation, X, start: int | None = None) -> int:
+        """The Legendre degree in x that holds the point X = (u, P) of a branch on ``disc`` (``plain_degrees``)."""
+        return int(self.plain_degrees(disc, X, start)[0])
+
+    def plain_degrees(self, disc: Discretisation, X, start: int | None = None) -> np.ndarray:
+        """Per row X = (u, P): the Legendre degree in x that holds it. Its own degree if the basis is not mapped;
+        else grown from ``start`` (default: the mapped degree) until the projection loses at most max_error and
+        the projected tail is within max_error (the mapped degree is far below what x needs near a wire), at
+        most max_degree. A signal (``numerics.interrupt``) raises ``Interrupted`` at the next degree (near a wire
+        the search costs seconds: a projection's pseudo-inverse per degree up to 320)."""
+        X = np.atleast_2d(X)
+        degree = disc.degree if start is None else start
+        degrees = np.full(len(X), disc.degree if disc.mapping is None else degree)
+        open_rows = np.arange(len(X)) if disc.mapping is not None else np.arange(0)
+        while open_rows.size and degree < self.max_degree:
+            interrupt.check()
+            plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
+            moved = disc.transfer(X[open_rows], plain)
+            loss = transfer_error(disc, X[open_rows], plain, moved)
+            tails = np.array([plain.tail(row[: plain.size]) for row in moved])
+            open_rows = open_rows[np.maximum(loss, tails) > self.max_error]
+            degree = self.grow(degree)
+            degrees[open_rows] = degree
+        return degrees
+
+
+def transfer_error(source: Discretisation, X, target: Discretisation, moved, n_theta: int = 721) -> np.ndarray:
+    """Per row: max |Δλ2|, |Δη| / |a_0| on a θ grid between X in ``source`` and ``moved`` = its transfer to
+    ``target`` (zero when the transfer is exact: same map, no lower degree)."""
+    X, moved = np.atleast_2d(X), np.atleast_2d(moved)
+    if source.nests_in(target):
+        return np.zeros(len(X))
+    theta = np.linspace(0.0, np.pi, n_theta)
+    before = source.evaluate(X[:, : source.size], theta)
+    after = target.evaluate(moved[:, : target.size], theta)
+    difference = np.maximum(np.abs(before[0] - after[0]).max(axis=1), np.abs(before[2] - after[2]).max(axis=1))
+    return difference / np.abs(before[0][:, 0])

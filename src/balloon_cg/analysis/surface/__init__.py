@@ -1,0 +1,1 @@
+"""Branches on the whole surface (non-axisymmetric states, the surface layer's discretisation): the primary branch of a field without axial symmetry, the branches born at m ≥ 1 points, their resolution and their stability."""

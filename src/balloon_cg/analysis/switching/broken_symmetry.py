@@ -1,0 +1,139 @@
+"""The pear branch a broken equator symmetry disconnects, found by continuation in the coil heights.
+
+A field off the equatorial plane breaks the pitchfork of the pear mode: one half of the pear branch joins the
+primary branch, the other is disconnected from it, so no trace from the primary branch meets it. It is found from
+the scene's symmetric relative, its coils' heights h_i scaled to t·h_i, at t = 0 (``symmetric_relative``): there
+the held reading's first pear pitchfork is located and both halves of its pear branch are traced (``bifurcation``,
+``switching``). On each half the first point of pear amplitude |A| ≥ SEED_AMPLITUDE (A = λ2(0) − λ2(π)) is
+continued in t from 0 to 1 at that amplitude, the pressure free,
+
+    R(u, P; t) = 0,   A(u) = A_seed,
+
+by Newton from the previous t (steps of 1/HEIGHT_STEPS, halved on failure down to MIN_STEP), on a plain general
+basis (balloon held) of the pear branch's degree. At t = 1 a continued point within ON_BRANCH of the primary
+branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
+branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
+the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
+"""
+import time
+
+import numpy as np
+
+from ...galerkin.equilibrium import Equilibrium
+from ...numerics import continuation
+from ...numerics.newton import newton
+from ..points import branch_points as bifurcation
+from ..branches.assembly import assemble
+from ..branches.events import with_events
+from ..branches.primary import trace_primary
+from ..branches.problem import ParameterSystem
+from ..results import Block, Branch, Origin
+from ..stability.axisymmetric import assess_branch
+from .pear import pear_landing, pear_stop_rule, trace_pear
+from ..branches.tracer import Tracer
+
+SEED_AMPLITUDE = 1.0  # |λ2(0) − λ2(π)| of the point continued in the coil heights: far from the primary branch
+HEIGHT_STEPS = 10  # the first steps in t: 1/HEIGHT_STEPS
+MIN_STEP = 1e-3  # a step in t halved below this: the continuation failed
+ON_BRANCH = 1e-2  # max-norm distance in (P, λ2(0), λ2(π)) below which a continued point lies on the primary branch
+
+
+class HomotopyError(RuntimeError):
+    """The disconnected branch could not be found; the message says where the search stopped."""
+
+
+def symmetric_relative(scene, t: float = 0.0):
+    """The scene with every coil's height scaled by ``t`` (t = 0: every coil in the equatorial plane)."""
+    return scene.with_overrides({f"field.coils[{i}].height": t * coil.height
+                                 for i, coil in enumerate(scene.field.coils)}, name=scene.name)
+
+
+def seeds(scene) -> list[tuple]:
+    """Per half of the first held pear branch of the symmetric relative: (its first point X = (u, P) of pear
+    amplitude |A| ≥ SEED_AMPLITUDE on the plain general held basis of that branch's degree, the branch's
+    parameters); none when the symmetric relative has no pear pitchfork (then there is no pear branch to break)."""
+    relative = symmetric_relative(scene)
+    primary = trace_primary(relative)
+    primary.stability, _ = assess_branch(primary, relative.stability.degree, True)
+    events = [e for e in bifurcation.detect(primary, primary.stability) if e[1] == Block.ODD_HELD]
+    if not events:
+        return []
+    bp = bifurcation.locate(primary, *events[0])
+    out = []
+    for sign in (1.0, -1.0):
+        pear = trace_pear(primary, bp, sign, "pear")
+        if pear is None:
+            raise HomotopyError("the pear branch of the symmetric relative could not be started")
+        poles = pear.pole_values()
+        wide = np.flatnonzero(np.abs(poles["lam2_north"] - poles["lam2_south"]) >= SEED_AMPLITUDE)
+        if not wide.size:
+            raise HomotopyError(f"the pear branch of the symmetric relative stays below amplitude {SEED_AMPLITUDE:g}")
+        plain = held_tracer(scene).system(pear.disc.degree, pear.params).eq.disc
+        out.append((pear.disc.transfer(pear.X[wide[0]], plain), pear.params))
+    return out
+
+
+def held_tracer(scene) -> Tracer:
+    """The general layout, balloon held (as the primary branch of a scene without equator symmetry)."""
+    return Tracer(scene, symmetric=False, held=True)
+
+
+def continued(scene, X: np.ndarray, params) -> np.ndarray:
+    """The seed X (at t = 0, on a plain general held basis) continued to the scene's coil heights (t = 1) at its
+    pear amplitude (module docstring); HomotopyError when a step fails at MIN_STEP."""
+    disc = held_tracer(scene).system(_degree(X), params).eq.disc
+    rows = disc.pole_rows()
+    amplitude = np.append(rows["lam2_north"] - rows["lam2_south"], 0.0)
+    target, t, step = float(amplitude @ X), 0.0, 1.0 / HEIGHT_STEPS
+    while t < 1.0:
+        trial = min(t + step, 1.0)
+        system = ParameterSystem(Equilibrium(symmetric_relative(scene, trial), disc), params, "P")
+        result = newton(system.residual, system.jacobian, X, amplitude, target, scene.solver.tol,
+                        scene.solver.max_newton)
+        if result.converged:
+            X, t = result.x, trial
+            continue
+        step /= 2
+        if step < MIN_STEP:
+            raise HomotopyError(f"the continuation in the coil heights failed at t = {trial:.4g} ({result.message})")
+    return X
+
+
+def _degree(X: np.ndarray) -> int:
+    """The degree N of a plain general held layout holding X = (u, P): N + 1 a's and N b's (b_0 pinned)."""
+    return (X.size - 1) // 2
+
+
+def distance_to(branch: Branch, X: np.ndarray, disc) -> float:
+    """The max-norm distance in (P, λ2(0), λ2(π)) from X (on ``disc``) to the polyline of ``branch``'s points."""
+    rows = disc.pole_rows()
+    target = np.array([X[-1], rows["lam2_north"] @ X[:-1], rows["lam2_south"] @ X[:-1]])
+    poles = branch.pole_values()
+    path = np.stack([branch.X[:, -1], poles["lam2_north"], poles["lam2_south"]], axis=1)
+    a, d = path[:-1], np.diff(path, axis=0)
+    s = np.clip(np.einsum("ij,ij->i", target - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    return float(np.abs(a + s[:, None] * d - target).max(axis=1).min())
+
+
+def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None) -> Branch | None:
+    """The pear branch the scene's broken equator symmetry disconnects from ``primary`` (module docstring), None
+    when the symmetric relative has no pear pitchfork; HomotopyError when it is not found."""
+    t0 = time.perf_counter()
+    tracer = held_tracer(scene)
+    found = seeds(scene)
+    if not found:
+        return None
+    for X, params in found:
+        X = continued(scene, X, params)
+        system = tracer.system(_degree(X), params)
+        if distance_to(primary, X, system.eq.disc) <= ON_BRANCH:
+            continue  # the half that joins the primary branch
+        stop, pressure = pear_stop_rule(scene), np.eye(X.size)[-1]
+        legs = [tracer.leg(continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0), params,
+                           stop, progress, degree=_degree(X)) for sign in (1.0, -1.0)]
+        branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=pear_landing(scene),
+                                      labels=("up", "down")))
+        branch.origin = Origin.CONTINUED_IN_HEIGHT
+        return branch
+    raise HomotopyError("both halves of the pear branch, continued in the coil heights, lie on the primary branch")
