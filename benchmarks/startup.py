@@ -42,7 +42,10 @@ MEASURE = """
 import json, statistics, sys, time
 clocks = (time.perf_counter, time.process_time)
 t0 = [c() for c in clocks]
-from balloon_cg.analysis.branches.primary import trace_primary
+try:
+    from balloon_cg.analysis.branches.primary import trace_primary
+except ImportError:  # an install from before analysis/ was regrouped (session 21)
+    from balloon_cg.analysis.primary import trace_primary
 from balloon_cg.app.api import computed
 from balloon_cg.app.summaries import summarise_file
 from balloon_cg.io.run_file import write_run

@@ -23,7 +23,11 @@ ROOT = Path(__file__).resolve().parents[1]
 MEASURE = """
 import hashlib, json, resource, time
 import numpy as np
-from balloon_cg.analysis import picture, surface_assessment, surface_branches
+from balloon_cg.analysis import picture
+try:
+    from balloon_cg.analysis.surface import assessment as surface_assessment, branches as surface_branches
+except ImportError:  # an install from before analysis/ was regrouped (session 21)
+    from balloon_cg.analysis import surface_assessment, surface_branches
 from balloon_cg.numerics.threads import limited_blas
 from balloon_cg.scene import load_scene
 

@@ -35,7 +35,12 @@ PHASES = ("trace", "stability", "branch points", "pear branches", "m >= 1 crossi
 
 MEASURE = """
 import json, resource, sys, time
-from balloon_cg.analysis import azimuthal_points, bifurcation, picture, surface_branches
+from balloon_cg.analysis import picture
+try:
+    from balloon_cg.analysis.points import azimuthal_points, branch_points as bifurcation
+    from balloon_cg.analysis.surface import branches as surface_branches
+except ImportError:  # an install from before analysis/ was regrouped (session 21)
+    from balloon_cg.analysis import azimuthal_points, bifurcation, surface_branches
 from balloon_cg.scene import load_scene
 seconds = {}
 
