@@ -187,7 +187,7 @@ def main():
     for case in wp.cases():
         branch, solver, targets = wp.prepare(case)
         system = FirstOrderSystem(case.scene)
-        eta_row = branch.disc.pole_rows()["eta_north"]
+        eta_row = branch.disc.pole_rows()["eta_top"]
         system.north_half(1.5, 1.5, 2.0, 1e-6)  # compile / load the jitted functions outside the timings
         lines.append(f"== {case.label} (reference: {targets[0].note})")
         lines.append(f"  {'λ*':>5}  {'(i) Nelder–Mead + solve_ivp':>45}  {'(ii) solve_bvp (numpy rhs)':>45}  "

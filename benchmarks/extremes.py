@@ -38,7 +38,7 @@ def two_coils(**overrides):
 
 
 def summary(branch, t0):
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     degrees = sorted({int(d) for d in branch.degree})
     return (f"{len(branch.X)} points, λ ∈ [1 + {lam.min() - 1:.3g}, {lam.max():.6g}], degrees {degrees}, "
             f"max residual {branch.residual.max():.1e}, max tail {branch.error_estimate.max():.1e}, "
@@ -48,14 +48,14 @@ def summary(branch, t0):
 
 def refined(branch, factor=1.5):
     X = branch.X[-1]
-    lam = branch.pole_values()["lam2_north"][-1]
+    lam = branch.pole_values()["lam2_top"][-1]
     result, _ = constrained_newton(branch.scene, int(branch.disc.degree * factor), X, branch.disc, lam,
                                    branch.params)
     return f"refinement × {factor}: P changes by {abs(result.x[-1] / X[-1] - 1):.1e} ({result.message})"
 
 
 def sphere_error(branch):
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     return np.abs(branch.pressure / sphere_pressure(branch.scene.material, lam) - 1).max()
 
 
@@ -116,7 +116,7 @@ def nearly_undeformed():
             except Exception as error:  # a clear stop is an acceptable outcome; report it
                 say(f"  start {start!r}, {label}: {type(error).__name__}: {error}")
                 continue
-            lam = branch.pole_values()["lam2_north"]
+            lam = branch.pole_values()["lam2_top"]
             extra = ""
             if not scene.field.coils:
                 error = np.abs(branch.pressure - sphere_pressure(scene.material, lam)).max()
@@ -147,7 +147,7 @@ def wire_approach():
             f"basis map {branch.disc.mapping}")
         X = branch.X[-1]
         rows = branch.disc.pole_rows()
-        shot = shoot_symmetric(scene, float(rows["lam2_north"] @ X[:-1]), X[-1], float(rows["eta_north"] @ X[:-1]))
+        shot = shoot_symmetric(scene, float(rows["lam2_top"] @ X[:-1]), X[-1], float(rows["eta_top"] @ X[:-1]))
         say(f"    last point against shooting at its pole stretch: |P/P_shoot − 1| = {abs(X[-1] / shot.P - 1):.1e} "
             f"({shot.message})")
 
@@ -173,7 +173,7 @@ def stability_basis():
         flags = "".join("S" if r.stable_pressure else "u" for r in results)
         say(f"  N = {N}: {seconds * 1e3:.0f} ms per point, all eigenvalues finite: {finite}, "
             f"pressure-control flags {flags} at λ = "
-            + ", ".join(f"{branch.pole_values()['lam2_north'][i]:.3f}" for i in picks))
+            + ", ".join(f"{branch.pole_values()['lam2_top'][i]:.3f}" for i in picks))
     say("  lowest eigenvalue change N = 40 → 60: "
         + ", ".join(f"{d:.1e}" for d in np.abs(lowest[60] - lowest[40]) / np.maximum(np.abs(lowest[60]), 1e-300)))
 

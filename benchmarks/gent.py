@@ -58,11 +58,11 @@ def closed_form(out: Path):
     scene = load_scene("spom1").with_overrides(GENT | {"continuation.stop_stretch": 6.0})
     branch = trace_primary(scene)
     bc.trace(scene).save(out / "gent_M0.h5")
-    lam2 = branch.pole_values()["lam2_north"]
+    lam2 = branch.pole_values()["lam2_top"]
     folds = [s for s in branch.special if s.kind.value == "LP"]
     print(f"  traced primary branch (spom1 scene, stop 6): {len(lam2)} points, {len(pear_points(branch))} pear "
           f"points; folds: " + "; ".join(
-              f"lambda {branch.pole_values(s.X)['lam2_north'][0]:.10f}, P {s.X[-1]:.10f} "
+              f"lambda {branch.pole_values(s.X)['lam2_top'][0]:.10f}, P {s.X[-1]:.10f} "
               f"(closed form {abs(s.X[-1] / float(sphere_pressure(get_preset('Gent'), extrema[k])) - 1):.1e} rel.)"
               for k, s in enumerate(folds)) + f"  ({time.perf_counter() - t:.1f} s)")
 
@@ -82,16 +82,16 @@ def whole_picture(label, file, out: Path):
     bps = [s for s in result.special_points if s["kind"] == "BP" and s["block"] == "odd_held"
            and s["branch"] == "primary"]
     primary = result.branches["primary"]
-    stretch = primary["lam2_north"]
+    stretch = primary["lam2_top"]
     print(f"{label}: whole picture {elapsed:.1f} s; primary branch {len(primary)} points, lambda2(0) "
           f"{stretch.min():.4f}..{stretch.max():.4f}, ended {primary.attrs['stop_reason']}")
     print(f"  pear pitchforks on the primary branch: {len(bps)}" + "".join(
-        f"; lambda2(0) {s['lam2_north']:.8f}, P {s['pressure']:.8f} ({s['classification']}, {s['status']})"
+        f"; lambda2(0) {s['lam2_top']:.8f}, P {s['pressure']:.8f} ({s['classification']}, {s['status']})"
         for s in bps))
     for name, b in result.branches.items():
         if name != "primary":
             print(f"  pear branch {name}: {len(b)} points, P {b['pressure'].min():.6f}..{b['pressure'].max():.6f},"
-                  f" lambda2(0) up to {b['lam2_north'].max():.4f}; ended {b.attrs['stop_reason']}")
+                  f" lambda2(0) up to {b['lam2_top'].max():.4f}; ended {b.attrs['stop_reason']}")
     return scene, path
 
 
@@ -138,7 +138,7 @@ def check_jm(scene, rows):
     bp = pear_points(neo)[0]
     P_neo = bp.X[-1]
     print(f"  check Jm -> infinity: neo-Hookean preset (Ogden kernels) pitchfork P = {P_neo:.10f}, lambda2(0) = "
-          f"{neo.pole_values(bp.X)['lam2_north'][0]:.8f}; on the curve (Gent kernels):")
+          f"{neo.pole_values(bp.X)['lam2_top'][0]:.8f}; on the curve (Gent kernels):")
     P = {}
     for Jm in (1e5, 2e5):
         X = land_on_q(up, Jm, int(np.argmin(np.abs(up.q - Jm))))

@@ -48,7 +48,7 @@ def rows(label: str, run: dict):
             start = time.perf_counter()
             u, P = branch["unknowns"][i][:disc.size], branch["pressure"][i]
             params = Parameters(P, branch["attrs"]["M"], branch["attrs"]["chi"])
-            line = f"{i:>4} {P:>8.5f} {branch['lam2_north'][i]:>7.4f} {stored[i]:>10.5g}"
+            line = f"{i:>4} {P:>8.5f} {branch['lam2_top'][i]:>7.4f} {stored[i]:>10.5g}"
             for N in DEGREES:
                 generated = az.spectrum(eq, u, params, 1, N, 1, held=True)[0]
                 block = bf.m1_block(disc, scene, u, params, N, bf.Grid(2 * (N + disc.degree) + 20, 12))

@@ -205,7 +205,7 @@ def _pear_points(scene, first_only=False):
     primary.stability, _ = assess_branch(primary, scene.stability.degree, True)
     events = [e for e in bifurcation.detect(primary, primary.stability) if e[1] == "odd_held"]
     points = [bifurcation.locate(primary, *e) for e in events[:1 if first_only else None]]
-    return [(primary.pole_values(bp.X)["lam2_north"][0], bp.X[-1], bp.status.value) for bp in points]
+    return [(primary.pole_values(bp.X)["lam2_top"][0], bp.X[-1], bp.status.value) for bp in points]
 
 
 def sphere_pear_points():

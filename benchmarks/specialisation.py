@@ -78,7 +78,7 @@ def throughput(eq, X, nodes=20000, repeat=REPEAT):
 
 def point_solve(eq, X0, stretch):
     residual, jacobian = point_system(eq)
-    row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
+    row = np.append(eq.disc.pole_rows()["lam2_top"], 0.0)
     t0 = time.process_time()
     result = newton(residual, jacobian, X0, row, stretch, 1e-11, 25)
     return time.process_time() - t0, result
@@ -88,7 +88,7 @@ def trace(eq, scene, top=3.0):
     system = ParameterSystem(eq, Parameters(0.0), "P")
     settings = continuation.Settings(0.02, 1e-7, 0.02, 2000, 1e-11, 25)
     X0 = sphere_X(eq, 1.01, scene.material)
-    north = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
+    north = np.append(eq.disc.pole_rows()["lam2_top"], 0.0)
     t0 = time.process_time()
     start = continuation.Point(X0, continuation.tangent(system, X0, north), 0, 0.0)
     path = continuation.trace(system, start, settings, lambda p: "top" if north @ p.X >= top else None,
@@ -107,7 +107,7 @@ def main():
         starts, results = {}, {}
         for name, eq in eqs.items():  # compile/load, and the neighbours (untimed)
             residual, jacobian = point_system(eq)
-            row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
+            row = np.append(eq.disc.pole_rows()["lam2_top"], 0.0)
             for s in STRETCHES:
                 guess = sphere_X(eq, s - wp.H, scene.material) * (1 + 1e-3)  # not on the solution: Newton works
                 starts[(name, s)] = newton(residual, jacobian, guess, row, s - wp.H, 1e-13, 25).x

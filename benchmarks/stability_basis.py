@@ -68,7 +68,7 @@ def main():
         for n in points:
             X = branch.X[n]
             params = branch.params_at(X)
-            north = float(branch.disc.pole_rows()["lam2_north"] @ X[:-1])
+            north = float(branch.disc.pole_rows()["lam2_top"] @ X[:-1])
             print(f"\n{name}, point {n}: λ2(0) = {north:.6f}, P = {X[-1]:.8f}; held in x at degree {plain[n]}, "
                   f"stored at mapped degree {branch.disc.degree}")
             with blas_threads():

@@ -47,7 +47,7 @@ def main():
         m = measures(basis, state)
         x = trace.eq.node_values(state)["state"][:3]
         gap = float(wire_distance(np.hypot(x[0], x[1]), x[2], coils).min())
-        found[L, M] = (basis.size, tails(basis, state), m["centroid"][0], m["lam_north"], gap)
+        found[L, M] = (basis.size, tails(basis, state), m["centroid"][0], m["lam_top"], gap)
     reference = found[REFERENCE]
     print("   L   M  unknowns  θ-tail   φ-tail   |Δx_c|    |Δλ(0)|   x_c")
     for (L, M), (size, (theta, phi), xc, lam, gap) in found.items():

@@ -76,7 +76,7 @@ def field_case(check: bool = True):
     print(f"SPOM1 single coil (a = 4, h = 0), continuation in M from M = {scene.field.M:g}, Legendre degree "
           f"{branch.disc.degree}")
     print("  pear pitchforks at the scene's M: " + "; ".join(
-        f"stretch {branch.pole_values(bp.X)['lam2_north'][0]:.6f}, P {bp.X[-1]:.6f}" for bp in bps))
+        f"stretch {branch.pole_values(bp.X)['lam2_top'][0]:.6f}, P {bp.X[-1]:.6f}" for bp in bps))
     print(f"  critical M (merge of the two pear pitchforks) = {q:.10f}  at P = {P:.8f}, pole stretch {lam:.6f}")
     print(f"  curve points {len(curve.X)}, largest spectral tail "
           f"{max(branch.disc.tail(X[:branch.disc.size]) for X in curve.X):.1e}; stop: {curve.stop_reason}")
@@ -92,10 +92,10 @@ def field_case(check: bool = True):
             primary = trace_primary(probe)
             found = pear_points(primary)
             print(f"  sweep check M = {M:.8f}: {len(found)} pear branch points"
-                  + "".join(f"; stretch {primary.pole_values(bp.X)['lam2_north'][0]:.6f}, P {bp.X[-1]:.6f}"
+                  + "".join(f"; stretch {primary.pole_values(bp.X)['lam2_top'][0]:.6f}, P {bp.X[-1]:.6f}"
                             for bp in found)
-                  + f"  (primary: {len(primary.X)} points, stretch {primary.pole_values()['lam2_north'].min():.3f}"
-                  f"..{primary.pole_values()['lam2_north'].max():.3f}, {time.perf_counter() - s:.1f} s)")
+                  + f"  (primary: {len(primary.X)} points, stretch {primary.pole_values()['lam2_top'].min():.3f}"
+                  f"..{primary.pole_values()['lam2_top'].max():.3f}, {time.perf_counter() - s:.1f} s)")
 
 
 def main():

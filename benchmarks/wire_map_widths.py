@@ -66,14 +66,14 @@ def past_turn_targets(study: StudyCase, solver):
     scene = study.case.scene
     branch = trace_primary(scene, down=False)
     disc = branch.disc
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     turn = int(np.argmax(lam))
     gaps = np.array([wire_gap(disc, X[:-1], scene.field.coils)[0] for X in branch.X])
     targets = []
     for goal in study.past_turn_gaps:
         i = turn + 1 + int(np.argmin(np.abs(gaps[turn + 1:] - goal)))
         X = branch.X[i]
-        eta0 = float(disc.pole_rows()["eta_north"] @ X[:-1])
+        eta0 = float(disc.pole_rows()["eta_top"] @ X[:-1])
         shot = shoot_symmetric(scene, lam[i], X[-1], eta0)
         pole = shoot_symmetric(scene, lam[i], X[-1], eta0, start="pole")
         if not (shot.converged and pole.converged):

@@ -93,7 +93,7 @@ class PointSolver:
             eq = self.equilibrium(degree, mapping)
             system = ParameterSystem(eq, self.params, "P")
             self._system[degree, mapping] = (system.residual, system.jacobian,
-                                             np.append(eq.disc.pole_rows()["lam2_north"], 0.0))
+                                             np.append(eq.disc.pole_rows()["lam2_top"], 0.0))
         return self._system[degree, mapping]
 
     def convert(self, X, source, degree, mapping=None):
@@ -136,8 +136,8 @@ def prepare(case: Case):
     branch = trace_primary(case.scene, stop_stretch=top, down=False)
     solver = PointSolver(case.scene, branch.params)
     disc = branch.disc
-    lam = branch.pole_values()["lam2_north"]
-    eta_row = disc.pole_rows()["eta_north"]
+    lam = branch.pole_values()["lam2_top"]
+    eta_row = disc.pole_rows()["eta_top"]
     targets = []
     for s in case.stretches:
         if s > lam.max() + 1e-12:
@@ -271,7 +271,7 @@ def bifurcation_rows(case, stability, bifurcation):
 
 def format_case(case, branch, targets, rows, degrees=DEGREES, tols=TOLS):
     lines = [f"== {case.label}: reference {targets[0].note if targets[0] else '-'}; branch traced to "
-             f"λ = {branch.pole_values()['lam2_north'].max():.4g} (adaptive degree up to {branch.disc.degree})"]
+             f"λ = {branch.pole_values()['lam2_top'].max():.4g} (adaptive degree up to {branch.disc.degree})"]
     for t in targets:
         if t is None:
             continue

@@ -52,8 +52,8 @@ def test_held_m1_crossing_is_located(field_scene, field_picture):
         assert abs(mu[0]) <= 1e-8, degree
     P0, P1 = branch.X[s.index, -1], branch.X[s.index + 1, -1]
     assert min(P0, P1) < s.X[-1] < max(P0, P1)
-    north = branch.pole_values()["lam2_north"][s.index: s.index + 2]
-    assert north.min() < branch.pole_values(s.X)["lam2_north"][0] < north.max()
+    north = branch.pole_values()["lam2_top"][s.index: s.index + 2]
+    assert north.min() < branch.pole_values(s.X)["lam2_top"][0] < north.max()
     # before the pear pitchfork (P = 2.2527) along the branch; located at the degree that holds the branch there
     # (100): 2.2642302776 at perturbation degrees 60, 90 and 135 alike, 2.2642244744 at the old fixed degree 20
     assert s.X[-1] == pytest.approx(2.2642302776, abs=1e-9)

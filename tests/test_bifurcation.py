@@ -35,8 +35,8 @@ def test_pear_bifurcations_match_the_independent_sphere_condition(picture):
     """Stretches to 1e-8 (relative) against the closed-form mode-1 condition of sphere_modes; P against the
     exact sphere pressure."""
     name, pic, primary, bps = pear_points(picture)
-    expected = bifurcation_stretches(get_preset(name), 1, lam_max=primary.pole_values()["lam2_north"].max())
-    found = np.array([primary.pole_values(bp.X)["lam2_north"][0] for bp in bps])
+    expected = bifurcation_stretches(get_preset(name), 1, lam_max=primary.pole_values()["lam2_top"].max())
+    found = np.array([primary.pole_values(bp.X)["lam2_top"][0] for bp in bps])
     assert found.size == expected.size
     np.testing.assert_allclose(found, expected, rtol=1e-8)
     for bp, lam in zip(bps, found):
@@ -73,17 +73,17 @@ def test_mirror_branch_swaps_the_poles(picture):
         mark_rejoin(traced, primary, bps[pear.rejoins])
     assert mirror.origin == Origin.REFLECTED and mirror.reflection_of == "pear_0"
     assert traced.origin == Origin.TRACED and len(traced.X) == len(mirror.X) == len(pear.X)
-    np.testing.assert_allclose(traced.pole_values()["lam2_north"], pear.pole_values()["lam2_south"], rtol=1e-9)
-    assert np.abs(pear.pole_values()["lam2_north"] - pear.pole_values()["lam2_south"]).max() > 0.5
+    np.testing.assert_allclose(traced.pole_values()["lam2_top"], pear.pole_values()["lam2_bottom"], rtol=1e-9)
+    assert np.abs(pear.pole_values()["lam2_top"] - pear.pole_values()["lam2_bottom"]).max() > 0.5
     np.testing.assert_allclose(mirror.X[:, -1], traced.X[:, -1], rtol=1e-9)
-    for pole in ("lam2_north", "lam2_south", "eta_north", "eta_south"):
+    for pole in ("lam2_top", "lam2_bottom", "eta_top", "eta_bottom"):
         np.testing.assert_allclose(mirror.pole_values()[pole], traced.pole_values()[pole], rtol=1e-9, atol=1e-9)
     assert [leg.stop.code for leg in mirror.legs] == [leg.stop.code for leg in traced.legs]
     own = [s for s in mirror.special if s.m == 0]  # the m ≥ 1 points are found on each stored branch (analyse)
     assert [(s.kind, s.index) for s in own] == [(s.kind, s.index) for s in traced.special]
     for s, t in zip(own, traced.special):
         assert s.X[-1] == pytest.approx(t.X[-1], rel=1e-9)
-        assert mirror.pole_values(s.X)["lam2_north"][0] == pytest.approx(traced.pole_values(t.X)["lam2_north"][0],
+        assert mirror.pole_values(s.X)["lam2_top"][0] == pytest.approx(traced.pole_values(t.X)["lam2_top"][0],
                                                                          rel=1e-9)
 
 

@@ -29,16 +29,16 @@ def test_sphere_branch_points_match_the_closed_forms(preset):
     branch's largest stretch is a LOCATED branch point to 1e-10 in λ, and the BP index brackets it."""
     scene = parse_scene(f'[material]\npreset = "{preset}"\n[continuation]\nstop_stretch = {STOP}\n', name=preset)
     primary = analyse(scene, pear=False).primary
-    lam = primary.pole_values()["lam2_north"]
+    lam = primary.pole_values()["lam2_top"]
     for n, block in ((1, Block.ODD_HELD), (2, Block.EVEN)):
         expected = bifurcation_stretches(get_preset(preset), n, lam_max=lam.max())
         found = {bp.index: bp for bp in primary.branch_points(block)}
-        located = np.array([primary.pole_values(bp.X)["lam2_north"][0] for bp in found.values()])
+        located = np.array([primary.pole_values(bp.X)["lam2_top"][0] for bp in found.values()])
         for root in expected:
             assert located.size and np.abs(located - root).min() <= 1e-10, (n, root, located)
         for index, bp in found.items():
             assert bp.kind == Kind.BP and bp.status == Status.LOCATED, bp.reason
-            stretch = primary.pole_values(bp.X)["lam2_north"][0]
+            stretch = primary.pole_values(bp.X)["lam2_top"][0]
             assert min(lam[index], lam[index + 1]) <= stretch <= max(lam[index], lam[index + 1])
 
 

@@ -238,10 +238,10 @@ def test_a_sweep_member_with_a_flipped_byte_is_refused(sweep, tmp_path, capsys):
     path = tmp_path / "sweep.h5"
     shutil.copy(sweep, path)
     capsys.readouterr()
-    flip_a_byte(path, "/members/1/branches/primary/lam2_north")
+    flip_a_byte(path, "/members/1/branches/primary/lam2_top")
     with contextlib.redirect_stdout(io.StringIO()):
         assert main(["inspect", str(path)]) == 2
-    assert "dataset /members/1/branches/primary/lam2_north: unreadable, damaged" in capsys.readouterr().err
+    assert "dataset /members/1/branches/primary/lam2_top: unreadable, damaged" in capsys.readouterr().err
 
 
 def test_each_sweep_attribute_and_group_deletion_is_refused(sweep, tmp_path):

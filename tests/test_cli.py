@@ -54,7 +54,7 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["scene_name"] == "small"
     assert summary["provenance"]["command"] == f"balloon-cg run {scene_file} -o {out}"
-    assert summary["provenance"]["format"] == "balloon-cg/5"
+    assert summary["provenance"]["format"] == "balloon-cg/6"
     branch = summary["branches"]["primary"]
     # SPOM1 up to stretch 2: the fold in P and the first pear pitchfork (λ = 1.6799), its pear branches
     assert [s["kind"] for s in branch["special_points"]] == ["EP", "LP", "BP", "EP"]
@@ -66,9 +66,9 @@ def test_run_then_inspect(tmp_path, scene_file, capsys):
     pear, mirror = summary["branches"]["pear_0"], summary["branches"]["pear_0_mirror"]
     assert (pear["origin"], pear["reflection_of"]) == ("traced", "")
     assert (mirror["origin"], mirror["reflection_of"]) == ("reflected", "pear_0") and mirror["parent"] == ["primary", 0]
-    assert mirror["lam2_north"] == pytest.approx(pear["lam2_south"], rel=1e-12)
+    assert mirror["lam2_top"] == pytest.approx(pear["lam2_bottom"], rel=1e-12)
     assert summary["snap_throughs"][0]["from_branch"] == "primary"
-    assert branch["lam2_north"][1] == pytest.approx(2.0, abs=1e-12)
+    assert branch["lam2_top"][1] == pytest.approx(2.0, abs=1e-12)
     assert branch["max_residual"] < 1e-10 and branch["max_error_estimate"] < 1e-10
     assert branch["points"] > 10 and branch["wall_time"] > 0
     timing = summary["run_time"]  # every phase that ran, writing included, within the whole run's time
@@ -105,14 +105,14 @@ def test_solve_json_matches_sphere(stretch, capsys):
     assert main(["solve", str(SPOM1), "--pole-stretch", str(stretch), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert set(result) == {
-        "pressure", "lam2_north", "lam2_south", "eta_north", "eta_south", "lam1_equator", "lam2_equator",
+        "pressure", "lam2_top", "lam2_bottom", "eta_top", "eta_bottom", "lam1_equator", "lam2_equator",
         "residual", "error_estimate", "wall_time",
     }
     assert result["pressure"] == pytest.approx(exact_sphere_pressure(stretch), rel=1e-10, abs=0)
-    assert result["lam2_north"] == pytest.approx(stretch, rel=1e-12)
-    for key in ("lam2_south", "lam1_equator", "lam2_equator", "eta_north"):
+    assert result["lam2_top"] == pytest.approx(stretch, rel=1e-12)
+    for key in ("lam2_bottom", "lam1_equator", "lam2_equator", "eta_top"):
         assert result[key] == pytest.approx(stretch, rel=1e-10)
-    assert result["eta_south"] == pytest.approx(-stretch, rel=1e-10)
+    assert result["eta_bottom"] == pytest.approx(-stretch, rel=1e-10)
 
 
 def test_solve_table(scene_file, capsys):
@@ -249,7 +249,7 @@ def test_a_set_material_is_stored_as_computed_not_as_its_preset(tmp_path):
     assert material.name == "TPOM2 (mu1 = 1)" and material.mu == (1.0,) and material.alpha == (1.98,)
     assert material != PRESETS["TPOM2"] and material.name != PRESETS["TPOM2"].name
     primary = result.branches["primary"]
-    lam, pressure = primary["lam2_north"], primary["pressure"]
+    lam, pressure = primary["lam2_top"], primary["pressure"]
     assert len(lam) > 5
     assert np.allclose(pressure, 2 * 1.0 * (lam ** (1.98 - 3) - lam ** (-2 * 1.98 - 3)), rtol=1e-9, atol=0)
     assert not np.allclose(pressure, 2 * 2.0202 * (lam ** (1.98 - 3) - lam ** (-2 * 1.98 - 3)), rtol=1e-3)

@@ -59,7 +59,7 @@ def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
     assert main(["run", str(scene), "--set", "continuation.stop_stretch=1.5", "--set", "solver.degree=30",
                  "--primary-only", "--quiet"]) == 0
     run = read_run(tmp_path / "small_M0_stop_stretch1.5_degree30.h5")  # the scene keeps its name, the file shows all
-    assert run["scene_name"] == "small_M0" and run["branches"]["primary"]["lam2_north"].max() == pytest.approx(1.5,
+    assert run["scene_name"] == "small_M0" and run["branches"]["primary"]["lam2_top"].max() == pytest.approx(1.5,
                                                                                                             abs=1e-12)
     assert "stop_stretch = 1.5" in run["attrs"]["scene_toml"] and "degree = 30" in run["attrs"]["scene_toml"]
     # --max-points 15 stops the up leg short: written, flagged, exit 1

@@ -58,7 +58,7 @@ def test_mapped_quadrature_and_transfer():
         assert np.abs(before - after).max() < 1e-10
     np.testing.assert_allclose(disc.transfer(moved, plain), u, atol=1e-10)
     # the pole rows of the mapped basis are those of Legendre (h(±1) = ±1)
-    assert disc.pole_rows()["lam2_north"] @ moved == pytest.approx(plain.pole_rows()["lam2_north"] @ u, abs=1e-12)
+    assert disc.pole_rows()["lam2_top"] @ moved == pytest.approx(plain.pole_rows()["lam2_top"] @ u, abs=1e-12)
 
 
 def test_curvature_of_a_mapped_profile_matches_the_plain_one():
@@ -99,7 +99,7 @@ def near_wire():
     scene = load_scene(SCENE).with_overrides({"continuation.stop_stretch": 1.8})
     branch = trace_primary(scene, down=False)
     X = branch.X[-1]
-    eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
+    eta0 = float(branch.disc.pole_rows()["eta_top"] @ X[:-1])
     shot = shoot_symmetric(scene, 1.8, X[-1], eta0, tol=1e-13)
     assert shot.converged
     return scene, branch, X, shot.P
@@ -107,7 +107,7 @@ def near_wire():
 
 def _solve_at(scene, branch, X, disc, stretch):
     system = ParameterSystem(Equilibrium(scene, disc), branch.params, "P")
-    row = np.append(disc.pole_rows()["lam2_north"], 0.0)
+    row = np.append(disc.pole_rows()["lam2_top"], 0.0)
     result = newton(system.residual, system.jacobian, branch.disc.transfer(X, disc), row, stretch, 1e-13, 30)
     assert result.converged
     return result.x
@@ -136,8 +136,8 @@ def test_branch_reaches_the_wire_gap_and_its_end_matches_shooting():
     assert np.all(branch.error_estimate <= scene.solver.max_error + 1e-11)
     X = branch.X[-1]  # the last stored point, one continuation step before the one within wire_gap
     assert wire_gap(branch.disc, X[:-1], scene.field.coils)[0] < 0.12
-    stretch = float(branch.disc.pole_rows()["lam2_north"] @ X[:-1])
-    eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
+    stretch = float(branch.disc.pole_rows()["lam2_top"] @ X[:-1])
+    eta0 = float(branch.disc.pole_rows()["eta_top"] @ X[:-1])
     shot = shoot_symmetric(scene, stretch, X[-1], eta0, tol=1e-13)
     assert shot.converged and abs(shot.P / X[-1] - 1) < 1e-8
 
@@ -217,8 +217,8 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire(t
     assert abs(held.weights @ held.node_state(u)[2]) < 1e-14
     theta = np.array([0.0, np.pi])
     eta = held.evaluate(u, theta)[2]
-    assert held.pole_rows()["eta_north"] @ u == pytest.approx(eta[0], abs=1e-14)
-    assert held.pole_rows()["eta_south"] @ u == pytest.approx(eta[1], abs=1e-14)
+    assert held.pole_rows()["eta_top"] @ u == pytest.approx(eta[0], abs=1e-14)
+    assert held.pole_rows()["eta_bottom"] @ u == pytest.approx(eta[1], abs=1e-14)
 
     scene = load_scene(SCENE)
     picture = two_coil_picture
@@ -234,8 +234,8 @@ def test_held_mapped_basis_keeps_the_hold_and_the_pear_branch_reaches_the_wire(t
     system = ParameterSystem(Equilibrium(scene, plain), pear.params, "P")
     row = np.append(np.zeros(plain.size), 1.0)
     result = newton(system.residual, system.jacobian, pear.disc.transfer(X, plain), row, X[-1], 1e-12, 30)
-    north = np.append(plain.pole_rows()["lam2_north"], 0.0)
-    stretch = float(pear.disc.pole_rows()["lam2_north"] @ X[:-1])
+    north = np.append(plain.pole_rows()["lam2_top"], 0.0)
+    stretch = float(pear.disc.pole_rows()["lam2_top"] @ X[:-1])
     assert result.converged and abs(north @ result.x / stretch - 1) < 2 * scene.solver.max_error
 
 
@@ -259,7 +259,7 @@ def test_mirror_on_the_mirrored_map_matches_the_traced_mirror(two_coil_picture):
     assert mirror.disc.mapping.centres != pear.disc.mapping.centres
     assert len(traced.X) == len(mirror.X) and np.array_equal(traced.degree, mirror.degree)
     np.testing.assert_allclose(mirror.X[:, -1], traced.X[:, -1], rtol=1e-9)
-    for pole in ("lam2_north", "lam2_south"):
+    for pole in ("lam2_top", "lam2_bottom"):
         np.testing.assert_allclose(mirror.pole_values()[pole], traced.pole_values()[pole], rtol=1e-9)
     assert [leg.stop.code for leg in mirror.legs] == [leg.stop.code for leg in traced.legs] == [StopCode.WIRE_GAP]
     assert [(s.kind, s.index) for s in mirror.special if s.m == 0] == [(s.kind, s.index) for s in traced.special]

@@ -140,7 +140,7 @@ def test_damaged_files_1000(good_files, tmp_path_factory, data, which):
 
 
 @pytest.mark.parametrize("which", ["run", "sweep"])
-@pytest.mark.parametrize("column", ["pressure", "lam2_north", "volume", "unknowns"])
+@pytest.mark.parametrize("column", ["pressure", "lam2_top", "volume", "unknowns"])
 def test_a_huge_declared_dataset_is_refused_without_allocating(good_files, tmp_path, capsys, which, column):
     path = tmp_path / f"{which}.h5"
     shutil.copy(good_files[which], path)

@@ -68,7 +68,7 @@ def test_pull_in_is_located_at_the_closed_form(pull_in_branch):
     folds = [s for s in pull_in_branch.special if s.kind == Kind.LP]
     assert len(folds) == 1
     fold = folds[0]
-    stretch = pull_in_branch.pole_values(fold.X)["lam2_north"][0]
+    stretch = pull_in_branch.pole_values(fold.X)["lam2_top"][0]
     assert abs(stretch - PULL_IN_STRETCH) < 1e-10
     assert abs(fold.X[-1] ** 2 - PULL_IN_VOLTAGE_SQ) < 1e-10
 
@@ -79,12 +79,12 @@ def test_the_pull_in_fold_reports_the_bracket_its_search_narrowed(pull_in_branch
     search evaluated (~2e-8), not the whole continuation step (it was 3.4e-3), and it covers the closed form."""
     fold = next(s for s in pull_in_branch.special if s.kind == Kind.LP)
     assert fold.status == Status.LOCATED or fold.uncertainty < 1e-6
-    stretch = pull_in_branch.pole_values(fold.X)["lam2_north"][0]
+    stretch = pull_in_branch.pole_values(fold.X)["lam2_top"][0]
     assert abs(stretch - PULL_IN_STRETCH) <= max(fold.uncertainty, 1e-10)
 
 
 def test_voltage_branch_is_the_zero_pressure_sphere(pull_in_branch):
-    lam = pull_in_branch.pole_values()["lam2_north"]
+    lam = pull_in_branch.pole_values()["lam2_top"]
     assert np.all(pull_in_branch.pressure == 0.0)
     assert np.abs(pull_in_branch.voltage**2 - (lam**-2 - lam**-8)).max() < 1e-10
     assert pull_in_branch.stopped(StopCode.STOP_STRETCH)
@@ -92,7 +92,7 @@ def test_voltage_branch_is_the_zero_pressure_sphere(pull_in_branch):
 
 def test_voltage_control_loses_stability_at_the_pull_in(pull_in_branch):
     """Stable (fixed P = 0 and Φ̄) below the pull-in stretch, unstable above it."""
-    lam = pull_in_branch.pole_values()["lam2_north"]
+    lam = pull_in_branch.pole_values()["lam2_top"]
     stable = np.array([a.stable_pressure for a in pull_in_branch.stability])
     assert np.all(stable[lam < PULL_IN_STRETCH - 1e-6]) and not np.any(stable[lam > PULL_IN_STRETCH + 1e-6])
 
@@ -107,7 +107,7 @@ def fixed_voltage():
 
 def test_fixed_voltage_pressure_is_the_sphere_closed_form(fixed_voltage):
     branch = fixed_voltage.primary
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     assert np.abs(branch.pressure - neo_hookean_pressure(lam, 0.3)).max() < 1e-10
     assert np.all(branch.voltage == 0.3)
 
@@ -118,15 +118,15 @@ def test_compressed_membrane_stops_the_branch(fixed_voltage):
     branch = fixed_voltage.primary
     slack = brentq(lambda lam: neo_hookean_derivatives(lam, 0.3)[0], 1.0001, 1.1)
     assert branch.stopped(StopCode.COMPRESSED)
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     assert slack < lam.min() < slack + 0.05
 
 
 def test_branch_points_satisfy_the_sphere_conditions_with_the_dielectric_term(fixed_voltage):
     """Pear (n = 1, λ⁸ = 3/Φ̄²), n = 2 (even block) and n = 3 (odd) points on the sphere: to 1e-9 in λ."""
     branch = fixed_voltage.primary
-    found = {(bp.block, round(float(branch.pole_values(bp.X)["lam2_north"][0]), 3)):
-             float(branch.pole_values(bp.X)["lam2_north"][0]) for bp in fixed_voltage.branch_points}
+    found = {(bp.block, round(float(branch.pole_values(bp.X)["lam2_top"][0]), 3)):
+             float(branch.pole_values(bp.X)["lam2_top"][0]) for bp in fixed_voltage.branch_points}
     pear = (3 / 0.3**2) ** (1 / 8)
     assert sphere_mode_condition(pear, 0.3, 1) == pytest.approx(0.0, abs=1e-12)
     expected = {Block.ODD_HELD: [pear, brentq(sphere_mode_condition, 2.2, 2.45, args=(0.3, 3))],
@@ -142,7 +142,7 @@ def test_azimuthal_blocks_cross_at_the_sphere_modes(fixed_voltage):
     eigenvalue of the held block m changes sign once, between the two points that bracket the stretch of the
     first mode with n ≥ m, i.e. n = m (n = 1: λ⁸ = 3/Φ̄²; n = 2: Δ_2 = 0)."""
     branch = fixed_voltage.primary
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     modes = {1: (3 / 0.3**2) ** (1 / 8), 2: brentq(sphere_mode_condition, 1.9, 2.2, args=(0.3, 2))}
     for m, stretch in modes.items():
         lowest = np.array([a.blocks[Block.azimuthal(m, True).value][0] for a in branch.stability])
@@ -156,7 +156,7 @@ def test_gent_with_voltage_follows_its_sphere_closed_form():
     scene = parse_scene('[material]\npreset = "Gent"\n[electric]\nvoltage = 0.2\n[continuation]\n'
                         "start_stretch = 1.1\nstop_stretch = 3.0\n", name="gent_voltage")
     branch = trace_primary(scene)
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     jm, i1 = 97.2, 2 * lam**2 + lam**-4
     exact = 2 * (jm / (jm - i1 + 3) * (2 * lam - 2 * lam**-5) - 2 * 0.2**2 * lam**3) / lam**2
     assert np.abs(branch.pressure - exact).max() < 1e-10
@@ -268,10 +268,10 @@ def test_galerkin_matches_shooting_with_voltage_and_two_coils():
                         "current = -1.0\n[continuation]\nstart_stretch = 1.2\n[solver]\ndegree = 80\n"
                         "max_degree = 80\nmax_error = 1e-2\n", name="two_coils_voltage")
     branch = trace_primary(scene, stop_stretch=1.5, down=False)
-    P, eta = branch.pressure[-1], branch.pole_values()["eta_north"][-1]
+    P, eta = branch.pressure[-1], branch.pole_values()["eta_top"][-1]
     shot = shoot_symmetric(scene, 1.5, P_guess=1.01 * P, eta0_guess=eta)
     assert shot.converged
-    assert abs(shot.P / P - 1) < 1e-10 and abs(shot.eta_north / eta - 1) < 1e-10
+    assert abs(shot.P / P - 1) < 1e-10 and abs(shot.eta_top / eta - 1) < 1e-10
     assert abs(P / neo_hookean_pressure(1.5, 0.25) - 1) > 0.01
 
 
@@ -285,7 +285,7 @@ def test_voltage_fold_at_a_positive_pressure_and_the_zero_voltage_end():
     square = lambda lam: (neo_hookean_pressure(lam, 0.0) - 0.5) / (4 * lam)  # noqa: E731
     peak = brentq(lambda lam: -2 * lam**-3 + 8 * lam**-9 + 0.5 / (4 * lam**2), 1.1, 1.6, xtol=1e-14)
     fold = next(s for s in branch.special if s.kind == Kind.LP)
-    assert abs(branch.pole_values(fold.X)["lam2_north"][0] - peak) < 1e-10
+    assert abs(branch.pole_values(fold.X)["lam2_top"][0] - peak) < 1e-10
     assert abs(fold.X[-1] ** 2 - square(peak)) < 1e-12
     assert np.all(branch.pressure == 0.5) and branch.voltage.min() > 0
     assert branch.stopped(StopCode.ZERO_VOLTAGE) and branch.stopped(StopCode.STOP_STRETCH)
@@ -300,7 +300,7 @@ def test_a_compressed_point_is_never_landed_on():
     slack = brentq(lambda lam: neo_hookean_derivatives(lam, 0.085)[0], 1.0001, 1.1)
     assert 1.001 < slack < 1.002
     assert branch.stopped(StopCode.COMPRESSED) and not branch.stopped(StopCode.MIN_STRETCH)
-    assert branch.pressure.min() > 0 and branch.pole_values()["lam2_north"].min() > slack
+    assert branch.pressure.min() > 0 and branch.pole_values()["lam2_top"].min() > slack
 
 
 def test_voltage_is_a_second_parameter():

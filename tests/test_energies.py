@@ -60,7 +60,7 @@ def family(request):
 def test_primary_branch_is_the_sphere_closed_form(family):
     name, primary = family
     pressure, _, _ = sphere_functions(INDEPENDENT[name])
-    lam = primary.pole_values()["lam2_north"]
+    lam = primary.pole_values()["lam2_top"]
     assert lam.max() == pytest.approx(STOP, abs=1e-12)
     assert np.abs(primary.pressure / pressure(lam) - 1).max() < 1e-10
 
@@ -70,7 +70,7 @@ def test_pear_points_and_pressure_extrema_match_the_closed_conditions(family):
     λ(Φ11 + Φ12) = 2Φ1 a located fold in P, to 1e-10 in λ; sphere_modes finds the same roots."""
     name, primary = family
     _, pear, extremum = sphere_functions(INDEPENDENT[name])
-    north = lambda X: primary.pole_values(X)["lam2_north"][0]  # noqa: E731
+    north = lambda X: primary.pole_values(X)["lam2_top"][0]  # noqa: E731
     pears = [north(bp.X) for bp in primary.branch_points(Block.ODD_HELD)]
     folds = [north(p.X) for p in primary.special if p.kind == Kind.LP and p.status == Status.LOCATED]
     for expected, located, n in ((roots(pear, STOP), pears, 1), (roots(extremum, STOP), folds, 0)):
@@ -102,7 +102,7 @@ def test_leaving_gent_domain_is_an_error_naming_the_point_and_stretch():
                         "[continuation]\nstop_stretch = 2.0\n")
     primary = analyse(scene, pear=False).primary
     X = primary.X[-1]
-    beyond = X[:-1] * 3.0 / primary.pole_values(X)["lam2_north"][0]  # the sphere λ = 3: I1 − 3 = 15 > Jm
+    beyond = X[:-1] * 3.0 / primary.pole_values(X)["lam2_top"][0]  # the sphere λ = 3: I1 − 3 = 15 > Jm
     equilibrium = equilibrium_of(primary)
     with pytest.raises(NonFiniteState, match=r"left the domain of gent at the node cos θ = -?[0-9.]+: log argument "
                                              r"1 - \(I1 - 3\) / Jm = -0\.501235 \(λ1 = 3, λ2 = 3\)"):

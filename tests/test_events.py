@@ -47,7 +47,7 @@ def test_volume_event_on_the_primary_and_the_pear_branches(picture):
         located = user_points(branch, "volume = 20")
         assert [s.index for s in located] == list(crossings) and located, branch.name
         system = branch_system(branch)
-        north = np.append(branch.disc.pole_rows()["lam2_north"], 0.0)
+        north = np.append(branch.disc.pole_rows()["lam2_top"], 0.0)
         for s in located:
             assert s.status == Status.LOCATED
             assert abs(enclosed_volume(branch.disc, s.X) / VOLUME - 1) < 1e-10
@@ -81,7 +81,7 @@ def test_mirror_image_events_are_its_own(picture):
 
 @pytest.mark.parametrize("table, message", [
     ('[[events]]\nquantity = "volum"\nvalue = 20', 'events[0].quantity = "volum": must be one of "volume", "amount", '
-                                                   '"pressure", "lam2_north", "lam2_south", "lam2_equator" '
+                                                   '"pressure", "lam2_top", "lam2_bottom", "lam2_equator" '
                                                    '(did you mean volume?)'),
     ('[[events]]\nquantity = "volume"\nvalue = 0', "events[0].value = 0: must be > 0"),
     ('[[events]]\nquantity = "volume"\nvalue = "20"', 'events[0].value = "20": must be a number'),

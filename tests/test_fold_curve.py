@@ -60,8 +60,8 @@ def test_gent_cusp_against_the_closed_form(gent_curve):
     q, P, stretch = curve.critical
     assert abs(q - float(Jm_c)) < 1e-8 and abs(stretch - float(lam_c)) < 1e-8
     assert abs(P - float(pressure.subs({lam: lam_c, Jm: Jm_c}))) < 1e-8
-    lam_north = curve.pole_stretch
-    assert lam_north[0] < float(lam_c) < lam_north[-1]  # from the maximum of P, back along the minimum
+    lam_top = curve.pole_stretch
+    assert lam_top[0] < float(lam_c) < lam_top[-1]  # from the maximum of P, back along the minimum
 
 
 def test_every_gent_fold_point_satisfies_the_closed_form(gent_curve):
@@ -72,8 +72,8 @@ def test_every_gent_fold_point_satisfies_the_closed_form(gent_curve):
     scale = sp.lambdify((lam, Jm), 2 * lam**2 * pressure / 2)  # 2Φ1: the size of the terms of g
     curve = gent_curve
     poles = curve.pole_values()
-    assert np.abs(poles["lam2_south"] - poles["lam2_north"]).max() < 1e-12
-    lams, q = poles["lam2_north"], curve.q
+    assert np.abs(poles["lam2_bottom"] - poles["lam2_top"]).max() < 1e-12
+    lams, q = poles["lam2_top"], curve.q
     assert len(q) > 50 and q.min() < 17.65 and q.max() <= 97.2
     assert np.abs(g_of(lams, q) / scale(lams, q)).max() < 1e-9
     assert np.abs(curve.pressure / P_of(lams, q) - 1).max() < 1e-10

@@ -38,7 +38,7 @@ def gas_branch(M: float):
     assert len(folds) == 1 and folds[0].status == Status.LOCATED
     bp = pear_point(branch)
     assert bp.status == Status.LOCATED
-    north = branch.disc.pole_rows()["lam2_north"]
+    north = branch.disc.pole_rows()["lam2_top"]
     return [(float(s.X[-1]), float(north @ s.X[:-1])) for s in (folds[0], bp)]
 
 
@@ -111,7 +111,7 @@ def test_sphere_pitchforks_against_the_closed_form():
     curve = continue_branch_point(branch, pear_point(branch), "alpha1", 1.0, max_points=12)
     assert curve.meetings == []
     system = curve.system()
-    north = curve.disc.pole_rows()["lam2_north"]
+    north = curve.disc.pole_rows()["lam2_top"]
     tangents = oriented_tangents(system, curve.X)
     for X, tau in zip(curve.X, tangents):
         u, P = X[:curve.n], X[curve.n]

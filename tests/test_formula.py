@@ -166,13 +166,13 @@ def test_user_formula_reproduces_the_preset(preset):
     assert [b.name for b in pictures[0].branches] == [b.name for b in pictures[1].branches]
     assert (len(pictures[0].branches) > 1) == bool(pears)  # SPOM1: the primary branch and the isola
     for preset_branch, formula_branch in zip(*(p.branches for p in pictures)):
-        lam_p, lam_f = (b.pole_values()["lam2_north"] for b in (preset_branch, formula_branch))
+        lam_p, lam_f = (b.pole_values()["lam2_top"] for b in (preset_branch, formula_branch))
         assert lam_p.shape == lam_f.shape
         assert np.abs(lam_f - lam_p).max() < 1e-12
         assert np.abs(formula_branch.pressure / preset_branch.pressure - 1).max() < 1e-12
     pair = [p.primary for p in pictures]
     for block in (Block.ODD_HELD, Block.EVEN):
-        points = [[b.pole_values(bp.X)["lam2_north"][0] for bp in b.branch_points(block)] for b in pair]
+        points = [[b.pole_values(bp.X)["lam2_top"][0] for bp in b.branch_points(block)] for b in pair]
         assert len(points[0]) == len(points[1]) and (block != Block.ODD_HELD or len(points[0]) == pears)
         assert np.abs(np.subtract(*points)).max(initial=0) < 1e-12
 

@@ -159,7 +159,7 @@ def test_the_free_pitchfork_is_the_moved_balloons_free_pear_point(all_branches):
             c = axisymmetric_coefficients(surface.basis, pear.disc, X[:-1])
             assert np.abs(loads(surface, c, pear.params_at(X))["force"]).max() <= 1e-10
         poles = pear.pole_values()
-        assert abs(poles["lam2_north"][-1] - poles["lam2_south"][-1]) > 0.1
+        assert abs(poles["lam2_top"][-1] - poles["lam2_bottom"][-1]) > 0.1
         assert abs(pear.disc.split(pear.X[-1, :-1])[1][0] - 0.5) > 1e-3
 
 

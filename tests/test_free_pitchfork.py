@@ -56,7 +56,7 @@ def test_the_free_pitchfork_is_located_apart_from_the_held_one(two_coils):
         assert np.abs(blocks[block.value]).min() <= 10 * tol
         other = Block.ODD_FREE if block == Block.ODD_HELD else Block.ODD_HELD
         assert np.abs(blocks[other.value]).min() > 1e-4
-        lam = primary.pole_values(bp.X)["lam2_north"][0]
+        lam = primary.pole_values(bp.X)["lam2_top"][0]
         assert abs(lam - lam_auto) <= AUTO_DIGITS and abs(bp.X[-1] - p_auto) <= AUTO_DIGITS
     assert points[Block.ODD_FREE].X[-1] < points[Block.ODD_HELD].X[-1] - 1e-2
 
@@ -73,7 +73,7 @@ def test_the_free_pear_branch_is_traced_with_the_translation_free(two_coils):
     assert pear is not None and pear.gauge == Gauge.FREE and not pear.disc.pin_translation
     assert len(pear.X) > 10 and pear.residual.max() <= primary.scene.solver.tol
     poles = pear.pole_values()
-    assert np.abs(poles["lam2_north"] - poles["lam2_south"]).max() > 0.5
+    assert np.abs(poles["lam2_top"] - poles["lam2_bottom"]).max() > 0.5
     assert abs(pear.X[0, -1] - bp.X[-1]) < 1e-3  # starts at the free pitchfork, not the held one
     held = trace_pear(primary, points[Block.ODD_HELD], 1.0, "pear_0")
     assert held.gauge == Gauge.HELD and held.disc.pin_translation

@@ -87,7 +87,7 @@ def uniform_second_variations(branch):
         H, g = variation.matrices(X[:-1], params)
         pressure = delta @ H @ delta
         rows.append((pressure, pressure + X[-1] / variation.eq.volume(X[:-1]) * (g @ delta) ** 2))
-    return np.array(rows), branch.pole_values()["lam2_north"]
+    return np.array(rows), branch.pole_values()["lam2_top"]
 
 
 @pytest.mark.parametrize("case", ["spom1_gas", "soft_gas"])
@@ -104,7 +104,7 @@ def test_gas_flag_follows_the_closed_form_on_spom1(spom1_gas):
     """Along SPOM1's primary branch (M = 0) the even block (the one holding the uniform inflation) is stable
     under gas control iff (Pλ³)' > 0 (always, for SPOM1), under pressure control iff P' > 0 (up to the fold)."""
     branch, assessments = spom1_gas
-    material, lam = branch.scene.material, branch.pole_values()["lam2_north"]
+    material, lam = branch.scene.material, branch.pole_values()["lam2_top"]
     assert np.allclose(branch.pressure, sphere_pressure(material, lam), rtol=1e-10)
     far = np.abs(closed_dP(material, lam)) > 1e-2  # not at the fold itself
     gas = np.array([a.blocks["even_gas"][0] > 0 for a in assessments])
@@ -123,7 +123,7 @@ def test_fold_in_n_matches_the_extremum_of_P_lambda3(soft_gas, spom1_gas):
     lam_star = brentq(lambda lam: closed_dPlam3(material, lam), 2.0, 4.0, xtol=1e-15)
     n_star = 4 * np.pi / 3 * lam_star**3 * closed_pressure(material, lam_star)
     fold = folds[0]
-    assert abs(branch.pole_values(fold.X)["lam2_north"][0] - lam_star) < 1e-8 * lam_star
+    assert abs(branch.pole_values(fold.X)["lam2_top"][0] - lam_star) < 1e-8 * lam_star
     assert abs(control_value(branch.disc, fold.X, Control.GAS) - n_star) < 1e-8 * n_star
     # the gas reading loses the uniform mode at the fold: unstable past it
     stable = np.array([a.stable_gas for a in assessments])
@@ -156,7 +156,7 @@ def test_branch_lands_on_the_control_stop(control, key, target):
     assert branch.legs[0].stop.code == (StopCode.STOP_AMOUNT if control == "gas" else StopCode.STOP_VOLUME)
     value = control_value(branch.disc, branch.X[-1], Control(control))
     assert abs(value - target) < 1e-11 * target
-    lam = branch.pole_values()["lam2_north"][-1]
+    lam = branch.pole_values()["lam2_top"][-1]
     volume = 4 * np.pi / 3 * lam**3
     assert abs((volume * sphere_pressure(scene.material, lam) if control == "gas" else volume) - target) < 1e-9 * target
 

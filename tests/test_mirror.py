@@ -63,8 +63,8 @@ def test_reflected_pear_point_solves_its_own_system(picture):
         Y = pear.disc.reflect(X)
         assert np.abs(system.residual(Y)).max() <= np.abs(system.residual(X)).max() + 1e-14
         poles, reflected = pear.pole_values(X), pear.pole_values(Y)
-        assert reflected["lam2_north"][0] == pytest.approx(poles["lam2_south"][0], abs=1e-14)
-        assert reflected["eta_north"][0] == pytest.approx(-poles["eta_south"][0], abs=1e-14)
+        assert reflected["lam2_top"][0] == pytest.approx(poles["lam2_bottom"][0], abs=1e-14)
+        assert reflected["eta_top"][0] == pytest.approx(-poles["eta_bottom"][0], abs=1e-14)
     assert np.abs(pear.disc.reflect(pear.X) - pear.X).max() > 0.1
     assert np.abs(reflection_excess(pear, picture.branches[2])).max() < 1e-13
 
@@ -109,7 +109,7 @@ def test_failed_reflection_is_traced_and_recorded(monkeypatch):
     pear, traced = picture.branches[1:]
     assert traced.name == "pear_0_mirror" and traced.origin == Origin.TRACED_REFLECTION_FAILED
     assert traced.reflection_of == "" and traced.stability is not None and traced.rejoins == pear.rejoins == 1
-    np.testing.assert_allclose(traced.pole_values()["lam2_north"], pear.pole_values()["lam2_south"], rtol=1e-9)
+    np.testing.assert_allclose(traced.pole_values()["lam2_top"], pear.pole_values()["lam2_bottom"], rtol=1e-9)
 
 
 def test_every_special_point_of_a_mirror_on_a_map_is_the_reflected_state(picture):

@@ -121,7 +121,7 @@ def test_the_disconnected_pear_branch_is_found_by_continuation_in_the_coil_heigh
     assert broken.origin == Origin.CONTINUED_IN_HEIGHT and broken.gauge == Gauge.HELD and len(broken.X) > 20
     tol = broken.scene.solver
     assert broken.residual.max() <= tol.tol and broken.error_estimate.max() <= tol.max_error
-    assert broken.stopped(StopCode.SOUTH_STOP_STRETCH) and any(s.kind == Kind.LP for s in broken.special)
+    assert broken.stopped(StopCode.BOTTOM_STOP_STRETCH) and any(s.kind == Kind.LP for s in broken.special)
     assert min(distance_to(primary, X, broken.disc) for X in broken.X) > 0.05
     assert "broken pitchfork" not in picture.not_searched and not failing(picture.incomplete)
     path = write_run(tmp_path / "off.h5", primary.scene, picture.branches, snaps=picture.snaps,

@@ -44,7 +44,7 @@ def test_issue30_repro1_a_sweep_never_replaces_a_run_file_without_force(scene, t
     assert str(out) in line and "--force" in line
     assert out.read_bytes() == run_bytes and not store_path(out).exists()
     assert main(sweep_argv(scene, out, "--force")) == 0
-    assert read_sweep(out)["attrs"]["format"] == "balloon-cg-sweep/2"
+    assert read_sweep(out)["attrs"]["format"] == "balloon-cg-sweep/3"
 
 
 def test_a_store_without_its_view_is_refused_by_run_and_resumed_by_its_sweep(scene, tmp_path, capsys):
@@ -116,7 +116,7 @@ def test_a_read_only_folder_names_the_output_not_the_lock(scene, tmp_path, capsy
 def test_sweep_file_over_which_run_writes_with_force_loses_its_store(tmp_path):
     out = tmp_path / "s.h5"
     with h5py.File(out, "w") as f:
-        f.attrs["format"] = "balloon-cg-sweep/2"
+        f.attrs["format"] = "balloon-cg-sweep/3"
     for folder in companions(out):
         folder.mkdir()
     with pytest.raises(FileExistsError, match="a sweep file"):

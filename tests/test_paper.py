@@ -19,7 +19,7 @@ from balloon_cg.post.paper import (ONE_COLUMN, SNAP_READINGS, TWO_COLUMNS, Case,
 from balloon_cg.post.plotting import Reading, load_branches, plot, robust_limits, stable_points
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
-POLE = r"pole stretch $\lambda_2(0)$ (north)"
+POLE = r"pole stretch $\lambda_2(0)$ (top)"
 PRESSURE = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
 THETA = r"material coordinate $\theta$ (rad)"
 EQUATOR_2 = r"equator stretch $\lambda_2(\pi/2)$ (circumferential)"

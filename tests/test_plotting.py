@@ -89,7 +89,7 @@ def test_packaged_default_scenes_match_the_scene_files():
 
 PRESSURE = r"pressure $P = \bar{P}R_0/(T_0\mu/2)$"
 LABELS = {
-    "pressure-pole": (r"pole stretch $\lambda_2(0)$ (north)", PRESSURE),
+    "pressure-pole": (r"pole stretch $\lambda_2(0)$ (top)", PRESSURE),
     "pressure-equator": (r"equator stretch $\lambda_2(\pi/2)$ (circumferential)", PRESSURE),
     "shapes": (r"$\pm\rho/R_0$ (distance from the axis)", r"$\eta/R_0$ (height)"),
     "stresses": (r"material coordinate $\theta$ (rad)", r"$\sigma_\phi$ / ($\mu$/2)"),

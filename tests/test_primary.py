@@ -28,7 +28,7 @@ def branch(request):
 def test_pressure_is_the_exact_sphere_pressure(branch):
     """Relative 1e-10, except next to a branch point of the sphere, where the error in the nearly singular mode
     is rounding (~1e-13 in the residual) divided by the smallest Hessian eigenvalue, and is bounded by that."""
-    stretch = branch.pole_values()["lam2_north"]
+    stretch = branch.pole_values()["lam2_top"]
     assert stretch[0] == pytest.approx(1.005, abs=1e-12) and stretch[-1] == pytest.approx(6.0, abs=1e-12)
     assert stretch.min() == pytest.approx(1.005, abs=1e-12)  # landed on min_stretch, not past it
     exact = sphere_pressure(branch.scene.material, stretch)
@@ -65,7 +65,7 @@ def test_limit_point_is_the_maximum_of_the_exact_pressure(branch):
     assert len(folds) == len(changes)
     for fold, i in zip(folds, changes):
         exact = brentq(slope, grid[i], grid[i + 1], xtol=1e-13)
-        assert branch.pole_values(fold.X)["lam2_north"][0] == pytest.approx(exact, rel=1e-7)
+        assert branch.pole_values(fold.X)["lam2_top"][0] == pytest.approx(exact, rel=1e-7)
         assert fold.X[-1] == pytest.approx(sphere_pressure(material, exact), rel=1e-12)
 
 
@@ -75,6 +75,6 @@ def test_general_mode_matches_the_symmetric_one():
     branch = trace_primary(scene)
     values = branch.pole_values()
     assert not branch.disc.symmetric
-    assert np.abs(values["lam2_north"] - values["lam2_south"]).max() < 1e-10
-    exact = sphere_pressure(scene.material, values["lam2_north"])
+    assert np.abs(values["lam2_top"] - values["lam2_bottom"]).max() < 1e-10
+    exact = sphere_pressure(scene.material, values["lam2_top"])
     assert np.abs(branch.pressure / exact - 1).max() < 1e-10

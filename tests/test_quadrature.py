@@ -33,8 +33,8 @@ def pressure(near_wire, nodes: int) -> float:
     scene, primary, i = near_wire
     disc = Discretisation(DEGREE, True, primary.disc.pin_translation, nodes)
     system = ParameterSystem(Equilibrium(scene, disc), primary.params, "P")
-    row = np.append(disc.pole_rows()["lam2_north"], 0.0)
-    stretch = primary.pole_values()["lam2_north"][i]
+    row = np.append(disc.pole_rows()["lam2_top"], 0.0)
+    stretch = primary.pole_values()["lam2_top"][i]
     result = newton(system.residual, system.jacobian, primary.disc.transfer(primary.X[i], disc), row, stretch,
                     1e-12, 20)
     assert result.converged, result.message

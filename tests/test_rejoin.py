@@ -50,8 +50,8 @@ def test_fold_at_the_rejoin_is_the_branch_point(isola):
     assert (s.kind, s.block, s.status, s.index) == (Kind.BP, Block.ODD_HELD, Status.LOCATED, len(crossed.X) - 2)
     assert s.classification == bp.classification != Classification.NONE
     assert s.X[-1] == bp.X[-1]
-    assert crossed.pole_values(s.X)["lam2_north"][0] == pytest.approx(
-        picture.primary.pole_values(bp.X)["lam2_north"][0], abs=1e-9)
+    assert crossed.pole_values(s.X)["lam2_top"][0] == pytest.approx(
+        picture.primary.pole_values(bp.X)["lam2_top"][0], abs=1e-9)
 
 
 def test_other_fold_candidates_stay_folds(isola):

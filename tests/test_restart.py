@@ -29,7 +29,7 @@ def on_branch(original, X):
     point nearest in (λ2(0), P): past a turning point of λ2(0) two points share it), to compare a restarted point
     with the branch it came from."""
     system, solver = branch_system(original), original.scene.solver
-    north = np.append(original.disc.pole_rows()["lam2_north"], 0.0)
+    north = np.append(original.disc.pole_rows()["lam2_top"], 0.0)
     nearest = original.X[np.argmin(np.hypot(original.X @ north - north @ X, original.X[:, -1] - X[-1]))]
     result = newton(system.residual, system.jacobian, nearest, north, north @ X, solver.tol, solver.max_newton)
     assert result.converged
@@ -286,10 +286,10 @@ def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coi
                       if s["kind"] == "EP"]
     main(["continue", str(run), str(label), "-o", str(out), "--quiet", "--allow-partial"])
     branch = read_run(out)["branches"]["primary"]
-    assert list(branch["attrs"]["leg_stop_codes"]) == ["stop_stretch", "south_stop_stretch"]
-    assert abs(max(branch["lam2_south"]) - 1.7) < 1e-12 and abs(max(branch["lam2_north"]) - 1.7) < 1e-12
+    assert list(branch["attrs"]["leg_stop_codes"]) == ["stop_stretch", "bottom_stop_stretch"]
+    assert abs(max(branch["lam2_bottom"]) - 1.7) < 1e-12 and abs(max(branch["lam2_top"]) - 1.7) < 1e-12
     mirror = read_run(run)["branches"]["pear_0_mirror"]
-    assert abs(branch["pressure"][np.argmax(branch["lam2_south"])] - mirror["pressure"][-1]) < 1e-10
+    assert abs(branch["pressure"][np.argmax(branch["lam2_bottom"])] - mirror["pressure"][-1]) < 1e-10
     # what is not searched on it: its branch points' branches; no "broken pitchfork" in a scene whose coils are
     # mirror-symmetric (the verdict said the pear branch of a broken pitchfork was not traced)
     capsys.readouterr()
@@ -347,8 +347,8 @@ def test_continue_from_the_end_of_a_pear_branch_passes_its_pitchfork_into_the_mi
     pitchfork = next(s for s in stored["primary"]["special_points"] if s["kind"] == "BP" and s["block"] == block)
     assert again["special_points"][1]["pressure"] == pitchfork["pressure"]
     mirror_end = next(s for s in stored[f"{name}_mirror"]["special_points"] if s["kind"] == "EP" and s["index"] > 0)
-    far = max(again["special_points"][::2], key=lambda s: abs(s["lam2_north"] - end["lam2_north"]))
-    for key in ("pressure", "lam2_north", "lam2_south"):
+    far = max(again["special_points"][::2], key=lambda s: abs(s["lam2_top"] - end["lam2_top"]))
+    for key in ("pressure", "lam2_top", "lam2_bottom"):
         assert abs(far[key] - mirror_end[key]) < 1e-10, key
 
 
@@ -512,7 +512,7 @@ def test_a_restart_on_the_isola_ends_where_its_closed_loop_does(spom1_run, isola
     pitchforks = [s["pressure"] for s in stored["primary"]["special_points"] if s["kind"] == "BP"]
     assert branch["special_points"][2]["pressure"] == pitchforks[0]
     for end in branch["special_points"][::4]:  # both ends a step past the second pitchfork, as the run's pear ends
-        assert abs(end["pressure"] - pitchforks[1]) < 1e-4 and abs(end["lam2_north"] - end["lam2_south"]) < 0.05
+        assert abs(end["pressure"] - pitchforks[1]) < 1e-4 and abs(end["lam2_top"] - end["lam2_bottom"]) < 0.05
 
 
 def test_a_restart_that_comes_back_to_its_start_stops_there(spom1_run, isola_restart, tmp_path, capsys):
@@ -536,6 +536,6 @@ def test_a_restart_that_comes_back_to_its_start_stops_there(spom1_run, isola_res
                    if s["kind"] == "TP")
     again = sorted(s["pressure"] for s in branch["special_points"] if s["kind"] == "TP")
     assert np.abs(np.subtract(turns, again)).max() < 1e-8
-    signature = np.column_stack([branch["pressure"], branch["lam2_north"], branch["lam2_south"]])
+    signature = np.column_stack([branch["pressure"], branch["lam2_top"], branch["lam2_bottom"]])
     step = np.abs(np.diff(signature, axis=0)).max()
     assert np.abs(signature[-1] - signature[0]).max() <= 2 * step  # it ends where it began: the loop closed

@@ -6,11 +6,14 @@ import h5py
 import numpy as np
 import pytest
 
+from balloon_cg.analysis.results import StopCode
+from balloon_cg.io.legacy import OLD_NAMES
 from balloon_cg.io.run_file import FORMAT, RunFileError, read_run, write_run
 from balloon_cg.io.schema import VARIABLES
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.post.plotting import plot
 from balloon_cg.scene import parse_scene
+from balloon_cg.scene.events import Quantity
 from netcdf_groups import uncoordinated
 
 xr = pytest.importorskip("xarray")
@@ -85,7 +88,7 @@ def test_volume_is_the_sphere_volume_on_the_primary_branch(run_file):
     """M = 0: the primary branch is the sphere of radius λ, V = 4π λ³/3 (closed form), to the Newton tolerance
     (1e-11 on the unknowns: 9e-12 seen)."""
     primary = read_run(run_file)["branches"]["primary"]
-    assert np.allclose(primary["volume"], 4 * np.pi / 3 * primary["lam2_north"] ** 3, rtol=5e-11, atol=0)
+    assert np.allclose(primary["volume"], 4 * np.pi / 3 * primary["lam2_top"] ** 3, rtol=5e-11, atol=0)
     pear = read_run(run_file)["branches"]["pear_0"]
     assert np.all(np.diff(pear["volume"]) != 0)  # a column per point on every branch
 
@@ -128,7 +131,46 @@ def test_format4_special_points_still_read(run_file, tmp_path):
             branch["special_points"].move("state/unknowns", "unknowns")
             del branch["special_points/state"]
     now, then = read_run(run_file)["branches"], read_run(old)["branches"]
-    assert FORMAT == "balloon-cg/5" and list(now) == list(then)
+    assert FORMAT == "balloon-cg/6" and list(now) == list(then)
     for name in now:
         assert np.array_equal(now[name]["special_unknowns"], then[name]["special_unknowns"])
         assert repr(now[name]["special_points"]) == repr(then[name]["special_points"])  # NaN E2..E4 read alike
+
+
+def _with_old_names(path, fmt: str) -> int:
+    """Rename every dataset of ``path`` to its name before balloon-cg/6 and stamp ``fmt``; the datasets renamed."""
+    new_to_old = {new: old for old, new in OLD_NAMES.items()}
+    with h5py.File(path, "r+") as f:
+        found = []
+        f.visititems(lambda name, item: found.append(name) if isinstance(item, h5py.Dataset)
+                     and name.rsplit("/", 1)[-1] in new_to_old else None)
+        for name in found:
+            head, _, base = name.rpartition("/")
+            f.move(name, f"{head}/{new_to_old[base]}")
+        f.attrs["format"] = fmt
+    return len(found)
+
+
+def test_format5_names_of_the_ends_read_as_top_and_bottom(run_file, tmp_path):
+    """A balloon-cg/5 file names the meridian's ends after the sphere's poles (lam2_north, eta_south, …): it reads
+    as the file it was made from, under today's names, and the file is not written."""
+    old = tmp_path / "format5.h5"
+    old.write_bytes(Path(run_file).read_bytes())
+    assert _with_old_names(old, "balloon-cg/5") >= 8  # the primary's and the pear's columns and special points
+    before = old.read_bytes()
+    now, then = read_run(run_file)["branches"], read_run(old)["branches"]
+    assert old.read_bytes() == before
+    assert list(now) == list(then)
+    for name in now:
+        for key in ("lam2_top", "lam2_bottom", "eta_top", "eta_bottom"):
+            assert np.array_equal(now[name][key], then[name][key])
+            assert [s[key] for s in now[name]["special_points"]] == [s[key] for s in then[name]["special_points"]]
+        assert not {"lam2_north", "lam2_south", "eta_north", "eta_south"} & set(then[name])
+
+
+def test_the_old_names_of_a_stop_and_an_event_still_read():
+    """A stop code and an event quantity stored (or written in a scene) before the ends were named top and bottom."""
+    assert StopCode("south_stop_stretch") is StopCode.BOTTOM_STOP_STRETCH
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[[events]]\nquantity = "lam2_north"\nvalue = 1.5\n'
+                        '[[events]]\nquantity = "lam2_south"\nvalue = 1.6\n', "old")
+    assert [e.quantity for e in scene.events] == [Quantity.LAM2_TOP, Quantity.LAM2_BOTTOM]

@@ -57,7 +57,7 @@ def test_curve_in_C20_satisfies_the_sphere_pear_condition(c20_curve):
         pressure, condition, scale = yeoh_sphere(lam, q)
         assert abs(condition) < 1e-8 * scale
         assert P == pytest.approx(pressure, rel=1e-8)
-    assert np.allclose(curve.pole_values()["lam2_south"], curve.pole_stretch, rtol=1e-10)
+    assert np.allclose(curve.pole_values()["lam2_bottom"], curve.pole_stretch, rtol=1e-10)
 
 
 def test_critical_C20_is_where_the_condition_touches_zero(c20_curve):

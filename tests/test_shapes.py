@@ -198,7 +198,7 @@ def test_spheroid_against_an_independent_shooting(preset, aspect, pole_stretch):
     scene = spheroid_scene(preset, aspect, f"[continuation]\nstop_stretch = {pole_stretch}\n"
                                            "[solver]\nmax_error = 1e-11\n")
     branch = trace_primary(scene, down=False)
-    north = branch.pole_values()["lam2_north"]
+    north = branch.pole_values()["lam2_top"]
     i = int(np.argmin(np.abs(north - pole_stretch)))
     assert north[i] == pytest.approx(pole_stretch, abs=1e-12)
     P = branch.X[i, -1]
@@ -207,10 +207,10 @@ def test_spheroid_against_an_independent_shooting(preset, aspect, pole_stretch):
                     xtol=1e-14, rtol=1e-14)
     assert abs(shot_P - P) <= 1e-10 * P
     assert abs(shot_spheroid(scene.material, aspect, pole_stretch, shot_P)[1] - lam2_equator) <= 1e-10
-    eta_north = branch.pole_values()["eta_north"][i]
-    generated = shoot_symmetric(scene, pole_stretch, P_guess=1.02 * P, eta0_guess=eta_north + 0.01)
+    eta_top = branch.pole_values()["eta_top"][i]
+    generated = shoot_symmetric(scene, pole_stretch, P_guess=1.02 * P, eta0_guess=eta_top + 0.01)
     assert generated.converged
-    assert abs(generated.P - P) <= 1e-10 * P and abs(generated.eta_north - eta_north) <= 1e-10
+    assert abs(generated.P - P) <= 1e-10 * P and abs(generated.eta_top - eta_top) <= 1e-10
 
 
 @pytest.mark.parametrize("table, message", [

@@ -40,7 +40,7 @@ def test_shooting_reproduces_the_sphere_pressure(preset):
         result = shoot_symmetric(scene, lam, P_guess=1.05 * exact, eta0_guess=0.95 * lam)
         assert result.converged, result.message
         assert result.P == pytest.approx(exact, rel=1e-10)
-        assert result.eta_north == pytest.approx(lam, rel=1e-10)
+        assert result.eta_top == pytest.approx(lam, rel=1e-10)
         assert result.lam2_equator == pytest.approx(lam, rel=1e-10)
 
 
@@ -52,7 +52,7 @@ def test_pole_start_and_taylor_start_agree_at_zero_field(lam):
     taylor = shoot_symmetric(scene, lam, start="taylor", eps=1e-4, **guess)
     assert at_pole.converged and taylor.converged
     assert at_pole.P == pytest.approx(taylor.P, rel=1e-9)
-    assert at_pole.eta_north == pytest.approx(taylor.eta_north, rel=1e-9)
+    assert at_pole.eta_top == pytest.approx(taylor.eta_top, rel=1e-9)
 
 
 def test_pole_start_and_taylor_start_agree_with_a_field(two_coils, magnetic):
@@ -60,7 +60,7 @@ def test_pole_start_and_taylor_start_agree_with_a_field(two_coils, magnetic):
         other = shoot_symmetric(two_coils, 1.5, P_guess=2.4, eta0_guess=1.45, start=start, eps=eps)
         assert other.converged
         assert other.P == pytest.approx(magnetic.P, rel=1e-9)
-        assert other.eta_north == pytest.approx(magnetic.eta_north, rel=1e-9)
+        assert other.eta_top == pytest.approx(magnetic.eta_top, rel=1e-9)
         assert other.lam2_equator == pytest.approx(magnetic.lam2_equator, rel=1e-9)
 
 
@@ -76,11 +76,11 @@ def test_galerkin_converges_to_the_shooting_solution(two_coils, magnetic):
         fixed = {"solver.degree": degree, "solver.max_degree": degree, "solver.max_error": 1e-2}
         branch = trace_primary(two_coils.with_overrides(fixed), stop_stretch=1.5)
         poles = branch.pole_values()
-        assert poles["lam2_north"][-1] == pytest.approx(1.5, abs=1e-12)
+        assert poles["lam2_top"][-1] == pytest.approx(1.5, abs=1e-12)
         errors.append(abs(branch.pressure[-1] / magnetic.P - 1))
     assert errors[0] > errors[1] > errors[2]
     assert errors[2] < 1e-9
-    assert poles["eta_north"][-1] == pytest.approx(magnetic.eta_north, rel=1e-9)
+    assert poles["eta_top"][-1] == pytest.approx(magnetic.eta_top, rel=1e-9)
     lam2, _, _, _ = branch.disc.evaluate(branch.X[-1, :-1], np.array([np.pi / 2]))
     assert lam2[0] == pytest.approx(magnetic.lam2_equator, rel=1e-9)
 
@@ -97,12 +97,12 @@ def test_default_settings_are_converged_under_refinement(two_coils, magnetic):
 
 
 def test_general_shooting_matches_the_symmetric_one(two_coils, magnetic):
-    result = shoot_general(two_coils, 1.5, 2.4, 1.45, lam2_south_guess=1.55, eta_south_guess=-1.4)
+    result = shoot_general(two_coils, 1.5, 2.4, 1.45, lam2_bottom_guess=1.55, eta_bottom_guess=-1.4)
     assert result.converged and result.residual < 1e-12
     assert result.P == pytest.approx(magnetic.P, rel=1e-10)
-    assert result.eta_north == pytest.approx(magnetic.eta_north, rel=1e-10)
-    assert result.lam2_south == pytest.approx(1.5, rel=1e-10)
-    assert result.eta_south == pytest.approx(-magnetic.eta_north, rel=1e-10)
+    assert result.eta_top == pytest.approx(magnetic.eta_top, rel=1e-10)
+    assert result.lam2_bottom == pytest.approx(1.5, rel=1e-10)
+    assert result.eta_bottom == pytest.approx(-magnetic.eta_top, rel=1e-10)
 
 
 def test_general_shooting_follows_translated_coils(two_coils, magnetic):
@@ -111,11 +111,11 @@ def test_general_shooting_follows_translated_coils(two_coils, magnetic):
     moved = two_coils.with_overrides({"field.coils[0].height": 1 + shift, "field.coils[1].height": -1 + shift})
     with pytest.raises(ValueError, match="shoot_general"):
         shoot_symmetric(moved, 1.5, 2.4, 1.45)
-    result = shoot_general(moved, 1.5, 2.4, 1.45 + shift, lam2_south_guess=1.55, eta_south_guess=-1.4 + shift)
+    result = shoot_general(moved, 1.5, 2.4, 1.45 + shift, lam2_bottom_guess=1.55, eta_bottom_guess=-1.4 + shift)
     assert result.converged
     assert result.P == pytest.approx(magnetic.P, rel=1e-10)
-    assert result.eta_north == pytest.approx(magnetic.eta_north + shift, rel=1e-10)
-    assert result.eta_south == pytest.approx(-magnetic.eta_north + shift, rel=1e-10)
+    assert result.eta_top == pytest.approx(magnetic.eta_top + shift, rel=1e-10)
+    assert result.eta_bottom == pytest.approx(-magnetic.eta_top + shift, rel=1e-10)
 
 
 def test_general_shooting_at_zero_field_pins_the_translation():
@@ -123,9 +123,9 @@ def test_general_shooting_at_zero_field_pins_the_translation():
     scene = sphere_scene("SPOM1")
     lam, eta0 = 2.0, 0.3 + 2.0
     exact = sphere_pressure(scene.material, lam)
-    result = shoot_general(scene, lam, 1.02 * exact, eta0, lam2_south_guess=1.05 * lam, eta_south_guess=-1.6)
+    result = shoot_general(scene, lam, 1.02 * exact, eta0, lam2_bottom_guess=1.05 * lam, eta_bottom_guess=-1.6)
     assert result.converged
     assert result.P == pytest.approx(exact, rel=1e-10)
-    assert result.eta_north == eta0
-    assert result.lam2_south == pytest.approx(lam, rel=1e-10)
-    assert result.eta_south == pytest.approx(eta0 - 2 * lam, rel=1e-10)
+    assert result.eta_top == eta0
+    assert result.lam2_bottom == pytest.approx(lam, rel=1e-10)
+    assert result.eta_bottom == pytest.approx(eta0 - 2 * lam, rel=1e-10)

@@ -58,7 +58,7 @@ def test_round_trip(run_file, scene, branch):
     run = read_run(run_file)
     attrs = run["attrs"]
     assert run["scene_name"] == scene.name == attrs["scene_name"]
-    assert attrs["format"] == "balloon-cg/5"
+    assert attrs["format"] == "balloon-cg/6"
     assert attrs["scene_toml"] == scene.text
     assert attrs["package_version"] == balloon_cg.__version__
     assert attrs["generated_digest"] == generated_digest()
@@ -95,7 +95,7 @@ def test_round_trip(run_file, scene, branch):
         assert stored["index"] == sp.index and stored["stop_code"] == (sp.stop.code.value if sp.stop else "")
         assert stored["note"] == (sp.stop.message if sp.stop else sp.note)
         assert stored["pressure"] == sp.X[-1]
-        assert stored["lam2_north"] == pytest.approx(branch.pole_values(sp.X)["lam2_north"][0], rel=1e-15)
+        assert stored["lam2_top"] == pytest.approx(branch.pole_values(sp.X)["lam2_top"][0], rel=1e-15)
     np.testing.assert_array_equal(b["special_unknowns"], [sp.X for sp in branch.special])
 
 
@@ -105,7 +105,7 @@ def test_sphere_profiles(request, scene, which):
     branch = request.getfixturevalue(which)
     theta = theta_grid(scene.output.theta_points)
     shape = profiles(branch.disc, branch.X, theta)
-    lam = branch.pole_values()["lam2_north"][:, None]
+    lam = branch.pole_values()["lam2_top"][:, None]
     np.testing.assert_allclose(shape["rho"] ** 2 + shape["eta"] ** 2, lam**2 * np.ones_like(theta), rtol=0, atol=1e-10)
     np.testing.assert_allclose(shape["lam1"], lam * np.ones_like(theta), rtol=0, atol=1e-10)
     np.testing.assert_allclose(shape["lam2"], lam * np.ones_like(theta), rtol=0, atol=1e-10)

@@ -210,7 +210,7 @@ def test_primary_branch_states_are_equilibria_with_a_field(two_coil_picture):
         assert np.abs(eq.residual(c, params)).max() <= 1e-10
         system = SurfaceSystem(eq, Gauge(basis, held=True, field_symmetry=FieldSymmetry.AXIAL), params)
         row, offset = axial_stretch_row(basis)
-        stretch = branch.pole_values(X)["lam2_north"][0]
+        stretch = branch.pole_values(X)["lam2_top"][0]
         result = newton(system.residual, system.jacobian, system.point(c, params.P * 1.01),
                         np.append(system.gauge.reduce(row), 0.0), stretch - offset, 1e-13, 30)
         assert result.converged
@@ -262,7 +262,7 @@ def test_measures_of_a_shifted_ellipsoid():
     assert m["volume"] == pytest.approx(4 / 3 * np.pi * 1.5 * 1.2 / (2 * np.pi), rel=1e-13)
     assert np.allclose(m["centroid"], [0.1, 0, 0], atol=1e-13)
     assert m["tilt"] == pytest.approx(90.0, abs=1e-9)
-    assert m["lam_north"] == pytest.approx(np.sqrt(1.5 * 1.2), rel=1e-13)
+    assert m["lam_top"] == pytest.approx(np.sqrt(1.5 * 1.2), rel=1e-13)
 
 
 @pytest.fixture(scope="module")
@@ -289,7 +289,7 @@ def turned_pear(poles, pears, shoot=False):
 
     def distance(b):
         ends = b.pole_values()
-        return np.abs(ends["lam2_north"] - poles[0]) + np.abs(ends["lam2_south"] - poles[1])
+        return np.abs(ends["lam2_top"] - poles[0]) + np.abs(ends["lam2_bottom"] - poles[1])
 
     pear = min(pears, key=lambda b: distance(b).min())
     nearest = int(np.argmin(distance(pear)))
@@ -298,11 +298,11 @@ def turned_pear(poles, pears, shoot=False):
     assert result.converged, (poles, result.message)
     rows, u = eq.disc.pole_rows(), result.x[:-1]
     if not shoot:
-        return result.x[-1], rows["lam2_south"] @ u
-    shot = shoot_general(pear.scene, poles[0], result.x[-1], rows["eta_north"] @ u, rows["lam2_south"] @ u,
-                         rows["eta_south"] @ u, tol=1e-13, max_iter=30)
+        return result.x[-1], rows["lam2_bottom"] @ u
+    shot = shoot_general(pear.scene, poles[0], result.x[-1], rows["eta_top"] @ u, rows["lam2_bottom"] @ u,
+                         rows["eta_bottom"] @ u, tol=1e-13, max_iter=30)
     assert shot.converged, (poles, shot.message)
-    return shot.P, shot.lam2_south
+    return shot.P, shot.lam2_bottom
 
 
 def test_m1_branch_at_M0_is_the_pear_branch_turned_by_90_degrees(spom1_picture):

@@ -167,7 +167,7 @@ def test_the_turned_scene_branches_at_the_pear_point_onto_the_pear_branch_turned
     assert mirror is not None and mirror.origin == Origin.REFLECTED and mirror.name == branch.name + "_mirror"
     assert np.abs(mirror.coefficients - branch.coefficients * signs).max() < 1e-12 * np.abs(branch.coefficients).max()
     assert np.allclose(mirror.measures["centroid"], -branch.measures["centroid"], rtol=0, atol=1e-15)
-    assert np.array_equal(mirror.measures["lam_north"], branch.measures["lam_south"])
+    assert np.array_equal(mirror.measures["lam_top"], branch.measures["lam_bottom"])
 
 
 @pytest.mark.slow

@@ -88,8 +88,8 @@ def test_round_trip_is_bit_exact(run_path, surface_branch, basis):
     assert d["attrs"]["gauge"] == b.gauge.value  # the reading (issue 27)
     assert np.array_equal(d["coefficients"], b.coefficients)
     assert np.array_equal(d["pressure"], b.values)
-    assert np.array_equal(d["lam2_north"], b.measures["lam_north"])
-    assert np.array_equal(d["lam2_south"], b.measures["lam_south"])
+    assert np.array_equal(d["lam2_top"], b.measures["lam_top"])
+    assert np.array_equal(d["lam2_bottom"], b.measures["lam_bottom"])
     assert np.array_equal(d["volume"], 2 * np.pi * b.measures["volume"])  # V / R0³ like every branch
     assert np.allclose(d["volume"], 4 * np.pi / 3 * STRETCHES ** 3, rtol=1e-12)
     assert np.array_equal(d["centroid"], b.measures["centroid"]) and d["centroid"].shape == (5, 3)
@@ -111,8 +111,8 @@ def test_round_trip_is_bit_exact(run_path, surface_branch, basis):
     assert [s["kind"] for s in special] == ["BP", "EP"] and special[0]["m"] == 1
     assert special[1]["stop_code"] == "stop_stretch"
     assert np.array_equal(d["special_unknowns"], np.array([s.X for s in b.special]))
-    assert np.allclose([s["lam2_north"] for s in special], STRETCHES[[0, -1]], rtol=1e-13)
-    assert np.allclose([s["eta_south"] for s in special], -STRETCHES[[0, -1]], rtol=1e-13)
+    assert np.allclose([s["lam2_top"] for s in special], STRETCHES[[0, -1]], rtol=1e-13)
+    assert np.allclose([s["eta_bottom"] for s in special], -STRETCHES[[0, -1]], rtol=1e-13)
 
 
 def test_a_mapped_order_capped_basis_is_rebuilt(tmp_path, scene, primary, surface_branch):
@@ -191,7 +191,7 @@ def test_every_kind_draws_a_file_with_a_surface_branch(run_path, kind):
         color = legend[name].get_color()
         drawn = [line.get_xdata() for line in axes[0].lines if line.get_color() == color
                  and len(line.get_xdata()) > 1 and line.get_gid() != GID]  # not the labels' leader lines
-        assert np.allclose(np.unique(np.concatenate(drawn).round(12)), STRETCHES)  # P against lam2_north
+        assert np.allclose(np.unique(np.concatenate(drawn).round(12)), STRETCHES)  # P against lam2_top
     elif kind == "energy":  # the normal form at the branch point the surface branch is born at
         labels = [t.get_text() for t in fig.legends[0].get_texts()]  # under the panel, not over the curves
         assert len(labels) == 1 and labels[0].startswith("m = 1: pitchfork-sub m=1 at P = ")

@@ -40,7 +40,7 @@ def assert_same_members(a: dict, b: dict):
         assert list(ma["branches"]) == list(mb["branches"])
         for name, ba in ma["branches"].items():
             bb = mb["branches"][name]
-            for key in ("unknowns", "pressure", "lam2_north", "residual", "error_estimate"):
+            for key in ("unknowns", "pressure", "lam2_top", "residual", "error_estimate"):
                 np.testing.assert_allclose(ba[key], bb[key], rtol=1e-12, atol=1e-14, err_msg=f"{index}/{name}/{key}")
             np.testing.assert_allclose(ba["profiles"]["rho"], bb["profiles"]["rho"], rtol=1e-12, atol=1e-14)
             assert [s["kind"] for s in ba["special_points"]] == [s["kind"] for s in bb["special_points"]]

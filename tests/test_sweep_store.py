@@ -31,7 +31,7 @@ def done(tmp_path) -> Path:
 def test_members_are_files_and_the_view_is_rebuilt_from_them(done):
     assert sorted(p.name for p in store_path(done).iterdir()) == ["000000.h5", "000001.h5", "sweep.h5"]
     view = read_sweep(done)
-    assert sorted(view["members"]) == [0, 1] and view["attrs"]["format"] == "balloon-cg-sweep/2"
+    assert sorted(view["members"]) == [0, 1] and view["attrs"]["format"] == "balloon-cg-sweep/3"
     done.unlink()  # the view is never the only copy: a resume rebuilds it without computing
     again = run_sweep(SCENE, SPECS, done, mode=MODE, workers=1)
     assert again.computed == [] and again.skipped == [0, 1] and sorted(read_sweep(done)["members"]) == [0, 1]
@@ -95,7 +95,7 @@ def test_single_file_sweep_of_format_1_reads_and_resumes(done):
     assert sorted(read_sweep(done)["members"]) == [0]
     result = run_sweep(SCENE, SPECS, done, mode=MODE, workers=1)
     assert result.skipped == [0] and result.computed == [1]
-    assert read_sweep(done)["attrs"]["format"] == "balloon-cg-sweep/2"
+    assert read_sweep(done)["attrs"]["format"] == "balloon-cg-sweep/3"
 
 
 def test_a_damaged_single_file_sweep_is_one_line(tmp_path, capsys):

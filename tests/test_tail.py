@@ -24,7 +24,7 @@ def landed():
     scene = load_scene(SCENE).with_overrides({"continuation.stop_stretch": STRETCH})
     branch = trace_primary(scene, down=False)
     X = branch.X[-1]
-    eta0 = float(branch.disc.pole_rows()["eta_north"] @ X[:-1])
+    eta0 = float(branch.disc.pole_rows()["eta_top"] @ X[:-1])
     shot = shoot_symmetric(scene, STRETCH, X[-1], eta0, tol=1e-13)
     assert shot.converged
     return scene, branch, X, shot.P
@@ -38,7 +38,7 @@ def test_tail_estimate_tracks_the_true_error(landed, degree):
     X0 = fine.transfer(X, disc)
     eq = Equilibrium(scene, disc)
     system = ParameterSystem(eq, branch.params, "P")
-    row = np.append(disc.pole_rows()["lam2_north"], 0.0)
+    row = np.append(disc.pole_rows()["lam2_top"], 0.0)
     result = newton(system.residual, system.jacobian, X0, row, STRETCH, 1e-13, 30)
     assert result.converged
     error = abs(result.x[-1] / P_ref - 1)

@@ -106,7 +106,7 @@ def test_the_curve_in_M_turns_at_a_fold_and_ends_at_the_field_free_spheres(tunin
     assert np.all(data["pressure"] == data["pressure"][0]) and abs(data["pressure"][0] - P0) < 1e-9
     folds = [s for s in data["special_points"] if s["kind"] == "LP"]
     assert len(folds) == 1 and folds[0]["status"] == "located" and folds[0]["M"] > 0.005
-    np.testing.assert_allclose(sorted(data["lam2_north"][[0, -1]]), sphere_stretches(), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(sorted(data["lam2_top"][[0, -1]]), sphere_stretches(), rtol=0, atol=1e-9)
 
 
 def test_at_M_zero_the_frequencies_are_the_field_free_spheres(tuning):
@@ -118,7 +118,7 @@ def test_at_M_zero_the_frequencies_are_the_field_free_spheres(tuning):
     _, curve = tuning
     data = curve.branches["primary"].data
     for end in (0, -1):
-        lam = float(data["lam2_north"][end])
+        lam = float(data["lam2_top"][end])
         forms = np.concatenate([[float(breathing("SPOM1", lam, P0)[0])]]
                                + [spheroidal("SPOM1", lam, P0, n) for n in range(1, 9)]
                                + [[toroidal("SPOM1", lam, P0, n) for n in range(2, 9)]])
@@ -233,7 +233,7 @@ def test_a_curve_in_the_voltage_holds_the_breathing_mode_of_each_sphere(tmp_path
     data = bc.load(curve).branches["primary"].data
     assert data["attrs"]["parameter"] == "voltage"
     assert sorted(data["attrs"]["leg_stop_codes"]) == ["stop_stretch", "zero_voltage"]
-    lam, voltage = data["lam2_north"], data["voltage"]
+    lam, voltage = data["lam2_top"], data["voltage"]
     assert np.abs(4 * (1 / lam - lam ** -7) - 4 * voltage ** 2 * lam - 1.0).max() <= 1e-10
     breathing_mode = lam ** 2 * (-4 * lam ** -2 + 28 * lam ** -8 - 4 * voltage ** 2) / 2
     assert np.abs(data["frequencies"]["even"] - breathing_mode[:, None]).min(axis=1).max() <= 1e-9

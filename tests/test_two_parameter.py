@@ -62,7 +62,7 @@ def test_curve_joins_the_two_pitchforks(curve, located):
     assert curve.stop.code == StopCode.PARTNER and curve.end == CurveEnd.ISOLA_MERGE
     assert curve.merge is curve.merges[0] and curve.merges[0].status == Status.LOCATED
     assert np.all(curve.pressure > 0)
-    upper = branch.pole_values(bps[1].X)["lam2_north"][0]
+    upper = branch.pole_values(bps[1].X)["lam2_top"][0]
     assert curve.pole_stretch[-1] > 0.9 * upper and curve.q[-1] < 1.5
 
 
@@ -94,11 +94,11 @@ def test_curve_round_trips_through_hdf5(curve, located, tmp_path):
     data = read_curve(path)
     np.testing.assert_array_equal(data["q"], curve.q)
     np.testing.assert_array_equal(data["pressure"], curve.pressure)
-    np.testing.assert_array_equal(data["lam2_north"], curve.pole_stretch)
+    np.testing.assert_array_equal(data["lam2_top"], curve.pole_stretch)
     special = data["special_points"]
     assert [s["kind"] for s in special] == ["LP"] and data["attrs"]["stop_code"] == "partner"
     assert data["special_q"][0] == curve.critical[0] == data["attrs"]["critical_q"]
-    assert special[0]["lam2_north"] == pytest.approx(curve.critical[2], rel=1e-14)
+    assert special[0]["lam2_top"] == pytest.approx(curve.critical[2], rel=1e-14)
     assert data["attrs"]["parameter"] == "alpha1" and data["attrs"]["end"] == "isola_merge"
     assert special[0]["status"] == "located" and "merge" in data["attrs"]["end_description"]
     assert read_run(path)["branches"] == {}  # also a readable run file (provenance attributes)

@@ -69,11 +69,11 @@ def test_pear_branches_end_on_the_requested_stretch():
     pears = {b.name: b for b in picture.branches if b.parent}
     assert set(pears) == {"pear_0", "pear_0_mirror"}
     north, south = pears["pear_0"].pole_values(), pears["pear_0_mirror"].pole_values()
-    assert north["lam2_north"][-1] == pytest.approx(5.0, abs=1e-12)
-    assert south["lam2_south"][-1] == pytest.approx(5.0, abs=1e-12)
+    assert north["lam2_top"][-1] == pytest.approx(5.0, abs=1e-12)
+    assert south["lam2_bottom"][-1] == pytest.approx(5.0, abs=1e-12)
     for branch in pears.values():
         assert all(s.index < len(branch.X) for s in branch.special)
-        pole = "lam2_north" if branch.name == "pear_0" else "lam2_south"
+        pole = "lam2_top" if branch.name == "pear_0" else "lam2_bottom"
         assert all(branch.pole_values(s.X)[pole][0] <= 5.0 + 1e-12 for s in branch.special)
 
 
@@ -139,7 +139,7 @@ def test_near_undeformed_leg_with_a_field_reaches_min_stretch():
         {"surface.branches": "none"})
     branch = trace_primary(scene)
     assert [leg.stop.code for leg in branch.legs] == [StopCode.WIRE_GAP, StopCode.MIN_STRETCH]
-    assert branch.pole_values()["lam2_north"][0] == pytest.approx(scene.continuation.min_stretch, abs=1e-12)
+    assert branch.pole_values()["lam2_top"][0] == pytest.approx(scene.continuation.min_stretch, abs=1e-12)
     assert branch.degree.max() < scene.solver.max_degree and branch.disc.mapping is not None
     assert branch.error_estimate.max() <= scene.solver.max_error
 

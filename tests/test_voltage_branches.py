@@ -52,7 +52,7 @@ def fixed_voltage_scene(voltage, name="fixed", field=""):
 
 
 def stretch(branch, X) -> float:
-    return float(branch.pole_values(X)["lam2_north"][0])
+    return float(branch.pole_values(X)["lam2_top"][0])
 
 
 @pytest.fixture(scope="module")
@@ -125,13 +125,13 @@ def test_the_pear_branch_is_traced_in_the_voltage_at_fixed_pressure(voltage_pict
     pear = trace_pear(short, voltage_picture.branch_points[0], 1.0, "pear_0")
     assert pear.parameter == "voltage" and np.all(pear.pressure == PRESSURE)
     poles = pear.pole_values()
-    asymmetry = poles["lam2_north"] - poles["lam2_south"]
+    asymmetry = poles["lam2_top"] - poles["lam2_bottom"]
     assert abs(pear.X[0, -1] - voltage_picture.branch_points[0].X[-1]) < 1e-4 and abs(asymmetry[-1]) > 0.01
     k = len(pear.X) - 1
-    shot = shoot_general(fixed_voltage_scene(float(pear.X[k, -1]), "shot"), poles["lam2_north"][k], PRESSURE,
-                         poles["eta_north"][k], poles["lam2_south"][k], poles["eta_south"][k])
+    shot = shoot_general(fixed_voltage_scene(float(pear.X[k, -1]), "shot"), poles["lam2_top"][k], PRESSURE,
+                         poles["eta_top"][k], poles["lam2_bottom"][k], poles["eta_bottom"][k])
     assert shot.converged
-    assert abs(shot.P - PRESSURE) < 1e-8 and abs(shot.lam2_south - poles["lam2_south"][k]) < 1e-8
+    assert abs(shot.P - PRESSURE) < 1e-8 and abs(shot.lam2_bottom - poles["lam2_bottom"][k]) < 1e-8
 
 
 def curve_pieces(ax) -> list:
@@ -149,15 +149,15 @@ def test_voltage_pole_draws_the_stored_voltage_and_stability(voltage_file):
     pieces = curve_pieces(ax)
     x = np.concatenate([pieces[0].get_xdata()] + [line.get_xdata()[1:] for line in pieces[1:]])
     y = np.concatenate([pieces[0].get_ydata()] + [line.get_ydata()[1:] for line in pieces[1:]])
-    np.testing.assert_array_equal(x, data["lam2_north"])
+    np.testing.assert_array_equal(x, data["lam2_top"])
     np.testing.assert_array_equal(y, data["voltage"])
     stable = data["stability"]["stable_pressure"]
     assert stable.any() and not stable.all()
     for line in pieces:
-        first = int(np.flatnonzero(data["lam2_north"] == line.get_xdata()[0])[0])
+        first = int(np.flatnonzero(data["lam2_top"] == line.get_xdata()[0])[0])
         assert line.get_linestyle() == ("-" if stable[first] else "--")
     markers = [(line.get_xdata()[0], line.get_ydata()[0]) for line in ax.get_lines() if len(line.get_xdata()) == 1]
-    assert markers == [(s["lam2_north"], s["voltage"]) for s in data["special_points"]]
+    assert markers == [(s["lam2_top"], s["voltage"]) for s in data["special_points"]]
     kinds = {t.get_text().partition(" ")[2] for t in ax.texts}  # "2 LP": the label, then what it is
     assert {"LP", "pitchfork-super", "transcritical", "pitchfork-sub"} <= kinds
     assert "voltage control at fixed P" in ax.get_legend().get_title().get_text()

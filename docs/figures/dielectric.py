@@ -28,10 +28,10 @@ def main(out=Path(__file__).parent.parent / "dielectric.png"):
         scene = parse_scene(NEO + f"[electric]\nvoltage = {voltage}\n[continuation]\nstart_stretch = 1.15\n"
                             "stop_stretch = 4.0\n[stability]\nm_max = 0\n", name=f"voltage{voltage}")
         branch = analyse(scene, pear=False).primary
-        lam = branch.pole_values()["lam2_north"]
+        lam = branch.pole_values()["lam2_top"]
         line, = left.plot(lam, branch.pressure, label=rf"$\bar\Phi$ = {voltage:g}")
         for s in branch.special:
-            stretch = branch.pole_values(s.X)["lam2_north"][0]
+            stretch = branch.pole_values(s.X)["lam2_top"][0]
             if s.kind == Kind.LP:
                 left.plot(stretch, s.X[-1], "o", color=line.get_color(), ms=4)
             elif s.kind == Kind.BP and s.block == Block.ODD_HELD:
@@ -44,14 +44,14 @@ def main(out=Path(__file__).parent.parent / "dielectric.png"):
 
     scene = parse_scene(NEO + '[electric]\n[continuation]\nparameter = "voltage"\nstop_stretch = 4.0\n', name="P0")
     branch = analyse(scene).primary
-    lam = branch.pole_values()["lam2_north"]
+    lam = branch.pole_values()["lam2_top"]
     stable = np.array([a.stable_pressure for a in branch.stability])
     right.plot(lam[stable], branch.voltage[stable], "C0-", label=r"stable (fixed P, $\bar\Phi$)")
     right.plot(lam[~stable], branch.voltage[~stable], "C0--", label="unstable")
     grid = np.linspace(1.001, 4, 400)
     right.plot(grid, np.sqrt(grid**-2 - grid**-8), "k:", lw=0.8, label=r"$\bar\Phi^2 = \lambda^{-2} - \lambda^{-8}$")
     fold = next(s for s in branch.special if s.kind == Kind.LP)
-    stretch = branch.pole_values(fold.X)["lam2_north"][0]
+    stretch = branch.pole_values(fold.X)["lam2_top"][0]
     right.plot(stretch, fold.X[-1], "ro")
     right.annotate(f"pull-in λ = {stretch:.6f}\n" + rf"$\bar\Phi$ = {fold.X[-1]:.6f}", (stretch, fold.X[-1]),
                    (2.0, 0.58), fontsize=8, arrowprops={"arrowstyle": "->"})

@@ -450,24 +450,24 @@ def pear_pair(scene, primary: Branch, picture: Picture, n: int, progress: Progre
     points = picture.branch_points if points is None else points
     bp, reflect = points[n], mirror.reflectable(scene)
     prefix = PEAR_NAMES[bp.block] if prefix is None else prefix
-    pear, south_turns = None, []
+    pear, bottom_turns = None, []
     for sign, suffix in ((1.0, ""), (-1.0, MIRROR)):
         if interrupt.requested():
             return False
         name = f"{prefix}_{n}{suffix}"
         origin = Origin.TRACED
         if sign < 0 and pear is not None:
-            reflected = mirror.reflection(pear, south_turns, name)
+            reflected = mirror.reflection(pear, bottom_turns, name)
             if isinstance(reflected, Branch):  # parent, rejoin and assessments are the pear's, reflected
                 picture.branches.append(reflected)
                 continue
             origin = reflected
-        branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR), south_turns=reflect)
+        branch = trace_pear(primary, bp, sign, name, progress.ticker(Phase.PEAR), bottom_turns=reflect)
         if branch is None:
             picture.not_started.append((name, f"the first correction from branch point {n} of {primary.name} "
                                               "along its mode did not converge"))
             continue
-        south_turns = mirror.take_south_turns(branch)
+        bottom_turns = mirror.take_bottom_turns(branch)
         branch.origin = origin
         branch.parent = (primary.name, n)
         branch.rejoins = _rejoin_point(branch, points, n)

@@ -127,8 +127,8 @@ class Status(enum.StrEnum):
 class StopCode(enum.StrEnum):
     """Why a leg of a branch (or a two-parameter curve) stopped, besides the engine's ``TraceStop``."""
 
-    STOP_STRETCH = "stop_stretch"  # the north pole stretch reached continuation.stop_stretch
-    MIN_STRETCH = "min_stretch"  # the north pole stretch reached continuation.min_stretch
+    STOP_STRETCH = "stop_stretch"  # the top pole stretch reached continuation.stop_stretch
+    MIN_STRETCH = "min_stretch"  # the top pole stretch reached continuation.min_stretch
     STOP_PRESSURE = "stop_pressure"  # P reached continuation.stop_pressure
     STOP_VOLUME = "stop_volume"  # V reached loading.stop_volume (volume control)
     STOP_AMOUNT = "stop_amount"  # the gas amount n = P V reached loading.stop_amount (gas control)
@@ -138,7 +138,7 @@ class StopCode(enum.StrEnum):
     ZERO_FIELD = "zero_field"  # M fell to 0 (a continuation in M reached the field-free balloon)
     COMPRESSED = "compressed"  # a principal stress (elastic + dielectric) became negative
     WIRE_GAP = "wire_gap"  # the membrane came within continuation.wire_gap of a coil wire
-    SOUTH_STOP_STRETCH = "south_stop_stretch"  # a pear branch's south pole stretch reached stop_stretch
+    BOTTOM_STOP_STRETCH = "bottom_stop_stretch"  # a pear branch's bottom pole stretch reached stop_stretch
     REJOINED = "rejoined"  # a pear branch crossed back through the primary branch
     CLOSED = "closed"  # a restarted branch came back to the point it was restarted from: a closed loop, traced once
     RESOLUTION = "resolution"  # the spectral error estimate exceeds max_error (the tracer refines)
@@ -148,6 +148,11 @@ class StopCode(enum.StrEnum):
     LANDING_FAILED = "landing_failed"  # Newton failed landing exactly on stop/min_stretch
     PARTNER = "partner"  # a two-parameter curve returned past its start value (reached the partner point)
     NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # a two-parameter curve's branch-point pressure reached 0
+
+    @classmethod
+    def _missing_(cls, value):
+        """The code of files before balloon-cg/6 (io/legacy.py): ``south_stop_stretch``."""
+        return cls.BOTTOM_STOP_STRETCH if value == "south_stop_stretch" else None
     ALPHA1_ZERO = "alpha1_zero"  # the α1 continuation reached α1 = 0
     INTERRUPTED = "interrupted"  # SIGINT/SIGTERM asked the computation to stop (numerics.interrupt)
 
@@ -199,7 +204,7 @@ class SpecialPoint:
 def bracket_uncertainty(disc, before, after) -> float:
     """Half the max-norm distance in (P, north pole stretch λ2(0)) between two points X = (u, P) bracketing a
     special point on ``disc``."""
-    north = disc.pole_rows()["lam2_north"]
+    north = disc.pole_rows()["lam2_top"]
     return 0.5 * max(abs(after[-1] - before[-1]), abs(north @ (after[:-1] - before[:-1])))
 
 

@@ -28,7 +28,7 @@ REQUESTED_STOPS = frozenset({StopCode.STOP_STRETCH, StopCode.MIN_STRETCH, StopCo
                              StopCode.STOP_VOLUME, StopCode.STOP_AMOUNT, StopCode.STOP_VOLTAGE, StopCode.ZERO_VOLTAGE,
                              StopCode.STOP_FIELD, StopCode.ZERO_FIELD,
                              StopCode.COMPRESSED, StopCode.WIRE_GAP,
-                             StopCode.SOUTH_STOP_STRETCH, StopCode.REJOINED, StopCode.CLOSED})
+                             StopCode.BOTTOM_STOP_STRETCH, StopCode.REJOINED, StopCode.CLOSED})
 
 
 # where a non-axisymmetric branch may end short without failing: the caps of the whole-sphere basis (its points up to

@@ -117,7 +117,7 @@ class BranchData:
             branch, m, points, P min, P max, λ2(0) min, λ2(0) max, the kinds of its special points, its parent
             branch and the label of the point it leaves from.
         """
-        P, north = self.data["pressure"], self.data["lam2_north"]
+        P, north = self.data["pressure"], self.data["lam2_top"]
         parent = self.parent
         return {"branch": self.name, "m": self.m, "points": len(self), "P min": P.min(), "P max": P.max(),
                 "λ2(0) min": north.min(), "λ2(0) max": north.max(),
@@ -125,7 +125,7 @@ class BranchData:
                 "parent": f"{parent[0]}, from label {self.born_at}" if self.born_at is not None else ""}
 
     def __repr__(self):
-        P, north, special = self.data["pressure"], self.data["lam2_north"], len(self.data["special_points"])
+        P, north, special = self.data["pressure"], self.data["lam2_top"], len(self.data["special_points"])
         return (f"BranchData({self.name!r}, {counted(len(self), 'point')}, P {P.min():.4g}..{P.max():.4g}, "
                 f"λ2(0) {north.min():.4g}..{north.max():.4g}, {counted(special, 'special point')})")
 

@@ -444,7 +444,7 @@ def solve(args) -> int:
         scene = scene.with_overrides({"continuation.start_stretch": (1 + x) / 2, "continuation.min_stretch": None})
     branch = trace_primary(scene, stop_stretch=x, down=False)
     if branch.legs[0].stop.code != StopCode.STOP_STRETCH:
-        reached = branch.pole_values()["lam2_north"].max()
+        reached = branch.pole_values()["lam2_top"].max()
         raise Failure(
             f"the primary branch did not reach north pole stretch {x:g} ({branch.stop_reason}); "
             f"largest stretch reached: {reached:.10g}"

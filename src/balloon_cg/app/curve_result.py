@@ -15,7 +15,7 @@ from ..io.curve_file import read_curve
 from ..io.layout import reading
 from .tables import html_table, optional
 
-COLUMNS = ("pressure", "lam2_north", "lam2_south", "newton_iterations", "residual")
+COLUMNS = ("pressure", "lam2_top", "lam2_bottom", "newton_iterations", "residual")
 
 
 @dataclass(frozen=True, repr=False)
@@ -54,7 +54,7 @@ class CurveResult:
         -------
         pandas.DataFrame
             One row per point of every curve: ``curve``, the parameter under its own name (``M``, ``alpha1``,
-            …), pressure, lam2_north, lam2_south, newton_iterations, residual.
+            …), pressure, lam2_top, lam2_bottom, newton_iterations, residual.
         """
         pd = optional("pandas", "to_dataframe")
         frames = [pd.DataFrame({"curve": name, c["attrs"]["parameter"]: c["q"]} | {k: c[k] for k in COLUMNS})

@@ -226,7 +226,7 @@ def closing_rule(disc, X0, base):
     more than AWAY_STEPS chords away. Elsewhere ``base``."""
     def signature(disc, X):
         rows = disc.pole_rows()
-        return np.array([rows[name] @ X[:-1] for name in ("lam2_north", "lam2_south", "eta_north", "eta_south")]
+        return np.array([rows[name] @ X[:-1] for name in ("lam2_top", "lam2_bottom", "eta_top", "eta_bottom")]
                         + [X[-1]])
 
     origin = signature(disc, X0)
@@ -263,7 +263,7 @@ def rejoin_rule(start: Labelled, base):
 
     def stop(disc, point):
         rows = disc.pole_rows()
-        amplitude = float((rows["lam2_north"] - rows["lam2_south"]) @ point.X[:-1])
+        amplitude = float((rows["lam2_top"] - rows["lam2_bottom"]) @ point.X[:-1])
         before, state["amplitude"] = state["amplitude"], amplitude
         if before is not None and before * amplitude < 0:
             n = min(pitchforks, key=lambda item: abs(item[1] - point.X[-1]))[0]

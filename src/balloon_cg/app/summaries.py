@@ -98,7 +98,7 @@ def format_curves(summary: dict) -> str:
                   f"  critical value       {critical:.12g}" if np.isfinite(critical) else
                   "  critical value       none (the curve did not end in a verified merge or cusp)",
                   *(f"  {m['kind']} meeting        {c['parameter']} = {m['q']:.12g}, P = {m['pressure']:.10g} "
-                    f"(pole stretch {m['lam2_north']:.10g}), {m['status']}" +
+                    f"(pole stretch {m['lam2_top']:.10g}), {m['status']}" +
                     (f" ±{m['uncertainty']:.1g}" if m["status"] != "located" else "") for m in c["meetings"]),
                   f"  wall time            {c['wall_time']:.3f} s"]
     return "\n".join(lines)
@@ -140,8 +140,8 @@ def summarise_branch(b: dict) -> dict:
         "m": 0,
         "points": n,
         "pressure": _range(b["pressure"]),
-        "lam2_north": _range(b["lam2_north"]),
-        "lam2_south": _range(b["lam2_south"]),
+        "lam2_top": _range(b["lam2_top"]),
+        "lam2_bottom": _range(b["lam2_bottom"]),
         "special_points": b["special_points"],
         "stop_reason": attrs["stop_reason"],
         "stop_codes": dict(zip(attrs.get("leg_labels", []), attrs.get("leg_stop_codes", []))),
@@ -192,8 +192,8 @@ def summarise_surface_branch(b: dict) -> dict:
         "points": n,
         "pressure": _range(b["pressure"]),
         "pressures": [float(p) for p in b["pressure"]],
-        "lam2_north": _range(b["lam2_north"]),
-        "lam2_south": _range(b["lam2_south"]),
+        "lam2_top": _range(b["lam2_top"]),
+        "lam2_bottom": _range(b["lam2_bottom"]),
         "volume": _range(b["volume"]),
         "tilt": _range(b["tilt"]),
         **{name: {"max": float(np.abs(b[name]).max()), "last": [float(v) for v in b[name][-1]]}
@@ -314,8 +314,8 @@ def _format_surface_branch(name: str, b: dict) -> list[str]:
         f"  points               {b['points']}"
         + (f"  ({_image(b['reflection'])} of {b['reflection_of']})" if b["reflection_of"] else ""),
         "  pressure             {:.10g} .. {:.10g}".format(*b["pressure"]),
-        "  lam2 north pole      {:.10g} .. {:.10g}  (√(λ1 λ2) at the material pole)".format(*b["lam2_north"]),
-        "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
+        "  lam2 top pole        {:.10g} .. {:.10g}  (√(λ1 λ2) at the material pole)".format(*b["lam2_top"]),
+        "  lam2 bottom pole     {:.10g} .. {:.10g}".format(*b["lam2_bottom"]),
         "  volume               {:.10g} .. {:.10g}".format(*b["volume"]),
         "  tilt                 {:.4g} .. {:.4g} degrees".format(*b["tilt"]),
         *([f"  field force          {_vector(b['force']['last'])} at the last point (|F| ≤ {b['force']['max']:.3g}; "
@@ -358,8 +358,8 @@ def _format_branch(name: str, b: dict) -> list[str]:
           if "voltage" in b else []),
         *(["  field M              {:.10g} .. {:.10g}  (continued in M at fixed P)".format(*b["field_M"])]
           if "field_M" in b else []),
-        "  lam2 north pole      {:.10g} .. {:.10g}".format(*b["lam2_north"]),
-        "  lam2 south pole      {:.10g} .. {:.10g}".format(*b["lam2_south"]),
+        "  lam2 top pole        {:.10g} .. {:.10g}".format(*b["lam2_top"]),
+        "  lam2 bottom pole     {:.10g} .. {:.10g}".format(*b["lam2_bottom"]),
         f"  stop reason          {b['stop_reason']}"
         + ("" if b.get("rejoin_label") is None else f" (at label {b['rejoin_label']})"),
         f"  max residual         {b['max_residual']:.3e}",
@@ -394,7 +394,7 @@ def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]
         lines.append(
             f"    {label:<{width}}  {place:<{place_width}}  P = {s['pressure']:.10g}  "
             + (f"voltage = {s['voltage']:.10g}  " if "voltage" in s else "") +
-            f"lam2 north = {s['lam2_north']:.10g}  lam2 south = {s['lam2_south']:.10g}{note}"
+            f"lam2 north = {s['lam2_top']:.10g}  lam2 south = {s['lam2_bottom']:.10g}{note}"
         )
     return lines
 

@@ -12,8 +12,8 @@ from collections import Counter
 from ..io.schema import VARIABLES
 
 EXTRA = "pip install 'balloon-cg[analysis]'"
-ORDER = ("branch", "kind", "classification", "block", "m", "status", "index", "pressure", "voltage", "lam2_north",
-         "lam2_south", "eta_north", "eta_south", "E2", "E3", "E4", "uncertainty", "reason", "stop_code", "note")
+ORDER = ("branch", "kind", "classification", "block", "m", "status", "index", "pressure", "voltage", "lam2_top",
+         "lam2_bottom", "eta_top", "eta_bottom", "E2", "E3", "E4", "uncertainty", "reason", "stop_code", "note")
 MAX_ROWS = 60  # an HTML table longer than this shows its head and tail (pandas' max_rows)
 
 

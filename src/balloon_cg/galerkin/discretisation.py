@@ -301,10 +301,10 @@ class Discretisation:
         ones = np.ones(self.degree + 1)
         zero = np.zeros(self.degree + 1)
         rows = {
-            "lam2_north": self.join(ones, zero),
-            "lam2_south": self.join(sign, zero),
-            "eta_north": self.join(zero, ones) - np.append(np.zeros(self.a_index.size), self.eta_mean),
-            "eta_south": self.join(zero, sign) - np.append(np.zeros(self.a_index.size), self.eta_mean),
+            "lam2_top": self.join(ones, zero),
+            "lam2_bottom": self.join(sign, zero),
+            "eta_top": self.join(zero, ones) - np.append(np.zeros(self.a_index.size), self.eta_mean),
+            "eta_bottom": self.join(zero, sign) - np.append(np.zeros(self.a_index.size), self.eta_mean),
         }
         for row in rows.values():
             row.flags.writeable = False

@@ -3,7 +3,7 @@
 Unknowns X = (u, P), u the Ritz coefficients on a Discretisation of the given degree. Equations (n + 1):
 
     R(u; P) = ∂E/∂u (u; P) = 0      (n equations: equilibrium.Equilibrium.residual at the other parameters)
-    λ2(0) = r_n·u = λ*              (the pole row r_n = Discretisation.pole_rows()["lam2_north"])
+    λ2(0) = r_n·u = λ*              (the pole row r_n = Discretisation.pole_rows()["lam2_top"])
 
 solved by numerics.newton with the Jacobian [∂R/∂u  ∂R/∂P] (n × (n + 1)) bordered by (r_n, 0). The start X0 may
 live on another discretisation ``source`` (same symmetry and translation hold): its Legendre coefficients
@@ -37,5 +37,5 @@ def constrained_newton(scene, degree, X0, source, stretch, params, tol=1e-12, ma
     def jacobian(X):
         return eq.bordered_jacobian(X[:-1], params.with_value("P", X[-1]), "P")
 
-    row = np.append(eq.disc.pole_rows()["lam2_north"], 0.0)
+    row = np.append(eq.disc.pole_rows()["lam2_top"], 0.0)
     return newton(residual, jacobian, X, row, stretch, tol, max_iter), eq

@@ -7,7 +7,7 @@ Layout::
     /two_parameter/<name>/       attrs: of, parameter, parameter_key, parameter_derivative, stop_reason, stop_code,
                                         end, end_description, q0, wall_time, degree, kernel_class, M, chi,
                                         critical_q (NaN unless end = isola_merge or cusp)
-        <parameter>, pressure, lam2_north, lam2_south, newton_iterations, residual      (n_points,)
+        <parameter>, pressure, lam2_top, lam2_bottom, newton_iterations, residual      (n_points,)
                         (<parameter>: q under its short name, alpha1, M, Jm, mu[0], with units and long_name;
                         files written before: q)
         unknowns (n_points, n + 1): u then P;  mode (n_points, m): φ on the odd perturbation block (BP), the
@@ -34,7 +34,8 @@ import numpy as np
 
 from ..analysis.results import Kind
 from .hdf5 import atomic_file, checksummed, plain
-from .layout import FileError, carries_checksums, check_columns, check_sizes, reading, require_attrs, require_group
+from .layout import (FileError, carries_checksums, check_columns, check_sizes, opened, require_attrs,
+                     require_group)
 from .run_file import check_coordinates, check_special, legendre_poles, read_run, read_special, root_attrs, write_special
 from .schema import attach_dimensions, describe_parameter, scale
 
@@ -95,7 +96,7 @@ def parameter_coordinate(group, name: str, key: str, values, dimension) -> None:
             item.attrs["coordinates"] = name
 
 
-CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_north", "lam2_south", "residual")},
+CURVE_COLUMNS = {**{name: ("float", 1) for name in ("q", "pressure", "lam2_top", "lam2_bottom", "residual")},
                  "newton_iterations": ("int", 1), "unknowns": ("float", 2), "mode": ("float", 2)}
 CURVE_REQUIRED = {"parameter": "str", "stop_reason": "str", "end": "str", "q0": "float", "critical_q": "float",
                   "end_description": "str", "degree": "int", "wall_time": "float"}
@@ -106,7 +107,7 @@ def read_curve(path, name: str = "pear") -> dict:
     """The datasets and attributes of a stored curve: {'attrs', datasets…, 'special_points': [dicts], 'q'}.
     Raises CurveFileError naming the file and what is missing (the file must also be a readable run file)."""
     read_run(path)  # the root attributes and /branches, checked
-    with h5py.File(path, "r") as f, reading(path, CurveFileError):
+    with opened(path, CurveFileError) as f:
         curves = require_group(f, "two_parameter", path, CurveFileError)
         group = require_group(curves, name, f"{path}: two_parameter", CurveFileError)
         where = f"{path}: two_parameter/{name}"
@@ -146,7 +147,7 @@ MEETING_KINDS = (Kind.LP_BP, Kind.LV_BP, Kind.LN_BP)  # the meetings of a fold a
 def curve_meetings(curve: dict) -> list[dict]:
     """The meetings of a fold and the pitchfork on a stored curve (``read_curve``): kind, q, pressure, north
     pole stretch, status and uncertainty each."""
-    return [{"kind": s["kind"], "q": float(q), "pressure": s["pressure"], "lam2_north": s["lam2_north"],
+    return [{"kind": s["kind"], "q": float(q), "pressure": s["pressure"], "lam2_top": s["lam2_top"],
              "status": s["status"], "uncertainty": s["uncertainty"]}
             for s, q in zip(curve["special_points"], curve["special_q"]) if s["kind"] in MEETING_KINDS]
 

@@ -12,6 +12,8 @@ import stat
 import h5py
 import numpy as np
 
+from .legacy import current
+
 
 class FileError(ValueError):
     """A file that is not a readable balloon-cg file of its kind: ``path`` and ``problem`` (exit code 2)."""
@@ -216,14 +218,15 @@ def _describe(value) -> str:
 @contextlib.contextmanager
 def opened(path, error=FileError):
     """``with opened(path) as f:`` the HDF5 file ``path`` open for reading (``check_input`` first), what h5py
-    raises while it is read mapped by ``reading``; ``error`` when it is not a readable HDF5 file."""
+    raises while it is read mapped by ``reading``, under this version's dataset names (``legacy.current``); ``error``
+    when it is not a readable HDF5 file."""
     check_input(path, error)
     try:
         f = h5py.File(path, "r")
     except (OSError, RuntimeError):
         raise error(path, "not a readable HDF5 file") from None
-    with f, reading(path, error):
-        yield f
+    with f, reading(path, error), current(f) as named:
+        yield named
 
 
 def file_kind(path, error=FileError) -> str:

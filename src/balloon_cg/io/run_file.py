@@ -1,4 +1,4 @@
-"""Run files (HDF5, format "balloon-cg/5"): traced branches with their provenance.
+"""Run files (HDF5, format "balloon-cg/6"): traced branches with their provenance.
 
 Layout::
 
@@ -21,7 +21,7 @@ Layout::
                                   the reading its states are equilibria of, analysis.results.Gauge),
                                   [parent_branch, parent_branch_point, rejoins_branch_point, reflection_of]
         point, unknown                                     dimension scales (0, 1, …)
-        pressure, volume, amount (n = P V), lam2_north, lam2_south, eta_north, eta_south,
+        pressure, volume, amount (n = P V), lam2_top, lam2_bottom, eta_top, eta_bottom,
         lam1_equator, lam2_equator, converged, residual, error_estimate,
         newton_iterations, solved_degree, [voltage], [M]   (point,) (voltage: where electric; M: a
                                                            continuation in M, ``continue --parameter M``)
@@ -30,7 +30,7 @@ Layout::
         profiles/lam1, profiles/lam2, profiles/rho, profiles/eta     (point, theta)
         special_points/kind (LP, TP, LV, LN, BP, EP, UZ), classification, block, gauge (held, free, both),
                        status (located, approximate), reason, stop_code, note, index, m, pressure, [voltage], [M], uncertainty, E2, E3, E4,
-                       lam2_north, lam2_south, eta_north, eta_south                          (special,)
+                       lam2_top, lam2_bottom, eta_top, eta_bottom                          (special,)
         special_points/state/unknowns                      (special, unknown): each point's own X
         stability/stable_*                                 (point,) flags
         stability/lowest_<block>                           (point, eigenvalue): lowest eigenvalues
@@ -52,7 +52,7 @@ Layout::
                            [reflection_of] (a branch's image under a diagonal reflection), [reflection] (its
                            signs (s_x, s_y, s_z); absent: the rotation by π about the axis, (−1, −1, 1))
         point, coefficient, axis                           dimension scales (axis: x, y, z as 0, 1, 2)
-        pressure, volume, amount, lam2_north, lam2_south (√J at the material poles), tilt (degrees),
+        pressure, volume, amount, lam2_top, lam2_bottom (√J at the material poles), tilt (degrees),
         converged, residual, error_estimate, newton_iterations, [voltage]                    (point,)
         centroid                                           (point, axis)
         coefficients                                       (point, coefficient)
@@ -87,13 +87,15 @@ import numpy as np
 from ..analysis.timing import Clock, Step
 from ..surface.loads import LOADS
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
+from .legacy import current
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
                      require_group)
 from .schema import FINITE, MODES, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, coordinates, scale
 
-FORMAT = "balloon-cg/5"
-READABLE = (FORMAT, "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")
-POLES = ("lam2_north", "lam2_south", "eta_north", "eta_south")
+FORMAT = "balloon-cg/6"
+READABLE = (FORMAT, "balloon-cg/5", "balloon-cg/4", "balloon-cg/3", "balloon-cg/2")  # /5 and older: the meridian's
+#                                                     ends named north and south, read as top and bottom (io/legacy.py)
+POLES = ("lam2_top", "lam2_bottom", "eta_top", "eta_bottom")
 SPECIAL_NUMBERS = ("pressure", "uncertainty", "E2", "E3", "E4") + POLES
 SPECIAL_TEXT = ("kind", "classification", "block", "status", "reason", "stop_code", "note")
 TRANSLATIONS = ("translation_axial", "translation_lateral")  # frequencies/: the rigid translations' Ω²
@@ -345,8 +347,8 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
         **parameters,
         "volume": volumes,
         "amount": parameters["pressure"] * volumes,
-        "lam2_north": np.asarray(measures["lam_north"], dtype=float),
-        "lam2_south": np.asarray(measures["lam_south"], dtype=float),
+        "lam2_top": np.asarray(measures["lam_top"], dtype=float),
+        "lam2_bottom": np.asarray(measures["lam_bottom"], dtype=float),
         "centroid": np.asarray(measures["centroid"], dtype=float).reshape(len(rows), 3),
         "tilt": np.asarray(measures["tilt"], dtype=float),
         "converged": finite(branch),
@@ -481,10 +483,10 @@ def surface_poles(basis, X) -> dict:
     from ..surface.measures import pole_stretch
 
     heights = np.array([basis.point_values(row[:-1], np.array([0.0, np.pi]), np.zeros(2))[0][2] for row in X])
-    return {"lam2_north": np.array([pole_stretch(basis, row[:-1], 0.0) for row in X]),
-            "lam2_south": np.array([pole_stretch(basis, row[:-1], np.pi) for row in X]),
-            "eta_north": heights[:, 0] if len(X) else np.zeros(0),
-            "eta_south": heights[:, 1] if len(X) else np.zeros(0)}
+    return {"lam2_top": np.array([pole_stretch(basis, row[:-1], 0.0) for row in X]),
+            "lam2_bottom": np.array([pole_stretch(basis, row[:-1], np.pi) for row in X]),
+            "eta_top": heights[:, 0] if len(X) else np.zeros(0),
+            "eta_bottom": heights[:, 1] if len(X) else np.zeros(0)}
 
 
 def write_special(group, special: list, width: int, poles, parameters=None, first_label: int = 1,
@@ -543,7 +545,7 @@ def read_run(path) -> dict:
     arrays), 'special_points' (list of dicts: the special_points columns) and 'special_unknowns'
     (their X rows). The layout is checked first (``io.layout``).
     Raises FileNotFoundError, IsADirectoryError, or RunFileError for a file that is not a readable run file
-    (format balloon-cg/5 or an earlier one of READABLE), naming the file and what is missing or wrong.
+    (format balloon-cg/6 or an earlier one of READABLE), naming the file and what is missing or wrong.
     """
     path = Path(path)
     with opened(path, RunFileError) as f:
@@ -553,9 +555,9 @@ def read_run(path) -> dict:
 
 def read_run_image(image: bytes, label: str = "run") -> dict:
     """``read_run`` of a file image (``run_image``); 'path' is None and errors name ``label``."""
-    with reading(label, RunFileError), h5py.File(io.BytesIO(image), "r") as f:
-        check_data(f, label, RunFileError, FINITE)
-        return _read_open(f, label) | {"path": None}
+    with reading(label, RunFileError), h5py.File(io.BytesIO(image), "r") as f, current(f) as named:
+        check_data(named, label, RunFileError, FINITE)
+        return _read_open(named, label) | {"path": None}
 
 
 def _read_open(f, label) -> dict:
@@ -581,7 +583,7 @@ def _read_open(f, label) -> dict:
     if "primary" not in branches and not len(f.get("two_parameter", {})):
         raise RunFileError(label, f"missing branch primary (branches: {', '.join(branches) or 'none'}): not a whole "
                                   "run file")
-    if plain(fmt) in READABLE[:2]:  # written by /4 and /5 always (older ones may lack them: OPTIONAL_COLUMNS)
+    if plain(fmt) in READABLE[:3]:  # written by /4 and later always (older ones may lack them: OPTIONAL_COLUMNS)
         for name, branch in branches.items():
             missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
             if missing:
@@ -603,7 +605,7 @@ BRANCH_KINDS = COMMON_KINDS | {"degree": "int", "symmetric": "bool", "pin_transl
 SURFACE_KINDS = COMMON_KINDS | {"m": "int", "parent_branch": "str", "parent_branch_point": "int",
                                 "surface_degree": "int", "surface_order": "int", "n_theta": "int", "n_phi": "int",
                                 "map_centres": "float[]", "map_widths": "float[]", "parameter": "str"}
-SURFACE_COLUMNS = {**{name: ("float", 1) for name in ("pressure", "volume", "lam2_north", "lam2_south", "tilt",
+SURFACE_COLUMNS = {**{name: ("float", 1) for name in ("pressure", "volume", "lam2_top", "lam2_bottom", "tilt",
                                                        "residual", "error_estimate")},
                    "converged": ("bool", 1), "newton_iterations": ("int", 1), "centroid": ("float", 2),
                    "coefficients": ("float", 2)}
@@ -782,7 +784,7 @@ def check_special(group, where, width: int, error, extra: dict | None = None, re
 
 
 def special_unknowns(group, where="", error=FileError, rows: int | None = None):
-    """The X rows of a special_points group: its ``state/unknowns`` (format balloon-cg/5), or its ``unknowns``
+    """The X rows of a special_points group: its ``state/unknowns`` (format balloon-cg/5 and later), or its ``unknowns``
     (balloon-cg/4 and older, where the 2-D rows sat among the columns); checked 2-d float, ``rows`` long."""
     holder = group if "unknowns" in group and "state" not in group else require_group(group, "state", where, error)
     label = where if holder is group else f"{where}/state"

@@ -49,9 +49,9 @@ VARIABLES = {
     "volume": (NONDIMENSIONAL, "enclosed volume V", "V / R0³ (4π/3 for the undeformed sphere)"),
     "amount": (NONDIMENSIONAL, "gas amount n", "n = P V, the isothermal ideal gas P V = n in these units: "
                                                "n = N R T / (T0 μ R0² / 2) for N moles at temperature T"),
-    "lam2_north": (NONDIMENSIONAL, "λ2 at the north pole", "hoop stretch λ2(θ = 0); on a surface branch √(λ1 λ2) "
+    "lam2_top": (NONDIMENSIONAL, "λ2 at the north pole", "hoop stretch λ2(θ = 0); on a surface branch √(λ1 λ2) "
                                                            "at the material pole (equal there when axisymmetric)"),
-    "lam2_south": (NONDIMENSIONAL, "λ2 at the south pole", "hoop stretch λ2(θ = π); on a surface branch √(λ1 λ2) "
+    "lam2_bottom": (NONDIMENSIONAL, "λ2 at the south pole", "hoop stretch λ2(θ = π); on a surface branch √(λ1 λ2) "
                                                            "at the material pole"),
     "coefficients": (NONDIMENSIONAL, "displacement coefficients c", "u = x − X in real spherical harmonics of "
                                                                     "degree ≤ surface_degree (docs/hdf5.md)"),
@@ -64,8 +64,8 @@ VARIABLES = {
     "tilt": ("degree", "tilt of the body's axis", "angle between e_z and the principal axis of the enclosed "
                                                   "body's second moments that stands apart (the largest, or the "
                                                   "smallest when closer to the middle one), 0 … 90"),
-    "eta_north": (NONDIMENSIONAL, "η at the north pole", "axial position η(0) / R0"),
-    "eta_south": (NONDIMENSIONAL, "η at the south pole", "axial position η(π) / R0"),
+    "eta_top": (NONDIMENSIONAL, "η at the north pole", "axial position η(0) / R0"),
+    "eta_bottom": (NONDIMENSIONAL, "η at the south pole", "axial position η(π) / R0"),
     "lam1_equator": (NONDIMENSIONAL, "λ1 at the equator", "meridional stretch λ1(π/2)"),
     "lam2_equator": (NONDIMENSIONAL, "λ2 at the equator", "hoop stretch λ2(π/2)"),
     "converged": (COUNT, "converged", "true: a finite converged Newton solution"),
@@ -177,7 +177,7 @@ def attach_dimensions(group, axes: dict) -> None:
 #: special point's state and pole values; a curve's q and mode): the readers refuse NaN or inf in them. The others
 #: may hold NaN (E2, E3, E4 of a point that has no normal form, critical_q) or are bounds and estimates
 #: (uncertainty, error_estimate, the lowest eigenvalues).
-FINITE = frozenset({"pressure", "voltage", "M", "volume", "amount", "lam2_north", "lam2_south", "eta_north", "eta_south",
+FINITE = frozenset({"pressure", "voltage", "M", "volume", "amount", "lam2_top", "lam2_bottom", "eta_top", "eta_bottom",
                     "lam1_equator", "lam2_equator", "residual", "unknowns", "coefficients", "centroid", "tilt",
                     "force", "torque", "theta", "lam1", "lam2", "rho", "eta", "q", "mode"})
 SCALE_ATTRIBUTES = ("CLASS", "NAME")  # HDF5 dimension scales (netCDF-4 dimensions); and REFERENCE_LIST (the

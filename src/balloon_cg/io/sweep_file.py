@@ -5,7 +5,7 @@
     SWEEP.h5.members/              the store (the authority)
         sweep.h5                   attrs: the sweep's root attributes (below), written once, atomically
         000003.h5                  member 3: attrs as /members/3 below, groups branches/, snap_throughs/
-    SWEEP.h5                       the consolidated view (format "balloon-cg-sweep/2"): a copy of the store
+    SWEEP.h5                       the consolidated view (format "balloon-cg-sweep/3"): a copy of the store
 
     /                   attrs: format, scene_name, scene_toml (base scene, normalised), vary (JSON list of
                                [key, values]), mode, members (total count), store (the store folder's name),
@@ -44,14 +44,16 @@ from .hdf5 import atomic_file, checksummed, copy_attrs, copy_tree, plain, proven
 from .output import store_path
 from .lock import remove_debris
 from .run_file import VERDICT_KINDS, read_branches, read_special, verdict_attrs, write_branches
+from .legacy import current
 from .layout import FileError, carries_checksums, check_data, check_input, reading, require_attrs
 from .schema import FINITE
 from .tube_file import read_tube, tube_row, write_tube
 from ..scene.tables import Shape
 
-FORMAT = "balloon-cg-sweep/2"
-FORMATS = ("balloon-cg-sweep/1", FORMAT)  # readable; /1 is the single-file layout of earlier versions
-MEMBER_FORMAT = "balloon-cg-sweep-member/1"
+FORMAT = "balloon-cg-sweep/3"
+FORMATS = ("balloon-cg-sweep/1", "balloon-cg-sweep/2", FORMAT)  # readable; /1 is the single-file layout of earlier
+#                                     versions, /2 names the meridian's ends north and south (io/legacy.py)
+MEMBER_FORMAT = "balloon-cg-sweep-member/2"
 MANIFEST = "sweep.h5"
 ROOT_KEYS = ("scene_name", "scene_toml", "vary", "mode", "members")
 MEMBER_KEYS = ("overrides", "scene_hash", "scene_toml")
@@ -393,7 +395,7 @@ def member_row(overrides: dict, complete: bool, special: list[dict]) -> dict:
     branch_points = [s for s in special if s["kind"] == "BP"]
     critical = sorted((s["pressure"] for s in branch_points if s["block"] == PEAR_BLOCK), reverse=True)
     row = dict(overrides) | {"complete": bool(complete), "P_LP": folds[0]["pressure"] if folds else np.nan,
-                             "lam2_LP": folds[0]["lam2_north"] if folds else np.nan}
+                             "lam2_LP": folds[0]["lam2_top"] if folds else np.nan}
     row |= {f"P_cr{k}": critical[k - 1] if len(critical) >= k else np.nan for k in (1, 2)}
     for k, s in enumerate(branch_points, 1):
         row |= {f"P_BP{k}": s["pressure"], f"block_BP{k}": s["block"],
@@ -493,10 +495,10 @@ def _open(path, check: bool = True):
         raise
     except (OSError, RuntimeError):
         raise SweepFileError(path, "not a readable HDF5 file (damaged or not HDF5)") from None
-    with f, reading(path, SweepFileError):
+    with f, reading(path, SweepFileError), current(f) as named:
         if check:
-            check_data(f, path, SweepFileError, FINITE)
-        yield f
+            check_data(named, path, SweepFileError, FINITE)
+        yield named
 
 
 def read_sweep(path) -> dict:

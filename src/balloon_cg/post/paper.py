@@ -155,7 +155,7 @@ def _coils_line(runs) -> str:
 
 
 def _x_label(kind, panel):
-    return {None: r"pole stretch $\lambda_2(0)$ (north)", 0: r"equator stretch $\lambda_2(\pi/2)$ (circumferential)",
+    return {None: r"pole stretch $\lambda_2(0)$ (top)", 0: r"equator stretch $\lambda_2(\pi/2)$ (circumferential)",
             1: r"equator stretch $\lambda_1(\pi/2)$ (meridional)"}[panel]
 
 
@@ -234,7 +234,7 @@ def mark_configurations(ax, run: dict, configurations):
     """The configurations' numbers at their (λ2(0), P) on a pressure-pole panel."""
     for c in configurations:
         data = run["branches"][c.branch]
-        x, y = data["lam2_north"][c.index], data["pressure"][c.index]
+        x, y = data["lam2_top"][c.index], data["pressure"][c.index]
         ax.plot(x, y, "o", markersize=3.5, markerfacecolor=c.color or "w", markeredgecolor="k", markeredgewidth=0.6)
         ax.annotate(c.label, (x, y), xytext=(3, 3), textcoords="offset points", fontsize="small", weight="bold")
 
@@ -429,7 +429,7 @@ def figures(quick: bool = False) -> dict[str, PaperFigure]:
 
 COMPACT_WIDTH = 5.0  # inches: narrower figures (one column) get the symbols as axis labels, smaller markers
 SHORT_LABELS = {  # the kinds' axis labels -> their symbols (units: docs/plots.md, stated in the caption)
-    P_LABEL: r"$P$", r"pole stretch $\lambda_2(0)$ (north)": r"$\lambda_2(0)$",
+    P_LABEL: r"$P$", r"pole stretch $\lambda_2(0)$ (top)": r"$\lambda_2(0)$",
     r"equator stretch $\lambda_2(\pi/2)$ (circumferential)": r"$\lambda_2(\pi/2)$",
     r"equator stretch $\lambda_1(\pi/2)$ (meridional)": r"$\lambda_1(\pi/2)$",
     r"material coordinate $\theta$ (rad)": r"$\theta$", r"$\pm\rho/R_0$ (distance from the axis)": r"$\pm\rho/R_0$",

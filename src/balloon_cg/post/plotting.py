@@ -640,16 +640,16 @@ def _pole_curves(branches, ordinate: Ordinate, axes=None) -> Figure:
         d, color, y = b.data, b.color, b.parameter_values
         if b.surface and (id(b.run), d["attrs"].get("reflection_of")) in drawn:
             continue  # a surface branch's image under the rotation about the axis: its source's curve and points
-        _curve(ax, d["lam2_north"], y, b.stable, color, mirror=b.mirror)
-        scale = np.abs(d["lam2_north"]).max()
+        _curve(ax, d["lam2_top"], y, b.stable, color, mirror=b.mirror)
+        scale = np.abs(d["lam2_top"]).max()
         partner = (id(b.run), b.name.removesuffix(MIRROR_SUFFIX) if b.mirror else b.name + MIRROR_SUFFIX)
         # a pear branch's south pole is its mirror image's north pole: drawn already when that one is
-        if partner not in drawn and np.abs(d["lam2_south"] - d["lam2_north"]).max() > 1e-8 * scale:
-            _curve(ax, d["lam2_south"], y, None, color, linestyle=":")
-            extra = [Line2D([], [], color="k", linestyle=":", label=r"south pole $\lambda_2(\pi)$")]
+        if partner not in drawn and np.abs(d["lam2_bottom"] - d["lam2_top"]).max() > 1e-8 * scale:
+            _curve(ax, d["lam2_bottom"], y, None, color, linestyle=":")
+            extra = [Line2D([], [], color="k", linestyle=":", label=r"bottom pole $\lambda_2(\pi)$")]
         special = d["special_points"]
-        marks += _special(ax, b, [s["lam2_north"] for s in special], [s[ordinate.column] for s in special], color)
-    ax.set_xlabel(r"pole stretch $\lambda_2(0)$ (north)")
+        marks += _special(ax, b, [s["lam2_top"] for s in special], [s[ordinate.column] for s in special], color)
+    ax.set_xlabel(r"pole stretch $\lambda_2(0)$ (top)")
     ax.set_ylabel(ordinate.label)
     ax.set_title(_title(branches))
     _branch_legend(fig, panels, own, branches, extra)
@@ -709,7 +709,7 @@ def select_points(data: dict, points=None) -> np.ndarray:
                                or not all(isinstance(p, (int, np.integer)) for p in points)):
         raise PlotError(f"points = {points!r}: expected a non-empty list of point indices, e.g. [0, 10, -1]")
     if points is None:
-        path = np.stack([data["lam2_north"], data[ordinate_of(data).column]])
+        path = np.stack([data["lam2_top"], data[ordinate_of(data).column]])
         span = np.ptp(path, axis=1, keepdims=True)
         step = np.hypot(*(np.diff(path, axis=1) / np.where(span > 0, span, 1.0)))
         length = np.r_[0.0, np.cumsum(step)]
@@ -917,7 +917,7 @@ def _state_title(branch: StoredBranch, index: int) -> str:
     d = branch.data
     return (f"{_title([branch])}, M = {branch.M:g}\n{branch.label}: #{index}  "
             f"{branch.ordinate.symbol} = {d[branch.ordinate.column][index]:.4g}, "
-            f"$\\lambda_2(0)$ = {d['lam2_north'][index]:.4g}, tilt {d['tilt'][index]:.1f}°")
+            f"$\\lambda_2(0)$ = {d['lam2_top'][index]:.4g}, tilt {d['tilt'][index]:.1f}°")
 
 
 def surface_grid(basis, c, samples: tuple = SURFACE_SAMPLES) -> np.ndarray:

@@ -6,7 +6,9 @@
 
 Every branch then gets a special point labelled UZ wherever its quantity passes the value, located to the solver
 tolerance (``analysis.branches.events``). The quantities are those stored per point: the enclosed volume V, the gas amount
-n = P V, the pressure P, and the hoop stretch λ2 at the north pole, the south pole and the equator.
+n = P V, the pressure P, and the hoop stretch λ2 at the meridian's top and bottom ends (a sphere's poles) and at
+the equator. Scenes written before session 21 name the ends ``lam2_north`` and ``lam2_south``: read as
+``lam2_top`` and ``lam2_bottom`` (OLD_QUANTITIES).
 """
 import enum
 from dataclasses import dataclass
@@ -20,9 +22,12 @@ class Quantity(enum.StrEnum):
     VOLUME = "volume"
     AMOUNT = "amount"
     PRESSURE = "pressure"
-    LAM2_NORTH = "lam2_north"
-    LAM2_SOUTH = "lam2_south"
+    LAM2_TOP = "lam2_top"
+    LAM2_BOTTOM = "lam2_bottom"
     LAM2_EQUATOR = "lam2_equator"
+
+
+OLD_QUANTITIES = {"lam2_north": Quantity.LAM2_TOP, "lam2_south": Quantity.LAM2_BOTTOM}
 
 
 @dataclass(frozen=True)
@@ -51,6 +56,8 @@ def _event(key: str, data) -> Event:
         if name not in data:
             raise SceneError(f"{key}.{name}: missing (an event needs quantity and value)")
     quantity = data["quantity"]
+    if isinstance(quantity, str):
+        quantity = OLD_QUANTITIES.get(quantity, quantity)
     if quantity not in tuple(Quantity):
         raise SceneError(f"{key}.quantity = {show(quantity)}: must be one of "
                          f"{', '.join(show(q.value) for q in Quantity)}{did_you_mean(quantity, tuple(Quantity))}")

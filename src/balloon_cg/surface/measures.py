@@ -9,7 +9,7 @@ import numpy as np
 
 from .basis import SphericalBasis
 
-MEASURES = ("lam_north", "lam_south", "volume", "centroid", "tilt")  # centroid: (n, 3); tilt: degrees
+MEASURES = ("lam_top", "lam_bottom", "volume", "centroid", "tilt")  # centroid: (n, 3); tilt: degrees
 
 
 def pole_stretch(basis: SphericalBasis, c: np.ndarray, theta: float) -> float:
@@ -37,7 +37,7 @@ def measures(basis: SphericalBasis, c: np.ndarray) -> dict:
     centroid = first / volume
     central = second / volume - np.outer(centroid, centroid)
     tilt = np.degrees(np.arccos(min(1.0, abs(float(body_axis(central)[2])))))
-    return {"lam_north": pole_stretch(basis, c, 0.0), "lam_south": pole_stretch(basis, c, np.pi),
+    return {"lam_top": pole_stretch(basis, c, 0.0), "lam_bottom": pole_stretch(basis, c, np.pi),
             "volume": volume, "centroid": centroid, "tilt": tilt}
 
 

@@ -4,7 +4,7 @@ Points are stored on the finest discretisation used (the last one of the most re
 latest), its degree raised by the resolution policy while the projection would lose more than the policy's
 loss limit of any point and raising it helps. A point's stored error estimate adds its measured projection
 loss. A leg that stopped on passing a pole stretch given in ``land_on`` (STOP_STRETCH, MIN_STRETCH,
-SOUTH_STOP_STRETCH) gets its exact end point there (Newton on the pole row r·X = target from the linear
+BOTTOM_STOP_STRETCH) gets its exact end point there (Newton on the pole row r·X = target from the linear
 interpolant); one that stopped on a value of the control parameter q (STOP_VOLUME, STOP_AMOUNT: q = V or n,
 nonlinear in X) lands by Newton on the linearised constraint ∇q(X_k)·(X − X_k) = target − q(X_k), repeated
 until |q − target| ≤ LANDING_RTOL·max(1, |target|); a fold found between the last point and the overshoot is

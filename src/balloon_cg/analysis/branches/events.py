@@ -25,7 +25,7 @@ from ...surface.measures import body_moments
 from .problem import branch_system, continuation_settings
 from ..results import Branch, Kind, SpecialPoint, Status, SurfaceBranch, approximate
 
-POLE_ROWS = {Quantity.LAM2_NORTH: "lam2_north", Quantity.LAM2_SOUTH: "lam2_south"}
+POLE_ROWS = {Quantity.LAM2_TOP: "lam2_top", Quantity.LAM2_BOTTOM: "lam2_bottom"}
 
 
 def event_quantity(system, quantity: Quantity):

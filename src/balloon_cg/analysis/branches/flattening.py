@@ -22,7 +22,7 @@ FLAT_TOL = 0.05  # |s₀| / s at which the poles meet at P = 0 (measured 0.004 w
 def pole_separation(disc, u) -> float:
     """s = η(0) − η(π): the axial distance between the poles."""
     rows = disc.pole_rows()
-    return float((rows["eta_north"] - rows["eta_south"]) @ u)
+    return float((rows["eta_top"] - rows["eta_bottom"]) @ u)
 
 
 def flattening_stop(disc, point: Point, max_degree: int) -> Stop | None:

@@ -127,7 +127,7 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
     if scene.geometry.shape == Shape.CAPSULE:
         b = disc.projection @ meridian.reference_height(scene.geometry, np.arccos(disc.x))
     X = np.append(disc.join(a, b), 0.0)
-    row = np.append(disc.pole_rows()["lam2_north"], 0.0)
+    row = np.append(disc.pole_rows()["lam2_top"], 0.0)
 
     def solve(X, value):
         return newton(system.residual, system.jacobian, X, row, value, scene.solver.tol, scene.solver.max_newton)
@@ -248,12 +248,12 @@ def initial_point(tracer: Tracer, start: continuation.Point, direction: float, p
                   degree: int) -> continuation.Point:
     """The start with its unit tangent oriented so that the north pole stretch moves in ``direction``."""
     system = tracer.system(degree, params)
-    north = np.append(system.eq.disc.pole_rows()["lam2_north"], 0.0)
+    north = np.append(system.eq.disc.pole_rows()["lam2_top"], 0.0)
     tangent = direction * continuation.tangent(system, start.X, north)
     return continuation.Point(start.X, tangent, start.iterations, start.residual)
 
 
-def north_stop_stretch(upper: float) -> Stop:
+def top_stop_stretch(upper: float) -> Stop:
     """The stop of a branch whose north pole stretch reached ``upper`` (continuation.stop_stretch)."""
     return Stop(StopCode.STOP_STRETCH, f"reached stop_stretch {upper:g}")
 
@@ -277,9 +277,9 @@ def range_limits(scene, upper: float, parameter: str | None = None, params: Para
             if compressed(disc, point.X[:-1], scene.material, voltage, scene.geometry):
                 return Stop(StopCode.COMPRESSED, "the membrane is compressed (dielectric stress above the elastic "
                                                  "tension: tension-field theory is not modelled)")
-        stretch = float(disc.pole_rows()["lam2_north"] @ point.X[:-1])
+        stretch = float(disc.pole_rows()["lam2_top"] @ point.X[:-1])
         if stretch >= upper:
-            return north_stop_stretch(upper)
+            return top_stop_stretch(upper)
         if stretch <= cont.min_stretch:
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and parameter == "P":
@@ -341,5 +341,5 @@ def landing_targets(scene, upper: float) -> dict:
     field_ends = {StopCode.ZERO_FIELD: (PARAMETER, 0.0)}
     if scene.continuation.stop_field is not None:
         field_ends[StopCode.STOP_FIELD] = (PARAMETER, scene.continuation.stop_field)
-    return {StopCode.STOP_STRETCH: ("lam2_north", upper),
-            StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading) | field_ends
+    return {StopCode.STOP_STRETCH: ("lam2_top", upper),
+            StopCode.MIN_STRETCH: ("lam2_top", scene.continuation.min_stretch)} | landing(scene.loading) | field_ends

@@ -54,7 +54,7 @@ def scene_parameter(scene) -> str:
     return "voltage" if scene.continuation.parameter == ContinuationParameter.VOLTAGE else "P"
 
 
-NORTH_TURNING = MappingProxyType({Kind.TP: "lam2_north"})  # the pole stretch folds a leg locates by default
+TOP_TURNING = MappingProxyType({Kind.TP: "lam2_top"})  # the pole stretch folds a leg locates by default
 
 
 class Tracer:
@@ -91,7 +91,7 @@ class Tracer:
         return ParameterSystem(self._systems[degree, mapping], params, self.parameter)
 
     def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None,
-            mapping=None, limits=None, turning=NORTH_TURNING) -> LegTrace:
+            mapping=None, limits=None, turning=TOP_TURNING) -> LegTrace:
         """Trace from ``start`` (at ``degree``, default the scene's, and ``mapping``) along its tangent, refining
         as needed (module docstring). ``stop(disc, point)`` returns a Stop or None; ``limits(disc, point)`` (the
         requested range of the branch) is asked first, before the resolution check: a point past the range ends

@@ -228,7 +228,7 @@ class TwoParameterCurve:
 
     @property
     def pole_stretch(self):
-        return self.pole_values()["lam2_north"]
+        return self.pole_values()["lam2_top"]
 
     @property
     def merge(self) -> SpecialPoint | None:
@@ -245,7 +245,7 @@ class TwoParameterCurve:
         if merge is None:
             return None
         X = merge.X
-        return float(X[-1]), float(self._parts(X)[1][0]), float(self.pole_values(X)["lam2_north"][0])
+        return float(X[-1]), float(self._parts(X)[1][0]), float(self.pole_values(X)["lam2_top"][0])
 
     @property
     def of(self) -> Kind:

@@ -174,7 +174,7 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
 def containing_interval(branch: Branch, X) -> int:
     """The interval i (between points i and i + 1) nearest to X in (p, north pole stretch), p the continuation
     parameter: the one that contains a point of the branch."""
-    north = branch.disc.pole_rows()["lam2_north"]
+    north = branch.disc.pole_rows()["lam2_top"]
     path = np.stack([branch.X[:, -1], branch.X[:, :-1] @ north], axis=1)
     target = np.array([X[-1], X[:-1] @ north])
     a, d = path[:-1], np.diff(path, axis=0)

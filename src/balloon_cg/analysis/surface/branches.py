@@ -179,7 +179,7 @@ def axisymmetric_solve(trace: SurfaceTrace, c: np.ndarray, P: float) -> np.ndarr
     return c + E @ result.x[:-1] if result.converged else None
 
 
-POLE_STOPS = {StopCode.STOP_STRETCH: StopCode.SOUTH_STOP_STRETCH, StopCode.SOUTH_STOP_STRETCH: StopCode.STOP_STRETCH}
+POLE_STOPS = {StopCode.STOP_STRETCH: StopCode.BOTTOM_STOP_STRETCH, StopCode.BOTTOM_STOP_STRETCH: StopCode.STOP_STRETCH}
 
 
 def pole_stop(code: StopCode, upper: float) -> Stop:
@@ -205,10 +205,10 @@ def _stop_rule(trace: SurfaceTrace, rejoin: tuple | None):
             return Stop(StopCode.REJOINED, "rejoined the branch it was born on")
         c = trace.system.coefficients(point.X)
         m = measures(basis, c)
-        if m["lam_north"] >= upper:
+        if m["lam_top"] >= upper:
             return pole_stop(StopCode.STOP_STRETCH, upper)
-        if m["lam_south"] >= upper:
-            return pole_stop(StopCode.SOUTH_STOP_STRETCH, upper)
+        if m["lam_bottom"] >= upper:
+            return pole_stop(StopCode.BOTTOM_STOP_STRETCH, upper)
         if trace.eq.has_field:
             distance = float(loop_distance(trace.eq.node_values(c)["state"][:3], trace.eq.coils).min())
             if distance < gap:
@@ -460,7 +460,7 @@ def reflected(branch: SurfaceBranch, S: tuple, name: str) -> SurfaceBranch:
     measures_ = {key: value * image[key] if key in image else value.copy()
                  for key, value in branch.measures.items()}
     if swap:
-        measures_["lam_north"], measures_["lam_south"] = branch.measures["lam_south"], branch.measures["lam_north"]
+        measures_["lam_top"], measures_["lam_bottom"] = branch.measures["lam_bottom"], branch.measures["lam_top"]
 
     def stop(s: Stop | None) -> Stop | None:
         if s is None or not swap or s.code not in POLE_STOPS:

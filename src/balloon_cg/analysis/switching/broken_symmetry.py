@@ -66,7 +66,7 @@ def seeds(scene) -> list[tuple]:
         if pear is None:
             raise HomotopyError("the pear branch of the symmetric relative could not be started")
         poles = pear.pole_values()
-        wide = np.flatnonzero(np.abs(poles["lam2_north"] - poles["lam2_south"]) >= SEED_AMPLITUDE)
+        wide = np.flatnonzero(np.abs(poles["lam2_top"] - poles["lam2_bottom"]) >= SEED_AMPLITUDE)
         if not wide.size:
             raise HomotopyError(f"the pear branch of the symmetric relative stays below amplitude {SEED_AMPLITUDE:g}")
         plain = held_tracer(scene).system(pear.disc.degree, pear.params).eq.disc
@@ -84,7 +84,7 @@ def continued(scene, X: np.ndarray, params) -> np.ndarray:
     pear amplitude (module docstring); HomotopyError when a step fails at MIN_STEP."""
     disc = held_tracer(scene).system(_degree(X), params).eq.disc
     rows = disc.pole_rows()
-    amplitude = np.append(rows["lam2_north"] - rows["lam2_south"], 0.0)
+    amplitude = np.append(rows["lam2_top"] - rows["lam2_bottom"], 0.0)
     target, t, step = float(amplitude @ X), 0.0, 1.0 / HEIGHT_STEPS
     while t < 1.0:
         trial = min(t + step, 1.0)
@@ -108,9 +108,9 @@ def _degree(X: np.ndarray) -> int:
 def distance_to(branch: Branch, X: np.ndarray, disc) -> float:
     """The max-norm distance in (P, λ2(0), λ2(π)) from X (on ``disc``) to the polyline of ``branch``'s points."""
     rows = disc.pole_rows()
-    target = np.array([X[-1], rows["lam2_north"] @ X[:-1], rows["lam2_south"] @ X[:-1]])
+    target = np.array([X[-1], rows["lam2_top"] @ X[:-1], rows["lam2_bottom"] @ X[:-1]])
     poles = branch.pole_values()
-    path = np.stack([branch.X[:, -1], poles["lam2_north"], poles["lam2_south"]], axis=1)
+    path = np.stack([branch.X[:, -1], poles["lam2_top"], poles["lam2_bottom"]], axis=1)
     a, d = path[:-1], np.diff(path, axis=0)
     s = np.clip(np.einsum("ij,ij->i", target - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
     return float(np.abs(a + s[:, None] * d - target).max(axis=1).min())

@@ -11,9 +11,9 @@ the assessments are copied.
 
 Only the bookkeeping of the pole stretches is not symmetric, and is reflected as the trace would have done it:
 the tracer locates the turning points of the north pole stretch (TP) only, and stops at min_stretch at the north
-pole only. So the pear branch is traced with its south pole turning points located too (``switching.Turn.SOUTH``):
+pole only. So the pear branch is traced with its south pole turning points located too (``switching.Turn.BOTTOM``):
 they become the mirror's TP, while the pear's own TP (the mirror's south turning points) are not carried over; the
-stops STOP_STRETCH and SOUTH_STOP_STRETCH swap; LP, LV, LN and EP keep their kind with X reflected; a rejoin (the
+stops STOP_STRETCH and BOTTOM_STOP_STRETCH swap; LP, LV, LN and EP keep their kind with X reflected; a rejoin (the
 BP of an equator-symmetric primary point) is its own reflection as a state, its coefficients reflected onto the
 mirrored wire map like every other point's (on a map an equator-symmetric state's coefficients are not their own
 reflection). A pear branch that stopped on min_stretch, or whose
@@ -31,10 +31,10 @@ from dataclasses import replace
 import numpy as np
 
 from ..branches.events import event_points
-from ..branches.primary import north_stop_stretch
+from ..branches.primary import top_stop_stretch
 from ..branches.problem import branch_system
 from ..results import Branch, Kind, Leg, Origin, SpecialPoint, Stop, StopCode
-from .pear import Turn, south_stop_stretch
+from .pear import Turn, bottom_stop_stretch
 
 MIRROR = "_mirror"  # the suffix of a branch's mirror image (a pear branch's, a whole-sphere pitchfork branch's)
 
@@ -44,29 +44,29 @@ def reflectable(scene) -> bool:
     return scene.field.is_equator_symmetric
 
 
-def take_south_turns(branch: Branch) -> list[SpecialPoint]:
-    """Remove the south pole turning points (``Turn.SOUTH``, traced for the reflection) from ``branch.special``
+def take_bottom_turns(branch: Branch) -> list[SpecialPoint]:
+    """Remove the south pole turning points (``Turn.BOTTOM``, traced for the reflection) from ``branch.special``
     and return them."""
-    turns = [s for s in branch.special if s.kind == Turn.SOUTH]
-    branch.special = [s for s in branch.special if s.kind != Turn.SOUTH]
+    turns = [s for s in branch.special if s.kind == Turn.BOTTOM]
+    branch.special = [s for s in branch.special if s.kind != Turn.BOTTOM]
     return turns
 
 
-def reflection(pear: Branch, south_turns: list[SpecialPoint], name: str) -> Branch | Origin:
+def reflection(pear: Branch, bottom_turns: list[SpecialPoint], name: str) -> Branch | Origin:
     """The mirror image ``name`` of the traced pear branch ``pear`` and of its assessments, if any (module
     docstring), its residuals checked; or, where it is not the mirror the trace would give or a reflected point
     fails the check, the Origin to record on the traced mirror instead."""
     t0 = time.perf_counter()
     cont = pear.scene.continuation
-    if pear.stopped(StopCode.MIN_STRETCH) or pear.pole_values()["lam2_south"].min() <= cont.min_stretch:
+    if pear.stopped(StopCode.MIN_STRETCH) or pear.pole_values()["lam2_bottom"].min() <= cont.min_stretch:
         return Origin.TRACED_NOT_REFLECTABLE
     disc = pear.disc.reflected()
     mirror = replace(pear, name=name, disc=disc, X=pear.disc.reflect(pear.X), origin=Origin.REFLECTED,
                      reflection_of=pear.name)
     if not reflection_excess(pear, mirror).max() <= pear.scene.solver.tol:
         return Origin.TRACED_REFLECTION_FAILED
-    swapped = {StopCode.STOP_STRETCH: south_stop_stretch(cont.stop_stretch),
-               StopCode.SOUTH_STOP_STRETCH: north_stop_stretch(cont.stop_stretch)}
+    swapped = {StopCode.STOP_STRETCH: bottom_stop_stretch(cont.stop_stretch),
+               StopCode.BOTTOM_STOP_STRETCH: top_stop_stretch(cont.stop_stretch)}
 
     def stop(s: Stop) -> Stop:  # the stops that name a pole or a coil are reflected; the others are the same
         if s.code == StopCode.WIRE_GAP:
@@ -74,7 +74,7 @@ def reflection(pear: Branch, south_turns: list[SpecialPoint], name: str) -> Bran
         return swapped.get(s.code, s)
 
     # the user points are located again on the image (an event of one pole is not one of the other)
-    special = [_reflected(s, pear.disc, stop) for s in pear.special + south_turns if s.kind not in (Kind.TP, Kind.UZ)]
+    special = [_reflected(s, pear.disc, stop) for s in pear.special + bottom_turns if s.kind not in (Kind.TP, Kind.UZ)]
     special += event_points(mirror)
     return replace(mirror, special=sorted(special, key=lambda s: s.index),
                    legs=tuple(Leg(leg.label, stop(leg.stop)) for leg in pear.legs),
@@ -98,5 +98,5 @@ def _reflected(s: SpecialPoint, disc, stop) -> SpecialPoint:
     basis: a south turning point becomes a TP. A rejoin (BP, a primary branch point) is its own reflection as a
     state, but not as coefficients on a wire map: there ``disc.reflect`` gives the same state on the mirrored map
     (its critical mode, in x, is the primary's and stays)."""
-    kind = Kind.TP if s.kind == Turn.SOUTH else s.kind
+    kind = Kind.TP if s.kind == Turn.BOTTOM else s.kind
     return replace(s, kind=kind, X=disc.reflect(s.X), stop=None if s.stop is None else stop(s.stop))

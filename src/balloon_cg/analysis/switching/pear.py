@@ -30,23 +30,23 @@ from ..branches.control import landing
 from ..branches.events import with_events
 from ..branches.primary import stop_rule
 from ..results import Branch, Kind, SpecialPoint, StopCode
-from ..branches.tracer import NORTH_TURNING
+from ..branches.tracer import TOP_TURNING
 from ...numerics.threads import limited_blas
 
 
 class Turn(enum.StrEnum):
     """A fold label of a pear trace that is no ``Kind``: the turning point of the south pole stretch, located when
-    ``trace_pear`` is asked for ``south_turns`` (the mirror image's TP: ``mirror``); never stored as such."""
+    ``trace_pear`` is asked for ``bottom_turns`` (the mirror image's TP: ``mirror``); never stored as such."""
 
-    SOUTH = "TP_south"
+    BOTTOM = "TP_bottom"
 
 
 @limited_blas
 def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progress=None,
-               delta: float = 1e-3, south_turns: bool = False) -> Branch | None:
+               delta: float = 1e-3, bottom_turns: bool = False) -> Branch | None:
     """The bifurcating branch leaving ``bp`` along sign·φ until it rejoins or stops; None if the first
-    correction fails. ``south_turns``: its special points include the turning points of the south pole stretch
-    too, labelled ``Turn.SOUTH`` (located as TP is for the north pole)."""
+    correction fails. ``bottom_turns``: its special points include the turning points of the south pole stretch
+    too, labelled ``Turn.BOTTOM`` (located as TP is for the north pole)."""
     t0 = time.perf_counter()
     scene = branch.scene
     tracer = general_tracer(scene, bp.block)
@@ -74,26 +74,26 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
             return Stop(StopCode.REJOINED, "rejoined the primary branch")
         return base(disc, point)
 
-    turning = NORTH_TURNING | ({Turn.SOUTH: "lam2_south"} if south_turns else {})
+    turning = TOP_TURNING | ({Turn.BOTTOM: "lam2_bottom"} if bottom_turns else {})
     return with_events(assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree,
                                                                  turning=turning), t0=t0, land_on=pear_landing(scene)))
 
 
-def south_stop_stretch(upper: float) -> Stop:
+def bottom_stop_stretch(upper: float) -> Stop:
     """The stop of a pear branch whose south pole stretch reached ``upper`` (continuation.stop_stretch)."""
-    return Stop(StopCode.SOUTH_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
+    return Stop(StopCode.BOTTOM_STOP_STRETCH, f"south pole stretch reached stop_stretch {upper:g}")
 
 
 def pear_stop_rule(scene):
     """stop(disc, point) -> Stop or None of a pear branch (no equator symmetry, either pole may grow): its south
-    pole stretch reaches continuation.stop_stretch (``south_stop_stretch``), or the primary branch's rule
+    pole stretch reaches continuation.stop_stretch (``bottom_stop_stretch``), or the primary branch's rule
     (``primary.stop_rule``: the north pole's range, the wires, the control's stops)."""
     stretch = scene.continuation.stop_stretch
     base = stop_rule(scene, stretch)
 
     def stop(disc, point):
-        south = float(disc.pole_rows()["lam2_south"] @ point.X[:-1])
-        return south_stop_stretch(stretch) if south >= stretch else base(disc, point)
+        south = float(disc.pole_rows()["lam2_bottom"] @ point.X[:-1])
+        return bottom_stop_stretch(stretch) if south >= stretch else base(disc, point)
 
     return stop
 
@@ -102,8 +102,8 @@ def pear_landing(scene) -> dict:
     """``assembly.assemble``'s land_on of a pear branch: either pole stretch at stop_stretch, the north pole at
     min_stretch, and the control stop (``control.landing``)."""
     stretch = scene.continuation.stop_stretch
-    return {StopCode.STOP_STRETCH: ("lam2_north", stretch), StopCode.SOUTH_STOP_STRETCH: ("lam2_south", stretch),
-            StopCode.MIN_STRETCH: ("lam2_north", scene.continuation.min_stretch)} | landing(scene.loading)
+    return {StopCode.STOP_STRETCH: ("lam2_top", stretch), StopCode.BOTTOM_STOP_STRETCH: ("lam2_bottom", stretch),
+            StopCode.MIN_STRETCH: ("lam2_top", scene.continuation.min_stretch)} | landing(scene.loading)
 
 
 def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:
@@ -115,12 +115,12 @@ def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:
     if fold.kind != Kind.LP or i + 1 >= len(branch.X):
         return False
     poles = branch.pole_values(branch.X[i:i + 2])
-    amplitude = poles["lam2_north"] - poles["lam2_south"]
+    amplitude = poles["lam2_top"] - poles["lam2_bottom"]
     if amplitude[0] * amplitude[1] > 0:
         return False
     at = branch.pole_values(bp_X)
-    point = np.array([bp_X[-1], at["lam2_north"][0], at["lam2_south"][0]])
-    ends = np.stack([branch.X[i:i + 2, -1], poles["lam2_north"], poles["lam2_south"]], axis=1)
+    point = np.array([bp_X[-1], at["lam2_top"][0], at["lam2_bottom"][0]])
+    ends = np.stack([branch.X[i:i + 2, -1], poles["lam2_top"], poles["lam2_bottom"]], axis=1)
     return float(np.abs(ends - point).max(axis=1).min()) <= float(np.abs(ends[1] - ends[0]).max())
 
 
