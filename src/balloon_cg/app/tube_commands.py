@@ -87,7 +87,10 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
     stage = run["attrs"]["interrupted"]
     if stage:
         stored = run["onset"] if stage == "onset" else run["branches"].get(stage)
-        if stored is None:
+        if stage == "frequencies":
+            done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
+            what = f"the branches whole, the frequencies of {', '.join(done) or 'none'} written"
+        elif stored is None:
             what = "not started"
         else:
             what = f"{stored['attrs']['stop_message']}, after {len(stored['pressure'])} points"

@@ -26,6 +26,7 @@ class Stage(enum.StrEnum):
     PRIMARY = "primary"  # the primary branch (tube/primary.py)
     BULGE = "bulge"  # the bulge branch (tube/bulge.py)
     ONSET = "onset"  # the onset curve of ``critical`` (tube/onset.py)
+    FREQUENCIES = "frequencies"  # the branches' natural frequencies (dynamics/tube.py): the branches are whole
 
 
 @dataclass(frozen=True)
