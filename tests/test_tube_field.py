@@ -123,3 +123,31 @@ def test_onset_curve_is_the_branch_points_of_the_primary_branch_and_turns_back_a
     above = primary_branch(coil_scene(1.01 * critical)).branch_points(Mirror.ODD)
     near = lambda points: [b for b in points if abs(b.pressure - fold_pressure) < 0.05]  # noqa: E731
     assert len(near(below)) >= 1 and len(near(above)) == 0
+
+
+def test_a_tube_in_a_coil_field_has_no_maxwell_pressure():
+    """Maxwell's equal-area rule joins two uniform states of a closed tube; in a coil's field no uniform state is an
+    equilibrium, so a tube run in a field stores none (tube/picture.maxwell), and the field-free value is kept where
+    the coils carry no current (M = 0). Why, from the energy written here: at a uniform state (ρ = λθ,
+    η = −λz(S − L/2)) the first variation along the mirror-symmetric mode δρ = cos(2πS/L) gets nothing from the
+    elastic and pressure terms (their densities are the same at every S, and the mode has zero mean) and
+    −½χM ∫ ∂H²/∂ρ cos(2πS/L) dS from the field (H² by the Biot–Savart integral written here): it is far from zero
+    on a grid of uniform states around the onset, so none of them is an equilibrium."""
+    from balloon_cg.tube.picture import maxwell
+
+    scene = coil_scene(0.01)
+    assert maxwell(scene) is None
+    assert maxwell(coil_scene(0.0)) == tube.maxwell_pressure(scene.material)[0]
+    coils = [(c.radius, c.height, c.current) for c in scene.field.coils]
+    x, w = np.polynomial.legendre.leggauss(200)
+    length = scene.geometry.length
+    S, weights = (x + 1) * length / 2, w * length / 2
+    mode, h = np.cos(2 * np.pi * S / length), 1e-5
+    first = []
+    for hoop in np.linspace(1.1, 2.3, 7):
+        for axial in (0.8, 1.0, 1.2, 1.5):
+            eta = -axial * (S - length / 2)
+            slope = (biot_savart_squared(np.full_like(S, hoop + h), eta, coils)
+                     - biot_savart_squared(np.full_like(S, hoop - h), eta, coils)) / (2 * h)
+            first.append(-scene.field.chi * scene.field.M / 2 * weights @ (slope * mode))
+    assert np.abs(first).min() > 1e-3, np.abs(first).min()  # measured 2.3e-2 (M = 0.01)
