@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
-from .primary import primary_branch
+from .primary import in_field, primary_branch
 from .results import IntervalBranch
 from ..analysis.results import StopCode
 from ..galerkin.interval import Mirror
@@ -103,7 +103,3 @@ def maxwell(scene) -> float | None:
     found = maxwell_pressure(scene.material)
     return None if found is None else float(found[0])
 
-
-def in_field(scene) -> bool:
-    """Whether coils act on the tube (field.M > 0 and at least one coil)."""
-    return scene.field.M > 0 and bool(scene.field.coils)

@@ -6,7 +6,9 @@ The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium; with its
 by pseudo-arclength continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted
 to the even block, interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps
 its equator symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the
-north pole stretch means nothing), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
+north pole stretch means nothing), in a coil field where its states turn compressed after being taut
+(IntervalStop.COMPRESSED: tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point
+after SIGINT/SIGTERM
 (numerics.interrupt: StopCode.INTERRUPTED); the points located up to stop_stretch are kept,
 those in the step that passed it included. Folds in P (LP) are located by the tracer's fold monitor. At every point the
 second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the spectrum of each is computed (its
@@ -24,7 +26,7 @@ from dataclasses import replace
 import numpy as np
 
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
-from .stability import smallest_stress, spectrum, unstable_counts
+from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
 from ..analysis.stability.crossings import count_changes
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
@@ -66,6 +68,11 @@ class TubeSystem:
         return self.system.jacobian(self.full(X))[np.ix_(self.unknowns, self.columns)]
 
 
+def in_field(scene) -> bool:
+    """Whether coils act on the tube (field.M > 0 and at least one coil)."""
+    return scene.field.M > 0 and bool(scene.field.coils)
+
+
 def scene_parameters(scene, pressure: float = 0.0) -> Parameters:
     """The branch parameters of a tube scene at ``pressure``: the field's M and χ (M = 0 without coils)."""
     return Parameters(pressure, scene.field.M, scene.field.chi)
@@ -101,14 +108,17 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     t = continuation.tangent(system, X, np.eye(X.size)[-1])
     start = continuation.Point(X, t, 0, float(np.abs(system.residual(X)).max()))
     limit = scene.continuation.stop_stretch
+    compressed = CompressionStop(eq, in_field(scene))
+    compressed(system.full(X)[:-1])
 
     def stop(point):
         if (interrupted := signalled()) is not None:
             return interrupted
-        hoop = eq.disc.node_state(system.full(point.X)[:-1])[0].max()
+        u = system.full(point.X)[:-1]
+        hoop = eq.disc.node_state(u)[0].max()
         if hoop > limit:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch {limit:g}")
-        return None
+        return compressed(u)
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
     reached = path.points + ([path.overshoot] if path.overshoot is not None else [])  # the last step's too
