@@ -13,7 +13,7 @@ import numpy as np
 
 from .primary import TubeSystem, held, primary_branch, volume_ratio
 from .results import IntervalStop
-from ..analysis.problem import ParameterSystem
+from ..analysis.branches.problem import ParameterSystem
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics.newton import newton
