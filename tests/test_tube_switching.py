@@ -35,12 +35,14 @@ def switched(length, degree, block, extra=""):
 def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
     """Closed and held apart (λ = 1.2): the branch switched at the first even branch point of L = 20 (degree 60) is
     mirror-symmetric (its odd coefficients zero), bulges at both ends (ρ(0) = ρ(L) > ρ(L/2)), and its first volume
-    fold (taut) has the P and V/V0 of the first volume fold of the bulge branch of L = 10 (degree 30) within 1e-9 (measured 3e-11 and
-    8e-12; the held even branch point itself is located only to 6e-7 in P, status nearest: the corrector of the even
-    block diverges near it, docs/shapes.md)."""
-    folds = {}
+    fold (taut) has the P and V/V0 of the first volume fold of the bulge branch of L = 10 (degree 30) within 1e-9
+    (measured 3.1e-11 and 8.2e-12); the branch points themselves, both located, within 1e-12 (measured 1.3e-15 and
+    8.9e-16; the held even one was found only to 5.6e-7 before tube/primary._off_mode_corrector)."""
+    folds, onsets = {}, {}
     for length, degree, block in ((10.0, 30, Mirror.ODD), (20.0, 60, Mirror.EVEN)):
         scene, primary, point, branch = switched(length, degree, block, extra)
+        assert point.status == "located"
+        onsets[block] = point.pressure
         assert branch.stop.code in ("volume", "rejoined")
         fold = next(s for s in branch.special if s.kind == "LV")
         assert fold.smallest_stress > 0 and fold.status == "located"
@@ -50,6 +52,7 @@ def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
     assert np.abs(branch.states[:, odd]).max() == 0  # traced on the even block
     rho = branch.disc.profile(branch.states[-1], np.array([0.0, 10.0, 20.0]))[0]
     assert rho[0] == pytest.approx(rho[2], abs=1e-12) and rho[0] > rho[1] + 1
+    assert abs(onsets[Mirror.EVEN] - onsets[Mirror.ODD]) <= 1e-12
     assert abs(folds[Mirror.EVEN][0] - folds[Mirror.ODD][0]) <= 1e-9
     assert abs(folds[Mirror.EVEN][1] - folds[Mirror.ODD][1]) <= 1e-9
 

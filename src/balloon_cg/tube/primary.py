@@ -24,6 +24,7 @@ basis) and its first odd-block branch point is the onset of the bulge mode cos(�
 from dataclasses import replace
 
 import numpy as np
+from scipy import linalg
 
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
@@ -193,11 +194,20 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
                   params: Parameters):
     """(Y = (u, P), status) where the eigenvalue number ``order`` (ascending, from 0) of ``block`` vanishes between
     two points, by Brent in the arclength from ``before`` (``params``: the branch's, P replaced); None when it is
-    the fold in P (the null vector not orthogonal to ∂R/∂P)."""
+    the fold in P (the null vector not orthogonal to ∂R/∂P). Each value is a Keller corrector; near a branch point
+    of the even block (the branch's own unknowns) that one may diverge, and then ``_off_mode_corrector`` is used."""
     index = eq.disc.block(block)
+    mode = None  # the crossing eigenvalue's vector at ``before`` where the branch's own unknowns hold it (even block)
+    if block == Mirror.EVEN:
+        Y = system.full(before.X)
+        H = eq.jacobian(Y[:-1], params.with_value("P", Y[-1]))[np.ix_(system.unknowns, system.unknowns)]
+        mode = np.append(np.linalg.eigh(H)[1][:, order], 0.0)
 
     def value_at(s):
-        result = continuation.correct(system, before.X + s * before.tangent, before.tangent, settings)
+        predictor = before.X + s * before.tangent
+        result = continuation.correct(system, predictor, before.tangent, settings)
+        if not result.converged and mode is not None:
+            result = _off_mode_corrector(system, predictor, before.tangent, mode, settings)
         if not result.converged:
             raise ArithmeticError(result.message)
         Y = system.full(result.x)
@@ -215,3 +225,22 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
     if abs(phi @ dP[index]) > ORTHOGONAL * np.linalg.norm(dP):
         return None
     return Y, root.status
+
+
+def _off_mode_corrector(system: TubeSystem, predictor: np.ndarray, tangent: np.ndarray, mode: np.ndarray, settings):
+    """Keller's corrector with the direction ``mode`` (X-coordinates; the crossing eigenvalue's vector of the branch's
+    own block) held at the predictor's component: near a branch point that breaks a symmetry the branch keeps (the
+    uniform tube's modes cos(nπS/L), n even, in the even block) the branch's states have no component along it, and
+    Keller's system, singular at the branch point, lets rounding grow along it. Solved: Qᵀ R(X) = 0 (Q an orthonormal
+    basis of the residual rows orthogonal to the mode: its own row, zero on the branch by the symmetry, dropped),
+    tangent·X and mode·X at the predictor's; not converged where the dropped row is not zero there (the branch does
+    move along the mode: no symmetry)."""
+    Q = linalg.null_space(mode[None, :-1])
+    result = newton(lambda X: Q.T @ system.residual(X), lambda X: Q.T @ system.jacobian(X), predictor,
+                    np.vstack([tangent, mode]), [tangent @ predictor, mode @ predictor], settings.tol,
+                    settings.max_newton)
+    dropped = abs(mode[:-1] @ system.residual(result.x)) if result.converged else np.inf
+    if dropped > settings.tol:
+        return replace(result, converged=False, message=f"{result.message}; off the mode: the residual along it is "
+                                                        f"{dropped:.3g}")
+    return result
