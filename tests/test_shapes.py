@@ -22,6 +22,7 @@ from balloon_cg.model.kernels import KernelSet
 from balloon_cg.model.shooting import shoot_symmetric
 from balloon_cg.post.quantities import quantities
 from balloon_cg.scene import SceneError, Shape, load_scene, parse_scene
+from documented import inspect_json_keys
 
 SPHEROID = '[geometry]\nshape = "spheroid"\naspect = {aspect}\n'
 
@@ -266,7 +267,8 @@ def test_inspect_and_load_name_the_shape_and_its_aspect(tmp_path, capsys, geomet
     assert main(["inspect", str(path)]) == 0
     assert f"shape          {shape}\n" in capsys.readouterr().out
     assert main(["inspect", "--json", str(path)]) == 0
-    assert json.loads(capsys.readouterr().out)["geometry"] == table
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["geometry"] == table and set(summary) == inspect_json_keys("run file")  # docs/hdf5.md's keys
     result = bc.load(path)
     assert result.geometry == table and (shape in repr(result)) == (shape != "sphere")
     assert {k: result.to_xarray().attrs[k] for k in table} == table

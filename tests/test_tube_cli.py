@@ -13,6 +13,7 @@ from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.model import tube
 from balloon_cg.scene import load_scene
 from balloon_cg.tube.picture import tube_picture
+from documented import inspect_json_keys
 SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
 FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s
 
@@ -57,7 +58,8 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     assert "Maxwell        P_M = 0.445022155" in text and "branch bulge:" in text and " LV " in text
     assert main(["inspect", str(run_file), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
-    assert summary["kind"] == "tube" and summary["geometry"]["axial_stretch"] is None
+    assert summary["kind"] == "tube" and set(summary) == inspect_json_keys("tube run file")  # docs/hdf5.md's keys
+    assert summary["geometry"] == {"shape": "tube", "length": 10.0, "ends": "sliding", "axial_stretch": None}
     assert summary["branches"]["primary"]["special_points"][0]["kind"] == "LP"
 
 

@@ -8,9 +8,12 @@ import numpy as np
 import pytest
 
 from balloon_cg.app.cli import main
-from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.galerkin.interval import Mirror
+from balloon_cg.io.tube_file import read_tube_run, stored_branch
 from balloon_cg.scene import load_scene
+from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.picture import tube_picture
+from balloon_cg.tube.primary import scene_parameters
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "tube_spom1_L10.toml"
@@ -40,6 +43,21 @@ def test_the_bulge_from_the_onset_label_is_runs_with_the_new_settings(run_file, 
     assert len(bulge.pressure) > len(stored["branches"]["bulge"]["pressure"])  # further than the file's
 
 
+def test_the_branch_from_an_even_label_is_bulge_branchs(run_file, tmp_path, capsys):
+    """Label 2, the primary branch's first even branch point (the mode cos(2πS/L) of the uniform tube): the branch
+    switched there (tube/bulge.bulge_branch, traced on the even block: mirror-symmetric), bit for bit."""
+    out = tmp_path / "even.h5"
+    assert main(["continue", str(run_file), "2", "-o", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("bulge branch from label 2: ")
+    scene = load_scene(SCENE).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 3})
+    primary = stored_branch(read_tube_run(run_file), "primary", scene_parameters(scene))
+    assert (primary.special[2].kind, primary.special[2].block) == ("BP", "even")
+    even = bulge_branch(scene, primary, primary.special[2], stop_stretch=3)
+    continued = read_tube_run(out)["branches"]["bulge"]
+    assert np.array_equal(continued["unknowns"], even.states) and len(even.pressure) > 5
+    assert np.abs(even.states[:, even.disc.block(Mirror.ODD)]).max() == 0
+
+
 def test_the_onset_in_m_from_the_label_is_critical_s(tmp_path, capsys):
     critical = tmp_path / "critical.h5"
     assert main(["critical", str(COIL_SCENE), "--parameter", "M", "-o", str(critical), "--quiet", *COIL_FAST]) == 0
@@ -54,8 +72,10 @@ def test_the_onset_in_m_from_the_label_is_critical_s(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["0"], "label 0: LP on branch primary; a tube continues from an odd branch point of its primary branch (the "
-            "onset of bulging): labels 1, 3, 5"),
+    (["0"], "label 0: LP on branch primary; a tube continues from a branch point of its primary branch (odd: the "
+            "onset of bulging; even: on its uniform branch): labels 1, 2, 3, 4, 5"),
+    (["2", "--parameter", "M"], "label 2: BP even on branch primary; a tube continues from an odd branch point of "
+                                "its primary branch (the onset of bulging): labels 1, 3, 5"),
     (["6"], "label 6: LV on branch bulge;"),
     (["17"], "label 17: no such label;"),
     (["1", "--set", "material.preset=TPOM1"], "--set material.preset=TPOM1: the stored branch belongs to the file's "

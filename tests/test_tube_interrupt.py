@@ -134,3 +134,21 @@ def test_a_signal_at_an_evenly_spaced_moment_stops_a_tube_run_within_2_s(referen
     assert got.code == 130, line
     stage = checked(folder / "r.h5", line, references[0])
     print(f"moment {t:.3f} s of {total:.3f} s CPU: {stage}, exit after {got.cpu_after:.3f} s CPU")
+
+
+def test_a_signal_during_a_tube_runs_frequencies_stops_them_at_the_next_point(references, tmp_path):
+    """With [dynamics] frequencies the signal after the 3rd point's frequencies (of the primary branch's ~20): the
+    command exits 130 within that point, the branches are the uninterrupted run's whole, no branch has frequencies
+    (the primary's were not finished) and the line says so."""
+    argv = run_argv("r.h5") + ["--set", "dynamics.frequencies=true"]
+    code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.dynamics.tube:tube_frequencies", argv, 3)
+    assert code == 130, err
+    assert one_line(err) == ("balloon-cg: interrupted (frequencies: the branches whole, the frequencies of none "
+                             "written); what was finished is written to r.h5 (flagged interrupted)")
+    run = read_tube_run(tmp_path / "r.h5")
+    assert run["attrs"]["interrupted"] == "frequencies"
+    assert set(run["branches"]) == set(references[0]["branches"]) == {"primary", "bulge"}
+    for name, branch in run["branches"].items():
+        assert branch["frequencies"] is None
+        assert np.array_equal(branch["unknowns"], references[0]["branches"][name]["unknowns"])
+        assert branch["attrs"]["stop_code"] == references[0]["branches"][name]["attrs"]["stop_code"]

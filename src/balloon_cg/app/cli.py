@@ -420,9 +420,13 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
 # --- solve -------------------------------------------------------------------------------------------------
 
 def _add_solve(commands):
-    p = commands.add_parser("solve", help="one equilibrium on the primary branch at a given north pole stretch")
+    p = commands.add_parser("solve", help="one equilibrium on the primary branch at a given north pole stretch (a "
+                                          "tube: at a given hoop stretch at its middle)")
     p.add_argument("scene", help=SCENE_HELP)
-    p.add_argument("--pole-stretch", type=float, required=True, metavar="X", help="north pole stretch λ2(0) (> 1)")
+    given = p.add_mutually_exclusive_group(required=True)
+    given.add_argument("--pole-stretch", type=float, metavar="X", help="north pole stretch λ2(0) (> 1)")
+    given.add_argument("--hoop-stretch", type=float, metavar="X",
+                       help="a tube's hoop stretch at its middle λ2(L/2) (> 1; docs/shapes.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_settings(p, shorthands=False)
     p.set_defaults(handler=solve)
@@ -437,6 +441,13 @@ def solve(args) -> int:
     from .summaries import format_table
 
     scene = axisymmetric(scene_of(args), "solve")
+    if (scene.geometry.shape == "tube") != (args.hoop_stretch is not None):
+        given = "--pole-stretch" if args.hoop_stretch is None else "--hoop-stretch"
+        wanted = "a tube has no pole: give --hoop-stretch X (λ2 at its middle)" if args.hoop_stretch is None else \
+            "the hoop stretch at a tube's middle: give --pole-stretch X for this shape"
+        raise UsageError(f"solve {args.scene}: {given}: {wanted}")
+    if args.hoop_stretch is not None:
+        return solve_tube(scene, args)
     x = args.pole_stretch
     if not np.isfinite(x) or x <= 1:
         raise UsageError(f"--pole-stretch = {x:g}: must be > 1 (λ2(0) = 1 is the undeformed sphere)")
@@ -450,6 +461,30 @@ def solve(args) -> int:
             f"largest stretch reached: {reached:.10g}"
         )
     result = solution(branch, -1)
+    print(strict_json(result) if args.json else format_table(result | {"wall_time": f"{result['wall_time']:.3f} s"}))
+    return 0
+
+
+def solve_tube(scene, args) -> int:
+    """``solve`` on a tube: the primary branch's state with the hoop stretch --hoop-stretch at its middle
+    (tube/point.py), reported as ``solve`` reports a sphere's."""
+    import time
+
+    import numpy as np
+
+    from ..scene.tables import MAX_STRETCH
+    from ..tube.point import NotReached, point_at_middle_hoop, tube_solution
+    from .summaries import format_table
+
+    x = args.hoop_stretch
+    if not np.isfinite(x) or not 1 < x <= MAX_STRETCH:
+        raise UsageError(f"--hoop-stretch = {x:g}: must be in (1, {MAX_STRETCH:g}] (1 is the undeformed tube)")
+    clock = time.perf_counter()
+    try:
+        point = point_at_middle_hoop(scene, x)
+    except NotReached as e:
+        raise Failure(str(e)) from None
+    result = tube_solution(point) | {"wall_time": time.perf_counter() - clock}
     print(strict_json(result) if args.json else format_table(result | {"wall_time": f"{result['wall_time']:.3f} s"}))
     return 0
 

@@ -5,6 +5,7 @@ file's ``interrupted`` attribute names the stage, and the command exits 130 with
 import sys
 
 from .cli import INTERRUPTED, PROG, Failure, UsageError, _say, field_needed
+from ..scene.tables import Ends
 
 
 def run_tube(scene, output, args) -> int:
@@ -87,7 +88,10 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
     stage = run["attrs"]["interrupted"]
     if stage:
         stored = run["onset"] if stage == "onset" else run["branches"].get(stage)
-        if stored is None:
+        if stage == "frequencies":
+            done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
+            what = f"the branches whole, the frequencies of {', '.join(done) or 'none'} written"
+        elif stored is None:
             what = "not started"
         else:
             what = f"{stored['attrs']['stop_message']}, after {len(stored['pressure'])} points"
@@ -99,6 +103,14 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
     return None
 
 
+def _has_field(run: dict) -> bool:
+    """Whether coils act in the tube run file's scene (its primary branch is then not uniform)."""
+    from .tube_summary import scene_field
+
+    field = scene_field(run["attrs"]["scene_toml"])
+    return field["coils"] > 0 and field["M"] > 0
+
+
 def tube_labels(run: dict) -> list:
     """The labels of a tube run (``read_tube_run``'s dict), as ``inspect`` numbers them: (branch, its k-th located
     point, the point) for the primary branch's located points, then the other branches'."""
@@ -108,33 +120,38 @@ def tube_labels(run: dict) -> list:
 
 def continue_tube(args) -> int:
     """``continue`` from a label of a tube run file (``inspect`` numbers the located points of its branches in
-    order, from 0): at an odd branch point of the primary branch (the onset of bulging) the bulge branch switched
-    there, with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
+    order, from 0): at an odd branch point of the primary branch (the onset of bulging), or at an even one of a
+    uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
     traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
     the stored primary branch to a tube run file (130 on a signal, as ``run``). Exit 2, before any work, for another
     label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
     from ..scene import SceneError, parse_scene
-    from ..scene.tables import Ends
     from ..tube.picture import bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
     from .cli import _with_settings
 
     run = read_tube_run(args.run)
     labels = tube_labels(run)
-    onsets = [i for i, (name, _, s) in enumerate(labels) if (name, s["kind"], s["block"]) == ("primary", "BP", "odd")]
+    if args.parameter not in (None, "P", "M", "field.M"):
+        raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M "
+                         "(allowed: M, or none for the bulge branch)")
+    in_field = args.parameter in ("M", "field.M")
+    uniform = run["attrs"]["ends"] == Ends.SLIDING.value and not _has_field(run)  # even BPs switched there
+    blocks = ("odd",) if in_field or not uniform else ("odd", "even")
+    onsets = [i for i, (name, _, s) in enumerate(labels) if name == "primary" and s["kind"] == "BP"
+              and s["block"] in blocks]
     if not 0 <= args.label < len(labels) or args.label not in onsets:
         if 0 <= args.label < len(labels):
             name, _, s = labels[args.label]
             what = " ".join(filter(None, (s["kind"], s["block"]))) + f" on branch {name}"
         else:
             what = "no such label"
-        raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from an odd branch point "
-                         f"of its primary branch (the onset of bulging): labels {', '.join(map(str, onsets)) or 'none'}")
-    if args.parameter not in (None, "P", "M", "field.M"):
-        raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M "
-                         "(allowed: M, or none for the bulge branch)")
+        which = "an odd branch point of its primary branch (the onset of bulging)" if blocks == ("odd",) else \
+            "a branch point of its primary branch (odd: the onset of bulging; even: on its uniform branch)"
+        raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
+                         f"{', '.join(map(str, onsets)) or 'none'}")
     try:
         stored = parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
     except SceneError as e:
@@ -144,7 +161,6 @@ def continue_tube(args) -> int:
     if other:
         raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
                          "the file's scene; allowed: continuation.* keys")
-    in_field = args.parameter in ("M", "field.M")
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:

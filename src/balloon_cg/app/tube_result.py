@@ -57,7 +57,7 @@ class TubeResult:
 
     @property
     def maxwell_pressure(self) -> float | None:
-        """Maxwell's pressure of the uniform closed tube (None: none, or the ends held)."""
+        """Maxwell's pressure of the uniform closed tube (None: none, the ends held, or coils acting)."""
         p = self.run["attrs"]["maxwell_pressure"]
         return None if math.isnan(p) else float(p)
 

@@ -67,11 +67,20 @@ def _onset(onset: dict | None) -> dict | None:
             "folds": onset["folds"], "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
 
 
+def _no_maxwell(summary: dict) -> str:
+    """Why a tube run has no Maxwell pressure (tube/picture.maxwell)."""
+    if summary["geometry"]["axial_stretch"] is not None:
+        return "none (the ends are held apart)"
+    if summary["field"]["coils"] and summary["field"]["M"] > 0:
+        return "none (in a coil field there is no uniform state to draw an equal-area line on)"
+    return "none (the uniform closed path has no pressure maximum and minimum)"
+
+
 def format_tube(summary: dict) -> str:
     """Readable summary of ``summarise_tube``."""
     g, p = summary["geometry"], summary["provenance"]
     held = "free (closed)" if g["axial_stretch"] is None else f"held at {g['axial_stretch']:g} L"
-    maxwell = "none" if summary["maxwell_pressure"] is None else f"{summary['maxwell_pressure']:.10g}"
+    maxwell = _no_maxwell(summary) if summary["maxwell_pressure"] is None else f"{summary['maxwell_pressure']:.10g}"
     lines = [f"file           {summary['file']}",
              f"scene          {summary['scene_name']}",
              f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",

@@ -21,6 +21,7 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..model.meridian import mass_density
 from ..numerics import eigen, interrupt
+from ..tube.picture import Stage
 from .pencil import PER_EIGENVALUE, table_of
 
 VOLUME = "_volume"  # the suffix of a block under volume control
@@ -67,13 +68,15 @@ class TubeFrequencies:
 
 def tube_branch_frequencies(scene, branch, count: int = 3) -> TubeFrequencies:
     """``tube_frequencies`` at every point and located point of ``branch`` (tube/results.IntervalBranch), the
-    mirror blocks where it is mirror-symmetric (its ``lowest`` per Mirror block is not empty)."""
+    mirror blocks where it is mirror-symmetric (its ``lowest`` per Mirror block is not empty); numerics.interrupt's
+    Interrupted before any point once a signal asked for a stop."""
     eq = Equilibrium(scene, branch.disc)
     mass = tube_mass(eq)
     symmetric = bool(branch.lowest)
     names = list(tube_blocks(branch.disc, symmetric))
 
     def at(u, pressure):
+        interrupt.check()
         return tube_frequencies(eq, mass, u, branch.params.with_value("P", float(pressure)), symmetric, count)
 
     rows = [at(u, P) for u, P in zip(branch.states, branch.pressure)]
@@ -93,9 +96,16 @@ def tube_matching_block(special, symmetric: bool) -> str:
 def with_frequencies(scene, picture):
     """``picture`` (tube/picture.TubePicture) with every branch's TubeFrequencies where the scene's [dynamics] asks
     for them (``count`` each), else as it is: also where a signal stopped the picture or has come since (they are
-    not computed then: a signal ends the work at its next stage, numerics.interrupt)."""
+    not computed then: a signal ends the work at its next stage, numerics.interrupt). A signal while they are
+    computed stops them at the next point: the branches finished keep theirs, the others have none, and the picture
+    is interrupted in the frequencies stage (Stage.FREQUENCIES)."""
     if not scene.dynamics.frequencies or picture.interrupted is not None or interrupt.requested():
         return picture
     count = scene.dynamics.count
-    return replace(picture, frequencies={name: tube_branch_frequencies(scene, branch, count)
-                                         for name, branch in picture.branches.items()})
+    found = {}
+    try:
+        for name, branch in picture.branches.items():
+            found[name] = tube_branch_frequencies(scene, branch, count)
+    except interrupt.Interrupted:
+        return replace(picture, frequencies=found, interrupted=Stage.FREQUENCIES)
+    return replace(picture, frequencies=found)

@@ -129,9 +129,9 @@ class Equilibrium:
         every other scene the Legendre basis in cos θ; a tube on the latter is refused in one line (SceneError)."""
         if (scene.geometry.shape == Shape.TUBE) != isinstance(discretisation, IntervalDiscretisation):
             if scene.geometry.shape == Shape.TUBE:
-                raise SceneError('geometry.shape = "tube": this command is not built for a tube yet (solve traces '
-                                 'spheres and spheroids); a tube\'s branches: balloon-cg run, sweep or continue, its '
-                                 'onset in M: balloon-cg critical, or balloon_cg.tube.picture.tube_picture '
+                raise SceneError('geometry.shape = "tube": this command is not built for a tube yet; a tube\'s '
+                                 'branches: balloon-cg run, sweep or continue, its onset in M: balloon-cg critical, '
+                                 'one state: balloon-cg solve --hoop-stretch, or balloon_cg.tube.picture.tube_picture '
                                  '(docs/shapes.md)')
             raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")
         self.scene = scene

@@ -15,7 +15,8 @@ special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``vol
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
 under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
-started, and is absent where it had not), "" where the work is whole (files before it have none: read as "").
+started, and is absent where it had not; ``frequencies``: the branches whole, the frequencies of the branches finished
+before the signal only), "" where the work is whole (files before it have none: read as "").
 With [dynamics] frequencies, each branch's natural frequencies under frequencies/ (io/tube_frequencies.py).
 """
 import math
@@ -142,7 +143,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
         _dimensions(group, "point", {"unknown": branch.disc.size})
         _dimensions(special, "special", {"unknown": branch.disc.size})
-        if picture.frequencies is not None:
+        if picture.frequencies is not None and name in picture.frequencies:  # (a signal: only the finished ones)
             write_tube_frequencies(group, picture.frequencies[name])
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)

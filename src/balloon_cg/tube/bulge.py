@@ -1,26 +1,31 @@
-"""The branch born at a mirror-odd branch point of a tube's primary branch (tube/primary.py): the bulge.
+"""The branch born at a branch point of a tube's primary branch (tube/primary.py): the bulge.
 
 At a branch point of the odd block (interval.Mirror) the mirror-symmetric branch is crossed by a pitchfork whose states
-break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image). It leaves the branch point X* = (u*,
-P*) along the odd block's null vector φ with dP = 0: the first point is the Keller corrector from X* + σ(φ, 0)/|φ| on
-the hyperplane normal to (φ, 0) (which the symmetric branch never meets), oriented so that the tube bulges at S = 0
-(ρ(0) > ρ(L)), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the symmetry (P and V are even in the
+break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image): the bulge at one end of a tube with
+sliding ends (plugged ends are refused: their odd branch points are not resolved, docs/shapes.md). At a branch point of the even block of a
+uniform primary branch (sliding ends, no field: the modes cos(nπS/L), n even) the branch stays mirror-symmetric and
+breaks the uniformity (a pitchfork too: on the tube of length L it is the odd bulge branch of the tube of length
+L/n, repeated). The branch leaves the branch point X* = (u*, P*) along the block's null vector φ with dP = 0: the first
+point is the Keller corrector from X* + σ(φ, 0)/|φ| on the hyperplane normal to (φ, 0) (which the primary branch never
+meets: its states have no component along φ), oriented so that ``Side`` is positive (the bulge at S = 0 on sliding
+ends), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the symmetry (P and V are even in the
 arclength along a pitchfork), so the fold monitors start from the first point. It is traced by pseudo-arclength
-continuation in X = (u, P) on every unknown (a held λ̄ stays fixed), its folds in P (LP) and in the enclosed volume (LV:
-V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the tracer's fold monitors, until it rejoins the mirror-symmetric
-states (ρ(0) − ρ(L) = −2 Σ_{k odd} a_k changes sign: the bulge has filled the tube and the branch meets the primary
-branch again at another odd branch point, the other end of the pitchfork's loop, where P and V are again even in the
-arclength: the monitors' sign changes in that last step are that symmetry, not folds, and are not kept), its V/V0 passes
-``stop_volume``, its largest hoop stretch ``stop_stretch``, after ``continuation.max_points``, or at the next point
-after SIGINT/SIGTERM (StopCode.INTERRUPTED). The branch point X* is
-the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is zero, its
-sign rounding).
+continuation in X = (u, P), at an odd branch point on every unknown, at an even one on the even block (a held λ̄ stays
+fixed), its folds in P (LP) and in the enclosed volume (LV: V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the
+tracer's fold monitors, until it rejoins the primary branch's kind of states (``Side`` changes sign: the bulge has
+filled the tube and the branch meets the primary branch again at another branch point of the block, the other end of
+the pitchfork's loop, where P and V are again even in the arclength: the monitors' sign changes in that last step are
+that symmetry, not folds, and are not kept), its V/V0 passes ``stop_volume``, its largest hoop stretch
+``stop_stretch``, in a coil field where its states turn compressed (IntervalStop.COMPRESSED:
+tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
+(StopCode.INTERRUPTED). The branch point X* is the branch's first point; the stability of every point is
+``unstable_counts``' (at X* itself one eigenvalue is zero, its sign rounding).
 """
 import numpy as np
 
-from .primary import TubeSystem, held, stressed, volume_ratio
+from .primary import TubeSystem, held, in_field, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
-from .stability import smallest_stress, unstable_counts
+from .stability import CompressionStop, smallest_stress, unstable_counts
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
 from ..galerkin.equilibrium import Equilibrium
@@ -31,33 +36,38 @@ from ..numerics.threads import limited_blas
 from ..scene.tables import Ends
 
 
+class UnswitchableBranchPoint(ValueError):
+    """A branch point ``bulge_branch`` does not switch at (one line saying which and why)."""
+
+
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None) -> IntervalBranch:
-    """The branch switched at ``point``, a branch point of the odd block of ``primary`` (module docstring);
-    ``step``: the first arclength step (None: continuation.step); ``stop_stretch``: also stop where the largest hoop
-    stretch at the nodes passes it."""
-    if point.kind != Kind.BP or point.block != Mirror.ODD:
-        raise ValueError(f"a bulge branch starts at a branch point of the odd block, not at {point.kind} "
-                         f"({point.block})")
+    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``step``: the first
+    arclength step (None: continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes
+    passes it. UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that
+    is not uniform."""
+    if point.kind != Kind.BP or point.block is None:
+        raise UnswitchableBranchPoint(f"a branch is switched at a branch point of a mirror block, not at "
+                                      f"{point.kind.value}")
     disc = primary.disc
     if disc.ends != Ends.SLIDING:
-        raise ValueError(f"a bulge branch is switched on a tube with sliding ends, not {disc.ends.value}")
+        raise UnswitchableBranchPoint(f"a branch is switched on sliding ends, not {disc.ends.value}: the odd branch "
+                                      "points of plugged ends are not resolved (docs/shapes.md)")
+    if point.block == Mirror.EVEN and in_field(scene):
+        raise UnswitchableBranchPoint("an even branch point is switched on a uniform primary branch (no field), not "
+                                      "in a coil field")
     eq = Equilibrium(scene, disc)
-    odd = disc.block(Mirror.ODD)
+    block = disc.block(point.block)
     params = primary.params.with_value("P", point.pressure)
-    H = eq.jacobian(point.u, params)[np.ix_(odd, odd)]
+    values, vectors = np.linalg.eigh(eq.jacobian(point.u, params)[np.ix_(block, block)])
     phi = np.zeros(disc.size)
-    phi[odd] = np.linalg.eigh(H)[1][:, 0]
-    odd_hoop = np.arange(1, disc.degree + 1, 2)
-
-    def bulge(u) -> float:
-        """ρ(0) − ρ(L) = −2 Σ_{k odd} a_k."""
-        return -2 * float(u[odd_hoop].sum())
-
-    if bulge(phi) < 0:
+    phi[block] = vectors[:, np.argmin(np.abs(values))]
+    side = Side(disc, point.block)
+    if side(phi) < 0:
         phi = -phi
-    system = TubeSystem(ParameterSystem(eq, params, "P"), disc.free, held(disc))
+    unknowns = disc.free if point.block == Mirror.ODD else disc.block(Mirror.EVEN)
+    system = TubeSystem(ParameterSystem(eq, params, "P"), unknowns, held(disc))
     settings = continuation_settings(scene)
     settings.step = settings.step if step is None else step
     X = np.append(point.u, point.pressure)[system.columns]
@@ -68,19 +78,22 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     start = continuation.Point(first.x, continuation.tangent(system, first.x, direction), first.iterations,
                                first.residual)
 
+    compressed = CompressionStop(eq, in_field(scene))
+    compressed(point.u)
+
     def stop(p):
         if (interrupted := signalled()) is not None:
             return interrupted
         Y = system.full(p.X)
-        if bulge(Y[:-1]) < 0:
-            return Stop(IntervalStop.REJOINED, "the branch rejoined the mirror-symmetric states")
+        if side(Y[:-1]) < 0:
+            return Stop(IntervalStop.REJOINED, f"the branch rejoined the {side.rejoins} states")
         if stop_volume is not None and volume_ratio(eq, Y) > stop_volume:
             return Stop(IntervalStop.VOLUME, f"V/V0 passed stop_volume {stop_volume:g}")
         hoop = disc.node_state(Y[:-1])[0].max()
         if stop_stretch is not None and hoop > stop_stretch:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
                                                    f"{stop_stretch:g}")
-        return None
+        return compressed(Y[:-1])
 
     def volume_gradient(X):
         Y = system.full(X)
@@ -96,3 +109,19 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                           np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points, params),
                           stressed(eq, special), path.stop, np.array([smallest_stress(eq, Y[:-1]) for Y in points]),
                           primary.params)
+
+
+class Side:
+    """Which side of the primary branch a state of the switched branch lies on: a linear functional of u that
+    vanishes on the primary branch's states (module docstring). Odd block: ρ(0) − ρ(L) = −2 Σ_{k odd} a_k, zero on
+    every mirror-symmetric state (the bulge at S = 0 where positive). Even block (the uniform primary branch of
+    sliding ends): ρ(0) − ρ̄ = Σ_{k ≥ 1 even} a_k, zero on every uniform state (ρ̄ = a_0, the Legendre series' mean;
+    P_k(−1) = (−1)^k)."""
+
+    def __init__(self, disc, block: Mirror):
+        self.hoops = np.arange(1 if block == Mirror.ODD else 2, disc.degree + 1, 2)
+        self.weight = -2.0 if block == Mirror.ODD else 1.0
+        self.rejoins = "mirror-symmetric" if block == Mirror.ODD else "uniform"
+
+    def __call__(self, u: np.ndarray) -> float:
+        return self.weight * float(u[self.hoops].sum())

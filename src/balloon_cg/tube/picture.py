@@ -2,8 +2,8 @@
 points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py; sliding ends only:
 on plugged ones the branch points are not trusted, docs/shapes.md) traced until it rejoins the mirror-symmetric
 states, its largest hoop stretch passes ``continuation.stop_stretch`` or after ``continuation.max_points``, and
-Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends only: ends held apart have
-no single one), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
+Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
+held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
 is finished is kept, and the picture names the stage (``Stage``)."""
 import enum
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
-from .primary import primary_branch
+from .primary import in_field, primary_branch
 from .results import IntervalBranch
 from ..analysis.results import StopCode
 from ..galerkin.interval import Mirror
@@ -26,15 +26,17 @@ class Stage(enum.StrEnum):
     PRIMARY = "primary"  # the primary branch (tube/primary.py)
     BULGE = "bulge"  # the bulge branch (tube/bulge.py)
     ONSET = "onset"  # the onset curve of ``critical`` (tube/onset.py)
+    FREQUENCIES = "frequencies"  # the branches' natural frequencies (dynamics/tube.py): the branches are whole
 
 
 @dataclass(frozen=True)
 class TubePicture:
     """The branches by name ("primary", "bulge" where one was switched), Maxwell's pressure (None where the
-    uniform closed path has no maximum and minimum, or the ends are held), for ``critical`` the onset of bulging
-    followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the work is whole; the
-    stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had not); ``frequencies``:
-    with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch name)."""
+    uniform closed path has no maximum and minimum, the ends are held, or coils act: ``maxwell``), for ``critical``
+    the onset of bulging followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the
+    work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
+    not); ``frequencies``: with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch
+    name)."""
 
     branches: dict
     maxwell: float | None
@@ -92,6 +94,12 @@ def onset_from(scene, primary: IntervalBranch, point, name: str, direction: floa
 
 
 def maxwell(scene) -> float | None:
-    """Maxwell's pressure of the scene's uniform closed tube (None: ends held apart, or no maximum and minimum)."""
-    found = None if scene.geometry.axial_stretch is not None else maxwell_pressure(scene.material)
+    """Maxwell's pressure of the scene's uniform closed tube; None where there is none: ends held apart, no maximum
+    and minimum on the uniform path, or coils acting on the tube (M > 0): the field varies along the tube, so there
+    is neither a uniform state nor the first integral of axial translation that the equal-area rule rests on
+    (docs/shapes.md), and the field-free value is not the field's."""
+    if scene.geometry.axial_stretch is not None or in_field(scene):
+        return None
+    found = maxwell_pressure(scene.material)
     return None if found is None else float(found[0])
+

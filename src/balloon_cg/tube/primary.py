@@ -6,7 +6,9 @@ The unstressed tube (λ2 = 1, λ̄ = 1, P = 0) is an exact equilibrium; with its
 by pseudo-arclength continuation in X = (u, P) (numerics/continuation.py) on the mirror-symmetric states (u restricted
 to the even block, interval.Mirror: the odd residual rows vanish there by symmetry, as the sphere's primary branch keeps
 its equator symmetry), until the largest hoop stretch at the nodes passes ``continuation.stop_stretch`` (on a tube the
-north pole stretch means nothing), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
+north pole stretch means nothing), in a coil field where its states turn compressed after being taut
+(IntervalStop.COMPRESSED: tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point
+after SIGINT/SIGTERM
 (numerics.interrupt: StopCode.INTERRUPTED); the points located up to stop_stretch are kept,
 those in the step that passed it included. Folds in P (LP) are located by the tracer's fold monitor. At every point the
 second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks and the spectrum of each is computed (its
@@ -22,9 +24,10 @@ basis) and its first odd-block branch point is the onset of the bulge mode cos(�
 from dataclasses import replace
 
 import numpy as np
+from scipy import linalg
 
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
-from .stability import smallest_stress, spectrum, unstable_counts
+from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
 from ..analysis.stability.crossings import count_changes
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind
@@ -66,6 +69,11 @@ class TubeSystem:
         return self.system.jacobian(self.full(X))[np.ix_(self.unknowns, self.columns)]
 
 
+def in_field(scene) -> bool:
+    """Whether coils act on the tube (field.M > 0 and at least one coil)."""
+    return scene.field.M > 0 and bool(scene.field.coils)
+
+
 def scene_parameters(scene, pressure: float = 0.0) -> Parameters:
     """The branch parameters of a tube scene at ``pressure``: the field's M and χ (M = 0 without coils)."""
     return Parameters(pressure, scene.field.M, scene.field.chi)
@@ -101,14 +109,17 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     t = continuation.tangent(system, X, np.eye(X.size)[-1])
     start = continuation.Point(X, t, 0, float(np.abs(system.residual(X)).max()))
     limit = scene.continuation.stop_stretch
+    compressed = CompressionStop(eq, in_field(scene))
+    compressed(system.full(X)[:-1])
 
     def stop(point):
         if (interrupted := signalled()) is not None:
             return interrupted
-        hoop = eq.disc.node_state(system.full(point.X)[:-1])[0].max()
+        u = system.full(point.X)[:-1]
+        hoop = eq.disc.node_state(u)[0].max()
         if hoop > limit:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch {limit:g}")
-        return None
+        return compressed(u)
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
     reached = path.points + ([path.overshoot] if path.overshoot is not None else [])  # the last step's too
@@ -183,11 +194,20 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
                   params: Parameters):
     """(Y = (u, P), status) where the eigenvalue number ``order`` (ascending, from 0) of ``block`` vanishes between
     two points, by Brent in the arclength from ``before`` (``params``: the branch's, P replaced); None when it is
-    the fold in P (the null vector not orthogonal to ∂R/∂P)."""
+    the fold in P (the null vector not orthogonal to ∂R/∂P). Each value is a Keller corrector; near a branch point
+    of the even block (the branch's own unknowns) that one may diverge, and then ``_off_mode_corrector`` is used."""
     index = eq.disc.block(block)
+    mode = None  # the crossing eigenvalue's vector at ``before`` where the branch's own unknowns hold it (even block)
+    if block == Mirror.EVEN:
+        Y = system.full(before.X)
+        H = eq.jacobian(Y[:-1], params.with_value("P", Y[-1]))[np.ix_(system.unknowns, system.unknowns)]
+        mode = np.append(np.linalg.eigh(H)[1][:, order], 0.0)
 
     def value_at(s):
-        result = continuation.correct(system, before.X + s * before.tangent, before.tangent, settings)
+        predictor = before.X + s * before.tangent
+        result = continuation.correct(system, predictor, before.tangent, settings)
+        if not result.converged and mode is not None:
+            result = _off_mode_corrector(system, predictor, before.tangent, mode, settings)
         if not result.converged:
             raise ArithmeticError(result.message)
         Y = system.full(result.x)
@@ -205,3 +225,22 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
     if abs(phi @ dP[index]) > ORTHOGONAL * np.linalg.norm(dP):
         return None
     return Y, root.status
+
+
+def _off_mode_corrector(system: TubeSystem, predictor: np.ndarray, tangent: np.ndarray, mode: np.ndarray, settings):
+    """Keller's corrector with the direction ``mode`` (X-coordinates; the crossing eigenvalue's vector of the branch's
+    own block) held at the predictor's component: near a branch point that breaks a symmetry the branch keeps (the
+    uniform tube's modes cos(nπS/L), n even, in the even block) the branch's states have no component along it, and
+    Keller's system, singular at the branch point, lets rounding grow along it. Solved: Qᵀ R(X) = 0 (Q an orthonormal
+    basis of the residual rows orthogonal to the mode: its own row, zero on the branch by the symmetry, dropped),
+    tangent·X and mode·X at the predictor's; not converged where the dropped row is not zero there (the branch does
+    move along the mode: no symmetry)."""
+    Q = linalg.null_space(mode[None, :-1])
+    result = newton(lambda X: Q.T @ system.residual(X), lambda X: Q.T @ system.jacobian(X), predictor,
+                    np.vstack([tangent, mode]), [tangent @ predictor, mode @ predictor], settings.tol,
+                    settings.max_newton)
+    dropped = abs(mode[:-1] @ system.residual(result.x)) if result.converged else np.inf
+    if dropped > settings.tol:
+        return replace(result, converged=False, message=f"{result.message}; off the mode: the residual along it is "
+                                                        f"{dropped:.3g}")
+    return result

@@ -18,6 +18,7 @@ class IntervalStop(enum.StrEnum):
     HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
     REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
     VOLUME = "volume"  # V/V0 passed the stop_volume asked for
+    COMPRESSED = "compressed"  # in a coil field, the membrane turned compressed after being taut (tube/stability.py)
 
 
 def signalled() -> Stop | None:

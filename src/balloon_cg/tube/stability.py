@@ -3,12 +3,15 @@ directions under pressure control (all of u's unknowns: a held λ̄ is not one) 
 δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman factorisation (numerics/eigen.py: ``restricted``
 removes the constraint); and where the membrane is compressed (``smallest_stress``): a membrane wrinkles where a
 principal stress is negative, its Ritz problem is not elliptic there and the states and eigenvalues computed there
-do not converge in the degree (docs/shapes.md: the plugged tube's necks)."""
+do not converge in the degree (docs/shapes.md: the plugged tube's necks); in a coil field a trace stops where its
+states turn compressed (``CompressionStop``: there they measurably do not converge, docs/shapes.md)."""
 import numpy as np
 
+from .results import IntervalStop
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model import meridian
 from ..model.stresses import elastic_stresses
+from ..numerics.continuation import Stop
 from ..numerics.eigen import GramFactor, negative_count, restricted
 from ..scene.loading import Control
 
@@ -44,3 +47,26 @@ def smallest_stress(eq: Equilibrium, u: np.ndarray) -> float:
     lam2, v, _, w = disc.node_state(u)
     lam1 = meridian.meridional_stretch(eq.scene.geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
     return float(min(np.min(stress) for stress in elastic_stresses(eq.scene.material, lam1, lam2)))
+
+
+class CompressionStop:
+    """The stop rule of a trace in a coil field: called with each point's state u, it returns
+    Stop(IntervalStop.COMPRESSED) at the first compressed one (``smallest_stress`` below COMPRESSED) after a taut one
+    (the start at P = 0 in a field may be compressed: the coil pulls the middle out), else None; ``active`` False:
+    never (no field)."""
+
+    def __init__(self, eq: Equilibrium, active: bool):
+        self.eq, self.active, self.taut = eq, active, False
+
+    def __call__(self, u: np.ndarray) -> Stop | None:
+        if not self.active:
+            return None
+        stress = smallest_stress(self.eq, u)
+        if stress >= COMPRESSED:
+            self.taut = True
+            return None
+        if self.taut:
+            return Stop(IntervalStop.COMPRESSED, f"the membrane turned compressed in the field (smallest principal "
+                                                 f"stress {stress:.3g}): beyond, a membrane wrinkles and the traced "
+                                                 "states do not converge in the degree")
+        return None

@@ -1,0 +1,74 @@
+"""Branches switched at a tube's branch points other than the first odd one (issue 38): the even branch points of a
+uniform primary branch (sliding ends, closed or held apart), tube/bulge.py.
+
+On a tube of length L with sliding ends (planes of symmetry) the mode cos(2πS/L) of the even block is the mode
+cos(πS/(L/2)) of the tube of length L/2 repeated: a state of the branch switched at the even branch point, restricted
+to S ∈ [0, L/2], is a state of the tube of length L/2 on the branch switched at its first odd branch point (the bulge
+at S = 0, the neck at L/2, where ρ' = 0 by the mirror symmetry), at the same P and V/V0. So the two branches, computed
+on different tubes at matching resolution (degree 2N on L, N on L/2), have the same volume fold: the second method.
+"""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from balloon_cg.analysis.results import Kind
+from balloon_cg.galerkin.interval import Mirror
+from balloon_cg.tube.bulge import UnswitchableBranchPoint, bulge_branch
+from balloon_cg.tube.primary import primary_branch, volume_ratio
+from balloon_cg.galerkin.equilibrium import Equilibrium
+
+from test_interval import tube_scene
+
+
+def switched(length, degree, block, extra=""):
+    """The primary branch of SPOM1 on a tube of ``length`` (sliding ends, ``extra`` scene keys) and the branch switched
+    at its first branch point of ``block``, to V/V0 = 20."""
+    scene = tube_scene("SPOM1", length, extra + f"[solver]\ndegree = {degree}\n[continuation]\nstop_stretch = 2.0\n"
+                                                "step_max = 0.5\n")
+    primary = primary_branch(scene)
+    point = primary.branch_points(block)[0]
+    return scene, primary, point, bulge_branch(scene, primary, point, stop_volume=20.0, step=0.02)
+
+
+@pytest.mark.parametrize("extra", ["", "axial_stretch = 1.2\n"])
+def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
+    """Closed and held apart (λ = 1.2): the branch switched at the first even branch point of L = 20 (degree 60) is
+    mirror-symmetric (its odd coefficients zero), bulges at both ends (ρ(0) = ρ(L) > ρ(L/2)), and its first volume
+    fold (taut) has the P and V/V0 of the first volume fold of the bulge branch of L = 10 (degree 30) within 1e-9
+    (measured 3.1e-11 and 8.2e-12); the branch points themselves, both located, within 1e-12 (measured 1.3e-15 and
+    8.9e-16; the held even one was found only to 5.6e-7 before tube/primary._off_mode_corrector)."""
+    folds, onsets = {}, {}
+    for length, degree, block in ((10.0, 30, Mirror.ODD), (20.0, 60, Mirror.EVEN)):
+        scene, primary, point, branch = switched(length, degree, block, extra)
+        assert point.status == "located"
+        onsets[block] = point.pressure
+        assert branch.stop.code in ("volume", "rejoined")
+        fold = next(s for s in branch.special if s.kind == "LV")
+        assert fold.smallest_stress > 0 and fold.status == "located"
+        eq = Equilibrium(scene, branch.disc)
+        folds[block] = (fold.pressure, volume_ratio(eq, np.append(fold.u, fold.pressure)))
+    odd = branch.disc.block(Mirror.ODD)
+    assert np.abs(branch.states[:, odd]).max() == 0  # traced on the even block
+    rho = branch.disc.profile(branch.states[-1], np.array([0.0, 10.0, 20.0]))[0]
+    assert rho[0] == pytest.approx(rho[2], abs=1e-12) and rho[0] > rho[1] + 1
+    assert abs(onsets[Mirror.EVEN] - onsets[Mirror.ODD]) <= 1e-12
+    assert abs(folds[Mirror.EVEN][0] - folds[Mirror.ODD][0]) <= 1e-9
+    assert abs(folds[Mirror.EVEN][1] - folds[Mirror.ODD][1]) <= 1e-9
+
+
+def test_branch_points_that_are_not_switched_are_refused_in_one_line():
+    """An even branch point in a coil field (the primary branch is not uniform there), any branch point on plugged
+    ends (their odd branch points are not resolved: docs/shapes.md) and a fold: UnswitchableBranchPoint, one line."""
+    coil = "[field]\nM = 0.01\n[[field.coils]]\nradius = 2.5\nheight = 0\ncurrent = 1\n"
+    for extra, block, message in ((coil, Mirror.EVEN, "uniform primary branch .* not in a coil field"),
+                                  ('ends = "plugged"\n', Mirror.ODD, "on sliding ends, not plugged")):
+        scene = tube_scene("SPOM1", 10.0, extra + "[solver]\ndegree = 16\n[continuation]\nstop_stretch = 1.7\n")
+        primary = primary_branch(scene)
+        fold = primary.special[0]
+        assert fold.kind == Kind.LP
+        with pytest.raises(UnswitchableBranchPoint, match=message) as refused:
+            bulge_branch(scene, primary, replace(fold, kind=Kind.BP, block=block))
+        assert "\n" not in str(refused.value)
+    with pytest.raises(UnswitchableBranchPoint, match="not at LP"):
+        bulge_branch(scene, primary, fold)
