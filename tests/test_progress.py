@@ -60,13 +60,20 @@ def test_progress_asked_for_where_bars_garble_is_the_finished_lines(monkeypatch)
     monkeypatch.setattr("sys.stderr", log)
     with PhaseBars("spom1", True) as bars:
         assert bars.display == Display.LINES
-        bars.expect(Phase.STABILITY, 40)
-        for _ in range(40):
-            bars.tick(Phase.STABILITY)
+        overlapping(bars, 40)
+    assert log.getvalue() == "spom1: stability: 40 points [00:00]\nspom1: pear branches: 41 points [00:00]\n"
+
+
+def overlapping(bars, count: int, step=lambda: None) -> None:
+    """Two overlapping phases: stability (40 points expected) and pear branches ticked in turn ``count`` times (then
+    ``step()``), stability finished, pear branches ticked once more and left unfinished (its line at the end)."""
+    bars.expect(Phase.STABILITY, 40)
+    for _ in range(count):
+        bars.tick(Phase.STABILITY)
         bars.tick(Phase.PEAR)
-        bars.finish(Phase.STABILITY, 40)
-        bars.tick(Phase.PEAR)
-    assert log.getvalue() == "spom1: stability: 40 points [00:00]\nspom1: pear branches: 2 points [00:00]\n"
+        step()
+    bars.finish(Phase.STABILITY, count)
+    bars.tick(Phase.PEAR)
 
 
 class Outputs:
@@ -105,13 +112,7 @@ def test_a_notebook_without_ipywidgets_gets_a_text_bar_per_phase_replaced_by_its
     monkeypatch.setattr("sys.stderr", stderr)
     with PhaseBars("spom1", True) as bars:
         assert bars.display == Display.TEXT
-        bars.expect(Phase.STABILITY, 40)
-        for _ in range(16):
-            bars.tick(Phase.STABILITY)
-            bars.tick(Phase.PEAR)
-            clock[0] += 0.125  # 2 s: an update every 0.5 s
-        bars.finish(Phase.STABILITY, 16)
-        bars.tick(Phase.PEAR)
+        overlapping(bars, 16, step=lambda: clock.append(clock.pop() + 0.125))  # 2 s: an update every 0.5 s
     stability, pear = outputs.shown
     assert re.fullmatch(r"spom1: stability:\s+0%\|.*\| 0/40 \[00:00<\?, \? points/s\]", stability[0])
     assert [re.search(r"\| (\d+)/40 \[00:0(\d)<", text).groups() for text in stability[1:-1]] == [
