@@ -79,9 +79,15 @@ def test_every_kind_fits_a_journal_width(kind, width, sources, drawn_texts):
 
 
 def test_a_width_is_for_a_new_figure_only(sources):
+    """``bc.plot(..., width=)`` lays a new figure out at that width; the Axes given have their figure's size."""
     import matplotlib.figure
 
+    import balloon_cg as bc
+
+    assert tuple(bc.plot(sources["pressure-pole"], "pressure-pole", width=3.5).get_size_inches())[0] == 3.5
     ax = matplotlib.figure.Figure().add_subplot()
+    with pytest.raises(PlotError, match="width: the figure of the Axes given has its own size"):
+        bc.plot(sources["pressure-pole"], "pressure-pole", ax=ax, width=3.5)
     with pytest.raises(PlotError, match="width: the figure of the Axes given has its own size"):
         plot([sources["pressure-pole"]], "pressure-pole", axes=ax, width=3.5)
     with pytest.raises(PlotError, match=r"width 0.5: must be in \[1, 40\] inches"):
@@ -108,3 +114,13 @@ def test_plot_width_and_dpi_from_the_command_line(sources, tmp_path, capsys):
     assert main(["plot", str(sources["pressure-pole"]), "--what", "pressure-pole", "--width", "100", "-o",
                  str(tmp_path / "q.png")]) == 2
     assert "width 100: must be in [1, 40] inches" in capsys.readouterr().err
+
+
+def test_a_fold_curves_phase_diagram_names_only_what_it_draws(sources):
+    """The Gent fold curve in Jm to its cusp (issue 40: its title spoke of pitchforks, its cusp value was text beside
+    the point that left the axes): title and y label name the fold, the cusp is in the legend, no text in the Axes."""
+    fig = plot([sources["cusp"]], "phase")
+    ax = fig.axes[0]
+    assert "pitchfork" not in ax.get_title() + ax.get_ylabel() and "fold (LP)" in ax.get_title() + ax.get_ylabel()
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any(text.startswith("cusp Jm = 17.638") for text in legend) and not ax.texts

@@ -285,7 +285,7 @@ def test_a_restarted_pear_branch_stops_where_the_run_stops_pear_branches(two_coi
     [(label, end)] = [(s["label"], s) for s in read_run(run)["branches"]["pear_0"]["special_points"]
                       if s["kind"] == "EP"]
     main(["continue", str(run), str(label), "-o", str(out), "--quiet", "--allow-partial"])
-    branch = read_run(out)["branches"]["primary"]
+    branch = read_run(out)["branches"]["pear_0"]
     assert list(branch["attrs"]["leg_stop_codes"]) == ["stop_stretch", "bottom_stop_stretch"]
     assert abs(max(branch["lam2_bottom"]) - 1.7) < 1e-12 and abs(max(branch["lam2_top"]) - 1.7) < 1e-12
     mirror = read_run(run)["branches"]["pear_0_mirror"]
@@ -341,7 +341,10 @@ def test_continue_from_the_end_of_a_pear_branch_passes_its_pitchfork_into_the_mi
     stored = read_run(run)["branches"]
     end = next(s for s in stored[name]["special_points"] if s["kind"] == "EP" and s["index"] > 0)
     assert main(["continue", str(run), str(end["label"]), "-o", str(out), "--quiet"]) == 0
-    again = read_run(out)["branches"]["primary"]
+    written = read_run(out)["branches"]
+    assert list(written) == ["primary", name]  # the parent as read, the pear branch under its name
+    again = written[name]
+    assert again["attrs"]["parent_branch_point"] == stored[name]["attrs"]["parent_branch_point"]
     kinds = [(s["kind"], s["block"]) for s in again["special_points"]]
     assert kinds == [("EP", ""), ("BP", block), ("EP", "")]
     pitchfork = next(s for s in stored["primary"]["special_points"] if s["kind"] == "BP" and s["block"] == block)
@@ -492,50 +495,85 @@ def isola_restart(spom1_run):
     return out
 
 
+def isola_points(stored: dict) -> tuple:
+    """(the turning points' P of the run's pear branch and its mirror image, sorted; the primary's pitchforks' P)."""
+    turns = sorted(s["pressure"] for name in ("pear_0", "pear_0_mirror") for s in stored[name]["special_points"]
+                   if s["kind"] == "TP")
+    return turns, [s["pressure"] for s in stored["primary"]["special_points"] if s["kind"] == "BP"]
+
+
+def assert_ends_as_run_ends(branch: dict, stored: dict) -> None:
+    """A restart on SPOM1's isola: both legs stopped where they rejoin the primary branch at its second pitchfork,
+    and the points run marks on the pear branch and its mirror image, once each: the two turning points (the same P
+    to 1e-8), the first pitchfork it passes (the primary's point), the two ends the last points before the second
+    pitchfork (the pear amplitude falling, its sign kept, as at the run's pear ends), every one located; no LV or LN (run marks none on pear branches)."""
+    turns, pitchforks = isola_points(stored)
+    assert list(branch["attrs"]["leg_stop_codes"]) == ["rejoined", "rejoined"]
+    assert [s["kind"] for s in branch["special_points"]] == ["EP", "TP", "BP", "TP", "EP"]
+    assert {s["status"] for s in branch["special_points"]} == {"located"}
+    again = sorted(s["pressure"] for s in branch["special_points"] if s["kind"] == "TP")
+    assert np.abs(np.subtract(turns, again)).max() < 1e-8
+    assert branch["special_points"][2]["pressure"] == pitchforks[0]
+    amplitude = np.subtract(branch["lam2_top"], branch["lam2_bottom"])  # the pear amplitude: its sign the side
+    for end, before in ((0, 1), (-1, -2)):  # the last point before the crossing, as the run's pear ends
+        assert 0 < amplitude[end] / amplitude[before] < 1
+    for end in branch["special_points"][::4]:
+        assert abs(end["pressure"] - pitchforks[1]) < 1e-3
+    assert (branch["attrs"]["parent_branch"], branch["attrs"]["parent_branch_point"]) == ("primary", 0)
+    assert branch["attrs"]["rejoins_branch_point"] == stored["pear_0"]["attrs"]["rejoins_branch_point"] == 1
+
+
 def test_a_restart_on_the_isola_ends_where_its_closed_loop_does(spom1_run, isola_restart):
     """SPOM1 at M = 0: the pear branch of the first pitchfork rejoins the primary branch at the second (an isola).
     `continue RUN LABEL` from its turning point (TP) goes once round the closed loop the pear branch and its mirror
-    image make, and stops where `run` stopped them: both legs at the second pitchfork (stop rejoined; it went round
-    the loop to max_points before, exit 1). It marks what run marks on those two branches, once each: their two
-    turning points (the same P to 1e-8), the first pitchfork it passes (the primary's point), no LV or LN (run
-    marks none on pear branches; it marked them before)."""
-    stored = read_run(spom1_run)["branches"]
-    assert stored["pear_0"]["attrs"]["rejoins_branch_point"] == 1
-    branch = read_run(isola_restart)["branches"]["primary"]
-    assert list(branch["attrs"]["leg_stop_codes"]) == ["rejoined", "rejoined"]
-    kinds = [s["kind"] for s in branch["special_points"]]
-    assert kinds == ["EP", "TP", "BP", "TP", "EP"]
-    turns = sorted(s["pressure"] for name in ("pear_0", "pear_0_mirror") for s in stored[name]["special_points"]
-                   if s["kind"] == "TP")
-    again = sorted(s["pressure"] for s in branch["special_points"] if s["kind"] == "TP")
-    assert np.abs(np.subtract(turns, again)).max() < 1e-8
-    pitchforks = [s["pressure"] for s in stored["primary"]["special_points"] if s["kind"] == "BP"]
-    assert branch["special_points"][2]["pressure"] == pitchforks[0]
-    for end in branch["special_points"][::4]:  # both ends a step past the second pitchfork, as the run's pear ends
-        assert abs(end["pressure"] - pitchforks[1]) < 1e-4 and abs(end["lam2_top"] - end["lam2_bottom"]) < 0.05
+    image make, and stops where `run` stopped them, marking what run marks (``assert_ends_as_run_ends``; it went
+    round the loop to max_points before, exit 1, and marked LV and LN points). The file holds the loop under the
+    pear branch's name, after its parent as read (the run's primary branch: its points and labels as in the run),
+    so that a restart from it knows where the loop crosses its parent (the next test)."""
+    stored, again = read_run(spom1_run)["branches"], read_run(isola_restart)["branches"]
+    assert list(again) == ["primary", "pear_0"]
+    assert_ends_as_run_ends(again["pear_0"], stored)
+    assert np.array_equal(again["primary"]["unknowns"], stored["primary"]["unknowns"])
+    assert [s["label"] for s in again["primary"]["special_points"]] == [
+        s["label"] for s in stored["primary"]["special_points"]]
 
 
-def test_a_restart_that_comes_back_to_its_start_stops_there(spom1_run, isola_restart, tmp_path, capsys):
-    """The file `continue` wrote from the isola holds the pear loop as its `primary`, without the branch it crosses:
-    `continue` from a TP of that loop cannot stop where it crosses its parent (it went round twice to max_points,
-    599 points, marking the turning points three times and LV, LN points). It is a pear branch (states without
-    the equator symmetry of the scene's primary branch: stopped and assessed as one) and its first leg stops where
-    it comes back to the point it started from (stop closed), one lap: each turning point once, at the run's
-    pear branches' P to 1e-8, no LV or LN, and no second leg. (Left: where the loop crosses the primary branch,
-    which that file does not hold, it marks fold candidates where run marks the primary's BP; the second is
-    approximate, so the exit status is 1.)"""
+def test_a_restart_from_the_loop_continue_wrote_ends_as_run_ends(spom1_run, isola_restart, tmp_path, capsys):
+    """`continue` from a TP of the loop `continue` wrote from the isola: its parent is in that file, so it stops and
+    marks as `run` does, exit 0 (before, the loop was stored as `primary` without the branch it crosses: it closed
+    on itself after one lap, with a fold candidate where run stores each pitchfork, the second approximate: exit 1;
+    before that it went round twice to max_points, 599 points, the turning points three times, LV and LN)."""
     out = tmp_path / "lap.h5"
-    [tp] = [s for s in read_run(isola_restart)["branches"]["primary"]["special_points"] if s["kind"] == "TP"][:1]
-    assert main(["continue", str(isola_restart), str(tp["label"]), "-o", str(out), "--quiet"]) in (0, 1)
-    branch = read_run(out)["branches"]["primary"]
-    assert list(branch["attrs"]["leg_stop_codes"]) == ["closed"] and len(branch["pressure"]) < 300
-    kinds = [s["kind"] for s in branch["special_points"]]
+    tp = next(s for s in read_run(isola_restart)["branches"]["pear_0"]["special_points"] if s["kind"] == "TP")
+    assert main(["continue", str(isola_restart), str(tp["label"]), "-o", str(out), "--quiet"]) == 0
+    assert f"branch pear_0 continued from label {tp['label']}: " in capsys.readouterr().out
+    assert_ends_as_run_ends(read_run(out)["branches"]["pear_0"], read_run(spom1_run)["branches"])
+
+
+def test_a_restart_that_comes_back_to_its_start_stops_there(spom1_run, isola_restart):
+    """A pear branch restarted without its parent (a loop `continue` wrote before it stored the parent: as
+    `primary`, states without the equator symmetry of the scene's primary branch) cannot stop where it crosses its
+    parent: it is restarted as a pear branch (``restart.is_pear``: stopped and assessed as one) and its first leg
+    stops where it comes back to the point it started from (stop closed), one lap: each turning point once, at the
+    run's pear branches' P to 1e-8, no LV or LN, and no second leg. (Where that loop crosses the primary branch
+    it is not stored with it marks fold candidates where run marks the primary's BP.)"""
+    from dataclasses import replace
+
+    from balloon_cg.app.restart import restart
+
+    run = read_run(isola_restart)
+    tp = next(s for s in run["branches"]["pear_0"]["special_points"] if s["kind"] == "TP")
+    start = find_label(run, tp["label"])
+    alone = replace(start, branch=replace(start.branch, name="primary"), parent=None, parent_point=-1)
+    [branch] = restart(alone, None).branches
+    assert branch.name == "primary" and [leg.stop.code.value for leg in branch.legs] == ["closed"]
+    assert len(branch.X) < 300
+    kinds = [s.kind.value for s in branch.special]
     assert kinds.count("TP") == 2 and not {"LV", "LN"} & set(kinds)
-    stored = read_run(spom1_run)["branches"]
-    turns = sorted(s["pressure"] for name in ("pear_0", "pear_0_mirror") for s in stored[name]["special_points"]
-                   if s["kind"] == "TP")
-    again = sorted(s["pressure"] for s in branch["special_points"] if s["kind"] == "TP")
+    turns, _ = isola_points(read_run(spom1_run)["branches"])
+    again = sorted(s.X[-1] for s in branch.special if s.kind.value == "TP")
     assert np.abs(np.subtract(turns, again)).max() < 1e-8
-    signature = np.column_stack([branch["pressure"], branch["lam2_top"], branch["lam2_bottom"]])
+    poles = branch.pole_values()
+    signature = np.column_stack([branch.X[:, -1], poles["lam2_top"], poles["lam2_bottom"]])
     step = np.abs(np.diff(signature, axis=0)).max()
     assert np.abs(signature[-1] - signature[0]).max() <= 2 * step  # it ends where it began: the loop closed

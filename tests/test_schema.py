@@ -78,6 +78,55 @@ def test_a_coordinate_that_does_not_repeat_its_own_is_refused(run_file, tmp_path
         read_run(damaged)
 
 
+def without_repeated_coordinates(path) -> list:
+    """Make ``path`` a file of the current format as written before its subgroups repeated their coordinates
+    (issue 40, f2f2dde): every variable of a subgroup attached to its enclosing group's dimension scale of the same
+    name, the subgroup's own removed; the (subgroup, scale) pairs removed."""
+    removed = []
+    with h5py.File(path, "r+") as f:
+        scales = []
+        f.visititems(lambda name, item: scales.append(item) if isinstance(item, h5py.Dataset) and item.is_scale
+                     else None)
+        for inner in scales:
+            name, outer = inner.name.rsplit("/", 1)[-1], inner.parent.parent
+            while outer.name != "/" and not isinstance(outer.get(name), h5py.Dataset):
+                outer = outer.parent
+            enclosing = outer.get(name)
+            if inner.parent.name == "/" or not isinstance(enclosing, h5py.Dataset) or not enclosing.is_scale:
+                continue  # a group's own coordinate, repeated by none
+            users = []
+            inner.parent.visititems(lambda _, item: users.append(item) if isinstance(item, h5py.Dataset) else None)
+            for data in users:
+                for dim in data.dims:
+                    if any(scale == inner for scale in dim.values()):
+                        dim.detach_scale(inner)
+                        dim.attach_scale(enclosing)
+            removed.append((inner.parent.name, name))
+        for group, name in removed:
+            del f[group][name]
+    return removed
+
+
+def test_a_file_whose_subgroups_do_not_repeat_their_coordinates_still_reads(run_file, tmp_path):
+    """A balloon-cg/5 file written before the subgroups carried their coordinates (their variables attached to the
+    enclosing group's scales; its ends named lam2_north, …) reads as the file it was made from, loads, opens with
+    xarray and draws (a file written by f2f2dde^ was checked alike by hand)."""
+    import balloon_cg as bc
+
+    old = tmp_path / "before.h5"
+    old.write_bytes(Path(run_file).read_bytes())
+    removed = without_repeated_coordinates(old)
+    assert ("/branches/primary/profiles", "theta") in removed and uncoordinated(old)  # as such files were
+    assert _with_old_names(old, "balloon-cg/5")  # and their ends named after the poles
+    new, before = read_run(run_file), read_run(old)
+    for name, branch in new["branches"].items():
+        np.testing.assert_array_equal(before["branches"][name]["unknowns"], branch["unknowns"])
+        np.testing.assert_array_equal(before["branches"][name]["profiles"]["rho"], branch["profiles"]["rho"])
+        assert repr(before["branches"][name]["special_points"]) == repr(branch["special_points"])  # nan: nan
+    assert bc.load(old).to_xarray().sizes["point"] == len(new["branches"]["primary"]["pressure"])
+    assert plot([old], "shapes").axes
+
+
 def test_kinds_read_as_strings(run_file):
     with xr.open_dataset(run_file, engine="h5netcdf", group="branches/primary/special_points") as ds:
         assert [str(k) for k in ds.kind.values] == ["EP", "LP", "BP", "EP"]

@@ -494,6 +494,7 @@ def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
     branches with their parent and pressures; [surface] branches = "none" leaves them out."""
     import json
 
+    import balloon_cg as bc
     from balloon_cg.app.cli import main
 
     scene = ROOT / "scenes" / "spom1_two_coils_M0.002.toml"
@@ -507,6 +508,10 @@ def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
     assert all(b["m"] == 0 for name, b in branches.items() if name not in surface)
     first = surface["m1_bp1"]
     assert first["m"] == 1 and first["parent"][0] == "primary" and len(first["pressures"]) == first["points"] > 10
+    parent = [s for s in branches["primary"]["special_points"] if s["kind"] == "BP"][first["parent"][1]]
+    assert parent["block"].startswith("m1") and first["parent_label"] == parent["label"]  # one name: its label
+    legend = [t.get_text() for t in bc.plot(out).legends[0].get_texts()]
+    assert f"m = 1 from {parent['label']}" in legend, legend  # the figure's name of it, as inspect's
     assert first["stop_codes"] == {"forward": "wire_gap"}
     assert first["max_error_estimate"] <= load_scene(scene).solver.max_error and first["max_residual"] <= 1e-10
     origin, *inner, end = first["special_points"]

@@ -424,7 +424,8 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
     -------
     Result or FoldCurve or TwoParameterCurve
         Without ``parameter``, the branch through the point (a Result whose branch is ``primary``, assessed and its
-        branch points located if the stored branch was), or at a branch point the branches bifurcating there (a
+        branch points located if the stored branch was; from a point of a pear branch, that branch under its name
+        after its parent ``primary`` as read), or at a branch point the branches bifurcating there (a
         Result of the point's branch as read, not assessed, and of them, assessed: ``pear_<n>`` and
         ``pear_<n>_mirror`` at a pear point, ``m<m>_bp<k>`` and its other direction at a held m ≥ 1 point);
         from a fold (LP, LV, LN) or a pear pitchfork (held or free) in ``parameter``, the two-parameter curve

@@ -1058,10 +1058,10 @@ def _write_continued(args, picture, attrs, switched: bool) -> int:
         listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
                            f"{stop_codes(b.legs)})" for b in branches[1:])
         print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
-    else:
-        branch = picture.primary
-        print(f"branch continued from label {args.label}: {len(branch.X)} points ({branch.stop_reason}), "
-              f"{len(branch.special)} special points; written to {args.output}")
+    else:  # the branch traced again (after its parent as read, for a pear branch: ``restart.restart_branch``)
+        branch = picture.branches[-1]
+        print(f"branch {branch.name} continued from label {args.label}: {len(branch.X)} points "
+              f"({branch.stop_reason}), {len(branch.special)} special points; written to {args.output}")
     return verdict_status(picture.incomplete, args.allow_partial)
 
 

@@ -25,7 +25,8 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   ``pear_point``), as ``critical`` traces the held one.
 
 A restarted leg stops where it crosses its known parent away from its own pitchfork (``rejoin_rule``) or comes
-back to where it started (``closing_rule``: a closed loop, traced once). The branch is rebuilt from the file
+back to where it started (``closing_rule``: a closed loop, traced once); a restarted pear branch whose parent is
+known is written under its own name after that parent as read, so that a restart from that file knows it too. The branch is rebuilt from the file
 (``stored_branch``): its scene (the stored scene text), discretisation,
 parameters, points and special points; ``with_settings`` sets keys of the scene that do not change the equations
 (stops, tolerances, readings, events: ``continue --set``). Not yet (RestartError, one line): the other branch
@@ -178,11 +179,12 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
     point = step_away(system, start, tracer.settings)
     upper = scene.continuation.stop_stretch
     pear = is_pear(branch)  # stopped as run stops pear branches
+    rejoined = []  # the parent's branch points where a leg stopped (``rejoin_rule``)
 
     def stop():  # a leg's own rule (a pear leg remembers its crossings of the parent; each leg its way round)
         if not pear:
             return closing_rule(disc, point.X, stop_rule(scene, upper, branch.parameter, params))
-        base = pear_stop_rule(scene) if start.parent is None else rejoin_rule(start, pear_stop_rule(scene))
+        base = pear_stop_rule(scene) if start.parent is None else rejoin_rule(start, pear_stop_rule(scene), rejoined)
         return closing_rule(disc, point.X, base)
 
     def leg(sign):
@@ -191,18 +193,21 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
 
     up = leg(1.0)
     down = None if up.stop.code == StopCode.CLOSED else leg(-1.0)  # closed: the loop is whole, traced once
-    name = branch.name if branch.name == FREE_PRIMARY else "primary"
-    primary = with_events(assemble(tracer, params, name, up, down, t0, labels=("up", "down"),
-                                   land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
-    if start.parent is not None:  # through its pitchfork on the parent into the mirror image: the fold of P there
-        #                             is that pitchfork (P is even in the pear amplitude), as run marks a rejoin
+    child = pear and start.parent is not None  # stored with its parent, under its own name
+    name = branch.name if child or branch.name == FREE_PRIMARY else "primary"
+    traced = with_events(assemble(tracer, params, name, up, down, t0, labels=("up", "down"),
+                                  land_on=pear_landing(scene) if pear else landing_targets(scene, upper)))
+    if child:  # through its pitchfork on the parent into the mirror image: the fold of P there is that pitchfork
+        #        (P is even in the pear amplitude), as run marks a rejoin
         points = numbered_branch_points(start.parent)
         block = points[start.parent_point].block  # its reading's pitchforks (held or free)
         for bp in points:
             if bp.block == block:
-                mark_rejoin(primary, start.parent, bp)
-    return (examine(scene, primary, Ticks(progress), pear=False, control=not pear) if start.assessed else
-            Picture([primary]))
+                mark_rejoin(traced, start.parent, bp)
+        traced.parent, traced.rejoins = (start.parent.name, start.parent_point), next(iter(rejoined), None)
+    picture = (examine(scene, traced, Ticks(progress), pear=False, control=not pear) if start.assessed else
+               Picture([traced]))
+    return replace(picture, branches=[start.parent, *picture.branches]) if child else picture
 
 
 def is_pear(branch: Branch) -> bool:
@@ -249,13 +254,14 @@ def closing_rule(disc, X0, base):
     return stop
 
 
-def rejoin_rule(start: Labelled, base):
+def rejoin_rule(start: Labelled, base, rejoined: list):
     """stop(disc, point) of one leg of a restarted pear branch whose parent is known: where the pear amplitude
     A = λ2(0) − λ2(π) changes sign the leg crosses the equator-symmetric parent; it passes the pitchfork it was
     born at once (into its mirror image: P is even in A there, ``mark_rejoin``) and stops at any other crossing
-    (StopCode.REJOINED, at the parent's pitchfork of its reading nearest in the branch parameter), as ``run``'s
-    pear branches stop: so a restart on an isola ends where the closed loop does instead of going round it.
-    Elsewhere ``base`` (``switching.pear_stop_rule``)."""
+    (StopCode.REJOINED, at the parent's pitchfork of its reading nearest in the branch parameter, whose number
+    in ``numbered_branch_points`` it appends to ``rejoined``), as ``run``'s pear branches stop: so a restart on an
+    isola ends where the closed loop does instead of going round it. Elsewhere ``base``
+    (``switching.pear_stop_rule``)."""
     points = numbered_branch_points(start.parent)
     block = points[start.parent_point].block
     pitchforks = [(n, bp.X[-1]) for n, bp in enumerate(points) if bp.block == block]
@@ -268,6 +274,7 @@ def rejoin_rule(start: Labelled, base):
         if before is not None and before * amplitude < 0:
             n = min(pitchforks, key=lambda item: abs(item[1] - point.X[-1]))[0]
             if n != start.parent_point or state["passed"]:
+                rejoined.append(n)
                 return Stop(StopCode.REJOINED, f"rejoined the primary branch at its pitchfork at P = {point.X[-1]:.6g}")
             state["passed"] = True
         return base(disc, point)
