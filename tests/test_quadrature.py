@@ -48,3 +48,22 @@ def test_default_rule_holds_the_near_wire_pressure_against_twice_the_nodes(near_
     fine = pressure(near_wire, 2 * DEGREE + 16)
     assert abs(pressure(near_wire, gauss_nodes(DEGREE)) / fine - 1) <= 1e-9
     assert abs(pressure(near_wire, DEGREE + 8) / fine - 1) >= 1e-8
+
+
+@pytest.mark.parametrize("n", [1, 8, 143, 488])
+def test_the_shared_gauss_rule_integrates_legendre_products_exactly_and_cannot_be_changed(n):
+    """``legendre.gauss_rule`` (numpy's leggauss, computed once per n): exact for P_j P_k with j + k < 2n (the
+    orthogonality ∫P_j P_k = 2δ_jk/(2k + 1)), the same arrays on every call, and read-only (a caller that wrote
+    into them would change every later discretisation's rule)."""
+    from numpy.polynomial import legendre
+
+    from balloon_cg.galerkin.legendre import gauss_rule
+
+    x, w = gauss_rule(n)
+    assert gauss_rule(n)[0] is x and not x.flags.writeable and not w.flags.writeable
+    k = min(n - 1, 40)
+    p = legendre.legvander(x, k)  # P_0..P_k at the nodes
+    gram = (p * w[:, None]).T @ p
+    assert np.allclose(gram, np.diag(2.0 / (2 * np.arange(k + 1) + 1)), atol=1e-13)
+    with pytest.raises(ValueError):
+        x[0] = 0.0

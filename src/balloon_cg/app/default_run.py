@@ -41,12 +41,14 @@ def default_scenes(max_points: int | None = None) -> list:
 
 
 def draw_figures(paths, outdir: Path, stem: str, kinds=None) -> list[Path]:
-    """Save every applicable plot kind (or those of ``kinds``) for the run files ``paths`` as <stem>_<kind>.png."""
-    applicable = applicable_kinds([b for p in paths for b in load_branches(p)])
+    """Save every applicable plot kind (or those of ``kinds``) for the run files ``paths`` as <stem>_<kind>.png (each
+    file read once for all of them)."""
+    runs = [read_run(p) for p in paths]
+    applicable = applicable_kinds([b for run in runs for b in load_branches(run)])
     images = []
     for kind in applicable if kinds is None else [k for k in kinds if k in applicable]:
         image = outdir / f"{stem}_{kind}.png"
-        figure = plot(paths, kind)
+        figure = plot(runs, kind)
         with replacing(image, force=True) as tmp:  # the default run owns out/ (its runs are replaced too)
             figure.savefig(tmp, dpi=150, format="png")
         images.append(image)

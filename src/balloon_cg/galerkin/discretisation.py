@@ -14,9 +14,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
-from numpy.polynomial import legendre
 
 from .coordinate_map import WireMap
+from .legendre import gauss_rule
 from ..generated import HESSIAN_PAIRS
 
 
@@ -397,8 +397,8 @@ def split_rule(n_q: int, joins: tuple = ()):
     each piece, where a kink of the integrand at a join costs a single rule O(n_q⁻²)). Mirror-symmetric when the
     joins are."""
     if not joins:
-        return legendre.leggauss(n_q)
-    nodes, weights = legendre.leggauss(n_q)
+        return gauss_rule(n_q)
+    nodes, weights = gauss_rule(n_q)
     ends = (-1.0, *joins, 1.0)
     pieces = [(0.5 * (b - a), 0.5 * (b + a)) for a, b in zip(ends[:-1], ends[1:])]
     return (np.concatenate([half * nodes + middle for half, middle in pieces]),

@@ -31,9 +31,9 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.polynomial import legendre
 from scipy import optimize
 
+from .legendre import gauss_rule
 from .discretisation import gauss_nodes, legendre_table, read_only, symmetric_rows
 from ..generated import HESSIAN_PAIRS
 from ..scene.tables import Ends
@@ -193,7 +193,7 @@ def _tables(disc: IntervalDiscretisation) -> dict:
     """Nodes, weights per dS, the meridian's R' and R at the nodes and the state maps (read-only; also split by the
     columns each reads: (λ2, v) of λ2's coefficients, (η, w) of (λ̄, b))."""
     n, length = disc.degree, disc.length
-    x, w = legendre.leggauss(disc.quadrature or gauss_nodes(n))
+    x, w = gauss_rule(disc.quadrature or gauss_nodes(n))
     p, dp = legendre_table(x, n)
     bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
     k = disc.axial_index

@@ -1,6 +1,19 @@
 """Orthonormal associated Legendre functions P̄_k^j(cos θ) and their θ-derivatives: the azimuthal perturbation
-bases (analysis/stability/azimuthal.py) and the spherical harmonics of the whole-sphere engine (surface/basis.py)."""
+bases (analysis/stability/azimuthal.py) and the spherical harmonics of the whole-sphere engine (surface/basis.py);
+the Gauss–Legendre rules every discretisation integrates with."""
+import functools
+
 import numpy as np
+from numpy.polynomial import legendre
+
+
+@functools.lru_cache(maxsize=64)
+def gauss_rule(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(nodes, weights) of the n-node Gauss–Legendre rule on [−1, 1] (numpy's ``leggauss``: an O(n³) eigenvalue
+    solve), computed once per n and shared read-only (a branch's points rebuild the same few rules)."""
+    nodes, weights = legendre.leggauss(n)
+    nodes.flags.writeable = weights.flags.writeable = False
+    return nodes, weights
 
 
 def legendre_values(x: np.ndarray, degree: int, order: int) -> np.ndarray:

@@ -33,11 +33,10 @@ from functools import cached_property
 
 import numpy as np
 from numba import njit
-from numpy.polynomial import legendre as gauss
 from scipy.linalg import lapack
 
 from ..galerkin.discretisation import read_only
-from ..galerkin.legendre import legendre_values, theta_derivative
+from ..galerkin.legendre import gauss_rule, legendre_values, theta_derivative
 
 COS, SIN = 0, 1
 MIRROR_Y = (1, -1, 1)  # the plane y = 0 through the axis (MODEL.md §8: x, z keep cos kφ, y keeps sin kφ)
@@ -148,7 +147,7 @@ class SphericalBasis:
     def nodes(self) -> dict:
         """cos θ_j, sin θ_j, the weights W_j = w_j/N_φ (with E's 1/2π), φ_k, and X, a_θ(X), a_φ(X) at every
         node (rows of the node state of u = 0), node index j N_φ + k."""
-        mapped, w = gauss.leggauss(self.n_theta)
+        mapped, w = gauss_rule(self.n_theta)
         mapped, w = mapped[::-1].copy(), w[::-1].copy()  # θ increasing: north to south
         if self.mapping is None:
             x = mapped

@@ -28,10 +28,10 @@ Non-axisymmetric modes m = 1..m_max (``azimuthal``, docs/second_variation.md) fo
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.polynomial import legendre
 
 from .azimuthal import merged_lowest, perturbation_map, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
+from ...galerkin.legendre import gauss_rule
 from ...galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
                                        read_only)
 from ...galerkin.equilibrium import NodeKernels, Parameters
@@ -130,7 +130,7 @@ class SecondVariation:
         b = self.basis
         # mirror-symmetric nodes: in x without a map, in s with one (x = g(s) is odd only to rounding, and the middle
         # node of an odd rule must count once)
-        nodes = b.x if b.mapping is None else legendre.leggauss(b.x.size)[0]
+        nodes = b.x if b.mapping is None else gauss_rule(b.x.size)[0]
         keep, weights = even_half(nodes, b.weights)
         n_q = b.x.size
         state_map = np.ascontiguousarray(self.state_map[:, np.concatenate([k * n_q + keep for k in range(4)])])

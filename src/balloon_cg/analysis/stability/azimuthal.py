@@ -37,7 +37,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from numpy.polynomial import legendre
 from scipy import linalg
 
 from numba import njit
@@ -45,7 +44,7 @@ from numba import njit
 from ...galerkin.coordinate_map import WireMap
 from ...galerkin.discretisation import even_half, symmetric_rows
 from ...galerkin.equilibrium import Equilibrium, Parameters
-from ...galerkin.legendre import assoc_legendre, legendre_values
+from ...galerkin.legendre import assoc_legendre, gauss_rule, legendre_values
 from ...generated import AZIMUTHAL_PAIRS
 from ...model.meridian import mass_density, metric
 from ...numerics import eigen
@@ -70,7 +69,7 @@ class AzimuthalBasis:
             raise ValueError(f"m = {m}: the azimuthal second variation needs m ≥ 1 (m = 0 is Equilibrium.jacobian)")
         if n < m:
             raise ValueError(f"degree = {n}: must be ≥ m = {m}")
-        nodes, weights = legendre.leggauss(self.quadrature)
+        nodes, weights = gauss_rule(self.quadrature)
         x = nodes if self.mapping is None else self.mapping.x(nodes)
         if self.mapping is not None:
             weights = weights / self.mapping.ds_dx(x)  # dx = ds/h'
