@@ -3,7 +3,8 @@
 For each default scene (SPOM1 at M = 0, and SPOM1 between the paper's two opposed coils at M = 0.002: the
 files scenes/spom1.toml and scenes/spom1_two_coils_M0.002.toml, read as the package data balloon_cg.scenes,
 which pyproject.toml maps to the top-level scenes/, so that an installed package runs them too) the primary
-branch is traced and written to OUTDIR/<scene>.h5, and every plot kind that applies is drawn as
+branch is traced and written to OUTDIR/<scene>.h5 (the scenes at once: each but the last, the longest, in a child
+process beside this one, whose workers get the cores a finished child frees), and every plot kind that applies is drawn as
 OUTDIR/<scene>_<kind>.png. The pressure curves of all scenes together (several M in one figure) go to
 OUTDIR/all_<kind>.png. Existing files of these names are overwritten. A summary table closes the run; the
 exit code is 1 if a scene failed or its result is incomplete (analysis.verdict), else 0. ``--quick`` limits
@@ -11,6 +12,7 @@ every leg of the continuation to QUICK_POINTS points (for tests: the results are
 do not change the exit code).
 """
 import argparse
+import subprocess
 import sys
 import time
 from importlib import resources
@@ -90,26 +92,39 @@ def main(argv=None) -> int:
     parser.add_argument("outdir", help="folder for the run files and figures (created if missing)")
     parser.add_argument("--quick", action="store_true", help=f"at most {QUICK_POINTS} points per leg (for tests)")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("--only", choices=SCENES, help=argparse.SUPPRESS)  # one scene, nothing combined: a child's
     args = parser.parse_args(argv)
     outdir = Path(args.outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    rows, paths, failed = [], [], []
-    for scene in default_scenes(QUICK_POINTS if args.quick else None):
-        try:
-            path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=shown(args.quiet))
-        except ContinuationError as e:
-            failed.append(f"{scene.name}: {e}")
-            continue
-        if failing(found) and not args.quick:
-            failed.append(f"{scene.name}: {summary_line(found)}")
-        paths.append(path)
-        for image in draw_figures([path], outdir, scene.name):
-            print(image)
-        rows.append(summary_row(path))
+    scenes = default_scenes(QUICK_POINTS if args.quick else None)
+    if args.only:
+        _, failure = run_and_draw(next(s for s in scenes if s.name == args.only), outdir, args.quick, args.quiet)
+        if failure:
+            print(f"failed: {failure}", file=sys.stderr)
+        return 1 if failure else 0
+    *beside, last = scenes
+    children = [_started(scene.name, outdir, args.quick) for scene in beside]
+    try:
+        path, failure = run_and_draw(last, outdir, args.quick, args.quiet)
+        failed, paths = [], []
+        for child in children:  # their lines after the last scene's: its progress bars stay whole
+            out, err = child.communicate()
+            sys.stdout.write(out)
+            paths += [Path(line) for line in out.splitlines() if line.endswith(".h5")]
+            said = [line.removeprefix("failed: ") for line in err.splitlines() if line.startswith("failed: ")]
+            sys.stderr.write("".join(f"{line}\n" for line in err.splitlines() if not line.startswith("failed: ")))
+            failed += said or ([f"{child.args[-1]}: exit {child.returncode}"] if child.returncode else [])
+        failed, paths = failed + ([failure] if failure else []), paths + ([path] if path else [])
+    finally:
+        for child in children:
+            if child.poll() is None:
+                child.kill()
+                child.wait()
     if len(paths) > 1:
         for image in draw_figures(paths, outdir, "all", COMBINED):
             print(image)
+    rows = [summary_row(path) for path in paths]
     if rows:
         print()
         print(format_summary(rows))
@@ -117,6 +132,27 @@ def main(argv=None) -> int:
     for message in failed:
         print(f"failed: {message}", file=sys.stderr)
     return 1 if failed else 0
+
+
+def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool) -> tuple[Path | None, str | None]:
+    """Analyse ``scene`` into outdir/<scene>.h5 and draw its figures (the run file's path and theirs printed): the
+    run file (None when the trace failed) and what failed, or None (a quick run's partial result is no failure)."""
+    try:
+        path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=shown(quiet))
+    except ContinuationError as e:
+        return None, f"{scene.name}: {e}"
+    print(path, flush=True)
+    for image in draw_figures([path], outdir, scene.name):
+        print(image, flush=True)
+    return path, f"{scene.name}: {summary_line(found)}" if failing(found) and not quick else None
+
+
+def _started(name: str, outdir: Path, quick: bool) -> subprocess.Popen:
+    """The default run of scene ``name`` alone, in a child process beside this one (no progress bars: this
+    process draws its own); its stdout and stderr captured."""
+    command = [sys.executable, "-m", "balloon_cg.app.default_run", str(outdir), "--quiet"] + (
+        ["--quick"] if quick else []) + ["--only", name]
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
 if __name__ == "__main__":
