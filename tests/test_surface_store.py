@@ -347,3 +347,17 @@ def test_a_sector_of_another_basis_is_not_written_nor_read(tmp_path, scene, prim
         assert main(["inspect", str(damaged)]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "m1_sector" in err and "sector" in err, err
+
+
+@pytest.mark.parametrize("mapping", [None, WireMap((0.3,), (0.2,))])
+def test_the_drawn_surface_is_the_series_at_every_grid_point(mapping):
+    """``plotting.surface_grid`` (the series once per ring) equals ``SphericalBasis.point_values`` (per point, the
+    poles included) on the drawn grid, on a plain and a wire-mapped basis, for a state with every block set."""
+    from balloon_cg.post.plotting import SURFACE_SAMPLES, surface_grid
+
+    basis = SphericalBasis(8, (MIRROR_Y,), mapping=mapping)
+    c = np.random.default_rng(2).normal(scale=0.1, size=basis.size)
+    theta, phi = np.meshgrid(np.linspace(0.0, np.pi, SURFACE_SAMPLES[0]),
+                             np.linspace(0.0, 2 * np.pi, SURFACE_SAMPLES[1]), indexing="ij")
+    x, _ = basis.point_values(c, theta.ravel(), phi.ravel())
+    assert np.abs(surface_grid(basis, c) - x.reshape(3, *SURFACE_SAMPLES)).max() < 1e-13

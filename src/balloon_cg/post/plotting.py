@@ -922,11 +922,8 @@ def _state_title(branch: StoredBranch, index: int) -> str:
 
 def surface_grid(basis, c, samples: tuple = SURFACE_SAMPLES) -> np.ndarray:
     """x (3, n_θ, n_φ) of the state c on a (θ, φ) grid of ``samples`` values from pole to pole and from φ = 0 to
-    2π (``SphericalBasis.point_values``: the series anywhere, the poles included)."""
-    theta, phi = np.meshgrid(np.linspace(0.0, np.pi, samples[0]), np.linspace(0.0, 2 * np.pi, samples[1]),
-                             indexing="ij")
-    x, _ = basis.point_values(c, theta.ravel(), phi.ravel())
-    return x.reshape(3, *samples)
+    2π (``SphericalBasis.grid_values``: each block's θ-series once per ring, the poles included)."""
+    return basis.grid_values(c, np.cos(np.linspace(0.0, np.pi, samples[0])), np.linspace(0.0, 2 * np.pi, samples[1]))
 
 
 def plot_surface(branch: StoredBranch, index: int, axes=None) -> Figure:
