@@ -48,18 +48,18 @@ class ShootingResult:
     """A shooting solve at prescribed north pole stretch.
 
     ``residual``: max-norm of the equator conditions at the returned unknowns; ``iterations``: Newton steps;
-    ``lam2_south``/``eta_south`` are the south pole values (by symmetry for ``shoot_symmetric``).
+    ``lam2_bottom``/``eta_bottom`` are the bottom (south) pole values (by symmetry for ``shoot_symmetric``).
     """
 
     P: float
-    eta_north: float
+    eta_top: float
     lam2_equator: float
     residual: float
     converged: bool
     message: str
     iterations: int = 0
-    lam2_south: float = np.nan
-    eta_south: float = np.nan
+    lam2_bottom: float = np.nan
+    eta_bottom: float = np.nan
     wall_time: float = 0.0
 
 
@@ -178,11 +178,11 @@ def _newton(equations, x0, tol, max_iter):
     return x, r, halves, max_iter, False, f"no convergence in {max_iter} Newton iterations"
 
 
-def _result(P, eta_north, halves, r, iterations, converged, message, lam2_south, eta_south, t_start):
+def _result(P, eta_top, halves, r, iterations, converged, message, lam2_bottom, eta_bottom, t_start):
     return ShootingResult(
-        P=float(P), eta_north=float(eta_north), lam2_equator=float(halves[0].y[0]) if halves else np.nan,
+        P=float(P), eta_top=float(eta_top), lam2_equator=float(halves[0].y[0]) if halves else np.nan,
         residual=float(np.abs(r).max()), converged=converged, message=message, iterations=iterations,
-        lam2_south=float(lam2_south), eta_south=float(eta_south), wall_time=time.perf_counter() - t_start,
+        lam2_bottom=float(lam2_bottom), eta_bottom=float(eta_bottom), wall_time=time.perf_counter() - t_start,
     )
 
 
@@ -206,7 +206,7 @@ def shoot_symmetric(scene, pole_stretch, P_guess, eta0_guess, start="taylor", ep
     return _result(x[0], x[1], halves, r, iterations, converged, message, pole_stretch, -x[1], t_start)
 
 
-def shoot_general(scene, pole_stretch, P_guess, eta0_guess, lam2_south_guess, eta_south_guess, start="taylor",
+def shoot_general(scene, pole_stretch, P_guess, eta0_guess, lam2_bottom_guess, eta_bottom_guess, start="taylor",
                   eps=1e-4, tol=1e-12, max_iter=20) -> ShootingResult:
     """Any axisymmetric equilibrium with λ2(0) = ``pole_stretch``: both halves shot to θ = π/2 and matched.
 
@@ -221,9 +221,9 @@ def shoot_general(scene, pole_stretch, P_guess, eta0_guess, lam2_south_guess, et
         return (x[0], x[1], x[2], x[3]) if free_translation else (x[0], eta0_guess, x[1], x[2])
 
     def equations(x):
-        P, eta0, lam2_south, eta_south = unpack(x)
+        P, eta0, lam2_bottom, eta_bottom = unpack(x)
         north = shooter.half(NORTH, pole_stretch, eta0, P, start, eps)
-        south = shooter.half(SOUTH, lam2_south, eta_south, P, start, eps)
+        south = shooter.half(SOUTH, lam2_bottom, eta_bottom, P, start, eps)
         mismatch = north.y - south.y
         # columns ∂/∂(P, η0, λ2(π), η(π))
         A = np.column_stack([north.Z[:, 0] - south.Z[:, 0], north.Z[:, 1], -south.Z[:, 2], -south.Z[:, 1]])
@@ -231,8 +231,8 @@ def shoot_general(scene, pole_stretch, P_guess, eta0_guess, lam2_south_guess, et
             return mismatch, A, (north, south)
         return mismatch[:3], A[:3][:, [0, 2, 3]], (north, south)
 
-    x0 = (P_guess, eta0_guess, lam2_south_guess, eta_south_guess)
+    x0 = (P_guess, eta0_guess, lam2_bottom_guess, eta_bottom_guess)
     x0 = x0 if free_translation else (x0[0],) + x0[2:]
     x, r, halves, iterations, converged, message = _newton(equations, x0, tol, max_iter)
-    P, eta0, lam2_south, eta_south = unpack(x)
-    return _result(P, eta0, halves, r, iterations, converged, message, lam2_south, eta_south, t_start)
+    P, eta0, lam2_bottom, eta_bottom = unpack(x)
+    return _result(P, eta0, halves, r, iterations, converged, message, lam2_bottom, eta_bottom, t_start)
