@@ -8,6 +8,10 @@ Gauss–Legendre quadrature at interior nodes. At a node
 Equator symmetry (λ2 even, η odd in x) keeps a_even and b_odd, and then every integrand is even in x: the
 quadrature runs over the nodes x ≥ 0 with doubled weights (``even_half``). Without a field the translation
 η → η + c is removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
+
+A capsule's discretisation (``joins`` = ±c, where its reference curvature jumps) has the piecewise basis φ_k of
+galerkin/elements.py in place of P_k (φ_0 = 1, parity (−1)^k, hierarchical: all of the above holds) and a composite
+Gauss rule split at the joins; it converges spectrally in the degree where one Legendre series converges as N⁻³.
 """
 import functools
 from dataclasses import dataclass, replace
@@ -16,22 +20,9 @@ import numpy as np
 from numba import njit
 
 from .coordinate_map import WireMap
-from .legendre import gauss_rule
+from .elements import element_table
+from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
-
-
-def legendre_table(x: np.ndarray, degree: int):
-    """(P_k(x), P_k'(x)) for k = 0..degree, each of shape (len(x), degree + 1), by the three-term recurrence."""
-    p = np.zeros((x.size, degree + 1))
-    dp = np.zeros_like(p)
-    p[:, 0] = 1.0
-    if degree >= 1:
-        p[:, 1] = x
-        dp[:, 1] = 1.0
-    for k in range(1, degree):
-        p[:, k + 1] = ((2 * k + 1) * x * p[:, k] - k * p[:, k - 1]) / (k + 1)
-        dp[:, k + 1] = dp[:, k - 1] + (2 * k + 1) * p[:, k]
-    return p, dp
 
 
 def read_only(array: np.ndarray) -> np.ndarray:
@@ -211,12 +202,19 @@ def _state_loops(A, B, u, out):
             out[2 + k, q] = total
 
 
+def basis_table(x: np.ndarray, degree: int, joins: tuple = ()):
+    """(φ_k(x), dφ_k/dx) for k = 0..degree: P_k(x), or with ``joins`` (a capsule's ±c) the elements' piecewise basis
+    (galerkin/elements.py)."""
+    return element_table(x, degree, joins[-1]) if joins else legendre_table(x, degree)
+
+
 @functools.lru_cache(maxsize=64)
-def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None):
-    """(P_k(s), dP_k/dx) at x = cos θ, s = h(x), for a θ grid met again and again (stability nodes, profiles)."""
+def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None, joins: tuple = ()):
+    """(φ_k(x), dφ_k/dx) at x = cos θ (P_k(s), s = h(x) on a map), for a θ grid met again and again (stability
+    nodes, profiles)."""
     x = np.cos(np.frombuffer(theta_bytes))
     if mapping is None:
-        return legendre_table(x, degree)
+        return basis_table(x, degree, joins)
     p, dp = legendre_table(np.clip(mapping.s(x), -1.0, 1.0), degree)
     return p, dp * mapping.ds_dx(x)[:, None]
 
@@ -237,7 +235,8 @@ class Discretisation:
     pin_translation: bool
     quadrature: int = 0
     mapping: WireMap | None = None
-    joins: tuple = ()  # x where the quadrature splits (a capsule's, where its reference curvature jumps)
+    joins: tuple = ()  # x where the basis and the quadrature split (a capsule's ±c, where its reference curvature
+    #                    jumps: the piecewise basis of galerkin/elements.py, a composite Gauss rule)
 
     def __reduce__(self):
         """Pickled as its six defining fields (the tables are rebuilt): results holding one stay small."""
@@ -297,8 +296,8 @@ class Discretisation:
 
     @functools.cached_property
     def _pole_rows(self) -> dict:
-        sign = (-1.0) ** np.arange(self.degree + 1)
-        ones = np.ones(self.degree + 1)
+        ones = basis_table(np.ones(1), self.degree, self.joins)[0][0]  # φ_k(1): all ones on Legendre's
+        sign = (-1.0) ** np.arange(self.degree + 1) * ones  # φ_k(−1) = (−1)^k φ_k(1)
         zero = np.zeros(self.degree + 1)
         rows = {
             "lam2_top": self.join(ones, zero),
@@ -312,7 +311,7 @@ class Discretisation:
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
-        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping)
+        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping, self.joins)
         s = np.sin(theta)
         U = np.atleast_2d(u)
         na = self.a_index.size
@@ -322,8 +321,9 @@ class Discretisation:
         return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
 
     def nests_in(self, other: "Discretisation") -> bool:
-        """Every function of this basis lies in ``other``'s (same map, degree no higher): transfers are exact."""
-        return other.mapping == self.mapping and other.degree >= self.degree
+        """Every function of this basis lies in ``other``'s (same map and joins, degree no higher): transfers are
+        exact."""
+        return other.mapping == self.mapping and other.joins == self.joins and other.degree >= self.degree
 
     def transfer(self, u: np.ndarray, other: "Discretisation") -> np.ndarray:
         """The same functions in the basis of ``other``; u may be (.., size + 1), trailing entries (P, ...) kept.
@@ -421,7 +421,7 @@ def _tables(disc: Discretisation) -> dict:
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
     n_q = disc.quadrature or gauss_nodes(disc.degree)
     nodes, s_weights = split_rule(n_q, disc.joins)
-    p, dp = legendre_table(nodes, disc.degree)
+    p, dp = basis_table(nodes, disc.degree, disc.joins)
     if disc.mapping is None:
         x, weights = nodes, s_weights
     else:

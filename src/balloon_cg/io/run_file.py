@@ -252,6 +252,7 @@ def _write_branch(group, branch, theta, first_label: int = 1):
         "quadrature": disc.quadrature,
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
+        "joins": np.array(disc.joins, dtype=float),
         "origin": branch.origin.value,
         "gauge": branch.gauge.value,
     })
@@ -601,7 +602,7 @@ TIMING_KINDS = {"phase_names": "str[]", "phase_seconds": "float[]", "total_secon
 COMMON_KINDS = {"stop_reason": "str", "wall_time": "float", "kernel_class": "str", "kernel_signature": "str",
                 "M": "float", "chi": "float", "leg_labels": "str[]", "leg_stop_codes": "str[]"}
 BRANCH_KINDS = COMMON_KINDS | {"degree": "int", "symmetric": "bool", "pin_translation": "bool", "quadrature": "int",
-                               "map_centres": "float[]", "map_widths": "float[]"}
+                               "map_centres": "float[]", "map_widths": "float[]", "joins": "float[]"}
 SURFACE_KINDS = COMMON_KINDS | {"m": "int", "parent_branch": "str", "parent_branch_point": "int",
                                 "surface_degree": "int", "surface_order": "int", "n_theta": "int", "n_phi": "int",
                                 "map_centres": "float[]", "map_widths": "float[]", "parameter": "str"}

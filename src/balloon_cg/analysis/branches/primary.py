@@ -99,8 +99,8 @@ def released(tracer: Tracer, held: continuation.Point, params: Parameters,
     at fixed P, where the b_0 row of the residual is the net axial force (its ∂E/∂b_0); then resolved
     (``_resolved_start``). ContinuationError when Newton does not reach a free equilibrium."""
     scene = tracer.scene
-    pinned = Discretisation(degree, tracer.symmetric, True)
     system = tracer.system(degree, params)
+    pinned = Discretisation(degree, tracer.symmetric, True, joins=system.eq.disc.joins)
     X = np.append(system.eq.disc.join(*pinned.split(held.X[:-1])), held.X[-1])
     result = newton(system.residual, system.jacobian, X, unit(X.size, -1), X[-1], scene.solver.tol,
                     scene.solver.max_newton)
