@@ -13,6 +13,7 @@ import json
 
 import numpy as np
 import pytest
+from numpy.polynomial import legendre
 import sympy as sp
 from scipy.optimize import brentq
 
@@ -20,6 +21,7 @@ from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.branches.primary import inflated_reference, start_parameters
 from balloon_cg.analysis.branches.tracer import Tracer, unit
 from balloon_cg.galerkin.discretisation import split_rule
+from balloon_cg.galerkin.elements import element_table
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.model import meridian, tube
 from balloon_cg.numerics import continuation
@@ -90,6 +92,51 @@ def test_reference_meridian_is_c1_with_the_curvature_jumping_at_the_joins():
             assert abs(f(np.array(t - 1e-9)) - f(np.array(t + 1e-9))) < 1e-7
     second = lambda t: (R(t + 1e-4) - 2 * R(t) + R(t - 1e-4)) / 1e-8  # noqa: E731
     assert abs(second(joint - 1e-3) + kappa**2) < 1e-2 and abs(second(joint + 1e-3)) < 1e-6
+
+
+def test_piecewise_basis_is_continuous_hierarchical_and_spans_piecewise_polynomials():
+    """galerkin/elements.py at length 6, degree 40: φ_k continuous at the joins, φ_k(−x) = (−1)^k φ_k(x), dφ/dx the
+    central differences of φ (1e-7), the degree-30 table the first 31 columns of degree 40's; a function continuous
+    at the joins, cubic in x on each cap and quintic in θ on the cylinder (written here), is fitted exactly (least
+    squares at 400 points, 1e-12), which one Legendre series in x of as many functions cannot (> 1e-5)."""
+    kappa = 1 + 6.0 / np.pi
+    joint = np.pi / (2 * kappa)
+    c = np.cos(joint)
+    x = np.cos(np.linspace(0.0, np.pi, 400))
+    p, dp = element_table(x, 40, c)
+    flipped, _ = element_table(-x, 40, c)
+    assert np.abs(flipped - p * (-1.0) ** np.arange(41)).max() < 1e-12
+    for side in (c, -c):
+        across, _ = element_table(np.array([side - 1e-12, side + 1e-12]), 40, c)
+        assert np.abs(across[0] - across[1]).max() < 1e-9
+    h, inner = 1e-6, np.array([0.999, 0.9 * c + 0.1, 0.5 * c, -0.3 * c, -0.95])
+    plus, minus, (_, slope) = element_table(inner + h, 40, c), element_table(inner - h, 40, c), element_table(inner, 40, c)
+    assert np.abs((plus[0] - minus[0]) / (2 * h) - slope).max() < 1e-7 * np.abs(slope).max()
+    lower, _ = element_table(x, 30, c)
+    assert np.array_equal(lower, p[:, :31])
+    theta = np.arccos(x)
+    xi = (np.pi / 2 - theta) / (np.pi / 2 - joint)
+    cylinder = 1 + 0.3 * xi - 0.5 * xi**2 + 0.2 * xi**5
+    f = np.where(x > c, 1.0 + 0.3 - 0.5 + 0.2 + 2 * (x - c) - 7 * (x - c) ** 3,
+                 np.where(x < -c, 1.0 - 0.3 - 0.5 - 0.2 + (x + c) ** 2, cylinder))
+    for table, exact in ((p, True), (legendre.legvander(x, 40), False)):
+        residual = np.abs(table @ np.linalg.lstsq(table, f, rcond=None)[0] - f).max()
+        assert residual < 1e-12 if exact else residual > 1e-5
+
+
+def test_capsule_converges_spectrally_in_the_degree():
+    """SPOM1 capsule of length 4 at P = 0.5: the enclosed volume and the hoop stretch at the middle at degrees 24,
+    32, 48 and 64 (benchmarks/results/capsule_convergence.txt): λ2's changes fall more than 20× per step, V changes
+    by less than 1e-12 from 48 to 64, and the tail estimate at 64 is within the default max_error 1e-9 (the
+    Legendre series in x changed V by 2.8e-5 from 48 to 64, its tail estimate stalling at 4e-3)."""
+    volumes, hoops = [], []
+    for degree in (24, 32, 48, 64):
+        eq, u = inflated(capsule_scene(4.0), degree, 0.5)
+        volumes.append(2 * np.pi * eq.volume(u))
+        hoops.append(float(eq.state_at(u, np.array([np.pi / 2]))[0][0]))
+    changes = np.abs(np.diff(hoops))
+    assert np.all(changes[1:] < changes[:-1] / 20)
+    assert abs(volumes[-1] - volumes[-2]) < 1e-12 and eq.disc.tail(u) < 1e-9
 
 
 def test_split_rule_integrates_a_kink_exactly():
@@ -246,6 +293,29 @@ def test_run_writes_the_capsules_profiles(tmp_path, capsys):
     assert np.abs(profiles["rho"] - profiles["lam2"] * R).max() < 1e-10
     assert np.all(np.isfinite(profiles["lam1"]))
     assert np.abs(profiles["lam1"][:, [0, -1]] - profiles["lam2"][:, [0, -1]]).max() < 1e-10
+
+
+def test_capsule_of_length_3_to_stretch_2_is_complete(tmp_path, capsys):
+    """``balloon-cg run`` on a SPOM1 capsule of length 3 to pole stretch 2 (m = 0) exits 0: its pear branches, switched
+    at the equator-breaking branch point, have no point whose stability flags change at the check degree (they
+    did at degree 20, where their first point's pear eigenvalue read 2.6e-6 against its converged −1.2e-8:
+    analysis/stability.point_degrees assesses a capsule at its branch's degree). The branch point is where the
+    primary branch traced from degree 64 has it (1e-10)."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.run_file import read_run
+
+    text = CAPSULE.format(length=3.0) + "[continuation]\nstop_stretch = 2.0\n"
+    scene = tmp_path / "capsule.toml"
+    scene.write_text(text)
+    path = tmp_path / "capsule.h5"
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    capsys.readouterr()
+    branches = read_run(path)["branches"]
+    assert {"primary", "pear_0", "pear_0_mirror"} <= set(branches)
+    stored = [p["pressure"] for p in branches["primary"]["special_points"] if p["kind"] == "BP"]
+    finer = analyse(parse_scene(text + "[solver]\ndegree = 64\n"), pear=False).branches[0]
+    again = [p.X[-1] for p in finer.special if p.kind.value == "BP"]
+    assert len(stored) == len(again) == 1 and abs(stored[0] - again[0]) < 1e-10
 
 
 def test_capsule_table_errors_name_key_value_and_range():
