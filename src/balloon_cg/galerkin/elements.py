@@ -19,7 +19,7 @@ for η, the reflection z → −z is a_k → (−1)^k a_k as on the Legendre bas
 
 the element chosen greedily (``sequence``) to keep the polynomial degree per radian of θ (per arclength) alike on the
 cylinder (degree j over π − 2θj) and on the caps (degree j in x, 2j in θ over the cap and its mirror, 2θj), once the
-caps hold a share of their own (CAP_SHARE). Every
+caps have a degree of their own (the two grow alike up to CAP_FLOOR). Every
 continuous piecewise polynomial is spanned (1 and ℓ match any values at the joins; what is left vanishes there).
 φ_0 = 1 keeps b_0 the rigid translation.
 """
@@ -30,16 +30,18 @@ import numpy as np
 from .legendre import legendre_table
 
 CONSTANT, HAT, CYLINDER, CAPS = range(4)  # the families of ``sequence``
-# the caps' least share of the functions: by arclength alone a capsule of length 40 gives its caps degree 6 of 162,
-# and the layer where the caps meet the cylinder (about 0.1 radii wide at 1.5 % hoop strain) is not resolved there
-CAP_SHARE = 1 / 3
+# up to this cap degree the caps and the cylinder grow alike, then by arclength: by arclength alone a capsule of
+# length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1 radii wide at
+# 1.5 % hoop strain) is not resolved: its start's pressure is 2.6e-5 off at degree 162 with caps of degree 6, 1e-7
+# with 12, 3.7e-10 with 16, 2e-14 with 24
+CAP_FLOOR = 24
 
 
 @functools.lru_cache(maxsize=32)
 def sequence(degree: int, join: float) -> tuple:
     """(family, j) of φ_0..φ_degree for the join x = c (module docstring): (CONSTANT, 0), (HAT, 1), then per parity
-    the caps while they hold less than CAP_SHARE of the functions, else the family with the lower degree per radian
-    once the function is added, the caps on a tie."""
+    the element of the lower degree once the function is added while the caps' is at most CAP_FLOOR, then the one
+    with the lower degree per radian; the caps on a tie."""
     theta_j = float(np.arccos(join))
     cylinder_span, cap_span = np.pi - 2 * theta_j, 2 * theta_j
     out = [(CONSTANT, 0), (HAT, 1)][: degree + 1]
@@ -47,13 +49,26 @@ def sequence(degree: int, join: float) -> tuple:
     caps = {0: 1, 1: 1}  # the next cap pair's degree of each parity
     for k in range(2, degree + 1):
         parity = k % 2
-        if 2 * (caps[parity] - 1) >= CAP_SHARE * k and cylinder[parity] / cylinder_span < 2 * caps[parity] / cap_span:
+        floor = min(CAP_FLOOR, cylinder[parity] / 2)
+        if caps[parity] > floor and cylinder[parity] / cylinder_span < 2 * caps[parity] / cap_span:
             out.append((CYLINDER, cylinder[parity]))
             cylinder[parity] += 2
         else:
             out.append((CAPS, caps[parity]))
             caps[parity] += 1
     return tuple(out)
+
+
+def families(degree: int, join: float) -> tuple:
+    """(cylinder, caps): the indices k of the cylinder's bubbles in the order of their degree, and of the caps' pairs
+    as (even, odd) columns per degree j (rows, shape (n, 2); the last degree's odd one repeats its even one when
+    it is not there yet): the elements' own coefficient series, whose tails ``Discretisation.tail`` reads."""
+    order = sequence(degree, join)
+    cylinder = [k for k, (family, _) in sorted(enumerate(order), key=lambda item: item[1][1]) if family == CYLINDER]
+    even = [k for k, (family, _) in enumerate(order) if family == CAPS and k % 2 == 0]
+    odd = [k for k, (family, _) in enumerate(order) if family == CAPS and k % 2 == 1]
+    pairs = [(e, odd[j] if j < len(odd) else e) for j, e in enumerate(even)]
+    return np.array(cylinder, dtype=int), np.array(pairs, dtype=int).reshape(-1, 2)
 
 
 def element_table(x: np.ndarray, degree: int, join: float):
