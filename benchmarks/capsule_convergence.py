@@ -34,7 +34,8 @@ def main() -> None:
         eq, u = inflated(capsule_scene(args.length), degree, args.pressure)
         volume = 2 * np.pi * eq.volume(u)
         hoop = float(eq.state_at(u, np.array([0.5 * np.pi]))[0][0])
-        changes = ("", "") if previous is None else (f"{abs(volume - previous[0]):.2e}", f"{abs(hoop - previous[1]):.2e}")
+        changes = ("", "") if previous is None else tuple(f"{abs(now - before):.2e}" for now, before
+                                                          in zip((volume, hoop), previous))
         print(f"{degree:4d} {volume:20.15f} {changes[0]:>9} {hoop:18.15f} {changes[1]:>9} {eq.disc.tail(u):8.1e} "
               f"{time.perf_counter() - start:6.2f}")
         previous = (volume, hoop)
