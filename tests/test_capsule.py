@@ -344,7 +344,9 @@ def test_capsule_table_errors_name_key_value_and_range():
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[electric]\nvoltage = 0.1\n',
          "[electric]"),
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
-         '[[field.coils]]\nradius = 3.0\nheight = 0.0\ncurrent = 1.0\n', "coils"),
+         '[[field.coils]]\nradius = 0.8\nheight = 3.0\ncurrent = 1.0\n', "inside the reference capsule of length 5"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
+         '[[field.coils]]\nradius = 2.0\ncentre = [0.5, 0.0, 0.0]\ncurrent = 1.0\n', "coils off the axis"),
     ]:
         with pytest.raises(SceneError) as error:
             parse_scene('[material]\npreset = "SPOM1"\n' + extra)
@@ -352,3 +354,65 @@ def test_capsule_table_errors_name_key_value_and_range():
     scene = capsule_scene(5.0)
     assert scene.geometry.to_table() == {"shape": "capsule", "length": 5.0}
     assert scene.geometry.describe() == "capsule of length 5"
+
+
+COIL = '[field]\nM = {M}\n[[field.coils]]\nradius = 3.0\nheight = 0.0\ncurrent = 1.0\n'
+
+
+def capsule_radius(theta, kappa):
+    """(R, dR/dθ) of the capsule over θ = S/κ (module docstring), written here."""
+    north, south = kappa * theta, kappa * (np.pi - theta)
+    R = np.where(north < np.pi / 2, np.sin(north), np.where(south < np.pi / 2, np.sin(south), 1.0))
+    dR = np.where(north < np.pi / 2, kappa * np.cos(north), np.where(south < np.pi / 2, -kappa * np.cos(south), 0.0))
+    return R, dR
+
+
+def test_capsule_in_a_coil_field_is_stationary_for_the_energy_written_here():
+    """SPOM1 capsule of length 3 in the field of a coil of radius 3 around its middle, M = 0.005 (the magnetic term's
+    kernels on the capsule's meridian, generated on demand; the field at ρ = λ2 R): at the last point of its primary
+    branch to pole stretch 1.05 the energy written here,
+    E/2π = ∫ [Φ(λ1, λ2) − ½ χ M H²(ρ, η)] R κ dθ + ½ P ∫ ρ² η' dθ, ρ = λ2 R, λ1 = |ρ', η'|/κ (R written here, H² by the
+    Biot–Savart integral of tests/test_tube_field.py, Gauss–Legendre with 200 nodes on each cap and on the
+    cylinder), is stationary along every basis direction (central differences, 1e-8), and it is not without the
+    field's term (> 1e-3)."""
+    from test_interval import ogden
+    from test_tube_field import biot_savart_squared
+
+    scene = capsule_scene(3.0, "[continuation]\nstop_stretch = 1.05\n" + COIL.format(M=0.005))
+    branch = analyse(scene, pear=False).branches[0]
+    assert branch.kernel_class.startswith("ogden_magnetic_capsule")
+    u, P, disc = branch.X[-1, :-1], branch.X[-1, -1], branch.disc
+    kappa = 1 + 3.0 / np.pi
+    joint = np.pi / (2 * kappa)
+    nodes, weights = legendre.leggauss(200)
+    theta = np.concatenate([(b - a) / 2 * nodes + (a + b) / 2 for a, b in
+                            ((0.0, joint), (joint, np.pi - joint), (np.pi - joint, np.pi))])
+    dtheta = np.concatenate([(b - a) / 2 * weights for a, b in ((0.0, joint), (joint, np.pi - joint),
+                                                                 (np.pi - joint, np.pi))])
+    R, dR = capsule_radius(theta, kappa)
+    coils = [(c.radius, c.height, c.current) for c in scene.field.coils]
+
+    def energy(unknowns, M):
+        lam2, dlam2, eta, deta = disc.evaluate(unknowns, theta)
+        rho, drho = lam2 * R, dlam2 * R + lam2 * dR
+        lam1 = np.hypot(drho, deta) / kappa
+        density = (ogden(scene.material, lam1, lam2) - scene.field.chi * M * biot_savart_squared(rho, eta, coils) / 2)
+        return dtheta @ (density * R * kappa + 0.5 * P * rho**2 * deta)
+
+    def gradient(M, step=1e-6):
+        return np.array([energy(u + step * e, M) - energy(u - step * e, M) for e in np.eye(disc.size)]) / (2 * step)
+
+    assert np.abs(gradient(scene.field.M)).max() < 1e-8
+    assert np.abs(gradient(0.0)).max() > 1e-3
+
+
+def test_capsule_of_length_zero_in_a_coil_field_is_the_sphere():
+    """SPOM1 with the coil of radius 3 around the middle at M = 0.005 to pole stretch 1.5: every point of the capsule
+    of length 0 (its magnetic kernels another module) is the sphere's to 1e-10, the fold too."""
+    text = ('[material]\npreset = "SPOM1"\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 1.5\n'
+            + COIL.format(M=0.005))
+    one, other = (analyse(parse_scene(text + extra), pear=False).branches[0]
+                  for extra in ("", '[geometry]\nshape = "capsule"\nlength = 0\n'))
+    assert other.kernel_class != one.kernel_class and one.X.shape == other.X.shape
+    assert np.abs(one.X - other.X).max() <= 1e-10
+    assert [p.kind for p in one.special] == [p.kind for p in other.special]

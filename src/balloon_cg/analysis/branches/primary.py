@@ -309,7 +309,7 @@ def stop_rule(scene, upper: float, parameter: str | None = None, params: Paramet
         beyond = limits(disc, point)
         if beyond is not None:
             return beyond
-        gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils)
+        gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils, scene.geometry)
         if gap < cont.wire_gap:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {cont.wire_gap:g} of coil {coil} (gap {gap:.3g})")
         return None
