@@ -314,8 +314,8 @@ def test_capsule_of_length_3_to_stretch_2_is_complete(tmp_path, capsys):
     """``balloon-cg run`` on a SPOM1 capsule of length 3 to pole stretch 2 (m = 0) exits 0: its pear branches, switched
     at the equator-breaking branch point, have no point whose stability flags change at the check degree (they
     did at degree 20, where their first point's pear eigenvalue read 2.6e-6 against its converged −1.2e-8:
-    analysis/stability.point_degrees assesses a capsule at its branch's degree). The branch point is where the
-    primary branch traced from degree 64 has it (1e-10)."""
+    analysis/stability/axisymmetric.point_degrees assesses a capsule at its branch's degree). The branch point is
+    where the primary branch traced from degree 64 has it (1e-10)."""
     from balloon_cg.app.cli import main
     from balloon_cg.io.run_file import read_run
 
