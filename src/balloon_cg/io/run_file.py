@@ -602,7 +602,7 @@ TIMING_KINDS = {"phase_names": "str[]", "phase_seconds": "float[]", "total_secon
 COMMON_KINDS = {"stop_reason": "str", "wall_time": "float", "kernel_class": "str", "kernel_signature": "str",
                 "M": "float", "chi": "float", "leg_labels": "str[]", "leg_stop_codes": "str[]"}
 BRANCH_KINDS = COMMON_KINDS | {"degree": "int", "symmetric": "bool", "pin_translation": "bool", "quadrature": "int",
-                               "map_centres": "float[]", "map_widths": "float[]", "joins": "float[]"}
+                               "map_centres": "float[]", "map_widths": "float[]"}
 SURFACE_KINDS = COMMON_KINDS | {"m": "int", "parent_branch": "str", "parent_branch_point": "int",
                                 "surface_degree": "int", "surface_order": "int", "n_theta": "int", "n_phi": "int",
                                 "map_centres": "float[]", "map_widths": "float[]", "parameter": "str"}
@@ -689,7 +689,8 @@ def check_branch(group, where, error, written: bool = False) -> None:
     ``check_written``)."""
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
-    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str"}, error)  # gauge: since issue 27
+    # gauge: since issue 27; joins: since a capsule's piecewise basis (absent: the Legendre basis)
+    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str", "joins": "float[]"}, error)
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
