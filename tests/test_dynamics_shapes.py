@@ -158,8 +158,8 @@ def test_capsule_located_points_have_a_vanishing_frequency_in_their_block():
     """Length 3 to a hoop stretch 3: at the located LP and equator-breaking BP one stored Ω² of its block is zero
     to 1e-9, the points around it differing by one in its negative Ω² (located_zeros). Not to solver.tol as on the
     sphere: the branch is refined to degree 135 (max_error), where the points are located to ~1e-10 in the
-    arclength and the LP's Ω² changes by 2.9 per unit arclength (measured 7.9e-11 at the LP, 2.7e-11 at the BP;
-    the bracketing points' are 1e-3 to 1e-1)."""
+    arclength and the LP's Ω² changes by 2.9 per unit arclength (measured 4.0e-11 at the LP, 2.7e-12 at the BP;
+    the bracketing points' are 4e-4 to 1e-1)."""
     kinds = located_zeros(bc.analyse(capsule_scene(3.0), pear=False).picture, zero=1e-9)
     assert Kind.LP in kinds and Kind.BP in kinds, kinds
 
