@@ -345,8 +345,8 @@ def test_capsule_table_errors_name_key_value_and_range():
         ('[geometry]\nshape = "capsule"\nlength = 5\nends = "plugged"\n', "geometry.ends"),
         ('[geometry]\nshape = "spheroid"\naspect = 2\nlength = 5\n', "geometry.length = 5"),
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 1\n', "stability.m_max = 1"),
-        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[electric]\nvoltage = 0.1\n',
-         "[electric]"),
+        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[continuation]\nparameter = "voltage"\n'
+         'pressure = 0.5\n[electric]\n', 'continuation.parameter = "voltage"'),
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
          '[[field.coils]]\nradius = 0.8\nheight = 3.0\ncurrent = 1.0\n', "inside the reference capsule of length 5"),
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
@@ -371,50 +371,75 @@ def capsule_radius(theta, kappa):
     return R, dR
 
 
+def energy_gradient(scene, branch, term):
+    """∂E/∂u at the last point of a capsule's ``branch`` by central differences (step 1e-6) of the energy written
+    here, E/2π = ∫ [Φ(λ1, λ2) + term(λ1, λ2, ρ, η)] R κ dθ + ½ P ∫ ρ² η' dθ, ρ = λ2 R, λ1 = |ρ', η'|/κ (Ogden, the
+    capsule's R written here, Gauss–Legendre with 200 nodes on each cap and on the cylinder)."""
+    from test_interval import ogden
+
+    u, P, disc = branch.X[-1, :-1], branch.X[-1, -1], branch.disc
+    kappa = 1 + scene.geometry.length / np.pi
+    joint = np.pi / (2 * kappa)
+    nodes, weights = legendre.leggauss(200)
+    pieces = ((0.0, joint), (joint, np.pi - joint), (np.pi - joint, np.pi))
+    theta = np.concatenate([(b - a) / 2 * nodes + (a + b) / 2 for a, b in pieces])
+    dtheta = np.concatenate([(b - a) / 2 * weights for a, b in pieces])
+    R, dR = capsule_radius(theta, kappa)
+
+    def energy(unknowns):
+        lam2, dlam2, eta, deta = disc.evaluate(unknowns, theta)
+        rho, drho = lam2 * R, dlam2 * R + lam2 * dR
+        lam1 = np.hypot(drho, deta) / kappa
+        density = ogden(scene.material, lam1, lam2) + term(lam1, lam2, rho, eta)
+        return dtheta @ (density * R * kappa + 0.5 * P * rho**2 * deta)
+
+    return np.array([energy(u + 1e-6 * e) - energy(u - 1e-6 * e) for e in np.eye(disc.size)]) / 2e-6
+
+
 def test_capsule_in_a_coil_field_is_stationary_for_the_energy_written_here():
     """SPOM1 capsule of length 3 in the field of a coil of radius 3 around its middle, M = 0.005 (the magnetic term's
     kernels on the capsule's meridian, generated on demand; the field at ρ = λ2 R): at the last point of its primary
-    branch to pole stretch 1.05 the energy written here,
-    E/2π = ∫ [Φ(λ1, λ2) − ½ χ M H²(ρ, η)] R κ dθ + ½ P ∫ ρ² η' dθ, ρ = λ2 R, λ1 = |ρ', η'|/κ (R written here, H² by the
-    Biot–Savart integral of tests/test_tube_field.py, Gauss–Legendre with 200 nodes on each cap and on the
-    cylinder), is stationary along every basis direction (central differences, 1e-8), and it is not without the
-    field's term (> 1e-3)."""
-    from test_interval import ogden
+    branch to pole stretch 1.05 the energy written here (``energy_gradient``) with the term −½ χ M H²(ρ, η) (H² by
+    the Biot–Savart integral of tests/test_tube_field.py) is stationary along every basis direction (1e-8), and it
+    is not without the field's term (> 1e-3)."""
     from test_tube_field import biot_savart_squared
 
     scene = capsule_scene(3.0, "[continuation]\nstop_stretch = 1.05\n" + COIL.format(M=0.005))
     branch = analyse(scene, pear=False).branches[0]
     assert branch.kernel_class.startswith("ogden_magnetic_capsule")
-    u, P, disc = branch.X[-1, :-1], branch.X[-1, -1], branch.disc
-    kappa = 1 + 3.0 / np.pi
-    joint = np.pi / (2 * kappa)
-    nodes, weights = legendre.leggauss(200)
-    theta = np.concatenate([(b - a) / 2 * nodes + (a + b) / 2 for a, b in
-                            ((0.0, joint), (joint, np.pi - joint), (np.pi - joint, np.pi))])
-    dtheta = np.concatenate([(b - a) / 2 * weights for a, b in ((0.0, joint), (joint, np.pi - joint),
-                                                                 (np.pi - joint, np.pi))])
-    R, dR = capsule_radius(theta, kappa)
     coils = [(c.radius, c.height, c.current) for c in scene.field.coils]
 
-    def energy(unknowns, M):
-        lam2, dlam2, eta, deta = disc.evaluate(unknowns, theta)
-        rho, drho = lam2 * R, dlam2 * R + lam2 * dR
-        lam1 = np.hypot(drho, deta) / kappa
-        density = (ogden(scene.material, lam1, lam2) - scene.field.chi * M * biot_savart_squared(rho, eta, coils) / 2)
-        return dtheta @ (density * R * kappa + 0.5 * P * rho**2 * deta)
+    def field(M):
+        return lambda lam1, lam2, rho, eta: -scene.field.chi * M * biot_savart_squared(rho, eta, coils) / 2
 
-    def gradient(M, step=1e-6):
-        return np.array([energy(u + step * e, M) - energy(u - step * e, M) for e in np.eye(disc.size)]) / (2 * step)
-
-    assert np.abs(gradient(scene.field.M)).max() < 1e-8
-    assert np.abs(gradient(0.0)).max() > 1e-3
+    assert np.abs(energy_gradient(scene, branch, field(scene.field.M))).max() < 1e-8
+    assert np.abs(energy_gradient(scene, branch, field(0.0))).max() > 1e-3
 
 
-def test_capsule_of_length_zero_in_a_coil_field_is_the_sphere():
-    """SPOM1 with the coil of radius 3 around the middle at M = 0.005 to pole stretch 1.5: every point of the capsule
-    of length 0 (its magnetic kernels another module) is the sphere's to 1e-10, the fold too."""
-    text = ('[material]\npreset = "SPOM1"\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 1.5\n'
-            + COIL.format(M=0.005))
+def test_capsule_under_a_voltage_is_stationary_for_the_energy_written_here():
+    """SPOM1 capsule of length 3 under the voltage Φ̄ = 0.1 ([electric]: its start inflated without it, then the
+    voltage switched on at the start stretch; the dielectric term's kernels on the capsule's meridian): at the last
+    point of its primary branch to pole stretch 1.05 the energy written here (``energy_gradient``) with the term
+    −Φ̄² λ1² λ2² (MODEL.md §2) is stationary along every basis direction (1e-8), and it is not without it (> 1e-3).
+    (Below the start the charged capsule nears compression and the trace needs max_degree: min_stretch 1.004.)"""
+    scene = capsule_scene(3.0, "[continuation]\nstop_stretch = 1.05\nmin_stretch = 1.004\n"
+                               "[electric]\nvoltage = 0.1\n")
+    branch = analyse(scene, pear=False).branches[0]
+    assert branch.kernel_class.startswith("ogden_dielectric_capsule") and branch.params.voltage == 0.1
+
+    def dielectric(voltage):
+        return lambda lam1, lam2, rho, eta: -voltage**2 * lam1**2 * lam2**2
+
+    assert np.abs(energy_gradient(scene, branch, dielectric(0.1))).max() < 1e-8
+    assert np.abs(energy_gradient(scene, branch, dielectric(0.0))).max() > 1e-3
+
+
+@pytest.mark.parametrize("load", [COIL.format(M=0.005), "[electric]\nvoltage = 0.1\n"], ids=["coil", "voltage"])
+def test_capsule_of_length_zero_in_a_field_or_under_a_voltage_is_the_sphere(load):
+    """SPOM1 with the coil of radius 3 around the middle at M = 0.005, or under the voltage 0.1, to pole stretch 1.5:
+    every point of the capsule of length 0 (its magnetic or dielectric kernels another module; under a voltage its
+    start inflated, then charged, the sphere's in closed form) is the sphere's to 1e-10, the fold too."""
+    text = ('[material]\npreset = "SPOM1"\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 1.5\n' + load)
     one, other = (analyse(parse_scene(text + extra), pear=False).branches[0]
                   for extra in ("", '[geometry]\nshape = "capsule"\nlength = 0\n'))
     assert other.kernel_class != one.kernel_class and one.X.shape == other.X.shape

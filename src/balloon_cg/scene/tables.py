@@ -640,6 +640,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric, loading)
+    if geometry.shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
+        raise SceneError('continuation.parameter = "voltage": a capsule is continued in the pressure only for now '
+                         "(its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
     if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
         raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 second variation is not built yet "
@@ -858,7 +861,6 @@ def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
     _coaxial_outside('geometry.shape = "capsule"', field,
                      lambda coil: coil.radius**2 + max(abs(coil.height) - length / 2, 0.0) ** 2,
                      f"the reference capsule of length {length:g} (radius² + (|height| − length/2)₊²")
-    _no_electric(Shape.CAPSULE, electric)
     return Geometry(Shape.CAPSULE, length=length)
 
 
