@@ -18,10 +18,10 @@ for η, the reflection z → −z is a_k → (−1)^k a_k as on the Legendre bas
     (−1)^j) or a cap pair q_j(ξ_north) ± q_j(ξ_south), q_j = P_j + P_{j−1} (j ≥ 1, zero at the joins, + even, − odd),
 
 the element chosen greedily (``sequence``) to keep the polynomial degree per radian of θ (per arclength) alike on the
-cylinder (degree j over π − 2θj) and on the caps (degree j in x, 2j in θ over the cap and its mirror, 2θj), once the
-caps have a degree of their own (the two grow alike up to CAP_FLOOR). Every
-continuous piecewise polynomial is spanned (1 and ℓ match any values at the joins; what is left vanishes there).
-φ_0 = 1 keeps b_0 the rigid translation.
+cylinder (degree j over π − 2θj) and on the caps (degree j in x, 2j in θ over the cap and its mirror, 2θj), the caps
+keeping at least half the cylinder's degree up to CAP_FLOOR. Every continuous piecewise polynomial is spanned (1 and
+ℓ match any values at the joins; what is left vanishes there). φ_0 = 1 keeps b_0 the rigid translation. The
+cylinder's quadrature is Gauss in θ (galerkin/discretisation.py ``split_rule``).
 """
 import functools
 
@@ -30,8 +30,8 @@ import numpy as np
 from .legendre import legendre_table
 
 CONSTANT, HAT, CYLINDER, CAPS = range(4)  # the families of ``sequence``
-# up to this cap degree the caps and the cylinder grow alike, then by arclength: by arclength alone a capsule of
-# length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1 radii wide at
+# the caps keep at least half the cylinder's degree up to this one, beyond it by arclength: by arclength alone a
+# capsule of length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1 radii wide at
 # 1.5 % hoop strain) is not resolved: its start's pressure is 2.6e-5 off at degree 162 with caps of degree 6, 1e-7
 # with 12, 3.7e-10 with 16, 2e-14 with 24
 CAP_FLOOR = 24
@@ -40,8 +40,8 @@ CAP_FLOOR = 24
 @functools.lru_cache(maxsize=32)
 def sequence(degree: int, join: float) -> tuple:
     """(family, j) of φ_0..φ_degree for the join x = c (module docstring): (CONSTANT, 0), (HAT, 1), then per parity
-    the element of the lower degree once the function is added while the caps' is at most CAP_FLOOR, then the one
-    with the lower degree per radian; the caps on a tie."""
+    the caps while their next degree is at most min(CAP_FLOOR, half the cylinder's next), else the family with the
+    lower degree per radian once the function is added, the caps on a tie."""
     theta_j = float(np.arccos(join))
     cylinder_span, cap_span = np.pi - 2 * theta_j, 2 * theta_j
     out = [(CONSTANT, 0), (HAT, 1)][: degree + 1]
