@@ -31,9 +31,9 @@ from .legendre import legendre_table
 
 CONSTANT, HAT, CYLINDER, CAPS = range(4)  # the families of ``sequence``
 # the caps keep at least half the cylinder's degree up to this one, beyond it by arclength: by arclength alone a
-# capsule of length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1 radii wide at
-# 1.5 % hoop strain) is not resolved: its start's pressure is 2.6e-5 off at degree 162 with caps of degree 6, 1e-7
-# with 12, 3.7e-10 with 16, 2e-14 with 24
+# capsule of length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1
+# radii wide at 1.5 % hoop strain) is not resolved: its start's pressure is 2.6e-5 off at degree 162 with caps of
+# degree 6, 1e-7 with 12, 3.7e-10 with 16, 2e-14 with 24
 CAP_FLOOR = 24
 
 
