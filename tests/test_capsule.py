@@ -235,7 +235,7 @@ def test_a_long_capsule_propagates_its_bulge_at_maxwells_pressure():
     moving towards the caps. Where both fronts are far from the caps and from each other (200 ≤ V/V0 ≤ 600,
     V0 = 40π + 4π/3) P is within 1e-4 of Maxwell's pressure (model/tube.maxwell_pressure, checked against the
     equal-area rule in tests/test_tube.py), from V/V0 = 400 within 1e-7; beyond V/V0 ≈ 700 the fronts reach the caps
-    and P rises (docs/shapes.md has the table). Measured 2.8e-5 and 2.0e-8; ~400 s on the loaded machine."""
+    and P rises (docs/shapes.md has the table). Measured 2.8e-5 and 2.0e-8; 400–700 s on the loaded machine."""
     scene = capsule_scene(40.0, "[continuation]\nstop_stretch = 3.0\nmax_points = 3000\nstep_max = 1.0\n"
                                 f"[solver]\ndegree = {DEGREE}\nmax_error = {PLATEAU_ERROR}\n")
     branch = analyse(scene, pear=False).branches[0]
