@@ -234,18 +234,19 @@ def spom1_run(tmp_path_factory):
     return result, path
 
 
-def located_zeros(picture) -> list:
+def located_zeros(picture, zero: float | None = None) -> list:
     """The kinds of the located folds and branch points of ``picture``'s branches, after checking that one stored Ω²
-    of each one's block (``matching_block``) is zero to the solver's tolerance and that the points around it differ
-    by one in that block's negative Ω² (the one that crossed: the lowest, or a higher one where a block already has
-    a negative one)."""
+    of each one's block (``matching_block``) is zero to ``zero`` (default the solver's tolerance) and that the points
+    around it differ by one in that block's negative Ω² (the one that crossed: the lowest, or a higher one where a
+    block already has a negative one)."""
     kinds = []
     for branch in picture.branches:
         for n, s in enumerate(branch.special):
             block = matching_block(s, branch)
             if block is None or s.status != Status.LOCATED:
                 continue
-            assert np.nanmin(np.abs(branch.frequencies.special[block][n])) <= branch.scene.solver.tol, (branch.name, s)
+            limit = branch.scene.solver.tol if zero is None else zero
+            assert np.nanmin(np.abs(branch.frequencies.special[block][n])) <= limit, (branch.name, s)
             around = branch.frequencies.omega2[block][s.index:s.index + 2]
             assert np.diff((around < 0).sum(axis=1)) != 0, (branch.name, s, around)
             kinds.append(s.kind)

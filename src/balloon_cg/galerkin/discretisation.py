@@ -8,6 +8,10 @@ Gauss–Legendre quadrature at interior nodes. At a node
 Equator symmetry (λ2 even, η odd in x) keeps a_even and b_odd, and then every integrand is even in x: the
 quadrature runs over the nodes x ≥ 0 with doubled weights (``even_half``). Without a field the translation
 η → η + c is removed by dropping b_0 (the energy does not depend on it: an exact zero mode).
+
+A capsule's discretisation (``joins`` = ±c, where its reference curvature jumps) has the piecewise basis φ_k of
+galerkin/elements.py in place of P_k (φ_0 = 1, parity (−1)^k, hierarchical: all of the above holds) and a composite
+Gauss rule split at the joins; it converges spectrally in the degree where one Legendre series converges as N⁻³.
 """
 import functools
 from dataclasses import dataclass, replace
@@ -16,22 +20,9 @@ import numpy as np
 from numba import njit
 
 from .coordinate_map import WireMap
-from .legendre import gauss_rule
+from .elements import element_table, families
+from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
-
-
-def legendre_table(x: np.ndarray, degree: int):
-    """(P_k(x), P_k'(x)) for k = 0..degree, each of shape (len(x), degree + 1), by the three-term recurrence."""
-    p = np.zeros((x.size, degree + 1))
-    dp = np.zeros_like(p)
-    p[:, 0] = 1.0
-    if degree >= 1:
-        p[:, 1] = x
-        dp[:, 1] = 1.0
-    for k in range(1, degree):
-        p[:, k + 1] = ((2 * k + 1) * x * p[:, k] - k * p[:, k - 1]) / (k + 1)
-        dp[:, k + 1] = dp[:, k - 1] + (2 * k + 1) * p[:, k]
-    return p, dp
 
 
 def read_only(array: np.ndarray) -> np.ndarray:
@@ -211,12 +202,19 @@ def _state_loops(A, B, u, out):
             out[2 + k, q] = total
 
 
+def basis_table(x: np.ndarray, degree: int, joins: tuple = ()):
+    """(φ_k(x), dφ_k/dx) for k = 0..degree: P_k(x), or with ``joins`` (a capsule's ±c) the elements' piecewise basis
+    (galerkin/elements.py)."""
+    return element_table(x, degree, joins[-1]) if joins else legendre_table(x, degree)
+
+
 @functools.lru_cache(maxsize=64)
-def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None):
-    """(P_k(s), dP_k/dx) at x = cos θ, s = h(x), for a θ grid met again and again (stability nodes, profiles)."""
+def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None, joins: tuple = ()):
+    """(φ_k(x), dφ_k/dx) at x = cos θ (P_k(s), s = h(x) on a map), for a θ grid met again and again (stability
+    nodes, profiles)."""
     x = np.cos(np.frombuffer(theta_bytes))
     if mapping is None:
-        return legendre_table(x, degree)
+        return basis_table(x, degree, joins)
     p, dp = legendre_table(np.clip(mapping.s(x), -1.0, 1.0), degree)
     return p, dp * mapping.ds_dx(x)[:, None]
 
@@ -237,7 +235,8 @@ class Discretisation:
     pin_translation: bool
     quadrature: int = 0
     mapping: WireMap | None = None
-    joins: tuple = ()  # x where the quadrature splits (a capsule's, where its reference curvature jumps)
+    joins: tuple = ()  # x where the basis and the quadrature split (a capsule's ±c, where its reference curvature
+    #                    jumps: the piecewise basis of galerkin/elements.py, a composite Gauss rule)
 
     def __reduce__(self):
         """Pickled as its six defining fields (the tables are rebuilt): results holding one stay small."""
@@ -297,8 +296,8 @@ class Discretisation:
 
     @functools.cached_property
     def _pole_rows(self) -> dict:
-        sign = (-1.0) ** np.arange(self.degree + 1)
-        ones = np.ones(self.degree + 1)
+        ones = basis_table(np.ones(1), self.degree, self.joins)[0][0]  # φ_k(1): all ones on Legendre's
+        sign = (-1.0) ** np.arange(self.degree + 1) * ones  # φ_k(−1) = (−1)^k φ_k(1)
         zero = np.zeros(self.degree + 1)
         rows = {
             "lam2_top": self.join(ones, zero),
@@ -312,7 +311,7 @@ class Discretisation:
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
-        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping)
+        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping, self.joins)
         s = np.sin(theta)
         U = np.atleast_2d(u)
         na = self.a_index.size
@@ -322,8 +321,9 @@ class Discretisation:
         return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
 
     def nests_in(self, other: "Discretisation") -> bool:
-        """Every function of this basis lies in ``other``'s (same map, degree no higher): transfers are exact."""
-        return other.mapping == self.mapping and other.degree >= self.degree
+        """Every function of this basis lies in ``other``'s (same map and joins, degree no higher): transfers are
+        exact."""
+        return other.mapping == self.mapping and other.joins == self.joins and other.degree >= self.degree
 
     def transfer(self, u: np.ndarray, other: "Discretisation") -> np.ndarray:
         """The same functions in the basis of ``other``; u may be (.., size + 1), trailing entries (P, ...) kept.
@@ -369,21 +369,31 @@ class Discretisation:
         return U if np.ndim(u) == 2 else U[0]
 
     def tail(self, u: np.ndarray) -> float:
-        """Spectral error estimate: the neglected tail Σ_{k>N} of a geometric series, E·r/(1 − r).
-
-        E is the coefficient envelope max(|a_k|, |b_k|)/|a_0| over the last window of N/8 degrees, and r the
-        decay per degree between that window and the one 2 windows earlier (capped at 0.999). The last
-        coefficients alone under-read the error by ~r/(1 − r) when the decay is slow (near a wire: r ≈ 0.91,
-        10×; the two-coil λ = 1.8 point at degree 192 has P error 1.3e-9 against 2.8e-11 from its last two
-        coefficients and 1.9e-9 from this estimate, tests/test_tail.py).
-        """
+        """Spectral error estimate: the neglected tail Σ_{k>N} of a geometric series, E·r/(1 − r)
+        (``geometric_tail`` of the envelope max(|a_k|, |b_k|)/|a_0|); on a capsule's piecewise basis the largest of
+        its elements' own series (``elements.families``: the cylinder's bubbles, the caps' pairs by degree), each
+        falling at its own rate."""
         a, b = self.split(u)
         envelope = np.maximum(np.abs(a), np.abs(b)) / abs(a[0])
-        n, window = self.degree, max(2, self.degree // 8)
-        last = float(envelope[n - window + 1:].max())
-        earlier = float(envelope[max(n - 3 * window + 1, 0): n - 2 * window + 1].max())
-        rate = min((last / earlier) ** (1.0 / (2 * window)), 0.999) if earlier > 0.0 else 0.999
-        return last * rate / (1.0 - rate)
+        if not self.joins:
+            return geometric_tail(envelope)
+        cylinder, caps = families(self.degree, self.joins[-1])
+        return max(geometric_tail(envelope[cylinder]), geometric_tail(envelope[caps].max(axis=1)))
+
+
+def geometric_tail(envelope: np.ndarray) -> float:
+    """E·r/(1 − r) for a coefficient envelope of length n + 1: E its largest value over the last window of n/8
+    entries, r the decay per entry between that window and the one 2 windows earlier (capped at 0.999). The last
+    coefficients alone under-read the error by ~r/(1 − r) when the decay is slow (near a wire: r ≈ 0.91, 10×; the
+    two-coil λ = 1.8 point at degree 192 has P error 1.3e-9 against 2.8e-11 from its last two coefficients and
+    1.9e-9 from this estimate, tests/test_tail.py). Fewer than 5 entries (no two windows): their largest (none: 0)."""
+    if envelope.size < 5:
+        return float(envelope.max(initial=0.0))
+    n, window = envelope.size - 1, max(2, (envelope.size - 1) // 8)
+    last = float(envelope[n - window + 1:].max())
+    earlier = float(envelope[max(n - 3 * window + 1, 0): n - 2 * window + 1].max())
+    rate = min((last / earlier) ** (1.0 / (2 * window)), 0.999) if earlier > 0.0 else 0.999
+    return last * rate / (1.0 - rate)
 
 
 def gauss_nodes(degree: int) -> int:
@@ -392,17 +402,30 @@ def gauss_nodes(degree: int) -> int:
 
 
 def split_rule(n_q: int, joins: tuple = ()):
-    """(nodes, weights) on [−1, 1]: Gauss–Legendre with n_q nodes, or with ``joins`` (sorted, in (−1, 1)) n_q nodes
-    on each piece between them (a composite rule: exact for an integrand that is a polynomial of degree < 2 n_q on
-    each piece, where a kink of the integrand at a join costs a single rule O(n_q⁻²)). Mirror-symmetric when the
-    joins are."""
-    if not joins:
-        return gauss_rule(n_q)
+    """(nodes, weights) on [−1, 1], ascending: Gauss–Legendre with n_q nodes, or with ``joins`` (sorted, in (−1, 1))
+    n_q nodes on each piece between them (a composite rule, where a kink of the integrand at a join costs a single
+    rule O(n_q⁻²)): Gauss in x on the two end pieces (the caps: exact for a polynomial in x of degree < 2 n_q) and
+    in θ on the inner ones (the cylinder, whose basis is polynomial in θ: ∫f dx = ∫f sin θ dθ; Gauss in x there
+    samples the ends of a high-degree polynomial in θ too sparsely, and the node table of a capsule of length 40
+    had the condition 3.7e8 at degree 320 against 4e2 at 200). Mirror-symmetric when the joins are."""
     nodes, weights = gauss_rule(n_q)
+    if not joins:
+        return nodes, weights
     ends = (-1.0, *joins, 1.0)
-    pieces = [(0.5 * (b - a), 0.5 * (b + a)) for a, b in zip(ends[:-1], ends[1:])]
-    return (np.concatenate([half * nodes + middle for half, middle in pieces]),
-            np.concatenate([half * weights for half, _ in pieces]))
+    out_nodes, out_weights = [], []
+    for i, (a, b) in enumerate(zip(ends[:-1], ends[1:])):
+        if i in (0, len(joins)):
+            out_nodes.append(0.5 * (b - a) * nodes + 0.5 * (b + a))
+            out_weights.append(0.5 * (b - a) * weights)
+        else:
+            low, high = np.arccos(b), np.arccos(a)  # θ ascending as x descends: reversed to ascend in x
+            theta = (0.5 * (high - low) * nodes + 0.5 * (high + low))[::-1]
+            x, w = np.cos(theta), (0.5 * (high - low) * weights)[::-1] * np.sin(theta)
+            if a == -b:  # mirror-symmetric to the last bit (an odd rule's middle node at x = 0 exactly: ``even_half``)
+                x, w = 0.5 * (x - x[::-1]), 0.5 * (w + w[::-1])
+            out_nodes.append(x)
+            out_weights.append(w)
+    return np.concatenate(out_nodes), np.concatenate(out_weights)
 
 
 @functools.lru_cache(maxsize=4)
@@ -421,7 +444,7 @@ def _tables(disc: Discretisation) -> dict:
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
     n_q = disc.quadrature or gauss_nodes(disc.degree)
     nodes, s_weights = split_rule(n_q, disc.joins)
-    p, dp = legendre_table(nodes, disc.degree)
+    p, dp = basis_table(nodes, disc.degree, disc.joins)
     if disc.mapping is None:
         x, weights = nodes, s_weights
     else:

@@ -61,7 +61,8 @@ class NodeKernels:
     """The generated kernels at fixed nodes (cos θ, sin θ) on a node state held in arrays owned here.
 
     The owner fills ``state`` ((4, n): λ2, v, η, w in the generated STATE order) and calls ``hold(params)``, which
-    evaluates the coil field H² and its derivatives at (ρ, η) = (λ2 sin θ, η) into ``field`` and checks the
+    evaluates the coil field H² and its derivatives at (ρ, η) = (λ2 R, η) into ``field`` (R the meridian's hoop
+    radius at the nodes: sin θ but on a capsule, model/meridian.py) and checks the
     material's domain there; ``__call__(kernel, params, **fixed)`` then runs the kernel's node loop on the held
     arrays, its arguments bound once by name with the extra named values ``fixed`` (the azimuthal number m) and
     only the scalar branch parameters refilled, into an output array owned here (valid until the next call of
@@ -75,6 +76,7 @@ class NodeKernels:
         n = geometry[0].shape[0]
         self.state = np.empty((4, n))
         self._rho = np.empty(n)
+        self._radius = read_only(np.asarray(hoop(equilibrium.scene.geometry, *geometry), dtype=float))
         self.field = np.zeros((6, n)) if kernels.field_class else np.zeros((6, 0))
         self.values = dict(zip(kernels.module.STATE, self.state), cos_theta=geometry[0], sin_theta=geometry[1],
                             field=self.field if kernels.field_class else None)
@@ -84,7 +86,7 @@ class NodeKernels:
         """The field at the held state (if there are coils), then the domain check (``Equilibrium._check_domain``)."""
         coils = self.eq.coils
         if coils.shape[0]:
-            _field_of_state(self.state, self.geometry[1], coils, self._rho, self.field)
+            _field_of_state(self.state, self._radius, coils, self._rho, self.field)
         if self.eq._domain_check:
             self.eq._check_domain(self.geometry, tuple(self.state), params)
 
@@ -254,10 +256,10 @@ def enclosed_volume(disc: Discretisation, u, radius: np.ndarray | None = None) -
 
 
 @njit(cache=True)
-def _field_of_state(state, sin_theta, coils, rho, out):
-    """field_squared_nodes at (ρ, z) = (λ2 sin θ, η) of the node state (λ2, v, η, w), ρ into ``rho``."""
+def _field_of_state(state, radius, coils, rho, out):
+    """field_squared_nodes at (ρ, z) = (λ2 R, η) of the node state (λ2, v, η, w), ρ into ``rho``."""
     for i in range(rho.shape[0]):
-        rho[i] = state[0, i] * sin_theta[i]
+        rho[i] = state[0, i] * radius[i]
     field_squared_nodes(rho, state[2], coils, out)
 
 

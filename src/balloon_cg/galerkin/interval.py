@@ -33,8 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from .legendre import gauss_rule
-from .discretisation import gauss_nodes, legendre_table, read_only, symmetric_rows
+from .discretisation import gauss_nodes, read_only, symmetric_rows
+from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
 from ..scene.tables import Ends
 

@@ -1,6 +1,7 @@
-"""Orthonormal associated Legendre functions P̄_k^j(cos θ) and their θ-derivatives: the azimuthal perturbation
-bases (analysis/stability/azimuthal.py) and the spherical harmonics of the whole-sphere engine (surface/basis.py);
-the Gauss–Legendre rules every discretisation integrates with."""
+"""Legendre polynomials P_k(x) and their derivatives (the Galerkin bases: galerkin/discretisation.py, elements.py,
+interval.py), the orthonormal associated Legendre functions P̄_k^j(cos θ) with their θ-derivatives: the azimuthal
+perturbation bases (analysis/stability/azimuthal.py) and the spherical harmonics of the whole-sphere engine
+(surface/basis.py); the Gauss–Legendre rules every discretisation integrates with."""
 import functools
 
 import numpy as np
@@ -14,6 +15,20 @@ def gauss_rule(n: int) -> tuple[np.ndarray, np.ndarray]:
     nodes, weights = legendre.leggauss(n)
     nodes.flags.writeable = weights.flags.writeable = False
     return nodes, weights
+
+
+def legendre_table(x: np.ndarray, degree: int):
+    """(P_k(x), P_k'(x)) for k = 0..degree, each of shape (len(x), degree + 1), by the three-term recurrence."""
+    p = np.zeros((x.size, degree + 1))
+    dp = np.zeros_like(p)
+    p[:, 0] = 1.0
+    if degree >= 1:
+        p[:, 1] = x
+        dp[:, 1] = 1.0
+    for k in range(1, degree):
+        p[:, k + 1] = ((2 * k + 1) * x * p[:, k] - k * p[:, k - 1]) / (k + 1)
+        dp[:, k + 1] = dp[:, k - 1] + (2 * k + 1) * p[:, k]
+    return p, dp
 
 
 def legendre_values(x: np.ndarray, degree: int, order: int) -> np.ndarray:

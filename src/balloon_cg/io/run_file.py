@@ -252,6 +252,7 @@ def _write_branch(group, branch, theta, first_label: int = 1):
         "quadrature": disc.quadrature,
         "map_centres": np.array(disc.mapping.centres if disc.mapping else [], dtype=float),
         "map_widths": np.array(disc.mapping.widths if disc.mapping else [], dtype=float),
+        "joins": np.array(disc.joins, dtype=float),
         "origin": branch.origin.value,
         "gauge": branch.gauge.value,
     })
@@ -688,7 +689,8 @@ def check_branch(group, where, error, written: bool = False) -> None:
     ``check_written``)."""
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
-    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str"}, error)  # gauge: since issue 27
+    # gauge: since issue 27; joins: since a capsule's piecewise basis (absent: the Legendre basis)
+    require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str", "joins": "float[]"}, error)
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)

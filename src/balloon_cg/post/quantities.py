@@ -41,13 +41,14 @@ def stored_scene(run: dict):
 
 def branch_discretisation(branch: dict) -> Discretisation:
     """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric,
-    pin_translation, quadrature (0: automatic) and the coordinate map (map_centres, map_widths; empty: none): it
-    evaluates the unknowns."""
+    pin_translation, quadrature (0: automatic), the coordinate map (map_centres, map_widths; empty: none) and a
+    capsule's joins (empty, or absent in files before its piecewise basis: the Legendre basis): it evaluates the
+    unknowns."""
     attrs = branch["attrs"]
     centres = tuple(float(c) for c in attrs.get("map_centres", ()))
     mapping = WireMap(centres, tuple(float(w) for w in attrs["map_widths"])) if centres else None
     return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]),
-                          int(attrs.get("quadrature", 0)), mapping)
+                          int(attrs.get("quadrature", 0)), mapping, tuple(float(x) for x in attrs.get("joins", ())))
 
 
 def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> dict:
@@ -55,8 +56,12 @@ def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> 
     scene of reference ``geometry``.
 
     Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), speed (s'), k_meridian, k_parallel,
-    gaussian_curvature (κ); each array has shape (n_points, len(theta)).
+    gaussian_curvature (κ); each array has shape (n_points, len(theta)). Not on a capsule's piecewise basis
+    (ValueError: its curvatures are not built, docs/shapes.md).
     """
+    if disc.joins:
+        raise ValueError("the curvatures and stresses of a capsule are not built (post/quantities.surface reads "
+                         "one Legendre series and the sphere's ρ = λ2 sin θ)")
     a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
     c, s = np.cos(theta), np.sin(theta)
 

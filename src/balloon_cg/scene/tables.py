@@ -640,6 +640,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric, loading)
+    if geometry.shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
+        raise SceneError('continuation.parameter = "voltage": a capsule is continued in the pressure only for now '
+                         "(its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
     if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
         raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 second variation is not built yet "
@@ -810,19 +813,26 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     aspect = _getter(data, "geometry", Geometry)("aspect", lambda x: MIN_ASPECT <= x <= MAX_ASPECT,
                                                   f"in [{MIN_ASPECT:g}, {MAX_ASPECT:g}]")
     where = f'geometry.shape = "{shape.value}"'
-    if not field.is_axisymmetric:
-        raise SceneError(f"{where}: coils off the axis are traced on the whole sphere, which has a spherical "
-                         'reference only; use coaxial coils or geometry.shape = "sphere"')
-    for k, coil in enumerate(field.coils):
-        inside = coil.radius**2 + (coil.height / aspect) ** 2
-        if inside <= 1 + 1e-9:
-            raise SceneError(f"field.coils[{k}]: wire at (radius {show(coil.radius)}, height {show(coil.height)}) lies "
-                             f"inside the reference spheroid of aspect {aspect:g} (radius² + (height/aspect)² = "
-                             f"{inside:.6g} must be > 1)")
+    _coaxial_outside(where, field, lambda coil: coil.radius**2 + (coil.height / aspect) ** 2,
+                     f"the reference spheroid of aspect {aspect:g} (radius² + (height/aspect)²")
     if electric is not None:
         raise SceneError(f"{where}: the [electric] term starts from the sphere held by its voltage, which has no "
                          'counterpart on another shape yet; leave [electric] out or use geometry.shape = "sphere"')
     return Geometry(shape, aspect)
+
+
+def _coaxial_outside(where: str, field: Field, measure, what: str):
+    """The coils of a shape other than the sphere: coaxial (off the axis the whole sphere traces them, whose
+    reference is spherical), each wire outside the reference surface (``measure``(coil) > 1, ``what`` names the
+    surface and the measure), refused one line each."""
+    if not field.is_axisymmetric:
+        raise SceneError(f"{where}: coils off the axis are traced on the whole sphere, which has a spherical "
+                         'reference only; use coaxial coils or geometry.shape = "sphere"')
+    for k, coil in enumerate(field.coils):
+        inside = measure(coil)
+        if inside <= 1 + 1e-9:
+            raise SceneError(f"field.coils[{k}]: wire at (radius {show(coil.radius)}, height {show(coil.height)}) lies "
+                             f"inside {what} = {inside:.6g} must be > 1)")
 
 
 def _length(data, shape: Shape, low: float) -> float:
@@ -845,13 +855,12 @@ def _no_electric(shape: Shape, electric: Electric | None):
 
 
 def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
-    """A capsule's [geometry] (its cylinder's length, 0 the sphere) and the parts of the model it does not have
-    yet, refused one line each."""
+    """A capsule's [geometry] (its cylinder's length, 0 the sphere), its coils (coaxial, outside it) and the parts
+    of the model it does not have yet, refused one line each."""
     length = _length(data, Shape.CAPSULE, 0.0)
-    if field.coils:
-        raise SceneError('geometry.shape = "capsule": coils around a capsule are not built yet; leave '
-                         "[[field.coils]] out or use another shape")
-    _no_electric(Shape.CAPSULE, electric)
+    _coaxial_outside('geometry.shape = "capsule"', field,
+                     lambda coil: coil.radius**2 + max(abs(coil.height) - length / 2, 0.0) ** 2,
+                     f"the reference capsule of length {length:g} (radius² + (|height| − length/2)₊²")
     return Geometry(Shape.CAPSULE, length=length)
 
 

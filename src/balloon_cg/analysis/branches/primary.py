@@ -99,8 +99,8 @@ def released(tracer: Tracer, held: continuation.Point, params: Parameters,
     at fixed P, where the b_0 row of the residual is the net axial force (its ∂E/∂b_0); then resolved
     (``_resolved_start``). ContinuationError when Newton does not reach a free equilibrium."""
     scene = tracer.scene
-    pinned = Discretisation(degree, tracer.symmetric, True)
     system = tracer.system(degree, params)
+    pinned = Discretisation(degree, tracer.symmetric, True, joins=system.eq.disc.joins)
     X = np.append(system.eq.disc.join(*pinned.split(held.X[:-1])), held.X[-1])
     result = newton(system.residual, system.jacobian, X, unit(X.size, -1), X[-1], scene.solver.tol,
                     scene.solver.max_newton)
@@ -117,10 +117,12 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
     from the unstressed reference (a_0 = 1, b_1 = aspect: λ2 = 1, η = aspect cos θ, P = 0; a capsule's η = Z(θ)
     projected on the basis and solved at P = 0, its meridian being no polynomial in cos θ) by natural
     continuation in the pole stretch (steps doubled after a success, halved after a failure), each point solved
-    by Newton on R(u; P) = 0 with the pole row λ2(0) = r_n·u prescribed (galerkin.point_solve's system).
-    ContinuationError when the step falls below 1e-6 of the way."""
+    by Newton on R(u; P) = 0 with the pole row λ2(0) = r_n·u prescribed (galerkin.point_solve's system); under a
+    voltage (a capsule with [electric]) the reference is inflated without it, then the voltage is switched on at
+    that pole stretch by natural continuation in Φ̄ (P still the unknown). ContinuationError when the step falls
+    below 1e-6 of the way."""
     scene = tracer.scene
-    system = tracer.system(degree, params.with_value("P", 0.0))
+    system = tracer.system(degree, params.with_value("P", 0.0).with_value("voltage", 0.0))
     disc = system.eq.disc
     a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
     a[0], b[1] = 1.0, scene.geometry.aspect
@@ -143,6 +145,16 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
         raise ContinuationError(f"could not inflate the {scene.geometry.shape.value} to continuation.start_stretch "
                                 f"= {stretch:g} beyond the north pole stretch {reached:.6g} ({message}); "
                                 "try a smaller continuation.start_stretch")
+    if params.voltage:
+        def charged(X, voltage):
+            charging = tracer.system(degree, params.with_value("P", X[-1]).with_value("voltage", voltage))
+            return newton(charging.residual, charging.jacobian, X, row, stretch, scene.solver.tol,
+                          scene.solver.max_newton)
+
+        X, reached, message = continuation.natural(charged, X, 0.0, params.voltage)
+        if reached < params.voltage:
+            raise ContinuationError(f"could not switch the voltage on at continuation.start_stretch = {stretch:g} "
+                                    f"beyond {reached:.6g} ({message}); try a larger continuation.start_stretch")
     return X[:-1], float(X[-1])
 
 
@@ -309,7 +321,7 @@ def stop_rule(scene, upper: float, parameter: str | None = None, params: Paramet
         beyond = limits(disc, point)
         if beyond is not None:
             return beyond
-        gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils)
+        gap, coil = wire_gap(disc, point.X[:-1], scene.field.coils, scene.geometry)
         if gap < cont.wire_gap:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {cont.wire_gap:g} of coil {coil} (gap {gap:.3g})")
         return None

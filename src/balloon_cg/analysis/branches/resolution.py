@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...galerkin.discretisation import Discretisation
-from ...model.meridian import joins
 from ...numerics import interrupt
 
 
@@ -28,12 +27,8 @@ class Resolution:
 
     @classmethod
     def of(cls, scene) -> "Resolution":
-        """The policy of a scene's [solver] table; on a meridian whose curvature jumps (a capsule: its Legendre
-        coefficients fall algebraically, so the geometric tail never reaches max_error; docs/shapes.md, "The
-        capsule") the degree stays solver.degree and every point counts as resolved (max_error ∞): its accuracy is
-        the convergence in solver.degree, not a per-point estimate."""
-        if joins(scene.geometry):
-            return cls(np.inf, scene.solver.degree)
+        """The policy of a scene's [solver] table (a capsule's too: its piecewise basis converges spectrally,
+        galerkin/elements.py, so its tail estimate is read as the sphere's)."""
         return cls(scene.solver.max_error, scene.solver.max_degree)
 
     def resolved(self, disc: Discretisation, u) -> bool:
@@ -69,7 +64,7 @@ class Resolution:
         open_rows = np.arange(len(X)) if disc.mapping is not None else np.arange(0)
         while open_rows.size and degree < self.max_degree:
             interrupt.check()
-            plain = Discretisation(degree, disc.symmetric, disc.pin_translation)
+            plain = Discretisation(degree, disc.symmetric, disc.pin_translation, joins=disc.joins)
             moved = disc.transfer(X[open_rows], plain)
             loss = transfer_error(disc, X[open_rows], plain, moved)
             tails = np.array([plain.tail(row[: plain.size]) for row in moved])

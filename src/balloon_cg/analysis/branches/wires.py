@@ -10,6 +10,8 @@ import numpy as np
 from ...galerkin.coordinate_map import WireMap
 from ...galerkin.discretisation import Discretisation
 from ...galerkin.profiles import meridional_stretch
+from ...model.meridian import hoop
+from ...scene.tables import Geometry
 
 # Map width ε_j = gap_j · clip(MAP_ARC_WIDTH · |dx/ds|_j, MAP_MIN_WIDTH, MAP_WIDTH) (x units) for each wire
 # within MAP_GAP of the membrane. benchmarks/results/wire_map_widths.txt (cheapest degree for P to 1e-8, gaps
@@ -35,19 +37,21 @@ class Approach:
     dx_ds: float
 
 
-def _profile(disc: Discretisation, u, n_theta: int):
-    """θ on n_theta points, ρ = λ2 sin θ and η there, and (λ2, λ2', η') there for the stretch λ1 (``approaches``
-    only: ``wire_gap`` runs at every continuation step and needs no λ1)."""
+def _profile(disc: Discretisation, u, n_theta: int, geometry: Geometry = Geometry()):
+    """θ on n_theta points, ρ = λ2 R (R = sin θ but on a capsule: model/meridian.py) and η there, and
+    (λ2, λ2', η') there for the stretch λ1 (``approaches`` only: ``wire_gap`` runs at every continuation step and
+    needs no λ1)."""
     theta = np.linspace(0.0, np.pi, n_theta)
     lam2, dlam2, eta, deta = disc.evaluate(u, theta)
-    return theta, lam2 * np.sin(theta), eta, (lam2, dlam2, deta)
+    return theta, lam2 * hoop(geometry, np.cos(theta), np.sin(theta)), eta, (lam2, dlam2, deta)
 
 
-def wire_gap(disc: Discretisation, u, coils, n_theta: int = 361) -> tuple[float, int]:
-    """Smallest distance from the membrane profile to a coil wire, and the coil index."""
+def wire_gap(disc: Discretisation, u, coils, geometry: Geometry = Geometry(), n_theta: int = 361) -> tuple[float, int]:
+    """Smallest distance from the membrane profile (on the reference ``geometry``) to a coil wire, and the coil
+    index."""
     if not len(coils):
         return np.inf, -1
-    _, rho, eta, _ = _profile(disc, u, n_theta)
+    _, rho, eta, _ = _profile(disc, u, n_theta, geometry)
     gaps = [np.hypot(rho - c.radius, eta - c.height).min() for c in coils]
     return float(min(gaps)), int(np.argmin(gaps))
 
@@ -102,8 +106,9 @@ def centred_map(found: list[Approach], widths, symmetric: bool) -> WireMap | Non
 
 def wire_map(disc: Discretisation, u, coils, symmetric: bool, n_theta: int = 2001) -> WireMap | None:
     """The map clustering a basis at the membrane's closest approach to each wire (``map_width``); None if no
-    wire gets a centre."""
-    if not len(coils):
+    wire gets a centre, or on a capsule's piecewise basis (``disc.joins``: a map of its elements is not built, so
+    its degree alone resolves a layer next to a wire)."""
+    if not len(coils) or disc.joins:
         return None
     found = approaches(disc, u, coils, n_theta)
     return centred_map(found, [map_width(a) for a in found], symmetric)

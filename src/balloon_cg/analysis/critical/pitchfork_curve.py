@@ -387,7 +387,7 @@ def trace_in_q(system, X0, what: str, branch: Branch, parameter: SecondParameter
         if point.X[n] <= 0:
             return Stop(StopCode.NONPOSITIVE_PRESSURE, f"the pressure P reached 0 (P = {point.X[n]:.4g} "
                                                         f"at {name} = {point.X[-1]:.6g})")
-        gap, coil = wire_gap(branch.disc, point.X[:n], coils)
+        gap, coil = wire_gap(branch.disc, point.X[:n], coils, branch.scene.geometry)
         if gap < gap_limit:
             return Stop(StopCode.WIRE_GAP, f"membrane within wire_gap {gap_limit:g} of coil {coil} (gap {gap:.3g})")
         stopped = rule(point)  # first: a curve back at its partner past a small q0 > 0 is back, not out of range

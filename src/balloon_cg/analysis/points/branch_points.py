@@ -132,7 +132,7 @@ def _solve_extended(branch: Branch, index: int, block: Block, k: int, start: "Ex
     from the point of the bracket where the crossing eigenvalue (``followed_crossing``) interpolates to zero, with
     its mode there (or from ``start``, with the mode of the eigenvalue nearest zero)."""
     degree = max(extended_degrees(branch, index))
-    plain = Discretisation(degree, True, branch.disc.pin_translation)
+    plain = Discretisation(degree, True, branch.disc.pin_translation, joins=branch.disc.joins)
     eq = Equilibrium(branch.scene, plain)
     variation = SecondVariation(eq, degree)
     idx = block_indices(variation, block, field_on=True)
