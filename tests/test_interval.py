@@ -340,6 +340,8 @@ def test_tube_table_errors_name_key_value_and_range(table, message):
     ("[electric]\nvoltage = 0.1\n", r'geometry.shape = "tube": the \[electric\] term on a tube is not built yet'),
     ('[loading]\ncontrol = "volume"\n', 'loading.control = "volume": a tube is continued in the pressure only'),
     ("[dynamics]\nfrequencies = true\nmodes = true\n", "dynamics.modes = true: a tube's mode shapes are not stored"),
+    ('[[events]]\nquantity = "pressure"\nvalue = 1.2\n', r"events: 1 \[\[events\]\] on a tube, whose branches do not "
+     "locate user points yet; allowed: none"),
 ])
 def test_tube_refuses_the_parts_it_does_not_have(extra, message):
     with pytest.raises(SceneError, match=message) as error:
