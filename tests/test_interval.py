@@ -370,7 +370,7 @@ def test_bulge_propagates_at_maxwells_pressure():
     (model/tube.maxwell_pressure, checked against the equal-area rule in tests/test_tube.py; measured ≤ 5.2e-7,
     1.2e-9 at V/V0 = 415), the same P(V) at degree 140 within 1e-7 (measured 2.3e-8: the pressure converges
     although the steep front is not resolved pointwise, the first integral varying along the tube by 6–16 % at
-    degree 100: docs/shapes.md), and under volume control the plateau is stable."""
+    degree 100: docs/tubes.md), and under volume control the plateau is stable."""
     from balloon_cg.tube.bulge import bulge_branch
 
     curves = {}

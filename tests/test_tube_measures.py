@@ -48,3 +48,8 @@ def test_front_of_a_tanh_profile(descending, sign):
         assert abs(found.low - 1.5) <= 1e-7 and abs(found.high - 6.5) <= 1e-7
         errors.append(abs(found.width - 1.6) / 1.6)
     assert errors[0] <= 2e-5 and 3.5 < errors[0] / errors[1] < 4.5
+
+
+def test_a_uniform_profile_has_no_front():
+    found = front(np.linspace(0.0, 5.0, 11), np.full(11, 1.6))
+    assert np.isnan(found.position) and np.isnan(found.width) and found.low == found.high == 1.6

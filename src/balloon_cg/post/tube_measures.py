@@ -44,9 +44,12 @@ def stretches(disc, u: np.ndarray, s: np.ndarray) -> tuple:
 def front(z: np.ndarray, rho: np.ndarray) -> Front:
     """The front of the profile ρ(z) sampled at increasing or decreasing heights z (module docstring): the mid-level
     crossing by linear interpolation between the samples that bracket it (the first, from the largest ρ's side),
-    the largest slope by central differences (np.gradient)."""
+    the largest slope by central differences (np.gradient). A uniform profile (ρ_max − ρ_min ≤ 1e-12 ρ_max) has
+    none: position and width NaN."""
     z, rho = np.asarray(z, dtype=float), np.asarray(rho, dtype=float)
     high, low = rho.max(), rho.min()
+    if high - low <= 1e-12 * abs(high):
+        return Front(np.nan, np.nan, float(low), float(high))
     middle, top = 0.5 * (high + low), int(np.argmax(rho))
     below = np.flatnonzero(rho < middle)
     after = below[below > top]

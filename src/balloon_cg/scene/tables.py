@@ -120,7 +120,7 @@ class Shape(enum.StrEnum):
 class Ends(enum.StrEnum):
     """How a tube ends (``Geometry.ends``): "sliding", planes of symmetry the meridian meets at a right angle (its
     radius free there), or "plugged", rigid plugs of the reference radius; both closed: no axial force beyond the
-    pressure's on the ends (docs/shapes.md)."""
+    pressure's on the ends (docs/tubes.md)."""
 
     SLIDING = "sliding"
     PLUGGED = "plugged"
