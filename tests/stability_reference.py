@@ -1,7 +1,8 @@
 """The reference tables of issue 37's "unchanged": every stored eigenvalue, flag and located point of the whole
 picture of every shipped scene and of the off-equator scene (tests/data/off_equator.toml), as computed by main at
 94ce54e (before the speed work of issue 37), and of a Gent balloon (tests/data/gent.toml), as computed by main at
-a7f2a88 (before issue 38 made the reference meridian data: its "sphere scenes unchanged"). tests/test_stability_reference.py computes the same tables with the
+a7f2a88 (before issue 38 made the reference meridian data: its "sphere scenes unchanged").
+tests/test_stability_reference.py computes the same tables with the
 code under test and compares them (``compare``); ``python tests/stability_reference.py [SCENE ...]`` rewrites
 tests/data/reference/SCENE.npz (only to record a deliberate change of the numbers).
 

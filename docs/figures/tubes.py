@@ -164,7 +164,8 @@ def plateau_table(coarse: dict, fine: dict) -> None:
         P = coarse["branches"]["bulge"]["pressure"][i]
         P_fine = np.interp(volume[i], finer["volume"], finer["pressure"])
         lever = LENGTH * (volume[i] - va) / (vb - va)
-        print(f"| {volume[i]:.4g} | {P - pm:.2e} | {P_fine - pm:.2e} | {reference[i].position:.4f} | {reference[i].position - lever:.4f} | "
+        S = reference[i].position
+        print(f"| {volume[i]:.4g} | {P - pm:.2e} | {P_fine - pm:.2e} | {S:.4f} | {S - lever:.4f} | "
               f"{deformed[i].width:.4f} |")
 
 

@@ -647,8 +647,8 @@ def _build(data: dict, name: str, text: str) -> Scene:
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
     if geometry.shape == Shape.TUBE and data.get("events"):
-        raise SceneError(f"events: {len(data['events'])} [[events]] on a tube, whose branches do not locate user points "
-                         "yet; allowed: none")
+        raise SceneError(f"events: {len(data['events'])} [[events]] on a tube, whose branches do not locate user "
+                         "points yet; allowed: none")
     stability = _stability(data.get("stability", {}))
     if geometry.shape == Shape.CAPSULE and stability.m_max != 0:
         raise SceneError(f"stability.m_max = {stability.m_max}: a capsule's m ≥ 1 second variation is not built yet "
