@@ -371,7 +371,11 @@ def test_bulge_propagates_at_maxwells_pressure():
     (model/tube.maxwell_pressure, checked against the equal-area rule in tests/test_tube.py; measured ≤ 5.2e-7,
     1.2e-9 at V/V0 = 415), the same P(V) at degree 140 within 1e-7 (measured 2.3e-8: the pressure converges
     although the steep front is not resolved pointwise, the first integral varying along the tube by 6–16 % at
-    degree 100: docs/tubes.md), and under volume control the plateau is stable."""
+    degree 100: docs/tubes.md), and under volume control the plateau is stable. The front (post/tube_measures.front,
+    its mid-level point S_f in the reference arclength) joins Maxwell's two states a and b (ρ at the last point within
+    1e-3 of λθ_a and 5e-3 of λθ_b; measured 1e-4, 2.5e-3) and moves by the lever rule of the sharp front,
+    V/V0 = v_a + (S_f/L)(v_b − v_a) with v = λθ²λz: S_f − L(V/V0 − v_a)/(v_b − v_a) is constant on the plateau to 3e-3
+    (measured: 1.8e-3 at both degrees, the front moving by 2.3 radii): the front translates without changing."""
     from balloon_cg.tube.bulge import bulge_branch
 
     curves = {}
@@ -391,3 +395,13 @@ def test_bulge_propagates_at_maxwells_pressure():
     finer = np.interp(coarse.volume[plateau], fine.volume, fine.pressure)
     assert np.abs(coarse.pressure[plateau] - finer).max() <= 1e-7
     assert np.all(coarse.unstable[Control.VOLUME][plateau] == 0)
+    from balloon_cg.post.tube_measures import front
+
+    _, a, b = tube.maxwell_pressure(scene.material)
+    va, vb = a.hoop**2 * a.axial, b.hoop**2 * b.axial
+    s = np.linspace(0.0, 20.0, 4001)
+    for branch in (coarse, fine):
+        fronts = [front(s, branch.disc.profile(u, s)[0]) for u in branch.states[branch.volume >= 320]]
+        offset = [f.position - 20.0 * (v - va) / (vb - va) for f, v in zip(fronts, branch.volume[branch.volume >= 320])]
+        assert np.ptp(offset) <= 3e-3
+        assert abs(fronts[-1].low - a.hoop) <= 1e-3 and abs(fronts[-1].high - b.hoop) <= 5e-3
