@@ -1,6 +1,8 @@
 """The reference tables of issue 37's "unchanged": every stored eigenvalue, flag and located point of the whole
 picture of every shipped scene and of the off-equator scene (tests/data/off_equator.toml), as computed by main at
-94ce54e (before the speed work of issue 37). tests/test_stability_reference.py computes the same tables with the
+94ce54e (before the speed work of issue 37), and of a Gent balloon (tests/data/gent.toml), as computed by main at
+a7f2a88 (before issue 38 made the reference meridian data: its "sphere scenes unchanged").
+tests/test_stability_reference.py computes the same tables with the
 code under test and compares them (``compare``); ``python tests/stability_reference.py [SCENE ...]`` rewrites
 tests/data/reference/SCENE.npz (only to record a deliberate change of the numbers).
 
@@ -20,8 +22,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
 OFF_EQUATOR = DATA / "off_equator.toml"
+GENT = DATA / "gent.toml"  # issue 38's Gent scene: its table computed by main before the meridian (a7f2a88)
+EXTRA = {path.stem: path for path in (OFF_EQUATOR, GENT)}  # scenes of tests/data/
 SCENES = tuple(sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")
-                     if not p.stem.startswith("tube_"))) + (OFF_EQUATOR.stem,)  # a tube's run is not a picture
+                     if not p.stem.startswith("tube_"))) + tuple(EXTRA)  # a tube's run is not a picture
 
 
 def reference_path(scene: str) -> Path:
@@ -76,11 +80,11 @@ def eigenvalue_errors(branch) -> dict[str, np.ndarray]:
 
 
 def scene_path(scene: str) -> Path:
-    return OFF_EQUATOR if scene == OFF_EQUATOR.stem else ROOT / "scenes" / f"{scene}.toml"
+    return EXTRA.get(scene, ROOT / "scenes" / f"{scene}.toml")
 
 
 def scene_table(scene: str, errors: bool = False) -> dict[str, np.ndarray]:
-    """``table`` of the whole picture of ``scene`` (a shipped scene's name, or off_equator)."""
+    """``table`` of the whole picture of ``scene`` (a shipped scene's name, or one of tests/data/: EXTRA)."""
     from balloon_cg.analysis.picture import analyse
     from balloon_cg.scene import load_scene
 

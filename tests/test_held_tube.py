@@ -103,7 +103,7 @@ def test_plugged_held_tube_has_a_pressure_maximum_and_minimum():
     a maximum, falls while a bulge grows in the middle, and rises again beyond a minimum (the strain stiffening): both
     folds located. The maximum is the same at degrees 30, 40 and 50 to 1e-10 (measured 1e-13); the minimum converges
     geometrically in the degree (differences 2.9e-4, 1.9e-4, 4.9e-5 from 24 to 50 and 5e-8 from 100 to 120:
-    docs/shapes.md), asserted here as shrinking differences from 30 to 50 and a gap below 1e-3. The plugs hold
+    docs/tubes.md), asserted here as shrinking differences from 30 to 50 and a gap below 1e-3. The plugs hold
     ρ = 1 and the ends' distance is λL; at the maximum the state solves the continuous problem: H is constant
     along the tube to 1e-6 (measured 1.8e-13). At the minimum it is not resolved pointwise (H varies by 10 % inside
     and 46 % at the plugs at degree 50): the necks beside the plugs are in hoop compression there (Φ_2 < 0, derived

@@ -11,7 +11,9 @@ import sys
 
 import numpy as np
 import pytest
+import sympy
 from numpy.polynomial import legendre
+from scipy import optimize
 
 from balloon_cg.tube.primary import primary_branch
 from balloon_cg.galerkin.discretisation import Discretisation
@@ -111,11 +113,24 @@ def test_discrete_energy_and_residual_are_those_written_here(ends):
     assert eq.volume(u) == pytest.approx(-weights @ (0.5 * lam2**2 * slope), rel=1e-13)  # V/(2π)
 
 
+def uniform_balances(material):
+    """(P(λθ, λz), N(λθ, λz)) of the uniform closed tube, derived here from the energy per 2π and unit reference
+    length e = Φ(λz, λθ) − ½Pλθ²λz (``ogden`` above, differentiated by SymPy): ∂e/∂λθ = 0 is the hoop balance
+    P = Φ_2/(λθλz), ∂e/∂λz = 0 the closed-end axial balance N = Φ_1 − λθΦ_2/(2λz) = 0 (the plugs' faces carry
+    Pπλθ², nothing else)."""
+    hoop, axial = sympy.symbols("hoop axial", positive=True)
+    phi = ogden(material, axial, hoop)
+    phi_2 = sympy.diff(phi, hoop)
+    return (sympy.lambdify((hoop, axial), phi_2 / (hoop * axial)),
+            sympy.lambdify((hoop, axial), sympy.diff(phi, axial) - hoop * phi_2 / (2 * axial)))
+
+
 @pytest.mark.parametrize("preset", ["SPOM1", "neo-Hookean"])
 def test_uniform_tube_is_an_exact_state(preset):
     """The closed-end state of model/tube.py at λθ = 1.2, 1.6, 2.5 has a zero residual (the uniform tube is exact in
     the basis: the hoop balance, the closed-end axial balance in the row of λ̄); the traced primary branch is that
-    path at every point (λ̄ = λz(λθ), P(λθ) and V/V0 = λθ²λz to 1e-10, the non-uniform coefficients zero)."""
+    path at every point (λ̄ = λz(λθ), P(λθ) and V/V0 = λθ²λz to 1e-10, the non-uniform coefficients zero), and
+    every point satisfies P = Φ_2/(λθλz) and N = 0 derived here (``uniform_balances``, 1e-12)."""
     scene = tube_scene(preset, 10.0).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 2.2})
     disc = IntervalDiscretisation(16, 10.0)
     eq = Equilibrium(scene, disc)
@@ -126,9 +141,11 @@ def test_uniform_tube_is_an_exact_state(preset):
     branch = primary_branch(scene)
     assert branch.stop.code == "hoop_stretch" and len(branch.pressure) > 20
     k = disc.axial_index
+    hoop_balance, axial_balance = uniform_balances(scene.material)
     for u, P, V in zip(branch.states, branch.pressure, branch.volume):
         state = tube.closed_end_state(scene.material, u[0])
         assert abs(u[k] - state.axial) <= 1e-10 and abs(P - state.pressure) <= 1e-10
+        assert abs(P - hoop_balance(u[0], u[k])) <= 1e-12 * (1 + P) and abs(axial_balance(u[0], u[k])) <= 1e-12
         assert abs(V - u[0] ** 2 * u[k]) <= 1e-10
         assert np.abs(np.delete(u, [0, k])).max() <= 1e-10
 
@@ -234,6 +251,34 @@ def test_bulge_branch_from_the_onset_through_its_volume_fold():
     assert np.abs(H - H.mean()).max() <= 1e-6 * abs(H.mean())
 
 
+def test_neo_hookean_bulge_keeps_falling_without_a_maxwell_state():
+    """Neo-Hookean, L = 10: the uniform closed tube's P(λθ) = 2(1 − λz⁻²λθ⁻⁴)/λz (``uniform_balances`` on N = 0)
+    falls for ever beyond its maximum (P → 0: checked here from λθ* to 50), so no two uniform states share a pressure
+    beyond it and there is no Maxwell state (model/tube.maxwell_pressure is None). The bulge branch switched at the
+    onset passes its volume fold (LV) and then P keeps falling as V/V0 grows to 100 (every step; no plateau; the last
+    kept point is the one before the stop), and the propagating bulge of SPOM1's plateau has no counterpart: P at
+    the last point is below a third of the onset's (measured: 0.352 at V/V0 = 96.9 against 1.4991)."""
+    from balloon_cg.tube.bulge import bulge_branch
+
+    scene = tube_scene("neo-Hookean", 10.0).with_overrides({"solver.degree": 40, "continuation.stop_stretch": 1.75,
+                                                            "continuation.step_max": 0.5})
+    assert tube.maxwell_pressure(scene.material) is None
+    hoop_balance, axial_balance = uniform_balances(scene.material)
+    peak = tube.pressure_maximum(scene.material)
+    hoops = np.linspace(peak.hoop, 50.0, 400)
+    axial = [optimize.brentq(lambda a: axial_balance(h, a), 0.5, 50.0, xtol=1e-14) for h in hoops]
+    uniform = np.array([hoop_balance(h, a) for h, a in zip(hoops, axial)])
+    assert np.all(np.diff(uniform) < 0) and uniform[-1] < 0.1 * uniform[0]
+    primary = primary_branch(scene)
+    onset = primary.branch_points()[0]
+    branch = bulge_branch(scene, primary, onset, stop_volume=100.0, step=0.02)
+    assert branch.stop.code == "volume" and branch.volume[-1] > 90  # the point past 100 is not kept
+    folds = [s for s in branch.special if s.kind == "LV"]
+    assert len(folds) == 1 and folds[0].status == "located"
+    assert np.all(np.diff(branch.pressure[1:]) < 0)  # falling, through the fold and beyond: no plateau
+    assert branch.pressure[-1] < onset.pressure / 3
+
+
 def test_plugged_tube_has_a_pressure_maximum_above_the_uniform_one():
     """Plugged ends (ρ = 1 at both ends, closed): SPOM1, L = 10, the primary branch's fold in P at degrees 30 and 40
     within 1e-10 (measured 1.7e-13); ρ(0) = ρ(L) = 1; at the fold the first integral H (written here) is constant
@@ -296,6 +341,8 @@ def test_tube_table_errors_name_key_value_and_range(table, message):
     ("[electric]\nvoltage = 0.1\n", r'geometry.shape = "tube": the \[electric\] term on a tube is not built yet'),
     ('[loading]\ncontrol = "volume"\n', 'loading.control = "volume": a tube is continued in the pressure only'),
     ("[dynamics]\nfrequencies = true\nmodes = true\n", "dynamics.modes = true: a tube's mode shapes are not stored"),
+    ('[[events]]\nquantity = "pressure"\nvalue = 1.2\n', r"events: 1 \[\[events\]\] on a tube, whose branches do not "
+     "locate user points yet; allowed: none"),
 ])
 def test_tube_refuses_the_parts_it_does_not_have(extra, message):
     with pytest.raises(SceneError, match=message) as error:
@@ -324,7 +371,11 @@ def test_bulge_propagates_at_maxwells_pressure():
     (model/tube.maxwell_pressure, checked against the equal-area rule in tests/test_tube.py; measured ≤ 5.2e-7,
     1.2e-9 at V/V0 = 415), the same P(V) at degree 140 within 1e-7 (measured 2.3e-8: the pressure converges
     although the steep front is not resolved pointwise, the first integral varying along the tube by 6–16 % at
-    degree 100: docs/shapes.md), and under volume control the plateau is stable."""
+    degree 100: docs/tubes.md), and under volume control the plateau is stable. The front (post/tube_measures.front,
+    its mid-level point S_f in the reference arclength) joins Maxwell's two states a and b (ρ at the last point within
+    1e-3 of λθ_a and 5e-3 of λθ_b; measured 1e-4, 2.5e-3) and moves by the lever rule of the sharp front,
+    V/V0 = v_a + (S_f/L)(v_b − v_a) with v = λθ²λz: S_f − L(V/V0 − v_a)/(v_b − v_a) is constant on the plateau to 3e-3
+    (measured: 1.8e-3 at both degrees, the front moving by 2.3 radii): the front translates without changing."""
     from balloon_cg.tube.bulge import bulge_branch
 
     curves = {}
@@ -344,3 +395,13 @@ def test_bulge_propagates_at_maxwells_pressure():
     finer = np.interp(coarse.volume[plateau], fine.volume, fine.pressure)
     assert np.abs(coarse.pressure[plateau] - finer).max() <= 1e-7
     assert np.all(coarse.unstable[Control.VOLUME][plateau] == 0)
+    from balloon_cg.post.tube_measures import front
+
+    _, a, b = tube.maxwell_pressure(scene.material)
+    va, vb = a.hoop**2 * a.axial, b.hoop**2 * b.axial
+    s = np.linspace(0.0, 20.0, 4001)
+    for branch in (coarse, fine):
+        fronts = [front(s, branch.disc.profile(u, s)[0]) for u in branch.states[branch.volume >= 320]]
+        offset = [f.position - 20.0 * (v - va) / (vb - va) for f, v in zip(fronts, branch.volume[branch.volume >= 320])]
+        assert np.ptp(offset) <= 3e-3
+        assert abs(fronts[-1].low - a.hoop) <= 1e-3 and abs(fronts[-1].high - b.hoop) <= 5e-3

@@ -141,7 +141,7 @@ def test_bulge_onset_solves_the_dispersion_relation(preset):
 
 def test_bulge_onset_tends_to_the_pressure_maximum():
     """λθ at the onset of cos(πS/L) minus λθ at the pressure maximum falls like 1/L² (the condition is the long-wave
-    one plus Φ_1Φ_11 k²/λz, k = π/L): SPOM1, L = 10, 20, 40, 80, 160 (docs/shapes.md has the table); the ratio of
+    one plus Φ_1Φ_11 k²/λz, k = π/L): SPOM1, L = 10, 20, 40, 80, 160 (docs/tubes.md has the table); the ratio of
     successive gaps is 4 within 1 % from L = 20 on, and the onset pressure approaches the maximum from below."""
     spom1 = material("SPOM1")
     peak = pressure_maximum(spom1)

@@ -426,7 +426,7 @@ def _add_solve(commands):
     given = p.add_mutually_exclusive_group(required=True)
     given.add_argument("--pole-stretch", type=float, metavar="X", help="north pole stretch λ2(0) (> 1)")
     given.add_argument("--hoop-stretch", type=float, metavar="X",
-                       help="a tube's hoop stretch at its middle λ2(L/2) (> 1; docs/shapes.md)")
+                       help="a tube's hoop stretch at its middle λ2(L/2) (> 1; docs/tubes.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_settings(p, shorthands=False)
     p.set_defaults(handler=solve)
@@ -957,7 +957,7 @@ def _add_continue(commands):
                     "surface branch).")
     p.add_argument("run", metavar="RUN", help="run file (HDF5) written by balloon-cg run (a tube's: from the onset "
                                               "of bulging, the bulge branch or with --parameter M its onset curve, "
-                                              "docs/shapes.md)")
+                                              "docs/tubes.md)")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P; from a point "
                                        "that is no fold or BP: M or voltage, at its fixed P)")

@@ -1,4 +1,4 @@
-"""The commands on a tube scene (docs/shapes.md): ``run`` (tube/picture.tube_picture) and ``critical``
+"""The commands on a tube scene (docs/tubes.md): ``run`` (tube/picture.tube_picture) and ``critical``
 (tube/picture.onset_picture) write a tube run file (io/tube_file.py) and summarise it. A signal (SIGINT or SIGTERM,
 numerics.interrupt) stops the work at its next point or before its next stage: what is finished is written, the
 file's ``interrupted`` attribute names the stage, and the command exits 130 with one line read from the file."""

@@ -134,7 +134,7 @@ class Equilibrium:
                 raise SceneError('geometry.shape = "tube": this command is not built for a tube yet; a tube\'s '
                                  'branches: balloon-cg run, sweep or continue, its onset in M: balloon-cg critical, '
                                  'one state: balloon-cg solve --hoop-stretch, or balloon_cg.tube.picture.tube_picture '
-                                 '(docs/shapes.md)')
+                                 '(docs/tubes.md)')
             raise ValueError(f"a {scene.geometry.shape.value} is discretised between its poles, not over an interval")
         self.scene = scene
         if isinstance(discretisation, Discretisation) and discretisation.joins != joins(scene.geometry):

@@ -1,4 +1,4 @@
-"""The uniformly inflated tube with closed, sliding ends: the state a tube's bulge bifurcates from (docs/shapes.md).
+"""The uniformly inflated tube with closed, sliding ends: the state a tube's bulge bifurcates from (docs/tubes.md).
 
 A cylinder of reference radius 1 inflated to the hoop stretch λθ (radius λθ) and the axial stretch λz, both
 uniform; its ends are closed by plugs that carry the pressure on their faces and slide freely (no axial force
@@ -129,7 +129,7 @@ def pressure_maximum(material, largest_hoop: float = 10.0) -> UniformTube | None
 
 def bulge_condition(material, state: UniformTube, wavenumber: float) -> float:
     """The sign of the second variation of the uniform ``state`` at fixed P under the bulge mode of axial
-    wavenumber k (docs/shapes.md): ρ = λθ + ε A cos kS, η = λz S + ε B sin kS (k = nπ/L on a tube of length L with
+    wavenumber k (docs/tubes.md): ρ = λθ + ε A cos kS, η = λz S + ε B sin kS (k = nπ/L on a tube of length L with
     sliding ends: ρ' = 0 and η fixed at both ends). Averaged over a period its Hessian in (A, B) is
 
         ½ [[Φ_22 + Φ_1 k²/λz − P λz,  k (Φ_12 − P λθ)], [k (Φ_12 − P λθ),  Φ_11 k²]],

@@ -120,7 +120,7 @@ class Shape(enum.StrEnum):
 class Ends(enum.StrEnum):
     """How a tube ends (``Geometry.ends``): "sliding", planes of symmetry the meridian meets at a right angle (its
     radius free there), or "plugged", rigid plugs of the reference radius; both closed: no axial force beyond the
-    pressure's on the ends (docs/shapes.md)."""
+    pressure's on the ends (docs/tubes.md)."""
 
     SLIDING = "sliding"
     PLUGGED = "plugged"
@@ -649,6 +649,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          "(its curvature jumps at the joins); allowed: 0")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
+    if geometry.shape == Shape.TUBE and data.get("events"):
+        raise SceneError(f"events: {len(data['events'])} [[events]] on a tube, whose branches do not locate user "
+                         "points yet; allowed: none")
     stability = _stability(data.get("stability", {}))
     if geometry.shape == Shape.CAPSULE and stability.m_max != 0:
         raise SceneError(f"stability.m_max = {stability.m_max}: a capsule's m ≥ 1 second variation is not built yet "

@@ -1,4 +1,4 @@
-"""A tube's branches (docs/shapes.md): the layer after ``analysis`` whose branches live on an interval without poles
+"""A tube's branches (docs/tubes.md): the layer after ``analysis`` whose branches live on an interval without poles
 (galerkin/interval.py), reading analysis's plain data and numerics. In reading order:
 
 - ``results``: a tube's branch and its located points as plain data, why a trace stopped

@@ -2,7 +2,7 @@
 
 At a branch point of the odd block (interval.Mirror) the mirror-symmetric branch is crossed by a pitchfork whose states
 break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image): the bulge at one end of a tube with
-sliding ends (plugged ends are refused: their odd branch points are not resolved, docs/shapes.md). At a branch point of the even block of a
+sliding ends (plugged ends are refused: their odd branch points are not resolved, docs/tubes.md). At a branch point of the even block of a
 uniform primary branch (sliding ends, no field: the modes cos(nπS/L), n even) the branch stays mirror-symmetric and
 breaks the uniformity (a pitchfork too: on the tube of length L it is the odd bulge branch of the tube of length
 L/n, repeated). The branch leaves the branch point X* = (u*, P*) along the block's null vector φ with dP = 0: the first
@@ -53,7 +53,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     disc = primary.disc
     if disc.ends != Ends.SLIDING:
         raise UnswitchableBranchPoint(f"a branch is switched on sliding ends, not {disc.ends.value}: the odd branch "
-                                      "points of plugged ends are not resolved (docs/shapes.md)")
+                                      "points of plugged ends are not resolved (docs/tubes.md)")
     if point.block == Mirror.EVEN and in_field(scene):
         raise UnswitchableBranchPoint("an even branch point is switched on a uniform primary branch (no field), not "
                                       "in a coil field")

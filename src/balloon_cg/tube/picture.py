@@ -1,6 +1,6 @@
 """Everything a tube scene asks for (``balloon-cg run`` on a tube): the primary branch with its folds and branch
 points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py; sliding ends only:
-on plugged ones the branch points are not trusted, docs/shapes.md) traced until it rejoins the mirror-symmetric
+on plugged ones the branch points are not trusted, docs/tubes.md) traced until it rejoins the mirror-symmetric
 states, its largest hoop stretch passes ``continuation.stop_stretch`` or after ``continuation.max_points``, and
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
@@ -97,7 +97,7 @@ def maxwell(scene) -> float | None:
     """Maxwell's pressure of the scene's uniform closed tube; None where there is none: ends held apart, no maximum
     and minimum on the uniform path, or coils acting on the tube (M > 0): the field varies along the tube, so there
     is neither a uniform state nor the first integral of axial translation that the equal-area rule rests on
-    (docs/shapes.md), and the field-free value is not the field's."""
+    (docs/tubes.md), and the field-free value is not the field's."""
     if scene.geometry.axial_stretch is not None or in_field(scene):
         return None
     found = maxwell_pressure(scene.material)

@@ -3,8 +3,8 @@ directions under pressure control (all of u's unknowns: a held λ̄ is not one) 
 δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman factorisation (numerics/eigen.py: ``restricted``
 removes the constraint); and where the membrane is compressed (``smallest_stress``): a membrane wrinkles where a
 principal stress is negative, its Ritz problem is not elliptic there and the states and eigenvalues computed there
-do not converge in the degree (docs/shapes.md: the plugged tube's necks); in a coil field a trace stops where its
-states turn compressed (``CompressionStop``: there they measurably do not converge, docs/shapes.md)."""
+do not converge in the degree (docs/tubes.md: the plugged tube's necks); in a coil field a trace stops where its
+states turn compressed (``CompressionStop``: there they measurably do not converge, docs/tubes.md)."""
 import numpy as np
 
 from .results import IntervalStop
