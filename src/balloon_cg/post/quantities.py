@@ -64,34 +64,29 @@ def _legendre_derivatives(coefficients, c, s, mapping):
 
 
 def _element_derivatives(coefficients, c, s, join: float):
-    """(f, f', f'', df/dx) in θ of f = Σ c_k φ_k on a capsule's elements (galerkin/elements.py: ``element_series``):
-    on the cylinder ξ = (π/2 − θ)/(π/2 − θj), f' = f_ξ ξ', f'' = f_ξξ ξ'², f_x = −f'/sin θ; on the caps
-    ξ = (2|x| − 1 − c)/(1 − c), f_x = f_ξ ξ_x, f_xx = f_ξξ ξ_x², then θ by the chain rule as on Legendre's. The
-    joins belong to the cylinder (its one-sided derivatives)."""
-    theta = np.arccos(np.clip(c, -1.0, 1.0))
+    """(f, f', f'', df/dx) in θ of f = Σ c_k φ_k (rows of ``coefficients``) on a capsule's elements
+    (galerkin/elements.py: ``element_series``): on the cylinder ξ = (π/2 − θ)/(π/2 − θj), f' = f_ξ ξ', f'' = f_ξξ ξ'²,
+    f_x = −f'/sin θ; on the caps ξ = (2|x| − 1 − c)/(1 − c), f_x = f_ξ ξ_x, f_xx = f_ξξ ξ_x², then θ by the chain
+    rule as on Legendre's. The joins belong to the cylinder (its one-sided derivatives)."""
     half_span = 0.5 * np.pi - np.arccos(join)
     cylinder, north = np.abs(c) <= join, c > join
-    out = [np.zeros(np.shape(coefficients)[:-1] + c.shape) for _ in range(4)]
-    for series, on, sign in zip(np.moveaxis(element_series_rows(coefficients, join), -2, 0),
-                                (north, cylinder, ~(north | cylinder)), (1.0, 0.0, -1.0)):
-        if sign == 0.0:
-            xi, rate = (0.5 * np.pi - theta) / half_span, -1.0 / half_span
-        else:
-            xi, rate = (2.0 * np.abs(c) - 1.0 - join) / (1.0 - join), 2.0 * sign / (1.0 - join)
-        f, fxi, fxixi = (legendre.legval(xi, legendre.legder(series.T, m)) for m in range(3))
-        if sign == 0.0:
-            parts = (f, fxi * rate, fxixi * rate**2, -fxi * rate / np.where(on, s, 1.0))
-        else:
-            fx, fxx = fxi * rate, fxixi * rate**2
-            parts = (f, -s * fx, s * s * fxx - c * fx, fx)
-        for target, part in zip(out, parts):
+    series = np.array([element_series(row, join) for row in np.atleast_2d(coefficients)])  # (rows, 3, degree)
+
+    def derivatives(element: int, xi):
+        """f, f_ξ, f_ξξ of the rows' series on ``element`` (0 north, 1 cylinder, 2 south) at ξ."""
+        return (legendre.legval(xi, legendre.legder(series[:, element].T, m)) for m in range(3))
+
+    f, fxi, fxixi = derivatives(1, (0.5 * np.pi - np.arccos(np.clip(c, -1.0, 1.0))) / half_span)
+    rate = -1.0 / half_span
+    out = [f, fxi * rate, fxixi * rate**2, -fxi * rate / np.where(cylinder, s, 1.0)]
+    xi_cap = (2.0 * np.abs(c) - 1.0 - join) / (1.0 - join)
+    for element, on, sign in ((0, north, 1.0), (2, ~(north | cylinder), -1.0)):
+        f, fxi, fxixi = derivatives(element, xi_cap)
+        rate = 2.0 * sign / (1.0 - join)
+        fx, fxx = fxi * rate, fxixi * rate**2
+        for target, part in zip(out, (f, -s * fx, s * s * fxx - c * fx, fx)):
             target[..., on] = part[..., on]
     return tuple(out)
-
-
-def element_series_rows(coefficients, join: float) -> np.ndarray:
-    """``element_series`` of each row of ``coefficients``: shape (rows, 3, degree of the series + 1)."""
-    return np.array([np.array(element_series(row, join)) for row in np.atleast_2d(coefficients)])
 
 
 def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> dict:
