@@ -201,6 +201,61 @@ def test_middle_of_a_long_capsule_is_the_uniform_closed_tube():
     assert abs(hoops[3] - hoops[2]) < 1e-2 * errors[2]
 
 
+def test_middle_of_a_long_capsule_has_the_closed_tubes_curvatures_and_stresses():
+    """post/quantities on the SPOM1 capsule of length 20 at P = 1.2 (degree 96; the caps' influence at the middle is
+    below 1e-7, test above): at θ = π/2 the curvatures are the cylinder's, k_m = 0 and k_p = 1/r (r = λ2), and the
+    elastic stresses carry the pressure as a closed-end tube's wall does (thickness h = 1/(λ1λ2) in units of the
+    reference one, stresses and P in the energy's units): the normal balance P = h(σ_θ k_m + σ_φ k_p) gives
+    σ_φ = P λ1 λ2², and the axial force on the ends, 2π r h σ_θ = π r² P, gives σ_θ = P λ1 λ2²/2."""
+    from balloon_cg.post.quantities import quantities
+
+    scene = capsule_scene(20.0)
+    eq, u = inflated(scene, 96, 1.2)
+    q = quantities(scene, eq.disc, np.append(u, 1.2), np.array([np.pi / 2]))
+    lam1, lam2 = q["lam1"][0, 0], q["lam2"][0, 0]
+    assert abs(q["k_meridian"][0, 0]) < 1e-7
+    assert abs(q["k_parallel"][0, 0] * lam2 - 1.0) < 1e-12
+    hoop = 1.2 * lam1 * lam2**2
+    assert abs(q["sigma_phi"][0, 0] / hoop - 1.0) < 1e-6
+    assert abs(q["sigma_theta"][0, 0] / (hoop / 2) - 1.0) < 1e-6
+
+
+def test_capsule_curvatures_are_the_deformed_meridians_everywhere():
+    """The SPOM1 capsule of length 3 at P = 1.0 (degree 64): post/quantities.surface's curvatures, from each element's
+    second derivatives, against a second method on every element: the tangent angle ψ = atan2(η', ρ') of the
+    meridian ρ = λ2 R (R written here, ``capsule_radius``; λ2, η and their first θ-derivatives from the basis table
+    of galerkin/elements.py) differentiated by central differences (step 1e-5), k_m = −ψ'/s', and k_p = −η'/(ρ s'),
+    away from the joins (1e-8); at the poles k_p = k_m (isotropic, 1e-9), and ρ = λ2 R, λ1 = s'/κ."""
+    from balloon_cg.post.quantities import surface
+
+    scene = capsule_scene(3.0)
+    kappa = 1 + 3.0 / np.pi
+    theta_j = np.pi / (2 * kappa)
+    eq, u = inflated(scene, 64, 1.0)
+    X = np.append(u, 1.0)
+    step = 1e-5
+    for low, high in ((0.02, theta_j - 0.02), (theta_j + 0.02, np.pi - theta_j - 0.02),
+                      (np.pi - theta_j + 0.02, np.pi - 0.02)):
+        theta = np.linspace(low, high, 41)
+        g = surface(eq.disc, X, theta, scene.geometry)
+
+        def angle_and_speed(at):
+            lam2, dlam2, _, w = eq.disc.evaluate(u, at)  # λ2, dλ2/dθ, η, dη/dθ
+            R, dR = capsule_radius(at, kappa)
+            drho = dlam2 * R + lam2 * dR
+            return np.arctan2(w, drho), np.hypot(drho, w), lam2 * R
+
+        psi_plus, _, _ = angle_and_speed(theta + step)
+        psi_minus, _, _ = angle_and_speed(theta - step)
+        _, speed, rho = angle_and_speed(theta)
+        k_meridian = -(psi_plus - psi_minus) / (2 * step) / speed
+        assert np.abs(g["k_meridian"][0] - k_meridian).max() < 1e-8  # measured 2.6e-10 (k_m from 0.02 to 0.94)
+        assert np.abs(g["k_parallel"][0] + g["deta"][0] / (rho * speed)).max() < 1e-10
+        assert np.abs(g["rho"][0] - rho).max() < 1e-12 and np.abs(g["lam1"][0] - speed / kappa).max() < 1e-12
+    poles = surface(eq.disc, X, np.array([0.0, np.pi]), scene.geometry)
+    assert np.abs(poles["k_parallel"] - poles["k_meridian"]).max() < 1e-9
+
+
 def pressure_maximum(length: float, degree: int) -> float:
     """P at the capsule's located pressure fold (``analyse`` from ``degree``, m = 0 stability, under volume control
     to 3.5 V0, past the fold)."""
@@ -281,7 +336,20 @@ def test_volume_control_measures_the_capsules_volume():
     assert all(a.stable_volume for a in beside) and not all(a.stable_pressure for a in beside)
 
 
-def test_run_writes_the_capsules_profiles(tmp_path, capsys):
+@pytest.fixture(scope="module")
+def capsule_run(tmp_path_factory):
+    """A run file of ``balloon-cg run`` on a capsule of length 10 (to pole stretch 1.05, before its fold, degree 64)."""
+    from balloon_cg.app.cli import main
+
+    folder = tmp_path_factory.mktemp("capsule_run")
+    scene = folder / "capsule.toml"
+    scene.write_text(CAPSULE.format(length=10.0) + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
+    path = folder / "capsule.h5"
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    return path
+
+
+def test_run_writes_the_capsules_profiles(capsule_run, capsys):
     """``balloon-cg run`` on a capsule of length 10 (to pole stretch 1.05, before its fold) writes a run file whose
     profiles measure from the capsule: ρ = λ2 R with R written here (1 on the cylinder, sin κθ on the caps), λ1
     finite on the whole θ grid and equal to λ2 at the poles (isotropic there), 1e-10; ``inspect`` (text and
@@ -290,10 +358,7 @@ def test_run_writes_the_capsules_profiles(tmp_path, capsys):
     from balloon_cg.app.cli import main
     from balloon_cg.io.run_file import read_run
 
-    scene = tmp_path / "capsule.toml"
-    scene.write_text(CAPSULE.format(length=10.0) + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
-    path = tmp_path / "capsule.h5"
-    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    path = capsule_run
     capsys.readouterr()
     assert main(["inspect", str(path)]) == 0
     assert "shape          capsule of length 10\n" in capsys.readouterr().out
@@ -312,6 +377,28 @@ def test_run_writes_the_capsules_profiles(tmp_path, capsys):
     assert np.abs(profiles["rho"] - profiles["lam2"] * R).max() < 1e-10
     assert np.all(np.isfinite(profiles["lam1"]))
     assert np.abs(profiles["lam1"][:, [0, -1]] - profiles["lam2"][:, [0, -1]]).max() < 1e-10
+
+
+# what ``plot`` draws of the capsule's run file; every other kind is refused (a pressure-continued branch without
+# coils, stability landscape, frequencies, curves or surface branches)
+DRAWN = {"pressure-pole", "pressure-equator", "shapes", "stresses", "curvature"}
+
+
+def test_plot_of_a_capsule_draws_or_refuses_every_kind(capsule_run, tmp_path, capsys):
+    """``balloon-cg plot`` of the capsule's run file, every kind: the five of DRAWN write their image (exit 0; the
+    curvatures and stresses are the capsule's, tests above), the others exit 2 with one line naming why."""
+    from balloon_cg.app.cli import PLOT_KINDS, main
+
+    capsys.readouterr()
+    for kind in PLOT_KINDS:
+        image = tmp_path / f"{kind}.png"
+        code = main(["plot", str(capsule_run), "--what", kind, "-o", str(image)])
+        err = capsys.readouterr().err
+        if kind in DRAWN:
+            assert code == 0 and image.stat().st_size > 0, (kind, err)
+        else:
+            assert code == 2 and not image.exists() and len(err.strip().splitlines()) == 1, (kind, code, err)
+            assert err.startswith("balloon-cg: error: "), (kind, err)
 
 
 def test_capsule_of_length_3_to_stretch_2_is_complete(tmp_path, capsys):

@@ -128,7 +128,7 @@ def test_paper_magnetic_additions(two_coils):
     elastic = quantities(two_coils, disc, X, THETA, M=0.0)
     np.testing.assert_array_equal(q["sigma_theta"], elastic["sigma_theta"])
     assert not elastic["sigma_phi_paper"].any()
-    zero = paper_magnetic_stresses(0.0, chi, THETA, lam2, q)
+    zero = paper_magnetic_stresses(0.0, chi, np.sin(THETA), lam2, q)
     assert not np.any(zero[0]) and not np.any(zero[1])
 
 

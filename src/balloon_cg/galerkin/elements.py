@@ -104,3 +104,32 @@ def element_table(x: np.ndarray, degree: int, join: float):
             p[:, k] = np.where(cylinder, 0.0, sign * (pq[:, j] + pq[:, j - 1]))
             dp[:, k] = np.where(cylinder, 0.0, sign * (dpq[:, j] + dpq[:, j - 1]) * dxi_cap)
     return p, dp
+
+
+def element_series(coefficients: np.ndarray, join: float) -> tuple:
+    """(north cap, cylinder, south cap): the function Σ_k c_k φ_k (k = 0..len − 1) as one Legendre series in each
+    element's own ξ (module docstring; the south cap's ξ runs from its join, −1, to its pole, +1, as the north's):
+
+        1 → 1 on each,   ℓ → (1, ξ, −1),   B_j → (0, P_j − P_{j−2}, 0),   q_j pair → (q_j, 0, (−1)^k q_j),
+
+    so that numpy's Legendre series calculus gives any derivative in ξ (the curvatures, post/quantities.py)."""
+    order = sequence(len(coefficients) - 1, join)
+    top = max(j for _, j in order) + 1
+    north, cylinder, south = np.zeros(top), np.zeros(top), np.zeros(top)
+    for k, ((family, j), c) in enumerate(zip(order, coefficients)):
+        if family == CONSTANT:
+            north[0] += c
+            cylinder[0] += c
+            south[0] += c
+        elif family == HAT:
+            north[0] += c
+            cylinder[1] += c
+            south[0] -= c
+        elif family == CYLINDER:
+            cylinder[j] += c
+            cylinder[j - 2] -= c
+        else:
+            for series, sign in ((north, 1.0), (south, (-1.0) ** k)):
+                series[j] += sign * c
+                series[j - 1] += sign * c
+    return north, cylinder, south

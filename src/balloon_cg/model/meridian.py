@@ -58,6 +58,14 @@ def hoop_rate(geometry: Geometry, cos_theta, sin_theta):
     return np.where(angle < np.pi / 2, side * capsule_rate(geometry) * np.cos(angle), 0.0)
 
 
+def hoop_acceleration(geometry: Geometry, cos_theta, sin_theta):
+    """R'' = d²R/dθ² at the node: −sin θ on a sphere and a spheroid, a capsule's −κ² sin κd (0 on its cylinder)."""
+    if geometry.shape != Shape.CAPSULE:
+        return -np.asarray(sin_theta, dtype=float)
+    angle, _ = _capsule_cap(geometry, cos_theta)
+    return np.where(angle < np.pi / 2, -capsule_rate(geometry) ** 2 * np.sin(angle), 0.0)
+
+
 def joins(geometry: Geometry) -> tuple:
     """The x = cos θ where the reference curvature jumps, where the quadrature splits (galerkin/discretisation.py:
     ``split_rule``): a capsule's ±cos θj, θj = π/(2κ) (none at length 0, the sphere); none on other shapes."""

@@ -1,11 +1,12 @@
 """What users look at (MODEL.md §6): stresses, wrinkling, the applied field on the surface, Gaussian curvature.
 
-Every quantity is evaluated from the stored Legendre unknowns of a point (λ2 = Σ a_k P_k(s), η = Σ b_k P_k(s),
-s = x = cos θ, or s = h(x) for a branch stored with a coordinate map) on a θ grid, poles included.
-θ-derivatives by the chain rule, regular at the poles:
+Every quantity is evaluated from the stored unknowns of a point (λ2 = Σ a_k P_k(s), η = Σ b_k P_k(s),
+s = x = cos θ, or s = h(x) for a branch stored with a coordinate map; a capsule's piecewise basis φ_k, each element
+a Legendre series in its own coordinate: galerkin/elements.py) on a θ grid, poles included. θ-derivatives by the
+chain rule, regular at the poles, with R(θ) the reference hoop radius (model/meridian.py: sin θ on a sphere):
 
     d/dθ = −sin θ d/dx,    d²/dθ² = sin²θ d²/dx² − cos θ d/dx,
-    ρ = λ2 sin θ,   ρ' = λ2' sin θ + λ2 cos θ,   ρ'' = λ2'' sin θ + 2 λ2' cos θ − λ2 sin θ,
+    ρ = λ2 R,   ρ' = λ2' R + λ2 R',   ρ'' = λ2'' R + 2 λ2' R' + λ2 R'',
     s' = sqrt(ρ'² + η'²) (the deformed arclength per dθ),   λ1 = s'/S'
 (S' = dS/dθ of the reference meridian, model/meridian.py: 1 on the sphere, where λ1 = s').
 
@@ -13,7 +14,7 @@ Geometry (t, n unit tangent along increasing θ and outward normal in the (e_ρ,
 
     t = (ρ', η')/s',   n = (−η', ρ')/s'          (on a sphere n = (sin θ, cos θ), away from the centre),
     k_m = −(ρ'η'' − ρ''η')/s'³                   meridian curvature,
-    k_p = −η'/(ρ s') = (dη/dx)/(λ2 s')            parallel curvature (η'/ρ = −(dη/dx)/λ2 exactly: no 0/0),
+    k_p = −η'/(ρ s') = (dη/dx)(sin θ/R)/(λ2 s')   parallel curvature (sin θ/R → 1/|R'| at a pole: no 0/0),
     κ = k_m k_p = η'(ρ'η'' − ρ''η')/(ρ (ρ'² + η'²)²)  Gaussian curvature (κ R0²);
 
 both principal curvatures are 1/λ on a sphere of radius λ, and at a pole k_p = k_m, so κ there is the square of
@@ -25,9 +26,10 @@ from numpy.polynomial import legendre
 
 from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import Discretisation
+from ..galerkin.elements import element_series
 from ..model.field import coaxial_table, coil_table, field_components, field_squared_nodes
 from ..model.stresses import elastic_stresses
-from ..model.meridian import metric
+from ..model.meridian import hoop, hoop_acceleration, hoop_rate, metric
 from ..scene import parse_scene
 from ..scene.tables import Geometry
 
@@ -51,44 +53,72 @@ def branch_discretisation(branch: dict) -> Discretisation:
                           int(attrs.get("quadrature", 0)), mapping, tuple(float(x) for x in attrs.get("joins", ())))
 
 
-def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> dict:
-    """Shape, stretches and principal curvatures (module docstring) for the rows X = (u, P) on ``theta`` of a
-    scene of reference ``geometry``.
-
-    Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), speed (s'), k_meridian, k_parallel,
-    gaussian_curvature (κ); each array has shape (n_points, len(theta)). Not on a capsule's piecewise basis
-    (ValueError: its curvatures are not built, docs/shapes.md).
-    """
-    if disc.joins:
-        raise ValueError("the curvatures and stresses of a capsule are not built (post/quantities.surface reads "
-                         "one Legendre series and the sphere's ρ = λ2 sin θ)")
-    a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
-    c, s = np.cos(theta), np.sin(theta)
-
-    mapping = disc.mapping
+def _legendre_derivatives(coefficients, c, s, mapping):
+    """(f, f', f'', df/dx) in θ of f = Σ c_k P_k(s), s = h(cos θ) (f_x = f_s h', f_xx = f_ss h'² + f_s h'')."""
     arg = c if mapping is None else np.clip(mapping.s(c), -1.0, 1.0)
     ds = 1.0 if mapping is None else mapping.ds_dx(c)
     d2s = 0.0 if mapping is None else mapping.d2s_dx2(c)
+    f, fs, fss = (legendre.legval(arg, legendre.legder(coefficients, m)) for m in range(3))
+    fx, fxx = fs * ds, fss * ds * ds + fs * d2s
+    return f, -s * fx, s * s * fxx - c * fx, fx
 
-    def series(coefficients):
-        """(f, f', f'') in θ of f = Σ c_k P_k(s), s = h(cos θ), and df/dx (f_x = f_s h', f_xx = f_ss h'² + f_s h'')."""
-        f, fs, fss = (legendre.legval(arg, legendre.legder(coefficients, m)) for m in range(3))
-        fx, fxx = fs * ds, fss * ds * ds + fs * d2s
-        return f, -s * fx, s * s * fxx - c * fx, fx
 
-    lam2, dlam2, d2lam2, _ = series(a)
-    eta, deta, d2eta, deta_dx = series(b)
-    rho = lam2 * s
-    drho = dlam2 * s + lam2 * c
-    d2rho = d2lam2 * s + 2 * dlam2 * c - lam2 * s
+def _element_derivatives(coefficients, c, s, join: float):
+    """(f, f', f'', df/dx) in θ of f = Σ c_k φ_k (rows of ``coefficients``) on a capsule's elements
+    (galerkin/elements.py: ``element_series``): on the cylinder ξ = (π/2 − θ)/(π/2 − θj), f' = f_ξ ξ', f'' = f_ξξ ξ'²,
+    f_x = −f'/sin θ; on the caps ξ = (2|x| − 1 − c)/(1 − c), f_x = f_ξ ξ_x, f_xx = f_ξξ ξ_x², then θ by the chain
+    rule as on Legendre's. The joins belong to the cylinder (its one-sided derivatives)."""
+    half_span = 0.5 * np.pi - np.arccos(join)
+    cylinder, north = np.abs(c) <= join, c > join
+    series = np.array([element_series(row, join) for row in np.atleast_2d(coefficients)])  # (rows, 3, degree)
+
+    def derivatives(element: int, xi):
+        """f, f_ξ, f_ξξ of the rows' series on ``element`` (0 north, 1 cylinder, 2 south) at ξ."""
+        return (legendre.legval(xi, legendre.legder(series[:, element].T, m)) for m in range(3))
+
+    f, fxi, fxixi = derivatives(1, (0.5 * np.pi - np.arccos(np.clip(c, -1.0, 1.0))) / half_span)
+    rate = -1.0 / half_span
+    out = [f, fxi * rate, fxixi * rate**2, -fxi * rate / np.where(cylinder, s, 1.0)]
+    xi_cap = (2.0 * np.abs(c) - 1.0 - join) / (1.0 - join)
+    for element, on, sign in ((0, north, 1.0), (2, ~(north | cylinder), -1.0)):
+        f, fxi, fxixi = derivatives(element, xi_cap)
+        rate = 2.0 * sign / (1.0 - join)
+        fx, fxx = fxi * rate, fxixi * rate**2
+        for target, part in zip(out, (f, -s * fx, s * s * fxx - c * fx, fx)):
+            target[..., on] = part[..., on]
+    return tuple(out)
+
+
+def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> dict:
+    """Shape, stretches and principal curvatures (module docstring) for the rows X = (u, P) on ``theta`` of a
+    scene of reference ``geometry`` (a sphere, a spheroid, a capsule on its piecewise basis).
+
+    Keys lam1, lam2, rho, eta, drho, deta (θ-derivatives), speed (s'), k_meridian, k_parallel,
+    gaussian_curvature (κ), radius (the reference R); each array has shape (n_points, len(theta)).
+    """
+    a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
+    c, s = np.cos(theta), np.sin(theta)
+    if disc.joins:
+        lam2, dlam2, d2lam2, _ = _element_derivatives(a.T, c, s, disc.joins[-1])
+        eta, deta, d2eta, deta_dx = _element_derivatives(b.T, c, s, disc.joins[-1])
+    else:
+        lam2, dlam2, d2lam2, _ = _legendre_derivatives(a, c, s, disc.mapping)
+        eta, deta, d2eta, deta_dx = _legendre_derivatives(b, c, s, disc.mapping)
+    radius, radius_rate = hoop(geometry, c, s), hoop_rate(geometry, c, s)
+    rho = lam2 * radius
+    drho = dlam2 * radius + lam2 * radius_rate
+    d2rho = d2lam2 * radius + 2 * dlam2 * radius_rate + lam2 * hoop_acceleration(geometry, c, s)
     speed = np.hypot(drho, deta)
     k_meridian = -(drho * d2eta - d2rho * deta) / speed**3
-    k_parallel = deta_dx / (lam2 * speed)
+    # sin θ/R, its limit 1/|R'| at a pole (R = 0): −η'/ρ = (dη/dx)(sin θ/R)/λ2 without 0/0
+    ratio = np.divide(s, radius, out=1.0 / np.maximum(np.abs(radius_rate), 1e-300), where=radius > 0)
+    k_parallel = deta_dx * ratio / (lam2 * speed)
     return {
         "lam1": speed / metric(geometry, c, s), "lam2": lam2, "rho": rho, "eta": eta, "drho": drho, "deta": deta,
         "speed": speed,
         "k_meridian": k_meridian, "k_parallel": k_parallel,
         "gaussian_curvature": k_meridian * k_parallel,
+        "radius": np.broadcast_to(radius, lam2.shape),
     }
 
 
@@ -114,11 +144,11 @@ def surface_field(coils, geometry: dict) -> dict:
     }
 
 
-def paper_magnetic_stresses(M: float, chi: float, theta, lam2, field: dict):
+def paper_magnetic_stresses(M: float, chi: float, radius, lam2, field: dict):
     """The paper's magnetic additions to (σ_θ, σ_φ) (its Cauchy stress section), taken as written:
 
-    Δσ_θ = (1 + χ) M H_θ² − ½ M H²,    Δσ_φ = ½ λ2 χ M ∂(H²)/∂λ2 − ½ M H²,    ∂(H²)/∂λ2 = sin θ ∂(H²)/∂ρ
-    (at fixed θ, ρ = λ2 sin θ). Its factors are not consistent with the energy of MODEL.md §2 (the paper
+    Δσ_θ = (1 + χ) M H_θ² − ½ M H²,    Δσ_φ = ½ λ2 χ M ∂(H²)/∂λ2 − ½ M H²,    ∂(H²)/∂λ2 = R ∂(H²)/∂ρ
+    (at fixed θ, ρ = λ2 R, R the reference hoop radius ``radius``: sin θ on a sphere). Its factors are not consistent with the energy of MODEL.md §2 (the paper
     switches between ½ χ M H² and χ M H², and calls these stresses nondimensional "with shear modulus μ" while
     its moduli are in units of μ/2), so the terms are reported on their own, next to the elastic stresses,
     never added to them.
@@ -126,7 +156,7 @@ def paper_magnetic_stresses(M: float, chi: float, theta, lam2, field: dict):
     half = 0.5 * M * field["H2"]
     return (
         (1.0 + chi) * M * field["H_theta"] ** 2 - half,
-        0.5 * lam2 * chi * M * np.sin(theta) * field["dH2_drho"] - half,
+        0.5 * lam2 * chi * M * radius * field["dH2_drho"] - half,
     )
 
 
@@ -153,7 +183,7 @@ def quantities(scene, disc: Discretisation, X, theta, M: float | None = None, ch
     geometry = surface(disc, X, theta, scene.geometry)
     field = surface_field(coaxial_table(scene.field.coils), geometry)
     sigma_theta, sigma_phi = elastic_stresses(scene.material, geometry["lam1"], geometry["lam2"])
-    extra_theta, extra_phi = paper_magnetic_stresses(M, chi, theta, geometry["lam2"], field)
+    extra_theta, extra_phi = paper_magnetic_stresses(M, chi, geometry["radius"], geometry["lam2"], field)
     return {
         "theta": theta,
         "pressure": X[:, -1],
