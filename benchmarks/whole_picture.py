@@ -2,7 +2,9 @@
 
 For each scene (spom1, spom1_two_coils_M0.002, spom1_paper_coil, and the off-equator coil of
 tests/data/off_equator.toml) one fresh process per install runs ``analysis.picture.analyse`` on it twice (the first
-loads the numba kernels) and reports the second's wall time (what a user waits for: the points of a branch are
+loads the numba kernels; with ``--first`` once: a user's ``run`` with the kernels compiled, the cached kernels loaded
+and every basis, plan and table built for the first time, where a second run finds the first's bases in their
+caches) and reports the measured run's wall time (what a user waits for: the points of a branch are
 assessed on every core, ``numerics.workers``), its CPU time (this process and its workers) and per phase the CPU
 seconds of this process (BLAS is single-threaded, so on a shared machine it is the steady number; a phase whose
 points went to workers shows only its share here), each phase measured by wrapping the functions ``analyse`` calls
@@ -20,6 +22,7 @@ against itself with another setting).
 
     python benchmarks/whole_picture.py --python /path/to/main/venv/bin/python --python python
     python benchmarks/whole_picture.py --python python --python python::stability.basis=mapped
+    BALLOON_CG_WORKERS=1 python benchmarks/whole_picture.py --first --python /main/venv/bin/python --python python
 """
 import argparse
 import json
@@ -67,7 +70,8 @@ def cpu():
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
-picture.analyse(scene)
+if not json.loads(sys.argv[3]):
+    picture.analyse(scene)
 seconds.clear()
 start, used = time.perf_counter(), cpu()
 found = picture.analyse(scene)
@@ -77,13 +81,14 @@ print(json.dumps({"wall": wall, "total": total, "phases": seconds,
 """
 
 
-def measure(python: str, scene: str) -> dict:
-    """One fresh process of ``python`` (``PYTHON::KEY=VALUE,...``: with those scene keys set) on ``scene``."""
+def measure(python: str, scene: str, first: bool = False) -> dict:
+    """One fresh process of ``python`` (``PYTHON::KEY=VALUE,...``: with those scene keys set) on ``scene``; ``first``:
+    its first analyse measured (module docstring)."""
     python, _, settings = python.partition("::")
     overrides = {key: _value(value) for key, value in (item.split("=", 1) for item in settings.split(",") if item)}
     path = PATHS.get(scene, ROOT / "scenes" / f"{scene}.toml")
-    out = subprocess.run([python, "-c", MEASURE, str(path), json.dumps(overrides)], capture_output=True,
-                         text=True, check=True, cwd=ROOT.parent)
+    out = subprocess.run([python, "-c", MEASURE, str(path), json.dumps(overrides), json.dumps(first)],
+                         capture_output=True, text=True, check=True, cwd=ROOT.parent)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -99,15 +104,16 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--python", action="append", help="an interpreter with balloon-cg installed (repeatable)")
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), help="default: %(default)s")
+    parser.add_argument("--first", action="store_true", help="measure each process' first analyse, not its second")
     args = parser.parse_args(argv)
     pythons = args.python or [sys.executable]
     results = {python: {} for python in pythons}
     for scene in args.scenes:
         for python in pythons:
-            results[python][scene] = measure(python, scene)
+            results[python][scene] = measure(python, scene, args.first)
     for python, found in results.items():
-        print(f"\n{python} (the second analyse in a fresh process: wall s, CPU s with its workers, per phase CPU s "
-              "of this process)")
+        print(f"\n{python} (the {'first' if args.first else 'second'} analyse in a fresh process: wall s, CPU s with "
+              "its workers, per phase CPU s of this process)")
         print(f"  {'scene':<24}{'wall':>9}{'CPU':>9}" + "".join(f"{p:>18}" for p in PHASES))
         for scene, r in found.items():
             print(f"  {scene:<24}{r['wall']:9.2f}{r['total']:9.2f}"

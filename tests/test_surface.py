@@ -78,6 +78,28 @@ def test_hessian_is_the_derivative_of_the_residual_and_the_residual_of_the_energ
     assert np.abs(H - H.T).max() <= 1e-12 * np.abs(H).max()
 
 
+@pytest.mark.parametrize("symmetry, characters, n_phi", [((), (), 0), ((MIRROR_Y, EQUATOR), (-1, 1), 0),
+                                                         ((MIRROR_Y,), (1,), 7), ((HALF_TURN,), (-1,), 6)])
+def test_the_gather_plan_is_the_discrete_phi_sum_of_every_block_pair(symmetry, characters, n_phi):
+    """The plan the Hessian contracts (product-to-sum on the φ-Fourier table) against the sum over the φ-nodes itself,
+    Σ_k W_j f_jk p^e_b(φ_k) p^e'_b'(φ_k), for every block pair and φ-type pair, with N_φ at the basis' default and
+    below 2M (frequencies m + m' alias mod N_φ)."""
+    basis = SphericalBasis(6, symmetry, characters, n_phi=n_phi, order=4 if n_phi else -1)
+    f = np.random.default_rng(3).standard_normal((basis.n_theta, basis.n_phi))
+    fourier = basis.fourier_table(f)[0]  # (n_theta, 2 N_φ)
+    phis, weights = basis.tables["phi"], basis.nodes["weights"]
+    components = basis.tables["components"]
+    for c in range(3):
+        for c2 in range(3):
+            i1, i2, a1, a2 = basis._products[c, c2]
+            rows, cols = components[c]["blocks"], components[c2]["blocks"]
+            for e in (0, 1):
+                for e2 in (0, 1):
+                    direct = np.einsum("jk,bk,ck->jbc", weights[:, None] * f, phis[rows, e], phis[cols, e2])
+                    gathered = (a1[e, e2] * fourier[:, i1[e, e2]] + a2[e, e2] * fourier[:, i2[e, e2]])
+                    assert np.abs(gathered - direct).max() <= 1e-13 * np.abs(direct).max()
+
+
 def test_sphere_spectrum_is_the_union_of_the_azimuthal_blocks(spom1):
     """MODEL.md §8 check: at a sphere state (M = 0) the 2D Hessian in the mirror sector y → −y (the cos mφ family of
     every m: no torsion) has the eigenvalues of the axisymmetric m = 0 Hessian and of the m = 1..L blocks of

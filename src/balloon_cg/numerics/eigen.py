@@ -111,8 +111,7 @@ def _reflect_rows(directions, rcond, rows):
     W = rows.copy()
     for r in range(D.shape[0]):
         n = D.shape[1]
-        v = D[r].copy()
-        v[0] += 1.0 if v[0] >= 0.0 else -1.0
+        v = _householder(D[r])
         w = 2.0 / _dot(v, v)
         rest = np.empty((D.shape[0], n - 1))
         for s in range(r + 1, D.shape[0]):
@@ -418,31 +417,49 @@ def _reflect_out(A, directions, rcond):
 
 @njit(cache=True)
 def _reflect(B, directions, rcond):
-    """The symmetric B (owned) on the orthogonal complement of the rows of ``directions``: each orthonormal
-    direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two update), then the
-    first row and column dropped (and the first coordinate of the remaining directions)."""
+    """The symmetric B (owned, overwritten) on the orthogonal complement of the rows of ``directions``: each
+    orthonormal direction d removed by the Householder reflection Q = I − w v vᵀ with Q d = ∓e₁ (a rank-two update
+    B ← B − w(v (Bv)ᵀ + (Bv) vᵀ) + w²(vᵀBv) v vᵀ), then the first row and column dropped (and the first coordinate
+    of the remaining directions). In place: the k-th reduced matrix is B[k:, k:], updated in one pass that also
+    forms the next B v (each entry and sum as a fresh matrix per direction would give them)."""
     n = B.shape[0]
     D = _orthonormal_rows(directions, rcond)
-    for r in range(D.shape[0]):
-        v = D[r].copy()
-        v[0] += 1.0 if v[0] >= 0.0 else -1.0
+    k = D.shape[0]
+    if k == 0:
+        return B
+    v = _householder(D[0])
+    Bv = np.zeros(n)
+    for i in range(n):
+        for j in range(n):
+            Bv[i] += B[i, j] * v[j]
+    for r in range(k):
+        o, size = r, n - r  # the current matrix is B[o:, o:]
         w = 2.0 / _dot(v, v)
-        Bv = np.zeros(n)
-        for i in range(n):
-            for j in range(n):
-                Bv[i] += B[i, j] * v[j]
         c = w * w * _dot(v, Bv)
-        C = np.empty((n - 1, n - 1))
-        for i in range(1, n):
-            for j in range(1, n):
-                C[i - 1, j - 1] = B[i, j] - w * (v[i] * Bv[j] + Bv[i] * v[j]) + c * v[i] * v[j]
-        rest = np.empty((D.shape[0], n - 1))
+        rest = np.empty((D.shape[0], size - 1))
         for s in range(r + 1, D.shape[0]):
             projected = _dot(D[s], v)
-            for i in range(1, n):
+            for i in range(1, size):
                 rest[s, i - 1] = D[s, i] - w * v[i] * projected
-        B, D, n = C, rest, n - 1
-    return B
+        following = r + 1 < k
+        v_next = _householder(rest[r + 1]) if following else np.zeros(0)
+        Bv_next = np.zeros(size - 1)
+        for i in range(1, size):
+            for j in range(1, size):
+                value = B[o + i, o + j] - w * (v[i] * Bv[j] + Bv[i] * v[j]) + c * v[i] * v[j]
+                B[o + i, o + j] = value
+                if following:
+                    Bv_next[i - 1] += value * v_next[j - 1]
+        D, v, Bv = rest, v_next, Bv_next
+    return np.ascontiguousarray(B[k:, k:])
+
+
+@njit(cache=True)
+def _householder(d):
+    """v = d ± e₁ (the sign of d₀): Q = I − 2 v vᵀ/vᵀv maps the unit d to ∓e₁."""
+    v = d.copy()
+    v[0] += 1.0 if v[0] >= 0.0 else -1.0
+    return v
 
 
 @njit(cache=True)

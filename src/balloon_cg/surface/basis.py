@@ -114,17 +114,8 @@ class SphericalBasis:
             put(self, "n_theta", (3 * (self.degree + 1) + 1) // 2 + 2)
         if not self.n_phi:
             put(self, "n_phi", 2 * ((3 * (self.order + 1) + 1) // 2 + 2))
-        blocks, offset = [], 0
-        for c in range(3):
-            for m in range(self.order + 1):
-                for t in (COS,) if m == 0 else (COS, SIN):
-                    degrees = tuple(l for l in range(m, self.degree + 1)
-                                    if all(S[c] * _sign_under(S, l, m, t) == chi
-                                           for S, chi in zip(self.symmetry, self.characters)))
-                    if degrees:
-                        blocks.append(Block(c, m, t, degrees, offset))
-                        offset += len(degrees)
-        put(self, "blocks", tuple(blocks))
+        symmetry = tuple(map(tuple, self.symmetry))
+        put(self, "blocks", _blocks(self.degree, self.order, symmetry, tuple(self.characters)))
 
     @property
     def size(self) -> int:
@@ -140,7 +131,8 @@ class SphericalBasis:
     def sectors(self) -> list:
         """The bases of every choice of characters for this basis' reflections (same degree and nodes): their
         spaces together are the whole space, and a Hessian at a state of the invariant subspace is block-diagonal
-        in them. Built once per basis (their tables are reused)."""
+        in them; the sector of this basis' own characters is this basis (its tables and products serve both). Built
+        once per basis (their tables are reused)."""
         return _sectors(self)
 
     @cached_property
@@ -233,48 +225,26 @@ class SphericalBasis:
     def _products(self) -> dict:
         """Gather plan of T from the φ-Fourier table of a node function: for component pair (c, c') the arrays
         (i1, i2, α1, α2), each (2, 2, n_b, n_b') by φ-types (e, e'), with T[j, b, b'] = α1 F[j, i1] + α2 F[j, i2],
-        F = [C_0 … C_{N−1}, S_0 … S_{N−1}], C_q = Σ_k f_k cos qφ_k, S_q = Σ_k f_k sin qφ_k."""
+        F = [C_0 … C_{N−1}, S_0 … S_{N−1}], C_q = Σ_k f_k cos qφ_k, S_q = Σ_k f_k sin qφ_k: for p^e_b ∝ cos aφ or
+        sin aφ and p^{e'}_{b'} ∝ cos bφ or sin bφ, with s = (a + b) mod N and r = |a − b| mod N, cos cos: ½(C_r + C_s),
+        sin sin: ½(C_r − C_s), cos sin: ½(S_s − sgn(a − b) S_r), sin cos: ½(S_s + sgn(a − b) S_r) (times the
+        normalisations and signs of the p), every block pair at once."""
         n = self.n_phi
-        amplitude = np.array([[_norm(b.m), _norm(b.m) if b.m else 0.0] for b in self.blocks])
+        m = np.array([b.m for b in self.blocks])
+        t = np.array([b.t for b in self.blocks])
+        amplitude = np.array([[_norm(b.m), _norm(b.m) if b.m else 0.0] for b in self.blocks]).T  # (e, block)
+        kind = np.array([t, np.where(t == COS, SIN, COS)])  # COS or SIN of p^e (e = 0: τ, e = 1: ∂φτ/m), (e, block)
+        sign = np.array([np.ones(t.size), np.where(t == COS, -1.0, 1.0)])
         plans = {}
         for c in range(3):
             rows = self.tables["components"][c]["blocks"]
             for c2 in range(3):
                 cols = self.tables["components"][c2]["blocks"]
-                parts = [[self._plan(rows, cols, e, e2, amplitude, n) for e2 in (0, 1)] for e in (0, 1)]
-                plans[c, c2] = tuple(read_only(np.ascontiguousarray(np.array([[p[k] for p in row] for row in parts])))
-                                     for k in range(4))
+                plans[c, c2] = tuple(read_only(np.ascontiguousarray(part))
+                                     for part in _gather_plan(m[rows], m[cols], kind[:, rows], kind[:, cols],
+                                                              amplitude[:, rows], amplitude[:, cols],
+                                                              sign[:, rows], sign[:, cols], n))
         return plans
-
-    def _plan(self, rows, cols, e, e2, amplitude, n):
-        """(i1, i2, α1, α2) of one (rows, cols, e, e') gather (see _products)."""
-        shape = (len(rows), len(cols))
-        i1, i2 = np.zeros(shape, np.int64), np.zeros(shape, np.int64)
-        a1, a2 = np.zeros(shape), np.zeros(shape)
-        for r, i in enumerate(rows):
-            bi = self.blocks[i]
-            kind_i, sign_i = self._kind(bi, e)
-            for q, k in enumerate(cols):
-                bk = self.blocks[k]
-                kind_k, sign_k = self._kind(bk, e2)
-                scale = 0.5 * amplitude[i, e] * amplitude[k, e2] * sign_i * sign_k
-                a, b = bi.m, bk.m
-                plus, minus = (a + b) % n, abs(a - b) % n
-                if kind_i == COS and kind_k == COS:
-                    i1[r, q], a1[r, q], i2[r, q], a2[r, q] = minus, scale, plus, scale
-                elif kind_i == SIN and kind_k == SIN:
-                    i1[r, q], a1[r, q], i2[r, q], a2[r, q] = minus, scale, plus, -scale
-                else:  # cos a sin b = ½[sin(a + b) − sin(a − b)], sin a cos b = ½[sin(a + b) + sin(a − b)]
-                    sign = np.sign(a - b) * (-1.0 if kind_i == COS else 1.0)
-                    i1[r, q], a1[r, q], i2[r, q], a2[r, q] = n + plus, scale, n + minus, scale * sign
-        return i1, i2, a1, a2
-
-    @staticmethod
-    def _kind(block: Block, e: int) -> tuple:
-        """(COS or SIN, sign) of the φ-function p^e of ``block``: τ for e = 0, ∂φτ/m for e = 1."""
-        if e == 0:
-            return block.t, 1.0
-        return (SIN, -1.0) if block.t == COS else (COS, 1.0)
 
     # ---- fields ------------------------------------------------------------------------------------------------
 
@@ -395,7 +365,26 @@ def _sectors(basis: SphericalBasis) -> list:
     if not basis.symmetry:
         return [basis]
     signs = np.array(np.meshgrid(*[(1, -1)] * len(basis.symmetry), indexing="ij")).reshape(len(basis.symmetry), -1)
-    return [replace(basis, characters=tuple(int(s) for s in column)) for column in signs.T]
+    characters = [tuple(int(s) for s in column) for column in signs.T]
+    return [basis if chi == basis.characters else replace(basis, characters=chi) for chi in characters]
+
+
+@functools.lru_cache(maxsize=64)
+def _blocks(degree: int, order: int, symmetry: tuple, characters: tuple) -> tuple:
+    """The Blocks of every (component, order m ≤ ``order``, φ-type) whose degrees l ≤ ``degree`` keep the reflections
+    with their characters, s_c σ_S(l, m, t) = χ_S, in order (shared by the bases of every map and node count)."""
+    blocks, offset = [], 0
+    for c in range(3):
+        for m in range(order + 1):
+            for t in (COS,) if m == 0 else (COS, SIN):
+                # l enters σ_S only through (−1)^(l+m): the degrees kept are all, none, or those of one parity
+                kept = [all(S[c] * _sign_under(S, l, m, t) == chi for S, chi in zip(symmetry, characters))
+                        for l in (m, m + 1)]
+                degrees = tuple(l for l in range(m, degree + 1) if kept[(l - m) % 2])
+                if degrees:
+                    blocks.append(Block(c, m, t, degrees, offset))
+                    offset += len(degrees)
+    return tuple(blocks)
 
 
 @functools.lru_cache(maxsize=256)
@@ -404,6 +393,23 @@ def _legendre_pair(points: bytes, degree: int, m: int) -> tuple:
     components, two φ-types, every symmetry sector) share them."""
     x = np.frombuffer(points)
     return read_only(legendre_values(x, degree, m)), read_only(theta_derivative(x, degree, m))
+
+
+def _gather_plan(a, b, kind_a, kind_b, amp_a, amp_b, sign_a, sign_b, n: int) -> tuple:
+    """(i1, i2, α1, α2) of ``SphericalBasis._products`` for row blocks of orders ``a`` and column blocks of orders
+    ``b``, each (2, 2, n_a, n_b) by φ-types (e, e'): ``kind``, ``amp``, ``sign`` per (e, block) the COS or SIN, the
+    normalisation and the sign of p^e."""
+    a, b = a[:, None], b[None, :]
+    plus, minus = (a + b) % n, np.abs(a - b) % n
+    rows, cols = (slice(None), None, slice(None), None), (None, slice(None), None, slice(None))  # → (e, e', a, b)
+    ki, kk = kind_a[rows], kind_b[cols]
+    scale = 0.5 * amp_a[rows] * amp_b[cols] * sign_a[rows] * sign_b[cols]
+    same = ki == kk
+    i1 = np.where(same, minus, n + plus)
+    i2 = np.where(same, plus, n + minus)
+    mixed = np.sign(a - b) * np.where(ki == COS, -1.0, 1.0)  # cos a sin b = ½[sin(a + b) − sin(a − b)], …
+    a2 = np.where(same, np.where(ki == COS, scale, -scale), scale * mixed)
+    return i1, i2, np.broadcast_to(scale, i1.shape), a2
 
 
 def _norm(m: int) -> float:
