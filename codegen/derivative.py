@@ -9,8 +9,9 @@ the result for unevaluated ``Derivative`` objects: most of the time codegen spen
     node._eval_derivative_n_times(x, 1)     otherwise (the node's own rule: sum, product, chain rule),
 
 memoised per (node, x) for the duration, which is what ``Derivative`` returns for it; a node without a rule or
-whose rule leaves an unevaluated ``Derivative`` (or none) and every other call (several symbols, keyword arguments) go to SymPy's
-``diff`` as before. The kernels are byte for byte those of plain SymPy (tests/test_codegen.py: staleness).
+whose rule leaves an unevaluated ``Derivative`` (or none), and every other call (several symbols, keyword
+arguments) go to SymPy's ``diff`` as before. The kernels are byte for byte those of plain SymPy
+(tests/test_codegen.py: the staleness test).
 """
 import contextlib
 
