@@ -3,7 +3,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from . import equations, poles
+from . import derivative, equations, poles
 from . import inertia, second_variation, stretch_derivatives, surface
 from .classes import scene_classes
 from .emit import module_text
@@ -34,15 +34,17 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     (if given) receives the seconds spent per stage: 'derive' (equations, poles, second variation), 'lower'
     (CSE), 'print'."""
     start = time.perf_counter()
-    kernels = equations.energy_kernels(cls)
-    # a meridian without poles (a tube) or with joins (a capsule) has its energy kernels only (codegen/meridian.py)
-    if cls.meridian.analytic:
-        kernels += equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
-        # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient
-        # (codegen/second_variation.py)
-        kernels += second_variation.second_variation_kernels(cls)
-    if cls.elastic.energy is not None:
-        kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
+    with derivative.lean():
+        kernels = equations.energy_kernels(cls)
+        # a meridian without poles (a tube) or with joins (a capsule) has its energy kernels only
+        # (codegen/meridian.py)
+        if cls.meridian.analytic:
+            kernels += equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
+            # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient
+            # (codegen/second_variation.py)
+            kernels += second_variation.second_variation_kernels(cls)
+        if cls.elastic.energy is not None:
+            kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
     title = cls.title("Kernels for scene class")
     derived = time.perf_counter()
     lowered = [lower(k) for k in kernels]
@@ -57,7 +59,8 @@ def surface_module(cls: SceneClass, timings: dict | None = None) -> str:
     """Module text of the surface kernels of one scene class (codegen/surface.py), separate from its class
     module; ``timings`` as for ``class_module``."""
     start = time.perf_counter()
-    kernels = surface.surface_kernels(cls)
+    with derivative.lean():
+        kernels = surface.surface_kernels(cls)
     title = cls.title("Surface kernels (MODEL.md §8) for scene class", surface=True)
     derived = time.perf_counter()
     lowered = [lower(k) for k in kernels]

@@ -74,7 +74,7 @@ def at_node(cls: SceneClass, expr):
     expansion = {}
     for term in cls.terms:
         expansion.update(term.expansion(radius))
-    return expr.subs(expansion)
+    return expr.xreplace(expansion)
 
 
 def energy_density(cls: SceneClass, c=cos_theta, s=sin_theta):

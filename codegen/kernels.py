@@ -9,6 +9,7 @@ symbols defined in earlier stages).
 ``convention`` is the calling convention as plain data, emitted into every module (``KERNELS``) so that the
 runtime binds arguments by name and reads output layouts instead of keeping copies of them.
 """
+import functools
 from dataclasses import dataclass, field
 
 import sympy as sp
@@ -73,14 +74,19 @@ class LoweredKernel:
     results: tuple
 
 
+@functools.lru_cache(maxsize=64)
+def lowered_stage(index: int, stage: tuple) -> tuple:
+    """The CSE'd assignments of stage ``index`` (its subexpressions named s{index}_k, then its definitions): the
+    same for every kernel that shares the stage (a class's rhs kernels, its surface kernels), so done once."""
+    replacements, reduced = sp.cse([expr for _, expr in stage], symbols=sp.numbered_symbols(f"s{index}_"))
+    return (*replacements, *zip((sym for sym, _ in stage), reduced))
+
+
 def lower(kernel: Kernel) -> LoweredKernel:
     """Common-subexpression elimination, stage by stage (definitions before uses)."""
     assignments = []
     for index, stage in enumerate(kernel.stages):
-        names = [sym for sym, _ in stage]
-        replacements, reduced = sp.cse([expr for _, expr in stage], symbols=sp.numbered_symbols(f"s{index}_"))
-        assignments.extend(replacements)
-        assignments.extend(zip(names, reduced))
+        assignments.extend(lowered_stage(index, stage))
     replacements, results = sp.cse(list(kernel.outputs), symbols=sp.numbered_symbols("t"))
     assignments.extend(replacements)
     return LoweredKernel(kernel, tuple(assignments), tuple(results))

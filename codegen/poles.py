@@ -84,11 +84,11 @@ def pole_kernel(cls: SceneClass) -> Kernel:
     for term in derived:
         if term not in cls.terms:
             off.update(term.off())
+    phis = {_phi_symbol(i, j): sp.diff(energy, l1, i, l2, j).subs({l1: lam0, l2: lam0})
+            for i in range(_TAYLOR_ORDER + 1) for j in range(_TAYLOR_ORDER + 1 - i)}  # the same at both poles
     outputs = []
     for pole in ("north", "south"):
         c2_value, e2_value, _, _ = pole_coefficients(pole, derived, cls.meridian)
-        phis = {_phi_symbol(i, j): sp.diff(energy, l1, i, l2, j).subs({l1: lam0, l2: lam0})
-                for i in range(_TAYLOR_ORDER + 1) for j in range(_TAYLOR_ORDER + 1 - i)}
         subs = {**phis, c0: lam0}
         for term in cls.terms:
             subs.update(term.pole_values(pole[0].upper()))

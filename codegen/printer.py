@@ -1,4 +1,6 @@
 """Numba-flavoured Python printer: integer powers become products, half powers become ``math.sqrt``."""
+import functools
+
 from sympy.printing.pycode import PythonCodePrinter
 import sympy as sp
 
@@ -45,5 +47,7 @@ class NumbaPrinter(PythonCodePrinter):
         return f"{int(expr)}.0" if abs(int(expr)) < 2**53 else repr(float(expr))
 
 
+@functools.lru_cache(maxsize=4096)
 def print_expr(expr) -> str:
+    """The expression's text (memoised: kernels that share a stage print its assignments once)."""
     return NumbaPrinter({"fully_qualified_modules": True, "standard": "python3"}).doprint(expr)

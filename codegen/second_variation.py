@@ -109,6 +109,7 @@ def second_order_density(cls: SceneClass):
     return phi_average(elastic) * metric + sum(term.second_order(x, x_t, x_p, metric) for term in cls.terms)
 
 
+@functools.cache
 def material_stage(cls: SceneClass):
     """(p1, p2, p11, p12, p22) = derivatives of φ̂(e1, e2) = Φ(√e1, √e2) at (λ1², λ2²), as functions of (λ1, λ2)."""
     e1, e2 = sp.symbols("e1 e2", positive=True)

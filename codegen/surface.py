@@ -92,7 +92,7 @@ def at_node(cls: fn.SceneClass, expr, normal_sq, invariant):
     expansion = {_I0: invariant, _J0: sp.sqrt(normal_sq)}
     for term in cls.terms:
         expansion.update(term.surface_expansion(STATE[:3]))
-    return expr.subs(expansion).xreplace({normal_sq: inv_J**2})
+    return expr.xreplace(expansion).xreplace({normal_sq: inv_J**2})
 
 
 def _total(expr, wrt):

@@ -35,6 +35,27 @@ def test_integer_powers_print_as_products():
     assert print_expr(x**-2) == "(1.0/(x*x))"
 
 
+@pytest.mark.parametrize("expr", ["(x + y)**3*sin(x*y)", "Piecewise((x**2, x > 0), (exp(x), True))", "f(x)*x", "Abs(x)*y",
+                                  "sqrt(x**2 + y**2)**(13/10)*log(x)"])
+def test_lean_derivatives_are_sympys(expr):
+    """Inside derivative.lean() a derivative is SymPy's expression, node for node (the same tree, not only the same
+    function: the emitted text depends on it), also where a node's rule leaves a Derivative (f(x)) or several
+    symbols are asked; leaving it restores SymPy's diff."""
+    from sympy.core.expr import Expr
+
+    from codegen import derivative
+
+    x, y = sp.symbols("x y", real=True)
+    e = sp.sympify(expr, locals={"x": x, "y": y, "f": sp.Function("f")})
+    plain = (e.diff(x), e.diff(y), sp.diff(e, x, 2), sp.diff(e, x, y))
+    diff = Expr.diff
+    with derivative.lean():
+        assert Expr.diff is not diff
+        lean = (e.diff(x), e.diff(y), sp.diff(e, x, 2), sp.diff(e, x, y))
+    assert Expr.diff is diff
+    assert [sp.srepr(d) for d in lean] == [sp.srepr(d) for d in plain]
+
+
 @pytest.mark.parametrize("name", ["ogden_spom1", "ogden_tpom2_field", "ogden_general_field"])
 def test_generated_gradient_matches_sympy(name):
     """The emitted energy_gradient equals SymPy's derivative of the functional at a random state."""
