@@ -620,7 +620,8 @@ SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int
 OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage", "M")}  # absent in older formats
 CONDITIONAL_COLUMNS = ("voltage", "M")  # written where electric, on a continuation in M
 WRITTEN_BRANCH = {"order": "int", "m": "int", "assessed": "bool", "origin": "str", "gauge": "str", "electric": "bool",
-                  "voltage": "float", "parameter": "str"}  # required in a file with checksums (older: optional)
+                  "voltage": "float", "parameter": "str", "joins": "float[]"}
+#                 required in a file with checksums (older: optional)
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}

@@ -70,9 +70,9 @@ class AzimuthalBasis:
         if n < m:
             raise ValueError(f"degree = {n}: must be ≥ m = {m}")
         nodes, weights = gauss_rule(self.quadrature)
-        x = nodes if self.mapping is None else self.mapping.x(nodes)
-        if self.mapping is not None:
-            weights = weights / self.mapping.ds_dx(x)  # dx = ds/h'
+        # owned, writable arrays either way: numba compiles its loops again for a read-only argument
+        x = nodes.copy() if self.mapping is None else self.mapping.x(nodes)
+        weights = weights.copy() if self.mapping is None else weights / self.mapping.ds_dx(x)  # dx = ds/h'
         put = object.__setattr__
         put(self, "x", x)
         put(self, "weights", weights)
