@@ -620,8 +620,7 @@ SPECIAL_COLUMNS = {**{name: ("str", 1) for name in SPECIAL_TEXT}, "index": ("int
 OPTIONAL_COLUMNS = {name: ("float", 1) for name in ("volume", "amount", "voltage", "M")}  # absent in older formats
 CONDITIONAL_COLUMNS = ("voltage", "M")  # written where electric, on a continuation in M
 WRITTEN_BRANCH = {"order": "int", "m": "int", "assessed": "bool", "origin": "str", "gauge": "str", "electric": "bool",
-                  "voltage": "float", "parameter": "str", "joins": "float[]"}
-#                 required in a file with checksums (older: optional)
+                  "voltage": "float", "parameter": "str"}  # required in a file with checksums (older: optional)
 PARENT_KINDS = {"parent_branch": "str", "parent_branch_point": "int"}
 SNAP_COLUMNS = {"from_branch": ("str", 1), "to_branch": ("str", 1), "from_index": ("int", 1),
                 "to_index": ("int", 1), "pressure": ("float", 1)}
@@ -692,6 +691,8 @@ def check_branch(group, where, error, written: bool = False) -> None:
         raise error(where, "is not a group")
     # gauge: since issue 27; joins: since a capsule's piecewise basis (absent: the Legendre basis)
     require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str", "joins": "float[]"}, error)
+    if written:  # an axisymmetric branch's basis, written by this version: its joins (none: the Legendre basis)
+        require_attrs(group.attrs, where, ("joins",), {"joins": "float[]"}, error)
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)
