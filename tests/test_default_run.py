@@ -1,5 +1,6 @@
-"""The default run's scenes at once (app/default_run.py): each but the last in a child process beside this one. What
-a child prints and what it says failed reach the run's output and exit code; a child that dies is a failure."""
+"""The default run's scenes at once (app/default_run.py): each but the last in a child process beside this one. A
+child's outcome (its files and what failed, one JSON object) and its stderr reach the run's output and exit code; a
+child that dies without its outcome is a failure."""
 import subprocess
 import sys
 
@@ -17,13 +18,14 @@ def _child(code: str):
 @pytest.fixture
 def last_scene_fails(monkeypatch):
     """The last scene's trace fails (no file), so that only the child's files could be listed."""
-    monkeypatch.setattr(default_run, "run_and_draw", lambda scene, outdir, quick, quiet: (None, f"{scene.name}: x"))
+    monkeypatch.setattr(default_run, "run_and_draw",
+                        lambda scene, outdir, quick, quiet: {"path": None, "images": [], "failure": f"{scene.name}: x"})
 
 
-def test_a_childs_failure_line_and_output_reach_the_run(monkeypatch, tmp_path, capsys, last_scene_fails):
+def test_a_childs_failure_and_output_reach_the_run(monkeypatch, tmp_path, capsys, last_scene_fails):
     monkeypatch.setattr(default_run, "_started", _child(
-        "import sys; print('figure.png'); print('failed: spom1: did not converge', file=sys.stderr); "
-        "print('a warning', file=sys.stderr); sys.exit(1)"))
+        "import json, sys; print('a warning', file=sys.stderr); print(json.dumps({'path': None, 'images': "
+        "['figure.png'], 'failure': 'spom1: did not converge'})); sys.exit(1)"))
     assert default_run.main([str(tmp_path), "--quiet"]) == 1
     out, err = capsys.readouterr()
     assert "figure.png" in out

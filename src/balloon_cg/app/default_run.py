@@ -12,6 +12,7 @@ every leg of the continuation to QUICK_POINTS points (for tests: the results are
 do not change the exit code).
 """
 import argparse
+import json
 import subprocess
 import sys
 import time
@@ -98,29 +99,28 @@ def main(argv=None) -> int:
     outdir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     scenes = default_scenes(QUICK_POINTS if args.quick else None)
-    if args.only:
-        _, failure = run_and_draw(next(s for s in scenes if s.name == args.only), outdir, args.quick, args.quiet)
-        if failure:
-            print(f"failed: {failure}", file=sys.stderr)
-        return 1 if failure else 0
+    if args.only:  # a child's: its outcome as one JSON object on stdout
+        outcome = run_and_draw(next(s for s in scenes if s.name == args.only), outdir, args.quick, args.quiet)
+        print(json.dumps(outcome))
+        return 1 if outcome["failure"] else 0
     *beside, last = scenes
     children = [_started(scene.name, outdir, args.quick) for scene in beside]
     try:
-        path, failure = run_and_draw(last, outdir, args.quick, args.quiet)
-        failed, paths = [], []
-        for child in children:  # their lines after the last scene's: its progress bars stay whole
+        outcomes = [run_and_draw(last, outdir, args.quick, args.quiet)]
+        for child in children:
             out, err = child.communicate()
-            sys.stdout.write(out)
-            paths += [Path(line) for line in out.splitlines() if line.endswith(".h5")]
-            said = [line.removeprefix("failed: ") for line in err.splitlines() if line.startswith("failed: ")]
-            sys.stderr.write("".join(f"{line}\n" for line in err.splitlines() if not line.startswith("failed: ")))
-            failed += said or ([f"{child.args[-1]}: exit {child.returncode}"] if child.returncode else [])
-        failed, paths = failed + ([failure] if failure else []), paths + ([path] if path else [])
+            sys.stderr.write(err)
+            outcomes.insert(-1, _outcome(child, out))
     finally:
         for child in children:
             if child.poll() is None:
                 child.kill()
                 child.wait()
+    for outcome in outcomes:  # the children's after the last scene's progress bars, in the scenes' order
+        for line in ([outcome["path"]] if outcome["path"] else []) + outcome["images"]:
+            print(line)
+    paths = [Path(o["path"]) for o in outcomes if o["path"]]
+    failed = [o["failure"] for o in outcomes if o["failure"]]
     if len(paths) > 1:
         for image in draw_figures(paths, outdir, "all", COMBINED):
             print(image)
@@ -134,22 +134,30 @@ def main(argv=None) -> int:
     return 1 if failed else 0
 
 
-def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool) -> tuple[Path | None, str | None]:
-    """Analyse ``scene`` into outdir/<scene>.h5 and draw its figures (the run file's path and theirs printed): the
-    run file (None when the trace failed) and what failed, or None (a quick run's partial result is no failure)."""
+def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool) -> dict:
+    """Analyse ``scene`` into outdir/<scene>.h5 and draw its figures: {'path': the run file (None when the trace
+    failed), 'images': the figures' paths, 'failure': what failed, or None (a quick run's partial result is none)},
+    plain data (a child's is sent as JSON)."""
     try:
         path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=shown(quiet))
     except ContinuationError as e:
-        return None, f"{scene.name}: {e}"
-    print(path, flush=True)
-    for image in draw_figures([path], outdir, scene.name):
-        print(image, flush=True)
-    return path, f"{scene.name}: {summary_line(found)}" if failing(found) and not quick else None
+        return {"path": None, "images": [], "failure": f"{scene.name}: {e}"}
+    return {"path": str(path), "images": [str(image) for image in draw_figures([path], outdir, scene.name)],
+            "failure": f"{scene.name}: {summary_line(found)}" if failing(found) and not quick else None}
+
+
+def _outcome(child: subprocess.Popen, out: str) -> dict:
+    """A finished child's outcome (``run_and_draw``'s, the last line of its stdout), or, where it died before
+    saying it, a failure naming its scene and exit status."""
+    try:
+        return json.loads(out.splitlines()[-1])
+    except (IndexError, ValueError):
+        return {"path": None, "images": [], "failure": f"{child.args[-1]}: exit {child.returncode}"}
 
 
 def _started(name: str, outdir: Path, quick: bool) -> subprocess.Popen:
     """The default run of scene ``name`` alone, in a child process beside this one (no progress bars: this
-    process draws its own); its stdout and stderr captured."""
+    process draws its own); its stdout (its outcome) and stderr captured."""
     command = [sys.executable, "-m", "balloon_cg.app.default_run", str(outdir), "--quiet"] + (
         ["--quick"] if quick else []) + ["--only", name]
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
