@@ -63,15 +63,50 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     assert summary["branches"]["primary"]["special_points"][0]["kind"] == "LP"
 
 
-def test_plot_draws_pressure_volume_and_profiles(run_file, tmp_path, capsys):
+def test_plot_draws_every_tube_kind(run_file, tmp_path, capsys):
     out = tmp_path / "t.png"
-    assert main(["plot", str(run_file), "--what", "pressure-volume,profiles", "-o", str(out)]) == 0
-    assert (tmp_path / "t_pressure-volume.png").stat().st_size > 10_000
-    assert (tmp_path / "t_profiles.png").stat().st_size > 10_000
+    kinds = ("pressure-volume", "profiles", "front", "stretches")
+    assert main(["plot", str(run_file), "--what", ",".join(kinds), "-o", str(out)]) == 0
+    for kind in kinds:
+        assert (tmp_path / f"t_{kind}.png").stat().st_size > 10_000
     assert main(["plot", str(run_file), "--what", "shapes", "-o", str(tmp_path / "s.png")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].endswith("--what shapes: not drawn for a tube run file; allowed: pressure-volume, profiles")
+    assert err[-1].endswith("--what shapes: not drawn for a tube run file; allowed: " + ", ".join(kinds))
     assert not (tmp_path / "s.png").exists()
+    assert main(["plot", str(run_file), "--what", "front", "--branch", "primary", "-o", str(tmp_path / "f.png")]) == 2
+    assert capsys.readouterr().err.strip().endswith("--what front: the primary branch's profiles are uniform at the "
+                                                     "points drawn (no front)")
+    assert not (tmp_path / "f.png").exists()
+
+
+def test_stretches_of_the_uniform_tube_are_its_radius_and_its_length_ratio(run_file):
+    """On the primary branch (the uniform closed tube) the drawn hoop stretch is the radius ρ and the axial stretch
+    the deformed length over L, η(0) − η(L), both read from the profile (not from its derivative), at every sample."""
+    from balloon_cg.io.tube_file import discretisation
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run = read_tube_run(run_file)
+    fig = tube_figure(run, "stretches", branch="primary", points=[-1])
+    hoop, axial = (line.get_ydata() for line in fig.axes[0].lines)
+    disc, u = discretisation(run["attrs"]), run["branches"]["primary"]["unknowns"][-1]
+    rho, eta = disc.profile(u, np.array([0.0, disc.length]))
+    assert rho[0] > 1.5 and np.abs(hoop - rho[0]).max() < 1e-12
+    assert np.abs(axial - (eta[0] - eta[1]) / disc.length).max() < 1e-12
+
+
+def test_front_moves_away_from_the_bulge_as_it_widens(run_file):
+    """The bulge forms at the branch's end (sliding ends: half a bulge there); past its volume fold the front first
+    steepens (its mid-level crossing draws back a little), then moves away along the axis as V/V0 grows: the drawn
+    position, from its smallest value after the LV on, rises at every point, by more than 0.1 radius here."""
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run = read_tube_run(run_file)
+    b = run["branches"]["bulge"]
+    fold = next(s for s in b["special_points"] if s["kind"] == "LV")
+    after = np.arange(int(fold["index"]) + 1, len(b["volume"]))
+    position = tube_figure(run, "front", points=after).axes[0].lines[0].get_ydata()
+    moving = position[int(np.argmin(position)):]
+    assert after.size > 5 and moving.size > 5 and np.all(np.diff(moving) > 0) and moving[-1] - moving[0] > 0.1
 
 
 def test_pressure_volume_figure_has_the_maxwell_line(run_file):

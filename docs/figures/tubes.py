@@ -4,7 +4,7 @@ The tube: SPOM1, length L = 20 reference radii, sliding closed ends (the repeati
 Its primary branch (the uniform tube) to a hoop stretch of 11.5, past the second Maxwell state, and its bulge branch
 switched at the first odd branch point (the onset) and traced to V/V0 = 420 (tube/primary.py, tube/bulge.py, as
 ``balloon-cg run`` does but with the bulge stopped at a volume), written to a tube run file (io/tube_file.py) and read
-back; the panels (post/tube_plots.py where it draws them, post/tube_measures.py):
+back; the panels are post/tube_plots.py's (``balloon-cg plot --what pressure-volume,profiles,front,stretches``):
 
 (a) P against V/V0, solid where stable under volume control, with Maxwell's line P_M (model/tube.maxwell_pressure);
 (b) the profiles r(Z) of the bulge branch at a few V/V0 (the classic photograph: the bulge forms at the end and its
@@ -34,8 +34,8 @@ from balloon_cg.galerkin.interval import Mirror  # noqa: E402
 from balloon_cg.io.tube_file import discretisation, read_tube_run, write_tube_run  # noqa: E402
 from balloon_cg.model import tube  # noqa: E402
 from balloon_cg.post.style import journal_style  # noqa: E402
-from balloon_cg.post.tube_measures import front, stretches  # noqa: E402
-from balloon_cg.post.tube_plots import matplotlib_colours, pressure_volume, profiles  # noqa: E402
+from balloon_cg.post.tube_measures import front  # noqa: E402
+from balloon_cg.post.tube_plots import front_motion, pressure_volume, profiles, stretch_profiles  # noqa: E402
 from balloon_cg.scene import parse_scene  # noqa: E402
 from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
 from balloon_cg.tube.picture import TubePicture, maxwell  # noqa: E402
@@ -79,10 +79,8 @@ def fronts(run: dict) -> tuple:
 
 
 def draw(run: dict, out: Path) -> None:
-    b, disc = run["branches"]["bulge"], discretisation(run["attrs"])
-    volume = b["volume"]
+    volume = run["branches"]["bulge"]["volume"]
     nearest = lambda targets: [int(np.argmin(np.abs(volume - v))) for v in targets]
-    _, deformed = fronts(run)
     with journal_style():
         fig, axes = plt.subplots(2, 2, figsize=(8.0, 6.4), layout="constrained")
         pressure_volume(axes[0, 0], run, "volume")
@@ -92,25 +90,10 @@ def draw(run: dict, out: Path) -> None:
         axes[0, 0].set_title("(a) P against V/V0 (solid: stable under volume control)")
         profiles(axes[0, 1], run, "bulge", nearest(SHOWN))
         axes[0, 1].set_title("(b) profiles r(Z) of the bulge branch")
-        plateau = volume >= 5.0
-        position, width = (np.array([getattr(f, key) for f in deformed]) for key in ("position", "width"))
-        axes[1, 0].plot(volume[plateau], position[plateau], color="C0")
-        axes[1, 0].set(xlabel="$V/V_0$", title="(c) the front along the deformed axis")
-        axes[1, 0].set_ylabel("position, from the bulge's end", color="C0")
-        widths = axes[1, 0].twinx()
-        widths.plot(volume[plateau], width[plateau], color="C1")
-        widths.set_ylabel("width", color="C1")
-        s = np.linspace(0.0, disc.length, SAMPLES)
-        for colour, i in zip(matplotlib_colours(len(STRETCHED)), nearest(STRETCHED)):
-            u = b["unknowns"][i]
-            axial, hoop = stretches(disc, u, s)
-            z = disc.profile(u, s)[1]
-            z = z[0] - z
-            axes[1, 1].plot(z, hoop, color=colour, label=f"$\\lambda_2$, V/V0 = {volume[i]:.3g}")
-            axes[1, 1].plot(z, axial, color=colour, linestyle="--", label=f"$\\lambda_1$, V/V0 = {volume[i]:.3g}")
-        axes[1, 1].set(xlabel="distance from the bulge's end", ylabel="stretch",
-                       title="(d) hoop (solid) and axial (dashed) stretch")
-        axes[1, 1].legend(fontsize=5)
+        front_motion(axes[1, 0], run, "bulge", np.flatnonzero(volume >= 5.0))
+        axes[1, 0].set_title("(c) the front along the deformed axis")
+        stretch_profiles(axes[1, 1], run, "bulge", nearest(STRETCHED))
+        axes[1, 1].set_title("(d) hoop (solid) and axial (dashed) stretch")
         fig.savefig(out, dpi=130)
     print(f"wrote {out}")
 

@@ -548,7 +548,7 @@ def _add_plot(commands):
     p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
     p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}; of a tube's run file: "
-                        "pressure-volume, profiles")
+                        "pressure-volume, profiles, front, stretches")
     p.add_argument("-o", "--output", help=f"image file, {', '.join(IMAGE_FORMATS)} (default: "
                                           "FIRST_FILE_STEM_KIND.png next to the first file; with several kinds: "
                                           "OUTPUT_STEM_KIND.SUFFIX; an existing file is replaced only with --force)")
@@ -626,7 +626,7 @@ def plot(args) -> int:
 
 
 def _plot_tube(args, outputs: dict) -> int:
-    """``plot`` of a tube run file (post/tube_plots.py): one file, kinds pressure-volume and profiles."""
+    """``plot`` of a tube run file (post/tube_plots.py): one file, post/tube_plots.TUBE_KINDS."""
     from ..io.output import replacing
     from ..io.tube_file import read_tube_run
     from ..post.tube_plots import tube_figure

@@ -1,5 +1,7 @@
-"""What people look at on a tube (a tube run file, io/tube_file.py): P against V/V0 of every branch with Maxwell's
-line (``pressure_volume``), and the family of profiles r(Z) of a branch (``profiles``), in the journal style.
+"""What people look at on a tube (a tube run file, io/tube_file.py), in the journal style: P against V/V0 of every
+branch with Maxwell's line (``pressure_volume``), the family of profiles r(Z) of a branch (``profiles``), the bulge's
+front, its position and width against V/V0 (``front_motion``), and the hoop and axial stretches along the deformed
+axis at a few states (``stretch_profiles``; post/tube_measures.py measures both).
 
 Curves are solid where a point is stable under the chosen control (no negative eigenvalue of ∂R/∂u without, or
 with, δV = 0: the file's ``unstable_pressure``/``unstable_volume``) and dashed where it is not; located points are
@@ -8,11 +10,14 @@ marked and labelled (LP, LV, BP with its mirror block).
 import numpy as np
 
 from .style import JournalFigure, journal_style
+from .tube_measures import front, stretches
 from ..io.tube_file import discretisation
 
-TUBE_KINDS = ("pressure-volume", "profiles")
+TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches")
 CONTROLS = ("pressure", "volume")
 PROFILES = 8  # profiles drawn along a branch unless the points are given
+STRETCHED = 3  # states whose stretches are drawn unless the points are given
+SAMPLES = 4001  # reference arclengths a front or a stretch profile is sampled at
 _COLOURS = {"primary": "k", "bulge": "C0"}
 
 
@@ -32,11 +37,12 @@ def tube_figure(run: dict, what: str, control: str = "pressure", branch: str | N
         ax = fig.add_subplot()
         if what == "pressure-volume":
             pressure_volume(ax, run, control)
-        else:
-            name = branch or ("bulge" if "bulge" in run["branches"] else "primary")
-            if name not in run["branches"]:
-                raise TubePlotError(f"--branch {name}: not in the file; it has {', '.join(run['branches'])}")
-            profiles(ax, run, name, points)
+            return fig
+        name = branch or ("bulge" if "bulge" in run["branches"] else "primary")
+        if name not in run["branches"]:
+            raise TubePlotError(f"--branch {name}: not in the file; it has {', '.join(run['branches'])}")
+        draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles}[what]
+        draw(ax, run, name, points)
     return fig
 
 
@@ -68,19 +74,72 @@ def profiles(ax, run: dict, name: str, points=None) -> None:
     """The profiles r(Z) (ρ against the height η, both over the reference radius) of branch ``name`` at
     ``points`` (indices, negative from the end; default: PROFILES spread along the branch), coloured by V/V0."""
     b = run["branches"][name]
-    disc, n = discretisation(run["attrs"]), len(b["pressure"])
-    chosen = np.unique(np.linspace(0, n - 1, min(PROFILES, n)).round().astype(int)) if points is None else points
+    disc = discretisation(run["attrs"])
+    chosen = _chosen(b, name, points, PROFILES)
     s = np.linspace(0, disc.length, 401)
     colours = matplotlib_colours(len(chosen))
     for colour, i in zip(colours, chosen):
-        if not -n <= i < n:
-            raise TubePlotError(f"--points {i}: branch {name} has points 0..{n - 1}")
         rho, eta = disc.profile(b["unknowns"][i], s)
         ax.plot(eta, rho, color=colour, label=f"{i}: V/V0 = {b['volume'][i]:.3g}, P = {b['pressure'][i]:.4g}")
     ax.set_xlabel("$Z$")
     ax.set_ylabel("$r$")
     ax.set_title(f"{run['attrs']['scene_name']}: profiles of the {name} branch")
     ax.legend(fontsize=5)
+
+
+def front_motion(ax, run: dict, name: str, points=None) -> None:
+    """The front of branch ``name``'s profiles at ``points`` (default: every point with a front) against V/V0: its
+    position along the deformed axis from the branch's end η(0) (left axis) and its width (right axis), as
+    tube_measures.front measures them; a branch whose profiles are all uniform has none (TubePlotError)."""
+    b = run["branches"][name]
+    chosen = _chosen(b, name, points, len(b["pressure"]))
+    disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
+    fronts = []
+    for i in chosen:
+        rho, eta = disc.profile(b["unknowns"][i], s)
+        fronts.append(front(eta[0] - eta, rho))
+    position, width = (np.array([getattr(f, key) for f in fronts]) for key in ("position", "width"))
+    if np.isnan(position).all():
+        raise TubePlotError(f"--what front: the {name} branch's profiles are uniform at the points drawn (no front)")
+    volume = b["volume"][chosen]
+    ax.plot(volume, position, color="C0")
+    ax.set(xlabel="$V/V_0$", title=f"{run['attrs']['scene_name']}: the front of the {name} branch")
+    ax.set_ylabel("position, from the branch's end", color="C0")
+    widths = ax.twinx()
+    widths.plot(volume, width, color="C1")
+    widths.set_ylabel("width", color="C1")
+
+
+def stretch_profiles(ax, run: dict, name: str, points=None) -> None:
+    """The hoop stretch λ2 (solid) and the axial stretch λ1 (dashed) along the deformed axis, from the branch's
+    end η(0), of branch ``name`` at ``points`` (default: STRETCHED spread along the branch), coloured by V/V0."""
+    b = run["branches"][name]
+    disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
+    chosen = _chosen(b, name, points, STRETCHED)
+    for colour, i in zip(matplotlib_colours(len(chosen)), chosen):
+        u = b["unknowns"][i]
+        axial, hoop = stretches(disc, u, s)
+        z = disc.profile(u, s)[1]
+        z = z[0] - z
+        ax.plot(z, hoop, color=colour, label=f"$\\lambda_2$, V/V0 = {b['volume'][i]:.3g}")
+        ax.plot(z, axial, color=colour, linestyle="--", label=f"$\\lambda_1$, V/V0 = {b['volume'][i]:.3g}")
+    ax.set(xlabel="distance from the branch's end", ylabel="stretch",
+           title=f"{run['attrs']['scene_name']}: hoop (solid) and axial (dashed) stretch, {name} branch")
+    ax.legend(fontsize=5)
+
+
+def _chosen(b: dict, name: str, points, count: int) -> np.ndarray:
+    """The point indices of branch ``b`` to draw: ``points`` (checked, negative from the end) or ``count`` spread
+    evenly along it."""
+    n = len(b["pressure"])
+    if points is not None and not len(points):
+        raise TubePlotError(f"--points: none given for branch {name}")
+    if points is None:
+        return np.unique(np.linspace(0, n - 1, min(count, n)).round().astype(int))
+    for i in points:
+        if not -n <= i < n:
+            raise TubePlotError(f"--points {i}: branch {name} has points 0..{n - 1}")
+    return np.asarray(points, dtype=int) % n
 
 
 def matplotlib_colours(count: int) -> list:
