@@ -54,13 +54,23 @@ def test_axial_stretch_errors_name_key_value_and_range():
                             "geometry.axial_stretch = 0.8: must be in [1, 5]"),
                            ('shape = "tube"\nlength = 10\naxial_stretch = 9\n',
                             "geometry.axial_stretch = 9: must be in [1, 5]"),
-                           ('axial_stretch = 1.5\n', 'geometry.axial_stretch = 1.5: only for geometry.shape = "tube"')):
+                           ('axial_stretch = 1.5\n', 'geometry.axial_stretch = 1.5: only for geometry.shape = "tube"'),
+                           ('shape = "tube"\nlength = 10\naxial = "closed"\naxial_stretch = 1.5\n',
+                            'geometry.axial = "closed" with geometry.axial_stretch = 1.5: give one (closed: the ends\' '
+                            "distance free; axial_stretch: the ends held at λL)"),
+                           ('shape = "tube"\nlength = 10\naxial = "held"\n',
+                            'geometry.axial = "held": must be "closed" (the ends\' distance free); ends held apart are '
+                            "written geometry.axial_stretch = λ alone"),
+                           ('axial = "closed"\n', 'geometry.axial = "closed": only for geometry.shape = "tube"')):
         with pytest.raises(SceneError) as error:
             parse_scene(base + table)
         assert str(error.value) == "scene: " + message
     scene = held_scene("SPOM1", 10, 1.5, "plugged", 20)
     assert parse_scene(scene.to_toml()).geometry == scene.geometry and scene.geometry.axial_stretch == 1.5
     assert "held at 1.5 L" in scene.geometry.describe()
+    closed = parse_scene(base + 'shape = "tube"\nlength = 10\naxial = "closed"\n')  # the default spelled out
+    assert closed.geometry == parse_scene(base + 'shape = "tube"\nlength = 10\n').geometry
+    assert closed.geometry.axial_stretch is None
 
 
 def test_sliding_held_tube_has_the_fixed_stretch_maximum_and_minimum():

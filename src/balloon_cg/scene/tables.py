@@ -281,6 +281,7 @@ MAX_VOLTAGE = 10.0  # electric.voltage, continuation.stop_voltage (a sphere's vo
 MAX_STRETCH = 100.0  # continuation.start_stretch, stop_stretch
 MIN_ASPECT, MAX_ASPECT = 0.1, 10.0  # geometry.aspect of a spheroid
 MIN_LENGTH, MAX_LENGTH = 0.1, 1000.0  # geometry.length of a tube (in reference radii)
+CLOSED = "closed"  # geometry.axial's one value: the default, the ends' distance free (axial_stretch left out)
 MIN_AXIAL, MAX_AXIAL = 1.0, 5.0  # geometry.axial_stretch: a tube's ends held at λL (below 1 the membrane would be
 #                                  compressed axially at P = 0)
 MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
@@ -793,13 +794,13 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     """[geometry]: the shape, a spheroid's aspect, a tube's length and ends; the parts of the model that are written
     for the sphere alone (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a
     voltage) refuse other shapes here."""
-    data = table("geometry", data, _keys(Geometry))
+    data = table("geometry", data, _keys(Geometry) + ("axial",))
     raw = data.get("shape")
     raw = Geometry.shape.value if raw is None else raw
     if raw not in tuple(Shape):
         raise SceneError(f"geometry.shape = {show(raw)}: must be one of " + ", ".join(f'"{s.value}"' for s in Shape))
     shape = Shape(raw)
-    for key in ("ends", "axial_stretch"):
+    for key in ("ends", "axial", "axial_stretch"):
         if shape != Shape.TUBE and data.get(key) is not None:
             raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "tube"')
     if shape not in (Shape.TUBE, Shape.CAPSULE) and data.get("length") is not None:
@@ -876,6 +877,7 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
         raise SceneError(f"geometry.ends = {show(raw)}: must be one of " + ", ".join(f'"{e.value}"' for e in Ends))
     held = _getter(data, "geometry", Geometry)("axial_stretch", lambda x: MIN_AXIAL <= x <= MAX_AXIAL,
                                                 f"in [{MIN_AXIAL:g}, {MAX_AXIAL:g}]")
+    _axial(data.get("axial"), held)
     where = 'geometry.shape = "tube"'
     if field.coils and not field.is_equator_symmetric:
         raise SceneError(f"{where}: the coils around a tube must be coaxial and mirror-symmetric about its middle "
@@ -891,6 +893,19 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
         raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
                          'for now; allowed: "pressure"')
     return Geometry(Shape.TUBE, length=length, ends=Ends(raw), axial_stretch=held)
+
+
+def _axial(raw, held: float | None):
+    """geometry.axial: "closed" (the ends' distance free, the default) spelled out; the ends held apart are
+    written ``axial_stretch = λ`` alone, so the two together are refused, one line."""
+    if raw is None:
+        return
+    if raw != CLOSED:
+        raise SceneError(f'geometry.axial = {show(raw)}: must be "{CLOSED}" (the ends\' distance free); ends held '
+                         "apart are written geometry.axial_stretch = λ alone")
+    if held is not None:
+        raise SceneError(f'geometry.axial = "{CLOSED}" with geometry.axial_stretch = {held:g}: give one (closed: the '
+                         "ends' distance free; axial_stretch: the ends held at λL)")
 
 
 def _parameter(data, electric: Electric | None):
