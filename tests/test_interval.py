@@ -338,7 +338,8 @@ def test_tube_table_errors_name_key_value_and_range(table, message):
     ("[field]\nM = 0.001\n[[field.coils]]\nradius = 0.8\nheight = 3\ncurrent = 1\n[[field.coils]]\nradius = 0.8\n"
      "height = -3\ncurrent = 1\n",
      r"field.coils\[0\]: wire at \(radius 0.8, height 3\) lies on or inside the reference tube"),
-    ("[electric]\nvoltage = 0.1\n", r'geometry.shape = "tube": the \[electric\] term on a tube is not built yet'),
+    ('[electric]\n[continuation]\nparameter = "voltage"\npressure = 0.5\n',
+     r'continuation.parameter = "voltage": a tube is continued in the pressure only for now'),
     ('[loading]\ncontrol = "volume"\n', 'loading.control = "volume": a tube is continued in the pressure only'),
     ("[dynamics]\nfrequencies = true\nmodes = true\n", "dynamics.modes = true: a tube's mode shapes are not stored"),
     ('[[events]]\nquantity = "pressure"\nvalue = 1.2\n', r"events: 1 \[\[events\]\] on a tube, whose branches do not "

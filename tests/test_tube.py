@@ -124,21 +124,30 @@ def bulge_determinant(energy):
                      P: d(theta) / (theta * z)}), k
 
 
+def dispersion_onset(energy, lengths, largest_hoop=4.0):
+    """[(λθ, λz)] at the onset of the mode cos(πS/L) for each L of ``lengths``: N = 0 and ``bulge_determinant`` of
+    ``energy`` at k = π/L, solved at 30 digits from the first sign change + → − on a coarse scan up to
+    ``largest_hoop``."""
+    _, N, axial_of = closed_end_path(energy)
+    det, k = bulge_determinant(energy)
+    onsets = []
+    for length in lengths:
+        det_L = det.subs(k, sp.pi / length)
+        det_of = sp.lambdify((theta, z), det_L)
+        coarse = np.linspace(1.05, largest_hoop, 120)
+        values = [det_of(h, axial_of(h)) for h in coarse]
+        j = next(j for j in range(len(coarse)) if values[j] > 0 >= values[j + 1])
+        with mpmath.workdps(30):
+            onsets.append(sp.nsolve((N, det_L), (theta, z), (coarse[j], axial_of(coarse[j])), prec=30))
+    return onsets
+
+
 @pytest.mark.parametrize("preset", ["neo-Hookean", "SPOM1", "Gent"])
 def test_bulge_onset_solves_the_dispersion_relation(preset):
     """The onset of the mode cos(πS/L) on tubes of length 10 and 40: bulge_onset against N = 0 and the determinant
     of the second variation derived here, solved at 30 digits from a sign change on a coarse scan."""
     energy = symbolic_energy(material(preset))
-    P, N, axial_of = closed_end_path(energy)
-    det, k = bulge_determinant(energy)
-    for length in (10.0, 40.0):
-        det_L = det.subs(k, sp.pi / length)
-        det_of = sp.lambdify((theta, z), det_L)
-        coarse = np.linspace(1.05, 4.0, 120)
-        values = [det_of(h, axial_of(h)) for h in coarse]
-        j = next(j for j in range(len(coarse)) if values[j] > 0 >= values[j + 1])
-        with mpmath.workdps(30):
-            hoop, axial = sp.nsolve((N, det_L), (theta, z), (coarse[j], axial_of(coarse[j])), prec=30)
+    for length, (hoop, axial) in zip((10.0, 40.0), dispersion_onset(energy, (10.0, 40.0))):
         found = bulge_onset(material(preset), length, largest_hoop=3.0)  # Gent's closed-end path ends near λθ = 6
         assert abs(found.hoop - float(hoop)) <= 1e-10 and abs(found.axial - float(axial)) <= 1e-10
 

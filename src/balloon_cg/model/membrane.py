@@ -7,8 +7,16 @@ material (MODEL.md §2) in closed form,
 The sphere closed forms and the elastic stresses of the Ogden presets are written out in numpy
 (model/sphere.py, model/sphere_modes.py, model/stresses.py); for any other energy they use these values,
 computed by the class's ``membrane_derivatives`` kernel (codegen/stretch_derivatives.py).
+
+Under the voltage Φ̄ ([electric]) a dielectric elastomer membrane has the effective energy (``Charged``; MODEL.md §2,
+units μ/2)
+
+    Φ_eff = Φ − Φ̄² λ1² λ2²,   Φ_eff,1 = Φ_1 − 2Φ̄² λ1 λ2²,   Φ_eff,11 = Φ_11 − 2Φ̄² λ2²,   Φ_eff,12 = Φ_12 − 4Φ̄² λ1 λ2,
+
+so that a closed form written for any material's Φ (model/tube.py) holds under a voltage with Φ_eff in its place.
 """
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,10 +31,29 @@ def _kernels(material) -> KernelSet:
     return KernelSet(material)
 
 
+@dataclass(frozen=True)
+class Charged:
+    """The effective energy Φ_eff = Φ − Φ̄² λ1² λ2² of ``material`` under the voltage Φ̄ (module docstring)."""
+
+    material: object
+    voltage: float
+
+
+def scene_energy(scene):
+    """The membrane energy of a scene as the closed forms take it: its material, ``Charged`` under [electric]."""
+    return scene.material if scene.electric is None else Charged(scene.material, scene.electric.voltage)
+
+
 def stretch_derivatives(material, lam1, lam2) -> dict:
-    """{label: array} of Φ, Φ_1, Φ_2, Φ_11, Φ_12, Φ_22 at (λ1, λ2) (broadcast; scalars give 0-d arrays)."""
+    """{label: array} of Φ, Φ_1, Φ_2, Φ_11, Φ_12, Φ_22 at (λ1, λ2) (broadcast; scalars give 0-d arrays); of Φ_eff
+    for a ``Charged`` material."""
     l1, l2 = np.broadcast_arrays(np.asarray(lam1, dtype=float), np.asarray(lam2, dtype=float))
     shape = l1.shape
+    if isinstance(material, Charged):
+        d, v2 = stretch_derivatives(material.material, l1, l2), material.voltage**2
+        return {"phi": d["phi"] - v2 * (l1 * l2) ** 2, "phi_1": d["phi_1"] - 2 * v2 * l1 * l2**2,
+                "phi_2": d["phi_2"] - 2 * v2 * l1**2 * l2, "phi_11": d["phi_11"] - 2 * v2 * l2**2,
+                "phi_12": d["phi_12"] - 4 * v2 * l1 * l2, "phi_22": d["phi_22"] - 2 * v2 * l1**2}
     if not isinstance(material, StrainEnergy):
         return _ogden(material, l1, l2)
     out = _kernels(material).nodes("membrane_derivatives", {"lam1": np.ascontiguousarray(l1.ravel()),

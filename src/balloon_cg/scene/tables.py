@@ -641,9 +641,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric, loading)
-    if geometry.shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
-        raise SceneError('continuation.parameter = "voltage": a capsule is continued in the pressure only for now '
-                         "(its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
+    if geometry.shape in (Shape.CAPSULE, Shape.TUBE) and continuation.parameter == ContinuationParameter.VOLTAGE:
+        raise SceneError(f'continuation.parameter = "voltage": a {geometry.shape.value} is continued in the pressure '
+                         "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
     if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
         raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 second variation is not built yet "
@@ -806,7 +806,7 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     if shape not in (Shape.TUBE, Shape.CAPSULE) and data.get("length") is not None:
         raise SceneError(f'geometry.length = {show(data["length"])}: only for geometry.shape = "tube" or "capsule"')
     if shape == Shape.TUBE:
-        return _tube(data, field, electric, loading)
+        return _tube(data, field, loading)
     if shape == Shape.CAPSULE:
         return _capsule(data, field, electric)
     if shape == Shape.SPHERE:
@@ -851,13 +851,6 @@ def _length(data, shape: Shape, low: float) -> float:
                                                 f"in [{low:g}, {MAX_LENGTH:g}]")
 
 
-def _no_electric(shape: Shape, electric: Electric | None):
-    """[electric] on a tube or a capsule, refused in one line (not built yet)."""
-    if electric is not None:
-        raise SceneError(f'geometry.shape = "{shape.value}": the [electric] term on a {shape.value} is not built yet; '
-                         "leave [electric] out or use another shape")
-
-
 def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
     """A capsule's [geometry] (its cylinder's length, 0 the sphere), its coils (coaxial, outside it) and the parts
     of the model it does not have yet, refused one line each."""
@@ -868,7 +861,7 @@ def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
     return Geometry(Shape.CAPSULE, length=length)
 
 
-def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
+def _tube(data, field: Field, loading: Loading) -> Geometry:
     """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet,
     refused one line each."""
     length = _length(data, Shape.TUBE, MIN_LENGTH)
@@ -888,7 +881,6 @@ def _tube(data, field: Field, electric: Electric | None, loading: Loading) -> Ge
             raise SceneError(f"field.coils[{k}]: wire at (radius {coil.radius:g}, height {coil.height:g}) lies on "
                              f"or inside the reference tube (radius 1, heights within ±length/2 = "
                              f"±{length / 2:g}); the radius must be > 1 there")
-    _no_electric(Shape.TUBE, electric)
     if loading.control != Control.PRESSURE:
         raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
                          'for now; allowed: "pressure"')

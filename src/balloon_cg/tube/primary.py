@@ -75,8 +75,10 @@ def in_field(scene) -> bool:
 
 
 def scene_parameters(scene, pressure: float = 0.0) -> Parameters:
-    """The branch parameters of a tube scene at ``pressure``: the field's M and χ (M = 0 without coils)."""
-    return Parameters(pressure, scene.field.M, scene.field.chi)
+    """The branch parameters of a tube scene at ``pressure``: the field's M and χ (M = 0 without coils) and the
+    voltage Φ̄ of [electric] (0 without)."""
+    voltage = 0.0 if scene.electric is None else scene.electric.voltage
+    return Parameters(pressure, scene.field.M, scene.field.chi, voltage)
 
 
 def held(disc: IntervalDiscretisation, stretch: float | None = None) -> np.ndarray:
@@ -151,15 +153,16 @@ def _start(parameters: ParameterSystem, disc: IntervalDiscretisation, solver) ->
     """X = (u[even block], P = 0) of the tube at P = 0: the unstressed reference (exact) where the ends' distance is
     free; where it is held at λ, the tube stretched to it by natural continuation in the held distance from 1
     (``continuation.natural``); in a field (M > 0), then the field switched on by natural continuation in M from 0
-    (the coils' pull on the tube at P = 0). Each point is solved by Newton on the even rows with P = 0 prescribed.
-    ContinuationError when it does not get there."""
+    (the coils' pull on the tube at P = 0); under a voltage (Φ̄ > 0), then the voltage switched on by natural
+    continuation in Φ̄ from 0 (the wall thinned by it: the tube widens and, with free ends, lengthens). Each point
+    is solved by Newton on the even rows with P = 0 prescribed. ContinuationError when it does not get there."""
     even = disc.block(Mirror.EVEN)
     X = np.append(disc.reference(), 0.0)[np.append(even, disc.size)]
-    field = parameters.params.M
+    field, voltage = parameters.params.M, parameters.params.voltage
 
-    def solve(X, stretch, M=0.0):
-        system = TubeSystem(ParameterSystem(parameters.eq, parameters.params.with_value("M", M), "P"), even,
-                            held(disc, stretch))
+    def solve(X, stretch, M=0.0, charge=0.0):
+        at = parameters.params.with_value("M", M).with_value("voltage", charge)
+        system = TubeSystem(ParameterSystem(parameters.eq, at, "P"), even, held(disc, stretch))
         return newton(system.residual, system.jacobian, X, np.eye(X.size)[-1], 0.0, solver.tol, solver.max_newton)
 
     stretch = disc.axial_stretch if disc.held else 1.0
@@ -173,6 +176,12 @@ def _start(parameters: ParameterSystem, disc: IntervalDiscretisation, solver) ->
         if reached < field:
             raise ContinuationError(f"could not switch the field on at P = 0 beyond M = {reached:.6g} of field.M = "
                                     f"{field:g} ({message})")
+    if voltage > 0:
+        X, reached, message = continuation.natural(lambda X, charge: solve(X, stretch, field, charge), X, 0.0,
+                                                   voltage)
+        if reached < voltage:
+            raise ContinuationError(f"could not switch the voltage on at P = 0 beyond {reached:.6g} of "
+                                    f"electric.voltage = {voltage:g} ({message}): past the tube's pull-in voltage")
     return X
 
 

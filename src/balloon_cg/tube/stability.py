@@ -10,7 +10,7 @@ import numpy as np
 from .results import IntervalStop
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model import meridian
-from ..model.stresses import elastic_stresses
+from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics.continuation import Stop
 from ..numerics.eigen import GramFactor, negative_count, restricted
 from ..scene.loading import Control
@@ -41,12 +41,14 @@ def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray, params: Paramete
 
 
 def smallest_stress(eq: Equilibrium, u: np.ndarray) -> float:
-    """The smallest elastic principal stress (λ1Φ_1, λ2Φ_2: model/stresses.py) over the quadrature nodes of the
-    state u; below COMPRESSED the membrane is compressed somewhere (module docstring)."""
-    disc = eq.disc
+    """The smallest principal stress over the quadrature nodes of the state u: the elastic λ1Φ_1, λ2Φ_2 plus, under a
+    voltage, the dielectric −2Φ̄²λ1²λ2² (model/stresses.py); below COMPRESSED the membrane is compressed somewhere
+    (module docstring)."""
+    disc, scene = eq.disc, eq.scene
     lam2, v, _, w = disc.node_state(u)
-    lam1 = meridian.meridional_stretch(eq.scene.geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
-    return float(min(np.min(stress) for stress in elastic_stresses(eq.scene.material, lam1, lam2)))
+    lam1 = meridian.meridional_stretch(scene.geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
+    dielectric = dielectric_stress(0.0 if scene.electric is None else scene.electric.voltage, lam1, lam2)
+    return float(min(np.min(stress + dielectric) for stress in elastic_stresses(scene.material, lam1, lam2)))
 
 
 class CompressionStop:
