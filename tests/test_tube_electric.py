@@ -8,17 +8,20 @@ Per 2π the tube's energy is E = ∫_0^L [Φ_eff(λ1, λ2) + ½ P ρ² η'] dS (
 the uniform closed tube's balances are those of tests/test_tube.py with Φ_eff: P = ∂Φ_eff/∂λθ/(λθλz),
 N = ∂Φ_eff/∂λz − λθ ∂Φ_eff/∂λθ/(2λz) = 0.
 """
+import json
+
 import mpmath
 import numpy as np
 import pytest
 import sympy as sp
 
+from balloon_cg.app.cli import main
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
+from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.model import tube
 from balloon_cg.model.membrane import Charged, stretch_derivatives
 from balloon_cg.scene import SceneError
-from balloon_cg.tube.picture import tube_picture
 from balloon_cg.tube.primary import primary_branch
 from test_interval import ogden, series, tube_scene
 from test_tube import closed_end_path, dispersion_onset, symbolic_energy, theta, z
@@ -154,20 +157,30 @@ def test_onset_falls_with_the_voltage_and_recovers_the_field_free_one():
     assert ratios[0] > 0 and abs(ratios[1] / ratios[0] - 1) <= 1e-3
 
 
-def test_run_on_a_charged_tube_switches_the_bulge_with_the_effective_maxwell_pressure():
-    """`run`'s picture of a charged tube (tube/picture.tube_picture; SPOM1, L = 10, Φ̄ = 0.1, degree 20, to a hoop
-    stretch of 3): the bulge branch switched at the first odd branch point and traced through its volume fold, at the
-    voltage; Maxwell's pressure is that of the effective energy (model/tube.maxwell_pressure of Charged: below the
-    field-free one); the charged start carries no stress (the smallest principal stress, elastic plus dielectric,
-    zero to rounding) and every later point is taut."""
-    scene = charged_scene(stop=3.0)
-    picture = tube_picture(scene)
-    primary, bulge = picture.branches["primary"], picture.branches["bulge"]
-    assert bulge.params.voltage == VOLTAGE and abs(bulge.pressure[0] - primary.branch_points()[0].pressure) < 1e-8
-    assert [s.kind for s in bulge.special] == ["LV"]
-    assert picture.maxwell == tube.maxwell_pressure(Charged(scene.material, VOLTAGE))[0]
-    assert picture.maxwell < tube.maxwell_pressure(scene.material)[0]
-    assert abs(primary.smallest_stress[0]) < 1e-10 and np.all(primary.smallest_stress[1:] > 0)
+def test_run_on_a_charged_tube_switches_the_bulge_with_the_effective_maxwell_pressure(tmp_path, capsys):
+    """`balloon-cg run` on a charged tube (SPOM1, L = 10, Φ̄ = 0.1, degree 20, to a hoop stretch of 3): the bulge
+    branch switched at the first odd branch point and traced through its volume fold; Maxwell's pressure is that of
+    the effective energy (model/tube.maxwell_pressure of Charged: below the field-free one); the charged start
+    carries no stress (the smallest principal stress, elastic plus dielectric, zero to rounding) and every later
+    point is taut; `inspect` (text and --json) names the voltage."""
+    scene, path = tmp_path / "charged.toml", tmp_path / "charged.h5"
+    scene.write_text(charged_scene(stop=3.0).to_toml())
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    run = read_tube_run(path)
+    primary, bulge = run["branches"]["primary"], run["branches"]["bulge"]
+    onset = next(s for s in primary["special_points"] if s["kind"] == "BP")
+    assert abs(bulge["pressure"][0] - onset["pressure"]) < 1e-8
+    assert [s["kind"] for s in bulge["special_points"]] == ["LV"]
+    material = tube_scene("SPOM1").material
+    assert run["attrs"]["maxwell_pressure"] == tube.maxwell_pressure(Charged(material, VOLTAGE))[0]
+    assert run["attrs"]["maxwell_pressure"] < tube.maxwell_pressure(material)[0]
+    stress = primary["smallest_stress"]
+    assert abs(stress[0]) < 1e-10 and np.all(stress[1:] > 0)
+    capsys.readouterr()
+    assert main(["inspect", str(path)]) == 0
+    assert "voltage        Φ̄ = 0.1" in capsys.readouterr().out
+    assert main(["inspect", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["voltage"] == VOLTAGE
 
 
 def test_effective_derivatives_are_those_of_the_energy_written_here():

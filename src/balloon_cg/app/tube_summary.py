@@ -1,6 +1,6 @@
-"""What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, Maxwell's
-pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are compressed
-(tube/stability.py), the height of its last point's crest and its located points (with their crest's height; those in
+"""What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
+voltage ([electric]; None without), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many
+of its points are compressed (tube/stability.py), the height of its last point's crest and its located points (with their crest's height; those in
 a compressed state marked: docs/tubes.md), with [dynamics] frequencies each block's lowest Ω² at every located point
 (``frequencies``: per block over the points, as a sphere run's), the onset curve of ``critical`` (its range, folds
 and stop), and the stage a signal stopped (``interrupted``)."""
@@ -28,8 +28,10 @@ def summarise_tube(run: dict) -> dict:
                           **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
+    electric = tomllib.loads(a["scene_toml"]).get("electric")
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
-            "field": field, "degree": a["degree"], "maxwell_pressure": maxwell,
+            "field": field, "voltage": None if electric is None else float(electric.get("voltage", 0.0)),
+            "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
 
@@ -88,6 +90,7 @@ def format_tube(summary: dict) -> str:
              f"shape          tube of length {g['length']:g}, {g['ends']} ends, end distance {held}",
              f"field          " + (f"{summary['field']['coils']} coil(s), M = {summary['field']['M']:g}"
                                    if summary["field"]["coils"] else "none"),
+             "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"),
              f"degree         {summary['degree']}",
              f"Maxwell        P_M = {maxwell}"]
     if summary["interrupted"]:
