@@ -9,12 +9,14 @@ the uniform closed tube's balances are those of tests/test_tube.py with Φ_eff: 
 N = ∂Φ_eff/∂λz − λθ ∂Φ_eff/∂λθ/(2λz) = 0.
 """
 import json
+import re
 
 import mpmath
 import numpy as np
 import pytest
 import sympy as sp
 
+from balloon_cg.analysis.branches.tracer import ContinuationError
 from balloon_cg.app.cli import main
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
@@ -194,6 +196,22 @@ def test_effective_derivatives_are_those_of_the_energy_written_here():
     for name, expression in names.items():
         expected = np.array([float(expression.subs({z: a, theta: b})) for a, b in pairs])
         assert np.abs(found[name] - expected).max() <= 1e-12 * max(1.0, np.abs(expected).max()), name
+
+
+def test_a_tube_past_its_pull_in_voltage_has_no_start():
+    """At P = 0 the free charged tube is equibiaxial with Φ̄² = Φ_1(λ, λ)/(2λ³) (∂Φ_eff/∂λ1 = 0), whose maximum over λ
+    is the pull-in voltage (SPOM1: derived here, 0.70115 at λ = 1.2604); under Φ̄ = 1.5 the start stops there, within
+    1e-5 (the natural continuation's last converged voltage, as the one-line error prints it: measured 4e-8)."""
+    lam = sp.Symbol("lam", positive=True)
+    squared = sp.diff(symbolic_energy(tube_scene("SPOM1").material), z).subs({z: lam, theta: lam}) / (2 * lam**3)
+    with mpmath.workdps(30):
+        peak = sp.nsolve(sp.diff(squared, lam), lam, 1.3, prec=30)
+    pull_in = float(sp.sqrt(squared.subs(lam, peak)))
+    with pytest.raises(ContinuationError, match="past the tube's pull-in voltage") as error:
+        primary_branch(charged_scene(voltage=1.5))
+    assert "\n" not in str(error.value)
+    reached = float(re.search(r"beyond (\S+) of electric.voltage = 1.5", str(error.value)).group(1))
+    assert abs(reached - pull_in) <= 1e-5  # printed to 6 digits
 
 
 def test_a_voltage_continuation_on_a_tube_is_refused_in_one_line():
