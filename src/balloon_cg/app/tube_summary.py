@@ -1,9 +1,9 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
 voltage ([electric]; None without), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many
-of its points are compressed (tube/stability.py), the height of its last point's crest and its located points (with their crest's height; those in
-a compressed state marked: docs/tubes.md), with [dynamics] frequencies each block's lowest Ω² at every located point
-(``frequencies``: per block over the points, as a sphere run's), the onset curve of ``critical`` (its range, folds
-and stop), and the stage a signal stopped (``interrupted``)."""
+of its points are compressed (tube/stability.py), the height of its last point's crest and its located points (with
+their crest's height; those in a compressed state marked: docs/tubes.md), with [dynamics] frequencies each block's
+lowest Ω² at every located point (``frequencies``: per block over the points, as a sphere run's), the onset curve of
+``critical`` (its range, folds and stop), and the stage a signal stopped (``interrupted``)."""
 import math
 import tomllib
 

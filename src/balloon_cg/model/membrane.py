@@ -11,7 +11,8 @@ computed by the class's ``membrane_derivatives`` kernel (codegen/stretch_derivat
 Under the voltage Φ̄ ([electric]) a dielectric elastomer membrane has the effective energy (``Charged``; MODEL.md §2,
 units μ/2)
 
-    Φ_eff = Φ − Φ̄² λ1² λ2²,   Φ_eff,1 = Φ_1 − 2Φ̄² λ1 λ2²,   Φ_eff,11 = Φ_11 − 2Φ̄² λ2²,   Φ_eff,12 = Φ_12 − 4Φ̄² λ1 λ2,
+    Φ_eff = Φ − Φ̄² λ1² λ2²,   Φ_eff,1 = Φ_1 − 2Φ̄² λ1 λ2²,   Φ_eff,11 = Φ_11 − 2Φ̄² λ2²,
+    Φ_eff,12 = Φ_12 − 4Φ̄² λ1 λ2   (Φ_eff,2, Φ_eff,22 by symmetry),
 
 so that a closed form written for any material's Φ (model/tube.py) holds under a voltage with Φ_eff in its place.
 """

@@ -96,10 +96,10 @@ def onset_from(scene, primary: IntervalBranch, point, name: str, direction: floa
 
 def maxwell(scene) -> float | None:
     """Maxwell's pressure of the scene's uniform closed tube (under a voltage, of its effective energy:
-    model/membrane.Charged); None where there is none: ends held apart, no maximum
-    and minimum on the uniform path, or coils acting on the tube (M > 0): the field varies along the tube, so there
-    is neither a uniform state nor the first integral of axial translation that the equal-area rule rests on
-    (docs/tubes.md), and the field-free value is not the field's."""
+    model/membrane.Charged); None where there is none: ends held apart, no maximum and minimum on the uniform path,
+    or coils acting on the tube (M > 0): the field varies along the tube, so there is neither a uniform state nor the
+    first integral of axial translation that the equal-area rule rests on (docs/tubes.md), and the field-free value
+    is not the field's."""
     if scene.geometry.axial_stretch is not None or in_field(scene):
         return None
     found = maxwell_pressure(scene_energy(scene))
