@@ -185,6 +185,39 @@ def test_run_on_a_charged_tube_switches_the_bulge_with_the_effective_maxwell_pre
     assert json.loads(capsys.readouterr().out)["voltage"] == VOLTAGE
 
 
+def test_critical_follows_the_onset_in_the_voltage(tmp_path, capsys):
+    """`critical --parameter voltage` on a charged tube (SPOM1, L = 10, Φ̄ = 0.1, degree 20): the onset curve in Φ̄
+    (tube/onset.py, ∂R/∂Φ̄ from the tube's generated voltage_gradient) is, at five points along it, the dispersion
+    relation of Φ_eff at that Φ̄ (model/tube.bulge_onset of Charged: λθ and P to 1e-8), P falling as Φ̄ rises towards the pull-in
+    (no fold: exit 1, the file written); downwards it lands on Φ̄ = 0 at the field-free onset (1e-8); the voltage
+    without [electric] exits 2 in one line."""
+    scene = tmp_path / "charged.toml"
+    scene.write_text(charged_scene().to_toml())
+    material = tube_scene("SPOM1").material
+    curves = {}
+    for direction in ("1", "-1"):
+        path = tmp_path / f"onset{direction}.h5"
+        assert main(["critical", str(scene), "--parameter", "voltage", "--direction", direction, "-o", str(path),
+                     "--quiet"]) == 1
+        assert "no critical voltage: the onset curve does not turn back in voltage" in capsys.readouterr().err
+        curves[direction] = read_tube_run(path)["onset"]
+        assert curves[direction]["attrs"]["parameter"] == "voltage"
+    up, down = curves["1"], curves["-1"]
+    assert up["q"][0] == VOLTAGE and up["q"][-1] > 0.6 and np.all(np.diff(up["pressure"]) < 0)
+    assert down["q"][-1] == 0.0
+    for k in np.linspace(0, up["q"].size - 1, 5).astype(int):  # the oracle scans its path: ~1 s a voltage
+        onset = tube.bulge_onset(Charged(material, up["q"][k]), 10.0, largest_hoop=3.0)
+        assert abs(up["unknowns"][k][0] - onset.hoop) <= 1e-8 and abs(up["pressure"][k] - onset.pressure) <= 1e-8
+    free = tube.bulge_onset(material, 10.0, largest_hoop=3.0)
+    assert abs(down["pressure"][-1] - free.pressure) <= 1e-8 and abs(down["unknowns"][-1][0] - free.hoop) <= 1e-8
+    plain = tmp_path / "plain.toml"
+    plain.write_text(tube_scene("SPOM1", 10.0).to_toml())
+    assert main(["critical", str(plain), "--parameter", "voltage", "-o", str(tmp_path / "x.h5"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "critical --parameter voltage needs an [electric] table" in err[0]
+    assert not (tmp_path / "x.h5").exists()
+
+
 def test_effective_derivatives_are_those_of_the_energy_written_here():
     """model/membrane.Charged: Φ_eff and its first and second derivatives against SymPy's of the effective energy
     (SPOM1, Φ̄ = 0.3, at three stretch pairs; 1e-12 relative)."""

@@ -26,26 +26,33 @@ def run_tube(scene, output, args) -> int:
     return 0
 
 
+ONSET_PARAMETERS = {"M": "M", "field.M": "M", "voltage": "voltage", "electric.voltage": "voltage"}  # critical's
+
+
 def critical_tube(scene, output, args) -> int:
     """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
-    followed in M, written with the primary branch to the tube run file ``output`` (its /onset group) and summarised.
-    Exit 0 with ``critical M = ...`` where the curve turns back in M (a located fold: the onset's largest or smallest
-    M), 1 (the file still written) where it does not; 1 without a file where the primary branch has no odd branch
-    point; 2 for anything but the onset (--of BP) in M, or no coils; 130 when a signal stopped it (module
-    docstring)."""
+    followed in M or the voltage Φ̄, written with the primary branch to the tube run file ``output`` (its /onset
+    group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns back in the parameter (a located
+    fold: the onset's largest or smallest value), 1 (the file still written) where it does not; 1 without a file
+    where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M or the voltage, M
+    without coils, the voltage without [electric]; 130 when a signal stopped it (module docstring)."""
     from ..tube.picture import onset_picture
 
-    if args.of != "BP" or args.parameter not in ("M", "field.M"):
-        raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M: {args.scene}: --of "
-                         f"{args.of} --parameter {args.parameter}")
+    name = ONSET_PARAMETERS.get(args.parameter)
+    if args.of != "BP" or name is None:
+        raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M or the voltage: "
+                         f"{args.scene}: --of {args.of} --parameter {args.parameter}")
     field_needed(scene, args.parameter, "critical --parameter M", args.scene)
+    if name == "voltage" and scene.electric is None:
+        raise UsageError(f"critical --parameter voltage needs an [electric] table: {args.scene} has none, so the "
+                         "equilibrium does not depend on the voltage")
 
     def picture():
-        found = onset_picture(scene, "M", args.direction)
+        found = onset_picture(scene, name, args.direction)
         if found.onset is None and found.interrupted is None:
             primary = found.branches["primary"]
             raise Failure(f"no odd branch point (the onset of bulging) on the primary branch of {args.scene} "
-                          f"({primary.stop.message}): nothing to follow in M")
+                          f"({primary.stop.message}): nothing to follow in {name}")
         return found
 
     run, signalled = _written(output, args, picture, scene)
@@ -56,11 +63,11 @@ def critical_tube(scene, output, args) -> int:
     _say(args, f"onset curve: {len(onset['q'])} points, stop {onset['attrs']['stop_code']} "
                f"({onset['attrs']['stop_message']})")
     if not onset["folds"]:
-        raise Failure(f"no critical M: the onset curve does not turn back in M ({onset['attrs']['stop_message']}; "
-                      f"last point M = {onset['q'][-1]:.10g}, P = {onset['pressure'][-1]:.10g}); curve written to "
-                      f"{output}")
+        raise Failure(f"no critical {name}: the onset curve does not turn back in {name} "
+                      f"({onset['attrs']['stop_message']}; last point {name} = {onset['q'][-1]:.10g}, P = "
+                      f"{onset['pressure'][-1]:.10g}); curve written to {output}")
     fold = max(onset["folds"], key=lambda f: args.direction * f["q"])
-    print(f"critical M = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in M: "
+    print(f"critical {name} = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in {name}: "
           f"{fold['status']}); curve written to {output}")
     return 0
 

@@ -64,7 +64,7 @@ TUBE_VARIABLES = {
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
     "index": ("", "point index", "the located point lies between points index and index + 1"),
-    "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M)"),
+    "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M or voltage)"),
     "modes": ("1", "odd null vector", "the odd block's null vector φ at the onset"),
 }
 

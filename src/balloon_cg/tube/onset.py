@@ -2,9 +2,9 @@
 
 At a branch point of the odd block (interval.Mirror) the mirror-symmetric primary branch (tube/primary.py) is crossed
 by the bulge's pitchfork: the odd block of ∂R/∂u is singular there. Following it in q, a runtime scalar of the tube's
-kernels (the field intensity M of coils mirror-symmetric about the tube's middle, which keep the mirror symmetry), is
-a Moore–Spence extended system on the even block's unknowns u_e (the mirror-symmetric states; a held λ̄ stays fixed)
-and the odd block's null vector φ:
+kernels (the field intensity M of coils mirror-symmetric about the tube's middle, which keep the mirror symmetry, or
+the voltage Φ̄ under [electric]), is a Moore–Spence extended system on the even block's unknowns u_e (the
+mirror-symmetric states; a held λ̄ stays fixed) and the odd block's null vector φ:
 
     unknowns  X = (u_e, P, φ, q)
     equations R_e(u; P, q)      = 0    equilibrium (the even rows; the odd rows vanish by symmetry)
@@ -14,13 +14,13 @@ and the odd block's null vector φ:
 one equation fewer than unknowns: a curve, traced by pseudo-arclength continuation (numerics/continuation.py).
 Jacobian: ∂R_e/∂(u_e, P, q) from the generated kernels (the Hessian, ∂R/∂P, ∂R/∂M); ∂(H_oo φ)/∂u_e is the central
 difference of the whole Hessian along φ restricted to the odd rows and even columns (the third derivative of E is
-symmetric), ∂(H_oo φ)/∂P and ∂/∂q central differences (H is affine in P and M: exact to rounding); the steps
-``H_STEP`` only set Newton's rate, never the converged points (the residual is exact).
+symmetric), ∂(H_oo φ)/∂P and ∂/∂q central differences (H is affine in P and M, quadratic in Φ̄: exact to
+rounding); the steps ``H_STEP`` only set Newton's rate, never the converged points (the residual is exact).
 
-The curve stops where P ≤ 0, where q falls below 0 (M is a square: the last point is then landed on q = 0 exactly,
-the field-free onset), at ``continuation.max_points``, at the minimum step, or at the next point after SIGINT/SIGTERM
-(StopCode.INTERRUPTED); its folds in q (LP: the onset's
-largest or smallest q) are located by the tracer's fold monitor.
+The curve stops where P ≤ 0, where q falls below 0 (M and Φ̄ are ≥ 0: the last point is then landed on q = 0
+exactly, the field-free onset), at ``continuation.max_points``, at the minimum step, or at the next point after
+SIGINT/SIGTERM (StopCode.INTERRUPTED); its folds in q (LP: the onset's largest or smallest q) are located by the
+tracer's fold monitor.
 """
 import enum
 from dataclasses import dataclass
@@ -127,8 +127,8 @@ class OnsetCurve:
 def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: str = "M", direction: float = 1.0,
                 max_points: int | None = None) -> OnsetCurve:
     """The curve of the odd branch point ``point`` of ``primary`` in the runtime scalar ``name`` (a Parameters
-    field with a derivative kernel: M), starting at the branch's value with q increasing (``direction`` 1) or
-    decreasing (−1) (module docstring)."""
+    field with a derivative kernel: M, voltage), starting at the branch's value with q increasing (``direction`` 1)
+    or decreasing (−1) (module docstring)."""
     if point.kind != Kind.BP or point.block != Mirror.ODD:
         raise ValueError(f"an onset curve starts at a branch point of the odd block, not at {point.kind} "
                          f"({point.block})")
@@ -137,7 +137,8 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
     if name == "M" and not eq.coils.shape[0]:
         raise ValueError("an onset curve in M needs coils: without a field R does not depend on M")
     if eq.derivative_kernel(name) is None:
-        raise ValueError(f"no generated derivative of the residual in {name!r}: a tube's onset is followed in M")
+        raise ValueError(f"no generated derivative of the residual in {name!r}: a tube's onset is followed in M or "
+                         "the voltage")
     q0 = float(getattr(primary.params, name))
     params = primary.params.with_value("P", point.pressure)
     odd = disc.block(Mirror.ODD)
