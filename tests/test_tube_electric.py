@@ -117,6 +117,23 @@ def test_charged_uniform_tube_is_the_closed_end_path(preset):
     assert abs(peak.hoop - float(hoop)) <= 1e-10 and abs(peak.pressure - fold.pressure) <= 1e-10
 
 
+def test_charged_tube_with_its_ends_held_apart_is_the_fixed_stretch_path():
+    """Sliding ends held at 1.5 L (SPOM1, Φ̄ = 0.1; the tube stretched at P = 0, then charged): the start is
+    ∂Φ_eff/∂λθ(1.5, λθ) = 0 solved here at 30 digits (1e-12), and every traced point is uniform at λz = 1.5 with
+    P = ∂Φ_eff/∂λθ/(λθλz) derived here (1e-10)."""
+    scene = charged_scene(extra="axial_stretch = 1.5\n")
+    energy = effective_energy("SPOM1", VOLTAGE).subs(z, sp.Rational(3, 2))
+    with mpmath.workdps(30):
+        start = float(sp.nsolve(sp.diff(energy, theta), theta, 0.8, prec=30))
+    P_of = sp.lambdify(theta, sp.diff(energy, theta) / (theta * sp.Rational(3, 2)))
+    branch = primary_branch(scene)
+    k = branch.disc.axial_index
+    assert abs(branch.states[0][0] - start) <= 1e-12 and branch.pressure[0] == 0.0 and len(branch.pressure) > 10
+    for u, pressure in zip(branch.states, branch.pressure):
+        assert u[k] == 1.5 and np.abs(np.delete(u, [0, k])).max() <= 1e-10
+        assert abs(pressure - P_of(u[0])) <= 1e-10 * (1 + pressure)
+
+
 @pytest.mark.parametrize("preset", ["SPOM1", "neo-Hookean"])
 def test_onset_under_a_voltage_is_the_dispersion_relation(preset):
     """Sliding closed ends, L = 10, Φ̄ = 0.1: the first odd branch point of the primary branch is the onset of the mode
