@@ -130,7 +130,7 @@ class StopCode(enum.StrEnum):
     STOP_STRETCH = "stop_stretch"  # the top pole stretch reached continuation.stop_stretch
     MIN_STRETCH = "min_stretch"  # the top pole stretch reached continuation.min_stretch
     STOP_PRESSURE = "stop_pressure"  # P reached continuation.stop_pressure
-    STOP_VOLUME = "stop_volume"  # V reached loading.stop_volume (volume control)
+    STOP_VOLUME = "stop_volume"  # V reached continuation.stop_volume (any control; landed exactly)
     STOP_AMOUNT = "stop_amount"  # the gas amount n = P V reached loading.stop_amount (gas control)
     STOP_VOLTAGE = "stop_voltage"  # Φ̄ reached continuation.stop_voltage (a voltage continuation)
     ZERO_VOLTAGE = "zero_voltage"  # Φ̄ fell to 0 (a voltage continuation reached the voltage-free sphere)

@@ -635,7 +635,7 @@ def _plot_tube(args, outputs: dict) -> int:
         raise UsageError(f"{args.files[1]}: a tube run file is drawn alone; give one file")
     run = read_tube_run(args.files[0])
     for kind, output in outputs.items():
-        figure = tube_figure(run, kind, args.stability or "pressure", args.branch, args.points,
+        figure = tube_figure(run, kind, args.stability, args.branch, args.points,
                              args.width or 3.5)
         with replacing(output, args.force) as tmp:
             figure.savefig(tmp, format=output.suffix.lower()[1:], **({} if args.dpi is None else {"dpi": args.dpi}))
@@ -913,8 +913,7 @@ def _fold_curve(scene, args):
 
     control = FOLD_CONTROL[args.of]
     if scene.loading.control.value != control:
-        scene = scene.with_overrides({"loading.control": control, "loading.stop_volume": None,
-                                      "loading.stop_amount": None}, name=scene.name)
+        scene = scene.with_overrides({"loading.control": control, "loading.stop_amount": None}, name=scene.name)
     branch = _primary(scene, args)
     if branch is None:
         return None

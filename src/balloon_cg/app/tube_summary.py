@@ -1,11 +1,15 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
-voltage ([electric]; None without), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many
-of its points are compressed (tube/stability.py), the height of its last point's crest and its located points (with
-their crest's height; those in a compressed state marked: docs/tubes.md), with [dynamics] frequencies each block's
-lowest Ω² at every located point (``frequencies``: per block over the points, as a sphere run's), the onset curve of
-``critical`` (its range, folds and stop), and the stage a signal stopped (``interrupted``)."""
+voltage ([electric]; None without), the loading control (its stability reading: how many of a branch's points are
+stable under it; under gas control the amount n = P V of every located point), Maxwell's pressure, per branch its
+points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py), the height of its last
+point's crest and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md),
+with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block over the points,
+as a sphere run's), the onset curve of ``critical`` (its range, folds and stop), and the stage a signal stopped
+(``interrupted``)."""
 import math
 import tomllib
+
+import numpy as np
 
 from ..io.tube_file import CREST
 from ..tube.stability import COMPRESSED
@@ -16,22 +20,27 @@ def summarise_tube(run: dict) -> dict:
     a = run["attrs"]
     geometry = {"shape": a["shape"], "length": a["length"], "ends": a["ends"],
                 "axial_stretch": None if math.isnan(a["axial_stretch"]) else a["axial_stretch"]}
+    control, v0 = a["control"], np.pi * a["length"]
     branches = {}
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
+        unstable = b.get(f"unstable_{control}")
+        special = [s | ({"amount": float(s["pressure"] * s["volume"] * v0)} if control == "gas" else {})
+                   for s in b["special_points"]]
         branches[name] = {"points": len(b["pressure"]), "stop_code": b["attrs"]["stop_code"],
                           "stop_message": b["attrs"]["stop_message"],
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
-                          "special_points": _with_omega2(b["special_points"], b.get("frequencies")),
+                          "stable_points": None if unstable is None else int((unstable == 0).sum()),
+                          "special_points": _with_omega2(special, b.get("frequencies")),
                           **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
     electric = tomllib.loads(a["scene_toml"]).get("electric")
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "voltage": None if electric is None else float(electric.get("voltage", 0.0)),
-            "degree": a["degree"], "maxwell_pressure": maxwell,
+            "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
 
@@ -91,6 +100,7 @@ def format_tube(summary: dict) -> str:
              f"field          " + (f"{summary['field']['coils']} coil(s), M = {summary['field']['M']:g}"
                                    if summary["field"]["coils"] else "none"),
              "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"),
+             f"control        {summary['control']}",
              f"degree         {summary['degree']}",
              f"Maxwell        P_M = {maxwell}"]
     if summary["interrupted"]:
@@ -99,6 +109,8 @@ def format_tube(summary: dict) -> str:
     for name, b in summary["branches"].items():
         lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"
+                      + ("" if b["stable_points"] is None else
+                         f"; {b['stable_points']} stable under {summary['control']} control")
                       + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
                       + ("" if b["last_crest_height"] is None else
                          f"; last crest at height {b['last_crest_height']:.6g}")]
@@ -107,8 +119,9 @@ def format_tube(summary: dict) -> str:
             block = f" {s['block']}" if s["block"] else ""
             compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
+            amount = f"  n = {s['amount']:.10g}" if "amount" in s else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
-                         f"V/V0 = {s['volume']:.8g}  {s['status']}{crest}{compressed}")
+                         f"V/V0 = {s['volume']:.8g}{amount}  {s['status']}{crest}{compressed}")
             if "omega2" in s:
                 lines.append("        lowest Ω²  " + "  ".join(f"{name} {value:.4g}"
                                                          for name, value in s["omega2"].items()))

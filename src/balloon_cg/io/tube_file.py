@@ -3,9 +3,11 @@ tube/picture.py, written atomically (io/hdf5.py), read back checked.
 
 Root attributes: the format, the scene (name, TOML), the shape and its parameters (``shape``, ``length``, ``ends``,
 ``axial_stretch``: NaN where the ends' distance is free), the discretisation (``degree``, ``quadrature``),
-``maxwell_pressure`` (NaN where there is none) and the provenance. One group per branch under /branches/<name>/:
-per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``
-and ``unstable_volume`` (negative eigenvalues of ∂R/∂u without and with δV = 0), ``smallest_stress`` (the smallest
+``maxwell_pressure`` (NaN where there is none), ``control`` (the scene's loading.control, whose stability reading
+and folds count: files before it have none, read as "pressure") and the provenance. One group per branch under /branches/<name>/:
+per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``,
+``unstable_volume`` and ``unstable_gas`` (negative eigenvalues of ∂R/∂u, on δV = 0, and of ∂R/∂u + (P/Ṽ) g gᵀ:
+tube/stability.py; files before gas control have no ``unstable_gas``), ``smallest_stress`` (the smallest
 principal stress: negative where the membrane is compressed, tube/stability.py), ``crest_height`` (the height η of
 the largest radius, the bulge's crest, from the tube's middle plane: IntervalDiscretisation.crest), ``lowest_even``/
 ``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch); its located points under
@@ -40,6 +42,7 @@ from ..scene.loading import Control
 FORMAT = "balloon-cg-tube/1"
 POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress")
 CREST = "crest_height"  # per point and located point: η of the largest radius (files before it have none)
+GAS = "unstable_gas"  # per point: unstable directions under gas control (files before it have none)
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
@@ -56,6 +59,7 @@ TUBE_VARIABLES = {
     "volume": ("1", "V/V0", "enclosed volume over the reference tube's, V0 = πL R³"),
     "unstable_pressure": ("", "unstable directions, pressure control", "negative eigenvalues of ∂R/∂u"),
     "unstable_volume": ("", "unstable directions, volume control", "negative eigenvalues of ∂R/∂u on δV = 0"),
+    GAS: ("", "unstable directions, gas control", "negative eigenvalues of ∂R/∂u + (P/Ṽ) g gᵀ (P V = n fixed)"),
     "smallest_stress": ("1", "smallest principal stress", "over the nodes, in μ/2: negative where compressed"),
     CREST: ("1", "crest height", "height η of the largest radius from the tube's middle plane, in R"),
     "lowest_even": ("1", "lowest eigenvalue, even block", "of the mirror-symmetric block of ∂R/∂u"),
@@ -113,6 +117,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
              "length": geometry.length, "ends": geometry.ends.value, "axial_stretch": held,
              "degree": primary.disc.degree, "quadrature": primary.disc.quadrature,
              "maxwell_pressure": math.nan if picture.maxwell is None else picture.maxwell,
+             "control": scene.loading.control.value,
              "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
     f.attrs.update(attrs)
@@ -122,7 +127,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(group, "unknowns", branch.states)
         for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
                                ("unstable_pressure", branch.unstable["pressure"]),
-                               ("unstable_volume", branch.unstable["volume"]),
+                               ("unstable_volume", branch.unstable["volume"]), (GAS, branch.unstable["gas"]),
                                ("smallest_stress", branch.smallest_stress),
                                (CREST, crest_heights(branch.disc, branch.states))):
             checksummed(group, column, values)
@@ -184,7 +189,7 @@ def read_tube_run(path) -> dict:
 def read_tube(f, path, where: str = "") -> dict:
     """{'attrs', 'branches', 'onset'} of the tube run written by ``write_tube`` into the open file or group ``f``
     (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
-    attrs = {"interrupted": ""} | {k: _text(plain(v)) for k, v in f.attrs.items()}
+    attrs = {"interrupted": "", "control": "pressure"} | {k: _text(plain(v)) for k, v in f.attrs.items()}
     if "branches" not in f or "primary" not in f["branches"]:
         raise TubeFileError(path, f"no {where}/branches/primary group")
     branches = {}
@@ -194,7 +199,7 @@ def read_tube(f, path, where: str = "") -> dict:
             raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
         branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
         n = branch["unknowns"].shape[0]
-        optional = tuple(c for c in (CREST, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
+        optional = tuple(c for c in (CREST, GAS, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
         for column in POINT_COLUMNS + optional:
             branch[column] = group[column][()]
             if branch[column].shape != (n,):
@@ -257,7 +262,7 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     stop = Stop(next(enum(code) for enum in (IntervalStop, StopCode, TraceStop) if code in enum._value2member_map_),
                 b["attrs"]["stop_message"])
     lowest = {block: b[f"lowest_{block.value}"] for block in Mirror if f"lowest_{block.value}" in b}
-    unstable = {Control.PRESSURE: b["unstable_pressure"], Control.VOLUME: b["unstable_volume"]}
+    unstable = {control: b[f"unstable_{control.value}"] for control in Control if f"unstable_{control.value}" in b}
     return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
                           special, stop, b["smallest_stress"], params)
 

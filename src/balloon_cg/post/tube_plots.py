@@ -3,9 +3,10 @@ branch with Maxwell's line (``pressure_volume``), the family of profiles r(Z) of
 front, its position and width against V/V0 (``front_motion``), and the hoop and axial stretches along the deformed
 axis at a few states (``stretch_profiles``; post/tube_measures.py measures both).
 
-Curves are solid where a point is stable under the chosen control (no negative eigenvalue of ∂R/∂u without, or
-with, δV = 0: the file's ``unstable_pressure``/``unstable_volume``) and dashed where it is not; located points are
-marked and labelled (LP, LV, BP with its mirror block).
+Curves are solid where a point is stable under the chosen control (default: the run's loading.control; no negative
+eigenvalue of the second variation under it: the file's ``unstable_pressure``/``unstable_volume``/``unstable_gas``,
+tube/stability.py) and dashed where it is not; located points are marked and labelled (LP, LV, LN, BP with its
+mirror block).
 """
 import numpy as np
 
@@ -14,7 +15,7 @@ from .tube_measures import front, stretches
 from ..io.tube_file import discretisation
 
 TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches")
-CONTROLS = ("pressure", "volume")
+CONTROLS = ("pressure", "volume", "gas")
 PROFILES = 8  # profiles drawn along a branch unless the points are given
 STRETCHED = 3  # states whose stretches are drawn unless the points are given
 SAMPLES = 4001  # reference arclengths a front or a stretch profile is sampled at
@@ -25,13 +26,18 @@ class TubePlotError(ValueError):
     """A figure a tube run file cannot give (exit code 2)."""
 
 
-def tube_figure(run: dict, what: str, control: str = "pressure", branch: str | None = None, points=None,
+def tube_figure(run: dict, what: str, control: str | None = None, branch: str | None = None, points=None,
                 width: float = 3.5):
-    """The figure of kind ``what`` (TUBE_KINDS) of a tube run (read_tube_run output)."""
+    """The figure of kind ``what`` (TUBE_KINDS) of a tube run (read_tube_run output); ``control``: the stability
+    reading (None: the run's loading.control)."""
     if what not in TUBE_KINDS:
         raise TubePlotError(f"--what {what}: not drawn for a tube run file; allowed: {', '.join(TUBE_KINDS)}")
+    control = run["attrs"]["control"] if control is None else control
     if control not in CONTROLS:
         raise TubePlotError(f"--stability {control}: allowed for a tube: {', '.join(CONTROLS)}")
+    if any(f"unstable_{control}" not in b for b in run["branches"].values()):
+        raise TubePlotError(f"--stability {control}: this file (written before gas control) has no "
+                            f"unstable_{control}; allowed here: pressure, volume")
     with journal_style():
         fig = JournalFigure(figsize=(width, 0.75 * width), layout="constrained")
         ax = fig.add_subplot()

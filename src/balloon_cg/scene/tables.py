@@ -18,7 +18,7 @@ from pathlib import Path
 from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
 from .events import Event, events_from_list
-from .loading import Control, Loading, loading_from_table
+from .loading import Control, Loading, loading_from_table, moved_stop_volume
 from .materials import ALPHA1, MAX_EXPONENT, Material, alpha1_terms, material_from_table, modified_name
 
 __all__ = [
@@ -180,7 +180,9 @@ class Continuation:
     (needs equator-symmetric coils), "none" never does, "auto" does when the field allows it.
     ``parameter``: "pressure" (P varies), or "voltage" (Φ̄ varies at the fixed P = ``pressure``, needs
     [electric]; it stops when Φ̄ passes ``stop_voltage``, None: no limit). ``stop_field``: the field M where a
-    continuation in M at fixed P (``continue --parameter M``) stops, None: no limit.
+    continuation in M at fixed P (``continue --parameter M``) stops, None: no limit. ``stop_volume``: the enclosed
+    volume V/R0³ where a branch ends (landed on exactly), under every control and on every shape (a tube's V0 = πL,
+    a sphere's 4π/3), None: no limit (``loading.stop_volume`` is its old name).
     """
 
     start_stretch: float = 1.01
@@ -197,6 +199,7 @@ class Continuation:
     pressure: float | None = None
     stop_voltage: float | None = None
     stop_field: float | None = None
+    stop_volume: float | None = None
 
 
 @dataclass(frozen=True)
@@ -633,14 +636,15 @@ def _build(data: dict, name: str, text: str) -> Scene:
     material = material_from_table(data["material"])
     field = _field(data.get("field", {}))
     electric = None if "electric" not in data else _electric(data["electric"])
-    loading = loading_from_table(data.get("loading", {}))
-    continuation = _continuation(data.get("continuation", {}), field, electric)
+    loading_table, continuation_table = moved_stop_volume(data.get("loading", {}), data.get("continuation", {}))
+    loading = loading_from_table(loading_table)
+    continuation = _continuation(continuation_table, field, electric)
     if loading.control != Control.PRESSURE and continuation.parameter == ContinuationParameter.VOLTAGE:
         raise SceneError(f'loading.control = "{loading.control.value}": a voltage continuation '
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
-    geometry = _geometry(data.get("geometry", {}), field, electric, loading)
+    geometry = _geometry(data.get("geometry", {}), field, electric)
     if geometry.shape in (Shape.CAPSULE, Shape.TUBE) and continuation.parameter == ContinuationParameter.VOLTAGE:
         raise SceneError(f'continuation.parameter = "voltage": a {geometry.shape.value} is continued in the pressure '
                          "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
@@ -790,7 +794,7 @@ def _electric(data) -> Electric:
     return Electric(get("voltage", lambda x: 0 <= x <= MAX_VOLTAGE, f"in [0, {MAX_VOLTAGE:g}]"))
 
 
-def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -> Geometry:
+def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     """[geometry]: the shape, a spheroid's aspect, a tube's length and ends; the parts of the model that are written
     for the sphere alone (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a
     voltage) refuse other shapes here."""
@@ -806,7 +810,7 @@ def _geometry(data, field: Field, electric: Electric | None, loading: Loading) -
     if shape not in (Shape.TUBE, Shape.CAPSULE) and data.get("length") is not None:
         raise SceneError(f'geometry.length = {show(data["length"])}: only for geometry.shape = "tube" or "capsule"')
     if shape == Shape.TUBE:
-        return _tube(data, field, loading)
+        return _tube(data, field)
     if shape == Shape.CAPSULE:
         return _capsule(data, field, electric)
     if shape == Shape.SPHERE:
@@ -861,7 +865,7 @@ def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
     return Geometry(Shape.CAPSULE, length=length)
 
 
-def _tube(data, field: Field, loading: Loading) -> Geometry:
+def _tube(data, field: Field) -> Geometry:
     """A tube's [geometry] (length, ends, axial_stretch) and the parts of the model a tube does not have yet,
     refused one line each."""
     length = _length(data, Shape.TUBE, MIN_LENGTH)
@@ -881,9 +885,6 @@ def _tube(data, field: Field, loading: Loading) -> Geometry:
             raise SceneError(f"field.coils[{k}]: wire at (radius {coil.radius:g}, height {coil.height:g}) lies on "
                              f"or inside the reference tube (radius 1, heights within ±length/2 = "
                              f"±{length / 2:g}); the radius must be > 1 there")
-    if loading.control != Control.PRESSURE:
-        raise SceneError(f'loading.control = "{loading.control.value}": a tube is continued in the pressure only '
-                         'for now; allowed: "pressure"')
     return Geometry(Shape.TUBE, length=length, ends=Ends(raw), axial_stretch=held)
 
 
@@ -953,8 +954,9 @@ def _continuation(data, field: Field, electric: Electric | None = None) -> Conti
         )
     parameter, fixed_pressure, stop_voltage = _parameter(data, electric)
     stop_field = get("stop_field", lambda x: 0 < x <= MAX_M, f"in (0, {MAX_M:g}]")
+    stop_volume = get("stop_volume", lambda x: x > 0, "> 0 (V/R0³)")
     return Continuation(start, stop, low, pressure, step, step_min, step_max, points, symmetry, gap, parameter,
-                        fixed_pressure, stop_voltage, stop_field)
+                        fixed_pressure, stop_voltage, stop_field, stop_volume)
 
 
 def _solver(data) -> Solver:

@@ -11,11 +11,12 @@ meets: its states have no component along φ), oriented so that ``Side`` is posi
 ends), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the symmetry (P and V are even in the
 arclength along a pitchfork), so the fold monitors start from the first point. It is traced by pseudo-arclength
 continuation in X = (u, P), at an odd branch point on every unknown, at an even one on the even block (a held λ̄ stays
-fixed), its folds in P (LP) and in the enclosed volume (LV: V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) located by the
-tracer's fold monitors, until it rejoins the primary branch's kind of states (``Side`` changes sign: the bulge has
+fixed), its folds in P (LP), in the enclosed volume (LV: V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) and under gas
+control in n = P V (LN: tube/control.py) located by the tracer's fold monitors, until it rejoins the primary branch's kind of states (``Side`` changes sign: the bulge has
 filled the tube and the branch meets the primary branch again at another branch point of the block, the other end of
 the pitchfork's loop, where P and V are again even in the arclength: the monitors' sign changes in that last step are
-that symmetry, not folds, and are not kept), its V/V0 passes ``stop_volume``, its largest hoop stretch
+that symmetry, not folds, and are not kept), its V reaches ``continuation.stop_volume`` (or the argument
+``stop_volume`` in V/V0; the end landed there exactly: tube/control.VolumeStop), its largest hoop stretch
 ``stop_stretch``, in a coil field where its states turn compressed (IntervalStop.COMPRESSED:
 tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
 (StopCode.INTERRUPTED). The branch point X* is the branch's first point; the stability of every point is
@@ -23,6 +24,7 @@ tube/stability.CompressionStop), after ``continuation.max_points``, or at the ne
 """
 import numpy as np
 
+from .control import VolumeStop, control_monitors, gradient
 from .primary import TubeSystem, held, in_field, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, unstable_counts
@@ -33,6 +35,7 @@ from ..galerkin.interval import Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.threads import limited_blas
+from ..scene.loading import Control
 from ..scene.tables import Ends
 
 
@@ -43,9 +46,9 @@ class UnswitchableBranchPoint(ValueError):
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None) -> IntervalBranch:
-    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``step``: the first
-    arclength step (None: continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes
-    passes it. UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that
+    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: V/V0
+    where it ends (None: the scene's continuation.stop_volume, V/R0³, if any); ``step``: the first arclength step
+    (None: continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it. UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that
     is not uniform."""
     if point.kind != Kind.BP or point.block is None:
         raise UnswitchableBranchPoint(f"a branch is switched at a branch point of a mirror block, not at "
@@ -80,6 +83,8 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
 
     compressed = CompressionStop(eq, in_field(scene))
     compressed(point.u)
+    target = scene.continuation.stop_volume if stop_volume is None else stop_volume * np.pi * disc.length
+    volume_stop = VolumeStop(target, system)
 
     def stop(p):
         if (interrupted := signalled()) is not None:
@@ -87,27 +92,27 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         Y = system.full(p.X)
         if side(Y[:-1]) < 0:
             return Stop(IntervalStop.REJOINED, f"the branch rejoined the {side.rejoins} states")
-        if stop_volume is not None and volume_ratio(eq, Y) > stop_volume:
-            return Stop(IntervalStop.VOLUME, f"V/V0 passed stop_volume {stop_volume:g}")
+        if (reached := volume_stop(p.X)) is not None:
+            return reached
         hoop = disc.node_state(Y[:-1])[0].max()
         if stop_stretch is not None and hoop > stop_stretch:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
                                                    f"{stop_stretch:g}")
         return compressed(Y[:-1])
 
-    def volume_gradient(X):
-        Y = system.full(X)
-        return np.append(-eq.parameter_derivative(Y[:-1], params.with_value("P", Y[-1]), "P"), 0.0)[system.columns]
-
-    path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1], Kind.LV: volume_gradient})
+    monitors = {Kind.LP: np.eye(X.size)[-1], Kind.LV: gradient(system, Control.VOLUME)}
+    path = continuation.trace(system, start, settings, stop, monitors | control_monitors(system, scene.loading.control))
     last = len(path.points) - 1
     folds = [f for f in path.folds if not (path.stop.code == IntervalStop.REJOINED and f.index == last)]
+    end, stopped = volume_stop.end(path, settings)
+    if end is not None:
+        folds = [f for f in folds if f.index < last or volume_stop.before(path, f.point.X)]
     special = tuple(IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + 1,
                                     f.status) for f in sorted(folds, key=lambda f: f.index))
-    points = [system.full(X)] + [system.full(p.X) for p in path.points]
+    points = [system.full(X)] + [system.full(p.X) for p in path.points] + ([] if end is None else [end])
     return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
                           np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points, params),
-                          stressed(eq, special), path.stop, np.array([smallest_stress(eq, Y[:-1]) for Y in points]),
+                          stressed(eq, special), stopped, np.array([smallest_stress(eq, Y[:-1]) for Y in points]),
                           primary.params)
 
 

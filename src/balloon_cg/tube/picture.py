@@ -1,7 +1,8 @@
 """Everything a tube scene asks for (``balloon-cg run`` on a tube): the primary branch with its folds and branch
 points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py; sliding ends only:
 on plugged ones the branch points are not trusted, docs/tubes.md) traced until it rejoins the mirror-symmetric
-states, its largest hoop stretch passes ``continuation.stop_stretch`` or after ``continuation.max_points``, and
+states, its largest hoop stretch passes ``continuation.stop_stretch``, its V reaches ``continuation.stop_volume``
+(V/R0³, landed on; the primary branch ends there too) or after ``continuation.max_points``, and
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what

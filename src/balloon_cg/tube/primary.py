@@ -26,6 +26,7 @@ from dataclasses import replace
 import numpy as np
 from scipy import linalg
 
+from .control import VolumeStop, control_monitors
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
 from ..analysis.stability.crossings import count_changes
@@ -113,6 +114,7 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     limit = scene.continuation.stop_stretch
     compressed = CompressionStop(eq, in_field(scene))
     compressed(system.full(X)[:-1])
+    volume_stop = VolumeStop(scene.continuation.stop_volume, system)
 
     def stop(point):
         if (interrupted := signalled()) is not None:
@@ -121,13 +123,14 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
         hoop = eq.disc.node_state(u)[0].max()
         if hoop > limit:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch {limit:g}")
-        return compressed(u)
+        return volume_stop(point.X) or compressed(u)
 
-    path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
+    monitors = {Kind.LP: np.eye(X.size)[-1]} | control_monitors(system, scene.loading.control)
+    path = continuation.trace(system, start, settings, stop, monitors)
     reached = path.points + ([path.overshoot] if path.overshoot is not None else [])  # the last step's too
     full = [system.full(p.X) for p in reached]
     spectra = {block: np.array([spectrum(eq, Y, disc.block(block), params) for Y in full]) for block in Mirror}
-    special = [IntervalSpecial(Kind.LP, system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index, f.status)
+    special = [IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index, f.status)
                for f in path.folds]
     for block in Mirror:
         for i, order in count_changes((spectra[block] < 0).sum(axis=1)):
@@ -136,12 +139,24 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
                 special.append(IntervalSpecial(Kind.BP, found[0][:-1], float(found[0][-1]), int(i), found[1], block))
     special = sorted((s for s in special if disc.node_state(s.u)[0].max() <= limit),
                      key=lambda s: _position(system, reached, s))
-    full, spectra = full[: len(path.points)], {block: values[: len(path.points)] for block, values in spectra.items()}
+    kept = len(path.points)
+    full, spectra = full[:kept], {block: values[:kept] for block, values in spectra.items()}
+    end, stopped = volume_stop.end(path, settings)
+    if end is not None:
+        special = [s for s in special if s.index < kept - 1 or volume_stop.before(path, _in(system, s))]
+        full.append(end)
+        spectra = {block: np.vstack([values, spectrum(eq, end, disc.block(block), params)])
+                   for block, values in spectra.items()}
     volume = np.array([volume_ratio(eq, Y) for Y in full])
     lowest = {block: spectra[block][:, 0] for block in Mirror}
     return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
-                          unstable_counts(eq, full, params), stressed(eq, special), path.stop,
+                          unstable_counts(eq, full, params), stressed(eq, special), stopped,
                           np.array([smallest_stress(eq, Y[:-1]) for Y in full]), params)
+
+
+def _in(system: TubeSystem, special: IntervalSpecial) -> np.ndarray:
+    """X of a located point in the coordinates of ``system``."""
+    return np.append(special.u, special.pressure)[system.columns]
 
 
 def stressed(eq: Equilibrium, special) -> tuple:

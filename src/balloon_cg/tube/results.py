@@ -17,7 +17,6 @@ class IntervalStop(enum.StrEnum):
 
     HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
     REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
-    VOLUME = "volume"  # V/V0 passed the stop_volume asked for
     COMPRESSED = "compressed"  # in a coil field, the membrane turned compressed after being taut (tube/stability.py)
 
 
@@ -49,7 +48,7 @@ class IntervalBranch:
     """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
     lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
     mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
-    Control.PRESSURE and Control.VOLUME -> int array), the located points, why the trace stopped and the smallest
+    Control -> int array; files before gas control have no Control.GAS), the located points, why the trace stopped and the smallest
     principal stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters
     (the field's M and χ; P is each point's)."""
 

@@ -1,7 +1,9 @@
 """Stability of a tube's states (m = 0): the spectra of the mirror blocks of ∂R/∂u and the number of unstable
-directions under pressure control (all of u's unknowns: a held λ̄ is not one) and under volume control (on
-δV = ∇V·δu = 0, ∇V = −∂R/∂P), by the inertia of a Bunch–Kaufman factorisation (numerics/eigen.py: ``restricted``
-removes the constraint); and where the membrane is compressed (``smallest_stress``): a membrane wrinkles where a
+directions under pressure control (all of u's unknowns: a held λ̄ is not one), under volume control (on
+δV = ∇V·δu = 0, ∇V = −∂R/∂P) and under gas control (P V = n fixed: the energy E − n ln V, whose Hessian at fixed n
+is ∂²E + (n/V²) ∇V∇Vᵀ, per 2π with Ṽ = V/2π: H + (P/Ṽ) g gᵀ, g = ∇Ṽ = −∂R/∂P, a positive rank-one update:
+stable under pressure ⇒ under gas ⇒ under volume control, as on the sphere, analysis/stability/axisymmetric.py), by
+the inertia of a Bunch–Kaufman factorisation (numerics/eigen.py: ``restricted`` removes the constraint); and where the membrane is compressed (``smallest_stress``): a membrane wrinkles where a
 principal stress is negative, its Ritz problem is not elliptic there and the states and eigenvalues computed there
 do not converge in the degree (docs/tubes.md: the plugged tube's necks); in a coil field a trace stops where its
 states turn compressed (``CompressionStop``: there they measurably do not converge, docs/tubes.md)."""
@@ -19,9 +21,10 @@ COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the
 
 
 def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
-    """{Control.PRESSURE, Control.VOLUME: the number of negative eigenvalues of ∂R/∂u at each Y = (u, P) of
-    ``points`` (``params``: the branch's, P replaced), without and with δV = 0} (module docstring)."""
-    counts = {Control.PRESSURE: [], Control.VOLUME: []}
+    """{Control: the number of negative eigenvalues of the second variation at each Y = (u, P) of ``points``
+    (``params``: the branch's, P replaced): ∂R/∂u (pressure), on δV = 0 (volume), H + (P/Ṽ) g gᵀ (gas)} (module
+    docstring)."""
+    counts = {control: [] for control in Control}
     free = eq.disc.free
     unit = GramFactor(np.ones(free.size), orthogonal=True)
     for Y in points:
@@ -30,6 +33,7 @@ def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
         counts[Control.PRESSURE].append(negative_count(H))
         gradient = -eq.parameter_derivative(Y[:-1], at, "P")[free]
         counts[Control.VOLUME].append(negative_count(restricted(H, unit, gradient[None, :])))
+        counts[Control.GAS].append(negative_count(H + Y[-1] / eq.volume(Y[:-1]) * np.outer(gradient, gradient)))
     return {control: np.array(values, dtype=int) for control, values in counts.items()}
 
 

@@ -13,23 +13,20 @@ from .problem import ParameterSystem
 from ..results import Kind, StopCode
 
 FOLD_KIND = {Control.PRESSURE: Kind.LP, Control.VOLUME: Kind.LV, Control.GAS: Kind.LN}
-STOP_KEY = {Control.VOLUME: ("stop_volume", StopCode.STOP_VOLUME), Control.GAS: ("stop_amount", StopCode.STOP_AMOUNT)}
 
 
-def control_stop(loading) -> tuple | None:
-    """(loading key, StopCode, limit) of a scene's stop in its control parameter (loading.stop_volume or
-    stop_amount), or None when it has none."""
-    if loading.control not in STOP_KEY:
-        return None
-    key, code = STOP_KEY[loading.control]
-    limit = getattr(loading, key)
-    return None if limit is None else (key, code, limit)
+def scene_stops(scene) -> tuple:
+    """((key, StopCode, Control q, limit), ...) of a scene's stops in V or n: ``continuation.stop_volume`` (V/R0³,
+    under every control) and ``loading.stop_amount`` (n = P V, gas control); the branch ends where q reaches
+    the limit, landed on exactly (``landing``)."""
+    stops = (("stop_volume", StopCode.STOP_VOLUME, Control.VOLUME, scene.continuation.stop_volume),
+             ("stop_amount", StopCode.STOP_AMOUNT, Control.GAS, scene.loading.stop_amount))
+    return tuple(stop for stop in stops if stop[3] is not None)
 
 
-def landing(loading) -> dict:
-    """The ``assembly.assemble`` land_on entry of a scene's control stop: {StopCode: (Control, limit)} or {}."""
-    stop = control_stop(loading)
-    return {} if stop is None else {stop[1]: (loading.control, stop[2])}
+def landing(scene) -> dict:
+    """The ``assembly.assemble`` land_on entries of a scene's stops in V or n: {StopCode: (Control, limit)}."""
+    return {code: (control, limit) for _, code, control, limit in scene_stops(scene)}
 
 
 def control_value(disc, X, control: Control, geometry: Geometry = Geometry()) -> float:

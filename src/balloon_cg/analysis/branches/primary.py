@@ -9,7 +9,7 @@
 2. Field on: natural continuation in M at that pressure (and voltage) from 0 to the scene's M.
 3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards
    to ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``),
-   ``loading.stop_volume``/``stop_amount``, a wire gap or ``max_points``; folds in the parameter (LP), in the
+   ``continuation.stop_volume`` (any control), ``loading.stop_amount``, a wire gap or ``max_points``; folds in the parameter (LP), in the
    north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and recorded; the degree and
    basis map adapt (``tracer``).
 
@@ -32,7 +32,7 @@ from ...numerics import continuation
 from ...numerics.continuation import Stop
 from ...numerics.newton import newton
 from .assembly import PARAMETER, assemble
-from .control import control_stop, control_value, landing
+from .control import control_value, landing, scene_stops
 from .events import with_events
 from .problem import ParameterSystem
 from ..results import Branch, StopCode
@@ -274,11 +274,10 @@ def range_limits(scene, upper: float, parameter: str | None = None, params: Para
     """limits(disc, point) -> Stop or None: a dielectric membrane is compressed, the north pole stretch leaves
     [min_stretch, upper], P reaches stop_pressure (Φ̄ reaches stop_voltage or falls below 0 in a voltage
     continuation; M reaches stop_field or falls below 0 in a continuation in M), or the control parameter reaches
-    loading.stop_volume or stop_amount: the range the scene asks for, and the model's. ``parameter``: the
+    continuation.stop_volume or loading.stop_amount: the range the scene asks for, and the model's. ``parameter``: the
     continuation parameter (default the scene's, ``tracer.scene_parameter``), ``params`` the fixed ones (default:
     the scene's voltage)."""
-    cont, control = scene.continuation, scene.loading.control
-    by_control = control_stop(scene.loading)
+    cont, stops = scene.continuation, scene_stops(scene)
     parameter = parameter or scene_parameter(scene)
     in_voltage = parameter == "voltage"
     fixed_voltage = params.voltage if params is not None else getattr(scene.electric, "voltage", 0.0)
@@ -296,9 +295,9 @@ def range_limits(scene, upper: float, parameter: str | None = None, params: Para
             return Stop(StopCode.MIN_STRETCH, f"reached min_stretch {cont.min_stretch:g}")
         if cont.stop_pressure is not None and point.X[-1] >= cont.stop_pressure and parameter == "P":
             return Stop(StopCode.STOP_PRESSURE, f"reached stop_pressure {cont.stop_pressure:g}")
-        if by_control is not None and control_value(disc, point.X, control, scene.geometry) >= by_control[2]:
-            key, code, limit = by_control
-            return Stop(code, f"reached {key} {limit:g}")
+        for key, code, control, limit in stops:
+            if control_value(disc, point.X, control, scene.geometry) >= limit:
+                return Stop(code, f"reached {key} {limit:g}")
         if in_voltage and cont.stop_voltage is not None and point.X[-1] >= cont.stop_voltage:
             return Stop(StopCode.STOP_VOLTAGE, f"reached stop_voltage {cont.stop_voltage:g}")
         if in_voltage and point.X[-1] < 0:  # Φ̄ → −Φ̄ is the same balloon: the branch ends at the voltage-free sphere
@@ -354,4 +353,4 @@ def landing_targets(scene, upper: float) -> dict:
     if scene.continuation.stop_field is not None:
         field_ends[StopCode.STOP_FIELD] = (PARAMETER, scene.continuation.stop_field)
     return {StopCode.STOP_STRETCH: ("lam2_top", upper),
-            StopCode.MIN_STRETCH: ("lam2_top", scene.continuation.min_stretch)} | landing(scene.loading) | field_ends
+            StopCode.MIN_STRETCH: ("lam2_top", scene.continuation.min_stretch)} | landing(scene) | field_ends

@@ -5,7 +5,7 @@ general (non-symmetric) space of the branch point's reading (``bifurcation.gener
 free at an odd_free point, where the translation b_0 is an unknown and the net axial force vanishes), until it rejoins the primary
 branch (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch
 point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch);
-it ends exactly on stop_stretch (north or south), or on the loading's stop_volume/stop_amount, when it stops
+it ends exactly on stop_stretch (north or south), or on continuation.stop_volume or loading.stop_amount, when it stops
 there.
 
 The rejoin is an extremum of P, not a fold: near a pitchfork P = P* + c A² + O(A⁴) on the pear branch (P is
@@ -103,7 +103,7 @@ def pear_landing(scene) -> dict:
     min_stretch, and the control stop (``control.landing``)."""
     stretch = scene.continuation.stop_stretch
     return {StopCode.STOP_STRETCH: ("lam2_top", stretch), StopCode.BOTTOM_STOP_STRETCH: ("lam2_bottom", stretch),
-            StopCode.MIN_STRETCH: ("lam2_top", scene.continuation.min_stretch)} | landing(scene.loading)
+            StopCode.MIN_STRETCH: ("lam2_top", scene.continuation.min_stretch)} | landing(scene)
 
 
 def rejoin_fold(branch: Branch, fold: SpecialPoint, bp_X) -> bool:
