@@ -43,7 +43,7 @@ def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
         scene, primary, point, branch = switched(length, degree, block, extra)
         assert point.status == "located"
         onsets[block] = point.pressure
-        assert branch.stop.code in ("volume", "rejoined")
+        assert branch.stop.code in ("stop_volume", "rejoined")
         fold = next(s for s in branch.special if s.kind == "LV")
         assert fold.smallest_stress > 0 and fold.status == "located"
         eq = Equilibrium(scene, branch.disc)
