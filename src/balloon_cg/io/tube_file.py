@@ -3,8 +3,9 @@ tube/picture.py, written atomically (io/hdf5.py), read back checked.
 
 Root attributes: the format, the scene (name, TOML), the shape and its parameters (``shape``, ``length``, ``ends``,
 ``axial_stretch``: NaN where the ends' distance is free), the discretisation (``degree``, ``quadrature``),
-``maxwell_pressure`` (NaN where there is none), ``control`` (the scene's loading.control, whose stability reading
-and folds count: files before it have none, read as "pressure") and the provenance. One group per branch under /branches/<name>/:
+``maxwell_pressure`` (NaN where there is none), ``control`` (the scene's loading.control, whose stability reading and
+folds count: files before it have none, read as "pressure") and the provenance. One group per branch under
+/branches/<name>/:
 per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``,
 ``unstable_volume`` and ``unstable_gas`` (negative eigenvalues of ∂R/∂u, on δV = 0, and of ∂R/∂u + (P/Ṽ) g gᵀ:
 tube/stability.py; files before gas control have no ``unstable_gas``), ``smallest_stress`` (the smallest

@@ -2,7 +2,8 @@
 (galerkin/interval.py), reading analysis's plain data and numerics. In reading order:
 
 - ``results``: a tube's branch and its located points as plain data, why a trace stopped
-- ``stability``: the spectra of the mirror blocks and the unstable directions under pressure and volume control
+- ``stability``: the spectra of the mirror blocks and the unstable directions under pressure, volume and gas control
+- ``control``: the loading control's parameter (V, n) on a trace, its folds (LV, LN), the stop at stop_volume
 - ``primary``: the primary branch in P from the unstressed tube, its folds and mirror-block branch points
 - ``bulge``: the branch switched at an odd branch point (the bulge), through its volume fold
 - ``picture``: all of a tube scene's run (``balloon-cg run``)

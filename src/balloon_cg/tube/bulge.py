@@ -12,14 +12,14 @@ ends), and the trace starts there: at X* itself dP/ds and dV/ds vanish by the sy
 arclength along a pitchfork), so the fold monitors start from the first point. It is traced by pseudo-arclength
 continuation in X = (u, P), at an odd branch point on every unknown, at an even one on the even block (a held λ̄ stays
 fixed), its folds in P (LP), in the enclosed volume (LV: V/(2π) = −∂E/∂P, whose gradient is −∂R/∂P) and under gas
-control in n = P V (LN: tube/control.py) located by the tracer's fold monitors, until it rejoins the primary branch's kind of states (``Side`` changes sign: the bulge has
-filled the tube and the branch meets the primary branch again at another branch point of the block, the other end of
-the pitchfork's loop, where P and V are again even in the arclength: the monitors' sign changes in that last step are
-that symmetry, not folds, and are not kept), its V reaches ``continuation.stop_volume`` (or the argument
-``stop_volume`` in V/V0; the end landed there exactly: tube/control.VolumeStop), its largest hoop stretch
-``stop_stretch``, in a coil field where its states turn compressed (IntervalStop.COMPRESSED:
-tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
-(StopCode.INTERRUPTED). The branch point X* is the branch's first point; the stability of every point is
+control in n = P V (LN: tube/control.py) located by the tracer's fold monitors, until it rejoins the primary branch's
+kind of states (``Side`` changes sign: the bulge has filled the tube and the branch meets the primary branch again at
+another branch point of the block, the other end of the pitchfork's loop, where P and V are again even in the arclength:
+the monitors' sign changes in that last step are that symmetry, not folds, and are not kept), its V reaches
+``continuation.stop_volume`` (or the argument ``stop_volume`` in V/V0; the end landed there exactly:
+tube/control.VolumeStop), its largest hoop stretch ``stop_stretch``, in a coil field where its states turn compressed
+(IntervalStop.COMPRESSED: tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point after
+SIGINT/SIGTERM (StopCode.INTERRUPTED). The branch point X* is the branch's first point; the stability of every point is
 ``unstable_counts``' (at X* itself one eigenvalue is zero, its sign rounding).
 """
 import numpy as np
@@ -29,7 +29,7 @@ from .primary import TubeSystem, held, in_field, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, unstable_counts
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
-from ..analysis.results import Kind
+from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..numerics import continuation
@@ -46,10 +46,11 @@ class UnswitchableBranchPoint(ValueError):
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None) -> IntervalBranch:
-    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: V/V0
-    where it ends (None: the scene's continuation.stop_volume, V/R0³, if any); ``step``: the first arclength step
-    (None: continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it. UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that
-    is not uniform."""
+    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: V/V0 where
+    it ends (None: the scene's continuation.stop_volume, V/R0³, if any); ``step``: the first arclength step (None:
+    continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it.
+    UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that is not
+    uniform."""
     if point.kind != Kind.BP or point.block is None:
         raise UnswitchableBranchPoint(f"a branch is switched at a branch point of a mirror block, not at "
                                       f"{point.kind.value}")
@@ -105,8 +106,8 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     last = len(path.points) - 1
     folds = [f for f in path.folds if not (path.stop.code == IntervalStop.REJOINED and f.index == last)]
     end, stopped = volume_stop.end(path, settings)
-    if end is not None:
-        folds = [f for f in folds if f.index < last or volume_stop.before(path, f.point.X)]
+    if path.stop.code == StopCode.STOP_VOLUME:
+        folds = [f for f in folds if f.index < last or volume_stop.kept(path, end, f.point.X)]
     special = tuple(IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + 1,
                                     f.status) for f in sorted(folds, key=lambda f: f.index))
     points = [system.full(X)] + [system.full(p.X) for p in path.points] + ([] if end is None else [end])

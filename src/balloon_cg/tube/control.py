@@ -62,8 +62,9 @@ class VolumeStop:
                                                        "(Newton failed); stopped before it")
         return self.system.full(landed.X), path.stop
 
-    def before(self, path, X) -> bool:
-        """Whether a point X located in the trace's last step (between its last point and the overshoot) lies on
-        the branch, before its landed end (V between the last point's and the target)."""
+    def kept(self, path, end, X) -> bool:
+        """Whether a point X located in the last step of a trace stopped here (between its last point and the
+        overshoot) lies on the branch: before its landed ``end`` (V between the last point's and the target); none
+        where the landing failed (``end`` None: the branch ends at its last point)."""
         last, here = self.volume(path.points[-1].X), self.volume(X)
-        return (here - last) * (self.target - here) >= 0
+        return end is not None and (here - last) * (self.target - here) >= 0

@@ -31,7 +31,7 @@ from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
 from ..analysis.stability.crossings import count_changes
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
-from ..analysis.results import Kind
+from ..analysis.results import Kind, StopCode
 from ..analysis.branches.tracer import ContinuationError
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
@@ -142,8 +142,8 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
     kept = len(path.points)
     full, spectra = full[:kept], {block: values[:kept] for block, values in spectra.items()}
     end, stopped = volume_stop.end(path, settings)
-    if end is not None:
-        special = [s for s in special if s.index < kept - 1 or volume_stop.before(path, _in(system, s))]
+    if path.stop.code == StopCode.STOP_VOLUME:
+        special = [s for s in special if s.index < kept - 1 or volume_stop.kept(path, end, _in(system, s))]
         full.append(end)
         spectra = {block: np.vstack([values, spectrum(eq, end, disc.block(block), params)])
                    for block, values in spectra.items()}

@@ -46,11 +46,11 @@ class IntervalSpecial:
 @dataclass(frozen=True)
 class IntervalBranch:
     """The points (``states`` rows u, ``pressure``), the enclosed volume over the reference one (V/V0, V0 = πL), the
-    lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without
-    mirror symmetry), the number of unstable directions at every point under each control (``unstable``:
-    Control -> int array; files before gas control have no Control.GAS), the located points, why the trace stopped and the smallest
-    principal stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters
-    (the field's M and χ; P is each point's)."""
+    lowest eigenvalue of each mirror block at every point (``lowest``: Mirror -> array; empty on a branch without mirror
+    symmetry), the number of unstable directions at every point under each control (``unstable``: Control -> int array;
+    files before gas control have no Control.GAS), the located points, why the trace stopped and the smallest principal
+    stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters (the field's M
+    and χ; P is each point's)."""
 
     disc: IntervalDiscretisation
     states: np.ndarray

@@ -1,12 +1,13 @@
-"""Stability of a tube's states (m = 0): the spectra of the mirror blocks of ∂R/∂u and the number of unstable
-directions under pressure control (all of u's unknowns: a held λ̄ is not one), under volume control (on
-δV = ∇V·δu = 0, ∇V = −∂R/∂P) and under gas control (P V = n fixed: the energy E − n ln V, whose Hessian at fixed n
-is ∂²E + (n/V²) ∇V∇Vᵀ, per 2π with Ṽ = V/2π: H + (P/Ṽ) g gᵀ, g = ∇Ṽ = −∂R/∂P, a positive rank-one update:
-stable under pressure ⇒ under gas ⇒ under volume control, as on the sphere, analysis/stability/axisymmetric.py), by
-the inertia of a Bunch–Kaufman factorisation (numerics/eigen.py: ``restricted`` removes the constraint); and where the membrane is compressed (``smallest_stress``): a membrane wrinkles where a
-principal stress is negative, its Ritz problem is not elliptic there and the states and eigenvalues computed there
-do not converge in the degree (docs/tubes.md: the plugged tube's necks); in a coil field a trace stops where its
-states turn compressed (``CompressionStop``: there they measurably do not converge, docs/tubes.md)."""
+"""Stability of a tube's states (m = 0): the spectra of the mirror blocks of ∂R/∂u and the number of unstable directions
+under pressure control (all of u's unknowns: a held λ̄ is not one), under volume control (on δV = ∇V·δu = 0, ∇V =
+−∂R/∂P) and under gas control (P V = n fixed: the energy E − n ln V, whose Hessian at fixed n is ∂²E + (n/V²) ∇V∇Vᵀ, per
+2π with Ṽ = V/2π: H + (P/Ṽ) g gᵀ, g = ∇Ṽ = −∂R/∂P, a positive rank-one update: stable under pressure ⇒ under gas ⇒ under
+volume control, as on the sphere, analysis/stability/axisymmetric.py), by the inertia of a Bunch–Kaufman factorisation
+(numerics/eigen.py: ``restricted`` removes the constraint); and where the membrane is compressed (``smallest_stress``):
+a membrane wrinkles where a principal stress is negative, its Ritz problem is not elliptic there and the states and
+eigenvalues computed there do not converge in the degree (docs/tubes.md: the plugged tube's necks); in a coil field a
+trace stops where its states turn compressed (``CompressionStop``: there they measurably do not converge,
+docs/tubes.md)."""
 import numpy as np
 
 from .results import IntervalStop

@@ -7,11 +7,11 @@
    (λ2 = 1, η = Z(θ), P = 0, an exact equilibrium) by natural continuation in the north pole stretch up to the
    start stretch, P an unknown (``inflated_reference``).
 2. Field on: natural continuation in M at that pressure (and voltage) from 0 to the scene's M.
-3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards
-   to ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``),
-   ``continuation.stop_volume`` (any control), ``loading.stop_amount``, a wire gap or ``max_points``; folds in the parameter (LP), in the
-   north pole stretch (TP) and in the control parameter V or n (LV, LN) are located and recorded; the degree and
-   basis map adapt (``tracer``).
+3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards to
+   ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``), ``continuation.stop_volume`` (any
+   control), ``loading.stop_amount``, a wire gap or ``max_points``; folds in the parameter (LP), in the north pole
+   stretch (TP) and in the control parameter V or n (LV, LN) are located and recorded; the degree and basis map adapt
+   (``tracer``).
 
 The equator-symmetric subspace is used whenever the field allows it; without a field (no coils, or M = 0) the
 axial translation is removed from the unknowns; with a field that is not equator-symmetric the balloon is held at

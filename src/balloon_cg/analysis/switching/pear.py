@@ -4,9 +4,8 @@ From u* + δφ (φ the critical mode, ±), corrected on the hyperplane normal to
 general (non-symmetric) space of the branch point's reading (``bifurcation.general_tracer``: the balloon held, or
 free at an odd_free point, where the translation b_0 is an unknown and the net axial force vanishes), until it rejoins the primary
 branch (the amplitude φ·(u − u*) changes sign: a closed loop, the isola, when that happens at another branch
-point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch);
-it ends exactly on stop_stretch (north or south), or on continuation.stop_volume or loading.stop_amount, when it stops
-there.
+point) or a stop rule applies (those of the primary branch, and the south pole stretch reaching stop_stretch); it ends
+exactly on stop_stretch (north or south), or on continuation.stop_volume or loading.stop_amount, when it stops there.
 
 The rejoin is an extremum of P, not a fold: near a pitchfork P = P* + c A² + O(A⁴) on the pear branch (P is
 even in the pear amplitude A), so dP/ds vanishes where the branch crosses the primary branch and the fold
