@@ -19,6 +19,7 @@ from scipy import linalg, optimize
 from balloon_cg.analysis.branches.control import control_value
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Kind, StopCode
+from balloon_cg.app.api import analyse
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.io.tube_file import read_tube_run, stored_branch, write_tube_run
@@ -256,3 +257,34 @@ def test_bulge_branch_under_gas_control_lands_on_stop_volume():
     assert [s.kind for s in bulge.special] == [Kind.LV, Kind.LN]
     i = bulge.special[1].index
     assert bulge.unstable[Control.GAS][i] == 1 and bulge.unstable[Control.GAS][i + 1] == 0
+
+
+def test_stop_volume_on_held_and_plugged_ends():
+    """Ends held at λz = 1.5 (sliding; volume control): the primary branch is uniform at λz = 1.5 and ends landed on
+    stop_volume = 4πL at λθ = sqrt(4/1.5), P = Φ_2(1.5, λθ)/(1.5 λθ) (1e-9); plugged ends (gas control): landed too
+    (1e-9), past the plugged tube's pressure fold, stable under gas control there (its LP is no fold of n)."""
+    held = tube('[material]\npreset = "SPOM1"\n', 10.0, 'axial_stretch = 1.5\n[solver]\ndegree = 20\n'
+                f'[continuation]\nstop_volume = {40 * np.pi!r}\n[loading]\ncontrol = "volume"\n')
+    branch = primary_branch(held)
+    hoop = np.sqrt(4 / 1.5)
+    assert branch.stop.code == StopCode.STOP_VOLUME and abs(branch.volume[-1] - 4) < 1e-9 * 4
+    assert abs(branch.states[-1, 0] - hoop) < 1e-9
+    assert abs(branch.pressure[-1] - derivatives(held.material, 1.5, hoop)[1] / (1.5 * hoop)) < 1e-9
+    plugged = tube('[material]\npreset = "SPOM1"\n', 10.0, 'ends = "plugged"\n[solver]\ndegree = 30\n'
+                   f'[continuation]\nstop_volume = {40 * np.pi!r}\n[loading]\ncontrol = "gas"\n')
+    branch = primary_branch(plugged)
+    assert branch.stop.code == StopCode.STOP_VOLUME and abs(branch.volume[-1] - 4) < 1e-9 * 4
+    assert [s.kind for s in branch.special] == [Kind.LP] and not branch.unstable[Control.GAS].any()
+    assert branch.unstable[Control.PRESSURE][-1] > 0
+
+
+def test_stop_volume_ends_the_spheres_pear_branches():
+    """SPOM1 sphere under pressure control, continuation.stop_volume = 40 (the pear branches reach V = 44.8 at
+    stop_stretch 5 without it): ``analyse`` ends the primary branch and both pear branches landed on V = 40 (1e-9)."""
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_volume = 40.0\n[stability]\nm_max = 0\n',
+                        "sphere")
+    branches = analyse(scene).picture.branches
+    assert [b.name for b in branches] == ["primary", "pear_0", "pear_0_mirror"]
+    for branch in branches:
+        assert branch.legs[0].stop.code == StopCode.STOP_VOLUME
+        assert abs(control_value(branch.disc, branch.X[-1], Control.VOLUME) - 40.0) < 1e-9 * 40.0
