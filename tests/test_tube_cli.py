@@ -56,6 +56,7 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     text = capsys.readouterr().out
     assert "tube of length 10, sliding ends, end distance free (closed)" in text
     assert "Maxwell        P_M = 0.445022155" in text and "branch bulge:" in text and " LV " in text
+    assert "m ≥ 1 not assessed" in text
     assert main(["inspect", str(run_file), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["kind"] == "tube" and set(summary) == inspect_json_keys("tube run file")  # docs/hdf5.md's keys

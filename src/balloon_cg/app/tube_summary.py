@@ -92,6 +92,7 @@ def format_tube(summary: dict) -> str:
                                    if summary["field"]["coils"] else "none"),
              "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"),
              f"degree         {summary['degree']}",
+             "stability      m = 0 (pressure and volume control); m ≥ 1 not assessed",
              f"Maxwell        P_M = {maxwell}"]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
