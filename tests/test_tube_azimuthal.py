@@ -57,7 +57,7 @@ def second_derivative(energy, h=1e-2):
     return sum(c * (energy(j * h) + energy(-j * h)) / (2 if j == 0 else 1) for j, c in enumerate(STENCIL)) / h**2
 
 
-def mode_matrix(material, state, P, L, m, n):
+def mode_matrix(material, state, P, L, m, n, nodes=48):
     """d²E/dε² = vᵀ K v for v = (A, B, C) (for n = 0 only A, B: sin 0 = 0), by the stencil and polarisation."""
     k = n * np.pi / L
     index = [0, 1] if n == 0 else [0, 1, 2]
@@ -72,7 +72,7 @@ def mode_matrix(material, state, P, L, m, n):
         def wave(S):
             return A * np.cos(k * S), -A * k * np.sin(k * S), B * np.cos(k * S), -B * k * np.sin(k * S), \
                 C * np.sin(k * S), C * k * np.cos(k * S)
-        return second_derivative(lambda e: perturbed_energy(material, P, L, m, uniform, wave, e))
+        return second_derivative(lambda e: perturbed_energy(material, P, L, m, uniform, wave, e, nodes))
 
     K = np.zeros((3, 3))
     for i in index:
@@ -174,3 +174,43 @@ def test_uniform_tube_has_no_m_ge_1_instability_before_its_bulge_onset():
         assert not modes.unstable[m][1:].any(), (m, modes.unstable[m])
         assert modes.lowest[m][1:, 0].min() > 0
     assert onset.index < len(primary.pressure) - 1  # the branch went beyond the onset
+
+
+def test_held_tube_buckles_sideways_where_the_mode_matrix_is_singular():
+    """Neo-Hookean, ends held at λz = 1.5 (sliding), L = 10, degree 16: inflated at fixed length the tube comes under
+    axial compression and its first m = 1 zero (located by tube/azimuthal_crossings.py along the primary branch) is
+    where the mode matrix K_n (this module's, from the energy) of the wave cos(nπS/L) first turns singular: λθ from
+    Brent on the lowest eigenvalue of K_n over n = 1..3, P = Φ_2/(λθλz) there (Φ_2 written here). The first root is the
+    longest wave n = 1 at λθ = 2.17430517 (n = 2: 2.36399); the located zero is within 4.9e-10 in λθ and 2.4e-11 in P
+    (asserted 1e-7: the stencil's accuracy), its eigenvalue 0 to 1e-10."""
+    from types import SimpleNamespace
+
+    from scipy import optimize
+
+    from balloon_cg.tube.azimuthal_crossings import crossings
+
+    scene = tube_scene("neo-Hookean", 10.0, "axial_stretch = 1.5\n").with_overrides(
+        {"solver.degree": 16, "continuation.stop_stretch": 2.3})
+    material, axial, L = scene.material, 1.5, 10.0
+
+    def pressure(hoop):  # Φ_2/(λθλz), Φ_2 = Σ μ (λ2^(α−1) − λ2^(−α−1) λ1^(−α))
+        phi2 = sum(mu * (hoop ** (a - 1) - hoop ** (-a - 1) * axial**-a) for mu, a in zip(material.mu, material.alpha))
+        return phi2 / (hoop * axial)
+
+    def lowest(hoop, n):
+        state = SimpleNamespace(hoop=hoop, axial=axial)
+        return np.linalg.eigvalsh(mode_matrix(material, state, pressure(hoop), L, 1, n, nodes=24))[0]
+
+    roots = [optimize.brentq(lambda h: lowest(h, n), 2.0, 2.6, xtol=1e-11) for n in range(1, 4)
+             if lowest(2.0, n) * lowest(2.6, n) < 0]
+    hoop = min(roots)
+    primary = primary_branch(scene)
+    eq = Equilibrium(scene, primary.disc)
+    modes = azimuthal.branch_modes(eq, np.column_stack([primary.states, primary.pressure]), primary.params, 1)
+    found = [c for c in crossings(scene, primary, modes) if c.pressure > 0.5]  # (P = 0 is hoop-compressed: λθ < 1)
+    first = found[0]
+    assert first.m == 1 and first.order == 0 and abs(first.value) < 1e-10
+    located_hoop = primary.disc.node_state(first.u)[0]
+    assert np.ptp(located_hoop) < 1e-10  # the uniform state
+    assert abs(located_hoop[0] - hoop) < 1e-7 and abs(first.pressure - pressure(hoop)) < 1e-7, \
+        (located_hoop[0] - hoop, first.pressure - pressure(hoop))

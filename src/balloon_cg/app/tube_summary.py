@@ -42,15 +42,16 @@ def summarise_tube(run: dict) -> dict:
 
 
 def _azimuthal(branch: dict) -> dict:
-    """{m: {'unstable_max', 'lowest_min', 'changes': [{'after_point', 'unstable', 'pressure', 'volume'}]}} of the
-    branch's m ≥ 1 blocks (a change between points i and i + 1 is listed after point i: not located)."""
+    """{m: {'unstable_max', 'lowest_min', 'changes': [{'after_point', 'unstable', 'pressure', 'volume'}], 'points'}}
+    of the branch's m ≥ 1 blocks: a change between points i and i + 1 listed after point i (at point i + 1's P and
+    V/V0), and the located zeros of the eigenvalues ('points': io/tube_file's dicts)."""
     out = {}
     for m, block in branch.get("azimuthal", {}).items():
         counts = block["unstable"]
         changes = [{"after_point": int(i), "unstable": int(counts[i + 1]), "pressure": float(branch["pressure"][i + 1]),
                     "volume": float(branch["volume"][i + 1])} for i in np.flatnonzero(np.diff(counts))]
         out[str(m)] = {"unstable_max": int(counts.max()), "lowest_min": float(block["lowest"][:, 0].min()),
-                       "changes": changes}
+                       "changes": changes, "points": block["points"]}
     return out
 
 
@@ -135,6 +136,8 @@ def format_tube(summary: dict) -> str:
                                 f"V/V0 = {c['volume']:.6g})" for c in block["changes"])
             lines.append(f"  m = {m}: lowest eigenvalue ≥ {block['lowest_min']:.4g}, at most {block['unstable_max']} "
                          f"unstable" + (f"; unstable count {changes}" if changes else ""))
+            lines += [f"        BP m = {m} (eigenvalue {p['order']}) after point {p['index']:<4} P = {p['pressure']:.10g}  "
+                      f"V/V0 = {p['volume']:.8g}  {p['status']}" for p in block["points"]]
         for s in b["special_points"]:
             k, label = label, label + 1
             block = f" {s['block']}" if s["block"] else ""

@@ -69,6 +69,9 @@ TUBE_VARIABLES = {
     **{f"unstable_m{m}": ("", f"unstable directions, m = {m}", f"negative eigenvalues of the cos {m}φ block (pressure "
                           "and volume control alike)") for m in range(1, AZIMUTHAL_LIMIT + 1)},
     "eigenvalue": ("", "eigenvalue index", "the lowest eigenvalues of a block, ascending"),
+    "m": ("", "azimuthal number", "the cos mφ block whose eigenvalue vanishes"),
+    "order": ("", "eigenvalue number", "which eigenvalue of the block vanishes (ascending, from 0)"),
+    "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
     "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
@@ -144,6 +147,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             for m in modes.lowest:
                 checksummed(group, f"lowest_m{m}", modes.lowest[m])
                 checksummed(group, f"unstable_m{m}", modes.unstable[m])
+            _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size)
         special = group.create_group("special_points")
         s = branch.special
         write_strings(special, "kind", [p.kind.value for p in s])
@@ -163,6 +167,17 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             write_tube_frequencies(group, picture.frequencies[name])
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
+
+
+def _write_crossings(group, found, size: int) -> None:
+    """The located zeros of the m ≥ 1 eigenvalues (tube/azimuthal_crossings.py): per point ``m``, ``order``,
+    ``index``, ``pressure``, ``volume``, ``value``, ``status``, ``unknowns``."""
+    for column, kind in (("m", int), ("order", int), ("index", int), ("pressure", float), ("volume", float),
+                         ("value", float)):
+        checksummed(group, column, np.array([getattr(c, column) for c in found], dtype=kind))
+    write_strings(group, "status", [c.status.value for c in found])
+    checksummed(group, "unknowns", np.array([c.u for c in found], dtype=float).reshape(len(found), size))
+    _dimensions(group, "special", {"unknown": size})
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
@@ -230,13 +245,21 @@ def read_tube(f, path, where: str = "") -> dict:
 
 
 def _read_modes(path, group, n: int, where: str) -> dict:
-    """{m: {'lowest': (n, COUNT), 'unstable': (n,)}} for m = 1..the group's ``m_max`` ({}: not assessed)."""
+    """{m: {'lowest': (n, COUNT), 'unstable': (n,), 'points': [dict per located zero]}} for m = 1..the group's
+    ``m_max`` ({}: not assessed; 'points' empty in files written before they were located)."""
     out = {}
+    located = group.get("azimuthal_points")
+    points = [] if located is None else [
+        {"m": int(m), "order": int(k), "index": int(i), "pressure": float(p), "volume": float(v), "value": float(x),
+         "status": s} for m, k, i, p, v, x, s in zip(*(located[c][()] for c in ("m", "order", "index", "pressure",
+                                                                              "volume", "value")),
+                                                    located["status"].asstr()[()])]
     for m in range(1, int(group.attrs.get("m_max", 0)) + 1):
         missing = [c for c in (f"lowest_m{m}", f"unstable_m{m}") if c not in group]
         if missing:
             raise TubeFileError(path, f"{where}: m_max = {group.attrs['m_max']} but {', '.join(missing)} missing")
-        out[m] = {"lowest": group[f"lowest_m{m}"][()], "unstable": group[f"unstable_m{m}"][()]}
+        out[m] = {"lowest": group[f"lowest_m{m}"][()], "unstable": group[f"unstable_m{m}"][()],
+                  "points": [p for p in points if p["m"] == m]}
         if out[m]["lowest"].shape[0] != n or out[m]["unstable"].shape != (n,):
             raise TubeFileError(path, f"{where}/lowest_m{m}, unstable_m{m}: not one row per point ({n})")
     return out

@@ -42,10 +42,12 @@ COUNT = 3  # the lowest eigenvalues kept per block and point
 @dataclass(frozen=True)
 class TubeModes:
     """The m = 1..m_max blocks at each point of a branch: ``lowest`` {m: (points, COUNT)} the lowest eigenvalues μ,
-    ``unstable`` {m: (points,)} the number of negative ones (the same under pressure and volume control)."""
+    ``unstable`` {m: (points,)} the number of negative ones (the same under pressure and volume control);
+    ``crossings`` where an eigenvalue vanishes (tube/azimuthal_crossings.AzimuthalCrossing)."""
 
     lowest: dict
     unstable: dict
+    crossings: tuple = ()
 
 
 @functools.lru_cache(maxsize=16)

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .azimuthal import branch_modes
+from .azimuthal_crossings import crossings
 from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
@@ -78,14 +79,17 @@ def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> Tu
 
 
 def with_modes(scene, picture: TubePicture) -> TubePicture:
-    """``picture`` with its branches' m = 1..``stability.m_max`` blocks (tube/azimuthal.py) where m_max ≥ 1 and no
-    signal stopped it (a signal ends the work at its next stage: then they are not assessed)."""
+    """``picture`` with its branches' m = 1..``stability.m_max`` blocks (tube/azimuthal.py) and the zeros of their
+    eigenvalues located (tube/azimuthal_crossings.py) where m_max ≥ 1 and no signal stopped it (a signal ends the
+    work at its next stage: then they are not assessed)."""
     m_max = scene.stability.m_max
     if m_max < 1 or picture.interrupted is not None or interrupt.requested():
         return picture
-    modes = {name: branch_modes(Equilibrium(scene, branch.disc), np.column_stack([branch.states, branch.pressure]),
-                                branch.params, m_max)
-             for name, branch in picture.branches.items()}
+    modes = {}
+    for name, branch in picture.branches.items():
+        found = branch_modes(Equilibrium(scene, branch.disc), np.column_stack([branch.states, branch.pressure]),
+                             branch.params, m_max)
+        modes[name] = replace(found, crossings=tuple(crossings(scene, branch, found)))
     return replace(picture, modes=modes)
 
 
