@@ -48,6 +48,8 @@ def test_run_writes_what_the_tube_pipeline_computes(run_file):
         modes = picture.modes[name]  # the m = 1 block (stability.m_max = 1: the default)
         assert set(stored["azimuthal"]) == {1} and np.array_equal(stored["azimuthal"][1]["lowest"], modes.lowest[1])
         assert np.array_equal(stored["azimuthal"][1]["unstable"], modes.unstable[1])
+        assert [(p["index"], p["pressure"]) for p in stored["azimuthal"][1]["points"]] == \
+            [(c.index, c.pressure) for c in modes.crossings]
         assert branch.smallest_stress.min() > -1e-8  # a closed sliding tube stays taut (no point flagged)
     kinds = [(s["kind"], s["block"]) for s in run["branches"]["primary"]["special_points"]]
     assert kinds[:2] == [("LP", ""), ("BP", "odd")] and ("LV", "") in [(s["kind"], s["block"]) for s in
