@@ -24,6 +24,7 @@ from ..galerkin.interval import Mirror
 from ..model.membrane import scene_energy
 from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
+from ..numerics.threads import limited_blas
 from ..scene.tables import Ends
 
 
@@ -78,10 +79,11 @@ def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> Tu
     return with_modes(scene, TubePicture(branches, pm, interrupted=stopped))
 
 
+@limited_blas
 def with_modes(scene, picture: TubePicture) -> TubePicture:
     """``picture`` with its branches' m = 1..``stability.m_max`` blocks (tube/azimuthal.py) and the zeros of their
     eigenvalues located (tube/azimuthal_crossings.py) where m_max ≥ 1 and no signal stopped it (a signal ends the
-    work at its next stage: then they are not assessed)."""
+    work at its next stage: then they are not assessed). One BLAS thread, as the traces."""
     m_max = scene.stability.m_max
     if m_max < 1 or picture.interrupted is not None or interrupt.requested():
         return picture
