@@ -5,5 +5,8 @@
 - ``stability``: the spectra of the mirror blocks and the unstable directions under pressure and volume control
 - ``primary``: the primary branch in P from the unstressed tube, its folds and mirror-block branch points
 - ``bulge``: the branch switched at an odd branch point (the bulge), through its volume fold
+- ``azimuthal``: the m ≥ 1 blocks of a tube's states (cos mφ perturbations), their lowest eigenvalues and unstable
+  directions
+- ``azimuthal_crossings``: where an m ≥ 1 eigenvalue vanishes along a branch, located
 - ``picture``: all of a tube scene's run (``balloon-cg run``)
 """
