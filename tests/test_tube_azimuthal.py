@@ -214,3 +214,21 @@ def test_held_tube_buckles_sideways_where_the_mode_matrix_is_singular():
     assert np.ptp(located_hoop) < 1e-10  # the uniform state
     assert abs(located_hoop[0] - hoop) < 1e-7 and abs(first.pressure - pressure(hoop)) < 1e-7, \
         (located_hoop[0] - hoop, first.pressure - pressure(hoop))
+
+
+def test_m_max_zero_is_said_not_assessed(tmp_path):
+    """stability.m_max = 0: no m ≥ 1 block is computed, the file holds none (its branches' m_max 0) and inspect says
+    "m ≥ 1 not assessed"; with m_max = 2 both blocks are stored and named."""
+    from balloon_cg.app.tube_summary import format_tube, summarise_tube
+    from balloon_cg.io.tube_file import read_tube_run, write_tube_run
+    from balloon_cg.tube.picture import tube_picture
+
+    for m_max, said in ((0, "m ≥ 1 not assessed"), (2, "m = 1..2 (the same under both")):
+        scene = tube_scene().with_overrides({"solver.degree": 12, "continuation.stop_stretch": 1.4,
+                                             "stability.m_max": m_max})
+        picture = tube_picture(scene, primary_only=True)
+        path = write_tube_run(tmp_path / f"m{m_max}.h5", scene, picture)
+        run = read_tube_run(path)
+        assert set(run["branches"]["primary"]["azimuthal"]) == set(range(1, m_max + 1))
+        assert (picture.modes is None) == (m_max == 0)
+        assert said in format_tube(summarise_tube(run))
