@@ -17,8 +17,8 @@ deformed surface's, −½ρ²η' per dt, the meridian running downwards as the s
 
 A meridian with poles (R = 0 at both ends) has its node at (cos θ, sin θ) = (R', R) of the sphere's kernels, the
 Legendre basis in cos θ and the pole series. A tube has no node coordinate at all: R' = 0, R = 1 and S' = 1 are
-folded into its kernels (only the energy kernels: no pole series, no first-order system in θ), and its ends are
-rows of its discretisation (galerkin/interval.py). The sphere's expressions are those derived before the meridian
+folded into its kernels (the energy kernels and the m ≥ 1 second variation: no pole series, no first-order system
+in θ), and its ends are rows of its discretisation (galerkin/interval.py). The sphere's expressions are those derived before the meridian
 was data, so its kernels are byte for byte what they were.
 
 A capsule (a cylinder of length L and radius 1 with hemispherical caps) is discretised as the sphere is, in
@@ -46,7 +46,8 @@ class Meridian:
     name = "sphere"
     parameters: tuple = ()
     poles = True  # both ends on the axis (R = 0): the Legendre basis in cos θ
-    analytic = True  # R, Z analytic in θ: the pole series, the first-order system, the m ≥ 1 second variation
+    analytic = True  # R, Z analytic in θ: the pole series, the first-order system
+    azimuthal = True  # the m ≥ 1 second variation (codegen/second_variation.py): not across a capsule's joins
 
     @property
     def node_symbols(self) -> tuple:
@@ -112,6 +113,7 @@ class Tube(Meridian):
     name = "tube"
     poles = False
     analytic = False
+    azimuthal = True
 
     def radius(self, t):
         return sp.S.One
@@ -129,6 +131,7 @@ class Capsule(Meridian):
     name = "capsule"
     parameters: tuple = (length,)
     analytic = False
+    azimuthal = False
 
     @staticmethod
     def _rate():

@@ -31,6 +31,12 @@ Why (R, T) and a straight Cartesian line rather than (a, B) and the angle β: fo
 angle form's second-order displacement ~ T²/ρ0 is singular there, which adds a spurious pole term to the
 second variation (the translation is then not a zero mode). Along the straight line d²E/dε² is the Hessian
 E''[x1, x1] itself, at any state. The kernel is written per scene class; m is a runtime argument.
+
+On a tube (codegen/meridian.py: t = S, R = 1, R' = 0, S' = 1) the same expressions hold with (cos θ, sin θ) → (R', R)
+= (0, 1): ' = d/dS, and E₂ is per dS; the tube's kernel takes no node coordinate. Its pressure term is the volume
+between the end planes, ½ x_h · (x_S × x_φ) with x_h the horizontal part of x (the end planes add nothing: x_h is
+parallel to them), not the cone form, whose flux through the end planes changes with the end sections' areas at
+O(ε²) (codegen/terms/pressure.py).
 """
 import functools
 
@@ -98,7 +104,8 @@ def second_order_density(cls: SceneClass):
     (λ1 = lam1, p1, p2, p11, p12, p22, K) and the node/state/field symbols; quadratic in PERTURBATION. The
     material stage carries Φ (every term of the stretches); the other terms add their own (``Term.second_order``)."""
     x, x_t, x_p = surface()
-    metric = cls.meridian.metric(cos_theta, sin_theta)
+    meridian = cls.meridian
+    metric = meridian.metric(cos_theta, sin_theta)
     c11 = dot(x_t, x_t) / metric**2
     c22 = dot(x_p, x_p) / sin_theta**2
     c12 = dot(x_t, x_p) / (sin_theta * metric)
@@ -106,7 +113,13 @@ def second_order_density(cls: SceneClass):
     elastic = p1 * epsilon_order(c11, 2) + p2 * epsilon_order(c22, 2)
     elastic += p11 * a1**2 / 2 + p12 * a1 * a2 + p22 * a2**2 / 2
     elastic += shear * epsilon_order(c12, 1) ** 2
-    return phi_average(elastic) * metric + sum(term.second_order(x, x_t, x_p, metric) for term in cls.terms)
+    density = phi_average(elastic) * metric
+    density += sum(term.second_order(x, x_t, x_p, metric, meridian.poles) for term in cls.terms)
+    if meridian.poles:
+        return density
+    # a tube: the node's (cos θ, sin θ) are its (R', R) (module docstring)
+    return density.xreplace({cos_theta: meridian.hoop_rate(cos_theta, sin_theta),
+                             sin_theta: meridian.hoop(cos_theta, sin_theta)})
 
 
 @functools.cache
@@ -182,7 +195,7 @@ def _divided_difference(term):
 
 
 def _kernel_args(cls: SceneClass):
-    return kernel_args(cls, (cos_theta, sin_theta, lam2, v, eta, w), leading_params=(m,))
+    return kernel_args(cls, (*cls.meridian.node_symbols, lam2, v, eta, w), leading_params=(m,))
 
 
 def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
@@ -190,7 +203,8 @@ def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
     outputs = tuple(sp.diff(density, PERTURBATION[i], PERTURBATION[j]) for i, j in PAIRS)
     material = material_stage(cls)
     stages = (
-        ((l1, fn.meridional_stretch(cos_theta, v, w) / cls.meridian.metric(cos_theta, sin_theta)),),
+        ((l1, fn.meridional_stretch(cls.meridian.hoop_rate(cos_theta, sin_theta), v, w)
+          / cls.meridian.metric(cos_theta, sin_theta)),),
         tuple(zip((p1, p2, p11, p12, p22), material)) + ((shear, shear_coefficient(cls)[0]),),
     )
     return Kernel(

@@ -45,6 +45,11 @@ def test_run_writes_what_the_tube_pipeline_computes(run_file):
         assert [s["pressure"] for s in stored["special_points"]] == [s.pressure for s in branch.special]
         assert stored["attrs"]["stop_code"] == branch.stop.code.value
         assert np.array_equal(stored["smallest_stress"], branch.smallest_stress)
+        modes = picture.modes[name]  # the m = 1 block (stability.m_max = 1: the default)
+        assert set(stored["azimuthal"]) == {1} and np.array_equal(stored["azimuthal"][1]["lowest"], modes.lowest[1])
+        assert np.array_equal(stored["azimuthal"][1]["unstable"], modes.unstable[1])
+        assert [(p["index"], p["pressure"]) for p in stored["azimuthal"][1]["points"]] == \
+            [(c.index, c.pressure) for c in modes.crossings]
         assert branch.smallest_stress.min() > -1e-8  # a closed sliding tube stays taut (no point flagged)
     kinds = [(s["kind"], s["block"]) for s in run["branches"]["primary"]["special_points"]]
     assert kinds[:2] == [("LP", ""), ("BP", "odd")] and ("LV", "") in [(s["kind"], s["block"]) for s in
@@ -56,6 +61,7 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     text = capsys.readouterr().out
     assert "tube of length 10, sliding ends, end distance free (closed)" in text
     assert "Maxwell        P_M = 0.445022155" in text and "branch bulge:" in text and " LV " in text
+    assert "m = 0 (pressure, volume and gas control); m = 1 (the same under all three" in text and "  m = 1: lowest" in text
     assert main(["inspect", str(run_file), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["kind"] == "tube" and set(summary) == inspect_json_keys("tube run file")  # docs/hdf5.md's keys

@@ -44,9 +44,10 @@ class Term:
         a_θ, a_φ and J = |a_θ × a_φ|."""
         return sp.S.Zero
 
-    def second_order(self, x, x_t, x_p, metric):
+    def second_order(self, x, x_t, x_p, metric, closed=True):
         """Its part of the φ-averaged ε² coefficient of the energy per d(cos θ) along the perturbed surface
-        (x, x_θ, x_φ) of codegen/second_variation.py (``metric``: as for ``axisymmetric``)."""
+        (x, x_θ, x_φ) of codegen/second_variation.py (``metric``: as for ``axisymmetric``; ``closed``: the
+        meridian has poles, else it is a tube's between its end planes)."""
         return sp.S.Zero
 
     def pole(self, lam, z, q, s, z0, metric):

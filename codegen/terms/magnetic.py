@@ -56,7 +56,7 @@ class MagneticField(Term):
     def surface(self, point, a_t, a_p, areal):
         return -chi * M * surface_field_proxy(point) / 2
 
-    def second_order(self, x, x_t, x_p, metric):
+    def second_order(self, x, x_t, x_p, metric, closed=True):
         """H²(|x_h|, z) with |x_h| = √(x² + y²) expanded to O(ε²) about ρ0 = λ2 sin θ: with x² + y² = ρ0² + ε q1 +
         ε² q2, |x_h| = ρ0 + ε q1/(2ρ0) + ε² (q2/(2ρ0) − q1²/(8ρ0³))."""
         rho_sq = x[0] ** 2 + x[1] ** 2

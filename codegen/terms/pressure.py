@@ -33,8 +33,11 @@ class Pressure(Term):
     def surface(self, point, a_t, a_p, areal):
         return -P * volume_density(point, a_t, a_p)
 
-    def second_order(self, x, x_t, x_p, metric):
-        return -P * phi_average(epsilon_order(volume_density(x, x_t, x_p), 2)) / sin_theta
+    def second_order(self, x, x_t, x_p, metric, closed=True):
+        """The cone form on a closed surface; on a tube the volume between its end planes, ½ x_h · (x_S × x_φ)
+        (codegen/second_variation.py)."""
+        density = volume_density(x, x_t, x_p) if closed else dot((x[0], x[1], 0), cross(x_t, x_p)) / 2
+        return -P * phi_average(epsilon_order(density, 2)) / sin_theta
 
     def pole(self, lam, z, q, s, z0, metric):
         return P * lam**2 * q * s**2 / 2

@@ -4,8 +4,9 @@ stable under it; under gas control the amount n = P V of every located point), M
 points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py), the height of its last
 point's crest and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md),
 with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block over the points,
-as a sphere run's), the onset curve of ``critical`` (its range, folds and stop), and the stage a signal stopped
-(``interrupted``)."""
+as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the smallest eigenvalue and
+the points after which the unstable count changes; {} where not assessed), the onset curve of ``critical`` (its range,
+folds and stop), and the stage a signal stopped (``interrupted``)."""
 import math
 import tomllib
 
@@ -34,6 +35,7 @@ def summarise_tube(run: dict) -> dict:
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
                           "stable_points": None if unstable is None else int((unstable == 0).sum()),
                           "special_points": _with_omega2(special, b.get("frequencies")),
+                          "azimuthal": _azimuthal(b),
                           **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
@@ -43,6 +45,20 @@ def summarise_tube(run: dict) -> dict:
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
+
+
+def _azimuthal(branch: dict) -> dict:
+    """{m: {'unstable_max', 'lowest_min', 'changes': [{'after_point', 'unstable', 'pressure', 'volume'}], 'points'}}
+    of the branch's m ≥ 1 blocks: a change between points i and i + 1 listed after point i (at point i + 1's P and
+    V/V0), and the located zeros of the eigenvalues ('points': io/tube_file's dicts)."""
+    out = {}
+    for m, block in branch.get("azimuthal", {}).items():
+        counts = block["unstable"]
+        changes = [{"after_point": int(i), "unstable": int(counts[i + 1]), "pressure": float(branch["pressure"][i + 1]),
+                    "volume": float(branch["volume"][i + 1])} for i in np.flatnonzero(np.diff(counts))]
+        out[str(m)] = {"unstable_max": int(counts.max()), "lowest_min": float(block["lowest"][:, 0].min()),
+                       "changes": changes, "points": block["points"]}
+    return out
 
 
 def _frequencies(frequencies: dict | None) -> dict:
@@ -87,6 +103,15 @@ def _no_maxwell(summary: dict) -> str:
     return "none (the uniform closed path has no pressure maximum and minimum)"
 
 
+def _assessed(summary: dict) -> str:
+    """Which m ≥ 1 blocks the branches were assessed for."""
+    largest = [len(b["azimuthal"]) for b in summary["branches"].values()]
+    if not largest or min(largest) == 0:
+        return "m ≥ 1 not assessed"
+    shown = "m = 1" if min(largest) == 1 else f"m = 1..{min(largest)}"
+    return f"{shown} (the same under all three: δV = 0 for m ≥ 1)"
+
+
 def format_tube(summary: dict) -> str:
     """Readable summary of ``summarise_tube``."""
     g, p = summary["geometry"], summary["provenance"]
@@ -102,6 +127,7 @@ def format_tube(summary: dict) -> str:
              "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"),
              f"control        {summary['control']}",
              f"degree         {summary['degree']}",
+             "stability      m = 0 (pressure, volume and gas control); " + _assessed(summary),
              f"Maxwell        P_M = {maxwell}"]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
@@ -114,6 +140,13 @@ def format_tube(summary: dict) -> str:
                       + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
                       + ("" if b["last_crest_height"] is None else
                          f"; last crest at height {b['last_crest_height']:.6g}")]
+        for m, block in b["azimuthal"].items():
+            changes = ", ".join(f"{c['unstable']} after point {c['after_point']} (P = {c['pressure']:.6g}, "
+                                f"V/V0 = {c['volume']:.6g})" for c in block["changes"])
+            lines.append(f"  m = {m}: lowest eigenvalue ≥ {block['lowest_min']:.4g}, at most {block['unstable_max']} "
+                         f"unstable" + (f"; unstable count {changes}" if changes else ""))
+            lines += [f"        BP m = {m} (eigenvalue {p['order']}) after point {p['index']:<4} P = {p['pressure']:.10g}  "
+                      f"V/V0 = {p['volume']:.8g}  {p['status']}" for p in block["points"]]
         for s in b["special_points"]:
             k, label = label, label + 1
             block = f" {s['block']}" if s["block"] else ""

@@ -11,7 +11,9 @@ per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``vol
 tube/stability.py; files before gas control have no ``unstable_gas``), ``smallest_stress`` (the smallest
 principal stress: negative where the membrane is compressed, tube/stability.py), ``crest_height`` (the height η of
 the largest radius, the bulge's crest, from the tube's middle plane: IntervalDiscretisation.crest), ``lowest_even``/
-``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch); its located points under
+``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), with stability.m_max ≥ 1 ``lowest_m<m>``
+(n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
+not assessed); its located points under
 special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``,
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
@@ -36,6 +38,7 @@ from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..scene.tables import Ends
 from ..analysis.results import Kind, StopCode
 from ..numerics.continuation import RootStatus, Stop, TraceStop
+from ..tube.azimuthal import COUNT
 from ..tube.primary import volume_ratio
 from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
 from ..scene.loading import Control
@@ -47,6 +50,7 @@ GAS = "unstable_gas"  # per point: unstable directions under gas control (files 
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
+AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
 
 
 #: name: (units, long_name, description) of a tube run file's datasets (io/schema.py's VARIABLES are the sphere's)
@@ -65,6 +69,14 @@ TUBE_VARIABLES = {
     CREST: ("1", "crest height", "height η of the largest radius from the tube's middle plane, in R"),
     "lowest_even": ("1", "lowest eigenvalue, even block", "of the mirror-symmetric block of ∂R/∂u"),
     "lowest_odd": ("1", "lowest eigenvalue, odd block", "of the mirror-antisymmetric block of ∂R/∂u"),
+    **{f"lowest_m{m}": ("1", f"lowest eigenvalues, m = {m}", f"the lowest μ of the cos {m}φ block, H c = μ G c "
+                        "(tube/azimuthal.py), ascending") for m in range(1, AZIMUTHAL_LIMIT + 1)},
+    **{f"unstable_m{m}": ("", f"unstable directions, m = {m}", f"negative eigenvalues of the cos {m}φ block (pressure "
+                          "and volume control alike)") for m in range(1, AZIMUTHAL_LIMIT + 1)},
+    "eigenvalue": ("", "eigenvalue index", "the lowest eigenvalues of a block, ascending"),
+    "m": ("", "azimuthal number", "the cos mφ block whose eigenvalue vanishes"),
+    "order": ("", "eigenvalue number", "which eigenvalue of the block vanishes (ascending, from 0)"),
+    "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
     "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
@@ -77,8 +89,8 @@ TUBE_VARIABLES = {
 def _dimensions(group, rows: str, axes: dict) -> None:
     """Named dimensions (netCDF-4, so that xarray with h5netcdf opens ``group`` alone with them): the scale ``rows``
     (0 … n − 1, n the rows of its datasets) and those of ``axes`` ({second axis's scale name: length}), attached to
-    every dataset (its first axis ``rows``; a 2-D dataset's second: ``unknown``, ``mode`` for ``modes``) and each
-    described from TUBE_VARIABLES."""
+    every dataset (its first axis ``rows``; a 2-D dataset's second: ``unknown``, ``mode`` for ``modes``,
+    ``eigenvalue`` for ``lowest_m<m>``) and each described from TUBE_VARIABLES."""
     items = [(name, item) for name, item in group.items() if isinstance(item, h5py.Dataset)]
     n = items[0][1].shape[0]
     scales = {name: checksummed(group, name, np.arange(length, dtype=np.int64))
@@ -89,7 +101,8 @@ def _dimensions(group, rows: str, axes: dict) -> None:
     for name, item in items:
         item.dims[0].attach_scale(scales[rows])
         if item.ndim == 2:
-            item.dims[1].attach_scale(scales["mode" if name == "modes" else "unknown"])
+            second = "mode" if name == "modes" else "eigenvalue" if name.startswith("lowest_m") else "unknown"
+            item.dims[1].attach_scale(scales[second])
         _describe(item, name)
 
 
@@ -134,6 +147,13 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             checksummed(group, column, values)
         for block, values in branch.lowest.items():
             checksummed(group, f"lowest_{block.value}", values)
+        modes = None if picture.modes is None else picture.modes[name]
+        group.attrs["m_max"] = 0 if modes is None else len(modes.lowest)
+        if modes is not None:
+            for m in modes.lowest:
+                checksummed(group, f"lowest_m{m}", modes.lowest[m])
+                checksummed(group, f"unstable_m{m}", modes.unstable[m])
+            _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size)
         special = group.create_group("special_points")
         s = branch.special
         write_strings(special, "kind", [p.kind.value for p in s])
@@ -147,12 +167,23 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
         checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
-        _dimensions(group, "point", {"unknown": branch.disc.size})
+        _dimensions(group, "point", {"unknown": branch.disc.size} | ({} if modes is None else {"eigenvalue": COUNT}))
         _dimensions(special, "special", {"unknown": branch.disc.size})
         if picture.frequencies is not None and name in picture.frequencies:  # (a signal: only the finished ones)
             write_tube_frequencies(group, picture.frequencies[name])
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
+
+
+def _write_crossings(group, found, size: int) -> None:
+    """The located zeros of the m ≥ 1 eigenvalues (tube/azimuthal_crossings.py): per point ``m``, ``order``,
+    ``index``, ``pressure``, ``volume``, ``value``, ``status``, ``unknowns``."""
+    for column, kind in (("m", int), ("order", int), ("index", int), ("pressure", float), ("volume", float),
+                         ("value", float)):
+        checksummed(group, column, np.array([getattr(c, column) for c in found], dtype=kind))
+    write_strings(group, "status", [c.status.value for c in found])
+    checksummed(group, "unknowns", np.array([c.u for c in found], dtype=float).reshape(len(found), size))
+    _dimensions(group, "special", {"unknown": size})
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
@@ -211,11 +242,33 @@ def read_tube(f, path, where: str = "") -> dict:
         columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
         branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                     for i in range(len(columns["kind"]))]
+        branch["azimuthal"] = _read_modes(path, group, n, f"{where}/branches/{name}")
         branch["special_unknowns"] = special["unknowns"][()]
         branch["frequencies"] = read_tube_frequencies(path, group, n, len(branch["special_points"]), TubeFileError)
         branches[name] = branch
     onset = None if "onset" not in f else _read_onset(path, f["onset"])
     return {"attrs": attrs, "branches": branches, "onset": onset}
+
+
+def _read_modes(path, group, n: int, where: str) -> dict:
+    """{m: {'lowest': (n, COUNT), 'unstable': (n,), 'points': [dict per located zero]}} for m = 1..the group's
+    ``m_max`` ({}: not assessed; 'points' empty in files written before they were located)."""
+    out = {}
+    located = group.get("azimuthal_points")
+    points = [] if located is None else [
+        {"m": int(m), "order": int(k), "index": int(i), "pressure": float(p), "volume": float(v), "value": float(x),
+         "status": s} for m, k, i, p, v, x, s in zip(*(located[c][()] for c in ("m", "order", "index", "pressure",
+                                                                              "volume", "value")),
+                                                    located["status"].asstr()[()])]
+    for m in range(1, int(group.attrs.get("m_max", 0)) + 1):
+        missing = [c for c in (f"lowest_m{m}", f"unstable_m{m}") if c not in group]
+        if missing:
+            raise TubeFileError(path, f"{where}: m_max = {group.attrs['m_max']} but {', '.join(missing)} missing")
+        out[m] = {"lowest": group[f"lowest_m{m}"][()], "unstable": group[f"unstable_m{m}"][()],
+                  "points": [p for p in points if p["m"] == m]}
+        if out[m]["lowest"].shape[0] != n or out[m]["unstable"].shape != (n,):
+            raise TubeFileError(path, f"{where}/lowest_m{m}, unstable_m{m}: not one row per point ({n})")
+    return out
 
 
 def tube_row(run: dict) -> dict:

@@ -6,5 +6,8 @@
 - ``control``: the loading control's parameter (V, n) on a trace, its folds (LV, LN), the stop at stop_volume
 - ``primary``: the primary branch in P from the unstressed tube, its folds and mirror-block branch points
 - ``bulge``: the branch switched at an odd branch point (the bulge), through its volume fold
+- ``azimuthal``: the m ≥ 1 blocks of a tube's states (cos mφ perturbations), their lowest eigenvalues and unstable
+  directions
+- ``azimuthal_crossings``: where an m ≥ 1 eigenvalue vanishes along a branch, located
 - ``picture``: all of a tube scene's run (``balloon-cg run``)
 """

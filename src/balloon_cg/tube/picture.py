@@ -6,19 +6,26 @@ states, its largest hoop stretch passes ``continuation.stop_stretch``, its V rea
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
-is finished is kept, and the picture names the stage (``Stage``)."""
+is finished is kept, and the picture names the stage (``Stage``). A whole picture's branches are assessed for m = 1..
+``stability.m_max`` (tube/azimuthal.py: ``modes``)."""
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import numpy as np
+
+from .azimuthal import branch_modes
+from .azimuthal_crossings import crossings
 from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
 from .results import IntervalBranch
 from ..analysis.results import StopCode
+from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..model.membrane import scene_energy
 from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
+from ..numerics.threads import limited_blas
 from ..scene.tables import Ends
 
 
@@ -38,13 +45,15 @@ class TubePicture:
     the onset of bulging followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the
     work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
     not); ``frequencies``: with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch
-    name)."""
+    name); ``modes``: each branch's m = 1..``stability.m_max`` blocks (tube/azimuthal.TubeModes by branch name; None:
+    not assessed, m_max = 0 or a signal)."""
 
     branches: dict
     maxwell: float | None
     onset: OnsetCurve | None = None
     interrupted: Stage | None = None
     frequencies: dict | None = None
+    modes: dict | None = None
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
@@ -57,7 +66,7 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     onset = primary.branch_points(Mirror.ODD)
     if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
         return bulge_picture(scene, primary, onset[0], pm)
-    return TubePicture(branches, pm)
+    return with_modes(scene, TubePicture(branches, pm))
 
 
 def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:
@@ -68,7 +77,23 @@ def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> Tu
         return TubePicture(branches, pm, interrupted=Stage.BULGE)
     branches["bulge"] = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
     stopped = Stage.BULGE if branches["bulge"].stop.code == StopCode.INTERRUPTED else None
-    return TubePicture(branches, pm, interrupted=stopped)
+    return with_modes(scene, TubePicture(branches, pm, interrupted=stopped))
+
+
+@limited_blas
+def with_modes(scene, picture: TubePicture) -> TubePicture:
+    """``picture`` with its branches' m = 1..``stability.m_max`` blocks (tube/azimuthal.py) and the zeros of their
+    eigenvalues located (tube/azimuthal_crossings.py) where m_max ≥ 1 and no signal stopped it (a signal ends the
+    work at its next stage: then they are not assessed). One BLAS thread, as the traces."""
+    m_max = scene.stability.m_max
+    if m_max < 1 or picture.interrupted is not None or interrupt.requested():
+        return picture
+    modes = {}
+    for name, branch in picture.branches.items():
+        found = branch_modes(Equilibrium(scene, branch.disc), np.column_stack([branch.states, branch.pressure]),
+                             branch.params, m_max)
+        modes[name] = replace(found, crossings=tuple(crossings(scene, branch, found)))
+    return replace(picture, modes=modes)
 
 
 def onset_picture(scene, name: str = "M", direction: float = 1.0) -> TubePicture:

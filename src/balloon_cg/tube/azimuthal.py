@@ -1,0 +1,129 @@
+"""Stability of a tube's states for non-axisymmetric perturbations, azimuthal number m ≥ 1 (the m ≥ 1 blocks).
+
+The perturbed tube is x0 + ε δx, δx = R(S) cos mφ e_ρ + T(S) sin mφ e_φ + Z(S) cos mφ e_z (the displacement
+amplitudes of codegen/second_variation.py; ' = d/dS). The tube's generated kernel ``azimuthal_hessian`` gives at each
+node the 6×6 h with d²E/dε² = ∫_0^L yᵀ h y dS, y = (R, R', Z, Z', T, T'), E per 2π (the pressure's work is the
+volume between the end planes). In x = 2S/L − 1, on the interval discretisation's own Gauss rule (galerkin/interval.py):
+
+    sliding ends   R, T = Σ_{k=0}^{N} c_k P_k(x),   Z = Σ_{k=0}^{N−2} c_k (P_{k+2} − P_k)(x)
+    plugged ends   R, T, Z = Σ_{k=0}^{N−2} c_k (P_{k+2} − P_k)(x)
+
+The end conditions. A sliding end is a plane of mirror symmetry of the tube, fixed: the perturbation is mirrored
+there (R, T even, Z odd about it), so Z = 0 on the end plane, R' = T' = 0 being natural (an end plane that would
+tilt, Z = cos φ for m = 1, is not a mirror plane). A plug is rigid and held: it neither tilts nor moves sideways, so
+the rim's displacement vanishes, R = T = Z = 0 (for m = 0 a plug of closed ends moves along the axis; no m ≥ 1
+motion of a rigid plug keeps it a plug of the reference radius but its tilt and its sideways translation, and both
+are held).
+
+The eigenvalues are those of H c = μ G c, G the Gram matrix of ‖δx‖² = ½ ∫_0^L (R² + T² + Z²) dS (per 2π, as E):
+the Rayleigh quotient of d²E/dε² over the displacement's L2 norm, basis independent. Zero modes: with sliding ends
+and m = 1 the sideways translation of the whole tube (R = 1, T = −1, Z = 0) changes nothing where there is no
+field; it is removed there (G c ⊥ it), kept in a coil's field (where it is not a zero mode: the free tube). Plugged
+ends hold it. Under volume control the m ≥ 1 blocks are the same: their perturbations leave the enclosed volume
+unchanged to first order (∫ cos mφ dφ = 0), so δV = 0 removes nothing (only m = 0 differs, tube/stability.py).
+"""
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..galerkin.discretisation import symmetric_rows
+from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..galerkin.interval import IntervalDiscretisation
+from ..galerkin.legendre import legendre_table
+from ..generated import AZIMUTHAL_PAIRS
+from ..numerics.eigen import NO_CONSTRAINT, GramFactor, lowest_of, negative_count, restricted
+from ..scene.tables import Ends
+
+_ROW = symmetric_rows(AZIMUTHAL_PAIRS)  # (6, 6): the row of h_ab in the kernel's output
+COUNT = 3  # the lowest eigenvalues kept per block and point
+
+
+@dataclass(frozen=True)
+class TubeModes:
+    """The m = 1..m_max blocks at each point of a branch: ``lowest`` {m: (points, COUNT)} the lowest eigenvalues μ,
+    ``unstable`` {m: (points,)} the number of negative ones (the same under pressure and volume control);
+    ``crossings`` where an eigenvalue vanishes (tube/azimuthal_crossings.AzimuthalCrossing)."""
+
+    lowest: dict
+    unstable: dict
+    crossings: tuple = ()
+
+
+@functools.lru_cache(maxsize=16)
+def operators(disc: IntervalDiscretisation) -> tuple:
+    """(ops, gram): ops (6, n_q, size) the node values of y = (R, R', Z, Z', T, T') per coefficient, the unknowns
+    ordered (R's, T's, Z's) (module docstring), on the nodes of ``disc``; gram the (size, size) G."""
+    n, length = disc.degree, disc.length
+    p, dp = legendre_table(disc.x, n)
+    bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
+    free, free_slopes = (p, dp) if disc.ends == Ends.SLIDING else (bubbles, slopes)
+    k, b = free.shape[1], bubbles.shape[1]
+    ops = np.zeros((6, disc.x.size, 2 * k + b))
+    r, t, z = slice(0, k), slice(k, 2 * k), slice(2 * k, 2 * k + b)
+    ops[0, :, r], ops[1, :, r] = free, 2 / length * free_slopes
+    ops[4, :, t], ops[5, :, t] = free, 2 / length * free_slopes
+    ops[2, :, z], ops[3, :, z] = bubbles, 2 / length * slopes
+    values = ops[[0, 2, 4]]
+    gram = 0.5 * np.einsum("aqi,q,aqj->ij", values, disc.weights, values)
+    return ops, gram
+
+
+def translation(disc: IntervalDiscretisation) -> np.ndarray:
+    """The coefficients of the m = 1 sideways translation R = 1, T = −1, Z = 0 (sliding ends: P_0 in R and T)."""
+    k = disc.hoops
+    c = np.zeros(2 * k + disc.degree - 1)
+    c[0], c[k] = 1.0, -1.0
+    return c
+
+
+def node_hessian(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int) -> np.ndarray:
+    """The kernel's h (21 pairs, n_q) at the nodes of ``eq.disc`` for the state u."""
+    disc = eq.disc
+    nodes = eq.at_nodes("tube_azimuthal", (disc.cos_theta, disc.sin_theta))
+    disc.node_state(u, out=nodes.state)
+    nodes.hold(params)
+    return nodes("azimuthal_hessian", params, m=float(m))
+
+
+def hessian(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int) -> np.ndarray:
+    """H = Σ_q W_q yᵀ h y: d²E/dε² = cᵀ H c."""
+    ops, _ = operators(eq.disc)
+    h = node_hessian(eq, u, params, m)[_ROW] * eq.disc.weights  # (6, 6, n_q)
+    flat = ops.reshape(-1, ops.shape[2])
+    return flat.T @ np.einsum("abq,bqj->aqj", h, ops).reshape(-1, ops.shape[2])
+
+
+def zero_modes(eq: Equilibrium, params: Parameters, m: int) -> np.ndarray:
+    """The rows G c of the removed zero modes (module docstring): the translation for m = 1 on sliding ends without
+    a field, else none."""
+    disc = eq.disc
+    field = eq.coils.shape[0] and params.M != 0
+    if m != 1 or disc.ends != Ends.SLIDING or field:
+        return NO_CONSTRAINT
+    return (operators(disc)[1] @ translation(disc))[None, :]
+
+
+def block(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int) -> np.ndarray:
+    """The m-th block as the standard symmetric matrix of the pencil (H, G) with the zero modes removed
+    (numerics/eigen.restricted): its eigenvalues are the μ, its inertia the block's."""
+    return restricted(hessian(eq, u, params, m), _factor(eq.disc), zero_modes(eq, params, m))
+
+
+@functools.lru_cache(maxsize=16)
+def _factor(disc: IntervalDiscretisation) -> GramFactor:
+    return GramFactor(operators(disc)[1])
+
+
+def branch_modes(eq: Equilibrium, points, params: Parameters, m_max: int, count: int = COUNT) -> TubeModes:
+    """``TubeModes`` of the points Y = (u, P) of a branch (``params``: the branch's, P replaced)."""
+    lowest, unstable = {}, {}
+    for m in range(1, m_max + 1):
+        values, negatives = [], []
+        for Y in points:
+            A = block(eq, Y[:-1], params.with_value("P", Y[-1]), m)
+            negatives.append(negative_count(A))
+            values.append(lowest_of(A, count))
+        lowest[m] = np.array(values, dtype=float).reshape(len(values), count)
+        unstable[m] = np.array(negatives, dtype=int)
+    return TubeModes(lowest, unstable)

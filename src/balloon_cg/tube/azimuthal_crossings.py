@@ -1,0 +1,75 @@
+"""Where an m ≥ 1 eigenvalue of a tube's branch vanishes (tube/azimuthal.py): the m ≥ 1 branch points.
+
+Between two stored points Y_i, Y_{i+1} of a branch whose m-th block's unstable count changes, the eigenvalue
+number k (ascending, from 0: analysis/stability/crossings.count_changes) is followed along the secant: at arclength
+s the state is Keller's corrector from Y_i + s t (t the unit secant, on every free unknown and P), and Brent's method
+in s finds its zero (numerics/continuation.locate_root: ``located``, or ``nearest`` where a corrector failed).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .azimuthal import block
+from .primary import TubeSystem, held, volume_ratio
+from ..analysis.branches.problem import ParameterSystem, continuation_settings
+from ..analysis.stability.crossings import count_changes
+from ..galerkin.equilibrium import Equilibrium
+from ..numerics import continuation
+from ..numerics.continuation import RootStatus
+
+BRENT_XTOL = 1e-13  # relative to the secant's length
+
+
+@dataclass(frozen=True)
+class AzimuthalCrossing:
+    """The m-th block's eigenvalue ``order`` vanishes at the state u, ``pressure``, ``volume`` (V/V0), between
+    points ``index`` and ``index + 1``; ``status`` of its location; ``value`` the eigenvalue there."""
+
+    m: int
+    order: int
+    index: int
+    u: np.ndarray
+    pressure: float
+    volume: float
+    status: RootStatus
+    value: float
+
+
+def crossings(scene, branch, modes) -> list[AzimuthalCrossing]:
+    """The zeros of the m ≥ 1 eigenvalues of ``branch`` (tube/results.IntervalBranch) where ``modes``
+    (tube/azimuthal.TubeModes) says its unstable counts change, ordered by m then along the branch."""
+    disc = branch.disc
+    eq = Equilibrium(scene, disc)
+    params = branch.params
+    system = TubeSystem(ParameterSystem(eq, params, "P"), disc.free, held(disc))
+    settings = continuation_settings(scene)
+    points = [np.append(u, P)[system.columns] for u, P in zip(branch.states, branch.pressure)]
+    found = []
+    for m, counts in modes.unstable.items():
+        for i, order in count_changes(counts):
+            located = _zero(system, eq, params, settings, points[i], points[i + 1], m, order)
+            if located is not None:
+                Y, status, value = located
+                found.append(AzimuthalCrossing(m, order, i, Y[:-1], float(Y[-1]), volume_ratio(eq, Y), status, value))
+    return found
+
+
+def _zero(system, eq, params, settings, before, after, m: int, order: int):
+    """(Y, status, eigenvalue) where the m-th block's eigenvalue ``order`` vanishes on the secant from ``before`` to
+    ``after`` (X coordinates of ``system``); None where nothing could be evaluated."""
+    length = float(np.linalg.norm(after - before))
+    tangent = (after - before) / length
+
+    def eigenvalue(Y):
+        return float(np.linalg.eigvalsh(block(eq, Y[:-1], params.with_value("P", Y[-1]), m))[order])
+
+    def value_at(s):
+        result = continuation.correct(system, before + s * tangent, tangent, settings)
+        if not result.converged:
+            raise ArithmeticError(result.message)
+        Y = system.full(result.x)
+        return eigenvalue(Y), Y
+
+    end = system.full(after)
+    root = continuation.locate_root(value_at, length, BRENT_XTOL, known={length: (eigenvalue(end), end)})
+    return None if root is None else (root.payload, root.status, root.value)
