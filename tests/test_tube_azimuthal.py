@@ -223,7 +223,7 @@ def test_m_max_zero_is_said_not_assessed(tmp_path):
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
     from balloon_cg.tube.picture import tube_picture
 
-    for m_max, said in ((0, "m ≥ 1 not assessed"), (2, "m = 1..2 (the same under both")):
+    for m_max, said in ((0, "m ≥ 1 not assessed"), (2, "m = 1..2 (the same under all three")):
         scene = tube_scene().with_overrides({"solver.degree": 12, "continuation.stop_stretch": 1.4,
                                              "stability.m_max": m_max})
         picture = tube_picture(scene, primary_only=True)
