@@ -21,7 +21,7 @@ from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.branches.primary import inflated_reference, start_parameters
 from balloon_cg.analysis.branches.tracer import Tracer, unit
 from balloon_cg.galerkin.discretisation import split_rule
-from balloon_cg.galerkin.elements import element_table
+from balloon_cg.galerkin.elements import CAPS, CYLINDER, element_series, element_table, families, sequence
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.model import meridian, tube
 from balloon_cg.numerics import continuation
@@ -31,11 +31,16 @@ from balloon_cg.scene import SceneError, Shape, parse_scene
 # the slow plateau test's start degree and max_error (docs/shapes.md: at the default max_error 1e-9 the branch stops
 # at max_degree soon after its fold, the bulge's fronts wanting more than one cylinder element's degree)
 DEGREE, PLATEAU_ERROR = 192, 1e-2
-CAPSULE = '[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = {length}\n[stability]\nm_max = 0\n'
+CAPSULE = '[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = {length}\n{split}[stability]\nm_max = 0\n'
+# the longest cylinder element of the split capsules here (geometry.element_length)
+ELEMENT = 5.0
 
 
-def capsule_scene(length: float, extra: str = ""):
-    return parse_scene(CAPSULE.format(length=length) + extra)
+def capsule_scene(length: float, extra: str = "", element: float | None = None):
+    """The SPOM1 capsule of ``length`` (m = 0 stability), its cylinder one element or cut into elements of at
+    most ``element`` radii."""
+    split = "" if element is None else f"element_length = {element!r}\n"
+    return parse_scene(CAPSULE.format(length=length, split=split) + extra)
 
 
 def inflated(scene, degree: int, P: float):
@@ -97,24 +102,27 @@ def test_reference_meridian_is_c1_with_the_curvature_jumping_at_the_joins():
 
 
 def test_piecewise_basis_is_continuous_hierarchical_and_spans_piecewise_polynomials():
-    """galerkin/elements.py at length 6, degree 40: φ_k continuous at the joins, φ_k(−x) = (−1)^k φ_k(x), dφ/dx the
-    central differences of φ (1e-7), the degree-30 table the first 31 columns of degree 40's; a function continuous
-    at the joins, cubic in x on each cap and quintic in θ on the cylinder (written here), is fitted exactly (least
-    squares at 400 points, 1e-12), which one Legendre series in x of as many functions cannot (> 1e-5)."""
+    """galerkin/elements.py at length 6, degree 40 (one cylinder element: joins ±c): φ_k continuous at the joins,
+    φ_k(−x) = (−1)^k φ_k(x), dφ/dx the central differences of φ (1e-7), the degree-30 table the first 31 columns of
+    degree 40's; a function continuous at the joins, cubic in x on each cap and quintic in θ on the cylinder
+    (written here), is fitted exactly (least squares at 400 points, 1e-12), which one Legendre series in x of as
+    many functions cannot (> 1e-5)."""
     kappa = 1 + 6.0 / np.pi
     joint = np.pi / (2 * kappa)
     c = np.cos(joint)
+    joins = (-c, c)
     x = np.cos(np.linspace(0.0, np.pi, 400))
-    p, dp = element_table(x, 40, c)
-    flipped, _ = element_table(-x, 40, c)
+    p, dp = element_table(x, 40, joins)
+    flipped, _ = element_table(-x, 40, joins)
     assert np.abs(flipped - p * (-1.0) ** np.arange(41)).max() < 1e-12
     for side in (c, -c):
-        across, _ = element_table(np.array([side - 1e-12, side + 1e-12]), 40, c)
+        across, _ = element_table(np.array([side - 1e-12, side + 1e-12]), 40, joins)
         assert np.abs(across[0] - across[1]).max() < 1e-9
     h, inner = 1e-6, np.array([0.999, 0.9 * c + 0.1, 0.5 * c, -0.3 * c, -0.95])
-    plus, minus, (_, slope) = element_table(inner + h, 40, c), element_table(inner - h, 40, c), element_table(inner, 40, c)
+    plus, minus = element_table(inner + h, 40, joins), element_table(inner - h, 40, joins)
+    slope = element_table(inner, 40, joins)[1]
     assert np.abs((plus[0] - minus[0]) / (2 * h) - slope).max() < 1e-7 * np.abs(slope).max()
-    lower, _ = element_table(x, 30, c)
+    lower, _ = element_table(x, 30, joins)
     assert np.array_equal(lower, p[:, :31])
     theta = np.arccos(x)
     xi = (np.pi / 2 - theta) / (np.pi / 2 - joint)
@@ -124,6 +132,71 @@ def test_piecewise_basis_is_continuous_hierarchical_and_spans_piecewise_polynomi
     for table, exact in ((p, True), (legendre.legvander(x, 40), False)):
         residual = np.abs(table @ np.linalg.lstsq(table, f, rcond=None)[0] - f).max()
         assert residual < 1e-12 if exact else residual > 1e-5
+
+
+@pytest.mark.parametrize("length", [12.0, 20.0])
+def test_split_cylinder_basis_is_continuous_hierarchical_and_spans_piecewise_polynomials(length):
+    """The cylinder of a capsule of length 12 (3 elements: a middle one and a mirror pair) and 20 (5: two mirror
+    pairs) cut into an odd number of elements of at most ELEMENT radii (geometry.element_length, model/meridian.joins),
+    degree 80: the inner boundaries at equal arclength (ξ_e = (2e − n)/n, the cylinder's S = κθ, written here) and
+    mirror-symmetric; φ_k continuous at every join (1e-12 apart: by no more than its slope over the gap) and of parity (−1)^k (1e-12); dφ/dx the
+    central differences of φ inside every element (1e-6 relative); the degree-60 table the first 61 columns of
+    degree 80's; a function continuous at the joins with a different polynomial on every element (cubic in x on
+    the caps, degree 3 + e in θ on cylinder element e: written here) fitted exactly (least squares at 1200 points,
+    1e-11), which the single-cylinder basis of as many functions cannot (> 1e-4); ``element_series`` gives the same
+    function on every element as the table (1e-12); the tail estimate reads every element's own series."""
+    scene = capsule_scene(length, element=ELEMENT)
+    joins = meridian.joins(scene.geometry)
+    n = int(np.ceil(length / ELEMENT)) | 1
+    kappa = 1 + length / np.pi
+    theta_j = np.pi / (2 * kappa)
+    bounds = (np.pi / 2 - theta_j) * (2 * np.arange(n + 1) - n) / n  # π/2 − θ at the boundaries
+    assert len(joins) == n + 1 and np.allclose(np.arcsin(joins), bounds, atol=1e-14)
+    assert np.array_equal(np.array(joins), -np.array(joins)[::-1])
+    x = np.cos(np.linspace(0.0, np.pi, 1200))
+    p, _ = element_table(x, 80, joins)
+    flipped, _ = element_table(-x, 80, joins)
+    assert np.abs(flipped - p * (-1.0) ** np.arange(81)).max() < 1e-12
+    for side in joins:  # continuous: apart by no more than the slope over the gap
+        across, slopes = element_table(np.array([side - 1e-12, side + 1e-12]), 80, joins)
+        assert np.all(np.abs(across[0] - across[1]) < 1e-12 + 2e-12 * np.abs(slopes).max(axis=0))
+    # inside every element: each cap, each cylinder element's middle
+    inner = np.concatenate([[0.999, -0.97 * joins[-1] - 0.03], np.sin(0.5 * (bounds[1:] + bounds[:-1]))])
+    h = 1e-7
+    plus, minus = element_table(inner + h, 80, joins), element_table(inner - h, 80, joins)
+    slope = element_table(inner, 80, joins)[1]
+    assert np.abs((plus[0] - minus[0]) / (2 * h) - slope).max() < 1e-6 * np.abs(slope).max()
+    lower, _ = element_table(x, 60, joins)
+    assert np.array_equal(lower, p[:, :61])
+    # a continuous function: its values at the boundaries given, a bubble of degree 3 + e on element e
+    s = np.pi / 2 - np.arccos(x)  # π/2 − θ
+    knots = np.cos(np.arange(n + 1))  # its values at the cylinder's boundaries
+    f = np.empty_like(x)
+    for e in range(n):
+        on = (s >= bounds[e]) & (s <= bounds[e + 1])
+        t = (2 * s[on] - bounds[e] - bounds[e + 1]) / (bounds[e + 1] - bounds[e])
+        f[on] = knots[e] * (1 - t) / 2 + knots[e + 1] * (1 + t) / 2 + (1 - t**2) * (0.3 + 0.1 * e) * t ** (1 + e)
+    c = joins[-1]
+    f = np.where(x > c, knots[-1] + 2 * (x - c) - 7 * (x - c) ** 3, np.where(x < -c, knots[0] + (x + c) ** 2, f))
+    single, _ = element_table(x, 80, (-c, c))
+    for table, exact in ((p, True), (single, False)):
+        residual = np.abs(table @ np.linalg.lstsq(table, f, rcond=None)[0] - f).max()
+        assert residual < 1e-11 if exact else residual > 1e-4
+    coefficients = np.random.default_rng(1).normal(size=81)
+    north, cylinder, south = element_series(coefficients, joins)
+    values = p @ coefficients
+    on_cylinder = np.abs(x) <= c
+    element = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0, n - 1)
+    t = (2 * s - bounds[element] - bounds[element + 1]) / (bounds[element + 1] - bounds[element])
+    from_series = np.array([legendre.legval(ti, cylinder[e]) for e, ti in zip(element, t)])
+    xi_cap = (2 * np.abs(x) - 1 - c) / (1 - c)
+    from_series = np.where(x > c, legendre.legval(xi_cap, north),
+                           np.where(x < -c, legendre.legval(xi_cap, south), from_series))
+    assert np.abs(from_series - values).max() < 1e-12 and on_cylinder.sum() > 0
+    groups = families(80, joins)
+    assert len(groups) == n // 2 + (n % 2) + 1  # the cylinder's mirror groups and the caps
+    assert sorted(np.unique(np.concatenate([g.ravel() for g in groups])).tolist()) == sorted(
+        k for k, (family, _, _) in enumerate(sequence(80, joins)) if family in (CYLINDER, CAPS))
 
 
 def test_capsule_converges_spectrally_in_the_degree():

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .coordinate_map import WireMap
-from .elements import element_table, families
+from .elements import element_degree, element_table, families
 from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
 
@@ -203,9 +203,9 @@ def _state_loops(A, B, u, out):
 
 
 def basis_table(x: np.ndarray, degree: int, joins: tuple = ()):
-    """(φ_k(x), dφ_k/dx) for k = 0..degree: P_k(x), or with ``joins`` (a capsule's ±c) the elements' piecewise basis
-    (galerkin/elements.py)."""
-    return element_table(x, degree, joins[-1]) if joins else legendre_table(x, degree)
+    """(φ_k(x), dφ_k/dx) for k = 0..degree: P_k(x), or with ``joins`` (a capsule's element boundaries, −c … c) the
+    elements' piecewise basis (galerkin/elements.py)."""
+    return element_table(x, degree, joins) if joins else legendre_table(x, degree)
 
 
 @functools.lru_cache(maxsize=64)
@@ -236,7 +236,8 @@ class Discretisation:
     quadrature: int = 0
     mapping: WireMap | None = None
     joins: tuple = ()  # x where the basis and the quadrature split (a capsule's ±c, where its reference curvature
-    #                    jumps: the piecewise basis of galerkin/elements.py, a composite Gauss rule)
+    #                    jumps, and its cylinder's element boundaries between: the piecewise basis of
+    #                    galerkin/elements.py, a composite Gauss rule)
 
     def __reduce__(self):
         """Pickled as its six defining fields (the tables are rebuilt): results holding one stay small."""
@@ -371,14 +372,14 @@ class Discretisation:
     def tail(self, u: np.ndarray) -> float:
         """Spectral error estimate: the neglected tail Σ_{k>N} of a geometric series, E·r/(1 − r)
         (``geometric_tail`` of the envelope max(|a_k|, |b_k|)/|a_0|); on a capsule's piecewise basis the largest of
-        its elements' own series (``elements.families``: the cylinder's bubbles, the caps' pairs by degree), each
-        falling at its own rate."""
+        its elements' own series (``elements.families``: each cylinder element's bubbles, the caps' pairs, by
+        degree), each falling at its own rate."""
         a, b = self.split(u)
         envelope = np.maximum(np.abs(a), np.abs(b)) / abs(a[0])
         if not self.joins:
             return geometric_tail(envelope)
-        cylinder, caps = families(self.degree, self.joins[-1])
-        return max(geometric_tail(envelope[cylinder]), geometric_tail(envelope[caps].max(axis=1)))
+        return max(geometric_tail(envelope[group] if group.ndim == 1 else envelope[group].max(axis=1))
+                   for group in families(self.degree, self.joins))
 
 
 def geometric_tail(envelope: np.ndarray) -> float:
@@ -401,13 +402,20 @@ def gauss_nodes(degree: int) -> int:
     return (3 * degree) // 2 + 8
 
 
+def piece_nodes(degree: int, joins: tuple = ()) -> int:
+    """Gauss nodes of the default rule at degree N: ``gauss_nodes`` of N, or with ``joins`` of the highest degree
+    of any element (each piece of ``split_rule`` holds one element's polynomial)."""
+    return gauss_nodes(element_degree(degree, joins) if joins else degree)
+
+
 def split_rule(n_q: int, joins: tuple = ()):
     """(nodes, weights) on [−1, 1], ascending: Gauss–Legendre with n_q nodes, or with ``joins`` (sorted, in (−1, 1))
     n_q nodes on each piece between them (a composite rule, where a kink of the integrand at a join costs a single
     rule O(n_q⁻²)): Gauss in x on the two end pieces (the caps: exact for a polynomial in x of degree < 2 n_q) and
     in θ on the inner ones (the cylinder, whose basis is polynomial in θ: ∫f dx = ∫f sin θ dθ; Gauss in x there
     samples the ends of a high-degree polynomial in θ too sparsely, and the node table of a capsule of length 40
-    had the condition 3.7e8 at degree 320 against 4e2 at 200). Mirror-symmetric when the joins are."""
+    had the condition 3.7e8 at degree 320 against 4e2 at 200). Mirror-symmetric to the last bit when the joins are
+    (an odd rule's middle node at x = 0 exactly: ``even_half`` counts it once)."""
     nodes, weights = gauss_rule(n_q)
     if not joins:
         return nodes, weights
@@ -420,12 +428,12 @@ def split_rule(n_q: int, joins: tuple = ()):
         else:
             low, high = np.arccos(b), np.arccos(a)  # θ ascending as x descends: reversed to ascend in x
             theta = (0.5 * (high - low) * nodes + 0.5 * (high + low))[::-1]
-            x, w = np.cos(theta), (0.5 * (high - low) * weights)[::-1] * np.sin(theta)
-            if a == -b:  # mirror-symmetric to the last bit (an odd rule's middle node at x = 0 exactly: ``even_half``)
-                x, w = 0.5 * (x - x[::-1]), 0.5 * (w + w[::-1])
-            out_nodes.append(x)
-            out_weights.append(w)
-    return np.concatenate(out_nodes), np.concatenate(out_weights)
+            out_nodes.append(np.cos(theta))
+            out_weights.append((0.5 * (high - low) * weights)[::-1] * np.sin(theta))
+    x, w = np.concatenate(out_nodes), np.concatenate(out_weights)
+    if joins == tuple(-join for join in reversed(joins)):
+        x, w = 0.5 * (x - x[::-1]), 0.5 * (w + w[::-1])
+    return x, w
 
 
 @functools.lru_cache(maxsize=4)
@@ -442,7 +450,7 @@ def _projection(disc: Discretisation) -> np.ndarray:
 def _tables(disc: Discretisation) -> dict:
     """The node, weight and basis tables of a Discretisation (keyed by its six fields: equal discretisations
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
-    n_q = disc.quadrature or gauss_nodes(disc.degree)
+    n_q = disc.quadrature or piece_nodes(disc.degree, disc.joins)
     nodes, s_weights = split_rule(n_q, disc.joins)
     p, dp = basis_table(nodes, disc.degree, disc.joins)
     if disc.mapping is None:

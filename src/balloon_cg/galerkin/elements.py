@@ -1,35 +1,44 @@
-"""The capsule's piecewise basis: three spectral elements, north cap | cylinder | south cap, joined C⁰ at the joins.
+"""The capsule's piecewise basis: spectral elements north cap | cylinder elements | south cap, joined C⁰ at the joins.
 
-A capsule's reference curvature jumps at its joins x = ±c (c = cos θj, θj = π/(2κ)), so λ2 and η are only C¹ and C²
-there and one Legendre series in x = cos θ converges algebraically (O(N⁻³): docs/shapes.md). On each element the
-solution is analytic, so a basis that is polynomial per element and continuous across the joins (conforming for the
-Ritz energy, which holds first derivatives only) converges spectrally. The elements' coordinates:
+A capsule's reference curvature jumps at its caps' joins x = ±c (c = cos θj, θj = π/(2κ)), so λ2 and η are only C¹
+and C² there and one Legendre series in x = cos θ converges algebraically (O(N⁻³): docs/shapes.md). On each element
+the solution is analytic, so a basis that is polynomial per element and continuous across the joins (conforming for
+the Ritz energy, which holds first derivatives only) converges spectrally. The cylinder is cut into n elements of
+equal arclength (model/meridian.joins: a long cylinder's bulge fronts want an element a few radii long, not one
+polynomial over its whole length); ``joins`` are all the element boundaries in x, ascending, −c first and c last,
+mirror-symmetric. The elements' coordinates:
 
     caps       ξ = (2|x| − 1 − c)/(1 − c) ∈ [−1, 1] (linear in x: smooth at the pole, λ2 and η even in θ there),
     cylinder   ξ = (π/2 − θ)/(π/2 − θj) ∈ [−1, 1] (linear in the arclength S = κθ: a polynomial in x would have
-               the branch point of θ = acos x just beyond the join, at x = ±1).
+               the branch point of θ = acos x just beyond the join, at x = ±1), element e (e = 0..n−1, ascending in
+               x) between ξ_e = (2e − n)/n and ξ_{e+1}, its own t = (2ξ − ξ_e − ξ_{e+1})/(ξ_{e+1} − ξ_e) ∈ [−1, 1].
 
 The basis is hierarchical (the functions of degree N are the first N + 1 of every higher degree, so transfers to a
 higher degree append zeros) and φ_k has the parity (−1)^k in x (the equator symmetry keeps φ_even for λ2 and φ_odd
 for η, the reflection z → −z is a_k → (−1)^k a_k as on the Legendre basis):
 
     φ_0 = 1,   φ_1 = ℓ (ξ on the cylinder, ±1 on the caps),
-    then, alternately even and odd, a cylinder bubble B_j = P_j(ξ) − P_{j−2}(ξ) (j ≥ 2, zero on the caps, parity
-    (−1)^j) or a cap pair q_j(ξ_north) ± q_j(ξ_south), q_j = P_j + P_{j−1} (j ≥ 1, zero at the joins, + even, − odd),
+    the hats h_i of the cylinder's inner boundaries ξ_i (piecewise linear, 1 at ξ_i, 0 at ξ_{i±1}) as mirror pairs
+    h_i ± h_{n−i} (i > n/2; the middle one, i = n/2, even alone),
+    then, alternately even and odd, a cylinder bubble B_j = P_j(t) − P_{j−2}(t) (j ≥ 2, zero off its element) on a
+    mirror pair of elements, B_j(t_e) ± (−1)^j B_j(t_{n−1−e}) (the middle element of an odd n alone: parity (−1)^j),
+    or a cap pair q_j(ξ_north) ± q_j(ξ_south), q_j = P_j + P_{j−1} (j ≥ 1, zero at the joins, + even, − odd),
 
-the element chosen greedily (``sequence``) to keep the polynomial degree per radian of θ (per arclength) alike on the
-cylinder (degree j over π − 2θj) and on the caps (degree j in x, 2j in θ over the cap and its mirror, 2θj), the caps
-keeping at least half the cylinder's degree up to CAP_FLOOR. Every continuous piecewise polynomial is spanned (1 and
-ℓ match any values at the joins; what is left vanishes there). φ_0 = 1 keeps b_0 the rigid translation. The
-cylinder's quadrature is Gauss in θ (galerkin/discretisation.py ``split_rule``).
+the element chosen greedily (``sequence``) to keep the polynomial degree per radian of θ (per arclength) alike on
+every cylinder element (degree j over (π − 2θj)/n) and on the caps (degree j in x, 2j in θ over the cap and its
+mirror, 2θj), the caps keeping at least half the degree of the cylinder's bubbles up to CAP_FLOOR. Every continuous
+piecewise polynomial is spanned (1, ℓ and the hats match any values at the joins; what is left vanishes there).
+φ_0 = 1 keeps b_0 the rigid translation. The cylinder's quadrature is Gauss in θ (galerkin/discretisation.py
+``split_rule``). With n = 1 (joins ±c) the basis is the three elements north cap | cylinder | south cap.
 """
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 
 from .legendre import legendre_table
 
-CONSTANT, HAT, CYLINDER, CAPS = range(4)  # the families of ``sequence``
+CONSTANT, HAT, VERTEX, CYLINDER, CAPS = range(5)  # the families of ``sequence``
 # the caps keep at least half the cylinder's degree up to this one, beyond it by arclength: by arclength alone a
 # capsule of length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1
 # radii wide at 1.5 % hoop strain) is not resolved: its start's pressure is 2.6e-5 off at degree 162 with caps of
@@ -37,99 +46,213 @@ CONSTANT, HAT, CYLINDER, CAPS = range(4)  # the families of ``sequence``
 CAP_FLOOR = 24
 
 
+@dataclass(frozen=True)
+class Layout:
+    """The elements of ``joins``: the caps' join c, the cylinder's half span π/2 − θj in θ, and its n elements'
+    bounds ξ_0 = −1 < ξ_1 < … < ξ_n = 1 in the cylinder's ξ (module docstring)."""
+
+    join: float
+    half_span: float
+    bounds: tuple
+
+    @property
+    def count(self) -> int:
+        return len(self.bounds) - 1
+
+    def mirror(self, element: int) -> int:
+        return self.count - 1 - element
+
+
 @functools.lru_cache(maxsize=32)
-def sequence(degree: int, join: float) -> tuple:
-    """(family, j) of φ_0..φ_degree for the join x = c (module docstring): (CONSTANT, 0), (HAT, 1), then per parity
-    the caps while their next degree is at most min(CAP_FLOOR, half the cylinder's next), else the family with the
-    lower degree per radian once the function is added, the caps on a tie."""
-    theta_j = float(np.arccos(join))
-    cylinder_span, cap_span = np.pi - 2 * theta_j, 2 * theta_j
-    out = [(CONSTANT, 0), (HAT, 1)][: degree + 1]
-    cylinder = {0: 2, 1: 3}  # the next bubble's degree of each parity
+def layout(joins: tuple) -> Layout:
+    """The Layout of ascending ``joins`` (−c, inner cylinder boundaries, c): ξ_e = (2e − n)/n, exactly
+    antisymmetric (model/meridian.joins puts the inner boundaries at x = sin(ξ_e (π/2 − θj)))."""
+    join = float(joins[-1])
+    n = len(joins) - 1
+    return Layout(join, 0.5 * np.pi - float(np.arccos(join)), tuple((2 * e - n) / n for e in range(n + 1)))
+
+
+@functools.lru_cache(maxsize=32)
+def sequence(degree: int, joins: tuple) -> tuple:
+    """(family, j, element) of φ_0..φ_degree for ``joins`` (module docstring): (CONSTANT, 0, 0), (HAT, 1, 0), the
+    inner boundaries' hats (VERTEX, 1, i) of each parity while there are any, then per parity the caps while their
+    next degree is at most min(CAP_FLOOR, half the cylinder elements' next), else the family with the lower degree
+    per radian once the function is added, the caps on a tie (the cylinder's degree in the floor: that of one
+    element holding all its bubbles of the parity so far, so that the caps' floor does not fall with n); a bubble (CYLINDER, j, e) names the northern
+    element e of its mirror pair (the middle element of an odd n its own mirror)."""
+    shape = layout(joins)
+    n, theta_j = shape.count, 0.5 * np.pi - shape.half_span
+    element_span, cap_span = (np.pi - 2 * theta_j) / n, 2 * theta_j
+    out = [(CONSTANT, 0, 0), (HAT, 1, 0)][: degree + 1]
+    # the northern inner boundary of each mirror pair of hats, from the middle outwards (the middle one even only)
+    vertices = {0: list(range((n + 1) // 2, n)), 1: list(range(n // 2 + 1, n))}
+    elements = list(range(n // 2, n))  # the northern element of each mirror pair, from the middle outwards
+    step = {e: 2 if shape.mirror(e) == e else 1 for e in elements}
+    cylinder = {e: {0: 2, 1: 3 if step[e] == 2 else 2} for e in elements}  # the next bubble's degree per parity
     caps = {0: 1, 1: 1}  # the next cap pair's degree of each parity
+    # the next degree of one cylinder element holding the cylinder's bubbles of each parity so far (the caps'
+    # floor: the layer where they meet the cylinder wants it whatever the cylinder's elements)
+    whole = {0: 2, 1: 3}
     for k in range(2, degree + 1):
         parity = k % 2
-        floor = min(CAP_FLOOR, cylinder[parity] / 2)
-        if caps[parity] > floor and cylinder[parity] / cylinder_span < 2 * caps[parity] / cap_span:
-            out.append((CYLINDER, cylinder[parity]))
-            cylinder[parity] += 2
+        if vertices[parity]:
+            out.append((VERTEX, 1, vertices[parity].pop(0)))
+            continue
+        e = min(elements, key=lambda element: cylinder[element][parity])
+        floor = min(CAP_FLOOR, whole[parity] / 2)
+        if caps[parity] > floor and cylinder[e][parity] / element_span < 2 * caps[parity] / cap_span:
+            out.append((CYLINDER, cylinder[e][parity], e))
+            cylinder[e][parity] += step[e]
+            whole[parity] += 2
         else:
-            out.append((CAPS, caps[parity]))
+            out.append((CAPS, caps[parity], 0))
             caps[parity] += 1
     return tuple(out)
 
 
-def families(degree: int, join: float) -> tuple:
-    """(cylinder, caps): the indices k of the cylinder's bubbles in the order of their degree, and of the caps' pairs
-    as (even, odd) columns per degree j (rows, shape (n, 2); the last degree's odd one repeats its even one when
-    it is not there yet): the elements' own coefficient series, whose tails ``Discretisation.tail`` reads."""
-    order = sequence(degree, join)
-    cylinder = [k for k, (family, _) in sorted(enumerate(order), key=lambda item: item[1][1]) if family == CYLINDER]
-    even = [k for k, (family, _) in enumerate(order) if family == CAPS and k % 2 == 0]
-    odd = [k for k, (family, _) in enumerate(order) if family == CAPS and k % 2 == 1]
-    pairs = [(e, odd[j] if j < len(odd) else e) for j, e in enumerate(even)]
-    return np.array(cylinder, dtype=int), np.array(pairs, dtype=int).reshape(-1, 2)
+def element_degree(degree: int, joins: tuple) -> int:
+    """The highest polynomial degree of any element at basis degree N (the caps' in x, a cylinder element's in θ):
+    what each piece's quadrature must integrate (galerkin/discretisation.py ``piece_nodes``)."""
+    return max(j for _, j, _ in sequence(degree, joins))
 
 
-def element_table(x: np.ndarray, degree: int, join: float):
-    """(φ_k(x), dφ_k/dx) for k = 0..degree, each of shape (len(x), degree + 1), at any x ∈ [−1, 1] (the joins
-    belong to the cylinder: φ is continuous there, its derivative the cylinder's)."""
+def _pairs(indices: list) -> np.ndarray:
+    """Rows (even, odd) of the k of one element group's functions per degree j, given as (k, j) in order; a degree
+    whose odd function is not there yet repeats its even one (and the reverse)."""
+    by_degree = {}
+    for k, j in indices:
+        by_degree.setdefault(j, [None, None])[k % 2] = k
+    rows = [(even if even is not None else odd, odd if odd is not None else even)
+            for _, (even, odd) in sorted(by_degree.items())]
+    return np.array(rows, dtype=int).reshape(-1, 2)
+
+
+def families(degree: int, joins: tuple) -> tuple:
+    """The elements' own coefficient series, whose tails ``Discretisation.tail`` reads: per cylinder group the
+    indices k of its bubbles in the order of their degree (the middle element of an odd n: one column) or as
+    (even, odd) rows per degree j (a mirror pair of elements), and the caps' pairs as (even, odd) rows per j."""
+    order = sequence(degree, joins)
+    shape = layout(joins)
+    groups = []
+    for e in range(shape.count // 2, shape.count):
+        bubbles = [(k, j) for k, (family, j, element) in enumerate(order) if family == CYLINDER and element == e]
+        if shape.mirror(e) == e:
+            groups.append(np.array([k for k, _ in sorted(bubbles, key=lambda item: item[1])], dtype=int))
+        else:
+            groups.append(_pairs(bubbles))
+    groups.append(_pairs([(k, j) for k, (family, j, _) in enumerate(order) if family == CAPS]))
+    return tuple(groups)
+
+
+def cylinder_coordinates(x: np.ndarray, shape: Layout):
+    """(element e, t, dt/dx) at cylinder nodes x (module docstring; at an inner boundary the northern element)."""
+    theta = np.arccos(np.clip(x, -1.0, 1.0))
+    xi = (0.5 * np.pi - theta) / shape.half_span
+    bounds = np.array(shape.bounds)
+    element = np.clip(np.searchsorted(bounds, xi, side="right") - 1, 0, shape.count - 1)
+    low, high = bounds[element], bounds[element + 1]
+    # dξ/dx = 1/((π/2 − θj) sin θ) on the cylinder (sin θ ≥ sin θj > 0 there)
+    dxi = 1.0 / (shape.half_span * np.sqrt(np.maximum(1.0 - x * x, 1e-300)))
+    return element, (2.0 * xi - (low + high)) / (high - low), 2.0 / (high - low) * dxi
+
+
+def element_table(x: np.ndarray, degree: int, joins: tuple):
+    """(φ_k(x), dφ_k/dx) for k = 0..degree, each of shape (len(x), degree + 1), at any x ∈ [−1, 1] (the caps'
+    joins belong to the cylinder, an inner boundary to its northern element: φ is continuous there, its
+    derivative that element's)."""
     x = np.asarray(x, dtype=float)
-    order = sequence(degree, join)
-    theta_j = np.arccos(join)
+    order = sequence(degree, joins)
+    shape = layout(joins)
+    join = shape.join
     cylinder = np.abs(x) <= join
     north = x > join
     side = np.where(north, 1.0, -1.0)  # which cap (on the cylinder unused)
-    theta = np.arccos(np.clip(x, -1.0, 1.0))
-    xi_cylinder = np.where(cylinder, (0.5 * np.pi - theta) / (0.5 * np.pi - theta_j), 0.0)
-    # dξ/dx = 1/((π/2 − θj) sin θ) on the cylinder (sin θ ≥ sin θj > 0 there)
-    dxi_cylinder = np.where(cylinder, 1.0 / ((0.5 * np.pi - theta_j) * np.sqrt(np.maximum(1.0 - x * x, 1e-300))), 0.0)
+    element, t, dt = cylinder_coordinates(np.where(cylinder, x, 0.0), shape)
+    element = np.where(cylinder, element, -1)
+    xi_cylinder = np.where(cylinder, (0.5 * np.pi - np.arccos(np.clip(x, -1.0, 1.0))) / shape.half_span, 0.0)
+    dxi_cylinder = np.where(cylinder, 1.0 / (shape.half_span * np.sqrt(np.maximum(1.0 - x * x, 1e-300))), 0.0)
+    t, dt = np.where(cylinder, t, 0.0), np.where(cylinder, dt, 0.0)
     xi_cap = np.where(cylinder, 0.0, (2.0 * np.abs(x) - 1.0 - join) / (1.0 - join))
     dxi_cap = 2.0 * side / (1.0 - join)  # dξ/dx of the cap the node is on
-    top = max(j for _, j in order) + 1
-    pc, dpc = legendre_table(xi_cylinder, top)
+    top = max(j for _, j, _ in order) + 1
+    pc, dpc = legendre_table(t, top)
     pq, dpq = legendre_table(xi_cap, top)
     p, dp = np.zeros((x.size, degree + 1)), np.zeros((x.size, degree + 1))
-    for k, (family, j) in enumerate(order):
+
+    def hat(i):
+        """The hat of inner boundary ξ_i and its dx-derivative: (1 + t)/2 on element i − 1, (1 − t)/2 on i."""
+        below, above = element == i - 1, element == i
+        return (np.where(below, 0.5 * (1 + t), 0.0) + np.where(above, 0.5 * (1 - t), 0.0),
+                np.where(below, 0.5 * dt, 0.0) - np.where(above, 0.5 * dt, 0.0))
+
+    for k, (family, j, e) in enumerate(order):
+        sign = (-1.0) ** k
         if family == CONSTANT:
             p[:, k] = 1.0
         elif family == HAT:
             p[:, k] = np.where(cylinder, xi_cylinder, side)
-            dp[:, k] = np.where(cylinder, dxi_cylinder, 0.0)
+            dp[:, k] = dxi_cylinder
+        elif family == VERTEX:
+            p[:, k], dp[:, k] = hat(e)
+            if shape.count - e != e:
+                mirrored, slope = hat(shape.count - e)
+                p[:, k] += sign * mirrored
+                dp[:, k] += sign * slope
         elif family == CYLINDER:
-            p[:, k] = np.where(cylinder, pc[:, j] - pc[:, j - 2], 0.0)
-            dp[:, k] = np.where(cylinder, (dpc[:, j] - dpc[:, j - 2]) * dxi_cylinder, 0.0)
+            weight = np.where(element == e, 1.0, 0.0)
+            if shape.mirror(e) != e:  # B_j(t_e) + (−1)^(k+j) B_j(t_mirror): parity (−1)^k
+                weight = weight + np.where(element == shape.mirror(e), sign * (-1.0) ** j, 0.0)
+            p[:, k] = weight * (pc[:, j] - pc[:, j - 2])
+            dp[:, k] = weight * (dpc[:, j] - dpc[:, j - 2]) * dt
         else:
-            sign = np.where(north, 1.0, (-1.0) ** k)  # the south cap's copy: + for even k, − for odd
-            p[:, k] = np.where(cylinder, 0.0, sign * (pq[:, j] + pq[:, j - 1]))
-            dp[:, k] = np.where(cylinder, 0.0, sign * (dpq[:, j] + dpq[:, j - 1]) * dxi_cap)
+            cap_sign = np.where(north, 1.0, sign)  # the south cap's copy: + for even k, − for odd
+            p[:, k] = np.where(cylinder, 0.0, cap_sign * (pq[:, j] + pq[:, j - 1]))
+            dp[:, k] = np.where(cylinder, 0.0, cap_sign * (dpq[:, j] + dpq[:, j - 1]) * dxi_cap)
     return p, dp
 
 
-def element_series(coefficients: np.ndarray, join: float) -> tuple:
-    """(north cap, cylinder, south cap): the function Σ_k c_k φ_k (k = 0..len − 1) as one Legendre series in each
-    element's own ξ (module docstring; the south cap's ξ runs from its join, −1, to its pole, +1, as the north's):
+def element_series(coefficients: np.ndarray, joins: tuple) -> tuple:
+    """(north cap, cylinder elements, south cap): the function Σ_k c_k φ_k (k = 0..len − 1) as one Legendre series
+    in each element's own coordinate (module docstring; the south cap's ξ runs from its join, −1, to its pole, +1,
+    as the north's; the cylinder's (n, top) rows ascending in x, each in its own t):
 
-        1 → 1 on each,   ℓ → (1, ξ, −1),   B_j → (0, P_j − P_{j−2}, 0),   q_j pair → (q_j, 0, (−1)^k q_j),
+        1 → 1 on each,   ℓ → (1, ξ_mid + t Δξ/2, −1),   hat h_i → (1 + t)/2 on e = i − 1, (1 − t)/2 on e = i,
+        bubble → ±(P_j − P_{j−2}) on its elements,   q_j pair → (q_j, 0, (−1)^k q_j),
 
-    so that numpy's Legendre series calculus gives any derivative in ξ (the curvatures, post/quantities.py)."""
-    order = sequence(len(coefficients) - 1, join)
-    top = max(j for _, j in order) + 1
-    north, cylinder, south = np.zeros(top), np.zeros(top), np.zeros(top)
-    for k, ((family, j), c) in enumerate(zip(order, coefficients)):
+    so that numpy's Legendre series calculus gives any derivative (the curvatures, post/quantities.py)."""
+    order = sequence(len(coefficients) - 1, joins)
+    shape = layout(joins)
+    top = max(j for _, j, _ in order) + 1
+    north, south, cylinder = np.zeros(top), np.zeros(top), np.zeros((shape.count, top))
+    bounds = np.array(shape.bounds)
+    middle, half = 0.5 * (bounds[1:] + bounds[:-1]), 0.5 * (bounds[1:] - bounds[:-1])
+
+    def add_hat(i, c):
+        cylinder[i - 1, :2] += (0.5 * c, 0.5 * c)
+        cylinder[i, :2] += (0.5 * c, -0.5 * c)
+
+    for k, ((family, j, e), c) in enumerate(zip(order, coefficients)):
+        sign = (-1.0) ** k
         if family == CONSTANT:
             north[0] += c
-            cylinder[0] += c
             south[0] += c
+            cylinder[:, 0] += c
         elif family == HAT:
             north[0] += c
-            cylinder[1] += c
             south[0] -= c
+            cylinder[:, 0] += c * middle
+            cylinder[:, 1] += c * half
+        elif family == VERTEX:
+            add_hat(e, c)
+            if shape.count - e != e:
+                add_hat(shape.count - e, sign * c)
         elif family == CYLINDER:
-            cylinder[j] += c
-            cylinder[j - 2] -= c
+            mirrored = [(shape.mirror(e), sign * (-1.0) ** j)] if shape.mirror(e) != e else []
+            for element, weight in [(e, 1.0), *mirrored]:
+                cylinder[element, j] += weight * c
+                cylinder[element, j - 2] -= weight * c
         else:
-            for series, sign in ((north, 1.0), (south, (-1.0) ** k)):
-                series[j] += sign * c
-                series[j - 1] += sign * c
+            for series, cap_sign in ((north, 1.0), (south, sign)):
+                series[j] += cap_sign * c
+                series[j - 1] += cap_sign * c
     return north, cylinder, south

@@ -66,13 +66,29 @@ def hoop_acceleration(geometry: Geometry, cos_theta, sin_theta):
     return np.where(angle < np.pi / 2, -capsule_rate(geometry) ** 2 * np.sin(angle), 0.0)
 
 
+def cylinder_elements(geometry: Geometry) -> int:
+    """n: the cylinder elements of a capsule's piecewise basis: 1 (``element_length`` not given), else the fewest of
+    equal length at most ``element_length`` radii, odd (a middle element about the equator, where a
+    mirror-symmetric state is smooth, λ2' = 0 exactly: an element boundary there would leave λ2' its one-sided
+    value, ~1e-11 off at L = 10)."""
+    if geometry.element_length is None:
+        return 1
+    n = max(1, int(np.ceil(geometry.length / geometry.element_length - 1e-12)))
+    return n + 1 - n % 2
+
+
 def joins(geometry: Geometry) -> tuple:
-    """The x = cos θ where the reference curvature jumps, where the quadrature splits (galerkin/discretisation.py:
-    ``split_rule``): a capsule's ±cos θj, θj = π/(2κ) (none at length 0, the sphere); none on other shapes."""
+    """The x = cos θ where the basis and the quadrature split (galerkin/elements.py, galerkin/discretisation.py
+    ``split_rule``), ascending: a capsule's ±cos θj, θj = π/(2κ), where its reference curvature jumps, and between
+    them its cylinder's n − 1 inner element boundaries (``cylinder_elements``, ``element_length``) at equal arclength,
+    x = sin(ξ_e (π/2 − θj)), ξ_e = (2e − n)/n (none at length 0, the sphere); none on other shapes."""
     if geometry.shape != Shape.CAPSULE or geometry.length == 0:
         return ()
+    half_span = np.pi / 2 - np.pi / (2 * capsule_rate(geometry))
     join = float(np.cos(np.pi / (2 * capsule_rate(geometry))))
-    return (-join, join)
+    n = cylinder_elements(geometry)
+    inner = tuple(float(np.sin((2 * e - n) / n * half_span)) for e in range(1, n))
+    return (-join, *inner, join)
 
 
 def metric(geometry: Geometry, cos_theta, sin_theta):

@@ -26,7 +26,7 @@ from numpy.polynomial import legendre
 
 from ..galerkin.coordinate_map import WireMap
 from ..galerkin.discretisation import Discretisation
-from ..galerkin.elements import element_series
+from ..galerkin.elements import cylinder_coordinates, element_series, layout
 from ..model.field import coaxial_table, coil_table, field_components, field_squared_nodes
 from ..model.stresses import elastic_stresses
 from ..model.meridian import hoop, hoop_acceleration, hoop_rate, metric
@@ -63,25 +63,33 @@ def _legendre_derivatives(coefficients, c, s, mapping):
     return f, -s * fx, s * s * fxx - c * fx, fx
 
 
-def _element_derivatives(coefficients, c, s, join: float):
+def _element_derivatives(coefficients, c, s, joins: tuple):
     """(f, f', f'', df/dx) in θ of f = Σ c_k φ_k (rows of ``coefficients``) on a capsule's elements
-    (galerkin/elements.py: ``element_series``): on the cylinder ξ = (π/2 − θ)/(π/2 − θj), f' = f_ξ ξ', f'' = f_ξξ ξ'²,
+    (galerkin/elements.py: ``element_series``): on cylinder element e, t linear in θ, f' = f_t t', f'' = f_tt t'²,
     f_x = −f'/sin θ; on the caps ξ = (2|x| − 1 − c)/(1 − c), f_x = f_ξ ξ_x, f_xx = f_ξξ ξ_x², then θ by the chain
-    rule as on Legendre's. The joins belong to the cylinder (its one-sided derivatives)."""
-    half_span = 0.5 * np.pi - np.arccos(join)
+    rule as on Legendre's. The caps' joins belong to the cylinder, an inner boundary to its northern element
+    (one-sided derivatives)."""
+    shape = layout(joins)
+    join = shape.join
     cylinder, north = np.abs(c) <= join, c > join
-    series = np.array([element_series(row, join) for row in np.atleast_2d(coefficients)])  # (rows, 3, degree)
+    rows = [element_series(row, joins) for row in np.atleast_2d(coefficients)]
 
-    def derivatives(element: int, xi):
-        """f, f_ξ, f_ξξ of the rows' series on ``element`` (0 north, 1 cylinder, 2 south) at ξ."""
-        return (legendre.legval(xi, legendre.legder(series[:, element].T, m)) for m in range(3))
+    def derivatives(series, at):
+        """f, f_t, f_tt of the rows' ``series`` (rows, top) at ``at``."""
+        return (legendre.legval(at, legendre.legder(series.T, m)) for m in range(3))
 
-    f, fxi, fxixi = derivatives(1, (0.5 * np.pi - np.arccos(np.clip(c, -1.0, 1.0))) / half_span)
-    rate = -1.0 / half_span
-    out = [f, fxi * rate, fxixi * rate**2, -fxi * rate / np.where(cylinder, s, 1.0)]
+    element, t, _ = cylinder_coordinates(np.where(cylinder, c, 0.0), shape)
+    bounds = np.array(shape.bounds)
+    out = [np.zeros((len(rows), c.size)) for _ in range(4)]
+    for e in range(shape.count):
+        on = cylinder & (element == e)
+        f, ft, ftt = derivatives(np.array([row[1][e] for row in rows]), t)
+        rate = -2.0 / ((bounds[e + 1] - bounds[e]) * shape.half_span)  # dt/dθ
+        for target, part in zip(out, (f, ft * rate, ftt * rate**2, -ft * rate / np.where(cylinder, s, 1.0))):
+            target[..., on] = part[..., on]
     xi_cap = (2.0 * np.abs(c) - 1.0 - join) / (1.0 - join)
-    for element, on, sign in ((0, north, 1.0), (2, ~(north | cylinder), -1.0)):
-        f, fxi, fxixi = derivatives(element, xi_cap)
+    for element_index, on, sign in ((0, north, 1.0), (2, ~(north | cylinder), -1.0)):
+        f, fxi, fxixi = derivatives(np.array([row[element_index] for row in rows]), xi_cap)
         rate = 2.0 * sign / (1.0 - join)
         fx, fxx = fxi * rate, fxixi * rate**2
         for target, part in zip(out, (f, -s * fx, s * s * fxx - c * fx, fx)):
@@ -99,8 +107,8 @@ def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> 
     a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
     c, s = np.cos(theta), np.sin(theta)
     if disc.joins:
-        lam2, dlam2, d2lam2, _ = _element_derivatives(a.T, c, s, disc.joins[-1])
-        eta, deta, d2eta, deta_dx = _element_derivatives(b.T, c, s, disc.joins[-1])
+        lam2, dlam2, d2lam2, _ = _element_derivatives(a.T, c, s, disc.joins)
+        eta, deta, d2eta, deta_dx = _element_derivatives(b.T, c, s, disc.joins)
     else:
         lam2, dlam2, d2lam2, _ = _legendre_derivatives(a, c, s, disc.mapping)
         eta, deta, d2eta, deta_dx = _legendre_derivatives(b, c, s, disc.mapping)

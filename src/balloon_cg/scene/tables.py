@@ -131,14 +131,16 @@ class Geometry:
     """The reference surface (docs/scenes.md, [geometry]): the unit sphere, a spheroid of equatorial semi-axis 1
     and polar semi-axis ``aspect`` (< 1 oblate, > 1 prolate; 1 is the sphere), the axis that of the coils, or a
     circular cylinder of radius 1 and ``length`` with ``ends``, or a capsule: the cylinder of ``length`` closed by
-    hemispherical caps of radius 1 (length 0: the sphere). Lengths stay in units of the equatorial radius; the
-    reference meridian is model/meridian.py's."""
+    hemispherical caps of radius 1 (length 0: the sphere), its cylinder discretised as one spectral element or
+    cut into elements of at most ``element_length`` (model/meridian.joins). Lengths stay in units of the
+    equatorial radius; the reference meridian is model/meridian.py's."""
 
     shape: Shape = Shape.SPHERE
     aspect: float = 1.0
     length: float | None = None  # a tube's or a capsule's cylinder's
     ends: Ends | None = None  # a tube's
     axial_stretch: float | None = None  # a tube's ends held at the distance λL (None: closed, the distance free)
+    element_length: float | None = None  # a capsule's longest cylinder element (None: the cylinder one element)
 
     def to_table(self) -> dict:
         """Its [geometry] table (a spheroid's keeps the text it had before tubes)."""
@@ -146,7 +148,8 @@ class Geometry:
             held = {} if self.axial_stretch is None else {"axial_stretch": self.axial_stretch}
             return {"shape": self.shape.value, "length": self.length, "ends": self.ends.value} | held
         if self.shape == Shape.CAPSULE:
-            return {"shape": self.shape.value, "length": self.length}
+            split = {} if self.element_length is None else {"element_length": self.element_length}
+            return {"shape": self.shape.value, "length": self.length} | split
         return {"shape": self.shape.value, "aspect": self.aspect}
 
     def describe(self) -> str:
@@ -285,6 +288,9 @@ MAX_STRETCH = 100.0  # continuation.start_stretch, stop_stretch
 MIN_ASPECT, MAX_ASPECT = 0.1, 10.0  # geometry.aspect of a spheroid
 MIN_LENGTH, MAX_LENGTH = 0.1, 1000.0  # geometry.length of a tube (in reference radii)
 CLOSED = "closed"  # geometry.axial's one value: the default, the ends' distance free (axial_stretch left out)
+# geometry.element_length of a capsule (reference radii), and the most cylinder elements it may cut (each adds
+# basis functions before any polynomial degree: model/meridian.cylinder_elements)
+MIN_ELEMENT, MAX_ELEMENTS = 1.0, 41
 MIN_AXIAL, MAX_AXIAL = 1.0, 5.0  # geometry.axial_stretch: a tube's ends held at λL (below 1 the membrane would be
 #                                  compressed axially at P = 0)
 MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
@@ -807,6 +813,9 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     for key in ("ends", "axial", "axial_stretch"):
         if shape != Shape.TUBE and data.get(key) is not None:
             raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "tube"')
+    if shape != Shape.CAPSULE and data.get("element_length") is not None:
+        raise SceneError(f'geometry.element_length = {show(data["element_length"])}: only for geometry.shape = '
+                         '"capsule"')
     if shape not in (Shape.TUBE, Shape.CAPSULE) and data.get("length") is not None:
         raise SceneError(f'geometry.length = {show(data["length"])}: only for geometry.shape = "tube" or "capsule"')
     if shape == Shape.TUBE:
@@ -856,13 +865,19 @@ def _length(data, shape: Shape, low: float) -> float:
 
 
 def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
-    """A capsule's [geometry] (its cylinder's length, 0 the sphere), its coils (coaxial, outside it) and the parts
-    of the model it does not have yet, refused one line each."""
+    """A capsule's [geometry] (its cylinder's length, 0 the sphere, and its longest cylinder element), its coils
+    (coaxial, outside it) and the parts of the model it does not have yet, refused one line each."""
     length = _length(data, Shape.CAPSULE, 0.0)
+    element = None
+    if data.get("element_length") is not None:
+        low = max(MIN_ELEMENT, length / MAX_ELEMENTS)
+        element = _getter(data, "geometry", Geometry)("element_length", lambda x: low <= x <= MAX_LENGTH,
+                                                       f"in [{low:g}, {MAX_LENGTH:g}] (at most {MAX_ELEMENTS} "
+                                                       f"elements on the cylinder of length {length:g})")
     _coaxial_outside('geometry.shape = "capsule"', field,
                      lambda coil: coil.radius**2 + max(abs(coil.height) - length / 2, 0.0) ** 2,
                      f"the reference capsule of length {length:g} (radius² + (|height| − length/2)₊²")
-    return Geometry(Shape.CAPSULE, length=length)
+    return Geometry(Shape.CAPSULE, length=length, element_length=element)
 
 
 def _tube(data, field: Field) -> Geometry:

@@ -32,7 +32,7 @@ import numpy as np
 from .azimuthal import merged_lowest, perturbation_map, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ...galerkin.legendre import gauss_rule
-from ...galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, gauss_nodes,
+from ...galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, piece_nodes,
                                        read_only)
 from ...galerkin.equilibrium import NodeKernels, Parameters
 from ...model.meridian import mass_density
@@ -85,7 +85,7 @@ class SecondVariation:
         norm = equilibrium.scene.stability.norm if norm is None else norm
         # per piece of the equilibrium's rule (split at a capsule's joins, where the integrand has kinks)
         joins = equilibrium.disc.joins
-        quadrature = max(equilibrium.disc.x.size // (len(joins) + 1), gauss_nodes(degree))
+        quadrature = max(equilibrium.disc.x.size // (len(joins) + 1), piece_nodes(degree, joins))
         # "legendre": P_k(x) even when the equilibrium's basis is mapped; "mapped": P_k(s) on the equilibrium's own
         # wire map (its Gauss nodes in s); on an unmapped equilibrium both are the same basis
         mapping = perturbation_map(equilibrium, self.basis_kind)
