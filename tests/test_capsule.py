@@ -293,22 +293,24 @@ def test_middle_of_a_long_capsule_has_the_closed_tubes_curvatures_and_stresses()
     assert abs(q["sigma_theta"][0, 0] / (hoop / 2) - 1.0) < 1e-6
 
 
-def test_capsule_curvatures_are_the_deformed_meridians_everywhere():
-    """The SPOM1 capsule of length 3 at P = 1.0 (degree 64): post/quantities.surface's curvatures, from each element's
-    second derivatives, against a second method on every element: the tangent angle ψ = atan2(η', ρ') of the
-    meridian ρ = λ2 R (R written here, ``capsule_radius``; λ2, η and their first θ-derivatives from the basis table
-    of galerkin/elements.py) differentiated by central differences (step 1e-5), k_m = −ψ'/s', and k_p = −η'/(ρ s'),
-    away from the joins (1e-8); at the poles k_p = k_m (isotropic, 1e-9), and ρ = λ2 R, λ1 = s'/κ."""
+@pytest.mark.parametrize("element", [None, 1.0])
+def test_capsule_curvatures_are_the_deformed_meridians_everywhere(element):
+    """The SPOM1 capsule of length 3 at P = 1.0 (degree 64), its cylinder one element or three (element_length 1):
+    post/quantities.surface's curvatures, from each element's second derivatives, against a second method on every
+    element: the tangent angle ψ = atan2(η', ρ') of the meridian ρ = λ2 R (R written here, ``capsule_radius``; λ2,
+    η and their first θ-derivatives from the basis table of galerkin/elements.py) differentiated by central
+    differences (step 1e-5), k_m = −ψ'/s', and k_p = −η'/(ρ s'), away from the joins (1e-8); at the poles
+    k_p = k_m (isotropic, 1e-9), and ρ = λ2 R, λ1 = s'/κ."""
     from balloon_cg.post.quantities import surface
 
-    scene = capsule_scene(3.0)
+    scene = capsule_scene(3.0, element=element)
     kappa = 1 + 3.0 / np.pi
-    theta_j = np.pi / (2 * kappa)
     eq, u = inflated(scene, 64, 1.0)
     X = np.append(u, 1.0)
     step = 1e-5
-    for low, high in ((0.02, theta_j - 0.02), (theta_j + 0.02, np.pi - theta_j - 0.02),
-                      (np.pi - theta_j + 0.02, np.pi - 0.02)):
+    bounds = np.concatenate([[0.0], np.arccos(meridian.joins(scene.geometry))[::-1], [np.pi]])
+    assert len(bounds) == (6 if element else 4)
+    for low, high in zip(bounds[:-1] + 0.02, bounds[1:] - 0.02):
         theta = np.linspace(low, high, 41)
         g = surface(eq.disc, X, theta, scene.geometry)
 
@@ -437,7 +439,7 @@ def capsule_run(tmp_path_factory):
 
     folder = tmp_path_factory.mktemp("capsule_run")
     scene = folder / "capsule.toml"
-    scene.write_text(CAPSULE.format(length=10.0) + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
+    scene.write_text(CAPSULE.format(length=10.0, split="") + "[continuation]\nstop_stretch = 1.05\n[solver]\ndegree = 64\n")
     path = folder / "capsule.h5"
     assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
     return path
@@ -504,7 +506,7 @@ def test_capsule_of_length_3_to_stretch_2_is_complete(tmp_path, capsys):
     from balloon_cg.app.cli import main
     from balloon_cg.io.run_file import read_run
 
-    text = CAPSULE.format(length=3.0) + "[continuation]\nstop_stretch = 2.0\n"
+    text = CAPSULE.format(length=3.0, split="") + "[continuation]\nstop_stretch = 2.0\n"
     scene = tmp_path / "capsule.toml"
     scene.write_text(text)
     path = tmp_path / "capsule.h5"
