@@ -31,7 +31,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize
 
 from .discretisation import gauss_nodes, read_only, symmetric_rows
 from .legendre import gauss_rule, legendre_table
@@ -179,6 +178,8 @@ class IntervalDiscretisation:
         """(S, η) of the bulge's crest, the largest radius ρ of the state u: its reference arclength and its height
         (measured from the tube's middle plane, where a mirror-symmetric field's coils lie). The largest of ρ on
         CREST_SAMPLES evenly spaced S, refined by Brent's bounded search between its neighbours."""
+        from scipy import optimize  # here: importing it costs every command ~0.25 s of CPU (this module is on every path)
+
         s = np.linspace(0.0, self.length, CREST_SAMPLES)
         k = int(np.argmax(self.profile(u, s)[0]))
         lo, hi = s[max(k - 1, 0)], s[min(k + 1, s.size - 1)]
