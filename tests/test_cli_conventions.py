@@ -357,16 +357,14 @@ def test_critical_interrupted_before_its_curve_leaves_the_output_alone(tmp_path,
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
-def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
+def test_interrupted_sweep_abandons_its_running_members_and_resumes(tmp_path, sig):
     """Members of a few seconds each on 2 workers: the signal comes once the first member is stored; the
-    running members are abandoned (workers terminated), the stored ones kept, and the same command resumes.
-    "Within a second" on an idle machine; a loaded one slows the stop as it slows the members, so the bound is
-    max(2 s, half the time the first member took from launch): waiting for the running members instead would take
-    about a member's time (the stress runs of session 14 saw 5 s at load 6, where the first member took far more)."""
+    running members are abandoned (workers terminated: none left), the stored ones kept, exit 130, and the same
+    command resumes. How soon it stops is checked in CPU time, not here in wall time (a loaded machine stretches
+    wall time at random): tests/test_interrupt_moments.py."""
     out = tmp_path / "sweep.h5"
     command = [sys.executable, "-m", "balloon_cg", "sweep", "spom1_two_coils_M0.002", "--vary",
                "M=0.001,0.0012,0.0014,0.0016,0.0018,0.002", "--no-pear", "--workers", "2", "-o", str(out), "--quiet"]
-    launched = time.monotonic()
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     store = Path(f"{out}.members")
     deadline = time.monotonic() + 600
@@ -375,11 +373,9 @@ def test_interrupted_sweep_stops_within_a_second_and_resumes(tmp_path, sig):
     if process.poll() is not None:  # say how it ended (seen once under load: no diagnosis was printed)
         pytest.fail(f"the sweep ended (exit {process.returncode}) before it could be interrupted; stored "
                     f"{sorted(p.name for p in store.glob('*'))}; stderr: {process.communicate()[1][-3000:]}")
-    started = time.monotonic()
     process.send_signal(sig)
     _, err = process.communicate(timeout=600)
-    stopped, first_member = time.monotonic() - started, started - launched
-    assert process.returncode == 130 and stopped < max(2.0, first_member / 2), (stopped, first_member, err)
+    assert process.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err
     stored = len(list(store.glob("0*.h5")))
     assert 1 <= stored < 6
