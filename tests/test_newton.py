@@ -45,6 +45,22 @@ def test_poor_start_refreshes_the_jacobian():
     assert result.converged and result.jacobians >= 3
 
 
+def test_a_neighbour_s_factors_start_the_chord():
+    """Given the factors of a solve at a neighbouring point with the same rows, a solve nearby needs no Jacobian of
+    its own and lands on the same root as with a fresh one; factors from far away (a poor chord) are refreshed."""
+    residual, jacobian, _, calls = circle_and_line()
+    rows = np.array([[1.0, 0.0]])  # x = target: the root (target, √(4 − target²))
+    neighbour = newton(residual, jacobian, (1.0, 1.732), rows, 1.0, 1e-13, 50)  # factored at ~its root
+    assert neighbour.converged and neighbour.factors is not None
+    fresh = newton(residual, jacobian, (1.001, 1.7), rows, 1.001, 1e-13, 50)
+    calls["jacobian"] = 0
+    chord = newton(residual, jacobian, (1.001, 1.7), rows, 1.001, 1e-13, 50, neighbour.factors)
+    assert chord.converged and chord.jacobians == calls["jacobian"] == 0
+    assert abs(chord.x[1] - np.sqrt(4.0 - 1.001**2)) < 1e-13 and np.abs(chord.x - fresh.x).max() < 1e-13
+    far = newton(residual, jacobian, (1.9, 1.7), rows, 1.9, 1e-13, 50, neighbour.factors)
+    assert far.converged and far.jacobians >= 1 and abs(far.x[1] - np.sqrt(4.0 - 1.9**2)) < 1e-13
+
+
 def test_double_root_converges_linearly_and_error_estimate_holds():
     """x² = 0: Newton halves the error each step (ρ = 1/2); the stop must account for ρ/(1 − ρ)|dx| = |dx|."""
     result = newton(lambda z: np.array([z[0] ** 2]), lambda z: np.array([[2 * z[0], 0.0]]), (1.0, 0.0),

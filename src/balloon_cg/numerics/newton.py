@@ -45,10 +45,13 @@ class NewtonResult:
     factors: tuple | None = None  # converged: dgetrf's (lu, pivots) of the last [∂R/∂x; rows] (at an earlier iterate)
 
 
-def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> NewtonResult:
+def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
+           factors: tuple | None = None) -> NewtonResult:
     """Solve R(x) = 0, rows @ x = targets; converged when the correction and the estimated error are below tol in
     the scaled max-norm max_i |dx_i|/(1 + |x_i|) (absolute for small components, relative for large ones: a
-    pressure of 10³ does not loosen the tolerance on the shape coefficients).
+    pressure of 10³ does not loosen the tolerance on the shape coefficients). ``factors``: dgetrf's factors of
+    [∂R/∂x; rows] at a neighbouring point with the same rows (a NewtonResult's), the chord to start from: stale,
+    refreshed as soon as its corrections contract too slowly.
 
     Near a singular point Newton converges only linearly (ratio ρ) even with a fresh Jacobian, and the
     remaining error ρ/(1 − ρ)|dx| may exceed |dx|: the estimate accounts for that.
@@ -60,7 +63,7 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int) -> 
     rows = np.array(rows, dtype=float, ndmin=2, copy=None)  # as np.atleast_2d, np.atleast_1d: one C call each
     targets = np.array(targets, dtype=float, ndmin=1)
     previous = np.inf
-    factors, fresh, jacobians, growth = None, False, 0, 0
+    fresh, jacobians, growth = False, 0, 0
     r, step = None, np.inf
     n = x.size - rows.shape[0]  # equations R
     matrix = np.empty((x.size, x.size), order="F")  # [∂R/∂x; rows], factored in place (LAPACK's column order)

@@ -153,11 +153,15 @@ def _secondary(sb: SurfaceBranch, traced: list, i: int, sector: tuple, k: int, e
     def on_final(c, value):
         return np.append(c if trace.basis == sb.basis else transfer(trace.basis, c, sb.basis), value)
 
+    last = {}  # the factors of the last evaluation's Newton matrix: the next one starts from them (same rows d)
+
     def value_at(s):
         interrupt.check()  # each evaluation is a Newton solve and a sector's eigenvalues (~0.5 s on two coils)
-        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton)
+        result = newton(system.residual, system.jacobian, X0 + s * d, d, d @ X0 + s, solver.tol, solver.max_newton,
+                        last.get("factors"))
         if not result.converged:
             raise ArithmeticError(result.message)
+        last["factors"] = result.factors
         c, params = system.coefficients(result.x), system.params_at(result.x)
         A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), (sector,))[held][sector]
         return float(eigen.lowest_following(A, k + 1, float(ends[0][0]))[k]), on_final(c, result.x[-1])
