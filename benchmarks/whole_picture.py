@@ -8,11 +8,15 @@ caches) and reports the measured run's wall time (what a user waits for: the poi
 assessed on every core, ``numerics.workers``), its CPU time (this process and its workers) and per phase the CPU
 seconds of this process (BLAS is single-threaded, so on a shared machine it is the steady number; a phase whose
 points went to workers shows only its share here), each phase measured by wrapping the functions ``analyse`` calls
-for it, the same in every install:
+for it, the same in every install (then this process's CPU outside them, ``untimed``, and its workers', ``workers``):
 
     trace: primary.trace_primary   stability: stability.assess_branch   branch points: bifurcation.locate, classify
-    pear branches: switching.trace_pear   m >= 1 crossings: azimuthal_points.find
+    pear branches: switching.trace_pear, broken_symmetry.broken_pear (the off-equator coil's disconnected pear
+    branch: its homotopy in the coil heights and trace; untimed before session 22)   m >= 1 crossings: azimuthal_points.find
     surface branches: surface_branches.trace_surface (its stability and secondary points included)
+
+A call inside a timed one (the broken pear's seed assesses a branch and locates its pitchfork) counts in the
+outer one's phase only.
 
 Then the floors as ratios of one run, in wall time: the two-coil picture ≤ 10× the spom1 picture, the paper coil
 and the off-equator coil ≤ 20× it; also in CPU time. Installs are given as interpreters (``--python``, default this
@@ -34,7 +38,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("spom1", "spom1_two_coils_M0.002", "spom1_paper_coil", "off_equator")
 FLOORS = {"spom1_two_coils_M0.002": 10.0, "spom1_paper_coil": 20.0, "off_equator": 20.0}
 PATHS = {"off_equator": ROOT / "tests" / "data" / "off_equator.toml"}
-PHASES = ("trace", "stability", "branch points", "pear branches", "m >= 1 crossings", "surface branches")
+PHASES = ("trace", "stability", "branch points", "pear branches", "m >= 1 crossings", "surface branches", "untimed",
+          "workers")  # untimed: this process's CPU outside the phases; workers: the CPU of its worker processes
 
 MEASURE = """
 import json, resource, sys, time
@@ -47,18 +52,26 @@ except ImportError:  # an install from before analysis/ was regrouped (session 2
 from balloon_cg.scene import load_scene
 seconds = {}
 
+running = []  # the timed call in progress: a timed call inside it counts in its phase (module docstring)
+
 def timed(phase, f):
     def wrapper(*args, **kwargs):
+        if running:
+            return f(*args, **kwargs)
         start = time.process_time()
+        running.append(phase)
         try:
             return f(*args, **kwargs)
         finally:
+            running.pop()
             seconds[phase] = seconds.get(phase, 0.0) + time.process_time() - start
     return wrapper
 
 for module, name, phase in ((picture, "trace_primary", "trace"), (picture, "assess_branch", "stability"),
                             (bifurcation, "locate", "branch points"), (bifurcation, "classify", "branch points"),
-                            (picture, "trace_pear", "pear branches"), (azimuthal_points, "find", "m >= 1 crossings"),
+                            (picture, "trace_pear", "pear branches"),
+                            (picture.broken_symmetry, "broken_pear", "pear branches"),
+                            (azimuthal_points, "find", "m >= 1 crossings"),
                             (surface_branches, "trace_surface", "surface branches")):
     setattr(module, name, timed(phase, getattr(module, name)))
 scene = load_scene(sys.argv[1])
@@ -68,15 +81,16 @@ if overrides:
 
 def cpu():
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+    return own.ru_utime + own.ru_stime, children.ru_utime + children.ru_stime
 
 if not json.loads(sys.argv[3]):
     picture.analyse(scene)
 seconds.clear()
-start, used = time.perf_counter(), cpu()
+start, (own, children) = time.perf_counter(), cpu()
 found = picture.analyse(scene)
-wall, total = time.perf_counter() - start, cpu() - used
-print(json.dumps({"wall": wall, "total": total, "phases": seconds,
+wall, (own, children) = time.perf_counter() - start, [now - then for now, then in zip(cpu(), (own, children))]
+seconds["untimed"], seconds["workers"] = own - sum(seconds.values()), children
+print(json.dumps({"wall": wall, "total": own + children, "phases": seconds,
                   "points": int(sum(len(b.X) for b in found.branches))}))
 """
 

@@ -143,6 +143,47 @@ def test_relatives_in_lockstep_are_each_alone_bit_for_bit():
         assert (found is None and alone is None) or np.array_equal(found, alone)
 
 
+@pytest.mark.parametrize("n", [60, 140])
+def test_relatives_read_below_the_base_matrix_s_lowest_eigenvalue(n, monkeypatch):
+    """``lowest_with_relatives``: the base matrix's own lowest eigenvalues are the dense ones, each relative's (a
+    volume constraint, a positive rank-one term, both) within 10 ε‖A‖ (‖A‖ = 1e6: the dense solve's own rounding
+    level) of its own matrix solved dense (through one
+    factorisation from RELATIVES_SIZE rows, here 100, the dense solve itself below it), a refused one (a negative
+    term) dense."""
+    monkeypatch.setattr(eigen, "RELATIVES_SIZE", 100)
+    A, _ = stiff_matrix(n, [-3.9, -0.2, 0.3, 0.3 + 1e-7, 0.5], 7)
+    rng = np.random.default_rng(10)
+    row, u = rng.normal(size=(1, n)), rng.normal(size=n)
+    unit = eigen.GramFactor(np.ones(n), orthogonal=True)
+    matrices = [lambda: eigen.restricted(A, unit, row), lambda: A + 0.7 * np.outer(u, u),
+                lambda: eigen.restricted(A + 0.7 * np.outer(u, u), unit, row), lambda: A - 0.7 * np.outer(u, u)]
+    relatives = [(row, None, matrices[0]), (None, (u, 0.7), matrices[1]), (row, (u, 0.7), matrices[2]),
+                 (None, (u, -0.7), matrices[3])]
+    own, values = eigen.lowest_with_relatives(A, 3, relatives)
+    assert np.array_equal(own, eigen.lowest_of(np.array(A), 3))
+    for found, matrix in zip(values, matrices):
+        assert np.abs(found - eigen.lowest_of(matrix(), 3)).max() < 10 * eigen.EPS * 1e6
+    assert np.array_equal(values[3], eigen.lowest_of(matrices[3](), 3))
+
+
+def test_assessment_reads_the_relatives_to_the_dense_rounding(monkeypatch):
+    """A point of the paper coil at perturbation degree 60 in the general layout with RELATIVES_SIZE 50 (m = 0 blocks
+    of 121 rows, the m = 1 block's two reflection classes of ~90: the volume, gas and held blocks read through one
+    factorisation each, ``lowest_with_relatives``): every block's lowest eigenvalues within 100 ε‖A‖ of its matrices'
+    by a second dense method (LAPACK's divide and conquer, dsyevd), the rounding level of dense eigenvalues of A
+    (at the default size: tests/test_stability_reference.py, the paper coil and the off-equator scene)."""
+    monkeypatch.setattr(eigen, "RELATIVES_SIZE", 50)
+    branch = trace_primary(load_scene(ROOT / "scenes" / "spom1_paper_coil.toml"), stop_stretch=2.5, down=False)
+    variation, X = SecondVariation(equilibrium_of(branch), 60), branch.X[-1]
+    params = branch.params_at(X)
+    found = variation.assess(X[:-1], params, False, 1).blocks
+    for name, parts, _ in variation.blocks(X[:-1], params, False, 1):
+        scale = 100 * np.finfo(float).eps * max(np.linalg.norm(A, 2) for A in parts)
+        dense = np.sort(np.concatenate([linalg.eigh(A, eigvals_only=True, driver="evd")[:3] for A in parts]))[:3]
+        assert min(A.shape[0] for A in parts) >= eigen.RELATIVES_SIZE
+        assert np.abs(found[name] - dense).max() < scale, name
+
+
 def test_negative_count_is_the_inertia():
     """The Bunch–Kaufman inertia counts the negative eigenvalues, with 2×2 pivots (zero diagonal blocks force them)."""
     for negatives in (0, 1, 3, 7):

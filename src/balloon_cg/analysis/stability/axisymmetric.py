@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .azimuthal import merged_lowest, perturbation_map, restricted_blocks
+from .azimuthal import lowest_readings, merged_lowest, perturbation_map, restricted_blocks
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ...galerkin.legendre import gauss_rule
 from ...galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, piece_nodes,
@@ -222,28 +222,49 @@ class SecondVariation:
         return out
 
     def _axisymmetric(self, u, params: Parameters, symmetric: bool, names=None) -> list:
-        """``blocks`` of the m = 0 plan (``_plan``; only those named in ``names``, if given). The blocks of one index
-        set share its reduction A = L⁻¹HL⁻ᵀ (one dsygst instead of three): volume control is A on (L⁻¹g)ᵀy = 0 (its
-        reflections), gas control A + (P/Ṽ)(L⁻¹g)(L⁻¹g)ᵀ; each block's matrix is its own array (the eigensolves
-        overwrite them)."""
+        """``blocks`` of the m = 0 plan (``_plan``; only those named in ``names``, if given): each block's matrix is
+        its own array (the eigensolves overwrite them), made from its index set's reduction (``_families``)."""
+        return [(name, (_member_matrix(A, row, weight, gas, constrained),), flags)
+                for A, row, weight, members in self._families(u, params, symmetric, names)
+                for name, gas, constrained, flags in members]
+
+    def _families(self, u, params: Parameters, symmetric: bool, names=None) -> list:
+        """The m = 0 plan (``_plan``; only the blocks named in ``names``, if given) by index set: (A, row, weight,
+        members) each, with A = L⁻¹HL⁻ᵀ the set's reduction (one dsygst for its blocks), row = L⁻¹g, weight = P/Ṽ and
+        members (name, gas, constrained, flags) its blocks: pressure control is A, volume control A on
+        (L⁻¹g)ᵀy = 0 (its reflections), gas control A + (P/Ṽ)(L⁻¹g)(L⁻¹g)ᵀ (``_member_matrix``)."""
         half = symmetric and self._even is not None  # g's odd entries are then not zero: read on even rows only
         H, g = self._even_matrices(u, params) if half else self.matrices(u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         weight = self._gas_weight(u, params)
-        reduced = {}  # per index set: A = L⁻¹HL⁻ᵀ and the row L⁻¹g, shared by its pressure, volume and gas blocks
-        out = []
+        families = {}  # per index set: [A, row, weight, members]
         for name, gas, idx, constrained, factor, flags in self._plan(symmetric, field_on):
             if names is not None and name not in names:
                 continue
-            if id(idx) not in reduced:
-                reduced[id(idx)] = (eigen.restricted(H, factor, eigen.NO_CONSTRAINT, idx),
-                                    factor.directions(g[idx][None, :]))
-            A, row = reduced[id(idx)]
-            if constrained:  # A on (L⁻¹g)ᵀy = 0
-                A = eigen.restricted(A, eigen.GramFactor(np.ones(idx.size), orthogonal=True), row)
-            elif gas:  # L⁻¹(H + (P/Ṽ) g gᵀ)L⁻ᵀ
-                A = A + weight * np.outer(row[0], row[0])
-            out.append((name, (A,), flags))
+            if id(idx) not in families:
+                families[id(idx)] = (eigen.restricted(H, factor, eigen.NO_CONSTRAINT, idx),
+                                     factor.directions(g[idx][None, :]), weight, [])
+            families[id(idx)][3].append((name, gas, constrained, flags))
+        return list(families.values())
+
+    def _axisymmetric_lowest(self, u, params: Parameters, symmetric: bool) -> list:
+        """(name, LOWEST eigenvalues, flags) of every m = 0 block (``_axisymmetric``): the blocks of one index set
+        are relatives of its pressure block A (``eigen.lowest_with_relatives``: large ones through one shifted
+        factorisation below A's lowest eigenvalue, not a dense eigensolve each)."""
+        out = []
+        for A, row, weight, members in self._families(u, params, symmetric):
+            plain = [member for member in members if not (member[1] or member[2])]
+            relatives = [member for member in members if member[1] or member[2]]
+            if len(plain) != 1:  # no pressure block to be the relatives' base: each alone
+                out += [(name, merged_lowest((_member_matrix(A, row, weight, gas, constrained),), LOWEST), flags)
+                        for name, gas, constrained, flags in members]
+                continue
+            own, values = eigen.lowest_with_relatives(
+                A, LOWEST, [(row if constrained else None, (row[0], weight) if gas else None,
+                             lambda gas=gas, constrained=constrained: _member_matrix(A, row, weight, gas, constrained))
+                            for _, gas, constrained, _ in relatives])
+            found = {plain[0][0]: own} | {member[0]: v for member, v in zip(relatives, values)}
+            out += [(name, found[name], flags) for name, _, _, flags in members]
         return out
 
     def _gas(self, H, g, u, params: Parameters) -> np.ndarray:
@@ -269,6 +290,20 @@ class SecondVariation:
         normals = g[idx][None, :] if constrained else np.zeros((0, idx.size))
         return K[np.ix_(idx, idx)], self.gram[np.ix_(idx, idx)], normals, idx
 
+    def _lowest_blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0):
+        """(name, LOWEST eigenvalues, flags) per block of ``blocks``, in its order; the blocks that are relatives of
+        another (volume and gas of a pressure block, the held m = 1 reading of the free one) read through one
+        factorisation where they are large (``_axisymmetric_lowest``, ``azimuthal.lowest_readings``)."""
+        yield from self._axisymmetric_lowest(u, params, symmetric)
+        field_on = self.eq.coils.shape[0] > 0 and params.M > 0
+        for m in range(1, m_max + 1):
+            interrupt.check()
+            readings = lowest_readings(self.eq, u, params, m, self.basis.degree, LOWEST,
+                                       (True, False) if field_on else (True,), kind=self.basis_kind)
+            yield f"m{m}_held", readings[True], HELD_FLAGS if field_on else EVERY_FLAG
+            if field_on:
+                yield f"m{m}_free", readings[False], FREE_FLAGS
+
     def lowest(self, u, params: Parameters, symmetric: bool, name: str) -> np.ndarray:
         """The LOWEST eigenvalues of the one m = 0 block ``name`` at one equilibrium (``blocks``)."""
         (_, parts, _), = self._axisymmetric(u, params, symmetric, (name,))
@@ -278,9 +313,9 @@ class SecondVariation:
         """Blocks (their LOWEST eigenvalues) and flags (a flag holds when every block it takes is positive) at one
         equilibrium (``blocks``)."""
         blocks, lowest = {}, [np.inf] * len(FLAGS)
-        for name, parts, flags in self.blocks(u, params, symmetric, m_max):
+        for name, values, flags in self._lowest_blocks(u, params, symmetric, m_max):
             interrupt.check()  # a signal: Interrupted at the next block (assess_branch's callers catch it)
-            blocks[name] = merged_lowest(parts, LOWEST)
+            blocks[name] = values
             for flag in flags:
                 lowest[flag] = min(lowest[flag], blocks[name][0])
         return Assessment(blocks, *(value > 0 for value in lowest), self.basis.degree)
@@ -323,6 +358,16 @@ def _hold(nodes: NodeKernels, u, state_map: np.ndarray, params: Parameters):
     """The node state u @ state_map (rows λ2, v, η, w) of the unknowns u into ``nodes``, held at ``params``."""
     np.dot(np.asarray(u, dtype=float), state_map, out=nodes.state.reshape(-1))
     nodes.hold(params)
+
+
+def _member_matrix(A, row, weight: float, gas: bool, constrained: bool) -> np.ndarray:
+    """One m = 0 block's matrix from its index set's reduction A (``SecondVariation._families``): A itself under
+    pressure control, A on rowᵀy = 0 under volume control, A + weight·row rowᵀ under gas control."""
+    if constrained:  # A on (L⁻¹g)ᵀy = 0
+        return eigen.restricted(A, eigen.GramFactor(np.ones(A.shape[0]), orthogonal=True), row)
+    if gas:  # L⁻¹(H + (P/Ṽ) g gᵀ)L⁻ᵀ
+        return A + weight * np.outer(row[0], row[0])
+    return A
 
 
 def block_indices(variation, block: str, field_on: bool):

@@ -431,6 +431,39 @@ def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, d
     return out
 
 
+def lowest_readings(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, count: int,
+                    readings=(True, False), kind: str | None = None) -> dict:
+    """The ``count`` lowest eigenvalues of each reading of ``restricted_blocks`` (held: True, free: False). Where
+    both are asked for at m = 1, the held matrix of each part is the free one on the translation's rows also
+    (``eigen.restricted_rows``: in the free matrix's coordinates), a relative of it (``eigen.lowest_with_relatives``:
+    large ones through one shifted factorisation below the free reading's lowest eigenvalue, no second reduction
+    nor dense eigensolve); a part without the translation's rows (its other reflection class) has one matrix for
+    both."""
+    if m != 1 or tuple(readings) != (True, False):
+        return {held: merged_lowest(parts, count) for held, parts in
+                restricted_blocks(equilibrium, u, params, m, degree, readings, kind=kind).items()}
+    b = perturbation_basis(equilibrium, m, degree, 0, kind)
+    moments, parts = _parts(equilibrium, u, params, m, b)
+    free_modes, held_modes = list(excluded_modes(equilibrium, params, False)), list(excluded_modes(equilibrium, params, True))
+    extra = [k for k in held_modes if k not in free_modes]
+    held, free = [], []
+    for H, index, factor, cls in parts:
+        free_rows, held_rows = _class_rows(moments, free_modes, cls, index), _class_rows(moments, held_modes, cls, index)
+        A = eigen.restricted(H, factor, free_rows)
+        if len(held_rows) == len(free_rows):  # the translation is not in this part: one matrix
+            values = eigen.lowest_of(A, count)
+            free.append(values)
+            held.append(values)
+            continue
+        own, (values,) = eigen.lowest_with_relatives(
+            A, count, [(eigen.restricted_rows(factor, free_rows, _class_rows(moments, extra, cls, index)), None,
+                        lambda: eigen.restricted(H, factor, held_rows))])
+        free.append(own)
+        held.append(values)
+    merged = lambda found: found[0] if len(found) == 1 else np.sort(np.concatenate(found))[:count]
+    return {True: merged(held), False: merged(free)}
+
+
 def _parts(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:
     """(the special modes' constraint rows G c, ((H, index, Gram factor, class) of each uncoupled part)): the two
     reflection classes of an equator-symmetric state, else the whole block (index and class None)."""
