@@ -151,15 +151,17 @@ def test_the_entry_points_catch_sigterm_before_importing_the_cli():
 @pytest.mark.parametrize("method", ["assess", "flags"])
 def test_a_stop_while_a_point_s_blocks_are_built_comes_before_their_eigenvalues(monkeypatch, method):
     """A point's blocks cost up to ~1 s of CPU on two coils at the check degree: a stop asked for while the first
-    point of ``method`` builds them (``SecondVariation.blocks``) raises Interrupted before any of its blocks is solved
-    (``assess``, the first pass: their eigenvalues; ``flags``, the check-degree pass: their Cholesky test)."""
+    point of ``method`` builds them raises Interrupted before any of its blocks is solved (``assess``, the first pass:
+    their eigenvalues, the m = 0 reductions built by ``SecondVariation._families``; ``flags``, the check-degree pass:
+    their Cholesky test, the blocks built by ``SecondVariation.blocks``)."""
     from balloon_cg.analysis.stability import axisymmetric as stability
     from balloon_cg.analysis.branches.primary import trace_primary
     from balloon_cg.numerics import eigen, workers
 
     branch = trace_primary(load_scene("spom1").with_overrides({"continuation.stop_stretch": 2.0}))
-    blocks, run = stability.SecondVariation.blocks, getattr(stability.SecondVariation, method)
-    lowest, definite = stability.merged_lowest, eigen.positive_definite
+    builder = "_families" if method == "assess" else "blocks"
+    blocks, run = getattr(stability.SecondVariation, builder), getattr(stability.SecondVariation, method)
+    lowest, definite, relatives = stability.merged_lowest, eigen.positive_definite, eigen.lowest_with_relatives
     inside, solved = [], []
 
     def asked(self, *args, **kwargs):
@@ -178,10 +180,11 @@ def test_a_stop_while_a_point_s_blocks_are_built_comes_before_their_eigenvalues(
             return solve(*args, **kwargs)
         return counted
 
-    monkeypatch.setattr(stability.SecondVariation, "blocks", asked)
+    monkeypatch.setattr(stability.SecondVariation, builder, asked)
     monkeypatch.setattr(stability.SecondVariation, method, entered)
     monkeypatch.setattr(stability, "merged_lowest", solving(lowest))
     monkeypatch.setattr(eigen, "positive_definite", solving(definite))
+    monkeypatch.setattr(eigen, "lowest_with_relatives", solving(relatives))
     with interrupt.stop_on_signals(), workers.serial(), pytest.raises(interrupt.Interrupted):
         stability.assess_branch(branch, branch.scene.stability.degree, check=True)
     assert len(inside) == 1 and True not in solved  # the point's blocks built, none solved after the request

@@ -251,8 +251,9 @@ class SecondVariation:
         """(name, LOWEST eigenvalues, flags) of every m = 0 block (``_axisymmetric``): the blocks of one index set
         are relatives of its pressure block A (``eigen.lowest_with_relatives``: large ones through one shifted
         factorisation below A's lowest eigenvalue, not a dense eigensolve each)."""
-        out = []
-        for A, row, weight, members in self._families(u, params, symmetric):
+        out, families = [], self._families(u, params, symmetric)
+        interrupt.check()  # a signal while the reductions were built: Interrupted before any of them is solved
+        for A, row, weight, members in families:
             plain = [member for member in members if not (member[1] or member[2])]
             relatives = [member for member in members if member[1] or member[2]]
             if len(plain) != 1:  # no pressure block to be the relatives' base: each alone
