@@ -79,7 +79,7 @@ class Shooter:
         self.coils = coaxial_table(f.coils)
         self.kernels = KernelSet.of_scene(scene)
         self.M, self.chi = (f.M, f.chi) if self.coils.shape[0] else (0.0, f.chi)
-        self.voltage = 0.0 if scene.electric is None else scene.electric.voltage
+        self.voltage = scene.voltage
         self.equator_symmetric = f.is_equator_symmetric
         self.rtol, self.atol = rtol, atol
 

@@ -328,6 +328,11 @@ class Scene:
     geometry: Geometry = Geometry()  # [geometry]: the reference surface
     dynamics: Dynamics = Dynamics()
 
+    @property
+    def voltage(self) -> float:
+        """The voltage Φ̄ of [electric] (MODEL.md's dimensionless voltage across the membrane), 0 without one."""
+        return 0.0 if self.electric is None else self.electric.voltage
+
     @classmethod
     def from_toml(cls, path) -> "Scene":
         """The scene of a TOML file.

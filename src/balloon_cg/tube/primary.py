@@ -78,8 +78,7 @@ def in_field(scene) -> bool:
 def scene_parameters(scene, pressure: float = 0.0) -> Parameters:
     """The branch parameters of a tube scene at ``pressure``: the field's M and χ (M = 0 without coils) and the
     voltage Φ̄ of [electric] (0 without)."""
-    voltage = 0.0 if scene.electric is None else scene.electric.voltage
-    return Parameters(pressure, scene.field.M, scene.field.chi, voltage)
+    return Parameters(pressure, scene.field.M, scene.field.chi, scene.voltage)
 
 
 def held(disc: IntervalDiscretisation, stretch: float | None = None) -> np.ndarray:

@@ -52,7 +52,7 @@ def smallest_stress(eq: Equilibrium, u: np.ndarray) -> float:
     disc, scene = eq.disc, eq.scene
     lam2, v, _, w = disc.node_state(u)
     lam1 = meridian.meridional_stretch(scene.geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
-    dielectric = dielectric_stress(0.0 if scene.electric is None else scene.electric.voltage, lam1, lam2)
+    dielectric = dielectric_stress(scene.voltage, lam1, lam2)
     return float(min(np.min(stress + dielectric) for stress in elastic_stresses(scene.material, lam1, lam2)))
 
 

@@ -163,8 +163,7 @@ def start_parameters(scene, parameter: str) -> Parameters:
     at continuation.pressure (parameter "voltage"; ContinuationError where no voltage holds it)."""
     lam, chi = scene.continuation.start_stretch, scene.field.chi
     if parameter == "P":
-        voltage = 0.0 if scene.electric is None else scene.electric.voltage
-        return Parameters(sphere_pressure(scene.material, lam, voltage), 0.0, chi, voltage)
+        return Parameters(sphere_pressure(scene.material, lam, scene.voltage), 0.0, chi, scene.voltage)
     P = scene.continuation.pressure
     try:
         return Parameters(P, 0.0, chi, sphere_voltage(scene.material, lam, P))
