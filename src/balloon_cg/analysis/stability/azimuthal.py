@@ -408,9 +408,12 @@ def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int
 
 def merged_lowest(parts, count: int) -> np.ndarray:
     """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
-    if len(parts) == 1:
-        return eigen.lowest_of(parts[0], count)
-    return np.sort(np.concatenate([eigen.lowest_of(A, count) for A in parts]))[:count]
+    return _merged([eigen.lowest_of(A, count) for A in parts], count)
+
+
+def _merged(found: list, count: int) -> np.ndarray:
+    """The ``count`` lowest of the uncoupled parts' lowest eigenvalues ``found`` (ascending each)."""
+    return found[0] if len(found) == 1 else np.sort(np.concatenate(found))[:count]
 
 
 def restricted_blocks(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int, readings=(True, False),
@@ -460,8 +463,7 @@ def lowest_readings(equilibrium: Equilibrium, u, params: Parameters, m: int, deg
                         lambda: eigen.restricted(H, factor, held_rows))])
         free.append(own)
         held.append(values)
-    merged = lambda found: found[0] if len(found) == 1 else np.sort(np.concatenate(found))[:count]
-    return {True: merged(held), False: merged(free)}
+    return {True: _merged(held, count), False: _merged(free, count)}
 
 
 def _parts(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:
