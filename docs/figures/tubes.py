@@ -34,7 +34,7 @@ from balloon_cg.galerkin.interval import Mirror  # noqa: E402
 from balloon_cg.io.tube_file import discretisation, read_tube_run, write_tube_run  # noqa: E402
 from balloon_cg.model import tube  # noqa: E402
 from balloon_cg.post.style import journal_style  # noqa: E402
-from balloon_cg.post.tube_measures import front  # noqa: E402
+from balloon_cg.post.tube_measures import fronts  # noqa: E402
 from balloon_cg.post.tube_plots import front_motion, pressure_volume, profiles, stretch_profiles  # noqa: E402
 from balloon_cg.scene import parse_scene  # noqa: E402
 from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
@@ -48,7 +48,6 @@ STRETCHED = (150.0, 250.0, 400.0)  # V/V0 of the stretches drawn
 TABLE = (20.0, 50.0, 100.0, 200.0, 300.0, 320.0, 360.0, 400.0)  # V/V0 of the plateau's table
 LENGTHS = (10.0, 20.0, 40.0, 80.0, 160.0)
 DEGREES = (30, 40, 60, 90)
-SAMPLES = 4001  # along S, for the fronts and the stretches
 
 
 def scene_of(length: float, degree: int, stop_stretch: float, preset: str = "SPOM1"):
@@ -63,19 +62,6 @@ def picture(length: float, degree: int, stop_stretch: float, stop_volume: float)
     primary = primary_branch(scene)
     bulge = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=stop_volume, step=0.02)
     return scene, TubePicture({"primary": primary, "bulge": bulge}, maxwell(scene))
-
-
-def fronts(run: dict) -> tuple:
-    """Per point of the bulge branch: (the front in the reference arclength S, the front along the deformed axis
-    measured from the bulge's end η(0))."""
-    b, disc = run["branches"]["bulge"], discretisation(run["attrs"])
-    s = np.linspace(0.0, disc.length, SAMPLES)
-    reference, deformed = [], []
-    for u in b["unknowns"]:
-        rho, eta = disc.profile(u, s)
-        reference.append(front(s, rho))
-        deformed.append(front(eta[0] - eta, rho))
-    return reference, deformed
 
 
 def draw(run: dict, out: Path) -> None:
@@ -136,7 +122,7 @@ def plateau_table(coarse: dict, fine: dict) -> None:
     rule of the Maxwell states."""
     pm, a, b = tube.maxwell_pressure(scene_of(LENGTH, DEGREE, 1.75).material)
     va, vb = a.hoop**2 * a.axial, b.hoop**2 * b.axial
-    reference, deformed = fronts(coarse)
+    reference, deformed = fronts(discretisation(coarse["attrs"]), coarse["branches"]["bulge"]["unknowns"])
     volume = coarse["branches"]["bulge"]["volume"]
     finer = fine["branches"]["bulge"]
     print(f"\nthe plateau (SPOM1, L = {LENGTH:g}): P_M = {pm:.12f}, states a: v = {va:.6f}, b: v = {vb:.4f}")

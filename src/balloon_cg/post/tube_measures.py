@@ -15,6 +15,8 @@ import numpy as np
 from ..galerkin.discretisation import legendre_table
 from ..scene.tables import Ends
 
+SAMPLES = 4001  # reference arclengths a state's front is sampled at (``fronts``)
+
 
 @dataclass(frozen=True)
 class Front:
@@ -57,3 +59,15 @@ def front(z: np.ndarray, rho: np.ndarray) -> Front:
     j = i - 1
     position = z[j] + (middle - rho[j]) * (z[i] - z[j]) / (rho[i] - rho[j])
     return Front(float(position), float((high - low) / np.abs(np.gradient(rho, z)).max()), float(low), float(high))
+
+
+def fronts(disc, states) -> tuple:
+    """Per state u of ``states``: (its front in the reference arclength S, its front along the deformed axis measured
+    from the end η(0)), each ``front`` of the profile sampled at SAMPLES evenly spaced S."""
+    s = np.linspace(0.0, disc.length, SAMPLES)
+    reference, deformed = [], []
+    for u in states:
+        rho, eta = disc.profile(u, s)
+        reference.append(front(s, rho))
+        deformed.append(front(eta[0] - eta, rho))
+    return reference, deformed

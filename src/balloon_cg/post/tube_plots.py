@@ -11,14 +11,13 @@ mirror block).
 import numpy as np
 
 from .style import JournalFigure, journal_style
-from .tube_measures import front, stretches
+from .tube_measures import SAMPLES, fronts, stretches
 from ..io.tube_file import discretisation
 
 TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches")
 CONTROLS = ("pressure", "volume", "gas")
 PROFILES = 8  # profiles drawn along a branch unless the points are given
 STRETCHED = 3  # states whose stretches are drawn unless the points are given
-SAMPLES = 4001  # reference arclengths a front or a stretch profile is sampled at
 _COLOURS = {"primary": "k", "bulge": "C0"}
 
 
@@ -99,12 +98,8 @@ def front_motion(ax, run: dict, name: str, points=None) -> None:
     tube_measures.front measures them; a branch whose profiles are all uniform has none (TubePlotError)."""
     b = run["branches"][name]
     chosen = _chosen(b, name, points, len(b["pressure"]))
-    disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
-    fronts = []
-    for i in chosen:
-        rho, eta = disc.profile(b["unknowns"][i], s)
-        fronts.append(front(eta[0] - eta, rho))
-    position, width = (np.array([getattr(f, key) for f in fronts]) for key in ("position", "width"))
+    _, deformed = fronts(discretisation(run["attrs"]), b["unknowns"][chosen])
+    position, width = (np.array([getattr(f, key) for f in deformed]) for key in ("position", "width"))
     if np.isnan(position).all():
         raise TubePlotError(f"--what front: the {name} branch's profiles are uniform at the points drawn (no front)")
     volume = b["volume"][chosen]
