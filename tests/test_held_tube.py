@@ -18,6 +18,7 @@ from balloon_cg.model import tube
 from balloon_cg.scene import parse_scene
 from balloon_cg.scene.validation import SceneError
 from balloon_cg.tube.primary import primary_branch
+from balloon_cg.tube.results import IntervalStop
 from balloon_cg.tube.stability import COMPRESSED
 from test_interval import series
 from test_tube import symbolic_energy, theta, z
@@ -82,7 +83,7 @@ def test_sliding_held_tube_has_the_fixed_stretch_maximum_and_minimum():
     scene = held_scene("SPOM1", 10.0, 1.5, "sliding", 20)
     branch = primary_branch(scene)
     disc, k = branch.disc, branch.disc.axial_index
-    assert branch.stop.code == "hoop_stretch"
+    assert branch.stop.code == IntervalStop.HOOP_STRETCH
     energy = symbolic_energy(scene.material)
     folds = fixed_stretch_folds(energy, 1.5, (1.5, 4.8))
     found = [s for s in branch.special if s.kind == "LP"]
@@ -126,7 +127,7 @@ def test_plugged_held_tube_has_a_pressure_maximum_and_minimum():
         folds = [s for s in branch.special if s.kind == "LP"]
         assert len(folds) == 2 and all(s.status == "located" for s in folds)
         found[degree] = folds
-        assert branch.stop.code == "hoop_stretch" and branch.pressure[-1] > folds[1].pressure
+        assert branch.stop.code == IntervalStop.HOOP_STRETCH and branch.pressure[-1] > folds[1].pressure
     maxima = [found[d][0].pressure for d in (30, 40, 50)]
     minima = [found[d][1].pressure for d in (30, 40, 50)]
     assert max(maxima) - min(maxima) <= 1e-10

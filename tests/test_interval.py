@@ -16,6 +16,7 @@ from numpy.polynomial import legendre
 from scipy import optimize
 
 from balloon_cg.tube.primary import primary_branch
+from balloon_cg.tube.results import IntervalStop
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
@@ -140,7 +141,7 @@ def test_uniform_tube_is_an_exact_state(preset):
         R = eq.residual(disc.uniform(state.hoop, state.axial), Parameters(state.pressure))
         assert np.abs(R).max() <= 1e-13 * state.pressure
     branch = primary_branch(scene)
-    assert branch.stop.code == "hoop_stretch" and len(branch.pressure) > 20
+    assert branch.stop.code == IntervalStop.HOOP_STRETCH and len(branch.pressure) > 20
     k = disc.axial_index
     hoop_balance, axial_balance = uniform_balances(scene.material)
     for u, P, V in zip(branch.states, branch.pressure, branch.volume):

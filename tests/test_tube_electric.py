@@ -25,6 +25,7 @@ from balloon_cg.model import tube
 from balloon_cg.model.membrane import Charged, stretch_derivatives
 from balloon_cg.scene import SceneError
 from balloon_cg.tube.primary import primary_branch
+from balloon_cg.tube.results import IntervalStop
 from test_interval import ogden, series, tube_scene
 from test_tube import closed_end_path, dispersion_onset, symbolic_energy, theta, z
 
@@ -69,7 +70,7 @@ def test_charged_tube_is_stationary_for_the_energy_written_here():
     assert np.abs(R - gradient).max() <= 1e-8 * np.abs(R).max()
 
     branch = primary_branch(scene)
-    assert branch.stop.code == "hoop_stretch" and branch.params.voltage == VOLTAGE
+    assert branch.stop.code == IntervalStop.HOOP_STRETCH and branch.params.voltage == VOLTAGE
     u, P, disc = branch.states[-1], branch.pressure[-1], branch.disc
     rho = disc.profile(u, np.array([0.0, 5.0, 10.0]))[0]
     assert abs(rho[0] - 1) < 1e-12 and abs(rho[2] - 1) < 1e-12 and rho[1] > 1.3

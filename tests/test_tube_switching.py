@@ -12,10 +12,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.results import Kind
+from balloon_cg.analysis.results import Kind, StopCode
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.tube.bulge import UnswitchableBranchPoint, bulge_branch
 from balloon_cg.tube.primary import primary_branch, volume_ratio
+from balloon_cg.tube.results import IntervalStop
 from balloon_cg.galerkin.equilibrium import Equilibrium
 
 from test_interval import tube_scene
@@ -43,7 +44,7 @@ def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
         scene, primary, point, branch = switched(length, degree, block, extra)
         assert point.status == "located"
         onsets[block] = point.pressure
-        assert branch.stop.code in ("stop_volume", "rejoined")
+        assert branch.stop.code in (StopCode.STOP_VOLUME, IntervalStop.REJOINED)
         fold = next(s for s in branch.special if s.kind == "LV")
         assert fold.smallest_stress > 0 and fold.status == "located"
         eq = Equilibrium(scene, branch.disc)
