@@ -58,7 +58,7 @@ def test_bulge_branch_stops_where_its_tail_passes_max_error():
 
 def test_unresolved_bulge_is_retraced_at_a_higher_degree():
     """The same with the policy max_error 1e-5, max_degree 100: retraced from degree 30 at 45 and 67 (the
-    policy's growth 1.5), where it reaches V/V0 = 4 resolved (measured tail ≤ 1.5e-6 at degree 60); its fold at the
+    policy's growth 1.5), where it reaches V/V0 = 4 resolved (degree 60's tail there: 3.1e-6); its fold at the
     converged one (docs/tubes.md: degrees 30–120 agree to 3e-11) within 1e-9. With max_degree 30 it is the stopped
     branch of degree 30."""
     _, branch = resolved_bulge_branch(spom1_l10(30), stop_volume=4.0, step=0.02, policy=Resolution(1e-5, 100))
