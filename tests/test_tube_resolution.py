@@ -102,8 +102,10 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
     """A tube run file (io/tube_file.py) holds per point of every branch ``tail`` and ``first_integral_spread``:
     the bulge branch's those it was traced with, bit for bit; the primary branch's (uniform, exact in the basis: its
     other coefficients zero to the Newton tolerance, test_interval.test_uniform_tube_is_an_exact_state) ≤ 1e-10
-    (measured 6.7e-14 and 3.4e-13 to a hoop stretch of 2.5), and they read back through TubeResult's points table."""
+    (measured 6.7e-14 and 3.4e-13 to a hoop stretch of 2.5), and they read back through TubeResult's points table;
+    ``inspect`` counts the points whose tail is above solver.max_error and shows the largest."""
     from balloon_cg.app.tube_result import TubeResult
+    from balloon_cg.app.tube_summary import format_tube, summarise_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
     from balloon_cg.tube.picture import tube_picture
 
@@ -117,3 +119,8 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
     assert branches["primary"]["tail"].max() <= 1e-10 and branches["primary"]["first_integral_spread"].max() <= 1e-10
     table = TubeResult.read(path).to_dataframe()
     assert {"tail", "first_integral_spread"} <= set(table.columns)
+    summary = summarise_tube(read_tube_run(path))["branches"]
+    assert summary["bulge"]["unresolved_points"] == (bulge.tail > 1e-9).sum() > 0  # solver.max_error: the default
+    assert summary["bulge"]["largest_tail"] == bulge.tail.max() and summary["primary"]["unresolved_points"] == 0
+    assert f"{summary['bulge']['unresolved_points']} points unresolved" in format_tube(summarise_tube(
+        read_tube_run(path)))
