@@ -27,9 +27,9 @@ def ogden_1972_tube(degree: int):
     """The closed tube of Ogden's 1972 rubber, sliding ends, L = 30, traced to a hoop stretch of 1.75."""
     mu, alpha = TRELOAR
     scale = 4.0 / sum(m * a for m, a in zip(mu, alpha))
-    return parse_scene(f'[material]\nmu = {[m * scale for m in mu]}\nalpha = {list(alpha)}\n[geometry]\nshape = "tube"\n'
-                       f'length = {LENGTH}\n[solver]\ndegree = {degree}\n[continuation]\nstop_stretch = 1.75\n'
-                       'max_points = 3000\n')
+    return parse_scene(f'[material]\nmu = {[m * scale for m in mu]}\nalpha = {list(alpha)}\n'
+                       f'[geometry]\nshape = "tube"\nlength = {LENGTH}\n[solver]\ndegree = {degree}\n'
+                       '[continuation]\nstop_stretch = 1.75\nmax_points = 3000\n')
 
 
 def equal_area_pressure(energy, largest_hoop: float = 30.0) -> tuple:
@@ -120,8 +120,8 @@ def test_ogden_bulge_reaches_maxwells_pressure_by_fifty_volumes(maxwell):
 
 @pytest.mark.slow
 def test_ogden_plateau_converges_in_the_degree(maxwell):
-    """Degrees 80, 120, 160 to V/V0 = 60 (~30 s of CPU, 142 s on the loaded machine): the chain at 120 and 160 (``check_chain``); the volume
-    fold the same at each degree (P and V/V0 within 1e-9); P on the plateau (V/V0 ≥ 50, the finer degrees
+    """Degrees 80, 120, 160 to V/V0 = 60 (~30 s of CPU, 142 s on the loaded machine): the chain at 120 and 160
+    (``check_chain``); the volume fold the same at each degree (P and V/V0 within 1e-9); P on the plateau (V/V0 ≥ 50, the finer degrees
     interpolated at the coarser one's volumes) converging: |P_120 − P_160| ≤ 1e-7 and below |P_80 − P_160| (measured
     6.5e-8 and 1.5e-6; the folds within 3e-15)."""
     branches, folds = {}, {}

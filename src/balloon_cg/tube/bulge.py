@@ -21,8 +21,9 @@ tube/control.VolumeStop), its largest hoop stretch ``stop_stretch``, in a coil f
 (IntervalStop.COMPRESSED: tube/stability.CompressionStop), where a point's Legendre tail passes ``max_error`` when one
 is given (IntervalStop.UNRESOLVED: that point is not stored, nor a fold located in the step to it; tube/resolution.py
 retraces at a higher degree), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
-(StopCode.INTERRUPTED). Every point carries its tail and first-integral spread (tube/accuracy.py). The branch point X* is the branch's first point; the stability of every point is
-``unstable_counts``' (at X* itself one eigenvalue is zero, its sign rounding).
+(StopCode.INTERRUPTED). Every point carries its tail and first-integral spread (tube/accuracy.py). The branch point
+X* is the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is
+zero, its sign rounding).
 """
 import numpy as np
 

@@ -19,13 +19,16 @@ def resolved_bulge_branch(scene, stop_volume: float | None = None, step: float |
                           policy: Resolution | None = None) -> tuple:
     """(primary, bulge) of a tube scene, the bulge switched at the primary branch's first odd branch point and every
     stored point resolved to ``policy.max_error`` (None: the scene's solver.max_error and max_degree), from
-    solver.degree (module docstring); ``stop_volume`` and ``step``: tube/bulge.bulge_branch's."""
+    solver.degree (module docstring); ``stop_volume`` and ``step``: tube/bulge.bulge_branch's. The bulge is None
+    where the primary branch has no odd branch point (up to continuation.stop_stretch)."""
     policy = Resolution.of(scene) if policy is None else policy
     degree = scene.solver.degree
     while True:
         primary = primary_branch(scene, degree)
-        branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume, step,
-                              max_error=policy.max_error)
+        onsets = primary.branch_points(Mirror.ODD)
+        if not onsets:
+            return primary, None
+        branch = bulge_branch(scene, primary, onsets[0], stop_volume, step, max_error=policy.max_error)
         if branch.stop.code != IntervalStop.UNRESOLVED or degree >= policy.max_degree:
             return primary, branch
         degree = policy.grow(degree)
