@@ -53,6 +53,23 @@ def closed_end_path(energy):
     return P, N, axial
 
 
+def equal_area_integral(energy, pressure: float, cuts, nodes: int = 80) -> tuple:
+    """(∫ (P − pressure) dv, ∫ |P − pressure| dv) along the closed-end path N = 0 of ``energy`` from λθ = cuts[0] to
+    cuts[-1], v = λθ²λz: dv/dλθ = 2λθλz + λθ² dλz/dλθ with dλz/dλθ = −N_θ/N_z; Gauss–Legendre with ``nodes`` nodes
+    on each piece between consecutive cuts."""
+    P, N, axial_of = closed_end_path(energy)
+    P_of = sp.lambdify((theta, z), P)
+    slope_of = sp.lambdify((theta, z), 2 * theta * z - theta**2 * sp.diff(N, theta) / sp.diff(N, z))
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    signed = absolute = 0.0
+    for low, high in zip(cuts, cuts[1:]):
+        for hoop, weight in zip((high - low) / 2 * x + (high + low) / 2, (high - low) / 2 * w):
+            axial = axial_of(hoop)
+            value = (P_of(hoop, axial) - pressure) * slope_of(hoop, axial) * weight
+            signed, absolute = signed + value, absolute + abs(value)
+    return signed, absolute
+
+
 @pytest.mark.parametrize("hoop", [1.05, 1.5, 2.5, 6.0])
 def test_neo_hookean_uniform_state_is_the_closed_form(hoop):
     state = closed_end_state(material("neo-Hookean"), hoop)
@@ -180,17 +197,8 @@ def test_maxwell_pressure_is_the_equal_area_rule(voltage):
     found, a, b = maxwell_pressure(energy_of)
     assert abs(a.pressure - found) <= 1e-12 and abs(b.pressure - found) <= 1e-12 and a.hoop < 1.2 < 10 < b.hoop
     energy = symbolic_energy(spom1) - sp.Rational(repr(voltage)) ** 2 * theta**2 * z**2
-    P, N, axial_of = closed_end_path(energy)
-    P_of = sp.lambdify((theta, z), P)
-    slope_of = sp.lambdify((theta, z), 2 * theta * z - theta**2 * sp.diff(N, theta) / sp.diff(N, z))
-    x, w = np.polynomial.legendre.leggauss(80)
     cuts = [a.hoop, pressure_maximum(energy_of).hoop, 3.0, pressure_minimum(energy_of).hoop, b.hoop]
-    signed = absolute = 0.0
-    for low, high in zip(cuts, cuts[1:]):
-        for hoop, weight in zip((high - low) / 2 * x + (high + low) / 2, (high - low) / 2 * w):
-            axial = axial_of(hoop)
-            value = (P_of(hoop, axial) - found) * slope_of(hoop, axial) * weight
-            signed, absolute = signed + value, absolute + abs(value)
+    signed, absolute = equal_area_integral(energy, found, cuts)
     assert abs(signed) <= 1e-9 * absolute
     equal_area = found + signed / (b.hoop**2 * b.axial - a.hoop**2 * a.axial)
     assert abs(equal_area - found) <= 1e-12 * found

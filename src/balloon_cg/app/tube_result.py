@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.tube_file import CREST, CURVE_COLUMNS, POINT_COLUMNS, read_tube_run
+from ..io.tube_file import ACCURACY, CREST, CURVE_COLUMNS, POINT_COLUMNS, read_tube_run
 from .tables import html_table, optional
 
 PARTS = ("points", "special")
@@ -149,7 +149,7 @@ class TubeResult:
 
     @staticmethod
     def _points(b: dict) -> dict:
-        return {c: b[c] for c in (*POINT_COLUMNS, CREST, "lowest_even", "lowest_odd") if c in b}
+        return {c: b[c] for c in (*POINT_COLUMNS, CREST, *ACCURACY, "lowest_even", "lowest_odd") if c in b}
 
     @staticmethod
     def _special(b: dict) -> dict:

@@ -1,7 +1,9 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
 voltage ([electric]; None without), the loading control (its stability reading: how many of a branch's points are
 stable under it; under gas control the amount n = P V of every located point), Maxwell's pressure, per branch its
-points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py), the height of its last
+points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py) and how many are not
+resolved (their Legendre tail above the scene's solver.max_error: tube/accuracy.py; None in files before the tail is
+stored), the largest tail, the height of its last
 point's crest and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md),
 with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block over the points,
 as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the smallest eigenvalue and
@@ -13,6 +15,7 @@ import tomllib
 import numpy as np
 
 from ..io.tube_file import CREST
+from ..scene import parse_scene
 from ..tube.stability import COMPRESSED
 
 
@@ -22,6 +25,7 @@ def summarise_tube(run: dict) -> dict:
     geometry = {"shape": a["shape"], "length": a["length"], "ends": a["ends"],
                 "axial_stretch": None if math.isnan(a["axial_stretch"]) else a["axial_stretch"]}
     control, v0 = a["control"], np.pi * a["length"]
+    max_error = parse_scene(a["scene_toml"]).solver.max_error
     branches = {}
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
         unstable = b.get(f"unstable_{control}")
@@ -32,6 +36,8 @@ def summarise_tube(run: dict) -> dict:
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
+                          "unresolved_points": int((b["tail"] > max_error).sum()) if "tail" in b else None,
+                          "largest_tail": float(b["tail"].max(initial=0.0)) if "tail" in b else None,
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
                           "stable_points": None if unstable is None else int((unstable == 0).sum()),
                           "special_points": _with_omega2(special, b.get("frequencies")),
@@ -138,6 +144,8 @@ def format_tube(summary: dict) -> str:
                       + ("" if b["stable_points"] is None else
                          f"; {b['stable_points']} stable under {summary['control']} control")
                       + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
+                      + (f"; {b['unresolved_points']} points unresolved (Legendre tail above solver.max_error, "
+                         f"largest {b['largest_tail']:.2g})" if b["unresolved_points"] else "")
                       + ("" if b["last_crest_height"] is None else
                          f"; last crest at height {b['last_crest_height']:.6g}")]
         for m, block in b["azimuthal"].items():

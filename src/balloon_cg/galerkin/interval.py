@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .discretisation import gauss_nodes, read_only, symmetric_rows
+from .discretisation import gauss_nodes, geometric_tail, read_only, symmetric_rows
 from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
 from ..scene.tables import Ends
@@ -173,6 +173,29 @@ class IntervalDiscretisation:
         bubbles = p[:, 2:] - p[:, : n - 1]
         rho = p @ u[:k] if self.ends == Ends.SLIDING else 1.0 + bubbles @ u[:k]
         return rho, -u[k] * self.length / 2 * x + bubbles @ u[k + 1:]
+
+    def series(self, u: np.ndarray) -> tuple:
+        """(λ2's Legendre coefficients c_0..c_N, those of η's bubble part Σ b_k (P_{k+2} − P_k)): the bubbles'
+        coefficients c_k = b_{k−2} − b_k (plugged ends: λ2 = 1 + bubbles, c_0 with the 1)."""
+        k, n = self.axial_index, self.degree
+
+        def bubbles(b):
+            c = np.zeros(n + 1)
+            c[2:] += b
+            c[: n - 1] -= b
+            return c
+
+        hoop = u[:k].copy() if self.ends == Ends.SLIDING else bubbles(u[:k])
+        if self.ends == Ends.PLUGGED:
+            hoop[0] += 1.0
+        return hoop, bubbles(u[k + 1:])
+
+    def tail(self, u: np.ndarray) -> float:
+        """Spectral error estimate of u, the sphere's (discretisation.geometric_tail): the neglected tail E·r/(1 − r)
+        of the envelope max(|c_k|, |d_k|)/|c_0| of λ2's and η's bubble part's Legendre coefficients (``series``),
+        in units of the mean radius c_0. Zero on the uniform tube (exact in the basis)."""
+        hoop, axial = self.series(u)
+        return geometric_tail(np.maximum(np.abs(hoop), np.abs(axial)) / abs(hoop[0]))
 
     def crest(self, u: np.ndarray) -> tuple:
         """(S, η) of the bulge's crest, the largest radius ρ of the state u: its reference arclength and its height

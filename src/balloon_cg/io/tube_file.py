@@ -10,7 +10,9 @@ per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``vol
 ``unstable_volume`` and ``unstable_gas`` (negative eigenvalues of ∂R/∂u, on δV = 0, and of ∂R/∂u + (P/Ṽ) g gᵀ:
 tube/stability.py; files before gas control have no ``unstable_gas``), ``smallest_stress`` (the smallest
 principal stress: negative where the membrane is compressed, tube/stability.py), ``crest_height`` (the height η of
-the largest radius, the bulge's crest, from the tube's middle plane: IntervalDiscretisation.crest), ``lowest_even``/
+the largest radius, the bulge's crest, from the tube's middle plane: IntervalDiscretisation.crest), ``tail`` and
+``first_integral_spread`` (the state's Legendre tail and the spread of H = λ1Φ_1 − Φ along the tube: tube/accuracy.py;
+files before them have none), ``lowest_even``/
 ``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), with stability.m_max ≥ 1 ``lowest_m<m>``
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
 not assessed); its located points under
@@ -38,6 +40,7 @@ from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..scene.tables import Ends
 from ..analysis.results import Kind, StopCode
 from ..numerics.continuation import RootStatus, Stop, TraceStop
+from ..tube.accuracy import accuracy
 from ..tube.azimuthal import COUNT
 from ..tube.primary import volume_ratio
 from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
@@ -47,6 +50,7 @@ FORMAT = "balloon-cg-tube/1"
 POINT_COLUMNS = ("pressure", "volume", "unstable_pressure", "unstable_volume", "smallest_stress")
 CREST = "crest_height"  # per point and located point: η of the largest radius (files before it have none)
 GAS = "unstable_gas"  # per point: unstable directions under gas control (files before it have none)
+ACCURACY = ("tail", "first_integral_spread")  # per point: tube/accuracy.accuracy (files before them have none)
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
@@ -67,6 +71,9 @@ TUBE_VARIABLES = {
     GAS: ("", "unstable directions, gas control", "negative eigenvalues of ∂R/∂u + (P/Ṽ) g gᵀ (P V = n fixed)"),
     "smallest_stress": ("1", "smallest principal stress", "over the nodes, in μ/2: negative where compressed"),
     CREST: ("1", "crest height", "height η of the largest radius from the tube's middle plane, in R"),
+    "tail": ("1", "Legendre tail", "spectral error estimate of the state over its mean radius (tube/accuracy.py)"),
+    "first_integral_spread": ("1", "spread of H", "(max H − min H)/max |H| over the nodes, H = λ1Φ_1 − Φ (constant "
+                              "on an exact state; NaN in a coil field)"),
     "lowest_even": ("1", "lowest eigenvalue, even block", "of the mirror-symmetric block of ∂R/∂u"),
     "lowest_odd": ("1", "lowest eigenvalue, odd block", "of the mirror-antisymmetric block of ∂R/∂u"),
     **{f"lowest_m{m}": ("1", f"lowest eigenvalues, m = {m}", f"the lowest μ of the cos {m}φ block, H c = μ G c "
@@ -139,11 +146,13 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         group = f.create_group(f"branches/{name}")
         group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
         checksummed(group, "unknowns", branch.states)
+        eq = Equilibrium(scene, branch.disc)
         for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
                                ("unstable_pressure", branch.unstable["pressure"]),
                                ("unstable_volume", branch.unstable["volume"]), (GAS, branch.unstable["gas"]),
                                ("smallest_stress", branch.smallest_stress),
-                               (CREST, crest_heights(branch.disc, branch.states))):
+                               (CREST, crest_heights(branch.disc, branch.states)),
+                               *zip(ACCURACY, accuracy(eq, branch.states))):
             checksummed(group, column, values)
         for block, values in branch.lowest.items():
             checksummed(group, f"lowest_{block.value}", values)
@@ -161,7 +170,6 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         write_strings(special, "status", [p.status.value for p in s])
         checksummed(special, "index", np.array([p.index for p in s], dtype=int))
         checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
-        eq = Equilibrium(scene, branch.disc)
         volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
         checksummed(special, "volume", np.array(volume, dtype=float))
         checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
@@ -231,7 +239,7 @@ def read_tube(f, path, where: str = "") -> dict:
             raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
         branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
         n = branch["unknowns"].shape[0]
-        optional = tuple(c for c in (CREST, GAS, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
+        optional = tuple(c for c in (CREST, GAS, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
         for column in POINT_COLUMNS + optional:
             branch[column] = group[column][()]
             if branch[column].shape != (n,):

@@ -18,12 +18,16 @@ another branch point of the block, the other end of the pitchfork's loop, where 
 the monitors' sign changes in that last step are that symmetry, not folds, and are not kept), its V reaches
 ``continuation.stop_volume`` (or the argument ``stop_volume`` in V/V0; the end landed there exactly:
 tube/control.VolumeStop), its largest hoop stretch ``stop_stretch``, in a coil field where its states turn compressed
-(IntervalStop.COMPRESSED: tube/stability.CompressionStop), after ``continuation.max_points``, or at the next point after
-SIGINT/SIGTERM (StopCode.INTERRUPTED). The branch point X* is the branch's first point; the stability of every point is
-``unstable_counts``' (at X* itself one eigenvalue is zero, its sign rounding).
+(IntervalStop.COMPRESSED: tube/stability.CompressionStop), where a point's Legendre tail passes ``max_error`` when one
+is given (IntervalStop.UNRESOLVED: that point is not stored, nor a fold located in the step to it; tube/resolution.py
+retraces at a higher degree), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
+(StopCode.INTERRUPTED). Every point carries its tail and first-integral spread (tube/accuracy.py). The branch point
+X* is the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is
+zero, its sign rounding).
 """
 import numpy as np
 
+from .accuracy import accuracy
 from .control import VolumeStop, control_monitors, gradient
 from .primary import TubeSystem, held, in_field, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
@@ -45,10 +49,12 @@ class UnswitchableBranchPoint(ValueError):
 
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
-                 step: float | None = None, stop_stretch: float | None = None) -> IntervalBranch:
+                 step: float | None = None, stop_stretch: float | None = None,
+                 max_error: float | None = None) -> IntervalBranch:
     """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: V/V0 where
     it ends (None: the scene's continuation.stop_volume, V/R0³, if any); ``step``: the first arclength step (None:
-    continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it.
+    continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it;
+    ``max_error``: stop where a point's Legendre tail passes it (None: no check).
     UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that is not
     uniform."""
     if point.kind != Kind.BP or point.block is None:
@@ -99,22 +105,31 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         if stop_stretch is not None and hoop > stop_stretch:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
                                                    f"{stop_stretch:g}")
+        if max_error is not None and (tail := disc.tail(Y[:-1])) > max_error:
+            return Stop(IntervalStop.UNRESOLVED, f"the Legendre tail {tail:.3g} passed solver.max_error "
+                                                 f"{max_error:g} at degree {disc.degree}")
         return compressed(Y[:-1])
 
     monitors = {Kind.LP: np.eye(X.size)[-1], Kind.LV: gradient(system, Control.VOLUME)}
     path = continuation.trace(system, start, settings, stop, monitors | control_monitors(system, scene.loading.control))
     last = len(path.points) - 1
-    folds = [f for f in path.folds if not (path.stop.code == IntervalStop.REJOINED and f.index == last)]
+    folds = [f for f in path.folds
+             if not (path.stop.code in (IntervalStop.REJOINED, IntervalStop.UNRESOLVED) and f.index == last)]
     end, stopped = volume_stop.end(path, settings)
+    if end is not None and max_error is not None and (tail := disc.tail(end[:-1])) > max_error:
+        end, stopped = None, Stop(IntervalStop.UNRESOLVED, f"the Legendre tail {tail:.3g} of the landed end passed "
+                                                           f"solver.max_error {max_error:g} at degree {disc.degree}")
     if path.stop.code == StopCode.STOP_VOLUME:
         folds = [f for f in folds if f.index < last or volume_stop.kept(path, end, f.point.X)]
     special = tuple(IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + 1,
                                     f.status) for f in sorted(folds, key=lambda f: f.index))
     points = [system.full(X)] + [system.full(p.X) for p in path.points] + ([] if end is None else [end])
-    return IntervalBranch(disc, np.array([Y[:-1] for Y in points]), np.array([Y[-1] for Y in points]),
+    states = np.array([Y[:-1] for Y in points])
+    tail, spread = accuracy(eq, states)
+    return IntervalBranch(disc, states, np.array([Y[-1] for Y in points]),
                           np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points, params),
                           stressed(eq, special), stopped, np.array([smallest_stress(eq, Y[:-1]) for Y in points]),
-                          primary.params)
+                          primary.params, tail, spread)
 
 
 class Side:

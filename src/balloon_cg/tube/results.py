@@ -18,6 +18,7 @@ class IntervalStop(enum.StrEnum):
     HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
     REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
     COMPRESSED = "compressed"  # in a coil field, the membrane turned compressed after being taut (tube/stability.py)
+    UNRESOLVED = "unresolved"  # a point's Legendre tail passed solver.max_error (tube/resolution.py); not stored
 
 
 def signalled() -> Stop | None:
@@ -50,7 +51,9 @@ class IntervalBranch:
     symmetry), the number of unstable directions at every point under each control (``unstable``: Control -> int array;
     files before gas control have no Control.GAS), the located points, why the trace stopped and the smallest principal
     stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters (the field's M
-    and χ; P is each point's)."""
+    and χ; P is each point's); ``tail`` and ``first_integral``: per point, the spectral error estimate and the
+    spread of H = λ1Φ_1 − Φ along the tube (tube/accuracy.py; None where not computed: the primary branch, a
+    branch read from a file)."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
@@ -62,6 +65,8 @@ class IntervalBranch:
     stop: Stop
     smallest_stress: np.ndarray  # per point: tube/stability.smallest_stress
     params: Parameters
+    tail: np.ndarray | None = None  # per point: galerkin/interval.IntervalDiscretisation.tail
+    first_integral: np.ndarray | None = None  # per point: tube/accuracy.first_integral_spread
 
     def branch_points(self, block: Mirror | None = None) -> list:
         return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]
