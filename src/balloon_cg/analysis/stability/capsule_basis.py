@@ -14,7 +14,11 @@ per element, the elements joined continuously (the energy holds first derivative
     cylinder   F = P̂_k(t), k = 0..n_e, t ∈ [−1, 1] linear in θ on each cylinder element (model/meridian.joins),
 
 with j = m, m + 1, m − 1 for Z, U, D. Continuity of each field at each element boundary is imposed by the null space
-of its jump rows (orthonormal columns: the conditioning is kept). The degrees: the caps' and each cylinder element's
+of its jump rows (orthonormal columns: the conditioning is kept), together with its parity under the reflection
+θ → π − θ (the elements are mirror images: the caps' functions of ψ alike, a cylinder element's P_k(t) the
+mirror's P_k(−t) = (−1)^k P_k(t)): the basis is the union of the two reflection classes (R, T even, Z odd | R, T
+odd, Z even, as the sphere's ``AzimuthalBasis.classes``), so that an equator-symmetric state's block splits into
+two of half the size. The degrees: the caps' and each cylinder element's
 in the equilibrium's piecewise basis of the same degree N (galerkin/elements.sequence: the caps' in x, an element's
 in θ), at least MIN_DEGREE; a capsule of length 0 (no joins: the sphere) has two hemispheres of degree N.
 
@@ -116,19 +120,20 @@ class CapsuleBasis:
             nodes.append(0.5 * (e.high - e.low) * s + 0.5 * (e.high + e.low))
             weights.append(0.5 * (e.high - e.low) * w)
         theta, theta_weights = np.concatenate(nodes), np.concatenate(weights)
-        fields = {}
-        for name, order in (("Z", m), ("U", m + 1), ("D", m - 1)):
-            fields[name] = _joined(parts, kappa, order, nodes)
         put = object.__setattr__
         put(self, "theta", theta)
         put(self, "x", np.cos(theta))
         put(self, "sin_theta", np.sin(theta))
         put(self, "weights", theta_weights * np.sin(theta))
         put(self, "elements", parts)
-        offsets, columns = {}, 0
-        for name in ("Z", "U", "D"):
+        # columns: Z, U, D, each its reflection class 0 then 1 (class 0: Z odd, U and D even under θ → π − θ)
+        offsets, columns, fields, parity = {}, 0, {}, []
+        for name, order, first in (("Z", m, -1), ("U", m + 1, 1), ("D", m - 1, 1)):
+            pieces = [_joined(parts, kappa, order, nodes, sign) for sign in (first, -first)]
+            fields[name] = tuple(np.hstack(arrays) for arrays in zip(*pieces))
             offsets[name] = slice(columns, columns + fields[name][0].shape[1])
             columns += fields[name][0].shape[1]
+            parity += [0] * pieces[0][0].shape[1] + [1] * pieces[1][0].shape[1]
         ops = np.zeros((6, theta.size, columns))
         ops[2, :, offsets["Z"]], ops[3, :, offsets["Z"]] = fields["Z"]
         for name, sign in (("U", 1.0), ("D", -1.0)):  # R = (U + D)/2, T = (U − D)/2
@@ -138,24 +143,33 @@ class CapsuleBasis:
         put(self, "blocks", offsets)
         put(self, "size", columns)
         put(self, "ops", ops)
-        z = offsets["Z"]
-        put(self, "ops_z", np.ascontiguousarray(ops[2:4, :, z]))
-        put(self, "ops_ud", np.ascontiguousarray(ops[[0, 1, 4, 5], :, z.stop:]))
+        nz = offsets["Z"].stop
+        put(self, "ops_z", np.ascontiguousarray(ops[2:4, :, :nz]))
+        put(self, "ops_ud", np.ascontiguousarray(ops[[0, 1, 4, 5], :, nz:]))
         area = theta_weights * kappa * hoop(self.geometry, np.cos(theta), np.sin(theta))  # S' R dθ
         values = ops[[0, 4, 2]]
         put(self, "gram", 0.5 * np.einsum("aqi,q,aqj->ij", values, area, values))
         put(self, "factor", eigen.GramFactor(self.gram))
         put(self, "moments", np.ascontiguousarray((0.5 * values * area[None, :, None]).reshape(-1, columns)))
-        put(self, "classes", ())
+        # the reflection classes, as AzimuthalBasis's: ``even`` the nodes (here all), weights and each class's columns
+        # of ops_ud and ops_z (Z ones first) for the assembly of an equator-symmetric state's two blocks
+        parity = np.array(parity)
+        classes = tuple(np.flatnonzero(parity == p) for p in (0, 1))
+        put(self, "classes", classes)
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)]) for c in classes))
+        put(self, "even", (np.arange(theta.size), self.weights, tuple(
+            (np.ascontiguousarray(self.ops_ud[:, :, c[c >= nz] - nz]), np.ascontiguousarray(self.ops_z[:, :, c[c < nz]]))
+            for c in classes)))
 
     def values(self, c: np.ndarray) -> np.ndarray:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
         return self.ops @ c
 
 
-def _joined(parts: tuple, kappa: float, order: int, nodes: list) -> tuple:
+def _joined(parts: tuple, kappa: float, order: int, nodes: list, parity: int) -> tuple:
     """(F, dF/dθ) at every element's ``nodes`` (stacked) of one field of regularity ``order`` on the C⁰ joined
-    elements: the broken functions times an orthonormal basis of the null space of the jumps at the boundaries."""
+    elements with F(π − θ) = ``parity`` · F(θ): the broken functions times an orthonormal basis of the null space of
+    the jumps at the boundaries and of c − parity · (the mirror's coefficients)."""
     blocks, ends = [], []
     for e, theta in zip(parts, nodes):
         blocks.append(_field_functions(e, kappa, order, theta))
@@ -166,7 +180,12 @@ def _joined(parts: tuple, kappa: float, order: int, nodes: list) -> tuple:
     for i in range(len(parts) - 1):  # the value at the end of element i equals that at the start of i + 1
         jumps[i, starts[i]:starts[i + 1]] = ends[i][1]
         jumps[i, starts[i + 1]:starts[i + 2]] -= ends[i + 1][0]
-    joined = linalg.null_space(jumps)
+    mirror = np.zeros((starts[-1], starts[-1]))  # the coefficients of F(π − θ)
+    for i, e in enumerate(parts):
+        j = len(parts) - 1 - i
+        signs = (-1.0) ** np.arange(sizes[i]) if e.kind == "cylinder" else np.ones(sizes[i])
+        mirror[starts[i]:starts[i + 1], starts[j]:starts[j + 1]] = np.diag(signs)
+    joined = linalg.null_space(np.vstack([jumps, np.eye(starts[-1]) - parity * mirror]))
     value = linalg.block_diag(*[b[0] for b in blocks]) @ joined
     slope = linalg.block_diag(*[b[1] for b in blocks]) @ joined
     return value, slope
