@@ -14,11 +14,12 @@ per element, the elements joined continuously (the energy holds first derivative
     cylinder   F = P̂_k(t), k = 0..n_e, t ∈ [−1, 1] linear in θ on each cylinder element (model/meridian.joins),
 
 with j = m, m + 1, m − 1 for Z, U, D. Continuity of each field at each element boundary is imposed by the null space
-of its jump rows (orthonormal columns: the conditioning is kept), together with its parity under the reflection
+of its jump rows, together with its parity under the reflection
 θ → π − θ (the elements are mirror images: the caps' functions of ψ alike, a cylinder element's P_k(t) the
 mirror's P_k(−t) = (−1)^k P_k(t)): the basis is the union of the two reflection classes (R, T even, Z odd | R, T
 odd, Z even, as the sphere's ``AzimuthalBasis.classes``), so that an equator-symmetric state's block splits into
-two of half the size. The degrees: the caps' and each cylinder element's
+two of half the size. Each field's functions of one class are then recombined orthonormal under ‖δx‖² (below):
+the Gram matrix is the identity, and each pencil's reduction a scaling, as on the sphere. The degrees: the caps' and each cylinder element's
 in the equilibrium's piecewise basis of the same degree N (galerkin/elements.sequence: the caps' in x, an element's
 in θ), at least MIN_DEGREE; a capsule of length 0 (no joins: the sphere) has two hemispheres of degree N.
 
@@ -126,10 +127,13 @@ class CapsuleBasis:
         put(self, "sin_theta", np.sin(theta))
         put(self, "weights", theta_weights * np.sin(theta))
         put(self, "elements", parts)
-        # columns: Z, U, D, each its reflection class 0 then 1 (class 0: Z odd, U and D even under θ → π − θ)
+        area = theta_weights * kappa * hoop(self.geometry, np.cos(theta), np.sin(theta))  # S' R dθ
+        # columns: Z, U, D, each its reflection class 0 then 1 (class 0: Z odd, U and D even under θ → π − θ), each
+        # group orthonormal under ‖δx‖² (R² + T² = (U² + D²)/2: G has no entries between the groups)
         offsets, columns, fields, parity = {}, 0, {}, []
-        for name, order, first in (("Z", m, -1), ("U", m + 1, 1), ("D", m - 1, 1)):
-            pieces = [_joined(parts, kappa, order, nodes, sign) for sign in (first, -first)]
+        for name, order, first, share in (("Z", m, -1, 0.5), ("U", m + 1, 1, 0.25), ("D", m - 1, 1, 0.25)):
+            pieces = [_orthonormal(*_joined(parts, kappa, order, nodes, sign), share * area)
+                      for sign in (first, -first)]
             fields[name] = tuple(np.hstack(arrays) for arrays in zip(*pieces))
             offsets[name] = slice(columns, columns + fields[name][0].shape[1])
             columns += fields[name][0].shape[1]
@@ -146,17 +150,16 @@ class CapsuleBasis:
         nz = offsets["Z"].stop
         put(self, "ops_z", np.ascontiguousarray(ops[2:4, :, :nz]))
         put(self, "ops_ud", np.ascontiguousarray(ops[[0, 1, 4, 5], :, nz:]))
-        area = theta_weights * kappa * hoop(self.geometry, np.cos(theta), np.sin(theta))  # S' R dθ
         values = ops[[0, 4, 2]]
-        put(self, "gram", 0.5 * np.einsum("aqi,q,aqj->ij", values, area, values))
-        put(self, "factor", eigen.GramFactor(self.gram))
+        put(self, "gram", 0.5 * np.einsum("aqi,q,aqj->ij", values, area, values))  # I to rounding
+        put(self, "factor", eigen.GramFactor(self.gram, orthogonal=True))
         put(self, "moments", np.ascontiguousarray((0.5 * values * area[None, :, None]).reshape(-1, columns)))
         # the reflection classes, as AzimuthalBasis's: ``even`` the nodes (here all), weights and each class's columns
         # of ops_ud and ops_z (Z ones first) for the assembly of an equator-symmetric state's two blocks
         parity = np.array(parity)
         classes = tuple(np.flatnonzero(parity == p) for p in (0, 1))
         put(self, "classes", classes)
-        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)]) for c in classes))
+        put(self, "class_factors", tuple(eigen.GramFactor(self.gram[np.ix_(c, c)], orthogonal=True) for c in classes))
         put(self, "even", (np.arange(theta.size), self.weights, tuple(
             (np.ascontiguousarray(self.ops_ud[:, :, c[c >= nz] - nz]), np.ascontiguousarray(self.ops_z[:, :, c[c < nz]]))
             for c in classes)))
@@ -189,6 +192,14 @@ def _joined(parts: tuple, kappa: float, order: int, nodes: list, parity: int) ->
     value = linalg.block_diag(*[b[0] for b in blocks]) @ joined
     slope = linalg.block_diag(*[b[1] for b in blocks]) @ joined
     return value, slope
+
+
+def _orthonormal(value: np.ndarray, slope: np.ndarray, weights: np.ndarray) -> tuple:
+    """(F, dF/dθ) of the columns recombined orthonormal under Σ_q weights_q F_i F_j (L⁻ᵀ of its Cholesky factor):
+    the Gram matrix is then the identity (GramFactor ``orthogonal``: the pencils' reduction is a scaling)."""
+    lower = np.linalg.cholesky(value.T @ (weights[:, None] * value))
+    inverse = linalg.solve_triangular(lower, np.eye(lower.shape[0]), lower=True).T
+    return value @ inverse, slope @ inverse
 
 
 @lru_cache(maxsize=32)
