@@ -30,7 +30,7 @@ def layout() -> dict:
 
 def class_module(cls: SceneClass, timings: dict | None = None) -> str:
     """Module text of one scene class: Galerkin energy kernels, first-order system, pole series (the last two only
-    on an analytic meridian with poles) and the m ≥ 1 second variation (not on a capsule). ``timings``
+    on an analytic meridian with poles) and the m ≥ 1 second variation. ``timings``
     (if given) receives the seconds spent per stage: 'derive' (equations, poles, second variation), 'lower'
     (CSE), 'print'."""
     start = time.perf_counter()
@@ -40,10 +40,9 @@ def class_module(cls: SceneClass, timings: dict | None = None) -> str:
         # (codegen/meridian.py)
         if cls.meridian.analytic:
             kernels += equations.first_order_kernels(cls) + [poles.pole_kernel(cls)]
-        if cls.meridian.azimuthal:
-            # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient
-            # (codegen/second_variation.py; a tube's too, a capsule's not)
-            kernels += second_variation.second_variation_kernels(cls)
+        # non-axisymmetric (m ≥ 1) second variation: azimuthal_hessian, shear_coefficient (codegen/second_variation.py;
+        # on every meridian)
+        kernels += second_variation.second_variation_kernels(cls)
         if cls.elastic.energy is not None:
             kernels += [stretch_derivatives.derivatives_kernel(cls), *stretch_derivatives.domain_kernels(cls)]
     title = cls.title("Kernels for scene class")

@@ -25,8 +25,9 @@ A capsule (a cylinder of length L and radius 1 with hemispherical caps) is discr
 x = cos θ with θ its arclength over κ: R and Z are C¹ in θ, only the curvature jumps at the joins θj, π − θj. Its
 R ≠ sin θ, so its kernels take the sphere's Galerkin state (v = λ2' sin θ, per d(cos θ)) and turn it into the
 meridian's (``galerkin``): v → v R/sin θ and π̂ → π̂ R/sin θ. R(θ) and R'(θ) are piecewise in the node's cos θ
-(θ = acos(cos θ)), and its kernels are the energy kernels only (``analytic`` is False: no pole series, no
-first-order system and no m ≥ 1 second variation across the joins).
+(θ = acos(cos θ)); it has the energy kernels and the m ≥ 1 second variation (``on_meridian``: the sphere node's
+form read over (R', R) and turned into the Galerkin density as its energy is), not the pole series nor the
+first-order system (``analytic`` is False: R is not analytic across the joins).
 """
 from dataclasses import dataclass
 
@@ -47,7 +48,6 @@ class Meridian:
     parameters: tuple = ()
     poles = True  # both ends on the axis (R = 0): the Legendre basis in cos θ
     analytic = True  # R, Z analytic in θ: the pole series, the first-order system
-    azimuthal = True  # the m ≥ 1 second variation (codegen/second_variation.py): not across a capsule's joins
 
     @property
     def node_symbols(self) -> tuple:
@@ -85,6 +85,19 @@ class Meridian:
         a meridian with R = sin θ (sphere, spheroid) or without node coordinates (tube)."""
         return density
 
+    def rate(self, c, s):
+        """The meridian's v = λ2' R in the Galerkin state's (v = λ2' sin θ): v itself but on a capsule."""
+        return _v
+
+    def on_meridian(self, density):
+        """A density written for the sphere's node, whose (cos θ, sin θ) are its (R', R) (codegen/second_variation.py),
+        as the meridian's Galerkin density: unchanged where R = sin θ (sphere, spheroid)."""
+        return density
+
+    def _at_radius(self, density):
+        """``density`` with the sphere's node (cos θ, sin θ) read as this meridian's (R', R) at the node."""
+        return density.xreplace({_cos: self.hoop_rate(_cos, _sin), _sin: self.hoop(_cos, _sin)})
+
     def inputs(self) -> dict:
         """Its entries in a module's header: none for the sphere (its modules' headers stay as they were)."""
         return {} if self.name == SPHERE.name else {"shape": self.name}
@@ -113,13 +126,15 @@ class Tube(Meridian):
     name = "tube"
     poles = False
     analytic = False
-    azimuthal = True
 
     def radius(self, t):
         return sp.S.One
 
     def height(self, t):
         return -t
+
+    def on_meridian(self, density):
+        return self._at_radius(density)
 
 
 @dataclass(frozen=True)
@@ -131,7 +146,6 @@ class Capsule(Meridian):
     name = "capsule"
     parameters: tuple = (length,)
     analytic = False
-    azimuthal = False
 
     @staticmethod
     def _rate():
@@ -165,10 +179,16 @@ class Capsule(Meridian):
     def metric(self, c, s):
         return self._rate()
 
+    def rate(self, c, s):
+        return _v * self.hoop(c, s) / s
+
     def galerkin(self, density, c, s):
         """π̂ R/sin θ with v → v R/sin θ (the module docstring)."""
-        scale = self.hoop(c, s) / s
-        return density.subs(_v, _v * scale) * scale
+        return density.subs(_v, self.rate(c, s)) * (self.hoop(c, s) / s)
+
+    def on_meridian(self, density):
+        """The sphere node's form over (R', R), per dθ over R, turned into the Galerkin density (``galerkin``)."""
+        return self.galerkin(self._at_radius(density), _cos, _sin)
 
 
 SPHERE = Meridian()

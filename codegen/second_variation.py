@@ -33,7 +33,9 @@ second variation (the translation is then not a zero mode). Along the straight l
 E''[x1, x1] itself, at any state. The kernel is written per scene class; m is a runtime argument.
 
 On a tube (codegen/meridian.py: t = S, R = 1, R' = 0, S' = 1) the same expressions hold with (cos θ, sin θ) → (R', R)
-= (0, 1): ' = d/dS, and E₂ is per dS; the tube's kernel takes no node coordinate. Its pressure term is the volume
+= (0, 1): ' = d/dS, and E₂ is per dS; the tube's kernel takes no node coordinate. On a capsule (θ = S/κ, R piecewise:
+codegen/meridian.py) (cos θ, sin θ) → (R', R) at the node gives E₂ per dθ over R, turned into the Galerkin density
+per d(cos θ) as its energy is (× R/sin θ, v → v R/sin θ: ``Meridian.on_meridian``). Its pressure term is the volume
 between the end planes, ½ x_h · (x_S × x_φ) with x_h the horizontal part of x (the end planes add nothing: x_h is
 parallel to them), not the cone form, whose flux through the end planes changes with the end sections' areas at
 O(ε²) (codegen/terms/pressure.py).
@@ -115,11 +117,8 @@ def second_order_density(cls: SceneClass):
     elastic += shear * epsilon_order(c12, 1) ** 2
     density = phi_average(elastic) * metric
     density += sum(term.second_order(x, x_t, x_p, metric, meridian.poles) for term in cls.terms)
-    if meridian.poles:
-        return density
-    # a tube: the node's (cos θ, sin θ) are its (R', R) (module docstring)
-    return density.xreplace({cos_theta: meridian.hoop_rate(cos_theta, sin_theta),
-                             sin_theta: meridian.hoop(cos_theta, sin_theta)})
+    # a tube, a capsule: the node's (cos θ, sin θ) are their (R', R) (module docstring)
+    return meridian.on_meridian(density)
 
 
 @functools.cache
@@ -203,7 +202,8 @@ def azimuthal_hessian_kernel(cls: SceneClass) -> Kernel:
     outputs = tuple(sp.diff(density, PERTURBATION[i], PERTURBATION[j]) for i, j in PAIRS)
     material = material_stage(cls)
     stages = (
-        ((l1, fn.meridional_stretch(cls.meridian.hoop_rate(cos_theta, sin_theta), v, w)
+        ((l1, fn.meridional_stretch(cls.meridian.hoop_rate(cos_theta, sin_theta),
+                                    cls.meridian.rate(cos_theta, sin_theta), w)
           / cls.meridian.metric(cos_theta, sin_theta)),),
         tuple(zip((p1, p2, p11, p12, p22), material)) + ((shear, shear_coefficient(cls)[0]),),
     )

@@ -232,3 +232,59 @@ def test_m_max_zero_is_said_not_assessed(tmp_path):
         assert set(run["branches"]["primary"]["azimuthal"]) == set(range(1, m_max + 1))
         assert (picture.modes is None) == (m_max == 0)
         assert said in format_tube(summarise_tube(run))
+
+
+def coil_scene(M, degree=16, stop=1.2):
+    """tube_spom1_L10_coil.toml's tube and coil (radius 2.5 about the middle) at M, m = 1 assessed."""
+    return tube_scene("SPOM1", 10.0, 'ends = "sliding"\n[field]\nM = ' + repr(M) + '\n[[field.coils]]\nradius = 2.5\n'
+                      'height = 0.0\ncurrent = 1.0\n').with_overrides(
+        {"solver.degree": degree, "continuation.stop_stretch": stop, "stability.m_max": 1})
+
+
+def test_tube_in_a_coil_field_reads_stable_held_and_unstable_free(tmp_path):
+    """SPOM1, L = 10, sliding ends, one coaxial coil about the middle, M = 0.01, degree 16, to a hoop stretch of 1.2
+    (P up to ~0.6): the free tube's m = 1 block has one negative eigenvalue at every point (the field pulls the tube
+    sideways, towards the wire: measured −0.0041 at P = 0), the held tube's (the translation removed) none; its lowest
+    eigenvalue is the free one's second (the translation's direction gone, the rest nearly unchanged: 0.0211 both at
+    P = 0). Stored (lowest_m1_held, unstable_m1_held) and shown by inspect as "m = 1 held"."""
+    from balloon_cg.app.tube_summary import format_tube, summarise_tube
+    from balloon_cg.io.tube_file import HELD_M1, read_tube_run, write_tube_run
+    from balloon_cg.tube.picture import tube_picture
+
+    scene = coil_scene(0.01)
+    picture = tube_picture(scene, primary_only=True)
+    modes = picture.modes["primary"]
+    assert modes.held is not None and len(picture.branches["primary"].pressure) > 5
+    assert (modes.unstable[1] == 1).all() and (modes.held["unstable"] == 0).all()
+    assert (modes.lowest[1][:, 0] < 0).all() and (modes.held["lowest"][:, 0] > 0).all()
+    assert not [c for c in modes.crossings if c.held]
+    run = read_tube_run(write_tube_run(tmp_path / "coil.h5", scene, picture))
+    stored = run["branches"]["primary"]["azimuthal"]
+    assert np.array_equal(stored[HELD_M1]["lowest"], modes.held["lowest"])
+    assert np.array_equal(stored[1]["unstable"], modes.unstable[1])
+    text = format_tube(summarise_tube(run))
+    assert "m = 1 free: lowest eigenvalue ≥ -0.00" in text and "m = 1 held: lowest eigenvalue ≥ 0.0" in text
+    assert "m = 1 (the same under all three" in text
+
+
+def test_held_and_free_m1_at_zero_field_differ_by_the_translation_alone():
+    """The coil scene at M = 0 (the coil present, no field): at a random state the block with no mode removed (the
+    free tube's, the translation kept) has the eigenvalue 0 (the translation: 1e-10 of the next), and its other
+    lowest eigenvalues are the held tube's (the translation removed, ``zero_modes(held=True)``) to 1e-10 relative; at
+    M = 0 the held and free readings are one (``readings``), in a field two."""
+    from balloon_cg.numerics.eigen import NO_CONSTRAINT, restricted
+
+    scene = coil_scene(0.0)
+    disc = IntervalDiscretisation(16, 10.0, ends=scene.geometry.ends)
+    eq = Equilibrium(scene, disc)
+    u = disc.reference() + 0.05 * np.random.default_rng(5).standard_normal(disc.size)
+    params = Parameters(0.7, 0.0)
+    H = azimuthal.hessian(eq, u, params, 1)
+    kept = np.linalg.eigvalsh(restricted(H, azimuthal._factor(disc), NO_CONSTRAINT))
+    held = np.linalg.eigvalsh(azimuthal.block(eq, u, params, 1, held=True))
+    zero = np.argmin(np.abs(kept))
+    assert abs(kept[zero]) <= 1e-10 * np.abs(kept).max()
+    rest = np.delete(kept, zero)
+    assert rest.size == held.size and np.max(np.abs(rest - held)) <= 1e-10 * np.abs(held).max()
+    assert azimuthal.readings(eq, params, 1) == (False,)
+    assert azimuthal.readings(eq, Parameters(0.7, 0.01), 1) == (False, True)

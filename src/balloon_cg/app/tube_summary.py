@@ -14,7 +14,7 @@ import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST
+from ..io.tube_file import CREST, HELD_M1
 from ..scene import parse_scene
 from ..tube.stability import COMPRESSED
 
@@ -55,8 +55,9 @@ def summarise_tube(run: dict) -> dict:
 
 def _azimuthal(branch: dict) -> dict:
     """{m: {'unstable_max', 'lowest_min', 'changes': [{'after_point', 'unstable', 'pressure', 'volume'}], 'points'}}
-    of the branch's m ≥ 1 blocks: a change between points i and i + 1 listed after point i (at point i + 1's P and
-    V/V0), and the located zeros of the eigenvalues ('points': io/tube_file's dicts)."""
+    of the branch's m ≥ 1 blocks ('1 held': the held tube's m = 1 block in a field, io/tube_file.HELD_M1): a change
+    between points i and i + 1 listed after point i (at point i + 1's P and V/V0), and the located zeros of the
+    eigenvalues ('points': io/tube_file's dicts)."""
     out = {}
     for m, block in branch.get("azimuthal", {}).items():
         counts = block["unstable"]
@@ -111,7 +112,7 @@ def _no_maxwell(summary: dict) -> str:
 
 def _assessed(summary: dict) -> str:
     """Which m ≥ 1 blocks the branches were assessed for."""
-    largest = [len(b["azimuthal"]) for b in summary["branches"].values()]
+    largest = [len([m for m in b["azimuthal"] if m != HELD_M1]) for b in summary["branches"].values()]
     if not largest or min(largest) == 0:
         return "m ≥ 1 not assessed"
     shown = "m = 1" if min(largest) == 1 else f"m = 1..{min(largest)}"
@@ -151,7 +152,8 @@ def format_tube(summary: dict) -> str:
         for m, block in b["azimuthal"].items():
             changes = ", ".join(f"{c['unstable']} after point {c['after_point']} (P = {c['pressure']:.6g}, "
                                 f"V/V0 = {c['volume']:.6g})" for c in block["changes"])
-            lines.append(f"  m = {m}: lowest eigenvalue ≥ {block['lowest_min']:.4g}, at most {block['unstable_max']} "
+            name = f"m = {m}" + (" free" if m == "1" and HELD_M1 in b["azimuthal"] else "")
+            lines.append(f"  {name}: lowest eigenvalue ≥ {block['lowest_min']:.4g}, at most {block['unstable_max']} "
                          f"unstable" + (f"; unstable count {changes}" if changes else ""))
             lines += [f"        BP m = {m} (eigenvalue {p['order']}) after point {p['index']:<4} P = {p['pressure']:.10g}  "
                       f"V/V0 = {p['volume']:.8g}  {p['status']}" for p in block["points"]]

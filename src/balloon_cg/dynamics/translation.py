@@ -35,7 +35,7 @@ def _form(pointwise, pairs, t) -> np.ndarray:
 def translation_omega2(variation, u, params) -> dict:
     """{"axial": Ω²_t along the axis, "lateral": Ω²_t across it} at the equilibrium u of ``variation`` (the pencil's
     m = 0 second variation, dynamics.pencil.mass_variation; module docstring), on the nodes of its equilibrium's
-    m = 1 basis of its degree. On a shape without the m = 1 second variation (a capsule: model/meridian.AZIMUTHAL)
+    m = 1 basis of its degree. On a shape without the m = 1 mass kernel (a capsule: model/meridian.AZIMUTHAL)
     the axial one is the Rayleigh quotient of b_0 (δη = 1) on the m = 0 pencil (its quadrature split at the
     capsule's joins), and the lateral one NaN (not computed)."""
     equilibrium = variation.eq

@@ -15,7 +15,9 @@ the largest radius, the bulge's crest, from the tube's middle plane: IntervalDis
 files before them have none), ``lowest_even``/
 ``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), with stability.m_max ≥ 1 ``lowest_m<m>``
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
-not assessed); its located points under
+not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
+block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
+azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0); its located points under
 special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``,
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
@@ -55,6 +57,7 @@ SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
+HELD_M1 = "1 held"  # read_tube_run's key of the held tube's m = 1 block (beside the free blocks' m)
 
 
 #: name: (units, long_name, description) of a tube run file's datasets (io/schema.py's VARIABLES are the sphere's)
@@ -80,6 +83,10 @@ TUBE_VARIABLES = {
                         "(tube/azimuthal.py), ascending") for m in range(1, AZIMUTHAL_LIMIT + 1)},
     **{f"unstable_m{m}": ("", f"unstable directions, m = {m}", f"negative eigenvalues of the cos {m}φ block (pressure "
                           "and volume control alike)") for m in range(1, AZIMUTHAL_LIMIT + 1)},
+    "lowest_m1_held": ("1", "lowest eigenvalues, m = 1, held", "the lowest μ of the cos φ block of the tube held at "
+                       "its centroid (the sideways translation removed: tube/azimuthal.py), ascending"),
+    "unstable_m1_held": ("", "unstable directions, m = 1, held", "negative eigenvalues of the held tube's cos φ block"),
+    "held": ("", "held block", "1: a zero of the held tube's m = 1 block, 0: of the free one's"),
     "eigenvalue": ("", "eigenvalue index", "the lowest eigenvalues of a block, ascending"),
     "m": ("", "azimuthal number", "the cos mφ block whose eigenvalue vanishes"),
     "order": ("", "eigenvalue number", "which eigenvalue of the block vanishes (ascending, from 0)"),
@@ -162,6 +169,9 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             for m in modes.lowest:
                 checksummed(group, f"lowest_m{m}", modes.lowest[m])
                 checksummed(group, f"unstable_m{m}", modes.unstable[m])
+            if modes.held is not None:
+                checksummed(group, "lowest_m1_held", modes.held["lowest"])
+                checksummed(group, "unstable_m1_held", modes.held["unstable"])
             _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size)
         special = group.create_group("special_points")
         s = branch.special
@@ -185,9 +195,9 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
 
 def _write_crossings(group, found, size: int) -> None:
     """The located zeros of the m ≥ 1 eigenvalues (tube/azimuthal_crossings.py): per point ``m``, ``order``,
-    ``index``, ``pressure``, ``volume``, ``value``, ``status``, ``unknowns``."""
+    ``index``, ``pressure``, ``volume``, ``value``, ``held``, ``status``, ``unknowns``."""
     for column, kind in (("m", int), ("order", int), ("index", int), ("pressure", float), ("volume", float),
-                         ("value", float)):
+                         ("value", float), ("held", int)):
         checksummed(group, column, np.array([getattr(c, column) for c in found], dtype=kind))
     write_strings(group, "status", [c.status.value for c in found])
     checksummed(group, "unknowns", np.array([c.u for c in found], dtype=float).reshape(len(found), size))
@@ -260,7 +270,9 @@ def read_tube(f, path, where: str = "") -> dict:
 
 def _read_modes(path, group, n: int, where: str) -> dict:
     """{m: {'lowest': (n, COUNT), 'unstable': (n,), 'points': [dict per located zero]}} for m = 1..the group's
-    ``m_max`` ({}: not assessed; 'points' empty in files written before they were located)."""
+    ``m_max`` of the free tube's blocks, and under the key '1 held' the held tube's m = 1 block where the file has
+    one ({}: not assessed; 'points' empty in files written before they were located; a point's 'held' False in
+    files before the held block)."""
     out = {}
     located = group.get("azimuthal_points")
     points = [] if located is None else [
@@ -268,14 +280,20 @@ def _read_modes(path, group, n: int, where: str) -> dict:
          "status": s} for m, k, i, p, v, x, s in zip(*(located[c][()] for c in ("m", "order", "index", "pressure",
                                                                               "volume", "value")),
                                                     located["status"].asstr()[()])]
-    for m in range(1, int(group.attrs.get("m_max", 0)) + 1):
-        missing = [c for c in (f"lowest_m{m}", f"unstable_m{m}") if c not in group]
+    held = [False] * len(points) if located is None or "held" not in located else located["held"][()].astype(bool)
+    for p, h in zip(points, held):
+        p["held"] = bool(h)
+    blocks = [(m, f"lowest_m{m}", f"unstable_m{m}", False) for m in range(1, int(group.attrs.get("m_max", 0)) + 1)]
+    blocks += [(HELD_M1, "lowest_m1_held", "unstable_m1_held", True)] if "lowest_m1_held" in group else []
+    for key, lowest, unstable, is_held in blocks:
+        missing = [c for c in (lowest, unstable) if c not in group]
         if missing:
             raise TubeFileError(path, f"{where}: m_max = {group.attrs['m_max']} but {', '.join(missing)} missing")
-        out[m] = {"lowest": group[f"lowest_m{m}"][()], "unstable": group[f"unstable_m{m}"][()],
-                  "points": [p for p in points if p["m"] == m]}
-        if out[m]["lowest"].shape[0] != n or out[m]["unstable"].shape != (n,):
-            raise TubeFileError(path, f"{where}/lowest_m{m}, unstable_m{m}: not one row per point ({n})")
+        m = 1 if is_held else key
+        out[key] = {"lowest": group[lowest][()], "unstable": group[unstable][()],
+                    "points": [p for p in points if p["m"] == m and p["held"] == is_held]}
+        if out[key]["lowest"].shape[0] != n or out[key]["unstable"].shape != (n,):
+            raise TubeFileError(path, f"{where}/{lowest}, {unstable}: not one row per point ({n})")
     return out
 
 

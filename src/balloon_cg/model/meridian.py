@@ -21,7 +21,8 @@ it encloses V0 = πL.
 
 The membrane's kinetic energy is taken over the reference surface, dA = R S' dθ dφ: its mass densities per
 d(cos θ) (generated/inertia.py, codegen/inertia.py) carry S' R/sin θ (``mass_density``). The sphere and the
-spheroid have the m ≥ 1 second variation (``AZIMUTHAL``), a capsule and a tube do not.
+spheroid have the m ≥ 1 mass kernel (``AZIMUTHAL``), a capsule and a tube do not (their m ≥ 1 blocks have their own
+Gram matrices: analysis/stability/capsule_basis.py, tube/azimuthal.py).
 """
 import numpy as np
 
@@ -138,7 +139,7 @@ def kernel_values(geometry: Geometry) -> dict:
     return {}
 
 
-AZIMUTHAL = (Shape.SPHERE, Shape.SPHEROID)  # the shapes with the m ≥ 1 second variation (codegen: ``analytic``)
+AZIMUTHAL = (Shape.SPHERE, Shape.SPHEROID)  # the shapes with the m ≥ 1 mass kernel (codegen/inertia.py: ``analytic``)
 
 
 def mass_density(geometry: Geometry, block: str, cos_theta, sin_theta) -> np.ndarray:

@@ -661,17 +661,14 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
     if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
-        raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 second variation is not built yet "
-                         "(its curvature jumps at the joins); allowed: 0")
+        raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 frequencies are not built yet (its "
+                         "m ≥ 1 mass matrix and mode shapes); allowed: 0")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
     if geometry.shape == Shape.TUBE and data.get("events"):
         raise SceneError(f"events: {len(data['events'])} [[events]] on a tube, whose branches do not locate user "
                          "points yet; allowed: none")
     stability = _stability(data.get("stability", {}))
-    if geometry.shape == Shape.CAPSULE and stability.m_max != 0:
-        raise SceneError(f"stability.m_max = {stability.m_max}: a capsule's m ≥ 1 second variation is not built yet "
-                         "(its curvature jumps at the joins); allowed: 0")
     return Scene(
         name=name,
         material=material,

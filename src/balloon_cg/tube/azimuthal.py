@@ -18,8 +18,9 @@ are held).
 The eigenvalues are those of H c = μ G c, G the Gram matrix of ‖δx‖² = ½ ∫_0^L (R² + T² + Z²) dS (per 2π, as E):
 the Rayleigh quotient of d²E/dε² over the displacement's L2 norm, basis independent. Zero modes: with sliding ends
 and m = 1 the sideways translation of the whole tube (R = 1, T = −1, Z = 0) changes nothing where there is no
-field; it is removed there (G c ⊥ it), kept in a coil's field (where it is not a zero mode: the free tube). Plugged
-ends hold it. Under volume control the m ≥ 1 blocks are the same: their perturbations leave the enclosed volume
+field; it is removed there (G c ⊥ it). In a coil's field it is not a zero mode and there are two readings, as the
+sphere's (analysis/stability/azimuthal.py): the free tube keeps it (the field may pull the tube sideways, towards
+the wire), the held tube (its centroid held: ∫ δx dA = 0, G c ⊥ the translation) removes it. Plugged ends hold it. Under volume control the m ≥ 1 blocks are the same: their perturbations leave the enclosed volume
 unchanged to first order (∫ cos mφ dφ = 0), so δV = 0 removes nothing (only m = 0 differs, tube/stability.py).
 """
 import functools
@@ -42,12 +43,15 @@ COUNT = 3  # the lowest eigenvalues kept per block and point
 @dataclass(frozen=True)
 class TubeModes:
     """The m = 1..m_max blocks at each point of a branch: ``lowest`` {m: (points, COUNT)} the lowest eigenvalues μ,
-    ``unstable`` {m: (points,)} the number of negative ones (the same under pressure and volume control);
-    ``crossings`` where an eigenvalue vanishes (tube/azimuthal_crossings.AzimuthalCrossing)."""
+    ``unstable`` {m: (points,)} the number of negative ones (the same under pressure and volume control), of the
+    free tube; ``held`` the m = 1 block of the held tube as {"lowest", "unstable"} where it differs from the free one
+    (a coil's field on sliding ends: ``readings``), else None; ``crossings`` where an eigenvalue vanishes
+    (tube/azimuthal_crossings.AzimuthalCrossing)."""
 
     lowest: dict
     unstable: dict
     crossings: tuple = ()
+    held: dict | None = None
 
 
 @functools.lru_cache(maxsize=16)
@@ -94,20 +98,36 @@ def hessian(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int) -> np.nd
     return flat.T @ np.einsum("abq,bqj->aqj", h, ops).reshape(-1, ops.shape[2])
 
 
-def zero_modes(eq: Equilibrium, params: Parameters, m: int) -> np.ndarray:
-    """The rows G c of the removed zero modes (module docstring): the translation for m = 1 on sliding ends without
-    a field, else none."""
+def in_field(eq: Equilibrium, params: Parameters) -> bool:
+    """Whether coils act on the tube (M ≠ 0): then the translation is no zero mode."""
+    return bool(eq.coils.shape[0] and params.M != 0)
+
+
+def readings(eq: Equilibrium, params: Parameters, m: int) -> tuple:
+    """The readings of the m-th block that differ (held: True, free: False): both for m = 1 on sliding ends in a
+    field, else the free one alone (it is the held one: the translation is removed or held by the plugs)."""
+    return (False, True) if m == 1 and eq.disc.ends == Ends.SLIDING and in_field(eq, params) else (False,)
+
+
+def zero_modes(eq: Equilibrium, params: Parameters, m: int, held: bool = False) -> np.ndarray:
+    """The rows G c of the removed modes (module docstring): the translation for m = 1 on sliding ends without a
+    field, or in a field for the ``held`` tube; else none."""
     disc = eq.disc
-    field = eq.coils.shape[0] and params.M != 0
-    if m != 1 or disc.ends != Ends.SLIDING or field:
+    if m != 1 or disc.ends != Ends.SLIDING or (in_field(eq, params) and not held):
         return NO_CONSTRAINT
     return (operators(disc)[1] @ translation(disc))[None, :]
 
 
-def block(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int) -> np.ndarray:
-    """The m-th block as the standard symmetric matrix of the pencil (H, G) with the zero modes removed
-    (numerics/eigen.restricted): its eigenvalues are the μ, its inertia the block's."""
-    return restricted(hessian(eq, u, params, m), _factor(eq.disc), zero_modes(eq, params, m))
+def block(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int, held: bool = False) -> np.ndarray:
+    """The m-th block of a reading (held or free) as the standard symmetric matrix of the pencil (H, G) with the
+    zero modes removed (numerics/eigen.restricted): its eigenvalues are the μ, its inertia the block's."""
+    return blocks(eq, u, params, m, (held,))[held]
+
+
+def blocks(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int, which=(False,)) -> dict:
+    """``block`` of each reading in ``which`` (held: True, free: False) from one assembly of H."""
+    H = hessian(eq, u, params, m)
+    return {held: restricted(H, _factor(eq.disc), zero_modes(eq, params, m, held)) for held in which}
 
 
 @functools.lru_cache(maxsize=16)
@@ -117,13 +137,18 @@ def _factor(disc: IntervalDiscretisation) -> GramFactor:
 
 def branch_modes(eq: Equilibrium, points, params: Parameters, m_max: int, count: int = COUNT) -> TubeModes:
     """``TubeModes`` of the points Y = (u, P) of a branch (``params``: the branch's, P replaced)."""
-    lowest, unstable = {}, {}
+    found = {}  # (m, held): (lowest, unstable)
     for m in range(1, m_max + 1):
-        values, negatives = [], []
+        which = readings(eq, params, m)
+        values, negatives = {held: [] for held in which}, {held: [] for held in which}
         for Y in points:
-            A = block(eq, Y[:-1], params.with_value("P", Y[-1]), m)
-            negatives.append(negative_count(A))
-            values.append(lowest_of(A, count))
-        lowest[m] = np.array(values, dtype=float).reshape(len(values), count)
-        unstable[m] = np.array(negatives, dtype=int)
-    return TubeModes(lowest, unstable)
+            for held, A in blocks(eq, Y[:-1], params.with_value("P", Y[-1]), m, which).items():
+                negatives[held].append(negative_count(A))
+                values[held].append(lowest_of(A, count))
+        for held in which:
+            found[m, held] = (np.array(values[held], dtype=float).reshape(len(points), count),
+                              np.array(negatives[held], dtype=int))
+    held = found.get((1, True))
+    return TubeModes({m: found[m, False][0] for m in range(1, m_max + 1)},
+                     {m: found[m, False][1] for m in range(1, m_max + 1)},
+                     held=None if held is None else {"lowest": held[0], "unstable": held[1]})

@@ -1,7 +1,8 @@
 """Where an m ≥ 1 eigenvalue of a tube's branch vanishes (tube/azimuthal.py): the m ≥ 1 branch points.
 
 Between two stored points Y_i, Y_{i+1} of a branch whose m-th block's unstable count changes, the eigenvalue
-number k (ascending, from 0: analysis/stability/crossings.count_changes) is followed along the secant: at arclength
+number k (ascending, from 0: analysis/stability/crossings.count_changes) of the free tube's block (and of the held
+tube's m = 1 block where it has one: tube/azimuthal.readings) is followed along the secant: at arclength
 s the state is Keller's corrector from Y_i + s t (t the unit secant, on every free unknown and P), and Brent's method
 in s finds its zero (numerics/continuation.locate_root: ``located``, or ``nearest`` where a corrector failed).
 """
@@ -23,7 +24,8 @@ BRENT_XTOL = 1e-13  # relative to the secant's length
 @dataclass(frozen=True)
 class AzimuthalCrossing:
     """The m-th block's eigenvalue ``order`` vanishes at the state u, ``pressure``, ``volume`` (V/V0), between
-    points ``index`` and ``index + 1``; ``status`` of its location; ``value`` the eigenvalue there."""
+    points ``index`` and ``index + 1``; ``status`` of its location; ``value`` the eigenvalue there; ``held``: of the
+    held tube's block (tube/azimuthal.readings), else the free one's."""
 
     m: int
     order: int
@@ -33,6 +35,7 @@ class AzimuthalCrossing:
     volume: float
     status: RootStatus
     value: float
+    held: bool = False
 
 
 def crossings(scene, branch, modes) -> list[AzimuthalCrossing]:
@@ -44,24 +47,28 @@ def crossings(scene, branch, modes) -> list[AzimuthalCrossing]:
     system = TubeSystem(ParameterSystem(eq, params, "P"), disc.free, held(disc))
     settings = continuation_settings(scene)
     points = [np.append(u, P)[system.columns] for u, P in zip(branch.states, branch.pressure)]
+    blocks = [(m, False, counts) for m, counts in modes.unstable.items()]
+    blocks += [] if modes.held is None else [(1, True, modes.held["unstable"])]
     found = []
-    for m, counts in modes.unstable.items():
+    for m, held_block, counts in blocks:
         for i, order in count_changes(counts):
-            located = _zero(system, eq, params, settings, points[i], points[i + 1], m, order)
+            located = _zero(system, eq, params, settings, points[i], points[i + 1], m, order, held_block)
             if located is not None:
                 Y, status, value = located
-                found.append(AzimuthalCrossing(m, order, i, Y[:-1], float(Y[-1]), volume_ratio(eq, Y), status, value))
+                found.append(AzimuthalCrossing(m, order, i, Y[:-1], float(Y[-1]), volume_ratio(eq, Y), status, value,
+                                               held_block))
     return found
 
 
-def _zero(system, eq, params, settings, before, after, m: int, order: int):
-    """(Y, status, eigenvalue) where the m-th block's eigenvalue ``order`` vanishes on the secant from ``before`` to
-    ``after`` (X coordinates of ``system``); None where nothing could be evaluated."""
+def _zero(system, eq, params, settings, before, after, m: int, order: int, held_block: bool):
+    """(Y, status, eigenvalue) where the eigenvalue ``order`` of the m-th block (the held tube's if ``held_block``)
+    vanishes on the secant from ``before`` to ``after`` (X coordinates of ``system``); None where nothing could be
+    evaluated."""
     length = float(np.linalg.norm(after - before))
     tangent = (after - before) / length
 
     def eigenvalue(Y):
-        return float(np.linalg.eigvalsh(block(eq, Y[:-1], params.with_value("P", Y[-1]), m))[order])
+        return float(np.linalg.eigvalsh(block(eq, Y[:-1], params.with_value("P", Y[-1]), m, held_block))[order])
 
     def value_at(s):
         result = continuation.correct(system, before + s * tangent, tangent, settings)

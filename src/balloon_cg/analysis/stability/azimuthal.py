@@ -46,9 +46,10 @@ from ...galerkin.discretisation import even_half, symmetric_rows
 from ...galerkin.equilibrium import Equilibrium, Parameters
 from ...galerkin.legendre import assoc_legendre, gauss_rule, legendre_values
 from ...generated import AZIMUTHAL_PAIRS
-from ...model.meridian import mass_density, metric
+from ...model.meridian import hoop, mass_density, metric
 from ...numerics import eigen
 from ...scene.tables import Geometry, Shape
+from .capsule_basis import capsule_basis
 
 
 @dataclass(frozen=True)
@@ -322,9 +323,12 @@ def perturbation_basis(equilibrium: Equilibrium, m: int, degree: int, quadrature
                        kind: str | None = None) -> AzimuthalBasis:
     """The basis ``azimuthal_hessian`` uses for this equilibrium's discretisation (cached): in x, or in s on its
     wire map (``perturbation_map``; ``kind`` None: the scene's stability.basis). Quadrature: ``default_quadrature``
-    (on a map both degrees are in s)."""
+    (on a map both degrees are in s). A capsule's: capsule_basis.CapsuleBasis (its own elements and rule)."""
+    geometry = equilibrium.scene.geometry
+    if geometry.shape == Shape.CAPSULE:  # spectral elements joined at the joins (capsule_basis.py)
+        return capsule_basis(m, degree, geometry)
     return basis(int(m), int(degree), int(quadrature or default_quadrature(degree, equilibrium.disc.degree)),
-                 perturbation_map(equilibrium, kind), equilibrium.scene.geometry)
+                 perturbation_map(equilibrium, kind), geometry)
 
 
 MODES = ("translation", "rotation", "relabelling")
@@ -338,7 +342,8 @@ def _mode_moments(b: AzimuthalBasis, state: tuple) -> np.ndarray:
     lam2, dlam2, eta, deta = state
     s, c = b.sin_theta, b.x
     one = np.ones_like(eta)
-    values = np.array([[one, -one, 0.0 * one], [eta, -eta, -lam2 * s], [lam2 * c + dlam2 * s, -lam2 * c, deta]])
+    radius = hoop(b.geometry, c, s)  # R: sin θ but on a capsule
+    values = np.array([[one, -one, 0.0 * one], [eta, -eta, -lam2 * radius], [lam2 * c + dlam2 * s, -lam2 * c, deta]])
     return np.einsum("mjkq,jqi->mki", values, b.moments.reshape(3, -1, b.size))
 
 
@@ -470,7 +475,7 @@ def _parts(equilibrium: Equilibrium, u, params: Parameters, m: int, b: Azimuthal
     """(the special modes' constraint rows G c, ((H, index, Gram factor, class) of each uncoupled part)): the two
     reflection classes of an equator-symmetric state, else the whole block (index and class None)."""
     moments = mode_moments(equilibrium, u, b) if m == 1 else np.zeros((0, b.size))
-    if equilibrium.disc.symmetric:
+    if equilibrium.disc.symmetric and b.classes:
         return moments, tuple(zip(_class_hessians(equilibrium, u, params, m, b), b.classes, b.class_factors, (0, 1)))
     return moments, ((_hessian(equilibrium, u, params, m, b), None, b.factor, None),)
 
@@ -499,7 +504,12 @@ def _class_rows(moments, modes: list, cls, index):
 
 def excluded_modes(equilibrium: Equilibrium, params: Parameters, held: bool) -> tuple:
     """Indices into MODES of the m = 1 modes ``spectrum`` removes: always the relabelling; at M = 0 (or without
-    coils) also the translation and the rotation; with a field the translation for a held balloon."""
+    coils) also the translation and the rotation; with a field the translation for a held balloon. A capsule of
+    length L > 0 has no relabelling (a rotation of its reference is no symmetry of it)."""
     if params.M == 0 or not equilibrium.coils.shape[0]:
-        return 0, 1, 2
-    return (0, 2) if held else (2,)
+        modes = 0, 1, 2
+    else:
+        modes = (0, 2) if held else (2,)
+    geometry = equilibrium.scene.geometry
+    relabelled = geometry.shape != Shape.CAPSULE or geometry.length == 0
+    return modes if relabelled else tuple(k for k in modes if k != 2)
