@@ -11,7 +11,7 @@ from ..io.tube_file import ACCURACY, CREST, CURVE_COLUMNS, POINT_COLUMNS, read_t
 from .tables import html_table, optional
 
 PARTS = ("points", "special")
-SPECIAL_COLUMNS = ("kind", "block", "status", "index", "pressure", "volume", "smallest_stress", CREST)
+SPECIAL_COLUMNS = ("kind", "block", "status", "note", "index", "pressure", "volume", "smallest_stress", CREST)
 
 
 @dataclass(frozen=True, repr=False)
@@ -73,8 +73,8 @@ class TubeResult:
         ----------
         table : str, optional
             ``"points"`` (default): one row per point of every branch (branch, point, the per-point columns);
-            ``"special"``: one row per located point (branch, kind, block, status, index, pressure, volume,
-            smallest_stress, crest_height); ``"onset"``: one row per point of the onset curve of ``critical`` (the
+            ``"special"``: one row per located point (branch, kind, block, status, note: a UZ point's event, index,
+            pressure, volume, smallest_stress, crest_height); ``"onset"``: one row per point of the onset curve of ``critical`` (the
             parameter under its own name, pressure, volume, crest_height).
 
         Returns

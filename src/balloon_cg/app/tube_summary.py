@@ -163,8 +163,9 @@ def format_tube(summary: dict) -> str:
             compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
             amount = f"  n = {s['amount']:.10g}" if "amount" in s else ""
+            note = f"  {s['note']}" if s["note"] else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
-                         f"V/V0 = {s['volume']:.8g}{amount}  {s['status']}{crest}{compressed}")
+                         f"V/V0 = {s['volume']:.8g}{amount}  {s['status']}{note}{crest}{compressed}")
             if "omega2" in s:
                 lines.append("        lowest Ω²  " + "  ".join(f"{name} {value:.4g}"
                                                          for name, value in s["omega2"].items()))

@@ -18,7 +18,8 @@ files before them have none), ``lowest_even``/
 not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
 block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
 azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0); its located points under
-special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``,
+special_points/ (``kind``, ``block``, ``status``, ``note`` (a UZ point's event, "volume_ratio = 3"; files before
+it have none), ``index``, ``pressure``, ``volume``, ``smallest_stress``,
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
@@ -56,6 +57,7 @@ ACCURACY = ("tail", "first_integral_spread")  # per point: tube/accuracy.accurac
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
+NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
 HELD_M1 = "1 held"  # read_tube_run's key of the held tube's m = 1 block (beside the free blocks' m)
 
@@ -91,7 +93,8 @@ TUBE_VARIABLES = {
     "m": ("", "azimuthal number", "the cos mφ block whose eigenvalue vanishes"),
     "order": ("", "eigenvalue number", "which eigenvalue of the block vanishes (ascending, from 0)"),
     "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
-    "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point"),
+    "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point, UZ an event's value reached"),
+    "note": ("", "event", "a UZ point's event, quantity = value (tube/events.py); empty for the others"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
     "index": ("", "point index", "the located point lies between points index and index + 1"),
@@ -178,6 +181,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         write_strings(special, "kind", [p.kind.value for p in s])
         write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
         write_strings(special, "status", [p.status.value for p in s])
+        write_strings(special, "note", [p.note for p in s])
         checksummed(special, "index", np.array([p.index for p in s], dtype=int))
         checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
         volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
@@ -257,6 +261,7 @@ def read_tube(f, path, where: str = "") -> dict:
                                           f"({n},)")
         special = group["special_points"]
         columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
+        columns[NOTE] = list(special[NOTE].asstr()[()]) if NOTE in special else [""] * len(columns["kind"])
         columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
         branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                     for i in range(len(columns["kind"]))]
@@ -336,7 +341,8 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     (``continue``)."""
     b = run["branches"][name]
     special = tuple(IntervalSpecial(Kind(s["kind"]), u, float(s["pressure"]), int(s["index"]), RootStatus(s["status"]),
-                                    Mirror(s["block"]) if s["block"] else None, float(s["smallest_stress"]))
+                                    Mirror(s["block"]) if s["block"] else None, float(s["smallest_stress"]),
+                                    s[NOTE])
                     for s, u in zip(b["special_points"], b["special_unknowns"]))
     code = b["attrs"]["stop_code"]
     stop = Stop(next(enum(code) for enum in (IntervalStop, StopCode, TraceStop) if code in enum._value2member_map_),

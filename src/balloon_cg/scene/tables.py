@@ -17,7 +17,7 @@ from pathlib import Path
 
 from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
-from .events import Event, events_from_list
+from .events import Event, check_on_shape, events_from_list
 from .loading import Control, Loading, loading_from_table, moved_stop_volume
 from .materials import ALPHA1, MAX_EXPONENT, Material, alpha1_terms, material_from_table, modified_name
 
@@ -665,9 +665,8 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          "m ≥ 1 mass matrix and mode shapes); allowed: 0")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
-    if geometry.shape == Shape.TUBE and data.get("events"):
-        raise SceneError(f"events: {len(data['events'])} [[events]] on a tube, whose branches do not locate user "
-                         "points yet; allowed: none")
+    events = events_from_list(data.get("events", []))
+    check_on_shape(events, geometry.shape, geometry.ends, geometry.axial_stretch is not None)
     stability = _stability(data.get("stability", {}))
     return Scene(
         name=name,
@@ -681,7 +680,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         text=text,
         loading=loading,
         surface=_surface(data.get("surface", {})),
-        events=events_from_list(data.get("events", [])),
+        events=events,
         geometry=geometry,
         dynamics=dynamics,
     )

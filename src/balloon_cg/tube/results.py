@@ -30,10 +30,11 @@ def signalled() -> Stop | None:
 
 @dataclass(frozen=True)
 class IntervalSpecial:
-    """A located point: LP (fold in P), LV (fold in V) or BP (``block`` the mirror block whose lowest eigenvalue
-    vanishes), its state ``u`` and pressure, between points ``index`` and ``index + 1`` (the last index: in the step
-    that passed the stop, whose end is not stored); ``status`` of its location; ``smallest_stress`` of its state
-    (negative: the membrane is compressed there and the point is not to be trusted: tube/stability.py)."""
+    """A located point: LP (fold in P), LV (fold in V), BP (``block`` the mirror block whose lowest eigenvalue
+    vanishes) or UZ (where an event's quantity reaches its value: ``note``, tube/events.py), its state ``u`` and
+    pressure, between points ``index`` and ``index + 1`` (the last index: in the step that passed the stop, whose end
+    is not stored); ``status`` of its location; ``smallest_stress`` of its state (negative: the membrane is compressed
+    there and the point is not to be trusted: tube/stability.py)."""
 
     kind: Kind
     u: np.ndarray
@@ -42,6 +43,7 @@ class IntervalSpecial:
     status: RootStatus
     block: Mirror | None = None
     smallest_stress: float = np.nan  # tube/stability.smallest_stress of the state: compressed below COMPRESSED
+    note: str = ""  # a UZ point's event: "volume_ratio = 3" (tube/events.py)
 
 
 @dataclass(frozen=True)
