@@ -1,0 +1,126 @@
+"""A tube continued in the voltage Φ̄ at a fixed pressure (tube/voltage.py) against the uniform closed tube under the
+effective energy derived here (MODEL.md §2, units μ/2)
+
+    Φ_eff(λ1 = λz, λ2 = λθ) = Φ − Φ̄² λz² λθ²:   P = ∂Φ_eff/∂λθ/(λθλz),   N = ∂Φ_eff/∂λz − λθ ∂Φ_eff/∂λθ/(2λz) = 0,
+
+(tests/test_tube_electric.py's balances): at fixed P = P0 the uniform states form a curve in (λθ, λz, Φ̄), and its
+fold in Φ̄ (the pull-in voltage) is where ∂(P, N)/∂(λθ, λz) is singular: P = P0, N = 0, det = 0, solved by nsolve
+at 30 digits. Every stored point is also checked against model/tube.closed_end_state of model/membrane.Charged."""
+import numpy as np
+import pytest
+import sympy as sp
+
+from balloon_cg.analysis.branches.tracer import ContinuationError
+from balloon_cg.analysis.results import Kind, StopCode
+from balloon_cg.app.cli import main
+from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.model.membrane import Charged
+from balloon_cg.model.tube import closed_end_state
+from balloon_cg.scene import SceneError
+from balloon_cg.tube.voltage import voltage_branch
+from test_interval import tube_scene
+from test_tube import symbolic_energy, theta, z
+
+PHI = sp.Symbol("Phi", positive=True)
+CASES = {"neo-Hookean": 0.8, "SPOM1": 1.2}  # P0, below each tube's pressure maximum (1.4997, 1.4905)
+
+
+def voltage_scene(preset, pressure, extra="", m_max=0):
+    """A closed tube of length 10 (sliding ends) continued in Φ̄ at ``pressure``, m ≥ 1 not read."""
+    return tube_scene(preset, 10.0, "[solver]\ndegree = 16\n[electric]\n[continuation]\nparameter = \"voltage\"\n"
+                                    f"pressure = {pressure}\nstop_stretch = 4\nstep_max = 0.5\n[stability]\n"
+                                    f"m_max = {m_max}\n" + extra)
+
+
+def balances(preset, pressure):
+    """(P − P0, N, det ∂(P, N)/∂(λθ, λz)) of the module docstring as SymPy expressions in (λθ, λz, Φ̄)."""
+    energy = symbolic_energy(tube_scene(preset).material) - PHI**2 * theta**2 * z**2
+    P = sp.diff(energy, theta) / (theta * z)
+    N = sp.diff(energy, z) - theta * sp.diff(energy, theta) / (2 * z)
+    det = sp.Matrix([P, N]).jacobian([theta, z]).det()
+    return P - sp.Rational(repr(pressure)), N, det
+
+
+@pytest.fixture(scope="module", params=list(CASES))
+def traced(request):
+    preset = request.param
+    return preset, CASES[preset], voltage_branch(voltage_scene(preset, CASES[preset]))
+
+
+def test_pull_in_voltage_is_the_fold_of_the_uniform_closed_tube(traced):
+    """The branch's one LP in Φ̄ is the pull-in: Φ̄ within 1e-12 of the fold solved here, λθ and λz within 1e-10
+    (measured: 1.3e-15 and 8.9e-16 for SPOM1, neo-Hookean's to rounding), and P stays P0."""
+    preset, pressure, branch = traced
+    folds = [s for s in branch.special if s.kind == Kind.LP]
+    assert len(folds) == 1 and folds[0].status == "located"
+    fold = folds[0]
+    axial = fold.u[branch.disc.axial_index]
+    root = sp.nsolve(balances(preset, pressure), [theta, z, PHI], [fold.u[0], axial, fold.voltage], prec=30)
+    hoop_exact, axial_exact, voltage_exact = (float(v) for v in root)
+    assert abs(fold.voltage - voltage_exact) <= 1e-12
+    assert abs(fold.u[0] - hoop_exact) <= 1e-10 and abs(axial - axial_exact) <= 1e-10
+    assert fold.pressure == pressure and np.all(branch.pressure == pressure)
+    assert branch.voltage.max() <= voltage_exact + 1e-10
+
+
+def test_every_point_is_the_charged_uniform_tube(traced):
+    """Each stored point is uniform, with λz and P of model/tube.closed_end_state of Charged(material, Φ̄) at its λθ
+    (1e-10); the first one is the voltage-free tube at P0 (Φ̄ = 0)."""
+    preset, pressure, branch = traced
+    material = tube_scene(preset).material
+    disc = branch.disc
+    assert branch.voltage[0] == 0.0
+    for u, voltage in zip(branch.states, branch.voltage):
+        state = closed_end_state(Charged(material, voltage), u[0])
+        assert abs(u[disc.axial_index] - state.axial) <= 1e-10
+        assert abs(state.pressure - pressure) <= 1e-10
+        assert np.abs(np.delete(u, [0, disc.axial_index])).max() <= 1e-10
+
+
+def test_stability_changes_at_the_pull_in(traced):
+    """Under pressure control (Φ̄ and P fixed) the points before the pull-in are stable and those after it are not:
+    the even block's lowest eigenvalue changes sign in the LP's interval; the branch ends where Φ̄ falls back to 0 (the
+    other voltage-free state at P0) or passes the stop stretch."""
+    _, _, branch = traced
+    fold = next(s for s in branch.special if s.kind == Kind.LP)
+    unstable = branch.unstable["pressure"]
+    assert np.all(unstable[: fold.index + 1] == 0) and np.all(unstable[fold.index + 1:] >= 1)
+    even = branch.lowest["even"]
+    assert even[fold.index] > 0 > even[fold.index + 1]
+    assert branch.stop.code in (StopCode.ZERO_VOLTAGE, "hoop_stretch")
+
+
+def test_run_writes_the_voltage_branch_and_inspect_shows_it(tmp_path, capsys):
+    """``run`` on a tube's voltage continuation writes Φ̄ per point and at the LP; ``inspect`` names the continuation
+    and the LP's Φ̄; stop_voltage ends the branch before the pull-in."""
+    scene = tmp_path / "v.toml"
+    scene.write_text(voltage_scene("neo-Hookean", 0.8).to_toml())
+    out = tmp_path / "v.h5"
+    assert main(["run", str(scene), "-o", str(out), "--quiet"]) == 0
+    primary = read_tube_run(out)["branches"]["primary"]
+    lp = [s for s in primary["special_points"] if s["kind"] == "LP"]
+    assert len(lp) == 1 and lp[0]["voltage"] == pytest.approx(primary["voltage"].max(), abs=1e-3)
+    capsys.readouterr()
+    assert main(["inspect", str(out)]) == 0
+    shown = capsys.readouterr().out
+    assert "continued in Φ̄ at P = 0.8" in shown and f"Φ̄ = {lp[0]['voltage']:.10g}" in shown
+    short = voltage_branch(voltage_scene("neo-Hookean", 0.8).with_overrides({"continuation.stop_voltage": 0.3}))
+    assert short.stop.code == StopCode.STOP_VOLTAGE and short.voltage.max() <= 0.3 and not short.special
+
+
+@pytest.mark.parametrize("m_max, extra, message", [
+    (1, "", "stability.m_max = 1: a tube's voltage continuation"),
+    (0, '[[events]]\nquantity = "volume"\nvalue = 40\n', "events: 1 [[events]]: a tube's voltage continuation"),
+    (0, "[dynamics]\nfrequencies = true\n", "dynamics.frequencies = true: a tube's voltage continuation"),
+])
+def test_what_a_voltage_continuation_does_not_read_is_refused(m_max, extra, message):
+    """The m ≥ 1 blocks (stability.m_max defaults to 1: it must be set to 0), events and frequencies: one line each."""
+    with pytest.raises(SceneError, match=message.replace("[", r"\[")) as error:
+        voltage_scene("SPOM1", 1.0, extra, m_max)
+    assert "\n" not in str(error.value)
+
+
+def test_a_pressure_beyond_the_maximum_has_no_start():
+    """P0 = 1.6 above the neo-Hookean tube's pressure maximum 1.4997: no voltage-free state to start from, one line."""
+    with pytest.raises(ContinuationError, match="could not inflate the tube to continuation.pressure = 1.6"):
+        voltage_branch(voltage_scene("neo-Hookean", 1.6))
