@@ -124,3 +124,66 @@ def test_a_pressure_beyond_the_maximum_has_no_start():
     """P0 = 1.6 above the neo-Hookean tube's pressure maximum 1.4997: no voltage-free state to start from, one line."""
     with pytest.raises(ContinuationError, match="could not inflate the tube to continuation.pressure = 1.6"):
         voltage_branch(voltage_scene("neo-Hookean", 1.6))
+
+
+def test_continue_in_the_voltage_from_an_event_label(tmp_path, capsys):
+    """A SPOM1 tube continued in P under Φ̄0 = 0.1 with an event at P = 1 (label 0, UZ): ``continue --parameter
+    voltage`` from it traces the tube in Φ̄ at P = 1 from Φ̄0; its LP is the pull-in at P = 1 solved here (1e-12)
+    and that of the scene continued in the voltage from Φ̄ = 0 at P = 1 (another start: 1e-12); ``--direction -1``
+    goes down to Φ̄ = 0 (ZERO_VOLTAGE), every point at P = 1."""
+    scene = tmp_path / "p.toml"
+    scene.write_text(tube_scene("SPOM1", 10.0, "[solver]\ndegree = 16\n[electric]\nvoltage = 0.1\n[continuation]\n"
+                                               "stop_stretch = 2\nstep_max = 0.5\n[stability]\nm_max = 0\n"
+                                               '[[events]]\nquantity = "pressure"\nvalue = 1.0\n').to_toml())
+    run = tmp_path / "p.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet", "--primary-only"]) == 0
+    up, down = tmp_path / "up.h5", tmp_path / "down.h5"
+    assert main(["continue", str(run), "0", "--parameter", "voltage", "-o", str(up), "--set",
+                 "continuation.stop_stretch=4"]) == 0
+    assert "voltage continuation from label 0 at P = 1" in capsys.readouterr().out
+    branch = read_tube_run(up)["branches"]["primary"]
+    assert branch["voltage"][0] == pytest.approx(0.1, abs=1e-15) and np.all(branch["pressure"] == 1.0)
+    lp = [s for s in branch["special_points"] if s["kind"] == "LP"]
+    assert len(lp) == 1
+    charged = voltage_branch(voltage_scene("SPOM1", 1.0))
+    fold = next(s for s in charged.special if s.kind == Kind.LP)
+    root = sp.nsolve(balances("SPOM1", 1.0), [theta, z, PHI],
+                     [fold.u[0], fold.u[charged.disc.axial_index], fold.voltage], prec=30)
+    assert abs(lp[0]["voltage"] - float(root[2])) <= 1e-12 and abs(lp[0]["voltage"] - fold.voltage) <= 1e-12
+    assert main(["continue", str(run), "0", "--parameter", "voltage", "--direction", "-1", "-o", str(down)]) == 0
+    falling = read_tube_run(down)["branches"]["primary"]
+    assert falling["attrs"]["stop_code"] == "zero_voltage" and falling["voltage"].max() == pytest.approx(0.1)
+    assert np.all(np.diff(falling["voltage"]) < 0)
+
+
+def test_continue_in_the_voltage_refuses_in_one_line(tmp_path, capsys):
+    """From a label that is no UZ of the primary branch, or a scene without [electric]: exit 2, one line, no file."""
+    for electric, label, message in (("[electric]\nvoltage = 0.1\n", "1", "label 1: LP on branch primary; a tube "
+                                      "continues in the voltage from a user point (UZ) of its primary branch: labels 0"),
+                                     ("", "0", "--parameter voltage needs an [electric] table")):
+        scene = tmp_path / "p.toml"
+        scene.write_text(tube_scene("SPOM1", 10.0, f"[solver]\ndegree = 16\n{electric}[continuation]\n"
+                                    "stop_stretch = 1.8\n[stability]\nm_max = 0\n"
+                                    '[[events]]\nquantity = "pressure"\nvalue = 1.0\n').to_toml())
+        run = tmp_path / "p.h5"
+        assert main(["run", str(scene), "-o", str(run), "--quiet", "--primary-only", "--force"]) == 0
+        capsys.readouterr()
+        assert main(["continue", str(run), label, "--parameter", "voltage", "-o", str(tmp_path / "v.h5")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and message in err[0], err
+        assert not (tmp_path / "v.h5").exists()
+
+
+@pytest.mark.parametrize("command", [["critical", "--parameter", "voltage", "-o", "o.h5"],
+                                     ["solve", "--hoop-stretch", "2"],
+                                     ["sweep", "--vary", "geometry.length=8,10", "-o", "o.h5"]])
+def test_commands_on_a_pressure_continuation_refuse_a_voltage_one(tmp_path, capsys, monkeypatch, command):
+    """critical (the onset on a pressure continuation), solve (a state at a hoop stretch on it) and sweep (its table
+    reads a pressure continuation's points) on a tube's voltage continuation: exit 2, one line, no file."""
+    monkeypatch.chdir(tmp_path)
+    scene = tmp_path / "v.toml"
+    scene.write_text(voltage_scene("neo-Hookean", 0.8).to_toml())
+    assert main([command[0], str(scene), *command[1:]]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and 'continues in the voltage (continuation.parameter = "voltage")' in err[0], err
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["v.toml"]

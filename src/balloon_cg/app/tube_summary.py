@@ -48,12 +48,12 @@ def summarise_tube(run: dict) -> dict:
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
     electric = tomllib.loads(a["scene_toml"]).get("electric")
-    continuation = tomllib.loads(a["scene_toml"]).get("continuation", {})
-    charged = continuation.get("parameter") == "voltage"  # tube/voltage.py: continued in Φ̄ at a fixed P
+    primary = run["branches"]["primary"]
+    charged = VOLTAGE in primary  # tube/voltage.py: continued in Φ̄ at a fixed P (run, or continue from a label)
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "voltage": None if electric is None else float(electric.get("voltage", 0.0)),
             "parameter": "voltage" if charged else "pressure",
-            "fixed_pressure": float(continuation.get("pressure", 0.0)) if charged else None,
+            "fixed_pressure": float(primary["pressure"][0]) if charged else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
