@@ -139,10 +139,8 @@ def continue_tube(args) -> int:
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
-    from ..scene import SceneError, parse_scene
     from ..tube.picture import bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
-    from .cli import _with_settings
 
     run = read_tube_run(args.run)
     labels = tube_labels(run)
@@ -166,15 +164,7 @@ def continue_tube(args) -> int:
             "a branch point of its primary branch (odd: the onset of bulging; even: on its uniform branch)"
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
                          f"{', '.join(map(str, onsets)) or 'none'}")
-    try:
-        stored = parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
-    except SceneError as e:
-        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
-    scene, overrides = _with_settings(args, stored)
-    other = [key for key in overrides if not key.startswith("continuation.")]
-    if other:
-        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
-                         "the file's scene; allowed: continuation.* keys")
+    scene = with_continuation_settings(args, stored_scene(args, run))
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:
@@ -213,10 +203,8 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
     branch's states are not mirror-symmetric: the voltage continuation is on the even block), a scene without
     [electric], with coils, or a setting outside [continuation]."""
     from ..io.tube_file import stored_branch
-    from ..scene import SceneError, parse_scene
     from ..tube.picture import charged_picture
     from ..tube.primary import scene_parameters
-    from .cli import _with_settings
 
     points = [i for i, (name, _, s) in enumerate(labels) if name == "primary" and s["kind"] == "UZ"]
     if args.label not in points:
@@ -224,21 +212,14 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
         what = "no such label" if s is None else f"{s['kind']} on branch {name}"
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues in the voltage from a "
                          f"user point (UZ) of its primary branch: labels {', '.join(map(str, points)) or 'none'}")
-    try:
-        stored = parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
-    except SceneError as e:
-        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
+    stored = stored_scene(args, run)
     if stored.electric is None:
         raise UsageError(f"continue {args.run}: --parameter voltage needs an [electric] table: the file's scene has "
                          "none, so the equilibrium does not depend on the voltage")
     if _has_field(run):
         raise UsageError(f"continue {args.run}: --parameter voltage: a tube's voltage continuation reads no coil "
                          "field yet; allowed: a scene without coils")
-    scene, overrides = _with_settings(args, stored)
-    other = [key for key in overrides if not key.startswith("continuation.")]
-    if other:
-        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored point belongs to "
-                         "the file's scene; allowed: continuation.* keys")
+    scene = with_continuation_settings(args, stored)
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     start = (point.u, point.pressure, scene.voltage)
@@ -251,3 +232,26 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
           f"points, Φ̄ {grown['voltage'].min():.6g}..{grown['voltage'].max():.6g}, stop {grown['attrs']['stop_code']} "
           f"({grown['attrs']['stop_message']}); written to {args.output}")
     return 0
+
+
+def stored_scene(args, run: dict):
+    """The scene a tube run file stores (UsageError, one line, where it is not a valid one)."""
+    from ..scene import SceneError, parse_scene
+
+    try:
+        return parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
+    except SceneError as e:
+        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
+
+
+def with_continuation_settings(args, stored):
+    """``stored`` with the command line's settings (``--set``, shorthands), which must be [continuation] keys: the
+    stored branch belongs to the file's scene (UsageError, one line, naming the first other key)."""
+    from .cli import _with_settings
+
+    scene, overrides = _with_settings(args, stored)
+    other = [key for key in overrides if not key.startswith("continuation.")]
+    if other:
+        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
+                         "the file's scene; allowed: continuation.* keys")
+    return scene
