@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+import balloon_cg
 from balloon_cg.analysis.results import Kind
 from balloon_cg.app.cli import main
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
@@ -104,7 +105,7 @@ def test_event_on_the_bulge_branch_is_its_landed_volume_end():
 
 def test_run_stores_the_events_and_inspect_shows_them(tmp_path, capsys):
     """``run`` on a tube scene with events: the file's UZ points carry their event (``note``) and read back through
-    ``stored_branch``; ``inspect`` lists them with it; ``--json`` too."""
+    ``stored_branch`` and ``load``'s table; ``inspect`` lists them with it; ``--json`` too."""
     scene = tmp_path / "t.toml"
     scene.write_text(tube_scene("neo-Hookean", 10.0, "[solver]\ndegree = 16\n[continuation]\nstop_stretch = 2.5\n"
                                 + events(volume_ratio=4.0)).to_toml())
@@ -115,6 +116,8 @@ def test_run_stores_the_events_and_inspect_shows_them(tmp_path, capsys):
     assert [s["note"] for s in uz] == ["volume_ratio = 4"] and uz[0]["volume"] == pytest.approx(4.0, rel=1e-12)
     branch = stored_branch(run, "primary", scene_parameters(tube_scene("neo-Hookean")))
     assert [s.note for s in branch.special if s.kind == Kind.UZ] == ["volume_ratio = 4"]
+    special = balloon_cg.load(out).to_dataframe("special")
+    assert list(special.loc[special["kind"] == "UZ", "note"]) == ["volume_ratio = 4"]
     capsys.readouterr()
     assert main(["inspect", str(out)]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if " UZ " in line]

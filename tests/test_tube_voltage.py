@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+import balloon_cg
 from balloon_cg.analysis.branches.tracer import ContinuationError
 from balloon_cg.analysis.results import Kind, StopCode
 from balloon_cg.app.cli import main
@@ -92,7 +93,7 @@ def test_stability_changes_at_the_pull_in(traced):
 
 def test_run_writes_the_voltage_branch_and_inspect_shows_it(tmp_path, capsys):
     """``run`` on a tube's voltage continuation writes Φ̄ per point and at the LP; ``inspect`` names the continuation
-    and the LP's Φ̄; stop_voltage ends the branch before the pull-in."""
+    and the LP's Φ̄, ``load`` gives it in its tables; stop_voltage ends the branch before the pull-in."""
     scene = tmp_path / "v.toml"
     scene.write_text(voltage_scene("neo-Hookean", 0.8).to_toml())
     out = tmp_path / "v.h5"
@@ -104,6 +105,9 @@ def test_run_writes_the_voltage_branch_and_inspect_shows_it(tmp_path, capsys):
     assert main(["inspect", str(out)]) == 0
     shown = capsys.readouterr().out
     assert "continued in Φ̄ at P = 0.8" in shown and f"Φ̄ = {lp[0]['voltage']:.10g}" in shown
+    loaded = balloon_cg.load(out)
+    assert list(loaded.to_dataframe("special")["voltage"]) == [lp[0]["voltage"]]
+    assert np.array_equal(loaded.to_xarray("primary")["voltage"].values, primary["voltage"])
     short = voltage_branch(voltage_scene("neo-Hookean", 0.8).with_overrides({"continuation.stop_voltage": 0.3}))
     assert short.stop.code == StopCode.STOP_VOLTAGE and short.voltage.max() <= 0.3 and not short.special
 
