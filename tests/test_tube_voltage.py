@@ -20,7 +20,7 @@ from balloon_cg.model.tube import closed_end_state
 from balloon_cg.scene import SceneError
 from balloon_cg.tube.voltage import voltage_branch
 from test_interval import tube_scene
-from test_tube import symbolic_energy, theta, z
+from test_tube import bulge_determinant, symbolic_energy, theta, z
 
 PHI = sp.Symbol("Phi", positive=True)
 CASES = {"neo-Hookean": 0.8, "SPOM1": 1.2}  # P0, below each tube's pressure maximum (1.4997, 1.4905)
@@ -62,6 +62,24 @@ def test_pull_in_voltage_is_the_fold_of_the_uniform_closed_tube(traced):
     assert abs(fold.u[0] - hoop_exact) <= 1e-10 and abs(axial - axial_exact) <= 1e-10
     assert fold.pressure == pressure and np.all(branch.pressure == pressure)
     assert branch.voltage.max() <= voltage_exact + 1e-10
+
+
+def test_first_odd_branch_point_is_the_bulge_onset_in_the_voltage(traced):
+    """The first odd branch point (the onset of the bulge cos(πS/L) in Φ̄ at P0) solves P = P0, N = 0 and the
+    dispersion relation of tests/test_tube.py (bulge_determinant of Φ_eff at k = π/L = 0), at 30 digits: Φ̄, λθ and
+    λz within 1e-10; past the pull-in on this finite tube (Φ̄ below its LP's, later along the branch)."""
+    preset, pressure, branch = traced
+    fold = next(s for s in branch.special if s.kind == Kind.LP)
+    onset = next(s for s in branch.special if s.kind == Kind.BP and s.block == "odd")
+    P, N, _ = balances(preset, pressure)
+    energy = symbolic_energy(tube_scene(preset).material) - PHI**2 * theta**2 * z**2
+    det, k = bulge_determinant(energy)
+    axial = onset.u[branch.disc.axial_index]
+    root = sp.nsolve([P, N, det.subs(k, sp.pi / 10)], [theta, z, PHI], [onset.u[0], axial, onset.voltage], prec=30)
+    assert onset.status == "located"
+    assert abs(onset.voltage - float(root[2])) <= 1e-10
+    assert abs(onset.u[0] - float(root[0])) <= 1e-10 and abs(axial - float(root[1])) <= 1e-10
+    assert onset.voltage < fold.voltage and branch.special.index(onset) > branch.special.index(fold)
 
 
 def test_every_point_is_the_charged_uniform_tube(traced):
@@ -106,7 +124,9 @@ def test_run_writes_the_voltage_branch_and_inspect_shows_it(tmp_path, capsys):
     shown = capsys.readouterr().out
     assert "continued in Φ̄ at P = 0.8" in shown and f"Φ̄ = {lp[0]['voltage']:.10g}" in shown
     loaded = balloon_cg.load(out)
-    assert list(loaded.to_dataframe("special")["voltage"]) == [lp[0]["voltage"]]
+    special = loaded.to_dataframe("special")
+    assert list(special["voltage"]) == [s["voltage"] for s in primary["special_points"]]
+    assert list(special.loc[special["kind"] == "LP", "voltage"]) == [lp[0]["voltage"]]
     assert np.array_equal(loaded.to_xarray("primary")["voltage"].values, primary["voltage"])
     short = voltage_branch(voltage_scene("neo-Hookean", 0.8).with_overrides({"continuation.stop_voltage": 0.3}))
     assert short.stop.code == StopCode.STOP_VOLTAGE and short.voltage.max() <= 0.3 and not short.special

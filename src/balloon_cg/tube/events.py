@@ -1,8 +1,9 @@
 """User points (UZ) on a tube's branches (``[[events]]``, scene/events.py): where a quantity q passes a value v
 between two stored points of a branch, the equilibrium there, landed on as on the sphere
-(analysis/branches/events.crossings: Newton on R(X) = 0 and the linearised constraint ∇q(X_k)·(X − X_k) = v − q(X_k),
-repeated until |q − v| ≤ LANDING_RTOL·max(1, |v|)), in the coordinates X = (u[unknowns], P) of the branch's
-TubeSystem (tube/primary.py: the even block on the primary branch, every unknown on an odd bulge branch).
+(analysis/branches/events.crossings: Newton on R(X) = 0 and the linearised constraint
+∇q(X_k)·(X − X_k) = v − q(X_k), repeated until |q − v| ≤ LANDING_RTOL·max(1, |v|)), in the coordinates
+X = (u[unknowns], P) of the branch's TubeSystem (tube/primary.py: the even block on the primary branch, every unknown
+on an odd bulge branch).
 
 The quantities, functions of Y = (u, P):
 

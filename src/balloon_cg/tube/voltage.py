@@ -7,23 +7,32 @@ with P prescribed); ContinuationError where it does not get there (P beyond the 
 lower path). ``continue --parameter voltage`` from a label starts at that stored point instead (its P and Φ̄).
 
 Trace: pseudo-arclength continuation in X = (u[even block], Φ̄) (tube/primary.TubeSystem on the ParameterSystem in
-"voltage": ∂R/∂Φ̄ from the generated voltage gradient), Φ̄ rising first (``direction`` −1: falling); its folds in Φ̄
-(LP, the pull-in: the largest voltage the tube holds at P) located by the tracer's fold monitor on Φ̄. It stops where
-Φ̄ passes ``continuation.stop_voltage`` (STOP_VOLTAGE), falls below 0 (ZERO_VOLTAGE: a voltage-free state at P
-again; not landed on Φ̄ = 0), the largest hoop stretch passes ``stop_stretch`` (HOOP_STRETCH), after
+"voltage": ∂R/∂Φ̄ from the generated voltage gradient), Φ̄ rising first (``direction`` −1: falling); its folds in
+Φ̄ (LP, the pull-in: the largest voltage the tube holds at P) located by the tracer's fold monitor on Φ̄. It stops
+where Φ̄ passes ``continuation.stop_voltage`` (STOP_VOLTAGE), falls below 0 (ZERO_VOLTAGE: a voltage-free state at
+P again; not landed on Φ̄ = 0), the largest hoop stretch passes ``stop_stretch`` (HOOP_STRETCH), after
 ``max_points``, or at the next point after SIGINT/SIGTERM. At every point, with its Φ̄: the number of unstable
 directions under each control (tube/stability.unstable_counts: at fixed Φ̄ and P, ∂R/∂u, on δV = 0 and with the
-gas term), the mirror blocks' lowest eigenvalues and the smallest principal stress (the dielectric stress at its Φ̄).
-Not located on it (scene/tables.py refuses what would ask for them): the zeros of the odd block (the onset of
-bulging in Φ̄: its sign change shows in ``lowest``/``unstable``), user events, the m ≥ 1 blocks, frequencies.
+gas term), the mirror blocks' spectra (their lowest eigenvalues stored) and the smallest principal stress (the
+dielectric stress at its Φ̄). Where a block's count of negative eigenvalues changes between points, the eigenvalue
+that crossed is followed to its zero by Brent in the arclength (``_branch_point``), a branch point (BP) where its
+null vector is orthogonal to ∂R/∂Φ̄ (the odd block's always: the onset of bulging in Φ̄), the fold otherwise (not
+kept: the LP is the monitor's); near an even branch point the Keller corrector may fail, and the point is then the
+nearest evaluated (status NEAREST). Not read on it (scene/tables.py refuses what would ask for them): user events,
+the m ≥ 1 blocks, frequencies, coils.
 """
+from dataclasses import replace
+
 import numpy as np
 
-from .primary import TubeSystem, _start, discretisation, held, scene_parameters, volume_ratio
+from .events import along
+from .primary import (BRENT_XTOL, ORTHOGONAL, TubeSystem, _start, discretisation, held, scene_parameters,
+                      volume_ratio)
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, spectrum, unstable_counts
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.branches.tracer import ContinuationError
+from ..analysis.stability.crossings import count_changes
 from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
@@ -91,15 +100,45 @@ def voltage_branch(scene, start: tuple | None = None, direction: float = 1.0) ->
     full = [np.append(s, pressure) for s in states]
     counts = [unstable_counts(eq, [Y], p) for Y, p in zip(full, at)]
     unstable = {control: np.array([c[control][0] for c in counts]) for control in counts[0]}
-    lowest = {block: np.array([spectrum(eq, Y, disc.block(block), p)[0] for Y, p in zip(full, at)])
-              for block in Mirror}
-    special = []
-    for f in path.folds:
-        Y = system.full(f.point.X)
-        special.append(IntervalSpecial(Kind(f.label), Y[:-1], pressure, f.index, f.status,
-                                       smallest_stress=smallest_stress(eq, Y[:-1], float(Y[-1])),
-                                       voltage=float(Y[-1])))
-    return IntervalBranch(disc, states, np.full(len(states), pressure),
-                          np.array([volume_ratio(eq, Y) for Y in full]), lowest, unstable, tuple(special), path.stop,
-                          np.array([smallest_stress(eq, s, v) for s, v in zip(states, voltage)]), params,
-                          voltage=voltage)
+    spectra = {block: np.array([spectrum(eq, Y, disc.block(block), p) for Y, p in zip(full, at)]) for block in Mirror}
+    found = [(Kind(f.label), system.full(f.point.X), f.index, f.status, None) for f in path.folds]
+    for block in Mirror:
+        for i, order in count_changes((spectra[block] < 0).sum(axis=1)):
+            zero = _branch_point(system, eq, path.points[i], path.points[i + 1], block, order, settings, params)
+            if zero is not None:
+                found.append((Kind.BP, zero[0], i, zero[1], block))
+    special = [IntervalSpecial(kind, Y[:-1], pressure, i, status, block,
+                               smallest_stress(eq, Y[:-1], float(Y[-1])), voltage=float(Y[-1]))
+               for kind, Y, i, status, block in found]
+    branch = IntervalBranch(disc, states, np.full(len(states), pressure),
+                            np.array([volume_ratio(eq, Y) for Y in full]),
+                            {block: values[:, 0] for block, values in spectra.items()}, unstable, (), path.stop,
+                            np.array([smallest_stress(eq, s, v) for s, v in zip(states, voltage)]), params,
+                            voltage=voltage)
+    return replace(branch, special=tuple(sorted(special, key=lambda s: along(branch, s))))
+
+
+def _branch_point(system, eq, before, after, block: Mirror, order: int, settings, params) -> tuple | None:
+    """(Y = (u, Φ̄), status) where the eigenvalue number ``order`` of ``block`` vanishes between two points of the
+    voltage trace ``system``, by Brent in the arclength from ``before`` (each value a Keller corrector; one that
+    fails ends the search NEAREST); None where it is the fold in Φ̄ (the null vector not orthogonal to ∂R/∂Φ̄, as
+    tube/primary's branch points in P)."""
+    index, pressure = eq.disc.block(block), params.P
+
+    def value_at(s):
+        result = continuation.correct(system, before.X + s * before.tangent, before.tangent, settings)
+        if not result.converged:
+            raise ArithmeticError(result.message)
+        Y = system.full(result.x)
+        return spectrum(eq, np.append(Y[:-1], pressure), index, params.with_value("voltage", Y[-1]))[order], Y
+
+    root = continuation.locate_root(value_at, float(before.tangent @ (after.X - before.X)), BRENT_XTOL)
+    if root is None:
+        return None
+    Y = root.payload
+    at = params.with_value("voltage", Y[-1])
+    phi = np.linalg.eigh(eq.jacobian(Y[:-1], at)[np.ix_(index, index)])[1][:, order]
+    dV = eq.parameter_derivative(Y[:-1], at, "voltage")
+    if abs(phi @ dV[index]) > ORTHOGONAL * np.linalg.norm(dV):
+        return None
+    return Y, root.status
