@@ -47,7 +47,6 @@ def tube_quantity(system, quantity: Quantity) -> tuple:
     """(q(X), ∇q(X)) of ``quantity`` in the coordinates X of ``system`` (a tube/primary.TubeSystem; module
     docstring)."""
     disc, columns = system.system.eq.disc, system.columns
-
     if quantity in CONTROLS:
         scale = 1 / (np.pi * disc.length) if quantity == Quantity.VOLUME_RATIO else 1.0
         q, dq = value(system, CONTROLS[quantity]), gradient(system, CONTROLS[quantity])
