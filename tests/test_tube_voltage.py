@@ -14,10 +14,12 @@ import balloon_cg
 from balloon_cg.analysis.branches.tracer import ContinuationError
 from balloon_cg.analysis.results import Kind, StopCode
 from balloon_cg.app.cli import main
-from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.io.tube_file import discretisation, read_tube_run
 from balloon_cg.model.membrane import Charged
 from balloon_cg.model.tube import closed_end_state
 from balloon_cg.scene import SceneError
+from balloon_cg.tube.accuracy import accuracy
 from balloon_cg.tube.voltage import voltage_branch
 from test_interval import tube_scene
 from test_tube import bulge_determinant, symbolic_energy, theta, z
@@ -211,3 +213,23 @@ def test_commands_on_a_pressure_continuation_refuse_a_voltage_one(tmp_path, caps
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and 'continues in the voltage (continuation.parameter = "voltage")' in err[0], err
     assert sorted(path.name for path in tmp_path.iterdir()) == ["v.toml"]
+
+
+def test_plugged_tube_keeps_the_first_integral_of_its_charged_energy(tmp_path):
+    """A plugged SPOM1 tube (not uniform: the plugs hold ρ = 1) continued in Φ̄ at P = 1 through its pull-in (20
+    points, degree 30): the first integral H = λ1Φ_1 − Φ of the effective energy at each point's Φ̄ is constant along
+    the tube to its discretisation (the file's first_integral_spread ≤ 1e-3; measured 1.1e-4), and with the
+    voltage-free Φ it is not (> 1e-2 past Φ̄ = 0.2): each state is an equilibrium of its own voltage."""
+    scene = tmp_path / "plugged.toml"
+    scene.write_text(tube_scene("SPOM1", 10.0, 'ends = "plugged"\n[solver]\ndegree = 30\n[electric]\n[continuation]\n'
+                                "parameter = \"voltage\"\npressure = 1.0\nmax_points = 20\nstep_max = 0.5\n"
+                                "[stability]\nm_max = 0\n").to_toml())
+    out = tmp_path / "plugged.h5"
+    assert main(["run", str(scene), "-o", str(out), "--quiet"]) == 0
+    primary = read_tube_run(out)["branches"]["primary"]
+    assert [s["kind"] for s in primary["special_points"]][0] == "LP"
+    assert primary["first_integral_spread"].max() <= 1e-3
+    plugged = tube_scene("SPOM1", 10.0, 'ends = "plugged"\n[electric]\n')
+    eq = Equilibrium(plugged, discretisation(read_tube_run(out)["attrs"]))
+    voltage_free = accuracy(eq, primary["unknowns"])[1]
+    assert voltage_free[primary["voltage"] > 0.2].min() > 1e-2

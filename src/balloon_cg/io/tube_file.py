@@ -165,7 +165,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
                                ("unstable_volume", branch.unstable["volume"]), (GAS, branch.unstable["gas"]),
                                ("smallest_stress", branch.smallest_stress),
                                (CREST, crest_heights(branch.disc, branch.states)),
-                               *zip(ACCURACY, accuracy(eq, branch.states))):
+                               *zip(ACCURACY, accuracy(eq, branch.states, branch.voltage))):
             checksummed(group, column, values)
         if branch.voltage is not None:
             checksummed(group, VOLTAGE, branch.voltage)
