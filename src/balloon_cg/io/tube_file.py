@@ -97,7 +97,7 @@ TUBE_VARIABLES = {
     "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
     "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point, UZ an event's value reached"),
     VOLTAGE: ("1", "voltage Φ̄", "a voltage continuation's Φ̄ (tube/voltage.py: P fixed), per point and located point"),
-    "note": ("", "event", "a UZ point's event, quantity = value (tube/events.py); empty for the others"),
+    NOTE: ("", "event", "a UZ point's event, quantity = value (tube/events.py); empty for the others"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
     "index": ("", "point index", "the located point lies between points index and index + 1"),
@@ -186,7 +186,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         write_strings(special, "kind", [p.kind.value for p in s])
         write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
         write_strings(special, "status", [p.status.value for p in s])
-        write_strings(special, "note", [p.note for p in s])
+        write_strings(special, NOTE, [p.note for p in s])
         checksummed(special, "index", np.array([p.index for p in s], dtype=int))
         checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
         volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
