@@ -183,10 +183,15 @@ def test_continue_in_the_voltage_from_an_event_label(tmp_path, capsys):
 
 
 def test_continue_in_the_voltage_refuses_in_one_line(tmp_path, capsys):
-    """From a label that is no UZ of the primary branch, or a scene without [electric]: exit 2, one line, no file."""
-    for electric, label, message in (("[electric]\nvoltage = 0.1\n", "1", "label 1: LP on branch primary; a tube "
-                                      "continues in the voltage from a user point (UZ) of its primary branch: labels 0"),
-                                     ("", "0", "--parameter voltage needs an [electric] table")):
+    """From a label that is no UZ of the primary branch, or a scene without [electric]: exit 2, one line, no file;
+    from a UZ without --parameter the line says how."""
+    for electric, argv, message in (
+            ("[electric]\nvoltage = 0.1\n", ["1", "--parameter", "voltage"], "label 1: LP on branch primary; a tube "
+             "continues in the voltage from a user point (UZ) of its primary branch: labels 0"),
+            ("", ["0", "--parameter", "voltage"], "--parameter voltage needs an [electric] table"),
+            ("", ["0"], "label 0: UZ on branch primary; a tube continues from a branch point of its primary branch "
+             "(odd: the onset of bulging; even: on its uniform branch): labels 2, 3 (from a UZ: --parameter voltage, "
+             "in Φ̄ at its P)")):
         scene = tmp_path / "p.toml"
         scene.write_text(tube_scene("SPOM1", 10.0, f"[solver]\ndegree = 16\n{electric}[continuation]\n"
                                     "stop_stretch = 1.8\n[stability]\nm_max = 0\n"
@@ -194,7 +199,7 @@ def test_continue_in_the_voltage_refuses_in_one_line(tmp_path, capsys):
         run = tmp_path / "p.h5"
         assert main(["run", str(scene), "-o", str(run), "--quiet", "--primary-only", "--force"]) == 0
         capsys.readouterr()
-        assert main(["continue", str(run), label, "--parameter", "voltage", "-o", str(tmp_path / "v.h5")]) == 2
+        assert main(["continue", str(run), *argv, "-o", str(tmp_path / "v.h5")]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and message in err[0], err
         assert not (tmp_path / "v.h5").exists()

@@ -162,8 +162,9 @@ def continue_tube(args) -> int:
             what = "no such label"
         which = "an odd branch point of its primary branch (the onset of bulging)" if blocks == ("odd",) else \
             "a branch point of its primary branch (odd: the onset of bulging; even: on its uniform branch)"
+        event = " (from a UZ: --parameter voltage, in Φ̄ at its P)" if what.startswith("UZ on branch primary") else ""
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
-                         f"{', '.join(map(str, onsets)) or 'none'}")
+                         f"{', '.join(map(str, onsets)) or 'none'}{event}")
     scene = with_continuation_settings(args, stored_scene(args, run))
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
