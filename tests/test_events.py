@@ -81,8 +81,9 @@ def test_mirror_image_events_are_its_own(picture):
 
 @pytest.mark.parametrize("table, message", [
     ('[[events]]\nquantity = "volum"\nvalue = 20', 'events[0].quantity = "volum": must be one of "volume", "amount", '
-                                                   '"pressure", "lam2_top", "lam2_bottom", "lam2_equator" '
-                                                   '(did you mean volume?)'),
+                                                   '"pressure", "lam2_top", "lam2_bottom", "lam2_equator", '
+                                                   '"volume_ratio", "lam2_max", "axial_stretch" (did you mean '
+                                                   'volume?)'),
     ('[[events]]\nquantity = "volume"\nvalue = 0', "events[0].value = 0: must be > 0"),
     ('[[events]]\nquantity = "volume"\nvalue = "20"', 'events[0].value = "20": must be a number'),
     ('[[events]]\nquantity = "volume"', "events[0].value: missing (an event needs quantity and value)"),

@@ -341,10 +341,11 @@ def test_tube_table_errors_name_key_value_and_range(table, message):
      "height = -3\ncurrent = 1\n",
      r"field.coils\[0\]: wire at \(radius 0.8, height 3\) lies on or inside the reference tube"),
     ('[electric]\n[continuation]\nparameter = "voltage"\npressure = 0.5\n',
-     r'continuation.parameter = "voltage": a tube is continued in the pressure only for now'),
+     r"stability.m_max = 1: a tube's voltage continuation \(continuation.parameter = \"voltage\"\) reads the m = 0 "
+     "stability only for now; allowed: 0"),
     ("[dynamics]\nfrequencies = true\nmodes = true\n", "dynamics.modes = true: a tube's mode shapes are not stored"),
-    ('[[events]]\nquantity = "pressure"\nvalue = 1.2\n', r"events: 1 \[\[events\]\] on a tube, whose branches do not "
-     "locate user points yet; allowed: none"),
+    ('ends = "plugged"\n[[events]]\nquantity = "lam2_top"\nvalue = 1.2\n',
+     r'events\[0\].quantity = "lam2_top": the plugs hold the hoop stretch at a plugged tube\'s ends at 1'),
 ])
 def test_tube_refuses_the_parts_it_does_not_have(extra, message):
     with pytest.raises(SceneError, match=message) as error:

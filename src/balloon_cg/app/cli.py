@@ -477,6 +477,9 @@ def solve_tube(scene, args) -> int:
     from .summaries import format_table
 
     x = args.hoop_stretch
+    if scene.continuation.parameter == "voltage":
+        raise UsageError('solve on a tube: the state at a hoop stretch is solved on the pressure continuation; the '
+                         'scene continues in the voltage (continuation.parameter = "voltage")')
     if not np.isfinite(x) or not 1 < x <= MAX_STRETCH:
         raise UsageError(f"--hoop-stretch = {x:g}: must be in (1, {MAX_STRETCH:g}] (1 is the undeformed tube)")
     clock = time.perf_counter()
@@ -1149,6 +1152,9 @@ def sweep(args) -> int:
 
     mode = "primary-only" if args.primary_only else "no-pear" if args.no_pear else "analysis"
     scene = axisymmetric(load_scene(args.scene), "sweep")
+    if scene.geometry.shape == "tube" and scene.continuation.parameter == "voltage":
+        raise UsageError(f"sweep of a tube: its table reads a pressure continuation's points: {args.scene} continues "
+                         'in the voltage (continuation.parameter = "voltage")')
     varied = "_".join(re.sub(r"[^A-Za-z0-9.+-]+", "", text.partition("=")[0].strip().split(".")[-1])
                       for text in args.vary)
     args.output = default_output(args.output, f"{scene.name}_sweep_{varied}", "sweep")

@@ -5,7 +5,7 @@ file's ``interrupted`` attribute names the stage, and the command exits 130 with
 import sys
 
 from .cli import INTERRUPTED, PROG, Failure, UsageError, _say, field_needed
-from ..scene.tables import Ends
+from ..scene.tables import ContinuationParameter, Ends
 
 
 def run_tube(scene, output, args) -> int:
@@ -35,10 +35,14 @@ def critical_tube(scene, output, args) -> int:
     group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns back in the parameter (a located
     fold: the onset's largest or smallest value), 1 (the file still written) where it does not; 1 without a file
     where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M or the voltage, M
-    without coils, the voltage without [electric]; 130 when a signal stopped it (module docstring)."""
+    without coils, the voltage without [electric], a scene continued in the voltage; 130 when a signal stopped it
+    (module docstring)."""
     from ..tube.picture import onset_picture
 
     name = ONSET_PARAMETERS.get(args.parameter)
+    if scene.continuation.parameter == ContinuationParameter.VOLTAGE:
+        raise UsageError(f"critical on a tube follows the onset of bulging on a pressure continuation: {args.scene} "
+                         'continues in the voltage (continuation.parameter = "voltage")')
     if args.of != "BP" or name is None:
         raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M or the voltage: "
                          f"{args.scene}: --of {args.of} --parameter {args.parameter}")
@@ -130,20 +134,21 @@ def continue_tube(args) -> int:
     order, from 0): at an odd branch point of the primary branch (the onset of bulging), or at an even one of a
     uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
     traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
-    the stored primary branch to a tube run file (130 on a signal, as ``run``). Exit 2, before any work, for another
-    label, a setting outside [continuation], another parameter, or no coils for M."""
+    the stored primary branch to a tube run file (130 on a signal, as ``run``); with ``--parameter voltage`` from a
+    user point (UZ) of the primary branch, the tube continued in Φ̄ at its P (``_continue_in_voltage``). Exit 2,
+    before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
-    from ..scene import SceneError, parse_scene
     from ..tube.picture import bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
-    from .cli import _with_settings
 
     run = read_tube_run(args.run)
     labels = tube_labels(run)
+    if args.parameter in VOLTAGE_NAMES:
+        return _continue_in_voltage(args, run, labels)
     if args.parameter not in (None, "P", "M", "field.M"):
-        raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M "
-                         "(allowed: M, or none for the bulge branch)")
+        raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M, a "
+                         "user point's state in the voltage (allowed: M, voltage, or none for the bulge branch)")
     in_field = args.parameter in ("M", "field.M")
     uniform = run["attrs"]["ends"] == Ends.SLIDING.value and not _has_field(run)  # even BPs switched there
     blocks = ("odd",) if in_field or not uniform else ("odd", "even")
@@ -157,17 +162,10 @@ def continue_tube(args) -> int:
             what = "no such label"
         which = "an odd branch point of its primary branch (the onset of bulging)" if blocks == ("odd",) else \
             "a branch point of its primary branch (odd: the onset of bulging; even: on its uniform branch)"
+        event = " (from a UZ: --parameter voltage, in Φ̄ at its P)" if what.startswith("UZ on branch primary") else ""
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
-                         f"{', '.join(map(str, onsets)) or 'none'}")
-    try:
-        stored = parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
-    except SceneError as e:
-        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
-    scene, overrides = _with_settings(args, stored)
-    other = [key for key in overrides if not key.startswith("continuation.")]
-    if other:
-        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
-                         "the file's scene; allowed: continuation.* keys")
+                         f"{', '.join(map(str, onsets)) or 'none'}{event}")
+    scene = with_continuation_settings(args, stored_scene(args, run))
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:
@@ -192,3 +190,69 @@ def continue_tube(args) -> int:
     print(f"{'onset curve in M' if in_field else 'bulge branch'} from label {args.label}: {size} points, stop "
           f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
     return 0
+
+
+VOLTAGE_NAMES = ("voltage", "electric.voltage")  # continue --parameter
+
+
+def _continue_in_voltage(args, run: dict, labels: list) -> int:
+    """``continue --parameter voltage`` from a UZ point of a tube file's primary branch (a state where an event's
+    quantity reached its value, at the scene's voltage Φ̄0): the tube continued in Φ̄ at that point's P
+    (tube/picture.charged_picture from the stored state, ``--direction`` −1: Φ̄ falling first), with the file's
+    scene and the command line's [continuation] settings (stop_stretch, max_points, steps), written as a tube run
+    file's primary branch (130 on a signal, as ``run``). Exit 2, before any work, for another label (the bulge
+    branch's states are not mirror-symmetric: the voltage continuation is on the even block), a scene without
+    [electric], with coils, or a setting outside [continuation]."""
+    from ..io.tube_file import stored_branch
+    from ..tube.picture import charged_picture
+    from ..tube.primary import scene_parameters
+
+    points = [i for i, (name, _, s) in enumerate(labels) if name == "primary" and s["kind"] == "UZ"]
+    if args.label not in points:
+        name, _, s = labels[args.label] if 0 <= args.label < len(labels) else (None, None, None)
+        what = "no such label" if s is None else f"{s['kind']} on branch {name}"
+        raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues in the voltage from a "
+                         f"user point (UZ) of its primary branch: labels {', '.join(map(str, points)) or 'none'}")
+    stored = stored_scene(args, run)
+    if stored.electric is None:
+        raise UsageError(f"continue {args.run}: --parameter voltage needs an [electric] table: the file's scene has "
+                         "none, so the equilibrium does not depend on the voltage")
+    if _has_field(run):
+        raise UsageError(f"continue {args.run}: --parameter voltage: a tube's voltage continuation reads no coil "
+                         "field yet; allowed: a scene without coils")
+    scene = with_continuation_settings(args, stored)
+    _, k, _ = labels[args.label]
+    point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
+    start = (point.u, point.pressure, scene.voltage)
+    written, signalled = _written(args.output, args, lambda: charged_picture(scene, start, args.direction), scene)
+    code = interrupted_status(written, args.output, signalled)
+    if code is not None:
+        return code
+    grown = written["branches"]["primary"]
+    print(f"voltage continuation from label {args.label} at P = {point.pressure:.10g}: {len(grown['pressure'])} "
+          f"points, Φ̄ {grown['voltage'].min():.6g}..{grown['voltage'].max():.6g}, stop {grown['attrs']['stop_code']} "
+          f"({grown['attrs']['stop_message']}); written to {args.output}")
+    return 0
+
+
+def stored_scene(args, run: dict):
+    """The scene a tube run file stores (UsageError, one line, where it is not a valid one)."""
+    from ..scene import SceneError, parse_scene
+
+    try:
+        return parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
+    except SceneError as e:
+        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
+
+
+def with_continuation_settings(args, stored):
+    """``stored`` with the command line's settings (``--set``, shorthands), which must be [continuation] keys: the
+    stored branch belongs to the file's scene (UsageError, one line, naming the first other key)."""
+    from .cli import _with_settings
+
+    scene, overrides = _with_settings(args, stored)
+    other = [key for key in overrides if not key.startswith("continuation.")]
+    if other:
+        raise UsageError(f"continue {args.run}: --set {other[0]}={overrides[other[0]]}: the stored branch belongs to "
+                         "the file's scene; allowed: continuation.* keys")
+    return scene

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.tube_file import ACCURACY, CREST, CURVE_COLUMNS, POINT_COLUMNS, read_tube_run
+from ..io.tube_file import ACCURACY, CREST, CURVE_COLUMNS, POINT_COLUMNS, VOLTAGE, read_tube_run
 from .tables import html_table, optional
 
 PARTS = ("points", "special")
-SPECIAL_COLUMNS = ("kind", "block", "status", "index", "pressure", "volume", "smallest_stress", CREST)
+SPECIAL_COLUMNS = ("kind", "block", "status", "note", "index", "pressure", VOLTAGE, "volume", "smallest_stress", CREST)
 
 
 @dataclass(frozen=True, repr=False)
@@ -73,9 +73,10 @@ class TubeResult:
         ----------
         table : str, optional
             ``"points"`` (default): one row per point of every branch (branch, point, the per-point columns);
-            ``"special"``: one row per located point (branch, kind, block, status, index, pressure, volume,
-            smallest_stress, crest_height); ``"onset"``: one row per point of the onset curve of ``critical`` (the
-            parameter under its own name, pressure, volume, crest_height).
+            ``"special"``: one row per located point (branch, kind, block, status, note: a UZ point's event, index,
+            pressure, voltage on a voltage continuation, volume, smallest_stress, crest_height); ``"onset"``: one
+            row per point of the onset curve of ``critical`` (the parameter under its own name, pressure, volume,
+            crest_height).
 
         Returns
         -------
@@ -149,7 +150,7 @@ class TubeResult:
 
     @staticmethod
     def _points(b: dict) -> dict:
-        return {c: b[c] for c in (*POINT_COLUMNS, CREST, *ACCURACY, "lowest_even", "lowest_odd") if c in b}
+        return {c: b[c] for c in (*POINT_COLUMNS, CREST, VOLTAGE, *ACCURACY, "lowest_even", "lowest_odd") if c in b}
 
     @staticmethod
     def _special(b: dict) -> dict:

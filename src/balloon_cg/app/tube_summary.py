@@ -1,20 +1,21 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
-voltage ([electric]; None without), the loading control (its stability reading: how many of a branch's points are
-stable under it; under gas control the amount n = P V of every located point), Maxwell's pressure, per branch its
-points, P and V/V0 ranges, its stop, how many of its points are compressed (tube/stability.py) and how many are not
-resolved (their Legendre tail above the scene's solver.max_error: tube/accuracy.py; None in files before the tail is
-stored), the largest tail, the height of its last
-point's crest and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md),
-with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block over the points,
-as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the smallest eigenvalue and
-the points after which the unstable count changes; {} where not assessed), the onset curve of ``critical`` (its range,
-folds and stop), and the stage a signal stopped (``interrupted``)."""
+voltage ([electric]; None without), the parameter continued in (``parameter``: "voltage" at ``fixed_pressure`` on a
+voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄), the loading control (its
+stability reading: how many of a branch's points are stable under it; under gas control the amount n = P V of every
+located point), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are
+compressed (tube/stability.py) and how many are not resolved (their Legendre tail above the scene's solver.max_error:
+tube/accuracy.py; None in files before the tail is stored), the largest tail, the height of its last point's crest
+and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md; a UZ point with
+its event), with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block
+over the points, as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the
+smallest eigenvalue and the points after which the unstable count changes; {} where not assessed), the onset curve of
+``critical`` (its range, folds and stop), and the stage a signal stopped (``interrupted``)."""
 import math
 import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST, HELD_M1
+from ..io.tube_file import CREST, HELD_M1, VOLTAGE
 from ..scene import parse_scene
 from ..tube.stability import COMPRESSED
 
@@ -35,6 +36,7 @@ def summarise_tube(run: dict) -> dict:
                           "stop_message": b["attrs"]["stop_message"],
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
+                          "voltage": None if VOLTAGE not in b else [float(b[VOLTAGE].min()), float(b[VOLTAGE].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
                           "unresolved_points": int((b["tail"] > max_error).sum()) if "tail" in b else None,
                           "largest_tail": float(b["tail"].max(initial=0.0)) if "tail" in b else None,
@@ -46,8 +48,12 @@ def summarise_tube(run: dict) -> dict:
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
     electric = tomllib.loads(a["scene_toml"]).get("electric")
+    primary = run["branches"]["primary"]
+    charged = VOLTAGE in primary  # tube/voltage.py: continued in Φ̄ at a fixed P (run, or continue from a label)
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "voltage": None if electric is None else float(electric.get("voltage", 0.0)),
+            "parameter": "voltage" if charged else "pressure",
+            "fixed_pressure": float(primary["pressure"][0]) if charged else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
@@ -103,6 +109,8 @@ def _onset(onset: dict | None) -> dict | None:
 
 def _no_maxwell(summary: dict) -> str:
     """Why a tube run has no Maxwell pressure (tube/picture.maxwell)."""
+    if summary["parameter"] == "voltage":
+        return "none (a voltage continuation: no bulge branch is traced)"
     if summary["geometry"]["axial_stretch"] is not None:
         return "none (the ends are held apart)"
     if summary["field"]["coils"] and summary["field"]["M"] > 0:
@@ -131,7 +139,9 @@ def format_tube(summary: dict) -> str:
              f"shape          tube of length {g['length']:g}, {g['ends']} ends, end distance {held}",
              f"field          " + (f"{summary['field']['coils']} coil(s), M = {summary['field']['M']:g}"
                                    if summary["field"]["coils"] else "none"),
-             "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"),
+             "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"
+                                     if summary["parameter"] != "voltage" else
+                                     f"continued in Φ̄ at P = {summary['fixed_pressure']:g}"),
              f"control        {summary['control']}",
              f"degree         {summary['degree']}",
              "stability      m = 0 (pressure, volume and gas control); " + _assessed(summary),
@@ -141,7 +151,9 @@ def format_tube(summary: dict) -> str:
     label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)
     for name, b in summary["branches"].items():
         lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
-                      f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, stop {b['stop_code']} ({b['stop_message']})"
+                      f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}"
+                      + ("" if b["voltage"] is None else f", Φ̄ {b['voltage'][0]:.6g}..{b['voltage'][1]:.6g}")
+                      + f", stop {b['stop_code']} ({b['stop_message']})"
                       + ("" if b["stable_points"] is None else
                          f"; {b['stable_points']} stable under {summary['control']} control")
                       + (f"; {b['compressed_points']} points compressed" if b["compressed_points"] else "")
@@ -163,8 +175,10 @@ def format_tube(summary: dict) -> str:
             compressed = "  compressed" if s["smallest_stress"] < COMPRESSED else ""
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
             amount = f"  n = {s['amount']:.10g}" if "amount" in s else ""
+            note = f"  {s['note']}" if s["note"] else ""
+            charge = f"  Φ̄ = {s[VOLTAGE]:.10g}" if VOLTAGE in s else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
-                         f"V/V0 = {s['volume']:.8g}{amount}  {s['status']}{crest}{compressed}")
+                         f"V/V0 = {s['volume']:.8g}{charge}{amount}  {s['status']}{note}{crest}{compressed}")
             if "omega2" in s:
                 lines.append("        lowest Ω²  " + "  ".join(f"{name} {value:.4g}"
                                                          for name, value in s["omega2"].items()))

@@ -13,12 +13,14 @@ principal stress: negative where the membrane is compressed, tube/stability.py),
 the largest radius, the bulge's crest, from the tube's middle plane: IntervalDiscretisation.crest), ``tail`` and
 ``first_integral_spread`` (the state's Legendre tail and the spread of H = λ1Φ_1 − Φ along the tube: tube/accuracy.py;
 files before them have none), ``lowest_even``/
-``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), with stability.m_max ≥ 1 ``lowest_m<m>``
+``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), on a voltage continuation (tube/voltage.py:
+P fixed) ``voltage`` (Φ̄, also per located point), with stability.m_max ≥ 1 ``lowest_m<m>``
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
 not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
 block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
 azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0); its located points under
-special_points/ (``kind``, ``block``, ``status``, ``index``, ``pressure``, ``volume``, ``smallest_stress``,
+special_points/ (``kind``, ``block``, ``status``, ``note`` (a UZ point's event, "volume_ratio = 3"; files before
+it have none), ``index``, ``pressure``, ``volume``, ``smallest_stress``,
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
@@ -56,6 +58,8 @@ ACCURACY = ("tail", "first_integral_spread")  # per point: tube/accuracy.accurac
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 SPECIAL_TEXT = ("kind", "block", "status")
+VOLTAGE = "voltage"  # per point and located point of a voltage continuation (tube/voltage.py; others have none)
+NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
 HELD_M1 = "1 held"  # read_tube_run's key of the held tube's m = 1 block (beside the free blocks' m)
 
@@ -91,7 +95,9 @@ TUBE_VARIABLES = {
     "m": ("", "azimuthal number", "the cos mφ block whose eigenvalue vanishes"),
     "order": ("", "eigenvalue number", "which eigenvalue of the block vanishes (ascending, from 0)"),
     "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
-    "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point"),
+    "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point, UZ an event's value reached"),
+    VOLTAGE: ("1", "voltage Φ̄", "a voltage continuation's Φ̄ (tube/voltage.py: P fixed), per point and located point"),
+    NOTE: ("", "event", "a UZ point's event, quantity = value (tube/events.py); empty for the others"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
     "index": ("", "point index", "the located point lies between points index and index + 1"),
@@ -159,8 +165,10 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
                                ("unstable_volume", branch.unstable["volume"]), (GAS, branch.unstable["gas"]),
                                ("smallest_stress", branch.smallest_stress),
                                (CREST, crest_heights(branch.disc, branch.states)),
-                               *zip(ACCURACY, accuracy(eq, branch.states))):
+                               *zip(ACCURACY, accuracy(eq, branch.states, branch.voltage))):
             checksummed(group, column, values)
+        if branch.voltage is not None:
+            checksummed(group, VOLTAGE, branch.voltage)
         for block, values in branch.lowest.items():
             checksummed(group, f"lowest_{block.value}", values)
         modes = None if picture.modes is None else picture.modes[name]
@@ -178,11 +186,14 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         write_strings(special, "kind", [p.kind.value for p in s])
         write_strings(special, "block", ["" if p.block is None else p.block.value for p in s])
         write_strings(special, "status", [p.status.value for p in s])
+        write_strings(special, NOTE, [p.note for p in s])
         checksummed(special, "index", np.array([p.index for p in s], dtype=int))
         checksummed(special, "pressure", np.array([p.pressure for p in s], dtype=float))
         volume = [volume_ratio(eq, np.append(p.u, p.pressure)) for p in s]
         checksummed(special, "volume", np.array(volume, dtype=float))
         checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
+        if branch.voltage is not None:
+            checksummed(special, VOLTAGE, np.array([p.voltage for p in s], dtype=float))
         checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
         _dimensions(group, "point", {"unknown": branch.disc.size} | ({} if modes is None else {"eigenvalue": COUNT}))
@@ -249,7 +260,8 @@ def read_tube(f, path, where: str = "") -> dict:
             raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
         branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
         n = branch["unknowns"].shape[0]
-        optional = tuple(c for c in (CREST, GAS, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror)) if c in group)
+        optional = tuple(c for c in (CREST, GAS, VOLTAGE, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror))
+                         if c in group)
         for column in POINT_COLUMNS + optional:
             branch[column] = group[column][()]
             if branch[column].shape != (n,):
@@ -257,7 +269,8 @@ def read_tube(f, path, where: str = "") -> dict:
                                           f"({n},)")
         special = group["special_points"]
         columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
-        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + ((CREST,) if CREST in special else ())}
+        columns[NOTE] = list(special[NOTE].asstr()[()]) if NOTE in special else [""] * len(columns["kind"])
+        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + tuple(c for c in (CREST, VOLTAGE) if c in special)}
         branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                     for i in range(len(columns["kind"]))]
         branch["azimuthal"] = _read_modes(path, group, n, f"{where}/branches/{name}")
@@ -336,7 +349,8 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     (``continue``)."""
     b = run["branches"][name]
     special = tuple(IntervalSpecial(Kind(s["kind"]), u, float(s["pressure"]), int(s["index"]), RootStatus(s["status"]),
-                                    Mirror(s["block"]) if s["block"] else None, float(s["smallest_stress"]))
+                                    Mirror(s["block"]) if s["block"] else None, float(s["smallest_stress"]),
+                                    s[NOTE], float(s.get(VOLTAGE, math.nan)))
                     for s, u in zip(b["special_points"], b["special_unknowns"]))
     code = b["attrs"]["stop_code"]
     stop = Stop(next(enum(code) for enum in (IntervalStop, StopCode, TraceStop) if code in enum._value2member_map_),
@@ -344,7 +358,7 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     lowest = {block: b[f"lowest_{block.value}"] for block in Mirror if f"lowest_{block.value}" in b}
     unstable = {control: b[f"unstable_{control.value}"] for control in Control if f"unstable_{control.value}" in b}
     return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
-                          special, stop, b["smallest_stress"], params)
+                          special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE))
 
 
 def discretisation(attrs: dict) -> IntervalDiscretisation:

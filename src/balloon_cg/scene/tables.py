@@ -17,7 +17,7 @@ from pathlib import Path
 
 from .validation import SceneError, did_you_mean, number, show, show_key, table
 from .energies import StrainEnergy
-from .events import Event, events_from_list
+from .events import Event, check_on_shape, events_from_list
 from .loading import Control, Loading, loading_from_table, moved_stop_volume
 from .materials import ALPHA1, MAX_EXPONENT, Material, alpha1_terms, material_from_table, modified_name
 
@@ -656,7 +656,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric)
-    if geometry.shape in (Shape.CAPSULE, Shape.TUBE) and continuation.parameter == ContinuationParameter.VOLTAGE:
+    if geometry.shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
         raise SceneError(f'continuation.parameter = "voltage": a {geometry.shape.value} is continued in the pressure '
                          "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
@@ -665,10 +665,11 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          "m ≥ 1 mass matrix and mode shapes); allowed: 0")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
-    if geometry.shape == Shape.TUBE and data.get("events"):
-        raise SceneError(f"events: {len(data['events'])} [[events]] on a tube, whose branches do not locate user "
-                         "points yet; allowed: none")
+    events = events_from_list(data.get("events", []))
+    check_on_shape(events, geometry.shape, geometry.ends, geometry.axial_stretch is not None)
     stability = _stability(data.get("stability", {}))
+    if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
+        _tube_voltage_reads(field, stability, dynamics, events)
     return Scene(
         name=name,
         material=material,
@@ -681,10 +682,24 @@ def _build(data: dict, name: str, text: str) -> Scene:
         text=text,
         loading=loading,
         surface=_surface(data.get("surface", {})),
-        events=events_from_list(data.get("events", [])),
+        events=events,
         geometry=geometry,
         dynamics=dynamics,
     )
+
+
+def _tube_voltage_reads(field, stability, dynamics, events) -> None:
+    """SceneError for what a tube's voltage continuation (tube/voltage.py) does not read yet: coils, the m ≥ 1 blocks,
+    natural frequencies, user events (one line naming the key and what is allowed)."""
+    what = "a tube's voltage continuation (continuation.parameter = \"voltage\") reads"
+    if field.M > 0 and field.coils:
+        raise SceneError(f"field.M = {field.M:g}: {what} no coil field yet; allowed: 0")
+    if stability.m_max != 0:
+        raise SceneError(f"stability.m_max = {stability.m_max}: {what} the m = 0 stability only for now; allowed: 0")
+    if dynamics.frequencies:
+        raise SceneError(f"dynamics.frequencies = true: {what} no natural frequencies yet; allowed: false")
+    if events:
+        raise SceneError(f"events: {len(events)} [[events]]: {what} no user points yet; allowed: none")
 
 
 def _getter(data: dict, prefix: str, cls):

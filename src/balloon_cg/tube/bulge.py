@@ -23,12 +23,13 @@ is given (IntervalStop.UNRESOLVED: that point is not stored, nor a fold located 
 retraces at a higher degree), after ``continuation.max_points``, or at the next point after SIGINT/SIGTERM
 (StopCode.INTERRUPTED). Every point carries its tail and first-integral spread (tube/accuracy.py). The branch point
 X* is the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is
-zero, its sign rounding).
+zero, its sign rounding). The scene's [[events]]: UZ points (tube/events.py).
 """
 import numpy as np
 
 from .accuracy import accuracy
 from .control import VolumeStop, control_monitors, gradient
+from .events import with_events
 from .primary import TubeSystem, held, in_field, stressed, volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, unstable_counts
@@ -126,10 +127,10 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     points = [system.full(X)] + [system.full(p.X) for p in path.points] + ([] if end is None else [end])
     states = np.array([Y[:-1] for Y in points])
     tail, spread = accuracy(eq, states)
-    return IntervalBranch(disc, states, np.array([Y[-1] for Y in points]),
-                          np.array([volume_ratio(eq, Y) for Y in points]), {}, unstable_counts(eq, points, params),
-                          stressed(eq, special), stopped, np.array([smallest_stress(eq, Y[:-1]) for Y in points]),
-                          primary.params, tail, spread)
+    return with_events(scene, system, IntervalBranch(
+        disc, states, np.array([Y[-1] for Y in points]), np.array([volume_ratio(eq, Y) for Y in points]), {},
+        unstable_counts(eq, points, params), stressed(eq, special), stopped,
+        np.array([smallest_stress(eq, Y[:-1]) for Y in points]), primary.params, tail, spread), settings)
 
 
 class Side:

@@ -7,7 +7,8 @@ Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; clos
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
 is finished is kept, and the picture names the stage (``Stage``). A whole picture's branches are assessed for m = 1..
-``stability.m_max`` (tube/azimuthal.py: ``modes``)."""
+``stability.m_max`` (tube/azimuthal.py: ``modes``). On a voltage continuation (``continuation.parameter =
+"voltage"``) the picture is the tube continued in Φ̄ at its fixed P alone (tube/voltage.py: ``charged_picture``)."""
 import enum
 from dataclasses import dataclass, replace
 
@@ -19,6 +20,7 @@ from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
 from .results import IntervalBranch
+from .voltage import voltage_branch
 from ..analysis.results import StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
@@ -26,7 +28,7 @@ from ..model.membrane import scene_energy
 from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
-from ..scene.tables import Ends
+from ..scene.tables import ContinuationParameter, Ends
 
 
 class Stage(enum.StrEnum):
@@ -57,7 +59,10 @@ class TubePicture:
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
-    """The primary branch and, unless ``primary_only``, the bulge branch of a tube scene (module docstring)."""
+    """The primary branch and, unless ``primary_only``, the bulge branch of a tube scene (module docstring); on a
+    voltage continuation the tube continued in Φ̄ at its fixed P alone (tube/voltage.py: ``charged_picture``)."""
+    if scene.continuation.parameter == ContinuationParameter.VOLTAGE:
+        return charged_picture(scene)
     pm = maxwell(scene)  # first: it does not poll for a signal (~0.16 s for SPOM1), the traces after it do
     primary = primary_branch(scene)
     branches: dict[str, IntervalBranch] = {"primary": primary}
@@ -67,6 +72,14 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
         return bulge_picture(scene, primary, onset[0], pm)
     return with_modes(scene, TubePicture(branches, pm))
+
+
+def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -> TubePicture:
+    """The tube continued in Φ̄ at fixed P (tube/voltage.voltage_branch from ``start``, ``direction``) as the picture's
+    primary branch: no bulge branch is switched, no Maxwell pressure, the m ≥ 1 blocks not read."""
+    branch = voltage_branch(scene, start, direction)
+    return TubePicture({"primary": branch}, None,
+                       interrupted=Stage.PRIMARY if branch.stop.code == StopCode.INTERRUPTED else None)
 
 
 def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:

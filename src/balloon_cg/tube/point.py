@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .events import hoop_row
 from .primary import TubeSystem, held, primary_branch, volume_ratio
 from .results import IntervalStop
 from ..analysis.branches.problem import ParameterSystem
@@ -43,10 +44,7 @@ class TubePoint:
 
 def middle_hoop(disc: IntervalDiscretisation) -> tuple:
     """(ℓ, c): λ2(L/2) = ℓ·u + c (c = 1 on plugged ends, else 0)."""
-    zero = disc.profile(np.zeros(disc.size), np.array([disc.length / 2]))[0][0]
-    rows = np.eye(disc.size)
-    ell = np.array([disc.profile(row, np.array([disc.length / 2]))[0][0] - zero for row in rows])
-    return ell, float(zero)
+    return hoop_row(disc, disc.length / 2)
 
 
 @limited_blas

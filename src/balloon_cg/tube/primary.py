@@ -27,6 +27,7 @@ import numpy as np
 from scipy import linalg
 
 from .control import VolumeStop, control_monitors
+from .events import with_events
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
 from ..analysis.stability.crossings import count_changes
@@ -148,9 +149,10 @@ def primary_branch(scene, degree: int | None = None) -> IntervalBranch:
                    for block, values in spectra.items()}
     volume = np.array([volume_ratio(eq, Y) for Y in full])
     lowest = {block: spectra[block][:, 0] for block in Mirror}
-    return IntervalBranch(disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
-                          unstable_counts(eq, full, params), stressed(eq, special), stopped,
-                          np.array([smallest_stress(eq, Y[:-1]) for Y in full]), params)
+    return with_events(scene, system, IntervalBranch(
+        disc, np.array([Y[:-1] for Y in full]), np.array([Y[-1] for Y in full]), volume, lowest,
+        unstable_counts(eq, full, params), stressed(eq, special), stopped,
+        np.array([smallest_stress(eq, Y[:-1]) for Y in full]), params), settings)
 
 
 def _in(system: TubeSystem, special: IntervalSpecial) -> np.ndarray:

@@ -30,10 +30,11 @@ def signalled() -> Stop | None:
 
 @dataclass(frozen=True)
 class IntervalSpecial:
-    """A located point: LP (fold in P), LV (fold in V) or BP (``block`` the mirror block whose lowest eigenvalue
-    vanishes), its state ``u`` and pressure, between points ``index`` and ``index + 1`` (the last index: in the step
-    that passed the stop, whose end is not stored); ``status`` of its location; ``smallest_stress`` of its state
-    (negative: the membrane is compressed there and the point is not to be trusted: tube/stability.py)."""
+    """A located point: LP (fold in P), LV (fold in V), BP (``block`` the mirror block whose lowest eigenvalue
+    vanishes) or UZ (where an event's quantity reaches its value: ``note``, tube/events.py), its state ``u`` and
+    pressure, between points ``index`` and ``index + 1`` (the last index: in the step that passed the stop, whose end
+    is not stored); ``status`` of its location; ``smallest_stress`` of its state (negative: the membrane is compressed
+    there and the point is not to be trusted: tube/stability.py)."""
 
     kind: Kind
     u: np.ndarray
@@ -42,6 +43,8 @@ class IntervalSpecial:
     status: RootStatus
     block: Mirror | None = None
     smallest_stress: float = np.nan  # tube/stability.smallest_stress of the state: compressed below COMPRESSED
+    note: str = ""  # a UZ point's event: "volume_ratio = 3" (tube/events.py)
+    voltage: float = np.nan  # on a voltage continuation (tube/voltage.py) the point's Φ̄; NaN on one in P
 
 
 @dataclass(frozen=True)
@@ -53,7 +56,7 @@ class IntervalBranch:
     stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters (the field's M
     and χ; P is each point's); ``tail`` and ``first_integral``: per point, the spectral error estimate and the
     spread of H = λ1Φ_1 − Φ along the tube (tube/accuracy.py; None where not computed: the primary branch, a
-    branch read from a file)."""
+    branch read from a file); ``voltage``: on a voltage continuation each point's Φ̄ (P fixed, tube/voltage.py)."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
@@ -67,6 +70,7 @@ class IntervalBranch:
     params: Parameters
     tail: np.ndarray | None = None  # per point: galerkin/interval.IntervalDiscretisation.tail
     first_integral: np.ndarray | None = None  # per point: tube/accuracy.first_integral_spread
+    voltage: np.ndarray | None = None  # per point Φ̄ on a voltage continuation (tube/voltage.py); None: in P
 
     def branch_points(self, block: Mirror | None = None) -> list:
         return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]

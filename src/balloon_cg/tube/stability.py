@@ -45,14 +45,14 @@ def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray, params: Paramete
     return np.linalg.eigvalsh(H[np.ix_(index, index)])
 
 
-def smallest_stress(eq: Equilibrium, u: np.ndarray) -> float:
+def smallest_stress(eq: Equilibrium, u: np.ndarray, voltage: float | None = None) -> float:
     """The smallest principal stress over the quadrature nodes of the state u: the elastic λ1Φ_1, λ2Φ_2 plus, under a
-    voltage, the dielectric −2Φ̄²λ1²λ2² (model/stresses.py); below COMPRESSED the membrane is compressed somewhere
-    (module docstring)."""
+    voltage (``voltage``; None: the scene's), the dielectric −2Φ̄²λ1²λ2² (model/stresses.py); below COMPRESSED the
+    membrane is compressed somewhere (module docstring)."""
     disc, scene = eq.disc, eq.scene
     lam2, v, _, w = disc.node_state(u)
     lam1 = meridian.meridional_stretch(scene.geometry, disc.cos_theta, disc.sin_theta, lam2, v, w)
-    dielectric = dielectric_stress(scene.voltage, lam1, lam2)
+    dielectric = dielectric_stress(scene.voltage if voltage is None else voltage, lam1, lam2)
     return float(min(np.min(stress + dielectric) for stress in elastic_stresses(scene.material, lam1, lam2)))
 
 
