@@ -203,6 +203,26 @@ def test_run_on_a_charged_tube_switches_the_bulge_with_the_effective_maxwell_pre
     assert json.loads(capsys.readouterr().out)["voltage"] == VOLTAGE
 
 
+def test_a_charged_path_that_ends_has_no_maxwell_state_and_its_run_completes(tmp_path):
+    """The charged neo-Hookean closed tube (Φ̄ = 0.1) loses its closed-end balance at large hoop stretch: N = ∂e/∂λz
+    of Φ_eff written here (SymPy) has one sign for every λz at λθ = 14.5, so the path ends before P rises again
+    (it falls through 0 near λθ = 10). The scans treat the end as the path's end (closed_end_axial NaN there, its
+    λz below it the root of N written here), there is no Maxwell state, and `run` completes (it exited 3 on the
+    scans' ValueError)."""
+    material = Charged(tube_scene("neo-Hookean").material, VOLTAGE)
+    N = sp.lambdify((theta, z), sp.diff(effective_energy("neo-Hookean", VOLTAGE), z)
+                    - theta * sp.diff(effective_energy("neo-Hookean", VOLTAGE), theta) / (2 * z))
+    axial = tube.closed_end_axial(material, np.array([3.0, 14.5]))
+    assert abs(N(3.0, axial[0])) < 1e-10 and np.isnan(axial[1])
+    assert np.all(N(14.5, np.geomspace(1e-3, 1e8, 2000)) < 0)
+    assert tube.maxwell_pressure(material) is None
+    assert tube.pressure_maximum(material) is not None
+    scene, path = tmp_path / "nh.toml", tmp_path / "nh.h5"
+    scene.write_text(charged_scene("neo-Hookean", stop=2.0).to_toml())
+    assert main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+    assert np.isnan(read_tube_run(path)["attrs"]["maxwell_pressure"])  # stored as NaN: none
+
+
 def test_critical_follows_the_onset_in_the_voltage(tmp_path, capsys):
     """`critical --parameter voltage` on a charged tube (SPOM1, L = 10, Φ̄ = 0.1, degree 20): the onset curve in Φ̄
     (tube/onset.py, ∂R/∂Φ̄ from the tube's generated voltage_gradient) is, at five points along it, the dispersion

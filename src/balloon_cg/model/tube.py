@@ -75,7 +75,8 @@ def closed_end_state(material, hoop: float) -> UniformTube:
 def closed_end_axial(material, hoops) -> np.ndarray:
     """λz of the closed-end path N = 0 at each of the hoop stretches ``hoops`` at once (the scans' grid): the root
     ``closed_end_state`` finds one at a time, here by bisection from the same brackets (each [1/2, 2] doubled outwards
-    until N changes sign) to the same relative width; ValueError where no axial stretch balances one."""
+    until N changes sign) to the same relative width; NaN where no axial stretch balances one (the path has ended
+    there: a charged membrane past its pull-in, model/membrane.Charged)."""
     hoops = np.asarray(hoops, dtype=float)
     low, high = np.full(hoops.shape, 0.5), np.full(hoops.shape, 2.0)
     for _ in range(_BRACKET_GROWTH):
@@ -83,13 +84,11 @@ def closed_end_axial(material, hoops) -> np.ndarray:
         if not open_.any():
             break
         low[open_], high[open_] = low[open_] / 2, high[open_] * 2
-    else:
-        raise ValueError(f"no axial stretch balances the closed tube at the hoop stretch {hoops[open_][0]:g}")
-    while np.any(high - low > TOLERANCE * high):
+    while np.any((high - low > TOLERANCE * high) & ~open_):
         mid = (low + high) / 2
         above = axial_force(material, hoops, mid) > 0
         high, low = np.where(above, mid, high), np.where(above, low, mid)
-    return (low + high) / 2
+    return np.where(open_, np.nan, (low + high) / 2)
 
 
 def pressure_slope(material, hoop: float) -> float:
@@ -107,6 +106,12 @@ def _path_slope(material, theta, z):
     N_theta = d["phi_12"] - (d["phi_2"] + theta * d["phi_22"]) / (2 * z)
     N_z = d["phi_11"] - theta * (d["phi_12"] - d["phi_2"] / z) / (2 * z)
     return P_theta - P_z * N_theta / N_z
+
+
+def _on_path(material, hoops: np.ndarray) -> np.ndarray:
+    """The grid ``hoops`` (ascending) up to where the closed-end path ends (``closed_end_axial``: NaN beyond)."""
+    ended = np.flatnonzero(np.isnan(closed_end_axial(material, hoops)))
+    return hoops if not ended.size else hoops[:ended[0]]
 
 
 def _grid_slopes(material, hoops) -> np.ndarray:
@@ -153,6 +158,7 @@ def bulge_onset(material, length: float, mode: int = 1, largest_hoop: float = 10
         return bulge_condition(material, closed_end_state(material, hoop), wavenumber)
 
     hoops = np.geomspace(1.0 + 1e-3, largest_hoop, _SCAN_POINTS)
+    hoops = _on_path(material, hoops)
     values = [condition(h) for h in hoops]
     for k in range(len(hoops) - 1):
         if values[k] > 0 >= values[k + 1]:
@@ -187,14 +193,16 @@ def closed_end_energy(material, state: UniformTube, pressure: float) -> float:
 def maxwell_pressure(material, largest_hoop: float = 100.0) -> tuple | None:
     """(P_M, a, b): the pressure at which the uniform states a (below the pressure maximum) and b (beyond the
     pressure minimum) of the closed-end path have the same e (module docstring), by brentq in P between the
-    minimum and the maximum; None where the path has no maximum and minimum. b is bracketed by the minimum and the
+    minimum and the maximum; None where the path has no maximum and minimum, or ends (``closed_end_axial``) before
+    the areas can be equal. b is bracketed by the minimum and the
     first point of a geometric grid beyond it where the path's P exceeds P (the grid's path computed once)."""
     peak = pressure_maximum(material)
     low = None if peak is None else pressure_minimum(material, largest_hoop, peak)
     if low is None:
         return None
-    grid = np.geomspace(low.hoop, largest_hoop, _SCAN_POINTS)[1:]
+    grid = _on_path(material, np.geomspace(low.hoop, largest_hoop, _SCAN_POINTS)[1:])
     rising = hoop_pressure(material, grid, closed_end_axial(material, grid))
+    top = min(peak.pressure, rising.max(initial=low.pressure))  # b exists for P up to it (the path may end first)
 
     def states(P):
         def at(h):
@@ -211,6 +219,11 @@ def maxwell_pressure(material, largest_hoop: float = 100.0) -> tuple | None:
         a, b = states(P)
         return closed_end_energy(material, a, P) - closed_end_energy(material, b, P)
 
-    span = peak.pressure - low.pressure
-    P = brentq(difference, low.pressure + 1e-9 * span, peak.pressure - 1e-9 * span, xtol=TOLERANCE, rtol=TOLERANCE)
+    span = top - low.pressure
+    if span <= 0:
+        return None
+    bracket = (low.pressure + 1e-9 * span, top - 1e-9 * span)
+    if difference(bracket[0]) * difference(bracket[1]) > 0:  # the path ends before the equal areas
+        return None
+    P = brentq(difference, *bracket, xtol=TOLERANCE, rtol=TOLERANCE)
     return (P, *states(P))
