@@ -35,11 +35,12 @@ LAMBDA2, ETA = 0, 1  # the fields of a PiecewiseBasis's functions
 class BandedVariation:
     """The m = 0 blocks of the second variation at equilibria of ``equilibrium`` on a PiecewiseBasis of
     ``elements`` elements of ``order`` p (``quadrature`` Gauss nodes each; default p + 8) on the perturbation map
-    of the scene's stability.basis (module docstring)."""
+    of the scene's stability.basis (module docstring); ``symmetric`` False reads an equator-symmetric state's
+    blocks on the whole interval (the blocks of a general state)."""
 
-    def __init__(self, equilibrium, elements: int, order: int, quadrature: int = 0):
+    def __init__(self, equilibrium, elements: int, order: int, quadrature: int = 0, symmetric: bool | None = None):
         self.eq = equilibrium
-        self.symmetric = equilibrium.disc.symmetric
+        self.symmetric = equilibrium.disc.symmetric if symmetric is None else symmetric and equilibrium.disc.symmetric
         self.basis = b = PiecewiseBasis(elements, order, quadrature or order + 8, perturbation_map(equilibrium),
                                         self.symmetric)
         x = b.x.ravel()
