@@ -3,10 +3,12 @@
 
 - the eigensolver against a dense generalized eigensolve of the same pencil, with constraints and a gas term;
 - the basis: the constant function, ∫1 dx = 2 on the whole interval and on the half one;
+- the scene key stability.banded_from, and the assessment of a whole branch with it (SPOM1 M = 0: flags unchanged);
 - near a wire (the two-coil primary branch's last point, gap 0.1, stored at mapped degree 90): every m = 0 block's
   three lowest eigenvalues, equator-symmetric blocks and the general ones, against the Legendre blocks (an
   independent discretisation) to within the two discretisations' own error estimates.
 """
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -15,13 +17,14 @@ from scipy import linalg
 
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.branches.problem import equilibrium_of
-from balloon_cg.analysis.stability.axisymmetric import SecondVariation, point_degrees
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, assess_branch, point_degrees
 from balloon_cg.analysis.stability.banded import BandedVariation
 from balloon_cg.galerkin.piecewise import PiecewiseBasis
 from balloon_cg.numerics.banded import BandedShiftInvert
-from balloon_cg.scene import load_scene
+from balloon_cg.scene import SceneError, load_scene, parse_scene
 
-TWO_COILS = Path(__file__).resolve().parent.parent / "scenes" / "spom1_two_coils_M0.002.toml"
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+TWO_COILS, SPOM1 = SCENES / "spom1_two_coils_M0.002.toml", SCENES / "spom1.toml"
 
 
 def _band(A: np.ndarray, bandwidth: int) -> np.ndarray:
@@ -89,11 +92,42 @@ def test_banded_blocks_agree_with_the_legendre_blocks_near_a_wire(near_wire, sym
     legendre = SecondVariation(eq, degree).assess(u, params, symmetric, 0).blocks
     coarse = SecondVariation(eq, int(degree / 1.5)).assess(u, params, symmetric, 0).blocks
     elements = 8 if symmetric else 16  # the half interval or the whole one: the same elements per unit of s
-    banded = BandedVariation(eq, elements, 8, symmetric=symmetric).assess(u, params).blocks
-    lower = BandedVariation(eq, elements, 6, symmetric=symmetric).assess(u, params).blocks
+    banded = BandedVariation(eq, elements, 8, symmetric=symmetric).lowest_blocks(u, params)
+    lower = BandedVariation(eq, elements, 6, symmetric=symmetric).lowest_blocks(u, params)
     assert banded.keys() == legendre.keys()
     for name, values in legendre.items():
         tolerance = (np.abs(values - coarse[name]) + np.abs(banded[name] - lower[name])
                      + 1e-10 * np.maximum(1.0, np.abs(values)))
         assert np.all(np.abs(banded[name] - values) <= tolerance), (name, banded[name] - values, tolerance)
     assert min(v[0] for v in banded.values()) < 0.0  # a point with negative blocks: the signs are read too
+
+
+def test_banded_from_key_default_and_refusal():
+    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.banded_from == 0
+    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 225\n').stability.banded_from == 225
+    with pytest.raises(SceneError) as error:
+        parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 10\n', name="s")
+    message = str(error.value)
+    assert "\n" not in message and "stability.banded_from = 10" in message and "[20, 400]" in message
+
+
+def test_assessment_with_banded_from_reads_the_banded_blocks_and_keeps_the_flags():
+    """The SPOM1 M = 0 primary branch assessed with stability.banded_from = 20 (every point's m = 0 blocks on
+    elements, unmapped: in x) against the default Legendre blocks: the same flags at every point, every eigenvalue
+    within the Legendre blocks' estimate |μ(20) − μ(13)| plus 1e-9·max(1, |μ|); the m = 1 blocks are the
+    Legendre ones, unchanged."""
+    scene = load_scene(SPOM1)
+    branch = trace_primary(scene, down=False)
+    banded_scene = scene.with_overrides({"stability.banded_from": 20}, name=scene.name)
+    banded_branch = replace(branch, scene=banded_scene)
+    legendre, _ = assess_branch(branch, 20, m_max=1)
+    coarse, _ = assess_branch(branch, 13, m_max=1)
+    banded, _ = assess_branch(banded_branch, 20, m_max=1)
+    for a, c, b in zip(legendre, coarse, banded):
+        assert b.flags() == a.flags()
+        assert b.blocks.keys() == a.blocks.keys()
+        for name, values in a.blocks.items():
+            if name.startswith("m"):
+                np.testing.assert_array_equal(b.blocks[name], values)
+            tolerance = np.abs(values - c.blocks[name]) + 1e-9 * np.maximum(1.0, np.abs(values))
+            assert np.all(np.abs(b.blocks[name] - values) <= tolerance), (name, b.blocks[name] - values, tolerance)

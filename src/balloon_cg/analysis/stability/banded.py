@@ -24,12 +24,15 @@ from ...galerkin.piecewise import PiecewiseBasis
 from ...generated import HESSIAN_PAIRS
 from ...model.meridian import mass_density
 from ...numerics.banded import BandedShiftInvert
-from .axisymmetric import (EVERY_FLAG, FLAGS, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_GAS, HELD_VOLUME,
-                           LOWEST, Assessment)
 from .azimuthal import perturbation_map
+from .flags import EVERY_FLAG, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_GAS, HELD_VOLUME, LOWEST
 
 _ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
 LAMBDA2, ETA = 0, 1  # the fields of a PiecewiseBasis's functions
+# ``banded_variation``'s elements: order 12, 1.1 functions per field per Legendre degree (benchmarks/
+# banded_stability.py: at the paper coil's pear_free_2 points of degree 320 on the map, 30 elements of order 12
+# agree with the Legendre blocks to within their own error estimates, 20 of order 12 or 40 of order 8 not everywhere)
+ORDER, ELEMENT_FUNCTIONS = 12, 1.1
 
 
 class BandedVariation:
@@ -107,40 +110,43 @@ class BandedVariation:
                      ("all_gas_free", (), False, False, True, (FREE_GAS,))]
         return plan
 
-    def lowest_blocks(self, u, params: Parameters, guesses: dict | None = None) -> dict:
-        """{name: the LOWEST eigenvalues} of every m = 0 block at the state u: per index set one banded factor
-        below its pressure block's spectrum (``BandedShiftInvert.below`` from ``guesses[name]`` of the plain
-        block, e.g. the previous point's lowest; else the smallest diagonal ratio H_ii/G_ii, an upper bound),
-        every block of the set read through it."""
+    def lowest(self, u, params: Parameters):
+        """(name, the LOWEST eigenvalues, the flags it enters) per m = 0 block at the state u (the order and flags of
+        ``SecondVariation._plan``): per index set one banded factor below its pressure block's spectrum
+        (``BandedShiftInvert.below`` from the smallest diagonal ratio H_ii/G_ii, an upper bound of its lowest
+        eigenvalue), every block of the set read through it."""
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         hessian, volume = self.local(u, params)
         weight = params.P / self.eq.volume(u)
-        out, shifts = {}, {}
-        for name, dropped, held, constrained, gas, _ in self._plan(field_on):
+        shifts = {}
+        for name, dropped, held, constrained, gas, flags in self._plan(field_on):
             layout = self._layout(dropped)
             if dropped not in shifts:
                 H, G = layout.band(hessian), layout.band(self._gram_local)
-                guess = (guesses or {}).get(name)
-                if guess is None:
-                    guess = float(np.min(H[0] / G[0]))
+                guess = float(np.min(H[0] / G[0]))
                 shifts[dropped] = BandedShiftInvert.below(H, G, guess, scale=max(1.0, abs(guess)))
                 if shifts[dropped] is None:
                     raise np.linalg.LinAlgError(f"no shift below the spectrum of block {name} from {guess:.4g}")
             g = layout.vector(volume)
             rows = ([layout.vector(self._hold_local)] if held else []) + ([g] if constrained else [])
-            out[name] = shifts[dropped].lowest(LOWEST, np.array(rows) if rows else None, (g, weight) if gas else None)
-        return out
+            yield name, shifts[dropped].lowest(LOWEST, np.array(rows) if rows else None,
+                                               (g, weight) if gas else None), flags
 
-    def assess(self, u, params: Parameters, guesses: dict | None = None) -> Assessment:
-        """The m = 0 blocks' lowest eigenvalues and the flags they decide (``SecondVariation.assess`` with
-        m_max = 0); ``degree`` holds the functions per field."""
-        field_on = self.eq.coils.shape[0] > 0 and params.M > 0
-        blocks = self.lowest_blocks(u, params, guesses)
-        lowest = [np.inf] * len(FLAGS)
-        for name, *_, flags in self._plan(field_on):
-            for flag in flags:
-                lowest[flag] = min(lowest[flag], blocks[name][0])
-        return Assessment(blocks, *(value > 0 for value in lowest), self.basis.functions)
+    def lowest_blocks(self, u, params: Parameters) -> dict:
+        """{name: the LOWEST eigenvalues} of every m = 0 block (``lowest``)."""
+        return {name: values for name, values, _ in self.lowest(u, params)}
+
+
+def banded_variation(equilibrium, degree: int, symmetric: bool) -> "BandedVariation | None":
+    """The banded sibling of the Legendre blocks of perturbation degree N at ``equilibrium``, or None below the
+    scene's stability.banded_from (0: never): elements of order ORDER, as many as give about ELEMENT_FUNCTIONS·N
+    functions per field on the whole interval (half as many on the half interval of an equator-symmetric state)."""
+    start = equilibrium.scene.stability.banded_from
+    if not start or degree < start:
+        return None
+    half = symmetric and equilibrium.disc.symmetric
+    elements = max(1, int(np.ceil(ELEMENT_FUNCTIONS * degree / ORDER / (2 if half else 1))))
+    return BandedVariation(equilibrium, elements, ORDER, symmetric=half)
 
 
 def _local_ops(basis: PiecewiseBasis, sin_theta: np.ndarray) -> np.ndarray:
