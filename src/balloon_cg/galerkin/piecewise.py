@@ -63,23 +63,24 @@ class PiecewiseBasis:
         """Functions per field: E·p + 1."""
         return self.elements * self.order + 1
 
-    def dofs(self, dropped: tuple = ()) -> np.ndarray:
-        """The global index of each element's 2(p + 1) local functions (local 2r + field: r as
-        ``shape_functions``, field 0 δλ2, 1 δη), shape (E, 2(p + 1)); −1 for the functions of ``dropped`` (field
-        numbers whose vertex at s = 0 is removed: on the half interval, the fields odd in x), the rest numbered
-        consecutively."""
-        return _dofs(self, tuple(sorted(dropped)))
+    def dofs(self, dropped: tuple = (), fields: int = 2) -> np.ndarray:
+        """The global index of each element's F(p + 1) local functions of F = ``fields`` interleaved fields
+        (local F·r + field: r as ``shape_functions``; m = 0: field 0 δλ2, 1 δη), shape (E, F(p + 1)); −1 for the
+        functions of ``dropped`` (field numbers whose vertex at s = 0 is removed: on the half interval, the fields
+        odd in x), the rest numbered consecutively."""
+        return _dofs(self, tuple(sorted(dropped)), fields)
 
 
-def _dofs(basis: PiecewiseBasis, dropped: tuple) -> np.ndarray:
+def _dofs(basis: PiecewiseBasis, dropped: tuple, fields: int) -> np.ndarray:
     p = basis.order
     per_field = np.arange(basis.elements)[:, None] * p + np.arange(p + 1)[None, :]  # (E, p + 1)
-    index = np.empty((basis.elements, 2 * (p + 1)), dtype=np.int64)
-    index[:, 0::2], index[:, 1::2] = 2 * per_field, 2 * per_field + 1
+    index = np.empty((basis.elements, fields * (p + 1)), dtype=np.int64)
+    for field in range(fields):
+        index[:, field::fields] = fields * per_field + field
     if dropped and not basis.half:
         raise ValueError("PiecewiseBasis.dofs: only the half interval has a vertex at s = 0 to drop")
-    removed = np.zeros(2 * basis.functions, dtype=bool)
-    removed[list(dropped)] = True  # field f's vertex at s = 0 is global 2·0 + f
+    removed = np.zeros(fields * basis.functions, dtype=bool)
+    removed[list(dropped)] = True  # field f's vertex at s = 0 is global F·0 + f
     numbers = np.cumsum(~removed) - 1
     out = numbers[index]
     out[removed[index]] = -1
@@ -89,7 +90,7 @@ def _dofs(basis: PiecewiseBasis, dropped: tuple) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def _tables(basis: PiecewiseBasis) -> dict:
-    """Nodes x (E, n_q), weights (dx, doubled on the half interval), φ and dφ/dx of the local functions
+    """Nodes s and x (E, n_q), weights (dx, doubled on the half interval), φ and dφ/dx of the local functions
     (E, n_q, p + 1), read-only."""
     t, w = gauss_rule(basis.quadrature)
     low = 0.0 if basis.half else -1.0
@@ -104,7 +105,7 @@ def _tables(basis: PiecewiseBasis) -> dict:
     weights = (2.0 if basis.half else 1.0) * 0.5 * width * w[None, :] / slope
     phi, dphi = shape_functions(t, basis.order)
     derivative = dphi[None, :, :] * (2.0 * slope / width)[:, :, None]  # d/dx = h'(x) (2/Δs) d/dt
-    tables = {"x": x, "weights": weights, "phi": np.broadcast_to(phi, (basis.elements, *phi.shape)).copy(),
+    tables = {"s": s, "x": x, "weights": weights, "phi": np.broadcast_to(phi, (basis.elements, *phi.shape)).copy(),
               "dphi_dx": derivative, "bounds": bounds}
     for array in tables.values():
         array.flags.writeable = False

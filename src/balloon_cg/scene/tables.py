@@ -227,8 +227,8 @@ class Stability:
     perturbation ``basis``: "legendre" (polynomials of x = cos θ) or "mapped" (of the mapped coordinate s(x) of a
     branch's wire map; the same as "legendre" on a branch without one), and the ``norm`` the m = 0 eigenvalues are
     relative to: "unknowns" ∫(δλ2² + δη²) d(cos θ) or "displacement" ∫(sin²θ δλ2² + δη²) d(cos θ) = |δx|², the
-    m ≥ 1 blocks' norm (flags and branch points do not depend on it). ``banded_from``: the m = 0 blocks of a point
-    assessed at perturbation degree N ≥ it are read on the banded sibling basis (C⁰ elements on the same map,
+    m ≥ 1 blocks' norm (flags and branch points do not depend on it). ``banded_from``: the blocks (m = 0 and m ≥ 1) of a
+    point assessed at perturbation degree N ≥ it are read on the banded sibling basis (C⁰ elements on the same map,
     analysis/stability/banded.py); 0 (the default): never."""
 
     degree: int = 20
