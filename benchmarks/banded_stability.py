@@ -30,7 +30,7 @@ from balloon_cg.numerics.threads import blas_threads
 from balloon_cg.scene import load_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
-LADDER = ((10, 8), (20, 8), (40, 8), (10, 12), (20, 12), (30, 12))
+LADDER = ((10, 8), (20, 8), (40, 8), (10, 12), (20, 12), (30, 12), (40, 12))
 REPEATS = 3
 
 

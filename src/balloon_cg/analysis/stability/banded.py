@@ -29,10 +29,14 @@ from .flags import EVERY_FLAG, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HE
 
 _ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
 LAMBDA2, ETA = 0, 1  # the fields of a PiecewiseBasis's functions
-# ``banded_variation``'s elements: order 12, 1.1 functions per field per Legendre degree (benchmarks/
-# banded_stability.py: at the paper coil's pear_free_2 points of degree 320 on the map, 30 elements of order 12
-# agree with the Legendre blocks to within their own error estimates, 20 of order 12 or 40 of order 8 not everywhere)
-ORDER, ELEMENT_FUNCTIONS = 12, 1.1
+# ``banded_variation``'s elements: order 12, 1.5 functions per field per Legendre degree. At the paper coil's
+# pear_free_2 points of degree 320 on the map 30 elements of order 12 (1.1 per degree) agree with the Legendre
+# blocks to within their own error estimates at points 35, 104 and 173 (benchmarks/banded_stability.py), but
+# not at points 37–140, where Legendre-320 is not converged (estimates up to 3e-5) and the elements' values lay up
+# to 1.6 times those estimates above it (Ritz values: above the converged ones); with 40 (1.5 per degree) every
+# stored m = 1 eigenvalue of those 139 points is within the reference rule but one, 1.5e-9 below Legendre-320,
+# whose dense eigensolve is ~1e-8 off (ε‖A‖); 2 per degree changes nothing more
+ORDER, ELEMENT_FUNCTIONS = 12, 1.5
 
 
 class BandedVariation:
