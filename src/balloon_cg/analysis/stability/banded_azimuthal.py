@@ -21,7 +21,7 @@ import numpy as np
 
 from ...galerkin.discretisation import symmetric_rows
 from ...generated import AZIMUTHAL_PAIRS
-from ...model.meridian import mass_density, metric
+from ...model.meridian import hoop, mass_density, metric
 from ...numerics.banded import BandedShiftInvert
 from .azimuthal import MODE_CLASS, _merged, excluded_modes
 from .banded import BandedVariation, _Layout
@@ -75,7 +75,8 @@ class BandedAzimuthal:
         x, s = self.variation.basis.x, self._sin_theta
         dlam2 = v / s  # v = λ2' sin θ
         one, zero = np.ones_like(x), np.zeros_like(x)
-        fields = ((one, -one, zero), (eta, -eta, -lam2 * s), (lam2 * x + dlam2 * s, -lam2 * x, deta))
+        radius = hoop(self.variation.eq.scene.geometry, x, s)  # R: sin θ on a sphere
+        fields = ((one, -one, zero), (eta, -eta, -lam2 * radius), (lam2 * x + dlam2 * s, -lam2 * x, deta))
         ops = self.ops[:, [0, 4, 2]]  # (E, 3: R, T, Z, n_q, L)
         return np.array([np.einsum("feq,efqj->ej", np.array(mode) * self._moment_weights, ops) for mode in fields])
 
