@@ -274,7 +274,7 @@ class ShiftInvert:
         return operator
 
 
-def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
+def largest_by_lanczos(operator, n: int, count: int, check_every: int = 1) -> np.ndarray:
     """The ``count`` largest eigenvalues (ascending) of the symmetric positive semidefinite operator (x ↦ Sx on
     vectors of size n) by Lanczos with full reorthogonalisation (two Gram–Schmidt passes a step, no restarts: ~2/3
     of the products ARPACK's implicitly restarted Lanczos needs here), stopped when every wanted Ritz pair's
@@ -282,8 +282,10 @@ def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
     exact to rounding, their error ≤ residual²/gap). A breakdown (an invariant Krylov space) continues from a new
     vector orthogonal to it; at n steps the space is everything and the Ritz values are the eigenvalues. As any
     single-vector Krylov method (ARPACK's too) it sees an exactly multiple eigenvalue once: its callers read
-    states off any symmetry that forces one (an axisymmetric point 0 of a surface branch is solved dense)."""
-    run = _lanczos(n, count)
+    states off any symmetry that forces one (an axisymmetric point 0 of a surface branch is solved dense).
+    ``check_every``: the Ritz values (the stopping test) are computed every that many steps only, for runs of
+    ~100 steps on an operator cheaper than the tridiagonal eigensolve (banded pencils: numerics/banded.py)."""
+    run = _lanczos(n, count, check_every)
     v = next(run)
     while True:
         try:
@@ -292,7 +294,7 @@ def largest_by_lanczos(operator, n: int, count: int) -> np.ndarray:
             return done.value
 
 
-def _lanczos(n: int, count: int):
+def _lanczos(n: int, count: int, check_every: int = 1):
     """``largest_by_lanczos`` as a generator: yields each vector the operator is to be applied to, is sent its
     product, and returns the Ritz values (StopIteration.value); several runs can share their products' cost."""
     rng = np.random.default_rng(LANCZOS_START)
@@ -307,7 +309,7 @@ def _lanczos(n: int, count: int):
         for _ in range(2):
             w -= basis.T @ (basis @ w)
         beta[j] = np.linalg.norm(w)
-        if j + 1 >= count:
+        if j + 1 >= count and ((j + 1 - count) % check_every == 0 or j + 1 == n):
             theta, Y = linalg.eigh_tridiagonal(alpha[:j + 1], beta[:j], select="i", select_range=(j + 1 - count, j))
             if j + 1 == n or np.all(np.abs(beta[j] * Y[-1]) <= 4.0 * EPS * theta.max()):
                 return theta

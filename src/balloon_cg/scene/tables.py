@@ -227,12 +227,15 @@ class Stability:
     perturbation ``basis``: "legendre" (polynomials of x = cos θ) or "mapped" (of the mapped coordinate s(x) of a
     branch's wire map; the same as "legendre" on a branch without one), and the ``norm`` the m = 0 eigenvalues are
     relative to: "unknowns" ∫(δλ2² + δη²) d(cos θ) or "displacement" ∫(sin²θ δλ2² + δη²) d(cos θ) = |δx|², the
-    m ≥ 1 blocks' norm (flags and branch points do not depend on it)."""
+    m ≥ 1 blocks' norm (flags and branch points do not depend on it). ``banded_from``: the blocks (m = 0 and m ≥ 1) of a
+    point assessed at perturbation degree N ≥ it are read on the banded sibling basis (C⁰ elements on the same map,
+    analysis/stability/banded.py); 0 (the default): never."""
 
     degree: int = 20
     m_max: int = 1
     basis: str = "mapped"
     norm: str = "displacement"
+    banded_from: int = 0
 
 
 STABILITY_BASES = ("legendre", "mapped")
@@ -1023,6 +1026,8 @@ def _stability(data) -> Stability:
         get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
         get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
         **choices,
+        banded_from=get("banded_from", lambda n: n == 0 or 20 <= n <= 400, "0 (off) or an integer in [20, 400]",
+                        integer=True),
     )
 
 

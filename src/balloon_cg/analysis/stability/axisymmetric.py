@@ -30,6 +30,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .azimuthal import lowest_readings, merged_lowest, perturbation_map, restricted_blocks
+from .banded import banded_variation
+from .banded_azimuthal import BandedAzimuthal
+from .flags import (EVERY_FLAG, FLAGS, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_FLAGS,  # noqa: F401
+                    HELD_GAS, HELD_VOLUME, LOWEST)
 from .crossings import branch_point_crossings, follow_modes, resolved
 from ...galerkin.legendre import gauss_rule
 from ...galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, piece_nodes,
@@ -41,12 +45,6 @@ from ..branches.problem import equilibrium_of
 from ..branches.resolution import Resolution, transfer_error
 from ...numerics.threads import limited_blas
 
-LOWEST = 3  # eigenvalues reported per block
-FLAGS = ("stable_pressure", "stable_volume", "stable_pressure_free", "stable_volume_free", "stable_gas",
-         "stable_gas_free")  # Assessment's order
-HELD, HELD_VOLUME, FREE, FREE_VOLUME, HELD_GAS, FREE_GAS = range(len(FLAGS))
-EVERY_FLAG = tuple(range(len(FLAGS)))
-HELD_FLAGS, FREE_FLAGS = (HELD, HELD_VOLUME, HELD_GAS), (FREE, FREE_VOLUME, FREE_GAS)
 CHECK_FACTOR = 2.0  # N-convergence is checked at CHECK_FACTOR·N
 # a point's flags are checked at the check degree where a block's lowest eigenvalue is below this in magnitude
 # (``near_zero``): 0.1 where eigenvalues are O(1) but the m = 0 blocks' are not converged in the degree (the
@@ -294,16 +292,41 @@ class SecondVariation:
     def _lowest_blocks(self, u, params: Parameters, symmetric: bool, m_max: int = 0):
         """(name, LOWEST eigenvalues, flags) per block of ``blocks``, in its order; the blocks that are relatives of
         another (volume and gas of a pressure block, the held m = 1 reading of the free one) read through one
-        factorisation where they are large (``_axisymmetric_lowest``, ``azimuthal.lowest_readings``)."""
-        yield from self._axisymmetric_lowest(u, params, symmetric)
+        factorisation where they are large (``_axisymmetric_lowest``, ``azimuthal.lowest_readings``); from
+        stability.banded_from on the banded sibling basis instead (``banded.banded_variation``,
+        ``banded_azimuthal.BandedAzimuthal``)."""
+        sibling = self._sibling(symmetric)
+        if sibling is None:
+            yield from self._axisymmetric_lowest(u, params, symmetric)
+        else:
+            yield from sibling.lowest(u, params)
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
+        wanted = (True, False) if field_on else (True,)
         for m in range(1, m_max + 1):
             interrupt.check()
-            readings = lowest_readings(self.eq, u, params, m, self.basis.degree, LOWEST,
-                                       (True, False) if field_on else (True,), kind=self.basis_kind)
+            if sibling is None:
+                readings = lowest_readings(self.eq, u, params, m, self.basis.degree, LOWEST, wanted,
+                                           kind=self.basis_kind)
+            else:
+                readings = self._sibling_block(symmetric, m).lowest_readings(u, params, LOWEST, wanted)
             yield f"m{m}_held", readings[True], HELD_FLAGS if field_on else EVERY_FLAG
             if field_on:
                 yield f"m{m}_free", readings[False], FREE_FLAGS
+
+    def _sibling(self, symmetric: bool):
+        """The m = 0 blocks' banded sibling at this degree (``banded.banded_variation``: None below
+        stability.banded_from), cached per symmetry."""
+        siblings = self.__dict__.setdefault("_banded", {})
+        if symmetric not in siblings:
+            siblings[symmetric] = banded_variation(self.eq, self.basis.degree, symmetric)
+        return siblings[symmetric]
+
+    def _sibling_block(self, symmetric: bool, m: int) -> BandedAzimuthal:
+        """The m-th block on the sibling's elements, cached."""
+        blocks = self.__dict__.setdefault("_banded_azimuthal", {})
+        if (symmetric, m) not in blocks:
+            blocks[symmetric, m] = BandedAzimuthal(self._sibling(symmetric), m)
+        return blocks[symmetric, m]
 
     def lowest(self, u, params: Parameters, symmetric: bool, name: str) -> np.ndarray:
         """The LOWEST eigenvalues of the one m = 0 block ``name`` at one equilibrium (``blocks``)."""

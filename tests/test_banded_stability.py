@@ -1,0 +1,137 @@
+"""The banded sibling of the m = 0 second variation (issue 37): C⁰ piecewise polynomials on the wire map
+(galerkin/piecewise.py), banded shift-invert Lanczos (numerics/banded.py), the blocks of analysis/stability/banded.py.
+
+- the eigensolver against a dense generalized eigensolve of the same pencil, with constraints and a gas term;
+- the basis: the constant function, ∫1 dx = 2 on the whole interval and on the half one;
+- the scene key stability.banded_from, and the assessment of a whole branch with it (SPOM1 M = 0: flags unchanged);
+- near a wire (the two-coil primary branch's last point, gap 0.1, stored at mapped degree 90): every block's three
+  lowest eigenvalues (m = 0; m = 1 held and free), equator-symmetric blocks and the general ones, against the
+  Legendre blocks (an independent discretisation) to within the two discretisations' own error estimates.
+"""
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import linalg
+
+from balloon_cg.analysis.branches.primary import trace_primary
+from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.stability.axisymmetric import SecondVariation, assess_branch, point_degrees
+from balloon_cg.analysis.stability.banded import BandedVariation
+from balloon_cg.analysis.stability.banded_azimuthal import BandedAzimuthal
+from balloon_cg.galerkin.piecewise import PiecewiseBasis
+from balloon_cg.numerics.banded import BandedShiftInvert
+from balloon_cg.scene import SceneError, load_scene, parse_scene
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+TWO_COILS, SPOM1 = SCENES / "spom1_two_coils_M0.002.toml", SCENES / "spom1.toml"
+
+
+def _band(A: np.ndarray, bandwidth: int) -> np.ndarray:
+    n = A.shape[0]
+    return np.array([np.concatenate([np.diag(A, -d), np.zeros(d)]) for d in range(bandwidth + 1)])
+
+
+def _banded_matrix(rng, n: int, bandwidth: int) -> np.ndarray:
+    A = np.zeros((n, n))
+    for d in range(bandwidth + 1):
+        values = rng.standard_normal(n - d)
+        A += np.diag(values, -d) + (np.diag(values, d) if d else 0.0)
+    return A
+
+
+def test_banded_shift_invert_against_a_dense_generalized_eigensolve():
+    rng = np.random.default_rng(3)
+    n, b = 120, 5
+    H = _banded_matrix(rng, n, b)
+    G = _banded_matrix(rng, n, b) * 0.05 + np.eye(n) * 2.0  # positive definite
+    assert np.linalg.eigvalsh(G).min() > 0.5
+    N = rng.standard_normal((2, n))
+    g, rho = rng.standard_normal(n), 0.7
+    shifted = BandedShiftInvert.below(_band(H, b), _band(G, b), guess=0.0)
+    assert shifted is not None and shifted.sigma < linalg.eigh(H, G, eigvals_only=True)[0]
+    Z = linalg.null_space(N)
+    for constraints, update, (K, M) in (
+            (None, None, (H, G)),
+            (N, None, (Z.T @ H @ Z, Z.T @ G @ Z)),
+            (None, (g, rho), (H + rho * np.outer(g, g), G)),
+            (N, (g, rho), (Z.T @ (H + rho * np.outer(g, g)) @ Z, Z.T @ G @ Z))):
+        dense = linalg.eigh(K, M, eigvals_only=True, subset_by_index=(0, 2))
+        found = shifted.lowest(3, constraints, update)
+        np.testing.assert_allclose(found, dense, rtol=0, atol=1e-10 * max(1.0, np.abs(dense).max()))
+
+
+def test_piecewise_basis_integrates_the_constant():
+    for half in (False, True):
+        basis = PiecewiseBasis(6, 5, 13, half=half)
+        assert basis.weights.sum() == pytest.approx(2.0, abs=1e-14)
+        dofs = basis.dofs((1,) if half else ())
+        vertex = dofs[:, 0::2][:, [0, -1]]  # the δλ2 hats: the constant is all ones there, no bubble
+        constant = basis.phi[:, :, 0] + basis.phi[:, :, -1]
+        assert np.all(vertex >= 0)
+        np.testing.assert_allclose(constant, 1.0, atol=1e-15)
+
+
+@pytest.fixture(scope="module")
+def near_wire():
+    """The two-coil primary branch (M = 0.002, to wire gap 0.1) and its last point."""
+    branch = trace_primary(load_scene(TWO_COILS), down=False)
+    return branch, len(branch.X) - 1
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_banded_blocks_agree_with_the_legendre_blocks_near_a_wire(near_wire, symmetric):
+    """Both discretisations of every block (m = 0: the equator-symmetric ones on the half interval, or the general
+    ones with the held row ∫δη dx = 0 and the volume row on the whole interval; m = 1: its reflection classes or the
+    whole block, the special modes' rows removed per reading): the three lowest eigenvalues agree
+    to within the Legendre blocks' own estimate |μ(N) − μ(N/1.5)| plus the elements' |μ(E, p) − μ(E, p − 2)|, and a
+    rounding floor of 1e-10·max(1, |μ|)."""
+    branch, n = near_wire
+    eq, X = equilibrium_of(branch), branch.X[n]
+    u, params = X[:-1], branch.params_at(X)
+    degree = int(point_degrees(branch, branch.scene.stability.degree)[n])
+    legendre = SecondVariation(eq, degree).assess(u, params, symmetric, 1).blocks
+    coarse = SecondVariation(eq, int(degree / 1.5)).assess(u, params, symmetric, 1).blocks
+    elements = 8 if symmetric else 16  # the half interval or the whole one: the same elements per unit of s
+
+    def blocks(order):
+        variation = BandedVariation(eq, elements, order, symmetric=symmetric)
+        readings = BandedAzimuthal(variation, 1).lowest_readings(u, params, 3)
+        return variation.lowest_blocks(u, params) | {"m1_held": readings[True], "m1_free": readings[False]}
+
+    banded, lower = blocks(8), blocks(6)
+    assert banded.keys() == legendre.keys()
+    for name, values in legendre.items():
+        tolerance = (np.abs(values - coarse[name]) + np.abs(banded[name] - lower[name])
+                     + 1e-10 * np.maximum(1.0, np.abs(values)))
+        assert np.all(np.abs(banded[name] - values) <= tolerance), (name, banded[name] - values, tolerance)
+    assert min(v[0] for v in banded.values()) < 0.0  # a point with negative blocks: the signs are read too
+
+
+def test_banded_from_key_default_and_refusal():
+    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.banded_from == 0
+    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 225\n').stability.banded_from == 225
+    with pytest.raises(SceneError) as error:
+        parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 10\n', name="s")
+    message = str(error.value)
+    assert "\n" not in message and "stability.banded_from = 10" in message and "[20, 400]" in message
+
+
+def test_assessment_with_banded_from_reads_the_banded_blocks_and_keeps_the_flags():
+    """The SPOM1 M = 0 primary branch assessed with stability.banded_from = 20 (every point's blocks, m = 0 and
+    m = 1, on elements, unmapped: in x) against the default Legendre blocks: the same flags at every point, every
+    eigenvalue within the Legendre blocks' estimate |μ(20) − μ(13)| plus 1e-9·max(1, |μ|)."""
+    scene = load_scene(SPOM1)
+    branch = trace_primary(scene, down=False)
+    banded_scene = scene.with_overrides({"stability.banded_from": 20}, name=scene.name)
+    banded_branch = replace(branch, scene=banded_scene)
+    legendre, _ = assess_branch(branch, 20, m_max=1)
+    coarse, _ = assess_branch(branch, 13, m_max=1)
+    banded, _ = assess_branch(banded_branch, 20, m_max=1)
+    for a, c, b in zip(legendre, coarse, banded):
+        assert b.flags() == a.flags()
+        assert b.blocks.keys() == a.blocks.keys()
+        for name, values in a.blocks.items():
+            tolerance = np.abs(values - c.blocks[name]) + 1e-9 * np.maximum(1.0, np.abs(values))
+            assert np.all(np.abs(b.blocks[name] - values) <= tolerance), (name, b.blocks[name] - values, tolerance)
