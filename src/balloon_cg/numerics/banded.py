@@ -20,7 +20,7 @@ import numpy as np
 from scipy.linalg.blas import dsbmv
 from scipy.linalg.lapack import dpbtrf, dtbtrs
 
-from .eigen import RCOND, _orthonormal_rows, largest_by_lanczos
+from .eigen import RCOND, orthonormal_rows, largest_by_lanczos
 
 SHIFT_TRIES = 12  # shifts tried (each 4× farther below the guess) before giving up
 # Lanczos steps between stopping tests (``largest_by_lanczos``): a step on a banded factor costs tens of µs, the
@@ -83,7 +83,7 @@ class BandedShiftInvert:
         if constraints is not None and len(constraints):
             rows = np.array([half(self._solve(np.asarray(row, dtype=float), False))
                              for row in np.atleast_2d(constraints)])
-            directions = _orthonormal_rows(np.ascontiguousarray(rows), rcond)
+            directions = orthonormal_rows(np.ascontiguousarray(rows), rcond)
 
         def project(z):
             return z - directions.T @ (directions @ z) if directions.shape[0] else z

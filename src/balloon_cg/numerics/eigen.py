@@ -101,13 +101,13 @@ def restricted_rows(factor: GramFactor, normals, rows, rcond: float = RCOND) -> 
 def rank_of(rows, rcond: float = RCOND) -> int:
     """The number of independent rows (k × n) as ``restricted`` counts them (pivoted Gram–Schmidt, rcond)."""
     rows = np.ascontiguousarray(np.atleast_2d(rows), dtype=float)
-    return _orthonormal_rows(rows, rcond).shape[0] if rows.size else 0
+    return orthonormal_rows(rows, rcond).shape[0] if rows.size else 0
 
 
 @njit(cache=True)
 def _reflect_rows(directions, rcond, rows):
     """The rows w of ``rows`` through the reflections ``_reflect`` makes of ``directions``: (Q w)[1:] each time."""
-    D = _orthonormal_rows(directions, rcond)
+    D = orthonormal_rows(directions, rcond)
     W = rows.copy()
     for r in range(D.shape[0]):
         n = D.shape[1]
@@ -263,7 +263,7 @@ class ShiftInvert:
                 return solved - (weight * (Su @ v)) * Su
         operator = base
         if constraints is not None and len(constraints):
-            U = _orthonormal_rows(np.ascontiguousarray(np.atleast_2d(constraints), dtype=float), rcond).T
+            U = orthonormal_rows(np.ascontiguousarray(np.atleast_2d(constraints), dtype=float), rcond).T
             if U.shape[1]:
                 SU = np.column_stack([base(U[:, k], self.solve(U[:, k])) for k in range(U.shape[1])])
                 K = np.linalg.cholesky(U.T @ SU)
@@ -375,7 +375,7 @@ def _gather(H, index):
 
 
 @njit(cache=True)
-def _orthonormal_rows(D, rcond):
+def orthonormal_rows(D, rcond):
     """Orthonormal rows spanning the rows of D (k × n): Gram–Schmidt with pivoting on the largest remaining norm
     and a second pass; a row whose remainder is below rcond times the largest norm is dependent and dropped."""
     k, n = D.shape
@@ -451,7 +451,7 @@ def _reflect(B, directions, rcond):
     of the remaining directions). In place: the k-th reduced matrix is B[k:, k:], updated in one pass that also
     forms the next B v (each entry and sum as a fresh matrix per direction would give them)."""
     n = B.shape[0]
-    D = _orthonormal_rows(directions, rcond)
+    D = orthonormal_rows(directions, rcond)
     k = D.shape[0]
     if k == 0:
         return B

@@ -413,10 +413,10 @@ def spectra(equilibrium: Equilibrium, u, params: Parameters, m: int, degree: int
 
 def merged_lowest(parts, count: int) -> np.ndarray:
     """The ``count`` lowest eigenvalues of a block given as the standard matrices of its uncoupled parts."""
-    return _merged([eigen.lowest_of(A, count) for A in parts], count)
+    return merged_parts([eigen.lowest_of(A, count) for A in parts], count)
 
 
-def _merged(found: list, count: int) -> np.ndarray:
+def merged_parts(found: list, count: int) -> np.ndarray:
     """The ``count`` lowest of the uncoupled parts' lowest eigenvalues ``found`` (ascending each)."""
     return found[0] if len(found) == 1 else np.sort(np.concatenate(found))[:count]
 
@@ -468,7 +468,7 @@ def lowest_readings(equilibrium: Equilibrium, u, params: Parameters, m: int, deg
                         lambda: eigen.restricted(H, factor, held_rows))])
         free.append(own)
         held.append(values)
-    return {True: _merged(held, count), False: _merged(free, count)}
+    return {True: merged_parts(held, count), False: merged_parts(free, count)}
 
 
 def _parts(equilibrium: Equilibrium, u, params: Parameters, m: int, b: AzimuthalBasis) -> tuple:

@@ -81,9 +81,9 @@ class BandedVariation:
         E, n_q = self.basis.x.shape
         return np.einsum("keq,ekqj->ej", pointwise.reshape(4, E, n_q) * self.basis.weights, self.ops)
 
-    def _layout(self, dropped: tuple) -> "_Layout":
+    def _layout(self, dropped: tuple) -> "BlockLayout":
         if dropped not in self._layouts:
-            self._layouts[dropped] = _Layout(self.basis.dofs(dropped))
+            self._layouts[dropped] = BlockLayout(self.basis.dofs(dropped))
         return self._layouts[dropped]
 
     def _state(self, u, params: Parameters):
@@ -166,7 +166,7 @@ def _local_ops(basis: PiecewiseBasis, sin_theta: np.ndarray) -> np.ndarray:
     return ops
 
 
-class _Layout:
+class BlockLayout:
     """Scatter of element matrices and vectors into lower band storage (numerics/banded.py) and global vectors, for
     one numbering of the functions (``PiecewiseBasis.dofs``: −1 for a dropped one)."""
 

@@ -23,8 +23,8 @@ from ...galerkin.discretisation import symmetric_rows
 from ...generated import AZIMUTHAL_PAIRS
 from ...model.meridian import hoop, mass_density, metric
 from ...numerics.banded import BandedShiftInvert
-from .azimuthal import MODE_CLASS, _merged, excluded_modes
-from .banded import BandedVariation, _Layout
+from .azimuthal import MODE_CLASS, merged_parts, excluded_modes
+from .banded import BandedVariation, BlockLayout
 
 Z_FIELD, U_FIELD, D_FIELD = range(3)  # the fields of the interleaved functions (local 3r + field)
 FIELDS = 3
@@ -64,9 +64,9 @@ class BandedAzimuthal:
         odd_class_0 = (Z_FIELD,)  # class 0: R, T (U, D) even in x, Z odd
         return [(0, odd_class_0), (1, (U_FIELD, D_FIELD))]
 
-    def _layout(self, dropped: tuple) -> _Layout:
+    def _layout(self, dropped: tuple) -> BlockLayout:
         if dropped not in self._layouts:
-            self._layouts[dropped] = _Layout(self.variation.basis.dofs(dropped, FIELDS))
+            self._layouts[dropped] = BlockLayout(self.variation.basis.dofs(dropped, FIELDS))
         return self._layouts[dropped]
 
     def _mode_moments(self, params) -> np.ndarray:
@@ -102,7 +102,7 @@ class BandedAzimuthal:
                          if cls is None or MODE_CLASS[k] == cls]
                 rows = np.array([layout.vector(moments[k]) for k in modes]) if modes else None
                 found[held].append(shifted.lowest(count, rows))
-        return {held: _merged(values, count) for held, values in found.items()}
+        return {held: merged_parts(values, count) for held, values in found.items()}
 
 
 def _azimuthal_ops(basis, m: int, x: np.ndarray, sin_theta: np.ndarray) -> np.ndarray:
