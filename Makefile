@@ -4,6 +4,10 @@ OUT ?= out
 RUN_FLAGS ?=
 PAPER_OUT ?= paper-figures
 PAPER_FLAGS ?=
+# pip byte-compiles every module it installs (numba's, scipy's and matplotlib's own tests included: ~10 s of one core,
+# half of a fresh install's CPU, benchmarks/make_run.py); Python writes the bytecode of what is imported at its first
+# import instead. Where PYTHONDONTWRITEBYTECODE is set Python never writes it, so there the install compiles it all.
+PIP_INSTALL = $(PYTHON) -m pip install --quiet $(if $(PYTHONDONTWRITEBYTECODE),,--no-compile)
 
 .PHONY: install install-dev regenerate api-docs test run paper bench clean
 
@@ -11,10 +15,10 @@ PAPER_FLAGS ?=
 # and the scenes, and numba's cache goes to ~/.cache/balloon-cg/numba, never into site-packages
 # (tests/test_packaging.py builds and inspects the wheel and runs install, run and test installs in a fresh venv).
 install:
-	$(PYTHON) -m pip install --quiet -e .
+	$(PIP_INSTALL) -e .
 
 install-dev:
-	$(PYTHON) -m pip install --quiet -e ".[test,codegen]"
+	$(PIP_INSTALL) -e ".[test,codegen]"
 
 regenerate:
 	$(PYTHON) -m codegen generated

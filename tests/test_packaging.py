@@ -95,7 +95,8 @@ def test_install_then_make_run_then_make_test_on_a_fresh_venv(tmp_path):
     tree = clean_copy(tmp_path)
     python, site = fresh_venv(tmp_path)
     cache = tmp_path / "cache"
-    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH")}
+    # PYTHONDONTWRITEBYTECODE unset: make's installs leave the bytecode to Python (pip --no-compile)
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH", "PYTHONDONTWRITEBYTECODE")}
     # PIP_NO_BUILD_ISOLATION=0 means --no-build-isolation (pip reads the variable as "isolation off")
     env.update(XDG_CACHE_HOME=str(cache), PIP_NO_INDEX="1", PIP_NO_BUILD_ISOLATION="0",
                PIP_DISABLE_PIP_VERSION_CHECK="1")
@@ -122,6 +123,18 @@ def test_install_then_make_run_then_make_test_on_a_fresh_venv(tmp_path):
 
     run(["make", "-C", tree, "install-dev", f"PYTHON={python}"], env, tmp_path)  # the install step of make test
     assert check(python, env, tmp_path) == editable
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="needs make")
+@pytest.mark.parametrize("target", ["install", "install-dev"])
+def test_make_leaves_the_bytecode_to_python_unless_python_never_writes_it(target):
+    """pip --no-compile (Python writes the bytecode of what it imports, at its first import), but pip's byte
+    compilation where PYTHONDONTWRITEBYTECODE is set (Python would compile the sources at every start)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    writes, never = (run(["make", "--dry-run", "-C", ROOT, target, "PYTHON=python3"], e, ROOT)
+                     for e in (env, env | {"PYTHONDONTWRITEBYTECODE": "1"}))
+    assert "pip install" in writes and "--no-compile" in writes
+    assert "pip install" in never and "--no-compile" not in never
 
 
 def test_generated_kernels_of_another_tree_are_refused(tmp_path):
