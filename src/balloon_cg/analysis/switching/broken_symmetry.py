@@ -3,25 +3,27 @@
 A field off the equatorial plane breaks the pitchfork of the pear mode: one half of the pear branch joins the
 primary branch, the other is disconnected from it, so no trace from the primary branch meets it. It is found from
 the scene's symmetric relative, its coils' heights h_i scaled to t·h_i, at t = 0 (``symmetric_relative``): there
-the held reading's first pear pitchfork is located and both halves of its pear branch are traced (``bifurcation``,
-``switching``). On each half the first point of pear amplitude |A| ≥ SEED_AMPLITUDE (A = λ2(0) − λ2(π)) is
-continued in t from 0 to 1 at that amplitude, the pressure free,
+the held reading's first pear pitchfork is located and each half of its pear branch is traced (``bifurcation``,
+``switching``) up to its first point of pear amplitude |A| ≥ SEED_AMPLITUDE (A = λ2(0) − λ2(π)), the seed, which
+is continued in t from 0 to 1 at that amplitude, the pressure free,
 
     R(u, P; t) = 0,   A(u) = A_seed,
 
 by Newton from the previous t (steps of 1/HEIGHT_STEPS, halved on failure down to MIN_STEP), on a plain general
-basis (balloon held) of the pear branch's degree. At t = 1 a continued point within ON_BRANCH of the primary
+basis (balloon held) of the degree the seed was computed at. At t = 1 a continued point within ON_BRANCH of the primary
 branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
 branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
 the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
-``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``). The two halves, then the two legs, run on every core.
 """
+import enum
 import time
 
 import numpy as np
 
 from ...galerkin.equilibrium import Equilibrium
 from ...numerics import continuation, workers
+from ...numerics.continuation import Stop
 from ...numerics.newton import newton
 from ..points import branch_points as bifurcation
 from ..points.branch_points import plain_degree
@@ -31,7 +33,7 @@ from ..branches.primary import trace_primary
 from ..branches.problem import ParameterSystem
 from ..results import Block, Branch, Origin
 from ..stability.axisymmetric import assess_branch, assessment_cost
-from .pear import pear_landing, pear_stop_rule, trace_pear
+from .pear import pear_landing, pear_leg, pear_stop_rule
 from ..branches.tracer import Tracer
 
 SEED_AMPLITUDE = 1.0  # |λ2(0) − λ2(π)| of the point continued in the coil heights: far from the primary branch
@@ -65,19 +67,35 @@ def pitchfork(scene):
     return primary, bifurcation.locate(primary, *events[0])
 
 
+class SeedStop(enum.StrEnum):
+    """Why a half of the symmetric relative's pear branch stopped early (``seed``)."""
+
+    WIDE = "wide"  # a point of pear amplitude |A| ≥ SEED_AMPLITUDE: the seed
+
+
 def seed(scene, relative: Branch, bp, sign: float) -> tuple:
-    """The half ``sign`` of the symmetric relative's pear branch at ``bp``: (its first point X = (u, P) of pear
-    amplitude |A| ≥ SEED_AMPLITUDE on the plain general held basis of that branch's degree, the branch's
-    parameters); HomotopyError when the half cannot be started or stays below that amplitude."""
-    pear = trace_pear(relative, bp, sign, "pear")
-    if pear is None:
+    """The half ``sign`` of the symmetric relative's pear branch at ``bp``, traced to its first point X = (u, P) of
+    pear amplitude |A| ≥ SEED_AMPLITUDE (a refined basis' first point included): (X on the plain general held basis
+    of the degree it was computed at, the branch's parameters); HomotopyError when the half cannot be started or
+    stops below that amplitude."""
+
+    def wide(disc, point):
+        rows = disc.pole_rows()
+        amplitude = (rows["lam2_top"] - rows["lam2_bottom"]) @ point.X[:-1]
+        return Stop(SeedStop.WIDE, "the seed's pear amplitude") if abs(amplitude) >= SEED_AMPLITUDE else None
+
+    traced = pear_leg(relative, bp, sign, until=wide)
+    if traced is None:
         raise HomotopyError("the pear branch of the symmetric relative could not be started")
-    poles = pear.pole_values()
-    wide = np.flatnonzero(np.abs(poles["lam2_top"] - poles["lam2_bottom"]) >= SEED_AMPLITUDE)
-    if not wide.size:
-        raise HomotopyError(f"the pear branch of the symmetric relative stays below amplitude {SEED_AMPLITUDE:g}")
-    plain = held_tracer(scene).system(pear.disc.degree, pear.params).eq.disc
-    return pear.disc.transfer(pear.X[wide[0]], plain), pear.params
+    _, leg = traced
+    last, path = leg.segments[-1]
+    candidates = [(disc, p) for disc, traced_path in leg.segments for p in traced_path.points]
+    candidates += [(last, path.overshoot)] if leg.stop.code == SeedStop.WIDE else []
+    for disc, point in candidates:
+        if wide(disc, point) is not None:
+            plain = held_tracer(scene).system(disc.degree, relative.params).eq.disc
+            return disc.transfer(point.X, plain), relative.params
+    raise HomotopyError(f"the pear branch of the symmetric relative stays below amplitude {SEED_AMPLITUDE:g}")
 
 
 def held_tracer(scene) -> Tracer:
