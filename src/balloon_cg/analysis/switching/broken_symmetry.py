@@ -25,6 +25,7 @@ from ...galerkin.equilibrium import Equilibrium
 from ...numerics import continuation, workers
 from ...numerics.continuation import Stop
 from ...numerics.newton import newton
+from ...numerics.threads import limited_blas
 from ..points import branch_points as bifurcation
 from ..points.branch_points import plain_degree
 from ..branches.assembly import assemble
@@ -73,6 +74,7 @@ class SeedStop(enum.StrEnum):
     WIDE = "wide"  # a point of pear amplitude |A| ≥ SEED_AMPLITUDE: the seed
 
 
+@limited_blas
 def seed(scene, relative: Branch, bp, sign: float) -> tuple:
     """The half ``sign`` of the symmetric relative's pear branch at ``bp``, traced to its first point X = (u, P) of
     pear amplitude |A| ≥ SEED_AMPLITUDE (a refined basis' first point included): (X on the plain general held basis
@@ -157,6 +159,7 @@ def trace_cost(degree: int) -> float:
     return TRACE_ASSESSMENTS * assessment_cost(degree, 0)
 
 
+@limited_blas
 def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None) -> Branch | None:
     """The pear branch the scene's broken equator symmetry disconnects from ``primary`` (module docstring), None
     when the symmetric relative has no pear pitchfork; HomotopyError when it is not found. The two halves (seed and
