@@ -14,7 +14,7 @@ basis (balloon held) of the degree the seed was computed at. At t = 1 a continue
 branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
 branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
 the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
-``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``). The two halves, then the two legs, run on every core.
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``). The two halves run on every core.
 """
 import enum
 import time
@@ -27,7 +27,7 @@ from ...numerics.continuation import Stop
 from ...numerics.newton import newton
 from ...numerics.threads import limited_blas
 from ..points import branch_points as bifurcation
-from ..points.branch_points import plain_degree
+from ..points.branch_points import general_tracer, plain_degree
 from ..branches.assembly import assemble
 from ..branches.events import with_events
 from ..branches.primary import trace_primary
@@ -41,8 +41,8 @@ SEED_AMPLITUDE = 1.0  # |λ2(0) − λ2(π)| of the point continued in the coil 
 HEIGHT_STEPS = 10  # the first steps in t: 1/HEIGHT_STEPS
 MIN_STEP = 1e-3  # a step in t halved below this: the continuation failed
 ON_BRANCH = 1e-2  # max-norm distance in (P, λ2(0), λ2(π)) below which a continued point lies on the primary branch
-SIGNS = (1.0, -1.0)  # the halves of the pear branch (along ±φ), and the legs of the trace in P (±dP)
-TRACE_ASSESSMENTS = 10  # a half or a leg costs at least ten assessments at its degree: tens of points, each factoring
+SIGNS = (1.0, -1.0)  # the halves of the pear branch (along ±φ), the legs of the trace in P (±dP)
+TRACE_ASSESSMENTS = 10  # a half costs at least ten assessments at its degree: tens of points, each factoring
 #                         a Jacobian the size of an assessment's block (``workers.spread``'s cost)
 
 
@@ -163,16 +163,17 @@ def trace_cost(degree: int) -> float:
 def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None) -> Branch | None:
     """The pear branch the scene's broken equator symmetry disconnects from ``primary`` (module docstring), None
     when the symmetric relative has no pear pitchfork; HomotopyError when it is not found. The two halves (seed and
-    continuation in the coil heights) and then the two legs of the trace in P run on every core
-    (``numerics.workers``: the numbers of the serial loop); ``progress(point)`` is told of the traced points as
-    the legs end."""
+    continuation in the coil heights) run on every core (``numerics.workers``: the numbers of the serial loop)."""
     t0 = time.perf_counter()
     found = pitchfork(scene)
     if found is None:
         return None
     relative, bp = found
+    degree = plain_degree(relative, bp.X)
+    general_tracer(scene, bp.block).system(degree, relative.params).eq.disc.projection  # a pseudo-inverse (~1 s
+    #   at degree 320) both halves start with (``pear_leg``'s transfer to the plain basis): built here, inherited
     halves = workers.spread(lambda sign: half(scene, relative, bp, primary, sign), SIGNS,
-                            [trace_cost(plain_degree(relative, bp.X))] * len(SIGNS))
+                            [trace_cost(degree)] * len(SIGNS))
     for continued_half in halves:
         if isinstance(continued_half, HomotopyError):
             raise continued_half
@@ -183,18 +184,13 @@ def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None
 
 
 def _traced(scene, X: np.ndarray, params, name: str, progress, t0: float) -> Branch:
-    """The disconnected branch traced in P both ways from its continued point X (module docstring)."""
+    """The disconnected branch traced in P both ways from its continued point X (module docstring), in this
+    process: a leg that refines onto a wire-mapped basis builds that basis' projection (a pseudo-inverse, ~1 s at
+    degree 320), which the assembly here transfers the other points with."""
     tracer, degree = held_tracer(scene), _degree(X)
     system, stop, pressure = tracer.system(degree, params), pear_stop_rule(scene), np.eye(X.size)[-1]
-
-    def leg(sign: float):
-        start = continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0)
-        return tracer.leg(start, params, stop, degree=degree)
-
-    legs = workers.spread(leg, SIGNS, [trace_cost(degree)] * len(SIGNS))
-    for _, path in (segment for traced in legs for segment in traced.segments):
-        for point in path.points if progress is not None else ():
-            progress(point)
+    legs = [tracer.leg(continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0), params,
+                       stop, progress, degree=degree) for sign in SIGNS]
     branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=pear_landing(scene),
                                   labels=("up", "down")))
     branch.origin = Origin.CONTINUED_IN_HEIGHT
