@@ -179,11 +179,11 @@ def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None
             raise continued_half
         X, params, joins = continued_half
         if not joins:  # the half that joins the primary branch is passed over
-            return _traced(scene, X, params, name, progress, t0)
+            return trace_disconnected(scene, X, params, name, progress, t0)
     raise HomotopyError("both halves of the pear branch, continued in the coil heights, lie on the primary branch")
 
 
-def _traced(scene, X: np.ndarray, params, name: str, progress, t0: float) -> Branch:
+def trace_disconnected(scene, X: np.ndarray, params, name: str, progress, t0: float) -> Branch:
     """The disconnected branch traced in P both ways from its continued point X (module docstring), in this
     process: a leg that refines onto a wire-mapped basis builds that basis' projection (a pseudo-inverse, ~1 s at
     degree 320), which the assembly here transfers the other points with."""
