@@ -156,6 +156,38 @@ def test_the_disconnected_pear_branch_gets_its_user_points():
         assert np.abs(system.residual(s.X)).max() <= scene.solver.tol
 
 
+@pytest.mark.slow
+def test_the_disconnected_pear_branch_on_two_workers_is_the_serial_one(monkeypatch):
+    """The halves of the symmetric relative's pear branch and the legs of the disconnected branch's trace go to two
+    forked workers (``broken_pear``; every spread forks here): the branch is the serial one bit for bit, and its
+    seed is the first point of pear amplitude ≥ SEED_AMPLITUDE of that half traced whole (``trace_pear``)."""
+    from balloon_cg.analysis.branches.primary import trace_primary
+    from balloon_cg.analysis.switching import broken_symmetry
+    from balloon_cg.analysis.switching.pear import trace_pear
+    from balloon_cg.numerics import workers
+
+    scene = coil_at(0.5)
+    primary = trace_primary(scene)
+    monkeypatch.setattr(workers, "MIN_COST", 0.0)
+    spread, calls = workers.spread, []
+    monkeypatch.setattr(workers, "spread", lambda work, items, *args, **kwargs: calls.append(
+        workers.sharing(len(items), 1.0)) or spread(work, items, *args, **kwargs))
+    found = {}
+    for count in ("1", "2"):
+        monkeypatch.setenv("BALLOON_CG_WORKERS", count)
+        found[count] = broken_symmetry.broken_pear(scene, primary)
+    assert calls == [1, 1, 2, 2]  # the relative's assessment, the halves: here, then on two workers
+    assert np.array_equal(found["1"].X, found["2"].X) and found["1"].degree.tolist() == found["2"].degree.tolist()
+    assert [(s.kind, s.index) for s in found["1"].special] == [(s.kind, s.index) for s in found["2"].special]
+    relative, bp = broken_symmetry.pitchfork(scene)
+    X, _ = broken_symmetry.seed(scene, relative, bp, 1.0)
+    whole = trace_pear(relative, bp, 1.0, "pear")
+    poles = whole.pole_values()
+    first = np.flatnonzero(np.abs(poles["lam2_top"] - poles["lam2_bottom"]) >= broken_symmetry.SEED_AMPLITUDE)[0]
+    assert whole.disc.mapping is None and X.size == whole.X.shape[1]  # stored on the seed's own basis
+    assert np.array_equal(X, whole.X[first])
+
+
 def test_critical_follows_a_fold_of_the_off_equator_coil_and_its_help_says_so(tmp_path, capsys):
     """`critical --of LP` needs no equator symmetry (a fold is no pitchfork): on the coil at h = 0.5 the fold of P in
     M runs until P reaches 0 (exit 1, no cusp), while the pitchfork (--of BP) is refused naming the coil (exit 2);

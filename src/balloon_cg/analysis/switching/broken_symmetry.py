@@ -3,40 +3,47 @@
 A field off the equatorial plane breaks the pitchfork of the pear mode: one half of the pear branch joins the
 primary branch, the other is disconnected from it, so no trace from the primary branch meets it. It is found from
 the scene's symmetric relative, its coils' heights h_i scaled to t·h_i, at t = 0 (``symmetric_relative``): there
-the held reading's first pear pitchfork is located and both halves of its pear branch are traced (``bifurcation``,
-``switching``). On each half the first point of pear amplitude |A| ≥ SEED_AMPLITUDE (A = λ2(0) − λ2(π)) is
-continued in t from 0 to 1 at that amplitude, the pressure free,
+the held reading's first pear pitchfork is located and each half of its pear branch is traced (``bifurcation``,
+``switching``) up to its first point of pear amplitude |A| ≥ SEED_AMPLITUDE (A = λ2(0) − λ2(π)), the seed, which
+is continued in t from 0 to 1 at that amplitude, the pressure free,
 
     R(u, P; t) = 0,   A(u) = A_seed,
 
 by Newton from the previous t (steps of 1/HEIGHT_STEPS, halved on failure down to MIN_STEP), on a plain general
-basis (balloon held) of the pear branch's degree. At t = 1 a continued point within ON_BRANCH of the primary
+basis (balloon held) of the degree the seed was computed at. At t = 1 a continued point within ON_BRANCH of the primary
 branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
 branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
 the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
-``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``).
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``). The two halves run on every core.
 """
+import enum
 import time
 
 import numpy as np
 
 from ...galerkin.equilibrium import Equilibrium
-from ...numerics import continuation
+from ...numerics import continuation, workers
+from ...numerics.continuation import Stop
 from ...numerics.newton import newton
+from ...numerics.threads import limited_blas
 from ..points import branch_points as bifurcation
+from ..points.branch_points import general_tracer, plain_degree
 from ..branches.assembly import assemble
 from ..branches.events import with_events
 from ..branches.primary import trace_primary
 from ..branches.problem import ParameterSystem
 from ..results import Block, Branch, Origin
-from ..stability.axisymmetric import assess_branch
-from .pear import pear_landing, pear_stop_rule, trace_pear
+from ..stability.axisymmetric import assess_branch, assessment_cost
+from .pear import pear_landing, pear_leg, pear_stop_rule
 from ..branches.tracer import Tracer
 
 SEED_AMPLITUDE = 1.0  # |λ2(0) − λ2(π)| of the point continued in the coil heights: far from the primary branch
 HEIGHT_STEPS = 10  # the first steps in t: 1/HEIGHT_STEPS
 MIN_STEP = 1e-3  # a step in t halved below this: the continuation failed
 ON_BRANCH = 1e-2  # max-norm distance in (P, λ2(0), λ2(π)) below which a continued point lies on the primary branch
+SIGNS = (1.0, -1.0)  # the halves of the pear branch (along ±φ), the legs of the trace in P (±dP)
+TRACE_ASSESSMENTS = 10  # a half costs at least ten assessments at its degree: tens of points, each factoring
+#                         a Jacobian the size of an assessment's block (``workers.spread``'s cost)
 
 
 class HomotopyError(RuntimeError):
@@ -49,29 +56,48 @@ def symmetric_relative(scene, t: float = 0.0):
                                  for i, coil in enumerate(scene.field.coils)}, name=scene.name)
 
 
-def seeds(scene) -> list[tuple]:
-    """Per half of the first held pear branch of the symmetric relative: (its first point X = (u, P) of pear
-    amplitude |A| ≥ SEED_AMPLITUDE on the plain general held basis of that branch's degree, the branch's
-    parameters); none when the symmetric relative has no pear pitchfork (then there is no pear branch to break)."""
+def pitchfork(scene):
+    """(the held primary branch of the symmetric relative, assessed; its first held pear pitchfork, located), or
+    None when it has none (then there is no pear branch to break)."""
     relative = symmetric_relative(scene)
     primary = trace_primary(relative)
     primary.stability, _ = assess_branch(primary, relative.stability.degree, True)
     events = [e for e in bifurcation.detect(primary, primary.stability) if e[1] == Block.ODD_HELD]
     if not events:
-        return []
-    bp = bifurcation.locate(primary, *events[0])
-    out = []
-    for sign in (1.0, -1.0):
-        pear = trace_pear(primary, bp, sign, "pear")
-        if pear is None:
-            raise HomotopyError("the pear branch of the symmetric relative could not be started")
-        poles = pear.pole_values()
-        wide = np.flatnonzero(np.abs(poles["lam2_top"] - poles["lam2_bottom"]) >= SEED_AMPLITUDE)
-        if not wide.size:
-            raise HomotopyError(f"the pear branch of the symmetric relative stays below amplitude {SEED_AMPLITUDE:g}")
-        plain = held_tracer(scene).system(pear.disc.degree, pear.params).eq.disc
-        out.append((pear.disc.transfer(pear.X[wide[0]], plain), pear.params))
-    return out
+        return None
+    return primary, bifurcation.locate(primary, *events[0])
+
+
+class SeedStop(enum.StrEnum):
+    """Why a half of the symmetric relative's pear branch stopped early (``seed``)."""
+
+    WIDE = "wide"  # a point of pear amplitude |A| ≥ SEED_AMPLITUDE: the seed
+
+
+@limited_blas
+def seed(scene, relative: Branch, bp, sign: float) -> tuple:
+    """The half ``sign`` of the symmetric relative's pear branch at ``bp``, traced to its first point X = (u, P) of
+    pear amplitude |A| ≥ SEED_AMPLITUDE (a refined basis' first point included): (X on the plain general held basis
+    of the degree it was computed at, the branch's parameters); HomotopyError when the half cannot be started or
+    stops below that amplitude."""
+
+    def wide(disc, point):
+        rows = disc.pole_rows()
+        amplitude = (rows["lam2_top"] - rows["lam2_bottom"]) @ point.X[:-1]
+        return Stop(SeedStop.WIDE, "the seed's pear amplitude") if abs(amplitude) >= SEED_AMPLITUDE else None
+
+    traced = pear_leg(relative, bp, sign, until=wide)
+    if traced is None:
+        raise HomotopyError("the pear branch of the symmetric relative could not be started")
+    _, leg = traced
+    last, path = leg.segments[-1]
+    candidates = [(disc, p) for disc, traced_path in leg.segments for p in traced_path.points]
+    candidates += [(last, path.overshoot)] if leg.stop.code == SeedStop.WIDE else []
+    for disc, point in candidates:
+        if wide(disc, point) is not None:
+            plain = held_tracer(scene).system(disc.degree, relative.params).eq.disc
+            return disc.transfer(point.X, plain), relative.params
+    raise HomotopyError(f"the pear branch of the symmetric relative stays below amplitude {SEED_AMPLITUDE:g}")
 
 
 def held_tracer(scene) -> Tracer:
@@ -116,24 +142,56 @@ def distance_to(branch: Branch, X: np.ndarray, disc) -> float:
     return float(np.abs(a + s[:, None] * d - target).max(axis=1).min())
 
 
+def half(scene, relative: Branch, bp, primary: Branch, sign: float):
+    """The half ``sign`` of the symmetric relative's pear branch at ``bp`` (``seed``) continued to the scene's coil
+    heights: (X, its parameters, whether X lies on ``primary``: within ON_BRANCH of it), or the HomotopyError that
+    stopped it, returned (a half is needed only when the halves before it lie on the primary branch)."""
+    try:
+        X, params = seed(scene, relative, bp, sign)
+        X = continued(scene, X, params)
+    except HomotopyError as error:
+        return error
+    return X, params, distance_to(primary, X, held_tracer(scene).system(_degree(X), params).eq.disc) <= ON_BRANCH
+
+
+def trace_cost(degree: int) -> float:
+    """``workers.spread``'s cost of a trace at ``degree``: TRACE_ASSESSMENTS assessments there."""
+    return TRACE_ASSESSMENTS * assessment_cost(degree, 0)
+
+
+@limited_blas
 def broken_pear(scene, primary: Branch, name: str = "broken_pear", progress=None) -> Branch | None:
     """The pear branch the scene's broken equator symmetry disconnects from ``primary`` (module docstring), None
-    when the symmetric relative has no pear pitchfork; HomotopyError when it is not found."""
+    when the symmetric relative has no pear pitchfork; HomotopyError when it is not found. The two halves (seed and
+    continuation in the coil heights) run on every core (``numerics.workers``: the numbers of the serial loop)."""
     t0 = time.perf_counter()
-    tracer = held_tracer(scene)
-    found = seeds(scene)
-    if not found:
+    found = pitchfork(scene)
+    if found is None:
         return None
-    for X, params in found:
-        X = continued(scene, X, params)
-        system = tracer.system(_degree(X), params)
-        if distance_to(primary, X, system.eq.disc) <= ON_BRANCH:
-            continue  # the half that joins the primary branch
-        stop, pressure = pear_stop_rule(scene), np.eye(X.size)[-1]
-        legs = [tracer.leg(continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0), params,
-                           stop, progress, degree=_degree(X)) for sign in (1.0, -1.0)]
-        branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=pear_landing(scene),
-                                      labels=("up", "down")))
-        branch.origin = Origin.CONTINUED_IN_HEIGHT
-        return branch
+    relative, bp = found
+    degree = plain_degree(relative, bp.X)
+    general_tracer(scene, bp.block).system(degree, relative.params).eq.disc.projection  # a pseudo-inverse (~1 s
+    #   at degree 320) both halves start with (``pear_leg``'s transfer to the plain basis): built here, inherited
+    halves = workers.spread(lambda sign: half(scene, relative, bp, primary, sign), SIGNS,
+                            [trace_cost(degree)] * len(SIGNS))
+    for continued_half in halves:
+        if isinstance(continued_half, HomotopyError):
+            raise continued_half
+        X, params, joins = continued_half
+        if not joins:  # the half that joins the primary branch is passed over
+            return trace_disconnected(scene, X, params, name, progress, t0)
     raise HomotopyError("both halves of the pear branch, continued in the coil heights, lie on the primary branch")
+
+
+def trace_disconnected(scene, X: np.ndarray, params, name: str, progress, t0: float) -> Branch:
+    """The disconnected branch traced in P both ways from its continued point X (module docstring), in this
+    process: a leg that refines onto a wire-mapped basis builds that basis' projection (a pseudo-inverse, ~1 s at
+    degree 320), which the assembly here transfers the other points with."""
+    tracer, degree = held_tracer(scene), _degree(X)
+    system, stop, pressure = tracer.system(degree, params), pear_stop_rule(scene), np.eye(X.size)[-1]
+    legs = [tracer.leg(continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0), params,
+                       stop, progress, degree=degree) for sign in SIGNS]
+    branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=pear_landing(scene),
+                                  labels=("up", "down")))
+    branch.origin = Origin.CONTINUED_IN_HEIGHT
+    return branch

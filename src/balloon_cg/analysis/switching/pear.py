@@ -47,6 +47,17 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
     correction fails. ``bottom_turns``: its special points include the turning points of the south pole stretch
     too, labelled ``Turn.BOTTOM`` (located as TP is for the north pole)."""
     t0 = time.perf_counter()
+    traced = pear_leg(branch, bp, sign, progress, delta, bottom_turns)
+    if traced is None:
+        return None
+    tracer, leg = traced
+    return with_events(assemble(tracer, branch.params, name, leg, t0=t0, land_on=pear_landing(branch.scene)))
+
+
+def pear_leg(branch: Branch, bp: SpecialPoint, sign: float, progress=None, delta: float = 1e-3,
+             bottom_turns: bool = False, until=None):
+    """(tracer, LegTrace) of the pear branch leaving ``bp`` along sign·φ (``trace_pear`` before its assembly), None
+    if the first correction fails. ``until(disc, point)``: a stop rule asked after the pear branch's own."""
     scene = branch.scene
     tracer = general_tracer(scene, bp.block)
     degree = plain_degree(branch, bp.X)
@@ -71,11 +82,10 @@ def trace_pear(branch: Branch, bp: SpecialPoint, sign: float, name: str, progres
         direction, star = anchors[disc]
         if direction @ (point.X - star) < 0:
             return Stop(StopCode.REJOINED, "rejoined the primary branch")
-        return base(disc, point)
+        return base(disc, point) or (until(disc, point) if until is not None else None)
 
     turning = TOP_TURNING | ({Turn.BOTTOM: "lam2_bottom"} if bottom_turns else {})
-    return with_events(assemble(tracer, params, name, tracer.leg(start, params, stop, progress, degree=degree,
-                                                                 turning=turning), t0=t0, land_on=pear_landing(scene)))
+    return tracer, tracer.leg(start, params, stop, progress, degree=degree, turning=turning)
 
 
 def bottom_stop_stretch(upper: float) -> Stop:
