@@ -4,7 +4,7 @@ A wall clock on a shared machine measures the other processes; a file's CPU does
 (``-p suite_cpu`` with benchmarks/ on PYTHONPATH) it records, in each worker, every test file's CPU seconds from
 its first test's setup to its last test's teardown (this process's and its waited-for children's: the subprocesses
 of the CLI tests, the pools of the sweeps) and its wall seconds, and writes them to ``$SUITE_CPU_OUT/<worker>.json``
-at the session's end. As a script it runs the default suite that way (pyproject's addopts: 2 workers, loadfile),
+as each file ends. As a script it runs the default suite that way (pyproject's addopts: 2 workers, loadfile),
 or reads the records of such runs, and prints per file the CPU seconds (one column per run), their ratio to the
 first run's, and the sums: the suite's CPU, each worker's CPU (the wall time of an idle 2-core machine is about the
 larger of the two, since a file runs whole on one worker) and the files' wall seconds on each worker.
@@ -45,9 +45,11 @@ def pytest_runtest_protocol(item, nextitem):
     TESTS[item.nodeid] = cpu() - start_cpu
     spent[0] += TESTS[item.nodeid]
     spent[1] += time.monotonic() - start_wall
+    if nextitem is None or nextitem.location[0] != item.location[0]:
+        write()  # a file done: a run stopped early keeps what it measured
 
 
-def pytest_sessionfinish(session):
+def write():
     folder = os.environ.get("SUITE_CPU_OUT")
     if not folder or not FILES:
         return
@@ -91,6 +93,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, help="run the suite, recording into this folder")
     parser.add_argument("--read", type=Path, nargs="+", default=[], help="folders of earlier runs to compare")
     parser.add_argument("--cost", action="store_true", help="print COST (tests/conftest.py) from the first run")
+    parser.add_argument("--tests", type=int, default=0, help="also list the first run's N costliest tests")
     parser.add_argument("pytest", nargs="*", help="arguments for pytest (after --)")
     args = parser.parse_args(argv)
     folders = list(args.read)
@@ -107,6 +110,10 @@ def main(argv=None) -> int:
         print(", ".join(f'"{name}": {spent:.0f}' for name, spent in cost if spent >= 5))
     if runs:
         table(runs, [f.name for f in folders])
+    if args.tests and folders:
+        tests = {k: v for record in folders[0].glob("*.tests") for k, v in json.loads(record.read_text()).items()}
+        for name, spent in sorted(tests.items(), key=lambda t: -t[1])[:args.tests]:
+            print(f"{spent:7.1f} s  {name}")
     return 0
 
 
