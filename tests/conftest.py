@@ -21,7 +21,8 @@ ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 COST = {  # seconds of each file on one worker of an idle 2-core run (issue 37): from a survey of the whole suite under
     # load (session 20), the mean of its CPU and wall shares scaled to the suite's ~780 worker-seconds; files added
     # since by their own runs' times, halved for the load they ran under; test_codegen and test_paper scaled by the
-    # CPU ratios of their serial runs after the faster derivation and the figures drawn once (0.54x, 0.82x)
+    # CPU ratios of their serial runs after the faster derivation and the figures drawn once (0.54x, 0.82x);
+    # `python benchmarks/suite_cpu.py --out DIR --cost` measures each file's CPU in a run and prints these entries
     "test_interrupt_moments": 118, "test_paper": 43, "test_codegen": 22, "test_surface": 37,
     "test_cli_conventions": 29, "test_packaging": 27, "test_restart": 26, "test_crash": 20, "test_damaged_fuzz": 19,
     "test_branch_points": 18, "test_verdict": 17, "test_signal_moments": 17, "test_tube_field": 15,
