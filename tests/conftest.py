@@ -18,19 +18,19 @@ import pytest
 
 ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
-COST = {  # seconds of each file on one worker of an idle 2-core run (issue 37): from a survey of the whole suite under
-    # load (session 20), the mean of its CPU and wall shares scaled to the suite's ~780 worker-seconds; files added
-    # since by their own runs' times, halved for the load they ran under; test_codegen and test_paper scaled by the
-    # CPU ratios of their serial runs after the faster derivation and the figures drawn once (0.54x, 0.82x)
-    "test_interrupt_moments": 118, "test_paper": 43, "test_codegen": 22, "test_surface": 37,
-    "test_cli_conventions": 29, "test_packaging": 27, "test_restart": 26, "test_crash": 20, "test_damaged_fuzz": 19,
-    "test_branch_points": 18, "test_verdict": 17, "test_signal_moments": 17, "test_tube_field": 15,
-    "test_azimuthal_points": 15, "test_plot_sizes": 13, "test_kernels_cmd": 13, "test_tuning": 12, "test_poles": 12,
-    "test_energies": 12, "test_api": 11, "test_fold_meeting": 11, "test_shooting": 10, "test_interval": 10,
-    "test_formula": 9, "test_dynamics": 9, "test_bifurcation": 9, "test_sweep": 9, "test_surface_store": 9,
-    "test_surface_kernels": 8, "test_events": 8, "test_checked_reads": 8, "test_stability_basis": 8,
-    "test_dynamics_surface": 8, "test_plotting": 7, "test_sphere_modes": 7, "test_api_notebook": 7,
-    "test_hostile_memory": 7, "test_tube": 7, "test_surface_pitchforks": 6, "test_dask_cluster": 6,
+COST = {  # CPU seconds of each file in one run of the default suite on 2 workers (benchmarks/suite_cpu.py --cost, this
+    # process and its children; session 23, the machine loaded 5-13: only the order matters), files of 5 s or more
+    "test_interrupt_moments": 125, "test_paper": 62, "test_restart": 47, "test_surface": 47, "test_codegen": 45,
+    "test_packaging": 43, "test_cli_conventions": 31, "test_plot_sizes": 25, "test_verdict": 24,
+    "test_tube_interrupt": 24, "test_capsule": 23, "test_signal_moments": 22, "test_crash": 18,
+    "test_damaged_fuzz": 17, "test_plotting": 15, "test_shooting": 15, "test_sweep": 15, "test_branch_points": 14,
+    "test_checked_reads": 13, "test_api_notebook": 13, "test_azimuthal_points": 12, "test_surface_kernels": 11,
+    "test_poles": 11, "test_events": 11, "test_dynamics": 10, "test_energies": 9, "test_formula": 9, "test_api": 8,
+    "test_fold_meeting": 8, "test_kernels_cmd": 8, "test_tube_electric": 8, "test_stability_basis": 8,
+    "test_dynamics_shapes": 8, "test_cli": 8, "test_field": 7, "test_surface_store": 7, "test_sphere_modes": 7,
+    "test_fuzz": 6, "test_damaged_files": 6, "test_dask_cluster": 6, "test_tube_field": 6, "test_two_parameter": 6,
+    "test_tube_control": 6, "test_surface_pitchforks": 5, "test_fold_curve": 5, "test_interval": 5, "test_schema": 5,
+    "test_hostile_memory": 5,
 }
 
 
