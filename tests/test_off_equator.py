@@ -39,7 +39,7 @@ def coil_at(height: float):
 
 @pytest.fixture(scope="module")
 def off_equator():
-    """The picture without the disconnected pear branch (``pear=False``: its search is the slow test below)."""
+    """The picture without the disconnected pear branch (``pear=False``: its search is the tests below)."""
     return analyse(coil_at(0.5), pear=False)
 
 
@@ -105,7 +105,6 @@ def test_the_coil_back_on_the_equator_gives_the_symmetric_analysis():
     assert not [s for s in picture.primary.special if s.kind in (Kind.LV, Kind.LN)]
 
 
-@pytest.mark.slow
 def test_the_disconnected_pear_branch_is_found_by_continuation_in_the_coil_height(tmp_path, capsys):
     """The pear branch the coil's height breaks off the primary branch: found from the pear branch of the coil at
     h = 0 (continued in h at its pear amplitude), traced both ways in P, stored with how it was found. Every point a
@@ -133,7 +132,6 @@ def test_the_disconnected_pear_branch_is_found_by_continuation_in_the_coil_heigh
     assert stored["origin"] == "continued_in_height" and stored["gauge"] == "held"
 
 
-@pytest.mark.slow
 def test_the_disconnected_pear_branch_gets_its_user_points():
     """A volume event (``[[events]]`` volume = 20) on the coil at h = 0.5: the disconnected pear branch passes V = 20
     twice (its volume has a minimum 19.886 between them) and holds a located UZ point in each interval, V = 20 there
@@ -156,7 +154,6 @@ def test_the_disconnected_pear_branch_gets_its_user_points():
         assert np.abs(system.residual(s.X)).max() <= scene.solver.tol
 
 
-@pytest.mark.slow
 def test_the_disconnected_pear_branch_on_two_workers_is_the_serial_one(monkeypatch):
     """The halves of the symmetric relative's pear branch and the legs of the disconnected branch's trace go to two
     forked workers (``broken_pear``; every spread forks here): the branch is the serial one bit for bit, and its

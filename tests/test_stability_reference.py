@@ -21,7 +21,11 @@ coil: every label and flag identical; its m1_free point next to the wire at P 1.
 its x-basis gap: the crossing eigenvalue there is −1.4e-8 in x at 400 and on the map); the m1_free eigenvalues of
 the primary's last points moved by up to 7.8e-8 (main's at x-degree 320, unconverged there; now the map's at 67);
 pear_0_mirror's rejoin point is the reflected state on the mirrored map (issue 39: 94ce54e stored the pear's
-coefficients there, another state on that map)."""
+coefficients there, another state on that map). The off-equator scene (session 23): its broken pear's legs start on
+the wire map of the continued point at the scene's degree instead of the seed's plain degree 320, so the branch is
+traced through other points (54 instead of 76, stored at degree 90): its four special points the same (kinds,
+labels, status), their P within 8.6e-10 (the fold 2.2e-13), the unstable count of every block the same sequence
+along the branch; the other branches unchanged."""
 import numpy as np
 import pytest
 

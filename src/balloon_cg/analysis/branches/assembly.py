@@ -5,7 +5,7 @@ latest), its degree raised by the resolution policy while the projection would l
 loss limit of any point and raising it helps. A point's stored error estimate adds its measured projection
 loss. A leg that stopped on passing a pole stretch given in ``land_on`` (STOP_STRETCH, MIN_STRETCH,
 BOTTOM_STOP_STRETCH) gets its exact end point there (Newton on the pole row r·X = target from the linear
-interpolant); one that stopped on a value of the control parameter q (STOP_VOLUME, STOP_AMOUNT: q = V or n,
+interpolant; on the leg's own last basis, then moved, where the storage basis does not resolve it); one that stopped on a value of the control parameter q (STOP_VOLUME, STOP_AMOUNT: q = V or n,
 nonlinear in X) lands by Newton on the linearised constraint ∇q(X_k)·(X − X_k) = target − q(X_k), repeated
 until |q − target| ≤ LANDING_RTOL·max(1, |target|); a fold found between the last point and the overshoot is
 kept only if it lies before that end. One that stopped on a value of a continuation parameter that has a
@@ -133,7 +133,29 @@ def _landed(tracer, final, leg: LegTrace, points: list, folds: list, land_on: di
                                                            "failed); stopped before it")
     q, last = quantity[0], quantity[0](points[-1][0])
     kept += [f for f in beyond if (q(f[2]) - last) * (target - q(f[2])) >= 0]
-    return points + [(end.X, end, disc.degree, disc.tail(end.X[:-1]))], kept, leg.stop
+    return points + [_resolved_end(tracer, final, leg, pole, target, end)], kept, leg.stop
+
+
+def _resolved_end(tracer, final, leg: LegTrace, pole, target, end: continuation.Point) -> tuple:
+    """(X, point, solved degree, error estimate) of a leg's end landed on the storage basis (``final``); where it
+    is not resolved there (its tail above max_error: a storage map made for another leg's states) and the leg
+    ended on another basis, the end landed on that one instead and moved to storage like the leg's other points,
+    its estimate the tail there plus the projection loss, if that is smaller."""
+    disc = final.eq.disc
+    estimate = disc.tail(end.X[:-1])
+    own_disc, path = leg.segments[-1]
+    if estimate <= tracer.resolution.max_error or own_disc is disc or not path.points:
+        return end.X, end, disc.degree, estimate
+    own = tracer.system(own_disc.degree, final.params, own_disc.mapping)
+    own_end = land(own, path.points[-1].X, path.overshoot.X, quantity_of(own, pole), target, tracer.settings)
+    if own_end is None:
+        return end.X, end, disc.degree, estimate
+    moved = own_disc.transfer(own_end.X, disc)
+    own_estimate = own_disc.tail(own_end.X[:-1]) + transfer_error(own_disc, own_end.X, disc, moved)[0]
+    if own_estimate >= estimate:
+        return end.X, end, disc.degree, estimate
+    return moved, continuation.Point(moved, own_end.tangent, own_end.iterations, own_end.residual), \
+        own_disc.degree, own_estimate
 
 
 def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | None = None, t0: float = 0.0,

@@ -14,7 +14,11 @@ basis (balloon held) of the degree the seed was computed at. At t = 1 a continue
 branch (the polyline of its points in (P, λ2(0), λ2(π)), max norm) lies on it: the half that joins the primary
 branch. The other is traced in P both ways from its continued point (held, stop rules of the primary branch and
 the south pole reaching stop_stretch), its user points (``events``) located, and stored with origin
-``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``). The two halves run on every core.
+``Origin.CONTINUED_IN_HEIGHT`` (``broken_pear``). The two halves run on every core. Its legs start on the wire map
+of the continued point's own state at the scene's degree (``wires.wire_map``, corrected there at its P: the tracer
+refines from it as the primary branch's does), not on the seed's plain basis, whose degree is the relative's pear
+branch's near its wire (320 in docs/numerics.md §6's off-equator scene: the legs 17× and their assessment 9× the
+mapped start's CPU); where no wire gets a map, or the corrector does not converge there, on the plain basis.
 """
 import enum
 import time
@@ -31,6 +35,7 @@ from ..points.branch_points import general_tracer, plain_degree
 from ..branches.assembly import assemble
 from ..branches.events import with_events
 from ..branches.primary import trace_primary
+from ..branches.wires import wire_map
 from ..branches.problem import ParameterSystem
 from ..results import Block, Branch, Origin
 from ..stability.axisymmetric import assess_branch, assessment_cost
@@ -126,6 +131,20 @@ def continued(scene, X: np.ndarray, params) -> np.ndarray:
     return X
 
 
+def _mapped_start(scene, tracer: Tracer, X: np.ndarray, params) -> tuple:
+    """(system, X) of the legs' start (module docstring): X moved onto the wire map of its state at the scene's
+    degree and corrected there at its P, or X on its plain basis where there is no map or no convergence."""
+    plain = tracer.system(_degree(X), params)
+    mapping = wire_map(plain.eq.disc, X[:-1], scene.field.coils, False)
+    if mapping is None:
+        return plain, X
+    system = tracer.system(scene.solver.degree, params, mapping)
+    Y = plain.eq.disc.transfer(X, system.eq.disc)
+    landed = newton(system.residual, system.jacobian, Y, np.eye(Y.size)[-1], Y[-1], scene.solver.tol,
+                    scene.solver.max_newton)
+    return (system, landed.x) if landed.converged else (plain, X)
+
+
 def _degree(X: np.ndarray) -> int:
     """The degree N of a plain general held layout holding X = (u, P): N + 1 a's and N b's (b_0 pinned)."""
     return (X.size - 1) // 2
@@ -187,10 +206,11 @@ def trace_disconnected(scene, X: np.ndarray, params, name: str, progress, t0: fl
     """The disconnected branch traced in P both ways from its continued point X (module docstring), in this
     process: a leg that refines onto a wire-mapped basis builds that basis' projection (a pseudo-inverse, ~1 s at
     degree 320), which the assembly here transfers the other points with."""
-    tracer, degree = held_tracer(scene), _degree(X)
-    system, stop, pressure = tracer.system(degree, params), pear_stop_rule(scene), np.eye(X.size)[-1]
+    tracer = held_tracer(scene)
+    system, X = _mapped_start(scene, tracer, X, params)
+    pressure, disc = np.eye(X.size)[-1], system.eq.disc
     legs = [tracer.leg(continuation.Point(X, sign * continuation.tangent(system, X, pressure), 0, 0.0), params,
-                       stop, progress, degree=degree) for sign in SIGNS]
+                       pear_stop_rule(scene), progress, degree=disc.degree, mapping=disc.mapping) for sign in SIGNS]
     branch = with_events(assemble(tracer, params, name, legs[0], legs[1], t0, land_on=pear_landing(scene),
                                   labels=("up", "down")))
     branch.origin = Origin.CONTINUED_IN_HEIGHT
