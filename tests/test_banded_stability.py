@@ -42,6 +42,14 @@ def _banded_matrix(rng, n: int, bandwidth: int) -> np.ndarray:
     return A
 
 
+def _relatives(H, G, N, g, rho) -> list:
+    """(constraints, update, the dense pencil) of (H, G), on Nᵀc = 0, with ρggᵀ, and both."""
+    Z = linalg.null_space(N)
+    return [(None, None, (H, G)), (N, None, (Z.T @ H @ Z, Z.T @ G @ Z)),
+            (None, (g, rho), (H + rho * np.outer(g, g), G)),
+            (N, (g, rho), (Z.T @ (H + rho * np.outer(g, g)) @ Z, Z.T @ G @ Z))]
+
+
 def test_banded_shift_invert_against_a_dense_generalized_eigensolve():
     rng = np.random.default_rng(3)
     n, b = 120, 5
@@ -52,12 +60,7 @@ def test_banded_shift_invert_against_a_dense_generalized_eigensolve():
     g, rho = rng.standard_normal(n), 0.7
     shifted = BandedShiftInvert.below(_band(H, b), _band(G, b), guess=0.0)
     assert shifted is not None and shifted.sigma < linalg.eigh(H, G, eigvals_only=True)[0]
-    Z = linalg.null_space(N)
-    for constraints, update, (K, M) in (
-            (None, None, (H, G)),
-            (N, None, (Z.T @ H @ Z, Z.T @ G @ Z)),
-            (None, (g, rho), (H + rho * np.outer(g, g), G)),
-            (N, (g, rho), (Z.T @ (H + rho * np.outer(g, g)) @ Z, Z.T @ G @ Z))):
+    for constraints, update, (K, M) in _relatives(H, G, N, g, rho):
         dense = linalg.eigh(K, M, eigvals_only=True, subset_by_index=(0, 2))
         found = shifted.lowest(3, constraints, update)
         np.testing.assert_allclose(found, dense, rtol=0, atol=1e-10 * max(1.0, np.abs(dense).max()))
@@ -93,12 +96,7 @@ def test_inside_shift_reads_an_isolated_lowest_eigenvalue_against_a_dense_eigens
     inside = InsideShift.between(shifted, estimates, None, None)
     assert inside is not None and dense[0] < inside.sigma < dense[1]
     N, g, rho = rng.standard_normal((2, n)), rng.standard_normal(n), 0.7
-    Z = linalg.null_space(N)
-    for constraints, update, (K, M) in (
-            (None, None, (H, G)),
-            (N, None, (Z.T @ H @ Z, Z.T @ G @ Z)),
-            (None, (g, rho), (H + rho * np.outer(g, g), G)),
-            (N, (g, rho), (Z.T @ (H + rho * np.outer(g, g)) @ Z, Z.T @ G @ Z))):
+    for constraints, update, (K, M) in _relatives(H, G, N, g, rho):
         expected = linalg.eigh(K, M, eigvals_only=True, subset_by_index=(0, 2))
         np.testing.assert_allclose(shifted.lowest(3, constraints, update), expected, rtol=0,
                                    atol=1e-10 * np.abs(expected).max())
