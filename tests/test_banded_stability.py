@@ -76,6 +76,9 @@ def test_band_ldlt_counts_the_negative_eigenvalues_and_solves():
         assert ldlt is not None and ldlt.negatives == int((np.linalg.eigvalsh(shifted) < 0).sum())
         r = rng.standard_normal(n)
         np.testing.assert_allclose(shifted @ ldlt.solve(r), r, atol=1e-9 * np.abs(r).max())
+    # a tiny pivot (growth 1e16 against max |A_ii| = 1) and a zero one: no inertia is claimed
+    assert BandLDLT.factor(_band(np.array([[1e-16, 1.0], [1.0, 1.0]]), 1)) is None
+    assert BandLDLT.factor(_band(np.array([[0.0, 1.0], [1.0, 1.0]]), 1)) is None
 
 
 def test_inside_shift_reads_an_isolated_lowest_eigenvalue_against_a_dense_eigensolve():
