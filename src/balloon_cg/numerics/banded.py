@@ -14,7 +14,9 @@ K + ρggᵀ − σG = R (I + ρĝĝᵀ) Rᵀ with ĝ = R⁻¹g (ρ > 0 keeps σ 
 M = (I + ρĝĝᵀ)^(−1/2) = I + α ĝĝᵀ/|ĝ|², α = (1 + ρ|ĝ|²)^(−1/2) − 1, makes the operator M W M. A constraint
 nᵀc = 0 reads (R⁻¹n)ᵀ z = 0, i.e. (M R⁻¹ n)ᵀ z' = 0: the operator P M W M P, P the orthogonal projector onto the
 complement of those rows, whose largest eigenvalues are the constrained pencil's 1/(μ − σ) (Courant–Fischer), its
-spectrum still above σ (a restriction interlaces).
+spectrum still above σ (a restriction interlaces). That reads μ₁; μ₂, μ₃, … come from a shift between μ₁ and μ₂
+proved by inertia (``InsideShift``), where the ν of clustered μ₂, μ₃ far above a very negative μ₁ no longer differ
+by only (μ₃ − μ₂)/(μ₂ − σ).
 """
 import numpy as np
 from scipy.linalg.blas import dsbmv
