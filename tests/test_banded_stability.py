@@ -21,7 +21,8 @@ from balloon_cg.analysis.stability.axisymmetric import SecondVariation, assess_b
 from balloon_cg.analysis.stability.banded import BandedVariation
 from balloon_cg.analysis.stability.banded_azimuthal import BandedAzimuthal
 from balloon_cg.galerkin.piecewise import PiecewiseBasis
-from balloon_cg.numerics.banded import BandedShiftInvert
+from balloon_cg.numerics.band_ldlt import BandLDLT
+from balloon_cg.numerics.banded import BandedShiftInvert, InsideShift
 from balloon_cg.scene import SceneError, load_scene, parse_scene
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -41,6 +42,14 @@ def _banded_matrix(rng, n: int, bandwidth: int) -> np.ndarray:
     return A
 
 
+def _relatives(H, G, N, g, rho) -> list:
+    """(constraints, update, the dense pencil) of (H, G), on Nᵀc = 0, with ρggᵀ, and both."""
+    Z = linalg.null_space(N)
+    return [(None, None, (H, G)), (N, None, (Z.T @ H @ Z, Z.T @ G @ Z)),
+            (None, (g, rho), (H + rho * np.outer(g, g), G)),
+            (N, (g, rho), (Z.T @ (H + rho * np.outer(g, g)) @ Z, Z.T @ G @ Z))]
+
+
 def test_banded_shift_invert_against_a_dense_generalized_eigensolve():
     rng = np.random.default_rng(3)
     n, b = 120, 5
@@ -51,15 +60,49 @@ def test_banded_shift_invert_against_a_dense_generalized_eigensolve():
     g, rho = rng.standard_normal(n), 0.7
     shifted = BandedShiftInvert.below(_band(H, b), _band(G, b), guess=0.0)
     assert shifted is not None and shifted.sigma < linalg.eigh(H, G, eigvals_only=True)[0]
-    Z = linalg.null_space(N)
-    for constraints, update, (K, M) in (
-            (None, None, (H, G)),
-            (N, None, (Z.T @ H @ Z, Z.T @ G @ Z)),
-            (None, (g, rho), (H + rho * np.outer(g, g), G)),
-            (N, (g, rho), (Z.T @ (H + rho * np.outer(g, g)) @ Z, Z.T @ G @ Z))):
+    for constraints, update, (K, M) in _relatives(H, G, N, g, rho):
         dense = linalg.eigh(K, M, eigvals_only=True, subset_by_index=(0, 2))
         found = shifted.lowest(3, constraints, update)
         np.testing.assert_allclose(found, dense, rtol=0, atol=1e-10 * max(1.0, np.abs(dense).max()))
+
+
+def test_band_ldlt_counts_the_negative_eigenvalues_and_solves():
+    rng = np.random.default_rng(5)
+    n, b = 90, 4
+    A = _banded_matrix(rng, n, b)
+    for shift in (-3.0, 0.0, 2.5):
+        shifted = A - shift * np.eye(n)
+        ldlt = BandLDLT.factor(_band(shifted, b))
+        assert ldlt is not None and ldlt.negatives == int((np.linalg.eigvalsh(shifted) < 0).sum())
+        r = rng.standard_normal(n)
+        np.testing.assert_allclose(shifted @ ldlt.solve(r), r, atol=1e-9 * np.abs(r).max())
+    # a tiny pivot (growth 1e16 against max |A_ii| = 1) and a zero one: no inertia is claimed
+    assert BandLDLT.factor(_band(np.array([[1e-16, 1.0], [1.0, 1.0]]), 1)) is None
+    assert BandLDLT.factor(_band(np.array([[0.0, 1.0], [1.0, 1.0]]), 1)) is None
+
+
+def test_inside_shift_reads_an_isolated_lowest_eigenvalue_against_a_dense_eigensolve():
+    """A pencil as the paper coil's blocks near a wire: μ₁ far below a cluster μ₂, μ₃ (a deep local well in a
+    discrete Laplacian); the inside shift is found and every relative's three lowest are the dense ones."""
+    rng = np.random.default_rng(1)
+    n, b = 400, 6
+    x = np.linspace(0.0, 1.0, n)
+    H = (n * n / 50.0) * (2.0 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
+    H -= np.diag(300.0 * np.exp(-((x - 0.3) / 0.01) ** 2))
+    G = np.eye(n) + 0.02 * (_banded_matrix(rng, n, b) - np.diag(np.diag(_banded_matrix(rng, n, b))))
+    G = 0.5 * (G + G.T)
+    H_band, G_band = _band(H, b), _band(G, b)
+    dense = linalg.eigh(H, G, eigvals_only=True, subset_by_index=(0, 2))
+    assert dense[0] < -100.0 and dense[2] - dense[1] < 2.0  # the case the inside shift is for
+    shifted = BandedShiftInvert.below(H_band, G_band, float(np.min(np.diag(H) / np.diag(G))))
+    estimates = shifted._below(1, None, None, 1e-9, also=2)
+    inside = InsideShift.between(shifted, estimates, None, None)
+    assert inside is not None and dense[0] < inside.sigma < dense[1]
+    N, g, rho = rng.standard_normal((2, n)), rng.standard_normal(n), 0.7
+    for constraints, update, (K, M) in _relatives(H, G, N, g, rho):
+        expected = linalg.eigh(K, M, eigvals_only=True, subset_by_index=(0, 2))
+        np.testing.assert_allclose(shifted.lowest(3, constraints, update), expected, rtol=0,
+                                   atol=1e-10 * np.abs(expected).max())
 
 
 def test_piecewise_basis_integrates_the_constant():

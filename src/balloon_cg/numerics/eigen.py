@@ -274,7 +274,7 @@ class ShiftInvert:
         return operator
 
 
-def largest_by_lanczos(operator, n: int, count: int, check_every: int = 1) -> np.ndarray:
+def largest_by_lanczos(operator, n: int, count: int, check_every: int = 1, also: int = 0) -> np.ndarray:
     """The ``count`` largest eigenvalues (ascending) of the symmetric positive semidefinite operator (x ↦ Sx on
     vectors of size n) by Lanczos with full reorthogonalisation (two Gram–Schmidt passes a step, no restarts: ~2/3
     of the products ARPACK's implicitly restarted Lanczos needs here), stopped when every wanted Ritz pair's
@@ -284,8 +284,10 @@ def largest_by_lanczos(operator, n: int, count: int, check_every: int = 1) -> np
     single-vector Krylov method (ARPACK's too) it sees an exactly multiple eigenvalue once: its callers read
     states off any symmetry that forces one (an axisymmetric point 0 of a surface branch is solved dense).
     ``check_every``: the Ritz values (the stopping test) are computed every that many steps only, for runs of
-    ~100 steps on an operator cheaper than the tridiagonal eigensolve (banded pencils: numerics/banded.py)."""
-    run = _lanczos(n, count, check_every)
+    ~100 steps on an operator cheaper than the tridiagonal eigensolve (banded pencils: numerics/banded.py).
+    ``also``: that many next Ritz values are returned below the wanted ones, unconverged (lower bounds of the
+    eigenvalues they approach: Cauchy interlacing), as estimates."""
+    run = _lanczos(n, count, check_every, also)
     v = next(run)
     while True:
         try:
@@ -294,7 +296,7 @@ def largest_by_lanczos(operator, n: int, count: int, check_every: int = 1) -> np
             return done.value
 
 
-def _lanczos(n: int, count: int, check_every: int = 1):
+def _lanczos(n: int, count: int, check_every: int = 1, also: int = 0):
     """``largest_by_lanczos`` as a generator: yields each vector the operator is to be applied to, is sent its
     product, and returns the Ritz values (StopIteration.value); several runs can share their products' cost."""
     rng = np.random.default_rng(LANCZOS_START)
@@ -310,8 +312,9 @@ def _lanczos(n: int, count: int, check_every: int = 1):
             w -= basis.T @ (basis @ w)
         beta[j] = np.linalg.norm(w)
         if j + 1 >= count and ((j + 1 - count) % check_every == 0 or j + 1 == n):
-            theta, Y = linalg.eigh_tridiagonal(alpha[:j + 1], beta[:j], select="i", select_range=(j + 1 - count, j))
-            if j + 1 == n or np.all(np.abs(beta[j] * Y[-1]) <= 4.0 * EPS * theta.max()):
+            theta, Y = linalg.eigh_tridiagonal(alpha[:j + 1], beta[:j], select="i",
+                                               select_range=(max(0, j + 1 - count - also), j))
+            if j + 1 == n or np.all(np.abs(beta[j] * Y[-1, -count:]) <= 4.0 * EPS * theta.max()):
                 return theta
         if j + 1 == V.shape[0]:
             V = np.vstack([V, np.empty((min(V.shape[0], n - V.shape[0]), n))])

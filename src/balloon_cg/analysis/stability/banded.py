@@ -34,8 +34,9 @@ LAMBDA2, ETA = 0, 1  # the fields of a PiecewiseBasis's functions
 # blocks to within their own error estimates at points 35, 104 and 173 (benchmarks/banded_stability.py), but
 # not at points 37–140, where Legendre-320 is not converged (estimates up to 3e-5) and the elements' values lay up
 # to 1.6 times those estimates above it (Ritz values: above the converged ones); with 40 (1.5 per degree) every
-# stored m = 1 eigenvalue of those 139 points is within the reference rule but one, 1.5e-9 below Legendre-320,
-# whose dense eigensolve is ~1e-8 off (ε‖A‖); 2 per degree changes nothing more
+# stored m = 1 eigenvalue of those 139 points is within the reference rule but one (point 36's second m1_free),
+# 1.5e-9 below Legendre-320, whose dense values scatter by 2e-9 over degrees 213–560 (rounding) around the
+# elements' −0.0446494742213, the same to 1.3e-12 on 40–120 elements of order 12 and 16 (docs/numerics.md §4)
 ORDER, ELEMENT_FUNCTIONS = 12, 1.5
 
 
