@@ -153,8 +153,8 @@ def test_banded_blocks_agree_with_the_legendre_blocks_near_a_wire(near_wire, sym
 
 
 def test_banded_from_key_default_and_refusal():
-    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.banded_from == 0
-    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 225\n').stability.banded_from == 225
+    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.banded_from == 225
+    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 0\n').stability.banded_from == 0
     with pytest.raises(SceneError) as error:
         parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 10\n', name="s")
     message = str(error.value)

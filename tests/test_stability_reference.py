@@ -25,7 +25,14 @@ coefficients there, another state on that map). The off-equator scene (session 2
 the wire map of the continued point at the scene's degree instead of the seed's plain degree 320, so the branch is
 traced through other points (54 instead of 76, stored at degree 90): its four special points the same (kinds,
 labels, status), their P within 8.6e-10 (the fold 2.2e-13), the unstable count of every block the same sequence
-along the branch; the other branches unchanged."""
+along the branch; the other branches unchanged. The paper coil (session 23), when `stability.banded_from = 225`
+became the default (its points at degree ≥ 225 read on the banded sibling blocks): every label, flag and special
+point identical, every eigenvalue within its error estimate of the table's (largest change 5.8e-6, where the
+estimates reach 8e-5) but one: pear_free_2's point 36 (and its mirror), second m1_free eigenvalue, 1.46e-9 from the
+table's −0.044649472758, where the rule allows 1.1e-9. The elements are right there: 40 to 120 elements of order
+12 and 16 give −0.0446494742213 within 1.3e-12 of each other, while the dense Legendre blocks at degrees 213, 320,
+400, 480 and 560 scatter by 2e-9 with no trend in the degree (the dense eigensolver's rounding ε‖H‖ at these
+sizes; docs/numerics.md §4)."""
 import numpy as np
 import pytest
 

@@ -229,13 +229,14 @@ class Stability:
     relative to: "unknowns" ∫(δλ2² + δη²) d(cos θ) or "displacement" ∫(sin²θ δλ2² + δη²) d(cos θ) = |δx|², the
     m ≥ 1 blocks' norm (flags and branch points do not depend on it). ``banded_from``: the blocks (m = 0 and m ≥ 1) of a
     point assessed at perturbation degree N ≥ it are read on the banded sibling basis (C⁰ elements on the same map,
-    analysis/stability/banded.py); 0 (the default): never."""
+    analysis/stability/banded.py); 0: never; the default 225 (below it the dense blocks are as fast or faster:
+    docs/numerics.md §6)."""
 
     degree: int = 20
     m_max: int = 1
     basis: str = "mapped"
     norm: str = "displacement"
-    banded_from: int = 0
+    banded_from: int = 225
 
 
 STABILITY_BASES = ("legendre", "mapped")

@@ -294,8 +294,9 @@ class SecondVariation:
         another (volume and gas of a pressure block, the held m = 1 reading of the free one) read through one
         factorisation where they are large (``_axisymmetric_lowest``, ``azimuthal.lowest_readings``); from
         stability.banded_from on the banded sibling basis instead (``banded.banded_variation``,
-        ``banded_azimuthal.BandedAzimuthal``)."""
-        sibling = self._sibling(symmetric)
+        ``banded_azimuthal.BandedAzimuthal``), where P ≥ 0 (its gas reading's proved shift needs the rank-one weight
+        P/Ṽ ≥ 0: numerics/banded.py)."""
+        sibling = self._sibling(symmetric) if params.P >= 0 else None
         if sibling is None:
             yield from self._axisymmetric_lowest(u, params, symmetric)
         else:
