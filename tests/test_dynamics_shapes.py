@@ -183,6 +183,6 @@ def test_capsule_run_stores_its_frequencies_and_inspect_reads_them(tmp_path, cap
 
 def test_capsule_frequencies_need_m_max_zero():
     """A capsule with frequencies and m_max 1 (the default): one line naming the key, its value and 0."""
-    with pytest.raises(SceneError, match=r"dynamics.m_max = 1: a capsule's m ≥ 1 second variation .*allowed: 0") as e:
+    with pytest.raises(SceneError, match=r"dynamics.m_max = 1: a capsule's m ≥ 1 frequencies are not built yet .*allowed: 0") as e:
         parse_scene(CAPSULE.format(length=3.0, stop=2.0).replace("m_max = 0\n[continuation]", "[continuation]"))
     assert "\n" not in str(e.value)
