@@ -12,13 +12,12 @@ import numpy as np
 
 from .azimuthal import block
 from .primary import TubeSystem, held, volume_ratio
+from .zeros import corrected_zero
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.stability.crossings import count_changes
 from ..galerkin.equilibrium import Equilibrium
-from ..numerics import continuation
 from ..numerics.continuation import RootStatus
 
-BRENT_XTOL = 1e-13  # relative to the secant's length
 
 
 @dataclass(frozen=True)
@@ -65,18 +64,11 @@ def _zero(system, eq, params, settings, before, after, m: int, order: int, held_
     vanishes on the secant from ``before`` to ``after`` (X coordinates of ``system``); None where nothing could be
     evaluated."""
     length = float(np.linalg.norm(after - before))
-    tangent = (after - before) / length
 
     def eigenvalue(Y):
         return float(np.linalg.eigvalsh(block(eq, Y[:-1], params.with_value("P", Y[-1]), m, held_block))[order])
 
-    def value_at(s):
-        result = continuation.correct(system, before + s * tangent, tangent, settings)
-        if not result.converged:
-            raise ArithmeticError(result.message)
-        Y = system.full(result.x)
-        return eigenvalue(Y), Y
-
     end = system.full(after)
-    root = continuation.locate_root(value_at, length, BRENT_XTOL, known={length: (eigenvalue(end), end)})
+    root = corrected_zero(system, settings, before, (after - before) / length, length, eigenvalue,
+                          {length: (eigenvalue(end), end)})
     return None if root is None else (root.payload, root.status, root.value)

@@ -15,7 +15,7 @@ second variation ∂R/∂u (the whole Hessian) is split into its mirror blocks a
 lowest eigenvalue stored); where a block's number of negative eigenvalues changes between neighbours, each eigenvalue
 that crossed (by its order in the spectrum) is followed to the point where it vanishes, located by Brent's method in the
 arclength from the earlier point (``continuation.locate_root``, each evaluation a Keller corrector), and kept as a
-branch point (BP) when its null vector φ is orthogonal to ∂R/∂P (|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|); the even block's
+branch point (BP) when its null vector φ is orthogonal to ∂R/∂P (|φ·∂R/∂P| ≤ ORTHOGONAL·|φ||∂R/∂P|, tube/zeros.py); the even block's
 zero where it is not is the fold in P itself (LP). Stability at every point: tube/stability.py's ``unstable_counts``.
 
 On a tube with sliding closed ends the branch is the uniform tube (model/tube.py's closed-end path, exact in the
@@ -30,6 +30,7 @@ from .control import VolumeStop, control_monitors
 from .events import with_events
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
+from .zeros import corrected_zero, is_fold
 from ..analysis.stability.crossings import count_changes
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind, StopCode
@@ -43,8 +44,6 @@ from ..numerics.newton import newton
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
-ORTHOGONAL = 1e-6  # |φ·∂R/∂P| relative to |φ||∂R/∂P| below which a block's zero is a branch point, not the fold
-BRENT_XTOL = 1e-13  # Brent's tolerance in the arclength, relative to the step
 
 
 class TubeSystem:
@@ -228,26 +227,15 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
         H = eq.jacobian(Y[:-1], params.with_value("P", Y[-1]))[np.ix_(system.unknowns, system.unknowns)]
         mode = np.append(np.linalg.eigh(H)[1][:, order], 0.0)
 
-    def value_at(s):
-        predictor = before.X + s * before.tangent
-        result = continuation.correct(system, predictor, before.tangent, settings)
-        if not result.converged and mode is not None:
-            result = _off_mode_corrector(system, predictor, before.tangent, mode, settings)
-        if not result.converged:
-            raise ArithmeticError(result.message)
-        Y = system.full(result.x)
-        return spectrum(eq, Y, index, params)[order], Y
-
     length = float(before.tangent @ (after.X - before.X))
     end = system.full(after.X)
-    root = continuation.locate_root(value_at, length, BRENT_XTOL,
-                                    known={length: (spectrum(eq, end, index, params)[order], end)})
+    fallback = None if mode is None else (
+        lambda predictor: _off_mode_corrector(system, predictor, before.tangent, mode, settings))
+    root = corrected_zero(system, settings, before.X, before.tangent, length,
+                          lambda Y: spectrum(eq, Y, index, params)[order],
+                          {length: (spectrum(eq, end, index, params)[order], end)}, fallback)
     Y = root.payload
-    at = params.with_value("P", Y[-1])
-    H = eq.jacobian(Y[:-1], at)[np.ix_(index, index)]
-    phi = np.linalg.eigh(H)[1][:, order]
-    dP = eq.parameter_derivative(Y[:-1], at, "P")
-    if abs(phi @ dP[index]) > ORTHOGONAL * np.linalg.norm(dP):
+    if is_fold(eq, Y[:-1], params.with_value("P", Y[-1]), "P", index, order):
         return None
     return Y, root.status
 

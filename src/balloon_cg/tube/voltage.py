@@ -26,7 +26,8 @@ from dataclasses import replace
 import numpy as np
 
 from .events import along
-from .primary import (BRENT_XTOL, ORTHOGONAL, TubeSystem, _start, discretisation, held, scene_parameters,
+from .zeros import corrected_zero, is_fold
+from .primary import (TubeSystem, _start, discretisation, held, scene_parameters,
                       volume_ratio)
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, spectrum, unstable_counts
@@ -124,21 +125,12 @@ def _branch_point(system, eq, before, after, block: Mirror, order: int, settings
     fails ends the search NEAREST); None where it is the fold in Φ̄ (the null vector not orthogonal to ∂R/∂Φ̄, as
     tube/primary's branch points in P)."""
     index, pressure = eq.disc.block(block), params.P
-
-    def value_at(s):
-        result = continuation.correct(system, before.X + s * before.tangent, before.tangent, settings)
-        if not result.converged:
-            raise ArithmeticError(result.message)
-        Y = system.full(result.x)
-        return spectrum(eq, np.append(Y[:-1], pressure), index, params.with_value("voltage", Y[-1]))[order], Y
-
-    root = continuation.locate_root(value_at, float(before.tangent @ (after.X - before.X)), BRENT_XTOL)
+    root = corrected_zero(system, settings, before.X, before.tangent, float(before.tangent @ (after.X - before.X)),
+                          lambda Y: spectrum(eq, np.append(Y[:-1], pressure), index,
+                                             params.with_value("voltage", Y[-1]))[order])
     if root is None:
         return None
     Y = root.payload
-    at = params.with_value("voltage", Y[-1])
-    phi = np.linalg.eigh(eq.jacobian(Y[:-1], at)[np.ix_(index, index)])[1][:, order]
-    dV = eq.parameter_derivative(Y[:-1], at, "voltage")
-    if abs(phi @ dV[index]) > ORTHOGONAL * np.linalg.norm(dV):
+    if is_fold(eq, Y[:-1], params.with_value("voltage", Y[-1]), "voltage", index, order):
         return None
     return Y, root.status
