@@ -155,14 +155,13 @@ def continue_tube(args) -> int:
     onsets = [i for i, (name, _, s) in enumerate(labels) if name == "primary" and s["kind"] == "BP"
               and s["block"] in blocks]
     if not 0 <= args.label < len(labels) or args.label not in onsets:
-        if 0 <= args.label < len(labels):
-            name, _, s = labels[args.label]
-            what = " ".join(filter(None, (s["kind"], s["block"]))) + f" on branch {name}"
-        else:
-            what = "no such label"
+        name, _, s = labels[args.label] if 0 <= args.label < len(labels) else (None, None, None)
+        what = "no such label" if s is None else " ".join(filter(None, (s["kind"], s["block"]))) + f" on branch {name}"
         which = "an odd branch point of its primary branch (the onset of bulging)" if blocks == ("odd",) else \
             "a branch point of its primary branch (odd: the onset of bulging; even: on its uniform branch)"
-        event = " (from a UZ: --parameter voltage, in Φ̄ at its P)" if what.startswith("UZ on branch primary") else ""
+        from ..analysis.results import Kind  # here, as cli's: the command line's start-up does not load analysis
+        primary_event = s is not None and name == "primary" and s["kind"] == Kind.UZ.value
+        event = " (from a UZ: --parameter voltage, in Φ̄ at its P)" if primary_event else ""
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
                          f"{', '.join(map(str, onsets)) or 'none'}{event}")
     scene = with_continuation_settings(args, stored_scene(args, run))
