@@ -108,10 +108,12 @@ def _path_slope(material, theta, z):
     return P_theta - P_z * N_theta / N_z
 
 
-def _on_path(material, hoops: np.ndarray) -> np.ndarray:
-    """The grid ``hoops`` (ascending) up to where the closed-end path ends (``closed_end_axial``: NaN beyond)."""
-    ended = np.flatnonzero(np.isnan(closed_end_axial(material, hoops)))
-    return hoops if not ended.size else hoops[:ended[0]]
+def _on_path(material, hoops: np.ndarray) -> tuple:
+    """(λθ, λz) of the grid ``hoops`` (ascending) up to where the closed-end path ends (``closed_end_axial``: NaN
+    beyond)."""
+    axial = closed_end_axial(material, hoops)
+    ended = np.flatnonzero(np.isnan(axial))
+    return (hoops, axial) if not ended.size else (hoops[:ended[0]], axial[:ended[0]])
 
 
 def _grid_slopes(material, hoops) -> np.ndarray:
@@ -158,7 +160,7 @@ def bulge_onset(material, length: float, mode: int = 1, largest_hoop: float = 10
         return bulge_condition(material, closed_end_state(material, hoop), wavenumber)
 
     hoops = np.geomspace(1.0 + 1e-3, largest_hoop, _SCAN_POINTS)
-    hoops = _on_path(material, hoops)
+    hoops, _ = _on_path(material, hoops)
     values = [condition(h) for h in hoops]
     for k in range(len(hoops) - 1):
         if values[k] > 0 >= values[k + 1]:
@@ -200,8 +202,8 @@ def maxwell_pressure(material, largest_hoop: float = 100.0) -> tuple | None:
     low = None if peak is None else pressure_minimum(material, largest_hoop, peak)
     if low is None:
         return None
-    grid = _on_path(material, np.geomspace(low.hoop, largest_hoop, _SCAN_POINTS)[1:])
-    rising = hoop_pressure(material, grid, closed_end_axial(material, grid))
+    grid, axial = _on_path(material, np.geomspace(low.hoop, largest_hoop, _SCAN_POINTS)[1:])
+    rising = hoop_pressure(material, grid, axial)
     top = min(peak.pressure, rising.max(initial=low.pressure))  # b exists for P up to it (the path may end first)
 
     def states(P):
