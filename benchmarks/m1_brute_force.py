@@ -19,7 +19,8 @@ from balloon_cg.analysis.stability import azimuthal as az, brute_force as bf
 from balloon_cg.app.figures import run_for
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.post.paper import SINGLE_COIL_M0001, SINGLE_COIL_REACH, Case
-from balloon_cg.post.quantities import branch_discretisation, stored_scene
+from balloon_cg.io.run_file import stored_scene
+from balloon_cg.post.quantities import branch_discretisation
 
 CASES = {
     "one coil a = 2, M = 0.001": Case("spom1_single_coil", (("field.M", 0.001), ("field.coils[0].radius", 2.0),

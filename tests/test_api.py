@@ -151,6 +151,20 @@ def test_import_is_light():
     assert "numpy" not in dir(bc) and {"analyse", "trace", "load", "plot", "Scene"} <= set(dir(bc))
 
 
+def test_inspect_of_a_run_file_loads_neither_numba_nor_scipy(tmp_path):
+    """`inspect` of a run file of the current format without surface branches, in a fresh interpreter, imports
+    neither numba nor scipy (app/cli.py: inspect starts fast; ~0.6 s of CPU of every such process, issue 37): the
+    reader builds no solver and writes no provenance."""
+    from balloon_cg.app.cli import main
+
+    assert main(["run", str(SCENES / "spom1.toml"), "--set", "continuation.stop_stretch=1.4", "-o",
+                 str(tmp_path / "r.h5"), "--quiet"]) == 0
+    code = ("import sys\nfrom balloon_cg.app.cli import main\nassert main(['inspect', 'r.h5']) == 0\n"
+            "print(sorted(m for m in ('numba', 'scipy', 'matplotlib') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=tmp_path)
+    assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout
+
+
 def test_a_run_loads_no_plotting_nor_the_scipy_it_does_not_use(tmp_path):
     """`run` in a fresh interpreter imports neither matplotlib, SymPy, pandas nor scipy's optimize, sparse,
     integrate and interpolate: each is start-up time of every command (scipy.optimize alone ~0.2 s of CPU, a fifth

@@ -57,7 +57,8 @@ from ..dynamics.frequencies import attach_to
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop, TraceStop
-from ..post.quantities import branch_discretisation, stored_scene
+from ..io.run_file import stored_scene
+from ..post.quantities import branch_discretisation
 
 
 class RestartError(ValueError):

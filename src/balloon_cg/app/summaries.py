@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io.parents import parent_label, rejoin_label
-from ..post.quantities import stored_scene
+from ..io.run_file import stored_scene
 
 
 def summarise_file(path) -> tuple[dict, str]:

@@ -16,7 +16,6 @@ import numpy as np
 
 import balloon_cg
 
-from ..model.kernels import generated_digest
 from .layout import can_checksum
 from .output import replacing
 
@@ -42,6 +41,8 @@ CONVENTIONS = "CF-1.10"  # the netCDF conventions the files follow (units, long_
 def provenance(command: str | None = None) -> dict:
     """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command, and
     the CF global attributes ``Conventions`` and ``history`` (time, command and version, one line)."""
+    from ..model.kernels import generated_digest  # here: model/ imports numba, which reading does not need
+
     created = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     command = command if command is not None else command_line()
     return {

@@ -85,7 +85,7 @@ import h5py
 import numpy as np
 
 from ..analysis.timing import Clock, Step
-from ..surface.loads import LOADS
+from ..scene import parse_scene
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .legacy import current
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
@@ -319,6 +319,8 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
     of ``surface.measures`` times 2π, as the axisymmetric ``volume``), the coefficients, special points with
     the pole values of their own states, and the lowest eigenvalues held and free with the pressure-control
     flags they give (the lowest > 0, as ``analysis.stability.axisymmetric.Assessment``)."""
+    from ..surface.loads import LOADS  # here, not at the top: surface/ imports numba and scipy
+
     basis = branch.basis
     _write_common_attrs(group, branch)
     group.attrs.update({
@@ -552,6 +554,11 @@ def read_run(path) -> dict:
     with opened(path, RunFileError) as f:
         check_data(f, path, RunFileError, FINITE)
         return _read_open(f, path) | {"path": str(path)}
+
+
+def stored_scene(run: dict):
+    """The Scene a run file was computed for, rebuilt from its ``scene_toml`` attribute."""
+    return parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
 
 
 def read_run_image(image: bytes, label: str = "run") -> dict:
@@ -821,6 +828,8 @@ def check_surface_branch(group, where, error, written: bool = False) -> None:
     """The attributes and columns of one stored surface branch: its basis (symmetry k × 3 of ±1, characters k of
     ±1) rebuilt, the coefficients as wide as its size, the centroid 3 wide, special points (c, p) rows and
     stability of consistent shapes."""
+    from ..surface.loads import LOADS
+
     require_attrs(group.attrs, where, (*SURFACE_KINDS, "symmetry", "characters"), SURFACE_KINDS, error)
     n = check_columns(group, where, SURFACE_COLUMNS, error, min_rows=1)
     check_columns(group, where, {k: v for k, v in OPTIONAL_COLUMNS.items()
@@ -932,8 +941,6 @@ def read_special(group, field_acts: bool = True, branch_gauge: str | None = None
     field acts when ``field_acts``), every other point's its branch's (``branch_gauge``; unknown: held where a
     field acts). A surface branch's points have their ``sector`` (a tuple of characters, () for none) where the file
     stores it (state/sector)."""
-    from ..analysis.results import Block, Gauge
-
     columns = {name: group[name].asstr()[()] for name in SPECIAL_TEXT + ("gauge",) if name in group}
     columns |= {name: group[name][()] for name in ("index", "m", "label") + SPECIAL_NUMBERS + CONDITIONAL_COLUMNS
                 if name in group}
@@ -941,7 +948,9 @@ def read_special(group, field_acts: bool = True, branch_gauge: str | None = None
     if "state" in group and "sector" in group["state"]:  # a surface branch's (files before it: none)
         for s, row in zip(points, group["state"]["sector"][()]):
             s["sector"] = tuple(int(chi) for chi in row) if row.any() else ()
-    if "gauge" not in columns:
+    if "gauge" not in columns:  # an old file (analysis/ imports numba: not for reading a current one)
+        from ..analysis.results import Block, Gauge
+
         blocks = {block.value: block for block in Block if block != Block.NONE}
         fallback = {g.value: g for g in Gauge}.get(branch_gauge, Gauge.HELD if field_acts else Gauge.BOTH)
         for s in points:

@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .plotting import P_LABEL, Configuration, PlotError, Reading, describe_scene, plot, stable_points
-from .quantities import branch_discretisation, stored_scene
+from .quantities import branch_discretisation
 from . import labels
 from .fit import fit_titles, fitted_legend
 from .style import JournalFigure, journal_style
@@ -29,6 +29,7 @@ from ..analysis.switching.mirror import MIRROR
 from ..analysis.picture import Curve, find_snaps, located_folds
 from ..analysis.results import Kind, Status
 from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..io.run_file import stored_scene
 from ..scene import Control, parse_scene
 
 ONE_COLUMN, TWO_COLUMNS = 3.5, 7.2  # journal widths, inches

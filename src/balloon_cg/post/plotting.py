@@ -38,7 +38,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 from scipy.interpolate import PchipInterpolator
 
-from .quantities import branch_discretisation, postprocess, stored_scene, surface
+from .quantities import branch_discretisation, postprocess, surface
 from .fit import NARROW, fit_width, fitted_size
 from .labels import label_points
 from .style import JournalFigure, journal_style
@@ -47,7 +47,7 @@ from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, file_kind, reading
 from ..io.parents import parent_label
-from ..io.run_file import read_run, stored_basis
+from ..io.run_file import read_run, stored_basis, stored_scene
 from ..io.sweep_file import read_sweep
 from ..model.meridian import hoop, reference_height
 from ..scene.tables import Shape

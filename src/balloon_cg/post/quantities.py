@@ -30,15 +30,10 @@ from ..galerkin.elements import cylinder_coordinates, element_series, layout
 from ..model.field import coaxial_table, coil_table, field_components, field_squared_nodes
 from ..model.stresses import elastic_stresses
 from ..model.meridian import hoop, hoop_acceleration, hoop_rate, metric
-from ..scene import parse_scene
+from ..io.run_file import stored_scene
 from ..scene.tables import Geometry
 
 WRINKLING_STATES = ("taut", "wrinkled", "slack")
-
-
-def stored_scene(run: dict):
-    """The Scene a run file was computed for, rebuilt from its ``scene_toml`` attribute."""
-    return parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
 
 
 def branch_discretisation(branch: dict) -> Discretisation:
