@@ -9,9 +9,6 @@ volume is V = πL λθ²λz (V0 = πL) and the gas amount n = P V = πL λθ Φ_
 n (LN) is where dn/dλθ = 0 along the path; under volume control a fold in V (LV) where dV/dλθ = 0, none on the
 uniform path (V grows along it).
 """
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 from scipy import linalg, optimize
@@ -20,6 +17,7 @@ from balloon_cg.analysis.branches.control import control_value
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.results import Kind, StopCode
 from balloon_cg.app.api import analyse
+from balloon_cg.app.cli import main
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.io.tube_file import read_tube_run, stored_branch, write_tube_run
@@ -171,7 +169,7 @@ def test_the_bulge_branch_under_volume_control_has_its_volume_fold(volume_run):
     assert bulge.unstable[Control.PRESSURE][i] == bulge.unstable[Control.PRESSURE][i + 1] == 1
 
 
-def test_tube_file_stores_every_reading_and_the_control(volume_run, tmp_path):
+def test_tube_file_stores_every_reading_and_the_control(volume_run, tmp_path, capsys):
     """The tube run file holds unstable_gas beside the other readings and the scene's control; read back equal;
     inspect names the control, plot draws it by default and refuses an unknown reading."""
     scene, picture = volume_run
@@ -182,12 +180,11 @@ def test_tube_file_stores_every_reading_and_the_control(volume_run, tmp_path):
         back = stored_branch(run, name, branch.params)
         for control in Control:
             assert np.array_equal(back.unstable[control], branch.unstable[control])
-    out = subprocess.run([sys.executable, "-m", "balloon_cg", "inspect", str(path)], capture_output=True, text=True)
-    assert out.returncode == 0 and "control        volume" in out.stdout and "stable under volume control" in out.stdout
+    assert main(["inspect", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "control        volume" in out and "stable under volume control" in out
     image = tmp_path / "pv.png"
-    drawn = subprocess.run([sys.executable, "-m", "balloon_cg", "plot", str(path), "--what", "pressure-volume", "-o",
-                            str(image)], capture_output=True, text=True)
-    assert drawn.returncode == 0 and image.exists()
+    assert main(["plot", str(path), "--what", "pressure-volume", "-o", str(image)]) == 0 and image.exists()
 
 
 @pytest.mark.parametrize("control", ["pressure", "gas"])
@@ -231,16 +228,15 @@ def test_stop_volume_ends_a_capsule_branch_and_the_old_key_reads():
      r"loading.stop_volume = 3.0: the old name of continuation.stop_volume, which is given too \(4.0\); give "
      r"continuation.stop_volume only$"),
 ])
-def test_bad_stop_volume_is_one_line(text, message, tmp_path):
+def test_bad_stop_volume_is_one_line(text, message, tmp_path, capsys):
     """One line naming the key, the value and the range; the CLI exits 2 and writes no file."""
     with pytest.raises(SceneError, match=message) as error:
         parse_scene('[material]\npreset = "SPOM1"\n' + text, "bad")
     assert "\n" not in str(error.value)
     path = tmp_path / "bad.toml"
     path.write_text('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n' + text)
-    out = subprocess.run([sys.executable, "-m", "balloon_cg", "run", str(path), "-o", str(tmp_path / "bad.h5")],
-                         capture_output=True, text=True)
-    assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1 and not (tmp_path / "bad.h5").exists()
+    assert main(["run", str(path), "-o", str(tmp_path / "bad.h5")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1 and not (tmp_path / "bad.h5").exists()
 
 
 def test_bulge_branch_under_gas_control_lands_on_stop_volume():
