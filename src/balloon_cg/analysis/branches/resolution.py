@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...galerkin.discretisation import Discretisation
+from ...galerkin.elements import group_degrees
 from ...numerics import interrupt
 
 
@@ -37,6 +38,23 @@ class Resolution:
     def grow(self, degree: int) -> int:
         """The next degree: ``growth`` times larger, at most max_degree."""
         return min(int(degree * self.growth), self.max_degree)
+
+    def element_degrees(self, disc: Discretisation, u) -> tuple:
+        """A degree per element group of a capsule's basis (``elements.groups``), each from its own series: a
+        group whose tail T (``Discretisation.element_tails``, decaying by r per degree) is above max_error grows by
+        the degrees that tail wants, ln(headroom · max_error / T)/ln r, at least 2 and at most by ``growth``; a
+        resolved group keeps its degree; none beyond max_degree. Unchanged degrees: every group resolved or at
+        max_degree."""
+        out = []
+        for degree, (tail, rate) in zip(group_degrees(disc.degree, disc.joins, disc.element_degrees),
+                                        disc.element_decay(u)):
+            if tail <= self.max_error:
+                out.append(degree)
+                continue
+            wanted = np.log(self.headroom * self.max_error / tail) / np.log(rate)
+            step = int(np.clip(np.ceil(wanted), 2, max(2, int(degree * (self.growth - 1)))))
+            out.append(min(degree + step, self.max_degree))
+        return tuple(out)
 
     @property
     def recentre_accept(self) -> float:
