@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .coordinate_map import WireMap
-from .elements import element_degree, element_table, families, function_keys, graded_degree
+from .elements import element_degree, element_table, families, function_keys, graded_degree, piece_degrees
 from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
 
@@ -405,9 +405,14 @@ class Discretisation:
 
     def element_decay(self, u: np.ndarray) -> tuple:
         """Per element group (tail, decay per degree r) of its own series (``geometric_fit``)."""
+        return tuple(geometric_fit(envelope) for envelope in self.element_envelopes(u))
+
+    def element_envelopes(self, u: np.ndarray) -> tuple:
+        """Per element group (``elements.groups``) the envelope max(|a|, |b|)/|a_0| of its own series, one entry per
+        degree, the last one the group's highest."""
         a, b = self.split(u)
         envelope = np.maximum(np.abs(a), np.abs(b)) / abs(a[0])
-        return tuple(geometric_fit(envelope[group] if group.ndim == 1 else envelope[group].max(axis=1))
+        return tuple(envelope[group] if group.ndim == 1 else envelope[group].max(axis=1)
                      for group in families(self.degree, self.joins, self.element_degrees))
 
 
@@ -458,20 +463,21 @@ def piece_nodes(degree: int, joins: tuple = (), degrees: tuple = ()) -> int:
     return gauss_nodes(element_degree(degree, joins, degrees) if joins else degree)
 
 
-def split_rule(n_q: int, joins: tuple = ()):
+def split_rule(n_q, joins: tuple = ()):
     """(nodes, weights) on [−1, 1], ascending: Gauss–Legendre with n_q nodes, or with ``joins`` (sorted, in (−1, 1))
-    n_q nodes on each piece between them (a composite rule, where a kink of the integrand at a join costs a single
+    n_q nodes on each piece between them (n_q a tuple: its own count on each piece, ascending; a composite rule, where a kink of the integrand at a join costs a single
     rule O(n_q⁻²)): Gauss in x on the two end pieces (the caps: exact for a polynomial in x of degree < 2 n_q) and
     in θ on the inner ones (the cylinder, whose basis is polynomial in θ: ∫f dx = ∫f sin θ dθ; Gauss in x there
     samples the ends of a high-degree polynomial in θ too sparsely, and the node table of a capsule of length 40
     had the condition 3.7e8 at degree 320 against 4e2 at 200). Mirror-symmetric to the last bit when the joins are
     (an odd rule's middle node at x = 0 exactly: ``even_half`` counts it once)."""
-    nodes, weights = gauss_rule(n_q)
     if not joins:
-        return nodes, weights
+        return gauss_rule(n_q)
     ends = (-1.0, *joins, 1.0)
+    counts = n_q if isinstance(n_q, tuple) else (n_q,) * (len(ends) - 1)
     out_nodes, out_weights = [], []
     for i, (a, b) in enumerate(zip(ends[:-1], ends[1:])):
+        nodes, weights = gauss_rule(counts[i])
         if i in (0, len(joins)):
             out_nodes.append(0.5 * (b - a) * nodes + 0.5 * (b + a))
             out_weights.append(0.5 * (b - a) * weights)
@@ -501,6 +507,8 @@ def _tables(disc: Discretisation) -> dict:
     """The node, weight and basis tables of a Discretisation (keyed by its seven fields: equal discretisations
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
     n_q = disc.quadrature or piece_nodes(disc.degree, disc.joins, disc.element_degrees)
+    if disc.element_degrees and not disc.quadrature:  # graded: each piece the rule of its own element's degree
+        n_q = tuple(gauss_nodes(degree) for degree in piece_degrees(disc.joins, disc.element_degrees))
     nodes, s_weights = split_rule(n_q, disc.joins)
     p, dp = basis_table(nodes, disc.degree, disc.joins, disc.element_degrees)
     if disc.mapping is None:

@@ -142,6 +142,15 @@ def group_degrees(degree: int, joins: tuple, degrees: tuple = ()) -> tuple:
     return tuple(top[group] for group in groups(joins))
 
 
+def piece_degrees(joins: tuple, degrees: tuple) -> tuple:
+    """The degree of each piece of the quadrature (ascending in x: the south cap, cylinder elements 0..n − 1, the
+    north cap) on the graded basis of ``degrees`` per group (``groups``; an element's its mirror pair's)."""
+    shape = layout(joins)
+    of = dict(zip(groups(joins), degrees))
+    cylinder = tuple(of[max(e, shape.mirror(e))] for e in range(shape.count))
+    return (of[CAPS_GROUP], *cylinder, of[CAPS_GROUP])
+
+
 @functools.lru_cache(maxsize=64)
 def graded_sequence(degrees: tuple, joins: tuple) -> tuple:
     """(family, j, element) of a basis with a degree per element group (``groups``): φ_0 = 1, φ_1 = ℓ, the inner
