@@ -1,9 +1,10 @@
 """A long capsule's bulge at the default max_error: one degree shared by the cylinder's elements against a degree per
 element (``geometry.element_degrees = "graded"``, analysis/branches/graded.py), one run each in this process.
 
-SPOM1 capsule of length L, its cylinder cut into elements of at most ``--element`` radii, traced in P with
-step_max 1 to pole stretch 3 at the default [solver] (degree 40, max_error 1e-9, max_degree 320), m = 0 stability.
-Per basis: points, wall and CPU seconds (this process; stability runs on worker threads), the stop, the highest
+SPOM1 capsule of length L, its cylinder cut into elements of at most ``--element`` radii, its primary branch traced
+in P (``trace_primary``: the trace and its folds, not the stability assessment) with step_max 1 to pole stretch 3 at
+the default [solver] (degree 40, max_error 1e-9, max_degree 320). Per basis: points, wall and CPU seconds, the
+stop, the highest
 V/V0, the fold's P against the long tube's pressure maximum P* and a sliding tube's onset at L (model/tube), the
 largest stored error estimate, and max |P − P_M| (model/tube.maxwell_pressure) over windows of V/V0; the load
 average before and after.
@@ -16,7 +17,7 @@ import time
 
 import numpy as np
 
-from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.model import tube
 from balloon_cg.scene import parse_scene
@@ -44,13 +45,13 @@ def main() -> None:
     for basis in args.bases:
         scene = parse_scene(scene_text(args.length, args.element, basis))
         wall, cpu = time.perf_counter(), time.process_time()
-        branch = analyse(scene, pear=False).branches[0]
+        branch = trace_primary(scene)
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
         eq = Equilibrium(scene, branch.disc)
         volume = np.array([2 * np.pi * eq.volume(x[:-1]) for x in branch.X]) / (args.length * np.pi + 4 * np.pi / 3)
         maxwell = tube.maxwell_pressure(scene.material)[0]
         folds = [p.X[-1] for p in branch.special if p.kind.value == "LP"]
-        up = branch.stop_reason.split(";")[0]
+        up = branch.stop_reason
         rows.append((basis, len(branch.X), wall, cpu, f"N {branch.disc.degree} {branch.disc.element_degrees or ''}",
                      volume.max(), folds[0] if folds else np.nan, float(branch.error_estimate.max()), up))
         windows[basis] = [np.abs(branch.X[(volume >= lo) & (volume < hi), -1] - maxwell).max()
@@ -60,7 +61,7 @@ def main() -> None:
     print(f"P* = {peak:.13f}, sliding tube's onset at L = {args.length:g}: {onset:.13f}, "
           f"P_M = {tube.maxwell_pressure(material)[0]:.12f}")
     print("| basis | points | wall s | CPU s | storage basis | max V/V0 | fold P | fold − P* | fold − onset | "
-          "max stored error | up end |")
+          "max stored error | stop |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for basis, points, wall, cpu, storage, top, fold, error, up in rows:
         print(f"| {basis} | {points} | {wall:.0f} | {cpu:.0f} | {storage} | {top:.1f} | {fold:.13f} | "

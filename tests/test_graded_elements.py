@@ -19,8 +19,8 @@ from balloon_cg.galerkin.discretisation import Discretisation, graded
 from balloon_cg.galerkin.elements import CYLINDER, element_table, group_degrees, groups
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.analysis.branches.problem import ParameterSystem
-from balloon_cg.analysis.branches.primary import start_parameters
-from balloon_cg.model import meridian
+from balloon_cg.analysis.branches.primary import start_parameters, trace_primary
+from balloon_cg.model import meridian, tube
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import SceneError, parse_scene
 
@@ -159,3 +159,33 @@ def test_graded_key_errors_name_key_value_and_range(text, key):
     assert "\n" not in str(error.value)
     kept = parse_scene('[material]\npreset = "SPOM1"\n' + GRADED.format(length=12.0))
     assert kept.geometry.to_table()["element_degrees"] == "graded"
+
+
+@pytest.mark.slow
+def test_a_graded_long_capsule_propagates_its_bulge_at_maxwells_pressure_at_the_default_max_error():
+    """SPOM1 capsule of length 40, 5 cylinder elements, graded, at the default [solver] (max_error 1e-9,
+    max_degree 320), traced in P with step_max 1 to pole stretch 3: every stored point within max_error
+    (``error_estimate``), from its start (pole stretch 1.001) past its fold, where it starts bulging within 1e-3 of
+    the long tube's pressure maximum P* and of a sliding tube's onset at L = 40 (model/tube) and at the shared
+    basis's fold (1.4907571927638, docs/shapes.md) to 1e-10, to V/V0 ≥ 700; where both fronts are far from the caps
+    and from each other (200 ≤ V/V0 ≤ 600) P is within 1e-4 of Maxwell's pressure (model/tube.maxwell_pressure),
+    from V/V0 = 400 within 1e-7. The shared basis stops at max_degree just past the fold (V/V0 2.7).
+    Measured (benchmarks/results/capsule_graded.txt): 2.8e-5, 1.9e-8; 1490 points, ~720 s on the loaded machine."""
+    text = ('[material]\npreset = "SPOM1"\n' + GRADED.format(length=40.0).replace("element_length = 5.0",
+                                                                              "element_length = 10.0")
+            + "[stability]\nm_max = 0\n[continuation]\nstop_stretch = 3.0\nstep_max = 1.0\nmax_points = 3000\n")
+    scene = parse_scene(text)
+    branch = trace_primary(scene)
+    assert "reached stop_stretch 3" in branch.stop_reason and "reached min_stretch" in branch.stop_reason
+    assert branch.error_estimate.max() <= 1e-9 and branch.disc.element_degrees
+    fold = next(p.X[-1] for p in branch.special if p.kind.value == "LP")
+    assert abs(fold - tube.pressure_maximum(scene.material).pressure) < 1e-3
+    assert abs(fold - tube.bulge_onset(scene.material, 40.0).pressure) < 1e-3
+    assert abs(fold - 1.4907571927638) < 1e-10
+    eq = Equilibrium(scene, branch.disc)
+    volume = np.array([2 * np.pi * eq.volume(x[:-1]) for x in branch.X]) / (40 * np.pi + 4 * np.pi / 3)
+    maxwell = tube.maxwell_pressure(scene.material)[0]
+    plateau = (volume >= 200) & (volume <= 600)
+    assert volume.max() >= 700 and plateau.sum() > 50
+    assert np.abs(branch.X[plateau, -1] - maxwell).max() <= 1e-4
+    assert np.abs(branch.X[plateau & (volume >= 400), -1] - maxwell).max() <= 1e-7
