@@ -48,10 +48,10 @@ def graded_point(system_on, disc: Discretisation, X: np.ndarray, row: np.ndarray
     rounds = [(group_degrees(disc.degree, disc.joins, disc.element_degrees), disc.element_tails(X[:-1]))]
     result, message = None, f"not resolved on {max_rounds} bases"
     for _ in range(max_rounds):
-        wanted = policy.element_degrees(disc, (X if ahead is None else ahead)[:-1])
-        ahead = None
+        read = X if ahead is None else ahead  # the point whose tails choose this round's degrees
+        wanted, ahead = policy.element_degrees(disc, read[:-1]), None
         if wanted == rounds[-1][0]:
-            message = RESOLVED if max(rounds[-1][1]) <= policy.max_error and result is not None else (
+            message = RESOLVED if disc.tail(read[:-1]) <= policy.max_error else (
                 f"an element group above solver.max_error = {policy.max_error:g} at solver.max_degree = "
                 f"{policy.max_degree}")
             break
