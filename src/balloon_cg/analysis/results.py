@@ -242,7 +242,7 @@ class Branch:
 
     name: str
     scene: Scene
-    disc: Discretisation  # the storage discretisation (pickles as its five defining fields)
+    disc: Discretisation  # the storage discretisation (pickles as its seven defining fields)
     kernel_class: str
     kernel_signature: str
     params: Parameters  # M, χ, Φ̄ or P of the branch (``parameter`` varies along it)

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .coordinate_map import WireMap
-from .elements import element_degree, element_table, families
+from .elements import element_degree, element_table, families, function_keys, graded_degree, piece_degrees
 from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
 
@@ -202,19 +202,20 @@ def _state_loops(A, B, u, out):
             out[2 + k, q] = total
 
 
-def basis_table(x: np.ndarray, degree: int, joins: tuple = ()):
+def basis_table(x: np.ndarray, degree: int, joins: tuple = (), degrees: tuple = ()):
     """(φ_k(x), dφ_k/dx) for k = 0..degree: P_k(x), or with ``joins`` (a capsule's element boundaries, −c … c) the
-    elements' piecewise basis (galerkin/elements.py)."""
-    return element_table(x, degree, joins) if joins else legendre_table(x, degree)
+    elements' piecewise basis (galerkin/elements.py; graded with ``degrees`` per element group)."""
+    return element_table(x, degree, joins, degrees) if joins else legendre_table(x, degree)
 
 
 @functools.lru_cache(maxsize=64)
-def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None, joins: tuple = ()):
+def _cached_table(theta_bytes: bytes, degree: int, mapping: WireMap | None = None, joins: tuple = (),
+                  degrees: tuple = ()):
     """(φ_k(x), dφ_k/dx) at x = cos θ (P_k(s), s = h(x) on a map), for a θ grid met again and again (stability
     nodes, profiles)."""
     x = np.cos(np.frombuffer(theta_bytes))
     if mapping is None:
-        return basis_table(x, degree, joins)
+        return basis_table(x, degree, joins, degrees)
     p, dp = legendre_table(np.clip(mapping.s(x), -1.0, 1.0), degree)
     return p, dp * mapping.ds_dx(x)[:, None]
 
@@ -238,16 +239,20 @@ class Discretisation:
     joins: tuple = ()  # x where the basis and the quadrature split (a capsule's ±c, where its reference curvature
     #                    jumps, and its cylinder's element boundaries between: the piecewise basis of
     #                    galerkin/elements.py, a composite Gauss rule)
+    element_degrees: tuple = ()  # with joins: a degree per element group (elements.graded_sequence) in place of
+    #                              the greedy order of ``degree`` (``graded``)
 
     def __reduce__(self):
-        """Pickled as its six defining fields (the tables are rebuilt): results holding one stay small."""
+        """Pickled as its seven defining fields (the tables are rebuilt): results holding one stay small."""
         return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping,
-                                self.joins)
+                                self.joins, self.element_degrees)
 
     def __post_init__(self):
         """Basis and quadrature tables from ``_tables`` (built once per set of fields, shared, read-only)."""
         if self.joins and self.mapping is not None:
             raise ValueError("Discretisation: a split quadrature (joins) and a wire map are not built together")
+        if self.element_degrees and not self.joins:
+            raise ValueError("Discretisation: element_degrees need the elements' joins")
         for name, value in _tables(self).items():
             object.__setattr__(self, name, value)
 
@@ -297,7 +302,7 @@ class Discretisation:
 
     @functools.cached_property
     def _pole_rows(self) -> dict:
-        ones = basis_table(np.ones(1), self.degree, self.joins)[0][0]  # φ_k(1): all ones on Legendre's
+        ones = basis_table(np.ones(1), self.degree, self.joins, self.element_degrees)[0][0]  # φ_k(1): all ones on Legendre's
         sign = (-1.0) ** np.arange(self.degree + 1) * ones  # φ_k(−1) = (−1)^k φ_k(1)
         zero = np.zeros(self.degree + 1)
         rows = {
@@ -312,7 +317,7 @@ class Discretisation:
 
     def evaluate(self, u: np.ndarray, theta: np.ndarray):
         """(λ2, λ2', η, η') on any θ grid (poles included); u is one unknown vector or a stack of them (rows)."""
-        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping, self.joins)
+        p, dp = _cached_table(theta.tobytes(), self.degree, self.mapping, self.joins, self.element_degrees)
         s = np.sin(theta)
         U = np.atleast_2d(u)
         na = self.a_index.size
@@ -322,24 +327,37 @@ class Discretisation:
         return values if np.ndim(u) == 2 else tuple(v[0] for v in values)
 
     def nests_in(self, other: "Discretisation") -> bool:
-        """Every function of this basis lies in ``other``'s (same map and joins, degree no higher): transfers are
-        exact."""
-        return other.mapping == self.mapping and other.joins == self.joins and other.degree >= self.degree
+        """Every function of this basis lies in ``other``'s (same map and joins, degree no higher; on elements
+        every function of this one found among ``other``'s, ``elements.function_keys``): transfers are exact."""
+        if other.mapping != self.mapping or other.joins != self.joins:
+            return False
+        if not (self.element_degrees or other.element_degrees):
+            return other.degree >= self.degree
+        return _embedding(self, other) is not None
+
+    @property
+    def function_keys(self) -> tuple:
+        """What names each φ_k (``elements.function_keys``; the Legendre basis: its degrees k)."""
+        if not self.joins:
+            return tuple(range(self.degree + 1))
+        return function_keys(self.degree, self.joins, self.element_degrees)
 
     def transfer(self, u: np.ndarray, other: "Discretisation") -> np.ndarray:
         """The same functions in the basis of ``other``; u may be (.., size + 1), trailing entries (P, ...) kept.
 
-        When this basis nests in ``other``, zero coefficients are appended (exact). Otherwise λ2 and η are
+        When this basis nests in ``other``, each coefficient moves to its function's place there and the others
+        are zero (exact: on the Legendre basis and the greedy element order zeros appended). Otherwise λ2 and η are
         evaluated at ``other``'s nodes and fitted by least squares (``projection``).
         """
         U = np.atleast_2d(u)
         rest = U[:, self.size:]
         if self.nests_in(other):
-            out = []
+            out, place = [], _embedding(self, other)
             for row in U[:, : self.size]:
                 a, b = self.split(row)
-                pad = other.degree - self.degree
-                out.append(other.join(np.pad(a, (0, pad)), np.pad(b, (0, pad))))
+                wide_a, wide_b = np.zeros(other.degree + 1), np.zeros(other.degree + 1)
+                wide_a[place], wide_b[place] = a, b
+                out.append(other.join(wide_a, wide_b))
             coefficients = np.array(out)
         else:
             lam2, _, eta, _ = self.evaluate(U[:, : self.size], np.arccos(other.x))
@@ -378,8 +396,40 @@ class Discretisation:
         envelope = np.maximum(np.abs(a), np.abs(b)) / abs(a[0])
         if not self.joins:
             return geometric_tail(envelope)
-        return max(geometric_tail(envelope[group] if group.ndim == 1 else envelope[group].max(axis=1))
-                   for group in families(self.degree, self.joins))
+        return max(self.element_tails(u))
+
+    def element_tails(self, u: np.ndarray) -> tuple:
+        """Per element group (``elements.groups``: the cylinder's middle element or mirror pairs outwards, then the
+        caps) the geometric tail of its own series (``tail``), each falling at its own rate."""
+        return tuple(tail for tail, _ in self.element_decay(u))
+
+    def element_decay(self, u: np.ndarray) -> tuple:
+        """Per element group (tail, decay per degree r) of its own series (``geometric_fit``)."""
+        return tuple(geometric_fit(envelope) for envelope in self.element_envelopes(u))
+
+    def element_envelopes(self, u: np.ndarray) -> tuple:
+        """Per element group (``elements.groups``) the envelope max(|a|, |b|)/|a_0| of its own series, one entry per
+        degree, the last one the group's highest."""
+        a, b = self.split(u)
+        envelope = np.maximum(np.abs(a), np.abs(b)) / abs(a[0])
+        return tuple(envelope[group] if group.ndim == 1 else envelope[group].max(axis=1)
+                     for group in families(self.degree, self.joins, self.element_degrees))
+
+
+def graded(disc: Discretisation, degrees: tuple) -> Discretisation:
+    """``disc`` (a capsule's, with joins) on the graded basis with ``degrees`` per element group
+    (``elements.graded_sequence``), its quadrature the default rule of its highest element degree."""
+    return replace(disc, degree=graded_degree(tuple(degrees), disc.joins), quadrature=0,
+                   element_degrees=tuple(int(d) for d in degrees))
+
+
+@functools.lru_cache(maxsize=64)
+def _embedding(source: Discretisation, target: Discretisation):
+    """Where each φ_k of ``source`` sits in ``target``'s order (an index per k), None if one is not there."""
+    place = {key: k for k, key in enumerate(target.function_keys)}
+    if any(key not in place for key in source.function_keys):
+        return None
+    return np.array([place[key] for key in source.function_keys], dtype=int)
 
 
 def geometric_tail(envelope: np.ndarray) -> float:
@@ -388,13 +438,18 @@ def geometric_tail(envelope: np.ndarray) -> float:
     coefficients alone under-read the error by ~r/(1 − r) when the decay is slow (near a wire: r ≈ 0.91, 10×; the
     two-coil λ = 1.8 point at degree 192 has P error 1.3e-9 against 2.8e-11 from its last two coefficients and
     1.9e-9 from this estimate, tests/test_tail.py). Fewer than 5 entries (no two windows): their largest (none: 0)."""
+    return geometric_fit(envelope)[0]
+
+
+def geometric_fit(envelope: np.ndarray) -> tuple:
+    """(``geometric_tail``, its decay per entry r); fewer than 5 entries: (their largest, 0.999)."""
     if envelope.size < 5:
-        return float(envelope.max(initial=0.0))
+        return float(envelope.max(initial=0.0)), 0.999
     n, window = envelope.size - 1, max(2, (envelope.size - 1) // 8)
     last = float(envelope[n - window + 1:].max())
     earlier = float(envelope[max(n - 3 * window + 1, 0): n - 2 * window + 1].max())
     rate = min((last / earlier) ** (1.0 / (2 * window)), 0.999) if earlier > 0.0 else 0.999
-    return last * rate / (1.0 - rate)
+    return last * rate / (1.0 - rate), rate
 
 
 def gauss_nodes(degree: int) -> int:
@@ -402,26 +457,27 @@ def gauss_nodes(degree: int) -> int:
     return (3 * degree) // 2 + 8
 
 
-def piece_nodes(degree: int, joins: tuple = ()) -> int:
+def piece_nodes(degree: int, joins: tuple = (), degrees: tuple = ()) -> int:
     """Gauss nodes of the default rule at degree N: ``gauss_nodes`` of N, or with ``joins`` of the highest degree
     of any element (each piece of ``split_rule`` holds one element's polynomial)."""
-    return gauss_nodes(element_degree(degree, joins) if joins else degree)
+    return gauss_nodes(element_degree(degree, joins, degrees) if joins else degree)
 
 
-def split_rule(n_q: int, joins: tuple = ()):
+def split_rule(n_q, joins: tuple = ()):
     """(nodes, weights) on [−1, 1], ascending: Gauss–Legendre with n_q nodes, or with ``joins`` (sorted, in (−1, 1))
-    n_q nodes on each piece between them (a composite rule, where a kink of the integrand at a join costs a single
+    n_q nodes on each piece between them (n_q a tuple: its own count on each piece, ascending; a composite rule, where a kink of the integrand at a join costs a single
     rule O(n_q⁻²)): Gauss in x on the two end pieces (the caps: exact for a polynomial in x of degree < 2 n_q) and
     in θ on the inner ones (the cylinder, whose basis is polynomial in θ: ∫f dx = ∫f sin θ dθ; Gauss in x there
     samples the ends of a high-degree polynomial in θ too sparsely, and the node table of a capsule of length 40
     had the condition 3.7e8 at degree 320 against 4e2 at 200). Mirror-symmetric to the last bit when the joins are
     (an odd rule's middle node at x = 0 exactly: ``even_half`` counts it once)."""
-    nodes, weights = gauss_rule(n_q)
     if not joins:
-        return nodes, weights
+        return gauss_rule(n_q)
     ends = (-1.0, *joins, 1.0)
+    counts = n_q if isinstance(n_q, tuple) else (n_q,) * (len(ends) - 1)
     out_nodes, out_weights = [], []
     for i, (a, b) in enumerate(zip(ends[:-1], ends[1:])):
+        nodes, weights = gauss_rule(counts[i])
         if i in (0, len(joins)):
             out_nodes.append(0.5 * (b - a) * nodes + 0.5 * (b + a))
             out_weights.append(0.5 * (b - a) * weights)
@@ -448,11 +504,13 @@ def _projection(disc: Discretisation) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def _tables(disc: Discretisation) -> dict:
-    """The node, weight and basis tables of a Discretisation (keyed by its six fields: equal discretisations
+    """The node, weight and basis tables of a Discretisation (keyed by its seven fields: equal discretisations
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
-    n_q = disc.quadrature or piece_nodes(disc.degree, disc.joins)
+    n_q = disc.quadrature or piece_nodes(disc.degree, disc.joins, disc.element_degrees)
+    if disc.element_degrees and not disc.quadrature:  # graded: each piece the rule of its own element's degree
+        n_q = tuple(gauss_nodes(degree) for degree in piece_degrees(disc.joins, disc.element_degrees))
     nodes, s_weights = split_rule(n_q, disc.joins)
-    p, dp = basis_table(nodes, disc.degree, disc.joins)
+    p, dp = basis_table(nodes, disc.degree, disc.joins, disc.element_degrees)
     if disc.mapping is None:
         x, weights = nodes, s_weights
     else:

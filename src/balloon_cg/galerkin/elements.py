@@ -39,6 +39,7 @@ import numpy as np
 from .legendre import legendre_table
 
 CONSTANT, HAT, VERTEX, CYLINDER, CAPS = range(5)  # the families of ``sequence``
+CAPS_GROUP = -1  # the caps' entry in ``groups``
 # the caps keep at least half the cylinder's degree up to this one, beyond it by arclength: by arclength alone a
 # capsule of length 40 gives its caps degree 6 of 162, and the layer where the caps meet the cylinder (about 0.1
 # radii wide at 1.5 % hoop strain) is not resolved: its start's pressure is 2.6e-5 off at degree 162 with caps of
@@ -72,14 +73,20 @@ def layout(joins: tuple) -> Layout:
     return Layout(join, 0.5 * np.pi - float(np.arccos(join)), tuple((2 * e - n) / n for e in range(n + 1)))
 
 
-@functools.lru_cache(maxsize=32)
-def sequence(degree: int, joins: tuple) -> tuple:
-    """(family, j, element) of φ_0..φ_degree for ``joins`` (module docstring): (CONSTANT, 0, 0), (HAT, 1, 0), the
+@functools.lru_cache(maxsize=64)
+def sequence(degree: int, joins: tuple, degrees: tuple = ()) -> tuple:
+    """(family, j, element) of φ_0..φ_degree for ``joins``: ``graded_sequence`` of ``degrees`` (one per element
+    group) if given, else the greedy order (module docstring): (CONSTANT, 0, 0), (HAT, 1, 0), the
     inner boundaries' hats (VERTEX, 1, i) of each parity while there are any, then per parity the caps while their
     next degree is at most min(CAP_FLOOR, half the cylinder elements' next), else the family with the lower degree
     per radian once the function is added, the caps on a tie (the cylinder's degree in the floor: that of one
     element holding all its bubbles of the parity so far, so that the caps' floor does not fall with n); a bubble (CYLINDER, j, e) names the northern
     element e of its mirror pair (the middle element of an odd n its own mirror)."""
+    if degrees:
+        order = graded_sequence(degrees, joins)
+        if len(order) != degree + 1:
+            raise ValueError(f"element degrees {degrees}: {len(order)} functions, not degree + 1 = {degree + 1}")
+        return order
     shape = layout(joins)
     n, theta_j = shape.count, 0.5 * np.pi - shape.half_span
     element_span, cap_span = (np.pi - 2 * theta_j) / n, 2 * theta_j
@@ -110,10 +117,72 @@ def sequence(degree: int, joins: tuple) -> tuple:
     return tuple(out)
 
 
-def element_degree(degree: int, joins: tuple) -> int:
+def element_degree(degree: int, joins: tuple, degrees: tuple = ()) -> int:
     """The highest polynomial degree of any element at basis degree N (the caps' in x, a cylinder element's in θ):
     what each piece's quadrature must integrate (galerkin/discretisation.py ``piece_nodes``)."""
-    return max(j for _, j, _ in sequence(degree, joins))
+    return max(j for _, j, _ in sequence(degree, joins, degrees))
+
+
+def groups(joins: tuple) -> tuple:
+    """The element groups of ``joins``, each one degree of a graded basis: the northern element e of each mirror
+    pair of cylinder elements from the middle outwards (the middle element of an odd n its own mirror), then the
+    caps (CAPS_GROUP) — the order of ``families``."""
+    shape = layout(joins)
+    return (*range(shape.count // 2, shape.count), CAPS_GROUP)
+
+
+def group_degrees(degree: int, joins: tuple, degrees: tuple = ()) -> tuple:
+    """Per element group (``groups``) the highest degree j of its functions at basis degree N: a cylinder group's
+    bubbles (1 without any: the hats' lines), the caps' pairs (0 without any)."""
+    top = {group: (0 if group == CAPS_GROUP else 1) for group in groups(joins)}
+    for family, j, e in sequence(degree, joins, degrees):
+        group = CAPS_GROUP if family == CAPS else e if family == CYLINDER else None
+        if group is not None:
+            top[group] = max(top[group], j)
+    return tuple(top[group] for group in groups(joins))
+
+
+def piece_degrees(joins: tuple, degrees: tuple) -> tuple:
+    """The degree of each piece of the quadrature (ascending in x: the south cap, cylinder elements 0..n − 1, the
+    north cap) on the graded basis of ``degrees`` per group (``groups``; an element's its mirror pair's)."""
+    shape = layout(joins)
+    of = dict(zip(groups(joins), degrees))
+    cylinder = tuple(of[max(e, shape.mirror(e))] for e in range(shape.count))
+    return (of[CAPS_GROUP], *cylinder, of[CAPS_GROUP])
+
+
+@functools.lru_cache(maxsize=64)
+def graded_sequence(degrees: tuple, joins: tuple) -> tuple:
+    """(family, j, element) of a basis with a degree per element group (``groups``): φ_0 = 1, φ_1 = ℓ, the inner
+    boundaries' hats, then every bubble j = 2..d_e of each cylinder group (both parities on a mirror pair, (−1)^j on
+    the middle element) and every cap pair j = 1..d_caps (both parities), ordered by j and then by group within
+    each parity and interleaved so that φ_k has the parity (−1)^k. The counts of the two parities differ by at most
+    one (1 and ℓ, the hats and the pairs balance; the middle element's B_j alternate, from j = 2), so the layout is
+    that of every other basis (a_even, b_odd, the reflection signs). A graded basis holds another one's functions
+    when its degrees are at least the other's per group (``Discretisation.nests_in``): transfers permute."""
+    shape = layout(joins)
+    names = groups(joins)
+    if len(degrees) != len(names):
+        raise ValueError(f"element degrees {degrees}: one per element group, {len(names)} for {len(joins) - 1} "
+                         "cylinder elements and the caps")
+    n = shape.count
+    by_parity = {0: [(VERTEX, 1, i) for i in range((n + 1) // 2, n)], 1: [(VERTEX, 1, i) for i in range(n // 2 + 1, n)]}
+    rest = {0: [], 1: []}
+    for group, top in zip(names, degrees):
+        if group == CAPS_GROUP:
+            rest[0] += [(j, len(names), (CAPS, j, 0)) for j in range(1, top + 1)]
+            rest[1] += [(j, len(names), (CAPS, j, 0)) for j in range(1, top + 1)]
+        for j in range(2, top + 1) if group != CAPS_GROUP else ():
+            parities = (j % 2,) if shape.mirror(group) == group else (0, 1)
+            for parity in parities:
+                rest[parity].append((j, group, (CYLINDER, j, group)))
+    for parity in (0, 1):
+        by_parity[parity] += [function for *_, function in sorted(rest[parity])]
+    even, odd = by_parity[0], by_parity[1]
+    out = [(CONSTANT, 0, 0), (HAT, 1, 0)]
+    for k in range(len(even) + len(odd)):
+        out.append((even if k % 2 == 0 else odd)[k // 2])
+    return tuple(out)
 
 
 def _pairs(indices: list) -> np.ndarray:
@@ -127,21 +196,33 @@ def _pairs(indices: list) -> np.ndarray:
     return np.array(rows, dtype=int).reshape(-1, 2)
 
 
-def families(degree: int, joins: tuple) -> tuple:
+def graded_degree(degrees: tuple, joins: tuple) -> int:
+    """The basis degree N (N + 1 functions) of the graded basis with ``degrees`` per element group."""
+    return len(graded_sequence(degrees, joins)) - 1
+
+
+@functools.lru_cache(maxsize=64)
+def function_keys(degree: int, joins: tuple, degrees: tuple = ()) -> tuple:
+    """(family, j, element, parity) of φ_0..φ_degree: what names a function whatever its place in the order (a mirror
+    pair's bubble and a cap pair come once per parity), so that one basis's functions are found in another's."""
+    return tuple((family, j, e, k % 2) for k, (family, j, e) in enumerate(sequence(degree, joins, degrees)))
+
+
+def families(degree: int, joins: tuple, degrees: tuple = ()) -> tuple:
     """The elements' own coefficient series, whose tails ``Discretisation.tail`` reads: per cylinder group the
     indices k of its bubbles in the order of their degree (the middle element of an odd n: one column) or as
     (even, odd) rows per degree j (a mirror pair of elements), and the caps' pairs as (even, odd) rows per j."""
-    order = sequence(degree, joins)
+    order = sequence(degree, joins, degrees)
     shape = layout(joins)
-    groups = []
+    series = []
     for e in range(shape.count // 2, shape.count):
         bubbles = [(k, j) for k, (family, j, element) in enumerate(order) if family == CYLINDER and element == e]
         if shape.mirror(e) == e:
-            groups.append(np.array([k for k, _ in sorted(bubbles, key=lambda item: item[1])], dtype=int))
+            series.append(np.array([k for k, _ in sorted(bubbles, key=lambda item: item[1])], dtype=int))
         else:
-            groups.append(_pairs(bubbles))
-    groups.append(_pairs([(k, j) for k, (family, j, _) in enumerate(order) if family == CAPS]))
-    return tuple(groups)
+            series.append(_pairs(bubbles))
+    series.append(_pairs([(k, j) for k, (family, j, _) in enumerate(order) if family == CAPS]))
+    return tuple(series)
 
 
 def cylinder_coordinates(x: np.ndarray, shape: Layout):
@@ -156,12 +237,12 @@ def cylinder_coordinates(x: np.ndarray, shape: Layout):
     return element, (2.0 * xi - (low + high)) / (high - low), 2.0 / (high - low) * dxi
 
 
-def element_table(x: np.ndarray, degree: int, joins: tuple):
+def element_table(x: np.ndarray, degree: int, joins: tuple, degrees: tuple = ()):
     """(φ_k(x), dφ_k/dx) for k = 0..degree, each of shape (len(x), degree + 1), at any x ∈ [−1, 1] (the caps'
     joins belong to the cylinder, an inner boundary to its northern element: φ is continuous there, its
     derivative that element's)."""
     x = np.asarray(x, dtype=float)
-    order = sequence(degree, joins)
+    order = sequence(degree, joins, degrees)
     shape = layout(joins)
     join = shape.join
     cylinder = np.abs(x) <= join
@@ -211,7 +292,7 @@ def element_table(x: np.ndarray, degree: int, joins: tuple):
     return p, dp
 
 
-def element_series(coefficients: np.ndarray, joins: tuple) -> tuple:
+def element_series(coefficients: np.ndarray, joins: tuple, degrees: tuple = ()) -> tuple:
     """(north cap, cylinder elements, south cap): the function Σ_k c_k φ_k (k = 0..len − 1) as one Legendre series
     in each element's own coordinate (module docstring; the south cap's ξ runs from its join, −1, to its pole, +1,
     as the north's; the cylinder's (n, top) rows ascending in x, each in its own t):
@@ -220,7 +301,7 @@ def element_series(coefficients: np.ndarray, joins: tuple) -> tuple:
         bubble → ±(P_j − P_{j−2}) on its elements,   q_j pair → (q_j, 0, (−1)^k q_j),
 
     so that numpy's Legendre series calculus gives any derivative (the curvatures, post/quantities.py)."""
-    order = sequence(len(coefficients) - 1, joins)
+    order = sequence(len(coefficients) - 1, joins, degrees)
     shape = layout(joins)
     top = max(j for _, j, _ in order) + 1
     north, south, cylinder = np.zeros(top), np.zeros(top), np.zeros((shape.count, top))

@@ -168,8 +168,8 @@ def require_attrs(attrs, where, keys, kinds: dict | None = None, error=FileError
             ok = isinstance(value, (str, bytes))
         elif kind == "str[]":
             ok = isinstance(value, np.ndarray) and value.ndim == 1 and (value.dtype == object or value.size == 0)
-        elif kind == "float[]":
-            ok = isinstance(value, np.ndarray) and value.ndim == 1 and _kind_ok(value.dtype, "float")
+        elif kind in ("float[]", "int[]"):
+            ok = isinstance(value, np.ndarray) and value.ndim == 1 and _kind_ok(value.dtype, kind[:-2])
         else:
             ok = np.ndim(value) == 0 and _kind_ok(np.asarray(value).dtype, kind)
         if not ok:

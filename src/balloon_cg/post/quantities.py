@@ -39,13 +39,14 @@ WRINKLING_STATES = ("taut", "wrinkled", "slack")
 def branch_discretisation(branch: dict) -> Discretisation:
     """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric,
     pin_translation, quadrature (0: automatic), the coordinate map (map_centres, map_widths; empty: none) and a
-    capsule's joins (empty, or absent in files before its piecewise basis: the Legendre basis): it evaluates the
-    unknowns."""
+    capsule's joins (empty, or absent in files before its piecewise basis: the Legendre basis) and its graded
+    element degrees (absent: shared): it evaluates the unknowns."""
     attrs = branch["attrs"]
     centres = tuple(float(c) for c in attrs.get("map_centres", ()))
     mapping = WireMap(centres, tuple(float(w) for w in attrs["map_widths"])) if centres else None
     return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]),
-                          int(attrs.get("quadrature", 0)), mapping, tuple(float(x) for x in attrs.get("joins", ())))
+                          int(attrs.get("quadrature", 0)), mapping, tuple(float(x) for x in attrs.get("joins", ())),
+                          tuple(int(d) for d in attrs.get("element_degrees", ())))
 
 
 def _legendre_derivatives(coefficients, c, s, mapping):
@@ -58,7 +59,7 @@ def _legendre_derivatives(coefficients, c, s, mapping):
     return f, -s * fx, s * s * fxx - c * fx, fx
 
 
-def _element_derivatives(coefficients, c, s, joins: tuple):
+def _element_derivatives(coefficients, c, s, joins: tuple, degrees: tuple = ()):
     """(f, f', f'', df/dx) in θ of f = Σ c_k φ_k (rows of ``coefficients``) on a capsule's elements
     (galerkin/elements.py: ``element_series``): on cylinder element e, t linear in θ, f' = f_t t', f'' = f_tt t'²,
     f_x = −f'/sin θ; on the caps ξ = (2|x| − 1 − c)/(1 − c), f_x = f_ξ ξ_x, f_xx = f_ξξ ξ_x², then θ by the chain
@@ -67,7 +68,7 @@ def _element_derivatives(coefficients, c, s, joins: tuple):
     shape = layout(joins)
     join = shape.join
     cylinder, north = np.abs(c) <= join, c > join
-    rows = [element_series(row, joins) for row in np.atleast_2d(coefficients)]
+    rows = [element_series(row, joins, degrees) for row in np.atleast_2d(coefficients)]
 
     def derivatives(series, at):
         """f, f_t, f_tt of the rows' ``series`` (rows, top) at ``at``."""
@@ -102,8 +103,8 @@ def surface(disc: Discretisation, X, theta, geometry: Geometry = Geometry()) -> 
     a, b = (np.array(c).T for c in zip(*(disc.split(row) for row in np.atleast_2d(X)[:, : disc.size])))
     c, s = np.cos(theta), np.sin(theta)
     if disc.joins:
-        lam2, dlam2, d2lam2, _ = _element_derivatives(a.T, c, s, disc.joins)
-        eta, deta, d2eta, deta_dx = _element_derivatives(b.T, c, s, disc.joins)
+        lam2, dlam2, d2lam2, _ = _element_derivatives(a.T, c, s, disc.joins, disc.element_degrees)
+        eta, deta, d2eta, deta_dx = _element_derivatives(b.T, c, s, disc.joins, disc.element_degrees)
     else:
         lam2, dlam2, d2lam2, _ = _legendre_derivatives(a, c, s, disc.mapping)
         eta, deta, d2eta, deta_dx = _legendre_derivatives(b, c, s, disc.mapping)

@@ -141,6 +141,7 @@ class Geometry:
     ends: Ends | None = None  # a tube's
     axial_stretch: float | None = None  # a tube's ends held at the distance λL (None: closed, the distance free)
     element_length: float | None = None  # a capsule's longest cylinder element (None: the cylinder one element)
+    element_degrees: str | None = None  # a capsule's: GRADED, a degree per element from its own tail (None: shared)
 
     def to_table(self) -> dict:
         """Its [geometry] table (a spheroid's keeps the text it had before tubes)."""
@@ -149,7 +150,8 @@ class Geometry:
             return {"shape": self.shape.value, "length": self.length, "ends": self.ends.value} | held
         if self.shape == Shape.CAPSULE:
             split = {} if self.element_length is None else {"element_length": self.element_length}
-            return {"shape": self.shape.value, "length": self.length} | split
+            graded = {} if self.element_degrees is None else {"element_degrees": self.element_degrees}
+            return {"shape": self.shape.value, "length": self.length} | split | graded
         return {"shape": self.shape.value, "aspect": self.aspect}
 
     def describe(self) -> str:
@@ -295,6 +297,7 @@ CLOSED = "closed"  # geometry.axial's one value: the default, the ends' distance
 # geometry.element_length of a capsule (reference radii), and the most cylinder elements it may cut (each adds
 # basis functions before any polynomial degree: model/meridian.cylinder_elements)
 MIN_ELEMENT, MAX_ELEMENTS = 1.0, 41
+GRADED = "graded"  # geometry.element_degrees of a capsule: a degree per element (analysis/branches/graded.py)
 MIN_AXIAL, MAX_AXIAL = 1.0, 5.0  # geometry.axial_stretch: a tube's ends held at λL (below 1 the membrane would be
 #                                  compressed axially at P = 0)
 MIN_STEP, MAX_STEP = 1e-12, 10.0  # continuation.step_min .. step_max
@@ -834,9 +837,9 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     for key in ("ends", "axial", "axial_stretch"):
         if shape != Shape.TUBE and data.get(key) is not None:
             raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "tube"')
-    if shape != Shape.CAPSULE and data.get("element_length") is not None:
-        raise SceneError(f'geometry.element_length = {show(data["element_length"])}: only for geometry.shape = '
-                         '"capsule"')
+    for key in ("element_length", "element_degrees"):
+        if shape != Shape.CAPSULE and data.get(key) is not None:
+            raise SceneError(f'geometry.{key} = {show(data[key])}: only for geometry.shape = "capsule"')
     if shape not in (Shape.TUBE, Shape.CAPSULE) and data.get("length") is not None:
         raise SceneError(f'geometry.length = {show(data["length"])}: only for geometry.shape = "tube" or "capsule"')
     if shape == Shape.TUBE:
@@ -895,10 +898,14 @@ def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
         element = _getter(data, "geometry", Geometry)("element_length", lambda x: low <= x <= MAX_LENGTH,
                                                        f"in [{low:g}, {MAX_LENGTH:g}] (at most {MAX_ELEMENTS} "
                                                        f"elements on the cylinder of length {length:g})")
+    graded = data.get("element_degrees")
+    if graded not in (None, GRADED):
+        raise SceneError(f'geometry.element_degrees = {show(graded)}: must be "{GRADED}" (a degree per element, '
+                         "each from its own tail) or left out (one degree shared by every element)")
     _coaxial_outside('geometry.shape = "capsule"', field,
                      lambda coil: coil.radius**2 + max(abs(coil.height) - length / 2, 0.0) ** 2,
                      f"the reference capsule of length {length:g} (radius² + (|height| − length/2)₊²")
-    return Geometry(Shape.CAPSULE, length=length, element_length=element)
+    return Geometry(Shape.CAPSULE, length=length, element_length=element, element_degrees=graded)
 
 
 def _tube(data, field: Field) -> Geometry:

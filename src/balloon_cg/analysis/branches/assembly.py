@@ -20,6 +20,7 @@ from ...numerics.continuation import Stop
 from ...numerics.newton import newton
 from ...scene import Control
 from .control import control_gradient, control_value
+from .graded import covering_basis
 from .resolution import transfer_error
 from ..results import Branch, Kind, Leg, SpecialPoint, StopCode, located_or_bracketed
 from .tracer import ContinuationError, LegTrace
@@ -43,9 +44,13 @@ def _worst(moves: dict) -> float:
 
 def storage_basis(tracer, params, legs: list[LegTrace]):
     """(discretisation, moves) for storing ``legs``: the finest one used, raised while that lowers the worst
-    projection loss below the policy's limit (a narrow final map may not hold the early points)."""
+    projection loss below the policy's limit (a narrow final map may not hold the early points); on graded bases
+    the one covering them all (``graded.covering_basis``: no loss)."""
     policy = tracer.resolution
     used = [d for leg in legs for d, _ in leg.segments]
+    if any(d.element_degrees for d in used):  # graded: the basis holding them all, each point moved exactly
+        disc = covering_basis(used)
+        return disc, _moved(legs, disc)
     disc = [d for d in used if d.degree == max(u.degree for u in used)][-1]
     moves = _moved(legs, disc)
     while _worst(moves) > policy.loss_limit and disc.degree < policy.max_degree:
@@ -146,7 +151,7 @@ def _resolved_end(tracer, final, leg: LegTrace, pole, target, end: continuation.
     own_disc, path = leg.segments[-1]
     if estimate <= tracer.resolution.max_error or own_disc is disc or not path.points:
         return end.X, end, disc.degree, estimate
-    own = tracer.system(own_disc.degree, final.params, own_disc.mapping)
+    own = tracer.system_on(own_disc, final.params)
     own_end = land(own, path.points[-1].X, path.overshoot.X, quantity_of(own, pole), target, tracer.settings)
     if own_end is None:
         return end.X, end, disc.degree, estimate
@@ -165,7 +170,7 @@ def assemble(tracer, params, name: str, forward: LegTrace, backward: LegTrace | 
     code (a pole stretch, or the control parameter V or n)."""
     legs = [leg for leg in (backward, forward) if leg is not None]
     disc, moves = storage_basis(tracer, params, legs)
-    final = tracer.system(disc.degree, params, disc.mapping)
+    final = tracer.system_on(disc, params)
     land_on = land_on or {}
     forward_points, forward_folds = _collect(forward, disc, moves)
     forward_points, forward_folds, forward_stop = _landed(tracer, final, forward, forward_points, forward_folds,

@@ -12,8 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...galerkin.discretisation import Discretisation
+from ...galerkin.discretisation import Discretisation, geometric_fit, geometric_tail
+from ...galerkin.elements import group_degrees
 from ...numerics import interrupt
+
+
+# the lowest degree an element group of a graded basis is cut to (``Resolution.element_degrees``)
+MIN_ELEMENT_DEGREE = 8
 
 
 @dataclass(frozen=True)
@@ -37,6 +42,38 @@ class Resolution:
     def grow(self, degree: int) -> int:
         """The next degree: ``growth`` times larger, at most max_degree."""
         return min(int(degree * self.growth), self.max_degree)
+
+    def element_degrees(self, disc: Discretisation, u) -> tuple:
+        """A degree per element group of a capsule's basis (``elements.groups``), each from its own series: a
+        group whose tail T (``Discretisation.element_tails``, decaying by r per degree) is above max_error grows by
+        the degrees that tail wants, ln(headroom · max_error / T)/ln r, at least 2 and at most by ``growth``; a
+        resolved group keeps its degree unless its series cut at a degree at most 1/growth of it still has a
+        tail estimate (``geometric_tail`` of what is kept, the cut coefficients below it too) of at most
+        headroom² · max_error, when it is cut to the lowest such degree, not below MIN_ELEMENT_DEGREE (a bulge's
+        front leaves the elements it passed uniform); none beyond max_degree. Unchanged degrees: every group
+        resolved (and none worth cutting) or at max_degree."""
+        out = []
+        for degree, envelope in zip(group_degrees(disc.degree, disc.joins, disc.element_degrees),
+                                    disc.element_envelopes(u)):
+            tail, rate = geometric_fit(envelope)
+            if tail <= self.max_error:
+                out.append(self._cut(degree, envelope))
+                continue
+            wanted = np.log(self.headroom * self.max_error / tail) / np.log(rate)
+            step = int(np.clip(np.ceil(wanted), 2, max(2, int(degree * (self.growth - 1)))))
+            out.append(min(degree + step, self.max_degree))
+        return tuple(out)
+
+    def _cut(self, degree: int, envelope: np.ndarray) -> int:
+        """The lowest degree ≥ MIN_ELEMENT_DEGREE and ≤ degree/growth at which the series ``envelope`` (one entry per
+        degree up to ``degree``) cut there keeps a tail estimate, and drops coefficients, of at most headroom² ·
+        max_error; else ``degree`` (``element_degrees``)."""
+        limit = self.headroom**2 * self.max_error
+        for cut in range(MIN_ELEMENT_DEGREE, int(degree / self.growth) + 1):
+            kept = envelope.size - (degree - cut)
+            if kept >= 1 and geometric_tail(envelope[:kept]) <= limit and envelope[kept:].max() <= limit:
+                return cut
+        return degree
 
     @property
     def recentre_accept(self) -> float:

@@ -24,7 +24,9 @@ from ...numerics.continuation import Stop
 from ...numerics.newton import newton
 from .control import fold_monitors
 from .flattening import flattening_stop
+from .graded import graded_point
 from ...scene import ContinuationParameter
+from ...scene.tables import GRADED
 from .problem import ParameterSystem, continuation_settings
 from .resolution import Resolution
 from ..results import Kind, StopCode
@@ -81,6 +83,8 @@ class Tracer:
         self.parameter = parameter or scene_parameter(scene)
         self.settings = continuation_settings(scene)
         self.resolution = Resolution.of(scene)
+        # a capsule's elements each at its own degree (geometry.element_degrees = "graded": ``graded``)
+        self.graded = scene.geometry.element_degrees == GRADED
         self._systems = {}
 
     def system(self, degree: int, params: Parameters, mapping=None) -> ParameterSystem:
@@ -89,6 +93,15 @@ class Tracer:
             disc = Discretisation(degree, self.symmetric, self.pin, quadrature, mapping)
             self._systems[degree, mapping] = Equilibrium(self.scene, disc)
         return ParameterSystem(self._systems[degree, mapping], params, self.parameter)
+
+    def system_on(self, disc: Discretisation, params: Parameters) -> ParameterSystem:
+        """The system on a discretisation of this tracer's: one of ``system``'s (by its degree and map), or a graded
+        one (``graded``)."""
+        if not disc.element_degrees:
+            return self.system(disc.degree, params, disc.mapping)
+        if disc not in self._systems:
+            self._systems[disc] = Equilibrium(self.scene, disc)
+        return ParameterSystem(self._systems[disc], params, self.parameter)
 
     def leg(self, start: continuation.Point, params: Parameters, stop, progress=None, degree=None,
             mapping=None, limits=None, turning=TOP_TURNING) -> LegTrace:
@@ -123,6 +136,13 @@ class Tracer:
                 return LegTrace(segments, path.stop)
             last = path.points.pop()  # recomputed on the new basis as the next segment's first point
             path.folds = [f for f in path.folds if f.index < len(path.points)]  # later ones are found again
+            if self.graded:
+                graded = self._graded(disc, last, path.overshoot, params)
+                if isinstance(graded, Stop):
+                    path.points.append(last)
+                    return LegTrace(segments, graded)
+                system, start = graded
+                continue
             recentred = wire_map(disc, last.X[:-1], self.scene.field.coils, self.symmetric)
             refined = None
             if recentred is not None and not recentred.close_to(disc.mapping) and recentres < policy.max_recentres:
@@ -145,6 +165,21 @@ class Tracer:
             system, result, t = refined
             start = continuation.Point(result.x, continuation.tangent(system, result.x, t), result.iterations,
                                        result.residual)
+
+    def _graded(self, disc: Discretisation, last: continuation.Point, ahead: continuation.Point, params: Parameters):
+        """``last`` recomputed on the graded basis that the element groups' own tails at the unresolved point
+        ``ahead`` want (``graded.graded_point``): (system, continuation start) there, or the Stop when no group can
+        grow or Newton fails."""
+        point = graded_point(lambda target: self.system_on(target, params), disc, last.X, last.tangent,
+                             self.resolution, self.settings.tol, self.settings.max_newton, ahead.X)
+        if point.result is None:
+            return Stop(StopCode.RESOLUTION_LIMIT, f"resolution: {point.message}; raise max_degree or shorten the "
+                                                   "branch")
+        if not point.result.converged:
+            return Stop(StopCode.REFINE_FAILED, f"could not refine: {point.message}")
+        system = self.system_on(point.disc, params)
+        return system, continuation.Point(point.X, continuation.tangent(system, point.X, point.row),
+                                          point.result.iterations, point.result.residual)
 
     def _refine(self, disc: Discretisation, last: continuation.Point, degree: int, mappings, params: Parameters,
                 accept: float):

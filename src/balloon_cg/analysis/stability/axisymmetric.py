@@ -83,12 +83,14 @@ class SecondVariation:
         norm = equilibrium.scene.stability.norm if norm is None else norm
         # per piece of the equilibrium's rule (split at a capsule's joins, where the integrand has kinks)
         joins = equilibrium.disc.joins
-        quadrature = max(equilibrium.disc.x.size // (len(joins) + 1), piece_nodes(degree, joins))
+        # a graded equilibrium's own element degrees at its degree (each element as resolved as its state)
+        graded = equilibrium.disc.element_degrees if degree == equilibrium.disc.degree else ()
+        quadrature = max(equilibrium.disc.x.size // (len(joins) + 1), piece_nodes(degree, joins, graded))
         # "legendre": P_k(x) even when the equilibrium's basis is mapped; "mapped": P_k(s) on the equilibrium's own
         # wire map (its Gauss nodes in s); on an unmapped equilibrium both are the same basis
         mapping = perturbation_map(equilibrium, self.basis_kind)
         self.basis = Discretisation(degree, symmetric=False, pin_translation=False, quadrature=quadrature,
-                                    mapping=mapping, joins=joins)
+                                    mapping=mapping, joins=joins, element_degrees=graded)
         self.theta = np.arccos(self.basis.x)
         k = np.arange(degree + 1)
         na = degree + 1
