@@ -664,9 +664,6 @@ def _build(data: dict, name: str, text: str) -> Scene:
         raise SceneError(f'continuation.parameter = "voltage": a {geometry.shape.value} is continued in the pressure '
                          "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
-    if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
-        raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 frequencies are not built yet (its "
-                         "m ≥ 1 mass matrix and mode shapes); allowed: 0")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
     events = events_from_list(data.get("events", []))
