@@ -660,9 +660,6 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric)
-    if geometry.shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
-        raise SceneError(f'continuation.parameter = "voltage": a {geometry.shape.value} is continued in the pressure '
-                         "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
