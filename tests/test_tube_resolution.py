@@ -127,10 +127,12 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
 
 
 def refined_scene(max_degree: int):
-    """``spom1_l10(30)`` to V/V0 = 4 (step 0.02, m = 0) with max_error 1e-5 and solver.tube_resolution = "refine"."""
+    """``spom1_l10(30)`` to V/V0 = 4 (step 0.02, m = 0, stop_stretch 6: past the bulge's V/V0 = 4) with max_error 1e-5
+    and solver.tube_resolution = "refine"."""
     return spom1_l10(30).with_overrides({"solver.max_error": 1e-5, "solver.max_degree": max_degree,
                                          "solver.tube_resolution": "refine", "continuation.stop_volume": 40.0 * np.pi,
-                                         "continuation.step": 0.02, "stability.m_max": 0})
+                                         "continuation.step": 0.02, "continuation.stop_stretch": 6.0,
+                                         "stability.m_max": 0})
 
 
 def test_run_refines_the_bulge_to_max_error_where_the_scene_asks(tmp_path, capsys):
