@@ -82,7 +82,9 @@ def test_capsule_voltage_continuation_from_a_uz_is_the_run_s_branch(tmp_path):
 
 
 def test_capsule_voltage_start_refused_above_its_voltage_free_pressure():
-    """P above the capsule's voltage-free pressure at the start stretch: no voltage holds it there (one line)."""
-    with pytest.raises(ContinuationError, match=r"pressure = 1.9: no voltage holds the capsule there") as e:
+    """P above the capsule's voltage-free pressure at the start stretch (a voltage lowers it): no voltage holds it
+    there, refused before any continuation (one line)."""
+    with pytest.raises(ContinuationError, match=r"pressure = 1.9: no voltage holds the capsule there \(its voltage-free "
+                                                r"pressure there is 1\.\d+, and a voltage moves it by dP/dΦ̄² = -") as e:
         analyse(voltage_scene(3.0, pressure=1.9), pear=False)
     assert "\n" not in str(e.value)

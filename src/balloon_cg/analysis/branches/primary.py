@@ -171,8 +171,9 @@ def held_by_voltage(tracer: Tracer, degree: int, stretch: float, params: Paramet
     stretch (``inflated_reference``, its pressure P0), then natural continuation in P from P0 to params.P at that
     pole stretch with (u, s = Φ̄²) the unknowns. The residual is linear in s (the dielectric term −Φ̄²λ1²λ2²):
     R(u; P, s) = R(u; P, 0) + s D(u), D = ½ ∂R/∂Φ̄ at Φ̄ = 1, so its Jacobian is regular at s = 0, where the one in Φ̄
-    is singular (∂R/∂Φ̄ = 2Φ̄ D). ContinuationError where the continuation does not get there or ends at s < 0 (no
-    voltage holds that stretch at P: a voltage lowers the pressure of a stretch)."""
+    is singular (∂R/∂Φ̄ = 2Φ̄ D). ContinuationError where no voltage holds that stretch at P: a voltage moves its
+    pressure away from P (ds/dP at s = 0, from the bordered system [∂R/∂u, D; pole row, 0], has the sign of P0 − P),
+    or the continuation does not get there or ends at s < 0."""
     scene = tracer.scene
     u, free = inflated_reference(tracer, degree, stretch, params.with_value("voltage", 0.0))
     eq = tracer.system(degree, params).eq
@@ -193,13 +194,24 @@ def held_by_voltage(tracer: Tracer, degree: int, stretch: float, params: Paramet
     def charge(u):
         return 0.5 * eq.parameter_derivative(u, params.with_value("voltage", 1.0), "voltage")
 
+    def refused(why):
+        return ContinuationError(f"cannot start the voltage continuation at continuation.start_stretch = {stretch:g}, "
+                                 f"continuation.pressure = {params.P:g}: no voltage holds the "
+                                 f"{scene.geometry.shape.value} there ({why}); lower continuation.pressure or choose "
+                                 "another start_stretch")
+
+    free_params = params.with_value("P", free).with_value("voltage", 0.0)
+    bordered = np.vstack([np.column_stack([eq.jacobian(u, free_params), charge(u)]), row])
+    rate = np.linalg.solve(bordered, np.append(-eq.parameter_derivative(u, free_params, "P"), 0.0))[-1]  # ds/dP
+    if rate * (params.P - free) <= 0:
+        raise refused(f"its voltage-free pressure there is {free:.6g}, and a voltage moves it by dP/dΦ̄² = "
+                      f"{1 / rate:.4g}: away from P")
     Y, reached, message = continuation.natural(solve, np.append(u, 0.0), 0.0, 1.0)
-    if reached < 1.0 or Y[-1] < 0:
-        where = f"at P = {free + reached * (params.P - free):.6g} ({message})" if reached < 1.0 else \
-            f"its voltage-free pressure there is {free:.6g}, below P"
-        raise ContinuationError(f"cannot start the voltage continuation at continuation.start_stretch = {stretch:g}, "
-                                f"continuation.pressure = {params.P:g}: no voltage holds the {scene.geometry.shape.value} "
-                                f"there ({where}); lower continuation.pressure or choose another start_stretch")
+    if reached < 1.0:
+        raise refused(f"the continuation from its voltage-free pressure {free:.6g} stopped at P = "
+                      f"{free + reached * (params.P - free):.6g}: {message}")
+    if Y[-1] < 0:
+        raise refused(f"Φ̄² = {Y[-1]:.3g} < 0 at P")
     return Y[:-1], float(np.sqrt(Y[-1]))
 
 
