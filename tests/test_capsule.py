@@ -527,10 +527,6 @@ def test_capsule_table_errors_name_key_value_and_range():
         ('[geometry]\nshape = "capsule"\nlength = 5\naspect = 2\n', "geometry.aspect = 2"),
         ('[geometry]\nshape = "capsule"\nlength = 5\nends = "plugged"\n', "geometry.ends"),
         ('[geometry]\nshape = "spheroid"\naspect = 2\nlength = 5\n', "geometry.length = 5"),
-        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[dynamics]\nfrequencies = true\n'
-         'm_max = 1\n', "dynamics.m_max = 1"),
-        ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[continuation]\nparameter = "voltage"\n'
-         'pressure = 0.5\n[electric]\n', 'continuation.parameter = "voltage"'),
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'
          '[[field.coils]]\nradius = 0.8\nheight = 3.0\ncurrent = 1.0\n', "inside the reference capsule of length 5"),
         ('[geometry]\nshape = "capsule"\nlength = 5\n[stability]\nm_max = 0\n[field]\nM = 0.01\n'

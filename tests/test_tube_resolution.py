@@ -124,3 +124,58 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
     assert summary["bulge"]["largest_tail"] == bulge.tail.max() and summary["primary"]["unresolved_points"] == 0
     assert f"{summary['bulge']['unresolved_points']} points unresolved" in format_tube(summarise_tube(
         read_tube_run(path)))
+
+
+def refined_scene(max_degree: int):
+    """``spom1_l10(30)`` to V/V0 = 4 (step 0.02, m = 0, stop_stretch 6: past the bulge's V/V0 = 4) with max_error 1e-5
+    and solver.tube_resolution = "refine"."""
+    return spom1_l10(30).with_overrides({"solver.max_error": 1e-5, "solver.max_degree": max_degree,
+                                         "solver.tube_resolution": "refine", "continuation.stop_volume": 40.0 * np.pi,
+                                         "continuation.step": 0.02, "continuation.stop_stretch": 6.0,
+                                         "stability.m_max": 0})
+
+
+def test_run_refines_the_bulge_to_max_error_where_the_scene_asks(tmp_path, capsys):
+    """``run`` with solver.tube_resolution = "refine" (max_error 1e-5, max_degree 100): the bulge branch of
+    test_unresolved_bulge_is_retraced_at_a_higher_degree, retraced to degree 67, is written with the primary branch of
+    that degree: every point's tail ≤ 1e-5, the end at V/V0 = 4, its fold at the converged one (1e-9); exit 0. With
+    max_degree 30 it stops unresolved: the bulge's stop code ``unresolved``, its message naming solver.max_degree,
+    every stored point resolved, and ``run`` exits 1 with one line saying so (0 with --allow-partial)."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.tube_file import read_tube_run
+
+    for max_degree, code in ((100, 0), (30, 1)):
+        scene_file, path = tmp_path / f"refine{max_degree}.toml", tmp_path / f"refine{max_degree}.h5"
+        scene_file.write_text(refined_scene(max_degree).to_toml())
+        assert main(["run", str(scene_file), "-o", str(path), "--quiet"]) == code
+        run = read_tube_run(path)
+        bulge = run["branches"]["bulge"]
+        assert bulge["tail"].max() <= 1e-5
+        err = capsys.readouterr().err
+        if code == 0:
+            assert run["attrs"]["degree"] == 67 and bulge["attrs"]["stop_code"] == StopCode.STOP_VOLUME
+            assert abs(bulge["volume"][-1] - 4.0) <= 1e-9 and err == ""
+            ((fold_pressure, fold_volume),) = [(s["pressure"], s["volume"]) for s in bulge["special_points"]
+                                               if s["kind"] == "LV"]
+            assert abs(fold_pressure - FOLD[0]) <= 1e-9 and abs(fold_volume - FOLD[1]) <= 1e-9
+        else:
+            assert run["attrs"]["degree"] == 30 and bulge["attrs"]["stop_code"] == IntervalStop.UNRESOLVED
+            assert "= solver.max_degree" in bulge["attrs"]["stop_message"]
+            assert "incomplete (bulge:" in err and len(err.strip().splitlines()) == 1
+            assert main(["run", str(scene_file), "-o", str(path), "--quiet", "--force", "--allow-partial"]) == 0
+
+
+def test_tube_resolution_key_is_the_tubes_and_left_out_of_default_texts():
+    """solver.tube_resolution: "flag" (the default) is not written into a scene's text (older texts stay); a wrong
+    value and the key on another shape are one line naming the key, its value and what is allowed."""
+    import pytest
+    from balloon_cg.scene import SceneError, load_scene, parse_scene
+
+    assert "tube_resolution" not in spom1_l10(30).to_toml() and "tube_resolution" in refined_scene(100).to_toml()
+    assert parse_scene(refined_scene(100).to_toml()).solver.tube_resolution == "refine"
+    for text, words in (('[solver]\ntube_resolution = "fine"\n', "solver.tube_resolution = \"fine\": must be one of"),
+                        ('[solver]\ntube_resolution = "refine"\n', 'only for geometry.shape = "tube"')):
+        with pytest.raises(SceneError) as error:
+            parse_scene('[material]\npreset = "SPOM1"\n' + text)
+        assert words in str(error.value) and "\n" not in str(error.value)
+    assert load_scene("spom1").solver.tube_resolution == "flag"

@@ -10,10 +10,13 @@ from ..scene.tables import ContinuationParameter, Ends
 
 def run_tube(scene, output, args) -> int:
     """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
-    written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring)."""
+    written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring); 1 (0 with
+    --allow-partial) where its bulge branch stopped unresolved at solver.max_degree (solver.tube_resolution =
+    "refine": tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run
     from ..tube.picture import tube_picture
+    from ..tube.results import IntervalStop
     from .tube_summary import format_tube, summarise_tube
 
     run, signalled = _written(output, args, lambda: with_frequencies(scene, tube_picture(scene, args.primary_only)),
@@ -23,7 +26,12 @@ def run_tube(scene, output, args) -> int:
         return code
     if not args.quiet:
         print(format_tube(summarise_tube(read_tube_run(output))))
-    return 0
+    bulge = run["branches"].get("bulge")
+    if bulge is None or bulge["attrs"]["stop_code"] != IntervalStop.UNRESOLVED:
+        return 0
+    print(f"{PROG}: incomplete (bulge: {bulge['attrs']['stop_message']}, after {len(bulge['pressure'])} resolved "
+          f"points); written to {output} (its stop code {IntervalStop.UNRESOLVED.value})", file=sys.stderr)
+    return 0 if args.allow_partial else 1
 
 
 ONSET_PARAMETERS = {"M": "M", "field.M": "M", "voltage": "voltage", "electric.voltage": "voltage"}  # critical's

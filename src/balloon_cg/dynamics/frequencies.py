@@ -46,8 +46,7 @@ class BranchFrequencies:
     has fewer than ``count`` modes in a block; ``degree`` the perturbation degree per point (``frequency_degrees``);
     ``special[name]`` (special points × count) the same at each special point's own state, at the
     higher degree of the points around it; ``translation[direction]`` (points,) the rigid translations' Ω²
-    (translation.translation_omega2: 0 without a field, else > 0 restored, < 0 pulled; the lateral one NaN on a
-    capsule); ``modes[name]``
+    (translation.translation_omega2: 0 without a field, else > 0 restored, < 0 pulled); ``modes[name]``
     (special points × count × 3 × θ, NaN where fewer modes) the mode shapes of ``special`` on ``theta``
     (modes.block_modes: δρ, δz, δφ over R0 for a unit modal mass), or None when not asked for."""
 

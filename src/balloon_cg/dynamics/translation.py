@@ -13,7 +13,7 @@ reading's instability, MODEL.md §5).
 """
 import numpy as np
 
-from ..analysis.stability.azimuthal import kernel_state_map, perturbation_basis
+from ..analysis.stability.azimuthal import azimuthal_hessian, kernel_state_map, perturbation_basis, state_maps
 from ..galerkin.discretisation import symmetric_rows
 from ..generated import AZIMUTHAL_PAIRS, HESSIAN_PAIRS
 from ..model.meridian import AZIMUTHAL, mass_density
@@ -37,13 +37,13 @@ def translation_omega2(variation, u, params) -> dict:
     m = 0 second variation, dynamics.pencil.mass_variation; module docstring), on the nodes of its equilibrium's
     m = 1 basis of its degree. On a shape without the m = 1 mass kernel (a capsule: model/meridian.AZIMUTHAL)
     the axial one is the Rayleigh quotient of b_0 (δη = 1) on the m = 0 pencil (its quadrature split at the
-    capsule's joins), and the lateral one NaN (not computed)."""
+    capsule's joins), and the lateral one ``lateral_omega2``'s on its m = 1 basis."""
     equilibrium = variation.eq
     geometry = equilibrium.scene.geometry
     if geometry.shape not in AZIMUTHAL:
         t = variation.translation
         return {"axial": PER_EIGENVALUE * variation.matrices(u, params)[0][t, t] / variation.gram[t, t],
-                "lateral": np.nan}
+                "lateral": lateral_omega2(equilibrium, u, params, variation.basis.degree)}
     b = perturbation_basis(equilibrium, 1, variation.basis.degree)
     nodes = equilibrium.at_nodes(("translation", b), (b.x, b.sin_theta))
     np.dot(np.asarray(u, dtype=float), kernel_state_map(equilibrium.disc, b, False), out=nodes.state.reshape(-1))
@@ -54,3 +54,13 @@ def translation_omega2(variation, u, params) -> dict:
         out[direction] = PER_EIGENVALUE * (b.weights @ _form(h, pairs, t)) / (
             b.weights @ _form(mass_density(geometry, mass, b.x, b.sin_theta), pairs, t))
     return out
+
+
+def lateral_omega2(equilibrium, u, params, degree: int) -> float:
+    """Ω²_t of the translation across the axis as the Rayleigh quotient ½ cᵀHc / cᵀGc of its coefficients c on the
+    m = 1 basis of ``degree`` (azimuthal.azimuthal_hessian; H its m = 1 block, G its Gram matrix, the mass
+    matrix): c = G⁻¹ (G c), G c the translation's L2 moments (azimuthal.state_maps), exact where the basis holds
+    R = 1, T = −1, Z = 0 (a capsule's: D = 2 is a constant on every element)."""
+    H, G = azimuthal_hessian(equilibrium, u, params, 1, degree)
+    c = np.linalg.solve(G, state_maps(equilibrium.disc, perturbation_basis(equilibrium, 1, degree)).translation)
+    return PER_EIGENVALUE * (c @ H @ c) / (c @ G @ c)

@@ -212,7 +212,10 @@ class Solver:
     """Discretisation: Legendre ``degree``, Gauss points (``quadrature``, 0 = automatic), Newton settings.
 
     The degree grows by half (up to ``max_degree``) whenever the spectral error estimate of a point exceeds
-    ``max_error``; a branch that would need more stops there, saying so.
+    ``max_error``; a branch that would need more stops there, saying so. A tube's bulge branch is traced at one
+    degree: ``tube_resolution`` "flag" (the default) stores its points at the scene's degree, those past
+    ``max_error`` flagged; "refine" retraces it at growing degree until it is resolved, stopping "unresolved" at
+    ``max_degree`` (tube/resolution.py).
     """
 
     degree: int = 40
@@ -221,6 +224,7 @@ class Solver:
     max_newton: int = 25
     max_degree: int = 320
     max_error: float = 1e-9
+    tube_resolution: str = "flag"
 
 
 @dataclass(frozen=True)
@@ -242,6 +246,7 @@ class Stability:
 
 
 STABILITY_BASES = ("legendre", "mapped")
+TUBE_RESOLUTIONS = ("flag", "refine")  # solver.tube_resolution
 STABILITY_NORMS = ("unknowns", "displacement")
 
 
@@ -372,7 +377,10 @@ class Scene:
             "material": m.to_table() if isinstance(m, StrainEnergy) else
             {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [c.to_table() for c in f.coils]},
-            **{t: asdict(getattr(self, t)) for t in _TABLES[2:5]},
+            "continuation": asdict(self.continuation),
+            "solver": {k: v for k, v in asdict(self.solver).items()  # tube_resolution only when set: older texts stay
+                       if k != "tube_resolution" or v != Solver.tube_resolution},
+            "stability": asdict(self.stability),
             "output": {k: v for k, v in asdict(self.output).items()  # memory_limit only when set: older texts stay
                        if k != "memory_limit" or v != Output.memory_limit},
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
@@ -663,13 +671,11 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field, electric)
-    if geometry.shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
-        raise SceneError(f'continuation.parameter = "voltage": a {geometry.shape.value} is continued in the pressure '
-                         "only for now (its start is solved at a pressure, not at a voltage); allowed: \"pressure\"")
     dynamics = _dynamics(data.get("dynamics", {}))
-    if geometry.shape == Shape.CAPSULE and dynamics.frequencies and dynamics.m_max != 0:
-        raise SceneError(f"dynamics.m_max = {dynamics.m_max}: a capsule's m ≥ 1 frequencies are not built yet (its "
-                         "m ≥ 1 mass matrix and mode shapes); allowed: 0")
+    solver = _solver(data.get("solver", {}))
+    if geometry.shape != Shape.TUBE and solver.tube_resolution != Solver.tube_resolution:
+        raise SceneError(f'solver.tube_resolution = "{solver.tube_resolution}": only for geometry.shape = "tube" (the '
+                         "other shapes' branches are always refined to solver.max_error)")
     if geometry.shape == Shape.TUBE and dynamics.modes:
         raise SceneError("dynamics.modes = true: a tube's mode shapes are not stored yet; allowed: false")
     events = events_from_list(data.get("events", []))
@@ -682,7 +688,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
         material=material,
         field=field,
         continuation=continuation,
-        solver=_solver(data.get("solver", {})),
+        solver=solver,
         stability=stability,
         output=output,
         electric=electric,
@@ -1018,7 +1024,11 @@ def _solver(data) -> Solver:
     max_degree = get("max_degree", lambda n: degree <= n <= 400, f"an integer in [solver.degree = {degree}, 400]",
                      integer=True)
     max_error = get("max_error", lambda x: MIN_TOLERANCE <= x <= 1e-2, f"in [{MIN_TOLERANCE:g}, 1e-2]")
-    return Solver(degree, quadrature, tol, max_newton, max_degree, max_error)
+    tube_resolution = data.get("tube_resolution", Solver.tube_resolution)
+    if tube_resolution not in TUBE_RESOLUTIONS:
+        raise SceneError(f"solver.tube_resolution = {show(tube_resolution)}: must be one of "
+                         f"{', '.join(map(repr, TUBE_RESOLUTIONS))}")
+    return Solver(degree, quadrature, tol, max_newton, max_degree, max_error, tube_resolution)
 
 
 def _stability(data) -> Stability:

@@ -1,5 +1,6 @@
 """Everything a tube scene asks for (``balloon-cg run`` on a tube): the primary branch with its folds and branch
-points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py; sliding ends only:
+points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py, held to the
+resolution policy where solver.tube_resolution = "refine": tube/resolution.py; sliding ends only:
 on plugged ones the branch points are not trusted, docs/tubes.md) traced until it rejoins the mirror-symmetric
 states, its largest hoop stretch passes ``continuation.stop_stretch``, its V reaches ``continuation.stop_volume``
 (V/R0³, landed on; the primary branch ends there too) or after ``continuation.max_points``, and
@@ -16,9 +17,9 @@ import numpy as np
 
 from .azimuthal import branch_modes
 from .azimuthal_crossings import crossings
-from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
+from .resolution import traced_bulge
 from .results import IntervalBranch
 from .voltage import voltage_branch
 from ..analysis.results import StopCode
@@ -84,11 +85,14 @@ def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -
 
 def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:
     """``primary`` and the bulge branch switched at its odd branch point ``point`` (tube/bulge.py), stopped as
-    ``tube_picture``'s; ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's label."""
+    ``tube_picture``'s, traced as solver.tube_resolution asks (tube/resolution.traced_bulge: "refine" retraces both
+    at growing degree until the bulge is resolved); ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's
+    label."""
     branches = {"primary": primary}
     if interrupt.requested():  # in the primary branch's stability and branch points: the bulge not started
         return TubePicture(branches, pm, interrupted=Stage.BULGE)
-    branches["bulge"] = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
+    branches["primary"], branches["bulge"] = traced_bulge(scene, primary, point,
+                                                          stop_stretch=scene.continuation.stop_stretch)
     stopped = Stage.BULGE if branches["bulge"].stop.code == StopCode.INTERRUPTED else None
     return with_modes(scene, TubePicture(branches, pm, interrupted=stopped))
 

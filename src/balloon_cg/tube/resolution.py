@@ -5,30 +5,65 @@ Legendre tail (galerkin/interval.IntervalDiscretisation.tail) passes ``max_error
 (IntervalStop.UNRESOLVED, tube/bulge.py: that point is not stored) and the primary branch and the bulge branch are
 traced again from the onset at the degree grown by the policy's factor (analysis/branches/resolution.Resolution: 1.5,
 up to ``max_degree``), until the branch reaches its stop resolved or the degree is ``max_degree``: then the branch
-is returned as traced there, stopped with IntervalStop.UNRESOLVED at its last resolved point. Every stored point has
-its tail (``IntervalBranch.tail``) at most max_error.
+is returned as traced there, stopped with IntervalStop.UNRESOLVED at its last resolved point, its message naming
+max_degree. Every stored point has its tail (``IntervalBranch.tail``) at most max_error.
+
+``balloon-cg run`` traces the bulge branch so where the scene asks for it (``solver.tube_resolution = "refine"``,
+``traced_bulge``); by default ("flag") at the scene's degree, with every point stored and those past max_error
+counted by ``inspect``.
 """
+from dataclasses import replace
+
 from .bulge import bulge_branch
 from .primary import primary_branch
 from .results import IntervalStop
 from ..analysis.branches.resolution import Resolution
 from ..galerkin.interval import Mirror
+from ..numerics.continuation import Stop
+
+REFINE = "refine"  # solver.tube_resolution: the bulge branch retraced until resolved (scene/tables.TUBE_RESOLUTIONS)
+
+
+def traced_bulge(scene, primary, point, **trace) -> tuple:
+    """(primary, bulge) of ``run``: the bulge branch switched at ``point`` of ``primary`` (tube/bulge.bulge_branch,
+    ``trace`` its stop_volume, step, stop_stretch), at the primary's degree with every point stored (solver.
+    tube_resolution "flag"), or held to the scene's policy (``refined_bulge``: "refine"), the primary branch then
+    the one of the degree the bulge was resolved on."""
+    if scene.solver.tube_resolution == REFINE:
+        return refined_bulge(scene, primary, point, **trace)
+    return primary, bulge_branch(scene, primary, point, **trace)
+
+
+def refined_bulge(scene, primary, point, policy: Resolution | None = None, **trace) -> tuple:
+    """(primary, bulge): the bulge branch switched at ``point``, an odd branch point of ``primary``, with every stored
+    point resolved to ``policy.max_error`` (None: the scene's solver.max_error and max_degree), the primary branch
+    traced again at the grown degree where it stops unresolved below max_degree and the bulge switched at its odd
+    branch point nearest ``point`` in P (the same onset at a finer degree: module docstring); ``trace``:
+    tube/bulge.bulge_branch's stop_volume, step, stop_stretch."""
+    policy = Resolution.of(scene) if policy is None else policy
+    while True:
+        branch = bulge_branch(scene, primary, point, max_error=policy.max_error, **trace)
+        degree = primary.disc.degree
+        if branch.stop.code != IntervalStop.UNRESOLVED:
+            return primary, branch
+        if degree >= policy.max_degree:
+            return primary, replace(branch, stop=Stop(branch.stop.code, f"{branch.stop.message} = solver.max_degree: "
+                                                                        "raise it or solver.max_error"))
+        finer = primary_branch(scene, policy.grow(degree))
+        onsets = finer.branch_points(Mirror.ODD)
+        if not onsets:
+            return primary, branch
+        primary, point = finer, min(onsets, key=lambda s: abs(s.pressure - point.pressure))
 
 
 def resolved_bulge_branch(scene, stop_volume: float | None = None, step: float | None = None,
                           policy: Resolution | None = None) -> tuple:
     """(primary, bulge) of a tube scene, the bulge switched at the primary branch's first odd branch point and every
-    stored point resolved to ``policy.max_error`` (None: the scene's solver.max_error and max_degree), from
-    solver.degree (module docstring); ``stop_volume`` and ``step``: tube/bulge.bulge_branch's. The bulge is None
-    where the primary branch has no odd branch point (up to continuation.stop_stretch)."""
-    policy = Resolution.of(scene) if policy is None else policy
-    degree = scene.solver.degree
-    while True:
-        primary = primary_branch(scene, degree)
-        onsets = primary.branch_points(Mirror.ODD)
-        if not onsets:
-            return primary, None
-        branch = bulge_branch(scene, primary, onsets[0], stop_volume, step, max_error=policy.max_error)
-        if branch.stop.code != IntervalStop.UNRESOLVED or degree >= policy.max_degree:
-            return primary, branch
-        degree = policy.grow(degree)
+    stored point resolved to ``policy.max_error`` (``refined_bulge``), from solver.degree; ``stop_volume`` and
+    ``step``: tube/bulge.bulge_branch's. The bulge is None where the primary branch has no odd branch point (up to
+    continuation.stop_stretch)."""
+    primary = primary_branch(scene, scene.solver.degree)
+    onsets = primary.branch_points(Mirror.ODD)
+    if not onsets:
+        return primary, None
+    return refined_bulge(scene, primary, onsets[0], policy, stop_volume=stop_volume, step=step)

@@ -3,9 +3,10 @@
 1. Start: the exact sphere (``model.sphere``) at the scene's start stretch, where the membrane is taut (the
    first-order system is singular at the undeformed state, MODEL.md §4): its pressure at the scene's voltage,
    or, for continuation.parameter = "voltage", its voltage at the scene's fixed pressure. Another reference
-   shape (scene.Geometry: the spheroid) has no closed form: its start is solved from the unstressed reference
-   (λ2 = 1, η = Z(θ), P = 0, an exact equilibrium) by natural continuation in the north pole stretch up to the
-   start stretch, P an unknown (``inflated_reference``).
+   shape (scene.Geometry: the spheroid, the capsule) has no closed form: its start is solved from the unstressed
+   reference (λ2 = 1, η = Z(θ), P = 0, an exact equilibrium) by natural continuation in the north pole stretch up
+   to the start stretch, P an unknown (``inflated_reference``); for a voltage continuation the voltage holding
+   that stretch at the scene's pressure is then solved for (``held_by_voltage``).
 2. Field on: natural continuation in M at that pressure (and voltage) from 0 to the scene's M.
 3. Continuation: pseudo-arclength in (u, P) (or (u, Φ̄) at fixed P) downwards to ``min_stretch`` and upwards to
    ``stop_stretch`` (landing exactly on it), ``stop_pressure`` (``stop_voltage``), ``continuation.stop_volume`` (any
@@ -55,12 +56,17 @@ def start(tracer: Tracer) -> tuple[continuation.Point, Parameters, int]:
     eq = tracer.system(degree, Parameters(0.0)).eq
     disc = eq.disc
     lam = scene.continuation.start_stretch
-    params = start_parameters(scene, tracer.parameter)
     if scene.geometry.shape == Shape.SPHERE:
+        params = start_parameters(scene, tracer.parameter)
         a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
         a[0], b[1] = lam, lam
         u = disc.join(a, b)
+    elif tracer.parameter == "voltage":
+        params = Parameters(scene.continuation.pressure, 0.0, scene.field.chi, 0.0)
+        u, voltage = held_by_voltage(tracer, degree, lam, params)
+        params = params.with_value("voltage", voltage)
     else:
+        params = start_parameters(scene, tracer.parameter)
         u, P = inflated_reference(tracer, degree, lam, params)
         params = params.with_value("P", P)
     if scene.electric is not None and not _taut(disc, u, scene.material, params.voltage, scene.geometry):
@@ -122,7 +128,8 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
     that pole stretch by natural continuation in Φ̄ (P still the unknown). ContinuationError when the step falls
     below 1e-6 of the way."""
     scene = tracer.scene
-    system = tracer.system(degree, params.with_value("P", 0.0).with_value("voltage", 0.0))
+    uncharged = params.with_value("P", 0.0).with_value("voltage", 0.0)
+    system = ParameterSystem(tracer.system(degree, uncharged).eq, uncharged, "P")  # P the unknown, whatever the trace's
     disc = system.eq.disc
     a, b = np.zeros(disc.degree + 1), np.zeros(disc.degree + 1)
     a[0], b[1] = 1.0, scene.geometry.aspect
@@ -147,7 +154,7 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
                                 "try a smaller continuation.start_stretch")
     if params.voltage:
         def charged(X, voltage):
-            charging = tracer.system(degree, params.with_value("P", X[-1]).with_value("voltage", voltage))
+            charging = ParameterSystem(system.eq, params.with_value("P", X[-1]).with_value("voltage", voltage), "P")
             return newton(charging.residual, charging.jacobian, X, row, stretch, scene.solver.tol,
                           scene.solver.max_newton)
 
@@ -156,6 +163,56 @@ def inflated_reference(tracer: Tracer, degree: int, stretch: float, params: Para
             raise ContinuationError(f"could not switch the voltage on at continuation.start_stretch = {stretch:g} "
                                     f"beyond {reached:.6g} ({message}); try a larger continuation.start_stretch")
     return X[:-1], float(X[-1])
+
+
+def held_by_voltage(tracer: Tracer, degree: int, stretch: float, params: Parameters) -> tuple[np.ndarray, float]:
+    """(u, Φ̄) of the M = 0 equilibrium whose north pole stretch is ``stretch`` at the pressure params.P, on any
+    reference shape (the sphere's closed form is ``model.sphere.sphere_voltage``): the voltage-free state at that
+    stretch (``inflated_reference``, its pressure P0), then natural continuation in P from P0 to params.P at that
+    pole stretch with (u, s = Φ̄²) the unknowns. The residual is linear in s (the dielectric term −Φ̄²λ1²λ2²):
+    R(u; P, s) = R(u; P, 0) + s D(u), D = ½ ∂R/∂Φ̄ at Φ̄ = 1, so its Jacobian is regular at s = 0, where the one in Φ̄
+    is singular (∂R/∂Φ̄ = 2Φ̄ D). ContinuationError where no voltage holds that stretch at P: a voltage moves its
+    pressure away from P (ds/dP at s = 0, from the bordered system [∂R/∂u, D; pole row, 0], has the sign of P0 − P),
+    or the continuation does not get there or ends at s < 0."""
+    scene = tracer.scene
+    u, free = inflated_reference(tracer, degree, stretch, params.with_value("voltage", 0.0))
+    eq = tracer.system(degree, params).eq
+    row = np.append(eq.disc.pole_rows()["lam2_top"], 0.0)
+
+    def solve(Y, t):
+        at = params.with_value("P", free + t * (params.P - free))
+
+        def residual(Y):
+            return eq.residual(Y[:-1], at.with_value("voltage", 0.0)) + Y[-1] * charge(Y[:-1])
+
+        def jacobian(Y):
+            return np.column_stack([eq.jacobian(Y[:-1], at.with_value("voltage", np.sqrt(max(Y[-1], 0.0)))),
+                                    charge(Y[:-1])])
+
+        return newton(residual, jacobian, Y, row, stretch, scene.solver.tol, scene.solver.max_newton)
+
+    def charge(u):
+        return 0.5 * eq.parameter_derivative(u, params.with_value("voltage", 1.0), "voltage")
+
+    def refused(why):
+        return ContinuationError(f"cannot start the voltage continuation at continuation.start_stretch = {stretch:g}, "
+                                 f"continuation.pressure = {params.P:g}: no voltage holds the "
+                                 f"{scene.geometry.shape.value} there ({why}); lower continuation.pressure or choose "
+                                 "another start_stretch")
+
+    free_params = params.with_value("P", free).with_value("voltage", 0.0)
+    bordered = np.vstack([np.column_stack([eq.jacobian(u, free_params), charge(u)]), row])
+    rate = np.linalg.solve(bordered, np.append(-eq.parameter_derivative(u, free_params, "P"), 0.0))[-1]  # ds/dP
+    if rate * (params.P - free) <= 0:
+        raise refused(f"its voltage-free pressure there is {free:.6g}, and a voltage moves it by dP/dΦ̄² = "
+                      f"{1 / rate:.4g}: away from P")
+    Y, reached, message = continuation.natural(solve, np.append(u, 0.0), 0.0, 1.0)
+    if reached < 1.0:
+        raise refused(f"the continuation from its voltage-free pressure {free:.6g} stopped at P = "
+                      f"{free + reached * (params.P - free):.6g}: {message}")
+    if Y[-1] < 0:
+        raise refused(f"Φ̄² = {Y[-1]:.3g} < 0 at P")
+    return Y[:-1], float(np.sqrt(Y[-1]))
 
 
 def start_parameters(scene, parameter: str) -> Parameters:

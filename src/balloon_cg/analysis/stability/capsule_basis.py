@@ -130,11 +130,12 @@ class CapsuleBasis:
         area = theta_weights * kappa * hoop(self.geometry, np.cos(theta), np.sin(theta))  # S' R dθ
         # columns: Z, U, D, each its reflection class 0 then 1 (class 0: Z odd, U and D even under θ → π − θ), each
         # group orthonormal under ‖δx‖² (R² + T² = (U² + D²)/2: G has no entries between the groups)
-        offsets, columns, fields, parity = {}, 0, {}, []
+        offsets, columns, fields, parity, combinations = {}, 0, {}, [], {}
         for name, order, first, share in (("Z", m, -1, 0.5), ("U", m + 1, 1, 0.25), ("D", m - 1, 1, 0.25)):
             pieces = [_orthonormal(*_joined(parts, kappa, order, nodes, sign), share * area)
                       for sign in (first, -first)]
-            fields[name] = tuple(np.hstack(arrays) for arrays in zip(*pieces))
+            *values, combinations[name] = (np.hstack(arrays) for arrays in zip(*pieces))
+            fields[name] = tuple(values)
             offsets[name] = slice(columns, columns + fields[name][0].shape[1])
             columns += fields[name][0].shape[1]
             parity += [0] * pieces[0][0].shape[1] + [1] * pieces[1][0].shape[1]
@@ -145,6 +146,7 @@ class CapsuleBasis:
             ops[0, :, offsets[name]], ops[1, :, offsets[name]] = value / 2, slope / 2
             ops[4, :, offsets[name]], ops[5, :, offsets[name]] = sign * value / 2, sign * slope / 2
         put(self, "blocks", offsets)
+        put(self, "combinations", combinations)
         put(self, "size", columns)
         put(self, "ops", ops)
         nz = offsets["Z"].stop
@@ -168,11 +170,38 @@ class CapsuleBasis:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
         return self.ops @ c
 
+    def displacement(self, c: np.ndarray, theta: np.ndarray) -> np.ndarray:
+        """(R, Z, T) on any θ grid in [0, π] for coefficients c (one vector or rows): the amplitudes of
+        δρ = R cos mφ, δz = Z cos mφ, δφ = T sin mφ, shape (3, n_θ) or (rows, 3, n_θ) (AzimuthalBasis's);
+        R = (U + D)/2, T = (U − D)/2 from each field's broken functions times its ``combinations``."""
+        theta = np.asarray(theta, dtype=float)
+        kappa = capsule_rate(self.geometry)
+        rows = np.atleast_2d(np.asarray(c, dtype=float))
+        field = {name: _broken(self.elements, kappa, order, theta) @ self.combinations[name] @ rows[:, self.blocks[name]].T
+                 for name, order in (("Z", self.m), ("U", self.m + 1), ("D", self.m - 1))}
+        shapes = np.stack([(field["U"] + field["D"]) / 2, field["Z"], (field["U"] - field["D"]) / 2]).transpose(2, 0, 1)
+        return shapes[0] if np.ndim(c) == 1 else shapes
+
+
+def _broken(parts: tuple, kappa: float, order: int, theta: np.ndarray) -> np.ndarray:
+    """The broken functions of regularity ``order`` (every element's, columns element by element) at any θ in
+    [0, π]: an element's own functions on it, zero elsewhere (a boundary point on the first element holding it)."""
+    out = np.zeros((theta.size, sum(e.degree + 1 for e in parts)))
+    column, free = 0, np.ones(theta.size, dtype=bool)
+    for e in parts:
+        on = free & (theta >= e.low) & (theta <= e.high)
+        out[on, column:column + e.degree + 1] = _field_functions(e, kappa, order, theta[on])[0]
+        free &= ~on
+        column += e.degree + 1
+    if free.any():
+        raise ValueError(f"theta = {theta[free][0]!r}: outside the capsule's meridian; allowed: [0, π]")
+    return out
+
 
 def _joined(parts: tuple, kappa: float, order: int, nodes: list, parity: int) -> tuple:
-    """(F, dF/dθ) at every element's ``nodes`` (stacked) of one field of regularity ``order`` on the C⁰ joined
-    elements with F(π − θ) = ``parity`` · F(θ): the broken functions times an orthonormal basis of the null space of
-    the jumps at the boundaries and of c − parity · (the mirror's coefficients)."""
+    """(F, dF/dθ, C) at every element's ``nodes`` (stacked) of one field of regularity ``order`` on the C⁰ joined
+    elements with F(π − θ) = ``parity`` · F(θ): the broken functions times C, an orthonormal basis of the null space
+    of the jumps at the boundaries and of c − parity · (the mirror's coefficients)."""
     blocks, ends = [], []
     for e, theta in zip(parts, nodes):
         blocks.append(_field_functions(e, kappa, order, theta))
@@ -191,15 +220,16 @@ def _joined(parts: tuple, kappa: float, order: int, nodes: list, parity: int) ->
     joined = linalg.null_space(np.vstack([jumps, np.eye(starts[-1]) - parity * mirror]))
     value = linalg.block_diag(*[b[0] for b in blocks]) @ joined
     slope = linalg.block_diag(*[b[1] for b in blocks]) @ joined
-    return value, slope
+    return value, slope, joined
 
 
-def _orthonormal(value: np.ndarray, slope: np.ndarray, weights: np.ndarray) -> tuple:
-    """(F, dF/dθ) of the columns recombined orthonormal under Σ_q weights_q F_i F_j (L⁻ᵀ of its Cholesky factor):
-    the Gram matrix is then the identity (GramFactor ``orthogonal``: the pencils' reduction is a scaling)."""
+def _orthonormal(value: np.ndarray, slope: np.ndarray, combination: np.ndarray, weights: np.ndarray) -> tuple:
+    """(F, dF/dθ, C) of the columns recombined orthonormal under Σ_q weights_q F_i F_j (L⁻ᵀ of its Cholesky factor;
+    C the broken functions' coefficients of the new columns): the Gram matrix is then the identity (GramFactor
+    ``orthogonal``: the pencils' reduction is a scaling)."""
     lower = np.linalg.cholesky(value.T @ (weights[:, None] * value))
     inverse = linalg.solve_triangular(lower, np.eye(lower.shape[0]), lower=True).T
-    return value @ inverse, slope @ inverse
+    return value @ inverse, slope @ inverse, combination @ inverse
 
 
 @lru_cache(maxsize=32)
