@@ -132,14 +132,15 @@ def tube_labels(run: dict) -> list:
 def continue_tube(args) -> int:
     """``continue`` from a label of a tube run file (``inspect`` numbers the located points of its branches in
     order, from 0): at an odd branch point of the primary branch (the onset of bulging), or at an even one of a
-    uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
+    uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py; named as ``run`` names it:
+tube/picture.branch_name), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
     traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
     the stored primary branch to a tube run file (130 on a signal, as ``run``); with ``--parameter voltage`` from a
     user point (UZ) of the primary branch, the tube continued in Φ̄ at its P (``_continue_in_voltage``). Exit 2,
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
-    from ..tube.picture import bulge_picture, maxwell, onset_from
+    from ..tube.picture import branch_name, bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
 
     run = read_tube_run(args.run)
@@ -178,15 +179,16 @@ def continue_tube(args) -> int:
         pm = maxwell(scene)
         if in_field:
             return onset_from(scene, primary, point, "M", args.direction, pm)
-        return with_frequencies(scene, bulge_picture(scene, primary, point, pm))
+        return with_frequencies(scene, bulge_picture(scene, primary, [k], pm))
 
     written, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code
-    grown = written["onset"] if in_field else written["branches"]["bulge"]
+    grown = written["onset"] if in_field else written["branches"][branch_name(primary, k)]
     size = len(grown["q"] if in_field else grown["pressure"])
-    print(f"{'onset curve in M' if in_field else 'bulge branch'} from label {args.label}: {size} points, stop "
+    print(f"{'onset curve in M' if in_field else 'branch ' + branch_name(primary, k)} from label {args.label}: "
+          f"{size} points, stop "
           f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
     return 0
 

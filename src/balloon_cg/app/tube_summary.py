@@ -3,7 +3,8 @@ voltage ([electric]; None without), the parameter continued in (``parameter``: "
 voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄), the loading control (its
 stability reading: how many of a branch's points are stable under it; under gas control the amount n = P V of every
 located point), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are
-compressed (tube/stability.py) and how many are not resolved (their Legendre tail above the scene's solver.max_error:
+compressed (tube/stability.py), a switched branch's parent label and where it rejoined (``parent``, ``rejoins``),
+how many are not resolved (their Legendre tail above the scene's solver.max_error:
 tube/accuracy.py; None in files before the tail is stored), the largest tail, the height of its last point's crest
 and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md; a UZ point with
 its event), with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block
@@ -32,7 +33,11 @@ def summarise_tube(run: dict) -> dict:
         unstable = b.get(f"unstable_{control}")
         special = [s | ({"amount": float(s["pressure"] * s["volume"] * v0)} if control == "gas" else {})
                    for s in b["special_points"]]
+        lineage = b["attrs"]
         branches[name] = {"points": len(b["pressure"]), "stop_code": b["attrs"]["stop_code"],
+                          "parent": None if "parent_label" not in lineage else
+                          {"branch": lineage["parent_branch"], "label": int(lineage["parent_label"])},
+                          "rejoins": None if lineage.get("rejoins_label", -1) < 0 else int(lineage["rejoins_label"]),
                           "stop_message": b["attrs"]["stop_message"],
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
@@ -150,7 +155,9 @@ def format_tube(summary: dict) -> str:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
     label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)
     for name, b in summary["branches"].items():
-        lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
+        origin = "" if b["parent"] is None else f" (from label {b['parent']['label']} of {b['parent']['branch']}" + (
+            "" if b["rejoins"] is None else f", rejoins it at label {b['rejoins']}") + ")"
+        lines += ["", f"branch {name}{origin}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}"
                       + ("" if b["voltage"] is None else f", Φ̄ {b['voltage'][0]:.6g}..{b['voltage'][1]:.6g}")
                       + f", stop {b['stop_code']} ({b['stop_message']})"

@@ -21,7 +21,10 @@ block, the translation removed; the free one's is ``lowest_m1``), the located ze
 azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0); its located points under
 special_points/ (``kind``, ``block``, ``status``, ``note`` (a UZ point's event, "volume_ratio = 3"; files before
 it have none), ``index``, ``pressure``, ``volume``, ``smallest_stress``,
-``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
+``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes); a switched branch
+("bulge", "bulge_<label>": tube/picture.branch_name) has the attributes ``parent_branch``, ``parent_label`` (the
+label of the branch point it was born at) and ``rejoins_label`` (where it rejoined the parent, −1: it did not; files
+before them have none). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
 under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
@@ -157,7 +160,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
     f.attrs.update(attrs)
     for name, branch in picture.branches.items():
         group = f.create_group(f"branches/{name}")
-        group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
+        group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message,
+                            **_lineage(branch)})
         checksummed(group, "unknowns", branch.states)
         eq = Equilibrium(scene, branch.disc)
         for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
@@ -202,6 +206,15 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             write_tube_frequencies(group, picture.frequencies[name])
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
+
+
+def _lineage(branch) -> dict:
+    """A switched branch's attributes ``parent_branch``, ``parent_label`` (the branch point it was born at) and
+    ``rejoins_label`` (where it rejoined its parent branch, −1: it did not); none for the primary branch."""
+    if branch.parent is None:
+        return {}
+    return {"parent_branch": branch.parent[0], "parent_label": branch.parent[1],
+            "rejoins_label": -1 if branch.rejoins is None else branch.rejoins}
 
 
 def _write_crossings(group, found, size: int) -> None:
@@ -357,8 +370,12 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
                 b["attrs"]["stop_message"])
     lowest = {block: b[f"lowest_{block.value}"] for block in Mirror if f"lowest_{block.value}" in b}
     unstable = {control: b[f"unstable_{control.value}"] for control in Control if f"unstable_{control.value}" in b}
+    attrs = b["attrs"]
+    parent = (attrs["parent_branch"], int(attrs["parent_label"])) if "parent_label" in attrs else None
+    rejoins = int(attrs["rejoins_label"]) if attrs.get("rejoins_label", -1) >= 0 else None
     return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
-                          special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE))
+                          special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
+                          rejoins=rejoins)
 
 
 def discretisation(attrs: dict) -> IntervalDiscretisation:

@@ -54,8 +54,9 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
 def pressure_volume(ax, run: dict, control: str) -> None:
     """P against V/V0 of every branch, solid where stable under ``control``, the located points labelled, and
     Maxwell's pressure as a dotted line where the file has one."""
+    others = iter(f"C{k}" for k in range(1, 10_000))  # a colour of its own for every other switched branch
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
-        colour = _COLOURS.get(name, "C1")
+        colour = _COLOURS.get(name) or next(others)
         stable = b[f"unstable_{control}"] == 0
         for solid in (True, False):
             shown = np.where(_runs(stable, solid), b["pressure"], np.nan)

@@ -1,8 +1,13 @@
 """Everything a tube scene asks for (``balloon-cg run`` on a tube): the primary branch with its folds and branch
-points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py; sliding ends only:
-on plugged ones the branch points are not trusted, docs/tubes.md) traced until it rejoins the mirror-symmetric
-states, its largest hoop stretch passes ``continuation.stop_stretch``, its V reaches ``continuation.stop_volume``
-(V/R0³, landed on; the primary branch ends there too) or after ``continuation.max_points``, and
+points (tube/primary.py), the branches switched at its branch points (tube/bulge.py; sliding ends only: on plugged
+ones the branch points are not trusted, docs/tubes.md): at every odd one, and at every even one where the primary
+branch is uniform (no coil field), in order along the primary branch, a branch point where an earlier branch rejoined
+the primary one not switched again (that branch is its branch, traced from its other end); each traced until it rejoins the mirror-symmetric
+(odd) or uniform (even) states, its largest hoop stretch passes ``continuation.stop_stretch``, its V reaches
+``continuation.stop_volume`` (V/R0³, landed on; the primary branch ends there too) or after
+``continuation.max_points``. The branch born at the first odd branch point (the onset of bulging) is named "bulge",
+the others "bulge_<label>", <label> their branch point's label (``inspect``: the primary branch's located points
+are numbered first); each knows its parent label and where it rejoined (IntervalBranch.parent, .rejoins). And
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
@@ -19,9 +24,9 @@ from .azimuthal_crossings import crossings
 from .bulge import bulge_branch
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
-from .results import IntervalBranch
+from .results import IntervalBranch, IntervalStop
 from .voltage import voltage_branch
-from ..analysis.results import StopCode
+from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..model.membrane import scene_energy
@@ -29,6 +34,9 @@ from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 from ..scene.tables import ContinuationParameter, Ends
+
+
+BULGE = "bulge"  # the name of the branch switched at the first odd branch point, the prefix of the others'
 
 
 class Stage(enum.StrEnum):
@@ -42,7 +50,7 @@ class Stage(enum.StrEnum):
 
 @dataclass(frozen=True)
 class TubePicture:
-    """The branches by name ("primary", "bulge" where one was switched), Maxwell's pressure (None where the
+    """The branches by name ("primary", "bulge" and "bulge_<label>" where they were switched: ``branch_name``), Maxwell's pressure (None where the
     uniform closed path has no maximum and minimum, the ends are held, or coils act: ``maxwell``), for ``critical``
     the onset of bulging followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the
     work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
@@ -59,7 +67,8 @@ class TubePicture:
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
-    """The primary branch and, unless ``primary_only``, the bulge branch of a tube scene (module docstring); on a
+    """The primary branch and, unless ``primary_only``, the branches switched at its branch points (module
+    docstring); on a
     voltage continuation the tube continued in Φ̄ at its fixed P alone (tube/voltage.py: ``charged_picture``)."""
     if scene.continuation.parameter == ContinuationParameter.VOLTAGE:
         return charged_picture(scene)
@@ -68,10 +77,26 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     branches: dict[str, IntervalBranch] = {"primary": primary}
     if primary.stop.code == StopCode.INTERRUPTED:
         return TubePicture(branches, pm, interrupted=Stage.PRIMARY)
-    onset = primary.branch_points(Mirror.ODD)
-    if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
-        return bulge_picture(scene, primary, onset[0], pm)
+    labels = switchable(scene, primary)
+    if not primary_only and labels:
+        return bulge_picture(scene, primary, labels, pm)
     return with_modes(scene, TubePicture(branches, pm))
+
+
+def switchable(scene, primary: IntervalBranch) -> list:
+    """The labels of the branch points of ``primary`` a branch is switched at (module docstring): none on plugged
+    ends, the odd ones in a coil field, else the odd and the even ones."""
+    if scene.geometry.ends != Ends.SLIDING:
+        return []
+    blocks = (Mirror.ODD,) if in_field(scene) else (Mirror.ODD, Mirror.EVEN)
+    return [k for k, s in enumerate(primary.special) if s.kind == Kind.BP and s.block in blocks]
+
+
+def branch_name(primary: IntervalBranch, label: int) -> str:
+    """The name of the branch switched at the located point ``label`` of ``primary``: "bulge" at its first odd branch
+    point, else "bulge_<label>"."""
+    first = next((k for k, s in enumerate(primary.special) if s.kind == Kind.BP and s.block == Mirror.ODD), None)
+    return BULGE if label == first else f"{BULGE}_{label}"
 
 
 def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -> TubePicture:
@@ -82,15 +107,40 @@ def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -
                        interrupted=Stage.PRIMARY if branch.stop.code == StopCode.INTERRUPTED else None)
 
 
-def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:
-    """``primary`` and the bulge branch switched at its odd branch point ``point`` (tube/bulge.py), stopped as
-    ``tube_picture``'s; ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's label."""
-    branches = {"primary": primary}
-    if interrupt.requested():  # in the primary branch's stability and branch points: the bulge not started
-        return TubePicture(branches, pm, interrupted=Stage.BULGE)
-    branches["bulge"] = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
-    stopped = Stage.BULGE if branches["bulge"].stop.code == StopCode.INTERRUPTED else None
+def bulge_picture(scene, primary: IntervalBranch, labels, pm: float | None) -> TubePicture:
+    """``primary`` and the branches switched at its branch points ``labels`` (tube/bulge.py; named by ``branch_name``),
+    in order, a label where an earlier one rejoined skipped, each stopped as ``tube_picture``'s; ``pm``: Maxwell's
+    pressure. Also ``continue`` from a tube file's label."""
+    branches, reached, stopped = {"primary": primary}, set(), None
+    for label in labels:
+        if label in reached:
+            continue
+        if interrupt.requested():  # in the primary branch's assessment or the branch before: this one not started
+            return TubePicture(branches, pm, interrupted=Stage.BULGE)
+        point = primary.special[label]
+        branch = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
+        rejoins = rejoined_at(scene, primary, branch, label)
+        branches[branch_name(primary, label)] = replace(branch, parent=("primary", label), rejoins=rejoins)
+        reached.add(rejoins)
+        if branch.stop.code == StopCode.INTERRUPTED:
+            stopped = Stage.BULGE
+            break
     return with_modes(scene, TubePicture(branches, pm, interrupted=stopped))
+
+
+def rejoined_at(scene, primary: IntervalBranch, branch: IntervalBranch, label: int) -> int | None:
+    """The label of the branch point of ``primary`` where ``branch`` (switched at ``label``) rejoined it: of the same
+    block, the nearest in (u, P) to its last point and within two of the scene's largest steps of it (the step that
+    crossed the primary branch's states ends beyond it); None where it did not rejoin or the point lies beyond the
+    traced primary branch."""
+    if branch.stop.code != IntervalStop.REJOINED:
+        return None
+    block = primary.special[label].block
+    last = np.append(branch.states[-1], branch.pressure[-1])
+    near = [(float(np.linalg.norm(np.append(s.u, s.pressure) - last)), k) for k, s in enumerate(primary.special)
+            if s.kind == Kind.BP and s.block == block and k != label]
+    distance, found = min(near, default=(np.inf, None))
+    return found if distance <= 2 * scene.continuation.step_max else None
 
 
 @limited_blas
