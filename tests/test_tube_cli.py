@@ -35,7 +35,8 @@ def test_run_writes_what_the_tube_pipeline_computes(run_file):
     assert (a["shape"], a["length"], a["ends"], a["degree"]) == ("tube", 10.0, "sliding", 16)
     assert math.isnan(a["axial_stretch"]) and a["format"] == "balloon-cg-tube/1"
     assert a["maxwell_pressure"] == tube.maxwell_pressure(scene.material)[0]
-    assert set(run["branches"]) == {"primary", "bulge"}
+    assert set(run["branches"]) == set(picture.branches) == {"primary", "bulge", "bulge_2", "bulge_3", "bulge_4",
+                                                              "bulge_5"}  # every branch point of labels 1..5
     for name, branch in picture.branches.items():
         stored = run["branches"][name]
         assert np.array_equal(stored["unknowns"], branch.states) and np.array_equal(stored["pressure"], branch.pressure)
@@ -60,7 +61,8 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     assert main(["inspect", str(run_file)]) == 0
     text = capsys.readouterr().out
     assert "tube of length 10, sliding ends, end distance free (closed)" in text
-    assert "Maxwell        P_M = 0.445022155" in text and "branch bulge:" in text and " LV " in text
+    assert "Maxwell        P_M = 0.445022155" in text and "branch bulge (from label 1 of primary):" in text
+    assert " LV " in text and "branch bulge_4 (from label 4 of primary):" in text
     assert "m = 0 (pressure, volume and gas control); m = 1 (the same under all three" in text and "  m = 1: lowest" in text
     assert main(["inspect", str(run_file), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
