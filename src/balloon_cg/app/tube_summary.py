@@ -9,17 +9,20 @@ tube/accuracy.py; None in files before the tail is stored), the largest tail, th
 and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md; a UZ point with
 its event), with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block
 over the points, as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the
-smallest eigenvalue and the points after which the unstable count changes; {} where not assessed), the onset curve of
+smallest eigenvalue, the points after which the unstable count changes and the located zeros with where their mode is
+largest; {} where not assessed), the onset curve of
 ``critical`` (its range, folds and stop), and the stage a signal stopped (``interrupted``)."""
 import math
 import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST, HELD_M1, VOLTAGE
+from ..io.tube_file import CREST, HELD_M1, VOLTAGE, discretisation
 from ..scene import parse_scene
+from ..tube.azimuthal import mode_profile
 from ..tube.stability import COMPRESSED
 
+PEAK_SAMPLES = 401  # points of [0, L] on which a critical mode's largest displacement is found
 
 def summarise_tube(run: dict) -> dict:
     """JSON-ready summary of ``io.tube_file.read_tube_run`` output."""
@@ -28,7 +31,7 @@ def summarise_tube(run: dict) -> dict:
                 "axial_stretch": None if math.isnan(a["axial_stretch"]) else a["axial_stretch"]}
     control, v0 = a["control"], np.pi * a["length"]
     max_error = parse_scene(a["scene_toml"]).solver.max_error
-    branches = {}
+    branches, disc = {}, discretisation(a)
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
         unstable = b.get(f"unstable_{control}")
         special = [s | ({"amount": float(s["pressure"] * s["volume"] * v0)} if control == "gas" else {})
@@ -48,7 +51,7 @@ def summarise_tube(run: dict) -> dict:
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
                           "stable_points": None if unstable is None else int((unstable == 0).sum()),
                           "special_points": _with_omega2(special, b.get("frequencies")),
-                          "azimuthal": _azimuthal(b),
+                          "azimuthal": _azimuthal(b, disc),
                           **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
@@ -64,19 +67,30 @@ def summarise_tube(run: dict) -> dict:
             "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
 
 
-def _azimuthal(branch: dict) -> dict:
+def _azimuthal(branch: dict, disc) -> dict:
     """{m: {'unstable_max', 'lowest_min', 'changes': [{'after_point', 'unstable', 'pressure', 'volume'}], 'points'}}
     of the branch's m ≥ 1 blocks ('1 held': the held tube's m = 1 block in a field, io/tube_file.HELD_M1): a change
     between points i and i + 1 listed after point i (at point i + 1's P and V/V0), and the located zeros of the
-    eigenvalues ('points': io/tube_file's dicts)."""
+    eigenvalues ('points': io/tube_file's dicts, the critical mode replaced by ``mode_peak``, the reference
+    arclength S where its displacement |(R, T, Z)| is largest: None in files before the mode is stored)."""
     out = {}
     for m, block in branch.get("azimuthal", {}).items():
         counts = block["unstable"]
         changes = [{"after_point": int(i), "unstable": int(counts[i + 1]), "pressure": float(branch["pressure"][i + 1]),
                     "volume": float(branch["volume"][i + 1])} for i in np.flatnonzero(np.diff(counts))]
+        points = [{k: v for k, v in p.items() if k != "mode"} | {"mode_peak": _peak(disc, p["mode"])}
+                  for p in block["points"]]
         out[str(m)] = {"unstable_max": int(counts.max()), "lowest_min": float(block["lowest"][:, 0].min()),
-                       "changes": changes, "points": block["points"]}
+                       "changes": changes, "points": points}
     return out
+
+
+def _peak(disc, mode) -> float | None:
+    """The reference arclength S (on PEAK_SAMPLES points of [0, L]) where the critical mode's |(R, T, Z)| is largest."""
+    if mode is None:
+        return None
+    S = np.linspace(0.0, disc.length, PEAK_SAMPLES)
+    return float(S[np.argmax(np.linalg.norm(mode_profile(disc, mode, S), axis=0))])
 
 
 def _frequencies(frequencies: dict | None) -> dict:
@@ -175,7 +189,9 @@ def format_tube(summary: dict) -> str:
             lines.append(f"  {name}: lowest eigenvalue ≥ {block['lowest_min']:.4g}, at most {block['unstable_max']} "
                          f"unstable" + (f"; unstable count {changes}" if changes else ""))
             lines += [f"        BP m = {m} (eigenvalue {p['order']}) after point {p['index']:<4} P = {p['pressure']:.10g}  "
-                      f"V/V0 = {p['volume']:.8g}  {p['status']}" for p in block["points"]]
+                      f"V/V0 = {p['volume']:.8g}  {p['status']}"
+                      + ("" if p["mode_peak"] is None else f"  mode largest at S = {p['mode_peak']:.4g}")
+                      for p in block["points"]]
         for s in b["special_points"]:
             k, label = label, label + 1
             block = f" {s['block']}" if s["block"] else ""

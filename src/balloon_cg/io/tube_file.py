@@ -18,7 +18,8 @@ P fixed) ``voltage`` (Φ̄, also per located point), with stability.m_max ≥ 1 
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
 not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
 block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
-azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0); its located points under
+azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0; ``critical_modes``: the
+eigenvector at each, files before it have none, read as None); its located points under
 special_points/ (``kind``, ``block``, ``status``, ``note`` (a UZ point's event, "volume_ratio = 3"; files before
 it have none), ``index``, ``pressure``, ``volume``, ``smallest_stress``,
 ``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes); a switched branch
@@ -48,7 +49,7 @@ from ..scene.tables import Ends
 from ..analysis.results import Kind, StopCode
 from ..numerics.continuation import RootStatus, Stop, TraceStop
 from ..tube.accuracy import accuracy
-from ..tube.azimuthal import COUNT
+from ..tube.azimuthal import COUNT, operators
 from ..tube.primary import volume_ratio
 from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
 from ..scene.loading import Control
@@ -64,6 +65,7 @@ SPECIAL_TEXT = ("kind", "block", "status")
 VOLTAGE = "voltage"  # per point and located point of a voltage continuation (tube/voltage.py; others have none)
 NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
+MODES = "critical_modes"  # per located m ≥ 1 zero: its eigenvector (files before it have none)
 HELD_M1 = "1 held"  # read_tube_run's key of the held tube's m = 1 block (beside the free blocks' m)
 
 
@@ -106,6 +108,10 @@ TUBE_VARIABLES = {
     "index": ("", "point index", "the located point lies between points index and index + 1"),
     "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M or voltage)"),
     "modes": ("1", "odd null vector", "the odd block's null vector φ at the onset"),
+    "coefficient": ("", "coefficient index", "index into the m ≥ 1 perturbation's coefficients (R's, T's, Z's: "
+                    "tube/azimuthal.py)"),
+    MODES: ("1", "critical mode", "the block's eigenvector at the located zero, coefficients of (R, T, Z) with "
+            "cᵀGc = 1 (tube/azimuthal.critical_mode)"),
 }
 
 
@@ -124,7 +130,8 @@ def _dimensions(group, rows: str, axes: dict) -> None:
     for name, item in items:
         item.dims[0].attach_scale(scales[rows])
         if item.ndim == 2:
-            second = "mode" if name == "modes" else "eigenvalue" if name.startswith("lowest_m") else "unknown"
+            second = {"modes": "mode", MODES: "coefficient"}.get(name, "eigenvalue" if name.startswith("lowest_m")
+                                                                  else "unknown")
             item.dims[1].attach_scale(scales[second])
         _describe(item, name)
 
@@ -184,7 +191,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             if modes.held is not None:
                 checksummed(group, "lowest_m1_held", modes.held["lowest"])
                 checksummed(group, "unstable_m1_held", modes.held["unstable"])
-            _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size)
+            _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size,
+                             operators(branch.disc)[1].shape[0])
         special = group.create_group("special_points")
         s = branch.special
         write_strings(special, "kind", [p.kind.value for p in s])
@@ -217,15 +225,17 @@ def _lineage(branch) -> dict:
             "rejoins_label": -1 if branch.rejoins is None else branch.rejoins}
 
 
-def _write_crossings(group, found, size: int) -> None:
+def _write_crossings(group, found, size: int, coefficients: int) -> None:
     """The located zeros of the m ≥ 1 eigenvalues (tube/azimuthal_crossings.py): per point ``m``, ``order``,
-    ``index``, ``pressure``, ``volume``, ``value``, ``held``, ``status``, ``unknowns``."""
+    ``index``, ``pressure``, ``volume``, ``value``, ``held``, ``status``, ``unknowns`` and ``critical_modes`` (the
+    eigenvector there: ``coefficients`` of (R, T, Z), tube/azimuthal.critical_mode)."""
     for column, kind in (("m", int), ("order", int), ("index", int), ("pressure", float), ("volume", float),
                          ("value", float), ("held", int)):
         checksummed(group, column, np.array([getattr(c, column) for c in found], dtype=kind))
     write_strings(group, "status", [c.status.value for c in found])
     checksummed(group, "unknowns", np.array([c.u for c in found], dtype=float).reshape(len(found), size))
-    _dimensions(group, "special", {"unknown": size})
+    checksummed(group, MODES, np.array([c.mode for c in found], dtype=float).reshape(len(found), coefficients))
+    _dimensions(group, "special", {"unknown": size, "coefficient": coefficients})
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
@@ -307,8 +317,9 @@ def _read_modes(path, group, n: int, where: str) -> dict:
                                                                               "volume", "value")),
                                                     located["status"].asstr()[()])]
     held = [False] * len(points) if located is None or "held" not in located else located["held"][()].astype(bool)
-    for p, h in zip(points, held):
-        p["held"] = bool(h)
+    modes = [None] * len(points) if located is None or MODES not in located else list(located[MODES][()])
+    for p, h, mode in zip(points, held, modes):
+        p["held"], p["mode"] = bool(h), mode
     blocks = [(m, f"lowest_m{m}", f"unstable_m{m}", False) for m in range(1, int(group.attrs.get("m_max", 0)) + 1)]
     blocks += [(HELD_M1, "lowest_m1_held", "unstable_m1_held", True)] if "lowest_m1_held" in group else []
     for key, lowest, unstable, is_held in blocks:
