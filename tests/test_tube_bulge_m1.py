@@ -178,7 +178,7 @@ def test_located_m1_zeros_are_zeros_of_the_brute_force_second_variation(bulge):
 def test_the_unstable_mode_bends_the_tube_at_the_bulge(bulge):
     """The second method's unstable eigenvector at the most unstable point (P ≈ 1.04, V/V0 ≈ 3.37): far from the
     bulge the tube moves sideways rigidly (T = −R, Z → 0 at S = L: |T + R| ≤ 5 % of |R|), the bulge's section at the
-    mirror plane S = 0 the other way and several times as far (R(0) ≈ −9.4 R(L), T(0) ≈ 0: its centre moves with
+    mirror plane S = 0 the other way and several times as far (R(0) ≈ −10 R(L), T(0) ≈ 0: its centre moves with
     the cross-section's own hoop displacement), and the sections between tilt (Z ≠ 0): the tube bends at its bulge, a
     lateral buckle of the bulge, the route Hejazi, Hsiang & Phani (2021) report for bulges on tubes with fixed ends."""
     scene, branch, modes, _, fine = bulge
