@@ -147,7 +147,7 @@ def test_a_signal_during_a_tube_runs_frequencies_stops_them_at_the_next_point(re
                              "written); what was finished is written to r.h5 (flagged interrupted)")
     run = read_tube_run(tmp_path / "r.h5")
     assert run["attrs"]["interrupted"] == "frequencies"
-    assert set(run["branches"]) == set(references[0]["branches"]) == {"primary", "bulge"}
+    assert set(run["branches"]) == set(references[0]["branches"]) and {"primary", "bulge"} < set(run["branches"])
     for name, branch in run["branches"].items():
         assert branch["frequencies"] is None
         assert np.array_equal(branch["unknowns"], references[0]["branches"][name]["unknowns"])
