@@ -120,3 +120,39 @@ def test_which_branch_points_run_switches():
     assert switchable(coil, primary) == odd
     assert switchable(tube_scene("SPOM1", 10.0, 'ends = "plugged"\n'), primary) == []
     assert branch_name(primary, odd[0]) == "bulge" and branch_name(primary, labels[1]) == f"bulge_{labels[1]}"
+
+
+def test_a_branch_that_cannot_start_is_listed_and_the_run_is_incomplete(tmp_path, monkeypatch, capsys):
+    """Where the first step off a branch point does not converge (BranchStartError, forced here at label 2), ``run``
+    traces the other branches, lists that one as not started in the file and in ``inspect``, and exits 1 with one
+    line; the other branches are those of the run without the failure."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.tube_file import read_tube_run
+    from balloon_cg.tube import picture
+    from balloon_cg.tube.bulge import BranchStartError
+
+    scene = tmp_path / "t.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\ndegree = 16\n'
+                     "[continuation]\nstop_stretch = 3.0\nstep_max = 0.5\n[stability]\nm_max = 0\n")
+    whole = tmp_path / "whole.h5"
+    assert main(["run", str(scene), "-o", str(whole), "--quiet"]) == 0
+    traced = picture.bulge_branch
+
+    def failing(scene, primary, point, **kwargs):
+        if point is primary.special[2]:
+            raise BranchStartError("the first step of the bulge branch did not converge: forced")
+        return traced(scene, primary, point, **kwargs)
+
+    monkeypatch.setattr(picture, "bulge_branch", failing)
+    out = tmp_path / "t.h5"
+    assert main(["run", str(scene), "-o", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err == (f"balloon-cg: incomplete: not started: bulge_2: the first step of the bulge branch did not converge:"
+                   f" forced; the rest is written to {out}")
+    run, expected = read_tube_run(out), read_tube_run(whole)
+    assert run["attrs"]["not_started"] == "bulge_2: the first step of the bulge branch did not converge: forced"
+    assert set(run["branches"]) == set(expected["branches"]) - {"bulge_2"}
+    for name, branch in run["branches"].items():
+        assert np.array_equal(branch["unknowns"], expected["branches"][name]["unknowns"])
+    assert main(["inspect", str(out)]) == 0
+    assert "not started    bulge_2: the first step" in capsys.readouterr().out

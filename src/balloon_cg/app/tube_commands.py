@@ -10,7 +10,8 @@ from ..scene.tables import ContinuationParameter, Ends
 
 def run_tube(scene, output, args) -> int:
     """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
-    written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring)."""
+    written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring), 1 when a
+    switched branch could not start (its first step did not converge: the file's ``not_started``)."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run
     from ..tube.picture import tube_picture
@@ -23,6 +24,10 @@ def run_tube(scene, output, args) -> int:
         return code
     if not args.quiet:
         print(format_tube(summarise_tube(read_tube_run(output))))
+    if run["attrs"]["not_started"]:
+        print(f"{PROG}: incomplete: not started: {run['attrs']['not_started'].replace(chr(10), '; ')}; the rest is "
+              f"written to {output}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -11,7 +11,8 @@ its event), with [dynamics] frequencies each block's lowest Ω² at every locate
 over the points, as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the
 smallest eigenvalue, the points after which the unstable count changes and the located zeros with where their mode is
 largest; {} where not assessed), the onset curve of
-``critical`` (its range, folds and stop), and the stage a signal stopped (``interrupted``)."""
+``critical`` (its range, folds and stop), the stage a signal stopped (``interrupted``) and the switched branches that
+did not start (``not_started``: "name: why")."""
 import math
 import tomllib
 
@@ -64,7 +65,8 @@ def summarise_tube(run: dict) -> dict:
             "fixed_pressure": float(primary["pressure"][0]) if charged else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
-            "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
+            "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None,
+            "not_started": [line for line in a["not_started"].split("\n") if line]}
 
 
 def _azimuthal(branch: dict, disc) -> dict:
@@ -165,6 +167,7 @@ def format_tube(summary: dict) -> str:
              f"degree         {summary['degree']}",
              "stability      m = 0 (pressure, volume and gas control); " + _assessed(summary),
              f"Maxwell        P_M = {maxwell}"]
+    lines += [f"not started    {line}" for line in summary["not_started"]]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
     label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)

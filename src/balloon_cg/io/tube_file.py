@@ -4,7 +4,8 @@ tube/picture.py, written atomically (io/hdf5.py), read back checked.
 Root attributes: the format, the scene (name, TOML), the shape and its parameters (``shape``, ``length``, ``ends``,
 ``axial_stretch``: NaN where the ends' distance is free), the discretisation (``degree``, ``quadrature``),
 ``maxwell_pressure`` (NaN where there is none), ``control`` (the scene's loading.control, whose stability reading and
-folds count: files before it have none, read as "pressure") and the provenance. One group per branch under
+folds count: files before it have none, read as "pressure"), ``not_started`` (one line "name: why" per switched
+branch whose first step did not converge, "" for none; files before it have none, read as "") and the provenance. One group per branch under
 /branches/<name>/:
 per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``,
 ``unstable_volume`` and ``unstable_gas`` (negative eigenvalues of ∂R/∂u, on δV = 0, and of ∂R/∂u + (P/Ṽ) g gᵀ:
@@ -162,6 +163,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
              "degree": primary.disc.degree, "quadrature": primary.disc.quadrature,
              "maxwell_pressure": math.nan if picture.maxwell is None else picture.maxwell,
              "control": scene.loading.control.value,
+             "not_started": "\n".join(f"{name}: {why}" for name, why in picture.not_started),
              "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
     f.attrs.update(attrs)
@@ -273,7 +275,8 @@ def read_tube_run(path) -> dict:
 def read_tube(f, path, where: str = "") -> dict:
     """{'attrs', 'branches', 'onset'} of the tube run written by ``write_tube`` into the open file or group ``f``
     (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
-    attrs = {"interrupted": "", "control": "pressure"} | {k: _text(plain(v)) for k, v in f.attrs.items()}
+    attrs = {"interrupted": "", "control": "pressure", "not_started": ""} | {k: _text(plain(v))
+                                                                             for k, v in f.attrs.items()}
     if "branches" not in f or "primary" not in f["branches"]:
         raise TubeFileError(path, f"no {where}/branches/primary group")
     branches = {}

@@ -21,7 +21,7 @@ import numpy as np
 
 from .azimuthal import branch_modes
 from .azimuthal_crossings import crossings
-from .bulge import bulge_branch
+from .bulge import BranchStartError, bulge_branch
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
 from .results import IntervalBranch, IntervalStop
@@ -56,7 +56,8 @@ class TubePicture:
     work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
     not); ``frequencies``: with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch
     name); ``modes``: each branch's m = 1..``stability.m_max`` blocks (tube/azimuthal.TubeModes by branch name; None:
-    not assessed, m_max = 0 or a signal)."""
+    not assessed, m_max = 0 or a signal); ``not_started``: (name, why) of the switched branches that could not start
+    (the run is then incomplete: exit 1)."""
 
     branches: dict
     maxwell: float | None
@@ -64,6 +65,7 @@ class TubePicture:
     interrupted: Stage | None = None
     frequencies: dict | None = None
     modes: dict | None = None
+    not_started: tuple = ()  # (name, why) of each branch whose first step off its branch point did not converge
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
@@ -109,23 +111,28 @@ def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -
 
 def bulge_picture(scene, primary: IntervalBranch, labels, pm: float | None) -> TubePicture:
     """``primary`` and the branches switched at its branch points ``labels`` (tube/bulge.py; named by ``branch_name``),
-    in order, a label where an earlier one rejoined skipped, each stopped as ``tube_picture``'s; ``pm``: Maxwell's
-    pressure. Also ``continue`` from a tube file's label."""
-    branches, reached, stopped = {"primary": primary}, set(), None
+    in order, a label where an earlier one rejoined skipped, each stopped as ``tube_picture``'s (one whose first step
+    does not converge listed in ``not_started``); ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's
+    label."""
+    branches, reached, stopped, not_started = {"primary": primary}, set(), None, ()
     for label in labels:
         if label in reached:
             continue
         if interrupt.requested():  # in the primary branch's assessment or the branch before: this one not started
-            return TubePicture(branches, pm, interrupted=Stage.BULGE)
-        point = primary.special[label]
-        branch = bulge_branch(scene, primary, point, stop_stretch=scene.continuation.stop_stretch)
+            return TubePicture(branches, pm, interrupted=Stage.BULGE, not_started=not_started)
+        name = branch_name(primary, label)
+        try:
+            branch = bulge_branch(scene, primary, primary.special[label], stop_stretch=scene.continuation.stop_stretch)
+        except BranchStartError as e:
+            not_started += ((name, str(e)),)
+            continue
         rejoins = rejoined_at(scene, primary, branch, label)
-        branches[branch_name(primary, label)] = replace(branch, parent=("primary", label), rejoins=rejoins)
+        branches[name] = replace(branch, parent=("primary", label), rejoins=rejoins)
         reached.add(rejoins)
         if branch.stop.code == StopCode.INTERRUPTED:
             stopped = Stage.BULGE
             break
-    return with_modes(scene, TubePicture(branches, pm, interrupted=stopped))
+    return with_modes(scene, TubePicture(branches, pm, interrupted=stopped, not_started=not_started))
 
 
 def rejoined_at(scene, primary: IntervalBranch, branch: IntervalBranch, label: int) -> int | None:
