@@ -101,9 +101,12 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
     """130 when the tube run file ``run`` says a signal stopped its work (its ``interrupted`` stage; the line is
     the file's: the stage, its points or that it had not started); else None, having said so when a signal came
     once the work had finished (``signalled``: the file is whole)."""
+    from ..analysis.results import StopCode  # here, as cli's: the command line's start-up does not load analysis
+
     stage = run["attrs"]["interrupted"]
     if stage:
-        stored = run["onset"] if stage == "onset" else run["branches"].get(stage)
+        stopped = (b for b in run["branches"].values() if b["attrs"]["stop_code"] == StopCode.INTERRUPTED.value)
+        stored = run["onset"] if stage == "onset" else next(stopped, None)  # the branch the signal stopped
         if stage == "frequencies":
             done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
             what = f"the branches whole, the frequencies of {', '.join(done) or 'none'} written"
