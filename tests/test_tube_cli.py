@@ -35,7 +35,8 @@ def test_run_writes_what_the_tube_pipeline_computes(run_file):
     assert (a["shape"], a["length"], a["ends"], a["degree"]) == ("tube", 10.0, "sliding", 16)
     assert math.isnan(a["axial_stretch"]) and a["format"] == "balloon-cg-tube/1"
     assert a["maxwell_pressure"] == tube.maxwell_pressure(scene.material)[0]
-    assert set(run["branches"]) == {"primary", "bulge"}
+    assert set(run["branches"]) == set(picture.branches) == {"primary", "bulge", "bulge_2", "bulge_3", "bulge_4",
+                                                              "bulge_5"}  # every branch point of labels 1..5
     for name, branch in picture.branches.items():
         stored = run["branches"][name]
         assert np.array_equal(stored["unknowns"], branch.states) and np.array_equal(stored["pressure"], branch.pressure)
@@ -60,7 +61,8 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     assert main(["inspect", str(run_file)]) == 0
     text = capsys.readouterr().out
     assert "tube of length 10, sliding ends, end distance free (closed)" in text
-    assert "Maxwell        P_M = 0.445022155" in text and "branch bulge:" in text and " LV " in text
+    assert "Maxwell        P_M = 0.445022155" in text and "branch bulge (from label 1 of primary):" in text
+    assert " LV " in text and "branch bulge_4 (from label 4 of primary):" in text
     assert "m = 0 (pressure, volume and gas control); m = 1 (the same under all three" in text and "  m = 1: lowest" in text
     assert main(["inspect", str(run_file), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
@@ -71,7 +73,7 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
 
 def test_plot_draws_every_tube_kind(run_file, tmp_path, capsys):
     out = tmp_path / "t.png"
-    kinds = ("pressure-volume", "profiles", "front", "stretches")
+    kinds = ("pressure-volume", "profiles", "front", "stretches", "modes")
     assert main(["plot", str(run_file), "--what", ",".join(kinds), "-o", str(out)]) == 0
     for kind in kinds:
         assert (tmp_path / f"t_{kind}.png").stat().st_size > 10_000
@@ -83,6 +85,28 @@ def test_plot_draws_every_tube_kind(run_file, tmp_path, capsys):
     assert capsys.readouterr().err.strip().endswith("--what front: the primary branch's profiles are uniform at the "
                                                      "points drawn (no front)")
     assert not (tmp_path / "f.png").exists()
+
+
+def test_modes_plot_draws_the_stored_critical_modes(run_file):
+    """``plot --what modes`` of the bulge branch: R, T, Z of each located m ≥ 1 zero's stored critical mode, as
+    tube/azimuthal.mode_profile evaluates it (1e-12), ½ ∫ (R² + T² + Z²) dS = 1 (1e-4, the trapezoid on the drawn
+    points); the primary branch (no m ≥ 1 zero) has none: one line."""
+    from balloon_cg.io.tube_file import discretisation
+    from balloon_cg.post.tube_plots import TubePlotError, tube_figure
+    from balloon_cg.tube.azimuthal import mode_profile
+
+    run = read_tube_run(run_file)
+    (point,) = run["branches"]["bulge"]["azimuthal"][1]["points"]
+    lines = tube_figure(run, "modes").axes[0].get_lines()
+    assert len(lines) == 3
+    s = lines[0].get_xdata()
+    expected = mode_profile(discretisation(run["attrs"]), point["mode"], s)
+    for line, values in zip(lines, expected):
+        assert np.max(np.abs(line.get_ydata() - values)) <= 1e-12
+    squared = sum(np.asarray(v) ** 2 for v in expected)
+    assert abs(0.5 * np.sum((squared[1:] + squared[:-1]) / 2 * np.diff(s)) - 1) <= 1e-4
+    with pytest.raises(TubePlotError, match="the primary branch has no located m ≥ 1 zero with a stored mode"):
+        tube_figure(run, "modes", branch="primary")
 
 
 def test_stretches_of_the_uniform_tube_are_its_radius_and_its_length_ratio(run_file):

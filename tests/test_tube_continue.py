@@ -32,7 +32,7 @@ def run_file(tmp_path_factory):
 def test_the_bulge_from_the_onset_label_is_runs_with_the_new_settings(run_file, tmp_path, capsys):
     out = tmp_path / "further.h5"
     assert main(["continue", str(run_file), "1", "--set", "continuation.stop_stretch=4", "-o", str(out)]) == 0
-    assert capsys.readouterr().out.startswith("bulge branch from label 1: ")
+    assert capsys.readouterr().out.startswith("branch bulge from label 1: ")
     continued, stored = read_tube_run(out), read_tube_run(run_file)
     assert np.array_equal(continued["branches"]["primary"]["unknowns"], stored["branches"]["primary"]["unknowns"])
     scene = load_scene(SCENE).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 4})
@@ -48,13 +48,15 @@ def test_the_branch_from_an_even_label_is_bulge_branchs(run_file, tmp_path, caps
     switched there (tube/bulge.bulge_branch, traced on the even block: mirror-symmetric), bit for bit."""
     out = tmp_path / "even.h5"
     assert main(["continue", str(run_file), "2", "-o", str(out)]) == 0
-    assert capsys.readouterr().out.startswith("bulge branch from label 2: ")
+    assert capsys.readouterr().out.startswith("branch bulge_2 from label 2: ")
     scene = load_scene(SCENE).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 3})
     primary = stored_branch(read_tube_run(run_file), "primary", scene_parameters(scene))
     assert (primary.special[2].kind, primary.special[2].block) == ("BP", "even")
     even = bulge_branch(scene, primary, primary.special[2], stop_stretch=3)
-    continued = read_tube_run(out)["branches"]["bulge"]
+    continued = read_tube_run(out)["branches"]["bulge_2"]
     assert np.array_equal(continued["unknowns"], even.states) and len(even.pressure) > 5
+    assert (continued["attrs"]["parent_branch"], continued["attrs"]["parent_label"]) == ("primary", 2)
+    assert np.array_equal(continued["unknowns"], read_tube_run(run_file)["branches"]["bulge_2"]["unknowns"])  # run's
     assert np.abs(even.states[:, even.disc.block(Mirror.ODD)]).max() == 0
 
 

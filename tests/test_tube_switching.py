@@ -1,5 +1,6 @@
 """Branches switched at a tube's branch points other than the first odd one (issue 38): the even branch points of a
-uniform primary branch (sliding ends, closed or held apart), tube/bulge.py.
+uniform primary branch (sliding ends, closed or held apart), tube/bulge.py, and ``run`` switching at every branch
+point it can (tube/picture.py).
 
 On a tube of length L with sliding ends (planes of symmetry) the mode cos(2πS/L) of the even block is the mode
 cos(πS/(L/2)) of the tube of length L/2 repeated: a state of the branch switched at the even branch point, restricted
@@ -15,6 +16,7 @@ import pytest
 from balloon_cg.analysis.results import Kind, StopCode
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.tube.bulge import UnswitchableBranchPoint, bulge_branch
+from balloon_cg.tube.picture import branch_name, rejoined_at, switchable, tube_picture
 from balloon_cg.tube.primary import primary_branch, volume_ratio
 from balloon_cg.tube.results import IntervalStop
 from balloon_cg.galerkin.equilibrium import Equilibrium
@@ -73,3 +75,84 @@ def test_branch_points_that_are_not_switched_are_refused_in_one_line():
         assert "\n" not in str(refused.value)
     with pytest.raises(UnswitchableBranchPoint, match="not at LP"):
         bulge_branch(scene, primary, fold)
+
+
+def test_run_switches_every_branch_point_once():
+    """``tube_picture`` (``run``), SPOM1, L = 10, degree 16, to a hoop stretch of 5: a branch at each of the primary
+    branch's branch points in order (odd and even: its labels 1..7), named "bulge" at the first odd one and
+    "bulge_<label>" at the others, each starting at its branch point's state and knowing its parent label; the
+    branch from label 5 rejoins the mirror-symmetric states at label 6, so label 6 is not switched again. The second
+    method: the branch switched at label 6 alone (tube/bulge.py) is that branch from its other end: it rejoins at
+    label 5, over the same P range (to 1e-4: the end steps), each of its points within a step of one of ours."""
+    scene = tube_scene("SPOM1", 10.0, "[solver]\ndegree = 16\n[continuation]\nstop_stretch = 5.0\nstep_max = 0.5\n"
+                                      "[stability]\nm_max = 0\n")
+    picture = tube_picture(scene)
+    primary = picture.branches["primary"]
+    labels = [k for k, s in enumerate(primary.special) if s.kind == Kind.BP]
+    assert labels == list(range(1, 8)) and switchable(scene, primary) == labels
+    assert [primary.special[k].block for k in (1, 2, 5, 6)] == [Mirror.ODD, Mirror.EVEN, Mirror.ODD, Mirror.ODD]
+    assert list(picture.branches) == ["primary", "bulge", "bulge_2", "bulge_3", "bulge_4", "bulge_5", "bulge_7"]
+    for name, branch in list(picture.branches.items())[1:]:
+        label = branch.parent[1]
+        assert branch.parent == ("primary", label) and branch_name(primary, label) == name
+        assert np.array_equal(branch.states[0], primary.special[label].u)
+    rejoined = picture.branches["bulge_5"]
+    assert rejoined.stop.code == IntervalStop.REJOINED and rejoined.rejoins == 6
+    assert all(b.rejoins is None for n, b in picture.branches.items() if n != "bulge_5")
+    other = bulge_branch(scene, primary, primary.special[6], stop_stretch=5.0)
+    assert other.stop.code == IntervalStop.REJOINED and rejoined_at(scene, primary, other, 6) == 5
+    assert abs(other.pressure.min() - rejoined.pressure.min()) <= 1e-4  # measured 3.1e-5 and 4.8e-5: the end steps
+    assert abs(other.pressure.max() - rejoined.pressure.max()) <= 1e-4
+    ours = np.column_stack([rejoined.states, rejoined.pressure])
+    for u, P in zip(other.states[1:-1], other.pressure[1:-1]):  # each of its points within a step of one of ours
+        assert np.linalg.norm(ours - np.append(u, P), axis=1).min() <= scene.continuation.step_max
+
+
+def test_which_branch_points_run_switches():
+    """On sliding ends every odd and even branch point; in a coil field (the primary branch not uniform) the odd ones
+    alone; on plugged ends none (their branch points are not resolved: docs/tubes.md)."""
+    scene = tube_scene("SPOM1", 10.0, "[solver]\ndegree = 16\n[continuation]\nstop_stretch = 2.0\n")
+    primary = primary_branch(scene)
+    labels = [k for k, s in enumerate(primary.special) if s.kind == Kind.BP]
+    odd = [k for k in labels if primary.special[k].block == Mirror.ODD]
+    assert switchable(scene, primary) == labels and odd != labels
+    coil = tube_scene("SPOM1", 10.0, "[field]\nM = 0.01\n[[field.coils]]\nradius = 2.5\nheight = 0\ncurrent = 1\n")
+    assert switchable(coil, primary) == odd
+    assert switchable(tube_scene("SPOM1", 10.0, 'ends = "plugged"\n'), primary) == []
+    assert branch_name(primary, odd[0]) == "bulge" and branch_name(primary, labels[1]) == f"bulge_{labels[1]}"
+
+
+def test_a_branch_that_cannot_start_is_listed_and_the_run_is_incomplete(tmp_path, monkeypatch, capsys):
+    """Where the first step off a branch point does not converge (BranchStartError, forced here at label 2), ``run``
+    traces the other branches, lists that one as not started in the file and in ``inspect``, and exits 1 with one
+    line; the other branches are those of the run without the failure."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.tube_file import read_tube_run
+    from balloon_cg.tube import resolution
+    from balloon_cg.tube.bulge import BranchStartError
+
+    scene = tmp_path / "t.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\ndegree = 16\n'
+                     "[continuation]\nstop_stretch = 3.0\nstep_max = 0.5\n[stability]\nm_max = 0\n")
+    whole = tmp_path / "whole.h5"
+    assert main(["run", str(scene), "-o", str(whole), "--quiet"]) == 0
+    traced = resolution.bulge_branch
+
+    def failing(scene, primary, point, **kwargs):
+        if point is primary.special[2]:
+            raise BranchStartError("the first step of the bulge branch did not converge: forced")
+        return traced(scene, primary, point, **kwargs)
+
+    monkeypatch.setattr(resolution, "bulge_branch", failing)
+    out = tmp_path / "t.h5"
+    assert main(["run", str(scene), "-o", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err == (f"balloon-cg: incomplete (not started: bulge_2: the first step of the bulge branch did not converge:"
+                   f" forced); the rest is written to {out}")
+    run, expected = read_tube_run(out), read_tube_run(whole)
+    assert run["attrs"]["not_started"] == "bulge_2: the first step of the bulge branch did not converge: forced"
+    assert set(run["branches"]) == set(expected["branches"]) - {"bulge_2"}
+    for name, branch in run["branches"].items():
+        assert np.array_equal(branch["unknowns"], expected["branches"][name]["unknowns"])
+    assert main(["inspect", str(out)]) == 0
+    assert "not started    bulge_2: the first step" in capsys.readouterr().out

@@ -11,8 +11,9 @@ from ..scene.tables import ContinuationParameter, Ends
 def run_tube(scene, output, args) -> int:
     """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
     written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring); 1 (0 with
-    --allow-partial) where its bulge branch stopped unresolved at solver.max_degree (solver.tube_resolution =
-    "refine": tube/resolution.py), saying so in one line."""
+    --allow-partial) when a switched branch could not start (its first step did not converge: the file's
+    ``not_started``) or the bulge branch stopped unresolved at solver.max_degree (solver.tube_resolution = "refine":
+    tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run
     from ..tube.picture import tube_picture
@@ -26,11 +27,16 @@ def run_tube(scene, output, args) -> int:
         return code
     if not args.quiet:
         print(format_tube(summarise_tube(read_tube_run(output))))
+    missing = []
+    if run["attrs"]["not_started"]:
+        missing.append(f"not started: {run['attrs']['not_started'].replace(chr(10), '; ')}")
     bulge = run["branches"].get("bulge")
-    if bulge is None or bulge["attrs"]["stop_code"] != IntervalStop.UNRESOLVED:
+    if bulge is not None and bulge["attrs"]["stop_code"] == IntervalStop.UNRESOLVED:
+        missing.append(f"bulge: {bulge['attrs']['stop_message']}, after {len(bulge['pressure'])} resolved points "
+                       f"(its stop code {IntervalStop.UNRESOLVED.value})")
+    if not missing:
         return 0
-    print(f"{PROG}: incomplete (bulge: {bulge['attrs']['stop_message']}, after {len(bulge['pressure'])} resolved "
-          f"points); written to {output} (its stop code {IntervalStop.UNRESOLVED.value})", file=sys.stderr)
+    print(f"{PROG}: incomplete ({'; '.join(missing)}); the rest is written to {output}", file=sys.stderr)
     return 0 if args.allow_partial else 1
 
 
@@ -104,9 +110,12 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
     """130 when the tube run file ``run`` says a signal stopped its work (its ``interrupted`` stage; the line is
     the file's: the stage, its points or that it had not started); else None, having said so when a signal came
     once the work had finished (``signalled``: the file is whole)."""
+    from ..analysis.results import StopCode  # here, as cli's: the command line's start-up does not load analysis
+
     stage = run["attrs"]["interrupted"]
     if stage:
-        stored = run["onset"] if stage == "onset" else run["branches"].get(stage)
+        stopped = (b for b in run["branches"].values() if b["attrs"]["stop_code"] == StopCode.INTERRUPTED.value)
+        stored = run["onset"] if stage == "onset" else next(stopped, None)  # the branch the signal stopped
         if stage == "frequencies":
             done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
             what = f"the branches whole, the frequencies of {', '.join(done) or 'none'} written"
@@ -140,14 +149,15 @@ def tube_labels(run: dict) -> list:
 def continue_tube(args) -> int:
     """``continue`` from a label of a tube run file (``inspect`` numbers the located points of its branches in
     order, from 0): at an odd branch point of the primary branch (the onset of bulging), or at an even one of a
-    uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
+    uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py; named as ``run`` names it:
+tube/picture.branch_name), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
     traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
     the stored primary branch to a tube run file (130 on a signal, as ``run``); with ``--parameter voltage`` from a
     user point (UZ) of the primary branch, the tube continued in Φ̄ at its P (``_continue_in_voltage``). Exit 2,
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
-    from ..tube.picture import bulge_picture, maxwell, onset_from
+    from ..tube.picture import branch_name, bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
 
     run = read_tube_run(args.run)
@@ -186,15 +196,16 @@ def continue_tube(args) -> int:
         pm = maxwell(scene)
         if in_field:
             return onset_from(scene, primary, point, "M", args.direction, pm)
-        return with_frequencies(scene, bulge_picture(scene, primary, point, pm))
+        return with_frequencies(scene, bulge_picture(scene, primary, [k], pm))
 
     written, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code
-    grown = written["onset"] if in_field else written["branches"]["bulge"]
+    grown = written["onset"] if in_field else written["branches"][branch_name(primary, k)]
     size = len(grown["q"] if in_field else grown["pressure"])
-    print(f"{'onset curve in M' if in_field else 'bulge branch'} from label {args.label}: {size} points, stop "
+    print(f"{'onset curve in M' if in_field else 'branch ' + branch_name(primary, k)} from label {args.label}: "
+          f"{size} points, stop "
           f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
     return 0
 

@@ -3,22 +3,27 @@ voltage ([electric]; None without), the parameter continued in (``parameter``: "
 voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄), the loading control (its
 stability reading: how many of a branch's points are stable under it; under gas control the amount n = P V of every
 located point), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are
-compressed (tube/stability.py) and how many are not resolved (their Legendre tail above the scene's solver.max_error:
+compressed (tube/stability.py), a switched branch's parent label and where it rejoined (``parent``, ``rejoins``),
+how many are not resolved (their Legendre tail above the scene's solver.max_error:
 tube/accuracy.py; None in files before the tail is stored), the largest tail, the height of its last point's crest
 and its located points (with their crest's height; those in a compressed state marked: docs/tubes.md; a UZ point with
 its event), with [dynamics] frequencies each block's lowest Ω² at every located point (``frequencies``: per block
 over the points, as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the
-smallest eigenvalue and the points after which the unstable count changes; {} where not assessed), the onset curve of
-``critical`` (its range, folds and stop), and the stage a signal stopped (``interrupted``)."""
+smallest eigenvalue, the points after which the unstable count changes and the located zeros with where their mode is
+largest; {} where not assessed), the onset curve of
+``critical`` (its range, folds and stop), the stage a signal stopped (``interrupted``) and the switched branches that
+did not start (``not_started``: "name: why")."""
 import math
 import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST, HELD_M1, VOLTAGE
+from ..io.tube_file import CREST, HELD_M1, VOLTAGE, discretisation
 from ..scene import parse_scene
+from ..tube.azimuthal import mode_profile
 from ..tube.stability import COMPRESSED
 
+PEAK_SAMPLES = 401  # points of [0, L] on which a critical mode's largest displacement is found
 
 def summarise_tube(run: dict) -> dict:
     """JSON-ready summary of ``io.tube_file.read_tube_run`` output."""
@@ -27,12 +32,16 @@ def summarise_tube(run: dict) -> dict:
                 "axial_stretch": None if math.isnan(a["axial_stretch"]) else a["axial_stretch"]}
     control, v0 = a["control"], np.pi * a["length"]
     max_error = parse_scene(a["scene_toml"]).solver.max_error
-    branches = {}
+    branches, disc = {}, discretisation(a)
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
         unstable = b.get(f"unstable_{control}")
         special = [s | ({"amount": float(s["pressure"] * s["volume"] * v0)} if control == "gas" else {})
                    for s in b["special_points"]]
+        lineage = b["attrs"]
         branches[name] = {"points": len(b["pressure"]), "stop_code": b["attrs"]["stop_code"],
+                          "parent": None if "parent_label" not in lineage else
+                          {"branch": lineage["parent_branch"], "label": int(lineage["parent_label"])},
+                          "rejoins": None if lineage.get("rejoins_label", -1) < 0 else int(lineage["rejoins_label"]),
                           "stop_message": b["attrs"]["stop_message"],
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
@@ -43,7 +52,7 @@ def summarise_tube(run: dict) -> dict:
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
                           "stable_points": None if unstable is None else int((unstable == 0).sum()),
                           "special_points": _with_omega2(special, b.get("frequencies")),
-                          "azimuthal": _azimuthal(b),
+                          "azimuthal": _azimuthal(b, disc),
                           **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])
@@ -56,22 +65,34 @@ def summarise_tube(run: dict) -> dict:
             "fixed_pressure": float(primary["pressure"][0]) if charged else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
-            "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None}
+            "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None,
+            "not_started": [line for line in a["not_started"].split("\n") if line]}
 
 
-def _azimuthal(branch: dict) -> dict:
+def _azimuthal(branch: dict, disc) -> dict:
     """{m: {'unstable_max', 'lowest_min', 'changes': [{'after_point', 'unstable', 'pressure', 'volume'}], 'points'}}
     of the branch's m ≥ 1 blocks ('1 held': the held tube's m = 1 block in a field, io/tube_file.HELD_M1): a change
     between points i and i + 1 listed after point i (at point i + 1's P and V/V0), and the located zeros of the
-    eigenvalues ('points': io/tube_file's dicts)."""
+    eigenvalues ('points': io/tube_file's dicts, the critical mode replaced by ``mode_peak``, the reference
+    arclength S where its displacement |(R, T, Z)| is largest: None in files before the mode is stored)."""
     out = {}
     for m, block in branch.get("azimuthal", {}).items():
         counts = block["unstable"]
         changes = [{"after_point": int(i), "unstable": int(counts[i + 1]), "pressure": float(branch["pressure"][i + 1]),
                     "volume": float(branch["volume"][i + 1])} for i in np.flatnonzero(np.diff(counts))]
+        points = [{k: v for k, v in p.items() if k != "mode"} | {"mode_peak": _peak(disc, p["mode"])}
+                  for p in block["points"]]
         out[str(m)] = {"unstable_max": int(counts.max()), "lowest_min": float(block["lowest"][:, 0].min()),
-                       "changes": changes, "points": block["points"]}
+                       "changes": changes, "points": points}
     return out
+
+
+def _peak(disc, mode) -> float | None:
+    """The reference arclength S (on PEAK_SAMPLES points of [0, L]) where the critical mode's |(R, T, Z)| is largest."""
+    if mode is None:
+        return None
+    S = np.linspace(0.0, disc.length, PEAK_SAMPLES)
+    return float(S[np.argmax(np.linalg.norm(mode_profile(disc, mode, S), axis=0))])
 
 
 def _frequencies(frequencies: dict | None) -> dict:
@@ -146,11 +167,14 @@ def format_tube(summary: dict) -> str:
              f"degree         {summary['degree']}",
              "stability      m = 0 (pressure, volume and gas control); " + _assessed(summary),
              f"Maxwell        P_M = {maxwell}"]
+    lines += [f"not started    {line}" for line in summary["not_started"]]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
     label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)
     for name, b in summary["branches"].items():
-        lines += ["", f"branch {name}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
+        origin = "" if b["parent"] is None else f" (from label {b['parent']['label']} of {b['parent']['branch']}" + (
+            "" if b["rejoins"] is None else f", rejoins it at label {b['rejoins']}") + ")"
+        lines += ["", f"branch {name}{origin}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}"
                       + ("" if b["voltage"] is None else f", Φ̄ {b['voltage'][0]:.6g}..{b['voltage'][1]:.6g}")
                       + f", stop {b['stop_code']} ({b['stop_message']})"
@@ -168,7 +192,9 @@ def format_tube(summary: dict) -> str:
             lines.append(f"  {name}: lowest eigenvalue ≥ {block['lowest_min']:.4g}, at most {block['unstable_max']} "
                          f"unstable" + (f"; unstable count {changes}" if changes else ""))
             lines += [f"        BP m = {m} (eigenvalue {p['order']}) after point {p['index']:<4} P = {p['pressure']:.10g}  "
-                      f"V/V0 = {p['volume']:.8g}  {p['status']}" for p in block["points"]]
+                      f"V/V0 = {p['volume']:.8g}  {p['status']}"
+                      + ("" if p["mode_peak"] is None else f"  mode largest at S = {p['mode_peak']:.4g}")
+                      for p in block["points"]]
         for s in b["special_points"]:
             k, label = label, label + 1
             block = f" {s['block']}" if s["block"] else ""

@@ -4,7 +4,8 @@ tube/picture.py, written atomically (io/hdf5.py), read back checked.
 Root attributes: the format, the scene (name, TOML), the shape and its parameters (``shape``, ``length``, ``ends``,
 ``axial_stretch``: NaN where the ends' distance is free), the discretisation (``degree``, ``quadrature``),
 ``maxwell_pressure`` (NaN where there is none), ``control`` (the scene's loading.control, whose stability reading and
-folds count: files before it have none, read as "pressure") and the provenance. One group per branch under
+folds count: files before it have none, read as "pressure"), ``not_started`` (one line "name: why" per switched
+branch whose first step did not converge, "" for none; files before it have none, read as "") and the provenance. One group per branch under
 /branches/<name>/:
 per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``,
 ``unstable_volume`` and ``unstable_gas`` (negative eigenvalues of ∂R/∂u, on δV = 0, and of ∂R/∂u + (P/Ṽ) g gᵀ:
@@ -18,10 +19,14 @@ P fixed) ``voltage`` (Φ̄, also per located point), with stability.m_max ≥ 1 
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
 not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
 block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
-azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0); its located points under
+azimuthal_points/ (``held`` 1 for the held block's: files before it have none, read as 0; ``critical_modes``: the
+eigenvector at each, files before it have none, read as None); its located points under
 special_points/ (``kind``, ``block``, ``status``, ``note`` (a UZ point's event, "volume_ratio = 3"; files before
 it have none), ``index``, ``pressure``, ``volume``, ``smallest_stress``,
-``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes). A ``critical`` run adds
+``crest_height``, ``unknowns``), and its stop (``stop_code``, ``stop_message`` attributes); a switched branch
+("bulge", "bulge_<label>": tube/picture.branch_name) has the attributes ``parent_branch``, ``parent_label`` (the
+label of the branch point it was born at) and ``rejoins_label`` (where it rejoined the parent, −1: it did not; files
+before them have none). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
 under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
@@ -45,7 +50,7 @@ from ..scene.tables import Ends
 from ..analysis.results import Kind, StopCode
 from ..numerics.continuation import RootStatus, Stop, TraceStop
 from ..tube.accuracy import accuracy
-from ..tube.azimuthal import COUNT
+from ..tube.azimuthal import COUNT, operators
 from ..tube.primary import volume_ratio
 from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
 from ..scene.loading import Control
@@ -61,6 +66,7 @@ SPECIAL_TEXT = ("kind", "block", "status")
 VOLTAGE = "voltage"  # per point and located point of a voltage continuation (tube/voltage.py; others have none)
 NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
+MODES = "critical_modes"  # per located m ≥ 1 zero: its eigenvector (files before it have none)
 HELD_M1 = "1 held"  # read_tube_run's key of the held tube's m = 1 block (beside the free blocks' m)
 
 
@@ -103,6 +109,10 @@ TUBE_VARIABLES = {
     "index": ("", "point index", "the located point lies between points index and index + 1"),
     "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M or voltage)"),
     "modes": ("1", "odd null vector", "the odd block's null vector φ at the onset"),
+    "coefficient": ("", "coefficient index", "index into the m ≥ 1 perturbation's coefficients (R's, T's, Z's: "
+                    "tube/azimuthal.py)"),
+    MODES: ("1", "critical mode", "the block's eigenvector at the located zero, coefficients of (R, T, Z) with "
+            "cᵀGc = 1 (tube/azimuthal.critical_mode)"),
 }
 
 
@@ -121,7 +131,8 @@ def _dimensions(group, rows: str, axes: dict) -> None:
     for name, item in items:
         item.dims[0].attach_scale(scales[rows])
         if item.ndim == 2:
-            second = "mode" if name == "modes" else "eigenvalue" if name.startswith("lowest_m") else "unknown"
+            second = {"modes": "mode", MODES: "coefficient"}.get(name, "eigenvalue" if name.startswith("lowest_m")
+                                                                  else "unknown")
             item.dims[1].attach_scale(scales[second])
         _describe(item, name)
 
@@ -152,12 +163,14 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
              "degree": primary.disc.degree, "quadrature": primary.disc.quadrature,
              "maxwell_pressure": math.nan if picture.maxwell is None else picture.maxwell,
              "control": scene.loading.control.value,
+             "not_started": "\n".join(f"{name}: {why}" for name, why in picture.not_started),
              "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
     f.attrs.update(attrs)
     for name, branch in picture.branches.items():
         group = f.create_group(f"branches/{name}")
-        group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message})
+        group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message,
+                            **_lineage(branch)})
         checksummed(group, "unknowns", branch.states)
         eq = Equilibrium(scene, branch.disc)
         for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
@@ -180,7 +193,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             if modes.held is not None:
                 checksummed(group, "lowest_m1_held", modes.held["lowest"])
                 checksummed(group, "unstable_m1_held", modes.held["unstable"])
-            _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size)
+            _write_crossings(group.create_group("azimuthal_points"), modes.crossings, branch.disc.size,
+                             operators(branch.disc)[1].shape[0])
         special = group.create_group("special_points")
         s = branch.special
         write_strings(special, "kind", [p.kind.value for p in s])
@@ -204,15 +218,26 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         _write_onset(f.create_group("onset"), picture.onset)
 
 
-def _write_crossings(group, found, size: int) -> None:
+def _lineage(branch) -> dict:
+    """A switched branch's attributes ``parent_branch``, ``parent_label`` (the branch point it was born at) and
+    ``rejoins_label`` (where it rejoined its parent branch, −1: it did not); none for the primary branch."""
+    if branch.parent is None:
+        return {}
+    return {"parent_branch": branch.parent[0], "parent_label": branch.parent[1],
+            "rejoins_label": -1 if branch.rejoins is None else branch.rejoins}
+
+
+def _write_crossings(group, found, size: int, coefficients: int) -> None:
     """The located zeros of the m ≥ 1 eigenvalues (tube/azimuthal_crossings.py): per point ``m``, ``order``,
-    ``index``, ``pressure``, ``volume``, ``value``, ``held``, ``status``, ``unknowns``."""
+    ``index``, ``pressure``, ``volume``, ``value``, ``held``, ``status``, ``unknowns`` and ``critical_modes`` (the
+    eigenvector there: ``coefficients`` of (R, T, Z), tube/azimuthal.critical_mode)."""
     for column, kind in (("m", int), ("order", int), ("index", int), ("pressure", float), ("volume", float),
                          ("value", float), ("held", int)):
         checksummed(group, column, np.array([getattr(c, column) for c in found], dtype=kind))
     write_strings(group, "status", [c.status.value for c in found])
     checksummed(group, "unknowns", np.array([c.u for c in found], dtype=float).reshape(len(found), size))
-    _dimensions(group, "special", {"unknown": size})
+    checksummed(group, MODES, np.array([c.mode for c in found], dtype=float).reshape(len(found), coefficients))
+    _dimensions(group, "special", {"unknown": size, "coefficient": coefficients})
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
@@ -250,7 +275,8 @@ def read_tube_run(path) -> dict:
 def read_tube(f, path, where: str = "") -> dict:
     """{'attrs', 'branches', 'onset'} of the tube run written by ``write_tube`` into the open file or group ``f``
     (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
-    attrs = {"interrupted": "", "control": "pressure"} | {k: _text(plain(v)) for k, v in f.attrs.items()}
+    attrs = {"interrupted": "", "control": "pressure", "not_started": ""} | {k: _text(plain(v))
+                                                                             for k, v in f.attrs.items()}
     if "branches" not in f or "primary" not in f["branches"]:
         raise TubeFileError(path, f"no {where}/branches/primary group")
     branches = {}
@@ -294,8 +320,9 @@ def _read_modes(path, group, n: int, where: str) -> dict:
                                                                               "volume", "value")),
                                                     located["status"].asstr()[()])]
     held = [False] * len(points) if located is None or "held" not in located else located["held"][()].astype(bool)
-    for p, h in zip(points, held):
-        p["held"] = bool(h)
+    modes = [None] * len(points) if located is None or MODES not in located else list(located[MODES][()])
+    for p, h, mode in zip(points, held, modes):
+        p["held"], p["mode"] = bool(h), mode
     blocks = [(m, f"lowest_m{m}", f"unstable_m{m}", False) for m in range(1, int(group.attrs.get("m_max", 0)) + 1)]
     blocks += [(HELD_M1, "lowest_m1_held", "unstable_m1_held", True)] if "lowest_m1_held" in group else []
     for key, lowest, unstable, is_held in blocks:
@@ -357,8 +384,12 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
                 b["attrs"]["stop_message"])
     lowest = {block: b[f"lowest_{block.value}"] for block in Mirror if f"lowest_{block.value}" in b}
     unstable = {control: b[f"unstable_{control.value}"] for control in Control if f"unstable_{control.value}" in b}
+    attrs = b["attrs"]
+    parent = (attrs["parent_branch"], int(attrs["parent_label"])) if "parent_label" in attrs else None
+    rejoins = int(attrs["rejoins_label"]) if attrs.get("rejoins_label", -1) >= 0 else None
     return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
-                          special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE))
+                          special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
+                          rejoins=rejoins)
 
 
 def discretisation(attrs: dict) -> IntervalDiscretisation:

@@ -1,7 +1,8 @@
 """What people look at on a tube (a tube run file, io/tube_file.py), in the journal style: P against V/V0 of every
 branch with Maxwell's line (``pressure_volume``), the family of profiles r(Z) of a branch (``profiles``), the bulge's
 front, its position and width against V/V0 (``front_motion``), and the hoop and axial stretches along the deformed
-axis at a few states (``stretch_profiles``; post/tube_measures.py measures both).
+axis at a few states (``stretch_profiles``; post/tube_measures.py measures both), and the critical modes of a
+branch's located m ≥ 1 zeros (``critical_modes``).
 
 Curves are solid where a point is stable under the chosen control (default: the run's loading.control; no negative
 eigenvalue of the second variation under it: the file's ``unstable_pressure``/``unstable_volume``/``unstable_gas``,
@@ -13,8 +14,9 @@ import numpy as np
 from .style import JournalFigure, journal_style
 from .tube_measures import SAMPLES, fronts, stretches
 from ..io.tube_file import discretisation
+from ..tube.azimuthal import mode_profile
 
-TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches")
+TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches", "modes")
 CONTROLS = ("pressure", "volume", "gas")
 PROFILES = 8  # profiles drawn along a branch unless the points are given
 STRETCHED = 3  # states whose stretches are drawn unless the points are given
@@ -46,7 +48,8 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
         name = branch or ("bulge" if "bulge" in run["branches"] else "primary")
         if name not in run["branches"]:
             raise TubePlotError(f"--branch {name}: not in the file; it has {', '.join(run['branches'])}")
-        draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles}[what]
+        draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles,
+                "modes": critical_modes}[what]
         draw(ax, run, name, points)
     return fig
 
@@ -54,8 +57,9 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
 def pressure_volume(ax, run: dict, control: str) -> None:
     """P against V/V0 of every branch, solid where stable under ``control``, the located points labelled, and
     Maxwell's pressure as a dotted line where the file has one."""
+    others = iter(f"C{k}" for k in range(1, 10_000))  # a colour of its own for every other switched branch
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
-        colour = _COLOURS.get(name, "C1")
+        colour = _COLOURS.get(name) or next(others)
         stable = b[f"unstable_{control}"] == 0
         for solid in (True, False):
             shown = np.where(_runs(stable, solid), b["pressure"], np.nan)
@@ -126,6 +130,27 @@ def stretch_profiles(ax, run: dict, name: str, points=None) -> None:
         ax.plot(z, axial, color=colour, linestyle="--", label=f"$\\lambda_1$, V/V0 = {b['volume'][i]:.3g}")
     ax.set(xlabel="distance from the branch's end", ylabel="stretch",
            title=f"{run['attrs']['scene_name']}: hoop (solid) and axial (dashed) stretch, {name} branch")
+    ax.legend(fontsize=5)
+
+
+def critical_modes(ax, run: dict, name: str, points=None) -> None:
+    """The critical modes of branch ``name``'s located m ≥ 1 zeros (tube/azimuthal.critical_mode, the file's
+    ``critical_modes``): R (solid), T (dashed) and Z (dotted) of δx = R cos mφ e_ρ + T sin mφ e_φ + Z cos mφ e_z
+    against the reference arclength S, one colour per zero (``points``: their indices, default all); a branch
+    without a stored one has none to draw (TubePlotError)."""
+    located = [(m, p) for m, block in run["branches"][name]["azimuthal"].items() for p in block["points"]
+               if p["mode"] is not None]
+    if not located:
+        raise TubePlotError(f"--what modes: the {name} branch has no located m ≥ 1 zero with a stored mode")
+    chosen = _chosen({"pressure": located}, name, points, len(located))
+    disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
+    for colour, k in zip(matplotlib_colours(len(chosen)), chosen):
+        m, p = located[k]
+        for values, style, part in zip(mode_profile(disc, p["mode"], s), ("-", "--", ":"), "RTZ"):
+            ax.plot(s, values, color=colour, linestyle=style,
+                    label=f"${part}$, m = {m}{' held' if p['held'] else ''}, P = {p['pressure']:.6g}")
+    ax.set(xlabel="$S$", ylabel="amplitude ($\\frac{1}{2}\\int (R^2 + T^2 + Z^2)\\,dS = 1$)",
+           title=f"{run['attrs']['scene_name']}: critical modes, {name} branch")
     ax.legend(fontsize=5)
 
 

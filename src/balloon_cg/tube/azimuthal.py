@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.stability.azimuthal import lowest_eigenvalues
 from ..galerkin.discretisation import symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation
@@ -54,23 +55,36 @@ class TubeModes:
     held: dict | None = None
 
 
-@functools.lru_cache(maxsize=16)
-def operators(disc: IntervalDiscretisation) -> tuple:
-    """(ops, gram): ops (6, n_q, size) the node values of y = (R, R', Z, Z', T, T') per coefficient, the unknowns
-    ordered (R's, T's, Z's) (module docstring), on the nodes of ``disc``; gram the (size, size) G."""
+def basis_values(disc: IntervalDiscretisation, x: np.ndarray) -> np.ndarray:
+    """(6, x.size, size): the values of y = (R, R', Z, Z', T, T') of each coefficient at the points x of [−1, 1], the
+    unknowns ordered (R's, T's, Z's) (module docstring)."""
     n, length = disc.degree, disc.length
-    p, dp = legendre_table(disc.x, n)
+    p, dp = legendre_table(x, n)
     bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
     free, free_slopes = (p, dp) if disc.ends == Ends.SLIDING else (bubbles, slopes)
     k, b = free.shape[1], bubbles.shape[1]
-    ops = np.zeros((6, disc.x.size, 2 * k + b))
+    ops = np.zeros((6, x.size, 2 * k + b))
     r, t, z = slice(0, k), slice(k, 2 * k), slice(2 * k, 2 * k + b)
     ops[0, :, r], ops[1, :, r] = free, 2 / length * free_slopes
     ops[4, :, t], ops[5, :, t] = free, 2 / length * free_slopes
     ops[2, :, z], ops[3, :, z] = bubbles, 2 / length * slopes
+    return ops
+
+
+@functools.lru_cache(maxsize=16)
+def operators(disc: IntervalDiscretisation) -> tuple:
+    """(ops, gram): ops (6, n_q, size) the node values of y = (R, R', Z, Z', T, T') per coefficient on the nodes of
+    ``disc`` (``basis_values``); gram the (size, size) G."""
+    ops = basis_values(disc, disc.x)
     values = ops[[0, 2, 4]]
     gram = 0.5 * np.einsum("aqi,q,aqj->ij", values, disc.weights, values)
     return ops, gram
+
+
+def mode_profile(disc: IntervalDiscretisation, c: np.ndarray, S: np.ndarray) -> tuple:
+    """(R, T, Z) of the perturbation with coefficients c at the reference arclengths S."""
+    y = basis_values(disc, 2 * np.asarray(S, dtype=float) / disc.length - 1) @ c
+    return y[0], y[4], y[2]
 
 
 def translation(disc: IntervalDiscretisation) -> np.ndarray:
@@ -109,13 +123,32 @@ def readings(eq: Equilibrium, params: Parameters, m: int) -> tuple:
     return (False, True) if m == 1 and eq.disc.ends == Ends.SLIDING and in_field(eq, params) else (False,)
 
 
-def zero_modes(eq: Equilibrium, params: Parameters, m: int, held: bool = False) -> np.ndarray:
-    """The rows G c of the removed modes (module docstring): the translation for m = 1 on sliding ends without a
-    field, or in a field for the ``held`` tube; else none."""
+def removed_modes(eq: Equilibrium, params: Parameters, m: int, held: bool = False) -> np.ndarray | None:
+    """The coefficient rows of the removed modes (module docstring): the translation for m = 1 on sliding ends without
+    a field, or in a field for the ``held`` tube; else None."""
     disc = eq.disc
     if m != 1 or disc.ends != Ends.SLIDING or (in_field(eq, params) and not held):
-        return NO_CONSTRAINT
-    return (operators(disc)[1] @ translation(disc))[None, :]
+        return None
+    return translation(disc)[None, :]
+
+
+def zero_modes(eq: Equilibrium, params: Parameters, m: int, held: bool = False) -> np.ndarray:
+    """The rows G c of the removed modes (``removed_modes``), NO_CONSTRAINT where there are none."""
+    removed = removed_modes(eq, params, m, held)
+    return NO_CONSTRAINT if removed is None else removed @ operators(eq.disc)[1]
+
+
+def critical_mode(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int, order: int,
+                  held: bool = False) -> np.ndarray:
+    """The eigenvector number ``order`` (ascending, from 0) of the m-th block of a reading at the state u, its
+    removed modes excluded (analysis/stability/azimuthal.lowest_eigenvalues): at a located zero of that eigenvalue
+    (tube/azimuthal_crossings.py) the mode the non-axisymmetric branch is born along. Coefficients on the basis of
+    ``operators``, cᵀGc = 1, its largest entry positive (the sign is reproducible, not the eigensolver's)."""
+    _, gram = operators(eq.disc)
+    vectors = lowest_eigenvalues(hessian(eq, u, params, m), gram, order + 1, removed_modes(eq, params, m, held),
+                                 vectors=True)[1]
+    vector = vectors[:, order] / np.sqrt(vectors[:, order] @ gram @ vectors[:, order])
+    return vector * np.sign(vector[np.argmax(np.abs(vector))])
 
 
 def block(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int, held: bool = False) -> np.ndarray:

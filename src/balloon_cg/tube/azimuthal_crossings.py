@@ -4,13 +4,14 @@ Between two stored points Y_i, Y_{i+1} of a branch whose m-th block's unstable c
 number k (ascending, from 0: analysis/stability/crossings.count_changes) of the free tube's block (and of the held
 tube's m = 1 block where it has one: tube/azimuthal.readings) is followed along the secant: at arclength
 s the state is Keller's corrector from Y_i + s t (t the unit secant, on every free unknown and P), and Brent's method
-in s finds its zero (numerics/continuation.locate_root: ``located``, or ``nearest`` where a corrector failed).
+in s finds its zero (numerics/continuation.locate_root: ``located``, or ``nearest`` where a corrector failed), and
+the eigenvector there is the critical mode (tube/azimuthal.critical_mode) a non-axisymmetric branch would leave along.
 """
 from dataclasses import dataclass
 
 import numpy as np
 
-from .azimuthal import block
+from .azimuthal import block, critical_mode
 from .primary import TubeSystem, held, volume_ratio
 from .zeros import corrected_zero
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
@@ -24,7 +25,9 @@ from ..numerics.continuation import RootStatus
 class AzimuthalCrossing:
     """The m-th block's eigenvalue ``order`` vanishes at the state u, ``pressure``, ``volume`` (V/V0), between
     points ``index`` and ``index + 1``; ``status`` of its location; ``value`` the eigenvalue there; ``held``: of the
-    held tube's block (tube/azimuthal.readings), else the free one's."""
+    held tube's block (tube/azimuthal.readings), else the free one's; ``mode``: its eigenvector there, the critical
+    mode the non-axisymmetric branch is born along (tube/azimuthal.critical_mode: coefficients of (R, T, Z), G-unit;
+    None where not computed: files before it)."""
 
     m: int
     order: int
@@ -35,6 +38,7 @@ class AzimuthalCrossing:
     status: RootStatus
     value: float
     held: bool = False
+    mode: np.ndarray | None = None
 
 
 def crossings(scene, branch, modes) -> list[AzimuthalCrossing]:
@@ -54,8 +58,9 @@ def crossings(scene, branch, modes) -> list[AzimuthalCrossing]:
             located = _zero(system, eq, params, settings, points[i], points[i + 1], m, order, held_block)
             if located is not None:
                 Y, status, value = located
+                mode = critical_mode(eq, Y[:-1], params.with_value("P", Y[-1]), m, order, held_block)
                 found.append(AzimuthalCrossing(m, order, i, Y[:-1], float(Y[-1]), volume_ratio(eq, Y), status, value,
-                                               held_block))
+                                               held_block, mode))
     return found
 
 

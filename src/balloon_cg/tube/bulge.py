@@ -48,6 +48,10 @@ class UnswitchableBranchPoint(ValueError):
     """A branch point ``bulge_branch`` does not switch at (one line saying which and why)."""
 
 
+class BranchStartError(ArithmeticError):
+    """The first step off the branch point did not converge (one line)."""
+
+
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None,
@@ -85,7 +89,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     direction = np.append(phi, 0.0)[system.columns] / np.linalg.norm(phi)
     first = continuation.correct(system, X + settings.step * direction, direction, settings)
     if not first.converged:
-        raise ArithmeticError(f"the first step of the bulge branch did not converge: {first.message}")
+        raise BranchStartError(f"the first step of the bulge branch did not converge: {first.message}")
     start = continuation.Point(first.x, continuation.tangent(system, first.x, direction), first.iterations,
                                first.residual)
 

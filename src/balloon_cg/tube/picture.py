@@ -1,9 +1,16 @@
 """Everything a tube scene asks for (``balloon-cg run`` on a tube): the primary branch with its folds and branch
-points (tube/primary.py), the bulge branch switched at its first odd branch point (tube/bulge.py, held to the
-resolution policy where solver.tube_resolution = "refine": tube/resolution.py; sliding ends only:
-on plugged ones the branch points are not trusted, docs/tubes.md) traced until it rejoins the mirror-symmetric
-states, its largest hoop stretch passes ``continuation.stop_stretch``, its V reaches ``continuation.stop_volume``
-(V/R0³, landed on; the primary branch ends there too) or after ``continuation.max_points``, and
+points (tube/primary.py), the branches switched at its branch points (tube/bulge.py; sliding ends only: on plugged
+ones the branch points are not trusted, docs/tubes.md): at every odd one, and at every even one where the primary
+branch is uniform (no coil field), in order along the primary branch, a branch point where an earlier branch rejoined
+the primary one not switched again (that branch is its branch, traced from its other end); where
+solver.tube_resolution = "refine" the first odd one alone, its branch held to the resolution policy
+(tube/resolution.py: the primary branch retraced with it, so the other labels would be a coarser branch's). Each is
+traced until it rejoins the mirror-symmetric (odd) or uniform (even) states, its largest hoop stretch passes
+``continuation.stop_stretch``, its V reaches ``continuation.stop_volume`` (V/R0³, landed on; the primary branch ends
+there too) or after ``continuation.max_points``. The branch born at the first odd branch point (the onset of
+bulging) is named "bulge", the others "bulge_<label>", <label> their branch point's label (``inspect``: the primary
+branch's located points are numbered first); each knows its parent label and where it rejoined
+(IntervalBranch.parent, .rejoins). And
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
@@ -17,12 +24,13 @@ import numpy as np
 
 from .azimuthal import branch_modes
 from .azimuthal_crossings import crossings
+from .bulge import BranchStartError
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
-from .resolution import traced_bulge
-from .results import IntervalBranch
+from .resolution import REFINE, traced_bulge
+from .results import IntervalBranch, IntervalStop
 from .voltage import voltage_branch
-from ..analysis.results import StopCode
+from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..model.membrane import scene_energy
@@ -30,6 +38,9 @@ from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
 from ..numerics.threads import limited_blas
 from ..scene.tables import ContinuationParameter, Ends
+
+
+BULGE = "bulge"  # the name of the branch switched at the first odd branch point, the prefix of the others'
 
 
 class Stage(enum.StrEnum):
@@ -43,13 +54,14 @@ class Stage(enum.StrEnum):
 
 @dataclass(frozen=True)
 class TubePicture:
-    """The branches by name ("primary", "bulge" where one was switched), Maxwell's pressure (None where the
+    """The branches by name ("primary", "bulge" and "bulge_<label>" where they were switched: ``branch_name``), Maxwell's pressure (None where the
     uniform closed path has no maximum and minimum, the ends are held, or coils act: ``maxwell``), for ``critical``
     the onset of bulging followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the
     work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
     not); ``frequencies``: with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch
     name); ``modes``: each branch's m = 1..``stability.m_max`` blocks (tube/azimuthal.TubeModes by branch name; None:
-    not assessed, m_max = 0 or a signal)."""
+    not assessed, m_max = 0 or a signal); ``not_started``: (name, why) of the switched branches that could not start
+    (the run is then incomplete: exit 1)."""
 
     branches: dict
     maxwell: float | None
@@ -57,10 +69,12 @@ class TubePicture:
     interrupted: Stage | None = None
     frequencies: dict | None = None
     modes: dict | None = None
+    not_started: tuple = ()  # (name, why) of each branch whose first step off its branch point did not converge
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
-    """The primary branch and, unless ``primary_only``, the bulge branch of a tube scene (module docstring); on a
+    """The primary branch and, unless ``primary_only``, the branches switched at its branch points (module
+    docstring); on a
     voltage continuation the tube continued in Φ̄ at its fixed P alone (tube/voltage.py: ``charged_picture``)."""
     if scene.continuation.parameter == ContinuationParameter.VOLTAGE:
         return charged_picture(scene)
@@ -69,10 +83,28 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     branches: dict[str, IntervalBranch] = {"primary": primary}
     if primary.stop.code == StopCode.INTERRUPTED:
         return TubePicture(branches, pm, interrupted=Stage.PRIMARY)
-    onset = primary.branch_points(Mirror.ODD)
-    if not primary_only and onset and scene.geometry.ends == Ends.SLIDING:
-        return bulge_picture(scene, primary, onset[0], pm)
+    labels = switchable(scene, primary)
+    if not primary_only and labels:
+        return bulge_picture(scene, primary, labels, pm)
     return with_modes(scene, TubePicture(branches, pm))
+
+
+def switchable(scene, primary: IntervalBranch) -> list:
+    """The labels of the branch points of ``primary`` a branch is switched at (module docstring): none on plugged
+    ends, the first odd one where solver.tube_resolution = "refine", the odd ones in a coil field, else the odd and
+    the even ones."""
+    if scene.geometry.ends != Ends.SLIDING:
+        return []
+    blocks = (Mirror.ODD,) if in_field(scene) or scene.solver.tube_resolution == REFINE else (Mirror.ODD, Mirror.EVEN)
+    labels = [k for k, s in enumerate(primary.special) if s.kind == Kind.BP and s.block in blocks]
+    return labels[:1] if scene.solver.tube_resolution == REFINE else labels
+
+
+def branch_name(primary: IntervalBranch, label: int) -> str:
+    """The name of the branch switched at the located point ``label`` of ``primary``: "bulge" at its first odd branch
+    point, else "bulge_<label>"."""
+    first = next((k for k, s in enumerate(primary.special) if s.kind == Kind.BP and s.block == Mirror.ODD), None)
+    return BULGE if label == first else f"{BULGE}_{label}"
 
 
 def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -> TubePicture:
@@ -83,18 +115,49 @@ def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -
                        interrupted=Stage.PRIMARY if branch.stop.code == StopCode.INTERRUPTED else None)
 
 
-def bulge_picture(scene, primary: IntervalBranch, point, pm: float | None) -> TubePicture:
-    """``primary`` and the bulge branch switched at its odd branch point ``point`` (tube/bulge.py), stopped as
-    ``tube_picture``'s, traced as solver.tube_resolution asks (tube/resolution.traced_bulge: "refine" retraces both
-    at growing degree until the bulge is resolved); ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's
-    label."""
-    branches = {"primary": primary}
-    if interrupt.requested():  # in the primary branch's stability and branch points: the bulge not started
-        return TubePicture(branches, pm, interrupted=Stage.BULGE)
-    branches["primary"], branches["bulge"] = traced_bulge(scene, primary, point,
-                                                          stop_stretch=scene.continuation.stop_stretch)
-    stopped = Stage.BULGE if branches["bulge"].stop.code == StopCode.INTERRUPTED else None
-    return with_modes(scene, TubePicture(branches, pm, interrupted=stopped))
+def bulge_picture(scene, primary: IntervalBranch, labels, pm: float | None) -> TubePicture:
+    """``primary`` and the branches switched at its branch points ``labels`` (tube/bulge.py; named by ``branch_name``),
+    in order, a label where an earlier one rejoined skipped, each stopped as ``tube_picture``'s (one whose first step
+    does not converge listed in ``not_started``), traced as solver.tube_resolution asks (tube/resolution.traced_bulge:
+    "refine" retraces the primary branch with it, which then replaces ``primary``: ``switchable`` gives one label
+    there); ``pm``: Maxwell's pressure. Also ``continue`` from a tube file's label."""
+    branches, reached, stopped, not_started = {"primary": primary}, set(), None, ()
+    for label in labels:
+        if label in reached:
+            continue
+        if interrupt.requested():  # in the primary branch's assessment or the branch before: this one not started
+            return TubePicture(branches, pm, interrupted=Stage.BULGE, not_started=not_started)
+        name = branch_name(primary, label)
+        try:
+            primary, point, branch = traced_bulge(scene, primary, primary.special[label],
+                                                  stop_stretch=scene.continuation.stop_stretch)
+        except BranchStartError as e:
+            not_started += ((name, str(e)),)
+            continue
+        branches["primary"] = primary
+        label = next(k for k, s in enumerate(primary.special) if s is point)  # its label on a retraced primary
+        rejoins = rejoined_at(scene, primary, branch, label)
+        branches[name] = replace(branch, parent=("primary", label), rejoins=rejoins)
+        reached.add(rejoins)
+        if branch.stop.code == StopCode.INTERRUPTED:
+            stopped = Stage.BULGE
+            break
+    return with_modes(scene, TubePicture(branches, pm, interrupted=stopped, not_started=not_started))
+
+
+def rejoined_at(scene, primary: IntervalBranch, branch: IntervalBranch, label: int) -> int | None:
+    """The label of the branch point of ``primary`` where ``branch`` (switched at ``label``) rejoined it: of the same
+    block, the nearest in (u, P) to its last point and within two of the scene's largest steps of it (the step that
+    crossed the primary branch's states ends beyond it); None where it did not rejoin or the point lies beyond the
+    traced primary branch."""
+    if branch.stop.code != IntervalStop.REJOINED:
+        return None
+    block = primary.special[label].block
+    last = np.append(branch.states[-1], branch.pressure[-1])
+    near = [(float(np.linalg.norm(np.append(s.u, s.pressure) - last)), k) for k, s in enumerate(primary.special)
+            if s.kind == Kind.BP and s.block == block and k != label]
+    distance, found = min(near, default=(np.inf, None))
+    return found if distance <= 2 * scene.continuation.step_max else None
 
 
 @limited_blas

@@ -25,17 +25,18 @@ REFINE = "refine"  # solver.tube_resolution: the bulge branch retraced until res
 
 
 def traced_bulge(scene, primary, point, **trace) -> tuple:
-    """(primary, bulge) of ``run``: the bulge branch switched at ``point`` of ``primary`` (tube/bulge.bulge_branch,
-    ``trace`` its stop_volume, step, stop_stretch), at the primary's degree with every point stored (solver.
-    tube_resolution "flag"), or held to the scene's policy (``refined_bulge``: "refine"), the primary branch then
-    the one of the degree the bulge was resolved on."""
-    if scene.solver.tube_resolution == REFINE:
+    """(primary, point, bulge) of ``run``: the bulge branch switched at ``point`` of ``primary`` (tube/bulge.
+    bulge_branch, ``trace`` its stop_volume, step, stop_stretch), at the primary's degree with every point stored
+    (solver.tube_resolution "flag"), or held to the scene's policy (``refined_bulge``: "refine"), the primary branch
+    and its branch point then the ones of the degree the bulge was resolved on (an even branch point's branch, from
+    ``continue``, is traced as by "flag")."""
+    if scene.solver.tube_resolution == REFINE and point.block == Mirror.ODD:
         return refined_bulge(scene, primary, point, **trace)
-    return primary, bulge_branch(scene, primary, point, **trace)
+    return primary, point, bulge_branch(scene, primary, point, **trace)
 
 
 def refined_bulge(scene, primary, point, policy: Resolution | None = None, **trace) -> tuple:
-    """(primary, bulge): the bulge branch switched at ``point``, an odd branch point of ``primary``, with every stored
+    """(primary, point, bulge): the bulge branch switched at ``point``, an odd branch point of ``primary``, with every stored
     point resolved to ``policy.max_error`` (None: the scene's solver.max_error and max_degree), the primary branch
     traced again at the grown degree where it stops unresolved below max_degree and the bulge switched at its odd
     branch point nearest ``point`` in P (the same onset at a finer degree: module docstring); ``trace``:
@@ -45,14 +46,14 @@ def refined_bulge(scene, primary, point, policy: Resolution | None = None, **tra
         branch = bulge_branch(scene, primary, point, max_error=policy.max_error, **trace)
         degree = primary.disc.degree
         if branch.stop.code != IntervalStop.UNRESOLVED:
-            return primary, branch
+            return primary, point, branch
         if degree >= policy.max_degree:
-            return primary, replace(branch, stop=Stop(branch.stop.code, f"{branch.stop.message} = solver.max_degree: "
-                                                                        "raise it or solver.max_error"))
+            message = f"{branch.stop.message} = solver.max_degree: raise it or solver.max_error"
+            return primary, point, replace(branch, stop=Stop(branch.stop.code, message))
         finer = primary_branch(scene, policy.grow(degree))
         onsets = finer.branch_points(Mirror.ODD)
         if not onsets:
-            return primary, branch
+            return primary, point, branch
         primary, point = finer, min(onsets, key=lambda s: abs(s.pressure - point.pressure))
 
 
@@ -66,4 +67,5 @@ def resolved_bulge_branch(scene, stop_volume: float | None = None, step: float |
     onsets = primary.branch_points(Mirror.ODD)
     if not onsets:
         return primary, None
-    return refined_bulge(scene, primary, onsets[0], policy, stop_volume=stop_volume, step=step)
+    primary, _, bulge = refined_bulge(scene, primary, onsets[0], policy, stop_volume=stop_volume, step=step)
+    return primary, bulge

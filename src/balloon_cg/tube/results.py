@@ -56,7 +56,9 @@ class IntervalBranch:
     stress at every point (negative: compressed, tube/stability.py); ``params``: the branch's parameters (the field's M
     and χ; P is each point's); ``tail`` and ``first_integral``: per point, the spectral error estimate and the
     spread of H = λ1Φ_1 − Φ along the tube (tube/accuracy.py; None where not computed: the primary branch, a
-    branch read from a file); ``voltage``: on a voltage continuation each point's Φ̄ (P fixed, tube/voltage.py)."""
+    branch read from a file); ``voltage``: on a voltage continuation each point's Φ̄ (P fixed, tube/voltage.py);
+    ``parent``: (branch name, label) of the branch point a switched branch was born at (tube/picture.py; None: the
+    primary branch), ``rejoins``: the label of the parent branch's point where it rejoined it (None: it did not)."""
 
     disc: IntervalDiscretisation
     states: np.ndarray
@@ -71,6 +73,8 @@ class IntervalBranch:
     tail: np.ndarray | None = None  # per point: galerkin/interval.IntervalDiscretisation.tail
     first_integral: np.ndarray | None = None  # per point: tube/accuracy.first_integral_spread
     voltage: np.ndarray | None = None  # per point Φ̄ on a voltage continuation (tube/voltage.py); None: in P
+    parent: tuple | None = None  # (branch name, label) of the branch point it was switched at
+    rejoins: int | None = None  # the label on the parent branch where it rejoined it
 
     def branch_points(self, block: Mirror | None = None) -> list:
         return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]
