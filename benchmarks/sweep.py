@@ -9,7 +9,10 @@ local worker processes, then the same members on a dask LocalCluster of 2 single
 started with balloon-cg's DASK_WORKER_CONFIG (cluster start-up excluded; dask's default malloc setting made its
 members 1.4x slower: benchmarks/dask_worker.py). Prints a table with the speed-up
 over serial (floor: >= 1.7x for 2 workers on an otherwise idle 2-core machine) and checks that every run stored
-the same members. Run: python benchmarks/sweep.py [--study two-coils]
+the same members. The numba cache is warmed first by a sweep over each range's two ends. Per run the table also shows the busiest
+worker's members added up (its members' own compute times: the least the run could take with that assignment) and
+the rest of the run's wall time (start-up, writing, the view, the idle tail). Run:
+python benchmarks/sweep.py [--study two-coils] [--no-dask] [--note TEXT]
 (output also in benchmarks/results/sweep.txt, or sweep_two_coils.txt)
 """
 import argparse
@@ -70,23 +73,42 @@ def member_sum(path: Path) -> float:
     return sum(m["attrs"]["wall_time"] for m in read_sweep(path)["members"].values())
 
 
+def busiest_worker(path: Path) -> float:
+    """The largest sum of the members' compute times over the worker processes that computed them."""
+    by_worker = {}
+    for m in read_sweep(path)["members"].values():
+        by_worker[m["attrs"]["worker_pid"]] = by_worker.get(m["attrs"]["worker_pid"], 0.0) + m["attrs"]["wall_time"]
+    return max(by_worker.values())
+
+
+def ends(spec: str) -> str:
+    """A --vary range START:STOP:COUNT as its two ends (the warm-up: every kernel the members load); else as given."""
+    key, _, text = spec.partition("=")
+    parts = text.split(":")
+    return f"{key}={parts[0]}:{parts[1]}:2" if len(parts) == 3 else spec
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--study", choices=sorted(STUDIES), default="single-coil")
-    scene, vary, result_name = STUDIES[parser.parse_args().study]
+    parser.add_argument("--no-dask", action="store_true", help="leave out the dask LocalCluster row")
+    parser.add_argument("--note", default="", help="a first line naming the install and the machine's state")
+    args = parser.parse_args()
+    scene, vary, result_name = STUDIES[args.study]
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        cli_run(scene, vary, tmp / "warm.h5", 1)  # numba cache warm for every run below
+        cli_run(scene, [ends(v) for v in vary], tmp / "warm.h5", 1)  # numba cache warm for every run below
         rows = [("serial (--workers 1)", cli_run(scene, vary, tmp / "serial.h5", 1), tmp / "serial.h5"),
                 ("local pool, 2 workers", cli_run(scene, vary, tmp / "pool.h5", 2), tmp / "pool.h5")]
-        t = dask_run(scene, vary, tmp / "dask.h5")
+        t = None if args.no_dask else dask_run(scene, vary, tmp / "dask.h5")
         if t is not None:
             rows.append(("dask LocalCluster, 2 workers", t, tmp / "dask.h5"))
         members = read_sweep(tmp / "serial.h5")["members"]
         member_time = [m["attrs"]["wall_time"] for m in members.values()]
         serial = rows[0][1][0]
-        lines = [
+        lines = [args.note] if args.note else []
+        lines += [
             f"sweep benchmark: {scene.name}, --vary {' --vary '.join(vary)}, {MODE_FLAG or 'full analysis'}: "
             f"{len(members)} members",
             f"per-member compute time (serial run): mean {np.mean(member_time):.2f} s, "
@@ -94,17 +116,20 @@ def main():
             f"cores: {os.cpu_count()}; load average before: {load[0]:.2f}, after: {os.getloadavg()[0]:.2f} "
             "(other processes share the cores)",
             "",
-            f"{'run':<30} {'sweep [s]':>10} {'speed-up':>9} {'process [s]':>12} {'speed-up':>9} {'Σ member [s]':>13}  same as serial",
+            f"{'run':<30} {'sweep [s]':>10} {'speed-up':>9} {'process [s]':>12} {'speed-up':>9} {'Σ member [s]':>13} {'busiest [s]':>12} {'rest [s]':>9}  same as serial",
         ]
         for name, (wall, total), path in rows:
             lines.append(f"{name:<30} {wall:>10.2f} {serial / wall:>8.2f}x {total:>12.2f} "
-                         f"{rows[0][1][1] / total:>8.2f}x {member_sum(path):>13.2f}  {same(rows[0][2], path)}")
+                         f"{rows[0][1][1] / total:>8.2f}x {member_sum(path):>13.2f} {busiest_worker(path):>12.2f} "
+                         f"{wall - busiest_worker(path):>9.2f}  {same(rows[0][2], path)}")
         lines += ["", "sweep: the sweep command after `import balloon_cg` (includes starting the local workers and "
                   "their numba cache loading); process: the whole `python -c ...` run including imports. The dask "
                   "row excludes the cluster start-up (the cluster exists before the sweep); its workers run with "
                   "DASK_WORKER_CONFIG.",
                   "Σ member: the members' own compute times added up; larger than the serial one means the workers "
-                  "competed for the cores with other processes."]
+                  "competed for the cores with other processes. busiest: the largest sum of member times over the worker "
+                  "processes (the run's least wall time with that assignment); rest: sweep − busiest (start-up, "
+                  "writing, the view and table, a worker idle while the last member runs)."]
     text = "\n".join(lines)
     print(text)
     out = ROOT / "benchmarks" / "results" / result_name
