@@ -1,8 +1,9 @@
 """Benchmark: the two loops-anywhere scenes of docs/scenes.md run whole (`balloon-cg run`), each in a fresh
 process: the tilted loop (SPOM1 beside one loop of the paper's pair turned by 30°) with ``[surface] branches =
 "all"``, and the displaced loop (the same loop moved sideways by 0.5). Prints per scene the wall time, the CPU time
-of the run and its children, whether it finished within ``--timeout``, the verdict line, the run file's phase
-times and each branch's points and degree, with the load average before and after (issue 37: measured before
+of the run and its children, whether it finished within ``--timeout`` (if not, the run is stopped by SIGTERM and
+what it had finished is read back from its file), the verdict line, the run file's phase times and each branch's
+points and degree, with the load average before and after (issue 37: measured before
 and after; the displaced loop took 90 min and ended ``limited`` at degree 112 in session 14).
 Run: python benchmarks/loops_anywhere.py [--scene tilted|displaced] [--timeout S] [--note TEXT]
 (appends to benchmarks/results/loops_anywhere.txt)
@@ -49,13 +50,16 @@ def run_scene(name: str, folder: Path, timeout: float) -> list[str]:
         os.killpg(child.pid, signal.SIGTERM)
         text = f"stopped after the timeout of {timeout:.0f} s\n" + child.communicate()[0]
         finished = False
+        if out.exists():  # what was finished is written, flagged interrupted
+            text += subprocess.run([sys.executable, "-m", "balloon_cg", "inspect", str(out)], capture_output=True,
+                                   text=True).stdout
     wall, cpu = time.perf_counter() - start, children_cpu() - cpu
     lines = [f"{name} loop: wall {wall:.1f} s, CPU {cpu:.1f} s (run and children), "
              f"{'finished' if finished else 'NOT finished'}; load average before {load[0]:.2f}, "
              f"after {os.getloadavg()[0]:.2f}"]
     kept = [line for line in text.splitlines() if line.startswith(SUMMARY_KEYS) or line.startswith("branch ")
             or line.lstrip().startswith(("points ", "stop reason", "special points", "max error estimate"))
-            or " LP " in line or " BP " in line or "except" in line or "stopped" in line]
+            or " LP " in line or " BP " in line or "except" in line or "stopped" in line or "interrupted" in line]
     return lines + ["  " + line for line in kept]
 
 
