@@ -14,7 +14,7 @@ member's own (its process's CPU over ``compute_member``, printed by the child) a
 members added up: on an otherwise idle machine a run takes at least that long. ``--no-serial`` leaves the serial
 run out (then no speed-up column: compare the CPU columns), ``--no-warm`` the warm-up (a sweep over each range's two
 ends, which loads or compiles every kernel the members use). Run:
-python benchmarks/sweep.py [--study two-coils] [--no-warm] [--no-serial] [--no-dask] [--note TEXT]
+python benchmarks/sweep.py [--study two-coils] [--count N] [--no-warm] [--no-serial] [--no-dask] [--note TEXT]
 (output also in benchmarks/results/sweep.txt, or sweep_two_coils.txt)
 """
 import argparse
@@ -133,12 +133,15 @@ def cells(run: dict, path: Path, serial: dict | None, reference: Path) -> str:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--study", choices=sorted(STUDIES), default="single-coil")
+    parser.add_argument("--count", type=int, help="the members of each range (default: the study's)")
     parser.add_argument("--no-warm", action="store_true", help="no warm-up (the numba cache is warm already)")
     parser.add_argument("--no-serial", action="store_true", help="leave out the serial run")
     parser.add_argument("--no-dask", action="store_true", help="leave out the dask LocalCluster run")
     parser.add_argument("--note", default="", help="a first line naming the install and the machine's state")
     args = parser.parse_args()
     scene, vary, result_name = STUDIES[args.study]
+    if args.count:
+        vary = [ends(v).removesuffix(":2") + f":{args.count}" if v != ends(v) else v for v in vary]
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
