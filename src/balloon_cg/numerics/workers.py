@@ -168,6 +168,7 @@ class Stream:
                 out.append([consume(item) for item in self.items])
             return out
         try:
+            interrupt.check()  # a signal during the feeding: no results (a serial reading would stop at its check)
             for _, inbox, _ in self.workers:
                 inbox.put(None)
             out = []
