@@ -121,8 +121,8 @@ def _in_order(parts: list, order) -> dict:
 
 def readers(trace, params, parameter: str, readings=surface_stability.READINGS) -> workers.Stream:
     """The sectors of ``trace``'s basis read beside the trace, in groups of about equal cost, one forked worker
-    each (``workers.Stream``; where forking does not pay, read at the end, here): ``feed(point(basis, c, value))``
-    each traced point in order once it is final, and ``assess(..., stream=)`` takes their readings. Each group
+    each (``workers.Stream``; where forking does not pay, read at the end, here): ``follow(..., final=fed(stream))``
+    hands them each traced point in order once it is kept, and ``assess(..., stream=)`` takes their readings. Each group
     reads as ``assessed`` reads it, so the numbers are the same; a basis the trace refines to is built again in
     the workers (the first one they inherit). The cost that decides the forking: the first point's Σ size³ over
     two points (a branch has at least two)."""
@@ -132,10 +132,10 @@ def readers(trace, params, parameter: str, readings=surface_stability.READINGS) 
     return workers.Stream(_reader(trace.scene, params, parameter, readings, {trace.basis: trace.eq}), groups, cost)
 
 
-def point(basis, c: np.ndarray, value: float) -> tuple:
-    """A traced point as ``readers`` are fed it: the basis without its cached tables (a few hundred bytes to send;
-    equal to it), the coefficients, the parameter's value."""
-    return replace(basis), np.asarray(c), float(value)
+def fed(stream: workers.Stream):
+    """final(trace, point) for ``surface.branches.follow``: the point handed to the ``readers`` as (its basis without
+    the cached tables: a few hundred bytes to send, equal to it; its coefficients; its parameter's value)."""
+    return lambda trace, p: stream.feed((replace(trace.basis), trace.system.coefficients(p.X), float(p.X[-1])))
 
 
 def _reader(scene, params, parameter: str, readings, equilibria: dict):

@@ -50,7 +50,7 @@ from ..branches.problem import continuation_settings, equilibrium_of
 from ..results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
 from ..stability.axisymmetric import assessed_degrees
-from .assessment import assess, point as reader_point, readers
+from .assessment import assess, fed, readers
 from .resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 from ...scene import Shape
 
@@ -270,9 +270,7 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     phi = sign * phi / np.linalg.norm(phi)
     with readers(trace, branch.params, "P") as stream:  # the points read beside the trace, on the other cores
         (E, kind), traced = leave(trace, X_star, phi, max_points, f"branch point {number} along its m = {bp.m} "
-                                  "mode", progress, lambda t, p: stream.feed(reader_point(t.basis,
-                                                                                          t.system.coefficients(p.X),
-                                                                                          p.X[-1])))
+                                  "mode", progress, fed(stream))
         origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
                          note=f"born here, on {branch.name} (m = {bp.m})")
         return branch_of(*traced, branch, number, origin, name, t0, stream=stream)
