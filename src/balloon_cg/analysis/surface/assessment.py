@@ -2,8 +2,9 @@
 read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
 change of the number of negative held eigenvalues of a sector under pressure control between two points is a
 secondary branch point, located by Brent's method on that eigenvalue. The symmetry sectors are read in groups,
-one per core (``numerics.workers``), each along the whole branch. A signal (``numerics.interrupt``) stops the assessment at the next point or root
-search: the branch is left as traced, not assessed (no half-assessed surface branch is kept).
+one per core (``numerics.workers``), each along the whole branch: while it is traced (``readers``, fed by the trace) or
+after it. A signal (``numerics.interrupt``) stops the assessment at the next point or root search: the branch is left
+as traced, not assessed (no half-assessed surface branch is kept).
 """
 from dataclasses import replace
 

@@ -123,7 +123,7 @@ def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broke
     TRACED_REFLECTION_FAILED, the mirror a reflection did not give); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     trace, X_star, phi = switching_start(primary, bp)
-    with readers(trace, primary.params, "P", READINGS) as stream:  # the points read beside the trace, on the other cores
+    with readers(trace, primary.params, "P", READINGS) as stream:  # read beside the trace
         (E, kind), traced = leave(trace, X_star, sign * phi, max_points,
                                   f"branch point {number} of {primary.name} along its mode", progress, fed(stream))
         origin = replace(bp, index=0, X=np.append(trace.system.coefficients(X_star), X_star[-1]), E=E,
