@@ -91,7 +91,8 @@ found = picture.analyse(scene)
 wall, (own, children) = time.perf_counter() - start, [now - then for now, then in zip(cpu(), (own, children))]
 seconds["untimed"], seconds["workers"] = own - sum(seconds.values()), children
 print(json.dumps({"wall": wall, "total": own + children, "phases": seconds,
-                  "points": int(sum(len(b.X) for b in found.branches))}))
+                  "points": int(sum(len(b.X) for b in found.branches)),
+                  "surface_points": int(sum(len(b.values) for b in found.surface_branches))}))
 """
 
 
@@ -132,6 +133,10 @@ def main(argv=None) -> int:
         for scene, r in found.items():
             print(f"  {scene:<24}{r['wall']:9.2f}{r['total']:9.2f}"
                   + "".join(f"{r['phases'].get(p, 0.0):18.2f}" for p in PHASES))
+        for scene, r in found.items():  # issue 37's "whole analysis per point" (against a solve_bvp point)
+            points = r["points"] + r.get("surface_points", 0)
+            print(f"  {scene}: {points} points ({r.get('surface_points', 0)} on surface branches), "
+                  f"{1e3 * r['total'] / points:.1f} ms of CPU and {1e3 * r['wall'] / points:.1f} ms of wall per point")
         base = found.get("spom1")
         if base is None:
             continue

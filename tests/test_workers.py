@@ -93,7 +93,7 @@ def test_a_surface_branch_read_by_sector_groups_on_two_workers_is_the_serial_rea
                                                           "surface.branches": "none"})).primary
     bp = primary.branch_points()[0]
     captured = []
-    monkeypatch.setattr(surface_branches, "assess", lambda sb, traced, readings: captured.append((sb, traced)))
+    monkeypatch.setattr(surface_branches, "assess", lambda sb, traced, readings, stream: captured.append((sb, traced)))
     branch = surface_branches.trace_surface(primary, 0, replace(bp, m=1, block=Block.M1_HELD), 1.0, "m1", 12)
     (sb, traced), = captured
     sizes = surface_assessment._sector_sizes(traced)
@@ -112,6 +112,66 @@ def test_a_surface_branch_read_by_sector_groups_on_two_workers_is_the_serial_rea
                                                                      for s in spread.special]
     for a, b in zip(serial.special, spread.special):
         np.testing.assert_array_equal(a.X, b.X)
+
+
+
+def test_a_surface_branch_read_beside_its_trace_is_the_serial_reading(monkeypatch):
+    """The SPOM1 m = 1 branch at M = 0 traced with its sectors read beside the trace (``assessment.readers``: two
+    forked workers fed each point as it is kept) and traced with the reading at the end in this process: the same
+    points, every stored eigenvalue and every secondary point bit for bit."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis.surface import branches as surface_branches
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.results import Block
+    from balloon_cg.scene import load_scene
+
+    primary = analyse(load_scene("spom1").with_overrides({"continuation.stop_stretch": 4.0,
+                                                          "surface.branches": "none"})).primary
+    bp = replace(primary.branch_points()[0], m=1, block=Block.M1_HELD)
+    found = {}
+    for count in ("1", "2"):
+        monkeypatch.setenv("BALLOON_CG_WORKERS", count)
+        with workers.Stream(lambda keys: None, [(), ()], 1e12) as probe:
+            assert bool(probe.workers) == (count == "2")  # the readers fork with two workers, not with one
+        found[count] = surface_branches.trace_surface(primary, 0, bp, 1.0, "m1", 12)
+    serial, beside = found["1"], found["2"]
+    np.testing.assert_array_equal(serial.coefficients, beside.coefficients)
+    assert serial.stability.keys() == beside.stability.keys() and serial.stability
+    for name, values in serial.stability.items():
+        np.testing.assert_array_equal(values, beside.stability[name])
+    for name, sectors in serial.sectors.items():
+        for key, values in sectors.items():
+            np.testing.assert_array_equal(values, beside.sectors[name][key])
+    assert [(s.kind, s.index, s.sector) for s in serial.special] == [(s.kind, s.index, s.sector)
+                                                                     for s in beside.special]
+    for a, b in zip(serial.special, beside.special):
+        np.testing.assert_array_equal(a.X, b.X)
+
+
+def test_a_stream_raises_its_workers_exception_and_stops_them(monkeypatch):
+    """A consumer that raises in a forked stream worker: ``results`` raises it here, and no worker is left."""
+    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
+
+    def make(group):
+        def consume(item):
+            if item == group:
+                raise ValueError(f"item {item}")
+            return item
+        return consume
+
+    stream = workers.Stream(make, [1, 2], 1e12)
+    processes = [process for process, _, _ in stream.workers]
+    assert len(processes) == 2
+    for item in (0, 1, 2):
+        stream.feed(item)
+    with pytest.raises(ValueError, match="item 1"):
+        stream.results()
+    assert not stream.workers and not any(process.is_alive() for process in processes)
+    with workers.Stream(make, [5, 6], 1e12) as ok:
+        for item in (0, 1):
+            ok.feed(item)
+        assert ok.results() == [[0, 1], [0, 1]]
 
 
 def _sleep_then_mark(item):

@@ -119,3 +119,94 @@ def _counted(result, on_result):
 def _run(i: int):
     work, items = _job
     return work(items[i])
+
+
+class Stream:
+    """``[consumer(item) for item in items]`` per group, the items fed while they are made: one forked worker per
+    group (``sharing(len(groups), cost)`` of them, else here, in ``results``) builds its consumer as
+    ``make(group)`` (a closure that may keep state from item to item: a reading that follows its previous values)
+    and applies it to every item ``feed`` hands it, in order, beside this process's own work (a branch's points
+    read as they are traced). Items go through a ``multiprocessing.Queue`` (its feeder thread: ``feed`` never
+    waits for a busy worker); ``results`` returns the lists per group, raises a worker's exception here, and
+    raises ``interrupt.Interrupted`` within a second of a signal; ``close`` kills the workers (``results`` and
+    the ``with`` block call it). Each consumer runs the code a serial loop runs on the same items: the same
+    numbers, bit for bit."""
+
+    def __init__(self, make, groups, cost: float):
+        self.make, self.groups = make, list(groups)
+        self.items, self.workers = [], []
+        if sharing(len(self.groups), cost) < 2:
+            return
+        context = multiprocessing.get_context("fork")
+        parent = os.getpid()
+        for group in self.groups:
+            inbox, (receive, send) = context.Queue(), context.Pipe(duplex=False)
+            process = context.Process(target=_consume, args=(parent, make, group, inbox, send), daemon=True)
+            process.start()
+            send.close()
+            self.workers.append((process, inbox, receive))
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def feed(self, item) -> None:
+        """Hand ``item`` to every group's consumer (here: kept for ``results``)."""
+        if not self.workers:
+            self.items.append(item)
+        for _, inbox, _ in self.workers:
+            inbox.put(item)
+
+    def results(self) -> list:
+        """Per group, its consumer's results over every item fed, in order."""
+        if not self.workers:
+            out = []
+            for group in self.groups:
+                consume = self.make(group)
+                out.append([consume(item) for item in self.items])
+            return out
+        try:
+            interrupt.check()  # a signal during the feeding: no results (a serial reading would stop at its check)
+            for _, inbox, _ in self.workers:
+                inbox.put(None)
+            out = []
+            for process, _, receive in self.workers:
+                while not receive.poll(1.0):
+                    interrupt.check()
+                    if not process.is_alive() and not receive.poll(0):
+                        raise RuntimeError(f"a stream worker (pid {process.pid}) died (exit code {process.exitcode})")
+                kind, value = receive.recv()
+                if kind == "error":
+                    raise value
+                out.append(value)
+            return out
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Kill the workers (idempotent)."""
+        for process, inbox, receive in self.workers:
+            if process.is_alive():
+                process.kill()
+            process.join()
+            inbox.cancel_join_thread()
+            inbox.close()
+            receive.close()
+        self.workers = []
+
+
+def _consume(parent: int, make, group, inbox, send) -> None:
+    """A stream worker: ``make(group)`` applied to each item of ``inbox`` until None, the list sent back (or the
+    exception raised)."""
+    worker_hygiene(parent, False)
+    _state.serial = 1  # a spread inside the consumer stays in this worker
+    try:
+        consume = make(group)
+        out = []
+        while (item := inbox.get()) is not None:
+            out.append(consume(item))
+        send.send(("done", out))
+    except BaseException as error:  # noqa: BLE001 - raised again in the parent
+        send.send(("error", error))

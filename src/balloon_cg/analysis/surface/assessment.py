@@ -2,33 +2,37 @@
 read held and free under pressure, volume and gas control (``surface.stability``) on the basis it was traced on; a
 change of the number of negative held eigenvalues of a sector under pressure control between two points is a
 secondary branch point, located by Brent's method on that eigenvalue. The symmetry sectors are read in groups,
-one per core (``numerics.workers``), each along the whole branch. A signal (``numerics.interrupt``) stops the assessment at the next point or root
-search: the branch is left as traced, not assessed (no half-assessed surface branch is kept).
+one per core (``numerics.workers``), each along the whole branch: while it is traced (``readers``, fed by the trace) or
+after it. A signal (``numerics.interrupt``) stops the assessment at the next point or root search: the branch is left
+as traced, not assessed (no half-assessed surface branch is kept).
 """
+from dataclasses import replace
+
 import numpy as np
 
 from ...numerics import continuation, eigen, interrupt, workers
 from ...numerics.newton import newton
 from ...surface import stability as surface_stability
 from ...surface.embedding import transfer
+from ...surface.equilibrium import SurfaceEquilibrium
 from ..results import Kind, SpecialPoint, Status, SurfaceBranch
 
 STABILITY_COUNT = 4  # lowest eigenvalues stored per point and reading
 
 
-def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> bool:
+def assess(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS, stream=None) -> bool:
     """``assessed``; False when a signal stopped it (``sb`` then left as traced: no stability, no secondary
     points)."""
     special = list(sb.special)
     try:
-        assessed(sb, traced, readings)
+        assessed(sb, traced, readings, stream)
     except interrupt.Interrupted:
         sb.stability, sb.sectors, sb.special = {}, None, special
         return False
     return True
 
 
-def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS) -> None:
+def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READINGS, stream=None) -> None:
     """The stability readings of every point (held and free, under pressure, volume and gas control:
     ``surface.stability.READINGS``: ``sb.stability`` the lowest over every sector, ``sb.sectors`` each sector's
     ``spectrum_count`` lowest) and the secondary branch points: where the number of negative held eigenvalues
@@ -37,13 +41,23 @@ def assessed(sb: SurfaceBranch, traced: list, readings=surface_stability.READING
     hyperplane (as azimuthal_points.locate); APPROXIMATE with the bracket when the search fails. ``traced``: per
     point, (the SurfaceTrace it was traced on, its coefficients there): a point is read on its own basis (resolved
     there; the final basis of a branch that refined is several times larger than its first points need).
-    ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). A fold (LP) of the
-    branch changes the count of the state's own sector between its points: not a branch point."""
+    ``readings``: the Readings made (default all; a field that is not axisymmetric: held only). ``stream``: the
+    ``workers.Stream`` of ``readers`` fed every traced point as it was traced (the readings read beside the trace:
+    the same numbers); None: read here, the sector groups on every core. A fold (LP) of the branch changes the
+    count of the state's own sector between its points: not a branch point."""
     held = surface_stability.Reading(True)
     sizes = _sector_sizes(traced)
-    groups = _sector_groups(sizes, workers.sharing(len(sizes), sum(float(c.size) ** 3 for _, c in traced)))
-    read = workers.spread(lambda keys: _read(sb, traced, readings, keys), groups,
-                          [sum(sizes[key] ** 3 for key in keys) for keys in groups])
+    if stream is None:
+        groups = _sector_groups(sizes, workers.sharing(len(sizes), sum(float(c.size) ** 3 for _, c in traced)))
+        make = _reader(sb.scene, sb.params, sb.parameter, readings, {trace.basis: trace.eq for trace, _ in traced})
+        items = [(trace.basis, c, value) for (trace, c), value in zip(traced, sb.values)]
+        read = workers.spread(lambda keys: _read_all(make(keys), items), groups,
+                              [sum(sizes[key] ** 3 for key in keys) for keys in groups])
+    else:
+        read = stream.results()
+        if any(len(part) != len(traced) for part in read):
+            raise RuntimeError(f"the readers were fed {[len(part) for part in read]} points of the {len(traced)} "
+                               "traced")
     spectra = [{r: _in_order([part[i][0][r] for part in read], sizes) for r in readings} for i in range(len(traced))]
     counts = [_in_order([part[i][1] for part in read], sizes) for i in range(len(traced))]
     held_spectra = [s[held] for s in spectra]
@@ -106,23 +120,56 @@ def _in_order(parts: list, order) -> dict:
     return {k: merged[k] for k in order if k in merged}
 
 
-def _read(sb: SurfaceBranch, traced: list, readings, keys: tuple) -> list:
-    """(spectra, negative held counts) of the sectors ``keys`` at every point of the branch in order, each sector
-    following its own spectra at the previous point (``surface.stability.sector_spectra``; at the first point it
-    solves dense). The groups of sectors go to every core (``numerics.workers``): a sector's numbers are those of
-    a serial reading of all of them."""
-    out, spectra, held = [], None, surface_stability.Reading(True)
-    for i in range(len(traced)):
-        interrupt.check()
-        trace, c = traced[i]
-        params = sb.params.with_value(sb.parameter, sb.values[i])
-        spectra = surface_stability.sector_spectra(trace.eq, c, params, spectrum_count(sb.scene), readings,
-                                                   guesses=spectra, only=keys)
-        out.append((spectra, _negative_counts(trace, c, params, spectra[held])))
-    return out
+def readers(trace, params, parameter: str, readings=surface_stability.READINGS) -> workers.Stream:
+    """The sectors of ``trace``'s basis read beside the trace, in groups of about equal cost, one forked worker
+    each (``workers.Stream``; where forking does not pay, read at the end, here): ``follow(..., final=fed(stream))``
+    hands them each traced point in order once it is kept, and ``assess(..., stream=)`` takes their readings. Each group
+    reads as ``assessed`` reads it, so the numbers are the same; a basis the trace refines to is built again in
+    the workers (the first one they inherit). The cost that decides the forking: the first point's Σ size³ over
+    two points (a branch has at least two)."""
+    sizes = {sector.characters: float(sector.size) for sector in trace.basis.sectors() if sector.size}
+    cost = 2.0 * sum(size ** 3 for size in sizes.values())
+    groups = _sector_groups(sizes, workers.sharing(len(sizes), cost))
+    return workers.Stream(_reader(trace.scene, params, parameter, readings, {trace.basis: trace.eq}), groups, cost)
 
 
-def _negative_counts(trace, c, params, lowest: dict) -> dict:
+def fed(stream: workers.Stream):
+    """final(trace, point) for ``surface.branches.follow``: the point handed to the ``readers`` as (its basis without
+    the cached tables: a few hundred bytes to send, equal to it; its coefficients; its parameter's value)."""
+    return lambda trace, p: stream.feed((replace(trace.basis), trace.system.coefficients(p.X), float(p.X[-1])))
+
+
+def _reader(scene, params, parameter: str, readings, equilibria: dict):
+    """make(keys) -> read((basis, c, value)) -> (spectra, negative held counts) of the sectors ``keys`` at one
+    point, the points given in the branch's order, each sector following its own spectra at the previous point
+    (``surface.stability.sector_spectra``; at the first point it solves dense). ``equilibria``: {basis:
+    SurfaceEquilibrium} known (others are built once). The groups of sectors go to every core
+    (``numerics.workers``): a sector's numbers are those of a serial reading of all of them."""
+    held = surface_stability.Reading(True)
+
+    def make(keys: tuple):
+        spectra = None
+
+        def read(item):
+            nonlocal spectra
+            interrupt.check()
+            basis, c, value = item
+            if basis not in equilibria:
+                equilibria[basis] = SurfaceEquilibrium(scene, basis)
+            eq, at = equilibria[basis], params.with_value(parameter, value)
+            spectra = surface_stability.sector_spectra(eq, c, at, spectrum_count(scene), readings, guesses=spectra,
+                                                       only=keys)
+            return spectra, _negative_counts(eq, c, at, spectra[held])
+        return read
+    return make
+
+
+def _read_all(read, items: list) -> list:
+    """``read`` (one group's reader: it follows its spectra from point to point) over the items in order."""
+    return [read(item) for item in items]
+
+
+def _negative_counts(eq, c, params, lowest: dict) -> dict:
     """{characters: the number of negative held eigenvalues of the sector}: from its lowest STABILITY_COUNT, or,
     when they are all negative, from the inertia of its matrix (numerics.eigen.negative_count)."""
     counts = {}
@@ -131,7 +178,7 @@ def _negative_counts(trace, c, params, lowest: dict) -> dict:
         if counts[key] == values.size:
             interrupt.check()
             held = surface_stability.Reading(True)
-            A = surface_stability.restricted_sectors(trace.eq, c, params, (held,), (key,))[held][key]
+            A = surface_stability.restricted_sectors(eq, c, params, (held,), (key,))[held][key]
             counts[key] = eigen.negative_count(A)
     return counts
 

@@ -50,7 +50,7 @@ from ..branches.problem import continuation_settings, equilibrium_of
 from ..results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
 from ..stability.axisymmetric import assessed_degrees
-from .assessment import assess
+from .assessment import assess, fed, readers
 from .resolution import MAX_DEGREE, MAX_ORDER, refined, remapped
 from ...scene import Shape
 
@@ -268,28 +268,30 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     X_star = trace.system.point(c_star, bp.X[-1])
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi = sign * phi / np.linalg.norm(phi)
-    (E, kind), traced = leave(trace, X_star, phi, max_points, f"branch point {number} along its m = {bp.m} mode",
-                              progress)
-    origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
-                     note=f"born here, on {branch.name} (m = {bp.m})")
-    return branch_of(*traced, branch, number, origin, name, t0)
+    with readers(trace, branch.params, "P") as stream:  # the points read beside the trace, on the other cores
+        (E, kind), traced = leave(trace, X_star, phi, max_points, f"branch point {number} along its m = {bp.m} "
+                                  "mode", progress, fed(stream))
+        origin = replace(bp, index=0, X=np.append(c_star, bp.X[-1]), E=E, classification=kind, mode=None,
+                         note=f"born here, on {branch.name} (m = {bp.m})")
+        return branch_of(*traced, branch, number, origin, name, t0, stream=stream)
 
 
-def leave(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, max_points: int, what: str, progress=None):
+def leave(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, max_points: int, what: str, progress=None,
+          final=None):
     """((E2, E3, E4), Classification) of the branch point X* along the unit mode φ (``classify``) and the branch
     that leaves it along φ: (trace, segments, folds, stop) of ``follow`` from the first point off it (``switch``)
-    until it crosses back the hyperplane φ·(X − X*) = 0; SurfaceStartError (naming ``what``) when that first
-    correction does not converge."""
+    until it crosses back the hyperplane φ·(X − X*) = 0 (``final``: as ``follow``'s); SurfaceStartError (naming
+    ``what``) when that first correction does not converge."""
     classified = classify(trace, X_star, phi)
     first = switch(trace, X_star, phi)
     if not isinstance(first, continuation.Point):
         raise SurfaceStartError(f"the first correction from {what} did not converge: {first.message}")
     start = continuation.Point(X_star, phi, 0, float(np.abs(trace.system.residual(X_star)).max()))
-    return classified, follow(trace, [start], first, max_points, (phi, X_star), progress)
+    return classified, follow(trace, [start], first, max_points, (phi, X_star), progress, final)
 
 
 def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_points: int, rejoin: tuple | None,
-           progress=None) -> tuple:
+           progress=None, final=None) -> tuple:
     """Pseudo-arclength continuation in P from ``first`` (after the stored ``points``) until a stop of ``_stop_rule``
     (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch); a point whose tail exceeds
     solver.max_error refines the basis (the wire map re-centred on the state, then the degree and the order
@@ -298,14 +300,44 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
     off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest singular value
     1.3e-6 at fixed P, 1.0e-3 on that hyperplane) and the trace goes on (a signal before the refinement or during
     it: the stop INTERRUPTED, the points so far kept). Returns (the last trace, the segments
-    [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop)."""
-    scene = trace.scene
-    segments, folds = [(trace, list(points))], []
+    [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop). ``final(trace,
+    point)``: called on each point in order once it is kept as it is, i.e. once a later point is accepted or the
+    trace ends (the last point may be solved again on a finer basis): the points read beside the trace
+    (``assessment.readers``)."""
+    segments, running = [(trace, list(points))], []  # running: (trace, point) of the continuation run under way
+    handed = 0
+
+    def hand(keep_last: bool):
+        nonlocal handed
+        kept = [(t, p) for t, kept_points in segments for p in kept_points] + running
+        for t, p in kept[handed:len(kept) - keep_last] if final is not None else ():
+            final(t, p)
+        handed = max(handed, len(kept) - keep_last)
+
+    def accepted(t: SurfaceTrace, p: continuation.Point):
+        running.append((t, p))
+        hand(True)
+        if progress is not None:
+            progress(p)
+
+    try:
+        return _follow(trace, segments, running, first, max_points, rejoin, accepted)
+    finally:
+        hand(False)
+
+
+def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuation.Point, max_points: int,
+            rejoin: tuple | None, accepted) -> tuple:
+    """``follow``'s loop on ``segments`` (extended in place); ``running``: the points of the continuation run under
+    way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments."""
+    scene, folds = trace.scene, []
     while True:
         done = sum(len(points) for _, points in segments)
         settings = continuation_settings(scene, max(max_points - done, 1))
+        running[:] = [(trace, first)]
         path = continuation.trace(trace.system, first, settings, _stop_rule(trace, rejoin),
-                                  {Kind.LP: np.eye(first.X.size)[-1]}, progress)
+                                  {Kind.LP: np.eye(first.X.size)[-1]}, lambda point, on=trace: accepted(on, point))
+        running.clear()
         stop = path.stop
         # a fold in the step to a point the resolution stop rejects is found again from the re-solved last point
         folds += [(trace, replace(f, index=f.index + done)) for f in path.folds
@@ -373,10 +405,10 @@ def traced_points(segments) -> list:
 
 
 def branch_of(trace: SurfaceTrace, segments, folds, stop, parent, number: int, bp: SpecialPoint, name: str, t0,
-              readings=surface_stability.READINGS, fields: dict | None = None) -> SurfaceBranch:
+              readings=surface_stability.READINGS, fields: dict | None = None, stream=None) -> SurfaceBranch:
     """The SurfaceBranch of the traced segments (``collected``, or their ``fields``), born at point ``number`` of
     the ``parent`` branch, its origin ``bp`` first; the stability of each point read on the basis it was traced on
-    (``assess``: ``readings``)."""
+    (``assess``: ``readings``; ``stream``: read beside the trace, ``assessment.readers``)."""
     fields = fields or collected(trace, segments, folds, stop)
     first_basis = segments[0][0].basis
     if first_basis is not trace.basis:  # the origin was made on the first basis
@@ -384,7 +416,7 @@ def branch_of(trace: SurfaceTrace, segments, folds, stop, parent, number: int, b
     fields["special"].insert(0, bp)
     out = SurfaceBranch(name=name, scene=parent.scene, kernel_class=parent.kernel_class, params=parent.params,
                         m=bp.m, parent=(parent.name, number), held=trace.held, **fields)
-    assess(out, traced_points(segments), readings)
+    assess(out, traced_points(segments), readings, stream)
     out.wall_time = time.perf_counter() - t0
     return out
 

@@ -36,6 +36,7 @@ from ...surface import stability as surface_stability
 from ...surface.embedding import embedded
 from ..switching.mirror import MIRROR
 from ..results import Kind, Origin, SpecialPoint, Status, SurfaceBranch
+from .assessment import fed, readers
 from .branches import CRITICAL_SEARCH, SurfaceTrace, branch_of, collected, leave, reflected
 from .primary import READINGS, with_loads
 
@@ -122,13 +123,15 @@ def trace_pitchfork(primary: SurfaceBranch, number: int, bp: SpecialPoint, broke
     TRACED_REFLECTION_FAILED, the mirror a reflection did not give); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     trace, X_star, phi = switching_start(primary, bp)
-    (E, kind), traced = leave(trace, X_star, sign * phi, max_points,
-                              f"branch point {number} of {primary.name} along its mode", progress)
-    origin = replace(bp, index=0, X=np.append(trace.system.coefficients(X_star), X_star[-1]), E=E,
-                     classification=kind, mode=None, sector=(),  # its sector is the parent's, on the parent's basis
-                     note=f"born here, on {primary.name} (its mode odd under {broken})")
-    name = branch_name(number) + ("" if sign > 0 else MIRROR)
-    out = branch_of(*traced, primary, number, origin, name, t0, READINGS, with_loads(traced[0], collected(*traced)))
+    with readers(trace, primary.params, "P", READINGS) as stream:  # read beside the trace
+        (E, kind), traced = leave(trace, X_star, sign * phi, max_points,
+                                  f"branch point {number} of {primary.name} along its mode", progress, fed(stream))
+        origin = replace(bp, index=0, X=np.append(trace.system.coefficients(X_star), X_star[-1]), E=E,
+                         classification=kind, mode=None, sector=(),  # the parent's sector, on the parent's basis
+                         note=f"born here, on {primary.name} (its mode odd under {broken})")
+        name = branch_name(number) + ("" if sign > 0 else MIRROR)
+        out = branch_of(*traced, primary, number, origin, name, t0, READINGS,
+                        with_loads(traced[0], collected(*traced)), stream)
     if sign < 0:
         out.origin = Origin.TRACED_REFLECTION_FAILED
     return out
