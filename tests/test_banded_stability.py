@@ -6,7 +6,9 @@
 - the scene key stability.banded_from, and the assessment of a whole branch with it (SPOM1 M = 0: flags unchanged);
 - near a wire (the two-coil primary branch's last point, gap 0.1, stored at mapped degree 90): every block's three
   lowest eigenvalues (m = 0; m = 1 held and free), equator-symmetric blocks and the general ones, against the
-  Legendre blocks (an independent discretisation) to within the two discretisations' own error estimates.
+  Legendre blocks (an independent discretisation) to within the two discretisations' own error estimates;
+- the flags from the banded blocks' inertia (numerics/banded.py ``BandedSigns``) against the dense eigenvalues'
+  signs of random pencils and their relatives, and against the Legendre blocks' flags near that wire.
 """
 from dataclasses import replace
 from pathlib import Path
@@ -22,7 +24,7 @@ from balloon_cg.analysis.stability.banded import BandedVariation
 from balloon_cg.analysis.stability.banded_azimuthal import BandedAzimuthal
 from balloon_cg.galerkin.piecewise import PiecewiseBasis
 from balloon_cg.numerics.band_ldlt import BandLDLT
-from balloon_cg.numerics.banded import BandedShiftInvert, InsideShift
+from balloon_cg.numerics.banded import BandedShiftInvert, BandedSigns, InsideShift
 from balloon_cg.scene import SceneError, load_scene, parse_scene
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -178,3 +180,55 @@ def test_assessment_with_banded_from_reads_the_banded_blocks_and_keeps_the_flags
         for name, values in a.blocks.items():
             tolerance = np.abs(values - c.blocks[name]) + 1e-9 * np.maximum(1.0, np.abs(values))
             assert np.all(np.abs(b.blocks[name] - values) <= tolerance), (name, b.blocks[name] - values, tolerance)
+
+
+def test_banded_signs_against_a_dense_generalized_eigensolve():
+    """``BandedSigns``: whether each relative (constraints, a positive rank-one term, both) of a banded pencil is
+    positive definite, against the sign of the dense pencil's lowest eigenvalue: K positive definite (its Cholesky
+    settles every relative), K with one negative eigenvalue (the inertia; the constraint Nᵀc = 0 with N = Gv₁ and
+    the term ρ(Gv₁)(Gv₁)ᵀ each make it positive), K with three, and a K whose LDLᵀ meets a zero pivot (K₀₀ = 0: the
+    lowest eigenvalue's sign decides)."""
+    rng = np.random.default_rng(11)
+    n, b = 80, 4
+    H = _banded_matrix(rng, n, b)
+    G = _banded_matrix(rng, n, b) * 0.05 + np.eye(n) * 2.0
+    mu, vectors = linalg.eigh(H, G)
+    seen = set()
+    for below in (None, 1, 3):  # the number of eigenvalues shifted below zero (None: all above)
+        shift = mu[0] - 1.0 if below is None else 0.5 * (mu[below - 1] + mu[below])
+        K = H - shift * G
+        dual = G @ vectors[:, 0]  # Gv₁: its constraint or rank-one term lifts μ₁
+        noise = 0.01 * rng.standard_normal(n)
+        for N, update in ((None, None), (dual[None, :], None), (None, (dual, 50.0)), ((dual + noise)[None, :], None),
+                          (rng.standard_normal((2, n)), (rng.standard_normal(n), 0.3))):
+            Z = np.eye(n) if N is None else linalg.null_space(N)
+            M = K + (0.0 if update is None else update[1] * np.outer(update[0], update[0]))
+            expected = linalg.eigh(Z.T @ M @ Z, Z.T @ G @ Z, eigvals_only=True)[0] > 0.0
+            assert BandedSigns(_band(K, b), _band(G, b)).positive(N, update) == expected, (below, N, update)
+            seen.add(expected)
+    assert seen == {True, False}
+    K = H - (0.5 * (mu[1] + mu[2])) * G
+    K[0, 0] = 0.0  # a zero pivot: the LDLᵀ is refused
+    assert BandLDLT.factor(_band(K, b)) is None
+    assert BandedSigns(_band(K, b), _band(G, b)).positive() == (linalg.eigh(K, G, eigvals_only=True)[0] > 0.0)
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_banded_flags_agree_with_the_legendre_flags_near_a_wire(near_wire, symmetric):
+    """``SecondVariation.flags`` on the banded sibling (stability.banded_from = 20: the blocks' inertia) against the
+    Legendre blocks' Cholesky factorisations (banded_from = 0) and against the signs of the banded eigenvalues
+    (``assess``), every block m = 0 and m = 1, held and free, at the branch's first point and at its near-wire
+    last point, where some flag fails."""
+    branch, last = near_wire
+    degree = int(point_degrees(branch, branch.scene.stability.degree)[last])
+    variations = {}
+    for start in (0, 20):
+        scene = branch.scene.with_overrides({"stability.banded_from": start}, name=branch.scene.name)
+        variations[start] = SecondVariation(equilibrium_of(replace(branch, scene=scene)), degree)
+    for n in (0, last):
+        X = branch.X[n]
+        u, params = X[:-1], branch.params_at(X)
+        banded = variations[20].flags(u, params, symmetric, 1)
+        assert banded == variations[0].flags(u, params, symmetric, 1)
+        assert banded == tuple(variations[20].assess(u, params, symmetric, 1).flags().values())
+    assert not all(banded)  # the last point: some flag fails there, its sign read by the inertia

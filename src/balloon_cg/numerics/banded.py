@@ -71,6 +71,16 @@ class BandedShiftInvert:
                 upper = middle
         return cls(factor, hessian, gram, sigma)
 
+    @classmethod
+    def under(cls, hessian: np.ndarray, gram: np.ndarray, name: str = "") -> "BandedShiftInvert":
+        """``below`` from the smallest diagonal ratio H_ii/G_ii (an upper bound of μ₁ as a Rayleigh quotient);
+        LinAlgError naming the pencil ``name`` where no shift is found."""
+        guess = float(np.min(hessian[0] / gram[0]))
+        shifted = cls.below(hessian, gram, guess, scale=max(1.0, abs(guess)))
+        if shifted is None:
+            raise np.linalg.LinAlgError(f"no shift below the spectrum of block {name} from {guess:.4g}")
+        return shifted
+
     def _solve(self, v: np.ndarray, transpose: bool) -> np.ndarray:
         """R⁻¹v, or R⁻ᵀv with ``transpose``."""
         out, info = dtbtrs(self.factor, v[:, None], uplo="L", trans="T" if transpose else "N")
@@ -168,27 +178,12 @@ class InsideShift:
 
     @classmethod
     def _at(cls, sigma: float, below: BandedShiftInvert, gram_factor, rows, update):
-        """(the number of eigenvalues below σ, None if not trusted: a refused LDLᵀ, a singular term; the shift at
-        σ if that number is one, else None)."""
-        ldlt = BandLDLT.factor(below.hessian - sigma * below.gram)
-        if ldlt is None:
+        """(the number of eigenvalues below σ, None if not trusted (``BandedInertia``); the shift at σ if that number
+        is one, else None)."""
+        inertia = BandedInertia.at(below.hessian, below.gram, sigma)
+        negatives, solve, solved, schur = (None, None, None, None) if inertia is None else inertia.of(rows, update)
+        if negatives is None:
             return None, None
-        negatives, solve = ldlt.negatives, ldlt.solve
-        if update is not None and update[1] > 0.0:
-            g, rho = np.asarray(update[0], dtype=float), float(update[1])
-            a_g = ldlt.solve(g)
-            denominator = 1.0 + rho * float(g @ a_g)
-            if denominator == 0.0:
-                return None, None
-            negatives -= int(denominator < 0.0)
-
-            def solve(w):
-                x = ldlt.solve(w)
-                return x - (rho * float(g @ x) / denominator) * a_g
-        solved = np.array([solve(row) for row in rows]).reshape(rows.shape)
-        schur = rows @ solved.T
-        if rows.shape[0]:
-            negatives -= int(np.count_nonzero(np.linalg.eigvalsh(0.5 * (schur + schur.T)) < 0.0))
         return negatives, cls(sigma, gram_factor, solve, rows, solved, schur) if negatives == 1 else None
 
     def lowest_above(self, count: int) -> np.ndarray:
@@ -203,3 +198,73 @@ class InsideShift:
 
         nu = largest_by_lanczos(operator, n, min(count, n - k - 1), CHECK_EVERY)
         return np.sort(self.sigma + 1.0 / nu)
+
+
+class BandedInertia:
+    """The number of eigenvalues of the pencil (K + ρggᵀ, G) on Nᵀc = 0 below σ, from the banded LDLᵀ of A = K − σG
+    (numerics/band_ldlt.py): A's negative pivots, one fewer when 1 + ρ gᵀA⁻¹g < 0 (ρ > 0) and as many fewer as
+    C = NᵀA'⁻¹N (N orthonormal rows, A' = A + ρggᵀ by Sherman–Morrison) has negative eigenvalues (Haynsworth's
+    inertia additivity on the bordered matrices). One factorisation serves every relative (``of``)."""
+
+    def __init__(self, ldlt: BandLDLT):
+        self.ldlt = ldlt
+
+    @classmethod
+    def at(cls, hessian: np.ndarray, gram: np.ndarray, sigma: float) -> "BandedInertia | None":
+        """The LDLᵀ of K − σG (lower band storage), or None where it is refused (``BandLDLT.factor``)."""
+        ldlt = BandLDLT.factor(hessian - sigma * gram)
+        return None if ldlt is None else cls(ldlt)
+
+    def of(self, rows: np.ndarray, update) -> tuple:
+        """(the number of eigenvalues below σ on rowsᵀc = 0 (orthonormal rows, k × n) with the rank-one term
+        ``update`` (g, ρ ≥ 0) or None, None if not trusted (a singular term 1 + ρ gᵀA⁻¹g); x ↦ A'⁻¹x; A'⁻¹ of the
+        rows; C)."""
+        ldlt = self.ldlt
+        negatives, solve = ldlt.negatives, ldlt.solve
+        if update is not None and update[1] > 0.0:
+            g, rho = np.asarray(update[0], dtype=float), float(update[1])
+            a_g = ldlt.solve(g)
+            denominator = 1.0 + rho * float(g @ a_g)
+            if denominator == 0.0:
+                return None, None, None, None
+            negatives -= int(denominator < 0.0)
+
+            def solve(w):
+                x = ldlt.solve(w)
+                return x - (rho * float(g @ x) / denominator) * a_g
+        solved = np.array([solve(row) for row in rows]).reshape(rows.shape)
+        schur = rows @ solved.T
+        if rows.shape[0]:
+            negatives -= int(np.count_nonzero(np.linalg.eigvalsh(0.5 * (schur + schur.T)) < 0.0))
+        return negatives, solve, solved, schur
+
+
+class BandedSigns:
+    """Whether the relatives of a banded pencil (K, G), G > 0, are positive definite (the stability flags at a
+    check degree, where only signs are asked): (K + ρggᵀ, G) with ρ ≥ 0 on Nᵀc = 0 has no eigenvalue ≤ 0 iff its
+    inertia at σ = 0 counts no negative one and A = K is not singular there. K's banded Cholesky (dpbtrf) settles
+    every relative when it exists (K > 0: so is every restriction and K + ρggᵀ); otherwise one LDLᵀ of K serves
+    them all (``BandedInertia``); where that is refused (a zero pivot or growth, a singular term) the sign of the
+    relative's lowest eigenvalue decides (``BandedShiftInvert``), the same answer at the cost of a Lanczos run."""
+
+    def __init__(self, hessian: np.ndarray, gram: np.ndarray):
+        self.hessian, self.gram = hessian, gram
+        self.definite = dpbtrf(hessian, lower=1)[1] == 0
+        self._inertia = None
+
+    def positive(self, constraints=None, update=None, rcond: float = RCOND) -> bool:
+        """Whether every eigenvalue of the relative (``update`` (g, ρ) with ρ ≥ 0 or None, ``constraints`` the
+        rows of N or None) is positive."""
+        if update is not None and update[1] < 0.0:
+            raise ValueError(f"BandedSigns.positive: the rank-one weight ρ = {update[1]} must be ≥ 0")
+        if self.definite:
+            return True
+        rows = np.zeros((0, self.hessian.shape[1]))
+        if constraints is not None and len(constraints):
+            rows = orthonormal_rows(np.ascontiguousarray(np.atleast_2d(constraints), dtype=float), rcond)
+        if self._inertia is None:
+            self._inertia = BandedInertia.at(self.hessian, self.gram, 0.0) or False
+        negatives = self._inertia.of(rows, update)[0] if self._inertia else None
+        if negatives is not None:
+            return negatives == 0
+        return bool(BandedShiftInvert.under(self.hessian, self.gram).lowest(1, constraints, update, rcond)[0] > 0.0)

@@ -348,16 +348,36 @@ class SecondVariation:
         return Assessment(blocks, *(value > 0 for value in lowest), self.basis.degree)
 
     def flags(self, u, params: Parameters, symmetric: bool, m_max: int = 0) -> tuple:
-        """The flags of ``assess`` (in FLAGS order) from the inertia alone: a block is positive when its Cholesky
-        factorisation exists (``eigen.positive_definite``), no eigenvalues; a block is skipped once every flag
-        it enters has failed."""
+        """The flags of ``assess`` (in FLAGS order) from the inertia alone, no eigenvalues: a block is positive when
+        its Cholesky factorisation exists (``eigen.positive_definite``), on the banded sibling where ``assess``
+        reads it (``_positive_blocks``); a block is skipped once every flag it enters has failed."""
         stable = [True] * len(FLAGS)
-        for _, parts, flags in self.blocks(u, params, symmetric, m_max):
+        for flags, positive in self._positive_blocks(u, params, symmetric, m_max):
             interrupt.check()  # as assess
-            if any(stable[flag] for flag in flags) and not all(eigen.positive_definite(A) for A in parts):
+            if any(stable[flag] for flag in flags) and not positive():
                 for flag in flags:
                     stable[flag] = False
         return tuple(stable)
+
+    def _positive_blocks(self, u, params: Parameters, symmetric: bool, m_max: int):
+        """(the flags a block enters, a call saying whether it is positive definite) per block, in ``blocks``'
+        order: the Legendre blocks' Cholesky factorisations, or from stability.banded_from where P ≥ 0 (as
+        ``_lowest_blocks``) the banded sibling's inertia (``BandedVariation.positive``,
+        ``BandedAzimuthal.positive_readings``: one factorisation per index set and part)."""
+        sibling = self._sibling(symmetric) if params.P >= 0 else None
+        if sibling is None:
+            for _, parts, flags in self.blocks(u, params, symmetric, m_max):
+                yield flags, lambda parts=parts: all(eigen.positive_definite(A) for A in parts)
+            return
+        for _, positive, flags in sibling.positive(u, params):
+            yield flags, lambda positive=positive: positive
+        field_on = self.eq.coils.shape[0] > 0 and params.M > 0
+        for m in range(1, m_max + 1):
+            readings = self._sibling_block(symmetric, m).positive_readings(u, params, (True, False) if field_on
+                                                                           else (True,))
+            yield (HELD_FLAGS if field_on else EVERY_FLAG), lambda held=readings[True]: held
+            if field_on:
+                yield FREE_FLAGS, lambda free=readings[False]: free
 
 
 def _held_ops(basis: Discretisation) -> np.ndarray:

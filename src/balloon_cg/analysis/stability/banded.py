@@ -23,7 +23,7 @@ from ...galerkin.equilibrium import NodeKernels, Parameters
 from ...galerkin.piecewise import PiecewiseBasis
 from ...generated import HESSIAN_PAIRS
 from ...model.meridian import mass_density
-from ...numerics.banded import BandedShiftInvert
+from ...numerics.banded import BandedShiftInvert, BandedSigns
 from .azimuthal import perturbation_map
 from .flags import EVERY_FLAG, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_GAS, HELD_VOLUME, LOWEST
 
@@ -115,27 +115,34 @@ class BandedVariation:
                      ("all_gas_free", (), False, False, True, (FREE_GAS,))]
         return plan
 
-    def lowest(self, u, params: Parameters):
-        """(name, the LOWEST eigenvalues, the flags it enters) per m = 0 block at the state u (the order and flags of
-        ``SecondVariation._plan``): per index set one banded factor below its pressure block's spectrum
-        (``BandedShiftInvert.below`` from the smallest diagonal ratio H_ii/G_ii, an upper bound of its lowest
-        eigenvalue), every block of the set read through it."""
+    def _relatives(self, u, params: Parameters, pencil):
+        """(name, the pencil's reader, its constraint rows or None, its gas update or None, flags) per m = 0 block at
+        the state u, in ``_plan``'s order; ``pencil(H, G, name)`` makes the reader of one index set's pressure block
+        (H, G in lower band storage), shared by the blocks of that set."""
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         hessian, volume = self.local(u, params)
         weight = params.P / self.eq.volume(u)
-        shifts = {}
+        readers = {}
         for name, dropped, held, constrained, gas, flags in self._plan(field_on):
             layout = self._layout(dropped)
-            if dropped not in shifts:
-                H, G = layout.band(hessian), layout.band(self._gram_local)
-                guess = float(np.min(H[0] / G[0]))
-                shifts[dropped] = BandedShiftInvert.below(H, G, guess, scale=max(1.0, abs(guess)))
-                if shifts[dropped] is None:
-                    raise np.linalg.LinAlgError(f"no shift below the spectrum of block {name} from {guess:.4g}")
+            if dropped not in readers:
+                readers[dropped] = pencil(layout.band(hessian), layout.band(self._gram_local), name)
             g = layout.vector(volume)
             rows = ([layout.vector(self._hold_local)] if held else []) + ([g] if constrained else [])
-            yield name, shifts[dropped].lowest(LOWEST, np.array(rows) if rows else None,
-                                               (g, weight) if gas else None), flags
+            yield name, readers[dropped], np.array(rows) if rows else None, (g, weight) if gas else None, flags
+
+    def lowest(self, u, params: Parameters):
+        """(name, the LOWEST eigenvalues, the flags it enters) per m = 0 block at the state u (the order and flags of
+        ``SecondVariation._plan``): per index set one banded factor below its pressure block's spectrum
+        (``BandedShiftInvert.under``), every block of the set read through it."""
+        for name, shifted, rows, update, flags in self._relatives(u, params, BandedShiftInvert.under):
+            yield name, shifted.lowest(LOWEST, rows, update), flags
+
+    def positive(self, u, params: Parameters):
+        """(name, whether every eigenvalue is positive, the flags it enters) per m = 0 block at the state u, as
+        ``lowest`` but from the inertia alone (``BandedSigns``: one banded Cholesky or LDLᵀ per index set)."""
+        for name, signs, rows, update, flags in self._relatives(u, params, lambda H, G, _: BandedSigns(H, G)):
+            yield name, signs.positive(rows, update), flags
 
     def lowest_blocks(self, u, params: Parameters) -> dict:
         """{name: the LOWEST eigenvalues} of every m = 0 block (``lowest``)."""

@@ -22,7 +22,7 @@ import numpy as np
 from ...galerkin.discretisation import symmetric_rows
 from ...generated import AZIMUTHAL_PAIRS
 from ...model.meridian import hoop, mass_density, metric
-from ...numerics.banded import BandedShiftInvert
+from ...numerics.banded import BandedShiftInvert, BandedSigns
 from .azimuthal import MODE_CLASS, merged_parts, excluded_modes
 from .banded import BandedVariation, BlockLayout
 
@@ -80,29 +80,43 @@ class BandedAzimuthal:
         ops = self.ops[:, [0, 4, 2]]  # (E, 3: R, T, Z, n_q, L)
         return np.array([np.einsum("feq,efqj->ej", np.array(mode) * self._moment_weights, ops) for mode in fields])
 
-    def lowest_readings(self, u, params, count: int, readings=(True, False)) -> dict:
-        """{held: the ``count`` lowest eigenvalues} of the m-th block for each reading (held: True, free: False),
-        the variation's state held at u: per part one banded factor below its spectrum, each reading's special
-        modes removed by constraint rows (``BandedShiftInvert.lowest``)."""
+    def _readings(self, u, params, readings, pencil):
+        """(the part's reader, {held: its special modes' constraint rows or None}) per uncoupled part of the m-th
+        block, the variation's state held at u; ``pencil(H, G, name)`` makes a part's reader from its matrices in
+        lower band storage."""
         variation = self.variation
         variation._state(u, params)
         h = variation._nodes("azimuthal_hessian", params, m=float(self.m))
         hessian = self._local_matrices(h, self._rows)
         moments = self._mode_moments(params) if self.m == 1 else None
-        found = {held: [] for held in readings}
         for cls, dropped in self._parts():
             layout = self._layout(dropped)
-            H, G = layout.band(hessian), layout.band(self._gram_local)
-            guess = float(np.min(H[0] / G[0]))
-            shifted = BandedShiftInvert.below(H, G, guess, scale=max(1.0, abs(guess)))
-            if shifted is None:
-                raise np.linalg.LinAlgError(f"no shift below the spectrum of block m{self.m} from {guess:.4g}")
+            reader = pencil(layout.band(hessian), layout.band(self._gram_local), f"m{self.m}")
+            rows = {}
             for held in readings:
                 modes = [k for k in (excluded_modes(variation.eq, params, held) if self.m == 1 else ())
                          if cls is None or MODE_CLASS[k] == cls]
-                rows = np.array([layout.vector(moments[k]) for k in modes]) if modes else None
-                found[held].append(shifted.lowest(count, rows))
+                rows[held] = np.array([layout.vector(moments[k]) for k in modes]) if modes else None
+            yield reader, rows
+
+    def lowest_readings(self, u, params, count: int, readings=(True, False)) -> dict:
+        """{held: the ``count`` lowest eigenvalues} of the m-th block for each reading (held: True, free: False),
+        the variation's state held at u: per part one banded factor below its spectrum (``BandedShiftInvert.under``),
+        each reading's special modes removed by constraint rows (``BandedShiftInvert.lowest``)."""
+        found = {held: [] for held in readings}
+        for shifted, rows in self._readings(u, params, readings, BandedShiftInvert.under):
+            for held in readings:
+                found[held].append(shifted.lowest(count, rows[held]))
         return {held: merged_parts(values, count) for held, values in found.items()}
+
+    def positive_readings(self, u, params, readings=(True, False)) -> dict:
+        """{held: whether every eigenvalue of the m-th block is positive} for each reading, from the inertia alone
+        (``BandedSigns``: one banded Cholesky or LDLᵀ per part)."""
+        positive = {held: True for held in readings}
+        for signs, rows in self._readings(u, params, readings, lambda H, G, _: BandedSigns(H, G)):
+            for held in readings:
+                positive[held] = positive[held] and signs.positive(rows[held])
+        return positive
 
 
 def _azimuthal_ops(basis, m: int, x: np.ndarray, sin_theta: np.ndarray) -> np.ndarray:
