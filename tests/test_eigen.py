@@ -123,9 +123,11 @@ def test_one_shifted_factorisation_serves_the_constrained_and_updated_readings(c
         assert shifted.lowest(4, update=(update[0], -0.7)) is None
 
 
-def test_relatives_in_lockstep_are_each_alone_bit_for_bit():
+def test_relatives_in_lockstep_are_each_alone_to_the_solve_s_rounding():
     """The Lanczos runs of several relatives sharing each solve (one right-hand side of several columns) give every
-    relative exactly the numbers it gets alone, a refused one (a negative update) None among them."""
+    relative the numbers it gets alone to the shifted solve's rounding (ε‖A‖/dist(σ, spectrum), ‖A‖ = 1e6, the gap
+    0.9: a column solved among others may differ in its last bits from one solved alone, as the BLAS build blocks
+    them), a refused one (a negative update) None among them; the same call twice gives the same bits."""
     n = eigen.FOLLOWING_SIZE + 40
     A, _ = stiff_matrix(n, [-3.9, -0.2, 0.3, 0.3 + 1e-7, 0.5], 7)
     rng = np.random.default_rng(9)
@@ -138,9 +140,11 @@ def test_relatives_in_lockstep_are_each_alone_bit_for_bit():
                  (4, None, (u, -0.7)), (5, None, (u, 0.2))]
     together = shifted.lowest_of_relatives(relatives)
     assert together[4] is None
-    for relative, found in zip(relatives, together):
+    rounding = np.finfo(float).eps * 1e6 / 0.9
+    for relative, found, again in zip(relatives, together, shifted.lowest_of_relatives(relatives)):
         alone = shifted.lowest(*relative)
-        assert (found is None and alone is None) or np.array_equal(found, alone)
+        assert (found is None and alone is None) or np.abs(found - alone).max() <= rounding
+        assert (found is None and again is None) or np.array_equal(found, again)
 
 
 @pytest.mark.parametrize("n", [60, 140])

@@ -226,8 +226,10 @@ class ShiftInvert:
     def lowest_of_relatives(self, relatives, rcond: float = RCOND) -> list:
         """``lowest(count, constraints, update)`` of every (count, constraints, update) in ``relatives``, their
         Lanczos runs in lockstep: each step solves with the factor once for all of them (the columns of one
-        right-hand side: the factor, memory-bound to read, is read once instead of once per relative; LAPACK's
-        dpotrs gives each column the numbers it gives it alone), the rest of each run as alone."""
+        right-hand side: the factor, memory-bound to read, is read once instead of once per relative), the rest of
+        each run as alone. A column solved among others may differ from one solved alone in its last bits (whether
+        dpotrs blocks the columns is the BLAS build's choice), so the values agree with ``lowest``'s to the solve's
+        rounding, not always bit for bit; a run's own numbers are the same on every call."""
         operators = [self._relative(constraints, update, rcond) for _, constraints, update in relatives]
         runs = {k: _lanczos(self.size, count) for k, (count, _, _) in enumerate(relatives)
                 if operators[k] is not None}
