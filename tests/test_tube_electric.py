@@ -283,12 +283,3 @@ def test_a_tube_past_its_pull_in_voltage_has_no_start():
     assert "\n" not in str(error.value)
     reached = float(re.search(r"beyond (\S+) of electric.voltage = 1.5", str(error.value)).group(1))
     assert abs(reached - pull_in) <= 1e-5  # printed to 6 digits
-
-
-def test_a_voltage_continuation_on_a_capsule_is_refused_in_one_line():
-    """A tube is continued in the voltage (tests/test_tube_voltage.py); a capsule not yet."""
-    with pytest.raises(SceneError, match='^scene: continuation.parameter = "voltage": a capsule is continued in the '
-                                         "pressure only for now") as error:
-        parse_scene('[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = 4\n[electric]\n'
-                    '[continuation]\nparameter = "voltage"\npressure = 0.5\n')
-    assert "\n" not in str(error.value)
