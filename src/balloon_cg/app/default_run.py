@@ -4,7 +4,10 @@ For each default scene (SPOM1 at M = 0, and SPOM1 between the paper's two oppose
 files scenes/spom1.toml and scenes/spom1_two_coils_M0.002.toml, read as the package data balloon_cg.scenes,
 which pyproject.toml maps to the top-level scenes/, so that an installed package runs them too) the primary
 branch is traced and written to OUTDIR/<scene>.h5 (the scenes at once: each but the last, the longest, in a child
-process beside this one, whose workers get the cores a finished child frees), and every plot kind that applies is drawn as
+process beside this one, whose workers get the cores a finished child frees; a child, its scene written, compiles
+the last scene's whole-sphere kernels into numba's cache before drawing, so that on a first run this process
+finds them there when its surface branches start: model/compile_lock.py makes either wait for a kernel the other
+is compiling), and every plot kind that applies is drawn as
 OUTDIR/<scene>_<kind>.png. The pressure curves of all scenes together (several M in one figure) go to
 OUTDIR/all_<kind>.png. Existing files of these names are overwritten. A summary table closes the run; the
 exit code is 1 if a scene failed or its result is incomplete (analysis.verdict), else 0. ``--quick`` limits
@@ -20,6 +23,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..analysis.branches.tracer import ContinuationError
+from ..analysis.surface.branches import compile_kernels
 from ..analysis.verdict import failing, summary_line
 from ..io.output import replacing
 from .cli import run_scene
@@ -94,17 +98,19 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help=f"at most {QUICK_POINTS} points per leg (for tests)")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
     parser.add_argument("--only", choices=SCENES, help=argparse.SUPPRESS)  # one scene, nothing combined: a child's
+    parser.add_argument("--ahead", choices=SCENES, help=argparse.SUPPRESS)  # a child's: the scene it runs beside
     args = parser.parse_args(argv)
     outdir = Path(args.outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     scenes = default_scenes(QUICK_POINTS if args.quick else None)
     if args.only:  # a child's: its outcome as one JSON object on stdout
-        outcome = run_and_draw(next(s for s in scenes if s.name == args.only), outdir, args.quick, args.quiet)
+        named = {s.name: s for s in scenes}
+        outcome = run_and_draw(named[args.only], outdir, args.quick, args.quiet, named.get(args.ahead))
         print(json.dumps(outcome))
         return 1 if outcome["failure"] else 0
     *beside, last = scenes
-    children = [_started(scene.name, outdir, args.quick) for scene in beside]
+    children = [_started(scene.name, outdir, args.quick, last.name) for scene in beside]
     try:
         outcomes = [run_and_draw(last, outdir, args.quick, args.quiet)]
         for child in children:
@@ -134,14 +140,17 @@ def main(argv=None) -> int:
     return 1 if failed else 0
 
 
-def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool) -> dict:
+def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool, ahead=None) -> dict:
     """Analyse ``scene`` into outdir/<scene>.h5 and draw its figures: {'path': the run file (None when the trace
     failed), 'images': the figures' paths, 'failure': what failed, or None (a quick run's partial result is none)},
-    plain data (a child's is sent as JSON)."""
+    plain data (a child's is sent as JSON). ``ahead``: a scene another process runs, whose whole-sphere kernels
+    are compiled into numba's cache between the run file and the figures (a child's; module docstring)."""
     try:
         path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=shown(quiet))
     except ContinuationError as e:
         return {"path": None, "images": [], "failure": f"{scene.name}: {e}"}
+    if ahead is not None:
+        compile_kernels(ahead)
     return {"path": str(path), "images": [str(image) for image in draw_figures([path], outdir, scene.name)],
             "failure": f"{scene.name}: {summary_line(found)}" if failing(found) and not quick else None}
 
@@ -155,11 +164,12 @@ def _outcome(child: subprocess.Popen, out: str) -> dict:
         return {"path": None, "images": [], "failure": f"{child.args[-1]}: exit {child.returncode}"}
 
 
-def _started(name: str, outdir: Path, quick: bool) -> subprocess.Popen:
+def _started(name: str, outdir: Path, quick: bool, ahead: str) -> subprocess.Popen:
     """The default run of scene ``name`` alone, in a child process beside this one (no progress bars: this
-    process draws its own); its stdout (its outcome) and stderr captured."""
+    process draws its own), compiling scene ``ahead``'s whole-sphere kernels before its figures; its stdout (its
+    outcome) and stderr captured."""
     command = [sys.executable, "-m", "balloon_cg.app.default_run", str(outdir), "--quiet"] + (
-        ["--quick"] if quick else []) + ["--only", name]
+        ["--quick"] if quick else []) + ["--only", name, "--ahead", ahead]
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 

@@ -29,7 +29,7 @@ from importlib import resources
 
 import numpy as np
 
-from . import kernel_cache
+from . import compile_lock, kernel_cache
 from .compile_notice import announce_first_use
 from .. import generated
 from . import meridian
@@ -38,6 +38,7 @@ from ..scene.tables import Geometry, Shape
 from ..scene.validation import SceneError
 
 
+compile_lock.install()  # before any kernel runs (a computation picks its kernel set first): compiled once across processes
 PLAIN = ("pressure",)  # the terms of a class without coils or voltage
 
 

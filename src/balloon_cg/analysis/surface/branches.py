@@ -46,6 +46,7 @@ from ...surface.gauge import Gauge
 from ...surface.measures import MEASURES, measures, tail, tails
 from ...surface.system import SurfaceSystem
 from ..stability import azimuthal
+from ..branches.primary import start_parameters
 from ..branches.problem import continuation_settings, equilibrium_of
 from ..results import (Branch, Classification, Kind, Leg, Origin, SpecialPoint, Status, StopCode,
                       SurfaceBranch, TraceStop)
@@ -136,6 +137,22 @@ class SurfaceTrace:
         zero = transfer(self.basis, np.zeros(self.basis.size), to.basis)
         moved = transfer(self.basis, self.system.gauge.expand(t[:-1]), to.basis) - zero
         return np.append(to.gauge.reduce(moved), t[-1])
+
+
+def compile_kernels(scene) -> None:
+    """Compile into numba's on-disk cache the kernels the surface branches of a sphere ``scene`` call (its class's
+    whole-sphere kernels, the coil field, the Hessian's assembly, the gauge's reduction) by one residual, Jacobian,
+    energy and reduced Hessian of a trace at the reference sphere (c = 0) in a degree-2 basis: the kernels'
+    argument types, and so the signatures compiled, are those of any degree, symmetry or wire map (the default
+    run's child does this for the scene it runs beside: app/default_run.py)."""
+    params = start_parameters(scene, "P").with_value("M", scene.field.M)
+    trace = SurfaceTrace(scene, SphericalBasis(2, (MIRROR_Y,)), params)
+    c = np.zeros(trace.basis.size)
+    X = trace.system.point(c, params.P)
+    trace.system.residual(X)
+    trace.system.jacobian(X)
+    trace.eq.energy(c, params)
+    trace.gauge.reduce_matrix(trace.eq.hessian(c, params))
 
 
 def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
