@@ -31,6 +31,8 @@ COST = {  # CPU seconds of each file in one run of the default suite on 2 worker
     "test_fuzz": 6, "test_damaged_files": 6, "test_dask_cluster": 6, "test_tube_field": 6, "test_two_parameter": 6,
     "test_tube_control": 6, "test_surface_pitchforks": 5, "test_fold_curve": 5, "test_interval": 5, "test_schema": 5,
     "test_hostile_memory": 5,
+    # session 24's new files, from their helpers' serial runs at load ~20 (rough: only the order matters)
+    "test_tube_bulge_m1": 35, "test_graded_elements": 20, "test_capsule_frequencies": 10,
 }
 
 

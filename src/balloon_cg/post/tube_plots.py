@@ -84,7 +84,7 @@ def profiles(ax, run: dict, name: str, points=None) -> None:
     ``points`` (indices, negative from the end; default: PROFILES spread along the branch), coloured by V/V0."""
     b = run["branches"][name]
     disc = discretisation(run["attrs"])
-    chosen = _chosen(b, name, points, PROFILES)
+    chosen = _chosen(len(b["pressure"]), name, points, PROFILES)
     s = np.linspace(0, disc.length, 401)
     colours = matplotlib_colours(len(chosen))
     for colour, i in zip(colours, chosen):
@@ -101,7 +101,7 @@ def front_motion(ax, run: dict, name: str, points=None) -> None:
     position along the deformed axis from the branch's end η(0) (left axis) and its width (right axis), as
     tube_measures.front measures them; a branch whose profiles are all uniform has none (TubePlotError)."""
     b = run["branches"][name]
-    chosen = _chosen(b, name, points, len(b["pressure"]))
+    chosen = _chosen(len(b["pressure"]), name, points, len(b["pressure"]))
     _, deformed = fronts(discretisation(run["attrs"]), b["unknowns"][chosen])
     position, width = (np.array([getattr(f, key) for f in deformed]) for key in ("position", "width"))
     if np.isnan(position).all():
@@ -120,7 +120,7 @@ def stretch_profiles(ax, run: dict, name: str, points=None) -> None:
     end η(0), of branch ``name`` at ``points`` (default: STRETCHED spread along the branch), coloured by V/V0."""
     b = run["branches"][name]
     disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
-    chosen = _chosen(b, name, points, STRETCHED)
+    chosen = _chosen(len(b["pressure"]), name, points, STRETCHED)
     for colour, i in zip(matplotlib_colours(len(chosen)), chosen):
         u = b["unknowns"][i]
         axial, hoop = stretches(disc, u, s)
@@ -142,7 +142,7 @@ def critical_modes(ax, run: dict, name: str, points=None) -> None:
                if p["mode"] is not None]
     if not located:
         raise TubePlotError(f"--what modes: the {name} branch has no located m ≥ 1 zero with a stored mode")
-    chosen = _chosen({"pressure": located}, name, points, len(located))
+    chosen = _chosen(len(located), name, points, len(located))
     disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
     for colour, k in zip(matplotlib_colours(len(chosen)), chosen):
         m, p = located[k]
@@ -154,10 +154,9 @@ def critical_modes(ax, run: dict, name: str, points=None) -> None:
     ax.legend(fontsize=5)
 
 
-def _chosen(b: dict, name: str, points, count: int) -> np.ndarray:
-    """The point indices of branch ``b`` to draw: ``points`` (checked, negative from the end) or ``count`` spread
-    evenly along it."""
-    n = len(b["pressure"])
+def _chosen(n: int, name: str, points, count: int) -> np.ndarray:
+    """The indices of the ``n`` points (of branch ``name``, or its located zeros) to draw: ``points`` (checked,
+    negative from the end) or ``count`` spread evenly among them."""
     if points is not None and not len(points):
         raise TubePlotError(f"--points: none given for branch {name}")
     if points is None:
