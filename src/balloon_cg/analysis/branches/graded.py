@@ -21,21 +21,15 @@ from .resolution import Resolution
 @dataclass
 class GradedPoint:
     """The point X = (u, p) on its last basis with the row r moved there, each basis's (element degrees, element
-    tails) in order, the last Newton result (None: no basis past the first), and why the rounds ended."""
+    tails) in order, the last Newton result (None: no basis past the first), whether every group ended resolved, and why the rounds ended."""
 
     disc: Discretisation
     X: np.ndarray
     row: np.ndarray
     rounds: list
     result: NewtonResult | None
+    resolved: bool  # every element group's tail at most max_error on the last basis
     message: str
-
-    @property
-    def resolved(self) -> bool:
-        return self.message == RESOLVED
-
-
-RESOLVED = "every element group resolved"
 
 
 def graded_point(system_on, disc: Discretisation, X: np.ndarray, row: np.ndarray, policy: Resolution, tol: float,
@@ -46,12 +40,13 @@ def graded_point(system_on, disc: Discretisation, X: np.ndarray, row: np.ndarray
     first basis is the one wanted by ``ahead`` (given: the point past X on ``disc`` that was not resolved, so that
     the continuation from X can pass it), the others by X's own tails."""
     rounds = [(group_degrees(disc.degree, disc.joins, disc.element_degrees), disc.element_tails(X[:-1]))]
-    result, message = None, f"not resolved on {max_rounds} bases"
+    result, resolved, message = None, False, f"not resolved on {max_rounds} bases"
     for _ in range(max_rounds):
         read = X if ahead is None else ahead  # the point whose tails choose this round's degrees
         wanted, ahead = policy.element_degrees(disc, read[:-1]), None
         if wanted == rounds[-1][0]:
-            message = RESOLVED if disc.tail(read[:-1]) <= policy.max_error else (
+            resolved = disc.tail(read[:-1]) <= policy.max_error
+            message = "every element group resolved" if resolved else (
                 f"an element group above solver.max_error = {policy.max_error:g} at solver.max_degree = "
                 f"{policy.max_degree}")
             break
@@ -64,7 +59,7 @@ def graded_point(system_on, disc: Discretisation, X: np.ndarray, row: np.ndarray
             break
         disc, X, row = target, result.x, moved_row
         rounds.append((wanted, disc.element_tails(X[:-1])))
-    return GradedPoint(disc, X, row, rounds, result, message)
+    return GradedPoint(disc, X, row, rounds, result, resolved, message)
 
 
 def covering_basis(used: list) -> Discretisation:
