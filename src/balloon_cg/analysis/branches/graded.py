@@ -21,7 +21,8 @@ from .resolution import Resolution
 @dataclass
 class GradedPoint:
     """The point X = (u, p) on its last basis with the row r moved there, each basis's (element degrees, element
-    tails) in order, the last Newton result (None: no basis past the first), whether every group ended resolved, and why the rounds ended."""
+    tails) in order, the last Newton result (None: no basis past the first), whether every group ended resolved,
+    and why the rounds ended."""
 
     disc: Discretisation
     X: np.ndarray
