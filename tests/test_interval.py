@@ -114,6 +114,27 @@ def test_discrete_energy_and_residual_are_those_written_here(ends):
     assert eq.volume(u) == pytest.approx(-weights @ (0.5 * lam2**2 * slope), rel=1e-13)  # V/(2π)
 
 
+@pytest.mark.parametrize("ends", ["sliding", "plugged"])
+def test_crests_are_the_largest_radius_among_the_roots_of_its_slope(ends):
+    """The crest (IntervalDiscretisation.crests) of random non-uniform states, several at once and one alone, against
+    numpy's: the largest ρ among the ends and the real roots in [−1, 1] of ρ's derivative series (legroots, a
+    companion-matrix eigensolve), and η there from the series: S to 1e-9 L, η to 1e-10."""
+    L = 7.0
+    disc = IntervalDiscretisation(12, L, ends=ends)
+    rng = np.random.default_rng(5)
+    states = disc.reference() * 1.2 + 0.05 * rng.standard_normal((6, disc.size)) / (1 + np.arange(disc.size) % 13)
+    S, eta = disc.crests(states)
+    n, k = disc.degree, disc.axial_index
+    for u, s, h in zip(states, S, eta):
+        a = u[:k] if ends == "sliding" else bubble_series(n, u[:k]) + np.eye(n + 1)[0]
+        roots = legendre.legroots(legendre.legder(a))
+        x = np.concatenate([[-1.0, 1.0], roots[(abs(roots.imag) < 1e-12) & (abs(roots.real) <= 1)].real])
+        top = x[np.argmax(legendre.legval(x, a))]
+        assert abs(s - (top + 1) * L / 2) <= 1e-9 * L
+        assert abs(h - (-u[k] * L / 2 * top + legendre.legval(top, bubble_series(n, u[k + 1:])))) <= 1e-10
+        assert disc.crest(u) == (s, h)
+
+
 def uniform_balances(material):
     """(P(λθ, λz), N(λθ, λz)) of the uniform closed tube, derived here from the energy per 2π and unit reference
     length e = Φ(λz, λθ) − ½Pλθ²λz (``ogden`` above, differentiated by SymPy): ∂e/∂λθ = 0 is the hoop balance

@@ -241,8 +241,9 @@ def _write_crossings(group, found, size: int, coefficients: int) -> None:
 
 
 def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
-    """η of the largest radius of each state (IntervalDiscretisation.crest)."""
-    return np.array([disc.crest(u)[1] for u in states], dtype=float)
+    """η of the largest radius of each state (IntervalDiscretisation.crests)."""
+    states = np.asarray(states, dtype=float)
+    return disc.crests(states)[1] if len(states) else np.zeros(0)
 
 
 def _write_onset(group, curve) -> None:
