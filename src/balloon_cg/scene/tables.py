@@ -670,7 +670,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
-    geometry = _geometry(data.get("geometry", {}), field, electric)
+    geometry = _geometry(data.get("geometry", {}), field)
     dynamics = _dynamics(data.get("dynamics", {}))
     solver = _solver(data.get("solver", {}))
     if geometry.shape != Shape.TUBE and solver.tube_resolution != Solver.tube_resolution:
@@ -830,10 +830,9 @@ def _electric(data) -> Electric:
     return Electric(get("voltage", lambda x: 0 <= x <= MAX_VOLTAGE, f"in [0, {MAX_VOLTAGE:g}]"))
 
 
-def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
+def _geometry(data, field: Field) -> Geometry:
     """[geometry]: the shape, a spheroid's aspect, a tube's length and ends; the parts of the model that are written
-    for the sphere alone (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a
-    voltage) refuse other shapes here."""
+    for the sphere alone (the whole-sphere engine of coils off the axis) refuse other shapes here."""
     data = table("geometry", data, _keys(Geometry) + ("axial",))
     raw = data.get("shape")
     raw = Geometry.shape.value if raw is None else raw
@@ -851,7 +850,7 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     if shape == Shape.TUBE:
         return _tube(data, field)
     if shape == Shape.CAPSULE:
-        return _capsule(data, field, electric)
+        return _capsule(data, field)
     if shape == Shape.SPHERE:
         if data.get("aspect") is not None and data["aspect"] != 1:
             raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (the '
@@ -862,9 +861,6 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     where = f'geometry.shape = "{shape.value}"'
     _coaxial_outside(where, field, lambda coil: coil.radius**2 + (coil.height / aspect) ** 2,
                      f"the reference spheroid of aspect {aspect:g} (radius² + (height/aspect)²")
-    if electric is not None:
-        raise SceneError(f"{where}: the [electric] term starts from the sphere held by its voltage, which has no "
-                         'counterpart on another shape yet; leave [electric] out or use geometry.shape = "sphere"')
     return Geometry(shape, aspect)
 
 
@@ -894,7 +890,7 @@ def _length(data, shape: Shape, low: float) -> float:
                                                 f"in [{low:g}, {MAX_LENGTH:g}]")
 
 
-def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
+def _capsule(data, field: Field) -> Geometry:
     """A capsule's [geometry] (its cylinder's length, 0 the sphere, and its longest cylinder element), its coils
     (coaxial, outside it) and the parts of the model it does not have yet, refused one line each."""
     length = _length(data, Shape.CAPSULE, 0.0)
