@@ -8,11 +8,11 @@ variation is solved against the membrane's mass, H_odd q = ν M_odd q (M: uᵀMu
 scaling) and converges in the degree where the state does; a branch point of the odd block (a bifurcation into
 non-symmetric states: a bulge shifted towards one plug) is where ν changes sign. Printed per degree: the fold in P,
 the odd branch points primary_branch reports, the smallest ν along the branch and where (P, V/V0, its state's tail,
-first-integral spread and smallest principal stress: negative is compression, tube/stability.py), and ν at fixed
-V/V0 (the branch point nearest each target corrected onto V = target by Newton on (R_even, V − target)): the
-convergence table.
+first-integral spread and smallest principal stress: negative is compression, tube/stability.py), and ν where the middle's hoop stretch ρ(L/2) (the bulge's amplitude, past the fold) takes given values (the point
+of the branch before each corrected onto it by Newton on (R_even, ρ(L/2) − target)): the convergence table, and
+across lengths the bulge's distance from the plugs.
 
-    python benchmarks/plugged_odd_block.py [--preset SPOM1] [--length 20] [--axial-stretch 1.5] [--stop-stretch 4] [--degrees 40 60 80 120 160 200]
+    python benchmarks/plugged_odd_block.py [--preset SPOM1] [--length 20] [--axial-stretch 1.5] [--stop-stretch 6] [--degrees 40 60 80 120 160 200]
 """
 import argparse
 import os
@@ -40,29 +40,35 @@ def odd_eigenvalue(eq, mass, Y, params) -> float:
     return float(linalg.eigh(H, mass[np.ix_(odd, odd)], eigvals_only=True, subset_by_index=[0, 0])[0])
 
 
-def at_volume(eq, params, Y, target, tol=1e-12, iterations=30):
-    """Y = (u, P) on the mirror-symmetric branch with V/V0 = ``target``, by Newton on (R_even(u, P), V/V0 − target)
-    from Y (the held λ̄ fixed)."""
+def middle_row(disc) -> tuple:
+    """(r, c) with ρ(L/2) = r·u + c, the middle's hoop stretch (affine in u)."""
+    rho = lambda u: float(disc.radius(u[None, :], np.zeros(1))[0][0])
+    c = rho(np.zeros(disc.size))
+    return np.array([rho(e) - c for e in np.eye(disc.size)]), c
+
+
+def at_middle(eq, params, Y, target, tol=1e-12, iterations=30):
+    """Y = (u, P) on the mirror-symmetric branch whose middle hoop stretch ρ(L/2) is ``target`` (the bulge's
+    amplitude), by Newton on (R_even(u, P), ρ(L/2) − target) from Y (a held λ̄ fixed)."""
     disc = eq.disc
     index = disc.block(Mirror.EVEN)
     if disc.held:
         index = index[index != disc.axial_index]
+    row, offset = middle_row(disc)
     Y = Y.copy()
     for _ in range(iterations):
         at = params.with_value("P", Y[-1])
-        R = eq.residual(Y[:-1], at)[index]
-        dP = eq.parameter_derivative(Y[:-1], at, "P")
-        F = np.append(R, volume_ratio(eq, Y) - target)
+        F = np.append(eq.residual(Y[:-1], at)[index], row @ Y[:-1] + offset - target)
         if np.abs(F).max() < tol:
             return Y
         J = np.zeros((index.size + 1, index.size + 1))
         J[:-1, :-1] = eq.jacobian(Y[:-1], at)[np.ix_(index, index)]
-        J[:-1, -1] = dP[index]
-        J[-1, :-1] = -2 * dP[index] / disc.length  # V/V0 = 2 Ṽ/L, ∇Ṽ = −∂R/∂P
+        J[:-1, -1] = eq.parameter_derivative(Y[:-1], at, "P")[index]
+        J[-1, :-1] = row[index]
         step = np.linalg.solve(J, -F)
         Y[index] += step[:-1]
         Y[-1] += step[-1]
-    raise ArithmeticError(f"no state at V/V0 = {target:g}: |F| = {np.abs(F).max():.2e}")
+    raise ArithmeticError(f"no state with middle hoop stretch {target:g}: |F| = {np.abs(F).max():.2e}")
 
 
 def main() -> None:
@@ -70,10 +76,10 @@ def main() -> None:
     parser.add_argument("--preset", default="SPOM1")
     parser.add_argument("--length", type=float, default=20.0)
     parser.add_argument("--axial-stretch", type=float, default=None)
-    parser.add_argument("--stop-stretch", type=float, default=4.0)
+    parser.add_argument("--stop-stretch", type=float, default=6.0)
     parser.add_argument("--step-max", type=float, default=0.1)
     parser.add_argument("--degrees", type=int, nargs="+", default=[40, 60, 80, 120, 160, 200])
-    parser.add_argument("--volumes", type=float, nargs="+", default=[1.5, 2.0, 3.0, 4.0, 6.0, 8.0])
+    parser.add_argument("--middle", type=float, nargs="+", default=[2.0, 3.0, 4.0, 5.0, 6.0])
     args = parser.parse_args()
     held = "" if args.axial_stretch is None else f"axial_stretch = {args.axial_stretch}\n"
     print(f"{args.preset} tube, plugged, L = {args.length:g}, {'closed' if not held else f'held at {args.axial_stretch:g}'}, "
@@ -90,7 +96,8 @@ def main() -> None:
         nu = np.array([odd_eigenvalue(eq, mass, Y, branch.params) for Y in Ys])
         low = int(np.argmin(nu))
         folds = [f"{s.pressure:.10f}" for s in branch.special if s.kind.value == "LP"]
-        odd = [f"P {s.pressure:.6f} V/V0 {volume_ratio(eq, np.append(s.u, s.pressure)):.4f}"
+        odd = [f"P {s.pressure:.6f} V/V0 {volume_ratio(eq, np.append(s.u, s.pressure)):.4f} (stress "
+               f"{s.smallest_stress:.2g}, tail {branch.disc.tail(s.u):.0e}, H {first_integral_spread(eq, s.u):.0e})"
                for s in branch.branch_points(Mirror.ODD)]
         print(f"\ndegree {degree}: {len(Ys)} points, stop: {branch.stop.message}; LP at P = {', '.join(folds)}; "
               f"odd BPs reported: {'; '.join(odd) or 'none'}; sign changes of nu: {int(np.sum(np.diff(np.sign(nu)) != 0))}")
@@ -99,22 +106,24 @@ def main() -> None:
               f"{branch.disc.tail(Y[:-1]):.1e}, H spread {first_integral_spread(eq, Y[:-1]):.1e}, smallest stress "
               f"{smallest_stress(eq, Y[:-1]):.3g}")
         row = {}
-        for target in args.volumes:
-            if not branch.volume.min() <= target <= branch.volume.max():
+        middle, offset = middle_row(branch.disc)
+        amplitude = branch.states @ middle + offset
+        for target in args.middle:
+            crossing = np.flatnonzero((amplitude[:-1] - target) * (amplitude[1:] - target) <= 0)
+            if crossing.size == 0 or crossing[0] < np.argmax(branch.pressure):  # past the fold: the bulge's
                 continue
-            near = int(np.argmin(np.abs(branch.volume - target)))
-            Yv = at_volume(eq, branch.params, Ys[near], target)
-            row[target] = (Yv[-1], odd_eigenvalue(eq, mass, Yv, branch.params), branch.disc.tail(Yv[:-1]),
-                           smallest_stress(eq, Yv[:-1]), first_integral_spread(eq, Yv[:-1]))
+            Yv = at_middle(eq, branch.params, Ys[crossing[0]], target)
+            row[target] = (Yv[-1], volume_ratio(eq, Yv), odd_eigenvalue(eq, mass, Yv, branch.params),
+                           branch.disc.tail(Yv[:-1]), smallest_stress(eq, Yv[:-1]), first_integral_spread(eq, Yv[:-1]))
         table[degree] = row
         print(f"  CPU {time.process_time() - start:.1f} s")
-    print("\nnu_odd (mass-normalised lowest odd eigenvalue) at fixed V/V0: P | nu | tail | smallest stress | H spread")
-    for target in args.volumes:
-        cells = [f"{degree}: " + ("-" if target not in row else
-                                  f"P {row[target][0]:.9f} nu {row[target][1]:+.6e} tail {row[target][2]:.0e} "
-                                  f"stress {row[target][3]:.2g} H {row[target][4]:.0e}")
-                 for degree, row in table.items()]
-        print(f"V/V0 {target:g}:\n    " + "\n    ".join(cells))
+    print("\nnu_odd (the lowest odd eigenvalue against the mass) past the fold where the middle's hoop stretch is "
+          "rho(L/2): P | V/V0 | nu | tail | smallest stress | H spread")
+    for target in args.middle:
+        cells = [f"{degree:4d}: " + ("-" if target not in row else
+                                     "P {:.10f}  V/V0 {:.6f}  nu {:+.6e}  tail {:.0e}  stress {:.3g}  H {:.0e}".format(
+                                         *row[target])) for degree, row in table.items()]
+        print(f"rho(L/2) = {target:g}:\n    " + "\n    ".join(cells))
 
 
 if __name__ == "__main__":
