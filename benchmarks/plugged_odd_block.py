@@ -116,6 +116,9 @@ def main() -> None:
             row[target] = (Yv[-1], volume_ratio(eq, Yv), odd_eigenvalue(eq, mass, Yv, branch.params),
                            branch.disc.tail(Yv[:-1]), smallest_stress(eq, Yv[:-1]), first_integral_spread(eq, Yv[:-1]))
         table[degree] = row
+        for target, values in row.items():
+            print(f"  rho(L/2) = {target:g}: " + "P {:.10f}  V/V0 {:.6f}  nu {:+.6e}  tail {:.0e}  stress {:.3g}  "
+                  "H {:.0e}".format(*values))
         print(f"  CPU {time.process_time() - start:.1f} s")
     print("\nnu_odd (the lowest odd eigenvalue against the mass) past the fold where the middle's hoop stretch is "
           "rho(L/2): P | V/V0 | nu | tail | smallest stress | H spread")

@@ -157,6 +157,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
+    from ..tube.bulge import PLUGGED_WHY
     from ..tube.picture import branch_name, bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
 
@@ -187,7 +188,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:
         raise UsageError(f"continue {args.run}: the bulge branch is switched on sliding ends, not "
-                         f"{scene.geometry.ends.value}")
+                         f"{scene.geometry.ends.value}: {PLUGGED_WHY}")
     name, k, _ = labels[args.label]
     primary = stored_branch(run, "primary", scene_parameters(scene))
     point = primary.special[k]
