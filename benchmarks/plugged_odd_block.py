@@ -1,18 +1,20 @@
 """Does a plugged tube's mirror-symmetric branch bifurcate into a non-symmetric one? The lowest eigenvalue of its odd
 block along the branch, against the degree.
 
-A closed tube (SPOM1 or ``--preset``) with plugged ends (ρ = 1 there; optionally held at ``--axial-stretch``) is traced in P on its
-mirror-symmetric states (tube/primary.primary_branch) at each degree. At every point the odd block of the second
-variation is solved against the membrane's mass, H_odd q = ν M_odd q (M: uᵀMu = ∫(δρ² + δη²) dS, dynamics/tube.py's
-``tube_mass``), so that ν is a property of the continuous problem (the raw eigenvalues of H depend on the basis's
-scaling) and converges in the degree where the state does; a branch point of the odd block (a bifurcation into
-non-symmetric states: a bulge shifted towards one plug) is where ν changes sign. Printed per degree: the fold in P,
-the odd branch points primary_branch reports, the smallest ν along the branch and where (P, V/V0, its state's tail,
-first-integral spread and smallest principal stress: negative is compression, tube/stability.py), and ν where the middle's hoop stretch ρ(L/2) (the bulge's amplitude, past the fold) takes given values (the point
-of the branch before each corrected onto it by Newton on (R_even, ρ(L/2) − target)): the convergence table, and
-across lengths the bulge's distance from the plugs.
+A closed tube (SPOM1 or ``--preset``) with plugged ends (ρ = 1 there; held apart with ``--axial-stretch``) is traced
+in P on its mirror-symmetric states (tube/primary.primary_branch) at each degree. At every point the odd block of the
+second variation is solved against the membrane's mass, H_odd q = ν M_odd q (M: uᵀMu = ∫(δρ² + δη²) dS,
+dynamics/tube.py's ``tube_mass``), so that ν is a property of the continuous problem (the raw eigenvalues of H depend
+on the basis's scaling) and converges in the degree where the state does; a branch point of the odd block (a
+bifurcation into non-symmetric states: a bulge shifted towards one plug) is where ν changes sign. Printed per degree:
+the fold in P, the odd branch points primary_branch reports, the smallest ν along the branch and where (P, V/V0, its
+state's tail, first-integral spread and smallest principal stress: negative is compression, tube/stability.py), and
+ν where the middle's hoop stretch ρ(L/2) (the bulge's amplitude, past the fold) takes given values (the point of the
+branch before each corrected onto it by Newton on (R_even, ρ(L/2) − target)): the convergence table, and across
+lengths the bulge's distance from the plugs.
 
-    python benchmarks/plugged_odd_block.py [--preset SPOM1] [--length 20] [--axial-stretch 1.5] [--stop-stretch 6] [--degrees 40 60 80 120 160 200]
+    python benchmarks/plugged_odd_block.py [--preset SPOM1] [--length 20] [--axial-stretch 1.5] [--stop-stretch 6]
+        [--degrees 40 60 80 120 160 200] [--middle 2 3 4 5 6]
 """
 import argparse
 import os
@@ -82,13 +84,14 @@ def main() -> None:
     parser.add_argument("--middle", type=float, nargs="+", default=[2.0, 3.0, 4.0, 5.0, 6.0])
     args = parser.parse_args()
     held = "" if args.axial_stretch is None else f"axial_stretch = {args.axial_stretch}\n"
-    print(f"{args.preset} tube, plugged, L = {args.length:g}, {'closed' if not held else f'held at {args.axial_stretch:g}'}, "
-          f"to a hoop stretch of {args.stop_stretch:g} (step_max {args.step_max:g}); load {os.getloadavg()}")
+    ends = "closed" if not held else f"held at {args.axial_stretch:g}"
+    print(f"{args.preset} tube, plugged, L = {args.length:g}, {ends}, to a hoop stretch of {args.stop_stretch:g} "
+          f"(step_max {args.step_max:g}); load {os.getloadavg()}")
     table = {}
     for degree in args.degrees:
         start = time.process_time()
-        scene = parse_scene(SCENE.format(preset=args.preset, length=args.length, held=held, degree=degree, stop=args.stop_stretch,
-                                         step=args.step_max))
+        scene = parse_scene(SCENE.format(preset=args.preset, length=args.length, held=held, degree=degree,
+                                         stop=args.stop_stretch, step=args.step_max))
         branch = primary_branch(scene, degree)
         eq = Equilibrium(scene, branch.disc)
         mass = tube_mass(eq)
@@ -100,7 +103,8 @@ def main() -> None:
                f"{s.smallest_stress:.2g}, tail {branch.disc.tail(s.u):.0e}, H {first_integral_spread(eq, s.u):.0e})"
                for s in branch.branch_points(Mirror.ODD)]
         print(f"\ndegree {degree}: {len(Ys)} points, stop: {branch.stop.message}; LP at P = {', '.join(folds)}; "
-              f"odd BPs reported: {'; '.join(odd) or 'none'}; sign changes of nu: {int(np.sum(np.diff(np.sign(nu)) != 0))}")
+              f"odd BPs reported: {'; '.join(odd) or 'none'}; sign changes of nu: "
+              f"{int(np.sum(np.diff(np.sign(nu)) != 0))}")
         Y = Ys[low]
         print(f"  smallest nu {nu[low]:.6e} at point {low}: P {Y[-1]:.6f}, V/V0 {branch.volume[low]:.4f}, tail "
               f"{branch.disc.tail(Y[:-1]):.1e}, H spread {first_integral_spread(eq, Y[:-1]):.1e}, smallest stress "
