@@ -18,10 +18,11 @@ lengths the bulge's distance from the plugs.
 """
 import argparse
 import os
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
-from scipy import linalg
 
 from balloon_cg.dynamics.tube import tube_mass
 from balloon_cg.galerkin.equilibrium import Equilibrium
@@ -31,46 +32,8 @@ from balloon_cg.tube.accuracy import first_integral_spread
 from balloon_cg.tube.primary import primary_branch, volume_ratio
 from balloon_cg.tube.stability import smallest_stress
 
-SCENE = ('[material]\npreset = "{preset}"\n[geometry]\nshape = "tube"\nlength = {length}\nends = "plugged"\n{held}'
-         "[solver]\ndegree = {degree}\n[continuation]\nstop_stretch = {stop}\nstep_max = {step}\nmax_points = 5000\n")
-
-
-def odd_eigenvalue(eq, mass, Y, params) -> float:
-    """The lowest ν of H_odd q = ν M_odd q at Y = (u, P)."""
-    odd = eq.disc.block(Mirror.ODD)
-    H = eq.jacobian(Y[:-1], params.with_value("P", Y[-1]))[np.ix_(odd, odd)]
-    return float(linalg.eigh(H, mass[np.ix_(odd, odd)], eigvals_only=True, subset_by_index=[0, 0])[0])
-
-
-def middle_row(disc) -> tuple:
-    """(r, c) with ρ(L/2) = r·u + c, the middle's hoop stretch (affine in u)."""
-    rho = lambda u: float(disc.radius(u[None, :], np.zeros(1))[0][0])
-    c = rho(np.zeros(disc.size))
-    return np.array([rho(e) - c for e in np.eye(disc.size)]), c
-
-
-def at_middle(eq, params, Y, target, tol=1e-12, iterations=30):
-    """Y = (u, P) on the mirror-symmetric branch whose middle hoop stretch ρ(L/2) is ``target`` (the bulge's
-    amplitude), by Newton on (R_even(u, P), ρ(L/2) − target) from Y (a held λ̄ fixed)."""
-    disc = eq.disc
-    index = disc.block(Mirror.EVEN)
-    if disc.held:
-        index = index[index != disc.axial_index]
-    row, offset = middle_row(disc)
-    Y = Y.copy()
-    for _ in range(iterations):
-        at = params.with_value("P", Y[-1])
-        F = np.append(eq.residual(Y[:-1], at)[index], row @ Y[:-1] + offset - target)
-        if np.abs(F).max() < tol:
-            return Y
-        J = np.zeros((index.size + 1, index.size + 1))
-        J[:-1, :-1] = eq.jacobian(Y[:-1], at)[np.ix_(index, index)]
-        J[:-1, -1] = eq.parameter_derivative(Y[:-1], at, "P")[index]
-        J[-1, :-1] = row[index]
-        step = np.linalg.solve(J, -F)
-        Y[index] += step[:-1]
-        Y[-1] += step[-1]
-    raise ArithmeticError(f"no state with middle hoop stretch {target:g}: |F| = {np.abs(F).max():.2e}")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from test_plugged_bifurcation import SCENE, odd_eigenvalue, past_the_fold  # noqa: E402
 
 
 def main() -> None:
@@ -110,13 +73,10 @@ def main() -> None:
               f"{branch.disc.tail(Y[:-1]):.1e}, H spread {first_integral_spread(eq, Y[:-1]):.1e}, smallest stress "
               f"{smallest_stress(eq, Y[:-1]):.3g}")
         row = {}
-        middle, offset = middle_row(branch.disc)
-        amplitude = branch.states @ middle + offset
         for target in args.middle:
-            crossing = np.flatnonzero((amplitude[:-1] - target) * (amplitude[1:] - target) <= 0)
-            if crossing.size == 0 or crossing[0] < np.argmax(branch.pressure):  # past the fold: the bulge's
+            Yv = past_the_fold(eq, branch, target)
+            if Yv is None:
                 continue
-            Yv = at_middle(eq, branch.params, Ys[crossing[0]], target)
             row[target] = (Yv[-1], volume_ratio(eq, Yv), odd_eigenvalue(eq, mass, Yv, branch.params),
                            branch.disc.tail(Yv[:-1]), smallest_stress(eq, Yv[:-1]), first_integral_spread(eq, Yv[:-1]))
         table[degree] = row
