@@ -15,7 +15,7 @@ from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model.sphere import sphere_pressure
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import load_scene, parse_scene
-from balloon_cg.surface import ladder, stability
+from balloon_cg.surface import stability
 from balloon_cg.surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
 from balloon_cg.surface.embedding import axisymmetric_coefficients, displacement_coefficients, mode_coefficients
 from balloon_cg.surface.equilibrium import SurfaceEquilibrium
@@ -695,44 +695,3 @@ def test_a_sub_basis_reads_upper_bounds_from_the_principal_submatrix(spom1):
         assert any(np.abs(bounds[r][key] - whole[r][key]).max() > 1e-6 for r in readings)
     with pytest.raises(ValueError, match="degree = 20, order = 4"):
         stability.sub_basis(basis, 20, 4)
-
-
-@pytest.fixture(scope="module")
-def smooth_state(spom1):
-    """A basis of degree 24 and order 8, a smooth deformed state on it (an inflated sphere plus harmonics of
-    geometrically decaying amplitude: its lowest modes converge within 1e-9 a few rungs below the sector) and
-    spom1's parameters at stretch 1.3."""
-    _, _, params = sphere(spom1, 1.3, 8)
-    basis = SphericalBasis(24, (MIRROR_Y, EQUATOR), order=8)
-    rng = np.random.default_rng(2)
-    decay = np.array([0.15 ** (l + b.m) for b in basis.blocks for l in b.degrees])
-    c = displacement_coefficients(basis, 0.3 * basis.nodes["reference"][:3]) + 0.02 * decay * rng.standard_normal(
-        basis.size)
-    return SurfaceEquilibrium(spom1, basis), c, params
-
-
-def test_the_ladder_reads_each_sector_on_a_rung_within_the_unchanged_rule(smooth_state, monkeypatch):
-    """``surface.ladder`` (its following size lowered to this basis' sectors): at a smooth state every value of every
-    reading is within 1e-9·max(1, |μ|) of the sector's own read, on a rung below the sector (the ladder was used);
-    at a rough state (coefficients of equal size up to the truncation) the rungs disagree and the ladder climbs
-    to the sector itself: its values are the sector's read, bit for bit."""
-    monkeypatch.setattr(ladder.eigen, "FOLLOWING_SIZE", 100)
-    eq, c, params = smooth_state
-    readings, keys = stability.READINGS, tuple(s.characters for s in eq.basis.sectors())
-    guesses = stability.sector_spectra(eq, c, params, 4, readings)
-    whole = stability.sector_spectra(eq, c, params, 4, readings, guesses)
-    rungs = {}
-    found = ladder.sector_spectra(eq, c, params, 4, readings, guesses, keys, rungs)
-    for r in readings:
-        for key in keys:
-            assert np.abs(found[r][key] - whole[r][key]).max() <= 1e-9 * max(1.0, np.abs(whole[r][key]).max())
-    assert max(rungs.values()) > 0
-    rough = c + 1e-3 * np.random.default_rng(3).standard_normal(c.size)
-    guesses = stability.sector_spectra(eq, rough, params, 4, readings)
-    whole = stability.sector_spectra(eq, rough, params, 4, readings, guesses)
-    rungs = {}
-    found = ladder.sector_spectra(eq, rough, params, 4, readings, guesses, keys, rungs)
-    assert set(rungs.values()) == {0}
-    for r in readings:
-        for key in keys:
-            assert np.array_equal(found[r][key], whole[r][key])

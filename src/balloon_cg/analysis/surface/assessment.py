@@ -12,7 +12,7 @@ import numpy as np
 
 from ...numerics import continuation, eigen, interrupt, workers
 from ...numerics.newton import newton
-from ...surface import ladder, stability as surface_stability
+from ...surface import stability as surface_stability
 from ...surface.embedding import transfer
 from ...surface.equilibrium import SurfaceEquilibrium
 from ..results import Kind, SpecialPoint, Status, SurfaceBranch
@@ -142,14 +142,13 @@ def fed(stream: workers.Stream):
 def _reader(scene, params, parameter: str, readings, equilibria: dict):
     """make(keys) -> read((basis, c, value)) -> (spectra, negative held counts) of the sectors ``keys`` at one
     point, the points given in the branch's order, each sector following its own spectra at the previous point
-    and read on the sub-basis it needs (``surface.ladder``, its rung following the previous point's; at the first
-    point it solves dense on the whole sector). ``equilibria``: {basis:
+    (``surface.stability.sector_spectra``; at the first point it solves dense). ``equilibria``: {basis:
     SurfaceEquilibrium} known (others are built once). The groups of sectors go to every core
     (``numerics.workers``): a sector's numbers are those of a serial reading of all of them."""
     held = surface_stability.Reading(True)
 
     def make(keys: tuple):
-        spectra, rungs = None, {}
+        spectra = None
 
         def read(item):
             nonlocal spectra
@@ -158,7 +157,8 @@ def _reader(scene, params, parameter: str, readings, equilibria: dict):
             if basis not in equilibria:
                 equilibria[basis] = SurfaceEquilibrium(scene, basis)
             eq, at = equilibria[basis], params.with_value(parameter, value)
-            spectra = ladder.sector_spectra(eq, c, at, spectrum_count(scene), readings, spectra, keys, rungs)
+            spectra = surface_stability.sector_spectra(eq, c, at, spectrum_count(scene), readings, guesses=spectra,
+                                                       only=keys)
             return spectra, _negative_counts(eq, c, at, spectra[held])
         return read
     return make
