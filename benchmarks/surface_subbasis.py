@@ -10,9 +10,10 @@ oracle: what a perfect choice would cost); ``nested``: it and the next finer one
 convergence by two nested sub-bases costs). The guess each read follows: the dense lowest μ of the (L/2, M/2)
 sub-basis (an upper bound), the same for every read of a sector.
 
-    BALLOON_CG_WORKERS=1 python benchmarks/surface_subbasis.py > benchmarks/results/surface_subbasis.txt
+    BALLOON_CG_WORKERS=1 python benchmarks/surface_subbasis.py [POINT ...] > benchmarks/results/surface_subbasis.txt
 """
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -56,7 +57,7 @@ def deviation(found: dict, full: dict) -> float:
     return max(float(np.max(np.abs(found[r] - full[r]) / np.maximum(1.0, np.abs(full[r])))) for r in full)
 
 
-def main():
+def main(points=POINTS):
     scene = load_scene(SCENE)
     traced, values, params0 = traced_branch(scene)
     print(f"# {SCENE.name}: m = 1 branch, {len(traced)} points; load average before the reads "
@@ -64,7 +65,7 @@ def main():
     print(f"{'point':>5} {'sector':>9} {'L,M':>6} {'n':>5} {'full s':>7}   " +
           "   ".join(f"{'k=' + str(k) + ' n':>7} {'dev':>8} {'cpu':>5}" for k in RUNGS) + "   needed  nested")
     totals = {"full": 0.0, "needed": 0.0, "nested": 0.0}
-    for i in POINTS:
+    for i in points:
         trace, c = traced[i]
         eq, params = trace.eq, params0.with_value("P", values[i])
         for sector in trace.basis.sectors():
@@ -101,4 +102,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    main(tuple(int(a) for a in sys.argv[1:]) or POINTS)
