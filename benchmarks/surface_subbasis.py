@@ -10,6 +10,12 @@ oracle: what a perfect choice would cost); ``nested``: it and the next finer one
 convergence by two nested sub-bases costs). The guess each read follows: the dense lowest μ of the (L/2, M/2)
 sub-basis (an upper bound), the same for every read of a sector.
 
+Then, at the last point given, a check without a second read: for the held reading under pressure control of each
+sector on rungs 2 and 4, the residual r of each Ritz pair (μ, y) on the whole sector (its zero modes projected out),
+and the estimate |r|²/(λ_rest − μ), λ_rest the lowest eigenvalue of the sector's block outside the rung (the second
+order Rayleigh–Ritz error where the unresolved part is stiff), against the error μ − μ_sector (dense solves on
+explicit null spaces: a study, not an implementation; |r| would come from ``SurfaceEquilibrium.hessian_product``).
+
     BALLOON_CG_WORKERS=1 python benchmarks/surface_subbasis.py [POINT ...] > benchmarks/results/surface_subbasis.txt
 """
 import os
@@ -18,6 +24,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy import linalg
 
 from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.surface import branches
@@ -55,6 +62,35 @@ def read(eq, c, params, key, guesses, within=None) -> tuple:
 def deviation(found: dict, full: dict) -> float:
     """max |μ_sub − μ| / max(1, |μ|) over the readings' values."""
     return max(float(np.max(np.abs(found[r] - full[r]) / np.maximum(1.0, np.abs(full[r])))) for r in full)
+
+
+def residual_study(eq, c, params, sector) -> None:
+    """Prints, for rungs 2 and 4 of ``sector``, the held pressure reading's error and residual estimate (module
+    docstring)."""
+    fields = stability.zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"],
+                                        stability.field_symmetry(eq, params), True)
+    with blas_threads():
+        A = eq.hessian(c, params, sector) / sector.gram()
+        Z = stability.mode_rows(sector, fields)
+        Q, N = linalg.orth(Z.T), linalg.null_space(Z)
+        exact = linalg.eigh(N.T @ A @ N, eigvals_only=True, subset_by_index=[0, COUNT - 1])
+        blocks = {(b.component, b.m, b.t): b for b in sector.blocks}
+        for k in (2, 4):
+            sub = stability.sub_basis(sector, sector.degree - 4 * k, sector.order - k)
+            index = np.concatenate([blocks[b.component, b.m, b.t].offset
+                                    + np.searchsorted(blocks[b.component, b.m, b.t].degrees, b.degrees)
+                                    for b in sub.blocks])
+            N1 = linalg.null_space(Z[:, index])
+            mu, W = linalg.eigh(N1.T @ A[np.ix_(index, index)] @ N1, subset_by_index=[0, COUNT - 1])
+            Y = np.zeros((A.shape[0], COUNT))
+            Y[index] = N1 @ W
+            R = A @ Y - Y * mu
+            r = np.linalg.norm(R - Q @ (Q.T @ R), axis=0)
+            rest = np.setdiff1d(np.arange(A.shape[0]), index)
+            stiff = linalg.eigh(A[np.ix_(rest, rest)], eigvals_only=True, subset_by_index=[0, 0])[0]
+            print(f"  {str(sector.characters):>9} k={k} n={sub.size:>5}  error " + " ".join(f"{e:8.1e}" for e in mu - exact)
+                  + "   |r|²/(λ_rest − μ) " + " ".join(f"{e:8.1e}" for e in r ** 2 / (stiff - mu))
+                  + f"   λ_rest {stiff:.0f}", flush=True)
 
 
 def main(points=POINTS):
@@ -99,6 +135,12 @@ def main(points=POINTS):
     print(f"# CPU over these points: full {totals['full']:.1f} s, the needed sub-basis {totals['needed']:.1f} s "
           f"({totals['needed'] / totals['full']:.2f}x), the nested pair {totals['nested']:.1f} s "
           f"({totals['nested'] / totals['full']:.2f}x); load average after {os.getloadavg()[0]:.1f}")
+    trace, c = traced[points[-1]]
+    print(f"# point {points[-1]}: the held reading under pressure control on rungs 2 and 4, its error against the "
+          "sector's and the residual estimate")
+    for sector in trace.basis.sectors():
+        if sector.size:
+            residual_study(trace.eq, c, params0.with_value("P", values[points[-1]]), sector)
 
 
 if __name__ == "__main__":
