@@ -41,6 +41,8 @@ from balloon_cg.tube.picture import tube_picture
 from balloon_cg.tube.primary import discretisation
 from balloon_cg.tube.stability import COMPRESSED
 
+from shared_pictures import first_bulge_picture
+
 SPOM1 = ((3.00508, 0.0145, -0.0177), (1.3, 4.0, -2.0))  # (μ_i, α_i), Σ μ_i α_i = 4
 COUNT = 6
 
@@ -121,9 +123,11 @@ def test_closed_tube_odd_modes_are_the_uniform_cylinders_vibrations(hoop):
 
 @pytest.fixture(scope="module")
 def tube_run():
-    """tube_spom1_L10 with [dynamics] frequencies (count 6): the picture with_frequencies and its frequencies."""
+    """tube_spom1_L10 with [dynamics] frequencies (count 6): its primary and bulge branches (``run``'s, without the
+    branches switched at the later branch points: shared_pictures.first_bulge_picture) with_frequencies, and their
+    frequencies."""
     scene = load_scene("tube_spom1_L10").with_overrides({"dynamics.frequencies": True, "dynamics.count": COUNT})
-    picture = with_frequencies(scene, tube_picture(scene))
+    picture = with_frequencies(scene, first_bulge_picture(scene))
     return scene, picture, picture.frequencies
 
 
