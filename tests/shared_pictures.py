@@ -93,8 +93,8 @@ def first_bulge_picture(scene):
     """``tube_picture(scene)`` asking for less: the primary branch and the branch switched at its first branch point
     alone ("bulge", the first odd one on sliding ends), with Maxwell's pressure and the m ≥ 1 blocks; both branches
     those of the whole picture number for number (``bulge_picture`` switches its labels in order). For tests that
-    read the primary and the bulge branch, not the switching at the later branch points (the shipped tube_spom1_L10:
-    2.4 s of CPU against the whole picture's 5.9 s, its natural frequencies 17.3 s against 72.2 s, loaded machine)."""
+    read the primary and the bulge branch, not the switching at the later branch points (which tube/picture.py does
+    at every one: the shipped tube_spom1_L10 has 8 branches)."""
     from balloon_cg.tube.picture import bulge_picture, maxwell, switchable
     from balloon_cg.tube.primary import primary_branch
 
