@@ -1,8 +1,8 @@
 """Benchmark: where the banded sibling of the stability blocks (analysis/stability/banded.py) starts to win over the
 dense Legendre blocks, per perturbation degree N: the assessment (every block's lowest eigenvalues, m = 0 and m = 1,
 held and free: ``SecondVariation.assess``) and the flags alone (``SecondVariation.flags``: the inertia, what a point's
-check at its check degree reads), each dense (stability.banded_from = 0) and banded (banded_from = 20) at the same
-points and degrees (issue 37; the key ``stability.banded_from`` and the check's ``banded_signs_from``).
+check at its check degree reads), each dense (stability.banded_from = banded_flags_from = 0) and banded (both 20) at
+the same points and degrees (issue 37: the defaults of those two keys).
 
 Points: the paper coil's branches (the whole picture analysed once, surface branches off, to reach them): pear_free_2
 and pear_0 (general states on their wire maps, held and free readings) and the primary branch (equator-symmetric),
@@ -49,9 +49,9 @@ def main() -> None:
             branch = next(b for b in picture.branches if b.name == name)
             symmetric = branch.disc.symmetric
             points = np.linspace(0, len(branch.X) - 1, POINTS).round().astype(int)
-            variants = {key: replace(branch, scene=scene.with_overrides({"stability.banded_from": start},
-                                                                        name=scene.name))
-                        for key, start in (("dense", 0), ("banded", 20))}
+            variants = {key: replace(branch, scene=scene.with_overrides(
+                {"stability.banded_from": start, "stability.banded_flags_from": start}, name=scene.name))
+                for key, start in (("dense", 0), ("banded", 20))}
             for degree in degrees:
                 variations = {key: SecondVariation(equilibrium_of(b), degree) for key, b in variants.items()}
                 X = branch.X[points[0]]
