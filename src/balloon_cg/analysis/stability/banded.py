@@ -189,9 +189,11 @@ class BlockLayout:
         self._vector, self._indices = kept.ravel(), dofs[kept]
 
     def band(self, local: np.ndarray) -> np.ndarray:
-        """The assembled symmetric matrix in lower band storage, (bandwidth + 1, size)."""
-        return np.bincount(self._positions, weights=local.ravel()[self._matrix],
-                           minlength=(self.bandwidth + 1) * self.size).reshape(self.bandwidth + 1, self.size)
+        """The assembled symmetric matrix in lower band storage, (bandwidth + 1, size), in Fortran order (LAPACK's:
+        scipy's band routines copy any other array on every call)."""
+        return np.asfortranarray(np.bincount(self._positions, weights=local.ravel()[self._matrix],
+                                             minlength=(self.bandwidth + 1) * self.size).reshape(self.bandwidth + 1,
+                                                                                                  self.size))
 
     def vector(self, local: np.ndarray) -> np.ndarray:
         return np.bincount(self._indices, weights=local.ravel()[self._vector], minlength=self.size)
