@@ -236,13 +236,15 @@ class Stability:
     m ≥ 1 blocks' norm (flags and branch points do not depend on it). ``banded_from``: the blocks (m = 0 and m ≥ 1) of a
     point assessed at perturbation degree N ≥ it are read on the banded sibling basis (C⁰ elements on the same map,
     analysis/stability/banded.py); 0: never; the default 225 (below it the dense blocks are as fast or faster:
-    docs/numerics.md §6)."""
+    docs/numerics.md §6). ``banded_flags_from``: the same for the flags alone (the check degree's, from the blocks'
+    inertia), default 60 (the banded inertia is the cheaper from ~45: benchmarks/banded_crossover.py)."""
 
     degree: int = 20
     m_max: int = 1
     basis: str = "mapped"
     norm: str = "displacement"
     banded_from: int = 225
+    banded_flags_from: int = 60
 
 
 STABILITY_BASES = ("legendre", "mapped")
@@ -1040,8 +1042,8 @@ def _stability(data) -> Stability:
         get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
         get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
         **choices,
-        banded_from=get("banded_from", lambda n: n == 0 or 20 <= n <= 400, "0 (off) or an integer in [20, 400]",
-                        integer=True),
+        **{key: get(key, lambda n: n == 0 or 20 <= n <= 400, "0 (off) or an integer in [20, 400]", integer=True)
+           for key in ("banded_from", "banded_flags_from")},
     )
 
 
