@@ -1,0 +1,85 @@
+"""The energy of a tube over (S, φ), its gradient (the residual) and Hessian (the exact Jacobian) in the coefficients
+c of tube/surface/basis.py (MODEL.md §8, §10), per 2π:
+
+    E(c) = Σ_nodes W (π_m(a_S, a_φ) − P v),   π_m = Φ(I, J),   I = |a_S|² + |a_φ|²,   J = |a_S × a_φ|,
+
+π_m, its gradient and Hessian in the 9 node variables from the scene class's generated surface kernels
+(codegen/surface.py, the sphere's: with R = 1 the tube's reference frame is orthonormal in (S, φ) as the sphere's in
+(θ, φ/sin θ), and the density per unit reference area is the same function of a_1, a_2) evaluated at P = 0, i.e.
+without their cone form of the volume, which misses the end planes; the pressure's work is the volume between the
+end planes, −P v (tube/surface/volume.py). A node variable is Σ_j T[·, node, j] c_j (+ a plugged end's 1), so
+
+    ∂E/∂c = Σ_a T_aᵀ (W ∂π/∂q_a),   ∂²E/∂c² = Σ_ab T_aᵀ diag(W ∂²π/∂q_a∂q_b) T_b,   ∂R/∂P = −∂Ṽ/∂c.
+
+Coils and a voltage are not built (one line): the field's H² needs x in Cartesian components and its rows.
+"""
+import numpy as np
+
+from . import volume
+from .basis import TubeSurfaceBasis
+from ...galerkin.discretisation import symmetric_rows
+from ...galerkin.equilibrium import NonFiniteState, Parameters
+from ...model.kernels import PLAIN, KernelSet, scene_terms
+from ...numerics.newton import finite
+from ...scene.tables import Shape
+
+
+class TubeSurfaceEquilibrium:
+    """E, ∇E, ∇²E and V/(2π) of a tube scene (field-free, no voltage) in a TubeSurfaceBasis."""
+
+    def __init__(self, scene, basis: TubeSurfaceBasis):
+        if scene.geometry.shape != Shape.TUBE:
+            raise ValueError(f"geometry.shape: {scene.geometry.shape.value!r}; the tube over (S, φ) takes \"tube\"")
+        if scene_terms(scene) != PLAIN:
+            raise ValueError(f"the tube over (S, φ) has the membrane and the pressure only, not {scene_terms(scene)[1:]} "
+                             "(allowed: no [[field.coils]], no [electric])")
+        if basis.disc.ends != scene.geometry.ends:
+            raise ValueError(f"basis ends: {basis.disc.ends.value!r}, the scene's {scene.geometry.ends.value!r}")
+        self.scene, self.basis = scene, basis
+        self.kernels = KernelSet(scene.material, PLAIN).surface()  # the class's membrane density; P = 0 (docstring)
+        self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
+
+    def node_state(self, c: np.ndarray) -> np.ndarray:
+        """The 9 node variables; NonFiniteState where the surface folds over (a_S × a_φ not along e_ρ's side)."""
+        state = self.basis.node_state(c)
+        normal_r = state[4] * state[8] - state[5] * state[7]  # (a_S × a_φ) · e_ρ, 1 on the reference tube
+        if not (normal_r > 0.0).all():
+            raise NonFiniteState("the tube's surface folds over: (a_S × a_φ) · e_ρ ≤ 0 at a node")
+        return state
+
+    def _membrane(self, kernel: str, state: np.ndarray, params: Parameters) -> np.ndarray:
+        out = self.kernels.nodes(kernel, {"state": state}, params.with_value("P", 0.0))
+        if not finite(out):
+            raise NonFiniteState(f"{kernel}: non-finite values (a stretch ≤ 0)")
+        return out
+
+    def energy(self, c: np.ndarray, params: Parameters) -> float:
+        """E/(2π)."""
+        state = self.node_state(c)
+        pi = self._membrane("surface_energy", state, params)[0] - params.P * volume.density(state)
+        return float(self.basis.weights @ pi)
+
+    def volume(self, c: np.ndarray) -> float:
+        """V/(2π), the volume between the end planes."""
+        return float(self.basis.weights @ volume.density(self.basis.node_state(c)))
+
+    def residual(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """∂E/∂c."""
+        state = self.node_state(c)
+        pointwise = self._membrane("surface_gradient", state, params) - params.P * volume.gradient(state)
+        return np.einsum("an,anj->j", pointwise * self.basis.weights, self.basis.maps)
+
+    def hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """∂²E/∂c² (the Jacobian of ``residual``)."""
+        state = self.node_state(c)
+        pointwise = self._membrane("surface_hessian", state, params)[self._pairs] - params.P * volume.hessian(state)
+        maps = self.basis.maps
+        scaled = np.einsum("abn,bnj->anj", pointwise * self.basis.weights, maps)
+        return maps.reshape(-1, maps.shape[2]).T @ scaled.reshape(-1, maps.shape[2])
+
+    def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str = "P") -> np.ndarray:
+        """∂R/∂P = −∂(V/2π)/∂c (the only continuation parameter built here)."""
+        if name != "P":
+            raise ValueError(f"continuation parameter: {name!r}; the tube over (S, φ) is continued in P only")
+        state = self.basis.node_state(c)
+        return -np.einsum("an,anj->j", volume.gradient(state) * self.basis.weights, self.basis.maps)
