@@ -130,3 +130,90 @@ def test_lowest_m1_eigenvalue_vanishes_at_the_located_branch_point(case):
         before = lowest(branch.states[zero.index], branch.pressure[zero.index])[0]
         after = lowest(branch.states[zero.index + 1], branch.pressure[zero.index + 1])[0]
         assert before * after < 0, (before, after)
+
+
+def legendre_values(coefficients, x, length):
+    """(f, df/dS) of Σ c_k P_k at x = 2S/L − 1."""
+    L = np.polynomial.legendre
+    return L.legval(x, coefficients), 2 / length * L.legval(x, L.legder(coefficients))
+
+
+def bubbles(b):
+    """The Legendre coefficients of Σ b_k (P_{k+2} − P_k)."""
+    c = np.zeros(b.size + 2)
+    c[2:] += b
+    c[:-2] -= b
+    return c
+
+
+def written_energy(material, disc, orders, n_phi, c, P):
+    """E/(2π) of the coefficients c written from their definition (tube/surface/basis.py): λ2 = Σ a_k P_k (plugged:
+    1 + bubbles), η = −λ̄(L/2)x + bubbles, R, T on P_k (plugged: bubbles), Z on bubbles; the Cartesian point
+    x = (r cos φ − t sin φ, r sin φ + t cos φ, z), its derivatives in S and φ, the metric's eigenvalues λ1², λ2²,
+    Φ = Σ μ/α (λ1^α + λ2^α + (λ1λ2)^−α − 3) and −P ½ (x, y, 0)·(x_S × x_φ); Gauss–Legendre in S with as many
+    nodes as the basis, n_phi points of the trapezoid in φ."""
+    n, L = disc.degree, disc.length
+    s, w = np.polynomial.legendre.leggauss(disc.x.size)
+    phi = 2 * np.pi * np.arange(n_phi) / n_phi
+    sliding = disc.ends.value == "sliding"
+    k = disc.hoops
+    hoop = c[:k] if sliding else bubbles(c[:k]) + np.eye(1, n + 1)[0]
+    rho, rho_s = legendre_values(hoop, s, L)
+    eta, eta_s = legendre_values(bubbles(c[k + 1: disc.size]), s, L)
+    eta, eta_s = eta - c[k] * L / 2 * s, eta_s - c[k]
+    r, r_s, r_p = rho[:, None] + 0 * phi, rho_s[:, None] + 0 * phi, 0 * rho[:, None] + 0 * phi
+    t, t_s, t_p = 0 * r, 0 * r, 0 * r
+    z, z_s, z_p = eta[:, None] + 0 * phi, eta_s[:, None] + 0 * phi, 0 * r
+    size = 2 * k + n - 1
+    for i, m in enumerate(orders[1:]):
+        block = c[disc.size + i * size: disc.size + (i + 1) * size]
+        a, b = (block[:k], block[k: 2 * k]) if sliding else (bubbles(block[:k]), bubbles(block[k: 2 * k]))
+        (R, R_s), (T, T_s) = legendre_values(a, s, L), legendre_values(b, s, L)
+        Z, Z_s = legendre_values(bubbles(block[2 * k:]), s, L)
+        cos, sin = np.cos(m * phi), np.sin(m * phi)
+        r, r_s, r_p = r + np.outer(R, cos), r_s + np.outer(R_s, cos), r_p - m * np.outer(R, sin)
+        t, t_s, t_p = t + np.outer(T, sin), t_s + np.outer(T_s, sin), t_p + m * np.outer(T, cos)
+        z, z_s, z_p = z + np.outer(Z, cos), z_s + np.outer(Z_s, cos), z_p - m * np.outer(Z, sin)
+    cos, sin = np.cos(phi), np.sin(phi)
+    x = np.array([r * cos - t * sin, r * sin + t * cos, z])
+    x_s = np.array([r_s * cos - t_s * sin, r_s * sin + t_s * cos, z_s])
+    x_p = np.array([r_p * cos - r * sin - t_p * sin - t * cos, r_p * sin + r * cos + t_p * cos - t * sin, z_p])
+    g11, g12, g22 = (x_s * x_s).sum(0), (x_s * x_p).sum(0), (x_p * x_p).sum(0)
+    root = np.sqrt((g11 - g22) ** 2 / 4 + g12**2)
+    l1, l2 = np.sqrt((g11 + g22) / 2 + root), np.sqrt((g11 + g22) / 2 - root)
+    phi_density = sum(mu / al * (l1**al + l2**al + (l1 * l2) ** -al - 3) for mu, al in zip(material.mu, material.alpha))
+    normal = np.cross(x_s, x_p, axis=0)
+    density = phi_density - P * 0.5 * (x[0] * normal[0] + x[1] * normal[1])
+    return (L / 2 * w) @ density.sum(axis=1) / n_phi
+
+
+@pytest.mark.parametrize("ends", ENDS)
+def test_energy_and_its_derivatives_are_those_written_here(ends):
+    """At a random non-axisymmetric state (orders 0, 1, 2, every coefficient perturbed): E/(2π) is the energy written
+    here (1e-12 relative), the residual its central differences (1e-7 relative), the Jacobian the residual's
+    (1e-7) and symmetric (1e-12); ∂R/∂P the derivative of the residual in P (1e-7)."""
+    scene, disc = scene_and_disc(ends, degree=10)
+    basis = TubeSurfaceBasis(disc, (0, 1, 2))
+    surface = TubeSurfaceEquilibrium(scene, basis)
+    rng = np.random.default_rng(11)
+    c = basis.axisymmetric(random_state(disc, seed=7)) + 0.02 * rng.standard_normal(basis.size) * (
+        np.arange(basis.size) >= disc.size)
+    P, h = 0.9, 1e-6
+    params = Parameters(P)
+
+    def energy(c):
+        return written_energy(scene.material, disc, basis.orders, basis.n_phi, c, P)
+
+    E = energy(c)
+    assert abs(surface.energy(c, params) - E) <= 1e-12 * abs(E)
+    R = surface.residual(c, params)
+    free = basis.free
+    steps = np.eye(basis.size)[free] * h
+    differences = np.array([(energy(c + e) - energy(c - e)) / (2 * h) for e in steps])
+    assert np.max(np.abs(R[free] - differences)) <= 1e-7 * np.max(np.abs(R)), np.max(np.abs(R[free] - differences))
+    H = surface.hessian(c, params)
+    assert np.max(np.abs(H - H.T)) <= 1e-12 * np.max(np.abs(H))
+    columns = np.array([(surface.residual(c + e, params) - surface.residual(c - e, params)) / (2 * h) for e in steps])
+    assert np.max(np.abs(H[:, free] - columns.T)) <= 1e-7 * np.max(np.abs(H))
+    dP = (surface.residual(c, Parameters(P + h)) - surface.residual(c, Parameters(P - h))) / (2 * h)
+    assert np.max(np.abs(surface.parameter_derivative(c, params) - dP)) <= 1e-7 * np.max(np.abs(dP))
