@@ -105,12 +105,16 @@ def located_zeros(case):
     return scene, branch, [c for c in crossings(scene, branch, modes) if c.pressure > 0.5]
 
 
-@pytest.mark.parametrize("case", ["held", "bulge"])
-def test_lowest_m1_eigenvalue_vanishes_at_the_located_branch_point(case):
+@pytest.fixture(scope="module", params=["held", "bulge"])
+def zeros(request):
+    return located_zeros(request.param)
+
+
+def test_lowest_m1_eigenvalue_vanishes_at_the_located_branch_point(zeros):
     """At each located m = 1 zero the lowest eigenvalue of the surface Hessian's m = 1 block (orders 0, 1, 2; the
     translation removed on the Gram matrix as tube/azimuthal.py does) is zero (1e-9 of the block's scale: the
     location's own tolerance), and it has opposite signs at the branch's points on either side."""
-    scene, branch, found = located_zeros(case)
+    scene, branch, found = zeros
     assert found, "no located m = 1 zero"
     disc = branch.disc
     eq = Equilibrium(scene, disc)
@@ -217,3 +221,45 @@ def test_energy_and_its_derivatives_are_those_written_here(ends):
     assert np.max(np.abs(H[:, free] - columns.T)) <= 1e-7 * np.max(np.abs(H))
     dP = (surface.residual(c, Parameters(P + h)) - surface.residual(c, Parameters(P - h))) / (2 * h)
     assert np.max(np.abs(surface.parameter_derivative(c, params) - dP)) <= 1e-7 * np.max(np.abs(dP))
+
+
+def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
+    """From each located m = 1 zero (tube/surface/switching.py, orders 0, 1, 2): Newton converges at ε = ±0.1 and
+    0.05 along the critical mode (residual ≤ 1e-12 of the pressure's terms in it, P ∂Ṽ/∂c); the point is stationary
+    for the energy written here (its central differences, h = 1e-6: ≤ 1e-9 of P ∂Ṽ/∂c, the predictor's ≥ 1e-5 of it:
+    the check tells the point from its predictor); the amplitude is ε,
+    the reaction of the held centroid zero; the branch is a pitchfork: P(−ε) = P(ε) (1e-12) and
+    (P(ε) − P_0)/ε² converges as ε² (its change from ε = 0.1 to 0.05 a quarter of that from 0.2 to 0.1, within 5 %)."""
+    from balloon_cg.tube.surface.switching import switched_point
+
+    scene, branch, found = zeros
+    disc, h = branch.disc, 1e-6
+    for zero in found:
+        points = {eps: switched_point(scene, disc, zero, eps, branch.params) for eps in (0.2, 0.1, -0.1, 0.05)}
+        for eps, point in points.items():
+            assert point.converged, (eps, point.message)
+            basis = point.basis
+            start = basis.with_mode(basis.axisymmetric(zero.u), 1, eps * zero.mode)
+            surface = TubeSurfaceEquilibrium(scene, basis)
+            scale = zero.pressure * np.max(np.abs(surface.parameter_derivative(start, branch.params)))
+            assert point.residual <= 1e-12 * scale, (eps, point.residual, scale)
+            amplitude = zero.mode @ azimuthal.operators(disc)[1] @ point.c[basis.block(1)]
+            assert abs(amplitude - eps) <= 1e-12 and abs(point.reaction) <= 1e-12 * scale
+        point = points[0.1]
+        basis = point.basis
+        steps = np.eye(basis.size)[basis.free] * h
+
+        def gradient(c, P):
+            def energy(c):
+                return written_energy(scene.material, disc, basis.orders, basis.n_phi, c, P)
+            return np.array([(energy(c + e) - energy(c - e)) / (2 * h) for e in steps])
+
+        start = basis.with_mode(basis.axisymmetric(zero.u), 1, 0.1 * zero.mode)
+        scale = zero.pressure * np.max(np.abs(TubeSurfaceEquilibrium(scene, basis).parameter_derivative(start, branch.params)))
+        stationary, predicted = (np.max(np.abs(gradient(c, P))) for c, P in ((point.c, point.pressure),
+                                                                              (start, zero.pressure)))
+        assert stationary <= 1e-9 * scale and predicted >= 1e-5 * scale
+        assert abs(points[-0.1].pressure - points[0.1].pressure) <= 1e-12 * zero.pressure
+        quotient = {eps: (points[eps].pressure - zero.pressure) / eps**2 for eps in (0.2, 0.1, 0.05)}
+        ratio = (quotient[0.2] - quotient[0.1]) / (quotient[0.1] - quotient[0.05])
+        assert abs(ratio - 4) <= 0.2, (quotient, ratio)

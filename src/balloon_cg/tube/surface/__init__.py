@@ -5,4 +5,5 @@ surface/ (docs/tubes.md "The tube over (S, φ)"). In reading order:
   blocks' (R, T, Z) of tube/azimuthal.py above it) and their node maps on Gauss(S) × uniform(φ)
 - ``volume``: the enclosed volume between the end planes, ½ x_h · (x_S × x_φ), and its node derivatives
 - ``equilibrium``: E/(2π), its gradient (the residual) and Hessian (the exact Jacobian) in the coefficients
+- ``switching``: one point of the branch born at a located m ≥ 1 zero along its critical mode (opt-in)
 """
