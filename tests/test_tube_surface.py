@@ -226,9 +226,9 @@ def test_energy_and_its_derivatives_are_those_written_here(ends):
 def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
     """From each located m = 1 zero (tube/surface/switching.py, orders 0, 1, 2): Newton converges at ε = ±0.1 and
     0.05 along the critical mode (residual ≤ 1e-12 of the pressure's terms in it, P ∂Ṽ/∂c); the point is stationary
-    for the energy written here (its central differences, h = 1e-6: ≤ 1e-9 of P ∂Ṽ/∂c, the predictor's ≥ 1e-5 of it:
-    the check tells the point from its predictor); the amplitude is ε,
-    the reaction of the held centroid zero; the branch is a pitchfork: P(−ε) = P(ε) (1e-12) and
+    for the energy written here (its central differences along 8 random unit directions, h = 1e-6: ≤ 1e-9 of
+    P ∂Ṽ/∂c; the predictor's ≥ 1e-6 of it, measured 2.3e-6 and more: the check tells the point from its predictor);
+    the amplitude is ε, the reaction of the held centroid zero; the branch is a pitchfork: P(−ε) = P(ε) (1e-12) and
     (P(ε) − P_0)/ε² converges as ε² (its change from ε = 0.1 to 0.05 a quarter of that from 0.2 to 0.1, within 5 %)."""
     from balloon_cg.tube.surface.switching import switched_point
 
@@ -247,7 +247,9 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
             assert abs(amplitude - eps) <= 1e-12 and abs(point.reaction) <= 1e-12 * scale
         point = points[0.1]
         basis = point.basis
-        steps = np.eye(basis.size)[basis.free] * h
+        directions = np.zeros((8, basis.size))
+        directions[:, basis.free] = np.random.default_rng(2).standard_normal((8, basis.free.size))
+        steps = h * directions / np.linalg.norm(directions, axis=1)[:, None]
 
         def gradient(c, P):
             def energy(c):
@@ -258,7 +260,7 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
         scale = zero.pressure * np.max(np.abs(TubeSurfaceEquilibrium(scene, basis).parameter_derivative(start, branch.params)))
         stationary, predicted = (np.max(np.abs(gradient(c, P))) for c, P in ((point.c, point.pressure),
                                                                               (start, zero.pressure)))
-        assert stationary <= 1e-9 * scale and predicted >= 1e-5 * scale
+        assert stationary <= 1e-9 * scale and predicted >= 1e-6 * scale
         assert abs(points[-0.1].pressure - points[0.1].pressure) <= 1e-12 * zero.pressure
         quotient = {eps: (points[eps].pressure - zero.pressure) / eps**2 for eps in (0.2, 0.1, 0.05)}
         ratio = (quotient[0.2] - quotient[0.1]) / (quotient[0.1] - quotient[0.05])
