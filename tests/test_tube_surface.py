@@ -257,7 +257,8 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
             return np.array([(energy(c + e) - energy(c - e)) / (2 * h) for e in steps])
 
         start = basis.with_mode(basis.axisymmetric(zero.u), 1, 0.1 * zero.mode)
-        scale = zero.pressure * np.max(np.abs(TubeSurfaceEquilibrium(scene, basis).parameter_derivative(start, branch.params)))
+        derivative = TubeSurfaceEquilibrium(scene, basis).parameter_derivative(start, branch.params)
+        scale = zero.pressure * np.max(np.abs(derivative))
         stationary, predicted = (np.max(np.abs(gradient(c, P))) for c, P in ((point.c, point.pressure),
                                                                               (start, zero.pressure)))
         assert stationary <= 1e-9 * scale and predicted >= 1e-6 * scale
@@ -265,3 +266,27 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
         quotient = {eps: (points[eps].pressure - zero.pressure) / eps**2 for eps in (0.2, 0.1, 0.05)}
         ratio = (quotient[0.2] - quotient[0.1]) / (quotient[0.1] - quotient[0.05])
         assert abs(ratio - 4) <= 0.2, (quotient, ratio)
+
+
+def test_what_it_does_not_take_is_refused_in_one_line():
+    """A coil, a sphere, orders not starting at 0, too few points in φ, another parameter than P: one line each,
+    naming the key, its value and what is allowed."""
+    from pathlib import Path
+
+    from balloon_cg.scene import load_scene
+
+    disc = IntervalDiscretisation(8, 10.0)
+    coil = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10_coil.toml")
+    cases = [(lambda: TubeSurfaceEquilibrium(coil, TubeSurfaceBasis(disc)), "field.coils"),
+             (lambda: TubeSurfaceEquilibrium(parse_scene('[material]\npreset = "SPOM1"\n'), TubeSurfaceBasis(disc)),
+              "geometry.shape"),
+             (lambda: TubeSurfaceBasis(disc, (1, 2)), "orders"),
+             (lambda: TubeSurfaceBasis(disc, (0, 3), n_phi=6), "n_phi"),
+             (lambda: TubeSurfaceEquilibrium(tube_scene(), TubeSurfaceBasis(disc)).parameter_derivative(
+                 np.zeros(TubeSurfaceBasis(disc).size), Parameters(1.0), "M"), "continuation parameter")]
+    for call, key in cases:
+        with pytest.raises(ValueError) as error:
+            call()
+        message = str(error.value)
+        assert message.startswith(key) and "allowed" in message, message
+        assert "\n" not in message

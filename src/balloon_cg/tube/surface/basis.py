@@ -104,7 +104,7 @@ class TubeSurfaceBasis:
         """c with order m ≥ 1 set to ``amplitudes`` (coefficients of tube/azimuthal.basis_values, e.g. a critical
         mode)."""
         if m == 0:
-            raise ValueError("with_mode: order 0 is the axisymmetric state (``axisymmetric``)")
+            raise ValueError(f"m: 0 is the axisymmetric state, set by ``axisymmetric`` (allowed: {self.orders[1:]})")
         out = np.array(c, dtype=float)
         out[self.block(m)] = amplitudes
         return out

@@ -29,12 +29,15 @@ class TubeSurfaceEquilibrium:
 
     def __init__(self, scene, basis: TubeSurfaceBasis):
         if scene.geometry.shape != Shape.TUBE:
-            raise ValueError(f"geometry.shape: {scene.geometry.shape.value!r}; the tube over (S, φ) takes \"tube\"")
+            raise ValueError(f"geometry.shape: {scene.geometry.shape.value!r}; the tube over (S, φ) is a tube's "
+                             '(allowed: "tube")')
         if scene_terms(scene) != PLAIN:
-            raise ValueError(f"the tube over (S, φ) has the membrane and the pressure only, not {scene_terms(scene)[1:]} "
-                             "(allowed: no [[field.coils]], no [electric])")
+            extra = ", ".join(scene_terms(scene)[1:])
+            raise ValueError(f"field.coils / electric: the scene's terms {extra}; the tube over (S, φ) has the membrane "
+                             "and the pressure only (allowed: no coils, no [electric] table)")
         if basis.disc.ends != scene.geometry.ends:
-            raise ValueError(f"basis ends: {basis.disc.ends.value!r}, the scene's {scene.geometry.ends.value!r}")
+            raise ValueError(f"basis ends: {basis.disc.ends.value!r} (allowed: the scene's, "
+                             f"{scene.geometry.ends.value!r})")
         self.scene, self.basis = scene, basis
         self.kernels = KernelSet(scene.material, PLAIN).surface()  # the class's membrane density; P = 0 (docstring)
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
@@ -80,6 +83,7 @@ class TubeSurfaceEquilibrium:
     def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str = "P") -> np.ndarray:
         """∂R/∂P = −∂(V/2π)/∂c (the only continuation parameter built here)."""
         if name != "P":
-            raise ValueError(f"continuation parameter: {name!r}; the tube over (S, φ) is continued in P only")
+            raise ValueError(f"continuation parameter: {name!r}; the tube over (S, φ) is continued in P only "
+                             '(allowed: "P")')
         state = self.basis.node_state(c)
         return -np.einsum("an,anj->j", volume.gradient(state) * self.basis.weights, self.basis.maps)

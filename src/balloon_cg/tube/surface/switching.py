@@ -50,12 +50,13 @@ def switched_point(scene, disc: IntervalDiscretisation, crossing, amplitude: flo
     branch's discretisation; ``params`` the branch's, P replaced), in the orders (0, m, 2m) unless ``orders``."""
     m = crossing.m
     if crossing.mode is None or crossing.held:
-        raise ValueError("switched_point: the crossing needs its critical mode of the free tube (crossing.mode)")
+        raise ValueError("crossing: held or without its mode; switched_point starts from the free tube's critical "
+                         "mode (allowed: a crossing with mode, held False)")
     if amplitude == 0:
         raise ValueError("amplitude: 0 is the axisymmetric state itself (allowed: ε ≠ 0)")
     basis = TubeSurfaceBasis(disc, orders or (0, m, 2 * m), n_phi)
     if m not in basis.orders:
-        raise ValueError(f"orders: {basis.orders} lack the crossing's order m = {m}")
+        raise ValueError(f"orders: {basis.orders} lack the crossing's order (allowed: orders holding m = {m})")
     surface = TubeSurfaceEquilibrium(scene, basis)
     gram = azimuthal.operators(disc)[1]
     free = basis.free
