@@ -33,8 +33,8 @@ class TubeSurfaceEquilibrium:
                              '(allowed: "tube")')
         if scene_terms(scene) != PLAIN:
             extra = ", ".join(scene_terms(scene)[1:])
-            raise ValueError(f"field.coils / electric: the scene's terms {extra}; the tube over (S, φ) has the membrane "
-                             "and the pressure only (allowed: no coils, no [electric] table)")
+            raise ValueError(f"field.coils / electric: the scene's terms {extra}; the tube over (S, φ) has the "
+                             "membrane and the pressure only (allowed: no coils, no [electric] table)")
         if basis.disc.ends != scene.geometry.ends:
             raise ValueError(f"basis ends: {basis.disc.ends.value!r} (allowed: the scene's, "
                              f"{scene.geometry.ends.value!r})")
