@@ -150,15 +150,12 @@ def bubbles(b):
     return c
 
 
-def written_energy(material, disc, orders, n_phi, c, P):
-    """E/(2π) of the coefficients c written from their definition (tube/surface/basis.py): λ2 = Σ a_k P_k (plugged:
-    1 + bubbles), η = −λ̄(L/2)x + bubbles, R, T on P_k (plugged: bubbles), Z on bubbles; the Cartesian point
-    x = (r cos φ − t sin φ, r sin φ + t cos φ, z), its derivatives in S and φ, the metric's eigenvalues λ1², λ2²,
-    Φ = Σ μ/α (λ1^α + λ2^α + (λ1λ2)^−α − 3) and −P ½ (x, y, 0)·(x_S × x_φ); Gauss–Legendre in S with as many
-    nodes as the basis, n_phi points of the trapezoid in φ."""
+def written_point(disc, orders, c, s, phi):
+    """(x, x_S, x_φ), each (3, s.size, phi.size), of the coefficients c at x = 2S/L − 1 = s and the azimuths φ,
+    written from their definition (tube/surface/basis.py): λ2 = Σ a_k P_k (plugged: 1 + bubbles), η = −λ̄(L/2)x +
+    bubbles, R, T on P_k (plugged: bubbles), Z on bubbles; the Cartesian x = (r cos φ − t sin φ, r sin φ + t cos φ, z)
+    and its derivatives."""
     n, L = disc.degree, disc.length
-    s, w = np.polynomial.legendre.leggauss(disc.x.size)
-    phi = 2 * np.pi * np.arange(n_phi) / n_phi
     sliding = disc.ends.value == "sliding"
     k = disc.hoops
     hoop = c[:k] if sliding else bubbles(c[:k]) + np.eye(1, n + 1)[0]
@@ -182,19 +179,28 @@ def written_energy(material, disc, orders, n_phi, c, P):
     x = np.array([r * cos - t * sin, r * sin + t * cos, z])
     x_s = np.array([r_s * cos - t_s * sin, r_s * sin + t_s * cos, z_s])
     x_p = np.array([r_p * cos - r * sin - t_p * sin - t * cos, r_p * sin + r * cos + t_p * cos - t * sin, z_p])
+    return x, x_s, x_p
+
+
+def written_energy(material, disc, orders, n_phi, c, P):
+    """E/(2π) of the coefficients c: the point of ``written_point``, the metric's eigenvalues λ1², λ2²,
+    Φ = Σ μ/α (λ1^α + λ2^α + (λ1λ2)^−α − 3) and −P ½ (x, y, 0)·(x_S × x_φ); Gauss–Legendre in S with as many
+    nodes as the basis, n_phi points of the trapezoid in φ."""
+    s, w = np.polynomial.legendre.leggauss(disc.x.size)
+    x, x_s, x_p = written_point(disc, orders, c, s, 2 * np.pi * np.arange(n_phi) / n_phi)
     g11, g12, g22 = (x_s * x_s).sum(0), (x_s * x_p).sum(0), (x_p * x_p).sum(0)
     root = np.sqrt((g11 - g22) ** 2 / 4 + g12**2)
     l1, l2 = np.sqrt((g11 + g22) / 2 + root), np.sqrt((g11 + g22) / 2 - root)
     phi_density = sum(mu / al * (l1**al + l2**al + (l1 * l2) ** -al - 3) for mu, al in zip(material.mu, material.alpha))
     normal = np.cross(x_s, x_p, axis=0)
     density = phi_density - P * 0.5 * (x[0] * normal[0] + x[1] * normal[1])
-    return (L / 2 * w) @ density.sum(axis=1) / n_phi
+    return (disc.length / 2 * w) @ density.sum(axis=1) / n_phi
 
 
 @pytest.mark.parametrize("ends", ENDS)
 def test_energy_and_its_derivatives_are_those_written_here(ends):
     """At a random non-axisymmetric state (orders 0, 1, 2, every coefficient perturbed): E/(2π) is the energy written
-    here (1e-12 relative), the residual its central differences (1e-7 relative), the Jacobian the residual's
+    here (1e-12 relative) and ``profile`` its Cartesian point (1e-13), the residual its central differences (1e-7 relative), the Jacobian the residual's
     (1e-7) and symmetric (1e-12); ∂R/∂P the derivative of the residual in P (1e-7)."""
     scene, disc = scene_and_disc(ends, degree=10)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
@@ -210,6 +216,9 @@ def test_energy_and_its_derivatives_are_those_written_here(ends):
 
     E = energy(c)
     assert abs(surface.energy(c, params) - E) <= 1e-12 * abs(E)
+    S, phi = np.linspace(0, disc.length, 7), np.linspace(0, 2 * np.pi, 5)
+    written = written_point(disc, basis.orders, c, 2 * S / disc.length - 1, phi)[0]
+    assert np.max(np.abs(basis.profile(c, S, phi) - written)) <= 1e-13 * np.max(np.abs(written))
     R = surface.residual(c, params)
     free = basis.free
     steps = np.eye(basis.size)[free] * h

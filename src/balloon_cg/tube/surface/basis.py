@@ -133,8 +133,8 @@ def _tables(basis: TubeSurfaceBasis) -> tuple:
     columns = basis.block(0)
     for row, source in ((0, 0), (7, 0), (2, 2), (3, 1), (5, 3)):  # r, a_φ2 = r, z, r_S, z_S
         maps[row, :, :, columns] = (axis[source][:, None, :] * one[None, :, None])
+    R, dR, Z, dZ, T, dT = basis_values(disc, disc.x)  # (n_q, mode_size) each
     for m in basis.orders[1:]:
-        R, dR, Z, dZ, T, dT = basis_values(disc, disc.x)  # (n_q, mode_size) each
         cos, sin = np.cos(m * basis.phi)[None, :, None], np.sin(m * basis.phi)[None, :, None]
         columns = basis.block(m)
         for row, F, g in ((0, R, cos), (1, T, sin), (2, Z, cos), (3, dR, cos), (4, dT, sin), (5, dZ, cos),
