@@ -4,8 +4,10 @@ discretisation, and what an evaluation costs.
 SPOM1, L = 10, sliding closed ends: the bulge branch to V/V0 = 5 at each degree, its first located m = 1 zero (the
 lateral buckle of the bulge), and the point of amplitude ε = 0.1 along its critical mode (tube/surface/switching.py)
 with the orders (0, 1, 2) at the default n_phi, with the order 3 added, and with n_phi doubled: P − P_0 and its
-change. Then the CPU of one residual and one Hessian of the surface (orders 0, 1, 2) against one Jacobian of the
-interval discretisation at the same state (best of ``REPEATS``), one run, with the load average.
+change. Then the CPU of one residual and one Hessian of the surface (orders 0, 1, 2; sum-factorised over φ, tube/surface/
+basis.py ``hessian``) against the same Hessian from dense node maps (the first version's assembly, rebuilt here from the
+basis' factors; their difference printed) and one Jacobian of the interval discretisation at the same state (best of
+``REPEATS``), one run, with the load average.
 
     OMP_NUM_THREADS=1 python benchmarks/tube_surface.py [--degrees 20 30 40]
 """
@@ -26,6 +28,7 @@ from balloon_cg.tube import azimuthal  # noqa: E402
 from balloon_cg.tube.azimuthal_crossings import crossings  # noqa: E402
 from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
 from balloon_cg.tube.primary import primary_branch  # noqa: E402
+from balloon_cg.tube.surface import volume  # noqa: E402
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis  # noqa: E402
 from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium  # noqa: E402
 from balloon_cg.tube.surface.switching import switched_point  # noqa: E402
@@ -42,6 +45,16 @@ def cpu(call) -> float:
         call()
         best = min(best, time.process_time() - start)
     return best
+
+
+def dense_hessian(basis: TubeSurfaceBasis, pointwise: np.ndarray) -> np.ndarray:
+    """Σ_ab T_aᵀ diag(h_ab) T_b with the dense node maps T_a[(q, k), j] = F_a[q, j] g_a[k] (9 × nodes × unknowns)."""
+    maps = np.zeros((9, basis.disc.x.size, basis.n_phi, basis.size))
+    for m, (F, g) in zip(basis.orders, basis.factors):
+        maps[:, :, :, basis.block(m)] = F[:, :, None, :] * g[:, None, :, None]
+    maps = maps.reshape(9, -1, basis.size)
+    scaled = np.einsum("abn,bnj->anj", pointwise, maps)
+    return maps.reshape(-1, basis.size).T @ scaled.reshape(-1, basis.size)
 
 
 def main(degrees) -> None:
@@ -67,14 +80,19 @@ def main(degrees) -> None:
         basis = TubeSurfaceBasis(branch.disc, (0, 1, 2))
         surface = TubeSurfaceEquilibrium(scene, basis)
         params = branch.params.with_value("P", point.pressure)
+        state = surface.node_state(point.c)
+        rows = (surface._membrane("surface_hessian", state, params)[surface._pairs]
+                - params.P * volume.hessian(state)) * basis.weights
+        factorised = surface.hessian(point.c, params)
+        gap = np.max(np.abs(dense_hessian(basis, rows) - factorised)) / np.max(np.abs(factorised))
         costs.append((degree, basis.size, branch.disc.size, basis.disc.x.size * basis.n_phi,
                       cpu(lambda: surface.residual(point.c, params)), cpu(lambda: surface.hessian(point.c, params)),
-                      cpu(lambda: eq.jacobian(zero.u, params))))
+                      cpu(lambda: dense_hessian(basis, rows)), gap, cpu(lambda: eq.jacobian(zero.u, params))))
     print(f"\n{'N':>3} {'unknowns':>8} {'interval':>8} {'nodes':>6} {'residual s':>11} {'Hessian s':>10} "
-          f"{'interval J s':>12} {'Hessian / J':>11}")
-    for degree, size, interval, nodes, residual, hessian, jacobian in costs:
-        print(f"{degree:3d} {size:8d} {interval:8d} {nodes:6d} {residual:11.2e} {hessian:10.2e} {jacobian:12.2e} "
-              f"{hessian / jacobian:11.0f}")
+          f"{'dense s':>9} {'dense/H':>7} {'|dense − H|':>11} {'interval J s':>12} {'H / J':>6}")
+    for degree, size, interval, nodes, residual, hessian, dense, gap, jacobian in costs:
+        print(f"{degree:3d} {size:8d} {interval:8d} {nodes:6d} {residual:11.2e} {hessian:10.2e} {dense:9.2e} "
+              f"{dense / hessian:7.1f} {gap:11.1e} {jacobian:12.2e} {hessian / jacobian:6.0f}")
     print(f"load average at the end {os.getloadavg()[0]:.2f}")
 
 

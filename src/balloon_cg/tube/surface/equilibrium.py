@@ -9,7 +9,9 @@ c of tube/surface/basis.py (MODEL.md §8, §10), per 2π:
 without their cone form of the volume, which misses the end planes; the pressure's work is the volume between the
 end planes, −P v (tube/surface/volume.py). A node variable is Σ_j T[·, node, j] c_j (+ a plugged end's 1), so
 
-    ∂E/∂c = Σ_a T_aᵀ (W ∂π/∂q_a),   ∂²E/∂c² = Σ_ab T_aᵀ diag(W ∂²π/∂q_a∂q_b) T_b,   ∂R/∂P = −∂Ṽ/∂c.
+    ∂E/∂c = Σ_a T_aᵀ (W ∂π/∂q_a),   ∂²E/∂c² = Σ_ab T_aᵀ diag(W ∂²π/∂q_a∂q_b) T_b,   ∂R/∂P = −∂Ṽ/∂c
+
+(sum-factorised over φ: tube/surface/basis.py ``project``, ``hessian``).
 
 Coils and a voltage are not built (one line): the field's H² needs x in Cartesian components and its rows.
 """
@@ -70,15 +72,13 @@ class TubeSurfaceEquilibrium:
         """∂E/∂c."""
         state = self.node_state(c)
         pointwise = self._membrane("surface_gradient", state, params) - params.P * volume.gradient(state)
-        return np.einsum("an,anj->j", pointwise * self.basis.weights, self.basis.maps)
+        return self.basis.project(pointwise * self.basis.weights)
 
     def hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
         """∂²E/∂c² (the Jacobian of ``residual``)."""
         state = self.node_state(c)
         pointwise = self._membrane("surface_hessian", state, params)[self._pairs] - params.P * volume.hessian(state)
-        maps = self.basis.maps
-        scaled = np.einsum("abn,bnj->anj", pointwise * self.basis.weights, maps)
-        return maps.reshape(-1, maps.shape[2]).T @ scaled.reshape(-1, maps.shape[2])
+        return self.basis.hessian(pointwise * self.basis.weights)
 
     def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str = "P") -> np.ndarray:
         """∂R/∂P = −∂(V/2π)/∂c (the only continuation parameter built here)."""
@@ -86,4 +86,4 @@ class TubeSurfaceEquilibrium:
             raise ValueError(f"continuation parameter: {name!r}; the tube over (S, φ) is continued in P only "
                              '(allowed: "P")')
         state = self.basis.node_state(c)
-        return -np.einsum("an,anj->j", volume.gradient(state) * self.basis.weights, self.basis.maps)
+        return -self.basis.project(volume.gradient(state) * self.basis.weights)
