@@ -28,7 +28,6 @@ from balloon_cg.tube import azimuthal  # noqa: E402
 from balloon_cg.tube.azimuthal_crossings import crossings  # noqa: E402
 from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
 from balloon_cg.tube.primary import primary_branch  # noqa: E402
-from balloon_cg.tube.surface import volume  # noqa: E402
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis  # noqa: E402
 from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium  # noqa: E402
 from balloon_cg.tube.surface.switching import switched_point  # noqa: E402
@@ -80,9 +79,7 @@ def main(degrees) -> None:
         basis = TubeSurfaceBasis(branch.disc, (0, 1, 2))
         surface = TubeSurfaceEquilibrium(scene, basis)
         params = branch.params.with_value("P", point.pressure)
-        state = surface.node_state(point.c)
-        rows = (surface._membrane("surface_hessian", state, params)[surface._pairs]
-                - params.P * volume.hessian(state)) * basis.weights
+        rows = surface.node_hessian(point.c, params)
         factorised = surface.hessian(point.c, params)
         gap = np.max(np.abs(dense_hessian(basis, rows) - factorised)) / np.max(np.abs(factorised))
         costs.append((degree, basis.size, branch.disc.size, basis.disc.x.size * basis.n_phi,

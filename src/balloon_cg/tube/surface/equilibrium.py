@@ -74,11 +74,15 @@ class TubeSurfaceEquilibrium:
         pointwise = self._membrane("surface_gradient", state, params) - params.P * volume.gradient(state)
         return self.basis.project(pointwise * self.basis.weights)
 
-    def hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
-        """∂²E/∂c² (the Jacobian of ``residual``)."""
+    def node_hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """(9, 9, nodes): W ∂²π/∂q² at every node, the rows ``hessian`` contracts."""
         state = self.node_state(c)
         pointwise = self._membrane("surface_hessian", state, params)[self._pairs] - params.P * volume.hessian(state)
-        return self.basis.hessian(pointwise * self.basis.weights)
+        return pointwise * self.basis.weights
+
+    def hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """∂²E/∂c² (the Jacobian of ``residual``)."""
+        return self.basis.hessian(self.node_hessian(c, params))
 
     def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str = "P") -> np.ndarray:
         """∂R/∂P = −∂(V/2π)/∂c (the only continuation parameter built here)."""
