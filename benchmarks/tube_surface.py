@@ -4,8 +4,8 @@ discretisation, and what an evaluation costs.
 SPOM1, L = 10, sliding closed ends: the bulge branch to V/V0 = 5 at each degree, its first located m = 1 zero (the
 lateral buckle of the bulge), and the point of amplitude ε = 0.1 along its critical mode (tube/surface/switching.py)
 with the orders (0, 1, 2) at the default n_phi, with the order 3 added, and with n_phi doubled: P − P_0 and its
-change. Then the CPU of one residual and one Hessian of the surface (orders 0, 1, 2; sum-factorised over φ, tube/surface/
-basis.py ``hessian``) against the same Hessian from dense node maps (the first version's assembly, rebuilt here from the
+change. Then the CPU of one residual and one Hessian of the surface (orders 0, 1, 2; sum-factorised over φ,
+tube/surface/basis.py ``hessian``) against the same Hessian from dense node maps (the first version's assembly, rebuilt here from the
 basis' factors; their difference printed) and one Jacobian of the interval discretisation at the same state (best of
 ``REPEATS``), one run, with the load average.
 

@@ -200,8 +200,9 @@ def written_energy(material, disc, orders, n_phi, c, P):
 @pytest.mark.parametrize("ends", ENDS)
 def test_energy_and_its_derivatives_are_those_written_here(ends):
     """At a random non-axisymmetric state (orders 0, 1, 2, every coefficient perturbed): E/(2π) is the energy written
-    here (1e-12 relative) and ``profile`` its Cartesian point (1e-13), the residual its central differences (1e-7 relative), the Jacobian the residual's
-    (1e-7) and symmetric (1e-12); ∂R/∂P the derivative of the residual in P (1e-7)."""
+    here (1e-12 relative) and ``profile`` its Cartesian point (1e-13), the residual its central differences (1e-7
+    relative), the Jacobian the residual's (1e-7) and symmetric (1e-12); ∂R/∂P the derivative of the residual in P
+    (1e-7)."""
     scene, disc = scene_and_disc(ends, degree=10)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
     surface = TubeSurfaceEquilibrium(scene, basis)
