@@ -18,7 +18,7 @@ Coils and a voltage are not built (one line): the field's H² needs x in Cartesi
 import numpy as np
 
 from . import volume
-from .basis import TubeSurfaceBasis
+from .basis import NODE_VARIABLES, TubeSurfaceBasis
 from ...galerkin.discretisation import symmetric_rows
 from ...galerkin.equilibrium import NonFiniteState, Parameters
 from ...model.kernels import PLAIN, KernelSet, scene_terms
@@ -42,6 +42,9 @@ class TubeSurfaceEquilibrium:
                              f"{scene.geometry.ends.value!r})")
         self.scene, self.basis = scene, basis
         self.kernels = KernelSet(scene.material, PLAIN).surface()  # the class's membrane density; P = 0 (docstring)
+        if tuple(self.kernels.module.SURFACE_STATE) != NODE_VARIABLES:
+            raise RuntimeError(f"{self.kernels.module.__name__}: node variables {self.kernels.module.SURFACE_STATE}, "
+                               f"tube/surface/basis.py assembles {NODE_VARIABLES}")
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
 
     def node_state(self, c: np.ndarray) -> np.ndarray:
