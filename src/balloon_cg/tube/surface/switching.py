@@ -62,7 +62,6 @@ def switched_point(scene, disc: IntervalDiscretisation, crossing, amplitude: flo
     free = basis.free
     mode_row = np.zeros(basis.size)
     mode_row[basis.block(m)] = gram @ crossing.mode
-    rows = [mode_row[free]]
     gauge = np.zeros(basis.size)
     if 1 in basis.orders and disc.ends == Ends.SLIDING:
         gauge[basis.block(1)] = gram @ azimuthal.translation(disc)
