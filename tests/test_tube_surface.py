@@ -85,8 +85,9 @@ def test_order_m_blocks_are_the_azimuthal_blocks(ends):
 
 def located_zeros(case):
     """(scene, branch, its located m = 1 zeros (tube/azimuthal_crossings.py)) of a held neo-Hookean tube's uniform
-    branch (λz = 1.5, degree 16: its sideways buckle) or of SPOM1's bulge branch (L = 10, degree 20, to V/V0 = 5: the
-    lateral buckle of the bulge, a non-uniform state)."""
+    branch (λz = 1.5, degree 16: its sideways buckle), of SPOM1's bulge branch (L = 10, degree 20, to V/V0 = 5: the
+    lateral buckle of the bulge, a non-uniform state) or of a plugged neo-Hookean tube held at λz = 1.2 (L = 10,
+    degree 16: one m = 1 zero at P = 1.18399, the plugs holding the rims: no translation to gauge)."""
     from balloon_cg.galerkin.interval import Mirror
     from balloon_cg.tube.azimuthal_crossings import crossings
     from balloon_cg.tube.bulge import bulge_branch
@@ -95,6 +96,10 @@ def located_zeros(case):
     if case == "held":
         scene = tube_scene("neo-Hookean", 10.0, "axial_stretch = 1.5\n").with_overrides(
             {"solver.degree": 16, "continuation.stop_stretch": 2.3})
+        branch = primary_branch(scene)
+    elif case == "plugged":
+        scene = tube_scene("neo-Hookean", 10.0, 'ends = "plugged"\naxial_stretch = 1.2\n').with_overrides(
+            {"solver.degree": 16, "continuation.stop_stretch": 3.5})
         branch = primary_branch(scene)
     else:
         scene = tube_scene("SPOM1", 10.0).with_overrides({"solver.degree": 20, "continuation.stop_stretch": 5.0})
@@ -105,7 +110,7 @@ def located_zeros(case):
     return scene, branch, [c for c in crossings(scene, branch, modes) if c.pressure > 0.5]
 
 
-@pytest.fixture(scope="module", params=["held", "bulge"])
+@pytest.fixture(scope="module", params=["held", "bulge", "plugged"])
 def zeros(request):
     return located_zeros(request.param)
 
