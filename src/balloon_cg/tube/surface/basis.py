@@ -138,6 +138,28 @@ class TubeSurfaceBasis:
         out[self.block(m)] = amplitudes
         return out
 
+    def fields(self, m: int) -> tuple:
+        """The sizes of order m's fields in c, in order: (λ2, λ̄, η) at m = 0, (R, T, Z) at m ≥ 1; a field's k-th
+        coefficient is the same function (P_k or P_{k+2} − P_k) at every degree."""
+        hoops, bubbles = self.disc.hoops, self.disc.degree - 1
+        return (hoops, 1, bubbles) if m == 0 else (hoops, hoops, bubbles)
+
+    def raised(self, c: np.ndarray, to: "TubeSurfaceBasis") -> np.ndarray:
+        """c as coefficients of ``to`` (the same ends and length, a degree and orders at least this one's): each
+        field's coefficients zero-padded, the orders ``to`` adds zero: the same surface."""
+        if not (to.disc.degree >= self.disc.degree and set(self.orders) <= set(to.orders)
+                and (to.disc.ends, to.disc.length) == (self.disc.ends, self.disc.length)):
+            raise ValueError(f"to: degree {to.disc.degree}, orders {to.orders} (allowed: the same ends and length, "
+                             f"degree ≥ {self.disc.degree}, orders holding {self.orders})")
+        out = np.zeros(to.size)
+        for m in self.orders:
+            source, target = c[self.block(m)], out[to.block(m)]
+            i = j = 0
+            for size, wider in zip(self.fields(m), to.fields(m)):
+                target[j:j + size] = source[i:i + size]
+                i, j = i + size, j + wider
+        return out
+
     def profile(self, c: np.ndarray, S: np.ndarray, phi: np.ndarray) -> np.ndarray:
         """(3, S.size, phi.size): the Cartesian deformed point at reference arclengths S and azimuths φ."""
         S, phi = np.asarray(S, dtype=float), np.asarray(phi, dtype=float)

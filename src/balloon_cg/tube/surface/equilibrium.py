@@ -13,7 +13,7 @@ end planes, −P v (tube/surface/volume.py). A node variable is Σ_j T[·, node,
 
 (sum-factorised over φ: tube/surface/basis.py ``project``, ``hessian``).
 
-Coils and a voltage are not built (one line): the field's H² needs x in Cartesian components and its rows.
+Coils and a voltage are refused (SceneError, one line: ``refuse_scene``): the field's H² needs x in Cartesian components and its rows.
 """
 import numpy as np
 
@@ -21,22 +21,31 @@ from . import volume
 from .basis import NODE_VARIABLES, TubeSurfaceBasis
 from ...galerkin.discretisation import symmetric_rows
 from ...galerkin.equilibrium import NonFiniteState, Parameters
-from ...model.kernels import PLAIN, KernelSet, scene_terms
+from ...model.kernels import PLAIN, KernelSet
 from ...numerics.newton import finite
 from ...scene.tables import Shape
+from ...scene.validation import SceneError
+
+
+def refuse_scene(scene) -> None:
+    """SceneError, one line naming the key, its value and what is allowed, for what the tube over (S, φ) does not
+    take: another shape, coils, a voltage."""
+    if scene.geometry.shape != Shape.TUBE:
+        raise SceneError(f"geometry.shape = {scene.geometry.shape.value!r}: the tube over (S, φ) is a tube's "
+                         '(allowed: "tube")')
+    if scene.field.coils:
+        raise SceneError(f"field.coils = {len(scene.field.coils)} coil(s): the tube over (S, φ) has no field "
+                         "(allowed: no coils)")
+    if scene.electric is not None:
+        raise SceneError(f"electric.voltage = {scene.electric.voltage:g}: the tube over (S, φ) has no dielectric "
+                         "term (allowed: no [electric] table)")
 
 
 class TubeSurfaceEquilibrium:
     """E, ∇E, ∇²E and V/(2π) of a tube scene (field-free, no voltage) in a TubeSurfaceBasis."""
 
     def __init__(self, scene, basis: TubeSurfaceBasis):
-        if scene.geometry.shape != Shape.TUBE:
-            raise ValueError(f"geometry.shape: {scene.geometry.shape.value!r}; the tube over (S, φ) is a tube's "
-                             '(allowed: "tube")')
-        if scene_terms(scene) != PLAIN:
-            extra = ", ".join(scene_terms(scene)[1:])
-            raise ValueError(f"field.coils / electric: the scene's terms {extra}; the tube over (S, φ) has the "
-                             "membrane and the pressure only (allowed: no coils, no [electric] table)")
+        refuse_scene(scene)
         if basis.disc.ends != scene.geometry.ends:
             raise ValueError(f"basis ends: {basis.disc.ends.value!r} (allowed: the scene's, "
                              f"{scene.geometry.ends.value!r})")
@@ -90,7 +99,7 @@ class TubeSurfaceEquilibrium:
     def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str = "P") -> np.ndarray:
         """∂R/∂P = −∂(V/2π)/∂c (the only continuation parameter built here)."""
         if name != "P":
-            raise ValueError(f"continuation parameter: {name!r}; the tube over (S, φ) is continued in P only "
-                             '(allowed: "P")')
+            raise SceneError(f"continuation.parameter = {name!r}: the tube over (S, φ) is continued in P only "
+                             '(allowed: "pressure")')
         state = self.basis.node_state(c)
         return -self.basis.project(volume.gradient(state) * self.basis.weights)

@@ -8,9 +8,8 @@ At the zero (tube/azimuthal_crossings.AzimuthalCrossing: the axisymmetric state 
     ∇E(c; P) + τ G t = 0,      tᵀ G c_1 = 0,      φᵀ G c_m = ε,
 
 from the predictor (u + ε φ, P_0), by Newton with the exact Jacobian (numerics/newton.py, the two conditions its
-bordering rows). t is the sideways translation (R = 1, T = −1, Z = 0 in order 1, sliding ends), a zero mode of E
-without a field: its gauge is the centroid held (tube/azimuthal.py's removed mode), its multiplier the reaction, zero
-at an equilibrium since E is invariant under t. The condition on the amplitude fixes the point on the branch:
+bordering row; tube/surface/system.py: t the sideways translation on sliding ends, its centroid held, τ its
+reaction, 0 at an equilibrium). The condition on the amplitude fixes the point on the branch:
 a pitchfork (the rotation by π/m maps c_m to −c_m), P − P_0 = O(ε²).
 """
 from dataclasses import dataclass
@@ -19,11 +18,11 @@ import numpy as np
 
 from .basis import TubeSurfaceBasis
 from .equilibrium import TubeSurfaceEquilibrium
+from .system import TubeSurfaceSystem
 from .. import azimuthal
 from ...galerkin.equilibrium import Parameters
 from ...galerkin.interval import IntervalDiscretisation
 from ...numerics.newton import newton
-from ...scene.tables import Ends
 
 
 @dataclass(frozen=True)
@@ -43,6 +42,13 @@ class SwitchedPoint:
     message: str
 
 
+def mode_row(basis: TubeSurfaceBasis, crossing) -> np.ndarray:
+    """G φ in c (order m): its product with c is the amplitude φᵀ G c_m of the crossing's critical mode φ."""
+    row = np.zeros(basis.size)
+    row[basis.block(crossing.m)] = azimuthal.operators(basis.disc)[1] @ crossing.mode
+    return row
+
+
 def switched_point(scene, disc: IntervalDiscretisation, crossing, amplitude: float, params: Parameters,
                    orders: tuple | None = None, n_phi: int = 0, tol: float = 1e-12,
                    max_iter: int = 30) -> SwitchedPoint:
@@ -57,44 +63,19 @@ def switched_point(scene, disc: IntervalDiscretisation, crossing, amplitude: flo
     basis = TubeSurfaceBasis(disc, orders or (0, m, 2 * m), n_phi)
     if m not in basis.orders:
         raise ValueError(f"orders: {basis.orders} lack the crossing's order (allowed: orders holding m = {m})")
-    surface = TubeSurfaceEquilibrium(scene, basis)
-    gram = azimuthal.operators(disc)[1]
-    free = basis.free
-    mode_row = np.zeros(basis.size)
-    mode_row[basis.block(m)] = gram @ crossing.mode
-    gauge = np.zeros(basis.size)
-    if 1 in basis.orders and disc.ends == Ends.SLIDING:
-        gauge[basis.block(1)] = gram @ azimuthal.translation(disc)
-    n, gauged = free.size, bool(gauge.any())
-    width = n + 1 + gauged
-
-    def state(X):
-        c = basis.axisymmetric(crossing.u)
-        c[free] = X[:n]
-        return c, params.with_value("P", X[n])
-
-    def residual(X):
-        c, at = state(X)
-        R = surface.residual(c, at)[free]
-        return R + X[n + 1] * gauge[free] if gauged else R
-
-    def jacobian(X):
-        c, at = state(X)
-        J = np.empty((n, width))
-        J[:, :n] = surface.hessian(c, at)[np.ix_(free, free)]
-        J[:, n] = surface.parameter_derivative(c, at)[free]
-        if gauged:
-            J[:, n + 1] = gauge[free]
-        return J
-
-    bordering = np.zeros((1 + gauged, width))
-    bordering[0, :n] = mode_row[free]
-    if gauged:
-        bordering[1, :n] = gauge[free]
     start = basis.with_mode(basis.axisymmetric(crossing.u), m, amplitude * crossing.mode)
-    X0 = np.concatenate([start[free], [crossing.pressure], [0.0] * gauged])
-    targets = np.array([amplitude] + [0.0] * gauged)
-    result = newton(residual, jacobian, X0, bordering, targets, tol, max_iter)
-    c, at = state(result.x)
-    return SwitchedPoint(basis, c, float(at.P), float(amplitude), m, float(result.x[n + 1]) if gauged else 0.0,
+    return point_at_amplitude(scene, basis, start, crossing.pressure, mode_row(basis, crossing), amplitude, m, params,
+                              tol, max_iter)
+
+
+def point_at_amplitude(scene, basis: TubeSurfaceBasis, start: np.ndarray, pressure: float, row: np.ndarray,
+                       amplitude: float, m: int, params: Parameters, tol: float = 1e-12,
+                       max_iter: int = 30) -> SwitchedPoint:
+    """The equilibrium on ``basis`` with row · c = ``amplitude`` (``mode_row``: the amplitude of order m's critical
+    mode) by Newton from (``start``, ``pressure``); the held unknowns (λ̄ of ends held apart) read from ``start``."""
+    system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, basis), params, start)
+    result = newton(system.residual, system.jacobian, system.point(start, pressure),
+                    np.append(row[system.free], [0.0] * (1 + system.gauged)), amplitude, tol, max_iter)
+    c = system.coefficients(result.x)
+    return SwitchedPoint(basis, c, float(result.x[-1]), float(amplitude), m, system.reaction(result.x),
                          bool(result.converged), int(result.iterations), float(result.residual), result.message)
