@@ -26,7 +26,7 @@ from ..results import IntervalStop, signalled
 from ...analysis.branches.problem import continuation_settings
 from ...galerkin.equilibrium import Parameters
 from ...numerics import continuation
-from ...numerics.continuation import Stop
+from ...numerics.continuation import Stop, TraceStop
 from ...scene.loading import Control
 
 START_AMPLITUDE = 0.05  # ε of the switched point the trace starts from (G-unit mode: ~5 % of the tube's radius)
@@ -101,8 +101,11 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
                                                    f"{upper:g}")
         return signalled()
 
-    settings = continuation_settings(scene, (max_points or scene.surface.max_points) - 1)
-    path = continuation.trace(system, start, settings, stop, {"LP": np.eye(X.size)[-1]})
+    max_points = max_points or scene.surface.max_points
+    path = continuation.trace(system, start, continuation_settings(scene, max_points - 1), stop,
+                              {"LP": np.eye(X.size)[-1]})
+    if path.stop.code == TraceStop.MAX_POINTS:  # point 0, the zero, is not the tracer's
+        path.stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
     origin = basis.axisymmetric(crossing.u)
     states = [origin] + [system.coefficients(p.X) for p in path.points]
     pressure = np.array([crossing.pressure] + [p.X[-1] for p in path.points])
