@@ -1,5 +1,5 @@
-"""One point of the non-axisymmetric branch born at a located m ≥ 1 zero of a tube (opt-in: not called by ``run``;
-the branch is not traced, docs/tubes.md "The tube over (S, φ)").
+"""One point of the non-axisymmetric branch born at a located m ≥ 1 zero of a tube, the start of its trace
+(tube/surface/branch.py; docs/tubes.md "The tube over (S, φ)").
 
 At the zero (tube/azimuthal_crossings.AzimuthalCrossing: the axisymmetric state u, the pressure P_0, the critical mode
 φ of the m-th block, G-unit) the branch leaves along φ. With the orders (0, m, 2m) of the branch's dihedral symmetry
