@@ -83,17 +83,17 @@ def test_the_branch_leaves_along_the_critical_mode_as_a_pitchfork(traced):
 
 def test_stability_at_the_first_points_follows_the_normal_form(traced):
     """A pitchfork's reduced energy ½ μ(P) ε² + ¼ b ε⁴ gives the branch P − P_0 = p_2 ε², p_2 = −b/μ'(P_0), and on
-    it the critical eigenvalue 2 b ε² = −2 μ' p_2 ε². With p_2 from the switched points at ε = ±0.05 and μ's sign
+    it the critical eigenvalue 2 b ε² = −2 μ' p_2 ε². With p_2 from the switched point at ε = 0.05 and
     μ'(P_0) = φᵀ (dH_1/dP) φ along the parent (its tangent at the zero, central differences), the eigenvalue of the
-    branch's sector nearest 0 at its first three traced points has the sign of −μ' p_2 and is −2 μ' p_2 ε² to
-    the normal form's order (measured 3.9e-7, 1.5e-5, 6.2e-5 relative at ε = 0.05, 0.12, 0.21; 1e-3 asserted), and the unstable count under pressure control is the zero's (its zero eigenvalue not
-    counted: it is 0 to rounding, 1e-9 of the largest) plus one where that sign is negative."""
+    branch's sector nearest 0 at its first three traced points has the sign of −μ' p_2 and is −2 μ' p_2 ε² to the
+    normal form's order (measured 3.9e-7, 1.5e-5, 6.2e-5 relative at ε = 0.05, 0.12, 0.21; 1e-3 asserted), and the
+    unstable count under pressure control is the zero's (its zero eigenvalue not counted: it is 0 to rounding, 1e-9
+    of the largest) plus one where that sign is negative."""
     scene, parent, zero, plus, _ = traced
     p2 = (switched_point(scene, parent.disc, zero, START_AMPLITUDE, parent.params).pressure - zero.pressure) / 0.05**2
     system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, plus.basis), parent.params, plus.coefficients[0])
     read = SectorStability(system)
     eq = Equilibrium(scene, parent.disc)
-
     free, h = parent.disc.free, 1e-5
     at = parent.params.with_value("P", zero.pressure)
     rate = np.zeros(parent.disc.size)  # du/dP along the parent at the zero (its m = 0 Jacobian is regular there)
@@ -103,7 +103,7 @@ def test_stability_at_the_first_points_follows_the_normal_form(traced):
              for s in (1, -1)]
     slope = zero.mode @ (moved[0] - moved[1]) @ zero.mode / (2 * h)  # μ'(P_0) = φᵀ (dH_1/dP) φ, φ G-unit
     sign = np.sign(-slope * p2)
-    at_zero = np.linalg.eigvalsh(read.pressure_matrix(plus.coefficients[0], parent.params.with_value("P", zero.pressure)))
+    at_zero = np.linalg.eigvalsh(read.pressure_matrix(plus.coefficients[0], at))
     zero_count = int(np.sum(at_zero < -1e-9 * np.max(np.abs(at_zero))))
     for k in (1, 2, 3):
         values = np.linalg.eigvalsh(read.pressure_matrix(plus.coefficients[k],
@@ -152,7 +152,8 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     assert shown["points"] == 4 and shown["parent"] == {"branch": "primary", "zero": 0}
     assert shown["stop_code"] == "max_points" and shown["stable_points"] == 0
     assert "surface branch m1_bp0 (m = 1, from zero 0 of block m = 1 of primary): 4 points" in format_tube(summary)
-    for extra, key in (("[field]\nM = 0.5\n[[field.coils]]\nradius = 1.5\nheight = 0.0\ncurrent = 1.0\n", "field.coils = 1"),
+    coil = "[field]\nM = 0.5\n[[field.coils]]\nradius = 1.5\nheight = 0.0\ncurrent = 1.0\n"
+    for extra, key in ((coil, "field.coils = 1"),
                        ("[electric]\nvoltage = 0.1\n", "electric.voltage = 0.1"),
                        ("[stability]\nm_max = 0\n", "stability.m_max")):
         with pytest.raises(SceneError) as error:

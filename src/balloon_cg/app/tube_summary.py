@@ -229,7 +229,8 @@ def format_tube(summary: dict) -> str:
                                                          for name, value in s["omega2"].items()))
     for name, b in summary.get("surface_branches", {}).items():
         lines += ["", f"surface branch {name} (m = {b['m']}, from zero {b['parent']['zero']} of block m = {b['m']} of "
-                      f"{b['parent']['branch']}): {b['points']} points, P {b['pressure'][0]:.8g}..{b['pressure'][1]:.8g}, "
+                      f"{b['parent']['branch']}): {b['points']} points, "
+                      f"P {b['pressure'][0]:.8g}..{b['pressure'][1]:.8g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, amplitude {b['amplitude'][0]:.4g}.."
                       f"{b['amplitude'][1]:.4g}, stop {b['stop_code']} ({b['stop_message']}); {b['stable_points']} "
                       f"stable under {summary['control']} control; largest error estimate "

@@ -278,7 +278,8 @@ def read_tube_run(path) -> dict:
 
 def read_tube(f, path, where: str = "") -> dict:
     """{'attrs', 'branches', 'onset', 'surface_branches'} of the tube run written by ``write_tube`` into the open file
-    or group ``f`` (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
+    or group ``f`` (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is
+    missing."""
     attrs = {"interrupted": "", "control": "pressure", "not_started": ""} | {k: _text(plain(v))
                                                                              for k, v in f.attrs.items()}
     if "branches" not in f or "primary" not in f["branches"]:

@@ -57,15 +57,16 @@ class Stage(enum.StrEnum):
 
 @dataclass(frozen=True)
 class TubePicture:
-    """The branches by name ("primary", "bulge" and "bulge_<label>" where they were switched: ``branch_name``), Maxwell's pressure (None where the
-    uniform closed path has no maximum and minimum, the ends are held, or coils act: ``maxwell``), for ``critical``
-    the onset of bulging followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the
-    work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
-    not); ``frequencies``: with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch
-    name); ``modes``: each branch's m = 1..``stability.m_max`` blocks (tube/azimuthal.TubeModes by branch name; None:
-    not assessed, m_max = 0 or a signal); ``surface``: the non-axisymmetric branches traced from the m ≥ 1 zeros
-    (``with_surface``: tube/surface/branch.TubeSurfaceBranch by name; None: none asked); ``not_started``: (name, why) of the switched branches that could not start
-    (the run is then incomplete: exit 1)."""
+    """The branches by name ("primary", "bulge" and "bulge_<label>" where they were switched: ``branch_name``),
+    Maxwell's pressure (None where the uniform closed path has no maximum and minimum, the ends are held, or coils
+    act: ``maxwell``), for ``critical`` the onset of bulging followed in a second parameter (tube/onset.py), and the
+    stage a signal stopped (None: the work is whole; the stage's branch or curve ends ``interrupted`` where it had
+    started, and is absent where it had not); ``frequencies``: with [dynamics] frequencies, each branch's
+    (dynamics/tube.py: TubeFrequencies by branch name); ``modes``: each branch's m = 1..``stability.m_max`` blocks
+    (tube/azimuthal.TubeModes by branch name; None: not assessed, m_max = 0 or a signal); ``surface``: the
+    non-axisymmetric branches traced from the m ≥ 1 zeros (``with_surface``: tube/surface/branch.TubeSurfaceBranch
+    by name; None: none asked); ``not_started``: (name, why) of the switched branches that could not start (the run
+    is then incomplete: exit 1)."""
 
     branches: dict
     maxwell: float | None

@@ -13,7 +13,8 @@ end planes, −P v (tube/surface/volume.py). A node variable is Σ_j T[·, node,
 
 (sum-factorised over φ: tube/surface/basis.py ``project``, ``hessian``).
 
-Coils and a voltage are refused (SceneError, one line: ``refuse_scene``): the field's H² needs x in Cartesian components and its rows.
+Coils and a voltage are refused (SceneError, one line: ``refuse_scene``): the field's H² needs x in Cartesian
+components and its rows.
 """
 import numpy as np
 

@@ -1,13 +1,11 @@
 """Stability of a state of the tube over (S, φ) in its mirror sector (y → −y: every order's cos/sin pattern of
-tube/surface/basis.py), as tube/stability.py reads the axisymmetric states.
-
-The second variation is the Hessian H of E/(2π) on the free coefficients, in the pencil with the block-diagonal
-metric M = diag(1 on order 0 (tube/stability.py's), G on each m ≥ 1 order (tube/azimuthal.py's Gram matrix)), the
-sideways translation removed on sliding ends (its centroid held, tᵀ G c_1 = 0: a zero mode without a field, so the
-held and free readings are one). Under pressure control: the lowest COUNT eigenvalues and the number of negative
-ones (from the eigenvalues); under volume control on δṼ = g·δc = 0 (g = ∇Ṽ = −∂R/∂P); under gas control of H + (P/Ṽ) g gᵀ
-(numerics/eigen.restricted: the inertia, which M does not change, is the stability; the eigenvalues' sizes are on
-M).
+tube/surface/basis.py), as tube/stability.py reads the axisymmetric states. The second variation is the Hessian H of
+E/(2π) on the free coefficients, in the pencil with the block-diagonal metric M = diag(1 on order 0
+(tube/stability.py's), G on each m ≥ 1 order (tube/azimuthal.py's Gram matrix)), the sideways translation removed on
+sliding ends (its centroid held, tᵀ G c_1 = 0: a zero mode without a field, so the held and free readings are one).
+Under pressure control: the lowest COUNT eigenvalues and the number of negative ones (from the eigenvalues); under
+volume control on δṼ = g·δc = 0 (g = ∇Ṽ = −∂R/∂P); under gas control of H + (P/Ṽ) g gᵀ (numerics/eigen.restricted: the
+inertia, which M does not change, is the stability; the eigenvalues' sizes are on M).
 """
 import numpy as np
 from scipy import linalg
