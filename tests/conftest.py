@@ -22,7 +22,7 @@ COST = {  # CPU seconds of each file in one run of the default suite on 2 worker
     # process and its children; session 23, the machine loaded 5-13: only the order matters), files of 5 s or more
     "test_interrupt_moments": 125, "test_paper": 62, "test_restart": 47, "test_surface": 47, "test_codegen": 45,
     "test_packaging": 43, "test_cli_conventions": 31, "test_plot_sizes": 25, "test_verdict": 24,
-    "test_tube_interrupt": 24, "test_capsule": 23, "test_signal_moments": 22, "test_crash": 18,
+    "test_tube_interrupt": 24, "test_capsule": 23, "test_signal_moments": 22, "test_tube_surface": 20, "test_crash": 18,
     "test_damaged_fuzz": 17, "test_plotting": 15, "test_shooting": 15, "test_sweep": 15, "test_branch_points": 14,
     "test_checked_reads": 13, "test_api_notebook": 13, "test_azimuthal_points": 12, "test_surface_kernels": 11,
     "test_poles": 11, "test_events": 11, "test_dynamics": 10, "test_energies": 9, "test_formula": 9, "test_api": 8,

@@ -120,7 +120,8 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
 
     stage = run["attrs"]["interrupted"]
     if stage:
-        stopped = (b for b in run["branches"].values() if b["attrs"]["stop_code"] == StopCode.INTERRUPTED.value)
+        traced = [*run["branches"].values(), *run.get("surface_branches", {}).values()]
+        stopped = (b for b in traced if b["attrs"]["stop_code"] == StopCode.INTERRUPTED.value)
         stored = run["onset"] if stage == "onset" else next(stopped, None)  # the branch the signal stopped
         if stage == "frequencies":
             done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]

@@ -266,6 +266,12 @@ class Surface:
 SURFACE_BRANCHES = ("first", "all", "none")
 
 
+def default_surface(shape) -> Surface:
+    """The [surface] table a scene without one has: on a tube ``branches = "none"`` (its non-axisymmetric branches,
+    tube/surface/branch.py, are not verified enough to be traced by default: docs/tubes.md), else ``Surface()``."""
+    return Surface(branches="none") if shape == Shape.TUBE else Surface()
+
+
 @dataclass(frozen=True)
 class Dynamics:
     """Natural frequencies (MODEL.md §11, docs/dynamics.md): with ``frequencies`` the lowest ``count`` Ω² of every
@@ -388,7 +394,7 @@ class Scene:
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
                                                                   "control": self.loading.control.value}}),
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
-            **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
+            **({} if self.surface == default_surface(self.geometry.shape) else {"surface": asdict(self.surface)}),
             **({"events": [e.to_table() for e in self.events]} if self.events else {}),
             **({} if self.geometry == Geometry() else {"geometry": self.geometry.to_table()}),
             **({} if self.dynamics == Dynamics() else {"dynamics": asdict(self.dynamics)}),
@@ -685,6 +691,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
     stability = _stability(data.get("stability", {}))
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
+    surface = _surface(data.get("surface", {}), geometry.shape)
+    if geometry.shape == Shape.TUBE:
+        _tube_surface_reads(surface, field, electric, stability)
     return Scene(
         name=name,
         material=material,
@@ -696,11 +705,28 @@ def _build(data: dict, name: str, text: str) -> Scene:
         electric=electric,
         text=text,
         loading=loading,
-        surface=_surface(data.get("surface", {})),
+        surface=surface,
         events=events,
         geometry=geometry,
         dynamics=dynamics,
     )
+
+
+def _tube_surface_reads(surface: Surface, field, electric, stability) -> None:
+    """SceneError for a tube's [surface] branches (tube/surface/branch.py) where they are not built: in a coil's
+    field, under a voltage, without the m ≥ 1 zeros they start from (stability.m_max = 0)."""
+    if surface.branches == "none":
+        return
+    asked = f"surface.branches = {show(surface.branches)}"
+    if field.coils:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches are traced without a field, not with "
+                         f"field.coils = {len(field.coils)} coil(s); allowed: \"none\" with coils")
+    if electric is not None:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches are traced without a voltage, not with "
+                         f"electric.voltage = {electric.voltage:g}; allowed: \"none\" with [electric]")
+    if stability.m_max < 1:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
+                         f"stability.m_max ≥ 1, not {stability.m_max}; allowed: \"none\" with stability.m_max = 0")
 
 
 def _tube_voltage_reads(field, stability, dynamics, events) -> None:
@@ -1047,10 +1073,10 @@ def _stability(data) -> Stability:
     )
 
 
-def _surface(data) -> Surface:
+def _surface(data, shape) -> Surface:
     data = table("surface", data, _keys(Surface))
     get = _getter(data, "surface", Surface)
-    branches = data.get("branches", Surface.branches)
+    branches = data.get("branches", default_surface(shape).branches)
     if branches not in SURFACE_BRANCHES:
         raise SceneError(f"surface.branches = {show(branches)}: must be one of "
                          + ", ".join(f'"{b}"' for b in SURFACE_BRANCHES))
