@@ -38,19 +38,22 @@ Known to fail on the session-25 machine (numpy 2.4.6, scipy 1.17.1, OpenBLAS 0.3
 on an AMD EPYC), not re-recorded (neither result is the better one; the comparison by point index is what breaks):
 spom1_single_coil and tpom1_two_coils_M0.002. The same code gives the same result there at bec04f4 (which recorded
 the tpom1 table on the previous machine) as on main e7c4889 (spom1: within 1.1e-10; tpom1: identical), so it is the
-build, not a commit. spom1_single_coil: its primary branch's samples agree (P to ~1e-15) up to point 67, the first
-point of a leg restarted at degree 60 near the wire; the step after it takes 1 corrector iteration with these
-kernels and 4 with others (the simplified Newton's Jacobian refresh and the ≤ 3-iterations step growth decided at
-rounding), so the samples after it differ and the leg reaches wire_gap after 75 points instead of 74. With
+build, not a commit. spom1_single_coil: its primary branch's samples agree (P to ~1e-15) up to point 67 (P
+0.876362), where the leg's last point is recomputed at degree 60 on the better of two wire maps (``Tracer._refine``:
+the smaller tail estimate): the current map (width 0.06672) and the re-centred one (0.05710) leave 1.087e-13 and
+1.123e-13 with these kernels, 1.439e-13 and 0.910e-13 with Sandybridge's; both at the tail's rounding floor, far
+below max_error, and the choice between them is rounding. On the other map the leg's tangent and so its samples
+differ from there on, and it reaches wire_gap after 75 points instead of 74. With
 OPENBLAS_CORETYPE=Sandybridge main reproduces the stored table (the comparison passes, 74 points); both builds give
 every other branch with the same samples, and every special point's λ2 and η on a 2001-point θ grid within 8e-12
 but two: the TP at point 71 (P 3.5e-10 apart, within the rule; λ2 1.6e-9) and the wire-gap end point (the first
-sample inside the gap: P 0.84084 against 0.84200); through the storage basis re-centred on the branch's points,
-every primary special point's coefficients moved by 0.013 to 0.05 (at P within 4e-12 but those two).
-tpom1_two_coils_M0.002: pear_free_1's (and its mirror's) point 28, the sample before its end point, lies 1.2e-5 in P
-earlier in the table (its m1 eigenvalues 3.4e-5 off, on the same curve between points 27 and 29, which agree to
-1e-11), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP): another
-storage map. Here the Haswell and Sandybridge kernels agree on every sample and on those points' λ2 and η (7.7e-11),
+sample inside the gap: P 0.84084 against 0.84200); the primary's storage map follows its last points (width
+0.02339 against 0.02725 at degree 60), so every primary special point's coefficients moved by 0.013 to 0.05 (at P
+within 4e-12 but those two).
+tpom1_two_coils_M0.002: pear_free_1's (and its mirror's) point 28, the sample before its end point, lies about 1.2e-5 in
+P earlier in the table (read off its m1 eigenvalue; the table stores no P of a sample) (its m1 eigenvalues 3.4e-5 off, on the same curve between points 27 and 29, which agree to
+1e-11), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP): by the
+spom1 case, another storage map (the table stores none). Here the Haswell and Sandybridge kernels agree on every sample and on those points' λ2 and η (7.7e-11),
 so the previous machine's different last sample could not be reproduced. A rule that survives a rounding-level step
 decision would store each branch's sampled P, compare eigenvalues by index only while the samples agree, and
 compare special points as λ2, η on a fixed θ grid (or with the storage map stored) instead of as coefficients."""
