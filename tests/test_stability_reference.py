@@ -50,9 +50,9 @@ but two: the TP at point 71 (P 3.5e-10 apart, within the rule; λ2 1.6e-9) and t
 sample inside the gap: P 0.84084 against 0.84200); the primary's storage map follows its last points (width
 0.02339 against 0.02725 at degree 60), so every primary special point's coefficients moved by 0.013 to 0.05 (at P
 within 4e-12 but those two).
-tpom1_two_coils_M0.002: pear_free_1's (and its mirror's) point 28, the sample before its end point, lies about 1.2e-5 in
-P earlier in the table (read off its m1 eigenvalue; the table stores no P of a sample) (its m1 eigenvalues 3.4e-5 off, on the same curve between points 27 and 29, which agree to
-1e-11), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP): another
+tpom1_two_coils_M0.002: pear_free_1's (and its mirror's) point 28, the sample before its end point, lies about
+1.2e-5 in P earlier in the table (read off its m1 eigenvalues, 3.4e-5 off, on the same curve between points 27 and
+29, which agree to 1e-11; the table stores no P of a sample), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP): another
 storage map. The same choice as spom1's: at point 27 (P 2.245873) ``Tracer._refine`` keeps, of two maps at degree
 202, the one with tail 2.7894e-11 (widths 0.18979, 0.24705) over 2.8036e-11 (widths 0.16903, 0.23597), 0.5% apart;
 read on that other map the table's LP and EP are this machine's to 4.8e-14 and 8.2e-11 in λ2 and η on a 2001-point
