@@ -52,8 +52,8 @@ sample inside the gap: P 0.84084 against 0.84200); the primary's storage map fol
 within 4e-12 but those two).
 tpom1_two_coils_M0.002: pear_free_1's (and its mirror's) point 28, the sample before its end point, lies about
 1.2e-5 in P earlier in the table (read off its m1 eigenvalues, 3.4e-5 off, on the same curve between points 27 and
-29, which agree to 1e-11; the table stores no P of a sample), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP): another
-storage map. The same choice as spom1's: at point 27 (P 2.245873) ``Tracer._refine`` keeps, of two maps at degree
+29, which agree to 1e-11; the table stores no P of a sample), and its two special points' coefficients moved by
+0.021 at P within 4e-16 (LP) and 1.8e-12 (EP): another storage map. The same choice as spom1's: at point 27 (P 2.245873) ``Tracer._refine`` keeps, of two maps at degree
 202, the one with tail 2.7894e-11 (widths 0.18979, 0.24705) over 2.8036e-11 (widths 0.16903, 0.23597), 0.5% apart;
 read on that other map the table's LP and EP are this machine's to 4.8e-14 and 8.2e-11 in λ2 and η on a 2001-point
 θ grid (on this machine's map they are 0.019 off). Here the Haswell and Sandybridge kernels both keep the first map
