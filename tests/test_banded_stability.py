@@ -32,7 +32,6 @@ TWO_COILS, SPOM1 = SCENES / "spom1_two_coils_M0.002.toml", SCENES / "spom1.toml"
 
 
 def _band(A: np.ndarray, bandwidth: int) -> np.ndarray:
-    n = A.shape[0]
     return np.array([np.concatenate([np.diag(A, -d), np.zeros(d)]) for d in range(bandwidth + 1)])
 
 

@@ -6,7 +6,7 @@ from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.results import Block, Classification, Kind, Origin, Status, StopCode
 from balloon_cg.analysis.switching.pear import mark_rejoin, trace_pear
 from balloon_cg.scene.materials import get_preset
-from balloon_cg.scene import load_scene, parse_scene
+from balloon_cg.scene import parse_scene
 from balloon_cg.model.sphere import sphere_pressure
 from balloon_cg.model.sphere_modes import bifurcation_stretches
 from shared_pictures import two_coil_picture

@@ -22,7 +22,7 @@ from balloon_cg.dynamics.pencil import mass_variation
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.model import meridian
-from balloon_cg.scene import SceneError, Shape, load_scene, parse_scene
+from balloon_cg.scene import Shape, load_scene, parse_scene
 from balloon_cg.scene.tables import Geometry
 from test_dynamics import located_zeros
 

@@ -82,7 +82,7 @@ def test_sliding_held_tube_has_the_fixed_stretch_maximum_and_minimum():
     by the corrector off the mode: tube/primary._off_mode_corrector)."""
     scene = held_scene("SPOM1", 10.0, 1.5, "sliding", 20)
     branch = primary_branch(scene)
-    disc, k = branch.disc, branch.disc.axial_index
+    k = branch.disc.axial_index
     assert branch.stop.code == IntervalStop.HOOP_STRETCH
     energy = symbolic_energy(scene.material)
     folds = fixed_stretch_folds(energy, 1.5, (1.5, 4.8))

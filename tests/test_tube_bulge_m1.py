@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from scipy.linalg import eigh
 
-from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.azimuthal_crossings import crossings

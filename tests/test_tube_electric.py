@@ -23,7 +23,6 @@ from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
 from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.model import tube
 from balloon_cg.model.membrane import Charged, stretch_derivatives
-from balloon_cg.scene import SceneError, parse_scene
 from balloon_cg.tube.primary import primary_branch
 from balloon_cg.tube.results import IntervalStop
 from test_interval import ogden, series, tube_scene

@@ -7,7 +7,7 @@ integral of MODEL.md §3 (written here: the trapezoid rule in ψ, spectrally acc
 """
 import numpy as np
 
-from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.model import tube
 from balloon_cg.model.kernels import KernelSet

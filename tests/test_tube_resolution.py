@@ -15,7 +15,7 @@ from balloon_cg.tube.primary import primary_branch
 from balloon_cg.tube.resolution import resolved_bulge_branch
 from balloon_cg.tube.results import IntervalStop
 from shared_pictures import first_bulge_picture
-from test_interval import ogden, series, tube_scene
+from test_interval import ogden, tube_scene
 
 FOLD = (1.3628306751130, 2.7222883983230)  # SPOM1, L = 10: the bulge's volume fold (P, V/V0), docs/tubes.md
 

@@ -177,7 +177,7 @@ def format_tube(summary: dict) -> str:
              f"created        {p['created']}  (balloon-cg {p['package_version']}, format {p['format']})",
              f"command        {p['command']}",
              f"shape          tube of length {g['length']:g}, {g['ends']} ends, end distance {held}",
-             f"field          " + (f"{summary['field']['coils']} coil(s), M = {summary['field']['M']:g}"
+             "field          " + (f"{summary['field']['coils']} coil(s), M = {summary['field']['M']:g}"
                                    if summary["field"]["coils"] else "none"),
              "voltage        " + ("none" if summary["voltage"] is None else f"Φ̄ = {summary['voltage']:g}"
                                      if summary["parameter"] != "voltage" else

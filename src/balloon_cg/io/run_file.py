@@ -382,11 +382,11 @@ def _write_surface_stability(group, lowest: dict, point) -> None:
     """lowest_<reading> (held, free, held_volume, free_volume, held_gas, free_gas: every symmetry sector, zero
     modes removed: surface.stability) and the flags they give."""
     columns = {f"lowest_{reading}": np.asarray(values, dtype=float) for reading, values in lowest.items()}
-    for name, reading in (("stable_pressure", "held"), ("stable_pressure_free", "free"),
-                          ("stable_volume", "held_volume"), ("stable_volume_free", "free_volume"),
-                          ("stable_gas", "held_gas"), ("stable_gas_free", "free_gas")):
-        if reading in lowest:
-            checksummed(group, name, np.asarray(lowest[reading])[:, 0] > 0)
+    for name, sector_reading in (("stable_pressure", "held"), ("stable_pressure_free", "free"),
+                                 ("stable_volume", "held_volume"), ("stable_volume_free", "free_volume"),
+                                 ("stable_gas", "held_gas"), ("stable_gas_free", "free_gas")):
+        if sector_reading in lowest:
+            checksummed(group, name, np.asarray(lowest[sector_reading])[:, 0] > 0)
             group[name].attrs["meaning"] = STABILITY_FLAGS[name]
     eigenvalue = scale(group, "eigenvalue", max(v.shape[1] for v in columns.values()))
     for name, values in columns.items():

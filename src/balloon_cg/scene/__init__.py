@@ -9,4 +9,5 @@ from .tables import (Coil, Continuation, ContinuationParameter, Electric, Ends, 
 from .validation import SceneError
 
 __all__ = ["Coil", "Continuation", "ContinuationParameter", "Control", "Electric", "Ends", "Field", "Geometry",
-           "Loading", "Output", "Scene", "SceneError", "Shape", "Solver", "Stability", "load_scene", "parse_scene"]
+           "Loading", "Output", "Scene", "SceneError", "Shape", "Solver", "Stability", "load_scene", "parse_scene",
+           "shipped_scenes"]
