@@ -21,7 +21,7 @@ ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 COST = {  # CPU seconds of each file in one run of the default suite on 2 workers (benchmarks/suite_cpu.py --cost, this
     # process and its children; session 23, the machine loaded 5-13: only the order matters), files of 5 s or more
     "test_interrupt_moments": 125, "test_spheroid_voltage": 28, "test_plugged_bifurcation": 20,
-    "test_tube_surface_branch": 6, "test_paper": 62, "test_restart": 47, "test_surface": 47, "test_codegen": 45,
+    "test_tube_surface_branch": 6, "test_paper": 55, "test_restart": 46, "test_surface": 40, "test_codegen": 45,
     "test_packaging": 43, "test_cli_conventions": 31, "test_plot_sizes": 25, "test_verdict": 24,
     "test_tube_interrupt": 24, "test_capsule": 23, "test_signal_moments": 22, "test_tube_surface": 20, "test_crash": 18,
     "test_damaged_fuzz": 17, "test_plotting": 15, "test_shooting": 15, "test_sweep": 15, "test_branch_points": 14,
@@ -33,13 +33,16 @@ COST = {  # CPU seconds of each file in one run of the default suite on 2 worker
     "test_surface_pitchforks": 5, "test_fold_curve": 5, "test_interval": 5, "test_schema": 5,
     "test_hostile_memory": 5,
     # session 24's new files, from their helpers' serial runs at load ~20 (rough: only the order matters)
-    "test_graded_elements": 20, "test_capsule_frequencies": 10,
+    "test_graded_elements": 8, "test_capsule_frequencies": 10,
     # session 25: the tube files it changed, measured on 2 workers at load 17-25 with a fresh numba cache (the first
     # file on a worker carries the compile): test_tube_cli 33, test_tube_control 24, test_dynamics_tube 10,
     # test_tube_resolution 9, test_tube_result 8, test_tube_continue 7, here divided by 2.5 (that run's load inflated
     # CPU: test_interrupt_moments 313 s against the 125 above) and kept where 5 s or more; test_tube_bulge_m1
     # measured at 3 s in the default suite, so dropped (was 35)
     "test_tube_cli": 13, "test_tube_control": 10,
+    # session 26 (s26-inproc) set test_paper, test_restart, test_surface and test_graded_elements above from its
+    # branch's run of the files it changed, on 2 workers at load 15-26 (benchmarks/results/suite_cpu_session26_inproc
+    # .txt), scaled by 0.65 (this table's sum over paper, restart, surface, capsule against that run's main: 179/275 s)
 }
 
 
