@@ -65,6 +65,26 @@ def shared_file(tmp_path_factory, name: str, write) -> Path:
         return path
 
 
+def two_coil_scene_to(stretch: float) -> bc.Scene:
+    """The shipped two-coil scene without surface branches, traced up to λ2(0) = ``stretch``."""
+    return bc.Scene.from_toml(TWO_COILS).with_overrides({"continuation.stop_stretch": stretch,
+                                                         "surface.branches": "none"})
+
+
+def two_coil_run_file(tmp_path_factory) -> Path:
+    """``balloon-cg run`` of the shipped two-coil scene up to λ2(0) = 1.7 (past its first held and free pear
+    pitchforks, 1.669 and 1.681) without surface branches (primary, pear branches, assessed): a file the restarts of
+    tests/test_restart.py and the ``surface.branches = "none"`` check of tests/test_surface.py read."""
+    from balloon_cg.app.cli import main
+
+    def write(path: Path) -> bool:
+        scene = path.with_name("two_coils.toml")  # the scene's name: two_coils
+        scene.write_text(two_coil_scene_to(1.7).to_toml())
+        return main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+
+    return shared_file(tmp_path_factory, "two_coils_1.7.h5", write)
+
+
 TUBE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
 TUBE_FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s of CPU, every branch switched
 TUBE_COIL = TUBE.with_name("tube_spom1_L10_coil.toml")

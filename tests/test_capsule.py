@@ -27,6 +27,7 @@ from balloon_cg.model import meridian, tube
 from balloon_cg.numerics import continuation
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import SceneError, Shape, parse_scene
+from shared_pictures import shared
 
 # the slow plateau test's start degree and max_error (docs/shapes.md: at the default max_error 1e-9 the branch stops
 # at max_degree soon after its fold, the bulge's fronts wanting more than one cylinder element's degree)
@@ -341,7 +342,14 @@ def pressure_maximum(length: float, degree: int, element: float | None = None) -
     return float(folds[0])
 
 
-def test_a_long_capsule_starts_bulging_at_the_long_tubes_onset():
+def shared_pressure_maximum(tmp_path_factory, length: float, degree: int, element: float | None = None) -> float:
+    """``pressure_maximum`` once per test session (``shared_pictures.shared``): the fold at L = 10 from degree 40 is
+    read by three tests in two files."""
+    return shared(tmp_path_factory, f"capsule_fold_L{length:g}_degree{degree}_element{element}",
+                  lambda: pressure_maximum(length, degree, element))
+
+
+def test_a_long_capsule_starts_bulging_at_the_long_tubes_onset(tmp_path_factory):
     """SPOM1: the capsule's pressure maximum (where its middle starts to bulge: the caps hold the cylinder's ends
     as plugs do, so the bulge is the even mode, a fold in P) at L = 10, 20, 40, traced from degree 40 (the tracer
     refines each to max_error: the capsule's piecewise basis converges spectrally; at L = 10 the trace from degree
@@ -352,23 +360,23 @@ def test_a_long_capsule_starts_bulging_at_the_long_tubes_onset():
     degrees 64 and 96 differed by 4.7e-7)."""
     material = capsule_scene(0.0).material
     peak, onset = tube.pressure_maximum(material).pressure, tube.bulge_onset(material, 40.0).pressure
-    gaps = [pressure_maximum(length, 40) - peak for length in (10.0, 20.0, 40.0)]
+    gaps = [shared_pressure_maximum(tmp_path_factory, length, 40) - peak for length in (10.0, 20.0, 40.0)]
     assert abs(pressure_maximum(10.0, 64) - peak - gaps[0]) < 1e-10
     assert all(gap > 0 for gap in gaps) and gaps[0] / gaps[1] > 5 and gaps[1] / gaps[2] > 5
     assert gaps[2] < 1e-3 and abs(gaps[2] + peak - onset) < 1e-3
 
 
-def test_split_capsule_folds_where_the_single_cylinder_element_does():
+def test_split_capsule_folds_where_the_single_cylinder_element_does(tmp_path_factory):
     """SPOM1 capsule of length 10 with its cylinder cut into 3 elements (element_length 5: a middle element and a
     mirror pair), traced from degree 40 and refined to max_error: its pressure maximum is the single cylinder
     element's (another basis: the cylinder's polynomials in θ of degree up to ~3× higher, no inner boundaries) to
     1e-10 (measured: the same 13 digits, 1.5063197245255; at L = 20 with 3 and 5 elements and at L = 40 with 5, the
     same 13 digits too: docs/shapes.md)."""
-    assert abs(pressure_maximum(10.0, 40, ELEMENT) - pressure_maximum(10.0, 40)) < 1e-10
+    assert abs(pressure_maximum(10.0, 40, ELEMENT) - shared_pressure_maximum(tmp_path_factory, 10.0, 40)) < 1e-10
 
 
 @pytest.mark.slow
-def test_a_split_long_capsule_starts_bulging_at_the_long_tubes_onset():
+def test_a_split_long_capsule_starts_bulging_at_the_long_tubes_onset(tmp_path_factory):
     """SPOM1 capsule of length 40, its cylinder cut into 5 elements (element_length 10), from degree 40: its
     pressure maximum within 1e-3 of the long tube's pressure maximum P* and of a sliding tube's onset at L = 40
     (model/tube), and equal to the single element's to 1e-10 (measured 1.4907571927638 on both, ~40 s loaded)."""
@@ -376,7 +384,7 @@ def test_a_split_long_capsule_starts_bulging_at_the_long_tubes_onset():
     split = pressure_maximum(40.0, 40, 10.0)
     assert abs(split - tube.pressure_maximum(material).pressure) < 1e-3
     assert abs(split - tube.bulge_onset(material, 40.0).pressure) < 1e-3
-    assert abs(split - pressure_maximum(40.0, 40)) < 1e-10
+    assert abs(split - shared_pressure_maximum(tmp_path_factory, 40.0, 40)) < 1e-10
 
 
 @pytest.mark.slow

@@ -24,7 +24,7 @@ from balloon_cg.model import meridian, tube
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import SceneError, parse_scene
 
-from test_capsule import capsule_scene, inflated, pressure_maximum
+from test_capsule import capsule_scene, inflated, shared_pressure_maximum
 
 GRADED = '[geometry]\nshape = "capsule"\nlength = {length}\nelement_length = 5.0\nelement_degrees = "graded"\n'
 
@@ -125,7 +125,7 @@ def test_graded_point_is_the_state_of_a_finer_shared_basis():
     assert point.disc.size < fine.disc.size
 
 
-def test_graded_capsule_folds_where_the_shared_basis_does():
+def test_graded_capsule_folds_where_the_shared_basis_does(tmp_path_factory):
     """SPOM1 capsule of length 10, 3 cylinder elements, traced from degree 40 with geometry.element_degrees =
     "graded": its pressure maximum is the shared basis's (1.5063197245255, docs/shapes.md) to 1e-10, stored on the
     graded basis covering every leg's (``covering_basis``)."""
@@ -133,7 +133,7 @@ def test_graded_capsule_folds_where_the_shared_basis_does():
                         + "[stability]\nm_max = 0\n[continuation]\nstop_stretch = 1.3\n")
     branch = analyse(scene, pear=False).branches[0]
     fold = next(p for p in branch.special if p.kind.value == "LP")
-    assert abs(fold.X[-1] - pressure_maximum(10.0, 40)) < 1e-10
+    assert abs(fold.X[-1] - shared_pressure_maximum(tmp_path_factory, 10.0, 40)) < 1e-10
     assert branch.disc.element_degrees and branch.disc.tail(fold.X[:-1]) <= 1e-9
 
 

@@ -314,9 +314,17 @@ def test_every_figure_keeps_its_text_inside_at_journal_widths(width, drawn, draw
                     if INTERNAL_NAME.search(t.get_text())]
 
 
-def test_figure_pdfs_embed_truetype_fonts_only(runs, tmp_path, capsys):
+def test_figure_pdfs_embed_truetype_fonts_only(runs, drawn, tmp_path, capsys, monkeypatch):
     """``figure all`` into PDFs and one figure into EPS: the fonts are embedded as TrueType (Type 42), never as
-    Type 3 (which many journals reject); TIFF is written too."""
+    Type 3 (which many journals reject); TIFF is written too. The command saves the figures ``drawn`` drew from the
+    same runs at the same width (``draw_figure`` with the command's arguments: the laying out is checked there, the
+    saving here), not drawn a second time."""
+    def shared(figure, loaded, width, reading):
+        assert reading == Reading.PRESSURE and [run["scene_name"] for run in loaded] == [
+            case.load(quick=True).name for case in figure.cases]
+        return drawn(figure.name, width)
+
+    monkeypatch.setattr(app_figures, "draw_figure", shared)
     folder = tmp_path / "figures"
     assert main(["figure", "all", "-o", str(folder), "--runs", str(runs), "--quick", "--quiet", "--width",
                  str(ONE_COLUMN), "--allow-partial"]) == 0

@@ -2,6 +2,7 @@
 one reproduces the branch, and from a fold in a second parameter gives the fold curve ``critical --of`` gives."""
 import json
 import re
+import shutil
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from balloon_cg.io.curve_file import read_curve
 from balloon_cg.io.run_file import read_run
 from balloon_cg.numerics.newton import newton
 from balloon_cg.scene import load_scene
+from shared_pictures import two_coil_run_file, two_coil_scene_to
 
 GENT = '[material]\npreset = "Gent"\n[continuation]\nstart_stretch = 1.01\nmin_stretch = 1.005\nstop_stretch = 5.0\n'
 EVENTS = '\n[[events]]\nquantity = "volume"\nvalue = 20\n'
@@ -208,12 +210,11 @@ def test_continue_from_python(gent_run):
 @pytest.fixture(scope="module")
 def two_coils(tmp_path_factory):
     """The shipped two-coil scene (M = 0.002) up to λ2(0) = 1.7, past its first held and free pear pitchforks (1.669,
-    1.681), without surface branches: its run file (primary, pear branches) and the scene file."""
+    1.681), without surface branches: a folder with its run file (primary, pear branches; the session's
+    ``shared_pictures.two_coil_run_file``, copied) and the scene file."""
     folder = tmp_path_factory.mktemp("two_coils")
-    scene = folder / "two_coils.toml"
-    scene.write_text(load_scene("spom1_two_coils_M0.002").with_overrides(
-        {"continuation.stop_stretch": 1.7, "surface.branches": "none"}).to_toml())
-    assert main(["run", str(scene), "-o", str(folder / "run.h5"), "--quiet"]) == 0
+    shutil.copyfile(two_coil_run_file(tmp_path_factory), folder / "run.h5")
+    (folder / "two_coils.toml").write_text(two_coil_scene_to(1.7).to_toml())
     return folder
 
 

@@ -507,7 +507,7 @@ def test_m1_eigenvalue_and_crossing_with_a_field(two_coil_picture):
     assert abs(found.payload[-1] - bp.X[-1]) <= 1e-9 * bp.X[-1]
 
 
-def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
+def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, tmp_path_factory, capsys):
     """`balloon-cg run` on the shipped two-coil scene stores the branch born at the first m = 1 point and its image:
     the branch reaches its stop (the membrane within wire_gap of the wires on one side, 14 points), every point
     resolved (tail ≤ solver.max_error) and an equilibrium (point 0, the branch point, solved in the axisymmetric
@@ -518,6 +518,7 @@ def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
 
     import balloon_cg as bc
     from balloon_cg.app.cli import main
+    from balloon_cg.io.run_file import read_run, stored_scene
 
     scene = ROOT / "scenes" / "spom1_two_coils_M0.002.toml"
     out = tmp_path / "run.h5"
@@ -548,9 +549,8 @@ def test_run_lists_the_m1_branch_born_at_the_first_m1_point(tmp_path, capsys):
     bps = [s for s in branches["primary"]["special_points"] if s["kind"] == "BP"]
     points = [f"m1_bp{k}" for k, bp in enumerate(bps) if bp["block"].startswith("m1") and k != 1]
     assert names.split(", ") == points and len(points) >= 3  # the held and the free readings' other points
-    none = tmp_path / "none.h5"
-    assert main(["run", str(scene), "-o", str(none), "--quiet", "--set", "surface.branches=none",
-                 "--set", "continuation.stop_stretch=1.7"]) == 0
+    none = shared_pictures.two_coil_run_file(tmp_path_factory)  # `run` of the scene to 1.7 with branches "none"
+    assert stored_scene(read_run(none)).surface.branches == "none"
     capsys.readouterr()
     assert main(["inspect", str(none), "--json"]) == 0
     assert all(b["m"] == 0 for b in json.loads(capsys.readouterr().out)["branches"].values())
