@@ -141,19 +141,25 @@ def test_coils_and_a_voltage_are_refused_in_one_line():
 
 
 def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
-    """A tube scene's [surface] branches default to "none" (and then no branch is traced); with "first" the primary
-    branch's first m = 1 zero starts "m1_bp0" (tube/picture.with_surface), written to the run file and read back
-    (io/tube_surface_file.py) with its parent, points, stability and stop, and shown by ``inspect`` (text and the
-    JSON summary); each refusal of the key is one line naming it, its value and what is allowed."""
+    """A tube scene's [surface] branches default to "first" where they are built, to "none" with coils, a voltage or
+    stability.m_max = 0 (and the default is left out of the scene's text); with "none" no branch is traced; with
+    "first" the primary branch's first m = 1 zero starts "m1_bp0" (tube/picture.with_surface), written to the run
+    file and read back (io/tube_surface_file.py) with its parent, points, stability, stop and ``limited``, and shown
+    by ``inspect`` (text and the JSON summary); each refusal of the key is one line naming it, its value and what is
+    allowed."""
     from balloon_cg.app.tube_summary import summarise_tube, format_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
     from balloon_cg.tube.picture import TubePicture, with_modes, with_surface
 
     scene, parent, zero, plus, _ = traced
-    assert scene.surface.branches == "none"
+    assert scene.surface.branches == "first" and "surface" not in scene.to_dict()
+    coil = "[field]\nM = 0.5\n[[field.coils]]\nradius = 1.5\nheight = 0.0\ncurrent = 1.0\n"
+    for extra in (coil, "[electric]\nvoltage = 0.1\n", "[stability]\nm_max = 0\n"):
+        unbuilt = tube_scene(extra=extra)
+        assert unbuilt.surface.branches == "none" and "surface" not in unbuilt.to_dict()
     picture = with_modes(scene, TubePicture({"primary": parent}, None))
-    assert with_surface(scene, picture).surface is None
-    first = scene.with_overrides({"surface.branches": "first", "surface.max_points": 4})
+    assert with_surface(scene.with_overrides({"surface.branches": "none"}), picture).surface is None
+    first = scene.with_overrides({"surface.max_points": 4})
     picture = with_surface(first, picture)
     branch = picture.surface["m1_bp0"]
     assert branch.parent == ("primary", 0) and len(branch.pressure) == 4
@@ -164,9 +170,8 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     summary = summarise_tube(read_tube_run(tmp_path / "tube.h5"))
     shown = summary["surface_branches"]["m1_bp0"]
     assert shown["points"] == 4 and shown["parent"] == {"branch": "primary", "zero": 0}
-    assert shown["stop_code"] == "max_points" and shown["stable_points"] == 0
+    assert shown["stop_code"] == "max_points" and shown["stable_points"] == 0 and shown["limited"] is False
     assert "surface branch m1_bp0 (m = 1, from zero 0 of block m = 1 of primary): 4 points" in format_tube(summary)
-    coil = "[field]\nM = 0.5\n[[field.coils]]\nradius = 1.5\nheight = 0.0\ncurrent = 1.0\n"
     for extra, key in ((coil, "field.coils = 1"),
                        ("[electric]\nvoltage = 0.1\n", "electric.voltage = 0.1"),
                        ("[stability]\nm_max = 0\n", "stability.m_max")):

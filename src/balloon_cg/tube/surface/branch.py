@@ -1,5 +1,5 @@
 """The non-axisymmetric branch born at a located m ≥ 1 zero of a tube, traced in P (docs/tubes.md "The tube over
-(S, φ)"; behind ``[surface] branches``, default "none" on a tube).
+(S, φ)"; ``[surface] branches``).
 
 Point 0 is the zero itself (c = u, P_0: amplitude 0); point 1 the switched point at ε = START_AMPLITUDE along the
 critical mode φ (switching.switched_point, on the orders (0, m, 2m) and the parent's degree, then re-solved at the
