@@ -145,10 +145,11 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     stability.m_max = 0 (and the default is left out of the scene's text); with "none" no branch is traced; with
     "first" the primary branch's first m = 1 zero starts "m1_bp0" (tube/picture.with_surface), written to the run
     file and read back (io/tube_surface_file.py) with its parent, points, stability, stop and ``limited``, and shown
-    by ``inspect`` (text and the JSON summary); each refusal of the key is one line naming it, its value and what is
-    allowed."""
+    by ``inspect`` (text and the JSON summary) and drawn by ``plot --what pressure-volume`` beside the axisymmetric
+    branches; each refusal of the key is one line naming it, its value and what is allowed."""
     from balloon_cg.app.tube_summary import summarise_tube, format_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
+    from balloon_cg.post.tube_plots import tube_figure
     from balloon_cg.tube.picture import TubePicture, with_modes, with_surface
 
     scene, parent, zero, plus, _ = traced
@@ -172,6 +173,10 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     assert shown["points"] == 4 and shown["parent"] == {"branch": "primary", "zero": 0}
     assert shown["stop_code"] == "max_points" and shown["stable_points"] == 0 and shown["limited"] is False
     assert "surface branch m1_bp0 (m = 1, from zero 0 of block m = 1 of primary): 4 points" in format_tube(summary)
+    figure = tube_figure(read_tube_run(tmp_path / "tube.h5"), "pressure-volume")
+    drawn = [line for line in figure.axes[0].lines if np.array_equal(line.get_xdata(), branch.volume)]
+    assert [line.get_label() for line in drawn][0] == "m1_bp0 (m = 1)" and len(drawn) == 2  # solid, dashed
+    assert np.array_equal(np.fmax(drawn[0].get_ydata(), drawn[1].get_ydata()), branch.pressure)
     for extra, key in ((coil, "field.coils = 1"),
                        ("[electric]\nvoltage = 0.1\n", "electric.voltage = 0.1"),
                        ("[stability]\nm_max = 0\n", "stability.m_max")):

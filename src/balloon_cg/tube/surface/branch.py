@@ -87,6 +87,10 @@ class _Leg:
         self.row = np.append(mode_row(basis, m, mode[basis.block(m)])[self.system.free],
                              [0.0] * (1 + self.system.gauged))
 
+    def amplitude(self, c: np.ndarray) -> float:
+        """φᵀ G c_m of the coefficients c of the basis."""
+        return float(self.row[:self.system.free.size] @ c[self.system.free])
+
 
 def resolved_start(scene, point: SwitchedPoint, mode: np.ndarray, params: Parameters) -> tuple:
     """(the switched ``point`` solved again at its amplitude on the bases resolution.refined asks for until its
@@ -142,6 +146,7 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
                                       f"{first.message}")
     origin_basis = first.basis
     mode = origin_basis.with_mode(np.zeros(origin_basis.size), m, crossing.mode)
+    origin = _Leg(scene, origin_basis, params, first.c, m, mode)
     first, limited = resolved_start(scene, first, mode, params)
     leg = _Leg(scene, first.basis, params, first.c, m, origin_basis.raised(mode, first.basis))
     X = leg.system.point(first.c, first.pressure)
@@ -186,28 +191,25 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
     if limited:
         stop = Stop(stop.code, f"{stop.message}; limited: the basis at its cap (degree ≤ {MAX_DEGREE}, orders up to "
                                f"{MAX_HARMONICS} m) with error estimates above solver.max_error {solver.max_error:g}")
-    return _branch(legs, origin_basis, crossing, params, tuple(folds), stop, parent, limited)
+    return _branch(origin, legs, crossing, params, tuple(folds), stop, parent, limited)
 
 
-def _branch(legs: list, origin_basis: TubeSurfaceBasis, crossing, params: Parameters, folds: tuple, stop: Stop,
-            parent: tuple | None, limited: bool) -> TubeSurfaceBranch:
-    """The TubeSurfaceBranch of the traced ``legs``, point 0 the zero (on ``origin_basis``, read on the first leg's
+def _branch(origin: _Leg, legs: list, crossing, params: Parameters, folds: tuple, stop: Stop, parent: tuple | None,
+            limited: bool) -> TubeSurfaceBranch:
+    """The TubeSurfaceBranch of the traced ``legs``, point 0 the zero on ``origin`` (the switched point's first
     basis): every point's values, estimate and stability on its own basis, its coefficients raised to the last."""
     final = legs[-1].basis
-    zero = origin_basis.axisymmetric(crossing.u)
-    rows = [(legs[0], origin_basis.raised(zero, legs[0].basis), crossing.pressure, 0.0, error_estimate(origin_basis,
-                                                                                                      zero))]
-    for leg in legs:
-        rows += [(leg, leg.system.coefficients(p.X), p.X[-1], leg.system.reaction(p.X),
-                  error_estimate(leg.basis, leg.system.coefficients(p.X))) for p in leg.points]
-    readers = {id(leg): SectorStability(leg.system) for leg in legs}
-    readings = [readers[id(leg)](c, params.with_value("P", P)) for leg, c, P, _, _ in rows]
+    points = [(origin, origin.basis.axisymmetric(crossing.u), crossing.pressure, 0.0)]
+    points += [(leg, leg.system.coefficients(p.X), p.X[-1], leg.system.reaction(p.X)) for leg in legs
+               for p in leg.points]
+    readers = {id(leg): SectorStability(leg.system) for leg in (origin, *legs)}
+    readings = [readers[id(leg)](c, params.with_value("P", P)) for leg, c, P, _ in points]
     return TubeSurfaceBranch(
-        final, crossing.m, np.array([leg.basis.raised(c, final) for leg, c, *_ in rows]),
-        np.array([P for _, _, P, _, _ in rows]),
-        np.array([2 * leg.system.surface.volume(c) / final.disc.length for leg, c, *_ in rows]),
-        np.array([leg.row[:leg.system.free.size] @ c[leg.system.free] for leg, c, *_ in rows]),
-        np.array([tau for *_, tau, _ in rows]), np.array([e for *_, e in rows]),
+        final, crossing.m, np.array([leg.basis.raised(c, final) for leg, c, _, _ in points]),
+        np.array([P for _, _, P, _ in points]),
+        np.array([2 * leg.system.surface.volume(c) / final.disc.length for leg, c, _, _ in points]),
+        np.array([leg.amplitude(c) for leg, c, _, _ in points]), np.array([tau for *_, tau in points]),
+        np.array([error_estimate(leg.basis, c) for leg, c, _, _ in points]),
         np.array([lowest for lowest, _ in readings]),
         {control: np.array([counts[control] for _, counts in readings], dtype=int) for control in Control},
         folds, stop, parent, limited)
