@@ -10,17 +10,29 @@ basis' factors; their difference printed) and one Jacobian of the interval discr
 ``REPEATS``), one run, with the load average.
 
     OMP_NUM_THREADS=1 python benchmarks/tube_surface.py [--degrees 20 30 40]
+
+With ``--refinement`` instead: the cost of the refinement along the branch (tube/surface/resolution.py), one run.
+SPOM1's bulge's lateral buckle (tests/test_tube_surface.py ``located_zeros("bulge")``: degree 20, its first m = 1
+zero) traced to ``--points`` points before (solver.max_error = 1e-2: no point refined, the orders (0, 1, 2) at the
+parent's degree, as before the refinement) and after (the scene's 1e-9): CPU, the final basis, the largest estimate,
+P at the last point. Then ``balloon-cg run scenes/tube_spom1_L10.toml`` with ``[surface] branches`` "none" and
+"first" (each in a child process, its CPU from getrusage), their ratio, and what "first" traced.
+
+    OMP_NUM_THREADS=1 python benchmarks/tube_surface.py --refinement [--points 30]
 """
 import argparse
 import os
+import resource
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_tube_surface import tube_scene  # noqa: E402
+from test_tube_surface import located_zeros, tube_scene  # noqa: E402
 
 from balloon_cg.galerkin.equilibrium import Equilibrium  # noqa: E402
 from balloon_cg.galerkin.interval import Mirror  # noqa: E402
@@ -28,7 +40,9 @@ from balloon_cg.tube import azimuthal  # noqa: E402
 from balloon_cg.tube.azimuthal_crossings import crossings  # noqa: E402
 from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
 from balloon_cg.tube.primary import primary_branch  # noqa: E402
+from balloon_cg.io.tube_file import read_tube_run  # noqa: E402
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis  # noqa: E402
+from balloon_cg.tube.surface.branch import traced_branch  # noqa: E402
 from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium  # noqa: E402
 from balloon_cg.tube.surface.switching import switched_point  # noqa: E402
 
@@ -93,7 +107,58 @@ def main(degrees) -> None:
     print(f"load average at the end {os.getloadavg()[0]:.2f}")
 
 
+SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
+
+
+def child_cpu(command: list) -> float:
+    """The CPU seconds (user + system) of ``command`` run to its end in a child process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+
+
+def refinement(points: int) -> None:
+    """The ``--refinement`` tables (module docstring)."""
+    print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}; OMP_NUM_THREADS="
+          f"{os.environ.get('OMP_NUM_THREADS', 'unset')}; SPOM1's bulge's lateral buckle, {points} points")
+    scene, parent, found = located_zeros("bulge")
+    print(f"{'':>7} {'max_error':>9} {'CPU s':>7} {'degree':>6} {'orders':>6} {'largest est.':>12} "
+          f"{'est. > max_error':>16} {'limited':>7} {'P at the last':>15} {'stop':>10}")
+    cpus = {}
+    for what, max_error in (("before", 1e-2), ("after", scene.solver.max_error)):
+        at = scene.with_overrides({"solver.max_error": max_error})
+        start = time.process_time()
+        branch = traced_branch(at, parent.disc, found[0], parent.params, max_points=points)
+        cpus[what] = time.process_time() - start
+        past = int(np.sum(branch.error_estimate[1:] > scene.solver.max_error))
+        print(f"{what:>7} {max_error:9.0e} {cpus[what]:7.1f} {branch.basis.disc.degree:6d} "
+              f"{branch.basis.orders[-1]:6d} {branch.error_estimate[1:].max():12.1e} {past:16d} "
+              f"{str(branch.limited):>7} {branch.pressure[-1]:15.10f} {branch.stop.code.value:>10}")
+    print(f"after / before: {cpus['after'] / cpus['before']:.1f}")
+    print(f"\nballoon-cg run {SCENE.name} (child processes, CPU from getrusage); load average "
+          f"{os.getloadavg()[0]:.2f}")
+    runs = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for asked in ("none", "first"):
+            out = Path(folder) / f"{asked}.h5"
+            runs[asked] = child_cpu([sys.executable, "-m", "balloon_cg", "run", str(SCENE), "--quiet", "--force",
+                                     "-o", str(out), "--set", f"surface.branches={asked}"])
+            traced = [f"{name} ({len(b['pressure'])} points)"
+                      for name, b in read_tube_run(out)["surface_branches"].items()]
+            print(f"  surface.branches = {asked!r:8} CPU {runs[asked]:6.1f} s; surface branches traced: "
+                  f"{', '.join(traced) or 'none'}")
+    print(f"  first / none: {runs['first'] / runs['none']:.2f}")
+    print(f"load average at the end {os.getloadavg()[0]:.2f}")
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--degrees", type=int, nargs="+", default=[20, 30, 40])
-    main(parser.parse_args().degrees)
+    parser.add_argument("--refinement", action="store_true", help="the cost of the refinement along the branch")
+    parser.add_argument("--points", type=int, default=30)
+    arguments = parser.parse_args()
+    if arguments.refinement:
+        refinement(arguments.points)
+    else:
+        main(arguments.degrees)

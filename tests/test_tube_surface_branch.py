@@ -5,6 +5,8 @@ Checked against a larger basis (a traced point re-solved with the degree and the
 pitchfork's symmetry (the half traced along −φ is the rotation by π of the half along +φ) and the critical mode it
 leaves along, and its stability against the exchange of stability a pitchfork's normal form predicts from the
 switched point's (P − P_0)/ε²."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -16,7 +18,8 @@ from balloon_cg.tube.surface.basis import TubeSurfaceBasis
 from balloon_cg.tube.surface.branch import START_AMPLITUDE, traced_branch
 from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium
 from balloon_cg.tube.surface.stability import SectorStability
-from balloon_cg.tube.surface.switching import point_at_amplitude, switched_point
+from balloon_cg.tube.surface.resolution import harmonics
+from balloon_cg.tube.surface.switching import mode_row, point_at_amplitude, switched_point
 from balloon_cg.tube.surface.system import TubeSurfaceSystem
 from test_tube_surface import located_zeros, tube_scene
 
@@ -32,25 +35,35 @@ def traced():
     return scene, branch, zero, *halves
 
 
+def larger_point(scene, parent, zero, branch, k, degrees: int, orders: int):
+    """Point k of ``branch`` (born at ``zero`` of ``parent``) re-solved at its amplitude on a larger basis: the degree
+    raised by ``degrees`` and the orders by ``orders`` multiples of m, Newton from the point itself zero-padded
+    (TubeSurfaceBasis.raised); (the SwitchedPoint, the padded start)."""
+    small, m = branch.basis, branch.m
+    large = TubeSurfaceBasis(replace(small.disc, degree=small.disc.degree + degrees, quadrature=0),
+                             harmonics(m, len(small.orders) - 1 + orders))
+    origin = TubeSurfaceBasis(parent.disc, (0, m, 2 * m))
+    mode = origin.raised(origin.with_mode(np.zeros(origin.size), m, zero.mode), large)[large.block(m)]
+    row = mode_row(large, m, mode)
+    start = small.raised(branch.coefficients[k], large)
+    assert row @ start == pytest.approx(branch.amplitude[k], abs=1e-12)
+    return point_at_amplitude(scene, large, start, branch.pressure[k], row, branch.amplitude[k], m,
+                              parent.params), start
+
+
 def test_a_traced_point_agrees_on_a_larger_basis(traced):
-    """The branch's last traced point re-solved at the same amplitude with the degree 16 -> 24 and the orders (0, 1, 2)
-    -> (0, 1, 2, 3): P within the point's error estimate (relative), every coefficient within it times the mean
-    radius; the estimate itself small (≤ 1e-2) and the re-solved point off the axisymmetric states."""
+    """The branch's last traced point re-solved at the same amplitude with the degree raised by 8 and the orders by
+    3: P within the point's error estimate (relative), every coefficient within it times the mean radius; the
+    estimate below solver.max_error at every point (the basis refined along the branch, not at its cap: not
+    ``limited``) and the re-solved point off the axisymmetric states."""
     scene, parent, zero, plus, _ = traced
     k = len(plus.pressure) - 1
-    small = plus.basis
-    large = TubeSurfaceBasis(IntervalDiscretisation(24, small.disc.length, ends=small.disc.ends,
-                                                    axial_stretch=small.disc.axial_stretch), (0, 1, 2, 3))
-    mode = small.raised(small.with_mode(np.zeros(small.size), 1, zero.mode), large)
-    row = np.zeros(large.size)
-    row[large.block(1)] = azimuthal.operators(large.disc)[1] @ mode[large.block(1)]
-    start = small.raised(plus.coefficients[k], large)
-    assert row @ start == pytest.approx(plus.amplitude[k], abs=1e-12)
-    point = point_at_amplitude(scene, large, start, plus.pressure[k], row, plus.amplitude[k], 1, parent.params)
+    point, start = larger_point(scene, parent, zero, plus, k, 8, 3)
     assert point.converged, point.message
     estimate = plus.error_estimate[k]
-    radius = abs(small.disc.series(plus.coefficients[k][small.block(0)])[0][0])
-    assert 0 < estimate <= 1e-2 and abs(plus.amplitude[k]) > 0.3
+    radius = abs(plus.basis.disc.series(plus.coefficients[k][plus.basis.block(0)])[0][0])
+    assert not plus.limited and np.all(plus.error_estimate <= scene.solver.max_error)
+    assert len(plus.basis.orders) > 3 and abs(plus.amplitude[k]) > 0.3
     assert abs(point.pressure - plus.pressure[k]) <= estimate * abs(plus.pressure[k]), (point.pressure, estimate)
     assert np.max(np.abs(point.c - start)) <= estimate * radius, (np.max(np.abs(point.c - start)), estimate)
 
@@ -58,7 +71,7 @@ def test_a_traced_point_agrees_on_a_larger_basis(traced):
 def test_the_branch_leaves_along_the_critical_mode_as_a_pitchfork(traced):
     """Point 0 is the zero; point 1 the switched point at ε = START_AMPLITUDE: its order-1 part is ε φ within O(ε²)
     (G-norm ≤ 2 ε² with φ G-unit) and its orders 0 and 2 move by O(ε²); the half along −φ is the image of the half
-    along +φ under the rotation by π about the axis (c_1 -> −c_1, orders 0 and 2 unchanged): the same P at every
+    along +φ under the rotation by π about the axis (c_m -> (−1)^m c_m): the same P at every
     point (1e-12 relative) and the same stability, the amplitudes opposite; the trace is a pitchfork from either
     side: P − P_0 the same function of ε."""
     scene, parent, zero, plus, minus = traced
@@ -74,7 +87,8 @@ def test_the_branch_leaves_along_the_critical_mode_as_a_pitchfork(traced):
     assert np.max(np.abs(plus.pressure - minus.pressure)) <= 1e-12 * zero.pressure
     assert np.max(np.abs(plus.amplitude + minus.amplitude)) <= 1e-10
     flip = np.ones(basis.size)
-    flip[basis.block(1)] = -1
+    for m in basis.orders[1::2]:  # the rotation by π: order m times (−1)^m
+        flip[basis.block(m)] = -1
     assert np.max(np.abs(plus.coefficients * flip - minus.coefficients)) <= 1e-9
     for control in plus.unstable:
         assert np.array_equal(plus.unstable[control], minus.unstable[control])
@@ -127,19 +141,26 @@ def test_coils_and_a_voltage_are_refused_in_one_line():
 
 
 def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
-    """A tube scene's [surface] branches default to "none" (and then no branch is traced); with "first" the primary
-    branch's first m = 1 zero starts "m1_bp0" (tube/picture.with_surface), written to the run file and read back
-    (io/tube_surface_file.py) with its parent, points, stability and stop, and shown by ``inspect`` (text and the
-    JSON summary); each refusal of the key is one line naming it, its value and what is allowed."""
+    """A tube scene's [surface] branches default to "first" where they are built, to "none" with coils, a voltage or
+    stability.m_max = 0 (and the default is left out of the scene's text); with "none" no branch is traced; with
+    "first" the primary branch's first m = 1 zero starts "m1_bp0" (tube/picture.with_surface), written to the run
+    file and read back (io/tube_surface_file.py) with its parent, points, stability, stop and ``limited``, and shown
+    by ``inspect`` (text and the JSON summary) and drawn by ``plot --what pressure-volume`` beside the axisymmetric
+    branches; each refusal of the key is one line naming it, its value and what is allowed."""
     from balloon_cg.app.tube_summary import summarise_tube, format_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
+    from balloon_cg.post.tube_plots import tube_figure
     from balloon_cg.tube.picture import TubePicture, with_modes, with_surface
 
     scene, parent, zero, plus, _ = traced
-    assert scene.surface.branches == "none"
+    assert scene.surface.branches == "first" and "surface" not in scene.to_dict()
+    coil = "[field]\nM = 0.5\n[[field.coils]]\nradius = 1.5\nheight = 0.0\ncurrent = 1.0\n"
+    for extra in (coil, "[electric]\nvoltage = 0.1\n", "[stability]\nm_max = 0\n"):
+        unbuilt = tube_scene(extra=extra)
+        assert unbuilt.surface.branches == "none" and "surface" not in unbuilt.to_dict()
     picture = with_modes(scene, TubePicture({"primary": parent}, None))
-    assert with_surface(scene, picture).surface is None
-    first = scene.with_overrides({"surface.branches": "first", "surface.max_points": 4})
+    assert with_surface(scene.with_overrides({"surface.branches": "none"}), picture).surface is None
+    first = scene.with_overrides({"surface.max_points": 4})
     picture = with_surface(first, picture)
     branch = picture.surface["m1_bp0"]
     assert branch.parent == ("primary", 0) and len(branch.pressure) == 4
@@ -150,9 +171,12 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     summary = summarise_tube(read_tube_run(tmp_path / "tube.h5"))
     shown = summary["surface_branches"]["m1_bp0"]
     assert shown["points"] == 4 and shown["parent"] == {"branch": "primary", "zero": 0}
-    assert shown["stop_code"] == "max_points" and shown["stable_points"] == 0
+    assert shown["stop_code"] == "max_points" and shown["stable_points"] == 0 and shown["limited"] is False
     assert "surface branch m1_bp0 (m = 1, from zero 0 of block m = 1 of primary): 4 points" in format_tube(summary)
-    coil = "[field]\nM = 0.5\n[[field.coils]]\nradius = 1.5\nheight = 0.0\ncurrent = 1.0\n"
+    figure = tube_figure(read_tube_run(tmp_path / "tube.h5"), "pressure-volume")
+    drawn = [line for line in figure.axes[0].lines if np.array_equal(line.get_xdata(), branch.volume)]
+    assert [line.get_label() for line in drawn][0] == "m1_bp0 (m = 1)" and len(drawn) == 2  # solid, dashed
+    assert np.array_equal(np.fmax(drawn[0].get_ydata(), drawn[1].get_ydata()), branch.pressure)
     for extra, key in ((coil, "field.coils = 1"),
                        ("[electric]\nvoltage = 0.1\n", "electric.voltage = 0.1"),
                        ("[stability]\nm_max = 0\n", "stability.m_max")):

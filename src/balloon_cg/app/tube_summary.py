@@ -73,8 +73,9 @@ def summarise_tube(run: dict) -> dict:
 
 def _surface_branches(found: dict, control: str) -> dict:
     """{name: {'m', 'parent' {'branch', 'zero'}, 'points', 'pressure', 'volume', 'amplitude' ranges, 'stable_points'
-    (under the file's control), 'largest_error_estimate', 'folds' [{'after_point', 'pressure'}], 'stop_code',
-    'stop_message'}} of a tube's non-axisymmetric branches (io/tube_surface_file.py)."""
+    (under the file's control), 'largest_error_estimate', 'limited' (the basis at its cap: estimates above
+    solver.max_error; False in files before it), 'folds' [{'after_point', 'pressure'}], 'stop_code', 'stop_message'}}
+    of a tube's non-axisymmetric branches (io/tube_surface_file.py)."""
     def span(values):
         return [float(values.min()), float(values.max())]
 
@@ -83,6 +84,7 @@ def _surface_branches(found: dict, control: str) -> dict:
                    "points": len(b["pressure"]), "pressure": span(b["pressure"]), "volume": span(b["volume"]),
                    "amplitude": span(b["amplitude"]), "stable_points": int((b[f"unstable_{control}"] == 0).sum()),
                    "largest_error_estimate": float(b["error_estimate"].max()),
+                   "limited": bool(b["attrs"].get("limited", False)),
                    "folds": [{"after_point": i, "pressure": p} for i, p in b["folds"]],
                    "stop_code": b["attrs"]["stop_code"], "stop_message": b["attrs"]["stop_message"]}
             for name, b in found.items()}
@@ -234,7 +236,7 @@ def format_tube(summary: dict) -> str:
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, amplitude {b['amplitude'][0]:.4g}.."
                       f"{b['amplitude'][1]:.4g}, stop {b['stop_code']} ({b['stop_message']}); {b['stable_points']} "
                       f"stable under {summary['control']} control; largest error estimate "
-                      f"{b['largest_error_estimate']:.2g}"]
+                      f"{b['largest_error_estimate']:.2g}{' (limited: the basis at its cap)' if b['limited'] else ''}"]
         lines += [f"  LP after point {f['after_point']:<4} P = {f['pressure']:.10g}" for f in b["folds"]]
     onset = summary["onset"]
     if onset is not None:

@@ -1,10 +1,12 @@
 """A tube's non-axisymmetric branches in its run file (tube/surface/branch.py; docs/hdf5.md "Tube run files"):
-/surface_branches/<name>/ with the attributes ``m``, ``orders``, ``n_phi``, ``degree`` (the basis: tube/surface/
-basis.py on the parent's discretisation), ``parent_branch``, ``parent_zero`` (the zero's order among the parent's
-located zeros of block m, as ``inspect`` lists them), ``stop_code``, ``stop_message``; per point ``coefficients``
-(n, size: c of the basis), ``pressure``, ``volume`` (V/V0), ``amplitude`` (φᵀ G c_m), ``reaction`` (the held
-centroid's τ), ``error_estimate``, ``lowest`` (n, 3: the mirror sector's lowest eigenvalues under pressure control)
-and ``unstable_pressure``, ``unstable_volume``, ``unstable_gas``; its folds in P: ``fold_index``, ``fold_pressure``.
+/surface_branches/<name>/ with the attributes ``m``, ``orders``, ``n_phi``, ``degree`` (the final basis: tube/
+surface/basis.py, refined along the branch from the parent's discretisation), ``parent_branch``, ``parent_zero`` (the
+zero's order among the parent's located zeros of block m, as ``inspect`` lists them), ``stop_code``,
+``stop_message``, ``limited`` (the basis reached its cap with estimates above solver.max_error; absent before it);
+per point ``coefficients`` (n, size: c of the basis), ``pressure``, ``volume`` (V/V0), ``amplitude`` (φᵀ G c_m),
+``reaction`` (the held centroid's τ), ``error_estimate``, ``lowest`` (n, 3: the mirror sector's lowest eigenvalues
+under pressure control) and ``unstable_pressure``, ``unstable_volume``, ``unstable_gas``; its folds in P:
+``fold_index``, ``fold_pressure``.
 Files before them have no /surface_branches (read as {})."""
 import numpy as np
 
@@ -23,7 +25,7 @@ def write_surface_branches(f, branches: dict | None) -> None:
         group.attrs.update({"m": branch.m, "orders": np.array(basis.orders, dtype=int), "n_phi": basis.n_phi,
                             "degree": basis.disc.degree, "parent_branch": branch.parent[0],
                             "parent_zero": branch.parent[1], "stop_code": branch.stop.code.value,
-                            "stop_message": branch.stop.message})
+                            "stop_message": branch.stop.message, "limited": branch.limited})
         checksummed(group, "coefficients", branch.coefficients)
         for column in POINT_COLUMNS:
             checksummed(group, column, getattr(branch, column))

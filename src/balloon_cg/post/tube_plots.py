@@ -55,20 +55,23 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
 
 
 def pressure_volume(ax, run: dict, control: str) -> None:
-    """P against V/V0 of every branch, solid where stable under ``control``, the located points labelled, and
+    """P against V/V0 of every branch, solid where stable under ``control``, the located points labelled, the
+    non-axisymmetric branches (/surface_branches: thinner, labelled with their m, their folds LP) beside them, and
     Maxwell's pressure as a dotted line where the file has one."""
     others = iter(f"C{k}" for k in range(1, 10_000))  # a colour of its own for every other switched branch
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
         colour = _COLOURS.get(name) or next(others)
-        stable = b[f"unstable_{control}"] == 0
-        for solid in (True, False):
-            shown = np.where(_runs(stable, solid), b["pressure"], np.nan)
-            ax.plot(b["volume"], shown, color=colour, linestyle="-" if solid else "--",
-                    label=name if solid else None)
+        _curve(ax, b, control, colour, name)
         for s in b["special_points"]:
             ax.plot(s["volume"], s["pressure"], "o", color=colour, markersize=3)
             ax.annotate(f"{s['kind']}{' ' + s['block'] if s['block'] else ''}", (s["volume"], s["pressure"]),
                         textcoords="offset points", xytext=(3, 3), fontsize=6)
+    for name, b in run.get("surface_branches", {}).items():
+        colour = next(others)
+        _curve(ax, b, control, colour, f"{name} (m = {b['attrs']['m']})", 0.8)
+        for index, pressure in b["folds"]:
+            ax.plot(b["volume"][index], pressure, "o", color=colour, markersize=3)
+            ax.annotate("LP", (b["volume"][index], pressure), textcoords="offset points", xytext=(3, 3), fontsize=6)
     maxwell = run["attrs"]["maxwell_pressure"]
     if np.isfinite(maxwell):
         ax.axhline(maxwell, color="0.4", linestyle=":", linewidth=0.8, label=f"Maxwell $P_M$ = {maxwell:.5g}")
@@ -172,6 +175,15 @@ def matplotlib_colours(count: int) -> list:
     from matplotlib import colormaps
 
     return [colormaps["viridis"](x) for x in np.linspace(0.0, 0.9, count)]
+
+
+def _curve(ax, b: dict, control: str, colour: str, label: str, width: float | None = None) -> None:
+    """Branch ``b``'s P against V/V0, solid where stable under ``control`` and dashed where not, ``label``led."""
+    stable = b[f"unstable_{control}"] == 0
+    for solid in (True, False):
+        shown = np.where(_runs(stable, solid), b["pressure"], np.nan)
+        ax.plot(b["volume"], shown, color=colour, linestyle="-" if solid else "--", linewidth=width,
+                label=label if solid else None)
 
 
 def _runs(stable: np.ndarray, solid: bool) -> np.ndarray:

@@ -266,10 +266,12 @@ class Surface:
 SURFACE_BRANCHES = ("first", "all", "none")
 
 
-def default_surface(shape) -> Surface:
-    """The [surface] table a scene without one has: on a tube ``branches = "none"`` (its non-axisymmetric branches,
-    tube/surface/branch.py, are not verified enough to be traced by default: docs/tubes.md), else ``Surface()``."""
-    return Surface(branches="none") if shape == Shape.TUBE else Surface()
+def default_surface(shape, field, electric, stability) -> Surface:
+    """The [surface] table a scene without one has: ``Surface()`` ("first"), except ``branches = "none"`` on a tube
+    whose non-axisymmetric branches (tube/surface/branch.py) are not built: in a coil's field, under a voltage,
+    without the m ≥ 1 zeros they start from (stability.m_max = 0; ``_tube_surface_reads`` refuses "first" there)."""
+    built = not field.coils and electric is None and stability.m_max >= 1
+    return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
 @dataclass(frozen=True)
@@ -394,7 +396,8 @@ class Scene:
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
                                                                   "control": self.loading.control.value}}),
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
-            **({} if self.surface == default_surface(self.geometry.shape) else {"surface": asdict(self.surface)}),
+            **({} if self.surface == default_surface(self.geometry.shape, f, self.electric, self.stability)
+               else {"surface": asdict(self.surface)}),
             **({"events": [e.to_table() for e in self.events]} if self.events else {}),
             **({} if self.geometry == Geometry() else {"geometry": self.geometry.to_table()}),
             **({} if self.dynamics == Dynamics() else {"dynamics": asdict(self.dynamics)}),
@@ -691,7 +694,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
     stability = _stability(data.get("stability", {}))
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
-    surface = _surface(data.get("surface", {}), geometry.shape)
+    surface = _surface(data.get("surface", {}), default_surface(geometry.shape, field, electric, stability))
     if geometry.shape == Shape.TUBE:
         _tube_surface_reads(surface, field, electric, stability)
     return Scene(
@@ -1073,10 +1076,10 @@ def _stability(data) -> Stability:
     )
 
 
-def _surface(data, shape) -> Surface:
+def _surface(data, default: Surface) -> Surface:
     data = table("surface", data, _keys(Surface))
     get = _getter(data, "surface", Surface)
-    branches = data.get("branches", default_surface(shape).branches)
+    branches = data.get("branches", default.branches)
     if branches not in SURFACE_BRANCHES:
         raise SceneError(f"surface.branches = {show(branches)}: must be one of "
                          + ", ".join(f'"{b}"' for b in SURFACE_BRANCHES))

@@ -10,7 +10,7 @@ traced until it rejoins the mirror-symmetric (odd) or uniform (even) states, its
 there too) or after ``continuation.max_points``. The branch born at the first odd branch point (the onset of
 bulging) is named "bulge", the others "bulge_<label>", <label> their branch point's label (``inspect``: the primary
 branch's located points are numbered first); each knows its parent label and where it rejoined
-(IntervalBranch.parent, .rejoins). With [surface] branches "first" or "all" (default "none" on a tube) the
+(IntervalBranch.parent, .rejoins). With [surface] branches "first" (the default where built) or "all" the
 non-axisymmetric branches traced from the located m ≥ 1 zeros (``with_surface``, tube/surface/branch.py). And
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before

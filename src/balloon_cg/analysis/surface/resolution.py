@@ -17,7 +17,7 @@ MAX_ORDER = 48  # the finest order of an anisotropic basis (a state pressed agai
 DEGREE_STEP, ORDER_STEP = 8, 2  # the smallest increments; larger ones where the decay asks for them
 
 
-def _increment(maxima: np.ndarray, target: float, step: int, most: int) -> int:
+def increment(maxima: np.ndarray, target: float, step: int, most: int) -> int:
     """How far to extend a spectrum whose largest coefficient per index is ``maxima`` (the last ones being the tail)
     for its predicted tail to fall below ``target``: geometric decay fitted to the last four indices, rounded up to
     a multiple of ``step``, at least ``step`` and at most ``most``."""
@@ -39,12 +39,12 @@ def refined(basis: SphericalBasis, c: np.ndarray, max_error: float) -> Spherical
     if theta > max_error:
         by_degree = np.array([max((abs(c[b.offset + i]) for b in basis.blocks for i, l in enumerate(b.degrees)
                                    if l == degree_), default=0.0) for degree_ in range(basis.degree + 1)])
-        degree += _increment(by_degree, max_error / 4, DEGREE_STEP, 4 * DEGREE_STEP)
+        degree += increment(by_degree, max_error / 4, DEGREE_STEP, 4 * DEGREE_STEP)
         order = degree if basis.order == basis.degree else order
     if phi > max_error:
         by_order = np.array([max((np.abs(c[b.slice]).max() for b in basis.blocks if b.m == m), default=0.0)
                              for m in range(basis.order + 1)])
-        order = min(order + _increment(by_order, max_error / 4, ORDER_STEP, 4 * ORDER_STEP), degree)
+        order = min(order + increment(by_order, max_error / 4, ORDER_STEP, 4 * ORDER_STEP), degree)
     if degree > MAX_DEGREE or (order < degree and order > max(MAX_ORDER, basis.order)):
         return None
     if (degree, order) == (basis.degree, basis.order):

@@ -8,5 +8,6 @@ surface/ (docs/tubes.md "The tube over (S, φ)"). In reading order:
 - ``system``: the gauged equations R(X) = 0 of a branch in P, X = (c, τ, P), and their exact Jacobian
 - ``switching``: one point of the branch born at a located m ≥ 1 zero along its critical mode
 - ``stability``: the lowest eigenvalues and unstable counts of a state's mirror sector (pressure, volume, gas)
-- ``branch``: that branch traced in P from the switched point (``[surface] branches``, default "none" on a tube)
+- ``resolution``: a state's error estimate and the refinement of the basis along the branch
+- ``branch``: that branch traced in P from the switched point (``[surface] branches``)
 """

@@ -42,10 +42,11 @@ class SwitchedPoint:
     message: str
 
 
-def mode_row(basis: TubeSurfaceBasis, crossing) -> np.ndarray:
-    """G φ in c (order m): its product with c is the amplitude φᵀ G c_m of the crossing's critical mode φ."""
+def mode_row(basis: TubeSurfaceBasis, m: int, mode: np.ndarray) -> np.ndarray:
+    """G φ in c (order m; φ the order-m amplitudes ``mode`` on ``basis``, e.g. a crossing's critical mode): its
+    product with c is the amplitude φᵀ G c_m, the L² product of the two order-m fields (on any basis holding φ)."""
     row = np.zeros(basis.size)
-    row[basis.block(crossing.m)] = azimuthal.operators(basis.disc)[1] @ crossing.mode
+    row[basis.block(m)] = azimuthal.operators(basis.disc)[1] @ mode
     return row
 
 
@@ -64,8 +65,8 @@ def switched_point(scene, disc: IntervalDiscretisation, crossing, amplitude: flo
     if m not in basis.orders:
         raise ValueError(f"orders: {basis.orders} lack the crossing's order (allowed: orders holding m = {m})")
     start = basis.with_mode(basis.axisymmetric(crossing.u), m, amplitude * crossing.mode)
-    return point_at_amplitude(scene, basis, start, crossing.pressure, mode_row(basis, crossing), amplitude, m, params,
-                              tol, max_iter)
+    return point_at_amplitude(scene, basis, start, crossing.pressure, mode_row(basis, m, crossing.mode), amplitude, m,
+                              params, tol, max_iter)
 
 
 def point_at_amplitude(scene, basis: TubeSurfaceBasis, start: np.ndarray, pressure: float, row: np.ndarray,

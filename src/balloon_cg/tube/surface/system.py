@@ -53,6 +53,15 @@ class TubeSurfaceSystem:
         c[self.free] = X[:self.free.size]
         return c
 
+    def raised(self, X: np.ndarray, to: "TubeSurfaceSystem", direction: bool = False) -> np.ndarray:
+        """X on the finer basis of ``to`` (TubeSurfaceBasis.raised: the coefficients zero-padded, τ and P as they
+        are), or with ``direction`` a vector of X's space (a tangent: the held unknowns 0)."""
+        c = np.zeros(self.basis.size) if direction else self.template.copy()
+        c[self.free] = X[:self.free.size]
+        out = to.point(self.basis.raised(c, to.basis), X[-1])
+        out[to.free.size:] = X[self.free.size:]
+        return out
+
     def params_at(self, X: np.ndarray) -> Parameters:
         return self.params.with_value("P", X[-1])
 
