@@ -398,10 +398,13 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
 
 def collected(trace: SurfaceTrace, segments, folds, stop) -> dict:
     """The SurfaceBranch fields of traced segments, every point on the final basis: coefficients, values, solver
-    records, tails, measures, and the special points of the trace (its folds, LP, and its end point, EP)."""
+    records, error estimates, measures, and the special points of the trace (its folds, LP, and its end point, EP).
+    A point's error estimate is the larger of its tail on the basis it was traced on (what the trace accepted: on
+    the final basis a state of a coarser one has a tail of zeros) and on the final basis (a transfer to another map
+    leaves one)."""
     basis = trace.basis
-    coefficients = np.array([transfer(t.basis, t.system.coefficients(p.X), basis) if t is not trace
-                             else t.system.coefficients(p.X) for t, points in segments for p in points])
+    own = traced_points(segments)
+    coefficients = np.array([c if t is trace else transfer(t.basis, c, basis) for t, c in own])
     values = np.array([p.X[-1] for _, points in segments for p in points])
     per_point = [measures(basis, c) for c in coefficients]
     special = [SpecialPoint(Kind.LP, f.index, np.append(transfer(t.basis, t.system.coefficients(f.point.X),
@@ -412,7 +415,8 @@ def collected(trace: SurfaceTrace, segments, folds, stop) -> dict:
     return dict(basis=basis, coefficients=coefficients, values=values,
                 iterations=np.array([p.iterations for _, points in segments for p in points]),
                 residual=np.array([p.residual for _, points in segments for p in points]),
-                error_estimate=np.array([tail(basis, c) for c in coefficients]),
+                error_estimate=np.array([max(tail(t.basis, c), tail(basis, moved))
+                                         for (t, c), moved in zip(own, coefficients)]),
                 measures={key: np.array([m[key] for m in per_point]) for key in MEASURES}, special=special,
                 legs=(Leg("forward", stop),), kernel_signature=trace.eq.kernels.signature)
 

@@ -1,0 +1,57 @@
+"""A surface branch's stored error estimates are those of the bases its points were traced on.
+
+A branch refined along its trace stores every point on its final basis; a state of a coarser basis has a tail of
+zeros there, so an estimate read on the final basis alone would claim an accuracy the point never had (SPOM1's
+m = 1 branch from degree 4: points traced at degree 12 read 1.3e-14 on degree 20 against up to 6.7e-11 on their
+own basis). The branch here (SPOM1 at M = 0, its pear point read as an m = 1 point, the pear branch turned by 90°)
+starts at `[surface] degree` 4 and is refined twice within 12 points."""
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.results import Block
+from balloon_cg.analysis.surface import branches as surface_branches
+from balloon_cg.numerics import workers
+from balloon_cg.scene import load_scene
+from balloon_cg.surface.measures import tail
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module")
+def refined_branch():
+    """(the SurfaceBranch, [(degree of the basis a point was traced on, its tail there)] per stored point)."""
+    scene = load_scene(ROOT / "scenes" / "spom1.toml").with_overrides(
+        {"continuation.stop_stretch": 2.0, "surface.branches": "none", "surface.degree": 4})
+    primary = analyse(scene).primary
+    bp = replace(primary.branch_points()[0], m=1, block=Block.M1_HELD)
+    own, collected = [], surface_branches.collected
+
+    def spied(trace, segments, folds, stop):
+        own.extend((t.basis.degree, tail(t.basis, c)) for t, c in surface_branches.traced_points(segments))
+        return collected(trace, segments, folds, stop)
+
+    surface_branches.collected = spied
+    try:
+        with workers.serial():
+            branch = surface_branches.trace_surface(primary, 0, bp, 1.0, "m1", 12)
+    finally:
+        surface_branches.collected = collected
+    return branch, own
+
+
+def test_each_point_keeps_the_estimate_of_the_basis_it_was_traced_on(refined_branch):
+    branch, own = refined_branch
+    degrees = [d for d, _ in own]
+    assert len(set(degrees)) >= 2 and degrees[-1] == branch.basis.degree  # refined along the trace
+    assert len(own) == len(branch.error_estimate)
+    for (degree, estimate), stored in zip(own, branch.error_estimate):
+        assert stored >= estimate
+    # the coarse points' tails are far above what their coefficients read on the final basis: the case that matters
+    coarse = [k for k, d in enumerate(degrees) if d < branch.basis.degree]
+    on_final = np.array([tail(branch.basis, branch.coefficients[k]) for k in coarse])
+    assert max(own[k][1] / max(f, 1e-300) for k, f in zip(coarse, on_final)) > 100.0
+    assert branch.error_estimate.max() <= branch.scene.solver.max_error
