@@ -37,7 +37,7 @@ COST = {  # CPU seconds of each file in one run of the default suite on 2 worker
     "test_poles": 6, "test_stability_basis": 6, "test_tube_field": 6, "test_fold_curve": 6, "test_surface_free": 6,
     "test_tube": 6, "test_tube_maxwell": 6, "test_fuzz": 5, "test_two_parameter": 5, "test_surface_pitchforks": 5,
     "test_interval": 5, "test_hostile_memory": 5, "test_tube_cli": 5, "test_ownership": 5, "test_sweep_store": 5,
-    "test_tube_switching": 5, "test_dynamics_surface": 5, "test_workers": 5,
+    "test_tube_switching": 5, "test_dynamics_surface": 5, "test_workers": 5, "test_surface_estimates": 7,
 }
 
 
