@@ -82,11 +82,10 @@ class Resolution:
     def clearly_lower(self, tail: float, current: float) -> bool:
         """Whether a basis map's tail estimate ``tail`` is clearly below the ``current`` map's: by the factor
         ``map_gain``. Measured (benchmarks/results/refine_choice.txt, three OpenBLAS kernel sets): where both maps
-        sit at the estimate's rounding floor the kernels' rounding moves their ratio between 0.6 and 1.6, and the
-        rounding comes from upstream (map widths and leg points different in their last digits), not from the
-        solve at hand (a Newton correction there moves T by 1e-17 to 1e-14, 10³ times less); the one choice
-        decided by content (x against a map, at 90 -> 135) reads 2.4 to 2.6 under every kernel. T itself reads
-        the error only to a factor ~1.5 (tests/test_tail.py)."""
+        sit at the estimate's rounding floor the kernels' rounding moves their ratio between 0.6 and 1.6 (it comes
+        from upstream too: the maps' widths and the leg's points differ in their last digits, so no floor estimated
+        from the solve at hand captures it); the one choice decided by content (x against a map, at 90 -> 135)
+        reads 2.4 to 2.6 under every kernel. T itself reads the error only to a factor ~1.5 (tests/test_tail.py)."""
         return tail * self.map_gain < current
 
     @property
