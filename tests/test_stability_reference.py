@@ -59,7 +59,15 @@ P 1.681873 (degree 60 -> 90) the current map (width 0.03280, T 1.630e-13) is kep
 1.219e-13; ratio 1.34, both at the floor); the samples agree to point 49 of 54, the branch is stored on the map of
 width 0.03280 (was 0.03213), and its eigenvalues compared by point index differ from point 50 on (other samples, up
 to 0.0147); its four special points (labels the same) have λ2 and η within 4.6e-13 and P within 5.6e-14 but the end
-point (EP, point 53): P 1.3e-11, λ2 7.5e-11, η 3.6e-11 apart; the primary is identical.
+point (EP, point 53): P 1.3e-11, λ2 7.5e-11, η 3.6e-11 apart; the primary is identical. spom1_two_coils_M0.003: at the
+primary's point 48 (P 2.068692, degree 60 -> 90) the current map (width 0.09438, T 1.553e-13) is kept over the
+re-centred one (0.08478, 1.519e-13; ratio 1.02, both at the floor); the samples agree to 4.4e-16 up to point 48 (the
+start point's P to 1.9e-12), then follow the other map and reach wire_gap after 55 points instead of 56 (the end
+point, the first sample inside the gap, at P 1.80413 against 1.77212); against main every special point's λ2 and η on
+a 2001-point θ grid are within 1.9e-10 and its P within 8.9e-11 (the pear branches' m1_free BPs; the primary's within
+2.9e-11 and 2e-12) but the primary's TP at point 51 (P 3.5e-10, λ2 1.4e-10, η 7e-11 apart) and that end point; the
+m1_bp0 surface branch's four special points keep their labels and P within 9.3e-13, one coefficient of each 4.7e-5
+apart (its basis follows the primary's storage map); every other stored number within the rule.
 """
 import numpy as np
 import pytest
