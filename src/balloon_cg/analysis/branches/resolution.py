@@ -6,9 +6,8 @@ neglected geometric tail of the Legendre coefficients) is at most ``max_error``.
 leaves ``headroom`` · max_error (at most ``max_recentres`` times per degree); when the degree grows, a re-centred map
 replaces the current one only where its estimate is lower by the factor ``map_gain`` (``clearly_lower``), so that
 a choice between two maps both at the estimate's rounding floor is not made by the BLAS kernels' rounding. Points
-moved to another basis
-(storage on the final basis, a branch point projected to the stability basis in x) may lose at most
-``storage_loss`` · max_error to the projection (``transfer_error``) before the target degree is raised.
+moved to another basis (storage on the final basis, a branch point projected to the stability basis in x) may lose
+at most ``storage_loss`` · max_error to the projection (``transfer_error``) before the target degree is raised.
 The tracer, the storage-basis rule, bifurcation and two-parameter code all ask this object.
 """
 from dataclasses import dataclass
