@@ -34,31 +34,42 @@ table's −0.044649472758, where the rule allows 1.1e-9. The elements are right 
 400, 480 and 560 scatter by 2e-9 with no trend in the degree (the dense eigensolver's rounding ε‖H‖ at these
 sizes; docs/numerics.md §4).
 
-Known to fail on the session-25 machine (numpy 2.4.6, scipy 1.17.1, OpenBLAS 0.3.31 picking its Haswell/Zen kernels
-on an AMD EPYC), not re-recorded (neither result is the better one; the comparison by point index is what breaks):
-spom1_single_coil and tpom1_two_coils_M0.002. The same code gives the same result there at bec04f4 (which recorded
-the tpom1 table on the previous machine) as on main e7c4889 (spom1: within 1.1e-10; tpom1: identical), so it is the
-build, not a commit. spom1_single_coil: its primary branch's samples agree (P to ~1e-15) up to point 67 (P 0.876362),
-where the leg's last point is recomputed at degree 60 on the better of two wire maps (``Tracer._refine``: the smaller
-tail estimate): the current map (width 0.06672) and the re-centred one (0.05710) leave 1.087e-13 and 1.123e-13 with
-these kernels, 1.439e-13 and 0.910e-13 with Sandybridge's; both at the tail's rounding floor, far below max_error,
-and the choice between them is rounding. On the other map the leg's tangent and so its samples differ from there on,
-and it reaches wire_gap after 75 points instead of 74. With OPENBLAS_CORETYPE=Sandybridge main reproduces the stored
-table (the comparison passes, 74 points); both builds give every other branch with the same samples, and every
-special point's λ2 and η on a 2001-point θ grid within 8e-12 but two: the TP at point 71 (P 3.5e-10 apart, within the
-rule; λ2 1.6e-9) and the wire-gap end point (the first sample inside the gap: P 0.84084 against 0.84200); the
-primary's storage map follows its last points (width 0.02339 against 0.02725 at degree 60), so every primary special
-point's coefficients moved by 0.013 to 0.05 (at P within 4e-12 but those two). tpom1_two_coils_M0.002: pear_free_1's
-(and its mirror's) point 28, the sample before its end point, lies about 1.2e-5 in P earlier in the table (read off
-its m1 eigenvalues, 3.4e-5 off, on the same curve between points 27 and 29, which agree to 1e-11; the table stores no
-P of a sample), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP):
-another storage map. The same choice as spom1's: at point 27 (P 2.245873) ``Tracer._refine`` keeps, of two maps at
-degree 202, the one with tail 2.7894e-11 (widths 0.18979, 0.24705) over 2.8036e-11 (widths 0.16903, 0.23597), 0.5%
-apart; read on that other map the table's LP and EP are this machine's to 4.8e-14 and 8.2e-11 in λ2 and η on a
-2001-point θ grid (on this machine's map they are 0.019 off). Here the Haswell and Sandybridge kernels both keep the
-first map and agree on every sample, so the previous machine's choice could not be reproduced here. A rule that
-survives a rounding-level choice of map would store each branch's sampled P and its storage map, compare eigenvalues
-by index only while the samples agree, and special points as λ2, η on a fixed θ grid instead of as coefficients."""
+Re-recorded in session 26, when ``Tracer._refine`` came to keep the current wire map at a degree step unless the
+re-centred one's tail estimate is below half the current's (``Resolution.clearly_lower``): before, the smaller of two
+estimates both at their rounding floor won, and the BLAS kernels chose. Session 25 found spom1_single_coil and
+tpom1_two_coils_M0.002 failing on its machine (numpy 2.4.6, scipy 1.17.1, OpenBLAS 0.3.31 picking its Haswell kernels
+on an AMD EPYC) at the commits that recorded them; benchmarks/results/refine_choice.txt shows both pictures' decisions
+the same under the Haswell, Sandybridge and Nehalem kernels now, different ones before. tpom1_two_coils_M0.002 passes
+again unchanged: at pear_free_1's point 27 (P 2.245873, degree 135 -> 202) the current map (widths 0.16903, 0.23597;
+T 2.804e-11 here) is kept over the re-centred one (0.18979, 0.24705; 2.789e-11 here, 2.504e-11 with Sandybridge's
+kernels, 2.542e-11 with Nehalem's), the choice of the machine that recorded its table. tpom1_two_coils_M0.001
+passes unchanged: at its pear_free_1's point 27 (P 2.255091, 135 -> 202) the current map (T 2.224e-11) is kept now
+over the re-centred one (2.088e-11), so the branch is stored on another map, but every sample agrees to 1e-12 and
+every stored number within the rule. Moved, re-recorded:
+spom1_single_coil: at the primary's point 67 (P 0.876362, degree 40 -> 60) the current map (width 0.06672,
+T 1.087e-13) is kept over the re-centred one (0.05710, 1.123e-13; with Sandybridge's kernels 1.439e-13 and
+0.910e-13, which kept the re-centred map and made the old table: main under OPENBLAS_CORETYPE=Sandybridge reproduces
+it). The primary's samples agree to point 67, then follow the other map and reach wire_gap after 75 points instead
+of 74, stored on the map of width 0.02339 (was 0.02725); every other branch has the same samples; against main under
+Sandybridge every special point's λ2 and η on a 2001-point θ grid are within 7.8e-12 and its P within 3.3e-12 but
+two: the TP at point 71 (P 3.5e-10 apart, λ2 1.6e-9, η 2.9e-10) and the wire-gap end point (the first sample inside
+the gap: P 0.84200 against 0.84084, where the samples fall). Neither map is the better one (both estimates at the
+floor, four orders below max_error); the new one is the one every kernel keeps. off_equator: on its broken pear at
+P 1.681873 (degree 60 -> 90) the current map (width 0.03280, T 1.630e-13) is kept over the re-centred one (0.03213,
+1.219e-13; ratio 1.34, both at the floor); the samples agree to point 49 of 54, the branch is stored on the map of
+width 0.03280 (was 0.03213), and its eigenvalues compared by point index differ from point 50 on (other samples, up
+to 0.0147); its four special points (labels the same) have λ2 and η within 4.6e-13 and P within 5.6e-14 but the end
+point (EP, point 53): P 1.3e-11, λ2 7.5e-11, η 3.6e-11 apart; the primary is identical. spom1_two_coils_M0.003: at the
+primary's point 48 (P 2.068692, degree 60 -> 90) the current map (width 0.09438, T 1.553e-13) is kept over the
+re-centred one (0.08478, 1.519e-13; ratio 1.02, both at the floor); the samples agree to 4.4e-16 up to point 48 (the
+start point's P to 1.9e-12), then follow the other map and reach wire_gap after 55 points instead of 56 (the end
+point, the first sample inside the gap, at P 1.80413 against 1.77212); against main every special point's λ2 and η on
+a 2001-point θ grid are within 1.9e-10 and its P within 8.9e-11 (the pear branches' m1_free BPs; the primary's within
+2.9e-11 and 2e-12) but the primary's TP at point 51 (P 3.5e-10, λ2 1.4e-10, η 7e-11 apart) and that end point; the
+m1_bp0 surface branch's four special points keep their labels and P within 9.3e-13, one coefficient of each 4.7e-5
+apart (its basis follows the primary's storage map); every other stored number within the rule. The three
+re-recorded tables pass under OPENBLAS_CORETYPE=Sandybridge as under the default kernels.
+"""
 import numpy as np
 import pytest
 

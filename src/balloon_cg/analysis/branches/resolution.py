@@ -3,9 +3,11 @@
 A point is resolved on a discretisation when its spectral error estimate (``Discretisation.tail``: the
 neglected geometric tail of the Legendre coefficients) is at most ``max_error``. Otherwise the degree grows by
 ``growth`` (up to ``max_degree``). With a wire map, a re-centred map at the same degree is preferred when it
-leaves ``headroom`` · max_error (at most ``max_recentres`` times per degree). Points moved to another basis
-(storage on the final basis, a branch point projected to the stability basis in x) may lose at most
-``storage_loss`` · max_error to the projection (``transfer_error``) before the target degree is raised.
+leaves ``headroom`` · max_error (at most ``max_recentres`` times per degree); when the degree grows, a re-centred map
+replaces the current one only where its estimate is lower by the factor ``map_gain`` (``clearly_lower``), so that
+a choice between two maps both at the estimate's rounding floor is not made by the BLAS kernels' rounding. Points
+moved to another basis (storage on the final basis, a branch point projected to the stability basis in x) may lose
+at most ``storage_loss`` · max_error to the projection (``transfer_error``) before the target degree is raised.
 The tracer, the storage-basis rule, bifurcation and two-parameter code all ask this object.
 """
 from dataclasses import dataclass
@@ -29,6 +31,7 @@ class Resolution:
     headroom: float = 0.25
     storage_loss: float = 0.5
     max_recentres: int = 6
+    map_gain: float = 2.0
 
     @classmethod
     def of(cls, scene) -> "Resolution":
@@ -74,6 +77,15 @@ class Resolution:
             if kept >= 1 and geometric_tail(envelope[:kept]) <= limit and envelope[kept:].max() <= limit:
                 return cut
         return degree
+
+    def clearly_lower(self, tail: float, current: float) -> bool:
+        """Whether a basis map's tail estimate ``tail`` is clearly below the ``current`` map's: by the factor
+        ``map_gain``. Measured (benchmarks/results/refine_choice.txt, three OpenBLAS kernel sets): where both maps
+        sit at the estimate's rounding floor the kernels' rounding moves their ratio between 0.6 and 1.6 (it comes
+        from upstream too: the maps' widths and the leg's points differ in their last digits, so no floor estimated
+        from the solve at hand captures it); the one choice decided by content (x against a map, at 90 -> 135)
+        reads 2.4 to 2.6 under every kernel. T itself reads the error only to a factor ~1.5 (tests/test_tail.py)."""
+        return tail * self.map_gain < current
 
     @property
     def recentre_accept(self) -> float:

@@ -5,9 +5,9 @@ in P (LP), in the north pole stretch (TP) and in the loading's control parameter
 point's spectral error estimate exceeds the resolution policy's max_error (``resolution.Resolution``), the leg stops
 with RESOLUTION and the last point is recomputed on a finer basis: with coils, first the wire map re-centred
 at the same degree (kept if the estimate leaves the policy's headroom, at most max_recentres times per degree);
-otherwise the degree grows and the better of the current and the re-centred map is kept. Past max_degree the
-leg stops with RESOLUTION_LIMIT, or FLATTENING where it is on its way to the balloon folded flat about a wire at
-P = 0, which no degree reaches (``flattening``).
+otherwise the degree grows and the current map is kept unless the re-centred one's estimate is clearly lower
+(``Resolution.clearly_lower``). Past max_degree the leg stops with RESOLUTION_LIMIT, or FLATTENING where it is on
+its way to the balloon folded flat about a wire at P = 0, which no degree reaches (``flattening``).
 
 The tracer is the same for the primary branch (``primary``) and the bifurcating ones (``switching``): they
 differ in the layout (equator-symmetric or general, held or free) and the stop rule.
@@ -183,8 +183,9 @@ class Tracer:
 
     def _refine(self, disc: Discretisation, last: continuation.Point, degree: int, mappings, params: Parameters,
                 accept: float):
-        """``last`` recomputed at ``degree`` on each basis map of ``mappings``: (system, Newton result, tangent
-        reference) of the one with the smallest error estimate, if that is ≤ ``accept``; else a message."""
+        """``last`` recomputed at ``degree`` on each basis map of ``mappings``, the current one first: (system, Newton
+        result, tangent reference) of the first with an error estimate ≤ ``accept``, or of a later one whose
+        estimate is clearly lower (``Resolution.clearly_lower``); else a message."""
         best, message = None, "no candidate basis"
         for mapping in mappings:
             system = self.system(degree, params, mapping)
@@ -194,7 +195,7 @@ class Tracer:
             message = result.message
             if result.converged:
                 estimate = system.eq.disc.tail(result.x[:-1])
-                if estimate <= accept and (best is None or estimate < best[0]):
+                if estimate <= accept and (best is None or self.resolution.clearly_lower(estimate, best[0])):
                     best = (estimate, system, result, t)
                 message = f"error estimate {estimate:.2g} above {accept:.2g}"
         return message if best is None else best[1:]
