@@ -95,6 +95,13 @@ def _class_job(job):
     return cls.name, class_module(cls)
 
 
+def module_names() -> list[str]:
+    """The modules ``write_all`` writes beside the registry: each class's, its surface kernels', the coil field's
+    and the mass matrices' (inertia)."""
+    classes = scene_classes()
+    return sorted([cls.name for cls in classes] + [surface_name(cls) for cls in classes] + ["coil_field", "inertia"])
+
+
 def all_modules(workers: int = 2):
     """{module name: text}, generated in parallel; output does not depend on the worker count."""
     classes = scene_classes()

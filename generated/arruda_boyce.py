@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "6a541f574b676ae418124831f248d1cf06122310bbe78f1630824bd27176c991"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'arruda_boyce'), ('energy', 'mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))'), ('field', False), ('parameters', ('mu', 'N'))]
 
 

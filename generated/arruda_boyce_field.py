@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "e482d08456fc21cd202cd6a83099db52af7697b4d4b941b98cb05039f4e85d09"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'arruda_boyce_field'), ('energy', 'mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))'), ('field', True), ('parameters', ('mu', 'N'))]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "57c1a9fdfaf63ce38e990aa2f83114908586c8d8e5d103ecc7e1cd1de59c54b5"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('stream_function', 'psi = 32 a^2 rho^2 G(m) / S^3, m = 4 a rho / S^2'), ('stream_pieces', '8 per octave of 1 - m, 12 octaves, 20 terms, tail 2^-60')]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "948994f4d63faaa7c5dfd204cd12501876b33b9731c639444b55f9b8819a5242"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)'), ('field', False), ('parameters', ('mu', 'Jm'))]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "8ca2393d4f154f03409c993443b1df2581106e5a9a5a6b729f8bd3f9f2706e44"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent_field'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)'), ('field', True), ('parameters', ('mu', 'Jm'))]
 
 

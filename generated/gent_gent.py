@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "fc7d0122984e71d6eec2d4ce62fa8916f0f99262b0231e3e463102669a11188a"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent_gent'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)'), ('field', False), ('parameters', ('mu', 'Jm', 'C2'))]
 
 

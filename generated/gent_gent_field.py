@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "9003d878ea2c56c8e3b65c9e448a8d600775d5abcdb812cb4dc4d813590dfe43"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent_gent_field'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)'), ('field', True), ('parameters', ('mu', 'Jm', 'C2'))]
 
 

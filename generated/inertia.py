@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "759f0cb5e9fe72292e2485072f9c128a93cf06443b0d19f08866ffe88f09e41c"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('kinetic_energy', '1/2 rho T0 |du/dt|^2 dA over the reference surface')]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "c6331693bb480c80bfe1044489e89150e27b5642a4ac18f506a361f1953ec1f7"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '-2')), ('class', 'ogden_fpom1'), ('field', False)]
 
 

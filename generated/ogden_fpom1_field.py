@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "7649e71b2388dc403d2495dcaf0bddf842c82de63fc77330f301a940d088f12f"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '-2')), ('class', 'ogden_fpom1_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "80d30c02fbe8febb0a981ea37e80f398c28de98e1f442e27c56a551ba23b50a8"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '-2')), ('class', 'ogden_fpom2'), ('field', False)]
 
 

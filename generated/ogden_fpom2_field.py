@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "ada7043b7c794833efd1b6055aa5424572d10a6b925053c4b92a813cfa8234ae"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '-2')), ('class', 'ogden_fpom2_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "1d2e7bb3cf0e3865fc04719012823142fca1d940d5b45a95984e4250ead99b56"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', 'runtime'), ('class', 'ogden_general_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "9a15323c5c5931086d19df37b916e6f69db1a4b3e6378de623b0079bf087374a"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2', '-2')), ('class', 'ogden_mooney_rivlin'), ('field', False)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "adc92a357b5814f86fc36fae861dc3f9c4049277632ef0da867c536705861ece"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2', '-2')), ('class', 'ogden_mooney_rivlin_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "2ccb441dc3e73c408f76781b9374242097c95a092fdd353d0f309b3e7ce1fff9"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2',)), ('class', 'ogden_neo_hookean'), ('field', False)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "d80329a464c1093c8c2e5e70b6537a9f74c5b47f1d868f56b07333fd90b8d6f2"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2',)), ('class', 'ogden_neo_hookean_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "23eade21f76aa9692879bab318d95b8b540475c277cd8986f4b60cafc60152bb"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '4', '-2')), ('class', 'ogden_spom1'), ('field', False)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "79c9c6caf84f33fab37ec5b2fe520c5b66edae2bcdbf24560e357d5ebd8d9b4f"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '4', '-2')), ('class', 'ogden_spom1_field'), ('field', True)]
 
 

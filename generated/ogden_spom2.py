@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "2950b9233965e6fd9a663624266d7f03c3c1b9f7319285258bb1c77ea2e5da6e"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '4', '-2')), ('class', 'ogden_spom2'), ('field', False)]
 
 

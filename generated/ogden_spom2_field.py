@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "105c2fb16f2cbaaac63254590e411b77433402f02b39564265f9bc4cb97b0a7f"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '4', '-2')), ('class', 'ogden_spom2_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "0a7c1016820ddcd022c9a4f78705a5b835a5e8d45250fcd51aba209b036f5340"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3',)), ('class', 'ogden_tpom1'), ('field', False)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "abf7f63f9a06227c05767285789c37e7fedf1d0f15587186c53fac9d6ee6b9e2"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3',)), ('class', 'ogden_tpom1_field'), ('field', True)]
 
 

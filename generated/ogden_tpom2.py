@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "4cf6bb6610e23fde4b3a0f0bb9c408be6473625ee856a2fe4a6c77c1ae0c86f3"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.98',)), ('class', 'ogden_tpom2'), ('field', False)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "8516799cdcbde3286ede930764bd6355460004b511a2697637203232b7105b6e"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.98',)), ('class', 'ogden_tpom2_field'), ('field', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "6e25a213d27229fcd8a34ed07f00bd29362868e8235feac5d4e8476ae82c635c"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'rivlin'), ('energy', 'C10 * (I1 - 3) + C01 * (I2 - 3) + C20 * (I1 - 3) ** 2 + C11 * (I1 - 3) * (I2 - 3) + C02 * (I2 - 3) ** 2 + C30 * (I1 - 3) ** 3'), ('field', False), ('parameters', ('C10', 'C01', 'C20', 'C11', 'C02', 'C30'))]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "60b7b6e6ab8e8a2b4b1ed1e29f826bedbd91dca02edf275b2ae8975a8773d1cf"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'rivlin_field'), ('energy', 'C10 * (I1 - 3) + C01 * (I2 - 3) + C20 * (I1 - 3) ** 2 + C11 * (I1 - 3) * (I2 - 3) + C02 * (I2 - 3) ** 2 + C30 * (I1 - 3) ** 3'), ('field', True), ('parameters', ('C10', 'C01', 'C20', 'C11', 'C02', 'C30'))]
 
 

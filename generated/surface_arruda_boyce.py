@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "4a8e6309cfc50c9d316d51fc09c1f83c1e46c1ff7b812ef3e7c6d14cd78211d6"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'arruda_boyce'), ('energy', 'mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))'), ('field', False), ('parameters', ('mu', 'N')), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "825c617c7ef9cfa57d91542185ea2b2174cef83358de071306b73500fa11cf45"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'arruda_boyce_field'), ('energy', 'mu * (I1 - 3) / 6 - mu * N * log((3 * N - I1) / (3 * N - 3))'), ('field', True), ('parameters', ('mu', 'N')), ('surface', True)]
 
 

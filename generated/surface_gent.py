@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "284ee4eeb8a8eda7b4ed720c149ef31da3a25d7301fd3e0e4556fbf553e5252a"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)'), ('field', False), ('parameters', ('mu', 'Jm')), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "410350f2d93712878dfce86bcf7f4a49f4ba817c6f975f0665ba7d0ae68f5c9a"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent_field'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm)'), ('field', True), ('parameters', ('mu', 'Jm')), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "8097f080379210e21f39e2c0634c063e8d2f77a415dcfb5376d15b5f43f7795e"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent_gent'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)'), ('field', False), ('parameters', ('mu', 'Jm', 'C2')), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "836010cceb6dd5c69b904ccfae39e081a56f3083e6369aac9ffe77555ce91a8f"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'gent_gent_field'), ('energy', '-(mu * Jm / 2) * log(1 - (I1 - 3) / Jm) + C2 * log(I2 / 3)'), ('field', True), ('parameters', ('mu', 'Jm', 'C2')), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "2f04094e74d84d26a2f2a2957cc8bb307f588f2629503a2f4eaa07ca5a4adeef"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '-2')), ('class', 'ogden_fpom1'), ('field', False), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "fba23791fefc760731746c25be626591b12066a623a896d453e9c81b49404c2d"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '-2')), ('class', 'ogden_fpom1_field'), ('field', True), ('surface', True)]
 
 

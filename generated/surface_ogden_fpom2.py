@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "ba9653a1e150986cdfc4fdc7deb0095a6f9b85ac721cf0c8d2cb0a3ee0ba7b59"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '-2')), ('class', 'ogden_fpom2'), ('field', False), ('surface', True)]
 
 

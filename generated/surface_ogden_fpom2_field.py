@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "2bd9f4b2969dc800bfe87d8562ccffe31698d499e92ada21a74432fd8301aab9"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '-2')), ('class', 'ogden_fpom2_field'), ('field', True), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "d973f9528e73e55abb37246aa1e069d77af7e97327de38b51ff1e1c5e2fa5a66"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', 'runtime'), ('class', 'ogden_general_field'), ('field', True), ('surface', True)]
 
 

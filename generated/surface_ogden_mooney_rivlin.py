@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "fbd24d9800b150721c1830bd5a079d79ad5e31d333c00d2c8efde118fb955317"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2', '-2')), ('class', 'ogden_mooney_rivlin'), ('field', False), ('surface', True)]
 
 

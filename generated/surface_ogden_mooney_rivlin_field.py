@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "40a4b792db65e9cc3b076c9b21ab59978aa69e206df132aff5e6fae9cba956e9"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2', '-2')), ('class', 'ogden_mooney_rivlin_field'), ('field', True), ('surface', True)]
 
 

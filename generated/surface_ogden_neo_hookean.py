@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "38cf1f048e7097f5b809febc6bb4d702e104c03a3c48a9cb00a5847d05f9626a"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2',)), ('class', 'ogden_neo_hookean'), ('field', False), ('surface', True)]
 
 

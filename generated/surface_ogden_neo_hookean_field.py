@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "639b15444df884ee0dc2143125cb1d84d9a6a874dc6490d724ecac4e88fd220f"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('2',)), ('class', 'ogden_neo_hookean_field'), ('field', True), ('surface', True)]
 
 

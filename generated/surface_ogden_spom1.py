@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "b27ff86b96d0052922ec1a9c8ead97069e0a0fae79b8ceb47612a75003868175"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '4', '-2')), ('class', 'ogden_spom1'), ('field', False), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "8a0484b40f12b9f75077c663bdb43a7bc8cf14bdc7ba348862afe11382d2a2d3"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3', '4', '-2')), ('class', 'ogden_spom1_field'), ('field', True), ('surface', True)]
 
 

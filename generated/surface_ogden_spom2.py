@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "72e9ef4ff516cfdab7b10c4ec8ad6d149aa49dc00915bbcac8c5141dedcbec4f"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '4', '-2')), ('class', 'ogden_spom2'), ('field', False), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "63dd8d2394da07d641213593de79410c0a79f76b29488b829f1c1bf02d909786"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.73', '4', '-2')), ('class', 'ogden_spom2_field'), ('field', True), ('surface', True)]
 
 

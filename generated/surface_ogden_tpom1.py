@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "e9b07998e0d982f5e6a93fcd2d3b8095f361f089fcd62b15158239b2e992bb3b"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3',)), ('class', 'ogden_tpom1'), ('field', False), ('surface', True)]
 
 

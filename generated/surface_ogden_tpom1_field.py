@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "4ae30477ea0cdbcb6ce34e15a6c0632fd18da6ec55ad0c102dfb397696d6753d"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.3',)), ('class', 'ogden_tpom1_field'), ('field', True), ('surface', True)]
 
 

@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "28b2f9783b0fa884ba23ac2128bba55eedc783aa020697f57a0e4da94eef3331"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.98',)), ('class', 'ogden_tpom2'), ('field', False), ('surface', True)]
 
 

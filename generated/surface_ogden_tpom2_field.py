@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "cf30a2b703be97c3b36778b76ee47179cfb4356d44e1b19ffe55aa656e3debc3"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('alphas', ('1.98',)), ('class', 'ogden_tpom2_field'), ('field', True), ('surface', True)]
 
 

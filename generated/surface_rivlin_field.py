@@ -9,6 +9,7 @@ import math
 from numba import njit
 
 SIGNATURE = "5c8330b5128655855d5210143472f04f8083c9ee590b42256f7cf8f5bbe1afa8"
+GENERATOR_SOURCES = "17e7543cde7f36a182cd70df91985d7e49f0ac270531cdffe55183f621db7e15"
 INPUTS = [('class', 'rivlin_field'), ('energy', 'C10 * (I1 - 3) + C01 * (I2 - 3) + C20 * (I1 - 3) ** 2 + C11 * (I1 - 3) * (I2 - 3) + C02 * (I2 - 3) ** 2 + C30 * (I1 - 3) ** 3'), ('field', True), ('parameters', ('C10', 'C01', 'C20', 'C11', 'C02', 'C30')), ('surface', True)]
 
 

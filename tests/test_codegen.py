@@ -1,5 +1,6 @@
 """The symbolic layer: printer text, kernels against SymPy, and generated/ up to date."""
 import filecmp
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -9,6 +10,8 @@ import pytest
 import sympy as sp
 
 from codegen import functional as fn, poles
+from codegen.build import module_names
+from codegen.freshness import stale
 from codegen.printer import print_expr
 from codegen.terms.magnetic import FIELD, M, chi
 from codegen.terms.pressure import P
@@ -109,8 +112,48 @@ def test_first_order_system_holds_on_the_exact_sphere(preset):
         assert np.allclose(f, (0.0, 0.0, -lam * s, -lam * c), atol=1e-12)
 
 
-def test_generated_is_up_to_date(tmp_path):
-    """`make regenerate` reproduces generated/ byte for byte (fails when generated/ is stale)."""
+def test_generated_is_up_to_date():
+    """generated/ is what today's generator prints (codegen/freshness.py, from the modules' headers: each module's
+    GENERATOR_SOURCES is the digest of codegen/ and the runtime modules it reads, and its text is the generator's
+    header over its body); fails when generated/ is stale: run `make regenerate`."""
+    assert stale(ROOT / "generated") == [], "generated/ is stale: run `make regenerate`"
+
+
+def test_a_stale_generated_folder_is_seen_without_regenerating(tmp_path):
+    """The check above on copies made stale on purpose: an edit to a generator source (codegen/ or the formula
+    parser it reads), a module edited by hand (its body; its header's inputs), a module missing, one left over, and
+    the registry edited: each is named."""
+    from codegen import generator_sources
+
+    folder = Path(shutil.copytree(ROOT / "generated", tmp_path / "generated"))
+    sources = generator_sources()
+    for name in ("codegen/printer.py", "balloon_cg/scene/formula.py"):
+        edited = tmp_path / name.replace("/", "_")
+        edited.write_text(sources[name].read_text() + "# an edit\n")
+        lines = stale(folder, sources | {name: edited})
+        assert len(lines) == len(module_names()) and all("printed by other generator sources" in line
+                                                          for line in lines), lines
+    assert stale(folder, sources) == []
+    spom1 = folder / "ogden_spom1.py"
+    text = spom1.read_text()
+    assert "\n    return (" in text
+    spom1.write_text(text.replace("\n    return (", "\n    return  (", 1))  # the body: one kernel's last line
+    (folder / "inertia.py").write_text((folder / "inertia.py").read_text().replace("Inputs: [", "Inputs: [ ", 1))
+    (folder / "coil_field.py").unlink()
+    (folder / "ogden_spom9.py").write_text("")
+    (folder / "__init__.py").write_text((folder / "__init__.py").read_text() + "\n")
+    assert stale(folder, sources) == [
+        "coil_field.py: missing", "ogden_spom9.py: not a module the generator writes",
+        "__init__.py: not the registry of today's scene table",
+        "inertia.py: edited after it was generated (its header does not match its body)",
+        "ogden_spom1.py: edited after it was generated (its header does not match its body)"]
+
+
+@pytest.mark.slow
+def test_make_regenerate_reproduces_generated_byte_for_byte(tmp_path):
+    """`make regenerate` reproduces generated/ byte for byte: also what the check from the headers cannot see
+    (another SymPy or mpmath printing otherwise). A minute of CPU: `-m slow`, and .ci/run runs it after the
+    default suite."""
     subprocess.run([sys.executable, "-m", "codegen", str(tmp_path)], cwd=ROOT, check=True, capture_output=True)
     fresh = sorted(p.name for p in tmp_path.glob("*.py"))
     committed = sorted(p.name for p in (ROOT / "generated").glob("*.py"))

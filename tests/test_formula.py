@@ -113,7 +113,7 @@ def test_cache_key_changes_with_formula_field_generator_source_and_version(monke
     assert kernel_cache.class_key(other.formula, PLAIN) == key
     assert kernel_cache.class_key(energy.formula, (*PLAIN, "magnetic")) != key
     assert kernel_cache.class_key(material_from_table({"energy": "I1 - 3 + 0*I2"}).formula, PLAIN) != key
-    monkeypatch.setattr(kernel_cache, "generator_digest", lambda: "an edited generator")
+    monkeypatch.setattr(codegen, "generator_digest", lambda: "an edited generator")
     assert kernel_cache.class_key(energy.formula, PLAIN) != key
     monkeypatch.undo()
     monkeypatch.setattr(codegen, "GENERATOR_VERSION", codegen.GENERATOR_VERSION + "-changed")

@@ -13,31 +13,26 @@ from balloon_cg.app.cli import main
 from balloon_cg.io.tube_file import read_tube_run
 
 from cpu_moments import command, evenly, handled
+from shared_pictures import TUBE, TUBE_COIL, TUBE_COIL_FAST, TUBE_FAST, tube_critical_file, tube_run_file
 from test_signal_moments import balloon_cg, one_line
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENE = str(ROOT / "scenes" / "tube_spom1_L10.toml")
-COIL_SCENE = str(ROOT / "scenes" / "tube_spom1_L10_coil.toml")
-FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s of CPU, both branches
-COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
 LATENCY = 2.0  # CPU seconds from the signal to the process's exit (issue 42)
 
 
 def run_argv(output: str) -> list:
-    return ["run", SCENE, "-o", output, "--quiet", "--force", *FAST]
+    return ["run", str(TUBE), "-o", output, "--quiet", "--force", *TUBE_FAST]  # ~3 s of CPU, every branch
 
 
 def critical_argv(output: str) -> list:
-    return ["critical", COIL_SCENE, "--parameter", "M", "-o", output, "--quiet", "--force", *COIL_FAST]
+    return ["critical", str(TUBE_COIL), "--parameter", "M", "-o", output, "--quiet", "--force", *TUBE_COIL_FAST]
 
 
 @pytest.fixture(scope="module")
 def references(tmp_path_factory):
-    """The uninterrupted run and critical files."""
-    folder = tmp_path_factory.mktemp("reference")
-    assert balloon_cg(folder, "SIGTERM", "never", run_argv("run.h5")) == (0, "")
-    assert balloon_cg(folder, "SIGTERM", "never", critical_argv("critical.h5"))[0] == 0
-    return read_tube_run(folder / "run.h5"), read_tube_run(folder / "critical.h5")
+    """The uninterrupted run and critical files: the session's (tests/shared_pictures.py, the same commands run
+    once for the tube CLI tests; in a process of their own or this one, the numbers are the same bit for bit: the
+    computation limits BLAS to one thread either way, numerics/threads.py)."""
+    return read_tube_run(tube_run_file(tmp_path_factory)), read_tube_run(tube_critical_file(tmp_path_factory))
 
 
 def checked(path: Path, line: str, reference: dict) -> str:

@@ -8,7 +8,8 @@ there by every later run. The key is the SHA-256 of
 
     (canonical formula and parameter names, or 'ogden' and the exponents (None: runtime exponents), the names of
      the energy terms beyond the elastic one, surface kernels or not, codegen.GENERATOR_VERSION, the generator's
-     source digest, SymPy version, and a reference shape other than the sphere: scene.Geometry),
+     source digest (codegen.generator_digest), SymPy version, and a reference shape other than the sphere:
+     scene.Geometry),
 
 so an edited formula, a new generator or another SymPy gives a new module; parameter values (material
 parameters, the voltage) are kernel arguments and never enter the key. The text is written to a temporary file in the cache folder and moved into
@@ -29,7 +30,6 @@ This is the only runtime module that imports SymPy or codegen (tests/test_layers
 """
 import contextlib
 import ctypes
-import functools
 import hashlib
 import importlib.metadata
 import importlib.util
@@ -78,14 +78,6 @@ def _sympy_version() -> str:
                          "needs SymPy: pip install 'balloon-cg[codegen]'") from None
 
 
-@functools.cache
-def generator_digest() -> str:
-    """SHA-256 of the generator's source (codegen/**/*.py and the formula parser it walks): an edit to the generator
-    invalidates cached modules even where GENERATOR_VERSION was not raised."""
-    files = sorted(Path(codegen.__file__).parent.rglob("*.py")) + [Path(formula_module.__file__)]
-    return hashlib.sha256(b"".join(f.name.encode() + f.read_bytes() for f in files)).hexdigest()
-
-
 @dataclass(frozen=True)
 class Exponents:
     """An Ogden material's class as plain data: the exponents of a committed class as the strings it was generated
@@ -106,7 +98,7 @@ def class_key(material, terms: tuple, surface: bool = False, shape: str = SPHERE
     ``terms`` (names, model/kernels.py: scene_terms) on the reference ``shape`` (codegen/meridian.py: MERIDIANS);
     ``surface``: its surface kernels (MODEL.md §8) instead of the axisymmetric ones."""
     text = repr((*_identity(material), tuple(terms), bool(surface), codegen.GENERATOR_VERSION,
-                 generator_digest(), _sympy_version(), *(() if shape == SPHERE else (shape,))))
+                 codegen.generator_digest(), _sympy_version(), *(() if shape == SPHERE else (shape,))))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
