@@ -39,6 +39,7 @@ COST = {  # CPU seconds of each file in one run of the default suite on 2 worker
     "test_interval": 5, "test_hostile_memory": 5, "test_tube_cli": 5, "test_ownership": 5, "test_sweep_store": 5,
     "test_tube_switching": 5, "test_dynamics_surface": 5, "test_workers": 5, "test_surface_estimates": 7,
     # session 26 (s26-contracts): test_codegen checks generated/ from its headers (0.07x its CPU): under 5 s
+    "test_interrupt": 8,
 }
 
 

@@ -188,3 +188,29 @@ def test_a_stop_while_a_point_s_blocks_are_built_comes_before_their_eigenvalues(
     with interrupt.stop_on_signals(), workers.serial(), pytest.raises(interrupt.Interrupted):
         stability.assess_branch(branch, branch.scene.stability.degree, check=True)
     assert len(inside) == 1 and True not in solved  # the point's blocks built, none solved after the request
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_continue_reads_its_file_stops_the_read_at_once(tmp_path, monkeypatch, capsys, sig):
+    """`continue` reads its run file before any work (seconds of CPU for a file with surface branches): a signal
+    then ends the read at once, not after it (the next branch is not read), exit 130, nothing written."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io import run_file
+
+    run = tmp_path / "r.h5"
+    assert main(["run", "spom1", "--set", "continuation.stop_stretch=3", "-o", str(run), "--quiet"]) == 0
+    assert len(read_run(run)["branches"]) >= 2
+    checked, check_branch = [], run_file.check_branch
+
+    def signalled(*args, **kwargs):
+        checked.append(args)
+        if len(checked) == 1:
+            signal.raise_signal(sig)
+        return check_branch(*args, **kwargs)
+
+    monkeypatch.setattr(run_file, "check_branch", signalled)
+    capsys.readouterr()
+    assert main(["continue", str(run), "1", "-o", str(tmp_path / "c.h5"), "--quiet"]) == 130
+    assert len(checked) == 1 and not (tmp_path / "c.h5").exists()
+    assert capsys.readouterr().err.strip() == (f"balloon-cg: interrupted: nothing is written to {tmp_path / 'c.h5'} "
+                                               "(the work had not started)")

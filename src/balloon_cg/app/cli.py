@@ -1001,20 +1001,25 @@ def _continue(args) -> int:
     from ..io.curve_file import write_curve
     from ..io.output import check_output
     from ..io.run_file import read_run
-    from ..numerics.interrupt import Interrupted, requested, stop_on_signals
+    from ..numerics.interrupt import Interrupted, requested, sigterm_raises, stop_on_signals
     from .restart import RestartError, find_label, restart, with_settings
 
     if args.direction != 1.0 and args.parameter is None:
         raise UsageError(f"continue: --direction {args.direction:g} starts a curve in a second parameter: give "
                          "--parameter KEY (without it the branch is traced both ways)")
     check_output(hdf5_output(args.output, "run"), args.force)
+    try:  # reading has nothing to keep: a signal stops it at once (a file with surface branches takes seconds)
+        with sigterm_raises():
+            stored = read_run(args.run)
+    except KeyboardInterrupt:
+        return curve_interrupted_status(None, args.output, True, "the work had not started")
     with stop_on_signals():  # as run: a signal stops the work at its next point, what is finished is written
         try:
-            start = find_label(read_run(args.run), args.label)
+            start = find_label(stored, args.label)
             start = with_settings(start, _with_settings(args, start.branch.scene)[1])
             if args.parameter is not None:
                 field_needed(start.branch.scene, args.parameter, f"continue --parameter {args.parameter}", args.run)
-            if requested():  # while the file was read: nothing computed
+            if requested():  # while its label was found: nothing computed
                 return curve_interrupted_status(None, args.output, True, "the work had not started")
             result = restart(start, args.parameter, args.direction)
         except (RestartError, UnknownParameter) as e:
