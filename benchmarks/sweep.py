@@ -1,7 +1,8 @@
 """Benchmark: a 21-member sweep over M, each member the full analysis (primary branch, stability, branch points,
-pear branches). Two studies (``--study``): ``single-coil`` (default), M = 0 .. 0.005 on the single-coil SPOM1
+pear branches). Three studies (``--study``): ``single-coil`` (default), M = 0 .. 0.005 on the single-coil SPOM1
 scene (stop_stretch 3, about 0.5-1 s per member); ``two-coils``, M = 0 .. 0.003 on the paper's two-coil SPOM1
-scene (issue 14's sweep; the largest fields bring the membrane close to the wires).
+scene (issue 14's sweep; the largest fields bring the membrane close to the wires); ``two-coils-axisymmetric``, the
+same without the non-axisymmetric branches (``[surface] branches = "none"``: the members of that sweep's first rows).
 
 Runs the command ``balloon-cg sweep`` in a fresh interpreter each time (worker start-up and numba cache loading
 included; the time of importing balloon_cg in the parent is shown separately) serially (--workers 1) and on 2
@@ -37,7 +38,12 @@ ROOT = Path(__file__).resolve().parents[1]
 STUDIES = {
     "single-coil": (ROOT / "scenes" / "spom1_single_coil.toml", ["M=0:0.005:21", "stop_stretch=3"], "sweep.txt"),
     "two-coils": (ROOT / "scenes" / "spom1_two_coils_M0.002.toml", ["M=0:0.003:21"], "sweep_two_coils.txt"),
+    "two-coils-axisymmetric": (ROOT / "scenes" / "spom1_two_coils_M0.002.toml", ["M=0:0.003:21"],
+                               "sweep_two_coils_axisymmetric.txt"),
 }
+# a study's scene with these lines added (its copy in the run's temporary folder, the same name): the two-coil
+# members without their non-axisymmetric branches, the kind of member sweep_two_coils.txt's 2026-12-02 rows held
+ADDED = {"two-coils-axisymmetric": '\n[surface]\nbranches = "none"\n'}
 MODE_FLAG = None  # full analysis
 # the sweep command in a fresh interpreter, each member's CPU seconds printed to stderr (the local pool's forked
 # workers look the patched function up by name in this __main__)
@@ -145,6 +151,10 @@ def main():
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
+        if args.study in ADDED:
+            (tmp / "scene").mkdir()
+            scene = (tmp / "scene" / scene.name).resolve()
+            scene.write_text(STUDIES[args.study][0].read_text() + ADDED[args.study])
         if not args.no_warm:
             cli_run(scene, [ends(v) for v in vary], tmp / "warm.h5", 1)  # numba cache warm for every run below
         rows = [] if args.no_serial else [("serial (--workers 1)", cli_run(scene, vary, tmp / "serial.h5", 1),
