@@ -1,10 +1,12 @@
 """Newton with Jacobian reuse (simplified Newton): converges to the root within the tolerance, factors the
-Jacobian only when the corrections stop contracting fast, and reports failures instead of returning garbage."""
+Jacobian only when the corrections stop contracting fast, reports failures instead of returning garbage, and ends
+at the rounding floor (AT_ROUNDING, with the accuracy attained) only where the caller accepts that accuracy."""
+import mpmath
 import numpy as np
 import pytest
 from scipy.linalg.lapack import dgetrf, dgetrs
 
-from balloon_cg.numerics.newton import SMALL_SOLVE, _correction, newton
+from balloon_cg.numerics.newton import EPSILON, SMALL_SOLVE, Convergence, _correction, newton, rounding_floor
 
 
 def circle_and_line():
@@ -114,3 +116,67 @@ def test_jitted_correction_is_the_lapack_solve(size):
     step = _correction(lu, pivots, r, rows, targets, x, dx)
     assert np.abs(dx - expected).max() <= 1e-12 * np.abs(expected).max()
     assert step == pytest.approx(np.max(np.abs(dx) / (1.0 + np.abs(x))), rel=1e-15)
+
+
+def ill_conditioned(condition: float, size: int = 12):
+    """A linear system R(x) = A[:-1] x − b[:-1], bordering row A[-1]·x = b[-1], A = U diag(σ) Vᵀ with σ from 1 to
+    1/condition, and x of mixed sizes (10⁻² … 10³: the scaled norm matters); its exact solution from the stored
+    floats by mpmath at 40 digits."""
+    rng = np.random.default_rng(7)
+    U, _ = np.linalg.qr(rng.normal(size=(size, size)))
+    V, _ = np.linalg.qr(rng.normal(size=(size, size)))
+    A = U @ np.diag(np.logspace(0, -np.log10(condition), size)) @ V.T
+    x_true = rng.choice([-1.0, 1.0], size) * 10.0 ** rng.uniform(-2, 3, size)
+    b = A @ x_true
+    with mpmath.workdps(40):
+        exact = np.array(mpmath.lu_solve(mpmath.matrix(A.tolist()), mpmath.matrix(b.tolist())).tolist(),
+                         dtype=float).ravel()
+    return (lambda x: A[:-1] @ x - b[:-1]), (lambda x: A[:-1]), A, b, exact
+
+
+def test_ill_conditioned_system_ends_at_the_rounding_floor():
+    """κ∞(A D) ~ 1e10 with tol 1e-14 far below ε·κ: the corrections stagnate at the rounding level. With a limit
+    above it the solve ends AT_ROUNDING, its attained accuracy (``step``) above tol and below ε·κ∞(A D), and the
+    true scaled error against the 40-digit solution below ε·κ∞(A D) too; without a limit the same solve fails (as
+    before the rule: never a silent success)."""
+    residual, jacobian, A, b, exact = ill_conditioned(1e8)
+    start = exact * (1 + 1e-3)
+    result = newton(residual, jacobian, start, A[-1:], b[-1:], 1e-14, 60, rounding_limit=1e-3)
+    assert result.outcome == Convergence.AT_ROUNDING and result.converged
+    assert "rounding floor" in result.message
+    floor = rounding_floor(dgetrf(np.asfortranarray(A))[0], result.x)
+    assert 1e-14 < result.step <= floor
+    error = np.abs(result.x - exact) / (1 + np.abs(exact))
+    assert error.max() <= floor
+    failed = newton(residual, jacobian, start, A[-1:], b[-1:], 1e-14, 60)
+    assert failed.outcome == Convergence.FAILED and not failed.converged
+
+
+def test_rounding_limit_below_the_attained_accuracy_is_failure():
+    """The caller's limit decides: a stagnation above ``rounding_limit`` is not accepted."""
+    residual, jacobian, A, b, exact = ill_conditioned(1e8)
+    accepted = newton(residual, jacobian, exact * (1 + 1e-3), A[-1:], b[-1:], 1e-14, 60, rounding_limit=1e-3)
+    limited = newton(residual, jacobian, exact * (1 + 1e-3), A[-1:], b[-1:], 1e-14, 60,
+                     rounding_limit=accepted.step / 10)
+    assert limited.outcome == Convergence.FAILED
+
+
+def test_rounding_floor_is_epsilon_times_the_scaled_condition():
+    """``rounding_floor`` (dgecon's estimate on the column-scaled factors) against ε·κ∞(A D) from the explicit
+    inverse: dgecon's estimate of ‖(A D)⁻¹‖ is a lower bound, in practice within a factor 3."""
+    _, _, A, _, exact = ill_conditioned(1e6)
+    AD = A * (1 + np.abs(exact))
+    direct = EPSILON * np.linalg.cond(AD, np.inf)
+    assert direct / 3 <= rounding_floor(dgetrf(np.asfortranarray(A))[0], exact) <= direct * (1 + 1e-10)
+
+
+def test_well_conditioned_and_linear_convergence_are_unchanged_by_a_limit():
+    """Where Newton reaches tol (a regular root; the double root's linear convergence, ρ = 1/2 < 1) a rounding
+    limit changes nothing: the same iterates, CONVERGED."""
+    residual, jacobian, rows, _ = circle_and_line()
+    plain = newton(residual, jacobian, (3.0, 3.0), rows, 0.0, 1e-13, 50)
+    limited = newton(residual, jacobian, (3.0, 3.0), rows, 0.0, 1e-13, 50, rounding_limit=1e-3)
+    assert limited.outcome == plain.outcome == Convergence.CONVERGED and np.array_equal(limited.x, plain.x)
+    double = newton(lambda z: np.array([z[0] ** 2]), lambda z: np.array([[2 * z[0], 0.0]]), (1.0, 0.0),
+                    np.array([[0.0, 1.0]]), 0.0, 1e-6, 200, rounding_limit=1e-3)
+    assert double.outcome == Convergence.CONVERGED and abs(double.x[0]) <= 2e-6

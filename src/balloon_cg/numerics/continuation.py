@@ -36,6 +36,7 @@ class Settings:
     max_newton: int
     max_turn: float = 0.3  # radians between successive tangents
     slow_newton: int = 6  # a correction needing more iterations is rejected (near-singular: e.g. a branch point)
+    rounding_limit: float = 0.0  # a correction at its rounding floor above tol is accepted up to this (newton)
 
 
 class TraceStop(enum.StrEnum):
@@ -126,7 +127,7 @@ def _refined_tangent(system, X, row, factors: tuple) -> np.ndarray | None:
 def correct(system, predictor, direction, settings: Settings):
     """Keller's corrector: R(X) = 0 on the hyperplane through the predictor normal to ``direction``."""
     return newton(system.residual, system.jacobian, predictor, direction, direction @ predictor,
-                  settings.tol, settings.max_newton)
+                  settings.tol, settings.max_newton, rounding_limit=settings.rounding_limit)
 
 
 class RootStatus(enum.StrEnum):

@@ -12,13 +12,24 @@ Jacobian every iteration this is plain Newton; from a good start (a continuation
 solution) one or two factorisations serve the whole solve, and the other iterations cost one residual each.
 Converged when both the last correction and the error estimate ρ/(1 − ρ)·|dx| (observed contraction
 ρ = |dx_k|/|dx_{k−1}|, Hairer & Wanner IV.8.10) are below the tolerance.
+
+The attainable accuracy. A residual evaluated in floating point carries rounding δR ~ ε|A||x| (its terms), so
+the corrections of an iterate at the solution are A⁻¹δR: in the scaled norm at most ε·κ∞(A D), D = diag(1 + |x_i|)
+(the limiting accuracy of Newton's method in floating point, Tisseur, SIAM J. Matrix Anal. Appl. 22 (2001)
+1038–1057; Higham, *Accuracy and Stability of Numerical Algorithms*, §12.1). Where that floor is above the
+tolerance the corrections stop contracting short of it, and converge or not by the luck of the rounding. A
+correction from a fresh Jacobian at least as large as the last one (no contraction at all: even at a singular
+root Newton contracts by ½) and below ε·κ∞(A D) (dgecon's estimate, computed only then) therefore ends the solve
+as ``Convergence.AT_ROUNDING`` if the caller accepts that accuracy (``rounding_limit``; default 0: never): the
+iterate is returned with that correction as its attained accuracy (``step``, above tol), never as CONVERGED.
 """
+import enum
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy.linalg.lapack import dgetrf, dgetrs  # LAPACK directly: scipy.linalg's wrappers cost ~10-20 µs a call
+from scipy.linalg.lapack import dgecon, dgetrf, dgetrs  # LAPACK directly: scipy.linalg's wrappers: ~10-20 µs a call
 
 # A stale Jacobian is kept while |dx_k| ≤ ratio·|dx_{k−1}|. A Jacobian (assembly and LU) costs about two
 # residuals below ~100 unknowns, where call overhead dominates, and about eight at 200 (O(n_q n²) assembly):
@@ -31,27 +42,42 @@ LARGE_SYSTEM = 100
 # and scaled size), from it LAPACK's dgetrs between two jitted calls: 0.6 µs against 3.1 at 10 unknowns, 1.1
 # against 3.3 at 30, equal at 50, 12 against 9 at 100 (single-threaded, on a loaded machine)
 SMALL_SOLVE = 50
+EPSILON = np.finfo(float).eps
+
+
+class Convergence(enum.StrEnum):
+    """How a Newton solve ended."""
+
+    CONVERGED = "converged"  # the correction and its error estimate below tol
+    AT_ROUNDING = "at_rounding"  # corrections stopped contracting below ε·κ∞(A D), above tol (module docstring)
+    FAILED = "failed"  # no solution: ``message`` says why
 
 
 @dataclass
 class NewtonResult:
     x: np.ndarray
-    converged: bool
+    outcome: Convergence
     iterations: int  # corrections computed (a dropped stale-Jacobian correction counts too)
     residual: float  # max-norm of R at the returned x
-    step: float  # the last correction in the scaled max-norm max_i |dx_i|/(1 + |x_i|)
+    step: float  # the last correction in the scaled max-norm max_i |dx_i|/(1 + |x_i|); AT_ROUNDING: the accuracy
     message: str
     jacobians: int = 0  # Jacobian evaluations and factorisations
-    factors: tuple | None = None  # converged: dgetrf's (lu, pivots) of the last [∂R/∂x; rows] (at an earlier iterate)
+    factors: tuple | None = None  # solved: dgetrf's (lu, pivots) of the last [∂R/∂x; rows] (at an earlier iterate)
+
+    @property
+    def converged(self) -> bool:
+        """Whether x solves the system: to tol (CONVERGED) or to the attainable accuracy ``step`` (AT_ROUNDING)."""
+        return self.outcome != Convergence.FAILED
 
 
 def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
-           factors: tuple | None = None) -> NewtonResult:
+           factors: tuple | None = None, rounding_limit: float = 0.0) -> NewtonResult:
     """Solve R(x) = 0, rows @ x = targets; converged when the correction and the estimated error are below tol in
     the scaled max-norm max_i |dx_i|/(1 + |x_i|) (absolute for small components, relative for large ones: a
-    pressure of 10³ does not loosen the tolerance on the shape coefficients). ``factors``: dgetrf's factors of
-    [∂R/∂x; rows] at a neighbouring point with the same rows (a NewtonResult's), the chord to start from: stale,
-    refreshed as soon as its corrections contract too slowly.
+    pressure of 10³ does not loosen the tolerance on the shape coefficients), or at the rounding floor above tol
+    (``Convergence.AT_ROUNDING``, module docstring) where that is at most ``rounding_limit``. ``factors``: dgetrf's
+    factors of [∂R/∂x; rows] at a neighbouring point with the same rows (a NewtonResult's), the chord to start from:
+    stale, refreshed as soon as its corrections contract too slowly.
 
     Near a singular point Newton converges only linearly (ratio ρ) even with a fresh Jacobian, and the
     remaining error ρ/(1 − ρ)|dx| may exceed |dx|: the estimate accounts for that.
@@ -81,7 +107,8 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
                     message = "singular Newton matrix" if info > 0 else "invalid Newton matrix"
                     return _failed(x, iteration, r, np.inf, message, jacobians)
         except ArithmeticError as error:
-            return NewtonResult(x, False, iteration, np.inf, np.inf, f"state left the domain: {error}", jacobians)
+            return NewtonResult(x, Convergence.FAILED, iteration, np.inf, np.inf, f"state left the domain: {error}",
+                                jacobians)
         if x.size < SMALL_SOLVE:
             dx, step = rhs, _correction(*factors, r, rows, targets, x, rhs)
         else:
@@ -94,6 +121,12 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
         if ratio is not None and ratio > refresh_ratio and not fresh:
             factors = None  # a stale Jacobian contracts too slowly: drop its step, redo it with a fresh one here
             continue
+        if fresh and ratio is not None and ratio >= 1.0 and tol < step <= rounding_limit:
+            floor = rounding_floor(factors[0], x)
+            if step <= floor < math.inf:  # a singular A (floor inf) attains nothing
+                return NewtonResult(x, Convergence.AT_ROUNDING, iteration, max_abs(r), step,
+                                    f"at the rounding floor: corrections stopped contracting at {step:.2g} (tol "
+                                    f"{tol:g}, ε·κ∞(A D) = {floor:.2g})", jacobians, factors)
         fresh = False
         x = x + dx
         r = None
@@ -102,16 +135,29 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
             try:
                 final = max_abs(residual(x))
             except ArithmeticError as failure:
-                return NewtonResult(x, False, iteration, np.inf, step, f"state left the domain: {failure}",
-                                    jacobians)
+                return NewtonResult(x, Convergence.FAILED, iteration, np.inf, step,
+                                    f"state left the domain: {failure}", jacobians)
             if not math.isfinite(final):
-                return NewtonResult(x, False, iteration, final, step, "non-finite residual at the solution", jacobians)
-            return NewtonResult(x, True, iteration, final, step, "converged", jacobians, factors)
+                return NewtonResult(x, Convergence.FAILED, iteration, final, step,
+                                    "non-finite residual at the solution", jacobians)
+            return NewtonResult(x, Convergence.CONVERGED, iteration, final, step, "converged", jacobians, factors)
         growth = growth + 1 if step > previous else 0
         if growth >= 3:
-            return NewtonResult(x, False, iteration, np.inf, step, "Newton corrections grow", jacobians)
+            return NewtonResult(x, Convergence.FAILED, iteration, np.inf, step, "Newton corrections grow", jacobians)
         previous = step
-    return NewtonResult(x, False, max_iter, np.inf, step, f"no convergence in {max_iter} iterations", jacobians)
+    return NewtonResult(x, Convergence.FAILED, max_iter, np.inf, step, f"no convergence in {max_iter} iterations",
+                        jacobians)
+
+
+def rounding_floor(lu, x) -> float:
+    """ε·κ∞(A D), D = diag(1 + |x_i|), from dgetrf's ``lu`` of A (P A = L U; inf if singular): the largest scaled
+    correction max_i |dx_i|/(1 + |x_i|) that rounding of the residual (δR ~ ε|A||x|) causes at the solution (module
+    docstring). P A D = L (U D): ‖A D‖∞ from the product (P permutes rows: the same norm), ‖(A D)⁻¹‖∞ by dgecon."""
+    scale = 1.0 + np.abs(x)
+    upper = np.triu(lu) * scale
+    norm = np.abs((np.tril(lu, -1) + np.eye(x.size)) @ upper).sum(axis=1).max()
+    rcond, info = dgecon(np.tril(lu, -1) + upper, norm, norm="I")
+    return EPSILON / rcond if info == 0 and rcond > 0 else math.inf
 
 
 @njit(cache=True)
@@ -182,4 +228,4 @@ def _scaled_size(dx, x) -> float:
 
 
 def _failed(x, iteration, r, step, message, jacobians) -> NewtonResult:
-    return NewtonResult(x, False, iteration, float(np.abs(r).max()), step, message, jacobians)
+    return NewtonResult(x, Convergence.FAILED, iteration, float(np.abs(r).max()), step, message, jacobians)

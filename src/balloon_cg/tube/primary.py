@@ -40,7 +40,7 @@ from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.threads import limited_blas
-from ..numerics.newton import newton
+from ..numerics.newton import Convergence, newton
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
@@ -254,6 +254,6 @@ def _off_mode_corrector(system: TubeSystem, predictor: np.ndarray, tangent: np.n
                     settings.max_newton)
     dropped = abs(mode[:-1] @ system.residual(result.x)) if result.converged else np.inf
     if dropped > settings.tol:
-        return replace(result, converged=False, message=f"{result.message}; off the mode: the residual along it is "
-                                                        f"{dropped:.3g}")
+        return replace(result, outcome=Convergence.FAILED,
+                       message=f"{result.message}; off the mode: the residual along it is {dropped:.3g}")
     return result

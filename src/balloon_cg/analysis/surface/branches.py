@@ -36,7 +36,7 @@ from ...galerkin.equilibrium import Parameters
 from ...model.loop import loop_distance
 from ...numerics import continuation, interrupt
 from ...numerics.continuation import Stop
-from ...numerics.newton import newton
+from ...numerics.newton import Convergence, newton
 from ...numerics.threads import limited_blas
 from ...surface import stability as surface_stability
 from ...surface.basis import EQUATOR, HALF_TURN, INVERSION, MIRROR_Y, SphericalBasis
@@ -254,8 +254,9 @@ def switch(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, step: float
                                       result.iterations, result.residual)
         if result.converged:
             far = float(np.linalg.norm(result.x - X_star))
-            result = replace(result, converged=False, message=f"the corrector landed {far:.3g} from the branch point "
-                                                              f"for a step {step:.3g} (on another branch)")
+            result = replace(result, outcome=Convergence.FAILED,
+                             message=f"the corrector landed {far:.3g} from the branch point for a step {step:.3g} (on "
+                                     "another branch)")
         step /= 4.0
     return result
 
