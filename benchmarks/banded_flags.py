@@ -6,7 +6,7 @@ Points: the paper coil's pear_free_2 (a general state near the wire; the whole p
 off, to reach it), every fifth point assessed at degree 320. Per degree N of the check (the check degrees of the
 points assessed at 135, 150 and 225: 270, 300, 320), in one process, interleaved point by point: the CPU seconds per
 point of ``SecondVariation.flags`` (m = 0 and m = 1, held and free: what ``assess_branch``'s flag check reads) on the
-dense blocks (stability.banded_from = 0) and on the banded ones (the default 225), their ratio, and the number of
+dense blocks (stability.banded_from and banded_flags_from = 0) and on the banded ones (the defaults), their ratio, and the number of
 points whose six flags differ (banded against dense, and banded against the signs of the banded eigenvalues).
 
     BALLOON_CG_WORKERS=1 python benchmarks/banded_flags.py > benchmarks/results/banded_flags.txt
@@ -30,7 +30,7 @@ EVERY = 5
 def main() -> None:
     scene = load_scene(SCENE).with_overrides({"surface.branches": "none"}, name="spom1_paper_coil")
     branch = next(b for b in analyse(scene).branches if b.name == "pear_free_2")
-    dense_scene = scene.with_overrides({"stability.banded_from": 0}, name=scene.name)
+    dense_scene = scene.with_overrides({"stability.banded_from": 0, "stability.banded_flags_from": 0}, name=scene.name)
     points = [n for n, a in enumerate(branch.stability) if a.degree == 320][::EVERY]
     print(f"# {SCENE.name}, pear_free_2: {len(points)} of its {len(branch.X)} points (every {EVERY}th assessed at 320); "
           f"load average {os.getloadavg()[0]:.1f} at the start")

@@ -49,3 +49,55 @@ def two_coil_result(tmp_path_factory) -> bc.Result:
 def two_coil_picture(tmp_path_factory):
     """The analysis objects (analysis.picture.Picture) of ``two_coil_result``."""
     return two_coil_result(tmp_path_factory).picture
+
+
+def shared_file(tmp_path_factory, name: str, write) -> Path:
+    """``write(path)`` once per session into the shared folder as ``name`` (a file the callers only read); its path.
+    ``write`` returns True when it succeeded: a failure raises in every caller, and the next caller tries again."""
+    folder = shared_folder(tmp_path_factory)
+    path = folder / name
+    with open(folder / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not path.exists():
+            partial = folder / f"partial-{name}"
+            assert write(partial), f"writing the shared {name} failed"
+            partial.replace(path)
+        return path
+
+
+TUBE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
+TUBE_FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s of CPU, every branch switched
+TUBE_COIL = TUBE.with_name("tube_spom1_L10_coil.toml")
+TUBE_COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
+
+
+def tube_run_file(tmp_path_factory) -> Path:
+    """``balloon-cg run`` of the shipped SPOM1 tube at TUBE_FAST (the primary branch and the branches switched at its
+    five branch points): a file the tube tests of the CLI, ``continue`` and ``load`` read (tests/test_tube_cli.py,
+    test_tube_continue.py, test_tube_result.py)."""
+    from balloon_cg.app.cli import main
+
+    return shared_file(tmp_path_factory, "tube.h5",
+                       lambda path: main(["run", str(TUBE), "-o", str(path), "--quiet", *TUBE_FAST]) == 0)
+
+
+def tube_critical_file(tmp_path_factory) -> Path:
+    """``balloon-cg critical --parameter M`` of the shipped coil tube at TUBE_COIL_FAST (its onset curve)."""
+    from balloon_cg.app.cli import main
+
+    return shared_file(tmp_path_factory, "tube_critical.h5", lambda path: main(
+        ["critical", str(TUBE_COIL), "--parameter", "M", "-o", str(path), "--quiet", *TUBE_COIL_FAST]) == 0)
+
+
+def first_bulge_picture(scene):
+    """``tube_picture(scene)`` asking for less: the primary branch and the branch switched at its first branch point
+    alone ("bulge", the first odd one on sliding ends), with Maxwell's pressure and the m ≥ 1 blocks; both branches
+    those of the whole picture number for number (``bulge_picture`` switches its labels in order). For tests that
+    read the primary and the bulge branch, not the switching at the later branch points (which tube/picture.py does
+    at every one: the shipped tube_spom1_L10 has 8 branches)."""
+    from balloon_cg.tube.picture import bulge_picture, maxwell, switchable
+    from balloon_cg.tube.primary import primary_branch
+
+    pm = maxwell(scene)
+    primary = primary_branch(scene)
+    return bulge_picture(scene, primary, switchable(scene, primary)[:1], pm)

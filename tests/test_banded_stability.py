@@ -154,13 +154,14 @@ def test_banded_blocks_agree_with_the_legendre_blocks_near_a_wire(near_wire, sym
     assert min(v[0] for v in banded.values()) < 0.0  # a point with negative blocks: the signs are read too
 
 
-def test_banded_from_key_default_and_refusal():
-    assert parse_scene('[material]\npreset = "SPOM1"\n').stability.banded_from == 225
-    assert parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 0\n').stability.banded_from == 0
+@pytest.mark.parametrize("key, default", [("banded_from", 225), ("banded_flags_from", 60)])
+def test_banded_keys_default_and_refusal(key, default):
+    assert getattr(parse_scene('[material]\npreset = "SPOM1"\n').stability, key) == default
+    assert getattr(parse_scene(f'[material]\npreset = "SPOM1"\n[stability]\n{key} = 0\n').stability, key) == 0
     with pytest.raises(SceneError) as error:
-        parse_scene('[material]\npreset = "SPOM1"\n[stability]\nbanded_from = 10\n', name="s")
+        parse_scene(f'[material]\npreset = "SPOM1"\n[stability]\n{key} = 10\n', name="s")
     message = str(error.value)
-    assert "\n" not in message and "stability.banded_from = 10" in message and "[20, 400]" in message
+    assert "\n" not in message and f"stability.{key} = 10" in message and "[20, 400]" in message
 
 
 def test_assessment_with_banded_from_reads_the_banded_blocks_and_keeps_the_flags():
@@ -215,15 +216,16 @@ def test_banded_signs_against_a_dense_generalized_eigensolve():
 
 @pytest.mark.parametrize("symmetric", [True, False])
 def test_banded_flags_agree_with_the_legendre_flags_near_a_wire(near_wire, symmetric):
-    """``SecondVariation.flags`` on the banded sibling (stability.banded_from = 20: the blocks' inertia) against the
-    Legendre blocks' Cholesky factorisations (banded_from = 0) and against the signs of the banded eigenvalues
-    (``assess``), every block m = 0 and m = 1, held and free, at the branch's first point and at its near-wire
-    last point, where some flag fails."""
+    """``SecondVariation.flags`` on the banded sibling (stability.banded_flags_from = 20: the blocks' inertia)
+    against the Legendre blocks' Cholesky factorisations (banded_flags_from = 0) and against the signs of the
+    banded eigenvalues (``assess``, banded_from = 20), every block m = 0 and m = 1, held and free, at the branch's
+    first point and at its near-wire last point, where some flag fails."""
     branch, last = near_wire
     degree = int(point_degrees(branch, branch.scene.stability.degree)[last])
     variations = {}
     for start in (0, 20):
-        scene = branch.scene.with_overrides({"stability.banded_from": start}, name=branch.scene.name)
+        scene = branch.scene.with_overrides({"stability.banded_from": start, "stability.banded_flags_from": start},
+                                            name=branch.scene.name)
         variations[start] = SecondVariation(equilibrium_of(replace(branch, scene=scene)), degree)
     for n in (0, last):
         X = branch.X[n]

@@ -35,11 +35,13 @@ from balloon_cg.dynamics.tube import (tube_branch_frequencies, tube_frequencies,
                                       with_frequencies)
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import Mirror
-from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.io.tube_file import read_tube_run, stored_branch
 from balloon_cg.scene import load_scene, shipped_scenes
 from balloon_cg.tube.picture import tube_picture
-from balloon_cg.tube.primary import discretisation
+from balloon_cg.tube.primary import discretisation, scene_parameters
 from balloon_cg.tube.stability import COMPRESSED
+
+from shared_pictures import first_bulge_picture
 
 SPOM1 = ((3.00508, 0.0145, -0.0177), (1.3, 4.0, -2.0))  # (μ_i, α_i), Σ μ_i α_i = 4
 COUNT = 6
@@ -121,9 +123,11 @@ def test_closed_tube_odd_modes_are_the_uniform_cylinders_vibrations(hoop):
 
 @pytest.fixture(scope="module")
 def tube_run():
-    """tube_spom1_L10 with [dynamics] frequencies (count 6): the picture with_frequencies and its frequencies."""
+    """tube_spom1_L10 with [dynamics] frequencies (count 6): its primary and bulge branches (``run``'s, without the
+    branches switched at the later branch points: shared_pictures.first_bulge_picture) with_frequencies, and their
+    frequencies."""
     scene = load_scene("tube_spom1_L10").with_overrides({"dynamics.frequencies": True, "dynamics.count": COUNT})
-    picture = with_frequencies(scene, tube_picture(scene))
+    picture = with_frequencies(scene, first_bulge_picture(scene))
     return scene, picture, picture.frequencies
 
 
@@ -168,20 +172,31 @@ def test_every_located_point_of_a_shipped_tube_scene_has_a_zero_frequency(name):
     assert located_zeros(scene, with_frequencies(scene, tube_picture(scene)))
 
 
-def test_tube_frequencies_are_stored_with_units_and_shown_by_inspect(tmp_path, capsys):
+@pytest.fixture(scope="module")
+def frequency_run(tmp_path_factory):
+    """``run`` of tube_spom1_L10 at degree 16 to a hoop stretch of 3 with [dynamics] frequencies (count 4), every
+    branch point switched: (its scene file, its run file)."""
+    folder = tmp_path_factory.mktemp("frequencies")
+    scene_file, path = folder / "tube.toml", folder / "tube.h5"
+    scene_file.write_text(load_scene("tube_spom1_L10").text.replace("degree = 40", "degree = 16")
+                          .replace("stop_stretch = 9.0", "stop_stretch = 3.0")
+                          + "\n[dynamics]\nfrequencies = true\ncount = 4\n")
+    assert main(["run", str(scene_file), "-o", str(path), "--quiet"]) == 0
+    return scene_file, path
+
+
+def test_tube_frequencies_are_stored_with_units_and_shown_by_inspect(frequency_run, capsys):
     """``run`` of a tube scene with [dynamics] frequencies (degree 16, to hoop stretch 3, primary and bulge): the file
-    holds every branch's Ω² of tube_branch_frequencies number for number, units "1"; ``inspect`` lists each located
-    point's lowest Ω² per block (the LP's even one zero), ``--json`` per branch block → lowest Ω² over the points."""
-    scene_file = tmp_path / "tube.toml"
-    scene_file.write_text(load_scene("tube_spom1_L10").text + "\n[dynamics]\nfrequencies = true\ncount = 4\n")
-    path = tmp_path / "tube.h5"
-    assert main(["run", str(scene_file), "-o", str(path), "--quiet", "--set", "solver.degree=16",
-                 "--set", "continuation.stop_stretch=3"]) == 0
-    scene = load_scene(scene_file).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 3})
-    picture = tube_picture(scene)
+    holds every branch's Ω² of tube_branch_frequencies number for number, units "1" (of the branches as stored: that
+    they are tube_picture's number for number is test_tube_cli's test_run_writes_what_the_tube_pipeline_computes, at
+    these settings); ``inspect`` lists each located point's lowest Ω² per block (the LP's even one zero), ``--json``
+    per branch block → lowest Ω² over the points."""
+    scene_file, path = frequency_run
+    scene = load_scene(scene_file)
     run = read_tube_run(path)
-    assert set(run["branches"]) == set(picture.branches) and {"primary", "bulge"} < set(run["branches"])
-    for name, branch in picture.branches.items():
+    assert {"primary", "bulge"} < set(run["branches"])
+    for name in run["branches"]:
+        branch = stored_branch(run, name, scene_parameters(scene))
         expected, stored = tube_branch_frequencies(scene, branch, 4), run["branches"][name]["frequencies"]
         assert stored["count"] == 4 and set(stored["omega2"]) == set(expected.omega2)
         for block in expected.omega2:
@@ -220,15 +235,10 @@ def test_a_tube_sweep_stores_each_members_frequencies(tmp_path):
             assert np.array_equal(stored[key][block], values, equal_nan=True)
 
 
-def test_continue_at_the_onset_keeps_the_frequencies(tmp_path):
+def test_continue_at_the_onset_keeps_the_frequencies(frequency_run, tmp_path):
     """``continue`` of a tube run with [dynamics] frequencies at its onset label (degree 16, hoop stretch 3): the
     written primary and bulge branches carry the frequencies of the run's, number for number."""
-    scene_file = tmp_path / "tube.toml"
-    scene_file.write_text(load_scene("tube_spom1_L10").text.replace("degree = 40", "degree = 16")
-                          .replace("stop_stretch = 9.0", "stop_stretch = 3.0")
-                          + "\n[dynamics]\nfrequencies = true\ncount = 2\n")
-    run, again = tmp_path / "run.h5", tmp_path / "again.h5"
-    assert main(["run", str(scene_file), "-o", str(run), "--quiet"]) == 0
+    run, again = frequency_run[1], tmp_path / "again.h5"
     first = read_tube_run(run)
     label = next(k for k, s in enumerate(first["branches"]["primary"]["special_points"])
                  if (s["kind"], s["block"]) == ("BP", "odd"))

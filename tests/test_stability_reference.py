@@ -32,7 +32,33 @@ estimates reach 8e-5) but one: pear_free_2's point 36 (and its mirror), second m
 table's −0.044649472758, where the rule allows 1.1e-9. The elements are right there: 40 to 120 elements of order
 12 and 16 give −0.0446494742213 within 1.3e-12 of each other, while the dense Legendre blocks at degrees 213, 320,
 400, 480 and 560 scatter by 2e-9 with no trend in the degree (the dense eigensolver's rounding ε‖H‖ at these
-sizes; docs/numerics.md §4)."""
+sizes; docs/numerics.md §4).
+
+Known to fail on the session-25 machine (numpy 2.4.6, scipy 1.17.1, OpenBLAS 0.3.31 picking its Haswell/Zen kernels
+on an AMD EPYC), not re-recorded (neither result is the better one; the comparison by point index is what breaks):
+spom1_single_coil and tpom1_two_coils_M0.002. The same code gives the same result there at bec04f4 (which recorded
+the tpom1 table on the previous machine) as on main e7c4889 (spom1: within 1.1e-10; tpom1: identical), so it is the
+build, not a commit. spom1_single_coil: its primary branch's samples agree (P to ~1e-15) up to point 67 (P 0.876362),
+where the leg's last point is recomputed at degree 60 on the better of two wire maps (``Tracer._refine``: the smaller
+tail estimate): the current map (width 0.06672) and the re-centred one (0.05710) leave 1.087e-13 and 1.123e-13 with
+these kernels, 1.439e-13 and 0.910e-13 with Sandybridge's; both at the tail's rounding floor, far below max_error,
+and the choice between them is rounding. On the other map the leg's tangent and so its samples differ from there on,
+and it reaches wire_gap after 75 points instead of 74. With OPENBLAS_CORETYPE=Sandybridge main reproduces the stored
+table (the comparison passes, 74 points); both builds give every other branch with the same samples, and every
+special point's λ2 and η on a 2001-point θ grid within 8e-12 but two: the TP at point 71 (P 3.5e-10 apart, within the
+rule; λ2 1.6e-9) and the wire-gap end point (the first sample inside the gap: P 0.84084 against 0.84200); the
+primary's storage map follows its last points (width 0.02339 against 0.02725 at degree 60), so every primary special
+point's coefficients moved by 0.013 to 0.05 (at P within 4e-12 but those two). tpom1_two_coils_M0.002: pear_free_1's
+(and its mirror's) point 28, the sample before its end point, lies about 1.2e-5 in P earlier in the table (read off
+its m1 eigenvalues, 3.4e-5 off, on the same curve between points 27 and 29, which agree to 1e-11; the table stores no
+P of a sample), and its two special points' coefficients moved by 0.021 at P within 4e-16 (LP) and 1.8e-12 (EP):
+another storage map. The same choice as spom1's: at point 27 (P 2.245873) ``Tracer._refine`` keeps, of two maps at
+degree 202, the one with tail 2.7894e-11 (widths 0.18979, 0.24705) over 2.8036e-11 (widths 0.16903, 0.23597), 0.5%
+apart; read on that other map the table's LP and EP are this machine's to 4.8e-14 and 8.2e-11 in λ2 and η on a
+2001-point θ grid (on this machine's map they are 0.019 off). Here the Haswell and Sandybridge kernels both keep the
+first map and agree on every sample, so the previous machine's choice could not be reproduced here. A rule that
+survives a rounding-level choice of map would store each branch's sampled P and its storage map, compare eigenvalues
+by index only while the samples agree, and special points as λ2, η on a fixed θ grid instead of as coefficients."""
 import numpy as np
 import pytest
 

@@ -660,3 +660,38 @@ def test_the_whole_m1_isola_at_M0_is_the_pear_isola_turned_by_90_degrees(spom1, 
         reference, south = turned_pear(poles[i, [pole, 1 - pole]], pears, shoot=True)
         errors.append(max(abs(reference - branch.values[i]) / branch.values[i], abs(south - poles[i, 1 - pole])))
     assert len(errors) > 100 and max(errors) <= 1e-9, (len(errors), np.median(errors), max(errors))
+
+
+def test_a_sub_basis_reads_upper_bounds_from_the_principal_submatrix(spom1):
+    """``stability.sub_basis`` of a sector of a wire-mapped basis (degree 16, order 6) at a deformed state: its Hessian
+    is the sector's principal submatrix on the same (component, order, type, degree) unknowns (a block's
+    orthonormalisation is triangular) to rounding, and every reading read on it (``sector_spectra(within=)``) is an
+    upper bound of the sector's (Rayleigh–Ritz, the zero modes and gᵀc = 0 included), reaching it on the sector
+    itself; the bad sub-basis is refused naming degree and order."""
+    _, _, params = sphere(spom1, 1.3, 8)
+    basis = SphericalBasis(16, (MIRROR_Y, EQUATOR), order=6, mapping=WireMap((0.4, -0.4), (0.05, 0.05)))
+    eq = SurfaceEquilibrium(spom1, basis)
+    rng = np.random.default_rng(1)
+    degrees = np.array([l for b in basis.blocks for l in b.degrees], dtype=float)
+    c = displacement_coefficients(basis, 0.3 * basis.nodes["reference"][:3]) + 0.01 * rng.standard_normal(
+        basis.size) / (1.0 + degrees) ** 2
+    readings = stability.READINGS
+    whole = stability.sector_spectra(eq, c, params, 4, readings)
+    for sector in basis.sectors():
+        key = sector.characters
+        sub = stability.sub_basis(sector, 12, 4)
+        blocks = {(b.component, b.m, b.t): b for b in sector.blocks}
+        index = np.concatenate([blocks[b.component, b.m, b.t].offset
+                                + np.searchsorted(blocks[b.component, b.m, b.t].degrees, b.degrees)
+                                for b in sub.blocks])
+        H = eq.hessian(c, params, sector)
+        assert np.abs(eq.hessian(c, params, sub) - H[np.ix_(index, index)]).max() <= 1e-12 * np.abs(H).max()
+        bounds = stability.sector_spectra(eq, c, params, 4, readings, only=(key,), within={key: sub})
+        same = stability.sector_spectra(eq, c, params, 4, readings, only=(key,),
+                                        within={key: stability.sub_basis(sector, 16, 6)})
+        for r in readings:
+            assert np.all(bounds[r][key] >= whole[r][key] - 1e-10 * np.maximum(1.0, np.abs(whole[r][key])))
+            assert np.abs(same[r][key] - whole[r][key]).max() <= 1e-10 * max(1.0, np.abs(whole[r][key]).max())
+        assert any(np.abs(bounds[r][key] - whole[r][key]).max() > 1e-6 for r in readings)
+    with pytest.raises(ValueError, match="degree = 20, order = 4"):
+        stability.sub_basis(basis, 20, 4)

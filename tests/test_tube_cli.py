@@ -14,15 +14,15 @@ from balloon_cg.model import tube
 from balloon_cg.scene import load_scene
 from balloon_cg.tube.picture import tube_picture
 from documented import inspect_json_keys
+from shared_pictures import TUBE_COIL_FAST as COIL_FAST, TUBE_FAST as FAST, tube_run_file
+
 SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
-FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s
 
 
 @pytest.fixture(scope="module")
 def run_file(tmp_path_factory):
-    path = tmp_path_factory.mktemp("tube") / "tube.h5"
-    assert main(["run", str(SCENE), "-o", str(path), "--quiet", *FAST]) == 0
-    return path
+    """`balloon-cg run` of SCENE at FAST, written once per session (tests/shared_pictures.py)."""
+    return tube_run_file(tmp_path_factory)
 
 
 def test_run_writes_what_the_tube_pipeline_computes(run_file):
@@ -155,7 +155,6 @@ def test_an_existing_file_is_kept_without_force(run_file, capsys):
 
 
 COIL_SCENE = SCENE.with_name("tube_spom1_L10_coil.toml")
-COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
 
 
 def test_critical_follows_the_onset_in_the_field_of_a_coil(tmp_path, capsys):

@@ -12,21 +12,19 @@ from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.io.tube_file import read_tube_run, stored_branch
 from balloon_cg.scene import load_scene
 from balloon_cg.tube.bulge import bulge_branch
-from balloon_cg.tube.picture import tube_picture
 from balloon_cg.tube.primary import scene_parameters
+
+from shared_pictures import first_bulge_picture, tube_critical_file, tube_run_file
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "tube_spom1_L10.toml"
 COIL_SCENE = ROOT / "scenes" / "tube_spom1_L10_coil.toml"
-FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]
-COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
 
 
 @pytest.fixture(scope="module")
 def run_file(tmp_path_factory):
-    path = tmp_path_factory.mktemp("continue") / "tube.h5"
-    assert main(["run", str(SCENE), "-o", str(path), "--quiet", *FAST]) == 0
-    return path
+    """`balloon-cg run` of SCENE at degree 16 to a hoop stretch of 3 (shared_pictures.TUBE_FAST), written once per session (tests/shared_pictures.py)."""
+    return tube_run_file(tmp_path_factory)
 
 
 def test_the_bulge_from_the_onset_label_is_runs_with_the_new_settings(run_file, tmp_path, capsys):
@@ -36,7 +34,7 @@ def test_the_bulge_from_the_onset_label_is_runs_with_the_new_settings(run_file, 
     continued, stored = read_tube_run(out), read_tube_run(run_file)
     assert np.array_equal(continued["branches"]["primary"]["unknowns"], stored["branches"]["primary"]["unknowns"])
     scene = load_scene(SCENE).with_overrides({"solver.degree": 16, "continuation.stop_stretch": 4})
-    bulge = tube_picture(scene).branches["bulge"]
+    bulge = first_bulge_picture(scene).branches["bulge"]  # run's (shared_pictures.py)
     assert np.array_equal(continued["branches"]["bulge"]["unknowns"], bulge.states)
     assert [s["pressure"] for s in continued["branches"]["bulge"]["special_points"]] == \
         [s.pressure for s in bulge.special]
@@ -60,9 +58,8 @@ def test_the_branch_from_an_even_label_is_bulge_branchs(run_file, tmp_path, caps
     assert np.abs(even.states[:, even.disc.block(Mirror.ODD)]).max() == 0
 
 
-def test_the_onset_in_m_from_the_label_is_critical_s(tmp_path, capsys):
-    critical = tmp_path / "critical.h5"
-    assert main(["critical", str(COIL_SCENE), "--parameter", "M", "-o", str(critical), "--quiet", *COIL_FAST]) == 0
+def test_the_onset_in_m_from_the_label_is_critical_s(tmp_path_factory, tmp_path, capsys):
+    critical = tube_critical_file(tmp_path_factory)  # `critical` of COIL_SCENE, once per session
     stored = read_tube_run(critical)
     label = next(k for k, s in enumerate(stored["branches"]["primary"]["special_points"])
                  if (s["kind"], s["block"]) == ("BP", "odd"))

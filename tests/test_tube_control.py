@@ -23,9 +23,10 @@ from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.io.tube_file import read_tube_run, stored_branch, write_tube_run
 from balloon_cg.scene import Control, SceneError, parse_scene
 from balloon_cg.tube.bulge import bulge_branch
-from balloon_cg.tube.picture import tube_picture
 from balloon_cg.tube.primary import primary_branch
 from balloon_cg.tube.stability import unstable_counts
+
+from shared_pictures import first_bulge_picture
 
 # SPOM1's exponents (the committed tube kernels) with a stronger α = −2 term: the closed tube's n = πL λθΦ_2 then
 # has a maximum (at λθ ≈ 3.55), which no preset's has
@@ -118,11 +119,12 @@ def test_gas_control_locates_the_fold_in_the_amount():
 
 @pytest.fixture(scope="module")
 def volume_run():
-    """SPOM1, L = 10, degree 20, volume control, continuation.stop_volume = 5 V0: ``tube_picture`` (``run``)."""
+    """SPOM1, L = 10, degree 20, volume control, continuation.stop_volume = 5 V0: ``run``'s primary and bulge
+    branches (shared_pictures.first_bulge_picture: the later branch points not switched)."""
     scene = tube('[material]\npreset = "SPOM1"\n', 10.0,
                  f'[solver]\ndegree = 20\n[continuation]\nstop_volume = {5 * np.pi * 10.0!r}\nstep_max = 0.5\n'
                  '[loading]\ncontrol = "volume"\n')
-    return scene, tube_picture(scene)
+    return scene, first_bulge_picture(scene)
 
 
 def test_stop_volume_ends_the_primary_and_the_bulge_branch(volume_run):

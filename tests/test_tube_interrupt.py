@@ -99,8 +99,10 @@ def test_a_signal_during_critical_on_a_tube_writes_what_is_finished(references, 
     assert (run["onset"] is not None) == (moment.endswith(":newton"))
 
 
-def test_a_signal_once_the_file_is_written_exits_0_and_says_so(references, tmp_path):
-    code, err = balloon_cg(tmp_path, "SIGTERM", "after balloon_cg.io.tube_file:write_tube_run", run_argv("r.h5"))
+@pytest.mark.parametrize("moment", ["after balloon_cg.io.tube_file:write_tube_run",
+                                    "after balloon_cg.io.tube_file:read_tube_run"])  # the file read back
+def test_a_signal_once_the_file_is_written_exits_0_and_says_so(references, tmp_path, moment):
+    code, err = balloon_cg(tmp_path, "SIGTERM", moment, run_argv("r.h5"))
     assert code == 0 and one_line(err) == "balloon-cg: a signal arrived once the work had finished: r.h5 is " \
                                           "written whole"
     run = read_tube_run(tmp_path / "r.h5")

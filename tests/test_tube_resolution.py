@@ -14,6 +14,7 @@ from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.primary import primary_branch
 from balloon_cg.tube.resolution import resolved_bulge_branch
 from balloon_cg.tube.results import IntervalStop
+from shared_pictures import first_bulge_picture
 from test_interval import ogden, series, tube_scene
 
 FOLD = (1.3628306751130, 2.7222883983230)  # SPOM1, L = 10: the bulge's volume fold (P, V/V0), docs/tubes.md
@@ -107,10 +108,9 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
     from balloon_cg.app.tube_result import TubeResult
     from balloon_cg.app.tube_summary import format_tube, summarise_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
-    from balloon_cg.tube.picture import tube_picture
 
     scene = spom1_l10(20).with_overrides({"continuation.stop_stretch": 2.5, "stability.m_max": 0})
-    picture = tube_picture(scene)
+    picture = first_bulge_picture(scene)  # run's primary and bulge branches (shared_pictures.py)
     path = write_tube_run(tmp_path / "tube.h5", scene, picture)
     branches = read_tube_run(path)["branches"]
     bulge = picture.branches["bulge"]

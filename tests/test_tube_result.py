@@ -1,28 +1,20 @@
 """``balloon_cg.load`` of a tube run file (app/tube_result.py): every group of the file (each branch's points and
 located points, the onset curve of ``critical``) as an xarray Dataset and as a pandas table holds the file's numbers
 (io.tube_file.read_tube_run), the shape's parameters are attributes; a branch or part that is not there is named."""
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import balloon_cg as bc
-from balloon_cg.app.cli import main
 from balloon_cg.io.tube_file import read_tube_run
 
-ROOT = Path(__file__).resolve().parents[1]
-FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]
-COIL_FAST = ["--set", "continuation.stop_stretch=1.75", "--set", "continuation.max_points=60"]
+from shared_pictures import tube_critical_file, tube_run_file
 
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("tube")
-    run, critical = folder / "run.h5", folder / "critical.h5"
-    assert main(["run", str(ROOT / "scenes" / "tube_spom1_L10.toml"), "-o", str(run), "--quiet", *FAST]) == 0
-    assert main(["critical", str(ROOT / "scenes" / "tube_spom1_L10_coil.toml"), "--parameter", "M", "-o",
-                 str(critical), "--quiet", *COIL_FAST]) == 0
-    return run, critical
+    """`run` of the shipped tube (degree 16, to a hoop stretch of 3) and `critical --parameter M` of its coil scene,
+    each written once per session (tests/shared_pictures.py)."""
+    return tube_run_file(tmp_path_factory), tube_critical_file(tmp_path_factory)
 
 
 def test_each_branch_as_xarray_holds_the_file(files):

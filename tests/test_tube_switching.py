@@ -62,10 +62,12 @@ def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
 
 def test_branch_points_that_are_not_switched_are_refused_in_one_line():
     """An even branch point in a coil field (the primary branch is not uniform there), any branch point on plugged
-    ends (their odd branch points are not resolved: docs/tubes.md) and a fold: UnswitchableBranchPoint, one line."""
+    ends (the line says why: closed, no odd bifurcation where resolved; held apart, the necks compressed at theirs:
+    docs/tubes.md, benchmarks/plugged_odd_block.py) and a fold: UnswitchableBranchPoint, one line."""
     coil = "[field]\nM = 0.01\n[[field.coils]]\nradius = 2.5\nheight = 0\ncurrent = 1\n"
     for extra, block, message in ((coil, Mirror.EVEN, "uniform primary branch .* not in a coil field"),
-                                  ('ends = "plugged"\n', Mirror.ODD, "on sliding ends, not plugged")):
+                                  ('ends = "plugged"\n', Mirror.ODD, "on sliding ends, not plugged: closed plugged "
+                                   "ends have no odd bifurcation .* held apart .* compressed")):
         scene = tube_scene("SPOM1", 10.0, extra + "[solver]\ndegree = 16\n[continuation]\nstop_stretch = 1.7\n")
         primary = primary_branch(scene)
         fold = primary.special[0]

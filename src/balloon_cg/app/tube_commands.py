@@ -15,18 +15,20 @@ def run_tube(scene, output, args) -> int:
     ``not_started``) or the bulge branch stopped unresolved at solver.max_degree (solver.tube_resolution = "refine":
     tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
-    from ..io.tube_file import read_tube_run
     from ..tube.picture import tube_picture
     from ..tube.results import IntervalStop
     from .tube_summary import format_tube, summarise_tube
 
-    run, signalled = _written(output, args, lambda: with_frequencies(scene, tube_picture(scene, args.primary_only)),
-                              scene)
+    def picture():
+        return with_frequencies(scene, tube_picture(scene, args.primary_only))
+
+    summarise = None if args.quiet else (lambda run: format_tube(summarise_tube(run)))
+    run, summary, signalled = _written(output, args, picture, scene, summarise)
     code = interrupted_status(run, output, signalled)
     if code is not None:
         return code
-    if not args.quiet:
-        print(format_tube(summarise_tube(read_tube_run(output))))
+    if summary is not None:
+        print(summary)
     missing = []
     if run["attrs"]["not_started"]:
         missing.append(f"not started: {run['attrs']['not_started'].replace(chr(10), '; ')}")
@@ -73,7 +75,7 @@ def critical_tube(scene, output, args) -> int:
                           f"({primary.stop.message}): nothing to follow in {name}")
         return found
 
-    run, signalled = _written(output, args, picture, scene)
+    run, _, signalled = _written(output, args, picture, scene)
     code = interrupted_status(run, output, signalled)
     if code is not None:
         return code
@@ -90,9 +92,11 @@ def critical_tube(scene, output, args) -> int:
     return 0
 
 
-def _written(output, args, compute, scene) -> tuple:
-    """``compute()`` (a TubePicture) under ``stop_on_signals``, written to ``output`` (owned, checked first) and read
-    back: (the file's contents, whether a signal came)."""
+def _written(output, args, compute, scene, summarise=None) -> tuple:
+    """``compute()`` (a TubePicture) under ``stop_on_signals``, written to ``output`` (owned, checked first), read
+    back and, unless a signal came, ``summarise``d (the text to print): (the file's contents, the summary or None,
+    whether a signal came). All of it under the flag, so that a signal before the command's end never raises in
+    the middle of reading (the run's exit 0 or 130 says what the file holds: app/cli.run's rule)."""
     from ..io.lock import claim
     from ..io.output import check_output
     from ..io.tube_file import read_tube_run, write_tube_run
@@ -102,8 +106,10 @@ def _written(output, args, compute, scene) -> tuple:
         check_output(output, args.force)
         with stop_on_signals():
             write_tube_run(output, scene, compute(), args.force, args.command_line)
+            run = read_tube_run(output)
+            summary = None if summarise is None or requested() else summarise(run)
             signalled = requested()
-    return read_tube_run(output), signalled
+    return run, summary, signalled
 
 
 def interrupted_status(run: dict, output, signalled: bool) -> int | None:
@@ -114,7 +120,8 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
 
     stage = run["attrs"]["interrupted"]
     if stage:
-        stopped = (b for b in run["branches"].values() if b["attrs"]["stop_code"] == StopCode.INTERRUPTED.value)
+        traced = [*run["branches"].values(), *run.get("surface_branches", {}).values()]
+        stopped = (b for b in traced if b["attrs"]["stop_code"] == StopCode.INTERRUPTED.value)
         stored = run["onset"] if stage == "onset" else next(stopped, None)  # the branch the signal stopped
         if stage == "frequencies":
             done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
@@ -157,6 +164,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
     from ..io.tube_file import read_tube_run, stored_branch
+    from ..tube.bulge import PLUGGED_WHY
     from ..tube.picture import branch_name, bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters
 
@@ -187,7 +195,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:
         raise UsageError(f"continue {args.run}: the bulge branch is switched on sliding ends, not "
-                         f"{scene.geometry.ends.value}")
+                         f"{scene.geometry.ends.value}: {PLUGGED_WHY}")
     name, k, _ = labels[args.label]
     primary = stored_branch(run, "primary", scene_parameters(scene))
     point = primary.special[k]
@@ -198,7 +206,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
             return onset_from(scene, primary, point, "M", args.direction, pm)
         return with_frequencies(scene, bulge_picture(scene, primary, [k], pm))
 
-    written, signalled = _written(args.output, args, picture, scene)
+    written, _, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code
@@ -242,7 +250,8 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     start = (point.u, point.pressure, scene.voltage)
-    written, signalled = _written(args.output, args, lambda: charged_picture(scene, start, args.direction), scene)
+    written, _, signalled = _written(args.output, args, lambda: charged_picture(scene, start, args.direction),
+                                     scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code

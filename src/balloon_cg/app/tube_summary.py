@@ -11,8 +11,9 @@ its event), with [dynamics] frequencies each block's lowest Ω² at every locate
 over the points, as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the
 smallest eigenvalue, the points after which the unstable count changes and the located zeros with where their mode is
 largest; {} where not assessed), the onset curve of
-``critical`` (its range, folds and stop), the stage a signal stopped (``interrupted``) and the switched branches that
-did not start (``not_started``: "name: why")."""
+``critical`` (its range, folds and stop), the stage a signal stopped (``interrupted``), the switched branches that
+did not start (``not_started``: "name: why") and the non-axisymmetric branches ([surface] branches:
+``surface_branches``, their parent branch and zero, ranges, stop, stable points and largest error estimate)."""
 import math
 import tomllib
 
@@ -65,8 +66,26 @@ def summarise_tube(run: dict) -> dict:
             "fixed_pressure": float(primary["pressure"][0]) if charged else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
-            "branches": branches, "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None,
+            "branches": branches, "surface_branches": _surface_branches(run.get("surface_branches", {}), control),
+            "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None,
             "not_started": [line for line in a["not_started"].split("\n") if line]}
+
+
+def _surface_branches(found: dict, control: str) -> dict:
+    """{name: {'m', 'parent' {'branch', 'zero'}, 'points', 'pressure', 'volume', 'amplitude' ranges, 'stable_points'
+    (under the file's control), 'largest_error_estimate', 'folds' [{'after_point', 'pressure'}], 'stop_code',
+    'stop_message'}} of a tube's non-axisymmetric branches (io/tube_surface_file.py)."""
+    def span(values):
+        return [float(values.min()), float(values.max())]
+
+    return {name: {"m": int(b["attrs"]["m"]),
+                   "parent": {"branch": b["attrs"]["parent_branch"], "zero": int(b["attrs"]["parent_zero"])},
+                   "points": len(b["pressure"]), "pressure": span(b["pressure"]), "volume": span(b["volume"]),
+                   "amplitude": span(b["amplitude"]), "stable_points": int((b[f"unstable_{control}"] == 0).sum()),
+                   "largest_error_estimate": float(b["error_estimate"].max()),
+                   "folds": [{"after_point": i, "pressure": p} for i, p in b["folds"]],
+                   "stop_code": b["attrs"]["stop_code"], "stop_message": b["attrs"]["stop_message"]}
+            for name, b in found.items()}
 
 
 def _azimuthal(branch: dict, disc) -> dict:
@@ -208,6 +227,15 @@ def format_tube(summary: dict) -> str:
             if "omega2" in s:
                 lines.append("        lowest Ω²  " + "  ".join(f"{name} {value:.4g}"
                                                          for name, value in s["omega2"].items()))
+    for name, b in summary.get("surface_branches", {}).items():
+        lines += ["", f"surface branch {name} (m = {b['m']}, from zero {b['parent']['zero']} of block m = {b['m']} of "
+                      f"{b['parent']['branch']}): {b['points']} points, "
+                      f"P {b['pressure'][0]:.8g}..{b['pressure'][1]:.8g}, "
+                      f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, amplitude {b['amplitude'][0]:.4g}.."
+                      f"{b['amplitude'][1]:.4g}, stop {b['stop_code']} ({b['stop_message']}); {b['stable_points']} "
+                      f"stable under {summary['control']} control; largest error estimate "
+                      f"{b['largest_error_estimate']:.2g}"]
+        lines += [f"  LP after point {f['after_point']:<4} P = {f['pressure']:.10g}" for f in b["folds"]]
     onset = summary["onset"]
     if onset is not None:
         name, last = onset["parameter"], onset["last"]

@@ -33,7 +33,8 @@ under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``.
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
 started, and is absent where it had not; ``frequencies``: the branches whole, the frequencies of the branches finished
 before the signal only), "" where the work is whole (files before it have none: read as "").
-With [dynamics] frequencies, each branch's natural frequencies under frequencies/ (io/tube_frequencies.py).
+With [dynamics] frequencies, each branch's natural frequencies under frequencies/ (io/tube_frequencies.py). With
+[surface] branches, the non-axisymmetric branches under /surface_branches/ (io/tube_surface_file.py).
 """
 import math
 from pathlib import Path
@@ -44,6 +45,7 @@ import numpy as np
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import FileError, opened
 from .tube_frequencies import read_tube_frequencies, write_tube_frequencies
+from .tube_surface_file import read_surface_branches, write_surface_branches
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..scene.tables import Ends
@@ -214,6 +216,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         _dimensions(special, "special", {"unknown": branch.disc.size})
         if picture.frequencies is not None and name in picture.frequencies:  # (a signal: only the finished ones)
             write_tube_frequencies(group, picture.frequencies[name])
+    write_surface_branches(f, picture.surface)
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
 
@@ -274,8 +277,9 @@ def read_tube_run(path) -> dict:
 
 
 def read_tube(f, path, where: str = "") -> dict:
-    """{'attrs', 'branches', 'onset'} of the tube run written by ``write_tube`` into the open file or group ``f``
-    (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is missing."""
+    """{'attrs', 'branches', 'onset', 'surface_branches'} of the tube run written by ``write_tube`` into the open file
+    or group ``f`` (``where``: its path in the file ``path``, for the messages); TubeFileError naming what is
+    missing."""
     attrs = {"interrupted": "", "control": "pressure", "not_started": ""} | {k: _text(plain(v))
                                                                              for k, v in f.attrs.items()}
     if "branches" not in f or "primary" not in f["branches"]:
@@ -305,7 +309,8 @@ def read_tube(f, path, where: str = "") -> dict:
         branch["frequencies"] = read_tube_frequencies(path, group, n, len(branch["special_points"]), TubeFileError)
         branches[name] = branch
     onset = None if "onset" not in f else _read_onset(path, f["onset"])
-    return {"attrs": attrs, "branches": branches, "onset": onset}
+    return {"attrs": attrs, "branches": branches, "onset": onset,
+            "surface_branches": read_surface_branches(f, path, TubeFileError)}
 
 
 def _read_modes(path, group, n: int, where: str) -> dict:

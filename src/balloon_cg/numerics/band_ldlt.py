@@ -9,7 +9,9 @@ the factorisation is backward stable when its growth is small: the computed fact
 one, ``growth`` = maxᵢ Σⱼ L_ij² |d_j|. ``BandLDLT.factor`` refuses a factor whose growth exceeds MAX_GROWTH times
 maxᵢ |A_ii| or with a zero pivot, so the inertia counted is that of a matrix within ~1e-11 ‖A‖ of A.
 
-Storage: LAPACK's lower band ``band[i − j, j] = A[i, j]``; the factor keeps D in row 0 and L below it.
+Storage: LAPACK's lower band ``band[i − j, j] = A[i, j]``; the factor keeps D in row 0 and L below it. The loops
+run on its transpose (n, b + 1), each column of the band one contiguous row: in Fortran order (as LAPACK keeps its
+band factors) that transpose is the array's own memory, no copy.
 """
 import numpy as np
 from numba import njit
@@ -27,10 +29,10 @@ class BandLDLT:
     def factor(cls, band: np.ndarray) -> "BandLDLT | None":
         """The factorisation of ``band`` (lower band storage), or None at a zero pivot or a growth beyond
         MAX_GROWTH maxᵢ |A_ii| (its inertia then not trusted)."""
-        factor, growth = _ldlt(np.ascontiguousarray(band, dtype=float))
+        factor, growth = _ldlt(np.ascontiguousarray(np.asarray(band, dtype=float).T))
         if not np.isfinite(growth) or growth > MAX_GROWTH * np.abs(band[0]).max():
             return None
-        return cls(factor)
+        return cls(factor.T)
 
     @property
     def negatives(self) -> int:
@@ -39,59 +41,62 @@ class BandLDLT:
 
     def solve(self, r: np.ndarray) -> np.ndarray:
         """A⁻¹ r for a vector r."""
-        return _ldlt_solve(self.factor, np.ascontiguousarray(r, dtype=float))
+        return _ldlt_solve(self.factor.T, np.ascontiguousarray(r, dtype=float))
 
 
 def lower_times(factor: np.ndarray, y: np.ndarray, transpose: bool) -> np.ndarray:
     """L y, or Lᵀ y with ``transpose``, for the lower triangular L in lower band storage (a Cholesky factor)."""
-    return _lower_times(factor, np.ascontiguousarray(y, dtype=float), transpose)
+    return _lower_times(np.ascontiguousarray(factor.T), np.ascontiguousarray(y, dtype=float), transpose)
 
 
 @njit(cache=True)
-def _ldlt(band):
-    """(the factor: D in row 0, L's columns below, the growth maxᵢ Σⱼ L_ij² |d_j|; inf at a zero pivot)."""
-    f = band.copy()
-    width, n = f.shape
+def _ldlt(columns):
+    """(the factor: D in column 0, L's columns in the rows (f[j, i] = L[j + i, j]), the growth
+    maxᵢ Σⱼ L_ij² |d_j|; inf at a zero pivot) of the band's transpose ``columns`` (n, b + 1)."""
+    f = columns.copy()
+    n, width = f.shape
     diagonal = np.zeros(n)
     for j in range(n):
-        d = f[0, j]
+        d = f[j, 0]
         if d == 0.0:
             return f, np.inf
         last = min(width - 1, n - 1 - j)
         for k in range(1, last + 1):
-            t = f[k, j] / d
+            t = f[j, k] / d
             for i in range(k, last + 1):
-                f[i - k, j + k] -= f[i, j] * t
+                f[j + k, i - k] -= f[j, i] * t
         diagonal[j] += abs(d)
         for i in range(1, last + 1):
-            f[i, j] /= d
-            diagonal[j + i] += f[i, j] * f[i, j] * abs(d)
+            f[j, i] /= d
+            diagonal[j + i] += f[j, i] * f[j, i] * abs(d)
     return f, diagonal.max()
 
 
 @njit(cache=True)
 def _ldlt_solve(f, r):
-    width, n = f.shape
+    """A⁻¹ r from the factor's transpose ``f`` (``_ldlt``)."""
+    n, width = f.shape
     x = r.copy()
     for j in range(n):
         for i in range(1, min(width - 1, n - 1 - j) + 1):
-            x[j + i] -= f[i, j] * x[j]
+            x[j + i] -= f[j, i] * x[j]
     for j in range(n):
-        x[j] /= f[0, j]
+        x[j] /= f[j, 0]
     for j in range(n - 1, -1, -1):
         for i in range(1, min(width - 1, n - 1 - j) + 1):
-            x[j] -= f[i, j] * x[j + i]
+            x[j] -= f[j, i] * x[j + i]
     return x
 
 
 @njit(cache=True)
 def _lower_times(f, y, transpose):
-    width, n = f.shape
+    """L y or Lᵀ y from the factor's transpose ``f`` (n, b + 1)."""
+    n, width = f.shape
     out = np.zeros(n)
     for j in range(n):
         for i in range(min(width - 1, n - 1 - j) + 1):
             if transpose:
-                out[j] += f[i, j] * y[j + i]
+                out[j] += f[j, i] * y[j + i]
             else:
-                out[j + i] += f[i, j] * y[j]
+                out[j + i] += f[j, i] * y[j]
     return out

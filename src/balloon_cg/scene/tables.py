@@ -236,13 +236,15 @@ class Stability:
     m ≥ 1 blocks' norm (flags and branch points do not depend on it). ``banded_from``: the blocks (m = 0 and m ≥ 1) of a
     point assessed at perturbation degree N ≥ it are read on the banded sibling basis (C⁰ elements on the same map,
     analysis/stability/banded.py); 0: never; the default 225 (below it the dense blocks are as fast or faster:
-    docs/numerics.md §6)."""
+    docs/numerics.md §6). ``banded_flags_from``: the same for the flags alone (the check degree's, from the blocks'
+    inertia), default 60 (the banded inertia is the cheaper from ~45: benchmarks/banded_crossover.py)."""
 
     degree: int = 20
     m_max: int = 1
     basis: str = "mapped"
     norm: str = "displacement"
     banded_from: int = 225
+    banded_flags_from: int = 60
 
 
 STABILITY_BASES = ("legendre", "mapped")
@@ -262,6 +264,12 @@ class Surface:
 
 
 SURFACE_BRANCHES = ("first", "all", "none")
+
+
+def default_surface(shape) -> Surface:
+    """The [surface] table a scene without one has: on a tube ``branches = "none"`` (its non-axisymmetric branches,
+    tube/surface/branch.py, are not verified enough to be traced by default: docs/tubes.md), else ``Surface()``."""
+    return Surface(branches="none") if shape == Shape.TUBE else Surface()
 
 
 @dataclass(frozen=True)
@@ -386,7 +394,7 @@ class Scene:
             **({} if self.loading == Loading() else {"loading": {**asdict(self.loading),
                                                                   "control": self.loading.control.value}}),
             **({} if self.electric is None else {"electric": asdict(self.electric)}),
-            **({} if self.surface == Surface() else {"surface": asdict(self.surface)}),
+            **({} if self.surface == default_surface(self.geometry.shape) else {"surface": asdict(self.surface)}),
             **({"events": [e.to_table() for e in self.events]} if self.events else {}),
             **({} if self.geometry == Geometry() else {"geometry": self.geometry.to_table()}),
             **({} if self.dynamics == Dynamics() else {"dynamics": asdict(self.dynamics)}),
@@ -670,7 +678,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
                          '(continuation.parameter = "voltage") is at fixed pressure; allowed: "pressure"')
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
-    geometry = _geometry(data.get("geometry", {}), field, electric)
+    geometry = _geometry(data.get("geometry", {}), field)
     dynamics = _dynamics(data.get("dynamics", {}))
     solver = _solver(data.get("solver", {}))
     if geometry.shape != Shape.TUBE and solver.tube_resolution != Solver.tube_resolution:
@@ -683,6 +691,9 @@ def _build(data: dict, name: str, text: str) -> Scene:
     stability = _stability(data.get("stability", {}))
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
+    surface = _surface(data.get("surface", {}), geometry.shape)
+    if geometry.shape == Shape.TUBE:
+        _tube_surface_reads(surface, field, electric, stability)
     return Scene(
         name=name,
         material=material,
@@ -694,11 +705,28 @@ def _build(data: dict, name: str, text: str) -> Scene:
         electric=electric,
         text=text,
         loading=loading,
-        surface=_surface(data.get("surface", {})),
+        surface=surface,
         events=events,
         geometry=geometry,
         dynamics=dynamics,
     )
+
+
+def _tube_surface_reads(surface: Surface, field, electric, stability) -> None:
+    """SceneError for a tube's [surface] branches (tube/surface/branch.py) where they are not built: in a coil's
+    field, under a voltage, without the m ≥ 1 zeros they start from (stability.m_max = 0)."""
+    if surface.branches == "none":
+        return
+    asked = f"surface.branches = {show(surface.branches)}"
+    if field.coils:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches are traced without a field, not with "
+                         f"field.coils = {len(field.coils)} coil(s); allowed: \"none\" with coils")
+    if electric is not None:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches are traced without a voltage, not with "
+                         f"electric.voltage = {electric.voltage:g}; allowed: \"none\" with [electric]")
+    if stability.m_max < 1:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
+                         f"stability.m_max ≥ 1, not {stability.m_max}; allowed: \"none\" with stability.m_max = 0")
 
 
 def _tube_voltage_reads(field, stability, dynamics, events) -> None:
@@ -830,10 +858,9 @@ def _electric(data) -> Electric:
     return Electric(get("voltage", lambda x: 0 <= x <= MAX_VOLTAGE, f"in [0, {MAX_VOLTAGE:g}]"))
 
 
-def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
+def _geometry(data, field: Field) -> Geometry:
     """[geometry]: the shape, a spheroid's aspect, a tube's length and ends; the parts of the model that are written
-    for the sphere alone (the whole-sphere engine of coils off the axis, the dielectric start: the sphere held by a
-    voltage) refuse other shapes here."""
+    for the sphere alone (the whole-sphere engine of coils off the axis) refuse other shapes here."""
     data = table("geometry", data, _keys(Geometry) + ("axial",))
     raw = data.get("shape")
     raw = Geometry.shape.value if raw is None else raw
@@ -851,7 +878,7 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     if shape == Shape.TUBE:
         return _tube(data, field)
     if shape == Shape.CAPSULE:
-        return _capsule(data, field, electric)
+        return _capsule(data, field)
     if shape == Shape.SPHERE:
         if data.get("aspect") is not None and data["aspect"] != 1:
             raise SceneError(f'geometry.aspect = {show(data["aspect"])}: only for geometry.shape = "spheroid" (the '
@@ -862,9 +889,6 @@ def _geometry(data, field: Field, electric: Electric | None) -> Geometry:
     where = f'geometry.shape = "{shape.value}"'
     _coaxial_outside(where, field, lambda coil: coil.radius**2 + (coil.height / aspect) ** 2,
                      f"the reference spheroid of aspect {aspect:g} (radius² + (height/aspect)²")
-    if electric is not None:
-        raise SceneError(f"{where}: the [electric] term starts from the sphere held by its voltage, which has no "
-                         'counterpart on another shape yet; leave [electric] out or use geometry.shape = "sphere"')
     return Geometry(shape, aspect)
 
 
@@ -894,7 +918,7 @@ def _length(data, shape: Shape, low: float) -> float:
                                                 f"in [{low:g}, {MAX_LENGTH:g}]")
 
 
-def _capsule(data, field: Field, electric: Electric | None) -> Geometry:
+def _capsule(data, field: Field) -> Geometry:
     """A capsule's [geometry] (its cylinder's length, 0 the sphere, and its longest cylinder element), its coils
     (coaxial, outside it) and the parts of the model it does not have yet, refused one line each."""
     length = _length(data, Shape.CAPSULE, 0.0)
@@ -1044,15 +1068,15 @@ def _stability(data) -> Stability:
         get("degree", lambda n: 4 <= n <= 200, "an integer in [4, 200]", integer=True),
         get("m_max", lambda n: 0 <= n <= 8, "an integer in [0, 8]", integer=True),
         **choices,
-        banded_from=get("banded_from", lambda n: n == 0 or 20 <= n <= 400, "0 (off) or an integer in [20, 400]",
-                        integer=True),
+        **{key: get(key, lambda n: n == 0 or 20 <= n <= 400, "0 (off) or an integer in [20, 400]", integer=True)
+           for key in ("banded_from", "banded_flags_from")},
     )
 
 
-def _surface(data) -> Surface:
+def _surface(data, shape) -> Surface:
     data = table("surface", data, _keys(Surface))
     get = _getter(data, "surface", Surface)
-    branches = data.get("branches", Surface.branches)
+    branches = data.get("branches", default_surface(shape).branches)
     if branches not in SURFACE_BRANCHES:
         raise SceneError(f"surface.branches = {show(branches)}: must be one of "
                          + ", ".join(f'"{b}"' for b in SURFACE_BRANCHES))

@@ -18,6 +18,7 @@ Zero modes removed (MODEL.md §8), at the state x:
 A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
 fine (numerics.eigen.restricted drops them).
 """
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -81,19 +82,23 @@ def mode_rows(basis: SphericalBasis, fields: list) -> np.ndarray:
     return np.array(out).reshape(-1, basis.size)
 
 
-def _sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings, only: tuple | None):
+def _sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings, only: tuple | None,
+             within: dict | None = None):
     """Yields (sector, H, g, groups, gas weight P/Ṽ) per symmetry sector: its Hessian, g = ∂Ṽ/∂c on the state's
     own sector under a controlled reading (else None), and groups {(zero-mode rows' bytes, control): (rows, the
     readings sharing that matrix)} (a sector without a translation reads the same held and free; one without g
-    the same under every control); ``only``: the characters of the sectors wanted (default all)."""
+    the same under every control); ``only``: the characters of the sectors wanted (default all); ``within``:
+    {characters: a ``sub_basis`` of that sector}, whose perturbations stand for the sector's (Rayleigh–Ritz:
+    ``sub_basis``)."""
     state = eq.node_values(c)["state"]
     fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], field_symmetry(eq, params), held)
               for held in {r.held for r in readings}}
     controlled = any(r.control != Control.PRESSURE for r in readings)
     weight = params.P / body_moments(eq.basis, state)[0] if controlled else None
-    for sector in eq.basis.sectors():
-        if not sector.size or (only is not None and sector.characters not in only):
+    for whole in eq.basis.sectors():
+        if not whole.size or (only is not None and whole.characters not in only):
             continue
+        sector = (within or {}).get(whole.characters, whole)
         H = eq.hessian(c, params, sector)
         g = -eq.parameter_derivative(c, params, "P", sector) if controlled and _own(sector, eq.basis) else None
         rows_of = {held: mode_rows(sector, modes) for held, modes in fields.items()}
@@ -137,7 +142,8 @@ def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
 
 
 def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, count: int = 6,
-                   readings=PRESSURE_READINGS, guesses: dict | None = None, only: tuple | None = None) -> dict:
+                   readings=PRESSURE_READINGS, guesses: dict | None = None, only: tuple | None = None,
+                   within: dict | None = None) -> dict:
     """{reading: {characters: the ``count`` lowest μ of the sector}}, one sector at a time in memory. ``guesses``
     (the same layout, the previous point's along a branch) let a large sector follow its lowest eigenvalues: one
     Cholesky factorisation of its matrix with the fewest zero modes removed under pressure control (the lowest
@@ -147,10 +153,11 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
     (numerics.eigen.ShiftInvert.lowest_of_relatives). Without guesses, below FOLLOWING_SIZE, or without a
     shift below the spectrum, each reading's matrix is solved dense (numerics.eigen.lowest_of). ``only``: the
     characters of the sectors wanted (default all): each sector follows its own guesses alone, so the sectors of a
-    branch can be read apart (on different cores) with the same numbers. A signal (numerics.interrupt.check) raises
-    Interrupted before each sector and each dense reading."""
+    branch can be read apart (on different cores) with the same numbers. ``within``: {characters: a ``sub_basis``
+    of the sector} to read it on instead (upper bounds of its eigenvalues). A signal (numerics.interrupt.check)
+    raises Interrupted before each sector and each dense reading."""
     out = {r: {} for r in readings}
-    for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only):
+    for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only, within):
         interrupt.check()
         key, gram = sector.characters, sector.gram()
         previous = [guesses[r][key][0] for r in readings if guesses and key in guesses.get(r, {})]
@@ -173,6 +180,17 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
             for r in shared:
                 out[r][key] = values
     return out
+
+
+def sub_basis(sector: SphericalBasis, degree: int, order: int) -> SphericalBasis:
+    """The perturbations of ``sector`` of degree ≤ ``degree`` and order ≤ ``order``, on its nodes and map: each
+    block's first functions (a block's orthonormalisation is triangular, so they span the same space in both), its
+    Hessian the sector's principal submatrix. Rayleigh–Ritz: the k-th lowest μ read on it is an upper bound of the
+    sector's k-th (its space, less the zero modes' projections, lies in the sector's less the zero modes)."""
+    if not 1 <= order <= degree <= sector.degree or order > sector.order:
+        raise ValueError(f"sub_basis: degree = {degree}, order = {order}: must satisfy 1 ≤ order ≤ degree, degree "
+                         f"≤ {sector.degree}, order ≤ {sector.order} (the sector's)")
+    return replace(sector, degree=degree, order=order)
 
 
 def _relative(H, gram: float, base_rows, rows, control: Control, g, weight):

@@ -10,4 +10,7 @@
   directions
 - ``azimuthal_crossings``: where an m ≥ 1 eigenvalue vanishes along a branch, located
 - ``picture``: all of a tube scene's run (``balloon-cg run``)
+- ``surface``: the tube over (S, φ), Legendre(S) × Fourier(φ): its energy, residual and exact Jacobian, one point
+  switched at a located m ≥ 1 zero, the non-axisymmetric branch traced from it (``[surface] branches``, default
+  "none" on a tube)
 """

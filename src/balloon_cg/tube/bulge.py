@@ -2,7 +2,7 @@
 
 At a branch point of the odd block (interval.Mirror) the mirror-symmetric branch is crossed by a pitchfork whose states
 break the symmetry (u_odd → −u_odd maps it onto its other half, the mirror image): the bulge at one end of a tube with
-sliding ends (plugged ends are refused: their odd branch points are not resolved, docs/tubes.md). At a branch point of the even block of a
+sliding ends (plugged ends are refused: ``PLUGGED_WHY``, docs/tubes.md). At a branch point of the even block of a
 uniform primary branch (sliding ends, no field: the modes cos(nπS/L), n even) the branch stays mirror-symmetric and
 breaks the uniformity (a pitchfork too: on the tube of length L it is the odd bulge branch of the tube of length
 L/n, repeated). The branch leaves the branch point X* = (u*, P*) along the block's null vector φ with dP = 0: the first
@@ -44,6 +44,13 @@ from ..scene.loading import Control
 from ..scene.tables import Ends
 
 
+PLUGGED_WHY = ("closed plugged ends have no odd bifurcation (the lowest odd eigenvalue, the middle bulge's shift "
+               "towards a plug, stays positive wherever it is resolved in the degree: the odd branch points reported "
+               "there are under-resolution), and the branch born at the odd branch point of plugged ends held apart "
+               "is compressed beside the plugs from its first steps, where a membrane wrinkles and no relaxed energy "
+               "is built (docs/tubes.md)")
+
+
 class UnswitchableBranchPoint(ValueError):
     """A branch point ``bulge_branch`` does not switch at (one line saying which and why)."""
 
@@ -67,8 +74,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                       f"{point.kind.value}")
     disc = primary.disc
     if disc.ends != Ends.SLIDING:
-        raise UnswitchableBranchPoint(f"a branch is switched on sliding ends, not {disc.ends.value}: the odd branch "
-                                      "points of plugged ends are not resolved (docs/tubes.md)")
+        raise UnswitchableBranchPoint(f"a branch is switched on sliding ends, not {disc.ends.value}: {PLUGGED_WHY}")
     if point.block == Mirror.EVEN and in_field(scene):
         raise UnswitchableBranchPoint("an even branch point is switched on a uniform primary branch (no field), not "
                                       "in a coil field")

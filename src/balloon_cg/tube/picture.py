@@ -10,7 +10,8 @@ traced until it rejoins the mirror-symmetric (odd) or uniform (even) states, its
 there too) or after ``continuation.max_points``. The branch born at the first odd branch point (the onset of
 bulging) is named "bulge", the others "bulge_<label>", <label> their branch point's label (``inspect``: the primary
 branch's located points are numbered first); each knows its parent label and where it rejoined
-(IntervalBranch.parent, .rejoins). And
+(IntervalBranch.parent, .rejoins). With [surface] branches "first" or "all" (default "none" on a tube) the
+non-axisymmetric branches traced from the located m ≥ 1 zeros (``with_surface``, tube/surface/branch.py). And
 Maxwell's pressure of the uniform closed tube (model/tube.maxwell_pressure; closed ends without a field only: ends
 held apart have no single one, a coil field no uniform state: ``maxwell``), computed first. A signal (numerics.interrupt) ends the stage it comes in at its next point, or before
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
@@ -28,6 +29,7 @@ from .bulge import BranchStartError
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
 from .resolution import REFINE, traced_bulge
+from .surface.branch import SurfaceBranchStartError, traced_branch
 from .results import IntervalBranch, IntervalStop
 from .voltage import voltage_branch
 from ..analysis.results import Kind, StopCode
@@ -49,19 +51,22 @@ class Stage(enum.StrEnum):
     PRIMARY = "primary"  # the primary branch (tube/primary.py)
     BULGE = "bulge"  # the bulge branch (tube/bulge.py)
     ONSET = "onset"  # the onset curve of ``critical`` (tube/onset.py)
+    SURFACE = "surface"  # the non-axisymmetric branches ([surface] branches: tube/surface/branch.py)
     FREQUENCIES = "frequencies"  # the branches' natural frequencies (dynamics/tube.py): the branches are whole
 
 
 @dataclass(frozen=True)
 class TubePicture:
-    """The branches by name ("primary", "bulge" and "bulge_<label>" where they were switched: ``branch_name``), Maxwell's pressure (None where the
-    uniform closed path has no maximum and minimum, the ends are held, or coils act: ``maxwell``), for ``critical``
-    the onset of bulging followed in a second parameter (tube/onset.py), and the stage a signal stopped (None: the
-    work is whole; the stage's branch or curve ends ``interrupted`` where it had started, and is absent where it had
-    not); ``frequencies``: with [dynamics] frequencies, each branch's (dynamics/tube.py: TubeFrequencies by branch
-    name); ``modes``: each branch's m = 1..``stability.m_max`` blocks (tube/azimuthal.TubeModes by branch name; None:
-    not assessed, m_max = 0 or a signal); ``not_started``: (name, why) of the switched branches that could not start
-    (the run is then incomplete: exit 1)."""
+    """The branches by name ("primary", "bulge" and "bulge_<label>" where they were switched: ``branch_name``),
+    Maxwell's pressure (None where the uniform closed path has no maximum and minimum, the ends are held, or coils
+    act: ``maxwell``), for ``critical`` the onset of bulging followed in a second parameter (tube/onset.py), and the
+    stage a signal stopped (None: the work is whole; the stage's branch or curve ends ``interrupted`` where it had
+    started, and is absent where it had not); ``frequencies``: with [dynamics] frequencies, each branch's
+    (dynamics/tube.py: TubeFrequencies by branch name); ``modes``: each branch's m = 1..``stability.m_max`` blocks
+    (tube/azimuthal.TubeModes by branch name; None: not assessed, m_max = 0 or a signal); ``surface``: the
+    non-axisymmetric branches traced from the m ≥ 1 zeros (``with_surface``: tube/surface/branch.TubeSurfaceBranch
+    by name; None: none asked); ``not_started``: (name, why) of the switched branches that could not start (the run
+    is then incomplete: exit 1)."""
 
     branches: dict
     maxwell: float | None
@@ -70,6 +75,7 @@ class TubePicture:
     frequencies: dict | None = None
     modes: dict | None = None
     not_started: tuple = ()  # (name, why) of each branch whose first step off its branch point did not converge
+    surface: dict | None = None  # name -> tube/surface/branch.TubeSurfaceBranch ([surface] branches; None: none)
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
@@ -84,9 +90,10 @@ def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     if primary.stop.code == StopCode.INTERRUPTED:
         return TubePicture(branches, pm, interrupted=Stage.PRIMARY)
     labels = switchable(scene, primary)
-    if not primary_only and labels:
-        return bulge_picture(scene, primary, labels, pm)
-    return with_modes(scene, TubePicture(branches, pm))
+    if primary_only:
+        return with_modes(scene, TubePicture(branches, pm))
+    picture = bulge_picture(scene, primary, labels, pm) if labels else with_modes(scene, TubePicture(branches, pm))
+    return with_surface(scene, picture)
 
 
 def switchable(scene, primary: IntervalBranch) -> list:
@@ -174,6 +181,48 @@ def with_modes(scene, picture: TubePicture) -> TubePicture:
                              branch.params, m_max)
         modes[name] = replace(found, crossings=tuple(crossings(scene, branch, found)))
     return replace(picture, modes=modes)
+
+
+def surface_name(parent: str, m: int, k: int) -> str:
+    """The name of the non-axisymmetric branch born at the k-th located zero of ``parent``'s m-th block (its order
+    in ``inspect``'s list of that block's zeros): "m<m>_bp<k>" on the primary branch, "<parent>_m<m>_bp<k>" else."""
+    return f"m{m}_bp{k}" if parent == "primary" else f"{parent}_m{m}_bp{k}"
+
+
+def with_surface(scene, picture: TubePicture) -> TubePicture:
+    """``picture`` with the non-axisymmetric branches of [surface] branches (tube/surface/branch.py, along +φ: the
+    −φ half is its image under the rotation by π/m): "first" at the primary branch's first located m ≥ 1 zero along
+    it, "all" at every located zero of every branch (the free tube's: without a field the held reading is the same);
+    "none", m ≥ 1 not assessed or a signal before: none. One whose switched point does not converge is listed in
+    ``not_started``; a signal during a trace ends the stage (Stage.SURFACE)."""
+    asked = scene.surface.branches
+    if asked == "none" or picture.modes is None or picture.interrupted is not None:
+        return picture
+    zeros = []  # (parent, the zero's order among its block's, the zero)
+    for parent, modes in picture.modes.items():
+        counted = {}  # m -> the free zeros of block m so far
+        for zero in (c for c in modes.crossings if not c.held):
+            k = counted[zero.m] = counted.get(zero.m, -1) + 1
+            if zero.mode is not None:
+                zeros.append((parent, k, zero))
+    if asked == "first":
+        zeros = sorted((z for z in zeros if z[0] == "primary"), key=lambda z: z[2].index)[:1]
+    traced, not_started, stopped = {}, picture.not_started, None
+    for parent, k, zero in zeros:
+        name = surface_name(parent, zero.m, k)
+        if interrupt.requested():
+            stopped = Stage.SURFACE
+            break
+        branch = picture.branches[parent]
+        try:
+            traced[name] = traced_branch(scene, branch.disc, zero, branch.params, parent=(parent, k))
+        except SurfaceBranchStartError as e:
+            not_started += ((name, str(e)),)
+            continue
+        if traced[name].stop.code == StopCode.INTERRUPTED:
+            stopped = Stage.SURFACE
+            break
+    return replace(picture, surface=traced, not_started=not_started, interrupted=stopped)
 
 
 def onset_picture(scene, name: str = "M", direction: float = 1.0) -> TubePicture:

@@ -316,19 +316,22 @@ class SecondVariation:
             if field_on:
                 yield f"m{m}_free", readings[False], FREE_FLAGS
 
-    def _sibling(self, symmetric: bool):
-        """The m = 0 blocks' banded sibling at this degree (``banded.banded_variation``: None below
-        stability.banded_from), cached per symmetry."""
+    def _sibling(self, symmetric: bool, start: int | None = None):
+        """The m = 0 blocks' banded sibling at this degree (``banded.banded_variation``), cached per symmetry; None
+        below ``start`` (default stability.banded_from; 0: never)."""
+        start = self.eq.scene.stability.banded_from if start is None else start
+        if not start or self.basis.degree < start:
+            return None
         siblings = self.__dict__.setdefault("_banded", {})
         if symmetric not in siblings:
             siblings[symmetric] = banded_variation(self.eq, self.basis.degree, symmetric)
         return siblings[symmetric]
 
-    def _sibling_block(self, symmetric: bool, m: int) -> BandedAzimuthal:
-        """The m-th block on the sibling's elements, cached."""
+    def _sibling_block(self, symmetric: bool, m: int, start: int | None = None) -> BandedAzimuthal:
+        """The m-th block on the sibling's elements (``_sibling``), cached."""
         blocks = self.__dict__.setdefault("_banded_azimuthal", {})
         if (symmetric, m) not in blocks:
-            blocks[symmetric, m] = BandedAzimuthal(self._sibling(symmetric), m)
+            blocks[symmetric, m] = BandedAzimuthal(self._sibling(symmetric, start), m)
         return blocks[symmetric, m]
 
     def lowest(self, u, params: Parameters, symmetric: bool, name: str) -> np.ndarray:
@@ -361,10 +364,11 @@ class SecondVariation:
 
     def _positive_blocks(self, u, params: Parameters, symmetric: bool, m_max: int):
         """(the flags a block enters, a call saying whether it is positive definite) per block, in ``blocks``'
-        order: the Legendre blocks' Cholesky factorisations, or from stability.banded_from where P ≥ 0 (as
+        order: the Legendre blocks' Cholesky factorisations, or from stability.banded_flags_from where P ≥ 0 (as
         ``_lowest_blocks``) the banded sibling's inertia (``BandedVariation.positive``,
         ``BandedAzimuthal.positive_readings``: one factorisation per index set and part)."""
-        sibling = self._sibling(symmetric) if params.P >= 0 else None
+        start = self.eq.scene.stability.banded_flags_from
+        sibling = self._sibling(symmetric, start) if params.P >= 0 else None
         if sibling is None:
             for _, parts, flags in self.blocks(u, params, symmetric, m_max):
                 yield flags, lambda parts=parts: all(eigen.positive_definite(A) for A in parts)
@@ -373,8 +377,8 @@ class SecondVariation:
             yield flags, lambda positive=positive: positive
         field_on = self.eq.coils.shape[0] > 0 and params.M > 0
         for m in range(1, m_max + 1):
-            readings = self._sibling_block(symmetric, m).positive_readings(u, params, (True, False) if field_on
-                                                                           else (True,))
+            readings = self._sibling_block(symmetric, m, start).positive_readings(u, params, (True, False) if field_on
+                                                                                  else (True,))
             yield (HELD_FLAGS if field_on else EVERY_FLAG), lambda held=readings[True]: held
             if field_on:
                 yield FREE_FLAGS, lambda free=readings[False]: free

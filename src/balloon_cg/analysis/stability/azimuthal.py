@@ -201,13 +201,11 @@ def basis(m: int, degree: int, quadrature: int, mapping: WireMap | None = None,
 
 @dataclass(frozen=True)
 class StateMaps:
-    """The linear maps of the unknowns u of a discretisation onto the nodes of an azimuthal basis: ``state``
-    (size, 4 n_q), u @ state = (λ2, λ2', η, η') at the nodes; ``modes`` (size, 2 size_b) and ``translation``
-    (size_b), the special modes' rows G c (``_mode_moments``): (rotation, relabelling) = u @ modes, and the
-    translation's, which does not depend on u."""
+    """The linear map of the unknowns u of a discretisation onto the nodes of an azimuthal basis: ``state``
+    (size, 4 n_q), u @ state = (λ2, λ2', η, η') at the nodes; and ``translation`` (size_b), the translation's row
+    G c (``_mode_moments``), which does not depend on u."""
 
     state: np.ndarray
-    modes: np.ndarray
     translation: np.ndarray
 
 
@@ -215,10 +213,8 @@ class StateMaps:
 def state_maps(disc, b: AzimuthalBasis) -> StateMaps:
     """``StateMaps`` of ``disc`` (a galerkin Discretisation) on the nodes of ``b``: columns of unit unknowns."""
     unit = tuple(np.atleast_2d(v) for v in disc.evaluate(np.eye(disc.size), b.theta))  # each (size, n_q)
-    moments = _mode_moments(b, unit)  # (3, size, size_b): G c of each mode for each unit u
     zero = _mode_moments(b, tuple(np.zeros((1, b.x.size)) for _ in range(4)))[0, 0]
-    return StateMaps(np.ascontiguousarray(np.concatenate(unit, axis=1)),
-                     np.ascontiguousarray(np.concatenate([moments[1], moments[2]], axis=1)), zero)
+    return StateMaps(np.ascontiguousarray(np.concatenate(unit, axis=1)), zero)
 
 
 @lru_cache(maxsize=32)
@@ -344,13 +340,15 @@ def _mode_moments(b: AzimuthalBasis, state: tuple) -> np.ndarray:
     one = np.ones_like(eta)
     radius = hoop(b.geometry, c, s)  # R: sin θ but on a capsule
     values = np.array([[one, -one, 0.0 * one], [eta, -eta, -lam2 * radius], [lam2 * c + dlam2 * s, -lam2 * c, deta]])
-    return np.einsum("mjkq,jqi->mki", values, b.moments.reshape(3, -1, b.size))
+    k = values.shape[2]  # Σ_j Σ_q values[m, j, k, q] moments[j, q, i]: one BLAS product per mode
+    return np.matmul(values.transpose(0, 2, 1, 3).reshape(3, k, -1), b.moments.reshape(-1, b.size))
 
 
 def mode_moments(equilibrium: Equilibrium, u, b: AzimuthalBasis) -> np.ndarray:
-    """G c of the special modes (rows in the order MODES) of the state u, by the linear maps ``state_maps``."""
-    maps = state_maps(equilibrium.disc, b)
-    return np.vstack([maps.translation, (np.asarray(u, dtype=float) @ maps.modes).reshape(2, -1)])
+    """G c of the special modes (rows in the order MODES) of the state u, from its node state (``state_maps``):
+    O(n_q size_b) a point (a map of every unit state's moments cost O(size n_q size_b) once per basis)."""
+    state = np.asarray(u, dtype=float) @ state_maps(equilibrium.disc, b).state
+    return _mode_moments(b, tuple(state.reshape(4, 1, -1)))[:, 0]
 
 
 def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0) -> dict:

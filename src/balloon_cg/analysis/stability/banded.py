@@ -150,12 +150,11 @@ class BandedVariation:
 
 
 def banded_variation(equilibrium, degree: int, symmetric: bool) -> "BandedVariation | None":
-    """The banded sibling of the Legendre blocks of perturbation degree N at ``equilibrium``, or None below the
-    scene's stability.banded_from (0: never): elements of order ORDER, as many as give about ELEMENT_FUNCTIONS·N
-    functions per field on the whole interval (half as many on the half interval of an equator-symmetric state).
-    None on a capsule's piecewise discretisation (``joins``), whose m ≥ 1 blocks have their own elements."""
-    start = equilibrium.scene.stability.banded_from
-    if not start or degree < start or equilibrium.disc.joins:
+    """The banded sibling of the Legendre blocks of perturbation degree N at ``equilibrium``: elements of order
+    ORDER, as many as give about ELEMENT_FUNCTIONS·N functions per field on the whole interval (half as many on the
+    half interval of an equator-symmetric state). None on a capsule's piecewise discretisation (``joins``), whose
+    m ≥ 1 blocks have their own elements."""
+    if equilibrium.disc.joins:
         return None
     half = symmetric and equilibrium.disc.symmetric
     elements = max(1, int(np.ceil(ELEMENT_FUNCTIONS * degree / ORDER / (2 if half else 1))))
@@ -190,9 +189,11 @@ class BlockLayout:
         self._vector, self._indices = kept.ravel(), dofs[kept]
 
     def band(self, local: np.ndarray) -> np.ndarray:
-        """The assembled symmetric matrix in lower band storage, (bandwidth + 1, size)."""
-        return np.bincount(self._positions, weights=local.ravel()[self._matrix],
-                           minlength=(self.bandwidth + 1) * self.size).reshape(self.bandwidth + 1, self.size)
+        """The assembled symmetric matrix in lower band storage, (bandwidth + 1, size), in Fortran order (LAPACK's:
+        scipy's band routines copy any other array on every call)."""
+        return np.asfortranarray(np.bincount(self._positions, weights=local.ravel()[self._matrix],
+                                             minlength=(self.bandwidth + 1) * self.size).reshape(self.bandwidth + 1,
+                                                                                                  self.size))
 
     def vector(self, local: np.ndarray) -> np.ndarray:
         return np.bincount(self._indices, weights=local.ravel()[self._vector], minlength=self.size)

@@ -1,0 +1,106 @@
+"""The energy of a tube over (S, φ), its gradient (the residual) and Hessian (the exact Jacobian) in the coefficients
+c of tube/surface/basis.py (MODEL.md §8, §10), per 2π:
+
+    E(c) = Σ_nodes W (π_m(a_S, a_φ) − P v),   π_m = Φ(I, J),   I = |a_S|² + |a_φ|²,   J = |a_S × a_φ|,
+
+π_m, its gradient and Hessian in the 9 node variables from the scene class's generated surface kernels
+(codegen/surface.py, the sphere's: with R = 1 the tube's reference frame is orthonormal in (S, φ) as the sphere's in
+(θ, φ/sin θ), and the density per unit reference area is the same function of a_1, a_2) evaluated at P = 0, i.e.
+without their cone form of the volume, which misses the end planes; the pressure's work is the volume between the
+end planes, −P v (tube/surface/volume.py). A node variable is Σ_j T[·, node, j] c_j (+ a plugged end's 1), so
+
+    ∂E/∂c = Σ_a T_aᵀ (W ∂π/∂q_a),   ∂²E/∂c² = Σ_ab T_aᵀ diag(W ∂²π/∂q_a∂q_b) T_b,   ∂R/∂P = −∂Ṽ/∂c
+
+(sum-factorised over φ: tube/surface/basis.py ``project``, ``hessian``).
+
+Coils and a voltage are refused (SceneError, one line: ``refuse_scene``): the field's H² needs x in Cartesian
+components and its rows.
+"""
+import numpy as np
+
+from . import volume
+from .basis import NODE_VARIABLES, TubeSurfaceBasis
+from ...galerkin.discretisation import symmetric_rows
+from ...galerkin.equilibrium import NonFiniteState, Parameters
+from ...model.kernels import PLAIN, KernelSet
+from ...numerics.newton import finite
+from ...scene.tables import Shape
+from ...scene.validation import SceneError
+
+
+def refuse_scene(scene) -> None:
+    """SceneError, one line naming the key, its value and what is allowed, for what the tube over (S, φ) does not
+    take: another shape, coils, a voltage."""
+    if scene.geometry.shape != Shape.TUBE:
+        raise SceneError(f"geometry.shape = {scene.geometry.shape.value!r}: the tube over (S, φ) is a tube's "
+                         '(allowed: "tube")')
+    if scene.field.coils:
+        raise SceneError(f"field.coils = {len(scene.field.coils)} coil(s): the tube over (S, φ) has no field "
+                         "(allowed: no coils)")
+    if scene.electric is not None:
+        raise SceneError(f"electric.voltage = {scene.electric.voltage:g}: the tube over (S, φ) has no dielectric "
+                         "term (allowed: no [electric] table)")
+
+
+class TubeSurfaceEquilibrium:
+    """E, ∇E, ∇²E and V/(2π) of a tube scene (field-free, no voltage) in a TubeSurfaceBasis."""
+
+    def __init__(self, scene, basis: TubeSurfaceBasis):
+        refuse_scene(scene)
+        if basis.disc.ends != scene.geometry.ends:
+            raise ValueError(f"basis ends: {basis.disc.ends.value!r} (allowed: the scene's, "
+                             f"{scene.geometry.ends.value!r})")
+        self.scene, self.basis = scene, basis
+        self.kernels = KernelSet(scene.material, PLAIN).surface()  # the class's membrane density; P = 0 (docstring)
+        if tuple(self.kernels.module.SURFACE_STATE) != NODE_VARIABLES:
+            raise RuntimeError(f"{self.kernels.module.__name__}: node variables {self.kernels.module.SURFACE_STATE}, "
+                               f"tube/surface/basis.py assembles {NODE_VARIABLES}")
+        self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
+
+    def node_state(self, c: np.ndarray) -> np.ndarray:
+        """The 9 node variables; NonFiniteState where the surface folds over (a_S × a_φ not along e_ρ's side)."""
+        state = self.basis.node_state(c)
+        normal_r = state[4] * state[8] - state[5] * state[7]  # (a_S × a_φ) · e_ρ, 1 on the reference tube
+        if not (normal_r > 0.0).all():
+            raise NonFiniteState("the tube's surface folds over: (a_S × a_φ) · e_ρ ≤ 0 at a node")
+        return state
+
+    def _membrane(self, kernel: str, state: np.ndarray, params: Parameters) -> np.ndarray:
+        out = self.kernels.nodes(kernel, {"state": state}, params.with_value("P", 0.0))
+        if not finite(out):
+            raise NonFiniteState(f"{kernel}: non-finite values (a stretch ≤ 0)")
+        return out
+
+    def energy(self, c: np.ndarray, params: Parameters) -> float:
+        """E/(2π)."""
+        state = self.node_state(c)
+        pi = self._membrane("surface_energy", state, params)[0] - params.P * volume.density(state)
+        return float(self.basis.weights @ pi)
+
+    def volume(self, c: np.ndarray) -> float:
+        """V/(2π), the volume between the end planes."""
+        return float(self.basis.weights @ volume.density(self.basis.node_state(c)))
+
+    def residual(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """∂E/∂c."""
+        state = self.node_state(c)
+        pointwise = self._membrane("surface_gradient", state, params) - params.P * volume.gradient(state)
+        return self.basis.project(pointwise * self.basis.weights)
+
+    def node_hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """(9, 9, nodes): W ∂²π/∂q² at every node, the rows ``hessian`` contracts."""
+        state = self.node_state(c)
+        pointwise = self._membrane("surface_hessian", state, params)[self._pairs] - params.P * volume.hessian(state)
+        return pointwise * self.basis.weights
+
+    def hessian(self, c: np.ndarray, params: Parameters) -> np.ndarray:
+        """∂²E/∂c² (the Jacobian of ``residual``)."""
+        return self.basis.hessian(self.node_hessian(c, params))
+
+    def parameter_derivative(self, c: np.ndarray, params: Parameters, name: str = "P") -> np.ndarray:
+        """∂R/∂P = −∂(V/2π)/∂c (the only continuation parameter built here)."""
+        if name != "P":
+            raise SceneError(f"continuation.parameter = {name!r}: the tube over (S, φ) is continued in P only "
+                             '(allowed: "pressure")')
+        state = self.basis.node_state(c)
+        return -self.basis.project(volume.gradient(state) * self.basis.weights)
