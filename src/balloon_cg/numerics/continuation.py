@@ -4,10 +4,12 @@ Knows nothing about balloons: a *system* has ``residual(X)`` and ``jacobian(X)``
 with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector solves R = 0 with τ·(X − X_pred) = 0
 (Keller). Steps grow after easy corrections and shrink on failure, on a sharp turn (τ_i·τ_{i+1} small) or
 on a slow correction (linear Newton convergence means a nearly singular Jacobian: landing close to a branch
-point, where the corrector may pick the crossing branch). A corrector that stagnates at its rounding floor above
-``rounding_limit`` (newton's ILL_CONDITIONED: the system is nearly singular there, e.g. at a codim-2 point of an
-extended system) doubles the step instead, on every failure until a point is accepted or the step would move the
-state more than step_max: shorter steps would land nearer the singular point, a longer one lands past it.
+point, where the corrector may pick the crossing branch). With ``Settings.rounding_limit`` > 0 (opt-in; 0, the
+default, turns both off) a corrector that stagnates at its rounding floor is accepted up to that limit (newton's
+AT_ROUNDING), and one that stagnates above it (ILL_CONDITIONED: the system is nearly singular there, e.g. at a
+codim-2 point of an extended system) doubles the step instead of halving it, on every failure until a point is
+accepted or the step would move the state more than step_max: shorter steps would land nearer the singular point,
+a longer one lands past it.
 ``step_max`` bounds the change of the state X[:-1] in one step, not of the parameter X[-1]: where the branch
 is steep in the parameter (a stiff material's pressure grows like λ^(α−1)) the arclength may grow until the
 state moves step_max, instead of crawling at a fixed arclength that the parameter alone uses up.
@@ -39,7 +41,7 @@ class Settings:
     max_newton: int
     max_turn: float = 0.3  # radians between successive tangents
     slow_newton: int = 6  # a correction needing more iterations is rejected (near-singular: e.g. a branch point)
-    rounding_limit: float = 0.0  # a correction at its rounding floor above tol is accepted up to this (newton)
+    rounding_limit: float = 0.0  # > 0: accept a corrector at its rounding floor up to this, step across above it
 
 
 class TraceStop(enum.StrEnum):

@@ -31,7 +31,7 @@ def continuation_settings(scene, max_points: int | None = None) -> continuation.
     """The continuation settings of a scene's [continuation] and [solver] tables (``max_points`` overridden)."""
     c, s = scene.continuation, scene.solver
     return continuation.Settings(c.step, c.step_min, c.step_max, c.max_points if max_points is None else max_points,
-                                 s.tol, s.max_newton, rounding_limit=s.max_error)
+                                 s.tol, s.max_newton)
 
 
 def equilibrium_of(branch) -> Equilibrium:

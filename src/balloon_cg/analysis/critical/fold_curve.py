@@ -36,10 +36,10 @@ from ...galerkin.equilibrium import Equilibrium
 from ...numerics import continuation
 from ...scene import Control
 from ..points.extended_systems import _parameter_step, _step
-from .pitchfork_curve import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status, plain_branch,
-                     trace_in_q)
+from .pitchfork_curve import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status,
+                              curve_settings, plain_branch, trace_in_q)
 from ..branches.control import FOLD_KIND, control_gradient_at
-from ..branches.problem import continuation_settings, equilibrium_of
+from ..branches.problem import equilibrium_of
 from ..results import Branch, Kind, SpecialPoint, StopCode
 from .second_parameter import Derivative, SecondParameter, second_parameter
 from ...numerics.threads import limited_blas
@@ -182,7 +182,7 @@ def continue_fold(branch: Branch, fold: SpecialPoint, parameter: str | SecondPar
     w = fold_tangent(eq, X, control, params)
     system = FoldSystem(eq, params, parameter, control, w)
     X0 = np.concatenate([X, w, [q0]])
-    settings = settings or continuation_settings(branch.scene, max_points)
+    settings = settings or curve_settings(branch.scene, max_points)
     path = trace_in_q(system, X0, f"the {fold.kind.value}", branch, parameter, q0, direction, settings, stop,
                       progress)
     end = _classify(system, path)

@@ -324,7 +324,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     system = ExtendedSystem(eq, params, parameter, ell, bp.block)
     X0 = system.initial(bp, q0)
     if settings is None:
-        settings = continuation_settings(scene, max_points)
+        settings = curve_settings(scene, max_points)
     path = trace_in_q(system, X0, "the branch point", branch, parameter, q0, direction, settings, stop, progress)
     end = _classify(path, branch.disc.size)
     name = parameter.name
@@ -338,6 +338,15 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
                              merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), bp.block,
                              meetings)
+
+
+def curve_settings(scene, max_points: int) -> continuation.Settings:
+    """The scene's continuation settings (``continuation_settings``) for a curve of an extended system, which opts
+    in to what no one-parameter trace does: a corrector at its rounding floor is accepted up to solver.max_error
+    (newton's AT_ROUNDING), and one above it (ILL_CONDITIONED) makes the trace step across instead of halving
+    (numerics/continuation.py). Such a curve passes singular points of its system: a fold curve where the branch
+    has a branch point (``fold_curve.fold_crossings``)."""
+    return replace(continuation_settings(scene, max_points), rounding_limit=scene.solver.max_error)
 
 
 def plain_branch(branch: Branch, X) -> Branch:
