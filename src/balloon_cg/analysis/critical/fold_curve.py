@@ -41,6 +41,7 @@ from .pitchfork_curve import (CurveEnd, TwoParameterCurve, TwoParameterError, _E
 from ..branches.control import FOLD_KIND, control_gradient_at
 from ..branches.problem import equilibrium_of
 from ..results import Branch, Kind, SpecialPoint, StopCode
+from .fold_crossing import fold_crossings
 from .second_parameter import Derivative, SecondParameter, second_parameter
 from ...numerics.threads import limited_blas
 
@@ -190,10 +191,11 @@ def continue_fold(branch: Branch, fold: SpecialPoint, parameter: str | SecondPar
     verdict = ": a cusp, the two folds merge" if end == CurveEnd.CUSP else " (not a verified cusp)"
     merges = [SpecialPoint(Kind.LP, f.index, f.point.X, **_merge_status(f, path, branch.disc, end, "a cusp"),
                            note=f"fold of the {fold.kind.value} curve in {name}{verdict}") for f in path.folds]
+    crossings = fold_crossings(system, path.points, branch.disc, settings)
     return FoldCurve(parameter, branch.scene, branch.disc, params, w, np.array([p.X for p in path.points]),
                      np.array([p.iterations for p in path.points]), np.array([p.residual for p in path.points]),
                      merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction),
-                     control=control)
+                     meetings=crossings, control=control)
 
 
 def _classify(system: FoldSystem, path) -> CurveEnd:

@@ -77,7 +77,7 @@ from ..points.branch_points import padded_mode, plain_degree
 from ..points.extended_systems import H_STEP, WernerSpence
 from .fold_meeting import fold_meetings
 from ..branches.problem import continuation_settings, equilibrium_of
-from ..results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
+from ..results import Block, Branch, Kind, SpecialPoint, Status, StopCode, approximate, located_or_bracketed
 from .second_parameter import Derivative, SecondParameter, alpha1_material, second_parameter
 from ..stability.axisymmetric import SecondVariation, block_indices
 from ..branches.wires import wire_gap
@@ -180,7 +180,8 @@ class TwoParameterCurve:
     q0: float = np.nan  # the start value of q
     direction: float = 1.0  # +1: q increased from q0, −1: decreased
     block: Block = Block.ODD_HELD  # the pear block: odd_held, or odd_free (the free balloon's pitchforks)
-    meetings: list = field(default_factory=list)  # codim-2 points LP-BP, LV-BP, LN-BP (``fold_meeting``)
+    meetings: list = field(default_factory=list)  # codim-2 points LP-BP, LV-BP, LN-BP (``fold_meeting``,
+    #                                                 on a fold curve ``fold_crossing``)
 
     @property
     def n(self) -> int:
@@ -258,9 +259,12 @@ class TwoParameterCurve:
         return self._ending() + self.describe_meetings()
 
     def describe_meetings(self) -> str:
-        """'; the LN fold meets the pitchfork at q = … (P = …, located)' per meeting, or ''."""
-        return "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets the pitchfork at {self.parameter} = "
-                       f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value})" for m in self.meetings)
+        """'; the LN fold meets the pitchfork at q = … (P = …, located)' per meeting (on a fold curve: 'meets a
+        branch point', ``fold_crossing``; an approximate one with its ±uncertainty), or ''."""
+        met = "the pitchfork" if self.of == Kind.BP else "a branch point"
+        return "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets {met} at {self.parameter} = "
+                       f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value}"
+                       + (f" ±{m.uncertainty:.1g})" if m.status != Status.LOCATED else ")") for m in self.meetings)
 
     def _ending(self) -> str:
         """``describe`` without the meetings."""
