@@ -173,6 +173,18 @@ def test_the_ln_curve_s_crossing_of_the_n4_bifurcation_is_a_special_point(soft_l
     assert f"LN-BP meeting        mu[2] = {mu3_c:.12g}" in capsys.readouterr().out
 
 
+def test_only_two_parameter_curves_accept_the_rounding_floor():
+    """The rounding rule and the step across (numerics/continuation.py) are opted in by analysis/critical's curves
+    alone (rounding_limit = solver.max_error); every one-parameter trace keeps 0 (the rule off: main's code path)."""
+    from balloon_cg.analysis.branches.problem import continuation_settings
+    from balloon_cg.analysis.critical.pitchfork_curve import curve_settings
+
+    scene = parse_scene(SOFT, "soft")
+    assert continuation_settings(scene).rounding_limit == 0.0
+    assert curve_settings(scene, 30).rounding_limit == scene.solver.max_error > 0
+    assert curve_settings(scene, 30).max_points == 30
+
+
 def test_pressure_fold_in_alpha1_uses_runtime_exponents():
     """SPOM1's maximum of P followed in α1 (μ1 = (4 − Σ_{i≥2} μ_i α_i)/α1: kernels with the exponents as runtime
     arguments): at every point dP/dλ = Σ μ_i ((α_i − 3)λ^(α_i − 4) + (2α_i + 3)λ^(−2α_i − 4)) = 0 at its own α1
