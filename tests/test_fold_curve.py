@@ -151,7 +151,9 @@ def test_the_ln_curve_s_crossing_of_the_n4_bifurcation_is_a_special_point(soft_l
     """The crossing above is the curve's one meeting: LN-BP, block even, between the two curve points that bracket
     λ* (fold_crossing.py). It is APPROXIMATE (the fold system's corrector fails within ~1e-3 of it): the closed
     form's λ* lies within its bracket, |λ − λ*| ≤ 2·uncertainty (the half-width in λ2(0) and P; measured: 1.3e-3
-    from λ*, ±1.3e-3), and the stored point is on the LN curve's closed form μ3(λ) to 1e-9. Stored in the curve
+    from λ*, ±1.3e-3; the bound 5e-3 leaves the corrector's failure zone room to double on another BLAS build,
+    under an eighth of the bracketing curve points' 0.038), and the stored point is on the LN curve's closed form μ3(λ) to
+    1e-9. Stored in the curve
     file as a special point of kind LN-BP, shown by ``inspect`` and in the curve's description."""
     from balloon_cg.io.curve_file import curve_meetings, write_curve
 
@@ -163,7 +165,7 @@ def test_the_ln_curve_s_crossing_of_the_n4_bifurcation_is_a_special_point(soft_l
     lams = curve.pole_stretch
     assert lams[crossing.index] < lam_star < lams[crossing.index + 1]
     lam_c, mu3_c = float(curve.pole_values(crossing.X)["lam2_top"][0]), float(crossing.X[-1])
-    assert abs(lam_c - lam_star) <= 2 * crossing.uncertainty and crossing.uncertainty < 2e-3
+    assert abs(lam_c - lam_star) <= 2 * crossing.uncertainty and crossing.uncertainty < 5e-3
     assert abs(mu3_c - float(soft_mu3_on_the_ln_curve(mpmath.mpf(lam_c)))) < 1e-9
     assert f"the LN fold meets a branch point at mu[2] = {mu3_c:.10g}" in curve.describe()
     out = write_curve(tmp_path / "ln.h5", scene, curve, name="LN")
