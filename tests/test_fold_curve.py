@@ -152,8 +152,8 @@ def test_the_ln_curve_s_crossing_of_the_n4_bifurcation_is_a_special_point(soft_l
     λ* (fold_crossing.py). It is APPROXIMATE (the fold system's corrector fails within ~1e-3 of it): the closed
     form's λ* lies within its bracket, |λ − λ*| ≤ 2·uncertainty (the half-width in λ2(0) and P; measured: 1.3e-3
     from λ*, ±1.3e-3; the bound 5e-3 leaves the corrector's failure zone room to double on another BLAS build,
-    under an eighth of the bracketing curve points' 0.038), and the stored point is on the LN curve's closed form μ3(λ) to
-    1e-9. Stored in the curve
+    under an eighth of the bracketing curve points' 0.038), and the stored point is on the LN curve's closed form
+    μ3(λ) to 1e-9. Stored in the curve
     file as a special point of kind LN-BP, shown by ``inspect`` and in the curve's description."""
     from balloon_cg.io.curve_file import curve_meetings, write_curve
 
