@@ -44,14 +44,13 @@ def fold_crossings(system, points: list, disc, settings: continuation.Settings) 
     of kind ``MEETING_KIND[system.control]`` with X on the curve's layout (u, P, w, q), in order along the
     curve."""
     g = [crossing_test(system, p.X) for p in points]
-    fold = FOLD_KIND[system.control].value
+    fold, n = FOLD_KIND[system.control].value, system.n
     found = []
     for i in np.flatnonzero(np.array(g[:-1]) * np.array(g[1:]) < 0):
         low, high, narrowed = _bracket(system, points[i], (0.0, g[i], points[i].X),
                                        (float(points[i].tangent @ (points[i + 1].X - points[i].X)), g[i + 1],
                                         points[i + 1].X), settings)
         X = min(low, high, key=lambda end: abs(end[1]))[2]
-        n = system.n
         before, after = (np.append(end[2][:n], end[2][n]) for end in (low, high))
         status = {"status": Status.LOCATED} if narrowed else approximate(
             disc, before, after, f"crossing of the {fold} and a branch point: the fold system's corrector fails "

@@ -26,6 +26,10 @@ is the branch with c as its parameter, ψ the left null vector of ∂F̃/∂x no
 end of the snap-through region; the curve then comes back in q along the partner fold. The curve's ``end`` is
 ``CurveEnd.CUSP`` (its ``critical`` value q of the cusp) only when a fold in q at P > 0 has the coefficient of
 opposite signs at the curve points bracketing it; another fold in q is FOLD (not verified).
+
+Where the curve passes a branch point of the branch (F_x loses rank: the fold system is singular there, and the
+trace steps across it, ``pitchfork_curve.curve_settings``) the crossing is bracketed and stored with the curve's
+``meetings`` (``fold_crossing``: LP-BP, LV-BP, LN-BP).
 """
 import time
 from dataclasses import dataclass

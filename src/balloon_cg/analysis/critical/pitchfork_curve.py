@@ -349,7 +349,7 @@ def curve_settings(scene, max_points: int) -> continuation.Settings:
     in to what no one-parameter trace does: a corrector at its rounding floor is accepted up to solver.max_error
     (newton's AT_ROUNDING), and one above it (ILL_CONDITIONED) makes the trace step across instead of halving
     (numerics/continuation.py). Such a curve passes singular points of its system: a fold curve where the branch
-    has a branch point (``fold_curve.fold_crossings``)."""
+    has a branch point (``fold_crossing``)."""
     return replace(continuation_settings(scene, max_points), rounding_limit=scene.solver.max_error)
 
 
