@@ -19,7 +19,7 @@ from balloon_cg.analysis.critical.pitchfork_curve import CurveEnd
 from balloon_cg.analysis.critical.fold_curve import FoldSystem, continue_fold
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.branches.problem import equilibrium_of
-from balloon_cg.analysis.results import Kind, Status
+from balloon_cg.analysis.results import Block, Kind, Status
 from balloon_cg.analysis.critical.second_parameter import second_parameter
 from balloon_cg.io.curve_file import read_curve
 from balloon_cg.scene import Control, load_scene, parse_scene
@@ -109,41 +109,82 @@ def test_gas_fold_curve_against_the_extremum_of_P_lambda3(soft_ln_curve):
     assert np.abs(curve.mode[:, curve.n]).min() > 1e-3
 
 
-def test_the_soft_ln_curve_meets_the_sphere_s_n4_bifurcation():
-    """Why the LN curve below stops near μ3 = 0.0467: along it (μ3(λ) from d(Pλ³)/dλ = 0, ``soft_mu3_on_the_ln_curve``) the sphere's
-    n = 4 bifurcation condition Δ_4 = Φ11² − Φ12² + t(19 Φ11 + 3 Φ12) − 2t² (t = Φ1/λ, docs/sphere_bifurcation.md
-    §7, written out here for Ogden) changes sign at λ* = 3.56181, μ3* = 0.046520. There J_u has the n = 4 mode as
-    a null vector orthogonal to R_P (an n = 0 field), so F_x = [J_u  R_P] loses rank and the fold system is
-    singular (fold_meeting.py's "not covered" case): its condition grows on approach (5e4 at μ3 = 0.06, 5e7 at
-    0.04674), and its Newton corrections stagnate above solver.tol."""
-    mpmath.mp.dps = 30
+def n4_bifurcation_on_the_ln_curve(stretch):
+    """The sphere's n = 4 bifurcation condition Δ_4 = Φ11² − Φ12² + t(19 Φ11 + 3 Φ12) − 2t² (t = Φ1/λ,
+    docs/sphere_bifurcation.md §7, written out here for Ogden) at the soft material's LN fold of stretch λ."""
     mu12, alpha = [mpmath.mpf(3.0), mpmath.mpf(0.0145)], [mpmath.mpf(1.3), mpmath.mpf(4), mpmath.mpf(-2)]
+    mu = mu12 + [soft_mu3_on_the_ln_curve(stretch)]
+    phi1 = sum(m * (stretch ** (a - 1) - stretch ** (-2 * a - 1)) for m, a in zip(mu, alpha))
+    phi11 = sum(m * ((a - 1) * stretch ** (a - 2) + (a + 1) * stretch ** (-2 * a - 2)) for m, a in zip(mu, alpha))
+    phi12 = sum(m * a * stretch ** (-2 * a - 2) for m, a in zip(mu, alpha))
+    t = phi1 / stretch
+    return phi11**2 - phi12**2 + t * (19 * phi11 + 3 * phi12) - 2 * t**2
 
-    def delta4(stretch):
-        mu = mu12 + [soft_mu3_on_the_ln_curve(stretch)]
-        phi1 = sum(m * (stretch ** (a - 1) - stretch ** (-2 * a - 1)) for m, a in zip(mu, alpha))
-        phi11 = sum(m * ((a - 1) * stretch ** (a - 2) + (a + 1) * stretch ** (-2 * a - 2)) for m, a in zip(mu, alpha))
-        phi12 = sum(m * a * stretch ** (-2 * a - 2) for m, a in zip(mu, alpha))
-        t = phi1 / stretch
-        return phi11**2 - phi12**2 + t * (19 * phi11 + 3 * phi12) - 2 * t**2
 
-    assert delta4(mpmath.mpf(3.13)) < 0 < delta4(mpmath.mpf(4.5))
-    crossing = mpmath.findroot(delta4, mpmath.mpf(3.56))
+def test_the_soft_ln_curve_meets_the_sphere_s_n4_bifurcation():
+    """Why the LN curve below stopped near μ3 = 0.0467 (session 24): along it (μ3(λ) from d(Pλ³)/dλ = 0,
+    ``soft_mu3_on_the_ln_curve``) the sphere's n = 4 bifurcation condition Δ_4 (``n4_bifurcation_on_the_ln_curve``)
+    changes sign at λ* = 3.56181, μ3* = 0.046520. There J_u has the n = 4 mode as a null vector orthogonal to R_P
+    (an n = 0 field), so F_x = [J_u  R_P] loses rank and the fold system is singular: its condition grows on
+    approach (5e4 at μ3 = 0.06, 5e7 at 0.04674), and its Newton corrections stagnate above solver.tol."""
+    mpmath.mp.dps = 30
+    assert n4_bifurcation_on_the_ln_curve(mpmath.mpf(3.13)) < 0 < n4_bifurcation_on_the_ln_curve(mpmath.mpf(4.5))
+    crossing = mpmath.findroot(n4_bifurcation_on_the_ln_curve, mpmath.mpf(3.56))
     assert abs(crossing - mpmath.mpf("3.5618137193")) < 1e-9
     assert abs(soft_mu3_on_the_ln_curve(crossing) - mpmath.mpf("0.0465201119")) < 1e-9
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "known defect (sessions 24, 25): the fold system is singular at λ* = 3.5618, μ3* = 0.046520, where the sphere's "
-    "n = 4 bifurcation meets the LN fold (test_the_soft_ln_curve_meets_the_sphere_s_n4_bifurcation); on approach "
-    "its Newton corrections stagnate above solver.tol (condition ~5e7 at μ3 = 0.04674) and the curve stops at the "
-    "minimum step. Accepting corrections at the rounding floor (newton's rounding_limit) does not pass it: the "
-    "floor grows without bound toward λ*; crossing needs a step over the codim-2 point"))
 def test_gas_fold_curve_reaches_below_mu3_0_03(soft_ln_curve):
     """The same LN fold curve followed in μ3 goes on down to μ3 < 0.03 in 30 points (the closed form μ3(λ) falls
-    smoothly, 0.0468 at λ = 3.55, 0.0314 at λ = 4.5, through the singular point of the fold system above)."""
+    smoothly, 0.0468 at λ = 3.55, 0.0314 at λ = 4.5) past the singular point of the fold system above: its
+    corrector is ILL_CONDITIONED there and the trace steps across it (numerics/continuation.py; opted in by
+    analysis/critical's curve_settings) instead of halving its step to the minimum (session 24's defect: the
+    curve stopped at μ3 ≈ 0.0467 after ~25 points). Every point, on both sides, is on the closed form
+    (test_gas_fold_curve_against_the_extremum_of_P_lambda3)."""
     _, curve = soft_ln_curve
-    assert len(curve.pole_stretch) == 30 and curve.q.min() < 0.03
+    lams = curve.pole_stretch
+    assert len(lams) == 30 and curve.q.min() < 0.03
+    assert lams.min() < 3.5618137193 - 0.01 and lams.max() > 3.5618137193 + 0.3
+
+
+def test_the_ln_curve_s_crossing_of_the_n4_bifurcation_is_a_special_point(soft_ln_curve, tmp_path, capsys):
+    """The crossing above is the curve's one meeting: LN-BP, block even, between the two curve points that bracket
+    λ* (fold_crossing.py). It is APPROXIMATE (the fold system's corrector fails within ~1e-3 of it): the closed
+    form's λ* lies within its bracket, |λ − λ*| ≤ 2·uncertainty (the half-width in λ2(0) and P; measured: 1.3e-3
+    from λ*, ±1.3e-3; the bound 5e-3 leaves the corrector's failure zone room to double on another BLAS build,
+    under an eighth of the bracketing curve points' 0.038), and the stored point is on the LN curve's closed form
+    μ3(λ) to 1e-9. Stored in the curve
+    file as a special point of kind LN-BP, shown by ``inspect`` and in the curve's description."""
+    from balloon_cg.io.curve_file import curve_meetings, write_curve
+
+    mpmath.mp.dps = 30
+    scene, curve = soft_ln_curve
+    lam_star = float(mpmath.findroot(n4_bifurcation_on_the_ln_curve, mpmath.mpf(3.56)))
+    [crossing] = curve.meetings
+    assert (crossing.kind, crossing.block, crossing.status) == (Kind.LN_BP, Block.EVEN, Status.APPROXIMATE)
+    lams = curve.pole_stretch
+    assert lams[crossing.index] < lam_star < lams[crossing.index + 1]
+    lam_c, mu3_c = float(curve.pole_values(crossing.X)["lam2_top"][0]), float(crossing.X[-1])
+    assert abs(lam_c - lam_star) <= 2 * crossing.uncertainty and crossing.uncertainty < 5e-3
+    assert abs(mu3_c - float(soft_mu3_on_the_ln_curve(mpmath.mpf(lam_c)))) < 1e-9
+    assert f"the LN fold meets a branch point at mu[2] = {mu3_c:.10g}" in curve.describe()
+    out = write_curve(tmp_path / "ln.h5", scene, curve, name="LN")
+    [stored] = curve_meetings(read_curve(out, "LN"))
+    assert stored["kind"] == "LN-BP" and stored["q"] == mu3_c and stored["status"] == "approximate"
+    assert main(["inspect", str(out)]) == 0
+    assert f"LN-BP meeting        mu[2] = {mu3_c:.12g}" in capsys.readouterr().out
+
+
+def test_only_two_parameter_curves_accept_the_rounding_floor():
+    """The rounding rule and the step across (numerics/continuation.py) are opted in by analysis/critical's curves
+    alone (rounding_limit = solver.max_error); every one-parameter trace keeps 0 (the rule off: main's code path)."""
+    from balloon_cg.analysis.branches.problem import continuation_settings
+    from balloon_cg.analysis.critical.pitchfork_curve import curve_settings
+
+    scene = parse_scene(SOFT, "soft")
+    assert continuation_settings(scene).rounding_limit == 0.0
+    assert curve_settings(scene, 30).rounding_limit == scene.solver.max_error > 0
+    assert curve_settings(scene, 30).max_points == 30
 
 
 def test_pressure_fold_in_alpha1_uses_runtime_exponents():

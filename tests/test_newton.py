@@ -152,13 +152,14 @@ def test_ill_conditioned_system_ends_at_the_rounding_floor():
     assert failed.outcome == Convergence.FAILED and not failed.converged
 
 
-def test_rounding_limit_below_the_attained_accuracy_is_failure():
-    """The caller's limit decides: a stagnation above ``rounding_limit`` is not accepted."""
+def test_rounding_limit_below_the_attained_accuracy_is_ill_conditioned():
+    """The caller's limit decides: a stagnation above ``rounding_limit`` is ILL_CONDITIONED, not a solution."""
     residual, jacobian, A, b, exact = ill_conditioned(1e8)
     accepted = newton(residual, jacobian, exact * (1 + 1e-3), A[-1:], b[-1:], 1e-14, 60, rounding_limit=1e-3)
     limited = newton(residual, jacobian, exact * (1 + 1e-3), A[-1:], b[-1:], 1e-14, 60,
                      rounding_limit=accepted.step / 10)
-    assert limited.outcome == Convergence.FAILED
+    assert limited.outcome == Convergence.ILL_CONDITIONED and not limited.converged
+    assert limited.step > accepted.step / 10 and "rounding floor" in limited.message
 
 
 def test_rounding_floor_is_epsilon_times_the_scaled_condition():

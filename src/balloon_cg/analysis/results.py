@@ -27,8 +27,8 @@ class Kind(enum.StrEnum):
     BP = "BP"  # branch point (a block of the second variation is singular)
     EP = "EP"  # end point of a branch (``stop`` says why)
     UZ = "UZ"  # user point
-    # codim-2 points of a curve of pitchforks where the symmetric branch has a fold (``fold_meeting``): the
-    # pitchfork meets the LP, LV or LN curve
+    # codim-2 points where a fold meets a branch point: on a curve of pitchforks where the symmetric branch has a
+    # fold (``fold_meeting``), on a fold curve where the branch has a branch point (``fold_crossing``)
     LP_BP = "LP-BP"
     LV_BP = "LV-BP"
     LN_BP = "LN-BP"

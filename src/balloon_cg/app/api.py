@@ -429,7 +429,7 @@ def continue_from(path, label: int, parameter: str | None = None, direction: flo
         Result of the point's branch as read, not assessed, and of them, assessed: ``pear_<n>`` and
         ``pear_<n>_mirror`` at a pear point, ``m<m>_bp<k>`` and its other direction at a held m ≥ 1 point);
         from a fold (LP, LV, LN) or a pear pitchfork (held or free) in ``parameter``, the two-parameter curve
-        (``end``, ``critical``, ``meetings``: where a fold meets a pitchfork, ``q``, ``pressure``).
+        (``end``, ``critical``, ``meetings``: where a fold meets a pitchfork or branch point, ``q``, ``pressure``).
 
     Raises
     ------

@@ -14,7 +14,8 @@ Layout::
                                                    fold's tangent w = (v, μ) in the unknowns' layout (LP, LV, LN)
         special_points/ the run file's special-point columns (kind LP: the folds in q; status located only for
                         the verified merge of the two pitchforks or the verified cusp; kinds LP-BP, LV-BP, LN-BP:
-                        the meetings of a fold and the pitchfork, analysis.critical.fold_meeting), and <parameter>;
+                        the meetings of a fold and the pitchfork, analysis.critical.fold_meeting, or on a fold
+                        curve the branch points it crosses, analysis.critical.fold_crossing), and <parameter>;
                         state/unknowns in the branch layout (u, P)
 
 ``of`` is what the curve follows: BP (pear pitchforks, group ``pear``; files without it), LP, LV or LN (a fold of
@@ -141,12 +142,12 @@ def parameter_column(group) -> str:
     return name if name in group and name not in CURVE_COLUMNS and name != "special_points" else "q"
 
 
-MEETING_KINDS = (Kind.LP_BP, Kind.LV_BP, Kind.LN_BP)  # the meetings of a fold and the pitchfork
+MEETING_KINDS = (Kind.LP_BP, Kind.LV_BP, Kind.LN_BP)  # the meetings of a fold and a pitchfork or branch point
 
 
 def curve_meetings(curve: dict) -> list[dict]:
-    """The meetings of a fold and the pitchfork on a stored curve (``read_curve``): kind, q, pressure, north
-    pole stretch, status and uncertainty each."""
+    """The meetings of a fold and a pitchfork or branch point on a stored curve (``read_curve``): kind, q,
+    pressure, north pole stretch, status and uncertainty each."""
     return [{"kind": s["kind"], "q": float(q), "pressure": s["pressure"], "lam2_top": s["lam2_top"],
              "status": s["status"], "uncertainty": s["uncertainty"]}
             for s, q in zip(curve["special_points"], curve["special_q"]) if s["kind"] in MEETING_KINDS]

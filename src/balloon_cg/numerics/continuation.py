@@ -4,7 +4,12 @@ Knows nothing about balloons: a *system* has ``residual(X)`` and ``jacobian(X)``
 with unit tangent τ (J τ = 0), the predictor is X + σ τ and the corrector solves R = 0 with τ·(X − X_pred) = 0
 (Keller). Steps grow after easy corrections and shrink on failure, on a sharp turn (τ_i·τ_{i+1} small) or
 on a slow correction (linear Newton convergence means a nearly singular Jacobian: landing close to a branch
-point, where the corrector may pick the crossing branch).
+point, where the corrector may pick the crossing branch). With ``Settings.rounding_limit`` > 0 (opt-in; 0, the
+default, turns both off) a corrector that stagnates at its rounding floor is accepted up to that limit (newton's
+AT_ROUNDING), and one that stagnates above it (ILL_CONDITIONED: the system is nearly singular there, e.g. at a
+codim-2 point of an extended system) doubles the step instead of halving it, on every failure until a point is
+accepted or the step would move the state more than step_max: shorter steps would land nearer the singular point,
+a longer one lands past it.
 ``step_max`` bounds the change of the state X[:-1] in one step, not of the parameter X[-1]: where the branch
 is steep in the parameter (a stiff material's pressure grows like λ^(α−1)) the arclength may grow until the
 state moves step_max, instead of crawling at a fixed arclength that the parameter alone uses up.
@@ -18,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg.lapack import dgetrs
 
-from .newton import newton
+from .newton import Convergence, newton
 from .roots import brent
 
 
@@ -36,7 +41,7 @@ class Settings:
     max_newton: int
     max_turn: float = 0.3  # radians between successive tangents
     slow_newton: int = 6  # a correction needing more iterations is rejected (near-singular: e.g. a branch point)
-    rounding_limit: float = 0.0  # a correction at its rounding floor above tol is accepted up to this (newton)
+    rounding_limit: float = 0.0  # > 0: accept a corrector at its rounding floor up to this, step across above it
 
 
 class TraceStop(enum.StrEnum):
@@ -225,7 +230,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
     callable(point).
     """
     path = Path(points=[start])
-    sigma = settings.step
+    sigma, across = settings.step, None  # across: the step that met ILL_CONDITIONED, while doubling
     current = start
     rates = {label: rate(c, start.X, start.tangent) for label, c in monitors.items()}  # at ``current``
     while len(path.points) < settings.max_points:
@@ -237,7 +242,16 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
                 new_tangent = tangent(system, result.x, current.tangent, result.factors)
             except np.linalg.LinAlgError:
                 new_tangent = None
-        if new_tangent is None or float(new_tangent @ current.tangent) < np.cos(settings.max_turn):
+        failed = new_tangent is None or float(new_tangent @ current.tangent) < np.cos(settings.max_turn)
+        if failed and across is None and result.outcome == Convergence.ILL_CONDITIONED:
+            across = sigma  # a singular point ahead: shorter steps land nearer to it, longer ones past it
+        cap = settings.step_max / max(float(np.linalg.norm(current.tangent[:-1])), 1e-6)
+        if failed and across is not None and sigma * 2.0 <= cap:
+            sigma *= 2.0
+            continue
+        if failed and across is not None:
+            sigma, across = across, None  # no step across within step_max: back to halving
+        if failed:
             sigma *= 0.5
             if sigma < settings.step_min:
                 path.stop = Stop(TraceStop.STEP_MIN,
@@ -261,7 +275,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         path.points.append(point)
         if progress is not None:
             progress(point)
-        current, rates = point, new_rates
+        current, rates, across = point, new_rates, None
         if result.iterations <= 3:
             state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
             sigma = min(sigma * 1.5, settings.step_max / state_share)

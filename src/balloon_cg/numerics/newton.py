@@ -20,8 +20,9 @@ the corrections of an iterate at the solution are A⁻¹δR: in the scaled norm 
 tolerance the corrections stop contracting short of it, and converge or not by the luck of the rounding. A
 correction from a fresh Jacobian at least as large as the last one (no contraction at all: even at a singular
 root Newton contracts by ½) and below ε·κ∞(A D) (dgecon's estimate, computed only then) therefore ends the solve
-as ``Convergence.AT_ROUNDING`` if the caller accepts that accuracy (``rounding_limit``; default 0: never): the
-iterate is returned with that correction as its attained accuracy (``step``, above tol), never as CONVERGED.
+as ``Convergence.AT_ROUNDING`` if the caller accepts that accuracy (``rounding_limit``; default 0: the rule is
+off), as ``ILL_CONDITIONED`` (not a solution) above it: the iterate is returned with that correction as its
+attained accuracy (``step``, above tol), never as CONVERGED.
 """
 import enum
 import math
@@ -50,6 +51,7 @@ class Convergence(enum.StrEnum):
 
     CONVERGED = "converged"  # the correction and its error estimate below tol
     AT_ROUNDING = "at_rounding"  # corrections stopped contracting below ε·κ∞(A D), above tol (module docstring)
+    ILL_CONDITIONED = "ill_conditioned"  # the same above the caller's rounding_limit: a nearly singular system
     FAILED = "failed"  # no solution: ``message`` says why
 
 
@@ -67,7 +69,7 @@ class NewtonResult:
     @property
     def converged(self) -> bool:
         """Whether x solves the system: to tol (CONVERGED) or to the attainable accuracy ``step`` (AT_ROUNDING)."""
-        return self.outcome != Convergence.FAILED
+        return self.outcome in (Convergence.CONVERGED, Convergence.AT_ROUNDING)
 
 
 def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
@@ -121,12 +123,14 @@ def newton(residual, jacobian, x0, rows, targets, tol: float, max_iter: int,
         if ratio is not None and ratio > refresh_ratio and not fresh:
             factors = None  # a stale Jacobian contracts too slowly: drop its step, redo it with a fresh one here
             continue
-        if fresh and ratio is not None and ratio >= 1.0 and tol < step <= rounding_limit:
+        if rounding_limit > 0 and fresh and ratio is not None and ratio >= 1.0 and step > tol:
             floor = rounding_floor(factors[0], x)
             if step <= floor < math.inf:  # a singular A (floor inf) attains nothing
-                return NewtonResult(x, Convergence.AT_ROUNDING, iteration, max_abs(r), step,
+                outcome = Convergence.AT_ROUNDING if step <= rounding_limit else Convergence.ILL_CONDITIONED
+                return NewtonResult(x, outcome, iteration, max_abs(r), step,
                                     f"at the rounding floor: corrections stopped contracting at {step:.2g} (tol "
-                                    f"{tol:g}, ε·κ∞(A D) = {floor:.2g})", jacobians, factors)
+                                    f"{tol:g}, limit {rounding_limit:g}, ε·κ∞(A D) = {floor:.2g})", jacobians,
+                                    factors)
         fresh = False
         x = x + dx
         r = None

@@ -1293,7 +1293,7 @@ def plot_phase(paths, axes=None) -> Figure:
                         label=f"{'critical' if of == 'BP' else 'cusp'} {curve['attrs']['parameter']} = {critical:.6g}")
             elif of != "BP":
                 open_folds.setdefault(of, []).append((q, P))  # one parameter: checked below
-            for meeting in curve_meetings(curve):  # a fold curve crosses this pitchfork curve
+            for meeting in curve_meetings(curve):  # a fold curve crosses this pitchfork curve, or a branch point
                 ax.plot(meeting["q"], meeting["pressure"], "D", color=line.get_color(), markerfacecolor="none",
                         label=f"{meeting['kind']} {curve['attrs']['parameter']} = {meeting['q']:.6g}")
     for of, folds in open_folds.items():

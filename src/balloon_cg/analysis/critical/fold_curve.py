@@ -26,6 +26,10 @@ is the branch with c as its parameter, ψ the left null vector of ∂F̃/∂x no
 end of the snap-through region; the curve then comes back in q along the partner fold. The curve's ``end`` is
 ``CurveEnd.CUSP`` (its ``critical`` value q of the cusp) only when a fold in q at P > 0 has the coefficient of
 opposite signs at the curve points bracketing it; another fold in q is FOLD (not verified).
+
+Where the curve passes a branch point of the branch (F_x loses rank: the fold system is singular there, and the
+trace steps across it, ``pitchfork_curve.curve_settings``) the crossing is bracketed and stored with the curve's
+``meetings`` (``fold_crossing``: LP-BP, LV-BP, LN-BP).
 """
 import time
 from dataclasses import dataclass
@@ -36,11 +40,12 @@ from ...galerkin.equilibrium import Equilibrium
 from ...numerics import continuation
 from ...scene import Control
 from ..points.extended_systems import _parameter_step, _step
-from .pitchfork_curve import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status, plain_branch,
-                     trace_in_q)
+from .pitchfork_curve import (CurveEnd, TwoParameterCurve, TwoParameterError, _END_OF_STOP, _merge_status,
+                              curve_settings, plain_branch, trace_in_q)
 from ..branches.control import FOLD_KIND, control_gradient_at
-from ..branches.problem import continuation_settings, equilibrium_of
+from ..branches.problem import equilibrium_of
 from ..results import Branch, Kind, SpecialPoint, StopCode
+from .fold_crossing import fold_crossings
 from .second_parameter import Derivative, SecondParameter, second_parameter
 from ...numerics.threads import limited_blas
 
@@ -182,7 +187,7 @@ def continue_fold(branch: Branch, fold: SpecialPoint, parameter: str | SecondPar
     w = fold_tangent(eq, X, control, params)
     system = FoldSystem(eq, params, parameter, control, w)
     X0 = np.concatenate([X, w, [q0]])
-    settings = settings or continuation_settings(branch.scene, max_points)
+    settings = settings or curve_settings(branch.scene, max_points)
     path = trace_in_q(system, X0, f"the {fold.kind.value}", branch, parameter, q0, direction, settings, stop,
                       progress)
     end = _classify(system, path)
@@ -190,10 +195,11 @@ def continue_fold(branch: Branch, fold: SpecialPoint, parameter: str | SecondPar
     verdict = ": a cusp, the two folds merge" if end == CurveEnd.CUSP else " (not a verified cusp)"
     merges = [SpecialPoint(Kind.LP, f.index, f.point.X, **_merge_status(f, path, branch.disc, end, "a cusp"),
                            note=f"fold of the {fold.kind.value} curve in {name}{verdict}") for f in path.folds]
+    crossings = fold_crossings(system, path.points, branch.disc, settings)
     return FoldCurve(parameter, branch.scene, branch.disc, params, w, np.array([p.X for p in path.points]),
                      np.array([p.iterations for p in path.points]), np.array([p.residual for p in path.points]),
                      merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction),
-                     control=control)
+                     meetings=crossings, control=control)
 
 
 def _classify(system: FoldSystem, path) -> CurveEnd:

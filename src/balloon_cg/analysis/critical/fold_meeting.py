@@ -16,7 +16,8 @@ normal to the curve's tangent at the first point: LOCATED, or APPROXIMATE with t
 root search fell back. Pitchfork and fold are then both at that (q, P) (tests/test_fold_meeting.py: the fold
 and the pitchfork located on a primary branch traced at that q). Not covered: a point where F_x itself loses rank
 (an even-block branch point of the symmetric branch on the curve: codim 2 for an n × (n + 1) matrix, so met along
-a curve only through a symmetry, as on the sphere); τ would turn over there and every g_c change sign.
+a curve only through a symmetry, as on the sphere); τ would turn over there and every g_c change sign. Such a point
+is found from the fold curve's side instead (``fold_crossing``).
 """
 from dataclasses import dataclass
 

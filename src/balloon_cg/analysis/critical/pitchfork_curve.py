@@ -77,7 +77,7 @@ from ..points.branch_points import padded_mode, plain_degree
 from ..points.extended_systems import H_STEP, WernerSpence
 from .fold_meeting import fold_meetings
 from ..branches.problem import continuation_settings, equilibrium_of
-from ..results import Block, Branch, Kind, SpecialPoint, StopCode, approximate, located_or_bracketed
+from ..results import Block, Branch, Kind, SpecialPoint, Status, StopCode, approximate, located_or_bracketed
 from .second_parameter import Derivative, SecondParameter, alpha1_material, second_parameter
 from ..stability.axisymmetric import SecondVariation, block_indices
 from ..branches.wires import wire_gap
@@ -180,7 +180,8 @@ class TwoParameterCurve:
     q0: float = np.nan  # the start value of q
     direction: float = 1.0  # +1: q increased from q0, −1: decreased
     block: Block = Block.ODD_HELD  # the pear block: odd_held, or odd_free (the free balloon's pitchforks)
-    meetings: list = field(default_factory=list)  # codim-2 points LP-BP, LV-BP, LN-BP (``fold_meeting``)
+    meetings: list = field(default_factory=list)  # codim-2 points LP-BP, LV-BP, LN-BP (``fold_meeting``,
+    #                                                 on a fold curve ``fold_crossing``)
 
     @property
     def n(self) -> int:
@@ -258,9 +259,12 @@ class TwoParameterCurve:
         return self._ending() + self.describe_meetings()
 
     def describe_meetings(self) -> str:
-        """'; the LN fold meets the pitchfork at q = … (P = …, located)' per meeting, or ''."""
-        return "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets the pitchfork at {self.parameter} = "
-                       f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value})" for m in self.meetings)
+        """'; the LN fold meets the pitchfork at q = … (P = …, located)' per meeting (on a fold curve: 'meets a
+        branch point', ``fold_crossing``; an approximate one with its ±uncertainty), or ''."""
+        met = "the pitchfork" if self.of == Kind.BP else "a branch point"
+        return "".join(f"; the {m.kind.value.removesuffix('-BP')} fold meets {met} at {self.parameter} = "
+                       f"{m.X[-1]:.10g} (P = {m.X[self.n]:.10g}, {m.status.value}"
+                       + (f" ±{m.uncertainty:.1g})" if m.status != Status.LOCATED else ")") for m in self.meetings)
 
     def _ending(self) -> str:
         """``describe`` without the meetings."""
@@ -324,7 +328,7 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
     system = ExtendedSystem(eq, params, parameter, ell, bp.block)
     X0 = system.initial(bp, q0)
     if settings is None:
-        settings = continuation_settings(scene, max_points)
+        settings = curve_settings(scene, max_points)
     path = trace_in_q(system, X0, "the branch point", branch, parameter, q0, direction, settings, stop, progress)
     end = _classify(path, branch.disc.size)
     name = parameter.name
@@ -338,6 +342,15 @@ def continue_branch_point(branch: Branch, bp: SpecialPoint, parameter: str | Sec
                              np.array([p.iterations for p in points]), np.array([p.residual for p in points]),
                              merges, path.stop, time.perf_counter() - t0, end, float(q0), float(direction), bp.block,
                              meetings)
+
+
+def curve_settings(scene, max_points: int) -> continuation.Settings:
+    """The scene's continuation settings (``continuation_settings``) for a curve of an extended system, which opts
+    in to what no one-parameter trace does: a corrector at its rounding floor is accepted up to solver.max_error
+    (newton's AT_ROUNDING), and one above it (ILL_CONDITIONED) makes the trace step across instead of halving
+    (numerics/continuation.py). Such a curve passes singular points of its system: a fold curve where the branch
+    has a branch point (``fold_crossing``)."""
+    return replace(continuation_settings(scene, max_points), rounding_limit=scene.solver.max_error)
 
 
 def plain_branch(branch: Branch, X) -> Branch:
