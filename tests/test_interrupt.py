@@ -190,10 +190,13 @@ def test_a_stop_while_a_point_s_blocks_are_built_comes_before_their_eigenvalues(
     assert len(inside) == 1 and True not in solved  # the point's blocks built, none solved after the request
 
 
+@pytest.mark.parametrize("dropped", [False, True])
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
-def test_a_signal_while_continue_reads_its_file_stops_the_read_at_once(tmp_path, monkeypatch, capsys, sig):
+def test_a_signal_while_continue_reads_its_file_stops_the_read_at_once(tmp_path, monkeypatch, capsys, sig, dropped):
     """`continue` reads its run file before any work (seconds of CPU for a file with surface branches): a signal
-    then ends the read at once, not after it (the next branch is not read), exit 130, nothing written."""
+    then ends the read at once, not after it (the next branch is not read), exit 130, nothing written. Where its
+    KeyboardInterrupt is raised in a callback that drops it (``dropped``: a ``__del__`` of h5py's, say), the flag it
+    set still stops the command once the read ends (CI saw that signal lost, the work done, exit 0)."""
     from balloon_cg.app.cli import main
     from balloon_cg.io import run_file
 
@@ -205,12 +208,16 @@ def test_a_signal_while_continue_reads_its_file_stops_the_read_at_once(tmp_path,
     def signalled(*args, **kwargs):
         checked.append(args)
         if len(checked) == 1:
-            signal.raise_signal(sig)
+            try:
+                signal.raise_signal(sig)
+            except KeyboardInterrupt:
+                if not dropped:
+                    raise
         return check_branch(*args, **kwargs)
 
     monkeypatch.setattr(run_file, "check_branch", signalled)
     capsys.readouterr()
     assert main(["continue", str(run), "1", "-o", str(tmp_path / "c.h5"), "--quiet"]) == 130
-    assert len(checked) == 1 and not (tmp_path / "c.h5").exists()
+    assert (len(checked) > 1) == dropped and not (tmp_path / "c.h5").exists()
     assert capsys.readouterr().err.strip() == (f"balloon-cg: interrupted: nothing is written to {tmp_path / 'c.h5'} "
                                                "(the work had not started)")

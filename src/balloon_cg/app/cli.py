@@ -1011,7 +1011,10 @@ def _continue(args) -> int:
     try:  # reading has nothing to keep: a signal stops it at once (a file with surface branches takes seconds)
         with sigterm_raises():
             stored = read_run(args.run)
+            came = requested()  # one whose KeyboardInterrupt was raised and dropped in a callback (a __del__) set it
     except KeyboardInterrupt:
+        came = True
+    if came:
         return curve_interrupted_status(None, args.output, True, "the work had not started")
     with stop_on_signals():  # as run: a signal stops the work at its next point, what is finished is written
         try:
