@@ -53,7 +53,11 @@ def spectra(basis: TubeSurfaceBasis, c: np.ndarray) -> tuple:
 
 def tails(basis: TubeSurfaceBasis, c: np.ndarray) -> tuple:
     """(the degree tail, the order tail) of c (module docstring)."""
-    by_degree, by_order = spectra(basis, c)
+    return _tails(basis, *spectra(basis, c))
+
+
+def _tails(basis: TubeSurfaceBasis, by_degree: np.ndarray, by_order: np.ndarray) -> tuple:
+    """(the degree tail, the order tail) of a state's ``spectra``."""
     return geometric_tail(by_degree), (float(by_order[-1]) if len(basis.orders) > 1 else 0.0)
 
 
@@ -72,8 +76,8 @@ def refined(basis: TubeSurfaceBasis, c: np.ndarray, m: int, max_error: float) ->
     degree and the number of multiples of m extended as far as the geometric decay fitted to the last coefficients
     (analysis/surface/resolution.increment) predicts is needed for a tail of max_error/4; ``basis`` itself when both
     tails are below max_error; None when the degree would pass MAX_DEGREE or the multiples MAX_HARMONICS."""
-    degree_tail, order_tail = tails(basis, c)
     by_degree, by_order = spectra(basis, c)
+    degree_tail, order_tail = _tails(basis, by_degree, by_order)
     degree, k = basis.disc.degree, len(basis.orders) - 1
     if degree_tail > max_error:
         degree += increment(by_degree, max_error / 4, DEGREE_STEP, 4 * DEGREE_STEP)
