@@ -245,11 +245,11 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         failed = new_tangent is None or float(new_tangent @ current.tangent) < np.cos(settings.max_turn)
         if failed and across is None and result.outcome == Convergence.ILL_CONDITIONED:
             across = sigma  # a singular point ahead: shorter steps land nearer to it, longer ones past it
-        cap = settings.step_max / max(float(np.linalg.norm(current.tangent[:-1])), 1e-6)
-        if failed and across is not None and sigma * 2.0 <= cap:
-            sigma *= 2.0
-            continue
         if failed and across is not None:
+            cap = settings.step_max / max(float(np.linalg.norm(current.tangent[:-1])), 1e-6)
+            if sigma * 2.0 <= cap:
+                sigma *= 2.0
+                continue
             sigma, across = across, None  # no step across within step_max: back to halving
         if failed:
             sigma *= 0.5
