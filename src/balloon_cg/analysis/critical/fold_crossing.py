@@ -68,20 +68,13 @@ def _bracket(system, start, low: tuple, high: tuple, settings: continuation.Sett
     docstring); ``narrowed``: the bracket reached XTOL."""
     def value_at(s):
         result = continuation.correct(system, start.X + s * start.tangent, start.tangent, settings)
-        if not result.converged:
-            raise ArithmeticError(result.message)
-        return s, crossing_test(system, result.x), result.x
+        return (s, crossing_test(system, result.x), result.x) if result.converged else None
 
     xtol = XTOL * max(1.0, high[0])
     while high[0] - low[0] > xtol:
         width = high[0] - low[0]
-        for fraction in (0.5, 0.25, 0.75):
-            try:
-                middle = value_at(low[0] + fraction * width)
-                break
-            except ArithmeticError:
-                continue
-        else:
+        middle = next(filter(None, (value_at(low[0] + fraction * width) for fraction in (0.5, 0.25, 0.75))), None)
+        if middle is None:
             return low, high, False
         if middle[1] * low[1] > 0:
             low = middle
