@@ -3,17 +3,19 @@
 About an axisymmetric state the second variation commutes with the rotations about the coil axis, so in the
 azimuthal families of a sector (``families``: z of order k, and the pairs (x, y) of order k ± 1 combined as
 x cos ± y sin, the cos kφ family of surface.stability.azimuthal_family and its sin twin) it is block-diagonal: D,
-~M + 2 blocks of ~3L/2 rows. The m = 1 branch's states leave the axisymmetric one, and H = D + E with E the
+M + 2 blocks of up to ~3L/2 rows. The m = 1 branch's states leave the axisymmetric one, and H = D + E with E the
 coupling between families. The branch of scenes/spom1_two_coils_M0.002.toml is traced (its stability not read), and
 at the points ``POINTS`` (early, middle, last: the last 0.114 from the wires) each symmetry sector is studied:
 
 (a) the spectrum of (D − σI)⁻¹(H − σI) on the constraint space, σ the shift today's reading factors at (below the
-    lowest μ): its extreme eigenvalues and condition against that of H − σI alone, and ‖E‖/‖H‖;
-(b) the ``COUNT`` lowest μ of every reading by LOBPCG (scipy.sparse.linalg.lobpcg, the zero modes and gᵀc = 0 as
-    its constraints, the gas term a rank-one product) with (D − σI)⁻¹ as preconditioner, started from D's lowest
-    eigenvectors, on dense products with H: the largest deviation from today's values (``sector_spectra``
-    following the previous point's, as the assessment reads) relative to max(1, |μ|), its iterations, and its CPU
-    against today's read of the sector beyond the assembly (the Cholesky of A − σI and the Lanczos runs);
+    lowest μ by δ): its condition against that of H − σI alone, and ‖E‖/‖H − σI‖; the coupling's decay with the
+    distance between families (``coupling``: the band of families that would prove σ, or keep the values within
+    1e-10, and what that band's Cholesky would cost);
+(b) the ``COUNT`` lowest μ of every reading (the zero modes and gᵀc = 0 as constraints, the gas term a rank-one
+    term) with (D − σI)⁻¹ as preconditioner, started from D's lowest eigenvectors, on dense products with H, by
+    scipy's LOBPCG and by block Davidson (``davidson``): the largest deviation from today's values
+    (``sector_spectra`` following the previous point's, as the assessment reads) relative to max(1, |μ|), the
+    iterations, and the CPU against today's read of the sector by parts (``Phases``);
 (c) the CPU of assembling H (``SurfaceEquilibrium.hessian`` on the sector) against assembling only D (each family's
     blocks as their own basis on the same nodes: the same contraction restricted to D's block pairs), and of one
     matrix-free product ``SurfaceEquilibrium.hessian_product`` against a dense one.
@@ -43,7 +45,7 @@ from balloon_cg.numerics.threads import blas_threads  # noqa: E402
 from balloon_cg.scene import load_scene  # noqa: E402
 from balloon_cg.scene.loading import Control  # noqa: E402
 from balloon_cg.surface import stability  # noqa: E402
-from balloon_cg.surface.basis import COS, SIN, _blocks  # noqa: E402
+from balloon_cg.surface.basis import COS, SIN  # noqa: E402
 from balloon_cg.surface.equilibrium import SurfaceEquilibrium  # noqa: E402
 
 POINTS = (2, 8, 13)
