@@ -12,7 +12,7 @@ import pytest
 
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation
-from balloon_cg.numerics.eigen import GramFactor, restricted
+from balloon_cg.numerics.eigen import NO_CONSTRAINT, GramFactor, restricted
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.primary import scene_parameters
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
@@ -103,3 +103,79 @@ def test_axisymmetric_in_a_field_it_is_the_interval_discretisation(case, ends):
         assert np.max(np.abs(H[axis, basis.block(m)])) <= 1e-12 * np.max(np.abs(H))
         assert close(H[basis.block(m), basis.block(m)], azimuthal.hessian(eq, u, params, m)), m
     assert np.max(np.abs(H[basis.block(1), basis.block(2)])) <= 1e-12 * np.max(np.abs(H))
+
+
+@pytest.fixture(scope="module")
+def m2_zero():
+    """(scene, the primary branch, its first located m = 2 zero above P = 0.5) of SPOM1's coil scene at M = 0.03
+    (degree 20; the zeros near P = 0 are the hoop-slack reference state's)."""
+    from pathlib import Path
+
+    from balloon_cg.scene import load_scene
+    from balloon_cg.tube.azimuthal_crossings import crossings
+    from balloon_cg.tube.primary import primary_branch
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10_coil.toml").with_overrides(
+        {"field.M": 0.03, "solver.degree": 20, "stability.m_max": 2, "continuation.stop_stretch": 5.0,
+         "continuation.max_points": 300})
+    branch = primary_branch(scene)
+    eq = Equilibrium(scene, branch.disc)
+    modes = azimuthal.branch_modes(eq, np.column_stack([branch.states, branch.pressure]), branch.params, 2)
+    found = [c for c in crossings(scene, branch, modes) if c.m == 2 and c.pressure > 0.5]
+    assert found, "no located m = 2 zero"
+    return scene, branch, found[0]
+
+
+def test_an_m2_zero_is_switched_to_an_equilibrium_of_the_written_energy(m2_zero):
+    """At the located m = 2 zero the lowest eigenvalue of the surface Hessian's order-2 block (orders 0, 2, 4: the
+    branch's dihedral sector, tube/surface/switching.py) on the Gram matrix is 0 (1e-9 of the block's scale), of
+    opposite signs at the branch's points on either side; the switched point at ε = 0.05 (and ±0.025, 0.0125)
+    converges (residual ≤ 1e-12 of P ∂Ṽ/∂c), its amplitude is ε, no gauge in the field; it is stationary for the
+    energy written here (field included: central differences along 8 random directions ≤ 1e-9 of P ∂Ṽ/∂c, the
+    predictor's ≥ 1e-6); a pitchfork: P(−ε) = P(ε) (the rotation by π/2 maps c_2 to −c_2; 1e-12) and (P − P_0)/ε²
+    converging as ε² (ratio of successive changes 4 ± 0.3)."""
+    from balloon_cg.tube.surface.switching import switched_point
+
+    scene, branch, zero = m2_zero
+    disc = branch.disc
+    basis = TubeSurfaceBasis(disc, (0, 2, 4))
+    surface = TubeSurfaceEquilibrium(scene, basis)
+    factor = GramFactor(azimuthal.operators(disc)[1])
+
+    def lowest(u, P):
+        block = surface.hessian(basis.axisymmetric(u), branch.params.with_value("P", P))[basis.block(2), basis.block(2)]
+        A = restricted(block, factor, NO_CONSTRAINT)
+        return np.linalg.eigvalsh(A)[0], np.max(np.abs(A))
+
+    value, scale = lowest(zero.u, zero.pressure)
+    assert abs(value) <= 1e-9 * scale, (value, scale)
+    before = lowest(branch.states[zero.index], branch.pressure[zero.index])[0]
+    after = lowest(branch.states[zero.index + 1], branch.pressure[zero.index + 1])[0]
+    assert before * after < 0, (before, after)
+
+    points = {eps: switched_point(scene, disc, zero, eps, branch.params) for eps in (0.05, 0.025, -0.025, 0.0125)}
+    start = basis.with_mode(basis.axisymmetric(zero.u), 2, 0.05 * zero.mode)
+    pressure_scale = zero.pressure * np.max(np.abs(surface.parameter_derivative(start, branch.params)))
+    gram = azimuthal.operators(disc)[1]
+    for eps, point in points.items():
+        assert point.converged and point.basis.orders == (0, 2, 4), (eps, point.message)
+        assert point.residual <= 1e-12 * pressure_scale, (eps, point.residual)
+        assert abs(zero.mode @ gram @ point.c[basis.block(2)] - eps) <= 1e-12 and point.reaction == 0.0
+    h = 1e-6
+    directions = np.zeros((8, basis.size))
+    directions[:, basis.free] = np.random.default_rng(2).standard_normal((8, basis.free.size))
+    steps = h * directions / np.linalg.norm(directions, axis=1)[:, None]
+
+    def gradient(c, P):
+        params = branch.params.with_value("P", P)
+        return np.array([(written_total(scene, disc, basis.orders, basis.n_phi, c + e, params)
+                          - written_total(scene, disc, basis.orders, basis.n_phi, c - e, params)) / (2 * h)
+                         for e in steps])
+
+    stationary = np.max(np.abs(gradient(points[0.05].c, points[0.05].pressure)))
+    predicted = np.max(np.abs(gradient(start, zero.pressure)))
+    assert stationary <= 1e-9 * pressure_scale and predicted >= 1e-6 * pressure_scale, (stationary, predicted)
+    assert abs(points[-0.025].pressure - points[0.025].pressure) <= 1e-12 * zero.pressure
+    quotient = {eps: (points[eps].pressure - zero.pressure) / eps**2 for eps in (0.05, 0.025, 0.0125)}
+    ratio = (quotient[0.05] - quotient[0.025]) / (quotient[0.025] - quotient[0.0125])
+    assert abs(ratio - 4) <= 0.3, (quotient, ratio)
