@@ -181,3 +181,45 @@ def test_an_m2_zero_is_switched_to_an_equilibrium_of_the_written_energy(m2_zero)
     quotient = {eps: (points[eps].pressure - zero.pressure) / eps**2 for eps in (0.05, 0.025, 0.0125)}
     ratio = (quotient[0.05] - quotient[0.025]) / (quotient[0.025] - quotient[0.0125])
     assert abs(ratio - 4) <= 0.3, (quotient, ratio)
+
+
+def test_first_traces_the_m1_branch_of_a_plugged_tube_in_a_coil_field(tmp_path):
+    """A plugged neo-Hookean tube held at λz = 1.2 (L = 10, degree 16) in the field of a coil of radius 2.5 around its
+    middle (M = 0.01), `[surface] branches = "first"`: its primary branch's first located m = 1 zero (the plugs hold
+    the rims: no translation, the free and held readings one) starts "m1_bp0" (tube/picture.with_surface), traced to
+    ``max_points``, no gauge (reaction 0), every estimate ≤ solver.max_error, not ``limited``; its last point is
+    stationary for the energy written here, the coil's term included (8 random directions, ≤ 1e-9 of P ∂Ṽ/∂c), and
+    not without that term (≥ 1e-6 of it: the field acts on the branch); written to a run file and read back."""
+    from balloon_cg.io.tube_file import read_tube_run, write_tube_run
+    from balloon_cg.tube.picture import TubePicture, with_modes, with_surface
+    from balloon_cg.tube.primary import primary_branch
+
+    scene = tube_scene("neo-Hookean", 10.0, 'ends = "plugged"\naxial_stretch = 1.2\n' + COIL.replace("0.05", "0.01")
+                       + '[surface]\nbranches = "first"\nmax_points = 3\n[solver]\ndegree = 16\n'
+                       + "[continuation]\nstop_stretch = 3.5\n")
+    parent = primary_branch(scene)
+    picture = with_surface(scene, with_modes(scene, TubePicture({"primary": parent}, None)))
+    zero = next(c for c in picture.modes["primary"].crossings if not c.held)
+    branch = picture.surface["m1_bp0"]
+    assert branch.parent == ("primary", 0) and branch.m == 1 and branch.pressure[0] == zero.pressure
+    assert len(branch.pressure) == 3 and branch.stop.code.value == "max_points" and not branch.limited
+    assert np.all(branch.reaction == 0.0) and np.all(branch.error_estimate <= scene.solver.max_error)
+    assert np.all(np.diff(branch.amplitude) > 0)
+    basis, c, P = branch.basis, branch.coefficients[-1], branch.pressure[-1]
+    params = parent.params.with_value("P", P)
+    surface = TubeSurfaceEquilibrium(scene, basis)
+    scale = P * np.max(np.abs(surface.parameter_derivative(c, params)))
+    h = 1e-6
+    directions = np.zeros((8, basis.size))
+    directions[:, basis.free] = np.random.default_rng(5).standard_normal((8, basis.free.size))
+    steps = h * directions / np.linalg.norm(directions, axis=1)[:, None]
+
+    def gradient(at):
+        return np.array([(written_total(scene, basis.disc, basis.orders, basis.n_phi, c + e, at)
+                          - written_total(scene, basis.disc, basis.orders, basis.n_phi, c - e, at)) / (2 * h)
+                         for e in steps])
+
+    assert np.max(np.abs(gradient(params))) <= 1e-9 * scale
+    assert np.max(np.abs(gradient(params.with_value("M", 0.0)))) >= 1e-6 * scale
+    read = read_tube_run(write_tube_run(tmp_path / "tube.h5", scene, picture))["surface_branches"]["m1_bp0"]
+    assert np.array_equal(read["coefficients"], branch.coefficients) and read["attrs"]["parent_branch"] == "primary"
