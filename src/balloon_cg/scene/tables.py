@@ -270,8 +270,8 @@ def default_surface(shape, field, electric, stability) -> Surface:
     """The [surface] table a scene without one has: ``Surface()`` ("first"), except ``branches = "none"`` on a tube
     without the m ≥ 1 zeros they start from (stability.m_max = 0; ``_tube_surface_reads`` refuses "first" there),
     and on a tube in a coil's field or under a voltage, where "first" is taken when asked for but is not the default:
-    the shipped coil tube's primary branch has an m = 1 zero, whose refined trace costs minutes per `run`
-    (docs/tubes.md "The tube over (S, φ)")."""
+    a trace there may refine to the basis's cap for tens of minutes (a plugged tube in a coil's field), and with
+    stability.m_max ≥ 2 the first zero can be the slack state's near P = 0 (docs/tubes.md "The tube over (S, φ)")."""
     built = not field.coils and electric is None and stability.m_max >= 1
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
