@@ -284,16 +284,12 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
 
 
 def test_what_it_does_not_take_is_refused_in_one_line():
-    """A coil, a sphere, another parameter than P (SceneError: the scene's), orders not starting at 0, too few points
-    in φ (ValueError: the call's): one line each, naming the key, its value and what is allowed."""
-    from pathlib import Path
-
-    from balloon_cg.scene import SceneError, load_scene
+    """A sphere, another parameter than P (SceneError: the scene's), orders not starting at 0, too few points in φ
+    (ValueError: the call's): one line each, naming the key, its value and what is allowed."""
+    from balloon_cg.scene import SceneError
 
     disc = IntervalDiscretisation(8, 10.0)
-    coil = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10_coil.toml")
-    cases = [(lambda: TubeSurfaceEquilibrium(coil, TubeSurfaceBasis(disc)), "field.coils", SceneError),
-             (lambda: TubeSurfaceEquilibrium(parse_scene('[material]\npreset = "SPOM1"\n'), TubeSurfaceBasis(disc)),
+    cases = [(lambda: TubeSurfaceEquilibrium(parse_scene('[material]\npreset = "SPOM1"\n'), TubeSurfaceBasis(disc)),
               "geometry.shape", SceneError),
              (lambda: TubeSurfaceBasis(disc, (1, 2)), "orders", ValueError),
              (lambda: TubeSurfaceBasis(disc, (0, 3), n_phi=6), "n_phi", ValueError),

@@ -19,9 +19,12 @@ and has no field here, so it sees only frame-invariant I, J):
 (∂e_ρ/∂φ = e_φ, ∂e_φ/∂φ = −e_ρ). Each is Σ_m F_m(S) g(mφ) with g = cos or sin, linear in c (plugged ends: r and a_φ's
 second entry carry λ2's 1). Gauss–Legendre in S (the interval's rule, weights per dS) and ``n_phi`` uniform nodes in
 φ, weight 1/n_phi: E/(2π) = (1/2π) ∫∫ π dS dφ ≈ Σ_q W_q Σ_k π(S_q, φ_k)/n_phi, exact for products of orders m, m'
-when n_phi > m + m'.
+when n_phi > m + m'. The default n_phi is the least multiple of 2g above 2(2 m_max + 1), g the greatest common divisor
+of the orders: the rotation by π/g (c_m → (−1)^(m/g) c_m, the symmetry of a branch's pitchfork on the orders 0, g,
+2g, …) maps the nodes to nodes, so the discrete energy keeps it exactly, not to the quadrature's aliasing.
 """
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +39,7 @@ NODE_VARIABLES = ("x", "y", "z", "xt", "yt", "zt", "xp", "yp", "zp")  # the surf
 @dataclass(frozen=True)
 class TubeSurfaceBasis:
     """The interval discretisation ``disc`` per azimuthal order in ``orders`` (ascending, 0 first, distinct) on
-    ``n_phi`` uniform nodes in φ."""
+    ``n_phi`` uniform nodes in φ (0: the default of the module docstring)."""
 
     disc: IntervalDiscretisation
     orders: tuple = (0, 1)
@@ -49,7 +52,8 @@ class TubeSurfaceBasis:
         object.__setattr__(self, "orders", orders)
         least = 2 * orders[-1] + 1
         if self.n_phi == 0:
-            object.__setattr__(self, "n_phi", 2 * least)
+            period = 2 * math.gcd(*orders[1:]) if len(orders) > 1 else 2
+            object.__setattr__(self, "n_phi", -(-2 * least // period) * period)
         elif self.n_phi < least:
             raise ValueError(f"n_phi: {self.n_phi} nodes in φ cannot hold the products of order {orders[-1]} "
                              f"(allowed: n_phi ≥ {least})")

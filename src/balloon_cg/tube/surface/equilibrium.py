@@ -1,20 +1,23 @@
 """The energy of a tube over (S, φ), its gradient (the residual) and Hessian (the exact Jacobian) in the coefficients
 c of tube/surface/basis.py (MODEL.md §8, §10), per 2π:
 
-    E(c) = Σ_nodes W (π_m(a_S, a_φ) − P v),   π_m = Φ(I, J),   I = |a_S|² + |a_φ|²,   J = |a_S × a_φ|,
+    E(c) = Σ_nodes W (π(x, a_S, a_φ) − P v),   π = Φ(I, J) − ½ χ M H²(x) − Φ̄² J²,   I = |a_S|² + |a_φ|²,
+    J = |a_S × a_φ|,
 
-π_m, its gradient and Hessian in the 9 node variables from the scene class's generated surface kernels
-(codegen/surface.py, the sphere's: with R = 1 the tube's reference frame is orthonormal in (S, φ) as the sphere's in
-(θ, φ/sin θ), and the density per unit reference area is the same function of a_1, a_2) evaluated at P = 0, i.e.
-without their cone form of the volume, which misses the end planes; the pressure's work is the volume between the
-end planes, −P v (tube/surface/volume.py). A node variable is Σ_j T[·, node, j] c_j (+ a plugged end's 1), so
+π, its gradient and Hessian in the 9 node variables from the scene class's generated surface kernels
+(codegen/surface.py, the sphere's, with the scene's terms: ``model/kernels.scene_terms``; with R = 1 the tube's
+reference frame is orthonormal in (S, φ) as the sphere's in (θ, φ/sin θ), and the density per unit reference area is
+the same function of x, a_1, a_2) evaluated at P = 0, i.e. without their cone form of the volume, which misses the end
+planes; the pressure's work is the volume between the end planes, −P v (tube/surface/volume.py). The node variables
+are frame components (r, t, z) (tube/surface/basis.py): Φ and the dielectric term see only I and J, and the coaxial
+coils' H² (model/loop.field_squared_cartesian, the sphere's) is invariant under rotations about the axis, so H² and
+its derivatives at the point (r, t, z) taken as Cartesian are those at the deformed point in the frame's components
+(the frame at a node is the Cartesian one turned by φ): exact for coaxial coils, the only ones a tube scene takes
+(scene/tables.py). A node variable is Σ_j T[·, node, j] c_j (+ a plugged end's 1), so
 
     ∂E/∂c = Σ_a T_aᵀ (W ∂π/∂q_a),   ∂²E/∂c² = Σ_ab T_aᵀ diag(W ∂²π/∂q_a∂q_b) T_b,   ∂R/∂P = −∂Ṽ/∂c
 
 (sum-factorised over φ: tube/surface/basis.py ``project``, ``hessian``).
-
-Coils and a voltage are refused (SceneError, one line: ``refuse_scene``): the field's H² needs x in Cartesian
-components and its rows.
 """
 import numpy as np
 
@@ -22,7 +25,8 @@ from . import volume
 from .basis import NODE_VARIABLES, TubeSurfaceBasis
 from ...galerkin.discretisation import symmetric_rows
 from ...galerkin.equilibrium import NonFiniteState, Parameters
-from ...model.kernels import PLAIN, KernelSet
+from ...model.kernels import KernelSet, scene_terms
+from ...model.loop import CARTESIAN, field_squared_cartesian, loop_table
 from ...numerics.newton import finite
 from ...scene.tables import Shape
 from ...scene.validation import SceneError
@@ -30,20 +34,14 @@ from ...scene.validation import SceneError
 
 def refuse_scene(scene) -> None:
     """SceneError, one line naming the key, its value and what is allowed, for what the tube over (S, φ) does not
-    take: another shape, coils, a voltage."""
+    take: another shape."""
     if scene.geometry.shape != Shape.TUBE:
         raise SceneError(f"geometry.shape = {scene.geometry.shape.value!r}: the tube over (S, φ) is a tube's "
                          '(allowed: "tube")')
-    if scene.field.coils:
-        raise SceneError(f"field.coils = {len(scene.field.coils)} coil(s): the tube over (S, φ) has no field "
-                         "(allowed: no coils)")
-    if scene.electric is not None:
-        raise SceneError(f"electric.voltage = {scene.electric.voltage:g}: the tube over (S, φ) has no dielectric "
-                         "term (allowed: no [electric] table)")
 
 
 class TubeSurfaceEquilibrium:
-    """E, ∇E, ∇²E and V/(2π) of a tube scene (field-free, no voltage) in a TubeSurfaceBasis."""
+    """E, ∇E, ∇²E and V/(2π) of a tube scene (its coaxial coils and voltage included) in a TubeSurfaceBasis."""
 
     def __init__(self, scene, basis: TubeSurfaceBasis):
         refuse_scene(scene)
@@ -51,7 +49,8 @@ class TubeSurfaceEquilibrium:
             raise ValueError(f"basis ends: {basis.disc.ends.value!r} (allowed: the scene's, "
                              f"{scene.geometry.ends.value!r})")
         self.scene, self.basis = scene, basis
-        self.kernels = KernelSet(scene.material, PLAIN).surface()  # the class's membrane density; P = 0 (docstring)
+        self.kernels = KernelSet(scene.material, scene_terms(scene)).surface()  # the class's density; P = 0 (docstring)
+        self.coils = loop_table(scene.field.coils)
         if tuple(self.kernels.module.SURFACE_STATE) != NODE_VARIABLES:
             raise RuntimeError(f"{self.kernels.module.__name__}: node variables {self.kernels.module.SURFACE_STATE}, "
                                f"tube/surface/basis.py assembles {NODE_VARIABLES}")
@@ -65,8 +64,19 @@ class TubeSurfaceEquilibrium:
             raise NonFiniteState("the tube's surface folds over: (a_S × a_φ) · e_ρ ≤ 0 at a node")
         return state
 
+    def _values(self, state: np.ndarray) -> dict:
+        """The kernels' node rows: the state and, with coils, H² and its derivatives at (r, t, z) (module
+        docstring); NonFiniteState where the membrane reaches a wire."""
+        if not self.coils.shape[0]:
+            return {"state": state}
+        field = np.empty((len(CARTESIAN), state.shape[1]))
+        field_squared_cartesian(np.ascontiguousarray(state[:3]), self.coils, field)
+        if not finite(field):
+            raise NonFiniteState("the membrane reached a wire: the coil field is singular there")
+        return {"state": state, "field": field}
+
     def _membrane(self, kernel: str, state: np.ndarray, params: Parameters) -> np.ndarray:
-        out = self.kernels.nodes(kernel, {"state": state}, params.with_value("P", 0.0))
+        out = self.kernels.nodes(kernel, self._values(state), params.with_value("P", 0.0))
         if not finite(out):
             raise NonFiniteState(f"{kernel}: non-finite values (a stretch ≤ 0)")
         return out

@@ -7,8 +7,9 @@ continuation.py's parameter)
 
 t the sideways translation (R = 1, T = −1, Z = 0 in order 1: tube/azimuthal.translation), a zero mode of E on
 sliding ends without a field, gauged by its held centroid tᵀ G c_1 = 0, τ the reaction (0 at an equilibrium: E is
-invariant under t). Plugged ends hold the rims: no gauge, X = (c_f, P). The Jacobian is exact (the surface Hessian
-bordered by G t and ∂R/∂P).
+invariant under t). Plugged ends hold the rims, and a coil's field (M ≠ 0: tube/azimuthal.in_field) makes the
+translation no symmetry, the tube free to move sideways in it (tube/azimuthal.py's free reading): no gauge,
+X = (c_f, P). The Jacobian is exact (the surface Hessian bordered by G t and ∂R/∂P).
 """
 import numpy as np
 
@@ -19,10 +20,11 @@ from ...galerkin.equilibrium import Parameters
 from ...scene.tables import Ends
 
 
-def gauge_row(basis: TubeSurfaceBasis) -> np.ndarray:
-    """G t in c (order 1 on sliding ends), zero where nothing is gauged (plugged ends, or no order 1)."""
+def gauge_row(basis: TubeSurfaceBasis, field: bool = False) -> np.ndarray:
+    """G t in c (order 1 on sliding ends), zero where nothing is gauged (plugged ends, no order 1, or in a coil's
+    ``field``)."""
     row = np.zeros(basis.size)
-    if 1 in basis.orders and basis.disc.ends == Ends.SLIDING:
+    if 1 in basis.orders and basis.disc.ends == Ends.SLIDING and not field:
         row[basis.block(1)] = azimuthal.operators(basis.disc)[1] @ azimuthal.translation(basis.disc)
     return row
 
@@ -36,7 +38,7 @@ class TubeSurfaceSystem:
         self.basis = surface.basis
         self.free = self.basis.free
         self.template = np.array(template, dtype=float)
-        self.gauge = gauge_row(self.basis)[self.free]
+        self.gauge = gauge_row(self.basis, azimuthal.in_field(surface, params))[self.free]
         self.gauged = bool(self.gauge.any())
 
     @property
