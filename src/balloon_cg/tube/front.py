@@ -1,0 +1,75 @@
+"""A tube's bulge branch resolved through its propagating front: traced on spectral elements refined where it passes.
+
+One Legendre series over the tube cannot resolve the front that joins the bulge to the tube on the propagation plateau
+(tube/resolution.py stops "unresolved" there). Here the bulge branch is traced on spectral elements in S
+(galerkin/interval_elements.py), switched at the primary branch's odd branch point onto them (tube/bulge.py ``on``),
+and the layout is refined from the per-element tails read over the whole branch:
+
+1. trace the branch on the layout (from ``solver.tube_elements`` elements of equal length, order
+   ``solver.tube_order``) to its stop, every point's element tails kept;
+2. every element whose tail passed ``max_error`` at some point of the branch is cut into k equal elements,
+   k = ceil((tail/max_error)^(1/RATE)) ≥ 2 (RATE: the tail's decay per halving assumed, in powers of 2 in
+   the element length: conservative for order ≥ 8, whose fronts measured 2^6–2^8 per halving);
+3. retrace from the onset on the refined layout; the branch is returned when every point's estimate is at most
+   max_error (the last trace checks it: bulge_branch stops UNRESOLVED at a point past it), or when the layout would
+   have more than ``solver.max_degree`` unknowns per field (E p): then the last trace is returned stopped
+   UNRESOLVED, its message naming max_degree.
+
+The front sweeps the tube once, so each round refines where it has passed and the last trace's layout is graded
+towards the front's path: short elements over the reference arclength the front crossed, the rest long.
+"""
+from dataclasses import replace
+
+import numpy as np
+
+from .bulge import bulge_branch
+from .results import IntervalStop
+from ..analysis.branches.resolution import Resolution
+from ..galerkin.interval_elements import ElementInterval, element_interval
+from ..numerics.continuation import Stop
+
+RATE = 4.0  # the assumed decay of an element's tail per halving of its length, as a power of 2 (module docstring)
+
+
+def uniform_layout(scene, elements: int, order: int) -> ElementInterval:
+    """``elements`` elements of equal length and ``order`` p over the scene's tube."""
+    geometry = scene.geometry
+    return element_interval(geometry.length, order, np.linspace(-1.0, 1.0, elements + 1)[1:-1], geometry.ends,
+                            scene.solver.quadrature, geometry.axial_stretch)
+
+
+def refined_layout(disc: ElementInterval, tails: np.ndarray, max_error: float) -> ElementInterval:
+    """``disc`` with each element whose largest tail over the branch (``tails``: points × elements) passes
+    ``max_error`` cut into k equal elements (module docstring); ``disc`` itself where none does."""
+    worst = tails.max(axis=0)
+    edges = disc.edges
+    bounds = []
+    for e, tail in enumerate(worst):
+        if e > 0:
+            bounds.append(edges[e])
+        if tail > max_error:
+            pieces = max(2, int(np.ceil((tail / max_error) ** (1.0 / RATE))))
+            bounds.extend(np.linspace(edges[e], edges[e + 1], pieces + 1)[1:-1])
+    return replace(disc, degree=(len(bounds) + 1) * disc.order, bounds=tuple(bounds))
+
+
+def front_bulge(scene, primary, point, policy: Resolution | None = None, layout: ElementInterval | None = None,
+                **trace):
+    """The bulge branch switched at ``point`` (an odd branch point of ``primary``) on spectral elements refined until
+    every stored point's estimate is at most ``policy.max_error`` (None: the scene's; module docstring), from
+    ``layout`` (None: ``uniform_layout`` of solver.tube_elements and tube_order); ``trace``: tube/bulge.bulge_branch's
+    stop_volume, step, stop_stretch."""
+    policy = Resolution.of(scene) if policy is None else policy
+    disc = uniform_layout(scene, scene.solver.tube_elements, scene.solver.tube_order) if layout is None else layout
+    while True:
+        branch = bulge_branch(scene, primary, point, on=disc, **trace)
+        tails = np.array([disc.element_tails(u) for u in branch.states])
+        finer = refined_layout(disc, tails, policy.max_error)
+        if finer == disc:
+            return branch
+        if finer.degree > policy.max_degree:
+            checked = bulge_branch(scene, primary, point, on=disc, max_error=policy.max_error, **trace)
+            message = (f"{checked.stop.message}: {finer.count} elements of order {disc.order} would pass "
+                       f"solver.max_degree {policy.max_degree} (elements × order): raise it or solver.max_error")
+            return replace(checked, stop=Stop(IntervalStop.UNRESOLVED, message))
+        disc = finer
