@@ -9,6 +9,7 @@ from numpy.polynomial import legendre
 
 from balloon_cg.analysis.results import Kind
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.galerkin.interval import IntervalDiscretisation
 from balloon_cg.galerkin.interval_elements import collocated, element_interval
 from balloon_cg.model import tube
 from balloon_cg.scene import parse_scene
@@ -65,6 +66,33 @@ def test_split_layout_holds_the_state_and_uniform_tube_is_exact():
     eq = Equilibrium(scene, element_interval(LENGTH, 8, BOUNDS))
     u = eq.disc.uniform(state.hoop, state.axial)
     assert u[0] == state.hoop and np.abs(eq.residual(u, Parameters(state.pressure))).max() <= 1e-12
+
+
+def test_element_energy_and_its_derivatives():
+    """A state of the Legendre series of degree 7 (tested against the energy written in tests/test_interval.py) is
+    one of elements of order 8 (``collocated``): E/(2π) and V/(2π) equal the series' (both quadratures fine enough
+    to be exact to rounding: 1e-13 relative); R = ∂E/∂u and J = ∂R/∂u (the sparse products) against central
+    differences, J symmetric."""
+    scene = ogden_1972_tube(20)
+    series = IntervalDiscretisation(7, LENGTH, quadrature=120)
+    disc = element_interval(LENGTH, 8, BOUNDS, quadrature=40)
+    rng = np.random.default_rng(4)
+    u = series.reference() * 1.2 + 0.02 * rng.standard_normal(series.size) / (1 + np.arange(series.size) % 8)
+    moved = collocated(series, u, disc)
+    P = Parameters(0.8)
+    on_series, on_elements = Equilibrium(scene, series), Equilibrium(scene, disc)
+    assert abs(on_elements.energy(moved, P) - on_series.energy(u, P)) <= 1e-13 * abs(on_series.energy(u, P))
+    assert abs(on_elements.volume(moved) - on_series.volume(u)) <= 1e-13 * abs(on_series.volume(u))
+    h = 1e-6
+    R = on_elements.residual(moved, P)
+    gradient = [(on_elements.energy(moved + h * e, P) - on_elements.energy(moved - h * e, P)) / (2 * h)
+                for e in np.eye(disc.size)]
+    assert np.abs(R - gradient).max() <= 1e-7 * np.abs(R).max()
+    J = on_elements.jacobian(moved, P)
+    assert np.abs(J - J.T).max() <= 1e-13 * np.abs(J).max()
+    difference = np.column_stack([(on_elements.residual(moved + h * e, P) - on_elements.residual(moved - h * e, P))
+                                  / (2 * h) for e in np.eye(disc.size)])
+    assert np.abs(J - difference).max() <= 1e-7 * np.abs(J).max()
 
 
 def test_bulge_fold_on_elements_is_the_legendre_bases_fold():

@@ -26,6 +26,7 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
 
 from .discretisation import gauss_nodes, geometric_tail, read_only
 from .interval import IntervalDiscretisation
@@ -94,6 +95,11 @@ class ElementInterval(IntervalDiscretisation):
         ones = np.ones((x.size, 1))
         return np.hstack([ones, x[:, None], axial]), np.hstack([0 * ones, ones, daxial]), axial, daxial
 
+    def transposed_maps(self, i: int):
+        """interval.py's, sparse (CSR): each node reads its element's p + 1 functions and the two global ones, so
+        ``hessian``'s products cost O(n_q p) per column, not O(n_q E p)."""
+        return _sparse_maps(self)[i]
+
     def block(self, mirror):
         raise ValueError("spectral elements over a tube have no mirror blocks (their bounds need not be "
                          "mirror-symmetric): the mirror-symmetric branches are traced on interval.py's Legendre basis")
@@ -145,6 +151,13 @@ def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterva
     out[onto_k] = u[k]
     out[onto_k + 1:] = np.linalg.lstsq(onto_axial, axial @ u[k + 1:], rcond=None)[0]
     return out
+
+
+@functools.lru_cache(maxsize=16)
+def _sparse_maps(disc: ElementInterval) -> tuple:
+    """The CSR transposes of the hoop and axial maps (``ElementInterval.transposed_maps``)."""
+    return tuple(sparse.csr_matrix(disc.tables[name].reshape(-1, disc.tables[name].shape[2]).T)
+                 for name in ("hoop_maps", "axial_maps"))
 
 
 @functools.lru_cache(maxsize=16)
