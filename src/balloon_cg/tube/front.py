@@ -5,16 +5,17 @@ One Legendre series over the tube cannot resolve the front that joins the bulge 
 (galerkin/interval_elements.py), switched at the primary branch's odd branch point onto them (tube/bulge.py ``on``),
 and the layout is refined from the per-element tails read over the whole branch:
 
-1. trace the branch on the layout (from ``solver.tube_elements`` elements of equal length, order
-   ``solver.tube_order``) to its stop, every point's element tails kept;
+1. trace the branch on the layout (from START_ELEMENTS elements of equal length, of ORDER) to its stop, every
+   point's element tails kept;
 2. every element whose tail passed ``max_error`` at some point of the branch is cut into k equal elements,
    k = ceil((tail/max_error)^(1/(RATE p))) ≥ 2 (RATE p: the tail's decay per halving of the element length
    assumed, in powers of 2: spectral convergence gives ~2^p once the front is resolved; measured on the Ogden
    tube's front at order 10, 2^6.6 from elements of 2 radii to 1);
-3. retrace from the onset on the refined layout; the branch is returned when every point's estimate is at most
-   max_error (the last trace checks it: bulge_branch stops UNRESOLVED at a point past it), or when the layout would
-   have more than ``solver.max_degree`` unknowns per field (E p): then the last trace is returned stopped
-   UNRESOLVED, its message naming max_degree.
+3. retrace from the onset on the refined layout; the branch is returned when no element's tail passed max_error
+   at any of its points (every stored point's estimate, the largest of its elements', is then at most max_error),
+   or when the refined layout would have more than ``solver.max_degree`` unknowns per field (E p): then the last
+   layout is traced once more with the check (bulge_branch stops UNRESOLVED at its first point past max_error,
+   that point not stored) and returned so, its message naming max_degree.
 
 The front sweeps the tube once, so each round refines where it has passed and the last trace's layout is graded
 towards the front's path: short elements over the reference arclength the front crossed, the rest long.
@@ -29,6 +30,8 @@ from ..analysis.branches.resolution import Resolution
 from ..galerkin.interval_elements import ElementInterval, element_interval
 from ..numerics.continuation import Stop
 
+START_ELEMENTS = 10  # the first layout's elements of equal length
+ORDER = 16  # the elements' polynomial degree
 RATE = 0.5  # the assumed decay of an element's tail per halving of its length: 2^(RATE p) (module docstring)
 
 
@@ -58,10 +61,10 @@ def front_bulge(scene, primary, point, policy: Resolution | None = None, layout:
                 **trace):
     """The bulge branch switched at ``point`` (an odd branch point of ``primary``) on spectral elements refined until
     every stored point's estimate is at most ``policy.max_error`` (None: the scene's; module docstring), from
-    ``layout`` (None: ``uniform_layout`` of solver.tube_elements and tube_order); ``trace``: tube/bulge.bulge_branch's
+    ``layout`` (None: ``uniform_layout`` of START_ELEMENTS and ORDER); ``trace``: tube/bulge.bulge_branch's
     stop_volume, step, stop_stretch."""
     policy = Resolution.of(scene) if policy is None else policy
-    disc = uniform_layout(scene, scene.solver.tube_elements, scene.solver.tube_order) if layout is None else layout
+    disc = uniform_layout(scene, START_ELEMENTS, ORDER) if layout is None else layout
     while True:
         branch = bulge_branch(scene, primary, point, on=disc, **trace)
         tails = np.array([disc.element_tails(u) for u in branch.states])
