@@ -139,21 +139,20 @@ class IntervalDiscretisation:
         out = np.zeros((self.size, self.size)) if out is None else out
         k = self.axial_index
         columns = (slice(0, k), slice(k, self.size))
-        maps = (self.tables["hoop_maps"], self.tables["axial_maps"])  # (2, n_q, columns): (λ2, v), (η, w)
         for i, j in ((0, 0), (0, 1), (1, 1)):
             h = weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]  # (2, 2, n_q): W h_kl of the block
-            scaled = h[:, 0, :, None] * maps[j][0] + h[:, 1, :, None] * maps[j][1]  # Σ_l W h_kl T_l
-            block = self.transposed_maps(i) @ scaled.reshape(-1, maps[j].shape[2])
+            block = self.hessian_block(i, j, h)
             out[columns[i], columns[j]] = block
             if i != j:
                 out[columns[j], columns[i]] = block.T
         return out
 
-    def transposed_maps(self, i: int) -> np.ndarray:
-        """The (columns, 2 n_q) transpose of block ``i``'s maps ((λ2, v) of λ2's coefficients, (η, w) of (λ̄, b)): the
-        left factor of ``hessian``'s products (spectral elements: a sparse one)."""
-        maps = self.tables["hoop_maps" if i == 0 else "axial_maps"]
-        return maps.reshape(-1, maps.shape[2]).T
+    def hessian_block(self, i: int, j: int, h: np.ndarray) -> np.ndarray:
+        """Σ_kl T_kᵀ diag(W h_kl) T_l of the column groups i, j (0: λ2's coefficients, read by (λ2, v); 1: (λ̄, b),
+        by (η, w)); ``h`` (2, 2, n_q) the weighted h_kl."""
+        maps = (self.tables["hoop_maps"], self.tables["axial_maps"])  # (2, n_q, columns): (λ2, v), (η, w)
+        scaled = h[:, 0, :, None] * maps[j][0] + h[:, 1, :, None] * maps[j][1]  # Σ_l W h_kl T_l
+        return maps[i].reshape(-1, maps[i].shape[2]).T @ scaled.reshape(-1, maps[j].shape[2])
 
     def uniform(self, hoop: float, axial: float) -> np.ndarray:
         """u of the uniform tube with sliding ends: λ2 = λθ, η = −λz(S − L/2)."""

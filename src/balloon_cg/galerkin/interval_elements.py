@@ -95,10 +95,11 @@ class ElementInterval(IntervalDiscretisation):
         ones = np.ones((x.size, 1))
         return np.hstack([ones, x[:, None], axial]), np.hstack([0 * ones, ones, daxial]), axial, daxial
 
-    def transposed_maps(self, i: int):
-        """interval.py's, sparse (CSR): each node reads its element's p + 1 functions and the two global ones, so
-        ``hessian``'s products cost O(n_q p) per column, not O(n_q E p)."""
-        return _sparse_maps(self)[i]
+    def hessian_block(self, i: int, j: int, h: np.ndarray) -> np.ndarray:
+        """interval.py's block product on sparse maps (CSR): each node reads its element's p + 1 functions and the
+        two global ones, so a block costs O(n_q p²), not O(n_q (E p)²)."""
+        maps = _sparse_maps(self)  # ((λ2, v), (η, w)): CSR (n_q, columns) each
+        return sum(maps[i][a].T @ maps[j][b].multiply(h[a, b][:, None]) for a in (0, 1) for b in (0, 1)).toarray()
 
     def block(self, mirror):
         raise ValueError("spectral elements over a tube have no mirror blocks (their bounds need not be "
@@ -155,9 +156,9 @@ def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterva
 
 @functools.lru_cache(maxsize=16)
 def _sparse_maps(disc: ElementInterval) -> tuple:
-    """The CSR transposes of the hoop and axial maps (``ElementInterval.transposed_maps``)."""
-    return tuple(sparse.csr_matrix(disc.tables[name].reshape(-1, disc.tables[name].shape[2]).T)
-                 for name in ("hoop_maps", "axial_maps"))
+    """((λ2, v) of λ2's coefficients, (η, w) of (λ̄, b)): the node maps as CSR matrices (n_q, columns)."""
+    tables = disc.tables
+    return tuple(tuple(sparse.csr_matrix(maps[a]) for a in (0, 1)) for maps in (tables["hoop_maps"], tables["axial_maps"]))
 
 
 @functools.lru_cache(maxsize=16)
