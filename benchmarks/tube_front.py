@@ -2,7 +2,7 @@
 
 Part 1: Ogden's 1972 rubber on L = 30 (tests/test_tube_maxwell.py's scene), the bulge from the onset to V/V0 = 52 by
 ``front_bulge`` (solver.max_error): the refinement's rounds (layout, CPU, largest tail), then the resolved layout
-against a much finer one (every element cut in two, the order + 4: the same branch retraced there) — P − P_M at fixed
+against a much finer one (the same bounds, the order + 4: the same branch retraced there) — P − P_M at fixed
 V/V0 (interpolated beyond the volume fold), the fold, P(V) on V/V0 ≥ 50 — and the Legendre series of degree 160
 (today's "flag" trace) beside them. Part 2: scenes/tube_spom1_L10.toml, the primary branch and the bulge branch to
 the scene's stop, "flag" (the Legendre series at solver.degree) against the resolved trace, CPU of each and their
@@ -24,6 +24,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 from test_tube import symbolic_energy  # noqa: E402
 from test_tube_maxwell import equal_area_pressure, ogden_1972_tube  # noqa: E402
 
+from balloon_cg.analysis.branches.resolution import Resolution  # noqa: E402
 from balloon_cg.analysis.results import Kind  # noqa: E402
 from balloon_cg.galerkin.equilibrium import Equilibrium  # noqa: E402
 from balloon_cg.scene import load_scene  # noqa: E402
@@ -60,7 +61,8 @@ def ogden() -> None:
 
     front.bulge_branch, plain = traced, front.bulge_branch
     start = time.process_time()
-    resolved = front.front_bulge(scene, primary, onset, stop_volume=52.0, step=0.02)
+    policy = Resolution(scene.solver.max_error, 400)  # E p up to 400 per field (solver.max_degree's largest)
+    resolved = front.front_bulge(scene, primary, onset, policy, stop_volume=52.0, step=0.02)
     total = time.process_time() - start
     front.bulge_branch = plain
     print(f"{'round':>5} {'elements':>8} {'order':>5} {'E p':>5} {'CPU s':>7} {'points':>6} {'largest tail':>12}")
@@ -69,8 +71,7 @@ def ogden() -> None:
     print(f"front_bulge: {total:.1f} s CPU; resolved layout's bounds in S: "
           + " ".join(f"{(b + 1) * 15:.3g}" for b in resolved.disc.edges))
     layout = resolved.disc
-    finer = front.element_interval(layout.length, layout.order + 4,
-                                   sorted(set(layout.bounds) | set(0.5 * (layout.edges[1:] + layout.edges[:-1]))))
+    finer = replace(layout, degree=layout.count * (layout.order + 4), order=layout.order + 4)
     start = time.process_time()
     fine = bulge_branch(scene, primary, onset, stop_volume=52.0, step=0.02, on=finer)
     fine_cpu = time.process_time() - start
@@ -79,7 +80,7 @@ def ogden() -> None:
     legendre = bulge_branch(scene, legendre_primary, legendre_primary.branch_points()[0], stop_volume=52.0, step=0.02)
     legendre_cpu = time.process_time() - start
     print(f"\n{'basis':>28} {'unknowns':>8} {'CPU s':>7} {'largest tail':>12} {'P at LV':>18} {'V/V0 at LV':>16}")
-    rows = (("resolved elements", resolved, total), (f"finer ({finer.count} el., order {finer.order})", fine, fine_cpu),
+    rows = (("resolved elements", resolved, total), (f"order {finer.order}, same bounds", fine, fine_cpu),
             ("Legendre degree 160 (flag)", legendre, legendre_cpu))
     for name, branch, cpu in rows:
         pressure, volume = fold_of(scene, branch)
