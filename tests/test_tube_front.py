@@ -142,3 +142,26 @@ def test_resolved_bulge_reaches_maxwells_pressure_with_every_point_resolved(maxw
     fold = check_chain(onset, branch, maxwell[0], 52.0)
     volume = 2 * Equilibrium(scene, branch.disc).volume(fold.u) / LENGTH
     assert abs(fold.pressure - 1.240702968978) <= 1e-10 and abs(volume - 2.145050161885) <= 1e-10
+
+
+def test_run_traces_the_bulge_on_elements_and_its_file_reads_back(tmp_path):
+    """solver.tube_resolution = "elements" (SPOM1, L = 10, to a hoop stretch of 2.5): ``run``'s bulge branch is on
+    spectral elements with every point within max_error and its m = 1 blocks assessed on them; the file stores the
+    layout, the branch read back is on it (the same unknowns, ρ(S) to rounding) and ``inspect`` reads the file."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.tube_file import read_tube_run, stored_branch, write_tube_run
+    from balloon_cg.tube.primary import scene_parameters
+    from shared_pictures import first_bulge_picture
+
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\n'
+                        'degree = 16\ntube_resolution = "elements"\n[continuation]\nstop_stretch = 2.5\n')
+    picture = first_bulge_picture(scene)
+    bulge = picture.branches["bulge"]
+    assert bulge.disc.order > 0 and bulge.tail.max() <= scene.solver.max_error
+    assert len(picture.modes["bulge"].lowest[1]) == len(bulge.pressure)
+    path = write_tube_run(tmp_path / "tube.h5", scene, picture)
+    read = stored_branch(read_tube_run(path), "bulge", scene_parameters(scene))
+    assert read.disc == bulge.disc and np.array_equal(read.states, bulge.states)
+    S = np.linspace(0, 10.0, 51)
+    assert np.abs(read.disc.profile(read.states[-1], S)[0] - bulge.disc.profile(bulge.states[-1], S)[0]).max() == 0
+    assert main(["inspect", str(path)]) == 0
