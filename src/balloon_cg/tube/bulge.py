@@ -176,7 +176,8 @@ class Side:
     vanishes on the primary branch's states (module docstring). Odd block: ρ(0) − ρ(L) = −2 Σ_{k odd} a_k, zero on
     every mirror-symmetric state (the bulge at S = 0 where positive). Even block (the uniform primary branch of
     sliding ends): ρ(0) − ρ̄ = Σ_{k ≥ 1 even} a_k, zero on every uniform state (ρ̄ = a_0, the Legendre series' mean;
-    P_k(−1) = (−1)^k)."""
+    P_k(−1) = (−1)^k). On spectral elements (the odd block's branch: tube/front.py) ρ(0) − ρ(L) from the basis's
+    values at the ends."""
 
     def __init__(self, disc, block: Mirror):
         self.disc, self.odd = disc, block == Mirror.ODD
