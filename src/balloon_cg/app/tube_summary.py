@@ -33,7 +33,7 @@ def summarise_tube(run: dict) -> dict:
                 "axial_stretch": None if math.isnan(a["axial_stretch"]) else a["axial_stretch"]}
     control, v0 = a["control"], np.pi * a["length"]
     max_error = parse_scene(a["scene_toml"]).solver.max_error
-    branches, disc = {}, discretisation(a)
+    branches = {}
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
         unstable = b.get(f"unstable_{control}")
         special = [s | ({"amount": float(s["pressure"] * s["volume"] * v0)} if control == "gas" else {})
@@ -53,7 +53,7 @@ def summarise_tube(run: dict) -> dict:
                           "last_crest_height": float(b[CREST][-1]) if CREST in b else None,
                           "stable_points": None if unstable is None else int((unstable == 0).sum()),
                           "special_points": _with_omega2(special, b.get("frequencies")),
-                          "azimuthal": _azimuthal(b, disc),
+                          "azimuthal": _azimuthal(b, discretisation(a, b["attrs"])),
                           **_frequencies(b.get("frequencies"))}
     maxwell = None if math.isnan(a["maxwell_pressure"]) else a["maxwell_pressure"]
     field = scene_field(a["scene_toml"])

@@ -80,28 +80,45 @@ class IntervalDiscretisation:
         return self.hoops
 
     @property
+    def tables(self) -> dict:
+        """The node tables (``_tables``: nodes, weights per dS, R' and R, the state maps), cached per disc."""
+        return _tables(self)
+
+    def rule(self) -> tuple:
+        """(x, w): the Gauss–Legendre rule in x (``quadrature`` nodes; 0: the sphere's default rule at N)."""
+        return gauss_rule(self.quadrature or gauss_nodes(self.degree))
+
+    def functions(self, x: np.ndarray) -> tuple:
+        """(λ2's basis functions, their d/dx, η's bubbles, their d/dx) at the points x, each (len(x), count): λ2's
+        P_0..P_N (sliding) or the bubbles P_{k+2} − P_k about 1 (plugged), η's P_{k+2} − P_k, k = 0..N − 2."""
+        n = self.degree
+        p, dp = legendre_table(np.asarray(x, dtype=float), n)
+        bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
+        return (p, dp, bubbles, slopes) if self.ends == Ends.SLIDING else (bubbles, slopes, bubbles, slopes)
+
+    @property
     def x(self) -> np.ndarray:
-        return _tables(self)["x"]
+        return self.tables["x"]
 
     @property
     def weights(self) -> np.ndarray:
         """(L/2) w_q: the quadrature weights per dS."""
-        return _tables(self)["weights"]
+        return self.tables["weights"]
 
     @property
     def cos_theta(self) -> np.ndarray:
         """R' = 0 at the nodes (module docstring)."""
-        return _tables(self)["rate"]
+        return self.tables["rate"]
 
     @property
     def sin_theta(self) -> np.ndarray:
         """R = 1 at the nodes (module docstring)."""
-        return _tables(self)["radius"]
+        return self.tables["radius"]
 
     @property
     def maps(self) -> np.ndarray:
         """(4, n_q, size): the node values of (λ2, v, η, w) as linear maps of u (the state is T u)."""
-        return _tables(self)["maps"]
+        return self.tables["maps"]
 
     def node_state(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """(λ2, v, η, w) at the nodes, (4, n_q), into ``out`` if given (plugged ends: λ2's 1 added)."""
@@ -122,15 +139,20 @@ class IntervalDiscretisation:
         out = np.zeros((self.size, self.size)) if out is None else out
         k = self.axial_index
         columns = (slice(0, k), slice(k, self.size))
-        maps = (_tables(self)["hoop_maps"], _tables(self)["axial_maps"])  # (2, n_q, columns): (λ2, v), (η, w)
         for i, j in ((0, 0), (0, 1), (1, 1)):
             h = weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]  # (2, 2, n_q): W h_kl of the block
-            scaled = h[:, 0, :, None] * maps[j][0] + h[:, 1, :, None] * maps[j][1]  # Σ_l W h_kl T_l
-            block = maps[i].reshape(-1, maps[i].shape[2]).T @ scaled.reshape(-1, maps[j].shape[2])
+            block = self.hessian_block(i, j, h)
             out[columns[i], columns[j]] = block
             if i != j:
                 out[columns[j], columns[i]] = block.T
         return out
+
+    def hessian_block(self, i: int, j: int, h: np.ndarray) -> np.ndarray:
+        """Σ_kl T_kᵀ diag(W h_kl) T_l of the column groups i, j (0: λ2's coefficients, read by (λ2, v); 1: (λ̄, b),
+        by (η, w)); ``h`` (2, 2, n_q) the weighted h_kl."""
+        maps = (self.tables["hoop_maps"], self.tables["axial_maps"])  # (2, n_q, columns): (λ2, v), (η, w)
+        scaled = h[:, 0, :, None] * maps[j][0] + h[:, 1, :, None] * maps[j][1]  # Σ_l W h_kl T_l
+        return maps[i].reshape(-1, maps[i].shape[2]).T @ scaled.reshape(-1, maps[j].shape[2])
 
     def uniform(self, hoop: float, axial: float) -> np.ndarray:
         """u of the uniform tube with sliding ends: λ2 = λθ, η = −λz(S − L/2)."""
@@ -169,10 +191,9 @@ class IntervalDiscretisation:
     def profile(self, u: np.ndarray, s: np.ndarray) -> tuple:
         """(ρ, η) at reference arclengths s ∈ [0, L]."""
         x = 2 * np.asarray(s, dtype=float) / self.length - 1
-        p, _ = legendre_table(x, self.degree)
-        n, k = self.degree, self.axial_index
-        bubbles = p[:, 2:] - p[:, : n - 1]
-        rho = p @ u[:k] if self.ends == Ends.SLIDING else 1.0 + bubbles @ u[:k]
+        hoop, _, bubbles, _ = self.functions(x)
+        k = self.axial_index
+        rho = hoop @ u[:k] + (0.0 if self.ends == Ends.SLIDING else 1.0)
         return rho, -u[k] * self.length / 2 * x + bubbles @ u[k + 1:]
 
     def series(self, u: np.ndarray) -> tuple:
@@ -200,13 +221,10 @@ class IntervalDiscretisation:
 
     def radius(self, states: np.ndarray, x: np.ndarray) -> tuple:
         """(ρ, dρ/dx) of each state (rows of ``states``) at its own point x_i ∈ [−1, 1]."""
-        p, dp = legendre_table(np.asarray(x, dtype=float), self.degree)
-        n, k = self.degree, self.axial_index
-        a = np.atleast_2d(states)[:, :k]
-        if self.ends == Ends.SLIDING:
-            return np.einsum("ij,ij->i", p, a), np.einsum("ij,ij->i", dp, a)
-        bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
-        return 1.0 + np.einsum("ij,ij->i", bubbles, a), np.einsum("ij,ij->i", slopes, a)
+        hoop, slope, _, _ = self.functions(x)
+        a = np.atleast_2d(states)[:, : self.axial_index]
+        rho = np.einsum("ij,ij->i", hoop, a) + (0.0 if self.ends == Ends.SLIDING else 1.0)
+        return rho, np.einsum("ij,ij->i", slope, a)
 
     def crests(self, states: np.ndarray) -> tuple:
         """(S, η) of each state's crest, its largest radius ρ: the reference arclength and the height (measured from
@@ -215,10 +233,8 @@ class IntervalDiscretisation:
         the roots of ρ' (found by bisection to rounding) on each side where ρ' falls through zero."""
         states = np.atleast_2d(np.asarray(states, dtype=float))
         grid = np.linspace(-1.0, 1.0, CREST_SAMPLES)
-        p, _ = legendre_table(grid, self.degree)
-        n, k = self.degree, self.axial_index
-        basis = p if self.ends == Ends.SLIDING else p[:, 2:] - p[:, : n - 1]
-        top = np.argmax(states[:, :k] @ basis.T, axis=1)
+        k = self.axial_index
+        top = np.argmax(states[:, :k] @ self.functions(grid)[0].T, axis=1)
         candidates = [grid[np.maximum(top - 1, 0)], grid[top], grid[np.minimum(top + 1, grid.size - 1)]]
         for lo, hi in ((candidates[0], candidates[1]), (candidates[1], candidates[2])):
             falls = (self.radius(states, lo)[1] > 0) & (self.radius(states, hi)[1] < 0)
@@ -231,8 +247,7 @@ class IntervalDiscretisation:
         x = np.array(candidates)
         heights = np.array([self.radius(states, c)[0] for c in x])
         best = x[np.argmax(heights, axis=0), np.arange(len(states))]
-        p, _ = legendre_table(best, n)
-        eta = -states[:, k] * self.length / 2 * best + np.einsum("ij,ij->i", p[:, 2:] - p[:, : n - 1], states[:, k + 1:])
+        eta = -states[:, k] * self.length / 2 * best + np.einsum("ij,ij->i", self.functions(best)[2], states[:, k + 1:])
         return (best + 1) * self.length / 2, eta
 
     def crest(self, u: np.ndarray) -> tuple:
@@ -244,14 +259,12 @@ class IntervalDiscretisation:
 @functools.lru_cache(maxsize=16)
 def _tables(disc: IntervalDiscretisation) -> dict:
     """Nodes, weights per dS, the meridian's R' and R at the nodes and the state maps (read-only; also split by the
-    columns each reads: (λ2, v) of λ2's coefficients, (η, w) of (λ̄, b))."""
-    n, length = disc.degree, disc.length
-    x, w = gauss_rule(disc.quadrature or gauss_nodes(n))
-    p, dp = legendre_table(x, n)
-    bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
+    columns each reads: (λ2, v) of λ2's coefficients, (η, w) of (λ̄, b)), from the disc's ``rule`` and ``functions``."""
+    length = disc.length
+    x, w = disc.rule()
+    hoop, rate, bubbles, slopes = disc.functions(x)
     k = disc.axial_index
     maps = np.zeros((4, x.size, disc.size))
-    hoop, rate = (p, dp) if disc.ends == Ends.SLIDING else (bubbles, slopes)
     maps[0, :, :k], maps[1, :, :k] = hoop, 2 / length * rate
     maps[2, :, k] = -length / 2 * x
     maps[2, :, k + 1:] = bubbles

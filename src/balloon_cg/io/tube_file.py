@@ -48,6 +48,7 @@ from .tube_frequencies import read_tube_frequencies, write_tube_frequencies
 from .tube_surface_file import read_surface_branches, write_surface_branches
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
+from ..galerkin.interval_elements import ElementInterval, element_interval
 from ..scene.tables import Ends
 from ..analysis.results import Kind, StopCode
 from ..numerics.continuation import RootStatus, Stop, TraceStop
@@ -172,7 +173,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
     for name, branch in picture.branches.items():
         group = f.create_group(f"branches/{name}")
         group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message,
-                            **_lineage(branch)})
+                            **_lineage(branch), **_layout(branch.disc)})
         checksummed(group, "unknowns", branch.states)
         eq = Equilibrium(scene, branch.disc)
         for column, values in (("pressure", branch.pressure), ("volume", branch.volume),
@@ -219,6 +220,14 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
     write_surface_branches(f, picture.surface)
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
+
+
+def _layout(disc) -> dict:
+    """A branch traced on spectral elements (tube/front.py): ``element_order`` and ``element_bounds`` (the inner
+    bounds in x = 2S/L − 1); none on the root's Legendre series."""
+    if not isinstance(disc, ElementInterval):
+        return {}
+    return {"element_order": disc.order, "element_bounds": np.array(disc.bounds, dtype=float)}
 
 
 def _lineage(branch) -> dict:
@@ -393,16 +402,22 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     attrs = b["attrs"]
     parent = (attrs["parent_branch"], int(attrs["parent_label"])) if "parent_label" in attrs else None
     rejoins = int(attrs["rejoins_label"]) if attrs.get("rejoins_label", -1) >= 0 else None
-    return IntervalBranch(discretisation(run["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
+    return IntervalBranch(discretisation(run["attrs"], b["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
                           special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
                           rejoins=rejoins)
 
 
-def discretisation(attrs: dict) -> IntervalDiscretisation:
-    """The interval discretisation a tube run file's unknowns are on (its root attributes)."""
+def discretisation(attrs: dict, branch: dict | None = None) -> IntervalDiscretisation:
+    """The interval discretisation a tube run file's unknowns are on: its root attributes' Legendre series, or the
+    spectral elements of a branch whose attributes ``branch`` name them (``element_order``, ``element_bounds``)."""
     held = attrs["axial_stretch"]
+    held = None if math.isnan(held) else float(held)
+    if branch is not None and "element_order" in branch:
+        return element_interval(float(attrs["length"]), int(branch["element_order"]),
+                                np.atleast_1d(branch["element_bounds"]), Ends(attrs["ends"]), int(attrs["quadrature"]),
+                                held)
     return IntervalDiscretisation(int(attrs["degree"]), float(attrs["length"]), int(attrs["quadrature"]),
-                                  Ends(attrs["ends"]), None if math.isnan(held) else float(held))
+                                  Ends(attrs["ends"]), held)
 
 
 def _text(value):

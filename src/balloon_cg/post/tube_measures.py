@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..galerkin.discretisation import legendre_table
 from ..scene.tables import Ends
 
 SAMPLES = 4001  # reference arclengths a state's front is sampled at (``fronts``)
@@ -32,13 +31,10 @@ class Front:
 def stretches(disc, u: np.ndarray, s: np.ndarray) -> tuple:
     """(λ1, λ2), the axial and hoop stretches of the tube's state u at reference arclengths s ∈ [0, L]."""
     x = 2 * np.asarray(s, dtype=float) / disc.length - 1
-    p, dp = legendre_table(x, disc.degree)
-    n, k = disc.degree, disc.axial_index
-    bubbles, bubble_slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
-    if disc.ends == Ends.SLIDING:
-        hoop, hoop_slope = p @ u[:k], dp @ u[:k]
-    else:
-        hoop, hoop_slope = 1.0 + bubbles @ u[:k], bubble_slopes @ u[:k]
+    functions, slopes, _, bubble_slopes = disc.functions(x)
+    k = disc.axial_index
+    hoop = functions @ u[:k] + (0.0 if disc.ends == Ends.SLIDING else 1.0)
+    hoop_slope = slopes @ u[:k]
     height_slope = -u[k] * disc.length / 2 + bubble_slopes @ u[k + 1:]
     return 2 / disc.length * np.hypot(hoop_slope, height_slope), hoop
 

@@ -86,7 +86,7 @@ def profiles(ax, run: dict, name: str, points=None) -> None:
     """The profiles r(Z) (ρ against the height η, both over the reference radius) of branch ``name`` at
     ``points`` (indices, negative from the end; default: PROFILES spread along the branch), coloured by V/V0."""
     b = run["branches"][name]
-    disc = discretisation(run["attrs"])
+    disc = discretisation(run["attrs"], b["attrs"])
     chosen = _chosen(len(b["pressure"]), name, points, PROFILES)
     s = np.linspace(0, disc.length, 401)
     colours = matplotlib_colours(len(chosen))
@@ -105,7 +105,7 @@ def front_motion(ax, run: dict, name: str, points=None) -> None:
     tube_measures.front measures them; a branch whose profiles are all uniform has none (TubePlotError)."""
     b = run["branches"][name]
     chosen = _chosen(len(b["pressure"]), name, points, len(b["pressure"]))
-    _, deformed = fronts(discretisation(run["attrs"]), b["unknowns"][chosen])
+    _, deformed = fronts(discretisation(run["attrs"], b["attrs"]), b["unknowns"][chosen])
     position, width = (np.array([getattr(f, key) for f in deformed]) for key in ("position", "width"))
     if np.isnan(position).all():
         raise TubePlotError(f"--what front: the {name} branch's profiles are uniform at the points drawn (no front)")
@@ -122,7 +122,7 @@ def stretch_profiles(ax, run: dict, name: str, points=None) -> None:
     """The hoop stretch λ2 (solid) and the axial stretch λ1 (dashed) along the deformed axis, from the branch's
     end η(0), of branch ``name`` at ``points`` (default: STRETCHED spread along the branch), coloured by V/V0."""
     b = run["branches"][name]
-    disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
+    disc, s = discretisation(run["attrs"], b["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
     chosen = _chosen(len(b["pressure"]), name, points, STRETCHED)
     for colour, i in zip(matplotlib_colours(len(chosen)), chosen):
         u = b["unknowns"][i]
@@ -146,7 +146,8 @@ def critical_modes(ax, run: dict, name: str, points=None) -> None:
     if not located:
         raise TubePlotError(f"--what modes: the {name} branch has no located m ≥ 1 zero with a stored mode")
     chosen = _chosen(len(located), name, points, len(located))
-    disc, s = discretisation(run["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
+    disc = discretisation(run["attrs"], run["branches"][name]["attrs"])
+    s = np.linspace(0.0, run["attrs"]["length"], SAMPLES)
     for colour, k in zip(matplotlib_colours(len(chosen)), chosen):
         m, p = located[k]
         for values, style, part in zip(mode_profile(disc, p["mode"], s), ("-", "--", ":"), "RTZ"):

@@ -215,7 +215,8 @@ class Solver:
     ``max_error``; a branch that would need more stops there, saying so. A tube's bulge branch is traced at one
     degree: ``tube_resolution`` "flag" (the default) stores its points at the scene's degree, those past
     ``max_error`` flagged; "refine" retraces it at growing degree until it is resolved, stopping "unresolved" at
-    ``max_degree`` (tube/resolution.py).
+    ``max_degree`` (tube/resolution.py); "elements" traces it on spectral elements whose layout is refined until
+    every point is resolved, at most ``max_degree`` unknowns per field (tube/front.py).
     """
 
     degree: int = 40
@@ -248,7 +249,7 @@ class Stability:
 
 
 STABILITY_BASES = ("legendre", "mapped")
-TUBE_RESOLUTIONS = ("flag", "refine")  # solver.tube_resolution
+TUBE_RESOLUTIONS = ("flag", "refine", "elements")  # solver.tube_resolution
 STABILITY_NORMS = ("unknowns", "displacement")
 
 

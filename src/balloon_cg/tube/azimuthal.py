@@ -8,6 +8,9 @@ volume between the end planes). In x = 2S/L − 1, on the interval discretisatio
     sliding ends   R, T = Σ_{k=0}^{N} c_k P_k(x),   Z = Σ_{k=0}^{N−2} c_k (P_{k+2} − P_k)(x)
     plugged ends   R, T, Z = Σ_{k=0}^{N−2} c_k (P_{k+2} − P_k)(x)
 
+(on spectral elements, galerkin/interval_elements.py, R and T on λ2's functions and Z on η's: the discretisation's
+``functions``).
+
 The end conditions. A sliding end is a plane of mirror symmetry of the tube, fixed: the perturbation is mirrored
 there (R, T even, Z odd about it), so Z = 0 on the end plane, R' = T' = 0 being natural (an end plane that would
 tilt, Z = cos φ for m = 1, is not a mirror plane). A plug is rigid and held: it neither tilts nor moves sideways, so
@@ -32,7 +35,6 @@ from ..analysis.stability.azimuthal import lowest_eigenvalues
 from ..galerkin.discretisation import symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation
-from ..galerkin.legendre import legendre_table
 from ..generated import AZIMUTHAL_PAIRS
 from ..numerics.eigen import NO_CONSTRAINT, GramFactor, lowest_of, negative_count, restricted
 from ..scene.tables import Ends
@@ -58,10 +60,8 @@ class TubeModes:
 def basis_values(disc: IntervalDiscretisation, x: np.ndarray) -> np.ndarray:
     """(6, x.size, size): the values of y = (R, R', Z, Z', T, T') of each coefficient at the points x of [−1, 1], the
     unknowns ordered (R's, T's, Z's) (module docstring)."""
-    n, length = disc.degree, disc.length
-    p, dp = legendre_table(x, n)
-    bubbles, slopes = p[:, 2:] - p[:, : n - 1], dp[:, 2:] - dp[:, : n - 1]
-    free, free_slopes = (p, dp) if disc.ends == Ends.SLIDING else (bubbles, slopes)
+    length = disc.length
+    free, free_slopes, bubbles, slopes = disc.functions(x)  # R and T on λ2's functions, Z on η's (zero at the ends)
     k, b = free.shape[1], bubbles.shape[1]
     ops = np.zeros((6, x.size, 2 * k + b))
     r, t, z = slice(0, k), slice(k, 2 * k), slice(2 * k, 2 * k + b)

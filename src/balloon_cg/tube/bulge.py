@@ -37,6 +37,7 @@ from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
+from ..galerkin.interval_elements import ElementInterval, collocated
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.threads import limited_blas
@@ -62,11 +63,13 @@ class BranchStartError(ArithmeticError):
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None,
-                 max_error: float | None = None) -> IntervalBranch:
+                 max_error: float | None = None, on=None) -> IntervalBranch:
     """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: V/V0 where
     it ends (None: the scene's continuation.stop_volume, V/R0³, if any); ``step``: the first arclength step (None:
     continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it;
-    ``max_error``: stop where a point's Legendre tail passes it (None: no check).
+    ``max_error``: stop where a point's Legendre tail passes it (None: no check); ``on``: the discretisation the
+    branch is traced on (None: the primary's; else at an odd branch point a spectral-element layout of the same
+    tube, galerkin/interval_elements.py: ``_switched_onto``).
     UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that is not
     uniform."""
     if point.kind != Kind.BP or point.block is None:
@@ -78,12 +81,12 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     if point.block == Mirror.EVEN and in_field(scene):
         raise UnswitchableBranchPoint("an even branch point is switched on a uniform primary branch (no field), not "
                                       "in a coil field")
+    if on is not None and point.block != Mirror.ODD:
+        raise UnswitchableBranchPoint("a branch is traced on its own discretisation from an odd branch point, not "
+                                      f"from an {point.block.value} one")
+    u, phi, disc = _switched(scene, primary, point) if on is None else _switched_onto(scene, primary, point, on)
     eq = Equilibrium(scene, disc)
-    block = disc.block(point.block)
     params = primary.params.with_value("P", point.pressure)
-    values, vectors = np.linalg.eigh(eq.jacobian(point.u, params)[np.ix_(block, block)])
-    phi = np.zeros(disc.size)
-    phi[block] = vectors[:, np.argmin(np.abs(values))]
     side = Side(disc, point.block)
     if side(phi) < 0:
         phi = -phi
@@ -91,7 +94,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     system = TubeSystem(ParameterSystem(eq, params, "P"), unknowns, held(disc))
     settings = continuation_settings(scene)
     settings.step = settings.step if step is None else step
-    X = np.append(point.u, point.pressure)[system.columns]
+    X = np.append(u, point.pressure)[system.columns]
     direction = np.append(phi, 0.0)[system.columns] / np.linalg.norm(phi)
     first = continuation.correct(system, X + settings.step * direction, direction, settings)
     if not first.converged:
@@ -100,7 +103,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                first.residual)
 
     compressed = CompressionStop(eq, in_field(scene))
-    compressed(point.u)
+    compressed(u)
     target = scene.continuation.stop_volume if stop_volume is None else stop_volume * np.pi * disc.length
     volume_stop = VolumeStop(target, system)
 
@@ -143,17 +146,47 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         np.array([smallest_stress(eq, Y[:-1]) for Y in points]), primary.params, tail, spread), settings)
 
 
+def _switched(scene, primary: IntervalBranch, point: IntervalSpecial) -> tuple:
+    """(u*, φ, disc) on the primary's discretisation: the branch point's state and its block's null vector."""
+    disc = primary.disc
+    block = disc.block(point.block)
+    params = primary.params.with_value("P", point.pressure)
+    values, vectors = np.linalg.eigh(Equilibrium(scene, disc).jacobian(point.u, params)[np.ix_(block, block)])
+    phi = np.zeros(disc.size)
+    phi[block] = vectors[:, np.argmin(np.abs(values))]
+    return point.u, phi, disc
+
+
+def _switched_onto(scene, primary: IntervalBranch, point: IntervalSpecial, disc) -> tuple:
+    """(u*, φ, disc) on another discretisation ``disc`` of the tube: the branch point's state collocated there
+    (galerkin/interval_elements.collocated: exact for the uniform tube) and φ the eigenvector of ∂R/∂u on the free
+    unknowns whose eigenvalue is nearest zero (the bulge mode: the odd block's zero of the primary's basis, within
+    the discretisations' difference)."""
+    u = collocated(primary.disc, point.u, disc)
+    params = primary.params.with_value("P", point.pressure)
+    free = disc.free
+    values, vectors = np.linalg.eigh(Equilibrium(scene, disc).jacobian(u, params)[np.ix_(free, free)])
+    phi = np.zeros(disc.size)
+    phi[free] = vectors[:, np.argmin(np.abs(values))]
+    return u, phi, disc
+
+
 class Side:
     """Which side of the primary branch a state of the switched branch lies on: a linear functional of u that
     vanishes on the primary branch's states (module docstring). Odd block: ρ(0) − ρ(L) = −2 Σ_{k odd} a_k, zero on
     every mirror-symmetric state (the bulge at S = 0 where positive). Even block (the uniform primary branch of
     sliding ends): ρ(0) − ρ̄ = Σ_{k ≥ 1 even} a_k, zero on every uniform state (ρ̄ = a_0, the Legendre series' mean;
-    P_k(−1) = (−1)^k)."""
+    P_k(−1) = (−1)^k). On spectral elements (the odd block's branch: tube/front.py) ρ(0) − ρ(L) from the basis's
+    values at the ends."""
 
     def __init__(self, disc, block: Mirror):
-        self.hoops = np.arange(1 if block == Mirror.ODD else 2, disc.degree + 1, 2)
-        self.weight = -2.0 if block == Mirror.ODD else 1.0
-        self.rejoins = "mirror-symmetric" if block == Mirror.ODD else "uniform"
+        self.disc, self.odd = disc, block == Mirror.ODD
+        self.hoops = np.arange(1 if self.odd else 2, disc.degree + 1, 2)
+        self.weight = -2.0 if self.odd else 1.0
+        self.rejoins = "mirror-symmetric" if self.odd else "uniform"
 
     def __call__(self, u: np.ndarray) -> float:
+        if isinstance(self.disc, ElementInterval):  # ρ(0) − ρ(L) from the basis's values at the ends
+            rho, _ = self.disc.radius(np.array([u, u]), np.array([-1.0, 1.0]))
+            return float(rho[0] - rho[1])
         return self.weight * float(u[self.hoops].sum())

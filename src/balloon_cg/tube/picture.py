@@ -35,6 +35,7 @@ from .voltage import voltage_branch
 from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
+from ..galerkin.interval_elements import collocated
 from ..model.membrane import scene_energy
 from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
@@ -156,12 +157,15 @@ def rejoined_at(scene, primary: IntervalBranch, branch: IntervalBranch, label: i
     """The label of the branch point of ``primary`` where ``branch`` (switched at ``label``) rejoined it: of the same
     block, the nearest in (u, P) to its last point and within two of the scene's largest steps of it (the step that
     crossed the primary branch's states ends beyond it); None where it did not rejoin or the point lies beyond the
-    traced primary branch."""
+    traced primary branch (a branch on other unknowns than the primary's, spectral elements, compared with the
+    branch points collocated onto them)."""
     if branch.stop.code != IntervalStop.REJOINED:
         return None
     block = primary.special[label].block
     last = np.append(branch.states[-1], branch.pressure[-1])
-    near = [(float(np.linalg.norm(np.append(s.u, s.pressure) - last)), k) for k, s in enumerate(primary.special)
+    on = ((lambda u: u) if branch.disc == primary.disc else
+          (lambda u: collocated(primary.disc, u, branch.disc)))  # a branch on spectral elements: tube/front.py
+    near = [(float(np.linalg.norm(np.append(on(s.u), s.pressure) - last)), k) for k, s in enumerate(primary.special)
             if s.kind == Kind.BP and s.block == block and k != label]
     distance, found = min(near, default=(np.inf, None))
     return found if distance <= 2 * scene.continuation.step_max else None

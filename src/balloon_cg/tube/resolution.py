@@ -9,12 +9,14 @@ is returned as traced there, stopped with IntervalStop.UNRESOLVED at its last re
 max_degree. Every stored point has its tail (``IntervalBranch.tail``) at most max_error.
 
 ``balloon-cg run`` traces the bulge branch so where the scene asks for it (``solver.tube_resolution = "refine"``,
-``traced_bulge``); by default ("flag") at the scene's degree, with every point stored and those past max_error
-counted by ``inspect``.
+``traced_bulge``), on spectral elements refined until every point is resolved where it says "elements"
+(tube/front.py: the front resolved, which one series is not); by default ("flag") at the scene's degree, with
+every point stored and those past max_error counted by ``inspect``.
 """
 from dataclasses import replace
 
 from .bulge import bulge_branch
+from .front import front_bulge
 from .primary import primary_branch
 from .results import IntervalStop
 from ..analysis.branches.resolution import Resolution
@@ -22,16 +24,20 @@ from ..galerkin.interval import Mirror
 from ..numerics.continuation import Stop
 
 REFINE = "refine"  # solver.tube_resolution: the bulge branch retraced until resolved (scene/tables.TUBE_RESOLUTIONS)
+ELEMENTS = "elements"  # solver.tube_resolution: an odd branch point's branch on refined spectral elements (front.py)
 
 
 def traced_bulge(scene, primary, point, **trace) -> tuple:
     """(primary, point, bulge) of ``run``: the bulge branch switched at ``point`` of ``primary`` (tube/bulge.
     bulge_branch, ``trace`` its stop_volume, step, stop_stretch), at the primary's degree with every point stored
     (solver.tube_resolution "flag"), or held to the scene's policy (``refined_bulge``: "refine"), the primary branch
-    and its branch point then the ones of the degree the bulge was resolved on (an even branch point's branch, from
-    ``continue``, is traced as by "flag")."""
+    and its branch point then the ones of the degree the bulge was resolved on, or on spectral elements refined
+    until resolved ("elements": tube/front.front_bulge; the primary branch kept) (an even branch point's branch
+    is traced as by "flag")."""
     if scene.solver.tube_resolution == REFINE and point.block == Mirror.ODD:
         return refined_bulge(scene, primary, point, **trace)
+    if scene.solver.tube_resolution == ELEMENTS and point.block == Mirror.ODD:
+        return primary, point, front_bulge(scene, primary, point, **trace)
     return primary, point, bulge_branch(scene, primary, point, **trace)
 
 
