@@ -80,7 +80,8 @@ def main():
             for side in ("old", "new") if r % 2 == 0 else ("new", "old"):
                 results[side].append(timed(old if side == "old" else new, paths, folders[side]))
         images = sorted(p.name for p in folders["old"].iterdir())
-        differ = [name for name in images if (folders["old"] / name).read_bytes() != (folders["new"] / name).read_bytes()]
+        differ = [name for name in images
+                  if (folders["old"] / name).read_bytes() != (folders["new"] / name).read_bytes()]
         assert images == sorted(p.name for p in folders["new"].iterdir())
     print(f"load {os.getloadavg()[0]:.1f} (1 min), {os.getloadavg()[1]:.1f} (5 min) after; {len(images)} figures, "
           f"{'all byte for byte the same' if not differ else 'DIFFERENT: ' + ', '.join(differ)}")
