@@ -19,8 +19,8 @@ def _child(code: str):
 @pytest.fixture
 def last_scene_fails(monkeypatch):
     """The last scene's trace fails (no file), so that only the child's files could be listed."""
-    monkeypatch.setattr(default_run, "run_and_draw",
-                        lambda scene, outdir, quick, quiet: {"path": None, "images": [], "failure": f"{scene.name}: x"})
+    monkeypatch.setattr(default_run, "run_and_draw", lambda scene, outdir, quick, quiet, **_: {
+        "path": None, "images": [], "failure": f"{scene.name}: x"})
 
 
 def test_a_childs_failure_and_output_reach_the_run(monkeypatch, tmp_path, capsys, last_scene_fails):

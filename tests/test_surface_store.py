@@ -115,6 +115,35 @@ def test_round_trip_is_bit_exact(run_path, surface_branch, basis):
     assert np.allclose([s["eta_bottom"] for s in special], -STRETCHES[[0, -1]], rtol=1e-13)
 
 
+def _same(a, b) -> bool:
+    """Whether two read runs (nested dicts, lists, arrays, scalars) hold the same values of the same types."""
+    if isinstance(a, dict):
+        return isinstance(b, dict) and list(a) == list(b) and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray):
+        return isinstance(b, np.ndarray) and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=True)
+    return type(a) is type(b) and (a == b or a != a and b != b)
+
+
+def test_a_read_opens_each_member_once_and_reads_what_h5py_reads(run_path, monkeypatch):
+    """io.layout.opened's file opens each member once (``_OpenedOnce``): the run read through it is the run read
+    through a plain h5py.File, value for value, with under a third of the opens (~2 per object: the rest are
+    ``.parent`` lookups, which h5py makes from the file's root; the plain file ~9)."""
+    from balloon_cg.io import layout
+
+    opens = []
+    get = h5py.Group._get
+    monkeypatch.setattr(h5py.Group, "_get", lambda self, name, lapl=None: opens.append(name) or get(self, name, lapl))
+    cached = read_run(run_path)
+    cached_opens = len(opens)
+    opens.clear()
+    monkeypatch.setattr(layout, "_ReadFile", h5py.File)
+    plain = read_run(run_path)
+    assert _same(cached, plain)
+    assert cached_opens < len(opens) / 3
+
+
 def test_a_mapped_order_capped_basis_is_rebuilt(tmp_path, scene, primary, surface_branch):
     """The attributes rebuild a basis with an azimuthal order cap and a polar coordinate map (whose functions are
     orthonormalised in its own quadrature) exactly: the same node states from the stored coefficients."""

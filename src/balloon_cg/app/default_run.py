@@ -8,17 +8,19 @@ process beside this one, whose workers get the cores a finished child frees; a c
 the last scene's whole-sphere kernels into numba's cache before drawing, so that on a first run this process
 finds them there when its surface branches start: model/compile_lock.py makes either wait for a kernel the other
 is compiling), and every plot kind that applies is drawn as
-OUTDIR/<scene>_<kind>.png. The pressure curves of all scenes together (several M in one figure) go to
-OUTDIR/all_<kind>.png. Existing files of these names are overwritten. A summary table closes the run; the
-exit code is 1 if a scene failed or its result is incomplete (analysis.verdict), else 0. ``--quick`` limits
-every leg of the continuation to QUICK_POINTS points (for tests: the results are then partial by design and
-do not change the exit code).
+OUTDIR/<scene>_<kind>.png (a child's by the child; the last scene's, once the children are done, with the
+pressure curves of all scenes together (several M in one figure), OUTDIR/all_<kind>.png, on every core, each
+run file read once for them and the summary). Existing files of these names are overwritten. A summary table
+closes the run; the exit code is 1 if a scene failed or its result is incomplete (analysis.verdict), else 0.
+``--quick`` limits every leg of the continuation to QUICK_POINTS points (for tests: the results are then partial
+by design and do not change the exit code).
 """
 import argparse
 import json
 import subprocess
 import sys
 import time
+from contextlib import nullcontext
 from importlib import resources
 from pathlib import Path
 
@@ -26,6 +28,7 @@ from ..analysis.branches.tracer import ContinuationError
 from ..analysis.surface.branches import compile_kernels
 from ..analysis.verdict import failing, summary_line
 from ..io.output import replacing
+from ..numerics.workers import MIN_COST, serial, spread
 from .cli import run_scene
 from .progress import shown
 from .summaries import run_time, summarise_branch
@@ -49,23 +52,38 @@ def default_scenes(max_points: int | None = None) -> list:
 
 def draw_figures(paths, outdir: Path, stem: str, kinds=None) -> list[Path]:
     """Save every applicable plot kind (or those of ``kinds``) for the run files ``paths`` as <stem>_<kind>.png (each
-    file read once for all of them)."""
-    runs = [read_run(p) for p in paths]
+    file read once for all of them; ``drawn``)."""
+    return drawn(figures([read_run(p) for p in paths], outdir, stem, kinds))
+
+
+def figures(runs: list, outdir: Path, stem: str, kinds=None) -> list[tuple]:
+    """(runs, kind, image) of every plot kind that applies to the read ``runs`` (or of those of ``kinds``), the image
+    outdir/<stem>_<kind>.png."""
     applicable = applicable_kinds([b for run in runs for b in load_branches(run)])
-    images = []
-    for kind in applicable if kinds is None else [k for k in kinds if k in applicable]:
-        image = outdir / f"{stem}_{kind}.png"
+    return [(runs, kind, outdir / f"{stem}_{kind}.png")
+            for kind in (applicable if kinds is None else [k for k in kinds if k in applicable])]
+
+
+# a figure's drawing (~0.4 s) in numerics.workers' cost units (degree³ of a block): each is worth a worker's start
+FIGURE_COST = MIN_COST
+
+
+def drawn(jobs: list[tuple]) -> list[Path]:
+    """Draw and save the figures ``jobs`` ((runs, kind, image) each: ``figures``) on the cores this process may use
+    (numerics.workers.spread: a forked worker draws the same figure it would here); their images in order."""
+    def draw(job: tuple) -> str:
+        runs, kind, image = job
         figure = plot(runs, kind)
         with replacing(image, force=True) as tmp:  # the default run owns out/ (its runs are replaced too)
             figure.savefig(tmp, dpi=150, format="png")
-        images.append(image)
-    return images
+        return str(image)
+
+    return [Path(image) for image in spread(draw, jobs, [FIGURE_COST] * len(jobs), interruptible=False)]
 
 
-def summary_row(path) -> dict:
+def summary_row(run: dict) -> dict:
     """Scene, points, P range, special points, max error estimate, the primary trace's time and the whole run's
-    (every phase, writing included: ``summaries.run_time``) of a run file."""
-    run = read_run(path)
+    (every phase, writing included: ``summaries.run_time``) of a read run file."""
     b = summarise_branch(run["branches"]["primary"])
     timing = run_time(run["attrs"])
     return {
@@ -112,7 +130,7 @@ def main(argv=None) -> int:
     *beside, last = scenes
     children = [_started(scene.name, outdir, args.quick, last.name) for scene in beside]
     try:
-        outcomes = [run_and_draw(last, outdir, args.quick, args.quiet)]
+        outcomes = [run_and_draw(last, outdir, args.quick, args.quiet, draw=False)]
         for child in children:
             out, err = child.communicate()
             sys.stderr.write(err)
@@ -122,15 +140,18 @@ def main(argv=None) -> int:
             if child.poll() is None:
                 child.kill()
                 child.wait()
+    runs = [read_run(o["path"]) for o in outcomes if o["path"]]  # each file read once: figures and summary
+    jobs = figures(runs[-1:], outdir, last.name) if outcomes[-1]["path"] else []
+    combined = figures(runs, outdir, "all", COMBINED) if len(runs) > 1 else []
+    images = drawn(jobs + combined)  # the last scene's and the combined figures at once, on both cores
+    outcomes[-1]["images"] = [str(image) for image in images[:len(jobs)]]
     for outcome in outcomes:  # the children's after the last scene's progress bars, in the scenes' order
         for line in ([outcome["path"]] if outcome["path"] else []) + outcome["images"]:
             print(line)
-    paths = [Path(o["path"]) for o in outcomes if o["path"]]
     failed = [o["failure"] for o in outcomes if o["failure"]]
-    if len(paths) > 1:
-        for image in draw_figures(paths, outdir, "all", COMBINED):
-            print(image)
-    rows = [summary_row(path) for path in paths]
+    for image in images[len(jobs):]:
+        print(image)
+    rows = [summary_row(run) for run in runs]
     if rows:
         print()
         print(format_summary(rows))
@@ -140,18 +161,21 @@ def main(argv=None) -> int:
     return 1 if failed else 0
 
 
-def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool, ahead=None) -> dict:
-    """Analyse ``scene`` into outdir/<scene>.h5 and draw its figures: {'path': the run file (None when the trace
-    failed), 'images': the figures' paths, 'failure': what failed, or None (a quick run's partial result is none)},
-    plain data (a child's is sent as JSON). ``ahead``: a scene another process runs, whose whole-sphere kernels
-    are compiled into numba's cache between the run file and the figures (a child's; module docstring)."""
+def run_and_draw(scene, outdir: Path, quick: bool, quiet: bool, ahead=None, draw: bool = True) -> dict:
+    """Analyse ``scene`` into outdir/<scene>.h5 and draw its figures (not ``draw``: none, 'images' empty): {'path':
+    the run file (None when the trace failed), 'images': the figures' paths, 'failure': what failed, or None (a
+    quick run's partial result is none)}, plain data (a child's is sent as JSON). ``ahead``: a scene another
+    process runs, whose whole-sphere kernels are compiled into numba's cache between the run file and the figures
+    (a child's, which draws on its one core: the other is that scene's; module docstring)."""
     try:
         path, found = run_scene(scene, outdir / f"{scene.name}.h5", force=True, progress=shown(quiet))
     except ContinuationError as e:
         return {"path": None, "images": [], "failure": f"{scene.name}: {e}"}
     if ahead is not None:
         compile_kernels(ahead)
-    return {"path": str(path), "images": [str(image) for image in draw_figures([path], outdir, scene.name)],
+    with serial() if ahead is not None else nullcontext():
+        images = draw_figures([path], outdir, scene.name) if draw else []
+    return {"path": str(path), "images": [str(image) for image in images],
             "failure": f"{scene.name}: {summary_line(found)}" if failing(found) and not quick else None}
 
 
