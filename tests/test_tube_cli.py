@@ -148,6 +148,40 @@ def test_pressure_volume_figure_has_the_maxwell_line(run_file):
     assert len(maxwell) == 1 and maxwell[0].get_ydata()[0] == run["attrs"]["maxwell_pressure"]
 
 
+def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(run_file):
+    """At the default width every title and axis label of every tube figure lies inside the figure (the stretches'
+    title ran past both edges); on P against V/V0 every located point is marked and its label is the number
+    ``inspect`` lists and ``continue`` takes with its kind ("1 BP odd"), the labels clear of one another (they were
+    drawn over one another, without numbers, where branch points crowd the pressure maximum)."""
+    from balloon_cg.io.tube_file import tube_labels
+    from balloon_cg.post.labels import GID
+    from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
+
+    run = read_tube_run(run_file)
+    for kind in TUBE_KINDS:
+        fig = tube_figure(run, kind)
+        fig.draw_without_rendering()
+        box = fig.bbox
+        for ax in fig.axes:
+            for text in (ax.title, ax.xaxis.label, ax.yaxis.label):
+                extent = text.get_window_extent()
+                assert box.x0 - 0.5 <= extent.x0 and extent.x1 <= box.x1 + 0.5, (kind, text.get_text())
+                assert box.y0 - 0.5 <= extent.y0 and extent.y1 <= box.y1 + 0.5, (kind, text.get_text())
+    fig = tube_figure(run, "pressure-volume")
+    fig.draw_without_rendering()
+    labels = [t for t in fig.axes[0].texts if t.get_gid() == GID and t.get_text()]
+    located = tube_labels(run)
+    markers = [line for line in fig.axes[0].lines if len(line.get_xdata()) == 1]
+    assert len(markers) == len(located) and len(labels) >= 3
+    for text in (t.get_text() for t in labels):  # a crowded plot drops a label with no free place (post/labels.py)
+        numbers, kind = text.split(maxsplit=1)
+        for n in map(int, numbers.split(",")):
+            assert kind == " ".join(filter(None, (located[n][2]["kind"], located[n][2]["block"]))), text
+    extents = [t.get_window_extent() for t in labels]
+    for i, a in enumerate(extents):
+        assert not any(a.overlaps(b) for b in extents[i + 1:]), labels[i].get_text()
+
+
 def test_an_existing_file_is_kept_without_force(run_file, capsys):
     before = run_file.read_bytes()
     assert main(["run", str(SCENE), "-o", str(run_file), "--quiet", *FAST]) == 2

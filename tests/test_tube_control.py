@@ -241,6 +241,32 @@ def test_bad_stop_volume_is_one_line(text, message, tmp_path, capsys):
     assert len(capsys.readouterr().err.strip().splitlines()) == 1 and not (tmp_path / "bad.h5").exists()
 
 
+@pytest.mark.parametrize("geometry, volume, reference", [
+    ('shape = "tube"\nlength = 20.0\n', 50.0, "62.8319 (the tube of length 20 with sliding ends"),
+    ('shape = "tube"\nlength = 10.0\nends = "plugged"\naxial_stretch = 1.2\n', 31.4159,
+     "31.4159 (the tube of length 10 with plugged ends held at 1.2 L"),
+    ('shape = "capsule"\nlength = 2.0\n', 10.47, "10.472 (the capsule of length 2"),
+    ('shape = "spheroid"\naspect = 1.5\n', 6.0, "6.28319 (the spheroid of aspect 1.5"),
+    ('shape = "sphere"\n', 3.0, "4.18879 (the sphere"),
+])
+def test_stop_volume_at_or_below_the_reference_volume_is_one_line(geometry, volume, reference, tmp_path, capsys):
+    """continuation.stop_volume is V/R0³, not V/V0: a value at or below the reference volume (πL, πL + 4π/3,
+    4π/3 · aspect) would end the branch at its start, landed backwards into compression (a tube of length 20 given
+    stop_volume = 60 traced P down to −0.19 and switched m = 1 branches there): one line naming the key, the
+    value and the allowed range; the CLI exits 2 and keeps an existing output file."""
+    text = f'[material]\npreset = "SPOM1"\n[geometry]\n{geometry}[continuation]\nstop_volume = {volume!r}\n'
+    message = (f"continuation.stop_volume = {volume!r}: at or below the reference volume {reference}; V/R0³, not "
+               f"V/V0); must be > {reference.split()[0]}")
+    with pytest.raises(SceneError) as error:
+        parse_scene(text, "small")
+    assert str(error.value) == f"small: {message}"
+    path, out = tmp_path / "small.toml", tmp_path / "small.h5"
+    path.write_text(text)
+    out.write_bytes(b"kept")
+    assert main(["run", str(path), "-o", str(out), "--force"]) == 2
+    assert capsys.readouterr().err.strip() == f"balloon-cg: error: {path.name}: {message}" and out.read_bytes() == b"kept"
+
+
 def test_bulge_branch_under_gas_control_lands_on_stop_volume():
     """SPOM1, L = 10, degree 20, gas control: the bulge switched at the onset passes its LV, then its fold in n (LN),
     across which the gas reading loses its unstable direction (1 → 0: a bulge holding a fixed amount of gas is

@@ -146,13 +146,6 @@ def _has_field(run: dict) -> bool:
     return field["coils"] > 0 and field["M"] > 0
 
 
-def tube_labels(run: dict) -> list:
-    """The labels of a tube run (``read_tube_run``'s dict), as ``inspect`` numbers them: (branch, its k-th located
-    point, the point) for the primary branch's located points, then the other branches'."""
-    ordered = sorted(run["branches"].items(), key=lambda item: item[0] != "primary")
-    return [(name, k, s) for name, b in ordered for k, s in enumerate(b["special_points"])]
-
-
 def continue_tube(args) -> int:
     """``continue`` from a label of a tube run file (``inspect`` numbers the located points of its branches in
     order, from 0): at an odd branch point of the primary branch (the onset of bulging), or at an even one of a
@@ -163,7 +156,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
     user point (UZ) of the primary branch, the tube continued in Φ̄ at its P (``_continue_in_voltage``). Exit 2,
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
-    from ..io.tube_file import read_tube_run, stored_branch
+    from ..io.tube_file import read_tube_run, stored_branch, tube_labels
     from ..tube.bulge import PLUGGED_WHY
     from ..tube.picture import branch_name, bulge_picture, maxwell, onset_from
     from ..tube.primary import scene_parameters

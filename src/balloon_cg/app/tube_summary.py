@@ -191,7 +191,7 @@ def format_tube(summary: dict) -> str:
     lines += [f"not started    {line}" for line in summary["not_started"]]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")
-    label = 0  # the labels of ``continue``, numbered through the branches (app/tube_commands.tube_labels)
+    label = 0  # the labels of ``continue``, numbered through the branches (io/tube_file.tube_labels)
     for name, b in summary["branches"].items():
         origin = "" if b["parent"] is None else f" (from label {b['parent']['label']} of {b['parent']['branch']}" + (
             "" if b["rejoins"] is None else f", rejoins it at label {b['rejoins']}") + ")"

@@ -352,6 +352,13 @@ def _read_modes(path, group, n: int, where: str) -> dict:
     return out
 
 
+def tube_labels(run: dict) -> list:
+    """The labels of a tube run (``read_tube_run``'s dict), as ``inspect`` numbers them and ``continue`` takes them:
+    (branch, its k-th located point, the point) for the primary branch's located points, then the other branches'."""
+    ordered = sorted(run["branches"].items(), key=lambda item: item[0] != "primary")
+    return [(name, k, s) for name, b in ordered for k, s in enumerate(b["special_points"])]
+
+
 def tube_row(run: dict) -> dict:
     """What a tube run (``read_tube``'s dict) found, as a sweep's table row (io/sweep_file.py): the uniform
     pressure maximum ``P_max`` (the primary branch's first LP), the onset of bulging ``P_onset``, ``V_onset`` (its

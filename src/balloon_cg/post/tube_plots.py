@@ -6,14 +6,17 @@ branch's located m ≥ 1 zeros (``critical_modes``).
 
 Curves are solid where a point is stable under the chosen control (default: the run's loading.control; no negative
 eigenvalue of the second variation under it: the file's ``unstable_pressure``/``unstable_volume``/``unstable_gas``,
-tube/stability.py) and dashed where it is not; located points are marked and labelled (LP, LV, LN, BP with its
-mirror block).
+tube/stability.py) and dashed where it is not; located points are marked and labelled with the number ``inspect``
+lists and ``continue`` takes ("1 BP odd", post/labels.py: clear of one another and of the curves); titles are
+wrapped to the figure (post/fit.py).
 """
 import numpy as np
 
+from .fit import fit_titles
+from .labels import label_points
 from .style import JournalFigure, journal_style
 from .tube_measures import SAMPLES, fronts, stretches
-from ..io.tube_file import discretisation
+from ..io.tube_file import discretisation, tube_labels
 from ..tube.azimuthal import mode_profile
 
 TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches", "modes")
@@ -44,13 +47,14 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
         ax = fig.add_subplot()
         if what == "pressure-volume":
             pressure_volume(ax, run, control)
-            return fig
-        name = branch or ("bulge" if "bulge" in run["branches"] else "primary")
-        if name not in run["branches"]:
-            raise TubePlotError(f"--branch {name}: not in the file; it has {', '.join(run['branches'])}")
-        draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles,
-                "modes": critical_modes}[what]
-        draw(ax, run, name, points)
+        else:
+            name = branch or ("bulge" if "bulge" in run["branches"] else "primary")
+            if name not in run["branches"]:
+                raise TubePlotError(f"--branch {name}: not in the file; it has {', '.join(run['branches'])}")
+            draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles,
+                    "modes": critical_modes}[what]
+            draw(ax, run, name, points)
+        fit_titles(fig)
     return fig
 
 
@@ -59,13 +63,15 @@ def pressure_volume(ax, run: dict, control: str) -> None:
     non-axisymmetric branches (/surface_branches: thinner, labelled with their m, their folds LP) beside them, and
     Maxwell's pressure as a dotted line where the file has one."""
     others = iter(f"C{k}" for k in range(1, 10_000))  # a colour of its own for every other switched branch
+    colours = {}
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
-        colour = _COLOURS.get(name) or next(others)
+        colour = colours[name] = _COLOURS.get(name) or next(others)
         _curve(ax, b, control, colour, name)
-        for s in b["special_points"]:
-            ax.plot(s["volume"], s["pressure"], "o", color=colour, markersize=3)
-            ax.annotate(f"{s['kind']}{' ' + s['block'] if s['block'] else ''}", (s["volume"], s["pressure"]),
-                        textcoords="offset points", xytext=(3, 3), fontsize=6)
+    marks = []
+    for label, (name, _, s) in enumerate(tube_labels(run)):
+        ax.plot(s["volume"], s["pressure"], "o", color=colours[name], markersize=3)
+        marks.append((ax, label, " ".join(filter(None, (s["kind"], s["block"]))), s["volume"], s["pressure"],
+                      colours[name]))
     for name, b in run.get("surface_branches", {}).items():
         colour = next(others)
         _curve(ax, b, control, colour, f"{name} (m = {b['attrs']['m']})", 0.8)
@@ -80,6 +86,7 @@ def pressure_volume(ax, run: dict, control: str) -> None:
     ax.set_ylabel("$P$")
     ax.set_title(f"{run['attrs']['scene_name']} (solid: stable under {control} control)")
     ax.legend()
+    label_points(marks)
 
 
 def profiles(ax, run: dict, name: str, points=None) -> None:

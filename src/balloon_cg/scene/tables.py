@@ -154,6 +154,13 @@ class Geometry:
             return {"shape": self.shape.value, "length": self.length} | split | graded
         return {"shape": self.shape.value, "aspect": self.aspect}
 
+    @property
+    def reference_volume(self) -> float:
+        """V0/R0³ enclosed by the reference surface: 4π/3 · aspect (sphere, spheroid), πL + 4π/3 (capsule), πL
+        (tube)."""
+        cylinder = 0.0 if self.length is None else math.pi * self.length
+        return cylinder if self.shape == Shape.TUBE else cylinder + 4 * math.pi / 3 * self.aspect
+
     def describe(self) -> str:
         """'sphere', 'spheroid of aspect 1.5', 'capsule of length 40', 'tube of length 10 with sliding ends',
         '... held at 1.5 L'."""
@@ -685,6 +692,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field)
+    _stop_volume_above_reference(continuation.stop_volume, geometry)
     dynamics = _dynamics(data.get("dynamics", {}))
     solver = _solver(data.get("solver", {}))
     if geometry.shape != Shape.TUBE and solver.tube_resolution != Solver.tube_resolution:
@@ -716,6 +724,15 @@ def _build(data: dict, name: str, text: str) -> Scene:
         geometry=geometry,
         dynamics=dynamics,
     )
+
+
+def _stop_volume_above_reference(stop_volume: float | None, geometry: Geometry) -> None:
+    """SceneError for a continuation.stop_volume at or below the reference volume (a stop that ends the branch at its
+    start: V/R0³ given as V/V0)."""
+    v0 = geometry.reference_volume
+    if stop_volume is not None and stop_volume <= v0:
+        raise SceneError(f"continuation.stop_volume = {show(stop_volume)}: at or below the reference volume {v0:g} "
+                         f"(the {geometry.describe()}; V/R0³, not V/V0); must be > {v0:g}")
 
 
 def _tube_surface_reads(surface: Surface, stability) -> None:
