@@ -171,3 +171,33 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     message = str(error.value)
     assert 'surface.branches = "first"' in message and "stability.m_max" in message and "allowed" in message, message
     assert "\n" not in message
+
+
+def test_a_signal_while_reading_the_stability_keeps_the_points_read(traced, monkeypatch):
+    """The branch's points are read after its trace (dense eigensolves: minutes on a large basis): a signal during
+    them ends the branch INTERRUPTED with the points read so far, each the uninterrupted branch's, and no point
+    unread (a tube run ignored SIGTERM for 388 s there)."""
+    from balloon_cg.analysis.results import StopCode
+    from balloon_cg.numerics import interrupt
+    from balloon_cg.tube.surface import branch as module
+
+    scene, parent, zero, whole, _ = traced
+    calls = []
+
+    class Signalled(SectorStability):
+        def __call__(self, *args):
+            calls.append(1)
+            if len(calls) == 2:
+                interrupt.request()  # during the second point's reading
+            return super().__call__(*args)
+
+    monkeypatch.setattr(module, "SectorStability", Signalled)
+    try:
+        cut = traced_branch(scene, parent.disc, zero, parent.params, 1, POINTS)
+    finally:
+        interrupt._flag.clear()
+    assert len(whole.pressure) > 2 and len(calls) == 2
+    assert cut.stop.code == StopCode.INTERRUPTED
+    assert len(cut.pressure) == len(cut.lowest) == len(cut.coefficients) == 2
+    assert np.array_equal(cut.pressure, whole.pressure[:2]) and np.array_equal(cut.lowest, whole.lowest[:2])
+    assert all(index < 1 for index, _ in cut.folds)

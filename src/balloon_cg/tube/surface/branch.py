@@ -34,7 +34,7 @@ from ..results import IntervalStop, signalled
 from ...analysis.branches.problem import continuation_settings
 from ...analysis.results import StopCode
 from ...galerkin.equilibrium import Parameters
-from ...numerics import continuation
+from ...numerics import continuation, interrupt
 from ...numerics.continuation import Stop, TraceStop
 from ...numerics.newton import newton
 from ...scene.loading import Control
@@ -203,7 +203,14 @@ def _branch(origin: _Leg, legs: list, crossing, params: Parameters, folds: tuple
     points += [(leg, leg.system.coefficients(p.X), p.X[-1], leg.system.reaction(p.X)) for leg in legs
                for p in leg.points]
     readers = {id(leg): SectorStability(leg.system) for leg in (origin, *legs)}
-    readings = [readers[id(leg)](c, params.with_value("P", P)) for leg, c, P, _ in points]
+    readings = []
+    for leg, c, P, _ in points:
+        if readings and interrupt.requested():  # dense readings of minutes: the points read are kept, none unread
+            stop = Stop(StopCode.INTERRUPTED, f"interrupted (SIGINT or SIGTERM) while reading the stability: the "
+                                              f"{len(readings)} points read are kept")
+            points, folds = points[:len(readings)], tuple(f for f in folds if f[0] < len(readings) - 1)
+            break
+        readings.append(readers[id(leg)](c, params.with_value("P", P)))
     return TubeSurfaceBranch(
         final, crossing.m, np.array([leg.basis.raised(c, final) for leg, c, _, _ in points]),
         np.array([P for _, _, P, _ in points]),
