@@ -44,7 +44,8 @@ H_STEP = 1e-6  # the central differences' step in u (along φ, |φ| ~ 1), P and 
 class OnsetStop(enum.StrEnum):
     """Why an onset curve stopped (beside the tracer's TraceStop)."""
 
-    FIELD_FREE = "field_free"  # q fell below 0: the last point is the onset at q = 0
+    FIELD_FREE = "field_free"  # q fell below 0: the last point is an odd branch point of the tube at q = 0 (not
+    #                            necessarily its first: the curve may return along another bulge mode)
     NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # P reached 0
 
 
@@ -161,7 +162,9 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
         if P <= 0:
             return Stop(OnsetStop.NONPOSITIVE_PRESSURE, f"P reached 0 at {name} = {q:.6g}")
         if q < 0:
-            return Stop(OnsetStop.FIELD_FREE, f"{name} fell below 0: the last point is the onset at {name} = 0")
+            return Stop(OnsetStop.FIELD_FREE, f"{name} fell below 0: the last point is an odd branch point at "
+                                              f"{name} = 0 (not necessarily the first onset: the curve may return "
+                                              "along another bulge mode)")
         return None
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
