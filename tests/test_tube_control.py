@@ -264,7 +264,8 @@ def test_stop_volume_at_or_below_the_reference_volume_is_one_line(geometry, volu
     path.write_text(text)
     out.write_bytes(b"kept")
     assert main(["run", str(path), "-o", str(out), "--force"]) == 2
-    assert capsys.readouterr().err.strip() == f"balloon-cg: error: {path.name}: {message}" and out.read_bytes() == b"kept"
+    assert capsys.readouterr().err.strip() == f"balloon-cg: error: {path.name}: {message}"
+    assert out.read_bytes() == b"kept"
 
 
 def test_bulge_branch_under_gas_control_lands_on_stop_volume():

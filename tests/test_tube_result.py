@@ -93,3 +93,24 @@ def test_every_group_opens_with_xarray_with_named_dimensions(files):
     with xr.open_dataset(files[1], engine="h5netcdf", group="branches/primary") as ds:
         assert ds["unknowns"].dims == ("point", "unknown") and ds["volume"].attrs["units"] == "1"
         assert np.array_equal(ds["unknowns"].values, stored["branches"]["primary"]["unknowns"])
+
+
+def test_plot_draws_a_tube_from_its_result_or_its_path_as_the_command_does(files):
+    """``bc.plot`` of a TubeResult or a tube file's path draws post.tube_plots' figure (the command's): the same
+    lines as ``tube_figure`` of the file; a tube beside another source or into given Axes is refused in one line."""
+    import matplotlib.pyplot as plt
+    from balloon_cg.post.plotting import PlotError
+    from balloon_cg.post.tube_plots import tube_figure
+
+    tube = bc.load(files[0])
+    expected = tube_figure(read_tube_run(files[0]), "profiles")
+    for source in (tube, files[0], str(files[0])):
+        fig = bc.plot(source, "profiles")
+        assert [line.get_xydata().tolist() for line in fig.axes[0].lines] == \
+            [line.get_xydata().tolist() for line in expected.axes[0].lines]
+    assert bc.plot(tube).axes[0].get_xlabel() == tube_figure(tube.run, "pressure-volume").axes[0].get_xlabel()
+    with pytest.raises(PlotError, match="alone"):
+        bc.plot([tube, tube], "profiles")
+    with pytest.raises(PlotError, match="ax"):
+        bc.plot(tube, "profiles", ax=plt.figure().add_subplot())
+    plt.close("all")

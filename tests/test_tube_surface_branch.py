@@ -133,7 +133,8 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     is traced; with "first" the primary branch's first m = 1 zero starts "m1_bp0" (tube/picture.with_surface),
     written to the run file and read back (io/tube_surface_file.py) with its parent, points, stability, stop and
     ``limited``, and shown by ``inspect`` (text and the JSON summary) and drawn by ``plot --what pressure-volume``
-    beside the axisymmetric branches; "first" with m_max = 0 is refused in one line naming the key, its value and what is allowed."""
+    beside the axisymmetric branches; "first" with m_max = 0 is refused in one line naming the key, its value and what
+    is allowed."""
     from balloon_cg.app.tube_summary import summarise_tube, format_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
     from balloon_cg.post.tube_plots import tube_figure

@@ -512,11 +512,13 @@ def plot(source, what: str | None = None, ax=None, points=None, branch: str | No
 
     Parameters
     ----------
-    source : Result, SweepResult, CurveResult, str or Path, or a list of them
-        What to draw (several: one curve set each): a run, a loaded sweep or curve file (``load``), a file's path.
+    source : Result, SweepResult, CurveResult, TubeResult, str or Path, or a list of them
+        What to draw (several: one curve set each): a run, a loaded sweep or curve file (``load``), a file's path;
+        a tube run (a TubeResult or its file) alone, on a Figure of its own.
     what : str, optional
-        The kind (docs/plots.md); None: the pole curve of the continuation parameter, ``pressure-pole`` or, for
-        a run continued in the voltage, ``voltage-pole``; ``phase`` for a sweep or curve.
+        The kind (docs/plots.md; a tube's: post.tube_plots.TUBE_KINDS); None: the pole curve of the continuation
+        parameter, ``pressure-pole`` or, for a run continued in the voltage, ``voltage-pole``; ``phase`` for a sweep
+        or curve; ``pressure-volume`` for a tube.
     ax : matplotlib Axes or sequence of Axes, optional
         Draw into these (a sequence for the kinds with several panels); None: a new Figure.
     points : list of int, optional
@@ -547,7 +549,29 @@ def plot(source, what: str | None = None, ax=None, points=None, branch: str | No
     from ..post.plotting import plot as draw
 
     sources = source if isinstance(source, (list, tuple)) else [source]
+    tube = _tube_run(sources, ax)
+    if tube is not None:
+        from ..post.tube_plots import tube_figure
+        return tube_figure(tube, what or "pressure-volume", stability, branch, points, width or 3.5)
     return draw([_drawable(s) for s in sources], what, points, branch, axes=ax, stability=stability, width=width)
+
+
+def _tube_run(sources: list, ax) -> dict | None:
+    """The run of a tube source of ``plot`` (a TubeResult or a tube run file's path: post.tube_plots draws it, alone
+    and on a Figure of its own; PlotError otherwise), None where no source is a tube's."""
+    from ..io.tube_file import read_tube_run
+    from ..post.plotting import PlotError
+    from .tube_result import TubeResult
+
+    tubes = [s for s in sources if isinstance(s, TubeResult)
+             or isinstance(s, (str, Path)) and Path(s).is_file() and file_kind(s) == "tube"]
+    if not tubes:
+        return None
+    if len(sources) > 1:
+        raise PlotError(f"plot draws a tube run alone; got {len(sources)} sources")
+    if ax is not None:
+        raise PlotError("ax: a tube run's figure is drawn on a Figure of its own (set its size with width)")
+    return tubes[0].run if isinstance(tubes[0], TubeResult) else read_tube_run(tubes[0])
 
 
 def _drawable(source):

@@ -26,7 +26,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 
 from .discretisation import gauss_nodes, geometric_tail, read_only
 from .interval import IntervalDiscretisation
@@ -157,8 +156,10 @@ def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterva
 @functools.lru_cache(maxsize=16)
 def _sparse_maps(disc: ElementInterval) -> tuple:
     """((λ2, v) of λ2's coefficients, (η, w) of (λ̄, b)): the node maps as CSR matrices (n_q, columns)."""
+    from scipy import sparse  # here: a sphere's `run` imports this module (io/tube_file) but never scipy.sparse
     tables = disc.tables
-    return tuple(tuple(sparse.csr_matrix(maps[a]) for a in (0, 1)) for maps in (tables["hoop_maps"], tables["axial_maps"]))
+    return tuple(tuple(sparse.csr_matrix(maps[a]) for a in (0, 1))
+                 for maps in (tables["hoop_maps"], tables["axial_maps"]))
 
 
 @functools.lru_cache(maxsize=16)

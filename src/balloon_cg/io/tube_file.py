@@ -409,8 +409,8 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     attrs = b["attrs"]
     parent = (attrs["parent_branch"], int(attrs["parent_label"])) if "parent_label" in attrs else None
     rejoins = int(attrs["rejoins_label"]) if attrs.get("rejoins_label", -1) >= 0 else None
-    return IntervalBranch(discretisation(run["attrs"], b["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest, unstable,
-                          special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
+    return IntervalBranch(discretisation(run["attrs"], b["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest,
+                          unstable, special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
                           rejoins=rejoins)
 
 
