@@ -290,14 +290,22 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
     with picture.clock.step(Step.BRANCH_POINTS):
         # the free balloon's pear points (odd_free) after the others: the held numbering does not depend on them
         crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
-        for n, (index, block, k) in enumerate(crossings):
-            if stopped(picture):
-                break
-            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
-            bp.note = f"{MODES[block]} mode"  # its name: its label in the file
+        located = workers.spread(lambda crossing: _located(primary, *crossing), crossings,
+                                 [bifurcation.location_cost(primary, index) for index, _, _ in crossings])
+        for bp in located:
             picture.branch_points.append(bp)
             primary.special.append(bp)
     primary.special.sort(key=_along)
+
+
+def _located(primary: Branch, index: int, block: Block, k: int):
+    """The m = 0 branch point detected between points index and index + 1 of ``primary``, located and classified
+    (``bifurcation``); each on its own (``_branch_points`` spreads them over the cores: the numbers of the serial
+    loop); a signal raises ``interrupt.Interrupted`` before it starts."""
+    interrupt.check()
+    bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
+    bp.note = f"{MODES[block]} mode"  # its name: its label in the file
+    return bp
 
 
 def _trace_broken(scene, primary: Branch, picture: Picture, progress: Progress) -> None:
