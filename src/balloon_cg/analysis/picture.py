@@ -8,8 +8,8 @@ and adds its mirror image (north and south poles swapped: the reflection z → �
 assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
 locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
 branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
-whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
-snap-throughs under the scene's loading control
+whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks; the primary's in a
+worker beside the pear branches, ``_surface_beside``: the same numbers) and lists the snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,

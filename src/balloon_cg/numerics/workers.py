@@ -1,4 +1,5 @@
-"""Independent pieces of one computation on every core: ``spread(work, items, costs)``.
+"""Independent pieces of one computation on every core: ``spread(work, items, costs)``; ``Stream`` (items fed to
+workers while they are made) and ``Beside`` (one piece of work in a worker while this process does another).
 
 The points of a branch are independent for stability (each is one set of dense Hessian blocks and eigensolves), so
 ``[work(i) for i in items]`` is handed to forked worker processes: a forked child inherits the jitted kernels and
