@@ -23,6 +23,7 @@ sphere (``surface.primary``) and the branches born at its pitchforks with their 
 in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
+import itertools
 from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
 
@@ -292,7 +293,7 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
         crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
         located = workers.spread(lambda crossing: _located(primary, *crossing), crossings,
                                  [bifurcation.location_cost(primary, index) for index, _, _ in crossings])
-        for bp in located:
+        for bp in itertools.takewhile(lambda bp: bp is not None, located):
             picture.branch_points.append(bp)
             primary.special.append(bp)
     primary.special.sort(key=_along)
@@ -301,8 +302,11 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
 def _located(primary: Branch, index: int, block: Block, k: int):
     """The m = 0 branch point detected between points index and index + 1 of ``primary``, located and classified
     (``bifurcation``); each on its own (``_branch_points`` spreads them over the cores: the numbers of the serial
-    loop); a signal raises ``interrupt.Interrupted`` before it starts."""
-    interrupt.check()
+    loop). None once a signal asked to stop: in this process the points located before it are kept, as the serial
+    loop kept them; on workers the signal raises ``interrupt.Interrupted`` here within a second (``workers.spread``)
+    and the points in the workers are abandoned, as a branch's assessments are."""
+    if interrupt.requested():
+        return None
     bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
     bp.note = f"{MODES[block]} mode"  # its name: its label in the file
     return bp
