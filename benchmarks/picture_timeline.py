@@ -4,8 +4,7 @@ One fresh process of this interpreter runs ``analysis.picture.analyse`` on a sce
 kernels) and prints, for the second, each timed call's start and end in wall seconds from the analysis's start,
 its duration, and the CPU seconds of this process and of the worker processes it collected meanwhile
 (``RUSAGE_CHILDREN``: a worker counts once it has ended): the phases of benchmarks/whole_picture.py and, nested in
-them, each ``numerics.workers.spread`` (its items, total cost and the workers it used) and the wait for a
-``workers.Beside`` (its work is not seen here: it runs in the worker). A line that starts after the previous one
+them, each ``numerics.workers.spread`` (its items, total cost and the workers it used). A line that starts after the previous one
 ended and overlaps nothing is time this process ran alone; wall time against own + workers' CPU says how many cores
 were busy on average.
 
@@ -60,8 +59,6 @@ def main(path: str) -> None:
                                 (picture, "snap_throughs", "snap-throughs")):
         setattr(module, name, timed(label, getattr(module, name)))
     workers.spread = timed("spread", workers.spread, spread_detail)
-    if hasattr(workers, "Beside"):
-        workers.Beside.result = timed("wait for the worker beside", workers.Beside.result)
     scene = load_scene(path)
     picture.analyse(scene)
     events.clear()

@@ -199,85 +199,33 @@ def test_workers_are_gone_when_spread_raises(monkeypatch, tmp_path):
     assert not (tmp_path / "done_0").exists()
 
 
-def _pid_and_spread():
-    return os.getpid(), workers.spread(_pid_and_square, range(6), BIG)
-
-
-def test_beside_computes_in_a_worker_that_spreads_its_own_work(monkeypatch):
-    """``Beside`` runs its work in a forked worker, which may spread its own items over workers of its own (it is no
-    item of a ``spread``); the result is the work's."""
-    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
-    with workers.Beside(_pid_and_spread, workers.MIN_COST) as beside:
-        assert beside.worker is not None
-        pid, found = beside.result()
-    assert pid != os.getpid() and [square for _, square in found] == [i * i for i in range(6)]
-    assert not {p for p, _ in found} & {pid, os.getpid()}
-    assert beside.worker is None
-
-
-@pytest.mark.parametrize("how", ["cheap", "one worker", "serial"])
-def test_beside_stays_in_this_process(monkeypatch, how):
-    monkeypatch.setenv("BALLOON_CG_WORKERS", "1" if how == "one worker" else "2")
-    cost = 1.0 if how == "cheap" else workers.MIN_COST
-    if how == "serial":
-        with workers.serial(), workers.Beside(lambda: os.getpid(), cost) as beside:
-            assert beside.worker is None and beside.result() == os.getpid()
-    else:
-        with workers.Beside(lambda: os.getpid(), cost) as beside:
-            assert beside.worker is None and beside.result() == os.getpid()
-
-
-def _fails():
-    raise ValueError("the work beside")
-
-
-def test_beside_raises_its_worker_s_error_and_a_signal_stops_it(monkeypatch):
-    """The worker's exception is raised by ``result``; a signal while ``result`` waits raises Interrupted within a
-    second, and no worker is left either way."""
-    import multiprocessing
-    import threading
-    import time
-
-    monkeypatch.setenv("BALLOON_CG_WORKERS", "2")
-    with pytest.raises(ValueError, match="the work beside"):
-        workers.Beside(_fails, workers.MIN_COST).result()
-    assert not multiprocessing.active_children()
-    beside = workers.Beside(lambda: time.sleep(30), workers.MIN_COST)
-    threading.Timer(0.5, interrupt.request).start()
-    try:
-        with pytest.raises(interrupt.Interrupted):
-            beside.result()
-    finally:
-        interrupt._flag.clear()
-    assert not multiprocessing.active_children()
-
-
-def test_a_picture_with_its_surface_branch_beside_its_pear_branches_is_the_serial_one(monkeypatch):
+def test_a_picture_with_its_branch_points_on_two_workers_is_the_serial_one(monkeypatch):
     """Two coils to the first branch points with 3-point surface branches (tests/test_interrupt_moments.py's scene):
-    on two workers (the branch points on both, the surface branches traced beside the pear branches:
-    ``picture._surface_beside``) and in this process, the same branches, special points, assessments and surface
-    branches, bit for bit."""
+    on two workers (the m = 0 branch points located on both: ``picture._branch_points``) and in this process, the
+    same branches, special points, assessments and surface branches, bit for bit."""
     from pathlib import Path
 
     from balloon_cg.analysis import picture
+    from balloon_cg.analysis.results import Block
     from balloon_cg.scene import load_scene
 
     root = Path(__file__).resolve().parents[1]
     scene = load_scene(root / "scenes" / "spom1_two_coils_M0.002.toml").with_overrides(
         {"continuation.stop_stretch": 1.7, "surface.max_points": 3})
-    started = []
-    beside = workers.Beside.__init__
+    forked, spread = [], workers.spread
 
-    def spied(self, work, cost):
-        beside(self, work, cost)
-        started.append(self.worker is not None)
+    def spied(work, items, costs=None, *args, **kwargs):
+        items = list(items)
+        if items and isinstance(items[0], tuple) and len(items[0]) == 3 and isinstance(items[0][1], Block):
+            forked.append(workers.sharing(len(items), sum(costs)) > 1)  # the m = 0 branch points' spread
+        return spread(work, items, costs, *args, **kwargs)
 
-    monkeypatch.setattr(workers.Beside, "__init__", spied)
+    monkeypatch.setattr(workers, "spread", spied)
     found = {}
     for count in ("1", "2"):
         monkeypatch.setenv("BALLOON_CG_WORKERS", count)
         found[count] = picture.analyse(scene)
-    assert started == [False, True]
+    assert forked == [False, True]
     serial, spread = found["1"], found["2"]
     assert [b.name for b in serial.branches] == [b.name for b in spread.branches]
     assert serial.surface_branches and [b.name for b in serial.surface_branches] == [b.name for b in

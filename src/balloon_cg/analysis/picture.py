@@ -8,8 +8,8 @@ and adds its mirror image (north and south poles swapped: the reflection z → �
 assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
 locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
 branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
-whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks; the primary's in a
-worker beside the pear branches, ``_surface_beside``: the same numbers) and lists the snap-throughs under the scene's loading control
+whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
+snap-throughs under the scene's loading control
 (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
@@ -24,7 +24,7 @@ in ``branch.stability`` and the points whose flags change at the check degree in
 """
 import enum
 import itertools
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -56,7 +56,6 @@ PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear bra
 MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",
          Block.EVEN: "equator-symmetric (even)"}
 ROTATED = "_rotated"  # the suffix of a non-axisymmetric branch's image under the rotation by π about the axis
-SURFACE_PARTS = ("surface_branches", "not_started", "not_switched", "not_asked")  # what _trace_surface adds
 OPPOSITE = "_opposite"  # the suffix of the branch traced along −φ (even m: the rotation by π maps the mode to itself)
 
 
@@ -232,28 +231,21 @@ def _examine(scene, picture: Picture, progress: Progress, pear: bool, control: b
         pear = False  # no equator-symmetric pitchforks to switch at
     if stopped(picture):
         return
-    beside = pear and surface  # the primary's surface branches traced beside its pear branches (``_surface_beside``)
-    if beside and not azimuthal_crossings(picture, [primary], scene):
+    if pear:
+        with clock.step(Step.PEAR_BRANCHES):
+            _trace_pears(scene, primary, picture, progress)
+        progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
+    progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
+    if not azimuthal_crossings(picture, picture.branches, scene):
         return
-    with _surface_beside(scene, primary) if beside else nullcontext() as surfaces:
-        if pear:
-            with clock.step(Step.PEAR_BRANCHES):
-                _trace_pears(scene, primary, picture, progress)
-            progress.finish(Phase.PEAR, sum(len(b.X) for b in picture.branches[1:]))
-        progress.finish(Phase.STABILITY, sum(len(b.stability or ()) for b in picture.branches))
-        if not azimuthal_crossings(picture, picture.branches[1:] if beside else picture.branches, scene):
-            return
-        if surface:
-            with clock.step(Step.SURFACE_BRANCHES):
-                if beside:
-                    _take_surface(surfaces.result(), primary, picture)
-                else:
-                    for branch in [b for b in picture.branches if b.name in (primary.name, FREE_PRIMARY)]:
-                        _trace_surface(scene, branch, picture, progress)
-                        if stopped(picture):
-                            return
-                unsearched_events(picture, scene)
-            progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
+    if surface:
+        with clock.step(Step.SURFACE_BRANCHES):
+            for branch in [b for b in picture.branches if b.name in (primary.name, FREE_PRIMARY)]:
+                _trace_surface(scene, branch, picture, progress)
+                if stopped(picture):
+                    return
+            unsearched_events(picture, scene)
+        progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
     label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
@@ -536,34 +528,6 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
             continue
         picture.surface_branches += pair
         _classified(branch, bp, pair[0])
-
-
-def _surface_beside(scene, primary: Branch) -> workers.Beside:
-    """The surface branches at the m ≥ 1 points of an equator-symmetric ``primary`` (its crossings located), traced
-    in a worker beside the pear branches and their stability (``workers.Beside``: they read nothing of each other;
-    a surface branch costs seconds, its sectors hundreds to thousands of unknowns), with what ``_trace_surface``
-    adds to a picture: ``_take_surface`` puts it into this one. Only the wait is the surface phase's time
-    (``Clock``); a signal stops the pear branches or the wait, and no surface branch is kept."""
-    switched = any(bp.m >= 1 and bp.status == Status.LOCATED for bp in primary.branch_points())
-    return workers.Beside(lambda: _surface_part(scene, primary), workers.MIN_COST if switched else 0.0)
-
-
-def _surface_part(scene, primary: Branch) -> tuple:
-    """What ``_trace_surface`` of ``primary`` adds to a picture (its surface branches, not_started, not_switched,
-    not_asked) and the (position, classification, E) of each of ``primary``'s special points it classified."""
-    part, before = Picture([primary]), list(primary.special)
-    _trace_surface(scene, primary, part, Progress())
-    classified = [(n, s.classification, s.E) for n, (s, old) in enumerate(zip(primary.special, before)) if s is not old]
-    return [getattr(part, name) for name in SURFACE_PARTS], classified
-
-
-def _take_surface(found: tuple, primary: Branch, picture: Picture) -> None:
-    """What ``_surface_part`` found, in ``picture`` and ``primary`` as ``_trace_surface`` there would put it."""
-    parts, classified = found
-    for name, added in zip(SURFACE_PARTS, parts):
-        getattr(picture, name).extend(added)
-    for n, classification, E in classified:
-        primary.special[n] = replace(primary.special[n], classification=classification, E=E)
 
 
 def surface_name(branch: Branch, k: int, bp) -> str:

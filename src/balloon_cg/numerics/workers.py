@@ -1,5 +1,4 @@
-"""Independent pieces of one computation on every core: ``spread(work, items, costs)``; ``Stream`` (items fed to
-workers while they are made) and ``Beside`` (one piece of work in a worker while this process does another).
+"""Independent pieces of one computation on every core: ``spread(work, items, costs)``.
 
 The points of a branch are independent for stability (each is one set of dense Hessian blocks and eigensolves), so
 ``[work(i) for i in items]`` is handed to forked worker processes: a forked child inherits the jitted kernels and
@@ -172,7 +171,17 @@ class Stream:
             interrupt.check()  # a signal during the feeding: no results (a serial reading would stop at its check)
             for _, inbox, _ in self.workers:
                 inbox.put(None)
-            return [_received(process, receive) for process, _, receive in self.workers]
+            out = []
+            for process, _, receive in self.workers:
+                while not receive.poll(1.0):
+                    interrupt.check()
+                    if not process.is_alive() and not receive.poll(0):
+                        raise RuntimeError(f"a stream worker (pid {process.pid}) died (exit code {process.exitcode})")
+                kind, value = receive.recv()
+                if kind == "error":
+                    raise value
+                out.append(value)
+            return out
         finally:
             self.close()
 
@@ -186,75 +195,6 @@ class Stream:
             inbox.close()
             receive.close()
         self.workers = []
-
-
-class Beside:
-    """``work()`` in one forked worker beside this process's own work (a branch whose inputs are ready, computed
-    while this process goes on with others that do not read it), where forking pays (``sharing(2, cost)``: else
-    here, when ``result`` asks for it). The worker may spread its own work over more processes (it is no item of
-    a ``spread``), and computes what this process would: the same numbers, bit for bit. ``result`` raises the
-    worker's exception here, and ``interrupt.Interrupted`` within a second of a signal; ``close`` kills the worker
-    (``result`` and the ``with`` block call it)."""
-
-    def __init__(self, work, cost: float):
-        self.work, self.worker = work, None
-        if sharing(2, cost) < 2:
-            return
-        context = multiprocessing.get_context("fork")
-        receive, send = context.Pipe(duplex=False)
-        # not a daemon: a daemonic process may not start the workers of its own spreads and streams; it dies with
-        # this process all the same (``worker_hygiene``) and ``close`` kills it
-        process = context.Process(target=_beside, args=(os.getpid(), work, send))
-        process.start()
-        send.close()
-        self.worker = (process, receive)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def result(self):
-        """``work()``: the worker's result, or computed here where no worker was started."""
-        if self.worker is None:
-            return self.work()
-        try:
-            return _received(*self.worker)
-        finally:
-            self.close()
-
-    def close(self) -> None:
-        """Kill the worker (idempotent)."""
-        if self.worker is not None:
-            process, receive = self.worker
-            if process.is_alive():
-                process.kill()
-            process.join()
-            receive.close()
-            self.worker = None
-
-
-def _received(process, receive):
-    """What a worker sent on ``receive`` (``_consume``, ``_beside``), waiting in steps so that a signal here is seen
-    within a second; the worker's exception raised here."""
-    while not receive.poll(1.0):
-        interrupt.check()
-        if not process.is_alive() and not receive.poll(0):
-            raise RuntimeError(f"a worker (pid {process.pid}) died (exit code {process.exitcode})")
-    kind, value = receive.recv()
-    if kind == "error":
-        raise value
-    return value
-
-
-def _beside(parent: int, work, send) -> None:
-    """A ``Beside`` worker: ``work()`` sent back (or the exception raised)."""
-    worker_hygiene(parent, False)
-    try:
-        send.send(("done", work()))
-    except BaseException as error:  # noqa: BLE001 - raised again in the parent
-        send.send(("error", error))
 
 
 def _consume(parent: int, make, group, inbox, send) -> None:
