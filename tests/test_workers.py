@@ -197,3 +197,54 @@ def test_workers_are_gone_when_spread_raises(monkeypatch, tmp_path):
         interrupt._flag.clear()
     assert not multiprocessing.active_children()
     assert not (tmp_path / "done_0").exists()
+
+
+def test_a_picture_with_its_branch_points_on_two_workers_is_the_serial_one(monkeypatch):
+    """Two coils to the first branch points with 3-point surface branches (tests/test_interrupt_moments.py's scene):
+    on two workers (the m = 0 branch points located on both: ``picture._branch_points``) and in this process, the
+    same branches, special points, assessments and surface branches, bit for bit."""
+    from pathlib import Path
+
+    from balloon_cg.analysis import picture
+    from balloon_cg.analysis.results import Block
+    from balloon_cg.scene import load_scene
+
+    root = Path(__file__).resolve().parents[1]
+    scene = load_scene(root / "scenes" / "spom1_two_coils_M0.002.toml").with_overrides(
+        {"continuation.stop_stretch": 1.7, "surface.max_points": 3})
+    forked, spread = [], workers.spread
+
+    def spied(work, items, costs=None, *args, **kwargs):
+        items = list(items)
+        if items and isinstance(items[0], tuple) and len(items[0]) == 3 and isinstance(items[0][1], Block):
+            forked.append(workers.sharing(len(items), sum(costs)) > 1)  # the m = 0 branch points' spread
+        return spread(work, items, costs, *args, **kwargs)
+
+    monkeypatch.setattr(workers, "spread", spied)
+    found = {}
+    for count in ("1", "2"):
+        monkeypatch.setenv("BALLOON_CG_WORKERS", count)
+        found[count] = picture.analyse(scene)
+    assert forked == [False, True]
+    serial, spread = found["1"], found["2"]
+    assert [b.name for b in serial.branches] == [b.name for b in spread.branches]
+    assert serial.surface_branches and [b.name for b in serial.surface_branches] == [b.name for b in
+                                                                                      spread.surface_branches]
+    assert (serial.not_started, serial.not_switched, serial.not_asked) == (spread.not_started, spread.not_switched,
+                                                                           spread.not_asked)
+    for a, b in zip(serial.branches + serial.surface_branches, spread.branches + spread.surface_branches):
+        assert repr(a.special) == repr(b.special), a.name
+        for s, t in zip(a.special, b.special):
+            np.testing.assert_array_equal(s.X, t.X)
+        np.testing.assert_array_equal(getattr(a, "X", getattr(a, "coefficients", None)),
+                                      getattr(b, "X", getattr(b, "coefficients", None)))
+    for a, b in zip(serial.branches, spread.branches):
+        assert len(a.stability) == len(b.stability) and a.unsettled == b.unsettled, a.name
+        for s, t in zip(a.stability, b.stability):
+            assert (s.flags(), s.degree, s.blocks.keys()) == (t.flags(), t.degree, t.blocks.keys())
+            for key, values in s.blocks.items():
+                np.testing.assert_array_equal(values, t.blocks[key])
+    for a, b in zip(serial.surface_branches, spread.surface_branches):
+        assert a.stability.keys() == b.stability.keys()
+        for name, values in a.stability.items():
+            np.testing.assert_array_equal(values, b.stability[name])

@@ -23,6 +23,7 @@ sphere (``surface.primary``) and the branches born at its pitchforks with their 
 in ``branch.stability`` and the points whose flags change at the check degree in ``branch.unsettled``.
 """
 import enum
+import itertools
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
@@ -43,7 +44,7 @@ from .switching.pear import mark_rejoin, trace_pear
 from .timing import Clock, Step
 from .branches.tracer import ContinuationError
 from .verdict import Gap, Incomplete, incomplete
-from ..numerics import interrupt
+from ..numerics import interrupt, workers
 from ..numerics.threads import limited_blas
 
 
@@ -282,14 +283,25 @@ def _branch_points(primary: Branch, picture: Picture) -> None:
     with picture.clock.step(Step.BRANCH_POINTS):
         # the free balloon's pear points (odd_free) after the others: the held numbering does not depend on them
         crossings = sorted(bifurcation.detect(primary, primary.stability), key=lambda c: c[1] == Block.ODD_FREE)
-        for n, (index, block, k) in enumerate(crossings):
-            if stopped(picture):
-                break
-            bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
-            bp.note = f"{MODES[block]} mode"  # its name: its label in the file
+        located = workers.spread(lambda crossing: _located(primary, *crossing), crossings,
+                                 [bifurcation.location_cost(primary, index) for index, _, _ in crossings])
+        for bp in itertools.takewhile(lambda bp: bp is not None, located):
             picture.branch_points.append(bp)
             primary.special.append(bp)
     primary.special.sort(key=_along)
+
+
+def _located(primary: Branch, index: int, block: Block, k: int):
+    """The m = 0 branch point detected between points index and index + 1 of ``primary``, located and classified
+    (``bifurcation``); each on its own (``_branch_points`` spreads them over the cores: the numbers of the serial
+    loop). None once a signal asked to stop: in this process the points located before it are kept, as the serial
+    loop kept them; on workers the signal raises ``interrupt.Interrupted`` here within a second (``workers.spread``)
+    and the points in the workers are abandoned, as a branch's assessments are."""
+    if interrupt.requested():
+        return None
+    bp = bifurcation.classify(primary, bifurcation.locate(primary, index, block, k))
+    bp.note = f"{MODES[block]} mode"  # its name: its label in the file
+    return bp
 
 
 def _trace_broken(scene, primary: Branch, picture: Picture, progress: Progress) -> None:

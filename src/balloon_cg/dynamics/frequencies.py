@@ -161,12 +161,13 @@ def attach(branches, count: int, m_max: int, modes: bool = False) -> None:
 def attach_to(picture, dynamics) -> None:
     """``attach`` to the branches and surface branches of ``picture`` (analysis.picture.Picture), timed
     (Step.FREQUENCIES), when ``dynamics`` (the scene's [dynamics]) asks for them and no signal stopped the work; a
-    signal during them stops them at the next point (the branches not reached are kept without) and the picture is
-    interrupted in that phase (``picture.stopped``)."""
-    if not dynamics.frequencies or interrupt.requested():
+    signal during them, or one that came after the analysis's last check of the flag, stops them at the next point
+    (the branches not reached are kept without) and the picture is interrupted in that phase (``picture.stopped``)."""
+    if not dynamics.frequencies or picture.interrupted:
         return
     try:
         with picture.clock.step(Step.FREQUENCIES):
+            interrupt.check()
             attach(picture.branches + picture.surface_branches, dynamics.count, dynamics.m_max, dynamics.modes)
     except interrupt.Interrupted:
         stopped(picture)

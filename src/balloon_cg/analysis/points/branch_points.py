@@ -31,10 +31,15 @@ from ..branches.problem import equilibrium_of
 from ..branches.resolution import Resolution
 from ..results import Block, Branch, Classification, Gauge, Kind, SpecialPoint, Status, approximate
 from ..stability.crossings import branch_point_crossings
-from ..stability.axisymmetric import SecondVariation, Variations, assessed_degrees, block_indices, convergence_problems
+from ..stability.axisymmetric import (SecondVariation, Variations, assessed_degrees, assessment_cost, block_indices,
+                                      convergence_problems)
 from ..branches.tracer import Tracer
 from ...numerics.threads import limited_blas
 
+# a branch point located (Newton on its extended system) and classified (four constrained minima) costs about four
+# dense m = 0 assessments at its plain degree N, N³ each: 0.6–3.5e-7 s per N³ at N = 40–320 on the shipped scenes
+# against ~3e-8 s per unit of ``assessment_cost`` in their stability (one loaded run, session 27)
+LOCATION_ASSESSMENTS = 4.0
 EIGENVALUE_TOL = 1e-8  # |crossing eigenvalue| at a located branch point (eigenvalues are O(1): L2 normalisation)
 
 
@@ -120,6 +125,12 @@ class ExtendedSolution:
         if abs(self.beta) > EIGENVALUE_TOL:
             out.append(f"Moore's β = {self.beta:.2g}: not a branch point of the unperturbed problem")
         return out
+
+
+def location_cost(branch: Branch, index: int) -> float:
+    """``numerics.workers.spread``'s cost of locating and classifying the branch point detected between points index
+    and index + 1 (``assessment_cost``'s units): LOCATION_ASSESSMENTS dense blocks at the plain degree there."""
+    return LOCATION_ASSESSMENTS * assessment_cost(max(extended_degrees(branch, index)), 0)
 
 
 def extended_degrees(branch: Branch, index: int) -> tuple[int, int]:
