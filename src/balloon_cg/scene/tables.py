@@ -272,6 +272,7 @@ class Surface:
 
 
 SURFACE_BRANCHES = ("first", "all", "none")
+UNTRACED_SURFACES = (Shape.CAPSULE, Shape.SPHEROID)  # shapes whose [surface] branches are "none" (default_surface)
 
 
 def default_surface(shape, field, electric, stability) -> Surface:
@@ -279,9 +280,22 @@ def default_surface(shape, field, electric, stability) -> Surface:
     without the m ≥ 1 zeros they start from (stability.m_max = 0; ``_tube_surface_reads`` refuses "first" there),
     and on a tube in a coil's field or under a voltage, where "first" is taken when asked for but is not the default:
     a trace there may refine to the basis's cap for tens of minutes (a plugged tube in a coil's field), and with
-    stability.m_max ≥ 2 the first zero can be the slack state's near P = 0 (docs/tubes.md "The tube over (S, φ)")."""
+    stability.m_max ≥ 2 the first zero can be the slack state's near P = 0 (docs/tubes.md "The tube over (S, φ)");
+    "none" on a capsule and a spheroid, whose branches are not traced (``_surface_on_shape``: the whole-sphere engine
+    has a spherical reference; their m ≥ 1 branch points are located all the same)."""
+    if shape in UNTRACED_SURFACES:
+        return Surface(branches="none")
     built = not field.coils and electric is None and stability.m_max >= 1
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
+
+
+def _surface_on_shape(surface: Surface, shape) -> None:
+    """SceneError for [surface] branches asked on a shape whose non-axisymmetric branches are not traced (a capsule,
+    a spheroid: a run would locate their m ≥ 1 branch points and end incomplete, each branch not started)."""
+    if shape in UNTRACED_SURFACES and surface.branches != "none":
+        raise SceneError(f"surface.branches = {show(surface.branches)}: the non-axisymmetric branches are traced on a "
+                         f"sphere and a tube, not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "
+                         '"none"')
 
 
 @dataclass(frozen=True)
@@ -706,6 +720,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
     surface = _surface(data.get("surface", {}), default_surface(geometry.shape, field, electric, stability))
+    _surface_on_shape(surface, geometry.shape)
     if geometry.shape == Shape.TUBE:
         _tube_surface_reads(surface, stability)
     return Scene(
