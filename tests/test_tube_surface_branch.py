@@ -202,3 +202,30 @@ def test_a_signal_while_reading_the_stability_keeps_the_points_read(traced, monk
     assert len(cut.pressure) == len(cut.lowest) == len(cut.coefficients) == 2
     assert np.array_equal(cut.pressure, whole.pressure[:2]) and np.array_equal(cut.lowest, whole.lowest[:2])
     assert all(index < 1 for index, _ in cut.folds)
+
+
+def test_a_signal_during_the_trace_keeps_every_traced_point_read(traced, monkeypatch):
+    """A signal during the trace stops it at its next point (INTERRUPTED): every point traced is kept and read (the
+    readings' own cut is for a signal that comes while they run), each the uninterrupted branch's."""
+    from balloon_cg.analysis.results import StopCode
+    from balloon_cg.numerics import interrupt
+    from balloon_cg.tube.surface import branch as module
+
+    scene, parent, zero, whole, _ = traced
+    calls, stretch = [], module.largest_hoop_stretch
+
+    def signalled_at_the_third(*args):
+        calls.append(1)
+        if len(calls) == 3:
+            interrupt.request()
+        return stretch(*args)
+
+    monkeypatch.setattr(module, "largest_hoop_stretch", signalled_at_the_third)
+    try:
+        cut = traced_branch(scene, parent.disc, zero, parent.params, 1, POINTS)
+    finally:
+        interrupt._flag.clear()
+    n = len(cut.pressure)
+    assert cut.stop.code == StopCode.INTERRUPTED and 3 <= n < len(whole.pressure)
+    assert len(cut.lowest) == n and np.array_equal(cut.lowest, whole.lowest[:n])
+    assert np.array_equal(cut.pressure, whole.pressure[:n])

@@ -27,6 +27,7 @@ import numpy as np
 from .bulge import bulge_branch
 from .results import IntervalStop
 from ..analysis.branches.resolution import Resolution
+from ..analysis.results import StopCode
 from ..galerkin.interval_elements import ElementInterval, element_interval
 from ..numerics.continuation import Stop
 
@@ -67,12 +68,16 @@ def front_bulge(scene, primary, point, policy: Resolution | None = None, layout:
     disc = uniform_layout(scene, START_ELEMENTS, ORDER) if layout is None else layout
     while True:
         branch = bulge_branch(scene, primary, point, on=disc, **trace)
+        if branch.stop.code == StopCode.INTERRUPTED:  # a signal: the points traced on this layout, not a retrace
+            return branch
         tails = np.array([disc.element_tails(u) for u in branch.states])
         finer = refined_layout(disc, tails, policy.max_error)
         if finer == disc:
             return branch
         if finer.degree > policy.max_degree:
             checked = bulge_branch(scene, primary, point, on=disc, max_error=policy.max_error, **trace)
+            if checked.stop.code == StopCode.INTERRUPTED:
+                return checked
             message = (f"{checked.stop.message}: {finer.count} elements of order {disc.order} would pass "
                        f"solver.max_degree {policy.max_degree} (elements × order): raise it or solver.max_error")
             return replace(checked, stop=Stop(IntervalStop.UNRESOLVED, message))

@@ -35,7 +35,7 @@ from .voltage import voltage_branch
 from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
-from ..galerkin.interval_elements import collocated
+from ..galerkin.interval_elements import ElementInterval, collocated
 from ..model.membrane import scene_energy
 from ..model.tube import maxwell_pressure
 from ..numerics import interrupt
@@ -218,6 +218,10 @@ def with_surface(scene, picture: TubePicture) -> TubePicture:
             stopped = Stage.SURFACE
             break
         branch = picture.branches[parent]
+        if isinstance(branch.disc, ElementInterval):  # the basis over (S, φ) reads one Legendre series in S
+            not_started += ((name, f"{parent} is on spectral elements (solver.tube_resolution = \"elements\"): its "
+                                   "non-axisymmetric branches are traced on the Legendre series only"),)
+            continue
         try:
             traced[name] = traced_branch(scene, branch.disc, zero, branch.params, parent=(parent, k))
         except SurfaceBranchStartError as e:

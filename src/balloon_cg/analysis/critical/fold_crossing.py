@@ -68,7 +68,12 @@ def _bracket(system, start, low: tuple, high: tuple, settings: continuation.Sett
     docstring); ``narrowed``: the bracket reached XTOL."""
     def value_at(s):
         result = continuation.correct(system, start.X + s * start.tangent, start.tangent, settings)
-        return (s, crossing_test(system, result.x), result.x) if result.converged else None
+        if not result.converged:
+            return None
+        try:
+            return s, crossing_test(system, result.x), result.x
+        except ArithmeticError:  # a state whose test is not finite (NonFiniteState): skipped as a failed corrector
+            return None
 
     xtol = XTOL * max(1.0, high[0])
     while high[0] - low[0] > xtol:

@@ -203,9 +203,9 @@ def _branch(origin: _Leg, legs: list, crossing, params: Parameters, folds: tuple
     points += [(leg, leg.system.coefficients(p.X), p.X[-1], leg.system.reaction(p.X)) for leg in legs
                for p in leg.points]
     readers = {id(leg): SectorStability(leg.system) for leg in (origin, *legs)}
-    readings = []
+    readings, traced_whole = [], not interrupt.requested()  # a signal in the trace: its points are all read
     for leg, c, P, _ in points:
-        if readings and interrupt.requested():  # dense readings of minutes: the points read are kept, none unread
+        if readings and traced_whole and interrupt.requested():  # readings of minutes: the points read are kept
             stop = Stop(StopCode.INTERRUPTED, f"interrupted (SIGINT or SIGTERM) while reading the stability: the "
                                               f"{len(readings)} points read are kept")
             points, folds = points[:len(readings)], tuple(f for f in folds if f[0] < len(readings) - 1)
