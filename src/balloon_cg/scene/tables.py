@@ -277,11 +277,11 @@ UNTRACED_SURFACES = (Shape.CAPSULE, Shape.SPHEROID)  # shapes whose [surface] br
 
 def default_surface(shape, field, electric, stability) -> Surface:
     """The [surface] table a scene without one has: ``Surface()`` ("first"), except ``branches = "none"`` on a tube
-    without the m ≥ 1 zeros they start from (stability.m_max = 0; ``_tube_surface_reads`` refuses "first" there),
+    without the m ≥ 1 zeros they start from (stability.m_max = 0; ``_surface_reads`` refuses "first" there),
     and on a tube in a coil's field or under a voltage, where "first" is taken when asked for but is not the default:
     a trace there may refine to the basis's cap for tens of minutes (a plugged tube in a coil's field), and with
     stability.m_max ≥ 2 the first zero can be the slack state's near P = 0 (docs/tubes.md "The tube over (S, φ)");
-    "none" on a capsule and a spheroid, whose branches are not traced (``_surface_on_shape``: the whole-sphere engine
+    "none" on a capsule and a spheroid, whose branches are not traced (``_surface_reads``: the whole-sphere engine
     has a spherical reference; their m ≥ 1 branch points are located all the same)."""
     if shape in UNTRACED_SURFACES:
         return Surface(branches="none")
@@ -289,13 +289,19 @@ def default_surface(shape, field, electric, stability) -> Surface:
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
-def _surface_on_shape(surface: Surface, shape) -> None:
-    """SceneError for [surface] branches asked on a shape whose non-axisymmetric branches are not traced (a capsule,
-    a spheroid: a run would locate their m ≥ 1 branch points and end incomplete, each branch not started)."""
-    if shape in UNTRACED_SURFACES and surface.branches != "none":
-        raise SceneError(f"surface.branches = {show(surface.branches)}: the non-axisymmetric branches are traced on a "
-                         f"sphere and a tube, not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "
-                         '"none"')
+def _surface_reads(surface: Surface, shape, stability) -> None:
+    """SceneError for [surface] branches asked where none can be traced: on a capsule or a spheroid (a run would
+    locate their m ≥ 1 branch points and end incomplete, each branch not started), on a tube without the m ≥ 1 zeros
+    they start from (stability.m_max = 0; tube/surface/branch.py)."""
+    if surface.branches == "none":
+        return
+    asked = f"surface.branches = {show(surface.branches)}"
+    if shape in UNTRACED_SURFACES:
+        raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere and a tube, not on a "
+                         f'{shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
+    if shape == Shape.TUBE and stability.m_max < 1:
+        raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
+                         f'stability.m_max ≥ 1, not {stability.m_max}; allowed: "none" with stability.m_max = 0')
 
 
 @dataclass(frozen=True)
@@ -720,9 +726,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
     surface = _surface(data.get("surface", {}), default_surface(geometry.shape, field, electric, stability))
-    _surface_on_shape(surface, geometry.shape)
-    if geometry.shape == Shape.TUBE:
-        _tube_surface_reads(surface, stability)
+    _surface_reads(surface, geometry.shape, stability)
     return Scene(
         name=name,
         material=material,
@@ -748,15 +752,6 @@ def _stop_volume_above_reference(stop_volume: float | None, geometry: Geometry) 
     if stop_volume is not None and stop_volume <= v0:
         raise SceneError(f"continuation.stop_volume = {show(stop_volume)}: at or below the reference volume {v0:g} "
                          f"(the {geometry.describe()}; V/R0³, not V/V0); must be > {v0:g}")
-
-
-def _tube_surface_reads(surface: Surface, stability) -> None:
-    """SceneError for a tube's [surface] branches (tube/surface/branch.py) without the m ≥ 1 zeros they start from
-    (stability.m_max = 0)."""
-    if surface.branches != "none" and stability.m_max < 1:
-        raise SceneError(f"surface.branches = {show(surface.branches)}: a tube's non-axisymmetric branches start at "
-                         f"the m ≥ 1 zeros located with stability.m_max ≥ 1, not {stability.m_max}; allowed: \"none\" "
-                         "with stability.m_max = 0")
 
 
 def _tube_voltage_reads(field, stability, dynamics, events) -> None:
