@@ -551,7 +551,7 @@ def _add_plot(commands):
     p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
     p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}; of a tube's run file: "
-                        "pressure-volume, profiles, front, stretches")
+                        "pressure-volume, profiles, front, stretches, modes, onset")
     p.add_argument("-o", "--output", help=f"image file, {', '.join(IMAGE_FORMATS)} (default: "
                                           "FIRST_FILE_STEM_KIND.png next to the first file; with several kinds: "
                                           "OUTPUT_STEM_KIND.SUFFIX; an existing file is replaced only with --force)")
@@ -724,7 +724,8 @@ def _add_critical(commands):
                     "input.")
     p.add_argument("scene", help=f"{SCENE_HELP}; with --of BP equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
-                                                       "material.parameters.Jm, voltage)")
+                                                       "material.parameters.Jm, voltage; on a tube M, voltage or "
+                                                       "axial_stretch: its onset of bulging followed)")
     p.add_argument("--of", default="BP", choices=CURVE_KINDS, metavar="KIND",
                    help="what to follow: BP (the first pear pitchfork, default), LP (the first fold in P: the "
                         "snap-through boundary, ending in its cusp), LV or LN (the first fold in the volume or in the "

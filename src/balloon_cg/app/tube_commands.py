@@ -42,17 +42,18 @@ def run_tube(scene, output, args) -> int:
     return 0 if args.allow_partial else 1
 
 
-ONSET_PARAMETERS = {"M": "M", "field.M": "M", "voltage": "voltage", "electric.voltage": "voltage"}  # critical's
+ONSET_PARAMETERS = {"M": "M", "field.M": "M", "voltage": "voltage", "electric.voltage": "voltage",
+                    "axial_stretch": "axial_stretch", "geometry.axial_stretch": "axial_stretch"}  # critical's
 
 
 def critical_tube(scene, output, args) -> int:
     """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
-    followed in M or the voltage Φ̄, written with the primary branch to the tube run file ``output`` (its /onset
-    group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns back in the parameter (a located
-    fold: the onset's largest or smallest value), 1 (the file still written) where it does not; 1 without a file
-    where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M or the voltage, M
-    without coils, the voltage without [electric], a scene continued in the voltage; 130 when a signal stopped it
-    (module docstring)."""
+    followed in M, the voltage Φ̄ or the held ends' distance λ (axial_stretch), written with the primary branch to the
+    tube run file ``output`` (its /onset group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns
+    back in the parameter (a located fold: the onset's largest or smallest value), 1 (the file still written) where it
+    does not; 1 without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of
+    BP) in M, the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed
+    ends (no held distance), a scene continued in the voltage; 130 when a signal stopped it (module docstring)."""
     from ..tube.picture import onset_picture
 
     name = ONSET_PARAMETERS.get(args.parameter)
@@ -60,8 +61,12 @@ def critical_tube(scene, output, args) -> int:
         raise UsageError(f"critical on a tube follows the onset of bulging on a pressure continuation: {args.scene} "
                          'continues in the voltage (continuation.parameter = "voltage")')
     if args.of != "BP" or name is None:
-        raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M or the voltage: "
-                         f"{args.scene}: --of {args.of} --parameter {args.parameter}")
+        raise UsageError(f"critical on a tube follows the onset of bulging (--of BP) in M, the voltage or "
+                         f"axial_stretch: {args.scene}: --of {args.of} --parameter {args.parameter}")
+    if name == "axial_stretch" and scene.geometry.axial_stretch is None:
+        raise UsageError(f"critical --parameter axial_stretch follows the onset in the held distance of the ends: "
+                         f"{args.scene} has closed ends (geometry.axial = \"closed\", the default: the distance free, "
+                         "none held); hold them apart with geometry.axial_stretch = λ (in [1, 5]) in its [geometry]")
     field_needed(scene, args.parameter, "critical --parameter M", args.scene)
     if name == "voltage" and scene.electric is None:
         raise UsageError(f"critical --parameter voltage needs an [electric] table: {args.scene} has none, so the "

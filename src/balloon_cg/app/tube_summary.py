@@ -19,7 +19,7 @@ import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST, HELD_M1, VOLTAGE, discretisation
+from ..io.tube_file import CREST, HELD_M1, HOOP, VOLTAGE, discretisation
 from ..scene import parse_scene
 from ..tube.azimuthal import mode_profile
 from ..tube.stability import COMPRESSED
@@ -144,8 +144,9 @@ def _onset(onset: dict | None) -> dict | None:
     return {"parameter": a["parameter"], "q0": a["q0"], "points": len(onset["q"]),
             "q": [float(onset["q"].min()), float(onset["q"].max())],
             "pressure": [float(onset["pressure"].min()), float(onset["pressure"].max())],
+            "hoop_stretch": [float(onset[HOOP].min()), float(onset[HOOP].max())],
             "last": {"q": float(onset["q"][-1]), "pressure": float(onset["pressure"][-1]),
-                     "crest_height": float(onset[CREST][-1])},
+                     "hoop_stretch": float(onset[HOOP][-1]), "crest_height": float(onset[CREST][-1])},
             "folds": onset["folds"], "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
 
 
@@ -243,8 +244,10 @@ def format_tube(summary: dict) -> str:
         name, last = onset["parameter"], onset["last"]
         lines += ["", f"onset in {name} (from {name} = {onset['q0']:g}): {onset['points']} points, {name} "
                       f"{onset['q'][0]:.6g}..{onset['q'][1]:.6g}, P {onset['pressure'][0]:.8g}..{onset['pressure'][1]:.8g}"
-                      f", stop {onset['stop_code']} ({onset['stop_message']}); last: {name} = {last['q']:.8g}, "
-                      f"P = {last['pressure']:.10g}, crest at {last['crest_height']:.6g}"]
+                      f", largest hoop stretch {onset['hoop_stretch'][0]:.6g}..{onset['hoop_stretch'][1]:.6g}, stop "
+                      f"{onset['stop_code']} ({onset['stop_message']}); last: {name} = {last['q']:.8g}, "
+                      f"P = {last['pressure']:.10g}, hoop stretch {last['hoop_stretch']:.8g}, crest at "
+                      f"{last['crest_height']:.6g}"]
         lines += [f"  fold in {name} at {name} = {f['q']:.10g}, P = {f['pressure']:.10g}  {f['status']}"
                   for f in onset["folds"]]
     return "\n".join(lines)

@@ -28,7 +28,8 @@ it have none), ``index``, ``pressure``, ``volume``, ``smallest_stress``,
 label of the branch point it was born at) and ``rejoins_label`` (where it rejoined the parent, −1: it did not; files
 before them have none). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
-``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector); its folds in q
+``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector; read back with
+``hoop_stretch``, the largest radius ρ of each state, from its unknowns); its folds in q
 under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
 started, and is absent where it had not; ``frequencies``: the branches whole, the frequencies of the branches finished
@@ -65,6 +66,7 @@ GAS = "unstable_gas"  # per point: unstable directions under gas control (files 
 ACCURACY = ("tail", "first_integral_spread")  # per point: tube/accuracy.accuracy (files before them have none)
 SPECIAL_NUMBERS = ("index", "pressure", "volume", "smallest_stress")
 CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
+HOOP = "hoop_stretch"  # the onset curve's largest radius per point (read back from its unknowns: crest_hoops)
 SPECIAL_TEXT = ("kind", "block", "status")
 VOLTAGE = "voltage"  # per point and located point of a voltage continuation (tube/voltage.py; others have none)
 NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
@@ -110,7 +112,8 @@ TUBE_VARIABLES = {
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
     "index": ("", "point index", "the located point lies between points index and index + 1"),
-    "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M or voltage)"),
+    "q": ("1", "second parameter", "the onset curve's parameter (the group's attribute parameter: M, voltage or "
+          "axial_stretch)"),
     "modes": ("1", "odd null vector", "the odd block's null vector φ at the onset"),
     "coefficient": ("", "coefficient index", "index into the m ≥ 1 perturbation's coefficients (R's, T's, Z's: "
                     "tube/azimuthal.py)"),
@@ -258,6 +261,14 @@ def crest_heights(disc: IntervalDiscretisation, states) -> np.ndarray:
     return disc.crests(states)[1] if len(states) else np.zeros(0)
 
 
+def crest_hoops(disc: IntervalDiscretisation, states) -> np.ndarray:
+    """ρ (the hoop stretch, R = 1) at the crest of each state (IntervalDiscretisation.crests): its largest radius."""
+    states = np.atleast_2d(np.asarray(states, dtype=float))
+    if not len(states):
+        return np.zeros(0)
+    return disc.radius(states, 2 * disc.crests(states)[0] / disc.length - 1)[0]
+
+
 def _write_onset(group, curve) -> None:
     group.attrs.update({"parameter": curve.name, "q0": curve.q0, "stop_code": curve.stop.code.value,
                         "stop_message": curve.stop.message})
@@ -317,7 +328,8 @@ def read_tube(f, path, where: str = "") -> dict:
         branch["special_unknowns"] = special["unknowns"][()]
         branch["frequencies"] = read_tube_frequencies(path, group, n, len(branch["special_points"]), TubeFileError)
         branches[name] = branch
-    onset = None if "onset" not in f else _read_onset(path, f["onset"])
+    onset = None if "onset" not in f else _read_onset(path, f["onset"], discretisation(attrs,
+                                                                                          branches["primary"]["attrs"]))
     return {"attrs": attrs, "branches": branches, "onset": onset,
             "surface_branches": read_surface_branches(f, path, TubeFileError)}
 
@@ -374,8 +386,9 @@ def tube_row(run: dict) -> dict:
             "P_LV": lv["pressure"], "V_LV": lv["volume"], "P_M": float(run["attrs"]["maxwell_pressure"])}
 
 
-def _read_onset(path, group) -> dict:
-    """The /onset group: its attributes, the point columns, ``unknowns``, ``modes`` and ``folds`` (dict per fold)."""
+def _read_onset(path, group, disc: IntervalDiscretisation) -> dict:
+    """The /onset group: its attributes, the point columns, ``unknowns``, ``modes``, ``folds`` (dict per fold) and
+    ``hoop_stretch``, the largest radius of each state (``crest_hoops``; ``disc``: the primary branch's)."""
     missing = [c for c in (*CURVE_COLUMNS, "unknowns", "modes", "folds") if c not in group]
     if missing:
         raise TubeFileError(path, f"/onset: missing {', '.join(missing)}")
@@ -389,6 +402,7 @@ def _read_onset(path, group) -> dict:
     status = list(folds["status"].asstr()[()])
     onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s}
                       for q, p, s in zip(folds["q"][()], folds["pressure"][()], status)]
+    onset[HOOP] = crest_hoops(disc, onset["unknowns"])
     return onset
 
 

@@ -1,8 +1,9 @@
 """What people look at on a tube (a tube run file, io/tube_file.py), in the journal style: P against V/V0 of every
 branch with Maxwell's line (``pressure_volume``), the family of profiles r(Z) of a branch (``profiles``), the bulge's
 front, its position and width against V/V0 (``front_motion``), and the hoop and axial stretches along the deformed
-axis at a few states (``stretch_profiles``; post/tube_measures.py measures both), and the critical modes of a
-branch's located m ≥ 1 zeros (``critical_modes``).
+axis at a few states (``stretch_profiles``; post/tube_measures.py measures both), the critical modes of a
+branch's located m ≥ 1 zeros (``critical_modes``), and the onset curve of ``critical`` (``onset_curve``: the onset's
+P and largest hoop stretch against its parameter).
 
 Curves are solid where a point is stable under the chosen control (default: the run's loading.control; no negative
 eigenvalue of the second variation under it: the file's ``unstable_pressure``/``unstable_volume``/``unstable_gas``,
@@ -19,7 +20,7 @@ from .tube_measures import SAMPLES, fronts, stretches
 from ..io.tube_file import discretisation, tube_labels
 from ..tube.azimuthal import mode_profile
 
-TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches", "modes")
+TUBE_KINDS = ("pressure-volume", "profiles", "front", "stretches", "modes", "onset")
 CONTROLS = ("pressure", "volume", "gas")
 PROFILES = 8  # profiles drawn along a branch unless the points are given
 STRETCHED = 3  # states whose stretches are drawn unless the points are given
@@ -47,6 +48,8 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
         ax = fig.add_subplot()
         if what == "pressure-volume":
             pressure_volume(ax, run, control)
+        elif what == "onset":
+            onset_curve(ax, run)
         else:
             name = branch or ("bulge" if "bulge" in run["branches"] else "primary")
             if name not in run["branches"]:
@@ -163,6 +166,27 @@ def critical_modes(ax, run: dict, name: str, points=None) -> None:
     ax.set(xlabel="$S$", ylabel="amplitude ($\\frac{1}{2}\\int (R^2 + T^2 + Z^2)\\,dS = 1$)",
            title=f"{run['attrs']['scene_name']}: critical modes, {name} branch")
     ax.legend(fontsize=5)
+
+
+def onset_curve(ax, run: dict) -> None:
+    """The onset curve of ``critical`` (/onset, tube/onset.py): the onset's P (left axis) and its largest hoop
+    stretch (right axis) against the curve's parameter q, its folds in q marked (the critical value); a file without
+    one has none to draw (TubePlotError)."""
+    onset = run["onset"]
+    if onset is None:
+        raise TubePlotError("--what onset: the file has no onset curve (written by balloon-cg critical on a tube)")
+    name = onset["attrs"]["parameter"]
+    ax.plot(onset["q"], onset["pressure"], color="C0")
+    for f in onset["folds"]:
+        ax.plot(f["q"], f["pressure"], "o", color="C0", markersize=3)
+        ax.annotate(f"LP {name} = {f['q']:.5g}", (f["q"], f["pressure"]), textcoords="offset points",
+                    xytext=(3, 3), fontsize=6)
+    labels = {"axial_stretch": "$\\lambda$ (ends held at $\\lambda L$)", "voltage": "$\\bar\\Phi$"}
+    ax.set(xlabel=labels.get(name, name), title=f"{run['attrs']['scene_name']}: onset of bulging against {name}")
+    ax.set_ylabel("onset $P$", color="C0")
+    hoops = ax.twinx()
+    hoops.plot(onset["q"], onset["hoop_stretch"], color="C1", linestyle="--")
+    hoops.set_ylabel("onset's largest hoop stretch", color="C1")
 
 
 def _chosen(n: int, name: str, points, count: int) -> np.ndarray:
