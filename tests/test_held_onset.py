@@ -1,0 +1,122 @@
+"""The onset of bulging followed in the held distance of the ends (``critical --parameter axial_stretch``,
+tube/onset.py with λ̄ as the curve's parameter) against the dispersion relation derived from the strain energy.
+
+With sliding ends held at λL the primary branch is the uniform tube at λz = λ (fixed: no axial balance), P =
+Φ_2/(λθλz), and its first odd branch point is the mode cos(πS/L): where the determinant of the period-averaged second
+variation in (A, B) of ρ = λθ + εA cos kS, η = λz S + εB sin kS vanishes at k = π/L (test_tube.bulge_determinant,
+derived there from e = Φ(λ1, λ2) − ½Pρ²η'). Along the onset curve every point is such a state at its own λ: λθ
+solves det(λθ, λ) = 0 (30 digits here). Where the curve turns back in λ (Gent) the two roots of det(·, λ) meet: the
+critical pre-stretch λ_c solves det = ∂det/∂λθ = 0, above which the tube held at λL does not bulge in that mode.
+"""
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from balloon_cg.app.cli import main
+from balloon_cg.galerkin.interval import Mirror
+from balloon_cg.io.tube_file import read_tube_run
+from balloon_cg.tube.onset import OnsetStop, onset_curve
+from balloon_cg.tube.primary import primary_branch
+from test_held_tube import held_scene
+from test_tube import bulge_determinant, symbolic_energy, theta, z
+
+LENGTH = 10.0
+
+
+def fixed_stretch_onset(energy, stretch: float, guess: float) -> tuple:
+    """(λθ, P) where the determinant of mode cos(πS/L) vanishes at λz = ``stretch``, P = Φ_2/(λθλz), by mpmath at
+    30 digits from ``guess``."""
+    det, k = bulge_determinant(energy)
+    at = {z: sp.Float(stretch, 30), k: sp.pi / sp.Integer(int(LENGTH))}
+    condition = sp.lambdify(theta, det.subs(at), "mpmath")
+    pressure = sp.lambdify(theta, (sp.diff(energy, theta) / (theta * z)).subs(at), "mpmath")
+    with mpmath.workdps(30):
+        root = mpmath.findroot(condition, mpmath.mpf(guess))
+        return float(root), float(pressure(root))
+
+
+def curve(preset: str, stretch: float, direction: float, stop: float = 6.0):
+    scene = held_scene(preset, LENGTH, stretch, "sliding", 12, stop)
+    primary = primary_branch(scene)
+    return scene, onset_curve(scene, primary, primary.branch_points(Mirror.ODD)[0], "axial_stretch", direction)
+
+
+@pytest.mark.parametrize("direction", [1.0, -1.0])
+def test_onset_in_the_held_stretch_solves_the_fixed_stretch_dispersion_relation(direction):
+    """SPOM1, L = 10, sliding ends held from λ = 1.5: upwards the curve runs to λ = 5 (stop stretch_limit: no fold,
+    bulging persists, at a falling pressure and, from λ ≈ 3.4, a hoop stretch below 1), downwards it lands on λ = 1
+    exactly (stop unstretched). At every fourth point and the last the state is uniform at λz = λ (λ̄ = q, 1e-12),
+    and its λθ and P are the root of the fixed-stretch dispersion relation derived here (1e-8; measured 4.2e-15)."""
+    scene, found = curve("SPOM1", 1.5, direction)
+    energy = symbolic_energy(scene.material)
+    k = found.disc.axial_index
+    assert found.stop.code == (OnsetStop.STRETCH_LIMIT if direction > 0 else OnsetStop.UNSTRETCHED)
+    assert not found.folds and np.all(np.diff(found.q) * direction > 0)
+    assert np.all(np.diff(found.pressure) * direction < 0)  # the onset pressure falls as the ends are pulled apart
+    if direction < 0:
+        assert found.q[-1] == 1.0
+    else:
+        assert 4.9 < found.q[-1] <= 5.0 and found.states[-1][0] < 1
+    for i in [*range(0, len(found.q), 4), len(found.q) - 1]:
+        u, P = found.states[i], found.pressure[i]
+        assert u[k] == found.q[i] and np.abs(np.delete(u, [0, k])).max() <= 1e-12
+        hoop, pressure = fixed_stretch_onset(energy, found.q[i], u[0])
+        assert abs(u[0] - hoop) <= 1e-8 and abs(P - pressure) <= 1e-8
+
+
+def test_gent_stops_bulging_above_a_critical_prestretch():
+    """Gent, L = 10, sliding ends held from λ = 1.5: the onset curve turns back at λ_c (a located fold in λ) and
+    returns along the upper root of the dispersion relation (where the uniform tube is stable again) until its hoop
+    stretch passes stop_stretch. λ_c and its λθ, P solve det = ∂det/∂λθ = 0 derived here (1e-8): above λ_c the held
+    tube has no bulge of this mode (measured: λ_c 1.3e-15, λθ 2.4e-10, P 1.6e-11; along the curve 1.3e-13)."""
+    scene, found = curve("Gent", 1.5, 1.0)
+    assert len(found.folds) == 1 and found.folds[0].status == "located"
+    assert found.stop.code == "hoop_stretch"
+    fold, critical = found.folds[0], float(found.fold_q[0])
+    energy = symbolic_energy(scene.material)
+    det, k = bulge_determinant(energy)
+    det = det.subs(k, sp.pi / sp.Integer(int(LENGTH)))
+    with mpmath.workdps(30):
+        hoop, stretch = sp.nsolve((det, sp.diff(det, theta)), (theta, z), (fold.u[0], critical), prec=30)
+    P = float((sp.diff(energy, theta) / (theta * z)).subs({theta: hoop, z: stretch}))
+    assert abs(critical - float(stretch)) <= 1e-8 and abs(fold.u[0] - float(hoop)) <= 1e-8
+    assert abs(fold.pressure - P) <= 1e-8
+    assert found.q.max() <= critical + 1e-12 and found.q[-1] < critical - 0.2  # back below λ_c along the upper root
+    hoop, P = fixed_stretch_onset(energy, found.q[-1], found.states[-1][0])
+    assert hoop > 5 and abs(found.states[-1][0] - hoop) <= 1e-8 and abs(found.pressure[-1] - P) <= 1e-8
+
+
+def test_critical_axial_stretch_from_the_command_line(tmp_path, capsys):
+    """``critical --parameter axial_stretch`` writes what onset_curve computes to /onset, prints the critical
+    pre-stretch (Gent: exit 0), ``inspect`` lists the curve with its hoop stretch, ``plot --what onset`` draws it;
+    closed ends and a held stretch outside [1, 5] exit 2 with one line and no file."""
+    scene = held_scene("Gent", LENGTH, 1.5, "sliding", 12, 6.0)
+    path = tmp_path / "gent.toml"
+    path.write_text(scene.to_toml())
+    out = tmp_path / "gent.h5"
+    assert main(["critical", str(path), "--parameter", "axial_stretch", "-o", str(out), "--quiet"]) == 0
+    _, expected = curve("Gent", 1.5, 1.0)
+    printed = capsys.readouterr().out
+    assert printed.startswith(f"critical axial_stretch = {expected.fold_q[0]:.12g} (P = ")
+    onset = read_tube_run(out)["onset"]
+    assert onset["attrs"]["parameter"] == "axial_stretch" and onset["attrs"]["q0"] == 1.5
+    assert np.array_equal(onset["q"], expected.q) and np.array_equal(onset["pressure"], expected.pressure)
+    assert np.allclose(onset["hoop_stretch"], expected.states[:, 0], rtol=0, atol=1e-12)  # uniform: ρ = λθ
+    assert main(["inspect", str(out)]) == 0
+    shown = capsys.readouterr().out
+    assert "onset in axial_stretch (from axial_stretch = 1.5)" in shown and "largest hoop stretch" in shown
+    assert f"fold in axial_stretch at axial_stretch = {expected.fold_q[0]:.10g}" in shown
+    assert main(["plot", str(out), "--what", "onset", "-o", str(tmp_path / "onset.png")]) == 0
+    assert (tmp_path / "onset.png").stat().st_size > 0
+    closed = tmp_path / "closed.toml"
+    closed.write_text('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10\naxial = "closed"\n')
+    far = tmp_path / "far.toml"
+    far.write_text(scene.to_toml().replace("axial_stretch = 1.5", "axial_stretch = 6"))
+    for given, message in ((closed, 'has closed ends (geometry.axial = "closed", the default: the distance free, '
+                                    "none held); hold them apart with geometry.axial_stretch = λ (in [1, 5])"),
+                           (far, "geometry.axial_stretch = 6: must be in [1, 5]")):
+        target = tmp_path / f"{given.stem}.h5"
+        assert main(["critical", str(given), "--parameter", "axial_stretch", "-o", str(target), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert message in err and err.count("\n") == 1 and not target.exists()
