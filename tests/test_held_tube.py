@@ -147,3 +147,32 @@ def test_plugged_held_tube_has_a_pressure_maximum_and_minimum():
     assert compressed[0] is False and len(compressed) > 2 and all(compressed[1:])  # the first odd BP only is taut
     eq = Equilibrium(scene, disc)
     assert np.abs(eq.residual(bottom.u, Parameters(bottom.pressure))[disc.free]).max() <= 1e-9
+
+
+def test_plugged_held_spom1_has_a_taut_pressure_maximum_and_minimum():
+    """SPOM1, plugged ends held at λ = 3, L = 6 (scenes/tube_spom1_L6_plugged_held3.toml): P rises to a maximum, falls
+    while a bulge grows in the middle, and rises again beyond a minimum, every state taut (no compressed point: the
+    pre-stretch keeps the necks beside the plugs in hoop tension, unlike λ = 1.5, docs/tubes.md). Both folds located,
+    the same at degrees 40 and 50 (1e-9; measured 0 and 7e-12), H constant along the tube at both (1e-4 of its
+    mean at degree 50; spread measured 5.9e-13 and 2.3e-5 at the minimum, whose necks are steep: 1.2e-6 at degree
+    60). The minimum is not the uniform one: P(λθ) at fixed λz = 3 derived here has its minimum at λθ = 4.85,
+    P = 0.497; the plugged tube's lies above it in P (0.5076), the middle's hoop stretch (6.79) beyond it."""
+    found = {}
+    for degree in (40, 50):
+        branch = primary_branch(held_scene("SPOM1", 6.0, 3.0, "plugged", degree, 7.5))
+        folds = [s for s in branch.special if s.kind == "LP"]
+        assert [s.status for s in folds] == ["located", "located"]
+        assert branch.stop.code == IntervalStop.HOOP_STRETCH and branch.smallest_stress.min() > 0
+        assert all(s.smallest_stress > 0 for s in folds)
+        found[degree] = folds
+    top, bottom = found[50]
+    for a, b in zip(found[40], found[50]):
+        assert abs(a.pressure - b.pressure) <= 1e-9
+    assert top.pressure > bottom.pressure + 0.3
+    energy, disc = symbolic_energy(held_scene("SPOM1", 6.0, 3.0, "plugged", 50).material), branch.disc
+    for s in (top, bottom):
+        H = first_integral(energy, disc, s.u)
+        assert np.abs(H - H.mean()).max() <= 1e-4 * abs(H.mean())
+    ((hoop, P),) = fixed_stretch_folds(energy, 3.0, (4.8,))
+    middle = disc.profile(bottom.u, np.array([3.0]))[0][0]
+    assert bottom.pressure > P + 1e-2 and middle > hoop + 1

@@ -21,8 +21,8 @@ never the converged points (the residual is exact).
 
 The curve stops where the largest hoop stretch passes ``continuation.stop_stretch`` (as the primary branch), where
 P ≤ 0, where q leaves its range (``RANGES``: M and Φ̄ ≥ 0, λ in [1, 5] as
-geometry.axial_stretch; below the lower end the last point is landed on it exactly: the field-free onset, or the
-tube held at its reference length), at ``continuation.max_points``, at the minimum step, or at the next point after
+geometry.axial_stretch; the last point is then landed exactly on the end it passed: the field-free onset, the tube
+held at its reference length or at 5L), at ``continuation.max_points``, at the minimum step, or at the next point after
 SIGINT/SIGTERM (StopCode.INTERRUPTED); its folds in q (LP: the onset's largest or smallest q) are located by the
 tracer's fold monitor.
 """
@@ -54,7 +54,7 @@ class OnsetStop(enum.StrEnum):
     FIELD_FREE = "field_free"  # q fell below 0: the last point is an odd branch point of the tube at q = 0 (not
     #                            necessarily its first: the curve may return along another bulge mode)
     UNSTRETCHED = "unstretched"  # λ fell below 1: the last point is an odd branch point of the tube held at λ = 1
-    STRETCH_LIMIT = "stretch_limit"  # λ passed the largest geometry.axial_stretch (5)
+    STRETCH_LIMIT = "stretch_limit"  # λ passed the largest geometry.axial_stretch: the last point is landed on 5
     NONPOSITIVE_PRESSURE = "nonpositive_pressure"  # P reached 0
 
 
@@ -182,6 +182,8 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
                                         "tube held at its reference length (λ = 1)") if name == STRETCH else \
         Stop(OnsetStop.FIELD_FREE, f"{name} fell below 0: the last point is an odd branch point at {name} = 0 (not "
                                    "necessarily the first onset: the curve may return along another bulge mode)")
+    beyond = Stop(OnsetStop.STRETCH_LIMIT, f"axial_stretch passed {high:g} (geometry.axial_stretch's largest value): "
+                                           f"the last point is an odd branch point of the tube held at λ = {high:g}")
 
     def stop(p):
         if (interrupted := signalled()) is not None:
@@ -195,17 +197,17 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
         if q < low:
             return below
         if q > high:
-            return Stop(OnsetStop.STRETCH_LIMIT, f"axial_stretch passed {high:g} (geometry.axial_stretch's largest "
-                                                 f"value) at P = {P:.6g}")
+            return beyond
         return None
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
     points = [p.X for p in path.points]
-    if path.stop.code == below.code:
-        landed = newton(system.residual, system.jacobian, path.overshoot.X, np.eye(X.size)[-1], low,
+    end = {below.code: low, beyond.code: high}.get(path.stop.code)
+    if end is not None:  # landed on the end of q's range it passed
+        landed = newton(system.residual, system.jacobian, path.overshoot.X, np.eye(X.size)[-1], end,
                         scene.solver.tol, scene.solver.max_newton)
         if not landed.converged:
-            raise ArithmeticError(f"the onset at {name} = {low:g} did not converge: {landed.message}")
+            raise ArithmeticError(f"the onset at {name} = {end:g} did not converge: {landed.message}")
         points.append(landed.x)
     parts = [system.split(Z) for Z in points]
     states = np.array([u for u, *_ in parts])
