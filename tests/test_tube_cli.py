@@ -14,7 +14,7 @@ from balloon_cg.model import tube
 from balloon_cg.scene import load_scene
 from balloon_cg.tube.picture import tube_picture
 from documented import inspect_json_keys
-from shared_pictures import TUBE_COIL_FAST as COIL_FAST, TUBE_FAST as FAST, tube_run_file
+from shared_pictures import TUBE_COIL_FAST as COIL_FAST, TUBE_FAST as FAST, tube_critical_file, tube_run_file
 
 SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
 
@@ -79,7 +79,7 @@ def test_plot_draws_every_tube_kind(run_file, tmp_path, capsys):
         assert (tmp_path / f"t_{kind}.png").stat().st_size > 10_000
     assert main(["plot", str(run_file), "--what", "shapes", "-o", str(tmp_path / "s.png")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].endswith("--what shapes: not drawn for a tube run file; allowed: " + ", ".join(kinds))
+    assert err[-1].endswith("--what shapes: not drawn for a tube run file; allowed: " + ", ".join((*kinds, "onset")))
     assert not (tmp_path / "s.png").exists()
     assert main(["plot", str(run_file), "--what", "front", "--branch", "primary", "-o", str(tmp_path / "f.png")]) == 2
     assert capsys.readouterr().err.strip().endswith("--what front: the primary branch's profiles are uniform at the "
@@ -148,18 +148,19 @@ def test_pressure_volume_figure_has_the_maxwell_line(run_file):
     assert len(maxwell) == 1 and maxwell[0].get_ydata()[0] == run["attrs"]["maxwell_pressure"]
 
 
-def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(run_file):
+def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(run_file,
+                                                                                           tmp_path_factory):
     """At the default width every title and axis label of every tube figure lies inside the figure (the stretches'
-    title ran past both edges); on P against V/V0 every located point is marked and its label is the number
+    title ran past both edges; the onset curve's of a ``critical`` file, the run's having none); on P against V/V0 every located point is marked and its label is the number
     ``inspect`` lists and ``continue`` takes with its kind ("1 BP odd"), the labels clear of one another (they were
     drawn over one another, without numbers, where branch points crowd the pressure maximum)."""
     from balloon_cg.io.tube_file import tube_labels
     from balloon_cg.post.labels import GID
     from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
 
-    run = read_tube_run(run_file)
+    run, critical = read_tube_run(run_file), read_tube_run(tube_critical_file(tmp_path_factory))
     for kind in TUBE_KINDS:
-        fig = tube_figure(run, kind)
+        fig = tube_figure(critical if kind == "onset" else run, kind)
         fig.draw_without_rendering()
         box = fig.bbox
         for ax in fig.axes:

@@ -16,11 +16,12 @@ one equation fewer than unknowns: a curve, traced by pseudo-arclength continuati
 Jacobian: ∂R_e/∂(u_e, P, q) from the generated kernels (the Hessian, ∂R/∂P, ∂R/∂M; for λ the Hessian's column
 of λ̄); ∂(H_oo φ)/∂u_e is the central difference of the whole Hessian along φ restricted to the odd rows and even
 columns (the third derivative of E is symmetric), ∂(H_oo φ)/∂P and ∂/∂q central differences (H is affine in P and
-M, quadratic in Φ̄: exact to rounding; for λ along λ̄'s unit vector); the steps ``H_STEP`` only set Newton's rate,
+M, quadratic in Φ̄: exact to rounding; for λ a central difference along λ̄'s unit vector); the steps ``H_STEP`` only set Newton's rate,
 never the converged points (the residual is exact).
 
-The curve stops where the largest hoop stretch passes ``continuation.stop_stretch`` (as the primary branch), where
-P ≤ 0, where q leaves its range (``RANGES``: M and Φ̄ ≥ 0, λ in [1, 5] as
+The curve in λ stops where the largest hoop stretch passes ``continuation.stop_stretch`` (as the primary branch:
+past the fold of a strain-stiffening material it runs along the upper onset towards the locking stretch); every curve
+stops where P ≤ 0, where q leaves its range (``RANGES``: M and Φ̄ ≥ 0, λ in [1, 5] as
 geometry.axial_stretch; the last point is then landed exactly on the end it passed: the field-free onset, the tube
 held at its reference length or at 5L), at ``continuation.max_points``, at the minimum step, or at the next point after
 SIGINT/SIGTERM (StopCode.INTERRUPTED); its folds in q (LP: the onset's largest or smallest q) are located by the
@@ -189,7 +190,7 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
         if (interrupted := signalled()) is not None:
             return interrupted
         u, P, _, q = system.split(p.X)
-        if (hoop := disc.node_state(u)[0].max()) > scene.continuation.stop_stretch:
+        if name == STRETCH and (hoop := disc.node_state(u)[0].max()) > scene.continuation.stop_stretch:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
                                                    f"{scene.continuation.stop_stretch:g} at {name} = {q:.6g}")
         if P <= 0:
