@@ -59,8 +59,9 @@ def test_scene_files_parse(path):
     scene = load_scene(path)
     assert scene.name == path.stem
     assert scene.text.startswith("#")
-    stop = {"spom1": 6.0, "tube_spom1_L10": 9.0, "tube_spom1_L10_coil": 9.0}.get(path.stem, 5.0)  # spom1: the whole
-    # isola; the tubes: their plateau
+    stop = {"spom1": 6.0, "tube_spom1_L10": 9.0, "tube_spom1_L10_coil": 9.0, "tube_gent_L10_held": 8.0,
+            "tube_spom1_L6_plugged_held3": 7.0}.get(path.stem, 5.0)  # spom1: the whole isola; the tubes: their
+    # plateau; the held Gent tube: its onset curve back along the upper root; the plugged one: past its minimum
     assert scene.continuation.stop_stretch == stop
     if "two_coils" in path.name:
         assert scene.field.coils == PAIR and scene.field.M == float(path.stem.split("_M")[1])
