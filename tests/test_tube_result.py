@@ -72,6 +72,8 @@ def test_the_onset_curve_as_xarray_and_table(files):
     table = tube.to_dataframe("onset")
     assert np.array_equal(table.M.values, onset["q"]) and np.array_equal(table.crest_height.values,
                                                                           onset["crest_height"])
+    assert np.array_equal(table.hoop_stretch.values, onset["hoop_stretch"])  # read back from the unknowns
+    assert np.array_equal(data["hoop_stretch"].values, onset["hoop_stretch"])
     assert "onset in M" in repr(tube)
 
 

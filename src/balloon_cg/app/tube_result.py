@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.tube_file import ACCURACY, CREST, CURVE_COLUMNS, POINT_COLUMNS, VOLTAGE, read_tube_run
+from ..io.tube_file import ACCURACY, CREST, CURVE_COLUMNS, HOOP, POINT_COLUMNS, VOLTAGE, read_tube_run
 from .tables import html_table, optional
 
 PARTS = ("points", "special")
@@ -76,7 +76,7 @@ class TubeResult:
             ``"special"``: one row per located point (branch, kind, block, status, note: a UZ point's event, index,
             pressure, voltage on a voltage continuation, volume, smallest_stress, crest_height); ``"onset"``: one
             row per point of the onset curve of ``critical`` (the parameter under its own name, pressure, volume,
-            crest_height).
+            crest_height, hoop_stretch: the onset's largest radius).
 
         Returns
         -------
@@ -164,7 +164,7 @@ class TubeResult:
 
     def _onset_columns(self) -> dict:
         onset = self._onset()
-        return {onset["attrs"]["parameter"]: onset["q"]} | {c: onset[c] for c in CURVE_COLUMNS if c != "q"}
+        return {onset["attrs"]["parameter"]: onset["q"]} | {c: onset[c] for c in (*CURVE_COLUMNS, HOOP) if c != "q"}
 
     def __repr__(self):
         g = self.geometry
