@@ -126,6 +126,8 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
         if stage == "frequencies":
             done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
             what = f"the branches whole, the frequencies of {', '.join(done) or 'none'} written"
+        elif stage == "modes":
+            what = "the branches whole, their m ≥ 1 blocks not read"
         elif stored is None:
             what = "not started"
         else:
