@@ -59,6 +59,8 @@ from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop, TraceStop
 from ..io.run_file import stored_scene
+from ..scene import SceneError
+from ..scene.tables import startable
 from ..post.quantities import branch_discretisation
 
 
@@ -387,9 +389,14 @@ def switch(start: Labelled, progress=None) -> Picture:
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
     """What ``continue`` computes from ``start`` (module docstring): a Picture (in the branch's own parameter: of
     the branch through it, or at a branch point of the branch of the point and the branches switched to) or a
-    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built. The
-    Picture's branches get their natural frequencies when the scene asks for them ([dynamics]: not after a signal;
-    a signal during them interrupts the picture there, ``attach_to``)."""
+    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built, and for
+    a stored scene a new run may not start (``scene.tables.startable``: a file written before one of its checks is
+    read, not continued). The Picture's branches get their natural frequencies when the scene asks for them
+    ([dynamics]: not after a signal; a signal during them interrupts the picture there, ``attach_to``)."""
+    try:
+        startable(start.branch.scene)
+    except SceneError as e:
+        raise RestartError(f"label {start.label}: the file's scene cannot start a new run: {e}") from None
     own = start.branch.parameter
     kind = start.point.kind
     if parameter in (None, own):
