@@ -61,6 +61,13 @@ def test_the_ln_meets_the_pitchfork(meeting):
     assert abs(lam_fold - lam_bp) < 1e-6  # λ at a fold of n is only as sharp as √(tolerance)
 
 
+def test_a_curve_point_names_q_not_p(meeting):
+    """A curve point's X ends in q (here M): its repr says M = q, not P = q."""
+    curve, meetings = meeting
+    assert f"M = {meetings[0].X[-1]:.10g}" in repr(meetings[0]) and "P =" not in repr(meetings[0])
+    assert all(s.parameter == "M" for s in curve.merges + curve.meetings)
+
+
 def test_the_ln_curve_passes_through_the_meeting(meeting):
     """The LN fold curve in M (fold_curve, from the LN of the gas-control branch at M = 0.002), landed on M*, is at
     the meeting's P to 1e-9 (measured: 1.4e-13)."""

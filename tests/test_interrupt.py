@@ -221,3 +221,57 @@ def test_a_signal_while_continue_reads_its_file_stops_the_read_at_once(tmp_path,
     assert (len(checked) > 1) == dropped and not (tmp_path / "c.h5").exists()
     assert capsys.readouterr().err.strip() == (f"balloon-cg: interrupted: nothing is written to {tmp_path / 'c.h5'} "
                                                "(the work had not started)")
+
+
+FREQUENCIES_SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n[dynamics]\nfrequencies = true\n'
+
+
+def _stop_at(n: int, progress=None):
+    """A tracer's per-point ``progress`` that asks for a stop (as a signal's handler does) at its ``n``-th point."""
+    ticks = []
+
+    def tick(*args):
+        ticks.append(1)
+        if progress is not None:
+            progress(*args)
+        if len(ticks) == n:
+            interrupt.request()
+    return tick
+
+
+def _interrupted_in(incomplete) -> list:
+    """The messages of the picture's own interrupted entry (not a leg's)."""
+    return [i.message for i in incomplete if i.gap == Gap.INTERRUPTED and i.message.startswith("interrupted by")]
+
+
+def test_a_signal_during_a_primary_only_trace_is_recorded_in_the_trace_not_the_frequencies(monkeypatch):
+    """app.api.computed's primary-only picture (built without ``picture.stopped``) with [dynamics] frequencies: a stop
+    asked for during the trace names the trace as the phase it came in, not the frequencies (not started)."""
+    from balloon_cg.analysis.branches import primary
+    from balloon_cg.app.api import computed
+    from balloon_cg.scene import parse_scene
+
+    trace = primary.trace_primary
+    monkeypatch.setattr(primary, "trace_primary", lambda scene, progress=None: trace(scene, progress=_stop_at(3, progress)))
+    with interrupt.stop_on_signals():
+        branches, _, found, _, _ = computed(parse_scene(FREQUENCIES_SCENE, "s"), primary_only=True)
+    assert branches[0].frequencies is None
+    assert _interrupted_in(found) == ["interrupted by a signal during trace: the branches and phases after the stored "
+                                      "points were not computed"], found
+
+
+def test_a_signal_during_continue_s_trace_is_recorded_in_the_trace_not_the_frequencies(tmp_path):
+    """``continue`` (app.restart.restart) from a label of an unassessed branch returns ``Picture([traced])``: a stop
+    asked for during its trace names the trace, not the frequencies, as the phase it came in."""
+    import balloon_cg as bc
+    from balloon_cg.app.restart import find_label, restart
+    from balloon_cg.scene import parse_scene
+
+    bc.trace(parse_scene(FREQUENCIES_SCENE, "s")).save(tmp_path / "t.h5")
+    run = read_run(tmp_path / "t.h5")
+    start = find_label(run, 1)
+    with interrupt.stop_on_signals():
+        picture = restart(start, None, progress=_stop_at(3))
+    assert picture.primary.frequencies is None
+    assert _interrupted_in(picture.incomplete) == [
+        "interrupted by a signal during trace: the branches and phases after the stored points were not computed"]

@@ -5,12 +5,14 @@ when the work had finished (and one line saying so, or nothing once Python exits
 nor with a traceback. The moments are picked by the code's own hooks (an import, a function called), in a fresh
 interpreter that sends the signal to itself there: no sleeps, the same on any machine."""
 import os
+import signal
 import subprocess
 import sys
 
 import pytest
 
 import balloon_cg as bc
+from balloon_cg.numerics import interrupt
 
 from cpu_moments import foreground
 
@@ -166,3 +168,36 @@ def test_a_signal_swallowed_while_the_last_member_is_copied_still_stops_the_swee
         run_sweep(load_scene("spom1"), ["stop_stretch=1.1:1.3:3"], tmp_path / "w.h5", mode="primary-only",
                   workers=2)
     assert len(calls) == 3 and sorted(bc.load(tmp_path / "w.h5").members) == sorted(calls)
+
+
+@pytest.mark.parametrize("stage", ["write_member", "copy_tree"])
+def test_a_signal_while_a_member_is_written_or_copied_is_not_raised_inside_h5py(tmp_path, monkeypatch, stage):
+    """The sweep's parent writes each member to the store (``Store.write_member``) and copies it into the view
+    (``View.add``: h5py's copy) under ``sigterm_raises``: a KeyboardInterrupt raised inside an h5py call can surface
+    as "SystemError: <cyfunction FastRLock.__exit__> returned a result with an exception set" (exit 3: seen once in
+    test_cli_conventions' interrupted sweep under load). A signal there only sets the flag: the call finishes, and
+    the sweep stops right after it (KeyboardInterrupt), the member stored and in the view. The signal is raised from
+    inside the h5py work (the member file's verdict written, the copy's start)."""
+    from balloon_cg.app.sweep import run_sweep
+    from balloon_cg.io import hdf5, run_file, sweep_file
+    from balloon_cg.scene import load_scene
+
+    finished = []
+
+    def signalling(original):
+        def inside(*args, **kwargs):
+            if not finished:
+                signal.raise_signal(signal.SIGTERM)  # the handler runs here, inside the h5py work
+                finished.append(stage)  # reached only if the handler did not raise
+            return original(*args, **kwargs)
+        return inside
+
+    if stage == "copy_tree":
+        monkeypatch.setattr(sweep_file, "copy_tree", signalling(hdf5.copy_tree))
+    else:
+        monkeypatch.setattr(sweep_file, "verdict_attrs", signalling(run_file.verdict_attrs))
+    with interrupt.sigterm_raises(), pytest.raises(KeyboardInterrupt):
+        run_sweep(load_scene("spom1"), ["stop_stretch=1.1:1.3:3"], tmp_path / "w.h5", mode="primary-only",
+                  workers=1)
+    assert finished == [stage]
+    assert sorted(bc.load(tmp_path / "w.h5").members) == [0]

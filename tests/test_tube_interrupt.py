@@ -152,3 +152,61 @@ def test_a_signal_during_a_tube_runs_frequencies_stops_them_at_the_next_point(re
         assert branch["frequencies"] is None
         assert np.array_equal(branch["unknowns"], references[0]["branches"][name]["unknowns"])
         assert branch["attrs"]["stop_code"] == references[0]["branches"][name]["attrs"]["stop_code"]
+
+
+def _signalled_after(monkeypatch, module, name):
+    """``module.name`` asking for a stop (as a signal's handler does) once it returns: a signal after the last check of
+    the flag in the trace it made."""
+    from balloon_cg.numerics import interrupt
+
+    original = getattr(module, name)
+
+    def traced(*args, **kwargs):
+        found = original(*args, **kwargs)
+        interrupt.request()
+        return found
+    monkeypatch.setattr(module, name, traced)
+
+
+@pytest.mark.parametrize("settings, stage, what", [
+    ([], "modes", "the branches whole, their m ≥ 1 blocks not read"),  # [surface] "first" after them
+    (["--set", "stability.m_max=0", "--set", "dynamics.frequencies=true"], "frequencies",
+     "the branches whole, the frequencies of none written")])
+def test_a_signal_after_the_primary_s_last_check_interrupts_the_stage_after_it(references, tmp_path, capsys,
+                                                                              monkeypatch, settings, stage, what):
+    """`run --primary-only`: a signal after the primary branch's last point (its branch points being located) skipped
+    the m ≥ 1 blocks (and the surface branch after them) or the frequencies, and the file said it was whole: it now
+    names the stage not computed, exit 130 with the file's line, the primary branch the uninterrupted run's."""
+    from balloon_cg.tube import picture
+
+    _signalled_after(monkeypatch, picture, "primary_branch")
+    path = tmp_path / "r.h5"
+    assert main(run_argv(str(path)) + ["--primary-only", *settings]) == 130
+    assert one_line(capsys.readouterr().err) == (f"balloon-cg: interrupted ({stage}: {what}); what was finished is "
+                                                 f"written to {path} (flagged interrupted)")
+    run = read_tube_run(path)
+    assert run["attrs"]["interrupted"] == stage and set(run["branches"]) == {"primary"}
+    assert np.array_equal(run["branches"]["primary"]["unknowns"], references[0]["branches"]["primary"]["unknowns"])
+    assert main(["inspect", str(path)]) == 0
+    assert f"a signal stopped the {stage} stage" in capsys.readouterr().out
+
+
+def test_a_signal_after_the_bulge_s_last_check_in_continue_interrupts_its_modes(tmp_path_factory, tmp_path, capsys,
+                                                                               monkeypatch):
+    """`continue` at the onset label: a signal after the bulge branch's last point: its m ≥ 1 blocks (and the surface
+    branch) not read, the file says so (it said whole), exit 130; the bulge is the uninterrupted continue's."""
+    from balloon_cg.tube import picture
+    from shared_pictures import tube_run_file
+
+    stored = tube_run_file(tmp_path_factory)
+    whole = tmp_path / "whole.h5"
+    assert main(["continue", str(stored), "1", "-o", str(whole), "--quiet"]) == 0
+    _signalled_after(monkeypatch, picture, "traced_bulge")
+    path = tmp_path / "c.h5"
+    assert main(["continue", str(stored), "1", "-o", str(path), "--quiet"]) == 130
+    assert one_line(capsys.readouterr().err) == ("balloon-cg: interrupted (modes: the branches whole, their m ≥ 1 "
+                                                 f"blocks not read); what was finished is written to {path} (flagged "
+                                                 "interrupted)")
+    run, reference = read_tube_run(path), read_tube_run(whole)
+    assert run["attrs"]["interrupted"] == "modes" and reference["attrs"]["interrupted"] == ""
+    assert np.array_equal(run["branches"]["bulge"]["unknowns"], reference["branches"]["bulge"]["unknowns"])

@@ -193,12 +193,13 @@ class SpecialPoint:
     sector: tuple = ()  # a secondary BP of a surface branch: the characters of the symmetry sector whose held
     #                     eigenvalue crosses zero, one per reflection of its basis (``surface.assessment``; run
     #                     files: special_points/state/sector)
+    parameter: str = "P"  # the name of X[-1]: q's on a two-parameter curve (its ``parameter``, set by the curve)
 
     def __repr__(self):
         label = " ".join(v for v in (self.kind.value, self.classification.value, self.block.value) if v)
         status = "" if self.status == Status.LOCATED else f", {self.status.value} ±{self.uncertainty:.1g}"
         return (f"SpecialPoint({label}{f' m={self.m}' if self.m else ''} after point {self.index}, "
-                f"P = {self.X[-1]:.10g}{status})")
+                f"{self.parameter} = {self.X[-1]:.10g}{status})")
 
 
 def bracket_uncertainty(disc, before, after) -> float:

@@ -21,9 +21,9 @@ from ..analysis.picture import Phase
 from ..io.hdf5 import atomic_bytes, command_line
 from ..io.layout import file_kind
 from ..io.parents import parent_label
-from ..io.run_file import RunFileError, read_run, read_run_image, run_image
+from ..io.run_file import RunFileError, read_run, read_run_image, run_image, stored_scene
 from ..numerics.interrupt import stop_on_signals
-from ..scene import Scene, SceneError, Shape, load_scene, parse_scene
+from ..scene import Scene, SceneError, Shape, load_scene
 from .progress import PhaseBars
 from .tables import SpecialPoints, counted, html_table, optional
 
@@ -500,7 +500,7 @@ def load(path):
         return TubeResult.read(path)
     run = read_run(path)
     try:
-        scene = parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
+        scene = stored_scene(run)
     except SceneError as e:
         raise RunFileError(path, f"the stored scene_toml is not a valid scene ({e})") from None
     return Result(scene, Path(path).read_bytes(), run)

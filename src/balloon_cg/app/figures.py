@@ -11,10 +11,9 @@ import sys
 from pathlib import Path
 
 from ..io.output import IMAGE_FORMATS, check_output, replacing
-from ..io.run_file import read_run
+from ..io.run_file import read_run, stored_scene
 from ..post.paper import TWO_COLUMNS, draw_figure, figures
 from ..post.plotting import MAX_WIDTH, MIN_WIDTH, Reading
-from ..scene import parse_scene
 from .api import analyse
 from .progress import shown
 
@@ -49,7 +48,7 @@ def run_for(case, runs: Path, quick: bool = False, progress: bool = False) -> di
     interrupted = run is not None and "interrupted" in list(run["attrs"].get("incomplete_gaps", []))
     if interrupted:
         print(f"balloon-cg: {path}: the run kept there was interrupted; computing it again", file=sys.stderr)
-    stale = run is None or parse_scene(run["attrs"]["scene_toml"], scene.name).to_toml() != scene.to_toml()
+    stale = run is None or stored_scene(run).to_toml() != scene.to_toml()
     if stale or interrupted:
         runs.mkdir(parents=True, exist_ok=True)
         result = analyse(scene, progress=progress)

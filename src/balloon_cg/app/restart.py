@@ -53,11 +53,14 @@ from ..analysis.critical.second_parameter import resolve
 from ..analysis.surface.branches import SurfaceStartError
 from ..analysis.switching.pear import mark_rejoin, pear_landing, pear_stop_rule
 from ..analysis.branches.tracer import Tracer
+from ..analysis.timing import Clock, Step
 from ..dynamics.frequencies import attach_to
 from ..galerkin.equilibrium import Parameters
 from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop, TraceStop
 from ..io.run_file import stored_scene
+from ..scene import SceneError
+from ..scene.tables import startable
 from ..post.quantities import branch_discretisation
 
 
@@ -192,8 +195,8 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
         return tracer.leg(replace(point, tangent=sign * point.tangent), params, stop(), progress, degree=disc.degree,
                           mapping=disc.mapping, limits=range_limits(scene, upper, branch.parameter, params))
 
-    up = leg(1.0)
-    down = None if up.stop.code == StopCode.CLOSED else leg(-1.0)  # closed: the loop is whole, traced once
+    clock = Clock()
+    up, down = both_ways(leg, clock)
     child = pear and start.parent is not None  # stored with its parent, under its own name
     name = branch.name if child or branch.name == FREE_PRIMARY else "primary"
     traced = with_events(assemble(tracer, params, name, up, down, t0, labels=("up", "down"),
@@ -206,8 +209,8 @@ def restart_branch(start: Labelled, progress=None) -> Picture:
             if bp.block == block:
                 mark_rejoin(traced, start.parent, bp)
         traced.parent, traced.rejoins = (start.parent.name, start.parent_point), next(iter(rejoined), None)
-    picture = (examine(scene, traced, Ticks(progress), pear=False, control=not pear) if start.assessed else
-               Picture([traced]))
+    picture = (examine(scene, traced, Ticks(progress), pear=False, clock=clock, control=not pear) if start.assessed
+               else Picture([traced], clock=clock))
     return replace(picture, branches=[start.parent, *picture.branches]) if child else picture
 
 
@@ -386,9 +389,14 @@ def switch(start: Labelled, progress=None) -> Picture:
 def restart(start: Labelled, parameter: str | None, direction: float = 1.0, progress=None):
     """What ``continue`` computes from ``start`` (module docstring): a Picture (in the branch's own parameter: of
     the branch through it, or at a branch point of the branch of the point and the branches switched to) or a
-    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built. The
-    Picture's branches get their natural frequencies when the scene asks for them ([dynamics]: not after a signal;
-    a signal during them interrupts the picture there, ``attach_to``)."""
+    two-parameter curve (a fold or a pear point in a second parameter); RestartError for what is not built, and for
+    a stored scene a new run may not start (``scene.tables.startable``: a file written before one of its checks is
+    read, not continued). The Picture's branches get their natural frequencies when the scene asks for them
+    ([dynamics]: not after a signal; a signal during them interrupts the picture there, ``attach_to``)."""
+    try:
+        startable(start.branch.scene)
+    except SceneError as e:
+        raise RestartError(f"label {start.label}: the file's scene cannot start a new run: {e}") from None
     own = start.branch.parameter
     kind = start.point.kind
     if parameter in (None, own):
@@ -449,11 +457,20 @@ def restart_in(start: Labelled, name: str, progress=None) -> Picture:
                           closing_rule(disc, X, stop_rule(scene, upper, name, params)), progress, degree=disc.degree,
                           mapping=disc.mapping, limits=range_limits(scene, upper, name, params))
 
-    up = leg(1.0)
-    down = None if up.stop.code == StopCode.CLOSED else leg(-1.0)
+    clock = Clock()
+    up, down = both_ways(leg, clock)
     primary = with_events(assemble(tracer, params, "primary", up, down, t0, labels=("up", "down"),
                                    land_on=landing_targets(scene, upper)))
-    return examine(scene, primary, Ticks(progress), pear=False) if start.assessed else Picture([primary])
+    return (examine(scene, primary, Ticks(progress), pear=False, clock=clock) if start.assessed else
+            Picture([primary], clock=clock))
+
+
+def both_ways(leg, clock: Clock) -> tuple:
+    """(up, down): ``leg(1.0)`` and, unless it closed (the loop is whole, traced once), ``leg(-1.0)``, charged to
+    Step.TRACE on ``clock`` (the restarted picture's: a signal during them is recorded in the trace)."""
+    with clock.step(Step.TRACE):
+        up = leg(1.0)
+        return up, None if up.stop.code == StopCode.CLOSED else leg(-1.0)
 
 
 def held_layout(branch: Branch) -> bool:

@@ -319,10 +319,13 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
                         for index, outcome in outcomes:
                             if isinstance(outcome, BaseException):
                                 result.failed[index] = f"{type(outcome).__name__}: {outcome}"
-                            else:
-                                store.write_member(by_index[index], outcome)
-                                view.add(index)
-                                result.computed.append(index)
+                            else:  # a signal meanwhile only sets the flag: raised after them (``interrupt.Held``),
+                                #    never inside h5py (a KeyboardInterrupt there can surface as a SystemError)
+                                with interrupt.Held() as held:
+                                    held.start()
+                                    store.write_member(by_index[index], outcome)
+                                    view.add(index)
+                                    result.computed.append(index)
                             bar.update()
                             _check_interrupt()  # a signal swallowed while the member was stored or copied
             finally:

@@ -131,6 +131,8 @@ def interrupted_status(run: dict, output, signalled: bool) -> int | None:
         if stage == "frequencies":
             done = [name for name, b in run["branches"].items() if b["frequencies"] is not None]
             what = f"the branches whole, the frequencies of {', '.join(done) or 'none'} written"
+        elif stage == "modes":
+            what = "the branches whole, their m ≥ 1 blocks not read"
         elif stored is None:
             what = "not started"
         else:
@@ -261,13 +263,14 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
 
 
 def stored_scene(args, run: dict):
-    """The scene a tube run file stores (UsageError, one line, where it is not a valid one)."""
+    """The scene a tube run file stores, as the new run of ``continue`` starts from it (UsageError, one line, where it
+    is not a valid scene or one a new run may not start: ``scene.tables.startable``)."""
     from ..scene import SceneError, parse_scene
 
     try:
         return parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
     except SceneError as e:
-        raise UsageError(f"continue {args.run}: the stored scene is not a valid scene ({e})") from None
+        raise UsageError(f"continue {args.run}: the stored scene cannot start a new run ({e})") from None
 
 
 def with_continuation_settings(args, stored):

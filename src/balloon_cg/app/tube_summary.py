@@ -20,7 +20,7 @@ import tomllib
 import numpy as np
 
 from ..io.tube_file import CREST, HELD_M1, HOOP, VOLTAGE, discretisation
-from ..scene import parse_scene
+from ..scene.tables import parse_stored
 from ..tube.azimuthal import mode_profile
 from ..tube.stability import COMPRESSED
 
@@ -32,7 +32,7 @@ def summarise_tube(run: dict) -> dict:
     geometry = {"shape": a["shape"], "length": a["length"], "ends": a["ends"],
                 "axial_stretch": None if math.isnan(a["axial_stretch"]) else a["axial_stretch"]}
     control, v0 = a["control"], np.pi * a["length"]
-    max_error = parse_scene(a["scene_toml"]).solver.max_error
+    max_error = parse_stored(a["scene_toml"]).solver.max_error
     branches = {}
     for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
         unstable = b.get(f"unstable_{control}")

@@ -161,9 +161,11 @@ def attach(branches, count: int, m_max: int, modes: bool = False) -> None:
 def attach_to(picture, dynamics) -> None:
     """``attach`` to the branches and surface branches of ``picture`` (analysis.picture.Picture), timed
     (Step.FREQUENCIES), when ``dynamics`` (the scene's [dynamics]) asks for them and no signal stopped the work; a
-    signal during them, or one that came after the analysis's last check of the flag, stops them at the next point
-    (the branches not reached are kept without) and the picture is interrupted in that phase (``picture.stopped``)."""
-    if not dynamics.frequencies or picture.interrupted:
+    signal that came before them (after the last check of the flag of the phase then running, or on a picture built
+    without ``picture.stopped``: the primary-only trace, ``continue``'s) interrupts the picture in the phase its
+    clock ran last, and they are not started; a signal during them stops them at the next point (the branches not
+    reached are kept without) and the picture is interrupted in that phase."""
+    if not dynamics.frequencies or stopped(picture):
         return
     try:
         with picture.clock.step(Step.FREQUENCIES):

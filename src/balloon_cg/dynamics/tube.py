@@ -95,15 +95,16 @@ def tube_matching_block(special, symmetric: bool) -> str:
 
 def with_frequencies(scene, picture):
     """``picture`` (tube/picture.TubePicture) with every branch's TubeFrequencies where the scene's [dynamics] asks
-    for them (``count`` each), else as it is: also where a signal stopped the picture or has come since (they are
-    not computed then: a signal ends the work at its next stage, numerics.interrupt). A signal while they are
-    computed stops them at the next point: the branches finished keep theirs, the others have none, and the picture
-    is interrupted in the frequencies stage (Stage.FREQUENCIES)."""
-    if not scene.dynamics.frequencies or picture.interrupted is not None or interrupt.requested():
+    for them (``count`` each), else as it is: also where a signal stopped the picture (they are not computed then:
+    a signal ends the work at its next stage, numerics.interrupt). A signal since the last check of the stage before
+    (none are computed) or while they are computed stops them at the next point: the branches finished keep theirs,
+    the others have none, and the picture is interrupted in the frequencies stage (Stage.FREQUENCIES)."""
+    if not scene.dynamics.frequencies or picture.interrupted is not None:
         return picture
     count = scene.dynamics.count
     found = {}
     try:
+        interrupt.check()
         for name, branch in picture.branches.items():
             found[name] = tube_branch_frequencies(scene, branch, count)
     except interrupt.Interrupted:

@@ -78,7 +78,7 @@ def write_curve(path, scene, curve, name: str = "pear", force: bool = False, ext
         parameter_coordinate(group, curve.parameter, curve.second.key, curve.q, point)
         points = sorted(curve.merges + curve.meetings, key=lambda s: (s.index, s.X[-1]))
         special = group.create_group("special_points")
-        write_special(special, [replace(s, X=curve.branch_X(s.X)[0]) for s in points], curve.n + 1,
+        write_special(special, [replace(s, X=curve.branch_X(s.X)[0], parameter="P") for s in points], curve.n + 1,
                       lambda X: legendre_poles(curve.disc, X))
         parameter_coordinate(special, curve.parameter, curve.second.key, [s.X[-1] for s in points],
                              special["special"])

@@ -85,7 +85,7 @@ import h5py
 import numpy as np
 
 from ..analysis.timing import Clock, Step
-from ..scene import parse_scene
+from ..scene.tables import parse_stored
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .legacy import current
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
@@ -559,8 +559,9 @@ def read_run(path) -> dict:
 
 
 def stored_scene(run: dict):
-    """The Scene a run file was computed for, rebuilt from its ``scene_toml`` attribute."""
-    return parse_scene(run["attrs"]["scene_toml"], run["scene_name"])
+    """The Scene a run file was computed for, rebuilt from its ``scene_toml`` attribute as it was written
+    (``scene.tables.parse_stored``: also a setting a new run may no longer start)."""
+    return parse_stored(run["attrs"]["scene_toml"], run["scene_name"])
 
 
 def read_run_image(image: bytes, label: str = "run") -> dict:

@@ -32,8 +32,8 @@ before them have none). A ``critical`` run adds
 ``hoop_stretch``, the largest radius ρ of each state, from its unknowns); its folds in q
 under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
-started, and is absent where it had not; ``frequencies``: the branches whole, the frequencies of the branches finished
-before the signal only), "" where the work is whole (files before it have none: read as "").
+started, and is absent where it had not; ``modes``: the branches whole, no m ≥ 1 blocks; ``frequencies``: the branches
+whole, the frequencies of the branches finished before the signal only), "" where the work is whole (files before it have none: read as "").
 With [dynamics] frequencies, each branch's natural frequencies under frequencies/ (io/tube_frequencies.py). With
 [surface] branches, the non-axisymmetric branches under /surface_branches/ (io/tube_surface_file.py).
 """

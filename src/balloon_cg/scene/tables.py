@@ -24,7 +24,7 @@ from .materials import ALPHA1, MAX_EXPONENT, Material, alpha1_terms, material_fr
 __all__ = [
     "Coil", "Field", "Electric", "Geometry", "Shape", "Ends", "ContinuationParameter", "Continuation", "Solver",
     "Stability", "Output", "Loading", "Control", "Scene", "SceneError",
-    "parse_scene", "load_scene",
+    "parse_scene", "parse_stored", "startable", "load_scene",
 ]
 
 
@@ -527,7 +527,7 @@ class Scene:
             for key, value in overrides.items():
                 if key != "material.preset" or preset is None:
                     _assign(data, key, value)
-            scene = _build(data, name or renamed(self.name, overrides), "")
+            scene = startable(_build(data, name or renamed(self.name, overrides), ""))
             if "material.name" not in overrides:  # the values computed with, never a preset's name they left
                 scene = replace(scene, material=replace(scene.material, name=modified_name(base, scene.material)))
         except SceneError as e:
@@ -601,6 +601,23 @@ def parse_scene(text: str, name: str = "scene") -> Scene:
     return _parse(text, name, name)
 
 
+def parse_stored(text: str, name: str = "scene") -> Scene:
+    """The scene a file stores (its ``scene_toml``), read as it was written: ``parse_scene`` without the checks of
+    what a new run may start (``startable``), so that a file written before one of them is still read (inspect,
+    plot, load) and says what it was computed with; SceneError for text that is no scene."""
+    return _parse(text, name, name, new=False)
+
+
+def startable(scene: Scene) -> Scene:
+    """``scene``, or SceneError for what a new run of it may not start: a stop at or below the reference volume
+    (``_stop_volume_above_reference``), [surface] branches where none can be traced (``_surface_reads``). Checked on
+    new input (``parse_scene``, ``load_scene``, ``Scene.with_overrides``) and where ``continue`` starts from a file's
+    scene; not on a file's stored text (``parse_stored``)."""
+    _stop_volume_above_reference(scene.continuation.stop_volume, scene.geometry)
+    _surface_reads(scene.surface, scene.geometry.shape, scene.stability)
+    return scene
+
+
 def load_scene(path) -> Scene:
     """Read a scene file.
 
@@ -665,7 +682,9 @@ def shipped_scenes() -> dict[str, Path]:
     return {item.name.removesuffix(".toml"): Path(str(item)) for item in folder.iterdir() if item.name.endswith(".toml")}
 
 
-def _parse(text: str, name: str, source: str) -> Scene:
+def _parse(text: str, name: str, source: str, new: bool = True) -> Scene:
+    """The scene of the TOML ``text`` (errors prefixed with ``source``), ``startable`` unless it is a file's stored
+    text (``new`` False: ``parse_stored``)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
@@ -674,7 +693,8 @@ def _parse(text: str, name: str, source: str) -> Scene:
         raise SceneError(f"{source}: invalid TOML: arrays or tables nested deeper than {MAX_NESTING} levels") from None
     try:
         _check_nesting(data)
-        return _build(data, name, text)
+        scene = _build(data, name, text)
+        return startable(scene) if new else scene
     except SceneError as e:
         raise SceneError(f"{source}: {e}") from None
 
@@ -712,7 +732,6 @@ def _build(data: dict, name: str, text: str) -> Scene:
     output = _output(data.get("output", {}))
     _check_products(continuation, output)
     geometry = _geometry(data.get("geometry", {}), field)
-    _stop_volume_above_reference(continuation.stop_volume, geometry)
     dynamics = _dynamics(data.get("dynamics", {}))
     solver = _solver(data.get("solver", {}))
     if geometry.shape != Shape.TUBE and solver.tube_resolution != Solver.tube_resolution:
@@ -726,7 +745,6 @@ def _build(data: dict, name: str, text: str) -> Scene:
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
     surface = _surface(data.get("surface", {}), default_surface(geometry.shape, field, electric, stability))
-    _surface_reads(surface, geometry.shape, stability)
     return Scene(
         name=name,
         material=material,

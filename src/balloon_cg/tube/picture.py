@@ -52,6 +52,7 @@ class Stage(enum.StrEnum):
     PRIMARY = "primary"  # the primary branch (tube/primary.py)
     BULGE = "bulge"  # the bulge branch (tube/bulge.py)
     ONSET = "onset"  # the onset curve of ``critical`` (tube/onset.py)
+    MODES = "modes"  # the branches' m ≥ 1 blocks and their zeros (``with_modes``): the branches are whole
     SURFACE = "surface"  # the non-axisymmetric branches ([surface] branches: tube/surface/branch.py)
     FREQUENCIES = "frequencies"  # the branches' natural frequencies (dynamics/tube.py): the branches are whole
 
@@ -174,13 +175,17 @@ def rejoined_at(scene, primary: IntervalBranch, branch: IntervalBranch, label: i
 @limited_blas
 def with_modes(scene, picture: TubePicture) -> TubePicture:
     """``picture`` with its branches' m = 1..``stability.m_max`` blocks (tube/azimuthal.py) and the zeros of their
-    eigenvalues located (tube/azimuthal_crossings.py) where m_max ≥ 1 and no signal stopped it (a signal ends the
-    work at its next stage: then they are not assessed). One BLAS thread, as the traces."""
+    eigenvalues located (tube/azimuthal_crossings.py) where m_max ≥ 1 and no signal stopped the picture. A signal
+    before a branch's blocks (after the last check of the stage before, or while the branch before was read: they do
+    not poll) ends the work there: none are kept, the picture is interrupted in Stage.MODES. One BLAS thread, as the
+    traces."""
     m_max = scene.stability.m_max
-    if m_max < 1 or picture.interrupted is not None or interrupt.requested():
+    if m_max < 1 or picture.interrupted is not None:
         return picture
     modes = {}
     for name, branch in picture.branches.items():
+        if interrupt.requested():
+            return replace(picture, interrupted=Stage.MODES)
         found = branch_modes(Equilibrium(scene, branch.disc), np.column_stack([branch.states, branch.pressure]),
                              branch.params, m_max)
         modes[name] = replace(found, crossings=tuple(crossings(scene, branch, found)))

@@ -183,6 +183,11 @@ class TwoParameterCurve:
     meetings: list = field(default_factory=list)  # codim-2 points LP-BP, LV-BP, LN-BP (``fold_meeting``,
     #                                                 on a fold curve ``fold_crossing``)
 
+    def __post_init__(self):
+        """Its merges' and meetings' X end in q: they name it (``SpecialPoint.parameter``)."""
+        self.merges = [replace(s, parameter=self.parameter) for s in self.merges]
+        self.meetings = [replace(s, parameter=self.parameter) for s in self.meetings]
+
     @property
     def n(self) -> int:
         return self.disc.size
