@@ -268,6 +268,15 @@ class SphericalBasis:
         """The 9 node rows (x, a_θ, a_φ) of x = X + u for coefficients ``c``, shape (9, n_theta n_phi)."""
         return self.nodes["reference"] + self.node_displacement(c)
 
+    def framed(self, state: np.ndarray) -> np.ndarray:
+        """The node rows (x, a_θ/S', a_φ) of a node state: the images of the reference's orthonormal frame
+        (A_θ/S', A_φ/sin θ), where the density and the stretches are read; the state itself on the sphere."""
+        if self.aspect == 1.0:
+            return state
+        out = state.copy()
+        out[3:6] /= np.repeat(self.nodes["rate"], self.n_phi)
+        return out
+
     def node_displacement(self, c: np.ndarray) -> np.ndarray:
         """The 9 node rows (u, ∂θu, ∂φu) of the displacement u of coefficients ``c`` (linear in c)."""
         tables = self.tables

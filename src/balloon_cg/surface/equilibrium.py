@@ -81,9 +81,8 @@ class SurfaceEquilibrium:
             if self._frame is None:
                 out = self.kernels.nodes(kernel, values, params)
             else:  # a spheroid's frame (module docstring)
-                state_scale, scales = self._frame
-                out = self.kernels.nodes(kernel, {**values, "state": values["state"] * state_scale}, params)
-                out = out * scales[out.shape[0]]
+                out = self.kernels.nodes(kernel, {**values, "state": self.basis.framed(values["state"])}, params)
+                out = out * self._frame[out.shape[0]]
             if not finite(out):
                 raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
             self._outputs[key] = out
@@ -125,15 +124,15 @@ class SurfaceEquilibrium:
         return (basis or self.basis).project(self._nodes(kernel, c, params))
 
 
-def _frame_scales(basis: SphericalBasis, rows: int, pairs) -> tuple | None:
-    """(f per node row (9, nodes), {output rows: their scales}: 1 → S', 9 → S' f_k, 45 → S' f_k f_l) of a
-    spheroid's frame (module docstring); None on the sphere (S' = 1: the kernels' rows as they are)."""
+def _frame_scales(basis: SphericalBasis, rows: int, pairs) -> dict | None:
+    """{kernel output rows: their scales}, 1 → S', 9 → S' f_k, 45 → S' f_k f_l, of a spheroid's frame (module
+    docstring); None on the sphere (S' = 1: the kernels' rows as they are)."""
     if basis.aspect == 1.0:
         return None
     rate = np.repeat(basis.nodes["rate"], basis.n_phi)
     f = np.ones((rows, rate.size))
     f[3:6] = 1.0 / rate
-    return f, {1: rate[None, :], rows: rate * f, len(pairs): np.array([rate * f[k] * f[l] for k, l in pairs])}
+    return {1: rate[None, :], rows: rate * f, len(pairs): np.array([rate * f[k] * f[l] for k, l in pairs])}
 
 
 def _key(kernel: str, params: Parameters) -> tuple:
