@@ -17,7 +17,7 @@ from balloon_cg.analysis.surface.branches import (SurfaceTrace, axisymmetric_sol
 from balloon_cg.galerkin.equilibrium import Parameters
 from balloon_cg.scene import load_scene
 from balloon_cg.surface.basis import MIRROR_Y, SphericalBasis
-from balloon_cg.surface.embedding import axisymmetric_coefficients, mode_coefficients
+from balloon_cg.surface.embedding import axisymmetric_coefficients, displacement_coefficients, mode_coefficients
 from balloon_cg.surface.equilibrium import SurfaceEquilibrium
 from balloon_cg.surface.gauge import FieldSymmetry, Gauge
 
@@ -26,9 +26,9 @@ from test_tube_field import biot_savart_squared
 STEP = 1e-3  # of the central differences of u in θ and φ (fourth order: error ~ STEP⁴ |u⁽⁵⁾|)
 
 
-def coil_scene(aspect: float, stop: float = 1.6):
+def coil_scene(aspect: float, stop: float = 3.0):
     """The single-coil scene on a spheroid of ``aspect`` (1.0: still a spheroid), traced to the pole stretch ``stop``
-    (past the first m = 1 branch point, at λ ≈ 1.39 for aspect 1.3)."""
+    (past its first m = 1 branch points)."""
     return load_scene("spom1_single_coil").with_overrides(
         {"geometry.shape": "spheroid", "geometry.aspect": aspect, "continuation.stop_stretch": stop,
          "surface.branches": "none"})
@@ -118,6 +118,20 @@ def test_gauge_of_a_spheroid_removes_only_its_relabelling_about_the_axis():
         assert gauge.constraints.shape[0] == 3 + count  # three translations held
 
 
+def smooth_direction(trace: SurfaceTrace, rng) -> np.ndarray:
+    """A unit direction of the gauge's free space (G d = 0) from a random quadratic displacement field with the
+    branch's reflections (y → −y, z → −z): smooth, so that the written energy's plain Gauss nodes integrate it (a
+    random coefficient vector of a wire-mapped basis has features of the map's width)."""
+    x, y, z = trace.basis.nodes["reference"][:3]
+    a, b, e = rng.standard_normal(5), rng.standard_normal(2), rng.standard_normal(2)
+    field = np.array([a[0] + a[1] * x + a[2] * x * x + a[3] * z * z + a[4] * y * y, y * (b[0] + b[1] * x),
+                      z * (e[0] + e[1] * x)])
+    d = displacement_coefficients(trace.basis, field)
+    G = trace.gauge.constraints
+    d -= G.T @ np.linalg.solve(G @ G.T, G @ d)
+    return d / np.linalg.norm(d)
+
+
 @pytest.fixture(scope="module")
 def spheroid_primary():
     return analyse(coil_scene(1.3), pear=False).primary
@@ -134,7 +148,11 @@ def test_spheroid_of_aspect_one_surface_branch_is_the_sphere_s():
         k, bp = next((k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m == 1 and bp.block.held)
         branches.append(trace_surface(primary, k, bp, 1.0, "m1", 4))
     one, other = branches
-    assert one.basis == other.basis and len(one.values) == len(other.values) == 4
+    assert len(one.values) == len(other.values) == 4
+    a, b = one.basis, other.basis
+    assert (a.degree, a.order, a.symmetry, a.n_theta, a.n_phi) == (b.degree, b.order, b.symmetry, b.n_theta, b.n_phi)
+    assert np.allclose(a.mapping.centres, b.mapping.centres, rtol=0, atol=1e-10)  # re-centred on the state
+    assert np.allclose(a.mapping.widths, b.mapping.widths, rtol=1e-10, atol=0)
     assert np.abs(one.values - other.values).max() <= 1e-10 * np.abs(one.values).max()
     assert np.abs(one.coefficients - other.coefficients).max() <= 1e-10
     assert [(s.kind, s.index, s.classification) for s in one.special] == [
@@ -145,11 +163,13 @@ def test_spheroid_of_aspect_one_surface_branch_is_the_sphere_s():
 
 def test_spheroid_m1_branch_is_a_pitchfork_along_the_located_mode(spheroid_primary):
     """Aspect 1.3, the first held m = 1 branch point (P ≈ 2.1067): its located m = 1 null vector, embedded, is a
-    null vector of the whole-sphere Jacobian at the branch point's state to 1e-6 of the Jacobian's scale; the
+    null vector of the whole-sphere Jacobian at the branch point's state to 1e-8 of the Jacobian's norm; the
     points on the hyperplanes φ·(X − X*) = ±δ have the same P to 1e-10 (P(+δ) = P(−δ): a pitchfork) and
-    P − P* scales as δ² (its ratio between δ and δ/2 is 4 to 2 %); the branch traced there (5 points) is an
-    equilibrium of the energy written here: its directional derivatives along the gauge's free directions vanish
-    (1e-7 of the membrane's scale), while at the same state off the branch (the amplitude doubled) they do not."""
+    P − P* scales as δ² (P(2δ) − P(δ) = 4 (P(δ) − P(δ/2)) to 1e-3: the whole-sphere branch point is 7e-7 from the
+    axisymmetric one in P, and the differences cancel it); the branch traced there (4 points) is an
+    equilibrium of the energy written here: its last point's directional derivatives along smooth directions of
+    the gauge's free space vanish (1e-9 of the energy's scale; measured 2e-11), while at the same state off the
+    branch (the amplitude doubled) they do not."""
     primary = spheroid_primary
     k, bp = next((k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m == 1 and bp.block.held)
     assert abs(bp.X[-1] - 2.1067) < 1e-3
@@ -163,15 +183,15 @@ def test_spheroid_m1_branch_is_a_pitchfork_along_the_located_mode(spheroid_prima
     phi = np.append(trace.gauge.reduce(mode_coefficients(trace.basis, az_basis, vector)), 0.0)
     phi /= np.linalg.norm(phi)
     J = trace.system.jacobian(X_star)[:, :-1]
-    assert np.linalg.norm(J @ phi[:-1]) <= 1e-6 * np.linalg.norm(J, 2)
-    rise = {}
-    for delta in (2e-2, 1e-2):
+    assert np.linalg.norm(J @ phi[:-1]) <= 1e-8 * np.linalg.norm(J, 2)  # measured 1.8e-10
+    pressure = []
+    for delta in (2e-2, 1e-2, 5e-3):
         plus, minus = (switch(trace, X_star, sign * phi, delta) for sign in (1.0, -1.0))
         assert abs(plus.X[-1] - minus.X[-1]) <= 1e-10
-        rise[delta] = plus.X[-1] - X_star[-1]
-    assert abs(rise[2e-2] / rise[1e-2] - 4.0) <= 0.08
+        pressure.append(plus.X[-1])
+    assert abs((pressure[0] - pressure[1]) / (pressure[1] - pressure[2]) - 4.0) <= 4e-3  # measured 5e-4
 
-    branch = trace_surface(primary, k, bp, 1.0, "m1", 5)
+    branch = trace_surface(primary, k, bp, 1.0, "m1", 4)
     assert branch.basis.aspect == 1.3 and branch.residual.max() <= 1e-10
     on = SurfaceTrace(scene, branch.basis, params, True)
     c, at = branch.coefficients[-1], params.with_value("P", branch.values[-1])
@@ -183,8 +203,8 @@ def test_spheroid_m1_branch_is_a_pitchfork_along_the_located_mode(spheroid_prima
             return written_energy(scene, branch.basis, state + step * direction, at, 64, 48)
         return (8 * (energy(h) - energy(-h)) - (energy(2 * h) - energy(-2 * h))) / (12 * h)
 
-    directions = [on.gauge.expand(rng.standard_normal(on.gauge.size)) for _ in range(3)]
-    directions = [d / np.linalg.norm(d) for d in directions]
-    assert max(abs(slope(c, d)) for d in directions) <= 1e-7 * scale
+    directions = [smooth_direction(on, rng) for _ in range(2)]
+    on_branch = [abs(slope(c, d)) for d in directions]
     off = 2 * c - branch.coefficients[0]  # the amplitude doubled: not an equilibrium
-    assert max(abs(slope(off, d)) for d in directions) > 1e-4 * scale
+    off_branch = abs(slope(off, directions[0]))
+    assert max(on_branch) <= 1e-9 * scale and off_branch > 1e-3 * scale  # measured 2e-11 and 7e-3
