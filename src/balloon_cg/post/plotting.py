@@ -1012,7 +1012,8 @@ def _plane_crossings(wire: np.ndarray) -> np.ndarray:
 
 def principal_stretches(state: np.ndarray) -> tuple:
     """(λ1, λ2) at every node of a node state (9 rows x, a_θ, a_φ; a_φ = ∂x/∂φ / sin θ, so that both are unit on
-    the reference sphere; a spheroid's state ``SphericalBasis.framed``): the square roots of the eigenvalues of C = [[a_θ·a_θ, a_θ·a_φ], [a_θ·a_φ, a_φ·a_φ]],
+    the reference sphere; a spheroid's state ``SphericalBasis.framed``): the square roots of the eigenvalues of
+    C = [[a_θ·a_θ, a_θ·a_φ], [a_θ·a_φ, a_φ·a_φ]],
     λ1 the one whose principal direction is nearer the meridian (the larger when a_θ·a_θ ≥ a_φ·a_φ): on an
     axisymmetric state the meridional and the hoop stretch."""
     a_theta, a_phi = state[3:6], state[6:9]

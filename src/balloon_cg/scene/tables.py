@@ -298,8 +298,8 @@ def _surface_reads(surface: Surface, shape, stability) -> None:
         return
     asked = f"surface.branches = {show(surface.branches)}"
     if shape in UNTRACED_SURFACES:
-        raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere, a spheroid and a tube, not on a "
-                         f'{shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
+        raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere, a spheroid and a tube, "
+                         f'not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
     if shape == Shape.TUBE and stability.m_max < 1:
         raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
                          f'stability.m_max ≥ 1, not {stability.m_max}; allowed: "none" with stability.m_max = 0')

@@ -167,8 +167,9 @@ class SphericalBasis:
         s2, sp = np.meshgrid(s, np.sin(phi), indexing="ij")
         c = self.aspect
         reference = np.stack([s2 * S, s2 * sp, c * C, C * S, C * sp, -c * s2, -sp, S, np.zeros_like(C)])
+        rate = np.ones_like(x) if c == 1.0 else np.sqrt(x * x + (c * s) ** 2)  # the sphere's exactly 1
         return {"cos_theta": read_only(x), "sin_theta": read_only(s), "weights": read_only(w / self.n_phi),
-                "mapped": read_only(mapped), "rate": read_only(np.sqrt(x * x + (c * s) ** 2)),
+                "mapped": read_only(mapped), "rate": read_only(rate),
                 "phi": read_only(phi), "reference": read_only(reference.reshape(STATE_ROWS, -1))}
 
     @cached_property
