@@ -208,3 +208,38 @@ def test_spheroid_m1_branch_is_a_pitchfork_along_the_located_mode(spheroid_prima
     off = 2 * c - branch.coefficients[0]  # the amplitude doubled: not an equilibrium
     off_branch = abs(slope(off, directions[0]))
     assert max(on_branch) <= 1e-9 * scale and off_branch > 1e-3 * scale  # measured 2e-11 and 7e-3
+
+
+def test_a_spheroid_surface_branch_is_stored_inspected_and_drawn(tmp_path, capsys):
+    """The aspect-1.3 scene to the pole stretch 1.45 (past the first m = 1 point, before the pear point): the branch
+    born at the first held m = 1 point (3 points) and its rotated image written with the primary (io.run_file), the
+    basis' aspect stored; `inspect` lists them, `plot` draws their states, and the stored point 0 (the branch
+    point's state solved on the whole spheroid) read back through ``stored_basis`` has the axisymmetric branch
+    point's stretches at every node in the spheroid's frame (λ2 = ρ/sin θ, λ1 = |(ρ', η')|/S', from the primary's
+    state evaluated here) to 1e-8."""
+    from balloon_cg.analysis.surface.branches import rotated
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.run_file import read_run, stored_basis, write_run
+    from balloon_cg.post.plotting import principal_stretches
+
+    scene = coil_scene(1.3, 1.45)
+    primary = analyse(scene, pear=False).primary
+    k, bp = next((k, bp) for k, bp in enumerate(primary.branch_points()) if bp.m == 1 and bp.block.held)
+    branch = trace_surface(primary, k, bp, 1.0, "m1_bp0", 3)
+    path = write_run(tmp_path / "spheroid.h5", scene, [primary, branch, rotated(branch, "m1_bp0_rotated")])
+    assert main(["inspect", str(path)]) == 0
+    shown = capsys.readouterr().out
+    assert "surface branch m1_bp0 " in shown and "surface branch m1_bp0_rotated " in shown
+    stored = read_run(path)["branches"]["m1_bp0"]
+    basis = stored_basis(stored["attrs"])
+    assert basis.aspect == 1.3 and stored["coefficients"].shape == (3, basis.size)
+    lam1, lam2 = principal_stretches(basis.framed(basis.node_state(stored["coefficients"][0])))
+    theta = np.arccos(basis.nodes["cos_theta"])
+    hoop, hoop_slope, _, w = primary.disc.evaluate(bp.X[:-1], theta)  # λ2, dλ2/dθ, η, dη/dθ
+    rate = np.sqrt(np.cos(theta) ** 2 + (1.3 * np.sin(theta)) ** 2)
+    meridional = np.hypot(hoop * np.cos(theta) + hoop_slope * np.sin(theta), w) / rate  # |(ρ', η')|/S'
+    assert np.abs(lam2 - np.repeat(hoop, basis.n_phi)).max() <= 1e-8
+    assert np.abs(lam1 - np.repeat(meridional, basis.n_phi)).max() <= 1e-8
+    out = tmp_path / "spheroid.png"
+    assert main(["plot", str(path), "--what", "surface,stretch-map", "--branch", "m1_bp0", "-o", str(out)]) == 0
+    assert (tmp_path / "spheroid_surface.png").stat().st_size and (tmp_path / "spheroid_stretch-map.png").stat().st_size
