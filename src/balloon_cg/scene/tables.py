@@ -290,13 +290,18 @@ def default_surface(shape, field, electric, stability) -> Surface:
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
-def _surface_reads(surface: Surface, shape, stability) -> None:
+def _surface_reads(surface: Surface, shape, stability, dynamics) -> None:
     """SceneError for [surface] branches asked where none can be traced: on a capsule (a run would locate its m ≥ 1
     branch points and end incomplete, each branch not started), on a tube without the m ≥ 1 zeros
-    they start from (stability.m_max = 0; tube/surface/branch.py)."""
+    they start from (stability.m_max = 0; tube/surface/branch.py); on a spheroid with natural frequencies (its
+    branches' eigenvalues are read in the sphere's displacement norm, not in the spheroid's kinetic energy:
+    surface/stability.py)."""
     if surface.branches == "none":
         return
     asked = f"surface.branches = {show(surface.branches)}"
+    if shape == Shape.SPHEROID and dynamics.frequencies:
+        raise SceneError(f"{asked}: a spheroid's surface branches have no natural frequencies yet (their "
+                         'eigenvalues are in the sphere\'s norm); allowed: "none" with dynamics.frequencies = true')
     if shape in UNTRACED_SURFACES:
         raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere, a spheroid and a tube, "
                          f'not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
@@ -727,7 +732,7 @@ def _build(data: dict, name: str, text: str) -> Scene:
     if geometry.shape == Shape.TUBE and continuation.parameter == ContinuationParameter.VOLTAGE:
         _tube_voltage_reads(field, stability, dynamics, events)
     surface = _surface(data.get("surface", {}), default_surface(geometry.shape, field, electric, stability))
-    _surface_reads(surface, geometry.shape, stability)
+    _surface_reads(surface, geometry.shape, stability, dynamics)
     return Scene(
         name=name,
         material=material,
