@@ -67,7 +67,7 @@ def deviation(found: dict, full: dict) -> float:
 def residual_study(eq, c, params, sector) -> None:
     """Prints, for rungs 2 and 4 of ``sector``, the held pressure reading's error and residual estimate (module
     docstring)."""
-    fields = stability.zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"],
+    fields = stability.zero_mode_fields(eq.node_values(c)["state"], eq.basis,
                                         stability.field_symmetry(eq, params), True)
     with blas_threads():
         A = eq.hessian(c, params, sector) / sector.gram()

@@ -337,6 +337,7 @@ def _write_surface_branch(group, branch, first_label: int = 1) -> None:
         "n_phi": basis.n_phi,
         "map_centres": np.array(basis.mapping.centres if basis.mapping else [], dtype=float),
         "map_widths": np.array(basis.mapping.widths if basis.mapping else [], dtype=float),
+        "aspect": basis.aspect,
         "origin": branch.origin.value,
         "gauge": branch.gauge.value,
     })
@@ -858,7 +859,8 @@ def check_surface_branch(group, where, error, written: bool = False) -> None:
 def stored_basis(attrs, where="", error=FileError):
     """The surface.basis.SphericalBasis of a stored surface branch, from its attributes surface_degree,
     surface_order, symmetry (k × 3 signs), characters (k signs), n_theta, n_phi and the polar coordinate map
-    map_centres, map_widths (empty: none) (``error`` naming ``where`` if they do not make one)."""
+    map_centres, map_widths (empty: none) and the reference's aspect (absent in older files: 1, the sphere)
+    (``error`` naming ``where`` if they do not make one)."""
     from ..galerkin.coordinate_map import WireMap
     from ..surface.basis import SphericalBasis
 
@@ -874,7 +876,8 @@ def stored_basis(attrs, where="", error=FileError):
         centres, widths = (tuple(float(v) for v in attrs.get(key, ())) for key in ("map_centres", "map_widths"))
         return SphericalBasis(int(attrs["surface_degree"]), tuple(tuple(int(s) for s in row) for row in symmetry),
                               tuple(int(c) for c in characters), int(attrs["n_theta"]), int(attrs["n_phi"]),
-                              int(attrs["surface_order"]), WireMap(centres, widths) if centres or widths else None)
+                              int(attrs["surface_order"]), WireMap(centres, widths) if centres or widths else None,
+                              float(attrs.get("aspect", 1.0)))
     except ValueError as e:
         raise error(where, f"the basis attributes do not make a basis: {e}") from None
 

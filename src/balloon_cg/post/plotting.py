@@ -1012,7 +1012,8 @@ def _plane_crossings(wire: np.ndarray) -> np.ndarray:
 
 def principal_stretches(state: np.ndarray) -> tuple:
     """(λ1, λ2) at every node of a node state (9 rows x, a_θ, a_φ; a_φ = ∂x/∂φ / sin θ, so that both are unit on
-    the reference sphere): the square roots of the eigenvalues of C = [[a_θ·a_θ, a_θ·a_φ], [a_θ·a_φ, a_φ·a_φ]],
+    the reference sphere; a spheroid's state ``SphericalBasis.framed``): the square roots of the eigenvalues of
+    C = [[a_θ·a_θ, a_θ·a_φ], [a_θ·a_φ, a_φ·a_φ]],
     λ1 the one whose principal direction is nearer the meridian (the larger when a_θ·a_θ ≥ a_φ·a_φ): on an
     axisymmetric state the meridional and the hoop stretch."""
     a_theta, a_phi = state[3:6], state[6:9]
@@ -1044,7 +1045,8 @@ def plot_stretch_map(branch: StoredBranch, index: int, axes=None) -> Figure:
     (from the poles to the midpoints between nodes), north pole at the top, two panels."""
     fig, axes, own = _panels(axes, 2, (10.5, 4.2), nrows=1, ncols=2, sharey=True)
     basis, c = stored_state(branch, index)
-    lam1, lam2 = (v.reshape(basis.n_theta, basis.n_phi) for v in principal_stretches(basis.node_state(c)))
+    lam1, lam2 = (v.reshape(basis.n_theta, basis.n_phi)
+                  for v in principal_stretches(basis.framed(basis.node_state(c))))
     theta = _cell_edges(np.arccos(basis.nodes["cos_theta"]), 0.0, np.pi)
     # uniform nodes φ_k = k 2π/N_φ: the cells (k ∓ ½) 2π/N_φ, node 0 again after the last, clipped to [0, 2π]
     phi = (np.arange(basis.n_phi + 2) - 0.5) * 2 * np.pi / basis.n_phi

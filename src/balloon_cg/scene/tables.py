@@ -272,7 +272,7 @@ class Surface:
 
 
 SURFACE_BRANCHES = ("first", "all", "none")
-UNTRACED_SURFACES = (Shape.CAPSULE, Shape.SPHEROID)  # shapes whose [surface] branches are "none" (default_surface)
+UNTRACED_SURFACES = (Shape.CAPSULE,)  # shapes whose [surface] branches are "none" and refused (_surface_reads)
 
 
 def default_surface(shape, field, electric, stability) -> Surface:
@@ -281,24 +281,30 @@ def default_surface(shape, field, electric, stability) -> Surface:
     and on a tube in a coil's field or under a voltage, where "first" is taken when asked for but is not the default:
     a trace there may refine to the basis's cap for tens of minutes (a plugged tube in a coil's field), and with
     stability.m_max ≥ 2 the first zero can be the slack state's near P = 0 (docs/tubes.md "The tube over (S, φ)");
-    "none" on a capsule and a spheroid, whose branches are not traced (``_surface_reads``: the whole-sphere engine
-    has a spherical reference; their m ≥ 1 branch points are located all the same)."""
-    if shape in UNTRACED_SURFACES:
+    "none" on a capsule, whose branches are not traced (``_surface_reads``: the whole-sphere engine takes a sphere's
+    or a spheroid's reference; its m ≥ 1 branch points are located all the same), and on a spheroid, where "first"
+    and "all" are taken when asked for but are not the default (docs/shapes.md "The spheroid's surface branches")."""
+    if shape in UNTRACED_SURFACES or shape == Shape.SPHEROID:
         return Surface(branches="none")
     built = not field.coils and electric is None and stability.m_max >= 1
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
-def _surface_reads(surface: Surface, shape, stability) -> None:
-    """SceneError for [surface] branches asked where none can be traced: on a capsule or a spheroid (a run would
-    locate their m ≥ 1 branch points and end incomplete, each branch not started), on a tube without the m ≥ 1 zeros
-    they start from (stability.m_max = 0; tube/surface/branch.py)."""
+def _surface_reads(surface: Surface, shape, stability, dynamics) -> None:
+    """SceneError for [surface] branches asked where none can be traced: on a capsule (a run would locate its m ≥ 1
+    branch points and end incomplete, each branch not started), on a tube without the m ≥ 1 zeros
+    they start from (stability.m_max = 0; tube/surface/branch.py); on a spheroid with natural frequencies (its
+    branches' eigenvalues are read in the sphere's displacement norm, not in the spheroid's kinetic energy:
+    surface/stability.py)."""
     if surface.branches == "none":
         return
     asked = f"surface.branches = {show(surface.branches)}"
+    if shape == Shape.SPHEROID and dynamics.frequencies:
+        raise SceneError(f"{asked}: a spheroid's surface branches have no natural frequencies yet (their "
+                         'eigenvalues are in the sphere\'s norm); allowed: "none" with dynamics.frequencies = true')
     if shape in UNTRACED_SURFACES:
-        raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere and a tube, not on a "
-                         f'{shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
+        raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere, a spheroid and a tube, "
+                         f'not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
     if shape == Shape.TUBE and stability.m_max < 1:
         raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
                          f'stability.m_max ≥ 1, not {stability.m_max}; allowed: "none" with stability.m_max = 0')
@@ -614,7 +620,7 @@ def startable(scene: Scene) -> Scene:
     new input (``parse_scene``, ``load_scene``, ``Scene.with_overrides``) and where ``continue`` starts from a file's
     scene; not on a file's stored text (``parse_stored``)."""
     _stop_volume_above_reference(scene.continuation.stop_volume, scene.geometry)
-    _surface_reads(scene.surface, scene.geometry.shape, scene.stability)
+    _surface_reads(scene.surface, scene.geometry.shape, scene.stability, scene.dynamics)
     return scene
 
 

@@ -87,7 +87,13 @@ class SphericalBasis:
     harmonics are those of the mapped polar coordinate s = h(cos θ), P̄_l^m(s) τ_{m,t}(φ), smooth on the sphere
     since (1 − s²)/(1 − cos²θ) is smooth and positive (h' > 0 at the poles); Gauss nodes in s, weights
     w_j / h'(x_j), and each block's functions orthonormalised in the quadrature's inner product (Cholesky of its
-    Gram matrix), so that the coefficients stay orthonormal and the spectral tail stays the last coefficients'."""
+    Gram matrix), so that the coefficients stay orthonormal and the spectral tail stays the last coefficients'.
+
+    ``aspect`` (c, default 1: the unit sphere): the reference surface is the spheroid X = (sin θ cos φ, sin θ sin φ,
+    c cos θ) of equatorial semi-axis 1 (scene.Geometry), the same poles and polar coordinate, so the same harmonics
+    (a smooth field on the spheroid is smooth on the sphere: X is a linear image of it); only the reference rows
+    of the node state change, A_θ = (cos θ cos φ, cos θ sin φ, −c sin θ) of length S'(θ) = √(cos²θ + c² sin²θ)
+    (``nodes['rate']``) and A_φ/sin θ = e_φ."""
 
     degree: int
     symmetry: tuple = ()
@@ -96,6 +102,7 @@ class SphericalBasis:
     n_phi: int = 0
     order: int = -1
     mapping: object = None
+    aspect: float = 1.0
     blocks: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -114,6 +121,8 @@ class SphericalBasis:
             put(self, "n_theta", (3 * (self.degree + 1) + 1) // 2 + 2)
         if not self.n_phi:
             put(self, "n_phi", 2 * ((3 * (self.order + 1) + 1) // 2 + 2))
+        if not self.aspect > 0.0:
+            raise ValueError(f"aspect = {self.aspect}: must be > 0 (the reference spheroid's polar semi-axis)")
         symmetry = tuple(map(tuple, self.symmetry))
         put(self, "blocks", _blocks(self.degree, self.order, symmetry, tuple(self.characters)))
 
@@ -128,6 +137,12 @@ class SphericalBasis:
         return np.array([reflection[b.component] * _sign_under(reflection, l, b.m, b.t)
                          for b in self.blocks for l in b.degrees], dtype=float)
 
+    @property
+    def relabellings(self) -> tuple:
+        """The axes k whose material rotations, X ↦ X + ε e_k × X, map the reference onto itself (relabellings
+        of every surface: zero modes of every energy): each axis on the sphere, the axis z on a spheroid."""
+        return (0, 1, 2) if self.aspect == 1.0 else (2,)
+
     def sectors(self) -> list:
         """The bases of every choice of characters for this basis' reflections (same degree and nodes): their
         spaces together are the whole space, and a Hessian at a state of the invariant subspace is block-diagonal
@@ -137,8 +152,8 @@ class SphericalBasis:
 
     @cached_property
     def nodes(self) -> dict:
-        """cos θ_j, sin θ_j, the weights W_j = w_j/N_φ (with E's 1/2π), φ_k, and X, a_θ(X), a_φ(X) at every
-        node (rows of the node state of u = 0), node index j N_φ + k."""
+        """cos θ_j, sin θ_j, the weights W_j = w_j/N_φ (with E's 1/2π), φ_k, S'(θ_j) (``rate``: the reference's
+        |A_θ|), and X, a_θ(X), a_φ(X) at every node (rows of the node state of u = 0), node index j N_φ + k."""
         mapped, w = gauss_rule(self.n_theta)
         mapped, w = mapped[::-1].copy(), w[::-1].copy()  # θ increasing: north to south
         if self.mapping is None:
@@ -150,9 +165,11 @@ class SphericalBasis:
         phi = 2.0 * np.pi * np.arange(self.n_phi) / self.n_phi
         C, S = np.meshgrid(x, np.cos(phi), indexing="ij")
         s2, sp = np.meshgrid(s, np.sin(phi), indexing="ij")
-        reference = np.stack([s2 * S, s2 * sp, C, C * S, C * sp, -s2, -sp, S, np.zeros_like(C)])
+        c = self.aspect
+        reference = np.stack([s2 * S, s2 * sp, c * C, C * S, C * sp, -c * s2, -sp, S, np.zeros_like(C)])
+        rate = np.ones_like(x) if c == 1.0 else np.sqrt(x * x + (c * s) ** 2)  # the sphere's exactly 1
         return {"cos_theta": read_only(x), "sin_theta": read_only(s), "weights": read_only(w / self.n_phi),
-                "mapped": read_only(mapped),
+                "mapped": read_only(mapped), "rate": read_only(rate),
                 "phi": read_only(phi), "reference": read_only(reference.reshape(STATE_ROWS, -1))}
 
     @cached_property
@@ -252,6 +269,15 @@ class SphericalBasis:
         """The 9 node rows (x, a_θ, a_φ) of x = X + u for coefficients ``c``, shape (9, n_theta n_phi)."""
         return self.nodes["reference"] + self.node_displacement(c)
 
+    def framed(self, state: np.ndarray) -> np.ndarray:
+        """The node rows (x, a_θ/S', a_φ) of a node state: the images of the reference's orthonormal frame
+        (A_θ/S', A_φ/sin θ), where the density and the stretches are read; the state itself on the sphere."""
+        if self.aspect == 1.0:
+            return state
+        out = state.copy()
+        out[3:6] /= np.repeat(self.nodes["rate"], self.n_phi)
+        return out
+
     def node_displacement(self, c: np.ndarray) -> np.ndarray:
         """The 9 node rows (u, ∂θu, ∂φu) of the displacement u of coefficients ``c`` (linear in c)."""
         tables = self.tables
@@ -332,8 +358,8 @@ class SphericalBasis:
         theta, phi = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(phi, float))
         z = np.cos(theta)
         mapped = z if self.mapping is None else self.mapping.s(z)
-        x = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), z])
-        a_theta = np.array([z * np.cos(phi), z * np.sin(phi), -np.sin(theta)])
+        x = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), self.aspect * z])
+        a_theta = np.array([z * np.cos(phi), z * np.sin(phi), -self.aspect * np.sin(theta)])
         for b, transform in zip(self.blocks, self.tables["transforms"]):
             p, dp = self._polar(mapped, z, b)
             trig = _norm(b.m) * (np.cos(b.m * phi) if b.t == COS else np.sin(b.m * phi))
@@ -348,7 +374,8 @@ class SphericalBasis:
         x = np.asarray(cos_theta, dtype=float)
         s = np.sqrt(np.clip(1.0 - x * x, 0.0, None))
         mapped = x if self.mapping is None else self.mapping.s(x)
-        out = np.array([np.outer(s, np.cos(phi)), np.outer(s, np.sin(phi)), np.outer(x, np.ones_like(phi))])
+        out = np.array([np.outer(s, np.cos(phi)), np.outer(s, np.sin(phi)),
+                        np.outer(self.aspect * x, np.ones_like(phi))])
         for b, transform in zip(self.blocks, self.tables["transforms"]):
             p, _ = self._polar(mapped, x, b)
             trig = _norm(b.m) * (np.cos(b.m * phi) if b.t == COS else np.sin(b.m * phi))

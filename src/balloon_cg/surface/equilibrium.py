@@ -6,6 +6,13 @@ spherical-harmonic coefficients c of the displacement (basis.py), and the residu
 π, its gradient and Hessian in the 9 node variables from the generated surface kernels of the scene's class
 (codegen: the same energy terms as the axisymmetric kernels), H² and its Cartesian derivatives from the coil field
 (model/loop.field_squared_cartesian: loops anywhere).
+
+On a reference spheroid (SphericalBasis.aspect c ≠ 1) π is the same function of x and the deformed images
+a_1 = ∂x/∂θ / S', a_2 = ∂x/∂φ / sin θ of the reference's orthonormal frame (A_θ/S', A_φ/sin θ), per unit reference
+area dA = S' d(cos θ) dφ, S' = √(cos²θ + c² sin²θ): the sphere's kernels (π per unit area of an orthonormal frame;
+the pressure's x · (a_1 × a_2) dA is x · (∂x/∂θ × ∂x/∂φ) dθ dφ on any reference) at the node rows (x, a_θ/S', a_φ),
+the energy's node rows times S', the gradient's row k times S' f_k and the Hessian's (k, l) times S' f_k f_l,
+f = 1/S' on the three a_θ rows and 1 elsewhere.
 """
 import numpy as np
 
@@ -13,8 +20,10 @@ from .basis import SphericalBasis
 from ..galerkin.discretisation import symmetric_rows
 from ..galerkin.equilibrium import NonFiniteState, Parameters
 from ..model.loop import CARTESIAN, field_squared_cartesian, loop_table
-from ..model.kernels import KernelSet
+from ..model.kernels import KernelSet, scene_terms
 from ..numerics.newton import finite
+from ..scene.tables import Shape
+from ..scene.validation import SceneError
 
 # the kernel of ∂R/∂name for a runtime scalar name
 DERIVATIVE_KERNELS = {"P": "surface_pressure_gradient", "M": "surface_field_gradient",
@@ -25,9 +34,18 @@ class SurfaceEquilibrium:
     """E, ∇E and ∇²E of one scene in a SphericalBasis; ``kernels``: the surface KernelSet (default: the scene's)."""
 
     def __init__(self, scene, basis: SphericalBasis, kernels=None):
+        geometry = scene.geometry
+        if geometry.shape not in (Shape.SPHERE, Shape.SPHEROID):
+            raise SceneError(f"geometry.shape = {geometry.shape.value!r}: the whole-sphere engine takes a sphere or a "
+                             'spheroid (allowed: "sphere", "spheroid")')
+        if basis.aspect != geometry.aspect:
+            raise ValueError(f"basis aspect = {basis.aspect:g}: the scene's reference has aspect "
+                             f"{geometry.aspect:g} (allowed: the scene's)")
         self.scene, self.basis = scene, basis
         self.coils = loop_table(scene.field.coils)
-        self.kernels = kernels if kernels is not None else KernelSet.of_scene(scene).surface()
+        # the sphere's class on either reference (module docstring)
+        self.kernels = kernels if kernels is not None else KernelSet(scene.material, scene_terms(scene)).surface()
+        self._frame = _frame_scales(basis, len(self.kernels.module.SURFACE_STATE), self.kernels.module.SURFACE_PAIRS)
         self.has_field = self.coils.shape[0] > 0
         self.coaxial = all(coil.is_coaxial for coil in scene.field.coils)  # H² is axisymmetric about z at any M
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
@@ -60,7 +78,11 @@ class SurfaceEquilibrium:
         values = self.node_values(c)
         key = _key(kernel, params)
         if key not in self._outputs:
-            out = self.kernels.nodes(kernel, values, params)
+            if self._frame is None:
+                out = self.kernels.nodes(kernel, values, params)
+            else:  # a spheroid's frame (module docstring)
+                out = self.kernels.nodes(kernel, {**values, "state": self.basis.framed(values["state"])}, params)
+                out = out * self._frame[out.shape[0]]
             if not finite(out):
                 raise NonFiniteState(f"{kernel}: non-finite values (stretch ≤ 0 or the membrane reached a wire)")
             self._outputs[key] = out
@@ -100,6 +122,17 @@ class SurfaceEquilibrium:
         if kernel is None or kernel not in self.kernels.module.KERNELS:
             raise ValueError(f"no generated derivative of the surface residual in {name!r} for this scene class")
         return (basis or self.basis).project(self._nodes(kernel, c, params))
+
+
+def _frame_scales(basis: SphericalBasis, rows: int, pairs) -> dict | None:
+    """{kernel output rows: their scales}, 1 → S', 9 → S' f_k, 45 → S' f_k f_l, of a spheroid's frame (module
+    docstring); None on the sphere (S' = 1: the kernels' rows as they are)."""
+    if basis.aspect == 1.0:
+        return None
+    rate = np.repeat(basis.nodes["rate"], basis.n_phi)
+    f = np.ones((rows, rate.size))
+    f[3:6] = 1.0 / rate
+    return {1: rate[None, :], rows: rate * f, len(pairs): np.array([rate * f[k] * f[l] for k, l in pairs])}
 
 
 def _key(kernel: str, params: Parameters) -> tuple:

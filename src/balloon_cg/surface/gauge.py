@@ -1,7 +1,8 @@
 """The gauge of the whole-sphere problem (MODEL.md §8): which exact zero modes are removed, and how.
 
-- Relabellings (a material rotation of the reference sphere) leave every surface unchanged: removed by the phase
-  conditions ∫∫ (e_k × X) · u dA = 0 (no rigid-rotation part of u in the reference frame), for each axis k whose
+- Relabellings (a material rotation of the reference sphere, or of a spheroid about its axis: the axes of
+  SphericalBasis.relabellings) leave every surface unchanged: removed by the phase conditions
+  ∫∫ (e_k × X) · u dA = 0 (no rigid-rotation part of u in the reference frame), for each such axis k whose
   rotation field lies in the basis' symmetry subspace. They are linear, homogeneous and hold for every
   axisymmetric state.
 - Translations: ∫∫ u dA = 0 (the l = 0 coefficients) along every axis where the balloon is held (``held``: the
@@ -63,7 +64,7 @@ class Gauge:
         rows = [self._translation(axis) for axis in self.field_symmetry.held_translations(self.held)]
         rows = [row for row in rows if row is not None]
         rotations = [self._rotation(axis) for axis in range(3)]
-        rows += [row for row in rotations if row is not None]
+        rows += [rotations[axis] for axis in self.basis.relabellings if rotations[axis] is not None]
         kept = [axis for axis in self.field_symmetry.free_rotations if rotations[axis] is not None]
         if kept:
             raise UnsupportedGauge(

@@ -10,7 +10,8 @@ The volume is invariant under the state's reflections, so g lies in its own sect
 other sectors read the same under every control.
 
 Zero modes removed (MODEL.md §8), at the state x:
-- relabellings, δx = (w·e_θ) a_θ + (w·e_φ) a_φ for w = e_k × X: always (every axis);
+- relabellings, δx = (w·A_θ/S'²) a_θ + (w·e_φ) a_φ for w = e_k × X: always, about every axis whose rotation maps
+  the reference onto itself (SphericalBasis.relabellings: each on the sphere, where S' = 1, the axis on a spheroid);
 - rigid rotations δx = e_k × x where the field allows them: every axis at M = 0, the coil axis for coaxial loops,
   none for loops anywhere (``gauge.FieldSymmetry``);
 - translations δx = e_k: without a field always (then held and free coincide), with one for a balloon held at its
@@ -57,13 +58,16 @@ def field_symmetry(eq: SurfaceEquilibrium, params: Parameters) -> FieldSymmetry:
     return FieldSymmetry.AXIAL if eq.coaxial else FieldSymmetry.GENERAL
 
 
-def zero_mode_fields(state: np.ndarray, reference: np.ndarray, symmetry: FieldSymmetry, held: bool) -> list:
-    """The displacement fields (3, nodes) of the exact zero modes removed (module docstring) at the node state."""
+def zero_mode_fields(state: np.ndarray, basis: SphericalBasis, symmetry: FieldSymmetry, held: bool) -> list:
+    """The displacement fields (3, nodes) of the exact zero modes removed (module docstring) at the node state of
+    ``basis``."""
     units = np.eye(3)[:, :, None]
+    reference = basis.nodes["reference"]
+    rate = np.repeat(basis.nodes["rate"], basis.n_phi)
     modes = []
-    for k in range(3):
+    for k in basis.relabellings:
         w = np.cross(units[k], reference[:3], axis=0)
-        modes.append(np.einsum("in,in->n", w, reference[3:6]) * state[3:6]
+        modes.append(np.einsum("in,in->n", w, reference[3:6]) / rate**2 * state[3:6]
                      + np.einsum("in,in->n", w, reference[6:9]) * state[6:9])
     for k in symmetry.free_rotations:
         modes.append(np.cross(units[k], state[:3], axis=0))
@@ -91,7 +95,7 @@ def _sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings
     {characters: a ``sub_basis`` of that sector}, whose perturbations stand for the sector's (Rayleigh–Ritz:
     ``sub_basis``)."""
     state = eq.node_values(c)["state"]
-    fields = {held: zero_mode_fields(state, eq.basis.nodes["reference"], field_symmetry(eq, params), held)
+    fields = {held: zero_mode_fields(state, eq.basis, field_symmetry(eq, params), held)
               for held in {r.held for r in readings}}
     controlled = any(r.control != Control.PRESSURE for r in readings)
     weight = params.P / body_moments(eq.basis, state)[0] if controlled else None
@@ -276,7 +280,7 @@ def azimuthal_spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
     the whole-sphere counterpart of analysis/stability/azimuthal.spectrum."""
     E = azimuthal_family(eq.basis, m)
     H = E.T @ eq.hessian(c, params) @ E
-    fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis.nodes["reference"], field_symmetry(eq, params), held)
+    fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis, field_symmetry(eq, params), held)
     rows = mode_rows(eq.basis, fields) @ E if m == 1 else np.zeros((0, E.shape[1]))
     rows = rows[np.linalg.norm(rows, axis=1) > 1e-10] if rows.size else rows
     return eigen.lowest_of(_restricted(H, eq.basis.gram(), rows), count)

@@ -146,7 +146,7 @@ def compile_kernels(scene) -> None:
     argument types, and so the signatures compiled, are those of any degree, symmetry or wire map (the default
     run's child does this for the scene it runs beside: app/default_run.py)."""
     params = start_parameters(scene, "P").with_value("M", scene.field.M)
-    trace = SurfaceTrace(scene, SphericalBasis(2, (MIRROR_Y,)), params)
+    trace = SurfaceTrace(scene, SphericalBasis(2, (MIRROR_Y,), aspect=scene.geometry.aspect), params)
     c = np.zeros(trace.basis.size)
     X = trace.system.point(c, params.P)
     trace.system.residual(X)
@@ -157,11 +157,12 @@ def compile_kernels(scene) -> None:
 
 def initial_basis(scene, disc, u, symmetry: tuple) -> SphericalBasis:
     """The basis of a branch's start: degree surface.degree on the axisymmetric state's wire map (isotropic without
-    one, order min(degree, 6) with one: a field's fine features are in θ), refined until the embedded state's
-    tails are below solver.max_error / 10 (``refined``); SurfaceStartError past MAX_DEGREE."""
+    one, order min(degree, 6) with one: a field's fine features are in θ) and the scene's reference (a spheroid's
+    aspect), refined until the embedded state's tails are below solver.max_error / 10 (``refined``);
+    SurfaceStartError past MAX_DEGREE."""
     degree = scene.surface.degree
     order = degree if disc.mapping is None else min(degree, 6)
-    basis = SphericalBasis(degree, symmetry, order=order, mapping=disc.mapping)
+    basis = SphericalBasis(degree, symmetry, order=order, mapping=disc.mapping, aspect=scene.geometry.aspect)
     while True:
         finer = refined(basis, axisymmetric_coefficients(basis, disc, u), scene.solver.max_error / 10)
         if finer is None:
@@ -268,8 +269,8 @@ def trace_surface(branch: Branch, number: int, bp: SpecialPoint, sign: float, na
     along sign·φ (module docstring); SurfaceStartError when it cannot start."""
     t0 = time.perf_counter()
     scene = branch.scene
-    if scene.geometry.shape != Shape.SPHERE:
-        raise SurfaceStartError(f"the whole-sphere engine has a spherical reference only; the scene's is a "
+    if scene.geometry.shape not in (Shape.SPHERE, Shape.SPHEROID):
+        raise SurfaceStartError(f"the whole-sphere engine has a sphere's or a spheroid's reference; the scene's is a "
                                 f"{scene.geometry.shape.value} (its m = {bp.m} branch point is located, the branch "
                                 "born there is not traced)")
     az_basis, vector = critical_mode(branch, bp, located_degree(branch, bp))

@@ -89,7 +89,7 @@ def critical_vector(trace: SurfaceTrace, c: np.ndarray, P: float, characters: tu
     (sector,) = [s for s in trace.basis.sectors() if s.characters == characters]
     params = trace.system.params.with_value("P", P)
     H = trace.eq.hessian(c, params, sector)
-    fields = surface_stability.zero_mode_fields(trace.eq.node_values(c)["state"], trace.basis.nodes["reference"],
+    fields = surface_stability.zero_mode_fields(trace.eq.node_values(c)["state"], trace.basis,
                                                 surface_stability.field_symmetry(trace.eq, params), True)
     rows = surface_stability.mode_rows(sector, fields)
     Q = linalg.null_space(rows) if rows.size else np.eye(sector.size)
