@@ -1,11 +1,14 @@
 """Text that stays inside a figure at a journal width (3.5 in one column, 7.2 in two), measured rather than
 guessed: ``fit_titles`` wraps each panel title to the room it has and the figure's title to the figure's width;
 ``fitted_legend`` gives a figure legend as many columns as fit across the figure (one column: its labels
-wrapped). Both need a figure with a renderer (``style.JournalFigure``: the Agg canvas).
+wrapped); ``fit_with_legend`` keeps a panel's legend inside it only where it hides nothing drawn. All need a figure
+with a renderer (``style.JournalFigure``: the Agg canvas).
 """
 import re
 import textwrap
 
+import numpy as np
+from matplotlib.path import Path
 from matplotlib.text import Text
 
 from .labels import relabel
@@ -115,3 +118,42 @@ def fit_width(fig, width: float) -> None:
     fit_titles(fig)
     relabel(fig)
 
+
+
+def fit_with_legend(fig, ax, width: float, **options) -> None:
+    """Fit ``fig`` to ``width`` inches (``fit_width``) with ``ax``'s legend (its handles and labels, ``options``) at
+    matplotlib's best place inside the panel, or, where that place hides anything drawn there after the layout
+    (``hides``: a curve, a marker, a special point's label), under the panels (``fit_width``'s figure legend)."""
+    handles, labels = ax.get_legend_handles_labels()
+    for other in fig.axes:  # a twin's curves (twinx) belong to the same legend
+        if other is not ax and other.bbox.bounds == ax.bbox.bounds:
+            more = other.get_legend_handles_labels()
+            handles, labels = handles + more[0], labels + more[1]
+    if not labels:
+        return fit_width(fig, width)
+    legend = ax.legend(handles, labels, loc="best", **options)
+    fit_width(fig, width)
+    if hides(legend, fig):
+        legend.remove()
+        fig.legend(handles, labels, **options)
+        fit_width(fig, width)
+
+
+def hides(legend, fig) -> bool:
+    """Whether ``legend``'s box covers a vertex or a segment of a line drawn in any panel of ``fig`` (curves, markers,
+    leaders) or any of their texts (the special points' labels), as laid out now."""
+    fig.draw_without_rendering()
+    box = legend.get_window_extent()
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            xy = line.get_transform().transform(line.get_xydata())
+            finite = np.isfinite(xy).all(axis=1)
+            if any(box.contains(x, y) for x, y in xy[finite]):
+                return True
+            runs = np.split(xy, np.flatnonzero(~finite))
+            if any(len(run := r[np.isfinite(r).all(axis=1)]) > 1 and Path(run).intersects_bbox(box, filled=False)
+                   for r in runs):
+                return True
+        if any(text.get_window_extent().overlaps(box) for text in ax.texts if text.get_text()):
+            return True
+    return False
