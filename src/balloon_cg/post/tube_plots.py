@@ -31,6 +31,7 @@ STRETCHED = 3  # states whose stretches are drawn unless the points are given
 _COLOURS = {"primary": "k", "bulge": "C0"}
 DISTANCE = "$z$, from the end $S = 0$"  # the axial coordinate of profiles, stretches and the front (module docstring)
 VOLUME = "$V/V_0$"
+PROFILE_KEY = f"point: {VOLUME}, $P$"  # the title of the profiles' legend, its entries "26: 2.81, 1.241"
 
 
 class TubePlotError(ValueError):
@@ -61,7 +62,7 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
             draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles,
                     "modes": critical_modes}[what]
             draw(ax, run, name, points)
-        fit_with_legend(fig, ax, width)
+        fit_with_legend(fig, ax, width, **({"title": PROFILE_KEY} if what == "profiles" else {}))
     return fig
 
 
@@ -105,7 +106,7 @@ def _born(item) -> tuple:
 def profiles(ax, run: dict, name: str, points=None) -> None:
     """The profiles r(z) (the radius ρ against the distance z along the deformed axis from the end S = 0, both over
     the reference radius) of branch ``name`` at ``points`` (indices, negative from the end; default: PROFILES spread
-    along the branch), coloured by V/V0."""
+    along the branch), coloured by V/V0; each labelled with its index, V/V0 and P (PROFILE_KEY)."""
     b = run["branches"][name]
     disc = discretisation(run["attrs"], b["attrs"])
     chosen = _chosen(len(b["pressure"]), name, points, PROFILES)
@@ -113,7 +114,7 @@ def profiles(ax, run: dict, name: str, points=None) -> None:
     colours = matplotlib_colours(len(chosen))
     for colour, i in zip(colours, chosen):
         ax.plot(*along(disc, b["unknowns"][i], s), color=colour,
-                label=f"{i}: {VOLUME} = {b['volume'][i]:.3g}, $P$ = {b['pressure'][i]:.4g}")
+                label=f"{i}: {b['volume'][i]:.3g}, {b['pressure'][i]:.4g}")
     ax.set_xlabel(DISTANCE)
     ax.set_ylabel("$r$")
     ax.set_title(f"{run['attrs']['scene_name']}: profiles of the {name} branch")
