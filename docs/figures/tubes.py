@@ -60,7 +60,7 @@ def picture(length: float, degree: int, stop_stretch: float, stop_volume: float)
     """(scene, TubePicture) of the module docstring's run."""
     scene = scene_of(length, degree, stop_stretch)
     primary = primary_branch(scene)
-    bulge = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=stop_volume, step=0.02)
+    bulge = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=stop_volume * np.pi * length, step=0.02)
     return scene, TubePicture({"primary": primary, "bulge": bulge}, maxwell(scene))
 
 
