@@ -189,9 +189,9 @@ def test_profiles_stretches_and_front_share_one_axis(bulged_file):
 def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, width):
     """At one and two columns, every tube figure laid out at its width: the special points' labels clear of one
     another, of the title, the axis labels and the legend; a legend left inside its panel hides no curve, marker or
-    label (post/fit.hides; P against V/V0 at 3.5 in had its legend over the primary branch); every legend entry and
+    label (post/fit.covers; P against V/V0 at 3.5 in had its legend over the primary branch); every legend entry and
     axis label writes V/V0 as the axis does, $V/V_0$, never a plain "V/V0"."""
-    from balloon_cg.post.fit import hides
+    from balloon_cg.post.fit import covers
     from balloon_cg.post.labels import GID
     from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
 
@@ -201,7 +201,7 @@ def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, wid
         fig.draw_without_rendering()
         legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend() is not None)]
         for legend in (ax.get_legend() for ax in fig.axes if ax.get_legend() is not None):
-            assert not hides(legend, fig), (kind, width)
+            assert not covers(legend, legend.axes), (kind, width)
         texts = [t for ax in fig.axes for t in (ax.title, ax.xaxis.label, ax.yaxis.label) if t.get_text()]
         others = [t.get_window_extent() for t in texts] + [legend.get_window_extent() for legend in legends]
         labels = [t.get_window_extent() for ax in fig.axes for t in ax.texts if t.get_gid() == GID and t.get_text()]

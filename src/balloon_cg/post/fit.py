@@ -6,6 +6,7 @@ with a renderer (``style.JournalFigure``: the Agg canvas).
 """
 import re
 import textwrap
+import warnings
 
 import numpy as np
 from matplotlib.path import Path
@@ -119,41 +120,46 @@ def fit_width(fig, width: float) -> None:
     relabel(fig)
 
 
-
 def fit_with_legend(fig, ax, width: float, **options) -> None:
     """Fit ``fig`` to ``width`` inches (``fit_width``) with ``ax``'s legend (its handles and labels, ``options``) at
     matplotlib's best place inside the panel, or, where that place hides anything drawn there after the layout
-    (``hides``: a curve, a marker, a special point's label), under the panels (``fit_width``'s figure legend)."""
+    (``covers``: a curve, a marker, a special point's label), under the panels (``fit_width``'s figure legend)."""
     handles, labels = ax.get_legend_handles_labels()
     for other in fig.axes:  # a twin's curves (twinx) belong to the same legend
         if other is not ax and other.bbox.bounds == ax.bbox.bounds:
             more = other.get_legend_handles_labels()
             handles, labels = handles + more[0], labels + more[1]
     if not labels:
-        return fit_width(fig, width)
+        fit_width(fig, width)
+        return
     legend = ax.legend(handles, labels, loc="best", **options)
     fit_width(fig, width)
-    if hides(legend, fig):
+    if covers(legend, ax):
         legend.remove()
         fig.legend(handles, labels, **options)
         fit_width(fig, width)
 
 
-def hides(legend, fig) -> bool:
-    """Whether ``legend``'s box covers a vertex or a segment of a line drawn in any panel of ``fig`` (curves, markers,
-    leaders) or any of their texts (the special points' labels), as laid out now."""
-    fig.draw_without_rendering()
-    box = legend.get_window_extent()
-    for ax in fig.axes:
-        for line in ax.get_lines():
-            xy = line.get_transform().transform(line.get_xydata())
-            finite = np.isfinite(xy).all(axis=1)
-            if any(box.contains(x, y) for x, y in xy[finite]):
+def covers(legend, ax) -> bool:
+    """Whether ``legend``, drawn in ``ax`` (laid out first), reaches out of it or covers a vertex or a segment of a
+    line drawn in it or in its twins (the Axes at its place: twinx), curves, markers and leaders, or one of their
+    texts (the special points' labels)."""
+    with warnings.catch_warnings():  # a trial layout of a figure the caller is still building (a panel grid half
+        warnings.simplefilter("ignore", UserWarning)  # drawn may collapse): its warnings are theirs when they draw it
+        ax.figure.draw_without_rendering()
+    frame, box = legend.get_window_extent(), ax.get_window_extent()
+    if frame.x0 < box.x0 or frame.x1 > box.x1 or frame.y0 < box.y0 or frame.y1 > box.y1:
+        return True
+    twins = [other for other in ax.figure.axes if other.bbox.bounds == ax.bbox.bounds]
+    for line in (line for other in twins for line in other.get_lines()):
+        xy = line.get_transform().transform(line.get_xydata())
+        gaps = ~np.isfinite(xy).all(axis=1)  # NaN: a break in the line (an unstable part drawn by another)
+        for piece in (piece[~gap] for piece, gap in zip(np.split(xy, np.flatnonzero(gaps)),
+                                                         np.split(gaps, np.flatnonzero(gaps)))):
+            x, y = piece.T
+            if ((x > frame.x0) & (x < frame.x1) & (y > frame.y0) & (y < frame.y1)).any():
                 return True
-            runs = np.split(xy, np.flatnonzero(~finite))
-            if any(len(run := r[np.isfinite(r).all(axis=1)]) > 1 and Path(run).intersects_bbox(box, filled=False)
-                   for r in runs):
+            if len(piece) > 1 and Path(piece).intersects_bbox(frame, filled=False):
                 return True
-        if any(text.get_window_extent().overlaps(box) for text in ax.texts if text.get_text()):
-            return True
-    return False
+    return any(frame.overlaps(text.get_window_extent()) for other in twins for text in other.texts
+               if text.get_visible() and text.get_text())
