@@ -97,6 +97,9 @@ def test_plot_draws_every_tube_kind(bulged_file, tmp_path, capsys):
                                                      "points drawn (uniform, a bump, or no part as long as the front "
                                                      "is wide)")
     assert not (tmp_path / "f.png").exists()
+    assert main(["plot", str(bulged_file), "--what", "profiles", "--width", "0.2", "-o", str(tmp_path / "w.png")]) == 2
+    assert capsys.readouterr().err.strip().endswith("--width 0.2: must be in [1, 40] inches (3.5 one column, 7.2 two)")
+    assert not (tmp_path / "w.png").exists()
 
 
 def test_modes_plot_draws_the_stored_critical_modes(run_file):

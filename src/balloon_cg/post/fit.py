@@ -15,6 +15,7 @@ from matplotlib.text import Text
 from .labels import relabel
 
 MIN_CHARS = 12  # the narrowest wrap tried, characters per line
+MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (as ``figure --width``)
 
 
 def wrap_to(text: Text, width: float, along: str = "width") -> None:

@@ -38,7 +38,7 @@ from matplotlib.ticker import MaxNLocator
 from scipy.interpolate import PchipInterpolator
 
 from .quantities import branch_discretisation, postprocess, surface
-from .fit import NARROW, covers, fit_width, fitted_size
+from .fit import MAX_WIDTH, MIN_WIDTH, NARROW, covers, fit_width, fitted_size
 from .labels import label_points
 from .style import JournalFigure, journal_style
 from ..analysis.results import Block
@@ -454,7 +454,6 @@ def sized(figsize):
     return figsize if width is None or figsize is None else fitted_size(figsize, width)
 
 
-MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (as ``figure --width``)
 
 
 def _draw(sources, what, points, branch, axes, stability) -> Figure:

@@ -17,7 +17,7 @@ branch, then each switched branch in the order of the label of its branch point 
 """
 import numpy as np
 
-from .fit import fit_with_legend
+from .fit import MAX_WIDTH, MIN_WIDTH, fit_with_legend
 from .labels import label_points
 from .style import JournalFigure, journal_style
 from .tube_measures import SAMPLES, along, fronts, stretches
@@ -44,6 +44,9 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
     reading (None: the run's loading.control)."""
     if what not in TUBE_KINDS:
         raise TubePlotError(f"--what {what}: not drawn for a tube run file; allowed: {', '.join(TUBE_KINDS)}")
+    if not MIN_WIDTH <= width <= MAX_WIDTH:
+        raise TubePlotError(f"--width {width:g}: must be in [{MIN_WIDTH:g}, {MAX_WIDTH:g}] inches (3.5 one column, "
+                            "7.2 two)")
     control = run["attrs"]["control"] if control is None else control
     if control not in CONTROLS:
         raise TubePlotError(f"--stability {control}: allowed for a tube: {', '.join(CONTROLS)}")
