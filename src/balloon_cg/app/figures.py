@@ -12,8 +12,8 @@ from pathlib import Path
 
 from ..io.output import IMAGE_FORMATS, check_output, replacing
 from ..io.run_file import read_run
-from ..post.paper import TWO_COLUMNS, draw_figure, figures
 from ..post.fit import MAX_WIDTH, MIN_WIDTH
+from ..post.paper import TWO_COLUMNS, draw_figure, figures
 from ..post.plotting import Reading
 from ..scene import parse_scene
 from .api import analyse
