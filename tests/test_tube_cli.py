@@ -193,7 +193,10 @@ def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, wid
     """At one and two columns, every tube figure laid out at its width: the special points' labels clear of one
     another, of the title, the axis labels and the legend; a legend left inside its panel hides no curve, marker or
     label (post/fit.covers; P against V/V0 at 3.5 in had its legend over the primary branch); every legend entry and
-    axis label writes V/V0 as the axis does, $V/V_0$, never a plain "V/V0"."""
+    axis label writes V/V0 as the axis does, $V/V_0$, never a plain "V/V0"; no label box crosses a curve, Maxwell's
+    line included (textalloc read its x, the Axes' fraction, as data: "6 BP odd" lay on it)."""
+    from matplotlib.path import Path as Segments
+
     from balloon_cg.post.fit import covers
     from balloon_cg.post.labels import GID
     from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
@@ -212,6 +215,14 @@ def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, wid
             assert not any(box.overlaps(other) for other in labels[k + 1:] + others), (kind, width)
         written = [t.get_text() for legend in legends for t in legend.get_texts()] + [t.get_text() for t in texts]
         assert not any("V/V0" in text for text in written), (kind, width, written)
+        curves = [line for ax in fig.axes for line in ax.get_lines()
+                  if line.get_gid() != GID and len(line.get_xdata()) > 1]
+        for box in labels:
+            for line in curves:
+                xy = line.get_transform().transform(line.get_xydata())
+                pieces = np.split(xy, np.flatnonzero(~np.isfinite(xy).all(axis=1)))
+                assert not any(Segments(p[np.isfinite(p).all(axis=1)]).intersects_bbox(box, filled=False) for p in pieces
+                               if np.isfinite(p).all(axis=1).sum() > 1), (kind, width, line.get_label())
 
 
 def test_legend_follows_the_labels_of_the_branch_points(bulged_file):
