@@ -33,6 +33,7 @@ from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
 from balloon_cg.tube.primary import primary_branch  # noqa: E402
 
 VOLUMES = (3, 10, 20, 30, 40, 50, 52)
+STOP_VOLUME = 52.0 * np.pi * 30.0  # V/R0³: V/V0 = 52 on the tube of length 30
 
 
 def fold_of(scene, branch) -> tuple:
@@ -62,7 +63,7 @@ def ogden() -> None:
     front.bulge_branch, plain = traced, front.bulge_branch
     start = time.process_time()
     policy = Resolution(scene.solver.max_error, 400)  # E p up to 400 per field (solver.max_degree's largest)
-    resolved = front.front_bulge(scene, primary, onset, policy, stop_volume=52.0, step=0.02)
+    resolved = front.front_bulge(scene, primary, onset, policy, stop_volume=STOP_VOLUME, step=0.02)
     total = time.process_time() - start
     front.bulge_branch = plain
     print(f"{'round':>5} {'elements':>8} {'order':>5} {'E p':>5} {'CPU s':>7} {'points':>6} {'largest tail':>12}")
@@ -73,11 +74,12 @@ def ogden() -> None:
     layout = resolved.disc
     finer = replace(layout, degree=layout.count * (layout.order + 4), order=layout.order + 4)
     start = time.process_time()
-    fine = bulge_branch(scene, primary, onset, stop_volume=52.0, step=0.02, on=finer)
+    fine = bulge_branch(scene, primary, onset, stop_volume=STOP_VOLUME, step=0.02, on=finer)
     fine_cpu = time.process_time() - start
     start = time.process_time()
     legendre_primary = primary_branch(scene, 160)
-    legendre = bulge_branch(scene, legendre_primary, legendre_primary.branch_points()[0], stop_volume=52.0, step=0.02)
+    legendre = bulge_branch(scene, legendre_primary, legendre_primary.branch_points()[0], stop_volume=STOP_VOLUME,
+                            step=0.02)
     legendre_cpu = time.process_time() - start
     print(f"\n{'basis':>28} {'unknowns':>8} {'CPU s':>7} {'largest tail':>12} {'P at LV':>18} {'V/V0 at LV':>16}")
     rows = (("resolved elements", resolved, total), (f"order {finer.order}, same bounds", fine, fine_cpu),

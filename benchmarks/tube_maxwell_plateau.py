@@ -64,7 +64,7 @@ def spom1_measures(degrees) -> None:
     for degree in degrees:
         scene = spom1_l10(degree)
         primary = primary_branch(scene)
-        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=20.0, step=0.02)
+        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=20.0 * np.pi * 10.0, step=0.02)
         (fold,) = [s for s in branch.special if s.kind == "LV"]
         row = [branch.disc.tail(fold.u), first_integral_spread(Equilibrium(scene, branch.disc), fold.u)]
         for v in (4, 10, 20):

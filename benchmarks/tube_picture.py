@@ -64,7 +64,8 @@ else:
         pm = stage("maxwell", maxwell, scene)
         primary = stage("primary", primary_branch, scene)
         onset = primary.branch_points(Mirror.ODD)[0]
-        bulge = stage("bulge", bulge_branch, scene, primary, onset, stop_volume=settings["stop_volume"])
+        bulge = stage("bulge", bulge_branch, scene, primary, onset,
+                      stop_volume=settings["stop_volume"] * 3.141592653589793 * scene.geometry.length)  # V/R0³
         return {"points": len(primary.pressure) + len(bulge.pressure), "onset_pressure": onset.pressure, "maxwell": pm,
                 "bulge_points": len(bulge.pressure), "last_volume": float(bulge.volume[-1]),
                 "last_pressure": float(bulge.pressure[-1]), "stop": str(bulge.stop.code)}

@@ -79,7 +79,7 @@ def main(degrees) -> None:
     for degree in degrees:
         scene = tube_scene("SPOM1", 10.0).with_overrides({"solver.degree": degree, "continuation.stop_stretch": 5.0})
         primary = primary_branch(scene)
-        branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=5.0)
+        branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=5.0 * np.pi * 10.0)
         eq = Equilibrium(scene, branch.disc)
         modes = azimuthal.branch_modes(eq, np.column_stack([branch.states, branch.pressure]), branch.params, 1)
         zero = [c for c in crossings(scene, branch, modes) if c.pressure > 0.5][0]

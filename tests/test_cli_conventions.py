@@ -52,6 +52,24 @@ def test_every_scene_argument_says_what_it_takes():
     assert all(text.startswith(SCENE_HELP) for text in helps.values()), helps
 
 
+def test_help_speaks_of_every_shape():
+    """``balloon-cg --help`` names the four reference shapes, and the help of every command that computes on or reads a
+    tube says what it does with one (they spoke of spheres only: pear branches, a north pole stretch); the examples
+    include a shipped tube scene that loads."""
+    from balloon_cg.app.cli import EXAMPLES
+    from balloon_cg.scene import load_scene
+
+    parser = build_parser()
+    top = " ".join(parser.format_help().split())
+    assert all(shape in top for shape in ("sphere", "spheroid", "capsule", "tube")), top
+    for name in ("run", "solve", "inspect", "plot", "sweep", "critical", "continue"):
+        text = " ".join(parser.subcommands[name].format_help().split())
+        assert "tube" in text, name
+    for name in ("run", "solve", "critical"):
+        assert any("tube_spom1_L10" in line for line in EXAMPLES[name]), name
+    assert load_scene("tube_spom1_L10").geometry.shape == "tube" and load_scene("tube_spom1_L10_coil").field.coils
+
+
 def test_run_set_renames_and_writes_the_default_output(tmp_path, monkeypatch):
     scene = tmp_path / "small_M0.toml"
     scene.write_text(SMALL)

@@ -249,7 +249,7 @@ def test_bulge_branch_from_the_onset_through_its_volume_fold():
         scene = tube_scene("SPOM1", 10.0).with_overrides({"solver.degree": degree, "continuation.stop_stretch": 1.75,
                                                           "continuation.step_max": 0.5})
         primary = primary_branch(scene)
-        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=60.0, step=0.02)
+        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=60.0 * np.pi * scene.geometry.length, step=0.02)
         assert branch.stop.code == StopCode.STOP_VOLUME and abs(branch.volume[-1] - 60) < 1e-9 * 60
         eq = Equilibrium(scene, branch.disc)
         folds.append([(s, 2 * eq.volume(s.u) / 10.0) for s in branch.special if s.kind == "LV"])  # V/V0
@@ -293,7 +293,7 @@ def test_neo_hookean_bulge_keeps_falling_without_a_maxwell_state():
     assert np.all(np.diff(uniform) < 0) and uniform[-1] < 0.1 * uniform[0]
     primary = primary_branch(scene)
     onset = primary.branch_points()[0]
-    branch = bulge_branch(scene, primary, onset, stop_volume=100.0, step=0.02)
+    branch = bulge_branch(scene, primary, onset, stop_volume=100.0 * np.pi * scene.geometry.length, step=0.02)
     assert branch.stop.code == StopCode.STOP_VOLUME and abs(branch.volume[-1] - 100) < 1e-9 * 100  # landed on it
     folds = [s for s in branch.special if s.kind == "LV"]
     assert len(folds) == 1 and folds[0].status == "located"
@@ -406,7 +406,7 @@ def test_bulge_propagates_at_maxwells_pressure():
                                                           "continuation.step_max": 0.5,
                                                           "continuation.max_points": 1000})
         primary = primary_branch(scene)
-        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=420.0, step=0.02)
+        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=420.0 * np.pi * scene.geometry.length, step=0.02)
         assert branch.stop.code == StopCode.STOP_VOLUME
         curves[degree] = branch
     maxwell, _, _ = tube.maxwell_pressure(scene.material)

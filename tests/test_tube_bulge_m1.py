@@ -128,7 +128,7 @@ def bulge():
     """SPOM1, L = 10, degree 40: the bulge branch from the onset to V/V0 = 5, its m = 1 blocks and located zeros."""
     scene = tube_scene("SPOM1", 10.0, "[solver]\ndegree = 40\n[continuation]\nstep_max = 0.5\nstop_stretch = 5.0\n")
     primary = primary_branch(scene)
-    branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=5.0)
+    branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=5.0 * np.pi * scene.geometry.length)
     eq = Equilibrium(scene, branch.disc)
     modes = azimuthal.branch_modes(eq, np.column_stack([branch.states, branch.pressure]), branch.params, 1)
     fine = IntervalDiscretisation(branch.disc.degree, branch.disc.length, quadrature=NODES)

@@ -14,7 +14,7 @@ from balloon_cg.model import tube
 from balloon_cg.scene import load_scene
 from balloon_cg.tube.picture import tube_picture
 from documented import inspect_json_keys
-from shared_pictures import TUBE_COIL_FAST as COIL_FAST, TUBE_FAST as FAST, tube_critical_file, tube_run_file
+from shared_pictures import TUBE_COIL_FAST as COIL_FAST, TUBE_FAST as FAST, shared_file, tube_critical_file, tube_run_file
 
 SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
 
@@ -23,6 +23,17 @@ SCENE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
 def run_file(tmp_path_factory):
     """`balloon-cg run` of SCENE at FAST, written once per session (tests/shared_pictures.py)."""
     return tube_run_file(tmp_path_factory)
+
+
+BULGED = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=6"]  # FAST with a front (~5 s of CPU)
+
+
+@pytest.fixture(scope="module")
+def bulged_file(tmp_path_factory):
+    """`balloon-cg run` of SCENE at BULGED: FAST's bulge stops at a hoop stretch of 3, before its profile has a front
+    (post/tube_measures.front); to 6 it has one over its last points."""
+    return shared_file(tmp_path_factory, "tube_bulged.h5",
+                       lambda path: main(["run", str(SCENE), "-o", str(path), "--quiet", *BULGED]) == 0)
 
 
 def test_run_writes_what_the_tube_pipeline_computes(run_file):
@@ -71,20 +82,24 @@ def test_inspect_names_the_shape_and_its_points(run_file, capsys):
     assert summary["branches"]["primary"]["special_points"][0]["kind"] == "LP"
 
 
-def test_plot_draws_every_tube_kind(run_file, tmp_path, capsys):
+def test_plot_draws_every_tube_kind(bulged_file, tmp_path, capsys):
     out = tmp_path / "t.png"
     kinds = ("pressure-volume", "profiles", "front", "stretches", "modes")
-    assert main(["plot", str(run_file), "--what", ",".join(kinds), "-o", str(out)]) == 0
+    assert main(["plot", str(bulged_file), "--what", ",".join(kinds), "-o", str(out)]) == 0
     for kind in kinds:
         assert (tmp_path / f"t_{kind}.png").stat().st_size > 10_000
-    assert main(["plot", str(run_file), "--what", "shapes", "-o", str(tmp_path / "s.png")]) == 2
+    assert main(["plot", str(bulged_file), "--what", "shapes", "-o", str(tmp_path / "s.png")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].endswith("--what shapes: not drawn for a tube run file; allowed: " + ", ".join((*kinds, "onset")))
     assert not (tmp_path / "s.png").exists()
-    assert main(["plot", str(run_file), "--what", "front", "--branch", "primary", "-o", str(tmp_path / "f.png")]) == 2
-    assert capsys.readouterr().err.strip().endswith("--what front: the primary branch's profiles are uniform at the "
-                                                     "points drawn (no front)")
+    assert main(["plot", str(bulged_file), "--what", "front", "--branch", "primary", "-o", str(tmp_path / "f.png")]) == 2
+    assert capsys.readouterr().err.strip().endswith("--what front: the primary branch's profiles have no front at the "
+                                                     "points drawn (uniform, a bump, or no part as long as the front "
+                                                     "is wide)")
     assert not (tmp_path / "f.png").exists()
+    assert main(["plot", str(bulged_file), "--what", "profiles", "--width", "0.2", "-o", str(tmp_path / "w.png")]) == 2
+    assert capsys.readouterr().err.strip().endswith("--width 0.2: must be in [1, 40] inches (3.5 one column, 7.2 two)")
+    assert not (tmp_path / "w.png").exists()
 
 
 def test_modes_plot_draws_the_stored_critical_modes(run_file):
@@ -124,19 +139,110 @@ def test_stretches_of_the_uniform_tube_are_its_radius_and_its_length_ratio(run_f
     assert np.abs(axial - (eta[0] - eta[1]) / disc.length).max() < 1e-12
 
 
-def test_front_moves_away_from_the_bulge_as_it_widens(run_file):
-    """The bulge forms at the branch's end (sliding ends: half a bulge there); past its volume fold the front first
-    steepens (its mid-level crossing draws back a little), then moves away along the axis as V/V0 grows: the drawn
-    position, from its smallest value after the LV on, rises at every point, by more than 0.1 radius here."""
+def test_front_moves_away_from_the_bulge_as_it_widens(bulged_file):
+    """The bulge forms at the tube's end S = 0 (sliding ends: half a bulge there); past its volume fold, once its
+    profile has a front (post/tube_measures.front: before, the profile is the onset's cos(πS/L) turning into a
+    localised bump), the front moves away along the axis as V/V0 grows: every drawn position rises, by more than 0.1
+    radius here; the points with none are not drawn but shaded "no front" (they drew a spike of position and width
+    near the onset, the volume hardly changing)."""
     from balloon_cg.post.tube_plots import tube_figure
 
-    run = read_tube_run(run_file)
+    run = read_tube_run(bulged_file)
     b = run["branches"]["bulge"]
     fold = next(s for s in b["special_points"] if s["kind"] == "LV")
     after = np.arange(int(fold["index"]) + 1, len(b["volume"]))
-    position = tube_figure(run, "front", points=after).axes[0].lines[0].get_ydata()
-    moving = position[int(np.argmin(position)):]
+    ax = tube_figure(run, "front", points=after).axes[0]
+    position = ax.lines[0].get_ydata()
+    moving = position[np.isfinite(position)]
     assert after.size > 5 and moving.size > 5 and np.all(np.diff(moving) > 0) and moving[-1] - moving[0] > 0.1
+    assert np.isnan(position[0]) and "no front" in ax.get_legend_handles_labels()[1]
+    everything = tube_figure(run, "front").axes
+    width = everything[1].lines[0].get_ydata()
+    assert np.nanmax(width) < 0.3 * run["attrs"]["length"]  # the onset's mode drew 2ℓ/π, 0.64 of the length
+
+
+def test_profiles_stretches_and_front_share_one_axis(bulged_file):
+    """The profiles, the stretches and the front read one axial coordinate, z from the end S = 0, on the same side:
+    at a bulge point the profile r(z) and the hoop stretch λ2(z) (= ρ on the tube) both start at z = 0 with ρ(0), the
+    bulged end, and end at the deformed length with ρ(L) (the profile was drawn against the height η, the bulge on
+    the right, and the stretches from the end S = 0, the bulge on the left); the front's drawn position is where the
+    drawn profile crosses its mid level (1e-3: the profile's 401 samples), and no axis text names "the branch's
+    end" (a branch's end is its last point)."""
+    from balloon_cg.io.tube_file import discretisation
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run = read_tube_run(bulged_file)
+    i = len(run["branches"]["bulge"]["volume"]) - 1
+    u = run["branches"]["bulge"]["unknowns"][i]
+    rho, eta = discretisation(run["attrs"]).profile(u, np.array([0.0, run["attrs"]["length"]]))
+    drawn = tube_figure(run, "profiles", points=[i]).axes[0].lines[0].get_xydata()
+    hoop = tube_figure(run, "stretches", points=[i]).axes[0].lines[0].get_xydata()
+    for line in (drawn, hoop):
+        assert np.abs(line[0] - (0.0, rho[0])).max() < 1e-12 and rho[0] > 2 * rho[1]
+        assert np.abs(line[-1] - (eta[0] - eta[1], rho[1])).max() < 1e-12
+    front = tube_figure(run, "front", points=[i]).axes[0].lines[0].get_ydata()[0]
+    middle = 0.5 * (drawn[:, 1].max() + drawn[:, 1].min())
+    assert abs(np.interp(-middle, -drawn[:, 1], drawn[:, 0]) - front) < 1e-3
+    for kind in ("profiles", "front", "stretches"):
+        texts = [t.get_text() for ax in tube_figure(run, kind).axes for t in (ax.title, ax.xaxis.label, ax.yaxis.label)]
+        assert not any("branch's end" in text for text in texts), (kind, texts)
+
+
+@pytest.mark.parametrize("width", [3.5, 7.2])
+def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, width):
+    """At one and two columns, every tube figure laid out at its width: the special points' labels clear of one
+    another, of the title, the axis labels and the legend; a legend left inside its panel hides no curve, marker or
+    label (post/fit.covers; P against V/V0 at 3.5 in had its legend over the primary branch); every legend entry and
+    axis label writes V/V0 as the axis does, $V/V_0$, never a plain "V/V0"; no label box crosses a curve, Maxwell's
+    line included (textalloc read its x, the Axes' fraction, as data: "6 BP odd" lay on it)."""
+    from matplotlib.path import Path as Segments
+
+    from balloon_cg.post.fit import covers
+    from balloon_cg.post.labels import GID
+    from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
+
+    run = read_tube_run(bulged_file)
+    for kind in TUBE_KINDS:
+        fig = tube_figure(run, kind, width=width)
+        fig.draw_without_rendering()
+        legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend() is not None)]
+        for legend in (ax.get_legend() for ax in fig.axes if ax.get_legend() is not None):
+            assert not covers(legend, legend.axes), (kind, width)
+        texts = [t for ax in fig.axes for t in (ax.title, ax.xaxis.label, ax.yaxis.label) if t.get_text()]
+        others = [t.get_window_extent() for t in texts] + [legend.get_window_extent() for legend in legends]
+        labels = [t.get_window_extent() for ax in fig.axes for t in ax.texts if t.get_gid() == GID and t.get_text()]
+        for k, box in enumerate(labels):
+            assert not any(box.overlaps(other) for other in labels[k + 1:] + others), (kind, width)
+        written = [t.get_text() for legend in legends for t in legend.get_texts()] + [t.get_text() for t in texts]
+        assert not any("V/V0" in text for text in written), (kind, width, written)
+        curves = [line for ax in fig.axes for line in ax.get_lines()
+                  if line.get_gid() != GID and len(line.get_xdata()) > 1]
+        for box in labels:
+            for line in curves:
+                xy = line.get_transform().transform(line.get_xydata())
+                pieces = np.split(xy, np.flatnonzero(~np.isfinite(xy).all(axis=1)))
+                assert not any(Segments(p[np.isfinite(p).all(axis=1)]).intersects_bbox(box, filled=False) for p in pieces
+                               if np.isfinite(p).all(axis=1).sum() > 1), (kind, width, line.get_label())
+
+
+def test_legend_follows_the_labels_of_the_branch_points(bulged_file):
+    """The branches switched at labels 2..8 of the primary branch are named bulge_2..bulge_8 (``continue``'s labels:
+    never renumbered); a file where one is bulge_10 (born at label 10) lists it after bulge_8 in the legend, not
+    after bulge (the file's, alphabetical, order), while the labels stay the file's (tube_labels)."""
+    from balloon_cg.io.tube_file import tube_labels
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run = read_tube_run(bulged_file)
+    moved = dict(run["branches"]["bulge_2"], attrs=dict(run["branches"]["bulge_2"]["attrs"], parent_label=10))
+    branches = {name: b for name, b in run["branches"].items() if name != "bulge_2"} | {"bulge_10": moved}
+    renamed = dict(run, branches=dict(sorted(branches.items())))
+    maxwell = run["attrs"]["maxwell_pressure"]
+    fig = tube_figure(renamed, "pressure-volume")
+    legend = (fig.legends or [fig.axes[0].get_legend()])[0]
+    entries = [t.get_text().replace("\n", " ") for t in legend.get_texts()]  # wrapped to the figure's width
+    assert entries == ["primary", "bulge", "bulge_3", "bulge_4", "bulge_5", "bulge_8", "bulge_10",
+                       f"Maxwell $P_M$ = {maxwell:.5g}"]
+    assert [name for name, _, _ in tube_labels(renamed)][:3] == ["primary"] * 3
 
 
 def test_pressure_volume_figure_has_the_maxwell_line(run_file):
@@ -148,7 +254,7 @@ def test_pressure_volume_figure_has_the_maxwell_line(run_file):
     assert len(maxwell) == 1 and maxwell[0].get_ydata()[0] == run["attrs"]["maxwell_pressure"]
 
 
-def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(run_file,
+def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(bulged_file,
                                                                                            tmp_path_factory):
     """At the default width every title and axis label of every tube figure lies inside the figure (the stretches'
     title ran past both edges; the onset curve's of a ``critical`` file, the run's having none); on P against V/V0 every located point is marked and its label is the number
@@ -158,7 +264,7 @@ def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_conti
     from balloon_cg.post.labels import GID
     from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
 
-    run, critical = read_tube_run(run_file), read_tube_run(tube_critical_file(tmp_path_factory))
+    run, critical = read_tube_run(bulged_file), read_tube_run(tube_critical_file(tmp_path_factory))
     for kind in TUBE_KINDS:
         fig = tube_figure(critical if kind == "onset" else run, kind)
         fig.draw_without_rendering()

@@ -98,7 +98,7 @@ def test_event_on_the_bulge_branch_is_its_landed_volume_end():
     volume = found["volume_ratio = 3.5"]
     assert volume_ratio(eq, np.append(volume.u, volume.pressure)) == pytest.approx(3.5, rel=1e-12)
     assert bulge.disc.profile(found["lam2_top = 3"].u, np.array([0.0]))[0][0] == pytest.approx(3.0, rel=1e-12)
-    ended = bulge_branch(scene, primary, onset, stop_volume=3.5, stop_stretch=4.0)
+    ended = bulge_branch(scene, primary, onset, stop_volume=3.5 * np.pi * scene.geometry.length, stop_stretch=4.0)
     assert ended.volume[-1] == pytest.approx(3.5, rel=1e-12)
     assert abs(ended.pressure[-1] - volume.pressure) <= 1e-9
 

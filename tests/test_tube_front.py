@@ -106,7 +106,7 @@ def test_bulge_fold_on_elements_is_the_legendre_bases_fold():
     primary = primary_branch(scene)
     onset = primary.branch_points()[0]
     disc = element_interval(LENGTH, 20, np.linspace(-1, 1, 16)[1:-1])
-    branch = bulge_branch(scene, primary, onset, stop_volume=3.0, step=0.02, on=disc)
+    branch = bulge_branch(scene, primary, onset, stop_volume=3.0 * np.pi * LENGTH, step=0.02, on=disc)
     (fold,) = [s for s in branch.special if s.kind == Kind.LV]
     volume = 2 * Equilibrium(scene, disc).volume(fold.u) / LENGTH
     assert abs(fold.pressure - 1.240702968978) <= 1e-9 and abs(volume - 2.145050161885) <= 1e-8
@@ -139,7 +139,7 @@ def test_resolved_bulge_reaches_maxwells_pressure_with_every_point_resolved(maxw
     scene = ogden_1972_tube(24)
     primary = primary_branch(scene)
     onset = primary.branch_points()[0]
-    branch = front_bulge(scene, primary, onset, Resolution(scene.solver.max_error, 400), stop_volume=52.0, step=0.02)
+    branch = front_bulge(scene, primary, onset, Resolution(scene.solver.max_error, 400), stop_volume=52.0 * np.pi * LENGTH, step=0.02)
     assert branch.tail.max() <= scene.solver.max_error
     fold = check_chain(onset, branch, maxwell[0], 52.0)
     volume = 2 * Equilibrium(scene, branch.disc).volume(fold.u) / LENGTH

@@ -78,7 +78,8 @@ def traced(degree: int, stop_volume: float):
     scene = ogden_1972_tube(degree)
     primary = primary_branch(scene)
     onset = primary.branch_points()[0]
-    return primary, onset, bulge_branch(scene, primary, onset, stop_volume=stop_volume, step=0.02)
+    return primary, onset, bulge_branch(scene, primary, onset, stop_volume=stop_volume * np.pi * scene.geometry.length,
+                                          step=0.02)
 
 
 def check_chain(onset, branch, maxwell_pressure: float, stop_volume: float):

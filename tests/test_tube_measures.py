@@ -53,3 +53,17 @@ def test_front_of_a_tanh_profile(descending, sign):
 def test_a_uniform_profile_has_no_front():
     found = front(np.linspace(0.0, 5.0, 11), np.full(11, 1.6))
     assert np.isnan(found.position) and np.isnan(found.width) and found.low == found.high == 1.6
+
+
+def test_a_profile_without_a_single_narrow_front_has_none():
+    """No front (position and width NaN) where there is none to single out: the onset's mode ρ = 1.6 + 0.05 cos(πz/ℓ)
+    over the whole tube (one mid-level crossing, at the middle, but a width 2ℓ/π: it drew a spike near the onset),
+    a bump in the middle (two crossings: a coil's bulge), and a tanh front of width 1.6 too near an end (z_f < 1.5 w:
+    the part beyond it shorter than the front is wide); the same front at 1.5 w + 0.1 from the end has one."""
+    z = np.linspace(0.0, 11.2, 4001)
+    for rho in (1.6 + 0.05 * np.cos(np.pi * z / 11.2), 1.6 + 0.05 * np.exp(-((z - 5.6) / 1.5) ** 2),
+                4.0 - 2.5 * np.tanh((z - 2.3) / 0.8)):
+        found = front(z, rho)
+        assert np.isnan(found.position) and np.isnan(found.width) and found.high > found.low
+    found = front(z, 4.0 - 2.5 * np.tanh((z - 2.5) / 0.8))
+    assert abs(found.position - 2.5) < 5e-3 and abs(found.width - 1.6) < 5e-3  # the end at 2.5 is not saturated

@@ -47,11 +47,11 @@ def test_bulge_branch_stops_where_its_tail_passes_max_error():
     to V/V0 = 4 with unresolved points (tail up to 7e-4)."""
     scene = spom1_l10(30)
     primary = primary_branch(scene)
-    stopped = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=4.0, step=0.02, max_error=1e-5)
+    stopped = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=4.0 * np.pi * 10.0, step=0.02, max_error=1e-5)
     assert stopped.stop.code == IntervalStop.UNRESOLVED
     assert stopped.tail.max() <= 1e-5 and 2.8 < stopped.volume[-1] < 3.5
     assert [s.kind for s in stopped.special] == [Kind.LV]
-    free = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=4.0, step=0.02)
+    free = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=4.0 * np.pi * 10.0, step=0.02)
     assert free.stop.code == StopCode.STOP_VOLUME and free.tail.max() > 1e-4
     same = len(stopped.volume)
     assert np.array_equal(free.states[:same], stopped.states) and np.array_equal(free.tail[:same], stopped.tail)
@@ -62,13 +62,13 @@ def test_unresolved_bulge_is_retraced_at_a_higher_degree():
     policy's growth 1.5), where it reaches V/V0 = 4 resolved (degree 60's tail there: 3.1e-6); its fold at the
     converged one (docs/tubes.md: degrees 30–120 agree to 3e-11) within 1e-9. With max_degree 30 it is the stopped
     branch of degree 30."""
-    _, branch = resolved_bulge_branch(spom1_l10(30), stop_volume=4.0, step=0.02, policy=Resolution(1e-5, 100))
+    _, branch = resolved_bulge_branch(spom1_l10(30), stop_volume=4.0 * np.pi * 10.0, step=0.02, policy=Resolution(1e-5, 100))
     assert branch.disc.degree == 67 and branch.stop.code == StopCode.STOP_VOLUME
     assert branch.tail.max() <= 1e-5 and abs(branch.volume[-1] - 4.0) <= 1e-9
     ((fold, volume),) = [(s, 2 * Equilibrium(spom1_l10(67), branch.disc).volume(s.u) / 10.0) for s in branch.special
                          if s.kind == Kind.LV]
     assert abs(fold.pressure - FOLD[0]) <= 1e-9 and abs(volume - FOLD[1]) <= 1e-9
-    _, capped = resolved_bulge_branch(spom1_l10(30), stop_volume=4.0, step=0.02, policy=Resolution(1e-5, 30))
+    _, capped = resolved_bulge_branch(spom1_l10(30), stop_volume=4.0 * np.pi * 10.0, step=0.02, policy=Resolution(1e-5, 30))
     assert capped.disc.degree == 30 and capped.stop.code == IntervalStop.UNRESOLVED and capped.tail.max() <= 1e-5
 
 
@@ -92,7 +92,7 @@ def test_first_integral_is_constant_on_exact_states_and_falls_with_the_degree():
     for degree in (30, 40, 60):
         scene = spom1_l10(degree)
         primary = primary_branch(scene)
-        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=4.0, step=0.02)
+        branch = bulge_branch(scene, primary, primary.branch_points()[0], stop_volume=4.0 * np.pi * 10.0, step=0.02)
         (fold,) = [s for s in branch.special if s.kind == Kind.LV]
         folds.append(first_integral_spread(Equilibrium(scene, branch.disc), fold.u))
         ends.append(branch.first_integral[-1])

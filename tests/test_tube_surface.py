@@ -104,7 +104,7 @@ def located_zeros(case):
     else:
         scene = tube_scene("SPOM1", 10.0).with_overrides({"solver.degree": 20, "continuation.stop_stretch": 5.0})
         primary = primary_branch(scene)
-        branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=5.0)
+        branch = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=5.0 * np.pi * scene.geometry.length)
     eq = Equilibrium(scene, branch.disc)
     modes = azimuthal.branch_modes(eq, np.column_stack([branch.states, branch.pressure]), branch.params, 1)
     return scene, branch, [c for c in crossings(scene, branch, modes) if c.pressure > 0.5]

@@ -31,7 +31,7 @@ def switched(length, degree, block, extra=""):
                                                 "step_max = 0.5\n")
     primary = primary_branch(scene)
     point = primary.branch_points(block)[0]
-    return scene, primary, point, bulge_branch(scene, primary, point, stop_volume=20.0, step=0.02)
+    return scene, primary, point, bulge_branch(scene, primary, point, stop_volume=20.0 * np.pi * length, step=0.02)
 
 
 @pytest.mark.parametrize("extra", ["", "axial_stretch = 1.2\n"])

@@ -7,10 +7,10 @@ switched at the first odd branch point (the onset) and traced to V/V0 = 420 (tub
 back; the panels are post/tube_plots.py's (``balloon-cg plot --what pressure-volume,profiles,front,stretches``):
 
 (a) P against V/V0, solid where stable under volume control, with Maxwell's line P_M (model/tube.maxwell_pressure);
-(b) the profiles r(Z) of the bulge branch at a few V/V0 (the classic photograph: the bulge forms at the end and its
-    front moves along the tube at P_M);
-(c) the front's position (from the bulge's end, along the deformed axis) and width against V/V0;
-(d) the hoop stretch λ2 and the axial stretch λ1 along the deformed axis at three states of the plateau.
+(b) the profiles r(z) of the bulge branch at a few V/V0, z the distance along the deformed axis from the end S = 0
+    (the classic photograph: the bulge forms at that end and its front moves along the tube at P_M);
+(c) the front's position z_f and width against V/V0 (none drawn where the profile has no front: near the onset);
+(d) the hoop stretch λ2 and the axial stretch λ1 against z at three states of the plateau.
 
 Printed (the tables of docs/tubes.md): the onset of bulging against L at degree 20 (the first odd branch point against
 model/tube.bulge_onset and the long-tube limit, the pressure maximum); the bulge's volume fold against the degree
@@ -60,7 +60,7 @@ def picture(length: float, degree: int, stop_stretch: float, stop_volume: float)
     """(scene, TubePicture) of the module docstring's run."""
     scene = scene_of(length, degree, stop_stretch)
     primary = primary_branch(scene)
-    bulge = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=stop_volume, step=0.02)
+    bulge = bulge_branch(scene, primary, primary.branch_points(Mirror.ODD)[0], stop_volume=stop_volume * np.pi * length, step=0.02)
     return scene, TubePicture({"primary": primary, "bulge": bulge}, maxwell(scene))
 
 
@@ -70,16 +70,19 @@ def draw(run: dict, out: Path) -> None:
     with journal_style():
         fig, axes = plt.subplots(2, 2, figsize=(8.0, 6.4), layout="constrained")
         pressure_volume(axes[0, 0], run, "volume")
-        kept = [next(text for text in axes[0, 0].texts if text.get_text() == kind) for kind in ("LP", "BP odd", "LV")]
+        kept = [next(text for text in axes[0, 0].texts if text.get_text().split(maxsplit=1)[-1] == kind)
+                for kind in ("LP", "BP odd", "LV")]  # the labels "0 LP", "1 BP odd", …: post/labels.py
         for text in [text for text in axes[0, 0].texts if text not in kept]:
             text.remove()  # the higher modes' branch points and the plateau's folds (docs/tubes.md): marked only
         axes[0, 0].set_title("(a) P against V/V0 (solid: stable under volume control)")
         profiles(axes[0, 1], run, "bulge", nearest(SHOWN))
-        axes[0, 1].set_title("(b) profiles r(Z) of the bulge branch")
+        axes[0, 1].set_title("(b) profiles r(z) of the bulge branch")
         front_motion(axes[1, 0], run, "bulge", np.flatnonzero(volume >= 5.0))
         axes[1, 0].set_title("(c) the front along the deformed axis")
         stretch_profiles(axes[1, 1], run, "bulge", nearest(STRETCHED))
         axes[1, 1].set_title("(d) hoop (solid) and axial (dashed) stretch")
+        for ax in axes.flat:  # each panel's legend at matplotlib's best place (tube_figure's: post/fit.py)
+            ax.legend(*ax.get_legend_handles_labels(), fontsize=5)
         fig.savefig(out, dpi=130)
     print(f"wrote {out}")
 

@@ -145,14 +145,17 @@ def docs_path(name: str) -> str:
     return str(resources.files("balloon_cg.docs") / name)
 
 
-SCENE_HELP = ("scene TOML file, or the name of a scene shipped with the package (spom1, tpom1_two_coils_M0.002, …: "
-              f"the files in {resources.files('balloon_cg.scenes')})")
+SCENE_HELP = ("scene TOML file of any shape (sphere, spheroid, capsule, tube), or the name of a scene shipped with the "
+              "package (spom1, tpom1_two_coils_M0.002, tube_spom1_L10, …: the files in "
+              f"{resources.files('balloon_cg.scenes')})")
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog=PROG, description="Inflated magnetoelastic membranes: equilibrium branches, their bifurcations and "
-                               f"stability. Documentation: {docs_path('')}")
+        prog=PROG, description="Inflated membranes of an axisymmetric reference shape (a sphere, a spheroid, a capsule "
+                               "or a tube: [geometry]), in the field of coils or under a voltage: equilibrium "
+                               "branches, their bifurcations (a sphere's pear branches, a tube's bulge) and stability. "
+                               f"Documentation: {docs_path('')}")
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -170,17 +173,20 @@ def build_parser() -> argparse.ArgumentParser:
 EXAMPLES_HEADING = "examples:\n"
 EXAMPLES = {  # each subcommand's --help ends with these
     "run": ("balloon-cg run spom1_two_coils_M0.002 -o two_coils.h5",
-            "balloon-cg run spom1 --set continuation.stop_stretch=3 --primary-only"),
-    "solve": ("balloon-cg solve spom1 --pole-stretch 2.5 --json",),
+            "balloon-cg run spom1 --set continuation.stop_stretch=3 --primary-only",
+            "balloon-cg run tube_spom1_L10 -o tube.h5"),
+    "solve": ("balloon-cg solve spom1 --pole-stretch 2.5 --json", "balloon-cg solve tube_spom1_L10 --hoop-stretch 1.5"),
     "inspect": ("balloon-cg inspect two_coils.h5", "balloon-cg inspect sweep.h5 --json"),
     "plot": ("balloon-cg plot two_coils.h5 --what pressure-pole,shapes -o p.pdf",
-             "balloon-cg plot two_coils.h5 --what pressure-pole --stability volume"),
+             "balloon-cg plot two_coils.h5 --what pressure-pole --stability volume",
+             "balloon-cg plot tube.h5 --what pressure-volume,profiles,front --width 3.5 -o tube.pdf"),
     "sweep": ("balloon-cg sweep spom1_two_coils_M0.002 --vary M=0:0.003:num=21 -o sweep.h5",
               "balloon-cg sweep spom1_two_coils_M0.002 --vary 'M=linspace(0, 0.003, 4)' --primary-only --workers 2"),
     "critical": ("balloon-cg critical spom1_single_coil --parameter M -o critical_M.h5",
                  "balloon-cg critical spom1 --parameter alpha1 --set continuation.stop_stretch=3",
                  "balloon-cg critical spom1 --set material.preset=Gent --of LP --parameter material.parameters.Jm "
-                 "--direction -1 -o cusp.h5"),
+                 "--direction -1 -o cusp.h5",
+                 "balloon-cg critical tube_spom1_L10_coil --parameter M -o onset_M.h5"),
     "continue": ("balloon-cg continue two_coils.h5 3 -o again.h5",
                  "balloon-cg continue gent.h5 2 --parameter material.parameters.Jm --direction -1 -o fold.h5",
                  "balloon-cg continue two_coils.h5 2 --parameter M --set continuation.stop_field=0.004 -o tuning.h5"),
@@ -219,8 +225,9 @@ def _os_message(e: OSError) -> str:
 # --- run ---------------------------------------------------------------------------------------------------
 
 def _add_run(commands):
-    p = commands.add_parser("run", help="analyse a scene (primary branch, stability, branch points, pear branches) "
-                                        "and write a run file")
+    p = commands.add_parser("run", help="analyse a scene of any shape (primary branch, stability, branch points and "
+                                        "the branches switched there: a sphere's pear branches, a tube's bulges) and "
+                                        "write a run file")
     p.add_argument("scene", help=SCENE_HELP)
     p.add_argument("-o", "--output", help="run file to write (HDF5; default: SCENE_NAME.h5 in the current folder, "
                                           "with a token per --set, --unset: SCENE_NAME_stop_stretch3.h5)")
@@ -228,7 +235,7 @@ def _add_run(commands):
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--primary-only", action="store_true",
-                   help="trace the primary branch only (no stability, branch points or pear branches)")
+                   help="trace the primary branch only (no stability, branch points or switched branches)")
     p.add_argument("--allow-partial", action="store_true",
                    help="exit 0 also when the result is incomplete (it is still flagged in the file and on stderr)")
     p.set_defaults(handler=run)
@@ -421,10 +428,11 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
 
 def _add_solve(commands):
     p = commands.add_parser("solve", help="one equilibrium on the primary branch at a given north pole stretch (a "
-                                          "tube: at a given hoop stretch at its middle)")
+                                          "sphere, spheroid or capsule) or hoop stretch at a tube's middle")
     p.add_argument("scene", help=SCENE_HELP)
     given = p.add_mutually_exclusive_group(required=True)
-    given.add_argument("--pole-stretch", type=float, metavar="X", help="north pole stretch λ2(0) (> 1)")
+    given.add_argument("--pole-stretch", type=float, metavar="X",
+                       help="north pole stretch λ2(0) (> 1; a sphere, spheroid or capsule)")
     given.add_argument("--hoop-stretch", type=float, metavar="X",
                        help="a tube's hoop stretch at its middle λ2(L/2) (> 1; docs/tubes.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -511,8 +519,8 @@ def solution(branch, i: int) -> dict:
 # --- inspect -----------------------------------------------------------------------------------------------
 
 def _add_inspect(commands):
-    p = commands.add_parser("inspect", help="summary of a run, sweep or curve file")
-    p.add_argument("file", help="run, sweep or two-parameter curve file (HDF5)")
+    p = commands.add_parser("inspect", help="summary of a run (of any shape), sweep or curve file")
+    p.add_argument("file", help="run file (of any shape, a tube's too), sweep or two-parameter curve file (HDF5)")
     p.add_argument("--json", action="store_true", help="print one JSON object (strict: null for NaN)")
     p.set_defaults(handler=inspect)
 
@@ -548,27 +556,31 @@ def _finite(value):
 
 def _add_plot(commands):
     p = commands.add_parser("plot", help=f"draw figures from one or more run files ({docs_path('plots.md')})")
-    p.add_argument("files", nargs="+", metavar="FILE", help="run files (HDF5); several: one curve set per file")
+    p.add_argument("files", nargs="+", metavar="FILE",
+                   help="run files (HDF5); several: one curve set per file (a tube's run file: one, alone)")
     p.add_argument("--what", required=True, type=_kinds, metavar="KIND[,KIND...]",
                    help=f"what to draw, one figure per kind: {', '.join(PLOT_KINDS)}; of a tube's run file: "
-                        "pressure-volume, profiles, front, stretches, modes, onset")
+                        "pressure-volume, profiles, front, stretches, modes, onset (docs/tubes.md)")
     p.add_argument("-o", "--output", help=f"image file, {', '.join(IMAGE_FORMATS)} (default: "
                                           "FIRST_FILE_STEM_KIND.png next to the first file; with several kinds: "
                                           "OUTPUT_STEM_KIND.SUFFIX; an existing file is replaced only with --force)")
     p.add_argument("--force", action="store_true", help="replace existing image files")
     p.add_argument("--points", type=_indices, metavar="I,J,K",
-                   help="point indices for shapes, stresses, field, curvature (negative: from the end); one "
-                        "index for surface and stretch-map (default: point 1 of the surface branch)")
+                   help="point indices for shapes, stresses, field, curvature and a tube's profiles, front, "
+                        "stretches (negative: from the end); one index for surface and stretch-map (default: point 1 "
+                        "of the surface branch); a tube's modes: indices of the located m >= 1 zeros")
     p.add_argument("--branch", metavar="NAME",
-                   help="branch to draw (default: every branch for pressure-* and energy, the first surface branch "
-                        "for surface and stretch-map, primary for the others)")
+                   help="branch to draw (default: every branch for pressure-*, energy and a tube's "
+                        "pressure-volume, the first surface branch for surface and stretch-map, a tube's bulge for "
+                        "its other kinds, primary for the others)")
     p.add_argument("--stability", default=None, metavar="READING",
                    help="what solid (stable) and dashed (unstable) mean: pressure (held at the centre, pressure "
                         "control), volume, gas, free, free-volume, free-gas, or axisymmetric (the paper's: m = 0 "
-                        "modes only); default: the run's loading.control, held")
+                        "modes only); a tube's: pressure, volume or gas; default: the run's loading.control, held")
     p.add_argument("--width", type=float, metavar="INCHES",
                    help="figure width in inches, its height in proportion (a journal's: 3.5 one column, "
-                        "7.2 two; default: each kind's own, 6.4 to 12); titles and legends fitted to it")
+                        "7.2 two; default: each kind's own, 6.4 to 12, a tube's 3.5); titles and legends fitted "
+                        "to it")
     p.add_argument("--dpi", type=int, metavar="N", help="resolution of PNG, JPEG and TIFF images (default: the "
                                                         "journal style's 300)")
     p.set_defaults(handler=plot)
@@ -710,7 +722,7 @@ def _add_critical(commands):
     p = commands.add_parser(
         "critical", help="continue the first pear pitchfork in a second parameter (M, alpha1, a material parameter; "
                          "two-parameter continuation) and report the critical value where the isola's two "
-                         "pitchforks merge",
+                         "pitchforks merge; on a tube, the onset of bulging in M or the voltage",
         description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in the second "
                     "parameter: any runtime parameter of the scene's kernels, named by its scene key (field.M or M, "
                     "field.chi, material.parameters.Jm, material.mu[0], material.alpha[0]) or alpha1 (with mu1 "
@@ -721,7 +733,10 @@ def _add_critical(commands):
                     "value (no pear pitchfork or fold, or the curve ended otherwise: one line says how and where; the "
                     "curve file is still written). Exit 2: a scene this command cannot handle (--of BP: not "
                     "equator-symmetric; --parameter M without coils), a parameter the scene does not have, or bad "
-                    "input.")
+                    "input. On a tube: its first odd branch point, the onset of bulging, followed in M or the voltage "
+                    "(--of BP only), written with the primary branch to a tube run file; exit 0 where the onset "
+                    "turns back in the parameter (its largest or smallest value printed), 1 where it does not "
+                    "(docs/tubes.md).")
     p.add_argument("scene", help=f"{SCENE_HELP}; with --of BP equator-symmetric: coils mirror-symmetric about z = 0")
     p.add_argument("--parameter", required=True, help="the second parameter (a scene key, e.g. M, alpha1, "
                                                        "material.parameters.Jm, voltage; on a tube M, voltage or "
@@ -1093,7 +1108,8 @@ def _asymmetry(scene) -> str:
 # --- sweep -------------------------------------------------------------------------------------------------
 
 def _add_sweep(commands):
-    p = commands.add_parser("sweep", help="run a scene over a grid of parameter values into one sweep file")
+    p = commands.add_parser("sweep", help="run a scene of any shape over a grid of parameter values into one sweep "
+                                          "file")
     p.add_argument("scene", help=f"{SCENE_HELP}; the base scene")
     p.add_argument("--vary", action="append", required=True, metavar="KEY=SPEC",
                    help="KEY=START:STOP:num=COUNT (or START:STOP:COUNT, or linspace(START, STOP, COUNT): COUNT "

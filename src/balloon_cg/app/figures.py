@@ -12,8 +12,9 @@ from pathlib import Path
 
 from ..io.output import IMAGE_FORMATS, check_output, replacing
 from ..io.run_file import read_run, stored_scene
+from ..post.fit import MAX_WIDTH, MIN_WIDTH
 from ..post.paper import TWO_COLUMNS, draw_figure, figures
-from ..post.plotting import MAX_WIDTH, MIN_WIDTH, Reading
+from ..post.plotting import Reading
 from .api import analyse
 from .progress import shown
 

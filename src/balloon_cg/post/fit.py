@@ -1,16 +1,21 @@
 """Text that stays inside a figure at a journal width (3.5 in one column, 7.2 in two), measured rather than
 guessed: ``fit_titles`` wraps each panel title to the room it has and the figure's title to the figure's width;
 ``fitted_legend`` gives a figure legend as many columns as fit across the figure (one column: its labels
-wrapped). Both need a figure with a renderer (``style.JournalFigure``: the Agg canvas).
+wrapped); ``fit_with_legend`` keeps a panel's legend inside it only where it hides nothing drawn. All need a figure
+with a renderer (``style.JournalFigure``: the Agg canvas).
 """
 import re
 import textwrap
+import warnings
 
+import numpy as np
+from matplotlib.path import Path
 from matplotlib.text import Text
 
 from .labels import relabel
 
 MIN_CHARS = 12  # the narrowest wrap tried, characters per line
+MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (as ``figure --width``)
 
 
 def wrap_to(text: Text, width: float, along: str = "width") -> None:
@@ -115,3 +120,47 @@ def fit_width(fig, width: float) -> None:
     fit_titles(fig)
     relabel(fig)
 
+
+def fit_with_legend(fig, ax, width: float, **options) -> None:
+    """Fit ``fig`` to ``width`` inches (``fit_width``) with ``ax``'s legend (its handles and labels, ``options``) at
+    matplotlib's best place inside the panel, or, where that place hides anything drawn there after the layout
+    (``covers``: a curve, a marker, a special point's label), under the panels (``fit_width``'s figure legend)."""
+    handles, labels = ax.get_legend_handles_labels()
+    for other in fig.axes:  # a twin's curves (twinx) belong to the same legend
+        if other is not ax and other.bbox.bounds == ax.bbox.bounds:
+            more = other.get_legend_handles_labels()
+            handles, labels = handles + more[0], labels + more[1]
+    if not labels:
+        fit_width(fig, width)
+        return
+    legend = ax.legend(handles, labels, loc="best", **options)
+    fit_width(fig, width)
+    if covers(legend, ax):
+        legend.remove()
+        fig.legend(handles, labels, **options)
+        fit_width(fig, width)
+
+
+def covers(legend, ax) -> bool:
+    """Whether ``legend``, drawn in ``ax`` (laid out first), reaches out of it or covers a vertex or a segment of a
+    line drawn in it or in its twins (the Axes at its place: twinx), curves, markers and leaders, or one of their
+    texts (the special points' labels)."""
+    with warnings.catch_warnings():  # a trial layout of a figure the caller is still building (a panel grid half
+        warnings.simplefilter("ignore", UserWarning)  # drawn may collapse): its warnings are theirs when they draw it
+        ax.figure.draw_without_rendering()
+    frame, box = legend.get_window_extent(), ax.get_window_extent()
+    if frame.x0 < box.x0 or frame.x1 > box.x1 or frame.y0 < box.y0 or frame.y1 > box.y1:
+        return True
+    twins = [other for other in ax.figure.axes if other.bbox.bounds == ax.bbox.bounds]
+    for line in (line for other in twins for line in other.get_lines()):
+        xy = line.get_transform().transform(line.get_xydata())
+        gaps = ~np.isfinite(xy).all(axis=1)  # NaN: a break in the line (an unstable part drawn by another)
+        for piece in (piece[~gap] for piece, gap in zip(np.split(xy, np.flatnonzero(gaps)),
+                                                         np.split(gaps, np.flatnonzero(gaps)))):
+            x, y = piece.T
+            if ((x > frame.x0) & (x < frame.x1) & (y > frame.y0) & (y < frame.y1)).any():
+                return True
+            if len(piece) > 1 and Path(piece).intersects_bbox(frame, filled=False):
+                return True
+    return any(frame.overlaps(text.get_window_extent()) for other in twins for text in other.texts
+               if text.get_visible() and text.get_text())

@@ -93,9 +93,17 @@ def _allocate(ax, points) -> None:
     with contextlib.redirect_stdout(io.StringIO()):  # textalloc prints when no label fits (stdout is the CLI's)
         _, _, labels, leaders = textalloc.allocate(
             ax, x, y, texts, x_scatter=[float(m.get_xdata()[0]) for m in markers],
-            y_scatter=[float(m.get_ydata()[0]) for m in markers], x_lines=[c.get_xdata() for c in curves],
-            y_lines=[c.get_ydata() for c in curves], textsize=LABEL_SIZE, textcolor=colors, linecolor=colors,
+            y_scatter=[float(m.get_ydata()[0]) for m in markers], x_lines=[_in_data(ax, c)[:, 0] for c in curves],
+            y_lines=[_in_data(ax, c)[:, 1] for c in curves], textsize=LABEL_SIZE, textcolor=colors, linecolor=colors,
             linewidth=0.4, draw_all=False, avoid_label_lines_overlap=True, avoid_crossing_label_lines=True)
     for artist in [*labels, *leaders]:
         if artist is not None:  # a label with no free place (draw_all=False): none drawn
             artist.set_gid(GID)
+
+
+def _in_data(ax, line):
+    """The points of ``line`` in ``ax``'s data coordinates (textalloc reads them so): a line drawn in other
+    coordinates (``axhline``'s x in the Axes' fraction: Maxwell's pressure) moved into them."""
+    if line.get_transform() is ax.transData:
+        return line.get_xydata()
+    return ax.transData.inverted().transform(line.get_transform().transform(line.get_xydata()))

@@ -26,7 +26,6 @@ field in I/(4π R0).
 import contextvars
 import enum
 import re
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,7 +38,7 @@ from matplotlib.ticker import MaxNLocator
 from scipy.interpolate import PchipInterpolator
 
 from .quantities import branch_discretisation, postprocess, surface
-from .fit import NARROW, fit_width, fitted_size
+from .fit import MAX_WIDTH, MIN_WIDTH, NARROW, covers, fit_width, fitted_size
 from .labels import label_points
 from .style import JournalFigure, journal_style
 from ..analysis.results import Block
@@ -455,7 +454,6 @@ def sized(figsize):
     return figsize if width is None or figsize is None else fitted_size(figsize, width)
 
 
-MIN_WIDTH, MAX_WIDTH = 1.0, 40.0  # inches: a figure's width (as ``figure --width``)
 
 
 def _draw(sources, what, points, branch, axes, stability) -> Figure:
@@ -519,22 +517,6 @@ def _legend(fig, axes, own: bool, loc: str, **options):
         depth = (ax.get_window_extent().y0 - ax.get_tightbbox().y0) / fig.dpi  # inches: its tick and axis labels
         below = ax.transAxes + matplotlib.transforms.ScaledTranslation(0.0, -depth, fig.dpi_scale_trans)
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, borderaxespad=0.3, **options)
-
-
-def covers(legend, ax) -> bool:
-    """Whether ``legend``, drawn in ``ax`` (laid out first), reaches out of it or covers a vertex of its curves or
-    one of its texts."""
-    with warnings.catch_warnings():  # a trial layout of a figure the caller is still building (a panel grid half
-        warnings.simplefilter("ignore", UserWarning)  # drawn may collapse): its warnings are theirs when they draw it
-        ax.figure.draw_without_rendering()
-    frame, box = legend.get_window_extent(), ax.get_window_extent()
-    if frame.x0 < box.x0 or frame.x1 > box.x1 or frame.y0 < box.y0 or frame.y1 > box.y1:
-        return True
-    for line in ax.get_lines():
-        x, y = line.get_transform().transform(line.get_xydata()).T
-        if ((x > frame.x0) & (x < frame.x1) & (y > frame.y0) & (y < frame.y1)).any():
-            return True
-    return any(frame.overlaps(text.get_window_extent()) for text in ax.texts if text.get_visible())
 
 
 def _suptitle(fig, axes, own: bool, text: str):

@@ -4,9 +4,19 @@ arclengths S, and the bulge's front, its position and width along the deformed a
 On the tube R = 1, S' = 1, so λ2 = ρ (hoop) and λ1 = sqrt(ρ'² + η'²) (axial, along the meridian), ' = d/dS; with
 x = 2S/L − 1, d/dS = (2/L) d/dx of the Legendre series (the derivative of the discretisation's ``profile``).
 
-A front joins a bulged part (ρ high) to an unbulged one (ρ low). Its position is the height z where ρ crosses the
+Along the deformed axis every figure reads the distance z = η(0) − η(S) from the end S = 0 (``along``): a bulge
+branch's bulge forms there (sliding ends: the plane of symmetry of a longer tube), so z is also the distance from the
+bulge's middle.
+
+A front joins a bulged part (ρ high) to an unbulged one (ρ low). Its position is the distance z where ρ crosses the
 mid level (ρ_max + ρ_min)/2, its width w = (ρ_max − ρ_min)/max|dρ/dz|: for ρ = c + b tanh((z − z_f)/δ) the
-position z_f and the width 2δ.
+position z_f and the width 2δ. A profile has a front only where it crosses its mid level once (a bump at a coil in
+the middle crosses it twice: two fronts, none singled out) and the front is narrower than each part it joins: the
+parts, the profile beyond half a width on either side of z_f, each at least w long (z_f ± 1.5 w inside the tube).
+Near a bulge's onset the profile is the mode cos(πS/L) over the whole tube, its mid-level crossing at the middle
+with a width 2ℓ/π (ℓ the deformed length), which shrinks to a front's as the bulge localises while V/V0 hardly
+changes: drawn against V/V0 that was a spike, and it is no front (nor, in a coil's field, the bump at the coil on
+its way to the end).
 """
 from dataclasses import dataclass
 
@@ -40,30 +50,42 @@ def stretches(disc, u: np.ndarray, s: np.ndarray) -> tuple:
 
 
 def front(z: np.ndarray, rho: np.ndarray) -> Front:
-    """The front of the profile ρ(z) sampled at increasing or decreasing heights z (module docstring): the mid-level
-    crossing by linear interpolation between the samples that bracket it (the first, from the largest ρ's side),
-    the largest slope by central differences (np.gradient). A uniform profile (ρ_max − ρ_min ≤ 1e-12 ρ_max) has
-    none: position and width NaN."""
+    """The front of the profile ρ(z) sampled at increasing or decreasing z (module docstring): the mid-level crossing
+    by linear interpolation between the two samples that bracket it, the largest slope by central differences
+    (np.gradient). None (position and width NaN) where the profile is uniform (ρ_max − ρ_min ≤ 1e-12 ρ_max), crosses
+    its mid level more than once, or leaves a part shorter than the width (module docstring)."""
     z, rho = np.asarray(z, dtype=float), np.asarray(rho, dtype=float)
     high, low = rho.max(), rho.min()
+    none = Front(np.nan, np.nan, float(low), float(high))
     if high - low <= 1e-12 * abs(high):
-        return Front(np.nan, np.nan, float(low), float(high))
-    middle, top = 0.5 * (high + low), int(np.argmax(rho))
-    below = np.flatnonzero(rho < middle)
-    after = below[below > top]
-    i = after[0] if after.size else below[below < top][-1] + 1  # ρ[i − 1] ≥ middle > ρ[i] or the reverse
-    j = i - 1
+        return none
+    middle = 0.5 * (high + low)
+    crossings = np.flatnonzero(np.diff(rho >= middle))
+    if crossings.size != 1:
+        return none
+    j = crossings[0]
+    i = j + 1
     position = z[j] + (middle - rho[j]) * (z[i] - z[j]) / (rho[i] - rho[j])
-    return Front(float(position), float((high - low) / np.abs(np.gradient(rho, z)).max()), float(low), float(high))
+    width = (high - low) / np.abs(np.gradient(rho, z)).max()
+    if not (z.min() + 1.5 * width <= position <= z.max() - 1.5 * width):
+        return none
+    return Front(float(position), float(width), float(low), float(high))
+
+
+def along(disc, u: np.ndarray, s: np.ndarray) -> tuple:
+    """(z, ρ): the distance z = η(0) − η(s) along the deformed axis from the end S = 0 and the radius ρ of the tube's
+    state u at reference arclengths s (module docstring)."""
+    rho, eta = disc.profile(u, np.concatenate([[0.0], np.asarray(s, dtype=float)]))
+    return eta[0] - eta[1:], rho[1:]
 
 
 def fronts(disc, states) -> tuple:
-    """Per state u of ``states``: (its front in the reference arclength S, its front along the deformed axis measured
-    from the end η(0)), each ``front`` of the profile sampled at SAMPLES evenly spaced S."""
+    """Per state u of ``states``: (its front in the reference arclength S, its front along the deformed axis, at the
+    distance z from the end S = 0: ``along``), each ``front`` of the profile sampled at SAMPLES evenly spaced S."""
     s = np.linspace(0.0, disc.length, SAMPLES)
     reference, deformed = [], []
     for u in states:
-        rho, eta = disc.profile(u, s)
+        z, rho = along(disc, u, s)
         reference.append(front(s, rho))
-        deformed.append(front(eta[0] - eta, rho))
+        deformed.append(front(z, rho))
     return reference, deformed

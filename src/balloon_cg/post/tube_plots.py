@@ -1,22 +1,27 @@
 """What people look at on a tube (a tube run file, io/tube_file.py), in the journal style: P against V/V0 of every
-branch with Maxwell's line (``pressure_volume``), the family of profiles r(Z) of a branch (``profiles``), the bulge's
+branch with Maxwell's line (``pressure_volume``), the family of profiles r(z) of a branch (``profiles``), the bulge's
 front, its position and width against V/V0 (``front_motion``), and the hoop and axial stretches along the deformed
 axis at a few states (``stretch_profiles``; post/tube_measures.py measures both), the critical modes of a
 branch's located m ≥ 1 zeros (``critical_modes``), and the onset curve of ``critical`` (``onset_curve``: the onset's
-P and largest hoop stretch against its parameter).
+P and largest hoop stretch against its parameter). Profiles, stretches and the front read one axial coordinate, the
+distance z along the deformed axis from the end S = 0 (tube_measures.along: where a bulge forms), the modes its
+reference S: every figure has that end on the left.
 
 Curves are solid where a point is stable under the chosen control (default: the run's loading.control; no negative
 eigenvalue of the second variation under it: the file's ``unstable_pressure``/``unstable_volume``/``unstable_gas``,
 tube/stability.py) and dashed where it is not; located points are marked and labelled with the number ``inspect``
-lists and ``continue`` takes ("1 BP odd", post/labels.py: clear of one another and of the curves); titles are
-wrapped to the figure (post/fit.py).
+lists and ``continue`` takes ("1 BP odd", post/labels.py: clear of one another and of the curves), placed once the
+figure is laid out at its width; titles are wrapped to the figure, and a legend stays inside the panel only where it
+hides nothing drawn, else it goes under it (post/fit.fit_with_legend). Legend entries follow the labels: the primary
+branch, then each switched branch in the order of the label of its branch point ("bulge" from 1, "bulge_2" from 2,
+…, "bulge_10" from 10: the names are the labels ``continue`` takes, never renumbered).
 """
 import numpy as np
 
-from .fit import fit_titles
+from .fit import MAX_WIDTH, MIN_WIDTH, fit_with_legend
 from .labels import label_points
 from .style import JournalFigure, journal_style
-from .tube_measures import SAMPLES, fronts, stretches
+from .tube_measures import SAMPLES, along, fronts, stretches
 from ..io.tube_file import discretisation, tube_labels
 from ..tube.azimuthal import mode_profile
 
@@ -25,6 +30,9 @@ CONTROLS = ("pressure", "volume", "gas")
 PROFILES = 8  # profiles drawn along a branch unless the points are given
 STRETCHED = 3  # states whose stretches are drawn unless the points are given
 _COLOURS = {"primary": "k", "bulge": "C0"}
+DISTANCE = "$z$, from the end $S = 0$"  # the axial coordinate of profiles, stretches and the front (module docstring)
+VOLUME = "$V/V_0$"
+PROFILE_KEY = f"point: {VOLUME}, $P$"  # the title of the profiles' legend, its entries "26: 2.81, 1.241"
 
 
 class TubePlotError(ValueError):
@@ -37,6 +45,9 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
     reading (None: the run's loading.control)."""
     if what not in TUBE_KINDS:
         raise TubePlotError(f"--what {what}: not drawn for a tube run file; allowed: {', '.join(TUBE_KINDS)}")
+    if not MIN_WIDTH <= width <= MAX_WIDTH:
+        raise TubePlotError(f"--width {width:g}: must be in [{MIN_WIDTH:g}, {MAX_WIDTH:g}] inches (3.5 one column, "
+                            "7.2 two)")
     control = run["attrs"]["control"] if control is None else control
     if control not in CONTROLS:
         raise TubePlotError(f"--stability {control}: allowed for a tube: {', '.join(CONTROLS)}")
@@ -57,7 +68,7 @@ def tube_figure(run: dict, what: str, control: str | None = None, branch: str | 
             draw = {"profiles": profiles, "front": front_motion, "stretches": stretch_profiles,
                     "modes": critical_modes}[what]
             draw(ax, run, name, points)
-        fit_titles(fig)
+        fit_with_legend(fig, ax, width, **({"title": PROFILE_KEY} if what == "profiles" else {}))
     return fig
 
 
@@ -67,7 +78,7 @@ def pressure_volume(ax, run: dict, control: str) -> None:
     Maxwell's pressure as a dotted line where the file has one."""
     others = iter(f"C{k}" for k in range(1, 10_000))  # a colour of its own for every other switched branch
     colours = {}
-    for name, b in sorted(run["branches"].items(), key=lambda item: item[0] != "primary"):
+    for name, b in sorted(run["branches"].items(), key=_born):
         colour = colours[name] = _COLOURS.get(name) or next(others)
         _curve(ax, b, control, colour, name)
     marks = []
@@ -77,7 +88,7 @@ def pressure_volume(ax, run: dict, control: str) -> None:
                       colours[name]))
     for name, b in run.get("surface_branches", {}).items():
         colour = next(others)
-        _curve(ax, b, control, colour, f"{name} (m = {b['attrs']['m']})", 0.8)
+        _curve(ax, b, control, colour, f"{name} ($m$ = {b['attrs']['m']})", 0.8)
         for index, pressure in b["folds"]:
             ax.plot(b["volume"][index], pressure, "o", color=colour, markersize=3)
             ax.annotate("LP", (b["volume"][index], pressure), textcoords="offset points", xytext=(3, 3), fontsize=6)
@@ -85,65 +96,76 @@ def pressure_volume(ax, run: dict, control: str) -> None:
     if np.isfinite(maxwell):
         ax.axhline(maxwell, color="0.4", linestyle=":", linewidth=0.8, label=f"Maxwell $P_M$ = {maxwell:.5g}")
     ax.set_xscale("log")
-    ax.set_xlabel("$V/V_0$")
+    ax.set_xlabel(VOLUME)
     ax.set_ylabel("$P$")
     ax.set_title(f"{run['attrs']['scene_name']} (solid: stable under {control} control)")
-    ax.legend()
     label_points(marks)
 
 
+def _born(item) -> tuple:
+    """The legend's order of a branch (name, group): the primary branch, then by the label of the branch point it was
+    switched at (its ``parent_label``), then by name."""
+    name, b = item
+    return name != "primary", int(b["attrs"].get("parent_label", -1)), name
+
+
 def profiles(ax, run: dict, name: str, points=None) -> None:
-    """The profiles r(Z) (ρ against the height η, both over the reference radius) of branch ``name`` at
-    ``points`` (indices, negative from the end; default: PROFILES spread along the branch), coloured by V/V0."""
+    """The profiles r(z) (the radius ρ against the distance z along the deformed axis from the end S = 0, both over
+    the reference radius) of branch ``name`` at ``points`` (indices, negative from the end; default: PROFILES spread
+    along the branch), coloured by V/V0; each labelled with its index, V/V0 and P (PROFILE_KEY)."""
     b = run["branches"][name]
     disc = discretisation(run["attrs"], b["attrs"])
     chosen = _chosen(len(b["pressure"]), name, points, PROFILES)
     s = np.linspace(0, disc.length, 401)
     colours = matplotlib_colours(len(chosen))
     for colour, i in zip(colours, chosen):
-        rho, eta = disc.profile(b["unknowns"][i], s)
-        ax.plot(eta, rho, color=colour, label=f"{i}: V/V0 = {b['volume'][i]:.3g}, P = {b['pressure'][i]:.4g}")
-    ax.set_xlabel("$Z$")
+        ax.plot(*along(disc, b["unknowns"][i], s), color=colour,
+                label=f"{i}: {b['volume'][i]:.3g}, {b['pressure'][i]:.4g}")
+    ax.set_xlabel(DISTANCE)
     ax.set_ylabel("$r$")
     ax.set_title(f"{run['attrs']['scene_name']}: profiles of the {name} branch")
-    ax.legend(fontsize=5)
 
 
 def front_motion(ax, run: dict, name: str, points=None) -> None:
-    """The front of branch ``name``'s profiles at ``points`` (default: every point with a front) against V/V0: its
-    position along the deformed axis from the branch's end η(0) (left axis) and its width (right axis), as
-    tube_measures.front measures them; a branch whose profiles are all uniform has none (TubePlotError)."""
+    """The front of branch ``name``'s profiles at ``points`` (default: every point) against V/V0, as
+    tube_measures.front measures it: its position z_f, the distance along the deformed axis from the end S = 0
+    (left axis), and its width w (right axis); the points whose profile has no front (uniform, a bump, or a front
+    wider than either part: near the onset) are not drawn, their V/V0 range shaded "no front"; a branch with no front
+    at any of them has none to draw (TubePlotError)."""
     b = run["branches"][name]
     chosen = _chosen(len(b["pressure"]), name, points, len(b["pressure"]))
     _, deformed = fronts(discretisation(run["attrs"], b["attrs"]), b["unknowns"][chosen])
     position, width = (np.array([getattr(f, key) for f in deformed]) for key in ("position", "width"))
     if np.isnan(position).all():
-        raise TubePlotError(f"--what front: the {name} branch's profiles are uniform at the points drawn (no front)")
+        raise TubePlotError(f"--what front: the {name} branch's profiles have no front at the points drawn (uniform, "
+                            "a bump, or no part as long as the front is wide)")
     volume = b["volume"][chosen]
-    ax.plot(volume, position, color="C0")
-    ax.set(xlabel="$V/V_0$", title=f"{run['attrs']['scene_name']}: the front of the {name} branch")
-    ax.set_ylabel("position, from the branch's end", color="C0")
+    ax.plot(volume, position, color="C0", label="position $z_f$")
+    ax.set(xlabel=VOLUME, title=f"{run['attrs']['scene_name']}: the front of the {name} branch")
+    ax.set_ylabel("position $z_f$, from the end $S = 0$", color="C0")
     widths = ax.twinx()
-    widths.plot(volume, width, color="C1")
-    widths.set_ylabel("width", color="C1")
+    widths.plot(volume, width, color="C1", label="width $w$")
+    widths.set_ylabel("width $w$", color="C1")
+    none = volume[np.isnan(position)]
+    if none.size:
+        ax.axvspan(none.min(), none.max(), color="0.9", zorder=0, label="no front")
 
 
 def stretch_profiles(ax, run: dict, name: str, points=None) -> None:
-    """The hoop stretch λ2 (solid) and the axial stretch λ1 (dashed) along the deformed axis, from the branch's
-    end η(0), of branch ``name`` at ``points`` (default: STRETCHED spread along the branch), coloured by V/V0."""
+    """The hoop stretch λ2 (solid) and the axial stretch λ1 (dashed) against the distance z along the deformed axis
+    from the end S = 0 (as ``profiles``), of branch ``name`` at ``points`` (default: STRETCHED spread along the
+    branch), coloured by V/V0."""
     b = run["branches"][name]
     disc, s = discretisation(run["attrs"], b["attrs"]), np.linspace(0.0, run["attrs"]["length"], SAMPLES)
     chosen = _chosen(len(b["pressure"]), name, points, STRETCHED)
     for colour, i in zip(matplotlib_colours(len(chosen)), chosen):
         u = b["unknowns"][i]
         axial, hoop = stretches(disc, u, s)
-        z = disc.profile(u, s)[1]
-        z = z[0] - z
-        ax.plot(z, hoop, color=colour, label=f"$\\lambda_2$, V/V0 = {b['volume'][i]:.3g}")
-        ax.plot(z, axial, color=colour, linestyle="--", label=f"$\\lambda_1$, V/V0 = {b['volume'][i]:.3g}")
-    ax.set(xlabel="distance from the branch's end", ylabel="stretch",
+        z = along(disc, u, s)[0]
+        ax.plot(z, hoop, color=colour, label=f"$\\lambda_2$, {VOLUME} = {b['volume'][i]:.3g}")
+        ax.plot(z, axial, color=colour, linestyle="--", label=f"$\\lambda_1$, {VOLUME} = {b['volume'][i]:.3g}")
+    ax.set(xlabel=DISTANCE, ylabel="stretch",
            title=f"{run['attrs']['scene_name']}: hoop (solid) and axial (dashed) stretch, {name} branch")
-    ax.legend(fontsize=5)
 
 
 def critical_modes(ax, run: dict, name: str, points=None) -> None:
@@ -162,10 +184,9 @@ def critical_modes(ax, run: dict, name: str, points=None) -> None:
         m, p = located[k]
         for values, style, part in zip(mode_profile(disc, p["mode"], s), ("-", "--", ":"), "RTZ"):
             ax.plot(s, values, color=colour, linestyle=style,
-                    label=f"${part}$, m = {m}{' held' if p['held'] else ''}, P = {p['pressure']:.6g}")
+                    label=f"${part}$, $m$ = {m}{' held' if p['held'] else ''}, $P$ = {p['pressure']:.6g}")
     ax.set(xlabel="$S$", ylabel="amplitude ($\\frac{1}{2}\\int (R^2 + T^2 + Z^2)\\,dS = 1$)",
            title=f"{run['attrs']['scene_name']}: critical modes, {name} branch")
-    ax.legend(fontsize=5)
 
 
 def onset_curve(ax, run: dict) -> None:

@@ -16,7 +16,7 @@ control in n = P V (LN: tube/control.py) located by the tracer's fold monitors, 
 kind of states (``Side`` changes sign: the bulge has filled the tube and the branch meets the primary branch again at
 another branch point of the block, the other end of the pitchfork's loop, where P and V are again even in the arclength:
 the monitors' sign changes in that last step are that symmetry, not folds, and are not kept), its V reaches
-``continuation.stop_volume`` (or the argument ``stop_volume`` in V/V0; the end landed there exactly:
+``continuation.stop_volume`` (or the argument ``stop_volume``, the same V/R0³; the end landed there exactly:
 tube/control.VolumeStop), its largest hoop stretch ``stop_stretch``, in a coil field where its states turn compressed
 (IntervalStop.COMPRESSED: tube/stability.CompressionStop), where a point's Legendre tail passes ``max_error`` when one
 is given (IntervalStop.UNRESOLVED: that point is not stored, nor a fold located in the step to it; tube/resolution.py
@@ -64,8 +64,9 @@ class BranchStartError(ArithmeticError):
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None,
                  max_error: float | None = None, on=None) -> IntervalBranch:
-    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: V/V0 where
-    it ends (None: the scene's continuation.stop_volume, V/R0³, if any); ``step``: the first arclength step (None:
+    """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: the
+    enclosed volume V/R0³ where it ends, as the scene key (None: the scene's continuation.stop_volume, if any; V/V0 = v
+    is v·πL on a tube of length L); ``step``: the first arclength step (None:
     continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it;
     ``max_error``: stop where a point's Legendre tail passes it (None: no check); ``on``: the discretisation the
     branch is traced on (None: the primary's; else at an odd branch point a spectral-element layout of the same
@@ -104,7 +105,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
 
     compressed = CompressionStop(eq, in_field(scene))
     compressed(u)
-    target = scene.continuation.stop_volume if stop_volume is None else stop_volume * np.pi * disc.length
+    target = scene.continuation.stop_volume if stop_volume is None else stop_volume
     volume_stop = VolumeStop(target, system)
 
     def stop(p):
