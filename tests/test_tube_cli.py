@@ -189,21 +189,22 @@ def test_profiles_stretches_and_front_share_one_axis(bulged_file):
 
 
 @pytest.mark.parametrize("width", [3.5, 7.2])
-def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, width):
+def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, width, tmp_path_factory):
     """At one and two columns, every tube figure laid out at its width: the special points' labels clear of one
     another, of the title, the axis labels and the legend; a legend left inside its panel hides no curve, marker or
     label (post/fit.covers; P against V/V0 at 3.5 in had its legend over the primary branch); every legend entry and
     axis label writes V/V0 as the axis does, $V/V_0$, never a plain "V/V0"; no label box crosses a curve, Maxwell's
-    line included (textalloc read its x, the Axes' fraction, as data: "6 BP odd" lay on it)."""
+    line included (textalloc read its x, the Axes' fraction, as data: "6 BP odd" lay on it); the onset curve of a
+    ``critical`` file likewise."""
     from matplotlib.path import Path as Segments
 
     from balloon_cg.post.fit import covers
     from balloon_cg.post.labels import GID
     from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
 
-    run = read_tube_run(bulged_file)
+    run, critical = read_tube_run(bulged_file), read_tube_run(tube_critical_file(tmp_path_factory))
     for kind in TUBE_KINDS:
-        fig = tube_figure(run, kind, width=width)
+        fig = tube_figure(critical if kind == "onset" else run, kind, width=width)
         fig.draw_without_rendering()
         legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend() is not None)]
         for legend in (ax.get_legend() for ax in fig.axes if ax.get_legend() is not None):
