@@ -15,7 +15,8 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model import meridian
 from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics.continuation import Stop
-from ..numerics.eigen import GramFactor, negative_count, restricted
+from ..numerics.banded import BandedInertia
+from ..numerics.eigen import DenseLDLT, GramFactor, negative_count, restricted
 from ..scene.loading import Control
 
 COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the stresses are O(1)) is compression
@@ -24,18 +25,36 @@ COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the
 def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
     """{Control: the number of negative eigenvalues of the second variation at each Y = (u, P) of ``points``
     (``params``: the branch's, P replaced): ∂R/∂u (pressure), on δV = 0 (volume), H + (P/Ṽ) g gᵀ (gas)} (module
-    docstring)."""
+    docstring), all three from one LDLᵀ of H (numerics/banded.BandedInertia: on g⊥ one fewer where gᵀH⁻¹g < 0,
+    with the rank-one term one fewer where 1 + (P/Ṽ) gᵀH⁻¹g < 0; Haynsworth's inertia additivity); where H is
+    singular (a zero pivot), g = 0, P < 0 or 1 + (P/Ṽ) gᵀH⁻¹g = 0, by the restricted and updated matrices' own
+    factorisations."""
     counts = {control: [] for control in Control}
     free = eq.disc.free
     unit = GramFactor(np.ones(free.size), orthogonal=True)
     for Y in points:
         at = params.with_value("P", Y[-1])
         H = eq.jacobian(Y[:-1], at)[np.ix_(free, free)]
-        counts[Control.PRESSURE].append(negative_count(H))
         gradient = -eq.parameter_derivative(Y[:-1], at, "P")[free]
-        counts[Control.VOLUME].append(negative_count(restricted(H, unit, gradient[None, :])))
-        counts[Control.GAS].append(negative_count(H + Y[-1] / eq.volume(Y[:-1]) * np.outer(gradient, gradient)))
+        weight = Y[-1] / eq.volume(Y[:-1])
+        counts_of = _counts_by_one_factor(H, gradient, weight)
+        values = counts_of or (negative_count(H), negative_count(restricted(H, unit, gradient[None, :])),
+                               negative_count(H + weight * np.outer(gradient, gradient)))
+        for control, value in zip((Control.PRESSURE, Control.VOLUME, Control.GAS), values):
+            counts[control].append(value)
     return {control: np.array(values, dtype=int) for control, values in counts.items()}
+
+
+def _counts_by_one_factor(H: np.ndarray, gradient: np.ndarray, weight: float) -> tuple | None:
+    """(pressure, volume, gas) counts from the LDLᵀ of H (``unstable_counts``), None where it does not decide them."""
+    factor = DenseLDLT(H)
+    norm = float(np.linalg.norm(gradient))
+    if factor.singular or norm == 0.0 or weight < 0.0:
+        return None
+    inertia = BandedInertia(factor)
+    volume = inertia.of(gradient[None, :] / norm, None)[0]
+    gas = inertia.of(np.zeros((0, H.shape[0])), (gradient, weight))[0]
+    return None if gas is None else (factor.negatives, volume, gas)
 
 
 def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray, params: Parameters) -> np.ndarray:
