@@ -207,6 +207,10 @@ class Equilibrium:
     def jacobian(self, u, params: Parameters) -> np.ndarray:
         return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
+    def hessian_product(self, u, params: Parameters, w: np.ndarray) -> np.ndarray:
+        """J w = (∂R/∂u) w without assembling J (an interval discretisation's ``hessian_product``)."""
+        return self.disc.hessian_product(self._pointwise("energy_hessian", u, params), w)
+
     def derivative_kernel(self, name: str) -> str | None:
         """The generated kernel of ∂π̂/∂s_k∂name for the runtime scalar ``name`` (``DERIVATIVE_KERNELS``, else
         ``NAME_gradient``), or None if the scene's class has none."""

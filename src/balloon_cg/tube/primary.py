@@ -69,6 +69,17 @@ class TubeSystem:
     def jacobian(self, X):
         return self.system.jacobian(self.full(X))[np.ix_(self.unknowns, self.columns)]
 
+    def jacobian_vector(self, X, v):
+        """J(X) v = (∂R/∂u v_u + ∂R/∂P v_P)[unknowns] without assembling J (Equilibrium.hessian_product): the
+        tracer's tangent refined on the corrector's factors (numerics/continuation.tangent)."""
+        Y, direction = self.full(X), np.zeros(self.fixed.size)
+        direction[self.columns] = v
+        system = self.system
+        at = system.params_at(Y)
+        product = system.eq.hessian_product(Y[:-1], at, direction[:-1])
+        product += direction[-1] * system.eq.parameter_derivative(Y[:-1], at, system.name)
+        return product[self.unknowns]
+
 
 def in_field(scene) -> bool:
     """Whether coils act on the tube (field.M > 0 and at least one coil)."""
