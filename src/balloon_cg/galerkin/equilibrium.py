@@ -239,6 +239,13 @@ class Equilibrium:
         self.parameter_derivative(u, params, name, out[:, n])
         return out
 
+    def sparse_jacobian(self, u, params: Parameters, name: str | None = None):
+        """``jacobian`` (or with ``name``, ``bordered_jacobian``) as a scipy.sparse matrix, for a discretisation with
+        a sparse Hessian (spectral elements: ``sparse_hessian``)."""
+        pointwise = self._pointwise("energy_hessian", u, params)
+        column = None if name is None else self.parameter_derivative(u, params, name)
+        return self.disc.sparse_hessian(pointwise, column)
+
     def volume(self, u) -> float:
         """Enclosed volume / (2π) (``enclosed_volume``)."""
         return enclosed_volume(self.disc, u, self._radius)
