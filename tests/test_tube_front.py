@@ -7,19 +7,25 @@ import numpy as np
 import pytest
 from numpy.polynomial import legendre
 
+from balloon_cg.analysis.branches.problem import ParameterSystem
 from balloon_cg.analysis.branches.resolution import Resolution
 from balloon_cg.analysis.results import Kind
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation
 from balloon_cg.galerkin.interval_elements import collocated, element_interval
 from balloon_cg.model import tube
+from balloon_cg.numerics.newton import SparseFactors
 from balloon_cg.scene import parse_scene
+from balloon_cg.scene.loading import Control
+from balloon_cg.scene.tables import Ends
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.front import front_bulge, refined_layout
-from balloon_cg.tube.primary import primary_branch
+from balloon_cg.tube.primary import TubeSystem, held, primary_branch
+from balloon_cg.tube.stability import arrow_factor, unstable_counts
 from test_tube_maxwell import LENGTH, check_chain, maxwell, ogden_1972_tube  # noqa: F401 (the fixture)
 
 BOUNDS = (-0.6, -0.1, 0.3, 0.75)
+PRESSURE = 3.0  # the pressure term makes the Hessian of the test states indefinite
 
 
 def random_state(disc, seed=2):
@@ -72,7 +78,7 @@ def test_split_layout_holds_the_state_and_uniform_tube_is_exact():
 def test_element_energy_and_its_derivatives():
     """A state of the Legendre series of degree 7 (tested against the energy written in tests/test_interval.py) is
     one of elements of order 8 (``collocated``): E/(2π) and V/(2π) equal the series' (both quadratures fine enough
-    to be exact to rounding: 1e-13 relative); R = ∂E/∂u and J = ∂R/∂u (the sparse products) against central
+    to be exact to rounding: 1e-13 relative); R = ∂E/∂u and J = ∂R/∂u (element by element) against central
     differences, J symmetric."""
     scene = ogden_1972_tube(20)
     series = IntervalDiscretisation(7, LENGTH, quadrature=120)
@@ -94,6 +100,52 @@ def test_element_energy_and_its_derivatives():
     difference = np.column_stack([(on_elements.residual(moved + h * e, P) - on_elements.residual(moved - h * e, P))
                                   / (2 * h) for e in np.eye(disc.size)])
     assert np.abs(J - difference).max() <= 1e-7 * np.abs(J).max()
+
+
+@pytest.mark.parametrize("ends, stretch", [("sliding", None), ("sliding", 1.1), ("plugged", None)])
+def test_sparse_and_arrow_factors_are_the_dense_ones(ends, stretch):
+    """The fast paths on elements against the dense matrices they stand for, at a state with negative eigenvalues:
+    the sparse bordered Jacobian equals the dense one (to rounding), J v without J equals J v, SuperLU's bordered
+    solve the dense solve; the Hessian on the free unknowns in ``arrow_order`` is banded with half-bandwidth 2p + 1
+    but for its last (global) columns, and the arrow LDLᵀ's inertia is numpy's eigenvalues' count and its solve H⁻¹r;
+    the three unstable counts equal the counts of eigvalsh of H, of H on g⊥ (a null-space basis) and of
+    H + (P/Ṽ) g gᵀ."""
+    scene = ogden_1972_tube(20)
+    disc = element_interval(LENGTH, 6, BOUNDS, Ends(ends), axial_stretch=stretch)
+    eq = Equilibrium(scene, disc)
+    rng = np.random.default_rng(7)
+    free = disc.free
+    u = disc.reference() * 1.5 + 0.05 * rng.standard_normal(disc.size)
+    P = Parameters(PRESSURE)
+    system = TubeSystem(ParameterSystem(eq, P, "P"), free, held(disc))
+    X = np.append(u, PRESSURE)[system.columns]
+    u = system.full(X)[:-1]  # held ends: λ̄ at its distance
+    J = system.jacobian(X)
+    dense = eq.bordered_jacobian(u, P, "P")[np.ix_(free, system.columns)]
+    assert np.abs(J.toarray() - dense).max() <= 1e-13 * np.abs(dense).max()
+    v = rng.standard_normal(X.size)
+    assert np.abs(system.jacobian_vector(X, v) - dense @ v).max() <= 1e-13 * np.abs(dense).max() * np.abs(v).max()
+    row, rhs = rng.standard_normal(X.size), rng.standard_normal(X.size)
+    solved = SparseFactors(J, row).solve(rhs)
+    assert np.allclose(solved, np.linalg.solve(np.vstack([dense, row]), rhs), rtol=0, atol=1e-10 * np.abs(solved).max())
+    H = eq.jacobian(u, P)[np.ix_(free, free)]
+    order, local, width = disc.arrow_order(free)
+    assert width == 2 * disc.order + 1
+    rows, columns = np.nonzero(H[np.ix_(order, order)][:local, :local])
+    assert np.abs(rows - columns).max() == width
+    arrow = arrow_factor(eq.sparse_jacobian(u, P), free, (order, local, width))
+    assert arrow.negatives == np.count_nonzero(np.linalg.eigvalsh(H) < 0) > 0
+    r = rng.standard_normal(free.size)
+    x = np.empty(free.size)
+    x[order] = arrow.solve(r[order])
+    assert np.abs(H @ x - r).max() <= 1e-9 * np.abs(r).max()
+    g = -eq.parameter_derivative(u, P, "P")[free]
+    weight = PRESSURE / eq.volume(u)
+    basis = np.linalg.svd(g[None, :])[2][1:].T  # an orthonormal basis of g⊥
+    expected = [np.count_nonzero(np.linalg.eigvalsh(M) < 0)
+                for M in (H, basis.T @ H @ basis, H + weight * np.outer(g, g))]
+    counts = unstable_counts(eq, [np.append(u, PRESSURE)], Parameters(0.0))
+    assert [int(counts[c][0]) for c in (Control.PRESSURE, Control.VOLUME, Control.GAS)] == expected
 
 
 @pytest.mark.slow

@@ -207,6 +207,10 @@ class Equilibrium:
     def jacobian(self, u, params: Parameters) -> np.ndarray:
         return self.disc.hessian(self._pointwise("energy_hessian", u, params))
 
+    def hessian_product(self, u, params: Parameters, w: np.ndarray) -> np.ndarray:
+        """J w = (∂R/∂u) w without assembling J (an interval discretisation's ``hessian_product``)."""
+        return self.disc.hessian_product(self._pointwise("energy_hessian", u, params), w)
+
     def derivative_kernel(self, name: str) -> str | None:
         """The generated kernel of ∂π̂/∂s_k∂name for the runtime scalar ``name`` (``DERIVATIVE_KERNELS``, else
         ``NAME_gradient``), or None if the scene's class has none."""
@@ -234,6 +238,13 @@ class Equilibrium:
         self.disc.hessian(self._pointwise("energy_hessian", u, params), out)
         self.parameter_derivative(u, params, name, out[:, n])
         return out
+
+    def sparse_jacobian(self, u, params: Parameters, name: str | None = None):
+        """``jacobian`` (or with ``name``, ``bordered_jacobian``) as a scipy.sparse matrix, for a discretisation with
+        a sparse Hessian (spectral elements: ``sparse_hessian``)."""
+        pointwise = self._pointwise("energy_hessian", u, params)
+        column = None if name is None else self.parameter_derivative(u, params, name)
+        return self.disc.sparse_hessian(pointwise, column)
 
     def volume(self, u) -> float:
         """Enclosed volume / (2π) (``enclosed_volume``)."""

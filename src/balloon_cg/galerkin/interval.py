@@ -154,6 +154,14 @@ class IntervalDiscretisation:
         scaled = h[:, 0, :, None] * maps[j][0] + h[:, 1, :, None] * maps[j][1]  # Σ_l W h_kl T_l
         return maps[i].reshape(-1, maps[i].shape[2]).T @ scaled.reshape(-1, maps[j].shape[2])
 
+    def hessian_product(self, pointwise: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """(∂²E/∂u²) w = Σ_kl T_kᵀ diag(W h_kl) T_l w without the matrix: the node values T w (``node_state``, the
+        plugged ends' constant taken off), h_kl applied at each node, then ``gradient``."""
+        change = self.node_state(w)
+        if self.ends == Ends.PLUGGED:
+            change[0] -= 1.0
+        return self.gradient(np.einsum("klq,lq->kq", pointwise[_HESSIAN_ROW], change))
+
     def uniform(self, hoop: float, axial: float) -> np.ndarray:
         """u of the uniform tube with sliding ends: λ2 = λθ, η = −λz(S − L/2)."""
         if self.ends != Ends.SLIDING:

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .discretisation import gauss_nodes, geometric_tail, read_only
-from .interval import IntervalDiscretisation
+from .interval import _HESSIAN_ROW, IntervalDiscretisation
 from .legendre import gauss_rule, legendre_table
 from ..scene.tables import Ends
 
@@ -94,11 +94,83 @@ class ElementInterval(IntervalDiscretisation):
         ones = np.ones((x.size, 1))
         return np.hstack([ones, x[:, None], axial]), np.hstack([0 * ones, ones, daxial]), axial, daxial
 
+    def node_state(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """(λ2, v, η, w) at the nodes, (4, n_q), element by element on ``_local_maps`` (the dense maps, 4 n_q
+        columns of E p + 1 values each, are read from memory at every call: ~10 ms at E p = 400)."""
+        out = np.empty((4, self.x.size)) if out is None else out
+        k = self.axial_index
+        for group, (rows, coefficients) in enumerate(((slice(0, 2), u[:k]), (slice(2, 4), u[k:]))):
+            columns, local = _local_maps(self)[group]
+            values = np.einsum("ekqc,ec->keq", local, coefficients[columns])
+            out[rows] = values.reshape(2, -1)
+        if self.ends == Ends.PLUGGED:
+            out[0] += 1.0
+        return out
+
+    def gradient(self, pointwise: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """∂E/∂u = Σ_q W_q Σ_k ∂π̂/∂s_k T_k[q] element by element (``node_state``), added into the columns."""
+        weighted = (pointwise * self.weights).reshape(4, self.count, -1)
+        out = np.empty(self.size) if out is None else out
+        k = self.axial_index
+        for group, (rows, columns) in enumerate(((slice(0, 2), slice(0, k)), (slice(2, 4), slice(k, self.size)))):
+            index, local = _local_maps(self)[group]
+            parts = np.einsum("keq,ekqc->ec", weighted[rows], local)
+            out[columns] = np.bincount(index.ravel(), parts.ravel(), minlength=columns.stop - columns.start)
+        return out
+
     def hessian_block(self, i: int, j: int, h: np.ndarray) -> np.ndarray:
-        """interval.py's block product on sparse maps (CSR): each node reads its element's p + 1 functions and the
-        two global ones, so a block costs O(n_q p²), not O(n_q (E p)²)."""
-        maps = _sparse_maps(self)  # ((λ2, v), (η, w)): CSR (n_q, columns) each
-        return sum(maps[i][a].T @ maps[j][b].multiply(h[a, b][:, None]) for a in (0, 1) for b in (0, 1)).toarray()
+        """interval.py's block product element by element (``_element_blocks``), the blocks added into their
+        columns: O(n_q p²), not O(n_q (E p)²)."""
+        index, shape = _block_index(self, i, j)
+        return np.bincount(index, self._element_blocks(i, j, h).ravel(), minlength=shape[0] * shape[1]).reshape(shape)
+
+    def _element_blocks(self, i: int, j: int, h: np.ndarray) -> np.ndarray:
+        """(E, m_i, m_j): block e is Σ_kl T_ekᵀ diag(W h_kl) T_el on its ``_local_maps`` columns (the nodes of element
+        e read only its p + 1 functions and the global ones); ``h`` (2, 2, n_q) the weighted h_kl."""
+        (_, left), (_, right) = _local_maps(self)[i], _local_maps(self)[j]
+        count, _, nodes, _ = left.shape
+        h = h.reshape(2, 2, count, nodes).transpose(2, 0, 1, 3)  # (E, k, l, q)
+        scaled = h[:, :, 0, :, None] * right[:, None, 0] + h[:, :, 1, :, None] * right[:, None, 1]  # (E, k, q, m_j)
+        return left.reshape(count, 2 * nodes, -1).transpose(0, 2, 1) @ scaled.reshape(count, 2 * nodes, -1)
+
+    def sparse_hessian(self, pointwise: np.ndarray, column: np.ndarray | None = None):
+        """∂²E/∂u² (``hessian``) as a scipy.sparse CSC matrix from the element blocks, O(E p²) entries (a sliding tube's
+        2E p + 1 unknowns couple only within an element but for 1, x and λ̄), with ``column`` appended as its last
+        column if given (a bordered Jacobian's ∂R/∂P): for numerics/newton.SparseFactors."""
+        from scipy import sparse  # here: a sphere's `run` imports this module (io/tube_file) but never scipy.sparse
+        weighted = pointwise * self.weights
+        blocks = [self._element_blocks(i, j, weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]).ravel()
+                  for i, j in ((0, 0), (0, 1), (1, 1))]
+        entry, indices, indptr = _sparse_pattern(self)
+        data = np.bincount(entry, np.concatenate([blocks[0], blocks[1], blocks[1], blocks[2]]), minlength=indices.size)
+        shape = (self.size, self.size)
+        if column is not None:
+            data, indices = np.concatenate([data, column]), np.concatenate([indices, np.arange(self.size)])
+            indptr, shape = np.append(indptr, indptr[-1] + self.size), (self.size, self.size + 1)
+        return sparse.csc_matrix((data, indices, indptr), shape=shape)
+
+    def arrow_order(self, unknowns: np.ndarray) -> tuple:
+        """(order, local, bandwidth): the positions in ``unknowns`` (indices into u) laid out so that the Hessian on
+        them is an arrow (numerics/band_ldlt.ArrowLDLT): its first ``local`` rows banded with half-bandwidth
+        ``bandwidth`` (the columns of one element, ``_local_maps``, within it of each other), the global columns (1,
+        x and λ̄: on every element, where there are more than two) last. Each local column goes with the last element
+        it lies on, after the ones it shares with the element before (a bound's hats, then the bubbles): 2p + 1."""
+        k = self.axial_index
+        maps = _local_maps(self)
+        elements = [np.concatenate([hoop, axial + k]) for hoop, axial in zip(maps[0][0], maps[1][0])]
+        first, last = np.full(self.size, self.count), np.full(self.size, -1)
+        for e, columns in enumerate(elements):
+            first[columns] = np.minimum(first[columns], e)
+            last[columns] = np.maximum(last[columns], e)
+        overall = (first == 0) & (last == self.count - 1) & (self.count > 2)
+        ranked = np.lexsort((first[unknowns], last[unknowns]))
+        banded = ~overall[unknowns[ranked]]
+        order = np.concatenate([ranked[banded], ranked[~banded]])
+        local = int(banded.sum())
+        position = np.full(self.size, -1)
+        position[unknowns[order[:local]]] = np.arange(local)
+        width = max(int(np.ptp(p[p >= 0])) for p in (position[c] for c in elements) if np.any(p >= 0))
+        return order, local, width
 
     def block(self, mirror):
         raise ValueError("spectral elements over a tube have no mirror blocks (their bounds need not be "
@@ -154,12 +226,50 @@ def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterva
 
 
 @functools.lru_cache(maxsize=16)
-def _sparse_maps(disc: ElementInterval) -> tuple:
-    """((λ2, v) of λ2's coefficients, (η, w) of (λ̄, b)): the node maps as CSR matrices (n_q, columns)."""
-    from scipy import sparse  # here: a sphere's `run` imports this module (io/tube_file) but never scipy.sparse
+def _local_maps(disc: ElementInterval) -> tuple:
+    """Per column group (0: λ2's coefficients, read by (λ2, v); 1: (λ̄, b), by (η, w)): (columns (E, m), maps
+    (E, 2, n_e, m)): the columns whose functions are not zero on element e (its hats, bubbles and the global ones)
+    and their values at its n_e nodes (the rule's nodes run element by element); rows padded to the largest m with
+    a column of zero values."""
     tables = disc.tables
-    return tuple(tuple(sparse.csr_matrix(maps[a]) for a in (0, 1))
-                 for maps in (tables["hoop_maps"], tables["axial_maps"]))
+    out = []
+    for maps in (tables["hoop_maps"], tables["axial_maps"]):
+        per_element = maps.reshape(2, disc.count, -1, maps.shape[2])
+        columns = [np.flatnonzero(np.any(per_element[:, e] != 0.0, axis=(0, 1))) for e in range(disc.count)]
+        width = max(c.size for c in columns)
+        index = np.zeros((disc.count, width), dtype=int)
+        local = np.zeros((disc.count, 2, per_element.shape[2], width))
+        for e, c in enumerate(columns):
+            index[e, : c.size] = c
+            local[e, :, :, : c.size] = per_element[:, e][:, :, c]
+        out.append((read_only(index), read_only(local)))
+    return tuple(out)
+
+
+@functools.lru_cache(maxsize=16)
+def _block_index(disc: ElementInterval, i: int, j: int) -> tuple:
+    """(the flat positions of the element blocks' entries in the (i, j) block of the Hessian, its shape)."""
+    (rows, _), (columns, _) = _local_maps(disc)[i], _local_maps(disc)[j]
+    k = disc.axial_index
+    shape = tuple(k if g == 0 else disc.size - k for g in (i, j))
+    return read_only((rows[:, :, None] * shape[1] + columns[:, None, :]).ravel()), shape
+
+
+@functools.lru_cache(maxsize=16)
+def _sparse_pattern(disc: ElementInterval) -> tuple:
+    """(entry, indices, indptr): the CSC pattern of ``sparse_hessian`` and the position in it of each entry of the
+    element blocks (0, 0), (0, 1), their transpose and (1, 1), raveled (padding entries hold zeros)."""
+    k, size = disc.axial_index, disc.size
+    (hoop, _), (axial, _) = _local_maps(disc)
+    offsets = {0: hoop, 1: axial + k}
+    rows, columns = [], []
+    for i, j, transpose in ((0, 0, False), (0, 1, False), (0, 1, True), (1, 1, False)):
+        a, b = np.broadcast_arrays(offsets[i][:, :, None], offsets[j][:, None, :])
+        rows.append((b if transpose else a).ravel())
+        columns.append((a if transpose else b).ravel())
+    keys, entry = np.unique(np.concatenate(columns) * size + np.concatenate(rows), return_inverse=True)
+    indptr = np.searchsorted(keys, np.arange(size + 1) * size)
+    return read_only(entry.ravel()), read_only(keys % size), read_only(indptr)
 
 
 @functools.lru_cache(maxsize=16)

@@ -100,3 +100,43 @@ def _lower_times(f, y, transpose):
             else:
                 out[j + i] += f[j, i] * y[j]
     return out
+
+
+class ArrowLDLT:
+    """The inertia and solves of a symmetric A = [[B, C], [Cᵀ, F]] whose leading block B is banded and whose border
+    (C, F: a few dense rows and columns) is not, by B's ``BandLDLT`` and the Schur complement S = F − Cᵀ B⁻¹ C:
+    In(A) = In(B) + In(S) (Haynsworth), and A⁻¹r by block elimination. The same ``negatives`` and ``solve`` as
+    BandLDLT (numerics/banded.BandedInertia reads either)."""
+
+    def __init__(self, ldlt: BandLDLT, border: np.ndarray, corner: np.ndarray):
+        self.ldlt, self.border = ldlt, border
+        self.solved = np.array([ldlt.solve(c) for c in border.T]).T.reshape(border.shape)  # B⁻¹ C
+        self.schur = corner - border.T @ self.solved
+
+    @classmethod
+    def factor(cls, band: np.ndarray, border: np.ndarray, corner: np.ndarray) -> "ArrowLDLT | None":
+        """B in lower band storage, C (n_B, k), F (k, k); None where B's LDLᵀ is refused (``BandLDLT.factor``) or S
+        is singular."""
+        ldlt = BandLDLT.factor(band)
+        if ldlt is None:
+            return None
+        arrow = cls(ldlt, border, corner)
+        values = np.linalg.eigvalsh(arrow.schur) if arrow.schur.size else np.zeros(0)
+        if np.any(values == 0.0):
+            return None
+        arrow.schur_negatives = int(np.count_nonzero(values < 0.0))
+        return arrow
+
+    @property
+    def negatives(self) -> int:
+        """The number of negative eigenvalues of A: B's and S's."""
+        return self.ldlt.negatives + self.schur_negatives
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        """A⁻¹ r: y = B⁻¹ r_B, x_F = S⁻¹(r_F − Cᵀ y), x_B = y − B⁻¹C x_F."""
+        n = self.border.shape[0]
+        y = self.ldlt.solve(r[:n])
+        if not self.schur.size:
+            return y
+        x_border = np.linalg.solve(self.schur, r[n:] - self.border.T @ y)
+        return np.concatenate([y - self.solved @ x_border, x_border])

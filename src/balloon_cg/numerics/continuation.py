@@ -21,9 +21,7 @@ import enum
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg.lapack import dgetrs
-
-from .newton import Convergence, newton
+from .newton import Convergence, SparseFactors, newton, solve_factored
 from .roots import brent
 
 
@@ -95,34 +93,36 @@ class Path:
         return self.points[fold.index].X, after.X
 
 
-def tangent(system, X, reference, factors: tuple | None = None, row: np.ndarray | None = None) -> np.ndarray:
+def tangent(system, X, reference, factors=None, row: np.ndarray | None = None) -> np.ndarray:
     """Unit null vector of J(X) oriented along ``reference``: t of A t = e_{n+1}, A = [J(X); referenceᵀ], normalised.
-    Given ``factors`` (dgetrf's LU of M = [J(X_k); rowᵀ], a corrector's at an iterate X_k near X; ``row`` its
-    bordering row, default ``reference``) and a system that applies J(X) without assembling it
+    Given ``factors`` (dgetrf's LU or newton.SparseFactors of M = [J(X_k); rowᵀ], a corrector's at an iterate X_k
+    near X; ``row`` its bordering row, default ``reference``) and a system that applies J(X) without assembling it
     (``jacobian_vector(X, v)``), by iterative refinement of [J(X); rowᵀ] t = e_{n+1} (the same null vector, scaled),
     t ← t + M⁻¹(e_{n+1} − [J(X); rowᵀ] t), which contracts as ‖I − M⁻¹[J(X); rowᵀ]‖ = O(|X − X_k|): a few
-    matrix-free products instead of an assembly and a factorisation; the dense solve where it does not reach
+    matrix-free products instead of an assembly and a factorisation; the direct solve where it does not reach
     TANGENT_TOL in TANGENT_REFINEMENTS steps."""
     if factors is not None and hasattr(system, "jacobian_vector"):
         t = _refined_tangent(system, X, reference if row is None else row, factors)
         if t is not None:
             return t if t @ reference > 0 else -t
     J = system.jacobian(X)
-    matrix = np.vstack([J, reference])
     rhs = np.zeros(J.shape[0] + 1)
     rhs[-1] = 1.0
-    t = np.linalg.solve(matrix, rhs)
+    if hasattr(J, "tocsc"):  # a sparse Jacobian (spectral elements)
+        t = SparseFactors(J, reference).solve(rhs)
+    else:
+        t = np.linalg.solve(np.vstack([J, reference]), rhs)
     return t / np.linalg.norm(t)
 
 
-def _refined_tangent(system, X, row, factors: tuple) -> np.ndarray | None:
+def _refined_tangent(system, X, row, factors) -> np.ndarray | None:
     """The unit solution of [J(X); rowᵀ] t = e_{n+1} by iterative refinement on ``factors`` (``tangent``), or None
     when a step is not below TANGENT_TOL·|t| within TANGENT_REFINEMENTS steps."""
     rhs = np.zeros(X.size)
     rhs[-1] = 1.0
-    t = dgetrs(*factors, rhs)[0]
+    t = solve_factored(factors, rhs)
     for _ in range(TANGENT_REFINEMENTS):
-        step = dgetrs(*factors, rhs - np.append(system.jacobian_vector(X, t), row @ t))[0]
+        step = solve_factored(factors, rhs - np.append(system.jacobian_vector(X, t), row @ t))
         t = t + step
         if np.linalg.norm(step) <= TANGENT_TOL * np.linalg.norm(t):
             return t / np.linalg.norm(t)

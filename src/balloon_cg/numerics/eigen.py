@@ -21,7 +21,7 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 from scipy import linalg
-from scipy.linalg.lapack import dpotrf, dpotrs, dsyevr, dsygst, dsytrf
+from scipy.linalg.lapack import dpotrf, dpotrs, dsyevr, dsygst, dsytrf, dsytrs
 
 EPS = np.finfo(float).eps
 
@@ -358,6 +358,28 @@ def negative_count(A) -> int:
     if info < 0:
         raise np.linalg.LinAlgError(f"dsytrf failed (info = {info})")
     return _block_negatives(np.ascontiguousarray(np.diag(ldu)), np.ascontiguousarray(np.diag(ldu, -1)), pivots)
+
+
+class DenseLDLT:
+    """The Bunch–Kaufman P A Pᵀ = L D Lᵀ of a dense symmetric A (LAPACK dsytrf): its inertia and A⁻¹r (dsytrs), the
+    dense sibling of band_ldlt.BandLDLT (the same ``negatives`` and ``solve``: numerics/banded.BandedInertia reads
+    either, every relative of A from the one factorisation)."""
+
+    def __init__(self, A):
+        self.ldu, self.pivots, info = dsytrf(np.array(A, order="F"), lower=1)
+        if info < 0:
+            raise np.linalg.LinAlgError(f"dsytrf failed (info = {info})")
+        self.singular = info > 0
+
+    @property
+    def negatives(self) -> int:
+        """The number of negative eigenvalues of A (Sylvester: D's)."""
+        return _block_negatives(np.ascontiguousarray(np.diag(self.ldu)), np.ascontiguousarray(np.diag(self.ldu, -1)),
+                                self.pivots)
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        """A⁻¹ r for a vector r (A not singular)."""
+        return dsytrs(self.ldu, self.pivots, r, lower=1)[0]
 
 
 @njit(cache=True)

@@ -15,7 +15,10 @@ from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model import meridian
 from ..model.stresses import dielectric_stress, elastic_stresses
 from ..numerics.continuation import Stop
-from ..numerics.eigen import GramFactor, negative_count, restricted
+from ..galerkin.interval_elements import ElementInterval
+from ..numerics.band_ldlt import ArrowLDLT
+from ..numerics.banded import BandedInertia
+from ..numerics.eigen import DenseLDLT, GramFactor, negative_count, restricted
 from ..scene.loading import Control
 
 COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the stresses are O(1)) is compression
@@ -24,18 +27,65 @@ COMPRESSED = -1e-8  # a smallest principal stress below this (units of μ/2: the
 def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
     """{Control: the number of negative eigenvalues of the second variation at each Y = (u, P) of ``points``
     (``params``: the branch's, P replaced): ∂R/∂u (pressure), on δV = 0 (volume), H + (P/Ṽ) g gᵀ (gas)} (module
-    docstring)."""
+    docstring), all three from one LDLᵀ of H (numerics/banded.BandedInertia: on g⊥ one fewer where gᵀH⁻¹g < 0,
+    with the rank-one term one fewer where 1 + (P/Ṽ) gᵀH⁻¹g < 0; Haynsworth's inertia additivity): on spectral
+    elements H's arrow (``arrow_factor``), else Bunch–Kaufman's. Where that one does not decide (the arrow's banded
+    block refused, H singular, g = 0, P < 0 or 1 + (P/Ṽ) gᵀH⁻¹g = 0) by the dense H's, restricted and updated
+    matrices' own factorisations."""
     counts = {control: [] for control in Control}
     free = eq.disc.free
     unit = GramFactor(np.ones(free.size), orthogonal=True)
+    arrow = eq.disc.arrow_order(free) if isinstance(eq.disc, ElementInterval) else None
     for Y in points:
         at = params.with_value("P", Y[-1])
-        H = eq.jacobian(Y[:-1], at)[np.ix_(free, free)]
-        counts[Control.PRESSURE].append(negative_count(H))
         gradient = -eq.parameter_derivative(Y[:-1], at, "P")[free]
-        counts[Control.VOLUME].append(negative_count(restricted(H, unit, gradient[None, :])))
-        counts[Control.GAS].append(negative_count(H + Y[-1] / eq.volume(Y[:-1]) * np.outer(gradient, gradient)))
+        weight = Y[-1] / eq.volume(Y[:-1])
+        values = _counts_by_one_factor(eq, Y[:-1], at, arrow, gradient, weight)
+        if values is None:
+            H = eq.jacobian(Y[:-1], at)[np.ix_(free, free)]
+            values = (negative_count(H), negative_count(restricted(H, unit, gradient[None, :])),
+                      negative_count(H + weight * np.outer(gradient, gradient)))
+        for control, value in zip((Control.PRESSURE, Control.VOLUME, Control.GAS), values):
+            counts[control].append(value)
     return {control: np.array(values, dtype=int) for control, values in counts.items()}
+
+
+def _counts_by_one_factor(eq: Equilibrium, u: np.ndarray, at: Parameters, arrow: tuple | None, gradient: np.ndarray,
+                          weight: float) -> tuple | None:
+    """(pressure, volume, gas) counts from one LDLᵀ of H on the free unknowns (``unstable_counts``): ``arrow`` (an
+    ElementInterval's ``arrow_order``) or None (dense); None where it does not decide them."""
+    free = eq.disc.free
+    norm = float(np.linalg.norm(gradient))
+    if norm == 0.0 or weight < 0.0:
+        return None
+    if arrow is None:
+        factor = DenseLDLT(eq.jacobian(u, at)[np.ix_(free, free)])
+        factor = None if factor.singular else factor
+    else:
+        order, _, _ = arrow
+        factor, gradient = arrow_factor(eq.sparse_jacobian(u, at), free, arrow), gradient[order]
+    if factor is None:
+        return None
+    inertia = BandedInertia(factor)
+    volume = inertia.of(gradient[None, :] / norm, None)[0]
+    gas = inertia.of(np.zeros((0, gradient.size)), (gradient, weight))[0]
+    return None if gas is None else (factor.negatives, volume, gas)
+
+
+def arrow_factor(hessian, free: np.ndarray, arrow: tuple) -> ArrowLDLT | None:
+    """The ArrowLDLT of the sparse Hessian ``hessian`` on the unknowns ``free`` laid out by ``arrow`` = (order,
+    local, bandwidth) (ElementInterval.arrow_order: the banded block first, the global columns last); None where it
+    is refused."""
+    order, local, width = arrow
+    chosen = free[order]
+    H = hessian.tocsr()[chosen][:, chosen].tocoo()
+    inside = (H.row < local) & (H.col < local) & (H.row >= H.col)
+    if np.any(H.row[inside] - H.col[inside] > width):
+        raise ValueError(f"the Hessian's banded block passes its half-bandwidth {width}")
+    band = np.zeros((width + 1, local))
+    np.add.at(band, (H.row[inside] - H.col[inside], H.col[inside]), H.data[inside])
+    border = H.tocsc()[:, local:].toarray()
+    return ArrowLDLT.factor(band, border[:local], border[local:])
 
 
 def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray, params: Parameters) -> np.ndarray:

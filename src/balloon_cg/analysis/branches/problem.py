@@ -26,6 +26,10 @@ class ParameterSystem:
     def jacobian(self, X):
         return self.eq.bordered_jacobian(X[:-1], self._at(X), self.name)
 
+    def sparse_jacobian(self, X):
+        """``jacobian`` as a scipy.sparse matrix (Equilibrium.sparse_jacobian)."""
+        return self.eq.sparse_jacobian(X[:-1], self._at(X), self.name)
+
 
 def continuation_settings(scene, max_points: int | None = None) -> continuation.Settings:
     """The continuation settings of a scene's [continuation] and [solver] tables (``max_points`` overridden)."""
