@@ -197,13 +197,16 @@ def onset_curve(ax, run: dict) -> None:
     if onset is None:
         raise TubePlotError("--what onset: the file has no onset curve (written by balloon-cg critical on a tube)")
     name = onset["attrs"]["parameter"]
+    symbol = {"axial_stretch": "$\\lambda$", "voltage": "$\\bar\\Phi$"}.get(name, name)
     ax.plot(onset["q"], onset["pressure"], color="C0")
-    for f in onset["folds"]:
+    middle = 0.5 * (np.min(onset["q"]) + np.max(onset["q"]))
+    for f in onset["folds"]:  # its text towards the middle of the curve's range: a fold in q is at one of its ends
         ax.plot(f["q"], f["pressure"], "o", color="C0", markersize=3)
-        ax.annotate(f"LP {name} = {f['q']:.5g}", (f["q"], f["pressure"]), textcoords="offset points",
-                    xytext=(3, 3), fontsize=6)
-    labels = {"axial_stretch": "$\\lambda$ (ends held at $\\lambda L$)", "voltage": "$\\bar\\Phi$"}
-    ax.set(xlabel=labels.get(name, name), title=f"{run['attrs']['scene_name']}: onset of bulging against {name}")
+        left = f["q"] > middle
+        ax.annotate(f"LP {symbol} = {f['q']:.5g}", (f["q"], f["pressure"]), textcoords="offset points",
+                    xytext=(-3 if left else 3, 3), ha="right" if left else "left", fontsize=6)
+    labels = {"axial_stretch": "$\\lambda$ (ends held at $\\lambda L$)"}
+    ax.set(xlabel=labels.get(name, symbol), title=f"{run['attrs']['scene_name']}: onset of bulging against {symbol}")
     ax.set_ylabel("onset $P$", color="C0")
     hoops = ax.twinx()
     hoops.plot(onset["q"], onset["hoop_stretch"], color="C1", linestyle="--")
