@@ -65,6 +65,8 @@ def test_help_speaks_of_every_shape():
     for name in ("run", "solve", "inspect", "plot", "sweep", "critical", "continue"):
         text = " ".join(parser.subcommands[name].format_help().split())
         assert "tube" in text, name
+    critical = " ".join(parser.subcommands["critical"].format_help().split())
+    assert all(q in critical for q in ("M", "voltage", "axial_stretch")), critical  # the tube onset's parameters
     for name in ("run", "solve", "critical"):
         assert any("tube_spom1_L10" in line for line in EXAMPLES[name]), name
     assert load_scene("tube_spom1_L10").geometry.shape == "tube" and load_scene("tube_spom1_L10_coil").field.coils

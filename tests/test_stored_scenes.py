@@ -94,3 +94,15 @@ def test_a_tube_file_whose_stop_volume_is_now_refused_is_read(tmp_path_factory, 
     text = with_stored_scene(path, stop_volume(10.0))
     read_what_it_says(path, text, capsys, tmp_path, ["1"])
     assert bc.load(path).geometry["length"] == 10.0
+
+
+def test_the_api_starts_no_run_from_a_stored_scene_a_new_run_may_not_start():
+    """A Scene read from a file's stored text (``parse_stored``: not checked as new input) handed back to the API is
+    checked as a new run's before it starts (``bc.trace`` ran such a spom1 with stop_volume 0.1 to completion)."""
+    from balloon_cg.scene.tables import parse_stored
+
+    text = stop_volume(0.1)(SPHERE)
+    with pytest.raises(SceneError, match="stop_volume"):
+        parse_scene(text)
+    with pytest.raises(SceneError, match="stop_volume"):
+        bc.trace(parse_stored(text))

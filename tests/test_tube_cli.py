@@ -161,6 +161,36 @@ def test_front_moves_away_from_the_bulge_as_it_widens(bulged_file):
     assert np.nanmax(width) < 0.3 * run["attrs"]["length"]  # the onset's mode drew 2ℓ/π, 0.64 of the length
 
 
+def test_no_front_shading_covers_only_the_points_without_one(bulged_file, monkeypatch):
+    """Front-less points on both sides of points with a front (a front reaching an end, a V folding back, --points)
+    are shaded each where they are: one band from the lowest to the highest of their V/V0 hid the fronts between."""
+    import dataclasses
+
+    from balloon_cg.post import tube_plots
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run = read_tube_run(bulged_file)
+    b = run["branches"]["bulge"]
+    fold = next(s for s in b["special_points"] if s["kind"] == "LV")
+    after = np.arange(int(fold["index"]) + 1, len(b["volume"]))
+    measured = tube_plots.fronts
+
+    def last_without(disc, states):  # the last point's front taken away: front-less points at both ends
+        reference, deformed = measured(disc, states)
+        return reference, deformed[:-1] + [dataclasses.replace(deformed[-1], position=np.nan, width=np.nan)]
+
+    monkeypatch.setattr(tube_plots, "fronts", last_without)
+    ax = tube_figure(run, "front", points=after).axes[0]
+    position = ax.lines[0].get_ydata()
+    volume = b["volume"][after]
+    with_front = volume[np.isfinite(position)]
+    assert np.isnan(position[0]) and np.isnan(position[-1]) and with_front.size > 5
+    (band,) = [c for c in ax.collections if c.get_label() == "no front"]
+    spans = [(p.vertices[:, 0].min(), p.vertices[:, 0].max()) for p in band.get_paths() if len(p.vertices)]
+    assert len(spans) >= 2
+    assert not any(lo < v < hi for v in with_front for lo, hi in spans)
+
+
 def test_profiles_stretches_and_front_share_one_axis(bulged_file):
     """The profiles, the stretches and the front read one axial coordinate, z from the end S = 0, on the same side:
     at a bulge point the profile r(z) and the hoop stretch λ2(z) (= ρ on the tube) both start at z = 0 with ρ(0), the

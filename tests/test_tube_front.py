@@ -21,7 +21,7 @@ from balloon_cg.scene.tables import Ends
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.front import front_bulge, refined_layout
 from balloon_cg.tube.primary import TubeSystem, held, primary_branch
-from balloon_cg.tube.stability import arrow_factor, unstable_counts
+from balloon_cg.tube.stability import _counts_by_one_factor, arrow_factor, unstable_counts
 from test_tube_maxwell import LENGTH, check_chain, maxwell, ogden_1972_tube  # noqa: F401 (the fixture)
 
 BOUNDS = (-0.6, -0.1, 0.3, 0.75)
@@ -144,6 +144,7 @@ def test_sparse_and_arrow_factors_are_the_dense_ones(ends, stretch):
     basis = np.linalg.svd(g[None, :])[2][1:].T  # an orthonormal basis of g⊥
     expected = [np.count_nonzero(np.linalg.eigvalsh(M) < 0)
                 for M in (H, basis.T @ H @ basis, H + weight * np.outer(g, g))]
+    assert _counts_by_one_factor(eq, u, P, (order, local, width), g, weight) is not None  # the arrow decided them
     counts = unstable_counts(eq, [np.append(u, PRESSURE)], Parameters(0.0))
     assert [int(counts[c][0]) for c in (Control.PRESSURE, Control.VOLUME, Control.GAS)] == expected
 

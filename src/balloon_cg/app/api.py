@@ -24,6 +24,7 @@ from ..io.parents import parent_label
 from ..io.run_file import RunFileError, read_run, read_run_image, run_image, stored_scene
 from ..numerics.interrupt import stop_on_signals
 from ..scene import Scene, SceneError, Shape, load_scene
+from ..scene.tables import startable
 from .progress import PhaseBars
 from .tables import SpecialPoints, counted, html_table, optional
 
@@ -310,7 +311,9 @@ class Result:
 
 
 def _scene(scene) -> Scene:
-    return scene if isinstance(scene, Scene) else load_scene(scene)
+    """A scene a new run may start: a Scene checked as new input is (``startable``: one read from a file's stored text
+    is not), or a path loaded."""
+    return startable(scene) if isinstance(scene, Scene) else load_scene(scene)
 
 
 def computed(scene: Scene, primary_only: bool = False, pear: bool = True, progress: bool = False):

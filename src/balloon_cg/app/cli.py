@@ -722,7 +722,7 @@ def _add_critical(commands):
     p = commands.add_parser(
         "critical", help="continue the first pear pitchfork in a second parameter (M, alpha1, a material parameter; "
                          "two-parameter continuation) and report the critical value where the isola's two "
-                         "pitchforks merge; on a tube, the onset of bulging in M or the voltage",
+                         "pitchforks merge; on a tube, the onset of bulging in M, the voltage or the held axial stretch",
         description="Trace the primary branch, locate its first pear-shaped pitchfork and follow it in the second "
                     "parameter: any runtime parameter of the scene's kernels, named by its scene key (field.M or M, "
                     "field.chi, material.parameters.Jm, material.mu[0], material.alpha[0]) or alpha1 (with mu1 "
@@ -733,8 +733,9 @@ def _add_critical(commands):
                     "value (no pear pitchfork or fold, or the curve ended otherwise: one line says how and where; the "
                     "curve file is still written). Exit 2: a scene this command cannot handle (--of BP: not "
                     "equator-symmetric; --parameter M without coils), a parameter the scene does not have, or bad "
-                    "input. On a tube: its first odd branch point, the onset of bulging, followed in M or the voltage "
-                    "(--of BP only), written with the primary branch to a tube run file; exit 0 where the onset "
+                    "input. On a tube: its first odd branch point, the onset of bulging, followed in M, the voltage or "
+                    "axial_stretch (the ends held apart at λL; --of BP only), written with the primary branch to a "
+                    "tube run file; exit 0 where the onset "
                     "turns back in the parameter (its largest or smallest value printed), 1 where it does not "
                     "(docs/tubes.md).")
     p.add_argument("scene", help=f"{SCENE_HELP}; with --of BP equator-symmetric: coils mirror-symmetric about z = 0")

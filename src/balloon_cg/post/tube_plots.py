@@ -146,9 +146,9 @@ def front_motion(ax, run: dict, name: str, points=None) -> None:
     widths = ax.twinx()
     widths.plot(volume, width, color="C1", label="width $w$")
     widths.set_ylabel("width $w$", color="C1")
-    none = volume[np.isnan(position)]
-    if none.size:
-        ax.axvspan(none.min(), none.max(), color="0.9", zorder=0, label="no front")
+    if np.isnan(position).any():  # each run of front-less points its own band (one band hid the fronts between)
+        ax.fill_between(volume, 0, 1, where=np.isnan(position), transform=ax.get_xaxis_transform(), step="mid",
+                        color="0.9", zorder=0, label="no front")
 
 
 def stretch_profiles(ax, run: dict, name: str, points=None) -> None:

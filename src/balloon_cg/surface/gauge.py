@@ -74,14 +74,19 @@ class Gauge:
         object.__setattr__(self, "constraints", np.array(rows).reshape(-1, self.basis.size))
 
     def _translation(self, axis: int):
-        """The constraint row ∫∫ u_axis dA (its moments: ``basis.project``), normalised, or None (not in the
-        subspace)."""
-        return self._moments(np.eye(3)[axis][:, None] * np.ones(self.basis.n_theta * self.basis.n_phi))
+        """The constraint row ∫∫ u_axis dA (dA the reference area: S' dθ sin θ dφ on a spheroid; its moments:
+        ``basis.project``), normalised, or None (not in the subspace)."""
+        return self._moments(np.eye(3)[axis][:, None] * self._area)
 
     def _rotation(self, axis: int):
         """The constraint row ∫∫ (e_axis × X) · u dA, normalised, or None when the subspace excludes it."""
         reference = self.basis.nodes["reference"][:3]
-        return self._moments(np.cross(np.eye(3)[axis][:, None], reference, axis=0))
+        return self._moments(np.cross(np.eye(3)[axis][:, None], reference, axis=0) * self._area)
+
+    @property
+    def _area(self) -> np.ndarray:
+        """The reference area element per the sphere's at the nodes (S'(θ); 1 on the sphere)."""
+        return np.repeat(self.basis.nodes["rate"], self.basis.n_phi)
 
     def _moments(self, field: np.ndarray):
         row = self.basis.project(field)
