@@ -83,3 +83,21 @@ def test_the_watchdog_fallback_exits_when_the_parent_dies(tmp_path):
             os.killpg(parent.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
+
+
+def test_a_worker_whose_parent_is_a_zombie_exits_at_once():
+    """A worker starting while its killed parent is not yet reaped (a zombie: the pid still answers ``os.kill``)
+    asked for the death signal too late: it exits at once (test_workers_exit_when_the_parent_is_killed failed once
+    under load, its workers running on after the kill: a worker's initializer ran between the kill and the reaping)."""
+    zombie = subprocess.Popen([sys.executable, "-c", "pass"])
+    deadline = time.monotonic() + 60
+    while alive(zombie.pid) and time.monotonic() < deadline:  # exited, not waited for: a zombie
+        time.sleep(0.05)
+    try:
+        assert Path(f"/proc/{zombie.pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+        worker = subprocess.run([sys.executable, "-c", "from balloon_cg.numerics.hygiene import worker_hygiene; "
+                                 f"worker_hygiene({zombie.pid}); print('running')"], capture_output=True, text=True,
+                                timeout=120)
+        assert worker.returncode == 1 and "running" not in worker.stdout, (worker.returncode, worker.stdout)
+    finally:
+        zombie.wait()

@@ -44,7 +44,10 @@ def checked(path: Path, line: str, reference: dict) -> str:
     stage = run["attrs"]["interrupted"]
     stopped = next((n for n, b in run["branches"].items() if b["attrs"]["stop_code"] == "interrupted"), None)
     stored = run["onset"] if stage == "onset" else run["branches"].get(stopped)
-    if stored is None:
+    if stage == "modes":  # after the last branch's last check: every branch whole, their m ≥ 1 blocks not read
+        assert stopped is None
+        what = "the branches whole, their m ≥ 1 blocks not read"
+    elif stored is None:
         what = "not started"
     else:
         what = f"{stored['attrs']['stop_message']}, after {len(stored['pressure'])} points"

@@ -163,7 +163,7 @@ def test_run_file_and_inspect_carry_the_branch(traced, tmp_path):
     assert "surface branch m1_bp0 (m = 1, from zero 0 of block m = 1 of primary): 4 points" in format_tube(summary)
     figure = tube_figure(read_tube_run(tmp_path / "tube.h5"), "pressure-volume")
     drawn = [line for line in figure.axes[0].lines if np.array_equal(line.get_xdata(), branch.volume)]
-    assert [line.get_label() for line in drawn][0] == "m1_bp0 (m = 1)" and len(drawn) == 2  # solid, dashed
+    assert [line.get_label() for line in drawn][0] == "m1_bp0 ($m$ = 1)" and len(drawn) == 2  # solid, dashed
     assert np.array_equal(np.fmax(drawn[0].get_ydata(), drawn[1].get_ydata()), branch.pressure)
     for extra in (coil, "[electric]\nvoltage = 0.1\n"):
         assert tube_scene(extra='[surface]\nbranches = "first"\n' + extra).surface.branches == "first"

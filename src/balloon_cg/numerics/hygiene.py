@@ -5,7 +5,7 @@ A worker whose parent is killed (SIGKILL, the OOM killer) would otherwise keep c
 pipe. On Linux the worker asks the kernel for SIGKILL when the process that started it dies
 (``prctl(PR_SET_PDEATHSIG)``: the parent with the fork start method, or the forkserver, which exits
 with it); elsewhere a daemon thread polls ``os.getppid()`` once a second. Either way the worker then exits at
-once if the parent ``pid`` died before the request was made.
+once if the parent ``pid`` died before the request was made (also where it is a zombie, not yet reaped).
 """
 import ctypes
 import ctypes.util
@@ -14,6 +14,7 @@ import signal
 import sys
 import threading
 import time
+from pathlib import Path
 
 PR_SET_PDEATHSIG = 1
 POLL_SECONDS = 1.0
@@ -41,13 +42,18 @@ def _pdeathsig() -> bool:
 
 
 def _alive(pid: int) -> bool:
+    """Whether the process ``pid`` runs: a zombie (killed, not yet reaped by its own parent) does not. A worker that
+    starts while its parent is one asked for the death signal too late, and ``os.kill`` still finds the pid."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
         return True
-    return True
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):  # no /proc (not Linux): the pid answered
+        return True
 
 
 def _watch(parent: int) -> None:
