@@ -353,11 +353,8 @@ def _ritz(alpha: np.ndarray, beta: np.ndarray, first: int, last: int) -> tuple:
 
 def negative_count(A) -> int:
     """The number of negative eigenvalues of the symmetric A (lower triangle read; kept): the inertia of its
-    Bunch–Kaufman factorisation P A Pᵀ = L D Lᵀ (LAPACK dsytrf), D of 1×1 and 2×2 blocks."""
-    ldu, pivots, info = dsytrf(np.array(A, order="F"), lower=1)
-    if info < 0:
-        raise np.linalg.LinAlgError(f"dsytrf failed (info = {info})")
-    return _block_negatives(np.ascontiguousarray(np.diag(ldu)), np.ascontiguousarray(np.diag(ldu, -1)), pivots)
+    Bunch–Kaufman factorisation P A Pᵀ = L D Lᵀ (LAPACK dsytrf), D of 1×1 and 2×2 blocks: ``DenseLDLT``'s."""
+    return DenseLDLT(A).negatives
 
 
 class DenseLDLT:
