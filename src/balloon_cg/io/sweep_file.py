@@ -332,7 +332,9 @@ def rebuilding(path, directory: Path, trusted=frozenset(), kept: bool = True):
     with interrupt.Held() as held:
         try:
             with atomic_file(path, force=True, keep_store=True) as f:
-                view = View(f, path, directory, trusted)
+                with interrupt.Held() as early:  # the stored members' copy: a signal raised after it, not in h5py
+                    early.start()
+                    view = View(f, path, directory, trusted)
                 view.kept = kept
                 try:
                     yield view
