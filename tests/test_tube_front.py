@@ -181,6 +181,39 @@ def test_refined_layout_cuts_the_elements_whose_tails_pass():
     assert refined_layout(disc, np.full((3, disc.count), 1e-10), 1e-9) == disc
 
 
+def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
+    """SPOM1, L = 10, from 4 elements of order 12 to a hoop stretch of 2.5: front_bulge refines the layout where a
+    traced point needs it (measured three times: 5, 6, then 7 elements) and continues without retracing: every
+    stored point's tail ≤ max_error; the first traced point, from the first layout, lies in that layout's space
+    (collocated there and back: 1e-12) and is its equilibrium (|R| ≤ 1e-9 there; measured 1.3e-13); the last point is
+    the last layout's (|R| ≤ 1e-9); the volume fold is where the whole branch traced from the onset on the last
+    layout (the retrace the local refinement saves, a second trace) has it: P within max(1e-9 relative, the tails of
+    the fold's neighbours) (measured 1.8e-15), V/V0 likewise (measured 0)."""
+    import balloon_cg.tube.front as front
+
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\n'
+                        'degree = 16\n')
+    primary = primary_branch(scene)
+    onset = primary.branch_points()[0]
+    counts, refined = [], front.refined_layout
+    monkeypatch.setattr(front, "refined_layout", lambda *a: counts.append((found := refined(*a)).count) or found)
+    first = front.uniform_layout(scene, 4, 12)
+    branch = front_bulge(scene, primary, onset, Resolution(1e-9, 400), layout=first, stop_stretch=2.5)
+    assert len(counts) >= 2 and counts == sorted(counts) and branch.disc.count == counts[-1]
+    assert branch.stop.code.value == "hoop_stretch" and branch.tail.max() <= 1e-9
+    on_first = collocated(branch.disc, branch.states[1], first)
+    assert np.abs(collocated(first, on_first, branch.disc) - branch.states[1]).max() <= 1e-12
+    for disc, u, P in ((first, on_first, branch.pressure[1]), (branch.disc, branch.states[-1], branch.pressure[-1])):
+        free = disc.free
+        assert np.abs(Equilibrium(scene, disc).residual(u, Parameters(P))[free]).max() <= 1e-9
+    whole = bulge_branch(scene, primary, onset, on=branch.disc, max_error=1e-9, stop_stretch=2.5)
+    (fold,), (again,) = ([s for s in b.special if s.kind == Kind.LV] for b in (branch, whole))
+    error = max(1e-9 * abs(again.pressure), *branch.tail[fold.index: fold.index + 2])
+    assert abs(fold.pressure - again.pressure) <= error
+    eq = Equilibrium(scene, branch.disc)
+    assert abs(eq.volume(fold.u) - eq.volume(again.u)) <= max(1e-9, error) * eq.volume(again.u)
+
+
 @pytest.mark.slow
 def test_resolved_bulge_reaches_maxwells_pressure_with_every_point_resolved(maxwell):  # noqa: F811
     """Ogden 1972, L = 30: the bulge on elements refined by tube/front.front_bulge to V/V0 = 52 (order 16, E p up to

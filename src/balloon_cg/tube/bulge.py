@@ -127,6 +127,9 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
             break
         system, start, step = continued
         settings, compressed = replace(settings, step=step), compressed.on(system.system.eq)
+    if len(legs) > 1 and path.stop.code == continuation.TraceStop.MAX_POINTS:  # the branch's, not the last leg's
+        legs[-1] = (system, replace(path, stop=Stop(path.stop.code, f"maximum number of points "
+                                                                    f"({settings.max_points}) reached")), volume_stop)
     return _assembled(scene, primary.params, branch_point, legs, settings, max_error)
 
 
