@@ -21,6 +21,7 @@ from balloon_cg.scene.tables import Ends
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.front import front_bulge, refined_layout
 from balloon_cg.tube.primary import TubeSystem, held, primary_branch
+from balloon_cg.tube.results import IntervalStop
 from balloon_cg.tube.stability import _counts_by_one_factor, arrow_factor, unstable_counts
 from test_tube_maxwell import LENGTH, check_chain, maxwell, ogden_1972_tube  # noqa: F401 (the fixture)
 
@@ -188,7 +189,8 @@ def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
     (collocated there and back: 1e-12) and is its equilibrium (|R| ≤ 1e-9 there; measured 1.3e-13); the last point is
     the last layout's (|R| ≤ 1e-9); the volume fold is where the whole branch traced from the onset on the last
     layout (the retrace the local refinement saves, a second trace) has it: P within max(1e-9 relative, the tails of
-    the fold's neighbours) (measured 1.8e-15), V/V0 likewise (measured 0)."""
+    the fold's neighbours) (measured 1.8e-15), V/V0 likewise (measured 0). With max_degree 60 (5 elements of order 12)
+    the branch stops UNRESOLVED at the first point that needed more, saying so, every stored point resolved."""
     import balloon_cg.tube.front as front
 
     scene = parse_scene('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\n'
@@ -200,7 +202,7 @@ def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
     first = front.uniform_layout(scene, 4, 12)
     branch = front_bulge(scene, primary, onset, Resolution(1e-9, 400), layout=first, stop_stretch=2.5)
     assert len(counts) >= 2 and counts == sorted(counts) and branch.disc.count == counts[-1]
-    assert branch.stop.code.value == "hoop_stretch" and branch.tail.max() <= 1e-9
+    assert branch.stop.code == IntervalStop.HOOP_STRETCH and branch.tail.max() <= 1e-9
     on_first = collocated(branch.disc, branch.states[1], first)
     assert np.abs(collocated(first, on_first, branch.disc) - branch.states[1]).max() <= 1e-12
     for disc, u, P in ((first, on_first, branch.pressure[1]), (branch.disc, branch.states[-1], branch.pressure[-1])):
@@ -212,6 +214,9 @@ def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
     assert abs(fold.pressure - again.pressure) <= error
     eq = Equilibrium(scene, branch.disc)
     assert abs(eq.volume(fold.u) - eq.volume(again.u)) <= max(1e-9, error) * eq.volume(again.u)
+    capped = front_bulge(scene, primary, onset, Resolution(1e-9, 60), layout=first, stop_stretch=2.5)
+    assert capped.stop.code == IntervalStop.UNRESOLVED and "solver.max_degree 60" in capped.stop.message
+    assert capped.disc.degree <= 60 and capped.tail.max() <= 1e-9 and len(capped.pressure) < len(branch.pressure)
 
 
 @pytest.mark.slow

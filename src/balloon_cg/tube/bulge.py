@@ -124,6 +124,10 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         finer = refine(system.system.eq.disc, system.full(path.overshoot.X)[:-1])
         continued = None if finer is None else _continued_on(scene, params, system, path, finer, settings)
         if continued is None:
+            if finer is not None:
+                legs[-1] = (system, replace(path, stop=Stop(path.stop.code, f"{path.stop.message}; its last point did "
+                                                            f"not converge on the refined layout ({finer.count} "
+                                                            "elements)")), volume_stop)
             break
         system, start, step = continued
         settings, compressed = replace(settings, step=step), compressed.on(system.system.eq)

@@ -70,14 +70,18 @@ def front_bulge(scene, primary, point, policy: Resolution | None = None, layout:
     bulge_branch's stop_volume, step, stop_stretch."""
     policy = Resolution.of(scene) if policy is None else policy
     disc = uniform_layout(scene, START_ELEMENTS, ORDER) if layout is None else layout
+    refused = []  # the layout a refinement would have passed max_degree with
 
-    def refine(disc: ElementInterval, u: np.ndarray) -> ElementInterval | None:
-        finer = refined_layout(disc, disc.element_tails(u)[None, :], policy.max_error)
-        return finer if finer.degree <= policy.max_degree else None
+    def refine(coarse: ElementInterval, u: np.ndarray) -> ElementInterval | None:
+        finer = refined_layout(coarse, coarse.element_tails(u)[None, :], policy.max_error)
+        if finer.degree <= policy.max_degree:
+            return finer
+        refused.append(finer)
+        return None
 
     branch = bulge_branch(scene, primary, point, max_error=policy.max_error, on=disc, refine=refine, **trace)
-    if branch.stop.code != IntervalStop.UNRESOLVED:
+    if branch.stop.code != IntervalStop.UNRESOLVED or not refused:
         return branch
-    message = (f"{branch.stop.message}: its elements refined would pass solver.max_degree {policy.max_degree} "
-               f"(elements × order {branch.disc.order}): raise it or solver.max_error")
+    message = (f"{branch.stop.message}: {refused[-1].count} elements of order {disc.order} would pass "
+               f"solver.max_degree {policy.max_degree} (elements × order): raise it or solver.max_error")
     return replace(branch, stop=Stop(IntervalStop.UNRESOLVED, message))
