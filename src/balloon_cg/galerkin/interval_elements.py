@@ -208,21 +208,22 @@ def element_interval(length: float, order: int, bounds, ends: Ends = Ends.SLIDIN
 
 
 def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterval) -> np.ndarray:
-    """u of ``disc`` (a Legendre series or another layout) on the layout ``onto`` of the same tube: λ2 and η's
-    bubble part collocated at order + 1 Gauss points of each of onto's elements and its inner bounds, by least
-    squares (exact where onto's space holds the state: the uniform tube, a layout with elements split or of a
-    higher order)."""
+    """u of ``disc`` (a Legendre series or another layout; one state or rows of states, or of tangents: the map is
+    linear) on the layout ``onto`` of the same tube: λ2 and η's bubble part collocated at order + 1 Gauss points of
+    each of onto's elements and its inner bounds, by least squares (exact where onto's space holds the state: the
+    uniform tube, a layout with elements split or of a higher order)."""
     k, onto_k = disc.axial_index, onto.axial_index
     t, _ = gauss_rule(onto.order + 1)
     edges = onto.edges
     x = np.concatenate([(edges[:-1, None] + 0.5 * np.diff(edges)[:, None] * (t[None, :] + 1.0)).ravel(), edges[1:-1]])
     hoop, _, axial, _ = disc.functions(x)
     onto_hoop, _, onto_axial, _ = onto.functions(x)
-    out = np.empty(onto.size)
-    out[:onto_k] = np.linalg.lstsq(onto_hoop, hoop @ u[:k], rcond=None)[0]
-    out[onto_k] = u[k]
-    out[onto_k + 1:] = np.linalg.lstsq(onto_axial, axial @ u[k + 1:], rcond=None)[0]
-    return out
+    rows = np.atleast_2d(u)
+    out = np.empty((rows.shape[0], onto.size))
+    out[:, :onto_k] = np.linalg.lstsq(onto_hoop, hoop @ rows[:, :k].T, rcond=None)[0].T
+    out[:, onto_k] = rows[:, k]
+    out[:, onto_k + 1:] = np.linalg.lstsq(onto_axial, axial @ rows[:, k + 1:].T, rcond=None)[0].T
+    return out.reshape(np.shape(u)[:-1] + (onto.size,))
 
 
 @functools.lru_cache(maxsize=16)
