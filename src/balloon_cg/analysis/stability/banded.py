@@ -22,7 +22,7 @@ from ...galerkin.discretisation import symmetric_rows
 from ...galerkin.equilibrium import NodeKernels, Parameters
 from ...galerkin.piecewise import PiecewiseBasis
 from ...generated import HESSIAN_PAIRS
-from ...model.meridian import mass_density
+from ...model.meridian import AZIMUTHAL, mass_density
 from ...numerics.banded import BandedShiftInvert, BandedSigns
 from .azimuthal import perturbation_map
 from .flags import EVERY_FLAG, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_GAS, HELD_VOLUME, LOWEST
@@ -152,9 +152,10 @@ class BandedVariation:
 def banded_variation(equilibrium, degree: int, symmetric: bool) -> "BandedVariation | None":
     """The banded sibling of the Legendre blocks of perturbation degree N at ``equilibrium``: elements of order
     ORDER, as many as give about ELEMENT_FUNCTIONS·N functions per field on the whole interval (half as many on the
-    half interval of an equator-symmetric state). None on a capsule's piecewise discretisation (``joins``), whose
-    m ≥ 1 blocks have their own elements."""
-    if equilibrium.disc.joins:
+    half interval of an equator-symmetric state). None on a capsule (its piecewise discretisation; of length 0, the
+    sphere's, without the m ≥ 1 mass kernel the sibling's blocks take: ``meridian.AZIMUTHAL``), whose m ≥ 1 blocks
+    have their own elements (capsule_basis.py)."""
+    if equilibrium.disc.joins or equilibrium.scene.geometry.shape not in AZIMUTHAL:
         return None
     half = symmetric and equilibrium.disc.symmetric
     elements = max(1, int(np.ceil(ELEMENT_FUNCTIONS * degree / ORDER / (2 if half else 1))))
