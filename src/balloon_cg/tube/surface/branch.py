@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .basis import TubeSurfaceBasis
-from .equilibrium import TubeSurfaceEquilibrium
+from .equilibrium import MeridianSurfaceEquilibrium
 from .resolution import MAX_DEGREE, MAX_HARMONICS, error_estimate, refined
 from .stability import SectorStability
 from .switching import SwitchedPoint, mode_row, point_at_amplitude, switched_point
@@ -82,7 +82,7 @@ class _Leg:
 
     def __init__(self, scene, basis: TubeSurfaceBasis, params: Parameters, template: np.ndarray, m: int,
                  mode: np.ndarray):
-        self.system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, basis), params, template)
+        self.system = TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, basis), params, template)
         self.basis, self.points = basis, []
         self.row = np.append(mode_row(basis, m, mode[basis.block(m)])[self.system.free],
                              [0.0] * (1 + self.system.gauged))

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .basis import TubeSurfaceBasis
-from .equilibrium import TubeSurfaceEquilibrium
+from .equilibrium import MeridianSurfaceEquilibrium
 from .system import TubeSurfaceSystem
 from .. import azimuthal
 from ...galerkin.equilibrium import Parameters
@@ -74,7 +74,7 @@ def point_at_amplitude(scene, basis: TubeSurfaceBasis, start: np.ndarray, pressu
                        max_iter: int = 30) -> SwitchedPoint:
     """The equilibrium on ``basis`` with row · c = ``amplitude`` (``mode_row``: the amplitude of order m's critical
     mode) by Newton from (``start``, ``pressure``); the held unknowns (λ̄ of ends held apart) read from ``start``."""
-    system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, basis), params, start)
+    system = TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, basis), params, start)
     result = newton(system.residual, system.jacobian, system.point(start, pressure),
                     np.append(row[system.free], [0.0] * (1 + system.gauged)), amplitude, tol, max_iter)
     c = system.coefficients(result.x)

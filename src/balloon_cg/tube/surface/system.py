@@ -14,7 +14,7 @@ X = (c_f, P). The Jacobian is exact (the surface Hessian bordered by G t and ∂
 import numpy as np
 
 from .basis import TubeSurfaceBasis
-from .equilibrium import TubeSurfaceEquilibrium
+from .equilibrium import MeridianSurfaceEquilibrium
 from .. import azimuthal
 from ...galerkin.equilibrium import Parameters
 from ...scene.tables import Ends
@@ -33,7 +33,7 @@ class TubeSurfaceSystem:
     """R(X) and its Jacobian (module docstring) of ``surface`` at ``params`` (P replaced by X[-1]); ``template``:
     the coefficients the held unknowns (λ̄ of ends held apart) are read from."""
 
-    def __init__(self, surface: TubeSurfaceEquilibrium, params: Parameters, template: np.ndarray):
+    def __init__(self, surface: MeridianSurfaceEquilibrium, params: Parameters, template: np.ndarray):
         self.surface, self.params = surface, params
         self.basis = surface.basis
         self.free = self.basis.free
