@@ -1,0 +1,108 @@
+"""The capsule over (θ, φ): the engine of tube/surface/meridian.py on a capsule's meridian, its two poles included.
+
+The coordinate is the polar angle θ ∈ [0, π] of model/meridian.py (S = κθ, κ = 1 + L/π: S' = κ; R = sin κd on the
+caps, d the angle from the nearer pole, 1 on the cylinder). Order 0 is the capsule's axisymmetric state u of its
+piecewise Discretisation (galerkin/elements.py, joined at model/meridian.joins): ρ = λ2 R, ρ' = λ2' R + λ2 R',
+η, η' from ``Discretisation.evaluate``; each m ≥ 1 order the amplitudes of the order's perturbation basis
+(analysis/stability/capsule_basis.CapsuleBasis of ``mode_degree``: caps in sin^j ψ × Jacobi, cylinder elements in
+Legendre, C⁰ joined, pole-regular: U ∈ R^(m+1), D ∈ R^(m−1), Z ∈ R^m near a pole, so a_φ = ∂x/∂φ/R is finite there).
+The quadrature is that basis' (Gauss in θ on every element, 3 n + NODE_MARGIN nodes): on it an order's block of the
+Hessian at an axisymmetric state is the capsule's m-block of analysis/stability/azimuthal.py, in the same
+coefficients. The volume is the whole enclosed one (tube/surface/volume.py's flux of x_h/2 through the closed
+surface).
+"""
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from .meridian import MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from ...analysis.stability.capsule_basis import capsule_basis
+from ...galerkin.discretisation import Discretisation
+from ...model.meridian import hoop, hoop_rate, joins, metric
+from ...scene.tables import Geometry, Shape
+
+
+@dataclass(frozen=True)
+class CapsuleSurfaceBasis(MeridianSurfaceBasis):
+    """The capsule ``geometry``'s state on ``disc`` (its joins the geometry's) and, per order m ≥ 1 in ``orders``,
+    capsule_basis(m, ``mode_degree``) on ``n_phi`` uniform nodes in φ (module docstring)."""
+
+    disc: Discretisation
+    geometry: Geometry
+    mode_degree: int
+    orders: tuple = (0, 1)
+    n_phi: int = 0
+    shape = Shape.CAPSULE
+
+    def __post_init__(self):
+        if self.geometry.shape != Shape.CAPSULE or self.disc.joins != joins(self.geometry):
+            raise ValueError(f"disc: joins {self.disc.joins} (allowed: a capsule's, {joins(self.geometry)})")
+        orders, n_phi = default_phi_nodes(self.orders, self.n_phi)
+        object.__setattr__(self, "orders", orders)
+        object.__setattr__(self, "n_phi", n_phi)
+        sizes = {self.perturbations(m).size for m in orders[1:]}
+        if len(sizes) > 1:
+            raise ValueError(f"orders: {orders} have perturbation bases of sizes {sorted(sizes)} (allowed: one size)")
+
+    def perturbations(self, m: int):
+        """The order's CapsuleBasis (its ``gram``, ``ops`` and ``displacement``)."""
+        return capsule_basis(m, self.mode_degree, self.geometry)
+
+    def rule(self) -> tuple:
+        return _rule(self.geometry, self.mode_degree)
+
+    def axis(self) -> tuple:
+        return _axis(self.disc, self.geometry, self.mode_degree)
+
+    def mode(self, m: int) -> np.ndarray:
+        return self.perturbations(m).ops
+
+    def tables(self) -> tuple:
+        return _tables(self)
+
+    def check_scene(self, scene) -> None:
+        """ValueError where the scene's capsule is not the basis'."""
+        if scene.geometry != self.geometry:
+            raise ValueError(f"basis geometry: {self.geometry.describe()} (allowed: the scene's, "
+                             f"{scene.geometry.describe()})")
+
+    @property
+    def axis_size(self) -> int:
+        return self.disc.size
+
+    @property
+    def mode_size(self) -> int:
+        return self.perturbations(self.orders[1]).size if len(self.orders) > 1 else 0
+
+    @property
+    def free(self) -> np.ndarray:
+        return np.arange(self.size)
+
+
+@functools.lru_cache(maxsize=8)
+def _rule(geometry: Geometry, degree: int) -> tuple:
+    """(W per dθ, R, R', S') at the perturbation basis' nodes (the same for every order), read-only."""
+    b = capsule_basis(1, degree, geometry)
+    out = (b.weights / b.sin_theta, np.asarray(hoop(geometry, b.x, b.sin_theta), dtype=float),
+           np.asarray(hoop_rate(geometry, b.x, b.sin_theta), dtype=float), metric(geometry, b.x, b.sin_theta))
+    for array in out:
+        array.flags.writeable = False
+    return out
+
+
+@functools.lru_cache(maxsize=8)
+def _axis(disc: Discretisation, geometry: Geometry, degree: int) -> tuple:
+    """(rows of ρ, ρ', η, η' in u at the nodes (module docstring), zero offset), read-only."""
+    theta = capsule_basis(1, degree, geometry).theta
+    lam2, dlam2, eta, deta = (values.T for values in disc.evaluate(np.eye(disc.size), theta))
+    _, R, dR, _ = _rule(geometry, degree)
+    rows = np.array([R[:, None] * lam2, R[:, None] * dlam2 + dR[:, None] * lam2, eta, deta])
+    offset = np.zeros((4, theta.size))
+    rows.flags.writeable = offset.flags.writeable = False
+    return rows, offset
+
+
+@functools.lru_cache(maxsize=8)
+def _tables(basis: CapsuleSurfaceBasis) -> tuple:
+    return meridian_tables(basis)
