@@ -4,8 +4,6 @@ Checked against the capsule's axisymmetric discretisation (its orders (0,) restr
 the capsule's own kernels, which take the pole limits symbolically where the engine divides by R at interior nodes)
 and against its m ≥ 1 blocks (analysis/stability/azimuthal.py on capsule_basis.py: the second-variation kernels
 derived for the capsule's meridian, another code path from the surface kernels' 9 node variables)."""
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,8 +15,7 @@ from balloon_cg.model import meridian
 from balloon_cg.tube.surface.capsule import CapsuleSurfaceBasis
 from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
-sys.path.insert(0, str(Path(__file__).parent))
-from test_capsule_azimuthal import capsule, random_state  # noqa: E402
+from test_capsule_azimuthal import capsule, random_state
 
 LENGTHS = (0.0, 3.0)
 FINE_RULE = 120  # Gauss nodes per piece of the axisymmetric discretisation (module docstring of the first test)
@@ -91,3 +88,87 @@ def test_what_it_does_not_take_is_refused_in_one_line():
             call()
         message = str(error.value)
         assert message.startswith(key) and "allowed" in message and "\n" not in message, message
+
+
+@pytest.fixture(scope="module")
+def switched():
+    """SPOM1 capsule of length 3 (m_max = 1, to a pole stretch of 1.3: test_capsule_azimuthal's branch), its first
+    located m1_held point (P = 1.46129) and the switched points at ε = ±0.05 on the orders (0, 1, 2)."""
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.tube.surface.capsule import switched_point
+
+    scene = capsule(3.0).with_overrides({"stability.m_max": 1, "continuation.stop_stretch": 1.3})
+    branch = analyse(scene, pear=False).branches[0]
+    bp = next(p for p in branch.special if p.kind.value == "BP" and p.block.value == "m1_held")
+    return scene, branch, bp, {eps: switched_point(scene, branch, bp, eps) for eps in (0.05, -0.05)}
+
+
+def written_energy(scene, basis, c, P, n_phi):
+    """E/(2π) of the capsule x = Σ_m (r_m cos mφ e_ρ + t_m sin mφ e_φ + z_m cos mφ e_z) of the coefficients c
+    (order 0: (λ2 R, η) of the discretisation's series, m ≥ 1: the perturbation bases' values) at the perturbation
+    basis' nodes in θ: Φ(λ1, λ2) of Ogden's moduli over the reference area κ R dθ dφ, λ1², λ2² the eigenvalues of
+    the metric over the reference's diag(κ², R²), minus P ⅓ x · (x_θ × x_φ) (the cone form of the volume, not the
+    engine's ½ x_h · n); R, R' and κ written here, the trapezoid in φ on ``n_phi`` points (the discrete energy's
+    own: at a random state of orders 0..2 the engine's E at 10, 20, 48 points is this one's to 1e-15, and 6.592136,
+    6.592207, 6.592212 across them: its φ quadrature is part of the discrete model, as the tube's)."""
+    elastic, volume = written_parts(scene, basis, c, n_phi)
+    return elastic - P * volume
+
+
+def written_parts(scene, basis, c, n_phi):
+    """(elastic E/(2π), V/(2π)) of ``written_energy``."""
+    material, kappa = scene.material, 1 + scene.geometry.length / np.pi
+    b = basis.perturbations(1)
+    theta, phi = b.theta, 2 * np.pi * np.arange(n_phi) / n_phi
+    cap = np.minimum(kappa * np.minimum(theta, np.pi - theta), np.pi / 2)
+    radius = np.sin(cap)
+    slope = np.where(cap < np.pi / 2, kappa * np.cos(cap) * np.sign(np.pi / 2 - theta), 0.0)
+    lam2, dlam2, eta, deta = basis.disc.evaluate(c[basis.block(0)], theta)
+    x = [np.outer(lam2 * radius, np.ones(n_phi)), np.zeros((theta.size, n_phi)), np.outer(eta, np.ones(n_phi))]
+    x_t = [np.outer(dlam2 * radius + lam2 * slope, np.ones(n_phi)), 0 * x[1], np.outer(deta, np.ones(n_phi))]
+    x_p = [0 * x[1], 0 * x[1], 0 * x[1]]  # ∂/∂φ of (r, t, z); the frame's turn is added below
+    for m in basis.orders[1:]:
+        Rv, dR, Zv, dZ, Tv, dT = basis.perturbations(m).values(c[basis.block(m)])
+        cos, sin = np.cos(m * phi), np.sin(m * phi)
+        for i, (value, rate, g, dg) in enumerate(((Rv, dR, cos, -m * sin), (Tv, dT, sin, m * cos),
+                                                  (Zv, dZ, cos, -m * sin))):
+            x[i] = x[i] + np.outer(value, g)
+            x_t[i] = x_t[i] + np.outer(rate, g)
+            x_p[i] = x_p[i] + np.outer(value, dg)
+    x, x_t = np.array(x), np.array(x_t)
+    x_p = np.array([x_p[0] - x[1], x_p[1] + x[0], x_p[2]])
+    r = radius[:, None]
+    a11, a12, a22 = (x_t * x_t).sum(0) / kappa**2, (x_t * x_p).sum(0) / (kappa * r), (x_p * x_p).sum(0) / r**2
+    root = np.sqrt((a11 - a22) ** 2 / 4 + a12**2)
+    l1, l2 = np.sqrt((a11 + a22) / 2 + root), np.sqrt((a11 + a22) / 2 - root)
+    elastic = sum(mu / al * (l1**al + l2**al + (l1 * l2) ** -al - 3) for mu, al in zip(material.mu, material.alpha))
+    volume = (x * np.cross(x_t, x_p, axis=0)).sum(0) / 3
+    dtheta = b.weights / np.sin(theta)
+    return dtheta @ (elastic * kappa * r).sum(1) / n_phi, dtheta @ volume.sum(1) / n_phi
+
+
+def test_a_switched_capsule_point_is_stationary_for_the_written_energy(switched):
+    """At the switched points (ε = ±0.05; Newton converged, residual ≤ 1e-10) the derivative of the written
+    energy E_el − P V along the state's own orders and random combinations of them (a 4th-order central difference,
+    h = 1e-3 of |c|) is below 1e-9 of the largest derivative of its elastic part alone (measured 6e-12); the pitchfork is
+    symmetric (P equal at ±ε, 1e-12) and bends from P_0 (P − P_0 = O(ε²) ≠ 0)."""
+    scene, branch, bp, points = switched
+    assert abs(points[0.05].pressure - points[-0.05].pressure) <= 1e-12 * bp.X[-1]
+    assert 0 < abs(points[0.05].pressure - bp.X[-1]) <= 0.01 * bp.X[-1]
+    rng = np.random.default_rng(5)
+    for point in points.values():
+        assert point.converged and point.residual <= 1e-10, point.message
+        basis, c, P = point.basis, point.c, point.pressure
+        parts = [basis.with_mode(np.zeros(basis.size), m, c[basis.block(m)]) if m else basis.axisymmetric(
+            c[basis.block(0)]) for m in basis.orders]  # smooth directions: the state's own orders (random ones of
+        #                                            the orthonormal functions of degree 135 have slopes of 1e3)
+        directions = parts + [sum(rng.standard_normal() * part for part in parts) for _ in range(2)]
+        totals, elastics = [], []
+        for d in directions:
+            d = d / np.linalg.norm(d) * np.linalg.norm(c)
+            h = 1e-3
+            values = [written_parts(scene, basis, c + k * h * d, basis.n_phi) for k in (-2, -1, 1, 2)]
+            elastic, volume = ((v[0] - 8 * v[1] + 8 * v[2] - v[3]) / (12 * h) for v in zip(*values))
+            totals.append(elastic - P * volume)
+            elastics.append(elastic)
+        assert np.max(np.abs(totals)) <= 1e-9 * np.max(np.abs(elastics)), (totals, elastics)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .meridian import NODE_VARIABLES, MeridianSurfaceBasis, default_phi_nodes, meridian_tables
-from ..azimuthal import basis_values
+from ..azimuthal import basis_values, operators, translation
 from ...galerkin.interval import IntervalDiscretisation
 from ...scene.tables import Ends, Shape
 
@@ -75,6 +75,19 @@ class TubeSurfaceBasis(MeridianSurfaceBasis):
     @property
     def axis_size(self) -> int:
         return self.disc.size
+
+    def gram(self, m: int) -> np.ndarray:
+        """The order's Gram matrix G of ‖δx‖² (tube/azimuthal.py)."""
+        return operators(self.disc)[1]
+
+    def gauge_rows(self, field: bool = False) -> np.ndarray:
+        """(rows, size): G t of the sideways translation t in order 1 on sliding ends (tube/surface/system.py), no
+        row where nothing is gauged (plugged ends, no order 1, or in a coil's ``field``)."""
+        if 1 not in self.orders or self.disc.ends != Ends.SLIDING or field:
+            return np.zeros((0, self.size))
+        row = np.zeros((1, self.size))
+        row[0, self.block(1)] = self.gram(1) @ translation(self.disc)
+        return row
 
     @property
     def mode_size(self) -> int:

@@ -12,13 +12,16 @@ coefficients. The volume is the whole enclosed one (tube/surface/volume.py's flu
 surface).
 """
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .meridian import MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from .switching import SwitchedPoint, mode_row, point_at_amplitude
 from ...analysis.stability.capsule_basis import capsule_basis
+from ...analysis.surface.branches import critical_mode, located_degree
 from ...galerkin.discretisation import Discretisation
+from ...model import meridian
 from ...model.meridian import hoop, hoop_rate, joins, metric
 from ...scene.tables import Geometry, Shape
 
@@ -79,6 +82,33 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
     def free(self) -> np.ndarray:
         return np.arange(self.size)
 
+    def gram(self, m: int) -> np.ndarray:
+        """The order's Gram matrix G of ‖δx‖² (capsule_basis.py)."""
+        return self.perturbations(m).gram
+
+    def gauge_rows(self, field: bool = False) -> np.ndarray:
+        """(rows, size): G f of the m = 1 zero modes f held (tube/surface/system.py), as quadratures
+        ½ ∫ f · δx dA of the order-1 rows: the translation along x, f = (R, T, Z) = (1, −1, 0) (the centroid held:
+        without a field a zero mode, in a coil's ``field`` the held reading), and the rotation about y of the
+        reference, f = (Z0, −Z0, −R0) (∫ (e_y × X) · x dA = 0): without a field the rigid rotation's phase, on a
+        capsule of length 0 in a field the material rotation's (a relabelling of the sphere). ValueError for a
+        capsule of length 0 without a field, where the rigid rotation and the relabelling are two zero modes this
+        one reference row cannot tell apart (the sphere's surface/gauge.py refuses them too)."""
+        if 1 not in self.orders:
+            return np.zeros((0, self.size))
+        sphere = self.geometry.length == 0
+        if sphere and not field:
+            raise ValueError("geometry.length = 0 without a field: the m = 1 rigid rotation and the relabelling "
+                             "are both zero modes (allowed: length > 0, or coils with M ≠ 0)")
+        W, R, _, rate = self.rule()
+        b = self.perturbations(1)
+        height, ones = meridian.reference_height(self.geometry, b.theta), np.ones(R.size)
+        modes = [(ones, -ones, 0 * ones)] + ([(height, -height, -R)] if sphere or not field else [])
+        rows = np.zeros((len(modes), self.size))
+        for row, mode in zip(rows, modes):
+            row[self.block(1)] = 0.5 * np.einsum("aq,q,aqj->j", np.array(mode), W * R * rate, b.ops[[0, 4, 2]])
+        return rows
+
 
 @functools.lru_cache(maxsize=8)
 def _rule(geometry: Geometry, degree: int) -> tuple:
@@ -106,3 +136,23 @@ def _axis(disc: Discretisation, geometry: Geometry, degree: int) -> tuple:
 @functools.lru_cache(maxsize=8)
 def _tables(basis: CapsuleSurfaceBasis) -> tuple:
     return meridian_tables(basis)
+
+
+def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = None, n_phi: int = 0,
+                   tol: float = 1e-12, max_iter: int = 30) -> SwitchedPoint:
+    """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
+    capsule's axisymmetric ``branch`` (analysis/results.Branch): its critical mode φ (analysis/surface/branches
+    .critical_mode of its reading at the degree it was located at, G-unit), the orders (0, m, 2m) unless ``orders``,
+    the state on the branch's discretisation made whole (not equator-symmetric: a mode odd in z breaks it);
+    solved by tube/surface/switching.point_at_amplitude (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
+    m = bp.m
+    if amplitude == 0:
+        raise ValueError("amplitude: 0 is the axisymmetric state itself (allowed: ε ≠ 0)")
+    degree = located_degree(branch, bp)
+    mode = critical_mode(branch, bp, degree)[1]
+    disc = replace(branch.disc, symmetric=False)
+    basis = CapsuleSurfaceBasis(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi)
+    mode = mode / np.sqrt(mode @ basis.gram(m) @ mode)
+    start = basis.with_mode(basis.axisymmetric(branch.disc.transfer(bp.X[:-1], disc)), m, amplitude * mode)
+    return point_at_amplitude(scene, basis, start, bp.X[-1], mode_row(basis, m, mode), amplitude, m,
+                              branch.params_at(bp.X), tol, max_iter)
