@@ -12,6 +12,7 @@ from balloon_cg.analysis.stability import azimuthal
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import meridian
+from balloon_cg.scene import parse_scene
 from balloon_cg.tube.surface.capsule import CapsuleSurfaceBasis
 from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
@@ -195,3 +196,50 @@ def test_the_mirror_sector_has_the_located_zero_and_the_switched_points_read_ali
     readings = [reader(p.c, params.with_value("P", p.pressure)) for p in points.values()]
     assert np.max(np.abs(readings[0][0] - readings[1][0])) <= 1e-9 * np.max(np.abs(readings[0][0]))
     assert readings[0][1] == readings[1][1]
+
+
+def sideways_poles(point) -> np.ndarray:
+    """(λ+, λ−): the hoop stretch |r + t_φ| (a_φ at φ = 0, π, where r_φ, t and z_φ vanish) at the material points
+    ±e_x (θ = π/2) of a switched point: the poles of a pear turned by 90° about y, where the stretch is equibiaxial."""
+    basis, c, theta = point.basis, point.c, np.array([np.pi / 2])
+    lam2 = basis.disc.evaluate(c[basis.block(0)], theta)[0][0]
+    poles = []
+    for sign in (1, -1):
+        hoop = lam2
+        for m in basis.orders[1:]:
+            full = np.zeros(basis.perturbations(m).size)
+            full[basis.kept(m)] = c[basis.block(m)]
+            R, _, T = basis.perturbations(m).displacement(full, theta)[:, 0]
+            hoop += sign**m * (R + m * T)
+        poles.append(abs(hoop))
+    return np.array(poles)
+
+
+def test_at_length_0_the_switched_m1_point_is_the_spheres_pear_turned_by_90_degrees():
+    """A capsule of length 0 is the sphere. At M = 0 the sphere's m = 1 branch born at its pear point is the pear
+    branch turned by 90° about y (tests/test_surface.py: the whole-sphere branch against it, 1e-9). The capsule's
+    switched points (ε = 0.05 and 0.1 along the m = 1 copy of its located pear point, the equator states: the mode is
+    even in z; orders 0..10) have at ±e_x the pole stretches (λ+, λ−) of the sphere's pear solved at λ2(0) = λ+
+    (test_surface.turned_pear: the sphere's own discretisation and kernels), and its P: P and λ− to 1e-8. In the
+    orders 0..K at ε = 0.05 the P differs from the pear's by −6.4e-8, −1.2e-10, −1.7e-13 at K = 4, 6, 8."""
+    from dataclasses import replace
+
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.results import Block
+    from balloon_cg.tube.surface.capsule import switched_point
+    from test_surface import turned_pear
+
+    settings = {"continuation.stop_stretch": 2.5, "stability.m_max": 1, "surface.branches": "none"}
+    sphere = analyse(parse_scene('[material]\npreset = "SPOM1"\n').with_overrides(settings))
+    pears = [b for b in sphere.branches[1:] if b.parent == ("primary", 0)]
+    scene = capsule(0.0).with_overrides(settings)
+    primary = analyse(scene, pear=False).primary
+    pear_point = next(p for p in primary.special if p.kind.value == "BP" and p.block == Block.ODD_HELD)
+    for eps in (0.05, 0.1):
+        point = switched_point(scene, primary, replace(pear_point, m=1, block=Block.M1_HELD), eps,
+                               orders=tuple(range(11)))
+        assert point.converged and point.basis.equator, point.message
+        poles = sideways_poles(point)
+        pressure, south = turned_pear(poles, pears)
+        assert abs(point.pressure - pressure) <= 1e-8 * pressure, (eps, point.pressure, pressure)
+        assert abs(poles[1] - south) <= 1e-8, (eps, poles, south)

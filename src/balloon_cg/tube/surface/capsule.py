@@ -29,22 +29,28 @@ from ...scene.tables import Geometry, Shape
 @dataclass(frozen=True)
 class CapsuleSurfaceBasis(MeridianSurfaceBasis):
     """The capsule ``geometry``'s state on ``disc`` (its joins the geometry's) and, per order m ≥ 1 in ``orders``,
-    capsule_basis(m, ``mode_degree``) on ``n_phi`` uniform nodes in φ (module docstring)."""
+    capsule_basis(m, ``mode_degree``) on ``n_phi`` uniform nodes in φ (module docstring); with ``equator`` only the
+    states even under the reflection z → −z: the disc equator-symmetric and every order's reflection class 0
+    (R, T even, Z odd under θ → π − θ: capsule_basis ``classes``), the subspace a branch born along a mode of that
+    class keeps (the products of two class-0 fields are in class 0)."""
 
     disc: Discretisation
     geometry: Geometry
     mode_degree: int
     orders: tuple = (0, 1)
     n_phi: int = 0
+    equator: bool = False
     shape = Shape.CAPSULE
 
     def __post_init__(self):
         if self.geometry.shape != Shape.CAPSULE or self.disc.joins != joins(self.geometry):
             raise ValueError(f"disc: joins {self.disc.joins} (allowed: a capsule's, {joins(self.geometry)})")
+        if self.disc.symmetric != self.equator:
+            raise ValueError(f"disc: symmetric {self.disc.symmetric} (allowed: {self.equator}, as equator)")
         orders, n_phi = default_phi_nodes(self.orders, self.n_phi)
         object.__setattr__(self, "orders", orders)
         object.__setattr__(self, "n_phi", n_phi)
-        sizes = {self.perturbations(m).size for m in orders[1:]}
+        sizes = {self.kept(m).size for m in orders[1:]}
         if len(sizes) > 1:
             raise ValueError(f"orders: {orders} have perturbation bases of sizes {sorted(sizes)} (allowed: one size)")
 
@@ -58,8 +64,13 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
     def axis(self) -> tuple:
         return _axis(self.disc, self.geometry, self.mode_degree)
 
+    def kept(self, m: int) -> np.ndarray:
+        """The columns of the order's CapsuleBasis in c: all, or with ``equator`` its class 0."""
+        b = self.perturbations(m)
+        return b.classes[0] if self.equator else np.arange(b.size)
+
     def mode(self, m: int) -> np.ndarray:
-        return self.perturbations(m).ops
+        return self.perturbations(m).ops[:, :, self.kept(m)]
 
     def tables(self) -> tuple:
         return _tables(self)
@@ -76,7 +87,7 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
 
     @property
     def mode_size(self) -> int:
-        return self.perturbations(self.orders[1]).size if len(self.orders) > 1 else 0
+        return self.kept(self.orders[1]).size if len(self.orders) > 1 else 0
 
     @property
     def free(self) -> np.ndarray:
@@ -84,7 +95,8 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
 
     def gram(self, m: int) -> np.ndarray:
         """The order's Gram matrix G of ‖δx‖² (capsule_basis.py)."""
-        return self.perturbations(m).gram
+        kept = self.kept(m)
+        return self.perturbations(m).gram[np.ix_(kept, kept)]
 
     def gauge_rows(self, field: bool = False) -> np.ndarray:
         """(rows, size): G f of the m = 1 zero modes f held (tube/surface/system.py), as quadratures
@@ -93,20 +105,23 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
         reference, f = (Z0, −Z0, −R0) (∫ (e_y × X) · x dA = 0): without a field the rigid rotation's phase, on a
         capsule of length 0 in a field the material rotation's (a relabelling of the sphere). ValueError for a
         capsule of length 0 without a field, where the rigid rotation and the relabelling are two zero modes this
-        one reference row cannot tell apart (the sphere's surface/gauge.py refuses them too)."""
+        one reference row cannot tell apart (the sphere's surface/gauge.py refuses them too); a row that vanishes on
+        the kept class is left out (``equator`` states hold no rotation about y)."""
         if 1 not in self.orders:
             return np.zeros((0, self.size))
-        sphere = self.geometry.length == 0
-        if sphere and not field:
-            raise ValueError("geometry.length = 0 without a field: the m = 1 rigid rotation and the relabelling "
-                             "are both zero modes (allowed: length > 0, or coils with M ≠ 0)")
         W, R, _, rate = self.rule()
-        b = self.perturbations(1)
+        b, kept = self.perturbations(1), self.kept(1)
         height, ones = meridian.reference_height(self.geometry, b.theta), np.ones(R.size)
-        modes = [(ones, -ones, 0 * ones)] + ([(height, -height, -R)] if sphere or not field else [])
+        translation, rotation = (0.5 * np.einsum("aq,q,aqj->j", np.array(f), W * R * rate, b.ops[[0, 4, 2]][:, :, kept])
+                                 for f in ((ones, -ones, 0 * ones), (height, -height, -R)))
+        sphere, turning = self.geometry.length == 0, np.abs(rotation).max() > 1e-12 * np.abs(translation).max()
+        if sphere and turning and not field:
+            raise ValueError("geometry.length = 0 without a field: the m = 1 rigid rotation and the relabelling "
+                             "are both zero modes (allowed: length > 0, coils with M ≠ 0, or equator states)")
+        modes = [translation] + ([rotation] if turning and (sphere or not field) else [])
         rows = np.zeros((len(modes), self.size))
         for row, mode in zip(rows, modes):
-            row[self.block(1)] = 0.5 * np.einsum("aq,q,aqj->j", np.array(mode), W * R * rate, b.ops[[0, 4, 2]])
+            row[self.block(1)] = mode
         return rows
 
 
@@ -143,15 +158,19 @@ def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = N
     """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
     capsule's axisymmetric ``branch`` (analysis/results.Branch): its critical mode φ (analysis/surface/branches
     .critical_mode of its reading at the degree it was located at, G-unit), the orders (0, m, 2m) unless ``orders``,
-    the state on the branch's discretisation made whole (not equator-symmetric: a mode odd in z breaks it);
+    on the ``equator`` states where the branch is equator-symmetric and the mode in reflection class 0 (as the
+    sphere's surface branches keep a mode's symmetry), else on the whole discretisation (a mode odd in z breaks it);
     solved by tube/surface/switching.point_at_amplitude (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
     m = bp.m
     if amplitude == 0:
         raise ValueError("amplitude: 0 is the axisymmetric state itself (allowed: ε ≠ 0)")
     degree = located_degree(branch, bp)
     mode = critical_mode(branch, bp, degree)[1]
-    disc = replace(branch.disc, symmetric=False)
-    basis = CapsuleSurfaceBasis(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi)
+    even = capsule_basis(m, degree, scene.geometry).classes[0]
+    equator = branch.disc.symmetric and np.abs(np.delete(mode, even)).max() <= 1e-10 * np.abs(mode).max()
+    disc = replace(branch.disc, symmetric=equator)
+    basis = CapsuleSurfaceBasis(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi, equator)
+    mode = mode[basis.kept(m)]
     mode = mode / np.sqrt(mode @ basis.gram(m) @ mode)
     start = basis.with_mode(basis.axisymmetric(branch.disc.transfer(bp.X[:-1], disc)), m, amplitude * mode)
     return point_at_amplitude(scene, basis, start, bp.X[-1], mode_row(basis, m, mode), amplitude, m,
