@@ -129,7 +129,9 @@ def written_parts(scene, basis, c, n_phi):
     x_t = [np.outer(dlam2 * radius + lam2 * slope, np.ones(n_phi)), 0 * x[1], np.outer(deta, np.ones(n_phi))]
     x_p = [0 * x[1], 0 * x[1], 0 * x[1]]  # ∂/∂φ of (r, t, z); the frame's turn is added below
     for m in basis.orders[1:]:
-        Rv, dR, Zv, dZ, Tv, dT = basis.perturbations(m).values(c[basis.block(m)])
+        full = np.zeros(basis.perturbations(m).size)
+        full[basis.kept(m)] = c[basis.block(m)]
+        Rv, dR, Zv, dZ, Tv, dT = basis.perturbations(m).values(full)
         cos, sin = np.cos(m * phi), np.sin(m * phi)
         for i, (value, rate, g, dg) in enumerate(((Rv, dR, cos, -m * sin), (Tv, dT, sin, m * cos),
                                                   (Zv, dZ, cos, -m * sin))):
