@@ -104,6 +104,23 @@ def switched():
     return scene, branch, bp, {eps: switched_point(scene, branch, bp, eps) for eps in (0.05, -0.05)}
 
 
+def test_on_the_whole_basis_the_rotation_is_gauged_and_the_point_is_the_same(switched):
+    """The L = 3 point's mode is even in z (the equator states, the translation alone gauged); on the whole basis (both
+    reflection classes, the disc not symmetric) the reference rotation about y is a second gauge row: Newton converges
+    to the same P (1e-10) with both reactions zero (1e-10), the state even in z (its class-1 part 1e-10 of the
+    amplitude)."""
+    from balloon_cg.tube.surface.capsule import switched_point
+
+    scene, branch, bp, points = switched
+    whole = switched_point(scene, branch, bp, 0.05, whole=True)
+    basis = whole.basis
+    assert whole.converged and not basis.equator and basis.gauge_rows(False).shape[0] == 2
+    assert abs(whole.pressure - points[0.05].pressure) <= 1e-10 * whole.pressure
+    assert abs(whole.reaction) <= 1e-10
+    odd = np.setdiff1d(np.arange(basis.mode_size), basis.perturbations(1).classes[0])
+    assert np.abs(whole.c[basis.block(1)][odd]).max() <= 1e-10 * 0.05
+
+
 def written_energy(scene, basis, c, P, n_phi):
     """E/(2π) of the capsule x = Σ_m (r_m cos mφ e_ρ + t_m sin mφ e_φ + z_m cos mφ e_z) of the coefficients c
     (order 0: (λ2 R, η) of the discretisation's series, m ≥ 1: the perturbation bases' values) at the perturbation

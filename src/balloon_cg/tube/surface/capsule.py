@@ -154,20 +154,20 @@ def _tables(basis: CapsuleSurfaceBasis) -> tuple:
 
 
 def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = None, n_phi: int = 0,
-                   tol: float = 1e-12, max_iter: int = 30) -> SwitchedPoint:
+                   tol: float = 1e-12, max_iter: int = 30, whole: bool = False) -> SwitchedPoint:
     """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
     capsule's axisymmetric ``branch`` (analysis/results.Branch): its critical mode φ (analysis/surface/branches
     .critical_mode of its reading at the degree it was located at, G-unit), the orders (0, m, 2m) unless ``orders``,
     on the ``equator`` states where the branch is equator-symmetric and the mode in reflection class 0 (as the
-    sphere's surface branches keep a mode's symmetry), else on the whole discretisation (a mode odd in z breaks it);
-    solved by tube/surface/switching.point_at_amplitude (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
+    sphere's surface branches keep a mode's symmetry), else (or ``whole``) on the whole discretisation (a mode odd in z
+    breaks it); solved by tube/surface/switching.point_at_amplitude (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
     m = bp.m
     if amplitude == 0:
         raise ValueError("amplitude: 0 is the axisymmetric state itself (allowed: ε ≠ 0)")
     degree = located_degree(branch, bp)
     mode = critical_mode(branch, bp, degree)[1]
     even = capsule_basis(m, degree, scene.geometry).classes[0]
-    equator = branch.disc.symmetric and np.abs(np.delete(mode, even)).max() <= 1e-10 * np.abs(mode).max()
+    equator = not whole and branch.disc.symmetric and np.abs(np.delete(mode, even)).max() <= 1e-10 * np.abs(mode).max()
     disc = replace(branch.disc, symmetric=equator)
     basis = CapsuleSurfaceBasis(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi, equator)
     mode = mode[basis.kept(m)]
