@@ -76,6 +76,10 @@ class TubeSurfaceBasis(MeridianSurfaceBasis):
     def axis_size(self) -> int:
         return self.disc.size
 
+    def volume_ratio(self, volume: float) -> float:
+        """V/V0 of V/(2π) = ``volume`` (V0 = πL)."""
+        return 2 * volume / self.disc.length
+
     def gram(self, m: int) -> np.ndarray:
         """The order's Gram matrix G of ‖δx‖² (tube/azimuthal.py)."""
         return operators(self.disc)[1]

@@ -16,7 +16,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .capsule_resolution import projected
 from .meridian import MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from .branch import START_AMPLITUDE, trace_from
 from .switching import SwitchedPoint, mode_row, point_at_amplitude
 from ...analysis.stability.capsule_basis import capsule_basis
 from ...analysis.surface.branches import critical_mode, located_degree
@@ -84,6 +86,26 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
     @property
     def axis_size(self) -> int:
         return self.disc.size
+
+    def volume_ratio(self, volume: float) -> float:
+        """V/V0 of V/(2π) = ``volume`` (V0 = πL + 4π/3)."""
+        return 2 * np.pi * volume / self.geometry.reference_volume
+
+    def raised(self, c: np.ndarray, to: "CapsuleSurfaceBasis") -> np.ndarray:
+        """c as coefficients of ``to`` (the same capsule, degrees and orders at least this one's): order 0
+        transferred (Discretisation.transfer: nested, exact), each m ≥ 1 order's field projected in L² on ``to``'s
+        basis (nested spaces: exact to rounding), the orders ``to`` adds zero."""
+        if not (to.geometry == self.geometry and set(self.orders) <= set(to.orders) and to.equator == self.equator
+                and to.disc.degree >= self.disc.degree and to.mode_degree >= self.mode_degree):
+            raise ValueError(f"to: degrees {to.disc.degree}, {to.mode_degree}, orders {to.orders} (allowed: the same "
+                             f"capsule, degrees ≥ {self.disc.degree}, {self.mode_degree}, orders holding {self.orders})")
+        out = np.zeros(to.size)
+        out[to.block(0)] = self.disc.transfer(c[self.block(0)], to.disc)
+        for m in self.orders[1:]:
+            full = np.zeros(self.perturbations(m).size)
+            full[self.kept(m)] = c[self.block(m)]
+            out[to.block(m)] = projected(full, self.perturbations(m).displacement, to.perturbations(m))[to.kept(m)]
+        return out
 
     @property
     def mode_size(self) -> int:
@@ -153,17 +175,14 @@ def _tables(basis: CapsuleSurfaceBasis) -> tuple:
     return meridian_tables(basis)
 
 
-def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = None, n_phi: int = 0,
-                   tol: float = 1e-12, max_iter: int = 30, whole: bool = False) -> SwitchedPoint:
-    """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
-    capsule's axisymmetric ``branch`` (analysis/results.Branch): its critical mode φ (analysis/surface/branches
-    .critical_mode of its reading at the degree it was located at, G-unit), the orders (0, m, 2m) unless ``orders``,
-    on the ``equator`` states where the branch is equator-symmetric and the mode in reflection class 0 (as the
-    sphere's surface branches keep a mode's symmetry), else (or ``whole``) on the whole discretisation (a mode odd in z
-    breaks it); solved by tube/surface/switching.point_at_amplitude (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
+def start(scene, branch, bp, orders: tuple | None = None, n_phi: int = 0, whole: bool = False) -> tuple:
+    """(the basis, the zero's c on it, the critical mode φ as c on it, G-unit) of the branch born at the located
+    m ≥ 1 point ``bp`` of the capsule's axisymmetric ``branch`` (analysis/results.Branch): φ from
+    analysis/surface/branches.critical_mode of its reading at the degree it was located at, the orders (0, m, 2m)
+    unless ``orders``, on the ``equator`` states where the branch is equator-symmetric and the mode in reflection class
+    0 (as the sphere's surface branches keep a mode's symmetry), else (or ``whole``) on the whole discretisation (a mode
+    odd in z breaks it)."""
     m = bp.m
-    if amplitude == 0:
-        raise ValueError("amplitude: 0 is the axisymmetric state itself (allowed: ε ≠ 0)")
     degree = located_degree(branch, bp)
     mode = critical_mode(branch, bp, degree)[1]
     even = capsule_basis(m, degree, scene.geometry).classes[0]
@@ -171,7 +190,35 @@ def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = N
     disc = replace(branch.disc, symmetric=equator)
     basis = CapsuleSurfaceBasis(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi, equator)
     mode = mode[basis.kept(m)]
-    mode = mode / np.sqrt(mode @ basis.gram(m) @ mode)
-    start = basis.with_mode(basis.axisymmetric(branch.disc.transfer(bp.X[:-1], disc)), m, amplitude * mode)
-    return point_at_amplitude(scene, basis, start, bp.X[-1], mode_row(basis, m, mode), amplitude, m,
-                              branch.params_at(bp.X), tol, max_iter)
+    mode = basis.with_mode(np.zeros(basis.size), m, mode / np.sqrt(mode @ basis.gram(m) @ mode))
+    return basis, basis.axisymmetric(branch.disc.transfer(bp.X[:-1], disc)), mode
+
+
+def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = None, n_phi: int = 0,
+                   tol: float = 1e-12, max_iter: int = 30, whole: bool = False) -> SwitchedPoint:
+    """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
+    capsule's axisymmetric ``branch`` (``start``), solved by tube/surface/switching.point_at_amplitude
+    (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
+    return _switched(scene, branch, bp, start(scene, branch, bp, orders, n_phi, whole), amplitude, tol, max_iter)
+
+
+def _switched(scene, branch, bp, started: tuple, amplitude: float, tol: float, max_iter: int) -> SwitchedPoint:
+    """``switched_point`` from the ``start`` (basis, zero, mode)."""
+    if amplitude == 0:
+        raise ValueError("amplitude: 0 is the axisymmetric state itself (allowed: ε ≠ 0)")
+    basis, zero, mode = started
+    m = bp.m
+    return point_at_amplitude(scene, basis, zero + amplitude * mode, bp.X[-1], mode_row(basis, m, mode[basis.block(m)]),
+                              amplitude, m, branch.params_at(bp.X), tol, max_iter)
+
+
+def traced_branch(scene, branch, bp, direction: float = 1.0, max_points: int | None = None,
+                  orders: tuple | None = None, parent: tuple | None = None):
+    """The branch born at the located m ≥ 1 point ``bp`` of the capsule's ``branch``, traced in P from its switched
+    point at ε = START_AMPLITUDE (tube/surface/branch.trace_from: refined by capsule_resolution, its mirror sector's
+    stability read at every point); SurfaceBranchStartError where the switched point does not converge."""
+    solver = scene.solver
+    started = start(scene, branch, bp, orders)
+    first = _switched(scene, branch, bp, started, direction * START_AMPLITUDE, solver.tol, solver.max_newton)
+    _, zero, mode = started
+    return trace_from(scene, first, mode, zero, bp.X[-1], branch.params_at(bp.X), direction, max_points, parent)
