@@ -170,8 +170,8 @@ def written_parts(scene, basis, c, n_phi):
 def test_a_switched_capsule_point_is_stationary_for_the_written_energy(switched):
     """At the switched points (ε = ±0.05; Newton converged, residual ≤ 1e-10) the derivative of the written
     energy E_el − P V along the state's own orders and random combinations of them (a 4th-order central difference,
-    h = 1e-3 of |c|) is below 1e-9 of the largest derivative of its elastic part alone (measured 6e-12); the pitchfork is
-    symmetric (P equal at ±ε, 1e-12) and bends from P_0 (P − P_0 = O(ε²) ≠ 0)."""
+    h = 1e-3 of |c|) is below 1e-9 of the largest derivative of its elastic part alone (measured 6e-12); the
+    pitchfork is symmetric (P equal at ±ε, 1e-12) and bends from P_0 (P − P_0 = O(ε²) ≠ 0)."""
     scene, branch, bp, points = switched
     assert abs(points[0.05].pressure - points[-0.05].pressure) <= 1e-12 * bp.X[-1]
     assert 0 < abs(points[0.05].pressure - bp.X[-1]) <= 0.01 * bp.X[-1]

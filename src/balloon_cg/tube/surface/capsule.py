@@ -97,8 +97,9 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
         basis (nested spaces: exact to rounding), the orders ``to`` adds zero."""
         if not (to.geometry == self.geometry and set(self.orders) <= set(to.orders) and to.equator == self.equator
                 and to.disc.degree >= self.disc.degree and to.mode_degree >= self.mode_degree):
-            raise ValueError(f"to: degrees {to.disc.degree}, {to.mode_degree}, orders {to.orders} (allowed: the same "
-                             f"capsule, degrees ≥ {self.disc.degree}, {self.mode_degree}, orders holding {self.orders})")
+            raise ValueError(f"to: degrees {to.disc.degree}, {to.mode_degree}, orders {to.orders} (allowed: the "
+                             f"same capsule, degrees ≥ {self.disc.degree}, {self.mode_degree}, orders holding "
+                             f"{self.orders})")
         out = np.zeros(to.size)
         out[to.block(0)] = self.disc.transfer(c[self.block(0)], to.disc)
         for m in self.orders[1:]:
