@@ -1,6 +1,8 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
 voltage ([electric]; None without), the parameter continued in (``parameter``: "voltage" at ``fixed_pressure`` on a
-voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄), the loading control (its
+voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄; "axial_stretch" at
+``fixed_pressure`` on a continuation in the held distance of the ends, tube/stretch.py, its λ range and its located
+points' λ), the loading control (its
 stability reading: how many of a branch's points are stable under it; under gas control the amount n = P V of every
 located point), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are
 compressed (tube/stability.py), a switched branch's parent label and where it rejoined (``parent``, ``rejoins``),
@@ -19,7 +21,7 @@ import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST, HELD_M1, HOOP, VOLTAGE, discretisation
+from ..io.tube_file import CREST, HELD_M1, HOOP, STRETCH, VOLTAGE, discretisation
 from ..scene.tables import parse_stored
 from ..tube.azimuthal import mode_profile
 from ..tube.stability import COMPRESSED
@@ -47,6 +49,8 @@ def summarise_tube(run: dict) -> dict:
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
                           "voltage": None if VOLTAGE not in b else [float(b[VOLTAGE].min()), float(b[VOLTAGE].max())],
+                          "axial_stretch": None if STRETCH not in b else [float(b[STRETCH].min()),
+                                                                          float(b[STRETCH].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
                           "unresolved_points": int((b["tail"] > max_error).sum()) if "tail" in b else None,
                           "largest_tail": float(b["tail"].max(initial=0.0)) if "tail" in b else None,
@@ -59,11 +63,12 @@ def summarise_tube(run: dict) -> dict:
     field = scene_field(a["scene_toml"])
     electric = tomllib.loads(a["scene_toml"]).get("electric")
     primary = run["branches"]["primary"]
-    charged = VOLTAGE in primary  # tube/voltage.py: continued in Φ̄ at a fixed P (run, or continue from a label)
+    parameter = "voltage" if VOLTAGE in primary else STRETCH if STRETCH in primary else "pressure"  # P fixed but
+    #                                     in P: tube/voltage.py (run, or continue from a label), tube/stretch.py
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "voltage": None if electric is None else float(electric.get("voltage", 0.0)),
-            "parameter": "voltage" if charged else "pressure",
-            "fixed_pressure": float(primary["pressure"][0]) if charged else None,
+            "parameter": parameter,
+            "fixed_pressure": float(primary["pressure"][0]) if parameter != "pressure" else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "surface_branches": _surface_branches(run.get("surface_branches", {}), control),
@@ -173,7 +178,8 @@ def _assessed(summary: dict) -> str:
 def format_tube(summary: dict) -> str:
     """Readable summary of ``summarise_tube``."""
     g, p = summary["geometry"], summary["provenance"]
-    held = "free (closed)" if g["axial_stretch"] is None else f"held at {g['axial_stretch']:g} L"
+    held = "free (closed)" if g["axial_stretch"] is None else f"held at {g['axial_stretch']:g} L" + (
+        f" (continued in λ at P = {summary['fixed_pressure']:g})" if summary["parameter"] == STRETCH else "")
     maxwell = _no_maxwell(summary) if summary["maxwell_pressure"] is None else f"{summary['maxwell_pressure']:.10g}"
     lines = [f"file           {summary['file']}",
              f"scene          {summary['scene_name']}",
@@ -199,6 +205,8 @@ def format_tube(summary: dict) -> str:
         lines += ["", f"branch {name}{origin}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}"
                       + ("" if b["voltage"] is None else f", Φ̄ {b['voltage'][0]:.6g}..{b['voltage'][1]:.6g}")
+                      + ("" if b["axial_stretch"] is None else
+                         f", λ {b['axial_stretch'][0]:.6g}..{b['axial_stretch'][1]:.6g}")
                       + f", stop {b['stop_code']} ({b['stop_message']})"
                       + ("" if b["stable_points"] is None else
                          f"; {b['stable_points']} stable under {summary['control']} control")
@@ -224,7 +232,7 @@ def format_tube(summary: dict) -> str:
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
             amount = f"  n = {s['amount']:.10g}" if "amount" in s else ""
             note = f"  {s['note']}" if s["note"] else ""
-            charge = f"  Φ̄ = {s[VOLTAGE]:.10g}" if VOLTAGE in s else ""
+            charge = f"  Φ̄ = {s[VOLTAGE]:.10g}" if VOLTAGE in s else f"  λ = {s[STRETCH]:.10g}" if STRETCH in s else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
                          f"V/V0 = {s['volume']:.8g}{charge}{amount}  {s['status']}{note}{crest}{compressed}")
             if "omega2" in s:

@@ -15,7 +15,8 @@ the largest radius, the bulge's crest, from the tube's middle plane: IntervalDis
 ``first_integral_spread`` (the state's Legendre tail and the spread of H = λ1Φ_1 − Φ along the tube: tube/accuracy.py;
 files before them have none), ``lowest_even``/
 ``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), on a voltage continuation (tube/voltage.py:
-P fixed) ``voltage`` (Φ̄, also per located point), with stability.m_max ≥ 1 ``lowest_m<m>``
+P fixed) ``voltage`` (Φ̄, also per located point), on a continuation in the held distance of the ends (tube/stretch.py: P
+fixed) ``axial_stretch`` (λ, each state's λ̄, also per located point), with stability.m_max ≥ 1 ``lowest_m<m>``
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
 not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
 block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
@@ -69,6 +70,7 @@ CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 HOOP = "hoop_stretch"  # the onset curve's largest radius per point (read back from its unknowns: crest_hoops)
 SPECIAL_TEXT = ("kind", "block", "status")
 VOLTAGE = "voltage"  # per point and located point of a voltage continuation (tube/voltage.py; others have none)
+STRETCH = "axial_stretch"  # per point and located point of a continuation in λ (tube/stretch.py; others have none)
 NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
 MODES = "critical_modes"  # per located m ≥ 1 zero: its eigenvector (files before it have none)
@@ -108,6 +110,8 @@ TUBE_VARIABLES = {
     "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
     "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point, UZ an event's value reached"),
     VOLTAGE: ("1", "voltage Φ̄", "a voltage continuation's Φ̄ (tube/voltage.py: P fixed), per point and located point"),
+    STRETCH: ("1", "held axial stretch λ", "a continuation in the held distance of the ends' λ (tube/stretch.py: P "
+              "fixed), the ends at λL; per point and located point"),
     NOTE: ("", "event", "a UZ point's event, quantity = value (tube/events.py); empty for the others"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
@@ -188,6 +192,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             checksummed(group, column, values)
         if branch.voltage is not None:
             checksummed(group, VOLTAGE, branch.voltage)
+        if branch.stretched:
+            checksummed(group, STRETCH, branch.held_stretch())
         for block, values in branch.lowest.items():
             checksummed(group, f"lowest_{block.value}", values)
         modes = None if picture.modes is None else picture.modes[name]
@@ -214,6 +220,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
         if branch.voltage is not None:
             checksummed(special, VOLTAGE, np.array([p.voltage for p in s], dtype=float))
+        if branch.stretched:
+            checksummed(special, STRETCH, np.array([p.u[branch.disc.axial_index] for p in s], dtype=float))
         checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
         _dimensions(group, "point", {"unknown": branch.disc.size} | ({} if modes is None else {"eigenvalue": COUNT}))
@@ -311,7 +319,7 @@ def read_tube(f, path, where: str = "") -> dict:
             raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
         branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
         n = branch["unknowns"].shape[0]
-        optional = tuple(c for c in (CREST, GAS, VOLTAGE, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror))
+        optional = tuple(c for c in (CREST, GAS, VOLTAGE, STRETCH, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror))
                          if c in group)
         for column in POINT_COLUMNS + optional:
             branch[column] = group[column][()]
@@ -321,7 +329,7 @@ def read_tube(f, path, where: str = "") -> dict:
         special = group["special_points"]
         columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
         columns[NOTE] = list(special[NOTE].asstr()[()]) if NOTE in special else [""] * len(columns["kind"])
-        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + tuple(c for c in (CREST, VOLTAGE) if c in special)}
+        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + tuple(c for c in (CREST, VOLTAGE, STRETCH) if c in special)}
         branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                     for i in range(len(columns["kind"]))]
         branch["azimuthal"] = _read_modes(path, group, n, f"{where}/branches/{name}")
@@ -424,7 +432,8 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     parent = (attrs["parent_branch"], int(attrs["parent_label"])) if "parent_label" in attrs else None
     rejoins = int(attrs["rejoins_label"]) if attrs.get("rejoins_label", -1) >= 0 else None
     return IntervalBranch(discretisation(run["attrs"], b["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest,
-                          unstable, special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
+                          unstable, special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), stretched=STRETCH in b,
+                          parent=parent,
                           rejoins=rejoins)
 
 

@@ -262,7 +262,8 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
                           lambda Y: spectrum(eq, Y, index, params)[order],
                           {length: (spectrum(eq, end, index, params)[order], end)}, fallback)
     Y = root.payload
-    if is_fold(eq, Y[:-1], params.with_value("P", Y[-1]), "P", index, order):
+    at = params.with_value("P", Y[-1])
+    if is_fold(eq, Y[:-1], at, eq.parameter_derivative(Y[:-1], at, "P"), index, order):
         return None
     return Y, root.status
 

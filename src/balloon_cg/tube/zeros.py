@@ -32,9 +32,8 @@ def corrected_zero(system, settings, origin: np.ndarray, direction: np.ndarray, 
     return continuation.locate_root(value_at, length, BRENT_XTOL, known=known)
 
 
-def is_fold(eq, u: np.ndarray, params, name: str, index: np.ndarray, order: int) -> bool:
+def is_fold(eq, u: np.ndarray, params, dq: np.ndarray, index: np.ndarray, order: int) -> bool:
     """Whether the zero eigenvalue number ``order`` of the block ``index`` at the state u (``params`` at it) is the
-    fold in the parameter ``name`` (module docstring)."""
+    fold in the continuation parameter q, ``dq`` = ∂R/∂q there (module docstring)."""
     phi = np.linalg.eigh(eq.jacobian(u, params)[np.ix_(index, index)])[1][:, order]
-    dq = eq.parameter_derivative(u, params, name)
     return abs(phi @ dq[index]) > ORTHOGONAL * np.linalg.norm(dq)
