@@ -24,7 +24,7 @@ from .events import along
 from .primary import volume_ratio
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import smallest_stress, spectrum, unstable_counts
-from .zeros import corrected_zero, is_fold
+from .zeros import corrected_zero, is_fold, off_mode_corrector
 from ..analysis.branches.problem import continuation_settings
 from ..analysis.stability.crossings import count_changes
 from ..analysis.results import Kind
@@ -106,12 +106,19 @@ def stretch_branch(scene, disc, u: np.ndarray, pressure: float, direction: float
 
 def _branch_point(system: StretchSystem, before, after, block: Mirror, order: int, settings) -> tuple | None:
     """(u, status) where the eigenvalue number ``order`` of ``block`` vanishes between two points of the trace, by
-    Brent in the arclength from ``before``; None where it is the fold in λ (the null vector not orthogonal to
-    ∂R/∂λ̄, the Hessian's column of λ̄)."""
+    Brent in the arclength from ``before`` (near a zero of the even block, the branch's own unknowns, Keller's
+    corrector may diverge: then tube/zeros.off_mode_corrector along the crossing eigenvalue's vector at ``before``,
+    as tube/primary's); None where it is the fold in λ (the null vector not orthogonal to ∂R/∂λ̄, the Hessian's
+    column of λ̄)."""
     eq, params = system.eq, system.params
     index, k = eq.disc.block(block), eq.disc.axial_index
+    fallback = None
+    if block == Mirror.EVEN:
+        H = eq.jacobian(system.full(before.X), params)[np.ix_(system.even, system.even)]
+        mode = np.append(np.linalg.eigh(H)[1][:, order], 0.0)
+        fallback = lambda predictor: off_mode_corrector(system, predictor, before.tangent, mode, settings)  # noqa: E731
     root = corrected_zero(system, settings, before.X, before.tangent, float(before.tangent @ (after.X - before.X)),
-                          lambda u: spectrum(eq, np.append(u, params.P), index, params)[order])
+                          lambda u: spectrum(eq, np.append(u, params.P), index, params)[order], fallback=fallback)
     if root is None:
         return None
     u = root.payload
