@@ -17,6 +17,8 @@ from balloon_cg.app.cli import main
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.tube.onset import OnsetStop, onset_curve
+from balloon_cg.scene import parse_scene
+from balloon_cg.tube.picture import onset_picture
 from balloon_cg.tube.primary import primary_branch
 from test_held_tube import held_scene
 from test_tube import bulge_determinant, symbolic_energy, theta, z
@@ -120,3 +122,42 @@ def test_critical_axial_stretch_from_the_command_line(tmp_path, capsys):
         assert main(["critical", str(given), "--parameter", "axial_stretch", "-o", str(target), "--quiet"]) == 2
         err = capsys.readouterr().err
         assert message in err and err.count("\n") == 1 and not target.exists()
+
+
+FIELD = "[field]\nM = {value!r}\n[[field.coils]]\nradius = 2.5\nheight = 0.0\ncurrent = 1.0\n"  # around the middle
+ELECTRIC = "[electric]\nvoltage = {value!r}\n"
+
+
+def onset_at_reference_length(table: str, value: float | None):
+    """The onset curve in λ of SPOM1, L = 10, sliding ends held at 1.5L, degree 12, with ``table`` at ``value`` (None:
+    without it), traced down to λ = 1 as ``critical --parameter axial_stretch --direction -1`` traces it."""
+    text = ('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10\nends = "sliding"\n'
+            'axial_stretch = 1.5\n[solver]\ndegree = 12\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 6.0\n'
+            'step_max = 0.5\n')
+    scene = parse_scene(text + ("" if value is None else table.format(value=value)))
+    return onset_picture(scene, "axial_stretch", -1.0).onset
+
+
+@pytest.mark.parametrize("table, values", [(FIELD, (1e-4, 5e-5, 2.5e-5)),
+                                           (ELECTRIC, (0.02, 0.02 / 2 ** 0.5, 0.01))], ids=["coil", "voltage"])
+def test_onset_in_the_held_stretch_tends_to_the_field_free_one(table, values):
+    """The onset curve in λ (down to λ = 1, landed: stop unstretched) in the field of a coaxial coil around the
+    tube's middle (radius 2.5) and under a voltage across its wall. With the term present at M = 0 (Φ̄ = 0) every
+    point is the field-free curve's (1e-8; measured 2e-16). The field moves it: at λ = 1 the onset pressure falls by
+    ΔP ∝ M (Φ̄²: the magnetic energy is linear in M, the dielectric one quadratic in Φ̄), checked at three values
+    halving M (Φ̄²) — each ΔP above 1e-6, halving to 1 % — and their Richardson extrapolation to M → 0 (Φ̄ → 0),
+    (8ΔP(q/4) − 6ΔP(q/2) + ΔP(q))/3 in q = M (Φ̄²), is the field-free onset within 1e-8 (measured 4.5e-11 and
+    1.6e-12)."""
+    free = onset_at_reference_length(table, None)
+    off = onset_at_reference_length(table, 0.0)
+    assert free.stop.code == off.stop.code == OnsetStop.UNSTRETCHED and off.q.size == free.q.size
+    assert np.abs(off.q - free.q).max() <= 1e-8 and np.abs(off.pressure - free.pressure).max() <= 1e-8
+    assert np.abs(off.states - free.states).max() <= 1e-8
+    moved = []
+    for value in values:
+        found = onset_at_reference_length(table, value)
+        assert found.stop.code == OnsetStop.UNSTRETCHED and found.q[-1] == 1.0
+        moved.append(found.pressure[-1] - free.pressure[-1])
+    assert all(d < -1e-6 for d in moved)
+    assert abs(moved[1] / moved[0] - 0.5) <= 0.01 and abs(moved[2] / moved[1] - 0.5) <= 0.01
+    assert abs((8 * moved[2] - 6 * moved[1] + moved[0]) / 3) <= 1e-8
