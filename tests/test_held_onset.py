@@ -161,3 +161,40 @@ def test_onset_in_the_held_stretch_tends_to_the_field_free_one(table, values):
     assert all(d < -1e-6 for d in moved)
     assert abs(moved[1] / moved[0] - 0.5) <= 0.01 and abs(moved[2] / moved[1] - 0.5) <= 0.01
     assert abs((8 * moved[2] - 6 * moved[1] + moved[0]) / 3) <= 1e-8
+
+
+def plugged_scene(degree: int, stop: float = 7.0):
+    """SPOM1, L = 10, plugged ends held at 2L (docs/tubes.md: taut to its pressure maximum and beyond)."""
+    return held_scene("SPOM1", LENGTH, 2.0, "plugged", degree, stop).with_overrides({"stability.m_max": 0})
+
+
+def test_plugged_onset_curve_folds_in_the_held_stretch_converged_in_the_degree(tmp_path, capsys):
+    """SPOM1, L = 10, plugged ends held at 2L: the onset curve traced down in λ turns back at λ_c = 1.7896071 (P =
+    0.73849), a fold converged in the degree — λ_c at 60, 80, 100 within 3.4e-6 and 3.9e-8 of the next, P within
+    4.4e-5 and 1.7e-7, each fold state's Legendre tail 8-13× smaller per 20 degrees (docs/tubes.md's table) — not an
+    artefact; but at degree 30 its state is not resolved (tail 8.6e-3: λ_c 1.7977, P 0.687, 7 % off), and
+    ``critical`` says so in one line on stderr (the value printed, exit 0, as run flags an unresolved branch) and
+    ``inspect`` marks the fold and counts the curve's unresolved points."""
+    folds = {}
+    for degree in (60, 80, 100):
+        scene = plugged_scene(degree)
+        primary = primary_branch(scene)
+        found = onset_curve(scene, primary, primary.branch_points(Mirror.ODD)[0], "axial_stretch", -1.0, 40)
+        assert len(found.folds) == 1 and found.folds[0].status == "located"
+        folds[degree] = (float(found.fold_q[0]), found.folds[0].pressure, float(found.fold_tail[0]))
+    (q60, P60, t60), (q80, P80, t80), (q100, P100, t100) = folds.values()
+    assert abs(q60 - q80) <= 1e-5 and abs(q80 - q100) <= 1e-7 and abs(q80 - q100) < abs(q60 - q80) / 10
+    assert abs(P60 - P80) <= 1e-4 and abs(P80 - P100) <= 1e-6 and t100 < t80 / 5 and t80 < t60 / 5
+    path = tmp_path / "plugged.toml"
+    path.write_text(plugged_scene(30, 4.5).to_toml())
+    out = tmp_path / "plugged.h5"
+    assert main(["critical", str(path), "--parameter", "axial_stretch", "--direction", "-1", "-o", str(out),
+                 "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("critical axial_stretch = 1.7976960")
+    assert captured.err.count("\n") == 1 and "the fold's state is not resolved at solver.degree = 30: its Legendre " \
+                                                "tail 0.0086 is above solver.max_error = 1e-09" in captured.err
+    assert abs(read_tube_run(out)["onset"]["folds"][0]["q"] - q100) > 5e-3
+    assert main(["inspect", str(out)]) == 0
+    shown = capsys.readouterr().out
+    assert "located  unresolved (tail 0.0086)" in shown and "points unresolved (Legendre tail above" in shown

@@ -95,6 +95,10 @@ def critical_tube(scene, output, args) -> int:
     fold = max(onset["folds"], key=lambda f: args.direction * f["q"])
     print(f"critical {name} = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in {name}: "
           f"{fold['status']}); curve written to {output}")
+    if fold["tail"] > scene.solver.max_error:
+        print(f"{PROG}: the fold's state is not resolved at solver.degree = {scene.solver.degree}: its Legendre tail "
+              f"{fold['tail']:.2g} is above solver.max_error = {scene.solver.max_error:g} (the critical value may be "
+              "off, or the fold an artefact: raise solver.degree; docs/tubes.md)", file=sys.stderr)
     return 0
 
 

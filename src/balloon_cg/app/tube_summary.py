@@ -72,7 +72,7 @@ def summarise_tube(run: dict) -> dict:
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "surface_branches": _surface_branches(run.get("surface_branches", {}), control),
-            "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None,
+            "onset": _onset(run.get("onset"), max_error), "interrupted": a["interrupted"] or None,
             "not_started": [line for line in a["not_started"].split("\n") if line]}
 
 
@@ -142,17 +142,24 @@ def scene_field(toml: str) -> dict:
     return {"M": float(field.get("M", 0.0)), "coils": len(field.get("coils", []))}
 
 
-def _onset(onset: dict | None) -> dict | None:
+def _onset(onset: dict | None, max_error: float) -> dict | None:
+    """The onset curve's ranges, last point, folds (each with its state's Legendre ``tail`` and ``unresolved``:
+    above ``max_error``, solver.max_error) and stop; ``unresolved_points`` and ``largest_tail`` (None in files
+    before the tail is stored)."""
     if onset is None:
         return None
     a = onset["attrs"]
-    return {"parameter": a["parameter"], "q0": a["q0"], "points": len(onset["q"]),
+    tail = onset.get("tail")
+    return {"unresolved_points": None if tail is None else int((tail > max_error).sum()),
+            "largest_tail": None if tail is None else float(tail.max(initial=0.0)),
+            "parameter": a["parameter"], "q0": a["q0"], "points": len(onset["q"]),
             "q": [float(onset["q"].min()), float(onset["q"].max())],
             "pressure": [float(onset["pressure"].min()), float(onset["pressure"].max())],
             "hoop_stretch": [float(onset[HOOP].min()), float(onset[HOOP].max())],
             "last": {"q": float(onset["q"][-1]), "pressure": float(onset["pressure"][-1]),
                      "hoop_stretch": float(onset[HOOP][-1]), "crest_height": float(onset[CREST][-1])},
-            "folds": onset["folds"], "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
+            "folds": [f | {"unresolved": bool(f["tail"] > max_error)} for f in onset["folds"]],
+            "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
 
 
 def _no_maxwell(summary: dict) -> str:
@@ -255,7 +262,9 @@ def format_tube(summary: dict) -> str:
                       f", largest hoop stretch {onset['hoop_stretch'][0]:.6g}..{onset['hoop_stretch'][1]:.6g}, stop "
                       f"{onset['stop_code']} ({onset['stop_message']}); last: {name} = {last['q']:.8g}, "
                       f"P = {last['pressure']:.10g}, hoop stretch {last['hoop_stretch']:.8g}, crest at "
-                      f"{last['crest_height']:.6g}"]
+                      f"{last['crest_height']:.6g}"
+                      + (f"; {onset['unresolved_points']} points unresolved (Legendre tail above solver.max_error, "
+                         f"largest {onset['largest_tail']:.2g})" if onset["unresolved_points"] else "")]
         lines += [f"  fold in {name} at {name} = {f['q']:.10g}, P = {f['pressure']:.10g}  {f['status']}"
-                  for f in onset["folds"]]
+                  + (f"  unresolved (tail {f['tail']:.2g})" if f["unresolved"] else "") for f in onset["folds"]]
     return "\n".join(lines)

@@ -30,8 +30,9 @@ label of the branch point it was born at) and ``rejoins_label`` (where it rejoin
 before them have none). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector; read back with
-``hoop_stretch``, the largest radius ρ of each state, from its unknowns); its folds in q
-under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
+``hoop_stretch``, the largest radius ρ of each state, from its unknowns) and ``tail`` (each state's Legendre tail:
+files before it have none); its folds in q under folds/ (``q``, ``pressure``, ``status``, ``tail``: files before it
+have none, read as NaN); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
 started, and is absent where it had not; ``modes``: the branches whole, no m ≥ 1 blocks; ``frequencies``: the branches
 whole, the frequencies of the branches finished before the signal only), "" where the work is whole (files before it have none: read as "").
@@ -282,10 +283,11 @@ def _write_onset(group, curve) -> None:
                         "stop_message": curve.stop.message})
     for column, values in (("q", curve.q), ("pressure", curve.pressure), ("volume", curve.volume),
                            (CREST, crest_heights(curve.disc, curve.states)), ("unknowns", curve.states),
-                           ("modes", curve.modes)):
+                           ("modes", curve.modes), ("tail", curve.tail)):
         checksummed(group, column, values)
     folds = group.create_group("folds")
     checksummed(folds, "q", np.asarray(curve.fold_q, dtype=float))
+    checksummed(folds, "tail", np.asarray(curve.fold_tail, dtype=float))
     checksummed(folds, "pressure", np.array([p.pressure for p in curve.folds], dtype=float))
     write_strings(folds, "status", [p.status.value for p in curve.folds])
     _dimensions(group, "point", {"unknown": curve.states.shape[1], "mode": curve.modes.shape[1]})
@@ -402,14 +404,15 @@ def _read_onset(path, group, disc: IntervalDiscretisation) -> dict:
         raise TubeFileError(path, f"/onset: missing {', '.join(missing)}")
     onset = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}}
     n = group["q"].shape[0]
-    for column in (*CURVE_COLUMNS, "unknowns", "modes"):
+    for column in (*CURVE_COLUMNS, "unknowns", "modes", *(["tail"] if "tail" in group else [])):
         onset[column] = group[column][()]
         if onset[column].shape[0] != n:
             raise TubeFileError(path, f"/onset/{column}: {onset[column].shape[0]} rows, expected {n}")
     folds = group["folds"]
     status = list(folds["status"].asstr()[()])
-    onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s}
-                      for q, p, s in zip(folds["q"][()], folds["pressure"][()], status)]
+    tails = folds["tail"][()] if "tail" in folds else [math.nan] * len(status)  # files before it have none
+    onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s, "tail": float(t)}
+                      for q, p, s, t in zip(folds["q"][()], folds["pressure"][()], status, tails)]
     onset[HOOP] = crest_hoops(disc, onset["unknowns"])
     return onset
 
