@@ -51,8 +51,9 @@ def critical_tube(scene, output, args) -> int:
     """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
     followed in M, the voltage Φ̄ or the held ends' distance λ (axial_stretch), written with the primary branch to the
     tube run file ``output`` (its /onset group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns
-    back in the parameter (a located fold: the onset's largest or smallest value), 1 (the file still written) where it
-    does not; 1 without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of
+    back in the parameter (a located fold: the onset's largest or smallest value; a line on stderr where its state is
+    not resolved, its Legendre tail above solver.max_error), 1 (the file still written) where it does not (the line
+    says the curve was traced one way from the scene's value, as every critical curve, and --direction the other); 1 without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of
     BP) in M, the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed
     ends (no held distance), a scene continued in the voltage; 130 when a signal stopped it (module docstring)."""
     from ..tube.picture import onset_picture
@@ -89,9 +90,12 @@ def critical_tube(scene, output, args) -> int:
     _say(args, f"onset curve: {len(onset['q'])} points, stop {onset['attrs']['stop_code']} "
                f"({onset['attrs']['stop_message']})")
     if not onset["folds"]:
+        side = "up" if args.direction > 0 else "down"
         raise Failure(f"no critical {name}: the onset curve does not turn back in {name} "
                       f"({onset['attrs']['stop_message']}; last point {name} = {onset['q'][-1]:.10g}, P = "
-                      f"{onset['pressure'][-1]:.10g}); curve written to {output}")
+                      f"{onset['pressure'][-1]:.10g}); traced {side} from {name} = {onset['attrs']['q0']:g} only, as "
+                      f"every critical curve: --direction {-args.direction:g} traces the other side; curve written to "
+                      f"{output}")
     fold = max(onset["folds"], key=lambda f: args.direction * f["q"])
     print(f"critical {name} = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in {name}: "
           f"{fold['status']}); curve written to {output}")
