@@ -174,7 +174,8 @@ def test_plugged_onset_curve_folds_in_the_held_stretch_converged_in_the_degree(t
     4.4e-5 and 1.7e-7, each fold state's Legendre tail 8-13× smaller per 20 degrees (docs/tubes.md's table) — not an
     artefact; but at degree 30 its state is not resolved (tail 8.6e-3: λ_c 1.7977, P 0.687, 7 % off), and
     ``critical`` says so in one line on stderr (the value printed, exit 0, as run flags an unresolved branch) and
-    ``inspect`` marks the fold and counts the curve's unresolved points."""
+    ``inspect`` marks the fold and counts the curve's unresolved points. The stop (hoop stretch 4.5) names the last
+    stored point's λ, not the step's that passed it."""
     folds = {}
     for degree in (60, 80, 100):
         scene = plugged_scene(degree)
@@ -194,7 +195,9 @@ def test_plugged_onset_curve_folds_in_the_held_stretch_converged_in_the_degree(t
     assert captured.out.startswith("critical axial_stretch = 1.7976960")
     assert captured.err.count("\n") == 1 and "the fold's state is not resolved at solver.degree = 30: its Legendre " \
                                                 "tail 0.0086 is above solver.max_error = 1e-09" in captured.err
-    assert abs(read_tube_run(out)["onset"]["folds"][0]["q"] - q100) > 5e-3
+    onset = read_tube_run(out)["onset"]
+    assert abs(onset["folds"][0]["q"] - q100) > 5e-3
+    assert onset["attrs"]["stop_message"].endswith(f"after axial_stretch = {onset['q'][-1]:.6g}, the last point")
     assert main(["inspect", str(out)]) == 0
     shown = capsys.readouterr().out
     assert "located  unresolved (tail 0.0086)" in shown and "points unresolved (Legendre tail above" in shown

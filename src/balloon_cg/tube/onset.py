@@ -190,19 +190,23 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
     beyond = Stop(OnsetStop.STRETCH_LIMIT, f"axial_stretch passed {high:g} (geometry.axial_stretch's largest value): "
                                            f"the last point is an odd branch point of the tube held at λ = {high:g}")
 
+    stored = [q0]  # q of the last point kept: a stop's point (the step that passed it) is not stored
+
     def stop(p):
         if (interrupted := signalled()) is not None:
             return interrupted
         u, P, _, q = system.split(p.X)
+        last = f"after {name} = {stored[-1]:.6g}, the last point"
         if name == STRETCH and (hoop := disc.node_state(u)[0].max()) > scene.continuation.stop_stretch:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
-                                                   f"{scene.continuation.stop_stretch:g} at {name} = {q:.6g}")
+                                                   f"{scene.continuation.stop_stretch:g} {last}")
         if P <= 0:
-            return Stop(OnsetStop.NONPOSITIVE_PRESSURE, f"P reached 0 at {name} = {q:.6g}")
+            return Stop(OnsetStop.NONPOSITIVE_PRESSURE, f"P reached 0 {last}")
         if q < low:
             return below
         if q > high:
             return beyond
+        stored.append(q)
         return None
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
