@@ -263,16 +263,8 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     start = (point.u, point.pressure, scene.voltage)
-    written, _, signalled = _written(args.output, args, lambda: charged_picture(scene, start, args.direction),
-                                     scene)
-    code = interrupted_status(written, args.output, signalled)
-    if code is not None:
-        return code
-    grown = written["branches"]["primary"]
-    print(f"voltage continuation from label {args.label} at P = {point.pressure:.10g}: {len(grown['pressure'])} "
-          f"points, Φ̄ {grown['voltage'].min():.6g}..{grown['voltage'].max():.6g}, stop {grown['attrs']['stop_code']} "
-          f"({grown['attrs']['stop_message']}); written to {args.output}")
-    return 0
+    return _at_fixed_pressure(args, scene, lambda: charged_picture(scene, start, args.direction), point.pressure,
+                              "voltage", "Φ̄")
 
 
 def _continue_in_stretch(args, run: dict, labels: list) -> int:
@@ -305,15 +297,22 @@ def _continue_in_stretch(args, run: dict, labels: list) -> int:
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     disc = discretisation(run["attrs"], run["branches"]["primary"]["attrs"])
-    written, _, signalled = _written(args.output, args, lambda: stretched_picture(scene, point, disc, args.direction),
-                                     scene)
+    return _at_fixed_pressure(args, scene, lambda: stretched_picture(scene, point, disc, args.direction),
+                              point.pressure, "axial_stretch", "λ")
+
+
+def _at_fixed_pressure(args, scene, picture, pressure: float, column: str, symbol: str) -> int:
+    """``picture()``, the file's primary branch continued from label ``args.label`` in ``column`` (voltage,
+    axial_stretch) at the fixed ``pressure``, written to ``args.output`` (130 on a signal, as ``run``) and said in one
+    line: its points, the range of ``symbol`` and its stop."""
+    written, _, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code
     grown = written["branches"]["primary"]
-    print(f"axial_stretch continuation from label {args.label} at P = {point.pressure:.10g}: "
-          f"{len(grown['pressure'])} points, λ {grown['axial_stretch'].min():.6g}..{grown['axial_stretch'].max():.6g}, "
-          f"stop {grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
+    print(f"{column} continuation from label {args.label} at P = {pressure:.10g}: {len(grown['pressure'])} points, "
+          f"{symbol} {grown[column].min():.6g}..{grown[column].max():.6g}, stop {grown['attrs']['stop_code']} "
+          f"({grown['attrs']['stop_message']}); written to {args.output}")
     return 0
 
 
