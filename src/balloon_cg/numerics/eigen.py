@@ -45,6 +45,7 @@ class GramFactor:
 
     def __init__(self, G, orthogonal: bool = False):
         G = np.asarray(G, dtype=float)
+        self.gram = G
         if orthogonal:
             self.scale, self._lower = 1.0 / np.sqrt(G if G.ndim == 1 else np.diag(G)), None
         else:
@@ -57,6 +58,13 @@ class GramFactor:
     @cached_property
     def inverse(self) -> np.ndarray:
         return np.diag(self.scale) if self.scale is not None else np.linalg.inv(self._lower)
+
+    def weighed(self, rows) -> np.ndarray:
+        """The rows G wᵢ of the vectors wᵢ (k × n): the normals of the constraints (G wᵢ)ᵀc = 0, c G-orthogonal to
+        the wᵢ (a diagonal G as the products wᵢ G_ii)."""
+        if self.scale is None:
+            return rows @ self.gram
+        return rows * (self.gram if self.gram.ndim == 1 else np.diag(self.gram))
 
     def directions(self, normals) -> np.ndarray:
         """The rows L⁻¹nᵢ of the constraint rows nᵢ (k × n), C-ordered whatever the normals' layout (the jitted
