@@ -400,9 +400,10 @@ class SphericalBasis:
             M[np.diag_indices(self.size)] = self.gram()
             return M
         nodes = self.nodes
-        weights = nodes["weights"] * self.n_phi * nodes["rate"] * self.gram()
+        root = np.sqrt(nodes["weights"] * self.n_phi * nodes["rate"] * self.gram())[:, None]
         for b, theta in zip(self.blocks, self.tables["theta"]):
-            M[b.slice, b.slice] = (theta[0].T * weights) @ theta[0]
+            scaled = root * theta[0]
+            M[b.slice, b.slice] = scaled.T @ scaled  # exactly symmetric (BLAS syrk)
         return M
 
 
