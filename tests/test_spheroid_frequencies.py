@@ -18,7 +18,9 @@ from numpy.polynomial import legendre
 from scipy import linalg
 
 from balloon_cg.analysis.picture import analyse
-from balloon_cg.dynamics.frequencies import frequencies
+from balloon_cg.analysis.surface.branches import trace_surface
+from balloon_cg.dynamics.frequencies import attach, frequencies
+from balloon_cg.dynamics.surface import sector_block, surface_matching_block
 from balloon_cg.dynamics.pencil import PER_EIGENVALUE, mass_variation
 from balloon_cg.galerkin.coordinate_map import WireMap
 from balloon_cg.galerkin.equilibrium import Equilibrium
@@ -166,3 +168,42 @@ def test_mirror_even_sectors_hold_the_axisymmetric_blocks(axisymmetric_state):
     assert blocks["m5_held"][0] > axisymmetric[COUNT - 1]  # order m ≥ 5 starts above: m ≥ 6 too
     assert np.abs(whole[:, None] - axisymmetric[None, :]).min(axis=1).max() <= 1e-9
     np.testing.assert_allclose(np.sort(whole)[:COUNT], axisymmetric[:COUNT], rtol=0, atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def m1_branch():
+    """SPOM1 on the spheroid of aspect 1.6 at M = 0 with [dynamics] frequencies (count 4, m_max 3): the primary
+    branch to the pole stretch 1.6 (its held m = 1 branch point at P = 1.9447), the branch born there traced 4
+    points on the whole spheroid, its frequencies attached as a run attaches them (dynamics.frequencies.attach)."""
+    scene = load_scene("spom1").with_overrides(
+        {"geometry.shape": "spheroid", "geometry.aspect": 1.6, "continuation.stop_stretch": 1.6,
+         "surface.branches": "none", "dynamics.frequencies": True, "dynamics.count": 4, "dynamics.m_max": 3})
+    primary = analyse(scene, pear=False).primary
+    k, bp = next((k, s) for k, s in enumerate(primary.branch_points()) if s.m == 1 and s.block.held)
+    branch = trace_surface(primary, k, bp, 1.0, "m1", 4)
+    attach([primary, branch], 4, 3)
+    return primary, bp, branch
+
+
+def test_a_spheroid_surface_branch_s_frequencies_at_its_birth_point(m1_branch):
+    """At point 0 of the branch (the branch point's state solved on the whole spheroid at its P*) the stored Ω²
+    (the assessment's sectors, Ω² = μ/2) of the two mirror-even held sectors are Ω² of the primary's blocks even,
+    m1..m3_held at the branch point and of the equator-odd m = 0 block (``odd_block``), and their four lowest with
+    multiplicity are the blocks' four lowest, to 1e-9 (the two states are the same to the solver's tolerance 1e-11
+    and an Ω² moves with the state by an O(1) factor, tests/test_dynamics_surface.py; measured 1.5e-12); at the
+    branch point's own state (special point 0) one Ω² of its sector is zero to the solver tolerance (measured
+    -8.0e-12, the lowest -1.28: the branch is born unstable)."""
+    primary, bp, branch = m1_branch
+    n = next(n for n, s in enumerate(primary.special) if s is bp)
+    count = branch.frequencies.count
+    parts = [primary.frequencies.special[name][n] for name in ("even", "m1_held", "m2_held", "m3_held")]
+    axisymmetric = np.sort(np.concatenate(parts + [odd_block(primary, bp.X)]))
+    mirror = branch.basis.symmetry.index(MIRROR_Y)
+    keys = [key for key in branch.sectors["held"] if key[mirror] == 1]
+    whole = np.concatenate([branch.frequencies.omega2[sector_block("held", key)][0] for key in keys])
+    assert abs(branch.values[0] - bp.X[-1]) < 1e-12 and np.isfinite(whole).all()
+    assert np.abs(whole[:, None] - axisymmetric[None, :]).min(axis=1).max() <= 1e-9
+    np.testing.assert_allclose(np.sort(whole)[:count], axisymmetric[:count], rtol=0, atol=1e-9)
+    origin = branch.special[0]
+    block = surface_matching_block(origin, branch)
+    assert np.min(np.abs(branch.frequencies.special[block][0])) <= branch.scene.solver.tol
