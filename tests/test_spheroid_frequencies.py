@@ -111,10 +111,11 @@ def surface_at(primary, X, degree: int, symmetry: tuple, order: int = -1):
 def test_each_azimuthal_order_has_the_axisymmetric_block_s_frequencies(axisymmetric_state):
     """Per order m = 1, 2, 3 the whole-sphere Hessian on the cos mφ family (held: the translation and the rigid
     rotation removed, M-orthogonally) has the Ω² of the axisymmetric block m<m>_held, the lowest COUNT, to 1e-10.
-    Resolution: at degrees 32 and 40 (order 4) the Ω² differ by ≤ 1e-11 (measured ≤ 1e-12; at degree 24 the sixth
+    Resolution: at degrees 32 and 40 (order 4) the Ω² differ by ≤ 1e-11 (measured ≤ 1.3e-12; at degree 24 the sixth
     Ω² of m = 3 is 8e-10 off at aspect 1.6), the axisymmetric blocks' at perturbation degrees 30 and 40 by
-    ≤ 2.2e-10 (so at 40 by less); measured ≤ 2.6e-12 apart. Before a spheroid's m = 1 blocks kept its relabelling about a horizontal
-    axis (azimuthal.excluded_modes), m1_held lacked the surface's 1.9987 (aspect 1.6) and read 2.4651 for 2.4669.
+    ≤ 2.2e-10 (so at 40 by less); measured ≤ 2.6e-12 apart. While a spheroid's m = 1 blocks removed a relabelling
+    about a horizontal axis (no zero mode there: azimuthal.excluded_modes), m1_held lacked the surface's 1.9987
+    (aspect 1.6) and read 2.4651 for 2.4669.
     A second method for the pencil: for m = 2 (no zero modes) scipy's generalised eigh of (EᵀHE, EᵀME) gives the
     same Ω² to 1e-10, and with the sphere's norm (EᵀE/2π) other ones (by more than 1 %)."""
     primary, X, blocks = axisymmetric_state

@@ -392,7 +392,7 @@ class SphericalBasis:
         ½ρT0R0⁴: dynamics/pencil.py), by the Hessian's quadrature: Σ_k τ_{m,t}(φ_k) τ_{m',t'}(φ_k) = N_φ/(2π) δ
         exactly on N_φ > 2M uniform nodes, so M is block-diagonal, per block
 
-            M_b[l, l'] = (1/2π) Σ_j w_j S'(θ_j) P̃_l(θ_j) P̃_l'(θ_j)      (w_j the θ-weights, P̃ the block's θ-functions);
+            M_b[l, l'] = (1/2π) Σ_j w_j S'(θ_j) P̃_l(θ_j) P̃_l'(θ_j)    (w_j the θ-weights, P̃ the block's θ-functions);
 
         gram()·I on the sphere (S' = 1: the basis is orthonormal in that quadrature)."""
         M = np.zeros((self.size, self.size))

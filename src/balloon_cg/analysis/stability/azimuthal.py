@@ -359,7 +359,8 @@ def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0)
     - ``relabelling``: the rotation of the *reference* sphere about e_y, δx = ∂x0/∂X·(e_y × X):
       R = ρ0', T = −ρ0 cot θ, Z = η0'. The reference sphere and the material are isotropic, so E[x ∘ Q] = E[x]
       for every rotation Q of the material labels: a zero mode of every equilibrium, with or without field
-      (material slides along the deformed surface, the shape does not change). On a sphere it is the rotation.
+      (material slides along the deformed surface, the shape does not change), where the reference is a sphere
+      (``excluded_modes``). On a sphere state it is the rotation.
 
     All are regular (D = R − T ≠ 0 at the poles) and exact in the basis when degree ≥ the equilibrium's Legendre
     degree + 1 (the translation for any degree)."""
