@@ -246,12 +246,14 @@ def mass_factor(sector: SphericalBasis) -> eigen.GramFactor:
 
 def _mass_on(basis: SphericalBasis, E: np.ndarray | None = None) -> eigen.GramFactor:
     """The factor of G on the columns E of ``basis`` (default all): the scaling of gram·I on the sphere (the basis
-    is orthonormal; so are E's columns), the Cholesky factor of Eᵀ M E, M = ``SphericalBasis.mass``, on a
-    spheroid."""
+    is orthonormal; so are E's columns), on a spheroid the Cholesky factors of M = ``SphericalBasis.mass`` block by
+    block (M is block-diagonal in the basis' blocks), or that of Eᵀ M E."""
     if basis.aspect == 1.0:
         return eigen.GramFactor(np.full(basis.size if E is None else E.shape[1], basis.gram()), orthogonal=True)
     M = basis.mass()
-    return eigen.GramFactor(M if E is None else E.T @ M @ E)
+    if E is None:
+        return eigen.GramFactor(M, blocks=tuple(b.slice for b in basis.blocks))
+    return eigen.GramFactor(E.T @ M @ E)
 
 
 def _own(sector: SphericalBasis, basis: SphericalBasis) -> bool:
