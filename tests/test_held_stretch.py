@@ -91,3 +91,15 @@ def test_continue_in_axial_stretch_follows_the_uniform_level_curve(tmp_path, cap
         assert main(["continue", str(given), str(label), "--parameter", "axial_stretch", "-o", str(target)]) == 2
         err = capsys.readouterr().err
         assert message in err and err.count("\n") == 1 and not target.exists()
+    # a label of the branch continued in λ away from the scene's λ: every continuation from it would start at the
+    # scene's λ (a branch of another tube stored as born there): refused, one line, no file; at the scene's λ taken
+    up_labels = read_tube_run(up)["branches"]["primary"]["special_points"]
+    away = next(i for i, s in enumerate(up_labels) if s["kind"] == "BP" and s["block"] == "odd"
+                and abs(s["axial_stretch"] - 1.5) > 1e-3)
+    for extra in ([], ["--parameter", "M"], ["--parameter", "axial_stretch"]):
+        target = tmp_path / "refused.h5"
+        assert main(["continue", str(up), str(away), "-o", str(target), *extra]) == 2
+        err = capsys.readouterr().err
+        assert (f"label {away}: its branch was continued in axial_stretch, this point at λ = "
+                f"{up_labels[away]['axial_stretch']:.10g}, the file's scene at λ = 1.5" in err)
+        assert err.count("\n") == 1 and not target.exists()

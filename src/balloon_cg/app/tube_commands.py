@@ -202,6 +202,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
         event = " (from a UZ: --parameter voltage, in Φ̄ at its P)" if primary_event else ""
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
                          f"{', '.join(map(str, onsets)) or 'none'}{event}")
+    at_fixed_scene(args, run, labels)
     scene = with_continuation_settings(args, stored_scene(args, run))
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
@@ -252,6 +253,7 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
         what = "no such label" if s is None else f"{s['kind']} on branch {name}"
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues in the voltage from a "
                          f"user point (UZ) of its primary branch: labels {', '.join(map(str, points)) or 'none'}")
+    at_fixed_scene(args, run, labels)
     stored = stored_scene(args, run)
     if stored.electric is None:
         raise UsageError(f"continue {args.run}: --parameter voltage needs an [electric] table: the file's scene has "
@@ -293,12 +295,31 @@ def _continue_in_stretch(args, run: dict, labels: list) -> int:
         raise UsageError(f"continue {args.run}: label {args.label}: {what}{why}; a held tube continues in "
                          "axial_stretch from a located point of its primary branch other than an even branch point: "
                          f"labels {', '.join(map(str, points)) or 'none'}")
+    at_fixed_scene(args, run, labels)
     scene = with_continuation_settings(args, stored_scene(args, run))
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     disc = discretisation(run["attrs"], run["branches"]["primary"]["attrs"])
     return _at_fixed_pressure(args, scene, lambda: stretched_picture(scene, point, disc, args.direction),
                               point.pressure, "axial_stretch", "λ")
+
+
+def at_fixed_scene(args, run: dict, labels: list) -> None:
+    """UsageError (exit 2, one line) for a label of a primary branch continued in the voltage or in λ (``continue
+    --parameter voltage|axial_stretch``) whose Φ̄ or λ is not the file's scene's: every continuation from a label
+    starts from the scene's (a branch of another tube, stored as born at that label)."""
+    from ..io.tube_file import STRETCH, VOLTAGE
+
+    primary, point = run["branches"]["primary"], labels[args.label][2]
+    scene = stored_scene(args, run)
+    for column, key, symbol, own in ((VOLTAGE, "electric.voltage", "Φ̄", scene.voltage),
+                                     (STRETCH, "geometry.axial_stretch", "λ", scene.geometry.axial_stretch)):
+        value = point.get(column) if column in primary else None
+        if value is not None and abs(value - (own or 0.0)) > 1e-12 * max(1.0, abs(value)):
+            raise UsageError(f"continue {args.run}: label {args.label}: its branch was continued in {column}, this "
+                             f"point at {symbol} = {value:.10g}, the file's scene at {symbol} = {own or 0.0:.10g}: a "
+                             f"continuation from it would start from the scene's; run the scene with {key} = "
+                             f"{value:.10g} and continue from that run's labels")
 
 
 def _at_fixed_pressure(args, scene, picture, pressure: float, column: str, symbol: str) -> int:

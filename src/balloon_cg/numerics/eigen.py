@@ -92,6 +92,8 @@ class GramFactor:
     def standard(self, B) -> np.ndarray:
         """L⁻¹ B L⁻ᵀ of a block-diagonal factor (``blocks``), B overwritten: the rows of each block solved, then its
         columns."""
+        if B.shape != (len(self.gram),) * 2:  # the blocks' slices are the factor's own unknowns
+            raise ValueError(f"a {B.shape} block against a block-diagonal factor of {len(self.gram)} unknowns")
         for s, part in self.parts:
             B[s, :] = linalg.solve_triangular(part, B[s, :], lower=True)
         for s, part in self.parts:

@@ -68,8 +68,12 @@ def stretch_branch(scene, disc, u: np.ndarray, pressure: float, direction: float
     system = StretchSystem(eq, params)
     settings = continuation_settings(scene)
     X = u[system.unknowns]
+    start_residual = float(np.abs(system.residual(X)).max())
+    if not start_residual <= scene.solver.tol * max(1.0, pressure):  # the start is stored as the branch's first point
+        raise ValueError(f"the start is no equilibrium of this scene at P = {pressure:.10g} (residual "
+                         f"{start_residual:.3g} > solver.tol {scene.solver.tol:g}): a stored point of another scene?")
     t = continuation.tangent(system, X, direction * np.eye(X.size)[-1])
-    first = continuation.Point(X, t, 0, float(np.abs(system.residual(X)).max()))
+    first = continuation.Point(X, t, 0, start_residual)
     limit = scene.continuation.stop_stretch
 
     def stop(point):
