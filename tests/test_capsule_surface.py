@@ -243,17 +243,11 @@ def test_at_length_0_the_switched_m1_point_is_the_spheres_pear_turned_by_90_degr
     orders 0..K at ε = 0.05 the P differs from the pear's by −6.4e-8, −1.2e-10, −1.7e-13 at K = 4, 6, 8."""
     from dataclasses import replace
 
-    from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block
     from balloon_cg.tube.surface.capsule import switched_point
     from test_surface import turned_pear
 
-    settings = {"continuation.stop_stretch": 2.5, "stability.m_max": 1, "surface.branches": "none"}
-    sphere = analyse(parse_scene('[material]\npreset = "SPOM1"\n').with_overrides(settings))
-    pears = [b for b in sphere.branches[1:] if b.parent == ("primary", 0)]
-    scene = capsule(0.0).with_overrides(settings)
-    primary = analyse(scene, pear=False).primary
-    pear_point = next(p for p in primary.special if p.kind.value == "BP" and p.block == Block.ODD_HELD)
+    pears, scene, primary, pear_point = length_zero_pear()
     for eps in (0.05, 0.1):
         point = switched_point(scene, primary, replace(pear_point, m=1, block=Block.M1_HELD), eps,
                                orders=tuple(range(11)))
@@ -274,18 +268,12 @@ def test_at_length_0_the_traced_m1_branch_is_the_spheres_pear_turned_by_90_degre
     pear point."""
     from dataclasses import replace
 
-    from balloon_cg.analysis.picture import analyse
     from balloon_cg.analysis.results import Block
     from balloon_cg.tube.surface.capsule import traced_branch
     from balloon_cg.tube.surface.switching import SwitchedPoint
     from test_surface import turned_pear
 
-    settings = {"continuation.stop_stretch": 2.5, "stability.m_max": 1, "surface.branches": "none"}
-    sphere = analyse(parse_scene('[material]\npreset = "SPOM1"\n').with_overrides(settings))
-    pears = [b for b in sphere.branches[1:] if b.parent == ("primary", 0)]
-    scene = capsule(0.0).with_overrides(settings)
-    primary = analyse(scene, pear=False).primary
-    pear_point = next(p for p in primary.special if p.kind.value == "BP" and p.block == Block.ODD_HELD)
+    pears, scene, primary, pear_point = length_zero_pear()
     branch = traced_branch(scene, primary, replace(pear_point, m=1, block=Block.M1_HELD), max_points=4)
     assert not branch.limited and branch.error_estimate.max() <= scene.solver.max_error, branch.stop.message
     assert len(branch.pressure) == 4 and np.all(np.diff(branch.pressure) < 0)
@@ -293,3 +281,17 @@ def test_at_length_0_the_traced_m1_branch_is_the_spheres_pear_turned_by_90_degre
         poles = sideways_poles(SwitchedPoint(branch.basis, c, P, 0.0, 1, 0.0, True, 0, 0.0, ""))
         pressure, south = turned_pear(poles, pears)
         assert abs(P - pressure) <= 1e-8 * pressure and abs(poles[1] - south) <= 1e-8, (P, pressure, poles, south)
+
+
+def length_zero_pear() -> tuple:
+    """The sphere's pear branches born at its first pitchfork (SPOM1 to a pole stretch of 2.5), the capsule of length
+    0 (that scene), its primary branch and its held pear point: where its m = 1 branch is the pear turned by 90°."""
+    from balloon_cg.analysis.picture import analyse
+    from balloon_cg.analysis.results import Block
+
+    settings = {"continuation.stop_stretch": 2.5, "stability.m_max": 1, "surface.branches": "none"}
+    sphere = analyse(parse_scene('[material]\npreset = "SPOM1"\n').with_overrides(settings))
+    pears = [b for b in sphere.branches[1:] if b.parent == ("primary", 0)]
+    scene = capsule(0.0).with_overrides(settings)
+    primary = analyse(scene, pear=False).primary
+    return pears, scene, primary, next(p for p in primary.special if p.kind.value == "BP" and p.block == Block.ODD_HELD)
