@@ -48,7 +48,7 @@ def check_size(item, where, error=FileError) -> None:
     """``error`` when the dataset ``item`` declares more bytes than its file can hold (the bound above)."""
     declared = int(np.prod(item.shape, dtype=object) or 0) * item.dtype.itemsize
     try:
-        size = item.file.id.get_filesize()
+        size = h5py.h5i.get_file_id(item.id).get_filesize()  # not item.file: it builds a File each time
     except (OSError, RuntimeError, ValueError):
         size = 0
     if declared > max(MIN_DECLARED, DECLARED_PER_FILE_BYTE * size):
