@@ -6,6 +6,7 @@ float 'f', int 'iu', bool 'b', str an HDF5 string type.
 """
 import contextlib
 import errno
+import math
 import os
 import stat
 
@@ -46,7 +47,8 @@ MIN_DECLARED = 64 * 1024**2
 
 def check_size(item, where, error=FileError) -> None:
     """``error`` when the dataset ``item`` declares more bytes than its file can hold (the bound above)."""
-    declared = int(np.prod(item.shape, dtype=object) or 0) * item.dtype.itemsize
+    shape = item.shape
+    declared = (math.prod(shape) if shape is not None else 0) * item.dtype.itemsize
     try:
         size = h5py.h5i.get_file_id(item.id).get_filesize()  # not item.file: it builds a File each time
     except (OSError, RuntimeError, ValueError):
