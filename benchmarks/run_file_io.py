@@ -6,7 +6,8 @@
 ``--make`` runs spom1 to stop_stretch 2 and the two-coil scene (spom1_two_coils_M0.002, stop_stretch 1.7) and pickles
 (scene, branches, snaps, found) per scene, so both installs write the same analysis. ``--compare`` runs ``--time``
 in both interpreters (each its own process, alternately per repetition) and prints the median CPU seconds
-(time.process_time) of ``write_run`` and ``read_run`` per scene and their ratio other / this; the load average is
+(time.process_time) of ``write_run``, ``read_run`` and ``io.layout.file_kind`` (what the CLI asks before it
+reads) per scene and their ratio other / this; the load average is
 printed with the table.
 """
 import argparse
@@ -38,6 +39,7 @@ def make(cache: Path) -> None:
 
 def time_once(cache: Path) -> dict:
     """CPU seconds of one write_run and one read_run of each cached scene."""
+    from balloon_cg.io.layout import file_kind
     from balloon_cg.io.run_file import read_run, write_run
 
     out = {}
@@ -50,7 +52,8 @@ def time_once(cache: Path) -> dict:
             t1 = time.process_time()
             read_run(path)
             t2 = time.process_time()
-            out[key] = {"write": t1 - t0, "read": t2 - t1}
+            file_kind(path)
+            out[key] = {"write": t1 - t0, "read": t2 - t1, "kind": time.process_time() - t2}
     return out
 
 
@@ -61,10 +64,10 @@ def compare(cache: Path, other: str, reps: int) -> None:
             text = subprocess.run([python, __file__, "--time", str(cache)], check=True, capture_output=True,
                                   text=True, cwd=Path(__file__).parent).stdout
             runs[who].append(json.loads(text.splitlines()[-1]))
-    print(f"load average before/after: {os.getloadavg()[0]:.2f} (1 min); reps {reps}; CPU s, median")
+    print(f"load average after: {os.getloadavg()[0]:.2f} (1 min); reps {reps}; CPU s, median; other = {other}")
     print(f"{'scene':<10} {'op':<6} {'other':>8} {'this':>8} {'other/this':>11}")
     for key in SCENES:
-        for op in ("write", "read"):
+        for op in ("write", "read", "kind"):
             a = statistics.median(r[key][op] for r in runs["other"])
             b = statistics.median(r[key][op] for r in runs["this"])
             print(f"{key:<10} {op:<6} {a:8.3f} {b:8.3f} {a / b:11.2f}")
