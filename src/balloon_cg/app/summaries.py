@@ -394,7 +394,7 @@ def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]
         note = f"  {s['note']}" if s["note"] else ""
         lines.append(
             f"    {label:<{width}}  {place:<{place_width}}  P = {s['pressure']:.10g}  "
-            + "".join(f"{name} = {s[key]:.10g}  " for key, name in (("M", "M"), ("voltage", "voltage")) if key in s) +
+            + "".join(f"{key} = {s[key]:.10g}  " for key in ("M", "voltage") if key in s) +
             f"lam2 north = {s['lam2_top']:.10g}  lam2 south = {s['lam2_bottom']:.10g}{note}"
         )
     return lines

@@ -53,9 +53,10 @@ def critical_tube(scene, output, args) -> int:
     tube run file ``output`` (its /onset group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns
     back in the parameter (a located fold: the onset's largest or smallest value; a line on stderr where its state is
     not resolved, its Legendre tail above solver.max_error), 1 (the file still written) where it does not (the line
-    says the curve was traced one way from the scene's value, as every critical curve, and --direction the other); 1 without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of
-    BP) in M, the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed
-    ends (no held distance), a scene continued in the voltage; 130 when a signal stopped it (module docstring)."""
+    says the curve was traced one way from the scene's value, as every critical curve, and --direction the other); 1
+    without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M,
+    the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed ends (no
+    held distance), a scene continued in the voltage; 130 when a signal stopped it (module docstring)."""
     from ..tube.picture import onset_picture
 
     name = ONSET_PARAMETERS.get(args.parameter)
@@ -202,8 +203,8 @@ tube/picture.branch_name), with the file's scene and the command line's continua
         event = " (from a UZ: --parameter voltage, in Φ̄ at its P)" if primary_event else ""
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
                          f"{', '.join(map(str, onsets)) or 'none'}{event}")
-    at_fixed_scene(args, run, labels)
     scene = with_continuation_settings(args, stored_scene(args, run))
+    at_fixed_scene(args, run, labels, scene)
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:
@@ -253,8 +254,8 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
         what = "no such label" if s is None else f"{s['kind']} on branch {name}"
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues in the voltage from a "
                          f"user point (UZ) of its primary branch: labels {', '.join(map(str, points)) or 'none'}")
-    at_fixed_scene(args, run, labels)
     stored = stored_scene(args, run)
+    at_fixed_scene(args, run, labels, stored)
     if stored.electric is None:
         raise UsageError(f"continue {args.run}: --parameter voltage needs an [electric] table: the file's scene has "
                          "none, so the equilibrium does not depend on the voltage")
@@ -295,8 +296,8 @@ def _continue_in_stretch(args, run: dict, labels: list) -> int:
         raise UsageError(f"continue {args.run}: label {args.label}: {what}{why}; a held tube continues in "
                          "axial_stretch from a located point of its primary branch other than an even branch point: "
                          f"labels {', '.join(map(str, points)) or 'none'}")
-    at_fixed_scene(args, run, labels)
     scene = with_continuation_settings(args, stored_scene(args, run))
+    at_fixed_scene(args, run, labels, scene)
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     disc = discretisation(run["attrs"], run["branches"]["primary"]["attrs"])
@@ -304,14 +305,13 @@ def _continue_in_stretch(args, run: dict, labels: list) -> int:
                               point.pressure, "axial_stretch", "λ")
 
 
-def at_fixed_scene(args, run: dict, labels: list) -> None:
+def at_fixed_scene(args, run: dict, labels: list, scene) -> None:
     """UsageError (exit 2, one line) for a label of a primary branch continued in the voltage or in λ (``continue
-    --parameter voltage|axial_stretch``) whose Φ̄ or λ is not the file's scene's: every continuation from a label
+    --parameter voltage|axial_stretch``) whose Φ̄ or λ is not the file's ``scene``'s: every continuation from a label
     starts from the scene's (a branch of another tube, stored as born at that label)."""
     from ..io.tube_file import STRETCH, VOLTAGE
 
     primary, point = run["branches"]["primary"], labels[args.label][2]
-    scene = stored_scene(args, run)
     for column, key, symbol, own in ((VOLTAGE, "electric.voltage", "Φ̄", scene.voltage),
                                      (STRETCH, "geometry.axial_stretch", "λ", scene.geometry.axial_stretch)):
         value = point.get(column) if column in primary else None
