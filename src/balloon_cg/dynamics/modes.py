@@ -68,8 +68,8 @@ def block_modes(variation, u, params, symmetric: bool, name: str, count: int, th
 
 def _axisymmetric_shapes(basis, c, theta, geometry) -> np.ndarray:
     """(δρ, δz, 0) on θ (rows × 3 × θ) of the m = 0 perturbation coefficients c (rows: a_0..a_N, b_0..b_N) on
-    ``basis`` (its η functions P_k(s) − m_k on a map: ``stability.held_means``), δρ = R δλ2 with R the reference
+    ``basis`` (its held η functions P_k − m_k on a map or a spheroid: ``stability.held_means``), δρ = R δλ2 with R the reference
     meridian's (model/meridian.hoop: sin θ on the sphere)."""
     lam2, _, eta, _ = basis.evaluate(c, theta)
-    eta = eta - (c[:, basis.a_index.size + 1:] @ held_means(basis))[:, None]
+    eta = eta - (c[:, basis.a_index.size + 1:] @ held_means(basis, geometry))[:, None]
     return np.stack([hoop(geometry, np.cos(theta), np.sin(theta)) * lam2, eta, np.zeros_like(eta)], axis=1)

@@ -103,6 +103,33 @@ def metric(geometry: Geometry, cos_theta, sin_theta):
     return np.sqrt(np.square(cos_theta) + np.square(geometry.aspect * np.asarray(sin_theta)))
 
 
+def area_density(geometry: Geometry, cos_theta, sin_theta):
+    """dA/(dφ d(cos θ)) = R S'/sin θ of the reference at the nodes, on the meridians with R = sin θ: S' (``metric``:
+    1 on the sphere and a capsule of length 0, sqrt(cos²θ + aspect² sin²θ) on the spheroid). The weight of a held
+    balloon's centroid, ∫δη dA = 0 (analysis/stability/axisymmetric.py ``held_means``, banded.py)."""
+    if geometry.shape == Shape.TUBE or joins(geometry):
+        raise ValueError(f"area_density: shape {geometry.shape.value!r} has R != sin θ; allowed: sphere, spheroid, "
+                         "capsule of length 0")
+    return metric(geometry, cos_theta, sin_theta)
+
+
+def reference_area(geometry: Geometry) -> float:
+    """A/2π = ∫ ``area_density`` d(cos θ) over [−1, 1] in closed form: 2 on the sphere (and a capsule of length 0);
+    on the spheroid of aspect c, 1 + c² artanh(e)/e with e² = 1 − c² (c < 1) and 1 + c arcsin(e)/e with
+    e² = 1 − 1/c² (c > 1)."""
+    if geometry.shape == Shape.TUBE or joins(geometry):
+        raise ValueError(f"reference_area: shape {geometry.shape.value!r} has R != sin θ; allowed: sphere, spheroid, "
+                         "capsule of length 0")
+    c = float(geometry.aspect) if geometry.shape == Shape.SPHEROID else 1.0
+    if c == 1.0:
+        return 2.0
+    if c < 1.0:
+        e = np.sqrt(1.0 - c * c)
+        return 1.0 + c * c * np.arctanh(e) / e
+    e = np.sqrt(1.0 - 1.0 / (c * c))
+    return 1.0 + c * np.arcsin(e) / e
+
+
 def meridional_stretch(geometry: Geometry, cos_theta, sin_theta, lam2, v, w):
     """λ1 = sqrt((λ2 R' + v R/sin θ)² + w²)/S' with v = λ2' sin θ, w = η' (module docstring)."""
     if geometry.shape == Shape.CAPSULE:

@@ -42,7 +42,7 @@ rate, not the converged point (the residuals are exact).
 import numpy as np
 
 from ...galerkin.equilibrium import Equilibrium
-from ..stability.axisymmetric import SecondVariation, block_indices
+from ..stability.axisymmetric import SecondVariation, block_indices, held_transform
 
 H_STEP = 1e-6
 
@@ -69,6 +69,7 @@ class WernerSpence:
         self.variation = SecondVariation(equilibrium, disc.degree)
         self.odd = block_indices(self.variation, block, field_on=True)
         self.basis = self.variation.basis
+        self.hold = held_transform(self.basis, equilibrium.scene.geometry)  # the blocks' held η functions
         self.embed = symmetric_embedding(disc)
         self.n, self.m = disc.size, self.odd.size
         self.ell = np.asarray(ell, dtype=float)
@@ -77,13 +78,19 @@ class WernerSpence:
         n, m = self.n, self.m
         return X[:n], float(X[n]), X[n + 1:n + 1 + m]
 
-    def full_hessian(self, c, params):
-        """Generated Hessian on the perturbation basis at the (general) coefficient vector c."""
+    def _hessian(self, c, params):
+        """Generated Hessian on the Legendre basis in x at the (general) coefficient vector c."""
         b = self.basis
         nodes = self.eq.at_nodes(("branch_point", b), (b.cos_theta, b.sin_theta))
         b.node_state(c, nodes.state)
         nodes.hold(params)
         return b.hessian(nodes("energy_hessian", params))
+
+    def full_hessian(self, c, params):
+        """``_hessian`` on the stability blocks' η functions, Tᵀ H T (``stability.held_transform``: the held
+        centroid of a spheroid's reference area; T = I on the sphere)."""
+        H = self._hessian(c, params)
+        return H if self.hold is None else self.hold.T @ H @ self.hold
 
     def odd_hessian(self, u, params):
         return self.full_hessian(self.embed @ u, params)[np.ix_(self.odd, self.odd)]
@@ -101,12 +108,14 @@ class WernerSpence:
         J[:n, n] = self.eq.parameter_derivative(u, params, self.continuation_parameter)
         c = self.embed @ u
         J[n:n + m, n + 1:] = self.full_hessian(c, params)[np.ix_(self.odd, self.odd)]
-        # ∂(H_odd φ)/∂u = D_c H[φ_full] restricted (symmetry of the third derivative)
+        # ∂(H_odd φ)/∂u = Tᵀ D_c H[T φ_full] restricted (symmetry of the third derivative)
         phi_full = np.zeros(c.size)
         phi_full[self.odd] = phi
+        if self.hold is not None:
+            phi_full = self.hold @ phi_full
         h = _step(c, phi_full)
-        dH = (self.full_hessian(c + h * phi_full, params) - self.full_hessian(c - h * phi_full, params)) / (2 * h)
-        J[n:n + m, :n] = dH[self.odd] @ self.embed
+        dH = (self._hessian(c + h * phi_full, params) - self._hessian(c - h * phi_full, params)) / (2 * h)
+        J[n:n + m, :n] = (dH if self.hold is None else self.hold.T @ dH)[self.odd] @ self.embed
         hp, name = _parameter_step(p), self.continuation_parameter
         J[n:n + m, n] = (self.odd_hessian(u, params.with_value(name, p + hp))
                          - self.odd_hessian(u, params.with_value(name, p - hp))) @ phi / (2 * hp)

@@ -39,7 +39,8 @@ from ...galerkin.legendre import gauss_rule
 from ...galerkin.discretisation import (Discretisation, assemble_gradient, assemble_hessian, even_half, piece_nodes,
                                        read_only)
 from ...galerkin.equilibrium import NodeKernels, Parameters
-from ...model.meridian import mass_density
+from ...model.meridian import area_density, mass_density, reference_area
+from ...scene.tables import Geometry, Shape
 from ...numerics import eigen, interrupt, workers
 from ..branches.problem import equilibrium_of
 from ..branches.resolution import Resolution, transfer_error
@@ -99,9 +100,9 @@ class SecondVariation:
             "b_even": na + k[k % 2 == 0], "b_odd": na + k[k % 2 == 1],
         }
         self.translation = na  # b_0
-        self.ops, self.weights = _held_ops(self.basis), self.basis.weights
+        self.ops, self.weights = _held_ops(self.basis, equilibrium.scene.geometry), self.basis.weights
         ops, w = self.ops, self.weights
-        if mapping is None:
+        if ops is self.basis.ops:
             self.basis_a, self.basis_b, self._gradient_ops = (self.basis.basis_a, self.basis.basis_b,
                                                               self.basis._gradient_ops)
         else:
@@ -116,8 +117,9 @@ class SecondVariation:
             self.gram = assemble_hessian(mass, w, self.basis_a, self.basis_b)
         else:
             self.gram = ops[0].T @ (w[:, None] * ops[0]) + ops[2].T @ (w[:, None] * ops[2])
-        # diagonal: "unknowns" on the Legendre basis in x only (not on a map, nor on a capsule's elements)
-        self._orthogonal = mapping is None and not joins and norm != "displacement"
+        # diagonal: "unknowns" on the Legendre basis in x only (not on a map, nor on a capsule's elements, nor with a
+        # spheroid's held η functions P_k − m_k)
+        self._orthogonal = ops is self.basis.ops and not joins and norm != "displacement"
         # the state at the nodes is linear in the equilibrium's unknowns: (λ2, v, η, w) = u @ state_map
         unit = self.eq.state_at(np.eye(self.eq.disc.size), self.theta)
         self.state_map = np.ascontiguousarray(np.concatenate([np.atleast_2d(v) for v in unit], axis=1))
@@ -384,25 +386,44 @@ class SecondVariation:
                 yield FREE_FLAGS, lambda free=readings[False]: free
 
 
-def _held_ops(basis: Discretisation) -> np.ndarray:
+def _held_ops(basis: Discretisation, geometry: Geometry) -> np.ndarray:
     """The node values (λ2, v, η, w) per perturbation coefficient (a_0..a_N, b_0..b_N), shape (4, n_q, 2N + 2).
-    On a mapped basis the η functions are 1 and P_k(s) − m_k (k ≥ 1, ``held_means``), the span of
-    P_0(s)..P_N(s): dropping b_0 (a held balloon) then means ∫δη dx = 0, the hold of the Legendre basis in x and of
-    the equilibrium's held mapped basis (``Discretisation``), not ∫δη ds = 0. In x, m_k = 0: the basis's own ops."""
-    if basis.mapping is None:
+    The η functions are 1 and P_k − m_k (k ≥ 1, ``held_means``), the span of P_0..P_N: dropping b_0 (a held
+    balloon) then means ∫δη dA = 0, the centroid of the reference surface fixed (dA = R S' dθ dφ; on the sphere
+    ∫δη dx = 0, also the hold of the equilibrium's held mapped basis, ``Discretisation``). On the sphere in x,
+    m_k = 0: the basis's own ops."""
+    if not _weighted_hold(basis, geometry):
         return basis.ops
     na = basis.a_index.size
     ops = np.array(basis.ops)
-    ops[2, :, na + 1:] -= held_means(basis)
+    ops[2, :, na + 1:] -= held_means(basis, geometry)
     return read_only(ops)
 
 
-def held_means(basis: Discretisation) -> np.ndarray:
-    """m_k = ½∫P_k(s(x)) dx, k = 1..N, subtracted from the η functions of a mapped perturbation basis
-    (``_held_ops``); zero in x."""
-    if basis.mapping is None:
+def _weighted_hold(basis: Discretisation, geometry: Geometry) -> bool:
+    """Whether the held η functions P_k − m_k differ from P_k: on a map, or on a spheroid (S' ≠ 1)."""
+    return basis.mapping is not None or geometry.shape == Shape.SPHEROID
+
+
+def held_means(basis: Discretisation, geometry: Geometry) -> np.ndarray:
+    """m_k = ∫P_k dA / A = ∫P_k ρ dx / ∫ρ dx, k = 1..N (ρ = R S'/sin θ, ``meridian.area_density``; ∫ρ dx = A/2π,
+    ``meridian.reference_area``; P_k of s(x) on a map), subtracted from the η functions of the perturbation basis
+    (``_held_ops``); zero on the sphere in x. The capsule's piecewise basis (joins) keeps its own functions."""
+    if not _weighted_hold(basis, geometry):
         return np.zeros(basis.degree)
-    return 0.5 * basis.weights @ basis.ops[2, :, basis.a_index.size + 1:]
+    density = area_density(geometry, basis.cos_theta, basis.sin_theta)
+    return (basis.weights * density) @ basis.ops[2, :, basis.a_index.size + 1:] / reference_area(geometry)
+
+
+def held_transform(basis: Discretisation, geometry: Geometry) -> np.ndarray | None:
+    """T with ``_held_ops`` = basis.ops @ T (the column b_k of T takes −m_k into the row b_0, ``held_means``), or
+    None where they are the basis's own ops."""
+    if not _weighted_hold(basis, geometry):
+        return None
+    na = basis.a_index.size
+    T = np.eye(basis.size)
+    T[na, na + 1:] = -held_means(basis, geometry)
+    return T
 
 
 def _hold(nodes: NodeKernels, u, state_map: np.ndarray, params: Parameters):

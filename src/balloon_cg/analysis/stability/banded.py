@@ -12,9 +12,10 @@ mass matrix, or ∫(δλ2² + δη²) dx: ``stability.norm``) and the volume gra
 Each element's 2(p + 1) functions are consecutive, so H and G are banded (half-bandwidth 2p + 1) and assembled
 element by element. The blocks and their constraints are ``SecondVariation``'s: an equator-symmetric state on the
 half interval (``even``: δλ2 even, δη odd; ``odd``: the reverse, the odd field's vertex at the equator dropped),
-the held reading ∫δη dx = 0 (a constraint row, the mapped Legendre blocks' hold), volume control gᵀc = 0, gas
-control H + (P/Ṽ) g gᵀ. The lowest eigenvalues come from shift-invert Lanczos on one banded Cholesky factor per
-index set below its pressure block's spectrum (numerics/banded.py), which also proves the signs.
+the held reading ∫δη dA = 0 (a constraint row, the reference area R S' dθ: ∫δη dx on the sphere; the Legendre
+blocks' hold), volume control gᵀc = 0, gas control H + (P/Ṽ) g gᵀ. The lowest eigenvalues come from shift-invert
+Lanczos on one banded Cholesky factor per index set below its pressure block's spectrum (numerics/banded.py), which
+also proves the signs.
 """
 import numpy as np
 
@@ -22,7 +23,7 @@ from ...galerkin.discretisation import HESSIAN_ROW
 from ...galerkin.equilibrium import NodeKernels, Parameters
 from ...galerkin.piecewise import PiecewiseBasis
 from ...generated import HESSIAN_PAIRS
-from ...model.meridian import AZIMUTHAL, mass_density
+from ...model.meridian import AZIMUTHAL, area_density, mass_density
 from ...numerics.banded import BandedShiftInvert, BandedSigns
 from .azimuthal import perturbation_map
 from .flags import EVERY_FLAG, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_GAS, HELD_VOLUME, LOWEST
@@ -63,7 +64,7 @@ class BandedVariation:
             norm[[HESSIAN_ROW[0, 0], HESSIAN_ROW[2, 2]]] = 1.0
         self._gram_local = self._local_matrices(norm)
         hold = np.zeros((4, x.size))
-        hold[2] = 1.0  # ∫δη dx
+        hold[2] = area_density(equilibrium.scene.geometry, x, sin_theta)  # ∫δη dA/2π, the centroid held
         self._hold_local = self._local_vectors(hold)
         self._layouts = {}
 
