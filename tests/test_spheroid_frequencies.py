@@ -141,9 +141,9 @@ def test_each_azimuthal_order_has_the_axisymmetric_block_s_frequencies(axisymmet
 def odd_block(primary, X) -> np.ndarray:
     """The 2 COUNT lowest Ω² of the axisymmetric m = 0 equator-odd block (a_odd, b_even: the pear modes) with the
     axial translation b_0 removed M-orthogonally, (M e_b0)ᵀq = 0 (the translation is a zero mode at M = 0: the
-    modes are M-orthogonal to it), from the axisymmetric second variation's own matrices. The block odd_held drops
-    b_0 instead, ∫δη d(cos θ) = 0: the sphere's hold, the same spectrum on the sphere (P_0 ⊥ P_k there), another
-    on a spheroid (whose M carries S': 7.1320 for 7.1754 at aspect 0.7)."""
+    modes are M-orthogonal to it), from the axisymmetric second variation's own matrices: the block odd_held, which
+    holds the reference centroid ∫δη dA = 0 (tests/test_spheroid_held.py; while it held the sphere's ∫δη d(cos θ) = 0
+    its lowest Ω² read 7.1320 for 7.1754 at aspect 0.7)."""
     variation = mass_variation(Equilibrium(primary.scene, primary.disc), AXISYMMETRIC_DEGREE)
     H, _ = variation.matrices(X[:-1], primary.params_at(X))
     G, t = variation.gram, variation.translation
@@ -156,15 +156,16 @@ def test_mirror_even_sectors_hold_the_axisymmetric_blocks(axisymmetric_state):
     """The frequency path itself (``stability.sector_spectra``, held under pressure control, as the assessment
     and dynamics/surface.py read a surface branch): on the full basis of degree 24 with the mirror y → −y and the
     equator z → −z, the two mirror-even sectors' COUNT lowest Ω² each are Ω² of the axisymmetric blocks even, the
-    equator-odd m = 0 block (``odd_block``) and m1..m5_held, and the COUNT lowest of both together, with
-    multiplicity, are the blocks' COUNT lowest, to 1e-9 (the resolution of degree 24: the test above; measured
-    ≤ 1.3e-11; the modes of m ≥ 6 lie above them: checked)."""
+    equator-odd m = 0 block (odd_held, the same as ``odd_block`` to 1e-10 relative) and m1..m5_held, and the COUNT
+    lowest of both together, with multiplicity, are the blocks' COUNT lowest, to 1e-9 (the resolution of degree 24:
+    the test above; measured ≤ 1.3e-11; the modes of m ≥ 6 lie above them: checked)."""
     primary, X, blocks = axisymmetric_state
     eq, c = surface_at(primary, X, 24, (MIRROR_Y, EQUATOR))
     held = stability.Reading(True)
     sectors = stability.sector_spectra(eq, c, primary.params_at(X), COUNT, (held,))[held]
     whole = PER_EIGENVALUE * np.concatenate([values for key, values in sectors.items() if key[0] == 1])
-    parts = [blocks["even"], odd_block(primary, X)] + [blocks[f"m{m}_held"] for m in range(1, 6)]
+    np.testing.assert_allclose(blocks["odd_held"], odd_block(primary, X), rtol=1e-10, atol=0)
+    parts = [blocks["even"], blocks["odd_held"]] + [blocks[f"m{m}_held"] for m in range(1, 6)]
     axisymmetric = np.sort(np.concatenate(parts))
     assert blocks["m5_held"][0] > axisymmetric[COUNT - 1]  # order m ≥ 5 starts above: m ≥ 6 too
     assert np.abs(whole[:, None] - axisymmetric[None, :]).min(axis=1).max() <= 1e-9
