@@ -209,3 +209,21 @@ def test_a_spheroid_surface_branch_s_frequencies_at_its_birth_point(m1_branch):
     origin = branch.special[0]
     block = surface_matching_block(origin, branch)
     assert np.min(np.abs(branch.frequencies.special[block][0])) <= branch.scene.solver.tol
+
+
+def test_mass_factors_are_kept_within_their_byte_bound(monkeypatch):
+    """``stability.mass_factor`` gives a basis its kept factor again (the same object) and drops the least recently
+    used factors while the kept ones hold more than MASS_CACHE_BYTES, the latest always kept; a spheroid's factor
+    counts its dense M and its blocks' Cholesky factors."""
+    monkeypatch.setattr(stability, "_mass_factors", {})
+    bases = [SphericalBasis(degree, aspect=1.3) for degree in (8, 10, 12)]
+    first = stability.mass_factor(bases[0])
+    assert stability.mass_factor(bases[0]) is first
+    assert first.nbytes >= 8 * bases[0].size ** 2 + sum(part.nbytes for _, part in first.parts)
+    sizes = [stability.mass_factor(basis).nbytes for basis in bases]
+    assert list(stability._mass_factors) == bases
+    monkeypatch.setattr(stability, "MASS_CACHE_BYTES", sizes[1] + sizes[2])
+    stability.mass_factor(bases[2])
+    assert list(stability._mass_factors) == bases[1:]
+    monkeypatch.setattr(stability, "MASS_CACHE_BYTES", 0)
+    assert stability.mass_factor(bases[1]) is not None and list(stability._mass_factors) == [bases[1]]

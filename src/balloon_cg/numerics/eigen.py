@@ -71,6 +71,12 @@ class GramFactor:
     def inverse(self) -> np.ndarray:
         return np.diag(self.scale) if self.scale is not None else np.linalg.inv(self.lower)
 
+    @property
+    def nbytes(self) -> int:
+        """The bytes it holds: G, its factors, and L and L⁻¹ once made."""
+        arrays = [v for v in vars(self).values() if isinstance(v, np.ndarray)]
+        return sum(a.nbytes for a in arrays) + sum(part.nbytes for _, part in self.parts or ())
+
     def weighed(self, rows) -> np.ndarray:
         """The rows G wᵢ of the vectors wᵢ (k × n): the normals of the constraints (G wᵢ)ᵀc = 0, c G-orthogonal to
         the wᵢ (a diagonal G as the products wᵢ G_ii)."""

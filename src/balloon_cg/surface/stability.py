@@ -21,7 +21,6 @@ Zero modes removed (MODEL.md §8), at the state x:
 A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
 fine (numerics.eigen.restricted drops them).
 """
-import functools
 from dataclasses import replace
 from typing import NamedTuple
 
@@ -237,11 +236,24 @@ def _restricted(H: np.ndarray, mass: eigen.GramFactor, rows: np.ndarray,
     return eigen.restricted(H, mass, np.vstack(normals) if normals else eigen.NO_CONSTRAINT)
 
 
-@functools.lru_cache(maxsize=8)
+# the mass factors ``mass_factor`` keeps, at most this many bytes together (the latest always): a spheroid's sector
+# of degree 64 holds its dense M (~78 MB) and its blocks' factors, one of degree 112 ~700 MB (8 of them, as a
+# maxsize-8 cache kept, 5.6 GB); the sphere's are a vector each
+MASS_CACHE_BYTES = 512 * 1024**2
+_mass_factors: dict = {}  # sector basis -> GramFactor, the least recently used first
+
+
 def mass_factor(sector: SphericalBasis) -> eigen.GramFactor:
     """The factor of G, the displacement norm (1/2π)∫∫|δu|² dA over the reference in the coefficients of
-    ``sector`` (module docstring), built once per basis (it holds no state): ``_mass_on``."""
-    return _mass_on(sector)
+    ``sector`` (module docstring), built once per basis (it holds no state: ``_mass_on``) and kept while the kept
+    ones hold at most MASS_CACHE_BYTES (the least recently used dropped first)."""
+    factor = _mass_factors.pop(sector, None)
+    if factor is None:
+        factor = _mass_on(sector)
+    _mass_factors[sector] = factor
+    while len(_mass_factors) > 1 and sum(f.nbytes for f in _mass_factors.values()) > MASS_CACHE_BYTES:
+        del _mass_factors[next(iter(_mass_factors))]
+    return factor
 
 
 def _mass_on(basis: SphericalBasis, E: np.ndarray | None = None) -> eigen.GramFactor:

@@ -84,8 +84,8 @@ def kept_reflections(symmetry: tuple, characters: tuple) -> tuple:
 def critical_vector(trace: SurfaceTrace, c: np.ndarray, P: float, characters: tuple,
                     count: int = CRITICAL_SEARCH) -> tuple:
     """(the sector basis of ``characters``, the unit eigenvector of its held Hessian at the state c, P, the exact zero
-    modes removed, whose eigenvalue is nearest zero among the ``count`` lowest; the eigenvalue). Its sign is fixed by
-    its largest entry, positive: which direction is +φ is reproducible."""
+    modes removed, whose eigenvalue is nearest zero among the ``count`` lowest). Its sign is fixed by its largest
+    entry, positive: which direction is +φ is reproducible."""
     (sector,) = [s for s in trace.basis.sectors() if s.characters == characters]
     params = trace.system.params.with_value("P", P)
     H = trace.eq.hessian(c, params, sector)
@@ -96,7 +96,7 @@ def critical_vector(trace: SurfaceTrace, c: np.ndarray, P: float, characters: tu
     values, vectors = linalg.eigh(Q.T @ H @ Q, subset_by_index=(0, min(count, Q.shape[1]) - 1))
     k = int(np.argmin(np.abs(values)))
     v = Q @ vectors[:, k]
-    return sector, v * np.sign(v[np.argmax(np.abs(v))]), float(values[k] / sector.gram())
+    return sector, v * np.sign(v[np.argmax(np.abs(v))])
 
 
 def switching_start(primary: SurfaceBranch, bp: SpecialPoint) -> tuple:
@@ -108,7 +108,7 @@ def switching_start(primary: SurfaceBranch, bp: SpecialPoint) -> tuple:
     P = bp.X[-1]
     solved = parent.system.solve(parent.system.point(bp.X[:-1], P), scene.solver.tol, scene.solver.max_newton)
     c_star = parent.system.coefficients(solved.x) if solved.converged else bp.X[:-1]
-    sector, v, _ = critical_vector(parent, c_star, P, bp.sector)
+    sector, v = critical_vector(parent, c_star, P, bp.sector)
     symmetry = kept_reflections(primary.basis.symmetry, bp.sector)
     trace = SurfaceTrace(scene, replace(primary.basis, symmetry=symmetry, characters=()), primary.params)
     phi = np.append(trace.gauge.reduce(embedded(sector, v, trace.basis)), 0.0)
