@@ -180,3 +180,34 @@ def test_read_run_rejects_other_files(tmp_path):
         read_run(other)
     with pytest.raises(FileNotFoundError):
         read_run(tmp_path / "missing.h5")
+
+
+@pytest.mark.parametrize("shape", ["sphere", "spheroid"])
+def test_a_file_from_before_a_change_of_its_shapes_readings_says_so(tmp_path, scene, shape):
+    """A spheroid's held and m = 1 readings changed meaning in readings revision 1 (io.legacy.CHANGED_READINGS):
+    a spheroid file without the root attribute ``readings`` (written before it) is shown OUTDATED by inspect and
+    its summary lists the change; the same file with it, and a sphere's file either way, are not."""
+    from balloon_cg.app.summaries import format_run, summarise_run
+    from balloon_cg.io.legacy import READINGS
+
+    shaped = scene.with_overrides({"geometry.shape": shape, "geometry.aspect": 1.2 if shape == "spheroid" else 1.0,
+                                   "continuation.stop_stretch": 1.3})
+    path = write_run(tmp_path / "run.h5", shaped, [trace_primary(shaped)])
+    assert read_run(path)["attrs"]["readings"] == READINGS and summarise_run(read_run(path))["stale_readings"] == []
+    with h5py.File(path, "r+") as f:
+        del f.attrs["readings"]
+    old = read_run(path)
+    stale = summarise_run(old)["stale_readings"]
+    assert (len(stale) == 1 and "spheroid" in stale[0]) if shape == "spheroid" else stale == []
+    assert ("OUTDATED" in format_run(old)) == (shape == "spheroid")
+
+
+def test_a_sweep_member_from_before_a_change_of_its_shapes_readings_says_so(scene):
+    """A sweep's members are judged each by its own provenance and scene (a resumed sweep may mix versions)."""
+    from balloon_cg.app.summaries import _stale_member
+    from balloon_cg.io.legacy import READINGS
+
+    spheroid = scene.with_overrides({"geometry.shape": "spheroid", "geometry.aspect": 0.8}).to_toml()
+    assert len(_stale_member({"scene_toml": spheroid})) == 1
+    assert _stale_member({"scene_toml": spheroid, "readings": READINGS}) == []
+    assert _stale_member({"scene_toml": scene.to_toml()}) == []

@@ -3,6 +3,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.legacy import stale_readings
 from ..io.parents import parent_label, rejoin_label
 from ..io.run_file import stored_scene
 
@@ -41,6 +42,7 @@ def summarise_sweep(path) -> dict:
         primary = member["branches"].get("primary")
         members[index] = {"overrides": member["overrides"],
                           "complete": bool(member["attrs"].get("complete", False)),
+                          "stale_readings": _stale_member(member["attrs"]),
                           "branches": {name: len(b["pressure"]) for name, b in member["branches"].items()},
                           "primary": summarise_branch(primary) if primary is not None else None}
     return {"file": str(path), "kind": "sweep", "provenance": sweep["attrs"], "members": members}
@@ -58,7 +60,16 @@ def format_sweep(summary: dict) -> str:
         specials = len(m["primary"]["special_points"]) if m["primary"] else 0
         lines.append(f"  member {index:<4} {settings}: {'complete' if m['complete'] else 'INCOMPLETE'}; "
                      f"{branches}; {specials} special points on the primary branch")
+        lines += [f"    OUTDATED readings: {what}" for what in m["stale_readings"]]
     return "\n".join(lines)
+
+
+def _stale_member(attrs) -> list[str]:
+    """``stale_readings`` of a sweep member (its scene's shape, its own provenance: a resumed sweep's members
+    may come from two versions)."""
+    from ..scene.tables import parse_stored
+
+    return stale_readings(attrs, parse_stored(attrs["scene_toml"], "member").geometry.shape.value)
 
 
 def summarise_curves(path) -> dict:
@@ -106,11 +117,14 @@ def format_curves(summary: dict) -> str:
 
 def summarise_run(run: dict) -> dict:
     """JSON-ready summary of read_run() output: the reference shape and its parameters (``geometry``: the stored
-    scene's [geometry] table), provenance, the run time per phase (``run_time``) and one summary per branch."""
+    scene's [geometry] table), provenance, what changed since in the meaning of its stored readings
+    (``stale_readings``: io.legacy), the run time per phase (``run_time``) and one summary per branch."""
+    geometry = stored_scene(run).geometry
     return {
         "file": run["path"],
         "scene_name": run["scene_name"],
-        "geometry": stored_scene(run).geometry.to_table(),
+        "geometry": geometry.to_table(),
+        "stale_readings": stale_readings(run["attrs"], geometry.shape.value),
         "provenance": run["attrs"],
         "run_time": run_time(run["attrs"]),
         "branches": {name: summarise_branch(b) | {"parent_label": parent_label(run, name),
@@ -239,6 +253,8 @@ def format_run(run: dict) -> str:
         f"control        {p.get('control', 'pressure')} (loading.control)",
         f"kernels        digest {p['generated_digest'][:16]}…",
         f"result         {_verdict(p)}",
+        *(f"OUTDATED       written before this version changed its readings: {what}; run the scene again for "
+          "this version's" for what in summary["stale_readings"]),
         *_run_time_lines(summary),
     ]
     for name, b in summary["branches"].items():

@@ -16,6 +16,7 @@ import numpy as np
 
 import balloon_cg
 
+from .legacy import READINGS
 from .layout import can_checksum
 from .output import replacing
 
@@ -39,8 +40,9 @@ CONVENTIONS = "CF-1.10"  # the netCDF conventions the files follow (units, long_
 
 
 def provenance(command: str | None = None) -> dict:
-    """Attributes naming what wrote a file: package version, digest of the generated kernels, time, command, and
-    the CF global attributes ``Conventions`` and ``history`` (time, command and version, one line)."""
+    """Attributes naming what wrote a file: package version, digest of the generated kernels, the revision of
+    its readings' meaning (``legacy.READINGS``), time, command, and the CF global attributes ``Conventions`` and
+    ``history`` (time, command and version, one line)."""
     from ..model.kernels import generated_digest  # here: model/ imports numba, which reading does not need
 
     created = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
@@ -48,6 +50,7 @@ def provenance(command: str | None = None) -> dict:
     return {
         "package_version": balloon_cg.__version__,
         "generated_digest": generated_digest(),
+        "readings": READINGS,
         "created": created,
         "command": command,
         "Conventions": CONVENTIONS,

@@ -1,4 +1,4 @@
-"""Dataset names of older files, read under this version's names.
+"""What older files mean under this version: their dataset names, and readings stored before they changed.
 
 Files written before session 21 name the meridian's two ends after a sphere's poles: ``lam2_north``, ``lam2_south``,
 ``eta_north``, ``eta_south`` (run files up to balloon-cg/5, sweep files up to balloon-cg-sweep/2, their curves and
@@ -6,11 +6,23 @@ members). This version writes the shape-neutral ``lam2_top``, ``lam2_bottom``, `
 ends at θ = 0 and θ = π, the top and bottom of the axis). ``current`` gives a reader the file under the new names:
 the file itself where it has no old name, else an in-memory copy of its image with those datasets renamed (the file
 on disk is never written).
+
+Stored readings whose meaning changed (a stability block that held another constraint) are told apart by the root
+attribute ``readings`` (``READINGS``, written with the provenance; a file without it has revision 0):
+``stale_readings`` says which of ``CHANGED_READINGS`` a file of a given shape predates, for ``inspect`` to say so.
 """
 import contextlib
 import io
 
 import h5py
+
+READINGS = 1
+
+CHANGED_READINGS = (  # (revision, the shapes whose stored readings it changed, what changed)
+    (1, ("spheroid",), "a spheroid's m = 1 blocks kept a rotation of the reference that is no zero mode of a "
+     "spheroid, and its held m = 0 blocks and pear points held the sphere's centroid, not the spheroid's "
+     "(docs/shapes.md)"),
+)
 
 OLD_NAMES = {"lam2_north": "lam2_top", "lam2_south": "lam2_bottom", "eta_north": "eta_top", "eta_south": "eta_bottom"}
 
@@ -45,3 +57,10 @@ def current(f):
         for path in old:
             copy.move(path, renamed(path))
         yield copy
+
+
+def stale_readings(attrs, shape: str) -> list[str]:
+    """What changed, since the file whose root attributes are ``attrs`` was written, in the readings it stores of
+    a ``shape`` scene (``CHANGED_READINGS``; empty when none did)."""
+    revision = int(attrs.get("readings", 0))
+    return [what for changed, shapes, what in CHANGED_READINGS if changed > revision and shape in shapes]
