@@ -202,14 +202,16 @@ def written_energy(material, disc, orders, n_phi, c, P):
     return (disc.length / 2 * w) @ density.sum(axis=1) / n_phi
 
 
-@pytest.mark.parametrize("ends", ENDS)
-def test_energy_and_its_derivatives_are_those_written_here(ends):
+@pytest.mark.parametrize("ends, orders", [(ends, (0, 1, 2)) for ends in ENDS] + [("sliding", (0, 2, 4))])
+def test_energy_and_its_derivatives_are_those_written_here(ends, orders):
     """At a random non-axisymmetric state (orders 0, 1, 2, every coefficient perturbed): E/(2π) is the energy written
     here (1e-12 relative) and ``profile`` its Cartesian point (1e-13), the residual its central differences (1e-7
     relative), the Jacobian the residual's (1e-7) and symmetric (1e-12); ∂R/∂P the derivative of the residual in P
-    (1e-7)."""
+    (1e-7). On the orders 0, 2, 4 the basis sums over the n_phi/2 nodes of one period π in φ, the energy written here
+    over all n_phi."""
     scene, disc = scene_and_disc(ends, degree=10)
-    basis = TubeSurfaceBasis(disc, (0, 1, 2))
+    basis = TubeSurfaceBasis(disc, orders)
+    assert basis.phi_nodes == basis.n_phi // (1 + (orders[1] == 2))
     surface = MeridianSurfaceEquilibrium(scene, basis)
     rng = np.random.default_rng(11)
     c = basis.axisymmetric(random_state(disc, seed=7)) + 0.02 * rng.standard_normal(basis.size) * (

@@ -182,3 +182,19 @@ def test_an_m2_zero_is_switched_to_an_equilibrium_of_the_written_energy(m2_zero)
     ratio = (quotient[0.05] - quotient[0.025]) / (quotient[0.025] - quotient[0.0125])
     assert abs(ratio - 4) <= 0.3, (quotient, ratio)
 
+
+
+def test_a_zero_on_an_unresolved_parent_is_refused_before_its_trace(m2_zero):
+    """The m = 2 zero's axisymmetric state has a Legendre tail (IntervalDiscretisation.tail: 0.13 at degree 30) above
+    the switch's step (ε = 0.05 times the critical mode's largest coefficient over the mean radius, λ2's degree-0
+    coefficient: 0.016): on a finer degree the zero itself moves by more than the step (its P 1.3547, 1.3707, 1.3598
+    at degrees 20, 30, 40, docs/tubes.md), so traced_branch refuses to start in one line naming the tail, the degree
+    and the step, instead of re-solving the switched point on a finer degree (where Newton leaves the domain)."""
+    from balloon_cg.tube.surface.branch import START_AMPLITUDE, SurfaceBranchStartError, traced_branch
+
+    scene, branch, zero = m2_zero
+    tail = branch.disc.tail(zero.u)
+    step = START_AMPLITUDE * np.max(np.abs(zero.mode)) / abs(branch.disc.series(zero.u)[0][0])
+    assert tail > step > scene.solver.max_error, (tail, step)
+    with pytest.raises(SurfaceBranchStartError, match=r"degree tail 0\.1\d at degree 30 .* step 0\.01\d"):
+        traced_branch(scene, branch.disc, zero, branch.params, max_points=2)

@@ -21,7 +21,8 @@ second entry carry λ2's 1). Gauss–Legendre in S (the interval's rule, weights
 φ, weight 1/n_phi: E/(2π) = (1/2π) ∫∫ π dS dφ ≈ Σ_q W_q Σ_k π(S_q, φ_k)/n_phi, exact for products of orders m, m'
 when n_phi > m + m'. The default n_phi is the least multiple of 2g above 2(2 m_max + 1), g the greatest common divisor
 of the orders: the rotation by π/g (c_m → (−1)^(m/g) c_m, the symmetry of a branch's pitchfork on the orders 0, g,
-2g, …) maps the nodes to nodes, so the discrete energy keeps it exactly, not to the quadrature's aliasing.
+2g, …) maps the nodes to nodes, so the discrete energy keeps it exactly, not to the quadrature's aliasing. The sums
+run over the n_phi/g nodes of one period 2π/g (tube/surface/meridian.py ``phi_nodes``).
 """
 import functools
 from dataclasses import dataclass

@@ -18,7 +18,10 @@ degree and the orders separately), the last kept point solved again on it on the
 its tangent, and the trace goes on (REFINE_FAILED where that Newton fails). Where the basis would pass
 resolution.MAX_DEGREE or MAX_HARMONICS the trace goes on at the cap, every point's estimate stored, and the branch is
 flagged ``limited``: never silently. The points are stored on the final basis (the earlier ones zero-padded:
-TubeSurfaceBasis.raised), each with the estimate and the stability read on the basis it was solved on.
+TubeSurfaceBasis.raised), each with the estimate and the stability read on the basis it was solved on. A zero whose
+axisymmetric state is less resolved than the switch's step is refused before its trace (``unresolved``): on the finer
+degree the estimate asks for, the zero itself would move by more than the step (docs/tubes.md: the m = 2 zero in a
+coil's field).
 """
 from dataclasses import dataclass
 
@@ -148,9 +151,24 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
     solver, m = scene.solver, crossing.m
     first = switched_point(scene, disc, crossing, direction * START_AMPLITUDE, params, orders, n_phi, solver.tol,
                            solver.max_newton)
+    zero = first.basis.axisymmetric(crossing.u)
+    unresolved(first, zero, solver.max_error)
     mode = first.basis.with_mode(np.zeros(first.basis.size), m, crossing.mode)
-    return trace_from(scene, first, mode, first.basis.axisymmetric(crossing.u), crossing.pressure, params, direction,
-                      max_points, parent)
+    return trace_from(scene, first, mode, zero, crossing.pressure, params, direction, max_points, parent)
+
+
+def unresolved(first: SwitchedPoint, zero: np.ndarray, max_error: float) -> None:
+    """SurfaceBranchStartError where the zero's axisymmetric state ``zero`` (c on ``first.basis``) has a degree tail
+    (tube/surface/resolution.py) above both ``max_error`` and the switch's step, the largest order-m coefficient of
+    the switched point ``first`` over the mean radius: on the finer degree its estimate asks for, the zero itself moves
+    by more than the step, and the point re-solved there at the same ε is no point of the branch near the start."""
+    parent = resolution.tails(first.basis, zero)[0]
+    step = resolution.spectra(first.basis, first.c)[1][first.basis.orders.index(first.m)]
+    if parent > max(max_error, step):
+        raise SurfaceBranchStartError(
+            f"the zero's axisymmetric state is not resolved: its degree tail {parent:.2g} at degree "
+            f"{first.basis.disc.degree} exceeds solver.max_error {max_error:g} and the switch's step {step:.2g} "
+            f"(ε = {first.amplitude:g}): locate the zero at a higher solver.degree")
 
 
 def trace_from(scene, first: SwitchedPoint, mode: np.ndarray, zero: np.ndarray, pressure: float,

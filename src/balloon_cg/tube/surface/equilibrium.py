@@ -53,7 +53,7 @@ class MeridianSurfaceEquilibrium:
             raise RuntimeError(f"{self.kernels.module.__name__}: node variables {self.kernels.module.SURFACE_STATE}, "
                                f"tube/surface/meridian.py assembles {NODE_VARIABLES}")
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
-        self._normal = np.repeat(basis.reference_normal(), basis.n_phi, axis=1)
+        self._normal = np.repeat(basis.reference_normal(), basis.phi_nodes, axis=1)
 
     def node_state(self, c: np.ndarray) -> np.ndarray:
         """The 9 node variables; NonFiniteState where the surface folds over (a_S × a_φ against the reference's

@@ -20,7 +20,9 @@ R at the quadrature's nodes, never at a pole. Each node variable is Σ_m F_m(t) 
 R S' and ``n_phi`` uniform nodes in φ, weight 1/n_phi: E/(2π) = (1/2π) ∫∫ π R S' dt dφ ≈ Σ_q W_q R_q S'_q Σ_k
 π(t_q, φ_k)/n_phi, exact in φ for products of orders m, m' when n_phi > m + m'. The default n_phi is the least
 multiple of 2g above 2(2 m_max + 1), g the greatest common divisor of the orders: the rotation by π/g (c_m →
-(−1)^(m/g) c_m) maps the nodes to nodes, so the discrete energy keeps the pitchfork's symmetry exactly.
+(−1)^(m/g) c_m) maps the nodes to nodes, so the discrete energy keeps the pitchfork's symmetry exactly. On the orders
+0, g, 2g, … every node variable has the period 2π/g in φ, so the sums run over the n_phi/g nodes of one period
+(``phi_nodes``, weight 1/(n_phi/g)): the same sums over all n_phi nodes, at 1/g of the cost.
 
 A shape is a subclass giving its ``rule`` (nodes' W, R, R', S'), its ``axis`` (the rows of ρ, ρ', η, η' in u and
 their offset) and its per-order ``mode`` rows (R, R', Z, Z', T, T'), primes d/dt: tube/surface/basis.py (R = 1,
@@ -79,18 +81,26 @@ class MeridianSurfaceBasis:
         return slice(start, start + self.mode_size)
 
     @property
+    def phi_nodes(self) -> int:
+        """The nodes in φ the sums run over: the n_phi/g of one period 2π/g, g the greatest common divisor of the
+        orders where it divides n_phi (module docstring), else all n_phi."""
+        period = math.gcd(*self.orders[1:]) if len(self.orders) > 1 else 1
+        return self.n_phi // period if self.n_phi % period == 0 else self.n_phi
+
+    @property
     def phi(self) -> np.ndarray:
-        return 2 * np.pi * np.arange(self.n_phi) / self.n_phi
+        """The ``phi_nodes`` azimuths 2πk/n_phi, k = 0 … phi_nodes − 1."""
+        return 2 * np.pi * np.arange(self.phi_nodes) / self.n_phi
 
     @property
     def weights(self) -> np.ndarray:
-        """(n_q · n_phi,): W_q R_q S'_q / n_phi per node, node order q n_phi + k."""
+        """(n_q · phi_nodes,): W_q R_q S'_q / phi_nodes per node, node order q phi_nodes + k."""
         W, R, _, rate = self.rule()
-        return np.repeat(W * R * rate, self.n_phi) / self.n_phi
+        return np.repeat(W * R * rate, self.phi_nodes) / self.phi_nodes
 
     @property
     def factors(self) -> tuple:
-        """Per order, (F (9, n_q, unknowns of the order), g (9, n_phi)): node variable a (NODE_VARIABLES) is
+        """Per order, (F (9, n_q, unknowns of the order), g (9, phi_nodes)): node variable a (NODE_VARIABLES) is
         Σ_m (F_a c_m)(t_q) g_a(φ_k), g_a = cos mφ or sin mφ (module docstring)."""
         return self.tables()[0]
 
@@ -101,11 +111,12 @@ class MeridianSurfaceBasis:
         return np.array([np.sqrt(np.maximum(rate**2 - dR**2, 0.0)), dR]) / rate
 
     def tables(self) -> tuple:
-        """(the ``factors`` per order, offset (9, n_q, n_phi)), read-only; built by ``meridian_tables``."""
+        """(the ``factors`` per order, offset (9, n_q, phi_nodes)), read-only; built by ``meridian_tables``."""
         raise NotImplementedError
 
     def node_state(self, c: np.ndarray) -> np.ndarray:
-        """(9, n_q · n_phi): x, a_S, a_φ in the frame at every node, node order q n_phi + k (module docstring)."""
+        """(9, n_q · phi_nodes): x, a_S, a_φ in the frame at every node, node order q phi_nodes + k (module
+        docstring)."""
         factors, offset = self.tables()
         out = offset.copy()
         for m, (F, g) in zip(self.orders, factors):
@@ -113,19 +124,19 @@ class MeridianSurfaceBasis:
         return out.reshape(9, -1)
 
     def project(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_a T_aᵀ p_a of node rows p (9, n_q · n_phi), T_a the map of node variable a: Σ_q F_aᵀ Σ_k g_a p_a per
-        order (a residual from W ∂π/∂q)."""
-        p = pointwise.reshape(9, -1, self.n_phi)
+        """Σ_a T_aᵀ p_a of node rows p (9, n_q · phi_nodes), T_a the map of node variable a: Σ_q F_aᵀ Σ_k g_a p_a
+        per order (a residual from W ∂π/∂q)."""
+        p = pointwise.reshape(9, -1, self.phi_nodes)
         out = np.empty(self.size)
         for m, (F, g) in zip(self.orders, self.factors):
             out[self.block(m)] = np.einsum("aq,aqj->j", np.einsum("aqk,ak->aq", p, g), F)
         return out
 
     def hessian(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_ab T_aᵀ diag(h_ab) T_b of node rows h (9, 9, n_q · n_phi), sum-factorised over φ: the block of orders
+        """Σ_ab T_aᵀ diag(h_ab) T_b of node rows h (9, 9, n_q · phi_nodes), sum-factorised over φ: the block of orders
         (m, m') is Σ_ab F_aᵀ diag(Θ_ab) F'_b with Θ_ab(t_q) = Σ_k g_a(φ_k) h_ab(t_q, φ_k) g'_b(φ_k) (9 n_q n² flops
         over all blocks instead of the n_phi times more of the dense node maps)."""
-        h = pointwise.reshape(9, 9, -1, self.n_phi)
+        h = pointwise.reshape(9, 9, -1, self.phi_nodes)
         out = np.empty((self.size, self.size))
         factors = list(zip(self.orders, self.factors))
         for i, (m, (F, g)) in enumerate(factors):
@@ -160,7 +171,7 @@ def meridian_tables(basis: MeridianSurfaceBasis) -> tuple:
     F = np.zeros((9, n_q, basis.axis_size))
     F[0], F[2], F[3], F[5], F[7] = rows[0], rows[2], rows[1] / rate[:, None], rows[3] / rate[:, None], \
         rows[0] / R[:, None]  # r, z, a_S = (ρ', 0, η')/S', a_φ2 = ρ/R
-    factors = [(F, np.ones((9, basis.n_phi)))]
+    factors = [(F, np.ones((9, phi.size)))]
     for m in basis.orders[1:]:
         dR, dZ, dT = (basis.mode(m)[k] / rate[:, None] for k in (1, 3, 5))
         Rm, Zm, Tm = (basis.mode(m)[k] for k in (0, 2, 4))
@@ -168,7 +179,7 @@ def meridian_tables(basis: MeridianSurfaceBasis) -> tuple:
         rows_m = (Rm, Tm, Zm, dR, dT, dZ, -(m * Rm + Tm) * over, (m * Tm + Rm) * over, -m * Zm * over)
         cos, sin = np.cos(m * phi), np.sin(m * phi)
         factors.append((np.array(rows_m), np.array([cos, sin, cos, cos, sin, cos, sin, cos, sin])))
-    offset = np.zeros((9, n_q, basis.n_phi))
+    offset = np.zeros((9, n_q, phi.size))
     for row, value in ((0, axis_offset[0]), (2, axis_offset[2]), (3, axis_offset[1] / rate),
                        (5, axis_offset[3] / rate), (7, axis_offset[0] / R)):
         offset[row] = value[:, None]
