@@ -18,7 +18,7 @@ POINT_COLUMNS = ("pressure", "volume", "amplitude", "reaction", "error_estimate"
 
 
 def write_surface_branches(f, branches: dict | None) -> None:
-    """``branches`` (name -> TubeSurfaceBranch) under ``f``/surface_branches; nothing where None or empty."""
+    """``branches`` (name -> MeridianSurfaceBranch) under ``f``/surface_branches; nothing where None or empty."""
     for name, branch in (branches or {}).items():
         group = f.create_group(f"{GROUP}/{name}")
         basis = branch.basis
