@@ -418,10 +418,10 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
 
     with claim(out_path, "run"):
         check_output(out_path, force)
-        branches, snaps, found, _, clock = computed(scene, primary_only, progress=progress)
+        branches, snaps, found, picture, clock = computed(scene, primary_only, progress=progress)
         extra = {} if command is None else {"command": command}
         return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found,
-                         clock=clock), found
+                         clock=clock, meridian_surface=picture and picture.meridian_surface), found
 
 
 # --- solve -------------------------------------------------------------------------------------------------

@@ -215,13 +215,14 @@ def _switched(scene, branch, bp, started: tuple, amplitude: float, tol: float, m
 
 
 def traced_branch(scene, branch, bp, direction: float = 1.0, max_points: int | None = None,
-                  orders: tuple | None = None, parent: tuple | None = None):
+                  orders: tuple | None = None, parent: tuple | None = None, progress=None):
     """The branch born at the located m ≥ 1 point ``bp`` of the capsule's ``branch``, traced in P from its switched
     point at ε = START_AMPLITUDE (trace.trace_from: refined by capsule_resolution, its mirror sector's
-    stability read at every point); SurfaceBranchStartError where the switched point does not converge."""
+    stability read at every point; ``progress`` told of every traced point); SurfaceBranchStartError where the
+    switched point does not converge."""
     solver = scene.solver
     started = start(scene, branch, bp, orders)
     first = _switched(scene, branch, bp, started, direction * START_AMPLITUDE, solver.tol, solver.max_newton)
     _, zero, mode = started
     return trace_from(scene, first, mode, zero, bp.X[-1], branch.params_at(bp.X), capsule_resolution, direction,
-                      max_points, parent)
+                      max_points, parent, progress)

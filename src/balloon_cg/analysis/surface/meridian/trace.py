@@ -135,12 +135,13 @@ def _stop_rule(scene, leg: _Leg, direction: float, resolving: bool, policy):
 
 def trace_from(scene, first: SwitchedPoint, mode: np.ndarray, zero: np.ndarray, pressure: float,
                params: Parameters, policy, direction: float = 1.0, max_points: int | None = None,
-               parent: tuple | None = None) -> MeridianSurfaceBranch:
+               parent: tuple | None = None, progress=None) -> MeridianSurfaceBranch:
     """The branch through the switched point ``first`` (any MeridianSurfaceBasis), born at the axisymmetric state
     ``zero`` (c on ``first.basis``) at ``pressure`` along the critical ``mode`` (c on ``first.basis``), traced
     (module docstring) with the error estimate and refinement of ``policy`` (the resolution module of the basis'
     shape: ``error_estimate``, ``refined``, MAX_DEGREE, MAX_HARMONICS; tube/surface/resolution.py,
-    capsule_resolution.py); SurfaceBranchStartError where ``first`` did not converge."""
+    capsule_resolution.py); ``progress``: callable(point), told of every traced point; SurfaceBranchStartError where
+    ``first`` did not converge."""
     solver, m = scene.solver, first.m
     if not first.converged:
         raise SurfaceBranchStartError(f"the switched point at ε = {first.amplitude:g} did not converge: "
@@ -157,7 +158,7 @@ def trace_from(scene, first: SwitchedPoint, mode: np.ndarray, zero: np.ndarray, 
     while True:
         path = continuation.trace(leg.system, start, continuation_settings(scene, max(max_points - done, 1)),
                                   _stop_rule(scene, leg, direction, not limited, policy),
-                                  {"LP": np.eye(start.X.size)[-1]})
+                                  {"LP": np.eye(start.X.size)[-1]}, progress)
         stop = path.stop
         # a fold in the step to a point the estimate rejects is found again from the re-solved last point
         folds += [(f.index + done, float(f.point.X[-1])) for f in path.folds
