@@ -124,3 +124,15 @@ def test_a_signal_during_the_trace_keeps_the_points_traced(run, monkeypatch):
     n = len(branch.pressure)
     assert branch.stop.code == StopCode.INTERRUPTED and 2 <= n < len(whole.pressure)
     assert np.max(np.abs(branch.pressure - whole.pressure[:n])) <= 1e-12 * whole.pressure.max()
+
+
+def test_a_sweep_of_a_capsule_with_surface_branches_is_refused_in_one_line(tmp_path):
+    """A sweep member stores no capsule's non-axisymmetric branches: a sweep of such a scene asking for them is
+    refused before anything is computed, in one line naming the key, its value and what is allowed."""
+    from balloon_cg.app.sweep import SweepError, run_sweep
+
+    with pytest.raises(SweepError) as raised:
+        run_sweep(capsule(3.0).with_overrides(SETTINGS), ["M=0:0.001:2"], tmp_path / "sweep.h5")
+    message = str(raised.value)
+    assert message.startswith("surface.branches = 'first'") and 'allowed in a sweep: "none"' in message
+    assert "\n" not in message and not (tmp_path / "sweep.h5").exists()

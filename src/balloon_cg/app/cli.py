@@ -1080,7 +1080,7 @@ def _write_continued(args, picture, attrs, switched: bool) -> int:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
     write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
-              found=picture.incomplete)
+              found=picture.incomplete, meridian_surface=picture.meridian_surface)
     code = interrupted_status(picture.incomplete, args.output, requested())
     if code is not None:
         return code
