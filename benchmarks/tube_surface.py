@@ -34,16 +34,16 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_tube_surface import located_zeros, tube_scene  # noqa: E402
 
+from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium  # noqa: E402
 from balloon_cg.galerkin.equilibrium import Equilibrium  # noqa: E402
 from balloon_cg.galerkin.interval import Mirror  # noqa: E402
+from balloon_cg.io.tube_file import read_tube_run  # noqa: E402
 from balloon_cg.tube import azimuthal  # noqa: E402
 from balloon_cg.tube.azimuthal_crossings import crossings  # noqa: E402
 from balloon_cg.tube.bulge import bulge_branch  # noqa: E402
 from balloon_cg.tube.primary import primary_branch  # noqa: E402
-from balloon_cg.io.tube_file import read_tube_run  # noqa: E402
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis  # noqa: E402
 from balloon_cg.tube.surface.branch import traced_branch  # noqa: E402
-from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium  # noqa: E402
 from balloon_cg.tube.surface.switching import switched_point  # noqa: E402
 
 AMPLITUDE = 0.1

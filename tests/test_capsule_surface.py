@@ -1,4 +1,5 @@
-"""The capsule over (θ, φ) (tube/surface/capsule.py, the engine of tube/surface/meridian.py on a capsule's meridian).
+"""The capsule over (θ, φ) (analysis/surface/meridian/capsule.py, the engine of analysis/surface/meridian/basis.py on
+a capsule's meridian).
 
 Checked against the capsule's axisymmetric discretisation (its orders (0,) restriction: galerkin/equilibrium.py with
 the capsule's own kernels, which take the pole limits symbolically where the engine divides by R at interior nodes)
@@ -9,12 +10,12 @@ import numpy as np
 import pytest
 
 from balloon_cg.analysis.stability import azimuthal
+from balloon_cg.analysis.surface.meridian.capsule import CapsuleSurfaceBasis
+from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import meridian
 from balloon_cg.scene import parse_scene
-from balloon_cg.tube.surface.capsule import CapsuleSurfaceBasis
-from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
 from test_capsule_azimuthal import capsule, random_state
 
@@ -96,7 +97,7 @@ def switched():
     """SPOM1 capsule of length 3 (m_max = 1, to a pole stretch of 1.3: test_capsule_azimuthal's branch), its first
     located m1_held point (P = 1.46129) and the switched points at ε = ±0.05 on the orders (0, 1, 2)."""
     from balloon_cg.analysis.picture import analyse
-    from balloon_cg.tube.surface.capsule import switched_point
+    from balloon_cg.analysis.surface.meridian.capsule import switched_point
 
     scene = capsule(3.0).with_overrides({"stability.m_max": 1, "continuation.stop_stretch": 1.3})
     branch = analyse(scene, pear=False).branches[0]
@@ -109,7 +110,7 @@ def test_on_the_whole_basis_the_rotation_is_gauged_and_the_point_is_the_same(swi
     reflection classes, the disc not symmetric) the reference rotation about y is a second gauge row: Newton converges
     to the same P (1e-10) with both reactions zero (1e-10), the state even in z (its class-1 part 1e-10 of the
     amplitude)."""
-    from balloon_cg.tube.surface.capsule import switched_point
+    from balloon_cg.analysis.surface.meridian.capsule import switched_point
 
     scene, branch, bp, points = switched
     whole = switched_point(scene, branch, bp, 0.05, whole=True)
@@ -175,41 +176,48 @@ def test_a_switched_capsule_point_is_stationary_for_the_written_energy(switched)
     scene, branch, bp, points = switched
     assert abs(points[0.05].pressure - points[-0.05].pressure) <= 1e-12 * bp.X[-1]
     assert 0 < abs(points[0.05].pressure - bp.X[-1]) <= 0.01 * bp.X[-1]
-    rng = np.random.default_rng(5)
     for point in points.values():
         assert point.converged and point.residual <= 1e-10, point.message
-        basis, c, P = point.basis, point.c, point.pressure
-        parts = [basis.with_mode(np.zeros(basis.size), m, c[basis.block(m)]) if m else basis.axisymmetric(
-            c[basis.block(0)]) for m in basis.orders]  # smooth directions: the state's own orders (random ones of
-        #                                            the orthonormal functions of degree 135 have slopes of 1e3)
-        directions = parts + [sum(rng.standard_normal() * part for part in parts) for _ in range(2)]
-        totals, elastics = [], []
-        for d in directions:
-            d = d / np.linalg.norm(d) * np.linalg.norm(c)
-            h = 1e-3
-            values = [written_parts(scene, basis, c + k * h * d, basis.n_phi) for k in (-2, -1, 1, 2)]
-            elastic, volume = ((v[0] - 8 * v[1] + 8 * v[2] - v[3]) / (12 * h) for v in zip(*values))
-            totals.append(elastic - P * volume)
-            elastics.append(elastic)
+        totals, elastics = written_derivatives(scene, point.basis, point.c, point.pressure)
         assert np.max(np.abs(totals)) <= 1e-9 * np.max(np.abs(elastics)), (totals, elastics)
 
 
+def written_derivatives(scene, basis, c, P, seed: int = 5) -> tuple:
+    """(the derivatives of the written energy E_el − P V, of its elastic part) at the state c of ``basis`` along the
+    state's own (nonzero) orders and two random combinations of them (a 4th-order central difference, h = 1e-3 of |c|):
+    smooth directions (random ones of the orthonormal functions of degree 135 have slopes of 1e3)."""
+    rng = np.random.default_rng(seed)
+    parts = [basis.with_mode(np.zeros(basis.size), m, c[basis.block(m)]) if m else basis.axisymmetric(
+        c[basis.block(0)]) for m in basis.orders]
+    parts = [part for part in parts if np.any(part)]  # an order a raised state leaves zero is no direction
+    directions = parts + [sum(rng.standard_normal() * part for part in parts) for _ in range(2)]
+    totals, elastics = [], []
+    for d in directions:
+        d = d / np.linalg.norm(d) * np.linalg.norm(c)
+        h = 1e-3
+        values = [written_parts(scene, basis, c + k * h * d, basis.n_phi) for k in (-2, -1, 1, 2)]
+        elastic, volume = ((v[0] - 8 * v[1] + 8 * v[2] - v[3]) / (12 * h) for v in zip(*values))
+        totals.append(elastic - P * volume)
+        elastics.append(elastic)
+    return totals, elastics
+
+
 def test_the_mirror_sector_has_the_located_zero_and_the_switched_points_read_alike(switched):
-    """The stability of the mirror sector (tube/surface/stability.py on the capsule: the metric of capsule_basis'
-    Gram matrices, the translation and the reference rotation gauged): at the located m1_held point itself
+    """The stability of the mirror sector (analysis/surface/meridian/stability.py on the capsule: the metric of
+    capsule_basis' Gram matrices, the translation and the reference rotation gauged): at the located m1_held point itself
     (axisymmetric, orders 0, 1, 2) one eigenvalue under pressure control vanishes (1e-7 of the next nearest zero:
     the zero of the capsule's held m = 1 block, located by its own code, survives the other gauge, as a null vector
     stays one on any complement; measured −1.3e-10 beside −7.61, the m = 0 block past the pressure maximum, and
     2.00); at the switched points ±ε, images under the rotation by π, the readings are equal (1e-9) under every
     control."""
-    from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
-    from balloon_cg.tube.surface.stability import SectorStability
-    from balloon_cg.tube.surface.system import TubeSurfaceSystem
+    from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium
+    from balloon_cg.analysis.surface.meridian.stability import SectorStability
+    from balloon_cg.analysis.surface.meridian.system import MeridianSurfaceSystem
 
     scene, branch, bp, points = switched
     basis, params = points[0.05].basis, branch.params_at(bp.X)
     zero = basis.axisymmetric(branch.disc.transfer(bp.X[:-1], basis.disc))
-    reader = SectorStability(TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, basis), params, zero))
+    reader = SectorStability(MeridianSurfaceSystem(MeridianSurfaceEquilibrium(scene, basis), params, zero))
     lowest = np.sort(np.abs(reader(zero, params)[0]))
     assert lowest[0] <= 1e-7 * lowest[1], lowest
     readings = [reader(p.c, params.with_value("P", p.pressure)) for p in points.values()]
@@ -244,7 +252,7 @@ def test_at_length_0_the_switched_m1_point_is_the_spheres_pear_turned_by_90_degr
     from dataclasses import replace
 
     from balloon_cg.analysis.results import Block
-    from balloon_cg.tube.surface.capsule import switched_point
+    from balloon_cg.analysis.surface.meridian.capsule import switched_point
     from test_surface import turned_pear
 
     pears, scene, primary, pear_point = length_zero_pear()
@@ -261,16 +269,16 @@ def test_at_length_0_the_switched_m1_point_is_the_spheres_pear_turned_by_90_degr
 @pytest.mark.slow  # 289 s on the loaded machine (4 points on up to 2000 unknowns)
 def test_at_length_0_the_traced_m1_branch_is_the_spheres_pear_turned_by_90_degrees():
     """The capsule of length 0's m = 1 branch born at the copy of its pear point, traced in P (capsule.traced_branch:
-    tube/surface/branch.trace_from with capsule_resolution's refinement, 4 points), is the sphere's pear branch turned
-    by 90°: at every traced point P and λ− of the pear solved at λ2(0) = λ+ (1e-8; measured ≤ 2.3e-11 over the first
+    analysis/surface/meridian/trace.trace_from with capsule_resolution's refinement, 4 points), is the sphere's pear
+    branch turned by 90°: at every traced point P and λ− of the pear solved at λ2(0) = λ+ (1e-8; measured ≤ 2.3e-11 over the first
     five points of a longer trace, 5.7e-9 at its 7th, where the orders reached their cap of 16 with estimates to
     2.3e-9: ``limited``), each point's estimate at most solver.max_error, the branch bending down in P from the
     pear point."""
     from dataclasses import replace
 
     from balloon_cg.analysis.results import Block
-    from balloon_cg.tube.surface.capsule import traced_branch
-    from balloon_cg.tube.surface.switching import SwitchedPoint
+    from balloon_cg.analysis.surface.meridian.capsule import traced_branch
+    from balloon_cg.analysis.surface.meridian.switching import SwitchedPoint
     from test_surface import turned_pear
 
     pears, scene, primary, pear_point = length_zero_pear()

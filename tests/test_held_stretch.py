@@ -15,7 +15,7 @@ import sympy as sp
 
 from balloon_cg.app.cli import main
 from balloon_cg.io.tube_file import discretisation, read_tube_run
-from balloon_cg.tube.results import IntervalStop
+from balloon_cg.analysis.results import IntervalStop
 from test_held_tube import held_scene
 from test_tube import bulge_determinant, symbolic_energy, theta, z
 

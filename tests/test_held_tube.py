@@ -18,7 +18,7 @@ from balloon_cg.model import tube
 from balloon_cg.scene import parse_scene
 from balloon_cg.scene.validation import SceneError
 from balloon_cg.tube.primary import primary_branch
-from balloon_cg.tube.results import IntervalStop
+from balloon_cg.analysis.results import IntervalStop
 from balloon_cg.tube.stability import COMPRESSED
 from test_interval import series
 from test_tube import symbolic_energy, theta, z

@@ -14,13 +14,12 @@ from numpy.polynomial import legendre
 from scipy import optimize
 
 from balloon_cg.tube.primary import primary_branch
-from balloon_cg.tube.results import IntervalStop
 from balloon_cg.galerkin.discretisation import Discretisation
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation, Mirror
 from balloon_cg.model import tube
 from balloon_cg.model.kernels import KernelSet
-from balloon_cg.analysis.results import StopCode
+from balloon_cg.analysis.results import IntervalStop, StopCode
 from balloon_cg.app.cli import main
 from balloon_cg.scene import Control, parse_scene
 from balloon_cg.scene.validation import SceneError

@@ -280,23 +280,24 @@ def test_inspect_and_load_name_the_shape_and_its_aspect(tmp_path, capsys, geomet
 
 
 @pytest.mark.parametrize("geometry", ['shape = "spheroid"\naspect = 1.5', 'shape = "capsule"\nlength = 3'])
-def test_surface_branches_are_none_on_a_capsule_and_a_spheroid_and_taken_on_a_spheroid_when_asked(geometry):
-    """The whole-sphere engine traces a sphere's and a spheroid's m ≥ 1 branches and tube/surface a tube's; a
-    capsule's are not traced. Both scenes default to [surface] branches = "none" (a spheroid's branches are taken
-    when asked for, also with natural frequencies: tests/test_spheroid_surface.py, tests/test_spheroid_frequencies.py);
-    on a capsule asking for them is one line naming the key, its value and what is allowed (with "first" a run ended
-    incomplete, exit 1, every branch not started). The sphere's default stays "first"."""
+def test_surface_branches_are_none_on_a_capsule_and_a_spheroid_and_taken_when_asked(geometry):
+    """The whole-sphere engine traces a sphere's and a spheroid's m ≥ 1 branches, analysis/surface/meridian a
+    capsule's and a tube's. Both scenes default to [surface] branches = "none" and take "first" and "all" when asked
+    (a spheroid's also with natural frequencies: tests/test_spheroid_surface.py, tests/test_spheroid_frequencies.py; a
+    capsule's run: tests/test_capsule_surface_run.py). A capsule of length 0 without a field is refused in one line
+    naming the key, its value and what is allowed (its rigid rotation and relabelling are both zero modes). The
+    sphere's default stays "first"."""
     material = '[material]\npreset = "spom1"\n'
     text = f"{material}[geometry]\n{geometry}\n"
     assert parse_scene(text, "scene").surface.branches == "none"
     assert parse_scene(material, "scene").surface.branches == "first"
     for asked in ("first", "all"):
-        if "spheroid" in geometry:
-            for dynamics in ("", "[dynamics]\nfrequencies = true\n"):
-                scene = parse_scene(f'{text}[surface]\nbranches = "{asked}"\n{dynamics}', "scene")
-                assert scene.surface.branches == asked and scene.dynamics.frequencies == bool(dynamics)
-            continue
-        with pytest.raises(SceneError) as raised:
-            parse_scene(f'{text}[surface]\nbranches = "{asked}"\n', "scene")
-        assert str(raised.value).startswith(f'scene: surface.branches = "{asked}": ') and "allowed: \"none\"" in \
-            str(raised.value) and "\n" not in str(raised.value)
+        for dynamics in ("", "[dynamics]\nfrequencies = true\n"):
+            scene = parse_scene(f'{text}[surface]\nbranches = "{asked}"\n{dynamics}', "scene")
+            assert scene.surface.branches == asked and scene.dynamics.frequencies == bool(dynamics)
+        if "capsule" in geometry:
+            with pytest.raises(SceneError) as raised:
+                parse_scene(f'{material}[geometry]\nshape = "capsule"\nlength = 0\n[surface]\nbranches = "{asked}"\n',
+                            "scene")
+            assert str(raised.value).startswith(f'scene: surface.branches = "{asked}": ') and "allowed: \"none\"" in \
+                str(raised.value) and "\n" not in str(raised.value)

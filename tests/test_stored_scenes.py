@@ -1,7 +1,8 @@
 """A file says what it was computed with: the scene text stored in a run file is read as it was written, also where
 a later version refuses that setting for a new run (scene.tables.startable: continuation.stop_volume at or below the
-reference volume, [surface] branches on a capsule or a spheroid). `inspect`, `plot` and ``bc.load`` read such a file;
-`continue` from it, a new run, is refused in one line (exit 2), as a new run with the setting is."""
+reference volume, [surface] branches on a capsule of length 0 without a field). `inspect`, `plot` and ``bc.load``
+read such a file; `continue` from it, a new run, is refused in one line (exit 2), as a new run with the setting
+is."""
 import shutil
 
 import h5py
@@ -14,7 +15,7 @@ from balloon_cg.scene import SceneError, parse_scene
 from shared_pictures import tube_run_file
 
 SPHERE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 1.6\n'
-CAPSULE = ('[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = 2.0\n[solver]\ndegree = 24\n'
+CAPSULE = ('[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = 0.0\n[solver]\ndegree = 24\n'
            '[stability]\nm_max = 0\n[continuation]\nstop_stretch = 1.4\n')
 
 

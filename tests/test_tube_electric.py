@@ -24,7 +24,7 @@ from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.model import tube
 from balloon_cg.model.membrane import Charged, stretch_derivatives
 from balloon_cg.tube.primary import primary_branch
-from balloon_cg.tube.results import IntervalStop
+from balloon_cg.analysis.results import IntervalStop
 from test_interval import ogden, series, tube_scene
 from test_tube import closed_end_path, dispersion_onset, symbolic_energy, theta, z
 

@@ -172,7 +172,7 @@ def test_a_tube_in_a_coil_field_stops_where_its_membrane_turns_compressed(monkey
     switched off, the fold and the onset (taut) agree between degrees 30 and 50 to 1e-6, while the first located
     point in a compressed state moves by more than 1e-2 in P (measured 0.0623 against 0.2233)."""
     from balloon_cg.tube import primary as primary_module
-    from balloon_cg.tube.results import IntervalStop
+    from balloon_cg.analysis.results import IntervalStop
 
     material = coil_scene(0.01).material
     branch = primary_branch(coil_scene(0.01, stop_stretch=9.0))

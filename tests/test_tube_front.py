@@ -9,7 +9,7 @@ from numpy.polynomial import legendre
 
 from balloon_cg.analysis.branches.problem import ParameterSystem
 from balloon_cg.analysis.branches.resolution import Resolution
-from balloon_cg.analysis.results import Kind
+from balloon_cg.analysis.results import IntervalStop, Kind
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation
 from balloon_cg.galerkin.interval_elements import collocated, element_interval
@@ -21,7 +21,6 @@ from balloon_cg.scene.tables import Ends
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.front import front_bulge, refined_layout
 from balloon_cg.tube.primary import TubeSystem, held, primary_branch
-from balloon_cg.tube.results import IntervalStop
 from balloon_cg.tube.stability import _counts_by_one_factor, arrow_factor, unstable_counts
 from test_tube_maxwell import LENGTH, check_chain, maxwell, ogden_1972_tube  # noqa: F401 (the fixture)
 

@@ -5,7 +5,7 @@ import numpy as np
 from numpy.polynomial import legendre
 
 from balloon_cg.analysis.branches.resolution import Resolution
-from balloon_cg.analysis.results import Kind, StopCode
+from balloon_cg.analysis.results import IntervalStop, Kind, StopCode
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.galerkin.interval import IntervalDiscretisation
 from balloon_cg.model import tube
@@ -13,7 +13,6 @@ from balloon_cg.tube.accuracy import first_integral, first_integral_spread
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.primary import primary_branch
 from balloon_cg.tube.resolution import resolved_bulge_branch
-from balloon_cg.tube.results import IntervalStop
 from shared_pictures import first_bulge_picture
 from test_interval import ogden, tube_scene
 

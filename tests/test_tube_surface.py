@@ -8,13 +8,13 @@ from the metric's eigenvalues, Ogden's Φ, the pressure's work over the volume b
 import numpy as np
 import pytest
 
+from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation
 from balloon_cg.numerics.eigen import GramFactor, restricted
 from balloon_cg.scene import parse_scene
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
-from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
 ENDS = ("sliding", "plugged", "held")
 

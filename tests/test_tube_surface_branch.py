@@ -10,16 +10,18 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium
+from balloon_cg.analysis.surface.meridian.stability import SectorStability
+from balloon_cg.analysis.surface.meridian.switching import mode_row, point_at_amplitude
+from balloon_cg.analysis.surface.meridian.system import MeridianSurfaceSystem
+from balloon_cg.analysis.surface.meridian.trace import START_AMPLITUDE
 from balloon_cg.galerkin.equilibrium import Equilibrium
 from balloon_cg.scene import Control, SceneError
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
-from balloon_cg.tube.surface.branch import START_AMPLITUDE, traced_branch
-from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
-from balloon_cg.tube.surface.stability import SectorStability
+from balloon_cg.tube.surface.branch import traced_branch
 from balloon_cg.tube.surface.resolution import harmonics
-from balloon_cg.tube.surface.switching import mode_row, point_at_amplitude, switched_point
-from balloon_cg.tube.surface.system import TubeSurfaceSystem
+from balloon_cg.tube.surface.switching import switched_point
 from test_tube_surface import located_zeros, tube_scene
 
 POINTS = 6
@@ -104,7 +106,7 @@ def test_stability_at_the_first_points_follows_the_normal_form(traced):
     of the largest) plus one where that sign is negative."""
     scene, parent, zero, plus, _ = traced
     p2 = (switched_point(scene, parent.disc, zero, START_AMPLITUDE, parent.params).pressure - zero.pressure) / 0.05**2
-    system = TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, plus.basis), parent.params, plus.coefficients[0])
+    system = MeridianSurfaceSystem(MeridianSurfaceEquilibrium(scene, plus.basis), parent.params, plus.coefficients[0])
     read = SectorStability(system)
     eq = Equilibrium(scene, parent.disc)
     free, h = parent.disc.free, 1e-5
@@ -180,7 +182,7 @@ def test_a_signal_while_reading_the_stability_keeps_the_points_read(traced, monk
     unread (a tube run ignored SIGTERM for 388 s there)."""
     from balloon_cg.analysis.results import StopCode
     from balloon_cg.numerics import interrupt
-    from balloon_cg.tube.surface import branch as module
+    from balloon_cg.analysis.surface.meridian import trace as module
 
     scene, parent, zero, whole, _ = traced
     calls = []
@@ -209,7 +211,7 @@ def test_a_signal_during_the_trace_keeps_every_traced_point_read(traced, monkeyp
     readings' own cut is for a signal that comes while they run), each the uninterrupted branch's."""
     from balloon_cg.analysis.results import StopCode
     from balloon_cg.numerics import interrupt
-    from balloon_cg.tube.surface import branch as module
+    from balloon_cg.analysis.surface.meridian import trace as module
 
     scene, parent, zero, whole, _ = traced
     calls, stretch = [], module.largest_hoop_stretch

@@ -11,13 +11,13 @@ a stretched membrane, docs/tubes.md): a zero of the discretised problem, the swi
 import numpy as np
 import pytest
 
+from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.galerkin.interval import IntervalDiscretisation
 from balloon_cg.numerics.eigen import NO_CONSTRAINT, GramFactor, restricted
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.primary import scene_parameters
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
-from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
 from test_tube_field import biot_savart_squared
 from test_tube_surface import random_state, tube_scene, written_energy, written_point

@@ -13,12 +13,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from balloon_cg.analysis.results import Kind, StopCode
+from balloon_cg.analysis.results import IntervalStop, Kind, StopCode
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.tube.bulge import UnswitchableBranchPoint, bulge_branch
 from balloon_cg.tube.picture import branch_name, rejoined_at, switchable, tube_picture
 from balloon_cg.tube.primary import primary_branch, volume_ratio
-from balloon_cg.tube.results import IntervalStop
 from balloon_cg.galerkin.equilibrium import Equilibrium
 
 from test_interval import tube_scene

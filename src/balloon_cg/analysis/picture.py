@@ -8,9 +8,9 @@ and adds its mirror image (north and south poles swapped: the reflection z → �
 assessments in a scene invariant under it, ``mirror``; traced and assessed where it cannot be reflected),
 locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
 branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
-whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks) and lists the
-snap-throughs under the scene's loading control
-(pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
+whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks; a capsule's over
+(θ, φ), along +φ: ``surface.meridian.capsule``, ``Picture.meridian_surface``) and lists the snap-throughs under the
+scene's loading control (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
 LN or BP) and its m ≥ 1 points, and the pear branch the broken symmetry disconnects from it is found by
@@ -32,19 +32,23 @@ import numpy as np
 from .branches import events
 from .points import azimuthal_points, branch_points as bifurcation, control_points, free_pitchforks
 from .surface import branches as surface_branches, pitchforks as surface_pitchforks, primary as surface_primary
+from .surface.meridian import capsule
+from .surface.meridian.trace import SurfaceBranchStartError
 from .switching import broken_symmetry, mirror
 from ..scene import Control, Geometry
+from ..scene.tables import Shape
 from .branches.control import FOLD_KIND, control_value, control_values, minimised_energy
 from .switching.mirror import MIRROR
 from .branches.primary import trace_primary
 from .branches.problem import equilibrium_of
-from .results import Block, Branch, Gauge, Kind, Origin, Status, StopCode
+from .results import Block, Branch, Gauge, IntervalStop, Kind, Origin, Status, StopCode
 from .stability.axisymmetric import assess_branch, assessed_degrees
 from .switching.pear import mark_rejoin, trace_pear
 from .timing import Clock, Step
 from .branches.tracer import ContinuationError
 from .verdict import Gap, Incomplete, incomplete
 from ..numerics import interrupt, workers
+from ..numerics.continuation import TraceStop
 from ..numerics.threads import limited_blas
 
 
@@ -132,6 +136,7 @@ class Picture:
     not_asked: list = field(default_factory=list)  # (names, reason) of branch points whose branches the scene did
     #                                                not ask for (``[surface] branches = "first"``)
     surface_branches: list = field(default_factory=list)  # SurfaceBranch from the m ≥ 1 points (surface_branches)
+    meridian_surface: dict = field(default_factory=dict)  # a capsule's: name -> MeridianSurfaceBranch (``capsule``)
     interrupted: bool = False  # a signal stopped the analysis (numerics.interrupt): later phases not computed
     interrupted_in: str = ""  # the phase it stopped (a timing.Step value; "" where none had started)
     clock: Clock = field(default_factory=Clock)  # seconds per phase (``timing``)
@@ -151,12 +156,28 @@ class Picture:
     def incomplete(self) -> list[Incomplete]:
         """What the picture lacks against the contract (``verdict``); empty when it is complete."""
         found = incomplete(self.branches + self.surface_branches, self.not_searched, tuple(self.not_started),
-                           tuple(self.not_switched), tuple(self.not_asked))
+                           tuple(self.not_switched), tuple(self.not_asked)) + meridian_gaps(self.meridian_surface)
         if self.interrupted:
             during = f" during {self.interrupted_in}" if self.interrupted_in else ""
             found.append(Incomplete(Gap.INTERRUPTED, self.primary.name, f"interrupted by a signal{during}: the "
                                     "branches and phases after the stored points were not computed"))
         return found
+
+
+MERIDIAN_ENDS = (IntervalStop.REJOINED, IntervalStop.HOOP_STRETCH, StopCode.INTERRUPTED)  # stops that end it whole
+
+
+def meridian_gaps(branches: dict) -> list[Incomplete]:
+    """What a capsule's non-axisymmetric branches (name -> MeridianSurfaceBranch) lack: LIMITED where one ended at
+    [surface] max_points or its basis' cap (stated), STOPPED_SHORT where it stopped otherwise before its ends
+    (MERIDIAN_ENDS: back through the axisymmetric states, stop_stretch, or a signal, which the picture states)."""
+    found = []
+    for name, branch in branches.items():
+        if branch.stop.code == TraceStop.MAX_POINTS or branch.limited:
+            found.append(Incomplete(Gap.LIMITED, name, branch.stop.message))
+        elif branch.stop.code not in MERIDIAN_ENDS:
+            found.append(Incomplete(Gap.STOPPED_SHORT, name, branch.stop.message))
+    return found
 
 
 def _assess(branch: Branch, scene, symmetric: bool, progress: Progress, clock: Clock) -> bool:
@@ -245,7 +266,8 @@ def _examine(scene, picture: Picture, progress: Progress, pear: bool, control: b
                 if stopped(picture):
                     return
             unsearched_events(picture, scene)
-        progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches))
+        progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches)
+                        + sum(len(b.pressure) for b in picture.meridian_surface.values()))
     label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
@@ -521,6 +543,9 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
         if stopped(picture):
             return
         name = surface_name(branch, k, bp)
+        if scene.geometry.shape == Shape.CAPSULE:
+            _trace_capsule(scene, branch, k, bp, picture, progress)
+            continue
         try:
             pair = surface_pair(branch, k, bp, scene.surface.max_points, progress)
         except surface_branches.SurfaceStartError as error:
@@ -528,6 +553,24 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
             continue
         picture.surface_branches += pair
         _classified(branch, bp, pair[0])
+
+
+def _trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress: Progress) -> None:
+    """The capsule's branch born at the m ≥ 1 point ``bp`` (number ``k`` in ``branch.branch_points()``), along +φ
+    (the −φ half its image under the rotation by π/m), over (θ, φ) (``capsule.traced_branch``: refined by its error
+    estimate, its mirror sector's stability at every point) into ``Picture.meridian_surface``; listed in
+    ``not_started`` where its switched point does not converge. A signal stops its trace at the next point, the points
+    traced kept (StopCode.INTERRUPTED), and the analysis."""
+    name = surface_name(branch, k, bp)
+    with progress.budget(Phase.SURFACE, scene.surface.max_points) as tick:
+        try:
+            traced = capsule.traced_branch(scene, branch, bp, parent=(branch.name, k), progress=tick)
+        except SurfaceBranchStartError as error:
+            picture.not_started.append((name, str(error)))
+            return
+    picture.meridian_surface[name] = traced
+    if traced.stop.code == StopCode.INTERRUPTED:
+        stopped(picture)
 
 
 def surface_name(branch: Branch, k: int, bp) -> str:

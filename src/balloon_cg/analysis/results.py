@@ -15,6 +15,7 @@ import numpy as np
 
 from ..galerkin.discretisation import Discretisation
 from ..galerkin.equilibrium import Parameters
+from ..numerics import interrupt
 from ..numerics.continuation import RootStatus, Stop, TraceStop  # noqa: F401  (re-exported: one vocabulary)
 from ..scene import Scene
 
@@ -155,6 +156,23 @@ class StopCode(enum.StrEnum):
         return cls.BOTTOM_STOP_STRETCH if value == "south_stop_stretch" else None
     ALPHA1_ZERO = "alpha1_zero"  # the α1 continuation reached α1 = 0
     INTERRUPTED = "interrupted"  # SIGINT/SIGTERM asked the computation to stop (numerics.interrupt)
+
+
+class IntervalStop(enum.StrEnum):
+    """Why an interval branch stopped (beside the tracer's TraceStop)."""
+
+    HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
+    REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
+    COMPRESSED = "compressed"  # in a coil field, the membrane turned compressed after being taut (tube/stability.py)
+    UNRESOLVED = "unresolved"  # a point's Legendre tail passed solver.max_error (tube/resolution.py); not stored
+    HELD_RANGE = "held_range"  # continued in the held distance (tube/stretch.py), λ left [1, 5]; not stored
+
+
+def signalled() -> Stop | None:
+    """The stop of a trace at its next point once SIGINT or SIGTERM asked for one (numerics.interrupt), else None."""
+    if interrupt.requested():
+        return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
+    return None
 
 
 class Origin(enum.StrEnum):

@@ -159,7 +159,8 @@ class Result:
     @classmethod
     def of(cls, scene: Scene, branches, snaps=None, found=None, picture=None, command: str = "",
            clock=None) -> "Result":
-        image = run_image(scene, branches, {"command": command or command_line()}, snaps, found, clock)
+        image = run_image(scene, branches, {"command": command or command_line()}, snaps, found, clock,
+                          None if picture is None else picture.meridian_surface)
         return cls(scene, image, read_run_image(image, scene.name), picture)
 
     @property

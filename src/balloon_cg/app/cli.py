@@ -418,10 +418,10 @@ def run_scene(scene, out_path, force: bool = False, progress: bool = False, comm
 
     with claim(out_path, "run"):
         check_output(out_path, force)
-        branches, snaps, found, _, clock = computed(scene, primary_only, progress=progress)
+        branches, snaps, found, picture, clock = computed(scene, primary_only, progress=progress)
         extra = {} if command is None else {"command": command}
         return write_run(out_path, scene, branches, force=force, extra_attrs=extra, snaps=snaps, found=found,
-                         clock=clock), found
+                         clock=clock, meridian_surface=picture and picture.meridian_surface), found
 
 
 # --- solve -------------------------------------------------------------------------------------------------
@@ -1080,7 +1080,7 @@ def _write_continued(args, picture, attrs, switched: bool) -> int:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
     write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
-              found=picture.incomplete)
+              found=picture.incomplete, meridian_surface=picture.meridian_surface)
     code = interrupted_status(picture.incomplete, args.output, requested())
     if code is not None:
         return code

@@ -131,7 +131,45 @@ def summarise_run(run: dict) -> dict:
                                                   "rejoin_label": rejoin_label(run, name)}
                      for name, b in run["branches"].items()},
         "snap_throughs": run.get("snap_throughs", []),
-    }
+    } | _capsule_surface(run)
+
+
+def _capsule_surface(run: dict) -> dict:
+    """{'surface_branches': a capsule's non-axisymmetric branches (``surface_branch_summaries``)} where the run file
+    has them, else {}."""
+    found = run.get("meridian_surface")
+    return {"surface_branches": surface_branch_summaries(found, run["attrs"].get("control", "pressure"))} if found else {}
+
+
+def surface_branch_summaries(found: dict, control: str) -> dict:
+    """{name: {'m', 'parent' {'branch', 'zero'}, 'points', 'pressure', 'volume', 'amplitude' ranges, 'stable_points'
+    (under the file's control), 'largest_error_estimate', 'limited' (the basis at its cap: estimates above
+    solver.max_error; False in files before it), 'folds' [{'after_point', 'pressure'}], 'stop_code', 'stop_message'}}
+    of a tube's or a capsule's non-axisymmetric branches (io/tube_surface_file.py)."""
+    def span(values):
+        return [float(values.min()), float(values.max())]
+
+    return {name: {"m": int(b["attrs"]["m"]),
+                   "parent": {"branch": b["attrs"]["parent_branch"], "zero": int(b["attrs"]["parent_zero"])},
+                   "points": len(b["pressure"]), "pressure": span(b["pressure"]), "volume": span(b["volume"]),
+                   "amplitude": span(b["amplitude"]), "stable_points": int((b[f"unstable_{control}"] == 0).sum()),
+                   "largest_error_estimate": float(b["error_estimate"].max()),
+                   "limited": bool(b["attrs"].get("limited", False)),
+                   "folds": [{"after_point": i, "pressure": p} for i, p in b["folds"]],
+                   "stop_code": b["attrs"]["stop_code"], "stop_message": b["attrs"]["stop_message"]}
+            for name, b in found.items()}
+
+
+def surface_branch_lines(name: str, b: dict, control: str, origin: str) -> list[str]:
+    """The lines of a tube's or a capsule's non-axisymmetric branch (``surface_branch_summaries``), born at
+    ``origin`` (its zero or branch point) of its parent branch."""
+    return [f"surface branch {name} (m = {b['m']}, from {origin} of {b['parent']['branch']}): {b['points']} points, "
+            f"P {b['pressure'][0]:.8g}..{b['pressure'][1]:.8g}, "
+            f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, amplitude {b['amplitude'][0]:.4g}.."
+            f"{b['amplitude'][1]:.4g}, stop {b['stop_code']} ({b['stop_message']}); {b['stable_points']} "
+            f"stable under {control} control; largest error estimate "
+            f"{b['largest_error_estimate']:.2g}{' (limited: the basis at its cap)' if b['limited'] else ''}",
+            *(f"  LP after point {f['after_point']:<4} P = {f['pressure']:.10g}" for f in b["folds"])]
 
 
 def run_time(attrs: dict) -> dict | None:
@@ -259,6 +297,9 @@ def format_run(run: dict) -> str:
     ]
     for name, b in summary["branches"].items():
         lines += ["", *_format_branch(name, b)]
+    for name, b in summary.get("surface_branches", {}).items():
+        lines += ["", *surface_branch_lines(name, b, p.get("control", "pressure"),
+                                            f"branch point {b['parent']['zero']}")]
     for s in summary["snap_throughs"]:
         target = f"{s['to_branch']} point {s['to_index']}" if s["to_branch"] else "no stable state on the traced branches"
         value = f"{_snap_symbol(run, s['from_branch'])} = {s['pressure']:.10g}"

@@ -301,6 +301,9 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
     """
     if mode not in MODES:
         raise SweepError(f"mode {mode!r}: must be one of {', '.join(MODES)}")
+    if mode == "analysis" and scene.geometry.shape == Shape.CAPSULE and scene.surface.branches != "none":
+        raise SweepError(f"surface.branches = {scene.surface.branches!r}: a sweep member stores no capsule's "
+                         "non-axisymmetric branches (a run file does); allowed in a sweep: \"none\"")
     start = time.perf_counter()
     path = Path(out_path)
     with claim(path, "sweep"):

@@ -16,8 +16,8 @@ def run_tube(scene, output, args) -> int:
     ``not_started``) or the bulge branch stopped unresolved at solver.max_degree (solver.tube_resolution = "refine":
     tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
+    from ..analysis.results import IntervalStop
     from ..tube.picture import tube_picture
-    from ..tube.results import IntervalStop
     from .tube_summary import format_tube, summarise_tube
 
     def picture():

@@ -21,6 +21,7 @@ import tomllib
 
 import numpy as np
 
+from .summaries import surface_branch_lines, surface_branch_summaries
 from ..io.tube_file import CREST, HELD_M1, HOOP, STRETCH, VOLTAGE, discretisation
 from ..scene.tables import parse_stored
 from ..tube.azimuthal import mode_profile
@@ -71,28 +72,9 @@ def summarise_tube(run: dict) -> dict:
             "fixed_pressure": float(primary["pressure"][0]) if parameter != "pressure" else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
-            "branches": branches, "surface_branches": _surface_branches(run.get("surface_branches", {}), control),
+            "branches": branches, "surface_branches": surface_branch_summaries(run.get("surface_branches", {}), control),
             "onset": _onset(run.get("onset"), max_error), "interrupted": a["interrupted"] or None,
             "not_started": [line for line in a["not_started"].split("\n") if line]}
-
-
-def _surface_branches(found: dict, control: str) -> dict:
-    """{name: {'m', 'parent' {'branch', 'zero'}, 'points', 'pressure', 'volume', 'amplitude' ranges, 'stable_points'
-    (under the file's control), 'largest_error_estimate', 'limited' (the basis at its cap: estimates above
-    solver.max_error; False in files before it), 'folds' [{'after_point', 'pressure'}], 'stop_code', 'stop_message'}}
-    of a tube's non-axisymmetric branches (io/tube_surface_file.py)."""
-    def span(values):
-        return [float(values.min()), float(values.max())]
-
-    return {name: {"m": int(b["attrs"]["m"]),
-                   "parent": {"branch": b["attrs"]["parent_branch"], "zero": int(b["attrs"]["parent_zero"])},
-                   "points": len(b["pressure"]), "pressure": span(b["pressure"]), "volume": span(b["volume"]),
-                   "amplitude": span(b["amplitude"]), "stable_points": int((b[f"unstable_{control}"] == 0).sum()),
-                   "largest_error_estimate": float(b["error_estimate"].max()),
-                   "limited": bool(b["attrs"].get("limited", False)),
-                   "folds": [{"after_point": i, "pressure": p} for i, p in b["folds"]],
-                   "stop_code": b["attrs"]["stop_code"], "stop_message": b["attrs"]["stop_message"]}
-            for name, b in found.items()}
 
 
 def _azimuthal(branch: dict, disc) -> dict:
@@ -246,14 +228,8 @@ def format_tube(summary: dict) -> str:
                 lines.append("        lowest Ω²  " + "  ".join(f"{name} {value:.4g}"
                                                          for name, value in s["omega2"].items()))
     for name, b in summary.get("surface_branches", {}).items():
-        lines += ["", f"surface branch {name} (m = {b['m']}, from zero {b['parent']['zero']} of block m = {b['m']} of "
-                      f"{b['parent']['branch']}): {b['points']} points, "
-                      f"P {b['pressure'][0]:.8g}..{b['pressure'][1]:.8g}, "
-                      f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, amplitude {b['amplitude'][0]:.4g}.."
-                      f"{b['amplitude'][1]:.4g}, stop {b['stop_code']} ({b['stop_message']}); {b['stable_points']} "
-                      f"stable under {summary['control']} control; largest error estimate "
-                      f"{b['largest_error_estimate']:.2g}{' (limited: the basis at its cap)' if b['limited'] else ''}"]
-        lines += [f"  LP after point {f['after_point']:<4} P = {f['pressure']:.10g}" for f in b["folds"]]
+        lines += ["", *surface_branch_lines(name, b, summary["control"], f"zero {b['parent']['zero']} of block "
+                                                                        f"m = {b['m']}")]
     onset = summary["onset"]
     if onset is not None:
         name, last = onset["parameter"], onset["last"]

@@ -57,6 +57,12 @@ class Parameters:
         return other
 
 
+def in_field(eq, params: Parameters) -> bool:
+    """Whether coils act on the membrane of ``eq`` (an Equilibrium or a surface over a meridian: its ``coils``) at
+    ``params`` (M ≠ 0): then a translation is no zero mode."""
+    return bool(eq.coils.shape[0] and params.M != 0)
+
+
 class NodeKernels:
     """The generated kernels at fixed nodes (cos θ, sin θ) on a node state held in arrays owned here.
 

@@ -90,6 +90,7 @@ from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .legacy import current
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
                      require_group)
+from .tube_surface_file import read_surface_branches, write_surface_branches
 from .schema import FINITE, MODES, OMEGA2, SPECIAL_OMEGA2, attach_dimensions, check_described, coordinates, scale
 
 FORMAT = "balloon-cg/6"
@@ -106,27 +107,32 @@ class RunFileError(FileError):
 
 
 def write_run(path, scene, branches, force: bool = False, extra_attrs: dict | None = None,
-              snaps: list | None = None, found: list | None = None, clock: Clock | None = None) -> Path:
+              snaps: list | None = None, found: list | None = None, clock: Clock | None = None,
+              meridian_surface: dict | None = None) -> Path:
     """Write the branches traced for ``scene`` to ``path`` atomically; returns the path.
 
     An existing file is kept unless ``force`` (FileExistsError); on any failure the existing file is
     untouched and the temporary file removed. ``extra_attrs`` are added to (or override, except ``format``)
     the root attributes. ``found``: analysis.verdict.Incomplete entries (default: those of ``branches``).
     ``clock``: the run's analysis.timing.Clock (its phases and total stored with the write's own time:
-    ``timing_attrs``). Raises ValueError if a branch holds a point that is not a finite solution.
+    ``timing_attrs``). ``meridian_surface``: a capsule's non-axisymmetric branches (name -> MeridianSurfaceBranch,
+    analysis/picture.Picture.meridian_surface) under /surface_branches/ (io/tube_surface_file.py). Raises ValueError
+    if a branch holds a point that is not a finite solution.
     """
     attrs = _run_attrs(scene, branches, extra_attrs, found)
     with atomic_file(path, force) as f:
         _write_timed(f, attrs, scene, branches, snaps, clock)
+        write_surface_branches(f, meridian_surface)
     return Path(path)
 
 
 def run_image(scene, branches, extra_attrs: dict | None = None, snaps: list | None = None,
-              found: list | None = None, clock: Clock | None = None) -> bytes:
+              found: list | None = None, clock: Clock | None = None, meridian_surface: dict | None = None) -> bytes:
     """The bytes of the file ``write_run`` writes, made in memory (an HDF5 file image; nothing on disk)."""
     attrs = _run_attrs(scene, branches, extra_attrs, found)
     with h5py.File(f"{scene.name}.h5", "w", driver="core", backing_store=False) as f:
         _write_timed(f, attrs, scene, branches, snaps, clock)
+        write_surface_branches(f, meridian_surface)
         f.flush()
         return f.id.get_file_image()
 
@@ -600,7 +606,8 @@ def _read_open(f, label) -> dict:
             missing = [k for k in ("volume", "amount") if isinstance(branch, h5py.Group) and k not in branch]
             if missing:
                 raise RunFileError(f"{label}: branch {name}", f"missing dataset {missing[0]}")
-    return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f, label, RunFileError, written)}
+    return {"scene_name": attrs["scene_name"], "attrs": attrs, **read_branches(f, label, RunFileError, written),
+            "meridian_surface": read_surface_branches(f, label, RunFileError)}
 
 
 ROOT_KINDS = {"scene_name": "str", "scene_toml": "str", "tolerance": "float", "package_version": "str",

@@ -53,12 +53,12 @@ from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror
 from ..galerkin.interval_elements import ElementInterval, element_interval
 from ..scene.tables import Ends
-from ..analysis.results import Kind, StopCode
+from ..analysis.results import IntervalStop, Kind, StopCode
 from ..numerics.continuation import RootStatus, Stop, TraceStop
 from ..tube.accuracy import accuracy
 from ..tube.azimuthal import COUNT, operators
 from ..tube.primary import volume_ratio
-from ..tube.results import IntervalBranch, IntervalSpecial, IntervalStop
+from ..tube.results import IntervalBranch, IntervalSpecial
 from ..scene.loading import Control
 
 FORMAT = "balloon-cg-tube/1"

@@ -1,7 +1,10 @@
-"""A tube's non-axisymmetric branches in its run file (tube/surface/branch.py; docs/hdf5.md "Tube run files"):
-/surface_branches/<name>/ with the attributes ``m``, ``orders``, ``n_phi``, ``degree`` (the final basis: tube/
-surface/basis.py, refined along the branch from the parent's discretisation), ``parent_branch``, ``parent_zero`` (the
-zero's order among the parent's located zeros of block m, as ``inspect`` lists them), ``stop_code``,
+"""A tube's or a capsule's non-axisymmetric branches in its run file (analysis/surface/meridian/trace.py; docs/hdf5.md
+"Tube run files", "Run files"): /surface_branches/<name>/ with the attributes ``m``, ``orders``, ``n_phi``, ``degree``
+(the final basis: tube/surface/basis.py, a capsule's analysis/surface/meridian/capsule.py, refined along the branch
+from the parent's discretisation; a capsule's also ``mode_degree``, its perturbation bases' degree, and ``equator``,
+whether it keeps the states even in z), ``parent_branch``, ``parent_zero`` (the zero's order among the parent's
+located zeros of block m, as ``inspect`` lists them; a capsule's: its number among the parent's branch points, as
+in its name m<m>_bp<k>), ``stop_code``,
 ``stop_message``, ``limited`` (the basis reached its cap with estimates above solver.max_error; absent before it);
 per point ``coefficients`` (n, size: c of the basis), ``pressure``, ``volume`` (V/V0), ``amplitude`` (φᵀ G c_m),
 ``reaction`` (the held centroid's τ), ``error_estimate``, ``lowest`` (n, 3: the mirror sector's lowest eigenvalues
@@ -12,13 +15,31 @@ import numpy as np
 
 from .hdf5 import checksummed, plain
 from ..scene.loading import Control
+from ..scene.tables import Shape
 
 GROUP = "surface_branches"
 POINT_COLUMNS = ("pressure", "volume", "amplitude", "reaction", "error_estimate")
+SURFACE_VARIABLES = {  # (units, long_name, description) of each dataset, as io/schema.py's VARIABLES
+    "point": ("", "point index", "index of the point along the branch, in continuation order (0: the zero)"),
+    "coefficient": ("", "coefficient index", "order 0's unknowns u, then (R, T, Z) per order m ≥ 1 (docs/hdf5.md)"),
+    "eigenvalue": ("", "eigenvalue index", "0: the lowest eigenvalue of the mirror sector, 1: the next, …"),
+    "fold": ("", "fold index", "index of the located fold in P along the branch"),
+    "coefficients": ("1", "surface coefficients c", "c of the branch's final basis (docs/hdf5.md)"),
+    "pressure": ("1", "pressure P", "P = P̄ R0 / (T0 μ/2)"),
+    "volume": ("1", "volume ratio V/V0", "the enclosed volume over the reference one"),
+    "amplitude": ("1", "amplitude", "φᵀ G c_m along the zero's critical mode"),
+    "reaction": ("1", "gauge reaction τ", "the first held zero mode's multiplier (0 at an equilibrium)"),
+    "error_estimate": ("1", "discretisation error estimate", "the shape's resolution policy's estimate (docs/hdf5.md)"),
+    "lowest": ("1", "lowest eigenvalues", "the mirror sector's lowest eigenvalues under pressure control"),
+    **{f"unstable_{c.value}": ("", f"unstable directions, {c.value} control", "negative eigenvalues of the mirror "
+                               "sector") for c in Control},
+    "fold_index": ("", "fold after point", "the fold in P lies between points fold_index and fold_index + 1"),
+    "fold_pressure": ("1", "fold pressure P", "P at the located fold"),
+}
 
 
 def write_surface_branches(f, branches: dict | None) -> None:
-    """``branches`` (name -> TubeSurfaceBranch) under ``f``/surface_branches; nothing where None or empty."""
+    """``branches`` (name -> MeridianSurfaceBranch) under ``f``/surface_branches; nothing where None or empty."""
     for name, branch in (branches or {}).items():
         group = f.create_group(f"{GROUP}/{name}")
         basis = branch.basis
@@ -26,6 +47,8 @@ def write_surface_branches(f, branches: dict | None) -> None:
                             "degree": basis.disc.degree, "parent_branch": branch.parent[0],
                             "parent_zero": branch.parent[1], "stop_code": branch.stop.code.value,
                             "stop_message": branch.stop.message, "limited": branch.limited})
+        if basis.shape == Shape.CAPSULE:
+            group.attrs.update({"mode_degree": basis.mode_degree, "equator": basis.equator})
         checksummed(group, "coefficients", branch.coefficients)
         for column in POINT_COLUMNS:
             checksummed(group, column, getattr(branch, column))
@@ -34,6 +57,29 @@ def write_surface_branches(f, branches: dict | None) -> None:
             checksummed(group, f"unstable_{control.value}", branch.unstable[control])
         checksummed(group, "fold_index", np.array([i for i, _ in branch.folds], dtype=int))
         checksummed(group, "fold_pressure", np.array([p for _, p in branch.folds], dtype=float))
+        _described(group, branch)
+
+
+def _described(group, branch) -> None:
+    """Every dataset of ``group`` described (SURFACE_VARIABLES) and attached to its dimension scales (netCDF-4: the
+    group opens alone in xarray): ``point`` (``fold`` for the folds), and ``coefficient`` or ``eigenvalue``."""
+    items = list(group.items())
+    scales = {}
+    for name, length in (("point", len(branch.pressure)), ("coefficient", branch.coefficients.shape[1]),
+                         ("eigenvalue", branch.lowest.shape[1]), ("fold", len(branch.folds))):
+        scales[name] = checksummed(group, name, np.arange(length, dtype=np.int64))
+        scales[name].make_scale(name)
+        _describe(scales[name], name)
+    for name, item in items:
+        item.dims[0].attach_scale(scales["fold" if name.startswith("fold_") else "point"])
+        if item.ndim == 2:
+            item.dims[1].attach_scale(scales["coefficient" if name == "coefficients" else "eigenvalue"])
+        _describe(item, name)
+
+
+def _describe(dataset, name: str) -> None:
+    units, long_name, description = SURFACE_VARIABLES[name]
+    dataset.attrs.update(({"units": units} if units else {}) | {"long_name": long_name, "description": description})
 
 
 def read_surface_branches(f, path, error) -> dict:

@@ -272,7 +272,6 @@ class Surface:
 
 
 SURFACE_BRANCHES = ("first", "all", "none")
-UNTRACED_SURFACES = (Shape.CAPSULE,)  # shapes whose [surface] branches are "none" and refused (_surface_reads)
 
 
 def default_surface(shape, field, electric, stability) -> Surface:
@@ -281,25 +280,27 @@ def default_surface(shape, field, electric, stability) -> Surface:
     and on a tube in a coil's field or under a voltage, where "first" is taken when asked for but is not the default:
     a trace there may refine to the basis's cap for tens of minutes (a plugged tube in a coil's field), and with
     stability.m_max ≥ 2 the first zero can be the slack state's near P = 0 (docs/tubes.md "The tube over (S, φ)");
-    "none" on a capsule, whose branches are not traced (``_surface_reads``: the whole-sphere engine takes a sphere's
-    or a spheroid's reference; its m ≥ 1 branch points are located all the same), and on a spheroid, where "first"
-    and "all" are taken when asked for but are not the default (docs/shapes.md "The spheroid's surface branches")."""
-    if shape in UNTRACED_SURFACES or shape == Shape.SPHEROID:
+    "none" on a capsule and a spheroid, where "first" and "all" are taken when asked for but are not the default (a
+    capsule's trace over (θ, φ) refines to hundreds or thousands of dense unknowns: minutes per point, docs/tubes.md
+    "The engine over any meridian"; docs/shapes.md "The spheroid's surface branches")."""
+    if shape in (Shape.CAPSULE, Shape.SPHEROID):
         return Surface(branches="none")
     built = not field.coils and electric is None and stability.m_max >= 1
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
-def _surface_reads(surface: Surface, shape, stability) -> None:
-    """SceneError for [surface] branches asked where none can be traced: on a capsule (a run would locate its m ≥ 1
-    branch points and end incomplete, each branch not started), on a tube without the m ≥ 1 zeros
-    they start from (stability.m_max = 0; tube/surface/branch.py)."""
+def _surface_reads(surface: Surface, geometry, field, stability) -> None:
+    """SceneError for [surface] branches asked where none can be traced: on a capsule of length 0 without a field
+    (the m = 1 rigid rotation and the relabelling are two zero modes its one reference row cannot tell apart:
+    analysis/surface/meridian/capsule.py ``gauge_rows``; the sphere's shape traces them), on a tube without the m ≥ 1
+    zeros they start from (stability.m_max = 0; tube/surface/branch.py)."""
     if surface.branches == "none":
         return
-    asked = f"surface.branches = {show(surface.branches)}"
-    if shape in UNTRACED_SURFACES:
-        raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere, a spheroid and a tube, "
-                         f'not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
+    asked, shape = f"surface.branches = {show(surface.branches)}", geometry.shape
+    if shape == Shape.CAPSULE and geometry.length == 0 and not (field.coils and field.M != 0):
+        raise SceneError(f"{asked}: a capsule of length 0 without a field (its m = 1 rigid rotation and relabelling "
+                         f'are both zero modes); allowed: "none", geometry.length > 0, coils with M ≠ 0, or '
+                         f'geometry.shape = "sphere"')
     if shape == Shape.TUBE and stability.m_max < 1:
         raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
                          f'stability.m_max ≥ 1, not {stability.m_max}; allowed: "none" with stability.m_max = 0')
@@ -615,7 +616,7 @@ def startable(scene: Scene) -> Scene:
     new input (``parse_scene``, ``load_scene``, ``Scene.with_overrides``) and where ``continue`` starts from a file's
     scene; not on a file's stored text (``parse_stored``)."""
     _stop_volume_above_reference(scene.continuation.stop_volume, scene.geometry)
-    _surface_reads(scene.surface, scene.geometry.shape, scene.stability)
+    _surface_reads(scene.surface, scene.geometry, scene.field, scene.stability)
     return scene
 
 

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..analysis.stability.azimuthal import lowest_eigenvalues
 from ..galerkin.discretisation import symmetric_rows
-from ..galerkin.equilibrium import Equilibrium, Parameters
+from ..galerkin.equilibrium import Equilibrium, Parameters, in_field
 from ..galerkin.interval import IntervalDiscretisation
 from ..generated import AZIMUTHAL_PAIRS
 from ..numerics.eigen import NO_CONSTRAINT, GramFactor, lowest_of, negative_count, restricted
@@ -110,11 +110,6 @@ def hessian(eq: Equilibrium, u: np.ndarray, params: Parameters, m: int) -> np.nd
     h = node_hessian(eq, u, params, m)[_ROW] * eq.disc.weights  # (6, 6, n_q)
     flat = ops.reshape(-1, ops.shape[2])
     return flat.T @ np.einsum("abq,bqj->aqj", h, ops).reshape(-1, ops.shape[2])
-
-
-def in_field(eq: Equilibrium, params: Parameters) -> bool:
-    """Whether coils act on the tube (M ≠ 0): then the translation is no zero mode."""
-    return bool(eq.coils.shape[0] and params.M != 0)
 
 
 def readings(eq: Equilibrium, params: Parameters, m: int) -> tuple:

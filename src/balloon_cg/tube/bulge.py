@@ -33,10 +33,10 @@ from .accuracy import accuracy
 from .control import VolumeStop, control_monitors, gradient
 from .events import with_events
 from .primary import TubeSystem, held, in_field, stressed, volume_ratio
-from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
+from .results import IntervalBranch, IntervalSpecial
 from .stability import CompressionStop, smallest_stress, unstable_counts
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
-from ..analysis.results import Kind, StopCode
+from ..analysis.results import IntervalStop, Kind, StopCode, signalled
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..galerkin.interval_elements import ElementInterval, collocated

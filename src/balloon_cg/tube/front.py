@@ -30,7 +30,7 @@ from dataclasses import replace
 import numpy as np
 
 from .bulge import bulge_branch
-from .results import IntervalStop
+from ..analysis.results import IntervalStop
 from ..analysis.branches.resolution import Resolution
 from ..galerkin.interval_elements import ElementInterval, element_interval
 from ..numerics.continuation import Stop

@@ -33,9 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .primary import held, volume_ratio
-from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
+from .results import IntervalBranch, IntervalSpecial
 from ..analysis.branches.problem import continuation_settings
-from ..analysis.results import Kind
+from ..analysis.results import IntervalStop, Kind, signalled
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import Mirror
 from ..numerics import continuation

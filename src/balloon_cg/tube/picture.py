@@ -31,11 +31,12 @@ from .bulge import BranchStartError
 from .onset import OnsetCurve, onset_curve
 from .primary import in_field, primary_branch
 from .resolution import REFINE, traced_bulge
-from .surface.branch import SurfaceBranchStartError, traced_branch
-from .results import IntervalBranch, IntervalStop
+from .surface.branch import traced_branch
+from .results import IntervalBranch
 from .stretch import stretch_branch
 from .voltage import voltage_branch
-from ..analysis.results import Kind, StopCode
+from ..analysis.results import IntervalStop, Kind, StopCode
+from ..analysis.surface.meridian.trace import SurfaceBranchStartError
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..galerkin.interval_elements import ElementInterval, collocated
@@ -69,7 +70,7 @@ class TubePicture:
     started, and is absent where it had not); ``frequencies``: with [dynamics] frequencies, each branch's
     (dynamics/tube.py: TubeFrequencies by branch name); ``modes``: each branch's m = 1..``stability.m_max`` blocks
     (tube/azimuthal.TubeModes by branch name; None: not assessed, m_max = 0 or a signal); ``surface``: the
-    non-axisymmetric branches traced from the m ≥ 1 zeros (``with_surface``: tube/surface/branch.TubeSurfaceBranch
+    non-axisymmetric branches traced from the m ≥ 1 zeros (``with_surface``: tube/surface/branch.MeridianSurfaceBranch
     by name; None: none asked); ``not_started``: (name, why) of the switched branches that could not start (the run
     is then incomplete: exit 1)."""
 
@@ -80,7 +81,7 @@ class TubePicture:
     frequencies: dict | None = None
     modes: dict | None = None
     not_started: tuple = ()  # (name, why) of each branch whose first step off its branch point did not converge
-    surface: dict | None = None  # name -> tube/surface/branch.TubeSurfaceBranch ([surface] branches; None: none)
+    surface: dict | None = None  # name -> tube/surface/branch.MeridianSurfaceBranch ([surface] branches; None: none)
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:

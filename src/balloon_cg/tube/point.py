@@ -13,7 +13,7 @@ import numpy as np
 
 from .events import hoop_row
 from .primary import TubeSystem, held, primary_branch, volume_ratio
-from .results import IntervalStop
+from ..analysis.results import IntervalStop
 from ..analysis.branches.problem import ParameterSystem
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import IntervalDiscretisation, Mirror

@@ -27,12 +27,12 @@ import numpy as np
 
 from .control import VolumeStop, control_monitors
 from .events import with_events
-from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
+from .results import IntervalBranch, IntervalSpecial
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
 from .zeros import corrected_zero, is_fold, off_mode_corrector
 from ..analysis.stability.crossings import count_changes
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
-from ..analysis.results import Kind, StopCode
+from ..analysis.results import IntervalStop, Kind, StopCode, signalled
 from ..analysis.branches.tracer import ContinuationError
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror

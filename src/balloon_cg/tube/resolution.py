@@ -18,7 +18,7 @@ from dataclasses import replace
 from .bulge import bulge_branch
 from .front import front_bulge
 from .primary import primary_branch
-from .results import IntervalStop
+from ..analysis.results import IntervalStop
 from ..analysis.branches.resolution import Resolution
 from ..galerkin.interval import Mirror
 from ..numerics.continuation import Stop

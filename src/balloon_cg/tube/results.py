@@ -1,32 +1,13 @@
-"""A tube's branch as plain data: its points, the located points (LP, LV, BP) and why the trace stopped (a signal:
-``signalled``, StopCode.INTERRUPTED)."""
-import enum
+"""A tube's branch as plain data: its points, the located points (LP, LV, BP) and why the trace stopped
+(analysis/results.IntervalStop; a signal: analysis/results.signalled, StopCode.INTERRUPTED)."""
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.results import Kind, StopCode
+from ..analysis.results import Kind
 from ..galerkin.equilibrium import Parameters
 from ..galerkin.interval import IntervalDiscretisation, Mirror
-from ..numerics import interrupt
 from ..numerics.continuation import RootStatus, Stop
-
-
-class IntervalStop(enum.StrEnum):
-    """Why an interval branch stopped (beside the tracer's TraceStop)."""
-
-    HOOP_STRETCH = "hoop_stretch"  # the largest hoop stretch passed continuation.stop_stretch
-    REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
-    COMPRESSED = "compressed"  # in a coil field, the membrane turned compressed after being taut (tube/stability.py)
-    UNRESOLVED = "unresolved"  # a point's Legendre tail passed solver.max_error (tube/resolution.py); not stored
-    HELD_RANGE = "held_range"  # continued in the held distance (tube/stretch.py), λ left [1, 5]; not stored
-
-
-def signalled() -> Stop | None:
-    """The stop of a trace at its next point once SIGINT or SIGTERM asked for one (numerics.interrupt), else None."""
-    if interrupt.requested():
-        return Stop(StopCode.INTERRUPTED, "interrupted (SIGINT or SIGTERM): stopped at this point")
-    return None
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ trace stops where its states turn compressed (``CompressionStop``: there they me
 docs/tubes.md)."""
 import numpy as np
 
-from .results import IntervalStop
+from ..analysis.results import IntervalStop
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..model import meridian
 from ..model.stresses import dielectric_stress, elastic_stresses

@@ -22,12 +22,12 @@ import numpy as np
 
 from .events import along
 from .primary import volume_ratio
-from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
+from .results import IntervalBranch, IntervalSpecial
 from .stability import smallest_stress, spectrum, unstable_counts
 from .zeros import corrected_zero, is_fold, off_mode_corrector
 from ..analysis.branches.problem import continuation_settings
 from ..analysis.stability.crossings import count_changes
-from ..analysis.results import Kind
+from ..analysis.results import IntervalStop, Kind, signalled
 from ..galerkin.equilibrium import Equilibrium, Parameters
 from ..galerkin.interval import Mirror
 from ..numerics import continuation

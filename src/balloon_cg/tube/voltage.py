@@ -29,12 +29,12 @@ from .events import along
 from .zeros import corrected_zero, is_fold
 from .primary import (TubeSystem, _start, discretisation, held, scene_parameters,
                       volume_ratio)
-from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
+from .results import IntervalBranch, IntervalSpecial
 from .stability import smallest_stress, spectrum, unstable_counts
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.branches.tracer import ContinuationError
 from ..analysis.stability.crossings import count_changes
-from ..analysis.results import Kind, StopCode
+from ..analysis.results import IntervalStop, Kind, StopCode, signalled
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..numerics import continuation

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .meridian import NODE_VARIABLES, MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from ...analysis.surface.meridian.basis import NODE_VARIABLES, MeridianSurfaceBasis, default_phi_nodes, meridian_tables
 from ..azimuthal import basis_values, operators, translation
 from ...galerkin.interval import IntervalDiscretisation
 from ...scene.tables import Ends, Shape
@@ -38,7 +38,8 @@ from ...scene.tables import Ends, Shape
 @dataclass(frozen=True)
 class TubeSurfaceBasis(MeridianSurfaceBasis):
     """The interval discretisation ``disc`` per azimuthal order in ``orders`` (ascending, 0 first, distinct) on
-    ``n_phi`` uniform nodes in φ (0: the default of tube/surface/meridian.py): the engine's case R = 1, S' = 1."""
+    ``n_phi`` uniform nodes in φ (0: the default of analysis/surface/meridian/basis.py): the engine's case R = 1,
+    S' = 1."""
 
     disc: IntervalDiscretisation
     orders: tuple = (0, 1)
@@ -86,8 +87,9 @@ class TubeSurfaceBasis(MeridianSurfaceBasis):
         return operators(self.disc)[1]
 
     def gauge_rows(self, field: bool = False) -> np.ndarray:
-        """(rows, size): G t of the sideways translation t in order 1 on sliding ends (tube/surface/system.py), no
-        row where nothing is gauged (plugged ends, no order 1, or in a coil's ``field``)."""
+        """(rows, size): G t of the sideways translation t in order 1 on sliding ends
+        (analysis/surface/meridian/system.py), no row where nothing is gauged (plugged ends, no order 1, or in a coil's
+        ``field``)."""
         if 1 not in self.orders or self.disc.ends != Ends.SLIDING or field:
             return np.zeros((0, self.size))
         row = np.zeros((1, self.size))

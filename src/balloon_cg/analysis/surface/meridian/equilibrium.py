@@ -1,5 +1,5 @@
 """The energy of a surface of revolution over (t, φ), its gradient (the residual) and Hessian (the exact Jacobian) in
-the coefficients c of tube/surface/meridian.py (MODEL.md §8, §10), per 2π:
+the coefficients c of basis.py (MODEL.md §8, §10), per 2π:
 
     E(c) = Σ_nodes W R S' (π(x, a_S, a_φ) − P v),   π = Φ(I, J) − ½ χ M H²(x) − Φ̄² J²,   I = |a_S|² + |a_φ|²,
     J = |a_S × a_φ|,
@@ -8,7 +8,7 @@ the coefficients c of tube/surface/meridian.py (MODEL.md §8, §10), per 2π:
 (codegen/surface.py, the sphere's, with the scene's terms: ``model/kernels.scene_terms``): the reference frame is
 orthonormal in (S, φ/R) as the sphere's in (θ, φ/sin θ), and the density per unit reference area is the same
 function of x, a_1, a_2. They are evaluated at P = 0, i.e. without their cone form of the volume, which misses a
-tube's end planes; the pressure's work is −P v (tube/surface/volume.py: the volume between a tube's end planes, a
+tube's end planes; the pressure's work is −P v (volume.py: the volume between a tube's end planes, a
 capsule's whole). The node variables are frame components (r, t, z): Φ and the dielectric term see only I and J, and
 the coaxial coils' H² (model/loop.field_squared_cartesian, the sphere's) is invariant under rotations about the axis,
 so H² and its derivatives at the point (r, t, z) taken as Cartesian are those at the deformed point in the frame's
@@ -17,18 +17,18 @@ capsule scene takes (scene/tables.py). A node variable is Σ_j T[·, node, j] c_
 
     ∂E/∂c = Σ_a T_aᵀ (W ∂π/∂q_a),   ∂²E/∂c² = Σ_ab T_aᵀ diag(W ∂²π/∂q_a∂q_b) T_b,   ∂R/∂P = −∂Ṽ/∂c
 
-(sum-factorised over φ: tube/surface/meridian.py ``project``, ``hessian``).
+(sum-factorised over φ: basis.py ``project``, ``hessian``).
 """
 import numpy as np
 
 from . import volume
-from .meridian import NODE_VARIABLES, MeridianSurfaceBasis
-from ...galerkin.discretisation import symmetric_rows
-from ...galerkin.equilibrium import NonFiniteState, Parameters
-from ...model.kernels import KernelSet, scene_terms
-from ...model.loop import CARTESIAN, field_squared_cartesian, loop_table
-from ...numerics.newton import finite
-from ...scene.validation import SceneError
+from .basis import NODE_VARIABLES, MeridianSurfaceBasis
+from ....galerkin.discretisation import symmetric_rows
+from ....galerkin.equilibrium import NonFiniteState, Parameters
+from ....model.kernels import KernelSet, scene_terms
+from ....model.loop import CARTESIAN, field_squared_cartesian, loop_table
+from ....numerics.newton import finite
+from ....scene.validation import SceneError
 
 
 def refuse_scene(scene, basis) -> None:
@@ -41,7 +41,7 @@ def refuse_scene(scene, basis) -> None:
 
 class MeridianSurfaceEquilibrium:
     """E, ∇E, ∇²E and V/(2π) of a scene (its coaxial coils and voltage included) in a MeridianSurfaceBasis of its
-    shape (tube/surface/meridian.py: a TubeSurfaceBasis, a CapsuleSurfaceBasis)."""
+    shape (basis.py: a TubeSurfaceBasis, a CapsuleSurfaceBasis)."""
 
     def __init__(self, scene, basis: MeridianSurfaceBasis):
         refuse_scene(scene, basis)
@@ -51,7 +51,7 @@ class MeridianSurfaceEquilibrium:
         self.coils = loop_table(scene.field.coils)
         if tuple(self.kernels.module.SURFACE_STATE) != NODE_VARIABLES:
             raise RuntimeError(f"{self.kernels.module.__name__}: node variables {self.kernels.module.SURFACE_STATE}, "
-                               f"tube/surface/meridian.py assembles {NODE_VARIABLES}")
+                               f"analysis/surface/meridian/basis.py assembles {NODE_VARIABLES}")
         self._pairs = symmetric_rows(self.kernels.module.SURFACE_PAIRS)
         self._normal = np.repeat(basis.reference_normal(), basis.phi_nodes, axis=1)
 

@@ -26,7 +26,7 @@ multiple of 2g above 2(2 m_max + 1), g the greatest common divisor of the orders
 
 A shape is a subclass giving its ``rule`` (nodes' W, R, R', S'), its ``axis`` (the rows of ρ, ρ', η, η' in u and
 their offset) and its per-order ``mode`` rows (R, R', Z, Z', T, T'), primes d/dt: tube/surface/basis.py (R = 1,
-S' = 1: every division exact) and tube/surface/capsule.py.
+S' = 1: every division exact) and capsule.py here.
 """
 import math
 

@@ -1,5 +1,5 @@
 """The equations of a non-axisymmetric branch in P: the gauged equilibrium of a surface over (t, φ)
-(tube/surface/meridian.py).
+(analysis/surface/meridian/basis.py).
 
 At X = (c_f, τ, P) (c_f the free coefficients of the basis, τ the multipliers of the gauge rows, P last:
 numerics/continuation.py's parameter)
@@ -7,19 +7,18 @@ numerics/continuation.py's parameter)
     R(X) = (∇E(c; P) + Σ_i τ_i g_i,  g_i · c) = 0,
 
 g_i = G f_i the rows of the basis' zero modes f_i held (``gauge_rows``: a tube's sideways translation on sliding ends
-without a field; a capsule's translation and rotation about a horizontal axis, tube/surface/capsule.py), τ_i their
+without a field; a capsule's translation and rotation about a horizontal axis, capsule.py), τ_i their
 reactions (0 at an equilibrium: E is invariant under them). Plugged ends hold the rims, and a coil's field
-(M ≠ 0: tube/azimuthal.in_field) makes the translation no symmetry, a tube free to move sideways in it: no gauge,
+(M ≠ 0: galerkin/equilibrium.in_field) makes the translation no symmetry, a tube free to move sideways in it: no gauge,
 X = (c_f, P). The Jacobian is exact (the surface Hessian bordered by the g_i and ∂R/∂P).
 """
 import numpy as np
 
 from .equilibrium import MeridianSurfaceEquilibrium
-from .. import azimuthal
-from ...galerkin.equilibrium import Parameters
+from ....galerkin.equilibrium import Parameters, in_field
 
 
-class TubeSurfaceSystem:
+class MeridianSurfaceSystem:
     """R(X) and its Jacobian (module docstring) of ``surface`` at ``params`` (P replaced by X[-1]); ``template``:
     the coefficients the held unknowns (λ̄ of ends held apart) are read from."""
 
@@ -28,7 +27,7 @@ class TubeSurfaceSystem:
         self.basis = surface.basis
         self.free = self.basis.free
         self.template = np.array(template, dtype=float)
-        self.gauges = self.basis.gauge_rows(azimuthal.in_field(surface, params))[:, self.free]
+        self.gauges = self.basis.gauge_rows(in_field(surface, params))[:, self.free]
         self.gauged = self.gauges.shape[0]
 
     @property
@@ -45,7 +44,7 @@ class TubeSurfaceSystem:
         c[self.free] = X[:self.free.size]
         return c
 
-    def raised(self, X: np.ndarray, to: "TubeSurfaceSystem", direction: bool = False) -> np.ndarray:
+    def raised(self, X: np.ndarray, to: "MeridianSurfaceSystem", direction: bool = False) -> np.ndarray:
         """X on the finer basis of ``to`` (TubeSurfaceBasis.raised: the coefficients zero-padded, τ and P as they
         are), or with ``direction`` a vector of X's space (a tangent: the held unknowns 0)."""
         c = np.zeros(self.basis.size) if direction else self.template.copy()

@@ -10,8 +10,8 @@ inertia, which M does not change, is the stability; the eigenvalues' sizes are o
 import numpy as np
 from scipy import linalg
 
-from ...numerics.eigen import GramFactor, restricted
-from ...scene.loading import Control
+from ....numerics.eigen import GramFactor, restricted
+from ....scene.loading import Control
 
 COUNT = 3  # the lowest eigenvalues stored per point (pressure control)
 
@@ -23,7 +23,7 @@ def metric(basis) -> np.ndarray:
 
 
 class SectorStability:
-    """The readings (module docstring) of the states of ``system`` (tube/surface/system.TubeSurfaceSystem: its
+    """The readings (module docstring) of the states of ``system`` (system.MeridianSurfaceSystem: its
     equilibrium, free unknowns and gauge), M factored once."""
 
     def __init__(self, system):

@@ -1,6 +1,6 @@
 """The resolution of a state of the capsule over (θ, φ) and the refinement of its basis along a branch (the tube's:
-tube/surface/resolution.py, the same three names). In units of the mean hoop stretch ρ̄ (λ2's coefficient of
-φ_0 = 1), per state c:
+tube/surface/resolution.py, the same names: the policy of trace.py). In units of the mean hoop stretch ρ̄ (λ2's
+coefficient of φ_0 = 1), per state c:
 
 - the axis tail: the axisymmetric state's own (Discretisation.tail: each element's series);
 - the mode tail: per order m ≥ 1 the RMS over the reference surface of what its field loses in its L² projection on
@@ -16,7 +16,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...analysis.stability.capsule_basis import capsule_basis
+from ...stability.capsule_basis import capsule_basis
 
 MAX_DEGREE = 256  # the finest degree the policy raises the disc or the perturbation bases to
 MAX_HARMONICS = 16  # the most multiples k of the branch's order m (orders 0, m, …, km)

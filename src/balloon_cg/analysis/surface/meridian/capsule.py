@@ -1,4 +1,4 @@
-"""The capsule over (θ, φ): the engine of tube/surface/meridian.py on a capsule's meridian, its two poles included.
+"""The capsule over (θ, φ): the engine of basis.py on a capsule's meridian, its two poles included.
 
 The coordinate is the polar angle θ ∈ [0, π] of model/meridian.py (S = κθ, κ = 1 + L/π: S' = κ; R = sin κd on the
 caps, d the angle from the nearer pole, 1 on the cylinder). Order 0 is the capsule's axisymmetric state u of its
@@ -8,7 +8,7 @@ piecewise Discretisation (galerkin/elements.py, joined at model/meridian.joins):
 Legendre, C⁰ joined, pole-regular: U ∈ R^(m+1), D ∈ R^(m−1), Z ∈ R^m near a pole, so a_φ = ∂x/∂φ/R is finite there).
 The quadrature is that basis' (Gauss in θ on every element, 3 n + NODE_MARGIN nodes): on it an order's block of the
 Hessian at an axisymmetric state is the capsule's m-block of analysis/stability/azimuthal.py, in the same
-coefficients. The volume is the whole enclosed one (tube/surface/volume.py's flux of x_h/2 through the closed
+coefficients. The volume is the whole enclosed one (volume.py's flux of x_h/2 through the closed
 surface).
 """
 import functools
@@ -16,16 +16,17 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from . import capsule_resolution
 from .capsule_resolution import projected
-from .meridian import MeridianSurfaceBasis, default_phi_nodes, meridian_tables
-from .branch import START_AMPLITUDE, trace_from
+from .basis import MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from .trace import START_AMPLITUDE, trace_from
 from .switching import SwitchedPoint, mode_row, point_at_amplitude
-from ...analysis.stability.capsule_basis import capsule_basis
-from ...analysis.surface.branches import critical_mode, located_degree
-from ...galerkin.discretisation import Discretisation
-from ...model import meridian
-from ...model.meridian import hoop, hoop_rate, joins, metric
-from ...scene.tables import Geometry, Shape
+from ...stability.capsule_basis import capsule_basis
+from ..branches import critical_mode, located_degree
+from ....galerkin.discretisation import Discretisation
+from ....model import meridian
+from ....model.meridian import hoop, hoop_rate, joins, metric
+from ....scene.tables import Geometry, Shape
 
 
 @dataclass(frozen=True)
@@ -122,7 +123,7 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
         return self.perturbations(m).gram[np.ix_(kept, kept)]
 
     def gauge_rows(self, field: bool = False) -> np.ndarray:
-        """(rows, size): G f of the m = 1 zero modes f held (tube/surface/system.py), as quadratures
+        """(rows, size): G f of the m = 1 zero modes f held (system.py), as quadratures
         ½ ∫ f · δx dA of the order-1 rows: the translation along x, f = (R, T, Z) = (1, −1, 0) (the centroid held:
         without a field a zero mode, in a coil's ``field`` the held reading), and the rotation about y of the
         reference, f = (Z0, −Z0, −R0) (∫ (e_y × X) · x dA = 0): without a field the rigid rotation's phase, on a
@@ -198,7 +199,7 @@ def start(scene, branch, bp, orders: tuple | None = None, n_phi: int = 0, whole:
 def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = None, n_phi: int = 0,
                    tol: float = 1e-12, max_iter: int = 30, whole: bool = False) -> SwitchedPoint:
     """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
-    capsule's axisymmetric ``branch`` (``start``), solved by tube/surface/switching.point_at_amplitude
+    capsule's axisymmetric ``branch`` (``start``), solved by switching.point_at_amplitude
     (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
     return _switched(scene, branch, bp, start(scene, branch, bp, orders, n_phi, whole), amplitude, tol, max_iter)
 
@@ -214,12 +215,14 @@ def _switched(scene, branch, bp, started: tuple, amplitude: float, tol: float, m
 
 
 def traced_branch(scene, branch, bp, direction: float = 1.0, max_points: int | None = None,
-                  orders: tuple | None = None, parent: tuple | None = None):
+                  orders: tuple | None = None, parent: tuple | None = None, progress=None):
     """The branch born at the located m ≥ 1 point ``bp`` of the capsule's ``branch``, traced in P from its switched
-    point at ε = START_AMPLITUDE (tube/surface/branch.trace_from: refined by capsule_resolution, its mirror sector's
-    stability read at every point); SurfaceBranchStartError where the switched point does not converge."""
+    point at ε = START_AMPLITUDE (trace.trace_from: refined by capsule_resolution, its mirror sector's
+    stability read at every point; ``progress`` told of every traced point); SurfaceBranchStartError where the
+    switched point does not converge."""
     solver = scene.solver
     started = start(scene, branch, bp, orders)
     first = _switched(scene, branch, bp, started, direction * START_AMPLITUDE, solver.tol, solver.max_newton)
     _, zero, mode = started
-    return trace_from(scene, first, mode, zero, bp.X[-1], branch.params_at(bp.X), direction, max_points, parent)
+    return trace_from(scene, first, mode, zero, bp.X[-1], branch.params_at(bp.X), capsule_resolution, direction,
+                      max_points, parent, progress)

@@ -1,0 +1,138 @@
+"""A capsule scene's `[surface] branches` run end to end (analysis/picture.py ``_trace_capsule``): SPOM1, length 3,
+m_max = 1, its primary branch to V = 65 (continuation.stop_volume: past its first located m1_held point at
+P = 1.46129, tests/test_capsule_surface.py's ``switched``; stop_stretch 3, which bounds the surface branch's largest
+hoop stretch, 2.36 at that point), `[surface] branches = "first"`, max_points 4. The run's m = 1 branch is written
+to the run file and read back, shown by `inspect` (text and JSON); it equals capsule.traced_branch called directly;
+its switched point is stationary for the energy written in tests/test_capsule_surface.py; a signal during its trace
+keeps the points traced, each the uninterrupted run's, and marks the run interrupted.
+"""
+import json
+
+import numpy as np
+import pytest
+
+from balloon_cg.analysis.picture import analyse
+from balloon_cg.analysis.results import StopCode
+from balloon_cg.analysis.surface.meridian import capsule as capsule_surface
+from balloon_cg.io.run_file import read_run, write_run
+from balloon_cg.numerics import interrupt
+from balloon_cg.numerics.threads import limited_blas
+from test_capsule_azimuthal import capsule
+from test_capsule_surface import written_derivatives
+
+POINTS = 4  # [surface] max_points: the zero (point 0) and the switched point count
+SETTINGS = {"stability.m_max": 1, "continuation.stop_stretch": 3.0, "continuation.stop_volume": 65.0,
+            "surface.branches": "first", "surface.max_points": POINTS}
+
+
+def first_held_point(branch):
+    """(k, bp): the branch's first located m1_held point and its number in ``branch.branch_points()``."""
+    return next((k, bp) for k, bp in enumerate(branch.branch_points()) if bp.block.value == "m1_held")
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """(scene, picture, the run file written and read back)."""
+    scene = capsule(3.0).with_overrides(SETTINGS)
+    picture = analyse(scene)
+    path = tmp_path_factory.mktemp("capsule") / "capsule.h5"
+    write_run(path, scene, picture.branches, snaps=picture.snaps, found=picture.incomplete,
+              meridian_surface=picture.meridian_surface)
+    return scene, picture, path, read_run(path)
+
+
+def test_the_run_traces_the_first_m1_branch_and_stores_it(run):
+    """One branch, m1_bp<k> at the primary's first m1_held point, POINTS points (the zero first), its parent named,
+    the picture's one gap its budget (LIMITED: stated, the run complete); stored with its points, stop and basis (the capsule's mode degree and equator flag)."""
+    scene, picture, _, stored = run
+    k, bp = first_held_point(picture.primary)
+    assert list(picture.meridian_surface) == [f"m1_bp{k}"] and not picture.not_started
+    branch = picture.meridian_surface[f"m1_bp{k}"]
+    assert branch.m == 1 and branch.parent == ("primary", k) and len(branch.pressure) == POINTS
+    assert abs(branch.pressure[0] - bp.X[-1]) <= 1e-14 * bp.X[-1]
+    assert branch.stop.code.value == "max_points" and [(i.gap.value, i.branch) for i in picture.incomplete] == [
+        ("limited", f"m1_bp{k}")]  # stated, not failing: the run is complete
+    found = stored["meridian_surface"][f"m1_bp{k}"]
+    assert np.array_equal(found["coefficients"], branch.coefficients)
+    assert np.array_equal(found["pressure"], branch.pressure)
+    assert found["attrs"]["stop_code"] == branch.stop.code.value
+    assert found["attrs"]["mode_degree"] == branch.basis.mode_degree
+    assert bool(found["attrs"]["equator"]) == branch.basis.equator
+
+
+def test_the_stored_branch_is_capsule_traced_branch_called_directly(run):
+    """capsule.traced_branch from the same point, with the same budget and BLAS threads (numerics/threads.py: the
+    run's, ``analyse`` is limited_blas): the same points (coefficients, P, V/V0, amplitude, the mirror sector's
+    lowest eigenvalues) to 1e-12."""
+    scene, picture, _, _ = run
+    k, bp = first_held_point(picture.primary)
+    direct = limited_blas(capsule_surface.traced_branch)(scene, picture.primary, bp, max_points=POINTS,
+                                                         parent=("primary", k))
+    ran = picture.meridian_surface[f"m1_bp{k}"]
+    for name in ("coefficients", "pressure", "volume", "amplitude", "lowest"):
+        ours, theirs = getattr(ran, name), getattr(direct, name)
+        assert ours.shape == theirs.shape and np.max(np.abs(ours - theirs)) <= 1e-12 * np.max(np.abs(theirs)), name
+
+
+def test_the_first_switched_point_is_stationary_for_the_written_energy(run):
+    """Point 1 (the switched point at ε = 0.05, on the final basis: nested, exact) is stationary for the energy
+    written in tests/test_capsule_surface.py: its derivatives along the state's orders below 1e-9 of the elastic
+    part's."""
+    scene, picture, _, _ = run
+    branch = next(iter(picture.meridian_surface.values()))
+    totals, elastics = written_derivatives(scene, branch.basis, branch.coefficients[1], branch.pressure[1])
+    assert np.max(np.abs(totals)) <= 1e-9 * np.max(np.abs(elastics)), (totals, elastics)
+
+
+def test_inspect_shows_it(run, capsys):
+    """`inspect` names the branch with its parent point, points and stop; `--json` has it under surface_branches."""
+    from balloon_cg.app.cli import main
+
+    _, picture, path, _ = run
+    (name, branch), = picture.meridian_surface.items()
+    assert main(["inspect", str(path)]) == 0
+    text = capsys.readouterr().out
+    assert f"surface branch {name} (m = 1, from branch point {branch.parent[1]} of primary): {POINTS} points" in text
+    assert main(["inspect", str(path), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)["surface_branches"][name]
+    assert summary["points"] == POINTS and summary["stop_code"] == branch.stop.code.value
+
+
+def test_a_signal_during_the_trace_keeps_the_points_traced(run, monkeypatch):
+    """A signal at the trace's second point stops it there (INTERRUPTED): the points traced are kept, each the
+    uninterrupted run's (1e-12), and the picture is interrupted (the run file says so; a run is computed again, as
+    the sphere's)."""
+    from balloon_cg.analysis.surface.meridian import trace as module
+
+    scene, picture, _, _ = run
+    whole = next(iter(picture.meridian_surface.values()))
+    calls, stretch = [], module.largest_hoop_stretch
+
+    def signalled_at_the_second(*args):
+        calls.append(1)
+        if len(calls) == 2:
+            interrupt.request()
+        return stretch(*args)
+
+    monkeypatch.setattr(module, "largest_hoop_stretch", signalled_at_the_second)
+    try:
+        cut = analyse(scene)
+    finally:
+        interrupt._flag.clear()
+    assert cut.interrupted and cut.incomplete
+    (branch,) = cut.meridian_surface.values()
+    n = len(branch.pressure)
+    assert branch.stop.code == StopCode.INTERRUPTED and 2 <= n < len(whole.pressure)
+    assert np.max(np.abs(branch.pressure - whole.pressure[:n])) <= 1e-12 * whole.pressure.max()
+
+
+def test_a_sweep_of_a_capsule_with_surface_branches_is_refused_in_one_line(tmp_path):
+    """A sweep member stores no capsule's non-axisymmetric branches: a sweep of such a scene asking for them is
+    refused before anything is computed, in one line naming the key, its value and what is allowed."""
+    from balloon_cg.app.sweep import SweepError, run_sweep
+
+    with pytest.raises(SweepError) as raised:
+        run_sweep(capsule(3.0).with_overrides(SETTINGS), ["M=0:0.001:2"], tmp_path / "sweep.h5")
+    message = str(raised.value)
+    assert message.startswith("surface.branches = 'first'") and 'allowed in a sweep: "none"' in message
+    assert "\n" not in message and not (tmp_path / "sweep.h5").exists()
