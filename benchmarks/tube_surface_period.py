@@ -1,4 +1,4 @@
-"""Benchmark: the tube over (S, φ) summed over one period 2π/g in φ (tube/surface/meridian.py ``phi_nodes``: the
+"""Benchmark: the tube over (S, φ) summed over one period 2π/g in φ (analysis/surface/meridian/basis.py ``phi_nodes``: the
 orders 0, g, 2g, … of a branch born at an m = g zero) against the whole circle (the code before: phi_nodes = n_phi),
 one process, the two alternating (a switch: the property patched), BLAS held to one thread.
 

@@ -22,14 +22,14 @@ second entry carry λ2's 1). Gauss–Legendre in S (the interval's rule, weights
 when n_phi > m + m'. The default n_phi is the least multiple of 2g above 2(2 m_max + 1), g the greatest common divisor
 of the orders: the rotation by π/g (c_m → (−1)^(m/g) c_m, the symmetry of a branch's pitchfork on the orders 0, g,
 2g, …) maps the nodes to nodes, so the discrete energy keeps it exactly, not to the quadrature's aliasing. The sums
-run over the n_phi/g nodes of one period 2π/g (tube/surface/meridian.py ``phi_nodes``).
+run over the n_phi/g nodes of one period 2π/g (analysis/surface/meridian/basis.py ``phi_nodes``).
 """
 import functools
 from dataclasses import dataclass
 
 import numpy as np
 
-from ...analysis.surface.meridian.basis import NODE_VARIABLES, MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from ...analysis.surface.meridian.basis import MeridianSurfaceBasis, default_phi_nodes, meridian_tables
 from ..azimuthal import basis_values, operators, translation
 from ...galerkin.interval import IntervalDiscretisation
 from ...scene.tables import Ends, Shape
