@@ -303,3 +303,21 @@ def length_zero_pear() -> tuple:
     scene = capsule(0.0).with_overrides(settings)
     primary = analyse(scene, pear=False).primary
     return pears, scene, primary, next(p for p in primary.special if p.kind.value == "BP" and p.block == Block.ODD_HELD)
+
+
+def test_a_branch_whose_zero_already_passes_stop_stretch_is_not_started(switched):
+    """On a capsule stop_stretch bounds the primary's pole stretch; the surface branch stops where its largest hoop
+    stretch passes it, which the cylinder's exceeds at the zero (2.26 at the L = 3 point against 1.3): the branch
+    is refused before its trace, naming the key (it stopped at its first point with the run complete before)."""
+    import re
+
+    from balloon_cg.analysis.surface.meridian.capsule import traced_branch
+    from balloon_cg.analysis.surface.meridian.trace import SurfaceBranchStartError
+
+    scene, branch, bp, _ = switched
+    with pytest.raises(SurfaceBranchStartError) as refused:
+        traced_branch(scene, branch, bp)
+    said = re.search(r"largest hoop stretch ([\d.]+) already passes continuation\.stop_stretch 1\.3,",
+                     str(refused.value))
+    assert said and float(said.group(1)) > 2
+

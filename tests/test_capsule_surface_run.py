@@ -136,3 +136,17 @@ def test_a_sweep_of_a_capsule_with_surface_branches_is_refused_in_one_line(tmp_p
     message = str(raised.value)
     assert message.startswith("surface.branches = 'first'") and 'allowed in a sweep: "none"' in message
     assert "\n" not in message and not (tmp_path / "sweep.h5").exists()
+
+
+def test_continue_at_its_m1_label_is_refused_in_one_line(run, capsys):
+    """continue does not switch at a capsule's m ≥ 1 point (run traces that branch): exit 2, one line saying so,
+    nothing written (before: the whole-sphere engine was tried and its refusal spoke of a sphere)."""
+    from balloon_cg.app.cli import main
+
+    _, picture, path, stored = run
+    label = next(p["label"] for p in stored["branches"]["primary"]["special_points"] if p["block"] == "m1_held")
+    out = path.with_name("continued.h5")
+    assert main(["continue", str(path), str(label), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "of a capsule: continue does not switch there yet" in err and not out.exists()
+

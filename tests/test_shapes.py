@@ -301,3 +301,19 @@ def test_surface_branches_are_none_on_a_capsule_and_a_spheroid_and_taken_when_as
                             "scene")
             assert str(raised.value).startswith(f'scene: surface.branches = "{asked}": ') and "allowed: \"none\"" in \
                 str(raised.value) and "\n" not in str(raised.value)
+
+
+@pytest.mark.parametrize("setting, named", [
+    ("[stability]\nm_max = 0\n", "stability.m_max ≥ 1, not 0"),
+    ('[electric]\n[continuation]\nparameter = "voltage"\npressure = 0.15\n',
+     'continuation.parameter = "voltage"')])
+def test_a_capsules_surface_branches_where_none_can_start_are_refused_in_one_line(setting, named):
+    """A capsule's [surface] branches start at its located m ≥ 1 points and are traced in P: with m_max = 0 (no
+    such points) or on a branch continued in the voltage, asking for them is one line naming the key and what is
+    allowed (before: accepted, nothing traced and the run complete, or the voltage taken for the pressure)."""
+    text = f'[material]\npreset = "spom1"\n[geometry]\nshape = "capsule"\nlength = 3\n[surface]\nbranches = "first"\n'
+    with pytest.raises(SceneError) as raised:
+        parse_scene(text + setting, "scene")
+    message = str(raised.value)
+    assert message.startswith('scene: surface.branches = "first": ') and named in message and "\n" not in message
+    assert parse_scene(text.replace('"first"', '"none"') + setting, "scene").surface.branches == "none"

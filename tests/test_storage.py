@@ -211,3 +211,12 @@ def test_a_sweep_member_from_before_a_change_of_its_shapes_readings_says_so(scen
     assert len(_stale_member({"scene_toml": spheroid})) == 1
     assert _stale_member({"scene_toml": spheroid, "readings": READINGS}) == []
     assert _stale_member({"scene_toml": scene.to_toml()}) == []
+
+
+def test_a_continued_file_keeps_the_older_readings_of_its_source():
+    """continue copies its source's branches and starts at its point: the file keeps the source's revision when
+    that is older (io.legacy.inherited_readings), so an outdated source's continuation is shown OUTDATED too."""
+    from balloon_cg.io.legacy import READINGS, inherited_readings
+
+    assert inherited_readings({}) == 0 and inherited_readings({"readings": READINGS}) == READINGS
+    assert inherited_readings({"readings": READINGS + 1}) == READINGS

@@ -1019,6 +1019,7 @@ def _continue(args) -> int:
     from ..analysis.results import Kind
     from ..analysis.critical.second_parameter import UnknownParameter
     from ..io.curve_file import write_curve
+    from ..io.legacy import inherited_readings
     from ..io.output import check_output
     from ..io.run_file import read_run
     from ..numerics.interrupt import Interrupted, requested, sigterm_raises, stop_on_signals
@@ -1051,7 +1052,8 @@ def _continue(args) -> int:
             return curve_interrupted_status(None, args.output, True)
         except TwoParameterError as e:
             raise Failure(f"the curve from label {args.label} could not start: {e}") from None
-        attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}"}
+        attrs = {"command": args.command_line, "continued_from": f"{args.run} label {args.label}",
+                 "readings": inherited_readings(stored["attrs"])}  # its start and copied branches are the file's
         if isinstance(result, Picture):
             return _write_continued(args, result, attrs, start.point.kind == Kind.BP)
         write_curve(args.output, result.scene, result, name=curve_group(result), force=args.force, extra_attrs=attrs)
@@ -1080,7 +1082,7 @@ def _write_continued(args, picture, attrs, switched: bool) -> int:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
     write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
-              found=picture.incomplete, meridian_surface=picture.meridian_surface)
+              found=picture.incomplete)
     code = interrupted_status(picture.incomplete, args.output, requested())
     if code is not None:
         return code

@@ -60,7 +60,7 @@ from ..numerics import continuation, interrupt
 from ..numerics.continuation import Stop, TraceStop
 from ..io.run_file import stored_scene
 from ..scene import SceneError
-from ..scene.tables import startable
+from ..scene.tables import Shape, startable
 from ..post.quantities import branch_discretisation
 
 
@@ -375,6 +375,9 @@ def switch(start: Labelled, progress=None) -> Picture:
         label_readings(picture.branches[1:])
         return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted,
                        interrupted_in=picture.interrupted_in, clock=clock)
+    if point.m >= 1 and branch.scene.geometry.shape == Shape.CAPSULE:
+        raise RestartError(f"{what} of a capsule: continue does not switch there yet; its branch is traced by run "
+                           "with [surface] branches = \"first\" or \"all\"")
     if point.m >= 1:  # held, or free on an equator-symmetric branch (its held states are free equilibria)
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
         try:

@@ -65,8 +65,8 @@ def format_sweep(summary: dict) -> str:
 
 
 def _stale_member(attrs) -> list[str]:
-    """``stale_readings`` of a sweep member (its scene's shape, its own provenance: a resumed sweep's members
-    may come from two versions)."""
+    """``stale_readings`` of a file or sweep member whose attributes ``attrs`` hold its scene (``scene_toml``) and
+    provenance (a resumed sweep's members may come from two versions)."""
     from ..scene.tables import parse_stored
 
     return stale_readings(attrs, parse_stored(attrs["scene_toml"], "member").geometry.shape.value)
@@ -91,14 +91,17 @@ def summarise_curves(path) -> dict:
                         "of": c["attrs"].get("of", "BP"),
                         "points": len(c["q"]), "q": _range(c["q"]), "pressure": _range(c["pressure"]),
                         "special_points": c["special_points"], "meetings": curve_meetings(c)}
-    return {"file": str(path), "kind": "curve", "provenance": attrs, "curves": curves}
+    return {"file": str(path), "kind": "curve", "provenance": attrs, "stale_readings": _stale_member(attrs),
+            "curves": curves}
 
 
 def format_curves(summary: dict) -> str:
     p = summary["provenance"]
     lines = [f"file           {summary['file']}", f"scene          {p.get('scene_name')}",
              f"created        {p.get('created')}  (balloon-cg {p.get('package_version')}, format {p.get('format')})",
-             f"command        {p.get('command')}"]
+             f"command        {p.get('command')}",
+             *(f"OUTDATED       written before this version changed its readings: {what}"
+               for what in summary["stale_readings"])]
     for name, c in summary["curves"].items():
         critical = c["critical_q"]
         lines += ["", f"two-parameter curve {name}   (of {c['of']} points, in {c['parameter']}, degree {c['degree']})",

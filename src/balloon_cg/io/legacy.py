@@ -59,6 +59,12 @@ def current(f):
         yield copy
 
 
+def inherited_readings(attrs) -> int:
+    """The ``readings`` revision of a file continued from the one whose root attributes are ``attrs``: the older of
+    the two (its start point and the branches it copies were read under that file's revision)."""
+    return min(int(attrs.get("readings", 0)), READINGS)
+
+
 def stale_readings(attrs, shape: str) -> list[str]:
     """What changed, since the file whose root attributes are ``attrs`` was written, in the readings it stores of
     a ``shape`` scene (``CHANGED_READINGS``; empty when none did)."""

@@ -289,11 +289,12 @@ def default_surface(shape, field, electric, stability) -> Surface:
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
-def _surface_reads(surface: Surface, geometry, field, stability) -> None:
+def _surface_reads(surface: Surface, geometry, field, stability, continuation) -> None:
     """SceneError for [surface] branches asked where none can be traced: on a capsule of length 0 without a field
     (the m = 1 rigid rotation and the relabelling are two zero modes its one reference row cannot tell apart:
-    analysis/surface/meridian/capsule.py ``gauge_rows``; the sphere's shape traces them), on a tube without the m ≥ 1
-    zeros they start from (stability.m_max = 0; tube/surface/branch.py)."""
+    analysis/surface/meridian/capsule.py ``gauge_rows``; the sphere's shape traces them), on a tube or a capsule
+    without the m ≥ 1 zeros they start from (stability.m_max = 0; tube/surface/branch.py), on a capsule continued
+    in the voltage (its meridian engine traces in P at a fixed Φ̄: analysis/surface/meridian/trace.py)."""
     if surface.branches == "none":
         return
     asked, shape = f"surface.branches = {show(surface.branches)}", geometry.shape
@@ -301,9 +302,13 @@ def _surface_reads(surface: Surface, geometry, field, stability) -> None:
         raise SceneError(f"{asked}: a capsule of length 0 without a field (its m = 1 rigid rotation and relabelling "
                          f'are both zero modes); allowed: "none", geometry.length > 0, coils with M ≠ 0, or '
                          f'geometry.shape = "sphere"')
-    if shape == Shape.TUBE and stability.m_max < 1:
-        raise SceneError(f"{asked}: a tube's non-axisymmetric branches start at the m ≥ 1 zeros located with "
-                         f'stability.m_max ≥ 1, not {stability.m_max}; allowed: "none" with stability.m_max = 0')
+    if shape in (Shape.TUBE, Shape.CAPSULE) and stability.m_max < 1:
+        raise SceneError(f"{asked}: a {shape.value}'s non-axisymmetric branches start at the m ≥ 1 zeros located "
+                         f'with stability.m_max ≥ 1, not {stability.m_max}; allowed: "none" with stability.m_max = 0')
+    if shape == Shape.CAPSULE and continuation.parameter == ContinuationParameter.VOLTAGE:
+        raise SceneError(f'{asked}: a capsule\'s non-axisymmetric branches are traced in P, not on a branch '
+                         f'continued in the voltage (continuation.parameter = "voltage"); allowed: "none", or '
+                         f'continuation.parameter = "pressure"')
 
 
 @dataclass(frozen=True)
@@ -616,7 +621,7 @@ def startable(scene: Scene) -> Scene:
     new input (``parse_scene``, ``load_scene``, ``Scene.with_overrides``) and where ``continue`` starts from a file's
     scene; not on a file's stored text (``parse_stored``)."""
     _stop_volume_above_reference(scene.continuation.stop_volume, scene.geometry)
-    _surface_reads(scene.surface, scene.geometry, scene.field, scene.stability)
+    _surface_reads(scene.surface, scene.geometry, scene.field, scene.stability, scene.continuation)
     return scene
 
 

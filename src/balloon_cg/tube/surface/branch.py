@@ -24,7 +24,8 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
     first = switched_point(scene, disc, crossing, direction * START_AMPLITUDE, params, orders, n_phi, solver.tol,
                            solver.max_newton)
     zero = first.basis.axisymmetric(crossing.u)
-    unresolved(first, zero, solver.max_error)
+    if first.converged:  # else trace_from says so
+        unresolved(first, zero, solver.max_error)
     mode = first.basis.with_mode(np.zeros(first.basis.size), m, crossing.mode)
     return trace_from(scene, first, mode, zero, crossing.pressure, params, resolution, direction, max_points, parent)
 

@@ -141,11 +141,17 @@ def trace_from(scene, first: SwitchedPoint, mode: np.ndarray, zero: np.ndarray, 
     (module docstring) with the error estimate and refinement of ``policy`` (the resolution module of the basis'
     shape: ``error_estimate``, ``refined``, MAX_DEGREE, MAX_HARMONICS; tube/surface/resolution.py,
     capsule_resolution.py); ``progress``: callable(point), told of every traced point; SurfaceBranchStartError where
-    ``first`` did not converge."""
+    ``first`` did not converge, or where the zero's largest hoop stretch already passes continuation.stop_stretch
+    (a capsule's primary stops at its pole stretch, which is below its cylinder's hoop stretch: the branch would
+    end at its first point)."""
     solver, m = scene.solver, first.m
     if not first.converged:
         raise SurfaceBranchStartError(f"the switched point at ε = {first.amplitude:g} did not converge: "
                                       f"{first.message}")
+    if (stretch := largest_hoop_stretch(first.basis, zero)) >= scene.continuation.stop_stretch:
+        raise SurfaceBranchStartError(f"the zero's largest hoop stretch {stretch:.4g} already passes "
+                                      f"continuation.stop_stretch {scene.continuation.stop_stretch:g}, where the "
+                                      f"branch would stop: raise continuation.stop_stretch above it")
     origin_basis = first.basis
     origin = _Leg(scene, origin_basis, params, first.c, m, mode)
     first, limited = resolved_start(scene, first, mode, params, policy)
