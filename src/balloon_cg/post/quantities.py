@@ -40,13 +40,15 @@ def branch_discretisation(branch: dict) -> Discretisation:
     """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric,
     pin_translation, quadrature (0: automatic), the coordinate map (map_centres, map_widths; empty: none) and a
     capsule's joins (empty, or absent in files before its piecewise basis: the Legendre basis) and its graded
-    element degrees (absent: shared): it evaluates the unknowns."""
+    element degrees (absent: shared), and a held spheroid's held_aspect (absent: the sphere's hold, b_0 = 0): it
+    evaluates the unknowns."""
     attrs = branch["attrs"]
     centres = tuple(float(c) for c in attrs.get("map_centres", ()))
     mapping = WireMap(centres, tuple(float(w) for w in attrs["map_widths"])) if centres else None
     return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]),
                           int(attrs.get("quadrature", 0)), mapping, tuple(float(x) for x in attrs.get("joins", ())),
-                          tuple(int(d) for d in attrs.get("element_degrees", ())))
+                          tuple(int(d) for d in attrs.get("element_degrees", ())),
+                          float(attrs.get("held_aspect", 1.0)))
 
 
 def _legendre_derivatives(coefficients, c, s, mapping):
