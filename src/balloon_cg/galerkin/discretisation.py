@@ -23,7 +23,7 @@ from .coordinate_map import WireMap
 from .elements import element_degree, element_table, families, function_keys, graded_degree, piece_degrees
 from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
-from ..model.meridian import area_density, reference_area
+from ..model.meridian import area_density, joins, reference_area
 from ..scene.tables import Geometry, Shape
 
 
@@ -243,13 +243,13 @@ class Discretisation:
     #                    galerkin/elements.py, a composite Gauss rule)
     element_degrees: tuple = ()  # with joins: a degree per element group (elements.graded_sequence) in place of
     #                              the greedy order of ``degree`` (``graded``)
-    held_aspect: float = 1.0  # a held general basis on the spheroid of this aspect holds its reference area's
-    #                           centroid, ∫η S' dx = 0 (``_tables``); 1: the sphere's, ∫η dx = 0 (b_0 = 0)
+    held: Geometry | None = None  # the reference surface (``held_surface``) whose area centroid a held general
+    #                               basis holds, ∫η dA = 0 (``_held_means``); None: ∫η dx = 0, the sphere's
 
     def __reduce__(self):
         """Pickled as its eight defining fields (the tables are rebuilt): results holding one stay small."""
         return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping,
-                                self.joins, self.element_degrees, self.held_aspect)
+                                self.joins, self.element_degrees, self.held)
 
     def __post_init__(self):
         """Basis and quadrature tables from ``_tables`` (built once per set of fields, shared, read-only)."""
@@ -333,7 +333,7 @@ class Discretisation:
     def nests_in(self, other: "Discretisation") -> bool:
         """Every function of this basis lies in ``other``'s (same map and joins, degree no higher; on elements
         every function of this one found among ``other``'s, ``elements.function_keys``): transfers are exact."""
-        if other.mapping != self.mapping or other.joins != self.joins or other.held_aspect != self.held_aspect:
+        if other.mapping != self.mapping or other.joins != self.joins or other.held != self.held:
             return False
         if not (self.element_degrees or other.element_degrees):
             return other.degree >= self.degree
@@ -506,24 +506,29 @@ def _projection(disc: Discretisation) -> np.ndarray:
     return projection
 
 
-def held_aspect(geometry: Geometry, symmetric: bool, pin_translation: bool) -> float:
-    """``Discretisation.held_aspect`` of a layout on ``geometry``: the spheroid's aspect for a held general basis
-    (its reference area's centroid held), 1 otherwise (the sphere's hold, or none)."""
-    held = pin_translation and not symmetric and geometry.shape == Shape.SPHEROID
-    return float(geometry.aspect) if held else 1.0
+def held_surface(geometry: Geometry, symmetric: bool, pin_translation: bool) -> Geometry | None:
+    """``Discretisation.held`` of a layout on ``geometry``: for a held general basis on a spheroid or on a capsule's
+    piecewise basis the surface whose area centroid it holds (its shape and aspect or length only: what
+    ``area_density`` reads), None otherwise (the sphere's hold ∫η dx = 0, or no hold)."""
+    if symmetric or not pin_translation:
+        return None
+    if geometry.shape == Shape.SPHEROID:
+        return Geometry(Shape.SPHEROID, float(geometry.aspect))
+    if geometry.shape == Shape.CAPSULE and joins(geometry):
+        return Geometry(Shape.CAPSULE, length=float(geometry.length))
+    return None
 
 
 def _held_means(disc: Discretisation, x: np.ndarray, weights: np.ndarray, p_held: np.ndarray) -> np.ndarray:
     """m_k of a held general basis's η functions P_k − m_k (η = Σ b_k P_k with b_0 = −Σ m_k b_k), so that the hold
-    is the same physical constraint in every basis: on the spheroid of ``held_aspect`` its reference area's
-    centroid, m_k = ∫P_k S' dx / ∫S' dx (model/meridian.py ``area_density``, ``reference_area``: the stability
-    blocks' ``held_means``); on a map ∫η dx = 0, m_k = ½∫P_k(s(x)) dx; zero otherwise (b_0 = 0: ∫η dx = 0)."""
+    is the same physical constraint in every basis: on ``held`` (a spheroid, a capsule) its reference area's
+    centroid, m_k = ∫φ_k ρ dx / ∫ρ dx, ρ = R S'/sin θ (model/meridian.py ``area_density``, ``reference_area``: the
+    stability blocks' ``held_means``); on a map ∫η dx = 0, m_k = ½∫P_k(s(x)) dx; zero otherwise (b_0 = 0)."""
     if disc.symmetric or not disc.pin_translation:
         return np.zeros(p_held.shape[1])
-    if disc.held_aspect != 1.0:
-        geometry = Geometry(Shape.SPHEROID, disc.held_aspect)
-        density = area_density(geometry, x, np.sqrt(1.0 - x * x))
-        return (weights * density) @ p_held / reference_area(geometry)
+    if disc.held is not None:
+        density = area_density(disc.held, x, np.sqrt(1.0 - x * x))
+        return (weights * density) @ p_held / reference_area(disc.held)
     return 0.5 * weights @ p_held if disc.mapping is not None else np.zeros(p_held.shape[1])
 
 

@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from ...galerkin.discretisation import Discretisation, held_aspect
+from ...galerkin.discretisation import Discretisation, held_surface
 from ...galerkin.equilibrium import Parameters
 from ...galerkin.profiles import meridional_stretch
 from ...model import meridian
@@ -107,7 +107,7 @@ def released(tracer: Tracer, held: continuation.Point, params: Parameters,
     scene = tracer.scene
     system = tracer.system(degree, params)
     pinned = Discretisation(degree, tracer.symmetric, True, joins=system.eq.disc.joins,
-                            held_aspect=held_aspect(scene.geometry, tracer.symmetric, True))
+                            held=held_surface(scene.geometry, tracer.symmetric, True))
     X = np.append(system.eq.disc.join(*pinned.split(held.X[:-1])), held.X[-1])
     result = newton(system.residual, system.jacobian, X, unit(X.size, -1), X[-1], scene.solver.tol,
                     scene.solver.max_newton)

@@ -114,7 +114,7 @@ class Resolution:
         while open_rows.size and degree < self.max_degree:
             interrupt.check()
             plain = Discretisation(degree, disc.symmetric, disc.pin_translation, joins=disc.joins,
-                                   held_aspect=disc.held_aspect)
+                                   held=disc.held)
             moved = disc.transfer(X[open_rows], plain)
             loss = transfer_error(disc, X[open_rows], plain, moved)
             tails = np.array([plain.tail(row[: plain.size]) for row in moved])

@@ -17,7 +17,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ...galerkin.discretisation import Discretisation, held_aspect
+from ...galerkin.discretisation import Discretisation, held_surface
 from ...galerkin.equilibrium import Equilibrium, Parameters
 from ...numerics import continuation, interrupt
 from ...numerics.continuation import Stop
@@ -91,7 +91,7 @@ class Tracer:
         if (degree, mapping) not in self._systems:
             quadrature = self.scene.solver.quadrature if degree == self.scene.solver.degree else 0
             disc = Discretisation(degree, self.symmetric, self.pin, quadrature, mapping,
-                                  held_aspect=held_aspect(self.scene.geometry, self.symmetric, self.pin))
+                                  held=held_surface(self.scene.geometry, self.symmetric, self.pin))
             self._systems[degree, mapping] = Equilibrium(self.scene, disc)
         return ParameterSystem(self._systems[degree, mapping], params, self.parameter)
 

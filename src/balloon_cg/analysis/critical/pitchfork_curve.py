@@ -365,7 +365,7 @@ def plain_branch(branch: Branch, X) -> Branch:
     if mapped.mapping is None:
         return branch
     plain = Discretisation(plain_degree(branch, X), mapped.symmetric, mapped.pin_translation,
-                           held_aspect=mapped.held_aspect)
+                           held=mapped.held)
     return replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
 
 
