@@ -81,7 +81,8 @@ def test_held_block_of_a_capsule_in_a_field_is_the_centroid_projection():
     about its middle (radius 3, M = 0.01; the second variation at that state, an equilibrium of the field-free
     scene only: the hold is what is checked), at the equilibrium's degree: odd_held's COUNT lowest against the full
     odd block's projected on the centroid's row written here (null space by scipy) to 1e-12 of the block's largest
-    |μ| plus 1e-9 relative (measured 1.1e-9 relative on the lowest, 0.29954; the code before read 0.22207, 3.57599, 4.61009 for 0.29954, 3.84546, 7.04045)."""
+    |μ| plus 1e-9 relative (measured 1.1e-9 relative on the lowest, 0.29954; the code before read 0.22207,
+    3.57599, 4.61009 for 0.29954, 3.84546, 7.04045)."""
     length = 3.0
     branch = trace_primary(capsule(length, stop=1.6).with_overrides({"surface.branches": "none"}), down=False)
     X = branch.X[len(branch.X) // 2]
