@@ -19,9 +19,9 @@ from scipy import linalg
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.stability.axisymmetric import SecondVariation
-from balloon_cg.galerkin.discretisation import Discretisation
-from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
+from balloon_cg.galerkin.equilibrium import Equilibrium
 from test_capsule_frequencies import capsule
+from test_spheroid_held import projected_lowest
 
 COUNT = 3
 
@@ -95,14 +95,7 @@ def test_held_block_of_a_capsule_in_a_field_is_the_centroid_projection():
     G, idx, t = variation.gram, odd_coefficients(variation), variation.translation
     assert np.linalg.norm(H[np.ix_(idx, idx)] @ (idx == t)) > 1e-6 * np.linalg.norm(H[np.ix_(idx, idx)])
     held = variation.assess(u, params, True).blocks["odd_held"][:COUNT]
-    projected = projected_lowest(H, G, area_row(variation, length)[idx], idx)
+    projected = projected_lowest(H, G, area_row(variation, length), idx)
     values = linalg.eigh(H[np.ix_(idx, idx)], G[np.ix_(idx, idx)], eigvals_only=True)
     assert np.all(np.abs(held - projected) <= 1e-12 * np.abs(values).max() + 1e-9 * np.abs(projected)), (
         held, projected)
-
-
-def projected_lowest(H, G, row, idx) -> np.ndarray:
-    """The COUNT lowest μ of H q = μ G q on the coefficients idx with row·q = 0 (scipy's null space and eigh)."""
-    Z = linalg.null_space(row[None, :])
-    Hz, Gz = Z.T @ H[np.ix_(idx, idx)] @ Z, Z.T @ G[np.ix_(idx, idx)] @ Z
-    return linalg.eigh(Hz, Gz, eigvals_only=True, subset_by_index=(0, COUNT - 1))
