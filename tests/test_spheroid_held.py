@@ -10,6 +10,8 @@ hold is G-orthogonal to t); in a coil's field, where the hold is a constraint, t
 are those of the full block projected on the null space of the row ∫δη S' dx, by scipy here; the banded sibling
 (its own elements and constraint row) gives the same to within both discretisations' error estimates.
 """
+import pickle
+
 import numpy as np
 import pytest
 from scipy import linalg
@@ -20,9 +22,11 @@ from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.stability.axisymmetric import SecondVariation, point_degrees
 from balloon_cg.analysis.stability.banded import BandedVariation
 from balloon_cg.analysis.points.branch_points import general_tracer, mode_direction, plain_degree, to_general
-from balloon_cg.galerkin.discretisation import Discretisation
+from balloon_cg.galerkin.discretisation import Discretisation, held_surface
 from balloon_cg.galerkin.equilibrium import Parameters
+from balloon_cg.model import meridian
 from balloon_cg.numerics.newton import newton
+from balloon_cg.post.quantities import held_geometry
 from balloon_cg.scene import load_scene
 
 COUNT = 3
@@ -197,3 +201,19 @@ def test_traced_held_pear_branch_of_a_spheroid_passes_through_its_branch_point(i
     u_off, u_bound = np.linalg.norm(fine[:-1] - X_star[:-1]), np.linalg.norm(fine[:-1] - coarse[:-1])
     assert u_off <= max(1e-9 * np.linalg.norm(X_star[:-1]), u_bound), (u_off, u_bound)
     assert abs(fine[-1] - X_star[-1]) <= max(1e-9 * X_star[-1], abs(fine[-1] - coarse[-1])), fine[-1] - X_star[-1]
+
+
+def test_held_surface_survives_pickling_and_storage():
+    """A held general basis's surface (``held_surface``: a spheroid's aspect, a capsule's length only) comes back
+    from a pickle (``Discretisation.__reduce__``) and from the stored attrs held_shape, held_size
+    (post/quantities.py ``held_geometry``) equal, so that a stored held pear branch evaluates on its own hold."""
+    for table in ({"geometry.shape": "spheroid", "geometry.aspect": 1.3},
+                  {"geometry.shape": "capsule", "geometry.length": 2.0, "geometry.element_length": 1.0}):
+        geometry = load_scene("spom1_single_coil").with_overrides(table).geometry
+        held = held_surface(geometry, False, True)
+        disc = Discretisation(24, False, True, joins=meridian.joins(geometry), held=held)
+        assert pickle.loads(pickle.dumps(disc)) == disc and disc.eta_mean.any()
+        size = held.aspect if held.shape.value == "spheroid" else held.length
+        assert held_geometry({"held_shape": held.shape.value, "held_size": size}) == held
+        assert held_surface(geometry, True, True) is None and held_surface(geometry, False, False) is None
+    assert held_surface(load_scene("spom1_single_coil").geometry, False, True) is None
