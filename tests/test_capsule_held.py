@@ -18,8 +18,9 @@ from scipy import linalg
 
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.branches.problem import equilibrium_of
+from balloon_cg.analysis.points.branch_points import general_tracer
 from balloon_cg.analysis.stability.axisymmetric import SecondVariation
-from balloon_cg.galerkin.equilibrium import Equilibrium
+from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from test_capsule_frequencies import capsule
 from test_spheroid_held import projected_lowest
 
@@ -99,3 +100,20 @@ def test_held_block_of_a_capsule_in_a_field_is_the_centroid_projection():
     values = linalg.eigh(H[np.ix_(idx, idx)], G[np.ix_(idx, idx)], eigvals_only=True)
     assert np.all(np.abs(held - projected) <= 1e-12 * np.abs(values).max() + 1e-9 * np.abs(projected)), (
         held, projected)
+
+
+@pytest.mark.parametrize("length", [2.0, 3.0])
+def test_held_general_basis_of_a_capsule_holds_its_area_centroid(length):
+    """The equilibrium's held general basis on a capsule in a coil (``Tracer.system``: a held pear branch's) holds
+    its reference area's centroid: every η function has ∫η κR/sin θ dx = 0 (the area element written here,
+    ``area_row``) to 1e-13 of its scale (the code before dropped φ_0 only: ∫φ_2 dA ≠ 0)."""
+    scene = capsule(length).with_overrides({"field.M": 0.002, "field.coils": [{"radius": 4.0, "height": 0.0,
+                                                                                "current": 1.0}]})
+    disc = general_tracer(scene).system(60, Parameters(P=1.0, M=0.002)).eq.disc
+    assert disc.pin_translation and not disc.symmetric and disc.joins
+    kappa = 1.0 + length / np.pi
+    S = kappa * np.arccos(np.abs(disc.cos_theta))
+    density = kappa * np.where(S < np.pi / 2, np.sin(np.minimum(S, np.pi / 2)), 1.0) / disc.sin_theta
+    eta = disc.ops[2][:, disc.a_index.size:]
+    means = (disc.weights * density) @ eta
+    assert np.abs(means).max() <= 1e-13 * ((disc.weights * density) @ np.abs(eta)).max(), np.abs(means).max()
