@@ -190,7 +190,8 @@ def test_traced_held_pear_branch_of_a_spheroid_passes_through_its_branch_point(i
     """``in_a_field``'s odd_held pear point: the held pear branch's corrections at φ·(X − X*) = ±δ (δ = 0.02, 0.01,
     0.005; P even in δ: P(δ) = P(−δ) to 1e-12) extrapolated to δ = 0 (the mean of ±δ is X* + O(δ²), Richardson
     in δ²) give P* and the state (its coefficient vector's norm) at the located point within max(1e-9 rel, the
-    estimate: the two Richardson pairs' difference) (measured: P 9.6e-12 off, the state 2.4e-10 relative, estimate 3.5e-9). The code before held the equilibrium by b_0 (the sphere's centroid), the
+    estimate: the two Richardson pairs' difference) (measured: P 9.6e-12 off, the state 2.4e-10 relative, estimate
+    3.5e-9). The code before held the equilibrium by b_0 (the sphere's centroid), the
     stability blocks by the area centroid: its branch went through P = 1.8290758529, 6.4e-6 below the P* located."""
     branch = in_a_field
     (bp,) = [s for s in branch.branch_points() if s.block.value == "odd_held"]
