@@ -121,7 +121,8 @@ def capsule_scene(length, stop=3.0):
 def test_capsule_mass_matrix_is_the_kinetic_energy_over_the_reference_capsule():
     """Length 2: cᵀ M c = (1/2π) ∫∫ |δx|² dA = ∫ (R² δλ2² + δη²) R dS for random coefficients c, by Gauss–Legendre
     in S on each cap and on the cylinder (δλ2, δη the basis's series at θ = S/κ: the capsule's piecewise basis,
-    galerkin/elements.py), to 1e-12."""
+    galerkin/elements.py; δη on the held functions φ_k − m_k, k ≥ 1, m_k = ∫φ_k dA/A by the same rule, A/2π = 2 + L),
+    to 1e-12."""
     rng = np.random.default_rng(38)
     length = 2.0
     scene = capsule_scene(length)
@@ -131,13 +132,18 @@ def test_capsule_mass_matrix_is_the_kinetic_energy_over_the_reference_capsule():
     kappa, t, w = 1 + length / np.pi, *legendre.leggauss(80)
     pieces = [(0.0, np.pi / 2, np.sin), (np.pi / 2, np.pi / 2 + length, np.ones_like),
               (np.pi / 2 + length, np.pi + length, lambda S: np.sin(np.pi + length - S))]
+    nodes = [(lo + (hi - lo) * (t + 1) / 2, (hi - lo) / 2 * w, radius) for lo, hi, radius in pieces]
+    na = variation.basis.a_index.size
+    # the held η functions φ_k − m_k, m_k = ∫φ_k dA/A (the reference's centroid: tests/test_capsule_held.py)
+    unit_eta = [variation.basis.evaluate(np.eye(variation.basis.size)[na + 1:], S / kappa)[2] for S, _, _ in nodes]
+    means = sum(e @ (W * radius(S)) for e, (S, W, radius) in zip(unit_eta, nodes)) / (2.0 + length)
     for _ in range(3):
         c = rng.standard_normal(variation.basis.size)
         direct = 0.0
-        for lo, hi, radius in pieces:
-            S = lo + (hi - lo) * (t + 1) / 2
+        for S, W, radius in nodes:
             lam2, _, eta, _ = variation.basis.evaluate(c, S / kappa)
-            direct += (hi - lo) / 2 * w @ ((radius(S)**2 * lam2**2 + eta**2) * radius(S))
+            eta = eta - means @ c[na + 1:]
+            direct += W @ ((radius(S)**2 * lam2**2 + eta**2) * radius(S))
         assert c @ variation.gram @ c == pytest.approx(direct, rel=1e-12)
 
 

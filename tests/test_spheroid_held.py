@@ -10,6 +10,8 @@ hold is G-orthogonal to t); in a coil's field, where the hold is a constraint, t
 are those of the full block projected on the null space of the row ∫δη S' dx, by scipy here; the banded sibling
 (its own elements and constraint row) gives the same to within both discretisations' error estimates.
 """
+import pickle
+
 import numpy as np
 import pytest
 from scipy import linalg
@@ -19,6 +21,12 @@ from balloon_cg.analysis.picture import analyse
 from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.stability.axisymmetric import SecondVariation, point_degrees
 from balloon_cg.analysis.stability.banded import BandedVariation
+from balloon_cg.analysis.points.branch_points import general_tracer, mode_direction, plain_degree, to_general
+from balloon_cg.galerkin.discretisation import Discretisation, held_surface
+from balloon_cg.galerkin.equilibrium import Parameters
+from balloon_cg.model import meridian
+from balloon_cg.numerics.newton import newton
+from balloon_cg.post.quantities import held_geometry
 from balloon_cg.scene import load_scene
 
 COUNT = 3
@@ -139,3 +147,74 @@ def test_held_block_of_a_spheroid_in_a_field_is_the_centroid_projection(in_a_fie
     np.testing.assert_allclose(blocks["odd_free"][:COUNT], free, rtol=1e-9, atol=0)
     banded, estimate = banded_and_estimate(eq, u, params)
     assert np.all(np.abs(banded - projected) <= estimate + 1e-9 * np.abs(projected)), (banded - projected, estimate)
+
+
+@pytest.mark.parametrize("aspect", [0.7, 1.3])
+def test_held_general_basis_of_a_spheroid_holds_its_area_centroid(aspect):
+    """The equilibrium's held general basis (``Tracer.system``: a pear branch's, the balloon held in a coil's field)
+    holds the centroid of the reference spheroid: every η function has ∫η S' dx = 0 with S' = sqrt(x² + c²(1 − x²))
+    written here, to 1e-13 (the quadrature's own error on ∫P_k S' dx; the code before dropped b_0, ∫η dx = 0:
+    ∫P_2 S' dx ≠ 0); the sphere's held basis is the one without b_0, bit for bit."""
+    scene = load_scene("spom1_single_coil").with_overrides({"geometry.shape": "spheroid", "geometry.aspect": aspect})
+    disc = general_tracer(scene).system(40, Parameters(P=1.0, M=0.002)).eq.disc
+    assert disc.pin_translation and not disc.symmetric
+    rate = np.hypot(disc.cos_theta, aspect * disc.sin_theta)
+    eta = disc.ops[2][:, disc.a_index.size:]
+    means = (disc.weights * rate) @ eta
+    assert np.abs(means).max() <= 1e-13 * np.abs((disc.weights * rate) @ np.abs(eta)).max(), np.abs(means).max()
+    sphere = general_tracer(load_scene("spom1_single_coil")).system(40, Parameters(P=1.0, M=0.002)).eq.disc
+    plain = Discretisation(40, False, True, sphere.quadrature)
+    assert np.array_equal(sphere.ops, plain.ops) and not sphere.eta_mean.any()
+
+
+def pear_corrections(branch, bp, deltas):
+    """(P, state) of the general held system's corrections on φ·(X − X*) = δ from X* + δφ (``pear.pear_leg``'s first
+    step; φ the located critical mode in the general basis), per δ."""
+    scene = branch.scene
+    tracer = general_tracer(scene, bp.block)
+    degree = plain_degree(branch, bp.X)
+    system = tracer.system(degree, branch.params)
+    X_star = np.append(to_general(branch, tracer, degree, bp.X[:-1]), bp.X[-1])
+    phi = mode_direction(bp, system.eq.disc)
+    points = []
+    for delta in deltas:
+        guess = X_star + delta * phi
+        result = newton(system.residual, system.jacobian, guess, phi, phi @ guess, scene.solver.tol,
+                        scene.solver.max_newton)
+        assert result.converged, delta
+        points.append(result.x)
+    return X_star, np.array(points)
+
+
+def test_traced_held_pear_branch_of_a_spheroid_passes_through_its_branch_point(in_a_field):
+    """``in_a_field``'s odd_held pear point: the held pear branch's corrections at φ·(X − X*) = ±δ (δ = 0.02, 0.01,
+    0.005; P even in δ: P(δ) = P(−δ) to 1e-12) extrapolated to δ = 0 (the mean of ±δ is X* + O(δ²), Richardson
+    in δ²) give P* and the state (its coefficient vector's norm) at the located point within max(1e-9 rel, the
+    estimate: the two Richardson pairs' difference) (measured: P 9.6e-12 off, the state 2.4e-10 relative, estimate
+    3.5e-9). The code before held the equilibrium by b_0 (the sphere's centroid), the
+    stability blocks by the area centroid: its branch went through P = 1.8290758529, 6.4e-6 below the P* located."""
+    branch = in_a_field
+    (bp,) = [s for s in branch.branch_points() if s.block.value == "odd_held"]
+    X_star, X = pear_corrections(branch, bp, (0.02, 0.01, 0.005, -0.02, -0.01, -0.005))
+    assert np.abs(X[:3, -1] - X[3:, -1]).max() <= 1e-12 * abs(X_star[-1])
+    mean = 0.5 * (X[:3] + X[3:])
+    fine, coarse = (4.0 * mean[2] - mean[1]) / 3.0, (4.0 * mean[1] - mean[0]) / 3.0
+    u_off, u_bound = np.linalg.norm(fine[:-1] - X_star[:-1]), np.linalg.norm(fine[:-1] - coarse[:-1])
+    assert u_off <= max(1e-9 * np.linalg.norm(X_star[:-1]), u_bound), (u_off, u_bound)
+    assert abs(fine[-1] - X_star[-1]) <= max(1e-9 * X_star[-1], abs(fine[-1] - coarse[-1])), fine[-1] - X_star[-1]
+
+
+def test_held_surface_survives_pickling_and_storage():
+    """A held general basis's surface (``held_surface``: a spheroid's aspect, a capsule's length only) comes back
+    from a pickle (``Discretisation.__reduce__``) and from the stored attrs held_shape, held_size
+    (post/quantities.py ``held_geometry``) equal, so that a stored held pear branch evaluates on its own hold."""
+    for table in ({"geometry.shape": "spheroid", "geometry.aspect": 1.3},
+                  {"geometry.shape": "capsule", "geometry.length": 2.0, "geometry.element_length": 1.0}):
+        geometry = load_scene("spom1_single_coil").with_overrides(table).geometry
+        held = held_surface(geometry, False, True)
+        disc = Discretisation(24, False, True, joins=meridian.joins(geometry), held=held)
+        assert pickle.loads(pickle.dumps(disc)) == disc and disc.eta_mean.any()
+        size = held.aspect if held.shape.value == "spheroid" else held.length
+        assert held_geometry({"held_shape": held.shape.value, "held_size": size}) == held
+        assert held_surface(geometry, True, True) is None and held_surface(geometry, False, False) is None
+    assert held_surface(load_scene("spom1_single_coil").geometry, False, True) is None

@@ -23,6 +23,8 @@ from .coordinate_map import WireMap
 from .elements import element_degree, element_table, families, function_keys, graded_degree, piece_degrees
 from .legendre import gauss_rule, legendre_table
 from ..generated import HESSIAN_PAIRS
+from ..model.meridian import area_density, joins, reference_area
+from ..scene.tables import Geometry, Shape
 
 
 def read_only(array: np.ndarray) -> np.ndarray:
@@ -241,11 +243,13 @@ class Discretisation:
     #                    galerkin/elements.py, a composite Gauss rule)
     element_degrees: tuple = ()  # with joins: a degree per element group (elements.graded_sequence) in place of
     #                              the greedy order of ``degree`` (``graded``)
+    held: Geometry | None = None  # the reference surface (``held_surface``) whose area centroid a held general
+    #                               basis holds, ∫η dA = 0 (``_held_means``); None: ∫η dx = 0, the sphere's
 
     def __reduce__(self):
-        """Pickled as its seven defining fields (the tables are rebuilt): results holding one stay small."""
+        """Pickled as its eight defining fields (the tables are rebuilt): results holding one stay small."""
         return Discretisation, (self.degree, self.symmetric, self.pin_translation, self.quadrature, self.mapping,
-                                self.joins, self.element_degrees)
+                                self.joins, self.element_degrees, self.held)
 
     def __post_init__(self):
         """Basis and quadrature tables from ``_tables`` (built once per set of fields, shared, read-only)."""
@@ -329,7 +333,7 @@ class Discretisation:
     def nests_in(self, other: "Discretisation") -> bool:
         """Every function of this basis lies in ``other``'s (same map and joins, degree no higher; on elements
         every function of this one found among ``other``'s, ``elements.function_keys``): transfers are exact."""
-        if other.mapping != self.mapping or other.joins != self.joins:
+        if other.mapping != self.mapping or other.joins != self.joins or other.held != self.held:
             return False
         if not (self.element_degrees or other.element_degrees):
             return other.degree >= self.degree
@@ -502,9 +506,35 @@ def _projection(disc: Discretisation) -> np.ndarray:
     return projection
 
 
+def held_surface(geometry: Geometry, symmetric: bool, pin_translation: bool) -> Geometry | None:
+    """``Discretisation.held`` of a layout on ``geometry``: for a held general basis on a spheroid or on a capsule's
+    piecewise basis the surface whose area centroid it holds (its shape and aspect or length only: what
+    ``area_density`` reads), None otherwise (the sphere's hold ∫η dx = 0, or no hold)."""
+    if symmetric or not pin_translation:
+        return None
+    if geometry.shape == Shape.SPHEROID:
+        return Geometry(Shape.SPHEROID, float(geometry.aspect))
+    if geometry.shape == Shape.CAPSULE and joins(geometry):
+        return Geometry(Shape.CAPSULE, length=float(geometry.length))
+    return None
+
+
+def _held_means(disc: Discretisation, x: np.ndarray, weights: np.ndarray, p_held: np.ndarray) -> np.ndarray:
+    """m_k of a held general basis's η functions P_k − m_k (η = Σ b_k P_k with b_0 = −Σ m_k b_k), so that the hold
+    is the same physical constraint in every basis: on ``held`` (a spheroid, a capsule) its reference area's
+    centroid, m_k = ∫φ_k ρ dx / ∫ρ dx, ρ = R S'/sin θ (model/meridian.py ``area_density``, ``reference_area``: the
+    stability blocks' ``held_means``); on a map ∫η dx = 0, m_k = ½∫P_k(s(x)) dx; zero otherwise (b_0 = 0)."""
+    if disc.symmetric or not disc.pin_translation:
+        return np.zeros(p_held.shape[1])
+    if disc.held is not None:
+        density = area_density(disc.held, x, np.sqrt(1.0 - x * x))
+        return (weights * density) @ p_held / reference_area(disc.held)
+    return 0.5 * weights @ p_held if disc.mapping is not None else np.zeros(p_held.shape[1])
+
+
 @functools.lru_cache(maxsize=16)
 def _tables(disc: Discretisation) -> dict:
-    """The node, weight and basis tables of a Discretisation (keyed by its seven fields: equal discretisations
+    """The node, weight and basis tables of a Discretisation (keyed by its eight fields: equal discretisations
     share them; every tracer, stability basis and branch point rebuilds the same few), read-only."""
     n_q = disc.quadrature or piece_nodes(disc.degree, disc.joins, disc.element_degrees)
     if disc.element_degrees and not disc.quadrature:  # graded: each piece the rule of its own element's degree
@@ -520,10 +550,7 @@ def _tables(disc: Discretisation) -> dict:
     k = np.arange(disc.degree + 1)
     a_keep = k[k % 2 == 0] if disc.symmetric else k
     b_keep = k[k % 2 == 1] if disc.symmetric else (k[1:] if disc.pin_translation else k)
-    # held (b_0 = 0 means ∫η dx = 0) on a mapped general basis: η = Σ b_k (P_k(s) − m_k), m_k = ½∫P_k(s(x)) dx,
-    # so that the hold is the same physical constraint in every basis (m = 0 without a map)
-    held_mapped = disc.mapping is not None and disc.pin_translation and not disc.symmetric
-    eta_mean = 0.5 * weights @ p[:, b_keep] if held_mapped else np.zeros(b_keep.size)
+    eta_mean = _held_means(disc, x, weights, p[:, b_keep])
     na = a_keep.size
     size = na + b_keep.size
     fitting = {"_node_table": p, "x": x}  # every node: least-squares fits (projection, transfer) need them all

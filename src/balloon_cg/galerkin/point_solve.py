@@ -24,7 +24,8 @@ def constrained_newton(scene, degree, X0, source, stretch, params, tol=1e-12, ma
 
     Returns (numerics.newton.NewtonResult with x = (u, P), the Equilibrium of the new discretisation).
     """
-    eq = Equilibrium(scene, Discretisation(degree, source.symmetric, source.pin_translation, joins=source.joins))
+    eq = Equilibrium(scene, Discretisation(degree, source.symmetric, source.pin_translation, joins=source.joins,
+                                           held=source.held))
     a, b = source.split(X0[:-1])
     n = min(degree, source.degree) + 1
     a2, b2 = np.zeros(degree + 1), np.zeros(degree + 1)

@@ -85,7 +85,7 @@ import h5py
 import numpy as np
 
 from ..analysis.timing import Clock, Step
-from ..scene.tables import parse_stored
+from ..scene.tables import Shape, parse_stored
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .legacy import current
 from .layout import (FileError, carries_checksums, check_columns, check_data, check_sizes, opened, reading, require_attrs,
@@ -264,6 +264,9 @@ def _write_branch(group, branch, theta, first_label: int = 1):
     })
     if disc.element_degrees:  # a capsule's graded basis (absent: the greedy order of ``degree``)
         group.attrs["element_degrees"] = np.array(disc.element_degrees, dtype=int)
+    if disc.held is not None:  # a held general basis holding its area centroid (absent: b_0 = 0)
+        size = disc.held.aspect if disc.held.shape == Shape.SPHEROID else disc.held.length
+        group.attrs.update({"held_shape": disc.held.shape.value, "held_size": float(size)})
     if branch.parent is not None:
         group.attrs["parent_branch"], group.attrs["parent_branch_point"] = branch.parent
     if branch.rejoins is not None:
@@ -708,9 +711,11 @@ def check_branch(group, where, error, written: bool = False) -> None:
     if not isinstance(group, h5py.Group):
         raise error(where, "is not a group")
     # gauge: since issue 27; joins: since a capsule's piecewise basis (absent: the Legendre basis); element_degrees:
-    # a capsule's graded basis (absent: one degree shared by its elements)
+    # a capsule's graded basis (absent: one degree shared by its elements); held_shape, held_size: a held general
+    # basis holding its area centroid (a spheroid's aspect, a capsule's length; absent: b_0 = 0)
     require_attrs(group.attrs, where, BRANCH_KINDS, BRANCH_KINDS | {"gauge": "str", "joins": "float[]",
-                                                                     "element_degrees": "int[]"}, error)
+                                                                     "element_degrees": "int[]",
+                                                                     "held_shape": "str", "held_size": "float"}, error)
     if written:  # an axisymmetric branch's basis, written by this version: its joins (none: the Legendre basis)
         require_attrs(group.attrs, where, ("joins",), {"joins": "float[]"}, error)
     if "parent_branch" in group.attrs:

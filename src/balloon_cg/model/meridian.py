@@ -104,22 +104,26 @@ def metric(geometry: Geometry, cos_theta, sin_theta):
 
 
 def area_density(geometry: Geometry, cos_theta, sin_theta):
-    """dA/(dφ d(cos θ)) = R S'/sin θ of the reference at the nodes, on the meridians with R = sin θ: S' (``metric``:
-    1 on the sphere and a capsule of length 0, sqrt(cos²θ + aspect² sin²θ) on the spheroid). The weight of a held
-    balloon's centroid, ∫δη dA = 0 (analysis/stability/axisymmetric.py ``held_means``, banded.py)."""
-    if geometry.shape == Shape.TUBE or joins(geometry):
-        raise ValueError(f"area_density: shape {geometry.shape.value!r} has R != sin θ; allowed: sphere, spheroid, "
-                         "capsule of length 0")
-    return metric(geometry, cos_theta, sin_theta)
+    """dA/(dφ d(cos θ)) = R S'/sin θ of the reference at the nodes (``hoop``, ``metric``): 1 on the sphere,
+    sqrt(cos²θ + aspect² sin²θ) on the spheroid, κ sin κd/sin θ on a capsule's caps and κ/sin θ on its cylinder. The
+    weight of a held balloon's centroid, ∫δη dA = 0 (analysis/stability/axisymmetric.py ``held_means``, banded.py,
+    galerkin/discretisation.py's held general basis). A tube's meridian is no closed surface over cos θ."""
+    if geometry.shape == Shape.TUBE:
+        raise ValueError("area_density: shape 'tube' is not a meridian over cos θ; allowed: sphere, spheroid, capsule")
+    if geometry.shape != Shape.CAPSULE:
+        return metric(geometry, cos_theta, sin_theta)
+    return hoop(geometry, cos_theta, sin_theta) * metric(geometry, cos_theta, sin_theta) / np.asarray(sin_theta)
 
 
 def reference_area(geometry: Geometry) -> float:
-    """A/2π = ∫ ``area_density`` d(cos θ) over [−1, 1] in closed form: 2 on the sphere (and a capsule of length 0);
-    on the spheroid of aspect c, 1 + c² artanh(e)/e with e² = 1 − c² (c < 1) and 1 + c arcsin(e)/e with
-    e² = 1 − 1/c² (c > 1)."""
-    if geometry.shape == Shape.TUBE or joins(geometry):
-        raise ValueError(f"reference_area: shape {geometry.shape.value!r} has R != sin θ; allowed: sphere, spheroid, "
-                         "capsule of length 0")
+    """A/2π = ∫ ``area_density`` d(cos θ) over [−1, 1] in closed form: 2 on the sphere; 2 + L on a capsule (two
+    hemispheres and its cylinder of length L); on the spheroid of aspect c, 1 + c² artanh(e)/e with e² = 1 − c²
+    (c < 1) and 1 + c arcsin(e)/e with e² = 1 − 1/c² (c > 1)."""
+    if geometry.shape == Shape.TUBE:
+        raise ValueError("reference_area: shape 'tube' is not a meridian over cos θ; allowed: sphere, spheroid, "
+                         "capsule")
+    if geometry.shape == Shape.CAPSULE:
+        return 2.0 + float(geometry.length)
     c = float(geometry.aspect) if geometry.shape == Shape.SPHEROID else 1.0
     if c == 1.0:
         return 2.0

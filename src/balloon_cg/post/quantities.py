@@ -31,7 +31,7 @@ from ..model.field import coaxial_table, coil_table, field_components, field_squ
 from ..model.stresses import elastic_stresses
 from ..model.meridian import hoop, hoop_acceleration, hoop_rate, metric
 from ..io.run_file import stored_scene
-from ..scene.tables import Geometry
+from ..scene.tables import Geometry, Shape
 
 WRINKLING_STATES = ("taut", "wrinkled", "slack")
 
@@ -40,13 +40,24 @@ def branch_discretisation(branch: dict) -> Discretisation:
     """The Discretisation of a stored branch (a read_run() branch dict) from its attrs degree, symmetric,
     pin_translation, quadrature (0: automatic), the coordinate map (map_centres, map_widths; empty: none) and a
     capsule's joins (empty, or absent in files before its piecewise basis: the Legendre basis) and its graded
-    element degrees (absent: shared): it evaluates the unknowns."""
+    element degrees (absent: shared), and the surface whose area centroid a held general basis holds (held_shape,
+    held_size: a spheroid's aspect, a capsule's length; absent: the sphere's hold, b_0 = 0): it evaluates the
+    unknowns."""
     attrs = branch["attrs"]
     centres = tuple(float(c) for c in attrs.get("map_centres", ()))
     mapping = WireMap(centres, tuple(float(w) for w in attrs["map_widths"])) if centres else None
     return Discretisation(int(attrs["degree"]), bool(attrs["symmetric"]), bool(attrs["pin_translation"]),
                           int(attrs.get("quadrature", 0)), mapping, tuple(float(x) for x in attrs.get("joins", ())),
-                          tuple(int(d) for d in attrs.get("element_degrees", ())))
+                          tuple(int(d) for d in attrs.get("element_degrees", ())),
+                          held_geometry(attrs))
+
+
+def held_geometry(attrs) -> Geometry | None:
+    """``Discretisation.held`` from a stored branch's held_shape and held_size (absent: None)."""
+    if "held_shape" not in attrs:
+        return None
+    shape, size = Shape(str(attrs["held_shape"])), float(attrs["held_size"])
+    return Geometry(shape, size) if shape == Shape.SPHEROID else Geometry(shape, length=size)
 
 
 def _legendre_derivatives(coefficients, c, s, mapping):

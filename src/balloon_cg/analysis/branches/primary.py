@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from ...galerkin.discretisation import Discretisation
+from ...galerkin.discretisation import Discretisation, held_surface
 from ...galerkin.equilibrium import Parameters
 from ...galerkin.profiles import meridional_stretch
 from ...model import meridian
@@ -106,7 +106,8 @@ def released(tracer: Tracer, held: continuation.Point, params: Parameters,
     (``_resolved_start``). ContinuationError when Newton does not reach a free equilibrium."""
     scene = tracer.scene
     system = tracer.system(degree, params)
-    pinned = Discretisation(degree, tracer.symmetric, True, joins=system.eq.disc.joins)
+    pinned = Discretisation(degree, tracer.symmetric, True, joins=system.eq.disc.joins,
+                            held=held_surface(scene.geometry, tracer.symmetric, True))
     X = np.append(system.eq.disc.join(*pinned.split(held.X[:-1])), held.X[-1])
     result = newton(system.residual, system.jacobian, X, unit(X.size, -1), X[-1], scene.solver.tol,
                     scene.solver.max_newton)

@@ -113,7 +113,8 @@ class Resolution:
         open_rows = np.arange(len(X)) if disc.mapping is not None else np.arange(0)
         while open_rows.size and degree < self.max_degree:
             interrupt.check()
-            plain = Discretisation(degree, disc.symmetric, disc.pin_translation, joins=disc.joins)
+            plain = Discretisation(degree, disc.symmetric, disc.pin_translation, joins=disc.joins,
+                                   held=disc.held)
             moved = disc.transfer(X[open_rows], plain)
             loss = transfer_error(disc, X[open_rows], plain, moved)
             tails = np.array([plain.tail(row[: plain.size]) for row in moved])

@@ -17,7 +17,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ...galerkin.discretisation import Discretisation
+from ...galerkin.discretisation import Discretisation, held_surface
 from ...galerkin.equilibrium import Equilibrium, Parameters
 from ...numerics import continuation, interrupt
 from ...numerics.continuation import Stop
@@ -90,7 +90,8 @@ class Tracer:
     def system(self, degree: int, params: Parameters, mapping=None) -> ParameterSystem:
         if (degree, mapping) not in self._systems:
             quadrature = self.scene.solver.quadrature if degree == self.scene.solver.degree else 0
-            disc = Discretisation(degree, self.symmetric, self.pin, quadrature, mapping)
+            disc = Discretisation(degree, self.symmetric, self.pin, quadrature, mapping,
+                                  held=held_surface(self.scene.geometry, self.symmetric, self.pin))
             self._systems[degree, mapping] = Equilibrium(self.scene, disc)
         return ParameterSystem(self._systems[degree, mapping], params, self.parameter)
 

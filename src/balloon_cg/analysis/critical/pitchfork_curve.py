@@ -364,7 +364,8 @@ def plain_branch(branch: Branch, X) -> Branch:
     mapped = branch.disc
     if mapped.mapping is None:
         return branch
-    plain = Discretisation(plain_degree(branch, X), mapped.symmetric, mapped.pin_translation)
+    plain = Discretisation(plain_degree(branch, X), mapped.symmetric, mapped.pin_translation,
+                           held=mapped.held)
     return replace(branch, disc=plain, X=mapped.transfer(branch.X, plain))
 
 

@@ -388,10 +388,10 @@ class SecondVariation:
 
 def _held_ops(basis: Discretisation, geometry: Geometry) -> np.ndarray:
     """The node values (λ2, v, η, w) per perturbation coefficient (a_0..a_N, b_0..b_N), shape (4, n_q, 2N + 2).
-    The η functions are 1 and P_k − m_k (k ≥ 1, ``held_means``), the span of P_0..P_N: dropping b_0 (a held
-    balloon) then means ∫δη dA = 0, the centroid of the reference surface fixed (dA = R S' dθ dφ; on the sphere
-    ∫δη dx = 0, also the hold of the equilibrium's held mapped basis, ``Discretisation``). On the sphere in x,
-    m_k = 0: the basis's own ops."""
+    The η functions are 1 and φ_k − m_k (k ≥ 1, ``held_means``; φ_k = P_k, or a capsule's piecewise functions with
+    φ_0 = 1), the span of φ_0..φ_N: dropping b_0 (a held balloon) then means ∫δη dA = 0, the centroid of the
+    reference surface fixed (dA = R S' dθ dφ; on the sphere ∫δη dx = 0), also the hold of the equilibrium's held
+    general basis (``Discretisation``). On the sphere in x, m_k = 0: the basis's own ops."""
     if not _weighted_hold(basis, geometry):
         return basis.ops
     na = basis.a_index.size
@@ -401,14 +401,15 @@ def _held_ops(basis: Discretisation, geometry: Geometry) -> np.ndarray:
 
 
 def _weighted_hold(basis: Discretisation, geometry: Geometry) -> bool:
-    """Whether the held η functions P_k − m_k differ from P_k: on a map, or on a spheroid (S' ≠ 1)."""
-    return basis.mapping is not None or geometry.shape == Shape.SPHEROID
+    """Whether the held η functions φ_k − m_k differ from φ_k: on a map, on a spheroid (S' ≠ 1), or on a capsule's
+    piecewise basis (joins; its R ≠ sin θ)."""
+    return basis.mapping is not None or geometry.shape == Shape.SPHEROID or bool(basis.joins)
 
 
 def held_means(basis: Discretisation, geometry: Geometry) -> np.ndarray:
-    """m_k = ∫P_k dA / A = ∫P_k ρ dx / ∫ρ dx, k = 1..N (ρ = R S'/sin θ, ``meridian.area_density``; ∫ρ dx = A/2π,
-    ``meridian.reference_area``; P_k of s(x) on a map), subtracted from the η functions of the perturbation basis
-    (``_held_ops``); zero on the sphere in x. The capsule's piecewise basis (joins) keeps its own functions."""
+    """m_k = ∫φ_k dA / A = ∫φ_k ρ dx / ∫ρ dx, k = 1..N (ρ = R S'/sin θ, ``meridian.area_density``; ∫ρ dx = A/2π,
+    ``meridian.reference_area``; φ_k = P_k of s(x) on a map, a capsule's piecewise functions on its joins),
+    subtracted from the η functions of the perturbation basis (``_held_ops``); zero on the sphere in x."""
     if not _weighted_hold(basis, geometry):
         return np.zeros(basis.degree)
     density = area_density(geometry, basis.cos_theta, basis.sin_theta)
