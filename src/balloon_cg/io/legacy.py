@@ -16,12 +16,15 @@ import io
 
 import h5py
 
-READINGS = 1
+READINGS = 2
 
 CHANGED_READINGS = (  # (revision, the shapes whose stored readings it changed, what changed)
     (1, ("spheroid",), "a spheroid's m = 1 blocks kept a rotation of the reference that is no zero mode of a "
      "spheroid, and its held m = 0 blocks and pear points held the sphere's centroid, not the spheroid's "
      "(docs/shapes.md)"),
+    (2, ("spheroid", "capsule"), "a held spheroid's or capsule's equilibrium (its pear branches, its general "
+     "basis) and a capsule's held m = 0 readings and pear points hold the reference surface's area centroid; they "
+     "held b_0, or dropped the capsule's constant function, before (docs/shapes.md)"),
 )
 
 OLD_NAMES = {"lam2_north": "lam2_top", "lam2_south": "lam2_bottom", "eta_north": "eta_top", "eta_south": "eta_bottom"}
