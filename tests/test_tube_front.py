@@ -221,9 +221,9 @@ def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
 
 @pytest.mark.slow
 def test_resolved_bulge_reaches_maxwells_pressure_with_every_point_resolved(maxwell):  # noqa: F811
-    """Ogden 1972, L = 30: the bulge on elements refined by tube/front.front_bulge to V/V0 = 52 (order 16, E p up to
-    400 per field: measured two rounds, 10 then 25 elements, the last 400), every stored point's estimate ≤
-    solver.max_error (1e-9; measured 7.4e-10), and the acceptance's chain (test_tube_maxwell.check_chain: the onset,
+    """Ogden 1972, L = 30: the bulge on elements refined locally by tube/front.front_bulge to V/V0 = 52 (order 16, E p
+    up to 400 per field: measured 22 elements at the end, 352), every stored point's estimate ≤ solver.max_error
+    (1e-9; measured 9.8e-10 to V/V0 = 50: benchmarks/tube_front_speed.py), and the acceptance's chain (test_tube_maxwell.check_chain: the onset,
     one LV, V rising beyond it, |P − P_M| ≤ 1e-6 from V/V0 = 50, stable under volume control; measured 6.0e-8, the
     finite tube's approach to the plateau, docs/tubes.md); the fold where the Legendre series of degree 120 has it
     (1e-10)."""
