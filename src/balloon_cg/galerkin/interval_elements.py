@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .discretisation import gauss_nodes, geometric_tail, read_only
-from .interval import _HESSIAN_ROW, IntervalDiscretisation
+from .discretisation import HESSIAN_ROW
+from .interval import IntervalDiscretisation
 from .legendre import gauss_rule, legendre_table
 from ..scene.tables import Ends
 
@@ -139,7 +140,7 @@ class ElementInterval(IntervalDiscretisation):
         column if given (a bordered Jacobian's ∂R/∂P): for numerics/newton.SparseFactors."""
         from scipy import sparse  # here: a sphere's `run` imports this module (io/tube_file) but never scipy.sparse
         weighted = pointwise * self.weights
-        blocks = [self._element_blocks(i, j, weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]).ravel()
+        blocks = [self._element_blocks(i, j, weighted[HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]).ravel()
                   for i, j in ((0, 0), (0, 1), (1, 1))]
         entry, indices, indptr = _sparse_pattern(self)
         data = np.bincount(entry, np.concatenate([blocks[0], blocks[1], blocks[1], blocks[2]]), minlength=indices.size)
