@@ -109,7 +109,8 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
     from balloon_cg.app.tube_summary import format_tube, summarise_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
 
-    scene = spom1_l10(20).with_overrides({"continuation.stop_stretch": 2.5, "stability.m_max": 0})
+    scene = spom1_l10(20).with_overrides({"continuation.stop_stretch": 2.5, "stability.m_max": 0,
+                                          "solver.tube_resolution": "flag"})  # a bulge with unresolved points
     picture = first_bulge_picture(scene)  # run's primary and bulge branches (shared_pictures.py)
     path = write_tube_run(tmp_path / "tube.h5", scene, picture)
     branches = read_tube_run(path)["branches"]
