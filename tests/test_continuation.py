@@ -159,13 +159,13 @@ def test_traced_folds_equal_brent_from_scratch(monkeypatch):
     """The fold trace() reports (its Brent run takes the step's end point as the bracket end) is bit for bit the
     one of a Brent run that evaluates both ends itself."""
     steps = []
-    original = continuation._locate_fold
+    original = continuation.locate_fold
 
     def recording(system, start, sigma, c, settings, end):
         steps.append((start, sigma))
         return original(system, start, sigma, c, settings, end)
 
-    monkeypatch.setattr(continuation, "_locate_fold", recording)
+    monkeypatch.setattr(continuation, "locate_fold", recording)
     u0 = -2.0
     path = continuation.trace(S_CURVE, start(S_CURVE, [u0, 1 + u0**3 - u0], [1.0, 0.0]), SETTINGS,
                               lambda p: Stop(Done.REACHED, "u > 2") if p.X[0] > 2 else None, {"lambda": LAMBDA})

@@ -311,7 +311,7 @@ def test_a_capsules_surface_branches_where_none_can_start_are_refused_in_one_lin
     """A capsule's [surface] branches start at its located m ≥ 1 points and are traced in P: with m_max = 0 (no
     such points) or on a branch continued in the voltage, asking for them is one line naming the key and what is
     allowed (before: accepted, nothing traced and the run complete, or the voltage taken for the pressure)."""
-    text = f'[material]\npreset = "spom1"\n[geometry]\nshape = "capsule"\nlength = 3\n[surface]\nbranches = "first"\n'
+    text = '[material]\npreset = "spom1"\n[geometry]\nshape = "capsule"\nlength = 3\n[surface]\nbranches = "first"\n'
     with pytest.raises(SceneError) as raised:
         parse_scene(text + setting, "scene")
     message = str(raised.value)

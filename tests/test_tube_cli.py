@@ -104,7 +104,7 @@ def test_plot_draws_every_tube_kind(bulged_file, tmp_path, capsys):
 
 def test_modes_plot_draws_the_stored_critical_modes(run_file):
     """``plot --what modes`` of the bulge branch: R, T, Z of each located m ≥ 1 zero's stored critical mode, as
-    tube/azimuthal.mode_profile evaluates it (1e-12), ½ ∫ (R² + T² + Z²) dS = 1 (1e-4, the trapezoid on the drawn
+    tube/azimuthal.mode_profile evaluates it on the branch's own discretisation (1e-12), ½ ∫ (R² + T² + Z²) dS = 1 (1e-4, the trapezoid on the drawn
     points); the primary branch (no m ≥ 1 zero) has none: one line."""
     from balloon_cg.io.tube_file import discretisation
     from balloon_cg.post.tube_plots import TubePlotError, tube_figure
@@ -115,7 +115,7 @@ def test_modes_plot_draws_the_stored_critical_modes(run_file):
     lines = tube_figure(run, "modes").axes[0].get_lines()
     assert len(lines) == 3
     s = lines[0].get_xdata()
-    expected = mode_profile(discretisation(run["attrs"]), point["mode"], s)
+    expected = mode_profile(discretisation(run["attrs"], run["branches"]["bulge"]["attrs"]), point["mode"], s)
     for line, values in zip(lines, expected):
         assert np.max(np.abs(line.get_ydata() - values)) <= 1e-12
     squared = sum(np.asarray(v) ** 2 for v in expected)
@@ -204,7 +204,8 @@ def test_profiles_stretches_and_front_share_one_axis(bulged_file):
     run = read_tube_run(bulged_file)
     i = len(run["branches"]["bulge"]["volume"]) - 1
     u = run["branches"]["bulge"]["unknowns"][i]
-    rho, eta = discretisation(run["attrs"]).profile(u, np.array([0.0, run["attrs"]["length"]]))
+    disc = discretisation(run["attrs"], run["branches"]["bulge"]["attrs"])  # the branch's own: spectral elements
+    rho, eta = disc.profile(u, np.array([0.0, run["attrs"]["length"]]))
     drawn = tube_figure(run, "profiles", points=[i]).axes[0].lines[0].get_xydata()
     hoop = tube_figure(run, "stretches", points=[i]).axes[0].lines[0].get_xydata()
     for line in (drawn, hoop):

@@ -21,7 +21,7 @@ from balloon_cg.scene.tables import Ends
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.front import front_bulge, refined_layout
 from balloon_cg.tube.primary import TubeSystem, held, primary_branch
-from balloon_cg.tube.stability import _counts_by_one_factor, arrow_factor, unstable_counts
+from balloon_cg.tube.stability import ArrowPattern, _counts_by_one_factor, unstable_counts
 from test_tube_maxwell import LENGTH, check_chain, maxwell, ogden_1972_tube  # noqa: F401 (the fixture)
 
 BOUNDS = (-0.6, -0.1, 0.3, 0.75)
@@ -133,7 +133,8 @@ def test_sparse_and_arrow_factors_are_the_dense_ones(ends, stretch):
     assert width == 2 * disc.order + 1
     rows, columns = np.nonzero(H[np.ix_(order, order)][:local, :local])
     assert np.abs(rows - columns).max() == width
-    arrow = arrow_factor(eq.sparse_jacobian(u, P), free, (order, local, width))
+    pattern = ArrowPattern(eq.sparse_jacobian(u, P), free, (order, local, width))
+    arrow = pattern.factor(eq.sparse_jacobian(u, P))
     assert arrow.negatives == np.count_nonzero(np.linalg.eigvalsh(H) < 0) > 0
     r = rng.standard_normal(free.size)
     x = np.empty(free.size)
@@ -144,7 +145,7 @@ def test_sparse_and_arrow_factors_are_the_dense_ones(ends, stretch):
     basis = np.linalg.svd(g[None, :])[2][1:].T  # an orthonormal basis of g⊥
     expected = [np.count_nonzero(np.linalg.eigvalsh(M) < 0)
                 for M in (H, basis.T @ H @ basis, H + weight * np.outer(g, g))]
-    assert _counts_by_one_factor(eq, u, P, (order, local, width), g, weight) is not None  # the arrow decided them
+    assert _counts_by_one_factor(eq, u, P, pattern, g, weight) is not None  # the arrow decided them
     counts = unstable_counts(eq, [np.append(u, PRESSURE)], Parameters(0.0))
     assert [int(counts[c][0]) for c in (Control.PRESSURE, Control.VOLUME, Control.GAS)] == expected
 
@@ -188,8 +189,8 @@ def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
     (collocated there and back: 1e-12) and is its equilibrium (|R| ≤ 1e-9 there; measured 1.3e-13); the last point is
     the last layout's (|R| ≤ 1e-9); the volume fold is where the whole branch traced from the onset on the last
     layout (the retrace the local refinement saves, a second trace) has it: P within max(1e-9 relative, the tails of
-    the fold's neighbours) (measured 1.8e-15), V/V0 likewise (measured 0). With max_degree 60 (5 elements of order 12)
-    the branch stops UNRESOLVED at the first point that needed more, saying so, every stored point resolved."""
+    the fold's neighbours) (measured 1.8e-15), V/V0 likewise (measured 0). With a cap of 60 unknowns per field (5 elements of order
+    12) the branch stops UNRESOLVED at the first point that needed more, saying so, every stored point resolved."""
     import balloon_cg.tube.front as front
 
     scene = parse_scene('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\n'
@@ -214,7 +215,8 @@ def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
     eq = Equilibrium(scene, branch.disc)
     assert abs(eq.volume(fold.u) - eq.volume(again.u)) <= max(1e-9, error) * eq.volume(again.u)
     capped = front_bulge(scene, primary, onset, Resolution(1e-9, 60), layout=first, stop_stretch=2.5)
-    assert capped.stop.code == IntervalStop.UNRESOLVED and "solver.max_degree 60" in capped.stop.message
+    assert capped.stop.code == IntervalStop.UNRESOLVED and "the layout's cap of 60 unknowns" in capped.stop.message
+    assert "\n" not in capped.stop.message
     assert capped.disc.degree <= 60 and capped.tail.max() <= 1e-9 and len(capped.pressure) < len(branch.pressure)
 
 

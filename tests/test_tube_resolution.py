@@ -108,7 +108,8 @@ def test_run_file_stores_each_points_tail_and_first_integral(tmp_path):
     from balloon_cg.app.tube_summary import format_tube, summarise_tube
     from balloon_cg.io.tube_file import read_tube_run, write_tube_run
 
-    scene = spom1_l10(20).with_overrides({"continuation.stop_stretch": 2.5, "stability.m_max": 0})
+    scene = spom1_l10(20).with_overrides({"continuation.stop_stretch": 2.5, "stability.m_max": 0,
+                                          "solver.tube_resolution": "flag"})  # a bulge with unresolved points
     picture = first_bulge_picture(scene)  # run's primary and bulge branches (shared_pictures.py)
     path = write_tube_run(tmp_path / "tube.h5", scene, picture)
     branches = read_tube_run(path)["branches"]
@@ -165,8 +166,9 @@ def test_run_refines_the_bulge_to_max_error_where_the_scene_asks(tmp_path, capsy
 
 
 def test_tube_resolution_key_is_the_tubes_and_left_out_of_default_texts():
-    """solver.tube_resolution: "flag" (the default) is not written into a scene's text (older texts stay); a wrong
-    value and the key on another shape are one line naming the key, its value and what is allowed."""
+    """solver.tube_resolution: "elements" (the default since session 29) is not written into a scene's text, "refine"
+    is; a wrong value and the key on another shape are one line naming the key, its value and what is allowed; a sphere
+    scene carries the default and never reads it."""
     import pytest
     from balloon_cg.scene import SceneError, load_scene, parse_scene
 
@@ -177,4 +179,4 @@ def test_tube_resolution_key_is_the_tubes_and_left_out_of_default_texts():
         with pytest.raises(SceneError) as error:
             parse_scene('[material]\npreset = "SPOM1"\n' + text)
         assert words in str(error.value) and "\n" not in str(error.value)
-    assert load_scene("spom1").solver.tube_resolution == "flag"
+    assert load_scene("spom1").solver.tube_resolution == "elements"

@@ -13,8 +13,8 @@ def run_tube(scene, output, args) -> int:
     """A tube scene's run (tube/picture.py: the primary branch, its folds and branch points, the bulge branch)
     written to the tube run file ``output`` and summarised; 130 when a signal stopped it (module docstring); 1 (0 with
     --allow-partial) when a switched branch could not start (its first step did not converge: the file's
-    ``not_started``) or the bulge branch stopped unresolved at solver.max_degree (solver.tube_resolution = "refine":
-    tube/resolution.py), saying so in one line."""
+    ``not_started``) or the bulge branch stopped unresolved at its cap (solver.tube_resolution "elements", the
+    default: the element layout's, tube/front.element_cap; "refine": solver.max_degree, tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
     from ..analysis.results import IntervalStop
     from ..tube.picture import tube_picture

@@ -78,17 +78,18 @@ class ElementInterval(IntervalDiscretisation):
         t = (2.0 * x - edges[element] - edges[element + 1]) / width
         dt = 2.0 / width
         leg, dleg = legendre_table(t, p)
+        rows = np.arange(x.size)
         hats, slopes = np.zeros((x.size, n - 1)), np.zeros((x.size, n - 1))
-        for i in range(1, n):
-            below, above = element == i - 1, element == i
-            hats[:, i - 1] = np.where(below, 0.5 * (1 + t), 0.0) + np.where(above, 0.5 * (1 - t), 0.0)
-            slopes[:, i - 1] = np.where(below, 0.5 * dt, 0.0) - np.where(above, 0.5 * dt, 0.0)
+        above = element >= 1  # the point lies above inner bound x_e: that hat falls on it
+        hats[rows[above], element[above] - 1] = 0.5 * (1 - t[above])
+        slopes[rows[above], element[above] - 1] = -0.5 * dt[above]
+        below = element <= n - 2  # below inner bound x_{e+1}: that hat rises on it
+        hats[rows[below], element[below]] = 0.5 * (1 + t[below])
+        slopes[rows[below], element[below]] = 0.5 * dt[below]
         bubbles, bubble_slopes = np.zeros((x.size, n * (p - 1))), np.zeros((x.size, n * (p - 1)))
-        for e in range(n):
-            on = element == e
-            columns = slice(e * (p - 1), (e + 1) * (p - 1))
-            bubbles[:, columns] = np.where(on[:, None], leg[:, 2:] - leg[:, :-2], 0.0)
-            bubble_slopes[:, columns] = np.where(on[:, None], (dleg[:, 2:] - dleg[:, :-2]) * dt[:, None], 0.0)
+        columns = element[:, None] * (p - 1) + np.arange(p - 1)[None, :]  # each point's own element's bubbles
+        bubbles[rows[:, None], columns] = leg[:, 2:] - leg[:, :-2]
+        bubble_slopes[rows[:, None], columns] = (dleg[:, 2:] - dleg[:, :-2]) * dt[:, None]
         axial, daxial = np.hstack([hats, bubbles]), np.hstack([slopes, bubble_slopes])
         if self.ends != Ends.SLIDING:
             return axial, daxial, axial, daxial
@@ -214,17 +215,27 @@ def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterva
     each of onto's elements and its inner bounds, by least squares (exact where onto's space holds the state: the
     uniform tube, a layout with elements split or of a higher order)."""
     k, onto_k = disc.axial_index, onto.axial_index
+    hoop, axial = _collocation(disc, onto)
+    rows = np.atleast_2d(u)
+    out = np.empty((rows.shape[0], onto.size))
+    out[:, :onto_k] = rows[:, :k] @ hoop.T
+    out[:, onto_k] = rows[:, k]
+    out[:, onto_k + 1:] = rows[:, k + 1:] @ axial.T
+    return out.reshape(np.shape(u)[:-1] + (onto.size,))
+
+
+@functools.lru_cache(maxsize=16)
+def _collocation(disc: IntervalDiscretisation, onto: ElementInterval) -> tuple:
+    """``collocated``'s maps of λ2's and of η's bubble coefficients, (onto's columns, disc's): the least-squares
+    solution of onto's basis at the collocation points against disc's basis there."""
     t, _ = gauss_rule(onto.order + 1)
     edges = onto.edges
     x = np.concatenate([(edges[:-1, None] + 0.5 * np.diff(edges)[:, None] * (t[None, :] + 1.0)).ravel(), edges[1:-1]])
+    from scipy.linalg import lstsq  # QR with pivoting (gelsy): onto's basis has full column rank at these points
     hoop, _, axial, _ = disc.functions(x)
     onto_hoop, _, onto_axial, _ = onto.functions(x)
-    rows = np.atleast_2d(u)
-    out = np.empty((rows.shape[0], onto.size))
-    out[:, :onto_k] = np.linalg.lstsq(onto_hoop, hoop @ rows[:, :k].T, rcond=None)[0].T
-    out[:, onto_k] = rows[:, k]
-    out[:, onto_k + 1:] = np.linalg.lstsq(onto_axial, axial @ rows[:, k + 1:].T, rcond=None)[0].T
-    return out.reshape(np.shape(u)[:-1] + (onto.size,))
+    return (read_only(lstsq(onto_hoop, hoop, lapack_driver="gelsy", check_finite=False)[0]),
+            read_only(lstsq(onto_axial, axial, lapack_driver="gelsy", check_finite=False)[0]))
 
 
 @functools.lru_cache(maxsize=16)

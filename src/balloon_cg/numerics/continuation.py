@@ -204,10 +204,10 @@ def rate(monitor, X: np.ndarray, t: np.ndarray) -> float:
     return float((monitor(X) if callable(monitor) else monitor) @ t)
 
 
-def _locate_fold(system, start: Point, sigma: float, c, settings: Settings, end: Point):
-    """The point where the monitor's rate (``rate``) vanishes between start and start + σ along the arclength
-    (Brent), or None; ``end`` is the point the step from start reached (``value_at(σ)``: the same corrector and
-    tangent, not recomputed)."""
+def locate_fold(system, start: Point, sigma: float, c, settings: Settings, end: Point | None = None):
+    """The Root where the monitor's rate (``rate``) vanishes between start and start + σ along the arclength
+    (Brent), or None; ``end`` (if given) is the point the step from start reached (``value_at(σ)``: the same
+    corrector and tangent, not recomputed)."""
 
     def value_at(s):
         result = correct(system, start.X + s * start.tangent, start.tangent, settings)
@@ -216,6 +216,8 @@ def _locate_fold(system, start: Point, sigma: float, c, settings: Settings, end:
         t = tangent(system, result.x, start.tangent, result.factors)
         return rate(c, result.x, t), Point(result.x, t, result.iterations, result.residual)
 
+    if end is None:
+        return locate_root(value_at, sigma)
     reached = Point(end.X.copy(), end.tangent.copy(), end.iterations, end.residual)  # a fold's own arrays
     return locate_root(value_at, sigma, known={sigma: (rate(c, end.X, end.tangent), reached)})
 
@@ -262,7 +264,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
         new_rates = {label: rate(c, point.X, point.tangent) for label, c in monitors.items()}
         for label, c in monitors.items():
             if rates[label] * new_rates[label] < 0:
-                fold = _locate_fold(system, current, sigma, c, settings, point)
+                fold = locate_fold(system, current, sigma, c, settings, point)
                 if fold is None:  # no evaluation converged: the fold is known to lie in the step, no better
                     path.folds.append(Fold(label, current, len(path.points) - 1, RootStatus.NEAREST))
                 else:

@@ -219,11 +219,11 @@ class Solver:
     """Discretisation: Legendre ``degree``, Gauss points (``quadrature``, 0 = automatic), Newton settings.
 
     The degree grows by half (up to ``max_degree``) whenever the spectral error estimate of a point exceeds
-    ``max_error``; a branch that would need more stops there, saying so. A tube's bulge branch is traced at one
-    degree: ``tube_resolution`` "flag" (the default) stores its points at the scene's degree, those past
-    ``max_error`` flagged; "refine" retraces it at growing degree until it is resolved, stopping "unresolved" at
-    ``max_degree`` (tube/resolution.py); "elements" traces it on spectral elements whose layout is refined until
-    every point is resolved, at most ``max_degree`` unknowns per field (tube/front.py).
+    ``max_error``; a branch that would need more stops there, saying so. A tube's bulge branch (switched at an odd
+    branch point) follows ``tube_resolution``: "elements" (the default) traces it on spectral elements whose layout
+    is refined locally until every point is resolved, at most ``max_degree`` unknowns per field (tube/front.py);
+    "flag" at the scene's degree, its points past ``max_error`` flagged; "refine" retraces it at growing degree until
+    it is resolved, stopping "unresolved" at ``max_degree`` (tube/resolution.py). Other shapes never read it.
     """
 
     degree: int = 40
@@ -232,7 +232,7 @@ class Solver:
     max_newton: int = 25
     max_degree: int = 320
     max_error: float = 1e-9
-    tube_resolution: str = "flag"
+    tube_resolution: str = "elements"
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,7 @@ from ..galerkin.discretisation import symmetric_rows
 from ..galerkin.equilibrium import Equilibrium, Parameters, in_field
 from ..galerkin.interval import IntervalDiscretisation
 from ..generated import AZIMUTHAL_PAIRS
+from ..numerics import interrupt
 from ..numerics.eigen import NO_CONSTRAINT, GramFactor, lowest_of, negative_count, restricted
 from ..scene.tables import Ends
 
@@ -164,12 +165,14 @@ def _factor(disc: IntervalDiscretisation) -> GramFactor:
 
 
 def branch_modes(eq: Equilibrium, points, params: Parameters, m_max: int, count: int = COUNT) -> TubeModes:
-    """``TubeModes`` of the points Y = (u, P) of a branch (``params``: the branch's, P replaced)."""
+    """``TubeModes`` of the points Y = (u, P) of a branch (``params``: the branch's, P replaced); a signal stops it
+    at the next point (numerics/interrupt.Interrupted)."""
     found = {}  # (m, held): (lowest, unstable)
     for m in range(1, m_max + 1):
         which = readings(eq, params, m)
         values, negatives = {held: [] for held in which}, {held: [] for held in which}
         for Y in points:
+            interrupt.check()
             for held, A in blocks(eq, Y[:-1], params.with_value("P", Y[-1]), m, which).items():
                 negatives[held].append(negative_count(A))
                 values[held].append(lowest_of(A, count))

@@ -17,6 +17,7 @@ from .zeros import corrected_zero
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.stability.crossings import count_changes
 from ..galerkin.equilibrium import Equilibrium
+from ..numerics import interrupt
 from ..numerics.continuation import RootStatus
 
 
@@ -43,7 +44,8 @@ class AzimuthalCrossing:
 
 def crossings(scene, branch, modes) -> list[AzimuthalCrossing]:
     """The zeros of the m ≥ 1 eigenvalues of ``branch`` (tube/results.IntervalBranch) where ``modes``
-    (tube/azimuthal.TubeModes) says its unstable counts change, ordered by m then along the branch."""
+    (tube/azimuthal.TubeModes) says its unstable counts change, ordered by m then along the branch; a signal stops
+    it at its next eigenvalue (numerics/interrupt.Interrupted)."""
     disc = branch.disc
     eq = Equilibrium(scene, disc)
     params = branch.params
@@ -71,6 +73,7 @@ def _zero(system, eq, params, settings, before, after, m: int, order: int, held_
     length = float(np.linalg.norm(after - before))
 
     def eigenvalue(Y):
+        interrupt.check()  # not an ArithmeticError: a signal ends the search, not this evaluation
         return float(np.linalg.eigvalsh(block(eq, Y[:-1], params.with_value("P", Y[-1]), m, held_block))[order])
 
     end = system.full(after)

@@ -75,8 +75,8 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     tube, galerkin/interval_elements.py: ``_switched_onto``); ``refine``: with ``on`` and ``max_error``, (layout,
     u) ↦ the finer layout (holding the layout's space) where a point u's tail passes max_error: the trace is continued
     there from its last point (``_continued_on``; None from ``refine``: stopped UNRESOLVED as without), tube/front.py.
-    A branch traced on several layouts stores its states on the last (``collocated``: exact), each point's tail,
-    spread, stability counts and smallest stress those of the layout it was traced on (``_assembled``).
+    A branch traced on several layouts stores its states on the last (``collocated``: exact), its folds located on the last (``_relocated``), each
+    point's tail, spread, stability counts and smallest stress those of the layout it was traced on (``_assembled``).
     UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that is not
     uniform."""
     if point.kind != Kind.BP or point.block is None:
@@ -113,8 +113,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     while True:
         volume_stop = VolumeStop(target, system)
         stop = _stop_rule(system, point.block, volume_stop, stop_stretch, max_error, compressed)
-        monitors = {Kind.LP: np.eye(start.X.size)[-1], Kind.LV: gradient(system, Control.VOLUME)}
-        monitors |= control_monitors(system, scene.loading.control)
+        monitors = _monitors(system, scene)
         leg = replace(settings, max_points=settings.max_points - stored + (1 if legs else 0))
         path = continuation.trace(system, start, leg, stop, monitors)
         legs.append((system, path, volume_stop))
@@ -135,6 +134,12 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         legs[-1] = (system, replace(path, stop=Stop(path.stop.code, f"maximum number of points "
                                                                     f"({settings.max_points}) reached")), volume_stop)
     return _assembled(scene, primary.params, branch_point, legs, settings, max_error)
+
+
+def _monitors(system, scene) -> dict:
+    """The fold monitors of a trace on ``system``: P (LP), V (LV) and the control's (tube/control.py)."""
+    monitors = {Kind.LP: np.eye(system.columns.size)[-1], Kind.LV: gradient(system, Control.VOLUME)}
+    return monitors | control_monitors(system, scene.loading.control)
 
 
 def _tube_system(scene, disc, params, unknowns) -> TubeSystem:
@@ -173,13 +178,9 @@ def _continued_on(scene, params, system, path, finer, settings) -> tuple | None:
     re-solved there by the Keller corrector on the hyperplane through it normal to the tangent, its tangent
     recomputed, the step the one that reached the unresolved point (``path.overshoot``); None where the corrector
     does not converge."""
-    disc, last = system.system.eq.disc, path.points[-1]
+    last = path.points[-1]
     onto = _tube_system(scene, finer, params, finer.free)
-    Y, direction = system.full(last.X), np.zeros(disc.size + 1)
-    direction[system.columns] = last.tangent
-    X = np.append(collocated(disc, Y[:-1], finer), Y[-1])[onto.columns]
-    direction = np.append(collocated(disc, direction[:-1], finer), direction[-1])[onto.columns]
-    direction /= np.linalg.norm(direction)
+    X, direction = _moved(system, last.X, last.tangent, onto)
     solved = continuation.correct(onto, X, direction, settings)
     if not solved.converged:
         return None
@@ -192,8 +193,8 @@ def _assembled(scene, params, branch_point: np.ndarray, legs: list, settings, ma
     """The IntervalBranch of the traces ``legs`` ((system, path, VolumeStop) per layout, each after the first
     starting at the one before's last stored point re-solved: that start not stored again) from ``branch_point``
     Y* = (u*, P): the end landed on the last leg's stop_volume, the folds of each leg but those in the step that
-    ended it where it rejoined or was unresolved (the next leg traces that step again) or beyond the landed end; each
-    point's counts, stress, volume, tail and spread on its own layout, the states on the last (``collocated``)."""
+    ended it where it rejoined or was unresolved (the next leg traces that step again) or beyond the landed end, an earlier leg's located again on the last layout (``_relocated``); each point's counts,
+    stress, volume, tail and spread on its own layout, the states on the last (``collocated``)."""
     last_system, last_path, volume_stop = legs[-1]
     disc = last_system.system.eq.disc
     end, stopped = volume_stop.end(last_path, settings)
@@ -211,15 +212,17 @@ def _assembled(scene, params, branch_point: np.ndarray, legs: list, settings, ma
             folds = [f for f in folds if f.index < last or volume_stop.kept(path, end, f.point.X)]
         points = ([branch_point] if k == 0 else []) + [system.full(p.X) for p in path.points[(1 if k else 0):]]
         points += [end] if k == len(legs) - 1 and end is not None else []
-        leg_special = stressed(eq, tuple(
-            IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + base,
+        if system is not last_system:  # located again on the layout the branch is stored on
+            folds = [_relocated(scene, f, system, path, last_system, settings) for f in folds]
+        leg_special = stressed(last_system.system.eq, tuple(
+            IntervalSpecial(Kind(f.label), last_system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + base,
                             f.status) for f in sorted(folds, key=lambda f: f.index)))
         moved = (lambda rows: rows) if eq.disc == disc else (lambda rows: collocated(eq.disc, rows, disc))
         Y = np.array(points)
         states.append(moved(Y[:, :-1]))
         pressure.append(Y[:, -1])
         volume.append([volume_ratio(eq, y) for y in Y])
-        special += [replace(s, u=moved(s.u)) for s in leg_special]
+        special += leg_special
         stress.append([smallest_stress(eq, y[:-1]) for y in Y])
         for control, counts in unstable_counts(eq, Y, params).items():
             unstable[control].append(counts)
@@ -231,6 +234,40 @@ def _assembled(scene, params, branch_point: np.ndarray, legs: list, settings, ma
         disc, np.concatenate(states), np.concatenate(pressure), np.concatenate(volume), {},
         {control: np.concatenate(counts) for control, counts in unstable.items()}, tuple(special), stopped,
         np.concatenate(stress), params, np.concatenate(tail), np.concatenate(spread)), settings)
+
+
+def _relocated(scene, fold, system, path, onto, settings):
+    """``fold`` of the trace ``path`` on ``system`` located again on the finer layout of ``onto`` (the one the branch
+    is stored on: a state solved on one layout is not stored with readings on another): points[index] and its
+    tangent moved onto it (``_moved``: exact) and re-solved there by the Keller corrector, and the monitor's zero
+    located in the step to the point after it, moved likewise, as the tracer locates it
+    (numerics/continuation.locate_fold). Where that fails: the fold's own state moved, status NEAREST."""
+    after = path.points[fold.index + 1] if fold.index + 1 < len(path.points) else path.overshoot
+    X, t = _moved(system, path.points[fold.index].X, path.points[fold.index].tangent, onto)
+    solved = continuation.correct(onto, X, t, settings)
+    root = None
+    if solved.converged:
+        start = continuation.Point(solved.x, continuation.tangent(onto, solved.x, t, solved.factors),
+                                   solved.iterations, solved.residual)
+        end, _ = _moved(system, after.X, after.tangent, onto)
+        root = continuation.locate_fold(onto, start, float(start.tangent @ (end - start.X)),
+                                        _monitors(onto, scene)[Kind(fold.label)], settings)
+    if root is None or root.status != continuation.RootStatus.LOCATED:
+        X, t = _moved(system, fold.point.X, fold.point.tangent, onto)
+        return replace(fold, point=continuation.Point(X, t, 0, np.nan), status=continuation.RootStatus.NEAREST,
+                       bracket=None)
+    return replace(fold, point=root.payload, status=root.status, bracket=None)
+
+
+def _moved(system, X, t, onto) -> tuple:
+    """(X, unit tangent) of ``system``'s point X and tangent t collocated onto the finer layout of ``onto``
+    (galerkin/interval_elements.collocated: exact where it holds the coarser one's space)."""
+    disc, finer = system.system.eq.disc, onto.system.eq.disc
+    Y, direction = system.full(X), np.zeros(disc.size + 1)
+    direction[system.columns] = t
+    X = np.append(collocated(disc, Y[:-1], finer), Y[-1])[onto.columns]
+    direction = np.append(collocated(disc, direction[:-1], finer), direction[-1])[onto.columns]
+    return X, direction / np.linalg.norm(direction)
 
 
 def _switched(scene, primary: IntervalBranch, point: IntervalSpecial) -> tuple:
@@ -271,9 +308,11 @@ class Side:
         self.hoops = np.arange(1 if self.odd else 2, disc.degree + 1, 2)
         self.weight = -2.0 if self.odd else 1.0
         self.rejoins = "mirror-symmetric" if self.odd else "uniform"
+        if isinstance(disc, ElementInterval):  # ρ(0) − ρ(L) from the basis's values at the ends
+            ends = disc.functions(np.array([-1.0, 1.0]))[0]
+            self.ends = ends[0] - ends[1]
 
     def __call__(self, u: np.ndarray) -> float:
-        if isinstance(self.disc, ElementInterval):  # ρ(0) − ρ(L) from the basis's values at the ends
-            rho, _ = self.disc.radius(np.array([u, u]), np.array([-1.0, 1.0]))
-            return float(rho[0] - rho[1])
+        if isinstance(self.disc, ElementInterval):
+            return float(self.ends @ u[: self.ends.size])
         return self.weight * float(u[self.hoops].sum())

@@ -15,14 +15,17 @@ and the layout is refined locally, where and when a traced point needs it (tube/
    is traced again on the refined layout (its folds located there); a point still unresolved there refines again;
 4. the branch is returned when it reaches its stop with every stored point's estimate (the largest of its elements'
    tails, on the layout it was traced on) at most ``max_error``, or stopped UNRESOLVED at the first point whose
-   refined layout would have more than ``solver.max_degree`` unknowns per field (E p), its message naming
-   max_degree.
+   refined layout would pass the layout's cap, its message saying so in one line: ``element_cap`` unknowns per field
+   (E p), elements of ORDER of mean length 1/ELEMENTS_PER_LENGTH radii over the whole tube, its own and not
+   solver.max_degree's (a Legendre series' cap: its dense matrices cost (E p)³, the elements' banded ones E p³).
 
 The layout only grows along the branch (the front sweeps the tube once: its elements are cut where it passes, the
 rest stays long), so the last layout holds every earlier one's space: the stored branch is on it, each earlier
 point's state moved there exactly (galerkin/interval_elements.collocated), and each point's tail, first-integral
 spread, stability counts and smallest stress are those of the layout it was traced and solved on (on the last
-layout an earlier state is not re-solved: its residual there is its own layout's discretisation error). Earlier
+layout an earlier state is not re-solved: its residual there is its own layout's discretisation error). A fold is
+the exception: it is located again on the last layout (its step's ends moved there and re-solved), so that what is
+read at it there (an m = 0 frequency's zero, its stability) is read at an equilibrium of that layout. Earlier
 points are never retraced: the branch costs one trace.
 """
 from dataclasses import replace
@@ -38,6 +41,13 @@ from ..numerics.continuation import Stop
 START_ELEMENTS = 10  # the first layout's elements of equal length
 ORDER = 16  # the elements' polynomial degree
 RATE = 0.5  # the assumed decay of an element's tail per halving of its length: 2^(RATE p) (module docstring)
+ELEMENTS_PER_LENGTH = 2  # the layout's cap: elements of mean length half a reference radius (a front is ~3 wide)
+
+
+def element_cap(scene) -> int:
+    """The layout's cap in unknowns per field, E p ≤ ORDER ⌈ELEMENTS_PER_LENGTH L⌉ (module docstring): 320 on
+    L = 10, 960 on L = 30 (whose branch to V/V0 = 50 ends on 22 elements)."""
+    return ORDER * int(np.ceil(ELEMENTS_PER_LENGTH * scene.geometry.length))
 
 
 def uniform_layout(scene, elements: int, order: int) -> ElementInterval:
@@ -65,10 +75,10 @@ def refined_layout(disc: ElementInterval, tails: np.ndarray, max_error: float) -
 def front_bulge(scene, primary, point, policy: Resolution | None = None, layout: ElementInterval | None = None,
                 **trace):
     """The bulge branch switched at ``point`` (an odd branch point of ``primary``) on spectral elements refined
-    locally until every stored point's estimate is at most ``policy.max_error`` (None: the scene's; module
-    docstring), from ``layout`` (None: ``uniform_layout`` of START_ELEMENTS and ORDER); ``trace``: tube/bulge.
+    locally until every stored point's estimate is at most ``policy.max_error``, the layout at most
+    ``policy.max_degree`` unknowns per field (None: solver.max_error and ``element_cap``; module docstring), from ``layout`` (None: ``uniform_layout`` of START_ELEMENTS and ORDER); ``trace``: tube/bulge.
     bulge_branch's stop_volume, step, stop_stretch."""
-    policy = Resolution.of(scene) if policy is None else policy
+    policy = Resolution(scene.solver.max_error, element_cap(scene)) if policy is None else policy
     disc = uniform_layout(scene, START_ELEMENTS, ORDER) if layout is None else layout
     refused = []  # the layout a refinement would have passed max_degree with
 
@@ -82,6 +92,7 @@ def front_bulge(scene, primary, point, policy: Resolution | None = None, layout:
     branch = bulge_branch(scene, primary, point, max_error=policy.max_error, on=disc, refine=refine, **trace)
     if branch.stop.code != IntervalStop.UNRESOLVED or not refused:
         return branch
-    message = (f"{branch.stop.message}: {refused[-1].count} elements of order {disc.order} would pass "
-               f"solver.max_degree {policy.max_degree} (elements × order): raise it or solver.max_error")
+    message = (f"{branch.stop.message}: {refused[-1].count} elements of order {disc.order} would pass the layout's "
+               f"cap of {policy.max_degree} unknowns per field (elements × order; tube/front.element_cap): raise "
+               "solver.max_error")
     return replace(branch, stop=Stop(IntervalStop.UNRESOLVED, message))

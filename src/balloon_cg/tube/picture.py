@@ -188,19 +188,21 @@ def rejoined_at(scene, primary: IntervalBranch, branch: IntervalBranch, label: i
 def with_modes(scene, picture: TubePicture) -> TubePicture:
     """``picture`` with its branches' m = 1..``stability.m_max`` blocks (tube/azimuthal.py) and the zeros of their
     eigenvalues located (tube/azimuthal_crossings.py) where m_max ≥ 1 and no signal stopped the picture. A signal
-    before a branch's blocks (after the last check of the stage before, or while the branch before was read: they do
-    not poll) ends the work there: none are kept, the picture is interrupted in Stage.MODES. One BLAS thread, as the
+    (after the last check of the stage before, or while the blocks are read: at each point and each eigenvalue of a
+    zero's search) ends the work there: none are kept, the picture is interrupted in Stage.MODES. One BLAS thread, as the
     traces."""
     m_max = scene.stability.m_max
     if m_max < 1 or picture.interrupted is not None:
         return picture
     modes = {}
-    for name, branch in picture.branches.items():
-        if interrupt.requested():
-            return replace(picture, interrupted=Stage.MODES)
-        found = branch_modes(Equilibrium(scene, branch.disc), np.column_stack([branch.states, branch.pressure]),
-                             branch.params, m_max)
-        modes[name] = replace(found, crossings=tuple(crossings(scene, branch, found)))
+    try:
+        for name, branch in picture.branches.items():
+            interrupt.check()
+            found = branch_modes(Equilibrium(scene, branch.disc), np.column_stack([branch.states, branch.pressure]),
+                                 branch.params, m_max)
+            modes[name] = replace(found, crossings=tuple(crossings(scene, branch, found)))
+    except interrupt.Interrupted:
+        return replace(picture, interrupted=Stage.MODES)
     return replace(picture, modes=modes)
 
 

@@ -29,13 +29,15 @@ def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
     (``params``: the branch's, P replaced): ∂R/∂u (pressure), on δV = 0 (volume), H + (P/Ṽ) g gᵀ (gas)} (module
     docstring), all three from one LDLᵀ of H (numerics/banded.BandedInertia: on g⊥ one fewer where gᵀH⁻¹g < 0,
     with the rank-one term one fewer where 1 + (P/Ṽ) gᵀH⁻¹g < 0; Haynsworth's inertia additivity): on spectral
-    elements H's arrow (``arrow_factor``), else Bunch–Kaufman's. Where that one does not decide (the arrow's banded
+    elements H's arrow (``ArrowPattern``), else Bunch–Kaufman's. Where that one does not decide (the arrow's banded
     block refused, H singular, g = 0, P < 0 or 1 + (P/Ṽ) gᵀH⁻¹g = 0) by the dense H's, restricted and updated
     matrices' own factorisations."""
     counts = {control: [] for control in Control}
     free = eq.disc.free
     unit = GramFactor(np.ones(free.size), orthogonal=True)
     arrow = eq.disc.arrow_order(free) if isinstance(eq.disc, ElementInterval) else None
+    if arrow is not None and len(points):
+        arrow = ArrowPattern(eq.sparse_jacobian(points[0][:-1], params.with_value("P", points[0][-1])), free, arrow)
     for Y in points:
         at = params.with_value("P", Y[-1])
         gradient = -eq.parameter_derivative(Y[:-1], at, "P")[free]
@@ -50,10 +52,10 @@ def unstable_counts(eq: Equilibrium, points, params: Parameters) -> dict:
     return {control: np.array(values, dtype=int) for control, values in counts.items()}
 
 
-def _counts_by_one_factor(eq: Equilibrium, u: np.ndarray, at: Parameters, arrow: tuple | None, gradient: np.ndarray,
+def _counts_by_one_factor(eq: Equilibrium, u: np.ndarray, at: Parameters, arrow, gradient: np.ndarray,
                           weight: float) -> tuple | None:
-    """(pressure, volume, gas) counts from one LDLᵀ of H on the free unknowns (``unstable_counts``): ``arrow`` (an
-    ElementInterval's ``arrow_order``) or None (dense); None where it does not decide them."""
+    """(pressure, volume, gas) counts from one LDLᵀ of H on the free unknowns (``unstable_counts``): ``arrow`` (the
+    layout's ``ArrowPattern``) or None (dense); None where it does not decide them."""
     free = eq.disc.free
     norm = float(np.linalg.norm(gradient))
     if norm == 0.0 or weight < 0.0:
@@ -62,8 +64,7 @@ def _counts_by_one_factor(eq: Equilibrium, u: np.ndarray, at: Parameters, arrow:
         factor = DenseLDLT(eq.jacobian(u, at)[np.ix_(free, free)])
         factor = None if factor.singular else factor
     else:
-        order, _, _ = arrow
-        factor, gradient = arrow_factor(eq.sparse_jacobian(u, at), free, arrow), gradient[order]
+        factor, gradient = arrow.factor(eq.sparse_jacobian(u, at)), gradient[arrow.order]
     if factor is None:
         return None
     inertia = BandedInertia(factor)
@@ -72,20 +73,34 @@ def _counts_by_one_factor(eq: Equilibrium, u: np.ndarray, at: Parameters, arrow:
     return None if gas is None else (factor.negatives, volume, gas)
 
 
-def arrow_factor(hessian, free: np.ndarray, arrow: tuple) -> ArrowLDLT | None:
-    """The ArrowLDLT of the sparse Hessian ``hessian`` on the unknowns ``free`` laid out by ``arrow`` = (order,
-    local, bandwidth) (ElementInterval.arrow_order: the banded block first, the global columns last); None where it
-    is refused."""
-    order, local, width = arrow
-    chosen = free[order]
-    H = hessian.tocsr()[chosen][:, chosen].tocoo()
-    inside = (H.row < local) & (H.col < local) & (H.row >= H.col)
-    if np.any(H.row[inside] - H.col[inside] > width):
-        raise ValueError(f"the Hessian's banded block passes its half-bandwidth {width}")
-    band = np.zeros((width + 1, local))
-    np.add.at(band, (H.row[inside] - H.col[inside], H.col[inside]), H.data[inside])
-    border = H.tocsc()[:, local:].toarray()
-    return ArrowLDLT.factor(band, border[:local], border[local:])
+class ArrowPattern:
+    """Where each stored entry of a sparse Hessian of one pattern (CSC: ElementInterval.sparse_hessian's) goes in its
+    arrow on the unknowns ``free`` laid out by ``arrow`` = (order, local, bandwidth) (ElementInterval.arrow_order:
+    the banded block first in lower band storage, the global columns last): read once per layout, so that each
+    point's arrow is two bincounts of its Hessian's values (``factor``)."""
+
+    def __init__(self, hessian, free: np.ndarray, arrow: tuple):
+        order, local, width = arrow
+        position = np.full(hessian.shape[0], -1)
+        position[free[order]] = np.arange(free.size)
+        row = position[hessian.indices]
+        column = position[np.repeat(np.arange(hessian.shape[1]), np.diff(hessian.indptr))]
+        kept = (row >= 0) & (column >= 0)
+        self.inside = kept & (row < local) & (column < local) & (row >= column)
+        if np.any(row[self.inside] - column[self.inside] > width):
+            raise ValueError(f"the Hessian's banded block passes its half-bandwidth {width}")
+        self.bordered = kept & (column >= local)
+        self.band_at = (row - column)[self.inside] * local + column[self.inside]
+        self.border_at = row[self.bordered] * (free.size - local) + column[self.bordered] - local
+        self.band_shape, self.border_shape, self.local = (width + 1, local), (free.size, free.size - local), local
+        self.order = order
+
+    def factor(self, hessian) -> ArrowLDLT | None:
+        """The ArrowLDLT of ``hessian`` (this pattern); None where it is refused."""
+        band = np.bincount(self.band_at, hessian.data[self.inside], minlength=self.band_shape[0] * self.band_shape[1])
+        border = np.bincount(self.border_at, hessian.data[self.bordered],
+                             minlength=self.border_shape[0] * self.border_shape[1]).reshape(self.border_shape)
+        return ArrowLDLT.factor(band.reshape(self.band_shape), border[:self.local], border[self.local:])
 
 
 def spectrum(eq: Equilibrium, Y: np.ndarray, index: np.ndarray, params: Parameters) -> np.ndarray:
