@@ -71,10 +71,12 @@ RUN_MOMENTS = [("after balloon_cg.numerics.continuation:correct", 10, "primary",
                ("after balloon_cg.tube.bulge:Equilibrium", 3, "bulge", True)]  # the third switched branch's start
 
 
-@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("moment, call, stage, started", RUN_MOMENTS)
-def test_a_signal_during_a_tube_run_writes_what_is_finished(references, tmp_path, capsys, sig, moment, call, stage,
-                                                            started):
+@pytest.mark.parametrize("moment, call, stage, started, sig", [
+    (*moment, ("SIGINT", "SIGTERM")[k % 2]) for k, moment in enumerate(RUN_MOMENTS)])
+def test_a_signal_during_a_tube_run_writes_what_is_finished(references, tmp_path, capsys, moment, call, stage,
+                                                            started, sig):
+    """SIGINT and SIGTERM in turn: the whole computation and its write run under one handler for both
+    (numerics.interrupt.stop_on_signals), so each moment is reached by one of them (until session 30: by each)."""
     code, err = balloon_cg(tmp_path, sig, moment, run_argv("r.h5"), call)
     assert code == 130, err
     assert checked(tmp_path / "r.h5", one_line(err), references[0]) == stage
