@@ -18,7 +18,7 @@ import pytest
 
 import balloon_cg as bc
 
-from cpu_moments import anchored, command, digests, evenly, handled, in_members
+from cpu_moments import anchored, command, digests, evenly, handled, in_members, warm_reference
 
 ROOT = Path(__file__).resolve().parents[1]
 LATENCY = 2.0  # CPU seconds from the signal to the process's exit (issue 42: "within 2 s of the signal")
@@ -40,8 +40,8 @@ def run_argv(scene: str, output: str = "r.h5") -> list:
 
 
 def reference(folder: Path, scene: str):
-    """The uninterrupted run (its marks and CPU, its file's digests)."""
-    done = command(folder, run_argv(scene, "reference.h5"))
+    """The uninterrupted run (its marks and CPU, its file's digests), on compiled kernels."""
+    done = warm_reference(folder, run_argv(scene, "reference.h5"))
     assert done.code == 0 and done.stderr == "", done.stderr
     return done, digests(folder / "reference.h5")
 
@@ -170,9 +170,12 @@ def member_digests(path: Path) -> dict:
 
 
 def sweep_reference(folder: Path, vary: str, scene: str = SWEEP_SCENE):
-    """The uninterrupted serial sweep (each member's CPU, the members' digests)."""
+    """The uninterrupted serial sweep (each member's CPU, the members' digests), on compiled kernels."""
+    from balloon_cg.io.sweep_file import store_path
+
     (folder / "s.toml").write_text(scene)
-    done = command(folder, sweep_argv("reference.h5", 1, vary))
+    done = warm_reference(folder, sweep_argv("reference.h5", 1, vary),
+                          outputs=("reference.h5", store_path(folder / "reference.h5").name))
     assert done.code == 0 and done.stderr == "", done.stderr
     return folder, vary, done, member_digests(folder / "reference.h5")
 
@@ -265,7 +268,7 @@ def handled_moments(folder: Path, argv: list, handler: str, output: str, k: int)
     moment's rerun is the same computation; the two ends leave the least and the most of a file behind."""
     key = (folder, tuple(argv))
     if key not in REFERENCES:
-        done = command(folder, argv, moment=handled(handler))
+        done = warm_reference(folder, argv, handled(handler))
         assert done.code == 0 and done.stderr == "", done.stderr
         REFERENCES[key] = done, digests(folder / output)
     done, expected = REFERENCES[key]
