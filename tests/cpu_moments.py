@@ -230,8 +230,9 @@ def compiled() -> set:
 def warm_reference(folder: Path, argv: list, moment: tuple = NEVER, outputs: tuple = ()) -> Moment:
     """`balloon-cg argv` in ``folder`` without a signal, to place moments on (``moment``: where its clock starts,
     ``handled``), run again (``outputs``: files and folders it wrote, removed first) when the first run compiled
-    kernels: a replay loads them from the cache, so on a fresh clone every moment placed on the compiling run's CPU
-    came after the replay's whole work, and no signal was sent (10 of test_interrupt_moments' 17 in a fresh worktree, session 30)."""
+    kernels: a replay loads them from the cache, so on a fresh clone a moment placed on the compiling run's CPU
+    could come after the replay's whole work, and no signal was sent (10 of test_interrupt_moments' 17 in a fresh
+    worktree, session 30)."""
     before = compiled()
     done = command(folder, argv, moment=moment)
     if compiled() == before:
