@@ -153,8 +153,8 @@ def test_a_signal_at_an_evenly_spaced_moment_of_the_two_coil_run(two_coils, k):
 SWEEP_SCENE = '[material]\npreset = "SPOM1"\n'  # members: stop_stretch 4 .. 5 (primary branch, its stability,
 #                                                  branch points, pear branches: ~0.2 s of CPU each)
 WHOLE_SWEEP_SCENE = FAST_SCENE  # members: M = 0.0016 .. 0.0024
-FAST_SWEEP_MOMENTS = 3  # in members 0 (a worker's first: its kernels loading, nothing stored), 2 and 4 (members
-#                         stored, others running); 4 moments fell in members 0, 1, 3 and 4 (warm cache)
+FAST_SWEEP_MOMENTS = 3  # in members 0 (a worker's first: its kernels loading), 2 and 4; 4 moments fell in members
+#                         0, 1, 3 and 4 (until session 30; each moment: one member stored, the others abandoned)
 KEPT = "balloon-cg: interrupted: the finished members are stored; re-run the same command to resume"
 FINISHED = "after the work had finished: exit 0"
 
