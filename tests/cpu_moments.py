@@ -17,6 +17,7 @@ signal) places the moments of a study (``evenly``).
 import hashlib
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -31,7 +32,8 @@ import atexit, contextlib, functools, importlib, json, os, signal, sys, time
 sig, where, offset, report, argv = (getattr(signal, sys.argv[1]), sys.argv[2], float(sys.argv[3]), sys.argv[4],
                                     sys.argv[5:])
 record = {"start_cpu": time.process_time(), "armed_cpu": None, "expiry_cpu": None, "sent_wall": None, "received_wall": None,
-          "received_cpu": None, "clock_cpu": None, "call_cpu": None, "events": [], "marks": 0, "member_cpu": {}}
+          "received_cpu": None, "clock_cpu": None, "call_cpu": None, "events": [], "marks": 0, "member_cpu": {},
+          "compiled": 0}
 DRIVER = os.getpid()
 install = signal.signal
 
@@ -77,6 +79,18 @@ def exiting():
 
 atexit.register(exiting)  # the first registered: Python calls it last
 from balloon_cg.__main__ import run
+from numba.core import event
+
+
+class Compiling(event.Listener):  # a kernel compiled here (not found in numba's cache), kept in the cache
+    def on_start(self, found):
+        record["compiled"] += type(found.data["dispatcher"]._cache).__name__ != "NullCache"
+
+    def on_end(self, found):
+        pass
+
+
+event.register("numba:compile", Compiling())
 from balloon_cg.analysis import timing
 from balloon_cg.app import progress, sweep
 
@@ -217,6 +231,21 @@ def command(folder: Path, argv: list, sig: str = "SIGTERM", moment: tuple = NEVE
     report.unlink()
     record["member_cpu"] = {int(k): v for k, v in record["member_cpu"].items()}
     return Moment(done.returncode, done.stderr, record)
+
+
+def warm_reference(folder: Path, argv: list, moment: tuple = NEVER, outputs: tuple = ()) -> Moment:
+    """`balloon-cg argv` in ``folder`` without a signal, to place moments on (``moment``: where its clock starts,
+    ``handled``), run again (``outputs``: files and folders it wrote, removed first) when the first run compiled
+    kernels for numba's cache (in its own process: the cache is shared with other processes): a replay loads them,
+    so on a fresh clone a moment placed on the compiling run's CPU could come after the replay's whole work, and no
+    signal was sent (10 of test_interrupt_moments' 17 in a fresh worktree, session 30)."""
+    done = command(folder, argv, moment=moment)
+    if not done.record["compiled"]:
+        return done
+    for name in outputs:
+        path = folder / name
+        shutil.rmtree(path) if path.is_dir() else path.unlink(missing_ok=True)
+    return command(folder, argv, moment=moment)
 
 
 def evenly(total: float, count: int) -> list[float]:

@@ -36,6 +36,26 @@ def bulged_file(tmp_path_factory):
                        lambda path: main(["run", str(SCENE), "-o", str(path), "--quiet", *BULGED]) == 0)
 
 
+@pytest.fixture(scope="module")
+def laid_out(bulged_file, tmp_path_factory):
+    """``laid_out(kind, width)``: the tube figure of ``kind`` (post/tube_plots.TUBE_KINDS; "onset" from the session's
+    ``critical`` file, the others from ``bulged_file``) at ``width`` inches, laid out (``draw_without_rendering``)
+    once and read by every test of this module that asks (the fit tests only measure it)."""
+    from balloon_cg.post.tube_plots import tube_figure
+
+    run, critical = read_tube_run(bulged_file), read_tube_run(tube_critical_file(tmp_path_factory))
+    figures = {}
+
+    def draw(kind: str, width: float):
+        if (kind, width) not in figures:
+            fig = tube_figure(critical if kind == "onset" else run, kind, width=width)
+            fig.draw_without_rendering()
+            figures[kind, width] = fig
+        return figures[kind, width]
+
+    return draw
+
+
 def test_run_writes_what_the_tube_pipeline_computes(run_file):
     """The file holds the primary and the bulge branch of tube_picture at the same settings, number for number;
     the shape and its parameters as attributes; Maxwell's pressure model/tube's."""
@@ -220,7 +240,7 @@ def test_profiles_stretches_and_front_share_one_axis(bulged_file):
 
 
 @pytest.mark.parametrize("width", [3.5, 7.2])
-def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, width, tmp_path_factory):
+def test_tube_figures_at_a_journal_width_keep_their_texts_apart(laid_out, width):
     """At one and two columns, every tube figure laid out at its width: the special points' labels clear of one
     another, of the title, the axis labels and the legend; a legend left inside its panel hides no curve, marker or
     label (post/fit.covers; P against V/V0 at 3.5 in had its legend over the primary branch); every legend entry and
@@ -231,12 +251,10 @@ def test_tube_figures_at_a_journal_width_keep_their_texts_apart(bulged_file, wid
 
     from balloon_cg.post.fit import covers
     from balloon_cg.post.labels import GID
-    from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
+    from balloon_cg.post.tube_plots import TUBE_KINDS
 
-    run, critical = read_tube_run(bulged_file), read_tube_run(tube_critical_file(tmp_path_factory))
     for kind in TUBE_KINDS:
-        fig = tube_figure(critical if kind == "onset" else run, kind, width=width)
-        fig.draw_without_rendering()
+        fig = laid_out(kind, width)
         legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend() is not None)]
         for legend in (ax.get_legend() for ax in fig.axes if ax.get_legend() is not None):
             assert not covers(legend, legend.axes), (kind, width)
@@ -286,28 +304,28 @@ def test_pressure_volume_figure_has_the_maxwell_line(run_file):
     assert len(maxwell) == 1 and maxwell[0].get_ydata()[0] == run["attrs"]["maxwell_pressure"]
 
 
-def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(bulged_file,
-                                                                                           tmp_path_factory):
+def test_tube_figures_keep_their_text_inside_and_label_the_points_by_their_continue_labels(bulged_file, laid_out):
     """At the default width every title and axis label of every tube figure lies inside the figure (the stretches'
     title ran past both edges; the onset curve's of a ``critical`` file, the run's having none); on P against V/V0 every located point is marked and its label is the number
     ``inspect`` lists and ``continue`` takes with its kind ("1 BP odd"), the labels clear of one another (they were
     drawn over one another, without numbers, where branch points crowd the pressure maximum)."""
+    import inspect
+
     from balloon_cg.io.tube_file import tube_labels
     from balloon_cg.post.labels import GID
     from balloon_cg.post.tube_plots import TUBE_KINDS, tube_figure
 
-    run, critical = read_tube_run(bulged_file), read_tube_run(tube_critical_file(tmp_path_factory))
+    default = inspect.signature(tube_figure).parameters["width"].default  # the figures the journal test reads at it
+    run = read_tube_run(bulged_file)
     for kind in TUBE_KINDS:
-        fig = tube_figure(critical if kind == "onset" else run, kind)
-        fig.draw_without_rendering()
+        fig = laid_out(kind, default)
         box = fig.bbox
         for ax in fig.axes:
             for text in (ax.title, ax.xaxis.label, ax.yaxis.label):
                 extent = text.get_window_extent()
                 assert box.x0 - 0.5 <= extent.x0 and extent.x1 <= box.x1 + 0.5, (kind, text.get_text())
                 assert box.y0 - 0.5 <= extent.y0 and extent.y1 <= box.y1 + 0.5, (kind, text.get_text())
-    fig = tube_figure(run, "pressure-volume")
-    fig.draw_without_rendering()
+    fig = laid_out("pressure-volume", default)
     labels = [t for t in fig.axes[0].texts if t.get_gid() == GID and t.get_text()]
     located = tube_labels(run)
     markers = [line for line in fig.axes[0].lines if len(line.get_xdata()) == 1]

@@ -12,7 +12,7 @@ import pytest
 from balloon_cg.app.cli import main
 from balloon_cg.io.tube_file import read_tube_run
 
-from cpu_moments import command, evenly, handled
+from cpu_moments import command, evenly, handled, warm_reference
 from shared_pictures import TUBE, TUBE_COIL, TUBE_COIL_FAST, TUBE_FAST, tube_critical_file, tube_run_file
 from test_signal_moments import balloon_cg, one_line
 
@@ -71,10 +71,12 @@ RUN_MOMENTS = [("after balloon_cg.numerics.continuation:correct", 10, "primary",
                ("after balloon_cg.tube.bulge:Equilibrium", 3, "bulge", True)]  # the third switched branch's start
 
 
-@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("moment, call, stage, started", RUN_MOMENTS)
-def test_a_signal_during_a_tube_run_writes_what_is_finished(references, tmp_path, capsys, sig, moment, call, stage,
-                                                            started):
+@pytest.mark.parametrize("moment, call, stage, started, sig", [
+    (*moment, ("SIGINT", "SIGTERM")[k % 2]) for k, moment in enumerate(RUN_MOMENTS)])
+def test_a_signal_during_a_tube_run_writes_what_is_finished(references, tmp_path, capsys, moment, call, stage,
+                                                            started, sig):
+    """SIGINT and SIGTERM in turn: the whole computation and its write run under one handler for both
+    (numerics.interrupt.stop_on_signals), so each moment is reached by one of them (until session 30: by each)."""
     code, err = balloon_cg(tmp_path, sig, moment, run_argv("r.h5"), call)
     assert code == 130, err
     assert checked(tmp_path / "r.h5", one_line(err), references[0]) == stage
@@ -109,9 +111,10 @@ def test_a_signal_once_the_file_is_written_exits_0_and_says_so(references, tmp_p
 
 @pytest.fixture(scope="module")
 def reference_cpu(tmp_path_factory):
-    """The CPU seconds of an uninterrupted tube run from the call of its command (cpu_moments.handled)."""
+    """The CPU seconds of an uninterrupted tube run from the call of its command (cpu_moments.handled), on compiled
+    kernels."""
     folder = tmp_path_factory.mktemp("cpu")
-    done = command(folder, run_argv("r.h5"), moment=handled("balloon_cg.app.tube_commands:run_tube"))
+    done = warm_reference(folder, run_argv("r.h5"), handled("balloon_cg.app.tube_commands:run_tube"))
     assert done.code == 0 and done.stderr == "", done.stderr
     return folder, done.handler_cpu
 
