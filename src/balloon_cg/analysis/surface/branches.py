@@ -347,16 +347,24 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
 def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuation.Point, max_points: int,
             rejoin: tuple | None, accepted) -> tuple:
     """``follow``'s loop on ``segments`` (extended in place); ``running``: the points of the continuation run under
-    way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments."""
-    scene, folds = trace.scene, []
+    way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments. At a
+    resolution stop the point the stop rejected (the overshoot: converged, its tail above max_error) is carried to
+    the finer basis and solved there (``_carried``), and the trace goes on from it with the step that reached it;
+    where a fold lies in that step, the last point is carried instead (the fold is found again from it)."""
+    scene, folds, step, fresh = trace.scene, [], None, False  # fresh: ``first`` is a new point, not yet accepted
     while True:
         done = sum(len(points) for _, points in segments)
         settings = continuation_settings(scene, max(max_points - done, 1))
-        running[:] = [(trace, first)]
+        if step is not None:
+            settings = replace(settings, step=step)
+        running[:] = [] if fresh else [(trace, first)]
+        if fresh:
+            accepted(trace, first)
         path = continuation.trace(trace.system, first, settings, _stop_rule(trace, rejoin),
                                   {Kind.LP: np.eye(first.X.size)[-1]}, lambda point, on=trace: accepted(on, point))
         running.clear()
         stop = path.stop
+        ahead = not any(f.index == len(path.points) - 1 for f in path.folds)  # no fold in the step to the overshoot
         # a fold in the step to a point the resolution stop rejects is found again from the re-solved last point
         folds += [(trace, replace(f, index=f.index + done)) for f in path.folds
                   if stop.code != StopCode.RESOLUTION or f.index < len(path.points) - 1]
@@ -365,35 +373,57 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
             stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
             return trace, segments, folds, stop
-        if interrupt.requested():  # not refined (a refinement and its first step: ~1 s of CPU on two coils)
-            return trace, segments, folds, INTERRUPTED
-        c = trace.system.coefficients(path.overshoot.X)
-        target = remapped(trace.basis, c, scene.field.coils)
-        finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target),
-                        scene.solver.max_error)
-        if finer is None:
-            stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
-                                                                  f"order {MAX_ORDER})")
-            return trace, segments, folds, stop
-        new = trace.on(finer)
-        last = segments[-1][1].pop()  # solved again on the finer basis: the first point of the next segment
-        moved, reference = trace.move(last.X, new), trace.move_direction(last.tangent, new)
-        across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
-        X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
-                   scene.solver.max_newton)
-        if not X.converged or interrupt.requested():
-            segments[-1][1].append(last)
-            if X.converged:  # a signal while the point was solved again: the trace not gone on
-                return trace, segments, folds, INTERRUPTED
-            stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
-                                                f"{finer.order}): {X.message}")
-            return trace, segments, folds, stop
-        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
-                                   X.iterations, X.residual)
-        if rejoin is not None:
-            rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
-        trace = new
+        carried = path.overshoot if ahead else segments[-1][1].pop()
+        while True:
+            if interrupt.requested():  # not refined (a refinement and its first step: ~1 s of CPU on two coils)
+                stop = INTERRUPTED
+                break
+            moved = _carried(trace, carried, rejoin, stop)
+            if isinstance(moved, Stop):
+                stop = moved
+                break
+            new, first, rejoin_new = moved
+            check = _stop_rule(new, rejoin_new)(first) if ahead else None
+            if check is not None and check.code == StopCode.RESOLUTION:  # still unresolved: refined again
+                trace, carried, rejoin, stop = new, first, rejoin_new, check
+                continue
+            stop = check
+            break
+        if stop is not None:  # the carried point not kept: the branch ends at its last point
+            if not ahead:
+                segments[-1][1].append(carried)
+            return segments[-1][0], segments, folds, stop
+        trace, rejoin, step, fresh = new, rejoin_new, path.step if ahead else None, ahead
         segments.append((trace, []))
+
+
+def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
+    """(the trace on the finer basis, ``point`` solved there, ``rejoin`` moved there) for a point whose tail exceeds
+    solver.max_error on ``trace``'s basis (``stop``: that resolution stop): the basis refined (``follow``), the
+    point transferred and solved on the hyperplane through it normal to its tangent; or the Stop where the basis
+    would pass MAX_DEGREE or MAX_ORDER, Newton fails there (REFINE_FAILED) or a signal came (INTERRUPTED)."""
+    scene = trace.scene
+    c = trace.system.coefficients(point.X)
+    target = remapped(trace.basis, c, scene.field.coils)
+    finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target), scene.solver.max_error)
+    if finer is None:
+        return Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
+                                                              f"order {MAX_ORDER})")
+    new = trace.on(finer)
+    moved, reference = trace.move(point.X, new), trace.move_direction(point.tangent, new)
+    across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
+    X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
+               scene.solver.max_newton)
+    if not X.converged:
+        return Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
+                                            f"{finer.order}): {X.message}")
+    if interrupt.requested():  # a signal while the point was solved again: the trace not gone on
+        return INTERRUPTED
+    solved = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
+                                X.iterations, X.residual)
+    if rejoin is not None:
+        rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
+    return new, solved, rejoin
 
 
 def collected(trace: SurfaceTrace, segments, folds, stop) -> dict:
