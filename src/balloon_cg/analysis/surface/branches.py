@@ -15,7 +15,8 @@ embedded mode, unit) is corrected on the hyperplane normal to φ, then the branc
 continuation until it rejoins the axisymmetric branch (the amplitude φ·(c − c*) changes sign), a pole stretch
 reaches stop_stretch, the membrane comes within wire_gap of a coil, or max_points; a point whose spectral tail
 exceeds solver.max_error refines the basis (``surface.resolution``: the wire map re-centred on the state, the
-degree and order extended; past MAX_DEGREE or MAX_ORDER the branch stops, flagged). The sign −φ is the image of the
+degree and order extended; past MAX_DEGREE or MAX_ORDER the branch stops, flagged) and is solved again there as the
+branch's next point (``follow``). The sign −φ is the image of the
 +φ branch under the rotation by π about the axis (``rotated``). Folds in P are located (LP).
 
 Every point carries its measures (pole stretches, volume, centroid offset, tilt) and the lowest eigenvalues of
@@ -311,17 +312,21 @@ def leave(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, max_points: 
 def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_points: int, rejoin: tuple | None,
            progress=None, final=None) -> tuple:
     """Pseudo-arclength continuation in P from ``first`` (after the stored ``points``) until a stop of ``_stop_rule``
-    (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch); a point whose tail exceeds
-    solver.max_error refines the basis (the wire map re-centred on the state, then the degree and the order
-    extended), the last point is solved again there on the hyperplane through it normal to its tangent (at fixed P
-    the bordered Jacobian is near-singular where the branch is tangent to P = const: the free m = 1 branch of the
-    off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest singular value
-    1.3e-6 at fixed P, 1.0e-3 on that hyperplane) and the trace goes on (a signal before the refinement or during
-    it: the stop INTERRUPTED, the points so far kept). Returns (the last trace, the segments
-    [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop). ``final(trace,
-    point)``: called on each point in order once it is kept as it is, i.e. once a later point is accepted or the
-    trace ends (the last point may be solved again on a finer basis): the points read beside the trace
-    (``assessment.readers``)."""
+    (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch). A point whose tail exceeds
+    solver.max_error (the overshoot: converged on its basis) refines the basis (the wire map re-centred on the
+    state, then the degree and the order extended), is solved again there on the hyperplane through it normal to
+    its tangent and, once the stop rule passes it there, is the next point; the trace goes on with the step that
+    reached it. Where a fold lies in that step, the last point is solved again there instead and the step starts
+    over (the fold is found again from it). (At fixed P the bordered Jacobian is near-singular where the branch is
+    tangent to P = const: the free m = 1 branch of the off-equator coil's free balloon at P = 1.6756, one point off
+    its branch point, has its smallest singular value 1.3e-6 at fixed P, 1.0e-3 on that hyperplane.) The two-coil
+    m = 1 branch refines at 11 of its 13 steps: carrying the overshoot costs one Newton solve from a converged
+    state instead of solving the last point again and a second corrector (23 correctors then, 13 now). A signal
+    before the refinement or during it: the stop INTERRUPTED, the points so far kept. Returns (the last trace, the
+    segments [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop).
+    ``final(trace, point)``: called on each point in order once it is kept as it is, i.e. once a later point is
+    accepted or the trace ends (the last point may be solved again on a finer basis): the points read beside the
+    trace (``assessment.readers``)."""
     segments, running = [(trace, list(points))], []  # running: (trace, point) of the continuation run under way
     handed = 0
 
