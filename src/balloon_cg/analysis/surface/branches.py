@@ -357,6 +357,14 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
     the finer basis and solved there (``_carried``), and the trace goes on from it with the step that reached it;
     where a fold lies in that step, the last point is carried instead (the fold is found again from it)."""
     scene, folds, step, fresh = trace.scene, [], None, False  # fresh: ``first`` is a new point, not yet accepted
+    unresolved = _stop_rule(trace, rejoin)(first)  # the first point off a branch point: its tail not checked yet
+    if unresolved is not None and unresolved.code == StopCode.RESOLUTION:
+        moved = _resolved(trace, first, rejoin, unresolved)
+        if isinstance(moved, Stop):
+            segments[-1][1].append(first)
+            return trace, segments, folds, moved
+        trace, first, rejoin = moved
+        segments.append((trace, []))
     while True:
         done = sum(len(points) for _, points in segments)
         settings = continuation_settings(scene, max(max_points - done, 1))
@@ -379,27 +387,32 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
         if stop.code != StopCode.RESOLUTION:
             return trace, segments, folds, stop
         carried = path.overshoot if ahead else segments[-1][1].pop()
-        while True:
-            if interrupt.requested():  # not refined (a refinement and its first step: ~1 s of CPU on two coils)
-                stop = INTERRUPTED
-                break
-            moved = _carried(trace, carried, rejoin, stop)
-            if isinstance(moved, Stop):
-                stop = moved
-                break
-            new, first, rejoin_new = moved
-            check = _stop_rule(new, rejoin_new)(first) if ahead else None
-            if check is not None and check.code == StopCode.RESOLUTION:  # still unresolved: refined again
-                trace, carried, rejoin, stop = new, first, rejoin_new, check
-                continue
-            stop = check
-            break
-        if stop is not None:  # the carried point not kept: the branch ends at its last point
+        moved = _resolved(trace, carried, rejoin, stop, check=ahead)
+        if isinstance(moved, Stop):  # the carried point not kept: the branch ends at its last point
             if not ahead:
                 segments[-1][1].append(carried)
-            return segments[-1][0], segments, folds, stop
-        trace, rejoin, step, fresh = new, rejoin_new, path.step if ahead else None, ahead
+            return trace, segments, folds, moved
+        trace, first, rejoin = moved
+        step, fresh = (path.step, True) if ahead else (None, False)
         segments.append((trace, []))
+
+
+def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop, check: bool = True):
+    """(trace, point, rejoin) of ``_carried`` repeated until the stop rule passes the point (``check``; without it
+    once: the last point solved again, which it passed), or the Stop that ended it: its own (not RESOLUTION) or
+    ``_carried``'s; INTERRUPTED at a signal before a refinement (~1 s of CPU on two coils with its first step)."""
+    while True:
+        if interrupt.requested():
+            return INTERRUPTED
+        moved = _carried(trace, point, rejoin, stop)
+        if isinstance(moved, Stop):
+            return moved
+        trace, point, rejoin = moved
+        stop = _stop_rule(trace, rejoin)(point) if check else None
+        if stop is None:
+            return moved
+        if stop.code != StopCode.RESOLUTION:
+            return stop
 
 
 def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
