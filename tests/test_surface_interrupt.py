@@ -171,5 +171,5 @@ def test_a_signal_as_a_surface_branch_would_refine_stops_it_there(pear_point, mo
     with interrupt.stop_on_signals():
         branch = trace_surface(primary, 0, bp, 1.0, "m1", 40)
     assert True not in refined and branch.legs[0].stop.code == StopCode.INTERRUPTED  # no refinement after it
-    assert len(branch.values) == 3  # the branch point, the first step off it (its tail the first checked), the next
+    assert len(branch.values) == 4  # the branch point, the first step off it and the two points before the third
     assert [item.gap for item in incomplete([branch])] == [Gap.INTERRUPTED]

@@ -355,16 +355,10 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
     way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments. At a
     resolution stop the point the stop rejected (the overshoot: converged, its tail above max_error) is carried to
     the finer basis and solved there (``_carried``), and the trace goes on from it with the step that reached it;
-    where a fold lies in that step, the last point is carried instead (the fold is found again from it)."""
+    where a fold lies in that step, the last point is carried instead (the fold is found again from it). The first
+    point off a branch point (no stop rule checks it) is solved again on the finer basis too where its tail exceeds
+    max_error."""
     scene, folds, step, fresh = trace.scene, [], None, False  # fresh: ``first`` is a new point, not yet accepted
-    unresolved = _stop_rule(trace, rejoin)(first)  # the first point off a branch point: its tail not checked yet
-    if unresolved is not None and unresolved.code == StopCode.RESOLUTION:
-        moved = _resolved(trace, first, rejoin, unresolved)
-        if isinstance(moved, Stop):
-            segments[-1][1].append(first)
-            return trace, segments, folds, moved
-        trace, first, rejoin = moved
-        segments.append((trace, []))
     while True:
         done = sum(len(points) for _, points in segments)
         settings = continuation_settings(scene, max(max_points - done, 1))
@@ -392,9 +386,19 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
             if not ahead:
                 segments[-1][1].append(carried)
             return trace, segments, folds, moved
-        trace, first, rejoin = moved
+        last = segments[-1][1][-1]
+        if ahead and tail(trace.basis, trace.system.coefficients(last.X)) > scene.solver.max_error:
+            # the first point off a branch point (no stop rule checked it), unresolved: solved again there too
+            again = _solved_on(trace, moved[0], segments[-1][1].pop())
+            if isinstance(again, Stop):
+                segments[-1][1].append(last)
+                return trace, segments, folds, again
+            trace, first, rejoin = moved
+            segments.append((trace, [again]))
+        else:
+            trace, first, rejoin = moved
+            segments.append((trace, []))
         step, fresh = (path.step, True) if ahead else (None, False)
-        segments.append((trace, []))
 
 
 def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop, check: bool = True):
@@ -428,6 +432,19 @@ def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | Non
         return Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
                                                               f"order {MAX_ORDER})")
     new = trace.on(finer)
+    solved = _solved_on(trace, new, point)
+    if isinstance(solved, Stop):
+        return solved
+    if rejoin is not None:
+        rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
+    return new, solved, rejoin
+
+
+def _solved_on(trace: SurfaceTrace, new: SurfaceTrace, point: continuation.Point):
+    """``point`` of ``trace`` transferred to ``new``'s finer basis and solved there on the hyperplane through it
+    normal to its tangent (``follow``), with its tangent; the Stop REFINE_FAILED where Newton fails, INTERRUPTED at
+    a signal during the solve."""
+    scene, finer = trace.scene, new.basis
     moved, reference = trace.move(point.X, new), trace.move_direction(point.tangent, new)
     across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
     X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
@@ -437,11 +454,8 @@ def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | Non
                                             f"{finer.order}): {X.message}")
     if interrupt.requested():  # a signal while the point was solved again: the trace not gone on
         return INTERRUPTED
-    solved = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
-                                X.iterations, X.residual)
-    if rejoin is not None:
-        rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
-    return new, solved, rejoin
+    return continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
+                              X.iterations, X.residual)
 
 
 def collected(trace: SurfaceTrace, segments, folds, stop) -> dict:
