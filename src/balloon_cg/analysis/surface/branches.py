@@ -386,10 +386,10 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
             if not ahead:
                 segments[-1][1].append(carried)
             return trace, segments, folds, moved
-        last = segments[-1][1][-1]
-        if ahead and tail(trace.basis, trace.system.coefficients(last.X)) > scene.solver.max_error:
+        if ahead and tail(trace.basis, trace.system.coefficients(segments[-1][1][-1].X)) > scene.solver.max_error:
             # the first point off a branch point (no stop rule checked it), unresolved: solved again there too
-            again = _solved_on(trace, moved[0], segments[-1][1].pop())
+            last = segments[-1][1].pop()
+            again = _solved_on(trace, moved[0], last)
             if isinstance(again, Stop):
                 segments[-1][1].append(last)
                 return trace, segments, folds, again
