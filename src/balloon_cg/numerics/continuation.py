@@ -83,6 +83,7 @@ class Path:
     folds: list = field(default_factory=list)
     stop: Stop | None = None
     overshoot: Point | None = None  # the first point past a stop condition (not part of the branch)
+    step: float | None = None  # the step σ that reached the overshoot
 
     def bracket(self, fold: Fold) -> tuple[np.ndarray, np.ndarray]:
         """X of the two points a fold lies between: the narrowest sign change its root search evaluated, else
@@ -269,8 +270,7 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
                     path.folds.append(Fold(label, fold.payload, len(path.points) - 1, fold.status, fold.bracket))
         reason = stop(point)
         if reason is not None:
-            path.stop = reason
-            path.overshoot = point
+            path.stop, path.overshoot, path.step = reason, point, sigma
             return path
         path.points.append(point)
         if progress is not None:
