@@ -381,39 +381,37 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
             stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
             return trace, segments, folds, stop
-        carried = path.overshoot if ahead else segments[-1][1].pop()
-        moved = _resolved(trace, carried, rejoin, stop, check=ahead)
-        if isinstance(moved, Stop):  # the carried point not kept: the branch ends at its last point
-            if not ahead:
-                segments[-1][1].append(carried)
+        if ahead:  # the overshoot carried to the finer basis: the next point
+            moved = _resolved(trace, path.overshoot, rejoin, stop)
+        else:  # a fold in the step to it: the step taken again, from the last point, on the basis refined for it
+            moved = _finer(trace, path.overshoot, rejoin, stop)
+        if isinstance(moved, Stop):  # the branch ends at its last point
             return trace, segments, folds, moved
-        if ahead and tail(trace.basis, trace.system.coefficients(segments[-1][1][-1].X)) > scene.solver.max_error:
-            # the first point off a branch point (no stop rule checked it), unresolved: solved again there too
-            last = segments[-1][1].pop()
-            again = _solved_on(trace, moved[0], last)
+        new, rejoin_there, last, again = moved[0], moved[-1], segments[-1][1][-1], None
+        if ahead and moved[1].tangent[-1] * last.tangent[-1] <= 0:
+            ahead = False  # dP/ds changed sign on the way to the finer basis: the step taken again over the fold there
+        if not ahead or tail(trace.basis, trace.system.coefficients(last.X)) > scene.solver.max_error:
+            # the last point solved again on the finer basis: the start of the step over the fold, or the first
+            # point off a branch point (no stop rule checked its tail), unresolved
+            again = _solved_on(trace, new, last)
             if isinstance(again, Stop):
-                segments[-1][1].append(last)
                 return trace, segments, folds, again
-            trace, first, rejoin = moved
-            segments.append((trace, [again]))
-        else:
-            trace, first, rejoin = moved
-            segments.append((trace, []))
+            segments[-1][1].pop()
+        trace, rejoin = new, rejoin_there
+        first, kept = (moved[1], [] if again is None else [again]) if ahead else (again, [])
+        segments.append((trace, kept))
         step, fresh = (path.step, True) if ahead else (None, False)
 
 
-def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop, check: bool = True):
-    """(trace, point, rejoin) of ``_carried`` repeated until the stop rule passes the point (``check``; without it
-    once: the last point solved again, which it passed), or the Stop that ended it: its own (not RESOLUTION) or
-    ``_carried``'s; INTERRUPTED at a signal before a refinement (~1 s of CPU on two coils with its first step)."""
+def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
+    """(trace, point, rejoin) of ``_carried`` repeated until the stop rule passes the point, or the Stop that ended
+    it: its own (not RESOLUTION) or ``_carried``'s."""
     while True:
-        if interrupt.requested():
-            return INTERRUPTED
         moved = _carried(trace, point, rejoin, stop)
         if isinstance(moved, Stop):
             return moved
         trace, point, rejoin = moved
-        stop = _stop_rule(trace, rejoin)(point) if check else None
+        stop = _stop_rule(trace, rejoin)(point)
         if stop is None:
             return moved
         if stop.code != StopCode.RESOLUTION:
@@ -422,9 +420,23 @@ def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | No
 
 def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
     """(the trace on the finer basis, ``point`` solved there, ``rejoin`` moved there) for a point whose tail exceeds
-    solver.max_error on ``trace``'s basis (``stop``: that resolution stop): the basis refined (``follow``), the
-    point transferred and solved on the hyperplane through it normal to its tangent; or the Stop where the basis
-    would pass MAX_DEGREE or MAX_ORDER, Newton fails there (REFINE_FAILED) or a signal came (INTERRUPTED)."""
+    solver.max_error on ``trace``'s basis (``stop``: that resolution stop): ``_finer``, then the point transferred
+    and solved on the hyperplane through it normal to its tangent (``_solved_on``); or the Stop of either."""
+    finer = _finer(trace, point, rejoin, stop)
+    if isinstance(finer, Stop):
+        return finer
+    new, rejoin = finer
+    solved = _solved_on(trace, new, point)
+    return solved if isinstance(solved, Stop) else (new, solved, rejoin)
+
+
+def _finer(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
+    """(the trace on the basis refined for ``point``, whose tail exceeds solver.max_error on ``trace``'s basis
+    (``stop``: that resolution stop), and ``rejoin`` moved there): the wire map re-centred on the point, then the
+    degree and the order extended (``follow``); or the Stop RESOLUTION_LIMIT where the basis would pass MAX_DEGREE
+    or MAX_ORDER, INTERRUPTED at a signal before the refinement (~1 s of CPU on two coils with its first step)."""
+    if interrupt.requested():
+        return INTERRUPTED
     scene = trace.scene
     c = trace.system.coefficients(point.X)
     target = remapped(trace.basis, c, scene.field.coils)
@@ -433,12 +445,9 @@ def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | Non
         return Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
                                                               f"order {MAX_ORDER})")
     new = trace.on(finer)
-    solved = _solved_on(trace, new, point)
-    if isinstance(solved, Stop):
-        return solved
     if rejoin is not None:
         rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
-    return new, solved, rejoin
+    return new, rejoin
 
 
 def _solved_on(trace: SurfaceTrace, new: SurfaceTrace, point: continuation.Point):
