@@ -356,7 +356,9 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
     way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments. At a
     resolution stop the point the stop rejected (the overshoot: converged, its tail above max_error) is carried to
     the finer basis and solved there (``_carried``), and the trace goes on from it with the step that reached it;
-    where a fold lies in that step, the last point is carried instead (the fold is found again from it). The first
+    where a fold lies in that step (on the coarse basis, or dP/ds changed sign on the way to the finer one), the last
+    point is solved again on the basis refined for the overshoot and the step taken again from it (the fold found
+    again there, on one basis). The first
     point off a branch point (no stop rule checks it) is solved again on the finer basis too where its tail exceeds
     max_error."""
     scene, folds, step, fresh = trace.scene, [], None, False  # fresh: ``first`` is a new point, not yet accepted
