@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 MEASUREMENTS = ("spom1 picture", "L10 flag", "L10 elements", "L30 flag", "L30 elements")
 
 MEASURE = """
-import json, sys, time
+import json, math, sys, time
 from pathlib import Path
 ROOT = Path(sys.argv[1])
 sys.path.insert(0, str(ROOT / "tests"))
@@ -50,9 +50,9 @@ else:
         scene = load_scene(ROOT / "scenes" / "tube_spom1_L10.toml")
         trace = dict(stop_stretch=scene.continuation.stop_stretch)
     else:
-        from test_tube_maxwell import ogden_1972_tube
+        from test_tube_maxwell import LENGTH, ogden_1972_tube
         scene = ogden_1972_tube(120)
-        trace = dict(stop_volume=50.0, step=0.02)
+        trace = dict(stop_volume=50.0 * math.pi * LENGTH, step=0.02)  # V/R0³ for V/V0 = 50 (bulge_branch's key)
     primary_branch(scene)
 
     def run():

@@ -43,7 +43,7 @@ from balloon_cg.tube.primary import primary_branch  # noqa: E402
 from balloon_cg.io.tube_file import read_tube_run  # noqa: E402
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis  # noqa: E402
 from balloon_cg.tube.surface.branch import traced_branch  # noqa: E402
-from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium  # noqa: E402
+from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium  # noqa: E402
 from balloon_cg.tube.surface.switching import switched_point  # noqa: E402
 
 AMPLITUDE = 0.1
@@ -91,7 +91,7 @@ def main(degrees) -> None:
         print(f"{degree:3d} {zero.pressure:14.10f} {zero.volume:8.5f} {rise:13.6e} {rise / AMPLITUDE**2:12.8f} "
               f"{more.pressure - point.pressure:10.1e} {finer.pressure - point.pressure:10.1e} {point.iterations:9d}")
         basis = TubeSurfaceBasis(branch.disc, (0, 1, 2))
-        surface = TubeSurfaceEquilibrium(scene, basis)
+        surface = MeridianSurfaceEquilibrium(scene, basis)
         params = branch.params.with_value("P", point.pressure)
         rows = surface.node_hessian(point.c, params)
         factorised = surface.hessian(point.c, params)

@@ -85,6 +85,24 @@ def two_coil_run_file(tmp_path_factory) -> Path:
     return shared_file(tmp_path_factory, "two_coils_1.7.h5", write)
 
 
+SMALL = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'  # the whole analysis: ~1.5 s of CPU
+
+
+def small_run_file(tmp_path_factory) -> Path:
+    """``balloon-cg run small.toml`` of SMALL (SPOM1 to λ2(0) = 2: the primary branch with its fold and pear
+    pitchfork, the pear branch and its mirror, stability, snap-throughs; complete): the run file the readers' tests
+    read or copy and damage (tests/test_damaged_files.py, test_damaged_fuzz.py, test_schema.py, the inspect and plot
+    checks of test_cli_conventions.py); made by one of them per session, never written to by any."""
+    from balloon_cg.app.cli import main
+
+    def write(path: Path) -> bool:
+        scene = path.with_name("small.toml")  # the scene's name: small
+        scene.write_text(SMALL)
+        return main(["run", str(scene), "-o", str(path), "--quiet"]) == 0
+
+    return shared_file(tmp_path_factory, "small.h5", write)
+
+
 TUBE = Path(__file__).resolve().parents[1] / "scenes" / "tube_spom1_L10.toml"
 TUBE_FAST = ["--set", "solver.degree=16", "--set", "continuation.stop_stretch=3"]  # ~3 s of CPU, every branch switched
 TUBE_COIL = TUBE.with_name("tube_spom1_L10_coil.toml")

@@ -639,3 +639,20 @@ def test_capsule_of_length_zero_in_a_field_or_under_a_voltage_is_the_sphere(load
     assert other.kernel_class != one.kernel_class and one.X.shape == other.X.shape
     assert np.abs(one.X - other.X).max() <= 1e-10
     assert [p.kind for p in one.special] == [p.kind for p in other.special]
+
+
+def test_capsule_of_length_zero_in_a_field_reads_its_m1_blocks_above_banded_from():
+    """Above stability.banded_from the sphere reads its blocks on the banded sibling, whose m ≥ 1 blocks take the
+    sphere's m ≥ 1 mass kernel; a capsule has none (its m ≥ 1 blocks have their own elements): the capsule of
+    length 0 in a coil's field stopped with a KeyError there (the two-coil scene as a capsule of length 0, whose
+    degree reaches 225). With banded_from = 20 (the branch at degree 40): the capsule's readings, on its own
+    blocks, are the sphere's on the sibling (1e-8; measured 1.8e-10 in m1_held at degree 20), every flag alike."""
+    text = ('[material]\npreset = "SPOM1"\n[stability]\nm_max = 1\nbanded_from = 20\n[continuation]\n'
+            'stop_stretch = 1.5\n[surface]\nbranches = "none"\n' + COIL.format(M=0.005))
+    sphere, capsule = (analyse(parse_scene(text + extra), pear=False).branches[0]
+                       for extra in ("", '[geometry]\nshape = "capsule"\nlength = 0\n'))
+    assert len(sphere.stability) == len(capsule.stability) > 5
+    for a, b in zip(sphere.stability, capsule.stability):
+        assert a.degree >= 20 and a.flags() == b.flags()
+        for block in ("even", "m1_held", "m1_free"):
+            assert abs(a.blocks[block][0] - b.blocks[block][0]) <= 1e-8 * max(1.0, abs(a.blocks[block][0])), block

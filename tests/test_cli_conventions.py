@@ -22,9 +22,9 @@ import balloon_cg
 from balloon_cg.app.cli import SCENE_HELP, build_parser, main, scene_of, strict_json
 from balloon_cg.io.run_file import read_run
 from balloon_cg.scene import load_scene, parse_scene
+from shared_pictures import SMALL, small_run_file
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
-SMALL = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'
 
 
 def cli(*args, cwd=None, **kw):
@@ -179,11 +179,11 @@ def test_unset_restores_the_default_and_a_key_is_given_once(tmp_path, capsys):
     assert not out.exists()
 
 
-def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, capsys):
+def test_inspect_json_is_strict_for_run_sweep_and_curve_files(tmp_path, tmp_path_factory, capsys):
+    """The run: the session's `run` of SMALL (shared_pictures.small_run_file)."""
     scene = tmp_path / "small.toml"
     scene.write_text(SMALL)
-    run, sweep = tmp_path / "run.h5", tmp_path / "sweep.h5"
-    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
+    run, sweep = small_run_file(tmp_path_factory), tmp_path / "sweep.h5"
     assert main(["sweep", str(scene), "--vary", "continuation.stop_stretch=1.5,1.6", "--primary-only",
                  "--workers", "1", "-o", str(sweep), "--quiet"]) == 0
     capsys.readouterr()
@@ -209,12 +209,8 @@ def test_a_closed_stdout_ends_quietly():
     assert process.stderr.read() == b""
 
 
-def test_plot_several_kinds_at_once(tmp_path, capsys):
-    scene = tmp_path / "small.toml"
-    scene.write_text(SMALL)
-    run = tmp_path / "run.h5"
-    assert main(["run", str(scene), "-o", str(run), "--quiet"]) == 0
-    capsys.readouterr()
+def test_plot_several_kinds_at_once(tmp_path, tmp_path_factory, capsys):
+    run = small_run_file(tmp_path_factory)  # the session's `run` of SMALL
     assert main(["plot", str(run), "--what", "pressure-pole,shapes", "-o", str(tmp_path / "fig.pdf")]) == 0
     assert capsys.readouterr().out.split() == [str(tmp_path / "fig_pressure-pole.pdf"), str(tmp_path / "fig_shapes.pdf")]
     with pytest.raises(SystemExit) as bad:

@@ -9,17 +9,15 @@ import pytest
 
 from balloon_cg.app import summaries
 from balloon_cg.app.cli import main
+from shared_pictures import small_run_file
 
-SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'
 
 
 @pytest.fixture(scope="module")
 def good(tmp_path_factory) -> Path:
-    """A full-analysis run file: primary and pear branches, stability, special points, snap-throughs."""
-    folder = tmp_path_factory.mktemp("good")
-    (folder / "s.toml").write_text(SCENE)
-    assert main(["run", str(folder / "s.toml"), "-o", str(folder / "good.h5"), "--quiet"]) == 0
-    return folder / "good.h5"
+    """A full-analysis run file: primary and pear branches, stability, special points, snap-throughs (the session's
+    shared_pictures.small_run_file, read here or copied before it is damaged)."""
+    return small_run_file(tmp_path_factory)
 
 
 def _zero_points(f):

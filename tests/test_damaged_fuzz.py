@@ -16,20 +16,18 @@ from hypothesis import HealthCheck, Phase, given, seed, settings, strategies as 
 import balloon_cg as bc
 from balloon_cg.app.cli import main
 from balloon_cg.io.layout import FileError
-
-SCENE = '[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n'
-
+from shared_pictures import SMALL, small_run_file
 
 @pytest.fixture(scope="module")
 def good_files(tmp_path_factory) -> dict:
+    """The session's small run file (shared_pictures.small_run_file: copied before it is damaged) and a sweep."""
     folder = tmp_path_factory.mktemp("good")
-    (folder / "s.toml").write_text(SCENE)
-    run, sweep = folder / "run.h5", folder / "sweep.h5"
-    assert main(["run", str(folder / "s.toml"), "-o", str(run), "--quiet", "--allow-partial"]) == 0
+    (folder / "s.toml").write_text(SMALL)
+    sweep = folder / "sweep.h5"
     assert main(["sweep", str(folder / "s.toml"), "--vary", "stop_stretch=1.4,1.5", "--primary-only",
                  "--workers", "1", "--quiet", "-o", str(sweep)]) == 0
     shutil.rmtree(sweep.with_name(sweep.name + ".members"))  # the view alone: what the readers read
-    return {"run": run, "sweep": sweep}
+    return {"run": small_run_file(tmp_path_factory), "sweep": sweep}
 
 
 def _objects(f) -> list:

@@ -24,7 +24,7 @@ from balloon_cg.analysis.stability import azimuthal
 from balloon_cg.analysis.branches.primary import trace_primary
 from balloon_cg.analysis.branches.problem import equilibrium_of
 from balloon_cg.analysis.stability.axisymmetric import SecondVariation
-from balloon_cg.galerkin.discretisation import SMALL_GRADIENT, SMALL_SYSTEM, Discretisation, _HESSIAN_ROW, gauss_nodes
+from balloon_cg.galerkin.discretisation import SMALL_GRADIENT, SMALL_SYSTEM, HESSIAN_ROW, Discretisation, gauss_nodes
 from balloon_cg.galerkin.equilibrium import Equilibrium, Parameters
 from balloon_cg.model import field
 from balloon_cg.numerics import eigen
@@ -75,7 +75,7 @@ def test_small_system_loops_match_the_node_sums(degree):
     rng = np.random.default_rng(3)
     n_q = disc.weights.size
     hessian_rows, gradient_rows = rng.normal(size=(10, n_q)), rng.normal(size=(4, n_q))
-    h = np.array([[hessian_rows[_HESSIAN_ROW[k, l]] for l in range(4)] for k in range(4)])  # (4, 4, n_q)
+    h = np.array([[hessian_rows[HESSIAN_ROW[k, l]] for l in range(4)] for k in range(4)])  # (4, 4, n_q)
     ops = disc.ops  # (4, n_q, size)
     expected = np.einsum("kqi,klq,q,lqj->ij", ops, h, disc.weights, ops)
     assert np.abs(disc.hessian(hessian_rows) - expected).max() <= 1e-13 * np.abs(expected).max()

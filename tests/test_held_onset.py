@@ -17,6 +17,8 @@ from balloon_cg.app.cli import main
 from balloon_cg.galerkin.interval import Mirror
 from balloon_cg.io.tube_file import read_tube_run
 from balloon_cg.tube.onset import OnsetStop, onset_curve
+from balloon_cg.scene import parse_scene
+from balloon_cg.tube.picture import onset_picture
 from balloon_cg.tube.primary import primary_branch
 from test_held_tube import held_scene
 from test_tube import bulge_determinant, symbolic_energy, theta, z
@@ -120,3 +122,82 @@ def test_critical_axial_stretch_from_the_command_line(tmp_path, capsys):
         assert main(["critical", str(given), "--parameter", "axial_stretch", "-o", str(target), "--quiet"]) == 2
         err = capsys.readouterr().err
         assert message in err and err.count("\n") == 1 and not target.exists()
+
+
+FIELD = "[field]\nM = {value!r}\n[[field.coils]]\nradius = 2.5\nheight = 0.0\ncurrent = 1.0\n"  # around the middle
+ELECTRIC = "[electric]\nvoltage = {value!r}\n"
+
+
+def onset_at_reference_length(table: str, value: float | None):
+    """The onset curve in λ of SPOM1, L = 10, sliding ends held at 1.5L, degree 12, with ``table`` at ``value`` (None:
+    without it), traced down to λ = 1 as ``critical --parameter axial_stretch --direction -1`` traces it."""
+    text = ('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10\nends = "sliding"\n'
+            'axial_stretch = 1.5\n[solver]\ndegree = 12\n[stability]\nm_max = 0\n[continuation]\nstop_stretch = 6.0\n'
+            'step_max = 0.5\n')
+    scene = parse_scene(text + ("" if value is None else table.format(value=value)))
+    return onset_picture(scene, "axial_stretch", -1.0).onset
+
+
+@pytest.mark.parametrize("table, values", [(FIELD, (1e-4, 5e-5, 2.5e-5)),
+                                           (ELECTRIC, (0.02, 0.02 / 2 ** 0.5, 0.01))], ids=["coil", "voltage"])
+def test_onset_in_the_held_stretch_tends_to_the_field_free_one(table, values):
+    """The onset curve in λ (down to λ = 1, landed: stop unstretched) in the field of a coaxial coil around the
+    tube's middle (radius 2.5) and under a voltage across its wall. With the term present at M = 0 (Φ̄ = 0) every
+    point is the field-free curve's (1e-8; measured 2e-16). The field moves it: at λ = 1 the onset pressure falls by
+    ΔP ∝ M (Φ̄²: the magnetic energy is linear in M, the dielectric one quadratic in Φ̄), checked at three values
+    halving M (Φ̄²) — each ΔP above 1e-6, halving to 1 % — and their Richardson extrapolation to M → 0 (Φ̄ → 0),
+    (8ΔP(q/4) − 6ΔP(q/2) + ΔP(q))/3 in q = M (Φ̄²), is the field-free onset within 1e-8 (measured 4.5e-11 and
+    1.6e-12)."""
+    free = onset_at_reference_length(table, None)
+    off = onset_at_reference_length(table, 0.0)
+    assert free.stop.code == off.stop.code == OnsetStop.UNSTRETCHED and off.q.size == free.q.size
+    assert np.abs(off.q - free.q).max() <= 1e-8 and np.abs(off.pressure - free.pressure).max() <= 1e-8
+    assert np.abs(off.states - free.states).max() <= 1e-8
+    moved = []
+    for value in values:
+        found = onset_at_reference_length(table, value)
+        assert found.stop.code == OnsetStop.UNSTRETCHED and found.q[-1] == 1.0
+        moved.append(found.pressure[-1] - free.pressure[-1])
+    assert all(d < -1e-6 for d in moved)
+    assert abs(moved[1] / moved[0] - 0.5) <= 0.01 and abs(moved[2] / moved[1] - 0.5) <= 0.01
+    assert abs((8 * moved[2] - 6 * moved[1] + moved[0]) / 3) <= 1e-8
+
+
+def plugged_scene(degree: int, stop: float = 7.0):
+    """SPOM1, L = 10, plugged ends held at 2L (docs/tubes.md: taut to its pressure maximum and beyond)."""
+    return held_scene("SPOM1", LENGTH, 2.0, "plugged", degree, stop).with_overrides({"stability.m_max": 0})
+
+
+def test_plugged_onset_curve_folds_in_the_held_stretch_converged_in_the_degree(tmp_path, capsys):
+    """SPOM1, L = 10, plugged ends held at 2L: the onset curve traced down in λ turns back at λ_c = 1.7896071 (P =
+    0.73849), a fold converged in the degree — λ_c at 60, 80, 100 within 3.4e-6 and 3.9e-8 of the next, P within
+    4.4e-5 and 1.7e-7, each fold state's Legendre tail 8-13× smaller per 20 degrees (docs/tubes.md's table) — not an
+    artefact; but at degree 30 its state is not resolved (tail 8.6e-3: λ_c 1.7977, P 0.687, 7 % off), and
+    ``critical`` says so in one line on stderr (the value printed, exit 0, as run flags an unresolved branch) and
+    ``inspect`` marks the fold and counts the curve's unresolved points. The stop (hoop stretch 4.5) names the last
+    stored point's λ, not the step's that passed it."""
+    folds = {}
+    for degree in (60, 80, 100):
+        scene = plugged_scene(degree)
+        primary = primary_branch(scene)
+        found = onset_curve(scene, primary, primary.branch_points(Mirror.ODD)[0], "axial_stretch", -1.0, 40)
+        assert len(found.folds) == 1 and found.folds[0].status == "located"
+        folds[degree] = (float(found.fold_q[0]), found.folds[0].pressure, float(found.fold_tail[0]))
+    (q60, P60, t60), (q80, P80, t80), (q100, P100, t100) = folds.values()
+    assert abs(q60 - q80) <= 1e-5 and abs(q80 - q100) <= 1e-7 and abs(q80 - q100) < abs(q60 - q80) / 10
+    assert abs(P60 - P80) <= 1e-4 and abs(P80 - P100) <= 1e-6 and t100 < t80 / 5 and t80 < t60 / 5
+    path = tmp_path / "plugged.toml"
+    path.write_text(plugged_scene(30, 4.5).to_toml())
+    out = tmp_path / "plugged.h5"
+    assert main(["critical", str(path), "--parameter", "axial_stretch", "--direction", "-1", "-o", str(out),
+                 "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("critical axial_stretch = 1.7976960")
+    assert captured.err.count("\n") == 1 and "the fold's state is not resolved at solver.degree = 30: its Legendre " \
+                                                "tail 0.0086 is above solver.max_error = 1e-09" in captured.err
+    onset = read_tube_run(out)["onset"]
+    assert abs(onset["folds"][0]["q"] - q100) > 5e-3
+    assert onset["attrs"]["stop_message"].endswith(f"after axial_stretch = {onset['q'][-1]:.6g}, the last point")
+    assert main(["inspect", str(out)]) == 0
+    shown = capsys.readouterr().out
+    assert "located  unresolved (tail 0.0086)" in shown and "points unresolved (Legendre tail above" in shown

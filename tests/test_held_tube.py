@@ -79,7 +79,7 @@ def test_sliding_held_tube_has_the_fixed_stretch_maximum_and_minimum():
     uniform at λz = λ with P = Φ_2/(λθλz), the two folds in P are the maximum and the minimum of P(λθ) at fixed λz
     derived here (1e-10), and the branch points are the bulge modes cos(nπS/L), odd n = 1, 3, 5 and even n = 2, 4, 6,
     at model/tube's dispersion relation on the fixed-stretch path (1e-8; measured ≤ 4e-14 for the even ones, located
-    by the corrector off the mode: tube/primary._off_mode_corrector)."""
+    by the corrector off the mode: tube/zeros.off_mode_corrector)."""
     scene = held_scene("SPOM1", 10.0, 1.5, "sliding", 20)
     branch = primary_branch(scene)
     k = branch.disc.axial_index

@@ -275,3 +275,26 @@ def test_a_signal_during_continue_s_trace_is_recorded_in_the_trace_not_the_frequ
     assert picture.primary.frequencies is None
     assert _interrupted_in(picture.incomplete) == [
         "interrupted by a signal during trace: the branches and phases after the stored points were not computed"]
+
+
+def test_a_signal_during_continue_s_pear_branches_is_recorded_in_them(tmp_path):
+    """``continue`` at a pear pitchfork (app.restart.switch): the pear branches' time is on the picture's clock as
+    run's is, and a stop asked for during their trace names them as the phase it came in (it named none)."""
+    from balloon_cg.analysis.results import Kind
+    from balloon_cg.analysis.timing import Step
+    from balloon_cg.app.cli import main
+    from balloon_cg.app.restart import find_label, restart
+
+    scene = tmp_path / "spom1.toml"
+    scene.write_text(load_scene("spom1").with_overrides({"surface.branches": "none"}).to_toml())
+    assert main(["run", str(scene), "-o", str(tmp_path / "run.h5"), "--quiet"]) == 0
+    run = read_run(tmp_path / "run.h5")
+    label = next(s["label"] for s in run["branches"]["primary"]["special_points"]
+                 if s["kind"] == Kind.BP.value and s["block"] == "odd_held")
+    with interrupt.stop_on_signals():
+        picture = restart(find_label(run, label), None, progress=_stop_at(3))
+    assert picture.interrupted and picture.interrupted_in == Step.PEAR_BRANCHES.value
+    assert picture.clock.seconds[Step.PEAR_BRANCHES] > 0
+    assert _interrupted_in(picture.incomplete) == [
+        "interrupted by a signal during pear branches: the branches and phases after the stored points were not "
+        "computed"]

@@ -8,13 +8,13 @@ import pytest
 
 from balloon_cg.analysis.results import StopCode
 from balloon_cg.io.legacy import OLD_NAMES
-from balloon_cg.io.run_file import FORMAT, RunFileError, read_run, write_run
+from balloon_cg.io.run_file import FORMAT, RunFileError, read_run
 from balloon_cg.io.schema import VARIABLES
-from balloon_cg.analysis.picture import analyse
 from balloon_cg.post.plotting import plot
 from balloon_cg.scene import parse_scene
 from balloon_cg.scene.events import Quantity
 from netcdf_groups import uncoordinated
+from shared_pictures import small_run_file
 
 xr = pytest.importorskip("xarray")
 pytest.importorskip("h5netcdf")
@@ -23,10 +23,8 @@ DATA = Path(__file__).resolve().parent / "data"
 
 @pytest.fixture(scope="module")
 def run_file(tmp_path_factory):
-    scene = parse_scene('[material]\npreset = "SPOM1"\n[continuation]\nstop_stretch = 2.0\n', "small")
-    picture = analyse(scene)
-    path = tmp_path_factory.mktemp("schema") / "run.h5"
-    return write_run(path, scene, picture.branches, snaps=picture.snaps, found=picture.incomplete)
+    """The session's run of the scene small (shared_pictures.small_run_file: read here, or copied to change it)."""
+    return small_run_file(tmp_path_factory)
 
 
 def groups(path):

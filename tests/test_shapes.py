@@ -283,19 +283,18 @@ def test_inspect_and_load_name_the_shape_and_its_aspect(tmp_path, capsys, geomet
 def test_surface_branches_are_none_on_a_capsule_and_a_spheroid_and_taken_on_a_spheroid_when_asked(geometry):
     """The whole-sphere engine traces a sphere's and a spheroid's m ≥ 1 branches and tube/surface a tube's; a
     capsule's are not traced. Both scenes default to [surface] branches = "none" (a spheroid's branches are taken
-    when asked for: tests/test_spheroid_surface.py, without natural frequencies); on a capsule asking for them is one line naming the key, its
-    value and what is allowed (with "first" a run ended incomplete, exit 1, every branch not started). The
-    sphere's default stays "first"."""
+    when asked for, also with natural frequencies: tests/test_spheroid_surface.py, tests/test_spheroid_frequencies.py);
+    on a capsule asking for them is one line naming the key, its value and what is allowed (with "first" a run ended
+    incomplete, exit 1, every branch not started). The sphere's default stays "first"."""
     material = '[material]\npreset = "spom1"\n'
     text = f"{material}[geometry]\n{geometry}\n"
     assert parse_scene(text, "scene").surface.branches == "none"
     assert parse_scene(material, "scene").surface.branches == "first"
     for asked in ("first", "all"):
         if "spheroid" in geometry:
-            assert parse_scene(f'{text}[surface]\nbranches = "{asked}"\n', "scene").surface.branches == asked
-            with pytest.raises(SceneError, match=f'surface.branches = "{asked}": a spheroid.s surface branches have '
-                                                 'no natural frequencies yet .*; allowed: "none" with'):
-                parse_scene(f'{text}[surface]\nbranches = "{asked}"\n[dynamics]\nfrequencies = true\n', "scene")
+            for dynamics in ("", "[dynamics]\nfrequencies = true\n"):
+                scene = parse_scene(f'{text}[surface]\nbranches = "{asked}"\n{dynamics}', "scene")
+                assert scene.surface.branches == asked and scene.dynamics.frequencies == bool(dynamics)
             continue
         with pytest.raises(SceneError) as raised:
             parse_scene(f'{text}[surface]\nbranches = "{asked}"\n', "scene")

@@ -202,6 +202,34 @@ def test_a_swallowed_interrupt_still_stops_the_sweep(scene, tmp_path, monkeypatc
     assert 1 <= len(list(store_path(tmp_path / "s.h5").glob("0*.h5"))) < 3  # member files; not all 3 computed
 
 
+def test_a_member_cut_short_by_a_signal_is_computed_again_on_resume(scene, serial, tmp_path, monkeypatch):
+    """A serial sweep computes its members in this process: a signal stops the member's trace where it is (its
+    file says interrupted) and then the sweep. The same command resumes and computes that member again: what
+    an interrupted member's file holds is not the member."""
+    from balloon_cg.numerics import interrupt
+
+    trace = sweep_module.trace_primary
+
+    def signalled_trace(member_scene):
+        interrupt.request()  # what the signal handler does, while the member is computed
+        return trace(member_scene)
+
+    path = tmp_path / "cut.h5"
+    monkeypatch.setattr(sweep_module, "trace_primary", signalled_trace)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_sweep(scene, SPECS, path, mode=MODE, workers=1)
+    finally:
+        interrupt._flag.clear()
+    monkeypatch.setattr(sweep_module, "trace_primary", trace)
+    with h5py.File(store_path(path) / "000000.h5") as f:
+        assert not f.attrs["complete"] and "interrupted" in list(f.attrs["incomplete_gaps"])
+
+    result = run_sweep(scene, SPECS, path, mode=MODE, workers=1)
+    assert result.skipped == [] and result.computed == [0, 1, 2]
+    assert_same_members(serial, read_sweep(path))
+
+
 # A pool whose worker is killed in the middle of sending its result: the parent's manager thread has read the
 # message's length and waits for the rest; the process must still exit once the pool is stopped.
 CUT_SEND = r"""

@@ -126,3 +126,37 @@ def test_member_count_is_refused_before_expanding(tmp_path, capsys):
     with pytest.raises(SweepError, match="200000 members; at most 10000"):
         run_sweep(SCENE, ["material.alpha[0]=1.2:1.4:400", "continuation.stop_stretch=2:3:500"], tmp_path / "y.h5")
     assert not (tmp_path / "x.h5").exists() and not store_path(tmp_path / "y.h5").exists()
+
+
+def test_a_signal_while_an_old_sweep_is_imported_stops_after_the_import(done, monkeypatch):
+    """Opening a /1 sweep copies its members into a store; a signal then is raised once the store is open (never
+    inside h5py, where a KeyboardInterrupt can surface as a SystemError): the member copied, the old file as it
+    was, and the same command resumes from the store."""
+    import os
+    import signal
+
+    from balloon_cg.io import sweep_file
+    from balloon_cg.numerics import interrupt
+
+    shutil.rmtree(store_path(done))
+    with h5py.File(done, "a") as f:
+        f.attrs["format"] = "balloon-cg-sweep/1"
+        del f.attrs["store"]
+        del f["members/1"]
+    copy = sweep_file.copy_tree
+
+    def signalled_copy(source, target):
+        os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C while the member is copied
+        copy(source, target)
+
+    monkeypatch.setattr(sweep_file, "copy_tree", signalled_copy)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_sweep(SCENE, SPECS, done, mode=MODE, workers=1)
+    finally:
+        interrupt._flag.clear()  # the flag the held signal set (a process would exit here)
+    monkeypatch.setattr(sweep_file, "copy_tree", copy)
+    assert sorted(p.name for p in store_path(done).glob("0*.h5")) == ["000000.h5"]  # the import finished
+    assert sorted(read_sweep(done)["members"]) == [0]
+    result = run_sweep(SCENE, SPECS, done, mode=MODE, workers=1)
+    assert result.skipped == [0] and result.computed == [1]

@@ -355,7 +355,9 @@ def test_critical_follows_the_onset_in_the_field_of_a_coil(tmp_path, capsys):
     down = tmp_path / "down.h5"
     assert main(["critical", str(COIL_SCENE), "--parameter", "M", "--direction", "-1", "-o", str(down), "--quiet",
                  *COIL_FAST]) == 1
-    assert "no critical M: the onset curve does not turn back in M" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "no critical M: the onset curve does not turn back in M" in err
+    assert "traced down from M = 0.01 only, as every critical curve: --direction 1 traces the other side" in err
     assert read_tube_run(down)["onset"]["q"][-1] == 0.0
     for extra in (["--parameter", "M", "--of", "LP"], ["--parameter", "chi"]):
         assert main(["critical", str(COIL_SCENE), "-o", str(tmp_path / "x.h5"), "--quiet", *extra]) == 2

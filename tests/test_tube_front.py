@@ -21,6 +21,7 @@ from balloon_cg.scene.tables import Ends
 from balloon_cg.tube.bulge import bulge_branch
 from balloon_cg.tube.front import front_bulge, refined_layout
 from balloon_cg.tube.primary import TubeSystem, held, primary_branch
+from balloon_cg.tube.results import IntervalStop
 from balloon_cg.tube.stability import _counts_by_one_factor, arrow_factor, unstable_counts
 from test_tube_maxwell import LENGTH, check_chain, maxwell, ogden_1972_tube  # noqa: F401 (the fixture)
 
@@ -181,11 +182,48 @@ def test_refined_layout_cuts_the_elements_whose_tails_pass():
     assert refined_layout(disc, np.full((3, disc.count), 1e-10), 1e-9) == disc
 
 
+def test_local_refinement_continues_the_trace_on_finer_layouts(monkeypatch):
+    """SPOM1, L = 10, from 4 elements of order 12 to a hoop stretch of 2.5: front_bulge refines the layout where a
+    traced point needs it (measured three times: 5, 6, then 7 elements) and continues without retracing: every
+    stored point's tail ≤ max_error; the first traced point, from the first layout, lies in that layout's space
+    (collocated there and back: 1e-12) and is its equilibrium (|R| ≤ 1e-9 there; measured 1.3e-13); the last point is
+    the last layout's (|R| ≤ 1e-9); the volume fold is where the whole branch traced from the onset on the last
+    layout (the retrace the local refinement saves, a second trace) has it: P within max(1e-9 relative, the tails of
+    the fold's neighbours) (measured 1.8e-15), V/V0 likewise (measured 0). With max_degree 60 (5 elements of order 12)
+    the branch stops UNRESOLVED at the first point that needed more, saying so, every stored point resolved."""
+    import balloon_cg.tube.front as front
+
+    scene = parse_scene('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\n'
+                        'degree = 16\n')
+    primary = primary_branch(scene)
+    onset = primary.branch_points()[0]
+    counts, refined = [], front.refined_layout
+    monkeypatch.setattr(front, "refined_layout", lambda *a: counts.append((found := refined(*a)).count) or found)
+    first = front.uniform_layout(scene, 4, 12)
+    branch = front_bulge(scene, primary, onset, Resolution(1e-9, 400), layout=first, stop_stretch=2.5)
+    assert len(counts) >= 2 and counts == sorted(counts) and branch.disc.count == counts[-1]
+    assert branch.stop.code == IntervalStop.HOOP_STRETCH and branch.tail.max() <= 1e-9
+    on_first = collocated(branch.disc, branch.states[1], first)
+    assert np.abs(collocated(first, on_first, branch.disc) - branch.states[1]).max() <= 1e-12
+    for disc, u, P in ((first, on_first, branch.pressure[1]), (branch.disc, branch.states[-1], branch.pressure[-1])):
+        free = disc.free
+        assert np.abs(Equilibrium(scene, disc).residual(u, Parameters(P))[free]).max() <= 1e-9
+    whole = bulge_branch(scene, primary, onset, on=branch.disc, max_error=1e-9, stop_stretch=2.5)
+    (fold,), (again,) = ([s for s in b.special if s.kind == Kind.LV] for b in (branch, whole))
+    error = max(1e-9 * abs(again.pressure), *branch.tail[fold.index: fold.index + 2])
+    assert abs(fold.pressure - again.pressure) <= error
+    eq = Equilibrium(scene, branch.disc)
+    assert abs(eq.volume(fold.u) - eq.volume(again.u)) <= max(1e-9, error) * eq.volume(again.u)
+    capped = front_bulge(scene, primary, onset, Resolution(1e-9, 60), layout=first, stop_stretch=2.5)
+    assert capped.stop.code == IntervalStop.UNRESOLVED and "solver.max_degree 60" in capped.stop.message
+    assert capped.disc.degree <= 60 and capped.tail.max() <= 1e-9 and len(capped.pressure) < len(branch.pressure)
+
+
 @pytest.mark.slow
 def test_resolved_bulge_reaches_maxwells_pressure_with_every_point_resolved(maxwell):  # noqa: F811
-    """Ogden 1972, L = 30: the bulge on elements refined by tube/front.front_bulge to V/V0 = 52 (order 16, E p up to
-    400 per field: measured two rounds, 10 then 25 elements, the last 400), every stored point's estimate ≤
-    solver.max_error (1e-9; measured 7.4e-10), and the acceptance's chain (test_tube_maxwell.check_chain: the onset,
+    """Ogden 1972, L = 30: the bulge on elements refined locally by tube/front.front_bulge to V/V0 = 52 (order 16, E p
+    up to 400 per field: measured 22 elements at the end, 352), every stored point's estimate ≤ solver.max_error
+    (1e-9; measured 9.8e-10 to V/V0 = 50: benchmarks/tube_front_speed.py), and the acceptance's chain (test_tube_maxwell.check_chain: the onset,
     one LV, V rising beyond it, |P − P_M| ≤ 1e-6 from V/V0 = 50, stable under volume control; measured 6.0e-8, the
     finite tube's approach to the plateau, docs/tubes.md); the fold where the Legendre series of degree 120 has it
     (1e-10)."""

@@ -58,7 +58,7 @@ def test_a_uniform_profile_has_no_front():
 def test_a_profile_without_a_single_narrow_front_has_none():
     """No front (position and width NaN) where there is none to single out: the onset's mode ρ = 1.6 + 0.05 cos(πz/ℓ)
     over the whole tube (one mid-level crossing, at the middle, but a width 2ℓ/π: it drew a spike near the onset),
-    a bump in the middle (two crossings: a coil's bulge), and a tanh front of width 1.6 too near an end (z_f < 1.5 w:
+    a bump in the middle (two crossings nearer than twice its width: a coil's bulge), and a tanh front of width 1.6 too near an end (z_f < 1.5 w:
     the part beyond it shorter than the front is wide); the same front at 1.5 w + 0.1 from the end has one."""
     z = np.linspace(0.0, 11.2, 4001)
     for rho in (1.6 + 0.05 * np.cos(np.pi * z / 11.2), 1.6 + 0.05 * np.exp(-((z - 5.6) / 1.5) ** 2),
@@ -67,3 +67,25 @@ def test_a_profile_without_a_single_narrow_front_has_none():
         assert np.isnan(found.position) and np.isnan(found.width) and found.high > found.low
     found = front(z, 4.0 - 2.5 * np.tanh((z - 2.5) / 0.8))
     assert abs(found.position - 2.5) < 5e-3 and abs(found.width - 1.6) < 5e-3  # the end at 2.5 is not saturated
+
+
+@pytest.mark.parametrize("descending", [False, True])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_middle_bulge_has_its_front_nearest_the_first_sample(descending, sign):
+    """A bulge (sign 1) or a neck (−1) in the middle, ρ = 2.75 + 1.25 sign (tanh((z − 6)/0.8) − tanh((z − 14)/0.8))
+    on [0, 20]: two fronts, mirror images; the one nearest the first sample (z = 0, or z = 20 sampled descending) is
+    reported: its position the crossing of the mid level of the samples, solved by brentq on the profile (1e-6), its
+    width 1.6 (2e-4: the other front's tail and the central differences). Four crossings (the bulge split in its
+    middle) have none."""
+    from scipy.optimize import brentq
+
+    profile = lambda z: 2.75 + 1.25 * sign * (np.tanh((z - 6.0) / 0.8) - np.tanh((z - 14.0) / 0.8))
+    z = np.linspace(0.0, 20.0, 4001)[:: -1 if descending else 1]
+    rho = profile(z)
+    middle = 0.5 * (rho.max() + rho.min())
+    near = (10.0, 20.0) if descending else (0.0, 10.0)
+    found = front(z, rho)
+    assert abs(found.position - brentq(lambda x: profile(x) - middle, *near, xtol=1e-14)) <= 1e-6
+    assert abs(found.width - 1.6) <= 2e-4
+    split = front(z, rho + 1.25 * np.exp(-((z - 10.0) / 0.3) ** 2) * -sign * 2)
+    assert np.isnan(split.position)

@@ -14,7 +14,7 @@ from balloon_cg.numerics.eigen import GramFactor, restricted
 from balloon_cg.scene import parse_scene
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
-from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium
+from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
 ENDS = ("sliding", "plugged", "held")
 
@@ -42,7 +42,7 @@ def test_restricted_to_m0_it_is_the_interval_discretisation(ends):
     scene, disc = scene_and_disc(ends)
     eq, params = Equilibrium(scene, disc), Parameters(0.9)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     u = random_state(disc)
     c = basis.axisymmetric(u)
     axis = basis.block(0)
@@ -70,7 +70,7 @@ def test_order_m_blocks_are_the_azimuthal_blocks(ends):
     scene, disc = scene_and_disc(ends)
     eq, params = Equilibrium(scene, disc), Parameters(0.9)
     basis = TubeSurfaceBasis(disc, (0, 1, 2, 3))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     u = random_state(disc, seed=5)
     H = surface.hessian(basis.axisymmetric(u), params)
     factor = GramFactor(azimuthal.operators(disc)[1])
@@ -124,7 +124,7 @@ def test_lowest_m1_eigenvalue_vanishes_at_the_located_branch_point(zeros):
     disc = branch.disc
     eq = Equilibrium(scene, disc)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     factor = GramFactor(azimuthal.operators(disc)[1])
 
     def lowest(u, P):
@@ -210,7 +210,7 @@ def test_energy_and_its_derivatives_are_those_written_here(ends):
     (1e-7)."""
     scene, disc = scene_and_disc(ends, degree=10)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     rng = np.random.default_rng(11)
     c = basis.axisymmetric(random_state(disc, seed=7)) + 0.02 * rng.standard_normal(basis.size) * (
         np.arange(basis.size) >= disc.size)
@@ -255,7 +255,7 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
             assert point.converged, (eps, point.message)
             basis = point.basis
             start = basis.with_mode(basis.axisymmetric(zero.u), 1, eps * zero.mode)
-            surface = TubeSurfaceEquilibrium(scene, basis)
+            surface = MeridianSurfaceEquilibrium(scene, basis)
             scale = zero.pressure * np.max(np.abs(surface.parameter_derivative(start, branch.params)))
             assert point.residual <= 1e-12 * scale, (eps, point.residual, scale)
             amplitude = zero.mode @ azimuthal.operators(disc)[1] @ point.c[basis.block(1)]
@@ -272,7 +272,7 @@ def test_switched_point_is_an_equilibrium_off_the_axisymmetric_branch(zeros):
             return np.array([(energy(c + e) - energy(c - e)) / (2 * h) for e in steps])
 
         start = basis.with_mode(basis.axisymmetric(zero.u), 1, 0.1 * zero.mode)
-        derivative = TubeSurfaceEquilibrium(scene, basis).parameter_derivative(start, branch.params)
+        derivative = MeridianSurfaceEquilibrium(scene, basis).parameter_derivative(start, branch.params)
         scale = zero.pressure * np.max(np.abs(derivative))
         stationary, predicted = (np.max(np.abs(gradient(c, P))) for c, P in ((point.c, point.pressure),
                                                                               (start, zero.pressure)))
@@ -289,11 +289,11 @@ def test_what_it_does_not_take_is_refused_in_one_line():
     from balloon_cg.scene import SceneError
 
     disc = IntervalDiscretisation(8, 10.0)
-    cases = [(lambda: TubeSurfaceEquilibrium(parse_scene('[material]\npreset = "SPOM1"\n'), TubeSurfaceBasis(disc)),
+    cases = [(lambda: MeridianSurfaceEquilibrium(parse_scene('[material]\npreset = "SPOM1"\n'), TubeSurfaceBasis(disc)),
               "geometry.shape", SceneError),
              (lambda: TubeSurfaceBasis(disc, (1, 2)), "orders", ValueError),
              (lambda: TubeSurfaceBasis(disc, (0, 3), n_phi=6), "n_phi", ValueError),
-             (lambda: TubeSurfaceEquilibrium(tube_scene(), TubeSurfaceBasis(disc)).parameter_derivative(
+             (lambda: MeridianSurfaceEquilibrium(tube_scene(), TubeSurfaceBasis(disc)).parameter_derivative(
                  np.zeros(TubeSurfaceBasis(disc).size), Parameters(1.0), "M"), "continuation.parameter", SceneError)]
     for call, key, kind in cases:
         with pytest.raises(kind) as error:

@@ -15,7 +15,7 @@ from balloon_cg.scene import Control, SceneError
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
 from balloon_cg.tube.surface.branch import START_AMPLITUDE, traced_branch
-from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium
+from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 from balloon_cg.tube.surface.stability import SectorStability
 from balloon_cg.tube.surface.resolution import harmonics
 from balloon_cg.tube.surface.switching import mode_row, point_at_amplitude, switched_point
@@ -104,7 +104,7 @@ def test_stability_at_the_first_points_follows_the_normal_form(traced):
     of the largest) plus one where that sign is negative."""
     scene, parent, zero, plus, _ = traced
     p2 = (switched_point(scene, parent.disc, zero, START_AMPLITUDE, parent.params).pressure - zero.pressure) / 0.05**2
-    system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, plus.basis), parent.params, plus.coefficients[0])
+    system = TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, plus.basis), parent.params, plus.coefficients[0])
     read = SectorStability(system)
     eq = Equilibrium(scene, parent.disc)
     free, h = parent.disc.free, 1e-5

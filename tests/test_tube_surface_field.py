@@ -17,7 +17,7 @@ from balloon_cg.numerics.eigen import NO_CONSTRAINT, GramFactor, restricted
 from balloon_cg.tube import azimuthal
 from balloon_cg.tube.primary import scene_parameters
 from balloon_cg.tube.surface.basis import TubeSurfaceBasis
-from balloon_cg.tube.surface.equilibrium import TubeSurfaceEquilibrium
+from balloon_cg.tube.surface.equilibrium import MeridianSurfaceEquilibrium
 
 from test_tube_field import biot_savart_squared
 from test_tube_surface import random_state, tube_scene, written_energy, written_point
@@ -55,7 +55,7 @@ def test_energy_in_a_field_and_under_a_voltage_is_the_one_written_here(case, end
     residual its central differences (1e-7 of its largest entry), the Jacobian the residual's (1e-7) and symmetric."""
     scene, disc = charged_scene(case, ends)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     rng = np.random.default_rng(13)
     c = basis.axisymmetric(random_state(disc, seed=9)) + 0.02 * rng.standard_normal(basis.size) * (
         np.arange(basis.size) >= disc.size)
@@ -86,7 +86,7 @@ def test_axisymmetric_in_a_field_it_is_the_interval_discretisation(case, ends):
     params = scene_parameters(scene, 0.9)
     eq = Equilibrium(scene, disc)
     basis = TubeSurfaceBasis(disc, (0, 1, 2))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     u = random_state(disc, seed=4)
     c = basis.axisymmetric(u)
     axis = basis.block(0)
@@ -141,7 +141,7 @@ def test_an_m2_zero_is_switched_to_an_equilibrium_of_the_written_energy(m2_zero)
     scene, branch, zero = m2_zero
     disc = branch.disc
     basis = TubeSurfaceBasis(disc, (0, 2, 4))
-    surface = TubeSurfaceEquilibrium(scene, basis)
+    surface = MeridianSurfaceEquilibrium(scene, basis)
     factor = GramFactor(azimuthal.operators(disc)[1])
 
     def lowest(u, P):

@@ -40,7 +40,7 @@ def test_even_branch_point_switches_to_the_half_tubes_bulge(extra):
     mirror-symmetric (its odd coefficients zero), bulges at both ends (ρ(0) = ρ(L) > ρ(L/2)), and its first volume
     fold (taut) has the P and V/V0 of the first volume fold of the bulge branch of L = 10 (degree 30) within 1e-9
     (measured 3.1e-11 and 8.2e-12); the branch points themselves, both located, within 1e-12 (measured 1.3e-15 and
-    8.9e-16; the held even one was found only to 5.6e-7 before tube/primary._off_mode_corrector)."""
+    8.9e-16; the held even one was found only to 5.6e-7 before tube/zeros.off_mode_corrector)."""
     folds, onsets = {}, {}
     for length, degree, block in ((10.0, 30, Mirror.ODD), (20.0, 60, Mirror.EVEN)):
         scene, primary, point, branch = switched(length, degree, block, extra)

@@ -238,3 +238,24 @@ def test_plugged_tube_keeps_the_first_integral_of_its_charged_energy(tmp_path):
     eq = Equilibrium(plugged, discretisation(read_tube_run(out)["attrs"]))
     voltage_free = accuracy(eq, primary["unknowns"])[1]
     assert voltage_free[primary["voltage"] > 0.2].min() > 1e-2
+
+
+def test_a_label_of_a_branch_continued_in_the_voltage_is_refused_away_from_the_scenes(tmp_path, capsys):
+    """A branch continued in Φ̄ (``continue --parameter voltage``) has its labels at other voltages than the file's
+    scene: the bulge branch from one of its odd branch points was traced at the scene's Φ̄ (P jumped 1 → 1.236 in its
+    first step, exit 0): refused, one line naming both voltages, no file."""
+    scene = tmp_path / "p.toml"
+    scene.write_text(tube_scene("SPOM1", 10.0, "[solver]\ndegree = 16\n[electric]\nvoltage = 0.1\n[continuation]\n"
+                                               "stop_stretch = 2\nstep_max = 0.5\n[stability]\nm_max = 0\n"
+                                               '[[events]]\nquantity = "pressure"\nvalue = 1.0\n').to_toml())
+    run, up = tmp_path / "p.h5", tmp_path / "up.h5"
+    assert main(["run", str(scene), "-o", str(run), "--quiet", "--primary-only"]) == 0
+    assert main(["continue", str(run), "0", "--parameter", "voltage", "-o", str(up), "--quiet", "--set",
+                 "continuation.stop_stretch=4"]) == 0
+    labels = read_tube_run(up)["branches"]["primary"]["special_points"]
+    odd = next(i for i, s in enumerate(labels) if s["kind"] == "BP" and s["block"] == "odd")
+    capsys.readouterr()
+    assert main(["continue", str(up), str(odd), "-o", str(tmp_path / "b.h5")]) == 2
+    err = capsys.readouterr().err
+    assert (f"label {odd}: its branch was continued in voltage, this point at Φ̄ = {labels[odd]['voltage']:.10g}, "
+            "the file's scene at Φ̄ = 0.1" in err and err.count("\n") == 1 and not (tmp_path / "b.h5").exists())

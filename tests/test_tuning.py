@@ -239,3 +239,16 @@ def test_a_curve_in_the_voltage_holds_the_breathing_mode_of_each_sphere(tmp_path
     assert np.abs(data["frequencies"]["even"] - breathing_mode[:, None]).min(axis=1).max() <= 1e-9
     n = next(n for n, s in enumerate(data["special_points"]) if s["kind"] == "LP")
     assert abs(data["special_frequencies"]["even"][n, 0]) <= 1e-11
+
+
+def test_inspect_gives_each_special_point_its_M(tuning, capsys):
+    """A branch continued in M at fixed P: `inspect` lists each special point with its M (the coordinate it was
+    located in; P is the branch's fixed one), read back as stored."""
+    folder, curve = tuning
+    assert main(["inspect", str(folder / "curve.h5")]) == 0
+    out = capsys.readouterr().out
+    special = curve.special_points
+    assert {s["kind"] for s in special} >= {"LP", "EP"}
+    for s in special:
+        line = next(line for line in out.splitlines() if line.lstrip().startswith(f"{s['label']} {s['kind']}"))
+        assert f"M = {s['M']:.10g}  " in line and f"P = {s['pressure']:.10g}  " in line

@@ -969,7 +969,9 @@ def _add_continue(commands):
                     "pear pitchfork (BP odd_held or odd_free) the curve of pitchforks and the isola's critical "
                     "value (a curve file), from another point (UZ, EP, TP) with --parameter M or voltage the branch "
                     "through it in that parameter at its fixed P (a run file of one branch, assessed as the stored "
-                    "one was, with [dynamics] its frequencies: tuning curves, docs/dynamics.md). Exit 0: written (a run file: and complete); 1: the computation did not "
+                    "one was, with [dynamics] its frequencies: tuning curves, docs/dynamics.md); from a located "
+                    "point of a held tube's primary branch (not an even BP) with --parameter axial_stretch the tube "
+                    "through it in the held distance of its ends at its fixed P (docs/tubes.md). Exit 0: written (a run file: and complete); 1: the computation did not "
                     "give it (the curve or no switched branch started; a run file written but incomplete, as run: "
                     "--allow-partial exits 0); 2: bad input (no such label, a label or parameter this does not "
                     "continue yet: an even or free m >= 1 BP, an even or m >= 1 BP in a second parameter, a "
@@ -979,7 +981,8 @@ def _add_continue(commands):
                                               "docs/tubes.md)")
     p.add_argument("label", type=int, help="the special point's label (balloon-cg inspect RUN lists them)")
     p.add_argument("--parameter", help="continue in this parameter (default: the branch's own, P; from a point "
-                                       "that is no fold or BP: M or voltage, at its fixed P)")
+                                       "that is no fold or BP: M or voltage, at its fixed P; a held tube's "
+                                       "located point: axial_stretch, at its fixed P)")
     p.add_argument("--direction", type=float, choices=(1.0, -1.0), default=1.0,
                    help="a fold curve: start with the parameter increasing (1, default) or decreasing (-1)")
     p.add_argument("-o", "--output", help="run or curve file to write (HDF5; default: RUN_label<LABEL>.h5 in the "

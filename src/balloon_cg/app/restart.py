@@ -358,19 +358,23 @@ def switch(start: Labelled, progress=None) -> Picture:
         points = numbered_branch_points(branch)
         n = next(i for i, s in enumerate(points) if s is point)
         picture = Picture([branch], branch_points=points)
+        clock = picture.clock  # the pear branches' time, and the phase a signal stops them in, as run records them
         try:
-            plain = plain_branch(branch, point.X)
-            interrupt.check()  # each of the two costs ~1 s near a wire, and neither polls inside
-            points[n] = replace(point, mode=pear_point(plain, start).mode)
-            if pear_pair(branch.scene, branch, picture, n, progress):
-                azimuthal_crossings(picture, picture.branches[1:], branch.scene)
+            with clock.step(Step.PEAR_BRANCHES):
+                plain = plain_branch(branch, point.X)
+                interrupt.check()  # each of the two costs ~1 s near a wire, and neither polls inside
+                points[n] = replace(point, mode=pear_point(plain, start).mode)
+                traced = pear_pair(branch.scene, branch, picture, n, progress)
+            if traced:
+                with clock.step(Step.CROSSINGS):
+                    azimuthal_crossings(picture, picture.branches[1:], branch.scene)
             else:  # a signal stopped them
                 stopped(picture)
         except interrupt.Interrupted:  # in a unit that polls inside (a plain degree's search): abandoned
             stopped(picture)
         label_readings(picture.branches[1:])
         return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted,
-                       interrupted_in=picture.interrupted_in)
+                       interrupted_in=picture.interrupted_in, clock=clock)
     if point.m >= 1:  # held, or free on an equator-symmetric branch (its held states are free equilibria)
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
         try:

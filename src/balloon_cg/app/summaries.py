@@ -379,7 +379,8 @@ READINGS = {"both": "held and free", "held": "held at its centre", "free": "free
 def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]:
     """One aligned line per stored special point: its label (the number ``continue`` takes), kind (with its reading
     where it is not its branch's ``gauge``, and a surface branch's secondary branch point's sector under the
-    reflections ``symmetry`` of its basis), place, P (and Φ̄), the pole stretches, the note."""
+    reflections ``symmetry`` of its basis), place, P (and M or Φ̄ on a branch continued in it), the pole stretches,
+    the note."""
     labels = [f"{s['label']:>3} {s['kind']} {s['classification']}".rstrip() + (f" m={s['m']}" if s["m"] else "")
               + (f" {s['gauge']}" if s.get("gauge", gauge) != gauge else "")
               + (f" sector {_reflections(symmetry, s['sector'])}" if s.get("sector") else "")
@@ -393,7 +394,7 @@ def _special_lines(special: list, gauge: str = "both", symmetry=()) -> list[str]
         note = f"  {s['note']}" if s["note"] else ""
         lines.append(
             f"    {label:<{width}}  {place:<{place_width}}  P = {s['pressure']:.10g}  "
-            + (f"voltage = {s['voltage']:.10g}  " if "voltage" in s else "") +
+            + "".join(f"{key} = {s[key]:.10g}  " for key in ("M", "voltage") if key in s) +
             f"lam2 north = {s['lam2_top']:.10g}  lam2 south = {s['lam2_bottom']:.10g}{note}"
         )
     return lines

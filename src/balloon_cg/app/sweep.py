@@ -307,7 +307,9 @@ def run_sweep(scene: Scene, specs: list[str], out_path, *, mode: str = "analysis
         check_output(path, force, sweep=True)  # another kind of file there only with --force (io.output)
         members = expand(scene, specs) if members is None else members
         axes = [list(parse_vary(s, scene)) for s in specs]
-        store = open_store(path, root_attrs(scene, axes, mode, len(members), command), members, force)
+        with interrupt.Held() as held:  # a signal meanwhile only sets the flag: raised once the store is open,
+            held.start()  #                 never inside h5py (an import copies members)
+            store = open_store(path, root_attrs(scene, axes, mode, len(members), command), members, force)
         result = SweepResult(path, members, mode, store.directory, skipped=sorted(store.done))
         todo = [m for m in members if m.index not in store.done]
         by_index = {m.index: m for m in members}

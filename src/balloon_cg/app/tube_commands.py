@@ -2,6 +2,7 @@
 (tube/picture.onset_picture) write a tube run file (io/tube_file.py) and summarise it. A signal (SIGINT or SIGTERM,
 numerics.interrupt) stops the work at its next point or before its next stage: what is finished is written, the
 file's ``interrupted`` attribute names the stage, and the command exits 130 with one line read from the file."""
+import math
 import sys
 
 from .cli import INTERRUPTED, PROG, Failure, UsageError, _say, field_needed
@@ -50,10 +51,12 @@ def critical_tube(scene, output, args) -> int:
     """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
     followed in M, the voltage Φ̄ or the held ends' distance λ (axial_stretch), written with the primary branch to the
     tube run file ``output`` (its /onset group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns
-    back in the parameter (a located fold: the onset's largest or smallest value), 1 (the file still written) where it
-    does not; 1 without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of
-    BP) in M, the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed
-    ends (no held distance), a scene continued in the voltage; 130 when a signal stopped it (module docstring)."""
+    back in the parameter (a located fold: the onset's largest or smallest value; a line on stderr where its state is
+    not resolved, its Legendre tail above solver.max_error), 1 (the file still written) where it does not (the line
+    says the curve was traced one way from the scene's value, as every critical curve, and --direction the other); 1
+    without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M,
+    the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed ends (no
+    held distance), a scene continued in the voltage; 130 when a signal stopped it (module docstring)."""
     from ..tube.picture import onset_picture
 
     name = ONSET_PARAMETERS.get(args.parameter)
@@ -88,12 +91,19 @@ def critical_tube(scene, output, args) -> int:
     _say(args, f"onset curve: {len(onset['q'])} points, stop {onset['attrs']['stop_code']} "
                f"({onset['attrs']['stop_message']})")
     if not onset["folds"]:
+        side = "up" if args.direction > 0 else "down"
         raise Failure(f"no critical {name}: the onset curve does not turn back in {name} "
                       f"({onset['attrs']['stop_message']}; last point {name} = {onset['q'][-1]:.10g}, P = "
-                      f"{onset['pressure'][-1]:.10g}); curve written to {output}")
+                      f"{onset['pressure'][-1]:.10g}); traced {side} from {name} = {onset['attrs']['q0']:g} only, as "
+                      f"every critical curve: --direction {-args.direction:g} traces the other side; curve written to "
+                      f"{output}")
     fold = max(onset["folds"], key=lambda f: args.direction * f["q"])
     print(f"critical {name} = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in {name}: "
           f"{fold['status']}); curve written to {output}")
+    if fold["tail"] > scene.solver.max_error:
+        print(f"{PROG}: the fold's state is not resolved at solver.degree = {scene.solver.degree}: its Legendre tail "
+              f"{fold['tail']:.2g} is above solver.max_error = {scene.solver.max_error:g} (the critical value may be "
+              "off, or the fold an artefact: raise solver.degree; docs/tubes.md)", file=sys.stderr)
     return 0
 
 
@@ -172,9 +182,12 @@ tube/picture.branch_name), with the file's scene and the command line's continua
     labels = tube_labels(run)
     if args.parameter in VOLTAGE_NAMES:
         return _continue_in_voltage(args, run, labels)
+    if args.parameter in STRETCH_NAMES:
+        return _continue_in_stretch(args, run, labels)
     if args.parameter not in (None, "P", "M", "field.M"):
         raise UsageError(f"continue {args.run}: --parameter {args.parameter}: a tube's onset is followed in M, a "
-                         "user point's state in the voltage (allowed: M, voltage, or none for the bulge branch)")
+                         "user point's state in the voltage, a held tube's located point in axial_stretch (allowed: "
+                         "M, voltage, axial_stretch, or none for the bulge branch)")
     in_field = args.parameter in ("M", "field.M")
     uniform = run["attrs"]["ends"] == Ends.SLIDING.value and not _has_field(run)  # even BPs switched there
     blocks = ("odd",) if in_field or not uniform else ("odd", "even")
@@ -191,6 +204,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues from {which}: labels "
                          f"{', '.join(map(str, onsets)) or 'none'}{event}")
     scene = with_continuation_settings(args, stored_scene(args, run))
+    at_fixed_scene(args, run, labels, scene)
     if in_field:
         field_needed(scene, "M", "continue --parameter M", args.run)
     elif scene.geometry.ends != Ends.SLIDING:
@@ -219,6 +233,7 @@ tube/picture.branch_name), with the file's scene and the command line's continua
 
 
 VOLTAGE_NAMES = ("voltage", "electric.voltage")  # continue --parameter
+STRETCH_NAMES = ("axial_stretch", "geometry.axial_stretch")  # continue --parameter
 
 
 def _continue_in_voltage(args, run: dict, labels: list) -> int:
@@ -240,6 +255,7 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
         raise UsageError(f"continue {args.run}: label {args.label}: {what}; a tube continues in the voltage from a "
                          f"user point (UZ) of its primary branch: labels {', '.join(map(str, points)) or 'none'}")
     stored = stored_scene(args, run)
+    at_fixed_scene(args, run, labels, stored)
     if stored.electric is None:
         raise UsageError(f"continue {args.run}: --parameter voltage needs an [electric] table: the file's scene has "
                          "none, so the equilibrium does not depend on the voltage")
@@ -250,14 +266,73 @@ def _continue_in_voltage(args, run: dict, labels: list) -> int:
     _, k, _ = labels[args.label]
     point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
     start = (point.u, point.pressure, scene.voltage)
-    written, _, signalled = _written(args.output, args, lambda: charged_picture(scene, start, args.direction),
-                                     scene)
+    return _at_fixed_pressure(args, scene, lambda: charged_picture(scene, start, args.direction), point.pressure,
+                              "voltage", "Φ̄")
+
+
+def _continue_in_stretch(args, run: dict, labels: list) -> int:
+    """``continue --parameter axial_stretch`` from a located point of a held tube's primary branch (a fold in P, the
+    onset of bulging, an event's point: mirror-symmetric states): the tube continued in the held distance λ at that
+    point's P (tube/picture.stretched_picture from the stored state on the file's discretisation, ``--direction``
+    −1: λ falling first), with the file's scene and the command line's [continuation] settings, written as a tube run
+    file's primary branch (130 on a signal, as ``run``). Exit 2, before any work, for closed ends (nothing held),
+    another branch's label (a bulge branch's states are not mirror-symmetric: the continuation is on the even
+    block), an even branch point (the path in λ is itself at a branch point there: its tangent is not unique; start
+    from a neighbouring label), or a setting outside [continuation]."""
+    from ..io.tube_file import discretisation, stored_branch
+    from ..tube.picture import stretched_picture
+    from ..tube.primary import scene_parameters
+
+    if math.isnan(run["attrs"]["axial_stretch"]):
+        raise UsageError(f"continue {args.run}: --parameter axial_stretch continues a tube whose ends are held apart: "
+                         "the file's has closed ends (the distance free, nothing held); hold them with "
+                         "geometry.axial_stretch = λ (in [1, 5]) and run it again")
+    points = [i for i, (name, _, s) in enumerate(labels) if name == "primary" and s["block"] != "even"]
+    if args.label not in points:
+        name, _, s = labels[args.label] if 0 <= args.label < len(labels) else (None, None, None)
+        what = "no such label" if s is None else " ".join(filter(None, (s["kind"], s["block"]))) + f" on branch {name}"
+        why = " (the path in λ is at a branch point there too: start from a neighbouring label)" if (
+            s is not None and name == "primary") else ""
+        raise UsageError(f"continue {args.run}: label {args.label}: {what}{why}; a held tube continues in "
+                         "axial_stretch from a located point of its primary branch other than an even branch point: "
+                         f"labels {', '.join(map(str, points)) or 'none'}")
+    scene = with_continuation_settings(args, stored_scene(args, run))
+    at_fixed_scene(args, run, labels, scene)
+    _, k, _ = labels[args.label]
+    point = stored_branch(run, "primary", scene_parameters(scene)).special[k]
+    disc = discretisation(run["attrs"], run["branches"]["primary"]["attrs"])
+    return _at_fixed_pressure(args, scene, lambda: stretched_picture(scene, point, disc, args.direction),
+                              point.pressure, "axial_stretch", "λ")
+
+
+def at_fixed_scene(args, run: dict, labels: list, scene) -> None:
+    """UsageError (exit 2, one line) for a label of a primary branch continued in the voltage or in λ (``continue
+    --parameter voltage|axial_stretch``) whose Φ̄ or λ is not the file's ``scene``'s: every continuation from a label
+    starts from the scene's (a branch of another tube, stored as born at that label)."""
+    from ..io.tube_file import STRETCH, VOLTAGE
+
+    primary, point = run["branches"]["primary"], labels[args.label][2]
+    for column, key, symbol, own in ((VOLTAGE, "electric.voltage", "Φ̄", scene.voltage),
+                                     (STRETCH, "geometry.axial_stretch", "λ", scene.geometry.axial_stretch)):
+        value = point.get(column) if column in primary else None
+        if value is not None and abs(value - (own or 0.0)) > 1e-12 * max(1.0, abs(value)):
+            raise UsageError(f"continue {args.run}: label {args.label}: its branch was continued in {column}, this "
+                             f"point at {symbol} = {value:.10g}, the file's scene at {symbol} = {own or 0.0:.10g}: a "
+                             f"continuation from it would start from the scene's; run the scene with {key} = "
+                             f"{value:.10g} and continue from that run's labels")
+
+
+def _at_fixed_pressure(args, scene, picture, pressure: float, column: str, symbol: str) -> int:
+    """``picture()``, the file's primary branch continued from label ``args.label`` in ``column`` (voltage,
+    axial_stretch) at the fixed ``pressure``, written to ``args.output`` (130 on a signal, as ``run``) and said in one
+    line: its points, the range of ``symbol`` and its stop."""
+    written, _, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code
     grown = written["branches"]["primary"]
-    print(f"voltage continuation from label {args.label} at P = {point.pressure:.10g}: {len(grown['pressure'])} "
-          f"points, Φ̄ {grown['voltage'].min():.6g}..{grown['voltage'].max():.6g}, stop {grown['attrs']['stop_code']} "
+    print(f"{column} continuation from label {args.label} at P = {pressure:.10g}: {len(grown['pressure'])} points, "
+          f"{symbol} {grown[column].min():.6g}..{grown[column].max():.6g}, stop {grown['attrs']['stop_code']} "
           f"({grown['attrs']['stop_message']}); written to {args.output}")
     return 0
 

@@ -1,6 +1,8 @@
 """What ``inspect`` shows of a tube's run file (io/tube_file.py): the shape and its parameters, the field, the
 voltage ([electric]; None without), the parameter continued in (``parameter``: "voltage" at ``fixed_pressure`` on a
-voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄), the loading control (its
+voltage continuation, tube/voltage.py, its branch's Φ̄ range and its located points' Φ̄; "axial_stretch" at
+``fixed_pressure`` on a continuation in the held distance of the ends, tube/stretch.py, its λ range and its located
+points' λ), the loading control (its
 stability reading: how many of a branch's points are stable under it; under gas control the amount n = P V of every
 located point), Maxwell's pressure, per branch its points, P and V/V0 ranges, its stop, how many of its points are
 compressed (tube/stability.py), a switched branch's parent label and where it rejoined (``parent``, ``rejoins``),
@@ -19,7 +21,7 @@ import tomllib
 
 import numpy as np
 
-from ..io.tube_file import CREST, HELD_M1, HOOP, VOLTAGE, discretisation
+from ..io.tube_file import CREST, HELD_M1, HOOP, STRETCH, VOLTAGE, discretisation
 from ..scene.tables import parse_stored
 from ..tube.azimuthal import mode_profile
 from ..tube.stability import COMPRESSED
@@ -47,6 +49,8 @@ def summarise_tube(run: dict) -> dict:
                           "pressure": [float(b["pressure"].min()), float(b["pressure"].max())],
                           "volume": [float(b["volume"].min()), float(b["volume"].max())],
                           "voltage": None if VOLTAGE not in b else [float(b[VOLTAGE].min()), float(b[VOLTAGE].max())],
+                          "axial_stretch": None if STRETCH not in b else [float(b[STRETCH].min()),
+                                                                          float(b[STRETCH].max())],
                           "compressed_points": int((b["smallest_stress"] < COMPRESSED).sum()),
                           "unresolved_points": int((b["tail"] > max_error).sum()) if "tail" in b else None,
                           "largest_tail": float(b["tail"].max(initial=0.0)) if "tail" in b else None,
@@ -59,15 +63,16 @@ def summarise_tube(run: dict) -> dict:
     field = scene_field(a["scene_toml"])
     electric = tomllib.loads(a["scene_toml"]).get("electric")
     primary = run["branches"]["primary"]
-    charged = VOLTAGE in primary  # tube/voltage.py: continued in Φ̄ at a fixed P (run, or continue from a label)
+    parameter = "voltage" if VOLTAGE in primary else STRETCH if STRETCH in primary else "pressure"  # P fixed but
+    #                                     in P: tube/voltage.py (run, or continue from a label), tube/stretch.py
     return {"file": run["path"], "kind": "tube", "scene_name": a["scene_name"], "geometry": geometry,
             "field": field, "voltage": None if electric is None else float(electric.get("voltage", 0.0)),
-            "parameter": "voltage" if charged else "pressure",
-            "fixed_pressure": float(primary["pressure"][0]) if charged else None,
+            "parameter": parameter,
+            "fixed_pressure": float(primary["pressure"][0]) if parameter != "pressure" else None,
             "control": control, "degree": a["degree"], "maxwell_pressure": maxwell,
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "surface_branches": _surface_branches(run.get("surface_branches", {}), control),
-            "onset": _onset(run.get("onset")), "interrupted": a["interrupted"] or None,
+            "onset": _onset(run.get("onset"), max_error), "interrupted": a["interrupted"] or None,
             "not_started": [line for line in a["not_started"].split("\n") if line]}
 
 
@@ -137,17 +142,24 @@ def scene_field(toml: str) -> dict:
     return {"M": float(field.get("M", 0.0)), "coils": len(field.get("coils", []))}
 
 
-def _onset(onset: dict | None) -> dict | None:
+def _onset(onset: dict | None, max_error: float) -> dict | None:
+    """The onset curve's ranges, last point, folds (each with its state's Legendre ``tail`` and ``unresolved``:
+    above ``max_error``, solver.max_error) and stop; ``unresolved_points`` and ``largest_tail`` (None in files
+    before the tail is stored)."""
     if onset is None:
         return None
     a = onset["attrs"]
-    return {"parameter": a["parameter"], "q0": a["q0"], "points": len(onset["q"]),
+    tail = onset.get("tail")
+    return {"unresolved_points": None if tail is None else int((tail > max_error).sum()),
+            "largest_tail": None if tail is None else float(tail.max(initial=0.0)),
+            "parameter": a["parameter"], "q0": a["q0"], "points": len(onset["q"]),
             "q": [float(onset["q"].min()), float(onset["q"].max())],
             "pressure": [float(onset["pressure"].min()), float(onset["pressure"].max())],
             "hoop_stretch": [float(onset[HOOP].min()), float(onset[HOOP].max())],
             "last": {"q": float(onset["q"][-1]), "pressure": float(onset["pressure"][-1]),
                      "hoop_stretch": float(onset[HOOP][-1]), "crest_height": float(onset[CREST][-1])},
-            "folds": onset["folds"], "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
+            "folds": [f | {"unresolved": bool(f["tail"] > max_error)} for f in onset["folds"]],
+            "stop_code": a["stop_code"], "stop_message": a["stop_message"]}
 
 
 def _no_maxwell(summary: dict) -> str:
@@ -173,7 +185,8 @@ def _assessed(summary: dict) -> str:
 def format_tube(summary: dict) -> str:
     """Readable summary of ``summarise_tube``."""
     g, p = summary["geometry"], summary["provenance"]
-    held = "free (closed)" if g["axial_stretch"] is None else f"held at {g['axial_stretch']:g} L"
+    held = "free (closed)" if g["axial_stretch"] is None else f"held at {g['axial_stretch']:g} L" + (
+        f" (continued in λ at P = {summary['fixed_pressure']:g})" if summary["parameter"] == STRETCH else "")
     maxwell = _no_maxwell(summary) if summary["maxwell_pressure"] is None else f"{summary['maxwell_pressure']:.10g}"
     lines = [f"file           {summary['file']}",
              f"scene          {summary['scene_name']}",
@@ -199,6 +212,8 @@ def format_tube(summary: dict) -> str:
         lines += ["", f"branch {name}{origin}: {b['points']} points, P {b['pressure'][0]:.6g}..{b['pressure'][1]:.6g}, "
                       f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}"
                       + ("" if b["voltage"] is None else f", Φ̄ {b['voltage'][0]:.6g}..{b['voltage'][1]:.6g}")
+                      + ("" if b["axial_stretch"] is None else
+                         f", λ {b['axial_stretch'][0]:.6g}..{b['axial_stretch'][1]:.6g}")
                       + f", stop {b['stop_code']} ({b['stop_message']})"
                       + ("" if b["stable_points"] is None else
                          f"; {b['stable_points']} stable under {summary['control']} control")
@@ -224,7 +239,7 @@ def format_tube(summary: dict) -> str:
             crest = f"  crest at {s[CREST]:.6g}" if CREST in s else ""
             amount = f"  n = {s['amount']:.10g}" if "amount" in s else ""
             note = f"  {s['note']}" if s["note"] else ""
-            charge = f"  Φ̄ = {s[VOLTAGE]:.10g}" if VOLTAGE in s else ""
+            charge = f"  Φ̄ = {s[VOLTAGE]:.10g}" if VOLTAGE in s else f"  λ = {s[STRETCH]:.10g}" if STRETCH in s else ""
             lines.append(f"  {k:>3} {s['kind']}{block:<5} after point {s['index']:<4} P = {s['pressure']:.10g}  "
                          f"V/V0 = {s['volume']:.8g}{charge}{amount}  {s['status']}{note}{crest}{compressed}")
             if "omega2" in s:
@@ -247,7 +262,9 @@ def format_tube(summary: dict) -> str:
                       f", largest hoop stretch {onset['hoop_stretch'][0]:.6g}..{onset['hoop_stretch'][1]:.6g}, stop "
                       f"{onset['stop_code']} ({onset['stop_message']}); last: {name} = {last['q']:.8g}, "
                       f"P = {last['pressure']:.10g}, hoop stretch {last['hoop_stretch']:.8g}, crest at "
-                      f"{last['crest_height']:.6g}"]
+                      f"{last['crest_height']:.6g}"
+                      + (f"; {onset['unresolved_points']} points unresolved (Legendre tail above solver.max_error, "
+                         f"largest {onset['largest_tail']:.2g})" if onset["unresolved_points"] else "")]
         lines += [f"  fold in {name} at {name} = {f['q']:.10g}, P = {f['pressure']:.10g}  {f['status']}"
-                  for f in onset["folds"]]
+                  + (f"  unresolved (tail {f['tail']:.2g})" if f["unresolved"] else "") for f in onset["folds"]]
     return "\n".join(lines)

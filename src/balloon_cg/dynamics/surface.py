@@ -3,8 +3,10 @@ reading (MODEL.md §8, §11; docs/dynamics.md).
 
 The stability of a surface branch (surface/stability.py) solves H c = μ G c in each symmetry sector of its
 SphericalBasis, H the Hessian of the energy per 2π with moduli over μ/2 (the axisymmetric K's units) and
-G = (1/2π)∫∫|δu|² dA the displacement norm, c·c/2π in the orthonormal harmonics (``SphericalBasis.gram``). The
-membrane's kinetic energy per 2π is (ρ T0 R0⁴) ½ (1/2π)∫∫|δu̇|² dA: G is the mass matrix M of ``pencil``, so each
+G = (1/2π)∫∫|δu|² dA the displacement norm over the reference, c·c/2π in the orthonormal harmonics on the sphere
+(``SphericalBasis.gram``), ``SphericalBasis.mass`` on a spheroid (dA = S' d(cos θ) dφ: surface/stability.py
+``mass_factor``). The membrane's kinetic energy per 2π is (ρ T0 R0⁴) ½ (1/2π)∫∫|δu̇|² dA: G is the mass matrix M
+of ``pencil``, so each
 μ is a ν of K q = ν M q and Ω² = ν/2 (``pencil.PER_EIGENVALUE``), per sector and reading: held or free, under
 pressure (H), volume (H on gᵀc = 0) or gas control (H + (P/Ṽ) g gᵀ), the zero modes removed. At an axisymmetric
 state the sectors even under the mirror y → −y hold the axisymmetric blocks' modes (m = 0 and the cos mφ family

@@ -43,7 +43,7 @@ def symmetric_rows(pairs) -> np.ndarray:
     return rows
 
 
-_HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
+HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output (every axisymmetric layout's)
 # below this many unknowns the node state and the Hessian are computed in jitted loops, from it by BLAS
 # (the loops win while call overhead dominates: Hessian at 17 unknowns 2.0 µs against 7.3 µs, at 29 5.2 against
 # 9.0, at 41 10.6-11.5 against 11.4-12.0, at 49 16-18 against 14-15; node state at 9 0.4 against 1.2, at 29 0.8
@@ -67,12 +67,12 @@ def _weighted_bases(pointwise, weights, A, B):
     for k in range(4):
         for q in range(n_q):
             if k < 2:
-                c0 = pointwise[_HESSIAN_ROW[k, 0], q] * weights[q]
-                c1 = pointwise[_HESSIAN_ROW[k, 1], q] * weights[q]
+                c0 = pointwise[HESSIAN_ROW[k, 0], q] * weights[q]
+                c1 = pointwise[HESSIAN_ROW[k, 1], q] * weights[q]
                 for i in range(n_a):
                     against_a[k, q, i] = c0 * A[0, q, i] + c1 * A[1, q, i]
-            c2 = pointwise[_HESSIAN_ROW[k, 2], q] * weights[q]
-            c3 = pointwise[_HESSIAN_ROW[k, 3], q] * weights[q]
+            c2 = pointwise[HESSIAN_ROW[k, 2], q] * weights[q]
+            c3 = pointwise[HESSIAN_ROW[k, 3], q] * weights[q]
             for i in range(n_b):
                 against_b[k, q, i] = c2 * B[0, q, i] + c3 * B[1, q, i]
     return against_a, against_b
@@ -136,12 +136,12 @@ def _hessian_loops(pointwise, weights, A, B, out):
     partner_b = np.empty((4, nb))
     for q in range(n_q):
         w = weights[q]
-        h00, h01, h11 = (pointwise[_HESSIAN_ROW[0, 0], q] * w, pointwise[_HESSIAN_ROW[0, 1], q] * w,
-                         pointwise[_HESSIAN_ROW[1, 1], q] * w)
-        h02, h03, h12, h13 = (pointwise[_HESSIAN_ROW[0, 2], q] * w, pointwise[_HESSIAN_ROW[0, 3], q] * w,
-                              pointwise[_HESSIAN_ROW[1, 2], q] * w, pointwise[_HESSIAN_ROW[1, 3], q] * w)
-        h22, h23, h33 = (pointwise[_HESSIAN_ROW[2, 2], q] * w, pointwise[_HESSIAN_ROW[2, 3], q] * w,
-                         pointwise[_HESSIAN_ROW[3, 3], q] * w)
+        h00, h01, h11 = (pointwise[HESSIAN_ROW[0, 0], q] * w, pointwise[HESSIAN_ROW[0, 1], q] * w,
+                         pointwise[HESSIAN_ROW[1, 1], q] * w)
+        h02, h03, h12, h13 = (pointwise[HESSIAN_ROW[0, 2], q] * w, pointwise[HESSIAN_ROW[0, 3], q] * w,
+                              pointwise[HESSIAN_ROW[1, 2], q] * w, pointwise[HESSIAN_ROW[1, 3], q] * w)
+        h22, h23, h33 = (pointwise[HESSIAN_ROW[2, 2], q] * w, pointwise[HESSIAN_ROW[2, 3], q] * w,
+                         pointwise[HESSIAN_ROW[3, 3], q] * w)
         for i in range(na):
             a0, a1 = A[0, q, i], A[1, q, i]
             partner_a[0, i] = h00 * a0 + h01 * a1

@@ -32,12 +32,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .discretisation import gauss_nodes, geometric_tail, read_only, symmetric_rows
+from .discretisation import HESSIAN_ROW, gauss_nodes, geometric_tail, read_only
 from .legendre import gauss_rule, legendre_table
-from ..generated import HESSIAN_PAIRS
 from ..scene.tables import Ends
 
-_HESSIAN_ROW = symmetric_rows(HESSIAN_PAIRS)
 CREST_SAMPLES = 401  # the samples of ρ(S) the crest is searched on (``IntervalDiscretisation.crests``)
 CREST_BISECTIONS = 52  # halvings of a sample interval: to the rounding of x ∈ [−1, 1]
 
@@ -140,7 +138,7 @@ class IntervalDiscretisation:
         k = self.axial_index
         columns = (slice(0, k), slice(k, self.size))
         for i, j in ((0, 0), (0, 1), (1, 1)):
-            h = weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]  # (2, 2, n_q): W h_kl of the block
+            h = weighted[HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]  # (2, 2, n_q): W h_kl of the block
             block = self.hessian_block(i, j, h)
             out[columns[i], columns[j]] = block
             if i != j:
@@ -160,7 +158,7 @@ class IntervalDiscretisation:
         change = self.node_state(w)
         if self.ends == Ends.PLUGGED:
             change[0] -= 1.0
-        return self.gradient(np.einsum("klq,lq->kq", pointwise[_HESSIAN_ROW], change))
+        return self.gradient(np.einsum("klq,lq->kq", pointwise[HESSIAN_ROW], change))
 
     def uniform(self, hoop: float, axial: float) -> np.ndarray:
         """u of the uniform tube with sliding ends: λ2 = λθ, η = −λz(S − L/2)."""

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .discretisation import gauss_nodes, geometric_tail, read_only
-from .interval import _HESSIAN_ROW, IntervalDiscretisation
+from .discretisation import HESSIAN_ROW
+from .interval import IntervalDiscretisation
 from .legendre import gauss_rule, legendre_table
 from ..scene.tables import Ends
 
@@ -139,7 +140,7 @@ class ElementInterval(IntervalDiscretisation):
         column if given (a bordered Jacobian's ∂R/∂P): for numerics/newton.SparseFactors."""
         from scipy import sparse  # here: a sphere's `run` imports this module (io/tube_file) but never scipy.sparse
         weighted = pointwise * self.weights
-        blocks = [self._element_blocks(i, j, weighted[_HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]).ravel()
+        blocks = [self._element_blocks(i, j, weighted[HESSIAN_ROW[2 * i: 2 * i + 2, 2 * j: 2 * j + 2]]).ravel()
                   for i, j in ((0, 0), (0, 1), (1, 1))]
         entry, indices, indptr = _sparse_pattern(self)
         data = np.bincount(entry, np.concatenate([blocks[0], blocks[1], blocks[1], blocks[2]]), minlength=indices.size)
@@ -208,21 +209,22 @@ def element_interval(length: float, order: int, bounds, ends: Ends = Ends.SLIDIN
 
 
 def collocated(disc: IntervalDiscretisation, u: np.ndarray, onto: ElementInterval) -> np.ndarray:
-    """u of ``disc`` (a Legendre series or another layout) on the layout ``onto`` of the same tube: λ2 and η's
-    bubble part collocated at order + 1 Gauss points of each of onto's elements and its inner bounds, by least
-    squares (exact where onto's space holds the state: the uniform tube, a layout with elements split or of a
-    higher order)."""
+    """u of ``disc`` (a Legendre series or another layout; one state or rows of states, or of tangents: the map is
+    linear) on the layout ``onto`` of the same tube: λ2 and η's bubble part collocated at order + 1 Gauss points of
+    each of onto's elements and its inner bounds, by least squares (exact where onto's space holds the state: the
+    uniform tube, a layout with elements split or of a higher order)."""
     k, onto_k = disc.axial_index, onto.axial_index
     t, _ = gauss_rule(onto.order + 1)
     edges = onto.edges
     x = np.concatenate([(edges[:-1, None] + 0.5 * np.diff(edges)[:, None] * (t[None, :] + 1.0)).ravel(), edges[1:-1]])
     hoop, _, axial, _ = disc.functions(x)
     onto_hoop, _, onto_axial, _ = onto.functions(x)
-    out = np.empty(onto.size)
-    out[:onto_k] = np.linalg.lstsq(onto_hoop, hoop @ u[:k], rcond=None)[0]
-    out[onto_k] = u[k]
-    out[onto_k + 1:] = np.linalg.lstsq(onto_axial, axial @ u[k + 1:], rcond=None)[0]
-    return out
+    rows = np.atleast_2d(u)
+    out = np.empty((rows.shape[0], onto.size))
+    out[:, :onto_k] = np.linalg.lstsq(onto_hoop, hoop @ rows[:, :k].T, rcond=None)[0].T
+    out[:, onto_k] = rows[:, k]
+    out[:, onto_k + 1:] = np.linalg.lstsq(onto_axial, axial @ rows[:, k + 1:].T, rcond=None)[0].T
+    return out.reshape(np.shape(u)[:-1] + (onto.size,))
 
 
 @functools.lru_cache(maxsize=16)

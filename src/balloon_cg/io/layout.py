@@ -6,6 +6,7 @@ float 'f', int 'iu', bool 'b', str an HDF5 string type.
 """
 import contextlib
 import errno
+import math
 import os
 import stat
 
@@ -46,9 +47,10 @@ MIN_DECLARED = 64 * 1024**2
 
 def check_size(item, where, error=FileError) -> None:
     """``error`` when the dataset ``item`` declares more bytes than its file can hold (the bound above)."""
-    declared = int(np.prod(item.shape, dtype=object) or 0) * item.dtype.itemsize
+    shape = item.shape
+    declared = (math.prod(shape) if shape is not None else 0) * item.dtype.itemsize
     try:
-        size = item.file.id.get_filesize()
+        size = h5py.h5i.get_file_id(item.id).get_filesize()  # not item.file: it builds a File each time
     except (OSError, RuntimeError, ValueError):
         size = 0
     if declared > max(MIN_DECLARED, DECLARED_PER_FILE_BYTE * size):
@@ -69,12 +71,14 @@ def can_checksum(dtype, size: int) -> bool:
     return size > 0 and h5py.check_string_dtype(dtype) is None and dtype.kind in "biuf"
 
 
-def stored_objects(group, path, error=FileError):
-    """Every group and dataset below ``group``, depth first, reached by hard links only: a soft or external link,
-    a named datatype, a virtual dataset (its data in other files, read as fill values when they are missing) or
-    a dataset stored in external files is ``error`` naming it (balloon-cg writes none of them)."""
+def stored_objects(group, path, error=FileError, prefix: str | None = None):
+    """(the path it was reached by, it) for every group and dataset below ``group`` (at the path ``prefix``, default
+    its name), depth first, reached by hard links only: a soft or external link, a named datatype, a virtual dataset
+    (its data in other files, read as fill values when they are missing) or a dataset stored in external files is
+    ``error`` naming it (balloon-cg writes none of them)."""
+    prefix = group.name.rstrip("/") if prefix is None else prefix
     for name in group:
-        where = f"{group.name.rstrip('/')}/{name}"
+        where = f"{prefix}/{name}"
         with naming(where, path, error):
             link = group.get(name, getlink=True)
             if not isinstance(link, h5py.HardLink):
@@ -85,9 +89,9 @@ def stored_objects(group, path, error=FileError):
                                   "(refused: a balloon-cg file holds its own data)")
             if not isinstance(item, (h5py.Group, h5py.Dataset)):
                 raise error(path, f"{where} is a {type(item).__name__}, not a group or a dataset")
-        yield item
+        yield where, item
         if isinstance(item, h5py.Group):
-            yield from stored_objects(item, path, error)
+            yield from stored_objects(item, path, error, where)
 
 
 @contextlib.contextmanager
@@ -106,16 +110,16 @@ def check_data(group, path, error=FileError, finite=frozenset()) -> None:
     """Read every dataset below ``group`` once (``stored_objects``; the declared size bounded first,
     ``check_size``): a checksum that does not match (HDF5's Fletcher32 filter) or a damaged chunk is ``error``
     naming the dataset, and so is NaN or inf in a float dataset whose name is in ``finite``."""
-    for item in stored_objects(group, path, error):
+    for where, item in stored_objects(group, path, error):
         if not isinstance(item, h5py.Dataset):
             continue
-        with naming(f"dataset {item.name}", path, error):
+        with naming(f"dataset {where}", path, error):
             check_size(item, path, error)
             data = item[()]
-        name = item.name.rsplit("/", 1)[-1]
+        name = where.rsplit("/", 1)[-1]
         if name in finite and item.dtype.kind == "f" and not np.isfinite(data).all():
             bad = np.argwhere(~np.isfinite(np.atleast_1d(data)))[0]
-            raise error(path, f"dataset {item.name} holds NaN or inf (at {tuple(int(i) for i in bad)}), a "
+            raise error(path, f"dataset {where} holds NaN or inf (at {tuple(int(i) for i in bad)}), a "
                               "quantity that is always finite")
 
 

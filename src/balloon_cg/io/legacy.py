@@ -19,12 +19,12 @@ def old_datasets(f) -> list[str]:
     """The paths of the datasets of ``f`` stored under an old name (and not also under the new one)."""
     found = []
 
-    def visit(name, item):
+    def visit(name):  # by name: only an old name's object is opened
         base = name.rsplit("/", 1)[-1]
-        if isinstance(item, h5py.Dataset) and base in OLD_NAMES and OLD_NAMES[base] not in item.parent:
+        if base in OLD_NAMES and isinstance(item := f[name], h5py.Dataset) and OLD_NAMES[base] not in item.parent:
             found.append(name)
 
-    f.visititems(visit)
+    f.visit(visit)
     return found
 
 

@@ -919,13 +919,16 @@ def check_coordinates(group, where, error) -> None:
     """Every dimension scale below ``group`` that repeats one of an enclosing group's (``schema.coordinates``:
     written since issue 40, absent before) holds the same values as that one."""
     scales = []
-    group.visititems(lambda name, item: scales.append(item) if isinstance(item, h5py.Dataset) and item.is_scale
-                     else None)
-    for item in scales:
-        name, outer = item.name.rsplit("/", 1)[-1], item.parent.parent
-        while outer.name != group.parent.name and not isinstance(outer.get(name), h5py.Dataset):
-            outer = outer.parent
-        repeated = outer.get(name)
+    group.visititems(lambda path, item: scales.append((path, item)) if isinstance(item, h5py.Dataset) and
+                     item.is_scale else None)
+    top = group.parent
+    for path, item in scales:
+        *groups, name = path.split("/")
+        # the enclosing groups from the scale's grandparent out to group.parent, by paths within ``group`` (h5py's
+        # ``parent`` looks each one up again from the file's root)
+        outers = [group["/".join(groups[:k])] if k else group for k in range(len(groups) - 1, -1, -1)] + [top]
+        repeated = next((found for outer in outers if isinstance(found := outer.get(name), h5py.Dataset)),
+                        top.get(name))
         if isinstance(repeated, h5py.Dataset) and repeated.is_scale and not np.array_equal(repeated[()], item[()]):
             raise error(where, f"dataset {item.name} does not repeat {repeated.name}, the coordinate it stands for")
 

@@ -199,20 +199,22 @@ def check_described(group, path, error) -> None:
     from .layout import can_checksum, naming
 
     items = []
-    group.visititems(lambda name, item: items.append(item) if isinstance(item, h5py.Dataset) else None)
-    for item in items:
+    group.visititems(lambda name, item: items.append((name, item)) if isinstance(item, h5py.Dataset) else None)
+    prefix = group.name.rstrip("/")
+    for where, item in items:
+        where = f"{prefix}/{where}"  # the path it was reached by (not item.name: HDF5 searches for a name)
         if can_checksum(item.dtype, item.size) and not item.fletcher32:
-            raise error(path, f"dataset {item.name} has no Fletcher32 checksum (every dataset of this file has: "
+            raise error(path, f"dataset {where} has no Fletcher32 checksum (every dataset of this file has: "
                               "rewritten after it was written)")
-        name = item.name.rsplit("/", 1)[-1]
-        with naming(f"dataset {item.name}", path, error):  # a damaged attribute (CLASS) is not a datatype
+        name = where.rsplit("/", 1)[-1]
+        with naming(f"dataset {where}", path, error):  # a damaged attribute (CLASS) is not a datatype
             is_scale = h5py.h5ds.is_scale(item.id)
             keys = set(item.attrs)
         units = (LOWEST if name.startswith("lowest_") else VARIABLES.get(name, (COUNT,)))[0]
-        scale_needs = SCALE_ATTRIBUTES + (() if stands_alone(item) else ("REFERENCE_LIST",))
-        needed = (scale_needs if is_scale else ("DIMENSION_LIST",) if item.ndim else ()) + (
+        scale_needs = (() if stands_alone(item) else ("REFERENCE_LIST",)) if is_scale else ()
+        needed = (SCALE_ATTRIBUTES + scale_needs if is_scale else ("DIMENSION_LIST",) if item.ndim else ()) + (
             "long_name", "description") + (("units",) if units else ())
         missing = [key for key in needed if key not in keys]
         if missing:
-            raise error(path, f"dataset {item.name} is missing its attribute{'s' if len(missing) > 1 else ''} "
+            raise error(path, f"dataset {where} is missing its attribute{'s' if len(missing) > 1 else ''} "
                               f"{', '.join(missing)}")

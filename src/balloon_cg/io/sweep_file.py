@@ -39,6 +39,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..analysis.verdict import Gap
 from ..numerics import interrupt
 from .hdf5 import atomic_file, checksummed, copy_attrs, copy_tree, plain, provenance, write_strings
 from .output import store_path
@@ -224,7 +225,7 @@ def _open_existing(directory: Path, attrs: dict, members: list, path: Path) -> S
         try:
             with _open(item) as f:
                 require_attrs(f.attrs, item, MEMBER_KEYS)
-                stored = plain(f.attrs["scene_hash"])
+                stored, cut = plain(f.attrs["scene_hash"]), interrupted(f.attrs)
         except SweepFileError:
             item.unlink()  # not a whole member (atomic writes leave none such): computed again
             continue
@@ -232,10 +233,17 @@ def _open_existing(directory: Path, attrs: dict, members: list, path: Path) -> S
             raise SweepError(f"{item}: member {index} ({m.label}) was computed for another scene "
                              f"(scene_hash {str(stored)[:12]}… in the file, {m.scene_hash[:12]}… now); "
                              "use --force to replace it")
-        done[index] = item
+        if not cut:  # a member a signal cut short is computed again (its file is replaced when it is)
+            done[index] = item
     for name in [MANIFEST, *(f"{i:06d}.h5" for i in expected)]:
         remove_debris(directory / name)
     return Store(directory, done)
+
+
+def interrupted(attrs) -> bool:
+    """Whether a member's attributes say a signal cut its computation short (analysis.verdict's ``interrupted``
+    gap): what it holds is not the member."""
+    return Gap.INTERRUPTED.value in [plain(gap) for gap in attrs.get("incomplete_gaps", [])]
 
 
 def _import(path: Path, directory: Path, attrs: dict, members: list) -> Store:
@@ -255,6 +263,8 @@ def _import(path: Path, directory: Path, attrs: dict, members: list) -> Store:
             if plain(group.attrs.get("scene_hash")) != m.scene_hash:
                 raise SweepError(f"{path}: member {name} ({m.label}) was computed for another scene; "
                                  "use --force to replace the file")
+            if interrupted(group.attrs):
+                continue  # cut short by a signal: computed again
             target = store.member_file(m.index)
             with atomic_file(target, force=True) as out:
                 copy_tree(group, out)
@@ -322,7 +332,9 @@ def rebuilding(path, directory: Path, trusted=frozenset(), kept: bool = True):
     with interrupt.Held() as held:
         try:
             with atomic_file(path, force=True, keep_store=True) as f:
-                view = View(f, path, directory, trusted)
+                with interrupt.Held() as early:  # the stored members' copy: a signal raised after it, not in h5py
+                    early.start()
+                    view = View(f, path, directory, trusted)
                 view.kept = kept
                 try:
                     yield view

@@ -15,7 +15,8 @@ the largest radius, the bulge's crest, from the tube's middle plane: IntervalDis
 ``first_integral_spread`` (the state's Legendre tail and the spread of H = λ1Φ_1 − Φ along the tube: tube/accuracy.py;
 files before them have none), ``lowest_even``/
 ``lowest_odd`` (the mirror blocks' lowest eigenvalues, on the primary branch), on a voltage continuation (tube/voltage.py:
-P fixed) ``voltage`` (Φ̄, also per located point), with stability.m_max ≥ 1 ``lowest_m<m>``
+P fixed) ``voltage`` (Φ̄, also per located point), on a continuation in the held distance of the ends (tube/stretch.py: P
+fixed) ``axial_stretch`` (λ, each state's λ̄, also per located point), with stability.m_max ≥ 1 ``lowest_m<m>``
 (n, 3) and ``unstable_m<m>`` for m = 1..m_max (tube/azimuthal.py; the branch's attribute ``m_max``, 0 or absent: m ≥ 1
 not assessed; in a coil's field on sliding ends also ``lowest_m1_held``, ``unstable_m1_held``: the held tube's m = 1
 block, the translation removed; the free one's is ``lowest_m1``), the located zeros of their eigenvalues under
@@ -29,8 +30,9 @@ label of the branch point it was born at) and ``rejoins_label`` (where it rejoin
 before them have none). A ``critical`` run adds
 /onset (tube/onset.py: the first odd branch point followed in the parameter ``parameter`` from ``q0``): per point
 ``q``, ``pressure``, ``volume``, ``crest_height``, ``unknowns`` and ``modes`` (the odd null vector; read back with
-``hoop_stretch``, the largest radius ρ of each state, from its unknowns); its folds in q
-under folds/ (``q``, ``pressure``, ``status``); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
+``hoop_stretch``, the largest radius ρ of each state, from its unknowns) and ``tail`` (each state's Legendre tail:
+files before it have none); its folds in q under folds/ (``q``, ``pressure``, ``status``, ``tail``: files before it
+have none, read as NaN); ``stop_code``, ``stop_message``. ``interrupted``: the stage a signal
 stopped (tube/picture.Stage: ``primary``, ``bulge``, ``onset``; its branch or curve ends ``interrupted`` where it had
 started, and is absent where it had not; ``modes``: the branches whole, no m ≥ 1 blocks; ``frequencies``: the branches
 whole, the frequencies of the branches finished before the signal only), "" where the work is whole (files before it have none: read as "").
@@ -69,6 +71,7 @@ CURVE_COLUMNS = ("q", "pressure", "volume", CREST)
 HOOP = "hoop_stretch"  # the onset curve's largest radius per point (read back from its unknowns: crest_hoops)
 SPECIAL_TEXT = ("kind", "block", "status")
 VOLTAGE = "voltage"  # per point and located point of a voltage continuation (tube/voltage.py; others have none)
+STRETCH = "axial_stretch"  # per point and located point of a continuation in λ (tube/stretch.py; others have none)
 NOTE = "note"  # per located point: a UZ point's event (files before tube events have none: read as "")
 AZIMUTHAL_LIMIT = 8  # the largest stability.m_max (scene/tables.py)
 MODES = "critical_modes"  # per located m ≥ 1 zero: its eigenvector (files before it have none)
@@ -108,6 +111,8 @@ TUBE_VARIABLES = {
     "value": ("1", "eigenvalue there", "the located eigenvalue at the located state (0 to the location's accuracy)"),
     "kind": ("", "located point kind", "LP fold in P, LV fold in V, BP branch point, UZ an event's value reached"),
     VOLTAGE: ("1", "voltage Φ̄", "a voltage continuation's Φ̄ (tube/voltage.py: P fixed), per point and located point"),
+    STRETCH: ("1", "held axial stretch λ", "a continuation in the held distance of the ends' λ (tube/stretch.py: P "
+              "fixed), the ends at λL; per point and located point"),
     NOTE: ("", "event", "a UZ point's event, quantity = value (tube/events.py); empty for the others"),
     "block": ("", "mirror block", "the block of a BP whose eigenvalue vanishes (even, odd)"),
     "status": ("", "location status", "located or nearest"),
@@ -188,6 +193,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
             checksummed(group, column, values)
         if branch.voltage is not None:
             checksummed(group, VOLTAGE, branch.voltage)
+        if branch.stretched:
+            checksummed(group, STRETCH, branch.held_stretch())
         for block, values in branch.lowest.items():
             checksummed(group, f"lowest_{block.value}", values)
         modes = None if picture.modes is None else picture.modes[name]
@@ -214,6 +221,8 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
         checksummed(special, "smallest_stress", np.array([p.smallest_stress for p in s], dtype=float))
         if branch.voltage is not None:
             checksummed(special, VOLTAGE, np.array([p.voltage for p in s], dtype=float))
+        if branch.stretched:
+            checksummed(special, STRETCH, np.array([p.u[branch.disc.axial_index] for p in s], dtype=float))
         checksummed(special, CREST, crest_heights(branch.disc, [p.u for p in s]))
         checksummed(special, "unknowns", np.array([p.u for p in s], dtype=float).reshape(len(s), branch.disc.size))
         _dimensions(group, "point", {"unknown": branch.disc.size} | ({} if modes is None else {"eigenvalue": COUNT}))
@@ -274,10 +283,11 @@ def _write_onset(group, curve) -> None:
                         "stop_message": curve.stop.message})
     for column, values in (("q", curve.q), ("pressure", curve.pressure), ("volume", curve.volume),
                            (CREST, crest_heights(curve.disc, curve.states)), ("unknowns", curve.states),
-                           ("modes", curve.modes)):
+                           ("modes", curve.modes), ("tail", curve.tail)):
         checksummed(group, column, values)
     folds = group.create_group("folds")
     checksummed(folds, "q", np.asarray(curve.fold_q, dtype=float))
+    checksummed(folds, "tail", np.asarray(curve.fold_tail, dtype=float))
     checksummed(folds, "pressure", np.array([p.pressure for p in curve.folds], dtype=float))
     write_strings(folds, "status", [p.status.value for p in curve.folds])
     _dimensions(group, "point", {"unknown": curve.states.shape[1], "mode": curve.modes.shape[1]})
@@ -311,7 +321,7 @@ def read_tube(f, path, where: str = "") -> dict:
             raise TubeFileError(path, f"{where}/branches/{name}: missing {', '.join(missing)}")
         branch = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}, "unknowns": group["unknowns"][()]}
         n = branch["unknowns"].shape[0]
-        optional = tuple(c for c in (CREST, GAS, VOLTAGE, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror))
+        optional = tuple(c for c in (CREST, GAS, VOLTAGE, STRETCH, *ACCURACY, *(f"lowest_{b.value}" for b in Mirror))
                          if c in group)
         for column in POINT_COLUMNS + optional:
             branch[column] = group[column][()]
@@ -321,7 +331,7 @@ def read_tube(f, path, where: str = "") -> dict:
         special = group["special_points"]
         columns = {c: list(special[c].asstr()[()]) for c in SPECIAL_TEXT}
         columns[NOTE] = list(special[NOTE].asstr()[()]) if NOTE in special else [""] * len(columns["kind"])
-        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + tuple(c for c in (CREST, VOLTAGE) if c in special)}
+        columns |= {c: special[c][()] for c in SPECIAL_NUMBERS + tuple(c for c in (CREST, VOLTAGE, STRETCH) if c in special)}
         branch["special_points"] = [{c: plain(v[i]) for c, v in columns.items()}
                                     for i in range(len(columns["kind"]))]
         branch["azimuthal"] = _read_modes(path, group, n, f"{where}/branches/{name}")
@@ -394,14 +404,15 @@ def _read_onset(path, group, disc: IntervalDiscretisation) -> dict:
         raise TubeFileError(path, f"/onset: missing {', '.join(missing)}")
     onset = {"attrs": {k: _text(plain(v)) for k, v in group.attrs.items()}}
     n = group["q"].shape[0]
-    for column in (*CURVE_COLUMNS, "unknowns", "modes"):
+    for column in (*CURVE_COLUMNS, "unknowns", "modes", *(["tail"] if "tail" in group else [])):
         onset[column] = group[column][()]
         if onset[column].shape[0] != n:
             raise TubeFileError(path, f"/onset/{column}: {onset[column].shape[0]} rows, expected {n}")
     folds = group["folds"]
     status = list(folds["status"].asstr()[()])
-    onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s}
-                      for q, p, s in zip(folds["q"][()], folds["pressure"][()], status)]
+    tails = folds["tail"][()] if "tail" in folds else [math.nan] * len(status)  # files before it have none
+    onset["folds"] = [{"q": float(q), "pressure": float(p), "status": s, "tail": float(t)}
+                      for q, p, s, t in zip(folds["q"][()], folds["pressure"][()], status, tails)]
     onset[HOOP] = crest_hoops(disc, onset["unknowns"])
     return onset
 
@@ -424,7 +435,8 @@ def stored_branch(run: dict, name: str, params) -> IntervalBranch:
     parent = (attrs["parent_branch"], int(attrs["parent_label"])) if "parent_label" in attrs else None
     rejoins = int(attrs["rejoins_label"]) if attrs.get("rejoins_label", -1) >= 0 else None
     return IntervalBranch(discretisation(run["attrs"], b["attrs"]), b["unknowns"], b["pressure"], b["volume"], lowest,
-                          unstable, special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), parent=parent,
+                          unstable, special, stop, b["smallest_stress"], params, voltage=b.get(VOLTAGE), stretched=STRETCH in b,
+                          parent=parent,
                           rejoins=rejoins)
 
 

@@ -10,9 +10,13 @@ bulge's middle.
 
 A front joins a bulged part (ρ high) to an unbulged one (ρ low). Its position is the distance z where ρ crosses the
 mid level (ρ_max + ρ_min)/2, its width w = (ρ_max − ρ_min)/max|dρ/dz|: for ρ = c + b tanh((z − z_f)/δ) the
-position z_f and the width 2δ. A profile has a front only where it crosses its mid level once (a bump at a coil in
-the middle crosses it twice: two fronts, none singled out) and the front is narrower than each part it joins: the
-parts, the profile beyond half a width on either side of z_f, each at least w long (z_f ± 1.5 w inside the tube).
+position z_f and the width 2δ. A profile has a front where it crosses its mid level once or twice, and the front is
+narrower than each part it joins: the parts, the profile beyond half a width on either side of z_f, each at least w
+long. Once: z_f ± 1.5 w inside the tube. Twice (a bulge in the middle, or a neck: two fronts, mirror images on a
+mirror-symmetric state): the front is the crossing nearest the first sample (S = 0 in ``fronts``), its width from
+the slopes up to halfway to the other crossing, its parts the profile from that end (at least 1.5 w from z_f) and
+the profile between the crossings (at least 2 w from z_f to the other: a bump narrower than that, such as a coil's
+bulge on its way up, has none).
 Near a bulge's onset the profile is the mode cos(πS/L) over the whole tube, its mid-level crossing at the middle
 with a width 2ℓ/π (ℓ the deformed length), which shrinks to a front's as the bulge localises while V/V0 hardly
 changes: drawn against V/V0 that was a spike, and it is no front (nor, in a coil's field, the bump at the coil on
@@ -51,9 +55,9 @@ def stretches(disc, u: np.ndarray, s: np.ndarray) -> tuple:
 
 def front(z: np.ndarray, rho: np.ndarray) -> Front:
     """The front of the profile ρ(z) sampled at increasing or decreasing z (module docstring): the mid-level crossing
-    by linear interpolation between the two samples that bracket it, the largest slope by central differences
-    (np.gradient). None (position and width NaN) where the profile is uniform (ρ_max − ρ_min ≤ 1e-12 ρ_max), crosses
-    its mid level more than once, or leaves a part shorter than the width (module docstring)."""
+    (the first of two) by linear interpolation between the two samples that bracket it, the largest slope by central
+    differences (np.gradient). None (position and width NaN) where the profile is uniform (ρ_max − ρ_min ≤ 1e-12
+    ρ_max), crosses its mid level more than twice, or leaves a part shorter than the width (module docstring)."""
     z, rho = np.asarray(z, dtype=float), np.asarray(rho, dtype=float)
     high, low = rho.max(), rho.min()
     none = Front(np.nan, np.nan, float(low), float(high))
@@ -61,13 +65,14 @@ def front(z: np.ndarray, rho: np.ndarray) -> Front:
         return none
     middle = 0.5 * (high + low)
     crossings = np.flatnonzero(np.diff(rho >= middle))
-    if crossings.size != 1:
+    if crossings.size not in (1, 2):
         return none
-    j = crossings[0]
-    i = j + 1
-    position = z[j] + (middle - rho[j]) * (z[i] - z[j]) / (rho[i] - rho[j])
-    width = (high - low) / np.abs(np.gradient(rho, z)).max()
-    if not (z.min() + 1.5 * width <= position <= z.max() - 1.5 * width):
+    position, *other = (z[j] + (middle - rho[j]) * (z[j + 1] - z[j]) / (rho[j + 1] - rho[j]) for j in crossings)
+    half = slice(None) if not other else slice(0, (crossings[0] + crossings[1]) // 2 + 1)
+    width = (high - low) / np.abs(np.gradient(rho, z)[half]).max()
+    if not other and not z.min() + 1.5 * width <= position <= z.max() - 1.5 * width:
+        return none
+    if other and (abs(position - z[0]) < 1.5 * width or abs(other[0] - position) < 2 * width):
         return none
     return Front(float(position), float(width), float(low), float(high))
 

@@ -129,8 +129,9 @@ def profiles(ax, run: dict, name: str, points=None) -> None:
 def front_motion(ax, run: dict, name: str, points=None) -> None:
     """The front of branch ``name``'s profiles at ``points`` (default: every point) against V/V0, as
     tube_measures.front measures it: its position z_f, the distance along the deformed axis from the end S = 0
-    (left axis), and its width w (right axis); the points whose profile has no front (uniform, a bump, or a front
-    wider than either part: near the onset) are not drawn, their V/V0 range shaded "no front"; a branch with no front
+    (left axis), and its width w (right axis); of a bulge in the middle or at both ends (two fronts) the one nearest
+    S = 0; the points whose profile has no front (uniform, a bump, or a front wider than either part: near the
+    onset) are not drawn, their V/V0 range shaded "no front"; a branch with no front
     at any of them has none to draw (TubePlotError)."""
     b = run["branches"][name]
     chosen = _chosen(len(b["pressure"]), name, points, len(b["pressure"]))

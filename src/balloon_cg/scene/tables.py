@@ -290,18 +290,13 @@ def default_surface(shape, field, electric, stability) -> Surface:
     return Surface(branches="none") if shape == Shape.TUBE and not built else Surface()
 
 
-def _surface_reads(surface: Surface, shape, stability, dynamics) -> None:
+def _surface_reads(surface: Surface, shape, stability) -> None:
     """SceneError for [surface] branches asked where none can be traced: on a capsule (a run would locate its m ≥ 1
     branch points and end incomplete, each branch not started), on a tube without the m ≥ 1 zeros
-    they start from (stability.m_max = 0; tube/surface/branch.py); on a spheroid with natural frequencies (its
-    branches' eigenvalues are read in the sphere's displacement norm, not in the spheroid's kinetic energy:
-    surface/stability.py)."""
+    they start from (stability.m_max = 0; tube/surface/branch.py)."""
     if surface.branches == "none":
         return
     asked = f"surface.branches = {show(surface.branches)}"
-    if shape == Shape.SPHEROID and dynamics.frequencies:
-        raise SceneError(f"{asked}: a spheroid's surface branches have no natural frequencies yet (their "
-                         'eigenvalues are in the sphere\'s norm); allowed: "none" with dynamics.frequencies = true')
     if shape in UNTRACED_SURFACES:
         raise SceneError(f"{asked}: the non-axisymmetric branches are traced on a sphere, a spheroid and a tube, "
                          f'not on a {shape.value} (its m ≥ 1 branch points are located); allowed: "none"')
@@ -620,7 +615,7 @@ def startable(scene: Scene) -> Scene:
     new input (``parse_scene``, ``load_scene``, ``Scene.with_overrides``) and where ``continue`` starts from a file's
     scene; not on a file's stored text (``parse_stored``)."""
     _stop_volume_above_reference(scene.continuation.stop_volume, scene.geometry)
-    _surface_reads(scene.surface, scene.geometry.shape, scene.stability, scene.dynamics)
+    _surface_reads(scene.surface, scene.geometry.shape, scene.stability)
     return scene
 
 

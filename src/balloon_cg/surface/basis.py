@@ -383,8 +383,28 @@ class SphericalBasis:
         return out
 
     def gram(self) -> float:
-        """The displacement norm (1/2π)∫∫|δu|² dA in these coefficients: c·c/(2π) (the basis is orthonormal)."""
+        """The sphere's displacement norm (1/2π)∫∫|δu|² d(cos θ) dφ in these coefficients: c·c/(2π) (the basis is
+        orthonormal); on a spheroid the norm over its reference area is ``mass``."""
         return 1.0 / (2.0 * np.pi)
+
+    def mass(self) -> np.ndarray:
+        """M with cᵀMc = (1/2π)∫∫|δu|² dA over the reference, dA = S' d(cos θ) dφ (the kinetic energy per 2π over
+        ½ρT0R0⁴: dynamics/pencil.py), by the Hessian's quadrature: Σ_k τ_{m,t}(φ_k) τ_{m',t'}(φ_k) = N_φ/(2π) δ
+        exactly on N_φ > 2M uniform nodes, so M is block-diagonal, per block
+
+            M_b[l, l'] = (1/2π) Σ_j w_j S'(θ_j) P̃_l(θ_j) P̃_l'(θ_j)    (w_j the θ-weights, P̃ the block's θ-functions);
+
+        gram()·I on the sphere (S' = 1: the basis is orthonormal in that quadrature)."""
+        M = np.zeros((self.size, self.size))
+        if self.aspect == 1.0:
+            M[np.diag_indices(self.size)] = self.gram()
+            return M
+        nodes = self.nodes
+        root = np.sqrt(nodes["weights"] * self.n_phi * nodes["rate"] * self.gram())[:, None]
+        for b, theta in zip(self.blocks, self.tables["theta"]):
+            scaled = root * theta[0]
+            M[b.slice, b.slice] = scaled.T @ scaled  # exactly symmetric (BLAS syrk)
+        return M
 
 
 @functools.lru_cache(maxsize=16)

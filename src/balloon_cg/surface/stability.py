@@ -1,5 +1,7 @@
 """Stability of a whole-sphere state: the lowest eigenvalues μ of the second variation, H c = μ G c with G the
-displacement norm (1/2π)∫∫|δu|² dA (analysis/stability/azimuthal.py uses the same, so the spectra compare), on the
+displacement norm (1/2π)∫∫|δu|² dA over the reference (``mass_factor``: gram·I in the orthonormal harmonics on the
+sphere, ``SphericalBasis.mass`` with the area element S' d(cos θ) dφ on a spheroid; the kinetic energy's mass matrix,
+so μ/2 = Ω²: dynamics/surface.py; analysis/stability/azimuthal.py uses the same, so the spectra compare), on the
 G-orthogonal complement of the state's exact zero modes, in each symmetry sector of the state's basis
 (SphericalBasis.sectors: together the whole space), for a balloon held at its centre or free, under each control
 (a ``Reading``), as analysis/stability/axisymmetric.py for axisymmetric modes:
@@ -19,6 +21,7 @@ Zero modes removed (MODEL.md §8), at the state x:
 A vector that vanishes in a sector is not in it; dependent ones (a rotation and a relabelling on a sphere) are
 fine (numerics.eigen.restricted drops them).
 """
+import functools
 from dataclasses import replace
 from typing import NamedTuple
 
@@ -122,17 +125,17 @@ def sector_matrices(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, r
     share it (``_sectors``); ``only``: the characters of the sectors wanted (default all)."""
     for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only):
         for (_, control), (rows, shared) in groups.items():
-            yield sector.characters, tuple(shared), _reading_matrix(H, sector.gram(), rows, control, g, weight)
+            yield sector.characters, tuple(shared), _reading_matrix(H, mass_factor(sector), rows, control, g, weight)
 
 
-def _reading_matrix(H, gram: float, rows, control: Control, g, weight) -> np.ndarray:
+def _reading_matrix(H, mass: eigen.GramFactor, rows, control: Control, g, weight) -> np.ndarray:
     """The standard matrix of one reading (module docstring): H without the zero modes ``rows``, on gᵀc = 0 under
     volume control, H + (P/Ṽ) g gᵀ under gas control."""
     if control == Control.VOLUME:
-        return _restricted(H, gram, rows, g)
+        return _restricted(H, mass, rows, g)
     if control == Control.GAS:
-        return _restricted(H + weight * np.outer(g, g), gram, rows)
-    return _restricted(H, gram, rows)
+        return _restricted(H + weight * np.outer(g, g), mass, rows)
+    return _restricted(H, mass, rows)
 
 
 def restricted_sectors(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, readings=PRESSURE_READINGS,
@@ -163,15 +166,15 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
     out = {r: {} for r in readings}
     for sector, H, g, groups, weight in _sectors(eq, c, params, readings, only, within):
         interrupt.check()
-        key, gram = sector.characters, sector.gram()
+        key, mass = sector.characters, mass_factor(sector)
         previous = [guesses[r][key][0] for r in readings if guesses and key in guesses.get(r, {})]
         base_rows = min((rows for rows, _ in groups.values()), key=len)
         shifted = None
         if previous and H.shape[0] - eigen.rank_of(base_rows) >= eigen.FOLLOWING_SIZE:
-            shifted = eigen.ShiftInvert.below(_restricted(H, gram, base_rows), float(min(previous)))
+            shifted = eigen.ShiftInvert.below(_restricted(H, mass, base_rows), float(min(previous)))
         relatives = {}  # the readings read through the factorisation, in lockstep
         for group, (rows, _) in groups.items() if shifted is not None else ():
-            relative = _relative(H, gram, base_rows, rows, group[1], g, weight)
+            relative = _relative(H, mass, base_rows, rows, group[1], g, weight)
             if relative is not None:
                 relatives[group] = relative
         found = {} if not relatives else dict(zip(relatives, shifted.lowest_of_relatives(
@@ -180,7 +183,7 @@ def sector_spectra(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters, co
             values = found.get(group)
             if values is None:
                 interrupt.check()
-                values = eigen.lowest_of(_reading_matrix(H, gram, rows, group[1], g, weight), count)
+                values = eigen.lowest_of(_reading_matrix(H, mass, rows, group[1], g, weight), count)
             for r in shared:
                 out[r][key] = values
     return out
@@ -197,20 +200,18 @@ def sub_basis(sector: SphericalBasis, degree: int, order: int) -> SphericalBasis
     return replace(sector, degree=degree, order=order)
 
 
-def _relative(H, gram: float, base_rows, rows, control: Control, g, weight):
+def _relative(H, mass: eigen.GramFactor, base_rows, rows, control: Control, g, weight):
     """(constraints, update) of one reading in the coordinates of the matrix without the zero modes ``base_rows``
     (``sector_spectra``: ``eigen.ShiftInvert.lowest``'s arguments), or None where its matrix is small (solved
     dense, as lowest_following would)."""
-    diagonal = np.full(H.shape[0], gram)
-    factor = eigen.GramFactor(diagonal, orthogonal=True)
-    normals = base_rows * diagonal
-    extra = np.vstack([rows * diagonal] + ([g[None, :]] if control == Control.VOLUME else []))
-    if H.shape[0] - eigen.rank_of(factor.directions(extra)) < eigen.FOLLOWING_SIZE:
+    normals = mass.weighed(base_rows)
+    extra = np.vstack([mass.weighed(rows)] + ([g[None, :]] if control == Control.VOLUME else []))
+    if H.shape[0] - eigen.rank_of(mass.directions(extra)) < eigen.FOLLOWING_SIZE:
         return None
-    constraints = eigen.restricted_rows(factor, normals, extra) if extra.size else None
+    constraints = eigen.restricted_rows(mass, normals, extra) if extra.size else None
     update = None
     if control == Control.GAS:
-        u = eigen.restricted_rows(factor, normals, g[None, :])
+        u = eigen.restricted_rows(mass, normals, g[None, :])
         update = (u[0], weight) if len(u) else None
     return constraints, update
 
@@ -226,15 +227,33 @@ def lowest_over(sectors: dict, count: int) -> np.ndarray:
     return np.sort(np.concatenate(list(sectors.values())))[:count]
 
 
-def _restricted(H: np.ndarray, gram: float, rows: np.ndarray, normal: np.ndarray | None = None) -> np.ndarray:
-    """The standard matrix of (H, gram·I) on the G-orthogonal complement of the coefficient vectors ``rows`` and,
-    given, on normalᵀc = 0 (numerics.eigen.restricted; the basis is orthonormal, so G = gram·I)."""
-    diagonal = np.full(H.shape[0], gram)
-    factor = eigen.GramFactor(diagonal, orthogonal=True)
-    normals = [rows * diagonal] if rows.size else []
+def _restricted(H: np.ndarray, mass: eigen.GramFactor, rows: np.ndarray,
+                normal: np.ndarray | None = None) -> np.ndarray:
+    """The standard matrix of (H, G) on the G-orthogonal complement of the coefficient vectors ``rows`` and, given,
+    on normalᵀc = 0 (numerics.eigen.restricted), G = LLᵀ the factor ``mass`` (``mass_factor``)."""
+    normals = [mass.weighed(rows)] if rows.size else []
     if normal is not None:
         normals.append(normal[None, :])
-    return eigen.restricted(H, factor, np.vstack(normals) if normals else eigen.NO_CONSTRAINT)
+    return eigen.restricted(H, mass, np.vstack(normals) if normals else eigen.NO_CONSTRAINT)
+
+
+@functools.lru_cache(maxsize=8)
+def mass_factor(sector: SphericalBasis) -> eigen.GramFactor:
+    """The factor of G, the displacement norm (1/2π)∫∫|δu|² dA over the reference in the coefficients of
+    ``sector`` (module docstring), built once per basis (it holds no state): ``_mass_on``."""
+    return _mass_on(sector)
+
+
+def _mass_on(basis: SphericalBasis, E: np.ndarray | None = None) -> eigen.GramFactor:
+    """The factor of G on the columns E of ``basis`` (default all): the scaling of gram·I on the sphere (the basis
+    is orthonormal; so are E's columns), on a spheroid the Cholesky factors of M = ``SphericalBasis.mass`` block by
+    block (M is block-diagonal in the basis' blocks), or that of Eᵀ M E."""
+    if basis.aspect == 1.0:
+        return eigen.GramFactor(np.full(basis.size if E is None else E.shape[1], basis.gram()), orthogonal=True)
+    M = basis.mass()
+    if E is None:
+        return eigen.GramFactor(M, blocks=tuple(b.slice for b in basis.blocks))
+    return eigen.GramFactor(E.T @ M @ E)
 
 
 def _own(sector: SphericalBasis, basis: SphericalBasis) -> bool:
@@ -283,4 +302,4 @@ def azimuthal_spectrum(eq: SurfaceEquilibrium, c: np.ndarray, params: Parameters
     fields = zero_mode_fields(eq.node_values(c)["state"], eq.basis, field_symmetry(eq, params), held)
     rows = mode_rows(eq.basis, fields) @ E if m == 1 else np.zeros((0, E.shape[1]))
     rows = rows[np.linalg.norm(rows, axis=1) > 1e-10] if rows.size else rows
-    return eigen.lowest_of(_restricted(H, eq.basis.gram(), rows), count)
+    return eigen.lowest_of(_restricted(H, _mass_on(eq.basis, E), rows), count)

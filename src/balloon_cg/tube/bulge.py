@@ -25,6 +25,8 @@ retraces at a higher degree), after ``continuation.max_points``, or at the next 
 X* is the branch's first point; the stability of every point is ``unstable_counts``' (at X* itself one eigenvalue is
 zero, its sign rounding). The scene's [[events]]: UZ points (tube/events.py).
 """
+from dataclasses import replace
+
 import numpy as np
 
 from .accuracy import accuracy
@@ -63,14 +65,18 @@ class BranchStartError(ArithmeticError):
 @limited_blas
 def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_volume: float | None = None,
                  step: float | None = None, stop_stretch: float | None = None,
-                 max_error: float | None = None, on=None) -> IntervalBranch:
+                 max_error: float | None = None, on=None, refine=None) -> IntervalBranch:
     """The branch switched at ``point``, a branch point of ``primary`` (module docstring); ``stop_volume``: the
     enclosed volume V/R0³ where it ends, as the scene key (None: the scene's continuation.stop_volume, if any; V/V0 = v
     is v·πL on a tube of length L); ``step``: the first arclength step (None:
     continuation.step); ``stop_stretch``: also stop where the largest hoop stretch at the nodes passes it;
     ``max_error``: stop where a point's Legendre tail passes it (None: no check); ``on``: the discretisation the
     branch is traced on (None: the primary's; else at an odd branch point a spectral-element layout of the same
-    tube, galerkin/interval_elements.py: ``_switched_onto``).
+    tube, galerkin/interval_elements.py: ``_switched_onto``); ``refine``: with ``on`` and ``max_error``, (layout,
+    u) ↦ the finer layout (holding the layout's space) where a point u's tail passes max_error: the trace is continued
+    there from its last point (``_continued_on``; None from ``refine``: stopped UNRESOLVED as without), tube/front.py.
+    A branch traced on several layouts stores its states on the last (``collocated``: exact), each point's tail,
+    spread, stability counts and smallest stress those of the layout it was traced on (``_assembled``).
     UnswitchableBranchPoint for a point that is no branch point, or an even one of a primary branch that is not
     uniform."""
     if point.kind != Kind.BP or point.block is None:
@@ -86,13 +92,11 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         raise UnswitchableBranchPoint("a branch is traced on its own discretisation from an odd branch point, not "
                                       f"from an {point.block.value} one")
     u, phi, disc = _switched(scene, primary, point) if on is None else _switched_onto(scene, primary, point, on)
-    eq = Equilibrium(scene, disc)
     params = primary.params.with_value("P", point.pressure)
-    side = Side(disc, point.block)
-    if side(phi) < 0:
+    if Side(disc, point.block)(phi) < 0:
         phi = -phi
     unknowns = disc.free if point.block == Mirror.ODD else disc.block(Mirror.EVEN)
-    system = TubeSystem(ParameterSystem(eq, params, "P"), unknowns, held(disc))
+    system = _tube_system(scene, disc, params, unknowns)
     settings = continuation_settings(scene)
     settings.step = settings.step if step is None else step
     X = np.append(u, point.pressure)[system.columns]
@@ -102,11 +106,46 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
         raise BranchStartError(f"the first step of the bulge branch did not converge: {first.message}")
     start = continuation.Point(first.x, continuation.tangent(system, first.x, direction), first.iterations,
                                first.residual)
-
-    compressed = CompressionStop(eq, in_field(scene))
+    compressed = CompressionStop(system.system.eq, in_field(scene))
     compressed(u)
     target = scene.continuation.stop_volume if stop_volume is None else stop_volume
-    volume_stop = VolumeStop(target, system)
+    branch_point, legs, stored = system.full(X), [], 0
+    while True:
+        volume_stop = VolumeStop(target, system)
+        stop = _stop_rule(system, point.block, volume_stop, stop_stretch, max_error, compressed)
+        monitors = {Kind.LP: np.eye(start.X.size)[-1], Kind.LV: gradient(system, Control.VOLUME)}
+        monitors |= control_monitors(system, scene.loading.control)
+        leg = replace(settings, max_points=settings.max_points - stored + (1 if legs else 0))
+        path = continuation.trace(system, start, leg, stop, monitors)
+        legs.append((system, path, volume_stop))
+        stored += len(path.points) - (1 if len(legs) > 1 else 0)
+        if refine is None or path.stop.code != IntervalStop.UNRESOLVED:
+            break
+        finer = refine(system.system.eq.disc, system.full(path.overshoot.X)[:-1])
+        continued = None if finer is None else _continued_on(scene, params, system, path, finer, settings)
+        if continued is None:
+            if finer is not None:
+                legs[-1] = (system, replace(path, stop=Stop(path.stop.code, f"{path.stop.message}; its last point did "
+                                                            f"not converge on the refined layout ({finer.count} "
+                                                            "elements)")), volume_stop)
+            break
+        system, start, step = continued
+        settings, compressed = replace(settings, step=step), compressed.on(system.system.eq)
+    if len(legs) > 1 and path.stop.code == continuation.TraceStop.MAX_POINTS:  # the branch's, not the last leg's
+        legs[-1] = (system, replace(path, stop=Stop(path.stop.code, f"maximum number of points "
+                                                                    f"({settings.max_points}) reached")), volume_stop)
+    return _assembled(scene, primary.params, branch_point, legs, settings, max_error)
+
+
+def _tube_system(scene, disc, params, unknowns) -> TubeSystem:
+    """R(u; P) of ``scene`` on ``disc`` in X = (u[unknowns], P), a held λ̄ fixed."""
+    return TubeSystem(ParameterSystem(Equilibrium(scene, disc), params, "P"), unknowns, held(disc))
+
+
+def _stop_rule(system, block: Mirror, volume_stop, stop_stretch, max_error, compressed):
+    """The stop of a trace on ``system`` (``bulge_branch``; module docstring)."""
+    disc = system.system.eq.disc
+    side = Side(disc, block)
 
     def stop(p):
         if (interrupted := signalled()) is not None:
@@ -125,26 +164,73 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
                                                  f"{max_error:g} at degree {disc.degree}")
         return compressed(Y[:-1])
 
-    monitors = {Kind.LP: np.eye(X.size)[-1], Kind.LV: gradient(system, Control.VOLUME)}
-    path = continuation.trace(system, start, settings, stop, monitors | control_monitors(system, scene.loading.control))
-    last = len(path.points) - 1
-    folds = [f for f in path.folds
-             if not (path.stop.code in (IntervalStop.REJOINED, IntervalStop.UNRESOLVED) and f.index == last)]
-    end, stopped = volume_stop.end(path, settings)
+    return stop
+
+
+def _continued_on(scene, params, system, path, finer, settings) -> tuple | None:
+    """(system, start, step) of a trace continued on the layout ``finer`` (``bulge_branch``'s ``refine``): the last
+    stored point of ``path`` and its tangent collocated onto it (exact: it holds the layout's space), the point
+    re-solved there by the Keller corrector on the hyperplane through it normal to the tangent, its tangent
+    recomputed, the step the one that reached the unresolved point (``path.overshoot``); None where the corrector
+    does not converge."""
+    disc, last = system.system.eq.disc, path.points[-1]
+    onto = _tube_system(scene, finer, params, finer.free)
+    Y, direction = system.full(last.X), np.zeros(disc.size + 1)
+    direction[system.columns] = last.tangent
+    X = np.append(collocated(disc, Y[:-1], finer), Y[-1])[onto.columns]
+    direction = np.append(collocated(disc, direction[:-1], finer), direction[-1])[onto.columns]
+    direction /= np.linalg.norm(direction)
+    solved = continuation.correct(onto, X, direction, settings)
+    if not solved.converged:
+        return None
+    start = continuation.Point(solved.x, continuation.tangent(onto, solved.x, direction, solved.factors),
+                               solved.iterations, solved.residual)
+    return onto, start, float(last.tangent @ (path.overshoot.X - last.X))
+
+
+def _assembled(scene, params, branch_point: np.ndarray, legs: list, settings, max_error) -> IntervalBranch:
+    """The IntervalBranch of the traces ``legs`` ((system, path, VolumeStop) per layout, each after the first
+    starting at the one before's last stored point re-solved: that start not stored again) from ``branch_point``
+    Y* = (u*, P): the end landed on the last leg's stop_volume, the folds of each leg but those in the step that
+    ended it where it rejoined or was unresolved (the next leg traces that step again) or beyond the landed end; each
+    point's counts, stress, volume, tail and spread on its own layout, the states on the last (``collocated``)."""
+    last_system, last_path, volume_stop = legs[-1]
+    disc = last_system.system.eq.disc
+    end, stopped = volume_stop.end(last_path, settings)
     if end is not None and max_error is not None and (tail := disc.tail(end[:-1])) > max_error:
         end, stopped = None, Stop(IntervalStop.UNRESOLVED, f"the Legendre tail {tail:.3g} of the landed end passed "
                                                            f"solver.max_error {max_error:g} at degree {disc.degree}")
-    if path.stop.code == StopCode.STOP_VOLUME:
-        folds = [f for f in folds if f.index < last or volume_stop.kept(path, end, f.point.X)]
-    special = tuple(IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + 1,
-                                    f.status) for f in sorted(folds, key=lambda f: f.index))
-    points = [system.full(X)] + [system.full(p.X) for p in path.points] + ([] if end is None else [end])
-    states = np.array([Y[:-1] for Y in points])
-    tail, spread = accuracy(eq, states)
-    return with_events(scene, system, IntervalBranch(
-        disc, states, np.array([Y[-1] for Y in points]), np.array([volume_ratio(eq, Y) for Y in points]), {},
-        unstable_counts(eq, points, params), stressed(eq, special), stopped,
-        np.array([smallest_stress(eq, Y[:-1]) for Y in points]), primary.params, tail, spread), settings)
+    states, pressure, volume, special, stress, tail, spread = [], [], [], [], [], [], []
+    unstable = {control: [] for control in Control}
+    base = 1  # the index of a leg's first path point among the branch's points
+    for k, (system, path, _) in enumerate(legs):
+        eq, last = system.system.eq, len(path.points) - 1
+        folds = [f for f in path.folds
+                 if not (path.stop.code in (IntervalStop.REJOINED, IntervalStop.UNRESOLVED) and f.index == last)]
+        if k == len(legs) - 1 and path.stop.code == StopCode.STOP_VOLUME:
+            folds = [f for f in folds if f.index < last or volume_stop.kept(path, end, f.point.X)]
+        points = ([branch_point] if k == 0 else []) + [system.full(p.X) for p in path.points[(1 if k else 0):]]
+        points += [end] if k == len(legs) - 1 and end is not None else []
+        leg_special = stressed(eq, tuple(
+            IntervalSpecial(Kind(f.label), system.full(f.point.X)[:-1], float(f.point.X[-1]), f.index + base,
+                            f.status) for f in sorted(folds, key=lambda f: f.index)))
+        moved = (lambda rows: rows) if eq.disc == disc else (lambda rows: collocated(eq.disc, rows, disc))
+        Y = np.array(points)
+        states.append(moved(Y[:, :-1]))
+        pressure.append(Y[:, -1])
+        volume.append([volume_ratio(eq, y) for y in Y])
+        special += [replace(s, u=moved(s.u)) for s in leg_special]
+        stress.append([smallest_stress(eq, y[:-1]) for y in Y])
+        for control, counts in unstable_counts(eq, Y, params).items():
+            unstable[control].append(counts)
+        accurate = accuracy(eq, Y[:, :-1])
+        tail.append(accurate[0])
+        spread.append(accurate[1])
+        base += last
+    return with_events(scene, last_system, IntervalBranch(
+        disc, np.concatenate(states), np.concatenate(pressure), np.concatenate(volume), {},
+        {control: np.concatenate(counts) for control, counts in unstable.items()}, tuple(special), stopped,
+        np.concatenate(stress), params, np.concatenate(tail), np.concatenate(spread)), settings)
 
 
 def _switched(scene, primary: IntervalBranch, point: IntervalSpecial) -> tuple:

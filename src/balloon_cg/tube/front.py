@@ -3,22 +3,27 @@
 One Legendre series over the tube cannot resolve the front that joins the bulge to the tube on the propagation plateau
 (tube/resolution.py stops "unresolved" there). Here the bulge branch is traced on spectral elements in S
 (galerkin/interval_elements.py), switched at the primary branch's odd branch point onto them (tube/bulge.py ``on``),
-and the layout is refined from the per-element tails read over the whole branch:
+and the layout is refined locally, where and when a traced point needs it (tube/bulge.py ``refine``):
 
-1. trace the branch on the layout (from START_ELEMENTS elements of equal length, of ORDER) to its stop, every
-   point's element tails kept;
-2. every element whose tail passed ``max_error`` at some point of the branch is cut into k equal elements,
+1. the trace starts on START_ELEMENTS elements of equal length, of ORDER;
+2. where a point's tail passes ``max_error``, each of its elements whose own tail does is cut into k equal elements,
    k = ceil((tail/max_error)^(1/(RATE p))) ≥ 2 (RATE p: the tail's decay per halving of the element length
    assumed, in powers of 2: spectral convergence gives ~2^p once the front is resolved; measured on the Ogden
    tube's front at order 10, 2^6.6 from elements of 2 radii to 1);
-3. retrace from the onset on the refined layout; the branch is returned when no element's tail passed max_error
-   at any of its points (every stored point's estimate, the largest of its elements', is then at most max_error),
-   or when the refined layout would have more than ``solver.max_degree`` unknowns per field (E p): then the last
-   layout is traced once more with the check (bulge_branch stops UNRESOLVED at its first point past max_error,
-   that point not stored) and returned so, its message naming max_degree.
+3. the last stored point and its tangent are moved onto the refined layout (exact: it holds the coarser one's
+   space), re-solved there, and the trace continues from it with the step that reached the unresolved point, which
+   is traced again on the refined layout (its folds located there); a point still unresolved there refines again;
+4. the branch is returned when it reaches its stop with every stored point's estimate (the largest of its elements'
+   tails, on the layout it was traced on) at most ``max_error``, or stopped UNRESOLVED at the first point whose
+   refined layout would have more than ``solver.max_degree`` unknowns per field (E p), its message naming
+   max_degree.
 
-The front sweeps the tube once, so each round refines where it has passed and the last trace's layout is graded
-towards the front's path: short elements over the reference arclength the front crossed, the rest long.
+The layout only grows along the branch (the front sweeps the tube once: its elements are cut where it passes, the
+rest stays long), so the last layout holds every earlier one's space: the stored branch is on it, each earlier
+point's state moved there exactly (galerkin/interval_elements.collocated), and each point's tail, first-integral
+spread, stability counts and smallest stress are those of the layout it was traced and solved on (on the last
+layout an earlier state is not re-solved: its residual there is its own layout's discretisation error). Earlier
+points are never retraced: the branch costs one trace.
 """
 from dataclasses import replace
 
@@ -27,7 +32,6 @@ import numpy as np
 from .bulge import bulge_branch
 from .results import IntervalStop
 from ..analysis.branches.resolution import Resolution
-from ..analysis.results import StopCode
 from ..galerkin.interval_elements import ElementInterval, element_interval
 from ..numerics.continuation import Stop
 
@@ -44,7 +48,7 @@ def uniform_layout(scene, elements: int, order: int) -> ElementInterval:
 
 
 def refined_layout(disc: ElementInterval, tails: np.ndarray, max_error: float) -> ElementInterval:
-    """``disc`` with each element whose largest tail over the branch (``tails``: points × elements) passes
+    """``disc`` with each element whose largest tail over ``tails``' points (points × elements) passes
     ``max_error`` cut into k equal elements (module docstring); ``disc`` itself where none does."""
     worst = tails.max(axis=0)
     edges = disc.edges
@@ -60,25 +64,24 @@ def refined_layout(disc: ElementInterval, tails: np.ndarray, max_error: float) -
 
 def front_bulge(scene, primary, point, policy: Resolution | None = None, layout: ElementInterval | None = None,
                 **trace):
-    """The bulge branch switched at ``point`` (an odd branch point of ``primary``) on spectral elements refined until
-    every stored point's estimate is at most ``policy.max_error`` (None: the scene's; module docstring), from
-    ``layout`` (None: ``uniform_layout`` of START_ELEMENTS and ORDER); ``trace``: tube/bulge.bulge_branch's
-    stop_volume, step, stop_stretch."""
+    """The bulge branch switched at ``point`` (an odd branch point of ``primary``) on spectral elements refined
+    locally until every stored point's estimate is at most ``policy.max_error`` (None: the scene's; module
+    docstring), from ``layout`` (None: ``uniform_layout`` of START_ELEMENTS and ORDER); ``trace``: tube/bulge.
+    bulge_branch's stop_volume, step, stop_stretch."""
     policy = Resolution.of(scene) if policy is None else policy
     disc = uniform_layout(scene, START_ELEMENTS, ORDER) if layout is None else layout
-    while True:
-        branch = bulge_branch(scene, primary, point, on=disc, **trace)
-        if branch.stop.code == StopCode.INTERRUPTED:  # a signal: the points traced on this layout, not a retrace
-            return branch
-        tails = np.array([disc.element_tails(u) for u in branch.states])
-        finer = refined_layout(disc, tails, policy.max_error)
-        if finer == disc:
-            return branch
-        if finer.degree > policy.max_degree:
-            checked = bulge_branch(scene, primary, point, on=disc, max_error=policy.max_error, **trace)
-            if checked.stop.code == StopCode.INTERRUPTED:
-                return checked
-            message = (f"{checked.stop.message}: {finer.count} elements of order {disc.order} would pass "
-                       f"solver.max_degree {policy.max_degree} (elements × order): raise it or solver.max_error")
-            return replace(checked, stop=Stop(IntervalStop.UNRESOLVED, message))
-        disc = finer
+    refused = []  # the layout a refinement would have passed max_degree with
+
+    def refine(coarse: ElementInterval, u: np.ndarray) -> ElementInterval | None:
+        finer = refined_layout(coarse, coarse.element_tails(u)[None, :], policy.max_error)
+        if finer.degree <= policy.max_degree:
+            return finer
+        refused.append(finer)
+        return None
+
+    branch = bulge_branch(scene, primary, point, max_error=policy.max_error, on=disc, refine=refine, **trace)
+    if branch.stop.code != IntervalStop.UNRESOLVED or not refused:
+        return branch
+    message = (f"{branch.stop.message}: {refused[-1].count} elements of order {disc.order} would pass "
+               f"solver.max_degree {policy.max_degree} (elements × order): raise it or solver.max_error")
+    return replace(branch, stop=Stop(IntervalStop.UNRESOLVED, message))

@@ -130,8 +130,10 @@ class OnsetSystem:
 @dataclass(frozen=True)
 class OnsetCurve:
     """The traced curve of onsets (plain data): per point the state ``states`` (rows u of the interval
-    discretisation), the pressure, q, V/V0 and the odd null vector ``modes`` (rows on the odd block); the folds in q
-    (IntervalSpecial LP, ``pressure`` its P, ``q`` below), why it stopped, q's name and its start value."""
+    discretisation), the pressure, q, V/V0, the odd null vector ``modes`` (rows on the odd block) and the state's
+    Legendre tail (``tail``: IntervalDiscretisation.tail, the error estimate solver.max_error bounds: a point above
+    it is not resolved at the scene's degree); the folds in q (IntervalSpecial LP, ``pressure`` its P, ``fold_q``
+    and ``fold_tail`` below), why it stopped, q's name and its start value."""
 
     disc: object
     name: str
@@ -141,8 +143,10 @@ class OnsetCurve:
     q: np.ndarray
     volume: np.ndarray
     modes: np.ndarray
+    tail: np.ndarray
     folds: tuple
     fold_q: np.ndarray
+    fold_tail: np.ndarray
     stop: Stop
 
 
@@ -186,19 +190,23 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
     beyond = Stop(OnsetStop.STRETCH_LIMIT, f"axial_stretch passed {high:g} (geometry.axial_stretch's largest value): "
                                            f"the last point is an odd branch point of the tube held at λ = {high:g}")
 
+    stored = [q0]  # q of the last point kept: a stop's point (the step that passed it) is not stored
+
     def stop(p):
         if (interrupted := signalled()) is not None:
             return interrupted
         u, P, _, q = system.split(p.X)
+        last = f"after {name} = {stored[-1]:.6g}, the last point"
         if name == STRETCH and (hoop := disc.node_state(u)[0].max()) > scene.continuation.stop_stretch:
             return Stop(IntervalStop.HOOP_STRETCH, f"the largest hoop stretch {hoop:.6g} passed stop_stretch "
-                                                   f"{scene.continuation.stop_stretch:g} at {name} = {q:.6g}")
+                                                   f"{scene.continuation.stop_stretch:g} {last}")
         if P <= 0:
-            return Stop(OnsetStop.NONPOSITIVE_PRESSURE, f"P reached 0 at {name} = {q:.6g}")
+            return Stop(OnsetStop.NONPOSITIVE_PRESSURE, f"P reached 0 {last}")
         if q < low:
             return below
         if q > high:
             return beyond
+        stored.append(q)
         return None
 
     path = continuation.trace(system, start, settings, stop, {Kind.LP: np.eye(X.size)[-1]})
@@ -217,5 +225,6 @@ def onset_curve(scene, primary: IntervalBranch, point: IntervalSpecial, name: st
                   for f in path.folds)
     return OnsetCurve(disc, name, q0, states, pressure, np.array([q for *_, q in parts]),
                       np.array([volume_ratio(eq, np.append(u, P)) for u, P in zip(states, pressure)]),
-                      np.array([phi for _, _, phi, _ in parts]), folds,
-                      np.array([system.split(f.point.X)[3] for f in path.folds]), path.stop)
+                      np.array([phi for _, _, phi, _ in parts]), np.array([disc.tail(u) for u in states]), folds,
+                      np.array([system.split(f.point.X)[3] for f in path.folds]),
+                      np.array([disc.tail(f.u) for f in folds]), path.stop)

@@ -17,7 +17,9 @@ held apart have no single one, a coil field no uniform state: ``maxwell``), comp
 the next stage starts (one during Maxwell's pressure, which does not poll, at the primary branch's first point): what
 is finished is kept, and the picture names the stage (``Stage``). A whole picture's branches are assessed for m = 1..
 ``stability.m_max`` (tube/azimuthal.py: ``modes``). On a voltage continuation (``continuation.parameter =
-"voltage"``) the picture is the tube continued in Φ̄ at its fixed P alone (tube/voltage.py: ``charged_picture``)."""
+"voltage"``) the picture is the tube continued in Φ̄ at its fixed P alone (tube/voltage.py: ``charged_picture``); from a
+stored point of a held tube, the tube continued in the held distance λ at its P alone (tube/stretch.py:
+``stretched_picture``)."""
 import enum
 from dataclasses import dataclass, replace
 
@@ -31,6 +33,7 @@ from .primary import in_field, primary_branch
 from .resolution import REFINE, traced_bulge
 from .surface.branch import SurfaceBranchStartError, traced_branch
 from .results import IntervalBranch, IntervalStop
+from .stretch import stretch_branch
 from .voltage import voltage_branch
 from ..analysis.results import Kind, StopCode
 from ..galerkin.equilibrium import Equilibrium
@@ -120,6 +123,14 @@ def charged_picture(scene, start: tuple | None = None, direction: float = 1.0) -
     """The tube continued in Φ̄ at fixed P (tube/voltage.voltage_branch from ``start``, ``direction``) as the picture's
     primary branch: no bulge branch is switched, no Maxwell pressure, the m ≥ 1 blocks not read."""
     branch = voltage_branch(scene, start, direction)
+    return TubePicture({"primary": branch}, None,
+                       interrupted=Stage.PRIMARY if branch.stop.code == StopCode.INTERRUPTED else None)
+
+
+def stretched_picture(scene, point, disc, direction: float = 1.0) -> TubePicture:
+    """The held tube continued in λ at fixed P from the stored located point ``point`` on ``disc``
+    (tube/stretch.stretch_branch, ``direction``) as the picture's primary branch, as ``charged_picture``'s."""
+    branch = stretch_branch(scene, disc, point.u, point.pressure, direction)
     return TubePicture({"primary": branch}, None,
                        interrupted=Stage.PRIMARY if branch.stop.code == StopCode.INTERRUPTED else None)
 

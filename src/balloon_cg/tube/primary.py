@@ -24,13 +24,12 @@ basis) and its first odd-block branch point is the onset of the bulge mode cos(�
 from dataclasses import replace
 
 import numpy as np
-from scipy import linalg
 
 from .control import VolumeStop, control_monitors
 from .events import with_events
 from .results import IntervalBranch, IntervalSpecial, IntervalStop, signalled
 from .stability import CompressionStop, smallest_stress, spectrum, unstable_counts
-from .zeros import corrected_zero, is_fold
+from .zeros import corrected_zero, is_fold, off_mode_corrector
 from ..analysis.stability.crossings import count_changes
 from ..analysis.branches.problem import ParameterSystem, continuation_settings
 from ..analysis.results import Kind, StopCode
@@ -41,7 +40,7 @@ from ..galerkin.interval_elements import ElementInterval
 from ..numerics import continuation
 from ..numerics.continuation import Stop
 from ..numerics.threads import limited_blas
-from ..numerics.newton import Convergence, newton
+from ..numerics.newton import newton
 from ..scene.tables import Shape
 from ..scene.validation import SceneError
 
@@ -246,7 +245,7 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
     """(Y = (u, P), status) where the eigenvalue number ``order`` (ascending, from 0) of ``block`` vanishes between
     two points, by Brent in the arclength from ``before`` (``params``: the branch's, P replaced); None when it is
     the fold in P (the null vector not orthogonal to ∂R/∂P). Each value is a Keller corrector; near a branch point
-    of the even block (the branch's own unknowns) that one may diverge, and then ``_off_mode_corrector`` is used."""
+    of the even block (the branch's own unknowns) that one may diverge, and then ``off_mode_corrector`` is used."""
     index = eq.disc.block(block)
     mode = None  # the crossing eigenvalue's vector at ``before`` where the branch's own unknowns hold it (even block)
     if block == Mirror.EVEN:
@@ -257,30 +256,12 @@ def _located_zero(system: TubeSystem, eq: Equilibrium, before, after, block: Mir
     length = float(before.tangent @ (after.X - before.X))
     end = system.full(after.X)
     fallback = None if mode is None else (
-        lambda predictor: _off_mode_corrector(system, predictor, before.tangent, mode, settings))
+        lambda predictor: off_mode_corrector(system, predictor, before.tangent, mode, settings))
     root = corrected_zero(system, settings, before.X, before.tangent, length,
                           lambda Y: spectrum(eq, Y, index, params)[order],
                           {length: (spectrum(eq, end, index, params)[order], end)}, fallback)
     Y = root.payload
-    if is_fold(eq, Y[:-1], params.with_value("P", Y[-1]), "P", index, order):
+    at = params.with_value("P", Y[-1])
+    if is_fold(eq, Y[:-1], at, eq.parameter_derivative(Y[:-1], at, "P"), index, order):
         return None
     return Y, root.status
-
-
-def _off_mode_corrector(system: TubeSystem, predictor: np.ndarray, tangent: np.ndarray, mode: np.ndarray, settings):
-    """Keller's corrector with the direction ``mode`` (X-coordinates; the crossing eigenvalue's vector of the branch's
-    own block) held at the predictor's component: near a branch point that breaks a symmetry the branch keeps (the
-    uniform tube's modes cos(nπS/L), n even, in the even block) the branch's states have no component along it, and
-    Keller's system, singular at the branch point, lets rounding grow along it. Solved: Qᵀ R(X) = 0 (Q an orthonormal
-    basis of the residual rows orthogonal to the mode: its own row, zero on the branch by the symmetry, dropped),
-    tangent·X and mode·X at the predictor's; not converged where the dropped row is not zero there (the branch does
-    move along the mode: no symmetry)."""
-    Q = linalg.null_space(mode[None, :-1])
-    result = newton(lambda X: Q.T @ system.residual(X), lambda X: Q.T @ system.jacobian(X), predictor,
-                    np.vstack([tangent, mode]), [tangent @ predictor, mode @ predictor], settings.tol,
-                    settings.max_newton)
-    dropped = abs(mode[:-1] @ system.residual(result.x)) if result.converged else np.inf
-    if dropped > settings.tol:
-        return replace(result, outcome=Convergence.FAILED,
-                       message=f"{result.message}; off the mode: the residual along it is {dropped:.3g}")
-    return result

@@ -19,6 +19,7 @@ class IntervalStop(enum.StrEnum):
     REJOINED = "rejoined"  # a bulge branch met the mirror-symmetric states again (tube/bulge.py)
     COMPRESSED = "compressed"  # in a coil field, the membrane turned compressed after being taut (tube/stability.py)
     UNRESOLVED = "unresolved"  # a point's Legendre tail passed solver.max_error (tube/resolution.py); not stored
+    HELD_RANGE = "held_range"  # continued in the held distance (tube/stretch.py), λ left [1, 5]; not stored
 
 
 def signalled() -> Stop | None:
@@ -73,8 +74,13 @@ class IntervalBranch:
     tail: np.ndarray | None = None  # per point: galerkin/interval.IntervalDiscretisation.tail
     first_integral: np.ndarray | None = None  # per point: tube/accuracy.first_integral_spread
     voltage: np.ndarray | None = None  # per point Φ̄ on a voltage continuation (tube/voltage.py); None: in P
+    stretched: bool = False  # continued in λ at a fixed P (tube/stretch.py); False: in P or Φ̄
     parent: tuple | None = None  # (branch name, label) of the branch point it was switched at
     rejoins: int | None = None  # the label on the parent branch where it rejoined it
+
+    def held_stretch(self) -> np.ndarray:
+        """λ of each point: its λ̄, the held distance of the ends over L (where they are held)."""
+        return self.states[:, self.disc.axial_index]
 
     def branch_points(self, block: Mirror | None = None) -> list:
         return [s for s in self.special if s.kind == Kind.BP and (block is None or s.block == block)]

@@ -127,3 +127,10 @@ class CompressionStop:
                                                  f"stress {stress:.3g}): beyond, a membrane wrinkles and the traced "
                                                  "states do not converge in the degree")
         return None
+
+    def on(self, eq: Equilibrium) -> "CompressionStop":
+        """The same rule on another discretisation's problem ``eq`` (a trace continued on a finer layout: tube/bulge.
+        py), whether a taut state was met kept."""
+        moved = CompressionStop(eq, self.active)
+        moved.taut = self.taut
+        return moved

@@ -131,6 +131,7 @@ def _branch_point(system, eq, before, after, block: Mirror, order: int, settings
     if root is None:
         return None
     Y = root.payload
-    if is_fold(eq, Y[:-1], params.with_value("voltage", Y[-1]), "voltage", index, order):
+    at = params.with_value("voltage", Y[-1])
+    if is_fold(eq, Y[:-1], at, eq.parameter_derivative(Y[:-1], at, "voltage"), index, order):
         return None
     return Y, root.status

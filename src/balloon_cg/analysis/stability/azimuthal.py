@@ -359,7 +359,8 @@ def special_modes(equilibrium: Equilibrium, u, degree: int, quadrature: int = 0)
     - ``relabelling``: the rotation of the *reference* sphere about e_y, δx = ∂x0/∂X·(e_y × X):
       R = ρ0', T = −ρ0 cot θ, Z = η0'. The reference sphere and the material are isotropic, so E[x ∘ Q] = E[x]
       for every rotation Q of the material labels: a zero mode of every equilibrium, with or without field
-      (material slides along the deformed surface, the shape does not change). On a sphere it is the rotation.
+      (material slides along the deformed surface, the shape does not change), where the reference is a sphere
+      (``excluded_modes``). On a sphere state it is the rotation.
 
     All are regular (D = R − T ≠ 0 at the poles) and exact in the basis when degree ≥ the equilibrium's Legendre
     degree + 1 (the translation for any degree)."""
@@ -502,12 +503,14 @@ def _class_rows(moments, modes: list, cls, index):
 
 def excluded_modes(equilibrium: Equilibrium, params: Parameters, held: bool) -> tuple:
     """Indices into MODES of the m = 1 modes ``spectrum`` removes: always the relabelling; at M = 0 (or without
-    coils) also the translation and the rotation; with a field the translation for a held balloon. A capsule of
-    length L > 0 has no relabelling (a rotation of its reference is no symmetry of it)."""
+    coils) also the translation and the rotation; with a field the translation for a held balloon. The relabelling
+    only where the reference is a sphere: a capsule of length L > 0 and a spheroid of aspect ≠ 1 have none (a
+    rotation of the reference about a horizontal axis is no symmetry of it: no zero mode, and removing it would
+    drop a mode of the block; surface.basis.SphericalBasis.relabellings)."""
     if params.M == 0 or not equilibrium.coils.shape[0]:
         modes = 0, 1, 2
     else:
         modes = (0, 2) if held else (2,)
     geometry = equilibrium.scene.geometry
-    relabelled = geometry.shape != Shape.CAPSULE or geometry.length == 0
+    relabelled = geometry.aspect == 1.0 and not geometry.length  # the sphere, also as a spheroid or a capsule
     return modes if relabelled else tuple(k for k in modes if k != 2)

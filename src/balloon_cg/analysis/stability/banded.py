@@ -18,16 +18,15 @@ index set below its pressure block's spectrum (numerics/banded.py), which also p
 """
 import numpy as np
 
-from ...galerkin.discretisation import symmetric_rows
+from ...galerkin.discretisation import HESSIAN_ROW
 from ...galerkin.equilibrium import NodeKernels, Parameters
 from ...galerkin.piecewise import PiecewiseBasis
 from ...generated import HESSIAN_PAIRS
-from ...model.meridian import mass_density
+from ...model.meridian import AZIMUTHAL, mass_density
 from ...numerics.banded import BandedShiftInvert, BandedSigns
 from .azimuthal import perturbation_map
 from .flags import EVERY_FLAG, FREE, FREE_FLAGS, FREE_GAS, FREE_VOLUME, HELD, HELD_GAS, HELD_VOLUME, LOWEST
 
-_ROW = symmetric_rows(HESSIAN_PAIRS)  # (k, l) -> row of energy_hessian's output
 LAMBDA2, ETA = 0, 1  # the fields of a PiecewiseBasis's functions
 # ``banded_variation``'s elements: order 12, 1.5 functions per field per Legendre degree. At the paper coil's
 # pear_free_2 points of degree 320 on the map 30 elements of order 12 (1.1 per degree) agree with the Legendre
@@ -61,7 +60,7 @@ class BandedVariation:
             norm = mass_density(equilibrium.scene.geometry, "axisymmetric", x, sin_theta)
         else:
             norm = np.zeros((len(HESSIAN_PAIRS), x.size))
-            norm[[_ROW[0, 0], _ROW[2, 2]]] = 1.0
+            norm[[HESSIAN_ROW[0, 0], HESSIAN_ROW[2, 2]]] = 1.0
         self._gram_local = self._local_matrices(norm)
         hold = np.zeros((4, x.size))
         hold[2] = 1.0  # ∫δη dx
@@ -72,7 +71,7 @@ class BandedVariation:
         """Σ_q W_q Σ_kl h_kl(q) D_k D_l per element, (E, L, L), from pointwise entries (10, n_nodes) in
         HESSIAN_PAIRS' rows."""
         E, n_q = self.basis.x.shape
-        h = pointwise[_ROW].reshape(4, 4, E, n_q) * self.basis.weights
+        h = pointwise[HESSIAN_ROW].reshape(4, 4, E, n_q) * self.basis.weights
         partner = np.einsum("kleq,elqj->ekqj", h, self.ops)
         L = self.ops.shape[-1]
         return np.matmul(self.ops.reshape(E, 4 * n_q, L).transpose(0, 2, 1), partner.reshape(E, 4 * n_q, L))
@@ -152,9 +151,10 @@ class BandedVariation:
 def banded_variation(equilibrium, degree: int, symmetric: bool) -> "BandedVariation | None":
     """The banded sibling of the Legendre blocks of perturbation degree N at ``equilibrium``: elements of order
     ORDER, as many as give about ELEMENT_FUNCTIONS·N functions per field on the whole interval (half as many on the
-    half interval of an equator-symmetric state). None on a capsule's piecewise discretisation (``joins``), whose
-    m ≥ 1 blocks have their own elements."""
-    if equilibrium.disc.joins:
+    half interval of an equator-symmetric state). None on a capsule (its piecewise discretisation; of length 0, the
+    sphere's, without the m ≥ 1 mass kernel the sibling's blocks take: ``meridian.AZIMUTHAL``), whose m ≥ 1 blocks
+    have their own elements (capsule_basis.py)."""
+    if equilibrium.disc.joins or equilibrium.scene.geometry.shape not in AZIMUTHAL:
         return None
     half = symmetric and equilibrium.disc.symmetric
     elements = max(1, int(np.ceil(ELEMENT_FUNCTIONS * degree / ORDER / (2 if half else 1))))

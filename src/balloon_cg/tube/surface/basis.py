@@ -24,39 +24,74 @@ of the orders: the rotation by π/g (c_m → (−1)^(m/g) c_m, the symmetry of a
 2g, …) maps the nodes to nodes, so the discrete energy keeps it exactly, not to the quadrature's aliasing.
 """
 import functools
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..azimuthal import basis_values
+from .meridian import NODE_VARIABLES, MeridianSurfaceBasis, default_phi_nodes, meridian_tables
+from ..azimuthal import basis_values, operators, translation
 from ...galerkin.interval import IntervalDiscretisation
-from ...scene.tables import Ends
-
-NODE_VARIABLES = ("x", "y", "z", "xt", "yt", "zt", "xp", "yp", "zp")  # the surface kernels' names (frame components)
+from ...scene.tables import Ends, Shape
 
 
 @dataclass(frozen=True)
-class TubeSurfaceBasis:
+class TubeSurfaceBasis(MeridianSurfaceBasis):
     """The interval discretisation ``disc`` per azimuthal order in ``orders`` (ascending, 0 first, distinct) on
-    ``n_phi`` uniform nodes in φ (0: the default of the module docstring)."""
+    ``n_phi`` uniform nodes in φ (0: the default of tube/surface/meridian.py): the engine's case R = 1, S' = 1."""
 
     disc: IntervalDiscretisation
     orders: tuple = (0, 1)
     n_phi: int = 0
+    shape = Shape.TUBE
 
     def __post_init__(self):
-        orders = tuple(int(m) for m in self.orders)
-        if not orders or orders[0] != 0 or any(b <= a for a, b in zip(orders, orders[1:])):
-            raise ValueError(f"orders: {self.orders} must start at 0 and ascend (allowed: distinct m ≥ 0)")
+        orders, n_phi = default_phi_nodes(self.orders, self.n_phi)
         object.__setattr__(self, "orders", orders)
-        least = 2 * orders[-1] + 1
-        if self.n_phi == 0:
-            period = 2 * math.gcd(*orders[1:]) if len(orders) > 1 else 2
-            object.__setattr__(self, "n_phi", -(-2 * least // period) * period)
-        elif self.n_phi < least:
-            raise ValueError(f"n_phi: {self.n_phi} nodes in φ cannot hold the products of order {orders[-1]} "
-                             f"(allowed: n_phi ≥ {least})")
+        object.__setattr__(self, "n_phi", n_phi)
+
+    def rule(self) -> tuple:
+        ones = np.ones(self.disc.x.size)
+        return self.disc.weights, ones, np.zeros_like(ones), ones
+
+    def axis(self) -> tuple:
+        """(λ2, v, η, w) of u (ρ = λ2 with R = 1), a plugged end's 1 in λ2."""
+        offset = np.zeros((4, self.disc.x.size))
+        if self.disc.ends == Ends.PLUGGED:  # λ2 = 1 + bubbles
+            offset[0] = 1.0
+        return self.disc.maps, offset
+
+    def mode(self, m: int) -> np.ndarray:
+        return _modes(self.disc)
+
+    def tables(self) -> tuple:
+        return _tables(self)
+
+    def check_scene(self, scene) -> None:
+        """ValueError where the scene's ends are not the basis'."""
+        if self.disc.ends != scene.geometry.ends:
+            raise ValueError(f"basis ends: {self.disc.ends.value!r} (allowed: the scene's, "
+                             f"{scene.geometry.ends.value!r})")
+
+    @property
+    def axis_size(self) -> int:
+        return self.disc.size
+
+    def volume_ratio(self, volume: float) -> float:
+        """V/V0 of V/(2π) = ``volume`` (V0 = πL)."""
+        return 2 * volume / self.disc.length
+
+    def gram(self, m: int) -> np.ndarray:
+        """The order's Gram matrix G of ‖δx‖² (tube/azimuthal.py)."""
+        return operators(self.disc)[1]
+
+    def gauge_rows(self, field: bool = False) -> np.ndarray:
+        """(rows, size): G t of the sideways translation t in order 1 on sliding ends (tube/surface/system.py), no
+        row where nothing is gauged (plugged ends, no order 1, or in a coil's ``field``)."""
+        if 1 not in self.orders or self.disc.ends != Ends.SLIDING or field:
+            return np.zeros((0, self.size))
+        row = np.zeros((1, self.size))
+        row[0, self.block(1)] = self.gram(1) @ translation(self.disc)
+        return row
 
     @property
     def mode_size(self) -> int:
@@ -64,83 +99,9 @@ class TubeSurfaceBasis:
         return 2 * self.disc.hoops + self.disc.degree - 1
 
     @property
-    def size(self) -> int:
-        return self.disc.size + (len(self.orders) - 1) * self.mode_size
-
-    def block(self, m: int) -> slice:
-        """The slice of c holding order m (m = 0: the interval's u)."""
-        i = self.orders.index(m)
-        if i == 0:
-            return slice(0, self.disc.size)
-        start = self.disc.size + (i - 1) * self.mode_size
-        return slice(start, start + self.mode_size)
-
-    @property
     def free(self) -> np.ndarray:
         """The indices of the unknowns: all but λ̄ where the ends are held (galerkin/interval.py ``free``)."""
         return np.flatnonzero(np.arange(self.size) != (self.disc.axial_index if self.disc.held else -1))
-
-    @property
-    def phi(self) -> np.ndarray:
-        return 2 * np.pi * np.arange(self.n_phi) / self.n_phi
-
-    @property
-    def weights(self) -> np.ndarray:
-        """(n_q · n_phi,): W_q / n_phi per node, node order q n_phi + k."""
-        return np.repeat(self.disc.weights, self.n_phi) / self.n_phi
-
-    @property
-    def factors(self) -> tuple:
-        """Per order, (F (9, n_q, unknowns of the order), g (9, n_phi)): node variable a (NODE_VARIABLES) is
-        Σ_m (F_a c_m)(S_q) g_a(φ_k), g_a = cos mφ or sin mφ (module docstring)."""
-        return _tables(self)[0]
-
-    def node_state(self, c: np.ndarray) -> np.ndarray:
-        """(9, n_q · n_phi): x, a_S, a_φ in the frame at every node, node order q n_phi + k (module docstring)."""
-        out = _tables(self)[1].copy()
-        for m, (F, g) in zip(self.orders, self.factors):
-            out += (F @ c[self.block(m)])[:, :, None] * g[:, None, :]
-        return out.reshape(9, -1)
-
-    def project(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_a T_aᵀ p_a of node rows p (9, n_q · n_phi), T_a the map of node variable a: Σ_q F_aᵀ Σ_k g_a p_a per
-        order (a residual from W ∂π/∂q)."""
-        p = pointwise.reshape(9, self.disc.x.size, self.n_phi)
-        out = np.empty(self.size)
-        for m, (F, g) in zip(self.orders, self.factors):
-            out[self.block(m)] = np.einsum("aq,aqj->j", np.einsum("aqk,ak->aq", p, g), F)
-        return out
-
-    def hessian(self, pointwise: np.ndarray) -> np.ndarray:
-        """Σ_ab T_aᵀ diag(h_ab) T_b of node rows h (9, 9, n_q · n_phi), sum-factorised over φ: the block of orders
-        (m, m') is Σ_ab F_aᵀ diag(Θ_ab) F'_b with Θ_ab(S_q) = Σ_k g_a(φ_k) h_ab(S_q, φ_k) g'_b(φ_k) (9 n_q n² flops
-        over all blocks instead of the n_phi times more of the dense node maps)."""
-        h = pointwise.reshape(9, 9, self.disc.x.size, self.n_phi)
-        out = np.empty((self.size, self.size))
-        factors = list(zip(self.orders, self.factors))
-        for i, (m, (F, g)) in enumerate(factors):
-            for m_, (F_, g_) in factors[i:]:
-                theta = np.einsum("abqk,ak,bk->abq", h, g, g_)
-                scaled = np.einsum("abq,bqj->aqj", theta, F_)
-                block = F.reshape(-1, F.shape[2]).T @ scaled.reshape(-1, F_.shape[2])
-                out[self.block(m), self.block(m_)] = block
-                out[self.block(m_), self.block(m)] = block.T
-        return out
-
-    def axisymmetric(self, u: np.ndarray) -> np.ndarray:
-        """c of the interval discretisation's state u (every m ≥ 1 amplitude 0)."""
-        c = np.zeros(self.size)
-        c[self.block(0)] = u
-        return c
-
-    def with_mode(self, c: np.ndarray, m: int, amplitudes: np.ndarray) -> np.ndarray:
-        """c with order m ≥ 1 set to ``amplitudes`` (coefficients of tube/azimuthal.basis_values, e.g. a critical
-        mode)."""
-        if m == 0:
-            raise ValueError(f"m: 0 is the axisymmetric state, set by ``axisymmetric`` (allowed: {self.orders[1:]})")
-        out = np.array(c, dtype=float)
-        out[self.block(m)] = amplitudes
-        return out
 
     def fields(self, m: int) -> tuple:
         """The sizes of order m's fields in c, in order: (λ2, λ̄, η) at m = 0, (R, T, Z) at m ≥ 1; a field's k-th
@@ -179,22 +140,12 @@ class TubeSurfaceBasis:
 
 @functools.lru_cache(maxsize=8)
 def _tables(basis: TubeSurfaceBasis) -> tuple:
-    """(the ``factors`` per order, offset (9, n_q, n_phi): a plugged end's 1 in r and a_φ2), read-only."""
-    disc, phi = basis.disc, basis.phi
-    n_q = disc.x.size
-    axis = disc.maps  # (λ2, v, η, w) of u
-    F = np.zeros((9, n_q, disc.size))
-    for row, source in ((0, 0), (7, 0), (2, 2), (3, 1), (5, 3)):  # r, a_φ2 = r, z, r_S, z_S
-        F[row] = axis[source]
-    factors = [(F, np.ones((9, basis.n_phi)))]
-    R, dR, Z, dZ, T, dT = basis_values(disc, disc.x)  # (n_q, mode_size) each
-    for m in basis.orders[1:]:
-        rows = (R, T, Z, dR, dT, dZ, -(m * R + T), m * T + R, -m * Z)  # r, t, z, a_S, a_φ (module docstring)
-        cos, sin = np.cos(m * phi), np.sin(m * phi)
-        factors.append((np.array(rows), np.array([cos, sin, cos, cos, sin, cos, sin, cos, sin])))
-    offset = np.zeros((9, n_q, basis.n_phi))
-    if disc.ends == Ends.PLUGGED:  # λ2 = 1 + bubbles: r and a_φ2 = r carry the 1
-        offset[0] = offset[7] = 1.0
-    for table in (offset, *(a for pair in factors for a in pair)):
-        table.flags.writeable = False
-    return tuple(factors), offset
+    return meridian_tables(basis)
+
+
+@functools.lru_cache(maxsize=8)
+def _modes(disc: IntervalDiscretisation) -> np.ndarray:
+    """(6, n_q, mode_size): tube/azimuthal.basis_values at the nodes, the same for every order."""
+    modes = basis_values(disc, disc.x)
+    modes.flags.writeable = False
+    return modes

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .basis import TubeSurfaceBasis
-from .equilibrium import TubeSurfaceEquilibrium
-from .resolution import MAX_DEGREE, MAX_HARMONICS, error_estimate, refined
+from .equilibrium import MeridianSurfaceEquilibrium
+from . import capsule_resolution, resolution
 from .stability import SectorStability
 from .switching import SwitchedPoint, mode_row, point_at_amplitude, switched_point
 from .system import TubeSurfaceSystem
@@ -38,8 +38,15 @@ from ...numerics import continuation, interrupt
 from ...numerics.continuation import Stop, TraceStop
 from ...numerics.newton import newton
 from ...scene.loading import Control
+from ...scene.tables import Shape
 
 START_AMPLITUDE = 0.05  # ε of the switched point the trace starts from (G-unit mode: ~5 % of the tube's radius)
+POLICIES = {Shape.TUBE: resolution, Shape.CAPSULE: capsule_resolution}  # a basis' error estimate and refinement
+
+
+def policy(basis):
+    """The resolution module of the basis' shape (``error_estimate``, ``refined``, MAX_DEGREE, MAX_HARMONICS)."""
+    return POLICIES[basis.shape]
 
 
 class SurfaceBranchStartError(ArithmeticError):
@@ -82,7 +89,7 @@ class _Leg:
 
     def __init__(self, scene, basis: TubeSurfaceBasis, params: Parameters, template: np.ndarray, m: int,
                  mode: np.ndarray):
-        self.system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, basis), params, template)
+        self.system = TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, basis), params, template)
         self.basis, self.points = basis, []
         self.row = np.append(mode_row(basis, m, mode[basis.block(m)])[self.system.free],
                              [0.0] * (1 + self.system.gauged))
@@ -98,7 +105,7 @@ def resolved_start(scene, point: SwitchedPoint, mode: np.ndarray, params: Parame
     ``point.basis``. SurfaceBranchStartError where Newton fails on a refined basis."""
     solver = scene.solver
     while True:
-        finer = refined(point.basis, point.c, point.m, solver.max_error)
+        finer = policy(point.basis).refined(point.basis, point.c, point.m, solver.max_error)
         if finer is None or finer is point.basis:
             return point, finer is None
         phi = point.basis.raised(mode, finer)
@@ -124,7 +131,7 @@ def _stop_rule(scene, leg: _Leg, direction: float, resolving: bool):
         if stretch >= upper:
             return Stop(IntervalStop.HOOP_STRETCH, f"largest hoop stretch {stretch:.4g} passed stop_stretch "
                                                    f"{upper:g}")
-        error = error_estimate(leg.basis, c) if resolving else 0.0
+        error = policy(leg.basis).error_estimate(leg.basis, c) if resolving else 0.0
         if error > max_error:
             return Stop(StopCode.RESOLUTION, f"error estimate {error:.2g} above solver.max_error {max_error:g} at "
                                              f"degree {leg.basis.disc.degree}, orders up to {leg.basis.orders[-1]}")
@@ -141,11 +148,22 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
     solver, m = scene.solver, crossing.m
     first = switched_point(scene, disc, crossing, direction * START_AMPLITUDE, params, orders, n_phi, solver.tol,
                            solver.max_newton)
+    mode = first.basis.with_mode(np.zeros(first.basis.size), m, crossing.mode)
+    return trace_from(scene, first, mode, first.basis.axisymmetric(crossing.u), crossing.pressure, params, direction,
+                      max_points, parent)
+
+
+def trace_from(scene, first: SwitchedPoint, mode: np.ndarray, zero: np.ndarray, pressure: float,
+               params: Parameters, direction: float = 1.0, max_points: int | None = None,
+               parent: tuple | None = None) -> TubeSurfaceBranch:
+    """The branch through the switched point ``first`` (any MeridianSurfaceBasis), born at the axisymmetric state
+    ``zero`` (c on ``first.basis``) at ``pressure`` along the critical ``mode`` (c on ``first.basis``), traced
+    (module docstring); SurfaceBranchStartError where ``first`` did not converge."""
+    solver, m = scene.solver, first.m
     if not first.converged:
         raise SurfaceBranchStartError(f"the switched point at ε = {first.amplitude:g} did not converge: "
                                       f"{first.message}")
     origin_basis = first.basis
-    mode = origin_basis.with_mode(np.zeros(origin_basis.size), m, crossing.mode)
     origin = _Leg(scene, origin_basis, params, first.c, m, mode)
     first, limited = resolved_start(scene, first, mode, params)
     leg = _Leg(scene, first.basis, params, first.c, m, origin_basis.raised(mode, first.basis))
@@ -165,7 +183,7 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
         done += len(path.points)
         if stop.code != StopCode.RESOLUTION:
             break
-        finer = refined(leg.basis, leg.system.coefficients(path.overshoot.X), m, solver.max_error)
+        finer = policy(leg.basis).refined(leg.basis, leg.system.coefficients(path.overshoot.X), m, solver.max_error)
         last = leg.points.pop()  # the start of the next run: on the finer basis, or here at the cap
         done -= 1
         if finer is None:
@@ -189,17 +207,20 @@ def traced_branch(scene, disc, crossing, params: Parameters, direction: float = 
     if stop.code == TraceStop.MAX_POINTS:
         stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
     if limited:
-        stop = Stop(stop.code, f"{stop.message}; limited: the basis at its cap (degree ≤ {MAX_DEGREE}, orders up to "
-                               f"{MAX_HARMONICS} m) with error estimates above solver.max_error {solver.max_error:g}")
-    return _branch(origin, legs, crossing, params, tuple(folds), stop, parent, limited)
+        caps = policy(leg.basis)
+        stop = Stop(stop.code, f"{stop.message}; limited: the basis at its cap (degree ≤ {caps.MAX_DEGREE}, orders up "
+                               f"to {caps.MAX_HARMONICS} m) with error estimates above solver.max_error "
+                               f"{solver.max_error:g}")
+    return _branch(origin, legs, (m, zero, pressure), params, tuple(folds), stop, parent, limited)
 
 
-def _branch(origin: _Leg, legs: list, crossing, params: Parameters, folds: tuple, stop: Stop, parent: tuple | None,
+def _branch(origin: _Leg, legs: list, born: tuple, params: Parameters, folds: tuple, stop: Stop, parent: tuple | None,
             limited: bool) -> TubeSurfaceBranch:
     """The TubeSurfaceBranch of the traced ``legs``, point 0 the zero on ``origin`` (the switched point's first
     basis): every point's values, estimate and stability on its own basis, its coefficients raised to the last."""
     final = legs[-1].basis
-    points = [(origin, origin.basis.axisymmetric(crossing.u), crossing.pressure, 0.0)]
+    m, zero, pressure = born  # the order, the zero's c on the origin's basis and its P
+    points = [(origin, zero, pressure, 0.0)]
     points += [(leg, leg.system.coefficients(p.X), p.X[-1], leg.system.reaction(p.X)) for leg in legs
                for p in leg.points]
     readers = {id(leg): SectorStability(leg.system) for leg in (origin, *legs)}
@@ -212,11 +233,11 @@ def _branch(origin: _Leg, legs: list, crossing, params: Parameters, folds: tuple
             break
         readings.append(readers[id(leg)](c, params.with_value("P", P)))
     return TubeSurfaceBranch(
-        final, crossing.m, np.array([leg.basis.raised(c, final) for leg, c, _, _ in points]),
+        final, m, np.array([leg.basis.raised(c, final) for leg, c, _, _ in points]),
         np.array([P for _, _, P, _ in points]),
-        np.array([2 * leg.system.surface.volume(c) / final.disc.length for leg, c, _, _ in points]),
+        np.array([leg.basis.volume_ratio(leg.system.surface.volume(c)) for leg, c, _, _ in points]),
         np.array([leg.amplitude(c) for leg, c, _, _ in points]), np.array([tau for *_, tau in points]),
-        np.array([error_estimate(leg.basis, c) for leg, c, _, _ in points]),
+        np.array([policy(leg.basis).error_estimate(leg.basis, c) for leg, c, _, _ in points]),
         np.array([lowest for lowest, _ in readings]),
         {control: np.array([counts[control] for _, counts in readings], dtype=int) for control in Control},
         folds, stop, parent, limited)

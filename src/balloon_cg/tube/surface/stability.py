@@ -10,7 +10,6 @@ inertia, which M does not change, is the stability; the eigenvalues' sizes are o
 import numpy as np
 from scipy import linalg
 
-from .. import azimuthal
 from ...numerics.eigen import GramFactor, restricted
 from ...scene.loading import Control
 
@@ -19,8 +18,7 @@ COUNT = 3  # the lowest eigenvalues stored per point (pressure control)
 
 def metric(basis) -> np.ndarray:
     """M on the free coefficients (module docstring)."""
-    gram = azimuthal.operators(basis.disc)[1]
-    blocks = [np.eye(basis.disc.size)] + [gram] * (len(basis.orders) - 1)
+    blocks = [np.eye(basis.axis_size)] + [basis.gram(m) for m in basis.orders[1:]]
     return linalg.block_diag(*blocks)[np.ix_(basis.free, basis.free)]
 
 
@@ -31,8 +29,7 @@ class SectorStability:
     def __init__(self, system):
         self.system = system
         self.factor = GramFactor(metric(system.basis))
-        free = system.free.size
-        self.gauge = system.gauge[None, :] if system.gauged else np.zeros((0, free))
+        self.gauge = system.gauges
 
     def pressure_matrix(self, c: np.ndarray, params) -> np.ndarray:
         """The standard symmetric matrix of the pencil (H, M) on tᵀ G c_1 = 0 (pressure control)."""

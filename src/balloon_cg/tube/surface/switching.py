@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .basis import TubeSurfaceBasis
-from .equilibrium import TubeSurfaceEquilibrium
+from .meridian import MeridianSurfaceBasis
+from .equilibrium import MeridianSurfaceEquilibrium
 from .system import TubeSurfaceSystem
-from .. import azimuthal
 from ...galerkin.equilibrium import Parameters
 from ...galerkin.interval import IntervalDiscretisation
 from ...numerics.newton import newton
@@ -30,7 +30,7 @@ class SwitchedPoint:
     """The state c (``basis``'s coefficients) and ``pressure`` at ``amplitude`` ε along the m-th critical mode;
     ``reaction`` τ; Newton's ``converged``, ``iterations``, ``residual`` (max-norm) and ``message``."""
 
-    basis: TubeSurfaceBasis
+    basis: MeridianSurfaceBasis
     c: np.ndarray
     pressure: float
     amplitude: float
@@ -42,11 +42,11 @@ class SwitchedPoint:
     message: str
 
 
-def mode_row(basis: TubeSurfaceBasis, m: int, mode: np.ndarray) -> np.ndarray:
+def mode_row(basis: MeridianSurfaceBasis, m: int, mode: np.ndarray) -> np.ndarray:
     """G φ in c (order m; φ the order-m amplitudes ``mode`` on ``basis``, e.g. a crossing's critical mode): its
     product with c is the amplitude φᵀ G c_m, the L² product of the two order-m fields (on any basis holding φ)."""
     row = np.zeros(basis.size)
-    row[basis.block(m)] = azimuthal.operators(basis.disc)[1] @ mode
+    row[basis.block(m)] = basis.gram(m) @ mode
     return row
 
 
@@ -69,12 +69,12 @@ def switched_point(scene, disc: IntervalDiscretisation, crossing, amplitude: flo
                               params, tol, max_iter)
 
 
-def point_at_amplitude(scene, basis: TubeSurfaceBasis, start: np.ndarray, pressure: float, row: np.ndarray,
+def point_at_amplitude(scene, basis: MeridianSurfaceBasis, start: np.ndarray, pressure: float, row: np.ndarray,
                        amplitude: float, m: int, params: Parameters, tol: float = 1e-12,
                        max_iter: int = 30) -> SwitchedPoint:
     """The equilibrium on ``basis`` with row · c = ``amplitude`` (``mode_row``: the amplitude of order m's critical
     mode) by Newton from (``start``, ``pressure``); the held unknowns (λ̄ of ends held apart) read from ``start``."""
-    system = TubeSurfaceSystem(TubeSurfaceEquilibrium(scene, basis), params, start)
+    system = TubeSurfaceSystem(MeridianSurfaceEquilibrium(scene, basis), params, start)
     result = newton(system.residual, system.jacobian, system.point(start, pressure),
                     np.append(row[system.free], [0.0] * (1 + system.gauged)), amplitude, tol, max_iter)
     c = system.coefficients(result.x)

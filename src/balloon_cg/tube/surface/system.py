@@ -1,45 +1,35 @@
-"""The equations of a tube's non-axisymmetric branch in P: the gauged equilibrium of the tube over (S, φ).
+"""The equations of a non-axisymmetric branch in P: the gauged equilibrium of a surface over (t, φ)
+(tube/surface/meridian.py).
 
-At X = (c_f, τ, P) (c_f the free coefficients of the basis, τ the multiplier of the gauge, P last: numerics/
-continuation.py's parameter)
+At X = (c_f, τ, P) (c_f the free coefficients of the basis, τ the multipliers of the gauge rows, P last:
+numerics/continuation.py's parameter)
 
-    R(X) = (∇E(c; P) + τ G t,  tᵀ G c_1) = 0,
+    R(X) = (∇E(c; P) + Σ_i τ_i g_i,  g_i · c) = 0,
 
-t the sideways translation (R = 1, T = −1, Z = 0 in order 1: tube/azimuthal.translation), a zero mode of E on
-sliding ends without a field, gauged by its held centroid tᵀ G c_1 = 0, τ the reaction (0 at an equilibrium: E is
-invariant under t). Plugged ends hold the rims, and a coil's field (M ≠ 0: tube/azimuthal.in_field) makes the
-translation no symmetry, the tube free to move sideways in it (tube/azimuthal.py's free reading): no gauge,
-X = (c_f, P). The Jacobian is exact (the surface Hessian bordered by G t and ∂R/∂P).
+g_i = G f_i the rows of the basis' zero modes f_i held (``gauge_rows``: a tube's sideways translation on sliding ends
+without a field; a capsule's translation and rotation about a horizontal axis, tube/surface/capsule.py), τ_i their
+reactions (0 at an equilibrium: E is invariant under them). Plugged ends hold the rims, and a coil's field
+(M ≠ 0: tube/azimuthal.in_field) makes the translation no symmetry, a tube free to move sideways in it: no gauge,
+X = (c_f, P). The Jacobian is exact (the surface Hessian bordered by the g_i and ∂R/∂P).
 """
 import numpy as np
 
-from .basis import TubeSurfaceBasis
-from .equilibrium import TubeSurfaceEquilibrium
+from .equilibrium import MeridianSurfaceEquilibrium
 from .. import azimuthal
 from ...galerkin.equilibrium import Parameters
-from ...scene.tables import Ends
-
-
-def gauge_row(basis: TubeSurfaceBasis, field: bool = False) -> np.ndarray:
-    """G t in c (order 1 on sliding ends), zero where nothing is gauged (plugged ends, no order 1, or in a coil's
-    ``field``)."""
-    row = np.zeros(basis.size)
-    if 1 in basis.orders and basis.disc.ends == Ends.SLIDING and not field:
-        row[basis.block(1)] = azimuthal.operators(basis.disc)[1] @ azimuthal.translation(basis.disc)
-    return row
 
 
 class TubeSurfaceSystem:
     """R(X) and its Jacobian (module docstring) of ``surface`` at ``params`` (P replaced by X[-1]); ``template``:
     the coefficients the held unknowns (λ̄ of ends held apart) are read from."""
 
-    def __init__(self, surface: TubeSurfaceEquilibrium, params: Parameters, template: np.ndarray):
+    def __init__(self, surface: MeridianSurfaceEquilibrium, params: Parameters, template: np.ndarray):
         self.surface, self.params = surface, params
         self.basis = surface.basis
         self.free = self.basis.free
         self.template = np.array(template, dtype=float)
-        self.gauge = gauge_row(self.basis, azimuthal.in_field(surface, params))[self.free]
-        self.gauged = bool(self.gauge.any())
+        self.gauges = self.basis.gauge_rows(azimuthal.in_field(surface, params))[:, self.free]
+        self.gauged = self.gauges.shape[0]
 
     @property
     def size(self) -> int:
@@ -68,7 +58,7 @@ class TubeSurfaceSystem:
         return self.params.with_value("P", X[-1])
 
     def reaction(self, X: np.ndarray) -> float:
-        """τ, the gauge's reaction (0 without a gauge)."""
+        """τ_1, the first gauge row's reaction (0 without a gauge)."""
         return float(X[self.free.size]) if self.gauged else 0.0
 
     def residual(self, X: np.ndarray) -> np.ndarray:
@@ -76,7 +66,8 @@ class TubeSurfaceSystem:
         R = self.surface.residual(c, at)[self.free]
         if not self.gauged:
             return R
-        return np.append(R + X[self.free.size] * self.gauge, self.gauge @ X[:self.free.size])
+        n = self.free.size
+        return np.concatenate([R + X[n:n + self.gauged] @ self.gauges, self.gauges @ X[:n]])
 
     def jacobian(self, X: np.ndarray) -> np.ndarray:
         c, at = self.coefficients(X), self.params_at(X)
@@ -84,7 +75,6 @@ class TubeSurfaceSystem:
         J = np.zeros((self.size, self.size + 1))
         J[:n, :n] = self.surface.hessian(c, at)[np.ix_(self.free, self.free)]
         J[:n, -1] = self.surface.parameter_derivative(c, at)[self.free]
-        if self.gauged:
-            J[:n, n] = self.gauge
-            J[n, :n] = self.gauge
+        J[:n, n:n + self.gauged] = self.gauges.T
+        J[n:, :n] = self.gauges
         return J
