@@ -402,7 +402,8 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
         trace, rejoin = new, rejoin_there
         first, kept = (moved[1], [] if again is None else [again]) if ahead else (again, [])
         segments.append((trace, kept))
-        step, fresh = (path.step, True) if ahead else (None, False)
+        # a new run: its first step the scene's, or the longer one the trace would take from the carried point
+        step, fresh = (max(path.step, scene.continuation.step), True) if ahead else (None, False)
 
 
 def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
