@@ -316,11 +316,12 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
     (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch). A point whose tail exceeds
     solver.max_error (the overshoot: converged on its basis) refines the basis (the wire map re-centred on the
     state, then the degree and the order extended), is solved again there on the hyperplane through it normal to
-    its tangent and, once the stop rule passes it there, is the next point; the trace goes on with the step that
-    reached it. Where a fold lies in that step, the last point is solved again there instead and the step starts
-    over (the fold is found again from it). (At fixed P the bordered Jacobian is near-singular where the branch is
-    tangent to P = const: the free m = 1 branch of the off-equator coil's free balloon at P = 1.6756, one point off
-    its branch point, has its smallest singular value 1.3e-6 at fixed P, 1.0e-3 on that hyperplane.) The two-coil
+    its tangent and, once the stop rule passes it there, is the next point; the trace goes on with the step it would
+    have taken from it (``continuation.next_step``), at least the scene's first step. Where a fold lies in that
+    step, the last point is solved again there instead and the step starts over (the fold is found again from it).
+    (At fixed P the bordered Jacobian is near-singular where the branch is tangent to P = const: the free m = 1
+    branch of the off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest
+    singular value 1.3e-6 at fixed P, 1.0e-3 on that hyperplane.) The two-coil
     m = 1 branch refines at 11 of its 13 steps: carrying the overshoot costs one Newton solve from a converged
     state instead of solving the last point again and a second corrector (23 correctors then, 13 now). A signal
     before the refinement or during it: the stop INTERRUPTED, the points so far kept. Returns (the last trace, the
@@ -355,12 +356,13 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
     """``follow``'s loop on ``segments`` (extended in place); ``running``: the points of the continuation run under
     way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments. At a
     resolution stop the point the stop rejected (the overshoot: converged, its tail above max_error) is carried to
-    the finer basis and solved there (``_carried``), and the trace goes on from it with the step that reached it;
-    where a fold lies in that step (on the coarse basis, or dP/ds changed sign on the way to the finer one), the last
-    point is solved again on the basis refined for the overshoot and the step taken again from it (the fold found
-    again there, on one basis). The first
-    point off a branch point (no stop rule checks it) is solved again on the finer basis too where its tail exceeds
-    max_error."""
+    the finer basis and solved there (``_carried``), and the trace goes on from it in a new run whose first step is
+    the longer of the scene's and the one the trace would have taken from it (``Path.step``: a coarse basis' slow
+    correctors shrank the step at every refinement, never grown in runs of one step); where a fold lies in that step
+    (on the coarse basis, or dP/ds changed sign on the way to the finer one), the last point is solved again on the
+    basis refined for the overshoot and the step taken again from it (the fold found again there, on one basis).
+    The first point off a branch point (no stop rule checks it) is solved again on the finer basis too where its
+    tail exceeds max_error."""
     scene, folds, step, fresh = trace.scene, [], None, False  # fresh: ``first`` is a new point, not yet accepted
     while True:
         done = sum(len(points) for _, points in segments)
