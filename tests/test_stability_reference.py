@@ -203,8 +203,8 @@ def test_compare_sees_a_moved_eigenvalue_and_a_changed_label():
     X, x = coils[f"{special}/X"], coils[f"{special}/x"]
     other_basis = np.append(X[:-1] + 1e-5, X[-1])  # coefficients of another basis, the same state
     assert compare(dict(coils, **{f"{special}/X": other_basis}), coils) == []
-    assert any(p.startswith(f"{special}/x") for p in compare(dict(coils, **{f"{special}/x": x + 1e-7}), coils))
-    assert any(p.startswith(f"{special}/x") for p in compare(dict(coils, **{f"{special}/X": X + 1e-7}), coils))
+    assert any(p.startswith(f"{special}/X") for p in compare(dict(coils, **{f"{special}/x": x + 1e-7}), coils))
+    assert any(p.startswith(f"{special}/X") for p in compare(dict(coils, **{f"{special}/X": X + 1e-7}), coils))
     label = next(k for k in expected if k.endswith("/label"))
     assert compare(dict(expected, **{label: np.array("LP even m=0 located fold index=0")}), expected)
     flags = expected["primary/flags"].copy()
