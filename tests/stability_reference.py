@@ -8,7 +8,10 @@ tests/data/reference/SCENE.npz (only to record a deliberate change of the number
 
 A picture's table (``table``): per branch, the lowest eigenvalues of every block (axisymmetric branches) or reading
 (surface branches), the six flags, the perturbation degree of each assessment, the unsettled points, and per
-special point its kind, block, m, status, classification and index (one text row) and its X (the located point).
+special point its kind, block, m, status, classification and index (one text row) and its X (the located point);
+on a surface branch also ``x``, its state x = X + u at SAMPLES (41 Gauss–Legendre cos θ × 12 φ: off the poles), which
+no basis enters (X's coefficients are of the branch's final basis, whose wire map the trace's chain of refinements
+chooses).
 Where an assessment's degree N was raised above stability.degree (near a wire), ``error_<block>`` holds its own error
 estimate, |μ(N) − μ(⌊N/1.5⌋)| per eigenvalue (the coarser degree: an over-estimate of the error at N, where the
 eigenvalues converge spectrally); zero elsewhere. A special point's ``uncertainty`` is the one it was stored with (an
@@ -26,6 +29,9 @@ GENT = DATA / "gent.toml"  # issue 38's Gent scene: its table computed by main b
 EXTRA = {path.stem: path for path in (OFF_EQUATOR, GENT)}  # scenes of tests/data/
 SCENES = tuple(sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")
                      if not p.stem.startswith("tube_"))) + tuple(EXTRA)  # a tube's run is not a picture
+
+
+SAMPLES = (np.polynomial.legendre.leggauss(41)[0], np.linspace(0.0, 2 * np.pi, 12, endpoint=False))  # (cos θ, φ)
 
 
 def reference_path(scene: str) -> Path:
@@ -53,6 +59,8 @@ def table(picture, errors: bool = False) -> dict[str, np.ndarray]:
             out[f"{key}/special_{n}/label"] = np.array(
                 f"{s.kind.value} {s.block.value} m={s.m} {s.status.value} {s.classification.value} index={s.index}")
             out[f"{key}/special_{n}/X"] = np.asarray(s.X, dtype=float)
+            if isinstance(branch.stability, dict):  # the state itself: its coefficients are of the branch's basis
+                out[f"{key}/special_{n}/x"] = branch.basis.grid_values(s.X[:-1], *SAMPLES)
             out[f"{key}/special_{n}/uncertainty"] = np.asarray(s.uncertainty, dtype=float)
     return out
 

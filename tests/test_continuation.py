@@ -178,3 +178,24 @@ def test_traced_folds_equal_brent_from_scratch(monkeypatch):
 
         root = continuation.locate_root(value_at, sigma)
         assert np.array_equal(root.payload[0], fold.point.X) and np.array_equal(root.payload[1], fold.point.tangent)
+
+
+def test_a_trace_resumed_from_its_overshoot_with_its_step_takes_the_same_points():
+    """``Path.step`` is the step the trace would take from its overshoot had it accepted it: resumed from the
+    overshoot with it (as a surface branch goes on from the point a resolution stop rejected, carried to a finer
+    basis) the trace takes the points of one never stopped (the S-curve's steps grow from 0.05 by 1.5 a point to
+    0.17; the overshoot here, the third point, is reached by 0.075 in 3 iterations: the next step is 0.1125)."""
+    from dataclasses import replace
+
+    u0 = -2.0
+    first = start(S_CURVE, [u0, 1 + u0**3 - u0], [1.0, 0.0])
+    whole = continuation.trace(S_CURVE, first, SETTINGS, lambda p: Stop(Done.REACHED, "u > 2") if p.X[0] > 2 else None,
+                               {})
+    stopped = continuation.trace(S_CURVE, first, SETTINGS,
+                                 lambda p: Stop(Done.REACHED, "u > -1.99") if p.X[0] > -1.99 else None, {})
+    assert len(stopped.points) == 2 and stopped.step == pytest.approx(0.1125)
+    resumed = continuation.trace(S_CURVE, stopped.overshoot, replace(SETTINGS, step=stopped.step),
+                                 lambda p: Stop(Done.REACHED, "u > 2") if p.X[0] > 2 else None, {})
+    joined = [p.X for p in stopped.points + resumed.points]
+    assert len(joined) == len(whole.points) > len(stopped.points) + 2
+    assert max(np.abs(a - b).max() for a, b in zip(joined, (p.X for p in whole.points))) < 1e-12

@@ -150,7 +150,7 @@ def test_a_signal_inside_a_point_s_spectra_stops_at_its_next_sector(pear_point, 
 
 
 def test_a_signal_as_a_surface_branch_would_refine_stops_it_there(pear_point, monkeypatch):
-    """A point whose tail exceeds solver.max_error refines the basis, solves the last point again and goes on (~1 s
+    """A point whose tail exceeds solver.max_error refines the basis, is solved again there and goes on (~1 s
     of CPU on two coils before the next point's poll): a signal then stops the branch where it is, not refined
     (the third point's tail made to exceed max_error as the signal comes)."""
     from balloon_cg.analysis.surface import branches as surface_branches

@@ -83,6 +83,7 @@ class Path:
     folds: list = field(default_factory=list)
     stop: Stop | None = None
     overshoot: Point | None = None  # the first point past a stop condition (not part of the branch)
+    step: float | None = None  # the step σ from the overshoot had it been accepted (``next_step``)
 
     def bracket(self, fold: Fold) -> tuple[np.ndarray, np.ndarray]:
         """X of the two points a fold lies between: the narrowest sign change its root search evaluated, else
@@ -222,6 +223,17 @@ def locate_fold(system, start: Point, sigma: float, c, settings: Settings, end: 
     return locate_root(value_at, sigma, known={sigma: (rate(c, end.X, end.tangent), reached)})
 
 
+def next_step(sigma: float, point: Point, settings: Settings) -> float:
+    """The step after ``point``, reached by the step σ: 1.5σ after an easy correction (≤ 3 iterations), at most
+    what moves the state by step_max along the point's tangent; 0.7σ, at least step_min, after a slow one (≥ 6)."""
+    if point.iterations <= 3:
+        state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
+        return min(sigma * 1.5, settings.step_max / state_share)
+    if point.iterations >= 6:
+        return max(sigma * 0.7, settings.step_min)
+    return sigma
+
+
 def trace(system, start: Point, settings: Settings, stop, monitors: dict, progress=None) -> Path:
     """Follow the branch from ``start`` along its tangent until ``stop(point)`` returns a ``Stop``.
 
@@ -271,17 +283,12 @@ def trace(system, start: Point, settings: Settings, stop, monitors: dict, progre
                     path.folds.append(Fold(label, fold.payload, len(path.points) - 1, fold.status, fold.bracket))
         reason = stop(point)
         if reason is not None:
-            path.stop = reason
-            path.overshoot = point
+            path.stop, path.overshoot, path.step = reason, point, next_step(sigma, point, settings)
             return path
         path.points.append(point)
         if progress is not None:
             progress(point)
         current, rates, across = point, new_rates, None
-        if result.iterations <= 3:
-            state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
-            sigma = min(sigma * 1.5, settings.step_max / state_share)
-        elif result.iterations >= 6:
-            sigma = max(sigma * 0.7, settings.step_min)
+        sigma = next_step(sigma, point, settings)
     path.stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({settings.max_points}) reached")
     return path

@@ -15,7 +15,8 @@ embedded mode, unit) is corrected on the hyperplane normal to φ, then the branc
 continuation until it rejoins the axisymmetric branch (the amplitude φ·(c − c*) changes sign), a pole stretch
 reaches stop_stretch, the membrane comes within wire_gap of a coil, or max_points; a point whose spectral tail
 exceeds solver.max_error refines the basis (``surface.resolution``: the wire map re-centred on the state, the
-degree and order extended; past MAX_DEGREE or MAX_ORDER the branch stops, flagged). The sign −φ is the image of the
+degree and order extended; past MAX_DEGREE or MAX_ORDER the branch stops, flagged) and is solved again there as the
+branch's next point (``follow``). The sign −φ is the image of the
 +φ branch under the rotation by π about the axis (``rotated``). Folds in P are located (LP).
 
 Every point carries its measures (pole stretches, volume, centroid offset, tilt) and the lowest eigenvalues of
@@ -312,17 +313,22 @@ def leave(trace: SurfaceTrace, X_star: np.ndarray, phi: np.ndarray, max_points: 
 def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_points: int, rejoin: tuple | None,
            progress=None, final=None) -> tuple:
     """Pseudo-arclength continuation in P from ``first`` (after the stored ``points``) until a stop of ``_stop_rule``
-    (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch); a point whose tail exceeds
-    solver.max_error refines the basis (the wire map re-centred on the state, then the degree and the order
-    extended), the last point is solved again there on the hyperplane through it normal to its tangent (at fixed P
-    the bordered Jacobian is near-singular where the branch is tangent to P = const: the free m = 1 branch of the
-    off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest singular value
-    1.3e-6 at fixed P, 1.0e-3 on that hyperplane) and the trace goes on (a signal before the refinement or during
-    it: the stop INTERRUPTED, the points so far kept). Returns (the last trace, the segments
-    [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop). ``final(trace,
-    point)``: called on each point in order once it is kept as it is, i.e. once a later point is accepted or the
-    trace ends (the last point may be solved again on a finer basis): the points read beside the trace
-    (``assessment.readers``)."""
+    (``rejoin``: (φ, X*) of a branch born at a branch point, None for a primary branch). A point whose tail exceeds
+    solver.max_error (the overshoot: converged on its basis) refines the basis (the wire map re-centred on the
+    state, then the degree and the order extended), is solved again there on the hyperplane through it normal to
+    its tangent and, once the stop rule passes it there, is the next point; the trace goes on with the step it would
+    have taken from it (``continuation.next_step``), at least the scene's first step. Where a fold lies in that
+    step, the last point is solved again there instead and the step starts over (the fold is found again from it).
+    (At fixed P the bordered Jacobian is near-singular where the branch is tangent to P = const: the free m = 1
+    branch of the off-equator coil's free balloon at P = 1.6756, one point off its branch point, has its smallest
+    singular value 1.3e-6 at fixed P, 1.0e-3 on that hyperplane.) The two-coil
+    m = 1 branch refines at 11 of its 13 steps: carrying the overshoot costs one Newton solve from a converged
+    state instead of solving the last point again and a second corrector (23 correctors then, 13 now). A signal
+    before the refinement or during it: the stop INTERRUPTED, the points so far kept. Returns (the last trace, the
+    segments [(trace, points)], the folds [(trace, Fold)] with indices over the whole branch, the Stop).
+    ``final(trace, point)``: called on each point in order once it is kept as it is, i.e. once a later point is
+    accepted or the trace ends (the last point may be solved again on a finer basis): the points read beside the
+    trace (``assessment.readers``)."""
     segments, running = [(trace, list(points))], []  # running: (trace, point) of the continuation run under way
     handed = 0
 
@@ -348,16 +354,29 @@ def follow(trace: SurfaceTrace, points: list, first: continuation.Point, max_poi
 def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuation.Point, max_points: int,
             rejoin: tuple | None, accepted) -> tuple:
     """``follow``'s loop on ``segments`` (extended in place); ``running``: the points of the continuation run under
-    way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments."""
-    scene, folds = trace.scene, []
+    way (its first, then each one ``accepted(trace, point)`` is told of) until they join the segments. At a
+    resolution stop the point the stop rejected (the overshoot: converged, its tail above max_error) is carried to
+    the finer basis and solved there (``_carried``), and the trace goes on from it in a new run whose first step is
+    the longer of the scene's and the one the trace would have taken from it (``Path.step``: a coarse basis' slow
+    correctors shrank the step at every refinement, never grown in runs of one step); where a fold lies in that step
+    (on the coarse basis, or dP/ds changed sign on the way to the finer one), the last point is solved again on the
+    basis refined for the overshoot and the step taken again from it (the fold found again there, on one basis).
+    The first point off a branch point (no stop rule checks it) is solved again on the finer basis too where its
+    tail exceeds max_error."""
+    scene, folds, step, fresh = trace.scene, [], None, False  # fresh: ``first`` is a new point, not yet accepted
     while True:
         done = sum(len(points) for _, points in segments)
         settings = continuation_settings(scene, max(max_points - done, 1))
-        running[:] = [(trace, first)]
+        if step is not None:
+            settings = replace(settings, step=step)
+        running[:] = [] if fresh else [(trace, first)]
+        if fresh:
+            accepted(trace, first)
         path = continuation.trace(trace.system, first, settings, _stop_rule(trace, rejoin),
                                   {Kind.LP: np.eye(first.X.size)[-1]}, lambda point, on=trace: accepted(on, point))
         running.clear()
         stop = path.stop
+        ahead = not any(f.index == len(path.points) - 1 for f in path.folds)  # no fold in the step to the overshoot
         # a fold in the step to a point the resolution stop rejects is found again from the re-solved last point
         folds += [(trace, replace(f, index=f.index + done)) for f in path.folds
                   if stop.code != StopCode.RESOLUTION or f.index < len(path.points) - 1]
@@ -366,35 +385,92 @@ def _follow(trace: SurfaceTrace, segments: list, running: list, first: continuat
             stop = Stop(TraceStop.MAX_POINTS, f"maximum number of points ({max_points}) reached")
         if stop.code != StopCode.RESOLUTION:
             return trace, segments, folds, stop
-        if interrupt.requested():  # not refined (a refinement and its first step: ~1 s of CPU on two coils)
-            return trace, segments, folds, INTERRUPTED
-        c = trace.system.coefficients(path.overshoot.X)
-        target = remapped(trace.basis, c, scene.field.coils)
-        finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target),
-                        scene.solver.max_error)
-        if finer is None:
-            stop = Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
-                                                                  f"order {MAX_ORDER})")
-            return trace, segments, folds, stop
-        new = trace.on(finer)
-        last = segments[-1][1].pop()  # solved again on the finer basis: the first point of the next segment
-        moved, reference = trace.move(last.X, new), trace.move_direction(last.tangent, new)
-        across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
-        X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
-                   scene.solver.max_newton)
-        if not X.converged or interrupt.requested():
-            segments[-1][1].append(last)
-            if X.converged:  # a signal while the point was solved again: the trace not gone on
-                return trace, segments, folds, INTERRUPTED
-            stop = Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
-                                                f"{finer.order}): {X.message}")
-            return trace, segments, folds, stop
-        first = continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
-                                   X.iterations, X.residual)
-        if rejoin is not None:
-            rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
-        trace = new
-        segments.append((trace, []))
+        if ahead:  # the overshoot carried to the finer basis: the next point
+            moved = _resolved(trace, path.overshoot, rejoin, stop)
+        else:  # a fold in the step to it: the step taken again, from the last point, on the basis refined for it
+            moved = _finer(trace, path.overshoot, rejoin, stop)
+        if isinstance(moved, Stop):  # the branch ends at its last point
+            return trace, segments, folds, moved
+        new, rejoin_there, last, again = moved[0], moved[-1], segments[-1][1][-1], None
+        if ahead and moved[1].tangent[-1] * last.tangent[-1] <= 0:
+            ahead = False  # dP/ds changed sign on the way to the finer basis: the step taken again over the fold there
+        if not ahead or tail(trace.basis, trace.system.coefficients(last.X)) > scene.solver.max_error:
+            # the last point solved again on the finer basis: the start of the step over the fold, or the first
+            # point off a branch point (no stop rule checked its tail), unresolved
+            again = _solved_on(trace, new, last)
+            if isinstance(again, Stop):
+                return trace, segments, folds, again
+            segments[-1][1].pop()
+        trace, rejoin = new, rejoin_there
+        first, kept = (moved[1], [] if again is None else [again]) if ahead else (again, [])
+        segments.append((trace, kept))
+        # a new run: its first step the scene's, or the longer one the trace would take from the carried point
+        step, fresh = (max(path.step, scene.continuation.step), True) if ahead else (None, False)
+
+
+def _resolved(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
+    """(trace, point, rejoin) of ``_carried`` repeated until the stop rule passes the point, or the Stop that ended
+    it: its own (not RESOLUTION) or ``_carried``'s."""
+    while True:
+        moved = _carried(trace, point, rejoin, stop)
+        if isinstance(moved, Stop):
+            return moved
+        trace, point, rejoin = moved
+        stop = _stop_rule(trace, rejoin)(point)
+        if stop is None:
+            return moved
+        if stop.code != StopCode.RESOLUTION:
+            return stop
+
+
+def _carried(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
+    """(the trace on the finer basis, ``point`` solved there, ``rejoin`` moved there) for a point whose tail exceeds
+    solver.max_error on ``trace``'s basis (``stop``: that resolution stop): ``_finer``, then the point transferred
+    and solved on the hyperplane through it normal to its tangent (``_solved_on``); or the Stop of either."""
+    finer = _finer(trace, point, rejoin, stop)
+    if isinstance(finer, Stop):
+        return finer
+    new, rejoin = finer
+    solved = _solved_on(trace, new, point)
+    return solved if isinstance(solved, Stop) else (new, solved, rejoin)
+
+
+def _finer(trace: SurfaceTrace, point: continuation.Point, rejoin: tuple | None, stop: Stop):
+    """(the trace on the basis refined for ``point``, whose tail exceeds solver.max_error on ``trace``'s basis
+    (``stop``: that resolution stop), and ``rejoin`` moved there): the wire map re-centred on the point, then the
+    degree and the order extended (``follow``); or the Stop RESOLUTION_LIMIT where the basis would pass MAX_DEGREE
+    or MAX_ORDER, INTERRUPTED at a signal before the refinement (~1 s of CPU on two coils with its first step)."""
+    if interrupt.requested():
+        return INTERRUPTED
+    scene = trace.scene
+    c = trace.system.coefficients(point.X)
+    target = remapped(trace.basis, c, scene.field.coils)
+    finer = refined(target, c if target is trace.basis else transfer(trace.basis, c, target), scene.solver.max_error)
+    if finer is None:
+        return Stop(StopCode.RESOLUTION_LIMIT, stop.message + f" (the basis would pass degree {MAX_DEGREE} or "
+                                                              f"order {MAX_ORDER})")
+    new = trace.on(finer)
+    if rejoin is not None:
+        rejoin = (trace.move_direction(rejoin[0], new), trace.move(rejoin[1], new))
+    return new, rejoin
+
+
+def _solved_on(trace: SurfaceTrace, new: SurfaceTrace, point: continuation.Point):
+    """``point`` of ``trace`` transferred to ``new``'s finer basis and solved there on the hyperplane through it
+    normal to its tangent (``follow``), with its tangent; the Stop REFINE_FAILED where Newton fails, INTERRUPTED at
+    a signal during the solve."""
+    scene, finer = trace.scene, new.basis
+    moved, reference = trace.move(point.X, new), trace.move_direction(point.tangent, new)
+    across = reference / np.linalg.norm(reference)  # the hyperplane through it normal to the branch
+    X = newton(new.system.residual, new.system.jacobian, moved, across, across @ moved, scene.solver.tol,
+               scene.solver.max_newton)
+    if not X.converged:
+        return Stop(StopCode.REFINE_FAILED, f"Newton failed on the refined basis (degree {finer.degree}, order "
+                                            f"{finer.order}): {X.message}")
+    if interrupt.requested():  # a signal while the point was solved again: the trace not gone on
+        return INTERRUPTED
+    return continuation.Point(X.x, continuation.tangent(new.system, X.x, reference, X.factors, across),
+                              X.iterations, X.residual)
 
 
 def collected(trace: SurfaceTrace, segments, folds, stop) -> dict:
