@@ -221,3 +221,32 @@ def test_a_continued_file_keeps_the_older_readings_of_its_source():
 
     assert inherited_readings({}) == 0 and inherited_readings({"readings": READINGS}) == READINGS
     assert inherited_readings({"readings": READINGS + 1}) == READINGS
+
+
+def test_continue_from_a_file_whose_readings_changed_is_refused_in_one_line(tmp_path, scene, capsys):
+    """A spheroid's branches stored before readings revision 2 were solved under another hold: continue refuses
+    the file (exit 2, one line naming the change) and writes nothing."""
+    from balloon_cg.app.cli import main
+
+    shaped = scene.with_overrides({"geometry.shape": "spheroid", "geometry.aspect": 1.2,
+                                   "continuation.stop_stretch": 1.3})
+    path = write_run(tmp_path / "run.h5", shaped, [trace_primary(shaped)])
+    with h5py.File(path, "r+") as f:
+        f.attrs["readings"] = 1
+    out = tmp_path / "continued.h5"
+    assert main(["continue", str(path), "1", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "written before this version changed its readings" in err and not out.exists()
+
+
+@pytest.mark.parametrize("held, named", [({"held_shape": "cube", "held_size": 1.2}, "held_shape = 'cube'"),
+                                         ({"held_shape": "spheroid"}, "held_shape without held_size"),
+                                         ({"held_shape": "spheroid", "held_size": -1.0}, "held_size = -1.0")])
+def test_a_damaged_held_attribute_is_refused_in_one_line(run_file, held, named):
+    """held_shape/held_size (a held general basis's area centroid) are both there or neither, a held shape and a
+    finite positive size: else RunFileError naming it (before: an internal error at continue, a KeyError)."""
+    with h5py.File(run_file, "r+") as f:
+        f["branches/primary"].attrs.update(held)
+    with pytest.raises(RunFileError) as refused:
+        read_run(run_file)
+    assert named in str(refused.value) and "\n" not in str(refused.value)

@@ -165,14 +165,16 @@ def test_run_refines_the_bulge_to_max_error_where_the_scene_asks(tmp_path, capsy
             assert main(["run", str(scene_file), "-o", str(path), "--quiet", "--force", "--allow-partial"]) == 0
 
 
-def test_tube_resolution_key_is_the_tubes_and_left_out_of_default_texts():
-    """solver.tube_resolution: "elements" (the default since session 29) is not written into a scene's text, "refine"
-    is; a wrong value and the key on another shape are one line naming the key, its value and what is allowed; a sphere
-    scene carries the default and never reads it."""
+def test_tube_resolution_key_is_the_tubes_and_always_in_a_tubes_text():
+    """solver.tube_resolution: a tube's normalised text always names it ("elements", the default since session 30,
+    and "refine" alike: a stored text without it reads as its file's revision ran, test_tube_sweep), another shape's
+    never; a wrong value and the key on another shape are one line naming the key, its value and what is allowed; a
+    sphere scene carries the default and never reads it."""
     import pytest
     from balloon_cg.scene import SceneError, load_scene, parse_scene
 
-    assert "tube_resolution" not in spom1_l10(30).to_toml() and "tube_resolution" in refined_scene(100).to_toml()
+    assert 'tube_resolution = "elements"' in spom1_l10(30).to_toml()
+    assert 'tube_resolution = "refine"' in refined_scene(100).to_toml()
     assert parse_scene(refined_scene(100).to_toml()).solver.tube_resolution == "refine"
     for text, words in (('[solver]\ntube_resolution = "fine"\n', "solver.tube_resolution = \"fine\": must be one of"),
                         ('[solver]\ntube_resolution = "refine"\n', 'only for geometry.shape = "tube"')):

@@ -2,6 +2,7 @@
 scene alone, bit for bit (its branches and located points), serially and on two workers; the table holds per member
 the uniform pressure maximum, the onset of bulging, the bulge's volume fold and Maxwell's pressure (those of its
 branches); the same command again computes nothing (resume); a bad value exits 2 with one line and writes nothing."""
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -79,3 +80,42 @@ def test_a_bad_value_exits_2_in_one_line_and_writes_nothing(folder, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "geometry.length = -1: must be in [0.1, 1000]" in err[0]
     assert not (folder / "bad.h5").exists() and not (folder / "bad.h5.members").exists()
+
+
+def test_a_member_whose_branch_stopped_unresolved_or_did_not_start_is_incomplete():
+    """tube/picture.unfinished, the rule by which ``run`` exits 1 and a sweep member is stored incomplete
+    (io/sweep_file.write_tube_member: before, a member was complete unless a signal stopped it): every branch that
+    did not start, every branch stopped unresolved (at its layout's cap), nothing else."""
+    from types import SimpleNamespace
+
+    from balloon_cg.analysis.results import IntervalStop
+    from balloon_cg.numerics.continuation import Stop, TraceStop
+    from balloon_cg.tube.picture import TubePicture, unfinished
+
+    def branch(code):
+        return SimpleNamespace(stop=Stop(code, f"stopped: {code.value}"))
+
+    whole = TubePicture({"primary": branch(IntervalStop.HOOP_STRETCH), "bulge": branch(TraceStop.MAX_POINTS)}, None)
+    assert unfinished(whole) == []
+    capped = TubePicture({"primary": branch(IntervalStop.HOOP_STRETCH), "bulge": branch(IntervalStop.UNRESOLVED)},
+                         None, not_started=(("bulge_3", "its first step did not converge"),))
+    assert [name for name, _ in unfinished(capped)] == ["bulge_3", "bulge"]
+
+
+def test_a_tube_file_written_before_the_elements_default_reads_its_scene_as_flag():
+    """A tube's solver.tube_resolution defaults to "elements" from readings revision scene.tables.ELEMENTS_SINCE on:
+    a stored tube text without the key read under an older revision is "flag" (what it ran), under this one or as a
+    new scene "elements"; a tube's normalised text always names it (sweep hashes of old and new members differ)."""
+    from balloon_cg.io.legacy import READINGS
+    from balloon_cg.scene import parse_scene
+    from balloon_cg.scene.tables import ELEMENTS_SINCE, parse_stored
+
+    assert "tube_resolution" not in tomllib.loads(SCENE)["solver"] and READINGS >= ELEMENTS_SINCE
+    assert parse_stored(SCENE, written=ELEMENTS_SINCE - 1).solver.tube_resolution == "flag"
+    assert parse_scene(SCENE, written=0).solver.tube_resolution == "flag"
+    for written in (None, ELEMENTS_SINCE, READINGS):
+        assert parse_stored(SCENE, written=written).solver.tube_resolution == "elements"
+    explicit = SCENE.replace("[solver]", '[solver]\ntube_resolution = "refine"')
+    assert parse_stored(explicit, written=0).solver.tube_resolution == "refine"
+    assert 'tube_resolution = "elements"' in parse_scene(SCENE).to_toml()
+    assert "tube_resolution" not in parse_scene('[material]\npreset = "spom1"\n').to_toml()

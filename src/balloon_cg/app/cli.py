@@ -1019,9 +1019,9 @@ def _continue(args) -> int:
     from ..analysis.results import Kind
     from ..analysis.critical.second_parameter import UnknownParameter
     from ..io.curve_file import write_curve
-    from ..io.legacy import inherited_readings
+    from ..io.legacy import inherited_readings, stale_readings
     from ..io.output import check_output
-    from ..io.run_file import read_run
+    from ..io.run_file import read_run, stored_scene
     from ..numerics.interrupt import Interrupted, requested, sigterm_raises, stop_on_signals
     from .restart import RestartError, find_label, restart, with_settings
 
@@ -1037,6 +1037,10 @@ def _continue(args) -> int:
         came = True
     if came:
         return curve_interrupted_status(None, args.output, True, "the work had not started")
+    stale = stale_readings(stored["attrs"], stored_scene(stored).geometry.shape.value)
+    if stale:  # its branches' states were solved under another hold: a start from them is no point of this version's
+        raise UsageError(f"continue {args.run}: written before this version changed its readings ({stale[0]}); run "
+                         "its scene again")
     with stop_on_signals():  # as run: a signal stops the work at its next point, what is finished is written
         try:
             start = find_label(stored, args.label)

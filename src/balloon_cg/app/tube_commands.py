@@ -33,10 +33,9 @@ def run_tube(scene, output, args) -> int:
     missing = []
     if run["attrs"]["not_started"]:
         missing.append(f"not started: {run['attrs']['not_started'].replace(chr(10), '; ')}")
-    bulge = run["branches"].get("bulge")
-    if bulge is not None and bulge["attrs"]["stop_code"] == IntervalStop.UNRESOLVED:
-        missing.append(f"bulge: {bulge['attrs']['stop_message']}, after {len(bulge['pressure'])} resolved points "
-                       f"(its stop code {IntervalStop.UNRESOLVED.value})")
+    missing += [f"{name}: {b['attrs']['stop_message']}, after {len(b['pressure'])} resolved points (its stop code "
+                f"{IntervalStop.UNRESOLVED.value})" for name, b in run["branches"].items()
+                if b["attrs"]["stop_code"] == IntervalStop.UNRESOLVED]  # tube/picture.unfinished's rule, as read
     if not missing:
         return 0
     print(f"{PROG}: incomplete ({'; '.join(missing)}); the rest is written to {output}", file=sys.stderr)
@@ -343,7 +342,8 @@ def stored_scene(args, run: dict):
     from ..scene import SceneError, parse_scene
 
     try:
-        return parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"])
+        return parse_scene(run["attrs"]["scene_toml"], run["attrs"]["scene_name"],
+                           written=int(run["attrs"].get("readings", 0)))  # its defaults: a tube's resolution
     except SceneError as e:
         raise UsageError(f"continue {args.run}: the stored scene cannot start a new run ({e})") from None
 

@@ -16,7 +16,7 @@ import io
 
 import h5py
 
-READINGS = 2
+READINGS = 3  # 3: a tube scene's solver.tube_resolution defaults to "elements" (scene.tables.ELEMENTS_SINCE)
 
 CHANGED_READINGS = (  # (revision, the shapes whose stored readings it changed, what changed)
     (1, ("spheroid",), "a spheroid's m = 1 blocks kept a rotation of the reference that is no zero mode of a "

@@ -571,7 +571,7 @@ def read_run(path) -> dict:
 def stored_scene(run: dict):
     """The Scene a run file was computed for, rebuilt from its ``scene_toml`` attribute as it was written
     (``scene.tables.parse_stored``: also a setting a new run may no longer start)."""
-    return parse_stored(run["attrs"]["scene_toml"], run["scene_name"])
+    return parse_stored(run["attrs"]["scene_toml"], run["scene_name"], written=int(run["attrs"].get("readings", 0)))
 
 
 def read_run_image(image: bytes, label: str = "run") -> dict:
@@ -704,6 +704,24 @@ def _check_snaps(snaps, branches, where, error) -> None:
                 raise error(where, f"{end}_index {index} is not a point of branch {name!r}")
 
 
+HELD_SHAPES = ("spheroid", "capsule")  # held_shape: the shapes whose held general basis holds its area centroid
+
+
+def _check_held(attrs, where, error) -> None:
+    """held_shape and held_size together or neither, the shape one of HELD_SHAPES, the size finite and positive (a
+    capsule's length may be 0)."""
+    held = [k for k in ("held_shape", "held_size") if k in attrs]
+    if len(held) == 1:
+        raise error(where, f"attribute {held[0]} without {({'held_shape', 'held_size'} - set(held)).pop()}")
+    if not held:
+        return
+    shape, size = str(attrs["held_shape"]), float(attrs["held_size"])
+    if shape not in HELD_SHAPES:
+        raise error(where, f"attribute held_shape = {shape!r}: must be one of {', '.join(HELD_SHAPES)}")
+    if not (np.isfinite(size) and (size > 0 or shape == "capsule" and size == 0)):
+        raise error(where, f"attribute held_size = {size!r}: must be finite and positive (a capsule's length ≥ 0)")
+
+
 def check_branch(group, where, error, written: bool = False) -> None:
     """The attributes and columns of one stored branch (at least one point; unknowns, profiles and special
     points of consistent shapes; ``written``: a file with checksums, also what this version writes,
@@ -718,6 +736,7 @@ def check_branch(group, where, error, written: bool = False) -> None:
                                                                      "held_shape": "str", "held_size": "float"}, error)
     if written:  # an axisymmetric branch's basis, written by this version: its joins (none: the Legendre basis)
         require_attrs(group.attrs, where, ("joins",), {"joins": "float[]"}, error)
+    _check_held(group.attrs, where, error)
     if "parent_branch" in group.attrs:
         require_attrs(group.attrs, where, PARENT_KINDS, PARENT_KINDS, error)
     n = check_columns(group, where, BRANCH_COLUMNS, error, min_rows=1)

@@ -147,12 +147,18 @@ class Store:
 
     def write_tube_member(self, member, result) -> None:
         """A tube member (app.sweep.TubeMemberResult): the tube run file's content (io.tube_file.write_tube), its
-        branch points and its verdict (complete unless a signal stopped it: ``interrupted`` names the stage) beside
+        branch points and its verdict (complete unless a signal stopped it, ``interrupted`` naming the stage, or a
+        branch did not start or stopped unresolved: tube/picture.unfinished, for which ``run`` exits 1) beside
         the member attributes."""
+        from ..tube.picture import unfinished  # here: tube/ imports numba, which reading does not need
+
         path = self.member_file(member.index)
         picture = result.picture
         points = picture.branches["primary"].branch_points()
-        stopped = picture.interrupted
+        stopped, unstarted = picture.interrupted, dict(picture.not_started)
+        gaps = ([(Gap.INTERRUPTED, stopped.value, f"interrupted by a signal during {stopped.value}")] if stopped
+                else []) + [(Gap.NOT_STARTED if name in unstarted else Gap.STOPPED_SHORT, name, why)
+                            for name, why in unfinished(picture)]
         with atomic_file(path, force=True) as f:
             write_tube(f, member.scene, picture)
             attrs = provenance()
@@ -163,14 +169,13 @@ class Store:
                 "overrides": json.dumps(member.overrides), "scene_hash": member.scene_hash,
                 "scene_toml": member.scene.to_toml(), "worker_pid": result.pid, "wall_time": result.wall_time,
                 "branch_point_pressures": np.array([p.pressure for p in points], dtype=float),
-                "complete": stopped is None})
+                "complete": not gaps})
             for key, values in (("branch_point_kinds", [p.kind.value for p in points]),
                                 ("branch_point_classifications", ["" for _ in points]),
                                 ("branch_point_blocks", [p.block.value for p in points]),
-                                ("incomplete_gaps", [] if stopped is None else ["interrupted"]),
-                                ("incomplete_branches", [] if stopped is None else [stopped.value]),
-                                ("incomplete_messages", [] if stopped is None else
-                                 [f"interrupted by a signal during {stopped.value}"])):
+                                ("incomplete_gaps", [gap.value for gap, _, _ in gaps]),
+                                ("incomplete_branches", [name for _, name, _ in gaps]),
+                                ("incomplete_messages", [why for _, _, why in gaps])):
                 f.attrs.create(key, np.array(values, dtype=object), dtype=text)
         self.done[member.index] = path
 

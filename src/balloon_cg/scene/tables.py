@@ -221,7 +221,7 @@ class Solver:
     The degree grows by half (up to ``max_degree``) whenever the spectral error estimate of a point exceeds
     ``max_error``; a branch that would need more stops there, saying so. A tube's bulge branch (switched at an odd
     branch point) follows ``tube_resolution``: "elements" (the default) traces it on spectral elements whose layout
-    is refined locally until every point is resolved, at most ``max_degree`` unknowns per field (tube/front.py);
+    is refined locally until every point is resolved, at most tube/front.element_cap unknowns per field;
     "flag" at the scene's degree, its points past ``max_error`` flagged; "refine" retraces it at growing degree until
     it is resolved, stopping "unresolved" at ``max_degree`` (tube/resolution.py). Other shapes never read it.
     """
@@ -425,8 +425,9 @@ class Scene:
             {"name": m.name, "mu": list(m.mu), "alpha": list(m.alpha)},
             "field": {"chi": f.chi, "M": f.M, "coils": [c.to_table() for c in f.coils]},
             "continuation": asdict(self.continuation),
-            "solver": {k: v for k, v in asdict(self.solver).items()  # tube_resolution only when set: older texts stay
-                       if k != "tube_resolution" or v != Solver.tube_resolution},
+            "solver": {k: v for k, v in asdict(self.solver).items()  # tube_resolution on tubes and where set: older
+                       if k != "tube_resolution" or v != Solver.tube_resolution  # texts stay; a tube's says it
+                       or self.geometry.shape == Shape.TUBE},
             "stability": asdict(self.stability),
             "output": {k: v for k, v in asdict(self.output).items()  # memory_limit only when set: older texts stay
                        if k != "memory_limit" or v != Output.memory_limit},
@@ -586,7 +587,11 @@ def _with_token(name: str, key: str, value) -> str:
         else f"{name}_{short}{text}"
 
 
-def parse_scene(text: str, name: str = "scene") -> Scene:
+ELEMENTS_SINCE = 3  # the readings revision (io.legacy.READINGS) of the first files whose tubes' default
+#                    solver.tube_resolution is "elements"; a tube's text stored before it without the key ran "flag"
+
+
+def parse_scene(text: str, name: str = "scene", written: int | None = None) -> Scene:
     """Parse and validate a scene from TOML text.
 
     Parameters
@@ -595,6 +600,9 @@ def parse_scene(text: str, name: str = "scene") -> Scene:
         The scene's TOML (docs/scenes.md).
     name : str, optional
         The scene's name (default ``"scene"``).
+    written : int, optional
+        The readings revision of the file that stored ``text`` (io.legacy.READINGS; None: a new scene): its
+        defaults are that revision's (``ELEMENTS_SINCE``).
 
     Returns
     -------
@@ -605,14 +613,15 @@ def parse_scene(text: str, name: str = "scene") -> Scene:
     SceneError
         Invalid TOML or an invalid scene (one line naming the key, the value and what is allowed).
     """
-    return _parse(text, name, name)
+    return _parse(text, name, name, written=written)
 
 
-def parse_stored(text: str, name: str = "scene") -> Scene:
+def parse_stored(text: str, name: str = "scene", written: int | None = None) -> Scene:
     """The scene a file stores (its ``scene_toml``), read as it was written: ``parse_scene`` without the checks of
     what a new run may start (``startable``), so that a file written before one of them is still read (inspect,
-    plot, load) and says what it was computed with; SceneError for text that is no scene."""
-    return _parse(text, name, name, new=False)
+    plot, load) and says what it was computed with, under the defaults of the file's readings revision
+    ``written``; SceneError for text that is no scene."""
+    return _parse(text, name, name, new=False, written=written)
 
 
 def startable(scene: Scene) -> Scene:
@@ -689,9 +698,9 @@ def shipped_scenes() -> dict[str, Path]:
     return {item.name.removesuffix(".toml"): Path(str(item)) for item in folder.iterdir() if item.name.endswith(".toml")}
 
 
-def _parse(text: str, name: str, source: str, new: bool = True) -> Scene:
+def _parse(text: str, name: str, source: str, new: bool = True, written: int | None = None) -> Scene:
     """The scene of the TOML ``text`` (errors prefixed with ``source``), ``startable`` unless it is a file's stored
-    text (``new`` False: ``parse_stored``)."""
+    text (``new`` False: ``parse_stored``), with the defaults of readings revision ``written`` (None: this one's)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
@@ -700,10 +709,20 @@ def _parse(text: str, name: str, source: str, new: bool = True) -> Scene:
         raise SceneError(f"{source}: invalid TOML: arrays or tables nested deeper than {MAX_NESTING} levels") from None
     try:
         _check_nesting(data)
-        scene = _build(data, name, text)
+        scene = _build(_as_written(data, written), name, text)
         return startable(scene) if new else scene
     except SceneError as e:
         raise SceneError(f"{source}: {e}") from None
+
+
+def _as_written(data: dict, written: int | None) -> dict:
+    """``data`` with the defaults of readings revision ``written`` where they differ from this version's: a tube's
+    solver.tube_resolution "flag" before ``ELEMENTS_SINCE``."""
+    geometry, solver = data.get("geometry"), data.get("solver", {})
+    if (written is None or written >= ELEMENTS_SINCE or not isinstance(geometry, dict) or not isinstance(solver, dict)
+            or geometry.get("shape") != Shape.TUBE.value or "tube_resolution" in solver):
+        return data
+    return {**data, "solver": {**solver, "tube_resolution": "flag"}}
 
 
 def _check_nesting(data) -> None:

@@ -242,7 +242,7 @@ def _relocated(scene, fold, system, path, onto, settings):
     tangent moved onto it (``_moved``: exact) and re-solved there by the Keller corrector, and the monitor's zero
     located in the step to the point after it, moved likewise, as the tracer locates it
     (numerics/continuation.locate_fold). Where that fails: the fold's own state moved, status NEAREST."""
-    after = path.points[fold.index + 1] if fold.index + 1 < len(path.points) else path.overshoot
+    after = path.points[fold.index + 1]  # an earlier leg's folds lie before its last point (bulge_branch)
     X, t = _moved(system, path.points[fold.index].X, path.points[fold.index].tangent, onto)
     solved = continuation.correct(onto, X, t, settings)
     root = None

@@ -45,9 +45,10 @@ ELEMENTS_PER_LENGTH = 2  # the layout's cap: elements of mean length half a refe
 
 
 def element_cap(scene) -> int:
-    """The layout's cap in unknowns per field, E p ≤ ORDER ⌈ELEMENTS_PER_LENGTH L⌉ (module docstring): 320 on
-    L = 10, 960 on L = 30 (whose branch to V/V0 = 50 ends on 22 elements)."""
-    return ORDER * int(np.ceil(ELEMENTS_PER_LENGTH * scene.geometry.length))
+    """The layout's cap in unknowns per field, E p ≤ ORDER max(⌈ELEMENTS_PER_LENGTH L⌉, 2 START_ELEMENTS) (module
+    docstring): 320 on L = 10, 960 on L = 30 (whose branch to V/V0 = 50 ends on 22 elements); on a short tube room
+    for twice the first layout (L = 3: 320, not 96, below the 160 it starts on)."""
+    return ORDER * max(int(np.ceil(ELEMENTS_PER_LENGTH * scene.geometry.length)), 2 * START_ELEMENTS)
 
 
 def uniform_layout(scene, elements: int, order: int) -> ElementInterval:

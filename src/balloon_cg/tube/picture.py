@@ -84,6 +84,14 @@ class TubePicture:
     surface: dict | None = None  # name -> tube/surface/branch.MeridianSurfaceBranch ([surface] branches; None: none)
 
 
+def unfinished(picture: TubePicture) -> list[tuple[str, str]]:
+    """(branch, why) of what a tube run lacks (``run`` exits 1 for it; a sweep member is stored incomplete): each
+    switched branch that did not start, each branch stopped unresolved (IntervalStop.UNRESOLVED: at its layout's
+    cap)."""
+    return [*picture.not_started, *((name, f"{b.stop.message} (its stop code {IntervalStop.UNRESOLVED.value})")
+                                    for name, b in picture.branches.items() if b.stop.code == IntervalStop.UNRESOLVED)]
+
+
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
     """The primary branch and, unless ``primary_only``, the branches switched at its branch points (module
     docstring); on a
