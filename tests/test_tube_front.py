@@ -259,3 +259,24 @@ def test_run_traces_the_bulge_on_elements_and_its_file_reads_back(tmp_path):
     S = np.linspace(0, 10.0, 51)
     assert np.abs(read.disc.profile(read.states[-1], S)[0] - bulge.disc.profile(bulge.states[-1], S)[0]).max() == 0
     assert main(["inspect", str(path)]) == 0
+
+
+def test_a_fold_found_on_an_earlier_layout_is_located_again_on_the_stored_one(monkeypatch):
+    """tube_spom1_L10's bulge on its default elements: its volume fold lies in a step of a layout the trace later
+    refines (tube/bulge._relocated runs: counted), and the stored fold is an equilibrium of the stored layout
+    (|R| ≤ solver.tol on its free rows; measured 7.6e-15) and V's extremum there: its two neighbours' volumes lie
+    on the same side of the fold's."""
+    import balloon_cg.tube.bulge as bulge
+    from balloon_cg.scene import load_scene
+    from shared_pictures import first_bulge_picture
+
+    relocated, original = [], bulge._relocated
+    monkeypatch.setattr(bulge, "_relocated", lambda *a: relocated.append(1) or original(*a))
+    scene = load_scene("tube_spom1_L10")
+    branch = first_bulge_picture(scene).branches["bulge"]
+    assert relocated and scene.solver.tube_resolution == "elements"
+    (fold,) = [s for s in branch.special if s.kind == Kind.LV]
+    eq = Equilibrium(scene, branch.disc)
+    assert np.abs(eq.residual(fold.u, Parameters(fold.pressure))[branch.disc.free]).max() <= scene.solver.tol
+    volumes = [eq.volume(u) for u in branch.states[fold.index:fold.index + 2]]
+    assert np.sign(volumes[0] - eq.volume(fold.u)) == np.sign(volumes[1] - eq.volume(fold.u)), volumes
