@@ -42,7 +42,8 @@ def test_continue_in_axial_stretch_follows_the_uniform_level_curve(tmp_path, cap
     path = tmp_path / "held.toml"
     path.write_text(scene.to_toml())
     run = tmp_path / "held.h5"
-    assert main(["run", str(path), "-o", str(run), "--quiet"]) == 0
+    # its fifth mode's bulge (bulge_5, two fronts more) passes the element layout's cap: the run says incomplete
+    assert main(["run", str(path), "-o", str(run), "--quiet", "--allow-partial"]) == 0
     labels = [s for s in read_tube_run(run)["branches"]["primary"]["special_points"]]
     assert (labels[0]["kind"], labels[0]["block"], labels[1]["block"]) == ("BP", "odd", "even")
     up, down = tmp_path / "up.h5", tmp_path / "down.h5"
