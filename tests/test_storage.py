@@ -204,14 +204,14 @@ def test_a_file_from_before_a_change_of_its_shapes_readings_says_so(tmp_path, sc
 
 def test_a_sweep_member_from_before_a_change_of_its_shapes_readings_says_so(scene):
     """A sweep's members are judged each by its own provenance and scene (a resumed sweep may mix versions)."""
-    from balloon_cg.app.summaries import _stale_member
+    from balloon_cg.app.summaries import _stale
     from balloon_cg.io.legacy import READINGS
 
     spheroid = scene.with_overrides({"geometry.shape": "spheroid", "geometry.aspect": 0.8}).to_toml()
-    assert len(_stale_member({"scene_toml": spheroid})) == 2 and len(_stale_member({"scene_toml": spheroid,
+    assert len(_stale({"scene_toml": spheroid})) == 2 and len(_stale({"scene_toml": spheroid,
                                                                                       "readings": 1})) == 1
-    assert _stale_member({"scene_toml": spheroid, "readings": READINGS}) == []
-    assert _stale_member({"scene_toml": scene.to_toml()}) == []
+    assert _stale({"scene_toml": spheroid, "readings": READINGS}) == []
+    assert _stale({"scene_toml": scene.to_toml()}) == []
 
 
 def test_a_continued_file_keeps_the_older_readings_of_its_source():

@@ -42,7 +42,7 @@ def summarise_sweep(path) -> dict:
         primary = member["branches"].get("primary")
         members[index] = {"overrides": member["overrides"],
                           "complete": bool(member["attrs"].get("complete", False)),
-                          "stale_readings": _stale_member(member["attrs"]),
+                          "stale_readings": _stale(member["attrs"]),
                           "branches": {name: len(b["pressure"]) for name, b in member["branches"].items()},
                           "primary": summarise_branch(primary) if primary is not None else None}
     return {"file": str(path), "kind": "sweep", "provenance": sweep["attrs"], "members": members}
@@ -60,16 +60,22 @@ def format_sweep(summary: dict) -> str:
         specials = len(m["primary"]["special_points"]) if m["primary"] else 0
         lines.append(f"  member {index:<4} {settings}: {'complete' if m['complete'] else 'INCOMPLETE'}; "
                      f"{branches}; {specials} special points on the primary branch")
-        lines += [f"    OUTDATED readings: {what}" for what in m["stale_readings"]]
+        lines += ["  " + line for line in _outdated(m["stale_readings"])]
     return "\n".join(lines)
 
 
-def _stale_member(attrs) -> list[str]:
+def _stale(attrs) -> list[str]:
     """``stale_readings`` of a file or sweep member whose attributes ``attrs`` hold its scene (``scene_toml``) and
     provenance (a resumed sweep's members may come from two versions)."""
     from ..scene.tables import parse_stored
 
     return stale_readings(attrs, parse_stored(attrs["scene_toml"], "member").geometry.shape.value)
+
+
+def _outdated(stale: list[str]) -> list[str]:
+    """One OUTDATED line per change of ``stale_readings`` a file or member predates."""
+    return [f"OUTDATED       written before this version changed its readings: {what}; run the scene again for "
+            "this version's" for what in stale]
 
 
 def summarise_curves(path) -> dict:
@@ -91,7 +97,7 @@ def summarise_curves(path) -> dict:
                         "of": c["attrs"].get("of", "BP"),
                         "points": len(c["q"]), "q": _range(c["q"]), "pressure": _range(c["pressure"]),
                         "special_points": c["special_points"], "meetings": curve_meetings(c)}
-    return {"file": str(path), "kind": "curve", "provenance": attrs, "stale_readings": _stale_member(attrs),
+    return {"file": str(path), "kind": "curve", "provenance": attrs, "stale_readings": _stale(attrs),
             "curves": curves}
 
 
@@ -99,9 +105,7 @@ def format_curves(summary: dict) -> str:
     p = summary["provenance"]
     lines = [f"file           {summary['file']}", f"scene          {p.get('scene_name')}",
              f"created        {p.get('created')}  (balloon-cg {p.get('package_version')}, format {p.get('format')})",
-             f"command        {p.get('command')}",
-             *(f"OUTDATED       written before this version changed its readings: {what}"
-               for what in summary["stale_readings"])]
+             f"command        {p.get('command')}", *_outdated(summary["stale_readings"])]
     for name, c in summary["curves"].items():
         critical = c["critical_q"]
         lines += ["", f"two-parameter curve {name}   (of {c['of']} points, in {c['parameter']}, degree {c['degree']})",
@@ -294,8 +298,7 @@ def format_run(run: dict) -> str:
         f"control        {p.get('control', 'pressure')} (loading.control)",
         f"kernels        digest {p['generated_digest'][:16]}…",
         f"result         {_verdict(p)}",
-        *(f"OUTDATED       written before this version changed its readings: {what}; run the scene again for "
-          "this version's" for what in summary["stale_readings"]),
+        *_outdated(summary["stale_readings"]),
         *_run_time_lines(summary),
     ]
     for name, b in summary["branches"].items():
