@@ -41,6 +41,12 @@ def test_map_is_monotone_onto_and_odd_for_mirrored_centres():
         WireMap((0.5,), (0.0,))
 
 
+def test_map_ends_are_exact():
+    """h(±1) = ±1 to the last bit: the sum of one centre at 0.6 rounds one ulp short of 1 without the guard."""
+    for mapping in (MAP, WireMap((0.6,), (0.06,)), WireMap((0.3,), (0.05,)), WireMap((-0.4, 0.4), (0.3, 0.3))):
+        assert mapping.s(np.array([-1.0, 1.0])).tolist() == [-1.0, 1.0]
+
+
 def test_mapped_quadrature_and_transfer():
     general = Discretisation(64, False, False, mapping=MAP)
     assert general.weights.sum() == pytest.approx(2.0, abs=1e-13)  # ∫ dx over [−1, 1]

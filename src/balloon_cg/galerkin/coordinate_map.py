@@ -54,8 +54,10 @@ class WireMap:
         return WireMap(tuple(-c for c in reversed(self.centres)), tuple(reversed(self.widths)))
 
     def s(self, x):
-        """h(x)."""
-        return -1.0 + self._scale * (self._sum(x) - self._low)
+        """h(x), exactly ±1 at x = ±1 (the rounded sum can fall one ulp short there, and an m ≥ 1 field's pole
+        factor √(1 − s²) would read ~1e-8 for 0)."""
+        x = np.asarray(x, dtype=float)
+        return np.where(np.abs(x) == 1.0, x, -1.0 + self._scale * (self._sum(x) - self._low))
 
     def ds_dx(self, x):
         """h'(x) > 0."""
