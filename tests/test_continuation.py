@@ -199,3 +199,18 @@ def test_a_trace_resumed_from_its_overshoot_with_its_step_takes_the_same_points(
     joined = [p.X for p in stopped.points + resumed.points]
     assert len(joined) == len(whole.points) > len(stopped.points) + 2
     assert max(np.abs(a - b).max() for a, b in zip(joined, (p.X for p in whole.points))) < 1e-12
+
+
+def test_easy_newton_sets_the_iterations_that_grow_the_step():
+    """``next_step`` grows σ by 1.5 after at most ``Settings.easy_newton`` corrector iterations (default 3; the bulge
+    branch on spectral elements passes 4: one SuperLU factor and its chord, tube/bulge.EASY_NEWTON_ELEMENTS), keeps
+    it up to 5 and shrinks it by 0.7 from 6; growth stops where the state would move step_max along the tangent."""
+    from dataclasses import replace
+
+    tangent = np.array([0.6, 0.8])  # the state's share of the unit tangent: 0.6
+    at = {k: continuation.Point(np.zeros(2), tangent, k, 0.0) for k in (3, 4, 5, 6)}
+    chord = replace(SETTINGS, easy_newton=4)
+    assert SETTINGS.easy_newton == 3
+    assert [continuation.next_step(0.1, at[k], SETTINGS) for k in (3, 4, 5, 6)] == pytest.approx([0.15, 0.1, 0.1, 0.07])
+    assert [continuation.next_step(0.1, at[k], chord) for k in (3, 4, 5, 6)] == pytest.approx([0.15, 0.15, 0.1, 0.07])
+    assert continuation.next_step(0.3, at[4], chord) == pytest.approx(SETTINGS.step_max / 0.6)

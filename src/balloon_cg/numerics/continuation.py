@@ -40,6 +40,7 @@ class Settings:
     max_turn: float = 0.3  # radians between successive tangents
     slow_newton: int = 6  # a correction needing more iterations is rejected (near-singular: e.g. a branch point)
     rounding_limit: float = 0.0  # > 0: accept a corrector at its rounding floor up to this, step across above it
+    easy_newton: int = 3  # a correction of at most this many iterations grows the next step (``next_step``)
 
 
 class TraceStop(enum.StrEnum):
@@ -224,9 +225,10 @@ def locate_fold(system, start: Point, sigma: float, c, settings: Settings, end: 
 
 
 def next_step(sigma: float, point: Point, settings: Settings) -> float:
-    """The step after ``point``, reached by the step σ: 1.5σ after an easy correction (≤ 3 iterations), at most
-    what moves the state by step_max along the point's tangent; 0.7σ, at least step_min, after a slow one (≥ 6)."""
-    if point.iterations <= 3:
+    """The step after ``point``, reached by the step σ: 1.5σ after an easy correction (at most settings.easy_newton
+    iterations, 3 unless a caller says otherwise), at most what moves the state by step_max along the point's
+    tangent; 0.7σ, at least step_min, after a slow one (≥ 6)."""
+    if point.iterations <= settings.easy_newton:
         state_share = max(float(np.linalg.norm(point.tangent[:-1])), 1e-6)  # σ moves the state by σ·share
         return min(sigma * 1.5, settings.step_max / state_share)
     if point.iterations >= 6:

@@ -52,6 +52,10 @@ PLUGGED_WHY = ("closed plugged ends have no odd bifurcation (the lowest odd eige
                "there are under-resolution), and the branch born at the odd branch point of plugged ends held apart "
                "is compressed beside the plugs from its first steps, where a membrane wrinkles and no relaxed energy "
                "is built (docs/tubes.md)")
+# On spectral elements (``on``) a corrector step of 4 iterations is easy: one SuperLU factorisation and its chord
+# (numerics/newton.py: REFRESH_RATIO_LARGE), which from a step of the plateau needs 4 corrections to reach the
+# tolerance; at the default 3 the step never grew there (the L = 30 branch: 478 points, 284 at 4, docs/tubes.md)
+EASY_NEWTON_ELEMENTS = 4
 
 
 class UnswitchableBranchPoint(ValueError):
@@ -99,6 +103,7 @@ def bulge_branch(scene, primary: IntervalBranch, point: IntervalSpecial, stop_vo
     system = _tube_system(scene, disc, params, unknowns)
     settings = continuation_settings(scene)
     settings.step = settings.step if step is None else step
+    settings.easy_newton = settings.easy_newton if on is None else EASY_NEWTON_ELEMENTS
     X = np.append(u, point.pressure)[system.columns]
     direction = np.append(phi, 0.0)[system.columns] / np.linalg.norm(phi)
     first = continuation.correct(system, X + settings.step * direction, direction, settings)
