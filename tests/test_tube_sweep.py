@@ -2,6 +2,7 @@
 scene alone, bit for bit (its branches and located points), serially and on two workers; the table holds per member
 the uniform pressure maximum, the onset of bulging, the bulge's volume fold and Maxwell's pressure (those of its
 branches); the same command again computes nothing (resume); a bad value exits 2 with one line and writes nothing."""
+import json
 import tomllib
 from pathlib import Path
 
@@ -72,6 +73,27 @@ def test_the_same_command_resumes_and_two_workers_give_the_same_members(folder, 
         for name, branch in serial.members[index].branches.items():
             assert np.array_equal(pool.members[index].branches[name]["unknowns"], branch["unknowns"])
     assert serial.to_dataframe().equals(pool.to_dataframe())
+
+
+def test_inspect_summarises_every_member_by_its_tube_summary(folder, capsys):
+    """``inspect`` of a tube sweep (text and --json): per member its verdict, branches and the primary's summary,
+    the one ``inspect`` gives the member's own run (app/tube_summary.py; a sphere's branch summary read attributes a
+    tube branch does not store: KeyError, exit 3, before)."""
+    from balloon_cg.app.tube_summary import summarise_tube
+
+    assert main(["inspect", str(folder / "serial.h5")]) == 0
+    text = capsys.readouterr().out
+    assert main(["inspect", "--json", str(folder / "serial.h5")]) == 0
+    members = json.loads(capsys.readouterr().out)["members"]
+    sweep = bc.load(folder / "serial.h5")
+    for index, length in enumerate(LENGTHS):
+        member = members[str(index)]
+        assert f"member {index:<4} geometry.length = {length:g}: complete" in text and member["complete"]
+        alone = main(["run", str(folder / "t.toml"), "--set", f"geometry.length={length}", "-o",
+                      str(folder / f"inspected_{index}.h5"), "--quiet"])
+        own = summarise_tube(read_tube_run(folder / f"inspected_{index}.h5"))["branches"]["primary"]
+        assert alone == 0 and member["primary"] == json.loads(json.dumps(own))
+        assert member["branches"] == {name: len(b["pressure"]) for name, b in sweep.members[index].branches.items()}
 
 
 def test_a_bad_value_exits_2_in_one_line_and_writes_nothing(folder, capsys):

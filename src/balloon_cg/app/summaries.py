@@ -6,6 +6,7 @@ import numpy as np
 from ..io.legacy import stale_readings
 from ..io.parents import parent_label, rejoin_label
 from ..io.run_file import stored_scene
+from ..scene.tables import Shape
 
 
 def summarise_file(path) -> tuple[dict, str]:
@@ -44,8 +45,21 @@ def summarise_sweep(path) -> dict:
                           "complete": bool(member["attrs"].get("complete", False)),
                           "stale_readings": _stale(member["attrs"]),
                           "branches": {name: len(b["pressure"]) for name, b in member["branches"].items()},
-                          "primary": summarise_branch(primary) if primary is not None else None}
+                          "primary": None if primary is None else _member_primary(path, index, member)}
     return {"file": str(path), "kind": "sweep", "provenance": sweep["attrs"], "members": members}
+
+
+def _member_primary(path, index: int, member: dict) -> dict:
+    """The summary of a sweep member's primary branch: a sphere's (``summarise_branch``) or, for a tube's member
+    (its ``shape`` attribute "tube", io.sweep_file.is_tube: its branches are a tube run's), the tube summary's
+    (app/tube_summary.py)."""
+    if member["attrs"].get("shape") != Shape.TUBE.value:
+        return summarise_branch(member["branches"]["primary"])
+    from .tube_summary import summarise_tube
+
+    tube = summarise_tube({"attrs": member["attrs"], "branches": {"primary": member["branches"]["primary"]},
+                           "path": f"{path}: /members/{index}"})
+    return tube["branches"]["primary"]
 
 
 def format_sweep(summary: dict) -> str:
