@@ -126,6 +126,24 @@ def test_unknown_parameter_is_one_line_listing_the_scene_parameters(tmp_path, ca
     assert not out.exists()
 
 
+def test_an_exponent_on_a_shape_other_than_the_sphere_is_refused_before_any_work(tmp_path, capsys):
+    """An Ogden exponent (alpha1, material.alpha[i]) is followed on the general kernel class, committed for the sphere
+    only: on a capsule ``critical`` refuses it in one line naming the key, the shape and what is allowed, before
+    tracing anything (it traced the primary branch and then failed on the kernel class, before); a modulus resolves."""
+    scene = tmp_path / "capsule.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[geometry]\nshape = "capsule"\nlength = 2.0\n')
+    capsule = load_scene(scene)
+    for key in ("alpha1", "material.alpha[1]"):
+        with pytest.raises(UnknownParameter, match=r"committed for the sphere only: scene capsule is a capsule"):
+            resolve(capsule, key)
+    assert resolve(capsule, "material.mu[1]") == "material.mu[1]"
+    assert resolve(parse_scene('[material]\npreset = "SPOM1"\n'), "alpha1") == "alpha1"
+    out = tmp_path / "curve.h5"
+    assert main(["critical", str(scene), "--of", "LP", "--parameter", "alpha1", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "'alpha1'" in err and "(allowed: " in err and not out.exists()
+
+
 def test_critical_C20_from_the_command_line(c20_curve, tmp_path, capsys):
     """`critical` with --set on a shipped scene (the Yeoh preset is the fixture's material) and a strain-energy
     parameter: the same merge as the library call, recorded in the curve file."""

@@ -27,6 +27,7 @@ from ...galerkin.equilibrium import Equilibrium, Parameters
 from ...model.kernels import KernelSet
 from ...scene.energies import FAMILIES, StrainEnergy
 from ...scene.materials import ALPHA1, alpha1_terms
+from ...scene.tables import Shape
 
 GENERAL_CLASS = "ogden_general_field"
 
@@ -135,7 +136,13 @@ def resolve(scene, key: str, kernels: KernelSet | None = None) -> str:
         listed = ", ".join(k for k, c in keys.items() if k == c)
         raise UnknownParameter(f"second parameter {key!r}: not a runtime parameter of scene {scene.name}; its "
                                f"parameters: {listed}")
-    return keys[key]
+    canonical = keys[key]
+    exponent = canonical == ALPHA1 or (_TERM.fullmatch(canonical) or [None, None])[1] == "alpha"
+    if exponent and scene.geometry.shape != Shape.SPHERE:
+        raise UnknownParameter(f"second parameter {key!r}: an Ogden exponent is followed on the general kernel "
+                               f"class, which is committed for the sphere only: scene {scene.name} is a "
+                               f"{scene.geometry.shape.value} (allowed: a modulus, material.mu[i], or a runtime scalar)")
+    return canonical
 
 
 _TERM = re.compile(r"material\.(mu|alpha)\[(\d+)\]")
