@@ -91,9 +91,25 @@ def test_inspect_summarises_every_member_by_its_tube_summary(folder, capsys):
         assert f"member {index:<4} geometry.length = {length:g}: complete" in text and member["complete"]
         alone = main(["run", str(folder / "t.toml"), "--set", f"geometry.length={length}", "-o",
                       str(folder / f"inspected_{index}.h5"), "--quiet"])
-        own = summarise_tube(read_tube_run(folder / f"inspected_{index}.h5"))["branches"]["primary"]
-        assert alone == 0 and member["primary"] == json.loads(json.dumps(own))
+        whole = summarise_tube(read_tube_run(folder / f"inspected_{index}.h5"))
+        assert alone == 0 and member["primary"] == json.loads(json.dumps(whole["branches"]["primary"]))
+        assert (whole["complete"], whole["result"]) == (True, "complete")  # the run file's stored verdict
         assert member["branches"] == {name: len(b["pressure"]) for name, b in sweep.members[index].branches.items()}
+
+
+def test_phase_draws_each_members_onset_maximum_fold_and_maxwell_pressure(folder):
+    """``plot --what phase`` of a tube sweep: the table's P_onset, P_max, P_LV and P_M against the varied length
+    (the sphere's pear pitchforks, which a tube has none of, drew only the LP before, under a pear title)."""
+    from balloon_cg.post.plotting import TUBE_PHASE, plot_phase
+
+    table = bc.load(folder / "serial.h5").to_dataframe()
+    fig = plot_phase([folder / "serial.h5"])
+    (ax,) = fig.axes
+    lines = {line.get_label().split(": ", 1)[1]: line for line in ax.get_lines()}
+    for column, label, _ in TUBE_PHASE:
+        assert list(lines[label].get_xdata()) == list(LENGTHS)
+        assert np.array_equal(lines[label].get_ydata(), table[column].to_numpy(), equal_nan=True)
+    assert "onset of bulging" in ax.get_title() and "pear" not in ax.get_title()
 
 
 def test_a_bad_value_exits_2_in_one_line_and_writes_nothing(folder, capsys):
@@ -105,23 +121,27 @@ def test_a_bad_value_exits_2_in_one_line_and_writes_nothing(folder, capsys):
 
 
 def test_a_member_whose_branch_stopped_unresolved_or_did_not_start_is_incomplete():
-    """tube/picture.unfinished, the rule by which ``run`` exits 1 and a sweep member is stored incomplete
-    (io/sweep_file.write_tube_member: before, a member was complete unless a signal stopped it): every branch that
-    did not start, every branch stopped unresolved (at its layout's cap), nothing else."""
+    """tube/picture.gaps, the verdict every tube run file stores (io/tube_file.write_tube), by which ``run`` exits 1
+    and a sweep member is incomplete: the stage a signal stopped, every branch that did not start, every branch
+    stopped unresolved (at its layout's cap, after its resolved points), nothing else."""
     from types import SimpleNamespace
 
-    from balloon_cg.analysis.results import IntervalStop
+    from balloon_cg.analysis.results import IntervalStop, StopCode
+    from balloon_cg.analysis.verdict import Gap
     from balloon_cg.numerics.continuation import Stop, TraceStop
-    from balloon_cg.tube.picture import TubePicture, unfinished
+    from balloon_cg.tube.picture import Stage, TubePicture, gaps
 
     def branch(code):
-        return SimpleNamespace(stop=Stop(code, f"stopped: {code.value}"))
+        return SimpleNamespace(stop=Stop(code, f"stopped: {code.value}"), pressure=np.zeros(7))
 
     whole = TubePicture({"primary": branch(IntervalStop.HOOP_STRETCH), "bulge": branch(TraceStop.MAX_POINTS)}, None)
-    assert unfinished(whole) == []
+    assert gaps(whole) == []
     capped = TubePicture({"primary": branch(IntervalStop.HOOP_STRETCH), "bulge": branch(IntervalStop.UNRESOLVED)},
                          None, not_started=(("bulge_3", "its first step did not converge"),))
-    assert [name for name, _ in unfinished(capped)] == ["bulge_3", "bulge"]
+    assert [(g.gap, g.branch) for g in gaps(capped)] == [(Gap.NOT_STARTED, "bulge_3"), (Gap.STOPPED_SHORT, "bulge")]
+    assert gaps(capped)[1].message == "stopped: unresolved, after 7 resolved points (its stop code unresolved)"
+    stopped = TubePicture({"primary": branch(StopCode.INTERRUPTED)}, None, interrupted=Stage.PRIMARY)
+    assert [(g.gap, g.branch) for g in gaps(stopped)] == [(Gap.INTERRUPTED, "primary")]
 
 
 def test_a_tube_file_written_before_the_elements_default_reads_its_scene_as_flag():

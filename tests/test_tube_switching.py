@@ -168,4 +168,7 @@ def test_a_branch_that_cannot_start_is_listed_and_the_run_is_incomplete(tmp_path
     for name, branch in run["branches"].items():
         assert np.array_equal(branch["unknowns"], expected["branches"][name]["unknowns"])
     assert main(["inspect", str(out)]) == 0
-    assert "not started    bulge_2: the first step" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "not started    bulge_2: the first step" in text
+    assert ("result         incomplete: not_started (bulge_2: the first step of the bulge branch did not converge: "
+            "forced)") in text and bool(run["attrs"]["complete"]) is False

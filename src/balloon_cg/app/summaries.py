@@ -311,7 +311,7 @@ def format_run(run: dict) -> str:
         f"tolerance      {p['tolerance']:g}",
         f"control        {p.get('control', 'pressure')} (loading.control)",
         f"kernels        digest {p['generated_digest'][:16]}…",
-        f"result         {_verdict(p)}",
+        f"result         {verdict_text(p)}",
         *_outdated(summary["stale_readings"]),
         *_run_time_lines(summary),
     ]
@@ -349,7 +349,7 @@ def _snap_symbol(run: dict, branch: str) -> str:
     return {Control.PRESSURE: "P", Control.VOLUME: "V", Control.GAS: "n"}[control]
 
 
-def _verdict(attrs: dict) -> str:
+def verdict_text(attrs: dict) -> str:
     """'complete', or the incomplete parts stored in a run file's root attributes; a complete result with stated
     limitations (a part not searched, a surface branch at its basis' cap: ``analysis.verdict.Gap.fails`` false)
     names them."""

@@ -16,7 +16,7 @@ def run_tube(scene, output, args) -> int:
     ``not_started``) or the bulge branch stopped unresolved at its cap (solver.tube_resolution "elements", the
     default: the element layout's, tube/front.element_cap; "refine": solver.max_degree, tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
-    from ..analysis.results import IntervalStop
+    from ..analysis.verdict import Gap
     from ..tube.picture import tube_picture
     from .tube_summary import format_tube, summarise_tube
 
@@ -30,12 +30,9 @@ def run_tube(scene, output, args) -> int:
         return code
     if summary is not None:
         print(summary)
-    missing = []
-    if run["attrs"]["not_started"]:
-        missing.append(f"not started: {run['attrs']['not_started'].replace(chr(10), '; ')}")
-    missing += [f"{name}: {b['attrs']['stop_message']}, after {len(b['pressure'])} resolved points (its stop code "
-                f"{IntervalStop.UNRESOLVED.value})" for name, b in run["branches"].items()
-                if b["attrs"]["stop_code"] == IntervalStop.UNRESOLVED]  # tube/picture.unfinished's rule, as read
+    a = run["attrs"]  # the verdict write_tube stored (tube/picture.gaps; a signal's was answered above)
+    missing = [f"not started: {branch}: {why}" if gap == Gap.NOT_STARTED else f"{branch}: {why}"
+               for gap, branch, why in zip(a["incomplete_gaps"], a["incomplete_branches"], a["incomplete_messages"])]
     if not missing:
         return 0
     print(f"{PROG}: incomplete ({'; '.join(missing)}); the rest is written to {output}", file=sys.stderr)

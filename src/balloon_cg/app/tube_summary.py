@@ -13,7 +13,8 @@ its event), with [dynamics] frequencies each block's lowest Ω² at every locate
 over the points, as a sphere run's), the m ≥ 1 blocks (``azimuthal``: per m the most unstable directions, the
 smallest eigenvalue, the points after which the unstable count changes and the located zeros with where their mode is
 largest; {} where not assessed), the onset curve of
-``critical`` (its range, folds and stop), the stage a signal stopped (``interrupted``), the switched branches that
+``critical`` (its range, folds and stop), the verdict (``complete``, ``result``: io/tube_file.py's; None and "not
+assessed" in files before it), the stage a signal stopped (``interrupted``), the switched branches that
 did not start (``not_started``: "name: why") and the non-axisymmetric branches ([surface] branches:
 ``surface_branches``, their parent branch and zero, ranges, stop, stable points and largest error estimate)."""
 import math
@@ -21,7 +22,7 @@ import tomllib
 
 import numpy as np
 
-from .summaries import surface_branch_lines, surface_branch_summaries
+from .summaries import surface_branch_lines, surface_branch_summaries, verdict_text
 from ..io.tube_file import CREST, HELD_M1, HOOP, STRETCH, VOLTAGE, discretisation
 from ..scene.tables import parse_stored
 from ..tube.azimuthal import mode_profile
@@ -74,6 +75,7 @@ def summarise_tube(run: dict) -> dict:
             "provenance": {k: a[k] for k in ("format", "created", "command", "package_version")},
             "branches": branches, "surface_branches": surface_branch_summaries(run.get("surface_branches", {}), control),
             "onset": _onset(run.get("onset"), max_error), "interrupted": a["interrupted"] or None,
+            "complete": None if "complete" not in a else bool(a["complete"]), "result": verdict_text(a),
             "not_started": [line for line in a["not_started"].split("\n") if line]}
 
 
@@ -183,7 +185,8 @@ def format_tube(summary: dict) -> str:
              f"control        {summary['control']}",
              f"degree         {summary['degree']}",
              "stability      m = 0 (pressure, volume and gas control); " + _assessed(summary),
-             f"Maxwell        P_M = {maxwell}"]
+             f"Maxwell        P_M = {maxwell}",
+             f"result         {summary['result']}"]
     lines += [f"not started    {line}" for line in summary["not_started"]]
     if summary["interrupted"]:
         lines.append(f"interrupted    a signal stopped the {summary['interrupted']} stage: what follows it is missing")

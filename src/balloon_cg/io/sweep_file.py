@@ -146,19 +146,12 @@ class Store:
         self.done[member.index] = path
 
     def write_tube_member(self, member, result) -> None:
-        """A tube member (app.sweep.TubeMemberResult): the tube run file's content (io.tube_file.write_tube), its
-        branch points and its verdict (complete unless a signal stopped it, ``interrupted`` naming the stage, or a
-        branch did not start or stopped unresolved: tube/picture.unfinished, for which ``run`` exits 1) beside
-        the member attributes."""
-        from ..tube.picture import unfinished  # here: tube/ imports numba, which reading does not need
-
+        """A tube member (app.sweep.TubeMemberResult): the tube run file's content and verdict (io.tube_file.write_tube:
+        complete unless a signal stopped it, or a branch did not start or stopped unresolved) and its branch points
+        beside the member attributes."""
         path = self.member_file(member.index)
         picture = result.picture
         points = picture.branches["primary"].branch_points()
-        stopped, unstarted = picture.interrupted, dict(picture.not_started)
-        gaps = ([(Gap.INTERRUPTED, stopped.value, f"interrupted by a signal during {stopped.value}")] if stopped
-                else []) + [(Gap.NOT_STARTED if name in unstarted else Gap.STOPPED_SHORT, name, why)
-                            for name, why in unfinished(picture)]
         with atomic_file(path, force=True) as f:
             write_tube(f, member.scene, picture)
             attrs = provenance()
@@ -168,14 +161,10 @@ class Store:
                 "format": MEMBER_FORMAT, "tolerance": member.scene.solver.tol,
                 "overrides": json.dumps(member.overrides), "scene_hash": member.scene_hash,
                 "scene_toml": member.scene.to_toml(), "worker_pid": result.pid, "wall_time": result.wall_time,
-                "branch_point_pressures": np.array([p.pressure for p in points], dtype=float),
-                "complete": not gaps})
+                "branch_point_pressures": np.array([p.pressure for p in points], dtype=float)})
             for key, values in (("branch_point_kinds", [p.kind.value for p in points]),
                                 ("branch_point_classifications", ["" for _ in points]),
-                                ("branch_point_blocks", [p.block.value for p in points]),
-                                ("incomplete_gaps", [gap.value for gap, _, _ in gaps]),
-                                ("incomplete_branches", [name for _, name, _ in gaps]),
-                                ("incomplete_messages", [why for _, _, why in gaps])):
+                                ("branch_point_blocks", [p.block.value for p in points])):
                 f.attrs.create(key, np.array(values, dtype=object), dtype=text)
         self.done[member.index] = path
 

@@ -5,7 +5,9 @@ Root attributes: the format, the scene (name, TOML), the shape and its parameter
 ``axial_stretch``: NaN where the ends' distance is free), the discretisation (``degree``, ``quadrature``),
 ``maxwell_pressure`` (NaN where there is none), ``control`` (the scene's loading.control, whose stability reading and
 folds count: files before it have none, read as "pressure"), ``not_started`` (one line "name: why" per switched
-branch whose first step did not converge, "" for none; files before it have none, read as "") and the provenance. One group per branch under
+branch whose first step did not converge, "" for none; files before it have none, read as ""), the verdict
+(``complete``, ``incomplete_gaps``/``_branches``/``_messages``: tube/picture.gaps, as a run file's; files before it
+have none) and the provenance. One group per branch under
 /branches/<name>/:
 per point ``unknowns`` (n, size: u of galerkin/interval.py), ``pressure``, ``volume`` (V/V0), ``unstable_pressure``,
 ``unstable_volume`` and ``unstable_gas`` (negative eigenvalues of ∂R/∂u, on δV = 0, and of ∂R/∂u + (P/Ṽ) g gᵀ:
@@ -47,6 +49,7 @@ import numpy as np
 
 from .hdf5 import atomic_file, checksummed, plain, provenance, write_strings
 from .layout import FileError, opened
+from .run_file import verdict_attrs
 from .tube_frequencies import read_tube_frequencies, write_tube_frequencies
 from .tube_surface_file import read_surface_branches, write_surface_branches
 from ..galerkin.equilibrium import Equilibrium
@@ -177,7 +180,7 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
              "not_started": "\n".join(f"{name}: {why}" for name, why in picture.not_started),
              "interrupted": "" if picture.interrupted is None else picture.interrupted.value,
              "title": f"balloon-cg run of the tube scene {scene.name}", **provenance(command)}
-    f.attrs.update(attrs)
+    f.attrs.update(attrs | _verdict(picture))
     for name, branch in picture.branches.items():
         group = f.create_group(f"branches/{name}")
         group.attrs.update({"stop_code": branch.stop.code.value, "stop_message": branch.stop.message,
@@ -232,6 +235,14 @@ def write_tube(f, scene, picture, command: str | None = None) -> None:
     write_surface_branches(f, picture.surface)
     if picture.onset is not None:
         _write_onset(f.create_group("onset"), picture.onset)
+
+
+def _verdict(picture) -> dict:
+    """``complete`` and ``incomplete_gaps``/``_branches``/``_messages`` (io/run_file.verdict_attrs) of tube/picture.gaps:
+    what ``inspect`` shows as the result, what ``run``'s exit code follows."""
+    from ..tube.picture import gaps  # here: reading a file does not need the tracers
+
+    return verdict_attrs(found=gaps(picture))
 
 
 def _layout(disc) -> dict:

@@ -1247,8 +1247,9 @@ def plot_phase(paths, axes=None) -> Figure:
             names = list(f.get("two_parameter", {}))
             is_sweep = "members" in f
         if is_sweep:
-            key = _sweep_phase(ax, path)
+            key, kind = _sweep_phase(ax, path)
             parameters.setdefault(key, ("M" if key == "field.M" else key, []))[1].append(Path(path).stem)
+            kinds.add(kind)
             continue
         if not names:
             raise PlotError(f"{path}: no two-parameter curve and no sweep members in this file (write one with "
@@ -1297,9 +1298,11 @@ def plot_phase(paths, axes=None) -> Figure:
 
 def phase_titles(kinds: set) -> tuple[str, str]:
     """(y label, title) of a phase diagram of the curves of ``kinds`` (what they follow: BP, the pear pitchforks;
-    LP, LV, LN, folds), naming only what is drawn."""
-    folds = ", ".join(sorted(kinds - {"BP"}))
+    LP, LV, LN, folds; "onset", a tube sweep's columns), naming only what is drawn."""
+    folds = ", ".join(sorted(kinds - {"BP", "onset"}))
     P = r"pressure $P = \bar P R_0/(T_0\mu/2)$"
+    if kinds == {"onset"}:
+        return P, "the tube's onset of bulging, pressure maximum, bulge fold and Maxwell's pressure"
     if not folds:
         return "bifurcation " + P, "pear-shaped pitchforks (the isola lies between the two)"
     if "BP" not in kinds:
@@ -1350,13 +1353,32 @@ def smooth_curve(q, P, samples: int = 400):
     return dense[:, 0], dense[:, 1]
 
 
-def _sweep_phase(ax, path) -> str:
+TUBE_PHASE = (("P_onset", "onset of bulging (the first odd BP)", "o-"),
+              ("P_max", "pressure maximum of the uniform tube (LP)", "s--"),
+              ("P_LV", "the bulge's volume fold (LV)", "^-"),
+              ("P_M", "Maxwell's pressure", "d:"))  # a tube sweep's columns (io/tube_file.tube_row) drawn by phase
+
+
+def _sweep_phase(ax, path) -> tuple[str, str]:
     """Pear pitchfork pressures of every sweep member against the first varied key, and the primary branch's
     fold (LP, the pressure maximum); the isola region (two pitchforks) shaded between them, its edges
-    interpolated between the members monotonically (PCHIP: no overshoot). Returns the varied key (dotted)."""
+    interpolated between the members monotonically (PCHIP: no overshoot). A tube's sweep: its members' onset of
+    bulging, pressure maximum, bulge fold and Maxwell pressure (``TUBE_PHASE``). Returns (the varied key (dotted),
+    what is drawn: "BP" or "onset", ``phase_titles``)."""
     sweep = read_sweep(path)
     if sweep["attrs"].get("mode") == "primary-only":  # no stability, so no branch points: an empty diagram
         raise PlotError(f"{path}: a primary-only sweep has no branch points to draw (sweep without --primary-only)")
+    members = sweep["members"].values()
+    if members and all(m["attrs"].get("shape") == Shape.TUBE.value for m in members):
+        from ..io.tube_file import tube_row  # here: a sphere's figures need none of the tube's modules
+
+        rows = sorted(((float(next(iter(m["overrides"].values()))), tube_row(m)) for m in members),
+                      key=lambda row: row[0])
+        for column, label, style in TUBE_PHASE:
+            values = np.array([row[column] for _, row in rows])
+            if np.isfinite(values).any():
+                ax.plot([q for q, _ in rows], values, style, ms=3, label=f"{Path(path).stem}: {label}")
+        return next(iter(next(iter(members))["overrides"])), "onset"
     rows = []
     for name, member in sweep["members"].items():
         key, value = next(iter(member["overrides"].items()))
@@ -1381,7 +1403,7 @@ def _sweep_phase(ax, path) -> str:
         dense = np.linspace(q[0], q[-1], 200)
         low, high = (PchipInterpolator(q, [r[1][k] for r in two])(dense) for k in (0, -1))
         ax.fill_between(dense, low, high, alpha=0.15, label="isola exists")
-    return key
+    return key, "BP"
 
 
 KINDS = {

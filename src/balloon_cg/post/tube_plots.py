@@ -182,10 +182,10 @@ def critical_modes(ax, run: dict, name: str, points=None) -> None:
     disc = discretisation(run["attrs"], run["branches"][name]["attrs"])
     s = np.linspace(0.0, run["attrs"]["length"], SAMPLES)
     for colour, k in zip(matplotlib_colours(len(chosen)), chosen):
-        m, p = located[k]
+        m, p = located[k]  # m: "1 held" (io/tube_file.HELD_M1) for a zero of the held tube's block
         for values, style, part in zip(mode_profile(disc, p["mode"], s), ("-", "--", ":"), "RTZ"):
             ax.plot(s, values, color=colour, linestyle=style,
-                    label=f"${part}$, $m$ = {m}{' held' if p['held'] else ''}, $P$ = {p['pressure']:.6g}")
+                    label=f"${part}$, $m$ = {m}, $P$ = {p['pressure']:.6g}")
     ax.set(xlabel="$S$", ylabel="amplitude ($\\frac{1}{2}\\int (R^2 + T^2 + Z^2)\\,dS = 1$)",
            title=f"{run['attrs']['scene_name']}: critical modes, {name} branch")
 

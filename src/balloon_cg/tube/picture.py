@@ -37,6 +37,7 @@ from .stretch import stretch_branch
 from .voltage import voltage_branch
 from ..analysis.results import IntervalStop, Kind, StopCode
 from ..analysis.surface.meridian.trace import SurfaceBranchStartError
+from ..analysis.verdict import Gap, Incomplete
 from ..galerkin.equilibrium import Equilibrium
 from ..galerkin.interval import Mirror
 from ..galerkin.interval_elements import ElementInterval, collocated
@@ -84,12 +85,16 @@ class TubePicture:
     surface: dict | None = None  # name -> tube/surface/branch.MeridianSurfaceBranch ([surface] branches; None: none)
 
 
-def unfinished(picture: TubePicture) -> list[tuple[str, str]]:
-    """(branch, why) of what a tube run lacks (``run`` exits 1 for it; a sweep member is stored incomplete): each
-    switched branch that did not start, each branch stopped unresolved (IntervalStop.UNRESOLVED: at its layout's
-    cap)."""
-    return [*picture.not_started, *((name, f"{b.stop.message} (its stop code {IntervalStop.UNRESOLVED.value})")
-                                    for name, b in picture.branches.items() if b.stop.code == IntervalStop.UNRESOLVED)]
+def gaps(picture: TubePicture) -> list[Incomplete]:
+    """What a tube run lacks (its file's verdict, io/tube_file.py; ``run`` exits 130 for a signal, 1 for the others; a
+    sweep member is stored incomplete): the stage a signal stopped, each switched branch that did not start, each
+    branch stopped unresolved (IntervalStop.UNRESOLVED: at its layout's cap) after its resolved points."""
+    stopped = picture.interrupted
+    return ([Incomplete(Gap.INTERRUPTED, stopped.value, f"interrupted by a signal during {stopped.value}")]
+            if stopped else []) + [Incomplete(Gap.NOT_STARTED, name, why) for name, why in picture.not_started] + [
+        Incomplete(Gap.STOPPED_SHORT, name, f"{b.stop.message}, after {len(b.pressure)} resolved points (its stop code "
+                                            f"{IntervalStop.UNRESOLVED.value})")
+        for name, b in picture.branches.items() if b.stop.code == IntervalStop.UNRESOLVED]
 
 
 def tube_picture(scene, primary_only: bool = False) -> TubePicture:
