@@ -126,8 +126,10 @@ def tube_run():
     """tube_spom1_L10 with [dynamics] frequencies (count 6): its primary and bulge branches (``run``'s, without the
     branches switched at the later branch points: shared_pictures.first_bulge_picture) with_frequencies, and their
     frequencies; the bulge on the default spectral elements (its fold's Ω² a Ritz value, numerics/eigen.lowest_ritz:
-    a dense solve's read ±3e-11 there, ε times the layout's highest mode)."""
-    scene = load_scene("tube_spom1_L10").with_overrides({"dynamics.frequencies": True, "dynamics.count": COUNT})
+    a dense solve's read ±3e-11 there, ε times the layout's highest mode; benchmarks/tube_frequency_ritz.py), without
+    the m ≥ 1 blocks (stability.m_max = 0: ~30 of the ~40 s of CPU on elements; the branches are the same)."""
+    scene = load_scene("tube_spom1_L10").with_overrides({"dynamics.frequencies": True, "dynamics.count": COUNT,
+                                                         "stability.m_max": 0})
     picture = with_frequencies(scene, first_bulge_picture(scene))
     return scene, picture, picture.frequencies
 
