@@ -125,12 +125,11 @@ def test_closed_tube_odd_modes_are_the_uniform_cylinders_vibrations(hoop):
 def tube_run():
     """tube_spom1_L10 with [dynamics] frequencies (count 6): its primary and bulge branches (``run``'s, without the
     branches switched at the later branch points: shared_pictures.first_bulge_picture) with_frequencies, and their
-    frequencies. The bulge on Legendre ("flag"), where its fold's Ω² is zero to solver.tol: on the default spectral
-    elements it reads 3.4e-11, within the rounding spread of that eigenproblem there (±2.9e-11 for state changes of
-    1e-15 relative; the element mass matrix's condition 2.5e5), which a bound of 1e-11 cannot tell from zero
-    (docs/tubes.md: the element frequencies' floor, not yet tested)."""
+    frequencies; the bulge on the default spectral elements (its fold's Ω² a Ritz value, numerics/eigen.lowest_ritz:
+    a dense solve's read ±3e-11 there, ε times the layout's highest mode; benchmarks/tube_frequency_ritz.py), without
+    the m ≥ 1 blocks (stability.m_max = 0: ~30 of the ~40 s of CPU on elements; the branches are the same)."""
     scene = load_scene("tube_spom1_L10").with_overrides({"dynamics.frequencies": True, "dynamics.count": COUNT,
-                                                         "solver.tube_resolution": "flag"})
+                                                         "stability.m_max": 0})
     picture = with_frequencies(scene, first_bulge_picture(scene))
     return scene, picture, picture.frequencies
 
@@ -165,6 +164,26 @@ def test_located_tube_points_have_a_vanishing_frequency_in_their_block(tube_run)
     assert all(s.smallest_stress >= COMPRESSED for b in picture.branches.values() for s in b.special)
     assert ("primary", Kind.LP, "even") in kinds and ("primary", Kind.BP, Mirror.ODD.value) in kinds, kinds
     assert ("bulge", Kind.LV, "all_volume") in kinds, kinds
+
+
+def test_the_volume_blocks_lowest_frequency_crosses_zero_at_the_located_fold(tube_run):
+    """A second check of the bulge's fold in V on elements: Ω²(P) of the volume block at the stored points, an
+    interpolating polynomial through k of them on each side of the fold (degree 2k − 1), has its zero at the located
+    fold's pressure, the more closely the more points: k = 1, 2, 3 off by ≤ 3e-4, 1e-6, 1e-7 (measured 1.1e-4,
+    1.5e-7, 8.8e-9; P is monotone there), and the fold's own Ω² is zero to 1e-13 (measured 5.7e-16)."""
+    scene, picture, frequencies = tube_run
+    branch = picture.branches["bulge"]
+    assert branch.disc.count > 1  # spectral elements
+    n, fold = next((n, s) for n, s in enumerate(branch.special) if s.kind == Kind.LV)
+    omega2 = frequencies["bulge"].omega2["all_volume"][:, 0]
+    assert abs(frequencies["bulge"].special["all_volume"][n, 0]) <= 1e-13
+    for k, bound in zip((1, 2, 3), (3e-4, 1e-6, 1e-7)):
+        around = slice(fold.index + 1 - k, fold.index + 1 + k)
+        P, values = branch.pressure[around], omega2[around]
+        assert np.all(np.diff(P) < 0) and values[0] * values[-1] < 0
+        roots = np.roots(np.polyfit(P, values, 2 * k - 1))
+        zero = roots[np.argmin(np.abs(roots - fold.pressure))]
+        assert abs(zero.imag) == 0 and abs(zero.real - fold.pressure) <= bound, (k, zero, fold.pressure)
 
 
 @pytest.mark.slow

@@ -45,14 +45,16 @@ def tube_blocks(disc: IntervalDiscretisation, symmetric: bool) -> dict:
 def tube_frequencies(eq: Equilibrium, mass: np.ndarray, u, params: Parameters, symmetric: bool,
                      count: int) -> dict:
     """{block: its ``count`` lowest Ω² (ascending)} at the state u at ``params``: ν of K q = ν M q on each block of
-    ``tube_blocks``, on gᵀq = 0 (g = ∂Ṽ/∂u = −∂R/∂P) for the volume blocks."""
+    ``tube_blocks``, on gᵀq = 0 (g = ∂Ṽ/∂u = −∂R/∂P) for the volume blocks, each the Ritz value of its computed
+    eigenvector (numerics/eigen.lowest_ritz: a dense solve reads ν near zero only to ε ν_max, the layout's highest
+    mode: ±3e-11 in Ω² at tube_spom1_L10's fold on elements, the Ritz value ~1e-15)."""
     H = eq.jacobian(u, params)
     g = -eq.parameter_derivative(u, params, "P")
     out = {}
     for name, (index, constrained) in tube_blocks(eq.disc, symmetric).items():
         normals = g[index][None, :] if constrained else eigen.NO_CONSTRAINT
         factor = eigen.GramFactor(mass[np.ix_(index, index)])
-        out[name] = PER_EIGENVALUE * eigen.lowest(H, factor, count, normals, index)
+        out[name] = PER_EIGENVALUE * eigen.lowest_ritz(H, factor, count, normals, index)
     return out
 
 

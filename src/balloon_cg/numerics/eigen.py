@@ -95,6 +95,17 @@ class GramFactor:
             return out
         return np.ascontiguousarray(normals * self.scale if self.scale is not None else normals @ self.inverse.T)
 
+    def back(self, Y) -> np.ndarray:
+        """The columns L⁻ᵀy of the columns y of Y (n × m): the vectors c of the coordinates y = Lᵀc."""
+        if self.scale is not None:
+            return Y * self.scale[:, None]
+        if self.parts is not None:
+            out = np.empty(Y.shape)
+            for s, part in self.parts:
+                out[s] = linalg.solve_triangular(part, Y[s], lower=True, trans="T")
+            return out
+        return linalg.solve_triangular(self.lower, Y, lower=True, trans="T")
+
     def standard(self, B) -> np.ndarray:
         """L⁻¹ B L⁻ᵀ of a block-diagonal factor (``blocks``), B overwritten: the rows of each block solved, then its
         columns."""
@@ -452,6 +463,32 @@ def lowest(H, factor: GramFactor, count: int, normals=NO_CONSTRAINT, index=None,
     return lowest_of(restricted(H, factor, normals, index, rcond), count)
 
 
+def lowest_ritz(H, factor: GramFactor, count: int, normals=NO_CONSTRAINT, index=None,
+                rcond: float = RCOND) -> np.ndarray:
+    """``lowest``'s μ each to the rounding of its own Rayleigh quotient: the Ritz values of the pencil (H, G) on the
+    block on the span of its ``count`` lowest eigenvectors, c_i = L⁻ᵀ Qᵀ(0, y_i) (y_i of ``restricted``'s A, moved
+    back through the reflections and the factor), eig(VᵀHV, VᵀGV).
+
+    A dense eigensolver's eigenvalues of A are exact for a matrix within ε‖A‖ of it, and ‖A‖ is the pencil's largest
+    μ in every basis (a refined element layout's highest mode: 7.2e5 on tube_spom1_L10's bulge), so its μ near zero
+    carry errors up to ε‖A‖ (1.6e-10 there). A Ritz value on y_i's span is off by Σ_j (μ_j − μ_i) δ_ij² ≈ n (ε‖A‖)²/gap
+    (δ_ij ≈ ε‖A‖/|μ_j − μ_i| the computed vector's part along the other eigenvectors) plus the rounding of VᵀHV,
+    ε‖H‖‖c‖²/cᵀGc: ~1e-15 near zero where ``lowest``'s read ±3e-11."""
+    A = restricted(H, factor, normals, index, rcond)
+    found = min(count, A.shape[0])
+    _, vectors, _, _, info = dsyevr(A.T, compute_v=1, range="I", il=1, iu=found)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"dsyevr failed (info = {info})")
+    H = np.asarray(H, dtype=float)
+    block = H if index is None else _gather(np.ascontiguousarray(H), np.asarray(index, dtype=np.int64))
+    normals = np.atleast_2d(normals)
+    directions = factor.directions(normals) if normals.shape[0] else np.zeros((0, block.shape[0]))
+    V = factor.back(_reflect_back(np.ascontiguousarray(directions), rcond,
+                                  np.ascontiguousarray(vectors[:, :found].T)).T)
+    G = factor.gram
+    return linalg.eigvalsh(V.T @ block @ V, V.T @ (G[:, None] * V if G.ndim == 1 else G @ V))
+
+
 @njit(cache=True)
 def _gather(H, index):
     """H[index][:, index]."""
@@ -569,6 +606,37 @@ def _reflect(B, directions, rcond):
                     Bv_next[i - 1] += value * v_next[j - 1]
         D, v, Bv = rest, v_next, Bv_next
     return np.ascontiguousarray(B[k:, k:])
+
+
+@njit(cache=True)
+def _reflect_back(directions, rcond, Y):
+    """The rows y of Y (m × (n − k)) in the coordinates of ``_reflect``'s result moved back to the n of its input:
+    y ← Q (0, y) for each of its k reflections Q, the last first (orthogonal to the ``directions``)."""
+    D = orthonormal_rows(directions, rcond)
+    k, n = D.shape
+    reflections = []
+    for r in range(k):
+        v = _householder(D[r])
+        reflections.append(v)
+        w = 2.0 / _dot(v, v)
+        rest = np.empty((k, n - r - 1))
+        for s in range(r + 1, k):
+            projected = _dot(D[s], v)
+            for i in range(1, n - r):
+                rest[s, i - 1] = D[s, i] - w * v[i] * projected
+        D = rest
+    out = Y.copy()
+    for r in range(k - 1, -1, -1):
+        v = reflections[r]
+        w = 2.0 / _dot(v, v)
+        moved = np.zeros((out.shape[0], out.shape[1] + 1))
+        moved[:, 1:] = out
+        for s in range(moved.shape[0]):
+            projected = _dot(moved[s], v)
+            for i in range(moved.shape[1]):
+                moved[s, i] -= w * v[i] * projected
+        out = moved
+    return out
 
 
 @njit(cache=True)
