@@ -1,6 +1,5 @@
-"""The public API: docs/api.md's example runs end to end; Results are short to print, save and load exactly,
-and tabulate what the run file holds."""
-import re
+"""The public API: Results are short to print, save and load exactly, and tabulate what the run file holds
+(docs/api.md's example runs end to end in tests/test_api_notebook.py)."""
 import subprocess
 import sys
 from pathlib import Path
@@ -13,31 +12,6 @@ from balloon_cg.io.run_file import read_run
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
-
-
-def example() -> str:
-    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "api.md").read_text(encoding="utf-8"), re.S)
-    assert len(blocks) == 1
-    return blocks[0]
-
-
-def test_the_documented_example_runs(tmp_path, capsys, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    namespace = {}
-    exec(compile(example(), "docs/api.md", "exec"), namespace)  # our own documentation, not user input
-    result, fig = namespace["result"], namespace["fig"]
-    assert (tmp_path / "spom1.png").stat().st_size > 10_000 and (tmp_path / "spom1.h5").exists()
-    left, right = fig.axes[:2]
-    assert "pole stretch" in left.get_xlabel() and "pressure" in left.get_ylabel()
-    assert "rho" in right.get_xlabel()
-    assert len(left.get_lines()) >= len(result.branches)  # every branch drawn into the caller's Axes
-    printed = capsys.readouterr().out
-    assert printed.startswith("Result('spom1'") and "long_name" not in printed
-    sweep, curve = namespace["sweep"], namespace["curve"]
-    members = sweep.to_dataframe()
-    assert list(members["field.M"]) == [0.0, 0.001, 0.002] and members["complete"].all()
-    assert members["P_cr1"].notna().all() and members["P_LP"].notna().all()
-    assert curve.parameter == "alpha1" and curve.critical["pear"] == pytest.approx(1.739619649392, abs=1e-9)
 
 
 @pytest.fixture(scope="module")

@@ -1,17 +1,18 @@
 """docs/api.md's example (a run, its tables and plots, a sweep and a two-parameter curve) runs as a notebook in a
 Jupyter kernel (nbclient): every paragraph a cell, no error, no terminal control codes in any output (progress and
-notices are plain text or widgets there), and results show as HTML tables. About 20 s (the run, a three-member sweep
-and the curve of critical α1), so it is in the default suite."""
+notices are plain text or widgets there), results show as HTML tables, and what it computes is what the page says.
+About 20 s (the run, a three-member sweep and the curve of critical α1), so it is in the default suite."""
+import json
 import re
+from pathlib import Path
 
 import pytest
-
-from test_api import example
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")
 pytest.importorskip("ipykernel")
 
+ROOT = Path(__file__).resolve().parents[1]
 ANSI = "\x1b["  # an escape sequence: colour, cursor movement (tqdm's terminal bars; they also write "\r")
 
 
@@ -31,12 +32,31 @@ def executed(sources: list[str], folder) -> nbformat.NotebookNode:
     return notebook
 
 
+def example() -> str:
+    """The Python block of docs/api.md."""
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "api.md").read_text(encoding="utf-8"), re.S)
+    assert len(blocks) == 1
+    return blocks[0]
+
+
+# what the example's objects hold, printed as one JSON line by a cell after it
+FACTS = """import json
+left, right = fig.axes[:2]
+members = sweep.to_dataframe()
+print(json.dumps({"labels": [left.get_xlabel(), left.get_ylabel(), right.get_xlabel()],
+                  "lines": len(left.get_lines()), "branches": len(result.branches), "M": list(members["field.M"]),
+                  "complete": bool(members["complete"].all()), "P_cr1": bool(members["P_cr1"].notna().all()),
+                  "P_LP": bool(members["P_LP"].notna().all()), "parameter": curve.parameter,
+                  "pear": curve.critical["pear"]}))"""
 PHASE_LINE = re.compile(r"^\S+: [a-z -]+: \d+ points \[\d\d:\d\d\]$")  # a finished phase (app.progress)
 
 
 def test_the_documented_example_runs_as_a_notebook(tmp_path):
+    """Its objects as the page says (until session 31 also checked by running the example in the test's own process,
+    tests/test_api.py, the same computation a second time): the figure's Axes drawn with every branch, the run printed
+    first, the sweep's members complete with their pressures, the pear pitchfork's α1 (docs/numerics.md)."""
     sources = [block.strip() for block in example().split("\n\n") if block.strip()]
-    notebook = executed(sources + ["result", "result.special_points", "sweep", "curve"], tmp_path)
+    notebook = executed(sources + [FACTS, "result", "result.special_points", "sweep", "curve"], tmp_path)
     outputs = [output for cell in notebook.cells for output in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert not [text for o in outputs for text in texts(o) if ANSI in text or "\r" in text]
@@ -49,6 +69,17 @@ def test_the_documented_example_runs_as_a_notebook(tmp_path):
         assert html.startswith("<p>") and "<table" in html, name
         assert "\n" not in shown[name]["data"]["text/plain"], name
     assert (tmp_path / "two_coils_sweep_M.h5").exists() and (tmp_path / "spom1.png").stat().st_size > 10_000
+    assert (tmp_path / "spom1.h5").exists()
+    printed = "".join(o.get("text", "") for cell in notebook.cells[:len(sources)] for o in cell.outputs
+                      if o.get("name") == "stdout")
+    assert printed.startswith("Result('spom1'") and "long_name" not in printed
+    facts = json.loads("".join(o.get("text", "") for o in notebook.cells[len(sources)].outputs
+                               if o.get("name") == "stdout"))
+    left_x, left_y, right_x = facts["labels"]
+    assert "pole stretch" in left_x and "pressure" in left_y and "rho" in right_x
+    assert facts["lines"] >= facts["branches"]  # every branch drawn into the caller's Axes
+    assert facts["M"] == [0.0, 0.001, 0.002] and facts["complete"] and facts["P_cr1"] and facts["P_LP"]
+    assert facts["parameter"] == "alpha1" and facts["pear"] == pytest.approx(1.739619649392, abs=1e-9)
 
 
 SMALL = ("import balloon_cg as bc\nscene = bc.Scene.from_toml('spom1').with_overrides("
