@@ -120,11 +120,12 @@ def tube_run_file(tmp_path_factory) -> Path:
 
 
 def tube_critical_file(tmp_path_factory) -> Path:
-    """``balloon-cg critical --parameter M`` of the shipped coil tube at TUBE_COIL_FAST (its onset curve)."""
+    """``balloon-cg critical --parameter M`` of the shipped coil tube at TUBE_COIL_FAST (its onset curve; exit 1: the
+    fold's state is not resolved at degree 30, its tail above solver.max_error, the file written)."""
     from balloon_cg.app.cli import main
 
     return shared_file(tmp_path_factory, "tube_critical.h5", lambda path: main(
-        ["critical", str(TUBE_COIL), "--parameter", "M", "-o", str(path), "--quiet", *TUBE_COIL_FAST]) == 0)
+        ["critical", str(TUBE_COIL), "--parameter", "M", "-o", str(path), "--quiet", *TUBE_COIL_FAST]) == 1)
 
 
 def first_bulge_picture(scene):

@@ -350,15 +350,18 @@ COIL_SCENE = SCENE.with_name("tube_spom1_L10_coil.toml")
 
 def test_critical_follows_the_onset_in_the_field_of_a_coil(tmp_path, capsys):
     """``critical --parameter M`` on the coil scene: the onset curve of tube/onset.py in the file's /onset group
-    (the same numbers), exit 0 with the fold in M printed; ``inspect`` shows the field, the curve and the crests;
-    downwards it lands on M = 0 (no fold: exit 1, the file written); other kinds and parameters exit 2."""
+    (the same numbers), the fold in M printed, exit 1 with one line on stderr (its state not resolved at degree 30:
+    tail 3.1e-3 above solver.max_error 1e-9; docs/tubes.md's convergence table: M_c off by 6.5e-4 relative there);
+    ``inspect`` shows the field, the curve and the crests; downwards it lands on M = 0 (no fold: exit 1, the file
+    written); other kinds and parameters exit 2."""
     from balloon_cg.galerkin.interval import Mirror
     from balloon_cg.tube.onset import onset_curve
     from balloon_cg.tube.primary import primary_branch
 
     path = tmp_path / "onset.h5"
-    assert main(["critical", str(COIL_SCENE), "--parameter", "M", "-o", str(path), "--quiet", *COIL_FAST]) == 0
-    out = capsys.readouterr().out
+    assert main(["critical", str(COIL_SCENE), "--parameter", "M", "-o", str(path), "--quiet", *COIL_FAST]) == 1
+    out, err = capsys.readouterr()
+    assert err.count("\n") == 1 and "the fold's state is not resolved at solver.degree = 30: its Legendre tail" in err
     scene = load_scene(COIL_SCENE).with_overrides({"continuation.stop_stretch": 1.75, "continuation.max_points": 60})
     primary = primary_branch(scene)
     curve = onset_curve(scene, primary, primary.branch_points(Mirror.ODD)[0], "M")
@@ -382,3 +385,48 @@ def test_critical_follows_the_onset_in_the_field_of_a_coil(tmp_path, capsys):
         assert main(["critical", str(COIL_SCENE), "-o", str(tmp_path / "x.h5"), "--quiet", *extra]) == 2
         assert "critical on a tube follows the onset of bulging (--of BP) in M" in capsys.readouterr().err
     assert not (tmp_path / "x.h5").exists()
+
+
+TRIAL_COIL = """[material]
+preset = "SPOM1"
+[geometry]
+shape = "tube"
+length = 8.0
+ends = "sliding"
+[field]
+M = 0.0005
+[[field.coils]]
+radius = 2.0
+height = 0.0
+current = 1.0
+[solver]
+degree = 30
+[continuation]
+stop_stretch = 4.0
+step_max = 0.5
+max_points = 150
+"""
+
+
+def test_critical_reports_the_first_fold_of_the_onset_curve_and_exit_1_where_it_is_unresolved(tmp_path, capsys):
+    """Issue 38's trial: L = 8, a coil of radius 2, from M = 0.0005 upwards. The onset curve turns back at M = 0.00175,
+    touches M ≈ 0 (a fold: the field-free middle bulge) and turns again at 0.00436; the critical field is the first
+    turning point (before: the largest fold, 0.00436, exit 0). A second method: the primary branch traced at fixed M
+    has an odd branch point near the fold's pressure 1 % below the first fold, none 1 % above it. Its state's tail
+    (7.8e-3) is above solver.max_error: exit 1, the value printed and the file written."""
+    from balloon_cg.galerkin.interval import Mirror
+    from balloon_cg.tube.primary import primary_branch
+
+    scene_path, path = tmp_path / "trial_coil.toml", tmp_path / "trial.h5"
+    scene_path.write_text(TRIAL_COIL)
+    assert main(["critical", str(scene_path), "--parameter", "M", "-o", str(path), "--quiet"]) == 1
+    out, err = capsys.readouterr()
+    folds = read_tube_run(path)["onset"]["folds"]
+    first = folds[0]["q"]
+    assert len(folds) >= 2 and max(f["q"] for f in folds) > 2 * first  # the largest fold is a later one
+    assert out.startswith(f"critical M = {first:.12g} (P = ") and "the fold's state is not resolved" in err
+    assert folds[0]["tail"] > 1e-9
+    scene = load_scene(scene_path)
+    near = lambda M: [b for b in primary_branch(scene.with_overrides({"field.M": M})).branch_points(Mirror.ODD)  # noqa: E731
+                      if abs(b.pressure - folds[0]["pressure"]) < 0.05]
+    assert len(near(0.99 * first)) >= 1 and len(near(1.01 * first)) == 0

@@ -47,8 +47,9 @@ def critical_tube(scene, output, args) -> int:
     """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
     followed in M, the voltage Φ̄ or the held ends' distance λ (axial_stretch), written with the primary branch to the
     tube run file ``output`` (its /onset group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns
-    back in the parameter (a located fold: the onset's largest or smallest value; a line on stderr where its state is
-    not resolved, its Legendre tail above solver.max_error), 1 (the file still written) where it does not (the line
+    back in the parameter (its first located fold, the first turning point in the --direction; printed, but exit 1
+    with a line on stderr where its state is not resolved, its Legendre tail above solver.max_error), 1 (the file
+    still written) where it does not (the line
     says the curve was traced one way from the scene's value, as every critical curve, and --direction the other); 1
     without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M,
     the voltage or axial_stretch, M without coils, the voltage without [electric], axial_stretch on closed ends (no
@@ -93,13 +94,14 @@ def critical_tube(scene, output, args) -> int:
                       f"{onset['pressure'][-1]:.10g}); traced {side} from {name} = {onset['attrs']['q0']:g} only, as "
                       f"every critical curve: --direction {-args.direction:g} traces the other side; curve written to "
                       f"{output}")
-    fold = max(onset["folds"], key=lambda f: args.direction * f["q"])
+    fold = onset["folds"][0]  # the first turning point: the curve starts with q moving in --direction
     print(f"critical {name} = {fold['q']:.12g} (P = {fold['pressure']:.10g}; the onset curve turns back in {name}: "
           f"{fold['status']}); curve written to {output}")
     if fold["tail"] > scene.solver.max_error:
-        print(f"{PROG}: the fold's state is not resolved at solver.degree = {scene.solver.degree}: its Legendre tail "
-              f"{fold['tail']:.2g} is above solver.max_error = {scene.solver.max_error:g} (the critical value may be "
-              "off, or the fold an artefact: raise solver.degree; docs/tubes.md)", file=sys.stderr)
+        raise Failure(f"the fold's state is not resolved at solver.degree = {scene.solver.degree}: its Legendre tail "
+                      f"{fold['tail']:.2g} is above solver.max_error = {scene.solver.max_error:g} (the critical value "
+                      "may be off, or the fold an artefact: raise solver.degree, or solver.max_error to accept it; "
+                      "docs/tubes.md)")
     return 0
 
 
