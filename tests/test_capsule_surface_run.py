@@ -43,15 +43,16 @@ def run(tmp_path_factory):
 
 def test_the_run_traces_the_first_m1_branch_and_stores_it(run):
     """One branch, m1_bp<k> at the primary's first m1_held point, POINTS points (the zero first), its parent named,
-    the picture's one gap its budget (LIMITED: stated, the run complete); stored with its points, stop and basis (the capsule's mode degree and equator flag)."""
+    and its −φ half m1_bp<k>_rotated; the picture's gaps their budget (LIMITED: stated, the run complete); stored with
+    its points, stop and basis (the capsule's mode degree and equator flag)."""
     scene, picture, _, stored = run
     k, bp = first_held_point(picture.primary)
-    assert list(picture.meridian_surface) == [f"m1_bp{k}"] and not picture.not_started
+    assert list(picture.meridian_surface) == [f"m1_bp{k}", f"m1_bp{k}_rotated"] and not picture.not_started
     branch = picture.meridian_surface[f"m1_bp{k}"]
     assert branch.m == 1 and branch.parent == ("primary", k) and len(branch.pressure) == POINTS
     assert abs(branch.pressure[0] - bp.X[-1]) <= 1e-14 * bp.X[-1]
     assert branch.stop.code.value == "max_points" and [(i.gap.value, i.branch) for i in picture.incomplete] == [
-        ("limited", f"m1_bp{k}")]  # stated, not failing: the run is complete
+        ("limited", f"m1_bp{k}"), ("limited", f"m1_bp{k}_rotated")]  # stated, not failing: the run is complete
     found = stored["meridian_surface"][f"m1_bp{k}"]
     assert np.array_equal(found["coefficients"], branch.coefficients)
     assert np.array_equal(found["pressure"], branch.pressure)
@@ -82,6 +83,59 @@ def test_the_first_switched_point_is_stationary_for_the_written_energy(run):
     branch = next(iter(picture.meridian_surface.values()))
     totals, elastics = written_derivatives(scene, branch.basis, branch.coefficients[1], branch.pressure[1])
     assert np.max(np.abs(totals)) <= 1e-9 * np.max(np.abs(elastics)), (totals, elastics)
+
+
+def rotated_pair(picture) -> tuple:
+    """(the traced branch, its stored image under the rotation by π/m) of the run."""
+    (name, branch), (image_name, image) = picture.meridian_surface.items()
+    assert image_name == f"{name}_rotated" and image.image_of == name and not branch.image_of
+    return branch, image
+
+
+def test_the_minus_phi_half_is_an_equilibrium_of_the_written_energy(run):
+    """The −φ half is the image of the +φ branch under the rotation Q by π/m about the axis (m = 1: by π; c_k ↦
+    (−1)^k c_k), a symmetry of the capsule, its pressure and the held gauge (analysis/surface/meridian/rotation.py).
+    Checked, not assumed, at every point: the engine's gauged residual at the image (its reaction τ negated) ≤ 1e-10
+    of the largest of its parts (the trace's tolerance: solver.tol 1e-12 on ~1e2 entries), its amplitude −φᵀ G c_1
+    of the source's, P, V/V0 and every eigenvalue the source's; the energy written in tests/test_capsule_surface.py
+    (another code path: Ogden's Φ over the metric, the cone volume) stationary at the image's points ≥ 1 (its
+    derivatives along the state's orders below 1e-9 of the elastic part's, as at the source's point 1)."""
+    from balloon_cg.analysis.surface.meridian.equilibrium import MeridianSurfaceEquilibrium
+    from balloon_cg.analysis.surface.meridian.system import MeridianSurfaceSystem
+
+    scene, picture, _, stored = run
+    branch, image = rotated_pair(picture)
+    assert np.array_equal(image.pressure, branch.pressure) and np.array_equal(image.volume, branch.volume)
+    assert np.array_equal(image.lowest, branch.lowest) and image.folds == branch.folds
+    assert np.array_equal(image.amplitude, -branch.amplitude) and np.all(branch.amplitude[1:] > 0)
+    params = picture.primary.params_at(picture.primary.X[0])
+    system = MeridianSurfaceSystem(MeridianSurfaceEquilibrium(scene, image.basis), params, image.coefficients[0])
+    assert system.gauged == 1  # the equator states: the translation along x alone (capsule.py gauge_rows)
+    for c, P, tau in zip(image.coefficients, image.pressure, image.reaction):
+        X = system.point(c, P)
+        X[system.free.size] = tau  # the held gauge's reaction τ: the source's, negated
+        load = P * np.abs(system.surface.parameter_derivative(c, params.with_value("P", P))).max()  # |P ∇V|
+        assert np.abs(system.residual(X)).max() <= 1e-10 * load
+    for c, P in zip(image.coefficients[1:], image.pressure[1:]):
+        totals, elastics = written_derivatives(scene, image.basis, c, P)
+        assert np.max(np.abs(totals)) <= 1e-9 * np.max(np.abs(elastics)), (totals, elastics)
+    name = image.image_of
+    assert stored["meridian_surface"][f"{name}_rotated"]["attrs"]["image_of"] == name
+    assert np.array_equal(stored["meridian_surface"][f"{name}_rotated"]["coefficients"], image.coefficients)
+
+
+def test_the_minus_phi_half_is_the_branch_traced_along_minus_phi(run):
+    """A second method: capsule.traced_branch along −φ (direction −1: switched at ε = −0.05, the tangent along −φ)
+    with the same budget gives the image's points: coefficients, P, amplitude and the mirror sector's eigenvalues
+    to 1e-9 (Newton's iterates are images of the +φ trace's to rounding)."""
+    scene, picture, _, _ = run
+    k, bp = first_held_point(picture.primary)
+    _, image = rotated_pair(picture)
+    traced = limited_blas(capsule_surface.traced_branch)(scene, picture.primary, bp, direction=-1.0,
+                                                         max_points=POINTS, parent=("primary", k))
+    for name in ("coefficients", "pressure", "amplitude", "lowest"):
+        ours, theirs = getattr(image, name), getattr(traced, name)
+        assert ours.shape == theirs.shape and np.max(np.abs(ours - theirs)) <= 1e-9 * np.max(np.abs(theirs)), name
 
 
 def test_inspect_shows_it(run, capsys):

@@ -5,7 +5,9 @@ from the parent's discretisation; a capsule's also ``mode_degree``, its perturba
 whether it keeps the states even in z), ``parent_branch``, ``parent_zero`` (the zero's order among the parent's
 located zeros of block m, as ``inspect`` lists them; a capsule's: its number among the parent's branch points, as
 in its name m<m>_bp<k>), ``stop_code``,
-``stop_message``, ``limited`` (the basis reached its cap with estimates above solver.max_error; absent before it);
+``stop_message``, ``limited`` (the basis reached its cap with estimates above solver.max_error; absent before it),
+``image_of`` (only on a branch that is the image of another under the rotation by π/m about the axis:
+analysis/surface/meridian/rotation.py; its name);
 per point ``coefficients`` (n, size: c of the basis), ``pressure``, ``volume`` (V/V0), ``amplitude`` (φᵀ G c_m),
 ``reaction`` (the held centroid's τ), ``error_estimate``, ``lowest`` (n, 3: the mirror sector's lowest eigenvalues
 under pressure control) and ``unstable_pressure``, ``unstable_volume``, ``unstable_gas``; its folds in P:
@@ -47,6 +49,8 @@ def write_surface_branches(f, branches: dict | None) -> None:
                             "degree": basis.disc.degree, "parent_branch": branch.parent[0],
                             "parent_zero": branch.parent[1], "stop_code": branch.stop.code.value,
                             "stop_message": branch.stop.message, "limited": branch.limited})
+        if branch.image_of:
+            group.attrs["image_of"] = branch.image_of
         if basis.shape == Shape.CAPSULE:
             group.attrs.update({"mode_degree": basis.mode_degree, "equator": basis.equator})
         checksummed(group, "coefficients", branch.coefficients)
