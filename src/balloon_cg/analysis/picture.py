@@ -545,7 +545,7 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
             return
         name = surface_name(branch, k, bp)
         if scene.geometry.shape == Shape.CAPSULE:
-            _trace_capsule(scene, branch, k, bp, picture, progress)
+            trace_capsule(scene, branch, k, bp, picture, progress)
             continue
         try:
             pair = surface_pair(branch, k, bp, scene.surface.max_points, progress)
@@ -556,13 +556,13 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
         _classified(branch, bp, pair[0])
 
 
-def _trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress: Progress) -> None:
+def trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress: Progress) -> None:
     """The capsule's branch born at the m ≥ 1 point ``bp`` (number ``k`` in ``branch.branch_points()``), along +φ
     over (θ, φ) (``capsule.traced_branch``: refined by its error estimate, its mirror sector's stability at every
     point), and its −φ half, the image under the rotation by π/m about the axis (meridian/rotation.py, named
     <name>_rotated), into ``Picture.meridian_surface``; listed in ``not_started`` where its switched point does not
     converge. A signal stops its trace at the next point, the points traced kept (StopCode.INTERRUPTED; its image
-    too), and the analysis."""
+    too), and the analysis. ``continue`` at a capsule's m ≥ 1 label calls it too."""
     name = surface_name(branch, k, bp)
     with progress.budget(Phase.SURFACE, scene.surface.max_points) as tick:
         try:
