@@ -18,7 +18,8 @@ stability data all solid, and the legend title says so. Titles name the material
 are marked and labelled with their label in the file and their kind ("2 LP", "3 pitchfork-super": ``labels``).
 Surface branches (m ≥ 1, states on the whole sphere) are drawn by the pole curves and the energy landscape,
 labelled 'm = 1 from 5' (their parent point's label), and left out of the other branch and per-point kinds;
-``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
+``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states; a capsule's (over (θ, φ):
+``meridian_branches``) are drawn by the same code, but for stretch-map.
 The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest (``robust_limits``).
 Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2,
 field in I/(4π R0).
