@@ -274,3 +274,45 @@ def test_surface_draws_the_stored_state(run):
     with pytest.raises(PlotError) as refused:
         plot([str(path)], "stretch-map", branch=name)
     assert "stretch-map" in str(refused.value) and "\n" not in str(refused.value)
+
+
+def test_events_are_located_on_it_stored_and_shown(run, tmp_path, capsys):
+    """[[events]] on the volume and the pressure (values between its points 1 and 2, and 2 and 3) give UZ points on
+    the branch (analysis/surface/meridian/events.py, the sphere's landing): each located between those points, at
+    the value (V to the landing's 1e-10 relative, P exactly), an equilibrium of the energy written in
+    tests/test_capsule_surface.py (its derivatives below 1e-9 of the elastic part's); its image's the rotated
+    points (P, V the same); written, read back and listed by `inspect`."""
+    from dataclasses import replace as replaced
+
+    from balloon_cg.analysis.surface.meridian import events, rotation
+    from balloon_cg.app.cli import main
+    from balloon_cg.scene.events import events_from_list
+
+    scene, picture, _, _ = run
+    branch, _ = rotated_pair(picture)
+    name = next(iter(picture.meridian_surface))
+    volume0 = scene.geometry.reference_volume
+    wanted = [{"quantity": "volume", "value": float(volume0 * branch.volume[1:3].mean())},
+              {"quantity": "pressure", "value": float(branch.pressure[2:4].mean())}]
+    asked = replaced(scene, events=events_from_list(wanted))
+    traced = events.with_events(asked, branch, picture.primary.params_at(picture.primary.X[0]))
+    (volume, pressure) = traced.events
+    assert (volume.index, pressure.index) == (1, 2) and volume.located and pressure.located
+    assert abs(volume.volume * volume0 - wanted[0]["value"]) <= 1e-10 * wanted[0]["value"]
+    assert pressure.pressure == wanted[1]["value"]
+    for point in (volume, pressure):
+        assert branch.pressure[point.index + 1] <= point.pressure <= branch.pressure[point.index]
+        totals, elastics = written_derivatives(scene, branch.basis, point.coefficients, point.pressure)
+        assert np.max(np.abs(totals)) <= 1e-9 * np.max(np.abs(elastics)), (totals, elastics)
+    image = rotation.rotated(traced, name)
+    signs = rotation.rotation_signs(branch.basis)
+    assert all(np.array_equal(e.coefficients, f.coefficients * signs) and e.pressure == f.pressure
+               for e, f in zip(image.events, traced.events))
+    path = tmp_path / "events.h5"
+    write_run(path, asked, picture.branches, meridian_surface={name: traced, f"{name}_rotated": image})
+    stored = read_run(path)["meridian_surface"][name]["events"]
+    assert [(e["after_point"], e["pressure"], e["located"]) for e in stored] == [
+        (p.index, p.pressure, True) for p in traced.events]
+    assert np.array_equal(stored[0]["coefficients"], volume.coefficients)
+    assert main(["inspect", str(path)]) == 0
+    assert f"UZ after point 1    P = {volume.pressure:.10g}" in capsys.readouterr().out

@@ -33,7 +33,7 @@ import numpy as np
 from .branches import events
 from .points import azimuthal_points, branch_points as bifurcation, control_points, free_pitchforks
 from .surface import branches as surface_branches, pitchforks as surface_pitchforks, primary as surface_primary
-from .surface.meridian import capsule, rotation
+from .surface.meridian import capsule, events as meridian_events, rotation
 from .surface.meridian.trace import SurfaceBranchStartError
 from .switching import broken_symmetry, mirror
 from ..scene import Control, Geometry
@@ -560,7 +560,7 @@ def trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress:
     """The capsule's branch born at the m ≥ 1 point ``bp`` (number ``k`` in ``branch.branch_points()``), along +φ
     over (θ, φ) (``capsule.traced_branch``: refined by its error estimate, its mirror sector's stability at every
     point), and its −φ half, the image under the rotation by π/m about the axis (meridian/rotation.py, named
-    <name>_rotated), into ``Picture.meridian_surface``; listed in ``not_started`` where its switched point does not
+    <name>_rotated), with their UZ points (meridian/events.py), into ``Picture.meridian_surface``; listed in ``not_started`` where its switched point does not
     converge. A signal stops its trace at the next point, the points traced kept (StopCode.INTERRUPTED; its image
     too), and the analysis. ``continue`` at a capsule's m ≥ 1 label calls it too."""
     name = surface_name(branch, k, bp)
@@ -570,8 +570,10 @@ def trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress:
         except SurfaceBranchStartError as error:
             picture.not_started.append((name, str(error)))
             return
+    if traced.stop.code != StopCode.INTERRUPTED:  # its UZ points (a signal: the points traced kept, no more work)
+        traced = meridian_events.with_events(scene, traced, branch.params_at(bp.X))
     picture.meridian_surface[name] = traced
-    picture.meridian_surface[f"{name}{ROTATED}"] = rotation.rotated(traced, name)
+    picture.meridian_surface[f"{name}{ROTATED}"] = rotation.rotated(traced, name)  # its UZ points the same P, V
     if traced.stop.code == StopCode.INTERRUPTED:
         stopped(picture)
 
@@ -621,7 +623,7 @@ def _with_events(branch):
 def unsearched_events(picture: Picture, scene) -> None:
     """Add to ``picture.not_searched`` the events not located on its surface branches, if it has any
     (``events.unlocated_on_surface``)."""
-    missing = events.unlocated_on_surface(scene) if picture.surface_branches else ""
+    missing = events.unlocated_on_surface(scene) if picture.surface_branches or picture.meridian_surface else ""
     if missing:
         picture.not_searched = "; ".join(filter(None, (picture.not_searched, missing)))
 

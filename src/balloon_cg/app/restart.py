@@ -383,6 +383,7 @@ def switch(start: Labelled, progress=None) -> Picture:
         picture = Picture([branch])
         trace_capsule(branch.scene, branch, k, point, picture, progress)
         stopped(picture)  # a signal in its trace: flagged
+        unsearched_events(picture, branch.scene)
         return picture
     if point.m >= 1:  # held, or free on an equator-symmetric branch (its held states are free equilibria)
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)

@@ -44,9 +44,11 @@ def rotation_signs(basis: MeridianSurfaceBasis) -> np.ndarray:
 
 def rotated(branch: MeridianSurfaceBranch, source: str) -> MeridianSurfaceBranch:
     """The image of ``branch`` (named ``source``) under the rotation by π/g about the axis (module docstring):
-    every point's coefficients times ``rotation_signs``, its amplitude and reaction negated, ``image_of`` the
-    source."""
+    every point's coefficients (and its UZ points') times ``rotation_signs``, its amplitude and reaction negated,
+    ``image_of`` the source."""
     if branch.image_of:
         raise ValueError(f"rotated: {source} is itself the image of {branch.image_of} (allowed: a traced branch)")
-    return replace(branch, coefficients=branch.coefficients * rotation_signs(branch.basis),
-                   amplitude=-branch.amplitude, reaction=-branch.reaction, image_of=source)
+    signs = rotation_signs(branch.basis)
+    return replace(branch, coefficients=branch.coefficients * signs, amplitude=-branch.amplitude,
+                   reaction=-branch.reaction, image_of=source,
+                   events=tuple(replace(e, coefficients=e.coefficients * signs) for e in branch.events))

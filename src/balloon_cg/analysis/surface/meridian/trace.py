@@ -53,7 +53,8 @@ class MeridianSurfaceBranch:
     under each control (stability.py); ``folds``: (index, pressure) of each located LP (between points
     index and index + 1); ``m``; ``parent``: (branch name, label) of the zero it was born at; ``stop``; ``limited``:
     the basis reached its cap with an estimate above solver.max_error (module docstring); ``image_of``: the name of
-    the branch this one is the image of under the rotation by π/m about the axis (rotation.py), "" where traced."""
+    the branch this one is the image of under the rotation by π/m about the axis (rotation.py), "" where traced;
+    ``events``: its UZ points (events.MeridianEvent: ``[[events]]``, events.py)."""
 
     basis: MeridianSurfaceBasis
     m: int
@@ -70,6 +71,7 @@ class MeridianSurfaceBranch:
     parent: tuple | None = None
     limited: bool = False
     image_of: str = ""
+    events: tuple = ()
 
 
 def largest_hoop_stretch(basis: MeridianSurfaceBasis, c: np.ndarray) -> float:
