@@ -76,6 +76,60 @@ def test_order_m_blocks_are_the_capsules_azimuthal_blocks(length):
         assert np.max(np.abs(ours - theirs)) <= 1e-9 * np.max(np.abs(theirs)), m
 
 
+@pytest.mark.parametrize("orders", [(0, 1, 2, 3), (0, 2, 4)])
+def test_the_rotation_by_pi_over_g_is_a_symmetry_of_the_discrete_energy(orders):
+    """The −φ half of a pitchfork is the +φ half's image under the rotation Q by π/g about the axis (g the gcd of the
+    orders: analysis/surface/meridian/rotation.py, c_k ↦ (−1)^(k/g) c_k; for m = 2 the rotation by π/2, which the
+    sphere's rotation by π is not). At a random state of every order (L = 3): the energy written above (another code
+    path, on the basis' n_phi nodes) takes the same value at Q c as at c (1e-13 relative), the engine's residual is
+    equivariant, ∇E(Q c) = Q ∇E(c) (1e-12), and its P-derivative (the volume's gradient) too; a node count in φ
+    that Q does not map to itself is refused in one line."""
+    from dataclasses import replace as replaced
+    from balloon_cg.analysis.surface.meridian.rotation import rotation_signs
+
+    scene, _, basis, surface, u, params = setting(3.0, orders=orders)
+    rng = np.random.default_rng(11)
+    c = basis.axisymmetric(u)
+    for m in orders[1:]:
+        c[basis.block(m)] = 0.02 * rng.standard_normal(basis.mode_size) / m
+    signs = rotation_signs(basis)
+    assert np.all(signs[basis.block(orders[1])] == -1)  # the critical mode φ, of order g, to −φ
+    assert close(written_energy(scene, basis, signs * c, 0.9, basis.n_phi),
+                 written_energy(scene, basis, c, 0.9, basis.n_phi), 1e-13)
+    assert close(surface.residual(signs * c, params), signs * surface.residual(c, params), 1e-12)
+    assert close(surface.parameter_derivative(signs * c, params), signs * surface.parameter_derivative(c, params),
+                 1e-12)
+    with pytest.raises(ValueError) as error:  # an odd count: no multiple of 2g
+        rotation_signs(replaced(basis, n_phi=2 * orders[-1] + 1))
+    message = str(error.value)
+    assert message.startswith("n_phi:") and "allowed" in message and "\n" not in message, message
+
+
+def test_point_and_grid_values_are_the_engines_node_state():
+    """The drawn state (CapsuleSurfaceBasis.point_values and grid_values: the disc's series and each order's
+    CapsuleBasis.displacement at any θ, another path than the engine's node tables) at the engine's nodes (θ_q, φ_k)
+    of a random state of orders 0..2 (L = 3): x and a_S = ∂x/∂θ / S' the frame's node_state turned to Cartesian
+    components (1e-13), and at the pole of an axisymmetric state a_S(0, φ) = λ2(0) (cos φ, sin φ, 0)."""
+    from balloon_cg.analysis.surface.meridian.capsule import _cartesian
+
+    scene, _, basis, _, u, _ = setting(3.0, orders=(0, 1, 2))
+    rng = np.random.default_rng(3)
+    c = basis.axisymmetric(u)
+    for m in (1, 2):
+        c[basis.block(m)] = 0.02 * rng.standard_normal(basis.mode_size) / m
+    theta = basis.perturbations(1).theta
+    state = basis.node_state(c).reshape(9, theta.size, -1)
+    phi = 2 * np.pi * np.arange(state.shape[2]) / basis.n_phi
+    grid_theta, grid_phi = np.meshgrid(theta, phi, indexing="ij")
+    x, a = (v.reshape(3, *grid_theta.shape) for v in basis.point_values(c, grid_theta.ravel(), grid_phi.ravel()))
+    assert close(x, _cartesian(state[:3], grid_phi), 1e-13) and close(a, _cartesian(state[3:6], grid_phi), 1e-13)
+    assert close(basis.grid_values(c, np.cos(theta), phi), x, 1e-13)
+    pole = np.array([0.0, np.pi / 3])
+    _, a = basis.point_values(basis.axisymmetric(u), np.zeros(2), pole)
+    lam2 = basis.disc.evaluate(u, np.zeros(1))[0][0]
+    assert close(a, lam2 * np.array([np.cos(pole), np.sin(pole), 0 * pole]), 1e-13)
+
+
 def test_what_it_does_not_take_is_refused_in_one_line():
     """A disc without the capsule's joins, a scene of another capsule: one line each, naming the key, its value and
     what is allowed."""

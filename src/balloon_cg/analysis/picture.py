@@ -9,7 +9,8 @@ assessments in a scene invariant under it, ``mirror``; traced and assessed where
 locates the branch points of the non-axisymmetric blocks on every branch (``azimuthal_points``: stored with the
 branch, not in ``Picture.branch_points``), follows the non-axisymmetric branches born at the m ≥ 1 points on the
 whole sphere (``surface.branches``: ``Picture.surface_branches``, as ``[surface] branches`` asks; a capsule's over
-(θ, φ), along +φ: ``surface.meridian.capsule``, ``Picture.meridian_surface``) and lists the snap-throughs under the
+(θ, φ), along +φ with its image under the rotation by π/m: ``surface.meridian.capsule``, ``rotation``,
+``Picture.meridian_surface``) and lists the snap-throughs under the
 scene's loading control (pressure, volume or gas: its held stability flag, on the branches of the held reading). A voltage continuation (at fixed P) gets the same, with
 Φ̄ as the parameter of every branch and of its branch points. A primary branch without equator symmetry (a field
 that breaks it) gets its stability changes under every control mode located instead (``control_points``: LP, LV,
@@ -32,7 +33,7 @@ import numpy as np
 from .branches import events
 from .points import azimuthal_points, branch_points as bifurcation, control_points, free_pitchforks
 from .surface import branches as surface_branches, pitchforks as surface_pitchforks, primary as surface_primary
-from .surface.meridian import capsule
+from .surface.meridian import capsule, events as meridian_events, rotation
 from .surface.meridian.trace import SurfaceBranchStartError
 from .switching import broken_symmetry, mirror
 from ..scene import Control, Geometry
@@ -59,7 +60,7 @@ FREE_NOT_ASKED = ('not traced: [surface] branches = "first" (the free balloon\'s
 PEAR_NAMES = {Block.ODD_HELD: "pear", Block.ODD_FREE: "pear_free"}  # a pear branch's name: <prefix>_<BP number>
 MODES = {Block.ODD_HELD: "pear (odd)", Block.ODD_FREE: "free pear (odd, translation free)",
          Block.EVEN: "equator-symmetric (even)"}
-ROTATED = "_rotated"  # the suffix of a non-axisymmetric branch's image under the rotation by π about the axis
+ROTATED = "_rotated"  # the suffix of a non-axisymmetric branch's image under the rotation by π (a capsule's: π/m)
 OPPOSITE = "_opposite"  # the suffix of the branch traced along −φ (even m: the rotation by π maps the mode to itself)
 
 
@@ -267,7 +268,7 @@ def _examine(scene, picture: Picture, progress: Progress, pear: bool, control: b
                     return
             unsearched_events(picture, scene)
         progress.finish(Phase.SURFACE, sum(len(b.values) for b in picture.surface_branches)
-                        + sum(len(b.pressure) for b in picture.meridian_surface.values()))
+                        + sum(len(b.pressure) for b in picture.meridian_surface.values() if not b.image_of))
     label_readings(picture.branches + picture.surface_branches)
     with clock.step(Step.SNAP_THROUGHS):
         picture.snaps = snap_throughs([b for b in picture.branches if b.gauge != Gauge.FREE], scene.loading.control)
@@ -544,7 +545,7 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
             return
         name = surface_name(branch, k, bp)
         if scene.geometry.shape == Shape.CAPSULE:
-            _trace_capsule(scene, branch, k, bp, picture, progress)
+            trace_capsule(scene, branch, k, bp, picture, progress)
             continue
         try:
             pair = surface_pair(branch, k, bp, scene.surface.max_points, progress)
@@ -555,12 +556,13 @@ def _trace_surface(scene, branch: Branch, picture: Picture, progress: Progress):
         _classified(branch, bp, pair[0])
 
 
-def _trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress: Progress) -> None:
+def trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress: Progress) -> None:
     """The capsule's branch born at the m ≥ 1 point ``bp`` (number ``k`` in ``branch.branch_points()``), along +φ
-    (the −φ half its image under the rotation by π/m), over (θ, φ) (``capsule.traced_branch``: refined by its error
-    estimate, its mirror sector's stability at every point) into ``Picture.meridian_surface``; listed in
-    ``not_started`` where its switched point does not converge. A signal stops its trace at the next point, the points
-    traced kept (StopCode.INTERRUPTED), and the analysis."""
+    over (θ, φ) (``capsule.traced_branch``: refined by its error estimate, its mirror sector's stability at every
+    point), and its −φ half, the image under the rotation by π/m about the axis (meridian/rotation.py, named
+    <name>_rotated), with their UZ points (meridian/events.py), into ``Picture.meridian_surface``; listed in ``not_started`` where its switched point does not
+    converge. A signal stops its trace at the next point, the points traced kept (StopCode.INTERRUPTED; its image
+    too), and the analysis. ``continue`` at a capsule's m ≥ 1 label calls it too."""
     name = surface_name(branch, k, bp)
     with progress.budget(Phase.SURFACE, scene.surface.max_points) as tick:
         try:
@@ -568,7 +570,10 @@ def _trace_capsule(scene, branch: Branch, k: int, bp, picture: Picture, progress
         except SurfaceBranchStartError as error:
             picture.not_started.append((name, str(error)))
             return
+    if traced.stop.code != StopCode.INTERRUPTED:  # its UZ points (a signal: the points traced kept, no more work)
+        traced = meridian_events.with_events(scene, traced, branch.params_at(bp.X))
     picture.meridian_surface[name] = traced
+    picture.meridian_surface[f"{name}{ROTATED}"] = rotation.rotated(traced, name)  # its UZ points the same P, V
     if traced.stop.code == StopCode.INTERRUPTED:
         stopped(picture)
 
@@ -618,7 +623,7 @@ def _with_events(branch):
 def unsearched_events(picture: Picture, scene) -> None:
     """Add to ``picture.not_searched`` the events not located on its surface branches, if it has any
     (``events.unlocated_on_surface``)."""
-    missing = events.unlocated_on_surface(scene) if picture.surface_branches else ""
+    missing = events.unlocated_on_surface(scene) if picture.surface_branches or picture.meridian_surface else ""
     if missing:
         picture.not_searched = "; ".join(filter(None, (picture.not_searched, missing)))
 

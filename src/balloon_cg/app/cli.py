@@ -1081,18 +1081,20 @@ def _write_continued(args, picture, attrs, switched: bool) -> int:
     from ..io.run_file import write_run
     from ..numerics.interrupt import requested
 
-    branches = picture.branches + picture.surface_branches
-    if switched and len(branches) == 1 and not picture.interrupted:
+    branches, over_meridian = picture.branches + picture.surface_branches, picture.meridian_surface
+    if switched and len(branches) == 1 and not over_meridian and not picture.interrupted:
         reasons = "; ".join(f"{name}: {reason}" for name, reason in picture.not_started)
         raise Failure(f"no branch started at label {args.label} ({reasons}); nothing written")
     write_run(args.output, branches[0].scene, branches, force=args.force, extra_attrs=attrs, snaps=picture.snaps,
-              found=picture.incomplete)
+              found=picture.incomplete, meridian_surface=over_meridian)
     code = interrupted_status(picture.incomplete, args.output, requested())
     if code is not None:
         return code
     if switched:
-        listed = ", ".join(f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
-                           f"{stop_codes(b.legs)})" for b in branches[1:])
+        listed = ", ".join([f"{b.name} ({len(b.X) if isinstance(b, Branch) else len(b.values)} points, "
+                            f"{stop_codes(b.legs)})" for b in branches[1:]]
+                           + [f"{name} ({len(b.pressure)} points, {b.stop.code.value})"
+                              for name, b in over_meridian.items()])
         print(f"branches switched to at label {args.label}: {listed}; written to {args.output}")
     else:  # the branch traced again (after its parent as read, for a pear branch: ``restart.restart_branch``)
         branch = picture.branches[-1]

@@ -14,7 +14,9 @@ branches in their order; ``inspect`` shows them). From the point with ``label``:
   the branch's states are equilibria of (``Branch.reads``: held or free on an equator-symmetric branch, the held
   reading's on a held branch without it, the free one's on the free balloon's ``primary_free``) the
   non-axisymmetric branch and its other direction on the whole sphere (``picture.surface_pair``, assessed as
-  ``run`` assesses it); the branch of the point is written as read (its stored stability is not read back);
+  ``run`` assesses it), on a capsule over (θ, φ) with its image under the rotation by π/m
+  (``picture.trace_capsule``, its mirror sector's stability read); the branch of the point is written as read (its
+  stored stability is not read back);
 - a fold (LP, LV, LN) in a second parameter q (any key of ``analysis.critical.second_parameter``): the fold curve through it
   (``analysis.critical.fold_curve.continue_fold``);
 - any other point (UZ, EP, TP) in M or Φ̄ (TUNED): the branch through it in that parameter at its fixed P
@@ -46,7 +48,8 @@ from ..analysis.branches.primary import landing_targets, range_limits, stop_rule
 from ..analysis.points.extended_systems import WernerSpence
 from ..analysis.critical.pitchfork_curve import continue_branch_point, plain_branch
 from ..analysis.picture import (FREE_PRIMARY, PEAR_NAMES, Picture, Progress, azimuthal_crossings, examine,
-                                label_readings, pear_pair, stopped, surface_name, surface_pair, unsearched_events)
+                                label_readings, pear_pair, stopped, surface_name, surface_pair, trace_capsule,
+                                unsearched_events)
 from ..analysis.branches.problem import equilibrium_of
 from ..analysis.results import Block, Branch, Classification, Gauge, Kind, Leg, SpecialPoint, Status, StopCode
 from ..analysis.critical.second_parameter import resolve
@@ -375,9 +378,13 @@ def switch(start: Labelled, progress=None) -> Picture:
         label_readings(picture.branches[1:])
         return Picture(picture.branches, not_started=picture.not_started, interrupted=picture.interrupted,
                        interrupted_in=picture.interrupted_in, clock=clock)
-    if point.m >= 1 and branch.scene.geometry.shape == Shape.CAPSULE:
-        raise RestartError(f"{what} of a capsule: continue does not switch there yet; its branch is traced by run "
-                           "with [surface] branches = \"first\" or \"all\"")
+    if point.m >= 1 and branch.scene.geometry.shape == Shape.CAPSULE:  # over (θ, φ), as run traces it
+        k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
+        picture = Picture([branch])
+        trace_capsule(branch.scene, branch, k, point, picture, progress)
+        stopped(picture)  # a signal in its trace: flagged
+        unsearched_events(picture, branch.scene)
+        return picture
     if point.m >= 1:  # held, or free on an equator-symmetric branch (its held states are free equilibria)
         k = next(i for i, s in enumerate(branch.branch_points()) if s is point)
         try:

@@ -165,7 +165,9 @@ def _capsule_surface(run: dict) -> dict:
 def surface_branch_summaries(found: dict, control: str) -> dict:
     """{name: {'m', 'parent' {'branch', 'zero'}, 'points', 'pressure', 'volume', 'amplitude' ranges, 'stable_points'
     (under the file's control), 'largest_error_estimate', 'limited' (the basis at its cap: estimates above
-    solver.max_error; False in files before it), 'folds' [{'after_point', 'pressure'}], 'stop_code', 'stop_message'}}
+    solver.max_error; False in files before it), 'image_of' (the branch it is the image of under the rotation by
+    π/m about the axis; "" where traced), 'folds' [{'after_point', 'pressure'}], 'events' (its UZ points:
+    [{'after_point', 'pressure', 'volume', 'note', 'located'}]), 'stop_code', 'stop_message'}}
     of a tube's or a capsule's non-axisymmetric branches (io/tube_surface_file.py)."""
     def span(values):
         return [float(values.min()), float(values.max())]
@@ -175,8 +177,9 @@ def surface_branch_summaries(found: dict, control: str) -> dict:
                    "points": len(b["pressure"]), "pressure": span(b["pressure"]), "volume": span(b["volume"]),
                    "amplitude": span(b["amplitude"]), "stable_points": int((b[f"unstable_{control}"] == 0).sum()),
                    "largest_error_estimate": float(b["error_estimate"].max()),
-                   "limited": bool(b["attrs"].get("limited", False)),
+                   "limited": bool(b["attrs"].get("limited", False)), "image_of": b["attrs"].get("image_of", ""),
                    "folds": [{"after_point": i, "pressure": p} for i, p in b["folds"]],
+                   "events": [{k: v for k, v in e.items() if k != "coefficients"} for e in b.get("events", [])],
                    "stop_code": b["attrs"]["stop_code"], "stop_message": b["attrs"]["stop_message"]}
             for name, b in found.items()}
 
@@ -189,8 +192,12 @@ def surface_branch_lines(name: str, b: dict, control: str, origin: str) -> list[
             f"V/V0 {b['volume'][0]:.6g}..{b['volume'][1]:.6g}, amplitude {b['amplitude'][0]:.4g}.."
             f"{b['amplitude'][1]:.4g}, stop {b['stop_code']} ({b['stop_message']}); {b['stable_points']} "
             f"stable under {control} control; largest error estimate "
-            f"{b['largest_error_estimate']:.2g}{' (limited: the basis at its cap)' if b['limited'] else ''}",
-            *(f"  LP after point {f['after_point']:<4} P = {f['pressure']:.10g}" for f in b["folds"])]
+            f"{b['largest_error_estimate']:.2g}{' (limited: the basis at its cap)' if b['limited'] else ''}"
+            + (f"; the image of {b['image_of']} under the rotation by π/{b['m']} about the axis" if b["image_of"]
+               else ""),
+            *(f"  LP after point {f['after_point']:<4} P = {f['pressure']:.10g}" for f in b["folds"]),
+            *(f"  UZ after point {e['after_point']:<4} P = {e['pressure']:.10g}  V/V0 = {e['volume']:.8g}  "
+              f"{e['note']}{'' if e['located'] else '  approximate'}" for e in b["events"])]
 
 
 def run_time(attrs: dict) -> dict | None:

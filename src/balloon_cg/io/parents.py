@@ -28,7 +28,13 @@ def _label_of(run: dict, name: str, attribute: str) -> int | None:
     if not parent or parent not in run["branches"] or attribute not in attrs:
         return None
     points = [s for s in run["branches"][parent]["special_points"] if s["kind"] == "BP"]
-    if "surface_degree" not in attrs:
+    if not non_axisymmetric(attrs):
         points = sorted((s for s in points if s["m"] == 0), key=lambda s: s["block"] == "odd_free")
     n = int(attrs[attribute])
     return int(points[n]["label"]) if 0 <= n < len(points) else None
+
+
+def non_axisymmetric(attrs) -> bool:
+    """Whether a stored branch's attributes are a non-axisymmetric branch's: the sphere's (its basis'
+    surface_degree) or one over a meridian (its ``orders``, io/tube_surface_file.py; post/meridian_branches.py)."""
+    return "surface_degree" in attrs or "orders" in attrs

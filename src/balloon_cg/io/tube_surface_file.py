@@ -5,11 +5,15 @@ from the parent's discretisation; a capsule's also ``mode_degree``, its perturba
 whether it keeps the states even in z), ``parent_branch``, ``parent_zero`` (the zero's order among the parent's
 located zeros of block m, as ``inspect`` lists them; a capsule's: its number among the parent's branch points, as
 in its name m<m>_bp<k>), ``stop_code``,
-``stop_message``, ``limited`` (the basis reached its cap with estimates above solver.max_error; absent before it);
+``stop_message``, ``limited`` (the basis reached its cap with estimates above solver.max_error; absent before it),
+``image_of`` (only on a branch that is the image of another under the rotation by π/m about the axis:
+analysis/surface/meridian/rotation.py; its name);
 per point ``coefficients`` (n, size: c of the basis), ``pressure``, ``volume`` (V/V0), ``amplitude`` (φᵀ G c_m),
 ``reaction`` (the held centroid's τ), ``error_estimate``, ``lowest`` (n, 3: the mirror sector's lowest eigenvalues
 under pressure control) and ``unstable_pressure``, ``unstable_volume``, ``unstable_gas``; its folds in P:
-``fold_index``, ``fold_pressure``.
+``fold_index``, ``fold_pressure``; its UZ points (``[[events]]``; absent without them): ``event_index``,
+``event_pressure``, ``event_volume`` (V/V0), ``event_located``, ``event_coefficients`` (events, size) and the
+attribute ``event_notes``.
 Files before them have no /surface_branches (read as {})."""
 import numpy as np
 
@@ -35,6 +39,12 @@ SURFACE_VARIABLES = {  # (units, long_name, description) of each dataset, as io/
                                "sector") for c in Control},
     "fold_index": ("", "fold after point", "the fold in P lies between points fold_index and fold_index + 1"),
     "fold_pressure": ("1", "fold pressure P", "P at the located fold"),
+    "event": ("", "event index", "index of the UZ point ([[events]]) along the branch"),
+    "event_index": ("", "event after point", "the UZ point lies between points event_index and event_index + 1"),
+    "event_pressure": ("1", "event pressure P", "P at the UZ point"),
+    "event_volume": ("1", "event volume ratio V/V0", "V/V0 at the UZ point"),
+    "event_located": ("", "event located", "1: Newton landed on the value; 0: the linear interpolant"),
+    "event_coefficients": ("1", "event surface coefficients c", "c of the UZ point on the branch's final basis"),
 }
 
 
@@ -47,6 +57,8 @@ def write_surface_branches(f, branches: dict | None) -> None:
                             "degree": basis.disc.degree, "parent_branch": branch.parent[0],
                             "parent_zero": branch.parent[1], "stop_code": branch.stop.code.value,
                             "stop_message": branch.stop.message, "limited": branch.limited})
+        if branch.image_of:
+            group.attrs["image_of"] = branch.image_of
         if basis.shape == Shape.CAPSULE:
             group.attrs.update({"mode_degree": basis.mode_degree, "equator": basis.equator})
         checksummed(group, "coefficients", branch.coefficients)
@@ -57,6 +69,11 @@ def write_surface_branches(f, branches: dict | None) -> None:
             checksummed(group, f"unstable_{control.value}", branch.unstable[control])
         checksummed(group, "fold_index", np.array([i for i, _ in branch.folds], dtype=int))
         checksummed(group, "fold_pressure", np.array([p for _, p in branch.folds], dtype=float))
+        if branch.events:  # the UZ points: absent without [[events]] (and in files before them)
+            for column, kind in (("index", int), ("pressure", float), ("volume", float), ("located", int)):
+                checksummed(group, f"event_{column}", np.array([getattr(e, column) for e in branch.events], dtype=kind))
+            checksummed(group, "event_coefficients", np.array([e.coefficients for e in branch.events]))
+            group.attrs["event_notes"] = [e.note for e in branch.events]
         _described(group, branch)
 
 
@@ -66,14 +83,16 @@ def _described(group, branch) -> None:
     items = list(group.items())
     scales = {}
     for name, length in (("point", len(branch.pressure)), ("coefficient", branch.coefficients.shape[1]),
-                         ("eigenvalue", branch.lowest.shape[1]), ("fold", len(branch.folds))):
+                         ("eigenvalue", branch.lowest.shape[1]), ("fold", len(branch.folds)),
+                         *((("event", len(branch.events)),) if branch.events else ())):
         scales[name] = checksummed(group, name, np.arange(length, dtype=np.int64))
         scales[name].make_scale(name)
         _describe(scales[name], name)
     for name, item in items:
-        item.dims[0].attach_scale(scales["fold" if name.startswith("fold_") else "point"])
+        item.dims[0].attach_scale(scales["fold" if name.startswith("fold_") else "event" if name.startswith("event_")
+                                         else "point"])
         if item.ndim == 2:
-            item.dims[1].attach_scale(scales["coefficient" if name == "coefficients" else "eigenvalue"])
+            item.dims[1].attach_scale(scales["coefficient" if name.endswith("coefficients") else "eigenvalue"])
         _describe(item, name)
 
 
@@ -99,5 +118,16 @@ def read_surface_branches(f, path, error) -> dict:
             if branch[column].shape[0] != n:
                 raise error(path, f"/{GROUP}/{name}/{column}: {branch[column].shape[0]} rows, expected {n}")
         branch["folds"] = list(zip(branch.pop("fold_index").tolist(), branch.pop("fold_pressure").tolist()))
+        branch["events"] = _events(group, branch["attrs"])
         out[name] = branch
     return out
+
+
+def _events(group, attrs: dict) -> list:
+    """[{'after_point', 'pressure', 'volume', 'note', 'located', 'coefficients'}] of a branch's UZ points ([] without
+    them)."""
+    if "event_index" not in group:
+        return []
+    columns = [group[f"event_{c}"][()].tolist() for c in ("index", "pressure", "volume", "located")]
+    return [{"after_point": i, "pressure": P, "volume": V, "note": note, "located": bool(located), "coefficients": c}
+            for i, P, V, located, note, c in zip(*columns, attrs.pop("event_notes"), group["event_coefficients"][()])]

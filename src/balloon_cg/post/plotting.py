@@ -18,7 +18,8 @@ stability data all solid, and the legend title says so. Titles name the material
 are marked and labelled with their label in the file and their kind ("2 LP", "3 pitchfork-super": ``labels``).
 Surface branches (m ≥ 1, states on the whole sphere) are drawn by the pole curves and the energy landscape,
 labelled 'm = 1 from 5' (their parent point's label), and left out of the other branch and per-point kinds;
-``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states.
+``surface`` (3D) and ``stretch-map`` (λ1, λ2 over (φ, θ)) draw one of their states; a capsule's (over (θ, φ):
+``meridian_branches``) are drawn by the same code, but for stretch-map.
 The θ plots limit y to the bulk of the data when a near-wire spike would flatten the rest (``robust_limits``).
 Units are nondimensional (MODEL.md §2): P = P̄R0/(T0 μ/2), Φ̄ = (Φ/H)√(ε/μ), lengths in R0, stresses in μ/2,
 field in I/(4π R0).
@@ -40,12 +41,13 @@ from scipy.interpolate import PchipInterpolator
 from .quantities import branch_discretisation, postprocess, surface
 from .fit import MAX_WIDTH, MIN_WIDTH, NARROW, covers, fit_width, fitted_size
 from .labels import label_points
+from .meridian_branches import stored_meridian_basis, with_meridian_branches
 from .style import JournalFigure, journal_style
 from ..analysis.results import Block
 from ..galerkin.profiles import EQUATOR
 from ..io.curve_file import curve_meetings, read_curve
 from ..io.layout import FileError, check_input, file_kind, reading
-from ..io.parents import parent_label
+from ..io.parents import non_axisymmetric, parent_label
 from ..io.run_file import read_run, stored_basis, stored_scene
 from ..io.sweep_file import read_sweep
 from ..model.meridian import hoop, reference_height
@@ -214,8 +216,9 @@ class StoredBranch:
 
     @property
     def surface(self) -> bool:
-        """Whether it is a surface branch (traced on the whole sphere: its basis attributes, docs/hdf5.md)."""
-        return "surface_degree" in self.data["attrs"]
+        """Whether it is a surface branch (traced on the whole sphere, or a capsule's over (θ, φ): its basis
+        attributes, docs/hdf5.md)."""
+        return non_axisymmetric(self.data["attrs"])
 
     @property
     def surface_name(self) -> str:
@@ -275,8 +278,9 @@ class StoredBranch:
 
 
 def as_run(source) -> dict:
-    """A run (read_run() output): ``source`` itself if it is one, else read from the file it names."""
-    return source if isinstance(source, dict) else read_run(source)
+    """A run (read_run() output): ``source`` itself if it is one, else read from the file it names; a capsule's
+    non-axisymmetric branches among its branches (``meridian_branches``: drawn as the sphere's surface branches)."""
+    return with_meridian_branches(source if isinstance(source, dict) else read_run(source))
 
 
 def load_branches(source, branch: str | None = None, reading: Reading | None = None) -> list[StoredBranch]:
@@ -874,7 +878,7 @@ def surface_state(sources, points, branch: str | None, what: str) -> tuple:
     run = as_run(sources[0])
     source = run["path"] or run["scene_name"]
     if branch is None:
-        branch = next((name for name, d in run["branches"].items() if "surface_degree" in d["attrs"]), None)
+        branch = next((name for name, d in run["branches"].items() if non_axisymmetric(d["attrs"])), None)
         if branch is None:
             raise PlotError(f"{source}: no surface branch (m ≥ 1) in this file: {what} draws a state of a "
                             "non-axisymmetric branch (shapes draws axisymmetric ones)")
@@ -884,22 +888,29 @@ def surface_state(sources, points, branch: str | None, what: str) -> tuple:
                         "(draw it with shapes)")
     if points is not None and np.ndim(points) == 1 and len(points) > 1:
         raise PlotError(f"{what} draws one state: give one point (got {len(points)})")
+    if what == "stretch-map" and "orders" in stored.data["attrs"]:
+        raise PlotError(f"{source}: branch {branch} is a capsule's (over (θ, φ)): stretch-map draws the sphere's "
+                        "surface branches (a capsule's: not built; draw it with surface)")
     n = len(stored.data["pressure"])
     index = int(select_points(stored.data, points)[0]) if points is not None else n - 1
     return stored, index
 
 
 def stored_state(branch: StoredBranch, index: int) -> tuple:
-    """(basis, coefficients) of point ``index`` of a stored surface branch, the SphericalBasis rebuilt from its
-    attributes (io.run_file.stored_basis)."""
-    return stored_basis(branch.data["attrs"], branch.source), branch.data["coefficients"][index]
+    """(basis, coefficients) of point ``index`` of a stored surface branch, its basis rebuilt from its attributes:
+    a SphericalBasis (io.run_file.stored_basis), a capsule's CapsuleSurfaceBasis (``stored_meridian_basis``)."""
+    attrs = branch.data["attrs"]
+    basis = (stored_meridian_basis(branch.run, branch.name) if "orders" in attrs else
+             stored_basis(attrs, branch.source))
+    return basis, branch.data["coefficients"][index]
 
 
 def _state_title(branch: StoredBranch, index: int) -> str:
     d = branch.data
     return (f"{_title([branch])}, M = {branch.M:g}\n{branch.label}: #{index}  "
             f"{branch.ordinate.symbol} = {d[branch.ordinate.column][index]:.4g}, "
-            f"$\\lambda_2(0)$ = {d['lam2_top'][index]:.4g}, tilt {d['tilt'][index]:.1f}°")
+            f"$\\lambda_2(0)$ = {d['lam2_top'][index]:.4g}, "
+            + (f"tilt {d['tilt'][index]:.1f}°" if "tilt" in d else f"$V/V_0$ = {d['volume'][index]:.4g}"))
 
 
 def surface_grid(basis, c, samples: tuple = SURFACE_SAMPLES) -> np.ndarray:

@@ -11,8 +11,9 @@ APPROXIMATE with its bracket.
 
 On a non-axisymmetric branch (``SurfaceBranch``, X = (a, P) of its ``surface.system``) the volume, the amount and
 the pressure are located the same way (``surface_event_points``): V = 2π Ṽ(c) (``surface.measures``), whose gradient
-is ∇_a V = −2π ∂R/∂P (R = Zᵀ∇E, and the −PṼ term of E gives ∂R/∂P = −∇_a Ṽ), n = P V, and P. λ2 at the poles and
-the equator are not located there (``SURFACE_UNLOCATED`` says so in the verdict line: ``unlocated_on_surface``).
+is ∇_a V = −2π ∂R/∂P (R = Zᵀ∇E, and the −PṼ term of E gives ∂R/∂P = −∇_a Ṽ), n = P V, and P (a capsule's branches over
+(θ, φ) the same way: analysis/surface/meridian/events.py). λ2 at the poles and the equator are not located there
+(``unlocated_on_surface`` says so in the verdict line).
 """
 import numpy as np
 
@@ -105,11 +106,7 @@ SURFACE_QUANTITIES = (Quantity.VOLUME, Quantity.AMOUNT, Quantity.PRESSURE)  # lo
 def surface_quantity(system, quantity: Quantity):
     """(q(X), ∇q(X)) of ``quantity`` (one of SURFACE_QUANTITIES) for a surface branch's continuation system
     (``surface.system.SurfaceSystem`` in P; module docstring)."""
-    basis, size = system.eq.basis, system.gauge.size + 1
-    if quantity == Quantity.PRESSURE:
-        row = np.zeros(size)
-        row[-1] = 1.0
-        return (lambda X: float(X[-1])), (lambda X: row)
+    basis = system.eq.basis
 
     def volume(X):
         return 2 * np.pi * body_moments(basis, basis.node_state(system.coefficients(X)))[0]
@@ -119,10 +116,20 @@ def surface_quantity(system, quantity: Quantity):
         return np.append(-2 * np.pi * system.gauge.reduce(system.eq.parameter_derivative(c, system.params_at(X), "P")),
                          0.0)
 
+    return quantity_of_volume(quantity, system.gauge.size + 1, volume, volume_gradient)
+
+
+def quantity_of_volume(quantity: Quantity, size: int, volume, volume_gradient):
+    """(q(X), ∇q(X)) of ``quantity`` (one of SURFACE_QUANTITIES) on a system in P of ``size`` unknowns (P last)
+    whose enclosed volume V(X) and its gradient are ``volume`` and ``volume_gradient``: V, n = P V (∇n = P ∇V + V e_P)
+    or P (the row e_P)."""
+    row = np.zeros(size)
+    row[-1] = 1.0
+    if quantity == Quantity.PRESSURE:
+        return (lambda X: float(X[-1])), (lambda X: row)
     if quantity == Quantity.VOLUME:
         return volume, volume_gradient
-    return (lambda X: X[-1] * volume(X)), (lambda X: X[-1] * volume_gradient(X) + np.append(np.zeros(size - 1),
-                                                                                             volume(X)))
+    return (lambda X: X[-1] * volume(X)), (lambda X: X[-1] * volume_gradient(X) + volume(X) * row)
 
 
 def surface_event_points(branch: SurfaceBranch, system) -> list[SpecialPoint]:

@@ -170,27 +170,29 @@ class CapsuleBasis:
         """(R, R', Z, Z', T, T') at the nodes for coefficients c, shape (6, n_q)."""
         return self.ops @ c
 
-    def displacement(self, c: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    def displacement(self, c: np.ndarray, theta: np.ndarray, rate: bool = False) -> np.ndarray:
         """(R, Z, T) on any θ grid in [0, π] for coefficients c (one vector or rows): the amplitudes of
         δρ = R cos mφ, δz = Z cos mφ, δφ = T sin mφ, shape (3, n_θ) or (rows, 3, n_θ) (AzimuthalBasis's);
-        R = (U + D)/2, T = (U − D)/2 from each field's broken functions times its ``combinations``."""
+        R = (U + D)/2, T = (U − D)/2 from each field's broken functions times its ``combinations``; with ``rate``
+        their derivatives d/dθ (at a join the first element's)."""
         theta = np.asarray(theta, dtype=float)
         kappa = capsule_rate(self.geometry)
         rows = np.atleast_2d(np.asarray(c, dtype=float))
-        field = {name: _broken(self.elements, kappa, order, theta) @ self.combinations[name] @ rows[:, self.blocks[name]].T
+        field = {name: _broken(self.elements, kappa, order, theta, rate) @ self.combinations[name] @ rows[:, self.blocks[name]].T
                  for name, order in (("Z", self.m), ("U", self.m + 1), ("D", self.m - 1))}
         shapes = np.stack([(field["U"] + field["D"]) / 2, field["Z"], (field["U"] - field["D"]) / 2]).transpose(2, 0, 1)
         return shapes[0] if np.ndim(c) == 1 else shapes
 
 
-def _broken(parts: tuple, kappa: float, order: int, theta: np.ndarray) -> np.ndarray:
-    """The broken functions of regularity ``order`` (every element's, columns element by element) at any θ in
-    [0, π]: an element's own functions on it, zero elsewhere (a boundary point on the first element holding it)."""
+def _broken(parts: tuple, kappa: float, order: int, theta: np.ndarray, rate: bool = False) -> np.ndarray:
+    """The broken functions of regularity ``order`` (every element's, columns element by element; with ``rate``
+    their derivatives d/dθ) at any θ in [0, π]: an element's own functions on it, zero elsewhere (a boundary point
+    on the first element holding it)."""
     out = np.zeros((theta.size, sum(e.degree + 1 for e in parts)))
     column, free = 0, np.ones(theta.size, dtype=bool)
     for e in parts:
         on = free & (theta >= e.low) & (theta <= e.high)
-        out[on, column:column + e.degree + 1] = _field_functions(e, kappa, order, theta[on])[0]
+        out[on, column:column + e.degree + 1] = _field_functions(e, kappa, order, theta[on])[int(rate)]
         free &= ~on
         column += e.degree + 1
     if free.any():

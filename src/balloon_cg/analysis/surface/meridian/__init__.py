@@ -12,4 +12,5 @@
 - ``trace``: the branch traced in P from its switched point, refined by its shape's resolution policy
 - ``capsule``: the capsule over (θ, φ), its poles included: its basis, switched point and traced branch;
   ``capsule_resolution``: its error estimate and refinement
+- ``rotation``: a branch's −φ half, its image under the rotation by π/m about the axis
 """

@@ -78,6 +78,44 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
     def tables(self) -> tuple:
         return _tables(self)
 
+    def grid_values(self, c: np.ndarray, cos_theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """x on the grid of rings cos θ_j × angles φ_k (poles included), shape (3, n_rings, n_φ), in Cartesian
+        components (surface.basis.SphericalBasis.grid_values' contract: the sphere's figures draw it)."""
+        phi = np.asarray(phi, dtype=float)
+        frame = self._frame(c, np.arccos(np.clip(np.asarray(cos_theta, dtype=float), -1.0, 1.0)), phi, True)
+        return _cartesian(frame[[0, 2, 4]], phi)
+
+    def point_values(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> tuple:
+        """(x, a_S) at the points (θ_i, φ_i), poles included, each (3, n) in Cartesian components, a_S = ∂x/∂θ / S'
+        along the reference meridian's arclength (SphericalBasis.point_values' contract, whose a_θ is the unit
+        sphere's: surface/measures.pole_stretch reads it)."""
+        theta, phi = np.atleast_1d(np.asarray(theta, dtype=float)), np.atleast_1d(np.asarray(phi, dtype=float))
+        frame = self._frame(c, theta, phi, False)
+        rate = metric(self.geometry, np.cos(theta), np.sin(theta))
+        return _cartesian(frame[[0, 2, 4]], phi), _cartesian(frame[[1, 3, 5]], phi) / rate
+
+    def _frame(self, c: np.ndarray, theta: np.ndarray, phi: np.ndarray, grid: bool) -> np.ndarray:
+        """(r, r', t, t', z, z') (primes d/dθ) on the grid θ × φ (``grid``: (6, n_θ, n_φ)) or at the points
+        (θ_i, φ_i) ((6, n)): r, z = Σ_m (r_m, z_m)(θ) cos mφ, t = Σ_m t_m(θ) sin mφ (basis.py); order 0's
+        ρ = λ2 R and η from the disc's series, each m ≥ 1 order's (R, Z, T) and their rates from its
+        CapsuleBasis.displacement."""
+        lam2, dlam2, eta, deta = self.disc.evaluate(c[self.block(0)], theta)
+        R, dR = (np.asarray(f(self.geometry, np.cos(theta), np.sin(theta)), dtype=float) for f in (hoop, hoop_rate))
+        zero = np.zeros_like(theta)
+        fields = [(0, np.array([lam2 * R, dlam2 * R + lam2 * dR, zero, zero, eta, deta]))]
+        for m in self.orders[1:]:
+            full = np.zeros(self.perturbations(m).size)
+            full[self.kept(m)] = c[self.block(m)]
+            (R_m, Z_m, T_m), (dR_m, dZ_m, dT_m) = (self.perturbations(m).displacement(full, theta, rate)
+                                                   for rate in (False, True))
+            fields.append((m, np.array([R_m, dR_m, T_m, dT_m, Z_m, dZ_m])))
+        out = 0.0
+        for m, F in fields:
+            cos, sin = np.cos(m * phi), np.sin(m * phi)
+            trig = np.array([cos, cos, sin, sin, cos, cos])
+            out = out + (np.einsum("in,ik->ink", F, trig) if grid else F * trig)
+        return out
+
     def check_scene(self, scene) -> None:
         """ValueError where the scene's capsule is not the basis'."""
         if scene.geometry != self.geometry:
@@ -147,6 +185,13 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
         for row, mode in zip(rows, modes):
             row[self.block(1)] = mode
         return rows
+
+
+def _cartesian(frame: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """The Cartesian components of a vector's frame components (r, t, z) along (e_ρ(φ), e_φ(φ), e_z) (φ broadcast
+    against the last axis)."""
+    r, t, z = frame
+    return np.array([r * np.cos(phi) - t * np.sin(phi), r * np.sin(phi) + t * np.cos(phi), z])
 
 
 @functools.lru_cache(maxsize=8)

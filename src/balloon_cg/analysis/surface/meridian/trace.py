@@ -9,8 +9,8 @@ from there pseudo-arclength continuation (numerics/continuation.py) of system.py
 X = (c, τ, P), the tangent oriented along +φ, folds in P located (LP). It stops where the amplitude a = φᵀ G c_m
 changes sign (REJOINED: back through the axisymmetric states), the largest hoop stretch |a_φ| over the nodes passes
 continuation.stop_stretch (HOOP_STRETCH), a signal (INTERRUPTED), the corrector fails at step_min or after
-``max_points`` ([surface] max_points). ``direction`` −1 traces the other half of the pitchfork (for odd m the image
-of the first under the rotation by π: P the same at opposite amplitudes).
+``max_points`` ([surface] max_points). ``direction`` −1 traces the other half of the pitchfork (the image of the
+first under the rotation by π/m, which rotation.py gives without a trace: P the same at opposite amplitudes).
 
 Refinement, as the sphere's surface branches (analysis/surface/branches.py): a point whose error estimate (the
 policy's ``error_estimate``: tube/surface/resolution.py, capsule_resolution.py) exceeds solver.max_error is rejected,
@@ -52,7 +52,9 @@ class MeridianSurfaceBranch:
     ``lowest`` COUNT eigenvalues of the mirror sector's pencil under pressure control and the ``unstable`` counts
     under each control (stability.py); ``folds``: (index, pressure) of each located LP (between points
     index and index + 1); ``m``; ``parent``: (branch name, label) of the zero it was born at; ``stop``; ``limited``:
-    the basis reached its cap with an estimate above solver.max_error (module docstring)."""
+    the basis reached its cap with an estimate above solver.max_error (module docstring); ``image_of``: the name of
+    the branch this one is the image of under the rotation by π/m about the axis (rotation.py), "" where traced;
+    ``events``: its UZ points (events.MeridianEvent: ``[[events]]``, events.py)."""
 
     basis: MeridianSurfaceBasis
     m: int
@@ -68,6 +70,8 @@ class MeridianSurfaceBranch:
     stop: Stop
     parent: tuple | None = None
     limited: bool = False
+    image_of: str = ""
+    events: tuple = ()
 
 
 def largest_hoop_stretch(basis: MeridianSurfaceBasis, c: np.ndarray) -> float:
