@@ -62,7 +62,8 @@ def main():
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     basis = mb.basis
     print(f"meridian trace: wall {wall:.1f} s, cpu {cpu:.1f} s, {len(mb.pressure)} points, stop {mb.stop.code.value}; "
-          f"final basis disc degree {basis.disc.degree}, mode degree {basis.mode_degree}, orders 0..{basis.orders[-1]}, "
+          f"final basis disc degree {basis.disc.degree}, mode degree {basis.mode_degree}, "
+          f"orders 0..{basis.orders[-1]}, "
           f"n_phi {basis.n_phi}, {basis.size} unknowns; folds {mb.folds}")
     print("stored branch: wall_time", stored["attrs"]["wall_time"], "s,", len(stored["pressure"]), "points")
     print("unstable counts of the mirror sector (pressure, volume, gas):",
@@ -72,12 +73,15 @@ def main():
     for i, c in enumerate(mb.coefficients):
         t = capsule_resolution.tails(basis, c)
         rms = [np.sqrt(c[basis.block(m)] @ basis.gram(m) @ c[basis.block(m)]) / radius[i] for m in basis.orders[1:]]
-        print(f" {i:2d} P={mb.pressure[i]:.6f} tails {t[0]:.1e} {t[1]:.1e} {t[2]:.1e} |", " ".join(f"{r:.0e}" for r in rms))
+        print(f" {i:2d} P={mb.pressure[i]:.6f} tails {t[0]:.1e} {t[1]:.1e} {t[2]:.1e} |",
+              " ".join(f"{r:.0e}" for r in rms))
 
     eq = MeridianSurfaceEquilibrium(scene, basis)
     system = MeridianSurfaceSystem(eq, params, mb.coefficients[0])
-    print(f"\nat the stored pressures (meridian re-solved on its final basis, orders 0..{basis.orders[-1]}, mode degree {basis.mode_degree}):")
-    print(" k  P               V stored         V meridian-stored  top stored     top mer-stored  bottom mer-stored  stored err  mer err at P")
+    print(f"\nat the stored pressures (meridian re-solved on its final basis, orders 0..{basis.orders[-1]}, "
+          f"mode degree {basis.mode_degree}):")
+    print(" k  P               V stored      V mer-stored  top stored    top mer-stored  bottom mer-stored  "
+          "stored err  mer err at P")
     for k, P in enumerate(stored["pressure"]):
         if k == 0:
             c = mb.coefficients[0]
@@ -86,14 +90,19 @@ def main():
             last = before[0] + 1 if before.size else len(mb.pressure)
             j = 1 + int(np.argmin(np.abs(mb.pressure[1:last] - P)))
             X0 = system.point(mb.coefficients[j], mb.pressure[j])
-            row = np.zeros(X0.size); row[-1] = 1.0
+            row = np.zeros(X0.size)
+            row[-1] = 1.0
             res = newton(system.residual, system.jacobian, X0, row, P, scene.solver.tol, scene.solver.max_newton)
             if not res.converged:
-                print(k, "no convergence", res.message); continue
+                print(k, "no convergence", res.message)
+                continue
             c = system.coefficients(res.x)
         V = 2 * np.pi * eq.volume(c)
         top, bottom = pole_stretch(basis, c, True), pole_stretch(basis, c, False)
-        print(f"{k:2d} {P:.12f} {stored['volume'][k]:.10f} {V - stored['volume'][k]:+.2e}          {stored['lam2_top'][k]:.10f} {top - stored['lam2_top'][k]:+.2e}       {bottom - stored['lam2_bottom'][k]:+.2e}           {stored['error_estimate'][k]:.1e}    {capsule_resolution.error_estimate(basis, c):.1e}")
+        print(f"{k:2d} {P:.12f} {stored['volume'][k]:.10f} {V - stored['volume'][k]:+.2e}     "
+              f"{stored['lam2_top'][k]:.10f} {top - stored['lam2_top'][k]:+.2e}       "
+              f"{bottom - stored['lam2_bottom'][k]:+.2e}           {stored['error_estimate'][k]:.1e}    "
+              f"{capsule_resolution.error_estimate(basis, c):.1e}")
 
 
 if __name__ == "__main__":

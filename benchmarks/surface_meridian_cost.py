@@ -2,16 +2,18 @@
 (surface/, the run's) against the sphere over (θ, φ) of the meridian engine (analysis/surface/meridian/sphere.py),
 in one process (one machine load), for issue 37's lever "a basis made for coaxial scenes".
 
-Harmonics: the run file's stored basis (degree 64, order 36, its map) at its stored points 7 and 13 (the last, gap
-0.096 from a wire): the bordered Jacobian's assembly (SurfaceSystem.jacobian), its LU factorisation, and the dense
-reading of every symmetry sector (surface.stability.sector_spectra, the six readings, 4 eigenvalues: a branch's first
-point; later points follow their guesses). Meridian: the sphere's basis at the branch point's mode degree (90, the
+Harmonics: the run file's stored basis (degree 64, order 36, its map) at its last stored point (13, gap 0.096 from
+a wire): the bordered Jacobian's assembly (SurfaceSystem.jacobian), its LU factorisation, and the dense reading of
+the branch's own sector (y → −y and z → −z even: surface.stability.sector_spectra, held, pressure control, 4
+eigenvalues; the run reads all four sectors and six readings). Meridian: the sphere's basis at the branch point's
+mode degree (90, the
 trace's) with the orders 0..K, K = 8 (what the branch's first points need for 1e-9), 16 (the refinement cap the
 trace reached, MAX_HARMONICS) and 36 (what its last stored point needs: the per-order content decays by ~0.65 per
 order there), at the axisymmetric branch point state (a dense assembly and factorisation cost the same at any
 state): the bordered Jacobian's assembly, its LU, and one dense eigvalsh of the pressure-control matrix (of the
-three readings SectorStability makes per point). Wall seconds of this process (BLAS threads as set), with the
-load average.
+three readings SectorStability makes per point: that sector, the meridian basis holding only it). CPU seconds of
+this process with one BLAS thread (numerics.threads.blas_threads; on a machine loaded several times over its cores,
+wall seconds measure the neighbours), with the load average.
 
     python benchmarks/surface_meridian_cost.py RUN_FILE   (a run of scenes/spom1_two_coils_M0.002.toml)
 """
@@ -30,15 +32,16 @@ from balloon_cg.analysis.surface.meridian.sphere import SphereSurfaceBasis
 from balloon_cg.analysis.surface.meridian.stability import SectorStability
 from balloon_cg.analysis.surface.meridian.system import MeridianSurfaceSystem
 from balloon_cg.io.run_file import read_run, stored_basis, stored_scene
+from balloon_cg.numerics.threads import blas_threads
 from balloon_cg.surface import stability as surface_stability
 
 MODE_DEGREE, ORDERS = 90, (8, 16, 36)
 
 
 def timed(call):
-    t = time.perf_counter()
+    t = time.process_time()
     out = call()
-    return time.perf_counter() - t, out
+    return time.process_time() - t, out
 
 
 def bordered(J):
@@ -57,7 +60,8 @@ def harmonic_costs(scene, run, k, branch_params):
     X = trace.system.point(c, P)
     t_jac, J = timed(lambda: trace.system.jacobian(X))
     t_lu, _ = timed(lambda: linalg.lu_factor(bordered(J)))
-    t_stab, _ = timed(lambda: surface_stability.sector_spectra(trace.eq, c, params, 4, surface_stability.READINGS))
+    held = (surface_stability.Reading(True),)
+    t_stab, _ = timed(lambda: surface_stability.sector_spectra(trace.eq, c, params, 4, held, only=((1, 1),)))
     sectors = [s.size for s in basis.sectors() if s.size]
     return f"harmonics L64 M36, point {k}", J.shape[0], f"sectors {sectors}", t_jac, t_lu, t_stab
 
@@ -82,11 +86,12 @@ def main():
     scene = stored_scene(run)
     primary = analyse(scene.with_overrides({"surface.branches": "none"})).primary
     bp = primary.branch_points()[run["branches"]["m1_bp1"]["attrs"]["parent_branch_point"]]
-    rows = [harmonic_costs(scene, run, k, primary.params) for k in (7, 13)]
+    rows = [harmonic_costs(scene, run, 13, primary.params)]
     rows += [meridian_costs(scene, primary, bp, K) for K in ORDERS]
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}; "
           f"wall s of this process")
-    print(f"{'basis':34s} {'unknowns':>8s} {'Jacobian':>9s} {'LU':>7s} {'stability':>10s}   ratio Jac+LU to harmonics pt 7")
+    print(f"{'basis':34s} {'unknowns':>8s} {'Jacobian':>9s} {'LU':>7s} {'stability':>10s}   "
+          "(Jacobian + LU) / harmonics'")
     base = rows[0][3] + rows[0][4]
     for name, n, note, t_jac, t_lu, t_stab in rows:
         print(f"{name:34s} {n:8d} {t_jac:9.3f} {t_lu:7.3f} {t_stab:10.3f}   {(t_jac + t_lu) / base:6.2f}   ({note})")
@@ -94,4 +99,5 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    with blas_threads():
+        main()
