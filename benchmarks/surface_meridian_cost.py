@@ -89,7 +89,7 @@ def main():
     rows = [harmonic_costs(scene, run, 13, primary.params)]
     rows += [meridian_costs(scene, primary, bp, K) for K in ORDERS]
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}; "
-          f"wall s of this process")
+          f"CPU s of this process, one BLAS thread")
     print(f"{'basis':34s} {'unknowns':>8s} {'Jacobian':>9s} {'LU':>7s} {'stability':>10s}   "
           "(Jacobian + LU) / harmonics'")
     base = rows[0][3] + rows[0][4]
