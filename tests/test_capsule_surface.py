@@ -45,7 +45,12 @@ def test_restricted_to_m0_it_is_the_capsules_axisymmetric_discretisation(length)
     orders couple (1e-12). The axisymmetric side runs on FINE_RULE nodes per piece: on its default rule (32 Gauss
     nodes in x at length 0, degree 16) its own Jacobian is 2e-7 off its value on 60 or 120 nodes, where it meets the
     engine's (Gauss in θ per element) to 3e-14: the engine's rule is the converged one."""
-    scene, eq, basis, surface, u, params = setting(length)
+    axisymmetric_restriction_holds(*setting(length))
+
+
+def axisymmetric_restriction_holds(scene, eq, basis, surface, u, params) -> None:
+    """The assertions of the m = 0 restriction (the test above; the sphere's in test_sphere_meridian_surface.py) at
+    the axisymmetric state u, orders 0..3."""
     c, axis = basis.axisymmetric(u), basis.block(0)
     assert close(surface.energy(c, params), eq.energy(u, params), 1e-10)
     assert close(surface.volume(c), eq.volume(u), 1e-10)

@@ -46,26 +46,40 @@ class CapsuleSurfaceBasis(MeridianSurfaceBasis):
     shape = Shape.CAPSULE
 
     def __post_init__(self):
-        if self.geometry.shape != Shape.CAPSULE or self.disc.joins != joins(self.geometry):
-            raise ValueError(f"disc: joins {self.disc.joins} (allowed: a capsule's, {joins(self.geometry)})")
+        self.check_reference()
         if self.disc.symmetric != self.equator:
             raise ValueError(f"disc: symmetric {self.disc.symmetric} (allowed: {self.equator}, as equator)")
         orders, n_phi = default_phi_nodes(self.orders, self.n_phi)
         object.__setattr__(self, "orders", orders)
         object.__setattr__(self, "n_phi", n_phi)
+        self.settle()
         sizes = {self.kept(m).size for m in orders[1:]}
         if len(sizes) > 1:
             raise ValueError(f"orders: {orders} have perturbation bases of sizes {sorted(sizes)} (allowed: one size)")
 
-    def perturbations(self, m: int):
-        """The order's CapsuleBasis (its ``gram``, ``ops`` and ``displacement``)."""
-        return capsule_basis(m, self.mode_degree, self.geometry)
+    def check_reference(self) -> None:
+        """ValueError where ``geometry`` and ``disc`` are not a capsule's."""
+        if self.geometry.shape != Shape.CAPSULE or self.disc.joins != joins(self.geometry):
+            raise ValueError(f"disc: joins {self.disc.joins} (allowed: a capsule's, {joins(self.geometry)})")
+
+    def settle(self) -> None:
+        """Set the fields derived from the orders (none here; the sphere's quadrature)."""
+
+    def perturbations(self, m: int, degree: int | None = None):
+        """The order's CapsuleBasis (its ``gram``, ``ops`` and ``displacement``), of ``degree`` (default
+        ``mode_degree``)."""
+        return capsule_basis(m, self.mode_degree if degree is None else degree, self.geometry)
 
     def rule(self) -> tuple:
-        return _rule(self.geometry, self.mode_degree)
+        return _rule(self.perturbations(1))
 
     def axis(self) -> tuple:
-        return _axis(self.disc, self.geometry, self.mode_degree)
+        return _axis(self.disc, self.perturbations(1))
+
+    def carried(self, m: int, perturbation, vector: np.ndarray) -> np.ndarray:
+        """The order-m coefficients ``vector`` of ``perturbation`` (a crossing's critical mode: ``start``) on the
+        order's basis: the same basis here."""
+        return vector
 
     def kept(self, m: int) -> np.ndarray:
         """The columns of the order's CapsuleBasis in c: all, or with ``equator`` its class 0."""
@@ -195,9 +209,9 @@ def _cartesian(frame: np.ndarray, phi: np.ndarray) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=8)
-def _rule(geometry: Geometry, degree: int) -> tuple:
-    """(W per dθ, R, R', S') at the perturbation basis' nodes (the same for every order), read-only."""
-    b = capsule_basis(1, degree, geometry)
+def _rule(b) -> tuple:
+    """(W per dθ, R, R', S') at the nodes of the perturbation basis ``b`` (the same for every order), read-only."""
+    geometry = b.geometry
     out = (b.weights / b.sin_theta, np.asarray(hoop(geometry, b.x, b.sin_theta), dtype=float),
            np.asarray(hoop_rate(geometry, b.x, b.sin_theta), dtype=float), metric(geometry, b.x, b.sin_theta))
     for array in out:
@@ -206,11 +220,12 @@ def _rule(geometry: Geometry, degree: int) -> tuple:
 
 
 @functools.lru_cache(maxsize=8)
-def _axis(disc: Discretisation, geometry: Geometry, degree: int) -> tuple:
-    """(rows of ρ, ρ', η, η' in u at the nodes (module docstring), zero offset), read-only."""
-    theta = capsule_basis(1, degree, geometry).theta
+def _axis(disc: Discretisation, b) -> tuple:
+    """(rows of ρ, ρ', η, η' in u at the nodes of the perturbation basis ``b`` (module docstring), zero offset),
+    read-only."""
+    theta = b.theta
     lam2, dlam2, eta, deta = (values.T for values in disc.evaluate(np.eye(disc.size), theta))
-    _, R, dR, _ = _rule(geometry, degree)
+    _, R, dR, _ = _rule(b)
     rows = np.array([R[:, None] * lam2, R[:, None] * dlam2 + dR[:, None] * lam2, eta, deta])
     offset = np.zeros((4, theta.size))
     rows.flags.writeable = offset.flags.writeable = False
@@ -222,31 +237,35 @@ def _tables(basis: CapsuleSurfaceBasis) -> tuple:
     return meridian_tables(basis)
 
 
-def start(scene, branch, bp, orders: tuple | None = None, n_phi: int = 0, whole: bool = False) -> tuple:
+def start(scene, branch, bp, orders: tuple | None = None, n_phi: int = 0, whole: bool = False,
+          kind: type = CapsuleSurfaceBasis) -> tuple:
     """(the basis, the zero's c on it, the critical mode φ as c on it, G-unit) of the branch born at the located
-    m ≥ 1 point ``bp`` of the capsule's axisymmetric ``branch`` (analysis/results.Branch): φ from
+    m ≥ 1 point ``bp`` of the axisymmetric ``branch`` (analysis/results.Branch) of a capsule (``kind``: its
+    CapsuleSurfaceBasis) or a sphere (sphere.SphereSurfaceBasis): φ from
     analysis/surface/branches.critical_mode of its reading at the degree it was located at, the orders (0, m, 2m)
     unless ``orders``, on the ``equator`` states where the branch is equator-symmetric and the mode in reflection class
     0 (as the sphere's surface branches keep a mode's symmetry), else (or ``whole``) on the whole discretisation (a mode
     odd in z breaks it)."""
     m = bp.m
     degree = located_degree(branch, bp)
-    mode = critical_mode(branch, bp, degree)[1]
-    even = capsule_basis(m, degree, scene.geometry).classes[0]
+    perturbation, mode = critical_mode(branch, bp, degree)
+    even = perturbation.classes[0]
     equator = not whole and branch.disc.symmetric and np.abs(np.delete(mode, even)).max() <= 1e-10 * np.abs(mode).max()
     disc = replace(branch.disc, symmetric=equator)
-    basis = CapsuleSurfaceBasis(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi, equator)
-    mode = mode[basis.kept(m)]
+    basis = kind(disc, scene.geometry, degree, orders or (0, m, 2 * m), n_phi, equator)
+    mode = basis.carried(m, perturbation, mode)[basis.kept(m)]
     mode = basis.with_mode(np.zeros(basis.size), m, mode / np.sqrt(mode @ basis.gram(m) @ mode))
     return basis, basis.axisymmetric(branch.disc.transfer(bp.X[:-1], disc)), mode
 
 
 def switched_point(scene, branch, bp, amplitude: float, orders: tuple | None = None, n_phi: int = 0,
-                   tol: float = 1e-12, max_iter: int = 30, whole: bool = False) -> SwitchedPoint:
+                   tol: float = 1e-12, max_iter: int = 30, whole: bool = False,
+                   kind: type = CapsuleSurfaceBasis) -> SwitchedPoint:
     """The point of amplitude ε = ``amplitude`` (≠ 0) on the branch born at the located m ≥ 1 point ``bp`` of the
-    capsule's axisymmetric ``branch`` (``start``), solved by switching.point_at_amplitude
+    axisymmetric ``branch`` (``start``, ``kind`` its basis), solved by switching.point_at_amplitude
     (φᵀ G c_m = ε, the m = 1 zero modes gauged)."""
-    return _switched(scene, branch, bp, start(scene, branch, bp, orders, n_phi, whole), amplitude, tol, max_iter)
+    return _switched(scene, branch, bp, start(scene, branch, bp, orders, n_phi, whole, kind), amplitude, tol,
+                     max_iter)
 
 
 def _switched(scene, branch, bp, started: tuple, amplitude: float, tol: float, max_iter: int) -> SwitchedPoint:
@@ -260,13 +279,15 @@ def _switched(scene, branch, bp, started: tuple, amplitude: float, tol: float, m
 
 
 def traced_branch(scene, branch, bp, direction: float = 1.0, max_points: int | None = None,
-                  orders: tuple | None = None, parent: tuple | None = None, progress=None):
-    """The branch born at the located m ≥ 1 point ``bp`` of the capsule's ``branch``, traced in P from its switched
+                  orders: tuple | None = None, parent: tuple | None = None, progress=None,
+                  kind: type = CapsuleSurfaceBasis):
+    """The branch born at the located m ≥ 1 point ``bp`` of the capsule's (``kind``: its CapsuleSurfaceBasis) or
+    the sphere's (sphere.SphereSurfaceBasis) ``branch``, traced in P from its switched
     point at ε = START_AMPLITUDE (trace.trace_from: refined by capsule_resolution, its mirror sector's
     stability read at every point; ``progress`` told of every traced point); SurfaceBranchStartError where the
     switched point does not converge."""
     solver = scene.solver
-    started = start(scene, branch, bp, orders)
+    started = start(scene, branch, bp, orders, kind=kind)
     first = _switched(scene, branch, bp, started, direction * START_AMPLITUDE, solver.tol, solver.max_newton)
     _, zero, mode = started
     return trace_from(scene, first, mode, zero, bp.X[-1], branch.params_at(bp.X), capsule_resolution, direction,

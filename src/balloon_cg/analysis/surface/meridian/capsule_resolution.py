@@ -16,7 +16,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...stability.capsule_basis import capsule_basis
 
 MAX_DEGREE = 256  # the finest degree the policy raises the disc or the perturbation bases to
 MAX_HARMONICS = 16  # the most multiples k of the branch's order m (orders 0, m, …, km)
@@ -50,7 +49,7 @@ def tails(basis, c: np.ndarray) -> tuple:
     lost = [0.0]
     for m in basis.orders[1:]:
         b, full = basis.perturbations(m), _full(basis, m, c[basis.block(m)])
-        lower = capsule_basis(m, basis.mode_degree - DEGREE_STEP, basis.geometry)
+        lower = basis.perturbations(m, basis.mode_degree - DEGREE_STEP)
         back = lower.displacement(projected(full, b.displacement, lower), b.theta)
         here = np.array(b.displacement(full, b.theta))
         lost.append(np.sqrt(0.5 * area @ ((here - back) ** 2).sum(axis=0)))
