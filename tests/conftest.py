@@ -58,7 +58,9 @@ COST = {  # CPU seconds of each file in one run of the default suite on 2 worker
 def byte_compiled() -> list[Path]:
     """The bytecode files written for this tree's modules that had none (``py_compile``, timestamp-checked as Python
     writes them), when Python itself writes none (``sys.dont_write_bytecode``) and balloon_cg is imported from this
-    tree (an editable install: a wheel's install is compiled by pip); else nothing."""
+    tree (an editable install: a wheel's install is compiled by pip); else nothing. A tree it cannot write (read-only)
+    stops it: what it wrote until then is returned (removed at the session's end); a session killed before its end
+    leaves them, as Python's own bytecode (timestamp-checked, gitignored)."""
     spec = importlib.util.find_spec("balloon_cg")
     if not sys.dont_write_bytecode or spec is None or not Path(spec.origin).is_relative_to(ROOT / "src"):
         return []
@@ -66,7 +68,11 @@ def byte_compiled() -> list[Path]:
     for source in sorted(path for folder in COMPILED for path in (ROOT / folder).rglob("*.py")):
         bytecode = Path(importlib.util.cache_from_source(source))
         if not bytecode.exists():
-            py_compile.compile(str(source), cfile=str(bytecode), doraise=True)
+            try:
+                py_compile.compile(str(source), cfile=str(bytecode), doraise=True,
+                                   invalidation_mode=py_compile.PycInvalidationMode.TIMESTAMP)
+            except OSError:  # a read-only tree: the processes compile as they did
+                break
             written.append(bytecode)
     return written
 

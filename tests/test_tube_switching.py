@@ -172,3 +172,40 @@ def test_a_branch_that_cannot_start_is_listed_and_the_run_is_incomplete(tmp_path
     assert "not started    bulge_2: the first step" in text
     assert ("result         incomplete: not_started (bulge_2: the first step of the bulge branch did not converge: "
             "forced)") in text and bool(run["attrs"]["complete"]) is False
+
+
+@pytest.mark.parametrize("failure", ["not_started", "unresolved"])
+def test_continue_exits_by_the_verdict_it_stores(tmp_path, monkeypatch, capsys, failure):
+    """``continue`` at the onset label writes the verdict ``run`` would (tube/picture.gaps) and exits by it, as ``run``:
+    1 with one line where the bulge branch did not start (a KeyError, exit 3, before) or stopped unresolved (exit 0,
+    before, though the file said incomplete)."""
+    from balloon_cg.app.cli import main
+    from balloon_cg.io.tube_file import read_tube_run, tube_labels
+    from balloon_cg.numerics.continuation import Stop
+    from balloon_cg.tube import picture
+    from balloon_cg.tube.bulge import BranchStartError
+
+    scene = tmp_path / "t.toml"
+    scene.write_text('[material]\npreset = "SPOM1"\n[geometry]\nshape = "tube"\nlength = 10.0\n[solver]\ndegree = 16\n'
+                     "[continuation]\nstop_stretch = 3.0\nstep_max = 0.5\n[stability]\nm_max = 0\n")
+    whole = tmp_path / "whole.h5"
+    assert main(["run", str(scene), "-o", str(whole), "--quiet", "--primary-only"]) == 0
+    label = next(i for i, (name, _, s) in enumerate(tube_labels(read_tube_run(whole)))
+                 if name == "primary" and (s["kind"], s["block"]) == ("BP", "odd"))
+    traced = picture.traced_bulge
+
+    def failing(scene, primary, point, **kwargs):
+        if failure == "not_started":
+            raise BranchStartError("the first step of the bulge branch did not converge: forced")
+        found = traced(scene, primary, point, **kwargs)
+        return (*found[:-1], replace(found[-1], stop=Stop(IntervalStop.UNRESOLVED, "forced at the cap")))
+
+    monkeypatch.setattr(picture, "traced_bulge", failing)
+    out = tmp_path / "c.h5"
+    capsys.readouterr()
+    assert main(["continue", str(whole), str(label), "-o", str(out)]) == 1
+    err = capsys.readouterr().err.strip()
+    stored = read_tube_run(out)["attrs"]
+    assert len(err.splitlines()) == 1 and err.startswith("balloon-cg: incomplete (") and bool(stored["complete"]) is False
+    assert list(stored["incomplete_gaps"]) == ["not_started" if failure == "not_started" else "stopped_short"]
+    assert ("not started: bulge: the first step" if failure == "not_started" else "bulge: forced at the cap, after") in err

@@ -16,7 +16,6 @@ def run_tube(scene, output, args) -> int:
     ``not_started``) or the bulge branch stopped unresolved at its cap (solver.tube_resolution "elements", the
     default: the element layout's, tube/front.element_cap; "refine": solver.max_degree, tube/resolution.py), saying so in one line."""
     from ..dynamics.tube import with_frequencies
-    from ..analysis.verdict import Gap
     from ..tube.picture import tube_picture
     from .tube_summary import format_tube, summarise_tube
 
@@ -30,13 +29,22 @@ def run_tube(scene, output, args) -> int:
         return code
     if summary is not None:
         print(summary)
-    a = run["attrs"]  # the verdict write_tube stored (tube/picture.gaps; a signal's was answered above)
+    return stored_verdict_status(run, output, args)
+
+
+def stored_verdict_status(run: dict, output, args) -> int:
+    """0 for a tube run file whose stored verdict (tube/picture.gaps; a signal's answered before, by
+    ``interrupted_status``) is complete; else one line on stderr naming what is missing and 1 (0 with
+    --allow-partial, where the command has it)."""
+    from ..analysis.verdict import Gap
+
+    a = run["attrs"]
     missing = [f"not started: {branch}: {why}" if gap == Gap.NOT_STARTED else f"{branch}: {why}"
                for gap, branch, why in zip(a["incomplete_gaps"], a["incomplete_branches"], a["incomplete_messages"])]
     if not missing:
         return 0
     print(f"{PROG}: incomplete ({'; '.join(missing)}); the rest is written to {output}", file=sys.stderr)
-    return 0 if args.allow_partial else 1
+    return 0 if getattr(args, "allow_partial", False) else 1
 
 
 ONSET_PARAMETERS = {"M": "M", "field.M": "M", "voltage": "voltage", "electric.voltage": "voltage",
@@ -167,7 +175,8 @@ def continue_tube(args) -> int:
     uniform primary branch (sliding ends, no field), the branch switched there (tube/bulge.py; named as ``run`` names it:
 tube/picture.branch_name), with the file's scene and the command line's continuation settings (``--set continuation.stop_stretch=6``:
     traced further than the file's), or with ``--parameter M`` the onset followed in M (as ``critical``); written with
-    the stored primary branch to a tube run file (130 on a signal, as ``run``); with ``--parameter voltage`` from a
+    the stored primary branch to a tube run file (130 on a signal; 1 where its verdict is incomplete, a branch not
+    started or stopped unresolved: as ``run``); with ``--parameter voltage`` from a
     user point (UZ) of the primary branch, the tube continued in Φ̄ at its P (``_continue_in_voltage``). Exit 2,
     before any work, for another label, a setting outside [continuation], another parameter, or no coils for M."""
     from ..dynamics.tube import with_frequencies
@@ -222,12 +231,13 @@ tube/picture.branch_name), with the file's scene and the command line's continua
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
         return code
-    grown = written["onset"] if in_field else written["branches"][branch_name(primary, k)]
-    size = len(grown["q"] if in_field else grown["pressure"])
-    print(f"{'onset curve in M' if in_field else 'branch ' + branch_name(primary, k)} from label {args.label}: "
-          f"{size} points, stop "
-          f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
-    return 0
+    grown = written["onset"] if in_field else written["branches"].get(branch_name(primary, k))
+    if grown is not None:  # (a branch that did not start is none: the verdict names it)
+        size = len(grown["q"] if in_field else grown["pressure"])
+        print(f"{'onset curve in M' if in_field else 'branch ' + branch_name(primary, k)} from label {args.label}: "
+              f"{size} points, stop "
+              f"{grown['attrs']['stop_code']} ({grown['attrs']['stop_message']}); written to {args.output}")
+    return stored_verdict_status(written, args.output, args)
 
 
 VOLTAGE_NAMES = ("voltage", "electric.voltage")  # continue --parameter
@@ -323,7 +333,7 @@ def at_fixed_scene(args, run: dict, labels: list, scene) -> None:
 def _at_fixed_pressure(args, scene, picture, pressure: float, column: str, symbol: str) -> int:
     """``picture()``, the file's primary branch continued from label ``args.label`` in ``column`` (voltage,
     axial_stretch) at the fixed ``pressure``, written to ``args.output`` (130 on a signal, as ``run``) and said in one
-    line: its points, the range of ``symbol`` and its stop."""
+    line: its points, the range of ``symbol`` and its stop; 1 where the file's verdict is incomplete, as ``run``."""
     written, _, signalled = _written(args.output, args, picture, scene)
     code = interrupted_status(written, args.output, signalled)
     if code is not None:
@@ -332,7 +342,7 @@ def _at_fixed_pressure(args, scene, picture, pressure: float, column: str, symbo
     print(f"{column} continuation from label {args.label} at P = {pressure:.10g}: {len(grown['pressure'])} points, "
           f"{symbol} {grown[column].min():.6g}..{grown[column].max():.6g}, stop {grown['attrs']['stop_code']} "
           f"({grown['attrs']['stop_message']}); written to {args.output}")
-    return 0
+    return stored_verdict_status(written, args.output, args)
 
 
 def stored_scene(args, run: dict):

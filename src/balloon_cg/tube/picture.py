@@ -88,7 +88,9 @@ class TubePicture:
 def gaps(picture: TubePicture) -> list[Incomplete]:
     """What a tube run lacks (its file's verdict, io/tube_file.py; ``run`` exits 130 for a signal, 1 for the others; a
     sweep member is stored incomplete): the stage a signal stopped, each switched branch that did not start, each
-    branch stopped unresolved (IntervalStop.UNRESOLVED: at its layout's cap) after its resolved points."""
+    branch stopped unresolved (IntervalStop.UNRESOLVED: at its layout's cap) after its resolved points. Not assessed
+    here: a ``critical`` run's onset curve (its command's exit says whether it turned back, resolved) and the [surface]
+    branches (their stops stored with them)."""
     stopped = picture.interrupted
     return ([Incomplete(Gap.INTERRUPTED, stopped.value, f"interrupted by a signal during {stopped.value}")]
             if stopped else []) + [Incomplete(Gap.NOT_STARTED, name, why) for name, why in picture.not_started] + [
