@@ -316,3 +316,24 @@ def test_events_are_located_on_it_stored_and_shown(run, tmp_path, capsys):
     assert np.array_equal(stored[0]["coefficients"], volume.coefficients)
     assert main(["inspect", str(path)]) == 0
     assert f"UZ after point 1    P = {volume.pressure:.10g}" in capsys.readouterr().out
+
+
+def test_an_event_not_landed_on_makes_the_result_incomplete_once():
+    """analysis/picture.meridian_gaps: a UZ point of a capsule's surface branch that Newton did not land on is an
+    APPROXIMATE gap (the run exits 1), as a sphere's surface branch's; named on the traced branch only (its image's
+    events are the same points, rotated); a landed one is none."""
+    from types import SimpleNamespace
+
+    from balloon_cg.analysis.picture import meridian_gaps
+    from balloon_cg.analysis.results import IntervalStop
+    from balloon_cg.analysis.verdict import Gap, failing
+    from balloon_cg.numerics.continuation import Stop
+
+    def branch(image_of, *located):
+        events = tuple(SimpleNamespace(index=k, note=f"volume = {k}", located=ok) for k, ok in enumerate(located))
+        return SimpleNamespace(stop=Stop(IntervalStop.REJOINED, "rejoined"), limited=False, events=events,
+                               image_of=image_of)
+
+    found = meridian_gaps({"m1_bp0": branch("", True, False), "m1_bp0_rotated": branch("m1_bp0", True, False)})
+    assert [(g.gap, g.branch, g.message) for g in found] == [(Gap.APPROXIMATE, "m1_bp0", "UZ after point 1: volume = 1")]
+    assert failing(found) and meridian_gaps({"m1_bp0": branch("", True, True)}) == []

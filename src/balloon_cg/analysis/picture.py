@@ -171,13 +171,17 @@ MERIDIAN_ENDS = (IntervalStop.REJOINED, IntervalStop.HOOP_STRETCH, StopCode.INTE
 def meridian_gaps(branches: dict) -> list[Incomplete]:
     """What a capsule's non-axisymmetric branches (name -> MeridianSurfaceBranch) lack: LIMITED where one ended at
     [surface] max_points or its basis' cap (stated), STOPPED_SHORT where it stopped otherwise before its ends
-    (MERIDIAN_ENDS: back through the axisymmetric states, stop_stretch, or a signal, which the picture states)."""
+    (MERIDIAN_ENDS: back through the axisymmetric states, stop_stretch, or a signal, which the picture states),
+    APPROXIMATE for each [[events]] UZ point Newton did not land on (as a sphere's surface branch's; listed once, on
+    the traced branch: an image's events are its source's, rotated)."""
     found = []
     for name, branch in branches.items():
         if branch.stop.code == TraceStop.MAX_POINTS or branch.limited:
             found.append(Incomplete(Gap.LIMITED, name, branch.stop.message))
         elif branch.stop.code not in MERIDIAN_ENDS:
             found.append(Incomplete(Gap.STOPPED_SHORT, name, branch.stop.message))
+        found += [Incomplete(Gap.APPROXIMATE, name, f"UZ after point {event.index}: {event.note}")
+                  for event in branch.events if not event.located and not branch.image_of]
     return found
 
 

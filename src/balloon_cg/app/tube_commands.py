@@ -39,6 +39,8 @@ def stored_verdict_status(run: dict, output, args) -> int:
     from ..analysis.verdict import Gap
 
     a = run["attrs"]
+    if a["complete"]:  # (a stated limitation alone leaves it complete)
+        return 0
     missing = [f"not started: {branch}: {why}" if gap == Gap.NOT_STARTED else f"{branch}: {why}"
                for gap, branch, why in zip(a["incomplete_gaps"], a["incomplete_branches"], a["incomplete_messages"])]
     if not missing:
@@ -55,8 +57,8 @@ def critical_tube(scene, output, args) -> int:
     """``critical`` on a tube (tube/onset.py): the primary branch, its first odd branch point (the onset of bulging)
     followed in M, the voltage Φ̄ or the held ends' distance λ (axial_stretch), written with the primary branch to the
     tube run file ``output`` (its /onset group) and summarised. Exit 0 with ``critical M = ...`` where the curve turns
-    back in the parameter (its first located fold, the first turning point in the --direction; printed, but exit 1
-    with a line on stderr where its state is not resolved, its Legendre tail above solver.max_error), 1 (the file
+    back in the parameter (its first fold, the first turning point in the --direction, with its status; printed,
+    but exit 1 with a line on stderr where its state is not resolved, its Legendre tail above solver.max_error), 1 (the file
     still written) where it does not (the line
     says the curve was traced one way from the scene's value, as every critical curve, and --direction the other); 1
     without a file where the primary branch has no odd branch point; 2 for anything but the onset (--of BP) in M,
