@@ -161,25 +161,39 @@ def rank_of(rows, rcond: float = RCOND) -> int:
 
 
 @njit(cache=True)
-def _reflect_rows(directions, rcond, rows):
-    """The rows w of ``rows`` through the reflections ``_reflect`` makes of ``directions``: (Q w)[1:] each time."""
+def _householder_vectors(directions, rcond):
+    """The Householder vectors v_r of the reflections ``_reflect`` makes of ``directions`` (orthonormalised): v_0
+    maps the first direction to ∓e₁, v_r the r-th one, reflected by the r earlier ones and its first r coordinates
+    dropped (each v_r of length n − r)."""
     D = orthonormal_rows(directions, rcond)
-    W = rows.copy()
+    vectors = []
     for r in range(D.shape[0]):
         n = D.shape[1]
         v = _householder(D[r])
+        vectors.append(v)
         w = 2.0 / _dot(v, v)
         rest = np.empty((D.shape[0], n - 1))
         for s in range(r + 1, D.shape[0]):
             projected = _dot(D[s], v)
             for i in range(1, n):
                 rest[s, i - 1] = D[s, i] - w * v[i] * projected
+        D = rest
+    return vectors
+
+
+@njit(cache=True)
+def _reflect_rows(directions, rcond, rows):
+    """The rows w of ``rows`` through the reflections ``_reflect`` makes of ``directions``: (Q w)[1:] each time."""
+    W = rows.copy()
+    for v in _householder_vectors(directions, rcond):
+        n = v.size
+        w = 2.0 / _dot(v, v)
         moved = np.empty((W.shape[0], n - 1))
         for s in range(W.shape[0]):
             projected = _dot(W[s], v)
             for i in range(1, n):
                 moved[s, i - 1] = W[s, i] - w * v[i] * projected
-        D, W = rest, moved
+        W = moved
     return W
 
 
@@ -612,21 +626,9 @@ def _reflect(B, directions, rcond):
 def _reflect_back(directions, rcond, Y):
     """The rows y of Y (m × (n − k)) in the coordinates of ``_reflect``'s result moved back to the n of its input:
     y ← Q (0, y) for each of its k reflections Q, the last first (orthogonal to the ``directions``)."""
-    D = orthonormal_rows(directions, rcond)
-    k, n = D.shape
-    reflections = []
-    for r in range(k):
-        v = _householder(D[r])
-        reflections.append(v)
-        w = 2.0 / _dot(v, v)
-        rest = np.empty((k, n - r - 1))
-        for s in range(r + 1, k):
-            projected = _dot(D[s], v)
-            for i in range(1, n - r):
-                rest[s, i - 1] = D[s, i] - w * v[i] * projected
-        D = rest
+    reflections = _householder_vectors(directions, rcond)
     out = Y.copy()
-    for r in range(k - 1, -1, -1):
+    for r in range(len(reflections) - 1, -1, -1):
         v = reflections[r]
         w = 2.0 / _dot(v, v)
         moved = np.zeros((out.shape[0], out.shape[1] + 1))
