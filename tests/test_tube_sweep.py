@@ -29,19 +29,26 @@ def folder(tmp_path_factory):
     return folder
 
 
+@pytest.fixture(scope="module")
+def alone(folder) -> list:
+    """Each member's scene run alone by ``balloon-cg run`` (its tube run file), once for the tests that compare."""
+    paths = [folder / f"alone_{index}.h5" for index in range(len(LENGTHS))]
+    for path, length in zip(paths, LENGTHS):
+        assert main(["run", str(folder / "t.toml"), "--set", f"geometry.length={length}", "-o", str(path),
+                     "--quiet"]) == 0
+    return paths
+
+
 def sweep_argv(folder: Path, output: str, workers: str = "1") -> list:
     return ["sweep", str(folder / "t.toml"), *VARY, "-o", str(folder / output), "--workers", workers]
 
 
-def test_each_member_is_the_run_of_its_scene_alone(folder):
+def test_each_member_is_the_run_of_its_scene_alone(folder, alone):
     sweep = bc.load(folder / "serial.h5")
     table = sweep.to_dataframe()
     assert list(table["geometry.length"]) == list(LENGTHS) and table.complete.all()
-    for index, length in enumerate(LENGTHS):
-        alone = folder / f"alone_{index}.h5"
-        assert main(["run", str(folder / "t.toml"), "--set", f"geometry.length={length}", "-o", str(alone),
-                     "--quiet"]) == 0
-        run = read_tube_run(alone)
+    for index, path in enumerate(alone):
+        run = read_tube_run(path)
         member = sweep.members[index]
         assert set(member.branches) == set(run["branches"]) and {"primary", "bulge"} < set(run["branches"])
         for name, branch in run["branches"].items():
@@ -75,7 +82,7 @@ def test_the_same_command_resumes_and_two_workers_give_the_same_members(folder, 
     assert serial.to_dataframe().equals(pool.to_dataframe())
 
 
-def test_inspect_summarises_every_member_by_its_tube_summary(folder, capsys):
+def test_inspect_summarises_every_member_by_its_tube_summary(folder, alone, capsys):
     """``inspect`` of a tube sweep (text and --json): per member its verdict, branches and the primary's summary,
     the one ``inspect`` gives the member's own run (app/tube_summary.py; a sphere's branch summary read attributes a
     tube branch does not store: KeyError, exit 3, before)."""
@@ -89,10 +96,8 @@ def test_inspect_summarises_every_member_by_its_tube_summary(folder, capsys):
     for index, length in enumerate(LENGTHS):
         member = members[str(index)]
         assert f"member {index:<4} geometry.length = {length:g}: complete" in text and member["complete"]
-        alone = main(["run", str(folder / "t.toml"), "--set", f"geometry.length={length}", "-o",
-                      str(folder / f"inspected_{index}.h5"), "--quiet"])
-        whole = summarise_tube(read_tube_run(folder / f"inspected_{index}.h5"))
-        assert alone == 0 and member["primary"] == json.loads(json.dumps(whole["branches"]["primary"]))
+        whole = summarise_tube(read_tube_run(alone[index]))
+        assert member["primary"] == json.loads(json.dumps(whole["branches"]["primary"]))
         assert (whole["complete"], whole["result"]) == (True, "complete")  # the run file's stored verdict
         assert member["branches"] == {name: len(b["pressure"]) for name, b in sweep.members[index].branches.items()}
 

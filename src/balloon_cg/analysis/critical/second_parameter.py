@@ -130,14 +130,17 @@ def parameter_keys(scene, kernels: KernelSet | None = None) -> dict[str, str]:
 
 
 def resolve(scene, key: str, kernels: KernelSet | None = None) -> str:
-    """The canonical key of ``key``; UnknownParameter, one line listing the scene's keys, if it names none."""
+    """The canonical key of ``key``; UnknownParameter, one line listing the scene's keys, if it names none, or
+    naming the shape if it is an Ogden exponent (alpha1, material.alpha[i]: the general kernel class) of a scene
+    other than the sphere."""
     keys = parameter_keys(scene, kernels)
     if key not in keys:
         listed = ", ".join(k for k, c in keys.items() if k == c)
         raise UnknownParameter(f"second parameter {key!r}: not a runtime parameter of scene {scene.name}; its "
                                f"parameters: {listed}")
     canonical = keys[key]
-    exponent = canonical == ALPHA1 or (_TERM.fullmatch(canonical) or [None, None])[1] == "alpha"
+    term = _TERM.fullmatch(canonical)
+    exponent = canonical == ALPHA1 or (term is not None and term.group(1) == "alpha")
     if exponent and scene.geometry.shape != Shape.SPHERE:
         raise UnknownParameter(f"second parameter {key!r}: an Ogden exponent is followed on the general kernel "
                                f"class, which is committed for the sphere only: scene {scene.name} is a "
